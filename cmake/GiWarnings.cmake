@@ -1,0 +1,16 @@
+# Warnings and sanitizers for project code, through INTERFACE targets (never applied to
+# third-party headers, which are included as SYSTEM).
+add_library(gi_warnings INTERFACE)
+target_compile_options(gi_warnings INTERFACE
+  -Wall -Wextra -Wpedantic -Wshadow -Wnon-virtual-dtor -Wcast-align -Woverloaded-virtual
+  -Wnull-dereference -Wdouble-promotion -Wformat=2 -Wimplicit-fallthrough)
+if(GI_WERROR)
+  target_compile_options(gi_warnings INTERFACE -Werror)
+endif()
+
+add_library(gi_sanitize INTERFACE)
+if(GI_SANITIZE)
+  target_compile_options(gi_sanitize INTERFACE -fsanitize=address,undefined -fno-omit-frame-pointer
+                         -fno-sanitize-recover=undefined)
+  target_link_options(gi_sanitize INTERFACE -fsanitize=address,undefined)
+endif()

@@ -1,0 +1,102 @@
+#pragma once
+// Plain scene data as stored in a glTF file: meshes, materials, images, lights, cameras
+// and the node hierarchy. The loader fills it, the writer writes it, instantiate() turns
+// it into entities. Bakers read the meshes from here, never from the registry.
+//   engine::Result<engine::SceneAsset> a = engine::load_gltf("assets/cornell_box.gltf");
+//   engine::Scene scene = engine::instantiate(std::move(a.value()));
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+#include <glm/gtc/quaternion.hpp>
+
+#include <engine/components.h>
+
+namespace engine {
+
+/// A decoded image, 8-bit RGBA (4 channels), rows top to bottom as in the file.
+struct Image {
+  std::string name;
+  std::string uri;  ///< Original URI (empty for embedded images).
+  int width = 0;
+  int height = 0;
+  std::vector<std::uint8_t> rgba8;
+};
+
+/// Metallic-roughness material. Colours are linear; textures index SceneAsset::images
+/// (-1: none). Base colour and emissive textures are sRGB-encoded, the others linear.
+struct Material {
+  std::string name;
+  glm::vec4 base_color{1.0f};
+  float metallic = 0.0f;
+  float roughness = 1.0f;
+  /// Emitted radiance, W/(m^2 sr) (glTF emissiveFactor x KHR_materials_emissive_strength).
+  glm::vec3 emissive{0.0f};
+  int base_color_texture = -1;
+  int metallic_roughness_texture = -1;
+  int normal_texture = -1;
+  int emissive_texture = -1;
+  bool double_sided = false;
+};
+
+/// One triangle list. positions are required; normals, uv0 and uv1 are empty or have one
+/// entry per position. uv1 is the light-atlas parameterization (TEXCOORD_1) when present.
+struct Primitive {
+  std::vector<glm::vec3> positions;
+  std::vector<glm::vec3> normals;
+  std::vector<glm::vec2> uv0;
+  std::vector<glm::vec2> uv1;
+  std::vector<std::uint32_t> indices;
+  int material = -1;  ///< Index into SceneAsset::materials; -1 uses a default material.
+};
+
+struct Mesh {
+  std::string name;
+  std::vector<Primitive> primitives;
+};
+
+/// How GI treats a node, from the glTF node's extras ("gi": {...}, see docs/scene-format.md).
+enum class Mobility : std::uint8_t { Unspecified, Static, Dynamic };
+
+struct NodeGiFlags {
+  Mobility mobility = Mobility::Unspecified;
+};
+
+/// A node of the hierarchy. `parent` is -1 for roots; children follow from parents.
+struct Node {
+  std::string name;
+  int parent = -1;
+  glm::vec3 translation{0.0f};
+  glm::quat rotation{1.0f, 0.0f, 0.0f, 0.0f};
+  glm::vec3 scale{1.0f};
+  int mesh = -1;    ///< Index into SceneAsset::meshes.
+  int light = -1;   ///< Index into SceneAsset::lights.
+  int camera = -1;  ///< Index into SceneAsset::cameras.
+  NodeGiFlags gi;
+};
+
+struct NamedLight {
+  std::string name;
+  Light light;  ///< Engine units (engine/units.h); `moves` comes from the node's extras.
+};
+
+struct NamedCamera {
+  std::string name;
+  Camera camera;
+};
+
+/// Everything a glTF scene file holds that the engine uses.
+struct SceneAsset {
+  std::string source;  ///< The file it was loaded from (for messages), or empty.
+  std::vector<Mesh> meshes;
+  std::vector<Material> materials;
+  std::vector<Image> images;
+  std::vector<NamedLight> lights;
+  std::vector<NamedCamera> cameras;
+  std::vector<Node> nodes;  ///< Parents come before their children.
+};
+
+}  // namespace engine

@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# Installs every build and test dependency of the project from Debian's packages.
+# Idempotent: packages already present are left alone; `apt-get update` runs once.
+set -euo pipefail
+packages=(
+  build-essential cmake ninja-build pkg-config git
+  libembree-dev libglm-dev libtinygltf-dev libdraco-dev libstb-dev nlohmann-json3-dev
+  libglfw3-dev libegl-dev libgl-dev libgl1-mesa-dri libegl-mesa0 libgles-dev
+  libgtest-dev libgmock-dev libbenchmark-dev
+  libeigen3-dev libzstd-dev libtinyexr-dev libcli11-dev libimgui-dev libtbb-dev
+  xvfb xauth
+)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all ${#packages[@]} packages present"
+  exit 0
+fi
+SUDO=""
+[ "$(id -u)" -eq 0 ] || SUDO="sudo"
+echo "install-deps: installing ${missing[*]}"
+$SUDO apt-get update -qq
+DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
