@@ -1,0 +1,37 @@
+#pragma once
+// CPU images and their files: tonemapped PNG and linear OpenEXR.
+//   engine::ImageRgba8 ldr = renderer.read_ldr();
+//   engine::save_png("frame_0001.png", ldr);
+
+#include <cstdint>
+#include <filesystem>
+#include <vector>
+
+#include <engine/result.h>
+
+namespace engine {
+
+/// 8-bit RGBA, sRGB-encoded, rows top to bottom.
+struct ImageRgba8 {
+  int width = 0;
+  int height = 0;
+  std::vector<std::uint8_t> pixels;  ///< width*height*4
+};
+
+/// 32-bit float RGBA, linear, rows top to bottom.
+struct ImageRgbaF {
+  int width = 0;
+  int height = 0;
+  std::vector<float> pixels;  ///< width*height*4
+};
+
+/// Writes a PNG (temporary file + rename).
+Status save_png(const std::filesystem::path& path, const ImageRgba8& image);
+/// Reads a PNG into RGBA8.
+Result<ImageRgba8> load_png(const std::filesystem::path& path);
+/// Writes a linear OpenEXR (half floats, RGBA; temporary file + rename).
+Status save_exr(const std::filesystem::path& path, const ImageRgbaF& image);
+/// Reads an OpenEXR into RGBA32F.
+Result<ImageRgbaF> load_exr(const std::filesystem::path& path);
+
+}  // namespace engine

@@ -1,0 +1,45 @@
+#pragma once
+// The hook through which indirect light enters the engine's shading. The engine declares
+// it; the gi library implements it; the game wires the two together. The engine never
+// includes gi.
+//   class MyGi : public engine::IndirectLightProvider { ... };
+//   renderer.set_indirect_light(&my_gi);   // nullptr: the labelled constant-ambient stand-in
+
+#include <cstdint>
+
+#include <engine/entity.h>
+
+namespace engine {
+
+/// What a provider hands the renderer for one frame. GL object names are owned by the
+/// provider and stay valid until its next update. 0 means "not provided".
+struct IndirectLightFrame {
+  /// RGBA16F/RGBA32F 2-D texture of indirect irradiance (W/m^2, linear RGB) sampled with
+  /// TEXCOORD_1 of static meshes. Shading uses albedo/pi x irradiance.
+  std::uint32_t irradiance_atlas_texture = 0;
+  /// Per-vertex indirect irradiance of a dynamic mesh entity: an SSBO of vec4 (W/m^2 in
+  /// xyz), one per vertex of the entity's mesh, primitives concatenated in order.
+  /// Returns 0 when the entity has none.
+  virtual std::uint32_t vertex_irradiance_buffer(Entity) const { return 0; }
+  /// Optional glossy (view-dependent) indirect term: an RGBA16F screen-sized texture of
+  /// reflected radiance added after direct light. 0: none.
+  std::uint32_t glossy_radiance_texture = 0;
+
+  IndirectLightFrame() = default;
+  IndirectLightFrame(const IndirectLightFrame&) = default;
+  IndirectLightFrame& operator=(const IndirectLightFrame&) = default;
+  virtual ~IndirectLightFrame() = default;
+};
+
+/// Implemented by the GI system. The renderer calls `frame()` once per rendered frame,
+/// after the simulation has run, with the GL context current.
+class IndirectLightProvider {
+ public:
+  virtual ~IndirectLightProvider() = default;
+  /// Indirect light for the frame about to be drawn.
+  virtual const IndirectLightFrame& frame() = 0;
+  /// Short label for the overlay ("light atlas", "PRM", ...).
+  virtual const char* label() const = 0;
+};
+
+}  // namespace engine
