@@ -33,6 +33,7 @@ constexpr int kElementArrayBuffer = 34963;
 
 // The shortest decimal that reads back as the same float (0.7f -> 0.7, not 0.699999988).
 json num(float f) {
+  if (f == 0.0f) f = 0.0f;  // no "-0.0" in the files
   char buf[64];
   const auto res = std::to_chars(buf, buf + sizeof buf, f);
   return json(std::strtod(std::string(buf, res.ptr).c_str(), nullptr));
