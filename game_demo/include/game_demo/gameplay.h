@@ -1,0 +1,79 @@
+#pragma once
+// The demo's gameplay: components the demo adds to a scene, and the systems that move the
+// player, switch the flashlight, push crates and integrate their motion.
+//   game_demo::GameplayContext ctx = game_demo::prepare_scene(scene);
+//   game_demo::add_gameplay_systems(schedule, ctx);   // then schedule.run(...) every fixed step
+
+#include <cstdint>
+
+#include <glm/glm.hpp>
+
+#include <engine/scene.h>
+#include <engine/system_schedule.h>
+
+#include <game_demo/collision_world.h>
+#include <game_demo/input_frame.h>
+
+namespace game_demo {
+
+/// First-person control state of the camera entity. The camera's rotation is
+/// yaw (about world +Y) then pitch (about local +X), both in radians.
+struct PlayerController {
+  float yaw_rad = 0.0f;
+  float pitch_rad = 0.0f;
+  float walk_speed_m_s = 3.0f;
+  float look_rad_per_px = 0.0025f;
+  /// The player's collision box relative to the eye (camera position), metres.
+  glm::vec3 box_min_from_eye_m{-0.25f, -1.2f, -0.25f};
+  glm::vec3 box_max_from_eye_m{0.25f, 0.1f, 0.25f};
+};
+
+/// Collision box of a pushable rigid body: world-space AABB centre relative to the
+/// entity's position (RigidBody::half_extents_m gives the size).
+struct CrateShape {
+  glm::vec3 center_offset_m{0.0f};
+};
+
+/// Gameplay tuning constants.
+struct GameplayTuning {
+  float push_reach_m = 2.0f;          ///< Farthest crate surface the push reaches.
+  float push_cone_cos = 0.5f;         ///< Crate centre within 60 degrees of the view direction.
+  float push_impulse_n_s = 3.0f;      ///< Impulse along the horizontal view direction.
+  float crate_damping = 0.9f;         ///< Fraction of crate velocity lost per second.
+  float rest_speed_m_s = 0.05f;       ///< Below this a crate stops exactly.
+  float collision_skin_m = 0.01f;     ///< Crate boxes are shrunk vertically by this (resting contact).
+};
+
+/// The entities and shared data the systems work on, owned by the caller (Simulation);
+/// the systems keep a pointer to it, so it must outlive the schedule.
+struct GameplayContext {
+  engine::Entity camera;
+  engine::Entity flashlight;
+  CollisionWorld collision;
+  GameplayTuning tuning;
+  InputFrame input;                  ///< This step's input (set before each run).
+  std::uint32_t previous_keys = 0;   ///< Last step's held keys.
+  bool split_view = false;           ///< Toggled by G; the renderer reads it.
+
+  bool pressed(Key k) const { return input.held(k) && (previous_keys & key_bit(k)) == 0; }
+};
+
+/// Readies an instantiated scene for play: finds the camera (the node named "camera", else
+/// the first Camera; creates one at the level's centre when there is none), adds its
+/// PlayerController, adds a flashlight (a Spot light child of the camera, moves = true,
+/// switched off) unless a Light entity named "flashlight" exists, gives each DynamicTag
+/// RigidBody a CrateShape and half extents from its mesh bounds, and builds the static
+/// collision world. Leaves world transforms up to date.
+GameplayContext prepare_scene(engine::Scene& scene, const GameplayTuning& tuning = {});
+
+/// Adds, in this order: player_controller (Input), flashlight and split_screen (Gameplay),
+/// push (Gameplay), rigid_bodies (Physics), world_transforms (Transform).
+void add_gameplay_systems(engine::SystemSchedule& schedule, GameplayContext& context);
+
+/// World-space collision box of a crate entity (shrunk vertically by `skin_m`).
+Aabb crate_box(const engine::Registry& registry, engine::Entity crate, float skin_m);
+
+/// Horizontal view direction of a yaw angle (unit length).
+glm::vec3 forward_of_yaw(float yaw_rad);
+
+}  // namespace game_demo

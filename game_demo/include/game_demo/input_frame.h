@@ -1,0 +1,50 @@
+#pragma once
+// One simulation step's worth of player input: held keys and the mouse movement since the
+// previous step. Produced by GLFW (windowed), a ScriptedPilot (headless) or a session file.
+//   game_demo::InputFrame in{.keys = game_demo::key_bit(game_demo::Key::W), .mouse_dx_px = 4.0f};
+//   if (in.held(game_demo::Key::W)) ...
+
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <vector>
+
+namespace game_demo {
+
+/// The keys the demo reacts to. Movement keys act while held; F, E and G act on the step
+/// where they go from released to held (edge-triggered in the gameplay systems).
+enum class Key : std::uint8_t {
+  W = 0,  ///< forward
+  A = 1,  ///< strafe left
+  S = 2,  ///< backward
+  D = 3,  ///< strafe right
+  F = 4,  ///< toggle the flashlight
+  E = 5,  ///< push the crate in front of the camera
+  G = 6,  ///< toggle the split screen (direct only | full)
+};
+inline constexpr int kKeyCount = 7;
+
+/// The bit of `k` in InputFrame::keys.
+constexpr std::uint32_t key_bit(Key k) { return 1u << static_cast<std::uint32_t>(k); }
+
+struct InputFrame {
+  std::uint32_t keys = 0;    ///< Bitmask of held keys (key_bit).
+  float mouse_dx_px = 0.0f;  ///< Mouse movement since the previous step, pixels, +x right.
+  float mouse_dy_px = 0.0f;  ///< Mouse movement since the previous step, pixels, +y down.
+
+  constexpr bool held(Key k) const { return (keys & key_bit(k)) != 0; }
+  friend bool operator==(const InputFrame&, const InputFrame&) = default;
+};
+
+/// Size of one serialized InputFrame in bytes.
+inline constexpr std::size_t kInputFrameBytes = 12;
+
+/// Appends `in` as 12 little-endian bytes: u32 keys, f32 mouse_dx_px, f32 mouse_dy_px
+/// (floats by bit pattern, so the round trip is exact).
+void append_input_frame(std::vector<std::uint8_t>& out, const InputFrame& in);
+
+/// Reads one InputFrame from the first 12 bytes of `bytes`; nullopt when there are fewer
+/// bytes or the key mask has bits no key uses.
+std::optional<InputFrame> read_input_frame(std::span<const std::uint8_t> bytes);
+
+}  // namespace game_demo

@@ -1,0 +1,77 @@
+#pragma once
+// Deterministic input scripts: an autopilot that plays the level like a person would
+// (turning with the mouse, walking with W, pressing F, E and G), so headless runs and the
+// committed sessions are input streams a command can reproduce.
+//   game_demo::ScriptedPilot pilot(sim, game_demo::Script::Tour, 600);
+//   for (int i = 0; i < 600; ++i) sim.step(pilot.next(sim));
+
+#include <cstdint>
+#include <optional>
+#include <string_view>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include <game_demo/input_frame.h>
+#include <game_demo/simulation.h>
+
+namespace game_demo {
+
+/// What a script does within its frame budget.
+enum class Script : std::uint8_t {
+  Tour,            ///< flashlight on, push the nearest crate, split screen on, walk the rooms
+  WalkFlashlight,  ///< walk from room to room, flashlight on then off again
+  PushCrates,      ///< walk to each crate in turn and push it
+  SplitScreen,     ///< walk the rooms toggling the split screen on and off
+};
+
+/// "tour", "walk_flashlight", "push_crates", "split_screen".
+std::optional<Script> script_from_name(std::string_view name);
+std::string_view script_name(Script s);
+
+class ScriptedPilot {
+ public:
+  /// Plans on the simulation's current state: a walkability grid (0.25 m cells) from the
+  /// collision world at the camera's height, waypoints at the level's static lights
+  /// (room centres) and crates. `frames` is the budget the timed key presses scale to.
+  ScriptedPilot(const Simulation& sim, Script script, std::uint64_t frames);
+
+  /// The input for the next step of `sim`.
+  InputFrame next(const Simulation& sim);
+
+  /// Waypoints (world, eye height) in visiting order; for tests and logs.
+  const std::vector<glm::vec3>& waypoints() const { return waypoints_; }
+
+ private:
+  struct Cell {
+    int x = 0, z = 0;
+  };
+  bool walkable(int x, int z) const;
+  std::optional<Cell> nearest_walkable(const glm::vec3& p) const;
+  glm::vec3 cell_center(Cell c) const;
+  std::vector<glm::vec3> find_path(const glm::vec3& from, const glm::vec3& to) const;
+  void start_target(const Simulation& sim);
+
+  Script script_;
+  std::uint64_t budget_;
+  std::uint64_t frame_ = 0;
+  // Grid.
+  glm::vec3 origin_{0.0f};
+  float cell_m_ = 0.25f;
+  int nx_ = 0, nz_ = 0;
+  std::vector<std::uint8_t> free_;
+  // Plan.
+  std::vector<glm::vec3> waypoints_;
+  std::vector<bool> waypoint_is_crate_;
+  std::size_t next_waypoint_ = 0;
+  std::vector<glm::vec3> path_;
+  std::size_t path_index_ = 0;
+  bool has_target_ = false;
+  bool target_is_crate_ = false;
+  glm::vec3 target_{0.0f};
+  std::uint64_t target_frames_ = 0;
+  std::uint64_t wait_until_ = 0;
+  std::vector<std::uint64_t> key_presses_[kKeyCount];
+};
+
+}  // namespace game_demo

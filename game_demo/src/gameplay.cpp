@@ -1,0 +1,242 @@
+#include <game_demo/gameplay.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <glm/gtc/quaternion.hpp>
+
+#include <engine/components.h>
+
+namespace game_demo {
+
+namespace {
+
+constexpr float kMaxPitchRad = 1.45f;
+
+glm::quat rotation_of(float yaw_rad, float pitch_rad) {
+  return glm::angleAxis(yaw_rad, glm::vec3(0, 1, 0)) * glm::angleAxis(pitch_rad, glm::vec3(1, 0, 0));
+}
+
+Aabb player_box(const PlayerController& pc, const glm::vec3& eye) {
+  return {eye + pc.box_min_from_eye_m, eye + pc.box_max_from_eye_m};
+}
+
+std::vector<engine::Entity> crates_of(const engine::Registry& reg) {
+  return reg.view<engine::DynamicTag, engine::RigidBody, engine::Transform>().entities();
+}
+
+// True when moving `mover` from `from` to `to` newly enters another crate's box.
+bool crate_blocks(const engine::Registry& reg, engine::Entity mover, const Aabb& from, const Aabb& to, float skin) {
+  for (engine::Entity c : crates_of(reg)) {
+    if (c == mover) continue;
+    const Aabb b = crate_box(reg, c, skin);
+    if (b.overlaps(to) && !b.overlaps(from)) return true;
+  }
+  return false;
+}
+
+// True when `to` leaves the level's horizontal bounds that `from` was inside.
+bool leaves_bounds(const Aabb& level, const Aabb& from, const Aabb& to) {
+  if (level.empty()) return false;
+  auto inside = [&](const Aabb& b) {
+    return b.min.x >= level.min.x && b.max.x <= level.max.x && b.min.z >= level.min.z && b.max.z <= level.max.z;
+  };
+  return inside(from) && !inside(to);
+}
+
+Aabb mesh_world_bounds(const engine::Scene& scene, engine::Entity e) {
+  Aabb box{glm::vec3(std::numeric_limits<float>::max()), glm::vec3(std::numeric_limits<float>::lowest())};
+  const auto* mr = scene.registry.try_get<engine::MeshRenderer>(e);
+  const auto* wt = scene.registry.try_get<engine::WorldTransform>(e);
+  if (!mr || !wt || mr->mesh >= scene.assets.meshes.size()) return box;
+  for (const engine::Primitive& p : scene.assets.meshes[mr->mesh].primitives)
+    for (const glm::vec3& v : p.positions) {
+      const glm::vec3 w = glm::vec3(wt->matrix * glm::vec4(v, 1.0f));
+      box.min = glm::min(box.min, w);
+      box.max = glm::max(box.max, w);
+    }
+  return box;
+}
+
+void player_controller(engine::Registry& reg, const engine::FrameTime& time, GameplayContext& ctx) {
+  if (!ctx.camera || !reg.has<PlayerController>(ctx.camera)) return;
+  const InputFrame& in = ctx.input;
+  const PlayerController& pc = reg.get<PlayerController>(ctx.camera);
+
+  // Mouse look: only a real change of angle is written.
+  float yaw = pc.yaw_rad - in.mouse_dx_px * pc.look_rad_per_px;
+  float pitch = std::clamp(pc.pitch_rad - in.mouse_dy_px * pc.look_rad_per_px, -kMaxPitchRad, kMaxPitchRad);
+  if (!std::isfinite(yaw) || !std::isfinite(pitch)) yaw = pc.yaw_rad, pitch = pc.pitch_rad;
+  yaw = std::remainder(yaw, 2.0f * glm::pi<float>());
+  if (yaw != pc.yaw_rad || pitch != pc.pitch_rad) {
+    PlayerController& w = reg.write<PlayerController>(ctx.camera);
+    w.yaw_rad = yaw;
+    w.pitch_rad = pitch;
+    reg.write<engine::Transform>(ctx.camera).rotation = rotation_of(yaw, pitch);
+  }
+
+  // Walking: horizontal, one axis at a time so the player slides along walls.
+  const float fwd = (in.held(Key::W) ? 1.0f : 0.0f) - (in.held(Key::S) ? 1.0f : 0.0f);
+  const float side = (in.held(Key::D) ? 1.0f : 0.0f) - (in.held(Key::A) ? 1.0f : 0.0f);
+  if (fwd == 0.0f && side == 0.0f) return;
+  const glm::vec3 forward = forward_of_yaw(yaw);
+  const glm::vec3 right(-forward.z, 0.0f, forward.x);
+  const glm::vec3 step = glm::normalize(forward * fwd + right * side) *
+                         (pc.walk_speed_m_s * static_cast<float>(time.dt_s));
+  glm::vec3 eye = reg.get<engine::Transform>(ctx.camera).position;
+  const glm::vec3 start = eye;
+  for (int axis : {0, 2}) {
+    if (step[axis] == 0.0f) continue;
+    glm::vec3 next = eye;
+    next[axis] += step[axis];
+    const Aabb from = player_box(pc, eye), to = player_box(pc, next);
+    if (ctx.collision.blocks_move(from, to) || leaves_bounds(ctx.collision.level_bounds(), from, to) ||
+        crate_blocks(reg, engine::kNullEntity, from, to, 0.0f))
+      continue;
+    eye = next;
+  }
+  if (eye != start) reg.write<engine::Transform>(ctx.camera).position = eye;
+}
+
+void toggle_flashlight(engine::Registry& reg, GameplayContext& ctx) {
+  if (!ctx.pressed(Key::F) || !ctx.flashlight || !reg.has<engine::Light>(ctx.flashlight)) return;
+  engine::Light& light = reg.write<engine::Light>(ctx.flashlight);
+  light.enabled = !light.enabled;
+}
+
+void push_crate(engine::Registry& reg, GameplayContext& ctx) {
+  if (!ctx.pressed(Key::E) || !ctx.camera) return;
+  const glm::vec3 eye = reg.get<engine::Transform>(ctx.camera).position;  // the player walks in world space
+  const glm::vec3 view = forward_of_yaw(reg.get<PlayerController>(ctx.camera).yaw_rad);
+  engine::Entity best;
+  float best_d = std::numeric_limits<float>::max();
+  for (engine::Entity c : crates_of(reg)) {
+    const Aabb box = crate_box(reg, c, 0.0f);
+    const glm::vec3 closest = glm::clamp(eye, box.min, box.max);
+    const float d = glm::length(closest - eye);
+    glm::vec3 to_center = box.center() - eye;
+    to_center.y = 0.0f;
+    const float len = glm::length(to_center);
+    const bool in_front = len < 1e-4f || glm::dot(to_center / len, view) >= ctx.tuning.push_cone_cos;
+    if (d <= ctx.tuning.push_reach_m && in_front && d < best_d) best_d = d, best = c;
+  }
+  if (!best) return;
+  engine::RigidBody& rb = reg.write<engine::RigidBody>(best);
+  rb.velocity_m_s += view * (ctx.tuning.push_impulse_n_s / std::max(rb.mass_kg, 1e-3f));
+}
+
+void integrate_rigid_bodies(engine::Registry& reg, const engine::FrameTime& time, GameplayContext& ctx) {
+  const float dt = static_cast<float>(time.dt_s);
+  const float skin = ctx.tuning.collision_skin_m;
+  for (engine::Entity c : crates_of(reg)) {
+    const engine::RigidBody& rb = reg.get<engine::RigidBody>(c);
+    if (rb.velocity_m_s == glm::vec3(0.0f)) continue;  // at rest: nothing is written
+    glm::vec3 v = rb.velocity_m_s * std::pow(1.0f - std::clamp(rb.linear_damping, 0.0f, 1.0f), dt);
+    glm::vec3 pos = reg.get<engine::Transform>(c).position;
+    const glm::vec3 start = pos;
+    for (int axis = 0; axis < 3; ++axis) {
+      if (v[axis] == 0.0f) continue;
+      const Aabb from = crate_box(reg, c, skin).shifted(pos - start);
+      const Aabb to = from.shifted(glm::vec3(axis == 0, axis == 1, axis == 2) * (v[axis] * dt));
+      if (ctx.collision.blocks_move(from, to) || crate_blocks(reg, c, from, to, skin)) {
+        v[axis] = 0.0f;  // hit a wall or another crate: stop along this axis
+        continue;
+      }
+      pos[axis] += v[axis] * dt;
+    }
+    if (glm::length(v) < ctx.tuning.rest_speed_m_s) v = glm::vec3(0.0f);
+    reg.write<engine::RigidBody>(c).velocity_m_s = v;
+    if (pos != start) reg.write<engine::Transform>(c).position = pos;
+  }
+}
+
+}  // namespace
+
+glm::vec3 forward_of_yaw(float yaw_rad) { return {-std::sin(yaw_rad), 0.0f, -std::cos(yaw_rad)}; }
+
+Aabb crate_box(const engine::Registry& reg, engine::Entity crate, float skin_m) {
+  const glm::vec3 pos = reg.get<engine::Transform>(crate).position;
+  const glm::vec3 half = reg.get<engine::RigidBody>(crate).half_extents_m - glm::vec3(0.0f, skin_m, 0.0f);
+  const auto* shape = reg.try_get<CrateShape>(crate);
+  const glm::vec3 center = pos + (shape ? shape->center_offset_m : glm::vec3(0.0f));
+  return {center - glm::max(half, glm::vec3(0.0f)), center + glm::max(half, glm::vec3(0.0f))};
+}
+
+GameplayContext prepare_scene(engine::Scene& scene, const GameplayTuning& tuning) {
+  engine::Registry& reg = scene.registry;
+  engine::update_world_transforms(reg);
+  GameplayContext ctx;
+  ctx.tuning = tuning;
+  ctx.collision = CollisionWorld::build(scene);
+
+  // Camera and player.
+  ctx.camera = engine::find_by_name(reg, "camera");
+  if (!ctx.camera || !reg.has<engine::Camera>(ctx.camera)) ctx.camera = engine::find_camera(reg);
+  if (!ctx.camera) {
+    ctx.camera = reg.create();
+    reg.emplace<engine::Name>(ctx.camera, engine::Name{"camera"});
+    const Aabb& b = ctx.collision.level_bounds();
+    engine::Transform t;
+    if (!b.empty()) t.position = glm::vec3(b.center().x, b.min.y + 1.6f, b.center().z);
+    reg.emplace<engine::Transform>(ctx.camera, t);
+    reg.emplace<engine::Camera>(ctx.camera);
+  }
+  const glm::quat q = reg.get<engine::Transform>(ctx.camera).rotation;
+  const glm::vec3 f = q * glm::vec3(0, 0, -1);
+  PlayerController pc;
+  pc.yaw_rad = std::atan2(-f.x, -f.z);
+  pc.pitch_rad = std::asin(std::clamp(f.y, -1.0f, 1.0f));
+  reg.emplace<PlayerController>(ctx.camera, pc);
+
+  // Flashlight.
+  ctx.flashlight = engine::find_by_name(reg, "flashlight");
+  if (!ctx.flashlight || !reg.has<engine::Light>(ctx.flashlight)) {
+    ctx.flashlight = reg.create();
+    reg.emplace<engine::Name>(ctx.flashlight, engine::Name{"flashlight"});
+    reg.emplace<engine::Transform>(ctx.flashlight,
+                                   engine::Transform{.position = {0.15f, -0.15f, 0.0f}, .parent = ctx.camera});
+    reg.emplace<engine::Light>(ctx.flashlight, engine::Light{.type = engine::LightType::Spot,
+                                                             .color = {1.0f, 0.93f, 0.82f},
+                                                             .intensity = 4.0f,
+                                                             .range_m = 20.0f,
+                                                             .inner_cone_rad = 0.22f,
+                                                             .outer_cone_rad = 0.42f,
+                                                             .moves = true,
+                                                             .cast_shadows = true,
+                                                             .enabled = false});
+  } else if (!reg.get<engine::Light>(ctx.flashlight).moves) {
+    reg.write<engine::Light>(ctx.flashlight).moves = true;
+  }
+
+  // Crates: collision boxes from their meshes.
+  for (engine::Entity c : crates_of(reg)) {
+    const Aabb box = mesh_world_bounds(scene, c);
+    if (box.empty()) continue;
+    engine::RigidBody& rb = reg.write<engine::RigidBody>(c);
+    rb.half_extents_m = 0.5f * (box.max - box.min);
+    if (rb.linear_damping == 0.0f) rb.linear_damping = tuning.crate_damping;
+    reg.emplace<CrateShape>(c, CrateShape{box.center() - reg.get<engine::Transform>(c).position});
+  }
+  engine::update_world_transforms(reg);
+  return ctx;
+}
+
+void add_gameplay_systems(engine::SystemSchedule& schedule, GameplayContext& ctx) {
+  GameplayContext* c = &ctx;
+  schedule.add(engine::Stage::Input, "player_controller",
+               [c](engine::Registry& r, const engine::FrameTime& t) { player_controller(r, t, *c); });
+  schedule.add(engine::Stage::Gameplay, "flashlight",
+               [c](engine::Registry& r, const engine::FrameTime&) { toggle_flashlight(r, *c); });
+  schedule.add(engine::Stage::Gameplay, "split_screen", [c](engine::Registry&, const engine::FrameTime&) {
+    if (c->pressed(Key::G)) c->split_view = !c->split_view;
+  });
+  schedule.add(engine::Stage::Gameplay, "push",
+               [c](engine::Registry& r, const engine::FrameTime&) { push_crate(r, *c); });
+  schedule.add(engine::Stage::Physics, "rigid_bodies",
+               [c](engine::Registry& r, const engine::FrameTime& t) { integrate_rigid_bodies(r, t, *c); });
+  schedule.add(engine::Stage::Transform, "world_transforms",
+               [](engine::Registry& r, const engine::FrameTime&) { engine::update_world_transforms(r); });
+}
+
+}  // namespace game_demo

@@ -1,0 +1,264 @@
+#include <game_demo/scripted_pilot.h>
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <limits>
+
+#include <engine/components.h>
+
+namespace game_demo {
+
+namespace {
+
+constexpr float kPi = 3.14159265358979f;
+constexpr float kWantedPitchRad = -0.12f;  // look slightly down: floor, crates and walls in view
+constexpr std::uint64_t kGiveUpFrames = 60 * 25;
+constexpr std::uint64_t kStuckFrames = 45;
+
+float wrap_angle(float a) { return std::remainder(a, 2.0f * kPi); }
+
+float yaw_towards(const glm::vec3& from, const glm::vec3& to) {
+  const glm::vec3 d = to - from;
+  return std::atan2(-d.x, -d.z);
+}
+
+float horizontal_distance(const glm::vec3& a, const glm::vec3& b) { return glm::length(glm::vec2(a.x - b.x, a.z - b.z)); }
+
+// Greedy nearest-neighbour order starting at `from`.
+std::vector<std::size_t> visiting_order(const glm::vec3& from, const std::vector<glm::vec3>& points) {
+  std::vector<std::size_t> order;
+  std::vector<bool> used(points.size(), false);
+  glm::vec3 at = from;
+  for (std::size_t n = 0; n < points.size(); ++n) {
+    std::size_t best = 0;
+    float best_d = std::numeric_limits<float>::max();
+    for (std::size_t i = 0; i < points.size(); ++i)
+      if (!used[i] && horizontal_distance(at, points[i]) < best_d) best_d = horizontal_distance(at, points[i]), best = i;
+    used[best] = true;
+    order.push_back(best);
+    at = points[best];
+  }
+  return order;
+}
+
+}  // namespace
+
+std::optional<Script> script_from_name(std::string_view name) {
+  for (Script s : {Script::Tour, Script::WalkFlashlight, Script::PushCrates, Script::SplitScreen})
+    if (script_name(s) == name) return s;
+  return std::nullopt;
+}
+
+std::string_view script_name(Script s) {
+  switch (s) {
+    case Script::Tour: return "tour";
+    case Script::WalkFlashlight: return "walk_flashlight";
+    case Script::PushCrates: return "push_crates";
+    case Script::SplitScreen: return "split_screen";
+  }
+  return "?";
+}
+
+ScriptedPilot::ScriptedPilot(const Simulation& sim, Script script, std::uint64_t frames)
+    : script_(script), budget_(frames) {
+  const engine::Registry& reg = sim.registry();
+  const GameplayContext& ctx = sim.context();
+  const PlayerController& pc = reg.get<PlayerController>(ctx.camera);
+  const glm::vec3 eye = reg.get<engine::Transform>(ctx.camera).position;
+
+  // Walkability grid over the level bounds at eye height.
+  const Aabb& level = ctx.collision.level_bounds();
+  if (!level.empty()) {
+    const double walls = static_cast<double>(std::max<std::size_t>(ctx.collision.wall_triangle_count(), 1));
+    auto cells_at = [&](double c) {
+      return (static_cast<double>(level.max.x - level.min.x) / c + 1.0) * (static_cast<double>(level.max.z - level.min.z) / c + 1.0);
+    };
+    while (cells_at(double{cell_m_}) * walls > 2e8 || cells_at(double{cell_m_}) > 4e6) cell_m_ *= 2.0f;
+    origin_ = glm::vec3(level.min.x, eye.y, level.min.z);
+    nx_ = static_cast<int>(std::ceil((level.max.x - level.min.x) / cell_m_)) + 1;
+    nz_ = static_cast<int>(std::ceil((level.max.z - level.min.z) / cell_m_)) + 1;
+    free_.assign(static_cast<std::size_t>(nx_) * static_cast<std::size_t>(nz_), 0);
+    std::vector<Aabb> crates;
+    for (engine::Entity c : reg.view<engine::DynamicTag, engine::RigidBody, engine::Transform>().entities())
+      crates.push_back(crate_box(reg, c, 0.0f));
+    for (int z = 0; z < nz_; ++z)
+      for (int x = 0; x < nx_; ++x) {
+        const glm::vec3 p = cell_center({x, z});
+        // A slightly fattened player box keeps the walk off the walls.
+        const Aabb box{p + pc.box_min_from_eye_m - glm::vec3(0.1f, 0, 0.1f), p + pc.box_max_from_eye_m + glm::vec3(0.1f, 0, 0.1f)};
+        bool ok = box.min.x >= level.min.x && box.max.x <= level.max.x && box.min.z >= level.min.z &&
+                  box.max.z <= level.max.z && !ctx.collision.overlaps_wall(box);
+        for (const Aabb& c : crates) ok = ok && !c.overlaps(box);
+        free_[static_cast<std::size_t>(z) * static_cast<std::size_t>(nx_) + static_cast<std::size_t>(x)] = ok ? 1 : 0;
+      }
+  }
+
+  // Waypoints: room centres (static lights) and crates.
+  std::vector<glm::vec3> rooms;
+  for (engine::Entity e : reg.view<engine::Light, engine::WorldTransform>().entities()) {
+    const engine::Light& l = reg.get<engine::Light>(e);
+    if (l.moves || l.type == engine::LightType::Directional || e == ctx.flashlight) continue;
+    glm::vec3 p = glm::vec3(reg.get<engine::WorldTransform>(e).matrix[3]);
+    p.y = eye.y;
+    const bool near_other = std::any_of(rooms.begin(), rooms.end(), [&](const glm::vec3& r) { return horizontal_distance(r, p) < 2.0f; });
+    if (!near_other && nearest_walkable(p)) rooms.push_back(p);
+  }
+  std::vector<glm::vec3> crates;
+  for (engine::Entity c : reg.view<engine::DynamicTag, engine::RigidBody, engine::Transform>().entities()) {
+    glm::vec3 p = crate_box(reg, c, 0.0f).center();
+    p.y = eye.y;
+    crates.push_back(p);
+  }
+  auto add = [&](const std::vector<glm::vec3>& pts, bool is_crate, std::size_t limit) {
+    const glm::vec3 from = waypoints_.empty() ? eye : waypoints_.back();
+    for (std::size_t i : visiting_order(from, pts)) {
+      if (limit-- == 0) break;
+      waypoints_.push_back(pts[i]);
+      waypoint_is_crate_.push_back(is_crate);
+    }
+  };
+  const std::uint64_t n = budget_;
+  switch (script_) {
+    case Script::Tour:
+      add(crates, true, 1);
+      add(rooms, false, rooms.size());
+      key_presses_[static_cast<int>(Key::F)] = {10};
+      key_presses_[static_cast<int>(Key::G)] = {n / 2};
+      break;
+    case Script::WalkFlashlight:
+      add(rooms, false, rooms.size());
+      key_presses_[static_cast<int>(Key::F)] = {15, 2 * n / 3};
+      break;
+    case Script::PushCrates:
+      add(crates, true, crates.size());
+      break;
+    case Script::SplitScreen:
+      add(rooms, false, rooms.size());
+      key_presses_[static_cast<int>(Key::G)] = {20, n / 2, 3 * n / 4};
+      break;
+  }
+}
+
+bool ScriptedPilot::walkable(int x, int z) const {
+  return x >= 0 && z >= 0 && x < nx_ && z < nz_ &&
+         free_[static_cast<std::size_t>(z) * static_cast<std::size_t>(nx_) + static_cast<std::size_t>(x)] != 0;
+}
+
+glm::vec3 ScriptedPilot::cell_center(Cell c) const {
+  return origin_ + glm::vec3((static_cast<float>(c.x) + 0.5f) * cell_m_, 0.0f, (static_cast<float>(c.z) + 0.5f) * cell_m_);
+}
+
+std::optional<ScriptedPilot::Cell> ScriptedPilot::nearest_walkable(const glm::vec3& p) const {
+  if (nx_ == 0) return std::nullopt;
+  const int cx = static_cast<int>(std::floor((p.x - origin_.x) / cell_m_));
+  const int cz = static_cast<int>(std::floor((p.z - origin_.z) / cell_m_));
+  const int max_ring = static_cast<int>(std::ceil(3.0f / cell_m_));
+  for (int ring = 0; ring <= max_ring; ++ring) {
+    std::optional<Cell> best;
+    float best_d = std::numeric_limits<float>::max();
+    for (int dz = -ring; dz <= ring; ++dz)
+      for (int dx = -ring; dx <= ring; ++dx) {
+        if (std::max(std::abs(dx), std::abs(dz)) != ring || !walkable(cx + dx, cz + dz)) continue;
+        const float d = horizontal_distance(cell_center({cx + dx, cz + dz}), p);
+        if (d < best_d) best_d = d, best = Cell{cx + dx, cz + dz};
+      }
+    if (best) return best;
+  }
+  return std::nullopt;
+}
+
+std::vector<glm::vec3> ScriptedPilot::find_path(const glm::vec3& from, const glm::vec3& to) const {
+  const std::optional<Cell> start = nearest_walkable(from), goal = nearest_walkable(to);
+  if (!start || !goal) return {};
+  const auto index = [&](Cell c) { return static_cast<std::size_t>(c.z) * static_cast<std::size_t>(nx_) + static_cast<std::size_t>(c.x); };
+  std::vector<std::int32_t> came_from(free_.size(), -1);
+  std::deque<Cell> queue{*start};
+  came_from[index(*start)] = static_cast<std::int32_t>(index(*start));
+  while (!queue.empty()) {
+    const Cell c = queue.front();
+    queue.pop_front();
+    if (c.x == goal->x && c.z == goal->z) break;
+    for (int dz = -1; dz <= 1; ++dz)
+      for (int dx = -1; dx <= 1; ++dx) {
+        if ((dx == 0 && dz == 0) || !walkable(c.x + dx, c.z + dz)) continue;
+        if (dx != 0 && dz != 0 && (!walkable(c.x + dx, c.z) || !walkable(c.x, c.z + dz))) continue;  // no corner cutting
+        const Cell n{c.x + dx, c.z + dz};
+        if (came_from[index(n)] >= 0) continue;
+        came_from[index(n)] = static_cast<std::int32_t>(index(c));
+        queue.push_back(n);
+      }
+  }
+  if (came_from[index(*goal)] < 0) return {};
+  std::vector<glm::vec3> path;
+  for (std::size_t i = index(*goal);; i = static_cast<std::size_t>(came_from[i])) {
+    path.push_back(cell_center({static_cast<int>(i % static_cast<std::size_t>(nx_)), static_cast<int>(i / static_cast<std::size_t>(nx_))}));
+    if (i == index(*start)) break;
+  }
+  std::reverse(path.begin(), path.end());
+  return path;
+}
+
+void ScriptedPilot::start_target(const Simulation& sim) {
+  const glm::vec3 eye = sim.registry().get<engine::Transform>(sim.context().camera).position;
+  for (std::size_t tries = 0; tries < waypoints_.size() && !has_target_; ++tries) {
+    const std::size_t i = next_waypoint_ % waypoints_.size();
+    ++next_waypoint_;
+    // Pushed crates have moved: aim for where they are now.
+    target_ = waypoints_[i];
+    target_is_crate_ = waypoint_is_crate_[i];
+    if (target_is_crate_ && next_waypoint_ > waypoints_.size()) continue;  // each crate is pushed once
+    path_ = find_path(eye, target_);
+    path_index_ = 0;
+    target_frames_ = 0;
+    has_target_ = !path_.empty();
+  }
+}
+
+InputFrame ScriptedPilot::next(const Simulation& sim) {
+  frame_ = sim.frame();
+  InputFrame in;
+  for (int k = 0; k < kKeyCount; ++k)
+    if (std::find(key_presses_[k].begin(), key_presses_[k].end(), frame_) != key_presses_[k].end())
+      in.keys |= key_bit(static_cast<Key>(k));
+
+  const engine::Registry& reg = sim.registry();
+  const PlayerController& pc = reg.get<PlayerController>(sim.context().camera);
+  const glm::vec3 eye = reg.get<engine::Transform>(sim.context().camera).position;
+  in.mouse_dy_px = std::clamp(-(kWantedPitchRad - pc.pitch_rad) / pc.look_rad_per_px * 0.1f, -6.0f, 6.0f);
+  if (std::abs(in.mouse_dy_px) < 0.05f) in.mouse_dy_px = 0.0f;
+  if (frame_ < wait_until_ || waypoints_.empty()) return in;
+  if (!has_target_) start_target(sim);
+  if (!has_target_) return in;
+
+  // Follow the path: aim a few cells ahead of the nearest one still in front.
+  while (path_index_ + 1 < path_.size() && horizontal_distance(eye, path_[path_index_]) < 0.4f) ++path_index_;
+  glm::vec3 aim = path_[std::min(path_index_ + 2, path_.size() - 1)];
+  const bool at_end = path_index_ + 1 >= path_.size() && horizontal_distance(eye, path_.back()) < 0.4f;
+  bool push_now = false;
+  if (target_is_crate_) {
+    const float reach = sim.context().tuning.push_reach_m * 0.6f;
+    if (horizontal_distance(eye, target_) < reach + 0.8f || at_end) {
+      aim = target_;
+      push_now = std::abs(wrap_angle(yaw_towards(eye, aim) - pc.yaw_rad)) < 0.1f;
+    }
+  }
+  const float err = wrap_angle(yaw_towards(eye, aim) - pc.yaw_rad);
+  in.mouse_dx_px = std::clamp(-err / pc.look_rad_per_px * 0.2f, -14.0f, 14.0f);
+  if (std::abs(in.mouse_dx_px) < 0.05f) in.mouse_dx_px = 0.0f;
+  const bool close_to_crate = target_is_crate_ && aim == target_;
+  if (std::abs(err) < 0.5f && !close_to_crate && !at_end) in.keys |= key_bit(Key::W);
+
+  ++target_frames_;
+  if (push_now) {
+    in.keys |= key_bit(Key::E);
+    has_target_ = false;
+    wait_until_ = frame_ + 50;  // watch the crate slide
+  } else if ((at_end && !target_is_crate_) || target_frames_ > kGiveUpFrames ||
+             (close_to_crate && target_frames_ > kStuckFrames * 4 && std::abs(err) < 0.1f)) {
+    has_target_ = false;
+  }
+  return in;
+}
+
+}  // namespace game_demo
