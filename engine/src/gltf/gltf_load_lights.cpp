@@ -1,0 +1,191 @@
+// Lights, cameras and the "gi" node extras of the glTF loader.
+// KHR_lights_punctual lights are converted from photometric glTF units to the engine's
+// radiometric ones (engine/units.h); the "gi" extras schema is in docs/scene-format.md.
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+
+#include <engine/units.h>
+
+#include "gltf/gltf_load_internal.h"
+
+namespace engine::gltf_load {
+namespace {
+
+/// A fixed-size array of finite numbers, e.g. a colour.
+template <int N>
+Result<glm::vec<N, float>> number_array(const Context& ctx, const Json& value, const std::string& where,
+                                        const char* name) {
+  if (!value.is_array() || value.size() != static_cast<std::size_t>(N)) {
+    return ctx.error(where, std::string("'") + name + "' must be an array of " + std::to_string(N) + " numbers");
+  }
+  glm::vec<N, float> out(0.0f);
+  for (int i = 0; i < N; ++i) {
+    const Json& v = value[static_cast<std::size_t>(i)];
+    if (!v.is_number()) {
+      return ctx.error(where, std::string("'") + name + "' must be an array of " + std::to_string(N) + " numbers");
+    }
+    out[i] = static_cast<float>(v.get<double>());
+    if (!std::isfinite(out[i])) return ctx.error(where, std::string("'") + name + "' is not finite (NaN or Inf)");
+  }
+  return out;
+}
+
+/// One KHR_lights_punctual light definition.
+Result<NamedLight> convert_light(const Context& ctx, const Json& src, const std::string& where) {
+  if (!src.is_object()) return ctx.error(where, "must be an object");
+  NamedLight out;
+  if (const Json* name = find_member(src, "name"); name != nullptr && name->is_string()) out.name = name->get<std::string>();
+  const Json* type = find_member(src, "type");
+  if (type == nullptr || !type->is_string()) return ctx.error(where, "'type' is required and must be a string");
+  const std::string t = type->get<std::string>();
+  auto intensity = number_member(ctx, src, "intensity", 1.0, where);
+  if (!intensity) return intensity.error();
+  if (!std::isfinite(*intensity) || *intensity < 0.0) {
+    return ctx.error(where, "intensity " + std::to_string(*intensity) + " is negative or not finite");
+  }
+  if (const Json* color = find_member(src, "color")) {
+    auto c = number_array<3>(ctx, *color, where, "color");
+    if (!c) return c.error();
+    if (c->x < 0.0f || c->y < 0.0f || c->z < 0.0f) return ctx.error(where, "color has a negative component");
+    out.light.color = *c;
+  }
+  if (t == "point" || t == "spot") {
+    // KHR_lights_punctual: point and spot intensity is luminous intensity in candela.
+    out.light.type = t == "point" ? LightType::Point : LightType::Spot;
+    out.light.intensity = units::candela_to_w_per_sr(static_cast<float>(*intensity));
+  } else if (t == "directional") {
+    // Directional intensity is illuminance in lux.
+    out.light.type = LightType::Directional;
+    out.light.intensity = units::lux_to_w_per_m2(static_cast<float>(*intensity));
+  } else {
+    return ctx.error(where, "unknown light type '" + t + "'");
+  }
+  if (find_member(src, "range") != nullptr) {
+    auto range = number_member(ctx, src, "range", 0.0, where);
+    if (!range) return range.error();
+    if (!std::isfinite(*range) || *range <= 0.0) return ctx.error(where, "range must be > 0");
+    if (out.light.type != LightType::Directional) out.light.range_m = static_cast<float>(*range);
+  }
+  if (out.light.type == LightType::Spot) {
+    const Json* spot = find_member(src, "spot");
+    if (spot != nullptr && !spot->is_object()) return ctx.error(where, "'spot' must be an object");
+    const Json empty = Json::object();
+    const Json& s = spot != nullptr ? *spot : empty;
+    auto inner = number_member(ctx, s, "innerConeAngle", 0.0, where + " spot");
+    if (!inner) return inner.error();
+    auto outer = number_member(ctx, s, "outerConeAngle", std::numbers::pi / 4.0, where + " spot");
+    if (!outer) return outer.error();
+    // KHR_lights_punctual: 0 <= innerConeAngle < outerConeAngle <= pi/2.
+    if (!(*inner >= 0.0) || !(*outer > 0.0) || *outer > std::numbers::pi / 2.0 + 1e-6) {
+      return ctx.error(where, "spot cone angles must satisfy 0 <= inner < outer <= pi/2");
+    }
+    if (*inner > *outer) {
+      return ctx.error(where, "spot innerConeAngle " + std::to_string(*inner) + " is greater than outerConeAngle " +
+                                  std::to_string(*outer));
+    }
+    out.light.inner_cone_rad = static_cast<float>(*inner);
+    out.light.outer_cone_rad = static_cast<float>(*outer);
+  }
+  return out;
+}
+
+}  // namespace
+
+Result<std::vector<NamedLight>> convert_punctual_lights(const Context& ctx, const Json& doc) {
+  std::vector<NamedLight> lights;
+  const Json* exts = find_member(doc, "extensions");
+  const Json* ext = exts != nullptr ? find_member(*exts, "KHR_lights_punctual") : nullptr;
+  if (ext == nullptr) return lights;
+  const Json* list = find_member(*ext, "lights");
+  if (list == nullptr || !list->is_array() || list->empty()) {
+    return ctx.error("KHR_lights_punctual", "'lights' must be a non-empty array");
+  }
+  for (std::size_t i = 0; i < list->size(); ++i) {
+    auto light = convert_light(ctx, (*list)[i], "light " + std::to_string(i));
+    if (!light) return light.error();
+    lights.push_back(std::move(light.value()));
+  }
+  return lights;
+}
+
+Result<std::vector<NamedCamera>> convert_cameras(const Context& ctx, const ParsedFile& file, std::vector<int>& index_map) {
+  std::vector<NamedCamera> cameras;
+  index_map.assign(file.model.cameras.size(), -1);
+  for (std::size_t i = 0; i < file.model.cameras.size(); ++i) {
+    const tinygltf::Camera& src = file.model.cameras[i];
+    const std::string where = "camera " + std::to_string(i);
+    if (src.type == "orthographic") {
+      std::fprintf(stderr, "warning: %s: %s: orthographic camera skipped (the engine has perspective cameras only)\n",
+                   ctx.file.c_str(), where.c_str());
+      continue;
+    }
+    if (src.type != "perspective") return ctx.error(where, "unknown camera type '" + src.type + "'");
+    // §5.13: yfov > 0, znear > 0, zfar > znear when present (absent: infinite; the engine uses 500 m).
+    const tinygltf::PerspectiveCamera& p = src.perspective;
+    if (!(p.yfov > 0.0) || !std::isfinite(p.yfov)) return ctx.error(where, "yfov must be > 0");
+    if (!(p.znear > 0.0) || !std::isfinite(p.znear)) return ctx.error(where, "znear must be > 0");
+    if (p.zfar != 0.0 && !(p.zfar > p.znear && std::isfinite(p.zfar))) return ctx.error(where, "zfar must be > znear");
+    if (p.aspectRatio < 0.0 || !std::isfinite(p.aspectRatio)) return ctx.error(where, "aspectRatio must be > 0");
+    NamedCamera cam;
+    cam.name = src.name;
+    cam.camera.yfov_rad = static_cast<float>(p.yfov);
+    cam.camera.znear_m = static_cast<float>(p.znear);
+    cam.camera.zfar_m = p.zfar == 0.0 ? 500.0f : static_cast<float>(p.zfar);
+    cam.camera.aspect = static_cast<float>(p.aspectRatio);
+    index_map[i] = static_cast<int>(cameras.size());
+    cameras.push_back(std::move(cam));
+  }
+  return cameras;
+}
+
+Result<GiExtras> parse_gi_extras(const Context& ctx, const Json& node, const std::string& location) {
+  GiExtras out;
+  const Json* extras = find_member(node, "extras");
+  const Json* gi = extras != nullptr ? find_member(*extras, "gi") : nullptr;
+  if (gi == nullptr) return out;
+  const std::string where = location + " extras.gi";
+  if (!gi->is_object()) return ctx.error(where, "must be an object");
+  if (const Json* mobility = find_member(*gi, "mobility")) {
+    const std::string m = mobility->is_string() ? mobility->get<std::string>() : std::string();
+    if (m == "static") {
+      out.mobility = Mobility::Static;
+    } else if (m == "dynamic") {
+      out.mobility = Mobility::Dynamic;
+    } else {
+      return ctx.error(where, "'mobility' must be \"static\" or \"dynamic\"");
+    }
+  }
+  if (const Json* moves = find_member(*gi, "light_moves")) {
+    if (!moves->is_boolean()) return ctx.error(where, "'light_moves' must be true or false");
+    out.light_moves = moves->get<bool>();
+  }
+  if (const Json* area = find_member(*gi, "area_light")) {
+    const std::string awhere = where + ".area_light";
+    if (!area->is_object()) return ctx.error(awhere, "must be an object");
+    const Json* size = find_member(*area, "size_m");
+    const Json* radiance = find_member(*area, "radiance");
+    if (size == nullptr || radiance == nullptr) return ctx.error(awhere, "needs 'size_m' and 'radiance'");
+    auto s = number_array<2>(ctx, *size, awhere, "size_m");
+    if (!s) return s.error();
+    auto r = number_array<3>(ctx, *radiance, awhere, "radiance");
+    if (!r) return r.error();
+    if (!(s->x > 0.0f && s->y > 0.0f)) return ctx.error(awhere, "'size_m' must be positive");
+    if (r->x < 0.0f || r->y < 0.0f || r->z < 0.0f) return ctx.error(awhere, "'radiance' has a negative component");
+    NamedLight light;
+    if (const Json* name = find_member(node, "name"); name != nullptr && name->is_string()) {
+      light.name = name->get<std::string>();
+    }
+    light.light.type = LightType::Area;
+    light.light.area_size_m = *s;
+    const float peak = std::max({r->x, r->y, r->z});
+    light.light.intensity = peak;  // W/(m^2 sr), one-sided towards local -Z
+    light.light.color = peak > 0.0f ? *r / peak : glm::vec3(1.0f);
+    out.area_light = std::move(light);
+  }
+  return out;
+}
+
+}  // namespace engine::gltf_load
