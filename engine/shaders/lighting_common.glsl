@@ -1,0 +1,170 @@
+// Direct lighting of the forward pass: light records, BRDF (Lambert + GGX) and the
+// evaluation of point, spot, directional and rectangular area lights in engine units
+// (engine/units.h). Shadows come from shadow_common.glsl.
+
+const float PI = 3.14159265358979;
+const int LIGHT_POINT = 0;
+const int LIGHT_SPOT = 1;
+const int LIGHT_DIRECTIONAL = 2;
+const int LIGHT_AREA = 3;
+
+// Mirrors engine/src/render/gpu_light.h (std430, 192 bytes).
+struct GpuLight {
+  vec4 position_type;     // xyz: world position (m); w: LIGHT_* type
+  vec4 direction_range;   // xyz: unit emission direction (the light's -Z); w: range (m), 0 = unlimited
+  vec4 radiant;           // rgb: colour x intensity (W/sr, W/m^2 or W/(m^2 sr) by type)
+  vec4 cone;              // x: cos(outer), y: cos(inner), z: 2-D shadow layer or -1, w: shadow cube or -1
+  vec4 area_half_x;       // xyz: half of the rectangle along the light's X axis (m)
+  vec4 area_half_y;       // xyz: half of the rectangle along the light's Y axis (m)
+  mat4 shadow_view_proj;  // world -> clip of the 2-D shadow map
+  vec4 shadow_eye;        // xyz: shadow camera position (m); w: far distance that maps to depth 1 (m)
+  vec4 shadow_params;     // x: 0 ortho / 1 distance; y: texel footprint (m, or m per m of distance); z: PCF radius (texels)
+};
+
+layout(std430, binding = 0) readonly buffer Lights { GpuLight lights[]; };
+
+// The shading point.
+struct Surface {
+  vec3 position;
+  vec3 normal;          // unit, facing the viewer's side for double-sided materials
+  vec3 view;            // unit, towards the camera
+  vec3 diffuse_albedo;  // (1 - metallic) * base colour
+  vec3 f0;              // specular reflectance at normal incidence
+  float alpha;          // GGX alpha = roughness^2
+};
+
+float ggx_distribution(float n_dot_h, float alpha) {
+  float a2 = alpha * alpha;
+  float d = n_dot_h * n_dot_h * (a2 - 1.0) + 1.0;
+  return a2 / (PI * d * d);
+}
+
+// Smith height-correlated visibility V = G / (4 NoL NoV) (Heitz 2014, eq. 99).
+float smith_ggx_correlated_visibility(float n_dot_v, float n_dot_l, float alpha) {
+  float a2 = alpha * alpha;
+  float gv = n_dot_l * sqrt(n_dot_v * n_dot_v * (1.0 - a2) + a2);
+  float gl = n_dot_v * sqrt(n_dot_l * n_dot_l * (1.0 - a2) + a2);
+  return 0.5 / max(gv + gl, 1e-7);
+}
+
+vec3 schlick_fresnel(vec3 f0, float v_dot_h) {
+  return f0 + (vec3(1.0) - f0) * pow(1.0 - v_dot_h, 5.0);
+}
+
+// GGX specular BRDF times cos(theta_l) for a unit light direction l.
+vec3 specular_brdf_cos(Surface s, vec3 l) {
+  float n_dot_l = dot(s.normal, l);
+  if (n_dot_l <= 0.0) return vec3(0.0);
+  float n_dot_v = max(dot(s.normal, s.view), 1e-4);
+  vec3 h = normalize(l + s.view);
+  float n_dot_h = max(dot(s.normal, h), 0.0);
+  float v_dot_h = max(dot(s.view, h), 0.0);
+  return ggx_distribution(n_dot_h, s.alpha) * smith_ggx_correlated_visibility(n_dot_v, n_dot_l, s.alpha) *
+         schlick_fresnel(s.f0, v_dot_h) * n_dot_l;
+}
+
+// (Lambert + GGX) BRDF times cos(theta_l).
+vec3 brdf_cos(Surface s, vec3 l) {
+  float n_dot_l = dot(s.normal, l);
+  if (n_dot_l <= 0.0) return vec3(0.0);
+  return s.diffuse_albedo / PI * n_dot_l + specular_brdf_cos(s, l);
+}
+
+// glTF KHR_lights_punctual range window: (1 - (d/range)^4)^2 clamped, 1 when range is 0.
+float range_window(float distance_m, float range_m) {
+  if (range_m <= 0.0) return 1.0;
+  float r = distance_m / range_m;
+  float w = clamp(1.0 - r * r * r * r, 0.0, 1.0);
+  return w * w;
+}
+
+// Integral of cos(theta) over the solid angle of a convex polygon above the horizon
+// (Lambert's formula): (1/2) sum_i angle(v_i, v_i+1) * dot(n, normalize(v_i x v_i+1)).
+float polygon_cosine_integral(vec3 v[5], int count, vec3 n) {
+  float sum = 0.0;
+  for (int i = 0; i < count; ++i) {
+    vec3 a = normalize(v[i]);
+    vec3 b = normalize(v[(i + 1) % count]);
+    vec3 c = cross(a, b);
+    float len = length(c);
+    if (len < 1e-7) continue;
+    float angle = atan(len, dot(a, b));
+    sum += angle * dot(c / len, n);
+  }
+  return abs(0.5 * sum);
+}
+
+// Clips the quad q[0..3] (positions relative to the shading point) against the tangent
+// plane dot(n, x) >= 0 (Sutherland-Hodgman); returns the vertex count (0, 3, 4 or 5).
+int clip_to_horizon(vec3 q[4], vec3 n, out vec3 v[5]) {
+  int count = 0;
+  for (int i = 0; i < 5; ++i) v[i] = vec3(0.0);
+  for (int i = 0; i < 4; ++i) {
+    vec3 a = q[i];
+    vec3 b = q[(i + 1) % 4];
+    float da = dot(n, a);
+    float db = dot(n, b);
+    if (da >= 0.0 && count < 5) v[count++] = a;
+    if ((da >= 0.0) != (db >= 0.0) && count < 5) v[count++] = a + (b - a) * (da / (da - db));
+  }
+  return count;
+}
+
+// Rectangular area light of radiance L (W/(m^2 sr)), one-sided towards its emission
+// direction. Diffuse: exact irradiance of the rectangle clipped to the horizon
+// (polygon_cosine_integral). Specular: a 4x4 stratified set of points on the rectangle,
+// each weighted by its solid angle cos(theta_light) dA / d^2 (converges to the integral).
+vec3 area_light_radiance(GpuLight light, Surface s) {
+  vec3 centre = light.position_type.xyz;
+  vec3 dir = light.direction_range.xyz;
+  if (dot(s.position - centre, dir) <= 0.0) return vec3(0.0);
+  vec3 hx = light.area_half_x.xyz;
+  vec3 hy = light.area_half_y.xyz;
+  vec3 rel = centre - s.position;
+  vec3 q[4] = vec3[4](rel - hx - hy, rel + hx - hy, rel + hx + hy, rel - hx + hy);
+  vec3 v[5];
+  int count = clip_to_horizon(q, s.normal, v);
+  if (count < 3) return vec3(0.0);
+  vec3 result = s.diffuse_albedo / PI * polygon_cosine_integral(v, count, s.normal);
+  const int kSide = 4;
+  float sample_area = 4.0 * length(hx) * length(hy) / float(kSide * kSide);
+  vec3 specular = vec3(0.0);
+  for (int j = 0; j < kSide; ++j) {
+    for (int i = 0; i < kSide; ++i) {
+      vec2 t = (vec2(i, j) + 0.5) / float(kSide) * 2.0 - 1.0;
+      vec3 to_light = rel + t.x * hx + t.y * hy;
+      float d2 = max(dot(to_light, to_light), 1e-8);
+      vec3 l = to_light * inversesqrt(d2);
+      float cos_light = max(-dot(dir, l), 0.0);
+      specular += specular_brdf_cos(s, l) * cos_light * sample_area / d2;
+    }
+  }
+  return light.radiant.rgb * (result + specular);
+}
+
+// Unshadowed outgoing radiance towards the viewer from one light, and the light direction
+// used for shadow biasing (out).
+vec3 light_radiance(GpuLight light, Surface s, out vec3 to_light) {
+  int type = int(light.position_type.w);
+  if (type == LIGHT_DIRECTIONAL) {
+    to_light = -light.direction_range.xyz;
+    return light.radiant.rgb * brdf_cos(s, to_light);
+  }
+  if (type == LIGHT_AREA) {
+    to_light = normalize(light.position_type.xyz - s.position);
+    return area_light_radiance(light, s);
+  }
+  vec3 d = light.position_type.xyz - s.position;
+  float dist2 = max(dot(d, d), 1e-8);
+  float dist = sqrt(dist2);
+  to_light = d / dist;
+  float attenuation = range_window(dist, light.direction_range.w) / dist2;
+  if (type == LIGHT_SPOT) {
+    float cos_axis = dot(-to_light, light.direction_range.xyz);
+    float cos_outer = light.cone.x;
+    float cos_inner = light.cone.y;
+    attenuation *= cos_inner - cos_outer > 1e-5 ? smoothstep(cos_outer, cos_inner, cos_axis)
+                                                : step(cos_outer, cos_axis);
+  }
+  return light.radiant.rgb * attenuation * brdf_cos(s, to_light);
+}

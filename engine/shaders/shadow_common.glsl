@@ -1,0 +1,67 @@
+// Shadow-map lookups of the forward pass. Every shadow map stores a linear depth:
+// distance from the light / far for point, spot and area lights, distance along the light
+// direction / far for directional lights. Filtering: hardware 2x2 compare (bilinear PCF)
+// over a (2r+1)^2 grid; the receiver is offset along its normal by one texel and the depth
+// reference is biased by texel * (1 + r * tan(theta)) (slope-scaled).
+
+layout(binding = 4) uniform sampler2DArrayShadow u_shadow_maps;
+layout(binding = 5) uniform samplerCubeArrayShadow u_point_shadow_maps;
+
+float slope_tangent(vec3 n, vec3 to_light) {
+  float n_dot_l = clamp(dot(n, to_light), 0.05, 1.0);
+  return min(sqrt(1.0 - n_dot_l * n_dot_l) / n_dot_l, 8.0);
+}
+
+float shadow_2d(GpuLight light, vec3 p, vec3 n, vec3 to_light) {
+  int layer = int(light.cone.z);
+  if (layer < 0) return 1.0;
+  bool ortho = light.shadow_params.x < 0.5;
+  vec3 eye = light.shadow_eye.xyz;
+  float far_m = light.shadow_eye.w;
+  vec3 axis = light.direction_range.xyz;
+  float dist = ortho ? dot(p - eye, axis) : length(p - eye);
+  float texel = ortho ? light.shadow_params.y : light.shadow_params.y * dist;
+  int radius = int(light.shadow_params.z);
+  vec3 po = p + n * texel;
+  vec4 clip = light.shadow_view_proj * vec4(po, 1.0);
+  if (clip.w <= 0.0) return 1.0;
+  vec2 uv = clip.xy / clip.w * 0.5 + 0.5;
+  if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)))) return 1.0;
+  float d = ortho ? dot(po - eye, axis) : length(po - eye);
+  float bias = texel * (1.0 + float(radius) * slope_tangent(n, to_light));
+  float ref = (d - bias) / far_m;
+  vec2 texel_uv = 1.0 / vec2(textureSize(u_shadow_maps, 0).xy);
+  float sum = 0.0;
+  for (int y = -radius; y <= radius; ++y)
+    for (int x = -radius; x <= radius; ++x)
+      sum += texture(u_shadow_maps, vec4(uv + vec2(x, y) * texel_uv, float(layer), ref));
+  float side = float(2 * radius + 1);
+  return sum / (side * side);
+}
+
+float shadow_cube(GpuLight light, vec3 p, vec3 n, vec3 to_light) {
+  int cube = int(light.cone.w);
+  if (cube < 0) return 1.0;
+  vec3 eye = light.position_type.xyz;
+  float far_m = light.shadow_eye.w;
+  float texel = light.shadow_params.y * length(p - eye);
+  vec3 po = p + n * texel;
+  vec3 d = po - eye;
+  float dist = length(d);
+  vec3 w = d / max(dist, 1e-8);
+  vec3 t = normalize(cross(abs(w.y) < 0.9 ? vec3(0, 1, 0) : vec3(1, 0, 0), w));
+  vec3 b = cross(w, t);
+  float bias = texel * (1.0 + slope_tangent(n, to_light));
+  float ref = (dist - bias) / far_m;
+  float sum = 0.0;
+  for (int y = -1; y <= 1; ++y)
+    for (int x = -1; x <= 1; ++x)
+      sum += texture(u_point_shadow_maps, vec4(d + (float(x) * t + float(y) * b) * texel, float(cube)), ref);
+  return sum / 9.0;
+}
+
+float light_shadow(GpuLight light, vec3 p, vec3 n, vec3 to_light) {
+  if (light.cone.w >= 0.0) return shadow_cube(light, p, n, to_light);
+  if (light.cone.z >= 0.0) return shadow_2d(light, p, n, to_light);
+  return 1.0;
+}

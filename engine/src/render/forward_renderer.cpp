@@ -1,0 +1,311 @@
+// engine::Renderer: shadow maps, a forward linear-HDR pass (RGBA16F + depth), then
+// exposure, ACES-fitted tonemap and sRGB encoding into an RGBA8 target.
+#include <engine/renderer.h>
+
+#include <algorithm>
+#include <string>
+
+#include <GL/glcorearb.h>
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/type_ptr.hpp>
+
+#include <engine/components.h>
+#include <engine/gpu/gl_objects.h>
+#include <engine/gpu/gpu_timer.h>
+#include <engine/gpu/shader_program.h>
+
+#include "render/frame_data.h"
+#include "render/gpu_scene.h"
+#include "render/light_list.h"
+#include "render/shadow_maps.h"
+
+namespace engine {
+
+namespace {
+
+using render::DrawItem;
+using render::GpuScene;
+
+// Texture units and SSBO bindings shared with forward.frag.glsl / shadow_common.glsl.
+enum TextureUnit : GLuint {
+  kBaseColorUnit = 0,
+  kMetallicRoughnessUnit = 1,
+  kEmissiveUnit = 2,
+  kIrradianceAtlasUnit = 3,
+  kShadowMapsUnit = 4,
+  kPointShadowMapsUnit = 5,
+  kGlossyUnit = 6,
+};
+constexpr GLuint kLightsBinding = 0;
+constexpr GLuint kVertexIrradianceBinding = 1;
+
+enum IndirectMode : int { kIndirectNone = 0, kIndirectAmbient = 1, kIndirectAtlas = 2, kIndirectVertex = 3 };
+
+Result<ShaderProgram> build(const char* vertex, const char* fragment) {
+  return ShaderProgramBuilder(engine_shader_files())
+      .stage(ShaderStage::Vertex, vertex)
+      .stage(ShaderStage::Fragment, fragment)
+      .build();
+}
+
+class ForwardRenderer final : public Renderer {
+ public:
+  ForwardRenderer(GpuScene scene, ShaderProgram forward, ShaderProgram shadow, ShaderProgram tonemap,
+                  const RenderSettings& settings)
+      : settings_(settings),
+        scene_(std::move(scene)),
+        forward_(std::move(forward)),
+        shadow_(std::move(shadow)),
+        tonemap_(std::move(tonemap)),
+        lights_buffer_(GlBuffer::create()),
+        empty_vao_(GlVertexArray::create()) {
+    ensure_targets();
+  }
+
+  void render(const Registry& registry, Entity camera) override;
+  ImageRgba8 read_ldr() const override;
+  ImageRgbaF read_hdr() const override;
+  void present(int window_width, int window_height) const override {
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
+    glBlitNamedFramebuffer(ldr_fbo_.id(), 0, 0, 0, width_, height_, 0, 0, window_width, window_height,
+                           GL_COLOR_BUFFER_BIT, GL_LINEAR);
+  }
+  void set_indirect_light(IndirectLightProvider* provider) override { provider_ = provider; }
+  RenderSettings& settings() override { return settings_; }
+  const std::vector<PassTiming>& last_timings() const override { return timings_; }
+
+ private:
+  void ensure_targets();
+  std::vector<DrawItem> draw_items(const Registry& registry) const;
+  void forward_pass(const Registry& registry, Entity camera, const std::vector<DrawItem>& items, int light_count);
+  void tonemap_pass();
+
+  RenderSettings settings_;
+  GpuScene scene_;
+  ShaderProgram forward_;
+  ShaderProgram shadow_;
+  ShaderProgram tonemap_;
+  render::ShadowMaps shadow_maps_;
+  GlBuffer lights_buffer_;
+  GlVertexArray empty_vao_;
+  GlTexture hdr_;
+  GlTexture depth_;
+  GlTexture ldr_;
+  GlFramebuffer hdr_fbo_;
+  GlFramebuffer ldr_fbo_;
+  int width_ = 0;
+  int height_ = 0;
+  IndirectLightProvider* provider_ = nullptr;
+  std::vector<PassTiming> timings_;
+};
+
+void ForwardRenderer::ensure_targets() {
+  GI_EXPECTS(settings_.width > 0 && settings_.height > 0, "render size must be positive");
+  if (settings_.width == width_ && settings_.height == height_ && !hdr_.empty()) return;
+  width_ = settings_.width;
+  height_ = settings_.height;
+  hdr_ = GlTexture::create_2d(GL_RGBA16F, width_, height_);
+  depth_ = GlTexture::create_2d(GL_DEPTH_COMPONENT32F, width_, height_);
+  ldr_ = GlTexture::create_2d(GL_RGBA8, width_, height_);
+  for (GLuint t : {hdr_.id(), ldr_.id()}) {
+    glTextureParameteri(t, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTextureParameteri(t, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  }
+  hdr_fbo_ = GlFramebuffer::create();
+  glNamedFramebufferTexture(hdr_fbo_.id(), GL_COLOR_ATTACHMENT0, hdr_.id(), 0);
+  glNamedFramebufferTexture(hdr_fbo_.id(), GL_DEPTH_ATTACHMENT, depth_.id(), 0);
+  ldr_fbo_ = GlFramebuffer::create();
+  glNamedFramebufferTexture(ldr_fbo_.id(), GL_COLOR_ATTACHMENT0, ldr_.id(), 0);
+  GI_EXPECTS(hdr_fbo_.complete() && ldr_fbo_.complete(), "render targets must be complete");
+}
+
+std::vector<DrawItem> ForwardRenderer::draw_items(const Registry& registry) const {
+  std::vector<DrawItem> items;
+  registry.view<MeshRenderer, WorldTransform>().each([&](Entity e, const MeshRenderer& mr, const WorldTransform& wt) {
+    GI_EXPECTS(mr.mesh < scene_.meshes().size(), "MeshRenderer::mesh must index the renderer's SceneAsset meshes");
+    DrawItem item;
+    item.entity = e;
+    item.mesh = &scene_.meshes()[mr.mesh];
+    item.model = wt.matrix;
+    item.material_override = mr.material_override;
+    item.cast_shadows = mr.cast_shadows;
+    item.is_static = registry.has<StaticTag>(e);
+    items.push_back(item);
+  });
+  return items;
+}
+
+void ForwardRenderer::render(const Registry& registry, Entity camera) {
+  GI_EXPECTS(registry.valid(camera) && registry.has<Camera>(camera) && registry.has<WorldTransform>(camera),
+             "render() needs a camera entity with Camera and WorldTransform");
+  ensure_targets();
+  timings_.clear();
+  GpuTimer timer;
+
+  const std::vector<DrawItem> items = draw_items(registry);
+  render::ShadowCapacity capacity;
+  capacity.map_size = std::max(16, settings_.shadow_map_size);
+  capacity.cube_size = std::max(16, settings_.shadow_map_size / 2);
+  const render::LightList lights = render::collect_lights(registry, render::scene_bounds(items), capacity);
+  shadow_maps_.reserve(capacity.map_size, lights.layers_2d, capacity.cube_size, lights.cubes);
+  shadow_maps_.render(lights.shadow_views, items, scene_, shadow_);
+  timings_.push_back({"shadow maps (" + std::to_string(lights.shadow_views.size()) + " views)", timer.lap_ms()});
+
+  glNamedBufferData(lights_buffer_.id(),
+                    static_cast<GLsizeiptr>(std::max<std::size_t>(1, lights.lights.size()) * sizeof(render::GpuLight)),
+                    lights.lights.empty() ? nullptr : lights.lights.data(), GL_STREAM_DRAW);
+  forward_pass(registry, camera, items, static_cast<int>(lights.lights.size()));
+  timings_.push_back({provider_ ? std::string("forward + indirect (") + provider_->label() + ")"
+                                : std::string("forward + constant ambient (stand-in)"),
+                      timer.lap_ms()});
+
+  tonemap_pass();
+  timings_.push_back({"tonemap (exposure, ACES fitted, sRGB)", timer.lap_ms()});
+}
+
+void ForwardRenderer::forward_pass(const Registry& registry, Entity camera, const std::vector<DrawItem>& items,
+                                   int light_count) {
+  const Camera& cam = registry.get<Camera>(camera);
+  const glm::mat4& camera_world = registry.get<WorldTransform>(camera).matrix;
+  const float aspect = cam.aspect > 0.0f ? cam.aspect : static_cast<float>(width_) / static_cast<float>(height_);
+  const glm::mat4 view_proj = glm::perspective(cam.yfov_rad, aspect, cam.znear_m, cam.zfar_m) * glm::inverse(camera_world);
+  const glm::vec3 camera_position(camera_world[3]);
+
+  const IndirectLightFrame* indirect = provider_ ? &provider_->frame() : nullptr;
+
+  glBindFramebuffer(GL_FRAMEBUFFER, hdr_fbo_.id());
+  glViewport(0, 0, width_, height_);
+  const float black[4] = {0.0f, 0.0f, 0.0f, 1.0f};
+  const float far_depth = 1.0f;
+  glClearNamedFramebufferfv(hdr_fbo_.id(), GL_COLOR, 0, black);
+  glClearNamedFramebufferfv(hdr_fbo_.id(), GL_DEPTH, 0, &far_depth);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LESS);
+  glDepthMask(GL_TRUE);
+  glDisable(GL_BLEND);
+  glFrontFace(GL_CCW);
+  glCullFace(GL_BACK);
+
+  forward_.use();
+  glBindVertexArray(scene_.vertex_array());
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kLightsBinding, lights_buffer_.id());
+  glBindTextureUnit(kShadowMapsUnit, shadow_maps_.maps_2d());
+  glBindTextureUnit(kPointShadowMapsUnit, shadow_maps_.cube_maps());
+  const GLuint atlas = indirect ? indirect->irradiance_atlas_texture : 0;
+  const GLuint glossy = indirect ? indirect->glossy_radiance_texture : 0;
+  glBindTextureUnit(kIrradianceAtlasUnit, atlas != 0 ? atlas : scene_.white_texture());
+  glBindTextureUnit(kGlossyUnit, glossy != 0 ? glossy : scene_.white_texture());
+
+  glUniformMatrix4fv(8, 1, GL_FALSE, glm::value_ptr(view_proj));
+  glUniform3fv(16, 1, glm::value_ptr(camera_position));
+  glUniform1i(17, light_count);
+  glUniform1f(23, settings_.stand_in_ambient);
+  glUniform1f(24, settings_.split == SplitView::DirectLeftFullRight ? 0.5f * static_cast<float>(width_) : -1.0f);
+  glUniform1i(25, glossy != 0 ? 1 : 0);
+
+  for (const DrawItem& item : items) {
+    int mode = kIndirectAmbient;
+    GLuint vertex_buffer = 0;
+    if (indirect != nullptr) {
+      mode = kIndirectNone;
+      if (item.is_static && atlas != 0) {
+        mode = kIndirectAtlas;
+      } else if (!item.is_static) {
+        vertex_buffer = indirect->vertex_irradiance_buffer(item.entity);
+        if (vertex_buffer != 0) mode = kIndirectVertex;
+      }
+    }
+    if (vertex_buffer != 0) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kVertexIrradianceBinding, vertex_buffer);
+    glUniform1i(12, item.mesh->first_vertex);
+    glUniform1i(13, vertex_buffer != 0 ? 1 : 0);
+    glUniform1i(22, mode);
+    glUniformMatrix4fv(0, 1, GL_FALSE, glm::value_ptr(item.model));
+    const glm::mat4 normal_matrix(glm::transpose(glm::inverse(glm::mat3(item.model))));
+    glUniformMatrix4fv(4, 1, GL_FALSE, glm::value_ptr(normal_matrix));
+    for (const render::GpuPrimitive& p : item.mesh->primitives) {
+      const render::GpuMaterial& m = scene_.material(item.material_override >= 0 ? item.material_override : p.material);
+      if (m.double_sided)
+        glDisable(GL_CULL_FACE);
+      else
+        glEnable(GL_CULL_FACE);
+      glUniform4fv(18, 1, glm::value_ptr(m.base_color));
+      glUniform1f(19, m.metallic);
+      glUniform1f(20, m.roughness);
+      glUniform3fv(21, 1, glm::value_ptr(m.emissive));
+      glUniform1i(26, m.double_sided ? 1 : 0);
+      glBindTextureUnit(kBaseColorUnit, m.base_color_texture);
+      glBindTextureUnit(kMetallicRoughnessUnit, m.metallic_roughness_texture);
+      glBindTextureUnit(kEmissiveUnit, m.emissive_texture);
+      glDrawElementsBaseVertex(GL_TRIANGLES, static_cast<GLsizei>(p.index_count), GL_UNSIGNED_INT,
+                               reinterpret_cast<const void*>(static_cast<std::uintptr_t>(p.first_index) * 4u),
+                               p.base_vertex);
+    }
+  }
+  glDisable(GL_CULL_FACE);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+}
+
+void ForwardRenderer::tonemap_pass() {
+  glBindFramebuffer(GL_FRAMEBUFFER, ldr_fbo_.id());
+  glViewport(0, 0, width_, height_);
+  glDisable(GL_DEPTH_TEST);
+  glDisable(GL_CULL_FACE);
+  tonemap_.use();
+  glUniform1f(0, settings_.exposure);
+  glBindTextureUnit(0, hdr_.id());
+  glBindVertexArray(empty_vao_.id());
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+}
+
+ImageRgba8 ForwardRenderer::read_ldr() const {
+  ImageRgba8 image;
+  image.width = width_;
+  image.height = height_;
+  std::vector<std::uint8_t> raw(static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_) * 4);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glGetTextureImage(ldr_.id(), 0, GL_RGBA, GL_UNSIGNED_BYTE, static_cast<GLsizei>(raw.size()), raw.data());
+  image.pixels.resize(raw.size());
+  const std::size_t row = static_cast<std::size_t>(width_) * 4;
+  for (int y = 0; y < height_; ++y)  // GL rows run bottom to top
+    std::copy_n(raw.begin() + static_cast<std::ptrdiff_t>(row * static_cast<std::size_t>(height_ - 1 - y)), row,
+                image.pixels.begin() + static_cast<std::ptrdiff_t>(row * static_cast<std::size_t>(y)));
+  return image;
+}
+
+ImageRgbaF ForwardRenderer::read_hdr() const {
+  ImageRgbaF image;
+  image.width = width_;
+  image.height = height_;
+  std::vector<float> raw(static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_) * 4);
+  glPixelStorei(GL_PACK_ALIGNMENT, 4);
+  glGetTextureImage(hdr_.id(), 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(raw.size() * sizeof(float)), raw.data());
+  image.pixels.resize(raw.size());
+  const std::size_t row = static_cast<std::size_t>(width_) * 4;
+  for (int y = 0; y < height_; ++y)
+    std::copy_n(raw.begin() + static_cast<std::ptrdiff_t>(row * static_cast<std::size_t>(height_ - 1 - y)), row,
+                image.pixels.begin() + static_cast<std::ptrdiff_t>(row * static_cast<std::size_t>(y)));
+  return image;
+}
+
+}  // namespace
+
+Result<std::unique_ptr<Renderer>> Renderer::create(const SceneAsset& assets, const RenderSettings& settings) {
+  GI_EXPECTS(settings.width > 0 && settings.height > 0, "RenderSettings width and height must be positive");
+  if (glGetString(GL_VERSION) == nullptr)
+    return Error{assets.source, "renderer", "no current OpenGL context (create an engine::GpuContext first)"};
+  auto forward = build("forward.vert.glsl", "forward.frag.glsl");
+  if (!forward) return forward.error();
+  auto shadow = build("shadow.vert.glsl", "shadow.frag.glsl");
+  if (!shadow) return shadow.error();
+  auto tonemap = build("fullscreen.vert.glsl", "tonemap.frag.glsl");
+  if (!tonemap) return tonemap.error();
+  auto scene = GpuScene::upload(assets);
+  if (!scene) return scene.error();
+  glEnable(GL_TEXTURE_CUBE_MAP_SEAMLESS);
+  return std::unique_ptr<Renderer>(std::make_unique<ForwardRenderer>(std::move(scene.value()), std::move(forward.value()),
+                                                                     std::move(shadow.value()),
+                                                                     std::move(tonemap.value()), settings));
+}
+
+}  // namespace engine

@@ -1,0 +1,165 @@
+#include "render/gpu_scene.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <limits>
+#include <map>
+#include <string>
+
+#include <GL/glcorearb.h>
+
+namespace engine::render {
+
+namespace {
+
+Error primitive_error(const SceneAsset& assets, std::size_t mesh, std::size_t prim, const std::string& what) {
+  return Error{assets.source, "meshes[" + std::to_string(mesh) + "].primitives[" + std::to_string(prim) + "]", what};
+}
+
+// Area-weighted vertex normals for primitives that have none.
+std::vector<glm::vec3> computed_normals(const Primitive& p, const std::vector<std::uint32_t>& indices) {
+  std::vector<glm::vec3> n(p.positions.size(), glm::vec3(0.0f));
+  for (std::size_t t = 0; t + 2 < indices.size(); t += 3) {
+    const glm::vec3& a = p.positions[indices[t]];
+    const glm::vec3& b = p.positions[indices[t + 1]];
+    const glm::vec3& c = p.positions[indices[t + 2]];
+    const glm::vec3 face = glm::cross(b - a, c - a);
+    for (int k = 0; k < 3; ++k) n[indices[t + static_cast<std::size_t>(k)]] += face;
+  }
+  for (glm::vec3& v : n) {
+    const float len = glm::length(v);
+    v = len > 0.0f ? v / len : glm::vec3(0.0f, 0.0f, 1.0f);
+  }
+  return n;
+}
+
+GlTexture upload_image(const Image& image, bool srgb) {
+  const int levels = 1 + static_cast<int>(std::floor(std::log2(std::max(image.width, image.height))));
+  GlTexture t = GlTexture::create_2d(srgb ? GL_SRGB8_ALPHA8 : GL_RGBA8, image.width, image.height, levels);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  // Rows top to bottom as in the file: glTF's UV (0, 0) is the image's top-left corner,
+  // which lands at texture coordinate (0, 0) this way.
+  glTextureSubImage2D(t.id(), 0, 0, 0, image.width, image.height, GL_RGBA, GL_UNSIGNED_BYTE, image.rgba8.data());
+  glGenerateTextureMipmap(t.id());
+  glTextureParameteri(t.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+  glTextureParameteri(t.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTextureParameteri(t.id(), GL_TEXTURE_WRAP_S, GL_REPEAT);
+  glTextureParameteri(t.id(), GL_TEXTURE_WRAP_T, GL_REPEAT);
+  return t;
+}
+
+}  // namespace
+
+const GpuMaterial& GpuScene::material(int index) const {
+  if (index < 0 || static_cast<std::size_t>(index) >= materials_.size()) return default_material_;
+  return materials_[static_cast<std::size_t>(index)];
+}
+
+Result<GpuScene> GpuScene::upload(const SceneAsset& assets) {
+  GpuScene scene;
+  std::vector<GpuVertex> vertices;
+  std::vector<std::uint32_t> indices;
+  for (std::size_t m = 0; m < assets.meshes.size(); ++m) {
+    const Mesh& mesh = assets.meshes[m];
+    GpuMesh gm;
+    gm.first_vertex = static_cast<std::int32_t>(vertices.size());
+    gm.bounds_min = glm::vec3(std::numeric_limits<float>::max());
+    gm.bounds_max = glm::vec3(-std::numeric_limits<float>::max());
+    for (std::size_t pi = 0; pi < mesh.primitives.size(); ++pi) {
+      const Primitive& p = mesh.primitives[pi];
+      const std::size_t n = p.positions.size();
+      if (!p.normals.empty() && p.normals.size() != n)
+        return primitive_error(assets, m, pi, "normals count differs from positions count");
+      if (!p.uv0.empty() && p.uv0.size() != n) return primitive_error(assets, m, pi, "uv0 count differs from positions count");
+      if (!p.uv1.empty() && p.uv1.size() != n) return primitive_error(assets, m, pi, "uv1 count differs from positions count");
+      if (p.material >= 0 && static_cast<std::size_t>(p.material) >= assets.materials.size())
+        return primitive_error(assets, m, pi, "material index " + std::to_string(p.material) + " out of range");
+      std::vector<std::uint32_t> prim_indices = p.indices;
+      if (prim_indices.empty()) {
+        prim_indices.resize(n);
+        for (std::size_t i = 0; i < n; ++i) prim_indices[i] = static_cast<std::uint32_t>(i);
+      }
+      if (prim_indices.size() % 3 != 0) return primitive_error(assets, m, pi, "index count is not a multiple of 3");
+      for (std::uint32_t i : prim_indices)
+        if (i >= n) return primitive_error(assets, m, pi, "index " + std::to_string(i) + " out of range");
+      const std::vector<glm::vec3> normals = p.normals.empty() ? computed_normals(p, prim_indices) : p.normals;
+      GpuPrimitive gp;
+      gp.first_index = static_cast<std::uint32_t>(indices.size());
+      gp.index_count = static_cast<std::uint32_t>(prim_indices.size());
+      gp.base_vertex = static_cast<std::int32_t>(vertices.size());
+      gp.material = p.material;
+      for (std::size_t i = 0; i < n; ++i) {
+        vertices.push_back(GpuVertex{p.positions[i], normals[i], p.uv0.empty() ? glm::vec2(0.0f) : p.uv0[i],
+                                     p.uv1.empty() ? glm::vec2(0.0f) : p.uv1[i]});
+        gm.bounds_min = glm::min(gm.bounds_min, p.positions[i]);
+        gm.bounds_max = glm::max(gm.bounds_max, p.positions[i]);
+      }
+      indices.insert(indices.end(), prim_indices.begin(), prim_indices.end());
+      gm.primitives.push_back(gp);
+    }
+    gm.vertex_count = static_cast<std::uint32_t>(vertices.size()) - static_cast<std::uint32_t>(gm.first_vertex);
+    if (gm.vertex_count == 0) gm.bounds_min = gm.bounds_max = glm::vec3(0.0f);
+    scene.meshes_.push_back(std::move(gm));
+  }
+
+  scene.vertices_ = GlBuffer::create(vertices.size() * sizeof(GpuVertex), vertices.data());
+  scene.indices_ = GlBuffer::create(indices.size() * sizeof(std::uint32_t), indices.data());
+  scene.vao_ = GlVertexArray::create();
+  const GLuint vao = scene.vao_.id();
+  glVertexArrayVertexBuffer(vao, 0, scene.vertices_.id(), 0, sizeof(GpuVertex));
+  glVertexArrayElementBuffer(vao, scene.indices_.id());
+  const GLuint offsets[4] = {offsetof(GpuVertex, position), offsetof(GpuVertex, normal), offsetof(GpuVertex, uv0),
+                             offsetof(GpuVertex, uv1)};
+  const GLint sizes[4] = {3, 3, 2, 2};
+  for (GLuint a = 0; a < 4; ++a) {
+    glEnableVertexArrayAttrib(vao, a);
+    glVertexArrayAttribFormat(vao, a, sizes[a], GL_FLOAT, GL_FALSE, offsets[a]);
+    glVertexArrayAttribBinding(vao, a, 0);
+  }
+
+  const std::uint8_t white[4] = {255, 255, 255, 255};
+  scene.white_ = GlTexture::create_2d(GL_RGBA8, 1, 1);
+  glTextureSubImage2D(scene.white_.id(), 0, 0, 0, 1, 1, GL_RGBA, GL_UNSIGNED_BYTE, white);
+  scene.default_material_.base_color_texture = scene.white_.id();
+  scene.default_material_.metallic_roughness_texture = scene.white_.id();
+  scene.default_material_.emissive_texture = scene.white_.id();
+
+  std::map<std::pair<int, bool>, std::uint32_t> uploaded;
+  auto texture = [&](int image, bool srgb, std::size_t material, const char* slot) -> Result<std::uint32_t> {
+    if (image < 0) return scene.white_.id();
+    if (static_cast<std::size_t>(image) >= assets.images.size())
+      return Error{assets.source, "materials[" + std::to_string(material) + "]." + slot,
+                   "image index " + std::to_string(image) + " out of range"};
+    const Image& img = assets.images[static_cast<std::size_t>(image)];
+    if (img.width <= 0 || img.height <= 0 ||
+        img.rgba8.size() != static_cast<std::size_t>(img.width) * static_cast<std::size_t>(img.height) * 4)
+      return Error{assets.source, "images[" + std::to_string(image) + "]", "image has no or inconsistent RGBA8 pixels"};
+    if (auto it = uploaded.find({image, srgb}); it != uploaded.end()) return it->second;
+    scene.textures_.push_back(upload_image(img, srgb));
+    uploaded[{image, srgb}] = scene.textures_.back().id();
+    return scene.textures_.back().id();
+  };
+  for (std::size_t i = 0; i < assets.materials.size(); ++i) {
+    const Material& src = assets.materials[i];
+    GpuMaterial gm;
+    gm.base_color = src.base_color;
+    gm.metallic = src.metallic;
+    gm.roughness = src.roughness;
+    gm.emissive = src.emissive;
+    gm.double_sided = src.double_sided;
+    auto base = texture(src.base_color_texture, true, i, "baseColorTexture");
+    if (!base) return base.error();
+    auto mr = texture(src.metallic_roughness_texture, false, i, "metallicRoughnessTexture");
+    if (!mr) return mr.error();
+    auto emissive = texture(src.emissive_texture, true, i, "emissiveTexture");
+    if (!emissive) return emissive.error();
+    gm.base_color_texture = base.value();
+    gm.metallic_roughness_texture = mr.value();
+    gm.emissive_texture = emissive.value();
+    scene.materials_.push_back(gm);
+  }
+  return scene;
+}
+
+}  // namespace engine::render

@@ -1,0 +1,135 @@
+#include "render/light_list.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include <engine/components.h>
+
+namespace engine::render {
+
+namespace {
+
+constexpr float kAreaShadowFov = glm::radians(150.0f);
+constexpr int kAreaPcfRadius = 2;
+
+glm::vec3 any_perpendicular_up(const glm::vec3& dir) {
+  return std::abs(dir.y) < 0.99f ? glm::vec3(0.0f, 1.0f, 0.0f) : glm::vec3(1.0f, 0.0f, 0.0f);
+}
+
+// Distance from p to the farthest corner of the bounds (at least 1 mm).
+float farthest_corner(const glm::vec3& p, const SceneBounds& b) {
+  float d = 1e-3f;
+  for (int i = 0; i < 8; ++i) {
+    const glm::vec3 c((i & 1) ? b.max.x : b.min.x, (i & 2) ? b.max.y : b.min.y, (i & 4) ? b.max.z : b.min.z);
+    d = std::max(d, glm::length(c - p));
+  }
+  return d;
+}
+
+}  // namespace
+
+SceneBounds scene_bounds(const std::vector<DrawItem>& items) {
+  SceneBounds b;
+  for (const DrawItem& item : items) {
+    for (int i = 0; i < 8; ++i) {
+      const glm::vec3& lo = item.mesh->bounds_min;
+      const glm::vec3& hi = item.mesh->bounds_max;
+      const glm::vec3 c((i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z);
+      const glm::vec3 w = glm::vec3(item.model * glm::vec4(c, 1.0f));
+      b.min = b.empty ? w : glm::min(b.min, w);
+      b.max = b.empty ? w : glm::max(b.max, w);
+      b.empty = false;
+    }
+  }
+  return b;
+}
+
+LightList collect_lights(const Registry& registry, const SceneBounds& bounds, const ShadowCapacity& capacity) {
+  LightList out;
+  registry.view<Light, WorldTransform>().each([&](Entity, const Light& light, const WorldTransform& wt) {
+    if (!light.enabled) return;
+    const glm::mat4& m = wt.matrix;
+    const glm::vec3 position(m[3]);
+    const glm::vec3 axis_x = glm::normalize(glm::vec3(m[0]));
+    const glm::vec3 axis_y = glm::normalize(glm::vec3(m[1]));
+    const glm::vec3 dir = -glm::normalize(glm::vec3(m[2]));  // lights emit along local -Z
+    GpuLight g;
+    g.position_type = glm::vec4(position, 0.0f);
+    g.direction_range = glm::vec4(dir, light.range_m);
+    g.radiant = glm::vec4(light.color * light.intensity, 0.0f);
+    g.cone = glm::vec4(std::cos(light.outer_cone_rad), std::cos(std::min(light.inner_cone_rad, light.outer_cone_rad)),
+                       -1.0f, -1.0f);
+    switch (light.type) {
+      case LightType::Point: g.position_type.w = static_cast<float>(GpuLightType::Point); break;
+      case LightType::Spot: g.position_type.w = static_cast<float>(GpuLightType::Spot); break;
+      case LightType::Directional: g.position_type.w = static_cast<float>(GpuLightType::Directional); break;
+      case LightType::Area:
+        g.position_type.w = static_cast<float>(GpuLightType::Area);
+        g.area_half_x = glm::vec4(axis_x * (0.5f * light.area_size_m.x), 0.0f);
+        g.area_half_y = glm::vec4(axis_y * (0.5f * light.area_size_m.y), 0.0f);
+        break;
+    }
+
+    const bool shadowed = light.cast_shadows && !bounds.empty;
+    if (shadowed && light.type == LightType::Point && out.cubes < capacity.max_cubes) {
+      const float far_m = (light.range_m > 0.0f ? light.range_m : farthest_corner(position, bounds)) * 1.01f;
+      const float near_m = std::max(0.01f, far_m * 1e-4f);
+      const glm::mat4 proj = glm::perspective(glm::radians(90.0f), 1.0f, near_m, far_m);
+      // GL cube-map face order and orientation (+X, -X, +Y, -Y, +Z, -Z).
+      const glm::vec3 face_dir[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+      const glm::vec3 face_up[6] = {{0, -1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}, {0, -1, 0}, {0, -1, 0}};
+      for (int f = 0; f < 6; ++f) {
+        ShadowView v;
+        v.view_proj = proj * glm::lookAt(position, position + face_dir[f], face_up[f]);
+        v.eye = position;
+        v.far_m = far_m;
+        v.cube = true;
+        v.layer = out.cubes * 6 + f;
+        out.shadow_views.push_back(v);
+      }
+      g.cone.w = static_cast<float>(out.cubes++);
+      g.shadow_eye = glm::vec4(position, far_m);
+      g.shadow_params = glm::vec4(1.0f, 2.0f / static_cast<float>(capacity.cube_size), 1.0f, 0.0f);
+    } else if (shadowed && light.type != LightType::Point && out.layers_2d < capacity.max_2d_layers) {
+      ShadowView v;
+      v.axis = dir;
+      v.layer = out.layers_2d;
+      float texel = 0.0f;
+      float pcf_radius = 1.0f;
+      if (light.type == LightType::Directional) {
+        const glm::vec3 centre = 0.5f * (bounds.min + bounds.max);
+        const float radius = std::max(0.5f * glm::length(bounds.max - bounds.min), 1e-3f) * 1.01f;
+        v.eye = centre - dir * radius;
+        v.far_m = 2.0f * radius;
+        v.ortho = true;
+        v.view_proj = glm::ortho(-radius, radius, -radius, radius, 0.0f, v.far_m) *
+                      glm::lookAt(v.eye, centre, any_perpendicular_up(dir));
+        texel = 2.0f * radius / static_cast<float>(capacity.map_size);
+      } else {
+        const float fov = light.type == LightType::Spot
+                              ? std::min(2.0f * light.outer_cone_rad + glm::radians(4.0f), glm::radians(170.0f))
+                              : kAreaShadowFov;
+        const float reach = light.type == LightType::Spot && light.range_m > 0.0f ? light.range_m
+                                                                                   : farthest_corner(position, bounds);
+        v.eye = position;
+        v.far_m = reach * 1.01f;
+        const float near_m = std::max(0.01f, v.far_m * 1e-4f);
+        v.view_proj = glm::perspective(fov, 1.0f, near_m, v.far_m) *
+                      glm::lookAt(position, position + dir, any_perpendicular_up(dir));
+        texel = 2.0f * std::tan(0.5f * fov) / static_cast<float>(capacity.map_size);
+        if (light.type == LightType::Area) pcf_radius = static_cast<float>(kAreaPcfRadius);
+      }
+      out.shadow_views.push_back(v);
+      g.cone.z = static_cast<float>(out.layers_2d++);
+      g.shadow_view_proj = v.view_proj;
+      g.shadow_eye = glm::vec4(v.eye, v.far_m);
+      g.shadow_params = glm::vec4(v.ortho ? 0.0f : 1.0f, texel, pcf_radius, 0.0f);
+    }
+    out.lights.push_back(g);
+  });
+  return out;
+}
+
+}  // namespace engine::render

@@ -1,0 +1,32 @@
+#pragma once
+// Turns the registry's enabled lights into GpuLight records and plans their shadow maps:
+// directional (orthographic, fitted to the scene bounds), spot (perspective, the cone),
+// area (perspective with a 150 degree field of view from the rectangle's centre, wider PCF),
+// point (a cube-map-array slice, six 90 degree faces).
+
+#include <vector>
+
+#include <engine/registry.h>
+
+#include "render/frame_data.h"
+#include "render/gpu_light.h"
+
+namespace engine::render {
+
+struct ShadowCapacity {
+  int map_size = 1024;     ///< Texels per side of a 2-D shadow map.
+  int cube_size = 512;     ///< Texels per side of a cube face.
+  int max_2d_layers = 8;   ///< Directional, spot and area lights with shadows beyond this are unshadowed.
+  int max_cubes = 4;       ///< Point lights with shadows beyond this are unshadowed.
+};
+
+struct LightList {
+  std::vector<GpuLight> lights;
+  std::vector<ShadowView> shadow_views;
+  int layers_2d = 0;
+  int cubes = 0;
+};
+
+LightList collect_lights(const Registry& registry, const SceneBounds& bounds, const ShadowCapacity& capacity);
+
+}  // namespace engine::render

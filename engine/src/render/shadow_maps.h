@@ -1,0 +1,38 @@
+#pragma once
+// Depth textures of the shadow-casting lights and the pass that fills them: a 2-D array
+// (directional, spot, area lights) and a cube-map array (point lights), both compared in
+// the shader (sampler*Shadow) against linear depth.
+
+#include <vector>
+
+#include <engine/gpu/gl_objects.h>
+#include <engine/gpu/shader_program.h>
+
+#include "render/frame_data.h"
+#include "render/gpu_scene.h"
+
+namespace engine::render {
+
+class ShadowMaps {
+ public:
+  /// Makes room for `layers_2d` maps of map_size^2 and `cubes` cube maps of cube_size^2
+  /// per face (at least one of each so the samplers are always complete).
+  void reserve(int map_size, int layers_2d, int cube_size, int cubes);
+  /// Renders every view's casters into its layer.
+  void render(const std::vector<ShadowView>& views, const std::vector<DrawItem>& items, const GpuScene& scene,
+              const ShaderProgram& program);
+
+  std::uint32_t maps_2d() const { return maps_2d_.id(); }
+  std::uint32_t cube_maps() const { return cube_maps_.id(); }
+
+ private:
+  GlTexture maps_2d_;
+  GlTexture cube_maps_;
+  GlFramebuffer framebuffer_;
+  int map_size_ = 0;
+  int layers_2d_ = 0;
+  int cube_size_ = 0;
+  int cubes_ = 0;
+};
+
+}  // namespace engine::render
