@@ -1,0 +1,84 @@
+// PNG and OpenEXR files: round trips and failure without leftovers.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+
+#include <engine/image.h>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path scratch_dir(const char* name) {
+  const fs::path dir = fs::path(GI_BINARY_DIR) / "test_output" / "image_test" / name;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+engine::ImageRgba8 gradient8(int w, int h) {
+  engine::ImageRgba8 img{w, h, {}};
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int c = 0; c < 4; ++c) img.pixels.push_back(static_cast<std::uint8_t>((x * 37 + y * 11 + c * 64) % 256));
+  return img;
+}
+
+TEST(ImagePng, WriteReadRoundTripIsExact) {
+  const fs::path dir = scratch_dir("png");
+  const engine::ImageRgba8 img = gradient8(13, 7);
+  ASSERT_TRUE(engine::save_png(dir / "a.png", img).ok());
+  auto back = engine::load_png(dir / "a.png");
+  ASSERT_TRUE(back.ok()) << back.error().to_string();
+  EXPECT_EQ(back->width, 13);
+  EXPECT_EQ(back->height, 7);
+  EXPECT_EQ(back->pixels, img.pixels);
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator{}), 1) << "no temporary file left";
+}
+
+TEST(ImageExr, WriteReadRoundTripWithinHalfPrecision) {
+  const fs::path dir = scratch_dir("exr");
+  engine::ImageRgbaF img{9, 5, {}};
+  for (int i = 0; i < 9 * 5 * 4; ++i) img.pixels.push_back(0.001f * static_cast<float>(i * i) + 0.25f);
+  ASSERT_TRUE(engine::save_exr(dir / "a.exr", img).ok());
+  auto back = engine::load_exr(dir / "a.exr");
+  ASSERT_TRUE(back.ok()) << back.error().to_string();
+  ASSERT_EQ(back->width, 9);
+  ASSERT_EQ(back->height, 5);
+  ASSERT_EQ(back->pixels.size(), img.pixels.size());
+  for (std::size_t i = 0; i < img.pixels.size(); ++i)  // half floats: 11-bit mantissa
+    EXPECT_NEAR(back->pixels[i], img.pixels[i], img.pixels[i] * 1e-3f) << "value " << i;
+  // Rows stay top to bottom: the first pixel is the first written.
+  EXPECT_NEAR(back->pixels[0], 0.25f, 1e-3f);
+}
+
+TEST(ImageFiles, WritingIntoMissingDirectoryFailsWithoutLeftovers) {
+  const fs::path dir = scratch_dir("missing");
+  const fs::path missing = dir / "no_such_dir";
+  auto png = engine::save_png(missing / "a.png", gradient8(4, 4));
+  ASSERT_FALSE(png.ok());
+  EXPECT_NE(png.error().to_string().find("no_such_dir"), std::string::npos) << png.error().to_string();
+  engine::ImageRgbaF f{2, 2, std::vector<float>(16, 1.0f)};
+  EXPECT_FALSE(engine::save_exr(missing / "a.exr", f).ok());
+  EXPECT_FALSE(fs::exists(missing));
+  EXPECT_TRUE(fs::is_empty(dir));
+}
+
+TEST(ImageFiles, ReadingMissingOrCorruptFilesReturnsErrors) {
+  const fs::path dir = scratch_dir("corrupt");
+  EXPECT_FALSE(engine::load_png(dir / "none.png").ok());
+  EXPECT_FALSE(engine::load_exr(dir / "none.exr").ok());
+  {
+    std::FILE* f = std::fopen((dir / "bad.exr").c_str(), "wb");
+    ASSERT_NE(f, nullptr);
+    std::fputs("not an exr file at all", f);
+    std::fclose(f);
+  }
+  auto bad = engine::load_exr(dir / "bad.exr");
+  ASSERT_FALSE(bad.ok());
+  EXPECT_EQ(bad.error().file, (dir / "bad.exr").string());
+  EXPECT_FALSE(engine::load_png(dir / "bad.exr").ok());
+}
+
+}  // namespace

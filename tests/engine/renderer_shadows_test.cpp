@@ -1,0 +1,230 @@
+// Shadows, split view, indirect-light plumbing and the LDR encoding of the renderer.
+#define GL_GLEXT_PROTOTYPES
+#include <GL/glcorearb.h>
+
+#include <cmath>
+
+#include "engine/renderer_test_scene.h"
+
+namespace {
+
+using namespace renderer_test;
+
+constexpr float kAlbedo = 0.5f;
+constexpr float kAmbient = 0.05f;  // stand-in ambient radiance, W/(m^2 sr)
+
+// A plane, a 0.3 m box floating at (-0.75, 1, 0) and a light at (-1.5, 2, 0) aimed at the
+// origin: the box's shadow is centred on the origin, which the camera above sees.
+struct OccluderScene {
+  engine::SceneAsset assets;
+  engine::Registry reg;
+  TestCamera cam{{0.0f, 3.0f, 0.0f}, {0.0f, 0.0f, 0.0f}};
+
+  OccluderScene() {
+    assets.materials.push_back(diffuse_material(kAlbedo));
+    assets.meshes.push_back(plane_mesh(10.0f, 0));
+    assets.meshes.push_back(box_mesh(glm::vec3(0.15f), 0));
+    add_mesh(reg, 0, glm::mat4(1.0f));
+    add_mesh(reg, 1, glm::translate(glm::mat4(1.0f), glm::vec3(-0.75f, 1.0f, 0.0f)));
+  }
+  engine::ImageRgbaF render(const engine::Light& light) {
+    add_light(reg, light, {-1.5f, 2.0f, 0.0f}, {0.0f, 0.0f, 0.0f});
+    engine::Entity camera = cam.add_to(reg);
+    auto r = make_renderer(assets, cam.size, kAmbient);
+    if (!r) return {};
+    r->render(reg, camera);
+    EXPECT_EQ(r->last_timings().size(), 3u);
+    return r->read_hdr();
+  }
+};
+
+// The pixel at the centre of the box's shadow sees only the ambient term; a pixel beside
+// the shadow is lit: at least 4x the ambient term.
+void expect_shadow(const engine::ImageRgbaF& img, const TestCamera& cam) {
+  ASSERT_EQ(img.width, cam.size);
+  const float ambient_only = kAlbedo * kAmbient;  // albedo/pi * (pi * L_ambient)
+  const float shadowed = red(img, cam.pixel_of({0.0f, 0.0f, 0.0f}));
+  const float beside = red(img, cam.pixel_of({0.0f, 0.0f, 0.8f}));
+  EXPECT_NEAR(shadowed, ambient_only, 0.05f * ambient_only) << "centre of the box's shadow";
+  EXPECT_GT(beside, 4.0f * ambient_only) << "beside the shadow";
+}
+
+TEST(RendererShadows, PointLightCubeMapShadow) {
+  engine::GpuContext ctx = headless_context();
+  OccluderScene s;
+  expect_shadow(s.render(engine::Light{.type = engine::LightType::Point, .intensity = 10.0f}), s.cam);
+}
+
+TEST(RendererShadows, SpotLightShadow) {
+  engine::GpuContext ctx = headless_context();
+  OccluderScene s;
+  expect_shadow(s.render(engine::Light{.type = engine::LightType::Spot, .intensity = 10.0f, .outer_cone_rad = 0.7f}), s.cam);
+}
+
+TEST(RendererShadows, DirectionalLightShadow) {
+  engine::GpuContext ctx = headless_context();
+  OccluderScene s;
+  expect_shadow(s.render(engine::Light{.type = engine::LightType::Directional, .intensity = 3.0f}), s.cam);
+}
+
+TEST(RendererShadows, AreaLightShadow) {
+  engine::GpuContext ctx = headless_context();
+  OccluderScene s;
+  expect_shadow(s.render(engine::Light{.type = engine::LightType::Area, .intensity = 250.0f, .area_size_m = {0.2f, 0.2f}}),
+                s.cam);
+}
+
+TEST(RendererShadows, NoSelfShadowAcneOnLitPlane) {
+  engine::GpuContext ctx = headless_context();
+  OccluderScene s;
+  const engine::ImageRgbaF img = s.render(engine::Light{.type = engine::LightType::Point, .intensity = 10.0f});
+  // Every pixel of the lit plane away from the shadow matches the unshadowed reference.
+  int checked = 0;
+  for (int y = 0; y < s.cam.size; y += 4)
+    for (int x = 0; x < s.cam.size; x += 4) {
+      const glm::vec3 p = s.cam.plane_point(x, y);
+      if (p.x < 0.8f && std::abs(p.z) < 0.45f) continue;  // the box's shadow spans x in [-0.4, 0.62] m
+      const float expected = reference_point_light(kAlbedo, 1.0f, p, s.cam.eye, {-1.5f, 2.0f, 0.0f}, 10.0f) +
+                             kAlbedo * kAmbient;
+      EXPECT_NEAR(red(img, x, y), expected, 0.02f * expected) << "pixel " << x << "," << y;
+      ++checked;
+    }
+  EXPECT_GT(checked, 100);
+}
+
+TEST(RendererSplitView, LeftHalfDirectOnlyRightHalfAddsAmbient) {
+  engine::GpuContext ctx = headless_context();
+  engine::SceneAsset assets;
+  assets.materials.push_back(diffuse_material(kAlbedo));
+  assets.meshes.push_back(plane_mesh(10.0f, 0));
+  engine::Registry reg;
+  add_mesh(reg, 0, glm::mat4(1.0f));
+  add_light(reg, engine::Light{.type = engine::LightType::Point, .intensity = 10.0f}, {0, 2, 0}, {0, 0, 0});
+  TestCamera cam{{0.0f, 3.0f, 0.0f}, {0.0f, 0.0f, 0.0f}};
+  engine::Entity camera = cam.add_to(reg);
+  auto r = make_renderer(assets, cam.size, 0.2f);
+  ASSERT_NE(r, nullptr);
+  r->settings().split = engine::SplitView::DirectLeftFullRight;
+  r->render(reg, camera);
+  const engine::ImageRgbaF img = r->read_hdr();
+  const int c = cam.size / 2;
+  // Mirror-symmetric pixels: same direct light, the right one adds albedo * L_ambient.
+  const float left = red(img, c - 10, c);
+  const float right = red(img, c + 10, c);
+  EXPECT_LT(left, right);
+  EXPECT_NEAR(right - left, kAlbedo * 0.2f, 0.02f * kAlbedo * 0.2f);
+  EXPECT_NE(r->last_timings()[1].name.find("constant ambient (stand-in)"), std::string::npos);
+}
+
+// sRGB(ACES fitted (Narkowicz 2015)(x * exposure)), written independently of the shader.
+float expected_ldr(float linear) {
+  const float x = linear;
+  const float t = std::clamp(x * (2.51f * x + 0.03f) / (x * (2.43f * x + 0.59f) + 0.14f), 0.0f, 1.0f);
+  const float s = t <= 0.0031308f ? 12.92f * t : 1.055f * std::pow(t, 1.0f / 2.4f) - 0.055f;
+  return s * 255.0f;
+}
+
+TEST(RendererTonemap, LdrPixelIsTonemappedHdrPixel) {
+  engine::GpuContext ctx = headless_context();
+  engine::SceneAsset assets;
+  assets.materials.push_back(diffuse_material(kAlbedo));
+  assets.meshes.push_back(plane_mesh(10.0f, 0));
+  engine::Registry reg;
+  add_mesh(reg, 0, glm::mat4(1.0f));
+  add_light(reg, engine::Light{.type = engine::LightType::Point, .intensity = 10.0f}, {0, 2, 0}, {0, 0, 0});
+  TestCamera cam{{0.0f, 3.0f, 0.0f}, {0.0f, 0.0f, 0.0f}};
+  engine::Entity camera = cam.add_to(reg);
+  auto r = make_renderer(assets, cam.size, 0.0f);
+  ASSERT_NE(r, nullptr);
+  r->settings().exposure = 0.7f;
+  r->render(reg, camera);
+  const engine::ImageRgbaF hdr = r->read_hdr();
+  const engine::ImageRgba8 ldr = r->read_ldr();
+  ASSERT_EQ(ldr.width, cam.size);
+  ASSERT_EQ(ldr.height, cam.size);
+  for (glm::ivec2 p : {glm::ivec2(cam.size / 2, cam.size / 2), glm::ivec2(3, 5), glm::ivec2(cam.size - 2, 10)}) {
+    const float expected = expected_ldr(red(hdr, p) * 0.7f);
+    const auto got = static_cast<float>(ldr.pixels[(static_cast<std::size_t>(p.y) * cam.size + p.x) * 4]);
+    EXPECT_NEAR(got, expected, 1.0f) << "pixel " << p.x << "," << p.y;
+    EXPECT_EQ(ldr.pixels[(static_cast<std::size_t>(p.y) * cam.size + p.x) * 4 + 3], 255);
+  }
+}
+
+TEST(RendererReadback, RowsRunTopToBottom) {
+  engine::GpuContext ctx = headless_context();
+  engine::SceneAsset assets;
+  assets.materials.push_back(diffuse_material(kAlbedo));
+  assets.meshes.push_back(plane_mesh(10.0f, 0));
+  engine::Registry reg;
+  add_mesh(reg, 0, glm::mat4(1.0f));
+  TestCamera cam{{0.0f, 3.0f, 0.0f}, {0.0f, 0.0f, 0.0f}};
+  // The camera's up is world -Z: a light at z = -1 is near the top of the image.
+  add_light(reg, engine::Light{.type = engine::LightType::Point, .intensity = 10.0f}, {0, 1, -1}, {0, 0, -1});
+  engine::Entity camera = cam.add_to(reg);
+  auto r = make_renderer(assets, cam.size, 0.0f);
+  ASSERT_NE(r, nullptr);
+  r->render(reg, camera);
+  const engine::ImageRgbaF hdr = r->read_hdr();
+  const glm::ivec2 under = cam.pixel_of({0, 0, -1});
+  EXPECT_LT(under.y, cam.size / 2);
+  EXPECT_GT(red(hdr, cam.size / 2, 2), red(hdr, cam.size / 2, cam.size - 3));
+  const float expected = reference_point_light(kAlbedo, 1.0f, cam.plane_point(under.x, under.y), cam.eye, {0, 1, -1}, 10.0f);
+  EXPECT_NEAR(red(hdr, under), expected, 0.02f * expected);
+}
+
+// A provider with a constant 1x1 irradiance atlas and a per-vertex buffer for one entity.
+class ConstantIndirect : public engine::IndirectLightProvider {
+ public:
+  struct Frame : engine::IndirectLightFrame {
+    engine::Entity dynamic;
+    std::uint32_t buffer = 0;
+    std::uint32_t vertex_irradiance_buffer(engine::Entity e) const override { return e == dynamic ? buffer : 0; }
+  };
+  const engine::IndirectLightFrame& frame() override { return frame_; }
+  const char* label() const override { return "test constant"; }
+  Frame frame_;
+};
+
+TEST(RendererIndirect, AtlasForStaticAndVertexBufferForDynamicMeshes) {
+  engine::GpuContext ctx = headless_context();
+  engine::SceneAsset assets;
+  assets.materials.push_back(diffuse_material(kAlbedo));
+  assets.meshes.push_back(plane_mesh(1.0f, 0));
+  engine::Registry reg;
+  add_mesh(reg, 0, glm::translate(glm::mat4(1.0f), glm::vec3(-1.2f, 0, 0)), /*is_static=*/true);
+  engine::Entity dyn = add_mesh(reg, 0, glm::translate(glm::mat4(1.0f), glm::vec3(1.2f, 0, 0)), /*is_static=*/false);
+  TestCamera cam{{0.0f, 4.0f, 0.0f}, {0.0f, 0.0f, 0.0f}};
+  engine::Entity camera = cam.add_to(reg);
+
+  const float atlas_e = 2.0f;  // W/m^2
+  const float atlas_texel[4] = {atlas_e, atlas_e, atlas_e, 1.0f};
+  GLuint atlas = 0;
+  glCreateTextures(GL_TEXTURE_2D, 1, &atlas);
+  glTextureStorage2D(atlas, 1, GL_RGBA32F, 1, 1);
+  glTextureSubImage2D(atlas, 0, 0, 0, 1, 1, GL_RGBA, GL_FLOAT, atlas_texel);
+  // Per-vertex irradiance of the dynamic plane's 4 vertices: 4 W/m^2 everywhere.
+  const float vertex_e[16] = {4, 4, 4, 0, 4, 4, 4, 0, 4, 4, 4, 0, 4, 4, 4, 0};
+  GLuint buffer = 0;
+  glCreateBuffers(1, &buffer);
+  glNamedBufferStorage(buffer, sizeof vertex_e, vertex_e, 0);
+
+  ConstantIndirect provider;
+  provider.frame_.irradiance_atlas_texture = atlas;
+  provider.frame_.dynamic = dyn;
+  provider.frame_.buffer = buffer;
+  {
+    auto r = make_renderer(assets, cam.size, 0.3f);
+    ASSERT_NE(r, nullptr);
+    r->set_indirect_light(&provider);
+    r->render(reg, camera);
+    const engine::ImageRgbaF img = r->read_hdr();
+    EXPECT_NEAR(red(img, cam.pixel_of({-1.2f, 0, 0})), kAlbedo / kPi * atlas_e, 0.01f * kAlbedo / kPi * atlas_e);
+    EXPECT_NEAR(red(img, cam.pixel_of({1.2f, 0, 0})), kAlbedo / kPi * 4.0f, 0.01f * kAlbedo / kPi * 4.0f);
+    EXPECT_NE(r->last_timings()[1].name.find("test constant"), std::string::npos);
+    EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
+  }
+  glDeleteTextures(1, &atlas);
+  glDeleteBuffers(1, &buffer);
+}
+
+}  // namespace
