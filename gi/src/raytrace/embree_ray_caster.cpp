@@ -1,0 +1,244 @@
+#include "raytrace/embree_ray_caster.h"
+
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include <embree3/rtcore.h>
+
+#include <engine/check.h>
+
+namespace gi {
+namespace {
+
+void embree_error(void* /*user*/, RTCError code, const char* message) {
+  std::fprintf(stderr, "embree error %d: %s\n", static_cast<int>(code), message ? message : "");
+}
+
+// Move-only owners of Embree handles (RAII; moved-from state is empty).
+struct DeviceHandle {
+  RTCDevice h = nullptr;
+  DeviceHandle() = default;
+  explicit DeviceHandle(RTCDevice d) : h(d) {}
+  DeviceHandle(DeviceHandle&& o) noexcept : h(std::exchange(o.h, nullptr)) {}
+  DeviceHandle& operator=(DeviceHandle&& o) noexcept {
+    if (this != &o) {
+      if (h) rtcReleaseDevice(h);
+      h = std::exchange(o.h, nullptr);
+    }
+    return *this;
+  }
+  ~DeviceHandle() {
+    if (h) rtcReleaseDevice(h);
+  }
+};
+
+struct SceneHandle {
+  RTCScene h = nullptr;
+  SceneHandle() = default;
+  explicit SceneHandle(RTCScene s) : h(s) {}
+  SceneHandle(SceneHandle&& o) noexcept : h(std::exchange(o.h, nullptr)) {}
+  SceneHandle& operator=(SceneHandle&& o) noexcept {
+    if (this != &o) {
+      if (h) rtcReleaseScene(h);
+      h = std::exchange(o.h, nullptr);
+    }
+    return *this;
+  }
+  ~SceneHandle() {
+    if (h) rtcReleaseScene(h);
+  }
+};
+
+bool finite(const glm::mat4& m) {
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r)
+      if (!std::isfinite(m[c][r])) return false;
+  return true;
+}
+
+class EmbreeRayCaster final : public RayCaster {
+ public:
+  engine::Status build(const RtSceneData& data) {
+    data_ = data;
+    for (std::size_t g = 0; g < data_.geometries.size(); ++g) {
+      const RtGeometry& geo = data_.geometries[g];
+      const std::string where = "geometry " + std::to_string(g);
+      if (geo.indices.size() % 3 != 0) return engine::Error{"", where, "index count is not a multiple of 3"};
+      for (std::uint32_t i : geo.indices)
+        if (i >= geo.positions.size()) return engine::Error{"", where, "index " + std::to_string(i) + " out of range"};
+      for (const glm::vec3& p : geo.positions)
+        if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+          return engine::Error{"", where, "non-finite vertex position"};
+    }
+    for (std::size_t i = 0; i < data_.instances.size(); ++i) {
+      if (data_.instances[i].geometry >= data_.geometries.size())
+        return engine::Error{"", "instance " + std::to_string(i), "geometry index out of range"};
+      if (!finite(data_.instances[i].object_to_world))
+        return engine::Error{"", "instance " + std::to_string(i), "non-finite transform"};
+    }
+
+    device_ = DeviceHandle(rtcNewDevice(nullptr));
+    if (!device_.h) return engine::Error{"", "embree", "rtcNewDevice failed"};
+    rtcSetDeviceErrorFunction(device_.h, embree_error, nullptr);
+    top_ = SceneHandle(rtcNewScene(device_.h));
+    rtcSetSceneBuildQuality(top_.h, RTC_BUILD_QUALITY_HIGH);
+
+    blas_.resize(data_.geometries.size());
+    for (std::size_t i = 0; i < data_.instances.size(); ++i) {
+      const RtInstance& inst = data_.instances[i];
+      const RtGeometry& geo = data_.geometries[inst.geometry];
+      unsigned id = 0;
+      if (inst.dynamic) {
+        if (!blas_[inst.geometry].h) {
+          blas_[inst.geometry] = SceneHandle(rtcNewScene(device_.h));
+          attach_triangles(blas_[inst.geometry].h, geo, glm::mat4(1.0f));
+          rtcCommitScene(blas_[inst.geometry].h);
+        }
+        RTCGeometry g = rtcNewGeometry(device_.h, RTC_GEOMETRY_TYPE_INSTANCE);
+        rtcSetGeometryInstancedScene(g, blas_[inst.geometry].h);
+        rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT4X4_COLUMN_MAJOR, &inst.object_to_world[0][0]);
+        rtcCommitGeometry(g);
+        id = rtcAttachGeometry(top_.h, g);
+        rtcReleaseGeometry(g);
+      } else {
+        id = attach_triangles(top_.h, geo, inst.object_to_world);
+      }
+      GI_EXPECTS(id == i, "Embree geometry ids follow instance order");
+    }
+    rtcCommitScene(top_.h);
+    if (rtcGetDeviceError(device_.h) != RTC_ERROR_NONE) return engine::Error{"", "embree", "scene build failed"};
+    return {};
+  }
+
+  Hit intersect(const Ray& ray) const override {
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    RTCRayHit rh = to_embree(ray);
+    rtcIntersect1(top_.h, &ctx, &rh);
+    return to_hit(rh);
+  }
+
+  bool occluded(const Ray& ray) const override {
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    RTCRay r = to_embree(ray).ray;
+    rtcOccluded1(top_.h, &ctx, &r);
+    return r.tfar < 0.0f;
+  }
+
+  void intersect_many(std::span<const Ray> rays, std::span<Hit> hits) const override {
+    GI_EXPECTS(rays.size() == hits.size(), "one hit per ray");
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    std::vector<RTCRayHit> batch(rays.size());
+    for (std::size_t i = 0; i < rays.size(); ++i) batch[i] = to_embree(rays[i]);
+    rtcIntersect1M(top_.h, &ctx, batch.data(), static_cast<unsigned>(batch.size()), sizeof(RTCRayHit));
+    for (std::size_t i = 0; i < rays.size(); ++i) hits[i] = to_hit(batch[i]);
+  }
+
+  void occluded_many(std::span<const Ray> rays, std::span<std::uint8_t> out) const override {
+    GI_EXPECTS(rays.size() == out.size(), "one result per ray");
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    std::vector<RTCRay> batch(rays.size());
+    for (std::size_t i = 0; i < rays.size(); ++i) batch[i] = to_embree(rays[i]).ray;
+    rtcOccluded1M(top_.h, &ctx, batch.data(), static_cast<unsigned>(batch.size()), sizeof(RTCRay));
+    for (std::size_t i = 0; i < rays.size(); ++i) out[i] = batch[i].tfar < 0.0f ? 1 : 0;
+  }
+
+  void set_instance_transform(std::uint32_t instance, const glm::mat4& object_to_world) override {
+    GI_EXPECTS(instance < data_.instances.size(), "instance index out of range");
+    GI_EXPECTS(data_.instances[instance].dynamic, "only dynamic instances can move");
+    GI_EXPECTS(finite(object_to_world), "instance transforms must be finite");
+    data_.instances[instance].object_to_world = object_to_world;
+    RTCGeometry g = rtcGetGeometry(top_.h, instance);
+    rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT4X4_COLUMN_MAJOR, &object_to_world[0][0]);
+    rtcCommitGeometry(g);
+  }
+
+  void commit() override { rtcCommitScene(top_.h); }
+
+  RTCScene top() const { return top_.h; }
+
+ private:
+  unsigned attach_triangles(RTCScene scene, const RtGeometry& geo, const glm::mat4& m) {
+    RTCGeometry g = rtcNewGeometry(device_.h, RTC_GEOMETRY_TYPE_TRIANGLE);
+    auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                          3 * sizeof(float), geo.positions.size()));
+    for (std::size_t i = 0; i < geo.positions.size(); ++i) {
+      const glm::vec3 p = glm::vec3(m * glm::vec4(geo.positions[i], 1.0f));
+      v[3 * i + 0] = p.x;
+      v[3 * i + 1] = p.y;
+      v[3 * i + 2] = p.z;
+    }
+    auto* idx = static_cast<unsigned*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                               3 * sizeof(unsigned), geo.indices.size() / 3));
+    for (std::size_t i = 0; i < geo.indices.size(); ++i) idx[i] = geo.indices[i];
+    rtcCommitGeometry(g);
+    const unsigned id = rtcAttachGeometry(scene, g);
+    rtcReleaseGeometry(g);
+    return id;
+  }
+
+  static RTCRayHit to_embree(const Ray& ray) {
+    RTCRayHit rh{};
+    rh.ray.org_x = ray.origin.x;
+    rh.ray.org_y = ray.origin.y;
+    rh.ray.org_z = ray.origin.z;
+    rh.ray.tnear = ray.t_min;
+    rh.ray.dir_x = ray.direction.x;
+    rh.ray.dir_y = ray.direction.y;
+    rh.ray.dir_z = ray.direction.z;
+    rh.ray.time = 0.0f;
+    rh.ray.tfar = ray.t_max;
+    rh.ray.mask = 0xffffffffu;
+    rh.ray.flags = 0;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    return rh;
+  }
+
+  Hit to_hit(const RTCRayHit& rh) const {
+    Hit h;
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return h;
+    const std::uint32_t inst = rh.hit.instID[0] != RTC_INVALID_GEOMETRY_ID ? rh.hit.instID[0] : rh.hit.geomID;
+    const RtInstance& instance = data_.instances[inst];
+    const RtGeometry& geo = data_.geometries[instance.geometry];
+    h.t = rh.ray.tfar;
+    h.instance = inst;
+    h.geometry = instance.geometry;
+    h.primitive = rh.hit.primID;
+    h.barycentric = {rh.hit.u, rh.hit.v};
+    // The geometric normal from the world-space triangle (independent of Embree's
+    // instance-space conventions).
+    const glm::mat4& m = instance.object_to_world;
+    const glm::vec3 p0 = glm::vec3(m * glm::vec4(geo.positions[geo.indices[3 * h.primitive + 0]], 1.0f));
+    const glm::vec3 p1 = glm::vec3(m * glm::vec4(geo.positions[geo.indices[3 * h.primitive + 1]], 1.0f));
+    const glm::vec3 p2 = glm::vec3(m * glm::vec4(geo.positions[geo.indices[3 * h.primitive + 2]], 1.0f));
+    h.geometric_normal = glm::cross(p1 - p0, p2 - p0);
+    return h;
+  }
+
+  RtSceneData data_;
+  DeviceHandle device_;
+  SceneHandle top_;
+  std::vector<SceneHandle> blas_;
+};
+
+}  // namespace
+
+engine::Result<std::unique_ptr<RayCaster>> make_embree_ray_caster(const RtSceneData& data) {
+  auto caster = std::make_unique<EmbreeRayCaster>();
+  if (engine::Status s = caster->build(data); !s) return s.error();
+  return std::unique_ptr<RayCaster>(std::move(caster));
+}
+
+void* embree_scene_handle(const RayCaster& caster) {
+  const auto* e = dynamic_cast<const EmbreeRayCaster*>(&caster);
+  GI_EXPECTS(e != nullptr, "not an Embree ray caster");
+  return e->top();
+}
+
+}  // namespace gi
