@@ -22,9 +22,16 @@ Aabb player_box(const PlayerController& pc, const glm::vec3& eye) {
   return {eye + pc.box_min_from_eye_m, eye + pc.box_max_from_eye_m};
 }
 
+}  // namespace
+
 std::vector<engine::Entity> crates_of(const engine::Registry& reg) {
-  return reg.view<engine::DynamicTag, engine::RigidBody, engine::Transform>().entities();
+  std::vector<engine::Entity> out;
+  for (engine::Entity e : reg.view<engine::DynamicTag, engine::RigidBody, engine::Transform>().entities())
+    if (!reg.get<engine::Transform>(e).parent) out.push_back(e);  // parts of rigs (lamp shade) are not crates
+  return out;
 }
+
+namespace {
 
 // True when moving `mover` from `from` to `to` newly enters another crate's box.
 bool crate_blocks(const engine::Registry& reg, engine::Entity mover, const Aabb& from, const Aabb& to, float skin) {
@@ -126,6 +133,14 @@ void push_crate(engine::Registry& reg, GameplayContext& ctx) {
   rb.velocity_m_s += view * (ctx.tuning.push_impulse_n_s / std::max(rb.mass_kg, 1e-3f));
 }
 
+void swing_lamp(engine::Registry& reg, const engine::FrameTime& time, const GameplayContext& ctx) {
+  if (!ctx.swinging_pivot) return;
+  const double phase = 2.0 * 3.14159265358979 * time.time_s / double{ctx.tuning.lamp_period_s};
+  const float angle = ctx.tuning.lamp_amplitude_rad * static_cast<float>(std::sin(phase));
+  const glm::quat q = ctx.pivot_rest_rotation * glm::angleAxis(angle, glm::vec3(0, 0, 1));
+  if (q != reg.get<engine::Transform>(ctx.swinging_pivot).rotation) reg.write<engine::Transform>(ctx.swinging_pivot).rotation = q;
+}
+
 void integrate_rigid_bodies(engine::Registry& reg, const engine::FrameTime& time, GameplayContext& ctx) {
   const float dt = static_cast<float>(time.dt_s);
   const float skin = ctx.tuning.collision_skin_m;
@@ -209,6 +224,13 @@ GameplayContext prepare_scene(engine::Scene& scene, const GameplayTuning& tuning
     reg.write<engine::Light>(ctx.flashlight).moves = true;
   }
 
+  // The swinging lamp's pivot (demo level), if the scene has one.
+  ctx.swinging_pivot = engine::find_by_name(reg, "lamp_pivot");
+  if (ctx.swinging_pivot && reg.has<engine::Transform>(ctx.swinging_pivot))
+    ctx.pivot_rest_rotation = reg.get<engine::Transform>(ctx.swinging_pivot).rotation;
+  else
+    ctx.swinging_pivot = engine::kNullEntity;
+
   // Crates: collision boxes from their meshes.
   for (engine::Entity c : crates_of(reg)) {
     const Aabb box = mesh_world_bounds(scene, c);
@@ -233,6 +255,8 @@ void add_gameplay_systems(engine::SystemSchedule& schedule, GameplayContext& ctx
   });
   schedule.add(engine::Stage::Gameplay, "push",
                [c](engine::Registry& r, const engine::FrameTime&) { push_crate(r, *c); });
+  schedule.add(engine::Stage::Gameplay, "swinging_lamp",
+               [c](engine::Registry& r, const engine::FrameTime& t) { swing_lamp(r, t, *c); });
   schedule.add(engine::Stage::Physics, "rigid_bodies",
                [c](engine::Registry& r, const engine::FrameTime& t) { integrate_rigid_bodies(r, t, *c); });
   schedule.add(engine::Stage::Transform, "world_transforms",

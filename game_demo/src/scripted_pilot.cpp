@@ -80,8 +80,7 @@ ScriptedPilot::ScriptedPilot(const Simulation& sim, Script script, std::uint64_t
     nz_ = static_cast<int>(std::ceil((level.max.z - level.min.z) / cell_m_)) + 1;
     free_.assign(static_cast<std::size_t>(nx_) * static_cast<std::size_t>(nz_), 0);
     std::vector<Aabb> crates;
-    for (engine::Entity c : reg.view<engine::DynamicTag, engine::RigidBody, engine::Transform>().entities())
-      crates.push_back(crate_box(reg, c, 0.0f));
+    for (engine::Entity c : crates_of(reg)) crates.push_back(crate_box(reg, c, 0.0f));
     for (int z = 0; z < nz_; ++z)
       for (int x = 0; x < nx_; ++x) {
         const glm::vec3 p = cell_center({x, z});
@@ -104,8 +103,26 @@ ScriptedPilot::ScriptedPilot(const Simulation& sim, Script script, std::uint64_t
     const bool near_other = std::any_of(rooms.begin(), rooms.end(), [&](const glm::vec3& r) { return horizontal_distance(r, p) < 2.0f; });
     if (!near_other && nearest_walkable(p)) rooms.push_back(p);
   }
+  // ...and the centres of large static meshes (rooms), for rooms without a fixed light.
+  for (engine::Entity e : reg.view<engine::MeshRenderer, engine::StaticTag, engine::WorldTransform>().entities()) {
+    const std::uint32_t mesh = reg.get<engine::MeshRenderer>(e).mesh;
+    if (mesh >= sim.scene().assets.meshes.size()) continue;
+    Aabb b{glm::vec3(std::numeric_limits<float>::max()), glm::vec3(std::numeric_limits<float>::lowest())};
+    const glm::mat4& m = reg.get<engine::WorldTransform>(e).matrix;
+    for (const engine::Primitive& prim : sim.scene().assets.meshes[mesh].primitives)
+      for (const glm::vec3& v : prim.positions) {
+        const glm::vec3 w(m * glm::vec4(v, 1.0f));
+        b.min = glm::min(b.min, w);
+        b.max = glm::max(b.max, w);
+      }
+    if (b.empty() || (b.max.x - b.min.x) * (b.max.z - b.min.z) < 6.0f || !(b.min.y < eye.y && b.max.y > eye.y)) continue;
+    glm::vec3 p = b.center();
+    p.y = eye.y;
+    const bool near_other = std::any_of(rooms.begin(), rooms.end(), [&](const glm::vec3& r) { return horizontal_distance(r, p) < 2.0f; });
+    if (!near_other && nearest_walkable(p)) rooms.push_back(p);
+  }
   std::vector<glm::vec3> crates;
-  for (engine::Entity c : reg.view<engine::DynamicTag, engine::RigidBody, engine::Transform>().entities()) {
+  for (engine::Entity c : crates_of(reg)) {
     glm::vec3 p = crate_box(reg, c, 0.0f).center();
     p.y = eye.y;
     crates.push_back(p);
@@ -231,10 +248,19 @@ InputFrame ScriptedPilot::next(const Simulation& sim) {
   if (!has_target_) start_target(sim);
   if (!has_target_) return in;
 
-  // Follow the path: aim a few cells ahead of the nearest one still in front.
-  while (path_index_ + 1 < path_.size() && horizontal_distance(eye, path_[path_index_]) < 0.4f) ++path_index_;
-  glm::vec3 aim = path_[std::min(path_index_ + 2, path_.size() - 1)];
-  const bool at_end = path_index_ + 1 >= path_.size() && horizontal_distance(eye, path_.back()) < 0.4f;
+  // Follow the path: find the path cell nearest to the player (searching a little ahead of
+  // the last one), then aim at the first cell at least 0.75 m away.
+  {
+    std::size_t best = path_index_;
+    float best_d = std::numeric_limits<float>::max();
+    for (std::size_t k = path_index_; k < std::min(path_.size(), path_index_ + 12); ++k)
+      if (horizontal_distance(eye, path_[k]) < best_d) best_d = horizontal_distance(eye, path_[k]), best = k;
+    path_index_ = best;
+  }
+  std::size_t aim_index = path_index_;
+  while (aim_index + 1 < path_.size() && horizontal_distance(eye, path_[aim_index]) < 0.75f) ++aim_index;
+  glm::vec3 aim = path_[aim_index];
+  const bool at_end = aim_index + 1 >= path_.size() && horizontal_distance(eye, path_.back()) < 0.3f;
   bool push_now = false;
   if (target_is_crate_) {
     const float reach = sim.context().tuning.push_reach_m * 0.6f;
@@ -243,7 +269,7 @@ InputFrame ScriptedPilot::next(const Simulation& sim) {
       push_now = std::abs(wrap_angle(yaw_towards(eye, aim) - pc.yaw_rad)) < 0.1f;
     }
   }
-  const float err = wrap_angle(yaw_towards(eye, aim) - pc.yaw_rad);
+  const float err = horizontal_distance(eye, aim) < 1e-3f ? 0.0f : wrap_angle(yaw_towards(eye, aim) - pc.yaw_rad);
   in.mouse_dx_px = std::clamp(-err / pc.look_rad_per_px * 0.2f, -14.0f, 14.0f);
   if (std::abs(in.mouse_dx_px) < 0.05f) in.mouse_dx_px = 0.0f;
   const bool close_to_crate = target_is_crate_ && aim == target_;

@@ -5,8 +5,10 @@
 //   game_demo::add_gameplay_systems(schedule, ctx);   // then schedule.run(...) every fixed step
 
 #include <cstdint>
+#include <vector>
 
 #include <glm/glm.hpp>
+#include <glm/gtc/quaternion.hpp>
 
 #include <engine/scene.h>
 #include <engine/system_schedule.h>
@@ -41,6 +43,8 @@ struct GameplayTuning {
   float push_impulse_n_s = 3.0f;      ///< Impulse along the horizontal view direction.
   float crate_damping = 0.9f;         ///< Fraction of crate velocity lost per second.
   float rest_speed_m_s = 0.05f;       ///< Below this a crate stops exactly.
+  float lamp_period_s = 3.2f;         ///< Swing period of the pivot named "lamp_pivot".
+  float lamp_amplitude_rad = 0.35f;   ///< Swing amplitude about the pivot's local Z.
   float collision_skin_m = 0.01f;     ///< Crate boxes are shrunk vertically by this (resting contact).
 };
 
@@ -49,6 +53,8 @@ struct GameplayTuning {
 struct GameplayContext {
   engine::Entity camera;
   engine::Entity flashlight;
+  engine::Entity swinging_pivot;     ///< "lamp_pivot" when the scene has one, else null.
+  glm::quat pivot_rest_rotation{1.0f, 0.0f, 0.0f, 0.0f};
   CollisionWorld collision;
   GameplayTuning tuning;
   InputFrame input;                  ///< This step's input (set before each run).
@@ -66,9 +72,12 @@ struct GameplayContext {
 /// collision world. Leaves world transforms up to date.
 GameplayContext prepare_scene(engine::Scene& scene, const GameplayTuning& tuning = {});
 
-/// Adds, in this order: player_controller (Input), flashlight and split_screen (Gameplay),
-/// push (Gameplay), rigid_bodies (Physics), world_transforms (Transform).
+/// Adds, in this order: player_controller (Input), flashlight, split_screen, push and
+/// swinging_lamp (Gameplay), rigid_bodies (Physics), world_transforms (Transform).
 void add_gameplay_systems(engine::SystemSchedule& schedule, GameplayContext& context);
+
+/// The pushable crates: root entities with DynamicTag, RigidBody and Transform.
+std::vector<engine::Entity> crates_of(const engine::Registry& registry);
 
 /// World-space collision box of a crate entity (shrunk vertically by `skin_m`).
 Aabb crate_box(const engine::Registry& registry, engine::Entity crate, float skin_m);

@@ -1,0 +1,60 @@
+#pragma once
+// The gi_demo executable's shared pieces: its options, the session being recorded or
+// replayed, and the two front ends (headless and windowed). Not part of gi_demo_lib.
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include <engine/renderer.h>
+
+#include <game_demo/replay.h>
+#include <game_demo/scripted_pilot.h>
+#include <game_demo/session_file.h>
+#include <game_demo/simulation.h>
+
+namespace game_demo {
+
+struct RunOptions {
+  std::string scene;            ///< As given (empty: the demo level).
+  bool headless = false;
+  std::uint64_t frames = 0;     ///< 0: headless default 120 / replay length / windowed unlimited.
+  std::string out_dir;          ///< Headless frame folder (empty: no images written).
+  int width = 960;
+  int height = 540;
+  bool size_given = false;
+  std::uint64_t every = 1;
+  bool exr = false;
+  bool no_render = false;
+  std::string record_file;
+  std::string replay_file;
+  std::string script = "tour";
+  std::uint64_t seed = 0;
+  bool verbose = false;
+};
+
+/// Everything a run needs after start-up checks: the simulation, and the session being
+/// replayed (loaded) or recorded (filled in as steps run).
+struct RunState {
+  std::unique_ptr<Simulation> sim;
+  std::optional<Session> replay;  ///< Set with --replay.
+  std::optional<Session> record;  ///< Set with --record; frames appended by record_step().
+  std::uint64_t mismatches = 0;
+
+  /// Steps the simulation with `input`, appends to the recording, checks the replay.
+  /// Returns false (after printing the mismatch) when a replayed checksum differs.
+  bool step(const InputFrame& input);
+  /// Writes the recording, if any; prints and returns false on failure.
+  bool finish_recording(const std::string& path) const;
+};
+
+/// Maps the simulation's split flag to the renderer's setting.
+inline engine::SplitView split_of(const Simulation& sim) {
+  return sim.context().split_view ? engine::SplitView::DirectLeftFullRight : engine::SplitView::Off;
+}
+
+int run_headless(const RunOptions& options, RunState& state);
+int run_windowed(const RunOptions& options, RunState& state);
+
+}  // namespace game_demo

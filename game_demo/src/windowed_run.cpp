@@ -1,0 +1,157 @@
+// Windowed front end: GLFW window, live input (or a replayed session), the fixed-step
+// accumulator, and the Dear ImGui overlay.
+#include <algorithm>
+#include <cstdio>
+#include <iostream>
+
+#define GL_GLEXT_PROTOTYPES
+#include <GL/gl.h>
+#include <GL/glext.h>
+#include <GLFW/glfw3.h>
+
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wold-style-cast"
+#include <imgui.h>
+#include <backends/imgui_impl_glfw.h>
+#include <backends/imgui_impl_opengl3.h>
+#pragma GCC diagnostic pop
+
+#include <engine/components.h>
+#include <engine/gpu/context.h>
+
+#include "demo_run.h"
+
+namespace game_demo {
+
+namespace {
+
+constexpr int kMaxStepsPerFrame = 8;  // beyond this the simulation slows down instead of spiralling
+
+InputFrame live_keys(GLFWwindow* window) {
+  InputFrame in;
+  const std::pair<int, Key> map[] = {{GLFW_KEY_W, Key::W}, {GLFW_KEY_A, Key::A}, {GLFW_KEY_S, Key::S},
+                                     {GLFW_KEY_D, Key::D}, {GLFW_KEY_F, Key::F}, {GLFW_KEY_E, Key::E},
+                                     {GLFW_KEY_G, Key::G}};
+  if (ImGui::GetIO().WantCaptureKeyboard) return in;
+  for (const auto& [glfw_key, key] : map)
+    if (glfwGetKey(window, glfw_key) == GLFW_PRESS) in.keys |= key_bit(key);
+  return in;
+}
+
+void draw_overlay(const RunOptions& o, const RunState& state, const engine::Renderer& renderer, double frame_ms,
+                  double fps) {
+  const Simulation& sim = *state.sim;
+  ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_Always);
+  ImGui::SetNextWindowBgAlpha(0.6f);
+  ImGui::Begin("gi_demo", nullptr,
+               ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoInputs);
+  ImGui::Text("%.1f fps   frame %.2f ms   step %llu", fps, frame_ms, static_cast<unsigned long long>(sim.frame()));
+  ImGui::Separator();
+  ImGui::TextUnformatted("GI effects: constant ambient (stand-in) - GI methods not baked");
+  const engine::Light* torch = sim.registry().try_get<engine::Light>(sim.context().flashlight);
+  ImGui::Text("flashlight (F): %s   split (G): %s", torch && torch->enabled ? "on" : "off",
+              sim.context().split_view ? "direct | full" : "off");
+  if (state.replay)
+    ImGui::Text("replaying %s: %llu / %zu", o.replay_file.c_str(), static_cast<unsigned long long>(sim.frame()),
+                state.replay->frames.size());
+  if (state.record) ImGui::Text("recording to %s: %zu frames", o.record_file.c_str(), state.record->frames.size());
+  ImGui::Separator();
+  ImGui::TextUnformatted("render passes (ms, glFinish-timed)");
+  for (const auto& p : renderer.last_timings()) ImGui::Text("  %-20s %7.3f", p.name.c_str(), p.ms);
+  ImGui::TextUnformatted("systems (CPU ms, last step)");
+  for (const auto& t : sim.schedule().last_timings()) ImGui::Text("  %-20s %7.3f", t.name.c_str(), t.cpu_ms);
+  ImGui::End();
+}
+
+}  // namespace
+
+int run_windowed(const RunOptions& o, RunState& state) {
+  Simulation& sim = *state.sim;
+  auto ctx = engine::GpuContext::create_window("gi_demo", o.width, o.height);
+  if (!ctx) {
+    std::cerr << "gi_demo: cannot open the window: " << ctx.error().to_string() << '\n';
+    return 1;
+  }
+  GLFWwindow* window = ctx->window();
+  auto r = engine::Renderer::create(sim.scene().assets, engine::RenderSettings{.width = o.width, .height = o.height});
+  if (!r) {
+    std::cerr << "gi_demo: " << r.error().to_string() << '\n';
+    return 1;
+  }
+  std::unique_ptr<engine::Renderer> renderer = std::move(r).value();
+  std::cout << "gi_demo: window " << o.width << "x" << o.height << " on " << ctx->description() << '\n';
+
+  glfwSetInputMode(window, GLFW_CURSOR, GLFW_CURSOR_DISABLED);
+  if (glfwRawMouseMotionSupported()) glfwSetInputMode(window, GLFW_RAW_MOUSE_MOTION, GLFW_TRUE);
+  IMGUI_CHECKVERSION();
+  ImGui::CreateContext();
+  ImGui::GetIO().IniFilename = nullptr;
+  ImGui_ImplGlfw_InitForOpenGL(window, true);
+  ImGui_ImplOpenGL3_Init("#version 450");
+
+  const double dt = sim.settings().fixed_dt_s;
+  double cursor_x = 0, cursor_y = 0;
+  glfwGetCursorPos(window, &cursor_x, &cursor_y);
+  double last = glfwGetTime(), accumulator = 0.0, fps = 0.0, frame_ms = 0.0;
+  int status = 0;
+  while (!glfwWindowShouldClose(window)) {
+    glfwPollEvents();
+    if (glfwGetKey(window, GLFW_KEY_ESCAPE) == GLFW_PRESS) break;
+    const double now = glfwGetTime();
+    frame_ms = (now - last) * 1000.0;
+    fps = fps == 0.0 ? 1000.0 / std::max(frame_ms, 1e-3) : 0.95 * fps + 0.05 * 1000.0 / std::max(frame_ms, 1e-3);
+    accumulator = std::min(accumulator + (now - last), kMaxStepsPerFrame * dt);
+    last = now;
+
+    double x = 0, y = 0;
+    glfwGetCursorPos(window, &x, &y);
+    InputFrame live = live_keys(window);
+    live.mouse_dx_px = static_cast<float>(x - cursor_x);
+    live.mouse_dy_px = static_cast<float>(y - cursor_y);
+    cursor_x = x;
+    cursor_y = y;
+
+    bool done = false;
+    while (accumulator >= dt) {
+      accumulator -= dt;
+      if (state.replay) {
+        if (sim.frame() >= state.replay->frames.size()) {
+          done = true;
+          break;
+        }
+        if (!state.step(state.replay->frames[sim.frame()].input)) {
+          status = 3;
+          done = true;
+          break;
+        }
+      } else {
+        state.step(live);
+        live.mouse_dx_px = live.mouse_dy_px = 0.0f;  // the mouse moved once, not once per step
+      }
+      if (o.frames > 0 && sim.frame() >= o.frames) done = true;
+    }
+
+    int fb_w = 0, fb_h = 0;
+    glfwGetFramebufferSize(window, &fb_w, &fb_h);
+    renderer->settings().split = split_of(sim);
+    renderer->render(sim.registry(), sim.context().camera);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glViewport(0, 0, fb_w, fb_h);
+    renderer->present(fb_w, fb_h);
+    ImGui_ImplOpenGL3_NewFrame();
+    ImGui_ImplGlfw_NewFrame();
+    ImGui::NewFrame();
+    draw_overlay(o, state, *renderer, frame_ms, fps);
+    ImGui::Render();
+    ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+    ctx->swap();
+    if (done) break;
+  }
+  ImGui_ImplOpenGL3_Shutdown();
+  ImGui_ImplGlfw_Shutdown();
+  ImGui::DestroyContext();
+  renderer.reset();
+  return status;
+}
+
+}  // namespace game_demo
