@@ -458,7 +458,13 @@ Result<ParsedFile> parse_file(const Context& ctx, const fs::path& path) {
   if (auto ok = prevalidate(ctx, container, out); !ok) return ok.error();
   out.mesh_quantization = declares_extension(out.doc, "KHR_mesh_quantization");
 
-  const std::string stripped = out.doc.dump();
+  // Lights are read from the JSON by the loader (gltf_load_lights.cpp); tinygltf's own
+  // parser rejects valid spot lights that rely on the default cone angles.
+  Json for_tinygltf = out.doc;
+  if (Json* exts = for_tinygltf.contains("extensions") ? &for_tinygltf["extensions"] : nullptr; exts != nullptr && exts->is_object()) {
+    exts->erase("KHR_lights_punctual");
+  }
+  const std::string stripped = for_tinygltf.dump();
   ImageDecodeState& images = out.images;
   images.decode = ctx.options.load_images;
   images.max_dimension = ctx.options.limits.max_image_dimension;

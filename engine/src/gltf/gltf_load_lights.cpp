@@ -70,10 +70,10 @@ Result<NamedLight> convert_light(const Context& ctx, const Json& src, const std:
     if (out.light.type != LightType::Directional) out.light.range_m = static_cast<float>(*range);
   }
   if (out.light.type == LightType::Spot) {
+    // KHR_lights_punctual: a spot light has a "spot" object (its members have defaults).
     const Json* spot = find_member(src, "spot");
-    if (spot != nullptr && !spot->is_object()) return ctx.error(where, "'spot' must be an object");
-    const Json empty = Json::object();
-    const Json& s = spot != nullptr ? *spot : empty;
+    if (spot == nullptr || !spot->is_object()) return ctx.error(where, "spot light needs a 'spot' object");
+    const Json& s = *spot;
     auto inner = number_member(ctx, s, "innerConeAngle", 0.0, where + " spot");
     if (!inner) return inner.error();
     auto outer = number_member(ctx, s, "outerConeAngle", std::numbers::pi / 4.0, where + " spot");
