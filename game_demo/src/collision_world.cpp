@@ -51,8 +51,7 @@ void CollisionWorld::add_triangle(const glm::vec3& a, const glm::vec3& b, const 
   const glm::vec3 n = glm::cross(b - a, c - a);
   const float len = glm::length(n);
   if (!(len > 1e-12f)) return;  // degenerate (or NaN): no wall
-  if (std::abs(n.y / len) >= 0.7f) return;  // floor or ceiling
-  walls_.push_back(Triangle{a, b, c, tb});
+  (std::abs(n.y / len) >= 0.7f ? floors_ : walls_).push_back(Triangle{a, b, c, tb});
 }
 
 CollisionWorld CollisionWorld::build(const engine::Scene& scene) {
@@ -84,8 +83,14 @@ bool CollisionWorld::overlaps_wall(const Aabb& box) const {
   return false;
 }
 
-bool CollisionWorld::blocks_move(const Aabb& from, const Aabb& box) const {
-  for (const Triangle& t : walls_) {
+bool CollisionWorld::blocks_move(const Aabb& from, const Aabb& box) const { return blocks(walls_, from, box); }
+
+bool CollisionWorld::blocks_vertical_move(const Aabb& from, const Aabb& box) const {
+  return blocks(floors_, from, box) || blocks(walls_, from, box);
+}
+
+bool CollisionWorld::blocks(const std::vector<Triangle>& tris, const Aabb& from, const Aabb& box) {
+  for (const Triangle& t : tris) {
     // Broad phase: flat bounds of axis-aligned walls still pass the strict interior test
     // when the box straddles their plane.
     if (!t.bounds.overlaps(box)) continue;

@@ -32,6 +32,7 @@ struct RunOptions {
   std::string script = "tour";
   std::uint64_t seed = 0;
   bool verbose = false;
+  bool only_written = false;  ///< Headless: render only the frames written to --out.
 };
 
 /// Everything a run needs after start-up checks: the simulation, and the session being

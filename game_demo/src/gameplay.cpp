@@ -141,27 +141,41 @@ void swing_lamp(engine::Registry& reg, const engine::FrameTime& time, const Game
   if (q != reg.get<engine::Transform>(ctx.swinging_pivot).rotation) reg.write<engine::Transform>(ctx.swinging_pivot).rotation = q;
 }
 
+// A crate rests on something when a box a few centimetres below it meets a floor or
+// another crate it does not already overlap.
+bool supported(const engine::Registry& reg, engine::Entity crate, const Aabb& box, const GameplayContext& ctx) {
+  const Aabb probe = box.shifted({0.0f, -ctx.tuning.support_probe_m, 0.0f});
+  return ctx.collision.blocks_vertical_move(box, probe) || crate_blocks(reg, crate, box, probe, ctx.tuning.collision_skin_m);
+}
+
 void integrate_rigid_bodies(engine::Registry& reg, const engine::FrameTime& time, GameplayContext& ctx) {
   const float dt = static_cast<float>(time.dt_s);
   const float skin = ctx.tuning.collision_skin_m;
   for (engine::Entity c : crates_of(reg)) {
     const engine::RigidBody& rb = reg.get<engine::RigidBody>(c);
-    if (rb.velocity_m_s == glm::vec3(0.0f)) continue;  // at rest: nothing is written
-    glm::vec3 v = rb.velocity_m_s * std::pow(1.0f - std::clamp(rb.linear_damping, 0.0f, 1.0f), dt);
+    const Aabb box0 = crate_box(reg, c, skin);
+    glm::vec3 v = rb.velocity_m_s;
+    const bool falling = !supported(reg, c, box0, ctx);
+    if (v == glm::vec3(0.0f) && !falling) continue;  // at rest: nothing is written
+    const float keep = std::pow(1.0f - std::clamp(rb.linear_damping, 0.0f, 1.0f), dt);
+    v.x *= keep;
+    v.z *= keep;
+    if (falling) v.y -= ctx.tuning.gravity_m_s2 * dt;
     glm::vec3 pos = reg.get<engine::Transform>(c).position;
     const glm::vec3 start = pos;
-    for (int axis = 0; axis < 3; ++axis) {
+    for (int axis : {1, 0, 2}) {
       if (v[axis] == 0.0f) continue;
-      const Aabb from = crate_box(reg, c, skin).shifted(pos - start);
+      const Aabb from = box0.shifted(pos - start);
       const Aabb to = from.shifted(glm::vec3(axis == 0, axis == 1, axis == 2) * (v[axis] * dt));
-      if (ctx.collision.blocks_move(from, to) || crate_blocks(reg, c, from, to, skin)) {
-        v[axis] = 0.0f;  // hit a wall or another crate: stop along this axis
+      const bool wall = axis == 1 ? ctx.collision.blocks_vertical_move(from, to) : ctx.collision.blocks_move(from, to);
+      if (wall || crate_blocks(reg, c, from, to, skin)) {
+        v[axis] = 0.0f;  // hit a wall, the floor or another crate: stop along this axis
         continue;
       }
       pos[axis] += v[axis] * dt;
     }
-    if (glm::length(v) < ctx.tuning.rest_speed_m_s) v = glm::vec3(0.0f);
-    reg.write<engine::RigidBody>(c).velocity_m_s = v;
+    if (glm::length(glm::vec2(v.x, v.z)) < ctx.tuning.rest_speed_m_s) v.x = v.z = 0.0f;
+    if (v != rb.velocity_m_s) reg.write<engine::RigidBody>(c).velocity_m_s = v;
     if (pos != start) reg.write<engine::Transform>(c).position = pos;
   }
 }

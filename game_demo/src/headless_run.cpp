@@ -93,7 +93,8 @@ int run_headless(const RunOptions& o, RunState& state) {
       if (!systems.contains(t.name)) system_order.push_back(t.name);
       systems[t.name].add(t.cpu_ms);
     }
-    if (renderer) {
+    const bool written = !o.out_dir.empty() && i % o.every == 0;
+    if (renderer && (written || !o.only_written)) {
       const auto t1 = Clock::now();
       renderer->settings().split = split_of(sim);
       renderer->render(sim.registry(), sim.context().camera);
@@ -102,7 +103,7 @@ int run_headless(const RunOptions& o, RunState& state) {
         if (!passes.contains(p.name)) pass_order.push_back(p.name);
         passes[p.name].add(p.ms);
       }
-      if (!o.out_dir.empty() && i % o.every == 0) {
+      if (written) {
         const auto t2 = Clock::now();
         char name[32];
         std::snprintf(name, sizeof name, "frame_%04llu", static_cast<unsigned long long>(i));

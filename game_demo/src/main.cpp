@@ -55,6 +55,8 @@ int main(int argc, char** argv) {
   app.add_option("--replay", o.replay_file, "Replay a .girec session, checking every frame's checksum")->excludes(rec);
   app.add_option("--script", o.script, "Headless input script: tour, walk_flashlight, push_crates, split_screen");
   app.add_option("--seed", o.seed, "Session seed (recorded in the header and the checksum)");
+  app.add_flag("--only-written-frames", o.only_written,
+               "Headless: render only the frames --out/--every write (fast golden and approval runs)");
   app.add_flag("--verbose", o.verbose, "Headless: print the script's waypoints and the player's position each second");
   CLI11_PARSE(app, argc, argv);
   o.size_given = w->count() > 0 || h->count() > 0;

@@ -264,7 +264,7 @@ InputFrame ScriptedPilot::next(const Simulation& sim) {
   bool push_now = false;
   if (target_is_crate_) {
     const float reach = sim.context().tuning.push_reach_m * 0.6f;
-    if (horizontal_distance(eye, target_) < reach + 0.8f || at_end) {
+    if (horizontal_distance(eye, target_) < reach + 0.4f || at_end) {
       aim = target_;
       push_now = std::abs(wrap_angle(yaw_towards(eye, aim) - pc.yaw_rad)) < 0.1f;
     }

@@ -184,8 +184,32 @@ TEST(SplitScreen, GTogglesOnPress) {
 TEST(Schedule, GameplaySystemsRunInTheDocumentedOrder) {
   game_demo::Simulation sim(demo_test::make_room({}));
   const std::vector<std::string> expected = {"player_controller", "flashlight", "split_screen",
-                                             "push", "rigid_bodies", "world_transforms"};
+                                             "push", "swinging_lamp", "rigid_bodies", "world_transforms"};
   EXPECT_EQ(sim.schedule().order(), expected);
+}
+
+}  // namespace
+
+namespace {
+
+TEST(RigidBodies, UnsupportedCrateFallsToTheFloorAndStackedCrateRests) {
+  // One crate floating 1 m up, one resting on another.
+  game_demo::Simulation sim(demo_test::make_room(
+      {{{3.0f, 1.4f, 0.0f}}, {{-3.0f, 0.4f, 0.0f}}, {{-3.0f, 1.2f, 0.0f}}}));
+  const auto& reg = sim.registry();
+  const auto crates = reg.entities_with<engine::DynamicTag>();
+  ASSERT_EQ(crates.size(), 3u);
+  sim.step({});
+  EXPECT_LT(reg.get<engine::RigidBody>(crates[0]).velocity_m_s.y, 0.0f);  // falling
+  EXPECT_EQ(reg.get<engine::RigidBody>(crates[2]).velocity_m_s, glm::vec3(0.0f));  // stacked: supported
+  for (int i = 0; i < 2 * 60; ++i) sim.step({});
+  const float bottom = reg.get<engine::Transform>(crates[0]).position.y - 0.4f;
+  EXPECT_GE(bottom, -0.01f - 1e-4f);  // never more than the 1 cm collision skin into the floor
+  EXPECT_LT(bottom, 0.03f + 1e-4f); // landed within the support probe
+  EXPECT_EQ(reg.get<engine::RigidBody>(crates[0]).velocity_m_s, glm::vec3(0.0f));
+  EXPECT_FLOAT_EQ(reg.get<engine::Transform>(crates[2]).position.y, 1.2f);
+  sim.step({});
+  EXPECT_TRUE(reg.changed<engine::Transform>().empty());  // everything at rest again
 }
 
 }  // namespace

@@ -44,6 +44,9 @@ class CollisionWorld {
   /// `from` to `box` would enter a wall. (Starting inside geometry never traps a mover.)
   bool blocks_move(const Aabb& from, const Aabb& box) const;
 
+  /// Like blocks_move, against floor and ceiling triangles (vertical motion).
+  bool blocks_vertical_move(const Aabb& from, const Aabb& box) const;
+
   /// True when `box` overlaps any wall triangle.
   bool overlaps_wall(const Aabb& box) const;
 
@@ -56,7 +59,9 @@ class CollisionWorld {
     glm::vec3 a, b, c;
     Aabb bounds;
   };
+  static bool blocks(const std::vector<Triangle>& tris, const Aabb& from, const Aabb& box);
   std::vector<Triangle> walls_;
+  std::vector<Triangle> floors_;  ///< Floors and ceilings (|normal.y| >= 0.7).
   Aabb bounds_{glm::vec3(1e30f), glm::vec3(-1e30f)};
 };
 

@@ -43,6 +43,8 @@ struct GameplayTuning {
   float push_impulse_n_s = 3.0f;      ///< Impulse along the horizontal view direction.
   float crate_damping = 0.9f;         ///< Fraction of crate velocity lost per second.
   float rest_speed_m_s = 0.05f;       ///< Below this a crate stops exactly.
+  float gravity_m_s2 = 9.81f;         ///< Unsupported crates fall.
+  float support_probe_m = 0.03f;      ///< How far below a crate support is looked for.
   float lamp_period_s = 3.2f;         ///< Swing period of the pivot named "lamp_pivot".
   float lamp_amplitude_rad = 0.35f;   ///< Swing amplitude about the pivot's local Z.
   float collision_skin_m = 0.01f;     ///< Crate boxes are shrunk vertically by this (resting contact).
