@@ -68,6 +68,9 @@ Result<Attribute> read_attribute(const Context& ctx, const ParsedFile& file, con
   if (index < 0 || static_cast<std::size_t>(index) >= file.model.accessors.size()) {
     return ctx.error(where, semantic + " refers to accessor " + std::to_string(index) + ", which is out of range");
   }
+  if (!file.accessor_problems.at(static_cast<std::size_t>(index)).empty()) {
+    return ctx.error("accessor " + std::to_string(index), file.accessor_problems[static_cast<std::size_t>(index)]);
+  }
   const tinygltf::Accessor& acc = file.model.accessors[static_cast<std::size_t>(index)];
   if (!attribute_layout_allowed(semantic, acc, file.mesh_quantization)) {
     return ctx.error("accessor " + std::to_string(index),
@@ -171,6 +174,10 @@ Result<std::optional<Primitive>> convert_primitive(const Context& ctx, const Par
   } else if (indices_accessor >= 0) {
     if (static_cast<std::size_t>(indices_accessor) >= file.model.accessors.size()) {
       return ctx.error(where, "indices accessor " + std::to_string(indices_accessor) + " is out of range");
+    }
+    if (!file.accessor_problems.at(static_cast<std::size_t>(indices_accessor)).empty()) {
+      return ctx.error("accessor " + std::to_string(indices_accessor),
+                       file.accessor_problems[static_cast<std::size_t>(indices_accessor)]);
     }
     const tinygltf::Accessor& acc = file.model.accessors[static_cast<std::size_t>(indices_accessor)];
     // §3.7.2.1: indices are SCALAR unsigned byte/short/int, not normalized.
