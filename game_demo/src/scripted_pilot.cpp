@@ -93,17 +93,8 @@ ScriptedPilot::ScriptedPilot(const Simulation& sim, Script script, std::uint64_t
       }
   }
 
-  // Waypoints: room centres (static lights) and crates.
+  // Waypoints: the centres of large static meshes at eye height (rooms), then crates.
   std::vector<glm::vec3> rooms;
-  for (engine::Entity e : reg.view<engine::Light, engine::WorldTransform>().entities()) {
-    const engine::Light& l = reg.get<engine::Light>(e);
-    if (l.moves || l.type == engine::LightType::Directional || e == ctx.flashlight) continue;
-    glm::vec3 p = glm::vec3(reg.get<engine::WorldTransform>(e).matrix[3]);
-    p.y = eye.y;
-    const bool near_other = std::any_of(rooms.begin(), rooms.end(), [&](const glm::vec3& r) { return horizontal_distance(r, p) < 2.0f; });
-    if (!near_other && nearest_walkable(p)) rooms.push_back(p);
-  }
-  // ...and the centres of large static meshes (rooms), for rooms without a fixed light.
   for (engine::Entity e : reg.view<engine::MeshRenderer, engine::StaticTag, engine::WorldTransform>().entities()) {
     const std::uint32_t mesh = reg.get<engine::MeshRenderer>(e).mesh;
     if (mesh >= sim.scene().assets.meshes.size()) continue;
@@ -117,6 +108,16 @@ ScriptedPilot::ScriptedPilot(const Simulation& sim, Script script, std::uint64_t
       }
     if (b.empty() || (b.max.x - b.min.x) * (b.max.z - b.min.z) < 6.0f || !(b.min.y < eye.y && b.max.y > eye.y)) continue;
     glm::vec3 p = b.center();
+    p.y = eye.y;
+    const bool near_other = std::any_of(rooms.begin(), rooms.end(), [&](const glm::vec3& r) { return horizontal_distance(r, p) < 2.0f; });
+    if (!near_other && nearest_walkable(p)) rooms.push_back(p);
+  }
+  // Fallback for levels without room meshes: the static lights.
+  const bool had_rooms = !rooms.empty();
+  for (engine::Entity e : reg.view<engine::Light, engine::WorldTransform>().entities()) {
+    const engine::Light& l = reg.get<engine::Light>(e);
+    if (had_rooms || l.moves || l.type == engine::LightType::Directional || e == ctx.flashlight) continue;
+    glm::vec3 p = glm::vec3(reg.get<engine::WorldTransform>(e).matrix[3]);
     p.y = eye.y;
     const bool near_other = std::any_of(rooms.begin(), rooms.end(), [&](const glm::vec3& r) { return horizontal_distance(r, p) < 2.0f; });
     if (!near_other && nearest_walkable(p)) rooms.push_back(p);

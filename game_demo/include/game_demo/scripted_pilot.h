@@ -32,8 +32,8 @@ std::string_view script_name(Script s);
 class ScriptedPilot {
  public:
   /// Plans on the simulation's current state: a walkability grid (0.25 m cells) from the
-  /// collision world at the camera's height, waypoints at the level's static lights
-  /// (room centres) and crates. `frames` is the budget the timed key presses scale to.
+  /// collision world at the camera's height, waypoints at the centres of large static
+  /// meshes spanning eye height (rooms; the static lights when there are none) and crates. `frames` is the budget the timed key presses scale to.
   ScriptedPilot(const Simulation& sim, Script script, std::uint64_t frames);
 
   /// The input for the next step of `sim`.
