@@ -149,14 +149,18 @@ Result<std::vector<double>> read_accessor(const Context& ctx, const ParsedFile& 
   }
   const std::size_t n = static_cast<std::size_t>(ncomp);
   const std::size_t element_size = csize * n;
-  std::vector<double> values(acc.count * n, 0.0);  // §3.6.2.3: no bufferView means zeros
+  std::vector<double> values;
   if (acc.bufferView >= 0) {
+    // Located before allocating, so the count is bounded by real data.
     auto range = locate(ctx, file, acc.bufferView, acc.byteOffset, acc.count, element_size, csize, true, where);
     if (!range) return range.error();
+    values.resize(acc.count * n);
     for (std::size_t i = 0; i < acc.count; ++i) {
       const std::uint8_t* e = range->data + i * range->stride;
       for (std::size_t c = 0; c < n; ++c) values[i * n + c] = read_component(e + c * csize, acc.componentType, acc.normalized);
     }
+  } else {
+    values.assign(acc.count * n, 0.0);  // §3.6.2.3: no bufferView means zeros
   }
   if (acc.sparse.isSparse) {
     const auto& sp = acc.sparse;

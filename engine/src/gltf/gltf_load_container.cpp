@@ -206,6 +206,7 @@ Status prevalidate(const Context& ctx, const Container& container, ParsedFile& o
     }
   }
   std::size_t view_count = 0;
+  std::vector<std::size_t> view_buffer;
   if (const Json* views = find_member(doc, "bufferViews")) {
     view_count = views->size();
     for (std::size_t i = 0; i < views->size(); ++i) {
@@ -222,6 +223,7 @@ Status prevalidate(const Context& ctx, const Container& container, ParsedFile& o
       auto length = index_member(ctx, view, "byteLength", -1, where);
       if (!length) return length.error();
       if (*length < 1) return ctx.error(where, "'byteLength' is required and must be >= 1");
+      view_buffer.push_back(static_cast<std::size_t>(*buffer));
       const std::int64_t buffer_length = buffer_lengths[static_cast<std::size_t>(*buffer)];
       if (*offset > buffer_length || *length > buffer_length - *offset) {
         return ctx.error(where, "byte range [" + std::to_string(*offset) + ", " + std::to_string(*offset + *length) +
@@ -243,6 +245,14 @@ Status prevalidate(const Context& ctx, const Container& container, ParsedFile& o
       if (!view) return view.error();
       if (*view >= 0 && static_cast<std::size_t>(*view) >= view_count) {
         return ctx.error(where, "'bufferView' " + std::to_string(*view) + " is out of range");
+      }
+      // tinygltf hands the view's bytes to the decoder without a check: a buffer without
+      // data (a placeholder) must not be read here.
+      if (*view >= 0) {
+        const std::size_t b = view_buffer[static_cast<std::size_t>(*view)];
+        if (!out.buffer_problems[b].empty()) {
+          return ctx.error(where, "reads buffer " + std::to_string(b) + ", which has no data: " + out.buffer_problems[b]);
+        }
       }
     }
   }
