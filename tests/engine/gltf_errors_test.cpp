@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <cstring>
+#include <random>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -291,6 +292,35 @@ TEST(GltfErrors, MaterialFactorsOutOfRange) {
   expect_error(write("rough.gltf", d.dump()), {"material 0", "roughnessFactor"});
   d["materials"] = json::parse(R"([{"extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": -2}}}])");
   expect_error(write("strength.gltf", d.dump()), {"material 0", "emissiveStrength"});
+}
+
+TEST(GltfErrors, TruncatedAndBitFlippedFilesNeverCrash) {
+  // Deterministic corruption of a valid .glb and .gltf: every outcome must be a value or an
+  // Error naming the file; a crash or an exception fails the whole test binary.
+  std::mt19937 rng(12345);
+  const std::vector<std::uint8_t> good_glb = glb();
+  const std::string good_json = valid_doc().dump();
+  int errors = 0;
+  for (int i = 0; i < 300; ++i) {
+    const bool binary = i % 2 == 0;
+    std::vector<std::uint8_t> bytes = binary ? good_glb : std::vector<std::uint8_t>(good_json.begin(), good_json.end());
+    if (i % 3 == 0) {
+      bytes.resize(std::uniform_int_distribution<std::size_t>(0, bytes.size() - 1)(rng));
+    } else {
+      for (int k = 0; k < 1 + i % 4; ++k) {
+        const std::size_t at = std::uniform_int_distribution<std::size_t>(0, bytes.size() - 1)(rng);
+        bytes[at] = static_cast<std::uint8_t>(rng());
+      }
+    }
+    const fs::path p = write_bytes(binary ? "fuzz.glb" : "fuzz.gltf", bytes);
+    auto r = engine::load_gltf(p);
+    if (!r.ok()) {
+      ++errors;
+      EXPECT_EQ(r.error().file, p.string());
+      EXPECT_FALSE(r.error().message.empty());
+    }
+  }
+  EXPECT_GT(errors, 100);  // most corruptions are detected
 }
 
 }  // namespace

@@ -9,7 +9,9 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -109,6 +111,37 @@ TEST(GltfExternalAssets, TruncatedDracoDataIsACleanError) {
   ASSERT_FALSE(r.ok());
   EXPECT_NE(r.error().to_string().find("Box.gltf"), std::string::npos);
   EXPECT_NE(r.error().to_string().find("Draco"), std::string::npos) << r.error().to_string();
+
+  // Every other cut and some flipped bytes: a clean error or finite geometry, never a crash.
+  nlohmann::json original;
+  std::ifstream(src / "Box.gltf") >> original;
+  const int full = original["bufferViews"][static_cast<std::size_t>(view)]["byteLength"].get<int>();
+  std::vector<char> bin((std::istreambuf_iterator<char>(*std::make_unique<std::ifstream>(src / "Box.bin", std::ios::binary))),
+                        std::istreambuf_iterator<char>());
+  const std::size_t view_offset = doc["bufferViews"][static_cast<std::size_t>(view)].value("byteOffset", 0u);
+  for (int cut = 1; cut < full; cut += 7) {
+    doc["bufferViews"][static_cast<std::size_t>(view)]["byteLength"] = cut;
+    std::ofstream(dir / "Box.gltf") << doc.dump();
+    auto c = engine::load_gltf(dir / "Box.gltf");
+    if (!c.ok()) {
+      EXPECT_NE(c.error().to_string().find("Draco"), std::string::npos) << c.error().to_string();
+    }
+  }
+  doc["bufferViews"][static_cast<std::size_t>(view)]["byteLength"] = full;
+  std::ofstream(dir / "Box.gltf") << doc.dump();
+  for (int flip = 0; flip < 60; ++flip) {
+    std::vector<char> corrupt = bin;
+    corrupt[view_offset + static_cast<std::size_t>((flip * 37) % full)] ^= static_cast<char>(1 + flip % 255);
+    std::ofstream(dir / "Box.bin", std::ios::binary).write(corrupt.data(), static_cast<std::streamsize>(corrupt.size()));
+    auto c = engine::load_gltf(dir / "Box.gltf");
+    if (c.ok()) {
+      for (const auto& m : c->meshes) {
+        for (const auto& p : m.primitives) {
+          for (std::uint32_t i : p.indices) ASSERT_LT(i, p.positions.size());
+        }
+      }
+    }
+  }
 }
 
 TEST(GltfExternalAssets, AvocadoDracoWithTextures) {
