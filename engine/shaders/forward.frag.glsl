@@ -2,6 +2,23 @@
 // Forward HDR pass: direct light of every enabled light with shadows, emission, and the
 // indirect term (provider atlas / per-vertex irradiance / glossy texture, or the constant
 // ambient stand-in). Output: linear radiance, W/(m^2 sr).
+//
+// The light list is sorted by type (point, spot, directional, area) and the count of each
+// type is a compile-time constant (one program variant per combination, built on demand):
+// llvmpipe executes dynamic loops and branches for all SIMD lanes with masks, so a generic
+// per-light switch would run every light type's code for every light.
+#ifndef POINT_LIGHTS
+#define POINT_LIGHTS 0
+#endif
+#ifndef SPOT_LIGHTS
+#define SPOT_LIGHTS 0
+#endif
+#ifndef DIRECTIONAL_LIGHTS
+#define DIRECTIONAL_LIGHTS 0
+#endif
+#ifndef AREA_LIGHTS
+#define AREA_LIGHTS 0
+#endif
 
 #include "lighting_common.glsl"
 #include "shadow_common.glsl"
@@ -13,7 +30,6 @@ in vec2 v_uv1;
 in vec3 v_vertex_irradiance;
 
 layout(location = 16) uniform vec3 u_camera_position;
-layout(location = 17) uniform int u_light_count;
 layout(location = 18) uniform vec4 u_base_color;
 layout(location = 19) uniform float u_metallic;
 layout(location = 20) uniform float u_roughness;
@@ -50,12 +66,32 @@ void main() {
   s.alpha = roughness * roughness;
 
   vec3 radiance = u_emissive * texture(u_emissive_texture, v_uv0).rgb;
-  for (int i = 0; i < u_light_count; ++i) {
-    vec3 to_light;
-    vec3 lit = light_radiance(lights[i], s, to_light);
-    if (all(equal(lit, vec3(0.0)))) continue;
-    radiance += lit * light_shadow(lights[i], s.position, s.normal, to_light);
+  // #if guards: llvmpipe runs a loop body at least once (masked) even for zero iterations.
+  vec3 to_light;
+#if POINT_LIGHTS > 0
+  for (int i = 0; i < POINT_LIGHTS; ++i)
+    radiance += point_light_radiance(lights[i], s, to_light) * shadow_cube(lights[i], s.position, s.normal, to_light);
+#endif
+#if SPOT_LIGHTS > 0
+  for (int k = 0; k < SPOT_LIGHTS; ++k) {
+    const int i = POINT_LIGHTS + k;
+    radiance += spot_light_radiance(lights[i], s, to_light) * shadow_2d(lights[i], s.position, s.normal, to_light, 1);
   }
+#endif
+#if DIRECTIONAL_LIGHTS > 0
+  for (int k = 0; k < DIRECTIONAL_LIGHTS; ++k) {
+    const int i = POINT_LIGHTS + SPOT_LIGHTS + k;
+    radiance += directional_light_radiance(lights[i], s, to_light) *
+                shadow_2d(lights[i], s.position, s.normal, to_light, 1);
+  }
+#endif
+#if AREA_LIGHTS > 0
+  for (int k = 0; k < AREA_LIGHTS; ++k) {
+    const int i = POINT_LIGHTS + SPOT_LIGHTS + DIRECTIONAL_LIGHTS + k;
+    to_light = normalize(lights[i].position_type.xyz - s.position);
+    radiance += area_light_radiance(lights[i], s) * shadow_2d(lights[i], s.position, s.normal, to_light, 2);
+  }
+#endif
 
   if (gl_FragCoord.x >= u_split_x) {
     // Indirect irradiance E (W/m^2) reflected by the diffuse lobe: albedo / pi * E.

@@ -18,7 +18,7 @@ struct GpuLight {
   vec4 area_half_y;       // xyz: half of the rectangle along the light's Y axis (m)
   mat4 shadow_view_proj;  // world -> clip of the 2-D shadow map
   vec4 shadow_eye;        // xyz: shadow camera position (m); w: far distance that maps to depth 1 (m)
-  vec4 shadow_params;     // x: 0 ortho / 1 distance; y: texel footprint (m, or m per m of distance); z: PCF radius (texels)
+  vec4 shadow_params;     // x: 0 ortho / 1 distance; y: texel footprint (m, or m per m of distance); zw: unused
 };
 
 layout(std430, binding = 0) readonly buffer Lights { GpuLight lights[]; };
@@ -78,41 +78,52 @@ float range_window(float distance_m, float range_m) {
   return w * w;
 }
 
-// Integral of cos(theta) over the solid angle of a convex polygon above the horizon
-// (Lambert's formula): (1/2) sum_i angle(v_i, v_i+1) * dot(n, normalize(v_i x v_i+1)).
-float polygon_cosine_integral(vec3 v[5], int count, vec3 n) {
-  float sum = 0.0;
-  for (int i = 0; i < count; ++i) {
-    vec3 a = normalize(v[i]);
-    vec3 b = normalize(v[(i + 1) % count]);
-    vec3 c = cross(a, b);
-    float len = length(c);
-    if (len < 1e-7) continue;
-    float angle = atan(len, dot(a, b));
-    sum += angle * dot(c / len, n);
-  }
-  return abs(0.5 * sum);
+// One edge term of Lambert's formula for the integral of cos(theta) over the solid angle of
+// a polygon, divided by 2 pi: angle(a, b) * dot(n, normalize(a x b)) / (2 pi) for unit
+// vectors a, b. theta / (2 pi sin(theta)) uses the rational fit of Heitz et al. 2016
+// ("Real-time polygonal-light shading with linearly transformed cosines", IntegrateEdge),
+// which avoids acos/atan; the integral is pi times the sum over the closed polygon.
+float edge_cosine_term(vec3 ua, vec3 ub, vec3 n) {
+  float x = dot(ua, ub);
+  float y = abs(x);
+  float a = 0.8543985 + (0.4965155 + 0.0145206 * y) * y;
+  float b = 3.4175940 + (4.1616724 + y) * y;
+  float v = a / b;
+  float theta_over_sin = x > 0.0 ? v : 0.5 * inversesqrt(max(1.0 - x * x, 1e-7)) - v;
+  return dot(cross(ua, ub), n) * theta_over_sin;
 }
 
-// Clips the quad q[0..3] (positions relative to the shading point) against the tangent
-// plane dot(n, x) >= 0 (Sutherland-Hodgman); returns the vertex count (0, 3, 4 or 5).
-int clip_to_horizon(vec3 q[4], vec3 n, out vec3 v[5]) {
-  int count = 0;
-  for (int i = 0; i < 5; ++i) v[i] = vec3(0.0);
+// Integral of cos(theta) d(omega) over the quad q[0..3] (vertices relative to the shading
+// point) clipped to the horizon dot(n, x) >= 0: every edge is clipped on its own and the
+// horizon segment from the exit to the entry point closes the polygon. Written without
+// dynamic indexing or data-dependent loops (cheap on llvmpipe's SIMD code).
+float clipped_quad_cosine_integral(vec3 q[4], vec3 n) {
+  vec3 u[4] = vec3[4](normalize(q[0]), normalize(q[1]), normalize(q[2]), normalize(q[3]));
+  float sum = 0.0;
+  vec3 exit_point = vec3(0.0);
+  vec3 entry_point = vec3(0.0);
+  bool crosses = false;
   for (int i = 0; i < 4; ++i) {
     vec3 a = q[i];
-    vec3 b = q[(i + 1) % 4];
+    vec3 b = q[(i + 1) & 3];
     float da = dot(n, a);
     float db = dot(n, b);
-    if (da >= 0.0 && count < 5) v[count++] = a;
-    if ((da >= 0.0) != (db >= 0.0) && count < 5) v[count++] = a + (b - a) * (da / (da - db));
+    bool a_up = da >= 0.0;
+    bool b_up = db >= 0.0;
+    // Only edges that cross the horizon need the (normalized) crossing point.
+    vec3 c = a_up != b_up ? normalize(a + (b - a) * (da / (da - db))) : u[i];
+    if (a_up && !b_up) exit_point = c;
+    if (!a_up && b_up) entry_point = c;
+    crosses = crosses || (a_up != b_up);
+    if (a_up || b_up) sum += edge_cosine_term(a_up ? u[i] : c, b_up ? u[(i + 1) & 3] : c, n);
   }
-  return count;
+  if (crosses) sum += edge_cosine_term(exit_point, entry_point, n);
+  return abs(PI * sum);
 }
 
 // Rectangular area light of radiance L (W/(m^2 sr)), one-sided towards its emission
 // direction. Diffuse: exact irradiance of the rectangle clipped to the horizon
-// (polygon_cosine_integral). Specular: a 4x4 stratified set of points on the rectangle,
+// (clipped_quad_cosine_integral). Specular: a 3x3 stratified set of points on the rectangle,
 // each weighted by its solid angle cos(theta_light) dA / d^2 (converges to the integral).
 vec3 area_light_radiance(GpuLight light, Surface s) {
   vec3 centre = light.position_type.xyz;
@@ -122,11 +133,8 @@ vec3 area_light_radiance(GpuLight light, Surface s) {
   vec3 hy = light.area_half_y.xyz;
   vec3 rel = centre - s.position;
   vec3 q[4] = vec3[4](rel - hx - hy, rel + hx - hy, rel + hx + hy, rel - hx + hy);
-  vec3 v[5];
-  int count = clip_to_horizon(q, s.normal, v);
-  if (count < 3) return vec3(0.0);
-  vec3 result = s.diffuse_albedo / PI * polygon_cosine_integral(v, count, s.normal);
-  const int kSide = 4;
+  vec3 result = s.diffuse_albedo / PI * clipped_quad_cosine_integral(q, s.normal);
+  const int kSide = 3;
   float sample_area = 4.0 * length(hx) * length(hy) / float(kSide * kSide);
   vec3 specular = vec3(0.0);
   for (int j = 0; j < kSide; ++j) {
@@ -142,29 +150,28 @@ vec3 area_light_radiance(GpuLight light, Surface s) {
   return light.radiant.rgb * (result + specular);
 }
 
-// Unshadowed outgoing radiance towards the viewer from one light, and the light direction
-// used for shadow biasing (out).
-vec3 light_radiance(GpuLight light, Surface s, out vec3 to_light) {
-  int type = int(light.position_type.w);
-  if (type == LIGHT_DIRECTIONAL) {
-    to_light = -light.direction_range.xyz;
-    return light.radiant.rgb * brdf_cos(s, to_light);
-  }
-  if (type == LIGHT_AREA) {
-    to_light = normalize(light.position_type.xyz - s.position);
-    return area_light_radiance(light, s);
-  }
+// Unshadowed outgoing radiance towards the viewer from one light of each type; `to_light`
+// (out) is the unit direction used for shadow biasing.
+vec3 directional_light_radiance(GpuLight light, Surface s, out vec3 to_light) {
+  to_light = -light.direction_range.xyz;
+  return light.radiant.rgb * brdf_cos(s, to_light);
+}
+
+// Point light: E = I cos / d^2 times the glTF range window.
+vec3 point_light_radiance(GpuLight light, Surface s, out vec3 to_light) {
   vec3 d = light.position_type.xyz - s.position;
   float dist2 = max(dot(d, d), 1e-8);
   float dist = sqrt(dist2);
   to_light = d / dist;
   float attenuation = range_window(dist, light.direction_range.w) / dist2;
-  if (type == LIGHT_SPOT) {
-    float cos_axis = dot(-to_light, light.direction_range.xyz);
-    float cos_outer = light.cone.x;
-    float cos_inner = light.cone.y;
-    attenuation *= cos_inner - cos_outer > 1e-5 ? smoothstep(cos_outer, cos_inner, cos_axis)
-                                                : step(cos_outer, cos_axis);
-  }
   return light.radiant.rgb * attenuation * brdf_cos(s, to_light);
+}
+
+// Spot light: a point light times smoothstep(cos outer, cos inner, cos angle to the axis).
+vec3 spot_light_radiance(GpuLight light, Surface s, out vec3 to_light) {
+  vec3 radiance = point_light_radiance(light, s, to_light);
+  float cos_axis = dot(-to_light, light.direction_range.xyz);
+  float cos_outer = light.cone.x;
+  float cos_inner = light.cone.y;
+  return radiance * (cos_inner - cos_outer > 1e-5 ? smoothstep(cos_outer, cos_inner, cos_axis) : step(cos_outer, cos_axis));
 }

@@ -12,7 +12,9 @@ float slope_tangent(vec3 n, vec3 to_light) {
   return min(sqrt(1.0 - n_dot_l * n_dot_l) / n_dot_l, 8.0);
 }
 
-float shadow_2d(GpuLight light, vec3 p, vec3 n, vec3 to_light) {
+// `radius` (texels) is passed as a literal so that, once inlined, the PCF loop has constant
+// bounds and is unrolled: llvmpipe's SIMD code runs dynamic loops and branches masked.
+float shadow_2d(GpuLight light, vec3 p, vec3 n, vec3 to_light, int radius) {
   int layer = int(light.cone.z);
   if (layer < 0) return 1.0;
   bool ortho = light.shadow_params.x < 0.5;
@@ -21,7 +23,6 @@ float shadow_2d(GpuLight light, vec3 p, vec3 n, vec3 to_light) {
   vec3 axis = light.direction_range.xyz;
   float dist = ortho ? dot(p - eye, axis) : length(p - eye);
   float texel = ortho ? light.shadow_params.y : light.shadow_params.y * dist;
-  int radius = int(light.shadow_params.z);
   vec3 po = p + n * texel;
   vec4 clip = light.shadow_view_proj * vec4(po, 1.0);
   if (clip.w <= 0.0) return 1.0;
@@ -58,10 +59,4 @@ float shadow_cube(GpuLight light, vec3 p, vec3 n, vec3 to_light) {
     for (int x = -1; x <= 1; ++x)
       sum += texture(u_point_shadow_maps, vec4(d + (float(x) * t + float(y) * b) * texel, float(cube)), ref);
   return sum / 9.0;
-}
-
-float light_shadow(GpuLight light, vec3 p, vec3 n, vec3 to_light) {
-  if (light.cone.w >= 0.0) return shadow_cube(light, p, n, to_light);
-  if (light.cone.z >= 0.0) return shadow_2d(light, p, n, to_light);
-  return 1.0;
 }

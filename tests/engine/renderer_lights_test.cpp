@@ -151,6 +151,38 @@ TEST(RendererAreaLight, CentreIrradianceMatchesRectangleFormFactor) {
   EXPECT_LT(red(img, 0, c), 0.5f * red(img, c, c));
 }
 
+// A vertical rectangle facing the receiver, partly below its horizon: the renderer clips it.
+// Reference: midpoint-rule integral of L f cos(theta_r) cos(theta_l) / d^2 dA over the
+// rectangle's part above the horizon (600 x 600 cells).
+TEST(RendererAreaLight, RectangleCrossingTheHorizonIsClipped) {
+  engine::GpuContext ctx = headless_context();
+  PlaneScene s;
+  const float radiance = 5.0f;
+  const glm::vec3 centre(1.0f, 0.2f, 0.0f);
+  const float size = 1.0f;  // y in [-0.3, 0.7], z in [-0.5, 0.5], facing -X
+  engine::Light light{.type = engine::LightType::Area, .intensity = radiance, .area_size_m = {size, size}};
+  light.cast_shadows = false;  // the shadow camera would sit at grazing incidence on the plane
+  add_light(s.reg, light, centre, centre + glm::vec3(-1, 0, 0));
+  const engine::ImageRgbaF img = s.render();
+  const int c = s.cam.size / 2;
+  double expected = 0.0;
+  const int n = 600;
+  const float cell = size / static_cast<float>(n);
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const glm::vec3 q = centre + glm::vec3(0.0f, (static_cast<float>(j) + 0.5f) * cell - 0.5f * size,
+                                             (static_cast<float>(i) + 0.5f) * cell - 0.5f * size);
+      if (q.y <= 0.0f) continue;
+      const float d2 = glm::dot(q, q);
+      const glm::vec3 l = q / std::sqrt(d2);
+      const float cos_light = l.x;  // light normal is -X, towards the origin
+      expected += static_cast<double>(radiance * reference_brdf_cos(kAlbedo, 0, 1, {0, 1, 0}, {0, 1, 0}, l) *
+                                      cos_light * cell * cell / d2);
+    }
+  EXPECT_GT(expected, 0.0);
+  EXPECT_NEAR(red(img, c, c), expected, 0.02 * expected);
+}
+
 TEST(RendererGgx, GlossyHighlightAtMirrorDirectionIsStrongerThanRough) {
   engine::GpuContext ctx = headless_context();
   float centre[2] = {0, 0};

@@ -3,6 +3,9 @@
 #include <engine/renderer.h>
 
 #include <algorithm>
+#include <array>
+#include <cstdio>
+#include <map>
 #include <string>
 
 #include <GL/glcorearb.h>
@@ -48,17 +51,32 @@ Result<ShaderProgram> build(const char* vertex, const char* fragment) {
       .build();
 }
 
+using LightCounts = std::array<int, 4>;  // point, spot, directional, area
+
+// The forward program for one combination of light counts (see forward.frag.glsl).
+Result<ShaderProgram> build_forward(const LightCounts& n) {
+  return ShaderProgramBuilder(engine_shader_files())
+      .stage(ShaderStage::Vertex, "forward.vert.glsl")
+      .stage(ShaderStage::Fragment, "forward.frag.glsl")
+      .define("POINT_LIGHTS " + std::to_string(n[0]))
+      .define("SPOT_LIGHTS " + std::to_string(n[1]))
+      .define("DIRECTIONAL_LIGHTS " + std::to_string(n[2]))
+      .define("AREA_LIGHTS " + std::to_string(n[3]))
+      .build();
+}
+
 class ForwardRenderer final : public Renderer {
  public:
   ForwardRenderer(GpuScene scene, ShaderProgram forward, ShaderProgram shadow, ShaderProgram tonemap,
                   const RenderSettings& settings)
       : settings_(settings),
         scene_(std::move(scene)),
-        forward_(std::move(forward)),
+
         shadow_(std::move(shadow)),
         tonemap_(std::move(tonemap)),
         lights_buffer_(GlBuffer::create()),
         empty_vao_(GlVertexArray::create()) {
+    forward_variants_.emplace(LightCounts{}, std::move(forward));
     ensure_targets();
   }
 
@@ -77,12 +95,13 @@ class ForwardRenderer final : public Renderer {
  private:
   void ensure_targets();
   std::vector<DrawItem> draw_items(const Registry& registry) const;
-  void forward_pass(const Registry& registry, Entity camera, const std::vector<DrawItem>& items, int light_count);
+  void forward_pass(const Registry& registry, Entity camera, const std::vector<DrawItem>& items, const LightCounts& counts);
+  const ShaderProgram& forward_program(const LightCounts& counts);
   void tonemap_pass();
 
   RenderSettings settings_;
   GpuScene scene_;
-  ShaderProgram forward_;
+  std::map<LightCounts, ShaderProgram> forward_variants_;
   ShaderProgram shadow_;
   ShaderProgram tonemap_;
   render::ShadowMaps shadow_maps_;
@@ -98,6 +117,16 @@ class ForwardRenderer final : public Renderer {
   IndirectLightProvider* provider_ = nullptr;
   std::vector<PassTiming> timings_;
 };
+
+const ShaderProgram& ForwardRenderer::forward_program(const LightCounts& counts) {
+  auto it = forward_variants_.find(counts);
+  if (it != forward_variants_.end()) return it->second;
+  Result<ShaderProgram> p = build_forward(counts);
+  // The variant without lights compiled in create(); a failure here is a shader bug.
+  if (!p) std::fprintf(stderr, "%s\n", p.error().to_string().c_str());
+  GI_EXPECTS(p.ok(), "forward shader variant must compile");
+  return forward_variants_.emplace(counts, std::move(p.value())).first->second;
+}
 
 void ForwardRenderer::ensure_targets() {
   GI_EXPECTS(settings_.width > 0 && settings_.height > 0, "render size must be positive");
@@ -154,7 +183,7 @@ void ForwardRenderer::render(const Registry& registry, Entity camera) {
   glNamedBufferData(lights_buffer_.id(),
                     static_cast<GLsizeiptr>(std::max<std::size_t>(1, lights.lights.size()) * sizeof(render::GpuLight)),
                     lights.lights.empty() ? nullptr : lights.lights.data(), GL_STREAM_DRAW);
-  forward_pass(registry, camera, items, static_cast<int>(lights.lights.size()));
+  forward_pass(registry, camera, items, lights.count_by_type);
   timings_.push_back({provider_ ? std::string("forward + indirect (") + provider_->label() + ")"
                                 : std::string("forward + constant ambient (stand-in)"),
                       timer.lap_ms()});
@@ -164,7 +193,8 @@ void ForwardRenderer::render(const Registry& registry, Entity camera) {
 }
 
 void ForwardRenderer::forward_pass(const Registry& registry, Entity camera, const std::vector<DrawItem>& items,
-                                   int light_count) {
+                                   const LightCounts& counts) {
+  const ShaderProgram& program = forward_program(counts);
   const Camera& cam = registry.get<Camera>(camera);
   const glm::mat4& camera_world = registry.get<WorldTransform>(camera).matrix;
   const float aspect = cam.aspect > 0.0f ? cam.aspect : static_cast<float>(width_) / static_cast<float>(height_);
@@ -186,7 +216,7 @@ void ForwardRenderer::forward_pass(const Registry& registry, Entity camera, cons
   glFrontFace(GL_CCW);
   glCullFace(GL_BACK);
 
-  forward_.use();
+  program.use();
   glBindVertexArray(scene_.vertex_array());
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kLightsBinding, lights_buffer_.id());
   glBindTextureUnit(kShadowMapsUnit, shadow_maps_.maps_2d());
@@ -198,7 +228,6 @@ void ForwardRenderer::forward_pass(const Registry& registry, Entity camera, cons
 
   glUniformMatrix4fv(8, 1, GL_FALSE, glm::value_ptr(view_proj));
   glUniform3fv(16, 1, glm::value_ptr(camera_position));
-  glUniform1i(17, light_count);
   glUniform1f(23, settings_.stand_in_ambient);
   glUniform1f(24, settings_.split == SplitView::DirectLeftFullRight ? 0.5f * static_cast<float>(width_) : -1.0f);
   glUniform1i(25, glossy != 0 ? 1 : 0);
@@ -294,7 +323,7 @@ Result<std::unique_ptr<Renderer>> Renderer::create(const SceneAsset& assets, con
   GI_EXPECTS(settings.width > 0 && settings.height > 0, "RenderSettings width and height must be positive");
   if (glGetString(GL_VERSION) == nullptr)
     return Error{assets.source, "renderer", "no current OpenGL context (create an engine::GpuContext first)"};
-  auto forward = build("forward.vert.glsl", "forward.frag.glsl");
+  auto forward = build_forward(LightCounts{});
   if (!forward) return forward.error();
   auto shadow = build("shadow.vert.glsl", "shadow.frag.glsl");
   if (!shadow) return shadow.error();

@@ -12,7 +12,6 @@ namespace engine::render {
 namespace {
 
 constexpr float kAreaShadowFov = glm::radians(150.0f);
-constexpr int kAreaPcfRadius = 2;
 
 glm::vec3 any_perpendicular_up(const glm::vec3& dir) {
   return std::abs(dir.y) < 0.99f ? glm::vec3(0.0f, 1.0f, 0.0f) : glm::vec3(1.0f, 0.0f, 0.0f);
@@ -91,13 +90,12 @@ LightList collect_lights(const Registry& registry, const SceneBounds& bounds, co
       }
       g.cone.w = static_cast<float>(out.cubes++);
       g.shadow_eye = glm::vec4(position, far_m);
-      g.shadow_params = glm::vec4(1.0f, 2.0f / static_cast<float>(capacity.cube_size), 1.0f, 0.0f);
+      g.shadow_params = glm::vec4(1.0f, 2.0f / static_cast<float>(capacity.cube_size), 0.0f, 0.0f);
     } else if (shadowed && light.type != LightType::Point && out.layers_2d < capacity.max_2d_layers) {
       ShadowView v;
       v.axis = dir;
       v.layer = out.layers_2d;
       float texel = 0.0f;
-      float pcf_radius = 1.0f;
       if (light.type == LightType::Directional) {
         const glm::vec3 centre = 0.5f * (bounds.min + bounds.max);
         const float radius = std::max(0.5f * glm::length(bounds.max - bounds.min), 1e-3f) * 1.01f;
@@ -119,16 +117,20 @@ LightList collect_lights(const Registry& registry, const SceneBounds& bounds, co
         v.view_proj = glm::perspective(fov, 1.0f, near_m, v.far_m) *
                       glm::lookAt(position, position + dir, any_perpendicular_up(dir));
         texel = 2.0f * std::tan(0.5f * fov) / static_cast<float>(capacity.map_size);
-        if (light.type == LightType::Area) pcf_radius = static_cast<float>(kAreaPcfRadius);
       }
       out.shadow_views.push_back(v);
       g.cone.z = static_cast<float>(out.layers_2d++);
       g.shadow_view_proj = v.view_proj;
       g.shadow_eye = glm::vec4(v.eye, v.far_m);
-      g.shadow_params = glm::vec4(v.ortho ? 0.0f : 1.0f, texel, pcf_radius, 0.0f);
+      g.shadow_params = glm::vec4(v.ortho ? 0.0f : 1.0f, texel, 0.0f, 0.0f);
     }
     out.lights.push_back(g);
   });
+  // Sorted by type (point, spot, directional, area): the forward shader loops over each
+  // type with a compile-time count.
+  std::stable_sort(out.lights.begin(), out.lights.end(),
+                   [](const GpuLight& a, const GpuLight& b) { return a.position_type.w < b.position_type.w; });
+  for (const GpuLight& g : out.lights) ++out.count_by_type[static_cast<std::size_t>(g.position_type.w)];
   return out;
 }
 

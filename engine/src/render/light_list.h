@@ -1,9 +1,11 @@
 #pragma once
 // Turns the registry's enabled lights into GpuLight records and plans their shadow maps:
 // directional (orthographic, fitted to the scene bounds), spot (perspective, the cone),
-// area (perspective with a 150 degree field of view from the rectangle's centre, wider PCF),
+// area (perspective with a 150 degree field of view from the rectangle's centre; the shader
+// softens it with a 5x5 instead of 3x3 PCF kernel),
 // point (a cube-map-array slice, six 90 degree faces).
 
+#include <array>
 #include <vector>
 
 #include <engine/registry.h>
@@ -21,7 +23,10 @@ struct ShadowCapacity {
 };
 
 struct LightList {
+  /// Sorted by GpuLightType: points, then spots, directionals, areas.
   std::vector<GpuLight> lights;
+  /// Number of lights of each GpuLightType.
+  std::array<int, 4> count_by_type{};
   std::vector<ShadowView> shadow_views;
   int layers_2d = 0;
   int cubes = 0;
