@@ -75,21 +75,21 @@ void main() {
 #if SPOT_LIGHTS > 0
   for (int k = 0; k < SPOT_LIGHTS; ++k) {
     const int i = POINT_LIGHTS + k;
-    radiance += spot_light_radiance(lights[i], s, to_light) * shadow_2d(lights[i], s.position, s.normal, to_light, 1);
+    radiance += spot_light_radiance(lights[i], s, to_light) * shadow_2d(lights[i], s.position, s.normal, to_light, 1.0);
   }
 #endif
 #if DIRECTIONAL_LIGHTS > 0
   for (int k = 0; k < DIRECTIONAL_LIGHTS; ++k) {
     const int i = POINT_LIGHTS + SPOT_LIGHTS + k;
     radiance += directional_light_radiance(lights[i], s, to_light) *
-                shadow_2d(lights[i], s.position, s.normal, to_light, 1);
+                shadow_2d(lights[i], s.position, s.normal, to_light, 1.0);
   }
 #endif
 #if AREA_LIGHTS > 0
   for (int k = 0; k < AREA_LIGHTS; ++k) {
     const int i = POINT_LIGHTS + SPOT_LIGHTS + DIRECTIONAL_LIGHTS + k;
     to_light = normalize(lights[i].position_type.xyz - s.position);
-    radiance += area_light_radiance(lights[i], s) * shadow_2d(lights[i], s.position, s.normal, to_light, 2);
+    radiance += area_light_radiance(lights[i], s) * shadow_2d(lights[i], s.position, s.normal, to_light, 2.0);
   }
 #endif
 

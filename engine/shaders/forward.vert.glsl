@@ -23,6 +23,9 @@ out vec2 v_uv0;
 out vec2 v_uv1;
 out vec3 v_vertex_irradiance;
 
+// The depth pre-pass (shadow.vert.glsl) and the forward pass must produce identical depths.
+invariant gl_Position;
+
 void main() {
   vec4 world = u_model * vec4(a_position, 1.0);
   v_world = world.xyz;

@@ -1,8 +1,8 @@
 // Shadow-map lookups of the forward pass. Every shadow map stores a linear depth:
 // distance from the light / far for point, spot and area lights, distance along the light
 // direction / far for directional lights. Filtering: hardware 2x2 compare (bilinear PCF)
-// over a (2r+1)^2 grid; the receiver is offset along its normal by one texel and the depth
-// reference is biased by texel * (1 + r * tan(theta)) (slope-scaled).
+// over a 3x3 grid; the receiver is offset along its normal by one texel and the depth
+// reference is biased by texel * (1 + spacing * tan(theta)) (slope-scaled).
 
 layout(binding = 4) uniform sampler2DArrayShadow u_shadow_maps;
 layout(binding = 5) uniform samplerCubeArrayShadow u_point_shadow_maps;
@@ -12,9 +12,9 @@ float slope_tangent(vec3 n, vec3 to_light) {
   return min(sqrt(1.0 - n_dot_l * n_dot_l) / n_dot_l, 8.0);
 }
 
-// `radius` (texels) is passed as a literal so that, once inlined, the PCF loop has constant
-// bounds and is unrolled: llvmpipe's SIMD code runs dynamic loops and branches masked.
-float shadow_2d(GpuLight light, vec3 p, vec3 n, vec3 to_light, int radius) {
+// A 3x3 grid of bilinear compare taps `spacing` texels apart (1: 4x4 texel footprint,
+// 2: 6x6, the softened area-light kernel). `spacing` is passed as a literal.
+float shadow_2d(GpuLight light, vec3 p, vec3 n, vec3 to_light, float spacing) {
   int layer = int(light.cone.z);
   if (layer < 0) return 1.0;
   bool ortho = light.shadow_params.x < 0.5;
@@ -29,15 +29,14 @@ float shadow_2d(GpuLight light, vec3 p, vec3 n, vec3 to_light, int radius) {
   vec2 uv = clip.xy / clip.w * 0.5 + 0.5;
   if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)))) return 1.0;
   float d = ortho ? dot(po - eye, axis) : length(po - eye);
-  float bias = texel * (1.0 + float(radius) * slope_tangent(n, to_light));
+  float bias = texel * (1.0 + spacing * slope_tangent(n, to_light));
   float ref = (d - bias) / far_m;
   vec2 texel_uv = 1.0 / vec2(textureSize(u_shadow_maps, 0).xy);
   float sum = 0.0;
-  for (int y = -radius; y <= radius; ++y)
-    for (int x = -radius; x <= radius; ++x)
-      sum += texture(u_shadow_maps, vec4(uv + vec2(x, y) * texel_uv, float(layer), ref));
-  float side = float(2 * radius + 1);
-  return sum / (side * side);
+  for (int y = -1; y <= 1; ++y)
+    for (int x = -1; x <= 1; ++x)
+      sum += texture(u_shadow_maps, vec4(uv + vec2(x, y) * spacing * texel_uv, float(layer), ref));
+  return sum / 9.0;
 }
 
 float shadow_cube(GpuLight light, vec3 p, vec3 n, vec3 to_light) {

@@ -40,7 +40,7 @@ TEST(RendererPerf, ForwardPassAt960x540With4ShadowedLights) {
   engine::RenderSettings settings;  // 960x540, 1024^2 shadow maps (cube faces 512^2)
   auto r = engine::Renderer::create(assets, settings);
   ASSERT_TRUE(r.ok()) << r.error().to_string();
-  constexpr int kFrames = 4;
+  constexpr int kFrames = 2;
   std::vector<double> ms[3];
   for (int f = 0; f < kFrames + 1; ++f) {
     r.value()->render(reg, camera);

@@ -67,10 +67,11 @@ Result<ShaderProgram> build_forward(const LightCounts& n) {
 
 class ForwardRenderer final : public Renderer {
  public:
-  ForwardRenderer(GpuScene scene, ShaderProgram forward, ShaderProgram shadow, ShaderProgram tonemap,
-                  const RenderSettings& settings)
+  ForwardRenderer(GpuScene scene, ShaderProgram forward, ShaderProgram depth, ShaderProgram shadow,
+                  ShaderProgram tonemap, const RenderSettings& settings)
       : settings_(settings),
         scene_(std::move(scene)),
+        depth_only_(std::move(depth)),
 
         shadow_(std::move(shadow)),
         tonemap_(std::move(tonemap)),
@@ -97,11 +98,13 @@ class ForwardRenderer final : public Renderer {
   std::vector<DrawItem> draw_items(const Registry& registry) const;
   void forward_pass(const Registry& registry, Entity camera, const std::vector<DrawItem>& items, const LightCounts& counts);
   const ShaderProgram& forward_program(const LightCounts& counts);
+  void depth_prepass(const glm::mat4& view_proj, const std::vector<DrawItem>& items);
   void tonemap_pass();
 
   RenderSettings settings_;
   GpuScene scene_;
   std::map<LightCounts, ShaderProgram> forward_variants_;
+  ShaderProgram depth_only_;
   ShaderProgram shadow_;
   ShaderProgram tonemap_;
   render::ShadowMaps shadow_maps_;
@@ -210,14 +213,16 @@ void ForwardRenderer::forward_pass(const Registry& registry, Entity camera, cons
   glClearNamedFramebufferfv(hdr_fbo_.id(), GL_COLOR, 0, black);
   glClearNamedFramebufferfv(hdr_fbo_.id(), GL_DEPTH, 0, &far_depth);
   glEnable(GL_DEPTH_TEST);
-  glDepthFunc(GL_LESS);
-  glDepthMask(GL_TRUE);
   glDisable(GL_BLEND);
   glFrontFace(GL_CCW);
   glCullFace(GL_BACK);
+  glBindVertexArray(scene_.vertex_array());
+  depth_prepass(view_proj, items);
+  // Shade only the visible surface of each pixel (llvmpipe pays per shaded fragment).
+  glDepthFunc(GL_EQUAL);
+  glDepthMask(GL_FALSE);
 
   program.use();
-  glBindVertexArray(scene_.vertex_array());
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kLightsBinding, lights_buffer_.id());
   glBindTextureUnit(kShadowMapsUnit, shadow_maps_.maps_2d());
   glBindTextureUnit(kPointShadowMapsUnit, shadow_maps_.cube_maps());
@@ -271,7 +276,31 @@ void ForwardRenderer::forward_pass(const Registry& registry, Entity camera, cons
     }
   }
   glDisable(GL_CULL_FACE);
+  glDepthFunc(GL_LESS);
+  glDepthMask(GL_TRUE);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
+}
+
+void ForwardRenderer::depth_prepass(const glm::mat4& view_proj, const std::vector<DrawItem>& items) {
+  glDepthFunc(GL_LESS);
+  glDepthMask(GL_TRUE);
+  glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+  depth_only_.use();
+  glUniformMatrix4fv(8, 1, GL_FALSE, glm::value_ptr(view_proj));
+  for (const DrawItem& item : items) {
+    glUniformMatrix4fv(0, 1, GL_FALSE, glm::value_ptr(item.model));
+    for (const render::GpuPrimitive& p : item.mesh->primitives) {
+      // Same culling as the shading pass, so both passes see the same surfaces.
+      if (scene_.material(item.material_override >= 0 ? item.material_override : p.material).double_sided)
+        glDisable(GL_CULL_FACE);
+      else
+        glEnable(GL_CULL_FACE);
+      glDrawElementsBaseVertex(GL_TRIANGLES, static_cast<GLsizei>(p.index_count), GL_UNSIGNED_INT,
+                               reinterpret_cast<const void*>(static_cast<std::uintptr_t>(p.first_index) * 4u),
+                               p.base_vertex);
+    }
+  }
+  glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
 }
 
 void ForwardRenderer::tonemap_pass() {
@@ -325,6 +354,8 @@ Result<std::unique_ptr<Renderer>> Renderer::create(const SceneAsset& assets, con
     return Error{assets.source, "renderer", "no current OpenGL context (create an engine::GpuContext first)"};
   auto forward = build_forward(LightCounts{});
   if (!forward) return forward.error();
+  auto depth = build("shadow.vert.glsl", "depth_only.frag.glsl");
+  if (!depth) return depth.error();
   auto shadow = build("shadow.vert.glsl", "shadow.frag.glsl");
   if (!shadow) return shadow.error();
   auto tonemap = build("fullscreen.vert.glsl", "tonemap.frag.glsl");
@@ -333,7 +364,7 @@ Result<std::unique_ptr<Renderer>> Renderer::create(const SceneAsset& assets, con
   if (!scene) return scene.error();
   glEnable(GL_TEXTURE_CUBE_MAP_SEAMLESS);
   return std::unique_ptr<Renderer>(std::make_unique<ForwardRenderer>(std::move(scene.value()), std::move(forward.value()),
-                                                                     std::move(shadow.value()),
+                                                                     std::move(depth.value()), std::move(shadow.value()),
                                                                      std::move(tonemap.value()), settings));
 }
 
