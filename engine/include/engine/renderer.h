@@ -2,6 +2,13 @@
 // The linear-HDR forward renderer: direct light from point, spot, directional and
 // rectangular area lights with shadow maps (cube maps for point lights), Lambert + GGX,
 // indirect light through engine::IndirectLightProvider, exposure and tonemapping last.
+// Shading (engine/shaders/lighting_common.glsl): Lambert + GGX (Smith height-correlated
+// visibility, Schlick Fresnel, metallic workflow, F0 = 0.04 for dielectrics); point/spot
+// E = I cos / d^2 with glTF's range window, spot smoothstep(cos outer, cos inner); area
+// lights: diffuse is the exact irradiance of the rectangle clipped to the horizon (Lambert's
+// polygon formula), specular a 3x3 stratified set of points weighted by cos_l dA / d^2.
+// Shadows: cube maps (point), orthographic fitted to the scene bounds (directional),
+// perspective (spot; area from the rectangle's centre with 150 degrees and a wider kernel).
 //   auto ctx = engine::GpuContext::create_headless();              // engine/gpu/context.h
 //   auto r = engine::Renderer::create(scene.assets, {.width = 640, .height = 360});
 //   r.value()->render(scene.registry, engine::find_camera(scene.registry));
@@ -27,7 +34,11 @@ struct RenderSettings {
   int width = 960;
   int height = 540;
   /// Linear scale applied before tonemapping (exposure = 1 / (1.2 * 2^EV100) style factor).
+  /// LDR = sRGB_encode(ACES_fitted(hdr x exposure)), ACES fitted = Narkowicz 2015:
+  /// x (2.51 x + 0.03) / (x (2.43 x + 0.59) + 0.14) per channel, clamped to [0, 1].
   float exposure = 1.0f;
+  /// Texels per side of 2-D shadow maps (directional, spot, area); point-light cube faces
+  /// use half of it. At most 8 2-D maps and 4 cube maps per frame; further lights are unshadowed.
   int shadow_map_size = 1024;
   /// Radiance of the constant ambient stand-in used when no IndirectLightProvider is set,
   /// W/(m^2 sr) per channel; it is labelled "constant ambient (stand-in)" in timings.
@@ -61,9 +72,25 @@ class Renderer {
   /// Blits the LDR result into the currently bound default framebuffer (windowed demo).
   virtual void present(int window_width, int window_height) const = 0;
 
+  /// The provider of indirect light (not owned; nullptr: the constant-ambient stand-in).
+  /// How the renderer uses IndirectLightFrame, per MeshRenderer entity:
+  ///  - entities with StaticTag: radiance += albedo/pi x texture(irradiance_atlas_texture,
+  ///    TEXCOORD_1).rgb (bilinear, as bound by the provider's sampler state);
+  ///  - other entities: radiance += albedo/pi x vertex_irradiance_buffer(entity)[k].xyz,
+  ///    interpolated over the triangle, where k is the vertex's index within the entity's
+  ///    mesh with the primitives concatenated in order (primitive p's vertex i has
+  ///    k = i + sum of the vertex counts of primitives 0..p-1); the shader reads it as
+  ///    gl_VertexID - (scene vertex where the mesh starts). The SSBO is bound at binding 1;
+  ///  - glossy_radiance_texture (if not 0) is added per pixel, texelFetch at the pixel;
+  ///  - albedo is the diffuse albedo (1 - metallic) x base colour.
+  /// Without a provider every entity gets albedo x stand_in_ambient (the irradiance of a
+  /// uniform sky of that radiance, pi x L, times albedo/pi). With SplitView::DirectLeftFullRight
+  /// none of this is added to the left half.
   virtual void set_indirect_light(IndirectLightProvider* provider) = 0;
   virtual RenderSettings& settings() = 0;
-  /// Timings of the passes of the last render(), in execution order.
+  /// Timings of the passes of the last render(), in execution order: "shadow maps (N views)",
+  /// "forward + constant ambient (stand-in)" or "forward + indirect (<provider label>)"
+  /// (includes the depth pre-pass), "tonemap (...)".
   virtual const std::vector<PassTiming>& last_timings() const = 0;
 };
 
