@@ -3,6 +3,9 @@
 // (engine/units.h). Shadows come from shadow_common.glsl.
 
 const float PI = 3.14159265358979;
+#ifndef AREA_SPECULAR_SIDE
+#define AREA_SPECULAR_SIDE 3
+#endif
 const int LIGHT_POINT = 0;
 const int LIGHT_SPOT = 1;
 const int LIGHT_DIRECTIONAL = 2;
@@ -123,7 +126,7 @@ float clipped_quad_cosine_integral(vec3 q[4], vec3 n) {
 
 // Rectangular area light of radiance L (W/(m^2 sr)), one-sided towards its emission
 // direction. Diffuse: exact irradiance of the rectangle clipped to the horizon
-// (clipped_quad_cosine_integral). Specular: a 3x3 stratified set of points on the rectangle,
+// (clipped_quad_cosine_integral). Specular: AREA_SPECULAR_SIDE^2 stratified points on the rectangle,
 // each weighted by its solid angle cos(theta_light) dA / d^2 (converges to the integral).
 vec3 area_light_radiance(GpuLight light, Surface s) {
   vec3 centre = light.position_type.xyz;
@@ -134,7 +137,7 @@ vec3 area_light_radiance(GpuLight light, Surface s) {
   vec3 rel = centre - s.position;
   vec3 q[4] = vec3[4](rel - hx - hy, rel + hx - hy, rel + hx + hy, rel - hx + hy);
   vec3 result = s.diffuse_albedo / PI * clipped_quad_cosine_integral(q, s.normal);
-  const int kSide = 3;
+  const int kSide = AREA_SPECULAR_SIDE;
   float sample_area = 4.0 * length(hx) * length(hy) / float(kSide * kSide);
   vec3 specular = vec3(0.0);
   for (int j = 0; j < kSide; ++j) {

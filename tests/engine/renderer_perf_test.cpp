@@ -61,6 +61,12 @@ TEST(RendererPerf, ForwardPassAt960x540With4ShadowedLights) {
     std::printf("  %-45s %8.1f ms\n", names[static_cast<std::size_t>(i)].name.c_str(), median);
     RecordProperty("pass_" + std::to_string(i) + "_ms", std::to_string(median));
   }
+  // The cheapest area-light specular (one point per rectangle): warm-up frame + one frame.
+  r.value()->settings().area_specular_samples_per_side = 1;
+  r.value()->render(reg, camera);
+  r.value()->render(reg, camera);
+  std::printf("  %-45s %8.1f ms (area_specular_samples_per_side = 1)\n", r.value()->last_timings()[1].name.c_str(),
+              r.value()->last_timings()[1].ms);
   const engine::ImageRgba8 ldr = r.value()->read_ldr();
   EXPECT_EQ(ldr.width, 960);
   EXPECT_EQ(ldr.height, 540);

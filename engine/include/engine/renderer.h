@@ -6,7 +6,7 @@
 // visibility, Schlick Fresnel, metallic workflow, F0 = 0.04 for dielectrics); point/spot
 // E = I cos / d^2 with glTF's range window, spot smoothstep(cos outer, cos inner); area
 // lights: diffuse is the exact irradiance of the rectangle clipped to the horizon (Lambert's
-// polygon formula), specular a 3x3 stratified set of points weighted by cos_l dA / d^2.
+// polygon formula), specular n x n stratified points weighted by cos_l dA / d^2.
 // Shadows: cube maps (point), orthographic fitted to the scene bounds (directional),
 // perspective (spot; area from the rectangle's centre with 150 degrees and a wider kernel).
 //   auto ctx = engine::GpuContext::create_headless();              // engine/gpu/context.h
@@ -44,6 +44,10 @@ struct RenderSettings {
   /// W/(m^2 sr) per channel; it is labelled "constant ambient (stand-in)" in timings.
   float stand_in_ambient = 0.02f;
   SplitView split = SplitView::Off;
+  /// Specular of area lights: n x n stratified points per rectangle (1..4). Cost on llvmpipe
+  /// grows about linearly with n^2 (9 points: ~2/3 of an area light's cost); the diffuse
+  /// part is exact whatever n.
+  int area_specular_samples_per_side = 3;
 };
 
 /// Wall time of one render pass (GPU work measured with glFinish + a steady clock on

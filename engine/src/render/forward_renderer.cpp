@@ -51,7 +51,8 @@ Result<ShaderProgram> build(const char* vertex, const char* fragment) {
       .build();
 }
 
-using LightCounts = std::array<int, 4>;  // point, spot, directional, area
+// Point, spot, directional and area light counts, then area specular samples per side.
+using LightCounts = std::array<int, 5>;
 
 // The forward program for one combination of light counts (see forward.frag.glsl).
 Result<ShaderProgram> build_forward(const LightCounts& n) {
@@ -62,6 +63,7 @@ Result<ShaderProgram> build_forward(const LightCounts& n) {
       .define("SPOT_LIGHTS " + std::to_string(n[1]))
       .define("DIRECTIONAL_LIGHTS " + std::to_string(n[2]))
       .define("AREA_LIGHTS " + std::to_string(n[3]))
+      .define("AREA_SPECULAR_SIDE " + std::to_string(n[4]))
       .build();
 }
 
@@ -77,7 +79,7 @@ class ForwardRenderer final : public Renderer {
         tonemap_(std::move(tonemap)),
         lights_buffer_(GlBuffer::create()),
         empty_vao_(GlVertexArray::create()) {
-    forward_variants_.emplace(LightCounts{}, std::move(forward));
+    forward_variants_.emplace(LightCounts{0, 0, 0, 0, 3}, std::move(forward));
     ensure_targets();
   }
 
@@ -186,7 +188,9 @@ void ForwardRenderer::render(const Registry& registry, Entity camera) {
   glNamedBufferData(lights_buffer_.id(),
                     static_cast<GLsizeiptr>(std::max<std::size_t>(1, lights.lights.size()) * sizeof(render::GpuLight)),
                     lights.lights.empty() ? nullptr : lights.lights.data(), GL_STREAM_DRAW);
-  forward_pass(registry, camera, items, lights.count_by_type);
+  const LightCounts variant{lights.count_by_type[0], lights.count_by_type[1], lights.count_by_type[2],
+                            lights.count_by_type[3], std::clamp(settings_.area_specular_samples_per_side, 1, 4)};
+  forward_pass(registry, camera, items, variant);
   timings_.push_back({provider_ ? std::string("forward + indirect (") + provider_->label() + ")"
                                 : std::string("forward + constant ambient (stand-in)"),
                       timer.lap_ms()});
@@ -352,7 +356,7 @@ Result<std::unique_ptr<Renderer>> Renderer::create(const SceneAsset& assets, con
   GI_EXPECTS(settings.width > 0 && settings.height > 0, "RenderSettings width and height must be positive");
   if (glGetString(GL_VERSION) == nullptr)
     return Error{assets.source, "renderer", "no current OpenGL context (create an engine::GpuContext first)"};
-  auto forward = build_forward(LightCounts{});
+  auto forward = build_forward(LightCounts{0, 0, 0, 0, 3});
   if (!forward) return forward.error();
   auto depth = build("shadow.vert.glsl", "depth_only.frag.glsl");
   if (!depth) return depth.error();
