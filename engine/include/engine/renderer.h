@@ -59,7 +59,11 @@ struct PassTiming {
 
 class Renderer {
  public:
-  /// Uploads meshes, materials and textures of `assets`. Needs a current GL 4.5 context.
+  /// Uploads meshes, materials and textures of `assets`. Needs a current GL 4.5 context
+  /// (engine::GpuContext); destroy the renderer before that context. Malformed meshes or
+  /// material image indices return an Error naming the mesh/primitive or material. Normal
+  /// textures are not used yet (no tangents); area-light size is Light::area_size_m
+  /// (the node's scale is ignored).
   static Result<std::unique_ptr<Renderer>> create(const SceneAsset& assets, const RenderSettings& settings);
   virtual ~Renderer() = default;
 
