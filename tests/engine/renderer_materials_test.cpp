@@ -99,4 +99,30 @@ TEST(RendererMaterials, SingleSidedBackFacesAreCulledDoubleSidedAreShaded) {
   }
 }
 
+TEST(RendererCreate, MalformedMeshIsAnErrorNotACrash) {
+  engine::GpuContext ctx = headless_context();
+  engine::SceneAsset assets;
+  assets.source = "bad.gltf";
+  assets.meshes.push_back(plane_mesh(1.0f, -1));
+  assets.meshes[0].primitives[0].indices.push_back(99);  // out of range, and count not a multiple of 3
+  assets.meshes[0].primitives[0].indices.push_back(0);
+  assets.meshes[0].primitives[0].indices.push_back(1);
+  engine::RenderSettings settings;
+  settings.width = 16;
+  settings.height = 16;
+  auto r = engine::Renderer::create(assets, settings);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.error().file, "bad.gltf");
+  EXPECT_EQ(r.error().location, "meshes[0].primitives[0]");
+  EXPECT_NE(r.error().message.find("99"), std::string::npos) << r.error().to_string();
+
+  engine::SceneAsset bad_image;
+  bad_image.materials.push_back(diffuse_material(0.5f));
+  bad_image.materials[0].base_color_texture = 3;  // no images
+  bad_image.meshes.push_back(plane_mesh(1.0f, 0));
+  auto r2 = engine::Renderer::create(bad_image, settings);
+  ASSERT_FALSE(r2.ok());
+  EXPECT_EQ(r2.error().location, "materials[0].baseColorTexture");
+}
+
 }  // namespace
