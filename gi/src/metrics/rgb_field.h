@@ -1,0 +1,42 @@
+#pragma once
+// Linear RGB samples on a grid (camera pixels or light-atlas texels) with an optional
+// validity mask: the data every accuracy metric and every sweep run compares.
+//   gi::RgbField f = gi::RgbField::filled(64, 64, 0.5f);
+//   f.valid.assign(f.count(), 1);  // mask texels that are not covered by any chart with 0
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace gi {
+
+/// width x height elements, row-major, 3 linear floats (R, G, B) each; radiance or
+/// irradiance, the unit is whatever the producer states (metrics are scale-free or say so).
+struct RgbField {
+  int width = 0;
+  int height = 0;
+  std::vector<float> rgb;           ///< 3 * width * height values.
+  std::vector<std::uint8_t> valid;  ///< Empty (every element valid) or width * height flags, nonzero = valid.
+
+  /// Number of elements (pixels / texels).
+  std::size_t count() const { return static_cast<std::size_t>(width) * static_cast<std::size_t>(height); }
+  /// True when element i takes part in comparisons.
+  bool is_valid(std::size_t i) const { return valid.empty() || valid[i] != 0; }
+  /// True when the vector sizes agree with width and height.
+  bool consistent() const {
+    return width >= 0 && height >= 0 && rgb.size() == 3 * count() && (valid.empty() || valid.size() == count());
+  }
+  /// True when two fields can be compared element by element (same width and height).
+  bool same_layout(const RgbField& other) const { return width == other.width && height == other.height; }
+
+  /// A width x height field with every channel set to `value` and no mask.
+  static RgbField filled(int w, int h, float value) {
+    RgbField f;
+    f.width = w;
+    f.height = h;
+    f.rgb.assign(3 * f.count(), value);
+    return f;
+  }
+};
+
+}  // namespace gi
