@@ -1,0 +1,47 @@
+#pragma once
+// The plain-data input of light-atlas parameterization: one static mesh instance in world
+// space per entry. Bakers and the atlas builder never walk the registry; this adapter reads
+// a SceneAsset (the glTF data) instead.
+//   std::vector<gi::AtlasInputMesh> inputs = gi::atlas_inputs_from(asset);
+//   auto layout = gi::build_atlas_layout(inputs, {.texels_per_metre = 32.0f});
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include <engine/result.h>
+#include <engine/scene_asset.h>
+
+namespace gi {
+
+/// One static mesh instance, already transformed to world space (metres).
+/// Triangles are `indices[3t..3t+2]`; `normals` is empty or has one unit normal per position.
+struct AtlasInputMesh {
+  std::vector<glm::vec3> positions;  ///< World space, metres.
+  std::vector<glm::vec3> normals;    ///< World space shading normals (may be empty).
+  std::vector<std::uint32_t> indices;
+  std::int64_t id = -1;  ///< The caller's id; atlas_inputs_from() stores the node index.
+};
+
+/// World matrix of `node`: the product of the local TRS matrices along its parent chain.
+/// Precondition: `node` indexes `scene.nodes` and parents come before children.
+glm::mat4 node_world_matrix(const engine::SceneAsset& scene, int node);
+
+/// One input per node that has a mesh and whose mobility is not Dynamic (Unspecified counts
+/// as static), in node order. The mesh's primitives are concatenated in order: vertex
+/// k = i + (vertex counts of the earlier primitives) is primitive p's vertex i, and indices
+/// are offset the same way (the engine's convention). Positions and normals are transformed
+/// to world space (normals by the inverse transpose and renormalized); a primitive without
+/// normals gets area-weighted face normals. Nothing is validated here (see
+/// validate_atlas_inputs); out-of-range indices are copied as they are.
+std::vector<AtlasInputMesh> atlas_inputs_from(const engine::SceneAsset& scene);
+
+/// Checks what the atlas builder and rasterizer rely on: at least one triangle overall, index
+/// counts divisible by 3, indices in range, finite positions, normals empty or one per
+/// position and finite. The error's location names the input ("input 3 (id 7)").
+engine::Status validate_atlas_inputs(std::span<const AtlasInputMesh> inputs);
+
+}  // namespace gi
