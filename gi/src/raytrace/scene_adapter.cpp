@@ -1,5 +1,7 @@
 #include "raytrace/scene_adapter.h"
 
+#include <glm/glm.hpp>
+
 namespace gi {
 
 RtSceneData rt_scene_from(const engine::Scene& scene) {
@@ -20,6 +22,95 @@ RtSceneData rt_scene_from(const engine::Scene& scene) {
         data.instances.push_back(RtInstance{mr.mesh, wt.matrix, reg.has<engine::DynamicTag>(e), e.id()});
       });
   return data;
+}
+
+ReferenceMaterial reference_material(const engine::Material& m) {
+  const ReferenceBrdf f = brdf_from_material(glm::vec3(m.base_color), m.metallic, m.roughness);
+  ReferenceMaterial out;
+  out.diffuse_albedo = f.diffuse_albedo;
+  out.f0 = f.f0;
+  out.alpha = f.alpha;
+  out.emission = m.emissive;
+  out.double_sided = m.double_sided;
+  return out;
+}
+
+namespace {
+
+// Per-triangle material indices of `mesh` (primitives concatenated); `override_material`
+// >= 0 replaces them all. Index materials.size() - 1 is the default material.
+std::vector<std::uint32_t> triangle_materials(const engine::Mesh& mesh, std::int32_t override_material,
+                                              std::size_t material_count) {
+  const auto default_index = static_cast<std::uint32_t>(material_count - 1);
+  std::vector<std::uint32_t> out;
+  for (const engine::Primitive& prim : mesh.primitives) {
+    const int m = override_material >= 0 ? override_material : prim.material;
+    const std::uint32_t index =
+        m >= 0 && static_cast<std::size_t>(m) + 1 < material_count ? static_cast<std::uint32_t>(m) : default_index;
+    out.insert(out.end(), prim.indices.size() / 3, index);
+  }
+  return out;
+}
+
+ReferenceLight reference_light(const engine::Light& light, const glm::mat4& m) {
+  ReferenceLight l;
+  l.position = glm::vec3(m[3]);
+  l.direction = -glm::normalize(glm::vec3(m[2]));  // lights emit along local -Z
+  l.half_x = glm::normalize(glm::vec3(m[0])) * (0.5f * light.area_size_m.x);
+  l.half_y = glm::normalize(glm::vec3(m[1])) * (0.5f * light.area_size_m.y);
+  l.radiant = light.color * light.intensity;
+  l.range_m = light.range_m;
+  l.cos_outer = std::cos(light.outer_cone_rad);
+  l.cos_inner = std::cos(std::min(light.inner_cone_rad, light.outer_cone_rad));
+  switch (light.type) {
+    case engine::LightType::Point: l.type = ReferenceLight::Type::Point; break;
+    case engine::LightType::Spot: l.type = ReferenceLight::Type::Spot; break;
+    case engine::LightType::Directional: l.type = ReferenceLight::Type::Directional; break;
+    case engine::LightType::Area: l.type = ReferenceLight::Type::Area; break;
+  }
+  return l;
+}
+
+}  // namespace
+
+ReferenceScene reference_scene_from(const engine::Scene& scene) {
+  ReferenceScene out;
+  out.geometry = rt_scene_from(scene);
+  for (const engine::Material& m : scene.assets.materials) out.materials.push_back(reference_material(m));
+  out.materials.push_back(reference_material(engine::Material{}));  // primitives without a material
+
+  for (const engine::Mesh& mesh : scene.assets.meshes) {
+    std::vector<glm::vec3> normals;
+    bool complete = true;
+    for (const engine::Primitive& prim : mesh.primitives) {
+      complete = complete && prim.normals.size() == prim.positions.size();
+      normals.insert(normals.end(), prim.normals.begin(), prim.normals.end());
+    }
+    if (!complete) normals.clear();  // flat shading for the whole mesh
+    out.normals.push_back(std::move(normals));
+    out.triangle_material.push_back(triangle_materials(mesh, -1, out.materials.size()));
+  }
+  // Instances whose entity overrides the material get a geometry of their own.
+  std::size_t instance = 0;
+  const engine::Registry& reg = scene.registry;
+  reg.view<engine::MeshRenderer, engine::WorldTransform>().each(
+      [&](engine::Entity, const engine::MeshRenderer& mr, const engine::WorldTransform&) {
+        if (mr.mesh >= scene.assets.meshes.size()) return;
+        if (mr.material_override >= 0) {
+          const auto geo = static_cast<std::uint32_t>(out.geometry.geometries.size());
+          out.geometry.geometries.push_back(out.geometry.geometries[mr.mesh]);
+          out.normals.push_back(out.normals[mr.mesh]);
+          out.triangle_material.push_back(
+              triangle_materials(scene.assets.meshes[mr.mesh], mr.material_override, out.materials.size()));
+          out.geometry.instances[instance].geometry = geo;
+        }
+        ++instance;
+      });
+  reg.view<engine::Light, engine::WorldTransform>().each(
+      [&](engine::Entity, const engine::Light& light, const engine::WorldTransform& wt) {
+        if (light.enabled) out.lights.push_back(reference_light(light, wt.matrix));
+      });
+  return out;
 }
 
 }  // namespace gi

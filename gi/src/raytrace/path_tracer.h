@@ -1,0 +1,62 @@
+#pragma once
+// One-sample estimators of the reference path tracer over a flattened scene: radiance
+// along a camera ray and irradiance at a surface point. The drivers (reference_render.h)
+// run them over pixels and points in parallel.
+//   gi::PathTracer pt(scene, index, caster, {.max_bounces = -1});
+//   glm::vec3 L = pt.radiance(camera_ray, rng);
+
+#include <limits>
+
+#include <glm/glm.hpp>
+
+#include "core/random.h"
+#include "raytrace/ray.h"
+#include "raytrace/ray_caster.h"
+#include "raytrace/reference_brdf.h"
+#include "raytrace/reference_scene.h"
+
+namespace gi {
+
+struct PathTracerSettings {
+  int max_bounces = -1;           ///< Indirect bounces; -1: unlimited; 0: direct only.
+  int russian_roulette_start = 3; ///< Path vertex from which Russian roulette applies.
+  int max_vertices = 1024;        ///< Safety stop (with albedo <= 0.95 the cut energy is < 1e-22).
+};
+
+class PathTracer {
+ public:
+  PathTracer(const ReferenceScene& scene, const ReferenceSceneIndex& index, const RayCaster& caster,
+             PathTracerSettings settings);
+
+  /// Radiance arriving along `ray` (unit direction) from the scene: emission seen, direct
+  /// and indirect reflected light.
+  glm::vec3 radiance(const Ray& ray, Pcg32& rng) const;
+
+  struct Irradiance {
+    glm::vec3 direct{0.0f};
+    glm::vec3 indirect{0.0f};
+  };
+  /// One-sample irradiance estimate at `p` on the side of unit normal `n`.
+  Irradiance irradiance(const glm::vec3& p, const glm::vec3& n, Pcg32& rng) const;
+
+ private:
+  struct Traced {
+    glm::vec3 emitted{0.0f};    ///< Emission (or sky) found at the ray's first hit, MIS-weighted.
+    glm::vec3 reflected{0.0f};  ///< Everything reflected at the first hit and beyond.
+  };
+  /// Follows a path from `ray`. `prev_pdf` is the solid-angle density of the ray's direction
+  /// (0: not BRDF-sampled, no MIS). Light may reach the path at vertices 1..max_light_vertex.
+  Traced trace(Ray ray, float prev_pdf, int max_light_vertex, Pcg32& rng) const;
+  /// Next-event estimation at a surface point: every analytic light plus one emitter.
+  glm::vec3 direct_light(const glm::vec3& origin, const glm::vec3& p, const ReferenceBrdf& brdf, const glm::vec3& wo,
+                         Pcg32& rng) const;
+  /// Solid-angle density with which direct_light() samples a point on emitter triangle t.
+  float emitter_pdf(const ShadingTriangle& t, float distance2, float cos_light) const;
+
+  const ReferenceScene& scene_;
+  const ReferenceSceneIndex& index_;
+  const RayCaster& caster_;
+  PathTracerSettings settings_;
+};
+
+}  // namespace gi

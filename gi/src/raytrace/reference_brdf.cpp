@@ -1,0 +1,145 @@
+#include "raytrace/reference_brdf.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+namespace gi {
+namespace {
+
+constexpr float kPi = std::numbers::pi_v<float>;
+
+float luminance(const glm::vec3& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+
+float ggx_d(float n_dot_h, float alpha) {
+  const float a2 = alpha * alpha;
+  const float d = n_dot_h * n_dot_h * (a2 - 1.0f) + 1.0f;
+  return a2 / (kPi * d * d);
+}
+
+// Heitz 2014, eq. 99: V = G2 / (4 NoL NoV), height-correlated (as the renderer).
+float smith_visibility(float n_dot_v, float n_dot_l, float alpha) {
+  const float a2 = alpha * alpha;
+  const float gv = n_dot_l * std::sqrt(n_dot_v * n_dot_v * (1.0f - a2) + a2);
+  const float gl = n_dot_v * std::sqrt(n_dot_l * n_dot_l * (1.0f - a2) + a2);
+  return 0.5f / std::max(gv + gl, 1e-7f);
+}
+
+// Smith masking G1 of the view direction (the normalization of the visible-normal density).
+float smith_g1(float n_dot_v, float alpha) {
+  const float a2 = alpha * alpha;
+  return 2.0f * n_dot_v / (n_dot_v + std::sqrt(a2 + (1.0f - a2) * n_dot_v * n_dot_v));
+}
+
+glm::vec3 schlick(const glm::vec3& f0, float v_dot_h) {
+  const float m = 1.0f - v_dot_h;
+  const float m2 = m * m;
+  return f0 + (glm::vec3(1.0f) - f0) * (m2 * m2 * m);
+}
+
+// Heitz 2018, listing 1: a visible normal in the local frame (z = normal) for view ve.
+glm::vec3 sample_ggx_vndf(const glm::vec3& ve, float alpha, float u1, float u2) {
+  const glm::vec3 vh = glm::normalize(glm::vec3(alpha * ve.x, alpha * ve.y, ve.z));
+  const float lensq = vh.x * vh.x + vh.y * vh.y;
+  const glm::vec3 t1 = lensq > 0.0f ? glm::vec3(-vh.y, vh.x, 0.0f) / std::sqrt(lensq) : glm::vec3(1.0f, 0.0f, 0.0f);
+  const glm::vec3 t2 = glm::cross(vh, t1);
+  const float r = std::sqrt(u1);
+  const float phi = 2.0f * kPi * u2;
+  const float p1 = r * std::cos(phi);
+  float p2 = r * std::sin(phi);
+  const float s = 0.5f * (1.0f + vh.z);
+  p2 = (1.0f - s) * std::sqrt(std::max(0.0f, 1.0f - p1 * p1)) + s * p2;
+  const glm::vec3 nh = p1 * t1 + p2 * t2 + std::sqrt(std::max(0.0f, 1.0f - p1 * p1 - p2 * p2)) * vh;
+  return glm::normalize(glm::vec3(alpha * nh.x, alpha * nh.y, std::max(0.0f, nh.z)));
+}
+
+}  // namespace
+
+void orthonormal_basis(const glm::vec3& n, glm::vec3& t, glm::vec3& b) {
+  const float sign = std::copysign(1.0f, n.z);
+  const float a = -1.0f / (sign + n.z);
+  const float bb = n.x * n.y * a;
+  t = glm::vec3(1.0f + sign * n.x * n.x * a, sign * bb, -sign * n.x);
+  b = glm::vec3(bb, sign + n.y * n.y * a, -n.y);
+}
+
+glm::vec3 sample_cosine_hemisphere(const glm::vec3& n, float u1, float u2) {
+  glm::vec3 t, b;
+  orthonormal_basis(n, t, b);
+  const float r = std::sqrt(u1);
+  const float phi = 2.0f * kPi * u2;
+  const float z = std::sqrt(std::max(0.0f, 1.0f - u1));
+  return glm::normalize(r * std::cos(phi) * t + r * std::sin(phi) * b + z * n);
+}
+
+ReferenceBrdf brdf_from_material(const glm::vec3& base_color, float metallic, float roughness) {
+  const float m = std::clamp(metallic, 0.0f, 1.0f);
+  const float r = std::clamp(roughness, 0.045f, 1.0f);
+  ReferenceBrdf f;
+  f.diffuse_albedo = (1.0f - m) * base_color;
+  f.f0 = glm::mix(glm::vec3(0.04f), base_color, m);
+  f.alpha = r * r;
+  return f;
+}
+
+float ReferenceBrdf::specular_probability(const glm::vec3& wo) const {
+  if (f0 == glm::vec3(0.0f)) return 0.0f;  // no GGX lobe (eval_cos skips it too)
+  const float spec = luminance(schlick(f0, std::clamp(glm::dot(normal, wo), 0.0f, 1.0f)));
+  const float diff = luminance(diffuse_albedo);
+  if (spec <= 0.0f) return 0.0f;
+  if (diff <= 0.0f) return 1.0f;
+  return std::clamp(spec / (spec + diff), 0.1f, 0.9f);
+}
+
+glm::vec3 ReferenceBrdf::eval_cos(const glm::vec3& wo, const glm::vec3& wi) const {
+  const float n_dot_l = glm::dot(normal, wi);
+  if (n_dot_l <= 0.0f) return glm::vec3(0.0f);
+  glm::vec3 f = diffuse_albedo / kPi;
+  if (f0 != glm::vec3(0.0f)) {
+    const float n_dot_v = std::max(glm::dot(normal, wo), 1e-4f);
+    const glm::vec3 h = glm::normalize(wi + wo);
+    const float n_dot_h = std::max(glm::dot(normal, h), 0.0f);
+    const float v_dot_h = std::max(glm::dot(wo, h), 0.0f);
+    f += ggx_d(n_dot_h, alpha) * smith_visibility(n_dot_v, n_dot_l, alpha) * schlick(f0, v_dot_h);
+  }
+  return f * n_dot_l;
+}
+
+float ReferenceBrdf::pdf(const glm::vec3& wo, const glm::vec3& wi) const {
+  const float n_dot_l = glm::dot(normal, wi);
+  const float n_dot_v = glm::dot(normal, wo);
+  if (n_dot_l <= 0.0f || n_dot_v <= 0.0f) return 0.0f;
+  const float ps = specular_probability(wo);
+  float pdf = (1.0f - ps) * n_dot_l / kPi;
+  if (ps > 0.0f) {
+    const glm::vec3 h = glm::normalize(wi + wo);
+    const float n_dot_h = std::max(glm::dot(normal, h), 0.0f);
+    // Visible-normal density mapped to wi: G1(wo) D(h) / (4 n.wo) (Heitz 2018, eq. 17 / 4 wo.h).
+    pdf += ps * smith_g1(n_dot_v, alpha) * ggx_d(n_dot_h, alpha) / (4.0f * n_dot_v);
+  }
+  return pdf;
+}
+
+bool ReferenceBrdf::sample(const glm::vec3& wo, float u_lobe, float u1, float u2, BrdfSample& out) const {
+  const float n_dot_v = glm::dot(normal, wo);
+  if (n_dot_v <= 0.0f) return false;
+  const float ps = specular_probability(wo);
+  glm::vec3 wi;
+  if (u_lobe < ps) {
+    glm::vec3 t, b;
+    orthonormal_basis(normal, t, b);
+    const glm::vec3 ve(glm::dot(wo, t), glm::dot(wo, b), n_dot_v);
+    const glm::vec3 m = sample_ggx_vndf(ve, alpha, u1, u2);
+    const glm::vec3 h = m.x * t + m.y * b + m.z * normal;
+    wi = 2.0f * glm::dot(wo, h) * h - wo;
+  } else {
+    wi = sample_cosine_hemisphere(normal, u1, u2);
+  }
+  out.pdf = pdf(wo, wi);
+  if (!(out.pdf > 0.0f) || !std::isfinite(out.pdf)) return false;
+  out.wi = wi;
+  out.weight = eval_cos(wo, wi) / out.pdf;
+  return out.weight != glm::vec3(0.0f);
+}
+
+}  // namespace gi

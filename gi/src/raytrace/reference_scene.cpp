@@ -1,0 +1,155 @@
+#include "raytrace/reference_scene.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+namespace gi {
+namespace {
+
+bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+float luminance(const glm::vec3& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+
+engine::Error scene_error(std::string location, std::string message) {
+  return engine::Error{"<reference scene>", std::move(location), std::move(message)};
+}
+
+// True when emissive triangle `t` lies on area light `l`'s rectangle (within 1 mm of its
+// plane and of its outline) and faces the same way: it is the light's visible surface.
+bool is_proxy_of(const ShadingTriangle& t, const ReferenceLight& l) {
+  constexpr float kTolerance = 1e-3f;
+  if (glm::dot(t.face_normal, l.direction) < 0.99f) return false;
+  const float hx = glm::length(l.half_x);
+  const float hy = glm::length(l.half_y);
+  if (hx <= 0.0f || hy <= 0.0f) return false;
+  const glm::vec3 ax = l.half_x / hx;
+  const glm::vec3 ay = l.half_y / hy;
+  for (const glm::vec3& p : {t.p0, t.p0 + t.e1, t.p0 + t.e2}) {
+    const glm::vec3 d = p - l.position;
+    if (std::fabs(glm::dot(d, l.direction)) > kTolerance) return false;
+    if (std::fabs(glm::dot(d, ax)) > hx + kTolerance || std::fabs(glm::dot(d, ay)) > hy + kTolerance) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+engine::Result<ReferenceSceneIndex> index_reference_scene(const ReferenceScene& scene) {
+  const RtSceneData& g = scene.geometry;
+  if (scene.normals.size() != g.geometries.size() || scene.triangle_material.size() != g.geometries.size())
+    return scene_error("geometries", "normals/materials given for " + std::to_string(scene.normals.size()) + "/" +
+                                         std::to_string(scene.triangle_material.size()) + " of " +
+                                         std::to_string(g.geometries.size()) + " geometries");
+  for (std::size_t m = 0; m < scene.materials.size(); ++m) {
+    const ReferenceMaterial& mat = scene.materials[m];
+    if (!finite(mat.diffuse_albedo) || !finite(mat.f0) || !finite(mat.emission) || !std::isfinite(mat.alpha) ||
+        mat.alpha <= 0.0f)
+      return scene_error("material " + std::to_string(m), "non-finite value or alpha <= 0");
+  }
+  for (std::size_t i = 0; i < scene.lights.size(); ++i) {
+    const ReferenceLight& l = scene.lights[i];
+    if (!finite(l.position) || !finite(l.direction) || !finite(l.radiant) || !finite(l.half_x) || !finite(l.half_y))
+      return scene_error("light " + std::to_string(i), "non-finite position, direction, size or intensity");
+  }
+
+  ReferenceSceneIndex index;
+  glm::vec3 lo(INFINITY), hi(-INFINITY);
+  for (std::size_t inst = 0; inst < g.instances.size(); ++inst) {
+    const RtInstance& in = g.instances[inst];
+    const std::string where = "instance " + std::to_string(inst);
+    if (in.geometry >= g.geometries.size()) return scene_error(where, "geometry index out of range");
+    const RtGeometry& geo = g.geometries[in.geometry];
+    const auto& normals = scene.normals[in.geometry];
+    const auto& mats = scene.triangle_material[in.geometry];
+    const std::size_t tri_count = geo.indices.size() / 3;
+    if (!normals.empty() && normals.size() != geo.positions.size())
+      return scene_error(where, "normal count differs from vertex count");
+    if (mats.size() != tri_count) return scene_error(where, "material count differs from triangle count");
+    const glm::mat4& m = in.object_to_world;
+    const glm::mat3 normal_matrix = glm::transpose(glm::inverse(glm::mat3(m)));
+    const bool mirrored = glm::determinant(glm::mat3(m)) < 0.0f;  // glTF: front faces turn clockwise
+    index.instance_first.push_back(static_cast<std::uint32_t>(index.triangles.size()));
+    for (std::size_t t = 0; t < tri_count; ++t) {
+      std::uint32_t vi[3];
+      for (int k = 0; k < 3; ++k) {
+        vi[k] = geo.indices[3 * t + static_cast<std::size_t>(k)];
+        if (vi[k] >= geo.positions.size()) return scene_error(where, "triangle " + std::to_string(t) + ": index out of range");
+      }
+      if (mats[t] >= scene.materials.size())
+        return scene_error(where, "triangle " + std::to_string(t) + ": material index out of range");
+      glm::vec3 p[3], n[3];
+      for (int k = 0; k < 3; ++k) {
+        p[k] = glm::vec3(m * glm::vec4(geo.positions[vi[k]], 1.0f));
+        if (!finite(p[k])) return scene_error(where, "triangle " + std::to_string(t) + ": non-finite position");
+        lo = glm::min(lo, p[k]);
+        hi = glm::max(hi, p[k]);
+      }
+      ShadingTriangle tri;
+      tri.p0 = p[0];
+      tri.e1 = p[1] - p[0];
+      tri.e2 = p[2] - p[0];
+      const glm::vec3 c = glm::cross(tri.e1, tri.e2);
+      const float len = glm::length(c);
+      tri.area_m2 = 0.5f * len;
+      tri.face_normal = len > 0.0f ? c / len : glm::vec3(0.0f, 1.0f, 0.0f);
+      if (mirrored) tri.face_normal = -tri.face_normal;
+      for (int k = 0; k < 3; ++k) {
+        n[k] = normals.empty() ? tri.face_normal : normal_matrix * normals[vi[k]];
+        const float nl = glm::length(n[k]);
+        n[k] = (nl > 0.0f && std::isfinite(nl)) ? n[k] / nl : tri.face_normal;
+      }
+      tri.n0 = n[0];
+      tri.n1 = n[1];
+      tri.n2 = n[2];
+      tri.material = mats[t];
+      index.triangles.push_back(tri);
+    }
+  }
+  index.scene_radius_m = index.triangles.empty() ? 1.0f : 0.5f * glm::length(hi - lo);
+
+  index.light_has_proxy.assign(scene.lights.size(), false);
+  std::vector<double> power;
+  for (std::uint32_t t = 0; t < index.triangles.size(); ++t) {
+    ShadingTriangle& tri = index.triangles[t];
+    const ReferenceMaterial& mat = scene.materials[tri.material];
+    const float lum = luminance(mat.emission);
+    if (!(lum > 0.0f) || !(tri.area_m2 > 0.0f)) continue;
+    for (std::size_t l = 0; l < scene.lights.size(); ++l)
+      if (scene.lights[l].type == ReferenceLight::Type::Area && is_proxy_of(tri, scene.lights[l]))
+        index.light_has_proxy[l] = true;
+    tri.emitter = static_cast<std::int32_t>(index.emitters.triangle.size());
+    index.emitters.triangle.push_back(t);
+    power.push_back(static_cast<double>(lum) * static_cast<double>(tri.area_m2) * (mat.double_sided ? 2.0 : 1.0));
+  }
+  double total = 0.0;
+  for (double p : power) total += p;
+  double running = 0.0;
+  for (double p : power) {
+    running += p;
+    index.emitters.probability.push_back(static_cast<float>(p / total));
+    index.emitters.cdf.push_back(static_cast<float>(running / total));
+  }
+  if (!index.emitters.cdf.empty()) index.emitters.cdf.back() = 1.0f;
+  return index;
+}
+
+ReferenceBrdf shading_brdf(const ReferenceScene& scene, const ShadingTriangle& tri, glm::vec2 uv, bool front) {
+  const ReferenceMaterial& mat = scene.materials[tri.material];
+  ReferenceBrdf f;
+  f.diffuse_albedo = mat.diffuse_albedo;
+  f.f0 = mat.f0;
+  f.alpha = mat.alpha;
+  glm::vec3 n = (1.0f - uv.x - uv.y) * tri.n0 + uv.x * tri.n1 + uv.y * tri.n2;
+  const float len = glm::length(n);
+  n = len > 1e-8f ? n / len : tri.face_normal;
+  const glm::vec3 facing = front ? tri.face_normal : -tri.face_normal;
+  if (!front) n = -n;
+  // A shading normal on the other side of the surface than the viewer would reflect light
+  // through the surface: use the geometric normal there.
+  if (glm::dot(n, facing) <= 0.0f) n = facing;
+  f.normal = n;
+  return f;
+}
+
+}  // namespace gi

@@ -1,0 +1,90 @@
+#pragma once
+// The reference path tracer's view of a scene: a snapshot in world space of every
+// triangle with its shading data, the lights in engine units, and the emitters (emissive
+// triangles) with a power-proportional sampling table. Plain data: tests build it by hand,
+// reference_scene_from() (scene_adapter.h) fills it from a live engine scene.
+//   gi::ReferenceScene s = gi::reference_scene_from(scene);
+//   gi::ReferenceSceneIndex index = gi::index_reference_scene(s).value();
+
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include <engine/result.h>
+
+#include "raytrace/reference_brdf.h"
+#include "raytrace/rt_scene_data.h"
+
+namespace gi {
+
+struct ReferenceMaterial {
+  glm::vec3 diffuse_albedo{0.8f};  ///< (1 - metallic) x base colour.
+  glm::vec3 f0{0.04f};             ///< 0: no GGX lobe (a pure Lambertian surface).
+  float alpha = 1.0f;              ///< GGX alpha.
+  glm::vec3 emission{0.0f};        ///< Emitted radiance, W/(m^2 sr), from the front face.
+  bool double_sided = false;       ///< Back faces shade (and emit) like front faces.
+};
+
+/// A light in engine units (engine/components.h), world space.
+struct ReferenceLight {
+  enum class Type : std::uint8_t { Point, Spot, Directional, Area };
+  Type type = Type::Point;
+  glm::vec3 position{0.0f};
+  glm::vec3 direction{0.0f, -1.0f, 0.0f};  ///< Unit emission direction (the light's -Z).
+  glm::vec3 half_x{0.5f, 0.0f, 0.0f};      ///< Area: half the rectangle along its X axis (m).
+  glm::vec3 half_y{0.0f, 0.0f, 0.5f};      ///< Area: half the rectangle along its Y axis (m).
+  glm::vec3 radiant{1.0f};  ///< W/sr (point, spot), W/m^2 (directional), W/(m^2 sr) (area).
+  float range_m = 0.0f;     ///< glTF range window; 0: unlimited.
+  float cos_outer = 0.0f;   ///< Spot cone.
+  float cos_inner = 1.0f;
+};
+
+/// Everything the path tracer reads. Per geometry: world-independent shading data
+/// (normals per vertex may be empty: flat shading); per triangle a material index.
+struct ReferenceScene {
+  RtSceneData geometry;
+  std::vector<std::vector<glm::vec3>> normals;               ///< [geometry][vertex], object space.
+  std::vector<std::vector<std::uint32_t>> triangle_material; ///< [geometry][triangle] into materials.
+  std::vector<ReferenceMaterial> materials;
+  std::vector<ReferenceLight> lights;
+  glm::vec3 sky_radiance{0.0f};  ///< Radiance of rays that escape, W/(m^2 sr) (a uniform sky).
+};
+
+/// One world-space triangle with what shading needs.
+struct ShadingTriangle {
+  glm::vec3 p0, e1, e2;          ///< p = p0 + u e1 + v e2.
+  glm::vec3 n0, n1, n2;          ///< Unit world-space vertex normals (the face normal when flat).
+  glm::vec3 face_normal;         ///< Unit, from the winding (front side).
+  float area_m2 = 0.0f;
+  std::uint32_t material = 0;
+  std::int32_t emitter = -1;     ///< Index into ReferenceSceneIndex::emitters, or -1.
+};
+
+/// Emissive triangles, sampled in proportion to their power (area x luminance x sides).
+struct EmitterTable {
+  std::vector<std::uint32_t> triangle;  ///< Index into ReferenceSceneIndex::triangles.
+  std::vector<float> probability;       ///< Probability of picking each emitter.
+  std::vector<float> cdf;               ///< Inclusive running sum of probability; back() == 1.
+};
+
+/// The snapshot flattened for shading: triangle index = instance_first[instance] + primitive.
+struct ReferenceSceneIndex {
+  std::vector<ShadingTriangle> triangles;
+  std::vector<std::uint32_t> instance_first;
+  EmitterTable emitters;
+  /// Area lights that are also drawn as emissive geometry (the scene generator's emissive
+  /// quad just in front of the light): the geometry stands for them, the analytic light is
+  /// not sampled again, so their light is not counted twice.
+  std::vector<bool> light_has_proxy;
+  float scene_radius_m = 0.0f;  ///< Half the diagonal of the world bounds.
+};
+
+/// Flattens the scene. Errors: inconsistent sizes, indices out of range, non-finite values.
+engine::Result<ReferenceSceneIndex> index_reference_scene(const ReferenceScene& scene);
+
+/// The BRDF of a hit on triangle `tri` at barycentrics (u, v), seen from the side of wo.
+/// `front` says whether wo lies on the front side.
+ReferenceBrdf shading_brdf(const ReferenceScene& scene, const ShadingTriangle& tri, glm::vec2 uv, bool front);
+
+}  // namespace gi
