@@ -1,9 +1,9 @@
 // Bad input to the light-atlas builder gives an engine::Error naming the problem, never a crash.
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <limits>
 #include <string>
-
-#include <gtest/gtest.h>
 
 #include "uv/atlas_input.h"
 #include "uv/atlas_layout.h"

@@ -1,16 +1,16 @@
 // Dilation of atlas images, and the seam guarantee: a constant field written into the valid
 // texels and dilated reads back constant through GL_LINEAR-style bilinear lookups anywhere on
 // triangle edges and vertices (the chart seams) of every scene.
+#include "uv/atlas_dilation.h"
+
+#include <engine/gltf.h>
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <vector>
 
-#include <gtest/gtest.h>
-
-#include <engine/gltf.h>
-
-#include "uv/atlas_dilation.h"
 #include "uv/atlas_input.h"
 #include "uv/atlas_layout.h"
 #include "uv/atlas_rasterizer.h"
@@ -29,7 +29,8 @@ Texel sample_bilinear(const std::vector<Texel>& img, int w, int h, glm::vec2 uv)
     return img[static_cast<std::size_t>(j * w + i)];
   };
   const int x0 = int(fx), y0 = int(fy);
-  return (1 - ay) * ((1 - ax) * at(x0, y0) + ax * at(x0 + 1, y0)) + ay * ((1 - ax) * at(x0, y0 + 1) + ax * at(x0 + 1, y0 + 1));
+  return (1 - ay) * ((1 - ax) * at(x0, y0) + ax * at(x0 + 1, y0)) +
+         ay * ((1 - ax) * at(x0, y0 + 1) + ax * at(x0 + 1, y0 + 1));
 }
 
 }  // namespace

@@ -1,6 +1,11 @@
 // Light-atlas layout on every scene in assets/: charts do not overlap, every triangle gets a
 // sample, texel density holds, uv1 stays in [0, 1]; plus determinism, vertex splitting,
 // degenerate triangles, density reduction and build timings.
+#include "uv/atlas_layout.h"
+
+#include <engine/gltf.h>
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -9,12 +14,7 @@
 #include <string>
 #include <vector>
 
-#include <gtest/gtest.h>
-
-#include <engine/gltf.h>
-
 #include "uv/atlas_input.h"
-#include "uv/atlas_layout.h"
 #include "uv/atlas_rasterizer.h"
 
 namespace {
@@ -115,7 +115,8 @@ void check_scene_layout(const std::vector<gi::AtlasInputMesh>& inputs, const gi:
   std::vector<std::vector<bool>> owns(l.meshes.size());
   for (std::size_t m = 0; m < l.meshes.size(); ++m) owns[m].assign(l.meshes[m].triangle_chart.size(), false);
   for (std::size_t i = 0; i < texels.valid.size(); ++i)
-    if (texels.valid[i]) owns[static_cast<std::size_t>(texels.mesh[i])][static_cast<std::size_t>(texels.triangle[i])] = true;
+    if (texels.valid[i])
+      owns[static_cast<std::size_t>(texels.mesh[i])][static_cast<std::size_t>(texels.triangle[i])] = true;
   for (std::size_t m = 0; m < l.meshes.size(); ++m)
     for (std::size_t t = 0; t < l.meshes[m].triangle_chart.size(); ++t) {
       const auto p = texel_corners(l, m, t);
@@ -230,7 +231,8 @@ TEST(AtlasLayout, DegenerateTrianglesGetValidUvAndASample) {
   ASSERT_TRUE(layout.ok()) << layout.error().to_string();
   const gi::AtlasMeshUv& uv = layout->meshes[0];
   EXPECT_EQ(uv.triangle_chart[2], uv.triangle_chart[0]) << "the point triangle joins the chart it touches";
-  for (glm::vec2 p : uv.uv1) EXPECT_TRUE(std::isfinite(p.x) && std::isfinite(p.y) && p.x >= 0 && p.x <= 1 && p.y >= 0 && p.y <= 1);
+  for (glm::vec2 p : uv.uv1)
+    EXPECT_TRUE(std::isfinite(p.x) && std::isfinite(p.y) && p.x >= 0 && p.x <= 1 && p.y >= 0 && p.y <= 1);
   const gi::AtlasTexels texels = gi::rasterize_atlas(layout.value(), inputs);
   const glm::vec2 size(float(layout->width), float(layout->height));
   for (std::size_t t = 0; t < 5; ++t) {
@@ -276,10 +278,10 @@ TEST(AtlasLayout, TimesDemoLevelBuildAndRasterization) {
     std::size_t valid = 0;
     for (std::uint8_t v : texels.valid) valid += v;
     const auto ms = [](auto d) { return std::chrono::duration<double, std::milli>(d).count(); };
-    std::printf("[ timing ] demo_level at %.0f texels/m: atlas %d x %d (achieved %.2f texels/m), %zu charts, "
-                "%zu valid texels (%.1f%%); build %.2f ms, rasterize %.2f ms\n",
-                double(density), layout->width, layout->height, double(layout->texels_per_metre),
-                layout->charts.size(), valid, 100.0 * double(valid) / double(texels.valid.size()), ms(t1 - t0),
-                ms(t2 - t1));
+    std::printf(
+        "[ timing ] demo_level at %.0f texels/m: atlas %d x %d (achieved %.2f texels/m), %zu charts, "
+        "%zu valid texels (%.1f%%); build %.2f ms, rasterize %.2f ms\n",
+        double(density), layout->width, layout->height, double(layout->texels_per_metre), layout->charts.size(), valid,
+        100.0 * double(valid) / double(texels.valid.size()), ms(t1 - t0), ms(t2 - t1));
   }
 }

@@ -1,15 +1,15 @@
 // Rasterization of atlas layouts into per-texel world samples: positions on the surface,
 // unit normals, the ownership rule and guaranteed samples for tiny triangles.
+#include "uv/atlas_rasterizer.h"
+
+#include <engine/gltf.h>
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <vector>
 
-#include <gtest/gtest.h>
-
-#include <engine/gltf.h>
-
 #include "uv/atlas_input.h"
 #include "uv/atlas_layout.h"
-#include "uv/atlas_rasterizer.h"
 #include "uv/texel_triangle.h"
 
 namespace {

@@ -1,16 +1,16 @@
 // Writing the light-atlas parameterization into scene data as TEXCOORD_1: a glTF round trip
 // of the Cornell box, and meshes shared by several nodes.
+#include "uv/atlas_scene_writer.h"
+
+#include <engine/gltf.h>
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <filesystem>
 #include <string>
 
-#include <gtest/gtest.h>
-
-#include <engine/gltf.h>
-
 #include "uv/atlas_input.h"
 #include "uv/atlas_layout.h"
-#include "uv/atlas_scene_writer.h"
 
 namespace {
 
@@ -149,7 +149,8 @@ TEST(AtlasSceneWriter, SplitVerticesStayInTheirPrimitive) {
   engine::SceneAsset s;
   engine::Primitive cube;
   for (int i = 0; i < 8; ++i) cube.positions.emplace_back(float(i & 1), float((i >> 1) & 1), float((i >> 2) & 1));
-  cube.indices = {0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4, 2, 6, 3, 3, 6, 7, 0, 4, 2, 2, 4, 6, 1, 3, 5, 3, 7, 5};
+  cube.indices = {0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4,
+                  2, 6, 3, 3, 6, 7, 0, 4, 2, 2, 4, 6, 1, 3, 5, 3, 7, 5};
   s.meshes = {engine::Mesh{"cube", {quad(glm::vec3(0, 0, -3)), cube}}};
   s.nodes = {engine::Node{"cube"}};
   s.nodes[0].mesh = 0;

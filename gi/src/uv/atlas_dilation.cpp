@@ -19,7 +19,8 @@ std::vector<std::uint8_t> dilate(std::span<Texel> values, int width, int height,
     ring_values.clear();
     for (int y = 0; y < height; ++y)
       for (int x = 0; x < width; ++x) {
-        const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x);
+        const std::size_t i =
+            static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x);
         if (mask[i]) continue;
         Texel sum(0.0f);
         int count = 0;
@@ -27,7 +28,8 @@ std::vector<std::uint8_t> dilate(std::span<Texel> values, int width, int height,
           for (int dx = -1; dx <= 1; ++dx) {
             const int nx = x + dx, ny = y + dy;
             if ((dx == 0 && dy == 0) || nx < 0 || ny < 0 || nx >= width || ny >= height) continue;
-            const std::size_t j = static_cast<std::size_t>(ny) * static_cast<std::size_t>(width) + static_cast<std::size_t>(nx);
+            const std::size_t j =
+                static_cast<std::size_t>(ny) * static_cast<std::size_t>(width) + static_cast<std::size_t>(nx);
             if (!mask[j]) continue;
             sum += values[j];
             ++count;

@@ -1,18 +1,17 @@
 #include "uv/atlas_input.h"
 
-#include <cmath>
-#include <string>
-
-#include <glm/gtc/quaternion.hpp>
-
 #include <engine/check.h>
+
+#include <cmath>
+#include <glm/gtc/quaternion.hpp>
+#include <string>
 
 namespace gi {
 namespace {
 
 glm::mat4 local_matrix(const engine::Node& n) {
-  const glm::mat4 t = glm::mat4(glm::vec4(1, 0, 0, 0), glm::vec4(0, 1, 0, 0), glm::vec4(0, 0, 1, 0),
-                                glm::vec4(n.translation, 1.0f));
+  const glm::mat4 t =
+      glm::mat4(glm::vec4(1, 0, 0, 0), glm::vec4(0, 1, 0, 0), glm::vec4(0, 0, 1, 0), glm::vec4(n.translation, 1.0f));
   const glm::mat4 s = glm::mat4(glm::vec4(n.scale.x, 0, 0, 0), glm::vec4(0, n.scale.y, 0, 0),
                                 glm::vec4(0, 0, n.scale.z, 0), glm::vec4(0, 0, 0, 1));
   return t * glm::mat4_cast(n.rotation) * s;

@@ -5,15 +5,14 @@
 //   std::vector<gi::AtlasInputMesh> inputs = gi::atlas_inputs_from(asset);
 //   auto layout = gi::build_atlas_layout(inputs, {.texels_per_metre = 32.0f});
 
+#include <engine/result.h>
+#include <engine/scene_asset.h>
+
 #include <cstdint>
+#include <glm/glm.hpp>
 #include <span>
 #include <string>
 #include <vector>
-
-#include <glm/glm.hpp>
-
-#include <engine/result.h>
-#include <engine/scene_asset.h>
 
 namespace gi {
 

@@ -69,7 +69,8 @@ engine::Result<AtlasLayout> build_atlas_layout(std::span<const AtlasInputMesh> i
   const int usable = settings.max_atlas_size - 2 * pad;
   double density = settings.texels_per_metre;
   double max_extent_m = 0.0;
-  for (const Chart& c : charts) max_extent_m = std::max(max_extent_m, static_cast<double>(std::max(c.size_m.x, c.size_m.y)));
+  for (const Chart& c : charts)
+    max_extent_m = std::max(max_extent_m, static_cast<double>(std::max(c.size_m.x, c.size_m.y)));
   if (max_extent_m * density > usable - 0.02) density = (usable - 0.02) / max_extent_m;
 
   std::optional<ShelfPacking> packing;
@@ -89,9 +90,8 @@ engine::Result<AtlasLayout> build_atlas_layout(std::span<const AtlasInputMesh> i
   if (!packing)
     return engine::Error{"", "build_atlas_layout",
                          std::to_string(charts.size()) + " charts do not fit a " +
-                             std::to_string(settings.max_atlas_size) + " x " +
-                             std::to_string(settings.max_atlas_size) + " atlas with padding " + std::to_string(pad) +
-                             " at any texel density"};
+                             std::to_string(settings.max_atlas_size) + " x " + std::to_string(settings.max_atlas_size) +
+                             " atlas with padding " + std::to_string(pad) + " at any texel density"};
 
   AtlasLayout layout;
   layout.width = packing->width;

@@ -18,13 +18,12 @@
 //   triangle order, that uses it); copies for further charts are appended in order of first
 //   use. Vertices no triangle uses keep uv (0, 0).
 
+#include <engine/result.h>
+
 #include <cstdint>
+#include <glm/glm.hpp>
 #include <span>
 #include <vector>
-
-#include <glm/glm.hpp>
-
-#include <engine/result.h>
 
 #include "uv/atlas_input.h"
 
@@ -44,31 +43,31 @@ inline constexpr float kMaxTexelsPerMetre = 1.0e4f;
 
 /// One chart placed in the atlas.
 struct AtlasChart {
-  std::uint32_t mesh = 0;          ///< Index into AtlasLayout::meshes (= the input index).
-  glm::ivec2 origin{0};            ///< Min texel of the footprint.
-  glm::ivec2 size{0};              ///< Footprint size, texels.
+  std::uint32_t mesh = 0;              ///< Index into AtlasLayout::meshes (= the input index).
+  glm::ivec2 origin{0};                ///< Min texel of the footprint.
+  glm::ivec2 size{0};                  ///< Footprint size, texels.
   glm::vec3 normal{0.0f, 0.0f, 1.0f};  ///< Unit projection axis, world space.
   std::uint32_t triangle_count = 0;
-  double area_m2 = 0.0;            ///< World-space area of its triangles.
+  double area_m2 = 0.0;  ///< World-space area of its triangles.
 };
 
 /// The atlas parameterization of one input mesh (see the conventions above).
 struct AtlasMeshUv {
-  std::int64_t id = -1;                      ///< The input's id.
-  std::vector<std::uint32_t> indices;        ///< 3 per triangle, input order, into source_vertex / uv1.
-  std::vector<std::uint32_t> source_vertex;  ///< Output vertex -> input vertex.
-  std::vector<glm::vec2> uv1;                ///< Normalized atlas coordinates in [0, 1], per output vertex.
-  std::vector<std::uint32_t> triangle_chart; ///< Chart (index into AtlasLayout::charts) per triangle.
+  std::int64_t id = -1;                       ///< The input's id.
+  std::vector<std::uint32_t> indices;         ///< 3 per triangle, input order, into source_vertex / uv1.
+  std::vector<std::uint32_t> source_vertex;   ///< Output vertex -> input vertex.
+  std::vector<glm::vec2> uv1;                 ///< Normalized atlas coordinates in [0, 1], per output vertex.
+  std::vector<std::uint32_t> triangle_chart;  ///< Chart (index into AtlasLayout::charts) per triangle.
 };
 
 struct AtlasLayout {
-  int width = 0;   ///< Texels.
-  int height = 0;  ///< Texels.
+  int width = 0;                            ///< Texels.
+  int height = 0;                           ///< Texels.
   float texels_per_metre = 0.0f;            ///< Achieved density (may be below the request, never above).
   float requested_texels_per_metre = 0.0f;  ///< What the settings asked for.
   int padding_texels = 0;
-  std::vector<AtlasChart> charts;  ///< In input order, then by seed triangle.
-  std::vector<AtlasMeshUv> meshes; ///< One per input, same order.
+  std::vector<AtlasChart> charts;   ///< In input order, then by seed triangle.
+  std::vector<AtlasMeshUv> meshes;  ///< One per input, same order.
 
   /// True when the charts did not fit max_atlas_size at the requested density.
   bool density_reduced() const { return texels_per_metre < requested_texels_per_metre; }

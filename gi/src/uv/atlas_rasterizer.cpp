@@ -1,10 +1,10 @@
 #include "uv/atlas_rasterizer.h"
 
+#include <engine/check.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
-
-#include <engine/check.h>
 
 #include "uv/texel_triangle.h"
 

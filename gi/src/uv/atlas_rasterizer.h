@@ -16,10 +16,9 @@
 //   sample there. An isolated tiny or degenerate triangle always owns a sample.
 
 #include <cstdint>
+#include <glm/glm.hpp>
 #include <span>
 #include <vector>
-
-#include <glm/glm.hpp>
 
 #include "uv/atlas_input.h"
 #include "uv/atlas_layout.h"
@@ -32,15 +31,17 @@ enum class TexelCoverage : std::uint8_t { Empty, Conservative, Inside };
 struct AtlasTexels {
   int width = 0;
   int height = 0;
-  std::vector<glm::vec3> position;       ///< World-space sample point, metres (0 where empty).
-  std::vector<glm::vec3> normal;         ///< Unit shading normal (interpolated; 0 where empty).
-  std::vector<std::uint8_t> valid;       ///< 1 where a triangle covers the texel.
-  std::vector<TexelCoverage> coverage;   ///< How it is covered.
-  std::vector<std::int32_t> mesh;        ///< Owning input mesh, -1 where empty.
-  std::vector<std::int32_t> triangle;    ///< Owning triangle of that mesh, -1 where empty.
-  std::vector<std::int32_t> chart;       ///< Chart of the owning triangle, -1 where empty.
+  std::vector<glm::vec3> position;      ///< World-space sample point, metres (0 where empty).
+  std::vector<glm::vec3> normal;        ///< Unit shading normal (interpolated; 0 where empty).
+  std::vector<std::uint8_t> valid;      ///< 1 where a triangle covers the texel.
+  std::vector<TexelCoverage> coverage;  ///< How it is covered.
+  std::vector<std::int32_t> mesh;       ///< Owning input mesh, -1 where empty.
+  std::vector<std::int32_t> triangle;   ///< Owning triangle of that mesh, -1 where empty.
+  std::vector<std::int32_t> chart;      ///< Chart of the owning triangle, -1 where empty.
 
-  std::size_t index(int x, int y) const { return static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x); }
+  std::size_t index(int x, int y) const {
+    return static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x);
+  }
 };
 
 /// Samples every texel of `layout`. Precondition: `inputs` are the meshes the layout was

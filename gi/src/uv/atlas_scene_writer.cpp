@@ -28,8 +28,9 @@ engine::Result<engine::Mesh> mesh_with_uv1(const engine::SceneAsset& scene, cons
     indices += p.indices.size();
   }
   if (indices != uv.indices.size())
-    return mismatch(scene, mesh_index,
-                    std::to_string(uv.indices.size()) + " indices against " + std::to_string(indices) + " in the scene");
+    return mismatch(
+        scene, mesh_index,
+        std::to_string(uv.indices.size()) + " indices against " + std::to_string(indices) + " in the scene");
   if (uv.source_vertex.size() < vertices || uv.uv1.size() != uv.source_vertex.size())
     return mismatch(scene, mesh_index, "fewer output vertices than the mesh has");
   for (std::size_t v = 0; v < vertices; ++v)
@@ -71,7 +72,8 @@ engine::Result<engine::Mesh> mesh_with_uv1(const engine::SceneAsset& scene, cons
     for (std::uint32_t& i : prim.indices) {
       const std::uint32_t o = uv.indices[k++];
       if (o >= local.size() || primitive_of(uv.source_vertex[o]) != p)
-        return mismatch(scene, mesh_index, "a triangle of primitive " + std::to_string(p) + " uses another primitive's vertex");
+        return mismatch(scene, mesh_index,
+                        "a triangle of primitive " + std::to_string(p) + " uses another primitive's vertex");
       i = local[o];
     }
   }

@@ -35,7 +35,8 @@ std::vector<std::uint32_t> weld_vertices(const std::vector<glm::vec3>& positions
   auto cell_of = [&](glm::vec3 p) {
     glm::i64vec3 c;
     for (int k = 0; k < 3; ++k)
-      c[k] = static_cast<std::int64_t>(std::clamp(std::floor(static_cast<double>(p[k]) / static_cast<double>(eps)), -limit, limit));
+      c[k] = static_cast<std::int64_t>(
+          std::clamp(std::floor(static_cast<double>(p[k]) / static_cast<double>(eps)), -limit, limit));
     return c;
   };
   const float eps2 = eps * eps;
@@ -124,8 +125,7 @@ std::vector<glm::vec2> convex_hull(std::vector<glm::vec2> pts) {
 
 // Fills the chart's projection: normal, in-plane axes (rotated so the bounding rectangle has
 // minimal area: it has a side collinear with a hull edge, Freeman & Shapira 1975), rectangle.
-void project_chart(Chart& chart, const AtlasInputMesh& mesh, const std::vector<glm::vec3>& face_cross,
-                   bool rotate) {
+void project_chart(Chart& chart, const AtlasInputMesh& mesh, const std::vector<glm::vec3>& face_cross, bool rotate) {
   glm::dvec3 sum(0.0);
   double area = 0.0;
   for (std::uint32_t t : chart.triangles) {

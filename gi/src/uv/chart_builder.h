@@ -5,9 +5,8 @@
 //   glm::vec2 m = charts[0].project_m(mesh.positions[i]);  // metres from the chart's corner
 
 #include <cstdint>
-#include <vector>
-
 #include <glm/glm.hpp>
+#include <vector>
 
 #include "uv/atlas_input.h"
 
@@ -27,15 +26,15 @@ struct ChartingSettings {
 
 /// A set of triangles of one mesh projected onto one plane.
 struct Chart {
-  std::uint32_t mesh = 0;               ///< Index of the input mesh.
+  std::uint32_t mesh = 0;                ///< Index of the input mesh.
   std::vector<std::uint32_t> triangles;  ///< Triangle indices into the mesh, ascending.
-  glm::vec3 normal{0.0f, 0.0f, 1.0f};   ///< Unit projection axis (area-weighted mean normal).
-  glm::vec3 axis_u{1.0f, 0.0f, 0.0f};   ///< Unit in-plane axes, axis_u x axis_v = normal.
+  glm::vec3 normal{0.0f, 0.0f, 1.0f};    ///< Unit projection axis (area-weighted mean normal).
+  glm::vec3 axis_u{1.0f, 0.0f, 0.0f};    ///< Unit in-plane axes, axis_u x axis_v = normal.
   glm::vec3 axis_v{0.0f, 1.0f, 0.0f};
-  glm::vec3 origin{0.0f};               ///< A point of the chart (keeps projections precise).
-  glm::vec2 min_m{0.0f};                ///< Bounding rectangle of the projection, metres.
-  glm::vec2 size_m{0.0f};               ///< Its size, metres; size_m.x >= size_m.y when rotated.
-  double area_m2 = 0.0;                 ///< World-space area of its triangles.
+  glm::vec3 origin{0.0f};  ///< A point of the chart (keeps projections precise).
+  glm::vec2 min_m{0.0f};   ///< Bounding rectangle of the projection, metres.
+  glm::vec2 size_m{0.0f};  ///< Its size, metres; size_m.x >= size_m.y when rotated.
+  double area_m2 = 0.0;    ///< World-space area of its triangles.
 
   /// Projection of a world point into the chart's rectangle, metres from its min corner.
   glm::vec2 project_m(glm::vec3 p) const {
