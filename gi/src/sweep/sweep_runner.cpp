@@ -1,0 +1,110 @@
+#include "sweep/sweep_runner.h"
+
+#include <chrono>
+#include <limits>
+#include <map>
+
+#include "sweep/reference_cache.h"
+
+namespace gi {
+namespace {
+
+std::string layout_problem(const RgbField& out, const RgbField& ref) {
+  if (!out.consistent()) return "the method's output vector sizes do not match its width x height";
+  if (!out.same_layout(ref)) {
+    return "the method's output is " + std::to_string(out.width) + "x" + std::to_string(out.height) +
+           " but the reference is " + std::to_string(ref.width) + "x" + std::to_string(ref.height);
+  }
+  return {};
+}
+
+}  // namespace
+
+engine::Result<SweepResult> run_sweep(const SweepRegistry& registry, const SweepMethod& method, const SweepScene& scene,
+                                      std::span<const KnobSetting> settings, const SweepOptions& options,
+                                      const SweepProgressFn& progress, const SweepLogFn& log) {
+  SweepResult result;
+  const ReferenceCache cache(options.cache_dir);
+
+  // Requests first: the number of distinct references is part of the work total.
+  std::vector<ReferenceRequest> requests;
+  std::map<std::string, std::size_t> request_index;  // request key -> index into requests
+  std::vector<std::size_t> request_of_run;
+  for (const KnobSetting& s : settings) {
+    ReferenceRequest r = method.reference_for(scene, s);
+    auto [it, inserted] = request_index.emplace(r.key(), requests.size());
+    if (inserted) requests.push_back(std::move(r));
+    request_of_run.push_back(it->second);
+  }
+  for (const ReferenceRequest& r : requests) {
+    if (registry.find_provider(r.kind) == nullptr) {
+      return engine::Error{"method " + method.name, r.key(),
+                           "no reference provider is registered for kind '" + r.kind + "'"};
+    }
+  }
+
+  SweepProgress state;
+  state.units_total = requests.size() + settings.size();
+  bool cancelled = false;
+  auto report = [&](double fraction) {
+    state.current_fraction = fraction;
+    if (progress && !progress(state)) cancelled = true;
+    return !cancelled;
+  };
+  const ProgressFn unit_progress = [&](double f) { return report(f); };
+
+  std::vector<ReferenceFetch> references;
+  for (const ReferenceRequest& r : requests) {
+    state.current = "reference " + r.key();
+    if (!report(0.0)) break;
+    engine::Result<ReferenceFetch> fetched =
+        fetch_reference(cache, *registry.find_provider(r.kind), scene, r, options.threads, unit_progress);
+    if (cancelled) break;
+    if (!fetched) return fetched.error();
+    if (!fetched->warning.empty() && log) log(fetched->warning);
+    (fetched->from_cache ? result.references_from_cache : result.references_computed) += 1;
+    references.push_back(std::move(fetched.value()));
+    ++state.units_done;
+  }
+
+  for (std::size_t run = 0; run < settings.size() && !cancelled; ++run) {
+    const ReferenceFetch& ref = references[request_of_run[run]];
+    SweepRow row;
+    row.method = method.name;
+    row.scene = scene.display_name();
+    row.knobs = settings[run];
+    row.reference_key = ref.key;
+    state.current = "run " + (row.knobs.label().empty() ? std::string("(no knobs)") : row.knobs.label());
+    if (!report(0.0)) break;
+    const auto start = std::chrono::steady_clock::now();
+    engine::Result<MethodOutput> out = method.run(RunContext{scene, row.knobs, requests[request_of_run[run]], ref.field,
+                                                             options.seed, options.threads, unit_progress});
+    row.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (cancelled) break;  // a cancelled run's output is not a measurement
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    row.error.rel_rmse = row.error.max_rel = row.error.psnr_db = nan;
+    row.error.fit_scale = row.error.fit_rel_rmse = row.error.fit_max_rel = row.error.fit_psnr_db = nan;
+    if (!out) {
+      row.status = "run failed: " + out.error().to_string();
+    } else {
+      row.costs = out->costs;
+      if (std::string p = layout_problem(out->field, ref.field); !p.empty()) {
+        row.status = p;
+      } else {
+        row.error = compare_rgb(out->field, ref.field, options.metrics);
+        if (!row.error.ok()) row.status = row.error.problem;
+      }
+    }
+    result.rows.push_back(std::move(row));
+    ++state.units_done;
+    state.current_fraction = 0.0;
+  }
+  result.cancelled = cancelled;
+  if (!cancelled && progress) {
+    state.current = "done";
+    progress(state);
+  }
+  return result;
+}
+
+}  // namespace gi
