@@ -101,7 +101,7 @@ engine::Result<SweepResult> run_sweep(const SweepRegistry& registry, const Sweep
   }
   result.cancelled = cancelled;
   if (!cancelled && progress) {
-    state.current = "done";
+    state.current.clear();
     progress(state);
   }
   return result;
