@@ -33,6 +33,13 @@ TEST(AtlasBadInput, NanPositionIsAnError) {
   EXPECT_NE(e.find("position 1 is not finite"), std::string::npos) << e;
 }
 
+TEST(AtlasBadInput, AbsurdlyFarPositionIsAnError) {
+  auto m = triangle();
+  m.positions[2].z = 1e30f;
+  const std::string e = error_of({m});
+  EXPECT_NE(e.find("position 2 is farther than"), std::string::npos) << e;
+}
+
 TEST(AtlasBadInput, InfiniteNormalIsAnError) {
   auto m = triangle();
   m.normals = {{0, 0, 1}, {0, 0, INFINITY}, {0, 0, 1}};

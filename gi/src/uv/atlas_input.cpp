@@ -101,6 +101,11 @@ engine::Status validate_atlas_inputs(std::span<const AtlasInputMesh> inputs) {
     for (std::size_t v = 0; v < m.positions.size(); ++v)
       if (!finite(m.positions[v]))
         return engine::Error{"", where, "position " + std::to_string(v) + " is not finite (NaN or Inf)"};
+      else if (glm::any(glm::greaterThan(glm::abs(m.positions[v]), glm::vec3(kMaxAtlasCoordinateM))))
+        return engine::Error{"", where,
+                             "position " + std::to_string(v) + " is farther than " +
+                                 std::to_string(static_cast<long long>(kMaxAtlasCoordinateM)) +
+                                 " m from the origin (absurd scale)"};
     for (std::size_t v = 0; v < m.normals.size(); ++v)
       if (!finite(m.normals[v]))
         return engine::Error{"", where, "normal " + std::to_string(v) + " is not finite (NaN or Inf)"};

@@ -38,8 +38,12 @@ glm::mat4 node_world_matrix(const engine::SceneAsset& scene, int node);
 /// validate_atlas_inputs); out-of-range indices are copied as they are.
 std::vector<AtlasInputMesh> atlas_inputs_from(const engine::SceneAsset& scene);
 
+/// Coordinates beyond this many metres are rejected: float spacing there (6 cm at 1e6 m) is
+/// too coarse for an atlas, and areas of such triangles overflow.
+inline constexpr float kMaxAtlasCoordinateM = 1.0e6f;
+
 /// Checks what the atlas builder and rasterizer rely on: at least one triangle overall, index
-/// counts divisible by 3, indices in range, finite positions, normals empty or one per
+/// counts divisible by 3, indices in range, finite positions within kMaxAtlasCoordinateM, normals empty or one per
 /// position and finite. The error's location names the input ("input 3 (id 7)").
 engine::Status validate_atlas_inputs(std::span<const AtlasInputMesh> inputs);
 
