@@ -1,0 +1,36 @@
+#pragma once
+// Ground truth of the light atlas: the reference path tracer's irradiance at every valid
+// texel of a rasterized atlas (direct, indirect and total), dilated across chart borders
+// like a baked atlas so it can be sampled bilinearly. Bakers are compared against it on the
+// valid texels only.
+//   auto texels = gi::rasterize_atlas(layout, inputs);
+//   auto truth = gi::reference_atlas_irradiance(scene, texels, {.samples_per_pixel = 256});
+
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include <engine/result.h>
+#include <engine/scene.h>
+#include <gi/reference.h>
+
+#include "uv/atlas_rasterizer.h"
+
+namespace gi {
+
+/// Per-texel irradiance (W/m^2, RGB), width x height, texel (x, y) at y * width + x.
+struct AtlasIrradiance {
+  int width = 0;
+  int height = 0;
+  std::vector<glm::vec3> direct;
+  std::vector<glm::vec3> indirect;
+  std::vector<glm::vec3> total;
+  std::vector<std::uint8_t> valid;  ///< Texels a triangle covers (the others hold dilated values or 0).
+};
+
+/// samples_per_pixel of `settings` is per texel.
+engine::Result<AtlasIrradiance> reference_atlas_irradiance(const engine::Scene& scene, const AtlasTexels& texels,
+                                                           const ReferenceSettings& settings);
+
+}  // namespace gi

@@ -1,0 +1,157 @@
+// gi-reference: renders a scene's camera with the reference path tracer (linear EXR, and a
+// tonemapped PNG on request), or the ground-truth irradiance of its light-atlas texels.
+//   gi-reference --scene assets/cornell_box.gltf --width 256 --height 256 --spp 256 --out cbox.exr
+//   gi-reference --scene assets/cornell_box.gltf --atlas-density 64 --spp 256 --atlas-out out/cbox_atlas
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include <engine/gltf.h>
+#include <engine/image.h>
+#include <engine/scene.h>
+#include <gi/reference.h>
+
+#include "metrics/display_tonemap.h"
+#include "raytrace/atlas_reference.h"
+#include "sweep/sweep_progress_bar.h"
+#include "uv/atlas_input.h"
+#include "uv/atlas_layout.h"
+#include "uv/atlas_rasterizer.h"
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+// "[#######.....]  42%  elapsed 0:12  ETA 0:16" on stderr, redrawn in place on a terminal.
+gi::ProgressCallback progress_bar(const std::string& label) {
+  const bool terminal = isatty(2) != 0;
+  const auto start = Clock::now();
+  auto last = start - std::chrono::seconds(1);
+  return [=](double f) mutable {
+    const auto now = Clock::now();
+    if (f < 1.0 && now - last < std::chrono::milliseconds(terminal ? 100 : 2000)) return true;
+    last = now;
+    const double elapsed = seconds_since(start);
+    const int filled = static_cast<int>(f * 30.0);
+    std::fprintf(stderr, "%s%s [%s%s] %3d%%  elapsed %s  ETA %s%s", terminal ? "\r" : "", label.c_str(),
+                 std::string(static_cast<std::size_t>(filled), '#').c_str(),
+                 std::string(static_cast<std::size_t>(30 - filled), '.').c_str(), static_cast<int>(f * 100.0),
+                 gi::format_duration(elapsed).c_str(), gi::format_duration(f > 0.0 ? elapsed * (1.0 - f) / f : -1.0).c_str(),
+                 terminal && f < 1.0 ? "" : "\n");
+    return true;
+  };
+}
+
+engine::ImageRgbaF rgb_image(int w, int h, const std::vector<glm::vec3>& v, const std::vector<std::uint8_t>& valid) {
+  engine::ImageRgbaF img;
+  img.width = w;
+  img.height = h;
+  img.pixels.resize(v.size() * 4);
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    img.pixels[4 * i + 0] = v[i].x;
+    img.pixels[4 * i + 1] = v[i].y;
+    img.pixels[4 * i + 2] = v[i].z;
+    img.pixels[4 * i + 3] = valid[i] ? 1.0f : 0.0f;  // alpha: texel covered by a triangle
+  }
+  return img;
+}
+
+int fail(const std::string& message) {
+  std::cerr << "gi-reference: " << message << '\n';
+  return 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Reference path tracer: camera images and light-atlas ground truth"};
+  std::string scene_path, out_path, png_path, atlas_out, camera_name;
+  int width = 256, height = 256, spp = 64, bounces = -1;
+  unsigned threads = 0;
+  std::uint64_t seed = 1;
+  float exposure = 1.0f, atlas_density = 0.0f;
+  app.add_option("--scene", scene_path, "glTF scene (.gltf/.glb)")->required();
+  app.add_option("--camera", camera_name, "camera node name (default: the first camera)");
+  app.add_option("--width", width, "image width")->check(CLI::Range(1, 16384));
+  app.add_option("--height", height, "image height")->check(CLI::Range(1, 16384));
+  app.add_option("--spp", spp, "samples per pixel (or per atlas texel)")->check(CLI::Range(1, 1 << 20));
+  app.add_option("--bounces", bounces, "indirect bounces (-1: unlimited, 0: direct only)")->check(CLI::Range(-1, 1000));
+  app.add_option("--threads", threads, "worker threads (0: all); the result does not depend on it");
+  app.add_option("--seed", seed, "random seed");
+  app.add_option("--out", out_path, "linear OpenEXR of the camera image");
+  app.add_option("--png", png_path, "tonemapped PNG of the camera image (the renderer's display transform)");
+  app.add_option("--exposure", exposure, "exposure for --png");
+  app.add_option("--atlas-density", atlas_density, "light-atlas texels per metre (enables the atlas output)");
+  app.add_option("--atlas-out", atlas_out, "folder for atlas_direct.exr, atlas_indirect.exr, atlas_total.exr");
+  CLI11_PARSE(app, argc, argv);
+  if (out_path.empty() && png_path.empty() && atlas_out.empty()) return fail("nothing to do: give --out, --png or --atlas-out");
+  if (!atlas_out.empty() && !(atlas_density > 0.0f)) return fail("--atlas-out needs --atlas-density > 0");
+
+  auto asset = engine::load_gltf(scene_path);
+  if (!asset) return fail(asset.error().to_string());
+  engine::Scene scene = engine::instantiate(asset.value());
+
+  gi::ReferenceSettings settings;
+  settings.samples_per_pixel = spp;
+  settings.max_bounces = bounces;
+  settings.threads = threads;
+  settings.seed = seed;
+
+  if (!out_path.empty() || !png_path.empty()) {
+    const engine::Entity camera = camera_name.empty() ? engine::find_camera(scene.registry)
+                                                      : engine::find_by_name(scene.registry, camera_name);
+    if (camera.is_null()) return fail(scene_path + ": no camera" + (camera_name.empty() ? "" : " named " + camera_name));
+    settings.progress = progress_bar("render");
+    const auto start = Clock::now();
+    auto image = gi::render_reference_image(scene, camera, width, height, settings);
+    if (!image) return fail(image.error().to_string());
+    const double secs = seconds_since(start);
+    std::printf("rendered %dx%d at %d spp in %.2f s (%.3f Mpaths/s)\n", width, height, spp, secs,
+                static_cast<double>(width) * height * spp / secs * 1e-6);
+    if (!out_path.empty())
+      if (auto ok = engine::save_exr(out_path, *image); !ok) return fail(ok.error().to_string());
+    if (!png_path.empty()) {
+      engine::ImageRgba8 ldr{image->width, image->height, std::vector<std::uint8_t>(image->pixels.size())};
+      for (std::size_t i = 0; i < image->pixels.size(); ++i)
+        ldr.pixels[i] = i % 4 == 3 ? 255
+                                   : static_cast<std::uint8_t>(std::lround(
+                                         255.0 * gi::display_tonemap(static_cast<double>(image->pixels[i]), exposure)));
+      if (auto ok = engine::save_png(png_path, ldr); !ok) return fail(ok.error().to_string());
+    }
+  }
+
+  if (!atlas_out.empty()) {
+    const auto start = Clock::now();
+    const auto inputs = gi::atlas_inputs_from(asset.value());
+    auto layout = gi::build_atlas_layout(inputs, {.texels_per_metre = atlas_density});
+    if (!layout) return fail(layout.error().to_string());
+    const gi::AtlasTexels texels = gi::rasterize_atlas(*layout, inputs);
+    settings.progress = progress_bar("atlas");
+    auto truth = gi::reference_atlas_irradiance(scene, texels, settings);
+    if (!truth) return fail(truth.error().to_string());
+    std::size_t valid = 0;
+    for (std::uint8_t v : truth->valid) valid += v;
+    std::printf("atlas %dx%d at %.1f texels/m (%zu valid texels) at %d spp in %.2f s\n", truth->width, truth->height,
+                static_cast<double>(layout->texels_per_metre), valid, spp, seconds_since(start));
+    std::error_code ec;
+    std::filesystem::create_directories(atlas_out, ec);
+    if (ec) return fail(atlas_out + ": cannot create folder: " + ec.message());
+    const std::pair<const char*, const std::vector<glm::vec3>*> files[] = {
+        {"atlas_direct.exr", &truth->direct}, {"atlas_indirect.exr", &truth->indirect}, {"atlas_total.exr", &truth->total}};
+    for (const auto& [name, values] : files) {
+      const auto path = std::filesystem::path(atlas_out) / name;
+      if (auto ok = engine::save_exr(path, rgb_image(truth->width, truth->height, *values, truth->valid)); !ok)
+        return fail(ok.error().to_string());
+    }
+  }
+  return 0;
+}
