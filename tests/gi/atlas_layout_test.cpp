@@ -268,7 +268,12 @@ TEST(AtlasLayout, ContentTooLargeForMaxSizeLowersAndReportsTheDensity) {
 
 TEST(AtlasLayout, TimesDemoLevelBuildAndRasterization) {
   const auto inputs = inputs_of(GI_SOURCE_DIR "/assets/demo_level.gltf");
-  for (float density : {32.0f, 128.0f}) {
+#ifdef NDEBUG
+  const std::vector<float> densities{32.0f, 128.0f};
+#else
+  const std::vector<float> densities{32.0f};  // a 4096 x 4096 atlas takes too long unoptimized
+#endif
+  for (float density : densities) {
     const auto t0 = std::chrono::steady_clock::now();
     auto layout = gi::build_atlas_layout(inputs, {.texels_per_metre = density});
     const auto t1 = std::chrono::steady_clock::now();

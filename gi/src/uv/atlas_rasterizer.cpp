@@ -33,8 +33,8 @@ AtlasTexels rasterize_atlas(const AtlasLayout& layout, std::span<const AtlasInpu
   out.width = layout.width;
   out.height = layout.height;
   const std::size_t n = static_cast<std::size_t>(layout.width) * static_cast<std::size_t>(layout.height);
-  out.position.assign(n, glm::vec3(0.0f));
-  out.normal.assign(n, glm::vec3(0.0f));
+  out.position.resize(n);  // value-initialized: zero (memset rather than an element loop)
+  out.normal.resize(n);
   out.valid.assign(n, 0);
   out.coverage.assign(n, TexelCoverage::Empty);
   out.mesh.assign(n, -1);
