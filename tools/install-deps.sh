@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs every build and test dependency of the project from Debian's packages.
 # Idempotent: packages already present are left alone; `apt-get update` runs once.
+# python3-matplotlib draws the sweep plots (tools/plot-sweep.py); nothing in the build needs it.
 set -euo pipefail
 packages=(
   build-essential cmake ninja-build pkg-config git
@@ -9,6 +10,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libeigen3-dev libzstd-dev libtinyexr-dev libcli11-dev libimgui-dev libtbb-dev
   xvfb xauth
+  python3-matplotlib
 )
 missing=()
 for p in "${packages[@]}"; do
