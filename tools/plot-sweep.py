@@ -42,6 +42,11 @@ def knob_label(row, knobs):
     return " ".join(f"{k}={row['knob:' + k]}" for k in knobs if row.get("knob:" + k, ""))
 
 
+def varying_knobs(rows, knobs):
+    """The knobs that take more than one value in these rows (labels skip constant ones)."""
+    return [k for k in knobs if len({r.get("knob:" + k, "") for r in rows}) > 1]
+
+
 def plot(csv_path, cost_axis):
     with open(csv_path, newline="") as f:
         rows = list(csv.DictReader(f))
@@ -52,6 +57,7 @@ def plot(csv_path, cost_axis):
     plotted = 0
     for m in methods:
         pts, labels = [], []
+        label_knobs = varying_knobs([r for r in rows if r["method"] == m], knobs)
         for r in rows:
             if r["method"] != m or r["status"] != "ok":
                 continue
@@ -59,7 +65,7 @@ def plot(csv_path, cost_axis):
             if not (e > 0 and c > 0 and math.isfinite(e) and math.isfinite(c)):
                 continue
             pts.append((e, c))
-            labels.append(knob_label(r, knobs))
+            labels.append(knob_label(r, label_knobs))
         if not pts:
             continue
         plotted += len(pts)

@@ -12,17 +12,34 @@ std::string shell_quote(const std::string& s) {
   return q + "'";
 }
 
+/// The first of `python3` (PATH) and Debian's /usr/bin/python3 that imports matplotlib, or
+/// empty. (A PATH python3 from pyenv or a venv does not see Debian's python3-matplotlib.)
+std::string python_with_matplotlib() {
+  for (const char* python : {"python3", "/usr/bin/python3"}) {
+    const std::string probe = std::string(python) + " -c 'import matplotlib' >/dev/null 2>&1";
+    if (std::system(probe.c_str()) == 0) return python;
+  }
+  return {};
+}
+
+std::string command_with(const std::string& python, const std::filesystem::path& csv) {
+  return python + " " + shell_quote(GI_PLOT_SCRIPT) + " " + shell_quote(csv.string());
+}
+
 }  // namespace
 
 std::string plot_command(const std::filesystem::path& csv) {
-  return "python3 " + shell_quote(GI_PLOT_SCRIPT) + " " + shell_quote(csv.string());
+  const std::string python = python_with_matplotlib();
+  return command_with(python.empty() ? std::string("python3") : python, csv);
 }
 
 std::string plot_sweep_csv(const std::filesystem::path& csv) {
-  const std::string cmd = plot_command(csv);
-  if (std::system("python3 -c 'import matplotlib' >/dev/null 2>&1") != 0) {
-    return "plots: python3 with matplotlib (Debian: python3-matplotlib) is not available; to plot, run:\n  " + cmd;
+  const std::string python = python_with_matplotlib();
+  if (python.empty()) {
+    return "plots: python3 with matplotlib (Debian: python3-matplotlib) is not available; to plot, run:\n  " +
+           command_with("python3", csv);
   }
+  const std::string cmd = command_with(python, csv);
   if (std::system((cmd + " >/dev/null").c_str()) != 0) {
     return "plots: the plot script failed; run it to see why:\n  " + cmd;
   }
