@@ -68,28 +68,26 @@ engine::Result<RgbField> atlas_indirect(const SweepScene& s, const ReferenceRequ
   return f;
 }
 
+// Converged-reference settings: the request's spp, the reference seed, unlimited bounces.
+ReferenceSettings reference_settings(const ReferenceJob& job) {
+  ReferenceSettings settings;
+  settings.samples_per_pixel = int_param(job.request, "spp");
+  settings.seed = kReferenceSeed;
+  settings.threads = job.threads;
+  settings.progress = job.progress;
+  return settings;
+}
+
 }  // namespace
 
 void register_reference_sweep(SweepRegistry& registry) {
-  registry.add_reference_provider(
-      {.kind = "camera_image", .version = "pt-1", .compute = [](const ReferenceJob& job) -> engine::Result<RgbField> {
-         ReferenceSettings settings;
-         settings.samples_per_pixel = int_param(job.request, "spp");
-         settings.seed = kReferenceSeed;
-         settings.threads = job.threads;
-         settings.progress = job.progress;
-         return render_camera(job.scene, job.request, settings);
-       }});
-  registry.add_reference_provider({.kind = "atlas_indirect_irradiance",
-                                   .version = "pt-1",
-                                   .compute = [](const ReferenceJob& job) -> engine::Result<RgbField> {
-                                     ReferenceSettings settings;
-                                     settings.samples_per_pixel = int_param(job.request, "spp");
-                                     settings.seed = kReferenceSeed;
-                                     settings.threads = job.threads;
-                                     settings.progress = job.progress;
-                                     return atlas_indirect(job.scene, job.request, settings);
+  registry.add_reference_provider({.kind = "camera_image", .version = "pt-1", .compute = [](const ReferenceJob& job) {
+                                     return render_camera(job.scene, job.request, reference_settings(job));
                                    }});
+  registry.add_reference_provider(
+      {.kind = "atlas_indirect_irradiance", .version = "pt-1", .compute = [](const ReferenceJob& job) {
+         return atlas_indirect(job.scene, job.request, reference_settings(job));
+       }});
 
   SweepMethod pt;
   pt.name = "pathtracer";
