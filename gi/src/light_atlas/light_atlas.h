@@ -1,0 +1,108 @@
+#pragma once
+// The light-atlas baker (Schärfig, Stamminger, Hormann 2016, "Creating light atlases with
+// multi-bounce indirect illumination"): multi-bounce diffuse indirect irradiance of the
+// static world under static lights, stored per texel of the scene's light atlas (uv1).
+//   auto bake = gi::bake_light_atlas(scene, gi::light_atlas_preset("medium").value());
+//   // bake->irradiance[y * bake->width + x]: indirect irradiance (W/m^2); shade albedo/pi x E.
+//
+// Steps (paper section in brackets):
+//   1. VPLs spread uniformly over the static surfaces, each owning ~10 sample points; a
+//      VPL's patch area is the area its sample points stand for (§3.1, eq. 1).
+//   2. Direct light to every VPL, averaged over its sample points with shadow rays (§3.2,
+//      eq. 5-6).
+//   3. Progressive refinement: the VPL with the largest unshot power shoots into all VPLs
+//      with the symmetric scaled form factor (§3.3, eq. 7-8), one generation per bounce.
+//   4. Final shooting: every VPL's reflected power into the atlas texels it sees (§4.1,
+//      eq. 9), visibility by one shadow ray per (texel, VPL).
+//   5. Incremental update when static lights change (§6.2): VPL powers redistributed, only
+//      the VPLs whose power changed by more than a threshold re-shot as differences.
+// Bit-identical for any thread count: every random number comes from (seed, item id).
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include <engine/result.h>
+#include <engine/scene.h>
+#include <gi/progress.h>
+
+#include "light_atlas/vpl_set.h"
+#include "uv/atlas_layout.h"
+
+namespace gi {
+
+struct LightAtlasSettings {
+  float texels_per_metre = 16.0f;  ///< Atlas density requested from the layout (uv/atlas_layout.h).
+  int vpl_count = 1000;            ///< Target number of VPLs over all static surfaces.
+  int samples_per_vpl = 10;        ///< Sample points per VPL (visibility fraction, patch area).
+  /// Indirect bounces carried by the atlas: 1 = light reflected once (VPLs hold direct light
+  /// only), b = b-1 generations of VPL-to-VPL shooting before the final shooting.
+  int bounces = 5;
+  /// A generation stops early when the largest unshot power falls below this fraction of
+  /// the largest power after direct lighting (paper §3.3's threshold).
+  float unshot_threshold = 1e-4f;
+  int area_light_samples = 64;  ///< Point samples per area light or emissive triangle (>= 1).
+  bool include_direct = false;  ///< Add direct irradiance to the atlas (default: indirect only).
+  std::uint64_t seed = 1;
+  unsigned threads = 0;          ///< 0: all hardware threads. The result does not depend on it.
+  ProgressCallback progress;     ///< Fraction done in [0, 1]; return false to cancel.
+};
+
+/// preview / medium / high, chosen from the measured Pareto front (docs/sweeps/).
+engine::Result<LightAtlasSettings> light_atlas_preset(std::string_view name);
+std::vector<std::string> light_atlas_preset_names();
+
+struct LightAtlasStats {
+  std::size_t vpls = 0;
+  std::size_t sample_points = 0;
+  std::size_t light_points = 0;    ///< Point emitters after sampling area lights / emissive triangles.
+  std::size_t shots = 0;           ///< VPL-to-VPL shooting steps (§3.3).
+  std::size_t valid_texels = 0;
+  std::uint64_t rays = 0;          ///< Shadow rays cast in total.
+  double vpl_seconds = 0.0;        ///< Distribution of VPLs and sample points.
+  double direct_seconds = 0.0;     ///< Direct light to the VPLs.
+  double propagate_seconds = 0.0;  ///< Progressive refinement.
+  double final_seconds = 0.0;      ///< Final shooting into the atlas.
+  double total_seconds = 0.0;      ///< Everything, layout and rasterization included.
+};
+
+/// A baked light atlas.
+struct LightAtlasBake {
+  AtlasLayout layout;  ///< The uv1 parameterization the atlas belongs to.
+  int width = 0;
+  int height = 0;
+  /// Irradiance per texel (W/m^2, linear RGB), texel (x, y) at y * width + x, dilated into
+  /// the chart gutters so bilinear reads inside a chart never see empty texels. Indirect
+  /// only unless settings.include_direct.
+  std::vector<glm::vec3> irradiance;
+  std::vector<std::uint8_t> valid;  ///< Texels a triangle covers.
+  LightAtlasSettings settings;
+  LightAtlasStats stats;
+  /// The VPL solution (positions, patches, powers), kept for incremental updates (§6.2).
+  VplSet vpls;
+  std::vector<glm::vec3> vpl_power;  ///< Reflected power E_i of every VPL (W), what step 4 shot.
+};
+
+/// Bakes the static meshes of `scene` (entities without DynamicTag) lit by its enabled
+/// lights and emissive static surfaces. Errors: no static geometry, invalid settings,
+/// cancellation, or a layout that cannot be built.
+engine::Result<LightAtlasBake> bake_light_atlas(const engine::Scene& scene, const LightAtlasSettings& settings);
+
+struct LightAtlasUpdateStats {
+  std::size_t reshot_vpls = 0;  ///< VPLs whose power change passed the threshold.
+  double seconds = 0.0;
+};
+
+/// Paper §6.2: `previous` was baked from `scene` with other light settings (same geometry).
+/// Recomputes the VPL solution under the scene's current lights, then re-shoots into the
+/// atlas only the differences E_new - E_old of VPLs whose change exceeds
+/// `relative_threshold` x the largest new VPL power. Threshold 0 reproduces a full re-bake
+/// up to float rounding.
+engine::Result<LightAtlasUpdateStats> update_light_atlas(const engine::Scene& scene, LightAtlasBake& previous,
+                                                         float relative_threshold);
+
+}  // namespace gi
