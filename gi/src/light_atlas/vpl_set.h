@@ -15,6 +15,7 @@
 
 #include <engine/result.h>
 
+#include "light_atlas/point_emitters.h"
 #include "raytrace/reference_scene.h"
 
 namespace gi {
@@ -39,6 +40,30 @@ struct VplSet {
   std::size_t size() const { return position.size(); }
   std::uint32_t sample_count(std::size_t j) const { return sample_first[j + 1] - sample_first[j]; }
 };
+
+/// Irradiance per watt of VPL i's reflected power at point p (unit normal n) standing for
+/// `receiver_area_m2`: the patch as the Lambertian emitters of its sample points, each
+/// carrying its share a_l / A_i (the patch-to-point form factor; no visibility). Evaluating
+/// every sample point instead of the VPL centre keeps the near-field regularization at the
+/// scale of one sample's area rather than the whole patch's.
+inline float patch_kernel(const VplSet& vpls, std::size_t i, const glm::vec3& p, const glm::vec3& n,
+                          float receiver_area_m2) {
+  float sum = 0.0f;
+  for (std::uint32_t l = vpls.sample_first[i]; l < vpls.sample_first[i + 1]; ++l)
+    sum += vpls.sample_area_m2[l] * lambertian_kernel(vpls.sample_position[l], vpls.sample_normal[l],
+                                                      vpls.sample_area_m2[l], false, p, n, receiver_area_m2);
+  return sum / vpls.area_m2[i];
+}
+
+/// One sample point of VPL i chosen by a hash of `key` (and `seed`): the end of a
+/// visibility ray, so a VPL's shadow is that of its patch, not of one point.
+inline std::uint32_t pick_sample(const VplSet& vpls, std::size_t i, std::uint64_t key, std::uint64_t seed = 0) {
+  std::uint64_t h = key + 0x9e3779b97f4a7c15ULL * (seed + 1);
+  h = (h ^ (h >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  h = (h ^ (h >> 27)) * 0x94d049bb133111ebULL;
+  h ^= h >> 31;
+  return vpls.sample_first[i] + static_cast<std::uint32_t>(h % vpls.sample_count(i));
+}
 
 /// Directional-hemispherical reflectance of a material's BRDF averaged over cosine-weighted
 /// incidence (the energy a diffuse patch of it reflects), estimated with `samples`

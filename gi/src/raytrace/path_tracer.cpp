@@ -4,6 +4,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "raytrace/light_falloff.h"
 #include "raytrace/ray_offset.h"
 
 namespace gi {
@@ -19,23 +20,8 @@ float power_heuristic(float a, float b) {
   return a2 + b2 > 0.0f && std::isfinite(a2 + b2) ? a2 / (a2 + b2) : (a > b ? 1.0f : 0.0f);
 }
 
-// glTF KHR_lights_punctual range window, as the renderer: (1 - (d/range)^4)^2 clamped.
-float range_window(float distance_m, float range_m) {
-  if (range_m <= 0.0f) return 1.0f;
-  const float r = distance_m / range_m;
-  const float w = std::clamp(1.0f - r * r * r * r, 0.0f, 1.0f);
-  return w * w;
-}
-
-float smoothstep(float e0, float e1, float x) {
-  const float t = std::clamp((x - e0) / (e1 - e0), 0.0f, 1.0f);
-  return t * t * (3.0f - 2.0f * t);
-}
-
 float spot_factor(const ReferenceLight& l, const glm::vec3& to_light) {
-  const float cos_axis = glm::dot(-to_light, l.direction);
-  if (l.cos_inner - l.cos_outer > 1e-5f) return smoothstep(l.cos_outer, l.cos_inner, cos_axis);
-  return cos_axis >= l.cos_outer ? 1.0f : 0.0f;
+  return spot_cone(l.direction, l.cos_outer, l.cos_inner, to_light);
 }
 
 float max_component(const glm::vec3& v) { return std::max(v.x, std::max(v.y, v.z)); }

@@ -1,5 +1,6 @@
 #include "sweep/builtin_methods.h"
 
+#include "light_atlas/light_atlas_sweep.h"
 #include "raytrace/reference_sweep.h"
 
 namespace gi {
@@ -8,6 +9,7 @@ void register_builtin_sweep_methods(SweepRegistry& registry) {
   // The reference path tracer: the camera-image and atlas-irradiance reference providers,
   // and its own spp / bounces curve ("pathtracer").
   register_reference_sweep(registry);
+  register_light_atlas_sweep(registry);
   //
   // GI METHODS (light atlas, PRM, DLM, BRF, antiradiance) register here as they land, one
   // add_method per method, with every quality knob declared (DESIGN.md 3, "Accuracy and its

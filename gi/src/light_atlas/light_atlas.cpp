@@ -1,0 +1,234 @@
+#include "light_atlas/light_atlas.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <span>
+
+#include "light_atlas/final_shooting.h"
+#include "light_atlas/point_emitters.h"
+#include "light_atlas/vpl_transport.h"
+#include "raytrace/embree_ray_caster.h"
+#include "raytrace/scene_adapter.h"
+#include "uv/atlas_dilation.h"
+#include "uv/atlas_input.h"
+#include "uv/atlas_rasterizer.h"
+
+namespace gi {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+engine::Status validate(const LightAtlasSettings& s) {
+  const auto bad = [](std::string what) { return engine::Error{.message = "light-atlas settings: " + what}; };
+  if (!(s.texels_per_metre > 0.0f) || s.texels_per_metre > kMaxTexelsPerMetre)
+    return bad("texels_per_metre " + std::to_string(s.texels_per_metre) + " is outside (0, 10^4]");
+  if (s.vpl_count < 1 || s.vpl_count > 1'000'000) return bad("vpl_count " + std::to_string(s.vpl_count) + " is outside 1..10^6");
+  if (s.samples_per_vpl < 1 || s.samples_per_vpl > 1024)
+    return bad("samples_per_vpl " + std::to_string(s.samples_per_vpl) + " is outside 1..1024");
+  if (s.bounces < 1 || s.bounces > 64) return bad("bounces " + std::to_string(s.bounces) + " is outside 1..64");
+  if (!(s.unshot_threshold >= 0.0f) || !std::isfinite(s.unshot_threshold))
+    return bad("unshot_threshold must be finite and >= 0");
+  if (s.area_light_samples < 1 || s.area_light_samples > 65536)
+    return bad("area_light_samples " + std::to_string(s.area_light_samples) + " is outside 1..65536");
+  return {};
+}
+
+// What every bake step reads: the path tracer's scene snapshot, a ray caster over the static
+// instances only (dynamic objects move, so they must not shadow the baked world), the atlas
+// texels and the emitters.
+struct BakeScene {
+  ReferenceScene scene;
+  ReferenceSceneIndex index;
+  std::unique_ptr<RayCaster> caster;
+  AtlasTexels texels;
+  float texel_area_m2 = 0.0f;
+  std::vector<PointEmitter> emitters;
+};
+
+engine::Result<BakeScene> prepare(const engine::Scene& scene, const AtlasLayout& layout, const LightAtlasSettings& s) {
+  BakeScene b;
+  b.scene = reference_scene_from(scene);
+  auto index = index_reference_scene(b.scene);
+  if (!index) return index.error();
+  b.index = std::move(index).value();
+  RtSceneData statics;
+  statics.geometries = b.scene.geometry.geometries;
+  for (const RtInstance& inst : b.scene.geometry.instances)
+    if (!inst.dynamic) statics.instances.push_back(inst);
+  if (statics.instances.empty()) return engine::Error{.message = "the scene has no static mesh to bake a light atlas for"};
+  auto caster = make_embree_ray_caster(statics);
+  if (!caster) return caster.error();
+  b.caster = std::move(caster).value();
+  b.texels = rasterize_atlas(layout, atlas_inputs_from(scene.assets));
+  b.texel_area_m2 = 1.0f / (layout.texels_per_metre * layout.texels_per_metre);
+  b.emitters = point_emitters(b.scene, b.index, s.area_light_samples, s.seed);
+  return b;
+}
+
+// Phases' shares of the progress bar (roughly their share of the time on our scenes).
+struct Phase {
+  double begin, end;
+};
+constexpr Phase kDirectPhase{0.02, 0.10}, kPropagatePhase{0.10, 0.35}, kFinalPhase{0.35, 1.0};
+
+ProgressCallback sub_progress(const ProgressCallback& p, Phase ph) {
+  if (!p) return {};
+  return [p, ph](double f) { return p(ph.begin + (ph.end - ph.begin) * f); };
+}
+
+struct VplPowers {
+  std::vector<glm::vec3> power;
+  std::size_t shots = 0;
+  std::uint64_t rays = 0;
+};
+
+// Steps 2-3: direct light into the VPLs, then progressive refinement; returns every VPL's
+// reflected power E_i = rho_i A_i I_i.
+engine::Result<VplPowers> light_vpls(const BakeScene& b, const VplSet& vpls, const LightAtlasSettings& s, ThreadPool& pool,
+                                     LightAtlasStats* stats) {
+  VplPowers out;
+  auto t0 = Clock::now();
+  const std::vector<glm::vec3> direct = direct_to_vpls(vpls, b.emitters, *b.caster, pool, &out.rays);
+  if (stats) stats->direct_seconds = seconds_since(t0);
+  if (s.progress && !s.progress(kDirectPhase.end)) return engine::Error{.message = "light-atlas bake cancelled"};
+  t0 = Clock::now();
+  auto solution = propagate(vpls, direct, *b.caster, pool,
+                            {.bounces = s.bounces,
+                             .unshot_threshold = s.unshot_threshold,
+                             .seed = s.seed,
+                             .progress = sub_progress(s.progress, kPropagatePhase)});
+  if (!solution) return solution.error();
+  if (stats) stats->propagate_seconds = seconds_since(t0);
+  out.shots = solution->shots;
+  out.rays += solution->rays;
+  out.power.resize(vpls.size());
+  for (std::size_t i = 0; i < vpls.size(); ++i)
+    out.power[i] = vpls.albedo[i] * vpls.area_m2[i] * solution->irradiance[i];
+  return out;
+}
+
+int dilation_rings(const AtlasLayout& layout) { return std::max(4, layout.padding_texels); }
+
+}  // namespace
+
+engine::Result<LightAtlasBake> bake_light_atlas(const engine::Scene& scene, const LightAtlasSettings& settings) {
+  if (auto ok = validate(settings); !ok) return ok.error();
+  const auto t_start = Clock::now();
+  const std::vector<AtlasInputMesh> inputs = atlas_inputs_from(scene.assets);
+  if (auto ok = validate_atlas_inputs(inputs); !ok) return ok.error();
+  auto layout = build_atlas_layout(inputs, {.texels_per_metre = settings.texels_per_metre});
+  if (!layout) return layout.error();
+
+  ThreadPool pool(settings.threads);
+  auto prepared = prepare(scene, *layout, settings);
+  if (!prepared) return prepared.error();
+  const BakeScene& b = *prepared;
+
+  LightAtlasBake out;
+  out.settings = settings;
+  out.layout = std::move(layout).value();
+  out.width = out.layout.width;
+  out.height = out.layout.height;
+  auto t0 = Clock::now();
+  auto vpls = distribute_vpls(b.scene, b.index,
+                              {.vpl_count = settings.vpl_count, .samples_per_vpl = settings.samples_per_vpl, .seed = settings.seed});
+  if (!vpls) return vpls.error();
+  out.vpls = std::move(vpls).value();
+  out.stats.vpl_seconds = seconds_since(t0);
+
+  auto powers = light_vpls(b, out.vpls, settings, pool, &out.stats);
+  if (!powers) return powers.error();
+  out.vpl_power = powers->power;
+
+  t0 = Clock::now();
+  std::vector<std::uint32_t> shooters;
+  std::vector<glm::vec3> shot;
+  for (std::uint32_t i = 0; i < out.vpls.size(); ++i)
+    if (out.vpl_power[i] != glm::vec3(0.0f)) shooters.push_back(i), shot.push_back(out.vpl_power[i]);
+  // Texels are point samples of irradiance (as the reference's): no receiver area; the
+  // emitter's sample areas alone bound the near field.
+  auto final_result = shoot_into_atlas(out.vpls, shooters, shot, b.texels, 0.0f, *b.caster, pool,
+                                       {.seed = settings.seed, .progress = sub_progress(settings.progress, kFinalPhase)});
+  if (!final_result) return final_result.error();
+  out.irradiance = std::move(final_result->irradiance);
+  std::uint64_t rays = powers->rays + final_result->rays;
+  if (settings.include_direct) {
+    const std::vector<glm::vec3> direct = direct_into_atlas(b.emitters, b.texels, b.texel_area_m2, *b.caster, pool, &rays);
+    for (std::size_t t = 0; t < direct.size(); ++t) out.irradiance[t] += direct[t];
+  }
+  out.stats.final_seconds = seconds_since(t0);
+  out.valid = b.texels.valid;
+  dilate<glm::vec3>(out.irradiance, out.width, out.height, out.valid, dilation_rings(out.layout));
+
+  out.stats.vpls = out.vpls.size();
+  out.stats.sample_points = out.vpls.sample_position.size();
+  out.stats.light_points = b.emitters.size();
+  out.stats.shots = powers->shots;
+  out.stats.valid_texels = static_cast<std::size_t>(std::count(out.valid.begin(), out.valid.end(), std::uint8_t{1}));
+  out.stats.rays = rays;
+  out.stats.total_seconds = seconds_since(t_start);
+  return out;
+}
+
+engine::Result<LightAtlasUpdateStats> update_light_atlas(const engine::Scene& scene, LightAtlasBake& previous,
+                                                         float relative_threshold) {
+  if (!(relative_threshold >= 0.0f) || !std::isfinite(relative_threshold))
+    return engine::Error{.message = "incremental light-atlas update: the threshold must be finite and >= 0"};
+  if (previous.settings.include_direct)
+    return engine::Error{.message = "incremental light-atlas update needs an indirect-only atlas (include_direct is set)"};
+  const auto t_start = Clock::now();
+  LightAtlasSettings settings = previous.settings;
+  settings.progress = {};
+  ThreadPool pool(settings.threads);
+  auto prepared = prepare(scene, previous.layout, settings);
+  if (!prepared) return prepared.error();
+  const BakeScene& b = *prepared;
+  if (b.texels.valid != previous.valid || previous.vpl_power.size() != previous.vpls.size())
+    return engine::Error{.message = "incremental light-atlas update: the scene's geometry differs from the bake's; re-bake"};
+
+  auto powers = light_vpls(b, previous.vpls, settings, pool, nullptr);
+  if (!powers) return powers.error();
+  float largest = 0.0f;
+  for (const glm::vec3& e : powers->power) largest = std::max(largest, std::max(e.x, std::max(e.y, e.z)));
+  std::vector<std::uint32_t> shooters;
+  std::vector<glm::vec3> delta;
+  for (std::uint32_t i = 0; i < previous.vpls.size(); ++i) {
+    const glm::vec3 d = powers->power[i] - previous.vpl_power[i];
+    const float change = std::max(std::fabs(d.x), std::max(std::fabs(d.y), std::fabs(d.z)));
+    if (change > relative_threshold * largest && change > 0.0f) {
+      shooters.push_back(i);
+      delta.push_back(d);
+      previous.vpl_power[i] = powers->power[i];  // what the atlas now holds for VPL i
+    }
+  }
+  auto diff = shoot_into_atlas(previous.vpls, shooters, delta, b.texels, 0.0f, *b.caster, pool,
+                               {.seed = settings.seed});
+  if (!diff) return diff.error();
+  for (std::size_t t = 0; t < previous.irradiance.size(); ++t) {
+    if (!previous.valid[t]) continue;
+    // Differences may undershoot zero by rounding where a light went dark.
+    previous.irradiance[t] = glm::max(previous.irradiance[t] + diff->irradiance[t], glm::vec3(0.0f));
+  }
+  dilate<glm::vec3>(previous.irradiance, previous.width, previous.height, previous.valid, dilation_rings(previous.layout));
+  return LightAtlasUpdateStats{.reshot_vpls = shooters.size(), .seconds = seconds_since(t_start)};
+}
+
+engine::Result<LightAtlasSettings> light_atlas_preset(std::string_view name) {
+  LightAtlasSettings s;
+  if (name == "preview") {
+    s.texels_per_metre = 8.0f, s.vpl_count = 250, s.bounces = 3;
+  } else if (name == "medium") {
+    s.texels_per_metre = 16.0f, s.vpl_count = 1000, s.bounces = 5;
+  } else if (name == "high") {
+    s.texels_per_metre = 32.0f, s.vpl_count = 3000, s.bounces = 6;
+  } else {
+    return engine::Error{.message = "unknown light-atlas preset '" + std::string(name) + "' (preview, medium, high)"};
+  }
+  return s;
+}
+
+std::vector<std::string> light_atlas_preset_names() { return {"preview", "medium", "high"}; }
+
+}  // namespace gi
