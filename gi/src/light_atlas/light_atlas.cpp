@@ -50,6 +50,17 @@ struct BakeScene {
 engine::Result<BakeScene> prepare(const engine::Scene& scene, const AtlasLayout& layout, const LightAtlasSettings& s) {
   BakeScene b;
   b.scene = reference_scene_from(scene);
+  // Lights that move belong to PRM (DESIGN.md 3): the atlas bakes the static ones only.
+  // reference_scene_from() lists the enabled lights in registry order; drop the moving ones.
+  std::vector<ReferenceLight> kept;
+  std::size_t k = 0;
+  scene.registry.view<engine::Light, engine::WorldTransform>().each(
+      [&](engine::Entity, const engine::Light& light, const engine::WorldTransform&) {
+        if (!light.enabled) return;
+        if (!light.moves && k < b.scene.lights.size()) kept.push_back(b.scene.lights[k]);
+        ++k;
+      });
+  b.scene.lights = std::move(kept);
   auto index = index_reference_scene(b.scene);
   if (!index) return index.error();
   b.index = std::move(index).value();
@@ -218,11 +229,11 @@ engine::Result<LightAtlasUpdateStats> update_light_atlas(const engine::Scene& sc
 engine::Result<LightAtlasSettings> light_atlas_preset(std::string_view name) {
   LightAtlasSettings s;
   if (name == "preview") {
-    s.texels_per_metre = 8.0f, s.vpl_count = 250, s.bounces = 3;
+    s.texels_per_metre = 8.0f, s.vpl_count = 300, s.bounces = 4;
   } else if (name == "medium") {
-    s.texels_per_metre = 16.0f, s.vpl_count = 1000, s.bounces = 5;
+    s.texels_per_metre = 16.0f, s.vpl_count = 1000, s.bounces = 8;
   } else if (name == "high") {
-    s.texels_per_metre = 32.0f, s.vpl_count = 3000, s.bounces = 6;
+    s.texels_per_metre = 32.0f, s.vpl_count = 3000, s.bounces = 16;
   } else {
     return engine::Error{.message = "unknown light-atlas preset '" + std::string(name) + "' (preview, medium, high)"};
   }

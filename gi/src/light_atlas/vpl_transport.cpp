@@ -1,40 +1,95 @@
 #include "light_atlas/vpl_transport.h"
 
 #include <algorithm>
+#include <cmath>
 #include <atomic>
 #include <numeric>
 #include <unordered_map>
 
 #include "core/random.h"
+#include "raytrace/light_falloff.h"
 #include "raytrace/ray_offset.h"
 #include "raytrace/reference_brdf.h"
 
 namespace gi {
 
+namespace {
+
+// Solid angle (sr) of static geometry lit by punctual light e, weighted by its spot cone and
+// range window: 4 pi / N sum over N stratified directions of cone x window x hit.
+double lit_solid_angle(const PointEmitter& e, const RayCaster& caster, int side) {
+  double sum = 0.0;
+  for (int a = 0; a < side; ++a)
+    for (int b = 0; b < side; ++b) {
+      const float z = 1.0f - 2.0f * (static_cast<float>(a) + 0.5f) / static_cast<float>(side);
+      const float phi = 6.2831853f * (static_cast<float>(b) + 0.5f) / static_cast<float>(side);
+      const float r = std::sqrt(std::max(0.0f, 1.0f - z * z));
+      const glm::vec3 w(r * std::cos(phi), r * std::sin(phi), z);
+      float weight = e.spot ? spot_cone(e.direction, e.cos_outer, e.cos_inner, -w) : 1.0f;
+      if (weight <= 0.0f) continue;
+      const Hit h = caster.intersect(Ray{e.position, 0.0f, w});
+      if (!h.valid()) continue;
+      weight *= range_window(h.t, e.range_m);
+      sum += static_cast<double>(weight);
+    }
+  return 4.0 * 3.14159265358979 * sum / static_cast<double>(side * side);
+}
+
+}  // namespace
+
 std::vector<glm::vec3> direct_to_vpls(const VplSet& vpls, const std::vector<PointEmitter>& emitters,
                                       const RayCaster& caster, ThreadPool& pool, std::uint64_t* rays) {
-  std::vector<glm::vec3> out(vpls.size(), glm::vec3(0.0f));
+  const std::size_t n = vpls.size();
+  std::vector<std::size_t> punctual;
+  for (std::size_t e = 0; e < emitters.size(); ++e)
+    if (emitters[e].kind == PointEmitter::Kind::Punctual) punctual.push_back(e);
+  std::vector<glm::vec3> out(n, glm::vec3(0.0f));
+  // Per punctual light, the irradiance it gives each VPL, kept apart for its flux check.
+  std::vector<std::vector<glm::vec3>> from_punctual(punctual.size(), std::vector<glm::vec3>(n, glm::vec3(0.0f)));
   std::atomic<std::uint64_t> ray_count{0};
   pool.parallel_for(
-      vpls.size(),
+      n,
       [&](std::size_t j) {
         glm::dvec3 sum(0.0);
+        std::vector<glm::dvec3> by_light(punctual.size(), glm::dvec3(0.0));
         std::uint64_t local_rays = 0;
         for (std::uint32_t k = vpls.sample_first[j]; k < vpls.sample_first[j + 1]; ++k) {
           const glm::vec3& p = vpls.sample_position[k];
-          const glm::vec3& n = vpls.sample_normal[k];
+          const glm::vec3& nk = vpls.sample_normal[k];
           const float a = vpls.sample_area_m2[k];
-          for (const PointEmitter& e : emitters) {
-            const glm::vec3 irr = emitter_irradiance(e, p, n, a);
+          std::size_t next_punctual = 0;
+          for (std::size_t e = 0; e < emitters.size(); ++e) {
+            const bool is_punctual = emitters[e].kind == PointEmitter::Kind::Punctual;
+            const std::size_t slot = is_punctual ? next_punctual++ : 0;
+            const glm::vec3 irr = emitter_irradiance(emitters[e], p, nk, a);
             if (irr == glm::vec3(0.0f)) continue;
             ++local_rays;
-            if (emitter_visible(caster, e, p, n)) sum += glm::dvec3(irr) * static_cast<double>(a);
+            if (!emitter_visible(caster, emitters[e], p, nk)) continue;
+            (is_punctual ? by_light[slot] : sum) += glm::dvec3(irr) * static_cast<double>(a);
           }
         }
-        out[j] = glm::vec3(sum / static_cast<double>(vpls.area_m2[j]));
+        const double area = static_cast<double>(vpls.area_m2[j]);
+        out[j] = glm::vec3(sum / area);
+        for (std::size_t l = 0; l < punctual.size(); ++l) from_punctual[l][j] = glm::vec3(by_light[l] / area);
         ray_count += local_rays;
       },
       16);
+  // Flux check of each punctual light: the patches' sampled irradiance must account for the
+  // light's flux onto the scene, I x (lit solid angle). Sample points miss the flux a light
+  // very close to a surface concentrates between them (a light 1 mm from a wall puts half its
+  // power within millimetres), so the light's VPL irradiance is rescaled to the traced flux.
+  constexpr int kFluxSide = 64;  // 4096 directions
+  for (std::size_t l = 0; l < punctual.size(); ++l) {
+    const PointEmitter& e = emitters[punctual[l]];
+    const float lum_i = luminance(e.radiant);
+    double sampled = 0.0;
+    for (std::size_t j = 0; j < n; ++j)
+      sampled += static_cast<double>(vpls.area_m2[j]) * static_cast<double>(luminance(from_punctual[l][j]));
+    const double traced = static_cast<double>(lum_i) * lit_solid_angle(e, caster, kFluxSide);
+    ray_count += kFluxSide * kFluxSide;
+    const double scale = sampled > 0.0 ? std::clamp(traced / sampled, 0.25, 4.0) : 1.0;
+    for (std::size_t j = 0; j < n; ++j) out[j] += from_punctual[l][j] * static_cast<float>(scale);
+  }
   if (rays) *rays += ray_count.load();
   return out;
 }

@@ -21,7 +21,10 @@ namespace gi {
 
 /// Direct irradiance I_j of every VPL (eq. 5-6): the area-weighted mean over its sample
 /// points of each emitter's (regularized) irradiance times the sample's visibility, so the
-/// visibility fraction V_ij of eq. 6 is taken per sample point. `rays` counts shadow rays.
+/// visibility fraction V_ij of eq. 6 is taken per sample point. Each punctual light's share
+/// is then rescaled so the patches receive the flux it really sends onto the scene (traced
+/// over 4096 directions): sample points cannot resolve the flux of a light touching a
+/// surface. `rays` counts the rays cast.
 std::vector<glm::vec3> direct_to_vpls(const VplSet& vpls, const std::vector<PointEmitter>& emitters,
                                       const RayCaster& caster, ThreadPool& pool, std::uint64_t* rays = nullptr);
 
