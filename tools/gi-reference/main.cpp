@@ -20,6 +20,7 @@
 
 #include "metrics/display_tonemap.h"
 #include "raytrace/atlas_reference.h"
+#include "console_progress.h"
 #include "sweep/sweep_progress_bar.h"
 #include "uv/atlas_input.h"
 #include "uv/atlas_layout.h"
@@ -30,26 +31,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
-
-// "[#######.....]  42%  elapsed 0:12  ETA 0:16" on stderr, redrawn in place on a terminal.
-gi::ProgressCallback progress_bar(const std::string& label) {
-  const bool terminal = isatty(2) != 0;
-  const auto start = Clock::now();
-  auto last = start - std::chrono::seconds(1);
-  return [=](double f) mutable {
-    const auto now = Clock::now();
-    if (f < 1.0 && now - last < std::chrono::milliseconds(terminal ? 100 : 2000)) return true;
-    last = now;
-    const double elapsed = seconds_since(start);
-    const int filled = static_cast<int>(f * 30.0);
-    std::fprintf(stderr, "%s%s [%s%s] %3d%%  elapsed %s  ETA %s%s", terminal ? "\r" : "", label.c_str(),
-                 std::string(static_cast<std::size_t>(filled), '#').c_str(),
-                 std::string(static_cast<std::size_t>(30 - filled), '.').c_str(), static_cast<int>(f * 100.0),
-                 gi::format_duration(elapsed).c_str(), gi::format_duration(f > 0.0 ? elapsed * (1.0 - f) / f : -1.0).c_str(),
-                 terminal && f < 1.0 ? "" : "\n");
-    return true;
-  };
-}
 
 engine::ImageRgbaF rgb_image(int w, int h, const std::vector<glm::vec3>& v, const std::vector<std::uint8_t>& valid) {
   engine::ImageRgbaF img;
@@ -110,7 +91,7 @@ int main(int argc, char** argv) {
     const engine::Entity camera = camera_name.empty() ? engine::find_camera(scene.registry)
                                                       : engine::find_by_name(scene.registry, camera_name);
     if (camera.is_null()) return fail(scene_path + ": no camera" + (camera_name.empty() ? "" : " named " + camera_name));
-    settings.progress = progress_bar("render");
+    settings.progress = tools::console_progress("render");
     const auto start = Clock::now();
     auto image = gi::render_reference_image(scene, camera, width, height, settings);
     if (!image) return fail(image.error().to_string());
@@ -135,7 +116,7 @@ int main(int argc, char** argv) {
     auto layout = gi::build_atlas_layout(inputs, {.texels_per_metre = atlas_density});
     if (!layout) return fail(layout.error().to_string());
     const gi::AtlasTexels texels = gi::rasterize_atlas(*layout, inputs);
-    settings.progress = progress_bar("atlas");
+    settings.progress = tools::console_progress("atlas");
     auto truth = gi::reference_atlas_irradiance(scene, texels, settings);
     if (!truth) return fail(truth.error().to_string());
     std::size_t valid = 0;
