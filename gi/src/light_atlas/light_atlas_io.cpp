@@ -162,8 +162,9 @@ engine::Status save_light_atlas(const fs::path& bundle_dir, const LightAtlasBake
   }
   const fs::path exr = bundle_dir / kLightAtlasExrFile;
   const fs::path vpls = bundle_dir / kLightAtlasVplsFile;
-  if (engine::Status s = engine::save_exr(exr, image, engine::ExrPixelType::Float); !s) return s;
+  // The VPL file first: it checks the VPL arrays, so a bad bake writes nothing.
   if (engine::Status s = write_light_atlas_vpls(vpls, bake, geometry_hash); !s) return s;
+  if (engine::Status s = engine::save_exr(exr, image, engine::ExrPixelType::Float); !s) return s;
   auto exr_sum = file_checksum(exr);
   if (!exr_sum) return exr_sum.error();
   auto vpls_sum = file_checksum(vpls);
