@@ -2,10 +2,9 @@
 // bundles and damaged files rejected with messages naming the file.
 #include "light_atlas/light_atlas_io.h"
 
-#include <gtest/gtest.h>
-
 #include <engine/gltf.h>
 #include <engine/image.h>
+#include <gtest/gtest.h>
 
 #include <cstdio>
 #include <cstring>
@@ -59,9 +58,17 @@ gi::LightAtlasBake fake_bake(const engine::SceneAsset& asset) {
   b.settings.include_direct = true;
   b.settings.seed = 0xfedcba9876543210ull;
   b.settings.threads = 2;
-  b.stats = {.vpls = 3, .sample_points = 5, .light_points = 17, .shots = 9, .valid_texels = n / 3 + 1,
-             .rays = 1ull << 40, .vpl_seconds = 0.125, .direct_seconds = 1.0 / 3.0, .propagate_seconds = 2.5,
-             .final_seconds = 1e-3, .total_seconds = 4.2};
+  b.stats = {.vpls = 3,
+             .sample_points = 5,
+             .light_points = 17,
+             .shots = 9,
+             .valid_texels = n / 3 + 1,
+             .rays = 1ull << 40,
+             .vpl_seconds = 0.125,
+             .direct_seconds = 1.0 / 3.0,
+             .propagate_seconds = 2.5,
+             .final_seconds = 1e-3,
+             .total_seconds = 4.2};
   gi::VplSet& v = b.vpls;
   v.position = {{0.1f, 0.2f, 0.3f}, {-1.0f, 0.5f, 2.0f}, {0.0f, 0.0f, 1.0f / 3.0f}};
   v.normal = {{0, 1, 0}, {1, 0, 0}, {0, 0, -1}};
@@ -79,7 +86,8 @@ gi::LightAtlasBake fake_bake(const engine::SceneAsset& asset) {
 fs::path saved_bundle(const std::string& name) {
   const fs::path dir = scratch_dir(name);
   const engine::SceneAsset asset = cornell();
-  const engine::Status s = gi::save_light_atlas(dir, fake_bake(asset), gi::scene_geometry_hash(asset), "cornell_box.gltf");
+  const engine::Status s =
+      gi::save_light_atlas(dir, fake_bake(asset), gi::scene_geometry_hash(asset), "cornell_box.gltf");
   EXPECT_TRUE(s.ok()) << s.error().to_string();
   return dir;
 }
@@ -232,18 +240,17 @@ TEST(LightAtlasIo, WrongSizeOrInvalidTexelsInTheExrAreRejected) {
   const gi::LightAtlasBake bake = fake_bake(cornell());
   {
     const fs::path dir = saved_bundle("wrong_size");
-    rewrite_exr(dir, engine::ImageRgbaF{bake.width + 1, bake.height,
-                                        std::vector<float>(static_cast<std::size_t>((bake.width + 1) * bake.height) * 4)});
+    rewrite_exr(dir,
+                engine::ImageRgbaF{bake.width + 1, bake.height,
+                                   std::vector<float>(static_cast<std::size_t>((bake.width + 1) * bake.height) * 4)});
     expect_load_error(dir, "light_atlas.exr", "size mismatch");
   }
   auto good = engine::load_exr(saved_bundle("read_good") / "light_atlas.exr");
   ASSERT_TRUE(good.ok());
   const std::size_t texel = static_cast<std::size_t>(2 * bake.width + 5);
   const std::string where = "texel (5, 2)";
-  const std::pair<int, float> cases[] = {{1, std::numeric_limits<float>::quiet_NaN()},
-                                         {0, std::numeric_limits<float>::infinity()},
-                                         {2, -0.5f},
-                                         {3, 0.5f}};
+  const std::pair<int, float> cases[] = {
+      {1, std::numeric_limits<float>::quiet_NaN()}, {0, std::numeric_limits<float>::infinity()}, {2, -0.5f}, {3, 0.5f}};
   const char* const what[] = {"NaN or infinite", "NaN or infinite", "negative", "alpha"};
   for (std::size_t c = 0; c < 4; ++c) {
     const fs::path dir = saved_bundle("bad_value_" + std::to_string(c));

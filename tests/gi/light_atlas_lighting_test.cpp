@@ -1,20 +1,17 @@
 // The light-atlas provider in the real renderer (llvmpipe through EGL; never skipped): a
 // constant atlas of irradiance pi x a shades exactly like the renderer's constant-ambient
 // stand-in of radiance a, and an atlas lit on one chart lights exactly that chart's pixels.
-#include <gi/light_atlas_lighting.h>
-
-#include <gtest/gtest.h>
-
-#include <glm/gtc/matrix_transform.hpp>
-
 #include <engine/gltf.h>
 #include <engine/gpu/context.h>
 #include <engine/renderer.h>
 #include <engine/scene.h>
+#include <gi/light_atlas_lighting.h>
+#include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <glm/gtc/matrix_transform.hpp>
 #include <limits>
 #include <optional>
 #include <string>
@@ -110,7 +107,8 @@ std::vector<int> chart_per_pixel(const engine::Scene& scene, const gi::AtlasLayo
   const engine::Camera& cam = scene.registry.get<engine::Camera>(camera);
   const glm::mat4 world = scene.registry.get<engine::WorldTransform>(camera).matrix;
   const float aspect = cam.aspect > 0.0f ? cam.aspect : 1.0f;
-  const glm::dmat4 inv(glm::inverse(glm::perspective(cam.yfov_rad, aspect, cam.znear_m, cam.zfar_m) * glm::inverse(world)));
+  const glm::dmat4 inv(
+      glm::inverse(glm::perspective(cam.yfov_rad, aspect, cam.znear_m, cam.zfar_m) * glm::inverse(world)));
   std::vector<int> chart(static_cast<std::size_t>(kSize * kSize), -1);
   for (int py = 0; py < kSize; ++py) {
     for (int px = 0; px < kSize; ++px) {
@@ -198,7 +196,8 @@ TEST(LightAtlasLighting, OneLitChartLightsExactlyItsPixels) {
   const gi::AtlasMeshUv& mesh_uv = lit.layout.meshes[ch.mesh];
   std::size_t first_triangle = 0;
   while (mesh_uv.triangle_chart[first_triangle] != chart) ++first_triangle;
-  const engine::Mesh& mesh = original.meshes[static_cast<std::size_t>(original.nodes[static_cast<std::size_t>(mesh_uv.id)].mesh)];
+  const engine::Mesh& mesh =
+      original.meshes[static_cast<std::size_t>(original.nodes[static_cast<std::size_t>(mesh_uv.id)].mesh)];
   std::size_t prim = 0;  // primitives are concatenated in order (atlas_inputs_from)
   for (std::size_t t = first_triangle; t >= mesh.primitives[prim].indices.size() / 3; ++prim)
     t -= mesh.primitives[prim].indices.size() / 3;
@@ -209,7 +208,8 @@ TEST(LightAtlasLighting, OneLitChartLightsExactlyItsPixels) {
     for (int px = 1; px + 1 < kSize; ++px) {
       int hits = 0;
       for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx) hits += charts[static_cast<std::size_t>((py + dy) * kSize + px + dx)] == static_cast<int>(chart);
+        for (int dx = -1; dx <= 1; ++dx)
+          hits += charts[static_cast<std::size_t>((py + dy) * kSize + px + dx)] == static_cast<int>(chart);
       const std::size_t p = static_cast<std::size_t>(py * kSize + px) * 4;
       if (hits == 9) {  // well inside the chart: albedo/pi x E added
         ++inside;
@@ -237,7 +237,8 @@ TEST(LightAtlasLighting, LoadsABundleAndGivesTheSceneUv1) {
   const std::filesystem::path dir = std::filesystem::path(GI_BINARY_DIR) / "test_output" / "light_atlas_lighting_test";
   std::filesystem::remove_all(dir);
   ASSERT_TRUE(gi::save_light_atlas(dir, uniform_bake(asset, glm::vec3(1.0f)), gi::scene_geometry_hash(asset),
-                                   "cornell_box.gltf").ok());
+                                   "cornell_box.gltf")
+                  .ok());
   auto provider = gi::LightAtlasLighting::load(dir, asset);
   ASSERT_TRUE(provider.ok()) << provider.error().to_string();
   EXPECT_GT((*provider)->atlas_width(), 0);
@@ -274,9 +275,11 @@ TEST(LightAtlasLighting, LoadIntoAnInstantiatedSceneFollowsDuplicatedMeshes) {
     n.gi.mobility = engine::Mobility::Static;
     asset.nodes.push_back(n);
   }
-  const std::filesystem::path dir = std::filesystem::path(GI_BINARY_DIR) / "test_output" / "light_atlas_lighting_shared";
+  const std::filesystem::path dir =
+      std::filesystem::path(GI_BINARY_DIR) / "test_output" / "light_atlas_lighting_shared";
   std::filesystem::remove_all(dir);
-  ASSERT_TRUE(gi::save_light_atlas(dir, uniform_bake(asset, glm::vec3(1.0f)), gi::scene_geometry_hash(asset), "quads").ok());
+  ASSERT_TRUE(
+      gi::save_light_atlas(dir, uniform_bake(asset, glm::vec3(1.0f)), gi::scene_geometry_hash(asset), "quads").ok());
 
   engine::Scene scene = engine::instantiate(asset);
   auto provider = gi::LightAtlasLighting::load(dir, scene);

@@ -13,16 +13,16 @@
 // The GL texture is created on the first frame() (the GL context must be current then) and
 // deleted with the provider: destroy it before the GL context.
 
-#include <cstdint>
-#include <filesystem>
-#include <memory>
-#include <vector>
-
 #include <engine/gpu/gl_objects.h>
 #include <engine/indirect_light.h>
 #include <engine/result.h>
 #include <engine/scene.h>
 #include <engine/scene_asset.h>
+
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <vector>
 
 namespace gi {
 
@@ -34,11 +34,11 @@ class LightAtlasLighting final : public engine::IndirectLightProvider {
   /// geometry is an error) and replaces `asset` with its uv1 copy. On error `asset` is
   /// unchanged. Use before engine::instantiate().
   static engine::Result<std::unique_ptr<LightAtlasLighting>> load(const std::filesystem::path& bundle_dir,
-                                                                   engine::SceneAsset& asset);
+                                                                  engine::SceneAsset& asset);
   /// The same for a scene already instantiated: replaces `scene.assets` and points the
   /// MeshRenderer of every node whose mesh was duplicated at its copy.
   static engine::Result<std::unique_ptr<LightAtlasLighting>> load(const std::filesystem::path& bundle_dir,
-                                                                   engine::Scene& scene);
+                                                                  engine::Scene& scene);
   /// From a bake in memory (its layout must come from atlas_inputs_from(asset)); replaces
   /// `asset` with its uv1 copy. Error when the layout does not match the asset.
   static engine::Result<std::unique_ptr<LightAtlasLighting>> from_bake(LightAtlasBake bake, engine::SceneAsset& asset);

@@ -72,13 +72,15 @@ engine::Result<std::vector<std::byte>> read_blob(const std::filesystem::path& pa
   if (!bytes) return bytes.error();
   const std::vector<std::byte>& file = bytes.value();
   if (file.size() < kBlobHeaderBytes) {
-    return blob_error(path, "header", "truncated header: " + std::to_string(file.size()) + " bytes, a " +
-                                          std::to_string(kBlobHeaderBytes) + "-byte header expected");
+    return blob_error(path, "header",
+                      "truncated header: " + std::to_string(file.size()) + " bytes, a " +
+                          std::to_string(kBlobHeaderBytes) + "-byte header expected");
   }
   const std::span<const std::byte> head(file.data(), kBlobHeaderBytes);
   if (std::memcmp(head.data(), magic.chars.data(), 8) != 0) {
-    return blob_error(path, "header", "wrong magic \"" + printable(head.first(8)) + "\", expected \"" +
-                                          std::string(magic.view()) + "\" (not this kind of bake file)");
+    return blob_error(path, "header",
+                      "wrong magic \"" + printable(head.first(8)) + "\", expected \"" + std::string(magic.view()) +
+                          "\" (not this kind of bake file)");
   }
   ByteReader r(head.subspan(8));
   std::uint32_t file_version = 0;
@@ -87,8 +89,9 @@ engine::Result<std::vector<std::byte>> read_blob(const std::filesystem::path& pa
   r.get(size);
   r.get(checksum);
   if (file_version != version) {
-    return blob_error(path, "header", "unsupported version " + std::to_string(file_version) + ", this build reads " +
-                                          std::to_string(version) + " (re-bake)");
+    return blob_error(path, "header",
+                      "unsupported version " + std::to_string(file_version) + ", this build reads " +
+                          std::to_string(version) + " (re-bake)");
   }
   const std::uint64_t actual = file.size() - kBlobHeaderBytes;
   if (size != actual) {

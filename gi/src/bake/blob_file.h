@@ -11,6 +11,8 @@
 //   offset 28  payload
 // FNV-1a detects truncation, bit flips and changed content; it is not cryptographic.
 
+#include <engine/result.h>
+
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -18,8 +20,6 @@
 #include <span>
 #include <string_view>
 #include <vector>
-
-#include <engine/result.h>
 
 namespace gi {
 

@@ -8,12 +8,11 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <glm/glm.hpp>
 #include <span>
 #include <string>
 #include <type_traits>
 #include <vector>
-
-#include <glm/glm.hpp>
 
 namespace gi {
 

@@ -3,9 +3,9 @@
 // baked from other geometry or materials is reported as stale instead of silently used.
 //   if (manifest.geometry_hash != gi::scene_geometry_hash(asset)) { /* stale bundle */ }
 
-#include <string>
-
 #include <engine/scene_asset.h>
+
+#include <string>
 
 namespace gi {
 

@@ -6,15 +6,14 @@
 //   int width = f.get<int>("layout.width");
 //   if (f.error()) return *f.error();
 
+#include <engine/result.h>
+
 #include <cstdint>
 #include <limits>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <type_traits>
-
-#include <nlohmann/json.hpp>
-
-#include <engine/result.h>
 
 namespace gi {
 

@@ -85,7 +85,8 @@ engine::Result<nlohmann::json> manifest_method(const std::filesystem::path& bund
                                                const std::string& method) {
   auto it = manifest.methods.find(method);
   if (it == manifest.methods.end()) {
-    return manifest_error(bundle_dir, "methods", "no \"" + method + "\" entry: the bundle was not baked with " + method);
+    return manifest_error(bundle_dir, "methods",
+                          "no \"" + method + "\" entry: the bundle was not baked with " + method);
   }
   if (!it->is_object()) return manifest_error(bundle_dir, "methods." + method, "must be an object");
   return *it;

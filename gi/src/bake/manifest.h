@@ -8,12 +8,11 @@
 //   { "format_version": 1, "geometry_hash": "0123456789abcdef", "scene": "level.gltf",
 //     "methods": { "light_atlas": { "files": {...}, "settings": {...}, ... } } }
 
-#include <filesystem>
-#include <string>
-
-#include <nlohmann/json.hpp>
-
 #include <engine/result.h>
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
 
 namespace gi {
 
@@ -22,8 +21,8 @@ inline constexpr const char* kManifestFileName = "manifest.json";
 
 struct Manifest {
   int format_version = kManifestFormatVersion;
-  std::string geometry_hash;  ///< gi::scene_geometry_hash of the baked scene.
-  std::string scene;          ///< File name of the baked scene (informative only).
+  std::string geometry_hash;                          ///< gi::scene_geometry_hash of the baked scene.
+  std::string scene;                                  ///< File name of the baked scene (informative only).
   nlohmann::json methods = nlohmann::json::object();  ///< Method name -> its entry (any JSON).
 };
 
@@ -39,8 +38,7 @@ engine::Status write_manifest(const std::filesystem::path& bundle_dir, const Man
 /// one that does not read (see read_manifest) or one of other geometry is replaced: its
 /// entries would describe files of another bake. DIR must exist.
 engine::Status update_manifest_method(const std::filesystem::path& bundle_dir, const std::string& geometry_hash,
-                                      const std::string& scene, const std::string& method,
-                                      const nlohmann::json& entry);
+                                      const std::string& scene, const std::string& method, const nlohmann::json& entry);
 
 /// The entry of `method`; error (naming the manifest) when the bundle has none.
 engine::Result<nlohmann::json> manifest_method(const std::filesystem::path& bundle_dir, const Manifest& manifest,

@@ -1,11 +1,10 @@
 #include "light_atlas/light_atlas_io.h"
 
-#include <cmath>
-#include <system_error>
-
-#include <nlohmann/json.hpp>
-
 #include <engine/image.h>
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+#include <system_error>
 
 #include "bake/bundle.h"
 #include "bake/json_fields.h"
@@ -29,10 +28,14 @@ engine::Result<std::string> file_checksum(const fs::path& path) {
 }
 
 json settings_json(const LightAtlasSettings& s) {
-  return json{{"texels_per_metre", s.texels_per_metre}, {"vpl_count", s.vpl_count},
-              {"samples_per_vpl", s.samples_per_vpl},   {"bounces", s.bounces},
-              {"unshot_threshold", s.unshot_threshold}, {"area_light_samples", s.area_light_samples},
-              {"include_direct", s.include_direct},     {"seed", s.seed},
+  return json{{"texels_per_metre", s.texels_per_metre},
+              {"vpl_count", s.vpl_count},
+              {"samples_per_vpl", s.samples_per_vpl},
+              {"bounces", s.bounces},
+              {"unshot_threshold", s.unshot_threshold},
+              {"area_light_samples", s.area_light_samples},
+              {"include_direct", s.include_direct},
+              {"seed", s.seed},
               {"threads", s.threads}};
 }
 
@@ -142,13 +145,13 @@ engine::Status read_atlas_exr(const fs::path& path, LightAtlasBake& bake) {
 
 engine::Status save_light_atlas(const fs::path& bundle_dir, const LightAtlasBake& bake,
                                 const std::string& geometry_hash, const std::string& scene_name) {
-  const std::size_t texels = static_cast<std::size_t>(std::max(bake.width, 0)) *
-                             static_cast<std::size_t>(std::max(bake.height, 0));
+  const std::size_t texels =
+      static_cast<std::size_t>(std::max(bake.width, 0)) * static_cast<std::size_t>(std::max(bake.height, 0));
   if (bake.width <= 0 || bake.height <= 0 || bake.width != bake.layout.width || bake.height != bake.layout.height ||
       bake.irradiance.size() != texels || bake.valid.size() != texels)
-    return engine::Error{bundle_dir.string(), "", "cannot save the light atlas: its size (" +
-                                                      std::to_string(bake.width) + "x" + std::to_string(bake.height) +
-                                                      ") does not match its layout or arrays"};
+    return engine::Error{bundle_dir.string(), "",
+                         "cannot save the light atlas: its size (" + std::to_string(bake.width) + "x" +
+                             std::to_string(bake.height) + ") does not match its layout or arrays"};
   std::error_code ec;
   fs::create_directories(bundle_dir, ec);
   if (ec) return engine::Error{bundle_dir.string(), "", "cannot create the bundle directory: " + ec.message()};
@@ -170,18 +173,17 @@ engine::Status save_light_atlas(const fs::path& bundle_dir, const LightAtlasBake
   auto vpls_sum = file_checksum(vpls);
   if (!vpls_sum) return vpls_sum.error();
 
-  const json entry{
-      {"files",
-       {{"irradiance", {{"file", kLightAtlasExrFile}, {"fnv1a64", *exr_sum}}},
-        {"vpls", {{"file", kLightAtlasVplsFile}, {"fnv1a64", *vpls_sum}}}}},
-      {"settings", settings_json(bake.settings)},
-      {"layout",
-       {{"requested_texels_per_metre", bake.layout.requested_texels_per_metre},
-        {"texels_per_metre", bake.layout.texels_per_metre},
-        {"padding_texels", bake.layout.padding_texels},
-        {"width", bake.layout.width},
-        {"height", bake.layout.height}}},
-      {"stats", stats_json(bake.stats)}};
+  const json entry{{"files",
+                    {{"irradiance", {{"file", kLightAtlasExrFile}, {"fnv1a64", *exr_sum}}},
+                     {"vpls", {{"file", kLightAtlasVplsFile}, {"fnv1a64", *vpls_sum}}}}},
+                   {"settings", settings_json(bake.settings)},
+                   {"layout",
+                    {{"requested_texels_per_metre", bake.layout.requested_texels_per_metre},
+                     {"texels_per_metre", bake.layout.texels_per_metre},
+                     {"padding_texels", bake.layout.padding_texels},
+                     {"width", bake.layout.width},
+                     {"height", bake.layout.height}}},
+                   {"stats", stats_json(bake.stats)}};
   return update_manifest_method(bundle_dir, geometry_hash, scene_name, kLightAtlasMethod, entry);
 }
 
@@ -208,12 +210,13 @@ engine::Result<LightAtlasBake> load_light_atlas(const fs::path& bundle_dir, cons
   auto vpl_file = read_light_atlas_vpls(vpls_path);
   if (!vpl_file) return vpl_file.error();
   if (vpl_file->geometry_hash != manifest->geometry_hash)
-    return engine::Error{vpls_path.string(), "", "belongs to geometry " + vpl_file->geometry_hash +
-                                                     ", the manifest to " + manifest->geometry_hash};
+    return engine::Error{
+        vpls_path.string(), "",
+        "belongs to geometry " + vpl_file->geometry_hash + ", the manifest to " + manifest->geometry_hash};
 
-  auto layout = build_atlas_layout(atlas_inputs_from(asset), AtlasSettings{.texels_per_metre =
-                                                                               entry->requested_texels_per_metre,
-                                                                           .padding_texels = entry->padding_texels});
+  auto layout = build_atlas_layout(
+      atlas_inputs_from(asset),
+      AtlasSettings{.texels_per_metre = entry->requested_texels_per_metre, .padding_texels = entry->padding_texels});
   if (!layout) {
     engine::Error e = layout.error();
     e.message = "cannot rebuild the light atlas layout of " + manifest_file.string() + ": " + e.message;

@@ -16,11 +16,11 @@
 // The manifest is written last and names the FNV-1a 64 of both files, so a bundle whose
 // bake was interrupted between files, or mixes files of two bakes, does not load.
 
-#include <filesystem>
-#include <string>
-
 #include <engine/result.h>
 #include <engine/scene_asset.h>
+
+#include <filesystem>
+#include <string>
 
 #include "light_atlas/light_atlas.h"
 

@@ -1,6 +1,5 @@
-#include <gi/light_atlas_lighting.h>
-
 #include <GL/glcorearb.h>
+#include <gi/light_atlas_lighting.h>
 
 #include "light_atlas/light_atlas.h"
 #include "light_atlas/light_atlas_io.h"
@@ -15,12 +14,12 @@ LightAtlasLighting::~LightAtlasLighting() = default;
 
 engine::Result<std::unique_ptr<LightAtlasLighting>> LightAtlasLighting::from_bake(LightAtlasBake bake,
                                                                                   engine::SceneAsset& asset) {
-  const std::size_t texels = static_cast<std::size_t>(std::max(bake.width, 0)) *
-                             static_cast<std::size_t>(std::max(bake.height, 0));
+  const std::size_t texels =
+      static_cast<std::size_t>(std::max(bake.width, 0)) * static_cast<std::size_t>(std::max(bake.height, 0));
   if (bake.width <= 0 || bake.height <= 0 || bake.irradiance.size() != texels || bake.valid.size() != texels)
-    return engine::Error{asset.source, "light atlas",
-                         "the bake's arrays do not hold " + std::to_string(bake.width) + "x" +
-                             std::to_string(bake.height) + " texels"};
+    return engine::Error{
+        asset.source, "light atlas",
+        "the bake's arrays do not hold " + std::to_string(bake.width) + "x" + std::to_string(bake.height) + " texels"};
   if (bake.width != bake.layout.width || bake.height != bake.layout.height)
     return engine::Error{asset.source, "light atlas", "the bake's size differs from its layout's"};
   auto with_uv1 = with_atlas_uv1(asset, bake.layout);

@@ -25,15 +25,15 @@ std::string check_vpls(const VplSet& s, const std::vector<glm::vec3>& power) {
   if (power.size() != n)
     return "vpl_power has " + std::to_string(power.size()) + " entries for " + std::to_string(n) + " VPLs";
   const std::size_t samples = s.sample_position.size();
-  if (s.sample_normal.size() != samples || s.sample_area_m2.size() != samples)
-    return "sample arrays differ in size";
+  if (s.sample_normal.size() != samples || s.sample_area_m2.size() != samples) return "sample arrays differ in size";
   if (n == 0 && s.sample_first.empty()) {
     if (samples != 0) return "sample points without VPLs";
   } else {
     if (s.sample_first.size() != n + 1)
       return "sample_first has " + std::to_string(s.sample_first.size()) + " entries, " + std::to_string(n + 1) +
              " expected";
-    if (s.sample_first.front() != 0 || s.sample_first.back() != samples) return "sample_first does not span the samples";
+    if (s.sample_first.front() != 0 || s.sample_first.back() != samples)
+      return "sample_first does not span the samples";
     for (std::size_t j = 0; j < n; ++j)
       if (s.sample_first[j] > s.sample_first[j + 1]) return "sample_first decreases at VPL " + std::to_string(j);
   }

@@ -15,10 +15,10 @@
 //   array<vec3> vpl_power
 // Nothing follows (trailing bytes are an error).
 
+#include <engine/result.h>
+
 #include <filesystem>
 #include <string>
-
-#include <engine/result.h>
 
 #include "bake/blob_file.h"
 #include "light_atlas/light_atlas.h"
