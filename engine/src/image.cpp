@@ -79,14 +79,15 @@ Result<ImageRgba8> load_png(const fs::path& path) {
   return image;
 }
 
-Status save_exr(const fs::path& path, const ImageRgbaF& image) {
+Status save_exr(const fs::path& path, const ImageRgbaF& image, ExrPixelType type) {
   GI_EXPECTS(image.width > 0 && image.height > 0, "image must not be empty");
   GI_EXPECTS(image.pixels.size() == static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height) * 4,
              "pixels must hold width*height*4 floats");
   if (Status s = check_parent_exists(path); !s) return s;
   const fs::path tmp = temporary_path_for(path);
   const char* err = nullptr;
-  const int ret = SaveEXR(image.pixels.data(), image.width, image.height, 4, /*save_as_fp16=*/1, tmp.c_str(), &err);
+  const int ret = SaveEXR(image.pixels.data(), image.width, image.height, 4,
+                          /*save_as_fp16=*/type == ExrPixelType::Half ? 1 : 0, tmp.c_str(), &err);
   if (ret != TINYEXR_SUCCESS) {
     std::string message = std::string("cannot write EXR: ") + (err ? err : "error " + std::to_string(ret));
     if (err) FreeEXRErrorMessage(err);

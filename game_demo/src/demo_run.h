@@ -7,6 +7,7 @@
 #include <optional>
 #include <string>
 
+#include <engine/indirect_light.h>
 #include <engine/renderer.h>
 
 #include <game_demo/replay.h>
@@ -33,6 +34,7 @@ struct RunOptions {
   std::uint64_t seed = 0;
   bool verbose = false;
   bool only_written = false;  ///< Headless: render only the frames written to --out.
+  std::string gi_bundle;      ///< Bake bundle (scene.gibake/) whose light atlas lights the scene; empty: stand-in.
 };
 
 /// Everything a run needs after start-up checks: the simulation, and the session being
@@ -54,6 +56,17 @@ struct RunState {
 inline engine::SplitView split_of(const Simulation& sim) {
   return sim.context().split_view ? engine::SplitView::DirectLeftFullRight : engine::SplitView::Off;
 }
+
+/// The indirect light of a run: with --gi-bundle, the bundle's light atlas loaded into the
+/// simulation's scene (which gains TEXCOORD_1, so create the renderer after this); without
+/// it, nullptr (the renderer's constant-ambient stand-in). Prints the error and returns
+/// false when the bundle does not load (missing, damaged, or baked from other geometry).
+/// Call with the GL context current; destroy the provider before the context.
+bool load_indirect_light(const RunOptions& options, Simulation& sim,
+                         std::unique_ptr<engine::IndirectLightProvider>& provider);
+
+/// One line for stdout and the overlay: which indirect light is used.
+std::string describe_indirect_light(const RunOptions& options, const engine::IndirectLightProvider* provider);
 
 int run_headless(const RunOptions& options, RunState& state);
 int run_windowed(const RunOptions& options, RunState& state);

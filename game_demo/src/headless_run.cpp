@@ -49,6 +49,7 @@ int run_headless(const RunOptions& o, RunState& state) {
     for (const glm::vec3& p : pilot->waypoints()) std::printf("waypoint (%.2f, %.2f, %.2f)\n", double{p.x}, double{p.y}, double{p.z});
 
   std::optional<engine::GpuContext> gpu;
+  std::unique_ptr<engine::IndirectLightProvider> indirect;  // destroyed before gpu
   std::unique_ptr<engine::Renderer> renderer;
   if (!o.no_render) {
     auto ctx = engine::GpuContext::create_headless();
@@ -57,13 +58,16 @@ int run_headless(const RunOptions& o, RunState& state) {
       return 1;
     }
     gpu.emplace(std::move(ctx).value());
+    if (!load_indirect_light(o, sim, indirect)) return 1;  // before the renderer: it adds TEXCOORD_1
     auto r = engine::Renderer::create(sim.scene().assets, engine::RenderSettings{.width = o.width, .height = o.height});
     if (!r) {
       std::cerr << "gi_demo: " << r.error().to_string() << '\n';
       return 1;
     }
     renderer = std::move(r).value();
+    renderer->set_indirect_light(indirect.get());
     std::cout << "gi_demo: headless " << o.width << "x" << o.height << " on " << gpu->description() << '\n';
+    std::cout << "gi_demo: indirect light: " << describe_indirect_light(o, indirect.get()) << '\n';
   }
   if (!o.out_dir.empty()) {
     std::error_code ec;

@@ -3,10 +3,13 @@
 //   gi_demo --headless --frames 120 --out /tmp/frames
 //   gi_demo --headless --script push_crates --frames 600 --record s.girec --no-render
 //   gi_demo --headless --replay tests/sessions/push_crates.girec
+//   gi_demo --gi-bundle assets/demo_level.gibake     light the static world with a baked light atlas
 #include <cstdio>
 #include <iostream>
 
 #include <CLI/CLI.hpp>
+
+#include <gi/light_atlas_lighting.h>
 
 #include "demo_run.h"
 
@@ -36,6 +39,23 @@ bool RunState::finish_recording(const std::string& path) const {
   return true;
 }
 
+bool load_indirect_light(const RunOptions& o, Simulation& sim, std::unique_ptr<engine::IndirectLightProvider>& provider) {
+  provider.reset();
+  if (o.gi_bundle.empty()) return true;
+  auto atlas = gi::LightAtlasLighting::load(o.gi_bundle, sim.scene());
+  if (!atlas) {
+    std::cerr << "gi_demo: cannot use --gi-bundle " << o.gi_bundle << ": " << atlas.error().to_string() << '\n';
+    return false;
+  }
+  provider = std::move(atlas).value();
+  return true;
+}
+
+std::string describe_indirect_light(const RunOptions& o, const engine::IndirectLightProvider* provider) {
+  if (provider == nullptr) return "constant ambient (stand-in), no GI bundle";
+  return std::string(provider->label()) + " from " + o.gi_bundle;
+}
+
 }  // namespace game_demo
 
 int main(int argc, char** argv) {
@@ -57,6 +77,8 @@ int main(int argc, char** argv) {
   app.add_option("--seed", o.seed, "Session seed (recorded in the header and the checksum)");
   app.add_flag("--only-written-frames", o.only_written,
                "Headless: render only the frames --out/--every write (fast golden and approval runs)");
+  app.add_option("--gi-bundle", o.gi_bundle,
+                 "Light the static world with the light atlas of this bake bundle (scene.gibake/)");
   app.add_flag("--verbose", o.verbose, "Headless: print the script's waypoints and the player's position each second");
   CLI11_PARSE(app, argc, argv);
   o.size_given = w->count() > 0 || h->count() > 0;
@@ -66,6 +88,10 @@ int main(int argc, char** argv) {
   }
   if (o.no_render && !o.out_dir.empty()) {
     std::cerr << "gi_demo: --no-render cannot write frames (--out)\n";
+    return 2;
+  }
+  if (o.no_render && !o.gi_bundle.empty()) {
+    std::cerr << "gi_demo: --no-render does not light anything (--gi-bundle)\n";
     return 2;
   }
 

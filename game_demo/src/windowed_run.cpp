@@ -38,8 +38,8 @@ InputFrame live_keys(GLFWwindow* window) {
   return in;
 }
 
-void draw_overlay(const RunOptions& o, const RunState& state, const engine::Renderer& renderer, double frame_ms,
-                  double fps) {
+void draw_overlay(const RunOptions& o, const RunState& state, const engine::Renderer& renderer,
+                  const std::string& indirect, double frame_ms, double fps) {
   const Simulation& sim = *state.sim;
   ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_Always);
   ImGui::SetNextWindowBgAlpha(0.6f);
@@ -47,7 +47,7 @@ void draw_overlay(const RunOptions& o, const RunState& state, const engine::Rend
                ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoInputs);
   ImGui::Text("%.1f fps   frame %.2f ms   step %llu", fps, frame_ms, static_cast<unsigned long long>(sim.frame()));
   ImGui::Separator();
-  ImGui::TextUnformatted("GI effects: constant ambient (stand-in) - GI methods not baked");
+  ImGui::Text("indirect light: %s", indirect.c_str());
   const engine::Light* torch = sim.registry().try_get<engine::Light>(sim.context().flashlight);
   ImGui::Text("flashlight (F): %s   split (G): %s", torch && torch->enabled ? "on" : "off",
               sim.context().split_view ? "direct | full" : "off");
@@ -73,13 +73,18 @@ int run_windowed(const RunOptions& o, RunState& state) {
     return 1;
   }
   GLFWwindow* window = ctx->window();
+  std::unique_ptr<engine::IndirectLightProvider> indirect;  // destroyed before the context
+  if (!load_indirect_light(o, sim, indirect)) return 1;    // before the renderer: it adds TEXCOORD_1
+  const std::string indirect_text = describe_indirect_light(o, indirect.get());
   auto r = engine::Renderer::create(sim.scene().assets, engine::RenderSettings{.width = o.width, .height = o.height});
   if (!r) {
     std::cerr << "gi_demo: " << r.error().to_string() << '\n';
     return 1;
   }
   std::unique_ptr<engine::Renderer> renderer = std::move(r).value();
+  renderer->set_indirect_light(indirect.get());
   std::cout << "gi_demo: window " << o.width << "x" << o.height << " on " << ctx->description() << '\n';
+  std::cout << "gi_demo: indirect light: " << indirect_text << '\n';
 
   glfwSetInputMode(window, GLFW_CURSOR, GLFW_CURSOR_DISABLED);
   if (glfwRawMouseMotionSupported()) glfwSetInputMode(window, GLFW_RAW_MOUSE_MOTION, GLFW_TRUE);
@@ -141,7 +146,7 @@ int run_windowed(const RunOptions& o, RunState& state) {
     ImGui_ImplOpenGL3_NewFrame();
     ImGui_ImplGlfw_NewFrame();
     ImGui::NewFrame();
-    draw_overlay(o, state, *renderer, frame_ms, fps);
+    draw_overlay(o, state, *renderer, indirect_text, frame_ms, fps);
     ImGui::Render();
     ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
     ctx->swap();
@@ -151,6 +156,7 @@ int run_windowed(const RunOptions& o, RunState& state) {
   ImGui_ImplGlfw_Shutdown();
   ImGui::DestroyContext();
   renderer.reset();
+  indirect.reset();
   return status;
 }
 

@@ -53,6 +53,18 @@ TEST(ImageExr, WriteReadRoundTripWithinHalfPrecision) {
   EXPECT_NEAR(back->pixels[0], 0.25f, 1e-3f);
 }
 
+TEST(ImageExr, FloatPixelsRoundTripBitExactly) {
+  const fs::path dir = scratch_dir("exr_float");
+  engine::ImageRgbaF img{7, 3, {}};
+  for (int i = 0; i < 7 * 3 * 4; ++i) img.pixels.push_back(1.0f / static_cast<float>(i + 3) + 1e5f * static_cast<float>(i % 3));
+  ASSERT_TRUE(engine::save_exr(dir / "a.exr", img, engine::ExrPixelType::Float).ok());
+  auto back = engine::load_exr(dir / "a.exr");
+  ASSERT_TRUE(back.ok()) << back.error().to_string();
+  ASSERT_EQ(back->width, 7);
+  ASSERT_EQ(back->height, 3);
+  EXPECT_EQ(back->pixels, img.pixels);  // values above the half range and full mantissas survive
+}
+
 TEST(ImageFiles, WritingIntoMissingDirectoryFailsWithoutLeftovers) {
   const fs::path dir = scratch_dir("missing");
   const fs::path missing = dir / "no_such_dir";

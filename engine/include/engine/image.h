@@ -29,8 +29,14 @@ struct ImageRgbaF {
 Status save_png(const std::filesystem::path& path, const ImageRgba8& image);
 /// Reads a PNG into RGBA8.
 Result<ImageRgba8> load_png(const std::filesystem::path& path);
-/// Writes a linear OpenEXR (half floats, RGBA; temporary file + rename).
-Status save_exr(const std::filesystem::path& path, const ImageRgbaF& image);
+/// Channel precision of a written OpenEXR.
+enum class ExrPixelType : std::uint8_t {
+  Half,   ///< 16-bit floats: pictures (11-bit mantissa, max 65504).
+  Float,  ///< 32-bit floats: data that must round-trip bit-exactly (baked irradiance).
+};
+
+/// Writes a linear OpenEXR (RGBA; temporary file + rename, so readers never see a half file).
+Status save_exr(const std::filesystem::path& path, const ImageRgbaF& image, ExrPixelType type = ExrPixelType::Half);
 /// Reads an OpenEXR into RGBA32F.
 Result<ImageRgbaF> load_exr(const std::filesystem::path& path);
 

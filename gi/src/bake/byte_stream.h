@@ -1,0 +1,99 @@
+#pragma once
+// Little-endian packing of plain values and arrays into a byte payload, and bounds-checked
+// reading back. The host is little-endian (static_assert), so values are copied as they are.
+//   gi::ByteWriter w; w.put(std::uint32_t{7}); w.put_array(std::span<const glm::vec3>(positions));
+//   gi::ByteReader r(w.bytes()); std::uint32_t v = 0; if (!r.get(v)) { /* truncated */ }
+
+#include <bit>
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <glm/glm.hpp>
+#include <span>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+namespace gi {
+
+static_assert(std::endian::native == std::endian::little, "bake files are little-endian; add byte swapping");
+
+static_assert(sizeof(glm::vec3) == 12 && sizeof(glm::vec4) == 16, "GLM vectors must be unpadded floats");
+
+/// A value with a fixed byte layout: arithmetic types and GLM float vectors (no padding).
+template <class T>
+inline constexpr bool kPackable = std::is_arithmetic_v<T> || std::is_same_v<T, glm::vec2> ||
+                                  std::is_same_v<T, glm::vec3> || std::is_same_v<T, glm::vec4>;
+
+class ByteWriter {
+ public:
+  template <class T>
+  void put(const T& v) {
+    static_assert(kPackable<T>, "pack fields one by one");
+    append(&v, sizeof(T));
+  }
+  /// uint64 element count, then the elements.
+  template <class T>
+  void put_array(std::span<const T> values) {
+    static_assert(kPackable<T>, "pack fields one by one");
+    put(static_cast<std::uint64_t>(values.size()));
+    append(values.data(), values.size_bytes());
+  }
+  /// uint64 length, then the characters.
+  void put_string(const std::string& s) {
+    put(static_cast<std::uint64_t>(s.size()));
+    append(s.data(), s.size());
+  }
+  std::span<const std::byte> bytes() const { return bytes_; }
+  std::vector<std::byte> take() { return std::move(bytes_); }
+
+ private:
+  void append(const void* data, std::size_t n) {
+    const auto* p = static_cast<const std::byte*>(data);
+    bytes_.insert(bytes_.end(), p, p + n);
+  }
+  std::vector<std::byte> bytes_;
+};
+
+/// Reads what ByteWriter wrote. Every getter returns false (and leaves the output alone)
+/// when the payload is too short; counts are checked against the bytes left before
+/// allocating, so a corrupt count cannot ask for gigabytes.
+class ByteReader {
+ public:
+  explicit ByteReader(std::span<const std::byte> bytes) : bytes_(bytes) {}
+
+  template <class T>
+  bool get(T& v) {
+    static_assert(kPackable<T>, "unpack fields one by one");
+    if (remaining() < sizeof(T)) return false;
+    std::memcpy(&v, bytes_.data() + offset_, sizeof(T));
+    offset_ += sizeof(T);
+    return true;
+  }
+  template <class T>
+  bool get_array(std::vector<T>& out) {
+    static_assert(kPackable<T>, "unpack fields one by one");
+    std::uint64_t n = 0;
+    if (!get(n) || n > remaining() / sizeof(T)) return false;
+    out.resize(static_cast<std::size_t>(n));
+    if (n > 0) std::memcpy(out.data(), bytes_.data() + offset_, static_cast<std::size_t>(n) * sizeof(T));
+    offset_ += static_cast<std::size_t>(n) * sizeof(T);
+    return true;
+  }
+  bool get_string(std::string& out) {
+    std::uint64_t n = 0;
+    if (!get(n) || n > remaining()) return false;
+    out.assign(reinterpret_cast<const char*>(bytes_.data() + offset_), static_cast<std::size_t>(n));
+    offset_ += static_cast<std::size_t>(n);
+    return true;
+  }
+
+  std::size_t offset() const { return offset_; }
+  std::size_t remaining() const { return bytes_.size() - offset_; }
+
+ private:
+  std::span<const std::byte> bytes_;
+  std::size_t offset_ = 0;
+};
+
+}  // namespace gi

@@ -1,0 +1,48 @@
+#pragma once
+// Saving a light-atlas bake into a bundle directory and loading it back for a scene.
+//   gi::save_light_atlas("level.gibake", bake, gi::scene_geometry_hash(asset), "level.gltf");
+//   auto bake = gi::load_light_atlas("level.gibake", asset);   // checks the geometry hash
+//
+// Files (DESIGN.md §5):
+//   light_atlas.exr        RGBA float32, width x height of the layout, texel (x, y) at row y
+//                          column x: RGB = irradiance (W/m^2), A = 1 where valid, else 0.
+//   light_atlas_vpls.bin   settings + VPL solution (light_atlas_vpl_file.h).
+//   manifest.json          methods.light_atlas = {
+//     "files":    { "irradiance": {"file": "light_atlas.exr", "fnv1a64": "<hex>"},
+//                   "vpls":       {"file": "light_atlas_vpls.bin", "fnv1a64": "<hex>"} },
+//     "settings": { LightAtlasSettings' scalar fields },
+//     "layout":   { "requested_texels_per_metre", "texels_per_metre", "padding_texels", "width", "height" },
+//     "stats":    { every LightAtlasStats field } }
+// The manifest is written last and names the FNV-1a 64 of both files, so a bundle whose
+// bake was interrupted between files, or mixes files of two bakes, does not load.
+
+#include <engine/result.h>
+#include <engine/scene_asset.h>
+
+#include <filesystem>
+#include <string>
+
+#include "light_atlas/light_atlas.h"
+
+namespace gi {
+
+inline constexpr const char* kLightAtlasMethod = "light_atlas";
+inline constexpr const char* kLightAtlasExrFile = "light_atlas.exr";
+inline constexpr const char* kLightAtlasVplsFile = "light_atlas_vpls.bin";
+
+/// Writes `bake` into `bundle_dir` (created if needed): the EXR, the VPL file, then the
+/// manifest's "light_atlas" entry (other methods' entries are kept when the manifest has the
+/// same geometry hash). Every file is written to a temporary name and renamed. Error when
+/// the bake's arrays do not match its size, or a file cannot be written.
+engine::Status save_light_atlas(const std::filesystem::path& bundle_dir, const LightAtlasBake& bake,
+                                const std::string& geometry_hash, const std::string& scene_name);
+
+/// Loads the light atlas of `bundle_dir` for `asset`: rejects a stale bundle (geometry hash
+/// differs from scene_geometry_hash(asset)), rebuilds the layout from atlas_inputs_from(asset)
+/// with the manifest's requested density and padding, and checks every file against the
+/// manifest (checksums, sizes, finite non-negative irradiance, alpha 0 or 1). Every error
+/// names the file and the problem.
+engine::Result<LightAtlasBake> load_light_atlas(const std::filesystem::path& bundle_dir,
+                                                const engine::SceneAsset& asset);
+
+}  // namespace gi
