@@ -229,9 +229,9 @@ engine::Result<LightAtlasUpdateStats> update_light_atlas(const engine::Scene& sc
 engine::Result<LightAtlasSettings> light_atlas_preset(std::string_view name) {
   LightAtlasSettings s;
   if (name == "preview") {
-    s.texels_per_metre = 8.0f, s.vpl_count = 300, s.bounces = 4;
+    s.texels_per_metre = 8.0f, s.vpl_count = 300, s.bounces = 8;
   } else if (name == "medium") {
-    s.texels_per_metre = 16.0f, s.vpl_count = 1000, s.bounces = 8;
+    s.texels_per_metre = 16.0f, s.vpl_count = 1000, s.bounces = 16;
   } else if (name == "high") {
     s.texels_per_metre = 32.0f, s.vpl_count = 3000, s.bounces = 16;
   } else {
