@@ -72,9 +72,7 @@ std::vector<PointEmitter> point_emitters(const ReferenceScene& scene, const Refe
   const auto& instances = scene.geometry.instances;
   for (std::size_t k = 0; k < instances.size(); ++k) {
     if (instances[k].dynamic) continue;
-    const std::uint32_t first = index.instance_first[k];
-    const std::uint32_t end = k + 1 < instances.size() ? index.instance_first[k + 1]
-                                                        : static_cast<std::uint32_t>(index.triangles.size());
+    const auto [first, end] = instance_triangles(index, k);
     for (std::uint32_t t = first; t < end; ++t) {
       const ShadingTriangle& tri = index.triangles[t];
       const ReferenceMaterial& m = scene.materials[tri.material];

@@ -192,9 +192,7 @@ engine::Result<VplSet> distribute_vpls(const ReferenceScene& scene, const Refere
   const auto& instances = scene.geometry.instances;
   for (std::size_t k = 0; k < instances.size(); ++k) {
     if (instances[k].dynamic) continue;
-    const std::uint32_t first = index.instance_first[k];
-    const std::uint32_t end = k + 1 < instances.size() ? index.instance_first[k + 1]
-                                                        : static_cast<std::uint32_t>(index.triangles.size());
+    const auto [first, end] = instance_triangles(index, k);
     StaticMesh m;
     m.first_triangle = first;
     for (std::uint32_t t = first; t < end; ++t) {

@@ -7,6 +7,7 @@
 //   gi::ReferenceSceneIndex index = gi::index_reference_scene(s).value();
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -79,6 +80,14 @@ struct ReferenceSceneIndex {
   std::vector<bool> light_has_proxy;
   float scene_radius_m = 0.0f;  ///< Half the diagonal of the world bounds.
 };
+
+/// The triangles [first, end) of `instance` in ReferenceSceneIndex::triangles.
+inline std::pair<std::uint32_t, std::uint32_t> instance_triangles(const ReferenceSceneIndex& index, std::size_t instance) {
+  const std::uint32_t first = index.instance_first[instance];
+  const std::uint32_t end = instance + 1 < index.instance_first.size() ? index.instance_first[instance + 1]
+                                                                        : static_cast<std::uint32_t>(index.triangles.size());
+  return {first, end};
+}
 
 /// Flattens the scene. Errors: inconsistent sizes, indices out of range, non-finite values.
 engine::Result<ReferenceSceneIndex> index_reference_scene(const ReferenceScene& scene);
