@@ -238,3 +238,33 @@ TEST(BundleGeometryHash, IgnoresDynamicNodes) {
   moved.meshes[2].primitives[0].positions[0].y += 0.2f;  // its own mesh deforms
   EXPECT_EQ(gi::scene_geometry_hash(moved), h);
 }
+
+TEST(BundleLightsHash, ChangesWithStaticLightsOnly) {
+  const engine::SceneAsset base = cornell();
+  const std::string h = gi::static_lights_hash(base);
+  EXPECT_EQ(gi::static_lights_hash(cornell()), h);
+  EXPECT_EQ(gi::scene_geometry_hash(base), gi::scene_geometry_hash(base)) << "lights do not enter the geometry hash";
+
+  int light_node = -1;
+  for (std::size_t n = 0; n < base.nodes.size(); ++n)
+    if (base.nodes[n].light >= 0) light_node = static_cast<int>(n);
+  ASSERT_GE(light_node, 0);
+  const auto ln = static_cast<std::size_t>(light_node);
+  const auto li = static_cast<std::size_t>(base.nodes[ln].light);
+
+  engine::SceneAsset brighter = base;
+  brighter.lights[li].light.intensity *= 2.0f;
+  EXPECT_NE(gi::static_lights_hash(brighter), h);
+  EXPECT_EQ(gi::scene_geometry_hash(brighter), gi::scene_geometry_hash(base));
+  engine::SceneAsset moved = base;
+  moved.nodes[ln].translation.x += 0.01f;
+  EXPECT_NE(gi::static_lights_hash(moved), h);
+
+  // A light that moves at runtime is not part of a static bake: editing it keeps the hash.
+  engine::SceneAsset dynamic = base;
+  dynamic.lights[li].light.moves = true;
+  const std::string hd = gi::static_lights_hash(dynamic);
+  dynamic.lights[li].light.intensity *= 3.0f;
+  dynamic.nodes[ln].translation.y -= 0.1f;
+  EXPECT_EQ(gi::static_lights_hash(dynamic), hd);
+}

@@ -87,7 +87,7 @@ fs::path saved_bundle(const std::string& name) {
   const fs::path dir = scratch_dir(name);
   const engine::SceneAsset asset = cornell();
   const engine::Status s =
-      gi::save_light_atlas(dir, fake_bake(asset), gi::scene_geometry_hash(asset), "cornell_box.gltf");
+      gi::save_light_atlas(dir, fake_bake(asset), asset, "cornell_box.gltf");
   EXPECT_TRUE(s.ok()) << s.error().to_string();
   return dir;
 }
@@ -177,6 +177,21 @@ TEST(LightAtlasIo, StaleBundleIsRejectedWithBothHashes) {
   EXPECT_NE(message.find(gi::scene_geometry_hash(cornell())), std::string::npos) << message;
   EXPECT_NE(message.find(gi::scene_geometry_hash(changed)), std::string::npos) << message;
   EXPECT_NE(message.find("manifest.json"), std::string::npos) << message;
+}
+
+TEST(LightAtlasIo, AtlasBakedUnderOtherStaticLightsIsRejected) {
+  const fs::path dir = saved_bundle("stale_lights");
+  engine::SceneAsset relit = cornell();
+  ASSERT_FALSE(relit.lights.empty());
+  relit.lights[0].light.intensity *= 1.5f;
+  auto r = gi::load_light_atlas(dir, relit);
+  ASSERT_FALSE(r.ok());
+  const std::string message = r.error().to_string();
+  EXPECT_NE(message.find("stale light atlas"), std::string::npos) << message;
+  EXPECT_NE(message.find(gi::static_lights_hash(cornell())), std::string::npos) << message;
+  EXPECT_NE(message.find(gi::static_lights_hash(relit)), std::string::npos) << message;
+  // The same bundle still loads for the scene it was baked from.
+  EXPECT_TRUE(gi::load_light_atlas(dir, cornell()).ok());
 }
 
 TEST(LightAtlasIo, MissingOrDamagedFilesAreRejected) {
@@ -281,7 +296,7 @@ TEST(LightAtlasIo, InconsistentVplsAreNotSaved) {
   gi::LightAtlasBake bake = fake_bake(asset);
   bake.vpls.sample_first = {0, 2, 1, 5};
   const fs::path dir = scratch_dir("bad_vpls");
-  const engine::Status s = gi::save_light_atlas(dir, bake, gi::scene_geometry_hash(asset), "cornell_box.gltf");
+  const engine::Status s = gi::save_light_atlas(dir, bake, asset, "cornell_box.gltf");
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.error().to_string().find("sample_first"), std::string::npos) << s.error().to_string();
   EXPECT_TRUE(!fs::exists(dir) || fs::is_empty(dir)) << "a failed save writes nothing";

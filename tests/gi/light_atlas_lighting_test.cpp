@@ -236,7 +236,7 @@ TEST(LightAtlasLighting, LoadsABundleAndGivesTheSceneUv1) {
   engine::SceneAsset asset = dark_cornell();
   const std::filesystem::path dir = std::filesystem::path(GI_BINARY_DIR) / "test_output" / "light_atlas_lighting_test";
   std::filesystem::remove_all(dir);
-  ASSERT_TRUE(gi::save_light_atlas(dir, uniform_bake(asset, glm::vec3(1.0f)), gi::scene_geometry_hash(asset),
+  ASSERT_TRUE(gi::save_light_atlas(dir, uniform_bake(asset, glm::vec3(1.0f)), asset,
                                    "cornell_box.gltf")
                   .ok());
   auto provider = gi::LightAtlasLighting::load(dir, asset);
@@ -279,7 +279,7 @@ TEST(LightAtlasLighting, LoadIntoAnInstantiatedSceneFollowsDuplicatedMeshes) {
       std::filesystem::path(GI_BINARY_DIR) / "test_output" / "light_atlas_lighting_shared";
   std::filesystem::remove_all(dir);
   ASSERT_TRUE(
-      gi::save_light_atlas(dir, uniform_bake(asset, glm::vec3(1.0f)), gi::scene_geometry_hash(asset), "quads").ok());
+      gi::save_light_atlas(dir, uniform_bake(asset, glm::vec3(1.0f)), asset, "quads").ok());
 
   engine::Scene scene = engine::instantiate(asset);
   auto provider = gi::LightAtlasLighting::load(dir, scene);

@@ -14,7 +14,6 @@
 #include <engine/gltf.h>
 #include <engine/scene.h>
 
-#include "bake/geometry_hash.h"
 #include "console_progress.h"
 #include "light_atlas/light_atlas.h"
 #include "light_atlas/light_atlas_io.h"
@@ -59,7 +58,6 @@ int main(int argc, char** argv) {
   }
   const std::filesystem::path scene_file(scene_path);
   if (out_dir.empty()) out_dir = (std::filesystem::path("out") / (scene_file.stem().string() + ".gibake")).string();
-  const std::string geometry_hash = gi::scene_geometry_hash(*asset);
   const engine::Scene scene = engine::instantiate(*asset);
 
   for (const std::string& method : split(methods)) {
@@ -95,7 +93,7 @@ int main(int argc, char** argv) {
     std::printf("  time: VPLs %.2f s, direct %.2f s, propagation %.2f s, final shooting %.2f s; total %.2f s; %.1f M rays\n",
                 st.vpl_seconds, st.direct_seconds, st.propagate_seconds, st.final_seconds, st.total_seconds,
                 static_cast<double>(st.rays) * 1e-6);
-    if (auto saved = gi::save_light_atlas(out_dir, *bake, geometry_hash, scene_file.filename().string()); !saved) {
+    if (auto saved = gi::save_light_atlas(out_dir, *bake, *asset, scene_file.filename().string()); !saved) {
       std::cerr << "gi-bake: " << saved.error().to_string() << '\n';
       return 1;
     }

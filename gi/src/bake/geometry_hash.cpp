@@ -73,4 +73,28 @@ std::string scene_geometry_hash(const engine::SceneAsset& scene) {
   return h.hex();
 }
 
+std::string static_lights_hash(const engine::SceneAsset& scene) {
+  ContentHash h;
+  h.add_string("gi static lights v1");
+  for (std::size_t n = 0; n < scene.nodes.size(); ++n) {
+    const engine::Node& node = scene.nodes[n];
+    if (node.light < 0 || static_cast<std::size_t>(node.light) >= scene.lights.size()) continue;
+    const engine::Light& l = scene.lights[static_cast<std::size_t>(node.light)].light;
+    if (!l.enabled || l.moves) continue;
+    h.add_value(static_cast<std::uint64_t>(n));
+    const glm::mat4 world = node_world_matrix(scene, static_cast<int>(n));
+    for (int c = 0; c < 4; ++c)
+      for (int r = 0; r < 4; ++r) h.add_value(world[c][r]);
+    h.add_value(static_cast<std::uint8_t>(l.type));
+    add_vec(h, l.color);
+    h.add_value(l.intensity);
+    h.add_value(l.range_m);
+    h.add_value(l.inner_cone_rad);
+    h.add_value(l.outer_cone_rad);
+    h.add_value(l.area_size_m.x);
+    h.add_value(l.area_size_m.y);
+  }
+  return h.hex();
+}
+
 }  // namespace gi

@@ -20,4 +20,11 @@ namespace gi {
 /// its atlas uv1 (gi::with_atlas_uv1) hashes like the original.
 std::string scene_geometry_hash(const engine::SceneAsset& scene);
 
+/// 16 hex digits over the lights a static bake (the light atlas) depends on: for every node
+/// with an enabled light that does not move, in node order, the node index, its world
+/// matrix and the light's type, colour, intensity, range, cone angles and area size. Moving
+/// or switched-off lights and names do not enter. A light-atlas bundle whose lights hash
+/// differs from the scene's was baked under other lights.
+std::string static_lights_hash(const engine::SceneAsset& scene);
+
 }  // namespace gi

@@ -71,7 +71,7 @@ LightAtlasStats read_stats(JsonFields& f) {
 
 // What the manifest entry says about the files and the layout.
 struct EntryInfo {
-  std::string exr_file, exr_checksum, vpls_file, vpls_checksum;
+  std::string exr_file, exr_checksum, vpls_file, vpls_checksum, lights_hash;
   float requested_texels_per_metre = 0.0f;
   float texels_per_metre = 0.0f;
   int padding_texels = 0;
@@ -87,6 +87,7 @@ engine::Result<EntryInfo> read_entry(const fs::path& manifest_file, const json& 
   e.exr_checksum = f.get<std::string>("files.irradiance.fnv1a64");
   e.vpls_file = f.get<std::string>("files.vpls.file");
   e.vpls_checksum = f.get<std::string>("files.vpls.fnv1a64");
+  e.lights_hash = f.get<std::string>("lights_hash");
   e.requested_texels_per_metre = f.get<float>("layout.requested_texels_per_metre");
   e.texels_per_metre = f.get<float>("layout.texels_per_metre");
   e.padding_texels = f.get<int>("layout.padding_texels");
@@ -144,7 +145,8 @@ engine::Status read_atlas_exr(const fs::path& path, LightAtlasBake& bake) {
 }  // namespace
 
 engine::Status save_light_atlas(const fs::path& bundle_dir, const LightAtlasBake& bake,
-                                const std::string& geometry_hash, const std::string& scene_name) {
+                                const engine::SceneAsset& asset, const std::string& scene_name) {
+  const std::string geometry_hash = scene_geometry_hash(asset);
   const std::size_t texels =
       static_cast<std::size_t>(std::max(bake.width, 0)) * static_cast<std::size_t>(std::max(bake.height, 0));
   if (bake.width <= 0 || bake.height <= 0 || bake.width != bake.layout.width || bake.height != bake.layout.height ||
@@ -176,6 +178,7 @@ engine::Status save_light_atlas(const fs::path& bundle_dir, const LightAtlasBake
   const json entry{{"files",
                     {{"irradiance", {{"file", kLightAtlasExrFile}, {"fnv1a64", *exr_sum}}},
                      {"vpls", {{"file", kLightAtlasVplsFile}, {"fnv1a64", *vpls_sum}}}}},
+                   {"lights_hash", static_lights_hash(asset)},
                    {"settings", settings_json(bake.settings)},
                    {"layout",
                     {{"requested_texels_per_metre", bake.layout.requested_texels_per_metre},
@@ -202,6 +205,11 @@ engine::Result<LightAtlasBake> load_light_atlas(const fs::path& bundle_dir, cons
   if (!entry_json) return entry_json.error();
   auto entry = read_entry(manifest_file, *entry_json);
   if (!entry) return entry.error();
+  if (const std::string lights = static_lights_hash(asset); entry->lights_hash != lights)
+    return engine::Error{manifest_file.string(), "methods.light_atlas.lights_hash",
+                         "stale light atlas in " + bundle_dir.string() + ": baked under static lights " +
+                             entry->lights_hash + ", but the scene's static lights hash to " + lights +
+                             " (a static light was edited; re-bake, or update it with gi::update_light_atlas)"};
 
   const fs::path vpls_path = bundle_dir / entry->vpls_file;
   const fs::path exr_path = bundle_dir / entry->exr_file;
