@@ -1,0 +1,83 @@
+#pragma once
+// Precomputed radiance maps (Szécsi, Szirmay-Kalos, Sbert 2006, "Light animation with
+// precomputed light paths on the GPU"): indirect irradiance of the static world under lights
+// that move. Bake: entry points over the static surfaces, random walks from each (splitting
+// factor, Russian roulette), every path node a virtual light connected by shadow rays to the
+// reference points (the light-atlas texels); items S_k summed per (entry point, texel)
+// (eq. 2-3) and, entry points being clustered, per (cluster, texel): the cluster's pane.
+// Runtime: per light, the weight of every entry point (eq. 4), a cluster's weight the mean
+// of its members', the K heaviest clusters' panes summed into an irradiance atlas.
+//   gi::Prm prm = gi::bake_prm(scene, {.entry_points = 1024, .clusters = 64}).value();
+//   std::vector<float> w = gi::cluster_weights(prm, light, visibility);
+//   std::vector<glm::vec3> atlas = gi::sum_panes(prm, gi::select_clusters(w, 32));
+
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include <engine/result.h>
+#include <engine/scene.h>
+#include <gi/progress.h>
+
+#include "uv/atlas_layout.h"
+
+namespace gi {
+
+struct PrmSettings {
+  float texels_per_metre = 8.0f;  ///< Pane (atlas) density; the layout is the light atlas's.
+  int entry_points = 1024;        ///< N_e, stratified over the static surfaces by area.
+  int clusters = 64;              ///< Panes stored: entry points are clustered into this many.
+  /// N_s: paths per entry point are N_s x albedo (eq. in §4.1), so every path carries the
+  /// same power.
+  float splitting = 4.0f;
+  int max_path_nodes = 64;  ///< Safety stop of a random walk (Russian roulette ends it first).
+  bool kmeans = false;      ///< Refine the median-split kd-tree clusters with k-means (Lloyd) steps.
+  std::uint64_t seed = 1;
+  unsigned threads = 0;
+  ProgressCallback progress;
+};
+
+/// One entry point y_1: where moving lights first hit the static world.
+struct PrmEntryPoint {
+  glm::vec3 position{0.0f};
+  glm::vec3 normal{0.0f, 1.0f, 0.0f};
+  float area_m2 = 0.0f;       ///< The surface it stands for (regularizes eq. 4 near a light).
+  std::uint32_t cluster = 0;  ///< Its cluster (pane).
+};
+
+struct PrmStats {
+  std::size_t paths = 0;
+  std::size_t path_nodes = 0;  ///< Virtual lights.
+  std::uint64_t rays = 0;
+  double walk_seconds = 0.0;
+  double pane_seconds = 0.0;
+  double total_seconds = 0.0;
+};
+
+/// A baked PRM. Panes cover `texels`: every texel a triangle covers plus the gutter rings
+/// the light atlas dilates into (dilation is linear, so it is applied to each pane at bake
+/// time and the runtime sum needs none).
+struct Prm {
+  AtlasLayout layout;
+  int width = 0;
+  int height = 0;
+  std::vector<std::uint32_t> texels;  ///< Atlas texel index (y * width + x) of each pane element, ascending.
+  std::vector<PrmEntryPoint> entries;
+  int cluster_count = 0;
+  std::vector<std::uint32_t> cluster_size;  ///< Members per cluster.
+  /// Pane c, element i, channel ch at panes[(c * texels.size() + i) * 3 + ch]: the indirect
+  /// irradiance (W/m^2) at texel texels[i] when every entry point of cluster c receives unit
+  /// irradiance (the sum of the members' items S_k).
+  std::vector<float> panes;
+  PrmSettings settings;
+  PrmStats stats;
+
+  std::size_t pane_size() const { return texels.size(); }
+};
+
+/// Bakes the PRM of the static meshes of `scene`. Errors: no static geometry, settings out
+/// of range, cancelled.
+engine::Result<Prm> bake_prm(const engine::Scene& scene, const PrmSettings& settings);
+
+}  // namespace gi
