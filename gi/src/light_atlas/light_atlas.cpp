@@ -5,14 +5,12 @@
 #include <cmath>
 #include <span>
 
+#include "bake/static_scene.h"
 #include "light_atlas/final_shooting.h"
 #include "light_atlas/point_emitters.h"
 #include "light_atlas/vpl_transport.h"
-#include "raytrace/embree_ray_caster.h"
-#include "raytrace/scene_adapter.h"
 #include "uv/atlas_dilation.h"
 #include "uv/atlas_input.h"
-#include "uv/atlas_rasterizer.h"
 
 namespace gi {
 namespace {
@@ -35,45 +33,16 @@ engine::Status validate(const LightAtlasSettings& s) {
   return {};
 }
 
-// What every bake step reads: the path tracer's scene snapshot, a ray caster over the static
-// instances only (dynamic objects move, so they must not shadow the baked world), the atlas
-// texels and the emitters.
-struct BakeScene {
-  ReferenceScene scene;
-  ReferenceSceneIndex index;
-  std::unique_ptr<RayCaster> caster;
-  AtlasTexels texels;
-  float texel_area_m2 = 0.0f;
+// The static scene (bake/static_scene.h) with the static lights, and their point emitters.
+struct BakeScene : StaticBakeScene {
   std::vector<PointEmitter> emitters;
 };
 
 engine::Result<BakeScene> prepare(const engine::Scene& scene, const AtlasLayout& layout, const LightAtlasSettings& s) {
-  BakeScene b;
-  b.scene = reference_scene_from(scene);
   // Lights that move belong to PRM (DESIGN.md 3): the atlas bakes the static ones only.
-  // reference_scene_from() lists the enabled lights in registry order; drop the moving ones.
-  std::vector<ReferenceLight> kept;
-  std::size_t k = 0;
-  scene.registry.view<engine::Light, engine::WorldTransform>().each(
-      [&](engine::Entity, const engine::Light& light, const engine::WorldTransform&) {
-        if (!light.enabled) return;
-        if (!light.moves && k < b.scene.lights.size()) kept.push_back(b.scene.lights[k]);
-        ++k;
-      });
-  b.scene.lights = std::move(kept);
-  auto index = index_reference_scene(b.scene);
-  if (!index) return index.error();
-  b.index = std::move(index).value();
-  RtSceneData statics;
-  statics.geometries = b.scene.geometry.geometries;
-  for (const RtInstance& inst : b.scene.geometry.instances)
-    if (!inst.dynamic) statics.instances.push_back(inst);
-  if (statics.instances.empty()) return engine::Error{.message = "the scene has no static mesh to bake a light atlas for"};
-  auto caster = make_embree_ray_caster(statics);
-  if (!caster) return caster.error();
-  b.caster = std::move(caster).value();
-  b.texels = rasterize_atlas(layout, atlas_inputs_from(scene.assets));
-  b.texel_area_m2 = 1.0f / (layout.texels_per_metre * layout.texels_per_metre);
+  auto prepared = prepare_static_scene(scene, layout, BakeLights::Static);
+  if (!prepared) return prepared.error();
+  BakeScene b{std::move(prepared).value(), {}};
   b.emitters = point_emitters(b.scene, b.index, s.area_light_samples, s.seed);
   return b;
 }
@@ -166,7 +135,8 @@ engine::Result<LightAtlasBake> bake_light_atlas(const engine::Scene& scene, cons
   out.irradiance = std::move(final_result->irradiance);
   std::uint64_t rays = powers->rays + final_result->rays;
   if (settings.include_direct) {
-    const std::vector<glm::vec3> direct = direct_into_atlas(b.emitters, b.texels, b.texel_area_m2, *b.caster, pool, &rays);
+    const float texel_area = 1.0f / (out.layout.texels_per_metre * out.layout.texels_per_metre);
+    const std::vector<glm::vec3> direct = direct_into_atlas(b.emitters, b.texels, texel_area, *b.caster, pool, &rays);
     for (std::size_t t = 0; t < direct.size(); ++t) out.irradiance[t] += direct[t];
   }
   out.stats.final_seconds = seconds_since(t0);

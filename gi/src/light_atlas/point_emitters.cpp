@@ -126,6 +126,31 @@ glm::vec3 emitter_irradiance(const PointEmitter& e, const glm::vec3& p, const gl
   return e.radiant * atten;
 }
 
+double punctual_lit_solid_angle(const PointEmitter& e, const RayCaster& caster, int side,
+                                std::vector<LitDirection>* hits) {
+  double sum = 0.0;
+  const float per_direction = 4.0f * kPi / static_cast<float>(side * side);
+  for (int a = 0; a < side; ++a)
+    for (int b = 0; b < side; ++b) {
+      const float z = 1.0f - 2.0f * (static_cast<float>(a) + 0.5f) / static_cast<float>(side);
+      const float phi = 2.0f * kPi * (static_cast<float>(b) + 0.5f) / static_cast<float>(side);
+      const float r = std::sqrt(std::max(0.0f, 1.0f - z * z));
+      const glm::vec3 w(r * std::cos(phi), r * std::sin(phi), z);
+      float weight = e.spot ? spot_cone(e.direction, e.cos_outer, e.cos_inner, -w) : 1.0f;
+      if (weight <= 0.0f) continue;
+      const Hit h = caster.intersect(Ray{e.position, 0.0f, w});
+      if (!h.valid()) continue;
+      // The back of a one-sided surface receives nothing (a light inside a closed box or
+      // behind a wall lights only those).
+      const glm::vec3 n = glm::normalize(h.geometric_normal);
+      if (glm::dot(n, w) >= 0.0f) continue;
+      weight *= range_window(h.t, e.range_m);
+      sum += static_cast<double>(weight);
+      if (hits && weight > 0.0f) hits->push_back({e.position + w * h.t, n, weight * per_direction});
+    }
+  return static_cast<double>(per_direction) * sum;
+}
+
 bool segment_visible(const RayCaster& caster, const glm::vec3& a, const glm::vec3& na, const glm::vec3& b,
                      const glm::vec3& nb) {
   const glm::vec3 o = offset_ray_origin(a, na);

@@ -60,6 +60,19 @@ float lambertian_kernel(const glm::vec3& q, const glm::vec3& nq, float emitter_a
 /// Surface end points are moved off their surfaces (ray_offset.h) so neither self-shadows.
 bool emitter_visible(const RayCaster& caster, const PointEmitter& e, const glm::vec3& p, const glm::vec3& n);
 
+/// Solid angle (sr) of static geometry lit by punctual emitter e, weighted by its spot cone
+/// and range window: 4 pi / N x the sum over N = side^2 stratified directions of cone x
+/// window x hit (front faces only: the back of a one-sided surface receives nothing).
+/// I x this is the flux the light sends onto the scene. `hits` (optional)
+/// receives every hit point with the solid angle it stands for (weighted).
+struct LitDirection {
+  glm::vec3 point;
+  glm::vec3 normal;  ///< Unit geometric normal (front side, facing the light).
+  float solid_angle_sr;
+};
+double punctual_lit_solid_angle(const PointEmitter& e, const RayCaster& caster, int side,
+                                std::vector<LitDirection>* hits = nullptr);
+
 /// True when the segment between two surface points (each with its unit normal, on the
 /// side facing the other) is free.
 bool segment_visible(const RayCaster& caster, const glm::vec3& a, const glm::vec3& na, const glm::vec3& b,

@@ -7,35 +7,10 @@
 #include <unordered_map>
 
 #include "core/random.h"
-#include "raytrace/light_falloff.h"
 #include "raytrace/ray_offset.h"
 #include "raytrace/reference_brdf.h"
 
 namespace gi {
-
-namespace {
-
-// Solid angle (sr) of static geometry lit by punctual light e, weighted by its spot cone and
-// range window: 4 pi / N sum over N stratified directions of cone x window x hit.
-double lit_solid_angle(const PointEmitter& e, const RayCaster& caster, int side) {
-  double sum = 0.0;
-  for (int a = 0; a < side; ++a)
-    for (int b = 0; b < side; ++b) {
-      const float z = 1.0f - 2.0f * (static_cast<float>(a) + 0.5f) / static_cast<float>(side);
-      const float phi = 6.2831853f * (static_cast<float>(b) + 0.5f) / static_cast<float>(side);
-      const float r = std::sqrt(std::max(0.0f, 1.0f - z * z));
-      const glm::vec3 w(r * std::cos(phi), r * std::sin(phi), z);
-      float weight = e.spot ? spot_cone(e.direction, e.cos_outer, e.cos_inner, -w) : 1.0f;
-      if (weight <= 0.0f) continue;
-      const Hit h = caster.intersect(Ray{e.position, 0.0f, w});
-      if (!h.valid()) continue;
-      weight *= range_window(h.t, e.range_m);
-      sum += static_cast<double>(weight);
-    }
-  return 4.0 * 3.14159265358979 * sum / static_cast<double>(side * side);
-}
-
-}  // namespace
 
 std::vector<glm::vec3> direct_to_vpls(const VplSet& vpls, const std::vector<PointEmitter>& emitters,
                                       const RayCaster& caster, ThreadPool& pool, std::uint64_t* rays) {
@@ -85,7 +60,7 @@ std::vector<glm::vec3> direct_to_vpls(const VplSet& vpls, const std::vector<Poin
     double sampled = 0.0;
     for (std::size_t j = 0; j < n; ++j)
       sampled += static_cast<double>(vpls.area_m2[j]) * static_cast<double>(luminance(from_punctual[l][j]));
-    const double traced = static_cast<double>(lum_i) * lit_solid_angle(e, caster, kFluxSide);
+    const double traced = static_cast<double>(lum_i) * punctual_lit_solid_angle(e, caster, kFluxSide);
     ray_count += kFluxSide * kFluxSide;
     const double scale = sampled > 0.0 ? std::clamp(traced / sampled, 0.25, 4.0) : 1.0;
     for (std::size_t j = 0; j < n; ++j) out[j] += from_punctual[l][j] * static_cast<float>(scale);

@@ -1,0 +1,47 @@
+#include "bake/static_scene.h"
+
+#include "raytrace/embree_ray_caster.h"
+#include "raytrace/scene_adapter.h"
+#include "uv/atlas_input.h"
+
+namespace gi {
+
+std::vector<ReferenceLight> scene_lights(const engine::Scene& scene, BakeLights lights) {
+  // reference_scene_from() lists the enabled lights in registry order: pick from it.
+  const std::vector<ReferenceLight> all = reference_scene_from(scene).lights;
+  std::vector<ReferenceLight> kept;
+  std::size_t k = 0;
+  scene.registry.view<engine::Light, engine::WorldTransform>().each(
+      [&](engine::Entity, const engine::Light& light, const engine::WorldTransform&) {
+        if (!light.enabled) return;
+        const bool keep = lights == BakeLights::Static ? !light.moves : lights == BakeLights::Moving && light.moves;
+        if (keep && k < all.size()) kept.push_back(all[k]);
+        ++k;
+      });
+  return kept;
+}
+
+engine::Result<StaticBakeScene> prepare_static_scene(const engine::Scene& scene, const AtlasLayout& layout,
+                                                     BakeLights lights) {
+  StaticBakeScene b;
+  b.scene = reference_scene_from(scene);
+  b.scene.lights = scene_lights(scene, lights);
+  auto index = index_reference_scene(b.scene);
+  if (!index) return index.error();
+  b.index = std::move(index).value();
+  RtSceneData statics;
+  statics.geometries = b.scene.geometry.geometries;
+  for (std::size_t i = 0; i < b.scene.geometry.instances.size(); ++i) {
+    if (b.scene.geometry.instances[i].dynamic) continue;
+    statics.instances.push_back(b.scene.geometry.instances[i]);
+    b.static_instance.push_back(static_cast<std::uint32_t>(i));
+  }
+  if (statics.instances.empty()) return engine::Error{.message = "the scene has no static mesh to bake"};
+  auto caster = make_embree_ray_caster(statics);
+  if (!caster) return caster.error();
+  b.caster = std::move(caster).value();
+  b.texels = rasterize_atlas(layout, atlas_inputs_from(scene.assets));
+  return b;
+}
+
+}  // namespace gi

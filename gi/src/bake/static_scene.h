@@ -1,0 +1,50 @@
+#pragma once
+// What every baker of the static world reads: the path tracer's snapshot of the scene
+// (triangles, materials, lights), a ray caster over the static instances only (dynamic
+// objects move, so they must not shadow baked data) and the light-atlas texels the bake
+// fills (its reference points).
+//   auto s = gi::prepare_static_scene(scene, layout, gi::BakeLights::Static).value();
+//   bool lit = !s.caster->occluded(ray);
+
+#include <memory>
+
+#include <engine/result.h>
+#include <engine/scene.h>
+
+#include "raytrace/ray_caster.h"
+#include "raytrace/reference_scene.h"
+#include "uv/atlas_layout.h"
+#include "uv/atlas_rasterizer.h"
+
+namespace gi {
+
+/// Which of the scene's enabled lights the snapshot keeps.
+enum class BakeLights : std::uint8_t {
+  Static,  ///< Lights that do not move (the light atlas bakes them; moving ones are PRM's).
+  Moving,  ///< Lights flagged as moving (the flashlight, scripted lamps).
+  None,    ///< No light (PRM panes are light-independent).
+};
+
+struct StaticBakeScene {
+  ReferenceScene scene;
+  ReferenceSceneIndex index;
+  std::unique_ptr<RayCaster> caster;  ///< Static instances only.
+  /// Caster instance -> snapshot instance (scene.geometry.instances index).
+  std::vector<std::uint32_t> static_instance;
+  AtlasTexels texels;                 ///< The layout's texels.
+
+  /// The index.triangles entry a hit of `caster` landed on.
+  std::uint32_t triangle_of(const Hit& hit) const {
+    return index.instance_first[static_instance[hit.instance]] + hit.primitive;
+  }
+};
+
+/// Errors: invalid scene data (non-finite values...), no static mesh instance.
+engine::Result<StaticBakeScene> prepare_static_scene(const engine::Scene& scene, const AtlasLayout& layout,
+                                                     BakeLights lights);
+
+/// The enabled lights of `scene` of the given kind, as the path tracer sees them, in
+/// registry order.
+std::vector<ReferenceLight> scene_lights(const engine::Scene& scene, BakeLights lights);
+
+}  // namespace gi

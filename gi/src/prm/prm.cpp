@@ -1,0 +1,215 @@
+#include "prm/prm.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <numbers>
+#include <unordered_map>
+
+#include "bake/static_scene.h"
+#include "core/random.h"
+#include "core/thread_pool.h"
+#include "light_atlas/point_emitters.h"
+#include "light_atlas/vpl_set.h"
+#include "prm/entry_clusters.h"
+#include "raytrace/ray_offset.h"
+#include "uv/atlas_dilation.h"
+#include "uv/atlas_input.h"
+
+namespace gi {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+engine::Status validate(const PrmSettings& s) {
+  const auto bad = [](std::string what) { return engine::Error{.message = "PRM settings: " + what}; };
+  if (!(s.texels_per_metre > 0.0f) || s.texels_per_metre > kMaxTexelsPerMetre)
+    return bad("texels_per_metre " + std::to_string(s.texels_per_metre) + " is outside (0, 10^4]");
+  if (s.entry_points < 1 || s.entry_points > 1'000'000)
+    return bad("entry_points " + std::to_string(s.entry_points) + " is outside 1..10^6");
+  if (s.clusters < 1 || s.clusters > 65536) return bad("clusters " + std::to_string(s.clusters) + " is outside 1..65536");
+  if (!(s.splitting > 0.0f) || s.splitting > 1024.0f) return bad("splitting must be in (0, 1024]");
+  if (s.max_path_nodes < 1 || s.max_path_nodes > 4096) return bad("max_path_nodes must be in 1..4096");
+  return {};
+}
+
+// A path node acting as a virtual light: a diffuse emitter of `power` (W per unit
+// irradiance at its entry point) at `position` facing `normal`.
+struct PathNode {
+  glm::vec3 position;
+  glm::vec3 normal;
+  glm::vec3 power;
+};
+
+float max_component(const glm::vec3& v) { return std::max(v.x, std::max(v.y, v.z)); }
+
+// The random walks of one entry point (§4.1): N_s x a(y_1) paths, each carrying
+// albedo x area / (N_s a) so that every path has the same weight; cosine sampling from the
+// entry point, then at every hit Russian roulette with the hit's albedo and cosine
+// (diffuse) sampling. Every node is a virtual light: y_1 shines the first reflection, y_j
+// the j-th (eq. 2: the product of BRDFs over the path density leaves the albedos' ratio).
+std::vector<PathNode> random_walks(const VplSet& entries, std::size_t k, const StaticBakeScene& s,
+                                   const std::vector<glm::vec3>& triangle_albedo, const PrmSettings& settings,
+                                   std::uint64_t& rays, std::size_t& paths) {
+  std::vector<PathNode> nodes;
+  Pcg32 rng = Pcg32::for_item(settings.seed, k);
+  const glm::vec3 rho = entries.albedo[k];
+  const float a = max_component(rho);
+  if (!(a > 0.0f)) return nodes;
+  const float expected = settings.splitting * a;
+  auto count = static_cast<int>(expected);
+  if (rng.next_float() < expected - static_cast<float>(count)) ++count;
+  const glm::vec3 path_power = rho * entries.area_m2[k] / expected;
+  for (int p = 0; p < count; ++p) {
+    ++paths;
+    glm::vec3 position = entries.position[k];
+    glm::vec3 normal = entries.normal[k];
+    glm::vec3 power = path_power;
+    nodes.push_back({position, normal, power});
+    for (int depth = 1; depth < settings.max_path_nodes; ++depth) {
+      const float u1 = rng.next_float(), u2 = rng.next_float(), u_rr = rng.next_float();
+      const glm::vec3 dir = sample_cosine_hemisphere(normal, u1, u2);
+      ++rays;
+      const Hit hit = s.caster->intersect(Ray{offset_ray_origin(position, normal), 0.0f, dir});
+      if (!hit.valid()) break;
+      const glm::vec3 ng = glm::normalize(hit.geometric_normal);
+      if (glm::dot(ng, dir) >= 0.0f) break;  // the back of a one-sided surface absorbs
+      const std::uint32_t tri = s.triangle_of(hit);
+      const glm::vec3 albedo = triangle_albedo[tri];
+      const float q = std::min(1.0f, max_component(albedo));
+      if (!(u_rr < q)) break;
+      position = s.index.triangles[tri].p0 + hit.barycentric.x * s.index.triangles[tri].e1 +
+                 hit.barycentric.y * s.index.triangles[tri].e2;
+      normal = ng;
+      power *= albedo / q;
+      nodes.push_back({position, normal, power});
+    }
+  }
+  return nodes;
+}
+
+}  // namespace
+
+engine::Result<Prm> bake_prm(const engine::Scene& scene, const PrmSettings& settings) {
+  if (auto ok = validate(settings); !ok) return ok.error();
+  const auto t_start = Clock::now();
+  const std::vector<AtlasInputMesh> inputs = atlas_inputs_from(scene.assets);
+  if (auto ok = validate_atlas_inputs(inputs); !ok) return ok.error();
+  auto layout = build_atlas_layout(inputs, {.texels_per_metre = settings.texels_per_metre});
+  if (!layout) return layout.error();
+  auto prepared = prepare_static_scene(scene, *layout, BakeLights::None);
+  if (!prepared) return prepared.error();
+  const StaticBakeScene& s = *prepared;
+  ThreadPool pool(settings.threads);
+
+  Prm prm;
+  prm.settings = settings;
+  prm.layout = std::move(layout).value();
+  prm.width = prm.layout.width;
+  prm.height = prm.layout.height;
+
+  // Entry points: stratified by area over the static surfaces (one sample per patch of the
+  // VPL distribution, so every chart keeps its exact area).
+  auto entries = distribute_vpls(s.scene, s.index, {.vpl_count = settings.entry_points, .samples_per_vpl = 1, .seed = settings.seed});
+  if (!entries) return entries.error();
+  const std::size_t n_entries = entries->size();
+  std::unordered_map<std::uint32_t, glm::vec3> material_albedo;
+  std::vector<glm::vec3> triangle_albedo(s.index.triangles.size());
+  for (std::size_t t = 0; t < triangle_albedo.size(); ++t) {
+    const std::uint32_t m = s.index.triangles[t].material;
+    auto it = material_albedo.find(m);
+    if (it == material_albedo.end()) it = material_albedo.emplace(m, hemispherical_albedo(s.scene.materials[m])).first;
+    triangle_albedo[t] = it->second;
+  }
+
+  // Clusters: the normal counts like a tenth of the scene's size.
+  const auto cluster_of = cluster_entry_points(entries->position, entries->normal, settings.clusters,
+                                               0.1f * std::max(s.index.scene_radius_m, 1e-6f), settings.kmeans ? 10 : 0);
+  prm.cluster_count = 0;
+  for (std::uint32_t c : cluster_of) prm.cluster_count = std::max(prm.cluster_count, static_cast<int>(c) + 1);
+  prm.cluster_size.assign(static_cast<std::size_t>(prm.cluster_count), 0);
+  for (std::size_t k = 0; k < n_entries; ++k) {
+    prm.entries.push_back({entries->position[k], entries->normal[k], entries->area_m2[k], cluster_of[k]});
+    ++prm.cluster_size[cluster_of[k]];
+  }
+
+  // Random walks, per entry point in parallel (each from its own stream).
+  auto t0 = Clock::now();
+  std::vector<std::vector<PathNode>> walks(n_entries);
+  std::vector<std::uint64_t> walk_rays(n_entries, 0);
+  std::vector<std::size_t> walk_paths(n_entries, 0);
+  pool.parallel_for(n_entries, [&](std::size_t k) {
+    walks[k] = random_walks(*entries, k, s, triangle_albedo, settings, walk_rays[k], walk_paths[k]);
+  });
+  for (std::size_t k = 0; k < n_entries; ++k) {
+    prm.stats.rays += walk_rays[k];
+    prm.stats.paths += walk_paths[k];
+    prm.stats.path_nodes += walks[k].size();
+  }
+  prm.stats.walk_seconds = seconds_since(t0);
+  if (settings.progress && !settings.progress(0.05)) return engine::Error{.message = "PRM bake cancelled"};
+
+  // Items (eq. 3): every virtual light connected to every reference point it sees, summed
+  // per (cluster, texel). Parallel over texels; each texel visits the nodes in a fixed
+  // order, so the sums do not depend on the thread count. The near field is regularized by
+  // the entry point's area (cos cos / (pi d^2 + A), point_emitters.h).
+  t0 = Clock::now();
+  const AtlasTexels& tex = s.texels;
+  std::vector<std::uint32_t> valid;
+  for (std::size_t t = 0; t < tex.valid.size(); ++t)
+    if (tex.valid[t]) valid.push_back(static_cast<std::uint32_t>(t));
+  const auto clusters = static_cast<std::size_t>(prm.cluster_count);
+  std::vector<glm::vec3> full(clusters * tex.valid.size(), glm::vec3(0.0f));  // [cluster][texel]
+  std::atomic<std::uint64_t> rays{0};
+  const std::size_t batches = std::clamp<std::size_t>(valid.size() / 64, 1, 100);
+  for (std::size_t b = 0; b < batches; ++b) {
+    const std::size_t begin = valid.size() * b / batches, end = valid.size() * (b + 1) / batches;
+    pool.parallel_for(
+        end - begin,
+        [&](std::size_t w) {
+          const std::uint32_t t = valid[begin + w];
+          const glm::vec3 p = tex.position[t], n = tex.normal[t];
+          std::vector<glm::dvec3> sum(clusters, glm::dvec3(0.0));
+          std::uint64_t local = 0;
+          for (std::size_t k = 0; k < n_entries; ++k) {
+            const float area = prm.entries[k].area_m2 / settings.splitting;
+            glm::dvec3 item(0.0);
+            for (const PathNode& v : walks[k]) {
+              const float f = lambertian_kernel(v.position, v.normal, area, false, p, n, 0.0f);
+              if (f <= 0.0f) continue;
+              ++local;
+              if (segment_visible(*s.caster, p, n, v.position, v.normal)) item += glm::dvec3(v.power) * static_cast<double>(f);
+            }
+            sum[prm.entries[k].cluster] += item;
+          }
+          for (std::size_t c = 0; c < clusters; ++c) full[c * tex.valid.size() + t] = glm::vec3(sum[c]);
+          rays += local;
+        },
+        4);
+    if (settings.progress && !settings.progress(0.05 + 0.9 * static_cast<double>(b + 1) / static_cast<double>(batches)))
+      return engine::Error{.message = "PRM bake cancelled"};
+  }
+  prm.stats.rays += rays.load();
+
+  // Dilation is linear: dilate every pane like the light atlas, keep the filled texels.
+  const int rings = std::max(4, prm.layout.padding_texels);
+  std::vector<std::uint8_t> filled;
+  for (std::size_t c = 0; c < clusters; ++c)
+    filled = dilate<glm::vec3>(std::span<glm::vec3>(full.data() + c * tex.valid.size(), tex.valid.size()), prm.width,
+                               prm.height, tex.valid, rings);
+  if (clusters == 0) filled = tex.valid;
+  for (std::size_t t = 0; t < filled.size(); ++t)
+    if (filled[t]) prm.texels.push_back(static_cast<std::uint32_t>(t));
+  prm.panes.resize(clusters * prm.texels.size() * 3);
+  for (std::size_t c = 0; c < clusters; ++c)
+    for (std::size_t i = 0; i < prm.texels.size(); ++i)
+      for (int ch = 0; ch < 3; ++ch)
+        prm.panes[(c * prm.texels.size() + i) * 3 + static_cast<std::size_t>(ch)] = full[c * tex.valid.size() + prm.texels[i]][ch];
+  prm.stats.pane_seconds = seconds_since(t0);
+  prm.stats.total_seconds = seconds_since(t_start);
+  return prm;
+}
+
+}  // namespace gi
