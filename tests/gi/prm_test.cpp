@@ -8,7 +8,6 @@
 #include <engine/scene.h>
 
 #include "bake/static_scene.h"
-#include "light_atlas/point_emitters.h"
 #include "metrics/error_metrics.h"
 #include "prm/entry_clusters.h"
 #include "prm/prm.h"
@@ -39,11 +38,9 @@ void place_spot(engine::Scene& scene, glm::vec3 position, glm::vec3 direction) {
 
 // The PRM's irradiance atlas for the scene's moving lights (all clusters).
 std::vector<glm::vec3> relight(const gi::Prm& prm, const engine::Scene& scene, int k = 0) {
-  auto s = gi::prepare_static_scene(scene, prm.layout, gi::BakeLights::Moving);
-  EXPECT_TRUE(s);
-  const auto emitters = gi::point_emitters(s->scene, s->index, 16, 1);
-  const auto e = gi::entry_irradiance(prm, emitters, *s->caster);
-  return gi::sum_panes(prm, gi::select_clusters(gi::cluster_weights(prm, e), k));
+  auto caster = gi::make_static_caster(scene);
+  EXPECT_TRUE(caster);
+  return gi::sum_panes(prm, gi::relight_clusters(prm, gi::scene_lights(scene, gi::BakeLights::Moving), **caster, k));
 }
 
 gi::RgbField field(int w, int h, const std::vector<glm::vec3>& v, const std::vector<std::uint8_t>& valid) {

@@ -21,6 +21,28 @@ std::vector<ReferenceLight> scene_lights(const engine::Scene& scene, BakeLights 
   return kept;
 }
 
+namespace {
+
+// The static instances of `data` with, per kept instance, its index in `data`.
+RtSceneData static_only(const RtSceneData& data, std::vector<std::uint32_t>* kept) {
+  RtSceneData statics;
+  statics.geometries = data.geometries;
+  for (std::size_t i = 0; i < data.instances.size(); ++i) {
+    if (data.instances[i].dynamic) continue;
+    statics.instances.push_back(data.instances[i]);
+    if (kept) kept->push_back(static_cast<std::uint32_t>(i));
+  }
+  return statics;
+}
+
+}  // namespace
+
+engine::Result<std::unique_ptr<RayCaster>> make_static_caster(const engine::Scene& scene) {
+  const RtSceneData statics = static_only(rt_scene_from(scene), nullptr);
+  if (statics.instances.empty()) return engine::Error{.message = "the scene has no static mesh"};
+  return make_embree_ray_caster(statics);
+}
+
 engine::Result<StaticBakeScene> prepare_static_scene(const engine::Scene& scene, const AtlasLayout& layout,
                                                      BakeLights lights) {
   StaticBakeScene b;
@@ -29,13 +51,7 @@ engine::Result<StaticBakeScene> prepare_static_scene(const engine::Scene& scene,
   auto index = index_reference_scene(b.scene);
   if (!index) return index.error();
   b.index = std::move(index).value();
-  RtSceneData statics;
-  statics.geometries = b.scene.geometry.geometries;
-  for (std::size_t i = 0; i < b.scene.geometry.instances.size(); ++i) {
-    if (b.scene.geometry.instances[i].dynamic) continue;
-    statics.instances.push_back(b.scene.geometry.instances[i]);
-    b.static_instance.push_back(static_cast<std::uint32_t>(i));
-  }
+  const RtSceneData statics = static_only(b.scene.geometry, &b.static_instance);
   if (statics.instances.empty()) return engine::Error{.message = "the scene has no static mesh to bake"};
   auto caster = make_embree_ray_caster(statics);
   if (!caster) return caster.error();

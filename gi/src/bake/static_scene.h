@@ -43,6 +43,10 @@ struct StaticBakeScene {
 engine::Result<StaticBakeScene> prepare_static_scene(const engine::Scene& scene, const AtlasLayout& layout,
                                                      BakeLights lights);
 
+/// A ray caster over the static mesh instances of `scene` (what a runtime relighting of the
+/// static world shadows with). Errors: no static instance, invalid data.
+engine::Result<std::unique_ptr<RayCaster>> make_static_caster(const engine::Scene& scene);
+
 /// The enabled lights of `scene` of the given kind, as the path tracer sees them, in
 /// registry order.
 std::vector<ReferenceLight> scene_lights(const engine::Scene& scene, BakeLights lights);

@@ -26,13 +26,14 @@ void stratified(int side, Pcg32& rng, Place place) {
 
 }  // namespace
 
-std::vector<PointEmitter> point_emitters(const ReferenceScene& scene, const ReferenceSceneIndex& index,
-                                         int area_samples, std::uint64_t seed) {
+std::vector<PointEmitter> light_point_emitters(std::span<const ReferenceLight> lights, int area_samples,
+                                               std::uint64_t seed, const std::vector<bool>* skip) {
   const int side = std::max(1, static_cast<int>(std::ceil(std::sqrt(static_cast<double>(std::max(1, area_samples))))));
   const auto strata = static_cast<float>(side * side);
   std::vector<PointEmitter> out;
-  for (std::size_t i = 0; i < scene.lights.size(); ++i) {
-    const ReferenceLight& l = scene.lights[i];
+  for (std::size_t i = 0; i < lights.size(); ++i) {
+    if (skip && i < skip->size() && (*skip)[i]) continue;
+    const ReferenceLight& l = lights[i];
     PointEmitter e;
     e.position = l.position;
     e.direction = l.direction;
@@ -51,7 +52,6 @@ std::vector<PointEmitter> point_emitters(const ReferenceScene& scene, const Refe
         out.push_back(e);
         break;
       case ReferenceLight::Type::Area: {
-        if (index.light_has_proxy[i]) break;  // its emissive geometry stands for it
         const float area = 4.0f * glm::length(l.half_x) * glm::length(l.half_y);
         if (!(area > 0.0f)) break;
         Pcg32 rng = Pcg32::for_item(seed, 0x4c000000ULL + i);
@@ -68,6 +68,18 @@ std::vector<PointEmitter> point_emitters(const ReferenceScene& scene, const Refe
       }
     }
   }
+  return out;
+}
+
+std::vector<PointEmitter> point_emitters(const ReferenceScene& scene, const ReferenceSceneIndex& index,
+                                         int area_samples, std::uint64_t seed) {
+  // Area lights drawn by an emissive proxy come from the proxy's triangles below.
+  std::vector<bool> proxied(scene.lights.size(), false);
+  for (std::size_t i = 0; i < scene.lights.size(); ++i)
+    proxied[i] = scene.lights[i].type == ReferenceLight::Type::Area && index.light_has_proxy[i];
+  std::vector<PointEmitter> out = light_point_emitters(scene.lights, area_samples, seed, &proxied);
+  const int side = std::max(1, static_cast<int>(std::ceil(std::sqrt(static_cast<double>(std::max(1, area_samples))))));
+  const auto strata = static_cast<float>(side * side);
   // Emissive triangles of static instances.
   const auto& instances = scene.geometry.instances;
   for (std::size_t k = 0; k < instances.size(); ++k) {

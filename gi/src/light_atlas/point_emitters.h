@@ -15,6 +15,7 @@
 //   glm::vec3 e = gi::emitter_irradiance(emitters[0], p, n, texel_area);
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -46,6 +47,12 @@ struct PointEmitter {
 /// of at least that many strata, jittered from `seed`).
 std::vector<PointEmitter> point_emitters(const ReferenceScene& scene, const ReferenceSceneIndex& index,
                                          int area_samples, std::uint64_t seed);
+
+/// Point emitters of `lights` alone (no emissive geometry; area lights become `area_samples`
+/// Lambertian points each): what a runtime relighting of moving lights needs.
+/// `skip[i]` (optional, same size) leaves light i out.
+std::vector<PointEmitter> light_point_emitters(std::span<const ReferenceLight> lights, int area_samples,
+                                               std::uint64_t seed, const std::vector<bool>* skip = nullptr);
 
 /// Unshadowed irradiance (W/m^2) at point p with unit normal n, the receiver standing for
 /// `receiver_area_m2`, from emitter e (the regularized kernels above).

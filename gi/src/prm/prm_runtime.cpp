@@ -88,6 +88,12 @@ std::vector<ClusterWeight> select_clusters(std::span<const glm::vec3> weights, i
   return out;
 }
 
+std::vector<ClusterWeight> relight_clusters(const Prm& prm, std::span<const ReferenceLight> lights,
+                                            const RayCaster& caster, int k) {
+  const std::vector<PointEmitter> emitters = light_point_emitters(lights, 16, prm.settings.seed);
+  return select_clusters(cluster_weights(prm, entry_irradiance(prm, emitters, caster)), k);
+}
+
 std::vector<glm::vec3> sum_panes(const Prm& prm, std::span<const ClusterWeight> selected) {
   std::vector<glm::vec3> out(static_cast<std::size_t>(prm.width) * static_cast<std::size_t>(prm.height), glm::vec3(0.0f));
   const std::size_t n = prm.pane_size();

@@ -40,6 +40,11 @@ struct ClusterWeight {
 /// are never selected (k <= 0: all non-zero clusters).
 std::vector<ClusterWeight> select_clusters(std::span<const glm::vec3> weights, int k);
 
+/// The whole per-light-change step: point emitters of `lights` (16 points per area light),
+/// entry irradiance, cluster weights and the `k` heaviest clusters (k <= 0: all).
+std::vector<ClusterWeight> relight_clusters(const Prm& prm, std::span<const ReferenceLight> lights,
+                                            const RayCaster& caster, int k);
+
 /// sum over `selected` of weight x pane, written to an atlas of width x height texels (0
 /// outside the panes' texels). The CPU twin of PrmGpuPass::run.
 std::vector<glm::vec3> sum_panes(const Prm& prm, std::span<const ClusterWeight> selected);

@@ -1,6 +1,7 @@
 #include "sweep/builtin_methods.h"
 
 #include "light_atlas/light_atlas_sweep.h"
+#include "prm/prm_sweep.h"
 #include "raytrace/reference_sweep.h"
 
 namespace gi {
@@ -10,6 +11,7 @@ void register_builtin_sweep_methods(SweepRegistry& registry) {
   // and its own spp / bounces curve ("pathtracer").
   register_reference_sweep(registry);
   register_light_atlas_sweep(registry);
+  register_prm_sweep(registry);
   //
   // GI METHODS (light atlas, PRM, DLM, BRF, antiradiance) register here as they land, one
   // add_method per method, with every quality knob declared (DESIGN.md 3, "Accuracy and its
