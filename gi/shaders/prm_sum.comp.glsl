@@ -5,9 +5,10 @@
 // invocation per pane element; work groups on a 2-D grid when one row would exceed 65535.
 //
 // Pane storage (prm_gpu_pass.cpp writes it): each pane is a run of half floats, three per
-// element (R, G, B) packed tightly, two halves per uint: element i's halves are 3i..3i+2, so
-// it spans words floor(3i/2) and floor(3i/2) + 1 (starting at the low half when i is even,
-// at the high half when odd). Every pane was scaled by a power of two before packing so its
+// element (R, G, B) packed tightly, two halves per uint (low half first): element i's halves
+// are 3i..3i+2, so the pair of elements (2j, 2j+1) fills words 3j..3j+2 exactly. One
+// invocation sums one pair: three word loads for two elements (llvmpipe gathers SSBO loads
+// lane by lane, so loads per element set the speed). Every pane was scaled by a power of two before packing so its
 // largest value sits just below 2^15 (no overflow, full half precision); the inverse scale
 // is folded into the weight, so weight * unpacked value is the true contribution.
 //
@@ -39,31 +40,36 @@ const uint kModeZero = 0u;
 const uint kModeBase = 1u;
 const uint kModeAccumulate = 2u;
 
-vec3 pane_value(uint pane_offset, uint element) {
-  const uint first_half = 3u * element;
-  const uint word = pane_offset + (first_half >> 1u);
-  const vec2 a = unpackHalf2x16(pane_words[word]);
-  const vec2 b = unpackHalf2x16(pane_words[word + 1u]);
-  return (first_half & 1u) == 0u ? vec3(a.x, a.y, b.x) : vec3(a.y, b.x, b.y);
-}
-
 void main() {
   const uint group = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
-  const uint element = group * gl_WorkGroupSize.x + gl_LocalInvocationIndex;
-  if (element >= u_element_count) return;
+  const uint pair = group * gl_WorkGroupSize.x + gl_LocalInvocationIndex;
+  const uint first = 2u * pair;
+  if (first >= u_element_count) return;
+  const bool has_second = first + 1u < u_element_count;
 
-  const uint texel = texels[element];
-  const ivec2 coord = ivec2(int(texel % u_atlas_width), int(texel / u_atlas_width));
+  const uint texel0 = texels[first];
+  const uint texel1 = has_second ? texels[first + 1u] : texel0;
+  const ivec2 coord0 = ivec2(int(texel0 % u_atlas_width), int(texel0 / u_atlas_width));
+  const ivec2 coord1 = ivec2(int(texel1 % u_atlas_width), int(texel1 / u_atlas_width));
 
-  vec3 sum = vec3(0.0);
+  vec3 sum0 = vec3(0.0);
+  vec3 sum1 = vec3(0.0);
   if (u_mode == kModeBase) {
-    sum = imageLoad(base_image, coord).xyz;
+    sum0 = imageLoad(base_image, coord0).xyz;
+    sum1 = imageLoad(base_image, coord1).xyz;
   } else if (u_mode == kModeAccumulate) {
-    sum = imageLoad(out_image, coord).xyz;
+    sum0 = imageLoad(out_image, coord0).xyz;
+    sum1 = imageLoad(out_image, coord1).xyz;
   }
   for (uint k = 0u; k < u_weight_count; ++k) {
     const PaneWeight w = weights[u_first_weight + k];
-    sum += w.weight * pane_value(w.pane_offset, element);
+    const uint word = w.pane_offset + 3u * pair;  // the pair's six halves: R0 G0 | B0 R1 | G1 B1
+    const vec2 a = unpackHalf2x16(pane_words[word]);
+    const vec2 b = unpackHalf2x16(pane_words[word + 1u]);
+    const vec2 c = unpackHalf2x16(pane_words[word + 2u]);
+    sum0 += w.weight * vec3(a.x, a.y, b.x);
+    sum1 += w.weight * vec3(b.y, c.x, c.y);
   }
-  imageStore(out_image, coord, vec4(sum, 1.0));
+  imageStore(out_image, coord0, vec4(sum0, 1.0));
+  if (has_second) imageStore(out_image, coord1, vec4(sum1, 1.0));
 }

@@ -247,25 +247,24 @@ TEST(PrmGpuPass, WideDynamicRangeKeepsRelativePrecision) {
   }
 }
 
-TEST(PrmGpuPass, LargePaneSetsUseATwoDimensionalGrid) {
+TEST(PrmGpuPass, WrapsWorkGroupsIntoATwoDimensionalGrid) {
   auto ctx = headless_or_fail();
-  // 2100 x 2100 pane texels: 68906 work groups of 64, above the 65535 of one dimension.
-  gi::Prm prm;
-  prm.width = prm.height = 2100;
-  prm.cluster_count = 1;
-  prm.texels.resize(2100u * 2100u);
-  for (std::uint32_t t = 0; t < prm.texels.size(); ++t) prm.texels[t] = t;
-  prm.panes.resize(prm.texels.size() * 3);
+  // Real atlases reach the 65535 groups of one dimension above 2 x 64 x 65535 texels; the
+  // test hook wraps after 2 groups instead, so 37 x 23 (~570 texels, 5 groups of 128) needs
+  // a 2 x 3 grid whose last group is out of range. Integer panes up to 1024 are exact in
+  // half, so the sum must be exact.
+  gi::Prm prm = synthetic_prm(37, 23, 2);
   for (std::size_t f = 0; f < prm.panes.size(); ++f) prm.panes[f] = static_cast<float>(f % 1024) + 1.0f;
-  auto pass = gi::PrmGpuPass::create(prm);
+  auto pass = gi::PrmGpuPass::create(prm, {.max_groups_x = 2});
   ASSERT_TRUE(pass.ok()) << pass.error().to_string();
-  const std::vector<gi::ClusterWeight> w{{0, glm::vec3(1.0f, 2.0f, 0.5f)}};
+  const std::vector<gi::ClusterWeight> w{{1, glm::vec3(1.0f, 2.0f, 0.5f)}};
   ASSERT_TRUE(pass->run(w).ok());
   const auto atlas = pass->read_back();
-  // Integers up to 1024 are exact in half.
-  for (std::size_t t = 0; t < atlas.size(); ++t) {
-    const glm::vec3 expected(prm.panes[3 * t] * 1.0f, prm.panes[3 * t + 1] * 2.0f, prm.panes[3 * t + 2] * 0.5f);
-    ASSERT_EQ(atlas[t], expected) << "texel " << t;
+  const std::size_t n = prm.texels.size();
+  ASSERT_GT(n, 4u * 128u);
+  for (std::size_t i = 0; i < n; ++i) {
+    const float* p = &prm.panes[(n + i) * 3];
+    ASSERT_EQ(atlas[prm.texels[i]], glm::vec3(p[0] * 1.0f, p[1] * 2.0f, p[2] * 0.5f)) << "element " << i;
   }
 }
 

@@ -17,7 +17,7 @@ namespace {
 
 constexpr const char* kWhere = "PRM GPU pass";
 constexpr std::size_t kSsboLimitBytes = std::size_t{128} << 20;  // DESIGN.md §4 (llvmpipe)
-constexpr std::uint32_t kGroupSize = 64;                        // local_size_x of prm_sum.comp.glsl
+constexpr std::uint32_t kGroupSize = 64;  // local_size_x of prm_sum.comp.glsl; an invocation sums 2 elements
 constexpr std::uint32_t kMaxGroupsPerDimension = 65535;
 
 /// The weight of one selected cluster as prm_sum.comp.glsl reads it (std430 PaneWeight).
@@ -32,9 +32,10 @@ enum class SumMode : std::uint32_t { Zero = 0, Base = 1, Accumulate = 2 };
 
 engine::Error error(std::string message) { return engine::Error{"", kWhere, std::move(message)}; }
 
-/// Words of one packed pane: 3 halves per element, two per word, rounded up to 16 bytes.
+/// Words of one packed pane: 3 halves per element, two per word, whole element pairs (the
+/// shader reads a pair's three words even for a lone last element), rounded up to 16 bytes.
 std::size_t pane_stride_words(std::size_t elements) {
-  const std::size_t words = (3 * elements + 1) / 2;
+  const std::size_t words = 3 * ((elements + 1) / 2);
   return (words + 3) / 4 * 4;
 }
 
@@ -109,6 +110,8 @@ engine::Result<PrmGpuPass> PrmGpuPass::create(const Prm& prm, const PrmGpuPassOp
   pass.width_ = prm.width;
   pass.height_ = prm.height;
   pass.element_count_ = static_cast<std::uint32_t>(elements);
+  pass.max_groups_x_ = options.max_groups_x > 0 ? std::min(options.max_groups_x, kMaxGroupsPerDimension)
+                                                : kMaxGroupsPerDimension;
 
   auto program = engine::ShaderProgramBuilder(gi_shader_files())
                      .stage(engine::ShaderStage::Compute, "prm_sum.comp.glsl")
@@ -197,8 +200,9 @@ engine::Status PrmGpuPass::run(std::span<const ClusterWeight> selected) {
   glBindImageTexture(0, output_.id(), 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
   glBindImageTexture(1, base_.id(), 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
 
-  const std::uint32_t groups = (element_count_ + kGroupSize - 1) / kGroupSize;
-  const std::uint32_t groups_x = std::min(groups, kMaxGroupsPerDimension);
+  const std::uint32_t pairs = element_count_ / 2 + element_count_ % 2;
+  const std::uint32_t groups = (pairs + kGroupSize - 1) / kGroupSize;
+  const std::uint32_t groups_x = std::min(groups, max_groups_x_);
   const std::uint32_t groups_y = (groups + groups_x - 1) / groups_x;
 
   // One dispatch per buffer holding a selected pane; K = 0 still needs one to write the

@@ -38,6 +38,9 @@ struct PrmGpuPassOptions {
   /// (whole panes each) above it. 0: the driver's GL_MAX_SHADER_STORAGE_BLOCK_SIZE, at most
   /// 128 MiB. Tests set it small to exercise the split.
   std::size_t max_buffer_bytes = 0;
+  /// Work groups along x before the grid wraps into y. 0: GL's minimum limit, 65535. Tests
+  /// set it small to exercise the 2-D grid.
+  std::uint32_t max_groups_x = 0;
 };
 
 /// Sums weighted PRM panes into an irradiance atlas texture on the GPU. Move-only; owns its
@@ -110,6 +113,7 @@ class PrmGpuPass {
   int width_ = 0;
   int height_ = 0;
   std::uint32_t element_count_ = 0;
+  std::uint32_t max_groups_x_ = 65535;
 };
 
 }  // namespace gi
