@@ -1,0 +1,119 @@
+#pragma once
+// The PRM runtime sum on the GPU (Szécsi et al. 2006, §5.2): the weighted sum of the
+// selected clusters' panes, written into an RGBA32F irradiance atlas texture, the GPU twin
+// of gi::sum_panes (prm_runtime.h). Panes are uploaded once, as half floats; a run uploads
+// only the K weights and dispatches one compute pass (gi/shaders/prm_sum.comp.glsl).
+//   auto pass = gi::PrmGpuPass::create(prm).value();            // a GL context is current
+//   if (auto s = pass.run(gi::select_clusters(weights, 32)); !s) { /* s.error() */ }
+//   // pass.texture(): irradiance (W/m^2) per atlas texel, 0 outside the panes' texels
+//
+// Precision: pane values are stored as half floats after a per-pane power-of-two scale
+// (exact, folded into the weight), so each pane value carries a relative rounding error of
+// at most 2^-11 (~4.9e-4) whatever its magnitude, down to 2^-29 of its pane's largest value
+// (smaller values are absolute errors below 2^-40 of it). Sums, weights and the atlas are
+// 32-bit floats: a texel's error is at most ~5e-4 x sum_k |weight_k| |pane_k| plus float
+// rounding.
+//
+// GL state: create(), run(), set_base() and read_back() need the creating context current
+// and change the bound program, shader-storage bindings 0-2 and image units 0-1.
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include <engine/gpu/gl_objects.h>
+#include <engine/gpu/shader_program.h>
+#include <engine/result.h>
+
+#include "prm/prm.h"
+#include "prm/prm_runtime.h"
+
+namespace gi {
+
+struct PrmGpuPassOptions {
+  /// Largest pane buffer (bytes) bound as one SSBO; panes are split over several buffers
+  /// (whole panes each) above it. 0: the driver's GL_MAX_SHADER_STORAGE_BLOCK_SIZE, at most
+  /// 128 MiB. Tests set it small to exercise the split.
+  std::size_t max_buffer_bytes = 0;
+  /// Work groups along x before the grid wraps into y. 0: GL's minimum limit, 65535. Tests
+  /// set it small to exercise the 2-D grid.
+  std::uint32_t max_groups_x = 0;
+};
+
+/// Sums weighted PRM panes into an irradiance atlas texture on the GPU. Move-only; owns its
+/// GL objects (moved-from: empty).
+///   auto pass = gi::PrmGpuPass::create(prm).value();
+///   pass.run(selected);   // then sample pass.texture() like a light atlas
+class PrmGpuPass {
+ public:
+  /// Compiles the shader, uploads `prm`'s texels and all its panes and creates the
+  /// width x height RGBA32F output texture (linear filtering, clamped, all zero). Errors:
+  /// inconsistent sizes, texels not ascending or outside the atlas, non-finite pane values,
+  /// one pane or the texel list larger than the SSBO limit, atlas above the texture limit,
+  /// shader build failure.
+  static engine::Result<PrmGpuPass> create(const Prm& prm, const PrmGpuPassOptions& options = {});
+
+  PrmGpuPass() = default;
+  PrmGpuPass(PrmGpuPass&&) noexcept = default;
+  PrmGpuPass& operator=(PrmGpuPass&&) noexcept = default;
+  PrmGpuPass(const PrmGpuPass&) = delete;
+  PrmGpuPass& operator=(const PrmGpuPass&) = delete;
+  ~PrmGpuPass() = default;
+
+  /// Writes base + sum over `selected` of weight x pane into every pane texel (texels outside
+  /// the panes keep 0). Overwrites the previous run. K = 0 writes the base (or 0). A cluster
+  /// listed twice counts twice. Ends with a memory barrier for texture fetches, image access
+  /// and read-back. Error: a cluster index >= cluster_count.
+  engine::Status run(std::span<const ClusterWeight> selected);
+
+  /// A base irradiance atlas (width x height texels, row-major) added at the pane texels by
+  /// every later run (e.g. a static-light atlas); an empty span removes it. Error: wrong size.
+  engine::Status set_base(std::span<const glm::vec3> base_atlas);
+
+  /// The RGBA32F output atlas (GL name; owned by the pass). Alpha is 1 at pane texels.
+  std::uint32_t texture() const { return output_.id(); }
+  /// The output atlas read back (width x height, row-major): for tests and tools.
+  std::vector<glm::vec3> read_back() const;
+  /// GPU memory held: texel list, pane buffers, weights, output and base textures (bytes).
+  std::size_t gpu_bytes() const;
+
+  int width() const { return width_; }
+  int height() const { return height_; }
+  /// Pane buffers the panes were split over (1 unless they exceed the SSBO limit).
+  std::size_t pane_buffer_count() const { return pane_buffers_.size(); }
+
+ private:
+  /// Where one cluster's pane lives: its buffer, its first word and its packing scale.
+  struct PaneLocation {
+    std::uint32_t buffer = 0;
+    std::uint32_t word_offset = 0;
+    float inverse_scale = 1.0f;
+  };
+  struct Uniforms {
+    int element_count = -1;
+    int atlas_width = -1;
+    int first_weight = -1;
+    int weight_count = -1;
+    int mode = -1;
+  };
+
+  engine::ShaderProgram program_;
+  Uniforms uniforms_;
+  engine::GlBuffer texels_;
+  std::vector<engine::GlBuffer> pane_buffers_;
+  std::vector<std::size_t> pane_buffer_bytes_;
+  std::vector<PaneLocation> panes_;
+  engine::GlBuffer weights_;
+  std::size_t weights_bytes_ = 0;  ///< Size of the last weight upload.
+  engine::GlTexture output_;
+  engine::GlTexture base_;
+  int width_ = 0;
+  int height_ = 0;
+  std::uint32_t element_count_ = 0;
+  std::uint32_t max_groups_x_ = 65535;
+};
+
+}  // namespace gi

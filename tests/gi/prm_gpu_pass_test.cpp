@@ -1,0 +1,325 @@
+// The PRM pane sum on the GPU (llvmpipe through EGL; fails, never skips, without a context)
+// against a CPU reference of the same formula (prm_runtime.h): atlas(texels[i]) = base +
+// sum_k weight_k x pane_k[i]. Panes travel as half floats, so the GPU sum must lie within
+// kRelativeTolerance x sum_k |weight_k| |pane_k[i]| (per channel) + kAbsoluteTolerance of the
+// reference: half rounding is at most 2^-11 (~4.9e-4) of each pane value, float
+// accumulation adds ~1e-7 per term.
+#include <engine/gpu/context.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <optional>
+#include <vector>
+
+#include "core/random.h"
+#include "prm/prm.h"
+#include "prm/prm_gpu_pass.h"
+#include "prm/prm_runtime.h"
+
+namespace {
+
+constexpr double kRelativeTolerance = 1e-3;
+constexpr double kAbsoluteTolerance = 1e-6;
+
+engine::GpuContext headless_or_fail() {
+  auto ctx = engine::GpuContext::create_headless();
+  if (!ctx) {
+    ADD_FAILURE() << "headless GL context creation failed: " << ctx.error().to_string();
+    std::abort();
+  }
+  return std::move(ctx).value();
+}
+
+// A hand-made PRM: a pseudo-random ascending two-thirds of the atlas texels, pane values
+// log-uniform in [min_value, max_value] per channel.
+gi::Prm synthetic_prm(int width, int height, int clusters, float min_value = 1e-3f, float max_value = 1e2f,
+                      std::uint64_t seed = 7) {
+  gi::Prm prm;
+  prm.width = width;
+  prm.height = height;
+  prm.cluster_count = clusters;
+  const auto atlas = static_cast<std::uint32_t>(width * height);
+  for (std::uint32_t t = 0; t < atlas; ++t)
+    if (gi::Pcg32::for_item(seed, t).next_u32() % 3 != 0) prm.texels.push_back(t);
+  const float decades = std::log10(max_value / min_value);
+  prm.panes.resize(static_cast<std::size_t>(clusters) * prm.texels.size() * 3);
+  for (std::size_t f = 0; f < prm.panes.size(); ++f) {
+    gi::Pcg32 rng = gi::Pcg32::for_item(seed + 1, f);
+    prm.panes[f] = min_value * std::pow(10.0f, decades * rng.next_float());
+  }
+  prm.cluster_size.assign(static_cast<std::size_t>(clusters), 1);
+  return prm;
+}
+
+// K clusters with distinct RGB weights in [0.05, 2], cluster ids spread over all clusters.
+std::vector<gi::ClusterWeight> pick(int clusters, int k, std::uint64_t seed) {
+  std::vector<gi::ClusterWeight> w;
+  for (int i = 0; i < k; ++i) {
+    gi::Pcg32 rng = gi::Pcg32::for_item(seed, static_cast<std::uint64_t>(i));
+    const auto cluster = static_cast<std::uint32_t>((i * 7 + static_cast<int>(seed)) % clusters);
+    w.push_back({cluster, glm::vec3(0.05f + 1.95f * rng.next_float(), 0.05f + 1.95f * rng.next_float(),
+                                    0.05f + 1.95f * rng.next_float())});
+  }
+  return w;
+}
+
+struct Reference {
+  std::vector<glm::dvec3> value;      // base + sum_k w_k pane_k, 0 outside the panes
+  std::vector<glm::dvec3> magnitude;  // sum_k |w_k| |pane_k|: the scale of the half error
+};
+
+Reference cpu_sum(const gi::Prm& prm, std::span<const gi::ClusterWeight> selected,
+                  std::span<const glm::vec3> base = {}) {
+  const std::size_t atlas = static_cast<std::size_t>(prm.width * prm.height);
+  Reference r{std::vector<glm::dvec3>(atlas, glm::dvec3(0.0)), std::vector<glm::dvec3>(atlas, glm::dvec3(0.0))};
+  const std::size_t n = prm.texels.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint32_t t = prm.texels[i];
+    if (!base.empty()) r.value[t] = glm::dvec3(base[t]);
+    for (const gi::ClusterWeight& w : selected)
+      for (int ch = 0; ch < 3; ++ch) {
+        const double p = prm.panes[(w.cluster * n + i) * 3 + static_cast<std::size_t>(ch)];
+        r.value[t][ch] += double(w.weight[ch]) * p;
+        r.magnitude[t][ch] += std::abs(double(w.weight[ch]) * p);
+      }
+  }
+  return r;
+}
+
+// Largest |gpu - ref| / (rel x magnitude + abs) over all texels and channels: <= 1 passes.
+double worst_error_ratio(const std::vector<glm::vec3>& gpu, const Reference& ref, double* max_relative = nullptr) {
+  EXPECT_EQ(gpu.size(), ref.value.size());
+  double worst = 0.0;
+  double worst_rel = 0.0;
+  for (std::size_t t = 0; t < std::min(gpu.size(), ref.value.size()); ++t)
+    for (int ch = 0; ch < 3; ++ch) {
+      const double err = std::abs(double(gpu[t][ch]) - ref.value[t][ch]);
+      worst = std::max(worst, err / (kRelativeTolerance * ref.magnitude[t][ch] + kAbsoluteTolerance));
+      if (ref.magnitude[t][ch] > 0.0) worst_rel = std::max(worst_rel, err / ref.magnitude[t][ch]);
+    }
+  if (max_relative != nullptr) *max_relative = worst_rel;
+  return worst;
+}
+
+std::vector<bool> pane_mask(const gi::Prm& prm) {
+  std::vector<bool> m(static_cast<std::size_t>(prm.width * prm.height), false);
+  for (std::uint32_t t : prm.texels) m[t] = true;
+  return m;
+}
+
+TEST(PrmGpuPass, MatchesCpuSumWithinHalfPrecision) {
+  auto ctx = headless_or_fail();
+  const gi::Prm prm = synthetic_prm(37, 23, 20);
+  auto pass = gi::PrmGpuPass::create(prm);
+  ASSERT_TRUE(pass.ok()) << pass.error().to_string();
+  EXPECT_EQ(pass->pane_buffer_count(), 1u);
+  EXPECT_NE(pass->texture(), 0u);
+  // Half panes: 6 bytes per element and pane.
+  EXPECT_GE(pass->gpu_bytes(), prm.texels.size() * 6 * 20);
+  for (int k : {1, 7, 20}) {
+    const auto selected = pick(20, k, static_cast<std::uint64_t>(k));
+    ASSERT_TRUE(pass->run(selected).ok());
+    double rel = 0.0;
+    EXPECT_LE(worst_error_ratio(pass->read_back(), cpu_sum(prm, selected), &rel), 1.0) << "K = " << k;
+    std::printf("K = %d: max |gpu - cpu| / sum_k |w_k pane_k| = %.3g\n", k, rel);
+  }
+}
+
+TEST(PrmGpuPass, TexelsOutsideThePanesStayZero) {
+  auto ctx = headless_or_fail();
+  const gi::Prm prm = synthetic_prm(37, 23, 20);
+  auto pass = gi::PrmGpuPass::create(prm);
+  ASSERT_TRUE(pass.ok()) << pass.error().to_string();
+  ASSERT_TRUE(pass->run(pick(20, 20, 3)).ok());
+  const auto atlas = pass->read_back();
+  const auto mask = pane_mask(prm);
+  std::size_t outside = 0;
+  for (std::size_t t = 0; t < atlas.size(); ++t) {
+    if (mask[t]) {
+      EXPECT_GT(atlas[t].x, 0.0f) << "pane texel " << t;
+      continue;
+    }
+    ++outside;
+    EXPECT_EQ(atlas[t], glm::vec3(0.0f)) << "texel " << t << " is outside the panes";
+  }
+  EXPECT_GT(outside, 100u);  // the synthetic subset leaves about a third out
+}
+
+TEST(PrmGpuPass, NoClustersSelectedGivesZeros) {
+  auto ctx = headless_or_fail();
+  const gi::Prm prm = synthetic_prm(37, 23, 20);
+  auto pass = gi::PrmGpuPass::create(prm);
+  ASSERT_TRUE(pass.ok()) << pass.error().to_string();
+  ASSERT_TRUE(pass->run(pick(20, 5, 1)).ok());  // something to overwrite
+  ASSERT_TRUE(pass->run({}).ok());
+  for (const glm::vec3& v : pass->read_back()) ASSERT_EQ(v, glm::vec3(0.0f));
+}
+
+TEST(PrmGpuPass, RerunOverwritesInsteadOfAccumulating) {
+  auto ctx = headless_or_fail();
+  const gi::Prm prm = synthetic_prm(37, 23, 20);
+  auto pass = gi::PrmGpuPass::create(prm);
+  ASSERT_TRUE(pass.ok()) << pass.error().to_string();
+  const auto first = pick(20, 12, 5);
+  const auto second = pick(20, 3, 11);
+  ASSERT_TRUE(pass->run(first).ok());
+  ASSERT_TRUE(pass->run(second).ok());
+  EXPECT_LE(worst_error_ratio(pass->read_back(), cpu_sum(prm, second)), 1.0);
+  ASSERT_TRUE(pass->run(second).ok());
+  EXPECT_LE(worst_error_ratio(pass->read_back(), cpu_sum(prm, second)), 1.0);
+}
+
+TEST(PrmGpuPass, AddsTheBaseAtlasAtPaneTexels) {
+  auto ctx = headless_or_fail();
+  const gi::Prm prm = synthetic_prm(37, 23, 20);
+  auto pass = gi::PrmGpuPass::create(prm);
+  ASSERT_TRUE(pass.ok()) << pass.error().to_string();
+  std::vector<glm::vec3> base(static_cast<std::size_t>(37 * 23));
+  for (std::size_t t = 0; t < base.size(); ++t) {
+    gi::Pcg32 rng = gi::Pcg32::for_item(99, t);
+    base[t] = glm::vec3(rng.next_float(), rng.next_float(), rng.next_float()) * 10.0f;
+  }
+  ASSERT_TRUE(pass->set_base(base).ok());
+  const auto selected = pick(20, 6, 2);
+  ASSERT_TRUE(pass->run(selected).ok());
+  auto atlas = pass->read_back();
+  EXPECT_LE(worst_error_ratio(atlas, cpu_sum(prm, selected, base)), 1.0);
+  // K = 0 with a base: exactly the base at pane texels, 0 elsewhere.
+  ASSERT_TRUE(pass->run({}).ok());
+  atlas = pass->read_back();
+  const auto mask = pane_mask(prm);
+  for (std::size_t t = 0; t < atlas.size(); ++t) ASSERT_EQ(atlas[t], mask[t] ? base[t] : glm::vec3(0.0f)) << t;
+  // Removing the base.
+  ASSERT_TRUE(pass->set_base({}).ok());
+  ASSERT_TRUE(pass->run(selected).ok());
+  EXPECT_LE(worst_error_ratio(pass->read_back(), cpu_sum(prm, selected)), 1.0);
+}
+
+TEST(PrmGpuPass, SplitsPanesOverSeveralBuffersAboveTheLimit) {
+  auto ctx = headless_or_fail();
+  const gi::Prm prm = synthetic_prm(37, 23, 20);
+  const std::size_t pane_bytes = (prm.texels.size() * 6 + 15) / 16 * 16;
+  auto pass = gi::PrmGpuPass::create(prm, {.max_buffer_bytes = 3 * pane_bytes + 8});
+  ASSERT_TRUE(pass.ok()) << pass.error().to_string();
+  EXPECT_EQ(pass->pane_buffer_count(), 7u);  // 3 whole panes per buffer
+  std::vector<glm::vec3> base(static_cast<std::size_t>(37 * 23), glm::vec3(0.5f, 0.25f, 2.0f));
+  for (int k : {1, 4, 20}) {
+    const auto selected = pick(20, k, 13);
+    ASSERT_TRUE(pass->run(selected).ok());
+    EXPECT_LE(worst_error_ratio(pass->read_back(), cpu_sum(prm, selected)), 1.0) << "K = " << k;
+    ASSERT_TRUE(pass->set_base(base).ok());
+    ASSERT_TRUE(pass->run(selected).ok());
+    EXPECT_LE(worst_error_ratio(pass->read_back(), cpu_sum(prm, selected, base)), 1.0) << "K = " << k << ", base";
+    ASSERT_TRUE(pass->set_base({}).ok());
+  }
+  // The same as the unsplit pass.
+  auto whole = gi::PrmGpuPass::create(prm);
+  ASSERT_TRUE(whole.ok()) << whole.error().to_string();
+  const auto all = pick(20, 20, 4);
+  ASSERT_TRUE(pass->run(all).ok());
+  ASSERT_TRUE(whole->run(all).ok());
+  const auto a = pass->read_back();
+  const auto b = whole->read_back();
+  const auto ref = cpu_sum(prm, all);
+  for (std::size_t t = 0; t < a.size(); ++t)
+    for (int ch = 0; ch < 3; ++ch)
+      ASSERT_NEAR(a[t][ch], b[t][ch], 1e-5 * ref.magnitude[t][ch]) << t;  // only the summation order differs
+}
+
+TEST(PrmGpuPass, WideDynamicRangeKeepsRelativePrecision) {
+  auto ctx = headless_or_fail();
+  // Above the half range (65504) and below its normal range (6e-5): the per-pane scale
+  // keeps both at full half precision.
+  const gi::Prm big = synthetic_prm(37, 23, 4, 1e4f, 1e7f, 21);
+  const gi::Prm small = synthetic_prm(37, 23, 4, 1e-9f, 1e-6f, 22);
+  for (const gi::Prm* prm : {&big, &small}) {
+    auto pass = gi::PrmGpuPass::create(*prm);
+    ASSERT_TRUE(pass.ok()) << pass.error().to_string();
+    const auto selected = pick(4, 4, 1);
+    ASSERT_TRUE(pass->run(selected).ok());
+    const Reference ref = cpu_sum(*prm, selected);
+    const auto gpu = pass->read_back();
+    for (std::size_t t = 0; t < gpu.size(); ++t)
+      for (int ch = 0; ch < 3; ++ch)
+        ASSERT_NEAR(gpu[t][ch], ref.value[t][ch], kRelativeTolerance * ref.magnitude[t][ch]) << t;
+  }
+}
+
+TEST(PrmGpuPass, WrapsWorkGroupsIntoATwoDimensionalGrid) {
+  auto ctx = headless_or_fail();
+  // Real atlases reach the 65535 groups of one dimension above 2 x 64 x 65535 texels; the
+  // test hook wraps after 2 groups instead, so 37 x 23 (~570 texels, 5 groups of 128) needs
+  // a 2 x 3 grid whose last group is out of range. Integer panes up to 1024 are exact in
+  // half, so the sum must be exact.
+  gi::Prm prm = synthetic_prm(37, 23, 2);
+  for (std::size_t f = 0; f < prm.panes.size(); ++f) prm.panes[f] = static_cast<float>(f % 1024) + 1.0f;
+  auto pass = gi::PrmGpuPass::create(prm, {.max_groups_x = 2});
+  ASSERT_TRUE(pass.ok()) << pass.error().to_string();
+  const std::vector<gi::ClusterWeight> w{{1, glm::vec3(1.0f, 2.0f, 0.5f)}};
+  ASSERT_TRUE(pass->run(w).ok());
+  const auto atlas = pass->read_back();
+  const std::size_t n = prm.texels.size();
+  ASSERT_GT(n, 4u * 128u);
+  for (std::size_t i = 0; i < n; ++i) {
+    const float* p = &prm.panes[(n + i) * 3];
+    ASSERT_EQ(atlas[prm.texels[i]], glm::vec3(p[0] * 1.0f, p[1] * 2.0f, p[2] * 0.5f)) << "element " << i;
+  }
+}
+
+TEST(PrmGpuPass, RejectsInconsistentInput) {
+  auto ctx = headless_or_fail();
+  const gi::Prm good = synthetic_prm(37, 23, 20);
+  {
+    gi::Prm p = good;
+    p.panes.pop_back();
+    auto pass = gi::PrmGpuPass::create(p);
+    ASSERT_FALSE(pass.ok());
+    EXPECT_NE(pass.error().message.find("panes hold"), std::string::npos) << pass.error().to_string();
+  }
+  {
+    gi::Prm p = good;
+    std::swap(p.texels[3], p.texels[4]);
+    auto pass = gi::PrmGpuPass::create(p);
+    ASSERT_FALSE(pass.ok());
+    EXPECT_NE(pass.error().message.find("ascending"), std::string::npos) << pass.error().to_string();
+  }
+  {
+    gi::Prm p = good;
+    p.texels.back() = 37 * 23;
+    EXPECT_FALSE(gi::PrmGpuPass::create(p).ok());
+  }
+  {
+    gi::Prm p = good;
+    p.panes[100] = std::nanf("");
+    EXPECT_FALSE(gi::PrmGpuPass::create(p).ok());
+  }
+  {
+    auto pass = gi::PrmGpuPass::create(good, {.max_buffer_bytes = 1024});
+    ASSERT_FALSE(pass.ok());
+    EXPECT_NE(pass.error().message.find("above the SSBO limit"), std::string::npos) << pass.error().to_string();
+  }
+  auto pass = gi::PrmGpuPass::create(good);
+  ASSERT_TRUE(pass.ok()) << pass.error().to_string();
+  const std::vector<gi::ClusterWeight> bad{{20, glm::vec3(1.0f)}};
+  EXPECT_FALSE(pass->run(bad).ok());
+  EXPECT_FALSE(pass->set_base(std::vector<glm::vec3>(10)).ok());
+}
+
+TEST(PrmGpuPass, MovesOwnership) {
+  auto ctx = headless_or_fail();
+  const gi::Prm prm = synthetic_prm(37, 23, 20);
+  auto created = gi::PrmGpuPass::create(prm);
+  ASSERT_TRUE(created.ok()) << created.error().to_string();
+  gi::PrmGpuPass pass = std::move(created).value();
+  const std::uint32_t texture = pass.texture();
+  gi::PrmGpuPass moved = std::move(pass);
+  EXPECT_EQ(pass.texture(), 0u);  // NOLINT(bugprone-use-after-move): the moved-from state is specified
+  EXPECT_EQ(moved.texture(), texture);
+  const auto selected = pick(20, 9, 8);
+  ASSERT_TRUE(moved.run(selected).ok());
+  EXPECT_LE(worst_error_ratio(moved.read_back(), cpu_sum(prm, selected)), 1.0);
+}
+
+}  // namespace
