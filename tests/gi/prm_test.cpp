@@ -40,7 +40,7 @@ void place_spot(engine::Scene& scene, glm::vec3 position, glm::vec3 direction) {
 std::vector<glm::vec3> relight(const gi::Prm& prm, const engine::Scene& scene, int k = 0) {
   auto caster = gi::make_static_caster(scene);
   EXPECT_TRUE(caster);
-  return gi::sum_panes(prm, gi::relight_clusters(prm, gi::scene_lights(scene, gi::BakeLights::Moving), **caster, k));
+  return gi::sum_panes(prm, gi::relight_clusters(prm, gi::scene_lights(scene.registry, gi::BakeLights::Moving), **caster, k));
 }
 
 gi::RgbField field(int w, int h, const std::vector<glm::vec3>& v, const std::vector<std::uint8_t>& valid) {

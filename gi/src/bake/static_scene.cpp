@@ -6,17 +6,13 @@
 
 namespace gi {
 
-std::vector<ReferenceLight> scene_lights(const engine::Scene& scene, BakeLights lights) {
-  // reference_scene_from() lists the enabled lights in registry order: pick from it.
-  const std::vector<ReferenceLight> all = reference_scene_from(scene).lights;
+std::vector<ReferenceLight> scene_lights(const engine::Registry& registry, BakeLights lights) {
   std::vector<ReferenceLight> kept;
-  std::size_t k = 0;
-  scene.registry.view<engine::Light, engine::WorldTransform>().each(
-      [&](engine::Entity, const engine::Light& light, const engine::WorldTransform&) {
+  registry.view<engine::Light, engine::WorldTransform>().each(
+      [&](engine::Entity, const engine::Light& light, const engine::WorldTransform& wt) {
         if (!light.enabled) return;
         const bool keep = lights == BakeLights::Static ? !light.moves : lights == BakeLights::Moving && light.moves;
-        if (keep && k < all.size()) kept.push_back(all[k]);
-        ++k;
+        if (keep) kept.push_back(reference_light(light, wt.matrix));
       });
   return kept;
 }
@@ -47,7 +43,7 @@ engine::Result<StaticBakeScene> prepare_static_scene(const engine::Scene& scene,
                                                      BakeLights lights) {
   StaticBakeScene b;
   b.scene = reference_scene_from(scene);
-  b.scene.lights = scene_lights(scene, lights);
+  b.scene.lights = scene_lights(scene.registry, lights);
   auto index = index_reference_scene(b.scene);
   if (!index) return index.error();
   b.index = std::move(index).value();

@@ -47,8 +47,8 @@ engine::Result<StaticBakeScene> prepare_static_scene(const engine::Scene& scene,
 /// static world shadows with). Errors: no static instance, invalid data.
 engine::Result<std::unique_ptr<RayCaster>> make_static_caster(const engine::Scene& scene);
 
-/// The enabled lights of `scene` of the given kind, as the path tracer sees them, in
-/// registry order.
-std::vector<ReferenceLight> scene_lights(const engine::Scene& scene, BakeLights lights);
+/// The enabled lights of `registry` of the given kind, as the path tracer sees them, in
+/// registry order (what reference_scene_from() lists). Cheap: no geometry is read.
+std::vector<ReferenceLight> scene_lights(const engine::Registry& registry, BakeLights lights);
 
 }  // namespace gi

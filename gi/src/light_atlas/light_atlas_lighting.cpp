@@ -7,6 +7,22 @@
 
 namespace gi {
 
+namespace {
+
+// RGB irradiance and the validity mask as RGBA texels, the upload format.
+std::vector<float> rgba_of(const LightAtlasBake& bake) {
+  std::vector<float> rgba(bake.irradiance.size() * 4);
+  for (std::size_t i = 0; i < bake.irradiance.size(); ++i) {
+    rgba[4 * i + 0] = bake.irradiance[i].x;
+    rgba[4 * i + 1] = bake.irradiance[i].y;
+    rgba[4 * i + 2] = bake.irradiance[i].z;
+    rgba[4 * i + 3] = bake.valid[i] != 0 ? 1.0f : 0.0f;
+  }
+  return rgba;
+}
+
+}  // namespace
+
 LightAtlasLighting::LightAtlasLighting(int width, int height, std::vector<float> rgba)
     : width_(width), height_(height), rgba_(std::move(rgba)) {}
 
@@ -24,15 +40,8 @@ engine::Result<std::unique_ptr<LightAtlasLighting>> LightAtlasLighting::from_bak
     return engine::Error{asset.source, "light atlas", "the bake's size differs from its layout's"};
   auto with_uv1 = with_atlas_uv1(asset, bake.layout);
   if (!with_uv1) return with_uv1.error();
-  std::vector<float> rgba(texels * 4);
-  for (std::size_t i = 0; i < texels; ++i) {
-    rgba[4 * i + 0] = bake.irradiance[i].x;
-    rgba[4 * i + 1] = bake.irradiance[i].y;
-    rgba[4 * i + 2] = bake.irradiance[i].z;
-    rgba[4 * i + 3] = bake.valid[i] != 0 ? 1.0f : 0.0f;
-  }
   asset = std::move(with_uv1).value();
-  return std::unique_ptr<LightAtlasLighting>(new LightAtlasLighting(bake.width, bake.height, std::move(rgba)));
+  return std::unique_ptr<LightAtlasLighting>(new LightAtlasLighting(bake.width, bake.height, rgba_of(bake)));
 }
 
 engine::Result<std::unique_ptr<LightAtlasLighting>> LightAtlasLighting::load(const std::filesystem::path& bundle_dir,
@@ -44,18 +53,10 @@ engine::Result<std::unique_ptr<LightAtlasLighting>> LightAtlasLighting::load(con
 
 engine::Result<std::unique_ptr<LightAtlasLighting>> LightAtlasLighting::load(const std::filesystem::path& bundle_dir,
                                                                              engine::Scene& scene) {
-  const std::vector<engine::Node> before = scene.assets.nodes;
-  auto provider = load(bundle_dir, scene.assets);
-  if (!provider) return provider;
-  // with_atlas_uv1 keeps the nodes and appends a mesh copy for a static node sharing its mesh.
-  for (std::size_t i = 0; i < before.size() && i < scene.node_entities.size(); ++i) {
-    const int mesh = scene.assets.nodes[i].mesh;
-    const engine::Entity e = scene.node_entities[i];
-    if (mesh == before[i].mesh || mesh < 0 || !scene.registry.valid(e)) continue;
-    if (scene.registry.has<engine::MeshRenderer>(e))
-      scene.registry.write<engine::MeshRenderer>(e).mesh = static_cast<std::uint32_t>(mesh);
-  }
-  return provider;
+  auto bake = load_light_atlas(bundle_dir, scene.assets);
+  if (!bake) return bake.error();
+  if (engine::Status s = apply_atlas_uv1(scene, bake->layout); !s) return s.error();
+  return std::unique_ptr<LightAtlasLighting>(new LightAtlasLighting(bake->width, bake->height, rgba_of(*bake)));
 }
 
 const engine::IndirectLightFrame& LightAtlasLighting::frame() {

@@ -49,8 +49,11 @@ engine::Result<engine::Scene> posed_scene(engine::SceneAsset asset, const std::s
       position = lo + glm::vec3(0.15f, 0.3f, 0.15f) * size;
       direction = glm::normalize(centre - position);
     } else if (pose == "wall") {
+      // A lamp held against a wall, shining down along it: the wall gets grazing light from
+      // 1 cm away (pointing it into the wall would put all light into a spot of millimetres,
+      // which the path-traced reference cannot resolve either).
       position = glm::vec3(hi.x - 0.01f, centre.y, centre.z);
-      direction = glm::vec3(1.0f, 0.0f, 0.0f);
+      direction = glm::vec3(0.0f, -1.0f, 0.0f);
     } else {
       return engine::Error{.message = "unknown light pose '" + pose + "' (authored, corner, wall)"};
     }
@@ -77,7 +80,7 @@ RgbField atlas_field(int w, int h, const std::vector<glm::vec3>& v, const std::v
 
 void register_prm_sweep(SweepRegistry& registry) {
   registry.add_reference_provider(
-      {.kind = "atlas_indirect_irradiance_posed", .version = "pt-1", .compute = [](const ReferenceJob& job) -> engine::Result<RgbField> {
+      {.kind = "atlas_indirect_irradiance_posed", .version = "pt-2", .compute = [](const ReferenceJob& job) -> engine::Result<RgbField> {
          auto scene = posed_scene(job.scene.asset, job.request.param("pose"));
          if (!scene) return scene.error();
          const auto inputs = atlas_inputs_from(job.scene.asset);
@@ -137,7 +140,7 @@ void register_prm_sweep(SweepRegistry& registry) {
     if (!caster) return caster.error();
     // Per-frame cost of a light change on the CPU: weights, selection and the pane sum.
     const auto t0 = std::chrono::steady_clock::now();
-    const auto picked = relight_clusters(*prm, scene_lights(*scene, BakeLights::Moving), **caster,
+    const auto picked = relight_clusters(*prm, scene_lights(scene->registry, BakeLights::Moving), **caster,
                                          static_cast<int>(ctx.knobs.integer("active")));
     const std::vector<glm::vec3> atlas = sum_panes(*prm, picked);
     const double frame_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();

@@ -52,6 +52,8 @@ std::vector<std::uint32_t> triangle_materials(const engine::Mesh& mesh, std::int
   return out;
 }
 
+}  // namespace
+
 ReferenceLight reference_light(const engine::Light& light, const glm::mat4& m) {
   ReferenceLight l;
   l.position = glm::vec3(m[3]);
@@ -70,8 +72,6 @@ ReferenceLight reference_light(const engine::Light& light, const glm::mat4& m) {
   }
   return l;
 }
-
-}  // namespace
 
 ReferenceScene reference_scene_from(const engine::Scene& scene) {
   ReferenceScene out;

@@ -20,6 +20,9 @@ RtSceneData rt_scene_from(const engine::Scene& scene);
 
 ReferenceScene reference_scene_from(const engine::Scene& scene);
 
+/// A light component placed by `world` as the path tracer (and the bakers) see it.
+ReferenceLight reference_light(const engine::Light& light, const glm::mat4& world);
+
 /// The renderer's material rule as a path-tracer material.
 ReferenceMaterial reference_material(const engine::Material& material);
 

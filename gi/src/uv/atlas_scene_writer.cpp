@@ -117,4 +117,20 @@ engine::Result<engine::SceneAsset> with_atlas_uv1(const engine::SceneAsset& scen
   return out;
 }
 
+engine::Status apply_atlas_uv1(engine::Scene& scene, const AtlasLayout& layout) {
+  auto with_uv1 = with_atlas_uv1(scene.assets, layout);
+  if (!with_uv1) return with_uv1.error();
+  const std::vector<engine::Node> before = scene.assets.nodes;
+  scene.assets = std::move(with_uv1).value();
+  // with_atlas_uv1 keeps the nodes and appends a mesh copy for a static node sharing its mesh.
+  for (std::size_t i = 0; i < before.size() && i < scene.node_entities.size(); ++i) {
+    const int mesh = scene.assets.nodes[i].mesh;
+    const engine::Entity e = scene.node_entities[i];
+    if (mesh == before[i].mesh || mesh < 0 || !scene.registry.valid(e)) continue;
+    if (scene.registry.has<engine::MeshRenderer>(e))
+      scene.registry.write<engine::MeshRenderer>(e).mesh = static_cast<std::uint32_t>(mesh);
+  }
+  return {};
+}
+
 }  // namespace gi

@@ -5,6 +5,7 @@
 //   engine::Result<engine::SceneAsset> with_uv1 = gi::with_atlas_uv1(asset, layout.value());
 
 #include <engine/result.h>
+#include <engine/scene.h>
 #include <engine/scene_asset.h>
 
 #include "uv/atlas_layout.h"
@@ -23,5 +24,10 @@ namespace gi {
 /// - Dynamic nodes and their meshes are left alone.
 /// Error when the layout does not match the scene (ids, vertex or triangle counts).
 engine::Result<engine::SceneAsset> with_atlas_uv1(const engine::SceneAsset& scene, const AtlasLayout& layout);
+
+/// The same for a scene already instantiated: replaces `scene.assets` with its uv1 copy and
+/// points the MeshRenderer of every node whose mesh was duplicated at its copy. On error
+/// the scene is unchanged.
+engine::Status apply_atlas_uv1(engine::Scene& scene, const AtlasLayout& layout);
 
 }  // namespace gi
