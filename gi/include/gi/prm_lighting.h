@@ -1,0 +1,69 @@
+#pragma once
+// The runtime side of precomputed radiance maps (PRM): an engine::IndirectLightProvider
+// whose irradiance atlas follows the scene's moving lights (the flashlight, a swinging
+// lamp), optionally on top of a light atlas baked for the static lights. Each frame it
+// checks the moving lights; only when one changed (moved, turned, switched, dimmed) it
+// recomputes the entry-point weights (CPU, shadow rays against the static world), picks the
+// K heaviest clusters and re-sums their panes on the GPU. A frame where nothing moved does
+// nothing.
+//   auto gi = gi::PrmLighting::load("level.gibake", scene);  // before Renderer::create
+//   auto renderer = engine::Renderer::create(scene.assets, settings).value();
+//   renderer->set_indirect_light(gi.value().get());
+//
+// Loading gives the scene's static meshes TEXCOORD_1 (see LightAtlasLighting). The provider
+// reads lights from `scene.registry`, which must outlive it. GL objects are created on the
+// first frame() (the context must be current) and deleted with the provider.
+
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+
+#include <engine/indirect_light.h>
+#include <engine/result.h>
+#include <engine/scene.h>
+
+namespace gi {
+
+struct Prm;
+struct LightAtlasBake;
+
+struct PrmLightingSettings {
+  int active_clusters = 32;  ///< K: panes summed per update (the heaviest); 0: all.
+};
+
+class PrmLighting final : public engine::IndirectLightProvider {
+ public:
+  /// Loads the bundle's PRM (and its light atlas as the static base when the bundle has one
+  /// at the same layout) for `scene`, and gives the scene uv1. Errors: stale or damaged
+  /// bundle, no PRM in it, a light atlas of another layout.
+  static engine::Result<std::unique_ptr<PrmLighting>> load(const std::filesystem::path& bundle_dir, engine::Scene& scene,
+                                                           PrmLightingSettings settings = {});
+  /// From bakes in memory (base may be null). Same layout required.
+  static engine::Result<std::unique_ptr<PrmLighting>> from_bake(Prm prm, const LightAtlasBake* base, engine::Scene& scene,
+                                                                PrmLightingSettings settings = {});
+
+  PrmLighting(const PrmLighting&) = delete;
+  PrmLighting& operator=(const PrmLighting&) = delete;
+  ~PrmLighting() override;
+
+  /// The irradiance atlas for this frame (re-summed only when a moving light changed).
+  const engine::IndirectLightFrame& frame() override;
+  const char* label() const override;
+
+  struct Stats {
+    std::uint64_t frames = 0;
+    std::uint64_t updates = 0;        ///< Frames on which the atlas was recomputed.
+    double last_weights_ms = 0.0;     ///< CPU: entry weights, cluster means, selection.
+    double last_gpu_ms = 0.0;         ///< GPU pane sum (glFinish-timed: CPU time on llvmpipe).
+    std::size_t last_active_clusters = 0;
+    std::size_t gpu_bytes = 0;
+  };
+  const Stats& stats() const;
+
+ private:
+  struct Impl;
+  explicit PrmLighting(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace gi

@@ -1,0 +1,111 @@
+#include <GL/glcorearb.h>
+#include <gi/prm_lighting.h>
+
+#include <chrono>
+#include <optional>
+
+#include "bake/static_scene.h"
+#include "light_atlas/light_atlas.h"
+#include "prm/prm.h"
+#include "prm/prm_gpu_pass.h"
+#include "prm/prm_runtime.h"
+#include "sweep/content_hash.h"
+#include "uv/atlas_scene_writer.h"
+
+namespace gi {
+
+struct PrmLighting::Impl {
+  const engine::Registry* registry = nullptr;
+  Prm prm;
+  std::vector<glm::vec3> base;  ///< Static-light atlas (empty: none).
+  std::unique_ptr<RayCaster> caster;
+  PrmLightingSettings settings;
+  std::optional<PrmGpuPass> pass;
+  std::uint64_t lights_signature = 0;
+  bool fresh = false;
+  engine::IndirectLightFrame frame;
+  Stats stats;
+
+  // A fingerprint of everything about the moving lights that changes their light.
+  std::uint64_t moving_lights_signature() const {
+    ContentHash h;
+    registry->view<engine::Light, engine::WorldTransform>().each(
+        [&](engine::Entity e, const engine::Light& l, const engine::WorldTransform& wt) {
+          if (!l.moves) return;
+          h.add_value(e.id());
+          h.add_value(static_cast<std::uint8_t>(l.enabled));
+          h.add_value(static_cast<std::uint8_t>(l.type));
+          h.add_value(l.color.x), h.add_value(l.color.y), h.add_value(l.color.z);
+          h.add_value(l.intensity), h.add_value(l.range_m);
+          h.add_value(l.inner_cone_rad), h.add_value(l.outer_cone_rad);
+          h.add_value(l.area_size_m.x), h.add_value(l.area_size_m.y);
+          for (int c = 0; c < 4; ++c)
+            for (int r = 0; r < 4; ++r) h.add_value(wt.matrix[c][r]);
+        });
+    return h.value();
+  }
+};
+
+PrmLighting::PrmLighting(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+PrmLighting::~PrmLighting() = default;
+
+engine::Result<std::unique_ptr<PrmLighting>> PrmLighting::from_bake(Prm prm, const LightAtlasBake* base,
+                                                                    engine::Scene& scene, PrmLightingSettings settings) {
+  if (base && (base->width != prm.width || base->height != prm.height ||
+               base->layout.texels_per_metre != prm.layout.texels_per_metre))
+    return engine::Error{scene.assets.source, "PRM",
+                         "the light atlas (" + std::to_string(base->width) + "x" + std::to_string(base->height) +
+                             ") and the PRM (" + std::to_string(prm.width) + "x" + std::to_string(prm.height) +
+                             ") were baked at different layouts; bake both at one density"};
+  auto caster = make_static_caster(scene);
+  if (!caster) return caster.error();
+  if (engine::Status s = apply_atlas_uv1(scene, prm.layout); !s) return s.error();
+  auto impl = std::make_unique<Impl>();
+  impl->registry = &scene.registry;
+  impl->prm = std::move(prm);
+  if (base) impl->base = base->irradiance;
+  impl->caster = std::move(caster).value();
+  impl->settings = settings;
+  return std::unique_ptr<PrmLighting>(new PrmLighting(std::move(impl)));
+}
+
+const engine::IndirectLightFrame& PrmLighting::frame() {
+  Impl& m = *impl_;
+  ++m.stats.frames;
+  if (!m.pass) {
+    auto pass = PrmGpuPass::create(m.prm);
+    if (!pass) {
+      // No GL resources: leave the frame empty (the renderer falls back to its stand-in).
+      std::fprintf(stderr, "gi: PRM disabled: %s\n", pass.error().to_string().c_str());
+      m.prm.panes = {};
+      return m.frame;
+    }
+    m.pass.emplace(std::move(pass).value());
+    if (!m.base.empty()) (void)m.pass->set_base(m.base);
+    m.frame.irradiance_atlas_texture = m.pass->texture();
+    m.stats.gpu_bytes = m.pass->gpu_bytes();
+  }
+  const std::uint64_t signature = m.moving_lights_signature();
+  if (m.fresh && signature == m.lights_signature) return m.frame;  // nothing moved
+  using Clock = std::chrono::steady_clock;
+  const auto t0 = Clock::now();
+  const std::vector<ClusterWeight> picked =
+      relight_clusters(m.prm, scene_lights(*m.registry, BakeLights::Moving), *m.caster, m.settings.active_clusters);
+  const auto t1 = Clock::now();
+  if (engine::Status s = m.pass->run(picked); !s) std::fprintf(stderr, "gi: PRM update failed: %s\n", s.error().to_string().c_str());
+  glFinish();
+  const auto t2 = Clock::now();
+  m.stats.last_weights_ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
+  m.stats.last_gpu_ms = std::chrono::duration<double, std::milli>(t2 - t1).count();
+  m.stats.last_active_clusters = picked.size();
+  ++m.stats.updates;
+  m.lights_signature = signature;
+  m.fresh = true;
+  return m.frame;
+}
+
+const char* PrmLighting::label() const { return impl_->base.empty() ? "PRM" : "light atlas + PRM"; }
+
+const PrmLighting::Stats& PrmLighting::stats() const { return impl_->stats; }
+
+}  // namespace gi
