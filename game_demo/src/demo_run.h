@@ -57,7 +57,8 @@ inline engine::SplitView split_of(const Simulation& sim) {
   return sim.context().split_view ? engine::SplitView::DirectLeftFullRight : engine::SplitView::Off;
 }
 
-/// The indirect light of a run: with --gi-bundle, the bundle's light atlas loaded into the
+/// The indirect light of a run: with --gi-bundle, the bundle's baked lighting (light atlas,
+/// PRM for the moving lights; gi::load_baked_lighting) loaded into the
 /// simulation's scene (which gains TEXCOORD_1, so create the renderer after this); without
 /// it, nullptr (the renderer's constant-ambient stand-in). Prints the error and returns
 /// false when the bundle does not load (missing, damaged, or baked from other geometry).

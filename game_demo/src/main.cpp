@@ -3,13 +3,13 @@
 //   gi_demo --headless --frames 120 --out /tmp/frames
 //   gi_demo --headless --script push_crates --frames 600 --record s.girec --no-render
 //   gi_demo --headless --replay tests/sessions/push_crates.girec
-//   gi_demo --gi-bundle assets/demo_level.gibake     light the static world with a baked light atlas
+//   gi_demo --gi-bundle out/demo_level.gibake        light the static world with its bake (light atlas, PRM)
 #include <cstdio>
 #include <iostream>
 
 #include <CLI/CLI.hpp>
 
-#include <gi/light_atlas_lighting.h>
+#include <gi/baked_lighting.h>
 
 #include "demo_run.h"
 
@@ -42,12 +42,12 @@ bool RunState::finish_recording(const std::string& path) const {
 bool load_indirect_light(const RunOptions& o, Simulation& sim, std::unique_ptr<engine::IndirectLightProvider>& provider) {
   provider.reset();
   if (o.gi_bundle.empty()) return true;
-  auto atlas = gi::LightAtlasLighting::load(o.gi_bundle, sim.scene());
-  if (!atlas) {
-    std::cerr << "gi_demo: cannot use --gi-bundle " << o.gi_bundle << ": " << atlas.error().to_string() << '\n';
+  auto baked = gi::load_baked_lighting(o.gi_bundle, sim.scene());
+  if (!baked) {
+    std::cerr << "gi_demo: cannot use --gi-bundle " << o.gi_bundle << ": " << baked.error().to_string() << '\n';
     return false;
   }
-  provider = std::move(atlas).value();
+  provider = std::move(baked).value();
   return true;
 }
 

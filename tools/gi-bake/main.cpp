@@ -1,7 +1,9 @@
 // gi-bake: bakes the GI data of a scene into a bake bundle.
 //   gi-bake --scene assets/cornell_box.gltf --methods atlas --preset high --out out/cornell_box.gibake
-// Methods available: atlas (light atlas, Schärfig 2016). The others of DESIGN.md 1 are
-// reported as not built yet rather than silently skipped.
+// Methods available: atlas (light atlas, Schärfig 2016; static lights) and prm (precomputed
+// radiance maps, Szécsi 2006; moving lights). Both use the preset's atlas density, so they
+// share one uv1 layout. The other methods of DESIGN.md 1 are reported as not built yet
+// rather than silently skipped.
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -17,6 +19,8 @@
 #include "console_progress.h"
 #include "light_atlas/light_atlas.h"
 #include "light_atlas/light_atlas_io.h"
+#include "prm/prm.h"
+#include "prm/prm_io.h"
 
 namespace {
 
@@ -26,6 +30,40 @@ std::vector<std::string> split(const std::string& list) {
   for (std::string item; std::getline(ss, item, ',');)
     if (!item.empty()) out.push_back(item);
   return out;
+}
+
+int bake_prm_method(const engine::Scene& scene, const engine::SceneAsset& asset, const std::filesystem::path& scene_file,
+                    const std::string& out_dir, const std::string& preset, float density, unsigned threads,
+                    std::uint64_t seed) {
+  auto settings = gi::prm_preset(preset);
+  if (!settings) {
+    std::cerr << "gi-bake: " << settings.error().to_string() << '\n';
+    return 2;
+  }
+  if (density > 0.0f) settings->texels_per_metre = density;
+  settings->threads = threads;
+  settings->seed = seed;
+  settings->progress = tools::console_progress("PRM");
+  std::printf("gi-bake: PRM of %s, preset %s: %d entry points, %d clusters, splitting %g, %g texels/m\n",
+              scene_file.filename().string().c_str(), preset.c_str(), settings->entry_points, settings->clusters,
+              double{settings->splitting}, double{settings->texels_per_metre});
+  auto prm = gi::bake_prm(scene, *settings);
+  if (!prm) {
+    std::cerr << "gi-bake: " << prm.error().to_string() << '\n';
+    return 1;
+  }
+  const gi::PrmStats& st = prm->stats;
+  std::printf("  panes %dx%d, %zu texels each, %d clusters (%.1f MB as half floats); %zu paths, %zu virtual lights\n",
+              prm->width, prm->height, prm->pane_size(), prm->cluster_count,
+              static_cast<double>(prm->pane_size()) * prm->cluster_count * 6.0 / 1e6, st.paths, st.path_nodes);
+  std::printf("  time: walks %.2f s, panes %.2f s; total %.2f s; %.1f M rays\n", st.walk_seconds, st.pane_seconds,
+              st.total_seconds, static_cast<double>(st.rays) * 1e-6);
+  if (auto saved = gi::save_prm(out_dir, *prm, asset, scene_file.filename().string()); !saved) {
+    std::cerr << "gi-bake: " << saved.error().to_string() << '\n';
+    return 1;
+  }
+  std::printf("  wrote %s\n", out_dir.c_str());
+  return 0;
 }
 
 }  // namespace
@@ -40,7 +78,7 @@ int main(int argc, char** argv) {
   std::uint64_t seed = 1;
   app.add_option("--scene", scene_path, "glTF/GLB scene")->required()->check(CLI::ExistingFile);
   app.add_option("--out", out_dir, "Bundle directory (default: out/<scene>.gibake)");
-  app.add_option("--methods", methods, "Comma-separated methods to bake: atlas");
+  app.add_option("--methods", methods, "Comma-separated methods to bake: atlas, prm");
   app.add_option("--preset", preset, "Quality preset: preview, medium, high (docs/light_atlas.md)");
   app.add_option("--vpls", vpls, "Override the preset's VPL count")->check(CLI::PositiveNumber);
   app.add_option("--bounces", bounces, "Override the preset's indirect bounces")->check(CLI::Range(1, 64));
@@ -60,10 +98,16 @@ int main(int argc, char** argv) {
   if (out_dir.empty()) out_dir = (std::filesystem::path("out") / (scene_file.stem().string() + ".gibake")).string();
   const engine::Scene scene = engine::instantiate(*asset);
 
-  for (const std::string& method : split(methods)) {
-    if (method != "atlas") {
-      std::cerr << "gi-bake: method '" << method << "' is not available in this build (available: atlas)\n";
+  const std::vector<std::string> wanted = split(methods);
+  for (const std::string& method : wanted)
+    if (method != "atlas" && method != "prm") {
+      std::cerr << "gi-bake: method '" << method << "' is not available in this build (available: atlas, prm)\n";
       return 2;
+    }
+  for (const std::string& method : wanted) {
+    if (method == "prm") {
+      if (int rc = bake_prm_method(scene, *asset, scene_file, out_dir, preset, density, threads, seed); rc != 0) return rc;
+      continue;
     }
     auto settings = gi::light_atlas_preset(preset);
     if (!settings) {

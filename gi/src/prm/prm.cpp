@@ -10,6 +10,7 @@
 #include "bake/static_scene.h"
 #include "core/random.h"
 #include "core/thread_pool.h"
+#include "light_atlas/light_atlas.h"
 #include "light_atlas/point_emitters.h"
 #include "light_atlas/vpl_set.h"
 #include "prm/entry_clusters.h"
@@ -210,6 +211,21 @@ engine::Result<Prm> bake_prm(const engine::Scene& scene, const PrmSettings& sett
   prm.stats.pane_seconds = seconds_since(t0);
   prm.stats.total_seconds = seconds_since(t_start);
   return prm;
+}
+
+engine::Result<PrmSettings> prm_preset(std::string_view name) {
+  auto atlas = light_atlas_preset(name);
+  if (!atlas) return engine::Error{.message = "unknown PRM preset '" + std::string(name) + "' (preview, medium, high)"};
+  PrmSettings s;
+  s.texels_per_metre = atlas->texels_per_metre;
+  if (name == "preview") {
+    s.entry_points = 512, s.clusters = 16, s.splitting = 2.0f;
+  } else if (name == "medium") {
+    s.entry_points = 1024, s.clusters = 64, s.splitting = 4.0f;
+  } else {
+    s.entry_points = 4096, s.clusters = 128, s.splitting = 4.0f;
+  }
+  return s;
 }
 
 }  // namespace gi

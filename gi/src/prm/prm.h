@@ -12,6 +12,7 @@
 //   std::vector<glm::vec3> atlas = gi::sum_panes(prm, gi::select_clusters(w, 32));
 
 #include <cstdint>
+#include <string_view>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -75,6 +76,10 @@ struct Prm {
 
   std::size_t pane_size() const { return texels.size(); }
 };
+
+/// preview / medium / high (docs/sweeps/prm_spot_chamber.md). The pane density follows the
+/// light atlas preset of the same name, so both share one uv1 layout.
+engine::Result<PrmSettings> prm_preset(std::string_view name);
 
 /// Bakes the PRM of the static meshes of `scene`. Errors: no static geometry, settings out
 /// of range, cancelled.

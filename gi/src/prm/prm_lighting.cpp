@@ -5,9 +5,12 @@
 #include <optional>
 
 #include "bake/static_scene.h"
+#include "bake/manifest.h"
 #include "light_atlas/light_atlas.h"
+#include "light_atlas/light_atlas_io.h"
 #include "prm/prm.h"
 #include "prm/prm_gpu_pass.h"
+#include "prm/prm_io.h"
 #include "prm/prm_runtime.h"
 #include "sweep/content_hash.h"
 #include "uv/atlas_scene_writer.h"
@@ -67,6 +70,21 @@ engine::Result<std::unique_ptr<PrmLighting>> PrmLighting::from_bake(Prm prm, con
   impl->caster = std::move(caster).value();
   impl->settings = settings;
   return std::unique_ptr<PrmLighting>(new PrmLighting(std::move(impl)));
+}
+
+engine::Result<std::unique_ptr<PrmLighting>> PrmLighting::load(const std::filesystem::path& bundle_dir,
+                                                               engine::Scene& scene, PrmLightingSettings settings) {
+  auto prm = load_prm(bundle_dir, scene.assets);
+  if (!prm) return prm.error();
+  auto manifest = read_manifest(bundle_dir);
+  if (!manifest) return manifest.error();
+  std::optional<LightAtlasBake> base;
+  if (manifest->methods.contains("light_atlas")) {
+    auto atlas = load_light_atlas(bundle_dir, scene.assets);
+    if (!atlas) return atlas.error();
+    base.emplace(std::move(atlas).value());
+  }
+  return from_bake(std::move(prm).value(), base ? &*base : nullptr, scene, settings);
 }
 
 const engine::IndirectLightFrame& PrmLighting::frame() {

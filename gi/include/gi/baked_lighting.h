@@ -1,0 +1,24 @@
+#pragma once
+// One call for a game: the indirect-light provider a bake bundle calls for. A bundle with a
+// PRM gives gi::PrmLighting (over the bundle's light atlas when it has one); a bundle with a
+// light atlas only gives gi::LightAtlasLighting.
+//   auto gi = gi::load_baked_lighting("level.gibake", scene);   // before Renderer::create
+//   if (!gi) { std::cerr << gi.error().to_string() << '\n'; return 1; }
+//   renderer->set_indirect_light(gi.value().get());
+
+#include <filesystem>
+#include <memory>
+
+#include <engine/indirect_light.h>
+#include <engine/result.h>
+#include <engine/scene.h>
+
+namespace gi {
+
+/// Loads the bundle's baked lighting for `scene` (which gains TEXCOORD_1; the registry must
+/// outlive the provider). Errors: no manifest, no light_atlas or prm entry, stale or damaged
+/// files.
+engine::Result<std::unique_ptr<engine::IndirectLightProvider>> load_baked_lighting(const std::filesystem::path& bundle_dir,
+                                                                                    engine::Scene& scene);
+
+}  // namespace gi
