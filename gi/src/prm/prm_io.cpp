@@ -1,0 +1,491 @@
+#include "prm/prm_io.h"
+
+#include <zstd.h>
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <span>
+#include <system_error>
+
+#include "bake/bundle.h"
+#include "bake/byte_stream.h"
+#include "bake/json_fields.h"
+#include "sweep/content_hash.h"
+#include "uv/atlas_input.h"
+
+namespace gi {
+
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+// zstd level of the pane array (1..19): a middle ground between bake-time speed and size.
+constexpr int kZstdLevel = 9;
+// Bounds a file may claim before anything is allocated (PrmSettings' limits).
+constexpr int kMaxClusters = 65536;
+constexpr int kMaxAtlasSide = 16384;
+
+template <class T>
+std::span<const T> as_span(const std::vector<T>& v) {
+  return std::span<const T>(v);
+}
+
+bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+std::string str(std::size_t v) { return std::to_string(v); }
+
+// Empty when the Prm's arrays fit together and its values are valid, else what is wrong.
+std::string check_prm(const Prm& p) {
+  const PrmSettings& s = p.settings;
+  if (!(s.texels_per_metre > 0.0f) || !std::isfinite(s.texels_per_metre) || !(s.splitting > 0.0f) ||
+      !std::isfinite(s.splitting) || s.entry_points < 1 || s.clusters < 1 || s.max_path_nodes < 1)
+    return "settings out of range (texels_per_metre and splitting must be positive, entry_points, clusters and "
+           "max_path_nodes at least 1)";
+  if (p.width <= 0 || p.height <= 0 || p.width > kMaxAtlasSide || p.height > kMaxAtlasSide)
+    return "atlas size " + std::to_string(p.width) + "x" + std::to_string(p.height) + " is outside 1..16384";
+  if (p.cluster_count < 1 || p.cluster_count > kMaxClusters)
+    return "cluster_count " + std::to_string(p.cluster_count) + " is outside 1..65536";
+  const auto clusters = static_cast<std::size_t>(p.cluster_count);
+  if (p.cluster_size.size() != clusters)
+    return "cluster_size has " + str(p.cluster_size.size()) + " elements for " + str(clusters) + " clusters";
+  const std::uint64_t atlas_texels = static_cast<std::uint64_t>(p.width) * static_cast<std::uint64_t>(p.height);
+  for (std::size_t i = 0; i < p.texels.size(); ++i) {
+    if (p.texels[i] >= atlas_texels)
+      return "texel " + str(i) + " (index " + str(p.texels[i]) + ") is outside the " + std::to_string(p.width) + "x" +
+             std::to_string(p.height) + " atlas";
+    if (i > 0 && p.texels[i] <= p.texels[i - 1]) return "texels are not strictly ascending at element " + str(i);
+  }
+  std::vector<std::uint32_t> members(clusters, 0);
+  for (std::size_t k = 0; k < p.entries.size(); ++k) {
+    const PrmEntryPoint& e = p.entries[k];
+    if (e.cluster >= clusters)
+      return "entry point " + str(k) + " is in cluster " + str(e.cluster) + ", there are " + str(clusters);
+    if (!finite(e.position) || !finite(e.normal) || !std::isfinite(e.area_m2))
+      return "entry point " + str(k) + " has a NaN or infinite value";
+    if (e.area_m2 < 0.0f) return "entry point " + str(k) + " has a negative area";
+    ++members[e.cluster];
+  }
+  for (std::size_t c = 0; c < clusters; ++c)
+    if (members[c] != p.cluster_size[c])
+      return "cluster_size[" + str(c) + "] is " + str(p.cluster_size[c]) + " but " + str(members[c]) +
+             " entry points are in that cluster";
+  const std::size_t n = p.texels.size();
+  if (p.panes.size() != clusters * n * 3)
+    return "panes has " + str(p.panes.size()) + " values, " + str(clusters) + " clusters x " + str(n) +
+           " texels x 3 = " + str(clusters * n * 3) + " expected";
+  for (std::size_t j = 0; j < p.panes.size(); ++j) {
+    const float v = p.panes[j];
+    if (!std::isfinite(v) || v < 0.0f) {
+      const std::size_t c = j / (3 * n), i = (j / 3) % n;
+      return "pane " + str(c) + " texel " + str(p.texels[i]) + " channel " + str(j % 3) + " is " +
+             (std::isnan(v) ? "NaN" : !std::isfinite(v) ? "infinite" : "negative (" + std::to_string(v) + ")") +
+             ": panes must be finite and non-negative";
+    }
+  }
+  return {};
+}
+
+// The power-of-two scale that maps a pane's largest value into [2^14, 2^15) (prm_io.h).
+float pane_scale(float max_value) {
+  if (!(max_value > 0.0f)) return 1.0f;
+  int e = 0;
+  std::frexp(max_value, &e);
+  return std::ldexp(1.0f, std::max(e - 15, -126));
+}
+
+bool is_power_of_two(float s) {
+  int e = 0;
+  return std::isfinite(s) && s > 0.0f && std::frexp(s, &e) == 0.5f;
+}
+
+engine::Error file_error(const fs::path& path, std::string location, std::string message) {
+  return engine::Error{path.string(), std::move(location), std::move(message)};
+}
+
+engine::Result<std::string> file_checksum(const fs::path& path) {
+  auto bytes = read_file_bytes(path);
+  if (!bytes) return bytes.error();
+  ContentHash h;
+  h.add_bytes(bytes->data(), bytes->size());
+  return h.hex();
+}
+
+json settings_json(const PrmSettings& s) {
+  return json{{"texels_per_metre", s.texels_per_metre},
+              {"entry_points", s.entry_points},
+              {"clusters", s.clusters},
+              {"splitting", s.splitting},
+              {"max_path_nodes", s.max_path_nodes},
+              {"kmeans", s.kmeans},
+              {"seed", s.seed},
+              {"threads", s.threads}};
+}
+
+json stats_json(const PrmStats& s) {
+  return json{{"paths", s.paths},
+              {"path_nodes", s.path_nodes},
+              {"rays", s.rays},
+              {"walk_seconds", s.walk_seconds},
+              {"pane_seconds", s.pane_seconds},
+              {"total_seconds", s.total_seconds}};
+}
+
+// What the manifest entry says about the file, the layout and the sizes.
+struct EntryInfo {
+  std::string panes_file, panes_checksum;
+  float requested_texels_per_metre = 0.0f;
+  float texels_per_metre = 0.0f;
+  int padding_texels = 0;
+  int width = 0;
+  int height = 0;
+  std::size_t entry_points = 0, clusters = 0, pane_texels = 0;
+  PrmStats stats;
+};
+
+engine::Result<EntryInfo> read_entry(const fs::path& manifest_file, const json& entry) {
+  const std::string prefix = std::string("methods.") + kPrmMethod;
+  JsonFields f(entry, manifest_file.string(), prefix);
+  EntryInfo e;
+  e.panes_file = f.get<std::string>("files.panes.file");
+  e.panes_checksum = f.get<std::string>("files.panes.fnv1a64");
+  e.requested_texels_per_metre = f.get<float>("layout.requested_texels_per_metre");
+  e.texels_per_metre = f.get<float>("layout.texels_per_metre");
+  e.padding_texels = f.get<int>("layout.padding_texels");
+  e.width = f.get<int>("layout.width");
+  e.height = f.get<int>("layout.height");
+  e.entry_points = f.get<std::size_t>("entry_points");
+  e.clusters = f.get<std::size_t>("clusters");
+  e.pane_texels = f.get<std::size_t>("pane_texels");
+  e.stats.paths = f.get<std::size_t>("stats.paths");
+  e.stats.path_nodes = f.get<std::size_t>("stats.path_nodes");
+  e.stats.rays = f.get<std::uint64_t>("stats.rays");
+  e.stats.walk_seconds = f.get<double>("stats.walk_seconds");
+  e.stats.pane_seconds = f.get<double>("stats.pane_seconds");
+  e.stats.total_seconds = f.get<double>("stats.total_seconds");
+  if (f.error()) return *f.error();
+  if (!is_bundle_file_name(e.panes_file))
+    return engine::Error{manifest_file.string(), prefix + ".files.panes.file",
+                         "\"" + e.panes_file + "\" is not a file name inside the bundle"};
+  return e;
+}
+
+// The panes as scaled halves in two byte planes (prm_io.h), plus each pane's scale.
+// Error text when a value does not survive (cannot happen for finite values below ~1e38).
+std::string encode_panes(const Prm& p, std::vector<float>& scales, std::vector<std::byte>& planes) {
+  const std::size_t per_pane = p.texels.size() * 3;
+  const std::size_t total = p.panes.size();
+  scales.assign(static_cast<std::size_t>(p.cluster_count), 1.0f);
+  planes.assign(total * 2, std::byte{0});
+  for (std::size_t c = 0; c < scales.size(); ++c) {
+    const auto first = p.panes.begin() + static_cast<std::ptrdiff_t>(c * per_pane);
+    const float max_value = per_pane == 0 ? 0.0f : *std::max_element(first, first + static_cast<std::ptrdiff_t>(per_pane));
+    const float scale = pane_scale(max_value);
+    scales[c] = scale;
+    for (std::size_t j = c * per_pane; j < (c + 1) * per_pane; ++j) {
+      const std::uint16_t h = float_to_half(p.panes[j] / scale);
+      if (!std::isfinite(half_to_float(h) * scale))
+        return "pane " + str(c) + " value " + std::to_string(p.panes[j]) + " is too large to store";
+      planes[j] = static_cast<std::byte>(h & 0xffu);
+      planes[total + j] = static_cast<std::byte>(h >> 8);
+    }
+  }
+  return {};
+}
+
+}  // namespace
+
+std::uint16_t float_to_half(float v) {
+  const auto bits = std::bit_cast<std::uint32_t>(v);
+  const auto sign = static_cast<std::uint16_t>((bits >> 16) & 0x8000u);
+  const std::uint32_t exponent = (bits >> 23) & 0xffu;
+  std::uint32_t mantissa = bits & 0x7fffffu;
+  if (exponent == 0xffu) return static_cast<std::uint16_t>(sign | 0x7c00u | (mantissa != 0 ? 0x200u : 0u));
+  const int e = static_cast<int>(exponent) - 127 + 15;  // the half's biased exponent
+  if (e >= 31) return static_cast<std::uint16_t>(sign | 0x7c00u);
+  if (e <= 0) {
+    // Half subnormal k x 2^-24 with k = (1.m x 2^23) >> (14 - e), rounded to nearest even.
+    if (exponent == 0) return sign;  // float zero or subnormal: far below 2^-25
+    mantissa |= 0x800000u;
+    const int shift = 14 - e;
+    if (shift > 24) return sign;  // below 2^-25: rounds to zero
+    std::uint32_t k = mantissa >> shift;
+    const std::uint32_t rest = mantissa & ((1u << shift) - 1u);
+    const std::uint32_t halfway = 1u << (shift - 1);
+    if (rest > halfway || (rest == halfway && (k & 1u) != 0)) ++k;
+    return static_cast<std::uint16_t>(sign | k);  // k == 0x400 is the smallest normal, correctly
+  }
+  std::uint32_t h = (static_cast<std::uint32_t>(e) << 10) | (mantissa >> 13);
+  const std::uint32_t rest = mantissa & 0x1fffu;
+  if (rest > 0x1000u || (rest == 0x1000u && (h & 1u) != 0)) ++h;  // a carry may reach infinity, correctly
+  return static_cast<std::uint16_t>(sign | h);
+}
+
+float half_to_float(std::uint16_t h) {
+  const std::uint32_t sign = static_cast<std::uint32_t>(h & 0x8000u) << 16;
+  const std::uint32_t exponent = (h >> 10) & 0x1fu;
+  const std::uint32_t mantissa = h & 0x3ffu;
+  if (exponent == 0) {
+    const float magnitude = std::ldexp(static_cast<float>(mantissa), -24);
+    return sign != 0 ? -magnitude : magnitude;
+  }
+  if (exponent == 31) return std::bit_cast<float>(sign | 0x7f800000u | (mantissa << 13));
+  return std::bit_cast<float>(sign | ((exponent - 15 + 127) << 23) | (mantissa << 13));
+}
+
+engine::Status write_prm_panes(const fs::path& path, const Prm& prm, const std::string& geometry_hash) {
+  if (std::string problem = check_prm(prm); !problem.empty())
+    return file_error(path, "", "cannot save the PRM: " + problem);
+  std::vector<float> scales;
+  std::vector<std::byte> planes;
+  if (std::string problem = encode_panes(prm, scales, planes); !problem.empty())
+    return file_error(path, "", "cannot save the PRM: " + problem);
+
+  std::vector<std::byte> frame(ZSTD_compressBound(planes.size()));
+  ZSTD_CCtx* cctx = ZSTD_createCCtx();
+  if (cctx == nullptr) return file_error(path, "", "cannot create a zstd compression context");
+  ZSTD_CCtx_setParameter(cctx, ZSTD_c_compressionLevel, kZstdLevel);
+  ZSTD_CCtx_setParameter(cctx, ZSTD_c_checksumFlag, 1);
+  ZSTD_CCtx_setParameter(cctx, ZSTD_c_contentSizeFlag, 1);
+  const std::size_t packed = ZSTD_compress2(cctx, frame.data(), frame.size(), planes.data(), planes.size());
+  ZSTD_freeCCtx(cctx);
+  if (ZSTD_isError(packed) != 0)
+    return file_error(path, "", std::string("zstd compression failed: ") + ZSTD_getErrorName(packed));
+  frame.resize(packed);
+
+  const PrmSettings& s = prm.settings;
+  std::vector<glm::vec3> position, normal;
+  std::vector<float> area;
+  std::vector<std::uint32_t> cluster;
+  for (const PrmEntryPoint& e : prm.entries) {
+    position.push_back(e.position);
+    normal.push_back(e.normal);
+    area.push_back(e.area_m2);
+    cluster.push_back(e.cluster);
+  }
+  ByteWriter w;
+  w.put_string(geometry_hash);
+  w.put(s.texels_per_metre);
+  w.put(static_cast<std::int32_t>(s.entry_points));
+  w.put(static_cast<std::int32_t>(s.clusters));
+  w.put(s.splitting);
+  w.put(static_cast<std::int32_t>(s.max_path_nodes));
+  w.put(static_cast<std::uint8_t>(s.kmeans ? 1 : 0));
+  w.put(static_cast<std::uint64_t>(s.seed));
+  w.put(static_cast<std::uint32_t>(s.threads));
+  w.put(static_cast<std::int32_t>(prm.width));
+  w.put(static_cast<std::int32_t>(prm.height));
+  w.put(static_cast<std::int32_t>(prm.cluster_count));
+  w.put_array(as_span(prm.texels));
+  w.put_array(as_span(position));
+  w.put_array(as_span(normal));
+  w.put_array(as_span(area));
+  w.put_array(as_span(cluster));
+  w.put_array(as_span(prm.cluster_size));
+  w.put_array(as_span(scales));
+  w.put(static_cast<std::uint64_t>(planes.size()));
+  w.put_array(std::span<const std::uint8_t>(reinterpret_cast<const std::uint8_t*>(frame.data()), frame.size()));
+  return write_blob(path, kPrmPanesMagic, kPrmPanesVersion, w.bytes());
+}
+
+engine::Result<PrmPaneFile> read_prm_panes(const fs::path& path) {
+  auto payload = read_blob(path, kPrmPanesMagic, kPrmPanesVersion);
+  if (!payload) return payload.error();
+  ByteReader r(payload.value());
+  PrmPaneFile f;
+  Prm& p = f.prm;
+  PrmSettings& s = p.settings;
+  std::int32_t entry_points = 0, clusters = 0, max_path_nodes = 0, width = 0, height = 0, cluster_count = 0;
+  std::uint8_t kmeans = 0;
+  std::uint64_t seed = 0, pane_half_bytes = 0;
+  std::uint32_t threads = 0;
+  std::vector<glm::vec3> position, normal;
+  std::vector<float> area, scales;
+  std::vector<std::uint32_t> cluster;
+  std::vector<std::uint8_t> frame;
+  const bool complete = r.get_string(f.geometry_hash) && r.get(s.texels_per_metre) && r.get(entry_points) &&
+                        r.get(clusters) && r.get(s.splitting) && r.get(max_path_nodes) && r.get(kmeans) &&
+                        r.get(seed) && r.get(threads) && r.get(width) && r.get(height) && r.get(cluster_count) &&
+                        r.get_array(p.texels) && r.get_array(position) && r.get_array(normal) &&
+                        r.get_array(area) && r.get_array(cluster) && r.get_array(p.cluster_size) &&
+                        r.get_array(scales) && r.get(pane_half_bytes) && r.get_array(frame);
+  const std::string location = "payload byte " + std::to_string(r.offset());
+  if (!complete) return file_error(path, location, "truncated payload");
+  if (r.remaining() != 0) return file_error(path, location, "unexpected data after the last field");
+  if (kmeans > 1) return file_error(path, "settings", "kmeans must be 0 or 1");
+  s.entry_points = entry_points;
+  s.clusters = clusters;
+  s.max_path_nodes = max_path_nodes;
+  s.kmeans = kmeans != 0;
+  s.seed = seed;
+  s.threads = threads;
+  p.width = width;
+  p.height = height;
+  p.cluster_count = cluster_count;
+
+  const std::size_t n_entries = position.size();
+  if (normal.size() != n_entries || area.size() != n_entries || cluster.size() != n_entries)
+    return file_error(path, "entry points",
+                      "arrays differ in size (position " + str(n_entries) + ", normal " + str(normal.size()) +
+                          ", area " + str(area.size()) + ", cluster " + str(cluster.size()) + ")");
+  p.entries.resize(n_entries);
+  for (std::size_t k = 0; k < n_entries; ++k) p.entries[k] = {position[k], normal[k], area[k], cluster[k]};
+  // Sizes before the panes are allocated: a corrupt count must not ask for gigabytes.
+  if (cluster_count < 1 || cluster_count > kMaxClusters)
+    return file_error(path, "cluster_count", "cluster_count " + std::to_string(cluster_count) + " is outside 1..65536");
+  if (scales.size() != static_cast<std::size_t>(cluster_count) ||
+      p.cluster_size.size() != static_cast<std::size_t>(cluster_count))
+    return file_error(path, "clusters",
+                      "cluster_size has " + str(p.cluster_size.size()) + " and pane_scale " + str(scales.size()) +
+                          " elements for " + std::to_string(cluster_count) + " clusters");
+  for (std::size_t c = 0; c < scales.size(); ++c)
+    if (!is_power_of_two(scales[c]))
+      return file_error(path, "pane_scale", "the scale of pane " + str(c) + " (" + std::to_string(scales[c]) +
+                                                ") is not a positive power of two");
+  const std::uint64_t values = static_cast<std::uint64_t>(cluster_count) * p.texels.size() * 3;
+  if (pane_half_bytes != values * 2)
+    return file_error(path, "pane_half_bytes",
+                      "the file says " + std::to_string(pane_half_bytes) + " bytes of halves, " +
+                          std::to_string(cluster_count) + " clusters x " + str(p.texels.size()) +
+                          " texels x 3 x 2 = " + std::to_string(values * 2) + " expected");
+  const unsigned long long content = ZSTD_getFrameContentSize(frame.data(), frame.size());
+  if (content == ZSTD_CONTENTSIZE_ERROR || content == ZSTD_CONTENTSIZE_UNKNOWN)
+    return file_error(path, "panes", "the pane data is not a zstd frame with a recorded size (corrupt)");
+  if (content != pane_half_bytes)
+    return file_error(path, "panes",
+                      "the zstd frame holds " + std::to_string(content) + " bytes, the header says " +
+                          std::to_string(pane_half_bytes));
+  const std::size_t frame_bytes = ZSTD_findFrameCompressedSize(frame.data(), frame.size());
+  if (ZSTD_isError(frame_bytes) != 0 || frame_bytes != frame.size())
+    return file_error(path, "panes", "the pane data is not exactly one zstd frame (corrupt)");
+  // A zstd block holds at most 128 KiB and takes at least 4 bytes (an RLE block), so a frame
+  // claiming more is corrupt: checked before allocating what it claims.
+  if (content / 131072 > frame.size() / 4 + 1)
+    return file_error(path, "panes", "the zstd frame is too small for the size it claims (corrupt)");
+  std::vector<std::uint8_t> planes(static_cast<std::size_t>(pane_half_bytes));
+  const std::size_t unpacked = ZSTD_decompress(planes.data(), planes.size(), frame.data(), frame.size());
+  if (ZSTD_isError(unpacked) != 0)
+    return file_error(path, "panes", std::string("zstd decompression failed: ") + ZSTD_getErrorName(unpacked));
+  if (unpacked != planes.size())
+    return file_error(path, "panes",
+                      "decompressed " + str(unpacked) + " bytes, " + str(planes.size()) + " expected");
+
+  const std::size_t total = static_cast<std::size_t>(values);
+  const std::size_t per_pane = p.texels.size() * 3;
+  p.panes.resize(total);
+  for (std::size_t j = 0; j < total; ++j) {
+    const auto h = static_cast<std::uint16_t>(planes[j] | (planes[total + j] << 8));
+    if ((h & 0x8000u) != 0 || (h & 0x7c00u) == 0x7c00u)
+      return file_error(path, "panes",
+                        "pane " + str(j / per_pane) + " texel " + str(p.texels[(j % per_pane) / 3]) + " channel " +
+                            str(j % 3) + " is negative, infinite or NaN (corrupt)");
+    p.panes[j] = half_to_float(h) * scales[j / per_pane];
+  }
+  if (std::string problem = check_prm(p); !problem.empty()) return file_error(path, "", problem);
+  return f;
+}
+
+engine::Status save_prm(const fs::path& bundle_dir, const Prm& prm, const engine::SceneAsset& asset,
+                        const std::string& scene_name) {
+  const fs::path panes = bundle_dir / kPrmPanesFile;
+  if (prm.width != prm.layout.width || prm.height != prm.layout.height)
+    return file_error(panes, "",
+                      "cannot save the PRM: its size " + std::to_string(prm.width) + "x" +
+                          std::to_string(prm.height) + " differs from its layout's " +
+                          std::to_string(prm.layout.width) + "x" + std::to_string(prm.layout.height));
+  // Checked before the directory is made, so a bad PRM leaves nothing behind.
+  if (std::string problem = check_prm(prm); !problem.empty())
+    return file_error(panes, "", "cannot save the PRM: " + problem);
+  std::error_code ec;
+  fs::create_directories(bundle_dir, ec);
+  if (ec) return engine::Error{bundle_dir.string(), "", "cannot create the bundle directory: " + ec.message()};
+
+  const std::string geometry_hash = scene_geometry_hash(asset);
+  if (engine::Status s = write_prm_panes(panes, prm, geometry_hash); !s) return s;
+  auto sum = file_checksum(panes);
+  if (!sum) return sum.error();
+  const std::uintmax_t file_bytes = fs::file_size(panes, ec);
+  if (ec) return file_error(panes, "", "cannot read the file size: " + ec.message());
+
+  const json entry{{"files", {{"panes", {{"file", kPrmPanesFile}, {"fnv1a64", *sum}}}}},
+                   {"settings", settings_json(prm.settings)},
+                   {"layout",
+                    {{"requested_texels_per_metre", prm.layout.requested_texels_per_metre},
+                     {"texels_per_metre", prm.layout.texels_per_metre},
+                     {"padding_texels", prm.layout.padding_texels},
+                     {"width", prm.layout.width},
+                     {"height", prm.layout.height}}},
+                   {"entry_points", prm.entries.size()},
+                   {"clusters", prm.cluster_count},
+                   {"pane_texels", prm.texels.size()},
+                   {"stats", stats_json(prm.stats)},
+                   {"memory",
+                    {{"pane_bytes_half", static_cast<std::uint64_t>(prm.panes.size()) * 2},
+                     {"file_bytes", static_cast<std::uint64_t>(file_bytes)}}}};
+  return update_manifest_method(bundle_dir, geometry_hash, scene_name, kPrmMethod, entry);
+}
+
+engine::Result<Prm> load_prm(const fs::path& bundle_dir, const engine::SceneAsset& asset) {
+  auto manifest = read_manifest(bundle_dir);
+  if (!manifest) return manifest.error();
+  const fs::path manifest_file = bundle_dir / kManifestFileName;
+  const std::string scene_hash = scene_geometry_hash(asset);
+  if (manifest->geometry_hash != scene_hash) {
+    const std::string scene = asset.source.empty() ? std::string("the scene") : asset.source;
+    return engine::Error{manifest_file.string(), "geometry_hash",
+                         "stale bundle " + bundle_dir.string() + ": baked from geometry " + manifest->geometry_hash +
+                             ", but " + scene + " hashes to " + scene_hash + " (re-bake the PRM)"};
+  }
+  auto entry_json = manifest_method(bundle_dir, *manifest, kPrmMethod);
+  if (!entry_json) return entry_json.error();
+  auto entry = read_entry(manifest_file, *entry_json);
+  if (!entry) return entry.error();
+
+  const fs::path panes_path = bundle_dir / entry->panes_file;
+  auto actual = file_checksum(panes_path);
+  if (!actual) return actual.error();
+  if (*actual != entry->panes_checksum)
+    return file_error(panes_path, "",
+                      "checksum mismatch: the manifest expects FNV-1a " + entry->panes_checksum + ", the file has " +
+                          *actual + " (corrupt, or from another bake; re-bake)");
+  auto file = read_prm_panes(panes_path);
+  if (!file) return file.error();
+  if (file->geometry_hash != manifest->geometry_hash)
+    return file_error(panes_path, "",
+                      "belongs to geometry " + file->geometry_hash + ", the manifest to " + manifest->geometry_hash);
+  Prm& prm = file->prm;
+  const std::string prefix = std::string("methods.") + kPrmMethod;
+  if (entry->entry_points != prm.entries.size() || entry->clusters != static_cast<std::size_t>(prm.cluster_count) ||
+      entry->pane_texels != prm.texels.size() || entry->width != prm.width || entry->height != prm.height)
+    return engine::Error{manifest_file.string(), prefix,
+                         "the manifest describes " + str(entry->entry_points) + " entry points, " +
+                             str(entry->clusters) + " clusters, " + str(entry->pane_texels) + " pane texels, " +
+                             std::to_string(entry->width) + "x" + std::to_string(entry->height) + "; " +
+                             panes_path.string() + " holds " + str(prm.entries.size()) + ", " +
+                             std::to_string(prm.cluster_count) + ", " + str(prm.texels.size()) + ", " +
+                             std::to_string(prm.width) + "x" + std::to_string(prm.height)};
+
+  auto layout = build_atlas_layout(
+      atlas_inputs_from(asset),
+      AtlasSettings{.texels_per_metre = entry->requested_texels_per_metre, .padding_texels = entry->padding_texels});
+  if (!layout) {
+    engine::Error e = layout.error();
+    e.message = "cannot rebuild the PRM atlas layout of " + manifest_file.string() + ": " + e.message;
+    return e;
+  }
+  if (layout->width != entry->width || layout->height != entry->height ||
+      layout->texels_per_metre != entry->texels_per_metre)
+    return engine::Error{manifest_file.string(), prefix + ".layout",
+                         "the rebuilt layout (" + std::to_string(layout->width) + "x" +
+                             std::to_string(layout->height) + ") differs from the baked one (" +
+                             std::to_string(entry->width) + "x" + std::to_string(entry->height) +
+                             "); the atlas code changed since the bake (re-bake)"};
+  prm.layout = std::move(layout).value();
+  prm.stats = entry->stats;
+  return std::move(file->prm);
+}
+
+}  // namespace gi
