@@ -12,6 +12,7 @@
 #include <engine/components.h>
 #include <engine/gpu/context.h>
 #include <engine/image.h>
+#include <gi/prm_lighting.h>
 
 #include "demo_run.h"
 
@@ -135,6 +136,13 @@ int run_headless(const RunOptions& o, RunState& state) {
   for (const auto& n : system_order) systems[n].print(n.c_str());
   if (!pass_order.empty()) std::printf("render passes:\n");
   for (const auto& n : pass_order) passes[n].print(n.c_str());
+  if (const auto* prm = dynamic_cast<const gi::PrmLighting*>(indirect.get())) {
+    const gi::PrmLighting::Stats& st = prm->stats();
+    std::printf("PRM: %llu of %llu frames re-lit (a moving light changed); last update: weights %.3f ms (CPU), pane sum "
+                "%.3f ms (GPU), %zu clusters, %.1f MB on the GPU\n",
+                static_cast<unsigned long long>(st.updates), static_cast<unsigned long long>(st.frames), st.last_weights_ms,
+                st.last_gpu_ms, st.last_active_clusters, static_cast<double>(st.gpu_bytes) / 1e6);
+  }
   std::printf("final state checksum 0x%016llx after frame %llu\n", static_cast<unsigned long long>(sim.checksum()),
               static_cast<unsigned long long>(sim.frame()));
   return 0;
