@@ -4,7 +4,7 @@
 // per-texel indirect irradiance with the moving light at the same pose
 // (docs/sweeps/README.md). Poses: "authored" (as in the scene file), "corner" (low in a
 // corner of the static bounds, facing the centre), "wall" (1 cm from the +x wall of the
-// static bounds, facing it).
+// static bounds, shining down along it).
 
 #include "sweep/sweep_registry.h"
 
