@@ -237,8 +237,11 @@ engine::Result<VplSet> distribute_vpls(const ReferenceScene& scene, const Refere
         sample_area = hs * hs;
       }
 
-      std::vector<Sample> seeds =
-          jittered_points(chart, plane, index, sm.first_triangle, static_cast<float>(h), rng);
+      // One sample per VPL: every sample is its own VPL (a second grid of the same spacing
+      // would leave about a third of its seeds without a sample).
+      std::vector<Sample> seeds = settings.samples_per_vpl == 1
+                                      ? samples
+                                      : jittered_points(chart, plane, index, sm.first_triangle, static_cast<float>(h), rng);
       if (seeds.empty()) seeds.push_back(samples[samples.size() / 2]);
 
       // Voronoi patches: every sample joins its nearest seed (in the chart's plane).

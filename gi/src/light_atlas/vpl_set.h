@@ -5,7 +5,7 @@
 // (a Voronoi patch), and the VPL moves to its patch's centroid (one Lloyd step, which keeps
 // VPLs away from corners and chart borders). A patch's area is the sum of the areas its
 // sample points stand for: eq. 1 (A_j = m_j C) with C computed per chart so every chart's
-// area is kept exactly.
+// area is kept exactly. With one sample per VPL every sample is a VPL (PRM's entry points).
 //   gi::VplSet vpls = gi::distribute_vpls(scene, index, {.vpl_count = 1000}).value();
 
 #include <cstdint>
