@@ -21,15 +21,6 @@ engine::Scene load(const char* name) {
   return engine::instantiate(std::move(asset.value()));
 }
 
-gi::RgbField field(int w, int h, const std::vector<glm::vec3>& v, const std::vector<std::uint8_t>& valid) {
-  gi::RgbField f;
-  f.width = w;
-  f.height = h;
-  f.valid = valid;
-  for (const glm::vec3& c : v) f.rgb.insert(f.rgb.end(), {c.x, c.y, c.z});
-  return f;
-}
-
 gi::AtlasIrradiance reference(const engine::Scene& scene, float density, int spp, int bounces = -1) {
   const auto inputs = gi::atlas_inputs_from(scene.assets);
   auto layout = gi::build_atlas_layout(inputs, {.texels_per_metre = density});
@@ -54,8 +45,8 @@ TEST(LightAtlasCornell, HighPresetMatchesReference) {
   s.texels_per_metre = 32.0f;
   auto bake = gi::bake_light_atlas(scene, s);
   ASSERT_TRUE(bake) << bake.error().to_string();
-  const gi::ErrorReport e = gi::compare_rgb(field(bake->width, bake->height, bake->irradiance, bake->valid),
-                                            field(truth.width, truth.height, truth.indirect, truth.valid));
+  const gi::ErrorReport e = gi::compare_rgb(gi::RgbField::from_texels(bake->width, bake->height, bake->irradiance, bake->valid),
+                                            gi::RgbField::from_texels(truth.width, truth.height, truth.indirect, truth.valid));
   std::printf("Cornell box, %zu VPLs, %d bounces: rel RMSE %.4f (scale fit %.4f, after fit %.4f), bake %.2f s\n",
               bake->stats.vpls, s.bounces, e.rel_rmse, e.fit_scale, e.fit_rel_rmse, bake->stats.total_seconds);
   EXPECT_LT(e.rel_rmse, 0.06);
@@ -94,8 +85,8 @@ TEST(LightAtlasCorridor, FiveBouncesReachTheCorridorOneBounceDoesNot) {
     for (std::size_t t = 0; t < mask.size(); ++t)
       if (mask[t]) sum += static_cast<double>(bake->irradiance[t].y);
     ratio[b == 1 ? 0 : 1] = sum / ref_sum;
-    const gi::ErrorReport e = gi::compare_rgb(field(bake->width, bake->height, bake->irradiance, mask),
-                                              field(truth.width, truth.height, truth.indirect, mask));
+    const gi::ErrorReport e = gi::compare_rgb(gi::RgbField::from_texels(bake->width, bake->height, bake->irradiance, mask),
+                                              gi::RgbField::from_texels(truth.width, truth.height, truth.indirect, mask));
     std::printf("corridor, %d bounce(s): corridor irradiance / reference %.4f, rel RMSE there %.4f, bake %.2f s\n", b,
                 sum / ref_sum, e.rel_rmse, bake->stats.total_seconds);
   }

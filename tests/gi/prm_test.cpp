@@ -43,15 +43,6 @@ std::vector<glm::vec3> relight(const gi::Prm& prm, const engine::Scene& scene, i
   return gi::sum_panes(prm, gi::relight_clusters(prm, gi::scene_lights(scene.registry, gi::BakeLights::Moving), **caster, k));
 }
 
-gi::RgbField field(int w, int h, const std::vector<glm::vec3>& v, const std::vector<std::uint8_t>& valid) {
-  gi::RgbField f;
-  f.width = w;
-  f.height = h;
-  f.valid = valid;
-  for (const glm::vec3& c : v) f.rgb.insert(f.rgb.end(), {c.x, c.y, c.z});
-  return f;
-}
-
 // The three positions include a light low in a corner, 0.3 m from two walls. Measured
 // (4096-sample reference): rel RMSE 0.077, 0.088, 0.078.
 TEST(PrmChamber, ThreeLightPositionsMatchTheReference) {
@@ -78,7 +69,7 @@ TEST(PrmChamber, ThreeLightPositionsMatchTheReference) {
     ASSERT_TRUE(truth);
     const std::vector<glm::vec3> ours = relight(*prm, scene);
     const gi::ErrorReport e =
-        gi::compare_rgb(field(prm->width, prm->height, ours, truth->valid), field(truth->width, truth->height, truth->indirect, truth->valid));
+        gi::compare_rgb(gi::RgbField::from_texels(prm->width, prm->height, ours, truth->valid), gi::RgbField::from_texels(truth->width, truth->height, truth->indirect, truth->valid));
     std::printf("light at (%.1f %.1f %.1f): rel RMSE %.4f, scale fit %.4f, after fit %.4f\n", double{l.p.x},
                 double{l.p.y}, double{l.p.z}, e.rel_rmse, e.fit_scale, e.fit_rel_rmse);
     EXPECT_LT(e.rel_rmse, 0.10);

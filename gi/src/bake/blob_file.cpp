@@ -106,4 +106,22 @@ engine::Result<std::vector<std::byte>> read_blob(const std::filesystem::path& pa
   return payload;
 }
 
+engine::Result<std::string> file_checksum(const std::filesystem::path& path) {
+  auto bytes = read_file_bytes(path);
+  if (!bytes) return bytes.error();
+  ContentHash h;
+  h.add_bytes(bytes->data(), bytes->size());
+  return h.hex();
+}
+
+engine::Status check_file_checksum(const std::filesystem::path& path, const std::string& expected) {
+  auto actual = file_checksum(path);
+  if (!actual) return actual.error();
+  if (*actual != expected)
+    return engine::Error{path.string(), "",
+                         "checksum mismatch: the manifest expects FNV-1a " + expected + ", the file has " + *actual +
+                             " (corrupt, or from another bake; re-bake)"};
+  return {};
+}
+
 }  // namespace gi

@@ -43,6 +43,13 @@ engine::Status write_file_atomic(const std::filesystem::path& path, std::span<co
 /// Reads a whole file. Error (naming it) when it is missing or unreadable.
 engine::Result<std::vector<std::byte>> read_file_bytes(const std::filesystem::path& path);
 
+/// FNV-1a 64 (gi::ContentHash) of a whole file as 16 hex digits: what a manifest records
+/// for each file it references. Error (naming it) when it cannot be read.
+engine::Result<std::string> file_checksum(const std::filesystem::path& path);
+
+/// Error naming `path` unless its file_checksum equals `expected` (the manifest's).
+engine::Status check_file_checksum(const std::filesystem::path& path, const std::string& expected);
+
 /// Header + payload, written atomically.
 engine::Status write_blob(const std::filesystem::path& path, BlobMagic magic, std::uint32_t version,
                           std::span<const std::byte> payload);

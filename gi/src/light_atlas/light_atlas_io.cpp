@@ -9,7 +9,6 @@
 #include "bake/bundle.h"
 #include "bake/json_fields.h"
 #include "light_atlas/light_atlas_vpl_file.h"
-#include "sweep/content_hash.h"
 #include "uv/atlas_input.h"
 
 namespace gi {
@@ -18,14 +17,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
-
-engine::Result<std::string> file_checksum(const fs::path& path) {
-  auto bytes = read_file_bytes(path);
-  if (!bytes) return bytes.error();
-  ContentHash h;
-  h.add_bytes(bytes->data(), bytes->size());
-  return h.hex();
-}
 
 json settings_json(const LightAtlasSettings& s) {
   return json{{"texels_per_metre", s.texels_per_metre},
@@ -100,16 +91,6 @@ engine::Result<EntryInfo> read_entry(const fs::path& manifest_file, const json& 
       return engine::Error{manifest_file.string(), "methods.light_atlas.files",
                            "\"" + *name + "\" is not a file name inside the bundle"};
   return e;
-}
-
-engine::Status check_checksum(const fs::path& path, const std::string& expected) {
-  auto actual = file_checksum(path);
-  if (!actual) return actual.error();
-  if (*actual != expected)
-    return engine::Error{path.string(), "",
-                         "checksum mismatch: the manifest expects FNV-1a " + expected + ", the file has " + *actual +
-                             " (corrupt, or from another bake; re-bake)"};
-  return {};
 }
 
 // Fills irradiance and valid from the EXR, checking its size and values.
@@ -213,8 +194,8 @@ engine::Result<LightAtlasBake> load_light_atlas(const fs::path& bundle_dir, cons
 
   const fs::path vpls_path = bundle_dir / entry->vpls_file;
   const fs::path exr_path = bundle_dir / entry->exr_file;
-  if (engine::Status s = check_checksum(vpls_path, entry->vpls_checksum); !s) return s.error();
-  if (engine::Status s = check_checksum(exr_path, entry->exr_checksum); !s) return s.error();
+  if (engine::Status s = check_file_checksum(vpls_path, entry->vpls_checksum); !s) return s.error();
+  if (engine::Status s = check_file_checksum(exr_path, entry->exr_checksum); !s) return s.error();
   auto vpl_file = read_light_atlas_vpls(vpls_path);
   if (!vpl_file) return vpl_file.error();
   if (vpl_file->geometry_hash != manifest->geometry_hash)

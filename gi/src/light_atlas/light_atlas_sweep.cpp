@@ -40,12 +40,7 @@ void register_light_atlas_sweep(SweepRegistry& registry) {
     if (bake->width != ctx.reference.width || bake->height != ctx.reference.height)
       return engine::Error{.message = "the bake's atlas size differs from the reference's"};
     MethodOutput out;
-    out.field.width = bake->width;
-    out.field.height = bake->height;
-    out.field.valid = bake->valid;
-    out.field.rgb.resize(3 * out.field.count());
-    for (std::size_t i = 0; i < out.field.count(); ++i)
-      for (int c = 0; c < 3; ++c) out.field.rgb[3 * i + static_cast<std::size_t>(c)] = bake->irradiance[i][c];
+    out.field = RgbField::from_texels(bake->width, bake->height, bake->irradiance, bake->valid);
     out.costs.bake_seconds = bake->stats.total_seconds;
     // What a game ships: the atlas as RGBA16F.
     out.costs.bytes = static_cast<std::uint64_t>(bake->width) * static_cast<std::uint64_t>(bake->height) * 8u;

@@ -6,7 +6,10 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <vector>
+
+#include <glm/glm.hpp>
 
 namespace gi {
 
@@ -35,6 +38,18 @@ struct RgbField {
     f.width = w;
     f.height = h;
     f.rgb.assign(3 * f.count(), value);
+    return f;
+  }
+
+  /// A width x height field from RGB triples (row-major, width * height of them) and a
+  /// mask (empty: every element valid). Precondition: the sizes agree.
+  static RgbField from_texels(int w, int h, std::span<const glm::vec3> values, std::vector<std::uint8_t> mask = {}) {
+    RgbField f;
+    f.width = w;
+    f.height = h;
+    f.valid = std::move(mask);
+    f.rgb.reserve(3 * values.size());
+    for (const glm::vec3& v : values) f.rgb.insert(f.rgb.end(), {v.x, v.y, v.z});
     return f;
   }
 };

@@ -13,7 +13,6 @@
 #include "bake/bundle.h"
 #include "bake/byte_stream.h"
 #include "bake/json_fields.h"
-#include "sweep/content_hash.h"
 #include "uv/atlas_input.h"
 
 namespace gi {
@@ -104,14 +103,6 @@ bool is_power_of_two(float s) {
 
 engine::Error file_error(const fs::path& path, std::string location, std::string message) {
   return engine::Error{path.string(), std::move(location), std::move(message)};
-}
-
-engine::Result<std::string> file_checksum(const fs::path& path) {
-  auto bytes = read_file_bytes(path);
-  if (!bytes) return bytes.error();
-  ContentHash h;
-  h.add_bytes(bytes->data(), bytes->size());
-  return h.hex();
 }
 
 json settings_json(const PrmSettings& s) {
@@ -445,12 +436,7 @@ engine::Result<Prm> load_prm(const fs::path& bundle_dir, const engine::SceneAsse
   if (!entry) return entry.error();
 
   const fs::path panes_path = bundle_dir / entry->panes_file;
-  auto actual = file_checksum(panes_path);
-  if (!actual) return actual.error();
-  if (*actual != entry->panes_checksum)
-    return file_error(panes_path, "",
-                      "checksum mismatch: the manifest expects FNV-1a " + entry->panes_checksum + ", the file has " +
-                          *actual + " (corrupt, or from another bake; re-bake)");
+  if (engine::Status s = check_file_checksum(panes_path, entry->panes_checksum); !s) return s.error();
   auto file = read_prm_panes(panes_path);
   if (!file) return file.error();
   if (file->geometry_hash != manifest->geometry_hash)

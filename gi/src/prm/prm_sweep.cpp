@@ -65,17 +65,6 @@ engine::Result<engine::Scene> posed_scene(engine::SceneAsset asset, const std::s
   return engine::instantiate(std::move(asset));
 }
 
-RgbField atlas_field(int w, int h, const std::vector<glm::vec3>& v, const std::vector<std::uint8_t>& valid) {
-  RgbField f;
-  f.width = w;
-  f.height = h;
-  f.valid = valid;
-  f.rgb.resize(3 * f.count());
-  for (std::size_t i = 0; i < f.count(); ++i)
-    for (int c = 0; c < 3; ++c) f.rgb[3 * i + static_cast<std::size_t>(c)] = v[i][c];
-  return f;
-}
-
 }  // namespace
 
 void register_prm_sweep(SweepRegistry& registry) {
@@ -93,7 +82,7 @@ void register_prm_sweep(SweepRegistry& registry) {
          rs.progress = job.progress;
          auto truth = reference_atlas_irradiance(*scene, rasterize_atlas(*layout, inputs), rs);
          if (!truth) return truth.error();
-         return atlas_field(truth->width, truth->height, truth->indirect, truth->valid);
+         return RgbField::from_texels(truth->width, truth->height, truth->indirect, truth->valid);
        }});
 
   SweepMethod m;
@@ -145,7 +134,7 @@ void register_prm_sweep(SweepRegistry& registry) {
     const std::vector<glm::vec3> atlas = sum_panes(*prm, picked);
     const double frame_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     MethodOutput out;
-    out.field = atlas_field(prm->width, prm->height, atlas, ctx.reference.valid);
+    out.field = RgbField::from_texels(prm->width, prm->height, atlas, ctx.reference.valid);
     out.costs.bake_seconds = prm->stats.total_seconds;
     out.costs.frame_ms = frame_ms;
     out.costs.bytes = static_cast<std::uint64_t>(prm->cluster_count) * prm->pane_size() * 3u * 2u;  // half-float panes

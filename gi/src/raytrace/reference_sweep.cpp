@@ -58,14 +58,7 @@ engine::Result<RgbField> atlas_indirect(const SweepScene& s, const ReferenceRequ
   if (!layout) return layout.error();
   auto truth = reference_atlas_irradiance(scene, rasterize_atlas(*layout, inputs), settings);
   if (!truth) return truth.error();
-  RgbField f;
-  f.width = truth->width;
-  f.height = truth->height;
-  f.valid = truth->valid;
-  f.rgb.resize(3 * f.count());
-  for (std::size_t i = 0; i < f.count(); ++i)
-    for (int c = 0; c < 3; ++c) f.rgb[3 * i + static_cast<std::size_t>(c)] = truth->indirect[i][c];
-  return f;
+  return RgbField::from_texels(truth->width, truth->height, truth->indirect, truth->valid);
 }
 
 // Converged-reference settings: the request's spp, the reference seed, unlimited bounces.
