@@ -1,0 +1,181 @@
+#include "brf/radiance_field.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "brf/spherical_harmonics.h"
+#include "core/thread_pool.h"
+#include "raytrace/embree_ray_caster.h"
+
+namespace gi {
+namespace {
+
+// Cube face f's point (u, v) in [-1, 1]^2 as a direction (not normalized).
+glm::vec3 cube_direction(int f, float u, float v) {
+  switch (f) {
+    case 0: return {1.0f, v, -u};
+    case 1: return {-1.0f, v, u};
+    case 2: return {u, 1.0f, -v};
+    case 3: return {u, -1.0f, v};
+    case 4: return {u, v, 1.0f};
+    default: return {-u, v, -1.0f};
+  }
+}
+
+// The face and (u, v) of a direction (inverse of cube_direction).
+void cube_face(const glm::vec3& d, int& f, float& u, float& v) {
+  const glm::vec3 a = glm::abs(d);
+  if (a.x >= a.y && a.x >= a.z) {
+    f = d.x > 0.0f ? 0 : 1;
+    u = d.x > 0.0f ? -d.z / a.x : d.z / a.x;
+    v = d.y / a.x;
+  } else if (a.y >= a.z) {
+    f = d.y > 0.0f ? 2 : 3;
+    u = d.x / a.y;
+    v = d.y > 0.0f ? -d.z / a.y : d.z / a.y;
+  } else {
+    f = d.z > 0.0f ? 4 : 5;
+    u = d.z > 0.0f ? d.x / a.z : -d.x / a.z;
+    v = d.y / a.z;
+  }
+}
+
+std::vector<glm::vec3> fibonacci_directions(int n) {
+  std::vector<glm::vec3> out;
+  const double golden = std::numbers::pi * (3.0 - std::sqrt(5.0));
+  for (int i = 0; i < n; ++i) {
+    const double z = 1.0 - (2.0 * i + 1.0) / n;
+    const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
+    out.emplace_back(static_cast<float>(r * std::cos(golden * i)), static_cast<float>(r * std::sin(golden * i)),
+                     static_cast<float>(z));
+  }
+  return out;
+}
+
+}  // namespace
+
+float BasisRadianceField::sphere_radius(int s) const {
+  if (spheres <= 1) return inner_radius;
+  return inner_radius * std::pow(outer_radius / inner_radius, static_cast<float>(s) / static_cast<float>(spheres - 1));
+}
+
+void BasisRadianceField::sample(const glm::vec3& p, std::span<float> out) const {
+  const auto per_point = static_cast<std::size_t>(basis_count * coefficient_count());
+  std::fill(out.begin(), out.begin() + static_cast<std::ptrdiff_t>(per_point), 0.0f);
+  const glm::vec3 d = p - centre;
+  const float r = glm::length(d);
+  if (!(r > 0.0f) || !std::isfinite(r)) return;
+  // Radius: linear in log r between spheres; clamped inside; 1/r^2 beyond the outermost.
+  float falloff = 1.0f;
+  float sr = 0.0f;
+  if (r <= inner_radius || spheres == 1) {
+    sr = 0.0f;
+  } else if (r >= outer_radius) {
+    sr = static_cast<float>(spheres - 1);
+    falloff = (outer_radius / r) * (outer_radius / r);
+  } else {
+    sr = std::log(r / inner_radius) / std::log(outer_radius / inner_radius) * static_cast<float>(spheres - 1);
+  }
+  const int s0 = std::min(static_cast<int>(sr), spheres - 1), s1 = std::min(s0 + 1, spheres - 1);
+  const float ts = sr - static_cast<float>(s0);
+  int f = 0;
+  float u = 0.0f, v = 0.0f;
+  cube_face(d, f, u, v);
+  // Cell centres sit at ((k + 0.5) / res) * 2 - 1; clamp to the face (seams use the edge).
+  const float n = static_cast<float>(face_resolution);
+  const float fu = std::clamp((u + 1.0f) * 0.5f * n - 0.5f, 0.0f, n - 1.0f);
+  const float fv = std::clamp((v + 1.0f) * 0.5f * n - 0.5f, 0.0f, n - 1.0f);
+  const int u0 = static_cast<int>(fu), v0 = static_cast<int>(fv);
+  const int u1 = std::min(u0 + 1, face_resolution - 1), v1 = std::min(v0 + 1, face_resolution - 1);
+  const float tu = fu - static_cast<float>(u0), tv = fv - static_cast<float>(v0);
+  const auto point = [&](int s, int uu, int vv) {
+    const std::size_t idx = ((static_cast<std::size_t>(s) * 6 + static_cast<std::size_t>(f)) * static_cast<std::size_t>(face_resolution) +
+                             static_cast<std::size_t>(vv)) * static_cast<std::size_t>(face_resolution) + static_cast<std::size_t>(uu);
+    return coefficients.data() + idx * per_point;
+  };
+  const struct {
+    int s, u, v;
+    float w;
+  } corners[8] = {{s0, u0, v0, (1 - ts) * (1 - tu) * (1 - tv)}, {s0, u1, v0, (1 - ts) * tu * (1 - tv)},
+                  {s0, u0, v1, (1 - ts) * (1 - tu) * tv},       {s0, u1, v1, (1 - ts) * tu * tv},
+                  {s1, u0, v0, ts * (1 - tu) * (1 - tv)},       {s1, u1, v0, ts * tu * (1 - tv)},
+                  {s1, u0, v1, ts * (1 - tu) * tv},             {s1, u1, v1, ts * tu * tv}};
+  // The object's radiance coefficients fall off about as 1 / r^2 between spheres:
+  // interpolate r^2 x coefficients (linear interpolation of 1 / r^2 itself overestimates by
+  // up to a few percent between spheres).
+  const bool between = r > inner_radius && r < outer_radius && spheres > 1;
+  for (const auto& c : corners) {
+    if (c.w == 0.0f) continue;
+    const float* src = point(c.s, c.u, c.v);
+    const float rs = sphere_radius(c.s);
+    const float scale = c.w * falloff * (between ? (rs / r) * (rs / r) : 1.0f);
+    for (std::size_t k = 0; k < per_point; ++k) out[k] += scale * src[k];
+  }
+}
+
+engine::Result<BasisRadianceField> compute_basis_radiance_field(const BrfMesh& mesh, const BrfBasis& basis,
+                                                               const RadianceFieldSettings& settings) {
+  if (basis.vertex_count != mesh.positions.size() || basis.basis_count < 1)
+    return engine::Error{.message = "basis radiance field: the basis does not belong to this mesh"};
+  if (settings.spheres < 1 || settings.spheres > 256 || settings.face_resolution < 1 || settings.face_resolution > 256 ||
+      (settings.sh_bands != 3 && settings.sh_bands != 4) || settings.directions < 16 || settings.directions > 65536 ||
+      !(settings.inner_radius_scale > 0.0f) || !(settings.outer_radius_scale >= settings.inner_radius_scale))
+    return engine::Error{.message = "basis radiance field: settings out of range"};
+
+  BasisRadianceField field;
+  field.spheres = settings.spheres;
+  field.face_resolution = settings.face_resolution;
+  field.sh_bands = settings.sh_bands;
+  field.basis_count = basis.basis_count;
+  field.centre = basis.centre;
+  field.inner_radius = basis.radius * settings.inner_radius_scale;
+  field.outer_radius = basis.radius * settings.outer_radius_scale;
+  const auto coefs = static_cast<std::size_t>(field.coefficient_count());
+  const auto per_point = static_cast<std::size_t>(field.basis_count) * coefs;
+  const std::size_t res = static_cast<std::size_t>(settings.face_resolution);
+  const std::size_t points = static_cast<std::size_t>(settings.spheres) * 6 * res * res;
+  field.coefficients.assign(points * per_point, 0.0f);
+
+  RtSceneData data;
+  data.geometries.push_back({mesh.positions, mesh.indices});
+  data.instances.push_back({0, glm::mat4(1.0f), false, 0});
+  auto caster = make_embree_ray_caster(data);
+  if (!caster) return caster.error();
+
+  const std::vector<glm::vec3> dirs = fibonacci_directions(settings.directions);
+  std::vector<std::array<float, kMaxShCoefficients>> y(dirs.size());
+  for (std::size_t k = 0; k < dirs.size(); ++k) y[k] = sh_basis(dirs[k]);
+  const float solid_angle = 4.0f * std::numbers::pi_v<float> / static_cast<float>(dirs.size());
+  const float inv_pi = 1.0f / std::numbers::pi_v<float>;
+  const std::size_t nv = basis.vertex_count;
+
+  ThreadPool pool(settings.threads);
+  pool.parallel_for(
+      points,
+      [&](std::size_t pt) {
+        const std::size_t s = pt / (6 * res * res), rem = pt % (6 * res * res);
+        const int f = static_cast<int>(rem / (res * res));
+        const std::size_t vv = (rem / res) % res, uu = rem % res;
+        const float u = (static_cast<float>(uu) + 0.5f) / static_cast<float>(res) * 2.0f - 1.0f;
+        const float v = (static_cast<float>(vv) + 0.5f) / static_cast<float>(res) * 2.0f - 1.0f;
+        const glm::vec3 p = field.centre + glm::normalize(cube_direction(f, u, v)) * field.sphere_radius(static_cast<int>(s));
+        float* out = field.coefficients.data() + pt * per_point;
+        for (std::size_t k = 0; k < dirs.size(); ++k) {
+          const Hit h = (*caster)->intersect(Ray{p, 0.0f, dirs[k]});
+          if (!h.valid() || glm::dot(h.geometric_normal, dirs[k]) >= 0.0f) continue;  // missed, or a back face
+          const std::uint32_t* tri = mesh.indices.data() + 3 * static_cast<std::size_t>(h.primitive);
+          const float b1 = h.barycentric.x, b2 = h.barycentric.y, b0 = 1.0f - b1 - b2;
+          for (std::size_t i = 0; i < static_cast<std::size_t>(field.basis_count); ++i) {
+            const float* psi = basis.psi.data() + i * nv;
+            // Radiance of a diffuse surface of radiosity Psi_i: Psi_i / pi (h(w) = 1/pi, K = 1).
+            const float radiance = (b0 * psi[tri[0]] + b1 * psi[tri[1]] + b2 * psi[tri[2]]) * inv_pi * solid_angle;
+            for (std::size_t c = 0; c < coefs; ++c) out[i * coefs + c] += radiance * y[k][c];
+          }
+        }
+      },
+      4);
+  return field;
+}
+
+}  // namespace gi

@@ -1,0 +1,35 @@
+#pragma once
+// Real spherical harmonics up to band 3 (16 coefficients; band l has 2l + 1), orthonormal
+// over the sphere, in the common "l, m" order: index = l (l + 1) + m. Used to store the
+// basis radiance of basis radiance fields (Iwasaki et al. §4.3) compactly.
+//   std::array<float, 16> y = gi::sh_basis(direction);   // unit direction
+//   float f = gi::sh_dot(coeffs_a, coeffs_b, 9);          // integral of the product (3 bands)
+
+#include <array>
+#include <cstddef>
+#include <span>
+
+#include <glm/glm.hpp>
+
+namespace gi {
+
+inline constexpr int kMaxShBands = 4;
+inline constexpr int kMaxShCoefficients = kMaxShBands * kMaxShBands;
+
+/// Y_lm(w) for l < 4 at a unit direction w (z up).
+std::array<float, kMaxShCoefficients> sh_basis(const glm::vec3& w);
+
+/// sum_i a_i b_i over the first `n` coefficients: the integral over the sphere of the
+/// product of the two functions (the basis is orthonormal).
+inline float sh_dot(std::span<const float> a, std::span<const float> b, std::size_t n) {
+  float s = 0.0f;
+  for (std::size_t i = 0; i < n; ++i) s += a[i] * b[i];
+  return s;
+}
+
+/// Coefficients of the clamped cosine max(0, n . w) around unit n (zonal: pi, 2pi/3, pi/4
+/// per band 0..2, 0 for band 3), for `bands` bands: dotted with a radiance's coefficients
+/// it gives the irradiance.
+std::array<float, kMaxShCoefficients> sh_clamped_cosine(const glm::vec3& n, int bands);
+
+}  // namespace gi
