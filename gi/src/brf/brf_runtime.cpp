@@ -7,11 +7,22 @@
 #include "raytrace/embree_ray_caster.h"
 
 namespace gi {
-namespace {
 
+BrfWorldVertices brf_world_vertices(const BrfObject& object) {
+  BrfWorldVertices v;
+  const glm::mat4& m = object.object_to_world;
+  const glm::mat3 nm = glm::transpose(glm::inverse(glm::mat3(m)));
+  const std::size_t count = object.mesh->positions.size();
+  v.positions.reserve(count);
+  v.normals.reserve(count);
+  for (std::size_t j = 0; j < count; ++j) {
+    v.positions.push_back(glm::vec3(m * glm::vec4(object.mesh->positions[j], 1.0f)));
+    v.normals.push_back(glm::normalize(nm * object.mesh->normals[j]));
+  }
+  return v;
+}
 
-// Weights (per channel) of radiosity values over an object's vertices.
-std::array<std::vector<float>, 3> fit_rgb(const BrfBasis& basis, const std::vector<glm::vec3>& radiosity) {
+std::array<std::vector<float>, 3> brf_fit_rgb(const BrfBasis& basis, std::span<const glm::vec3> radiosity) {
   std::array<std::vector<float>, 3> w;
   std::vector<float> channel(radiosity.size());
   for (int c = 0; c < 3; ++c) {
@@ -21,120 +32,196 @@ std::array<std::vector<float>, 3> fit_rgb(const BrfBasis& basis, const std::vect
   return w;
 }
 
-}  // namespace
+void brf_basis_irradiance(const BrfObject& source, std::span<const glm::vec3> positions,
+                          std::span<const glm::vec3> normals, std::vector<float>& out) {
+  const BasisRadianceField& f = *source.field;
+  const auto cc = static_cast<std::size_t>(f.coefficient_count());
+  const auto nb = static_cast<std::size_t>(f.basis_count);
+  const glm::mat4 to_source = glm::inverse(source.object_to_world);
+  // Rotation part only (uniform scale removed) for normals.
+  const glm::mat3 rot = glm::mat3(to_source);
+  std::vector<float> coeffs(nb * cc);
+  out.assign(positions.size() * nb, 0.0f);
+  for (std::size_t j = 0; j < positions.size(); ++j) {
+    const glm::vec3 p = glm::vec3(to_source * glm::vec4(positions[j], 1.0f));
+    const glm::vec3 n = glm::normalize(rot * normals[j]);
+    f.sample(p, coeffs);
+    const auto lobe = sh_clamped_cosine(n, f.sh_bands);
+    for (std::size_t i = 0; i < nb; ++i)
+      out[j * nb + i] = sh_dot(std::span<const float>(coeffs).subspan(i * cc), lobe, cc);
+  }
+}
 
-BrfResult update_brf(std::span<const BrfObject> objects, std::span<const PointEmitter> lights,
-                     const BrfUpdateSettings& settings) {
-  BrfResult out;
+std::vector<std::uint8_t> brf_pair_culling(std::span<const BrfObject> objects,
+                                           std::span<const std::array<std::vector<float>, 3>> weights,
+                                           float threshold) {
   const std::size_t n = objects.size();
-  out.direct.resize(n);
-  out.indirect.resize(n);
-  if (n == 0) return out;
+  std::vector<float> bound(n * n, 0.0f);
+  float largest = 0.0f;
+  std::vector<float> coeffs;
+  for (std::size_t s = 0; s < n; ++s)
+    for (std::size_t r = 0; r < n; ++r) {
+      if (s == r) continue;
+      const BasisRadianceField& f = *objects[s].field;
+      const glm::mat4 to_source = glm::inverse(objects[s].object_to_world);
+      const glm::vec3 centre_r = glm::vec3(objects[r].object_to_world * glm::vec4(objects[r].basis->centre, 1.0f));
+      const glm::vec3 p = glm::vec3(to_source * glm::vec4(centre_r, 1.0f));
+      coeffs.assign(static_cast<std::size_t>(f.basis_count * f.coefficient_count()), 0.0f);
+      f.sample(p, coeffs);
+      // Irradiance on the plane facing the source (the receiver's best case), largest channel.
+      const glm::vec3 to_centre = f.centre - p;
+      const glm::vec3 facing = glm::length(to_centre) > 0.0f ? glm::normalize(to_centre) : glm::vec3(0, 1, 0);
+      const auto lobe = sh_clamped_cosine(facing, f.sh_bands);
+      float b = 0.0f;
+      for (std::size_t c = 0; c < 3; ++c) {
+        float e = 0.0f;
+        for (int i = 0; i < f.basis_count; ++i)
+          e += weights[s][c][static_cast<std::size_t>(i)] *
+               sh_dot(std::span<const float>(coeffs).subspan(static_cast<std::size_t>(i * f.coefficient_count())), lobe,
+                      static_cast<std::size_t>(f.coefficient_count()));
+        b = std::max(b, std::fabs(e));
+      }
+      bound[s * n + r] = b;
+      largest = std::max(largest, b);
+    }
+  std::vector<std::uint8_t> culled(n * n, 1);
+  for (std::size_t s = 0; s < n; ++s)
+    for (std::size_t r = 0; r < n; ++r)
+      if (s != r && (threshold <= 0.0f || bound[s * n + r] > threshold * largest)) culled[s * n + r] = 0;
+  return culled;
+}
 
-  // All objects in one ray caster for shadows.
+std::vector<std::vector<glm::vec3>> brf_direct_light(std::span<const BrfObject> objects,
+                                                     std::span<const PointEmitter> lights, const RayCaster* world) {
+  const std::size_t n = objects.size();
+  std::vector<std::vector<glm::vec3>> direct(n);
+  if (n == 0) return direct;
   RtSceneData data;
   for (std::size_t o = 0; o < n; ++o) {
     data.geometries.push_back({objects[o].mesh->positions, objects[o].mesh->indices});
     data.instances.push_back({static_cast<std::uint32_t>(o), objects[o].object_to_world, true, o});
   }
   auto caster = make_embree_ray_caster(data);
-  if (!caster) return out;
-
-  // World-space vertices and normals.
-  std::vector<std::vector<glm::vec3>> wp(n), wn(n);
   for (std::size_t o = 0; o < n; ++o) {
-    const glm::mat4& m = objects[o].object_to_world;
-    const glm::mat3 nm = glm::transpose(glm::inverse(glm::mat3(m)));
-    for (std::size_t j = 0; j < objects[o].mesh->positions.size(); ++j) {
-      wp[o].push_back(glm::vec3(m * glm::vec4(objects[o].mesh->positions[j], 1.0f)));
-      wn[o].push_back(glm::normalize(nm * objects[o].mesh->normals[j]));
-    }
-  }
-
-  // 1. Direct light.
-  for (std::size_t o = 0; o < n; ++o) {
-    out.direct[o].assign(wp[o].size(), glm::vec3(0.0f));
-    out.indirect[o].assign(wp[o].size(), glm::vec3(0.0f));
-    for (std::size_t j = 0; j < wp[o].size(); ++j)
+    const BrfWorldVertices v = brf_world_vertices(objects[o]);
+    direct[o].assign(v.positions.size(), glm::vec3(0.0f));
+    for (std::size_t j = 0; j < v.positions.size(); ++j)
       for (const PointEmitter& l : lights) {
-        const glm::vec3 e = emitter_irradiance(l, wp[o][j], wn[o][j], 0.0f);
-        if (e != glm::vec3(0.0f) && emitter_visible(**caster, l, wp[o][j], wn[o][j])) out.direct[o][j] += e;
+        const glm::vec3 e = emitter_irradiance(l, v.positions[j], v.normals[j], 0.0f);
+        if (e == glm::vec3(0.0f)) continue;
+        if (caster && !emitter_visible(**caster, l, v.positions[j], v.normals[j])) continue;
+        if (world != nullptr && !emitter_visible(*world, l, v.positions[j], v.normals[j])) continue;
+        direct[o][j] += e;
       }
   }
+  return direct;
+}
 
-  // Pair culling (§5.4): the bound irradiance of each source at each receiver's centre,
-  // evaluated once with the source's mean weights.
-  std::vector<std::vector<glm::vec3>> light(n);  // radiosity leaving each vertex this bounce
-  for (std::size_t o = 0; o < n; ++o) {
-    light[o].resize(wp[o].size());
-    for (std::size_t j = 0; j < wp[o].size(); ++j) light[o][j] = objects[o].albedo * out.direct[o][j];
-  }
-  std::vector<float> coeffs;
-  for (int bounce = 0; bounce < settings.bounces; ++bounce) {
-    std::vector<std::array<std::vector<float>, 3>> w(n);
-    for (std::size_t s = 0; s < n; ++s) w[s] = fit_rgb(*objects[s].basis, light[s]);
-    // Bound contributions I_c of every pair for culling.
-    std::vector<float> bound(n * n, 0.0f);
-    float largest = 0.0f;
-    for (std::size_t s = 0; s < n; ++s)
-      for (std::size_t r = 0; r < n; ++r) {
-        if (s == r) continue;
-        const BasisRadianceField& f = *objects[s].field;
-        const glm::mat4 to_source = glm::inverse(objects[s].object_to_world);
-        const glm::vec3 centre_r = glm::vec3(objects[r].object_to_world * glm::vec4(objects[r].basis->centre, 1.0f));
-        const glm::vec3 p = glm::vec3(to_source * glm::vec4(centre_r, 1.0f));
-        coeffs.assign(static_cast<std::size_t>(f.basis_count * f.coefficient_count()), 0.0f);
-        f.sample(p, coeffs);
-        // Irradiance on the plane facing the source (the receiver's best case), per channel max.
-        const glm::vec3 facing = glm::normalize(f.centre - p);
-        const auto lobe = sh_clamped_cosine(glm::length(facing) > 0.0f ? facing : glm::vec3(0, 1, 0), f.sh_bands);
-        float b = 0.0f;
-        for (int c = 0; c < 3; ++c) {
-          float e = 0.0f;
-          for (int i = 0; i < f.basis_count; ++i)
-            e += w[s][static_cast<std::size_t>(c)][static_cast<std::size_t>(i)] *
-                 sh_dot(std::span<const float>(coeffs).subspan(static_cast<std::size_t>(i * f.coefficient_count())), lobe,
-                        static_cast<std::size_t>(f.coefficient_count()));
-          b = std::max(b, std::fabs(e));
-        }
-        bound[s * n + r] = b;
-        largest = std::max(largest, b);
-      }
-    std::vector<std::vector<glm::vec3>> gathered(n);
-    for (std::size_t r = 0; r < n; ++r) gathered[r].assign(wp[r].size(), glm::vec3(0.0f));
-    for (std::size_t s = 0; s < n; ++s) {
-      const BasisRadianceField& f = *objects[s].field;
-      const glm::mat4 to_source = glm::inverse(objects[s].object_to_world);
-      const glm::mat3 rot = glm::mat3(to_source);
-      const auto cc = static_cast<std::size_t>(f.coefficient_count());
-      for (std::size_t r = 0; r < n; ++r) {
-        if (s == r) continue;
-        if (bound[s * n + r] <= settings.cull_threshold * largest) {
-          ++out.pairs_culled;
-          continue;
-        }
-        ++out.pairs_evaluated;
-        coeffs.assign(static_cast<std::size_t>(f.basis_count) * cc, 0.0f);
-        for (std::size_t j = 0; j < wp[r].size(); ++j) {
-          const glm::vec3 p = glm::vec3(to_source * glm::vec4(wp[r][j], 1.0f));
-          const glm::vec3 nrm = glm::normalize(rot * wn[r][j]);
-          f.sample(p, coeffs);
-          const auto lobe = sh_clamped_cosine(nrm, f.sh_bands);
-          glm::vec3 e(0.0f);
-          for (int i = 0; i < f.basis_count; ++i) {
-            const float phi = sh_dot(std::span<const float>(coeffs).subspan(static_cast<std::size_t>(i) * cc), lobe, cc);
-            for (int c = 0; c < 3; ++c) e[c] += w[s][static_cast<std::size_t>(c)][static_cast<std::size_t>(i)] * phi;
-          }
-          gathered[r][j] += glm::max(e, glm::vec3(0.0f));  // SH ringing must not make light negative
-        }
-      }
+namespace {
+
+// E(x_j) += max(0, sum_i w_c,i Phi_i(x_j)) per channel.
+void gather(std::span<const float> phi, std::size_t basis_count, const std::array<std::vector<float>, 3>& w,
+            std::span<glm::vec3> out) {
+  for (std::size_t j = 0; j < out.size(); ++j) {
+    glm::vec3 e(0.0f);
+    for (std::size_t i = 0; i < basis_count; ++i) {
+      const float p = phi[j * basis_count + i];
+      for (std::size_t c = 0; c < 3; ++c) e[static_cast<int>(c)] += w[c][i] * p;
     }
+    out[j] += glm::max(e, glm::vec3(0.0f));  // SH ringing must not make light negative
+  }
+}
+
+}  // namespace
+
+BrfResult brf_interreflect(std::span<const BrfObject> objects, std::span<const std::vector<glm::vec3>> incoming,
+                           const BrfUpdateSettings& settings, const BrfStaticReceivers& receivers) {
+  BrfResult out;
+  const std::size_t n = objects.size();
+  out.indirect.resize(n);
+  out.static_irradiance.assign(receivers.positions.size(), glm::vec3(0.0f));
+  if (n == 0) return out;
+
+  std::vector<BrfWorldVertices> wv(n);
+  std::vector<std::vector<glm::vec3>> light(n);  // radiosity leaving each vertex this bounce
+  std::vector<std::vector<glm::vec3>> total(n);  // all radiosity leaving each vertex
+  for (std::size_t o = 0; o < n; ++o) {
+    wv[o] = brf_world_vertices(objects[o]);
+    out.indirect[o].assign(wv[o].positions.size(), glm::vec3(0.0f));
+    light[o].resize(wv[o].positions.size());
+    for (std::size_t j = 0; j < light[o].size(); ++j) light[o][j] = objects[o].albedo * incoming[o][j];
+    total[o] = light[o];
+  }
+  std::vector<std::array<std::vector<float>, 3>> w(n);
+  for (std::size_t s = 0; s < n; ++s) w[s] = brf_fit_rgb(*objects[s].basis, light[s]);
+  const std::vector<std::uint8_t> culled = brf_pair_culling(objects, w, settings.cull_threshold);
+
+  // Basis irradiance of every live pair, once per frame.
+  std::vector<std::vector<float>> phi(n * n);
+  for (std::size_t s = 0; s < n; ++s)
+    for (std::size_t r = 0; r < n; ++r) {
+      if (s == r) continue;
+      if (culled[s * n + r] != 0) {
+        ++out.pairs_culled;
+        continue;
+      }
+      ++out.pairs_evaluated;
+      brf_basis_irradiance(objects[s], wv[r].positions, wv[r].normals, phi[s * n + r]);
+    }
+
+  for (int bounce = 0; bounce < settings.bounces; ++bounce) {
+    if (bounce > 0)
+      for (std::size_t s = 0; s < n; ++s) w[s] = brf_fit_rgb(*objects[s].basis, light[s]);
+    std::vector<std::vector<glm::vec3>> gathered(n);
+    for (std::size_t r = 0; r < n; ++r) gathered[r].assign(wv[r].positions.size(), glm::vec3(0.0f));
+    for (std::size_t s = 0; s < n; ++s)
+      for (std::size_t r = 0; r < n; ++r)
+        if (s != r && culled[s * n + r] == 0)
+          gather(phi[s * n + r], static_cast<std::size_t>(objects[s].field->basis_count), w[s], gathered[r]);
     for (std::size_t r = 0; r < n; ++r)
-      for (std::size_t j = 0; j < wp[r].size(); ++j) {
+      for (std::size_t j = 0; j < gathered[r].size(); ++j) {
         out.indirect[r][j] += gathered[r][j];
         light[r][j] = objects[r].albedo * gathered[r][j];
+        total[r][j] += light[r][j];
       }
   }
+
+  // The static world receives every object's total radiosity inside its field.
+  if (!receivers.positions.empty()) {
+    std::vector<glm::vec3> pos, nrm;
+    std::vector<std::size_t> index;
+    std::vector<float> phi_static;
+    std::vector<glm::vec3> e;
+    for (std::size_t s = 0; s < n; ++s) {
+      const BasisRadianceField& f = *objects[s].field;
+      const glm::vec3 centre = glm::vec3(objects[s].object_to_world * glm::vec4(f.centre, 1.0f));
+      const float scale = glm::length(glm::vec3(objects[s].object_to_world[0]));
+      const float reach = f.outer_radius * scale;
+      pos.clear();
+      nrm.clear();
+      index.clear();
+      for (std::size_t t = 0; t < receivers.positions.size(); ++t)
+        if (glm::length(receivers.positions[t] - centre) <= reach) {
+          pos.push_back(receivers.positions[t]);
+          nrm.push_back(receivers.normals[t]);
+          index.push_back(t);
+        }
+      if (index.empty()) continue;
+      brf_basis_irradiance(objects[s], pos, nrm, phi_static);
+      const auto wt = brf_fit_rgb(*objects[s].basis, total[s]);
+      e.assign(index.size(), glm::vec3(0.0f));
+      gather(phi_static, static_cast<std::size_t>(f.basis_count), wt, e);
+      for (std::size_t k = 0; k < index.size(); ++k) out.static_irradiance[index[k]] += e[k];
+    }
+  }
+  return out;
+}
+
+BrfResult update_brf(std::span<const BrfObject> objects, std::span<const PointEmitter> lights,
+                     const BrfUpdateSettings& settings) {
+  std::vector<std::vector<glm::vec3>> direct = brf_direct_light(objects, lights, nullptr);
+  BrfResult out = brf_interreflect(objects, direct, settings);
+  out.direct = std::move(direct);
   return out;
 }
 

@@ -1,20 +1,30 @@
 #pragma once
 // The per-frame side of basis radiance fields on the CPU (Iwasaki et al. §5): rigid objects
-// with their precomputed basis and field, placed by world transforms. Each update:
+// with their precomputed basis and field, placed by world transforms. A frame is
 //   1. direct light at every object's vertices (point and spot lights, shadowed by all the
-//      objects);
-//   2. weights w = A^-1 b of each object's reflected light (eq. 14, per RGB channel);
-//   3. basis irradiance at every receiver vertex from every other source object: the
-//      source's field sampled at the vertex in the source's object space, dotted with the
-//      receiver normal's clamped-cosine lobe in that same space (rotating the zonal lobe into
-//      the source frame is the SH rotation of eq. 13 done on the receiver side);
-//      bounce radiosity B = albedo x sum_i w_i Phi_i (eq. 12);
-//   4. steps 2-3 again with B as the light, for more bounces.
-// Pairs whose bound contribution I_c (§5.4) is below a threshold are skipped.
-//   gi::BrfScene s; s.objects.push_back({&mesh, &basis, &field, transform, albedo});
-//   gi::BrfResult r = gi::update_brf(s, lights, {.bounces = 3});
+//      objects and the static world): brf_direct_light();
+//   2. brf_interreflect(), the CPU twin of the GPU pass (brf_gpu_pass.h), from the light
+//      arriving from outside the objects (direct + the static world's indirect light):
+//      a. weights w = A^-1 b of each object's reflected light (eq. 14, per RGB channel);
+//      b. the basis irradiance Phi_sr,i(x_j) of every (source s, receiver r) pair: the
+//         source's field sampled at receiver vertex x_j in the source's object space, dotted
+//         with the receiver normal's clamped-cosine lobe in that same space (rotating the
+//         zonal lobe into the source frame is the SH rotation of eq. 13 done on the receiver
+//         side). It depends on the pair's relative pose only, so it is computed once per
+//         frame and shared by all bounces (and the GPU pass keeps it while the pose holds);
+//      c. per bounce: E_r(x_j) = sum_s max(0, sum_i w_s,i Phi_sr,i(x_j)), the bounce
+//         radiosity B = albedo x E (eq. 12) is fitted again for the next bounce;
+//      d. static receivers (points of the static world, e.g. light-atlas texels) inside a
+//         source's outermost field sphere get that source's bounce from its total radiosity
+//         albedo x (incoming + interreflected).
+// Pairs whose bound contribution I_c (§5.4) — the first bounce's irradiance at the
+// receiver's centre, facing the source — is below `cull_threshold` x the largest pair's are
+// skipped for the whole frame (brf_pair_culling).
+//   std::vector<gi::BrfObject> objects{{&mesh, &basis, &field, transform, albedo}};
+//   gi::BrfResult r = gi::update_brf(objects, lights, {.bounces = 3});
 //   // r.indirect[object][vertex]: interreflected irradiance (W/m^2, RGB)
 
+#include <array>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -27,6 +37,8 @@
 
 namespace gi {
 
+class RayCaster;
+
 struct BrfObject {
   const BrfMesh* mesh = nullptr;
   const BrfBasis* basis = nullptr;
@@ -37,18 +49,58 @@ struct BrfObject {
 
 struct BrfUpdateSettings {
   int bounces = 3;
-  /// Skip a (source, receiver) pair when the source's bound irradiance at the receiver's
-  /// bounding-sphere centre is below this fraction of the largest pair's.
+  /// Skip a (source, receiver) pair when its bound contribution I_c is below this fraction
+  /// of the largest pair's (0: evaluate every pair).
   float cull_threshold = 1e-3f;
 };
 
+/// Points of the static world that take the objects' bounce (world space, unit normals).
+struct BrfStaticReceivers {
+  std::span<const glm::vec3> positions;
+  std::span<const glm::vec3> normals;
+};
+
 struct BrfResult {
-  std::vector<std::vector<glm::vec3>> direct;    ///< [object][vertex] direct irradiance.
+  std::vector<std::vector<glm::vec3>> direct;    ///< [object][vertex] direct irradiance (update_brf only).
   std::vector<std::vector<glm::vec3>> indirect;  ///< [object][vertex] interreflected irradiance.
+  std::vector<glm::vec3> static_irradiance;      ///< [static receiver] irradiance from all objects.
   std::size_t pairs_evaluated = 0;
   std::size_t pairs_culled = 0;
 };
 
+/// Per-vertex world-space positions and unit normals of an object.
+struct BrfWorldVertices {
+  std::vector<glm::vec3> positions, normals;
+};
+BrfWorldVertices brf_world_vertices(const BrfObject& object);
+
+/// Weights (per RGB channel, basis_count each) of per-vertex radiosity over an object.
+std::array<std::vector<float>, 3> brf_fit_rgb(const BrfBasis& basis, std::span<const glm::vec3> radiosity);
+
+/// The basis irradiance at world points p_j (unit normals n_j) from `source`'s field:
+/// out[j * basis_count + i] = Phi_i(p_j, n_j). out is resized.
+void brf_basis_irradiance(const BrfObject& source, std::span<const glm::vec3> positions,
+                          std::span<const glm::vec3> normals, std::vector<float>& out);
+
+/// Pair culling (§5.4): culled[s * n + r] != 0 when the bound irradiance of source s at
+/// receiver r's centre (facing s, weights `weights[s]`) is at most threshold x the largest
+/// pair's. The diagonal is always culled.
+std::vector<std::uint8_t> brf_pair_culling(std::span<const BrfObject> objects,
+                                           std::span<const std::array<std::vector<float>, 3>> weights,
+                                           float threshold);
+
+/// Direct irradiance at every object's vertices from point/spot emitters (world space),
+/// shadowed by all the objects and, when given, by `world` (the static scene).
+std::vector<std::vector<glm::vec3>> brf_direct_light(std::span<const BrfObject> objects,
+                                                     std::span<const PointEmitter> lights, const RayCaster* world);
+
+/// Steps 2a-2d from `incoming[object][vertex]`, the irradiance arriving from outside the
+/// objects. `direct` is left empty. Preconditions: sizes match the meshes; receiver spans
+/// have equal sizes.
+BrfResult brf_interreflect(std::span<const BrfObject> objects, std::span<const std::vector<glm::vec3>> incoming,
+                           const BrfUpdateSettings& settings, const BrfStaticReceivers& receivers = {});
+
+/// Direct light (objects only, no world) then brf_interreflect; `direct` is filled.
 /// Preconditions: every object's mesh, basis and field belong together; lights are point or
 /// spot emitters (PointEmitter::Kind::Punctual) in world space.
 BrfResult update_brf(std::span<const BrfObject> objects, std::span<const PointEmitter> lights,
