@@ -1,0 +1,63 @@
+#pragma once
+// The static world as a light source for dynamic objects: a regular grid of irradiance
+// probes, each holding the radiance arriving from the static world's baked light as 3-band
+// spherical harmonics (RGB). A dynamic vertex's world light is the probes' radiance,
+// interpolated trilinearly at its position, dotted with its normal's clamped-cosine lobe.
+//   auto grid = gi::bake_world_probes(*static_caster, atlas.vpls, atlas.vpl_power, {.spacing_m = 1.0f}).value();
+//   glm::vec3 e = grid.irradiance(world_position, world_normal);   // W/m^2
+//
+// The radiance comes from the light atlas's VPL solution (Schärfig 2016): VPL i leaving
+// power Phi_i from its patch (area A_i, normal n_i) sends a probe at distance d, direction
+// w (probe to VPL), the radiance-times-solid-angle Phi_i cos_i / (pi d^2 + A_i) (the
+// regularized Lambertian kernel of light_atlas/point_emitters.h), projected on Y(w), with
+// one shadow ray against the static world. It is what the atlas's final shooting sends into
+// texels, so the dynamic objects see the same world light as the static ones: direct light
+// reflected once plus the atlas's bounces, static lights only (moving lights' bounce off
+// the world, PRM's domain, is not in the probes).
+//
+// Probes inside geometry see no VPL; they get weight 0 and interpolation renormalizes over
+// the probes that do, so walls do not leak darkness into rooms. A point whose 8 probes are
+// all invalid gets no world light.
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include <engine/result.h>
+
+#include "light_atlas/vpl_set.h"
+
+namespace gi {
+
+class RayCaster;
+
+struct WorldProbeSettings {
+  float spacing_m = 1.0f;     ///< Grid spacing.
+  int max_probes = 65536;     ///< The spacing grows until the grid fits.
+  unsigned threads = 0;       ///< 0: all hardware threads. The result does not depend on it.
+};
+
+struct WorldProbeGrid {
+  glm::vec3 origin{0.0f};    ///< Probe (0, 0, 0).
+  float spacing = 1.0f;
+  glm::ivec3 dims{0};
+  /// Per probe (x fastest, then y, then z): 9 SH coefficients per channel, radiance_sh[p][k].
+  std::vector<std::array<glm::vec3, 9>> radiance_sh;
+  std::vector<std::uint8_t> valid;  ///< Probe sees at least one VPL.
+
+  std::size_t probe_count() const { return radiance_sh.size(); }
+  std::size_t bytes() const { return radiance_sh.size() * sizeof(radiance_sh[0]) + valid.size(); }
+  /// World light (W/m^2) at world point p with unit normal n; 0 outside the grid's reach.
+  glm::vec3 irradiance(const glm::vec3& p, const glm::vec3& n) const;
+};
+
+/// Probes over the bounding box of the VPLs (one spacing of margin). Errors: VPL arrays of
+/// different sizes, non-finite values, spacing not positive.
+engine::Result<WorldProbeGrid> bake_world_probes(const RayCaster& static_world, const VplSet& vpls,
+                                                 std::span<const glm::vec3> vpl_power,
+                                                 const WorldProbeSettings& settings);
+
+}  // namespace gi
