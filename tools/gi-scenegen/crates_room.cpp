@@ -38,8 +38,8 @@ engine::SceneAsset crates_room() {
 
   // Crates: 0.5 m cubes, local origin at the bottom centre, dynamic.
   MeshBuilder crate, red_crate;
-  crate.box(wood, {0, 0.25f, 0}, glm::vec3(0.25f));
-  red_crate.box(red, {0, 0.25f, 0}, glm::vec3(0.25f));
+  crate.tessellated_box(wood, {0, 0.25f, 0}, glm::vec3(0.25f), 6);  // per-vertex indirect light needs inner vertices
+  red_crate.tessellated_box(red, {0, 0.25f, 0}, glm::vec3(0.25f), 6);
   const int crate_mesh = b.add_mesh("crate", crate);
   const int red_mesh = b.add_mesh("crate_red", red_crate);
   b.add_instance_node("crate_red", red_mesh, engine::Mobility::Dynamic, {0.8f, 0, -0.6f});

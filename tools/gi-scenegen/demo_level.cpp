@@ -59,10 +59,18 @@ engine::SceneAsset demo_level() {
   b.add_mesh_node("crate_room_floor", crate_floor, engine::Mobility::Static);
   b.add_light_node("crate_room_light", point_light(12.0f), {11.2f, 2.8f, 4.0f});
   MeshBuilder crate, red_crate;
-  crate.box(wood, {0, 0.25f, 0}, glm::vec3(0.25f));
-  red_crate.box(red, {0, 0.25f, 0}, glm::vec3(0.25f));
+  // Tessellated: the crates get per-vertex indirect light (basis radiance fields).
+  crate.tessellated_box(wood, {0, 0.25f, 0}, glm::vec3(0.25f), 6);
+  red_crate.tessellated_box(red, {0, 0.25f, 0}, glm::vec3(0.25f), 6);
   const int crate_mesh = b.add_mesh("crate", crate);
   const int red_mesh = b.add_mesh("crate_red", red_crate);
+  // A white statue (static) beside the red crate: it turns pink from the crate's bounce.
+  const int statue_mat = b.material("statue_white", {0.85f, 0.85f, 0.85f});
+  MeshBuilder statue;
+  statue.box(statue_mat, {0, 0.2f, 0}, {0.3f, 0.2f, 0.3f});
+  statue.box(statue_mat, {0, 0.9f, 0}, {0.18f, 0.5f, 0.18f});
+  statue.box(statue_mat, {0, 1.55f, 0}, {0.13f, 0.15f, 0.13f});
+  b.add_mesh_node("statue", statue, engine::Mobility::Static, {9.2f, 0, 2.0f});
   b.add_instance_node("crate_red", red_mesh, engine::Mobility::Dynamic, {10.0f, 0, 3.2f});
   b.add_instance_node("crate_1", crate_mesh, engine::Mobility::Dynamic, {11.5f, 0, 5.0f},
                       glm::angleAxis(glm::radians(15.0f), glm::vec3(0, 1, 0)));

@@ -27,6 +27,47 @@ void MeshBuilder::quad(int material, glm::vec3 p0, glm::vec3 p1, glm::vec3 p2, g
   for (std::uint32_t i : {0u, 1u, 2u, 0u, 2u, 3u}) prim.indices.push_back(base + i);
 }
 
+void MeshBuilder::quad_grid(int material, glm::vec3 p0, glm::vec3 p1, glm::vec3 p2, glm::vec3 p3, glm::vec3 facing_hint,
+                            int n) {
+  glm::vec3 nrm = glm::normalize(glm::cross(p2 - p0, p3 - p1));
+  if (glm::dot(nrm, facing_hint) < 0.0f) {
+    std::swap(p1, p3);
+    nrm = -nrm;
+  }
+  engine::Primitive& prim = by_material_[material];
+  prim.material = material;
+  const auto base = static_cast<std::uint32_t>(prim.positions.size());
+  const glm::vec3 e1 = glm::normalize(p1 - p0);
+  const glm::vec3 e2 = glm::normalize(glm::cross(nrm, e1));
+  const auto fn = static_cast<float>(n);
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) {
+      const float u = static_cast<float>(i) / fn, v = static_cast<float>(j) / fn;
+      const glm::vec3 p = (1.0f - v) * ((1.0f - u) * p0 + u * p1) + v * ((1.0f - u) * p3 + u * p2);
+      prim.positions.push_back(p);
+      prim.normals.push_back(nrm);
+      prim.uv0.emplace_back(glm::dot(p - p0, e1), glm::dot(p - p0, e2));
+    }
+  const auto at = [&](int i, int j) { return base + static_cast<std::uint32_t>(j * (n + 1) + i); };
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i)
+      for (std::uint32_t k : {at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j), at(i + 1, j + 1), at(i, j + 1)})
+        prim.indices.push_back(k);
+}
+
+void MeshBuilder::tessellated_box(int material, glm::vec3 c, glm::vec3 h, int n) {
+  for (int a = 0; a < 3; ++a)
+    for (float sign : {-1.0f, 1.0f}) {
+      glm::vec3 nrm(0.0f), t(0.0f), b(0.0f);
+      nrm[a] = sign;
+      t[(a + 1) % 3] = 1.0f;
+      b[(a + 2) % 3] = 1.0f;
+      const glm::vec3 f = c + nrm * h;
+      const glm::vec3 tu = t * h, bv = b * h;
+      quad_grid(material, f - tu - bv, f + tu - bv, f + tu + bv, f - tu + bv, nrm, n);
+    }
+}
+
 void MeshBuilder::box(int material, glm::vec3 c, glm::vec3 h, bool inward) {
   const glm::vec3 top[4] = {c + glm::vec3(-h.x, h.y, -h.z), c + glm::vec3(h.x, h.y, -h.z),
                             c + glm::vec3(h.x, h.y, h.z), c + glm::vec3(-h.x, h.y, h.z)};

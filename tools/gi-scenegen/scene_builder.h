@@ -23,8 +23,13 @@ class MeshBuilder {
   /// A planar quad p0,p1,p2,p3 (in order around it). Its front faces `facing_hint`: the
   /// winding is flipped when the computed normal points away from the hint.
   void quad(int material, glm::vec3 p0, glm::vec3 p1, glm::vec3 p2, glm::vec3 p3, glm::vec3 facing_hint);
+  /// The quad split into n x n cells sharing their vertices (n >= 1): per-vertex lighting
+  /// (basis radiance fields) needs vertices inside a face, not only at its corners.
+  void quad_grid(int material, glm::vec3 p0, glm::vec3 p1, glm::vec3 p2, glm::vec3 p3, glm::vec3 facing_hint, int n);
   /// Closed axis-aligned box; faces point outward (`inward`: faces point inside, for rooms).
   void box(int material, glm::vec3 center, glm::vec3 half_extents, bool inward = false);
+  /// Closed outward box whose faces are n x n grids (quad_grid).
+  void tessellated_box(int material, glm::vec3 center, glm::vec3 half_extents, int n);
   /// Closed prism from a 4-corner top outline at height y_top down to y_bottom (with a bottom).
   void prism(int material, const glm::vec3 (&top)[4], float y_bottom);
   /// Wall in the plane x = `x`, spanning z in [z0, z1] and y in [y0, y1], facing +x
