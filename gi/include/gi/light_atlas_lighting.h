@@ -42,6 +42,8 @@ class LightAtlasLighting final : public engine::IndirectLightProvider {
   /// From a bake in memory (its layout must come from atlas_inputs_from(asset)); replaces
   /// `asset` with its uv1 copy. Error when the layout does not match the asset.
   static engine::Result<std::unique_ptr<LightAtlasLighting>> from_bake(LightAtlasBake bake, engine::SceneAsset& asset);
+  /// The same for a scene already instantiated (see load(bundle_dir, scene)).
+  static engine::Result<std::unique_ptr<LightAtlasLighting>> from_bake(const LightAtlasBake& bake, engine::Scene& scene);
 
   LightAtlasLighting(const LightAtlasLighting&) = delete;
   LightAtlasLighting& operator=(const LightAtlasLighting&) = delete;

@@ -55,8 +55,13 @@ engine::Result<std::unique_ptr<LightAtlasLighting>> LightAtlasLighting::load(con
                                                                              engine::Scene& scene) {
   auto bake = load_light_atlas(bundle_dir, scene.assets);
   if (!bake) return bake.error();
-  if (engine::Status s = apply_atlas_uv1(scene, bake->layout); !s) return s.error();
-  return std::unique_ptr<LightAtlasLighting>(new LightAtlasLighting(bake->width, bake->height, rgba_of(*bake)));
+  return from_bake(std::move(bake).value(), scene);
+}
+
+engine::Result<std::unique_ptr<LightAtlasLighting>> LightAtlasLighting::from_bake(const LightAtlasBake& bake,
+                                                                                  engine::Scene& scene) {
+  if (engine::Status s = apply_atlas_uv1(scene, bake.layout); !s) return s.error();
+  return std::unique_ptr<LightAtlasLighting>(new LightAtlasLighting(bake.width, bake.height, rgba_of(bake)));
 }
 
 const engine::IndirectLightFrame& LightAtlasLighting::frame() {
