@@ -1,7 +1,8 @@
 // gi-bake: bakes the GI data of a scene into a bake bundle.
 //   gi-bake --scene assets/cornell_box.gltf --methods atlas --preset high --out out/cornell_box.gibake
-// Methods available: atlas (light atlas, Schärfig 2016; static lights) and prm (precomputed
-// radiance maps, Szécsi 2006; moving lights). Both use the preset's atlas density, so they
+// Methods available: atlas (light atlas, Schärfig 2016; static lights), prm (precomputed
+// radiance maps, Szécsi 2006; moving lights) and brf (basis radiance fields, Iwasaki et al.;
+// one per distinct dynamic mesh). atlas and prm use the preset's atlas density, so they
 // share one uv1 layout. The other methods of DESIGN.md 1 are reported as not built yet
 // rather than silently skipped.
 #include <cstdio>
@@ -16,6 +17,9 @@
 #include <engine/gltf.h>
 #include <engine/scene.h>
 
+#include "brf/brf_bake.h"
+#include "brf/brf_io.h"
+#include "brf/brf_mesh.h"
 #include "console_progress.h"
 #include "light_atlas/light_atlas.h"
 #include "light_atlas/light_atlas_io.h"
@@ -66,24 +70,74 @@ int bake_prm_method(const engine::Scene& scene, const engine::SceneAsset& asset,
   return 0;
 }
 
+// Basis radiance fields (Iwasaki et al.) of every distinct dynamic mesh; `basis` and
+// `spheres` override the preset when positive.
+int bake_brf_method(const engine::Scene& scene, const engine::SceneAsset& asset, const std::filesystem::path& scene_file,
+                    const std::string& out_dir, const std::string& preset, int basis, int spheres, unsigned threads) {
+  auto settings = gi::brf_preset(preset);
+  if (!settings) {
+    std::cerr << "gi-bake: " << settings.error().to_string() << '\n';
+    return 2;
+  }
+  if (basis > 0) settings->basis.basis = basis;
+  if (spheres > 0) settings->field.spheres = spheres;
+  settings->field.threads = threads;
+  auto sources = gi::dynamic_brf_meshes(scene);
+  if (!sources) {
+    std::cerr << "gi-bake: " << sources.error().to_string() << '\n';
+    return 1;
+  }
+  const gi::PcaBasisSettings& b = settings->basis;
+  const gi::RadianceFieldSettings& f = settings->field;
+  std::printf("gi-bake: basis radiance fields of %s, preset %s: %zu dynamic meshes; %d lights, N = %d, %d spheres x "
+              "6x%dx%d points, %d SH bands, %d directions\n",
+              scene_file.filename().string().c_str(), preset.c_str(), sources->size(), b.lights, b.basis, f.spheres,
+              f.face_resolution, f.face_resolution, f.sh_bands, f.directions);
+  if (sources->empty()) {
+    std::printf("  no dynamic mesh: nothing to bake\n");
+    return 0;
+  }
+  gi::BrfBake bake{.settings = *settings, .meshes = {}};
+  for (const gi::BrfSource& s : *sources) {
+    auto mesh = gi::bake_brf_mesh(s, *settings);
+    if (!mesh) {
+      std::cerr << "gi-bake: " << mesh.error().to_string() << '\n';
+      return 1;
+    }
+    std::printf("  %-16s %6zu vertices, %zu entities, basis %d of %d kept, condition %.3g, field %.2f MB, %.2f s\n",
+                s.name.c_str(), s.mesh.positions.size(), s.entities.size(), mesh->basis.basis_count, b.basis,
+                mesh->basis.condition, static_cast<double>(mesh->field.bytes()) / 1e6,
+                mesh->basis_seconds + mesh->field_seconds);
+    bake.meshes.push_back(std::move(mesh).value());
+  }
+  if (auto saved = gi::save_brf(out_dir, bake, asset, scene_file.filename().string()); !saved) {
+    std::cerr << "gi-bake: " << saved.error().to_string() << '\n';
+    return 1;
+  }
+  std::printf("  wrote %s\n", out_dir.c_str());
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"Bakes a scene's GI data into a bake bundle (manifest.json + one file per method)"};
   std::string scene_path, out_dir, methods = "atlas", preset = "medium";
-  int vpls = 0, bounces = 0, samples = 0;
+  int vpls = 0, bounces = 0, samples = 0, brf_basis = 0, brf_spheres = 0;
   float density = 0.0f;
   bool include_direct = false;
   unsigned threads = 0;
   std::uint64_t seed = 1;
   app.add_option("--scene", scene_path, "glTF/GLB scene")->required()->check(CLI::ExistingFile);
   app.add_option("--out", out_dir, "Bundle directory (default: out/<scene>.gibake)");
-  app.add_option("--methods", methods, "Comma-separated methods to bake: atlas, prm");
+  app.add_option("--methods", methods, "Comma-separated methods to bake: atlas, prm, brf");
   app.add_option("--preset", preset, "Quality preset: preview, medium, high (docs/light_atlas.md)");
   app.add_option("--vpls", vpls, "Override the preset's VPL count")->check(CLI::PositiveNumber);
   app.add_option("--bounces", bounces, "Override the preset's indirect bounces")->check(CLI::Range(1, 64));
   app.add_option("--density", density, "Override the preset's atlas texels per metre")->check(CLI::PositiveNumber);
   app.add_option("--samples", samples, "Override the sample points per VPL")->check(CLI::Range(1, 1024));
+  app.add_option("--brf-basis", brf_basis, "Override the preset's BRF basis functions N")->check(CLI::Range(1, 1024));
+  app.add_option("--brf-spheres", brf_spheres, "Override the preset's BRF field spheres")->check(CLI::Range(1, 256));
   app.add_flag("--include-direct", include_direct, "Store direct + indirect irradiance (default: indirect only)");
   app.add_option("--threads", threads, "Worker threads (0: all); the result does not depend on it");
   app.add_option("--seed", seed, "Random seed");
@@ -100,13 +154,18 @@ int main(int argc, char** argv) {
 
   const std::vector<std::string> wanted = split(methods);
   for (const std::string& method : wanted)
-    if (method != "atlas" && method != "prm") {
-      std::cerr << "gi-bake: method '" << method << "' is not available in this build (available: atlas, prm)\n";
+    if (method != "atlas" && method != "prm" && method != "brf") {
+      std::cerr << "gi-bake: method '" << method << "' is not available in this build (available: atlas, prm, brf)\n";
       return 2;
     }
   for (const std::string& method : wanted) {
     if (method == "prm") {
       if (int rc = bake_prm_method(scene, *asset, scene_file, out_dir, preset, density, threads, seed); rc != 0) return rc;
+      continue;
+    }
+    if (method == "brf") {
+      if (int rc = bake_brf_method(scene, *asset, scene_file, out_dir, preset, brf_basis, brf_spheres, threads); rc != 0)
+        return rc;
       continue;
     }
     auto settings = gi::light_atlas_preset(preset);

@@ -1,0 +1,55 @@
+#include "brf/brf_bake.h"
+
+#include <chrono>
+#include <utility>
+
+namespace gi {
+
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace
+
+engine::Result<BrfSettings> brf_preset(std::string_view name) {
+  BrfSettings s;
+  if (name == "preview") {
+    s.basis.lights = 128, s.basis.basis = 16;
+    s.field.spheres = 8, s.field.face_resolution = 8, s.field.directions = 128;
+  } else if (name == "medium") {
+    s.basis.lights = 256, s.basis.basis = 16;
+    s.field.spheres = 12, s.field.face_resolution = 12, s.field.directions = 128;
+  } else if (name == "high") {
+    s.basis.lights = 256, s.basis.basis = 16;
+    s.field.spheres = 16, s.field.face_resolution = 16, s.field.directions = 256;
+  } else {
+    return engine::Error{.message = "unknown BRF preset '" + std::string(name) + "' (preview, medium, high)"};
+  }
+  s.field.sh_bands = 3;
+  return s;
+}
+
+engine::Result<BrfMeshBake> bake_brf_mesh(const BrfSource& source, const BrfSettings& settings) {
+  const auto prefixed = [&](engine::Error e) {
+    e.message = "mesh \"" + source.name + "\": " + e.message;
+    return e;
+  };
+  BrfMeshBake out;
+  out.name = source.name;
+  out.mesh_hash = source.mesh_hash;
+  auto start = std::chrono::steady_clock::now();
+  auto basis = compute_pca_basis(source.mesh, settings.basis);
+  if (!basis) return prefixed(basis.error());
+  out.basis_seconds = seconds_since(start);
+  start = std::chrono::steady_clock::now();
+  auto field = compute_basis_radiance_field(source.mesh, *basis, settings.field);
+  if (!field) return prefixed(field.error());
+  out.field_seconds = seconds_since(start);
+  out.basis = std::move(basis).value();
+  out.field = std::move(field).value();
+  return out;
+}
+
+}  // namespace gi

@@ -1,0 +1,134 @@
+#include "brf/brf_mesh.h"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+#include <span>
+#include <utility>
+
+#include "sweep/content_hash.h"
+
+namespace gi {
+
+namespace {
+
+bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+float luminance(const glm::vec4& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+
+// A file-name fragment from a mesh name: [A-Za-z0-9_-] kept, anything else '_'.
+std::string name_fragment(const std::string& name, std::uint32_t mesh_index) {
+  std::string out;
+  for (char c : name) {
+    const bool plain = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-';
+    out += plain ? c : '_';
+  }
+  if (out.empty()) out = "mesh" + std::to_string(mesh_index);
+  return out;
+}
+
+std::string lower(std::string s) {
+  for (char& c : s)
+    if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
+  return s;
+}
+
+}  // namespace
+
+std::string brf_mesh_hash(const BrfMesh& mesh) {
+  ContentHash h;
+  h.add_value(static_cast<std::uint64_t>(mesh.positions.size()));
+  for (const glm::vec3& p : mesh.positions) h.add_value(p.x), h.add_value(p.y), h.add_value(p.z);
+  h.add_value(static_cast<std::uint64_t>(mesh.normals.size()));
+  for (const glm::vec3& n : mesh.normals) h.add_value(n.x), h.add_value(n.y), h.add_value(n.z);
+  h.add_values(std::span<const std::uint32_t>(mesh.indices));
+  h.add_values(std::span<const float>(mesh.reflectance));
+  return h.hex();
+}
+
+engine::Result<BrfMesh> brf_mesh_from_asset(const engine::SceneAsset& asset, std::uint32_t mesh_index,
+                                            std::int32_t material_override) {
+  const std::string where = asset.source.empty() ? std::string("the scene") : asset.source;
+  if (mesh_index >= asset.meshes.size())
+    return engine::Error{where, "meshes", "mesh " + std::to_string(mesh_index) + " does not exist"};
+  const engine::Mesh& m = asset.meshes[mesh_index];
+  const std::string location = "mesh " + std::to_string(mesh_index) + " \"" + m.name + "\"";
+  BrfMesh out;
+  for (std::size_t pi = 0; pi < m.primitives.size(); ++pi) {
+    const engine::Primitive& p = m.primitives[pi];
+    const std::size_t n = p.positions.size();
+    const auto base = static_cast<std::uint32_t>(out.positions.size());
+    if (!p.normals.empty() && p.normals.size() != n)
+      return engine::Error{where, location, "primitive " + std::to_string(pi) + " has " +
+                                                std::to_string(p.normals.size()) + " normals for " +
+                                                std::to_string(n) + " positions"};
+    if (p.indices.size() % 3 != 0)
+      return engine::Error{where, location, "primitive " + std::to_string(pi) + " index count is not a multiple of 3"};
+    for (std::uint32_t i : p.indices)
+      if (i >= n)
+        return engine::Error{where, location, "primitive " + std::to_string(pi) + " index " + std::to_string(i) +
+                                                  " is out of range (" + std::to_string(n) + " vertices)"};
+    for (const glm::vec3& v : p.positions)
+      if (!finite(v)) return engine::Error{where, location, "a position is NaN or infinite"};
+    std::vector<glm::vec3> normals = p.normals;
+    if (normals.empty()) {
+      normals.assign(n, glm::vec3(0.0f));
+      for (std::size_t t = 0; t + 2 < p.indices.size(); t += 3) {
+        const std::uint32_t a = p.indices[t], b = p.indices[t + 1], c = p.indices[t + 2];
+        const glm::vec3 area_normal = glm::cross(p.positions[b] - p.positions[a], p.positions[c] - p.positions[a]);
+        normals[a] += area_normal, normals[b] += area_normal, normals[c] += area_normal;
+      }
+    }
+    for (glm::vec3& v : normals) {
+      if (!finite(v)) return engine::Error{where, location, "a normal is NaN or infinite"};
+      const float len = glm::length(v);
+      v = len > 0.0f && std::isfinite(len) ? v / len : glm::vec3(0.0f, 0.0f, 1.0f);  // unused vertex or degenerate
+    }
+    const int material = material_override >= 0 ? material_override : p.material;
+    const engine::Material mat = material >= 0 && static_cast<std::size_t>(material) < asset.materials.size()
+                                     ? asset.materials[static_cast<std::size_t>(material)]
+                                     : engine::Material{};
+    const float rho = std::clamp(luminance(mat.base_color), 0.0f, 1.0f);
+    if (!std::isfinite(rho)) return engine::Error{where, location, "the base colour is NaN or infinite"};
+    out.positions.insert(out.positions.end(), p.positions.begin(), p.positions.end());
+    out.normals.insert(out.normals.end(), normals.begin(), normals.end());
+    out.reflectance.insert(out.reflectance.end(), n, rho);
+    for (std::uint32_t i : p.indices) out.indices.push_back(base + i);
+  }
+  if (out.indices.empty()) return engine::Error{where, location, "the mesh has no triangle"};
+  return out;
+}
+
+engine::Result<std::vector<BrfSource>> dynamic_brf_meshes(const engine::Scene& scene) {
+  std::vector<engine::Entity> entities = scene.registry.view<engine::DynamicTag, engine::MeshRenderer>().entities();
+  std::sort(entities.begin(), entities.end(),
+            [](engine::Entity a, engine::Entity b) { return a.index < b.index; });
+  std::vector<BrfSource> out;
+  std::set<std::string> taken;  // lower case: file names must not clash on case-insensitive file systems
+  for (engine::Entity e : entities) {
+    const engine::MeshRenderer& mr = scene.registry.get<engine::MeshRenderer>(e);
+    auto it = std::find_if(out.begin(), out.end(), [&](const BrfSource& s) {
+      return s.mesh_index == mr.mesh && s.material_override == mr.material_override;
+    });
+    if (it != out.end()) {
+      it->entities.push_back(e);
+      continue;
+    }
+    auto mesh = brf_mesh_from_asset(scene.assets, mr.mesh, mr.material_override);
+    if (!mesh) return mesh.error();
+    BrfSource s;
+    const std::string base = name_fragment(scene.assets.meshes[mr.mesh].name, mr.mesh);
+    s.name = base;
+    for (int k = 2; taken.count(lower(s.name)) != 0; ++k) s.name = base + "_" + std::to_string(k);
+    taken.insert(lower(s.name));
+    s.mesh_index = mr.mesh;
+    s.material_override = mr.material_override;
+    s.mesh = std::move(mesh).value();
+    s.mesh_hash = brf_mesh_hash(s.mesh);
+    s.entities.push_back(e);
+    out.push_back(std::move(s));
+  }
+  return out;
+}
+
+}  // namespace gi

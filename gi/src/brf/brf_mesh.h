@@ -1,0 +1,56 @@
+#pragma once
+// The rigid objects a scene needs basis radiance fields for: one BrfSource per distinct mesh
+// drawn by an entity tagged DynamicTag (the adapter from the ECS to the plain BrfMesh the
+// bakers take; CONVENTIONS.md 4). Instanced props (five crates, one mesh) share one source.
+//   auto sources = gi::dynamic_brf_meshes(scene).value();
+//   for (const gi::BrfSource& s : sources) bake(s.mesh);   // s.entities: who draws it
+//
+// Vertex order: the mesh's primitives concatenated in order, each primitive's vertices in
+// its own order — exactly the order of the renderer's per-vertex irradiance buffer
+// (engine::IndirectLightFrame::vertex_irradiance_buffer), so a baked basis Psi_i(x_j) and
+// that buffer index the same vertices.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <engine/entity.h>
+#include <engine/result.h>
+#include <engine/scene.h>
+
+#include "brf/pca_basis.h"
+
+namespace gi {
+
+/// One distinct dynamic mesh and the entities that draw it.
+struct BrfSource {
+  /// Unique among the scene's sources, a plain file-name fragment ([A-Za-z0-9_-]): the
+  /// glTF mesh name with other characters replaced by '_', "_2", "_3"... added on a clash.
+  std::string name;
+  std::uint32_t mesh_index = 0;           ///< Into SceneAsset::meshes.
+  std::int32_t material_override = -1;    ///< The entities' MeshRenderer::material_override.
+  BrfMesh mesh;                           ///< Object space; reflectance per vertex.
+  std::string mesh_hash;                  ///< brf_mesh_hash(mesh): what a bake depends on.
+  std::vector<engine::Entity> entities;   ///< Ascending entity index.
+};
+
+/// 16 lowercase hex digits (FNV-1a 64) over the vertex count, positions, normals, indices
+/// and reflectance of `mesh`, in order. A bake whose stored hash differs is stale.
+std::string brf_mesh_hash(const BrfMesh& mesh);
+
+/// The mesh of a scene asset as a BrfMesh: positions, unit normals (area-weighted from the
+/// triangles where a primitive has none), indices rebased onto the concatenation, and per
+/// vertex the luminance (Rec. 709) of its material's base colour factor (textures are not
+/// read); `material_override` >= 0 replaces every primitive's material, as the renderer
+/// does. Errors (naming the mesh): out-of-range mesh index or vertex index, non-finite
+/// positions or normals, no triangle.
+engine::Result<BrfMesh> brf_mesh_from_asset(const engine::SceneAsset& asset, std::uint32_t mesh_index,
+                                            std::int32_t material_override = -1);
+
+/// One source per distinct (mesh, material override) drawn by a DynamicTag entity with a
+/// MeshRenderer (dynamic nodes without a mesh, such as a lamp's pivot, are skipped), in
+/// order of the first entity (ascending index) drawing it. No dynamic mesh: empty.
+/// Errors: as brf_mesh_from_asset.
+engine::Result<std::vector<BrfSource>> dynamic_brf_meshes(const engine::Scene& scene);
+
+}  // namespace gi
