@@ -41,18 +41,6 @@ void cube_face(const glm::vec3& d, int& f, float& u, float& v) {
   }
 }
 
-std::vector<glm::vec3> fibonacci_directions(int n) {
-  std::vector<glm::vec3> out;
-  const double golden = std::numbers::pi * (3.0 - std::sqrt(5.0));
-  for (int i = 0; i < n; ++i) {
-    const double z = 1.0 - (2.0 * i + 1.0) / n;
-    const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
-    out.emplace_back(static_cast<float>(r * std::cos(golden * i)), static_cast<float>(r * std::sin(golden * i)),
-                     static_cast<float>(z));
-  }
-  return out;
-}
-
 }  // namespace
 
 float BasisRadianceField::sphere_radius(int s) const {
@@ -143,11 +131,14 @@ engine::Result<BasisRadianceField> compute_basis_radiance_field(const BrfMesh& m
   auto caster = make_embree_ray_caster(data);
   if (!caster) return caster.error();
 
-  const std::vector<glm::vec3> dirs = fibonacci_directions(settings.directions);
-  std::vector<std::array<float, kMaxShCoefficients>> y(dirs.size());
-  for (std::size_t k = 0; k < dirs.size(); ++k) y[k] = sh_basis(dirs[k]);
-  const float solid_angle = 4.0f * std::numbers::pi_v<float> / static_cast<float>(dirs.size());
+  // Directions: only the cone the bounding sphere subtends can see the object, so the rays
+  // are spread over that cap (a Fibonacci spiral in cos theta and phi), each standing for
+  // cap / directions steradians. Far spheres then get as many hits as near ones; uniform
+  // directions over the whole sphere would leave an object 8 radii away about one hit in
+  // 256.
+  const auto n_dirs = static_cast<std::size_t>(settings.directions);
   const float inv_pi = 1.0f / std::numbers::pi_v<float>;
+  const float golden = std::numbers::pi_v<float> * (3.0f - std::sqrt(5.0f));
   const std::size_t nv = basis.vertex_count;
 
   ThreadPool pool(settings.threads);
@@ -159,18 +150,33 @@ engine::Result<BasisRadianceField> compute_basis_radiance_field(const BrfMesh& m
         const std::size_t vv = (rem / res) % res, uu = rem % res;
         const float u = (static_cast<float>(uu) + 0.5f) / static_cast<float>(res) * 2.0f - 1.0f;
         const float v = (static_cast<float>(vv) + 0.5f) / static_cast<float>(res) * 2.0f - 1.0f;
-        const glm::vec3 p = field.centre + glm::normalize(cube_direction(f, u, v)) * field.sphere_radius(static_cast<int>(s));
+        const glm::vec3 outward = glm::normalize(cube_direction(f, u, v));
+        const float d = field.sphere_radius(static_cast<int>(s));
+        const glm::vec3 p = field.centre + outward * d;
+        const glm::vec3 axis = -outward;
+        const float sin_max = d > basis.radius ? basis.radius / d : 1.0f;
+        const float cos_max = std::sqrt(std::max(0.0f, 1.0f - sin_max * sin_max));
+        const float cap = 2.0f * std::numbers::pi_v<float> * (1.0f - cos_max);
+        const float solid_angle = cap / static_cast<float>(n_dirs);
+        const glm::vec3 t = glm::normalize(std::abs(axis.x) < 0.9f ? glm::cross(axis, glm::vec3(1, 0, 0))
+                                                                    : glm::cross(axis, glm::vec3(0, 1, 0)));
+        const glm::vec3 b = glm::cross(axis, t);
         float* out = field.coefficients.data() + pt * per_point;
-        for (std::size_t k = 0; k < dirs.size(); ++k) {
-          const Hit h = (*caster)->intersect(Ray{p, 0.0f, dirs[k]});
-          if (!h.valid() || glm::dot(h.geometric_normal, dirs[k]) >= 0.0f) continue;  // missed, or a back face
+        for (std::size_t k = 0; k < n_dirs; ++k) {
+          const float ct = 1.0f - (1.0f - cos_max) * (static_cast<float>(k) + 0.5f) / static_cast<float>(n_dirs);
+          const float st = std::sqrt(std::max(0.0f, 1.0f - ct * ct));
+          const float phi = golden * static_cast<float>(k);
+          const glm::vec3 dir = ct * axis + st * (std::cos(phi) * t + std::sin(phi) * b);
+          const Hit h = (*caster)->intersect(Ray{p, 0.0f, dir});
+          if (!h.valid() || glm::dot(h.geometric_normal, dir) >= 0.0f) continue;  // missed, or a back face
+          const auto y = sh_basis(dir);
           const std::uint32_t* tri = mesh.indices.data() + 3 * static_cast<std::size_t>(h.primitive);
           const float b1 = h.barycentric.x, b2 = h.barycentric.y, b0 = 1.0f - b1 - b2;
           for (std::size_t i = 0; i < static_cast<std::size_t>(field.basis_count); ++i) {
             const float* psi = basis.psi.data() + i * nv;
             // Radiance of a diffuse surface of radiosity Psi_i: Psi_i / pi (h(w) = 1/pi, K = 1).
             const float radiance = (b0 * psi[tri[0]] + b1 * psi[tri[1]] + b2 * psi[tri[2]]) * inv_pi * solid_angle;
-            for (std::size_t c = 0; c < coefs; ++c) out[i * coefs + c] += radiance * y[k][c];
+            for (std::size_t c = 0; c < coefs; ++c) out[i * coefs + c] += radiance * y[c];
           }
         }
       },
