@@ -1,6 +1,7 @@
 // Basis radiance fields at runtime (Iwasaki et al. §5) against the reference path tracer:
 // two boxes under a point light, the interreflected irradiance at the receiver's vertices;
 // rotating everything together leaves the result unchanged.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
@@ -127,6 +128,52 @@ TEST(BrfRuntime, RotatingEverythingTogetherChangesNothing) {
   }
   std::printf("rotation: relative difference %.2e\n", std::sqrt(err / norm));
   EXPECT_LT(std::sqrt(err / norm), 1e-3);
+}
+
+// Hard cases: overlapping objects (a receiver's vertices inside the source and inside its
+// innermost sphere), objects touching face to face, and the scene at 1 cm and 100 m.
+TEST(BrfRuntime, OverlappingTouchingAndScaledObjectsStayFiniteAndBounded) {
+  const TwoBoxes s;
+  const glm::vec3 light_p(-1.2f, 1.0f, 0.6f);
+  const auto run = [&](glm::vec3 receiver_at, float scale) {
+    const glm::mat4 scaled = glm::scale(glm::mat4(1.0f), glm::vec3(scale));
+    const gi::BrfObject objects[] = {
+        {&s.source, &s.source_basis, &s.source_field, scaled * glm::translate(glm::mat4(1.0f), {-0.45f, 0.0f, 0.0f}),
+         glm::vec3(0.8f, 0.1f, 0.1f)},
+        {&s.receiver, &s.receiver_basis, &s.receiver_field, scaled * glm::translate(glm::mat4(1.0f), receiver_at), glm::vec3(0.8f)}};
+    // Intensity x scale^2 keeps the irradiance of the scaled scene the same.
+    const gi::PointEmitter light = point_light(scale * light_p, 4.0f * scale * scale);
+    return gi::update_brf(objects, std::span<const gi::PointEmitter>(&light, 1), {.bounces = 3});
+  };
+  const auto check = [](const gi::BrfResult& r, const char* what) {
+    float direct = 0.0f, indirect = 0.0f;
+    for (std::size_t o = 0; o < r.direct.size(); ++o)
+      for (std::size_t j = 0; j < r.direct[o].size(); ++j) {
+        for (int c = 0; c < 3; ++c) {
+          ASSERT_TRUE(std::isfinite(r.indirect[o][j][c])) << what;
+          ASSERT_GE(r.indirect[o][j][c], 0.0f) << what;
+        }
+        direct = std::max(direct, r.direct[o][j].x);
+        indirect = std::max(indirect, r.indirect[o][j].x);
+      }
+    // Light reflected by albedo 0.8 at most adds up to 0.8 / (1 - 0.8) x the brightest direct.
+    std::printf("%s: largest direct %.4f, largest indirect %.4f\n", what, double{direct}, double{indirect});
+    EXPECT_LE(indirect, 4.0f * direct) << what;
+  };
+  check(run({-0.3f, 0.05f, 0.0f}, 1.0f), "overlapping");  // centres 0.15 m apart: each inside the other
+  check(run({0.1f, 0.0f, 0.0f}, 1.0f), "touching");  // receiver x in [-0.15, 0.35], source x in [-0.75, -0.15]
+  const gi::BrfResult metre = run({0.4f, 0.1f, 0.05f}, 1.0f);
+  for (float scale : {0.01f, 100.0f}) {
+    const gi::BrfResult r = run({0.4f, 0.1f, 0.05f}, scale);
+    double err = 0.0, norm = 0.0;
+    for (std::size_t j = 0; j < r.indirect[1].size(); ++j) {
+      const glm::dvec3 d = glm::dvec3(r.indirect[1][j] - metre.indirect[1][j]);
+      err += glm::dot(d, d);
+      norm += glm::dot(glm::dvec3(metre.indirect[1][j]), glm::dvec3(metre.indirect[1][j]));
+    }
+    std::printf("scale %g: relative difference to 1 m %.2e\n", double{scale}, std::sqrt(err / norm));
+    EXPECT_LT(std::sqrt(err / norm), 1e-3);
+  }
 }
 
 }  // namespace

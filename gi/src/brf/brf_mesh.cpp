@@ -6,6 +6,8 @@
 #include <span>
 #include <utility>
 
+#include "light_atlas/vpl_set.h"
+#include "raytrace/scene_adapter.h"
 #include "sweep/content_hash.h"
 
 namespace gi {
@@ -129,6 +131,16 @@ engine::Result<std::vector<BrfSource>> dynamic_brf_meshes(const engine::Scene& s
     out.push_back(std::move(s));
   }
   return out;
+}
+
+glm::vec3 brf_source_albedo(const engine::SceneAsset& asset, const BrfSource& source) {
+  int material = source.material_override;
+  if (material < 0 && source.mesh_index < asset.meshes.size() && !asset.meshes[source.mesh_index].primitives.empty())
+    material = asset.meshes[source.mesh_index].primitives.front().material;
+  const engine::Material m = material >= 0 && static_cast<std::size_t>(material) < asset.materials.size()
+                                 ? asset.materials[static_cast<std::size_t>(material)]
+                                 : engine::Material{};
+  return hemispherical_albedo(reference_material(m));
 }
 
 }  // namespace gi

@@ -53,4 +53,9 @@ engine::Result<BrfMesh> brf_mesh_from_asset(const engine::SceneAsset& asset, std
 /// Errors: as brf_mesh_from_asset.
 engine::Result<std::vector<BrfSource>> dynamic_brf_meshes(const engine::Scene& scene);
 
+/// The RGB reflectance the runtime bounces with for `source`: its (first) material's
+/// hemispherical albedo as the path tracer and the light atlas see it (Lambert plus the
+/// renderer's GGX lobe, light_atlas/vpl_set.h). The glTF default material when it has none.
+glm::vec3 brf_source_albedo(const engine::SceneAsset& asset, const BrfSource& source);
+
 }  // namespace gi

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "brf/spherical_harmonics.h"
 #include "raytrace/embree_ray_caster.h"
@@ -32,6 +33,28 @@ std::array<std::vector<float>, 3> brf_fit_rgb(const BrfBasis& basis, std::span<c
   return w;
 }
 
+BrfBox brf_object_box(const BrfMesh& mesh) {
+  BrfBox b{glm::vec3(std::numeric_limits<float>::max()), glm::vec3(-std::numeric_limits<float>::max())};
+  for (const glm::vec3& v : mesh.positions) {
+    b.lo = glm::min(b.lo, v);
+    b.hi = glm::max(b.hi, v);
+  }
+  return b;
+}
+
+BrfHorizon brf_horizon(const BrfBox& box, const glm::vec3& p, const glm::vec3& n) {
+  // Signed distances of the 8 corners above the plane: centre term +- the half extents.
+  const glm::vec3 c = 0.5f * (box.lo + box.hi), h = 0.5f * (box.hi - box.lo);
+  const float centre = glm::dot(n, c - p);
+  const float spread = std::abs(n.x) * h.x + std::abs(n.y) * h.y + std::abs(n.z) * h.z;
+  // A box touching the plane (a neighbour's face coplanar with the receiver's) counts as on
+  // the side it lies: the tolerance keeps rounding from flipping the choice.
+  const float tolerance = 1e-4f * (h.x + h.y + h.z);
+  if (centre + spread <= tolerance) return BrfHorizon::Behind;
+  if (centre - spread >= -tolerance) return BrfHorizon::InFront;
+  return BrfHorizon::Straddling;
+}
+
 void brf_basis_irradiance(const BrfObject& source, std::span<const glm::vec3> positions,
                           std::span<const glm::vec3> normals, std::vector<float>& out) {
   const BasisRadianceField& f = *source.field;
@@ -42,11 +65,20 @@ void brf_basis_irradiance(const BrfObject& source, std::span<const glm::vec3> po
   const glm::mat3 rot = glm::mat3(to_source);
   std::vector<float> coeffs(nb * cc);
   out.assign(positions.size() * nb, 0.0f);
+  // The object lies inside its bounding box: where the tangent plane of the receiver has
+  // the whole box behind it the answer is 0; where the whole box is in front, every
+  // direction the light comes from has n . w > 0, so the unclamped cosine (band 1) gives
+  // the exact irradiance of the stored radiance. Only a box straddling the plane needs the
+  // clamped lobe, truncated to the stored bands (whose ringing would otherwise light
+  // faces that see nothing, such as the tops of crates beside each other).
+  const BrfBox box = brf_object_box(*source.mesh);
   for (std::size_t j = 0; j < positions.size(); ++j) {
     const glm::vec3 p = glm::vec3(to_source * glm::vec4(positions[j], 1.0f));
     const glm::vec3 n = glm::normalize(rot * normals[j]);
+    const BrfHorizon side = brf_horizon(box, p, n);
+    if (side == BrfHorizon::Behind) continue;
     f.sample(p, coeffs);
-    const auto lobe = sh_clamped_cosine(n, f.sh_bands);
+    const auto lobe = side == BrfHorizon::InFront ? sh_cosine(n) : sh_clamped_cosine(n, f.sh_bands);
     for (std::size_t i = 0; i < nb; ++i)
       out[j * nb + i] = sh_dot(std::span<const float>(coeffs).subspan(i * cc), lobe, cc);
   }

@@ -77,8 +77,21 @@ BrfWorldVertices brf_world_vertices(const BrfObject& object);
 /// Weights (per RGB channel, basis_count each) of per-vertex radiosity over an object.
 std::array<std::vector<float>, 3> brf_fit_rgb(const BrfBasis& basis, std::span<const glm::vec3> radiosity);
 
+/// An object's axis-aligned bounding box in its own space.
+struct BrfBox {
+  glm::vec3 lo, hi;
+};
+BrfBox brf_object_box(const BrfMesh& mesh);
+
+/// Where an object (its box, object space) lies relative to the tangent plane of a receiver
+/// point p with unit normal n (object space): wholly behind it (no light can arrive), wholly
+/// in front (the unclamped cosine is exact), or straddling it.
+enum class BrfHorizon : std::uint8_t { Behind, InFront, Straddling };
+BrfHorizon brf_horizon(const BrfBox& box, const glm::vec3& p, const glm::vec3& n);
+
 /// The basis irradiance at world points p_j (unit normals n_j) from `source`'s field:
-/// out[j * basis_count + i] = Phi_i(p_j, n_j). out is resized.
+/// out[j * basis_count + i] = Phi_i(p_j, n_j), 0 where the source is behind the receiver's
+/// tangent plane, the unclamped cosine where it is wholly in front (brf_horizon). out is resized.
 void brf_basis_irradiance(const BrfObject& source, std::span<const glm::vec3> positions,
                           std::span<const glm::vec3> normals, std::vector<float>& out);
 

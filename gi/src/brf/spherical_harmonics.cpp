@@ -43,4 +43,12 @@ std::array<float, kMaxShCoefficients> sh_clamped_cosine(const glm::vec3& n, int 
   return out;
 }
 
+std::array<float, kMaxShCoefficients> sh_cosine(const glm::vec3& n) {
+  // n . w = (4 pi / 3) sum_m Y_1m(n) Y_1m(w): band 1 only, twice the clamped lobe's.
+  const std::array<float, kMaxShCoefficients> y = sh_basis(n);
+  std::array<float, kMaxShCoefficients> out{};
+  for (std::size_t i = 1; i < 4; ++i) out[i] = 4.0f * std::numbers::pi_v<float> / 3.0f * y[i];
+  return out;
+}
+
 }  // namespace gi

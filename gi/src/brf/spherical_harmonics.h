@@ -32,4 +32,10 @@ inline float sh_dot(std::span<const float> a, std::span<const float> b, std::siz
 /// it gives the irradiance.
 std::array<float, kMaxShCoefficients> sh_clamped_cosine(const glm::vec3& n, int bands);
 
+/// Coefficients of the unclamped cosine n . w (band 1 only: (4 pi / 3) Y_1m(n)). For
+/// radiance arriving only from directions with n . w > 0 (a source wholly in front of the
+/// receiver's tangent plane) its product with the radiance is the exact irradiance: no
+/// truncation of the clamped lobe's higher bands, no ringing.
+std::array<float, kMaxShCoefficients> sh_cosine(const glm::vec3& n);
+
 }  // namespace gi

@@ -1,5 +1,6 @@
 #include "sweep/builtin_methods.h"
 
+#include "brf/brf_sweep.h"
 #include "light_atlas/light_atlas_sweep.h"
 #include "prm/prm_sweep.h"
 #include "raytrace/reference_sweep.h"
@@ -12,6 +13,7 @@ void register_builtin_sweep_methods(SweepRegistry& registry) {
   register_reference_sweep(registry);
   register_light_atlas_sweep(registry);
   register_prm_sweep(registry);
+  register_brf_sweep(registry);
   //
   // GI METHODS (light atlas, PRM, DLM, BRF, antiradiance) register here as they land, one
   // add_method per method, with every quality knob declared (DESIGN.md 3, "Accuracy and its

@@ -1,0 +1,119 @@
+#pragma once
+// Basis radiance fields in a running scene (Iwasaki et al. §5, the static world coupled in):
+// every dynamic entity with a baked mesh gets a per-vertex indirect irradiance buffer for the
+// renderer (engine::IndirectLightFrame::vertex_irradiance_buffer), and the objects' bounce
+// is added into the static world's irradiance atlas. Per update, only when something changed:
+//   - the entities' world transforms and every enabled light are fingerprinted; nothing runs
+//     when neither changed;
+//   - direct light at the objects' vertices on the CPU (Embree shadow rays against the
+//     objects and the static world), plus the static world's light from the probes
+//     (world_probes.h) when an object moved;
+//   - the interreflection on the GPU (brf_gpu_pass.h): weights, basis irradiance of pairs
+//     whose relative pose changed (the others are reused), bounces, and the bounce onto the
+//     static receivers (atlas texels) inside each object's field;
+//   - per vertex: world light + interreflected light (brf_vertex_sum.comp.glsl).
+// composite_world() writes base atlas + bounce into the caller's atlas texture
+// (brf_world_composite.comp.glsl).
+//   auto brf = gi::BrfLighting::create(std::move(models), bindings, scene.registry, std::move(world), {}).value();
+//   if (brf->update()) brf->composite_world(base_texture, composite_texture, width, height);
+//   GLuint ssbo = brf->vertex_buffer(crate_entity);
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include <engine/entity.h>
+#include <engine/registry.h>
+#include <engine/result.h>
+
+#include "brf/brf_runtime.h"
+#include "brf/pca_basis.h"
+#include "brf/radiance_field.h"
+#include "brf/world_probes.h"
+
+namespace gi {
+
+class RayCaster;
+
+/// One distinct dynamic mesh with its precomputed basis and field.
+struct BrfModelData {
+  std::string name;
+  BrfMesh mesh;
+  BrfBasis basis;
+  BasisRadianceField field;
+};
+
+/// A dynamic entity drawn with model `model`, diffuse albedo `albedo`.
+struct BrfInstanceBinding {
+  engine::Entity entity;
+  std::uint32_t model = 0;
+  glm::vec3 albedo{0.8f};
+};
+
+/// The static world's part (every member optional).
+struct BrfWorldLink {
+  std::unique_ptr<RayCaster> caster;       ///< Static shadows for the objects' direct light.
+  std::optional<WorldProbeGrid> probes;    ///< The world's light onto the objects.
+  /// Static receivers: atlas texels (index y * width + x) with their world points and normals.
+  std::vector<std::uint32_t> receiver_texels;
+  std::vector<glm::vec3> receiver_positions;
+  std::vector<glm::vec3> receiver_normals;
+  int atlas_width = 0;
+  int atlas_height = 0;
+};
+
+struct BrfLightingSettings {
+  BrfUpdateSettings update;
+  int area_light_samples = 16;  ///< Point emitters per area light for the direct light.
+};
+
+class BrfLighting {
+ public:
+  /// Errors: a binding's model out of range, models whose parts do not belong together,
+  /// receiver arrays of different sizes.
+  static engine::Result<std::unique_ptr<BrfLighting>> create(std::vector<BrfModelData> models,
+                                                             std::vector<BrfInstanceBinding> instances,
+                                                             const engine::Registry& registry, BrfWorldLink world,
+                                                             BrfLightingSettings settings = {});
+  BrfLighting(const BrfLighting&) = delete;
+  BrfLighting& operator=(const BrfLighting&) = delete;
+  ~BrfLighting();
+
+  /// With the GL context current: recomputes what changed. True when the objects' light (and
+  /// so their bounce onto the world) changed this call. The first call always computes.
+  bool update();
+  /// The per-vertex indirect irradiance SSBO of `e` (vec4 per vertex), 0 for other entities.
+  std::uint32_t vertex_buffer(engine::Entity e) const;
+  /// Copies `base_texture` (RGBA32F atlas, width x height) into `composite_texture` (same
+  /// size and format) and adds the objects' bounce at the static receivers.
+  void composite_world(std::uint32_t base_texture, std::uint32_t composite_texture) const;
+  bool has_static_receivers() const;
+
+  struct Stats {
+    std::uint64_t updates = 0;          ///< update() calls that computed something.
+    std::uint64_t skipped = 0;          ///< update() calls on which nothing had changed.
+    std::uint64_t objects_moved = 0;    ///< Updates with at least one moved object.
+    std::size_t pairs_evaluated = 0;    ///< Last update (GPU pass stats).
+    std::size_t pairs_culled = 0;
+    std::size_t pairs_reused = 0;
+    double last_cpu_ms = 0.0;           ///< Direct light, probes, fits.
+    double last_gpu_ms = 0.0;           ///< GPU pass + vertex sums (glFinish-timed).
+    std::size_t instances = 0;
+    std::size_t vertices = 0;
+    std::size_t static_receivers = 0;
+    std::size_t field_bytes = 0;        ///< Precomputed data of all models (CPU copies).
+    std::size_t gpu_bytes = 0;
+  };
+  const Stats& stats() const;
+
+ private:
+  struct Impl;
+  explicit BrfLighting(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace gi
