@@ -27,12 +27,15 @@ struct BrfInstance {
   uint model;
   uint vertex_offset;    // first vertex in the frame's global vertex buffers
   uint vertex_count;
-  uint weight_offset;    // first float of its weights: [channel][basis], 3 x N
+  uint weight_offset;    // first vec4 of its weights: one rgb vec4 per basis function, N padded to 4
   uint live_first;       // its live sources in the live-source list
   uint live_count;
   uint pad0;
   uint pad1;
 };
+
+// Basis functions padded to a multiple of 4: Phi rows and weight runs are read as vec4s.
+uint brf_padded(uint basis_count) { return (basis_count + 3u) & ~3u; }
 
 // Y_lm(w) for l < 4 (w unit, z up), "l, m" order: index l (l + 1) + m.
 void brf_sh_basis(vec3 w, out float c[16]) {

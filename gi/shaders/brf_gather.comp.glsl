@@ -11,9 +11,10 @@ layout(local_size_x = 64) in;
 
 layout(std430, binding = 0) readonly buffer Instances { BrfInstance instances[]; };
 layout(std430, binding = 1) readonly buffer Models { BrfModel models[]; };
-layout(std430, binding = 2) readonly buffer LiveSources { uvec2 live_sources[]; };  // (source instance, phi offset)
-layout(std430, binding = 3) readonly buffer Weights { float weights[]; };
-layout(std430, binding = 4) readonly buffer Phi { float phi[]; };
+// Per live (source, receiver) pair: (source's first weight vec4, first Phi vec4 of the pair, N4 / 4, source).
+layout(std430, binding = 2) readonly buffer LiveSources { uvec4 live_sources[]; };
+layout(std430, binding = 3) readonly buffer Weights { vec4 weights[]; };          // rgb per basis function, pads 0
+layout(std430, binding = 4) readonly buffer Phi { vec4 phi[]; };                  // rows of N4 floats, pads 0
 layout(std430, binding = 5) writeonly buffer Gathered { vec4 gathered[]; };
 layout(std430, binding = 6) buffer Indirect { vec4 indirect[]; };
 
@@ -34,15 +35,14 @@ void main() {
   const uint j = gv - inst.vertex_offset;
   vec3 e = vec3(0.0);
   for (uint l = 0u; l < inst.live_count; ++l) {
-    const uvec2 src = live_sources[inst.live_first + l];
-    const BrfInstance s = instances[src.x];
-    const uint nb = models[s.model].basis_count;
-    const uint at = src.y + j * nb;
+    const uvec4 src = live_sources[inst.live_first + l];
+    const uint q4 = src.z;
+    const uint at = src.y + j * q4;
     vec3 pair = vec3(0.0);
-    for (uint i = 0u; i < nb; ++i) {
-      const float p = phi[at + i];
-      pair += p * vec3(weights[s.weight_offset + i], weights[s.weight_offset + nb + i],
-                       weights[s.weight_offset + 2u * nb + i]);
+    for (uint q = 0u; q < q4; ++q) {
+      const vec4 p = phi[at + q];
+      const uint w = src.x + 4u * q;
+      pair += p.x * weights[w].xyz + p.y * weights[w + 1u].xyz + p.z * weights[w + 2u].xyz + p.w * weights[w + 3u].xyz;
     }
     e += max(pair, vec3(0.0));  // SH ringing must not make light negative
   }

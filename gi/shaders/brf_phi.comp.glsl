@@ -5,7 +5,8 @@
 // receivers (u_kind 1, world-space points picked through an index list). The point goes into
 // the source's object space (to_source), its normal too (normal_to_source, then normalized),
 // and
-//   phi[phi_offset + k N + i] = sum over the 8 field samples of weight x (coefficients_i . lobe(n))
+//   phi[phi_offset + k N4 + i] = sum over the 8 field samples of weight x (coefficients_i . lobe(n))
+// (N4: N padded to a multiple of 4, the pads written 0)
 // the twin of brf_basis_irradiance (brf_runtime.cpp). Work groups map to (job, first point)
 // through the group table, so a dispatch covers many jobs of different lengths.
 
@@ -62,8 +63,9 @@ void main() {
   uint base[8];
   float weight[8];
   const bool inside = brf_field_corners(m, p, base, weight);
-  const uint nb = m.basis_count;
+  const uint nb = m.basis_count, n4 = brf_padded(nb);
   const uint cc = m.sh_bands * m.sh_bands;
+  for (uint i = nb; i < n4; ++i) phi[job.phi_offset + k * n4 + i] = 0.0;
   for (uint i = 0u; i < nb; ++i) {
     float sum = 0.0;
     if (inside)
@@ -74,6 +76,6 @@ void main() {
         for (uint q = 0u; q < cc; ++q) d += field[at + q] * lobe[q];
         sum += weight[c] * d;
       }
-    phi[job.phi_offset + k * nb + i] = sum;
+    phi[job.phi_offset + k * n4 + i] = sum;
   }
 }

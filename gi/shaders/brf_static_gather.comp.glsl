@@ -11,11 +11,11 @@
 layout(local_size_x = 64) in;
 
 layout(std430, binding = 0) readonly buffer Touched { uvec4 touched[]; };          // (receiver, first entry, entry count, 0)
-layout(std430, binding = 1) readonly buffer Entries { uvec2 entries[]; };          // (source instance, phi offset)
+layout(std430, binding = 1) readonly buffer Entries { uvec4 entries[]; };          // (first weight vec4, first Phi vec4, N4 / 4, source)
 layout(std430, binding = 2) readonly buffer Instances { BrfInstance instances[]; };
 layout(std430, binding = 3) readonly buffer Models { BrfModel models[]; };
-layout(std430, binding = 4) readonly buffer Weights { float weights[]; };
-layout(std430, binding = 5) readonly buffer StaticPhi { float static_phi[]; };
+layout(std430, binding = 4) readonly buffer Weights { vec4 weights[]; };     // rgb per basis function, pads 0
+layout(std430, binding = 5) readonly buffer StaticPhi { vec4 static_phi[]; };  // rows of N4 floats, pads 0
 layout(std430, binding = 6) writeonly buffer StaticOut { vec4 static_out[]; };
 
 uniform uint u_touched_count;
@@ -27,14 +27,13 @@ void main() {
   const uvec4 t = touched[k];
   vec3 e = vec3(0.0);
   for (uint l = 0u; l < t.z; ++l) {
-    const uvec2 src = entries[t.y + l];
-    const BrfInstance s = instances[src.x];
-    const uint nb = models[s.model].basis_count;
+    const uvec4 src = entries[t.y + l];
+    const uint q4 = src.z;
     vec3 pair = vec3(0.0);
-    for (uint i = 0u; i < nb; ++i) {
-      const float p = static_phi[src.y + i];
-      pair += p * vec3(weights[s.weight_offset + i], weights[s.weight_offset + nb + i],
-                       weights[s.weight_offset + 2u * nb + i]);
+    for (uint q = 0u; q < q4; ++q) {
+      const vec4 p = static_phi[src.y + q];
+      const uint w = src.x + 4u * q;
+      pair += p.x * weights[w].xyz + p.y * weights[w + 1u].xyz + p.z * weights[w + 2u].xyz + p.w * weights[w + 3u].xyz;
     }
     e += max(pair, vec3(0.0));
   }

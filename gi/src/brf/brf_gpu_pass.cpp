@@ -74,6 +74,10 @@ void dispatch_groups(std::uint32_t groups) {
 
 std::uint32_t u32(std::size_t v) { return static_cast<std::uint32_t>(v); }
 
+/// Basis functions padded to a multiple of 4 (brf_padded in brf_common.glsl): Phi rows and
+/// weight runs are read as vec4s.
+std::uint32_t padded(std::uint32_t basis_count) { return (basis_count + 3u) & ~3u; }
+
 engine::Result<engine::ShaderProgram> build(const char* file) {
   return engine::ShaderProgramBuilder(gi_shader_files()).stage(engine::ShaderStage::Compute, file).build();
 }
@@ -248,7 +252,7 @@ engine::Status BrfGpuPass::reset_layout(std::span<const BrfGpuInstance> instance
   for (std::size_t i = 0; i < n; ++i) {
     const ModelInfo& m = models_[instances[i].model];
     vertex_offsets[i + 1] = vertex_offsets[i] + m.vertex_count;
-    weight_offsets[i + 1] = weight_offsets[i] + 3 * m.basis_count;
+    weight_offsets[i + 1] = weight_offsets[i] + padded(m.basis_count);  // rgb vec4 per function
   }
   std::vector<PairSlot> pairs(n * n);
   std::size_t phi_floats = 0;
@@ -256,7 +260,7 @@ engine::Status BrfGpuPass::reset_layout(std::span<const BrfGpuInstance> instance
     for (std::size_t r = 0; r < n; ++r) {
       if (s == r) continue;
       pairs[s * n + r].phi_offset = u32(phi_floats);
-      phi_floats += static_cast<std::size_t>(models_[instances[r].model].vertex_count) * models_[instances[s].model].basis_count;
+      phi_floats += static_cast<std::size_t>(models_[instances[r].model].vertex_count) * padded(models_[instances[s].model].basis_count);
     }
   if (phi_floats * sizeof(float) > max_buffer_bytes_)
     return error(std::to_string(n) + " instances need " + std::to_string(phi_floats * sizeof(float)) +
@@ -273,7 +277,7 @@ engine::Status BrfGpuPass::reset_layout(std::span<const BrfGpuInstance> instance
   static_touched_count_ = 0;
   const std::size_t vertex_bytes = static_cast<std::size_t>(vertex_offsets_[n]) * sizeof(glm::vec4);
   for (Buffer* b : {&incoming_, &gathered_, &indirect_}) b->reserve(vertex_bytes);
-  weights_.reserve(weight_offsets_[n] * sizeof(float));
+  weights_.reserve(weight_offsets_[n] * sizeof(glm::vec4));
   phi_.reserve(phi_floats * sizeof(float));
   outputs_.clear();
   output_bytes_ = 0;
@@ -353,7 +357,7 @@ engine::Status BrfGpuPass::update_static(std::span<const BrfGpuInstance> instanc
     } else {
       inside[s] = static_slots_[s].receivers;
     }
-    total_floats += inside[s].size() * model.basis_count;
+    total_floats += inside[s].size() * padded(model.basis_count);
   }
   if (total_floats * sizeof(float) > max_buffer_bytes_)
     return error("static receivers need " + std::to_string(total_floats * sizeof(float)) +
@@ -371,7 +375,7 @@ engine::Status BrfGpuPass::update_static(std::span<const BrfGpuInstance> instanc
     if (moved[s] == 0 && count > 0)
       glCopyNamedBufferSubData(static_phi_.buffer.id(), static_phi_spare_.buffer.id(),
                                static_cast<GLintptr>(slot.phi_offset * sizeof(float)), static_cast<GLintptr>(phi_offset * sizeof(float)),
-                               static_cast<GLsizeiptr>(count * model.basis_count * sizeof(float)));
+                               static_cast<GLsizeiptr>(count * padded(model.basis_count) * sizeof(float)));
     slot.index_offset = u32(indices.size());
     slot.phi_offset = phi_offset;
     if (moved[s] != 0) {
@@ -390,7 +394,7 @@ engine::Status BrfGpuPass::update_static(std::span<const BrfGpuInstance> instanc
       }
     }
     indices.insert(indices.end(), slot.receivers.begin(), slot.receivers.end());
-    phi_offset += u32(count * model.basis_count);
+    phi_offset += u32(count * padded(model.basis_count));
   }
   std::swap(static_phi_, static_phi_spare_);
   static_indices_.upload(indices.data(), indices.size() * sizeof(std::uint32_t));
@@ -409,15 +413,15 @@ engine::Status BrfGpuPass::update_static(std::span<const BrfGpuInstance> instanc
     next[t] = first;
     first += count[t];
   }
-  std::vector<glm::uvec2> entries(first);
+  std::vector<glm::uvec4> entries(first);
   for (std::size_t s = 0; s < n; ++s) {
     const StaticSlot& slot = static_slots_[s];
-    const std::uint32_t nb = models_[instances[s].model].basis_count;
+    const std::uint32_t nb = padded(models_[instances[s].model].basis_count);
     for (std::size_t k = 0; k < slot.receivers.size(); ++k)
-      entries[next[slot.receivers[k]]++] = glm::uvec2(u32(s), slot.phi_offset + u32(k) * nb);
+      entries[next[slot.receivers[k]]++] = glm::uvec4(weight_offsets_[s], (slot.phi_offset + u32(k) * nb) / 4, nb / 4, u32(s));
   }
   static_touched_.upload(touched.data(), touched.size() * sizeof(glm::uvec4));
-  static_entries_.upload(entries.data(), entries.size() * sizeof(glm::uvec2));
+  static_entries_.upload(entries.data(), entries.size() * sizeof(glm::uvec4));
   static_touched_count_ = u32(touched.size());
   return {};
 }
@@ -462,15 +466,15 @@ engine::Status BrfGpuPass::run(std::span<const BrfGpuInstance> instances, std::s
   std::vector<BrfObject> objects(n);
   std::vector<std::array<std::vector<float>, 3>> first_weights(n);
   std::vector<glm::vec3> light;
-  std::vector<float> weights(weight_offsets_[n], 0.0f);
+  std::vector<glm::vec4> weights(weight_offsets_[n], glm::vec4(0.0f));  // pads stay 0
   for (std::size_t i = 0; i < n; ++i) {
     const ModelInfo& m = models_[instances[i].model];
     objects[i] = {m.mesh, m.basis, m.field, instances[i].object_to_world, instances[i].albedo};
     light.resize(incoming[i].size());
     for (std::size_t j = 0; j < light.size(); ++j) light[j] = instances[i].albedo * incoming[i][j];
     first_weights[i] = brf_fit_rgb(*m.basis, light);
-    for (std::size_t c = 0; c < 3; ++c)
-      std::copy(first_weights[i][c].begin(), first_weights[i][c].end(), weights.begin() + weight_offsets_[i] + c * m.basis_count);
+    for (std::size_t k = 0; k < m.basis_count; ++k)
+      weights[weight_offsets_[i] + k] = glm::vec4(first_weights[i][0][k], first_weights[i][1][k], first_weights[i][2][k], 0.0f);
   }
   std::vector<std::uint8_t> culled;
   if (!(settings.cull_threshold <= 0.0f)) {  // > 0 or NaN: as brf_interreflect
@@ -482,7 +486,7 @@ engine::Status BrfGpuPass::run(std::span<const BrfGpuInstance> instances, std::s
 
   // Pairs whose relative pose changed (or never computed): Phi jobs; live sources per receiver.
   std::vector<BrfPhiJob> jobs;
-  std::vector<glm::uvec2> live;
+  std::vector<glm::uvec4> live;  // (source's first weight vec4, first Phi vec4, N4 / 4, source)
   std::vector<GpuInstance> table(n);
   std::vector<glm::mat4> to_source(n);
   for (std::size_t s = 0; s < n; ++s) to_source[s] = glm::inverse(instances[s].object_to_world);
@@ -504,7 +508,7 @@ engine::Status BrfGpuPass::run(std::span<const BrfGpuInstance> instances, std::s
       ++stats_.pairs_evaluated;
       PairSlot& slot = pairs_[s * n + r];
       const glm::mat4 relative = to_source[s] * instances[r].object_to_world;
-      live.emplace_back(u32(s), slot.phi_offset);
+      live.emplace_back(weight_offsets_[s], slot.phi_offset / 4, padded(models_[instances[s].model].basis_count) / 4, u32(s));
       if (slot.valid && same_pose(slot.pose, relative, pose_tolerance_)) {
         ++stats_.pairs_reused;
         continue;
@@ -530,8 +534,8 @@ engine::Status BrfGpuPass::run(std::span<const BrfGpuInstance> instances, std::s
     for (std::size_t j = 0; j < incoming[i].size(); ++j) in4[vertex_offsets_[i] + j] = glm::vec4(incoming[i][j], 0.0f);
   incoming_.upload(in4.data(), in4.size() * sizeof(glm::vec4));
   instance_table_.upload(table.data(), table.size() * sizeof(GpuInstance));
-  weights_.upload(weights.data(), weights.size() * sizeof(float));
-  live_.upload(live.data(), live.size() * sizeof(glm::uvec2));
+  weights_.upload(weights.data(), weights.size() * sizeof(glm::vec4));
+  live_.upload(live.data(), live.size() * sizeof(glm::uvec4));
   glClearNamedBufferData(indirect_.buffer.id(), GL_R32F, GL_RED, GL_FLOAT, nullptr);
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
 
