@@ -3,18 +3,18 @@
 // same bounces, the same static receivers, relative RMSE below 1e-3 (float32 on both sides;
 // the GPU fits sum in float where the CPU sums in double). Phi caching: moving one object
 // re-evaluates only its pairs, a still frame none.
+#include "brf/brf_gpu_pass.h"
+
 #include <engine/gpu/context.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <glm/gtc/matrix_transform.hpp>
 #include <limits>
 #include <vector>
 
-#include <glm/gtc/matrix_transform.hpp>
-
-#include "brf/brf_gpu_pass.h"
 #include "brf/brf_runtime.h"
 
 namespace {
@@ -48,7 +48,8 @@ gi::BrfMesh box(glm::vec3 half, int n) {
       const auto at = [&](int i, int j) { return base + static_cast<std::uint32_t>(i * (n + 1) + j); };
       for (int i = 0; i < n; ++i)
         for (int j = 0; j < n; ++j)
-          m.indices.insert(m.indices.end(), {at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+          m.indices.insert(m.indices.end(),
+                           {at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j), at(i + 1, j + 1), at(i, j + 1)});
     }
   return m;
 }
@@ -61,10 +62,12 @@ struct Models {
   gi::BrfBasis cube_basis = gi::compute_pca_basis(cube, {.lights = 64, .basis = 8}).value();
   gi::BrfBasis slab_basis = gi::compute_pca_basis(slab, {.lights = 64, .basis = 6}).value();
   gi::BasisRadianceField cube_field =
-      gi::compute_basis_radiance_field(cube, cube_basis, {.spheres = 6, .face_resolution = 6, .sh_bands = 3, .directions = 64})
+      gi::compute_basis_radiance_field(cube, cube_basis,
+                                       {.spheres = 6, .face_resolution = 6, .sh_bands = 3, .directions = 64})
           .value();
   gi::BasisRadianceField slab_field =
-      gi::compute_basis_radiance_field(slab, slab_basis, {.spheres = 5, .face_resolution = 5, .sh_bands = 4, .directions = 64})
+      gi::compute_basis_radiance_field(slab, slab_basis,
+                                       {.spheres = 5, .face_resolution = 5, .sh_bands = 4, .directions = 64})
           .value();
   std::vector<gi::BrfGpuModel> gpu() const {
     return {{&cube, &cube_basis, &cube_field}, {&slab, &slab_basis, &slab_field}};
@@ -204,7 +207,8 @@ TEST(BrfGpuPass, MatchesCpuTwinWithoutCullingWithStaticReceivers) {
   double static_norm = 0.0;
   const auto st = pass.read_back_static();
   const double es = relative_rmse(st, ref.static_irradiance, &static_norm);
-  std::printf("no culling: vertices rel RMSE %.2e, static rel RMSE %.2e, %zu bytes on the GPU\n", e, es, pass.gpu_bytes());
+  std::printf("no culling: vertices rel RMSE %.2e, static rel RMSE %.2e, %zu bytes on the GPU\n", e, es,
+              pass.gpu_bytes());
   EXPECT_LT(e, kTolerance);
   EXPECT_GT(static_norm, 0.0);
   EXPECT_LT(es, kTolerance);

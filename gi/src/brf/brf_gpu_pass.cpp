@@ -18,7 +18,7 @@ constexpr const char* kWhere = "BRF GPU pass";
 constexpr std::size_t kSsboLimitBytes = std::size_t{128} << 20;  // DESIGN.md §4 (llvmpipe)
 constexpr std::uint32_t kGroupSize = 64;                         // local_size_x of every brf_*.comp.glsl
 constexpr std::uint32_t kMaxGroupsPerDimension = 65535;
-constexpr int kMaxBasis = 64;                                    // kMaxBasis in brf_fit.comp.glsl
+constexpr int kMaxBasis = 64;  // kMaxBasis in brf_fit.comp.glsl
 
 /// BrfModel in brf_common.glsl (std430).
 struct GpuModel {
@@ -134,8 +134,8 @@ engine::Result<BrfGpuPass> BrfGpuPass::create(std::span<const BrfGpuModel> model
     if ((f.sh_bands != 3 && f.sh_bands != 4) || f.spheres < 1 || f.face_resolution < 1 || !(f.inner_radius > 0.0f) ||
         !(f.outer_radius >= f.inner_radius) || !std::isfinite(f.outer_radius) || !finite(f.centre))
       return error(which + "field settings out of range");
-    const std::size_t points =
-        static_cast<std::size_t>(f.spheres) * 6 * static_cast<std::size_t>(f.face_resolution) * static_cast<std::size_t>(f.face_resolution);
+    const std::size_t points = static_cast<std::size_t>(f.spheres) * 6 * static_cast<std::size_t>(f.face_resolution) *
+                               static_cast<std::size_t>(f.face_resolution);
     if (f.coefficients.size() != points * nb * static_cast<std::size_t>(f.coefficient_count()))
       return error(which + "field holds " + std::to_string(f.coefficients.size()) + " floats, expected " +
                    std::to_string(points * nb * static_cast<std::size_t>(f.coefficient_count())));
@@ -143,7 +143,8 @@ engine::Result<BrfGpuPass> BrfGpuPass::create(std::span<const BrfGpuModel> model
       return error(which + "field of " + std::to_string(f.bytes()) + " bytes is above the SSBO limit of " +
                    std::to_string(limit));
     for (std::size_t j = 0; j < nv; ++j)
-      if (!finite(mesh.positions[j]) || !finite(mesh.normals[j])) return error(which + "non-finite vertex " + std::to_string(j));
+      if (!finite(mesh.positions[j]) || !finite(mesh.normals[j]))
+        return error(which + "non-finite vertex " + std::to_string(j));
     for (float v : basis.psi)
       if (!std::isfinite(v)) return error(which + "non-finite basis value");
     for (float v : basis.a_inverse)
@@ -155,9 +156,10 @@ engine::Result<BrfGpuPass> BrfGpuPass::create(std::span<const BrfGpuModel> model
   BrfGpuPass pass;
   pass.max_buffer_bytes_ = limit;
   pass.pose_tolerance_ = options.pose_tolerance;
-  for (auto [program, file] : {std::pair{&pass.programs_.phi, "brf_phi.comp.glsl"}, std::pair{&pass.programs_.fit, "brf_fit.comp.glsl"},
-                               std::pair{&pass.programs_.gather, "brf_gather.comp.glsl"},
-                               std::pair{&pass.programs_.static_gather, "brf_static_gather.comp.glsl"}}) {
+  for (auto [program, file] :
+       {std::pair{&pass.programs_.phi, "brf_phi.comp.glsl"}, std::pair{&pass.programs_.fit, "brf_fit.comp.glsl"},
+        std::pair{&pass.programs_.gather, "brf_gather.comp.glsl"},
+        std::pair{&pass.programs_.static_gather, "brf_static_gather.comp.glsl"}}) {
     auto built = build(file);
     if (!built) return built.error();
     *program = std::move(built).value();
@@ -192,8 +194,8 @@ engine::Result<BrfGpuPass> BrfGpuPass::create(std::span<const BrfGpuModel> model
     }
     psi.insert(psi.end(), model.basis->psi.begin(), model.basis->psi.end());
     a_inverse.insert(a_inverse.end(), model.basis->a_inverse.begin(), model.basis->a_inverse.end());
-    pass.models_.push_back({g.vertex_offset, g.vertex_count, g.basis_count, g.field_buffer, f.outer_radius, f.centre, model.basis,
-                            model.mesh, model.field});
+    pass.models_.push_back({g.vertex_offset, g.vertex_count, g.basis_count, g.field_buffer, f.outer_radius, f.centre,
+                            model.basis, model.mesh, model.field});
   }
   const auto upload_once = [&pass](const auto& v) {
     using T = typename std::decay_t<decltype(v)>::value_type;
@@ -212,7 +214,8 @@ engine::Result<BrfGpuPass> BrfGpuPass::create(std::span<const BrfGpuModel> model
   }
   for (std::size_t m = 0; m < models.size(); ++m) {
     const BasisRadianceField& f = *models[m].field;
-    glNamedBufferSubData(pass.fields_[table[m].field_buffer].id(), static_cast<GLintptr>(table[m].field_offset * sizeof(float)),
+    glNamedBufferSubData(pass.fields_[table[m].field_buffer].id(),
+                         static_cast<GLintptr>(table[m].field_offset * sizeof(float)),
                          static_cast<GLsizeiptr>(f.bytes()), f.coefficients.data());
   }
   if (pass.fields_.empty()) pass.fields_.push_back(engine::GlBuffer::create(16, nullptr, GL_DYNAMIC_STORAGE_BIT));
@@ -222,14 +225,16 @@ engine::Result<BrfGpuPass> BrfGpuPass::create(std::span<const BrfGpuModel> model
   return pass;
 }
 
-engine::Status BrfGpuPass::set_static_receivers(std::span<const glm::vec3> positions, std::span<const glm::vec3> normals) {
+engine::Status BrfGpuPass::set_static_receivers(std::span<const glm::vec3> positions,
+                                                std::span<const glm::vec3> normals) {
   GI_EXPECTS(!programs_.phi.empty(), "BrfGpuPass::set_static_receivers on an empty (default or moved-from) pass");
   if (positions.size() != normals.size())
     return error(std::to_string(positions.size()) + " static receiver positions but " + std::to_string(normals.size()) +
                  " normals");
   if (positions.size() >= (std::size_t{1} << 31)) return error("too many static receivers");
   for (std::size_t t = 0; t < positions.size(); ++t)
-    if (!finite(positions[t]) || !finite(normals[t])) return error("static receiver " + std::to_string(t) + " is not finite");
+    if (!finite(positions[t]) || !finite(normals[t]))
+      return error("static receiver " + std::to_string(t) + " is not finite");
   std::vector<glm::vec4> points;
   points.reserve(2 * positions.size());
   for (std::size_t t = 0; t < positions.size(); ++t) {
@@ -260,7 +265,8 @@ engine::Status BrfGpuPass::reset_layout(std::span<const BrfGpuInstance> instance
     for (std::size_t r = 0; r < n; ++r) {
       if (s == r) continue;
       pairs[s * n + r].phi_offset = u32(phi_floats);
-      phi_floats += static_cast<std::size_t>(models_[instances[r].model].vertex_count) * padded(models_[instances[s].model].basis_count);
+      phi_floats += static_cast<std::size_t>(models_[instances[r].model].vertex_count) *
+                    padded(models_[instances[s].model].basis_count);
     }
   if (phi_floats * sizeof(float) > max_buffer_bytes_)
     return error(std::to_string(n) + " instances need " + std::to_string(phi_floats * sizeof(float)) +
@@ -282,7 +288,8 @@ engine::Status BrfGpuPass::reset_layout(std::span<const BrfGpuInstance> instance
   outputs_.clear();
   output_bytes_ = 0;
   for (std::size_t i = 0; i < n; ++i) {
-    const std::size_t bytes = std::max<std::size_t>(static_cast<std::size_t>(vertex_offsets_[i + 1] - vertex_offsets_[i]) * sizeof(glm::vec4), 16);
+    const std::size_t bytes = std::max<std::size_t>(
+        static_cast<std::size_t>(vertex_offsets_[i + 1] - vertex_offsets_[i]) * sizeof(glm::vec4), 16);
     outputs_.push_back(engine::GlBuffer::create(bytes, nullptr, GL_DYNAMIC_STORAGE_BIT));
     glClearNamedBufferData(outputs_.back().id(), GL_R32F, GL_RED, GL_FLOAT, nullptr);
     output_bytes_ += bytes;
@@ -299,7 +306,8 @@ void BrfGpuPass::dispatch_phi(std::span<const BrfPhiJob> jobs, bool static_kind)
     ranges[b].first = u32(groups.size());
     for (std::size_t j = 0; j < jobs.size(); ++j) {
       if (models_[jobs[j].source_model].field_buffer != b) continue;
-      for (std::uint32_t first = 0; first < jobs[j].point_count; first += kGroupSize) groups.emplace_back(u32(j), first);
+      for (std::uint32_t first = 0; first < jobs[j].point_count; first += kGroupSize)
+        groups.emplace_back(u32(j), first);
     }
     ranges[b].second = u32(groups.size()) - ranges[b].first;
   }
@@ -374,7 +382,8 @@ engine::Status BrfGpuPass::update_static(std::span<const BrfGpuInstance> instanc
     const std::size_t count = inside[s].size();
     if (moved[s] == 0 && count > 0)
       glCopyNamedBufferSubData(static_phi_.buffer.id(), static_phi_spare_.buffer.id(),
-                               static_cast<GLintptr>(slot.phi_offset * sizeof(float)), static_cast<GLintptr>(phi_offset * sizeof(float)),
+                               static_cast<GLintptr>(slot.phi_offset * sizeof(float)),
+                               static_cast<GLintptr>(phi_offset * sizeof(float)),
                                static_cast<GLsizeiptr>(count * padded(model.basis_count) * sizeof(float)));
     slot.index_offset = u32(indices.size());
     slot.phi_offset = phi_offset;
@@ -418,7 +427,8 @@ engine::Status BrfGpuPass::update_static(std::span<const BrfGpuInstance> instanc
     const StaticSlot& slot = static_slots_[s];
     const std::uint32_t nb = padded(models_[instances[s].model].basis_count);
     for (std::size_t k = 0; k < slot.receivers.size(); ++k)
-      entries[next[slot.receivers[k]]++] = glm::uvec4(weight_offsets_[s], (slot.phi_offset + u32(k) * nb) / 4, nb / 4, u32(s));
+      entries[next[slot.receivers[k]]++] =
+          glm::uvec4(weight_offsets_[s], (slot.phi_offset + u32(k) * nb) / 4, nb / 4, u32(s));
   }
   static_touched_.upload(touched.data(), touched.size() * sizeof(glm::uvec4));
   static_entries_.upload(entries.data(), entries.size() * sizeof(glm::uvec4));
@@ -426,20 +436,21 @@ engine::Status BrfGpuPass::update_static(std::span<const BrfGpuInstance> instanc
   return {};
 }
 
-engine::Status BrfGpuPass::run(std::span<const BrfGpuInstance> instances, std::span<const std::vector<glm::vec3>> incoming,
-                               const BrfUpdateSettings& settings) {
+engine::Status BrfGpuPass::run(std::span<const BrfGpuInstance> instances,
+                               std::span<const std::vector<glm::vec3>> incoming, const BrfUpdateSettings& settings) {
   GI_EXPECTS(!programs_.phi.empty(), "BrfGpuPass::run on an empty (default or moved-from) pass");
   const auto t0 = std::chrono::steady_clock::now();
   const std::size_t n = instances.size();
   if (incoming.size() != n)
-    return error("incoming light for " + std::to_string(incoming.size()) + " instances, " + std::to_string(n) + " given");
+    return error("incoming light for " + std::to_string(incoming.size()) + " instances, " + std::to_string(n) +
+                 " given");
   if (n >= (std::size_t{1} << 16)) return error("too many instances");
   for (std::size_t i = 0; i < n; ++i) {
     const BrfGpuInstance& inst = instances[i];
     const std::string which = "instance " + std::to_string(i) + ": ";
     if (inst.model >= models_.size())
-      return error(which + "model " + std::to_string(inst.model) + " does not exist (" + std::to_string(models_.size()) +
-                   " models)");
+      return error(which + "model " + std::to_string(inst.model) + " does not exist (" +
+                   std::to_string(models_.size()) + " models)");
     if (!finite(inst.object_to_world)) return error(which + "non-finite transform");
     const float det = glm::determinant(glm::mat3(inst.object_to_world));
     if (!(std::fabs(det) > 0.0f) || !std::isfinite(det)) return error(which + "singular transform");
@@ -474,7 +485,8 @@ engine::Status BrfGpuPass::run(std::span<const BrfGpuInstance> instances, std::s
     for (std::size_t j = 0; j < light.size(); ++j) light[j] = instances[i].albedo * incoming[i][j];
     first_weights[i] = brf_fit_rgb(*m.basis, light);
     for (std::size_t k = 0; k < m.basis_count; ++k)
-      weights[weight_offsets_[i] + k] = glm::vec4(first_weights[i][0][k], first_weights[i][1][k], first_weights[i][2][k], 0.0f);
+      weights[weight_offsets_[i] + k] =
+          glm::vec4(first_weights[i][0][k], first_weights[i][1][k], first_weights[i][2][k], 0.0f);
   }
   std::vector<std::uint8_t> culled;
   if (!(settings.cull_threshold <= 0.0f)) {  // > 0 or NaN: as brf_interreflect
@@ -508,7 +520,8 @@ engine::Status BrfGpuPass::run(std::span<const BrfGpuInstance> instances, std::s
       ++stats_.pairs_evaluated;
       PairSlot& slot = pairs_[s * n + r];
       const glm::mat4 relative = to_source[s] * instances[r].object_to_world;
-      live.emplace_back(weight_offsets_[s], slot.phi_offset / 4, padded(models_[instances[s].model].basis_count) / 4, u32(s));
+      live.emplace_back(weight_offsets_[s], slot.phi_offset / 4, padded(models_[instances[s].model].basis_count) / 4,
+                        u32(s));
       if (slot.valid && same_pose(slot.pose, relative, pose_tolerance_)) {
         ++stats_.pairs_reused;
         continue;
@@ -594,7 +607,8 @@ engine::Status BrfGpuPass::run(std::span<const BrfGpuInstance> instances, std::s
   for (std::size_t i = 0; i < n; ++i) {
     const std::size_t bytes = static_cast<std::size_t>(vertex_offsets_[i + 1] - vertex_offsets_[i]) * sizeof(glm::vec4);
     if (bytes > 0)
-      glCopyNamedBufferSubData(indirect_.buffer.id(), outputs_[i].id(), static_cast<GLintptr>(vertex_offsets_[i] * sizeof(glm::vec4)), 0,
+      glCopyNamedBufferSubData(indirect_.buffer.id(), outputs_[i].id(),
+                               static_cast<GLintptr>(vertex_offsets_[i] * sizeof(glm::vec4)), 0,
                                static_cast<GLsizeiptr>(bytes));
   }
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_VERTEX_ATTRIB_ARRAY_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
@@ -622,7 +636,8 @@ std::vector<glm::vec3> BrfGpuPass::read_back_static() const {
   GI_EXPECTS(!static_out_.buffer.empty(), "BrfGpuPass::read_back_static on an empty (default or moved-from) pass");
   std::vector<glm::vec4> v(static_count_);
   if (static_count_ > 0)
-    glGetNamedBufferSubData(static_out_.buffer.id(), 0, static_cast<GLsizeiptr>(static_count_ * sizeof(glm::vec4)), v.data());
+    glGetNamedBufferSubData(static_out_.buffer.id(), 0, static_cast<GLsizeiptr>(static_count_ * sizeof(glm::vec4)),
+                            v.data());
   std::vector<glm::vec3> out(static_count_);
   for (std::size_t t = 0; t < static_count_; ++t) out[t] = glm::vec3(v[t]);
   return out;
@@ -630,9 +645,9 @@ std::vector<glm::vec3> BrfGpuPass::read_back_static() const {
 
 std::size_t BrfGpuPass::gpu_bytes() const {
   std::size_t bytes = model_bytes_ + output_bytes_;
-  for (const Buffer* b : {&static_points_, &instance_table_, &incoming_, &gathered_, &indirect_, &weights_, &phi_, &live_, &jobs_,
-                          &groups_, &static_indices_, &static_phi_, &static_phi_spare_, &static_touched_, &static_entries_,
-                          &static_out_})
+  for (const Buffer* b :
+       {&static_points_, &instance_table_, &incoming_, &gathered_, &indirect_, &weights_, &phi_, &live_, &jobs_,
+        &groups_, &static_indices_, &static_phi_, &static_phi_spare_, &static_touched_, &static_entries_, &static_out_})
     bytes += b->bytes;
   return bytes;
 }
