@@ -1,13 +1,24 @@
-// Basis radiance fields, CPU runtime: milliseconds per update for 1, 5, 10 and 30 crates
-// (pairs grow as n^2) with the I_c pair culling (§5.4) on and off, and the precomputed
-// memory per object. Crates share one mesh, basis and field (instanced props).
+// Basis radiance fields: milliseconds per update for 1, 5, 10 and 30 crates (pairs grow as
+// n^2) with the I_c pair culling (§5.4) on and off, and the precomputed memory per object.
+// Crates share one mesh, basis and field (instanced props).
+//   BM_BrfUpdate: the CPU runtime, direct light included (update_brf);
+//   BM_BrfInterreflectCpu: the CPU interreflection alone (brf_interreflect), the GPU pass's twin;
+//   BM_BrfGpu: BrfGpuPass::run on llvmpipe (DESIGN.md §4: these are CPU timings; compare
+//   them as ratios), glFinish inside the timed region, with every crate moving each run (all
+//   pairs' Phi re-evaluated) or none moving (every Phi reused; only the bounces run).
 //   ./build/benchmarks/brf_bench --benchmark_counters_tabular=true
+#include <GL/glcorearb.h>
+
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <vector>
 
 #include <benchmark/benchmark.h>
+#include <engine/gpu/context.h>
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "brf/brf_gpu_pass.h"
 #include "brf/brf_runtime.h"
 
 namespace {
@@ -46,20 +57,35 @@ const Shared& shared() {
   return s;
 }
 
+// Crates on a floor-like grid, 1.2 m apart: far pairs exchange little light. `turn` rotates
+// every crate about its own vertical axis by a per-crate angle (so relative poses change).
+std::vector<gi::BrfObject> crates(int n, float turn = 0.0f) {
+  const Shared& s = shared();
+  std::vector<gi::BrfObject> objects;
+  const int side = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(n))));
+  for (int i = 0; i < n; ++i)
+    objects.push_back({&s.mesh, &s.basis, &s.field,
+                       glm::rotate(glm::translate(glm::mat4(1.0f), {1.2f * static_cast<float>(i % side), 0.25f,
+                                                                    1.2f * static_cast<float>(i / side)}),
+                                   turn * static_cast<float>(i + 1), glm::vec3(0.0f, 1.0f, 0.0f)),
+                       glm::vec3(0.8f, 0.3f + 0.05f * static_cast<float>(i % 5), 0.2f)});
+  return objects;
+}
+
+gi::PointEmitter grid_light(int n) {
+  const int side = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(n))));
+  gi::PointEmitter light;
+  light.position = {0.5f * static_cast<float>(side), 3.0f, 0.5f * static_cast<float>(side)};
+  light.radiant = glm::vec3(20.0f);
+  return light;
+}
+
 void BM_BrfUpdate(benchmark::State& state) {
   const Shared& s = shared();
   const int n = static_cast<int>(state.range(0));
   const bool cull = state.range(1) != 0;
-  std::vector<gi::BrfObject> objects;
-  // Crates on a floor-like grid, 1.2 m apart: far pairs exchange little light.
-  const int side = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(n))));
-  for (int i = 0; i < n; ++i)
-    objects.push_back({&s.mesh, &s.basis, &s.field,
-                       glm::translate(glm::mat4(1.0f), {1.2f * static_cast<float>(i % side), 0.25f, 1.2f * static_cast<float>(i / side)}),
-                       glm::vec3(0.8f, 0.3f + 0.05f * static_cast<float>(i % 5), 0.2f)});
-  gi::PointEmitter light;
-  light.position = {0.5f * static_cast<float>(side), 3.0f, 0.5f * static_cast<float>(side)};
-  light.radiant = glm::vec3(20.0f);
+  const std::vector<gi::BrfObject> objects = crates(n);
+  const gi::PointEmitter light = grid_light(n);
   std::size_t evaluated = 0, culled = 0;
   for (auto _ : state) {
     const gi::BrfResult r = gi::update_brf(objects, std::span<const gi::PointEmitter>(&light, 1),
@@ -74,6 +100,67 @@ void BM_BrfUpdate(benchmark::State& state) {
   state.counters["basis_MB_per_mesh"] = static_cast<double>(s.basis.psi.size() * sizeof(float)) / 1e6;
 }
 BENCHMARK(BM_BrfUpdate)->ArgsProduct({{1, 5, 10, 30}, {0, 1}})->Unit(benchmark::kMillisecond);
+
+void BM_BrfInterreflectCpu(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  const bool cull = state.range(1) != 0;
+  const std::vector<gi::BrfObject> objects = crates(n);
+  const gi::PointEmitter light = grid_light(n);
+  const auto incoming = gi::brf_direct_light(objects, std::span<const gi::PointEmitter>(&light, 1), nullptr);
+  for (auto _ : state) {
+    const gi::BrfResult r = gi::brf_interreflect(objects, incoming, {.bounces = 3, .cull_threshold = cull ? 1e-2f : 0.0f});
+    benchmark::DoNotOptimize(r.indirect.data());
+  }
+}
+BENCHMARK(BM_BrfInterreflectCpu)->ArgsProduct({{1, 5, 10, 30}, {0, 1}})->Unit(benchmark::kMillisecond);
+
+engine::GpuContext& context() {
+  static engine::GpuContext ctx = [] {
+    auto c = engine::GpuContext::create_headless();
+    if (!c) {
+      std::fprintf(stderr, "headless GL context creation failed: %s\n", c.error().to_string().c_str());
+      std::exit(1);
+    }
+    return std::move(c).value();
+  }();
+  return ctx;
+}
+
+void BM_BrfGpu(benchmark::State& state) {
+  (void)context();
+  const Shared& s = shared();
+  const int n = static_cast<int>(state.range(0));
+  const bool moving = state.range(1) != 0;
+  const bool cull = state.range(2) != 0;
+  const gi::BrfGpuModel model{&s.mesh, &s.basis, &s.field};
+  auto pass = gi::BrfGpuPass::create(std::span(&model, 1));
+  if (!pass) {
+    state.SkipWithError(pass.error().to_string().c_str());
+    return;
+  }
+  const gi::PointEmitter light = grid_light(n);
+  // Two poses a few degrees apart; moving runs alternate between them.
+  std::vector<gi::BrfGpuInstance> poses[2];
+  for (int k = 0; k < 2; ++k)
+    for (const gi::BrfObject& o : crates(n, 0.02f * static_cast<float>(k)))
+      poses[k].push_back({0, o.object_to_world, o.albedo});
+  const auto incoming = gi::brf_direct_light(crates(n), std::span<const gi::PointEmitter>(&light, 1), nullptr);
+  const gi::BrfUpdateSettings settings{.bounces = 3, .cull_threshold = cull ? 1e-2f : 0.0f};
+  if (!pass->run(poses[1], incoming, settings)) state.SkipWithError("run failed");
+  glFinish();
+  std::size_t frame = 0;
+  for (auto _ : state) {
+    const auto status = pass->run(poses[moving ? frame % 2 : 1], incoming, settings);
+    glFinish();
+    if (!status) state.SkipWithError(status.error().to_string().c_str());
+    ++frame;
+  }
+  state.counters["pairs_evaluated"] = static_cast<double>(pass->stats().pairs_evaluated);
+  state.counters["pairs_reused"] = static_cast<double>(pass->stats().pairs_reused);
+  state.counters["run_cpu_ms"] = pass->stats().cpu_ms;
+  state.counters["gpu_MB"] = static_cast<double>(pass->gpu_bytes()) / 1e6;
+}
+BENCHMARK(BM_BrfGpu)->ArgsProduct({{1, 5, 10, 30}, {0, 1}, {0, 1}})->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

@@ -1,0 +1,142 @@
+// Shared by the basis-radiance-field compute passes (brf_gpu_pass.cpp mirrors these structs
+// with static_asserts on their sizes). GLSL twins of gi/src/brf/spherical_harmonics.cpp and
+// BasisRadianceField::sample (gi/src/brf/radiance_field.cpp): same cube-face mapping, same
+// corner weights, same radius interpolation, so the GPU and CPU runtimes agree to float
+// rounding.
+
+// One uploaded model: its field's geometry and where its data lives.
+struct BrfModel {
+  vec4 centre_inner;     // xyz: field centre (object space), w: innermost sphere radius
+  float outer_radius;    // outermost sphere radius
+  uint spheres;
+  uint face_resolution;
+  uint sh_bands;         // 3 or 4
+  uint basis_count;      // N
+  uint vertex_offset;    // first vertex in the model-vertex buffer
+  uint vertex_count;
+  uint psi_offset;       // first float of Psi (N x vertex_count, basis-major) in the psi buffer
+  uint ainv_offset;      // first float of A^-1 (N x N, row-major)
+  uint field_offset;     // first float of the field in its field buffer
+  uint field_buffer;     // which field buffer (one dispatch per buffer)
+  uint pad0;
+};
+
+// One placed instance this frame.
+struct BrfInstance {
+  vec4 albedo;           // rgb diffuse albedo
+  uint model;
+  uint vertex_offset;    // first vertex in the frame's global vertex buffers
+  uint vertex_count;
+  uint weight_offset;    // first vec4 of its weights: one rgb vec4 per basis function, N padded to 4
+  uint live_first;       // its live sources in the live-source list
+  uint live_count;
+  uint pad0;
+  uint pad1;
+};
+
+// Basis functions padded to a multiple of 4: Phi rows and weight runs are read as vec4s.
+uint brf_padded(uint basis_count) { return (basis_count + 3u) & ~3u; }
+
+// Y_lm(w) for l < 4 (w unit, z up), "l, m" order: index l (l + 1) + m.
+void brf_sh_basis(vec3 w, out float c[16]) {
+  const float x = w.x, y = w.y, z = w.z;
+  c[0] = 0.282094792;
+  c[1] = 0.488602512 * y;
+  c[2] = 0.488602512 * z;
+  c[3] = 0.488602512 * x;
+  c[4] = 1.092548431 * x * y;
+  c[5] = 1.092548431 * y * z;
+  c[6] = 0.315391565 * (3.0 * z * z - 1.0);
+  c[7] = 1.092548431 * x * z;
+  c[8] = 0.546274215 * (x * x - y * y);
+  c[9] = 0.590043589 * y * (3.0 * x * x - y * y);
+  c[10] = 2.890611442 * x * y * z;
+  c[11] = 0.457045799 * y * (5.0 * z * z - 1.0);
+  c[12] = 0.373176333 * z * (5.0 * z * z - 3.0);
+  c[13] = 0.457045799 * x * (5.0 * z * z - 1.0);
+  c[14] = 1.445305721 * z * (x * x - y * y);
+  c[15] = 0.590043589 * x * (x * x - 3.0 * y * y);
+}
+
+// The clamped cosine max(0, n . w) around unit n, `bands` bands (band 3 is zero).
+void brf_clamped_cosine(vec3 n, uint bands, out float lobe[16]) {
+  const float kPi = 3.14159265358979;
+  brf_sh_basis(n, lobe);
+  const float band[4] = float[4](kPi, 2.0 * kPi / 3.0, kPi / 4.0, 0.0);
+  for (uint l = 0u; l < 4u; ++l)
+    for (uint i = l * l; i < (l + 1u) * (l + 1u); ++i) lobe[i] = l < bands ? band[l] * lobe[i] : 0.0;
+}
+
+// Cube face f and (u, v) in [-1, 1]^2 of direction d (radiance_field.cpp's cube_face).
+void brf_cube_face(vec3 d, out uint f, out float u, out float v) {
+  const vec3 a = abs(d);
+  if (a.x >= a.y && a.x >= a.z) {
+    f = d.x > 0.0 ? 0u : 1u;
+    u = d.x > 0.0 ? -d.z / a.x : d.z / a.x;
+    v = d.y / a.x;
+  } else if (a.y >= a.z) {
+    f = d.y > 0.0 ? 2u : 3u;
+    u = d.x / a.y;
+    v = d.y > 0.0 ? -d.z / a.y : d.z / a.y;
+  } else {
+    f = d.z > 0.0 ? 4u : 5u;
+    u = d.z > 0.0 ? d.x / a.z : -d.x / a.z;
+    v = d.y / a.z;
+  }
+}
+
+float brf_sphere_radius(BrfModel m, uint s) {
+  if (m.spheres <= 1u) return m.centre_inner.w;
+  return m.centre_inner.w * pow(m.outer_radius / m.centre_inner.w, float(s) / float(m.spheres - 1u));
+}
+
+// The 8 samples around object-space point p, as in BasisRadianceField::sample: first float
+// of each sample's [basis][coefficient] block (relative to the field) and its weight
+// (trilinear weight x falloff x (r_s / r)^2 between spheres). Returns false at the centre
+// or for non-finite points (the sample is zero there).
+bool brf_field_corners(BrfModel m, vec3 p, out uint base[8], out float weight[8]) {
+  for (int k = 0; k < 8; ++k) {
+    base[k] = 0u;
+    weight[k] = 0.0;
+  }
+  const vec3 d = p - m.centre_inner.xyz;
+  const float r = length(d);
+  if (!(r > 0.0) || isinf(r) || isnan(r)) return false;
+  const float inner = m.centre_inner.w, outer = m.outer_radius;
+  float falloff = 1.0;
+  float sr = 0.0;
+  if (r <= inner || m.spheres == 1u) {
+    sr = 0.0;
+  } else if (r >= outer) {
+    sr = float(m.spheres - 1u);
+    falloff = (outer / r) * (outer / r);
+  } else {
+    sr = log(r / inner) / log(outer / inner) * float(m.spheres - 1u);
+  }
+  const uint s0 = min(uint(sr), m.spheres - 1u), s1 = min(s0 + 1u, m.spheres - 1u);
+  const float ts = sr - float(s0);
+  uint f;
+  float u, v;
+  brf_cube_face(d, f, u, v);
+  const float n = float(m.face_resolution);
+  const float fu = clamp((u + 1.0) * 0.5 * n - 0.5, 0.0, n - 1.0);
+  const float fv = clamp((v + 1.0) * 0.5 * n - 0.5, 0.0, n - 1.0);
+  const uint u0 = uint(fu), v0 = uint(fv);
+  const uint u1 = min(u0 + 1u, m.face_resolution - 1u), v1 = min(v0 + 1u, m.face_resolution - 1u);
+  const float tu = fu - float(u0), tv = fv - float(v0);
+  const uint per_point = m.basis_count * m.sh_bands * m.sh_bands;
+  const bool between = r > inner && r < outer && m.spheres > 1u;
+  const uint cs[8] = uint[8](s0, s0, s0, s0, s1, s1, s1, s1);
+  const uint cu[8] = uint[8](u0, u1, u0, u1, u0, u1, u0, u1);
+  const uint cv[8] = uint[8](v0, v0, v1, v1, v0, v0, v1, v1);
+  const float cw[8] = float[8]((1.0 - ts) * (1.0 - tu) * (1.0 - tv), (1.0 - ts) * tu * (1.0 - tv),
+                               (1.0 - ts) * (1.0 - tu) * tv, (1.0 - ts) * tu * tv, ts * (1.0 - tu) * (1.0 - tv),
+                               ts * tu * (1.0 - tv), ts * (1.0 - tu) * tv, ts * tu * tv);
+  for (int k = 0; k < 8; ++k) {
+    const uint idx = ((cs[k] * 6u + f) * m.face_resolution + cv[k]) * m.face_resolution + cu[k];
+    base[k] = idx * per_point;
+    const float rs = brf_sphere_radius(m, cs[k]);
+    weight[k] = cw[k] * falloff * (between ? (rs / r) * (rs / r) : 1.0);
+  }
+  return true;
+}

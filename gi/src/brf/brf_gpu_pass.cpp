@@ -1,0 +1,655 @@
+#include "brf/brf_gpu_pass.h"
+
+#include <GL/glcorearb.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <string>
+#include <utility>
+
+#include "gpu/gi_shaders.h"
+
+namespace gi {
+
+namespace {
+
+constexpr const char* kWhere = "BRF GPU pass";
+constexpr std::size_t kSsboLimitBytes = std::size_t{128} << 20;  // DESIGN.md §4 (llvmpipe)
+constexpr std::uint32_t kGroupSize = 64;                         // local_size_x of every brf_*.comp.glsl
+constexpr std::uint32_t kMaxGroupsPerDimension = 65535;
+constexpr int kMaxBasis = 64;  // kMaxBasis in brf_fit.comp.glsl
+
+/// BrfModel in brf_common.glsl (std430).
+struct GpuModel {
+  glm::vec4 centre_inner{0.0f};
+  float outer_radius = 0.0f;
+  std::uint32_t spheres = 0, face_resolution = 0, sh_bands = 0;
+  std::uint32_t basis_count = 0, vertex_offset = 0, vertex_count = 0, psi_offset = 0;
+  std::uint32_t ainv_offset = 0, field_offset = 0, field_buffer = 0, pad0 = 0;
+};
+static_assert(sizeof(GpuModel) == 64, "must match BrfModel in brf_common.glsl (std430)");
+
+/// BrfInstance in brf_common.glsl (std430).
+struct GpuInstance {
+  glm::vec4 albedo{0.0f};
+  std::uint32_t model = 0, vertex_offset = 0, vertex_count = 0, weight_offset = 0;
+  std::uint32_t live_first = 0, live_count = 0, pad0 = 0, pad1 = 0;
+};
+static_assert(sizeof(GpuInstance) == 48, "must match BrfInstance in brf_common.glsl (std430)");
+
+static_assert(sizeof(glm::uvec2) == 8 && sizeof(glm::uvec4) == 16 && sizeof(glm::vec4) == 16,
+              "uvec2 / uvec4 / vec4 arrays are uploaded as std430 arrays");
+
+engine::Error error(std::string message) { return engine::Error{"", kWhere, std::move(message)}; }
+
+std::size_t gl_limit(GLenum name) {
+  GLint64 value = 0;
+  glGetInteger64v(name, &value);
+  return value > 0 ? static_cast<std::size_t>(value) : 0;
+}
+
+bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+bool finite(const glm::mat4& m) {
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r)
+      if (!std::isfinite(m[c][r])) return false;
+  return true;
+}
+
+bool same_pose(const glm::mat4& a, const glm::mat4& b, float tolerance) {
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r)
+      if (std::fabs(a[c][r] - b[c][r]) > tolerance * (1.0f + std::fabs(a[c][r]))) return false;
+  return true;
+}
+
+/// 2-D grid of `groups` work groups (x wraps at 65535).
+void dispatch_groups(std::uint32_t groups) {
+  if (groups == 0) return;
+  const std::uint32_t gx = std::min(groups, kMaxGroupsPerDimension);
+  glDispatchCompute(gx, (groups + gx - 1) / gx, 1);
+}
+
+std::uint32_t u32(std::size_t v) { return static_cast<std::uint32_t>(v); }
+
+/// Basis functions padded to a multiple of 4 (brf_padded in brf_common.glsl): Phi rows and
+/// weight runs are read as vec4s.
+std::uint32_t padded(std::uint32_t basis_count) { return (basis_count + 3u) & ~3u; }
+
+engine::Result<engine::ShaderProgram> build(const char* file) {
+  return engine::ShaderProgramBuilder(gi_shader_files()).stage(engine::ShaderStage::Compute, file).build();
+}
+
+void bind(GLuint binding, GLuint buffer) { glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding, buffer); }
+
+}  // namespace
+
+/// PhiJob in brf_phi.comp.glsl (std430).
+struct BrfPhiJob {
+  glm::mat4 to_source{1.0f};
+  glm::mat4 normal_to_source{1.0f};
+  std::uint32_t source_model = 0, point_offset = 0, point_count = 0, phi_offset = 0;
+};
+static_assert(sizeof(BrfPhiJob) == 144, "must match PhiJob in brf_phi.comp.glsl (std430)");
+
+void BrfGpuPass::Buffer::reserve(std::size_t size) {
+  size = std::max<std::size_t>(size, 16);
+  if (!buffer.empty() && bytes >= size) return;
+  if (buffer.empty()) buffer = engine::GlBuffer::create();
+  glNamedBufferData(buffer.id(), static_cast<GLsizeiptr>(size), nullptr, GL_DYNAMIC_DRAW);
+  bytes = size;
+}
+
+void BrfGpuPass::Buffer::upload(const void* data, std::size_t size) {
+  reserve(size);
+  if (size > 0) glNamedBufferSubData(buffer.id(), 0, static_cast<GLsizeiptr>(size), data);
+}
+
+engine::Result<BrfGpuPass> BrfGpuPass::create(std::span<const BrfGpuModel> models, const BrfGpuPassOptions& options) {
+  // Check the data before acquiring anything.
+  std::size_t limit = std::min(kSsboLimitBytes, gl_limit(GL_MAX_SHADER_STORAGE_BLOCK_SIZE));
+  if (options.max_buffer_bytes > 0) limit = std::min(limit, options.max_buffer_bytes);
+  if (!(options.pose_tolerance >= 0.0f)) return error("pose tolerance must be >= 0");
+  for (std::size_t m = 0; m < models.size(); ++m) {
+    const std::string which = "model " + std::to_string(m) + ": ";
+    const BrfGpuModel& model = models[m];
+    if (model.mesh == nullptr || model.basis == nullptr || model.field == nullptr)
+      return error(which + "mesh, basis and field must all be given");
+    const BrfMesh& mesh = *model.mesh;
+    const BrfBasis& basis = *model.basis;
+    const BasisRadianceField& f = *model.field;
+    const std::size_t nv = mesh.positions.size();
+    if (mesh.normals.size() != nv || basis.vertex_count != nv)
+      return error(which + "the mesh has " + std::to_string(nv) + " positions, " + std::to_string(mesh.normals.size()) +
+                   " normals, the basis " + std::to_string(basis.vertex_count) + " vertices");
+    if (basis.basis_count < 1 || basis.basis_count > kMaxBasis)
+      return error(which + "basis of " + std::to_string(basis.basis_count) + " functions (1 to " +
+                   std::to_string(kMaxBasis) + " supported)");
+    const auto nb = static_cast<std::size_t>(basis.basis_count);
+    if (basis.psi.size() != nb * nv || basis.a_inverse.size() != nb * nb)
+      return error(which + "basis arrays do not match its size");
+    if (f.basis_count != basis.basis_count) return error(which + "the field was computed for another basis");
+    if ((f.sh_bands != 3 && f.sh_bands != 4) || f.spheres < 1 || f.face_resolution < 1 || !(f.inner_radius > 0.0f) ||
+        !(f.outer_radius >= f.inner_radius) || !std::isfinite(f.outer_radius) || !finite(f.centre))
+      return error(which + "field settings out of range");
+    const std::size_t points = static_cast<std::size_t>(f.spheres) * 6 * static_cast<std::size_t>(f.face_resolution) *
+                               static_cast<std::size_t>(f.face_resolution);
+    if (f.coefficients.size() != points * nb * static_cast<std::size_t>(f.coefficient_count()))
+      return error(which + "field holds " + std::to_string(f.coefficients.size()) + " floats, expected " +
+                   std::to_string(points * nb * static_cast<std::size_t>(f.coefficient_count())));
+    if (f.bytes() > limit)
+      return error(which + "field of " + std::to_string(f.bytes()) + " bytes is above the SSBO limit of " +
+                   std::to_string(limit));
+    for (std::size_t j = 0; j < nv; ++j)
+      if (!finite(mesh.positions[j]) || !finite(mesh.normals[j]))
+        return error(which + "non-finite vertex " + std::to_string(j));
+    for (float v : basis.psi)
+      if (!std::isfinite(v)) return error(which + "non-finite basis value");
+    for (float v : basis.a_inverse)
+      if (!std::isfinite(v)) return error(which + "non-finite A^-1 value");
+    for (float v : f.coefficients)
+      if (!std::isfinite(v)) return error(which + "non-finite field coefficient");
+  }
+
+  BrfGpuPass pass;
+  pass.max_buffer_bytes_ = limit;
+  pass.pose_tolerance_ = options.pose_tolerance;
+  for (auto [program, file] :
+       {std::pair{&pass.programs_.phi, "brf_phi.comp.glsl"}, std::pair{&pass.programs_.fit, "brf_fit.comp.glsl"},
+        std::pair{&pass.programs_.gather, "brf_gather.comp.glsl"},
+        std::pair{&pass.programs_.static_gather, "brf_static_gather.comp.glsl"}}) {
+    auto built = build(file);
+    if (!built) return built.error();
+    *program = std::move(built).value();
+  }
+
+  // Model tables, vertices, bases; fields grouped into buffers under the limit.
+  std::vector<GpuModel> table;
+  std::vector<glm::vec4> vertices;
+  std::vector<float> psi, a_inverse;
+  std::vector<std::size_t> field_group_bytes;
+  for (const BrfGpuModel& model : models) {
+    const BasisRadianceField& f = *model.field;
+    GpuModel g;
+    g.centre_inner = glm::vec4(f.centre, f.inner_radius);
+    g.outer_radius = f.outer_radius;
+    g.spheres = u32(static_cast<std::size_t>(f.spheres));
+    g.face_resolution = u32(static_cast<std::size_t>(f.face_resolution));
+    g.sh_bands = u32(static_cast<std::size_t>(f.sh_bands));
+    g.basis_count = u32(static_cast<std::size_t>(model.basis->basis_count));
+    g.vertex_offset = u32(vertices.size() / 2);
+    g.vertex_count = u32(model.mesh->positions.size());
+    g.psi_offset = u32(psi.size());
+    g.ainv_offset = u32(a_inverse.size());
+    if (field_group_bytes.empty() || field_group_bytes.back() + f.bytes() > limit) field_group_bytes.push_back(0);
+    g.field_buffer = u32(field_group_bytes.size() - 1);
+    g.field_offset = u32(field_group_bytes.back() / sizeof(float));
+    field_group_bytes.back() += f.bytes();
+    table.push_back(g);
+    for (std::size_t j = 0; j < model.mesh->positions.size(); ++j) {
+      vertices.emplace_back(model.mesh->positions[j], 1.0f);
+      vertices.emplace_back(model.mesh->normals[j], 0.0f);
+    }
+    psi.insert(psi.end(), model.basis->psi.begin(), model.basis->psi.end());
+    a_inverse.insert(a_inverse.end(), model.basis->a_inverse.begin(), model.basis->a_inverse.end());
+    pass.models_.push_back({g.vertex_offset, g.vertex_count, g.basis_count, g.field_buffer, f.outer_radius, f.centre,
+                            model.basis, model.mesh, model.field});
+  }
+  const auto upload_once = [&pass](const auto& v) {
+    using T = typename std::decay_t<decltype(v)>::value_type;
+    std::vector<T> padded(v);
+    padded.resize(std::max<std::size_t>(padded.size(), (16 + sizeof(T) - 1) / sizeof(T)));
+    pass.model_bytes_ += padded.size() * sizeof(T);
+    return engine::GlBuffer::create(padded.size() * sizeof(T), padded.data());
+  };
+  pass.model_table_ = upload_once(table);
+  pass.model_vertices_ = upload_once(vertices);
+  pass.psi_ = upload_once(psi);
+  pass.a_inverse_ = upload_once(a_inverse);
+  for (std::size_t bytes : field_group_bytes) {
+    pass.fields_.push_back(engine::GlBuffer::create(std::max<std::size_t>(bytes, 16), nullptr, GL_DYNAMIC_STORAGE_BIT));
+    pass.model_bytes_ += std::max<std::size_t>(bytes, 16);
+  }
+  for (std::size_t m = 0; m < models.size(); ++m) {
+    const BasisRadianceField& f = *models[m].field;
+    glNamedBufferSubData(pass.fields_[table[m].field_buffer].id(),
+                         static_cast<GLintptr>(table[m].field_offset * sizeof(float)),
+                         static_cast<GLsizeiptr>(f.bytes()), f.coefficients.data());
+  }
+  if (pass.fields_.empty()) pass.fields_.push_back(engine::GlBuffer::create(16, nullptr, GL_DYNAMIC_STORAGE_BIT));
+  pass.static_out_.reserve(16);
+  pass.static_points_.reserve(16);
+  if (glGetError() == GL_OUT_OF_MEMORY) return error("out of GPU memory uploading the models");
+  return pass;
+}
+
+engine::Status BrfGpuPass::set_static_receivers(std::span<const glm::vec3> positions,
+                                                std::span<const glm::vec3> normals) {
+  GI_EXPECTS(!programs_.phi.empty(), "BrfGpuPass::set_static_receivers on an empty (default or moved-from) pass");
+  if (positions.size() != normals.size())
+    return error(std::to_string(positions.size()) + " static receiver positions but " + std::to_string(normals.size()) +
+                 " normals");
+  if (positions.size() >= (std::size_t{1} << 31)) return error("too many static receivers");
+  for (std::size_t t = 0; t < positions.size(); ++t)
+    if (!finite(positions[t]) || !finite(normals[t]))
+      return error("static receiver " + std::to_string(t) + " is not finite");
+  std::vector<glm::vec4> points;
+  points.reserve(2 * positions.size());
+  for (std::size_t t = 0; t < positions.size(); ++t) {
+    points.emplace_back(positions[t], 1.0f);
+    points.emplace_back(normals[t], 0.0f);
+  }
+  static_points_.upload(points.data(), points.size() * sizeof(glm::vec4));
+  static_positions_.assign(positions.begin(), positions.end());
+  static_count_ = positions.size();
+  static_out_.reserve(static_count_ * sizeof(glm::vec4));
+  glClearNamedBufferData(static_out_.buffer.id(), GL_R32F, GL_RED, GL_FLOAT, nullptr);
+  for (StaticSlot& s : static_slots_) s = StaticSlot{};
+  static_touched_count_ = 0;
+  return {};
+}
+
+engine::Status BrfGpuPass::reset_layout(std::span<const BrfGpuInstance> instances) {
+  const std::size_t n = instances.size();
+  std::vector<std::uint32_t> vertex_offsets(n + 1, 0), weight_offsets(n + 1, 0);
+  for (std::size_t i = 0; i < n; ++i) {
+    const ModelInfo& m = models_[instances[i].model];
+    vertex_offsets[i + 1] = vertex_offsets[i] + m.vertex_count;
+    weight_offsets[i + 1] = weight_offsets[i] + padded(m.basis_count);  // rgb vec4 per function
+  }
+  std::vector<PairSlot> pairs(n * n);
+  std::size_t phi_floats = 0;
+  for (std::size_t s = 0; s < n; ++s)
+    for (std::size_t r = 0; r < n; ++r) {
+      if (s == r) continue;
+      pairs[s * n + r].phi_offset = u32(phi_floats);
+      phi_floats += static_cast<std::size_t>(models_[instances[r].model].vertex_count) *
+                    padded(models_[instances[s].model].basis_count);
+    }
+  if (phi_floats * sizeof(float) > max_buffer_bytes_)
+    return error(std::to_string(n) + " instances need " + std::to_string(phi_floats * sizeof(float)) +
+                 " bytes of pair Phi, above the SSBO limit of " + std::to_string(max_buffer_bytes_));
+  if (static_cast<std::size_t>(vertex_offsets[n]) * sizeof(glm::vec4) > max_buffer_bytes_)
+    return error("the instances' vertices exceed the SSBO limit");
+
+  layout_models_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) layout_models_[i] = instances[i].model;
+  vertex_offsets_ = std::move(vertex_offsets);
+  weight_offsets_ = std::move(weight_offsets);
+  pairs_ = std::move(pairs);
+  static_slots_.assign(n, StaticSlot{});
+  static_touched_count_ = 0;
+  const std::size_t vertex_bytes = static_cast<std::size_t>(vertex_offsets_[n]) * sizeof(glm::vec4);
+  for (Buffer* b : {&incoming_, &gathered_, &indirect_}) b->reserve(vertex_bytes);
+  weights_.reserve(weight_offsets_[n] * sizeof(glm::vec4));
+  phi_.reserve(phi_floats * sizeof(float));
+  outputs_.clear();
+  output_bytes_ = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t bytes = std::max<std::size_t>(
+        static_cast<std::size_t>(vertex_offsets_[i + 1] - vertex_offsets_[i]) * sizeof(glm::vec4), 16);
+    outputs_.push_back(engine::GlBuffer::create(bytes, nullptr, GL_DYNAMIC_STORAGE_BIT));
+    glClearNamedBufferData(outputs_.back().id(), GL_R32F, GL_RED, GL_FLOAT, nullptr);
+    output_bytes_ += bytes;
+  }
+  return {};
+}
+
+void BrfGpuPass::dispatch_phi(std::span<const BrfPhiJob> jobs, bool static_kind) {
+  if (jobs.empty()) return;
+  // Work groups sorted by the source's field buffer: one dispatch per buffer.
+  std::vector<glm::uvec2> groups;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> ranges(fields_.size(), {0u, 0u});
+  for (std::size_t b = 0; b < fields_.size(); ++b) {
+    ranges[b].first = u32(groups.size());
+    for (std::size_t j = 0; j < jobs.size(); ++j) {
+      if (models_[jobs[j].source_model].field_buffer != b) continue;
+      for (std::uint32_t first = 0; first < jobs[j].point_count; first += kGroupSize)
+        groups.emplace_back(u32(j), first);
+    }
+    ranges[b].second = u32(groups.size()) - ranges[b].first;
+  }
+  jobs_.upload(jobs.data(), jobs.size() * sizeof(BrfPhiJob));
+  groups_.upload(groups.data(), groups.size() * sizeof(glm::uvec2));
+
+  const GLuint id = programs_.phi.id();
+  programs_.phi.use();
+  glProgramUniform1ui(id, glGetUniformLocation(id, "u_kind"), static_kind ? 1u : 0u);
+  bind(0, model_table_.id());
+  bind(1, model_vertices_.id());
+  bind(2, static_points_.buffer.id());
+  bind(3, static_indices_.buffer.empty() ? static_points_.buffer.id() : static_indices_.buffer.id());
+  bind(4, jobs_.buffer.id());
+  bind(5, groups_.buffer.id());
+  bind(7, static_kind ? static_phi_.buffer.id() : phi_.buffer.id());
+  for (std::size_t b = 0; b < fields_.size(); ++b) {
+    if (ranges[b].second == 0) continue;
+    bind(6, fields_[b].id());
+    glProgramUniform1ui(id, glGetUniformLocation(id, "u_first_group"), ranges[b].first);
+    glProgramUniform1ui(id, glGetUniformLocation(id, "u_group_count"), ranges[b].second);
+    dispatch_groups(ranges[b].second);
+  }
+}
+
+engine::Status BrfGpuPass::update_static(std::span<const BrfGpuInstance> instances) {
+  const std::size_t n = instances.size();
+  stats_.static_sources_reused = 0;
+  std::vector<std::uint8_t> moved(n, 0);
+  bool any = false;
+  for (std::size_t s = 0; s < n; ++s) {
+    StaticSlot& slot = static_slots_[s];
+    const glm::mat4& m = instances[s].object_to_world;
+    if (slot.valid && same_pose(slot.pose, m, pose_tolerance_)) {
+      ++stats_.static_sources_reused;
+      continue;
+    }
+    moved[s] = 1;
+    any = true;
+  }
+  if (!any) return {};
+
+  // Which receivers lie inside each moved source's outermost sphere (as brf_interreflect tests it).
+  std::vector<std::vector<std::uint32_t>> inside(n);
+  std::size_t total_floats = 0;
+  for (std::size_t s = 0; s < n; ++s) {
+    const ModelInfo& model = models_[instances[s].model];
+    if (moved[s] != 0) {
+      const glm::mat4& m = instances[s].object_to_world;
+      const glm::vec3 centre = glm::vec3(m * glm::vec4(model.field_centre, 1.0f));
+      const float scale = glm::length(glm::vec3(m[0]));
+      const float reach = model.outer_radius * scale;
+      for (std::size_t t = 0; t < static_count_; ++t)
+        if (glm::length(static_positions_[t] - centre) <= reach) inside[s].push_back(u32(t));
+    } else {
+      inside[s] = static_slots_[s].receivers;
+    }
+    total_floats += inside[s].size() * padded(model.basis_count);
+  }
+  if (total_floats * sizeof(float) > max_buffer_bytes_)
+    return error("static receivers need " + std::to_string(total_floats * sizeof(float)) +
+                 " bytes of Phi, above the SSBO limit of " + std::to_string(max_buffer_bytes_));
+
+  // New layout; unmoved sources' Phi is copied over, moved ones are evaluated.
+  static_phi_spare_.reserve(total_floats * sizeof(float));
+  std::vector<std::uint32_t> indices;
+  std::vector<BrfPhiJob> jobs;
+  std::uint32_t phi_offset = 0;
+  for (std::size_t s = 0; s < n; ++s) {
+    StaticSlot& slot = static_slots_[s];
+    const ModelInfo& model = models_[instances[s].model];
+    const std::size_t count = inside[s].size();
+    if (moved[s] == 0 && count > 0)
+      glCopyNamedBufferSubData(static_phi_.buffer.id(), static_phi_spare_.buffer.id(),
+                               static_cast<GLintptr>(slot.phi_offset * sizeof(float)),
+                               static_cast<GLintptr>(phi_offset * sizeof(float)),
+                               static_cast<GLsizeiptr>(count * padded(model.basis_count) * sizeof(float)));
+    slot.index_offset = u32(indices.size());
+    slot.phi_offset = phi_offset;
+    if (moved[s] != 0) {
+      slot.valid = true;
+      slot.pose = instances[s].object_to_world;
+      slot.receivers = std::move(inside[s]);
+      if (count > 0) {
+        BrfPhiJob job;
+        job.to_source = glm::inverse(instances[s].object_to_world);
+        job.normal_to_source = glm::mat4(glm::mat3(job.to_source));
+        job.source_model = instances[s].model;
+        job.point_offset = slot.index_offset;
+        job.point_count = u32(count);
+        job.phi_offset = phi_offset;
+        jobs.push_back(job);
+      }
+    }
+    indices.insert(indices.end(), slot.receivers.begin(), slot.receivers.end());
+    phi_offset += u32(count * padded(model.basis_count));
+  }
+  std::swap(static_phi_, static_phi_spare_);
+  static_indices_.upload(indices.data(), indices.size() * sizeof(std::uint32_t));
+  dispatch_phi(jobs, true);
+
+  // Per touched receiver, its sources in instance order.
+  std::vector<std::uint32_t> count(static_count_, 0);
+  for (std::size_t s = 0; s < n; ++s)
+    for (std::uint32_t t : static_slots_[s].receivers) ++count[t];
+  std::vector<glm::uvec4> touched;
+  std::vector<std::uint32_t> next(static_count_, 0);
+  std::uint32_t first = 0;
+  for (std::size_t t = 0; t < static_count_; ++t) {
+    if (count[t] == 0) continue;
+    touched.emplace_back(u32(t), first, count[t], 0u);
+    next[t] = first;
+    first += count[t];
+  }
+  std::vector<glm::uvec4> entries(first);
+  for (std::size_t s = 0; s < n; ++s) {
+    const StaticSlot& slot = static_slots_[s];
+    const std::uint32_t nb = padded(models_[instances[s].model].basis_count);
+    for (std::size_t k = 0; k < slot.receivers.size(); ++k)
+      entries[next[slot.receivers[k]]++] =
+          glm::uvec4(weight_offsets_[s], (slot.phi_offset + u32(k) * nb) / 4, nb / 4, u32(s));
+  }
+  static_touched_.upload(touched.data(), touched.size() * sizeof(glm::uvec4));
+  static_entries_.upload(entries.data(), entries.size() * sizeof(glm::uvec4));
+  static_touched_count_ = u32(touched.size());
+  return {};
+}
+
+engine::Status BrfGpuPass::run(std::span<const BrfGpuInstance> instances,
+                               std::span<const std::vector<glm::vec3>> incoming, const BrfUpdateSettings& settings) {
+  GI_EXPECTS(!programs_.phi.empty(), "BrfGpuPass::run on an empty (default or moved-from) pass");
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::size_t n = instances.size();
+  if (incoming.size() != n)
+    return error("incoming light for " + std::to_string(incoming.size()) + " instances, " + std::to_string(n) +
+                 " given");
+  if (n >= (std::size_t{1} << 16)) return error("too many instances");
+  for (std::size_t i = 0; i < n; ++i) {
+    const BrfGpuInstance& inst = instances[i];
+    const std::string which = "instance " + std::to_string(i) + ": ";
+    if (inst.model >= models_.size())
+      return error(which + "model " + std::to_string(inst.model) + " does not exist (" +
+                   std::to_string(models_.size()) + " models)");
+    if (!finite(inst.object_to_world)) return error(which + "non-finite transform");
+    const float det = glm::determinant(glm::mat3(inst.object_to_world));
+    if (!(std::fabs(det) > 0.0f) || !std::isfinite(det)) return error(which + "singular transform");
+    if (!finite(inst.albedo)) return error(which + "non-finite albedo");
+    if (incoming[i].size() != models_[inst.model].vertex_count)
+      return error(which + "incoming light for " + std::to_string(incoming[i].size()) + " vertices, the mesh has " +
+                   std::to_string(models_[inst.model].vertex_count));
+    for (const glm::vec3& e : incoming[i])
+      if (!finite(e)) return error(which + "non-finite incoming light");
+  }
+  bool same_layout = layout_models_.size() == n;
+  for (std::size_t i = 0; same_layout && i < n; ++i) same_layout = layout_models_[i] == instances[i].model;
+  if (!same_layout)
+    if (auto s = reset_layout(instances); !s) return s;
+
+  stats_ = Stats{};
+  if (n == 0) {
+    if (static_count_ > 0) glClearNamedBufferData(static_out_.buffer.id(), GL_R32F, GL_RED, GL_FLOAT, nullptr);
+    stats_.cpu_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    return {};
+  }
+
+  // First weights and pair culling on the CPU, exactly as brf_interreflect decides them.
+  std::vector<BrfObject> objects(n);
+  std::vector<std::array<std::vector<float>, 3>> first_weights(n);
+  std::vector<glm::vec3> light;
+  std::vector<glm::vec4> weights(weight_offsets_[n], glm::vec4(0.0f));  // pads stay 0
+  for (std::size_t i = 0; i < n; ++i) {
+    const ModelInfo& m = models_[instances[i].model];
+    objects[i] = {m.mesh, m.basis, m.field, instances[i].object_to_world, instances[i].albedo};
+    light.resize(incoming[i].size());
+    for (std::size_t j = 0; j < light.size(); ++j) light[j] = instances[i].albedo * incoming[i][j];
+    first_weights[i] = brf_fit_rgb(*m.basis, light);
+    for (std::size_t k = 0; k < m.basis_count; ++k)
+      weights[weight_offsets_[i] + k] =
+          glm::vec4(first_weights[i][0][k], first_weights[i][1][k], first_weights[i][2][k], 0.0f);
+  }
+  std::vector<std::uint8_t> culled;
+  if (!(settings.cull_threshold <= 0.0f)) {  // > 0 or NaN: as brf_interreflect
+    culled = brf_pair_culling(objects, first_weights, settings.cull_threshold);
+  } else {  // what brf_pair_culling returns for a threshold <= 0, without evaluating the bounds
+    culled.assign(n * n, 0);
+    for (std::size_t s = 0; s < n; ++s) culled[s * n + s] = 1;
+  }
+
+  // Pairs whose relative pose changed (or never computed): Phi jobs; live sources per receiver.
+  std::vector<BrfPhiJob> jobs;
+  std::vector<glm::uvec4> live;  // (source's first weight vec4, first Phi vec4, N4 / 4, source)
+  std::vector<GpuInstance> table(n);
+  std::vector<glm::mat4> to_source(n);
+  for (std::size_t s = 0; s < n; ++s) to_source[s] = glm::inverse(instances[s].object_to_world);
+  for (std::size_t r = 0; r < n; ++r) {
+    const ModelInfo& mr = models_[instances[r].model];
+    GpuInstance& g = table[r];
+    g.albedo = glm::vec4(instances[r].albedo, 0.0f);
+    g.model = instances[r].model;
+    g.vertex_offset = vertex_offsets_[r];
+    g.vertex_count = mr.vertex_count;
+    g.weight_offset = weight_offsets_[r];
+    g.live_first = u32(live.size());
+    for (std::size_t s = 0; s < n; ++s) {
+      if (s == r) continue;
+      if (culled[s * n + r] != 0) {
+        ++stats_.pairs_culled;
+        continue;
+      }
+      ++stats_.pairs_evaluated;
+      PairSlot& slot = pairs_[s * n + r];
+      const glm::mat4 relative = to_source[s] * instances[r].object_to_world;
+      live.emplace_back(weight_offsets_[s], slot.phi_offset / 4, padded(models_[instances[s].model].basis_count) / 4,
+                        u32(s));
+      if (slot.valid && same_pose(slot.pose, relative, pose_tolerance_)) {
+        ++stats_.pairs_reused;
+        continue;
+      }
+      BrfPhiJob job;
+      job.to_source = relative;
+      job.normal_to_source = glm::mat4(glm::transpose(glm::inverse(glm::mat3(relative))));
+      job.source_model = instances[s].model;
+      job.point_offset = mr.first_vertex;  // receiver vertices in the model-vertex buffer
+      job.point_count = mr.vertex_count;
+      job.phi_offset = slot.phi_offset;
+      jobs.push_back(job);
+      slot.valid = true;
+      slot.pose = relative;
+    }
+    g.live_count = u32(live.size()) - g.live_first;
+  }
+  dispatch_phi(jobs, false);
+
+  // Frame inputs.
+  std::vector<glm::vec4> in4(vertex_offsets_[n]);
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t j = 0; j < incoming[i].size(); ++j) in4[vertex_offsets_[i] + j] = glm::vec4(incoming[i][j], 0.0f);
+  incoming_.upload(in4.data(), in4.size() * sizeof(glm::vec4));
+  instance_table_.upload(table.data(), table.size() * sizeof(GpuInstance));
+  weights_.upload(weights.data(), weights.size() * sizeof(glm::vec4));
+  live_.upload(live.data(), live.size() * sizeof(glm::uvec4));
+  glClearNamedBufferData(indirect_.buffer.id(), GL_R32F, GL_RED, GL_FLOAT, nullptr);
+  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+
+  const auto fit = [&](std::uint32_t mode) {
+    const GLuint id = programs_.fit.id();
+    programs_.fit.use();
+    glProgramUniform1ui(id, glGetUniformLocation(id, "u_mode"), mode);
+    bind(0, instance_table_.buffer.id());
+    bind(1, model_table_.id());
+    bind(2, psi_.id());
+    bind(3, a_inverse_.id());
+    bind(4, incoming_.buffer.id());
+    bind(5, gathered_.buffer.id());
+    bind(6, indirect_.buffer.id());
+    bind(7, weights_.buffer.id());
+    glDispatchCompute(u32(n), 1, 1);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+  };
+  const std::uint32_t vertex_total = vertex_offsets_[n];
+  for (int bounce = 0; bounce < settings.bounces; ++bounce) {
+    if (bounce > 0) fit(0);
+    const GLuint id = programs_.gather.id();
+    programs_.gather.use();
+    glProgramUniform1ui(id, glGetUniformLocation(id, "u_instance_count"), u32(n));
+    glProgramUniform1ui(id, glGetUniformLocation(id, "u_vertex_total"), vertex_total);
+    bind(0, instance_table_.buffer.id());
+    bind(1, model_table_.id());
+    bind(2, live_.buffer.id());
+    bind(3, weights_.buffer.id());
+    bind(4, phi_.buffer.id());
+    bind(5, gathered_.buffer.id());
+    bind(6, indirect_.buffer.id());
+    dispatch_groups((vertex_total + kGroupSize - 1) / kGroupSize);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+  }
+
+  if (static_count_ > 0) {
+    if (auto s = update_static(instances); !s) return s;
+    fit(1);
+    glClearNamedBufferData(static_out_.buffer.id(), GL_R32F, GL_RED, GL_FLOAT, nullptr);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    const GLuint id = programs_.static_gather.id();
+    programs_.static_gather.use();
+    glProgramUniform1ui(id, glGetUniformLocation(id, "u_touched_count"), static_touched_count_);
+    bind(0, static_touched_.buffer.id());
+    bind(1, static_entries_.buffer.id());
+    bind(2, instance_table_.buffer.id());
+    bind(3, model_table_.id());
+    bind(4, weights_.buffer.id());
+    bind(5, static_phi_.buffer.id());
+    bind(6, static_out_.buffer.id());
+    dispatch_groups((static_touched_count_ + kGroupSize - 1) / kGroupSize);
+  }
+
+  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t bytes = static_cast<std::size_t>(vertex_offsets_[i + 1] - vertex_offsets_[i]) * sizeof(glm::vec4);
+    if (bytes > 0)
+      glCopyNamedBufferSubData(indirect_.buffer.id(), outputs_[i].id(),
+                               static_cast<GLintptr>(vertex_offsets_[i] * sizeof(glm::vec4)), 0,
+                               static_cast<GLsizeiptr>(bytes));
+  }
+  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_VERTEX_ATTRIB_ARRAY_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+  stats_.cpu_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  return {};
+}
+
+std::uint32_t BrfGpuPass::vertex_buffer(std::size_t instance) const {
+  GI_EXPECTS(instance < outputs_.size(), "BrfGpuPass::vertex_buffer: instance out of range of the last run");
+  return outputs_[instance].id();
+}
+
+std::vector<glm::vec3> BrfGpuPass::read_back_vertices(std::size_t instance) const {
+  GI_EXPECTS(instance < outputs_.size(), "BrfGpuPass::read_back_vertices: instance out of range of the last run");
+  const std::size_t count = vertex_offsets_[instance + 1] - vertex_offsets_[instance];
+  std::vector<glm::vec4> v(count);
+  if (count > 0)
+    glGetNamedBufferSubData(outputs_[instance].id(), 0, static_cast<GLsizeiptr>(count * sizeof(glm::vec4)), v.data());
+  std::vector<glm::vec3> out(count);
+  for (std::size_t j = 0; j < count; ++j) out[j] = glm::vec3(v[j]);
+  return out;
+}
+
+std::vector<glm::vec3> BrfGpuPass::read_back_static() const {
+  GI_EXPECTS(!static_out_.buffer.empty(), "BrfGpuPass::read_back_static on an empty (default or moved-from) pass");
+  std::vector<glm::vec4> v(static_count_);
+  if (static_count_ > 0)
+    glGetNamedBufferSubData(static_out_.buffer.id(), 0, static_cast<GLsizeiptr>(static_count_ * sizeof(glm::vec4)),
+                            v.data());
+  std::vector<glm::vec3> out(static_count_);
+  for (std::size_t t = 0; t < static_count_; ++t) out[t] = glm::vec3(v[t]);
+  return out;
+}
+
+std::size_t BrfGpuPass::gpu_bytes() const {
+  std::size_t bytes = model_bytes_ + output_bytes_;
+  for (const Buffer* b :
+       {&static_points_, &instance_table_, &incoming_, &gathered_, &indirect_, &weights_, &phi_, &live_, &jobs_,
+        &groups_, &static_indices_, &static_phi_, &static_phi_spare_, &static_touched_, &static_entries_, &static_out_})
+    bytes += b->bytes;
+  return bytes;
+}
+
+}  // namespace gi

@@ -1,0 +1,201 @@
+#pragma once
+// The basis-radiance-field interreflection on the GPU (Iwasaki et al. §5): the compute twin of
+// gi::brf_interreflect (brf_runtime.h). Models (mesh, PCA basis, field) are uploaded once; a
+// frame uploads the instances' transforms and albedos and the light arriving at their
+// vertices, and compute shaders do the rest:
+//   - brf_phi.comp.glsl: the basis irradiance Phi of every (source, receiver) pair whose
+//     relative pose changed, all such pairs in one dispatch (a group table maps work groups
+//     to pairs); Phi stays on the GPU between frames, so a frame where nothing moved
+//     evaluates no field (a pair culled for a while keeps its slot and is reused if its pose
+//     is unchanged when it comes back);
+//   - brf_gather.comp.glsl: per bounce, E_r(x_j) = sum_s max(0, sum_i w_s,i Phi_sr,i(x_j));
+//   - brf_fit.comp.glsl: per bounce, the next weights w = A^-1 Psi^T (albedo x E) of every
+//     instance in one dispatch (the first bounce's weights come from the CPU, which needs
+//     them anyway for the pair culling);
+//   - static-world receivers: Phi per source (kept while the source does not move), the fit
+//     of each source's total radiosity and brf_static_gather.comp.glsl.
+// Pair culling is brf_pair_culling on the CPU with the same first weights as the CPU twin, so
+// both evaluate the same pairs.
+//   auto pass = gi::BrfGpuPass::create(models).value();          // a GL context is current
+//   pass.run(instances, incoming, {.bounces = 3});               // then bind pass.vertex_buffer(i)
+//
+// Precision: float32 throughout; the fits sum in float where the CPU sums in double. Relative
+// RMSE against brf_interreflect is ~2e-7 on the test scenes (tests/gi/brf_gpu_pass_test.cpp).
+//
+// Limits: every pair's Phi slot (receiver vertices x source basis functions) lives in one
+// SSBO, at most 128 MiB (or GL_MAX_SHADER_STORAGE_BLOCK_SIZE): run() reports an error above
+// it (about 115 instances of 150 vertices and 16 basis functions). Fields are grouped into
+// buffers under the same limit (one Phi dispatch per buffer); one field above it is an error.
+//
+// GL state: create(), run(), set_static_receivers() and the read-backs need the creating
+// context current; they change the bound program and shader-storage bindings 0-7.
+
+#include <engine/gpu/gl_objects.h>
+#include <engine/gpu/shader_program.h>
+#include <engine/result.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <glm/glm.hpp>
+#include <span>
+#include <vector>
+
+#include "brf/brf_runtime.h"
+
+namespace gi {
+
+struct BrfPhiJob;  // one batched Phi evaluation (brf_gpu_pass.cpp)
+
+/// One kind of rigid object: its mesh, basis and field belong together (not owned; read at
+/// create() only).
+struct BrfGpuModel {
+  const BrfMesh* mesh = nullptr;
+  const BrfBasis* basis = nullptr;
+  const BasisRadianceField* field = nullptr;
+};
+
+/// One placed object this frame.
+struct BrfGpuInstance {
+  std::uint32_t model = 0;          ///< Index into create()'s models.
+  glm::mat4 object_to_world{1.0f};  ///< Rigid (rotation + translation; uniform scale allowed).
+  glm::vec3 albedo{0.8f};           ///< Diffuse albedo.
+};
+
+struct BrfGpuPassOptions {
+  /// Largest buffer bound as one SSBO (bytes). 0: GL_MAX_SHADER_STORAGE_BLOCK_SIZE, at most
+  /// 128 MiB. Tests set it small to exercise field buffers split by model.
+  std::size_t max_buffer_bytes = 0;
+  /// Two poses (relative source-receiver pose, or a source's world transform) are the same
+  /// when no matrix element differs by more than this x (1 + |element|).
+  float pose_tolerance = 1e-6f;
+};
+
+/// Interreflection between rigid objects on the GPU. Move-only; owns its GL objects
+/// (moved-from: empty).
+///   auto pass = gi::BrfGpuPass::create(models).value();
+///   pass.run(instances, incoming, settings);  // pass.vertex_buffer(i): vec4 per vertex
+class BrfGpuPass {
+ public:
+  /// Compiles the shaders and uploads every model's vertices, basis and field. Errors: a null
+  /// pointer, mesh / basis / field that do not belong together, non-finite data, a basis of
+  /// more than 64 functions, a field larger than the SSBO limit, shader build failure.
+  static engine::Result<BrfGpuPass> create(std::span<const BrfGpuModel> models, const BrfGpuPassOptions& options = {});
+
+  BrfGpuPass() = default;
+  BrfGpuPass(BrfGpuPass&&) noexcept = default;
+  BrfGpuPass& operator=(BrfGpuPass&&) noexcept = default;
+  BrfGpuPass(const BrfGpuPass&) = delete;
+  BrfGpuPass& operator=(const BrfGpuPass&) = delete;
+  ~BrfGpuPass() = default;
+
+  /// Static-world receiver points (world space, unit normals), e.g. light-atlas texels;
+  /// uploaded once, replacing earlier ones (empty: none). Errors: sizes differ, non-finite.
+  engine::Status set_static_receivers(std::span<const glm::vec3> positions, std::span<const glm::vec3> normals);
+
+  /// One frame. incoming[i][j]: irradiance (W/m^2, RGB) arriving at instance i's vertex j
+  /// from outside the objects (direct + world). Computes what brf_interreflect(objects,
+  /// incoming, settings, receivers) computes into vertex_buffer(i) and
+  /// static_receiver_buffer(). Errors (nothing is changed): a model index out of range,
+  /// incoming sizes that do not match the instances' meshes, non-finite transforms, albedos
+  /// or incoming light, Phi slots above the SSBO limit. Ends with a barrier for shader
+  /// storage, vertex attribute and buffer reads.
+  engine::Status run(std::span<const BrfGpuInstance> instances, std::span<const std::vector<glm::vec3>> incoming,
+                     const BrfUpdateSettings& settings);
+
+  /// GL buffer of instance i of the last run: vec4 per vertex, xyz = interreflected
+  /// irradiance (W/m^2), w = 0. Owned by the pass; valid until the instance count changes.
+  std::uint32_t vertex_buffer(std::size_t instance) const;
+  /// GL buffer: vec4 per static receiver, xyz = irradiance from all objects (W/m^2).
+  std::uint32_t static_receiver_buffer() const { return static_out_.buffer.id(); }
+  /// vertex_buffer(i) read back (for tests and tools).
+  std::vector<glm::vec3> read_back_vertices(std::size_t instance) const;
+  /// static_receiver_buffer() read back.
+  std::vector<glm::vec3> read_back_static() const;
+
+  struct Stats {
+    std::size_t pairs_evaluated = 0;  ///< Live (not culled) pairs, as BrfResult counts them.
+    std::size_t pairs_culled = 0;
+    std::size_t pairs_reused = 0;           ///< Live pairs whose Phi was kept (relative pose unchanged).
+    std::size_t static_sources_reused = 0;  ///< Sources whose static-receiver Phi was kept.
+    double cpu_ms = 0.0;                    ///< Wall time of the last run() on the CPU.
+  };
+  const Stats& stats() const { return stats_; }
+  /// GPU memory held by the pass (bytes): models, per-frame buffers, Phi caches.
+  std::size_t gpu_bytes() const;
+
+ private:
+  /// A GL buffer that grows on demand (glNamedBufferData), never shrinks.
+  struct Buffer {
+    engine::GlBuffer buffer;
+    std::size_t bytes = 0;
+    /// Ensures at least `size` bytes (>= 16); contents are lost when it grows.
+    void reserve(std::size_t size);
+    /// reserve(size) then upload.
+    void upload(const void* data, std::size_t size);
+  };
+  struct ModelInfo {
+    std::uint32_t first_vertex = 0;  ///< In the model-vertex buffer.
+    std::uint32_t vertex_count = 0;
+    std::uint32_t basis_count = 0;
+    std::uint32_t field_buffer = 0;
+    float outer_radius = 0.0f;
+    glm::vec3 field_centre{0.0f};
+    const BrfBasis* basis = nullptr;  ///< For the CPU first fit.
+    const BrfMesh* mesh = nullptr;    ///< For pair culling (BrfObject).
+    const BasisRadianceField* field = nullptr;
+  };
+  /// One ordered (source, receiver) pair's cached Phi.
+  struct PairSlot {
+    std::uint32_t phi_offset = 0;  ///< First float in phi_.
+    bool valid = false;            ///< Phi holds the basis irradiance at `pose`.
+    glm::mat4 pose{1.0f};          ///< inverse(M_source) x M_receiver when computed.
+  };
+  /// One source's static-receiver Phi.
+  struct StaticSlot {
+    bool valid = false;
+    glm::mat4 pose{1.0f};                  ///< M_source when computed.
+    std::vector<std::uint32_t> receivers;  ///< Static receivers inside its outermost sphere.
+    std::uint32_t index_offset = 0;        ///< First entry in static_indices_.
+    std::uint32_t phi_offset = 0;          ///< First float in static_phi_.
+  };
+  struct Programs {
+    engine::ShaderProgram phi, fit, gather, static_gather;
+  };
+
+  engine::Status reset_layout(std::span<const BrfGpuInstance> instances);
+  /// Static receivers' Phi of the sources that moved, the per-receiver source lists.
+  engine::Status update_static(std::span<const BrfGpuInstance> instances);
+  /// Evaluates `jobs` (one dispatch per field buffer) into phi_ or, for static_kind, static_phi_.
+  void dispatch_phi(std::span<const BrfPhiJob> jobs, bool static_kind);
+
+  Programs programs_;
+  std::vector<ModelInfo> models_;
+  std::size_t max_buffer_bytes_ = 0;
+  float pose_tolerance_ = 1e-6f;
+
+  // Uploaded once at create().
+  engine::GlBuffer model_table_, model_vertices_, psi_, a_inverse_;
+  std::vector<engine::GlBuffer> fields_;
+  std::size_t model_bytes_ = 0;
+
+  // Static receivers.
+  Buffer static_points_;
+  std::size_t static_count_ = 0;
+  std::vector<glm::vec3> static_positions_;  ///< CPU copy for the inside-the-field test.
+
+  // Per layout (instance count and models).
+  std::vector<std::uint32_t> layout_models_;
+  std::vector<std::uint32_t> vertex_offsets_;  ///< Per instance, plus the total.
+  std::vector<std::uint32_t> weight_offsets_;
+  std::vector<PairSlot> pairs_;  ///< [source * n + receiver].
+  std::vector<StaticSlot> static_slots_;
+  std::vector<engine::GlBuffer> outputs_;  ///< Per instance: vec4 per vertex.
+  std::size_t output_bytes_ = 0;
+  Buffer instance_table_, incoming_, gathered_, indirect_, weights_, phi_, live_, jobs_, groups_;
+  Buffer static_indices_, static_phi_, static_phi_spare_, static_touched_, static_entries_, static_out_;
+  std::uint32_t static_touched_count_ = 0;
+
+  Stats stats_;
+};
+
+}  // namespace gi

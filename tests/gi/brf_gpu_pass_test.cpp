@@ -1,0 +1,395 @@
+// The basis-radiance-field interreflection on the GPU (llvmpipe through EGL; fails, never
+// skips, without a context) against its CPU twin gi::brf_interreflect: the same pairs, the
+// same bounces, the same static receivers, relative RMSE below 1e-3 (float32 on both sides;
+// the GPU fits sum in float where the CPU sums in double). Phi caching: moving one object
+// re-evaluates only its pairs, a still frame none.
+#include "brf/brf_gpu_pass.h"
+
+#include <engine/gpu/context.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <glm/gtc/matrix_transform.hpp>
+#include <limits>
+#include <vector>
+
+#include "brf/brf_runtime.h"
+
+namespace {
+
+constexpr double kTolerance = 1e-3;
+
+engine::GpuContext headless_or_fail() {
+  auto ctx = engine::GpuContext::create_headless();
+  if (!ctx) {
+    ADD_FAILURE() << "headless GL context creation failed: " << ctx.error().to_string();
+    std::abort();
+  }
+  return std::move(ctx).value();
+}
+
+gi::BrfMesh box(glm::vec3 half, int n) {
+  gi::BrfMesh m;
+  const glm::vec3 axes[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  for (int a = 0; a < 3; ++a)
+    for (float sign : {-1.0f, 1.0f}) {
+      const glm::vec3 nrm = axes[a] * sign;
+      const glm::vec3 t = axes[(a + 1) % 3] * sign, b = axes[(a + 2) % 3];
+      const auto base = static_cast<std::uint32_t>(m.positions.size());
+      for (int i = 0; i <= n; ++i)
+        for (int j = 0; j <= n; ++j) {
+          const float s = (2.0f * static_cast<float>(i) / static_cast<float>(n) - 1.0f) * 0.98f;
+          const float r = (2.0f * static_cast<float>(j) / static_cast<float>(n) - 1.0f) * 0.98f;
+          m.positions.push_back((nrm + s * t + r * b) * half);
+          m.normals.push_back(nrm);
+        }
+      const auto at = [&](int i, int j) { return base + static_cast<std::uint32_t>(i * (n + 1) + j); };
+      for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j)
+          m.indices.insert(m.indices.end(),
+                           {at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+    }
+  return m;
+}
+
+// Two small models: a cube (8 functions, 3 SH bands) and a slab (6 functions, 4 bands), so
+// offsets, basis counts and band counts differ between pairs.
+struct Models {
+  gi::BrfMesh cube = box({0.3f, 0.3f, 0.3f}, 3);
+  gi::BrfMesh slab = box({0.2f, 0.4f, 0.25f}, 3);
+  gi::BrfBasis cube_basis = gi::compute_pca_basis(cube, {.lights = 64, .basis = 8}).value();
+  gi::BrfBasis slab_basis = gi::compute_pca_basis(slab, {.lights = 64, .basis = 6}).value();
+  gi::BasisRadianceField cube_field =
+      gi::compute_basis_radiance_field(cube, cube_basis,
+                                       {.spheres = 6, .face_resolution = 6, .sh_bands = 3, .directions = 64})
+          .value();
+  gi::BasisRadianceField slab_field =
+      gi::compute_basis_radiance_field(slab, slab_basis,
+                                       {.spheres = 5, .face_resolution = 5, .sh_bands = 4, .directions = 64})
+          .value();
+  std::vector<gi::BrfGpuModel> gpu() const {
+    return {{&cube, &cube_basis, &cube_field}, {&slab, &slab_basis, &slab_field}};
+  }
+  gi::BrfObject object(const gi::BrfGpuInstance& i) const {
+    return i.model == 0 ? gi::BrfObject{&cube, &cube_basis, &cube_field, i.object_to_world, i.albedo}
+                        : gi::BrfObject{&slab, &slab_basis, &slab_field, i.object_to_world, i.albedo};
+  }
+};
+
+const Models& models() {
+  static const Models m;
+  return m;
+}
+
+glm::mat4 pose(glm::vec3 t, float angle, glm::vec3 axis, float scale = 1.0f) {
+  return glm::scale(glm::rotate(glm::translate(glm::mat4(1.0f), t), angle, glm::normalize(axis)), glm::vec3(scale));
+}
+
+std::vector<gi::BrfGpuInstance> three_objects(float third_distance = 0.7f) {
+  return {{0, pose({-0.5f, 0.0f, 0.0f}, 0.4f, {0, 1, 0}), {0.8f, 0.2f, 0.1f}},
+          {1, pose({0.45f, 0.1f, 0.05f}, 0.3f, {1, 1, 0}, 1.1f), {0.7f, 0.7f, 0.7f}},
+          {0, pose({0.0f, 0.1f, third_distance}, -0.6f, {0, 1, 1}, 0.8f), {0.2f, 0.5f, 0.8f}}};
+}
+
+// Light arriving at each vertex from a point light (unshadowed) plus a constant sky term.
+std::vector<std::vector<glm::vec3>> incoming_light(std::span<const gi::BrfGpuInstance> instances, glm::vec3 light,
+                                                   float strength = 4.0f) {
+  std::vector<std::vector<glm::vec3>> in;
+  for (const gi::BrfGpuInstance& i : instances) {
+    const gi::BrfWorldVertices v = gi::brf_world_vertices(models().object(i));
+    auto& e = in.emplace_back();
+    for (std::size_t j = 0; j < v.positions.size(); ++j) {
+      const glm::vec3 d = light - v.positions[j];
+      const float cos_theta = std::max(0.0f, glm::dot(v.normals[j], glm::normalize(d)));
+      e.push_back(glm::vec3(1.0f, 0.8f, 0.6f) * (strength * cos_theta / glm::dot(d, d)) + glm::vec3(0.05f));
+    }
+  }
+  return in;
+}
+
+struct StaticPoints {
+  std::vector<glm::vec3> positions, normals;
+};
+
+// A floor under the objects, a wall beside them and two points far outside every field. The
+// grid is offset by odd amounts: a point whose source-space direction ties two cube faces
+// exactly (|x| == |y|, as the slab's rotation about (1, 1, 0) makes of (1, -0.45, -0.4)) may
+// round to either face on CPU and GPU, and the field lookup jumps across face seams.
+StaticPoints static_points() {
+  StaticPoints s;
+  for (int i = 0; i < 12; ++i)
+    for (int k = 0; k < 12; ++k) {
+      s.positions.emplace_back(-1.187f + 0.2f * static_cast<float>(i), -0.45f, -0.991f + 0.2f * static_cast<float>(k));
+      s.normals.emplace_back(0.0f, 1.0f, 0.0f);
+      s.positions.emplace_back(1.3f, -0.4f + 0.1f * static_cast<float>(i), -0.6f + 0.12f * static_cast<float>(k));
+      s.normals.emplace_back(-1.0f, 0.0f, 0.0f);
+    }
+  s.positions.emplace_back(40.0f, 0.0f, 0.0f);
+  s.normals.emplace_back(-1.0f, 0.0f, 0.0f);
+  s.positions.emplace_back(0.0f, -30.0f, 0.0f);
+  s.normals.emplace_back(0.0f, 1.0f, 0.0f);
+  return s;
+}
+
+gi::BrfResult cpu(std::span<const gi::BrfGpuInstance> instances, std::span<const std::vector<glm::vec3>> incoming,
+                  const gi::BrfUpdateSettings& settings, const StaticPoints* receivers = nullptr) {
+  std::vector<gi::BrfObject> objects;
+  for (const auto& i : instances) objects.push_back(models().object(i));
+  gi::BrfStaticReceivers r;
+  if (receivers != nullptr) r = {receivers->positions, receivers->normals};
+  return gi::brf_interreflect(objects, incoming, settings, r);
+}
+
+// sqrt(sum |a - b|^2 / sum |b|^2); 0 when both are zero.
+double relative_rmse(std::span<const glm::vec3> a, std::span<const glm::vec3> b, double* norm_out = nullptr) {
+  EXPECT_EQ(a.size(), b.size());
+  double err = 0.0, norm = 0.0;
+  for (std::size_t k = 0; k < std::min(a.size(), b.size()); ++k) {
+    const glm::dvec3 d = glm::dvec3(a[k]) - glm::dvec3(b[k]);
+    err += glm::dot(d, d);
+    norm += glm::dot(glm::dvec3(b[k]), glm::dvec3(b[k]));
+  }
+  if (norm_out != nullptr) *norm_out = norm;
+  const double e = norm > 0.0 ? std::sqrt(err / norm) : std::sqrt(err);
+  if (e >= kTolerance)  // name the worst entries
+    for (std::size_t k = 0, shown = 0; k < std::min(a.size(), b.size()) && shown < 6; ++k)
+      if (glm::length(a[k] - b[k]) > 1e-3f * glm::length(b[k]) + 1e-6f) {
+        std::printf("  [%zu] gpu (%g %g %g) cpu (%g %g %g)\n", k, double(a[k].x), double(a[k].y), double(a[k].z),
+                    double(b[k].x), double(b[k].y), double(b[k].z));
+        ++shown;
+      }
+  return e;
+}
+
+double vertices_error(const gi::BrfGpuPass& pass, const gi::BrfResult& ref) {
+  std::vector<glm::vec3> a, b;
+  for (std::size_t i = 0; i < ref.indirect.size(); ++i) {
+    const auto v = pass.read_back_vertices(i);
+    a.insert(a.end(), v.begin(), v.end());
+    b.insert(b.end(), ref.indirect[i].begin(), ref.indirect[i].end());
+  }
+  double norm = 0.0;
+  const double e = relative_rmse(a, b, &norm);
+  EXPECT_GT(norm, 0.0) << "the scene has no interreflection to compare";
+  return e;
+}
+
+bool all_finite(std::span<const glm::vec3> v) {
+  for (const glm::vec3& x : v)
+    if (!std::isfinite(x.x) || !std::isfinite(x.y) || !std::isfinite(x.z)) return false;
+  return true;
+}
+
+gi::BrfGpuPass make_pass(const gi::BrfGpuPassOptions& options = {}) {
+  auto pass = gi::BrfGpuPass::create(models().gpu(), options);
+  if (!pass) {
+    ADD_FAILURE() << pass.error().to_string();
+    std::abort();
+  }
+  return std::move(pass).value();
+}
+
+TEST(BrfGpuPass, MatchesCpuTwinWithoutCullingWithStaticReceivers) {
+  auto ctx = headless_or_fail();
+  gi::BrfGpuPass pass = make_pass();
+  const StaticPoints floor = static_points();
+  ASSERT_TRUE(pass.set_static_receivers(floor.positions, floor.normals).ok());
+  const auto instances = three_objects();
+  const auto incoming = incoming_light(instances, {-1.0f, 1.5f, 0.8f});
+  const gi::BrfUpdateSettings settings{.bounces = 2, .cull_threshold = 0.0f};
+  const auto status = pass.run(instances, incoming, settings);
+  ASSERT_TRUE(status.ok()) << status.error().to_string();
+  const gi::BrfResult ref = cpu(instances, incoming, settings, &floor);
+
+  const double e = vertices_error(pass, ref);
+  double static_norm = 0.0;
+  const auto st = pass.read_back_static();
+  const double es = relative_rmse(st, ref.static_irradiance, &static_norm);
+  std::printf("no culling: vertices rel RMSE %.2e, static rel RMSE %.2e, %zu bytes on the GPU\n", e, es,
+              pass.gpu_bytes());
+  EXPECT_LT(e, kTolerance);
+  EXPECT_GT(static_norm, 0.0);
+  EXPECT_LT(es, kTolerance);
+  EXPECT_EQ(st[st.size() - 1], glm::vec3(0.0f));  // outside every field
+  EXPECT_EQ(st[st.size() - 2], glm::vec3(0.0f));
+  EXPECT_EQ(pass.stats().pairs_evaluated, ref.pairs_evaluated);
+  EXPECT_EQ(pass.stats().pairs_evaluated, 6u);
+  EXPECT_EQ(pass.stats().pairs_culled, 0u);
+  EXPECT_EQ(pass.stats().pairs_reused, 0u);
+  EXPECT_EQ(pass.stats().static_sources_reused, 0u);
+  EXPECT_GT(pass.gpu_bytes(), models().cube_field.bytes() + models().slab_field.bytes());
+}
+
+TEST(BrfGpuPass, MatchesCpuTwinWithCulling) {
+  auto ctx = headless_or_fail();
+  gi::BrfGpuPass pass = make_pass();
+  const auto instances = three_objects(3.0f);  // the third object far away: its pairs are culled
+  const auto incoming = incoming_light(instances, {-1.0f, 1.5f, 0.8f});
+  for (int bounces : {1, 2, 3}) {
+    const gi::BrfUpdateSettings settings{.bounces = bounces, .cull_threshold = 0.05f};
+    ASSERT_TRUE(pass.run(instances, incoming, settings).ok());
+    const gi::BrfResult ref = cpu(instances, incoming, settings);
+    const double e = vertices_error(pass, ref);
+    std::printf("culling, %d bounces: rel RMSE %.2e, %zu pairs evaluated, %zu culled\n", bounces, e,
+                pass.stats().pairs_evaluated, pass.stats().pairs_culled);
+    EXPECT_LT(e, kTolerance);
+    EXPECT_GT(ref.pairs_culled, 0u);
+    EXPECT_EQ(pass.stats().pairs_culled, ref.pairs_culled);
+    EXPECT_EQ(pass.stats().pairs_evaluated, ref.pairs_evaluated);
+  }
+}
+
+TEST(BrfGpuPass, MovingOneObjectRecomputesOnlyItsPairs) {
+  auto ctx = headless_or_fail();
+  gi::BrfGpuPass pass = make_pass();
+  const StaticPoints floor = static_points();
+  ASSERT_TRUE(pass.set_static_receivers(floor.positions, floor.normals).ok());
+  auto instances = three_objects();
+  const gi::BrfUpdateSettings settings{.bounces = 2, .cull_threshold = 0.0f};
+  ASSERT_TRUE(pass.run(instances, incoming_light(instances, {-1.0f, 1.5f, 0.8f}), settings).ok());
+
+  instances[1].object_to_world = pose({0.5f, 0.15f, 0.1f}, 0.5f, {1, 1, 0}, 1.1f);
+  const auto incoming = incoming_light(instances, {-1.0f, 1.5f, 0.8f});
+  ASSERT_TRUE(pass.run(instances, incoming, settings).ok());
+  // Pairs with instance 1 as source or receiver: 2 x (n - 1) = 4 of 6.
+  EXPECT_EQ(pass.stats().pairs_evaluated, 6u);
+  EXPECT_EQ(pass.stats().pairs_reused, 2u);
+  EXPECT_EQ(pass.stats().static_sources_reused, 2u);
+  const gi::BrfResult ref = cpu(instances, incoming, settings, &floor);
+  const double e = vertices_error(pass, ref);
+  const double es = relative_rmse(pass.read_back_static(), ref.static_irradiance);
+  std::printf("one moved: rel RMSE %.2e, static %.2e\n", e, es);
+  EXPECT_LT(e, kTolerance);
+  EXPECT_LT(es, kTolerance);
+
+  // Everything moved together: relative poses hold (pairs reused), every source moved (static re-evaluated).
+  const glm::mat4 shift = glm::translate(glm::mat4(1.0f), {0.3f, 0.0f, -0.2f});
+  for (auto& i : instances) i.object_to_world = shift * i.object_to_world;
+  const auto incoming2 = incoming_light(instances, {-1.0f, 1.5f, 0.8f});
+  ASSERT_TRUE(pass.run(instances, incoming2, settings).ok());
+  EXPECT_EQ(pass.stats().pairs_reused, 6u);
+  EXPECT_EQ(pass.stats().static_sources_reused, 0u);
+  const gi::BrfResult ref2 = cpu(instances, incoming2, settings, &floor);
+  EXPECT_LT(vertices_error(pass, ref2), kTolerance);
+  EXPECT_LT(relative_rmse(pass.read_back_static(), ref2.static_irradiance), kTolerance);
+}
+
+TEST(BrfGpuPass, StillFrameReusesEveryPairUnderNewLight) {
+  auto ctx = headless_or_fail();
+  gi::BrfGpuPass pass = make_pass();
+  const StaticPoints floor = static_points();
+  ASSERT_TRUE(pass.set_static_receivers(floor.positions, floor.normals).ok());
+  const auto instances = three_objects();
+  const gi::BrfUpdateSettings settings{.bounces = 2, .cull_threshold = 1e-3f};
+  ASSERT_TRUE(pass.run(instances, incoming_light(instances, {-1.0f, 1.5f, 0.8f}), settings).ok());
+  const auto incoming = incoming_light(instances, {1.2f, 1.0f, -0.5f}, 7.0f);  // the light moved, the objects did not
+  ASSERT_TRUE(pass.run(instances, incoming, settings).ok());
+  EXPECT_EQ(pass.stats().pairs_reused, pass.stats().pairs_evaluated);
+  EXPECT_EQ(pass.stats().static_sources_reused, 3u);
+  const gi::BrfResult ref = cpu(instances, incoming, settings, &floor);
+  EXPECT_LT(vertices_error(pass, ref), kTolerance);
+  EXPECT_LT(relative_rmse(pass.read_back_static(), ref.static_irradiance), kTolerance);
+}
+
+TEST(BrfGpuPass, InstanceCountChangeResetsTheCache) {
+  auto ctx = headless_or_fail();
+  gi::BrfGpuPass pass = make_pass();
+  auto instances = three_objects();
+  const gi::BrfUpdateSettings settings{.bounces = 2, .cull_threshold = 0.0f};
+  ASSERT_TRUE(pass.run(instances, incoming_light(instances, {-1.0f, 1.5f, 0.8f}), settings).ok());
+  instances.pop_back();
+  const auto incoming = incoming_light(instances, {-1.0f, 1.5f, 0.8f});
+  ASSERT_TRUE(pass.run(instances, incoming, settings).ok());
+  EXPECT_EQ(pass.stats().pairs_evaluated, 2u);
+  EXPECT_EQ(pass.stats().pairs_reused, 0u);
+  EXPECT_LT(vertices_error(pass, cpu(instances, incoming, settings)), kTolerance);
+  // Same count, another model in a slot: the layout changes too.
+  instances[0].model = 1;
+  const auto incoming2 = incoming_light(instances, {-1.0f, 1.5f, 0.8f});
+  ASSERT_TRUE(pass.run(instances, incoming2, settings).ok());
+  EXPECT_EQ(pass.stats().pairs_reused, 0u);
+  EXPECT_LT(vertices_error(pass, cpu(instances, incoming2, settings)), kTolerance);
+}
+
+TEST(BrfGpuPass, FieldsSplitOverBuffersStillMatch) {
+  auto ctx = headless_or_fail();
+  // Each field in its own buffer: one Phi dispatch per buffer.
+  const std::size_t limit = std::max(models().cube_field.bytes(), models().slab_field.bytes()) + 1024;
+  gi::BrfGpuPass pass = make_pass({.max_buffer_bytes = limit});
+  const auto instances = three_objects();
+  const auto incoming = incoming_light(instances, {-1.0f, 1.5f, 0.8f});
+  const gi::BrfUpdateSettings settings{.bounces = 3, .cull_threshold = 0.0f};
+  ASSERT_TRUE(pass.run(instances, incoming, settings).ok());
+  EXPECT_LT(vertices_error(pass, cpu(instances, incoming, settings)), kTolerance);
+}
+
+TEST(BrfGpuPass, OverlapsAndPointsInsideTheInnermostSphereStayFinite) {
+  auto ctx = headless_or_fail();
+  gi::BrfGpuPass pass = make_pass();
+  // Two objects sharing a centre (every vertex inside the other's innermost sphere), a third
+  // overlapping them; static receivers at a field centre and inside the innermost sphere.
+  const std::vector<gi::BrfGpuInstance> instances = {{0, pose({0.0f, 0.0f, 0.0f}, 0.0f, {0, 1, 0}), glm::vec3(0.8f)},
+                                                     {1, pose({0.0f, 0.0f, 0.0f}, 0.7f, {0, 1, 0}), glm::vec3(0.6f)},
+                                                     {0, pose({0.2f, 0.1f, 0.0f}, 0.3f, {1, 0, 0}), glm::vec3(0.5f)}};
+  const StaticPoints points{{glm::vec3(0.0f), glm::vec3(0.05f, 0.02f, 0.0f), glm::vec3(0.2f, 0.1f, 0.0f)},
+                            {glm::vec3(0, 1, 0), glm::vec3(1, 0, 0), glm::vec3(0, 0, 1)}};
+  ASSERT_TRUE(pass.set_static_receivers(points.positions, points.normals).ok());
+  const auto incoming = incoming_light(instances, {-1.0f, 1.5f, 0.8f});
+  const gi::BrfUpdateSettings settings{.bounces = 3, .cull_threshold = 0.0f};
+  ASSERT_TRUE(pass.run(instances, incoming, settings).ok());
+  const gi::BrfResult ref = cpu(instances, incoming, settings, &points);
+  for (std::size_t i = 0; i < instances.size(); ++i) EXPECT_TRUE(all_finite(pass.read_back_vertices(i))) << i;
+  const auto st = pass.read_back_static();
+  EXPECT_TRUE(all_finite(st));
+  EXPECT_LT(vertices_error(pass, ref), kTolerance);
+  EXPECT_LT(relative_rmse(st, ref.static_irradiance), kTolerance);
+}
+
+TEST(BrfGpuPass, BadInputReturnsErrors) {
+  auto ctx = headless_or_fail();
+  gi::BrfGpuPass pass = make_pass();
+  const auto instances = three_objects();
+  const auto incoming = incoming_light(instances, {-1.0f, 1.5f, 0.8f});
+  const gi::BrfUpdateSettings settings{.bounces = 2, .cull_threshold = 0.0f};
+
+  auto bad_model = instances;
+  bad_model[2].model = 7;
+  auto s = pass.run(bad_model, incoming, settings);
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.error().message.find("model 7"), std::string::npos) << s.error().to_string();
+
+  EXPECT_FALSE(pass.run(instances, std::span(incoming).first(2), settings).ok());
+  auto short_incoming = incoming;
+  short_incoming[1].pop_back();
+  s = pass.run(instances, short_incoming, settings);
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.error().message.find("instance 1"), std::string::npos) << s.error().to_string();
+
+  auto nan_pose = instances;
+  nan_pose[0].object_to_world[3][1] = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_FALSE(pass.run(nan_pose, incoming, settings).ok());
+  auto singular = instances;
+  singular[0].object_to_world = glm::mat4(0.0f);
+  EXPECT_FALSE(pass.run(singular, incoming, settings).ok());
+  auto nan_light = incoming;
+  nan_light[2][5].y = std::numeric_limits<float>::infinity();
+  EXPECT_FALSE(pass.run(instances, nan_light, settings).ok());
+
+  const glm::vec3 p[2] = {glm::vec3(0.0f), glm::vec3(1.0f)};
+  const glm::vec3 nrm[1] = {glm::vec3(0, 1, 0)};
+  EXPECT_FALSE(pass.set_static_receivers(p, nrm).ok());
+
+  gi::BrfGpuModel broken = models().gpu()[0];
+  broken.field = nullptr;
+  EXPECT_FALSE(gi::BrfGpuPass::create(std::span(&broken, 1)).ok());
+  gi::BrfGpuModel mismatched{&models().cube, &models().cube_basis, &models().slab_field};  // 8 vs 6 functions
+  EXPECT_FALSE(gi::BrfGpuPass::create(std::span(&mismatched, 1)).ok());
+
+  // Still usable after the errors.
+  ASSERT_TRUE(pass.run(instances, incoming, settings).ok());
+  EXPECT_LT(vertices_error(pass, cpu(instances, incoming, settings)), kTolerance);
+}
+
+}  // namespace
