@@ -19,6 +19,8 @@ struct BrfModel {
   uint field_offset;     // first float of the field in its field buffer
   uint field_buffer;     // which field buffer (one dispatch per buffer)
   uint pad0;
+  vec4 box_lo;           // xyz: the object's bounding box (object space), brf_object_box
+  vec4 box_hi;
 };
 
 // One placed instance this frame.
@@ -56,6 +58,24 @@ void brf_sh_basis(vec3 w, out float c[16]) {
   c[13] = 0.457045799 * x * (5.0 * z * z - 1.0);
   c[14] = 1.445305721 * z * (x * x - y * y);
   c[15] = 0.590043589 * x * (x * x - 3.0 * y * y);
+}
+
+// Where the object's box lies relative to the tangent plane of (p, n), object space: the
+// twin of brf_horizon (brf_runtime.cpp). 0: behind, 1: wholly in front, 2: straddling.
+uint brf_horizon(BrfModel m, vec3 p, vec3 n) {
+  const vec3 c = 0.5 * (m.box_lo.xyz + m.box_hi.xyz), h = 0.5 * (m.box_hi.xyz - m.box_lo.xyz);
+  const float centre = dot(n, c - p);
+  const float spread = abs(n.x) * h.x + abs(n.y) * h.y + abs(n.z) * h.z;
+  const float tolerance = 1e-4 * (h.x + h.y + h.z);
+  if (centre + spread <= tolerance) return 0u;
+  if (centre - spread >= -tolerance) return 1u;
+  return 2u;
+}
+
+// The unclamped cosine n . w: band 1 only, (4 pi / 3) Y_1m(n) (sh_cosine).
+void brf_cosine(vec3 n, out float lobe[16]) {
+  brf_sh_basis(n, lobe);
+  for (uint i = 0u; i < 16u; ++i) lobe[i] = (i >= 1u && i <= 3u) ? 4.18879020 * lobe[i] : 0.0;
 }
 
 // The clamped cosine max(0, n . w) around unit n, `bands` bands (band 3 is zero).

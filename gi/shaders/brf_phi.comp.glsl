@@ -6,6 +6,8 @@
 // the source's object space (to_source), its normal too (normal_to_source, then normalized),
 // and
 //   phi[phi_offset + k N4 + i] = sum over the 8 field samples of weight x (coefficients_i . lobe(n))
+// with lobe = 0 / the unclamped cosine / the clamped cosine as the source's box lies behind /
+// in front of / across the tangent plane (brf_horizon)
 // (N4: N padded to a multiple of 4, the pads written 0)
 // the twin of brf_basis_irradiance (brf_runtime.cpp). Work groups map to (job, first point)
 // through the group table, so a dispatch covers many jobs of different lengths.
@@ -58,12 +60,20 @@ void main() {
   const vec3 n = normalize(mat3(job.normal_to_source) * n_in);
 
   const BrfModel m = models[job.source_model];
+  const uint nb = m.basis_count, n4 = brf_padded(nb);
+  const uint side = brf_horizon(m, p, n);
+  if (side == 0u) {  // the source is behind the tangent plane: no light
+    for (uint i = 0u; i < n4; ++i) phi[job.phi_offset + k * n4 + i] = 0.0;
+    return;
+  }
   float lobe[16];
-  brf_clamped_cosine(n, m.sh_bands, lobe);
+  if (side == 1u)
+    brf_cosine(n, lobe);
+  else
+    brf_clamped_cosine(n, m.sh_bands, lobe);
   uint base[8];
   float weight[8];
   const bool inside = brf_field_corners(m, p, base, weight);
-  const uint nb = m.basis_count, n4 = brf_padded(nb);
   const uint cc = m.sh_bands * m.sh_bands;
   for (uint i = nb; i < n4; ++i) phi[job.phi_offset + k * n4 + i] = 0.0;
   for (uint i = 0u; i < nb; ++i) {

@@ -27,8 +27,9 @@ struct GpuModel {
   std::uint32_t spheres = 0, face_resolution = 0, sh_bands = 0;
   std::uint32_t basis_count = 0, vertex_offset = 0, vertex_count = 0, psi_offset = 0;
   std::uint32_t ainv_offset = 0, field_offset = 0, field_buffer = 0, pad0 = 0;
+  glm::vec4 box_lo{0.0f}, box_hi{0.0f};
 };
-static_assert(sizeof(GpuModel) == 64, "must match BrfModel in brf_common.glsl (std430)");
+static_assert(sizeof(GpuModel) == 96, "must match BrfModel in brf_common.glsl (std430)");
 
 /// BrfInstance in brf_common.glsl (std430).
 struct GpuInstance {
@@ -175,6 +176,9 @@ engine::Result<BrfGpuPass> BrfGpuPass::create(std::span<const BrfGpuModel> model
     GpuModel g;
     g.centre_inner = glm::vec4(f.centre, f.inner_radius);
     g.outer_radius = f.outer_radius;
+    const BrfBox box = brf_object_box(*model.mesh);
+    g.box_lo = glm::vec4(box.lo, 0.0f);
+    g.box_hi = glm::vec4(box.hi, 0.0f);
     g.spheres = u32(static_cast<std::size_t>(f.spheres));
     g.face_resolution = u32(static_cast<std::size_t>(f.face_resolution));
     g.sh_bands = u32(static_cast<std::size_t>(f.sh_bands));

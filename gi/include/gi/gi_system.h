@@ -1,0 +1,89 @@
+#pragma once
+// The GI system a game adds to its frame loop: it loads a bake bundle (gi-bake's output)
+// and hands the renderer the indirect light of every frame, recomputing only what changed.
+//
+//   engine::Scene scene = engine::instantiate(engine::load_gltf("level.gltf").value());
+//   auto gi = gi::GISystem::load("out/level.gibake", scene);   // before Renderer::create
+//   if (!gi) { std::cerr << gi.error().to_string() << '\n'; return 1; }
+//   auto renderer = engine::Renderer::create(scene.assets, {}).value();
+//   renderer->set_indirect_light(gi.value().get());             // frame() runs once per drawn frame
+//   // ... game loop: simulate (move crates, lights), then renderer->render(...)
+//
+// What runs, from what the bundle holds (gi-bake bakes what gi::plan() asks for):
+//   light atlas  static world, static lights: uploaded once;
+//   PRM          moving lights: entry weights and the pane sum only on frames where a
+//                moving light changed;
+//   BRF          dynamic rigid objects: per-vertex indirect light (world probes + light
+//                interreflected between objects, GPU), their bounce added into the static
+//                atlas; only on frames where an object moved or any light changed, and the
+//                basis irradiance only for pairs whose relative pose changed.
+// A frame where nothing changed does no work (Stats counts it).
+//
+// Loading checks every file against the scene (a bundle baked from other geometry, or from
+// other meshes, is rejected naming the file and both hashes) and gives the static meshes
+// TEXCOORD_1, so create the renderer from the scene after load(). The scene's registry must
+// outlive the system; GL objects are created on the first frame() (context current) and
+// deleted with the system: destroy it before the GL context.
+
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include <engine/indirect_light.h>
+#include <engine/result.h>
+#include <engine/scene.h>
+
+namespace gi {
+
+struct GISystemSettings {
+  int prm_active_clusters = 32;   ///< PRM: panes summed per update (the heaviest K; 0: all).
+  int brf_bounces = 3;            ///< BRF: bounces between dynamic objects.
+  float brf_cull_threshold = 1e-3f;  ///< BRF: skip object pairs below this share of the largest (§5.4).
+  float probe_spacing_m = 1.0f;   ///< BRF: spacing of the world-light probes for dynamic objects.
+};
+
+class GISystem final : public engine::IndirectLightProvider {
+ public:
+  /// Errors: no manifest, no method the runtime uses, stale or damaged files (the message
+  /// names the file and the problem).
+  static engine::Result<std::unique_ptr<GISystem>> load(const std::filesystem::path& bundle_dir, engine::Scene& scene,
+                                                        GISystemSettings settings = {});
+  GISystem(const GISystem&) = delete;
+  GISystem& operator=(const GISystem&) = delete;
+  ~GISystem() override;
+
+  /// Indirect light for the frame about to be drawn (GL context current).
+  const engine::IndirectLightFrame& frame() override;
+  /// "light atlas", "light atlas + PRM", "light atlas + PRM + BRF", ...
+  const char* label() const override;
+
+  struct Stats {
+    std::uint64_t frames = 0;
+    std::uint64_t idle_frames = 0;       ///< Frames on which nothing was recomputed.
+    std::uint64_t prm_updates = 0;       ///< Frames on which a moving light re-summed the PRM.
+    std::uint64_t brf_updates = 0;       ///< Frames on which the dynamic objects' light was recomputed.
+    std::uint64_t brf_moves = 0;         ///< ... of which at least one object had moved.
+    std::uint64_t world_composites = 0;  ///< Frames on which the objects' bounce was re-added to the atlas.
+    std::size_t brf_pairs_evaluated = 0; ///< Last BRF update: object pairs with light between them,
+    std::size_t brf_pairs_reused = 0;    ///< ... of which their basis irradiance was reused (pose unchanged),
+    std::size_t brf_pairs_culled = 0;    ///< and pairs skipped by the I_c bound.
+    double last_prm_ms = 0.0;            ///< CPU weights + GPU sum (glFinish-timed).
+    double last_brf_cpu_ms = 0.0;        ///< Direct light at vertices, probes.
+    double last_brf_gpu_ms = 0.0;        ///< Interreflection pass (glFinish-timed).
+    std::size_t dynamic_objects = 0;
+    std::size_t dynamic_vertices = 0;
+    std::size_t brf_field_bytes = 0;     ///< Basis + fields of all dynamic meshes (CPU copy).
+    std::size_t load_probe_ms = 0;       ///< Probe grid computed at load.
+  };
+  const Stats& stats() const;
+  /// One line per active method with what drives it, for overlays and logs.
+  std::string describe() const;
+
+ private:
+  struct Impl;
+  explicit GISystem(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace gi

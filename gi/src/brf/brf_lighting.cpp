@@ -1,0 +1,258 @@
+#include <GL/glcorearb.h>
+
+#include "brf/brf_lighting.h"
+
+#include <chrono>
+#include <cstdio>
+#include <unordered_map>
+
+#include <engine/components.h>
+#include <engine/gpu/gl_objects.h>
+#include <engine/gpu/shader_program.h>
+
+#include "bake/static_scene.h"
+#include "brf/brf_gpu_pass.h"
+#include "gpu/gi_shaders.h"
+#include "light_atlas/point_emitters.h"
+#include "raytrace/ray_caster.h"
+#include "sweep/content_hash.h"
+
+namespace gi {
+
+namespace {
+
+constexpr std::uint32_t kGroupSize = 64;
+
+std::uint64_t lights_signature(const engine::Registry& registry) {
+  ContentHash h;
+  registry.view<engine::Light, engine::WorldTransform>().each(
+      [&](engine::Entity e, const engine::Light& l, const engine::WorldTransform& wt) {
+        h.add_value(e.id());
+        h.add_value(static_cast<std::uint8_t>(l.enabled));
+        h.add_value(static_cast<std::uint8_t>(l.type));
+        h.add_value(l.color.x), h.add_value(l.color.y), h.add_value(l.color.z);
+        h.add_value(l.intensity), h.add_value(l.range_m);
+        h.add_value(l.inner_cone_rad), h.add_value(l.outer_cone_rad);
+        h.add_value(l.area_size_m.x), h.add_value(l.area_size_m.y);
+        for (int c = 0; c < 4; ++c)
+          for (int r = 0; r < 4; ++r) h.add_value(wt.matrix[c][r]);
+      });
+  return h.value();
+}
+
+bool finite_matrix(const glm::mat4& m) {
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r)
+      if (!std::isfinite(m[c][r])) return false;
+  return true;
+}
+
+}  // namespace
+
+struct BrfLighting::Impl {
+  const engine::Registry* registry = nullptr;
+  std::vector<BrfModelData> models;
+  std::vector<BrfInstanceBinding> instances;
+  BrfWorldLink world;
+  BrfLightingSettings settings;
+  std::unordered_map<std::uint32_t, std::size_t> instance_of;  // entity id -> instance
+
+  // GPU side, created on the first update (the GL context is current then).
+  std::optional<BrfGpuPass> pass;
+  engine::ShaderProgram sum_program, composite_program;
+  std::vector<engine::GlBuffer> world_light, total;  // per instance
+  engine::GlBuffer receiver_texels;
+  bool gpu_failed = false;
+
+  std::vector<glm::mat4> transforms;
+  std::vector<std::vector<glm::vec3>> world_incoming;  // probe light per instance vertex
+  std::uint64_t last_lights = 0;
+  bool computed = false;
+  Stats stats;
+
+  bool create_gpu() {
+    std::vector<BrfGpuModel> gm;
+    for (const BrfModelData& m : models) gm.push_back({&m.mesh, &m.basis, &m.field});
+    auto p = BrfGpuPass::create(gm);
+    auto sum = engine::ShaderProgramBuilder(gi_shader_files()).stage(engine::ShaderStage::Compute, "brf_vertex_sum.comp.glsl").build();
+    auto comp =
+        engine::ShaderProgramBuilder(gi_shader_files()).stage(engine::ShaderStage::Compute, "brf_world_composite.comp.glsl").build();
+    if (!p || !sum || !comp) {
+      std::fprintf(stderr, "gi: basis radiance fields disabled: %s\n",
+                   (!p ? p.error() : !sum ? sum.error() : comp.error()).to_string().c_str());
+      return false;
+    }
+    pass.emplace(std::move(p).value());
+    sum_program = std::move(sum).value();
+    composite_program = std::move(comp).value();
+    if (!world.receiver_texels.empty()) {
+      if (auto s = pass->set_static_receivers(world.receiver_positions, world.receiver_normals); !s) {
+        std::fprintf(stderr, "gi: basis radiance fields: %s\n", s.error().to_string().c_str());
+        return false;
+      }
+      receiver_texels = engine::GlBuffer::create(world.receiver_texels.size() * sizeof(std::uint32_t),
+                                                 world.receiver_texels.data());
+    }
+    for (const BrfInstanceBinding& b : instances) {
+      const std::size_t bytes = std::max<std::size_t>(models[b.model].mesh.positions.size(), 1) * sizeof(glm::vec4);
+      const std::vector<glm::vec4> zeros(bytes / sizeof(glm::vec4), glm::vec4(0.0f));
+      world_light.push_back(engine::GlBuffer::create(bytes, zeros.data(), GL_DYNAMIC_STORAGE_BIT));
+      total.push_back(engine::GlBuffer::create(bytes, zeros.data(), 0));
+    }
+    return true;
+  }
+};
+
+BrfLighting::BrfLighting(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+BrfLighting::~BrfLighting() = default;
+
+engine::Result<std::unique_ptr<BrfLighting>> BrfLighting::create(std::vector<BrfModelData> models,
+                                                                 std::vector<BrfInstanceBinding> instances,
+                                                                 const engine::Registry& registry, BrfWorldLink world,
+                                                                 BrfLightingSettings settings) {
+  for (const BrfModelData& m : models)
+    if (m.basis.vertex_count != m.mesh.positions.size() || m.field.basis_count != m.basis.basis_count)
+      return engine::Error{.location = "basis radiance fields", .message = "model '" + m.name + "': mesh, basis and field do not belong together"};
+  for (const BrfInstanceBinding& b : instances)
+    if (b.model >= models.size())
+      return engine::Error{.location = "basis radiance fields",
+                           .message = "entity " + std::to_string(b.entity.id()) + " uses model " + std::to_string(b.model) +
+                                      " of " + std::to_string(models.size())};
+  if (world.receiver_positions.size() != world.receiver_texels.size() ||
+      world.receiver_normals.size() != world.receiver_texels.size())
+    return engine::Error{.location = "basis radiance fields", .message = "static receiver arrays of different sizes"};
+  auto impl = std::make_unique<Impl>();
+  impl->registry = &registry;
+  impl->models = std::move(models);
+  impl->instances = std::move(instances);
+  impl->world = std::move(world);
+  impl->settings = settings;
+  for (std::size_t i = 0; i < impl->instances.size(); ++i) {
+    impl->instance_of[impl->instances[i].entity.id()] = i;
+    impl->stats.vertices += impl->models[impl->instances[i].model].mesh.positions.size();
+  }
+  for (const BrfModelData& m : impl->models)
+    impl->stats.field_bytes += m.field.bytes() + m.basis.psi.size() * sizeof(float);
+  impl->stats.instances = impl->instances.size();
+  impl->stats.static_receivers = impl->world.receiver_texels.size();
+  impl->transforms.assign(impl->instances.size(), glm::mat4(0.0f));
+  impl->world_incoming.resize(impl->instances.size());
+  return std::unique_ptr<BrfLighting>(new BrfLighting(std::move(impl)));
+}
+
+bool BrfLighting::update() {
+  Impl& m = *impl_;
+  if (m.gpu_failed || m.instances.empty()) return false;
+  if (!m.pass && !m.create_gpu()) {
+    m.gpu_failed = true;
+    return false;
+  }
+  using Clock = std::chrono::steady_clock;
+  const auto t0 = Clock::now();
+  // What changed: object transforms (NaN transforms keep the last valid pose) and lights.
+  std::vector<std::uint8_t> moved(m.instances.size(), 0);
+  bool any_moved = false;
+  for (std::size_t i = 0; i < m.instances.size(); ++i) {
+    const auto* wt = m.registry->try_get<engine::WorldTransform>(m.instances[i].entity);
+    if (wt == nullptr || !finite_matrix(wt->matrix)) continue;
+    if (!m.computed || wt->matrix != m.transforms[i]) {
+      m.transforms[i] = wt->matrix;
+      moved[i] = 1;
+      any_moved = true;
+    }
+  }
+  const std::uint64_t lights = lights_signature(*m.registry);
+  if (m.computed && !any_moved && lights == m.last_lights) {
+    ++m.stats.skipped;
+    return false;
+  }
+  m.last_lights = lights;
+
+  std::vector<BrfObject> objects;
+  std::vector<BrfGpuInstance> gpu_instances;
+  for (std::size_t i = 0; i < m.instances.size(); ++i) {
+    const BrfModelData& model = m.models[m.instances[i].model];
+    objects.push_back({&model.mesh, &model.basis, &model.field, m.transforms[i], m.instances[i].albedo});
+    gpu_instances.push_back({m.instances[i].model, m.transforms[i], m.instances[i].albedo});
+  }
+  // Direct light from every enabled light (static and moving), shadowed by objects and world.
+  std::vector<ReferenceLight> all = scene_lights(*m.registry, BakeLights::Static);
+  for (ReferenceLight& l : scene_lights(*m.registry, BakeLights::Moving)) all.push_back(l);
+  const std::vector<PointEmitter> emitters = light_point_emitters(all, m.settings.area_light_samples, 1);
+  std::vector<std::vector<glm::vec3>> incoming = brf_direct_light(objects, emitters, m.world.caster.get());
+  // The static world's light, re-read from the probes where an object moved.
+  for (std::size_t i = 0; i < objects.size(); ++i) {
+    if (moved[i] != 0) {
+      const BrfWorldVertices v = brf_world_vertices(objects[i]);
+      m.world_incoming[i].assign(v.positions.size(), glm::vec3(0.0f));
+      if (m.world.probes)
+        for (std::size_t j = 0; j < v.positions.size(); ++j)
+          m.world_incoming[i][j] = m.world.probes->irradiance(v.positions[j], v.normals[j]);
+      std::vector<glm::vec4> packed(std::max<std::size_t>(v.positions.size(), 1), glm::vec4(0.0f));
+      for (std::size_t j = 0; j < v.positions.size(); ++j) packed[j] = glm::vec4(m.world_incoming[i][j], 0.0f);
+      glNamedBufferSubData(m.world_light[i].id(), 0, static_cast<GLsizeiptr>(packed.size() * sizeof(glm::vec4)), packed.data());
+    }
+    for (std::size_t j = 0; j < incoming[i].size(); ++j) incoming[i][j] += m.world_incoming[i][j];
+  }
+  const auto t1 = Clock::now();
+  if (engine::Status s = m.pass->run(gpu_instances, incoming, m.settings.update); !s) {
+    std::fprintf(stderr, "gi: basis radiance fields update failed: %s\n", s.error().to_string().c_str());
+    return false;
+  }
+  // Per vertex: world light + interreflected.
+  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+  m.sum_program.use();
+  for (std::size_t i = 0; i < m.instances.size(); ++i) {
+    const auto count = static_cast<std::uint32_t>(m.models[m.instances[i].model].mesh.positions.size());
+    glProgramUniform1ui(m.sum_program.id(), glGetUniformLocation(m.sum_program.id(), "u_count"), count);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, m.world_light[i].id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, m.pass->vertex_buffer(i));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, m.total[i].id());
+    glDispatchCompute((count + kGroupSize - 1) / kGroupSize, 1, 1);
+  }
+  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_VERTEX_ATTRIB_ARRAY_BARRIER_BIT);
+  glFinish();
+  const auto t2 = Clock::now();
+  const auto& ps = m.pass->stats();
+  m.stats.pairs_evaluated = ps.pairs_evaluated;
+  m.stats.pairs_culled = ps.pairs_culled;
+  m.stats.pairs_reused = ps.pairs_reused;
+  m.stats.last_cpu_ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
+  m.stats.last_gpu_ms = std::chrono::duration<double, std::milli>(t2 - t1).count();
+  m.stats.gpu_bytes = m.pass->gpu_bytes();
+  ++m.stats.updates;
+  if (any_moved) ++m.stats.objects_moved;
+  m.computed = true;
+  return true;
+}
+
+std::uint32_t BrfLighting::vertex_buffer(engine::Entity e) const {
+  const Impl& m = *impl_;
+  const auto it = m.instance_of.find(e.id());
+  if (it == m.instance_of.end() || it->second >= m.total.size() || !m.computed) return 0;
+  return m.total[it->second].id();
+}
+
+bool BrfLighting::has_static_receivers() const { return !impl_->world.receiver_texels.empty(); }
+
+void BrfLighting::composite_world(std::uint32_t base_texture, std::uint32_t composite_texture) const {
+  const Impl& m = *impl_;
+  glCopyImageSubData(base_texture, GL_TEXTURE_2D, 0, 0, 0, 0, composite_texture, GL_TEXTURE_2D, 0, 0, 0, 0,
+                     m.world.atlas_width, m.world.atlas_height, 1);
+  if (!m.pass || m.world.receiver_texels.empty() || !m.computed) return;
+  const auto count = static_cast<std::uint32_t>(m.world.receiver_texels.size());
+  glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
+  m.composite_program.use();
+  glProgramUniform1ui(m.composite_program.id(), glGetUniformLocation(m.composite_program.id(), "u_count"), count);
+  glProgramUniform1ui(m.composite_program.id(), glGetUniformLocation(m.composite_program.id(), "u_atlas_width"),
+                      static_cast<GLuint>(m.world.atlas_width));
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, m.receiver_texels.id());
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, m.pass->static_receiver_buffer());
+  glBindImageTexture(0, composite_texture, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+  glDispatchCompute((count + kGroupSize - 1) / kGroupSize, 1, 1);
+  glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
+}
+
+const BrfLighting::Stats& BrfLighting::stats() const { return impl_->stats; }
+
+}  // namespace gi

@@ -1,0 +1,220 @@
+#include <GL/glcorearb.h>
+#include <gi/gi_system.h>
+
+#include <chrono>
+#include <cstdio>
+#include <optional>
+#include <sstream>
+
+#include <engine/components.h>
+#include <engine/gpu/gl_objects.h>
+#include <gi/light_atlas_lighting.h>
+#include <gi/prm_lighting.h>
+
+#include "bake/manifest.h"
+#include "bake/static_scene.h"
+#include "brf/brf_lighting.h"
+#include "brf/brf_io.h"
+#include "brf/brf_mesh.h"
+#include "brf/world_probes.h"
+#include "light_atlas/light_atlas.h"
+#include "light_atlas/light_atlas_io.h"
+#include "prm/prm.h"
+#include "prm/prm_io.h"
+
+namespace gi {
+
+namespace {
+
+// The frame handed to the renderer: the atlas texture plus the dynamic objects' buffers.
+struct SystemFrame final : engine::IndirectLightFrame {
+  const BrfLighting* brf = nullptr;
+  std::uint32_t vertex_irradiance_buffer(engine::Entity e) const override { return brf ? brf->vertex_buffer(e) : 0; }
+};
+
+}  // namespace
+
+struct GISystem::Impl {
+  std::unique_ptr<LightAtlasLighting> atlas;
+  std::unique_ptr<PrmLighting> prm;
+  std::unique_ptr<BrfLighting> brf;
+  engine::GlTexture composite;
+  int width = 0, height = 0;
+  std::uint64_t seen_prm_updates = 0;
+  bool composed = false;
+  SystemFrame frame;
+  Stats stats;
+  std::string label;
+  std::string description;
+};
+
+GISystem::GISystem(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+GISystem::~GISystem() = default;
+
+engine::Result<std::unique_ptr<GISystem>> GISystem::load(const std::filesystem::path& bundle_dir, engine::Scene& scene,
+                                                         GISystemSettings settings) {
+  auto manifest = read_manifest(bundle_dir);
+  if (!manifest) return manifest.error();
+  const bool has_atlas = manifest->methods.contains("light_atlas");
+  const bool has_prm = manifest->methods.contains("prm");
+  const bool has_brf = manifest->methods.contains("brf");
+  if (!has_atlas && !has_prm && !has_brf)
+    return engine::Error{(bundle_dir / "manifest.json").string(), "methods",
+                         "the bundle holds no light atlas, PRM or basis radiance fields"};
+  auto impl = std::make_unique<Impl>();
+  std::ostringstream text;
+
+  std::optional<LightAtlasBake> atlas;
+  if (has_atlas) {
+    auto a = load_light_atlas(bundle_dir, scene.assets);
+    if (!a) return a.error();
+    atlas.emplace(std::move(a).value());
+    text << "light atlas: " << atlas->width << "x" << atlas->height << ", static lights, " << atlas->settings.bounces
+         << " bounces\n";
+  }
+  std::optional<Prm> prm;
+  if (has_prm) {
+    auto p = load_prm(bundle_dir, scene.assets);
+    if (!p) return p.error();
+    prm.emplace(std::move(p).value());
+    text << "PRM: " << prm->cluster_count << " clusters, K = " << settings.prm_active_clusters
+         << ", relit when a moving light changes\n";
+  }
+
+  // Basis radiance fields, coupled to the static world before the static meshes get uv1
+  // (the atlas texels are those of the layout built from the original meshes).
+  if (has_brf) {
+    auto sources = dynamic_brf_meshes(scene);
+    if (!sources) return sources.error();
+    auto loaded = load_brf(bundle_dir, *sources);
+    if (!loaded) return loaded.error();
+    std::vector<BrfModelData> models;
+    std::vector<BrfInstanceBinding> bindings;
+    for (std::size_t i = 0; i < sources->size(); ++i) {
+      BrfSource& src = (*sources)[i];
+      BrfMeshBake& b = loaded->meshes[i];
+      const auto model = static_cast<std::uint32_t>(models.size());
+      const glm::vec3 albedo = brf_source_albedo(scene.assets, src);
+      for (engine::Entity e : src.entities) bindings.push_back({e, model, albedo});
+      models.push_back({src.name, std::move(src.mesh), std::move(b.basis), std::move(b.field)});
+    }
+    BrfWorldLink world;
+    const AtlasLayout* layout = atlas ? &atlas->layout : prm ? &prm->layout : nullptr;
+    if (layout != nullptr) {
+      auto s = prepare_static_scene(scene, *layout, BakeLights::None);
+      if (!s) return s.error();
+      world.atlas_width = s->texels.width;
+      world.atlas_height = s->texels.height;
+      for (std::size_t t = 0; t < s->texels.valid.size(); ++t)
+        if (s->texels.valid[t] != 0) {
+          world.receiver_texels.push_back(static_cast<std::uint32_t>(t));
+          world.receiver_positions.push_back(s->texels.position[t]);
+          world.receiver_normals.push_back(s->texels.normal[t]);
+        }
+      world.caster = std::move(s->caster);
+    } else if (auto c = make_static_caster(scene)) {
+      world.caster = std::move(c).value();
+    }
+    if (atlas && world.caster) {
+      const auto t0 = std::chrono::steady_clock::now();
+      auto probes = bake_world_probes(*world.caster, atlas->vpls, atlas->vpl_power, {.spacing_m = settings.probe_spacing_m});
+      if (!probes) return probes.error();
+      world.probes.emplace(std::move(probes).value());
+      impl->stats.load_probe_ms = static_cast<std::size_t>(
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    }
+    const std::size_t receivers = world.receiver_texels.size();
+    const std::size_t probe_count = world.probes ? world.probes->probe_count() : 0;
+    auto brf = BrfLighting::create(std::move(models), std::move(bindings), scene.registry, std::move(world),
+                                   {.update = {.bounces = settings.brf_bounces, .cull_threshold = settings.brf_cull_threshold}});
+    if (!brf) return brf.error();
+    impl->brf = std::move(brf).value();
+    const auto& st = impl->brf->stats();
+    impl->stats.dynamic_objects = st.instances;
+    impl->stats.dynamic_vertices = st.vertices;
+    impl->stats.brf_field_bytes = st.field_bytes;
+    text << "BRF: " << st.instances << " dynamic objects (" << st.vertices << " vertices, "
+         << static_cast<double>(st.field_bytes) / 1e6 << " MB of basis + fields), " << settings.brf_bounces
+         << " bounces; world light from " << probe_count << " probes; bounce onto " << receivers << " atlas texels\n";
+  }
+
+  if (prm) {
+    auto p = PrmLighting::from_bake(std::move(*prm), atlas ? &*atlas : nullptr, scene, {settings.prm_active_clusters});
+    if (!p) return p.error();
+    impl->prm = std::move(p).value();
+  } else if (atlas) {
+    auto a = LightAtlasLighting::from_bake(*atlas, scene);
+    if (!a) return a.error();
+    impl->atlas = std::move(a).value();
+  }
+  impl->label = std::string(impl->prm ? impl->prm->label() : impl->atlas ? impl->atlas->label() : "");
+  if (impl->brf) impl->label += impl->label.empty() ? "BRF" : " + BRF";
+  impl->description = text.str();
+  impl->frame.brf = impl->brf.get();
+  return std::unique_ptr<GISystem>(new GISystem(std::move(impl)));
+}
+
+const engine::IndirectLightFrame& GISystem::frame() {
+  Impl& m = *impl_;
+  ++m.stats.frames;
+  bool work = false;
+  std::uint32_t base = 0;
+  bool base_changed = false;
+  if (m.prm) {
+    base = m.prm->frame().irradiance_atlas_texture;
+    const PrmLighting::Stats& ps = m.prm->stats();
+    if (ps.updates != m.seen_prm_updates) {
+      m.seen_prm_updates = ps.updates;
+      ++m.stats.prm_updates;
+      m.stats.last_prm_ms = ps.last_weights_ms + ps.last_gpu_ms;
+      base_changed = true;
+      work = true;
+    }
+  } else if (m.atlas) {
+    base = m.atlas->frame().irradiance_atlas_texture;
+    base_changed = !m.composed;
+  }
+  bool objects_changed = false;
+  if (m.brf) {
+    objects_changed = m.brf->update();
+    if (objects_changed) {
+      work = true;
+      const BrfLighting::Stats& bs = m.brf->stats();
+      ++m.stats.brf_updates;
+      m.stats.brf_moves = bs.objects_moved;
+      m.stats.brf_pairs_evaluated = bs.pairs_evaluated;
+      m.stats.brf_pairs_reused = bs.pairs_reused;
+      m.stats.brf_pairs_culled = bs.pairs_culled;
+      m.stats.last_brf_cpu_ms = bs.last_cpu_ms;
+      m.stats.last_brf_gpu_ms = bs.last_gpu_ms;
+    }
+  }
+  m.frame.irradiance_atlas_texture = base;
+  if (m.brf && m.brf->has_static_receivers() && base != 0) {
+    if (m.composite.empty()) {
+      GLint w = 0, h = 0;
+      glGetTextureLevelParameteriv(base, 0, GL_TEXTURE_WIDTH, &w);
+      glGetTextureLevelParameteriv(base, 0, GL_TEXTURE_HEIGHT, &h);
+      m.composite = engine::GlTexture::create_2d(GL_RGBA32F, w, h);
+      glTextureParameteri(m.composite.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+      glTextureParameteri(m.composite.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+      glTextureParameteri(m.composite.id(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+      glTextureParameteri(m.composite.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    }
+    if (!m.composed || base_changed || objects_changed) {
+      m.brf->composite_world(base, m.composite.id());
+      ++m.stats.world_composites;
+      m.composed = true;
+    }
+    m.frame.irradiance_atlas_texture = m.composite.id();
+  }
+  m.composed = true;
+  if (!work) ++m.stats.idle_frames;
+  return m.frame;
+}
+
+const char* GISystem::label() const { return impl_->label.c_str(); }
+const GISystem::Stats& GISystem::stats() const { return impl_->stats; }
+std::string GISystem::describe() const { return impl_->description; }
+
+}  // namespace gi

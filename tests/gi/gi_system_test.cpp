@@ -1,0 +1,178 @@
+// The GI system on llvmpipe with the crates room: a light atlas and basis radiance fields
+// from one bundle; the red crate's bounce turns the white statue pink, and each frame
+// recomputes only what changed (counters).
+#define GL_GLEXT_PROTOTYPES 1
+#include <GL/glcorearb.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+#include <gtest/gtest.h>
+
+#include <engine/components.h>
+#include <engine/gltf.h>
+#include <engine/gpu/context.h>
+#include <engine/scene.h>
+#include <gi/gi_system.h>
+
+#include "bake/static_scene.h"
+#include "brf/brf_bake.h"
+#include "brf/brf_io.h"
+#include "brf/brf_mesh.h"
+#include "light_atlas/light_atlas.h"
+#include "light_atlas/light_atlas_io.h"
+
+namespace {
+
+std::vector<glm::vec3> read_texture(std::uint32_t texture, int w, int h) {
+  std::vector<float> rgba(static_cast<std::size_t>(w) * static_cast<std::size_t>(h) * 4);
+  glGetTextureImage(texture, 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(rgba.size() * sizeof(float)), rgba.data());
+  std::vector<glm::vec3> out(rgba.size() / 4);
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = {rgba[4 * i], rgba[4 * i + 1], rgba[4 * i + 2]};
+  return out;
+}
+
+engine::Scene crates_room() {
+  auto asset = engine::load_gltf(GI_SOURCE_DIR "/assets/crates_room.gltf");
+  EXPECT_TRUE(asset) << asset.error().to_string();
+  return engine::instantiate(std::move(asset.value()));
+}
+
+// One bundle for all tests: light atlas (preview, 8 texels/m) + BRF (preview).
+struct Bundle {
+  std::filesystem::path dir = std::filesystem::temp_directory_path() / "gi_system_test.gibake";
+  gi::LightAtlasBake atlas;
+  Bundle() {
+    std::filesystem::remove_all(dir);
+    engine::Scene scene = crates_room();
+    gi::LightAtlasSettings s = gi::light_atlas_preset("preview").value();
+    atlas = gi::bake_light_atlas(scene, s).value();
+    EXPECT_TRUE(gi::save_light_atlas(dir, atlas, scene.assets, "crates_room.gltf"));
+    const auto sources = gi::dynamic_brf_meshes(scene).value();
+    gi::BrfBake brf;
+    brf.settings = gi::brf_preset("preview").value();
+    for (const gi::BrfSource& src : sources) brf.meshes.push_back(gi::bake_brf_mesh(src, brf.settings).value());
+    EXPECT_TRUE(gi::save_brf(dir, brf, scene.assets, "crates_room.gltf"));
+  }
+};
+
+const Bundle& bundle() {
+  static const Bundle b;
+  return b;
+}
+
+void move_to(engine::Scene& scene, const char* name, glm::vec3 position) {
+  const engine::Entity e = engine::find_by_name(scene.registry, name);
+  scene.registry.write<engine::Transform>(e).position = position;
+  engine::update_world_transforms(scene.registry);
+}
+
+TEST(GISystem, RecomputesOnlyWhatChanged) {
+  auto ctx = engine::GpuContext::create_headless();
+  ASSERT_TRUE(ctx) << "no headless GL context: " << ctx.error().to_string();
+  engine::Scene scene = crates_room();
+  auto loaded = gi::GISystem::load(bundle().dir, scene);
+  ASSERT_TRUE(loaded) << loaded.error().to_string();
+  gi::GISystem& gi = **loaded;
+  std::printf("%s\n%s", gi.label(), gi.describe().c_str());
+  EXPECT_STREQ(gi.label(), "light atlas + BRF");
+
+  gi.frame();
+  EXPECT_EQ(gi.stats().brf_updates, 1u);
+  const std::size_t pairs = gi.stats().brf_pairs_evaluated + gi.stats().brf_pairs_culled;
+  EXPECT_EQ(pairs, 5u * 4u);  // five crates
+  gi.frame();
+  gi.frame();
+  EXPECT_EQ(gi.stats().brf_updates, 1u);
+  EXPECT_EQ(gi.stats().idle_frames, 2u);
+  EXPECT_EQ(gi.stats().world_composites, 1u);
+
+  // One crate moves: only the pairs with it get new basis irradiance.
+  move_to(scene, "crate_3", {2.0f, 0.0f, -1.5f});
+  gi.frame();
+  EXPECT_EQ(gi.stats().brf_updates, 2u);
+  EXPECT_EQ(gi.stats().brf_moves, 2u);
+  std::printf("crate_3 moved: %zu pairs evaluated, %zu reused, %zu culled\n", gi.stats().brf_pairs_evaluated,
+              gi.stats().brf_pairs_reused, gi.stats().brf_pairs_culled);
+  EXPECT_GE(gi.stats().brf_pairs_reused + 8u, gi.stats().brf_pairs_evaluated);
+  EXPECT_GT(gi.stats().brf_pairs_reused, 0u);
+  EXPECT_EQ(gi.stats().world_composites, 2u);
+
+  // A light changes, nothing moves: new light, every evaluated pair's basis irradiance reused.
+  const engine::Entity light = engine::find_by_name(scene.registry, "ceiling_light");
+  ASSERT_FALSE(light.is_null());
+  scene.registry.write<engine::Light>(light).intensity *= 0.5f;
+  gi.frame();
+  EXPECT_EQ(gi.stats().brf_updates, 3u);
+  EXPECT_EQ(gi.stats().brf_moves, 2u);
+  EXPECT_EQ(gi.stats().brf_pairs_reused, gi.stats().brf_pairs_evaluated);
+  gi.frame();
+  EXPECT_EQ(gi.stats().idle_frames, 3u);
+
+  // Per-vertex buffers for the crates only, finite and non-negative.
+  const engine::Entity crate = engine::find_by_name(scene.registry, "crate_1");
+  const std::uint32_t buffer = gi.frame().vertex_irradiance_buffer(crate);
+  ASSERT_NE(buffer, 0u);
+  EXPECT_EQ(gi.frame().vertex_irradiance_buffer(engine::find_by_name(scene.registry, "statue")), 0u);
+  GLint64 bytes = 0;
+  glGetNamedBufferParameteri64v(buffer, GL_BUFFER_SIZE, &bytes);
+  std::vector<glm::vec4> v(static_cast<std::size_t>(bytes) / sizeof(glm::vec4));
+  glGetNamedBufferSubData(buffer, 0, bytes, v.data());
+  float largest = 0.0f;
+  for (const glm::vec4& x : v) {
+    ASSERT_TRUE(std::isfinite(x.x) && std::isfinite(x.y) && std::isfinite(x.z));
+    EXPECT_GE(std::min({x.x, x.y, x.z}), 0.0f);
+    largest = std::max(largest, x.x);
+  }
+  EXPECT_GT(largest, 0.0f);
+}
+
+TEST(GISystem, TheRedCrateTurnsTheStatuePink) {
+  auto ctx = engine::GpuContext::create_headless();
+  ASSERT_TRUE(ctx) << "no headless GL context: " << ctx.error().to_string();
+  engine::Scene scene = crates_room();
+  // The statue's plinth faces +x at x = -0.85 (statue at (-1.2, 0, 1.2), half width 0.35).
+  auto layout_scene = gi::prepare_static_scene(scene, bundle().atlas.layout, gi::BakeLights::None).value();
+  std::vector<std::size_t> plinth;
+  for (std::size_t t = 0; t < layout_scene.texels.valid.size(); ++t) {
+    const glm::vec3 p = layout_scene.texels.position[t], n = layout_scene.texels.normal[t];
+    if (layout_scene.texels.valid[t] != 0 && std::abs(p.x + 0.85f) < 0.02f && n.x > 0.9f && p.y < 0.4f &&
+        std::abs(p.z - 1.2f) < 0.3f)
+      plinth.push_back(t);
+  }
+  ASSERT_GT(plinth.size(), 0u);
+  auto loaded = gi::GISystem::load(bundle().dir, scene);
+  ASSERT_TRUE(loaded) << loaded.error().to_string();
+  gi::GISystem& gi = **loaded;
+  const int w = bundle().atlas.width, h = bundle().atlas.height;
+  const auto bounce_on_plinth = [&] {
+    const std::vector<glm::vec3> atlas = read_texture(gi.frame().irradiance_atlas_texture, w, h);
+    glm::dvec3 sum(0.0);
+    for (std::size_t t : plinth) sum += glm::dvec3(atlas[t] - bundle().atlas.irradiance[t]);
+    return sum / static_cast<double>(plinth.size());
+  };
+  const glm::dvec3 far = bounce_on_plinth();
+  move_to(scene, "crate_red", {-0.5f, 0.0f, 1.2f});  // 10 cm from the plinth
+  const glm::dvec3 near = bounce_on_plinth();
+  std::printf("bounce on the plinth (W/m^2): red crate far (%.4f, %.4f, %.4f), near (%.4f, %.4f, %.4f); base %.4f\n",
+              far.x, far.y, far.z, near.x, near.y, near.z, double{bundle().atlas.irradiance[plinth[0]].x});
+  EXPECT_GT(near.x, 3.0 * near.y);           // red light
+  EXPECT_GT(near.x, 5.0 * std::max(far.x, 1e-6));  // from the crate that came close
+  EXPECT_GE(std::min({far.x, far.y, far.z}), 0.0);
+}
+
+TEST(GISystem, ABundleOfOtherMeshesIsRejectedAsStale) {
+  auto asset = engine::load_gltf(GI_SOURCE_DIR "/assets/crates_room.gltf").value();
+  for (engine::Mesh& m : asset.meshes)
+    if (m.name == "crate")
+      for (engine::Primitive& p : m.primitives)
+        for (glm::vec3& v : p.positions) v *= 1.1f;
+  engine::Scene scene = engine::instantiate(std::move(asset));
+  auto loaded = gi::GISystem::load(bundle().dir, scene);
+  ASSERT_FALSE(loaded);
+  std::printf("%s\n", loaded.error().to_string().c_str());
+  EXPECT_NE(loaded.error().to_string().find("stale"), std::string::npos);
+}
+
+}  // namespace
