@@ -6,9 +6,11 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <engine/indirect_light.h>
 #include <engine/renderer.h>
+#include <gi/gi_system.h>
 
 #include <game_demo/replay.h>
 #include <game_demo/scripted_pilot.h>
@@ -57,17 +59,20 @@ inline engine::SplitView split_of(const Simulation& sim) {
   return sim.context().split_view ? engine::SplitView::DirectLeftFullRight : engine::SplitView::Off;
 }
 
-/// The indirect light of a run: with --gi-bundle, the bundle's baked lighting (light atlas,
-/// PRM for the moving lights; gi::load_baked_lighting) loaded into the
-/// simulation's scene (which gains TEXCOORD_1, so create the renderer after this); without
-/// it, nullptr (the renderer's constant-ambient stand-in). Prints the error and returns
-/// false when the bundle does not load (missing, damaged, or baked from other geometry).
-/// Call with the GL context current; destroy the provider before the context.
-bool load_indirect_light(const RunOptions& options, Simulation& sim,
-                         std::unique_ptr<engine::IndirectLightProvider>& provider);
+/// The indirect light of a run: with --gi-bundle, the GI system of the bundle (light atlas,
+/// PRM for the moving lights, basis radiance fields for the crates; gi::GISystem) loaded
+/// into the simulation's scene (which gains TEXCOORD_1, so create the renderer after this);
+/// without it, nullptr (the renderer's constant-ambient stand-in). Prints the error and
+/// returns false when the bundle does not load (missing, damaged, or baked from other
+/// geometry). Call with the GL context current; destroy the system before the context.
+bool load_indirect_light(const RunOptions& options, Simulation& sim, std::unique_ptr<gi::GISystem>& system);
 
 /// One line for stdout and the overlay: which indirect light is used.
-std::string describe_indirect_light(const RunOptions& options, const engine::IndirectLightProvider* provider);
+std::string describe_indirect_light(const RunOptions& options, const gi::GISystem* system);
+
+/// The GI system's per-method lines and counters for the overlay and the headless summary
+/// (what runs and why, frames re-lit, idle frames, last update times). Empty without GI.
+std::vector<std::string> gi_status_lines(const gi::GISystem* system);
 
 int run_headless(const RunOptions& options, RunState& state);
 int run_windowed(const RunOptions& options, RunState& state);

@@ -12,7 +12,6 @@
 #include <engine/components.h>
 #include <engine/gpu/context.h>
 #include <engine/image.h>
-#include <gi/prm_lighting.h>
 
 #include "demo_run.h"
 
@@ -50,7 +49,7 @@ int run_headless(const RunOptions& o, RunState& state) {
     for (const glm::vec3& p : pilot->waypoints()) std::printf("waypoint (%.2f, %.2f, %.2f)\n", double{p.x}, double{p.y}, double{p.z});
 
   std::optional<engine::GpuContext> gpu;
-  std::unique_ptr<engine::IndirectLightProvider> indirect;  // destroyed before gpu
+  std::unique_ptr<gi::GISystem> indirect;  // destroyed before gpu
   std::unique_ptr<engine::Renderer> renderer;
   if (!o.no_render) {
     auto ctx = engine::GpuContext::create_headless();
@@ -136,13 +135,7 @@ int run_headless(const RunOptions& o, RunState& state) {
   for (const auto& n : system_order) systems[n].print(n.c_str());
   if (!pass_order.empty()) std::printf("render passes:\n");
   for (const auto& n : pass_order) passes[n].print(n.c_str());
-  if (const auto* prm = dynamic_cast<const gi::PrmLighting*>(indirect.get())) {
-    const gi::PrmLighting::Stats& st = prm->stats();
-    std::printf("PRM: %llu of %llu frames re-lit (a moving light changed); last update: weights %.3f ms (CPU), pane sum "
-                "%.3f ms (GPU), %zu clusters, %.1f MB on the GPU\n",
-                static_cast<unsigned long long>(st.updates), static_cast<unsigned long long>(st.frames), st.last_weights_ms,
-                st.last_gpu_ms, st.last_active_clusters, static_cast<double>(st.gpu_bytes) / 1e6);
-  }
+  for (const std::string& line : gi_status_lines(indirect.get())) std::printf("%s\n", line.c_str());
   std::printf("final state checksum 0x%016llx after frame %llu\n", static_cast<unsigned long long>(sim.checksum()),
               static_cast<unsigned long long>(sim.frame()));
   return 0;

@@ -9,7 +9,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include <gi/baked_lighting.h>
+#include <gi/gi_system.h>
 
 #include "demo_run.h"
 
@@ -39,21 +39,46 @@ bool RunState::finish_recording(const std::string& path) const {
   return true;
 }
 
-bool load_indirect_light(const RunOptions& o, Simulation& sim, std::unique_ptr<engine::IndirectLightProvider>& provider) {
-  provider.reset();
+bool load_indirect_light(const RunOptions& o, Simulation& sim, std::unique_ptr<gi::GISystem>& system) {
+  system.reset();
   if (o.gi_bundle.empty()) return true;
-  auto baked = gi::load_baked_lighting(o.gi_bundle, sim.scene());
-  if (!baked) {
-    std::cerr << "gi_demo: cannot use --gi-bundle " << o.gi_bundle << ": " << baked.error().to_string() << '\n';
+  auto loaded = gi::GISystem::load(o.gi_bundle, sim.scene());
+  if (!loaded) {
+    std::cerr << "gi_demo: cannot use --gi-bundle " << o.gi_bundle << ": " << loaded.error().to_string() << '\n';
     return false;
   }
-  provider = std::move(baked).value();
+  system = std::move(loaded).value();
   return true;
 }
 
-std::string describe_indirect_light(const RunOptions& o, const engine::IndirectLightProvider* provider) {
-  if (provider == nullptr) return "constant ambient (stand-in), no GI bundle";
-  return std::string(provider->label()) + " from " + o.gi_bundle;
+std::string describe_indirect_light(const RunOptions& o, const gi::GISystem* system) {
+  if (system == nullptr) return "constant ambient (stand-in), no GI bundle";
+  return std::string(system->label()) + " from " + o.gi_bundle;
+}
+
+std::vector<std::string> gi_status_lines(const gi::GISystem* system) {
+  std::vector<std::string> lines;
+  if (system == nullptr) return lines;
+  std::string text = system->describe();
+  for (std::size_t at = 0; at < text.size();) {
+    const std::size_t end = text.find('\n', at);
+    lines.push_back(text.substr(at, end == std::string::npos ? std::string::npos : end - at));
+    if (end == std::string::npos) break;
+    at = end + 1;
+  }
+  const gi::GISystem::Stats& st = system->stats();
+  char line[256];
+  std::snprintf(line, sizeof line, "GI frames %llu: %llu idle, PRM re-lit %llu (%.2f ms), BRF updated %llu (%llu with motion)",
+                static_cast<unsigned long long>(st.frames), static_cast<unsigned long long>(st.idle_frames),
+                static_cast<unsigned long long>(st.prm_updates), st.last_prm_ms,
+                static_cast<unsigned long long>(st.brf_updates), static_cast<unsigned long long>(st.brf_moves));
+  lines.emplace_back(line);
+  if (st.dynamic_objects > 0) {
+    std::snprintf(line, sizeof line, "BRF last update: %.2f ms CPU (direct, probes) + %.2f ms GPU; pairs %zu live, %zu reused, %zu culled",
+                  st.last_brf_cpu_ms, st.last_brf_gpu_ms, st.brf_pairs_evaluated, st.brf_pairs_reused, st.brf_pairs_culled);
+    lines.emplace_back(line);
+  }
+  return lines;
 }
 
 }  // namespace game_demo

@@ -39,7 +39,7 @@ InputFrame live_keys(GLFWwindow* window) {
 }
 
 void draw_overlay(const RunOptions& o, const RunState& state, const engine::Renderer& renderer,
-                  const std::string& indirect, double frame_ms, double fps) {
+                  const std::string& indirect, const gi::GISystem* gi, double frame_ms, double fps) {
   const Simulation& sim = *state.sim;
   ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_Always);
   ImGui::SetNextWindowBgAlpha(0.6f);
@@ -48,6 +48,7 @@ void draw_overlay(const RunOptions& o, const RunState& state, const engine::Rend
   ImGui::Text("%.1f fps   frame %.2f ms   step %llu", fps, frame_ms, static_cast<unsigned long long>(sim.frame()));
   ImGui::Separator();
   ImGui::Text("indirect light: %s", indirect.c_str());
+  for (const std::string& line : gi_status_lines(gi)) ImGui::TextUnformatted(line.c_str());
   const engine::Light* torch = sim.registry().try_get<engine::Light>(sim.context().flashlight);
   ImGui::Text("flashlight (F): %s   split (G): %s", torch && torch->enabled ? "on" : "off",
               sim.context().split_view ? "direct | full" : "off");
@@ -73,7 +74,7 @@ int run_windowed(const RunOptions& o, RunState& state) {
     return 1;
   }
   GLFWwindow* window = ctx->window();
-  std::unique_ptr<engine::IndirectLightProvider> indirect;  // destroyed before the context
+  std::unique_ptr<gi::GISystem> indirect;  // destroyed before the context
   if (!load_indirect_light(o, sim, indirect)) return 1;    // before the renderer: it adds TEXCOORD_1
   const std::string indirect_text = describe_indirect_light(o, indirect.get());
   auto r = engine::Renderer::create(sim.scene().assets, engine::RenderSettings{.width = o.width, .height = o.height});
@@ -146,7 +147,7 @@ int run_windowed(const RunOptions& o, RunState& state) {
     ImGui_ImplOpenGL3_NewFrame();
     ImGui_ImplGlfw_NewFrame();
     ImGui::NewFrame();
-    draw_overlay(o, state, *renderer, indirect_text, frame_ms, fps);
+    draw_overlay(o, state, *renderer, indirect_text, indirect.get(), frame_ms, fps);
     ImGui::Render();
     ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
     ctx->swap();

@@ -1,7 +1,6 @@
 #pragma once
-// One call for a game: the indirect-light provider a bake bundle calls for. A bundle with a
-// PRM gives gi::PrmLighting (over the bundle's light atlas when it has one); a bundle with a
-// light atlas only gives gi::LightAtlasLighting.
+// One call for a game that only needs the renderer hook: gi::GISystem::load (gi_system.h)
+// as a plain engine::IndirectLightProvider. Use GISystem directly for its stats.
 //   auto gi = gi::load_baked_lighting("level.gibake", scene);   // before Renderer::create
 //   if (!gi) { std::cerr << gi.error().to_string() << '\n'; return 1; }
 //   renderer->set_indirect_light(gi.value().get());
@@ -16,8 +15,7 @@
 namespace gi {
 
 /// Loads the bundle's baked lighting for `scene` (which gains TEXCOORD_1; the registry must
-/// outlive the provider). Errors: no manifest, no light_atlas or prm entry, stale or damaged
-/// files.
+/// outlive the provider). Errors: those of GISystem::load.
 engine::Result<std::unique_ptr<engine::IndirectLightProvider>> load_baked_lighting(const std::filesystem::path& bundle_dir,
                                                                                     engine::Scene& scene);
 
