@@ -60,7 +60,6 @@ void add_instance_charts(const std::vector<Triangle>& tris, std::vector<ChartExt
   for (std::uint32_t root : roots) {
     const std::vector<std::uint32_t>& members = pieces[root];
     ChartExtent chart;
-    glm::dvec3 u(0.0);
     double longest = 0.0;
     glm::dvec3 n(0.0);
     for (std::uint32_t t : members) {
@@ -68,20 +67,35 @@ void add_instance_charts(const std::vector<Triangle>& tris, std::vector<ChartExt
       n += tris[t].normal * tris[t].area;
       for (int e = 0; e < 3; ++e) {
         const glm::dvec3 edge = tris[t].p[(e + 1) % 3] - tris[t].p[e];
-        if (glm::dot(edge, edge) > longest) longest = glm::dot(edge, edge), u = edge;
+        longest = std::max(longest, glm::dot(edge, edge));
       }
     }
     if (longest <= 0.0 || glm::dot(n, n) <= 0.0) continue;
-    u = glm::normalize(u);
-    const glm::dvec3 v = glm::normalize(glm::cross(glm::normalize(n), u));
-    double u0 = 1e300, u1 = -1e300, v0 = 1e300, v1 = -1e300;
-    for (std::uint32_t t : members)
-      for (const glm::dvec3& p : tris[t].p) {
-        u0 = std::min(u0, glm::dot(p, u)), u1 = std::max(u1, glm::dot(p, u));
-        v0 = std::min(v0, glm::dot(p, v)), v1 = std::max(v1, glm::dot(p, v));
+    n = glm::normalize(n);
+    // The charting rotates a chart to its minimal-area rectangle; try the directions of the
+    // piece's edges (a quad's diagonal is its longest edge but not a side).
+    double best = 1e300;
+    for (std::size_t k = 0; k < members.size() && k < 32; ++k) {
+      const Triangle& tri = tris[members[k]];
+      for (int e = 0; e < 3; ++e) {
+        glm::dvec3 dir = tri.p[(e + 1) % 3] - tri.p[e];
+        dir -= n * glm::dot(dir, n);
+        if (glm::dot(dir, dir) <= 1e-18) continue;
+        const glm::dvec3 a = glm::normalize(dir);
+        const glm::dvec3 b = glm::cross(n, a);
+        double a0 = 1e300, a1 = -1e300, b0 = 1e300, b1 = -1e300;
+        for (std::uint32_t t : members)
+          for (const glm::dvec3& p : tris[t].p) {
+            a0 = std::min(a0, glm::dot(p, a)), a1 = std::max(a1, glm::dot(p, a));
+            b0 = std::min(b0, glm::dot(p, b)), b1 = std::max(b1, glm::dot(p, b));
+          }
+        if ((a1 - a0) * (b1 - b0) < best) {
+          best = (a1 - a0) * (b1 - b0);
+          chart.width_m = std::max(a1 - a0, b1 - b0);
+          chart.height_m = std::min(a1 - a0, b1 - b0);
+        }
       }
-    chart.width_m = u1 - u0;
-    chart.height_m = v1 - v0;
+    }
     out.push_back(chart);
   }
 }

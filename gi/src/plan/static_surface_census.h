@@ -16,8 +16,8 @@ namespace gi {
 /// One estimated chart: a connected, coplanar piece of one static mesh instance.
 struct ChartExtent {
   double area_m2 = 0.0;
-  double width_m = 0.0;   ///< Extent along the piece's longest edge direction.
-  double height_m = 0.0;  ///< Extent across it, in the piece's plane.
+  double width_m = 0.0;   ///< Sides of its minimal-area rectangle (over its edge directions), width >= height.
+  double height_m = 0.0;
 };
 
 struct StaticSurfaceCensus {
