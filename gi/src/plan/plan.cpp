@@ -258,11 +258,16 @@ EffectPlan plan(const engine::Scene& scene, const PlanOptions& options) {
   const std::size_t static_sources = static_lights.size() + emissive_meshes.size();
   if (static_sources > 0 && !static_meshes.empty()) {
     atlas.enabled = true;
-    std::string sources = static_lights.empty() ? "" : plural(static_lights.size(), "static light", "static lights");
-    if (!emissive_meshes.empty())
-      sources += (sources.empty() ? "" : " and ") + plural(emissive_meshes.size(), "emissive surface", "emissive surfaces");
-    atlas.reason = sources + (static_sources == 1 ? " lights " : " light ") +
-                   plural(static_meshes.size(), "static mesh", "static meshes") + " (" + fixed(census.area_m2, 1) + " m^2)";
+    const std::string area = fixed(census.area_m2, 1) + " m^2";
+    const std::string meshes = plural(static_meshes.size(), "static mesh", "static meshes");
+    const std::string emitting = plural(emissive_meshes.size(), "emissive surface", "emissive surfaces");
+    if (static_lights.empty()) {
+      atlas.reason = emitting + (emissive_meshes.size() == 1 ? " lights " : " light ") + meshes + " (" + area + ")";
+    } else {
+      atlas.reason = plural(static_lights.size(), "static light", "static lights") +
+                     (static_lights.size() == 1 ? " lights " : " light ") + meshes + " (" + area +
+                     (emissive_meshes.empty() ? "" : "; " + emitting + " too") + ")";
+    }
     atlas.targets = static_meshes;
     if (estimates) {
       const BakeWork w = light_atlas_work(census, *atlas_settings, points);
@@ -350,7 +355,7 @@ EffectPlan plan(const engine::Scene& scene, const PlanOptions& options) {
                     std::to_string(mesh_names.size()) + " meshes, " + std::to_string(vertices) + " vertices; per mesh " +
                         std::to_string(field.spheres) + " spheres x 6 x " + std::to_string(field.face_resolution) + "^2 points x " +
                         std::to_string(basis.basis) + " functions x " + std::to_string(field.sh_bands * field.sh_bands) +
-                        " SH coefficients x 4 B (brf defaults for every preset)"};
+                        " SH coefficients x 4 B (brf defaults for every preset; seconds from the ray rate, no BRF bake measured yet)"};
   } else {
     brf.reason = "no dynamic mesh -> no basis radiance fields";
   }
