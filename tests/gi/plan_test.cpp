@@ -1,9 +1,8 @@
 // gi::plan on the project's scenes (DESIGN.md §3 "Effects on demand", docs/plan.md): which
 // methods each scene calls for and why, the JSON form, the manifest's "plan" section, and
 // the cost model against the bakes it was calibrated on.
-#include <gi/plan.h>
-
 #include <engine/gltf.h>
+#include <gi/plan.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -51,7 +50,8 @@ TEST(Plan, CornellBoxGetsTheLightAtlasOnly) {
   EXPECT_FALSE(prm.enabled);
   EXPECT_TRUE(contains(prm.reason, "no light moves")) << prm.reason;
   EXPECT_EQ(prm.estimate.bake_seconds, 0.0);
-  for (EffectMethod m : {EffectMethod::DirectionalLightMaps, EffectMethod::Antiradiance, EffectMethod::BasisRadianceFields})
+  for (EffectMethod m :
+       {EffectMethod::DirectionalLightMaps, EffectMethod::Antiradiance, EffectMethod::BasisRadianceFields})
     EXPECT_FALSE(p.effect(m).enabled) << gi::effect_key(m);
   EXPECT_EQ(p.methods_to_bake(), std::vector<std::string>{"atlas"});
   EXPECT_TRUE(p.warnings.empty());
@@ -74,7 +74,8 @@ TEST(Plan, SpotChamberNeedsPrmOnceItsSpotMoves) {
   EXPECT_TRUE(contains(prm.reason, "light 'spot' moves (light_moves)")) << prm.reason;
   EXPECT_EQ(sorted(prm.targets), sorted({"chamber", "chamber_floor", "pedestal"}));
   EXPECT_FALSE(p.effect(EffectMethod::LightAtlas).enabled);
-  EXPECT_TRUE(contains(p.effect(EffectMethod::LightAtlas).reason, "no static light")) << p.effect(EffectMethod::LightAtlas).reason;
+  EXPECT_TRUE(contains(p.effect(EffectMethod::LightAtlas).reason, "no static light"))
+      << p.effect(EffectMethod::LightAtlas).reason;
   EXPECT_EQ(p.methods_to_bake(), std::vector<std::string>{"prm"});
 }
 
@@ -83,7 +84,8 @@ TEST(Plan, DemoLevelNeedsEveryBuiltMethodAndSaysDlmIsNotBuilt) {
   const gi::PlannedEffect& prm = p.effect(EffectMethod::Prm);
   EXPECT_TRUE(prm.enabled);
   EXPECT_TRUE(contains(prm.reason, "swinging_lamp")) << prm.reason;
-  EXPECT_TRUE(contains(p.effect(EffectMethod::LightAtlas).reason, "4 static lights")) << p.effect(EffectMethod::LightAtlas).reason;
+  EXPECT_TRUE(contains(p.effect(EffectMethod::LightAtlas).reason, "4 static lights"))
+      << p.effect(EffectMethod::LightAtlas).reason;
   const gi::PlannedEffect& dlm = p.effect(EffectMethod::DirectionalLightMaps);
   EXPECT_TRUE(dlm.enabled);
   EXPECT_FALSE(dlm.available);
@@ -123,7 +125,8 @@ TEST(Plan, GlossyRoomCallsForDirectionalLightMapsThatThisBuildCannotBake) {
   // A stricter threshold drops it, and the reason says so.
   const gi::EffectPlan strict = gi::plan(load("glossy_room.gltf"), {.glossy_roughness = 0.1f});
   EXPECT_FALSE(strict.effect(EffectMethod::DirectionalLightMaps).enabled);
-  EXPECT_TRUE(contains(strict.effect(EffectMethod::DirectionalLightMaps).reason, "no static surface has roughness < 0.10"));
+  EXPECT_TRUE(
+      contains(strict.effect(EffectMethod::DirectionalLightMaps).reason, "no static surface has roughness < 0.10"));
 }
 
 TEST(Plan, ASceneWithoutLightGetsNothing) {
@@ -244,9 +247,11 @@ TEST(PlanCost, EstimatesAreWithinAFactorOfTwoOfTheCalibrationBakes) {
       {"demo_level.gltf", "preview", 45443, 55974, 256, 2237, 10.1e6, 60.6e6, 1.79, 5.98},
       {"demo_level.gltf", "medium", 177599, 200153, 512, 8673, 114.7e6, 928.9e6, 21.05, 97.64},
   };
-  const auto within2 = [](double estimate, double measured) { return estimate > 0.5 * measured && estimate < 2.0 * measured; };
-  std::printf("%-18s %-8s %14s %14s %14s %12s %14s %14s\n", "scene", "preset", "lit texels", "pane texels", "path nodes",
-              "atlas side", "atlas cpu s", "prm cpu s");
+  const auto within2 = [](double estimate, double measured) {
+    return estimate > 0.5 * measured && estimate < 2.0 * measured;
+  };
+  std::printf("%-18s %-8s %14s %14s %14s %12s %14s %14s\n", "scene", "preset", "lit texels", "pane texels",
+              "path nodes", "atlas side", "atlas cpu s", "prm cpu s");
   for (const Measured& r : runs) {
     const engine::Scene scene = load(r.scene);
     const gi::StaticSurfaceCensus census = gi::census_static_surfaces(scene);
@@ -262,13 +267,16 @@ TEST(PlanCost, EstimatesAreWithinAFactorOfTwoOfTheCalibrationBakes) {
     double nodes = 0.0;
     const gi::BakeWork pw = gi::prm_work(census, ps, &nodes);
     const double side = std::sqrt(static_cast<double>(t.width) * t.height);
-    auto layout = gi::build_atlas_layout(gi::atlas_inputs_from(scene.assets), {.texels_per_metre = as.texels_per_metre});
+    auto layout =
+        gi::build_atlas_layout(gi::atlas_inputs_from(scene.assets), {.texels_per_metre = as.texels_per_metre});
     ASSERT_TRUE(layout);
-    std::printf("charts: %zu estimated, %zu in the layout; atlas %dx%d estimated, %dx%d laid out\n", census.charts.size(),
-                layout->charts.size(), t.width, t.height, layout->width, layout->height);
-    std::printf("%-18s %-8s %6.0f/%-7.0f %6.0f/%-7.0f %6.0f/%-7.0f %5.0f/%-6.0f %6.2f/%-7.2f %6.2f/%-7.2f  (estimate/measured)\n",
-                r.scene, r.preset, t.lit_texels, r.lit_texels, t.pane_texels, r.pane_texels, nodes, r.path_nodes, side,
-                r.atlas_side_texels, aw.cpu_seconds, r.atlas_cpu_s, pw.cpu_seconds, r.prm_cpu_s);
+    std::printf("charts: %zu estimated, %zu in the layout; atlas %dx%d estimated, %dx%d laid out\n",
+                census.charts.size(), layout->charts.size(), t.width, t.height, layout->width, layout->height);
+    std::printf(
+        "%-18s %-8s %6.0f/%-7.0f %6.0f/%-7.0f %6.0f/%-7.0f %5.0f/%-6.0f %6.2f/%-7.2f %6.2f/%-7.2f  "
+        "(estimate/measured)\n",
+        r.scene, r.preset, t.lit_texels, r.lit_texels, t.pane_texels, r.pane_texels, nodes, r.path_nodes, side,
+        r.atlas_side_texels, aw.cpu_seconds, r.atlas_cpu_s, pw.cpu_seconds, r.prm_cpu_s);
     std::printf("%-18s %-8s rays: atlas %.1f/%.1f M, prm %.1f/%.1f M\n", "", "", aw.rays * 1e-6, r.atlas_rays * 1e-6,
                 pw.rays * 1e-6, r.prm_rays * 1e-6);
     EXPECT_TRUE(within2(t.lit_texels, r.lit_texels)) << r.scene << ' ' << r.preset;

@@ -30,10 +30,10 @@ std::vector<std::string> methods_from_plan(const gi::EffectPlan& plan, const std
   return out;
 }
 
-bool record_plan(const std::filesystem::path& bundle_dir, const engine::SceneAsset& asset, const std::string& scene_name,
-                 const gi::EffectPlan& plan) {
-  auto status = gi::update_manifest_plan(bundle_dir, gi::scene_geometry_hash(asset), scene_name,
-                                         gi::plan_to_json_value(plan));
+bool record_plan(const std::filesystem::path& bundle_dir, const engine::SceneAsset& asset,
+                 const std::string& scene_name, const gi::EffectPlan& plan) {
+  auto status =
+      gi::update_manifest_plan(bundle_dir, gi::scene_geometry_hash(asset), scene_name, gi::plan_to_json_value(plan));
   if (!status) {
     std::cerr << "gi-bake: " << status.error().to_string() << '\n';
     return false;

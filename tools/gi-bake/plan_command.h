@@ -4,12 +4,12 @@
 //   gi::EffectPlan p = gi::plan(scene, options);
 //   std::vector<std::string> methods = tools::methods_from_plan(p, {"atlas", "prm"});
 
+#include <engine/scene_asset.h>
+#include <gi/plan.h>
+
 #include <filesystem>
 #include <string>
 #include <vector>
-
-#include <engine/scene_asset.h>
-#include <gi/plan.h>
 
 namespace tools {
 
@@ -21,7 +21,7 @@ void print_plan(const gi::EffectPlan& plan);
 std::vector<std::string> methods_from_plan(const gi::EffectPlan& plan, const std::vector<std::string>& bakeable);
 
 /// Writes the plan into DIR/manifest.json ("plan"). Returns false after printing an error.
-bool record_plan(const std::filesystem::path& bundle_dir, const engine::SceneAsset& asset, const std::string& scene_name,
-                 const gi::EffectPlan& plan);
+bool record_plan(const std::filesystem::path& bundle_dir, const engine::SceneAsset& asset,
+                 const std::string& scene_name, const gi::EffectPlan& plan);
 
 }  // namespace tools

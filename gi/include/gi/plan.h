@@ -18,14 +18,14 @@
 // constants measured on this project's scenes (the table in gi/src/plan/plan_cost.cpp);
 // they are meant to be right within a factor of about 2, not more.
 
+#include <engine/result.h>
+#include <engine/scene.h>
+
 #include <cstdint>
 #include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
-
-#include <engine/result.h>
-#include <engine/scene.h>
 
 namespace gi {
 
@@ -51,23 +51,23 @@ struct EffectEstimate {
 /// One method's entry in a plan.
 struct PlannedEffect {
   EffectMethod method = EffectMethod::LightAtlas;
-  bool enabled = false;    ///< The scene calls for it.
-  bool available = false;  ///< This build can bake it (atlas, prm, brf); dlm and antiradiance: not yet.
-  std::string reason;      ///< One line naming the facts ("light 'swinging_lamp' moves").
+  bool enabled = false;              ///< The scene calls for it.
+  bool available = false;            ///< This build can bake it (atlas, prm, brf); dlm and antiradiance: not yet.
+  std::string reason;                ///< One line naming the facts ("light 'swinging_lamp' moves").
   std::vector<std::string> targets;  ///< Entity names (atlas, prm, dlm, antiradiance) or mesh names (brf).
   EffectEstimate estimate;           ///< Filled when enabled and available.
 };
 
 /// The facts of the scene the rules read (also printed and stored).
 struct SceneFacts {
-  int static_lights = 0;             ///< Enabled lights that do not move.
-  int moving_lights = 0;             ///< Enabled lights that move.
-  int disabled_lights = 0;           ///< Switched off: ignored.
-  int emissive_surfaces = 0;         ///< Static mesh entities with an emissive material.
-  int static_meshes = 0;             ///< Mesh entities without DynamicTag.
-  int dynamic_meshes = 0;            ///< Mesh entities with DynamicTag.
-  double static_area_m2 = 0.0;       ///< World-space area of the static meshes.
-  double static_albedo = 0.0;        ///< Area-weighted mean albedo (luminance) of the static meshes.
+  int static_lights = 0;        ///< Enabled lights that do not move.
+  int moving_lights = 0;        ///< Enabled lights that move.
+  int disabled_lights = 0;      ///< Switched off: ignored.
+  int emissive_surfaces = 0;    ///< Static mesh entities with an emissive material.
+  int static_meshes = 0;        ///< Mesh entities without DynamicTag.
+  int dynamic_meshes = 0;       ///< Mesh entities with DynamicTag.
+  double static_area_m2 = 0.0;  ///< World-space area of the static meshes.
+  double static_albedo = 0.0;   ///< Area-weighted mean albedo (luminance) of the static meshes.
 };
 
 /// gi::plan's answer: one entry per method, in EffectMethod order.

@@ -66,8 +66,9 @@ std::string why_light_moves(const engine::Scene& scene, const EntityNodes& nodes
     return "scripted by the game";
   for (engine::Entity a = e; !a.is_null() && scene.registry.valid(a);) {
     const int n = nodes.node(a);
-    const bool dynamic = scene.registry.has<engine::DynamicTag>(a) ||
-                         (n >= 0 && scene.assets.nodes[static_cast<std::size_t>(n)].gi.mobility == engine::Mobility::Dynamic);
+    const bool dynamic =
+        scene.registry.has<engine::DynamicTag>(a) ||
+        (n >= 0 && scene.assets.nodes[static_cast<std::size_t>(n)].gi.mobility == engine::Mobility::Dynamic);
     if (dynamic) {
       *only_by_node = true;
       return a == e ? "on a dynamic node" : "hangs from dynamic node '" + name_of(scene.registry, a) + "'";
@@ -97,8 +98,9 @@ std::pair<float, std::string> min_roughness(const engine::SceneAsset& assets, co
   for (const engine::Primitive& p : assets.meshes[mr.mesh].primitives) {
     const int mi = mr.material_override >= 0 ? mr.material_override : p.material;
     const engine::Material def;
-    const engine::Material& m =
-        mi >= 0 && static_cast<std::size_t>(mi) < assets.materials.size() ? assets.materials[static_cast<std::size_t>(mi)] : def;
+    const engine::Material& m = mi >= 0 && static_cast<std::size_t>(mi) < assets.materials.size()
+                                    ? assets.materials[static_cast<std::size_t>(mi)]
+                                    : def;
     if (m.roughness < best.first) best = {m.roughness, m.name};
   }
   return best;
@@ -185,14 +187,18 @@ EffectPlan plan(const engine::Scene& scene, const PlanOptions& options) {
       moving_lights.push_back(name);
       moving_why.push_back(why);
       if (only_by_node)
-        out.warnings.push_back("light '" + name + "' " + why + " but is not flagged light_moves: the light atlas would bake it "
+        out.warnings.push_back("light '" + name + "' " + why +
+                               " but is not flagged light_moves: the light atlas would bake it "
                                "as static; set gi.light_moves");
       return;
     }
     static_lights.push_back(name);
-    if (light.type == engine::LightType::Area) ++points.sampled;
-    else if (light.type == engine::LightType::Directional) ++points.directional;
-    else ++points.punctual;
+    if (light.type == engine::LightType::Area)
+      ++points.sampled;
+    else if (light.type == engine::LightType::Directional)
+      ++points.directional;
+    else
+      ++points.punctual;
   });
   facts.static_lights = static_cast<int>(static_lights.size());
   facts.moving_lights = static_cast<int>(moving_lights.size());
@@ -237,9 +243,11 @@ EffectPlan plan(const engine::Scene& scene, const PlanOptions& options) {
   auto atlas_settings = light_atlas_preset(options.preset);
   auto prm_settings = prm_preset(options.preset);
   const bool estimates = atlas_settings && prm_settings;
-  if (!estimates) out.warnings.push_back("unknown preset '" + options.preset + "' (preview, medium, high): no estimates");
+  if (!estimates)
+    out.warnings.push_back("unknown preset '" + options.preset + "' (preview, medium, high): no estimates");
   if (estimates) {
-    if (options.texels_per_metre > 0.0f) atlas_settings->texels_per_metre = prm_settings->texels_per_metre = options.texels_per_metre;
+    if (options.texels_per_metre > 0.0f)
+      atlas_settings->texels_per_metre = prm_settings->texels_per_metre = options.texels_per_metre;
     if (options.vpls > 0) atlas_settings->vpl_count = options.vpls;
     if (options.samples_per_vpl > 0) atlas_settings->samples_per_vpl = options.samples_per_vpl;
     if (options.bounces > 0) atlas_settings->bounces = options.bounces;
@@ -247,9 +255,11 @@ EffectPlan plan(const engine::Scene& scene, const PlanOptions& options) {
 
   const bool any_light = !static_lights.empty() || !moving_lights.empty() || !emissive_meshes.empty();
   if (!any_light) {
-    const std::string why = facts.disabled_lights > 0
-                                ? "no light is on (" + plural(static_cast<std::size_t>(facts.disabled_lights), "light is", "lights are") + " switched off) and no surface is emissive: nothing to bake"
-                                : "the scene has no light and no emissive surface: nothing to bake";
+    const std::string why =
+        facts.disabled_lights > 0
+            ? "no light is on (" + plural(static_cast<std::size_t>(facts.disabled_lights), "light is", "lights are") +
+                  " switched off) and no surface is emissive: nothing to bake"
+            : "the scene has no light and no emissive surface: nothing to bake";
     for (PlannedEffect& e : out.effects) e.reason = why;
     return out;
   }
@@ -273,15 +283,17 @@ EffectPlan plan(const engine::Scene& scene, const PlanOptions& options) {
       const BakeWork w = light_atlas_work(census, *atlas_settings, points);
       const AtlasTexelEstimate t = atlas_texels(census, atlas_settings->texels_per_metre);
       atlas.estimate = {w.bake_seconds, w.runtime_bytes, static_cast<std::uint64_t>(t.lit_texels),
-                        fixed(census.area_m2, 1) + " m^2 x " + fixed(atlas_settings->texels_per_metre, 0) + "^2 texels/m^2 -> ~" +
-                            std::to_string(static_cast<long long>(t.lit_texels)) + " texels (atlas " + std::to_string(t.width) +
-                            "x" + std::to_string(t.height) + ") x " + std::to_string(atlas_settings->vpl_count) + " VPLs, " +
+                        fixed(census.area_m2, 1) + " m^2 x " + fixed(atlas_settings->texels_per_metre, 0) +
+                            "^2 texels/m^2 -> ~" + std::to_string(static_cast<long long>(t.lit_texels)) +
+                            " texels (atlas " + std::to_string(t.width) + "x" + std::to_string(t.height) + ") x " +
+                            std::to_string(atlas_settings->vpl_count) + " VPLs, " +
                             std::to_string(atlas_settings->bounces) + " bounces"};
     }
   } else if (static_meshes.empty()) {
     atlas.reason = "no static mesh: nothing for a light atlas to hold";
   } else {
-    atlas.reason = "no static light (" + plural(moving_lights.size(), "light moves", "lights move") + ") -> no light atlas";
+    atlas.reason =
+        "no static light (" + plural(moving_lights.size(), "light moves", "lights move") + ") -> no light atlas";
   }
 
   // PRM: moving lights over static geometry.
@@ -290,16 +302,18 @@ EffectPlan plan(const engine::Scene& scene, const PlanOptions& options) {
     std::vector<std::string> parts;
     for (std::size_t i = 0; i < moving_lights.size() && i < 3; ++i)
       parts.push_back("light '" + moving_lights[i] + "' moves (" + moving_why[i] + ")");
-    prm.reason = list_names(parts, 3) + " -> PRM panes over " + plural(static_meshes.size(), "static mesh", "static meshes");
+    prm.reason =
+        list_names(parts, 3) + " -> PRM panes over " + plural(static_meshes.size(), "static mesh", "static meshes");
     prm.targets = static_meshes;
     if (estimates) {
       double nodes_est = 0.0;
       const BakeWork w = prm_work(census, *prm_settings, &nodes_est);
       const AtlasTexelEstimate t = atlas_texels(census, prm_settings->texels_per_metre);
       prm.estimate = {w.bake_seconds, w.runtime_bytes, static_cast<std::uint64_t>(nodes_est),
-                      std::to_string(prm_settings->entry_points) + " entry points x N_s " + fixed(prm_settings->splitting, 0) +
-                          " at albedo " + fixed(census.albedo, 2) + " -> ~" + std::to_string(static_cast<long long>(nodes_est)) +
-                          " path nodes x ~" + std::to_string(static_cast<long long>(t.pane_texels)) + " pane texels; " +
+                      std::to_string(prm_settings->entry_points) + " entry points x N_s " +
+                          fixed(prm_settings->splitting, 0) + " at albedo " + fixed(census.albedo, 2) + " -> ~" +
+                          std::to_string(static_cast<long long>(nodes_est)) + " path nodes x ~" +
+                          std::to_string(static_cast<long long>(t.pane_texels)) + " pane texels; " +
                           std::to_string(prm_settings->clusters) + " panes as half floats"};
     }
   } else if (moving_lights.empty()) {
@@ -348,14 +362,18 @@ EffectPlan plan(const engine::Scene& scene, const PlanOptions& options) {
       total.runtime_bytes += w.runtime_bytes;
       total.units += w.units;
     }
-    brf.reason = plural(static_cast<std::size_t>(facts.dynamic_meshes), "dynamic entity uses ", "dynamic entities use ") +
-                 plural(mesh_names.size(), "mesh", "meshes") + " (" + list_names(mesh_names) + ") -> a basis and a field per mesh";
+    brf.reason =
+        plural(static_cast<std::size_t>(facts.dynamic_meshes), "dynamic entity uses ", "dynamic entities use ") +
+        plural(mesh_names.size(), "mesh", "meshes") + " (" + list_names(mesh_names) +
+        ") -> a basis and a field per mesh";
     brf.targets = mesh_names;
     brf.estimate = {total.bake_seconds, total.runtime_bytes, static_cast<std::uint64_t>(total.units),
-                    std::to_string(mesh_names.size()) + " meshes, " + std::to_string(vertices) + " vertices; per mesh " +
-                        std::to_string(field.spheres) + " spheres x 6 x " + std::to_string(field.face_resolution) + "^2 points x " +
-                        std::to_string(basis.basis) + " functions x " + std::to_string(field.sh_bands * field.sh_bands) +
-                        " SH coefficients x 4 B (brf defaults for every preset; seconds from the ray rate, no BRF bake measured yet)"};
+                    std::to_string(mesh_names.size()) + " meshes, " + std::to_string(vertices) +
+                        " vertices; per mesh " + std::to_string(field.spheres) + " spheres x 6 x " +
+                        std::to_string(field.face_resolution) + "^2 points x " + std::to_string(basis.basis) +
+                        " functions x " + std::to_string(field.sh_bands * field.sh_bands) +
+                        " SH coefficients x 4 B (brf defaults for every preset; seconds from the ray rate, no BRF bake "
+                        "measured yet)"};
   } else {
     brf.reason = "no dynamic mesh -> no basis radiance fields";
   }
@@ -370,8 +388,8 @@ std::string format_plan(const EffectPlan& p) {
   const SceneFacts& f = p.facts;
   s += "  facts: " + plural(static_cast<std::size_t>(f.static_lights), "static light", "static lights") + ", " +
        plural(static_cast<std::size_t>(f.moving_lights), "moving light", "moving lights") + ", " +
-       plural(static_cast<std::size_t>(f.static_meshes), "static mesh", "static meshes") + " (" + fixed(f.static_area_m2, 1) +
-       " m^2, albedo " + fixed(f.static_albedo, 2) + "), " +
+       plural(static_cast<std::size_t>(f.static_meshes), "static mesh", "static meshes") + " (" +
+       fixed(f.static_area_m2, 1) + " m^2, albedo " + fixed(f.static_albedo, 2) + "), " +
        plural(static_cast<std::size_t>(f.dynamic_meshes), "dynamic mesh", "dynamic meshes") + "\n";
   double seconds = 0.0;
   std::uint64_t bytes = 0;
@@ -381,7 +399,8 @@ std::string format_plan(const EffectPlan& p) {
     std::snprintf(head, sizeof head, "  %-13s %-4s", std::string(effect_key(e.method)).c_str(), state);
     s += std::string(head) + (e.enabled && !e.available ? " " : "  ") + e.reason + "\n";
     if (e.enabled && !e.available)
-      s += "                      this build cannot bake " + std::string(effect_key(e.method)) + ": it will be skipped\n";
+      s += "                      this build cannot bake " + std::string(effect_key(e.method)) +
+           ": it will be skipped\n";
     if (e.enabled && !e.targets.empty()) s += "                      targets: " + list_names(e.targets, 6) + "\n";
     if (!e.estimate.basis.empty()) {
       s += "                      estimate: " + estimate_line(e.estimate.bake_seconds, e.estimate.runtime_bytes) + "\n";

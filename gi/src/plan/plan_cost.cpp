@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-
 #include <glm/glm.hpp>
 
 #include "uv/chart_packer.h"
@@ -26,22 +25,24 @@ namespace {
 // per generation set; direct light casts one ray per (sample point, light point).
 constexpr double kAtlasFinalFacing = 0.55;        // rays / (lit texels x VPLs): 0.45-0.65 measured
 constexpr double kAtlasPropagationRaysPerV2 = 5;  // rays / VPL^2 over all generations: 4.4-6.6 measured
-constexpr double kAtlasCpuPerFinalRay = 2.0e-7;   // s; final shooting: demo_level medium 19.9 s / 97.7 M, spot_chamber medium 2.4 s / 12.1 M
-constexpr double kAtlasCpuPerPropRay = 2.2e-7;    // s; propagation incl. the shooting loop: cornell_box medium 1.26 s, ~5 M rays (serial)
+constexpr double kAtlasCpuPerFinalRay =
+    2.0e-7;  // s; final shooting: demo_level medium 19.9 s / 97.7 M, spot_chamber medium 2.4 s / 12.1 M
+constexpr double kAtlasCpuPerPropRay =
+    2.2e-7;  // s; propagation incl. the shooting loop: cornell_box medium 1.26 s, ~5 M rays (serial)
 constexpr double kAtlasCpuPerDirectRay = 1.0e-7;  // s; cornell_box preview (128 light points) minus the other terms
 constexpr double kAtlasCpuOverhead = 0.05;        // s; layout, rasterization, files
 
 // PRM (gi/src/prm): every path node (virtual light) is connected to every pane texel facing
 // it by one shadow ray; nodes = E x N_s x a / (1 - a) for a mean albedo a.
-constexpr double kPrmFacing = 0.5;               // rays / (nodes x pane texels): 0.26 (cornell) - 0.68 (spot)
-constexpr double kPrmCpuPerRay = 9.0e-8;         // s; measured 7.6e-8 (spot_chamber medium) to 1.05e-7 (demo_level medium)
-constexpr double kPrmCpuOverhead = 0.03;         // s
-constexpr double kPrmNodesFudge = 1.0;           // measured nodes / modelled nodes
+constexpr double kPrmFacing = 0.5;        // rays / (nodes x pane texels): 0.26 (cornell) - 0.68 (spot)
+constexpr double kPrmCpuPerRay = 9.0e-8;  // s; measured 7.6e-8 (spot_chamber medium) to 1.05e-7 (demo_level medium)
+constexpr double kPrmCpuOverhead = 0.03;  // s
+constexpr double kPrmNodesFudge = 1.0;    // measured nodes / modelled nodes
 
 // Texels: a chart of w x h metres at density d covers about (w d + 1)(h d + 1) x fill texels
 // (conservative rasterization); the PRM pane adds the dilation rings around it.
-constexpr double kPaneRings = 2.0;     // texels each side
-constexpr int kAtlasPadding = 2;       // uv/atlas_layout.h default
+constexpr double kPaneRings = 2.0;  // texels each side
+constexpr int kAtlasPadding = 2;    // uv/atlas_layout.h default
 constexpr int kAtlasMaxSize = 4096;
 
 // Basis radiance fields (gi/src/brf): no BRF bake exists in this build yet, so the constants
@@ -81,11 +82,13 @@ AtlasTexelEstimate atlas_texels(const StaticSurfaceCensus& census, float texels_
   return out;
 }
 
-BakeWork light_atlas_work(const StaticSurfaceCensus& census, const LightAtlasSettings& s, const LightPointCount& lights) {
+BakeWork light_atlas_work(const StaticSurfaceCensus& census, const LightAtlasSettings& s,
+                          const LightPointCount& lights) {
   BakeWork w;
   const AtlasTexelEstimate t = atlas_texels(census, s.texels_per_metre);
   const double v = s.vpl_count;
-  const double light_points = lights.punctual + lights.directional + static_cast<double>(lights.sampled) * s.area_light_samples;
+  const double light_points =
+      lights.punctual + lights.directional + static_cast<double>(lights.sampled) * s.area_light_samples;
   const double final_rays = kAtlasFinalFacing * t.lit_texels * v;
   const double prop_rays = s.bounces > 1 ? kAtlasPropagationRaysPerV2 * v * v : 0.0;
   const double direct_rays = 0.5 * v * s.samples_per_vpl * light_points + 4096.0 * lights.punctual;

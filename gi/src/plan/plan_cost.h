@@ -19,8 +19,8 @@ namespace gi {
 
 /// The light sources a static bake shoots from.
 struct LightPointCount {
-  int punctual = 0;       ///< Point and spot lights (one point each, plus a flux check).
-  int sampled = 0;        ///< Area lights and emissive triangles (area_light_samples points each).
+  int punctual = 0;  ///< Point and spot lights (one point each, plus a flux check).
+  int sampled = 0;   ///< Area lights and emissive triangles (area_light_samples points each).
   int directional = 0;
 };
 

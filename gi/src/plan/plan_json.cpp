@@ -9,10 +9,10 @@ nlohmann::json plan_to_json_value(const EffectPlan& p) {
   j["scene"] = p.scene;
   j["preset"] = p.preset;
   j["glossy_roughness"] = p.glossy_roughness;
-  j["facts"] = {{"static_lights", p.facts.static_lights},         {"moving_lights", p.facts.moving_lights},
-                {"disabled_lights", p.facts.disabled_lights},     {"emissive_surfaces", p.facts.emissive_surfaces},
-                {"static_meshes", p.facts.static_meshes},         {"dynamic_meshes", p.facts.dynamic_meshes},
-                {"static_area_m2", p.facts.static_area_m2},       {"static_albedo", p.facts.static_albedo}};
+  j["facts"] = {{"static_lights", p.facts.static_lights},     {"moving_lights", p.facts.moving_lights},
+                {"disabled_lights", p.facts.disabled_lights}, {"emissive_surfaces", p.facts.emissive_surfaces},
+                {"static_meshes", p.facts.static_meshes},     {"dynamic_meshes", p.facts.dynamic_meshes},
+                {"static_area_m2", p.facts.static_area_m2},   {"static_albedo", p.facts.static_albedo}};
   nlohmann::json effects = nlohmann::json::array();
   for (const PlannedEffect& e : p.effects) {
     effects.push_back({{"method", std::string(effect_key(e.method))},
@@ -47,7 +47,8 @@ engine::Result<EffectPlan> plan_from_json_value(const nlohmann::json& json, cons
   p.facts.static_area_m2 = f.get<double>("facts.static_area_m2");
   p.facts.static_albedo = f.get<double>("facts.static_albedo");
   if (f.error()) return *f.error();
-  const auto strings = [&](const nlohmann::json& arr, const std::string& where) -> engine::Result<std::vector<std::string>> {
+  const auto strings = [&](const nlohmann::json& arr,
+                           const std::string& where) -> engine::Result<std::vector<std::string>> {
     std::vector<std::string> out;
     if (!arr.is_array()) return engine::Error{file, where, "must be an array of strings"};
     for (const nlohmann::json& s : arr) {

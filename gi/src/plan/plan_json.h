@@ -3,10 +3,10 @@
 //   nlohmann::json j = gi::plan_to_json_value(plan);
 //   auto back = gi::plan_from_json_value(j, "out/level.gibake/manifest.json");
 
-#include <nlohmann/json.hpp>
-
 #include <engine/result.h>
 #include <gi/plan.h>
+
+#include <nlohmann/json.hpp>
 
 namespace gi {
 

@@ -2,10 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <glm/glm.hpp>
 #include <numeric>
 #include <unordered_map>
-
-#include <glm/glm.hpp>
 
 namespace gi {
 
@@ -100,9 +99,7 @@ void add_instance_charts(const std::vector<Triangle>& tris, std::vector<ChartExt
   }
 }
 
-double luminance(const glm::vec4& c) {
-  return 0.2126 * double{c.x} + 0.7152 * double{c.y} + 0.0722 * double{c.z};
-}
+double luminance(const glm::vec4& c) { return 0.2126 * double{c.x} + 0.7152 * double{c.y} + 0.0722 * double{c.z}; }
 
 }  // namespace
 

@@ -6,17 +6,17 @@
 //   gi::StaticSurfaceCensus c = gi::census_static_surfaces(scene);
 //   double texels = c.area_m2 * d * d;  // the plain estimate; charts add their rims
 
+#include <engine/scene.h>
+
 #include <cstdint>
 #include <vector>
-
-#include <engine/scene.h>
 
 namespace gi {
 
 /// One estimated chart: a connected, coplanar piece of one static mesh instance.
 struct ChartExtent {
   double area_m2 = 0.0;
-  double width_m = 0.0;   ///< Sides of its minimal-area rectangle (over its edge directions), width >= height.
+  double width_m = 0.0;  ///< Sides of its minimal-area rectangle (over its edge directions), width >= height.
   double height_m = 0.0;
 };
 
