@@ -1,10 +1,14 @@
 // gi-bake: bakes the GI data of a scene into a bake bundle.
 //   gi-bake --scene assets/cornell_box.gltf --methods atlas --preset high --out out/cornell_box.gibake
+//   gi-bake --plan assets/demo_level.gltf --preset preview    # print the effect plan, bake nothing
+// Without --methods it bakes what gi::plan (gi/plan.h) calls for; the plan goes into the
+// manifest either way (plan_command.h).
 // Methods available: atlas (light atlas, Schärfig 2016; static lights), prm (precomputed
 // radiance maps, Szécsi 2006; moving lights) and brf (basis radiance fields, Iwasaki et al.;
 // one per distinct dynamic mesh). atlas and prm use the preset's atlas density, so they
 // share one uv1 layout. The other methods of DESIGN.md 1 are reported as not built yet
 // rather than silently skipped.
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -21,6 +25,7 @@
 #include "brf/brf_io.h"
 #include "brf/brf_mesh.h"
 #include "console_progress.h"
+#include "plan_command.h"
 #include "light_atlas/light_atlas.h"
 #include "light_atlas/light_atlas_io.h"
 #include "prm/prm.h"
@@ -122,15 +127,18 @@ int bake_brf_method(const engine::Scene& scene, const engine::SceneAsset& asset,
 
 int main(int argc, char** argv) {
   CLI::App app{"Bakes a scene's GI data into a bake bundle (manifest.json + one file per method)"};
-  std::string scene_path, out_dir, methods = "atlas", preset = "medium";
+  std::string scene_path, positional_scene, out_dir, methods, preset = "medium";
+  bool plan_only = false;
   int vpls = 0, bounces = 0, samples = 0, brf_basis = 0, brf_spheres = 0;
   float density = 0.0f;
   bool include_direct = false;
   unsigned threads = 0;
   std::uint64_t seed = 1;
-  app.add_option("--scene", scene_path, "glTF/GLB scene")->required()->check(CLI::ExistingFile);
+  app.add_option("--scene", scene_path, "glTF/GLB scene")->check(CLI::ExistingFile);
+  app.add_option("scene", positional_scene, "glTF/GLB scene (instead of --scene)")->check(CLI::ExistingFile);
+  app.add_flag("--plan", plan_only, "Print the effect plan with estimates for --preset and exit (docs/plan.md)");
   app.add_option("--out", out_dir, "Bundle directory (default: out/<scene>.gibake)");
-  app.add_option("--methods", methods, "Comma-separated methods to bake: atlas, prm, brf");
+  app.add_option("--methods", methods, "Comma-separated methods to bake: atlas, prm, brf (default: what the plan calls for)");
   app.add_option("--preset", preset, "Quality preset: preview, medium, high (docs/light_atlas.md)");
   app.add_option("--vpls", vpls, "Override the preset's VPL count")->check(CLI::PositiveNumber);
   app.add_option("--bounces", bounces, "Override the preset's indirect bounces")->check(CLI::Range(1, 64));
@@ -142,6 +150,11 @@ int main(int argc, char** argv) {
   app.add_option("--threads", threads, "Worker threads (0: all); the result does not depend on it");
   app.add_option("--seed", seed, "Random seed");
   CLI11_PARSE(app, argc, argv);
+  if (scene_path.empty()) scene_path = positional_scene;
+  if (scene_path.empty()) {
+    std::cerr << "gi-bake: no scene (--scene FILE or FILE)\n";
+    return 2;
+  }
 
   auto asset = engine::load_gltf(scene_path);
   if (!asset) {
@@ -152,9 +165,26 @@ int main(int argc, char** argv) {
   if (out_dir.empty()) out_dir = (std::filesystem::path("out") / (scene_file.stem().string() + ".gibake")).string();
   const engine::Scene scene = engine::instantiate(*asset);
 
-  const std::vector<std::string> wanted = split(methods);
+  const gi::EffectPlan plan = gi::plan(scene, {.preset = preset, .texels_per_metre = density, .vpls = vpls,
+                                               .samples_per_vpl = samples, .bounces = bounces});
+  if (plan_only) {
+    tools::print_plan(plan);
+    return 0;
+  }
+  const std::vector<std::string> bakeable = {"atlas", "prm", "brf"};
+  std::vector<std::string> wanted = split(methods);
+  if (methods.empty()) {
+    wanted = tools::methods_from_plan(plan, bakeable);
+    std::string list;
+    for (const std::string& m : wanted) list += (list.empty() ? "" : ",") + m;
+    if (wanted.empty()) {
+      std::printf("gi-bake: the plan calls for nothing this build can bake; no bundle written (gi-bake --plan says why)\n");
+      return 0;
+    }
+    std::printf("gi-bake: baking the plan's methods: %s\n", list.c_str());
+  }
   for (const std::string& method : wanted)
-    if (method != "atlas" && method != "prm" && method != "brf") {
+    if (std::find(bakeable.begin(), bakeable.end(), method) == bakeable.end()) {
       std::cerr << "gi-bake: method '" << method << "' is not available in this build (available: atlas, prm, brf)\n";
       return 2;
     }
@@ -202,5 +232,6 @@ int main(int argc, char** argv) {
     }
     std::printf("  wrote %s\n", out_dir.c_str());
   }
+  if (!tools::record_plan(out_dir, *asset, scene_file.filename().string(), plan)) return 1;
   return 0;
 }

@@ -61,8 +61,14 @@ struct Mesh {
 /// How GI treats a node, from the glTF node's extras ("gi": {...}, see docs/scene-format.md).
 enum class Mobility : std::uint8_t { Unspecified, Static, Dynamic };
 
+/// A region flag from the node's extras ("gi": {"region": "deforming"}): geometry that
+/// deforms or opens at runtime (a door, a movable wall), which gi::plan lights with
+/// antiradiance instead of baking.
+enum class GiRegion : std::uint8_t { None, Deforming };
+
 struct NodeGiFlags {
   Mobility mobility = Mobility::Unspecified;
+  GiRegion region = GiRegion::None;
 };
 
 /// A node of the hierarchy. `parent` is -1 for roots; children follow from parents.

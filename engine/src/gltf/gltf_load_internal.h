@@ -131,6 +131,7 @@ Result<std::vector<NamedCamera>> convert_cameras(const Context& ctx, const Parse
 /// The "gi" object of a node's extras (docs/scene-format.md).
 struct GiExtras {
   Mobility mobility = Mobility::Unspecified;
+  GiRegion region = GiRegion::None;
   std::optional<bool> light_moves;
   std::optional<NamedLight> area_light;
 };

@@ -158,6 +158,11 @@ Result<GiExtras> parse_gi_extras(const Context& ctx, const Json& node, const std
       return ctx.error(where, "'mobility' must be \"static\" or \"dynamic\"");
     }
   }
+  if (const Json* region = find_member(*gi, "region")) {
+    if (!region->is_string() || region->get<std::string>() != "deforming")
+      return ctx.error(where, "'region' must be \"deforming\"");
+    out.region = GiRegion::Deforming;
+  }
   if (const Json* moves = find_member(*gi, "light_moves")) {
     if (!moves->is_boolean()) return ctx.error(where, "'light_moves' must be true or false");
     out.light_moves = moves->get<bool>();

@@ -137,6 +137,7 @@ Status convert_nodes(const Context& ctx, const ParsedFile& file, const std::vect
     if (!gi) return gi.error();
     fn.gi = std::move(gi.value());
     fn.node.gi.mobility = fn.gi.mobility;
+    fn.node.gi.region = fn.gi.region;
     if (fn.gi.area_light && fn.punctual_light >= 0) {
       return ctx.error(where, "has both a KHR_lights_punctual light and a gi area_light");
     }

@@ -348,6 +348,7 @@ class GltfBuilder {
       json gi = json::object();
       if (n.gi.mobility == Mobility::Static) gi["mobility"] = "static";
       if (n.gi.mobility == Mobility::Dynamic) gi["mobility"] = "dynamic";
+      if (n.gi.region == GiRegion::Deforming) gi["region"] = "deforming";
       if (n.light >= 0) {
         const Light& l = scene_.lights[static_cast<std::size_t>(n.light)].light;
         gi["light_moves"] = l.moves;

@@ -54,6 +54,10 @@ engine::Result<Manifest> read_manifest(const std::filesystem::path& bundle_dir) 
   auto methods = field("methods", &nlohmann::json::is_object, "an object");
   if (!methods) return methods.error();
   m.methods = **methods;
+  if (auto it = doc.find("plan"); it != doc.end()) {
+    if (!it->is_object()) return manifest_error(bundle_dir, "plan", "must be an object");
+    m.plan = *it;
+  }
   return m;
 }
 
@@ -63,6 +67,7 @@ engine::Status write_manifest(const std::filesystem::path& bundle_dir, const Man
   doc["geometry_hash"] = manifest.geometry_hash;
   doc["scene"] = manifest.scene;
   doc["methods"] = manifest.methods.is_object() ? manifest.methods : nlohmann::json::object();
+  if (manifest.plan.is_object()) doc["plan"] = manifest.plan;
   const std::string text = doc.dump(2) + "\n";
   return write_file_atomic(manifest_path(bundle_dir),
                            std::span<const std::byte>(reinterpret_cast<const std::byte*>(text.data()), text.size()));
@@ -78,6 +83,18 @@ engine::Status update_manifest_method(const std::filesystem::path& bundle_dir, c
   m.geometry_hash = geometry_hash;
   m.scene = scene;
   m.methods[method] = entry;
+  return write_manifest(bundle_dir, m);
+}
+
+engine::Status update_manifest_plan(const std::filesystem::path& bundle_dir, const std::string& geometry_hash,
+                                    const std::string& scene, const nlohmann::json& plan) {
+  Manifest m;
+  if (auto existing = read_manifest(bundle_dir); existing && existing->geometry_hash == geometry_hash) {
+    m = std::move(existing).value();
+  }
+  m.geometry_hash = geometry_hash;
+  m.scene = scene;
+  m.plan = plan;
   return write_manifest(bundle_dir, m);
 }
 

@@ -24,6 +24,8 @@ struct Manifest {
   std::string geometry_hash;                          ///< gi::scene_geometry_hash of the baked scene.
   std::string scene;                                  ///< File name of the baked scene (informative only).
   nlohmann::json methods = nlohmann::json::object();  ///< Method name -> its entry (any JSON).
+  /// The effect plan the bundle was baked under (gi/src/plan/plan_json.h); null when absent.
+  nlohmann::json plan;
 };
 
 /// Reads DIR/manifest.json. Errors (naming the file): missing, malformed JSON, a
@@ -39,6 +41,11 @@ engine::Status write_manifest(const std::filesystem::path& bundle_dir, const Man
 /// entries would describe files of another bake. DIR must exist.
 engine::Status update_manifest_method(const std::filesystem::path& bundle_dir, const std::string& geometry_hash,
                                       const std::string& scene, const std::string& method, const nlohmann::json& entry);
+
+/// Sets the manifest's "plan" section, keeping the methods' entries when the existing
+/// manifest was baked from the same geometry_hash (as update_manifest_method). DIR must exist.
+engine::Status update_manifest_plan(const std::filesystem::path& bundle_dir, const std::string& geometry_hash,
+                                    const std::string& scene, const nlohmann::json& plan);
 
 /// The entry of `method`; error (naming the manifest) when the bundle has none.
 engine::Result<nlohmann::json> manifest_method(const std::filesystem::path& bundle_dir, const Manifest& manifest,

@@ -1,0 +1,142 @@
+#include "plan/plan_cost.h"
+
+#include <algorithm>
+#include <cmath>
+#include <glm/glm.hpp>
+
+#include "uv/chart_packer.h"
+
+namespace gi {
+
+namespace {
+
+// ---------------------------------------------------------------------------------------
+// Calibration table. CPU seconds are user + sys of `gi-bake --methods <m> --preset <p>`
+// (/usr/bin/time), one method per run, on cornell_box, spot_chamber and demo_level at preview
+// and medium (docs/plan.md, "Calibration"): CPU time does not change when other jobs share
+// the two cores, wall time does. Wall time on a quiet machine = the parallel part / 2 + the
+// serial part; checked against the quiet wall times in docs/prm.md (spot chamber medium
+// 6.0 s, demo level preview 2.9 s) and docs/prm.md's 0.93 s light-atlas preview re-bake of
+// the demo level.
+// ---------------------------------------------------------------------------------------
+
+// Light atlas (gi/src/light_atlas): final shooting casts one shadow ray per (lit texel, VPL
+// facing it); progressive refinement computes form-factor rows, about V^2 visibility tests
+// per generation set; direct light casts one ray per (sample point, light point).
+constexpr double kAtlasFinalFacing = 0.55;        // rays / (lit texels x VPLs): 0.45-0.65 measured
+constexpr double kAtlasPropagationRaysPerV2 = 5;  // rays / VPL^2 over all generations: 4.4-6.6 measured
+constexpr double kAtlasCpuPerFinalRay =
+    2.0e-7;  // s; final shooting: demo_level medium 19.9 s / 97.7 M, spot_chamber medium 2.4 s / 12.1 M
+constexpr double kAtlasCpuPerPropRay =
+    2.2e-7;  // s; propagation incl. the shooting loop: cornell_box medium 1.26 s, ~5 M rays (serial)
+constexpr double kAtlasCpuPerDirectRay = 1.0e-7;  // s; cornell_box preview (128 light points) minus the other terms
+constexpr double kAtlasCpuOverhead = 0.05;        // s; layout, rasterization, files
+
+// PRM (gi/src/prm): every path node (virtual light) is connected to every pane texel facing
+// it by one shadow ray; nodes = E x N_s x a / (1 - a) for a mean albedo a.
+constexpr double kPrmFacing = 0.5;        // rays / (nodes x pane texels): 0.26 (cornell) - 0.68 (spot)
+constexpr double kPrmCpuPerRay = 9.0e-8;  // s; measured 7.6e-8 (spot_chamber medium) to 1.05e-7 (demo_level medium)
+constexpr double kPrmCpuOverhead = 0.03;  // s
+constexpr double kPrmNodesFudge = 1.0;    // measured nodes / modelled nodes
+
+// Texels: a chart of w x h metres at density d covers about (w d + 1)(h d + 1) x fill texels
+// (conservative rasterization); the PRM pane adds the dilation rings around it.
+constexpr double kPaneRings = 2.0;  // texels each side
+constexpr int kAtlasPadding = 2;    // uv/atlas_layout.h default
+constexpr int kAtlasMaxSize = 4096;
+
+// Basis radiance fields (gi/src/brf): no BRF bake exists in this build yet, so the constants
+// are the ray rate of this machine kind (DESIGN.md §4: Embree traces ~6 M incoherent rays/s
+// on 2 threads, 3 M per thread) and ~1 ns per SH multiply-add of the projection.
+constexpr double kBrfCpuPerRay = 1.0 / 3.0e6;
+constexpr double kBrfCpuPerMadd = 1.0e-9;
+
+// Runtime bytes: the light atlas is an RGBA32F texture (light_atlas_lighting.cpp); PRM panes
+// are half floats (6 bytes per texel and cluster) plus its own RGBA32F irradiance atlas.
+constexpr double kAtlasTexelBytes = 16.0;
+constexpr double kPaneTexelBytes = 6.0;
+
+double wall_seconds(double parallel_cpu, double serial_cpu) { return parallel_cpu / 2.0 + serial_cpu; }
+
+}  // namespace
+
+AtlasTexelEstimate atlas_texels(const StaticSurfaceCensus& census, float texels_per_metre) {
+  AtlasTexelEstimate out;
+  const double d = texels_per_metre;
+  std::vector<glm::ivec2> footprints;
+  for (const ChartExtent& c : census.charts) {
+    const double w = c.width_m * d, h = c.height_m * d;
+    const double fill = w > 0.0 && h > 0.0 ? std::clamp(c.area_m2 * d * d / (w * h), 0.05, 1.0) : 1.0;
+    out.lit_texels += fill * (w + 1.0) * (h + 1.0);
+    out.pane_texels += fill * (w + 1.0 + 2.0 * kPaneRings) * (h + 1.0 + 2.0 * kPaneRings);
+    footprints.emplace_back(static_cast<int>(std::ceil(w)) + 1, static_cast<int>(std::ceil(h)) + 1);
+  }
+  if (!footprints.empty()) {
+    // The packer itself (cheap): footprints too large for the biggest atlas get the maximum.
+    if (auto packing = pack_growing(footprints, kAtlasPadding, kAtlasMaxSize)) {
+      out.width = packing->width, out.height = packing->height;
+    } else {
+      out.width = out.height = kAtlasMaxSize;
+    }
+  }
+  return out;
+}
+
+BakeWork light_atlas_work(const StaticSurfaceCensus& census, const LightAtlasSettings& s,
+                          const LightPointCount& lights) {
+  BakeWork w;
+  const AtlasTexelEstimate t = atlas_texels(census, s.texels_per_metre);
+  const double v = s.vpl_count;
+  const double light_points =
+      lights.punctual + lights.directional + static_cast<double>(lights.sampled) * s.area_light_samples;
+  const double final_rays = kAtlasFinalFacing * t.lit_texels * v;
+  const double prop_rays = s.bounces > 1 ? kAtlasPropagationRaysPerV2 * v * v : 0.0;
+  const double direct_rays = 0.5 * v * s.samples_per_vpl * light_points + 4096.0 * lights.punctual;
+  w.rays = final_rays + prop_rays + direct_rays;
+  w.units = t.lit_texels * v;
+  const double parallel = final_rays * kAtlasCpuPerFinalRay + direct_rays * kAtlasCpuPerDirectRay;
+  const double serial = prop_rays * kAtlasCpuPerPropRay + kAtlasCpuOverhead;
+  w.cpu_seconds = parallel + serial;
+  w.bake_seconds = wall_seconds(parallel, serial);
+  w.runtime_bytes = static_cast<std::uint64_t>(static_cast<double>(t.width) * t.height * kAtlasTexelBytes);
+  return w;
+}
+
+BakeWork prm_work(const StaticSurfaceCensus& census, const PrmSettings& s, double* path_nodes) {
+  BakeWork w;
+  const AtlasTexelEstimate t = atlas_texels(census, s.texels_per_metre);
+  const double a = std::clamp(census.albedo, 0.0, 0.95);
+  const double nodes = kPrmNodesFudge * s.entry_points * static_cast<double>(s.splitting) * a / (1.0 - a);
+  if (path_nodes) *path_nodes = nodes;
+  w.rays = kPrmFacing * nodes * t.pane_texels;
+  w.units = nodes;
+  const double parallel = w.rays * kPrmCpuPerRay;
+  w.cpu_seconds = parallel + kPrmCpuOverhead;
+  w.bake_seconds = wall_seconds(parallel, kPrmCpuOverhead);
+  w.runtime_bytes = static_cast<std::uint64_t>(static_cast<double>(s.clusters) * t.pane_texels * kPaneTexelBytes +
+                                               static_cast<double>(t.width) * t.height * kAtlasTexelBytes);
+  return w;
+}
+
+BakeWork brf_work(std::size_t vertex_count, std::size_t triangle_count, const PcaBasisSettings& basis,
+                  const RadianceFieldSettings& field) {
+  (void)triangle_count;
+  BakeWork w;
+  const double n = basis.basis;
+  const double coefficients = static_cast<double>(field.sh_bands) * field.sh_bands;
+  const double samples = static_cast<double>(field.spheres) * 6.0 * field.face_resolution * field.face_resolution;
+  const double pca_rays = static_cast<double>(basis.lights) * static_cast<double>(vertex_count);
+  const double field_rays = samples * field.directions;
+  w.rays = pca_rays + field_rays;
+  w.units = samples;
+  const double parallel = w.rays * kBrfCpuPerRay + field_rays * n * coefficients * kBrfCpuPerMadd;
+  w.cpu_seconds = parallel;
+  w.bake_seconds = wall_seconds(parallel, 0.0);
+  // Field (Iwasaki §4.3): spheres x 6 x res^2 points x N functions x SH coefficients floats;
+  // basis: N values per vertex and the N x N inverse.
+  w.runtime_bytes = static_cast<std::uint64_t>(samples * n * coefficients * 4.0 +
+                                               n * static_cast<double>(vertex_count) * 4.0 + n * n * 4.0);
+  return w;
+}
+
+}  // namespace gi

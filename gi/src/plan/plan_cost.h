@@ -1,0 +1,54 @@
+#pragma once
+// The planner's cost model: the work each baker does, counted from scene quantities and
+// settings (texels, VPLs, path nodes, shadow rays, field samples), turned into bake seconds
+// and runtime bytes with constants measured on this project's scenes (the calibration table
+// in plan_cost.cpp says where each number comes from).
+//   gi::AtlasWork w = gi::light_atlas_work(census, gi::light_atlas_preset("preview").value(), lights);
+//   double s = w.bake_seconds;
+
+#include <cstdint>
+#include <vector>
+
+#include "brf/pca_basis.h"
+#include "brf/radiance_field.h"
+#include "light_atlas/light_atlas.h"
+#include "plan/static_surface_census.h"
+#include "prm/prm.h"
+
+namespace gi {
+
+/// The light sources a static bake shoots from.
+struct LightPointCount {
+  int punctual = 0;  ///< Point and spot lights (one point each, plus a flux check).
+  int sampled = 0;   ///< Area lights and emissive triangles (area_light_samples points each).
+  int directional = 0;
+};
+
+/// The light-atlas layout the census implies at a density (shared by the atlas and PRM).
+struct AtlasTexelEstimate {
+  double lit_texels = 0.0;   ///< Texels a triangle covers (the atlas's "texels lit").
+  double pane_texels = 0.0;  ///< Lit texels plus the dilated gutter rings (PRM pane elements).
+  int width = 0;             ///< Packed atlas size (power of two, as gi's packer chooses).
+  int height = 0;
+};
+AtlasTexelEstimate atlas_texels(const StaticSurfaceCensus& census, float texels_per_metre);
+
+struct BakeWork {
+  double rays = 0.0;          ///< Shadow rays the bake casts.
+  double units = 0.0;         ///< The model's main quantity (texels x VPLs, path nodes, samples).
+  double cpu_seconds = 0.0;   ///< CPU time (load-independent; what the constants were fitted to).
+  double bake_seconds = 0.0;  ///< Wall time on 2 threads of a quiet machine.
+  std::uint64_t runtime_bytes = 0;
+};
+
+BakeWork light_atlas_work(const StaticSurfaceCensus& census, const LightAtlasSettings& settings,
+                          const LightPointCount& lights);
+
+/// `path_nodes` out: the virtual lights the random walks leave (E x N_s x a / (1 - a)).
+BakeWork prm_work(const StaticSurfaceCensus& census, const PrmSettings& settings, double* path_nodes = nullptr);
+
+/// One distinct dynamic mesh (a basis and a field each, shared by all its instances).
+BakeWork brf_work(std::size_t vertex_count, std::size_t triangle_count, const PcaBasisSettings& basis,
+                  const RadianceFieldSettings& field);
+
+}  // namespace gi
