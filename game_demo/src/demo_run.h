@@ -26,6 +26,7 @@ struct RunOptions {
   std::string out_dir;          ///< Headless frame folder (empty: no images written).
   int width = 960;
   int height = 540;
+  float exposure = kDemoExposure;  ///< Linear scale before tonemapping.
   bool size_given = false;
   std::uint64_t every = 1;
   bool exr = false;

@@ -59,7 +59,7 @@ int run_headless(const RunOptions& o, RunState& state) {
     }
     gpu.emplace(std::move(ctx).value());
     if (!load_indirect_light(o, sim, indirect)) return 1;  // before the renderer: it adds TEXCOORD_1
-    auto r = engine::Renderer::create(sim.scene().assets, engine::RenderSettings{.width = o.width, .height = o.height});
+    auto r = engine::Renderer::create(sim.scene().assets, engine::RenderSettings{.width = o.width, .height = o.height, .exposure = o.exposure});
     if (!r) {
       std::cerr << "gi_demo: " << r.error().to_string() << '\n';
       return 1;

@@ -93,6 +93,7 @@ int main(int argc, char** argv) {
   app.add_option("--out", o.out_dir, "Headless: write DIR/frame_NNNN.png (tonemapped)");
   auto* w = app.add_option("--width", o.width, "Render width in pixels")->check(CLI::Range(16, 8192));
   auto* h = app.add_option("--height", o.height, "Render height in pixels")->check(CLI::Range(16, 8192));
+  app.add_option("--exposure", o.exposure, "Linear exposure before tonemapping (default 0.3)")->check(CLI::PositiveNumber);
   app.add_option("--every", o.every, "Headless: write every K-th frame")->check(CLI::PositiveNumber);
   app.add_flag("--exr", o.exr, "Headless: also write DIR/frame_NNNN.exr (linear HDR)");
   app.add_flag("--no-render", o.no_render, "Headless: simulate only (no GPU), e.g. to record sessions");

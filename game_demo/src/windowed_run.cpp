@@ -77,7 +77,7 @@ int run_windowed(const RunOptions& o, RunState& state) {
   std::unique_ptr<gi::GISystem> indirect;  // destroyed before the context
   if (!load_indirect_light(o, sim, indirect)) return 1;    // before the renderer: it adds TEXCOORD_1
   const std::string indirect_text = describe_indirect_light(o, indirect.get());
-  auto r = engine::Renderer::create(sim.scene().assets, engine::RenderSettings{.width = o.width, .height = o.height});
+  auto r = engine::Renderer::create(sim.scene().assets, engine::RenderSettings{.width = o.width, .height = o.height, .exposure = o.exposure});
   if (!r) {
     std::cerr << "gi_demo: " << r.error().to_string() << '\n';
     return 1;

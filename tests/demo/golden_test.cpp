@@ -94,7 +94,7 @@ engine::ImageRgba8 render_replayed_frame(const GoldenSpec& g) {
   auto ctx = engine::GpuContext::create_headless();
   EXPECT_TRUE(ctx) << "no headless GL 4.5 context: " << ctx.error().to_string();
   if (!ctx) return {};
-  auto renderer = engine::Renderer::create(sim->scene().assets, engine::RenderSettings{.width = g.width, .height = g.height});
+  auto renderer = engine::Renderer::create(sim->scene().assets, engine::RenderSettings{.width = g.width, .height = g.height, .exposure = game_demo::kDemoExposure});
   EXPECT_TRUE(renderer) << renderer.error().to_string();
   if (!renderer) return {};
   (*renderer)->settings().split =

@@ -15,6 +15,10 @@
 
 namespace game_demo {
 
+/// The level's exposure (linear scale before tonemapping): its white rooms under multi-bounce
+/// indirect light. gi_demo's default, and what the golden replays render with.
+inline constexpr float kDemoExposure = 0.3f;
+
 struct SimulationSettings {
   double fixed_dt_s = 1.0 / 60.0;  ///< Length of one step, seconds.
   std::uint64_t seed = 0;          ///< Session seed (part of the checksum).
