@@ -7,6 +7,7 @@
 #include <set>
 #include <unordered_map>
 
+#include "brf/brf_bake.h"
 #include "plan/plan_cost.h"
 #include "plan/static_surface_census.h"
 
@@ -348,8 +349,9 @@ EffectPlan plan(const engine::Scene& scene, const PlanOptions& options) {
     std::vector<std::string> mesh_names;
     std::size_t vertices = 0, triangles = 0;
     BakeWork total;
-    const PcaBasisSettings basis{};
-    const RadianceFieldSettings field{};
+    const auto brf_settings = brf_preset(options.preset);
+    const PcaBasisSettings basis = brf_settings ? brf_settings->basis : PcaBasisSettings{};
+    const RadianceFieldSettings field = brf_settings ? brf_settings->field : RadianceFieldSettings{};
     for (const auto& [mesh, users] : dynamic_by_mesh) {
       if (mesh >= scene.assets.meshes.size()) continue;
       const engine::Mesh& m = scene.assets.meshes[mesh];
@@ -372,8 +374,7 @@ EffectPlan plan(const engine::Scene& scene, const PlanOptions& options) {
                         " vertices; per mesh " + std::to_string(field.spheres) + " spheres x 6 x " +
                         std::to_string(field.face_resolution) + "^2 points x " + std::to_string(basis.basis) +
                         " functions x " + std::to_string(field.sh_bands * field.sh_bands) +
-                        " SH coefficients x 4 B (brf defaults for every preset; seconds from the ray rate, no BRF bake "
-                        "measured yet)"};
+                        " SH coefficients x 4 B, " + std::to_string(field.directions) + " rays per point (brf_preset)"};
   } else {
     brf.reason = "no dynamic mesh -> no basis radiance fields";
   }

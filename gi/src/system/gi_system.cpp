@@ -9,6 +9,7 @@
 #include <engine/components.h>
 #include <engine/gpu/gl_objects.h>
 #include <gi/light_atlas_lighting.h>
+#include <gi/plan.h>
 #include <gi/prm_lighting.h>
 
 #include "bake/manifest.h"
@@ -63,6 +64,21 @@ engine::Result<std::unique_ptr<GISystem>> GISystem::load(const std::filesystem::
                          "the bundle holds no light atlas, PRM or basis radiance fields"};
   auto impl = std::make_unique<Impl>();
   std::ostringstream text;
+  // What the scene calls for (gi::plan) next to what the bundle holds.
+  const EffectPlan wanted = plan(scene, {});
+  const auto in_bundle = [&](EffectMethod m) {
+    switch (m) {
+      case EffectMethod::LightAtlas: return has_atlas;
+      case EffectMethod::Prm: return has_prm;
+      case EffectMethod::BasisRadianceFields: return has_brf;
+      default: return false;
+    }
+  };
+  for (const PlannedEffect& e : wanted.effects) {
+    text << "plan " << effect_key(e.method) << ": "
+         << (!e.enabled ? "off" : !e.available ? "needed, not built" : in_bundle(e.method) ? "on" : "needed, NOT IN THE BUNDLE (re-bake)")
+         << " - " << e.reason << '\n';
+  }
 
   std::optional<LightAtlasBake> atlas;
   if (has_atlas) {
