@@ -10,11 +10,19 @@ demo="$build_dir/game_demo/gi_demo"
 [ -x "$demo" ] || { echo "approve-goldens: $demo not built (BUILD_DIR=$build_dir bash tools/build.sh)" >&2; exit 1; }
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-while read -r session frame width height; do
+bundle="$build_dir/test-bundles/demo_level.gibake"
+while read -r session frame width height lighting; do
   case "$session" in ''|'#'*) continue ;; esac
+  gi=() suffix=""
+  if [ "${lighting:-}" = "gi" ]; then
+    # The bake the golden test uses (ctest's DemoBundle.BakePreview writes the same).
+    [ -f "$bundle/manifest.json" ] || "$build_dir/tools/gi-bake/gi-bake" --scene assets/demo_level.gltf --preset preview \
+                                           --out "$bundle" >/dev/null
+    gi=(--gi-bundle "$bundle") suffix="_gi"
+  fi
   "$demo" --headless --replay "tests/sessions/$session.girec" --frames $((frame + 1)) --width "$width" \
-          --height "$height" --out "$tmp/$session" --every "$frame" --only-written-frames >/dev/null
-  out=$(printf "tests/golden/%s_f%04d.png" "$session" "$frame")
-  cp "$(printf "%s/%s/frame_%04d.png" "$tmp" "$session" "$frame")" "$out"
+          --height "$height" --out "$tmp/$session$suffix" --every "$frame" --only-written-frames "${gi[@]}" >/dev/null
+  out=$(printf "tests/golden/%s_f%04d%s.png" "$session" "$frame" "$suffix")
+  cp "$(printf "%s/%s%s/frame_%04d.png" "$tmp" "$session" "$suffix" "$frame")" "$out"
   echo "approved $out"
 done < tests/golden/goldens.txt

@@ -1,6 +1,9 @@
 // Golden images: frame N of a committed session, replayed headlessly and rendered at a
 // small size (tests/golden/goldens.txt lists session, frame and size), must match
-// tests/golden/<session>_fNNNN.png.
+// tests/golden/<session>_fNNNN.png. Lines ending in "gi" are rendered with the demo level's
+// preview bake through gi::GISystem (light atlas, PRM, basis radiance fields; ctest bakes it
+// first, DemoBundle.BakePreview) and compared with <session>_fNNNN_gi.png, so the replay
+// suite catches regressions of the indirect light too.
 //
 // Metric: a pixel "differs" when any RGB channel differs by more than 8/255. The test passes
 // when fewer than 0.5% of the pixels differ AND the mean absolute channel difference over
@@ -24,6 +27,7 @@
 #include <engine/gpu/context.h>
 #include <engine/image.h>
 #include <engine/renderer.h>
+#include <gi/gi_system.h>
 
 #include <game_demo/replay.h>
 
@@ -33,7 +37,17 @@ struct GoldenSpec {
   std::string session;
   std::uint64_t frame = 0;
   int width = 0, height = 0;
+  bool gi = false;  ///< Lit by the demo level's preview bake (gi::GISystem), not the stand-in.
+
+  std::string name() const {
+    char buf[128];
+    std::snprintf(buf, sizeof buf, "%s_f%04llu%s", session.c_str(), static_cast<unsigned long long>(frame), gi ? "_gi" : "");
+    return buf;
+  }
 };
+
+// What DemoBundle.BakePreview (tests/CMakeLists.txt) writes: gi-bake --preset preview.
+std::filesystem::path demo_bundle() { return std::filesystem::path(GI_BINARY_DIR) / "test-bundles" / "demo_level.gibake"; }
 
 std::vector<GoldenSpec> golden_specs() {
   std::ifstream in(std::filesystem::path(GI_SOURCE_DIR) / "tests" / "golden" / "goldens.txt");
@@ -43,7 +57,10 @@ std::vector<GoldenSpec> golden_specs() {
     if (line.empty() || line[0] == '#') continue;
     std::istringstream ls(line);
     GoldenSpec g;
-    if (ls >> g.session >> g.frame >> g.width >> g.height) out.push_back(g);
+    if (!(ls >> g.session >> g.frame >> g.width >> g.height)) continue;
+    std::string lighting;
+    g.gi = (ls >> lighting) && lighting == "gi";
+    out.push_back(g);
   }
   return out;
 }
@@ -94,21 +111,33 @@ engine::ImageRgba8 render_replayed_frame(const GoldenSpec& g) {
   auto ctx = engine::GpuContext::create_headless();
   EXPECT_TRUE(ctx) << "no headless GL 4.5 context: " << ctx.error().to_string();
   if (!ctx) return {};
+  std::unique_ptr<gi::GISystem> gi;
+  if (g.gi) {  // before the renderer: the static meshes get the atlas UVs
+    auto loaded = gi::GISystem::load(demo_bundle(), sim->scene());
+    EXPECT_TRUE(loaded) << loaded.error().to_string() << " (ctest bakes it in DemoBundle.BakePreview; by hand: "
+                        << "build/tools/gi-bake/gi-bake --scene assets/demo_level.gltf --preset preview --out "
+                        << demo_bundle().string() << ")";
+    if (!loaded) return {};
+    gi = std::move(loaded).value();
+  }
   auto renderer = engine::Renderer::create(sim->scene().assets, engine::RenderSettings{.width = g.width, .height = g.height, .exposure = game_demo::kDemoExposure});
   EXPECT_TRUE(renderer) << renderer.error().to_string();
   if (!renderer) return {};
+  (*renderer)->set_indirect_light(gi.get());
   (*renderer)->settings().split =
       sim->context().split_view ? engine::SplitView::DirectLeftFullRight : engine::SplitView::Off;
   (*renderer)->render(sim->registry(), sim->context().camera);
-  return (*renderer)->read_ldr();
+  engine::ImageRgba8 image = (*renderer)->read_ldr();
+  renderer->reset();
+  gi.reset();  // before the context
+  return image;
 }
 
 TEST(GoldenImages, ReplayedSessionFramesMatchTheGoldens) {
   const std::vector<GoldenSpec> specs = golden_specs();
   ASSERT_GE(specs.size(), 1u) << "tests/golden/goldens.txt lists no golden image";
   for (const GoldenSpec& g : specs) {
-    char name[128];
-    std::snprintf(name, sizeof name, "%s_f%04llu", g.session.c_str(), static_cast<unsigned long long>(g.frame));
+    const std::string name = g.name();
     SCOPED_TRACE(name);
     const engine::ImageRgba8 actual = render_replayed_frame(g);
     ASSERT_EQ(actual.width, g.width);

@@ -1,0 +1,188 @@
+// gi-replay-quality: one recorded session replayed with GI bakes of different quality, each
+// frame timed and selected frames compared with the reference path tracer rendering the same
+// state (docs/replay_quality.md).
+//   gi-replay-quality --session tests/sessions/walk_flashlight.girec --bundle none
+//       --bundle preview=out/dl_preview.gibake --bundle medium=out/dl_medium.gibake
+//       --frames 150,300,450 --spp 256 --out docs/replay_quality.md
+// "none" is the renderer's constant-ambient stand-in. The error is the relative RMSE of linear
+// radiance over the frame (the renderer's HDR target against the path tracer's image), so it
+// includes the rasterizer's own approximations (shadow maps, light falloff), which the
+// stand-in row shows on its own.
+#define GL_GLEXT_PROTOTYPES 1
+#include <GL/glcorearb.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <numeric>
+#include <sstream>
+
+#include <CLI/CLI.hpp>
+
+#include <engine/gpu/context.h>
+#include <engine/renderer.h>
+#include <gi/gi_system.h>
+#include <gi/reference.h>
+
+#include <game_demo/replay.h>
+#include <game_demo/session_file.h>
+#include <game_demo/simulation.h>
+
+#include "metrics/error_metrics.h"
+#include "metrics/rgb_field.h"
+
+namespace {
+
+gi::RgbField field_of(const engine::ImageRgbaF& image) {
+  std::vector<glm::vec3> v(static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height));
+  for (std::size_t i = 0; i < v.size(); ++i) v[i] = {image.pixels[4 * i], image.pixels[4 * i + 1], image.pixels[4 * i + 2]};
+  return gi::RgbField::from_texels(image.width, image.height, v);
+}
+
+struct Row {
+  std::string name, bundle;
+  double mean_ms = 0.0, p95_ms = 0.0;
+  std::vector<double> errors;
+  std::uint64_t gi_idle = 0, gi_frames = 0;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string session_path, out_path, frames_text = "150,300,450";
+  std::vector<std::string> bundles;
+  int width = 320, height = 180, spp = 256;
+  CLI::App app{"Replays a session with GI bakes of different quality: frame time vs image error against the path tracer"};
+  app.add_option("--session", session_path, "Recorded session (.girec)")->required()->check(CLI::ExistingFile);
+  app.add_option("--bundle", bundles, "NAME=DIR of a bake bundle, or 'none' for the stand-in (repeatable)")->required();
+  app.add_option("--frames", frames_text, "Comma-separated frames compared with the path tracer");
+  app.add_option("--width", width)->check(CLI::Range(16, 4096));
+  app.add_option("--height", height)->check(CLI::Range(16, 4096));
+  app.add_option("--spp", spp, "Path-tracer samples per pixel of the reference frames")->check(CLI::PositiveNumber);
+  app.add_option("--out", out_path, "Markdown table to write (also printed)");
+  CLI11_PARSE(app, argc, argv);
+
+  std::vector<std::uint64_t> picked;
+  std::stringstream ss(frames_text);
+  for (std::string f; std::getline(ss, f, ',');) picked.push_back(std::stoull(f));
+  std::sort(picked.begin(), picked.end());
+  auto session = game_demo::load_session(session_path);
+  if (!session) {
+    std::cerr << "gi-replay-quality: " << session.error().to_string() << '\n';
+    return 1;
+  }
+  const std::uint64_t last = picked.back();
+  if (last >= session->frames.size()) {
+    std::cerr << "gi-replay-quality: frame " << last << " is past the session's " << session->frames.size() << " frames\n";
+    return 2;
+  }
+
+  // Reference: the path tracer at each picked frame of the replayed state.
+  std::map<std::uint64_t, gi::RgbField> reference;
+  {
+    auto sim = game_demo::simulation_for_session(*session, session_path);
+    if (!sim) {
+      std::cerr << "gi-replay-quality: " << sim.error().to_string() << '\n';
+      return 1;
+    }
+    for (std::uint64_t f = 0; f <= last; ++f) {
+      sim->step(session->frames[f].input);
+      if (!std::binary_search(picked.begin(), picked.end(), f)) continue;
+      const auto t0 = std::chrono::steady_clock::now();
+      gi::ReferenceSettings rs;
+      rs.samples_per_pixel = spp;
+      auto image = gi::render_reference_image(sim->scene(), sim->context().camera, width, height, rs);
+      if (!image) {
+        std::cerr << "gi-replay-quality: " << image.error().to_string() << '\n';
+        return 1;
+      }
+      reference.emplace(f, field_of(*image));
+      std::printf("reference frame %llu: %.1f s\n", static_cast<unsigned long long>(f),
+                  std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    }
+  }
+
+  auto gpu = engine::GpuContext::create_headless();
+  if (!gpu) {
+    std::cerr << "gi-replay-quality: " << gpu.error().to_string() << '\n';
+    return 1;
+  }
+  std::vector<Row> rows;
+  for (const std::string& spec : bundles) {
+    Row row;
+    const std::size_t eq = spec.find('=');
+    row.name = eq == std::string::npos ? spec : spec.substr(0, eq);
+    row.bundle = eq == std::string::npos ? "" : spec.substr(eq + 1);
+    auto sim = game_demo::simulation_for_session(*session, session_path);
+    if (!sim) {
+      std::cerr << "gi-replay-quality: " << sim.error().to_string() << '\n';
+      return 1;
+    }
+    std::unique_ptr<gi::GISystem> gi;
+    if (!row.bundle.empty()) {
+      auto loaded = gi::GISystem::load(row.bundle, sim->scene());
+      if (!loaded) {
+        std::cerr << "gi-replay-quality: " << loaded.error().to_string() << '\n';
+        return 1;
+      }
+      gi = std::move(loaded).value();
+    }
+    auto renderer = engine::Renderer::create(sim->scene().assets, engine::RenderSettings{.width = width, .height = height,
+                                                                                        .exposure = game_demo::kDemoExposure});
+    if (!renderer) {
+      std::cerr << "gi-replay-quality: " << renderer.error().to_string() << '\n';
+      return 1;
+    }
+    (*renderer)->set_indirect_light(gi.get());
+    std::vector<double> ms;
+    for (std::uint64_t f = 0; f <= last; ++f) {
+      sim->step(session->frames[f].input);
+      const auto t0 = std::chrono::steady_clock::now();
+      (*renderer)->render(sim->registry(), sim->context().camera);
+      glFinish();
+      ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+      if (const auto it = reference.find(f); it != reference.end())
+        row.errors.push_back(gi::relative_rmse(field_of((*renderer)->read_hdr()), it->second));
+    }
+    row.mean_ms = std::accumulate(ms.begin(), ms.end(), 0.0) / static_cast<double>(ms.size());
+    std::sort(ms.begin(), ms.end());
+    row.p95_ms = ms[static_cast<std::size_t>(0.95 * static_cast<double>(ms.size() - 1))];
+    if (gi) row.gi_idle = gi->stats().idle_frames, row.gi_frames = gi->stats().frames;
+    rows.push_back(row);
+    std::printf("%s: %.2f ms mean per frame\n", row.name.c_str(), row.mean_ms);
+  }
+
+  std::ostringstream md;
+  md << "| GI | frame ms (mean / p95) | GI idle frames |";
+  for (std::uint64_t f : picked) md << " rel RMSE f" << f << " |";
+  md << " mean rel RMSE |\n|---|---|---|";
+  for (std::size_t i = 0; i < picked.size(); ++i) md << "---|";
+  md << "---|\n";
+  for (const Row& r : rows) {
+    char buf[128];
+    std::snprintf(buf, sizeof buf, "| %s | %.1f / %.1f | %llu of %llu |", r.name.c_str(), r.mean_ms, r.p95_ms,
+                  static_cast<unsigned long long>(r.gi_idle), static_cast<unsigned long long>(r.gi_frames));
+    md << buf;
+    double sum = 0.0;
+    for (double e : r.errors) {
+      std::snprintf(buf, sizeof buf, " %.3f |", e);
+      md << buf;
+      sum += e;
+    }
+    std::snprintf(buf, sizeof buf, " %.3f |\n", sum / static_cast<double>(std::max<std::size_t>(r.errors.size(), 1)));
+    md << buf;
+  }
+  std::cout << md.str();
+  if (!out_path.empty()) {
+    std::ofstream out(out_path);
+    out << md.str();
+    if (!out) {
+      std::cerr << "gi-replay-quality: cannot write " << out_path << '\n';
+      return 1;
+    }
+  }
+  return 0;
+}
