@@ -3,8 +3,9 @@
 // whose irradiance atlas follows the scene's moving lights (the flashlight, a swinging
 // lamp), optionally on top of a light atlas baked for the static lights. Each frame it
 // checks the moving lights; only when one changed (moved, turned, switched, dimmed) it
-// recomputes the entry-point weights (CPU, shadow rays against the static world), picks the
-// K heaviest clusters and re-sums their panes on the GPU. A frame where nothing moved does
+// recomputes that light's entry-point irradiance (CPU, shadow rays against the static
+// world; the other lights' is cached), sums them into the cluster weights, picks the K
+// heaviest clusters and re-sums their panes on the GPU. A frame where nothing moved does
 // nothing.
 //   auto gi = gi::PrmLighting::load("level.gibake", scene);  // before Renderer::create
 //   auto renderer = engine::Renderer::create(scene.assets, settings).value();
@@ -56,6 +57,8 @@ class PrmLighting final : public engine::IndirectLightProvider {
     double last_weights_ms = 0.0;     ///< CPU: entry weights, cluster means, selection.
     double last_gpu_ms = 0.0;         ///< GPU pane sum (glFinish-timed: CPU time on llvmpipe).
     std::size_t last_active_clusters = 0;
+    std::size_t last_lights_recomputed = 0;  ///< Moving lights whose entry irradiance was recomputed last update,
+    std::size_t last_lights_reused = 0;      ///< and those whose cached one was reused (they had not changed).
     std::size_t gpu_bytes = 0;
   };
   const Stats& stats() const;

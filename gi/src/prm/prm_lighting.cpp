@@ -3,15 +3,18 @@
 
 #include <chrono>
 #include <optional>
+#include <unordered_map>
 
 #include "bake/static_scene.h"
 #include "bake/manifest.h"
 #include "light_atlas/light_atlas.h"
 #include "light_atlas/light_atlas_io.h"
+#include "light_atlas/point_emitters.h"
 #include "prm/prm.h"
 #include "prm/prm_gpu_pass.h"
 #include "prm/prm_io.h"
 #include "prm/prm_runtime.h"
+#include "raytrace/scene_adapter.h"
 #include "sweep/content_hash.h"
 #include "uv/atlas_scene_writer.h"
 
@@ -24,28 +27,68 @@ struct PrmLighting::Impl {
   std::unique_ptr<RayCaster> caster;
   PrmLightingSettings settings;
   std::optional<PrmGpuPass> pass;
-  std::uint64_t lights_signature = 0;
   bool fresh = false;
   engine::IndirectLightFrame frame;
   Stats stats;
 
-  // A fingerprint of everything about the moving lights that changes their light.
-  std::uint64_t moving_lights_signature() const {
+  // Per moving light: a fingerprint of everything that changes its light, and its entry
+  // irradiance (eq. 4), kept while the fingerprint holds. Entry irradiance is linear in the
+  // lights, so a frame where one of several moving lights changed recomputes that light only.
+  struct LightCache {
+    std::uint64_t signature = 0;
+    std::vector<glm::vec3> entry;
+    bool seen = false;
+  };
+  std::unordered_map<std::uint32_t, LightCache> lights;
+
+  static std::uint64_t light_signature(engine::Entity e, const engine::Light& l, const engine::WorldTransform& wt) {
     ContentHash h;
+    h.add_value(e.id());
+    h.add_value(static_cast<std::uint8_t>(l.enabled));
+    h.add_value(static_cast<std::uint8_t>(l.type));
+    h.add_value(l.color.x), h.add_value(l.color.y), h.add_value(l.color.z);
+    h.add_value(l.intensity), h.add_value(l.range_m);
+    h.add_value(l.inner_cone_rad), h.add_value(l.outer_cone_rad);
+    h.add_value(l.area_size_m.x), h.add_value(l.area_size_m.y);
+    for (int c = 0; c < 4; ++c)
+      for (int r = 0; r < 4; ++r) h.add_value(wt.matrix[c][r]);
+    return h.value();
+  }
+
+  // Brings every moving light's cached entry irradiance up to date; returns whether any
+  // changed (appeared, changed, or disappeared) and counts the recomputed ones.
+  bool refresh_lights(std::size_t& recomputed) {
+    bool changed = false;
+    recomputed = 0;
+    for (auto& [id, c] : lights) c.seen = false;
     registry->view<engine::Light, engine::WorldTransform>().each(
         [&](engine::Entity e, const engine::Light& l, const engine::WorldTransform& wt) {
           if (!l.moves) return;
-          h.add_value(e.id());
-          h.add_value(static_cast<std::uint8_t>(l.enabled));
-          h.add_value(static_cast<std::uint8_t>(l.type));
-          h.add_value(l.color.x), h.add_value(l.color.y), h.add_value(l.color.z);
-          h.add_value(l.intensity), h.add_value(l.range_m);
-          h.add_value(l.inner_cone_rad), h.add_value(l.outer_cone_rad);
-          h.add_value(l.area_size_m.x), h.add_value(l.area_size_m.y);
-          for (int c = 0; c < 4; ++c)
-            for (int r = 0; r < 4; ++r) h.add_value(wt.matrix[c][r]);
+          const std::uint64_t sig = light_signature(e, l, wt);
+          LightCache& c = lights[e.id()];
+          c.seen = true;
+          if (!c.entry.empty() && c.signature == sig) return;
+          c.signature = sig;
+          changed = true;
+          ++recomputed;
+          if (!l.enabled) {
+            c.entry.assign(prm.entries.size(), glm::vec3(0.0f));
+            return;
+          }
+          const ReferenceLight ref = reference_light(l, wt.matrix);
+          const std::vector<PointEmitter> emitters =
+              light_point_emitters(std::span<const ReferenceLight>(&ref, 1), 16, prm.settings.seed);
+          c.entry = entry_irradiance(prm, emitters, *caster);
         });
-    return h.value();
+    for (auto it = lights.begin(); it != lights.end();) {
+      if (!it->second.seen) {
+        it = lights.erase(it);
+        changed = true;
+      } else {
+        ++it;
+      }
+    }
+    return changed;
   }
 };
 
@@ -103,12 +146,17 @@ const engine::IndirectLightFrame& PrmLighting::frame() {
     m.frame.irradiance_atlas_texture = m.pass->texture();
     m.stats.gpu_bytes = m.pass->gpu_bytes();
   }
-  const std::uint64_t signature = m.moving_lights_signature();
-  if (m.fresh && signature == m.lights_signature) return m.frame;  // nothing moved
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();
+  std::size_t recomputed = 0;
+  if (!m.refresh_lights(recomputed) && m.fresh) return m.frame;  // no moving light changed
+  std::vector<glm::vec3> entry(m.prm.entries.size(), glm::vec3(0.0f));
+  for (const auto& [id, c] : m.lights)
+    for (std::size_t i = 0; i < entry.size() && i < c.entry.size(); ++i) entry[i] += c.entry[i];
   const std::vector<ClusterWeight> picked =
-      relight_clusters(m.prm, scene_lights(*m.registry, BakeLights::Moving), *m.caster, m.settings.active_clusters);
+      select_clusters(cluster_weights(m.prm, entry), m.settings.active_clusters);
+  m.stats.last_lights_recomputed = recomputed;
+  m.stats.last_lights_reused = m.lights.size() - std::min(recomputed, m.lights.size());
   const auto t1 = Clock::now();
   if (engine::Status s = m.pass->run(picked); !s) std::fprintf(stderr, "gi: PRM update failed: %s\n", s.error().to_string().c_str());
   glFinish();
@@ -117,7 +165,6 @@ const engine::IndirectLightFrame& PrmLighting::frame() {
   m.stats.last_gpu_ms = std::chrono::duration<double, std::milli>(t2 - t1).count();
   m.stats.last_active_clusters = picked.size();
   ++m.stats.updates;
-  m.lights_signature = signature;
   m.fresh = true;
   return m.frame;
 }
