@@ -51,7 +51,9 @@ float smith_ggx_correlated_visibility(float n_dot_v, float n_dot_l, float alpha)
 }
 
 vec3 schlick_fresnel(vec3 f0, float v_dot_h) {
-  return f0 + (vec3(1.0) - f0) * pow(1.0 - v_dot_h, 5.0);
+  // pow(x, y) is undefined for x < 0: a v_dot_h rounded just above 1 (the light beside the
+  // camera, as a flashlight is) made NaN pixels.
+  return f0 + (vec3(1.0) - f0) * pow(max(1.0 - v_dot_h, 0.0), 5.0);
 }
 
 // GGX specular BRDF times cos(theta_l) for a unit light direction l.
@@ -60,8 +62,8 @@ vec3 specular_brdf_cos(Surface s, vec3 l) {
   if (n_dot_l <= 0.0) return vec3(0.0);
   float n_dot_v = max(dot(s.normal, s.view), 1e-4);
   vec3 h = normalize(l + s.view);
-  float n_dot_h = max(dot(s.normal, h), 0.0);
-  float v_dot_h = max(dot(s.view, h), 0.0);
+  float n_dot_h = clamp(dot(s.normal, h), 0.0, 1.0);
+  float v_dot_h = clamp(dot(s.view, h), 0.0, 1.0);
   return ggx_distribution(n_dot_h, s.alpha) * smith_ggx_correlated_visibility(n_dot_v, n_dot_l, s.alpha) *
          schlick_fresnel(s.f0, v_dot_h) * n_dot_l;
 }

@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -36,10 +37,31 @@
 
 namespace {
 
-gi::RgbField field_of(const engine::ImageRgbaF& image) {
+// Non-finite pixels are masked out (and counted): one NaN would make the whole frame's error NaN.
+gi::RgbField field_of(const engine::ImageRgbaF& image, std::size_t* non_finite = nullptr) {
   std::vector<glm::vec3> v(static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height));
-  for (std::size_t i = 0; i < v.size(); ++i) v[i] = {image.pixels[4 * i], image.pixels[4 * i + 1], image.pixels[4 * i + 2]};
-  return gi::RgbField::from_texels(image.width, image.height, v);
+  std::vector<std::uint8_t> valid(v.size(), 1);
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    v[i] = {image.pixels[4 * i], image.pixels[4 * i + 1], image.pixels[4 * i + 2]};
+    if (!std::isfinite(v[i].x) || !std::isfinite(v[i].y) || !std::isfinite(v[i].z)) {
+      v[i] = glm::vec3(0.0f);
+      valid[i] = 0;
+      if (non_finite) {
+        if (*non_finite < 3)
+          std::fprintf(stderr, "  non-finite pixel at (%zu, %zu)\n", i % static_cast<std::size_t>(image.width),
+                       i / static_cast<std::size_t>(image.width));
+        ++*non_finite;
+      }
+    }
+  }
+  return gi::RgbField::from_texels(image.width, image.height, v, valid);
+}
+
+// The reference's mask applied to a render too (and the render's own non-finite pixels).
+gi::RgbField masked(gi::RgbField f, const gi::RgbField& reference) {
+  for (std::size_t i = 0; i < f.valid.size() && i < reference.valid.size(); ++i)
+    if (!reference.is_valid(i)) f.valid[i] = 0;
+  return f;
 }
 
 struct Row {
@@ -99,9 +121,11 @@ int main(int argc, char** argv) {
         std::cerr << "gi-replay-quality: " << image.error().to_string() << '\n';
         return 1;
       }
-      reference.emplace(f, field_of(*image));
-      std::printf("reference frame %llu: %.1f s\n", static_cast<unsigned long long>(f),
-                  std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+      std::size_t bad = 0;
+      reference.emplace(f, field_of(*image, &bad));
+      std::printf("reference frame %llu: %.1f s, %zu non-finite pixels masked\n", static_cast<unsigned long long>(f),
+                  std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), bad);
+      std::fflush(stdout);
     }
   }
 
@@ -145,7 +169,15 @@ int main(int argc, char** argv) {
       glFinish();
       ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
       if (const auto it = reference.find(f); it != reference.end())
-        row.errors.push_back(gi::relative_rmse(field_of((*renderer)->read_hdr()), it->second));
+      {
+        std::size_t bad = 0;
+        gi::RgbField mine = masked(field_of((*renderer)->read_hdr(), &bad), it->second);
+        gi::RgbField ref = it->second;
+        for (std::size_t i = 0; i < ref.valid.size(); ++i)
+          if (!mine.is_valid(i)) ref.valid[i] = 0;
+        if (bad > 0) std::printf("%s frame %llu: %zu non-finite pixels masked\n", row.name.c_str(), static_cast<unsigned long long>(f), bad);
+        row.errors.push_back(gi::relative_rmse(mine, ref));
+      }
     }
     row.mean_ms = std::accumulate(ms.begin(), ms.end(), 0.0) / static_cast<double>(ms.size());
     std::sort(ms.begin(), ms.end());

@@ -128,6 +128,12 @@ engine::ImageRgba8 render_replayed_frame(const GoldenSpec& g) {
       sim->context().split_view ? engine::SplitView::DirectLeftFullRight : engine::SplitView::Off;
   (*renderer)->render(sim->registry(), sim->context().camera);
   engine::ImageRgba8 image = (*renderer)->read_ldr();
+  // Every HDR pixel finite: a NaN shows as a black speck in the LDR image, too small for the
+  // tolerances (walk_flashlight frame 300 had two, from pow() of a negative in the Fresnel term).
+  const engine::ImageRgbaF hdr = (*renderer)->read_hdr();
+  std::size_t non_finite = 0;
+  for (float v : hdr.pixels) non_finite += std::isfinite(v) ? 0 : 1;
+  EXPECT_EQ(non_finite, 0u) << g.name() << ": non-finite HDR values";
   renderer->reset();
   gi.reset();  // before the context
   return image;
