@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "brf/brf_runtime.h"
+#include "brf_scenes.h"
 
 namespace {
 
@@ -30,29 +31,7 @@ engine::GpuContext headless_or_fail() {
   return std::move(ctx).value();
 }
 
-gi::BrfMesh box(glm::vec3 half, int n) {
-  gi::BrfMesh m;
-  const glm::vec3 axes[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
-  for (int a = 0; a < 3; ++a)
-    for (float sign : {-1.0f, 1.0f}) {
-      const glm::vec3 nrm = axes[a] * sign;
-      const glm::vec3 t = axes[(a + 1) % 3] * sign, b = axes[(a + 2) % 3];
-      const auto base = static_cast<std::uint32_t>(m.positions.size());
-      for (int i = 0; i <= n; ++i)
-        for (int j = 0; j <= n; ++j) {
-          const float s = (2.0f * static_cast<float>(i) / static_cast<float>(n) - 1.0f) * 0.98f;
-          const float r = (2.0f * static_cast<float>(j) / static_cast<float>(n) - 1.0f) * 0.98f;
-          m.positions.push_back((nrm + s * t + r * b) * half);
-          m.normals.push_back(nrm);
-        }
-      const auto at = [&](int i, int j) { return base + static_cast<std::uint32_t>(i * (n + 1) + j); };
-      for (int i = 0; i < n; ++i)
-        for (int j = 0; j < n; ++j)
-          m.indices.insert(m.indices.end(),
-                           {at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j), at(i + 1, j + 1), at(i, j + 1)});
-    }
-  return m;
-}
+gi::BrfMesh box(glm::vec3 half, int n) { return brftest::box(half, n); }
 
 // Two small models: a cube (8 functions, 3 SH bands) and a slab (6 functions, 4 bands), so
 // offsets, basis counts and band counts differ between pairs.

@@ -10,6 +10,7 @@
 #include <engine/gpu/gl_objects.h>
 #include <engine/gpu/shader_program.h>
 
+#include "bake/light_signature.h"
 #include "bake/static_scene.h"
 #include "brf/brf_gpu_pass.h"
 #include "gpu/gi_shaders.h"
@@ -23,20 +24,11 @@ namespace {
 
 constexpr std::uint32_t kGroupSize = 64;
 
+// Every light together: any change to any of them changes the objects' direct light.
 std::uint64_t lights_signature(const engine::Registry& registry) {
   ContentHash h;
   registry.view<engine::Light, engine::WorldTransform>().each(
-      [&](engine::Entity e, const engine::Light& l, const engine::WorldTransform& wt) {
-        h.add_value(e.id());
-        h.add_value(static_cast<std::uint8_t>(l.enabled));
-        h.add_value(static_cast<std::uint8_t>(l.type));
-        h.add_value(l.color.x), h.add_value(l.color.y), h.add_value(l.color.z);
-        h.add_value(l.intensity), h.add_value(l.range_m);
-        h.add_value(l.inner_cone_rad), h.add_value(l.outer_cone_rad);
-        h.add_value(l.area_size_m.x), h.add_value(l.area_size_m.y);
-        for (int c = 0; c < 4; ++c)
-          for (int r = 0; r < 4; ++r) h.add_value(wt.matrix[c][r]);
-      });
+      [&](engine::Entity e, const engine::Light& l, const engine::WorldTransform& wt) { h.add_value(light_signature(e, l, wt)); });
   return h.value();
 }
 

@@ -6,6 +6,7 @@
 #include <unordered_map>
 
 #include "bake/static_scene.h"
+#include "bake/light_signature.h"
 #include "bake/manifest.h"
 #include "light_atlas/light_atlas.h"
 #include "light_atlas/light_atlas_io.h"
@@ -15,7 +16,6 @@
 #include "prm/prm_io.h"
 #include "prm/prm_runtime.h"
 #include "raytrace/scene_adapter.h"
-#include "sweep/content_hash.h"
 #include "uv/atlas_scene_writer.h"
 
 namespace gi {
@@ -40,20 +40,6 @@ struct PrmLighting::Impl {
     bool seen = false;
   };
   std::unordered_map<std::uint32_t, LightCache> lights;
-
-  static std::uint64_t light_signature(engine::Entity e, const engine::Light& l, const engine::WorldTransform& wt) {
-    ContentHash h;
-    h.add_value(e.id());
-    h.add_value(static_cast<std::uint8_t>(l.enabled));
-    h.add_value(static_cast<std::uint8_t>(l.type));
-    h.add_value(l.color.x), h.add_value(l.color.y), h.add_value(l.color.z);
-    h.add_value(l.intensity), h.add_value(l.range_m);
-    h.add_value(l.inner_cone_rad), h.add_value(l.outer_cone_rad);
-    h.add_value(l.area_size_m.x), h.add_value(l.area_size_m.y);
-    for (int c = 0; c < 4; ++c)
-      for (int r = 0; r < 4; ++r) h.add_value(wt.matrix[c][r]);
-    return h.value();
-  }
 
   // Brings every moving light's cached entry irradiance up to date; returns whether any
   // changed (appeared, changed, or disappeared) and counts the recomputed ones.
