@@ -7,6 +7,9 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <string>
+
+#include <unistd.h>
 
 #include <gtest/gtest.h>
 
@@ -39,9 +42,15 @@ engine::Scene crates_room() {
   return engine::instantiate(std::move(asset.value()));
 }
 
-// One bundle for all tests: light atlas (preview, 8 texels/m) + BRF (preview).
+// One bundle for all tests of this process: light atlas (preview, 8 texels/m) + BRF (preview).
+// ctest runs each test in its own process, in parallel: the directory is per process.
 struct Bundle {
-  std::filesystem::path dir = std::filesystem::temp_directory_path() / "gi_system_test.gibake";
+  std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("gi_system_test_" + std::to_string(::getpid()) + ".gibake");
+  ~Bundle() {
+    std::error_code ec;
+    std::filesystem::remove_all(dir, ec);
+  }
   gi::LightAtlasBake atlas;
   Bundle() {
     std::filesystem::remove_all(dir);
