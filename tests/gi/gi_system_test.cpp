@@ -25,16 +25,11 @@
 #include "brf/brf_mesh.h"
 #include "light_atlas/light_atlas.h"
 #include "light_atlas/light_atlas_io.h"
+#include "gl_readback.h"
 
 namespace {
 
-std::vector<glm::vec3> read_texture(std::uint32_t texture, int w, int h) {
-  std::vector<float> rgba(static_cast<std::size_t>(w) * static_cast<std::size_t>(h) * 4);
-  glGetTextureImage(texture, 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(rgba.size() * sizeof(float)), rgba.data());
-  std::vector<glm::vec3> out(rgba.size() / 4);
-  for (std::size_t i = 0; i < out.size(); ++i) out[i] = {rgba[4 * i], rgba[4 * i + 1], rgba[4 * i + 2]};
-  return out;
-}
+using gltest::read_texture;
 
 engine::Scene crates_room() {
   auto asset = engine::load_gltf(GI_SOURCE_DIR "/assets/crates_room.gltf");

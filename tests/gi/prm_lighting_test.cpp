@@ -16,16 +16,11 @@
 #include "bake/static_scene.h"
 #include "prm/prm.h"
 #include "prm/prm_runtime.h"
+#include "gl_readback.h"
 
 namespace {
 
-std::vector<glm::vec3> read_texture(std::uint32_t texture, int w, int h) {
-  std::vector<float> rgba(static_cast<std::size_t>(w) * static_cast<std::size_t>(h) * 4);
-  glGetTextureImage(texture, 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(rgba.size() * sizeof(float)), rgba.data());
-  std::vector<glm::vec3> out(rgba.size() / 4);
-  for (std::size_t i = 0; i < out.size(); ++i) out[i] = {rgba[4 * i], rgba[4 * i + 1], rgba[4 * i + 2]};
-  return out;
-}
+using gltest::read_texture;
 
 TEST(PrmLighting, UpdatesOnlyWhenAMovingLightChangesAndMatchesTheCpuSum) {
   auto ctx = engine::GpuContext::create_headless();
