@@ -52,6 +52,7 @@ struct BrfLighting::Impl {
   // GPU side, created on the first update (the GL context is current then).
   std::optional<BrfGpuPass> pass;
   engine::ShaderProgram sum_program, composite_program;
+  GLint sum_count = -1, composite_count = -1, composite_width = -1;  // uniform locations
   std::vector<engine::GlBuffer> world_light, total;  // per instance
   engine::GlBuffer receiver_texels;
   bool gpu_failed = false;
@@ -77,6 +78,9 @@ struct BrfLighting::Impl {
     pass.emplace(std::move(p).value());
     sum_program = std::move(sum).value();
     composite_program = std::move(comp).value();
+    sum_count = glGetUniformLocation(sum_program.id(), "u_count");
+    composite_count = glGetUniformLocation(composite_program.id(), "u_count");
+    composite_width = glGetUniformLocation(composite_program.id(), "u_atlas_width");
     if (!world.receiver_texels.empty()) {
       if (auto s = pass->set_static_receivers(world.receiver_positions, world.receiver_normals); !s) {
         std::fprintf(stderr, "gi: basis radiance fields: %s\n", s.error().to_string().c_str());
@@ -196,7 +200,7 @@ bool BrfLighting::update() {
   m.sum_program.use();
   for (std::size_t i = 0; i < m.instances.size(); ++i) {
     const auto count = static_cast<std::uint32_t>(m.models[m.instances[i].model].mesh.positions.size());
-    glProgramUniform1ui(m.sum_program.id(), glGetUniformLocation(m.sum_program.id(), "u_count"), count);
+    glProgramUniform1ui(m.sum_program.id(), m.sum_count, count);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, m.world_light[i].id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, m.pass->vertex_buffer(i));
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, m.total[i].id());
@@ -235,9 +239,8 @@ void BrfLighting::composite_world(std::uint32_t base_texture, std::uint32_t comp
   const auto count = static_cast<std::uint32_t>(m.world.receiver_texels.size());
   glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
   m.composite_program.use();
-  glProgramUniform1ui(m.composite_program.id(), glGetUniformLocation(m.composite_program.id(), "u_count"), count);
-  glProgramUniform1ui(m.composite_program.id(), glGetUniformLocation(m.composite_program.id(), "u_atlas_width"),
-                      static_cast<GLuint>(m.world.atlas_width));
+  glProgramUniform1ui(m.composite_program.id(), m.composite_count, count);
+  glProgramUniform1ui(m.composite_program.id(), m.composite_width, static_cast<GLuint>(m.world.atlas_width));
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, m.receiver_texels.id());
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, m.pass->static_receiver_buffer());
   glBindImageTexture(0, composite_texture, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
