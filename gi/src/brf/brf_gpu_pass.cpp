@@ -132,6 +132,7 @@ engine::Result<BrfGpuPass> BrfGpuPass::create(std::span<const BrfGpuModel> model
     if (basis.psi.size() != nb * nv || basis.a_inverse.size() != nb * nb)
       return error(which + "basis arrays do not match its size");
     if (f.basis_count != basis.basis_count) return error(which + "the field was computed for another basis");
+    if (f.terms != 1) return error(which + "a glossy field (" + std::to_string(f.terms) + " BRDF terms): the GPU pass takes diffuse objects only");
     if ((f.sh_bands != 3 && f.sh_bands != 4) || f.spheres < 1 || f.face_resolution < 1 || !(f.inner_radius > 0.0f) ||
         !(f.outer_radius >= f.inner_radius) || !std::isfinite(f.outer_radius) || !finite(f.centre))
       return error(which + "field settings out of range");

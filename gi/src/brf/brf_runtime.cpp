@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 
 #include "brf/spherical_harmonics.h"
 #include "raytrace/embree_ray_caster.h"
@@ -13,22 +14,31 @@ BrfWorldVertices brf_world_vertices(const BrfObject& object) {
   BrfWorldVertices v;
   const glm::mat4& m = object.object_to_world;
   const glm::mat3 nm = glm::transpose(glm::inverse(glm::mat3(m)));
+  const glm::mat3 rot = glm::mat3(m) / glm::length(glm::vec3(m[0]));  // uniform scale removed
   const std::size_t count = object.mesh->positions.size();
   v.positions.reserve(count);
   v.normals.reserve(count);
   for (std::size_t j = 0; j < count; ++j) {
     v.positions.push_back(glm::vec3(m * glm::vec4(object.mesh->positions[j], 1.0f)));
     v.normals.push_back(glm::normalize(nm * object.mesh->normals[j]));
+    if (object.glossy != nullptr) v.frames.push_back(rot * brf_tangent_frame(object.mesh->normals[j]));
   }
   return v;
 }
 
 std::array<std::vector<float>, 3> brf_fit_rgb(const BrfBasis& basis, std::span<const glm::vec3> radiosity) {
   std::array<std::vector<float>, 3> w;
-  std::vector<float> channel(radiosity.size());
+  const std::size_t nv = basis.vertex_count, nb = static_cast<std::size_t>(basis.basis_count);
+  const std::size_t blocks = nv > 0 ? radiosity.size() / nv : 0;
+  std::vector<float> channel(nv);
   for (int c = 0; c < 3; ++c) {
-    for (std::size_t j = 0; j < radiosity.size(); ++j) channel[j] = radiosity[j][c];
-    w[static_cast<std::size_t>(c)] = basis.fit(channel);
+    std::vector<float>& out = w[static_cast<std::size_t>(c)];
+    out.assign(blocks * nb, 0.0f);
+    for (std::size_t k = 0; k < blocks; ++k) {
+      for (std::size_t j = 0; j < nv; ++j) channel[j] = radiosity[k * nv + j][c];
+      const std::vector<float> wk = basis.fit(channel);
+      std::copy(wk.begin(), wk.end(), out.begin() + static_cast<std::ptrdiff_t>(k * nb));
+    }
   }
   return w;
 }
@@ -56,22 +66,27 @@ BrfHorizon brf_horizon(const BrfBox& box, const glm::vec3& p, const glm::vec3& n
 }
 
 void brf_basis_irradiance(const BrfObject& source, std::span<const glm::vec3> positions,
-                          std::span<const glm::vec3> normals, std::vector<float>& out) {
+                          std::span<const glm::vec3> normals, std::vector<float>& out,
+                          const BrdfSeparation* receiver_glossy, std::span<const glm::mat3> frames) {
   const BasisRadianceField& f = *source.field;
   const auto cc = static_cast<std::size_t>(f.coefficient_count());
-  const auto nb = static_cast<std::size_t>(f.basis_count);
+  const auto channels = static_cast<std::size_t>(f.channel_count());
+  const std::size_t kr = 1 + (receiver_glossy != nullptr ? static_cast<std::size_t>(receiver_glossy->terms) : 0);
   const glm::mat4 to_source = glm::inverse(source.object_to_world);
-  // Rotation part only (uniform scale removed) for normals.
+  // Rotation part (uniform scale removed for the frames; normals are renormalized).
   const glm::mat3 rot = glm::mat3(to_source);
-  std::vector<float> coeffs(nb * cc);
-  out.assign(positions.size() * nb, 0.0f);
+  const glm::mat3 pure = rot / glm::length(rot[0]);
+  std::vector<float> coeffs(channels * cc);
+  out.assign(positions.size() * kr * channels, 0.0f);
   // The object lies inside its bounding box: where the tangent plane of the receiver has
   // the whole box behind it the answer is 0; where the whole box is in front, every
   // direction the light comes from has n . w > 0, so the unclamped cosine (band 1) gives
   // the exact irradiance of the stored radiance. Only a box straddling the plane needs the
   // clamped lobe, truncated to the stored bands (whose ringing would otherwise light
-  // faces that see nothing, such as the tops of crates beside each other).
+  // faces that see nothing, such as the tops of crates beside each other). A glossy
+  // receiver's g_k cos lobes are projected on the hemisphere and rotated as they are.
   const BrfBox box = brf_object_box(*source.mesh);
+  std::array<float, kMaxShCoefficients> rotated{};
   for (std::size_t j = 0; j < positions.size(); ++j) {
     const glm::vec3 p = glm::vec3(to_source * glm::vec4(positions[j], 1.0f));
     const glm::vec3 n = glm::normalize(rot * normals[j]);
@@ -79,9 +94,28 @@ void brf_basis_irradiance(const BrfObject& source, std::span<const glm::vec3> po
     if (side == BrfHorizon::Behind) continue;
     f.sample(p, coeffs);
     const auto lobe = side == BrfHorizon::InFront ? sh_cosine(n) : sh_clamped_cosine(n, f.sh_bands);
-    for (std::size_t i = 0; i < nb; ++i)
-      out[j * nb + i] = sh_dot(std::span<const float>(coeffs).subspan(i * cc), lobe, cc);
+    float* row = out.data() + j * kr * channels;
+    for (std::size_t c = 0; c < channels; ++c) row[c] = sh_dot(std::span<const float>(coeffs).subspan(c * cc), lobe, cc);
+    if (kr == 1) continue;
+    const ShRotation to_source_frame(pure * frames[j]);
+    for (std::size_t k = 1; k < kr; ++k) {
+      to_source_frame.apply(receiver_glossy->lobe_coefficients(static_cast<int>(k - 1)), rotated, f.sh_bands);
+      for (std::size_t c = 0; c < channels; ++c)
+        row[k * channels + c] = sh_dot(std::span<const float>(coeffs).subspan(c * cc), rotated, cc);
+    }
   }
+}
+
+glm::vec3 brf_outgoing_radiance(const BrfObject& object, const BrfWorldVertices& vertices,
+                                std::span<const glm::vec3> light, std::size_t j, const glm::vec3& w_out) {
+  const std::size_t nv = vertices.positions.size();
+  glm::vec3 radiance = object.albedo * light[j] / std::numbers::pi_v<float>;
+  if (object.glossy == nullptr) return radiance;
+  const glm::vec3 local = glm::transpose(vertices.frames[j]) * w_out;
+  if (local.z <= 0.0f) return radiance;
+  for (int k = 1; k <= object.glossy->terms; ++k)
+    radiance += object.specular * object.glossy->h_at(k - 1, local) * light[static_cast<std::size_t>(k) * nv + j];
+  return radiance;
 }
 
 std::vector<std::uint8_t> brf_pair_culling(std::span<const BrfObject> objects,
@@ -98,7 +132,7 @@ std::vector<std::uint8_t> brf_pair_culling(std::span<const BrfObject> objects,
       const glm::mat4 to_source = glm::inverse(objects[s].object_to_world);
       const glm::vec3 centre_r = glm::vec3(objects[r].object_to_world * glm::vec4(objects[r].basis->centre, 1.0f));
       const glm::vec3 p = glm::vec3(to_source * glm::vec4(centre_r, 1.0f));
-      coeffs.assign(static_cast<std::size_t>(f.basis_count * f.coefficient_count()), 0.0f);
+      coeffs.assign(static_cast<std::size_t>(f.channel_count() * f.coefficient_count()), 0.0f);
       f.sample(p, coeffs);
       // Irradiance on the plane facing the source (the receiver's best case), largest channel.
       const glm::vec3 to_centre = f.centre - p;
@@ -107,7 +141,7 @@ std::vector<std::uint8_t> brf_pair_culling(std::span<const BrfObject> objects,
       float b = 0.0f;
       for (std::size_t c = 0; c < 3; ++c) {
         float e = 0.0f;
-        for (int i = 0; i < f.basis_count; ++i)
+        for (int i = 0; i < f.channel_count(); ++i)
           e += weights[s][c][static_cast<std::size_t>(i)] *
                sh_dot(std::span<const float>(coeffs).subspan(static_cast<std::size_t>(i * f.coefficient_count())), lobe,
                       static_cast<std::size_t>(f.coefficient_count()));
@@ -136,14 +170,20 @@ std::vector<std::vector<glm::vec3>> brf_direct_light(std::span<const BrfObject> 
   auto caster = make_embree_ray_caster(data);
   for (std::size_t o = 0; o < n; ++o) {
     const BrfWorldVertices v = brf_world_vertices(objects[o]);
-    direct[o].assign(v.positions.size(), glm::vec3(0.0f));
-    for (std::size_t j = 0; j < v.positions.size(); ++j)
+    const std::size_t nv = v.positions.size();
+    const BrdfSeparation* glossy = objects[o].glossy;
+    direct[o].assign(nv * static_cast<std::size_t>(objects[o].terms()), glm::vec3(0.0f));
+    for (std::size_t j = 0; j < nv; ++j)
       for (const PointEmitter& l : lights) {
         const glm::vec3 e = emitter_irradiance(l, v.positions[j], v.normals[j], 0.0f);
         if (e == glm::vec3(0.0f)) continue;
         if (caster && !emitter_visible(**caster, l, v.positions[j], v.normals[j])) continue;
         if (world != nullptr && !emitter_visible(*world, l, v.positions[j], v.normals[j])) continue;
         direct[o][j] += e;
+        if (glossy == nullptr) continue;
+        // E_k = g_k(w_light) E (eq. 8 for a point light), w_light in the vertex's frame.
+        const glm::vec3 w = glm::transpose(v.frames[j]) * glm::normalize(l.position - v.positions[j]);
+        for (int k = 1; k <= glossy->terms; ++k) direct[o][static_cast<std::size_t>(k) * nv + j] += glossy->g_at(k - 1, w) * e;
       }
   }
   return direct;
@@ -151,17 +191,27 @@ std::vector<std::vector<glm::vec3>> brf_direct_light(std::span<const BrfObject> 
 
 namespace {
 
-// E(x_j) += max(0, sum_i w_c,i Phi_i(x_j)) per channel.
-void gather(std::span<const float> phi, std::size_t basis_count, const std::array<std::vector<float>, 3>& w,
-            std::span<glm::vec3> out) {
-  for (std::size_t j = 0; j < out.size(); ++j) {
-    glm::vec3 e(0.0f);
-    for (std::size_t i = 0; i < basis_count; ++i) {
-      const float p = phi[j * basis_count + i];
-      for (std::size_t c = 0; c < 3; ++c) e[static_cast<int>(c)] += w[c][i] * p;
+// E_k'(x_j) += sum_c w_c Phi_(k',c)(x_j) per RGB channel, out laid out [k' x V + j]; the
+// irradiance (k' = 0) is clamped at 0 (SH ringing must not make light negative), the
+// glossy terms are signed like g_k.
+void gather(std::span<const float> phi, std::size_t channels, std::size_t receiver_terms,
+            const std::array<std::vector<float>, 3>& w, std::span<glm::vec3> out) {
+  const std::size_t nv = out.size() / receiver_terms;
+  for (std::size_t j = 0; j < nv; ++j)
+    for (std::size_t k = 0; k < receiver_terms; ++k) {
+      const float* row = phi.data() + (j * receiver_terms + k) * channels;
+      glm::vec3 e(0.0f);
+      for (std::size_t c = 0; c < channels; ++c)
+        for (std::size_t rgb = 0; rgb < 3; ++rgb) e[static_cast<int>(rgb)] += w[rgb][c] * row[c];
+      out[k * nv + j] += k == 0 ? glm::max(e, glm::vec3(0.0f)) : e;
     }
-    out[j] += glm::max(e, glm::vec3(0.0f));  // SH ringing must not make light negative
-  }
+}
+
+// The light an object sends on from per-vertex incoming values: albedo x E for the diffuse
+// term, specular x E_k for the glossy ones.
+void reflect(const BrfObject& object, std::span<const glm::vec3> in, std::span<glm::vec3> out) {
+  const std::size_t nv = object.mesh->positions.size();
+  for (std::size_t i = 0; i < in.size(); ++i) out[i] = (i < nv ? object.albedo : object.specular) * in[i];
 }
 
 }  // namespace
@@ -175,13 +225,16 @@ BrfResult brf_interreflect(std::span<const BrfObject> objects, std::span<const s
   if (n == 0) return out;
 
   std::vector<BrfWorldVertices> wv(n);
-  std::vector<std::vector<glm::vec3>> light(n);  // radiosity leaving each vertex this bounce
-  std::vector<std::vector<glm::vec3>> total(n);  // all radiosity leaving each vertex
+  std::vector<std::size_t> terms(n);
+  std::vector<std::vector<glm::vec3>> light(n);  // light leaving each vertex this bounce, per term
+  std::vector<std::vector<glm::vec3>> total(n);  // all light leaving each vertex, per term
   for (std::size_t o = 0; o < n; ++o) {
     wv[o] = brf_world_vertices(objects[o]);
-    out.indirect[o].assign(wv[o].positions.size(), glm::vec3(0.0f));
-    light[o].resize(wv[o].positions.size());
-    for (std::size_t j = 0; j < light[o].size(); ++j) light[o][j] = objects[o].albedo * incoming[o][j];
+    terms[o] = static_cast<std::size_t>(objects[o].terms());
+    const std::size_t size = wv[o].positions.size() * terms[o];
+    out.indirect[o].assign(size, glm::vec3(0.0f));
+    light[o].resize(size);
+    reflect(objects[o], incoming[o], light[o]);
     total[o] = light[o];
   }
   std::vector<std::array<std::vector<float>, 3>> w(n);
@@ -198,24 +251,25 @@ BrfResult brf_interreflect(std::span<const BrfObject> objects, std::span<const s
         continue;
       }
       ++out.pairs_evaluated;
-      brf_basis_irradiance(objects[s], wv[r].positions, wv[r].normals, phi[s * n + r]);
+      brf_basis_irradiance(objects[s], wv[r].positions, wv[r].normals, phi[s * n + r], objects[r].glossy, wv[r].frames);
     }
 
   for (int bounce = 0; bounce < settings.bounces; ++bounce) {
     if (bounce > 0)
       for (std::size_t s = 0; s < n; ++s) w[s] = brf_fit_rgb(*objects[s].basis, light[s]);
     std::vector<std::vector<glm::vec3>> gathered(n);
-    for (std::size_t r = 0; r < n; ++r) gathered[r].assign(wv[r].positions.size(), glm::vec3(0.0f));
+    for (std::size_t r = 0; r < n; ++r) gathered[r].assign(light[r].size(), glm::vec3(0.0f));
     for (std::size_t s = 0; s < n; ++s)
       for (std::size_t r = 0; r < n; ++r)
         if (s != r && culled[s * n + r] == 0)
-          gather(phi[s * n + r], static_cast<std::size_t>(objects[s].field->basis_count), w[s], gathered[r]);
-    for (std::size_t r = 0; r < n; ++r)
+          gather(phi[s * n + r], static_cast<std::size_t>(objects[s].field->channel_count()), terms[r], w[s], gathered[r]);
+    for (std::size_t r = 0; r < n; ++r) {
+      reflect(objects[r], gathered[r], light[r]);
       for (std::size_t j = 0; j < gathered[r].size(); ++j) {
         out.indirect[r][j] += gathered[r][j];
-        light[r][j] = objects[r].albedo * gathered[r][j];
         total[r][j] += light[r][j];
       }
+    }
   }
 
   // The static world receives every object's total radiosity inside its field.
@@ -242,7 +296,7 @@ BrfResult brf_interreflect(std::span<const BrfObject> objects, std::span<const s
       brf_basis_irradiance(objects[s], pos, nrm, phi_static);
       const auto wt = brf_fit_rgb(*objects[s].basis, total[s]);
       e.assign(index.size(), glm::vec3(0.0f));
-      gather(phi_static, static_cast<std::size_t>(f.basis_count), wt, e);
+      gather(phi_static, static_cast<std::size_t>(f.channel_count()), 1, wt, e);
       for (std::size_t k = 0; k < index.size(); ++k) out.static_irradiance[index[k]] += e[k];
     }
   }

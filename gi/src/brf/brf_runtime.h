@@ -23,6 +23,15 @@
 //   std::vector<gi::BrfObject> objects{{&mesh, &basis, &field, transform, albedo}};
 //   gi::BrfResult r = gi::update_brf(objects, lights, {.bounces = 3});
 //   // r.indirect[object][vertex]: interreflected irradiance (W/m^2, RGB)
+//
+// Glossy objects (BrfObject::glossy, brdf_separation.h) carry K = 1 + glossy terms values
+// per vertex wherever a diffuse one carries one, laid out [k x vertex_count + vertex]:
+// k = 0 the irradiance E, k >= 1 the g_k-weighted irradiance E_k = int L g_k cos (eq. 8 and
+// 11). Their radiance leaving a vertex is albedo E / pi + specular sum_k h_k(w_out) E_k
+// (brf_outgoing_radiance). As a source, each term is fitted with the basis and the field
+// has a channel per (term, basis function); as a receiver, Phi gets one row per receiver
+// term: the clamped-cosine lobe for k = 0, for k >= 1 the SH projection of g_k cos in the
+// vertex's tangent frame rotated into the source's space (ShRotation, eq. 13).
 
 #include <array>
 #include <cstdint>
@@ -31,6 +40,7 @@
 
 #include <glm/glm.hpp>
 
+#include "brf/brdf_separation.h"
 #include "brf/pca_basis.h"
 #include "brf/radiance_field.h"
 #include "light_atlas/point_emitters.h"
@@ -45,6 +55,11 @@ struct BrfObject {
   const BasisRadianceField* field = nullptr;
   glm::mat4 object_to_world{1.0f};  ///< Rigid (rotation + translation; uniform scale allowed).
   glm::vec3 albedo{0.8f};           ///< Diffuse albedo.
+  /// The separated glossy lobe (nullptr: diffuse). The basis and field were baked with it.
+  const BrdfSeparation* glossy = nullptr;
+  glm::vec3 specular{1.0f};         ///< Glossy colour: f0 (RGB) / glossy->lobe.f0.
+
+  int terms() const { return field->terms; }
 };
 
 struct BrfUpdateSettings {
@@ -61,20 +76,24 @@ struct BrfStaticReceivers {
 };
 
 struct BrfResult {
-  std::vector<std::vector<glm::vec3>> direct;    ///< [object][vertex] direct irradiance (update_brf only).
-  std::vector<std::vector<glm::vec3>> indirect;  ///< [object][vertex] interreflected irradiance.
+  /// [object][k x vertex_count + vertex]: k = 0 irradiance, k >= 1 glossy terms (above).
+  std::vector<std::vector<glm::vec3>> direct;    ///< Direct light (update_brf only).
+  std::vector<std::vector<glm::vec3>> indirect;  ///< Interreflected light.
   std::vector<glm::vec3> static_irradiance;      ///< [static receiver] irradiance from all objects.
   std::size_t pairs_evaluated = 0;
   std::size_t pairs_culled = 0;
 };
 
-/// Per-vertex world-space positions and unit normals of an object.
+/// Per-vertex world-space positions and unit normals of an object; for a glossy object also
+/// the tangent frames (columns t, b, n in world space, from the object-space normals).
 struct BrfWorldVertices {
   std::vector<glm::vec3> positions, normals;
+  std::vector<glm::mat3> frames;
 };
 BrfWorldVertices brf_world_vertices(const BrfObject& object);
 
-/// Weights (per RGB channel, basis_count each) of per-vertex radiosity over an object.
+/// Weights (per RGB channel, terms x basis_count each, [k x basis_count + i]) of per-vertex
+/// values over an object, `radiosity` holding terms x vertex_count values ([k x V + j]).
 std::array<std::vector<float>, 3> brf_fit_rgb(const BrfBasis& basis, std::span<const glm::vec3> radiosity);
 
 /// An object's axis-aligned bounding box in its own space.
@@ -90,10 +109,19 @@ enum class BrfHorizon : std::uint8_t { Behind, InFront, Straddling };
 BrfHorizon brf_horizon(const BrfBox& box, const glm::vec3& p, const glm::vec3& n);
 
 /// The basis irradiance at world points p_j (unit normals n_j) from `source`'s field:
-/// out[j * basis_count + i] = Phi_i(p_j, n_j), 0 where the source is behind the receiver's
-/// tangent plane, the unclamped cosine where it is wholly in front (brf_horizon). out is resized.
+/// out[(j * K_r + k') * C + c] = Phi_(k',c)(p_j), C = source's channel_count(), 0 where the
+/// source is behind the receiver's tangent plane. For k' = 0 the irradiance lobe: the
+/// unclamped cosine where the source is wholly in front (brf_horizon), else the clamped
+/// cosine; for k' >= 1 (a glossy receiver: `receiver_glossy` and world `frames` given,
+/// K_r = 1 + its terms) the projection of g_k' cos rotated from the vertex's frame. out is resized.
 void brf_basis_irradiance(const BrfObject& source, std::span<const glm::vec3> positions,
-                          std::span<const glm::vec3> normals, std::vector<float>& out);
+                          std::span<const glm::vec3> normals, std::vector<float>& out,
+                          const BrdfSeparation* receiver_glossy = nullptr, std::span<const glm::mat3> frames = {});
+
+/// Radiance (W/(m^2 sr), RGB) leaving vertex j of `object` toward world direction w_out,
+/// from its per-vertex values `light` ([k x V + j], incoming light of all kinds summed).
+glm::vec3 brf_outgoing_radiance(const BrfObject& object, const BrfWorldVertices& vertices,
+                                std::span<const glm::vec3> light, std::size_t j, const glm::vec3& w_out);
 
 /// Pair culling (§5.4): culled[s * n + r] != 0 when the bound irradiance of source s at
 /// receiver r's centre (facing s, weights `weights[s]`) is at most threshold x the largest
@@ -107,8 +135,8 @@ std::vector<std::uint8_t> brf_pair_culling(std::span<const BrfObject> objects,
 std::vector<std::vector<glm::vec3>> brf_direct_light(std::span<const BrfObject> objects,
                                                      std::span<const PointEmitter> lights, const RayCaster* world);
 
-/// Steps 2a-2d from `incoming[object][vertex]`, the irradiance arriving from outside the
-/// objects. `direct` is left empty. Preconditions: sizes match the meshes; receiver spans
+/// Steps 2a-2d from `incoming[object][k x V + vertex]`, the light arriving from outside the
+/// objects (a diffuse object: its irradiance only). `direct` is left empty. Preconditions: sizes match the meshes; receiver spans
 /// have equal sizes.
 BrfResult brf_interreflect(std::span<const BrfObject> objects, std::span<const std::vector<glm::vec3>> incoming,
                            const BrfUpdateSettings& settings, const BrfStaticReceivers& receivers = {});

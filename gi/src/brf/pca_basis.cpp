@@ -6,6 +6,7 @@
 
 #include <Eigen/Dense>
 
+#include "brf/brdf_separation.h"
 #include "raytrace/embree_ray_caster.h"
 #include "raytrace/ray_offset.h"
 
@@ -69,7 +70,8 @@ std::vector<float> point_light_response(const BrfMesh& mesh, const RayCaster& ca
   return out;
 }
 
-engine::Result<BrfBasis> compute_pca_basis(const BrfMesh& mesh, const PcaBasisSettings& settings) {
+engine::Result<BrfBasis> compute_pca_basis(const BrfMesh& mesh, const PcaBasisSettings& settings,
+                                           const BrdfSeparation* glossy) {
   const std::size_t nv = mesh.positions.size();
   if (mesh.indices.empty() || mesh.indices.size() % 3 != 0)
     return engine::Error{.message = "basis radiance fields: the mesh has no triangles"};
@@ -99,14 +101,36 @@ engine::Result<BrfBasis> compute_pca_basis(const BrfMesh& mesh, const PcaBasisSe
   auto caster = make_embree_ray_caster(data);
   if (!caster) return caster.error();
 
-  // Training distributions B_eta, one column per light (§4.2).
+  // Training distributions B_eta, one column per light (§4.2); a glossy object adds one
+  // column per light and glossy term, L_k = g_k(w_light) E (eq. 8).
+  const int terms = 1 + (glossy != nullptr ? glossy->terms : 0);
+  out.terms = terms;
   const auto lights = static_cast<Eigen::Index>(settings.lights);
-  Eigen::MatrixXd c(static_cast<Eigen::Index>(nv), lights);
+  Eigen::MatrixXd c(static_cast<Eigen::Index>(nv), lights * terms);
   const std::vector<glm::vec3> dirs = sphere_points(settings.lights);
+  BrfMesh bare = mesh;
+  bare.reflectance.clear();
+  std::vector<glm::mat3> frames;
+  if (glossy != nullptr)
+    for (const glm::vec3& n : mesh.normals) frames.push_back(glm::transpose(brf_tangent_frame(n)));  // world -> local
   for (Eigen::Index k = 0; k < lights; ++k) {
     const glm::vec3 light = out.centre + dirs[static_cast<std::size_t>(k)] * (out.radius * settings.light_radius_scale);
-    const std::vector<float> b = point_light_response(mesh, **caster, light);
-    for (std::size_t j = 0; j < nv; ++j) c(static_cast<Eigen::Index>(j), k) = static_cast<double>(b[j]);
+    const std::vector<float> e = point_light_response(bare, **caster, light);  // irradiance
+    for (std::size_t j = 0; j < nv; ++j)
+      c(static_cast<Eigen::Index>(j), k) = static_cast<double>((mesh.reflectance.empty() ? 1.0f : mesh.reflectance[j]) * e[j]);
+    for (int t = 1; t < terms; ++t)
+      for (std::size_t j = 0; j < nv; ++j) {
+        const glm::vec3 w = frames[j] * glm::normalize(light - mesh.positions[j]);
+        c(static_cast<Eigen::Index>(j), t * lights + k) = e[j] > 0.0f ? static_cast<double>(glossy->g_at(t - 1, w) * e[j]) : 0.0;
+      }
+  }
+  // Each glossy term's block scaled to the diffuse block's norm (a black diffuse part: 1).
+  if (terms > 1) {
+    const double diffuse_norm = c.leftCols(lights).norm();
+    for (int t = 1; t < terms; ++t) {
+      const double norm = c.middleCols(t * lights, lights).norm();
+      if (norm > 0.0 && diffuse_norm > 0.0) c.middleCols(t * lights, lights) *= diffuse_norm / norm;
+    }
   }
   const Eigen::VectorXd mean = c.rowwise().mean();
   c.colwise() -= mean;

@@ -49,6 +49,7 @@ struct PcaBasisSettings {
 
 struct BrfBasis {
   std::size_t vertex_count = 0;
+  int terms = 1;                    ///< Distributions per vertex it was trained on: 1 + glossy terms.
   int basis_count = 0;              ///< N actually kept (<= requested).
   std::vector<float> psi;           ///< Psi_i(x_j) at psi[i * vertex_count + j]; Psi_0 is the normalized mean.
   std::vector<float> a_inverse;     ///< N x N, row-major: the (pseudo-)inverse of A.
@@ -69,7 +70,10 @@ struct BrfBasis {
 class RayCaster;
 std::vector<float> point_light_response(const BrfMesh& mesh, const RayCaster& caster, const glm::vec3& light);
 
+struct BrdfSeparation;
 /// Errors: no triangles, sizes inconsistent, non-finite values, settings out of range.
-engine::Result<BrfBasis> compute_pca_basis(const BrfMesh& mesh, const PcaBasisSettings& settings);
+/// `glossy`: the object's separated glossy lobe (nullptr: diffuse, K = 1).
+engine::Result<BrfBasis> compute_pca_basis(const BrfMesh& mesh, const PcaBasisSettings& settings,
+                                           const BrdfSeparation* glossy = nullptr);
 
 }  // namespace gi

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "brf/brdf_separation.h"
 #include "brf/spherical_harmonics.h"
 #include "core/thread_pool.h"
 #include "raytrace/embree_ray_caster.h"
@@ -49,7 +50,7 @@ float BasisRadianceField::sphere_radius(int s) const {
 }
 
 void BasisRadianceField::sample(const glm::vec3& p, std::span<float> out) const {
-  const auto per_point = static_cast<std::size_t>(basis_count * coefficient_count());
+  const auto per_point = static_cast<std::size_t>(channel_count() * coefficient_count());
   std::fill(out.begin(), out.begin() + static_cast<std::ptrdiff_t>(per_point), 0.0f);
   const glm::vec3 d = p - centre;
   const float r = glm::length(d);
@@ -103,9 +104,14 @@ void BasisRadianceField::sample(const glm::vec3& p, std::span<float> out) const 
 }
 
 engine::Result<BasisRadianceField> compute_basis_radiance_field(const BrfMesh& mesh, const BrfBasis& basis,
-                                                               const RadianceFieldSettings& settings) {
+                                                               const RadianceFieldSettings& settings,
+                                                               const BrdfSeparation* glossy) {
   if (basis.vertex_count != mesh.positions.size() || basis.basis_count < 1)
     return engine::Error{.message = "basis radiance field: the basis does not belong to this mesh"};
+  const int terms = 1 + (glossy != nullptr ? glossy->terms : 0);
+  if (basis.terms != terms)
+    return engine::Error{.message = "basis radiance field: the basis was trained for " + std::to_string(basis.terms) +
+                                    " BRDF terms, the material has " + std::to_string(terms)};
   if (settings.spheres < 1 || settings.spheres > 256 || settings.face_resolution < 1 || settings.face_resolution > 256 ||
       (settings.sh_bands != 3 && settings.sh_bands != 4) || settings.directions < 16 || settings.directions > 65536 ||
       !(settings.inner_radius_scale > 0.0f) || !(settings.outer_radius_scale >= settings.inner_radius_scale))
@@ -116,11 +122,13 @@ engine::Result<BasisRadianceField> compute_basis_radiance_field(const BrfMesh& m
   field.face_resolution = settings.face_resolution;
   field.sh_bands = settings.sh_bands;
   field.basis_count = basis.basis_count;
+  field.terms = terms;
   field.centre = basis.centre;
   field.inner_radius = basis.radius * settings.inner_radius_scale;
   field.outer_radius = basis.radius * settings.outer_radius_scale;
   const auto coefs = static_cast<std::size_t>(field.coefficient_count());
-  const auto per_point = static_cast<std::size_t>(field.basis_count) * coefs;
+  const auto per_point = static_cast<std::size_t>(field.channel_count()) * coefs;
+  const std::size_t nb = static_cast<std::size_t>(field.basis_count);
   const std::size_t res = static_cast<std::size_t>(settings.face_resolution);
   const std::size_t points = static_cast<std::size_t>(settings.spheres) * 6 * res * res;
   field.coefficients.assign(points * per_point, 0.0f);
@@ -172,12 +180,20 @@ engine::Result<BasisRadianceField> compute_basis_radiance_field(const BrfMesh& m
           const auto y = sh_basis(dir);
           const std::uint32_t* tri = mesh.indices.data() + 3 * static_cast<std::size_t>(h.primitive);
           const float b1 = h.barycentric.x, b2 = h.barycentric.y, b0 = 1.0f - b1 - b2;
-          for (std::size_t i = 0; i < static_cast<std::size_t>(field.basis_count); ++i) {
-            const float* psi = basis.psi.data() + i * nv;
-            // Radiance of a diffuse surface of radiosity Psi_i: Psi_i / pi (h(w) = 1/pi, K = 1).
-            const float radiance = (b0 * psi[tri[0]] + b1 * psi[tri[1]] + b2 * psi[tri[2]]) * inv_pi * solid_angle;
-            for (std::size_t c = 0; c < coefs; ++c) out[i * coefs + c] += radiance * y[c];
+          // h_k toward the sample point, in the hit's tangent frame (interpolated normal).
+          float h_out[1 + kMaxGlossyTerms];
+          h_out[0] = inv_pi;  // the diffuse term: radiance of radiosity Psi_i is Psi_i / pi
+          if (terms > 1) {
+            const glm::vec3 n = glm::normalize(b0 * mesh.normals[tri[0]] + b1 * mesh.normals[tri[1]] + b2 * mesh.normals[tri[2]]);
+            const glm::vec3 w = glm::transpose(brf_tangent_frame(n)) * -dir;
+            for (int term = 1; term < terms; ++term) h_out[term] = glossy->h_at(term - 1, w);
           }
+          for (std::size_t term = 0; term < static_cast<std::size_t>(terms); ++term)
+            for (std::size_t i = 0; i < nb; ++i) {
+              const float* psi = basis.psi.data() + i * nv;
+              const float radiance = (b0 * psi[tri[0]] + b1 * psi[tri[1]] + b2 * psi[tri[2]]) * h_out[term] * solid_angle;
+              for (std::size_t c = 0; c < coefs; ++c) out[(term * nb + i) * coefs + c] += radiance * y[c];
+            }
         }
       },
       4);

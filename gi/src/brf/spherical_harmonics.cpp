@@ -1,7 +1,11 @@
 #include "brf/spherical_harmonics.h"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <vector>
+
+#include <Eigen/Dense>
 
 namespace gi {
 
@@ -49,6 +53,77 @@ std::array<float, kMaxShCoefficients> sh_cosine(const glm::vec3& n) {
   std::array<float, kMaxShCoefficients> out{};
   for (std::size_t i = 1; i < 4; ++i) out[i] = 4.0f * std::numbers::pi_v<float> / 3.0f * y[i];
   return out;
+}
+
+namespace {
+
+// Fixed directions D (a Fibonacci spiral, turned off the axes so no symmetry of the basis
+// meets them) and, per band l >= 1, the least-squares inverse of the band's basis matrix
+// over them, (Y_l^T Y_l)^-1 Y_l^T, in double precision once. More directions than 2l + 1
+// keep every band well conditioned; for band-limited functions the fit is exact.
+struct BandFrames {
+  static constexpr int kDirections = 26;
+  std::vector<glm::vec3> dirs;
+  std::array<Eigen::MatrixXd, kMaxShBands> pinv;
+  BandFrames() {
+    const double golden = std::numbers::pi * (3.0 - std::sqrt(5.0));
+    for (int n = 0; n < kDirections; ++n) {
+      const double z = 1.0 - (2.0 * n + 1.0) / kDirections;
+      const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
+      const double phi = golden * n + 0.3;
+      const double x = r * std::cos(phi), y = r * std::sin(phi);
+      dirs.push_back(glm::normalize(glm::vec3(static_cast<float>(x), static_cast<float>(y * std::cos(0.4) - z * std::sin(0.4)),
+                                              static_cast<float>(y * std::sin(0.4) + z * std::cos(0.4)))));
+    }
+    for (int l = 1; l < kMaxShBands; ++l) {
+      const int count = 2 * l + 1;
+      Eigen::MatrixXd y(kDirections, count);
+      for (int n = 0; n < kDirections; ++n) {
+        const auto b = sh_basis(dirs[static_cast<std::size_t>(n)]);
+        for (int m = 0; m < count; ++m) y(n, m) = static_cast<double>(b[static_cast<std::size_t>(l * l + m)]);
+      }
+      pinv[static_cast<std::size_t>(l)] = (y.transpose() * y).inverse() * y.transpose();
+    }
+  }
+};
+
+const BandFrames& band_frames() {
+  static const BandFrames frames;
+  return frames;
+}
+
+}  // namespace
+
+ShRotation::ShRotation(const glm::mat3& r) {
+  const BandFrames& frames = band_frames();
+  const glm::mat3 rt = glm::transpose(r);
+  std::array<std::array<float, kMaxShCoefficients>, BandFrames::kDirections> yr;
+  for (std::size_t n = 0; n < yr.size(); ++n) yr[n] = sh_basis(rt * frames.dirs[n]);
+  m_[0] = 1.0f;
+  for (int l = 1; l < kMaxShBands; ++l) {
+    const int count = 2 * l + 1;
+    const Eigen::MatrixXd& pinv = frames.pinv[static_cast<std::size_t>(l)];
+    for (int a = 0; a < count; ++a)
+      for (int c = 0; c < count; ++c) {
+        double s = 0.0;
+        for (int n = 0; n < BandFrames::kDirections; ++n)
+          s += pinv(a, n) * static_cast<double>(yr[static_cast<std::size_t>(n)][static_cast<std::size_t>(l * l + c)]);
+        m_[kOffset[l] + static_cast<std::size_t>(a * count + c)] = static_cast<float>(s);
+      }
+  }
+}
+
+void ShRotation::apply(std::span<const float> in, std::span<float> out, int bands) const {
+  out[0] = in[0];
+  for (int l = 1; l < bands && l < kMaxShBands; ++l) {
+    const int count = 2 * l + 1;
+    const float* b = block(l);
+    for (int a = 0; a < count; ++a) {
+      float s = 0.0f;
+      for (int c = 0; c < count; ++c) s += b[a * count + c] * in[static_cast<std::size_t>(l * l + c)];
+      out[static_cast<std::size_t>(l * l + a)] = s;
+    }
+  }
 }
 
 }  // namespace gi

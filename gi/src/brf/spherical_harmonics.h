@@ -38,4 +38,25 @@ std::array<float, kMaxShCoefficients> sh_clamped_cosine(const glm::vec3& n, int 
 /// truncation of the clamped lobe's higher bands, no ringing.
 std::array<float, kMaxShCoefficients> sh_cosine(const glm::vec3& n);
 
+/// A rotation of SH coefficients (bands < 4): for f given by `in` in one frame, apply()
+/// gives the coefficients of the same function seen in another frame, f(R^T w), where R
+/// (orthonormal) maps the first frame's directions into the second's. Rotations keep bands
+/// apart, so each band is a (2l + 1)^2 block, built by evaluating the basis at 2l + 1
+/// fixed directions d_n and at R^T d_n: M_l = Y_l(D)^-1 Y_l(R^T D) (exact for band-limited
+/// functions; the direction sets are chosen well conditioned).
+///   gi::ShRotation rot(frame_to_world);       // columns: the frame's axes in world space
+///   rot.apply(local_coeffs, world_coeffs, 4);
+class ShRotation {
+ public:
+  explicit ShRotation(const glm::mat3& r);
+  /// out[0 .. bands^2) from in[0 .. bands^2); in and out must not overlap.
+  void apply(std::span<const float> in, std::span<float> out, int bands) const;
+  /// The band-l block, row-major ((2l + 1) x (2l + 1)): out_l = block(l) in_l.
+  const float* block(int l) const { return m_.data() + kOffset[l]; }
+
+ private:
+  static constexpr std::size_t kOffset[kMaxShBands] = {0, 1, 10, 35};
+  std::array<float, 84> m_{};
+};
+
 }  // namespace gi
