@@ -280,7 +280,7 @@ TEST(BrfIo, DamagedContainersAreRejected) {
   poke_file(file, 0, 'X');  // magic
   EXPECT_NE(read_error(file).find("wrong magic"), std::string::npos);
   restore();
-  poke_file(file, 8, 2);  // version
+  poke_file(file, 8, 1);  // version 1: before glossy terms
   EXPECT_NE(read_error(file).find("unsupported version"), std::string::npos);
   restore();
   poke_file(file, fs::file_size(file) - 5, 0xa5);  // payload bit flips
@@ -338,10 +338,10 @@ TEST(BrfIo, InconsistentPayloadsAreRejected) {
   put_payload(file, p);
   EXPECT_NE(read_error(file).find("vertex_count"), std::string::npos);
 
-  // The field header: spheres (after psi, a_inverse and singular_values).
+  // The field header: spheres (after psi, a_inverse, singular_values and the basis's terms).
   const std::size_t a_inv = o.psi_data + b.basis.psi.size() * 4;
   const std::size_t sv = a_inv + 8 + b.basis.a_inverse.size() * 4;
-  const std::size_t spheres = sv + 8 + b.basis.singular_values.size() * 4;
+  const std::size_t spheres = sv + 8 + b.basis.singular_values.size() * 4 + 4;
   p = original;
   poke(p, spheres, std::int32_t{100000});
   put_payload(file, p);
@@ -351,7 +351,7 @@ TEST(BrfIo, InconsistentPayloadsAreRejected) {
   put_payload(file, p);
   EXPECT_NE(read_error(file).find("coefficient bytes"), std::string::npos);
   // coefficient_bytes and the frame's own size disagree.
-  const std::size_t coefficient_bytes = spheres + 16 + 12 + 8;
+  const std::size_t coefficient_bytes = spheres + 20 + 12 + 8;
   p = original;
   poke(p, coefficient_bytes, static_cast<std::uint64_t>(b.field.bytes() + 4));
   put_payload(file, p);

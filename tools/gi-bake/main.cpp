@@ -113,6 +113,10 @@ int bake_brf_method(const engine::Scene& scene, const engine::SceneAsset& asset,
                 s.name.c_str(), s.mesh.positions.size(), s.entities.size(), mesh->basis.basis_count, b.basis,
                 mesh->basis.condition, static_cast<double>(mesh->field.bytes()) / 1e6,
                 mesh->basis_seconds + mesh->field_seconds);
+    if (mesh->glossy)
+      std::printf("  %-16s glossy (GGX alpha %.3f, f0 %.2f): %d BRDF terms, weighted BRDF error %.2f\n", "",
+                  static_cast<double>(mesh->glossy->lobe.alpha), static_cast<double>(mesh->glossy->lobe.f0),
+                  mesh->glossy->terms, static_cast<double>(mesh->glossy->relative_error));
     bake.meshes.push_back(std::move(mesh).value());
   }
   if (auto saved = gi::save_brf(out_dir, bake, asset, scene_file.filename().string()); !saved) {

@@ -24,10 +24,13 @@ engine::Result<BrfSettings> brf_preset(std::string_view name) {
   } else if (name == "high") {
     s.basis.lights = 256, s.basis.basis = 16;
     s.field.spheres = 16, s.field.face_resolution = 16, s.field.directions = 256;
+    s.glossy.resolution = 24;
   } else {
     return engine::Error{.message = "unknown BRF preset '" + std::string(name) + "' (preview, medium, high)"};
   }
   s.field.sh_bands = 3;
+  s.glossy.terms = 4;
+  if (name != "high") s.glossy.resolution = 16;
   return s;
 }
 
@@ -40,11 +43,17 @@ engine::Result<BrfMeshBake> bake_brf_mesh(const BrfSource& source, const BrfSett
   out.name = source.name;
   out.mesh_hash = source.mesh_hash;
   auto start = std::chrono::steady_clock::now();
-  auto basis = compute_pca_basis(source.mesh, settings.basis);
+  if (source.glossy) {
+    auto sep = separate_glossy_brdf(*source.glossy, settings.glossy);
+    if (!sep) return prefixed(sep.error());
+    out.glossy = std::move(sep).value();
+  }
+  const BrdfSeparation* glossy = out.glossy ? &*out.glossy : nullptr;
+  auto basis = compute_pca_basis(source.mesh, settings.basis, glossy);
   if (!basis) return prefixed(basis.error());
   out.basis_seconds = seconds_since(start);
   start = std::chrono::steady_clock::now();
-  auto field = compute_basis_radiance_field(source.mesh, *basis, settings.field);
+  auto field = compute_basis_radiance_field(source.mesh, *basis, settings.field, glossy);
   if (!field) return prefixed(field.error());
   out.field_seconds = seconds_since(start);
   out.basis = std::move(basis).value();

@@ -9,7 +9,10 @@
 //   preview 128 lights, N = 16,  8 spheres x 6x8x8 points,   3 bands, 128 directions
 //   medium  256 lights, N = 16, 12 spheres x 6x12x12 points, 3 bands, 128 directions
 //   high    256 lights, N = 16, 16 spheres x 6x16x16 points, 3 bands, 256 directions (the paper's)
+// Glossy meshes (BrfSource::glossy) get K = 4 glossy terms (the default) from a
+// 16 x 16 (preview, medium) or 24 x 24 (high) hemisphere table.
 
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -25,6 +28,7 @@ namespace gi {
 struct BrfSettings {
   PcaBasisSettings basis;
   RadianceFieldSettings field;
+  BrdfSeparationSettings glossy;  ///< For glossy meshes only.
 };
 
 /// "preview", "medium" or "high" (above); error naming the valid names otherwise.
@@ -36,12 +40,13 @@ struct BrfMeshBake {
   std::string mesh_hash;  ///< BrfSource::mesh_hash of the mesh baked.
   BrfBasis basis;
   BasisRadianceField field;
+  std::optional<BrdfSeparation> glossy;  ///< The separated lobe of a glossy mesh.
   double basis_seconds = 0.0;  ///< Wall time of compute_pca_basis.
   double field_seconds = 0.0;  ///< Wall time of compute_basis_radiance_field.
 };
 
-/// Bakes `source.mesh`: compute_pca_basis with settings.basis, then
-/// compute_basis_radiance_field with settings.field. Errors: those of the two steps,
+/// Bakes `source.mesh`: for a glossy source separate_glossy_brdf with settings.glossy, then
+/// compute_pca_basis with settings.basis, then compute_basis_radiance_field with settings.field. Errors: those of the two steps,
 /// prefixed with the source's name.
 engine::Result<BrfMeshBake> bake_brf_mesh(const BrfSource& source, const BrfSettings& settings);
 

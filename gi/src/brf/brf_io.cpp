@@ -52,12 +52,31 @@ bool is_hex16(const std::string& s) {
 }
 
 // The raw coefficient count a field's header implies (0 when out of range).
-std::uint64_t field_values(int spheres, int res, int bands, int basis) {
+std::uint64_t field_values(int spheres, int res, int bands, int basis, int terms) {
   if (spheres < 1 || spheres > kMaxSpheres || res < 1 || res > kMaxFaceResolution || (bands != 3 && bands != 4) ||
-      basis < 1 || basis > kMaxBasis)
+      basis < 1 || basis > kMaxBasis || terms < 1 || terms > 1 + kMaxGlossyTerms)
     return 0;
   return static_cast<std::uint64_t>(spheres) * 6 * static_cast<std::uint64_t>(res) * static_cast<std::uint64_t>(res) *
-         static_cast<std::uint64_t>(basis) * static_cast<std::uint64_t>(bands) * static_cast<std::uint64_t>(bands);
+         static_cast<std::uint64_t>(basis) * static_cast<std::uint64_t>(terms) * static_cast<std::uint64_t>(bands) *
+         static_cast<std::uint64_t>(bands);
+}
+
+// Empty when a glossy separation's tables fit its header and hold finite values.
+std::string check_glossy(const BrdfSeparation& g) {
+  if (g.terms < 1 || g.terms > kMaxGlossyTerms || g.resolution < 4 || g.resolution > 64)
+    return "glossy separation: " + std::to_string(g.terms) + " terms at resolution " + std::to_string(g.resolution) +
+           " (1..15 terms, 4..64 expected)";
+  if (!(g.lobe.f0 > 0.0f && g.lobe.f0 <= 1.0f) || !(g.lobe.alpha > 0.0f && g.lobe.alpha <= 1.0f) ||
+      !std::isfinite(g.relative_error))
+    return "glossy separation: f0 and alpha must lie in (0, 1] and the error be finite";
+  const auto cells = static_cast<std::uint64_t>(g.terms) * static_cast<std::uint64_t>(g.resolution * g.resolution);
+  if (g.g.size() != cells || g.h.size() != cells || g.lobe_sh.size() != static_cast<std::uint64_t>(g.terms) * kMaxShCoefficients ||
+      g.singular_values.size() > 4096)
+    return "glossy separation: table sizes do not match " + std::to_string(g.terms) + " terms at resolution " +
+           std::to_string(g.resolution);
+  for (const std::vector<float>* v : {&g.g, &g.h, &g.lobe_sh, &g.singular_values})
+    if (std::size_t i = first_non_finite(*v); i != std::string::npos) return "glossy separation value " + str(i) + " is NaN or infinite";
+  return {};
 }
 
 // Empty when the bake's parts fit together and hold finite values, else what is wrong.
@@ -88,7 +107,13 @@ std::string check_bake(const BrfMeshBake& b) {
   if (std::size_t i = first_non_finite(s.singular_values); i != std::string::npos)
     return "singular value " + str(i) + " is NaN or infinite";
   const BasisRadianceField& f = b.field;
-  const std::uint64_t values = field_values(f.spheres, f.face_resolution, f.sh_bands, f.basis_count);
+  const int terms = 1 + (b.glossy ? b.glossy->terms : 0);
+  if (b.glossy)
+    if (std::string problem = check_glossy(*b.glossy); !problem.empty()) return problem;
+  if (s.terms != terms || f.terms != terms)
+    return "BRDF terms disagree: the basis was trained for " + std::to_string(s.terms) + ", the field holds " +
+           std::to_string(f.terms) + ", the material has " + std::to_string(terms);
+  const std::uint64_t values = field_values(f.spheres, f.face_resolution, f.sh_bands, f.basis_count, f.terms);
   if (values == 0)
     return "field settings out of range (spheres " + std::to_string(f.spheres) + ", face_resolution " +
            std::to_string(f.face_resolution) + ", sh_bands " + std::to_string(f.sh_bands) + ", basis_count " +
@@ -101,8 +126,8 @@ std::string check_bake(const BrfMeshBake& b) {
     return "the field's centre and radii are not finite with 0 < inner_radius <= outer_radius";
   if (f.coefficients.size() != values)
     return "the field has " + str(f.coefficients.size()) + " coefficients, " + std::to_string(f.spheres) +
-           " spheres x 6 x " + std::to_string(f.face_resolution) + "^2 points x " + std::to_string(f.basis_count) +
-           " functions x " + std::to_string(f.coefficient_count()) + " = " + str(values) + " expected";
+           " spheres x 6 x " + std::to_string(f.face_resolution) + "^2 points x " + std::to_string(f.channel_count()) +
+           " channels x " + std::to_string(f.coefficient_count()) + " = " + str(values) + " expected";
   if (std::size_t i = first_non_finite(f.coefficients); i != std::string::npos)
     return "field coefficient " + str(i) + " is NaN or infinite";
   return {};
@@ -204,15 +229,29 @@ engine::Status write_brf_mesh(const fs::path& path, const BrfMeshBake& bake, std
   w.put_array(as_span(b.psi));
   w.put_array(as_span(b.a_inverse));
   w.put_array(as_span(b.singular_values));
+  w.put(static_cast<std::int32_t>(b.terms));
   w.put(static_cast<std::int32_t>(f.spheres));
   w.put(static_cast<std::int32_t>(f.face_resolution));
   w.put(static_cast<std::int32_t>(f.sh_bands));
   w.put(static_cast<std::int32_t>(f.basis_count));
+  w.put(static_cast<std::int32_t>(f.terms));
   w.put(f.centre);
   w.put(f.inner_radius);
   w.put(f.outer_radius);
   w.put(static_cast<std::uint64_t>(planes.size()));
   w.put_array(as_span(frame));
+  w.put(static_cast<std::int32_t>(bake.glossy ? bake.glossy->terms : 0));
+  if (bake.glossy) {
+    const BrdfSeparation& g = *bake.glossy;
+    w.put(g.lobe.f0);
+    w.put(g.lobe.alpha);
+    w.put(static_cast<std::int32_t>(g.resolution));
+    w.put(g.relative_error);
+    w.put_array(as_span(g.g));
+    w.put_array(as_span(g.h));
+    w.put_array(as_span(g.lobe_sh));
+    w.put_array(as_span(g.singular_values));
+  }
   return write_blob(path, kBrfMeshMagic, kBrfMeshVersion, w.bytes());
 }
 
@@ -224,14 +263,23 @@ engine::Result<BrfMeshBake> read_brf_mesh(const fs::path& path) {
   BrfBasis& b = out.basis;
   BasisRadianceField& f = out.field;
   std::uint64_t vertex_count = 0, coefficient_bytes = 0;
-  std::int32_t basis_count = 0, spheres = 0, res = 0, bands = 0, field_basis = 0;
+  std::int32_t basis_count = 0, basis_terms = 0, spheres = 0, res = 0, bands = 0, field_basis = 0, field_terms = 0,
+               glossy_terms = 0;
   std::vector<std::uint8_t> frame;
-  const bool complete = r.get_string(out.name) && r.get_string(out.mesh_hash) && r.get(vertex_count) &&
-                        r.get(basis_count) && r.get(b.condition) && r.get(b.centre) && r.get(b.radius) &&
-                        r.get_array(b.psi) && r.get_array(b.a_inverse) && r.get_array(b.singular_values) &&
-                        r.get(spheres) && r.get(res) && r.get(bands) && r.get(field_basis) && r.get(f.centre) &&
-                        r.get(f.inner_radius) && r.get(f.outer_radius) && r.get(coefficient_bytes) &&
-                        r.get_array(frame);
+  bool complete = r.get_string(out.name) && r.get_string(out.mesh_hash) && r.get(vertex_count) && r.get(basis_count) &&
+                  r.get(b.condition) && r.get(b.centre) && r.get(b.radius) && r.get_array(b.psi) &&
+                  r.get_array(b.a_inverse) && r.get_array(b.singular_values) && r.get(basis_terms) && r.get(spheres) &&
+                  r.get(res) && r.get(bands) && r.get(field_basis) && r.get(field_terms) && r.get(f.centre) &&
+                  r.get(f.inner_radius) && r.get(f.outer_radius) && r.get(coefficient_bytes) && r.get_array(frame) &&
+                  r.get(glossy_terms);
+  if (complete && glossy_terms != 0) {
+    BrdfSeparation& g = out.glossy.emplace();
+    std::int32_t table = 0;
+    complete = r.get(g.lobe.f0) && r.get(g.lobe.alpha) && r.get(table) && r.get(g.relative_error) && r.get_array(g.g) &&
+               r.get_array(g.h) && r.get_array(g.lobe_sh) && r.get_array(g.singular_values);
+    g.terms = glossy_terms;
+    g.resolution = table;
+  }
   const std::string location = "payload byte " + std::to_string(r.offset());
   if (!complete) return file_error(path, location, "truncated payload");
   if (r.remaining() != 0) return file_error(path, location, "unexpected data after the last field");
@@ -239,18 +287,20 @@ engine::Result<BrfMeshBake> read_brf_mesh(const fs::path& path) {
     return file_error(path, "vertex_count", "vertex_count " + str(vertex_count) + " is outside 1..2^31");
   b.vertex_count = static_cast<std::size_t>(vertex_count);
   b.basis_count = basis_count;
+  b.terms = basis_terms;
+  f.terms = field_terms;
   f.spheres = spheres;
   f.face_resolution = res;
   f.sh_bands = bands;
   f.basis_count = field_basis;
 
   // Sizes before the coefficients are allocated: a corrupt count must not ask for gigabytes.
-  const std::uint64_t values = field_values(spheres, res, bands, field_basis);
+  const std::uint64_t values = field_values(spheres, res, bands, field_basis, field_terms);
   if (values == 0)
     return file_error(path, "field",
                       "field settings out of range (spheres " + std::to_string(spheres) + ", face_resolution " +
                           std::to_string(res) + ", sh_bands " + std::to_string(bands) + ", basis_count " +
-                          std::to_string(field_basis) + ")");
+                          std::to_string(field_basis) + ", terms " + std::to_string(field_terms) + ")");
   if (coefficient_bytes != values * 4)
     return file_error(path, "coefficient_bytes",
                       "the file says " + str(coefficient_bytes) + " coefficient bytes, " + str(values) +
@@ -312,6 +362,8 @@ engine::Status save_brf(const fs::path& bundle_dir, const BrfBake& bake, const e
                           {"basis_requested", bake.settings.basis.basis},
                           {"basis_kept", m.basis.basis_count},
                           {"condition", m.basis.condition},
+                          {"glossy_terms", m.glossy ? m.glossy->terms : 0},
+                          {"glossy_brdf_error", m.glossy ? static_cast<double>(m.glossy->relative_error) : 0.0},
                           {"field_bytes", static_cast<std::uint64_t>(m.field.bytes())},
                           {"field_compressed_bytes", compressed},
                           {"file_bytes", static_cast<std::uint64_t>(file_bytes)},

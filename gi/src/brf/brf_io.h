@@ -5,13 +5,14 @@
 //   auto brf = gi::load_brf("level.gibake", scene);   // checks every mesh's hash
 //
 // Files (DESIGN.md §5, docs/bake-bundle.md):
-//   brf_<name>.bin  the checksummed container of bake/blob_file.h, magic "GIBRFMSH", version 1;
+//   brf_<name>.bin  the checksummed container of bake/blob_file.h, magic "GIBRFMSH", version 2;
 //                   <name> is BrfSource::name ([A-Za-z0-9_-], unique in the scene).
 //   manifest.json   methods.brf = {
 //     "files":    { "<name>": {"file": "brf_<name>.bin", "fnv1a64": "<hex of the whole file>"}, ... },
 //     "settings": { "basis": { PcaBasisSettings' fields }, "field": { RadianceFieldSettings' fields } },
 //     "meshes":   { "<name>": { "mesh_hash", "mesh_index", "entities", "vertices", "basis_requested",
-//                               "basis_kept", "condition", "field_bytes" (raw float32 coefficients),
+//                               "basis_kept", "condition", "glossy_terms" (0: diffuse), "glossy_brdf_error",
+//                               "field_bytes" (raw float32 coefficients),
 //                               "field_compressed_bytes" (their zstd frame), "file_bytes",
 //                               "basis_seconds", "field_seconds", "bake_seconds" }, ... } }
 // A BRF depends on its mesh only (object space), not on the static world or the lights, so
@@ -31,13 +32,20 @@
 //   array<float32> psi                 N x V, psi[i * V + j] = Psi_i(x_j)
 //   array<float32> a_inverse           N x N, row-major
 //   array<float32> singular_values     descending, at most 65536
+//   int32          terms               K it was trained on: 1 + glossy terms
 //   -- the basis radiance field (BasisRadianceField) --
 //   int32 spheres (1..256), int32 face_resolution (1..256), int32 sh_bands (3 or 4),
-//   int32 basis_count (= N)
+//   int32 basis_count (= N), int32 terms (= K)
 //   vec3           centre
 //   float32        inner_radius, float32 outer_radius     0 < inner <= outer
-//   uint64         coefficient_bytes   S x 6 x R^2 x N x B^2 x 4: the raw float32 size
+//   uint64         coefficient_bytes   S x 6 x R^2 x K x N x B^2 x 4: the raw float32 size
 //   array<uint8>   coefficients_zstd   one zstd frame (content size and checksum recorded)
+//   -- the glossy separation (BrdfSeparation), for a glossy mesh --
+//   int32          glossy_terms        0: diffuse, nothing follows; else 1..15 and:
+//   float32 f0, float32 alpha, int32 resolution (4..64), float32 relative_error
+//   array<float32> g, h                glossy_terms x resolution^2 each
+//   array<float32> lobe_sh             glossy_terms x 16
+//   array<float32> singular_values     at most 4096
 // Nothing follows (trailing bytes are an error). The frame decompresses to the coefficients
 // in BasisRadianceField::coefficients' order, as float32 split into four byte planes (every
 // value's byte 0, then every byte 1, 2, 3): lossless, so a load is bit-exact, and the
@@ -61,7 +69,7 @@ namespace gi {
 
 inline constexpr const char* kBrfMethod = "brf";
 inline constexpr BlobMagic kBrfMeshMagic{"GIBRFMSH"};
-inline constexpr std::uint32_t kBrfMeshVersion = 1;
+inline constexpr std::uint32_t kBrfMeshVersion = 2;
 
 /// A scene's BRF bake: the settings and one BrfMeshBake per dynamic mesh.
 struct BrfBake {

@@ -13,6 +13,7 @@
 #include "bake/light_signature.h"
 #include "bake/static_scene.h"
 #include "brf/brf_gpu_pass.h"
+#include "brf/spherical_harmonics.h"
 #include "gpu/gi_shaders.h"
 #include "light_atlas/point_emitters.h"
 #include "raytrace/ray_caster.h"
@@ -168,7 +169,8 @@ bool BrfLighting::update() {
   std::vector<BrfGpuInstance> gpu_instances;
   for (std::size_t i = 0; i < m.instances.size(); ++i) {
     const BrfModelData& model = m.models[m.instances[i].model];
-    objects.push_back({&model.mesh, &model.basis, &model.field, m.transforms[i], m.instances[i].albedo});
+    objects.push_back({&model.mesh, &model.basis, &model.field, m.transforms[i], m.instances[i].albedo,
+                       model.glossy ? &*model.glossy : nullptr, m.instances[i].specular});
     gpu_instances.push_back({m.instances[i].model, m.transforms[i], m.instances[i].albedo});
   }
   // Direct light from every enabled light (static and moving), shadowed by objects and world.
@@ -180,10 +182,26 @@ bool BrfLighting::update() {
   for (std::size_t i = 0; i < objects.size(); ++i) {
     if (moved[i] != 0) {
       const BrfWorldVertices v = brf_world_vertices(objects[i]);
-      m.world_incoming[i].assign(v.positions.size(), glm::vec3(0.0f));
+      const std::size_t nv = v.positions.size();
+      m.world_incoming[i].assign(incoming[i].size(), glm::vec3(0.0f));
       if (m.world.probes)
-        for (std::size_t j = 0; j < v.positions.size(); ++j)
+        for (std::size_t j = 0; j < nv; ++j) {
           m.world_incoming[i][j] = m.world.probes->irradiance(v.positions[j], v.normals[j]);
+          const BrdfSeparation* glossy = objects[i].glossy;
+          if (glossy == nullptr) continue;
+          // A glossy vertex's E_k: the probes' radiance against g_k cos, turned from the
+          // vertex's frame into the world's.
+          std::array<glm::vec3, 9> radiance;
+          if (!m.world.probes->radiance(v.positions[j], radiance)) continue;
+          const ShRotation to_world(v.frames[j]);
+          std::array<float, kMaxShCoefficients> lobe{};
+          for (int k = 1; k <= glossy->terms; ++k) {
+            to_world.apply(glossy->lobe_coefficients(k - 1), lobe, 3);
+            glm::vec3 e(0.0f);
+            for (std::size_t c = 0; c < 9; ++c) e += lobe[c] * radiance[c];
+            m.world_incoming[i][static_cast<std::size_t>(k) * nv + j] = e;
+          }
+        }
       std::vector<glm::vec4> packed(std::max<std::size_t>(v.positions.size(), 1), glm::vec4(0.0f));
       for (std::size_t j = 0; j < v.positions.size(); ++j) packed[j] = glm::vec4(m.world_incoming[i][j], 0.0f);
       glNamedBufferSubData(m.world_light[i].id(), 0, static_cast<GLsizeiptr>(packed.size() * sizeof(glm::vec4)), packed.data());

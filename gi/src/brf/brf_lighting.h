@@ -45,13 +45,16 @@ struct BrfModelData {
   BrfMesh mesh;
   BrfBasis basis;
   BasisRadianceField field;
+  std::optional<BrdfSeparation> glossy;  ///< A glossy mesh's separated lobe.
 };
 
-/// A dynamic entity drawn with model `model`, diffuse albedo `albedo`.
+/// A dynamic entity drawn with model `model`, diffuse albedo `albedo` (and, for a glossy
+/// model, glossy colour `specular`, BrfObject::specular).
 struct BrfInstanceBinding {
   engine::Entity entity;
   std::uint32_t model = 0;
   glm::vec3 albedo{0.8f};
+  glm::vec3 specular{1.0f};
 };
 
 /// The static world's part (every member optional).

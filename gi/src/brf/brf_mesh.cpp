@@ -37,7 +37,21 @@ std::string lower(std::string s) {
 
 }  // namespace
 
-std::string brf_mesh_hash(const BrfMesh& mesh) {
+namespace {
+
+// The (first) material a source is drawn with; the glTF default material when none.
+engine::Material source_material(const engine::SceneAsset& asset, const BrfSource& source) {
+  int material = source.material_override;
+  if (material < 0 && source.mesh_index < asset.meshes.size() && !asset.meshes[source.mesh_index].primitives.empty())
+    material = asset.meshes[source.mesh_index].primitives.front().material;
+  return material >= 0 && static_cast<std::size_t>(material) < asset.materials.size()
+             ? asset.materials[static_cast<std::size_t>(material)]
+             : engine::Material{};
+}
+
+}  // namespace
+
+std::string brf_mesh_hash(const BrfMesh& mesh, const std::optional<GlossyLobe>& glossy) {
   ContentHash h;
   h.add_value(static_cast<std::uint64_t>(mesh.positions.size()));
   for (const glm::vec3& p : mesh.positions) h.add_value(p.x), h.add_value(p.y), h.add_value(p.z);
@@ -45,6 +59,7 @@ std::string brf_mesh_hash(const BrfMesh& mesh) {
   for (const glm::vec3& n : mesh.normals) h.add_value(n.x), h.add_value(n.y), h.add_value(n.z);
   h.add_values(std::span<const std::uint32_t>(mesh.indices));
   h.add_values(std::span<const float>(mesh.reflectance));
+  if (glossy) h.add_value(glossy->f0), h.add_value(glossy->alpha);
   return h.hex();
 }
 
@@ -126,21 +141,26 @@ engine::Result<std::vector<BrfSource>> dynamic_brf_meshes(const engine::Scene& s
     s.mesh_index = mr.mesh;
     s.material_override = mr.material_override;
     s.mesh = std::move(mesh).value();
-    s.mesh_hash = brf_mesh_hash(s.mesh);
+    s.glossy = brf_glossy_lobe(source_material(scene.assets, s), &s.specular);
+    s.mesh_hash = brf_mesh_hash(s.mesh, s.glossy);
     s.entities.push_back(e);
     out.push_back(std::move(s));
   }
   return out;
 }
 
+std::optional<GlossyLobe> brf_glossy_lobe(const engine::Material& material, glm::vec3* specular) {
+  const ReferenceMaterial m = reference_material(material);
+  const float top = std::max(m.f0.x, std::max(m.f0.y, m.f0.z));
+  if (!(material.roughness < 0.6f) || !(top >= 0.2f)) return std::nullopt;
+  const float mean = (m.f0.x + m.f0.y + m.f0.z) / 3.0f;
+  if (specular != nullptr) *specular = m.f0 / mean;
+  return GlossyLobe{.f0 = std::min(mean, 1.0f), .alpha = std::clamp(m.alpha, 1e-3f, 1.0f)};
+}
+
 glm::vec3 brf_source_albedo(const engine::SceneAsset& asset, const BrfSource& source) {
-  int material = source.material_override;
-  if (material < 0 && source.mesh_index < asset.meshes.size() && !asset.meshes[source.mesh_index].primitives.empty())
-    material = asset.meshes[source.mesh_index].primitives.front().material;
-  const engine::Material m = material >= 0 && static_cast<std::size_t>(material) < asset.materials.size()
-                                 ? asset.materials[static_cast<std::size_t>(material)]
-                                 : engine::Material{};
-  return hemispherical_albedo(reference_material(m));
+  const ReferenceMaterial m = reference_material(source_material(asset, source));
+  return source.glossy ? m.diffuse_albedo : hemispherical_albedo(m);
 }
 
 }  // namespace gi

@@ -11,6 +11,7 @@
 // that buffer index the same vertices.
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -18,6 +19,7 @@
 #include <engine/result.h>
 #include <engine/scene.h>
 
+#include "brf/brdf_separation.h"
 #include "brf/pca_basis.h"
 
 namespace gi {
@@ -30,13 +32,24 @@ struct BrfSource {
   std::uint32_t mesh_index = 0;           ///< Into SceneAsset::meshes.
   std::int32_t material_override = -1;    ///< The entities' MeshRenderer::material_override.
   BrfMesh mesh;                           ///< Object space; reflectance per vertex.
-  std::string mesh_hash;                  ///< brf_mesh_hash(mesh): what a bake depends on.
+  /// The glossy lobe the bake separates (brf_glossy_lobe of its material); none: diffuse.
+  std::optional<GlossyLobe> glossy;
+  glm::vec3 specular{1.0f};               ///< Glossy colour: f0 (RGB) / glossy->f0.
+  std::string mesh_hash;                  ///< brf_mesh_hash(mesh, glossy): what a bake depends on.
   std::vector<engine::Entity> entities;   ///< Ascending entity index.
 };
 
 /// 16 lowercase hex digits (FNV-1a 64) over the vertex count, positions, normals, indices
-/// and reflectance of `mesh`, in order. A bake whose stored hash differs is stale.
-std::string brf_mesh_hash(const BrfMesh& mesh);
+/// and reflectance of `mesh`, in order, then the glossy lobe when there is one. A bake whose
+/// stored hash differs is stale.
+std::string brf_mesh_hash(const BrfMesh& mesh, const std::optional<GlossyLobe>& glossy = std::nullopt);
+
+/// A material whose lobe BRF carries as glossy terms: roughness below 0.6 (GGX alpha < 0.36:
+/// a lobe directional enough that reflecting it diffusely misplaces its light, and broad
+/// enough for a few separable terms, brdf_separation.h) and a specular reflectance f0 of at
+/// least 0.2 in some channel (metals; a dielectric's 0.04 sends too little light to
+/// matter next to its diffuse part). Returns the lobe (f0: the channels' mean) or none.
+std::optional<GlossyLobe> brf_glossy_lobe(const engine::Material& material, glm::vec3* specular = nullptr);
 
 /// The mesh of a scene asset as a BrfMesh: positions, unit normals (area-weighted from the
 /// triangles where a primitive has none), indices rebased onto the concatenation, and per
@@ -55,7 +68,8 @@ engine::Result<std::vector<BrfSource>> dynamic_brf_meshes(const engine::Scene& s
 
 /// The RGB reflectance the runtime bounces with for `source`: its (first) material's
 /// hemispherical albedo as the path tracer and the light atlas see it (Lambert plus the
-/// renderer's GGX lobe, light_atlas/vpl_set.h). The glTF default material when it has none.
+/// renderer's GGX lobe, light_atlas/vpl_set.h); for a glossy source its diffuse albedo only
+/// (the lobe is its glossy terms). The glTF default material when it has none.
 glm::vec3 brf_source_albedo(const engine::SceneAsset& asset, const BrfSource& source);
 
 }  // namespace gi

@@ -140,12 +140,14 @@ std::vector<std::uint8_t> brf_pair_culling(std::span<const BrfObject> objects,
       const auto lobe = sh_clamped_cosine(facing, f.sh_bands);
       float b = 0.0f;
       for (std::size_t c = 0; c < 3; ++c) {
+        // Each channel's term in absolute value (the paper bounds every (k', k, i) term
+        // apart): signed terms can cancel at the centre while the receiver's faces see light.
         float e = 0.0f;
         for (int i = 0; i < f.channel_count(); ++i)
-          e += weights[s][c][static_cast<std::size_t>(i)] *
-               sh_dot(std::span<const float>(coeffs).subspan(static_cast<std::size_t>(i * f.coefficient_count())), lobe,
-                      static_cast<std::size_t>(f.coefficient_count()));
-        b = std::max(b, std::fabs(e));
+          e += std::fabs(weights[s][c][static_cast<std::size_t>(i)] *
+                         sh_dot(std::span<const float>(coeffs).subspan(static_cast<std::size_t>(i * f.coefficient_count())),
+                                lobe, static_cast<std::size_t>(f.coefficient_count())));
+        b = std::max(b, e);
       }
       bound[s * n + r] = b;
       largest = std::max(largest, b);

@@ -18,7 +18,7 @@
 //         source's outermost field sphere get that source's bounce from its total radiosity
 //         albedo x (incoming + interreflected).
 // Pairs whose bound contribution I_c (§5.4) — the first bounce's irradiance at the
-// receiver's centre, facing the source — is below `cull_threshold` x the largest pair's are
+// receiver's centre, facing the source, summed over the channels in absolute value — is below `cull_threshold` x the largest pair's are
 // skipped for the whole frame (brf_pair_culling).
 //   std::vector<gi::BrfObject> objects{{&mesh, &basis, &field, transform, albedo}};
 //   gi::BrfResult r = gi::update_brf(objects, lights, {.bounces = 3});
@@ -124,8 +124,8 @@ glm::vec3 brf_outgoing_radiance(const BrfObject& object, const BrfWorldVertices&
                                 std::span<const glm::vec3> light, std::size_t j, const glm::vec3& w_out);
 
 /// Pair culling (§5.4): culled[s * n + r] != 0 when the bound irradiance of source s at
-/// receiver r's centre (facing s, weights `weights[s]`) is at most threshold x the largest
-/// pair's. The diagonal is always culled.
+/// receiver r's centre (facing s, weights `weights[s]`; sum over channels of |w Phi|, so
+/// terms of opposite sign cannot cancel) is at most threshold x the largest pair's. The diagonal is always culled.
 std::vector<std::uint8_t> brf_pair_culling(std::span<const BrfObject> objects,
                                            std::span<const std::array<std::vector<float>, 3>> weights,
                                            float threshold);

@@ -19,17 +19,14 @@ bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y
 
 }  // namespace
 
-glm::vec3 WorldProbeGrid::irradiance(const glm::vec3& p, const glm::vec3& n) const {
-  if (radiance_sh.empty() || !finite(p) || !finite(n)) return glm::vec3(0.0f);
+bool WorldProbeGrid::radiance(const glm::vec3& p, std::array<glm::vec3, 9>& out) const {
+  out.fill(glm::vec3(0.0f));
+  if (radiance_sh.empty() || !finite(p)) return false;
   const glm::vec3 g = (p - origin) / spacing;
   const glm::ivec3 last = dims - 1;
   const glm::vec3 clamped = glm::clamp(g, glm::vec3(0.0f), glm::vec3(last));
   const glm::ivec3 i0 = glm::min(glm::ivec3(glm::floor(clamped)), glm::max(last - 1, glm::ivec3(0)));
   const glm::vec3 f = glm::clamp(clamped - glm::vec3(i0), glm::vec3(0.0f), glm::vec3(1.0f));
-  const float nl = glm::length(n);
-  if (!(nl > 0.0f)) return glm::vec3(0.0f);
-  const auto lobe = sh_clamped_cosine(n / nl, 3);
-  glm::vec3 sum(0.0f);
   float weight = 0.0f;
   for (int c = 0; c < 8; ++c) {
     const glm::ivec3 o(c & 1, (c >> 1) & 1, (c >> 2) & 1);
@@ -40,13 +37,23 @@ glm::vec3 WorldProbeGrid::irradiance(const glm::vec3& p, const glm::vec3& n) con
     if (valid[k] == 0) continue;
     const float w = (o.x != 0 ? f.x : 1.0f - f.x) * (o.y != 0 ? f.y : 1.0f - f.y) * (o.z != 0 ? f.z : 1.0f - f.z);
     if (w <= 0.0f) continue;
-    glm::vec3 e(0.0f);
-    for (int j = 0; j < 9; ++j) e += lobe[static_cast<std::size_t>(j)] * radiance_sh[k][static_cast<std::size_t>(j)];
-    sum += w * e;
+    for (std::size_t j = 0; j < 9; ++j) out[j] += w * radiance_sh[k][j];
     weight += w;
   }
-  if (weight <= 0.0f) return glm::vec3(0.0f);
-  return glm::max(sum / weight, glm::vec3(0.0f));  // 3-band ringing must not make light negative
+  if (weight <= 0.0f) return false;
+  for (glm::vec3& v : out) v /= weight;
+  return true;
+}
+
+glm::vec3 WorldProbeGrid::irradiance(const glm::vec3& p, const glm::vec3& n) const {
+  const float nl = glm::length(n);
+  if (!finite(n) || !(nl > 0.0f)) return glm::vec3(0.0f);
+  std::array<glm::vec3, 9> l;
+  if (!radiance(p, l)) return glm::vec3(0.0f);
+  const auto lobe = sh_clamped_cosine(n / nl, 3);
+  glm::vec3 e(0.0f);
+  for (std::size_t j = 0; j < 9; ++j) e += lobe[j] * l[j];
+  return glm::max(e, glm::vec3(0.0f));  // 3-band ringing must not make light negative
 }
 
 engine::Result<WorldProbeGrid> bake_world_probes(const RayCaster& static_world, const VplSet& vpls,

@@ -52,6 +52,9 @@ struct WorldProbeGrid {
   std::size_t bytes() const { return radiance_sh.size() * sizeof(radiance_sh[0]) + valid.size(); }
   /// World light (W/m^2) at world point p with unit normal n; 0 outside the grid's reach.
   glm::vec3 irradiance(const glm::vec3& p, const glm::vec3& n) const;
+  /// The radiance SH interpolated at p (over the valid probes); false (and zeros) where no
+  /// valid probe reaches. For lobes other than the cosine (a glossy vertex's g_k cos).
+  bool radiance(const glm::vec3& p, std::array<glm::vec3, 9>& out) const;
 };
 
 /// Probes over the bounding box of the VPLs (one spacing of margin). Errors: VPL arrays of

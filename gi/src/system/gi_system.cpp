@@ -111,8 +111,8 @@ engine::Result<std::unique_ptr<GISystem>> GISystem::load(const std::filesystem::
       BrfMeshBake& b = loaded->meshes[i];
       const auto model = static_cast<std::uint32_t>(models.size());
       const glm::vec3 albedo = brf_source_albedo(scene.assets, src);
-      for (engine::Entity e : src.entities) bindings.push_back({e, model, albedo});
-      models.push_back({src.name, std::move(src.mesh), std::move(b.basis), std::move(b.field)});
+      for (engine::Entity e : src.entities) bindings.push_back({e, model, albedo, src.specular});
+      models.push_back({src.name, std::move(src.mesh), std::move(b.basis), std::move(b.field), std::move(b.glossy)});
     }
     BrfWorldLink world;
     const AtlasLayout* layout = atlas ? &atlas->layout : prm ? &prm->layout : nullptr;
