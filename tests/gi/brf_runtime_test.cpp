@@ -18,14 +18,18 @@ namespace {
 
 gi::BrfMesh box(glm::vec3 half, int n) { return brftest::box(half, n); }
 
+// N = 24: at N = 16 the fit of the bounce light is what fails (a source lit by its
+// neighbour's face, a receiver with the source's cast shadow: 26-64% relative residual), and
+// the receiver's error stays at 0.13 even with brute-force transport of the fitted radiosity;
+// 24 functions take it to 0.074 (0.066 with the exact per-vertex radiosity, the mesh's floor).
 struct TwoBoxes {
   gi::BrfMesh source = box({0.3f, 0.3f, 0.3f}, 6);
   gi::BrfMesh receiver = box({0.25f, 0.4f, 0.25f}, 6);
   gi::BrfBasis source_basis, receiver_basis;
   gi::BasisRadianceField source_field, receiver_field;
   TwoBoxes() {
-    source_basis = gi::compute_pca_basis(source, {.lights = 256, .basis = 16}).value();
-    receiver_basis = gi::compute_pca_basis(receiver, {.lights = 256, .basis = 16}).value();
+    source_basis = gi::compute_pca_basis(source, {.lights = 256, .basis = 24}).value();
+    receiver_basis = gi::compute_pca_basis(receiver, {.lights = 256, .basis = 24}).value();
     const gi::RadianceFieldSettings fs{.spheres = 12, .face_resolution = 12, .sh_bands = 3, .directions = 1024};
     source_field = gi::compute_basis_radiance_field(source, source_basis, fs).value();
     receiver_field = gi::compute_basis_radiance_field(receiver, receiver_basis, fs).value();
@@ -68,8 +72,10 @@ TEST(BrfRuntime, TwoBoxesMatchThePathTracersInterreflection) {
   std::vector<gi::SurfacePoint> points;
   for (std::size_t j = 0; j < s.receiver.positions.size(); ++j)
     points.push_back({glm::vec3(m_receiver * glm::vec4(s.receiver.positions[j], 1.0f)), s.receiver.normals[j]});
+  // 2048 samples leave 0.069 relative RMSE of noise in the reference itself (seed 1 vs 32768
+  // samples), as much as the method's error; 32768 leave about 0.017 and take ~2 s.
   gi::ReferenceSettings rs;
-  rs.samples_per_pixel = 2048;
+  rs.samples_per_pixel = 32768;
   const auto truth = gi::estimate_irradiance(ref, points, rs).value();
 
   double err = 0.0, norm = 0.0, sum_ours = 0.0, sum_truth = 0.0;
@@ -82,7 +88,7 @@ TEST(BrfRuntime, TwoBoxesMatchThePathTracersInterreflection) {
   }
   std::printf("receiver vertices: rel RMSE %.4f, red total ratio %.4f (%zu pairs evaluated, %zu culled)\n",
               std::sqrt(err / norm), sum_ours / sum_truth, r.pairs_evaluated, r.pairs_culled);
-  EXPECT_LT(std::sqrt(err / norm), 0.2);
+  EXPECT_LT(std::sqrt(err / norm), 0.1);
   EXPECT_NEAR(sum_ours / sum_truth, 1.0, 0.1);
 }
 
