@@ -3,12 +3,20 @@
 #include <cmath>
 #include <cstdio>
 #include <numbers>
+#include <limits>
 #include <random>
+
+#include <unistd.h>
 
 #include <glm/gtc/matrix_transform.hpp>
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
+
 #include "brf/brdf_separation.h"
+#include "brf/brf_bake.h"
+#include "brf/brf_io.h"
 #include "brf/brf_runtime.h"
 #include "brf/spherical_harmonics.h"
 #include "brf_scenes.h"
@@ -102,7 +110,7 @@ struct Baked {
   gi::BrfBasis basis;
   gi::BasisRadianceField field;
   Baked(gi::BrfMesh m, const gi::BrdfSeparation* glossy) : mesh(std::move(m)) {
-    basis = gi::compute_pca_basis(mesh, {.lights = 256, .basis = 16}, glossy).value();
+    basis = gi::compute_pca_basis(mesh, {.lights = 256, .basis = 24}, glossy).value();
     field = gi::compute_basis_radiance_field(mesh, basis, {.spheres = 12, .face_resolution = 12, .sh_bands = 3, .directions = 512},
                                              glossy)
                 .value();
@@ -126,15 +134,15 @@ double rel_rmse(std::span<const glm::vec3> ours, std::span<const glm::vec3> trut
   return std::sqrt(err / norm);
 }
 
-// A glossy metal box under a low light beside a tall white box: the top face's glossy
-// reflection lands on the white box's facing side. The white box's interreflected
+// A glossy metal box under a low light beside a tall white box 25 cm away: the top face's
+// glossy reflection lands on the white box's facing side. The white box's interreflected
 // irradiance against the path tracer, with the lobe separated into K terms, against
 // leaving the lobe out and against a diffuse stand-in of the same reflectance.
 TEST(BrfGlossy, GlossySourceLightsItsNeighbourAsThePathTracerDoes) {
   const gi::GlossyLobe lobe{.f0 = 0.9f, .alpha = 0.5f};
   const glm::vec3 source_diffuse(0.3f, 0.05f, 0.05f), white(0.8f);
   const glm::mat4 m_source(1.0f);
-  const glm::mat4 m_receiver = glm::translate(glm::mat4(1.0f), {0.55f, 0.0f, 0.0f});
+  const glm::mat4 m_receiver = glm::translate(glm::mat4(1.0f), {0.75f, 0.0f, 0.0f});
   const gi::PointEmitter light = point_light({-1.0f, 0.9f, 0.0f}, 4.0f);
   const gi::BrfMesh source_mesh = brftest::box({0.3f, 0.3f, 0.3f}, 6), receiver_mesh = brftest::box({0.2f, 0.8f, 0.4f}, 6);
   const Baked receiver(receiver_mesh, nullptr), diffuse_source(source_mesh, nullptr);
@@ -158,7 +166,7 @@ TEST(BrfGlossy, GlossySourceLightsItsNeighbourAsThePathTracerDoes) {
   for (std::size_t j = 0; j < receiver_mesh.positions.size(); ++j)
     points.push_back({glm::vec3(m_receiver * glm::vec4(receiver_mesh.positions[j], 1.0f)), receiver_mesh.normals[j]});
   gi::ReferenceSettings rs;
-  rs.samples_per_pixel = 1024;
+  rs.samples_per_pixel = 8192;
   const auto truth = gi::estimate_irradiance(ref, points, rs).value();
 
   const auto run = [&](const Baked& source, const gi::BrdfSeparation* glossy, glm::vec3 albedo) {
@@ -179,17 +187,17 @@ TEST(BrfGlossy, GlossySourceLightsItsNeighbourAsThePathTracerDoes) {
   const double none = run(diffuse_source, nullptr, source_diffuse);
   const double stand_in = run(diffuse_source, nullptr, source_diffuse + glm::vec3(static_cast<float>(albedo)));
   std::printf("receiver rel RMSE: glossy lobe left out %.3f, diffuse stand-in (albedo +%.2f) %.3f\n", none, albedo, stand_in);
-  double k4 = 0.0;
+  double k1 = 0.0, k4 = 0.0;
   for (int k : {1, 4}) {
-    const gi::BrdfSeparation sep = gi::separate_glossy_brdf(lobe, {.terms = k, .resolution = 16}).value();
+    const gi::BrdfSeparation sep = gi::separate_glossy_brdf(lobe, {.terms = k, .resolution = 32}).value();
     const Baked source(source_mesh, &sep);
     const double e = run(source, &sep, source_diffuse);
     std::printf("receiver rel RMSE: %d glossy terms (BRDF error %.2f) %.3f\n", sep.terms, static_cast<double>(sep.relative_error), e);
-    if (k == 4) k4 = e;
+    (k == 1 ? k1 : k4) = e;
   }
-  EXPECT_LT(k4, none);
-  EXPECT_LT(k4, stand_in);
-  EXPECT_LT(k4, 0.5);
+  EXPECT_LT(k4, 0.6 * k1);
+  EXPECT_LT(k4, 0.6 * stand_in);
+  EXPECT_LT(k4, 0.25);
 }
 
 // A white glossy box beside a red diffuse one, one bounce: the radiance the glossy box's
@@ -249,6 +257,80 @@ TEST(BrfGlossy, GlossyReceiverReflectsTowardTheViewerLikeTheExactLobe) {
               truth.size(), err, sep.terms, err_diffuse);
   EXPECT_LT(err, 0.5 * err_diffuse);
   EXPECT_LT(err, 0.3);
+}
+
+// Turning both glossy objects and the light together changes no term: the tangent frames
+// come from object-space normals and turn with the objects.
+TEST(BrfGlossy, RotatingEverythingTogetherChangesNoTerm) {
+  const gi::BrdfSeparation sep = gi::separate_glossy_brdf({.f0 = 0.9f, .alpha = 0.5f}, {.terms = 4, .resolution = 16}).value();
+  gi::BrfMesh a_mesh = brftest::box({0.3f, 0.3f, 0.3f}, 4), b_mesh = brftest::box({0.25f, 0.4f, 0.25f}, 4);
+  const auto bake = [&](const gi::BrfMesh& m, gi::BrfBasis& basis, gi::BasisRadianceField& field) {
+    basis = gi::compute_pca_basis(m, {.lights = 128, .basis = 12}, &sep).value();
+    field = gi::compute_basis_radiance_field(m, basis, {.spheres = 6, .face_resolution = 6, .directions = 128}, &sep).value();
+  };
+  gi::BrfBasis a_basis, b_basis;
+  gi::BasisRadianceField a_field, b_field;
+  bake(a_mesh, a_basis, a_field);
+  bake(b_mesh, b_basis, b_field);
+  const auto run = [&](const glm::mat4& world) {
+    gi::BrfObject objects[] = {
+        {&a_mesh, &a_basis, &a_field, world * glm::translate(glm::mat4(1.0f), {-0.45f, 0.0f, 0.0f}), glm::vec3(0.3f, 0.05f, 0.05f)},
+        {&b_mesh, &b_basis, &b_field, world * glm::translate(glm::mat4(1.0f), {0.4f, 0.1f, 0.05f}), glm::vec3(0.2f)}};
+    objects[0].glossy = objects[1].glossy = &sep;
+    const gi::PointEmitter light = point_light(glm::vec3(world * glm::vec4(-1.2f, 1.0f, 0.6f, 1.0f)), 4.0f);
+    return gi::update_brf(objects, std::span<const gi::PointEmitter>(&light, 1), {.bounces = 2});
+  };
+  const gi::BrfResult a = run(glm::mat4(1.0f));
+  const gi::BrfResult b = run(glm::rotate(glm::mat4(1.0f), 0.9f, glm::normalize(glm::vec3(0.3f, 1.0f, -0.2f))));
+  ASSERT_EQ(a.indirect[1].size(), b_mesh.positions.size() * static_cast<std::size_t>(sep.terms + 1));
+  const double d = rel_rmse(b.indirect[1], a.indirect[1]), d0 = rel_rmse(b.indirect[0], a.indirect[0]);
+  std::printf("rotation: relative difference over all terms %.2e / %.2e\n", d, d0);
+  EXPECT_LT(d, 1e-3);
+  EXPECT_LT(d0, 1e-3);
+}
+
+// A glossy mesh's bake file keeps the separation bit for bit, and a damaged table is
+// rejected naming the problem.
+TEST(BrfGlossy, BakeFileKeepsTheSeparationAndRejectsDamage) {
+  gi::BrfSource source;
+  source.name = "shade";
+  source.mesh = brftest::box({0.2f, 0.1f, 0.2f}, 3);
+  source.glossy = gi::GlossyLobe{.f0 = 0.3f, .alpha = 0.16f};
+  source.mesh_hash = gi::brf_mesh_hash(source.mesh, source.glossy);
+  EXPECT_NE(source.mesh_hash, gi::brf_mesh_hash(source.mesh));  // the lobe is part of what a bake depends on
+  gi::BrfSettings settings = gi::brf_preset("preview").value();
+  settings.field.spheres = 4;
+  settings.field.face_resolution = 4;
+  const gi::BrfMeshBake bake = gi::bake_brf_mesh(source, settings).value();
+  ASSERT_TRUE(bake.glossy.has_value());
+  EXPECT_GE(bake.glossy->terms, 4);
+  EXPECT_EQ(bake.field.terms, bake.glossy->terms + 1);
+  const std::filesystem::path dir =
+      std::filesystem::path(GI_BINARY_DIR) / "test_output" / ("brf_glossy_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::filesystem::path file = dir / "brf_shade.bin";
+  ASSERT_TRUE(gi::write_brf_mesh(file, bake).ok());
+  const gi::BrfMeshBake back = gi::read_brf_mesh(file).value();
+  ASSERT_TRUE(back.glossy.has_value());
+  EXPECT_EQ(back.glossy->terms, bake.glossy->terms);
+  EXPECT_EQ(back.glossy->g, bake.glossy->g);
+  EXPECT_EQ(back.glossy->h, bake.glossy->h);
+  EXPECT_EQ(back.glossy->lobe_sh, bake.glossy->lobe_sh);
+  EXPECT_EQ(back.field.coefficients, bake.field.coefficients);
+  EXPECT_EQ(back.basis.terms, bake.basis.terms);
+
+  gi::BrfMeshBake bad = bake;
+  bad.glossy->h[3] = std::numeric_limits<float>::quiet_NaN();
+  const auto written = gi::write_brf_mesh(dir / "brf_bad.bin", bad);
+  ASSERT_FALSE(written.ok());
+  EXPECT_NE(written.error().message.find("glossy separation value"), std::string::npos) << written.error().to_string();
+  EXPECT_FALSE(std::filesystem::exists(dir / "brf_bad.bin"));
+  bad = bake;
+  bad.glossy.reset();  // a field of 1 + K terms without its separation
+  const auto mismatch = gi::write_brf_mesh(dir / "brf_bad.bin", bad);
+  ASSERT_FALSE(mismatch.ok());
+  EXPECT_NE(mismatch.error().message.find("BRDF terms disagree"), std::string::npos) << mismatch.error().to_string();
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace
