@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <limits>
+#include <optional>
 #include <string>
 
 #include <engine/components.h>
@@ -24,9 +25,14 @@ constexpr std::uint64_t kReferenceSeed = 0x6272667265667074ULL;
 // The scene's dynamic mesh nodes and lights only: static geometry is dropped. `apart`:
 // objects whose world bounding boxes touch another's (within 1 cm, e.g. stacked crates) are
 // dropped too: contact is the method's known weak case (docs/brf.md), measured separately.
-engine::Scene objects_only(engine::SceneAsset asset, bool apart) {
+// `metal` names a material made a glossy metal (metallic 1, roughness 0.5: GGX alpha 0.25),
+// so the glossy terms are measured on the same scene ("none": unchanged).
+engine::Scene objects_only(engine::SceneAsset asset, bool apart, const std::string& metal = "none") {
   for (engine::Node& n : asset.nodes)
     if (n.mesh >= 0 && n.gi.mobility != engine::Mobility::Dynamic) n.mesh = -1;
+  if (metal == "red_crate")
+    for (engine::Material& m : asset.materials)
+      if (m.name == "crate_red") m.metallic = 1.0f, m.roughness = 0.5f;
   engine::Scene scene = engine::instantiate(asset);
   if (!apart) return scene;
   struct Box {
@@ -63,6 +69,7 @@ struct Objects {
     std::size_t source;
     glm::mat4 transform;
     glm::vec3 albedo;
+    glm::vec3 specular;
   };
   std::vector<Instance> instances;  // entity order within each source, sources in order
 };
@@ -78,7 +85,7 @@ engine::Result<Objects> scene_objects(const engine::Scene& scene) {
     const glm::vec3 albedo = brf_source_albedo(scene.assets, src);
     for (engine::Entity e : src.entities) {
       const auto* wt = scene.registry.try_get<engine::WorldTransform>(e);
-      o.instances.push_back({s, wt ? wt->matrix : glm::mat4(1.0f), albedo});
+      o.instances.push_back({s, wt ? wt->matrix : glm::mat4(1.0f), albedo, src.specular});
     }
   }
   return o;
@@ -100,7 +107,8 @@ std::vector<SurfacePoint> vertex_points(const Objects& o) {
 void register_brf_sweep(SweepRegistry& registry) {
   registry.add_reference_provider(
       {.kind = "brf_vertex_indirect", .version = "pt-1", .compute = [](const ReferenceJob& job) -> engine::Result<RgbField> {
-         const engine::Scene scene = objects_only(job.scene.asset, job.request.param("objects") == "apart");
+         const engine::Scene scene =
+             objects_only(job.scene.asset, job.request.param("objects") == "apart", job.request.param("metal"));
          auto objects = scene_objects(scene);
          if (!objects) return objects.error();
          const std::vector<SurfacePoint> points = vertex_points(*objects);
@@ -137,33 +145,52 @@ void register_brf_sweep(SweepRegistry& registry) {
        .default_grid = {"apart"}, .choices = {"apart", "all"}},
       {.name = "ref_spp", .description = "path-traced samples per vertex of the reference", .kind = KnobKind::Integer,
        .default_grid = {"2048"}, .min_value = 1, .max_value = 1 << 20},
+      {.name = "metal", .description = "a material turned glossy metal (roughness 0.5): none or red_crate", .kind = KnobKind::Choice,
+       .default_grid = {"none"}, .choices = {"none", "red_crate"}},
+      {.name = "glossy_terms", .description = "glossy BRDF terms K of glossy meshes (SVD of the lobe)", .kind = KnobKind::Integer,
+       .default_grid = {"4"}, .min_value = 1, .max_value = kMaxGlossyTerms},
+      {.name = "brdf_res", .description = "hemisphere table of the BRDF separation: brdf_res^2 directions", .kind = KnobKind::Integer,
+       .default_grid = {"16"}, .min_value = 4, .max_value = 64},
   };
   m.reference_for = [](const SweepScene&, const KnobSetting& k) {
     ReferenceRequest r;
     r.kind = "brf_vertex_indirect";
     r.params.emplace_back("spp", std::to_string(k.integer("ref_spp")));
     r.params.emplace_back("objects", k.text("objects"));
+    r.params.emplace_back("metal", k.text("metal"));
     return r;
   };
   m.run = [](const RunContext& ctx) -> engine::Result<MethodOutput> {
-    const engine::Scene scene = objects_only(ctx.scene.asset, ctx.knobs.text("objects") == "apart");
+    const engine::Scene scene =
+        objects_only(ctx.scene.asset, ctx.knobs.text("objects") == "apart", ctx.knobs.text("metal"));
     auto objects = scene_objects(scene);
     if (!objects) return objects.error();
     const auto t0 = std::chrono::steady_clock::now();
     std::vector<BrfBasis> bases;
     std::vector<BasisRadianceField> fields;
+    std::vector<std::optional<BrdfSeparation>> glossy(objects->sources.size());
     std::uint64_t bytes = 0;
     for (std::size_t s = 0; s < objects->sources.size(); ++s) {
       const BrfMesh& mesh = objects->sources[s].mesh;
+      if (objects->sources[s].glossy) {
+        auto sep = separate_glossy_brdf(*objects->sources[s].glossy,
+                                        {.terms = static_cast<int>(ctx.knobs.integer("glossy_terms")),
+                                         .resolution = static_cast<int>(ctx.knobs.integer("brdf_res"))});
+        if (!sep) return sep.error();
+        glossy[s] = std::move(sep).value();
+      }
+      const BrdfSeparation* g = glossy[s] ? &*glossy[s] : nullptr;
       auto basis = compute_pca_basis(mesh, {.lights = static_cast<int>(ctx.knobs.integer("lights")),
-                                            .basis = static_cast<int>(ctx.knobs.integer("basis"))});
+                                            .basis = static_cast<int>(ctx.knobs.integer("basis"))},
+                                     g);
       if (!basis) return basis.error();
       auto field = compute_basis_radiance_field(mesh, *basis,
                                                 {.spheres = static_cast<int>(ctx.knobs.integer("spheres")),
                                                  .face_resolution = static_cast<int>(ctx.knobs.integer("face_res")),
                                                  .sh_bands = static_cast<int>(ctx.knobs.integer("bands")),
                                                  .directions = static_cast<int>(ctx.knobs.integer("directions")),
-                                                 .threads = ctx.threads});
+                                                 .threads = ctx.threads},
+                                                g);
       if (!field) return field.error();
       bytes += field->bytes() + basis->psi.size() * sizeof(float);
       bases.push_back(std::move(basis).value());
@@ -174,15 +201,18 @@ void register_brf_sweep(SweepRegistry& registry) {
     const double bake_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     std::vector<BrfObject> brf;
     for (const Objects::Instance& in : objects->instances)
-      brf.push_back({&objects->sources[in.source].mesh, &bases[in.source], &fields[in.source], in.transform, in.albedo});
+      brf.push_back({&objects->sources[in.source].mesh, &bases[in.source], &fields[in.source], in.transform, in.albedo,
+                     glossy[in.source] ? &*glossy[in.source] : nullptr, in.specular});
     std::vector<ReferenceLight> lights = scene_lights(scene.registry, BakeLights::Static);
     for (ReferenceLight& l : scene_lights(scene.registry, BakeLights::Moving)) lights.push_back(l);
     const std::vector<PointEmitter> emitters = light_point_emitters(lights, 64, ctx.seed);
     const auto t1 = std::chrono::steady_clock::now();
     const BrfResult r = update_brf(brf, emitters, {.bounces = static_cast<int>(ctx.knobs.integer("bounces")), .cull_threshold = 0.0f});
     const double frame_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t1).count();
-    std::vector<glm::vec3> values;
-    for (const auto& v : r.indirect) values.insert(values.end(), v.begin(), v.end());
+    std::vector<glm::vec3> values;  // the irradiance: each object's first block
+    for (std::size_t i = 0; i < r.indirect.size(); ++i)
+      values.insert(values.end(), r.indirect[i].begin(),
+                    r.indirect[i].begin() + static_cast<std::ptrdiff_t>(brf[i].mesh->positions.size()));
     if (static_cast<int>(values.size()) != ctx.reference.width)
       return engine::Error{.message = "vertex count differs from the reference's"};
     MethodOutput out;

@@ -346,7 +346,7 @@ EffectPlan plan(const engine::Scene& scene, const PlanOptions& options) {
   // Basis radiance fields: the meshes of dynamic entities, once per mesh.
   if (!dynamic_by_mesh.empty()) {
     brf.enabled = true;
-    std::vector<std::string> mesh_names;
+    std::vector<std::string> mesh_names, glossy_meshes;
     std::size_t vertices = 0, triangles = 0;
     BakeWork total;
     const auto brf_settings = brf_preset(options.preset);
@@ -359,7 +359,14 @@ EffectPlan plan(const engine::Scene& scene, const PlanOptions& options) {
       std::size_t v = 0, t = 0;
       for (const engine::Primitive& p : m.primitives) v += p.positions.size(), t += p.indices.size() / 3;
       vertices += v, triangles += t;
-      const BakeWork w = brf_work(v, t, basis, field);
+      // A glossy material (brf_glossy_lobe) multiplies the field by 1 + its terms; the
+      // separation may keep one more term to keep an azimuthal pair whole.
+      const int material = m.primitives.empty() ? -1 : m.primitives.front().material;
+      const bool is_glossy = material >= 0 && static_cast<std::size_t>(material) < scene.assets.materials.size() &&
+                          brf_glossy_lobe(scene.assets.materials[static_cast<std::size_t>(material)]).has_value();
+      const int terms = is_glossy ? 2 + (brf_settings ? brf_settings->glossy.terms : 4) : 1;
+      if (is_glossy) glossy_meshes.push_back(mesh_names.back());
+      const BakeWork w = brf_work(v, t, basis, field, terms);
       total.bake_seconds += w.bake_seconds;
       total.runtime_bytes += w.runtime_bytes;
       total.units += w.units;
@@ -367,7 +374,9 @@ EffectPlan plan(const engine::Scene& scene, const PlanOptions& options) {
     brf.reason =
         plural(static_cast<std::size_t>(facts.dynamic_meshes), "dynamic entity uses ", "dynamic entities use ") +
         plural(mesh_names.size(), "mesh", "meshes") + " (" + list_names(mesh_names) +
-        ") -> a basis and a field per mesh";
+        ") -> a basis and a field per mesh" +
+        (glossy_meshes.empty() ? std::string()
+                               : "; glossy metal (" + list_names(glossy_meshes) + ") -> its lobe in separable terms");
     brf.targets = mesh_names;
     brf.estimate = {total.bake_seconds, total.runtime_bytes, static_cast<std::uint64_t>(total.units),
                     std::to_string(mesh_names.size()) + " meshes, " + std::to_string(vertices) +

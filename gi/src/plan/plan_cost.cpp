@@ -120,10 +120,10 @@ BakeWork prm_work(const StaticSurfaceCensus& census, const PrmSettings& s, doubl
 }
 
 BakeWork brf_work(std::size_t vertex_count, std::size_t triangle_count, const PcaBasisSettings& basis,
-                  const RadianceFieldSettings& field) {
+                  const RadianceFieldSettings& field, int terms) {
   (void)triangle_count;
   BakeWork w;
-  const double n = basis.basis;
+  const double n = static_cast<double>(basis.basis) * terms;  // channels: a glossy mesh has one per (term, function)
   const double coefficients = static_cast<double>(field.sh_bands) * field.sh_bands;
   const double samples = static_cast<double>(field.spheres) * 6.0 * field.face_resolution * field.face_resolution;
   const double pca_rays = static_cast<double>(basis.lights) * static_cast<double>(vertex_count);
@@ -133,10 +133,11 @@ BakeWork brf_work(std::size_t vertex_count, std::size_t triangle_count, const Pc
   const double parallel = w.rays * kBrfCpuPerRay + field_rays * n * coefficients * kBrfCpuPerMadd;
   w.cpu_seconds = parallel;
   w.bake_seconds = wall_seconds(parallel, 0.0);
-  // Field (Iwasaki §4.3): spheres x 6 x res^2 points x N functions x SH coefficients floats;
-  // basis: N values per vertex and the N x N inverse.
+  // Field (Iwasaki §4.3): spheres x 6 x res^2 points x K terms x N functions x SH
+  // coefficients floats; basis: N values per vertex and the N x N inverse.
+  const double nb = basis.basis;
   w.runtime_bytes = static_cast<std::uint64_t>(samples * n * coefficients * 4.0 +
-                                               n * static_cast<double>(vertex_count) * 4.0 + n * n * 4.0);
+                                               nb * static_cast<double>(vertex_count) * 4.0 + nb * nb * 4.0);
   return w;
 }
 

@@ -47,8 +47,9 @@ BakeWork light_atlas_work(const StaticSurfaceCensus& census, const LightAtlasSet
 /// `path_nodes` out: the virtual lights the random walks leave (E x N_s x a / (1 - a)).
 BakeWork prm_work(const StaticSurfaceCensus& census, const PrmSettings& settings, double* path_nodes = nullptr);
 
-/// One distinct dynamic mesh (a basis and a field each, shared by all its instances).
+/// One distinct dynamic mesh (a basis and a field each, shared by all its instances);
+/// `terms`: 1 for a diffuse mesh, 1 + glossy terms for a glossy one.
 BakeWork brf_work(std::size_t vertex_count, std::size_t triangle_count, const PcaBasisSettings& basis,
-                  const RadianceFieldSettings& field);
+                  const RadianceFieldSettings& field, int terms = 1);
 
 }  // namespace gi
