@@ -9,8 +9,8 @@
 //   preview 128 lights, N = 16,  8 spheres x 6x8x8 points,   3 bands, 128 directions
 //   medium  256 lights, N = 16, 12 spheres x 6x12x12 points, 3 bands, 128 directions
 //   high    256 lights, N = 16, 16 spheres x 6x16x16 points, 3 bands, 256 directions (the paper's)
-// Glossy meshes (BrfSource::glossy) get K = 4 glossy terms (the default) from a
-// 16 x 16 (preview, medium) or 24 x 24 (high) hemisphere table.
+// Glossy meshes (BrfSource::glossy) get 4 glossy terms (preview, medium; the issue's
+// default) or 8 (high) from a 16 x 16 hemisphere table (docs/sweeps/brf_glossy).
 
 #include <optional>
 #include <string>
