@@ -3,6 +3,8 @@
 // Crates share one mesh, basis and field (instanced props).
 //   BM_BrfUpdate: the CPU runtime, direct light included (update_brf);
 //   BM_BrfInterreflectCpu: the CPU interreflection alone (brf_interreflect), the GPU pass's twin;
+//   BM_BrfInterreflectCpuGlossy: the same with every crate a glossy metal (4 terms asked,
+//   GGX alpha 0.25): K = 1 + terms channels per basis function and K rows per receiver;
 //   BM_BrfGpu: BrfGpuPass::run on llvmpipe (DESIGN.md §4: these are CPU timings; compare
 //   them as ratios), glFinish inside the timed region, with every crate moving each run (all
 //   pairs' Phi re-evaluated) or none moving (every Phi reused; only the bounces run).
@@ -113,6 +115,34 @@ void BM_BrfInterreflectCpu(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_BrfInterreflectCpu)->ArgsProduct({{1, 5, 10, 30}, {0, 1}})->Unit(benchmark::kMillisecond);
+
+struct SharedGlossy {
+  gi::BrfMesh mesh = crate(0.25f, 4);
+  gi::BrdfSeparation sep = gi::separate_glossy_brdf({.f0 = 0.9f, .alpha = 0.25f}, {.terms = 4, .resolution = 16}).value();
+  gi::BrfBasis basis = gi::compute_pca_basis(mesh, {.lights = 256, .basis = 16}, &sep).value();
+  gi::BasisRadianceField field = gi::compute_basis_radiance_field(mesh, basis, {}, &sep).value();
+};
+
+void BM_BrfInterreflectCpuGlossy(benchmark::State& state) {
+  static const SharedGlossy g;
+  const int n = static_cast<int>(state.range(0));
+  std::vector<gi::BrfObject> objects = crates(n);
+  for (gi::BrfObject& o : objects) {
+    o.basis = &g.basis;
+    o.field = &g.field;
+    o.glossy = &g.sep;
+    o.albedo = glm::vec3(0.0f);
+  }
+  const gi::PointEmitter light = grid_light(n);
+  const auto incoming = gi::brf_direct_light(objects, std::span<const gi::PointEmitter>(&light, 1), nullptr);
+  for (auto _ : state) {
+    const gi::BrfResult r = gi::brf_interreflect(objects, incoming, {.bounces = 3, .cull_threshold = 0.0f});
+    benchmark::DoNotOptimize(r.indirect.data());
+  }
+  state.counters["terms"] = static_cast<double>(g.field.terms);
+  state.counters["field_MB_per_mesh"] = static_cast<double>(g.field.bytes()) / 1e6;
+}
+BENCHMARK(BM_BrfInterreflectCpuGlossy)->Arg(1)->Arg(5)->Arg(10)->Arg(30)->Unit(benchmark::kMillisecond);
 
 engine::GpuContext& context() {
   static engine::GpuContext ctx = [] {
