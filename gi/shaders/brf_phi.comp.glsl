@@ -12,7 +12,9 @@
 // the receiver's g_k' cos lobe (lobe SH in the vertex's tangent frame) rotated into the
 // source's space as ShRotation does (least squares over fixed directions), or 0 behind
 // (C4: C padded to a multiple of 4, the pads written 0)
-// the twin of brf_basis_irradiance (brf_runtime.cpp). Work groups map to (job, first point)
+// the twin of brf_basis_irradiance (brf_runtime.cpp). Built twice: without
+// BRF_GLOSSY_RECEIVER for jobs of one row, with it for glossy receivers (the rotation's local
+// arrays would slow the diffuse jobs on llvmpipe). Work groups map to (job, first point)
 // through the group table, so a dispatch covers many jobs of different lengths.
 
 #include "brf_common.glsl"
@@ -95,7 +97,8 @@ void main() {
   for (uint r = 0u; r < rows; ++r)
     for (uint i = nc; i < c4; ++i) phi[row0 + r * c4 + i] = 0.0;
 
-  if (rows == 1u) {  // a diffuse receiver: the irradiance row only
+#ifndef BRF_GLOSSY_RECEIVER
+  {  // a diffuse receiver or static point: the irradiance row only
     for (uint i = 0u; i < nc; ++i) {
       float sum = 0.0;
       if (inside)
@@ -110,7 +113,7 @@ void main() {
     }
     return;
   }
-
+#else
   // A glossy receiver (kind 0 only). ShRotation of R = frame_to_source x tangent frame:
   // block_l = pinv_l Y_l(R^T D), then out_l = block_l in_l for the source's bands.
   const uint vertex = k;  // receiver vertex index within its model
@@ -162,4 +165,5 @@ void main() {
       phi[row0 + r * c4 + i] = d;
     }
   }
+#endif
 }

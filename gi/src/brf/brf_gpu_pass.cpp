@@ -184,6 +184,14 @@ engine::Result<BrfGpuPass> BrfGpuPass::create(std::span<const BrfGpuModel> model
     if (!built) return built.error();
     *program = std::move(built).value();
   }
+  {
+    auto built = engine::ShaderProgramBuilder(gi_shader_files())
+                     .define("BRF_GLOSSY_RECEIVER 1")
+                     .stage(engine::ShaderStage::Compute, "brf_phi.comp.glsl")
+                     .build();
+    if (!built) return built.error();
+    pass.programs_.phi_glossy = std::move(built).value();
+  }
 
   // Model tables, vertices, bases; fields grouped into buffers under the limit.
   std::vector<GpuModel> table;
@@ -355,24 +363,24 @@ engine::Status BrfGpuPass::reset_layout(std::span<const BrfGpuInstance> instance
 
 void BrfGpuPass::dispatch_phi(std::span<const BrfPhiJob> jobs, bool static_kind) {
   if (jobs.empty()) return;
-  // Work groups sorted by the source's field buffer: one dispatch per buffer.
+  // Work groups sorted by program (one-row jobs, glossy receivers) and the source's field
+  // buffer: one dispatch per (program, buffer).
   std::vector<glm::uvec2> groups;
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> ranges(fields_.size(), {0u, 0u});
-  for (std::size_t b = 0; b < fields_.size(); ++b) {
-    ranges[b].first = u32(groups.size());
-    for (std::size_t j = 0; j < jobs.size(); ++j) {
-      if (models_[jobs[j].source_model].field_buffer != b) continue;
-      for (std::uint32_t first = 0; first < jobs[j].point_count; first += kGroupSize)
-        groups.emplace_back(u32(j), first);
+  const std::size_t nf = fields_.size();
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> ranges(2 * nf, {0u, 0u});
+  for (std::size_t v = 0; v < 2; ++v)
+    for (std::size_t b = 0; b < nf; ++b) {
+      ranges[v * nf + b].first = u32(groups.size());
+      for (std::size_t j = 0; j < jobs.size(); ++j) {
+        if (models_[jobs[j].source_model].field_buffer != b || (jobs[j].rows > 1) != (v == 1)) continue;
+        for (std::uint32_t first = 0; first < jobs[j].point_count; first += kGroupSize)
+          groups.emplace_back(u32(j), first);
+      }
+      ranges[v * nf + b].second = u32(groups.size()) - ranges[v * nf + b].first;
     }
-    ranges[b].second = u32(groups.size()) - ranges[b].first;
-  }
   jobs_.upload(jobs.data(), jobs.size() * sizeof(BrfPhiJob));
   groups_.upload(groups.data(), groups.size() * sizeof(glm::uvec2));
 
-  const GLuint id = programs_.phi.id();
-  programs_.phi.use();
-  glProgramUniform1ui(id, glGetUniformLocation(id, "u_kind"), static_kind ? 1u : 0u);
   bind(0, model_table_.id());
   bind(1, model_vertices_.id());
   bind(2, static_points_.buffer.id());
@@ -381,12 +389,19 @@ void BrfGpuPass::dispatch_phi(std::span<const BrfPhiJob> jobs, bool static_kind)
   bind(5, groups_.buffer.id());
   bind(7, static_kind ? static_phi_.buffer.id() : phi_.buffer.id());
   bind(8, sh_data_.id());
-  for (std::size_t b = 0; b < fields_.size(); ++b) {
-    if (ranges[b].second == 0) continue;
-    bind(6, fields_[b].id());
-    glProgramUniform1ui(id, glGetUniformLocation(id, "u_first_group"), ranges[b].first);
-    glProgramUniform1ui(id, glGetUniformLocation(id, "u_group_count"), ranges[b].second);
-    dispatch_groups(ranges[b].second);
+  for (std::size_t v = 0; v < 2; ++v) {
+    const engine::ShaderProgram& program = v == 0 ? programs_.phi : programs_.phi_glossy;
+    const GLuint id = program.id();
+    program.use();
+    glProgramUniform1ui(id, glGetUniformLocation(id, "u_kind"), static_kind ? 1u : 0u);
+    for (std::size_t b = 0; b < nf; ++b) {
+      const auto [first, count] = ranges[v * nf + b];
+      if (count == 0) continue;
+      bind(6, fields_[b].id());
+      glProgramUniform1ui(id, glGetUniformLocation(id, "u_first_group"), first);
+      glProgramUniform1ui(id, glGetUniformLocation(id, "u_group_count"), count);
+      dispatch_groups(count);
+    }
   }
 }
 

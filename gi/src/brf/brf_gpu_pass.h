@@ -186,7 +186,7 @@ class BrfGpuPass {
     std::uint32_t phi_offset = 0;          ///< First float in static_phi_.
   };
   struct Programs {
-    engine::ShaderProgram phi, fit, gather, static_gather;
+    engine::ShaderProgram phi, phi_glossy, fit, gather, static_gather;  ///< phi_glossy: jobs of K_r > 1 rows
   };
 
   engine::Status reset_layout(std::span<const BrfGpuInstance> instances);
