@@ -18,7 +18,7 @@ struct BrfModel {
   uint ainv_offset;      // first float of A^-1 (N x N, row-major)
   uint field_offset;     // first float of the field in its field buffer
   uint field_buffer;     // which field buffer (one dispatch per buffer)
-  uint pad0;
+  uint terms;            // K: 1 + glossy terms; the field has K x N channels (k x N + i)
   vec4 box_lo;           // xyz: the object's bounding box (object space), brf_object_box
   vec4 box_hi;
 };
@@ -26,18 +26,19 @@ struct BrfModel {
 // One placed instance this frame.
 struct BrfInstance {
   vec4 albedo;           // rgb diffuse albedo
+  vec4 specular;         // rgb glossy colour (glossy models)
   uint model;
-  uint vertex_offset;    // first vertex in the frame's global vertex buffers
-  uint vertex_count;
-  uint weight_offset;    // first vec4 of its weights: one rgb vec4 per basis function, N padded to 4
+  uint vertex_offset;    // first vertex of the instance (the gather's invocation index)
+  uint vertex_count;     // V
+  uint weight_offset;    // first vec4 of its weights: one rgb vec4 per channel (k x N + i), K x N padded to 4
   uint live_first;       // its live sources in the live-source list
   uint live_count;
-  uint pad0;
-  uint pad1;
+  uint value_offset;     // first of its K x V per-vertex values ([k x V + j]) in the value buffers
+  uint terms;            // K
 };
 
-// Basis functions padded to a multiple of 4: Phi rows and weight runs are read as vec4s.
-uint brf_padded(uint basis_count) { return (basis_count + 3u) & ~3u; }
+// Channels padded to a multiple of 4: Phi rows and weight runs are read as vec4s.
+uint brf_padded(uint count) { return (count + 3u) & ~3u; }
 
 // Y_lm(w) for l < 4 (w unit, z up), "l, m" order: index l (l + 1) + m.
 void brf_sh_basis(vec3 w, out float c[16]) {
@@ -111,7 +112,7 @@ float brf_sphere_radius(BrfModel m, uint s) {
 }
 
 // The 8 samples around object-space point p, as in BasisRadianceField::sample: first float
-// of each sample's [basis][coefficient] block (relative to the field) and its weight
+// of each sample's [term][basis][coefficient] block (relative to the field) and its weight
 // (trilinear weight x falloff x (r_s / r)^2 between spheres). Returns false at the centre
 // or for non-finite points (the sample is zero there).
 bool brf_field_corners(BrfModel m, vec3 p, out uint base[8], out float weight[8]) {
@@ -144,7 +145,7 @@ bool brf_field_corners(BrfModel m, vec3 p, out uint base[8], out float weight[8]
   const uint u0 = uint(fu), v0 = uint(fv);
   const uint u1 = min(u0 + 1u, m.face_resolution - 1u), v1 = min(v0 + 1u, m.face_resolution - 1u);
   const float tu = fu - float(u0), tv = fv - float(v0);
-  const uint per_point = m.basis_count * m.sh_bands * m.sh_bands;
+  const uint per_point = m.terms * m.basis_count * m.sh_bands * m.sh_bands;
   const bool between = r > inner && r < outer && m.spheres > 1u;
   const uint cs[8] = uint[8](s0, s0, s0, s0, s1, s1, s1, s1);
   const uint cu[8] = uint[8](u0, u1, u0, u1, u0, u1, u0, u1);

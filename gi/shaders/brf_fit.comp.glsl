@@ -1,10 +1,11 @@
 #version 450 core
-// Least-squares weights of every instance's radiosity over its PCA basis (Iwasaki et al.
-// §5.2, eq. 14), the three RGB channels at once: b = Psi^T L, w = A^-1 b. One work group per
-// instance; an invocation per basis function. L = albedo x gathered (u_mode 0: the last
-// bounce) or albedo x (incoming + indirect) (u_mode 1: the total radiosity, for the static
-// world). The twin of brf_fit_rgb, summed in float instead of double. Writes one rgb vec4 per
-// basis function; the pads up to a multiple of 4 keep the zeros the CPU uploaded.
+// Least-squares weights of every instance's light over its PCA basis (Iwasaki et al. §5.2,
+// eq. 14), per term k and the three RGB channels at once: b_k = Psi^T L_k, w_k = A^-1 b_k.
+// One work group per instance; an invocation per channel (k, i). L_k = reflect(E_k): albedo
+// x E_0 for the irradiance, specular x E_k for the glossy terms, with E = gathered (u_mode 0:
+// the last bounce) or incoming + indirect (u_mode 1: the total light, for the static world).
+// The twin of brf_fit_rgb, summed in float instead of double. Writes one rgb vec4 per channel
+// (k x N + i); the pads up to a multiple of 4 keep the zeros the CPU uploaded.
 
 #include "brf_common.glsl"
 
@@ -21,27 +22,31 @@ layout(std430, binding = 7) writeonly buffer Weights { vec4 weights[]; };
 
 uniform uint u_mode;
 
-const uint kMaxBasis = 64u;  // brf_gpu_pass.cpp rejects larger bases
-shared vec3 s_b[kMaxBasis];
+const uint kMaxChannels = 1024u;  // 64 basis functions x 16 terms (brf_gpu_pass.cpp rejects more)
+shared vec3 s_b[kMaxChannels];
 
 void main() {
   const BrfInstance inst = instances[gl_WorkGroupID.x];
   const BrfModel m = models[inst.model];
-  const uint nb = m.basis_count, nv = m.vertex_count;
-  for (uint i = gl_LocalInvocationIndex; i < nb; i += gl_WorkGroupSize.x) {
+  const uint nb = m.basis_count, nv = m.vertex_count, nc = nb * inst.terms;
+  for (uint ch = gl_LocalInvocationIndex; ch < nc; ch += gl_WorkGroupSize.x) {
+    const uint term = ch / nb, i = ch - term * nb;
     const uint psi_row = m.psi_offset + i * nv;
+    const vec3 reflectance = term == 0u ? inst.albedo.xyz : inst.specular.xyz;
+    const uint first = inst.value_offset + term * nv;
     vec3 b = vec3(0.0);
     for (uint j = 0u; j < nv; ++j) {
-      const uint gv = inst.vertex_offset + j;
+      const uint gv = first + j;
       const vec3 e = u_mode == 0u ? gathered[gv].xyz : incoming[gv].xyz + indirect[gv].xyz;
-      b += psi[psi_row + j] * (inst.albedo.xyz * e);
+      b += psi[psi_row + j] * (reflectance * e);
     }
-    s_b[i] = b;
+    s_b[ch] = b;
   }
   barrier();
-  for (uint r = gl_LocalInvocationIndex; r < nb; r += gl_WorkGroupSize.x) {
+  for (uint ch = gl_LocalInvocationIndex; ch < nc; ch += gl_WorkGroupSize.x) {
+    const uint term = ch / nb, r = ch - term * nb;
     vec3 w = vec3(0.0);
-    for (uint q = 0u; q < nb; ++q) w += a_inverse[m.ainv_offset + r * nb + q] * s_b[q];
-    weights[inst.weight_offset + r] = vec4(w, 0.0);
+    for (uint q = 0u; q < nb; ++q) w += a_inverse[m.ainv_offset + r * nb + q] * s_b[term * nb + q];
+    weights[inst.weight_offset + ch] = vec4(w, 0.0);
   }
 }

@@ -4,12 +4,17 @@
 // points from the model-vertex buffer in the receiver's object space) or static-world
 // receivers (u_kind 1, world-space points picked through an index list). The point goes into
 // the source's object space (to_source), its normal too (normal_to_source, then normalized),
-// and
-//   phi[phi_offset + k N4 + i] = sum over the 8 field samples of weight x (coefficients_i . lobe(n))
-// with lobe = 0 / the unclamped cosine / the clamped cosine as the source's box lies behind /
-// in front of / across the tangent plane (brf_horizon)
-// (N4: N padded to a multiple of 4, the pads written 0)
-// the twin of brf_basis_irradiance (brf_runtime.cpp). Work groups map to (job, first point)
+// and for each receiver term k' (rows; 1 for diffuse receivers and static points) and source
+// channel c (C = terms x N of the source, channel = k x N + i)
+//   phi[phi_offset + (k rows + k') C4 + c] = sum over the 8 field samples of weight x (coefficients_c . lobe_k')
+// with lobe_0 = 0 / the unclamped cosine / the clamped cosine as the source's box lies behind /
+// in front of / across the tangent plane (brf_horizon), and for k' >= 1 (a glossy receiver)
+// the receiver's g_k' cos lobe (lobe SH in the vertex's tangent frame) rotated into the
+// source's space as ShRotation does (least squares over fixed directions), or 0 behind
+// (C4: C padded to a multiple of 4, the pads written 0)
+// the twin of brf_basis_irradiance (brf_runtime.cpp). Built twice: without
+// BRF_GLOSSY_RECEIVER for jobs of one row, with it for glossy receivers (the rotation's local
+// arrays would slow the diffuse jobs on llvmpipe). Work groups map to (job, first point)
 // through the group table, so a dispatch covers many jobs of different lengths.
 
 #include "brf_common.glsl"
@@ -23,6 +28,11 @@ struct PhiJob {
   uint point_offset;      // kind 0: first model vertex; kind 1: first entry of static_indices
   uint point_count;
   uint phi_offset;        // first float written
+  mat4 frame_to_source;   // glossy receiver: rotation (mat3 part) of its object space into the source's
+  uint rows;              // receiver terms K_r (1: diffuse receiver or static point)
+  uint frame_offset;      // glossy receiver: first float of its vertex frames (t, b, n per vertex) in sh_data
+  uint lobe_offset;       // glossy receiver: first float of its lobe SH (16 per glossy term) in sh_data
+  uint pad0;
 };
 
 layout(std430, binding = 0) readonly buffer Models { BrfModel models[]; };
@@ -33,10 +43,17 @@ layout(std430, binding = 4) readonly buffer Jobs { PhiJob jobs[]; };
 layout(std430, binding = 5) readonly buffer Groups { uvec2 groups[]; };  // (job, first point)
 layout(std430, binding = 6) readonly buffer Field { float field[]; };
 layout(std430, binding = 7) writeonly buffer Phi { float phi[]; };
+// sh_rotation_tables(): 26 directions (vec4 each, 104 floats), the pinv of bands 1..3
+// (3, 5, 7 rows x 26, row-major), then the glossy models' lobe SH and vertex frames.
+layout(std430, binding = 8) readonly buffer ShData { float sh_data[]; };
 
 uniform uint u_first_group;
 uniform uint u_group_count;
 uniform uint u_kind;  // 0: instance vertices, 1: static receivers
+
+const uint kDirections = 26u;
+const uint kPinvOffset[4] = uint[4](0u, 104u, 182u, 312u);
+const uint kMaxRows = 16u;  // 1 + kMaxGlossyTerms
 
 void main() {
   const uint group = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
@@ -60,10 +77,12 @@ void main() {
   const vec3 n = normalize(mat3(job.normal_to_source) * n_in);
 
   const BrfModel m = models[job.source_model];
-  const uint nb = m.basis_count, n4 = brf_padded(nb);
+  const uint nc = m.basis_count * m.terms, c4 = brf_padded(nc);
+  const uint rows = job.rows;
+  const uint row0 = job.phi_offset + k * rows * c4;
   const uint side = brf_horizon(m, p, n);
   if (side == 0u) {  // the source is behind the tangent plane: no light
-    for (uint i = 0u; i < n4; ++i) phi[job.phi_offset + k * n4 + i] = 0.0;
+    for (uint i = 0u; i < rows * c4; ++i) phi[row0 + i] = 0.0;
     return;
   }
   float lobe[16];
@@ -75,17 +94,76 @@ void main() {
   float weight[8];
   const bool inside = brf_field_corners(m, p, base, weight);
   const uint cc = m.sh_bands * m.sh_bands;
-  for (uint i = nb; i < n4; ++i) phi[job.phi_offset + k * n4 + i] = 0.0;
-  for (uint i = 0u; i < nb; ++i) {
-    float sum = 0.0;
+  for (uint r = 0u; r < rows; ++r)
+    for (uint i = nc; i < c4; ++i) phi[row0 + r * c4 + i] = 0.0;
+
+#ifndef BRF_GLOSSY_RECEIVER
+  {  // a diffuse receiver or static point: the irradiance row only
+    for (uint i = 0u; i < nc; ++i) {
+      float sum = 0.0;
+      if (inside)
+        for (int c = 0; c < 8; ++c) {
+          if (weight[c] == 0.0) continue;
+          const uint at = m.field_offset + base[c] + i * cc;
+          float d = 0.0;
+          for (uint q = 0u; q < cc; ++q) d += field[at + q] * lobe[q];
+          sum += weight[c] * d;
+        }
+      phi[row0 + i] = sum;
+    }
+    return;
+  }
+#else
+  // A glossy receiver (kind 0 only). ShRotation of R = frame_to_source x tangent frame:
+  // block_l = pinv_l Y_l(R^T D), then out_l = block_l in_l for the source's bands.
+  const uint vertex = k;  // receiver vertex index within its model
+  const uint fo = job.frame_offset + 9u * vertex;
+  const mat3 local = mat3(sh_data[fo], sh_data[fo + 1u], sh_data[fo + 2u], sh_data[fo + 3u], sh_data[fo + 4u],
+                          sh_data[fo + 5u], sh_data[fo + 6u], sh_data[fo + 7u], sh_data[fo + 8u]);
+  const mat3 rt = transpose(mat3(job.frame_to_source) * local);
+  float block[84];  // bands 1..3 at 0, 9, 34 (row-major (2l + 1)^2 each)
+  for (uint i = 0u; i < 84u; ++i) block[i] = 0.0;
+  const uint bo[4] = uint[4](0u, 0u, 9u, 34u);
+  for (uint d = 0u; d < kDirections; ++d) {
+    float y[16];
+    brf_sh_basis(rt * vec3(sh_data[4u * d], sh_data[4u * d + 1u], sh_data[4u * d + 2u]), y);
+    for (uint l = 1u; l < m.sh_bands; ++l) {
+      const uint count = 2u * l + 1u;
+      for (uint a = 0u; a < count; ++a) {
+        const float pa = sh_data[kPinvOffset[l] + a * kDirections + d];
+        for (uint c = 0u; c < count; ++c) block[bo[l] + a * count + c] += pa * y[l * l + c];
+      }
+    }
+  }
+  float lobes[kMaxRows * 16u];
+  for (uint q = 0u; q < 16u; ++q) lobes[q] = lobe[q];
+  for (uint r = 1u; r < rows; ++r) {
+    const uint in0 = job.lobe_offset + (r - 1u) * 16u;
+    lobes[r * 16u] = sh_data[in0];
+    for (uint l = 1u; l < m.sh_bands; ++l) {
+      const uint count = 2u * l + 1u;
+      for (uint a = 0u; a < count; ++a) {
+        float s = 0.0;
+        for (uint c = 0u; c < count; ++c) s += block[bo[l] + a * count + c] * sh_data[in0 + l * l + c];
+        lobes[r * 16u + l * l + a] = s;
+      }
+    }
+  }
+  // Per channel, the sample interpolated as BasisRadianceField::sample does, dotted with every row's lobe.
+  for (uint i = 0u; i < nc; ++i) {
+    float coeffs[16];
+    for (uint q = 0u; q < cc; ++q) coeffs[q] = 0.0;
     if (inside)
       for (int c = 0; c < 8; ++c) {
         if (weight[c] == 0.0) continue;
         const uint at = m.field_offset + base[c] + i * cc;
-        float d = 0.0;
-        for (uint q = 0u; q < cc; ++q) d += field[at + q] * lobe[q];
-        sum += weight[c] * d;
+        for (uint q = 0u; q < cc; ++q) coeffs[q] += weight[c] * field[at + q];
       }
-    phi[job.phi_offset + k * n4 + i] = sum;
+    for (uint r = 0u; r < rows; ++r) {
+      float d = 0.0;
+      for (uint q = 0u; q < cc; ++q) d += coeffs[q] * lobes[r * 16u + q];
+      phi[row0 + r * c4 + i] = d;
+    }
   }
+#endif
 }

@@ -18,7 +18,11 @@ constexpr const char* kWhere = "BRF GPU pass";
 constexpr std::size_t kSsboLimitBytes = std::size_t{128} << 20;  // DESIGN.md §4 (llvmpipe)
 constexpr std::uint32_t kGroupSize = 64;                         // local_size_x of every brf_*.comp.glsl
 constexpr std::uint32_t kMaxGroupsPerDimension = 65535;
-constexpr int kMaxBasis = 64;  // kMaxBasis in brf_fit.comp.glsl
+constexpr int kMaxBasis = 64;  // kMaxChannels = 64 x 16 in brf_fit.comp.glsl
+// sh_data_ layout (ShData in brf_phi.comp.glsl): 26 directions as vec4s, then the pinv of
+// bands 1..3, then the glossy models' lobe SH and vertex frames.
+constexpr std::size_t kShDirections = 26;
+constexpr std::size_t kShTableFloats = 4 * kShDirections + (3 + 5 + 7) * kShDirections;
 
 /// BrfModel in brf_common.glsl (std430).
 struct GpuModel {
@@ -26,18 +30,18 @@ struct GpuModel {
   float outer_radius = 0.0f;
   std::uint32_t spheres = 0, face_resolution = 0, sh_bands = 0;
   std::uint32_t basis_count = 0, vertex_offset = 0, vertex_count = 0, psi_offset = 0;
-  std::uint32_t ainv_offset = 0, field_offset = 0, field_buffer = 0, pad0 = 0;
+  std::uint32_t ainv_offset = 0, field_offset = 0, field_buffer = 0, terms = 1;
   glm::vec4 box_lo{0.0f}, box_hi{0.0f};
 };
 static_assert(sizeof(GpuModel) == 96, "must match BrfModel in brf_common.glsl (std430)");
 
 /// BrfInstance in brf_common.glsl (std430).
 struct GpuInstance {
-  glm::vec4 albedo{0.0f};
+  glm::vec4 albedo{0.0f}, specular{0.0f};
   std::uint32_t model = 0, vertex_offset = 0, vertex_count = 0, weight_offset = 0;
-  std::uint32_t live_first = 0, live_count = 0, pad0 = 0, pad1 = 0;
+  std::uint32_t live_first = 0, live_count = 0, value_offset = 0, terms = 1;
 };
-static_assert(sizeof(GpuInstance) == 48, "must match BrfInstance in brf_common.glsl (std430)");
+static_assert(sizeof(GpuInstance) == 64, "must match BrfInstance in brf_common.glsl (std430)");
 
 static_assert(sizeof(glm::uvec2) == 8 && sizeof(glm::uvec4) == 16 && sizeof(glm::vec4) == 16,
               "uvec2 / uvec4 / vec4 arrays are uploaded as std430 arrays");
@@ -92,8 +96,10 @@ struct BrfPhiJob {
   glm::mat4 to_source{1.0f};
   glm::mat4 normal_to_source{1.0f};
   std::uint32_t source_model = 0, point_offset = 0, point_count = 0, phi_offset = 0;
+  glm::mat4 frame_to_source{1.0f};  // glossy receiver: its object space's rotation into the source's
+  std::uint32_t rows = 1, frame_offset = 0, lobe_offset = 0, pad0 = 0;
 };
-static_assert(sizeof(BrfPhiJob) == 144, "must match PhiJob in brf_phi.comp.glsl (std430)");
+static_assert(sizeof(BrfPhiJob) == 224, "must match PhiJob in brf_phi.comp.glsl (std430)");
 
 void BrfGpuPass::Buffer::reserve(std::size_t size) {
   size = std::max<std::size_t>(size, 16);
@@ -132,15 +138,27 @@ engine::Result<BrfGpuPass> BrfGpuPass::create(std::span<const BrfGpuModel> model
     if (basis.psi.size() != nb * nv || basis.a_inverse.size() != nb * nb)
       return error(which + "basis arrays do not match its size");
     if (f.basis_count != basis.basis_count) return error(which + "the field was computed for another basis");
-    if (f.terms != 1) return error(which + "a glossy field (" + std::to_string(f.terms) + " BRDF terms): the GPU pass takes diffuse objects only");
+    if (model.glossy == nullptr && f.terms != 1)
+      return error(which + "a glossy field (" + std::to_string(f.terms) + " BRDF terms) but no glossy lobe");
+    if (model.glossy != nullptr) {
+      const BrdfSeparation& g = *model.glossy;
+      if (g.terms < 1 || g.terms > kMaxGlossyTerms || f.terms != 1 + g.terms)
+        return error(which + "the field has " + std::to_string(f.terms) + " BRDF terms, the glossy lobe " +
+                     std::to_string(g.terms) + " (+1 diffuse)");
+      if (g.lobe_sh.size() != static_cast<std::size_t>(g.terms) * kMaxShCoefficients)
+        return error(which + "the glossy lobe's SH do not match its terms");
+      for (float v : g.lobe_sh)
+        if (!std::isfinite(v)) return error(which + "non-finite glossy lobe SH");
+    }
+    const std::size_t channels = nb * static_cast<std::size_t>(f.terms);
     if ((f.sh_bands != 3 && f.sh_bands != 4) || f.spheres < 1 || f.face_resolution < 1 || !(f.inner_radius > 0.0f) ||
         !(f.outer_radius >= f.inner_radius) || !std::isfinite(f.outer_radius) || !finite(f.centre))
       return error(which + "field settings out of range");
     const std::size_t points = static_cast<std::size_t>(f.spheres) * 6 * static_cast<std::size_t>(f.face_resolution) *
                                static_cast<std::size_t>(f.face_resolution);
-    if (f.coefficients.size() != points * nb * static_cast<std::size_t>(f.coefficient_count()))
+    if (f.coefficients.size() != points * channels * static_cast<std::size_t>(f.coefficient_count()))
       return error(which + "field holds " + std::to_string(f.coefficients.size()) + " floats, expected " +
-                   std::to_string(points * nb * static_cast<std::size_t>(f.coefficient_count())));
+                   std::to_string(points * channels * static_cast<std::size_t>(f.coefficient_count())));
     if (f.bytes() > limit)
       return error(which + "field of " + std::to_string(f.bytes()) + " bytes is above the SSBO limit of " +
                    std::to_string(limit));
@@ -166,12 +184,29 @@ engine::Result<BrfGpuPass> BrfGpuPass::create(std::span<const BrfGpuModel> model
     if (!built) return built.error();
     *program = std::move(built).value();
   }
+  {
+    auto built = engine::ShaderProgramBuilder(gi_shader_files())
+                     .define("BRF_GLOSSY_RECEIVER 1")
+                     .stage(engine::ShaderStage::Compute, "brf_phi.comp.glsl")
+                     .build();
+    if (!built) return built.error();
+    pass.programs_.phi_glossy = std::move(built).value();
+  }
 
   // Model tables, vertices, bases; fields grouped into buffers under the limit.
   std::vector<GpuModel> table;
   std::vector<glm::vec4> vertices;
   std::vector<float> psi, a_inverse;
   std::vector<std::size_t> field_group_bytes;
+  // SH rotation tables first (brf_phi.comp.glsl's kPinvOffset), then per glossy model.
+  const ShRotationTables& rotation = sh_rotation_tables();
+  GI_EXPECTS(rotation.directions.size() == kShDirections, "ShRotation uses 26 fixed directions");
+  std::vector<float> sh_data;
+  for (const glm::vec3& d : rotation.directions) sh_data.insert(sh_data.end(), {d.x, d.y, d.z, 0.0f});
+  for (int l = 1; l < kMaxShBands; ++l)
+    sh_data.insert(sh_data.end(), rotation.pinv[static_cast<std::size_t>(l)].begin(),
+                   rotation.pinv[static_cast<std::size_t>(l)].end());
+  GI_EXPECTS(sh_data.size() == kShTableFloats, "SH rotation table layout");
   for (const BrfGpuModel& model : models) {
     const BasisRadianceField& f = *model.field;
     GpuModel g;
@@ -190,6 +225,7 @@ engine::Result<BrfGpuPass> BrfGpuPass::create(std::span<const BrfGpuModel> model
     g.ainv_offset = u32(a_inverse.size());
     if (field_group_bytes.empty() || field_group_bytes.back() + f.bytes() > limit) field_group_bytes.push_back(0);
     g.field_buffer = u32(field_group_bytes.size() - 1);
+    g.terms = u32(static_cast<std::size_t>(f.terms));
     g.field_offset = u32(field_group_bytes.back() / sizeof(float));
     field_group_bytes.back() += f.bytes();
     table.push_back(g);
@@ -199,8 +235,28 @@ engine::Result<BrfGpuPass> BrfGpuPass::create(std::span<const BrfGpuModel> model
     }
     psi.insert(psi.end(), model.basis->psi.begin(), model.basis->psi.end());
     a_inverse.insert(a_inverse.end(), model.basis->a_inverse.begin(), model.basis->a_inverse.end());
-    pass.models_.push_back({g.vertex_offset, g.vertex_count, g.basis_count, g.field_buffer, f.outer_radius, f.centre,
-                            model.basis, model.mesh, model.field});
+    ModelInfo info;
+    info.first_vertex = g.vertex_offset;
+    info.vertex_count = g.vertex_count;
+    info.basis_count = g.basis_count;
+    info.terms = g.terms;
+    info.field_buffer = g.field_buffer;
+    info.outer_radius = f.outer_radius;
+    info.field_centre = f.centre;
+    info.basis = model.basis;
+    info.mesh = model.mesh;
+    info.field = model.field;
+    info.glossy = model.glossy;
+    if (model.glossy != nullptr) {  // lobe SH (local frame), object-space tangent frames (columns t, b, n)
+      info.lobe_offset = u32(sh_data.size());
+      sh_data.insert(sh_data.end(), model.glossy->lobe_sh.begin(), model.glossy->lobe_sh.end());
+      info.frame_offset = u32(sh_data.size());
+      for (const glm::vec3& nrm : model.mesh->normals) {
+        const glm::mat3 frame = brf_tangent_frame(nrm);
+        for (int c = 0; c < 3; ++c) sh_data.insert(sh_data.end(), {frame[c].x, frame[c].y, frame[c].z});
+      }
+    }
+    pass.models_.push_back(info);
   }
   const auto upload_once = [&pass](const auto& v) {
     using T = typename std::decay_t<decltype(v)>::value_type;
@@ -213,6 +269,7 @@ engine::Result<BrfGpuPass> BrfGpuPass::create(std::span<const BrfGpuModel> model
   pass.model_vertices_ = upload_once(vertices);
   pass.psi_ = upload_once(psi);
   pass.a_inverse_ = upload_once(a_inverse);
+  pass.sh_data_ = upload_once(sh_data);
   for (std::size_t bytes : field_group_bytes) {
     pass.fields_.push_back(engine::GlBuffer::create(std::max<std::size_t>(bytes, 16), nullptr, GL_DYNAMIC_STORAGE_BIT));
     pass.model_bytes_ += std::max<std::size_t>(bytes, 16);
@@ -258,11 +315,12 @@ engine::Status BrfGpuPass::set_static_receivers(std::span<const glm::vec3> posit
 
 engine::Status BrfGpuPass::reset_layout(std::span<const BrfGpuInstance> instances) {
   const std::size_t n = instances.size();
-  std::vector<std::uint32_t> vertex_offsets(n + 1, 0), weight_offsets(n + 1, 0);
+  std::vector<std::uint32_t> vertex_offsets(n + 1, 0), value_offsets(n + 1, 0), weight_offsets(n + 1, 0);
   for (std::size_t i = 0; i < n; ++i) {
     const ModelInfo& m = models_[instances[i].model];
     vertex_offsets[i + 1] = vertex_offsets[i] + m.vertex_count;
-    weight_offsets[i + 1] = weight_offsets[i] + padded(m.basis_count);  // rgb vec4 per function
+    value_offsets[i + 1] = value_offsets[i] + m.terms * m.vertex_count;
+    weight_offsets[i + 1] = weight_offsets[i] + padded(m.channels());  // rgb vec4 per channel
   }
   std::vector<PairSlot> pairs(n * n);
   std::size_t phi_floats = 0;
@@ -270,31 +328,32 @@ engine::Status BrfGpuPass::reset_layout(std::span<const BrfGpuInstance> instance
     for (std::size_t r = 0; r < n; ++r) {
       if (s == r) continue;
       pairs[s * n + r].phi_offset = u32(phi_floats);
-      phi_floats += static_cast<std::size_t>(models_[instances[r].model].vertex_count) *
-                    padded(models_[instances[s].model].basis_count);
+      const ModelInfo& mr = models_[instances[r].model];
+      phi_floats += static_cast<std::size_t>(mr.vertex_count) * mr.terms * padded(models_[instances[s].model].channels());
     }
   if (phi_floats * sizeof(float) > max_buffer_bytes_)
     return error(std::to_string(n) + " instances need " + std::to_string(phi_floats * sizeof(float)) +
                  " bytes of pair Phi, above the SSBO limit of " + std::to_string(max_buffer_bytes_));
-  if (static_cast<std::size_t>(vertex_offsets[n]) * sizeof(glm::vec4) > max_buffer_bytes_)
+  if (static_cast<std::size_t>(value_offsets[n]) * sizeof(glm::vec4) > max_buffer_bytes_)
     return error("the instances' vertices exceed the SSBO limit");
 
   layout_models_.resize(n);
   for (std::size_t i = 0; i < n; ++i) layout_models_[i] = instances[i].model;
   vertex_offsets_ = std::move(vertex_offsets);
+  value_offsets_ = std::move(value_offsets);
   weight_offsets_ = std::move(weight_offsets);
   pairs_ = std::move(pairs);
   static_slots_.assign(n, StaticSlot{});
   static_touched_count_ = 0;
-  const std::size_t vertex_bytes = static_cast<std::size_t>(vertex_offsets_[n]) * sizeof(glm::vec4);
-  for (Buffer* b : {&incoming_, &gathered_, &indirect_}) b->reserve(vertex_bytes);
+  const std::size_t value_bytes = static_cast<std::size_t>(value_offsets_[n]) * sizeof(glm::vec4);
+  for (Buffer* b : {&incoming_, &gathered_, &indirect_}) b->reserve(value_bytes);
   weights_.reserve(weight_offsets_[n] * sizeof(glm::vec4));
   phi_.reserve(phi_floats * sizeof(float));
   outputs_.clear();
   output_bytes_ = 0;
   for (std::size_t i = 0; i < n; ++i) {
     const std::size_t bytes = std::max<std::size_t>(
-        static_cast<std::size_t>(vertex_offsets_[i + 1] - vertex_offsets_[i]) * sizeof(glm::vec4), 16);
+        static_cast<std::size_t>(value_offsets_[i + 1] - value_offsets_[i]) * sizeof(glm::vec4), 16);
     outputs_.push_back(engine::GlBuffer::create(bytes, nullptr, GL_DYNAMIC_STORAGE_BIT));
     glClearNamedBufferData(outputs_.back().id(), GL_R32F, GL_RED, GL_FLOAT, nullptr);
     output_bytes_ += bytes;
@@ -304,24 +363,24 @@ engine::Status BrfGpuPass::reset_layout(std::span<const BrfGpuInstance> instance
 
 void BrfGpuPass::dispatch_phi(std::span<const BrfPhiJob> jobs, bool static_kind) {
   if (jobs.empty()) return;
-  // Work groups sorted by the source's field buffer: one dispatch per buffer.
+  // Work groups sorted by program (one-row jobs, glossy receivers) and the source's field
+  // buffer: one dispatch per (program, buffer).
   std::vector<glm::uvec2> groups;
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> ranges(fields_.size(), {0u, 0u});
-  for (std::size_t b = 0; b < fields_.size(); ++b) {
-    ranges[b].first = u32(groups.size());
-    for (std::size_t j = 0; j < jobs.size(); ++j) {
-      if (models_[jobs[j].source_model].field_buffer != b) continue;
-      for (std::uint32_t first = 0; first < jobs[j].point_count; first += kGroupSize)
-        groups.emplace_back(u32(j), first);
+  const std::size_t nf = fields_.size();
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> ranges(2 * nf, {0u, 0u});
+  for (std::size_t v = 0; v < 2; ++v)
+    for (std::size_t b = 0; b < nf; ++b) {
+      ranges[v * nf + b].first = u32(groups.size());
+      for (std::size_t j = 0; j < jobs.size(); ++j) {
+        if (models_[jobs[j].source_model].field_buffer != b || (jobs[j].rows > 1) != (v == 1)) continue;
+        for (std::uint32_t first = 0; first < jobs[j].point_count; first += kGroupSize)
+          groups.emplace_back(u32(j), first);
+      }
+      ranges[v * nf + b].second = u32(groups.size()) - ranges[v * nf + b].first;
     }
-    ranges[b].second = u32(groups.size()) - ranges[b].first;
-  }
   jobs_.upload(jobs.data(), jobs.size() * sizeof(BrfPhiJob));
   groups_.upload(groups.data(), groups.size() * sizeof(glm::uvec2));
 
-  const GLuint id = programs_.phi.id();
-  programs_.phi.use();
-  glProgramUniform1ui(id, glGetUniformLocation(id, "u_kind"), static_kind ? 1u : 0u);
   bind(0, model_table_.id());
   bind(1, model_vertices_.id());
   bind(2, static_points_.buffer.id());
@@ -329,12 +388,20 @@ void BrfGpuPass::dispatch_phi(std::span<const BrfPhiJob> jobs, bool static_kind)
   bind(4, jobs_.buffer.id());
   bind(5, groups_.buffer.id());
   bind(7, static_kind ? static_phi_.buffer.id() : phi_.buffer.id());
-  for (std::size_t b = 0; b < fields_.size(); ++b) {
-    if (ranges[b].second == 0) continue;
-    bind(6, fields_[b].id());
-    glProgramUniform1ui(id, glGetUniformLocation(id, "u_first_group"), ranges[b].first);
-    glProgramUniform1ui(id, glGetUniformLocation(id, "u_group_count"), ranges[b].second);
-    dispatch_groups(ranges[b].second);
+  bind(8, sh_data_.id());
+  for (std::size_t v = 0; v < 2; ++v) {
+    const engine::ShaderProgram& program = v == 0 ? programs_.phi : programs_.phi_glossy;
+    const GLuint id = program.id();
+    program.use();
+    glProgramUniform1ui(id, glGetUniformLocation(id, "u_kind"), static_kind ? 1u : 0u);
+    for (std::size_t b = 0; b < nf; ++b) {
+      const auto [first, count] = ranges[v * nf + b];
+      if (count == 0) continue;
+      bind(6, fields_[b].id());
+      glProgramUniform1ui(id, glGetUniformLocation(id, "u_first_group"), first);
+      glProgramUniform1ui(id, glGetUniformLocation(id, "u_group_count"), count);
+      dispatch_groups(count);
+    }
   }
 }
 
@@ -370,7 +437,7 @@ engine::Status BrfGpuPass::update_static(std::span<const BrfGpuInstance> instanc
     } else {
       inside[s] = static_slots_[s].receivers;
     }
-    total_floats += inside[s].size() * padded(model.basis_count);
+    total_floats += inside[s].size() * padded(model.channels());
   }
   if (total_floats * sizeof(float) > max_buffer_bytes_)
     return error("static receivers need " + std::to_string(total_floats * sizeof(float)) +
@@ -389,7 +456,7 @@ engine::Status BrfGpuPass::update_static(std::span<const BrfGpuInstance> instanc
       glCopyNamedBufferSubData(static_phi_.buffer.id(), static_phi_spare_.buffer.id(),
                                static_cast<GLintptr>(slot.phi_offset * sizeof(float)),
                                static_cast<GLintptr>(phi_offset * sizeof(float)),
-                               static_cast<GLsizeiptr>(count * padded(model.basis_count) * sizeof(float)));
+                               static_cast<GLsizeiptr>(count * padded(model.channels()) * sizeof(float)));
     slot.index_offset = u32(indices.size());
     slot.phi_offset = phi_offset;
     if (moved[s] != 0) {
@@ -408,7 +475,7 @@ engine::Status BrfGpuPass::update_static(std::span<const BrfGpuInstance> instanc
       }
     }
     indices.insert(indices.end(), slot.receivers.begin(), slot.receivers.end());
-    phi_offset += u32(count * padded(model.basis_count));
+    phi_offset += u32(count * padded(model.channels()));
   }
   std::swap(static_phi_, static_phi_spare_);
   static_indices_.upload(indices.data(), indices.size() * sizeof(std::uint32_t));
@@ -430,7 +497,7 @@ engine::Status BrfGpuPass::update_static(std::span<const BrfGpuInstance> instanc
   std::vector<glm::uvec4> entries(first);
   for (std::size_t s = 0; s < n; ++s) {
     const StaticSlot& slot = static_slots_[s];
-    const std::uint32_t nb = padded(models_[instances[s].model].basis_count);
+    const std::uint32_t nb = padded(models_[instances[s].model].channels());
     for (std::size_t k = 0; k < slot.receivers.size(); ++k)
       entries[next[slot.receivers[k]]++] =
           glm::uvec4(weight_offsets_[s], (slot.phi_offset + u32(k) * nb) / 4, nb / 4, u32(s));
@@ -460,9 +527,11 @@ engine::Status BrfGpuPass::run(std::span<const BrfGpuInstance> instances,
     const float det = glm::determinant(glm::mat3(inst.object_to_world));
     if (!(std::fabs(det) > 0.0f) || !std::isfinite(det)) return error(which + "singular transform");
     if (!finite(inst.albedo)) return error(which + "non-finite albedo");
-    if (incoming[i].size() != models_[inst.model].vertex_count)
-      return error(which + "incoming light for " + std::to_string(incoming[i].size()) + " vertices, the mesh has " +
-                   std::to_string(models_[inst.model].vertex_count));
+    if (!finite(inst.specular)) return error(which + "non-finite specular colour");
+    const ModelInfo& m = models_[inst.model];
+    if (incoming[i].size() != static_cast<std::size_t>(m.terms) * m.vertex_count)
+      return error(which + "incoming light of " + std::to_string(incoming[i].size()) + " values, the model needs " +
+                   std::to_string(m.terms) + " x " + std::to_string(m.vertex_count) + " (terms x vertices)");
     for (const glm::vec3& e : incoming[i])
       if (!finite(e)) return error(which + "non-finite incoming light");
   }
@@ -485,11 +554,13 @@ engine::Status BrfGpuPass::run(std::span<const BrfGpuInstance> instances,
   std::vector<glm::vec4> weights(weight_offsets_[n], glm::vec4(0.0f));  // pads stay 0
   for (std::size_t i = 0; i < n; ++i) {
     const ModelInfo& m = models_[instances[i].model];
-    objects[i] = {m.mesh, m.basis, m.field, instances[i].object_to_world, instances[i].albedo};
-    light.resize(incoming[i].size());
-    for (std::size_t j = 0; j < light.size(); ++j) light[j] = instances[i].albedo * incoming[i][j];
+    objects[i] = {m.mesh, m.basis, m.field, instances[i].object_to_world, instances[i].albedo, m.glossy,
+                  instances[i].specular};
+    light.resize(incoming[i].size());  // reflect() of brf_runtime.cpp: albedo x E_0, specular x E_k
+    for (std::size_t j = 0; j < light.size(); ++j)
+      light[j] = (j < m.vertex_count ? instances[i].albedo : instances[i].specular) * incoming[i][j];
     first_weights[i] = brf_fit_rgb(*m.basis, light);
-    for (std::size_t k = 0; k < m.basis_count; ++k)
+    for (std::size_t k = 0; k < m.channels(); ++k)
       weights[weight_offsets_[i] + k] =
           glm::vec4(first_weights[i][0][k], first_weights[i][1][k], first_weights[i][2][k], 0.0f);
   }
@@ -503,18 +574,29 @@ engine::Status BrfGpuPass::run(std::span<const BrfGpuInstance> instances,
 
   // Pairs whose relative pose changed (or never computed): Phi jobs; live sources per receiver.
   std::vector<BrfPhiJob> jobs;
-  std::vector<glm::uvec4> live;  // (source's first weight vec4, first Phi vec4, N4 / 4, source)
+  std::vector<glm::uvec4> live;  // (source's first weight vec4, first Phi vec4, C4 / 4, source)
   std::vector<GpuInstance> table(n);
   std::vector<glm::mat4> to_source(n);
-  for (std::size_t s = 0; s < n; ++s) to_source[s] = glm::inverse(instances[s].object_to_world);
+  std::vector<glm::mat3> pure_to_source(n);  // uniform scale removed, as brf_basis_irradiance
+  for (std::size_t s = 0; s < n; ++s) {
+    to_source[s] = glm::inverse(instances[s].object_to_world);
+    const glm::mat3 rot = glm::mat3(to_source[s]);
+    pure_to_source[s] = rot / glm::length(rot[0]);
+  }
   for (std::size_t r = 0; r < n; ++r) {
     const ModelInfo& mr = models_[instances[r].model];
     GpuInstance& g = table[r];
     g.albedo = glm::vec4(instances[r].albedo, 0.0f);
+    g.specular = glm::vec4(instances[r].specular, 0.0f);
     g.model = instances[r].model;
     g.vertex_offset = vertex_offsets_[r];
     g.vertex_count = mr.vertex_count;
     g.weight_offset = weight_offsets_[r];
+    g.value_offset = value_offsets_[r];
+    g.terms = mr.terms;
+    // A glossy receiver's frames: rot(M_r) x brf_tangent_frame(n), as brf_world_vertices.
+    const glm::mat3 receiver_rot =
+        glm::mat3(instances[r].object_to_world) / glm::length(glm::vec3(instances[r].object_to_world[0]));
     g.live_first = u32(live.size());
     for (std::size_t s = 0; s < n; ++s) {
       if (s == r) continue;
@@ -525,7 +607,7 @@ engine::Status BrfGpuPass::run(std::span<const BrfGpuInstance> instances,
       ++stats_.pairs_evaluated;
       PairSlot& slot = pairs_[s * n + r];
       const glm::mat4 relative = to_source[s] * instances[r].object_to_world;
-      live.emplace_back(weight_offsets_[s], slot.phi_offset / 4, padded(models_[instances[s].model].basis_count) / 4,
+      live.emplace_back(weight_offsets_[s], slot.phi_offset / 4, padded(models_[instances[s].model].channels()) / 4,
                         u32(s));
       if (slot.valid && same_pose(slot.pose, relative, pose_tolerance_)) {
         ++stats_.pairs_reused;
@@ -538,6 +620,12 @@ engine::Status BrfGpuPass::run(std::span<const BrfGpuInstance> instances,
       job.point_offset = mr.first_vertex;  // receiver vertices in the model-vertex buffer
       job.point_count = mr.vertex_count;
       job.phi_offset = slot.phi_offset;
+      job.rows = mr.terms;
+      if (mr.glossy != nullptr) {
+        job.frame_to_source = glm::mat4(pure_to_source[s] * receiver_rot);
+        job.frame_offset = mr.frame_offset;
+        job.lobe_offset = mr.lobe_offset;
+      }
       jobs.push_back(job);
       slot.valid = true;
       slot.pose = relative;
@@ -547,9 +635,9 @@ engine::Status BrfGpuPass::run(std::span<const BrfGpuInstance> instances,
   dispatch_phi(jobs, false);
 
   // Frame inputs.
-  std::vector<glm::vec4> in4(vertex_offsets_[n]);
+  std::vector<glm::vec4> in4(value_offsets_[n]);
   for (std::size_t i = 0; i < n; ++i)
-    for (std::size_t j = 0; j < incoming[i].size(); ++j) in4[vertex_offsets_[i] + j] = glm::vec4(incoming[i][j], 0.0f);
+    for (std::size_t j = 0; j < incoming[i].size(); ++j) in4[value_offsets_[i] + j] = glm::vec4(incoming[i][j], 0.0f);
   incoming_.upload(in4.data(), in4.size() * sizeof(glm::vec4));
   instance_table_.upload(table.data(), table.size() * sizeof(GpuInstance));
   weights_.upload(weights.data(), weights.size() * sizeof(glm::vec4));
@@ -610,10 +698,10 @@ engine::Status BrfGpuPass::run(std::span<const BrfGpuInstance> instances,
 
   glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
   for (std::size_t i = 0; i < n; ++i) {
-    const std::size_t bytes = static_cast<std::size_t>(vertex_offsets_[i + 1] - vertex_offsets_[i]) * sizeof(glm::vec4);
+    const std::size_t bytes = static_cast<std::size_t>(value_offsets_[i + 1] - value_offsets_[i]) * sizeof(glm::vec4);
     if (bytes > 0)
       glCopyNamedBufferSubData(indirect_.buffer.id(), outputs_[i].id(),
-                               static_cast<GLintptr>(vertex_offsets_[i] * sizeof(glm::vec4)), 0,
+                               static_cast<GLintptr>(value_offsets_[i] * sizeof(glm::vec4)), 0,
                                static_cast<GLsizeiptr>(bytes));
   }
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_VERTEX_ATTRIB_ARRAY_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
@@ -629,6 +717,17 @@ std::uint32_t BrfGpuPass::vertex_buffer(std::size_t instance) const {
 std::vector<glm::vec3> BrfGpuPass::read_back_vertices(std::size_t instance) const {
   GI_EXPECTS(instance < outputs_.size(), "BrfGpuPass::read_back_vertices: instance out of range of the last run");
   const std::size_t count = vertex_offsets_[instance + 1] - vertex_offsets_[instance];
+  std::vector<glm::vec4> v(count);
+  if (count > 0)
+    glGetNamedBufferSubData(outputs_[instance].id(), 0, static_cast<GLsizeiptr>(count * sizeof(glm::vec4)), v.data());
+  std::vector<glm::vec3> out(count);
+  for (std::size_t j = 0; j < count; ++j) out[j] = glm::vec3(v[j]);
+  return out;
+}
+
+std::vector<glm::vec3> BrfGpuPass::read_back_terms(std::size_t instance) const {
+  GI_EXPECTS(instance < outputs_.size(), "BrfGpuPass::read_back_terms: instance out of range of the last run");
+  const std::size_t count = value_offsets_[instance + 1] - value_offsets_[instance];
   std::vector<glm::vec4> v(count);
   if (count > 0)
     glGetNamedBufferSubData(outputs_[instance].id(), 0, static_cast<GLsizeiptr>(count * sizeof(glm::vec4)), v.data());

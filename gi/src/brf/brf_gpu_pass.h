@@ -2,18 +2,26 @@
 // The basis-radiance-field interreflection on the GPU (Iwasaki et al. §5): the compute twin of
 // gi::brf_interreflect (brf_runtime.h). Models (mesh, PCA basis, field) are uploaded once; a
 // frame uploads the instances' transforms and albedos and the light arriving at their
-// vertices, and compute shaders do the rest:
+// vertices, and compute shaders do the rest. Glossy models (BrfGpuModel::glossy, as
+// BrfObject::glossy) carry K = 1 + glossy terms values per vertex ([k x V + j], brf_runtime.h),
+// have fields with K x N channels and get K Phi rows per vertex as receivers:
 //   - brf_phi.comp.glsl: the basis irradiance Phi of every (source, receiver) pair whose
 //     relative pose changed, all such pairs in one dispatch (a group table maps work groups
 //     to pairs); Phi stays on the GPU between frames, so a frame where nothing moved
 //     evaluates no field (a pair culled for a while keeps its slot and is reused if its pose
 //     is unchanged when it comes back);
-//   - brf_gather.comp.glsl: per bounce, E_r(x_j) = sum_s max(0, sum_i w_s,i Phi_sr,i(x_j));
-//   - brf_fit.comp.glsl: per bounce, the next weights w = A^-1 Psi^T (albedo x E) of every
-//     instance in one dispatch (the first bounce's weights come from the CPU, which needs
-//     them anyway for the pair culling);
-//   - static-world receivers: Phi per source (kept while the source does not move), the fit
-//     of each source's total radiosity and brf_static_gather.comp.glsl.
+//     Rows k' >= 1 of a glossy receiver are its g_k' cos lobes (BrdfSeparation::lobe_sh) in
+//     the vertex's tangent frame, rotated into the source's space by a twin of ShRotation
+//     (least squares over sh_rotation_tables(), frames from brf_tangent_frame uploaded per
+//     model vertex); they depend on the relative pose only, so the cache holds for them too;
+//   - brf_gather.comp.glsl: per bounce, E_r,k'(x_j) = sum_s sum_c w_s,c Phi_sr,(k',c)(x_j),
+//     each source's k' = 0 sum clamped at 0 (the irradiance), the glossy terms signed;
+//   - brf_fit.comp.glsl: per bounce, the next weights w_k = A^-1 Psi^T (reflect(E_k)) of
+//     every instance in one dispatch (albedo x E_0, specular x E_k for k >= 1; the first
+//     bounce's weights come from the CPU, which needs them anyway for the pair culling);
+//   - static-world receivers: Phi per source (one row of C channels; kept while the source
+//     does not move), the fit of each source's total light (all terms) and
+//     brf_static_gather.comp.glsl.
 // Pair culling is brf_pair_culling on the CPU with the same first weights as the CPU twin, so
 // both evaluate the same pairs.
 //   auto pass = gi::BrfGpuPass::create(models).value();          // a GL context is current
@@ -22,13 +30,16 @@
 // Precision: float32 throughout; the fits sum in float where the CPU sums in double. Relative
 // RMSE against brf_interreflect is ~2e-7 on the test scenes (tests/gi/brf_gpu_pass_test.cpp).
 //
-// Limits: every pair's Phi slot (receiver vertices x source basis functions) lives in one
-// SSBO, at most 128 MiB (or GL_MAX_SHADER_STORAGE_BLOCK_SIZE): run() reports an error above
-// it (about 115 instances of 150 vertices and 16 basis functions). Fields are grouped into
-// buffers under the same limit (one Phi dispatch per buffer); one field above it is an error.
+// Limits: every pair's Phi slot (receiver vertices V_r x receiver terms K_r x source channels
+// C_s = K_s N_s, C_s padded to a multiple of 4) lives in one SSBO, at most 128 MiB (or
+// GL_MAX_SHADER_STORAGE_BLOCK_SIZE): run() reports an error above it (about 115 diffuse
+// instances of 150 vertices and 16 basis functions; glossy pairs take K_r K_s times that).
+// Fields are grouped into buffers under the same limit (one Phi dispatch per buffer); one
+// field above it is an error. A basis has at most 64 functions, a glossy lobe at most
+// kMaxGlossyTerms terms (16 values per vertex with the diffuse one).
 //
 // GL state: create(), run(), set_static_receivers() and the read-backs need the creating
-// context current; they change the bound program and shader-storage bindings 0-7.
+// context current; they change the bound program and shader-storage bindings 0-8.
 
 #include <engine/gpu/gl_objects.h>
 #include <engine/gpu/shader_program.h>
@@ -52,6 +63,9 @@ struct BrfGpuModel {
   const BrfMesh* mesh = nullptr;
   const BrfBasis* basis = nullptr;
   const BasisRadianceField* field = nullptr;
+  /// The separated glossy lobe the basis and field were baked with (nullptr: diffuse); the
+  /// field must have 1 + glossy->terms terms. Read at create() only.
+  const BrdfSeparation* glossy = nullptr;
 };
 
 /// One placed object this frame.
@@ -59,6 +73,7 @@ struct BrfGpuInstance {
   std::uint32_t model = 0;          ///< Index into create()'s models.
   glm::mat4 object_to_world{1.0f};  ///< Rigid (rotation + translation; uniform scale allowed).
   glm::vec3 albedo{0.8f};           ///< Diffuse albedo.
+  glm::vec3 specular{1.0f};         ///< Glossy colour (BrfObject::specular); unused for diffuse models.
 };
 
 struct BrfGpuPassOptions {
@@ -77,8 +92,9 @@ struct BrfGpuPassOptions {
 class BrfGpuPass {
  public:
   /// Compiles the shaders and uploads every model's vertices, basis and field. Errors: a null
-  /// pointer, mesh / basis / field that do not belong together, non-finite data, a basis of
-  /// more than 64 functions, a field larger than the SSBO limit, shader build failure.
+  /// pointer, mesh / basis / field that do not belong together, a field whose terms do not
+  /// match the model's glossy lobe (or a glossy field without one), non-finite data, a basis
+  /// of more than 64 functions, a field larger than the SSBO limit, shader build failure.
   static engine::Result<BrfGpuPass> create(std::span<const BrfGpuModel> models, const BrfGpuPassOptions& options = {});
 
   BrfGpuPass() = default;
@@ -92,8 +108,10 @@ class BrfGpuPass {
   /// uploaded once, replacing earlier ones (empty: none). Errors: sizes differ, non-finite.
   engine::Status set_static_receivers(std::span<const glm::vec3> positions, std::span<const glm::vec3> normals);
 
-  /// One frame. incoming[i][j]: irradiance (W/m^2, RGB) arriving at instance i's vertex j
-  /// from outside the objects (direct + world). Computes what brf_interreflect(objects,
+  /// One frame. incoming[i][k x V + j]: light (W/m^2, RGB) arriving at instance i's vertex j
+  /// from outside the objects (direct + world): k = 0 the irradiance, k >= 1 (glossy models
+  /// only) the g_k-weighted irradiance E_k; V values for a diffuse model, K x V for a glossy
+  /// one. Computes what brf_interreflect(objects,
   /// incoming, settings, receivers) computes into vertex_buffer(i) and
   /// static_receiver_buffer(). Errors (nothing is changed): a model index out of range,
   /// incoming sizes that do not match the instances' meshes, non-finite transforms, albedos
@@ -103,12 +121,16 @@ class BrfGpuPass {
                      const BrfUpdateSettings& settings);
 
   /// GL buffer of instance i of the last run: vec4 per vertex, xyz = interreflected
-  /// irradiance (W/m^2), w = 0. Owned by the pass; valid until the instance count changes.
+  /// irradiance (W/m^2), w = 0. A glossy instance's buffer goes on with the glossy terms
+  /// (K x V vec4s, [k x V + j]). Owned by the pass; valid until the instance count changes.
   std::uint32_t vertex_buffer(std::size_t instance) const;
   /// GL buffer: vec4 per static receiver, xyz = irradiance from all objects (W/m^2).
   std::uint32_t static_receiver_buffer() const { return static_out_.buffer.id(); }
-  /// vertex_buffer(i) read back (for tests and tools).
+  /// vertex_buffer(i) read back (for tests and tools): the irradiance, V values.
   std::vector<glm::vec3> read_back_vertices(std::size_t instance) const;
+  /// All terms of instance i, K x V values [k x V + j] as BrfResult::indirect holds them (V
+  /// for a diffuse instance).
+  std::vector<glm::vec3> read_back_terms(std::size_t instance) const;
   /// static_receiver_buffer() read back.
   std::vector<glm::vec3> read_back_static() const;
 
@@ -137,12 +159,17 @@ class BrfGpuPass {
     std::uint32_t first_vertex = 0;  ///< In the model-vertex buffer.
     std::uint32_t vertex_count = 0;
     std::uint32_t basis_count = 0;
+    std::uint32_t terms = 1;          ///< K: 1 + glossy terms.
+    std::uint32_t frame_offset = 0;   ///< Glossy: first float of its vertex frames / lobes in sh_data_.
+    std::uint32_t lobe_offset = 0;
     std::uint32_t field_buffer = 0;
     float outer_radius = 0.0f;
     glm::vec3 field_centre{0.0f};
     const BrfBasis* basis = nullptr;  ///< For the CPU first fit.
     const BrfMesh* mesh = nullptr;    ///< For pair culling (BrfObject).
     const BasisRadianceField* field = nullptr;
+    const BrdfSeparation* glossy = nullptr;
+    std::uint32_t channels() const { return terms * basis_count; }
   };
   /// One ordered (source, receiver) pair's cached Phi.
   struct PairSlot {
@@ -159,7 +186,7 @@ class BrfGpuPass {
     std::uint32_t phi_offset = 0;          ///< First float in static_phi_.
   };
   struct Programs {
-    engine::ShaderProgram phi, fit, gather, static_gather;
+    engine::ShaderProgram phi, phi_glossy, fit, gather, static_gather;  ///< phi_glossy: jobs of K_r > 1 rows
   };
 
   engine::Status reset_layout(std::span<const BrfGpuInstance> instances);
@@ -175,6 +202,8 @@ class BrfGpuPass {
 
   // Uploaded once at create().
   engine::GlBuffer model_table_, model_vertices_, psi_, a_inverse_;
+  /// SH rotation tables, then the glossy models' lobe SH and object-space vertex frames.
+  engine::GlBuffer sh_data_;
   std::vector<engine::GlBuffer> fields_;
   std::size_t model_bytes_ = 0;
 
@@ -186,6 +215,7 @@ class BrfGpuPass {
   // Per layout (instance count and models).
   std::vector<std::uint32_t> layout_models_;
   std::vector<std::uint32_t> vertex_offsets_;  ///< Per instance, plus the total.
+  std::vector<std::uint32_t> value_offsets_;   ///< Per instance (K x V values each), plus the total.
   std::vector<std::uint32_t> weight_offsets_;
   std::vector<PairSlot> pairs_;  ///< [source * n + receiver].
   std::vector<StaticSlot> static_slots_;

@@ -94,6 +94,22 @@ const BandFrames& band_frames() {
 
 }  // namespace
 
+const ShRotationTables& sh_rotation_tables() {
+  static const ShRotationTables tables = [] {
+    const BandFrames& frames = band_frames();
+    ShRotationTables t;
+    t.directions = frames.dirs;
+    for (int l = 1; l < kMaxShBands; ++l) {
+      const Eigen::MatrixXd& p = frames.pinv[static_cast<std::size_t>(l)];
+      std::vector<float>& out = t.pinv[static_cast<std::size_t>(l)];
+      for (Eigen::Index a = 0; a < p.rows(); ++a)
+        for (Eigen::Index n = 0; n < p.cols(); ++n) out.push_back(static_cast<float>(p(a, n)));
+    }
+    return t;
+  }();
+  return tables;
+}
+
 ShRotation::ShRotation(const glm::mat3& r) {
   const BandFrames& frames = band_frames();
   const glm::mat3 rt = glm::transpose(r);

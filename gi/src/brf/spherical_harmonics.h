@@ -8,6 +8,7 @@
 #include <array>
 #include <cstddef>
 #include <span>
+#include <vector>
 
 #include <glm/glm.hpp>
 
@@ -58,5 +59,13 @@ class ShRotation {
   static constexpr std::size_t kOffset[kMaxShBands] = {0, 1, 10, 35};
   std::array<float, 84> m_{};
 };
+
+/// The fixed construction behind ShRotation, for twins of it (the GPU pass): block(l) =
+/// pinv[l] Y_l(R^T directions), pinv[l] row-major (2l + 1) x directions.size() (band 0 empty).
+struct ShRotationTables {
+  std::vector<glm::vec3> directions;
+  std::array<std::vector<float>, kMaxShBands> pinv;
+};
+const ShRotationTables& sh_rotation_tables();
 
 }  // namespace gi
