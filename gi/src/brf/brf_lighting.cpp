@@ -66,7 +66,7 @@ struct BrfLighting::Impl {
 
   bool create_gpu() {
     std::vector<BrfGpuModel> gm;
-    for (const BrfModelData& m : models) gm.push_back({&m.mesh, &m.basis, &m.field});
+    for (const BrfModelData& m : models) gm.push_back({&m.mesh, &m.basis, &m.field, m.glossy ? &*m.glossy : nullptr});
     auto p = BrfGpuPass::create(gm);
     auto sum = engine::ShaderProgramBuilder(gi_shader_files()).stage(engine::ShaderStage::Compute, "brf_vertex_sum.comp.glsl").build();
     auto comp =
@@ -171,7 +171,7 @@ bool BrfLighting::update() {
     const BrfModelData& model = m.models[m.instances[i].model];
     objects.push_back({&model.mesh, &model.basis, &model.field, m.transforms[i], m.instances[i].albedo,
                        model.glossy ? &*model.glossy : nullptr, m.instances[i].specular});
-    gpu_instances.push_back({m.instances[i].model, m.transforms[i], m.instances[i].albedo});
+    gpu_instances.push_back({m.instances[i].model, m.transforms[i], m.instances[i].albedo, m.instances[i].specular});
   }
   // Direct light from every enabled light (static and moving), shadowed by objects and world.
   std::vector<ReferenceLight> all = scene_lights(*m.registry, BakeLights::Static);
