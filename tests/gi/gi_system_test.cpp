@@ -179,4 +179,67 @@ TEST(GISystem, ABundleOfOtherMeshesIsRejectedAsStale) {
   EXPECT_NE(loaded.error().to_string().find("stale"), std::string::npos);
 }
 
+// The red crate made a metal (metallic 1, roughness 0.5): the bake separates its lobe, the
+// system bounces it as a glossy object on the GPU, the crate it stands beside turns red on
+// the facing side, and turning the metal rough makes the bundle stale.
+TEST(GISystem, AMetalCrateBouncesAsAGlossyObject) {
+  auto ctx = engine::GpuContext::create_headless();
+  ASSERT_TRUE(ctx) << "no headless GL context: " << ctx.error().to_string();
+  const auto metal_room = [](float roughness) {
+    auto asset = engine::load_gltf(GI_SOURCE_DIR "/assets/crates_room.gltf").value();
+    for (engine::Material& m : asset.materials)
+      if (m.name == "crate_red") m.metallic = 1.0f, m.roughness = roughness;
+    return engine::instantiate(std::move(asset));
+  };
+  engine::Scene scene = metal_room(0.5f);
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("gi_system_glossy_" + std::to_string(::getpid()) + ".gibake");
+  std::filesystem::remove_all(dir);
+  const auto sources = gi::dynamic_brf_meshes(scene).value();
+  gi::BrfBake brf;
+  brf.settings = gi::brf_preset("preview").value();
+  for (const gi::BrfSource& src : sources) {
+    brf.meshes.push_back(gi::bake_brf_mesh(src, brf.settings).value());
+    EXPECT_EQ(brf.meshes.back().glossy.has_value(), src.name == "crate_red") << src.name;
+  }
+  ASSERT_TRUE(gi::save_brf(dir, brf, scene.assets, "crates_room.gltf"));
+
+  auto loaded = gi::GISystem::load(dir, scene);
+  ASSERT_TRUE(loaded) << loaded.error().to_string();
+  gi::GISystem& gi = **loaded;
+  EXPECT_NE(gi.describe().find("glossy metal (crate_red)"), std::string::npos) << gi.describe();
+  // crate_2 stands at (-0.4, 0, -1.6), unturned: its +z face looks at where the red crate goes.
+  const engine::Entity crate_2 = engine::find_by_name(scene.registry, "crate_2");
+  const engine::MeshRenderer& mr = scene.registry.get<engine::MeshRenderer>(crate_2);
+  const gi::BrfMesh mesh = gi::brf_mesh_from_asset(scene.assets, mr.mesh).value();
+  const auto facing_light = [&] {
+    const std::uint32_t buffer = gi.frame().vertex_irradiance_buffer(crate_2);
+    std::vector<glm::vec4> v(mesh.positions.size());
+    glGetNamedBufferSubData(buffer, 0, static_cast<GLsizeiptr>(v.size() * sizeof(glm::vec4)), v.data());
+    glm::dvec3 sum(0.0);
+    int count = 0;
+    for (std::size_t j = 0; j < v.size(); ++j) {
+      EXPECT_TRUE(std::isfinite(v[j].x) && std::isfinite(v[j].y) && std::isfinite(v[j].z)) << j;
+      if (mesh.normals[j].z > 0.9f) sum += glm::dvec3(v[j]), ++count;
+    }
+    EXPECT_GT(count, 0);
+    return sum / static_cast<double>(std::max(count, 1));
+  };
+  const glm::dvec3 far = facing_light();
+  move_to(scene, "crate_red", {-0.4f, 0.0f, -0.9f});  // 20 cm in front of crate_2's +z face
+  const glm::dvec3 near = facing_light();
+  std::printf("crate_2's face toward the metal crate (W/m^2): far (%.4f, %.4f, %.4f), near (%.4f, %.4f, %.4f)\n", far.x, far.y,
+              far.z, near.x, near.y, near.z);
+  EXPECT_GT(near.x - far.x, 3.0 * std::abs(near.y - far.y));  // the metal's red reflection
+  EXPECT_GT(near.x - far.x, 0.05 * far.x);
+  loaded->reset();
+
+  // The same bundle for a rough red crate: the lobe is part of the mesh hash.
+  engine::Scene rough = metal_room(0.9f);
+  auto stale = gi::GISystem::load(dir, rough);
+  ASSERT_FALSE(stale);
+  EXPECT_NE(stale.error().to_string().find("stale"), std::string::npos) << stale.error().to_string();
+  std::filesystem::remove_all(dir);
+}
+
 }  // namespace

@@ -26,6 +26,8 @@ void stratified(int side, Pcg32& rng, Place place) {
 
 }  // namespace
 
+constexpr float kAreaSampleLift = 1e-3f;  // metres, light_point_emitters
+
 std::vector<PointEmitter> light_point_emitters(std::span<const ReferenceLight> lights, int area_samples,
                                                std::uint64_t seed, const std::vector<bool>* skip) {
   const int side = std::max(1, static_cast<int>(std::ceil(std::sqrt(static_cast<double>(std::max(1, area_samples))))));
@@ -58,7 +60,10 @@ std::vector<PointEmitter> light_point_emitters(std::span<const ReferenceLight> l
         stratified(side, rng, [&](float u, float v) {
           PointEmitter p;
           p.kind = PointEmitter::Kind::Lambertian;
-          p.position = l.position + (2.0f * u - 1.0f) * l.half_x + (2.0f * v - 1.0f) * l.half_y;
+          // 1 mm in front of the light's plane: a panel drawn for the light (its emissive
+          // proxy, just in front of the plane so the light is not inside it) must not shadow
+          // the light's own points.
+          p.position = l.position + (2.0f * u - 1.0f) * l.half_x + (2.0f * v - 1.0f) * l.half_y + kAreaSampleLift * l.direction;
           p.direction = l.direction;
           p.radiant = kPi * l.radiant * area / strata;
           p.area_m2 = area / strata;

@@ -49,7 +49,9 @@ std::vector<PointEmitter> point_emitters(const ReferenceScene& scene, const Refe
                                          int area_samples, std::uint64_t seed);
 
 /// Point emitters of `lights` alone (no emissive geometry; area lights become `area_samples`
-/// Lambertian points each): what a runtime relighting of moving lights needs.
+/// Lambertian points each, 1 mm in front of the light's plane so the panel a scene draws for
+/// the light does not shadow them): what a runtime relighting of moving lights and the
+/// dynamic objects' direct light need.
 /// `skip[i]` (optional, same size) leaves light i out.
 std::vector<PointEmitter> light_point_emitters(std::span<const ReferenceLight> lights, int area_samples,
                                                std::uint64_t seed, const std::vector<bool>* skip = nullptr);
