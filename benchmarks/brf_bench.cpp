@@ -7,7 +7,8 @@
 //   GGX alpha 0.25): K = 1 + terms channels per basis function and K rows per receiver;
 //   BM_BrfGpu: BrfGpuPass::run on llvmpipe (DESIGN.md §4: these are CPU timings; compare
 //   them as ratios), glFinish inside the timed region, with every crate moving each run (all
-//   pairs' Phi re-evaluated) or none moving (every Phi reused; only the bounces run).
+//   pairs' Phi re-evaluated) or none moving (every Phi reused; only the bounces run);
+//   BM_BrfGpuGlossy: the GPU pass with every crate a glossy metal, all moving.
 //   ./build/benchmarks/brf_bench --benchmark_counters_tabular=true
 #include <GL/glcorearb.h>
 
@@ -191,6 +192,38 @@ void BM_BrfGpu(benchmark::State& state) {
   state.counters["gpu_MB"] = static_cast<double>(pass->gpu_bytes()) / 1e6;
 }
 BENCHMARK(BM_BrfGpu)->ArgsProduct({{1, 5, 10, 30}, {0, 1}, {0, 1}})->Unit(benchmark::kMillisecond);
+
+// Every crate a glossy metal (SharedGlossy), every crate moving each run.
+void BM_BrfGpuGlossy(benchmark::State& state) {
+  (void)context();
+  static const SharedGlossy g;
+  const int n = static_cast<int>(state.range(0));
+  const gi::BrfGpuModel model{&g.mesh, &g.basis, &g.field, &g.sep};
+  auto pass = gi::BrfGpuPass::create(std::span(&model, 1));
+  if (!pass) {
+    state.SkipWithError(pass.error().to_string().c_str());
+    return;
+  }
+  const gi::PointEmitter light = grid_light(n);
+  std::vector<gi::BrfObject> objects = crates(n);
+  for (gi::BrfObject& o : objects) o.basis = &g.basis, o.field = &g.field, o.glossy = &g.sep, o.albedo = glm::vec3(0.0f);
+  std::vector<gi::BrfGpuInstance> poses[2];
+  for (int k = 0; k < 2; ++k)
+    for (const gi::BrfObject& o : crates(n, 0.02f * static_cast<float>(k))) poses[k].push_back({0, o.object_to_world, glm::vec3(0.0f)});
+  const auto incoming = gi::brf_direct_light(objects, std::span<const gi::PointEmitter>(&light, 1), nullptr);
+  const gi::BrfUpdateSettings settings{.bounces = 3, .cull_threshold = 0.0f};
+  if (!pass->run(poses[1], incoming, settings)) state.SkipWithError("run failed");
+  glFinish();
+  std::size_t frame = 0;
+  for (auto _ : state) {
+    const auto status = pass->run(poses[frame % 2], incoming, settings);
+    glFinish();
+    if (!status) state.SkipWithError(status.error().to_string().c_str());
+    ++frame;
+  }
+  state.counters["gpu_MB"] = static_cast<double>(pass->gpu_bytes()) / 1e6;
+}
+BENCHMARK(BM_BrfGpuGlossy)->Arg(1)->Arg(5)->Arg(10)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 
