@@ -81,6 +81,15 @@ std::uint32_t u32(std::size_t v) { return static_cast<std::uint32_t>(v); }
 
 /// Basis functions padded to a multiple of 4 (brf_padded in brf_common.glsl): Phi rows and
 /// weight runs are read as vec4s.
+// The xyz of the first `count` vec4s of a GL buffer.
+std::vector<glm::vec3> read_back_vec4s(std::uint32_t buffer, std::size_t count) {
+  std::vector<glm::vec4> v(count);
+  if (count > 0) glGetNamedBufferSubData(buffer, 0, static_cast<GLsizeiptr>(count * sizeof(glm::vec4)), v.data());
+  std::vector<glm::vec3> out(count);
+  for (std::size_t j = 0; j < count; ++j) out[j] = glm::vec3(v[j]);
+  return out;
+}
+
 std::uint32_t padded(std::uint32_t basis_count) { return (basis_count + 3u) & ~3u; }
 
 engine::Result<engine::ShaderProgram> build(const char* file) {
@@ -716,35 +725,17 @@ std::uint32_t BrfGpuPass::vertex_buffer(std::size_t instance) const {
 
 std::vector<glm::vec3> BrfGpuPass::read_back_vertices(std::size_t instance) const {
   GI_EXPECTS(instance < outputs_.size(), "BrfGpuPass::read_back_vertices: instance out of range of the last run");
-  const std::size_t count = vertex_offsets_[instance + 1] - vertex_offsets_[instance];
-  std::vector<glm::vec4> v(count);
-  if (count > 0)
-    glGetNamedBufferSubData(outputs_[instance].id(), 0, static_cast<GLsizeiptr>(count * sizeof(glm::vec4)), v.data());
-  std::vector<glm::vec3> out(count);
-  for (std::size_t j = 0; j < count; ++j) out[j] = glm::vec3(v[j]);
-  return out;
+  return read_back_vec4s(outputs_[instance].id(), vertex_offsets_[instance + 1] - vertex_offsets_[instance]);
 }
 
 std::vector<glm::vec3> BrfGpuPass::read_back_terms(std::size_t instance) const {
   GI_EXPECTS(instance < outputs_.size(), "BrfGpuPass::read_back_terms: instance out of range of the last run");
-  const std::size_t count = value_offsets_[instance + 1] - value_offsets_[instance];
-  std::vector<glm::vec4> v(count);
-  if (count > 0)
-    glGetNamedBufferSubData(outputs_[instance].id(), 0, static_cast<GLsizeiptr>(count * sizeof(glm::vec4)), v.data());
-  std::vector<glm::vec3> out(count);
-  for (std::size_t j = 0; j < count; ++j) out[j] = glm::vec3(v[j]);
-  return out;
+  return read_back_vec4s(outputs_[instance].id(), value_offsets_[instance + 1] - value_offsets_[instance]);
 }
 
 std::vector<glm::vec3> BrfGpuPass::read_back_static() const {
   GI_EXPECTS(!static_out_.buffer.empty(), "BrfGpuPass::read_back_static on an empty (default or moved-from) pass");
-  std::vector<glm::vec4> v(static_count_);
-  if (static_count_ > 0)
-    glGetNamedBufferSubData(static_out_.buffer.id(), 0, static_cast<GLsizeiptr>(static_count_ * sizeof(glm::vec4)),
-                            v.data());
-  std::vector<glm::vec3> out(static_count_);
-  for (std::size_t t = 0; t < static_count_; ++t) out[t] = glm::vec3(v[t]);
-  return out;
+  return read_back_vec4s(static_out_.buffer.id(), static_count_);
 }
 
 std::size_t BrfGpuPass::gpu_bytes() const {
