@@ -39,6 +39,10 @@ class ByteWriter {
     put(static_cast<std::uint64_t>(values.size()));
     append(values.data(), values.size_bytes());
   }
+  template <class T>
+  void put_array(const std::vector<T>& values) {
+    put_array(std::span<const T>(values));
+  }
   /// uint64 length, then the characters.
   void put_string(const std::string& s) {
     put(static_cast<std::uint64_t>(s.size()));

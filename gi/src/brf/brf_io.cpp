@@ -190,11 +190,6 @@ BrfSettings read_settings(JsonFields& f) {
   return s;
 }
 
-template <class T>
-std::span<const T> as_span(const std::vector<T>& v) {
-  return std::span<const T>(v);
-}
-
 }  // namespace
 
 std::string brf_file_name(const std::string& mesh_name) { return "brf_" + mesh_name + ".bin"; }
@@ -226,9 +221,9 @@ engine::Status write_brf_mesh(const fs::path& path, const BrfMeshBake& bake, std
   w.put(b.condition);
   w.put(b.centre);
   w.put(b.radius);
-  w.put_array(as_span(b.psi));
-  w.put_array(as_span(b.a_inverse));
-  w.put_array(as_span(b.singular_values));
+  w.put_array(b.psi);
+  w.put_array(b.a_inverse);
+  w.put_array(b.singular_values);
   w.put(static_cast<std::int32_t>(b.terms));
   w.put(static_cast<std::int32_t>(f.spheres));
   w.put(static_cast<std::int32_t>(f.face_resolution));
@@ -239,7 +234,7 @@ engine::Status write_brf_mesh(const fs::path& path, const BrfMeshBake& bake, std
   w.put(f.inner_radius);
   w.put(f.outer_radius);
   w.put(static_cast<std::uint64_t>(planes.size()));
-  w.put_array(as_span(frame));
+  w.put_array(frame);
   w.put(static_cast<std::int32_t>(bake.glossy ? bake.glossy->terms : 0));
   if (bake.glossy) {
     const BrdfSeparation& g = *bake.glossy;
@@ -247,10 +242,10 @@ engine::Status write_brf_mesh(const fs::path& path, const BrfMeshBake& bake, std
     w.put(g.lobe.alpha);
     w.put(static_cast<std::int32_t>(g.resolution));
     w.put(g.relative_error);
-    w.put_array(as_span(g.g));
-    w.put_array(as_span(g.h));
-    w.put_array(as_span(g.lobe_sh));
-    w.put_array(as_span(g.singular_values));
+    w.put_array(g.g);
+    w.put_array(g.h);
+    w.put_array(g.lobe_sh);
+    w.put_array(g.singular_values);
   }
   return write_blob(path, kBrfMeshMagic, kBrfMeshVersion, w.bytes());
 }

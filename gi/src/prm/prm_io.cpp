@@ -28,11 +28,6 @@ constexpr int kZstdLevel = 9;
 constexpr int kMaxClusters = 65536;
 constexpr int kMaxAtlasSide = 16384;
 
-template <class T>
-std::span<const T> as_span(const std::vector<T>& v) {
-  return std::span<const T>(v);
-}
-
 bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
 std::string str(std::size_t v) { return std::to_string(v); }
@@ -270,13 +265,13 @@ engine::Status write_prm_panes(const fs::path& path, const Prm& prm, const std::
   w.put(static_cast<std::int32_t>(prm.width));
   w.put(static_cast<std::int32_t>(prm.height));
   w.put(static_cast<std::int32_t>(prm.cluster_count));
-  w.put_array(as_span(prm.texels));
-  w.put_array(as_span(position));
-  w.put_array(as_span(normal));
-  w.put_array(as_span(area));
-  w.put_array(as_span(cluster));
-  w.put_array(as_span(prm.cluster_size));
-  w.put_array(as_span(scales));
+  w.put_array(prm.texels);
+  w.put_array(position);
+  w.put_array(normal);
+  w.put_array(area);
+  w.put_array(cluster);
+  w.put_array(prm.cluster_size);
+  w.put_array(scales);
   w.put(static_cast<std::uint64_t>(planes.size()));
   w.put_array(std::span<const std::uint8_t>(reinterpret_cast<const std::uint8_t*>(frame.data()), frame.size()));
   return write_blob(path, kPrmPanesMagic, kPrmPanesVersion, w.bytes());
