@@ -14,40 +14,21 @@
 
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <vector>
 
 #include <benchmark/benchmark.h>
 #include <engine/gpu/context.h>
+
+#include "bench_gl.h"
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "brf/brf_gpu_pass.h"
+#include "brf/brf_mesh.h"
 #include "brf/brf_runtime.h"
 
 namespace {
 
-gi::BrfMesh crate(float half, int n) {
-  gi::BrfMesh m;
-  const glm::vec3 axes[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
-  for (int a = 0; a < 3; ++a)
-    for (float sign : {-1.0f, 1.0f}) {
-      const glm::vec3 nrm = axes[a] * sign;
-      const glm::vec3 t = axes[(a + 1) % 3] * sign, b = axes[(a + 2) % 3];
-      const auto base = static_cast<std::uint32_t>(m.positions.size());
-      for (int i = 0; i <= n; ++i)
-        for (int j = 0; j <= n; ++j) {
-          const float s = (2.0f * static_cast<float>(i) / static_cast<float>(n) - 1.0f) * 0.98f;
-          const float r = (2.0f * static_cast<float>(j) / static_cast<float>(n) - 1.0f) * 0.98f;
-          m.positions.push_back((nrm + s * t + r * b) * half);
-          m.normals.push_back(nrm);
-        }
-      const auto at = [&](int i, int j) { return base + static_cast<std::uint32_t>(i * (n + 1) + j); };
-      for (int i = 0; i < n; ++i)
-        for (int j = 0; j < n; ++j)
-          m.indices.insert(m.indices.end(), {at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j), at(i + 1, j + 1), at(i, j + 1)});
-    }
-  return m;
-}
+gi::BrfMesh crate(float half, int n) { return gi::brf_box_mesh(glm::vec3(half), n); }
 
 struct Shared {
   gi::BrfMesh mesh = crate(0.25f, 4);
@@ -145,20 +126,9 @@ void BM_BrfInterreflectCpuGlossy(benchmark::State& state) {
 }
 BENCHMARK(BM_BrfInterreflectCpuGlossy)->Arg(1)->Arg(5)->Arg(10)->Arg(30)->Unit(benchmark::kMillisecond);
 
-engine::GpuContext& context() {
-  static engine::GpuContext ctx = [] {
-    auto c = engine::GpuContext::create_headless();
-    if (!c) {
-      std::fprintf(stderr, "headless GL context creation failed: %s\n", c.error().to_string().c_str());
-      std::exit(1);
-    }
-    return std::move(c).value();
-  }();
-  return ctx;
-}
 
 void BM_BrfGpu(benchmark::State& state) {
-  (void)context();
+  (void)bench::gl_context();
   const Shared& s = shared();
   const int n = static_cast<int>(state.range(0));
   const bool moving = state.range(1) != 0;
@@ -195,7 +165,7 @@ BENCHMARK(BM_BrfGpu)->ArgsProduct({{1, 5, 10, 30}, {0, 1}, {0, 1}})->Unit(benchm
 
 // Every crate a glossy metal (SharedGlossy), every crate moving each run.
 void BM_BrfGpuGlossy(benchmark::State& state) {
-  (void)context();
+  (void)bench::gl_context();
   static const SharedGlossy g;
   const int n = static_cast<int>(state.range(0));
   const gi::BrfGpuModel model{&g.mesh, &g.basis, &g.field, &g.sep};

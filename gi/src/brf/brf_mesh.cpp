@@ -51,6 +51,29 @@ engine::Material source_material(const engine::SceneAsset& asset, const BrfSourc
 
 }  // namespace
 
+BrfMesh brf_box_mesh(glm::vec3 half, int n, float inset) {
+  BrfMesh m;
+  const glm::vec3 axes[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  for (int a = 0; a < 3; ++a)
+    for (float sign : {-1.0f, 1.0f}) {
+      const glm::vec3 nrm = axes[a] * sign;
+      const glm::vec3 t = axes[(a + 1) % 3] * sign, b = axes[(a + 2) % 3];
+      const auto base = static_cast<std::uint32_t>(m.positions.size());
+      for (int i = 0; i <= n; ++i)
+        for (int j = 0; j <= n; ++j) {
+          const float s = (2.0f * static_cast<float>(i) / static_cast<float>(n) - 1.0f) * inset;
+          const float r = (2.0f * static_cast<float>(j) / static_cast<float>(n) - 1.0f) * inset;
+          m.positions.push_back((nrm + s * t + r * b) * half);
+          m.normals.push_back(nrm);
+        }
+      const auto at = [&](int i, int j) { return base + static_cast<std::uint32_t>(i * (n + 1) + j); };
+      for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j)
+          m.indices.insert(m.indices.end(), {at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+    }
+  return m;
+}
+
 std::string brf_mesh_hash(const BrfMesh& mesh, const std::optional<GlossyLobe>& glossy) {
   ContentHash h;
   h.add_value(static_cast<std::uint64_t>(mesh.positions.size()));

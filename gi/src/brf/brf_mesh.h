@@ -39,6 +39,12 @@ struct BrfSource {
   std::vector<engine::Entity> entities;   ///< Ascending entity index.
 };
 
+/// A box of half extents `half` around the origin made of n x n quads per face, normals
+/// outwards, each face's own vertices (hard edges). `inset` < 1 pulls the vertices inside
+/// their face (0.98: none sits exactly on an edge, where two faces' normals meet). For
+/// tests, benchmarks and tools that need a rigid object without a scene.
+BrfMesh brf_box_mesh(glm::vec3 half, int n, float inset = 0.98f);
+
 /// 16 lowercase hex digits (FNV-1a 64) over the vertex count, positions, normals, indices
 /// and reflectance of `mesh`, in order, then the glossy lobe when there is one. A bake whose
 /// stored hash differs is stale.
