@@ -14,6 +14,8 @@
 #include <benchmark/benchmark.h>
 #include <engine/gpu/context.h>
 
+#include "bench_gl.h"
+
 #include "core/random.h"
 #include "prm/prm.h"
 #include "prm/prm_gpu_pass.h"
@@ -24,17 +26,6 @@ namespace {
 constexpr int kClusters = 128;  // the largest K benchmarked
 constexpr int kAtlasWidth = 1024;
 
-engine::GpuContext& context() {
-  static engine::GpuContext ctx = [] {
-    auto c = engine::GpuContext::create_headless();
-    if (!c) {
-      std::fprintf(stderr, "headless GL context creation failed: %s\n", c.error().to_string().c_str());
-      std::exit(1);
-    }
-    return std::move(c).value();
-  }();
-  return ctx;
-}
 
 // T pane texels: every other texel of a 1024-wide atlas; 128 clusters of pane values in (0, 10).
 gi::Prm synthetic_prm(std::size_t texels) {
@@ -52,7 +43,7 @@ gi::Prm synthetic_prm(std::size_t texels) {
 
 gi::PrmGpuPass& pass_for(std::size_t texels) {
   static std::map<std::size_t, std::unique_ptr<gi::PrmGpuPass>> passes;
-  context();
+  bench::gl_context();
   auto& p = passes[texels];
   if (!p) {
     auto created = gi::PrmGpuPass::create(synthetic_prm(texels));
