@@ -41,6 +41,8 @@ layout(location = 23) uniform float u_ambient_radiance;
 layout(location = 24) uniform float u_split_x;
 layout(location = 25) uniform int u_use_glossy;
 layout(location = 26) uniform int u_double_sided;
+layout(location = 27) uniform float u_specular_factor;       // KHR_materials_specular
+layout(location = 28) uniform vec3 u_specular_color_factor;  // KHR_materials_specular
 
 layout(binding = 0) uniform sampler2D u_base_color_texture;
 layout(binding = 1) uniform sampler2D u_metallic_roughness_texture;
@@ -53,17 +55,13 @@ layout(location = 0) out vec4 o_radiance;
 void main() {
   vec4 base = u_base_color * texture(u_base_color_texture, v_uv0);
   vec4 mr = texture(u_metallic_roughness_texture, v_uv0);
-  float metallic = clamp(u_metallic * mr.b, 0.0, 1.0);
-  float roughness = clamp(u_roughness * mr.g, 0.045, 1.0);
 
   Surface s;
   s.position = v_world;
   s.normal = normalize(v_normal);
   if (u_double_sided != 0 && !gl_FrontFacing) s.normal = -s.normal;
   s.view = normalize(u_camera_position - v_world);
-  s.diffuse_albedo = (1.0 - metallic) * base.rgb;
-  s.f0 = mix(vec3(0.04), base.rgb, metallic);
-  s.alpha = roughness * roughness;
+  s.brdf = gltf_brdf(base.rgb, u_metallic * mr.b, u_roughness * mr.g, u_specular_factor, u_specular_color_factor);
 
   vec3 radiance = u_emissive * texture(u_emissive_texture, v_uv0).rgb;
   // #if guards: llvmpipe runs a loop body at least once (masked) even for zero iterations.
@@ -93,12 +91,21 @@ void main() {
   }
 #endif
 
-  if (gl_FragCoord.x >= u_split_x) {
-    // Indirect irradiance E (W/m^2) reflected by the diffuse lobe: albedo / pi * E.
-    if (u_indirect_mode == 1) radiance += s.diffuse_albedo * u_ambient_radiance;  // E = pi * L_ambient
-    if (u_indirect_mode == 2) radiance += s.diffuse_albedo / PI * texture(u_irradiance_atlas, v_uv1).rgb;
-    if (u_indirect_mode == 3) radiance += s.diffuse_albedo / PI * v_vertex_irradiance;
-    if (u_use_glossy != 0) radiance += texelFetch(u_glossy_radiance, ivec2(gl_FragCoord.xy), 0).rgb;
+  if (gl_FragCoord.x >= u_split_x && u_indirect_mode != 0) {
+    // Indirect irradiance E (W/m^2) without direction information, reflected as uniformly
+    // arriving light is: E / pi x the BRDF's directional albedo, per lobe. A provider's
+    // glossy texture replaces the specular lobe's share where its alpha (coverage) says so.
+    vec3 e = vec3(0.0);
+    if (u_indirect_mode == 1) e = vec3(PI * u_ambient_radiance);
+    if (u_indirect_mode == 2) e = texture(u_irradiance_atlas, v_uv1).rgb;
+    if (u_indirect_mode == 3) e = v_vertex_irradiance;
+    GltfBrdfValue albedo = gltf_directional_albedo(s.brdf, dot(s.normal, s.view));
+    vec3 specular = e / PI * albedo.specular;
+    if (u_use_glossy != 0) {
+      vec4 glossy = texelFetch(u_glossy_radiance, ivec2(gl_FragCoord.xy), 0);
+      specular = mix(specular, glossy.rgb, clamp(glossy.a, 0.0, 1.0));
+    }
+    radiance += e / PI * albedo.diffuse + specular;
   }
   o_radiance = vec4(radiance, 1.0);
 }

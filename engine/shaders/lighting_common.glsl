@@ -1,8 +1,10 @@
-// Direct lighting of the forward pass: light records, BRDF (Lambert + GGX) and the
-// evaluation of point, spot, directional and rectangular area lights in engine units
-// (engine/units.h). Shadows come from shadow_common.glsl.
+// Direct lighting of the forward pass: light records and the evaluation of point, spot,
+// directional and rectangular area lights in engine units (engine/units.h) with glTF's BRDF
+// (gltf_brdf.glsl). Shadows come from shadow_common.glsl.
 
-const float PI = 3.14159265358979;
+#include "gltf_brdf.glsl"
+
+const float PI = GLTF_PI;
 #ifndef AREA_SPECULAR_SIDE
 #define AREA_SPECULAR_SIDE 3
 #endif
@@ -26,53 +28,18 @@ struct GpuLight {
 
 layout(std430, binding = 0) readonly buffer Lights { GpuLight lights[]; };
 
-// The shading point.
+// The shading point: where, which way, and glTF's BRDF there (gltf_brdf.glsl).
 struct Surface {
   vec3 position;
-  vec3 normal;          // unit, facing the viewer's side for double-sided materials
-  vec3 view;            // unit, towards the camera
-  vec3 diffuse_albedo;  // (1 - metallic) * base colour
-  vec3 f0;              // specular reflectance at normal incidence
-  float alpha;          // GGX alpha = roughness^2
+  vec3 normal;  // unit, facing the viewer's side for double-sided materials
+  vec3 view;    // unit, towards the camera
+  GltfBrdf brdf;
 };
 
-float ggx_distribution(float n_dot_h, float alpha) {
-  float a2 = alpha * alpha;
-  float d = n_dot_h * n_dot_h * (a2 - 1.0) + 1.0;
-  return a2 / (PI * d * d);
-}
-
-// Smith height-correlated visibility V = G / (4 NoL NoV) (Heitz 2014, eq. 99).
-float smith_ggx_correlated_visibility(float n_dot_v, float n_dot_l, float alpha) {
-  float a2 = alpha * alpha;
-  float gv = n_dot_l * sqrt(n_dot_v * n_dot_v * (1.0 - a2) + a2);
-  float gl = n_dot_v * sqrt(n_dot_l * n_dot_l * (1.0 - a2) + a2);
-  return 0.5 / max(gv + gl, 1e-7);
-}
-
-vec3 schlick_fresnel(vec3 f0, float v_dot_h) {
-  // pow(x, y) is undefined for x < 0: a v_dot_h rounded just above 1 (the light beside the
-  // camera, as a flashlight is) made NaN pixels.
-  return f0 + (vec3(1.0) - f0) * pow(max(1.0 - v_dot_h, 0.0), 5.0);
-}
-
-// GGX specular BRDF times cos(theta_l) for a unit light direction l.
-vec3 specular_brdf_cos(Surface s, vec3 l) {
-  float n_dot_l = dot(s.normal, l);
-  if (n_dot_l <= 0.0) return vec3(0.0);
-  float n_dot_v = max(dot(s.normal, s.view), 1e-4);
-  vec3 h = normalize(l + s.view);
-  float n_dot_h = clamp(dot(s.normal, h), 0.0, 1.0);
-  float v_dot_h = clamp(dot(s.view, h), 0.0, 1.0);
-  return ggx_distribution(n_dot_h, s.alpha) * smith_ggx_correlated_visibility(n_dot_v, n_dot_l, s.alpha) *
-         schlick_fresnel(s.f0, v_dot_h) * n_dot_l;
-}
-
-// (Lambert + GGX) BRDF times cos(theta_l).
+// The glTF BRDF times cos(theta_l) for a unit light direction l, both lobes.
 vec3 brdf_cos(Surface s, vec3 l) {
-  float n_dot_l = dot(s.normal, l);
-  if (n_dot_l <= 0.0) return vec3(0.0);
-  return s.diffuse_albedo / PI * n_dot_l + specular_brdf_cos(s, l);
+  GltfBrdfValue f = gltf_eval_cos(s.brdf, s.normal, s.view, l);
+  return f.diffuse + f.specular;
 }
 
 // glTF KHR_lights_punctual range window: (1 - (d/range)^4)^2 clamped, 1 when range is 0.
@@ -127,9 +94,12 @@ float clipped_quad_cosine_integral(vec3 q[4], vec3 n) {
 }
 
 // Rectangular area light of radiance L (W/(m^2 sr)), one-sided towards its emission
-// direction. Diffuse: exact irradiance of the rectangle clipped to the horizon
-// (clipped_quad_cosine_integral). Specular: AREA_SPECULAR_SIDE^2 stratified points on the rectangle,
-// each weighted by its solid angle cos(theta_light) dA / d^2 (converges to the integral).
+// direction. Diffuse: the exact irradiance of the rectangle clipped to the horizon
+// (clipped_quad_cosine_integral) times the diffuse lobe's Fresnel weight averaged over the
+// light (glTF's 1 - F(v.h) changes across it). Specular: AREA_SPECULAR_SIDE^2 stratified
+// points on the rectangle, each weighted by its solid angle cos(theta_light) dA / d^2
+// (converges to the integral); the same points give the diffuse weight's average, weighted
+// by cos(theta_surface) x solid angle as the irradiance integral weights them.
 vec3 area_light_radiance(GpuLight light, Surface s) {
   vec3 centre = light.position_type.xyz;
   vec3 dir = light.direction_range.xyz;
@@ -138,21 +108,31 @@ vec3 area_light_radiance(GpuLight light, Surface s) {
   vec3 hy = light.area_half_y.xyz;
   vec3 rel = centre - s.position;
   vec3 q[4] = vec3[4](rel - hx - hy, rel + hx - hy, rel + hx + hy, rel - hx + hy);
-  vec3 result = s.diffuse_albedo / PI * clipped_quad_cosine_integral(q, s.normal);
+  float irradiance_per_radiance = clipped_quad_cosine_integral(q, s.normal);
   const int kSide = AREA_SPECULAR_SIDE;
   float sample_area = 4.0 * length(hx) * length(hy) / float(kSide * kSide);
   vec3 specular = vec3(0.0);
+  float weight_sum = 0.0;
+  float diffuse_weight_sum = 0.0;
   for (int j = 0; j < kSide; ++j) {
     for (int i = 0; i < kSide; ++i) {
       vec2 t = (vec2(i, j) + 0.5) / float(kSide) * 2.0 - 1.0;
       vec3 to_light = rel + t.x * hx + t.y * hy;
       float d2 = max(dot(to_light, to_light), 1e-8);
       vec3 l = to_light * inversesqrt(d2);
-      float cos_light = max(-dot(dir, l), 0.0);
-      specular += specular_brdf_cos(s, l) * cos_light * sample_area / d2;
+      float solid_angle = max(-dot(dir, l), 0.0) * sample_area / d2;
+      specular += gltf_eval_cos(s.brdf, s.normal, s.view, l).specular * solid_angle;
+      float w = max(dot(s.normal, l), 0.0) * solid_angle;
+      weight_sum += w;
+      diffuse_weight_sum += w * gltf_diffuse_weight(s.brdf, dot(s.view, normalize(l + s.view)));
     }
   }
-  return light.radiant.rgb * (result + specular);
+  // All sample points below the horizon while the clipped rectangle is not: the weight
+  // towards the light's centre.
+  float diffuse_weight = weight_sum > 0.0 ? diffuse_weight_sum / weight_sum
+                                          : gltf_diffuse_weight(s.brdf, dot(s.view, normalize(normalize(rel) + s.view)));
+  vec3 diffuse = (1.0 - s.brdf.metallic) * s.brdf.base_color / PI * diffuse_weight * irradiance_per_radiance;
+  return light.radiant.rgb * (diffuse + specular);
 }
 
 // Unshadowed outgoing radiance towards the viewer from one light of each type; `to_light`

@@ -40,9 +40,10 @@ TEST(RendererPointLight, PixelUnderLightIsAlbedoOverPiTimesIntensityOverHeightSq
   const engine::ImageRgbaF img = s.render();
   ASSERT_EQ(img.width, s.cam.size);
   const int c = s.cam.size / 2;  // odd size: the centre pixel looks straight down at the origin
-  // rho/pi * I/h^2 plus the rough dielectric's GGX lobe (F0 = 0.04; 2% here), from the CPU reference.
+  // glTF's dielectric at v = l = n (v.h = 1, F = 0.04): (1 - F) rho / pi + F D V with D = 1 / pi
+  // and V = 1/4 at roughness 1, times I / h^2; the CPU reference must agree.
   const float expected = reference_point_light(kAlbedo, 1.0f, {0, 0, 0}, s.cam.eye, {0, h, 0}, intensity);
-  EXPECT_NEAR(expected, (kAlbedo / kPi + 0.04f * 0.25f / kPi) * intensity / (h * h), 1e-5f);
+  EXPECT_NEAR(expected, (0.96f * kAlbedo / kPi + 0.04f * 0.25f / kPi) * intensity / (h * h), 1e-5f);
   EXPECT_NEAR(red(img, c, c), expected, 0.01f * expected);
   // Off axis: irradiance falls off as I cos^3(theta) / h^2.
   const int px = c + 20;

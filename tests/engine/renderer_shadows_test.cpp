@@ -4,6 +4,8 @@
 
 #include <cmath>
 
+#include <engine/gltf_brdf.h>
+
 #include "engine/renderer_test_scene.h"
 
 namespace {
@@ -218,8 +220,12 @@ TEST(RendererIndirect, AtlasForStaticAndVertexBufferForDynamicMeshes) {
     r->set_indirect_light(&provider);
     r->render(reg, camera);
     const engine::ImageRgbaF img = r->read_hdr();
-    EXPECT_NEAR(red(img, cam.pixel_of({-1.2f, 0, 0})), kAlbedo / kPi * atlas_e, 0.01f * kAlbedo / kPi * atlas_e);
-    EXPECT_NEAR(red(img, cam.pixel_of({1.2f, 0, 0})), kAlbedo / kPi * 4.0f, 0.01f * kAlbedo / kPi * 4.0f);
+    // Irradiance without direction is reflected as uniform light: E / pi x the BRDF's
+    // directional albedo at the view angle (both lobes).
+    const float cos_v = 4.0f / std::sqrt(16.0f + 1.2f * 1.2f);
+    const float albedo = engine::gltf_directional_albedo(engine::gltf_brdf(glm::vec3(kAlbedo), 0.0f, 1.0f), cos_v).sum().x;
+    EXPECT_NEAR(red(img, cam.pixel_of({-1.2f, 0, 0})), albedo / kPi * atlas_e, 0.01f * albedo / kPi * atlas_e);
+    EXPECT_NEAR(red(img, cam.pixel_of({1.2f, 0, 0})), albedo / kPi * 4.0f, 0.01f * albedo / kPi * 4.0f);
     EXPECT_NE(r->last_timings()[1].name.find("test constant"), std::string::npos);
     EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
   }

@@ -148,7 +148,9 @@ inline float red(const engine::ImageRgbaF& img, int x, int y) {
 inline float red(const engine::ImageRgbaF& img, glm::ivec2 p) { return red(img, p.x, p.y); }
 
 /// CPU reference of the renderer's BRDF times cos for a dielectric/metal of grey base
-/// colour: Lambert + GGX (Smith height-correlated visibility, Schlick Fresnel).
+/// colour, written from glTF 2.0's Appendix B independently of engine/gltf_brdf.h:
+/// mix(dielectric = (1 - F_d) Lambert + F_d GGX, metal = F_m GGX, metallic), GGX with Smith
+/// height-correlated visibility, Schlick Fresnel on v.h.
 inline float reference_brdf_cos(float base, float metallic, float roughness, glm::vec3 n, glm::vec3 v, glm::vec3 l) {
   const float nl = glm::dot(n, l);
   if (nl <= 0.0f) return 0.0f;
@@ -161,9 +163,12 @@ inline float reference_brdf_cos(float base, float metallic, float roughness, glm
   const float dd = nh * nh * (a2 - 1.0f) + 1.0f;
   const float d = a2 / (kPi * dd * dd);
   const float vis = 0.5f / (nl * std::sqrt(nv * nv * (1 - a2) + a2) + nv * std::sqrt(nl * nl * (1 - a2) + a2));
-  const float f0 = 0.04f * (1.0f - metallic) + base * metallic;
-  const float f = f0 + (1.0f - f0) * std::pow(1.0f - vh, 5.0f);
-  return ((1.0f - metallic) * base / kPi + d * vis * f) * nl;
+  const float w = std::pow(1.0f - vh, 5.0f);
+  const float f_dielectric = 0.04f + 0.96f * w;
+  const float f_metal = base + (1.0f - base) * w;
+  const float dielectric = (1.0f - f_dielectric) * base / kPi + f_dielectric * d * vis;
+  const float metal = f_metal * d * vis;
+  return ((1.0f - metallic) * dielectric + metallic * metal) * nl;
 }
 
 /// Radiance at plane point p (normal +Y) seen from `eye`, lit by a point light.

@@ -57,8 +57,8 @@ TEST(BrfRuntime, TwoBoxesMatchThePathTracersInterreflection) {
   gi::ReferenceScene ref;
   const auto add = [&](const gi::BrfMesh& mesh, const glm::mat4& m, glm::vec3 albedo) {
     gi::RtGeometry g{mesh.positions, mesh.indices};
-    gi::ReferenceMaterial mat = reftest::lambert(0.0f);
-    mat.diffuse_albedo = albedo;
+    gi::ReferenceMaterial mat;
+    mat.brdf = engine::gltf_lambertian(albedo);
     reftest::add_geometry(ref, std::move(g), mat);
     ref.geometry.instances.back().object_to_world = m;
   };

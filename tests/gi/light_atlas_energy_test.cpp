@@ -19,7 +19,7 @@ namespace {
 TEST(LightAtlasEnergy, ClosedBoxMatchesGeometricSeries) {
   for (float base : {0.5f, 0.8f}) {
     const engine::Scene scene = engine::instantiate(latest::closed_box(2.0f, base, {0.3f, -0.2f, 0.1f}, 5.0f));
-    const double rho = double{gi::hemispherical_albedo(gi::reference_material(scene.assets.materials[0])).y};
+    const double rho = double{engine::gltf_hemispherical_albedo(gi::reference_material(scene.assets.materials[0]).brdf).sum().y};
     gi::LightAtlasSettings s;
     s.texels_per_metre = 8.0f;
     s.vpl_count = 600;

@@ -29,10 +29,15 @@ constexpr float kPi = 3.14159265358979f;
 constexpr int kSize = 96;
 
 // The Cornell box with its lights switched off: only the emissive quad and indirect light.
-engine::SceneAsset dark_cornell() {
+// The Cornell box without its light; `lambertian` removes the materials' specular layer
+// (KHR_materials_specular factor 0), so that the BRDF's reflectance is the base colour
+// exactly at every view angle.
+engine::SceneAsset dark_cornell(bool lambertian = false) {
   auto asset = engine::load_gltf(GI_SOURCE_DIR "/assets/cornell_box.gltf");
   EXPECT_TRUE(asset.ok()) << asset.error().to_string();
   for (engine::NamedLight& l : asset->lights) l.light.enabled = false;
+  if (lambertian)
+    for (engine::Material& m : asset->materials) m.specular_factor = 0.0f;
   return std::move(asset).value();
 }
 
@@ -165,7 +170,7 @@ TEST(LightAtlasLighting, ConstantAtlasMatchesTheConstantAmbientStandIn) {
 }
 
 TEST(LightAtlasLighting, OneLitChartLightsExactlyItsPixels) {
-  engine::SceneAsset original = dark_cornell();
+  engine::SceneAsset original = dark_cornell(/*lambertian=*/true);
   const std::vector<gi::AtlasInputMesh> inputs = gi::atlas_inputs_from(original);
   gi::LightAtlasBake dark = uniform_bake(original, glm::vec3(0.0f));
   gi::LightAtlasBake lit = dark;

@@ -31,7 +31,7 @@ engine::Scene cornell_box() {
 TEST(ReferenceCornellBox, EnergyBalance) {
   const engine::Scene scene = cornell_box();
   gi::ReferenceScene s = gi::reference_scene_from(scene);
-  for (gi::ReferenceMaterial& m : s.materials) m.f0 = glm::vec3(0.0f);
+  for (gi::ReferenceMaterial& m : s.materials) m.brdf = engine::gltf_lambertian(m.brdf.base_color);
   auto index = gi::index_reference_scene(s);
   ASSERT_TRUE(index) << index.error().to_string();
   ASSERT_FALSE(index->emitters.triangle.empty());
@@ -52,7 +52,7 @@ TEST(ReferenceCornellBox, EnergyBalance) {
       float u = rng.next_float(), v = rng.next_float();
       if (u + v > 1.0f) { u = 1.0f - u; v = 1.0f - v; }
       points.push_back({tri.p0 + u * tri.e1 + v * tri.e2, tri.face_normal});
-      weight.push_back(glm::dvec3(1.0f - s.materials[tri.material].diffuse_albedo) *
+      weight.push_back(glm::dvec3(1.0f - s.materials[tri.material].brdf.base_color) *
                        (static_cast<double>(tri.area_m2) / n));
     }
   }

@@ -33,9 +33,7 @@ inline void add_geometry(gi::ReferenceScene& s, gi::RtGeometry g, const gi::Refe
 
 inline gi::ReferenceMaterial lambert(float albedo, glm::vec3 emission = glm::vec3(0.0f)) {
   gi::ReferenceMaterial m;
-  m.diffuse_albedo = glm::vec3(albedo);
-  m.f0 = glm::vec3(0.0f);
-  m.alpha = 1.0f;
+  m.brdf = engine::gltf_lambertian(glm::vec3(albedo));
   m.emission = emission;
   return m;
 }

@@ -35,6 +35,10 @@ struct Material {
   float roughness = 1.0f;
   /// Emitted radiance, W/(m^2 sr) (glTF emissiveFactor x KHR_materials_emissive_strength).
   glm::vec3 emissive{0.0f};
+  /// KHR_materials_specular: strength of the dielectric's specular layer (0: pure
+  /// Lambertian) and the colour its F0 (0.04) is multiplied by. Metals ignore both.
+  float specular_factor = 1.0f;
+  glm::vec3 specular_color_factor{1.0f};
   int base_color_texture = -1;
   int metallic_roughness_texture = -1;
   int normal_texture = -1;

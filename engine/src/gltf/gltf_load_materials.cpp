@@ -116,6 +116,31 @@ Result<float> unit_factor(const Context& ctx, double v, const std::string& where
   return static_cast<float>(v);
 }
 
+// KHR_materials_specular's factors: specularFactor in [0, 1] (0: no specular layer, a pure
+// Lambertian dielectric), specularColorFactor >= 0 per channel (the BRDF clamps 0.04 x it to
+// 1). Its textures are not read: the factors alone apply.
+Status read_specular_extension(const Context& ctx, const Json* exts, const std::string& where, Material& m) {
+  const Json* ext = exts != nullptr ? find_member(*exts, "KHR_materials_specular") : nullptr;
+  if (ext == nullptr) return {};
+  const std::string at = where + " KHR_materials_specular";
+  auto factor = number_member(ctx, *ext, "specularFactor", 1.0, at);
+  if (!factor) return factor.error();
+  auto weight = unit_factor(ctx, *factor, at, "specularFactor");
+  if (!weight) return weight.error();
+  m.specular_factor = *weight;
+  const Json* color = find_member(*ext, "specularColorFactor");
+  if (color == nullptr) return {};
+  if (!color->is_array() || color->size() != 3) return ctx.error(at, "specularColorFactor must be an array of 3 numbers");
+  for (std::size_t c = 0; c < 3; ++c) {
+    const Json& v = (*color)[c];
+    if (!v.is_number() || !std::isfinite(v.get<double>()) || v.get<double>() < 0.0 || v.get<double>() > 1e6) {
+      return ctx.error(at, "specularColorFactor components must be finite numbers in [0, 1e6]");
+    }
+    m.specular_color_factor[static_cast<glm::length_t>(c)] = static_cast<float>(v.get<double>());
+  }
+  return {};
+}
+
 }  // namespace
 
 Result<std::vector<Material>> convert_materials(const Context& ctx, const ParsedFile& file) {
@@ -147,9 +172,10 @@ Result<std::vector<Material>> convert_materials(const Context& ctx, const Parsed
       if (!v) return v.error();
       m.emissive[c] = *v;
     }
-    // KHR_materials_emissive_strength: emissiveStrength >= 0 multiplies emissiveFactor.
     if (json_materials != nullptr && i < json_materials->size()) {
       const Json* exts = find_member((*json_materials)[i], "extensions");
+      if (auto ok = read_specular_extension(ctx, exts, where, m); !ok) return ok.error();
+      // KHR_materials_emissive_strength: emissiveStrength >= 0 multiplies emissiveFactor.
       const Json* strength_ext = exts != nullptr ? find_member(*exts, "KHR_materials_emissive_strength") : nullptr;
       if (strength_ext != nullptr) {
         auto strength = number_member(ctx, *strength_ext, "emissiveStrength", 1.0,

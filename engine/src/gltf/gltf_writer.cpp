@@ -152,6 +152,11 @@ class GltfBuilder {
       } else if (peak > 0.0f) {
         j["emissiveFactor"] = vec(m.emissive);
       }
+      if (m.specular_factor != 1.0f || m.specular_color_factor != glm::vec3(1.0f)) {
+        j["extensions"]["KHR_materials_specular"] = {{"specularFactor", num(m.specular_factor)},
+                                                     {"specularColorFactor", vec(m.specular_color_factor)}};
+        used_.insert("KHR_materials_specular");
+      }
       if (m.double_sided) j["doubleSided"] = true;
       materials.push_back(std::move(j));
     }

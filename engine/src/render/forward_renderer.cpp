@@ -14,6 +14,7 @@
 
 #include <engine/components.h>
 #include <engine/gpu/gl_objects.h>
+#include <engine/gpu/gltf_brdf_texture.h>
 #include <engine/gpu/gpu_timer.h>
 #include <engine/gpu/shader_program.h>
 
@@ -78,7 +79,8 @@ class ForwardRenderer final : public Renderer {
         shadow_(std::move(shadow)),
         tonemap_(std::move(tonemap)),
         lights_buffer_(GlBuffer::create()),
-        empty_vao_(GlVertexArray::create()) {
+        empty_vao_(GlVertexArray::create()),
+        albedo_table_(upload_gltf_albedo_table()) {
     forward_variants_.emplace(LightCounts{0, 0, 0, 0, 3}, std::move(forward));
     ensure_targets();
   }
@@ -112,6 +114,7 @@ class ForwardRenderer final : public Renderer {
   render::ShadowMaps shadow_maps_;
   GlBuffer lights_buffer_;
   GlVertexArray empty_vao_;
+  GlTexture albedo_table_;  // gltf_brdf.glsl's directional albedo table
   GlTexture hdr_;
   GlTexture depth_;
   GlTexture ldr_;
@@ -234,6 +237,7 @@ void ForwardRenderer::forward_pass(const Registry& registry, Entity camera, cons
   const GLuint glossy = indirect ? indirect->glossy_radiance_texture : 0;
   glBindTextureUnit(kIrradianceAtlasUnit, atlas != 0 ? atlas : scene_.white_texture());
   glBindTextureUnit(kGlossyUnit, glossy != 0 ? glossy : scene_.white_texture());
+  glBindTextureUnit(kGltfAlbedoTableUnit, albedo_table_.id());
 
   glUniformMatrix4fv(8, 1, GL_FALSE, glm::value_ptr(view_proj));
   glUniform3fv(16, 1, glm::value_ptr(camera_position));
@@ -271,6 +275,8 @@ void ForwardRenderer::forward_pass(const Registry& registry, Entity camera, cons
       glUniform1f(20, m.roughness);
       glUniform3fv(21, 1, glm::value_ptr(m.emissive));
       glUniform1i(26, m.double_sided ? 1 : 0);
+      glUniform1f(27, m.specular_factor);
+      glUniform3fv(28, 1, glm::value_ptr(m.specular_color_factor));
       glBindTextureUnit(kBaseColorUnit, m.base_color_texture);
       glBindTextureUnit(kMetallicRoughnessUnit, m.metallic_roughness_texture);
       glBindTextureUnit(kEmissiveUnit, m.emissive_texture);

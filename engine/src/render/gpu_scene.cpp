@@ -147,6 +147,8 @@ Result<GpuScene> GpuScene::upload(const SceneAsset& assets) {
     gm.metallic = src.metallic;
     gm.roughness = src.roughness;
     gm.emissive = src.emissive;
+    gm.specular_factor = src.specular_factor;
+    gm.specular_color_factor = src.specular_color_factor;
     gm.double_sided = src.double_sided;
     auto base = texture(src.base_color_texture, true, i, "baseColorTexture");
     if (!base) return base.error();

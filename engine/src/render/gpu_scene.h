@@ -42,6 +42,8 @@ struct GpuMaterial {
   float metallic = 0.0f;
   float roughness = 1.0f;
   glm::vec3 emissive{0.0f};
+  float specular_factor = 1.0f;
+  glm::vec3 specular_color_factor{1.0f};
   bool double_sided = false;
   std::uint32_t base_color_texture = 0;  ///< GL names (0: the white default).
   std::uint32_t metallic_roughness_texture = 0;

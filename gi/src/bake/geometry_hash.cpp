@@ -23,6 +23,8 @@ void add_material(ContentHash& h, const engine::SceneAsset& scene, int index) {
   h.add_value(m.metallic);
   h.add_value(m.roughness);
   add_vec(h, m.emissive);
+  h.add_value(m.specular_factor);
+  add_vec(h, m.specular_color_factor);
   const int t = m.base_color_texture;
   if (t >= 0 && static_cast<std::size_t>(t) < scene.images.size()) {
     const engine::Image& image = scene.images[static_cast<std::size_t>(t)];
@@ -54,7 +56,9 @@ void add_primitive(ContentHash& h, const engine::Primitive& p) {
 
 std::string scene_geometry_hash(const engine::SceneAsset& scene) {
   ContentHash h;
-  h.add_string("gi scene geometry v1");
+  // v2: glTF's BRDF (engine/gltf_brdf.h) replaced Lambert + GGX; a bundle baked with the old
+  // reflectances is stale even where the geometry is the same.
+  h.add_string("gi scene geometry v2");
   for (std::size_t n = 0; n < scene.nodes.size(); ++n) {
     const engine::Node& node = scene.nodes[n];
     if (node.mesh < 0 || static_cast<std::size_t>(node.mesh) >= scene.meshes.size()) continue;

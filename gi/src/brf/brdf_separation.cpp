@@ -32,9 +32,12 @@ glm::mat3 brf_tangent_frame(const glm::vec3& n) {
 
 float glossy_lobe_brdf(const GlossyLobe& lobe, const glm::vec3& w_in, const glm::vec3& w_out) {
   if (w_in.z <= 0.0f || w_out.z <= 0.0f) return 0.0f;
-  const ReferenceBrdf f{.normal = glm::vec3(0.0f, 0.0f, 1.0f), .diffuse_albedo = glm::vec3(0.0f), .f0 = glm::vec3(lobe.f0),
-                        .alpha = lobe.alpha};
-  return f.eval_cos(w_out, w_in).x / w_in.z;
+  // The lobe is glTF's conductor: a metal whose base colour is f0.
+  engine::GltfBrdf metal;
+  metal.base_color = glm::vec3(lobe.f0);
+  metal.metallic = 1.0f;
+  metal.alpha = lobe.alpha;
+  return engine::gltf_eval_cos(metal, glm::vec3(0.0f, 0.0f, 1.0f), w_out, w_in).specular.x / w_in.z;
 }
 
 namespace {

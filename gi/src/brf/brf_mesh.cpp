@@ -173,17 +173,23 @@ engine::Result<std::vector<BrfSource>> dynamic_brf_meshes(const engine::Scene& s
 }
 
 std::optional<GlossyLobe> brf_glossy_lobe(const engine::Material& material, glm::vec3* specular) {
-  const ReferenceMaterial m = reference_material(material);
-  const float top = std::max(m.f0.x, std::max(m.f0.y, m.f0.z));
+  const engine::GltfBrdf b = reference_material(material).brdf;
+  // Reflectance of the specular lobe at normal incidence: the metal's base colour, the
+  // dielectric's weighted F0, mixed by metallic (glTF's material = mix(dielectric, metal)).
+  const glm::vec3 f0 = (1.0f - b.metallic) * b.specular_weight * b.dielectric_f0 + b.metallic * b.base_color;
+  const float top = std::max(f0.x, std::max(f0.y, f0.z));
   if (!(material.roughness < 0.6f) || !(top >= 0.2f)) return std::nullopt;
-  const float mean = (m.f0.x + m.f0.y + m.f0.z) / 3.0f;
-  if (specular != nullptr) *specular = m.f0 / mean;
-  return GlossyLobe{.f0 = std::min(mean, 1.0f), .alpha = std::clamp(m.alpha, 1e-3f, 1.0f)};
+  const float mean = (f0.x + f0.y + f0.z) / 3.0f;
+  if (specular != nullptr) *specular = f0 / mean;
+  return GlossyLobe{.f0 = std::min(mean, 1.0f), .alpha = std::clamp(b.alpha, 1e-3f, 1.0f)};
 }
 
 glm::vec3 brf_source_albedo(const engine::SceneAsset& asset, const BrfSource& source) {
   const ReferenceMaterial m = reference_material(source_material(asset, source));
-  return source.glossy ? m.diffuse_albedo : hemispherical_albedo(m);
+  // A glossy source carries its specular lobe in separated terms; only the diffuse lobe's
+  // share is folded into the diffuse reflectance.
+  const engine::GltfBrdfValue albedo = engine::gltf_hemispherical_albedo(m.brdf);
+  return source.glossy ? albedo.diffuse : albedo.sum();
 }
 
 }  // namespace gi

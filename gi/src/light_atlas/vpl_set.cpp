@@ -11,31 +11,6 @@
 
 namespace gi {
 
-glm::vec3 hemispherical_albedo(const ReferenceMaterial& material, int samples) {
-  if (material.f0 == glm::vec3(0.0f)) return material.diffuse_albedo;
-  const ReferenceBrdf brdf{.normal = glm::vec3(0.0f, 0.0f, 1.0f),
-                           .diffuse_albedo = material.diffuse_albedo,
-                           .f0 = material.f0,
-                           .alpha = material.alpha};
-  // Stratified over the cosine-weighted outgoing direction, one BRDF sample per stratum.
-  const int side = std::max(1, static_cast<int>(std::sqrt(static_cast<double>(samples))));
-  Pcg32 rng = Pcg32::for_item(0x5eed, 0);
-  glm::dvec3 sum(0.0);
-  for (int a = 0; a < side; ++a) {
-    for (int b = 0; b < side; ++b) {
-      const float u1 = (static_cast<float>(a) + rng.next_float()) / static_cast<float>(side);
-      const float u2 = (static_cast<float>(b) + rng.next_float()) / static_cast<float>(side);
-      const glm::vec3 wo = sample_cosine_hemisphere(brdf.normal, u1, u2);
-      BrdfSample s;
-      const float ul = rng.next_float();
-      const float v1 = rng.next_float();
-      const float v2 = rng.next_float();
-      if (wo.z > 0.0f && brdf.sample(wo, ul, v1, v2, s)) sum += glm::dvec3(s.weight);
-    }
-  }
-  return glm::vec3(sum / static_cast<double>(side * side));
-}
-
 namespace {
 
 // One chart in its plane: the 2-D triangles and a bucket grid over them for point location.
@@ -212,7 +187,7 @@ engine::Result<VplSet> distribute_vpls(const ReferenceScene& scene, const Refere
   std::unordered_map<std::uint32_t, glm::vec3> albedo_cache;
   const auto albedo = [&](std::uint32_t m) {
     auto it = albedo_cache.find(m);
-    if (it == albedo_cache.end()) it = albedo_cache.emplace(m, hemispherical_albedo(scene.materials[m])).first;
+    if (it == albedo_cache.end()) it = albedo_cache.emplace(m, engine::gltf_hemispherical_albedo(scene.materials[m].brdf).sum()).first;
     return it->second;
   };
 

@@ -65,11 +65,6 @@ inline std::uint32_t pick_sample(const VplSet& vpls, std::size_t i, std::uint64_
   return vpls.sample_first[i] + static_cast<std::uint32_t>(h % vpls.sample_count(i));
 }
 
-/// Directional-hemispherical reflectance of a material's BRDF averaged over cosine-weighted
-/// incidence (the energy a diffuse patch of it reflects), estimated with `samples`
-/// stratified BRDF samples from a fixed seed. A Lambertian material returns its albedo.
-glm::vec3 hemispherical_albedo(const ReferenceMaterial& material, int samples = 4096);
-
 /// VPLs over the triangles of the instances of `scene` whose `dynamic` flag is false.
 /// Triangles are charted per instance (uv/chart_builder.h). Errors: no static surface area,
 /// settings out of range.

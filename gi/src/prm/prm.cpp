@@ -121,7 +121,7 @@ engine::Result<Prm> bake_prm(const engine::Scene& scene, const PrmSettings& sett
   for (std::size_t t = 0; t < triangle_albedo.size(); ++t) {
     const std::uint32_t m = s.index.triangles[t].material;
     auto it = material_albedo.find(m);
-    if (it == material_albedo.end()) it = material_albedo.emplace(m, hemispherical_albedo(s.scene.materials[m])).first;
+    if (it == material_albedo.end()) it = material_albedo.emplace(m, engine::gltf_hemispherical_albedo(s.scene.materials[m].brdf).sum()).first;
     triangle_albedo[t] = it->second;
   }
 

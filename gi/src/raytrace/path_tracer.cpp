@@ -176,8 +176,7 @@ PathTracer::Irradiance PathTracer::irradiance(const glm::vec3& p, const glm::vec
   // The receiver is a cosine lobe: "BRDF x cos" = cos, sampled with density cos / pi.
   ReferenceBrdf receiver;
   receiver.normal = n;
-  receiver.diffuse_albedo = glm::vec3(kPi);
-  receiver.f0 = glm::vec3(0.0f);
+  receiver.material = engine::gltf_lambertian(glm::vec3(kPi));
   const glm::vec3 origin = offset_ray_origin(p, n);
   Irradiance e;
   e.direct = direct_light(origin, p, receiver, n, rng);

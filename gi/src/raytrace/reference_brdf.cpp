@@ -11,30 +11,10 @@ constexpr float kPi = std::numbers::pi_v<float>;
 
 float luminance(const glm::vec3& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 
-float ggx_d(float n_dot_h, float alpha) {
-  const float a2 = alpha * alpha;
-  const float d = n_dot_h * n_dot_h * (a2 - 1.0f) + 1.0f;
-  return a2 / (kPi * d * d);
-}
-
-// Heitz 2014, eq. 99: V = G2 / (4 NoL NoV), height-correlated (as the renderer).
-float smith_visibility(float n_dot_v, float n_dot_l, float alpha) {
-  const float a2 = alpha * alpha;
-  const float gv = n_dot_l * std::sqrt(n_dot_v * n_dot_v * (1.0f - a2) + a2);
-  const float gl = n_dot_v * std::sqrt(n_dot_l * n_dot_l * (1.0f - a2) + a2);
-  return 0.5f / std::max(gv + gl, 1e-7f);
-}
-
 // Smith masking G1 of the view direction (the normalization of the visible-normal density).
 float smith_g1(float n_dot_v, float alpha) {
   const float a2 = alpha * alpha;
   return 2.0f * n_dot_v / (n_dot_v + std::sqrt(a2 + (1.0f - a2) * n_dot_v * n_dot_v));
-}
-
-glm::vec3 schlick(const glm::vec3& f0, float v_dot_h) {
-  const float m = 1.0f - v_dot_h;
-  const float m2 = m * m;
-  return f0 + (glm::vec3(1.0f) - f0) * (m2 * m2 * m);
 }
 
 // Heitz 2018, listing 1: a visible normal in the local frame (z = normal) for view ve.
@@ -72,37 +52,18 @@ glm::vec3 sample_cosine_hemisphere(const glm::vec3& n, float u1, float u2) {
   return glm::normalize(r * std::cos(phi) * t + r * std::sin(phi) * b + z * n);
 }
 
-ReferenceBrdf brdf_from_material(const glm::vec3& base_color, float metallic, float roughness) {
-  const float m = std::clamp(metallic, 0.0f, 1.0f);
-  const float r = std::clamp(roughness, 0.045f, 1.0f);
-  ReferenceBrdf f;
-  f.diffuse_albedo = (1.0f - m) * base_color;
-  f.f0 = glm::mix(glm::vec3(0.04f), base_color, m);
-  f.alpha = r * r;
-  return f;
-}
-
 float ReferenceBrdf::specular_probability(const glm::vec3& wo) const {
-  if (f0 == glm::vec3(0.0f)) return 0.0f;  // no GGX lobe (eval_cos skips it too)
-  const float spec = luminance(schlick(f0, std::clamp(glm::dot(normal, wo), 0.0f, 1.0f)));
-  const float diff = luminance(diffuse_albedo);
-  if (spec <= 0.0f) return 0.0f;
-  if (diff <= 0.0f) return 1.0f;
+  const engine::GltfBrdfValue albedo =
+      engine::gltf_directional_albedo(material, std::clamp(glm::dot(normal, wo), 0.0f, 1.0f));
+  const float spec = luminance(albedo.specular);
+  const float diff = luminance(albedo.diffuse);
+  if (!(spec > 0.0f)) return 0.0f;
+  if (!(diff > 0.0f)) return 1.0f;
   return std::clamp(spec / (spec + diff), 0.1f, 0.9f);
 }
 
 glm::vec3 ReferenceBrdf::eval_cos(const glm::vec3& wo, const glm::vec3& wi) const {
-  const float n_dot_l = glm::dot(normal, wi);
-  if (n_dot_l <= 0.0f) return glm::vec3(0.0f);
-  glm::vec3 f = diffuse_albedo / kPi;
-  if (f0 != glm::vec3(0.0f)) {
-    const float n_dot_v = std::max(glm::dot(normal, wo), 1e-4f);
-    const glm::vec3 h = glm::normalize(wi + wo);
-    const float n_dot_h = std::max(glm::dot(normal, h), 0.0f);
-    const float v_dot_h = std::max(glm::dot(wo, h), 0.0f);
-    f += ggx_d(n_dot_h, alpha) * smith_visibility(n_dot_v, n_dot_l, alpha) * schlick(f0, v_dot_h);
-  }
-  return f * n_dot_l;
+  return engine::gltf_eval_cos(material, normal, wo, wi).sum();
 }
 
 float ReferenceBrdf::pdf(const glm::vec3& wo, const glm::vec3& wi) const {
@@ -115,7 +76,8 @@ float ReferenceBrdf::pdf(const glm::vec3& wo, const glm::vec3& wi) const {
     const glm::vec3 h = glm::normalize(wi + wo);
     const float n_dot_h = std::max(glm::dot(normal, h), 0.0f);
     // Visible-normal density mapped to wi: G1(wo) D(h) / (4 n.wo) (Heitz 2018, eq. 17 / 4 wo.h).
-    pdf += ps * smith_g1(n_dot_v, alpha) * ggx_d(n_dot_h, alpha) / (4.0f * n_dot_v);
+    pdf += ps * smith_g1(n_dot_v, material.alpha) * engine::gltf_ggx_distribution(n_dot_h, material.alpha) /
+           (4.0f * n_dot_v);
   }
   return pdf;
 }
@@ -129,7 +91,7 @@ bool ReferenceBrdf::sample(const glm::vec3& wo, float u_lobe, float u1, float u2
     glm::vec3 t, b;
     orthonormal_basis(normal, t, b);
     const glm::vec3 ve(glm::dot(wo, t), glm::dot(wo, b), n_dot_v);
-    const glm::vec3 m = sample_ggx_vndf(ve, alpha, u1, u2);
+    const glm::vec3 m = sample_ggx_vndf(ve, material.alpha, u1, u2);
     const glm::vec3 h = m.x * t + m.y * b + m.z * normal;
     wi = 2.0f * glm::dot(wo, h) * h - wo;
   } else {

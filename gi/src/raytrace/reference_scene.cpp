@@ -43,9 +43,11 @@ engine::Result<ReferenceSceneIndex> index_reference_scene(const ReferenceScene& 
                                          std::to_string(g.geometries.size()) + " geometries");
   for (std::size_t m = 0; m < scene.materials.size(); ++m) {
     const ReferenceMaterial& mat = scene.materials[m];
-    if (!finite(mat.diffuse_albedo) || !finite(mat.f0) || !finite(mat.emission) || !std::isfinite(mat.alpha) ||
-        mat.alpha <= 0.0f)
-      return scene_error("material " + std::to_string(m), "non-finite value or alpha <= 0");
+    const engine::GltfBrdf& b = mat.brdf;
+    if (!finite(b.base_color) || !finite(b.dielectric_f0) || !finite(mat.emission) || !std::isfinite(b.alpha) ||
+        !(b.alpha > 0.0f) || !(b.metallic >= 0.0f && b.metallic <= 1.0f) ||
+        !(b.specular_weight >= 0.0f && b.specular_weight <= 1.0f))
+      return scene_error("material " + std::to_string(m), "non-finite value, alpha <= 0, or metallic / specular weight outside [0, 1]");
   }
   for (std::size_t i = 0; i < scene.lights.size(); ++i) {
     const ReferenceLight& l = scene.lights[i];
@@ -137,9 +139,7 @@ engine::Result<ReferenceSceneIndex> index_reference_scene(const ReferenceScene& 
 ReferenceBrdf shading_brdf(const ReferenceScene& scene, const ShadingTriangle& tri, glm::vec2 uv, bool front) {
   const ReferenceMaterial& mat = scene.materials[tri.material];
   ReferenceBrdf f;
-  f.diffuse_albedo = mat.diffuse_albedo;
-  f.f0 = mat.f0;
-  f.alpha = mat.alpha;
+  f.material = mat.brdf;
   glm::vec3 n = (1.0f - uv.x - uv.y) * tri.n0 + uv.x * tri.n1 + uv.y * tri.n2;
   const float len = glm::length(n);
   n = len > 1e-8f ? n / len : tri.face_normal;

@@ -20,9 +20,8 @@
 namespace gi {
 
 struct ReferenceMaterial {
-  glm::vec3 diffuse_albedo{0.8f};  ///< (1 - metallic) x base colour.
-  glm::vec3 f0{0.04f};             ///< 0: no GGX lobe (a pure Lambertian surface).
-  float alpha = 1.0f;              ///< GGX alpha.
+  /// glTF's BRDF (engine/gltf_brdf.h); engine::gltf_lambertian(albedo) for a pure Lambertian.
+  engine::GltfBrdf brdf = engine::gltf_brdf(glm::vec3(0.8f), 0.0f, 1.0f);
   glm::vec3 emission{0.0f};        ///< Emitted radiance, W/(m^2 sr), from the front face.
   bool double_sided = false;       ///< Back faces shade (and emit) like front faces.
 };

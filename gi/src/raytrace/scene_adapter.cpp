@@ -25,11 +25,9 @@ RtSceneData rt_scene_from(const engine::Scene& scene) {
 }
 
 ReferenceMaterial reference_material(const engine::Material& m) {
-  const ReferenceBrdf f = brdf_from_material(glm::vec3(m.base_color), m.metallic, m.roughness);
   ReferenceMaterial out;
-  out.diffuse_albedo = f.diffuse_albedo;
-  out.f0 = f.f0;
-  out.alpha = f.alpha;
+  out.brdf = engine::gltf_brdf(glm::vec3(m.base_color), m.metallic, m.roughness, m.specular_factor,
+                               m.specular_color_factor);
   out.emission = m.emissive;
   out.double_sided = m.double_sided;
   return out;

@@ -51,6 +51,8 @@ void add_asset(ContentHash& h, const engine::SceneAsset& a) {
     h.add_value(m.metallic);
     h.add_value(m.roughness);
     add_vec(h, m.emissive);
+    h.add_value(m.specular_factor);
+    add_vec(h, m.specular_color_factor);
     h.add_value(m.base_color_texture);
     h.add_value(m.metallic_roughness_texture);
     h.add_value(m.normal_texture);
@@ -107,7 +109,7 @@ void add_asset(ContentHash& h, const engine::SceneAsset& a) {
 
 engine::Result<std::string> scene_fingerprint(const std::filesystem::path& path, const engine::SceneAsset& asset) {
   ContentHash h;
-  h.add_string("gi-sweep-scene-v1");
+  h.add_string("gi-sweep-scene-v2");  // v2: glTF's BRDF (references made before it are not reused)
   if (!path.empty()) {
     std::ifstream in(path, std::ios::binary);
     if (!in) return engine::Error{path.string(), "", "cannot open the scene file to fingerprint it"};
