@@ -15,14 +15,16 @@ namespace engine {
 /// provider and stay valid until its next update. 0 means "not provided".
 struct IndirectLightFrame {
   /// RGBA16F/RGBA32F 2-D texture of indirect irradiance (W/m^2, linear RGB) sampled with
-  /// TEXCOORD_1 of static meshes. Shading uses albedo/pi x irradiance.
+  /// TEXCOORD_1 of static meshes. Shading reflects it as uniformly arriving light:
+  /// E/pi x the BRDF's directional albedo (engine/gltf_brdf.h).
   std::uint32_t irradiance_atlas_texture = 0;
   /// Per-vertex indirect irradiance of a dynamic mesh entity: an SSBO of vec4 (W/m^2 in
   /// xyz), one per vertex of the entity's mesh, primitives concatenated in order.
   /// Returns 0 when the entity has none.
   virtual std::uint32_t vertex_irradiance_buffer(Entity) const { return 0; }
   /// Optional glossy (view-dependent) indirect term: an RGBA16F screen-sized texture of
-  /// reflected radiance added after direct light. 0: none.
+  /// reflected radiance (rgb) and coverage (a): where a = 1 it replaces the specular lobe's
+  /// share of the direction-less irradiance above. 0: none.
   std::uint32_t glossy_radiance_texture = 0;
 
   IndirectLightFrame() = default;

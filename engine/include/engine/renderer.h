@@ -1,12 +1,14 @@
 #pragma once
 // The linear-HDR forward renderer: direct light from point, spot, directional and
-// rectangular area lights with shadow maps (cube maps for point lights), Lambert + GGX,
+// rectangular area lights with shadow maps (cube maps for point lights), glTF's BRDF,
 // indirect light through engine::IndirectLightProvider, exposure and tonemapping last.
-// Shading (engine/shaders/lighting_common.glsl): Lambert + GGX (Smith height-correlated
-// visibility, Schlick Fresnel, metallic workflow, F0 = 0.04 for dielectrics); point/spot
+// Shading (engine/shaders/lighting_common.glsl): glTF 2.0's BRDF (engine/gltf_brdf.h and its
+// twin engine/shaders/gltf_brdf.glsl: fresnel_mix of Lambert and GGX for dielectrics,
+// conductor Fresnel for metals, KHR_materials_specular factors); point/spot
 // E = I cos / d^2 with glTF's range window, spot smoothstep(cos outer, cos inner); area
 // lights: diffuse is the exact irradiance of the rectangle clipped to the horizon (Lambert's
-// polygon formula), specular n x n stratified points weighted by cos_l dA / d^2.
+// polygon formula) times the diffuse lobe's Fresnel weight averaged over n x n stratified
+// points, specular those points weighted by cos_l dA / d^2.
 // Shadows: cube maps (point), orthographic fitted to the scene bounds (directional),
 // perspective (spot; area from the rectangle's centre with 150 degrees and a wider kernel).
 //   auto ctx = engine::GpuContext::create_headless();              // engine/gpu/context.h
@@ -82,17 +84,20 @@ class Renderer {
 
   /// The provider of indirect light (not owned; nullptr: the constant-ambient stand-in).
   /// How the renderer uses IndirectLightFrame, per MeshRenderer entity:
-  ///  - entities with StaticTag: radiance += albedo/pi x texture(irradiance_atlas_texture,
-  ///    TEXCOORD_1).rgb (bilinear, as bound by the provider's sampler state);
-  ///  - other entities: radiance += albedo/pi x vertex_irradiance_buffer(entity)[k].xyz,
+  /// Indirect irradiance E carries no direction, so it is reflected as uniformly arriving
+  /// light is: radiance += E/pi x the BRDF's directional albedo at the view angle, per lobe
+  /// (engine::gltf_directional_albedo), where E is
+  ///  - for entities with StaticTag: texture(irradiance_atlas_texture, TEXCOORD_1).rgb
+  ///    (bilinear, as bound by the provider's sampler state);
+  ///  - for other entities: vertex_irradiance_buffer(entity)[k].xyz,
   ///    interpolated over the triangle, where k is the vertex's index within the entity's
   ///    mesh with the primitives concatenated in order (primitive p's vertex i has
   ///    k = i + sum of the vertex counts of primitives 0..p-1); the shader reads it as
   ///    gl_VertexID - (scene vertex where the mesh starts). The SSBO is bound at binding 1;
-  ///  - glossy_radiance_texture (if not 0) is added per pixel, texelFetch at the pixel;
-  ///  - albedo is the diffuse albedo (1 - metallic) x base colour.
-  /// Without a provider every entity gets albedo x stand_in_ambient (the irradiance of a
-  /// uniform sky of that radiance, pi x L, times albedo/pi). With SplitView::DirectLeftFullRight
+  ///  - glossy_radiance_texture (if not 0, texelFetch at the pixel) replaces the specular
+  ///    lobe's share by its rgb in proportion to its alpha (coverage).
+  /// Without a provider every entity gets E = pi x stand_in_ambient (the irradiance of a
+  /// uniform sky of that radiance). With SplitView::DirectLeftFullRight
   /// none of this is added to the left half.
   virtual void set_indirect_light(IndirectLightProvider* provider) = 0;
   virtual RenderSettings& settings() = 0;

@@ -1,6 +1,6 @@
 #pragma once
 // The reference path tracer: the ground truth every GI method is measured against.
-// Unbiased path tracing of the renderer's BRDF (Lambert + GGX) with next-event estimation
+// Unbiased path tracing of the renderer's BRDF (glTF's, engine/gltf_brdf.h) with next-event estimation
 // to point, spot, directional and area lights and to emissive surfaces, multiple importance
 // sampling (power heuristic) between light and BRDF sampling for emissive surfaces, and
 // Russian roulette. Multithreaded and deterministic: every pixel or point draws from its

@@ -73,9 +73,9 @@ engine::Result<BrfMesh> brf_mesh_from_asset(const engine::SceneAsset& asset, std
 engine::Result<std::vector<BrfSource>> dynamic_brf_meshes(const engine::Scene& scene);
 
 /// The RGB reflectance the runtime bounces with for `source`: its (first) material's
-/// hemispherical albedo as the path tracer and the light atlas see it (Lambert plus the
-/// renderer's GGX lobe, light_atlas/vpl_set.h); for a glossy source its diffuse albedo only
-/// (the lobe is its glossy terms). The glTF default material when it has none.
+/// hemispherical albedo (engine::gltf_hemispherical_albedo, both lobes, as the light atlas
+/// folds it); for a glossy source its diffuse lobe's only (the specular lobe is its glossy
+/// terms). The glTF default material when it has none.
 glm::vec3 brf_source_albedo(const engine::SceneAsset& asset, const BrfSource& source);
 
 }  // namespace gi
