@@ -4,8 +4,8 @@
 #include <cstdio>
 #include <iostream>
 
-#include "bake/geometry_hash.h"
-#include "bake/manifest.h"
+#include "bundle/geometry_hash.h"
+#include "bundle/manifest.h"
 #include "plan/plan_json.h"
 
 namespace tools {

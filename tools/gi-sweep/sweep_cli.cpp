@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "plot_command.h"
-#include "sweep/atomic_file.h"
+#include "io/atomic_file.h"
 #include "sweep/knob_grid.h"
 #include "sweep/knob_spec.h"
 #include "sweep/sweep_csv.h"

@@ -8,9 +8,9 @@
 #include <set>
 #include <system_error>
 
-#include "bake/bundle.h"
-#include "bake/byte_stream.h"
-#include "bake/json_fields.h"
+#include "bundle/bundle.h"
+#include "io/byte_stream.h"
+#include "io/json_fields.h"
 
 namespace gi {
 

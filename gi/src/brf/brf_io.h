@@ -61,7 +61,7 @@
 #include <string>
 #include <vector>
 
-#include "bake/blob_file.h"
+#include "io/blob_file.h"
 #include "brf/brf_bake.h"
 #include "brf/brf_mesh.h"
 

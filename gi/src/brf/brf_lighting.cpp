@@ -10,14 +10,14 @@
 #include <engine/gpu/gl_objects.h>
 #include <engine/gpu/shader_program.h>
 
-#include "bake/light_signature.h"
-#include "bake/static_scene.h"
+#include "bundle/light_signature.h"
+#include "transport/static_scene.h"
 #include "brf/brf_gpu_pass.h"
 #include "brf/spherical_harmonics.h"
 #include "gpu/gi_shaders.h"
-#include "light_atlas/point_emitters.h"
+#include "transport/point_emitters.h"
 #include "raytrace/ray_caster.h"
-#include "sweep/content_hash.h"
+#include "io/content_hash.h"
 
 namespace gi {
 

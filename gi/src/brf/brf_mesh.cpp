@@ -6,9 +6,9 @@
 #include <span>
 #include <utility>
 
-#include "light_atlas/vpl_set.h"
+#include "transport/vpl_set.h"
 #include "raytrace/scene_adapter.h"
-#include "sweep/content_hash.h"
+#include "io/content_hash.h"
 
 namespace gi {
 

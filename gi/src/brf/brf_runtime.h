@@ -43,7 +43,7 @@
 #include "brf/brdf_separation.h"
 #include "brf/pca_basis.h"
 #include "brf/radiance_field.h"
-#include "light_atlas/point_emitters.h"
+#include "transport/point_emitters.h"
 
 namespace gi {
 

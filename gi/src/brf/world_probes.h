@@ -28,7 +28,7 @@
 
 #include <engine/result.h>
 
-#include "light_atlas/vpl_set.h"
+#include "transport/vpl_set.h"
 
 namespace gi {
 

@@ -18,8 +18,8 @@
 #include <gi/progress.h>
 
 #include "core/thread_pool.h"
-#include "light_atlas/point_emitters.h"
-#include "light_atlas/vpl_set.h"
+#include "transport/point_emitters.h"
+#include "transport/vpl_set.h"
 #include "raytrace/ray_caster.h"
 #include "uv/atlas_rasterizer.h"
 

@@ -5,10 +5,11 @@
 #include <cmath>
 #include <span>
 
-#include "bake/static_scene.h"
+#include "transport/static_scene.h"
 #include "light_atlas/final_shooting.h"
-#include "light_atlas/point_emitters.h"
-#include "light_atlas/vpl_transport.h"
+#include "transport/point_emitters.h"
+#include "transport/vpl_transport.h"
+#include "uv/atlas_density.h"
 #include "uv/atlas_dilation.h"
 #include "uv/atlas_input.h"
 
@@ -197,15 +198,16 @@ engine::Result<LightAtlasUpdateStats> update_light_atlas(const engine::Scene& sc
 }
 
 engine::Result<LightAtlasSettings> light_atlas_preset(std::string_view name) {
+  auto density = atlas_density_preset(name);
+  if (!density) return engine::Error{.message = "unknown light-atlas preset '" + std::string(name) + "' (preview, medium, high)"};
   LightAtlasSettings s;
+  s.texels_per_metre = *density;
   if (name == "preview") {
-    s.texels_per_metre = 8.0f, s.vpl_count = 300, s.bounces = 8;
+    s.vpl_count = 300, s.bounces = 8;
   } else if (name == "medium") {
-    s.texels_per_metre = 16.0f, s.vpl_count = 1000, s.bounces = 16;
-  } else if (name == "high") {
-    s.texels_per_metre = 32.0f, s.vpl_count = 3000, s.bounces = 16;
+    s.vpl_count = 1000, s.bounces = 16;
   } else {
-    return engine::Error{.message = "unknown light-atlas preset '" + std::string(name) + "' (preview, medium, high)"};
+    s.vpl_count = 3000, s.bounces = 16;
   }
   return s;
 }

@@ -30,7 +30,7 @@
 #include <engine/scene.h>
 #include <gi/progress.h>
 
-#include "light_atlas/vpl_set.h"
+#include "transport/vpl_set.h"
 #include "uv/atlas_layout.h"
 
 namespace gi {

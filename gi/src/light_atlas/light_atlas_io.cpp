@@ -6,8 +6,8 @@
 #include <nlohmann/json.hpp>
 #include <system_error>
 
-#include "bake/bundle.h"
-#include "bake/json_fields.h"
+#include "bundle/bundle.h"
+#include "io/json_fields.h"
 #include "light_atlas/light_atlas_vpl_file.h"
 #include "uv/atlas_input.h"
 

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <span>
 
-#include "bake/byte_stream.h"
+#include "io/byte_stream.h"
 
 namespace gi {
 

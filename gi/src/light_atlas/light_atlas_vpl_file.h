@@ -20,7 +20,7 @@
 #include <filesystem>
 #include <string>
 
-#include "bake/blob_file.h"
+#include "io/blob_file.h"
 #include "light_atlas/light_atlas.h"
 
 namespace gi {

@@ -1,6 +1,6 @@
 #include "plan/plan_json.h"
 
-#include "bake/json_fields.h"
+#include "io/json_fields.h"
 
 namespace gi {
 

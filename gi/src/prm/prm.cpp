@@ -7,14 +7,14 @@
 #include <numbers>
 #include <unordered_map>
 
-#include "bake/static_scene.h"
+#include "transport/static_scene.h"
 #include "core/random.h"
 #include "core/thread_pool.h"
-#include "light_atlas/light_atlas.h"
-#include "light_atlas/point_emitters.h"
-#include "light_atlas/vpl_set.h"
+#include "transport/point_emitters.h"
+#include "transport/vpl_set.h"
 #include "prm/entry_clusters.h"
 #include "raytrace/ray_offset.h"
+#include "uv/atlas_density.h"
 #include "uv/atlas_dilation.h"
 #include "uv/atlas_input.h"
 
@@ -214,10 +214,10 @@ engine::Result<Prm> bake_prm(const engine::Scene& scene, const PrmSettings& sett
 }
 
 engine::Result<PrmSettings> prm_preset(std::string_view name) {
-  auto atlas = light_atlas_preset(name);
-  if (!atlas) return engine::Error{.message = "unknown PRM preset '" + std::string(name) + "' (preview, medium, high)"};
+  auto density = atlas_density_preset(name);
+  if (!density) return engine::Error{.message = "unknown PRM preset '" + std::string(name) + "' (preview, medium, high)"};
   PrmSettings s;
-  s.texels_per_metre = atlas->texels_per_metre;
+  s.texels_per_metre = *density;
   if (name == "preview") {
     s.entry_points = 512, s.clusters = 16, s.splitting = 2.0f;
   } else if (name == "medium") {

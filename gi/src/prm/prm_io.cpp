@@ -10,9 +10,9 @@
 #include <span>
 #include <system_error>
 
-#include "bake/bundle.h"
-#include "bake/byte_stream.h"
-#include "bake/json_fields.h"
+#include "bundle/bundle.h"
+#include "io/byte_stream.h"
+#include "io/json_fields.h"
 #include "uv/atlas_input.h"
 
 namespace gi {

@@ -51,7 +51,7 @@
 #include <filesystem>
 #include <string>
 
-#include "bake/blob_file.h"
+#include "io/blob_file.h"
 #include "prm/prm.h"
 
 namespace gi {

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <numeric>
 
-#include "light_atlas/vpl_transport.h"
+#include "transport/vpl_transport.h"
 
 namespace gi {
 

@@ -13,7 +13,7 @@
 
 #include <glm/glm.hpp>
 
-#include "light_atlas/point_emitters.h"
+#include "transport/point_emitters.h"
 #include "prm/prm.h"
 #include "raytrace/ray_caster.h"
 

@@ -1,9 +1,9 @@
 #include "sweep/builtin_methods.h"
 
-#include "brf/brf_sweep.h"
-#include "light_atlas/light_atlas_sweep.h"
-#include "prm/prm_sweep.h"
-#include "raytrace/reference_sweep.h"
+#include "sweep/brf_sweep.h"
+#include "sweep/light_atlas_sweep.h"
+#include "sweep/prm_sweep.h"
+#include "sweep/reference_sweep.h"
 
 namespace gi {
 

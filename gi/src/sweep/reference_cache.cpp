@@ -9,8 +9,8 @@
 #include <iterator>
 #include <system_error>
 
-#include "sweep/atomic_file.h"
-#include "sweep/content_hash.h"
+#include "io/atomic_file.h"
+#include "io/content_hash.h"
 
 namespace gi {
 namespace {

@@ -6,7 +6,7 @@
 #include <iterator>
 #include <vector>
 
-#include "sweep/content_hash.h"
+#include "io/content_hash.h"
 
 namespace gi {
 namespace {

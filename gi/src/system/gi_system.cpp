@@ -8,12 +8,12 @@
 
 #include <engine/components.h>
 #include <engine/gpu/gl_objects.h>
-#include <gi/light_atlas_lighting.h>
+#include "system/light_atlas_lighting.h"
 #include <gi/plan.h>
-#include <gi/prm_lighting.h>
+#include "system/prm_lighting.h"
 
-#include "bake/manifest.h"
-#include "bake/static_scene.h"
+#include "bundle/manifest.h"
+#include "transport/static_scene.h"
 #include "brf/brf_lighting.h"
 #include "brf/brf_io.h"
 #include "brf/brf_mesh.h"

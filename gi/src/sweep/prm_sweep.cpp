@@ -1,0 +1,146 @@
+#include "sweep/prm_sweep.h"
+
+#include <chrono>
+#include <limits>
+#include <string>
+
+#include <glm/gtc/quaternion.hpp>
+
+#include <engine/scene.h>
+#include <gi/reference.h>
+
+#include "transport/static_scene.h"
+#include "prm/prm.h"
+#include "prm/prm_runtime.h"
+#include "raytrace/atlas_reference.h"
+#include "uv/atlas_input.h"
+#include "uv/atlas_layout.h"
+#include "uv/atlas_rasterizer.h"
+
+namespace gi {
+namespace {
+
+constexpr std::uint64_t kReferenceSeed = 0x7072656665726e63ULL;
+
+// The scene with only its moving light on (the first light flagged as moving, else the
+// first light), flagged as moving, at `pose`. Errors: no light, unknown pose.
+engine::Result<engine::Scene> posed_scene(engine::SceneAsset asset, const std::string& pose) {
+  int chosen = -1;
+  for (std::size_t n = 0; n < asset.nodes.size() && chosen < 0; ++n) {
+    const int l = asset.nodes[n].light;
+    if (l >= 0 && static_cast<std::size_t>(l) < asset.lights.size() && asset.lights[static_cast<std::size_t>(l)].light.moves)
+      chosen = static_cast<int>(n);
+  }
+  for (std::size_t n = 0; n < asset.nodes.size() && chosen < 0; ++n)
+    if (asset.nodes[n].light >= 0) chosen = static_cast<int>(n);
+  if (chosen < 0) return engine::Error{.message = "the scene has no light to move"};
+  for (engine::NamedLight& l : asset.lights) l.light.enabled = false;
+  engine::Node& node = asset.nodes[static_cast<std::size_t>(chosen)];
+  engine::Light& light = asset.lights[static_cast<std::size_t>(node.light)].light;
+  light.enabled = true;
+  light.moves = true;
+  if (pose != "authored") {
+    glm::vec3 lo(std::numeric_limits<float>::infinity()), hi(-lo);
+    for (const AtlasInputMesh& m : atlas_inputs_from(asset))
+      for (const glm::vec3& p : m.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
+    const glm::vec3 size = hi - lo, centre = 0.5f * (lo + hi);
+    glm::vec3 position, direction;
+    if (pose == "corner") {
+      position = lo + glm::vec3(0.15f, 0.3f, 0.15f) * size;
+      direction = glm::normalize(centre - position);
+    } else if (pose == "wall") {
+      // A lamp held against a wall, shining down along it: the wall gets grazing light from
+      // 1 cm away (pointing it into the wall would put all light into a spot of millimetres,
+      // which the path-traced reference cannot resolve either).
+      position = glm::vec3(hi.x - 0.01f, centre.y, centre.z);
+      direction = glm::vec3(0.0f, -1.0f, 0.0f);
+    } else {
+      return engine::Error{.message = "unknown light pose '" + pose + "' (authored, corner, wall)"};
+    }
+    if (node.parent >= 0) return engine::Error{.message = "the moving light has a parent node; pose it in world space first"};
+    node.translation = position;
+    // Lights shine along their local -Z.
+    node.rotation = glm::quatLookAtRH(direction, std::abs(direction.y) > 0.9f ? glm::vec3(1, 0, 0) : glm::vec3(0, 1, 0));
+  }
+  return engine::instantiate(std::move(asset));
+}
+
+}  // namespace
+
+void register_prm_sweep(SweepRegistry& registry) {
+  registry.add_reference_provider(
+      {.kind = "atlas_indirect_irradiance_posed", .version = "pt-2", .compute = [](const ReferenceJob& job) -> engine::Result<RgbField> {
+         auto scene = posed_scene(job.scene.asset, job.request.param("pose"));
+         if (!scene) return scene.error();
+         const auto inputs = atlas_inputs_from(job.scene.asset);
+         auto layout = build_atlas_layout(inputs, {.texels_per_metre = std::stof(job.request.param("texels_per_m"))});
+         if (!layout) return layout.error();
+         ReferenceSettings rs;
+         rs.samples_per_pixel = std::stoi(job.request.param("spp"));
+         rs.seed = kReferenceSeed;
+         rs.threads = job.threads;
+         rs.progress = job.progress;
+         auto truth = reference_atlas_irradiance(*scene, rasterize_atlas(*layout, inputs), rs);
+         if (!truth) return truth.error();
+         return RgbField::from_texels(truth->width, truth->height, truth->indirect, truth->valid);
+       }});
+
+  SweepMethod m;
+  m.name = "prm";
+  m.description = "precomputed radiance maps (Szécsi 2006): entry points x clusters x active K x density x splitting, moving light at several poses";
+  m.knobs = {
+      {.name = "entries", .description = "entry points", .kind = KnobKind::Integer,
+       .default_grid = {"256", "1024", "4096"}, .min_value = 1, .max_value = 1'000'000},
+      {.name = "clusters", .description = "entry-point clusters (stored panes)", .kind = KnobKind::Integer,
+       .default_grid = {"32", "128"}, .min_value = 1, .max_value = 65536},
+      {.name = "active", .description = "clusters summed per frame (K heaviest; 0: all)", .kind = KnobKind::Integer,
+       .default_grid = {"0"}, .min_value = 0, .max_value = 65536},
+      {.name = "density", .description = "pane (atlas) texels per metre", .kind = KnobKind::Real,
+       .default_grid = {"4"}, .min_value = 0.01, .max_value = 1e4},
+      {.name = "splitting", .description = "paths per entry point per unit albedo (N_s)", .kind = KnobKind::Real,
+       .default_grid = {"4"}, .min_value = 0.01, .max_value = 1024},
+      {.name = "pose", .description = "moving light pose", .kind = KnobKind::Choice,
+       .default_grid = {"authored", "corner", "wall"}, .choices = {"authored", "corner", "wall"}},
+      {.name = "ref_spp", .description = "samples per texel of the path-traced reference", .kind = KnobKind::Integer,
+       .default_grid = {"4096"}, .min_value = 1, .max_value = 1 << 20},
+  };
+  m.reference_for = [](const SweepScene&, const KnobSetting& k) {
+    ReferenceRequest r = ReferenceRequest::atlas_indirect_irradiance(k.real("density"), static_cast<int>(k.integer("ref_spp")));
+    r.kind = "atlas_indirect_irradiance_posed";
+    r.params.emplace_back("pose", k.text("pose"));
+    return r;
+  };
+  m.run = [](const RunContext& ctx) -> engine::Result<MethodOutput> {
+    auto scene = posed_scene(ctx.scene.asset, ctx.knobs.text("pose"));
+    if (!scene) return scene.error();
+    PrmSettings s;
+    s.texels_per_metre = static_cast<float>(ctx.knobs.real("density"));
+    s.entry_points = static_cast<int>(ctx.knobs.integer("entries"));
+    s.clusters = static_cast<int>(ctx.knobs.integer("clusters"));
+    s.splitting = static_cast<float>(ctx.knobs.real("splitting"));
+    s.seed = ctx.seed;
+    s.threads = ctx.threads;
+    s.progress = ctx.progress;
+    auto prm = bake_prm(*scene, s);
+    if (!prm) return prm.error();
+    if (prm->width != ctx.reference.width || prm->height != ctx.reference.height)
+      return engine::Error{.message = "the PRM's atlas size differs from the reference's"};
+    auto caster = make_static_caster(*scene);
+    if (!caster) return caster.error();
+    // Per-frame cost of a light change on the CPU: weights, selection and the pane sum.
+    const auto t0 = std::chrono::steady_clock::now();
+    const auto picked = relight_clusters(*prm, scene_lights(scene->registry, BakeLights::Moving), **caster,
+                                         static_cast<int>(ctx.knobs.integer("active")));
+    const std::vector<glm::vec3> atlas = sum_panes(*prm, picked);
+    const double frame_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    MethodOutput out;
+    out.field = RgbField::from_texels(prm->width, prm->height, atlas, ctx.reference.valid);
+    out.costs.bake_seconds = prm->stats.total_seconds;
+    out.costs.frame_ms = frame_ms;
+    out.costs.bytes = static_cast<std::uint64_t>(prm->cluster_count) * prm->pane_size() * 3u * 2u;  // half-float panes
+    return out;
+  };
+  registry.add_method(std::move(m));
+}
+
+}  // namespace gi

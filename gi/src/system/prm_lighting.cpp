@@ -1,0 +1,162 @@
+#include <GL/glcorearb.h>
+#include "system/prm_lighting.h"
+
+#include <chrono>
+#include <optional>
+#include <unordered_map>
+
+#include "transport/static_scene.h"
+#include "bundle/light_signature.h"
+#include "bundle/manifest.h"
+#include "light_atlas/light_atlas.h"
+#include "light_atlas/light_atlas_io.h"
+#include "transport/point_emitters.h"
+#include "prm/prm.h"
+#include "prm/prm_gpu_pass.h"
+#include "prm/prm_io.h"
+#include "prm/prm_runtime.h"
+#include "raytrace/scene_adapter.h"
+#include "uv/atlas_scene_writer.h"
+
+namespace gi {
+
+struct PrmLighting::Impl {
+  const engine::Registry* registry = nullptr;
+  Prm prm;
+  std::vector<glm::vec3> base;  ///< Static-light atlas (empty: none).
+  std::unique_ptr<RayCaster> caster;
+  PrmLightingSettings settings;
+  std::optional<PrmGpuPass> pass;
+  bool fresh = false;
+  engine::IndirectLightFrame frame;
+  Stats stats;
+
+  // Per moving light: a fingerprint of everything that changes its light, and its entry
+  // irradiance (eq. 4), kept while the fingerprint holds. Entry irradiance is linear in the
+  // lights, so a frame where one of several moving lights changed recomputes that light only.
+  struct LightCache {
+    std::uint64_t signature = 0;
+    std::vector<glm::vec3> entry;
+    bool seen = false;
+  };
+  std::unordered_map<std::uint32_t, LightCache> lights;
+
+  // Brings every moving light's cached entry irradiance up to date; returns whether any
+  // changed (appeared, changed, or disappeared) and counts the recomputed ones.
+  bool refresh_lights(std::size_t& recomputed) {
+    bool changed = false;
+    recomputed = 0;
+    for (auto& [id, c] : lights) c.seen = false;
+    registry->view<engine::Light, engine::WorldTransform>().each(
+        [&](engine::Entity e, const engine::Light& l, const engine::WorldTransform& wt) {
+          if (!l.moves) return;
+          const std::uint64_t sig = light_signature(e, l, wt);
+          LightCache& c = lights[e.id()];
+          c.seen = true;
+          if (!c.entry.empty() && c.signature == sig) return;
+          c.signature = sig;
+          changed = true;
+          ++recomputed;
+          if (!l.enabled) {
+            c.entry.assign(prm.entries.size(), glm::vec3(0.0f));
+            return;
+          }
+          const ReferenceLight ref = reference_light(l, wt.matrix);
+          const std::vector<PointEmitter> emitters =
+              light_point_emitters(std::span<const ReferenceLight>(&ref, 1), 16, prm.settings.seed);
+          c.entry = entry_irradiance(prm, emitters, *caster);
+        });
+    for (auto it = lights.begin(); it != lights.end();) {
+      if (!it->second.seen) {
+        it = lights.erase(it);
+        changed = true;
+      } else {
+        ++it;
+      }
+    }
+    return changed;
+  }
+};
+
+PrmLighting::PrmLighting(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+PrmLighting::~PrmLighting() = default;
+
+engine::Result<std::unique_ptr<PrmLighting>> PrmLighting::from_bake(Prm prm, const LightAtlasBake* base,
+                                                                    engine::Scene& scene, PrmLightingSettings settings) {
+  if (base && (base->width != prm.width || base->height != prm.height ||
+               base->layout.texels_per_metre != prm.layout.texels_per_metre))
+    return engine::Error{scene.assets.source, "PRM",
+                         "the light atlas (" + std::to_string(base->width) + "x" + std::to_string(base->height) +
+                             ") and the PRM (" + std::to_string(prm.width) + "x" + std::to_string(prm.height) +
+                             ") were baked at different layouts; bake both at one density"};
+  auto caster = make_static_caster(scene);
+  if (!caster) return caster.error();
+  if (engine::Status s = apply_atlas_uv1(scene, prm.layout); !s) return s.error();
+  auto impl = std::make_unique<Impl>();
+  impl->registry = &scene.registry;
+  impl->prm = std::move(prm);
+  if (base) impl->base = base->irradiance;
+  impl->caster = std::move(caster).value();
+  impl->settings = settings;
+  return std::unique_ptr<PrmLighting>(new PrmLighting(std::move(impl)));
+}
+
+engine::Result<std::unique_ptr<PrmLighting>> PrmLighting::load(const std::filesystem::path& bundle_dir,
+                                                               engine::Scene& scene, PrmLightingSettings settings) {
+  auto prm = load_prm(bundle_dir, scene.assets);
+  if (!prm) return prm.error();
+  auto manifest = read_manifest(bundle_dir);
+  if (!manifest) return manifest.error();
+  std::optional<LightAtlasBake> base;
+  if (manifest->methods.contains("light_atlas")) {
+    auto atlas = load_light_atlas(bundle_dir, scene.assets);
+    if (!atlas) return atlas.error();
+    base.emplace(std::move(atlas).value());
+  }
+  return from_bake(std::move(prm).value(), base ? &*base : nullptr, scene, settings);
+}
+
+const engine::IndirectLightFrame& PrmLighting::frame() {
+  Impl& m = *impl_;
+  ++m.stats.frames;
+  if (!m.pass) {
+    auto pass = PrmGpuPass::create(m.prm);
+    if (!pass) {
+      // No GL resources: leave the frame empty (the renderer falls back to its stand-in).
+      std::fprintf(stderr, "gi: PRM disabled: %s\n", pass.error().to_string().c_str());
+      m.prm.panes = {};
+      return m.frame;
+    }
+    m.pass.emplace(std::move(pass).value());
+    if (!m.base.empty()) (void)m.pass->set_base(m.base);
+    m.frame.irradiance_atlas_texture = m.pass->texture();
+    m.stats.gpu_bytes = m.pass->gpu_bytes();
+  }
+  using Clock = std::chrono::steady_clock;
+  const auto t0 = Clock::now();
+  std::size_t recomputed = 0;
+  if (!m.refresh_lights(recomputed) && m.fresh) return m.frame;  // no moving light changed
+  std::vector<glm::vec3> entry(m.prm.entries.size(), glm::vec3(0.0f));
+  for (const auto& [id, c] : m.lights)
+    for (std::size_t i = 0; i < entry.size() && i < c.entry.size(); ++i) entry[i] += c.entry[i];
+  const std::vector<ClusterWeight> picked =
+      select_clusters(cluster_weights(m.prm, entry), m.settings.active_clusters);
+  m.stats.last_lights_recomputed = recomputed;
+  m.stats.last_lights_reused = m.lights.size() - std::min(recomputed, m.lights.size());
+  const auto t1 = Clock::now();
+  if (engine::Status s = m.pass->run(picked); !s) std::fprintf(stderr, "gi: PRM update failed: %s\n", s.error().to_string().c_str());
+  glFinish();
+  const auto t2 = Clock::now();
+  m.stats.last_weights_ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
+  m.stats.last_gpu_ms = std::chrono::duration<double, std::milli>(t2 - t1).count();
+  m.stats.last_active_clusters = picked.size();
+  ++m.stats.updates;
+  m.fresh = true;
+  return m.frame;
+}
+
+const char* PrmLighting::label() const { return impl_->base.empty() ? "PRM" : "light atlas + PRM"; }
+
+const PrmLighting::Stats& PrmLighting::stats() const { return impl_->stats; }
+
+}  // namespace gi

@@ -1,0 +1,59 @@
+#include "transport/static_scene.h"
+
+#include "raytrace/embree_ray_caster.h"
+#include "raytrace/scene_adapter.h"
+#include "uv/atlas_input.h"
+
+namespace gi {
+
+std::vector<ReferenceLight> scene_lights(const engine::Registry& registry, BakeLights lights) {
+  std::vector<ReferenceLight> kept;
+  registry.view<engine::Light, engine::WorldTransform>().each(
+      [&](engine::Entity, const engine::Light& light, const engine::WorldTransform& wt) {
+        if (!light.enabled) return;
+        const bool keep = lights == BakeLights::Static ? !light.moves : lights == BakeLights::Moving && light.moves;
+        if (keep) kept.push_back(reference_light(light, wt.matrix));
+      });
+  return kept;
+}
+
+namespace {
+
+// The static instances of `data` with, per kept instance, its index in `data`.
+RtSceneData static_only(const RtSceneData& data, std::vector<std::uint32_t>* kept) {
+  RtSceneData statics;
+  statics.geometries = data.geometries;
+  for (std::size_t i = 0; i < data.instances.size(); ++i) {
+    if (data.instances[i].dynamic) continue;
+    statics.instances.push_back(data.instances[i]);
+    if (kept) kept->push_back(static_cast<std::uint32_t>(i));
+  }
+  return statics;
+}
+
+}  // namespace
+
+engine::Result<std::unique_ptr<RayCaster>> make_static_caster(const engine::Scene& scene) {
+  const RtSceneData statics = static_only(rt_scene_from(scene), nullptr);
+  if (statics.instances.empty()) return engine::Error{.message = "the scene has no static mesh"};
+  return make_embree_ray_caster(statics);
+}
+
+engine::Result<StaticBakeScene> prepare_static_scene(const engine::Scene& scene, const AtlasLayout& layout,
+                                                     BakeLights lights) {
+  StaticBakeScene b;
+  b.scene = reference_scene_from(scene);
+  b.scene.lights = scene_lights(scene.registry, lights);
+  auto index = index_reference_scene(b.scene);
+  if (!index) return index.error();
+  b.index = std::move(index).value();
+  const RtSceneData statics = static_only(b.scene.geometry, &b.static_instance);
+  if (statics.instances.empty()) return engine::Error{.message = "the scene has no static mesh to bake"};
+  auto caster = make_embree_ray_caster(statics);
+  if (!caster) return caster.error();
+  b.caster = std::move(caster).value();
+  b.texels = rasterize_atlas(layout, atlas_inputs_from(scene.assets));
+  return b;
+}
+
+}  // namespace gi

@@ -1,0 +1,96 @@
+// The static world as a light source for dynamic objects (gi/src/brf/world_probes.h):
+// probe irradiance from the light atlas's VPLs against the path tracer's indirect
+// irradiance at free points of a closed box, and probes inside walls not leaking.
+#include <cmath>
+#include <cstdio>
+
+#include <gtest/gtest.h>
+
+#include <engine/scene.h>
+
+#include "transport/static_scene.h"
+#include "brf/world_probes.h"
+#include "light_atlas/light_atlas.h"
+#include "raytrace/reference_render.h"
+#include "raytrace/scene_adapter.h"
+#include "light_atlas_scenes.h"
+
+namespace {
+
+struct BoxWithProbes {
+  engine::Scene scene = engine::instantiate(latest::closed_box(2.0f, 0.6f, {0.3f, 0.4f, -0.2f}, 4.0f));
+  gi::LightAtlasBake atlas;
+  gi::WorldProbeGrid probes;
+  BoxWithProbes() {
+    gi::LightAtlasSettings s = gi::light_atlas_preset("medium").value();
+    s.bounces = 16;
+    atlas = gi::bake_light_atlas(scene, s).value();
+    auto caster = gi::make_static_caster(scene).value();
+    probes = gi::bake_world_probes(*caster, atlas.vpls, atlas.vpl_power, {.spacing_m = 0.5f}).value();
+  }
+};
+
+const BoxWithProbes& box_with_probes() {
+  static const BoxWithProbes b;
+  return b;
+}
+
+TEST(BrfWorldProbes, IrradianceAtFreePointsMatchesThePathTracer) {
+  const BoxWithProbes& b = box_with_probes();
+  std::vector<gi::SurfacePoint> points;
+  for (glm::vec3 p : {glm::vec3(-0.4f, -0.5f, 0.3f), glm::vec3(0.2f, 0.1f, 0.45f), glm::vec3(-0.6f, 0.5f, -0.55f)})
+    for (glm::vec3 n : {glm::vec3(1, 0, 0), glm::vec3(-1, 0, 0), glm::vec3(0, 1, 0), glm::vec3(0, -1, 0), glm::vec3(0, 0, 1)})
+      points.push_back({p, n});
+  gi::ReferenceSettings rs;
+  rs.samples_per_pixel = 2048;
+  const auto truth = gi::estimate_irradiance(gi::reference_scene_from(b.scene), points, rs).value();
+  double err = 0.0, norm = 0.0, ours_sum = 0.0, truth_sum = 0.0;
+  for (std::size_t j = 0; j < points.size(); ++j) {
+    const glm::vec3 e = b.probes.irradiance(points[j].position_m, points[j].normal);
+    ASSERT_TRUE(std::isfinite(e.x) && e.x >= 0.0f);
+    const double d = static_cast<double>(e.x - truth.indirect[j].x);
+    err += d * d;
+    norm += static_cast<double>(truth.indirect[j].x) * static_cast<double>(truth.indirect[j].x);
+    ours_sum += static_cast<double>(e.x);
+    truth_sum += static_cast<double>(truth.indirect[j].x);
+  }
+  std::printf("world probes (%zu probes, %.2f m): rel RMSE %.3f, total ratio %.3f vs path tracer\n",
+              b.probes.probe_count(), double{b.probes.spacing}, std::sqrt(err / norm), ours_sum / truth_sum);
+  EXPECT_LT(std::sqrt(err / norm), 0.15);
+  EXPECT_NEAR(ours_sum / truth_sum, 1.0, 0.1);
+}
+
+TEST(BrfWorldProbes, ProbesOutsideTheRoomAreInvalidAndDoNotDarkenItsEdges) {
+  const BoxWithProbes& b = box_with_probes();
+  std::size_t invalid = 0;
+  for (std::uint8_t v : b.probes.valid) invalid += v == 0 ? 1 : 0;
+  // The grid's outer layer lies on or outside the walls: those probes see no VPL.
+  EXPECT_GT(invalid, 0u);
+  EXPECT_LT(invalid, b.probes.probe_count());
+  // Near a wall (between the last valid probes and the invalid ones) the light stays that of the room.
+  const glm::vec3 centre = b.probes.irradiance({0.0f, 0.0f, 0.0f}, {0, 1, 0});
+  const glm::vec3 edge = b.probes.irradiance({0.95f, 0.0f, 0.0f}, {0, 1, 0});
+  std::printf("probe irradiance facing up: centre %.4f, 5 cm from a wall %.4f\n", double{centre.x}, double{edge.x});
+  EXPECT_GT(edge.x, 0.5f * centre.x);
+  // Outside the grid the light is clamped to its border, never NaN.
+  const glm::vec3 far = b.probes.irradiance({100.0f, 0.0f, 0.0f}, {0, 1, 0});
+  EXPECT_TRUE(std::isfinite(far.x));
+  EXPECT_EQ(b.probes.irradiance({NAN, 0.0f, 0.0f}, {0, 1, 0}), glm::vec3(0.0f));
+}
+
+TEST(BrfWorldProbes, BadInputIsAnError) {
+  const engine::Scene scene = engine::instantiate(latest::closed_box(2.0f, 0.6f));
+  auto caster = gi::make_static_caster(scene).value();
+  gi::VplSet vpls;
+  vpls.position = {glm::vec3(0.0f)};
+  vpls.normal = {glm::vec3(0, 1, 0)};
+  vpls.area_m2 = {1.0f};
+  const std::vector<glm::vec3> two(2, glm::vec3(1.0f));
+  EXPECT_FALSE(gi::bake_world_probes(*caster, vpls, two, {}).ok());
+  const std::vector<glm::vec3> nan_power{glm::vec3(NAN)};
+  EXPECT_FALSE(gi::bake_world_probes(*caster, vpls, nan_power, {}).ok());
+  const std::vector<glm::vec3> one{glm::vec3(1.0f)};
+  EXPECT_FALSE(gi::bake_world_probes(*caster, vpls, one, {.spacing_m = 0.0f}).ok());
+}
+
+}  // namespace

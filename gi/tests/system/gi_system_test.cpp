@@ -1,0 +1,245 @@
+// The GI system on llvmpipe with the crates room: a light atlas and basis radiance fields
+// from one bundle; the red crate's bounce turns the white statue pink, and each frame
+// recomputes only what changed (counters).
+#define GL_GLEXT_PROTOTYPES 1
+#include <GL/glcorearb.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+
+#include <engine/components.h>
+#include <engine/gltf.h>
+#include <engine/gpu/context.h>
+#include <engine/scene.h>
+#include <gi/gi_system.h>
+
+#include "transport/static_scene.h"
+#include "brf/brf_bake.h"
+#include "brf/brf_io.h"
+#include "brf/brf_mesh.h"
+#include "light_atlas/light_atlas.h"
+#include "light_atlas/light_atlas_io.h"
+#include "gl_readback.h"
+
+namespace {
+
+using gltest::read_texture;
+
+engine::Scene crates_room() {
+  auto asset = engine::load_gltf(GI_SOURCE_DIR "/assets/crates_room.gltf");
+  EXPECT_TRUE(asset) << asset.error().to_string();
+  return engine::instantiate(std::move(asset.value()));
+}
+
+// One bundle for all tests of this process: light atlas (preview, 8 texels/m) + BRF (preview).
+// ctest runs each test in its own process, in parallel: the directory is per process.
+struct Bundle {
+  std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("gi_system_test_" + std::to_string(::getpid()) + ".gibake");
+  ~Bundle() {
+    std::error_code ec;
+    std::filesystem::remove_all(dir, ec);
+  }
+  gi::LightAtlasBake atlas;
+  Bundle() {
+    std::filesystem::remove_all(dir);
+    engine::Scene scene = crates_room();
+    gi::LightAtlasSettings s = gi::light_atlas_preset("preview").value();
+    atlas = gi::bake_light_atlas(scene, s).value();
+    EXPECT_TRUE(gi::save_light_atlas(dir, atlas, scene.assets, "crates_room.gltf"));
+    const auto sources = gi::dynamic_brf_meshes(scene).value();
+    gi::BrfBake brf;
+    brf.settings = gi::brf_preset("preview").value();
+    for (const gi::BrfSource& src : sources) brf.meshes.push_back(gi::bake_brf_mesh(src, brf.settings).value());
+    EXPECT_TRUE(gi::save_brf(dir, brf, scene.assets, "crates_room.gltf"));
+  }
+};
+
+const Bundle& bundle() {
+  static const Bundle b;
+  return b;
+}
+
+void move_to(engine::Scene& scene, const char* name, glm::vec3 position) {
+  const engine::Entity e = engine::find_by_name(scene.registry, name);
+  scene.registry.write<engine::Transform>(e).position = position;
+  engine::update_world_transforms(scene.registry);
+}
+
+TEST(GISystem, RecomputesOnlyWhatChanged) {
+  auto ctx = engine::GpuContext::create_headless();
+  ASSERT_TRUE(ctx) << "no headless GL context: " << ctx.error().to_string();
+  engine::Scene scene = crates_room();
+  auto loaded = gi::GISystem::load(bundle().dir, scene);
+  ASSERT_TRUE(loaded) << loaded.error().to_string();
+  gi::GISystem& gi = **loaded;
+  std::printf("%s\n%s", gi.label(), gi.describe().c_str());
+  EXPECT_STREQ(gi.label(), "light atlas + BRF");
+
+  gi.frame();
+  EXPECT_EQ(gi.stats().brf_updates, 1u);
+  const std::size_t pairs = gi.stats().brf_pairs_evaluated + gi.stats().brf_pairs_culled;
+  EXPECT_EQ(pairs, 5u * 4u);  // five crates
+  gi.frame();
+  gi.frame();
+  EXPECT_EQ(gi.stats().brf_updates, 1u);
+  EXPECT_EQ(gi.stats().idle_frames, 2u);
+  EXPECT_EQ(gi.stats().world_composites, 1u);
+
+  // One crate moves: only the pairs with it get new basis irradiance.
+  move_to(scene, "crate_3", {2.0f, 0.0f, -1.5f});
+  gi.frame();
+  EXPECT_EQ(gi.stats().brf_updates, 2u);
+  EXPECT_EQ(gi.stats().brf_moves, 2u);
+  std::printf("crate_3 moved: %zu pairs evaluated, %zu reused, %zu culled\n", gi.stats().brf_pairs_evaluated,
+              gi.stats().brf_pairs_reused, gi.stats().brf_pairs_culled);
+  EXPECT_GE(gi.stats().brf_pairs_reused + 8u, gi.stats().brf_pairs_evaluated);
+  EXPECT_GT(gi.stats().brf_pairs_reused, 0u);
+  EXPECT_EQ(gi.stats().world_composites, 2u);
+
+  // A light changes, nothing moves: new light, every evaluated pair's basis irradiance reused.
+  const engine::Entity light = engine::find_by_name(scene.registry, "ceiling_light");
+  ASSERT_FALSE(light.is_null());
+  scene.registry.write<engine::Light>(light).intensity *= 0.5f;
+  gi.frame();
+  EXPECT_EQ(gi.stats().brf_updates, 3u);
+  EXPECT_EQ(gi.stats().brf_moves, 2u);
+  EXPECT_EQ(gi.stats().brf_pairs_reused, gi.stats().brf_pairs_evaluated);
+  gi.frame();
+  EXPECT_EQ(gi.stats().idle_frames, 3u);
+
+  // Per-vertex buffers for the crates only, finite and non-negative.
+  const engine::Entity crate = engine::find_by_name(scene.registry, "crate_1");
+  const std::uint32_t buffer = gi.frame().vertex_irradiance_buffer(crate);
+  ASSERT_NE(buffer, 0u);
+  EXPECT_EQ(gi.frame().vertex_irradiance_buffer(engine::find_by_name(scene.registry, "statue")), 0u);
+  GLint64 bytes = 0;
+  glGetNamedBufferParameteri64v(buffer, GL_BUFFER_SIZE, &bytes);
+  std::vector<glm::vec4> v(static_cast<std::size_t>(bytes) / sizeof(glm::vec4));
+  glGetNamedBufferSubData(buffer, 0, bytes, v.data());
+  float largest = 0.0f;
+  for (const glm::vec4& x : v) {
+    ASSERT_TRUE(std::isfinite(x.x) && std::isfinite(x.y) && std::isfinite(x.z));
+    EXPECT_GE(std::min({x.x, x.y, x.z}), 0.0f);
+    largest = std::max(largest, x.x);
+  }
+  EXPECT_GT(largest, 0.0f);
+}
+
+TEST(GISystem, TheRedCrateTurnsTheStatuePink) {
+  auto ctx = engine::GpuContext::create_headless();
+  ASSERT_TRUE(ctx) << "no headless GL context: " << ctx.error().to_string();
+  engine::Scene scene = crates_room();
+  // The statue's plinth faces +x at x = -0.85 (statue at (-1.2, 0, 1.2), half width 0.35).
+  auto layout_scene = gi::prepare_static_scene(scene, bundle().atlas.layout, gi::BakeLights::None).value();
+  std::vector<std::size_t> plinth;
+  for (std::size_t t = 0; t < layout_scene.texels.valid.size(); ++t) {
+    const glm::vec3 p = layout_scene.texels.position[t], n = layout_scene.texels.normal[t];
+    if (layout_scene.texels.valid[t] != 0 && std::abs(p.x + 0.85f) < 0.02f && n.x > 0.9f && p.y < 0.4f &&
+        std::abs(p.z - 1.2f) < 0.3f)
+      plinth.push_back(t);
+  }
+  ASSERT_GT(plinth.size(), 0u);
+  auto loaded = gi::GISystem::load(bundle().dir, scene);
+  ASSERT_TRUE(loaded) << loaded.error().to_string();
+  gi::GISystem& gi = **loaded;
+  const int w = bundle().atlas.width, h = bundle().atlas.height;
+  const auto bounce_on_plinth = [&] {
+    const std::vector<glm::vec3> atlas = read_texture(gi.frame().irradiance_atlas_texture, w, h);
+    glm::dvec3 sum(0.0);
+    for (std::size_t t : plinth) sum += glm::dvec3(atlas[t] - bundle().atlas.irradiance[t]);
+    return sum / static_cast<double>(plinth.size());
+  };
+  const glm::dvec3 far = bounce_on_plinth();
+  move_to(scene, "crate_red", {-0.5f, 0.0f, 1.2f});  // 10 cm from the plinth
+  const glm::dvec3 near = bounce_on_plinth();
+  std::printf("bounce on the plinth (W/m^2): red crate far (%.4f, %.4f, %.4f), near (%.4f, %.4f, %.4f); base %.4f\n",
+              far.x, far.y, far.z, near.x, near.y, near.z, double{bundle().atlas.irradiance[plinth[0]].x});
+  EXPECT_GT(near.x, 3.0 * near.y);           // red light
+  EXPECT_GT(near.x, 5.0 * std::max(far.x, 1e-6));  // from the crate that came close
+  EXPECT_GE(std::min({far.x, far.y, far.z}), 0.0);
+}
+
+TEST(GISystem, ABundleOfOtherMeshesIsRejectedAsStale) {
+  auto asset = engine::load_gltf(GI_SOURCE_DIR "/assets/crates_room.gltf").value();
+  for (engine::Mesh& m : asset.meshes)
+    if (m.name == "crate")
+      for (engine::Primitive& p : m.primitives)
+        for (glm::vec3& v : p.positions) v *= 1.1f;
+  engine::Scene scene = engine::instantiate(std::move(asset));
+  auto loaded = gi::GISystem::load(bundle().dir, scene);
+  ASSERT_FALSE(loaded);
+  std::printf("%s\n", loaded.error().to_string().c_str());
+  EXPECT_NE(loaded.error().to_string().find("stale"), std::string::npos);
+}
+
+// The red crate made a metal (metallic 1, roughness 0.5): the bake separates its lobe, the
+// system bounces it as a glossy object on the GPU, the crate it stands beside turns red on
+// the facing side, and turning the metal rough makes the bundle stale.
+TEST(GISystem, AMetalCrateBouncesAsAGlossyObject) {
+  auto ctx = engine::GpuContext::create_headless();
+  ASSERT_TRUE(ctx) << "no headless GL context: " << ctx.error().to_string();
+  const auto metal_room = [](float roughness) {
+    auto asset = engine::load_gltf(GI_SOURCE_DIR "/assets/crates_room.gltf").value();
+    for (engine::Material& m : asset.materials)
+      if (m.name == "crate_red") m.metallic = 1.0f, m.roughness = roughness;
+    return engine::instantiate(std::move(asset));
+  };
+  engine::Scene scene = metal_room(0.5f);
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("gi_system_glossy_" + std::to_string(::getpid()) + ".gibake");
+  std::filesystem::remove_all(dir);
+  const auto sources = gi::dynamic_brf_meshes(scene).value();
+  gi::BrfBake brf;
+  brf.settings = gi::brf_preset("preview").value();
+  for (const gi::BrfSource& src : sources) {
+    brf.meshes.push_back(gi::bake_brf_mesh(src, brf.settings).value());
+    EXPECT_EQ(brf.meshes.back().glossy.has_value(), src.name == "crate_red") << src.name;
+  }
+  ASSERT_TRUE(gi::save_brf(dir, brf, scene.assets, "crates_room.gltf"));
+
+  auto loaded = gi::GISystem::load(dir, scene);
+  ASSERT_TRUE(loaded) << loaded.error().to_string();
+  gi::GISystem& gi = **loaded;
+  EXPECT_NE(gi.describe().find("glossy metal (crate_red)"), std::string::npos) << gi.describe();
+  // crate_2 stands at (-0.4, 0, -1.6), unturned: its +z face looks at where the red crate goes.
+  const engine::Entity crate_2 = engine::find_by_name(scene.registry, "crate_2");
+  const engine::MeshRenderer& mr = scene.registry.get<engine::MeshRenderer>(crate_2);
+  const gi::BrfMesh mesh = gi::brf_mesh_from_asset(scene.assets, mr.mesh).value();
+  const auto facing_light = [&] {
+    const std::uint32_t buffer = gi.frame().vertex_irradiance_buffer(crate_2);
+    std::vector<glm::vec4> v(mesh.positions.size());
+    glGetNamedBufferSubData(buffer, 0, static_cast<GLsizeiptr>(v.size() * sizeof(glm::vec4)), v.data());
+    glm::dvec3 sum(0.0);
+    int count = 0;
+    for (std::size_t j = 0; j < v.size(); ++j) {
+      EXPECT_TRUE(std::isfinite(v[j].x) && std::isfinite(v[j].y) && std::isfinite(v[j].z)) << j;
+      if (mesh.normals[j].z > 0.9f) sum += glm::dvec3(v[j]), ++count;
+    }
+    EXPECT_GT(count, 0);
+    return sum / static_cast<double>(std::max(count, 1));
+  };
+  const glm::dvec3 far = facing_light();
+  move_to(scene, "crate_red", {-0.4f, 0.0f, -0.9f});  // 20 cm in front of crate_2's +z face
+  const glm::dvec3 near = facing_light();
+  std::printf("crate_2's face toward the metal crate (W/m^2): far (%.4f, %.4f, %.4f), near (%.4f, %.4f, %.4f)\n", far.x, far.y,
+              far.z, near.x, near.y, near.z);
+  EXPECT_GT(near.x - far.x, 3.0 * std::abs(near.y - far.y));  // the metal's red reflection
+  EXPECT_GT(near.x - far.x, 0.05 * far.x);
+  loaded->reset();
+
+  // The same bundle for a rough red crate: the lobe is part of the mesh hash.
+  engine::Scene rough = metal_room(0.9f);
+  auto stale = gi::GISystem::load(dir, rough);
+  ASSERT_FALSE(stale);
+  EXPECT_NE(stale.error().to_string().find("stale"), std::string::npos) << stale.error().to_string();
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace

@@ -1,0 +1,292 @@
+// gi::plan on the project's scenes (DESIGN.md §3 "Effects on demand", docs/plan.md): which
+// methods each scene calls for and why, the JSON form, the manifest's "plan" section, and
+// the cost model against the bakes it was calibrated on.
+#include <engine/gltf.h>
+#include <gi/plan.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "bundle/manifest.h"
+#include "plan/plan_cost.h"
+#include "plan/plan_json.h"
+#include "plan/static_surface_census.h"
+#include "uv/atlas_input.h"
+#include "uv/atlas_layout.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using gi::EffectMethod;
+
+engine::Scene load(const std::string& name) {
+  auto asset = engine::load_gltf(std::string(GI_SOURCE_DIR) + "/assets/" + name);
+  EXPECT_TRUE(asset) << asset.error().to_string();
+  return engine::instantiate(std::move(asset).value());
+}
+
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+std::vector<std::string> sorted(std::vector<std::string> v) {
+  std::sort(v.begin(), v.end());
+  return v;
+}
+
+TEST(Plan, CornellBoxGetsTheLightAtlasOnly) {
+  const gi::EffectPlan p = gi::plan(load("cornell_box.gltf"), {.preset = "preview"});
+  ASSERT_EQ(p.effects.size(), 5u);
+  const gi::PlannedEffect& atlas = p.effect(EffectMethod::LightAtlas);
+  EXPECT_TRUE(atlas.enabled);
+  EXPECT_TRUE(atlas.available);
+  EXPECT_TRUE(contains(atlas.reason, "1 static light")) << atlas.reason;
+  EXPECT_TRUE(contains(atlas.reason, "4 static meshes")) << atlas.reason;
+  EXPECT_GT(atlas.estimate.bake_seconds, 0.0);
+  EXPECT_GT(atlas.estimate.runtime_bytes, 0u);
+  const gi::PlannedEffect& prm = p.effect(EffectMethod::Prm);
+  EXPECT_FALSE(prm.enabled);
+  EXPECT_TRUE(contains(prm.reason, "no light moves")) << prm.reason;
+  EXPECT_EQ(prm.estimate.bake_seconds, 0.0);
+  for (EffectMethod m :
+       {EffectMethod::DirectionalLightMaps, EffectMethod::Antiradiance, EffectMethod::BasisRadianceFields})
+    EXPECT_FALSE(p.effect(m).enabled) << gi::effect_key(m);
+  EXPECT_EQ(p.methods_to_bake(), std::vector<std::string>{"atlas"});
+  EXPECT_TRUE(p.warnings.empty());
+}
+
+TEST(Plan, SpotChamberNeedsPrmOnceItsSpotMoves) {
+  engine::Scene scene = load("spot_chamber.gltf");
+  // As authored the spot does not move: atlas only.
+  EXPECT_EQ(gi::plan(scene).methods_to_bake(), std::vector<std::string>{"atlas"});
+  // The game scripts it (as the PRM tests and sweeps move it), named in the options...
+  gi::EffectPlan scripted = gi::plan(scene, {.moving_lights = {"spot"}});
+  EXPECT_TRUE(scripted.effect(EffectMethod::Prm).enabled);
+  EXPECT_TRUE(contains(scripted.effect(EffectMethod::Prm).reason, "light 'spot' moves (scripted by the game)"))
+      << scripted.effect(EffectMethod::Prm).reason;
+  // ...or flagged on the light: the same plan. With no static light left, no atlas.
+  scene.registry.write<engine::Light>(engine::find_by_name(scene.registry, "spot")).moves = true;
+  const gi::EffectPlan p = gi::plan(scene);
+  const gi::PlannedEffect& prm = p.effect(EffectMethod::Prm);
+  EXPECT_TRUE(prm.enabled);
+  EXPECT_TRUE(contains(prm.reason, "light 'spot' moves (light_moves)")) << prm.reason;
+  EXPECT_EQ(sorted(prm.targets), sorted({"chamber", "chamber_floor", "pedestal"}));
+  EXPECT_FALSE(p.effect(EffectMethod::LightAtlas).enabled);
+  EXPECT_TRUE(contains(p.effect(EffectMethod::LightAtlas).reason, "no static light"))
+      << p.effect(EffectMethod::LightAtlas).reason;
+  EXPECT_EQ(p.methods_to_bake(), std::vector<std::string>{"prm"});
+}
+
+TEST(Plan, DemoLevelNeedsEveryBuiltMethodAndSaysDlmIsNotBuilt) {
+  const gi::EffectPlan p = gi::plan(load("demo_level.gltf"), {.preset = "preview"});
+  const gi::PlannedEffect& prm = p.effect(EffectMethod::Prm);
+  EXPECT_TRUE(prm.enabled);
+  EXPECT_TRUE(contains(prm.reason, "swinging_lamp")) << prm.reason;
+  EXPECT_TRUE(contains(p.effect(EffectMethod::LightAtlas).reason, "4 static lights"))
+      << p.effect(EffectMethod::LightAtlas).reason;
+  const gi::PlannedEffect& dlm = p.effect(EffectMethod::DirectionalLightMaps);
+  EXPECT_TRUE(dlm.enabled);
+  EXPECT_FALSE(dlm.available);
+  EXPECT_EQ(dlm.targets, std::vector<std::string>{"corridor_floor"});
+  EXPECT_EQ(sorted(p.effect(EffectMethod::BasisRadianceFields).targets), sorted({"crate", "crate_red", "lamp_shade"}));
+  EXPECT_EQ(p.methods_to_bake(), (std::vector<std::string>{"atlas", "prm", "brf"}));
+  const std::string text = gi::format_plan(p);
+  EXPECT_TRUE(contains(text, "this build cannot bake dlm")) << text;
+  std::fputs(text.c_str(), stdout);
+}
+
+TEST(Plan, CratesRoomGetsBasisRadianceFieldsForTheCrateMeshesOnly) {
+  const gi::EffectPlan p = gi::plan(load("crates_room.gltf"));
+  const gi::PlannedEffect& brf = p.effect(EffectMethod::BasisRadianceFields);
+  EXPECT_TRUE(brf.enabled);
+  EXPECT_TRUE(brf.available);
+  EXPECT_EQ(brf.targets, (std::vector<std::string>{"crate", "crate_red"}));
+  EXPECT_TRUE(contains(brf.reason, "5 dynamic entities use 2 meshes (crate, crate_red)")) << brf.reason;
+  EXPECT_EQ(std::count(brf.targets.begin(), brf.targets.end(), "statue"), 0);
+  // The static statue is the atlas's.
+  const auto& atlas_targets = p.effect(EffectMethod::LightAtlas).targets;
+  EXPECT_EQ(std::count(atlas_targets.begin(), atlas_targets.end(), "statue"), 1);
+  // One field per mesh at the medium preset (brf_preset): 12 spheres x 6 x 12^2 x 16 functions
+  // x 9 coefficients x 4 B = 5.97 MB, plus the basis.
+  EXPECT_NEAR(static_cast<double>(brf.estimate.runtime_bytes), 2 * 5.97e6, 0.01 * 2 * 5.97e6);
+}
+
+TEST(Plan, GlossyRoomCallsForDirectionalLightMapsThatThisBuildCannotBake) {
+  const gi::EffectPlan p = gi::plan(load("glossy_room.gltf"));
+  const gi::PlannedEffect& dlm = p.effect(EffectMethod::DirectionalLightMaps);
+  EXPECT_TRUE(dlm.enabled);
+  EXPECT_FALSE(dlm.available);
+  EXPECT_EQ(dlm.targets, std::vector<std::string>{"glossy_floor"});
+  EXPECT_TRUE(contains(dlm.reason, "roughness 0.15 < 0.35")) << dlm.reason;
+  EXPECT_EQ(dlm.estimate.bake_seconds, 0.0);
+  EXPECT_EQ(p.methods_to_bake(), std::vector<std::string>{"atlas"});
+  EXPECT_TRUE(contains(gi::format_plan(p), "NOT BUILT"));
+  // A stricter threshold drops it, and the reason says so.
+  const gi::EffectPlan strict = gi::plan(load("glossy_room.gltf"), {.glossy_roughness = 0.1f});
+  EXPECT_FALSE(strict.effect(EffectMethod::DirectionalLightMaps).enabled);
+  EXPECT_TRUE(
+      contains(strict.effect(EffectMethod::DirectionalLightMaps).reason, "no static surface has roughness < 0.10"));
+}
+
+TEST(Plan, ASceneWithoutLightGetsNothing) {
+  engine::SceneAsset a;
+  engine::Mesh quad{"floor", {}};
+  engine::Primitive prim;
+  prim.positions = {{0, 0, 0}, {1, 0, 0}, {1, 0, 1}, {0, 0, 1}};
+  prim.indices = {0, 2, 1, 0, 3, 2};
+  quad.primitives.push_back(prim);
+  a.meshes.push_back(quad);
+  engine::Node node;
+  node.name = "floor";
+  node.mesh = 0;
+  node.gi.mobility = engine::Mobility::Static;
+  a.nodes.push_back(node);
+  const gi::EffectPlan p = gi::plan(engine::instantiate(a));
+  for (const gi::PlannedEffect& e : p.effects) {
+    EXPECT_FALSE(e.enabled) << gi::effect_key(e.method);
+    EXPECT_TRUE(contains(e.reason, "no light")) << e.reason;
+  }
+  EXPECT_TRUE(p.methods_to_bake().empty());
+  // Switched-off lights count as none, and the reason says they are off.
+  engine::Scene box = load("cornell_box.gltf");
+  box.registry.write<engine::Light>(engine::find_by_name(box.registry, "light")).enabled = false;
+  const gi::EffectPlan off = gi::plan(box);
+  // The emissive quad still lights the box.
+  EXPECT_TRUE(off.effect(EffectMethod::LightAtlas).enabled);
+  EXPECT_EQ(off.facts.disabled_lights, 1);
+}
+
+TEST(Plan, DeformingRegionsFromTheFileGetAntiradiance) {
+  auto asset = engine::load_gltf(std::string(GI_SOURCE_DIR) + "/assets/corridor.gltf");
+  ASSERT_TRUE(asset);
+  for (engine::Node& n : asset->nodes)
+    if (n.name == "door") n.gi.region = engine::GiRegion::Deforming;
+  const fs::path dir = fs::path(GI_BINARY_DIR) / "test_output" / "plan_test";
+  fs::create_directories(dir);
+  ASSERT_TRUE(engine::write_gltf(*asset, dir / "corridor_door.gltf"));
+  auto reloaded = engine::load_gltf(dir / "corridor_door.gltf");
+  ASSERT_TRUE(reloaded) << reloaded.error().to_string();
+  const gi::EffectPlan p = gi::plan(engine::instantiate(std::move(reloaded).value()));
+  const gi::PlannedEffect& anti = p.effect(EffectMethod::Antiradiance);
+  EXPECT_TRUE(anti.enabled);
+  EXPECT_FALSE(anti.available);
+  EXPECT_EQ(anti.targets, std::vector<std::string>{"door"});
+  EXPECT_TRUE(contains(anti.reason, "'door'")) << anti.reason;
+}
+
+TEST(Plan, LightUnderADynamicNodeMovesWithAWarningWhenNotFlagged) {
+  auto asset = engine::load_gltf(std::string(GI_SOURCE_DIR) + "/assets/demo_level.gltf");
+  ASSERT_TRUE(asset);
+  for (engine::Node& n : asset->nodes)
+    if (n.name == "swinging_lamp") n.gi.mobility = engine::Mobility::Unspecified;
+  engine::Scene parented = engine::instantiate(*asset);
+  parented.registry.write<engine::Light>(engine::find_by_name(parented.registry, "swinging_lamp")).moves = false;
+  EXPECT_TRUE(contains(gi::plan(parented).effect(EffectMethod::Prm).reason, "hangs from dynamic node 'lamp_pivot'"))
+      << gi::plan(parented).effect(EffectMethod::Prm).reason;
+  engine::Scene scene = load("demo_level.gltf");
+  scene.registry.write<engine::Light>(engine::find_by_name(scene.registry, "swinging_lamp")).moves = false;
+  const gi::EffectPlan p = gi::plan(scene);
+  // Its own node is dynamic (it swings with lamp_pivot).
+  EXPECT_TRUE(contains(p.effect(EffectMethod::Prm).reason, "light 'swinging_lamp' moves (on a dynamic node)"))
+      << p.effect(EffectMethod::Prm).reason;
+  ASSERT_EQ(p.warnings.size(), 1u);
+  EXPECT_TRUE(contains(p.warnings[0], "set gi.light_moves")) << p.warnings[0];
+}
+
+TEST(PlanJson, RoundTripsAndRejectsBadInput) {
+  const gi::EffectPlan p = gi::plan(load("demo_level.gltf"), {.preset = "medium"});
+  const std::string text = gi::to_json(p);
+  auto back = gi::plan_from_json(text);
+  ASSERT_TRUE(back) << back.error().to_string();
+  EXPECT_EQ(gi::to_json(*back), text);
+  EXPECT_EQ(gi::format_plan(*back), gi::format_plan(p));
+  EXPECT_TRUE(contains(text, "\"bake\"")) << text;
+
+  EXPECT_FALSE(gi::plan_from_json("{not json"));
+  std::string bad = text;
+  bad.replace(bad.find("\"antiradiance\""), 14, "\"radiosity\"");
+  auto unknown = gi::plan_from_json(bad);
+  ASSERT_FALSE(unknown);
+  EXPECT_TRUE(contains(unknown.error().to_string(), "unknown method 'radiosity'")) << unknown.error().to_string();
+  auto missing = gi::plan_from_json(R"({"scene": "x"})");
+  ASSERT_FALSE(missing);
+  EXPECT_TRUE(contains(missing.error().to_string(), "plan.preset")) << missing.error().to_string();
+}
+
+TEST(PlanJson, TheManifestKeepsThePlanBesideTheMethods) {
+  const fs::path dir = fs::path(GI_BINARY_DIR) / "test_output" / "plan_test" / "bundle";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  ASSERT_TRUE(gi::update_manifest_method(dir, "0123456789abcdef", "x.gltf", "light_atlas", {{"files", {}}}));
+  const gi::EffectPlan p = gi::plan(load("cornell_box.gltf"));
+  ASSERT_TRUE(gi::update_manifest_plan(dir, "0123456789abcdef", "x.gltf", gi::plan_to_json_value(p)));
+  ASSERT_TRUE(gi::update_manifest_method(dir, "0123456789abcdef", "x.gltf", "prm", {{"files", {}}}));
+  auto m = gi::read_manifest(dir);
+  ASSERT_TRUE(m) << m.error().to_string();
+  EXPECT_TRUE(m->methods.contains("light_atlas"));
+  EXPECT_TRUE(m->methods.contains("prm"));
+  auto plan = gi::plan_from_json_value(m->plan, "manifest.json");
+  ASSERT_TRUE(plan) << plan.error().to_string();
+  EXPECT_EQ(plan->methods_to_bake(), std::vector<std::string>{"atlas"});
+}
+
+// The cost model against the gi-bake runs it was calibrated on (docs/plan.md: CPU seconds
+// user + sys, one method per run; texels, path nodes and rays as gi-bake printed them).
+TEST(PlanCost, EstimatesAreWithinAFactorOfTwoOfTheCalibrationBakes) {
+  struct Measured {
+    const char* scene;
+    const char* preset;
+    double lit_texels, pane_texels, atlas_side_texels, path_nodes, atlas_rays, prm_rays, atlas_cpu_s, prm_cpu_s;
+  };
+  const Measured runs[] = {
+      {"cornell_box.gltf", "preview", 183, 747, 32, 2169, 0.9e6, 0.2e6, 0.18, 0.06},
+      {"cornell_box.gltf", "medium", 555, 1325, 45, 8857, 7.6e6, 3.0e6, 1.26, 0.39},
+      {"spot_chamber.gltf", "preview", 5688, 7637, 128, 2282, 2.1e6, 10.2e6, 0.32, 0.81},
+      {"spot_chamber.gltf", "medium", 21990, 25798, 256, 9151, 25.7e6, 159.6e6, 3.51, 12.15},
+      {"demo_level.gltf", "preview", 45443, 55974, 256, 2237, 10.1e6, 60.6e6, 1.79, 5.98},
+      {"demo_level.gltf", "medium", 177599, 200153, 512, 8673, 114.7e6, 928.9e6, 21.05, 97.64},
+  };
+  const auto within2 = [](double estimate, double measured) {
+    return estimate > 0.5 * measured && estimate < 2.0 * measured;
+  };
+  std::printf("%-18s %-8s %14s %14s %14s %12s %14s %14s\n", "scene", "preset", "lit texels", "pane texels",
+              "path nodes", "atlas side", "atlas cpu s", "prm cpu s");
+  for (const Measured& r : runs) {
+    const engine::Scene scene = load(r.scene);
+    const gi::StaticSurfaceCensus census = gi::census_static_surfaces(scene);
+    const gi::LightAtlasSettings as = gi::light_atlas_preset(r.preset).value();
+    const gi::PrmSettings ps = gi::prm_preset(r.preset).value();
+    const gi::AtlasTexelEstimate t = gi::atlas_texels(census, as.texels_per_metre);
+    // The light points gi-bake reported: spot 1 (the spot); cornell 128 = the area light's
+    // emissive proxy, 2 triangles x 64; demo 131 = 3 punctual lights + 2 x 64.
+    gi::LightPointCount lights{.punctual = 1};
+    if (std::string(r.scene) == "cornell_box.gltf") lights = {.punctual = 0, .sampled = 2};
+    if (std::string(r.scene) == "demo_level.gltf") lights = {.punctual = 3, .sampled = 2};
+    const gi::BakeWork aw = gi::light_atlas_work(census, as, lights);
+    double nodes = 0.0;
+    const gi::BakeWork pw = gi::prm_work(census, ps, &nodes);
+    const double side = std::sqrt(static_cast<double>(t.width) * t.height);
+    auto layout =
+        gi::build_atlas_layout(gi::atlas_inputs_from(scene.assets), {.texels_per_metre = as.texels_per_metre});
+    ASSERT_TRUE(layout);
+    std::printf("charts: %zu estimated, %zu in the layout; atlas %dx%d estimated, %dx%d laid out\n",
+                census.charts.size(), layout->charts.size(), t.width, t.height, layout->width, layout->height);
+    std::printf(
+        "%-18s %-8s %6.0f/%-7.0f %6.0f/%-7.0f %6.0f/%-7.0f %5.0f/%-6.0f %6.2f/%-7.2f %6.2f/%-7.2f  "
+        "(estimate/measured)\n",
+        r.scene, r.preset, t.lit_texels, r.lit_texels, t.pane_texels, r.pane_texels, nodes, r.path_nodes, side,
+        r.atlas_side_texels, aw.cpu_seconds, r.atlas_cpu_s, pw.cpu_seconds, r.prm_cpu_s);
+    std::printf("%-18s %-8s rays: atlas %.1f/%.1f M, prm %.1f/%.1f M\n", "", "", aw.rays * 1e-6, r.atlas_rays * 1e-6,
+                pw.rays * 1e-6, r.prm_rays * 1e-6);
+    EXPECT_TRUE(within2(t.lit_texels, r.lit_texels)) << r.scene << ' ' << r.preset;
+    EXPECT_TRUE(within2(t.pane_texels, r.pane_texels)) << r.scene << ' ' << r.preset;
+    EXPECT_TRUE(within2(nodes, r.path_nodes)) << r.scene << ' ' << r.preset;
+    EXPECT_TRUE(within2(side, r.atlas_side_texels)) << r.scene << ' ' << r.preset;
+    EXPECT_TRUE(within2(aw.cpu_seconds, r.atlas_cpu_s)) << r.scene << ' ' << r.preset;
+    EXPECT_TRUE(within2(pw.cpu_seconds, r.prm_cpu_s)) << r.scene << ' ' << r.preset;
+  }
+}
+
+}  // namespace

@@ -1,0 +1,167 @@
+// The architecture, checked: gi/src folders include only the folders of the targets they
+// link (gi/CMakeLists.txt writes the targets' folders and links to GI_LAYERS_FILE), the
+// folder include graph has no cycle, engine never includes gi, and nothing outside gi/
+// includes gi/src: tools, the demo and the top-level tests use the public headers.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <functional>
+#include <fstream>
+#include <map>
+#include <regex>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Layers {
+  std::map<std::string, std::string> target_of_folder;
+  std::map<std::string, std::set<std::string>> links;  // target -> targets it links
+};
+
+Layers read_layers() {
+  Layers l;
+  std::ifstream in(GI_LAYERS_FILE);
+  EXPECT_TRUE(in) << "cannot read " << GI_LAYERS_FILE;
+  for (std::string line; std::getline(in, line);) {
+    std::istringstream words(line);
+    std::string kind, target;
+    words >> kind >> target;
+    if (kind == "folder") {
+      std::string folder;
+      words >> folder;
+      l.target_of_folder[folder] = target;
+    } else if (kind == "link") {
+      for (std::string t; words >> t;) l.links[target].insert(t);
+    }
+  }
+  return l;
+}
+
+bool is_source(const fs::path& p) {
+  const std::string e = p.extension().string();
+  return e == ".h" || e == ".cpp" || e == ".hpp";
+}
+
+// "folder/..." of every #include "folder/file.h" in `file`.
+std::set<std::string> included_folders(const fs::path& file) {
+  static const std::regex include_re(R"re(^\s*#\s*include\s*"([a-z_0-9]+)/[^"]+")re");
+  std::set<std::string> out;
+  std::ifstream in(file);
+  for (std::string line; std::getline(in, line);) {
+    std::smatch m;
+    if (std::regex_search(line, m, include_re)) out.insert(m[1]);
+  }
+  return out;
+}
+
+std::set<std::string> reachable_targets(const Layers& l, const std::string& target) {
+  std::set<std::string> seen{target};
+  std::vector<std::string> todo{target};
+  while (!todo.empty()) {
+    const std::string t = todo.back();
+    todo.pop_back();
+    auto it = l.links.find(t);
+    if (it == l.links.end()) continue;
+    for (const std::string& next : it->second)
+      if (seen.insert(next).second) todo.push_back(next);
+  }
+  return seen;
+}
+
+const fs::path kGiSrc = fs::path(GI_SOURCE_DIR) / "gi" / "src";
+
+// folder -> folders its files include (other gi/src folders only).
+std::map<std::string, std::set<std::string>> folder_graph(const Layers& l) {
+  std::map<std::string, std::set<std::string>> g;
+  for (const auto& [folder, target] : l.target_of_folder) {
+    g[folder];
+    if (!fs::exists(kGiSrc / folder)) continue;
+    for (const auto& e : fs::recursive_directory_iterator(kGiSrc / folder))
+      if (e.is_regular_file() && is_source(e.path()))
+        for (const std::string& inc : included_folders(e.path()))
+          if (inc != folder && l.target_of_folder.count(inc)) g[folder].insert(inc);
+  }
+  return g;
+}
+
+TEST(Architecture, EveryGiSrcFolderBelongsToATarget) {
+  const Layers l = read_layers();
+  for (const auto& e : fs::directory_iterator(kGiSrc)) {
+    if (!e.is_directory()) continue;
+    EXPECT_TRUE(l.target_of_folder.count(e.path().filename().string()))
+        << "gi/src/" << e.path().filename().string() << " is compiled by no target in gi/CMakeLists.txt";
+  }
+}
+
+TEST(Architecture, FoldersIncludeOnlyFoldersOfTheTargetsTheyLink) {
+  const Layers l = read_layers();
+  ASSERT_FALSE(l.target_of_folder.empty());
+  for (const auto& [folder, includes] : folder_graph(l)) {
+    const std::string& target = l.target_of_folder.at(folder);
+    const std::set<std::string> allowed = reachable_targets(l, target);
+    for (const std::string& inc : includes)
+      EXPECT_TRUE(allowed.count(l.target_of_folder.at(inc)))
+          << "gi/src/" << folder << " (" << target << ") includes gi/src/" << inc << " ("
+          << l.target_of_folder.at(inc) << "), a target it does not link";
+  }
+}
+
+TEST(Architecture, FolderIncludeGraphHasNoCycle) {
+  const Layers l = read_layers();
+  const auto g = folder_graph(l);
+  // Depth-first search with colours; a grey node reached again closes a cycle.
+  std::map<std::string, int> colour;
+  std::vector<std::string> path;
+  std::string cycle;
+  std::function<void(const std::string&)> visit = [&](const std::string& f) {
+    colour[f] = 1;
+    path.push_back(f);
+    for (const std::string& next : g.at(f)) {
+      if (!cycle.empty()) break;
+      if (colour[next] == 1) {
+        for (auto it = std::find(path.begin(), path.end(), next); it != path.end(); ++it) cycle += *it + " -> ";
+        cycle += next;
+      } else if (colour[next] == 0) {
+        visit(next);
+      }
+    }
+    path.pop_back();
+    colour[f] = 2;
+  };
+  for (const auto& [f, unused] : g)
+    if (colour[f] == 0 && cycle.empty()) visit(f);
+  EXPECT_TRUE(cycle.empty()) << "include cycle between gi/src folders: " << cycle;
+}
+
+TEST(Architecture, NothingOutsideGiIncludesGiSrcAndEngineNeverIncludesGi) {
+  const Layers l = read_layers();
+  static const std::regex gi_public(R"re(^\s*#\s*include\s*[<"]gi/)re");
+  for (const char* top : {"engine", "tools", "tests", "game_demo"}) {
+    for (const auto& e : fs::recursive_directory_iterator(fs::path(GI_SOURCE_DIR) / top)) {
+      if (!e.is_regular_file()) continue;
+      const std::string rel = fs::relative(e.path(), GI_SOURCE_DIR).string();
+      if (e.path().filename() == "CMakeLists.txt") {
+        std::ifstream in(e.path());
+        const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        EXPECT_EQ(text.find("gi/src"), std::string::npos) << rel << " puts gi/src on an include path";
+        continue;
+      }
+      if (!is_source(e.path())) continue;
+      for (const std::string& inc : included_folders(e.path()))
+        EXPECT_FALSE(l.target_of_folder.count(inc)) << rel << " includes gi/src/" << inc << "/...";
+      if (std::string(top) == "engine") {
+        std::ifstream in(e.path());
+        for (std::string line; std::getline(in, line);)
+          EXPECT_FALSE(std::regex_search(line, gi_public)) << rel << " (engine) includes gi: " << line;
+      }
+    }
+  }
+}
+
+}  // namespace
