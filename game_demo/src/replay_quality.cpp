@@ -10,7 +10,17 @@
 // stand-in row shows on its own.
 #define GL_GLEXT_PROTOTYPES 1
 #include <GL/glcorearb.h>
+#include <engine/gpu/context.h>
+#include <engine/renderer.h>
+#include <game_demo/replay.h>
+#include <game_demo/session_file.h>
+#include <game_demo/simulation.h>
+#include <gi/error_metrics.h>
+#include <gi/gi_system.h>
+#include <gi/reference.h>
+#include <gi/rgb_field.h>
 
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -20,20 +30,6 @@
 #include <map>
 #include <numeric>
 #include <sstream>
-
-#include <CLI/CLI.hpp>
-
-#include <engine/gpu/context.h>
-#include <engine/renderer.h>
-#include <gi/gi_system.h>
-#include <gi/reference.h>
-
-#include <game_demo/replay.h>
-#include <game_demo/session_file.h>
-#include <game_demo/simulation.h>
-
-#include "metrics/error_metrics.h"
-#include "metrics/rgb_field.h"
 
 namespace {
 
@@ -77,7 +73,8 @@ int main(int argc, char** argv) {
   std::string session_path, out_path, frames_text = "150,300,450";
   std::vector<std::string> bundles;
   int width = 320, height = 180, spp = 256;
-  CLI::App app{"Replays a session with GI bakes of different quality: frame time vs image error against the path tracer"};
+  CLI::App app{
+      "Replays a session with GI bakes of different quality: frame time vs image error against the path tracer"};
   app.add_option("--session", session_path, "Recorded session (.girec)")->required()->check(CLI::ExistingFile);
   app.add_option("--bundle", bundles, "NAME=DIR of a bake bundle, or 'none' for the stand-in (repeatable)")->required();
   app.add_option("--frames", frames_text, "Comma-separated frames compared with the path tracer");
@@ -98,7 +95,8 @@ int main(int argc, char** argv) {
   }
   const std::uint64_t last = picked.back();
   if (last >= session->frames.size()) {
-    std::cerr << "gi-replay-quality: frame " << last << " is past the session's " << session->frames.size() << " frames\n";
+    std::cerr << "gi-replay-quality: frame " << last << " is past the session's " << session->frames.size()
+              << " frames\n";
     return 2;
   }
 
@@ -154,8 +152,9 @@ int main(int argc, char** argv) {
       }
       gi = std::move(loaded).value();
     }
-    auto renderer = engine::Renderer::create(sim->scene().assets, engine::RenderSettings{.width = width, .height = height,
-                                                                                        .exposure = game_demo::kDemoExposure});
+    auto renderer = engine::Renderer::create(
+        sim->scene().assets,
+        engine::RenderSettings{.width = width, .height = height, .exposure = game_demo::kDemoExposure});
     if (!renderer) {
       std::cerr << "gi-replay-quality: " << renderer.error().to_string() << '\n';
       return 1;
@@ -168,14 +167,15 @@ int main(int argc, char** argv) {
       (*renderer)->render(sim->registry(), sim->context().camera);
       glFinish();
       ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-      if (const auto it = reference.find(f); it != reference.end())
-      {
+      if (const auto it = reference.find(f); it != reference.end()) {
         std::size_t bad = 0;
         gi::RgbField mine = masked(field_of((*renderer)->read_hdr(), &bad), it->second);
         gi::RgbField ref = it->second;
         for (std::size_t i = 0; i < ref.valid.size(); ++i)
           if (!mine.is_valid(i)) ref.valid[i] = 0;
-        if (bad > 0) std::printf("%s frame %llu: %zu non-finite pixels masked\n", row.name.c_str(), static_cast<unsigned long long>(f), bad);
+        if (bad > 0)
+          std::printf("%s frame %llu: %zu non-finite pixels masked\n", row.name.c_str(),
+                      static_cast<unsigned long long>(f), bad);
         row.errors.push_back(gi::relative_rmse(mine, ref));
       }
     }

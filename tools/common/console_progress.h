@@ -1,38 +1,57 @@
 #pragma once
-// A progress bar for the command-line tools: "[#######.....]  42%  elapsed 0:12  ETA 0:16"
-// on stderr, redrawn in place on a terminal, one line every 2 s otherwise (CI logs).
-//   settings.progress = tools::console_progress("bake");
+// The command-line tools' one progress bar, on stderr:
+//   "light atlas [##########..........]  42%  elapsed 0:12  ETA 0:16"
+// redrawn in place on a terminal (at most every 0.1 s), one line every 2 s otherwise (CI
+// logs); a new label ends the previous line. Every callback it hands out returns false once
+// the user pressed Ctrl-C (tools::interrupted()), which cancels the work.
+//   tools::ConsoleProgress bar;
+//   settings.progress = bar.stage("render");                  // gi::ProgressCallback
+//   host.progress = bar.stages();                             // gi::StageProgressCallback
 
-#include <unistd.h>
+#include <gi/progress.h>
 
 #include <chrono>
 #include <cstdio>
 #include <string>
-
-#include <gi/progress.h>
-
-#include "sweep/sweep_progress_bar.h"
+#include <string_view>
 
 namespace tools {
 
-inline gi::ProgressCallback console_progress(const std::string& label) {
+/// "1:05", "1:02:03", or "--:--" for a negative or unknown time.
+std::string format_duration(double seconds);
+
+/// "<label> [####......] 42%  <detail>  elapsed 0:12  ETA 0:16" for a fraction in [0, 1];
+/// ETA = elapsed x (1 - f) / f.
+std::string format_progress(std::string_view label, double fraction, double elapsed_s, std::string_view detail = {},
+                            int bar_width = 20);
+
+class ConsoleProgress {
+ public:
+  /// Draws on `out` (stderr by default); `terminal` chooses in-place redraws.
+  explicit ConsoleProgress(std::FILE* out = stderr);
+  ConsoleProgress(std::FILE* out, bool terminal);
+  ~ConsoleProgress();
+  ConsoleProgress(const ConsoleProgress&) = delete;
+  ConsoleProgress& operator=(const ConsoleProgress&) = delete;
+
+  /// Draws (throttled; always at 100% and on a new label). Returns !tools::interrupted().
+  bool update(std::string_view label, double fraction, std::string_view detail = {});
+  /// Ends the current line, if any.
+  void finish();
+
+  /// A callback drawing under `label`; the clock restarts for it.
+  gi::ProgressCallback stage(std::string label);
+  /// A callback for staged work (the label is the stage's name).
+  gi::StageProgressCallback stages();
+
+ private:
   using Clock = std::chrono::steady_clock;
-  const bool terminal = isatty(2) != 0;
-  const auto start = Clock::now();
-  auto last = start - std::chrono::seconds(1);
-  return [=](double f) mutable {
-    const auto now = Clock::now();
-    if (f < 1.0 && now - last < std::chrono::milliseconds(terminal ? 100 : 2000)) return true;
-    last = now;
-    const double elapsed = std::chrono::duration<double>(now - start).count();
-    const int filled = static_cast<int>(f * 30.0);
-    std::fprintf(stderr, "%s%s [%s%s] %3d%%  elapsed %s  ETA %s%s", terminal ? "\r" : "", label.c_str(),
-                 std::string(static_cast<std::size_t>(filled), '#').c_str(),
-                 std::string(static_cast<std::size_t>(30 - filled), '.').c_str(), static_cast<int>(f * 100.0),
-                 gi::format_duration(elapsed).c_str(), gi::format_duration(f > 0.0 ? elapsed * (1.0 - f) / f : -1.0).c_str(),
-                 terminal && f < 1.0 ? "" : "\n");
-    return true;
-  };
-}
+  std::FILE* out_;
+  bool terminal_;
+  std::string label_;
+  Clock::time_point start_ = Clock::now();
+  Clock::time_point last_draw_{};
+  bool line_open_ = false;
+};
 
 }  // namespace tools

@@ -2,8 +2,14 @@
 // tonemapped PNG on request), or the ground-truth irradiance of its light-atlas texels.
 //   gi-reference --scene assets/cornell_box.gltf --width 256 --height 256 --spp 256 --out cbox.exr
 //   gi-reference --scene assets/cornell_box.gltf --atlas-density 64 --spp 256 --atlas-out out/cbox_atlas
-#include <unistd.h>
+// Exit codes: tools/common/tool_main.h.
+#include <engine/display_transform.h>
+#include <engine/gltf.h>
+#include <engine/image.h>
+#include <engine/scene.h>
+#include <gi/reference.h>
 
+#include <CLI/CLI.hpp>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -11,23 +17,12 @@
 #include <iostream>
 #include <string>
 
-#include <CLI/CLI.hpp>
-
-#include <engine/gltf.h>
-#include <engine/image.h>
-#include <engine/scene.h>
-#include <gi/reference.h>
-
-#include "metrics/display_tonemap.h"
-#include "raytrace/atlas_reference.h"
 #include "console_progress.h"
-#include "sweep/sweep_progress_bar.h"
-#include "uv/atlas_input.h"
-#include "uv/atlas_layout.h"
-#include "uv/atlas_rasterizer.h"
+#include "tool_main.h"
 
 namespace {
 
+constexpr const char* kTool = "gi-reference";
 using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
@@ -44,11 +39,6 @@ engine::ImageRgbaF rgb_image(int w, int h, const std::vector<glm::vec3>& v, cons
     img.pixels[4 * i + 3] = valid[i] ? 1.0f : 0.0f;  // alpha: texel covered by a triangle
   }
   return img;
-}
-
-int fail(const std::string& message) {
-  std::cerr << "gi-reference: " << message << '\n';
-  return 1;
 }
 
 }  // namespace
@@ -73,13 +63,17 @@ int main(int argc, char** argv) {
   app.add_option("--exposure", exposure, "exposure for --png");
   app.add_option("--atlas-density", atlas_density, "light-atlas texels per metre (enables the atlas output)");
   app.add_option("--atlas-out", atlas_out, "folder for atlas_direct.exr, atlas_indirect.exr, atlas_total.exr");
-  CLI11_PARSE(app, argc, argv);
-  if (out_path.empty() && png_path.empty() && atlas_out.empty()) return fail("nothing to do: give --out, --png or --atlas-out");
-  if (!atlas_out.empty() && !(atlas_density > 0.0f)) return fail("--atlas-out needs --atlas-density > 0");
+  if (auto rc = tools::parse(app, kTool, argc, argv)) return *rc;
+  if (out_path.empty() && png_path.empty() && atlas_out.empty())
+    return tools::fail(kTool, "nothing to do: give --out, --png or --atlas-out", tools::kExitUsage);
+  if (!atlas_out.empty() && !(atlas_density > 0.0f))
+    return tools::fail(kTool, "--atlas-out needs --atlas-density > 0", tools::kExitUsage);
 
   auto asset = engine::load_gltf(scene_path);
-  if (!asset) return fail(asset.error().to_string());
-  engine::Scene scene = engine::instantiate(asset.value());
+  if (!asset) return tools::fail(kTool, asset.error());
+  engine::Scene scene = engine::instantiate(std::move(asset).value());
+  tools::install_interrupt_handler();
+  tools::ConsoleProgress bar;
 
   gi::ReferenceSettings settings;
   settings.samples_per_pixel = spp;
@@ -88,51 +82,53 @@ int main(int argc, char** argv) {
   settings.seed = seed;
 
   if (!out_path.empty() || !png_path.empty()) {
-    const engine::Entity camera = camera_name.empty() ? engine::find_camera(scene.registry)
-                                                      : engine::find_by_name(scene.registry, camera_name);
-    if (camera.is_null()) return fail(scene_path + ": no camera" + (camera_name.empty() ? "" : " named " + camera_name));
-    settings.progress = tools::console_progress("render");
+    const engine::Entity camera =
+        camera_name.empty() ? engine::find_camera(scene.registry) : engine::find_by_name(scene.registry, camera_name);
+    if (camera.is_null())
+      return tools::fail(kTool, scene_path + ": no camera" + (camera_name.empty() ? "" : " named " + camera_name),
+                         tools::kExitUsage);
+    settings.progress = bar.stage("render");
     const auto start = Clock::now();
     auto image = gi::render_reference_image(scene, camera, width, height, settings);
-    if (!image) return fail(image.error().to_string());
+    bar.finish();
+    if (!image) return tools::fail(kTool, image.error());
     const double secs = seconds_since(start);
     std::printf("rendered %dx%d at %d spp in %.2f s (%.3f Mpaths/s)\n", width, height, spp, secs,
                 static_cast<double>(width) * height * spp / secs * 1e-6);
     if (!out_path.empty())
-      if (auto ok = engine::save_exr(out_path, *image); !ok) return fail(ok.error().to_string());
+      if (auto ok = engine::save_exr(out_path, *image); !ok) return tools::fail(kTool, ok.error());
     if (!png_path.empty()) {
       engine::ImageRgba8 ldr{image->width, image->height, std::vector<std::uint8_t>(image->pixels.size())};
       for (std::size_t i = 0; i < image->pixels.size(); ++i)
-        ldr.pixels[i] = i % 4 == 3 ? 255
-                                   : static_cast<std::uint8_t>(std::lround(
-                                         255.0 * gi::display_tonemap(static_cast<double>(image->pixels[i]), exposure)));
-      if (auto ok = engine::save_png(png_path, ldr); !ok) return fail(ok.error().to_string());
+        ldr.pixels[i] = i % 4 == 3
+                            ? 255
+                            : static_cast<std::uint8_t>(std::lround(
+                                  255.0 * engine::display_tonemap(static_cast<double>(image->pixels[i]), exposure)));
+      if (auto ok = engine::save_png(png_path, ldr); !ok) return tools::fail(kTool, ok.error());
     }
   }
 
   if (!atlas_out.empty()) {
     const auto start = Clock::now();
-    const auto inputs = gi::atlas_inputs_from(asset.value());
-    auto layout = gi::build_atlas_layout(inputs, {.texels_per_metre = atlas_density});
-    if (!layout) return fail(layout.error().to_string());
-    const gi::AtlasTexels texels = gi::rasterize_atlas(*layout, inputs);
-    settings.progress = tools::console_progress("atlas");
-    auto truth = gi::reference_atlas_irradiance(scene, texels, settings);
-    if (!truth) return fail(truth.error().to_string());
+    settings.progress = bar.stage("atlas");
+    auto truth = gi::reference_atlas(gi::bake_input_from(scene), atlas_density, settings);
+    bar.finish();
+    if (!truth) return tools::fail(kTool, truth.error());
     std::size_t valid = 0;
     for (std::uint8_t v : truth->valid) valid += v;
     std::printf("atlas %dx%d at %.1f texels/m (%zu valid texels) at %d spp in %.2f s\n", truth->width, truth->height,
-                static_cast<double>(layout->texels_per_metre), valid, spp, seconds_since(start));
+                static_cast<double>(truth->texels_per_metre), valid, spp, seconds_since(start));
     std::error_code ec;
     std::filesystem::create_directories(atlas_out, ec);
-    if (ec) return fail(atlas_out + ": cannot create folder: " + ec.message());
-    const std::pair<const char*, const std::vector<glm::vec3>*> files[] = {
-        {"atlas_direct.exr", &truth->direct}, {"atlas_indirect.exr", &truth->indirect}, {"atlas_total.exr", &truth->total}};
+    if (ec) return tools::fail(kTool, atlas_out + ": cannot create folder: " + ec.message(), tools::kExitFailure);
+    const std::pair<const char*, const std::vector<glm::vec3>*> files[] = {{"atlas_direct.exr", &truth->direct},
+                                                                           {"atlas_indirect.exr", &truth->indirect},
+                                                                           {"atlas_total.exr", &truth->total}};
     for (const auto& [name, values] : files) {
       const auto path = std::filesystem::path(atlas_out) / name;
       if (auto ok = engine::save_exr(path, rgb_image(truth->width, truth->height, *values, truth->valid)); !ok)
-        return fail(ok.error().to_string());
+        return tools::fail(kTool, ok.error());
     }
   }
-  return 0;
+  return tools::kExitOk;
 }

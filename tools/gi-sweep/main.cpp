@@ -1,12 +1,104 @@
 // gi-sweep: measures a GI method's error against the reference over a grid of its quality
-// knobs and writes CSV, a Markdown summary with the Pareto front and presets, and plots.
+// knobs and writes CSV, a Markdown summary with the Pareto front and presets, and plots
+// (gi::run_sweep, gi/sweep.h). Exit codes: tools/common/tool_main.h (130: interrupted,
+// the files hold the runs done).
 //   gi-sweep --list
 //   gi-sweep --method pathtracer --scene assets/cornell_box.gltf --knob spp=1,4,16 --out out/sweeps
-#include "sweep/builtin_methods.h"
-#include "sweep_cli.h"
+#include <gi/sweep.h>
+
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "console_progress.h"
+#include "plot_command.h"
+#include "tool_main.h"
+
+namespace {
+
+constexpr const char* kTool = "gi-sweep";
+
+void print_list() {
+  for (const gi::SweepMethodInfo& m : gi::sweep_methods()) {
+    std::printf("%s  %s\n", m.name.c_str(), m.description.c_str());
+    for (const gi::SweepKnobInfo& k : m.knobs)
+      std::printf("  --knob %s=%s   (%s %s) %s\n", k.name.c_str(), k.default_grid.c_str(), k.kind.c_str(),
+                  k.range.c_str(), k.description.c_str());
+  }
+  const std::vector<std::string> providers = gi::sweep_reference_providers();
+  if (providers.empty()) return;
+  std::printf("reference providers:");
+  for (const std::string& p : providers) std::printf(" %s", p.c_str());
+  std::printf("\n");
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
-  gi::SweepRegistry registry;
-  gi::register_builtin_sweep_methods(registry);
-  return gi_sweep::run_cli(argc, argv, registry);
+  CLI::App app{"Measures a GI method's accuracy (vs the reference) and cost over a grid of its quality knobs"};
+  gi::SweepRequest request;
+  std::string scene, out_dir, cache_dir, cost = "bake";
+  std::vector<double> presets;
+  bool list = false, no_plot = false;
+  app.add_option("--method", request.method, "Sweep method (see --list)");
+  app.add_option("--scene", scene, "glTF/GLB scene file")->check(CLI::ExistingFile);
+  app.add_option("--knob", request.knobs, "Override a knob's values: name=v1,v2,... (repeatable)");
+  app.add_option("--out", out_dir, "Output folder for <method>_<scene>.csv/.md/.png (created when missing)");
+  app.add_option("--cache", cache_dir, "Reference cache folder (default: <out>/reference-cache)");
+  app.add_option("--threads", request.threads, "Worker threads for methods and references (0: all)");
+  app.add_option("--seed", request.seed, "Random seed passed to the methods");
+  app.add_option("--cost", cost, "Cost axis of the Pareto front: bake (seconds) or frame (ms)")
+      ->check(CLI::IsMember({"bake", "frame"}));
+  app.add_option("--presets", presets, "Relative-RMSE targets of the presets preview,medium,high")
+      ->delimiter(',')
+      ->expected(3);
+  app.add_option("--exposure", request.exposure, "Exposure before tonemapping, for PSNR")->check(CLI::PositiveNumber);
+  app.add_flag("--no-plot", no_plot, "Do not run the plot script (print its command)");
+  app.add_flag("--list", list, "List the sweep methods, their knobs and default grids, and exit");
+  if (auto rc = tools::parse(app, kTool, argc, argv)) return *rc;
+  if (list) {
+    print_list();
+    return tools::kExitOk;
+  }
+  if (request.method.empty() || scene.empty() || out_dir.empty())
+    return tools::fail(kTool, "give --method NAME --scene FILE --out DIR (or --list)", tools::kExitUsage);
+  request.scene = scene;
+  request.out_dir = out_dir;
+  request.cache_dir = cache_dir;
+  request.frame_cost = cost == "frame";
+  if (!presets.empty())
+    for (int i = 0; i < 3; ++i) request.preset_targets[i] = presets[static_cast<std::size_t>(i)];
+
+  tools::install_interrupt_handler();
+  tools::ConsoleProgress bar;
+  const gi::SweepHost host{
+      .progress =
+          [&](const gi::SweepStatus& s) {
+            char detail[64];
+            std::snprintf(detail, sizeof detail, "%zu/%zu", s.units_done, s.units_total);
+            return bar.update("sweep", s.fraction(), std::string(detail) + "  " + s.current);
+          },
+      .log =
+          [&](gi::LogLevel level, std::string_view line) {
+            bar.finish();
+            std::fprintf(stderr, "%s: %s%.*s\n", kTool,
+                         level == gi::LogLevel::Info ? "" : "warning: ", static_cast<int>(line.size()), line.data());
+          }};
+  auto report = gi::run_sweep(request, host);
+  bar.finish();
+  if (!report) return tools::fail(kTool, report.error());
+  for (const std::string& f : report->failures) std::fprintf(stderr, "%s: run %s\n", kTool, f.c_str());
+  std::fprintf(stderr, "%s: wrote %s and %s (%zu run(s), %zu failed; references: %zu computed, %zu from cache)\n",
+               kTool, report->csv.c_str(), report->markdown.c_str(), report->runs, report->failures.size(),
+               report->references_computed, report->references_from_cache);
+  std::fprintf(stderr, "%s\n",
+               (no_plot ? "plots: skipped; to plot, run:\n  " + gi_sweep::plot_command(report->csv)
+                        : gi_sweep::plot_sweep_csv(report->csv))
+                   .c_str());
+  if (report->cancelled) {
+    std::fprintf(stderr, "%s: interrupted; the files hold the runs completed so far\n", kTool);
+    return tools::kExitCancelled;
+  }
+  return tools::kExitOk;
 }

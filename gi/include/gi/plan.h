@@ -20,6 +20,7 @@
 
 #include <engine/result.h>
 #include <engine/scene.h>
+#include <gi/bake_input.h>
 
 #include <cstdint>
 #include <optional>
@@ -99,9 +100,12 @@ struct PlanOptions {
   int bounces = 0;
 };
 
-/// Plans the effects of `scene` (its registry and assets; world transforms must be current,
-/// as engine::instantiate leaves them). Cheap: no ray is traced. An unknown preset gives a
-/// plan without estimates and a warning saying so.
+/// Plans the effects of `input` (gi/bake_input.h). Cheap: no ray is traced. An unknown
+/// preset gives a plan without estimates and a warning saying so.
+EffectPlan plan(const BakeInput& input, const PlanOptions& options = {});
+
+/// plan(bake_input_from(scene), options): world transforms must be current, as
+/// engine::instantiate leaves them.
 EffectPlan plan(const engine::Scene& scene, const PlanOptions& options = {});
 
 /// The plan as console text: one block per method (state, reason, targets, estimate).

@@ -5,24 +5,25 @@
 // sampling (power heuristic) between light and BRDF sampling for emissive surfaces, and
 // Russian roulette. Multithreaded and deterministic: every pixel or point draws from its
 // own random stream, so results are bit-identical for any thread count.
-//   auto img = gi::render_reference_image(scene, engine::find_camera(scene.registry), 256, 256, {.samples_per_pixel = 64});
-//   engine::save_exr("reference.exr", img.value());
+//   auto img = gi::render_reference_image(scene, engine::find_camera(scene.registry), 256, 256, {.samples_per_pixel =
+//   64}); engine::save_exr("reference.exr", img.value()); auto atlas =
+//   gi::reference_atlas(gi::bake_input_from(scene), 32.0f, {.samples_per_pixel = 256});  // ground truth per texel
 //
 // What it does not do yet: textures (base colour, emissive, metallic-roughness factors only)
 // and normal maps; area lights that have no emissive geometry are sampled by next-event
 // estimation only (BRDF-sampled rays cannot hit them, so no MIS for those).
 
-#include <cstdint>
-#include <span>
-#include <vector>
-
-#include <glm/glm.hpp>
-
 #include <engine/entity.h>
 #include <engine/image.h>
 #include <engine/result.h>
 #include <engine/scene.h>
+#include <gi/bake_input.h>
 #include <gi/progress.h>
+
+#include <cstdint>
+#include <glm/glm.hpp>
+#include <span>
+#include <vector>
 
 namespace gi {
 
@@ -42,9 +43,20 @@ struct ReferenceSettings {
   ProgressCallback progress;
 };
 
-/// Linear radiance, W/(m^2 sr), seen from `camera` (an entity with Camera and
-/// WorldTransform) at width x height (rows top to bottom; alpha 1). Errors: no such camera,
-/// bad sizes or settings, malformed geometry, cancellation.
+/// A pinhole camera looking along its local -Z with +Y up.
+struct ReferenceCamera {
+  glm::mat4 camera_to_world{1.0f};
+  float yfov_rad = 0.8f;  ///< Vertical field of view.
+  float aspect = 0.0f;    ///< Width / height; 0: the image's.
+};
+
+/// Linear radiance, W/(m^2 sr), of `input` seen from `camera` at width x height (rows top to
+/// bottom; alpha 1). Errors: bad sizes or settings, malformed geometry, cancellation.
+engine::Result<engine::ImageRgbaF> render_reference_image(const BakeInput& input, const ReferenceCamera& camera,
+                                                          int width, int height, const ReferenceSettings& settings);
+
+/// The same for a live scene and one of its camera entities (Camera and WorldTransform).
+/// Errors: also no such camera.
 engine::Result<engine::ImageRgbaF> render_reference_image(const engine::Scene& scene, engine::Entity camera, int width,
                                                           int height, const ReferenceSettings& settings);
 
@@ -61,9 +73,29 @@ struct IrradianceEstimate {
   std::vector<glm::vec3> indirect;
 };
 
-/// Estimates the irradiance at each point (samples_per_pixel samples each). This is the
-/// ground truth of light-atlas texels.
-engine::Result<IrradianceEstimate> reference_irradiance(const engine::Scene& scene, std::span<const SurfacePoint> points,
-                                                         const ReferenceSettings& settings);
+/// Estimates the irradiance at each point (samples_per_pixel samples each).
+engine::Result<IrradianceEstimate> reference_irradiance(const BakeInput& input, std::span<const SurfacePoint> points,
+                                                        const ReferenceSettings& settings);
+engine::Result<IrradianceEstimate> reference_irradiance(const engine::Scene& scene,
+                                                        std::span<const SurfacePoint> points,
+                                                        const ReferenceSettings& settings);
+
+/// The ground truth of a light atlas: irradiance (W/m^2) at every texel of the layout a bake
+/// of `input` gets at `texels_per_metre` (the static instances charted as the bakers chart
+/// them), width x height, texel (x, y) at y * width + x; texels no triangle covers hold
+/// their neighbours' values (dilated, as a baked atlas) and valid = 0.
+struct AtlasReference {
+  int width = 0;
+  int height = 0;
+  float texels_per_metre = 0.0f;  ///< The layout's (lower than asked when the atlas would exceed its size limit).
+  std::vector<glm::vec3> direct;
+  std::vector<glm::vec3> indirect;
+  std::vector<glm::vec3> total;
+  std::vector<std::uint8_t> valid;
+};
+/// samples_per_pixel of `settings` is per texel. Errors: no static triangle, a layout that
+/// cannot be built, bad settings, cancellation.
+engine::Result<AtlasReference> reference_atlas(const BakeInput& input, float texels_per_metre,
+                                               const ReferenceSettings& settings);
 
 }  // namespace gi

@@ -25,7 +25,7 @@ engine::Result<BrfSettings> brf_preset(std::string_view name) {
     s.basis.lights = 256, s.basis.basis = 16;
     s.field.spheres = 16, s.field.face_resolution = 16, s.field.directions = 256;
   } else {
-    return engine::Error{.message = "unknown BRF preset '" + std::string(name) + "' (preview, medium, high)"};
+    return engine::invalid_request("unknown BRF preset '" + std::string(name) + "' (preview, medium, high)");
   }
   s.field.sh_bands = 3;
   // docs/sweeps/brf_glossy: 4 terms are the cheapest on the front, 8 the most accurate.
@@ -34,7 +34,8 @@ engine::Result<BrfSettings> brf_preset(std::string_view name) {
   return s;
 }
 
-engine::Result<BrfMeshBake> bake_brf_mesh(const BrfSource& source, const BrfSettings& settings) {
+engine::Result<BrfMeshBake> bake_brf_mesh(const BrfSource& source, const BrfSettings& settings,
+                                          const ProgressCallback& progress) {
   const auto prefixed = [&](engine::Error e) {
     e.message = "mesh \"" + source.name + "\": " + e.message;
     return e;
@@ -42,6 +43,8 @@ engine::Result<BrfMeshBake> bake_brf_mesh(const BrfSource& source, const BrfSett
   BrfMeshBake out;
   out.name = source.name;
   out.mesh_hash = source.mesh_hash;
+  constexpr double kBasisShare = 0.1;
+  if (progress && !progress(0.0)) return prefixed(engine::cancelled_error("basis radiance field bake"));
   auto start = std::chrono::steady_clock::now();
   if (source.glossy) {
     auto sep = separate_glossy_brdf(*source.glossy, settings.glossy);
@@ -52,8 +55,11 @@ engine::Result<BrfMeshBake> bake_brf_mesh(const BrfSource& source, const BrfSett
   auto basis = compute_pca_basis(source.mesh, settings.basis, glossy);
   if (!basis) return prefixed(basis.error());
   out.basis_seconds = seconds_since(start);
+  if (progress && !progress(kBasisShare)) return prefixed(engine::cancelled_error("basis radiance field bake"));
   start = std::chrono::steady_clock::now();
-  auto field = compute_basis_radiance_field(source.mesh, *basis, settings.field, glossy);
+  RadianceFieldSettings field_settings = settings.field;
+  if (progress) field_settings.progress = [&](double f) { return progress(kBasisShare + (1.0 - kBasisShare) * f); };
+  auto field = compute_basis_radiance_field(source.mesh, *basis, field_settings, glossy);
   if (!field) return prefixed(field.error());
   out.field_seconds = seconds_since(start);
   out.basis = std::move(basis).value();

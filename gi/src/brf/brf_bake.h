@@ -12,11 +12,12 @@
 // Glossy meshes (BrfSource::glossy) get 4 glossy terms (preview, medium; the issue's
 // default) or 8 (high) from a 16 x 16 hemisphere table (docs/sweeps/brf_glossy).
 
+#include <engine/result.h>
+#include <gi/progress.h>
+
 #include <optional>
 #include <string>
 #include <string_view>
-
-#include <engine/result.h>
 
 #include "brf/brf_mesh.h"
 #include "brf/pca_basis.h"
@@ -41,13 +42,16 @@ struct BrfMeshBake {
   BrfBasis basis;
   BasisRadianceField field;
   std::optional<BrdfSeparation> glossy;  ///< The separated lobe of a glossy mesh.
-  double basis_seconds = 0.0;  ///< Wall time of compute_pca_basis.
-  double field_seconds = 0.0;  ///< Wall time of compute_basis_radiance_field.
+  double basis_seconds = 0.0;            ///< Wall time of compute_pca_basis.
+  double field_seconds = 0.0;            ///< Wall time of compute_basis_radiance_field.
 };
 
 /// Bakes `source.mesh`: for a glossy source separate_glossy_brdf with settings.glossy, then
-/// compute_pca_basis with settings.basis, then compute_basis_radiance_field with settings.field. Errors: those of the two steps,
-/// prefixed with the source's name.
-engine::Result<BrfMeshBake> bake_brf_mesh(const BrfSource& source, const BrfSettings& settings);
+/// compute_pca_basis with settings.basis, then compute_basis_radiance_field with
+/// settings.field. `progress` gets the fraction done (the basis counts as the first 10%, the
+/// field as the rest) and cancels by returning false. Errors: those of the steps, prefixed
+/// with the source's name; cancellation (ErrorKind::Cancelled).
+engine::Result<BrfMeshBake> bake_brf_mesh(const BrfSource& source, const BrfSettings& settings,
+                                          const ProgressCallback& progress = {});
 
 }  // namespace gi

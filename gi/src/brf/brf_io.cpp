@@ -70,21 +70,24 @@ std::string check_glossy(const BrdfSeparation& g) {
       !std::isfinite(g.relative_error))
     return "glossy separation: f0 and alpha must lie in (0, 1] and the error be finite";
   const auto cells = static_cast<std::uint64_t>(g.terms) * static_cast<std::uint64_t>(g.resolution * g.resolution);
-  if (g.g.size() != cells || g.h.size() != cells || g.lobe_sh.size() != static_cast<std::uint64_t>(g.terms) * kMaxShCoefficients ||
-      g.singular_values.size() > 4096)
+  if (g.g.size() != cells || g.h.size() != cells ||
+      g.lobe_sh.size() != static_cast<std::uint64_t>(g.terms) * kMaxShCoefficients || g.singular_values.size() > 4096)
     return "glossy separation: table sizes do not match " + std::to_string(g.terms) + " terms at resolution " +
            std::to_string(g.resolution);
   for (const std::vector<float>* v : {&g.g, &g.h, &g.lobe_sh, &g.singular_values})
-    if (std::size_t i = first_non_finite(*v); i != std::string::npos) return "glossy separation value " + str(i) + " is NaN or infinite";
+    if (std::size_t i = first_non_finite(*v); i != std::string::npos)
+      return "glossy separation value " + str(i) + " is NaN or infinite";
   return {};
 }
 
 // Empty when the bake's parts fit together and hold finite values, else what is wrong.
 std::string check_bake(const BrfMeshBake& b) {
-  if (b.name.empty() || !is_bundle_file_name(brf_file_name(b.name))) return "mesh name \"" + b.name + "\" is not usable in a file name";
+  if (b.name.empty() || !is_bundle_file_name(brf_file_name(b.name)))
+    return "mesh name \"" + b.name + "\" is not usable in a file name";
   if (!is_hex16(b.mesh_hash)) return "mesh_hash \"" + b.mesh_hash + "\" is not 16 lowercase hex digits";
   const BrfBasis& s = b.basis;
-  if (s.vertex_count < 1 || s.vertex_count > kMaxVertices) return "vertex_count " + str(s.vertex_count) + " is outside 1..2^31";
+  if (s.vertex_count < 1 || s.vertex_count > kMaxVertices)
+    return "vertex_count " + str(s.vertex_count) + " is outside 1..2^31";
   if (s.basis_count < 1 || s.basis_count > kMaxBasis)
     return "basis_count " + std::to_string(s.basis_count) + " is outside 1..1024";
   const auto n = static_cast<std::uint64_t>(s.basis_count);
@@ -318,14 +321,15 @@ engine::Result<BrfMeshBake> read_brf_mesh(const fs::path& path) {
   if (ZSTD_isError(unpacked) != 0)
     return file_error(path, "coefficients", std::string("zstd decompression failed: ") + ZSTD_getErrorName(unpacked));
   if (unpacked != planes.size())
-    return file_error(path, "coefficients", "decompressed " + str(unpacked) + " bytes, " + str(planes.size()) + " expected");
+    return file_error(path, "coefficients",
+                      "decompressed " + str(unpacked) + " bytes, " + str(planes.size()) + " expected");
   f.coefficients = from_planes(planes);
   if (std::string problem = check_bake(out); !problem.empty()) return file_error(path, "", problem);
   return out;
 }
 
-engine::Status save_brf(const fs::path& bundle_dir, const BrfBake& bake, const engine::SceneAsset& asset,
-                        const std::string& scene_name) {
+engine::Status save_brf(const fs::path& bundle_dir, const BrfBake& bake, const BakeInput& input) {
+  const std::string scene_name = fs::path(input.name).filename().string();
   const fs::path manifest_file = bundle_dir / kManifestFileName;
   if (bake.meshes.empty()) return file_error(manifest_file, "", "cannot save the BRF bake: it holds no mesh");
   // Checked before the directory is made, so a bad bake leaves nothing behind.
@@ -367,7 +371,7 @@ engine::Status save_brf(const fs::path& bundle_dir, const BrfBake& bake, const e
                           {"bake_seconds", m.basis_seconds + m.field_seconds}};
   }
   const json entry{{"files", files}, {"settings", settings_json(bake.settings)}, {"meshes", meshes}};
-  return update_manifest_method(bundle_dir, scene_geometry_hash(asset), scene_name, kBrfMethod, entry);
+  return update_manifest_method(bundle_dir, scene_geometry_hash(input), scene_name, kBrfMethod, entry);
 }
 
 engine::Result<BrfBake> load_brf(const fs::path& bundle_dir, std::span<const BrfSource> sources) {
@@ -385,9 +389,9 @@ engine::Result<BrfBake> load_brf(const fs::path& bundle_dir, std::span<const Brf
   for (const BrfSource& source : sources) {
     const std::string key = "files." + source.name;
     if (!entry->contains("files") || !(*entry)["files"].is_object() || !(*entry)["files"].contains(source.name))
-      return engine::Error{manifest_file.string(), prefix + "." + key,
-                           "no basis radiance field for the scene's dynamic mesh \"" + source.name +
-                               "\" (re-bake with --methods brf)"};
+      return engine::Error{
+          manifest_file.string(), prefix + "." + key,
+          "no basis radiance field for the scene's dynamic mesh \"" + source.name + "\" (re-bake with --methods brf)"};
     const std::string file_name = fields.get<std::string>(key + ".file");
     const std::string checksum = fields.get<std::string>(key + ".fnv1a64");
     const double basis_seconds = fields.get<double>("meshes." + source.name + ".basis_seconds");
@@ -401,15 +405,17 @@ engine::Result<BrfBake> load_brf(const fs::path& bundle_dir, std::span<const Brf
     auto mesh = read_brf_mesh(path);
     if (!mesh) return mesh.error();
     if (mesh->name != source.name)
-      return file_error(path, "name", "holds mesh \"" + mesh->name + "\", the manifest lists it for \"" + source.name + "\"");
+      return file_error(path, "name",
+                        "holds mesh \"" + mesh->name + "\", the manifest lists it for \"" + source.name + "\"");
     if (mesh->mesh_hash != source.mesh_hash)
       return file_error(path, "mesh_hash",
                         "stale basis radiance field: baked from mesh hash " + mesh->mesh_hash + ", but mesh \"" +
-                            source.name + "\" of the scene hashes to " + source.mesh_hash + " (re-bake with --methods brf)");
+                            source.name + "\" of the scene hashes to " + source.mesh_hash +
+                            " (re-bake with --methods brf)");
     if (mesh->basis.vertex_count != source.mesh.positions.size())
       return file_error(path, "vertex_count",
-                        "the basis has " + str(mesh->basis.vertex_count) + " vertices, mesh \"" + source.name +
-                            "\" " + str(source.mesh.positions.size()));
+                        "the basis has " + str(mesh->basis.vertex_count) + " vertices, mesh \"" + source.name + "\" " +
+                            str(source.mesh.positions.size()));
     mesh->basis_seconds = basis_seconds;
     mesh->field_seconds = field_seconds;
     out.meshes.push_back(std::move(mesh).value());
@@ -417,8 +423,8 @@ engine::Result<BrfBake> load_brf(const fs::path& bundle_dir, std::span<const Brf
   return out;
 }
 
-engine::Result<BrfBake> load_brf(const fs::path& bundle_dir, const engine::Scene& scene) {
-  auto sources = dynamic_brf_meshes(scene);
+engine::Result<BrfBake> load_brf(const fs::path& bundle_dir, const BakeInput& input) {
+  auto sources = dynamic_brf_meshes(input);
   if (!sources) return sources.error();
   return load_brf(bundle_dir, std::span<const BrfSource>(*sources));
 }

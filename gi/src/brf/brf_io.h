@@ -1,7 +1,7 @@
 #pragma once
 // Saving baked basis radiance fields (Iwasaki et al.) into a bake bundle and loading them
 // back, one file per distinct dynamic mesh.
-//   gi::save_brf("level.gibake", bake, asset, "level.gltf");
+//   gi::save_brf("level.gibake", bake, input);
 //   auto brf = gi::load_brf("level.gibake", scene);   // checks every mesh's hash
 //
 // Files (DESIGN.md §5, docs/bake-bundle.md):
@@ -53,7 +53,7 @@
 
 #include <engine/result.h>
 #include <engine/scene.h>
-#include <engine/scene_asset.h>
+#include <gi/bake_input.h>
 
 #include <cstdint>
 #include <filesystem>
@@ -61,9 +61,9 @@
 #include <string>
 #include <vector>
 
-#include "io/blob_file.h"
 #include "brf/brf_bake.h"
 #include "brf/brf_mesh.h"
+#include "io/blob_file.h"
 
 namespace gi {
 
@@ -93,10 +93,9 @@ engine::Result<BrfMeshBake> read_brf_mesh(const std::filesystem::path& path);
 
 /// Writes every mesh's file into `bundle_dir` (created if needed), then the manifest's
 /// "brf" entry (other methods' entries kept when the manifest has the same geometry hash,
-/// scene_geometry_hash(asset)). Everything is checked before anything is written. Errors:
+/// scene_geometry_hash(input)). Everything is checked before anything is written. Errors:
 /// an inconsistent bake, two meshes of one name, a file that cannot be written.
-engine::Status save_brf(const std::filesystem::path& bundle_dir, const BrfBake& bake, const engine::SceneAsset& asset,
-                        const std::string& scene_name);
+engine::Status save_brf(const std::filesystem::path& bundle_dir, const BrfBake& bake, const BakeInput& input);
 
 /// Loads the bake of each of `sources` (result meshes[i] belongs to sources[i]): its
 /// manifest entry, the file's checksum against the manifest, read_brf_mesh, then the mesh
@@ -105,7 +104,7 @@ engine::Status save_brf(const std::filesystem::path& bundle_dir, const BrfBake& 
 /// Every error names the file and the problem.
 engine::Result<BrfBake> load_brf(const std::filesystem::path& bundle_dir, std::span<const BrfSource> sources);
 
-/// load_brf of dynamic_brf_meshes(scene).
-engine::Result<BrfBake> load_brf(const std::filesystem::path& bundle_dir, const engine::Scene& scene);
+/// load_brf of dynamic_brf_meshes(input).
+engine::Result<BrfBake> load_brf(const std::filesystem::path& bundle_dir, const BakeInput& input);
 
 }  // namespace gi

@@ -6,9 +6,9 @@
 #include <span>
 #include <utility>
 
-#include "transport/vpl_set.h"
-#include "raytrace/scene_adapter.h"
 #include "io/content_hash.h"
+#include "raytrace/scene_adapter.h"
+#include "transport/vpl_set.h"
 
 namespace gi {
 
@@ -16,13 +16,14 @@ namespace {
 
 bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
-float luminance(const glm::vec4& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+float luminance(const glm::vec3& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 
 // A file-name fragment from a mesh name: [A-Za-z0-9_-] kept, anything else '_'.
 std::string name_fragment(const std::string& name, std::uint32_t mesh_index) {
   std::string out;
   for (char c : name) {
-    const bool plain = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-';
+    const bool plain =
+        (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-';
     out += plain ? c : '_';
   }
   if (out.empty()) out = "mesh" + std::to_string(mesh_index);
@@ -40,13 +41,13 @@ std::string lower(std::string s) {
 namespace {
 
 // The (first) material a source is drawn with; the glTF default material when none.
-engine::Material source_material(const engine::SceneAsset& asset, const BrfSource& source) {
-  int material = source.material_override;
-  if (material < 0 && source.mesh_index < asset.meshes.size() && !asset.meshes[source.mesh_index].primitives.empty())
-    material = asset.meshes[source.mesh_index].primitives.front().material;
-  return material >= 0 && static_cast<std::size_t>(material) < asset.materials.size()
-             ? asset.materials[static_cast<std::size_t>(material)]
-             : engine::Material{};
+BakeMaterial source_material(const BakeInput& input, const BrfSource& source) {
+  BakeInstance inst;
+  inst.mesh = source.mesh_index;
+  inst.material_override = source.material_override;
+  if (source.mesh_index < input.meshes.size() && !input.meshes[source.mesh_index].primitives.empty())
+    return bake_material(input, inst, input.meshes[source.mesh_index].primitives.front());
+  return bake_material(input, inst, BakePrimitive{});
 }
 
 }  // namespace
@@ -69,7 +70,8 @@ BrfMesh brf_box_mesh(glm::vec3 half, int n, float inset) {
       const auto at = [&](int i, int j) { return base + static_cast<std::uint32_t>(i * (n + 1) + j); };
       for (int i = 0; i < n; ++i)
         for (int j = 0; j < n; ++j)
-          m.indices.insert(m.indices.end(), {at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+          m.indices.insert(m.indices.end(),
+                           {at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j), at(i + 1, j + 1), at(i, j + 1)});
     }
   return m;
 }
@@ -86,28 +88,29 @@ std::string brf_mesh_hash(const BrfMesh& mesh, const std::optional<GlossyLobe>& 
   return h.hex();
 }
 
-engine::Result<BrfMesh> brf_mesh_from_asset(const engine::SceneAsset& asset, std::uint32_t mesh_index,
+engine::Result<BrfMesh> brf_mesh_from_input(const BakeInput& input, std::uint32_t mesh_index,
                                             std::int32_t material_override) {
-  const std::string where = asset.source.empty() ? std::string("the scene") : asset.source;
-  if (mesh_index >= asset.meshes.size())
+  const std::string where = input.name.empty() ? std::string("the scene") : input.name;
+  if (mesh_index >= input.meshes.size())
     return engine::Error{where, "meshes", "mesh " + std::to_string(mesh_index) + " does not exist"};
-  const engine::Mesh& m = asset.meshes[mesh_index];
+  const BakeMesh& m = input.meshes[mesh_index];
   const std::string location = "mesh " + std::to_string(mesh_index) + " \"" + m.name + "\"";
   BrfMesh out;
   for (std::size_t pi = 0; pi < m.primitives.size(); ++pi) {
-    const engine::Primitive& p = m.primitives[pi];
+    const BakePrimitive& p = m.primitives[pi];
     const std::size_t n = p.positions.size();
     const auto base = static_cast<std::uint32_t>(out.positions.size());
     if (!p.normals.empty() && p.normals.size() != n)
-      return engine::Error{where, location, "primitive " + std::to_string(pi) + " has " +
-                                                std::to_string(p.normals.size()) + " normals for " +
-                                                std::to_string(n) + " positions"};
+      return engine::Error{where, location,
+                           "primitive " + std::to_string(pi) + " has " + std::to_string(p.normals.size()) +
+                               " normals for " + std::to_string(n) + " positions"};
     if (p.indices.size() % 3 != 0)
       return engine::Error{where, location, "primitive " + std::to_string(pi) + " index count is not a multiple of 3"};
     for (std::uint32_t i : p.indices)
       if (i >= n)
-        return engine::Error{where, location, "primitive " + std::to_string(pi) + " index " + std::to_string(i) +
-                                                  " is out of range (" + std::to_string(n) + " vertices)"};
+        return engine::Error{where, location,
+                             "primitive " + std::to_string(pi) + " index " + std::to_string(i) + " is out of range (" +
+                                 std::to_string(n) + " vertices)"};
     for (const glm::vec3& v : p.positions)
       if (!finite(v)) return engine::Error{where, location, "a position is NaN or infinite"};
     std::vector<glm::vec3> normals = p.normals;
@@ -124,11 +127,12 @@ engine::Result<BrfMesh> brf_mesh_from_asset(const engine::SceneAsset& asset, std
       const float len = glm::length(v);
       v = len > 0.0f && std::isfinite(len) ? v / len : glm::vec3(0.0f, 0.0f, 1.0f);  // unused vertex or degenerate
     }
-    const int material = material_override >= 0 ? material_override : p.material;
-    const engine::Material mat = material >= 0 && static_cast<std::size_t>(material) < asset.materials.size()
-                                     ? asset.materials[static_cast<std::size_t>(material)]
-                                     : engine::Material{};
-    const float rho = std::clamp(luminance(mat.base_color), 0.0f, 1.0f);
+    BakeInstance drawn;
+    drawn.material_override = material_override;
+    const BakeMaterial mat = bake_material(input, drawn, p);
+    // The reflectance the bakers fold every surface to: the BRDF's hemispherical albedo.
+    const float rho =
+        std::clamp(luminance(engine::gltf_hemispherical_albedo(reference_material(mat).brdf).sum()), 0.0f, 1.0f);
     if (!std::isfinite(rho)) return engine::Error{where, location, "the base colour is NaN or infinite"};
     out.positions.insert(out.positions.end(), p.positions.begin(), p.positions.end());
     out.normals.insert(out.normals.end(), normals.begin(), normals.end());
@@ -139,40 +143,38 @@ engine::Result<BrfMesh> brf_mesh_from_asset(const engine::SceneAsset& asset, std
   return out;
 }
 
-engine::Result<std::vector<BrfSource>> dynamic_brf_meshes(const engine::Scene& scene) {
-  std::vector<engine::Entity> entities = scene.registry.view<engine::DynamicTag, engine::MeshRenderer>().entities();
-  std::sort(entities.begin(), entities.end(),
-            [](engine::Entity a, engine::Entity b) { return a.index < b.index; });
+engine::Result<std::vector<BrfSource>> dynamic_brf_meshes(const BakeInput& input) {
   std::vector<BrfSource> out;
   std::set<std::string> taken;  // lower case: file names must not clash on case-insensitive file systems
-  for (engine::Entity e : entities) {
-    const engine::MeshRenderer& mr = scene.registry.get<engine::MeshRenderer>(e);
+  for (std::uint32_t i = 0; i < input.instances.size(); ++i) {
+    const BakeInstance& inst = input.instances[i];
+    if (inst.mobility != BakeMobility::Dynamic || inst.mesh >= input.meshes.size()) continue;
     auto it = std::find_if(out.begin(), out.end(), [&](const BrfSource& s) {
-      return s.mesh_index == mr.mesh && s.material_override == mr.material_override;
+      return s.mesh_index == inst.mesh && s.material_override == inst.material_override;
     });
     if (it != out.end()) {
-      it->entities.push_back(e);
+      it->instances.push_back(i);
       continue;
     }
-    auto mesh = brf_mesh_from_asset(scene.assets, mr.mesh, mr.material_override);
+    auto mesh = brf_mesh_from_input(input, inst.mesh, inst.material_override);
     if (!mesh) return mesh.error();
     BrfSource s;
-    const std::string base = name_fragment(scene.assets.meshes[mr.mesh].name, mr.mesh);
+    const std::string base = name_fragment(input.meshes[inst.mesh].name, inst.mesh);
     s.name = base;
     for (int k = 2; taken.count(lower(s.name)) != 0; ++k) s.name = base + "_" + std::to_string(k);
     taken.insert(lower(s.name));
-    s.mesh_index = mr.mesh;
-    s.material_override = mr.material_override;
+    s.mesh_index = inst.mesh;
+    s.material_override = inst.material_override;
     s.mesh = std::move(mesh).value();
-    s.glossy = brf_glossy_lobe(source_material(scene.assets, s), &s.specular);
+    s.glossy = brf_glossy_lobe(source_material(input, s), &s.specular);
     s.mesh_hash = brf_mesh_hash(s.mesh, s.glossy);
-    s.entities.push_back(e);
+    s.instances.push_back(i);
     out.push_back(std::move(s));
   }
   return out;
 }
 
-std::optional<GlossyLobe> brf_glossy_lobe(const engine::Material& material, glm::vec3* specular) {
+std::optional<GlossyLobe> brf_glossy_lobe(const BakeMaterial& material, glm::vec3* specular) {
   const engine::GltfBrdf b = reference_material(material).brdf;
   // Reflectance of the specular lobe at normal incidence: the metal's base colour, the
   // dielectric's weighted F0, mixed by metallic (glTF's material = mix(dielectric, metal)).
@@ -184,8 +186,8 @@ std::optional<GlossyLobe> brf_glossy_lobe(const engine::Material& material, glm:
   return GlossyLobe{.f0 = std::min(mean, 1.0f), .alpha = std::clamp(b.alpha, 1e-3f, 1.0f)};
 }
 
-glm::vec3 brf_source_albedo(const engine::SceneAsset& asset, const BrfSource& source) {
-  const ReferenceMaterial m = reference_material(source_material(asset, source));
+glm::vec3 brf_source_albedo(const BakeInput& input, const BrfSource& source) {
+  const ReferenceMaterial m = reference_material(source_material(input, source));
   // A glossy source carries its specular lobe in separated terms; only the diffuse lobe's
   // share is folded into the diffuse reflectance.
   const engine::GltfBrdfValue albedo = engine::gltf_hemispherical_albedo(m.brdf);

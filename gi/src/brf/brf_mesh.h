@@ -1,42 +1,41 @@
 #pragma once
 // The rigid objects a scene needs basis radiance fields for: one BrfSource per distinct mesh
-// drawn by an entity tagged DynamicTag (the adapter from the ECS to the plain BrfMesh the
-// bakers take; CONVENTIONS.md 4). Instanced props (five crates, one mesh) share one source.
-//   auto sources = gi::dynamic_brf_meshes(scene).value();
-//   for (const gi::BrfSource& s : sources) bake(s.mesh);   // s.entities: who draws it
+// of a Dynamic instance of a BakeInput (gi/bake_input.h). Instanced props (five crates, one
+// mesh) share one source.
+//   auto sources = gi::dynamic_brf_meshes(input).value();
+//   for (const gi::BrfSource& s : sources) bake(s.mesh);   // s.instances: who draws it
 //
 // Vertex order: the mesh's primitives concatenated in order, each primitive's vertices in
 // its own order — exactly the order of the renderer's per-vertex irradiance buffer
 // (engine::IndirectLightFrame::vertex_irradiance_buffer), so a baked basis Psi_i(x_j) and
 // that buffer index the same vertices.
 
+#include <engine/result.h>
+#include <gi/bake_input.h>
+
 #include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <engine/entity.h>
-#include <engine/result.h>
-#include <engine/scene.h>
 
 #include "brf/brdf_separation.h"
 #include "brf/pca_basis.h"
 
 namespace gi {
 
-/// One distinct dynamic mesh and the entities that draw it.
+/// One distinct dynamic mesh and the instances that draw it.
 struct BrfSource {
   /// Unique among the scene's sources, a plain file-name fragment ([A-Za-z0-9_-]): the
   /// glTF mesh name with other characters replaced by '_', "_2", "_3"... added on a clash.
   std::string name;
-  std::uint32_t mesh_index = 0;           ///< Into SceneAsset::meshes.
-  std::int32_t material_override = -1;    ///< The entities' MeshRenderer::material_override.
-  BrfMesh mesh;                           ///< Object space; reflectance per vertex.
+  std::uint32_t mesh_index = 0;         ///< Into BakeInput::meshes.
+  std::int32_t material_override = -1;  ///< The instances' BakeInstance::material_override.
+  BrfMesh mesh;                         ///< Object space; reflectance per vertex.
   /// The glossy lobe the bake separates (brf_glossy_lobe of its material); none: diffuse.
   std::optional<GlossyLobe> glossy;
-  glm::vec3 specular{1.0f};               ///< Glossy colour: f0 (RGB) / glossy->f0.
-  std::string mesh_hash;                  ///< brf_mesh_hash(mesh, glossy): what a bake depends on.
-  std::vector<engine::Entity> entities;   ///< Ascending entity index.
+  glm::vec3 specular{1.0f};              ///< Glossy colour: f0 (RGB) / glossy->f0.
+  std::string mesh_hash;                 ///< brf_mesh_hash(mesh, glossy): what a bake depends on.
+  std::vector<std::uint32_t> instances;  ///< Into BakeInput::instances, ascending.
 };
 
 /// A box of half extents `half` around the origin made of n x n quads per face, normals
@@ -55,27 +54,25 @@ std::string brf_mesh_hash(const BrfMesh& mesh, const std::optional<GlossyLobe>& 
 /// enough for a few separable terms, brdf_separation.h) and a specular reflectance f0 of at
 /// least 0.2 in some channel (metals; a dielectric's 0.04 sends too little light to
 /// matter next to its diffuse part). Returns the lobe (f0: the channels' mean) or none.
-std::optional<GlossyLobe> brf_glossy_lobe(const engine::Material& material, glm::vec3* specular = nullptr);
+std::optional<GlossyLobe> brf_glossy_lobe(const BakeMaterial& material, glm::vec3* specular = nullptr);
 
-/// The mesh of a scene asset as a BrfMesh: positions, unit normals (area-weighted from the
+/// Mesh `mesh_index` of `input` as a BrfMesh: positions, unit normals (area-weighted from the
 /// triangles where a primitive has none), indices rebased onto the concatenation, and per
-/// vertex the luminance (Rec. 709) of its material's base colour factor (textures are not
-/// read); `material_override` >= 0 replaces every primitive's material, as the renderer
+/// vertex the luminance (Rec. 709) of its material's hemispherical albedo (the fold every
+/// baker uses; textures are not read); `material_override` >= 0 replaces every primitive's material, as the renderer
 /// does. Errors (naming the mesh): out-of-range mesh index or vertex index, non-finite
 /// positions or normals, no triangle.
-engine::Result<BrfMesh> brf_mesh_from_asset(const engine::SceneAsset& asset, std::uint32_t mesh_index,
+engine::Result<BrfMesh> brf_mesh_from_input(const BakeInput& input, std::uint32_t mesh_index,
                                             std::int32_t material_override = -1);
 
-/// One source per distinct (mesh, material override) drawn by a DynamicTag entity with a
-/// MeshRenderer (dynamic nodes without a mesh, such as a lamp's pivot, are skipped), in
-/// order of the first entity (ascending index) drawing it. No dynamic mesh: empty.
-/// Errors: as brf_mesh_from_asset.
-engine::Result<std::vector<BrfSource>> dynamic_brf_meshes(const engine::Scene& scene);
+/// One source per distinct (mesh, material override) of the Dynamic instances, in order of
+/// the first instance drawing it. No dynamic mesh: empty. Errors: as brf_mesh_from_input.
+engine::Result<std::vector<BrfSource>> dynamic_brf_meshes(const BakeInput& input);
 
 /// The RGB reflectance the runtime bounces with for `source`: its (first) material's
 /// hemispherical albedo (engine::gltf_hemispherical_albedo, both lobes, as the light atlas
 /// folds it); for a glossy source its diffuse lobe's only (the specular lobe is its glossy
 /// terms). The glTF default material when it has none.
-glm::vec3 brf_source_albedo(const engine::SceneAsset& asset, const BrfSource& source);
+glm::vec3 brf_source_albedo(const BakeInput& input, const BrfSource& source);
 
 }  // namespace gi

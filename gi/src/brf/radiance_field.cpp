@@ -15,12 +15,18 @@ namespace {
 // Cube face f's point (u, v) in [-1, 1]^2 as a direction (not normalized).
 glm::vec3 cube_direction(int f, float u, float v) {
   switch (f) {
-    case 0: return {1.0f, v, -u};
-    case 1: return {-1.0f, v, u};
-    case 2: return {u, 1.0f, -v};
-    case 3: return {u, -1.0f, v};
-    case 4: return {u, v, 1.0f};
-    default: return {-u, v, -1.0f};
+    case 0:
+      return {1.0f, v, -u};
+    case 1:
+      return {-1.0f, v, u};
+    case 2:
+      return {u, 1.0f, -v};
+    case 3:
+      return {u, -1.0f, v};
+    case 4:
+      return {u, v, 1.0f};
+    default:
+      return {-u, v, -1.0f};
   }
 }
 
@@ -79,17 +85,24 @@ void BasisRadianceField::sample(const glm::vec3& p, std::span<float> out) const 
   const int u1 = std::min(u0 + 1, face_resolution - 1), v1 = std::min(v0 + 1, face_resolution - 1);
   const float tu = fu - static_cast<float>(u0), tv = fv - static_cast<float>(v0);
   const auto point = [&](int s, int uu, int vv) {
-    const std::size_t idx = ((static_cast<std::size_t>(s) * 6 + static_cast<std::size_t>(f)) * static_cast<std::size_t>(face_resolution) +
-                             static_cast<std::size_t>(vv)) * static_cast<std::size_t>(face_resolution) + static_cast<std::size_t>(uu);
+    const std::size_t idx =
+        ((static_cast<std::size_t>(s) * 6 + static_cast<std::size_t>(f)) * static_cast<std::size_t>(face_resolution) +
+         static_cast<std::size_t>(vv)) *
+            static_cast<std::size_t>(face_resolution) +
+        static_cast<std::size_t>(uu);
     return coefficients.data() + idx * per_point;
   };
   const struct {
     int s, u, v;
     float w;
-  } corners[8] = {{s0, u0, v0, (1 - ts) * (1 - tu) * (1 - tv)}, {s0, u1, v0, (1 - ts) * tu * (1 - tv)},
-                  {s0, u0, v1, (1 - ts) * (1 - tu) * tv},       {s0, u1, v1, (1 - ts) * tu * tv},
-                  {s1, u0, v0, ts * (1 - tu) * (1 - tv)},       {s1, u1, v0, ts * tu * (1 - tv)},
-                  {s1, u0, v1, ts * (1 - tu) * tv},             {s1, u1, v1, ts * tu * tv}};
+  } corners[8] = {{s0, u0, v0, (1 - ts) * (1 - tu) * (1 - tv)},
+                  {s0, u1, v0, (1 - ts) * tu * (1 - tv)},
+                  {s0, u0, v1, (1 - ts) * (1 - tu) * tv},
+                  {s0, u1, v1, (1 - ts) * tu * tv},
+                  {s1, u0, v0, ts * (1 - tu) * (1 - tv)},
+                  {s1, u1, v0, ts * tu * (1 - tv)},
+                  {s1, u0, v1, ts * (1 - tu) * tv},
+                  {s1, u1, v1, ts * tu * tv}};
   // The object's radiance coefficients fall off about as 1 / r^2 between spheres:
   // interpolate r^2 x coefficients (linear interpolation of 1 / r^2 itself overestimates by
   // up to a few percent between spheres).
@@ -104,17 +117,18 @@ void BasisRadianceField::sample(const glm::vec3& p, std::span<float> out) const 
 }
 
 engine::Result<BasisRadianceField> compute_basis_radiance_field(const BrfMesh& mesh, const BrfBasis& basis,
-                                                               const RadianceFieldSettings& settings,
-                                                               const BrdfSeparation* glossy) {
+                                                                const RadianceFieldSettings& settings,
+                                                                const BrdfSeparation* glossy) {
   if (basis.vertex_count != mesh.positions.size() || basis.basis_count < 1)
     return engine::Error{.message = "basis radiance field: the basis does not belong to this mesh"};
   const int terms = 1 + (glossy != nullptr ? glossy->terms : 0);
   if (basis.terms != terms)
     return engine::Error{.message = "basis radiance field: the basis was trained for " + std::to_string(basis.terms) +
                                     " BRDF terms, the material has " + std::to_string(terms)};
-  if (settings.spheres < 1 || settings.spheres > 256 || settings.face_resolution < 1 || settings.face_resolution > 256 ||
-      (settings.sh_bands != 3 && settings.sh_bands != 4) || settings.directions < 16 || settings.directions > 65536 ||
-      !(settings.inner_radius_scale > 0.0f) || !(settings.outer_radius_scale >= settings.inner_radius_scale))
+  if (settings.spheres < 1 || settings.spheres > 256 || settings.face_resolution < 1 ||
+      settings.face_resolution > 256 || (settings.sh_bands != 3 && settings.sh_bands != 4) ||
+      settings.directions < 16 || settings.directions > 65536 || !(settings.inner_radius_scale > 0.0f) ||
+      !(settings.outer_radius_scale >= settings.inner_radius_scale))
     return engine::Error{.message = "basis radiance field: settings out of range"};
 
   BasisRadianceField field;
@@ -150,8 +164,8 @@ engine::Result<BasisRadianceField> compute_basis_radiance_field(const BrfMesh& m
   const std::size_t nv = basis.vertex_count;
 
   ThreadPool pool(settings.threads);
-  pool.parallel_for(
-      points,
+  const bool completed = pool.parallel_for_with_progress(
+      points, settings.progress,
       [&](std::size_t pt) {
         const std::size_t s = pt / (6 * res * res), rem = pt % (6 * res * res);
         const int f = static_cast<int>(rem / (res * res));
@@ -167,7 +181,7 @@ engine::Result<BasisRadianceField> compute_basis_radiance_field(const BrfMesh& m
         const float cap = 2.0f * std::numbers::pi_v<float> * (1.0f - cos_max);
         const float solid_angle = cap / static_cast<float>(n_dirs);
         const glm::vec3 t = glm::normalize(std::abs(axis.x) < 0.9f ? glm::cross(axis, glm::vec3(1, 0, 0))
-                                                                    : glm::cross(axis, glm::vec3(0, 1, 0)));
+                                                                   : glm::cross(axis, glm::vec3(0, 1, 0)));
         const glm::vec3 b = glm::cross(axis, t);
         float* out = field.coefficients.data() + pt * per_point;
         for (std::size_t k = 0; k < n_dirs; ++k) {
@@ -184,19 +198,22 @@ engine::Result<BasisRadianceField> compute_basis_radiance_field(const BrfMesh& m
           float h_out[1 + kMaxGlossyTerms];
           h_out[0] = inv_pi;  // the diffuse term: radiance of radiosity Psi_i is Psi_i / pi
           if (terms > 1) {
-            const glm::vec3 n = glm::normalize(b0 * mesh.normals[tri[0]] + b1 * mesh.normals[tri[1]] + b2 * mesh.normals[tri[2]]);
+            const glm::vec3 n =
+                glm::normalize(b0 * mesh.normals[tri[0]] + b1 * mesh.normals[tri[1]] + b2 * mesh.normals[tri[2]]);
             const glm::vec3 w = glm::transpose(brf_tangent_frame(n)) * -dir;
             for (int term = 1; term < terms; ++term) h_out[term] = glossy->h_at(term - 1, w);
           }
           for (std::size_t term = 0; term < static_cast<std::size_t>(terms); ++term)
             for (std::size_t i = 0; i < nb; ++i) {
               const float* psi = basis.psi.data() + i * nv;
-              const float radiance = (b0 * psi[tri[0]] + b1 * psi[tri[1]] + b2 * psi[tri[2]]) * h_out[term] * solid_angle;
+              const float radiance =
+                  (b0 * psi[tri[0]] + b1 * psi[tri[1]] + b2 * psi[tri[2]]) * h_out[term] * solid_angle;
               for (std::size_t c = 0; c < coefs; ++c) out[(term * nb + i) * coefs + c] += radiance * y[c];
             }
         }
       },
       4);
+  if (!completed) return engine::cancelled_error("basis radiance field");
   return field;
 }
 

@@ -11,26 +11,27 @@
 //   std::vector<float> c(field.basis_count * field.coefficient_count());
 //   field.sample(receiver_point, c);   // object space
 
+#include <engine/result.h>
+#include <gi/progress.h>
+
 #include <cstdint>
+#include <glm/glm.hpp>
 #include <span>
 #include <vector>
-
-#include <glm/glm.hpp>
-
-#include <engine/result.h>
 
 #include "brf/pca_basis.h"
 
 namespace gi {
 
 struct RadianceFieldSettings {
-  int spheres = 16;                ///< Concentric spheres.
-  int face_resolution = 16;        ///< Points per sphere: 6 cube faces x resolution^2.
-  int sh_bands = 3;                ///< 3 (9 coefficients) or 4 (16).
-  float inner_radius_scale = 1.0f; ///< Innermost sphere at this x the bounding radius.
-  float outer_radius_scale = 8.0f; ///< Outermost; spheres are spaced geometrically between.
-  int directions = 256;            ///< Rays per sample point for the projection.
+  int spheres = 16;                 ///< Concentric spheres.
+  int face_resolution = 16;         ///< Points per sphere: 6 cube faces x resolution^2.
+  int sh_bands = 3;                 ///< 3 (9 coefficients) or 4 (16).
+  float inner_radius_scale = 1.0f;  ///< Innermost sphere at this x the bounding radius.
+  float outer_radius_scale = 8.0f;  ///< Outermost; spheres are spaced geometrically between.
+  int directions = 256;             ///< Rays per sample point for the projection.
   unsigned threads = 0;
+  ProgressCallback progress;  ///< Fraction of the sample points done; false cancels.
 };
 
 struct BasisRadianceField {
@@ -38,7 +39,7 @@ struct BasisRadianceField {
   int face_resolution = 0;
   int sh_bands = 0;
   int basis_count = 0;
-  int terms = 1;                   ///< K: 1 + glossy terms.
+  int terms = 1;  ///< K: 1 + glossy terms.
   glm::vec3 centre{0.0f};
   float inner_radius = 0.0f;
   float outer_radius = 0.0f;
@@ -62,7 +63,7 @@ struct BasisRadianceField {
 /// Errors: settings out of range, a basis that does not belong to the mesh, a basis trained
 /// for other terms than `glossy` gives (nullptr: diffuse).
 engine::Result<BasisRadianceField> compute_basis_radiance_field(const BrfMesh& mesh, const BrfBasis& basis,
-                                                               const RadianceFieldSettings& settings,
-                                                               const BrdfSeparation* glossy = nullptr);
+                                                                const RadianceFieldSettings& settings,
+                                                                const BrdfSeparation* glossy = nullptr);
 
 }  // namespace gi

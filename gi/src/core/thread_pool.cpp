@@ -66,4 +66,17 @@ void ThreadPool::parallel_for(std::size_t count, const std::function<void(std::s
   job_ = nullptr;
 }
 
+bool ThreadPool::parallel_for_with_progress(std::size_t count, const ProgressCallback& progress,
+                                            const std::function<void(std::size_t)>& fn, std::size_t grain) {
+  const std::size_t batches = std::clamp<std::size_t>(count / 256, 1, 200);
+  const std::size_t per_batch = (count + batches - 1) / batches;
+  for (std::size_t begin = 0; begin < count; begin += per_batch) {
+    const std::size_t n = std::min(per_batch, count - begin);
+    parallel_for(
+        n, [&](std::size_t i) { fn(begin + i); }, grain);
+    if (progress && !progress(static_cast<double>(begin + n) / static_cast<double>(count))) return false;
+  }
+  return true;
+}
+
 }  // namespace gi

@@ -5,6 +5,8 @@
 //   gi::ThreadPool pool(4);
 //   pool.parallel_for(n, [&](std::size_t i) { out[i] = shade(i); });
 
+#include <gi/progress.h>
+
 #include <atomic>
 #include <condition_variable>
 #include <cstddef>
@@ -30,6 +32,12 @@ class ThreadPool {
   /// Calls fn(i) for every i in [0, count), items handed out in chunks of `grain`. Blocks
   /// until all are done. Not re-entrant (fn must not call parallel_for on the same pool).
   void parallel_for(std::size_t count, const std::function<void(std::size_t)>& fn, std::size_t grain = 1);
+
+  /// parallel_for in batches (at most 200), calling `progress` (if set) with the fraction
+  /// done after each batch, from the calling thread. Returns false, having stopped after
+  /// the batch, when the callback returns false (cancelled).
+  bool parallel_for_with_progress(std::size_t count, const ProgressCallback& progress,
+                                  const std::function<void(std::size_t)>& fn, std::size_t grain = 4);
 
  private:
   void worker_loop();

@@ -35,14 +35,15 @@ engine::Result<FinalShootingResult> shoot_into_atlas(const VplSet& vpls, const s
             if (f <= 0.0f) continue;
             const std::uint32_t k = pick_sample(vpls, i, (std::uint64_t{t} << 32) | i, settings.seed);
             ++local;
-            if (segment_visible(caster, p, n, vpls.sample_position[k], vpls.sample_normal[k])) sum += glm::dvec3(power[s]) * static_cast<double>(f);
+            if (segment_visible(caster, p, n, vpls.sample_position[k], vpls.sample_normal[k]))
+              sum += glm::dvec3(power[s]) * static_cast<double>(f);
           }
           out.irradiance[t] = glm::vec3(sum);
           rays += local;
         },
         8);
     if (settings.progress && !settings.progress(static_cast<double>(b + 1) / static_cast<double>(batches)))
-      return engine::Error{.message = "light-atlas bake cancelled"};
+      return engine::cancelled_error("light-atlas bake");
   }
   out.rays = rays.load();
   return out;

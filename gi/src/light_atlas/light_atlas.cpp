@@ -5,9 +5,9 @@
 #include <cmath>
 #include <span>
 
-#include "transport/static_scene.h"
 #include "light_atlas/final_shooting.h"
 #include "transport/point_emitters.h"
+#include "transport/static_scene.h"
 #include "transport/vpl_transport.h"
 #include "uv/atlas_density.h"
 #include "uv/atlas_dilation.h"
@@ -20,10 +20,11 @@ using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 engine::Status validate(const LightAtlasSettings& s) {
-  const auto bad = [](std::string what) { return engine::Error{.message = "light-atlas settings: " + what}; };
+  const auto bad = [](std::string what) { return engine::invalid_request("light-atlas settings: " + what); };
   if (!(s.texels_per_metre > 0.0f) || s.texels_per_metre > kMaxTexelsPerMetre)
     return bad("texels_per_metre " + std::to_string(s.texels_per_metre) + " is outside (0, 10^4]");
-  if (s.vpl_count < 1 || s.vpl_count > 1'000'000) return bad("vpl_count " + std::to_string(s.vpl_count) + " is outside 1..10^6");
+  if (s.vpl_count < 1 || s.vpl_count > 1'000'000)
+    return bad("vpl_count " + std::to_string(s.vpl_count) + " is outside 1..10^6");
   if (s.samples_per_vpl < 1 || s.samples_per_vpl > 1024)
     return bad("samples_per_vpl " + std::to_string(s.samples_per_vpl) + " is outside 1..1024");
   if (s.bounces < 1 || s.bounces > 64) return bad("bounces " + std::to_string(s.bounces) + " is outside 1..64");
@@ -39,9 +40,9 @@ struct BakeScene : StaticBakeScene {
   std::vector<PointEmitter> emitters;
 };
 
-engine::Result<BakeScene> prepare(const engine::Scene& scene, const AtlasLayout& layout, const LightAtlasSettings& s) {
+engine::Result<BakeScene> prepare(const BakeInput& input, const AtlasLayout& layout, const LightAtlasSettings& s) {
   // Lights that move belong to PRM (DESIGN.md 3): the atlas bakes the static ones only.
-  auto prepared = prepare_static_scene(scene, layout, BakeLights::Static);
+  auto prepared = prepare_static_scene(input, layout, BakeLights::Static);
   if (!prepared) return prepared.error();
   BakeScene b{std::move(prepared).value(), {}};
   b.emitters = point_emitters(b.scene, b.index, s.area_light_samples, s.seed);
@@ -67,13 +68,13 @@ struct VplPowers {
 
 // Steps 2-3: direct light into the VPLs, then progressive refinement; returns every VPL's
 // reflected power E_i = rho_i A_i I_i.
-engine::Result<VplPowers> light_vpls(const BakeScene& b, const VplSet& vpls, const LightAtlasSettings& s, ThreadPool& pool,
-                                     LightAtlasStats* stats) {
+engine::Result<VplPowers> light_vpls(const BakeScene& b, const VplSet& vpls, const LightAtlasSettings& s,
+                                     ThreadPool& pool, LightAtlasStats* stats) {
   VplPowers out;
   auto t0 = Clock::now();
   const std::vector<glm::vec3> direct = direct_to_vpls(vpls, b.emitters, *b.caster, pool, &out.rays);
   if (stats) stats->direct_seconds = seconds_since(t0);
-  if (s.progress && !s.progress(kDirectPhase.end)) return engine::Error{.message = "light-atlas bake cancelled"};
+  if (s.progress && !s.progress(kDirectPhase.end)) return engine::cancelled_error("light-atlas bake");
   t0 = Clock::now();
   auto solution = propagate(vpls, direct, *b.caster, pool,
                             {.bounces = s.bounces,
@@ -94,16 +95,17 @@ int dilation_rings(const AtlasLayout& layout) { return std::max(4, layout.paddin
 
 }  // namespace
 
-engine::Result<LightAtlasBake> bake_light_atlas(const engine::Scene& scene, const LightAtlasSettings& settings) {
+engine::Result<LightAtlasBake> bake_light_atlas(const BakeInput& input, const LightAtlasSettings& settings) {
   if (auto ok = validate(settings); !ok) return ok.error();
+  if (auto ok = validate_bake_input(input); !ok) return ok.error();
   const auto t_start = Clock::now();
-  const std::vector<AtlasInputMesh> inputs = atlas_inputs_from(scene.assets);
+  const std::vector<AtlasInputMesh> inputs = atlas_inputs_from(input);
   if (auto ok = validate_atlas_inputs(inputs); !ok) return ok.error();
   auto layout = build_atlas_layout(inputs, {.texels_per_metre = settings.texels_per_metre});
   if (!layout) return layout.error();
 
   ThreadPool pool(settings.threads);
-  auto prepared = prepare(scene, *layout, settings);
+  auto prepared = prepare(input, *layout, settings);
   if (!prepared) return prepared.error();
   const BakeScene& b = *prepared;
 
@@ -113,8 +115,9 @@ engine::Result<LightAtlasBake> bake_light_atlas(const engine::Scene& scene, cons
   out.width = out.layout.width;
   out.height = out.layout.height;
   auto t0 = Clock::now();
-  auto vpls = distribute_vpls(b.scene, b.index,
-                              {.vpl_count = settings.vpl_count, .samples_per_vpl = settings.samples_per_vpl, .seed = settings.seed});
+  auto vpls = distribute_vpls(
+      b.scene, b.index,
+      {.vpl_count = settings.vpl_count, .samples_per_vpl = settings.samples_per_vpl, .seed = settings.seed});
   if (!vpls) return vpls.error();
   out.vpls = std::move(vpls).value();
   out.stats.vpl_seconds = seconds_since(t0);
@@ -130,8 +133,9 @@ engine::Result<LightAtlasBake> bake_light_atlas(const engine::Scene& scene, cons
     if (out.vpl_power[i] != glm::vec3(0.0f)) shooters.push_back(i), shot.push_back(out.vpl_power[i]);
   // Texels are point samples of irradiance (as the reference's): no receiver area; the
   // emitter's sample areas alone bound the near field.
-  auto final_result = shoot_into_atlas(out.vpls, shooters, shot, b.texels, 0.0f, *b.caster, pool,
-                                       {.seed = settings.seed, .progress = sub_progress(settings.progress, kFinalPhase)});
+  auto final_result =
+      shoot_into_atlas(out.vpls, shooters, shot, b.texels, 0.0f, *b.caster, pool,
+                       {.seed = settings.seed, .progress = sub_progress(settings.progress, kFinalPhase)});
   if (!final_result) return final_result.error();
   out.irradiance = std::move(final_result->irradiance);
   std::uint64_t rays = powers->rays + final_result->rays;
@@ -154,21 +158,23 @@ engine::Result<LightAtlasBake> bake_light_atlas(const engine::Scene& scene, cons
   return out;
 }
 
-engine::Result<LightAtlasUpdateStats> update_light_atlas(const engine::Scene& scene, LightAtlasBake& previous,
+engine::Result<LightAtlasUpdateStats> update_light_atlas(const BakeInput& input, LightAtlasBake& previous,
                                                          float relative_threshold) {
   if (!(relative_threshold >= 0.0f) || !std::isfinite(relative_threshold))
     return engine::Error{.message = "incremental light-atlas update: the threshold must be finite and >= 0"};
   if (previous.settings.include_direct)
-    return engine::Error{.message = "incremental light-atlas update needs an indirect-only atlas (include_direct is set)"};
+    return engine::Error{.message =
+                             "incremental light-atlas update needs an indirect-only atlas (include_direct is set)"};
   const auto t_start = Clock::now();
   LightAtlasSettings settings = previous.settings;
   settings.progress = {};
   ThreadPool pool(settings.threads);
-  auto prepared = prepare(scene, previous.layout, settings);
+  auto prepared = prepare(input, previous.layout, settings);
   if (!prepared) return prepared.error();
   const BakeScene& b = *prepared;
   if (b.texels.valid != previous.valid || previous.vpl_power.size() != previous.vpls.size())
-    return engine::Error{.message = "incremental light-atlas update: the scene's geometry differs from the bake's; re-bake"};
+    return engine::Error{.message =
+                             "incremental light-atlas update: the scene's geometry differs from the bake's; re-bake"};
 
   auto powers = light_vpls(b, previous.vpls, settings, pool, nullptr);
   if (!powers) return powers.error();
@@ -185,21 +191,23 @@ engine::Result<LightAtlasUpdateStats> update_light_atlas(const engine::Scene& sc
       previous.vpl_power[i] = powers->power[i];  // what the atlas now holds for VPL i
     }
   }
-  auto diff = shoot_into_atlas(previous.vpls, shooters, delta, b.texels, 0.0f, *b.caster, pool,
-                               {.seed = settings.seed});
+  auto diff =
+      shoot_into_atlas(previous.vpls, shooters, delta, b.texels, 0.0f, *b.caster, pool, {.seed = settings.seed});
   if (!diff) return diff.error();
   for (std::size_t t = 0; t < previous.irradiance.size(); ++t) {
     if (!previous.valid[t]) continue;
     // Differences may undershoot zero by rounding where a light went dark.
     previous.irradiance[t] = glm::max(previous.irradiance[t] + diff->irradiance[t], glm::vec3(0.0f));
   }
-  dilate<glm::vec3>(previous.irradiance, previous.width, previous.height, previous.valid, dilation_rings(previous.layout));
+  dilate<glm::vec3>(previous.irradiance, previous.width, previous.height, previous.valid,
+                    dilation_rings(previous.layout));
   return LightAtlasUpdateStats{.reshot_vpls = shooters.size(), .seconds = seconds_since(t_start)};
 }
 
 engine::Result<LightAtlasSettings> light_atlas_preset(std::string_view name) {
   auto density = atlas_density_preset(name);
-  if (!density) return engine::Error{.message = "unknown light-atlas preset '" + std::string(name) + "' (preview, medium, high)"};
+  if (!density)
+    return engine::invalid_request("unknown light-atlas preset '" + std::string(name) + "' (preview, medium, high)");
   LightAtlasSettings s;
   s.texels_per_metre = *density;
   if (name == "preview") {

@@ -2,7 +2,7 @@
 // The light-atlas baker (Schärfig, Stamminger, Hormann 2016, "Creating light atlases with
 // multi-bounce indirect illumination"): multi-bounce diffuse indirect irradiance of the
 // static world under static lights, stored per texel of the scene's light atlas (uv1).
-//   auto bake = gi::bake_light_atlas(scene, gi::light_atlas_preset("medium").value());
+//   auto bake = gi::bake_light_atlas(input, gi::light_atlas_preset("medium").value());  // input: gi/bake_input.h
 //   // bake->irradiance[y * bake->width + x]: indirect irradiance (W/m^2); shade albedo/pi x E.
 //
 // Steps (paper section in brackets):
@@ -18,17 +18,16 @@
 //      the VPLs whose power changed by more than a threshold re-shot as differences.
 // Bit-identical for any thread count: every random number comes from (seed, item id).
 
+#include <engine/result.h>
+#include <gi/bake_input.h>
+#include <gi/progress.h>
+
 #include <cstdint>
+#include <glm/glm.hpp>
 #include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
-
-#include <glm/glm.hpp>
-
-#include <engine/result.h>
-#include <engine/scene.h>
-#include <gi/progress.h>
 
 #include "transport/vpl_set.h"
 #include "uv/atlas_layout.h"
@@ -48,8 +47,8 @@ struct LightAtlasSettings {
   int area_light_samples = 64;  ///< Point samples per area light or emissive triangle (>= 1).
   bool include_direct = false;  ///< Add direct irradiance to the atlas (default: indirect only).
   std::uint64_t seed = 1;
-  unsigned threads = 0;          ///< 0: all hardware threads. The result does not depend on it.
-  ProgressCallback progress;     ///< Fraction done in [0, 1]; return false to cancel.
+  unsigned threads = 0;       ///< 0: all hardware threads. The result does not depend on it.
+  ProgressCallback progress;  ///< Fraction done in [0, 1]; return false to cancel.
 };
 
 /// preview / medium / high, chosen from the measured Pareto front (docs/sweeps/).
@@ -59,8 +58,8 @@ std::vector<std::string> light_atlas_preset_names();
 struct LightAtlasStats {
   std::size_t vpls = 0;
   std::size_t sample_points = 0;
-  std::size_t light_points = 0;    ///< Point emitters after sampling area lights / emissive triangles.
-  std::size_t shots = 0;           ///< VPL-to-VPL shooting steps (§3.3).
+  std::size_t light_points = 0;  ///< Point emitters after sampling area lights / emissive triangles.
+  std::size_t shots = 0;         ///< VPL-to-VPL shooting steps (§3.3).
   std::size_t valid_texels = 0;
   std::uint64_t rays = 0;          ///< Shadow rays cast in total.
   double vpl_seconds = 0.0;        ///< Distribution of VPLs and sample points.
@@ -87,22 +86,22 @@ struct LightAtlasBake {
   std::vector<glm::vec3> vpl_power;  ///< Reflected power E_i of every VPL (W), what step 4 shot.
 };
 
-/// Bakes the static meshes of `scene` (entities without DynamicTag) lit by its enabled
-/// lights and emissive static surfaces. Errors: no static geometry, invalid settings,
+/// Bakes the Static instances of `input` lit by its lights that do not move and its
+/// emissive static surfaces. Errors: no static geometry, invalid settings,
 /// cancellation, or a layout that cannot be built.
-engine::Result<LightAtlasBake> bake_light_atlas(const engine::Scene& scene, const LightAtlasSettings& settings);
+engine::Result<LightAtlasBake> bake_light_atlas(const BakeInput& input, const LightAtlasSettings& settings);
 
 struct LightAtlasUpdateStats {
   std::size_t reshot_vpls = 0;  ///< VPLs whose power change passed the threshold.
   double seconds = 0.0;
 };
 
-/// Paper §6.2: `previous` was baked from `scene` with other light settings (same geometry).
-/// Recomputes the VPL solution under the scene's current lights, then re-shoots into the
+/// Paper §6.2: `previous` was baked from `input` with other light settings (same geometry).
+/// Recomputes the VPL solution under the input's current lights, then re-shoots into the
 /// atlas only the differences E_new - E_old of VPLs whose change exceeds
 /// `relative_threshold` x the largest new VPL power. Threshold 0 reproduces a full re-bake
 /// up to float rounding.
-engine::Result<LightAtlasUpdateStats> update_light_atlas(const engine::Scene& scene, LightAtlasBake& previous,
+engine::Result<LightAtlasUpdateStats> update_light_atlas(const BakeInput& input, LightAtlasBake& previous,
                                                          float relative_threshold);
 
 }  // namespace gi

@@ -125,9 +125,9 @@ engine::Status read_atlas_exr(const fs::path& path, LightAtlasBake& bake) {
 
 }  // namespace
 
-engine::Status save_light_atlas(const fs::path& bundle_dir, const LightAtlasBake& bake,
-                                const engine::SceneAsset& asset, const std::string& scene_name) {
-  const std::string geometry_hash = scene_geometry_hash(asset);
+engine::Status save_light_atlas(const fs::path& bundle_dir, const LightAtlasBake& bake, const BakeInput& input) {
+  const std::string geometry_hash = scene_geometry_hash(input);
+  const std::string scene_name = fs::path(input.name).filename().string();
   const std::size_t texels =
       static_cast<std::size_t>(std::max(bake.width, 0)) * static_cast<std::size_t>(std::max(bake.height, 0));
   if (bake.width <= 0 || bake.height <= 0 || bake.width != bake.layout.width || bake.height != bake.layout.height ||
@@ -159,7 +159,7 @@ engine::Status save_light_atlas(const fs::path& bundle_dir, const LightAtlasBake
   const json entry{{"files",
                     {{"irradiance", {{"file", kLightAtlasExrFile}, {"fnv1a64", *exr_sum}}},
                      {"vpls", {{"file", kLightAtlasVplsFile}, {"fnv1a64", *vpls_sum}}}}},
-                   {"lights_hash", static_lights_hash(asset)},
+                   {"lights_hash", static_lights_hash(input)},
                    {"settings", settings_json(bake.settings)},
                    {"layout",
                     {{"requested_texels_per_metre", bake.layout.requested_texels_per_metre},
@@ -171,13 +171,13 @@ engine::Status save_light_atlas(const fs::path& bundle_dir, const LightAtlasBake
   return update_manifest_method(bundle_dir, geometry_hash, scene_name, kLightAtlasMethod, entry);
 }
 
-engine::Result<LightAtlasBake> load_light_atlas(const fs::path& bundle_dir, const engine::SceneAsset& asset) {
+engine::Result<LightAtlasBake> load_light_atlas(const fs::path& bundle_dir, const BakeInput& input) {
   auto manifest = read_manifest(bundle_dir);
   if (!manifest) return manifest.error();
   const fs::path manifest_file = bundle_dir / kManifestFileName;
-  const std::string scene_hash = scene_geometry_hash(asset);
+  const std::string scene_hash = scene_geometry_hash(input);
   if (manifest->geometry_hash != scene_hash) {
-    const std::string scene = asset.source.empty() ? std::string("the scene") : asset.source;
+    const std::string scene = input.name.empty() ? std::string("the scene") : input.name;
     return engine::Error{manifest_file.string(), "geometry_hash",
                          "stale bundle " + bundle_dir.string() + ": baked from geometry " + manifest->geometry_hash +
                              ", but " + scene + " hashes to " + scene_hash + " (re-bake)"};
@@ -186,7 +186,7 @@ engine::Result<LightAtlasBake> load_light_atlas(const fs::path& bundle_dir, cons
   if (!entry_json) return entry_json.error();
   auto entry = read_entry(manifest_file, *entry_json);
   if (!entry) return entry.error();
-  if (const std::string lights = static_lights_hash(asset); entry->lights_hash != lights)
+  if (const std::string lights = static_lights_hash(input); entry->lights_hash != lights)
     return engine::Error{manifest_file.string(), "methods.light_atlas.lights_hash",
                          "stale light atlas in " + bundle_dir.string() + ": baked under static lights " +
                              entry->lights_hash + ", but the scene's static lights hash to " + lights +
@@ -204,7 +204,7 @@ engine::Result<LightAtlasBake> load_light_atlas(const fs::path& bundle_dir, cons
         "belongs to geometry " + vpl_file->geometry_hash + ", the manifest to " + manifest->geometry_hash};
 
   auto layout = build_atlas_layout(
-      atlas_inputs_from(asset),
+      atlas_inputs_from(input),
       AtlasSettings{.texels_per_metre = entry->requested_texels_per_metre, .padding_texels = entry->padding_texels});
   if (!layout) {
     engine::Error e = layout.error();

@@ -1,7 +1,7 @@
 #pragma once
 // Saving a light-atlas bake into a bundle directory and loading it back for a scene.
-//   gi::save_light_atlas("level.gibake", bake, asset, "level.gltf");
-//   auto bake = gi::load_light_atlas("level.gibake", asset);   // checks the geometry hash
+//   gi::save_light_atlas("level.gibake", bake, input);
+//   auto bake = gi::load_light_atlas("level.gibake", input);   // checks the geometry hash
 //
 // Files (DESIGN.md §5):
 //   light_atlas.exr        RGBA float32, width x height of the layout, texel (x, y) at row y
@@ -17,7 +17,7 @@
 // bake was interrupted between files, or mixes files of two bakes, does not load.
 
 #include <engine/result.h>
-#include <engine/scene_asset.h>
+#include <gi/bake_input.h>
 
 #include <filesystem>
 #include <string>
@@ -30,20 +30,19 @@ inline constexpr const char* kLightAtlasMethod = "light_atlas";
 inline constexpr const char* kLightAtlasExrFile = "light_atlas.exr";
 inline constexpr const char* kLightAtlasVplsFile = "light_atlas_vpls.bin";
 
-/// Writes `bake` of `asset` into `bundle_dir` (created if needed): the EXR, the VPL file,
-/// then the manifest's "light_atlas" entry with the asset's static_lights_hash (other
-/// methods' entries are kept when the manifest has the same geometry hash). Every file is written to a temporary name and renamed. Error when
-/// the bake's arrays do not match its size, or a file cannot be written.
+/// Writes `bake` of `input` into `bundle_dir` (created if needed): the EXR, the VPL file,
+/// then the manifest's "light_atlas" entry with the input's static_lights_hash (other
+/// methods' entries are kept when the manifest has the same geometry hash). Every file is written to a temporary name
+/// and renamed. Error when the bake's arrays do not match its size, or a file cannot be written.
 engine::Status save_light_atlas(const std::filesystem::path& bundle_dir, const LightAtlasBake& bake,
-                                const engine::SceneAsset& asset, const std::string& scene_name);
+                                const BakeInput& input);
 
-/// Loads the light atlas of `bundle_dir` for `asset`: rejects a stale bundle (geometry hash
-/// differs from scene_geometry_hash(asset), or the atlas was baked under other static lights:
-/// static_lights_hash), rebuilds the layout from atlas_inputs_from(asset)
+/// Loads the light atlas of `bundle_dir` for `input`: rejects a stale bundle (geometry hash
+/// differs from scene_geometry_hash(input), or the atlas was baked under other static lights:
+/// static_lights_hash), rebuilds the layout from atlas_inputs_from(input)
 /// with the manifest's requested density and padding, and checks every file against the
 /// manifest (checksums, sizes, finite non-negative irradiance, alpha 0 or 1). Every error
 /// names the file and the problem.
-engine::Result<LightAtlasBake> load_light_atlas(const std::filesystem::path& bundle_dir,
-                                                const engine::SceneAsset& asset);
+engine::Result<LightAtlasBake> load_light_atlas(const std::filesystem::path& bundle_dir, const BakeInput& input);
 
 }  // namespace gi

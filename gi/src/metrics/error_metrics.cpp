@@ -1,12 +1,10 @@
-#include "metrics/error_metrics.h"
-
 #include <engine/check.h>
+#include <engine/display_transform.h>
+#include <gi/error_metrics.h>
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
-
-#include "metrics/display_tonemap.h"
 
 namespace gi {
 namespace {
@@ -82,7 +80,7 @@ double tonemapped_psnr_db(const RgbField& a, const RgbField& r, double exposure,
       const double av = scale * at(a, 3 * i + c);
       const double rv = at(r, 3 * i + c);
       if (!std::isfinite(av) || !std::isfinite(rv)) return kNaN;
-      const double d = display_tonemap(av, exposure) - display_tonemap(rv, exposure);
+      const double d = engine::display_tonemap(av, exposure) - engine::display_tonemap(rv, exposure);
       sum += d * d;
       ++n;
     }

@@ -4,8 +4,8 @@
 #include <algorithm>
 #include <cstdio>
 #include <map>
+#include <optional>
 #include <set>
-#include <unordered_map>
 
 #include "brf/brf_bake.h"
 #include "plan/plan_cost.h"
@@ -18,11 +18,6 @@ namespace {
 constexpr std::string_view kKeys[kEffectMethodCount] = {"atlas", "prm", "dlm", "antiradiance", "brf"};
 // What this build can bake (gi-bake --methods). DLM and antiradiance are not built yet.
 constexpr bool kAvailable[kEffectMethodCount] = {true, true, false, false, true};
-
-std::string name_of(const engine::Registry& reg, engine::Entity e) {
-  const engine::Name* n = reg.try_get<engine::Name>(e);
-  return n && !n->value.empty() ? n->value : "entity " + std::to_string(e.index);
-}
 
 std::string plural(std::size_t n, const char* one, const char* many) {
   return std::to_string(n) + " " + (n == 1 ? one : many);
@@ -48,63 +43,259 @@ std::string fixed(double v, int digits) {
   return buf;
 }
 
-struct EntityNodes {
-  std::unordered_map<std::uint32_t, int> node_of;  // entity index -> node index
-  int node(engine::Entity e) const {
-    auto it = node_of.find(e.index);
-    return it == node_of.end() ? -1 : it->second;
-  }
-};
+std::string instance_name(const BakeInput& input, std::size_t i) {
+  const std::string& n = input.instances[i].name;
+  return n.empty() ? "instance " + std::to_string(i) : n;
+}
 
 // Why a light moves, or empty: its own flag, the plan options, or a dynamic node it hangs
-// from (the light's own node or an ancestor, by mobility or DynamicTag).
-std::string why_light_moves(const engine::Scene& scene, const EntityNodes& nodes, engine::Entity e,
-                            const engine::Light& light, const std::string& name, const PlanOptions& options,
+// from (which the bakers do not see: `only_by_node` says so).
+std::string why_light_moves(const BakeLight& l, const std::string& name, const PlanOptions& options,
                             bool* only_by_node) {
   *only_by_node = false;
-  if (light.moves) return "light_moves";
+  if (l.light.moves) return "light_moves";
   if (std::find(options.moving_lights.begin(), options.moving_lights.end(), name) != options.moving_lights.end())
     return "scripted by the game";
-  for (engine::Entity a = e; !a.is_null() && scene.registry.valid(a);) {
-    const int n = nodes.node(a);
-    const bool dynamic =
-        scene.registry.has<engine::DynamicTag>(a) ||
-        (n >= 0 && scene.assets.nodes[static_cast<std::size_t>(n)].gi.mobility == engine::Mobility::Dynamic);
-    if (dynamic) {
-      *only_by_node = true;
-      return a == e ? "on a dynamic node" : "hangs from dynamic node '" + name_of(scene.registry, a) + "'";
-    }
-    const engine::Transform* t = scene.registry.try_get<engine::Transform>(a);
-    a = t ? t->parent : engine::Entity{};
+  if (!l.dynamic_parent.empty()) {
+    *only_by_node = true;
+    return l.dynamic_parent == name ? "on a dynamic node" : "hangs from dynamic node '" + l.dynamic_parent + "'";
   }
   return {};
 }
 
-bool emissive(const engine::SceneAsset& assets, const engine::MeshRenderer& mr) {
-  if (mr.mesh >= assets.meshes.size()) return false;
-  for (const engine::Primitive& p : assets.meshes[mr.mesh].primitives) {
-    const int mi = mr.material_override >= 0 ? mr.material_override : p.material;
-    if (mi >= 0 && static_cast<std::size_t>(mi) < assets.materials.size() &&
-        glm::length(assets.materials[static_cast<std::size_t>(mi)].emissive) > 0.0f)
-      return true;
-  }
+bool emissive(const BakeInput& input, const BakeInstance& inst) {
+  for (const BakePrimitive& p : input.meshes[inst.mesh].primitives)
+    if (glm::length(bake_material(input, inst, p).emission) > 0.0f) return true;
   return false;
 }
 
-// The lowest roughness factor among the entity's materials (textures can only lower it
+// The lowest roughness factor among the instance's materials (textures can only lower it
 // further: glTF multiplies the factor by the texture), and that material's name.
-std::pair<float, std::string> min_roughness(const engine::SceneAsset& assets, const engine::MeshRenderer& mr) {
+std::pair<float, std::string> min_roughness(const BakeInput& input, const BakeInstance& inst) {
   std::pair<float, std::string> best{2.0f, {}};
-  if (mr.mesh >= assets.meshes.size()) return best;
-  for (const engine::Primitive& p : assets.meshes[mr.mesh].primitives) {
-    const int mi = mr.material_override >= 0 ? mr.material_override : p.material;
-    const engine::Material def;
-    const engine::Material& m = mi >= 0 && static_cast<std::size_t>(mi) < assets.materials.size()
-                                    ? assets.materials[static_cast<std::size_t>(mi)]
-                                    : def;
+  for (const BakePrimitive& p : input.meshes[inst.mesh].primitives) {
+    const BakeMaterial m = bake_material(input, inst, p);
     if (m.roughness < best.first) best = {m.roughness, m.name};
   }
   return best;
+}
+
+// What the rules read, gathered once.
+struct PlanFacts {
+  std::vector<std::string> static_lights, moving_lights, moving_why;
+  std::vector<std::string> static_meshes, emissive_meshes, glossy, glossy_why, deforming;
+  std::map<std::uint32_t, std::vector<std::string>> dynamic_by_mesh;  // mesh -> instances
+  LightPointCount points;
+  StaticSurfaceCensus census;
+};
+
+PlanFacts gather_facts(const BakeInput& input, const PlanOptions& options, EffectPlan& out) {
+  PlanFacts f;
+  SceneFacts& facts = out.facts;
+  for (std::size_t i = 0; i < input.lights.size(); ++i) {
+    const BakeLight& l = input.lights[i];
+    if (!l.light.enabled) {
+      ++facts.disabled_lights;
+      continue;
+    }
+    const std::string name = l.name.empty() ? "light " + std::to_string(i) : l.name;
+    bool only_by_node = false;
+    const std::string why = why_light_moves(l, name, options, &only_by_node);
+    if (!why.empty()) {
+      f.moving_lights.push_back(name);
+      f.moving_why.push_back(why);
+      if (only_by_node)
+        out.warnings.push_back("light '" + name + "' " + why +
+                               " but is not flagged light_moves: the light atlas would bake it as static; set "
+                               "gi.light_moves");
+      continue;
+    }
+    f.static_lights.push_back(name);
+    if (l.light.type == engine::LightType::Area)
+      ++f.points.sampled;
+    else if (l.light.type == engine::LightType::Directional)
+      ++f.points.directional;
+    else
+      ++f.points.punctual;
+  }
+  facts.static_lights = static_cast<int>(f.static_lights.size());
+  facts.moving_lights = static_cast<int>(f.moving_lights.size());
+
+  for (std::size_t i = 0; i < input.instances.size(); ++i) {
+    const BakeInstance& inst = input.instances[i];
+    if (inst.mesh >= input.meshes.size()) continue;
+    const std::string name = instance_name(input, i);
+    if (inst.deforming) f.deforming.push_back(name);
+    if (inst.mobility == BakeMobility::Dynamic) {
+      ++facts.dynamic_meshes;
+      f.dynamic_by_mesh[inst.mesh].push_back(name);
+      continue;
+    }
+    ++facts.static_meshes;
+    f.static_meshes.push_back(name);
+    if (emissive(input, inst)) f.emissive_meshes.push_back(name);
+    const auto [roughness, material] = min_roughness(input, inst);
+    if (roughness < options.glossy_roughness) {
+      f.glossy.push_back(name);
+      f.glossy_why.push_back("'" + name + "' (" + material + ") has roughness " + fixed(roughness, 2));
+    }
+  }
+  facts.emissive_surfaces = static_cast<int>(f.emissive_meshes.size());
+  f.points.sampled += 2 * facts.emissive_surfaces;  // emissive quads: two triangles each, typically
+  f.census = census_static_surfaces(input);
+  facts.static_area_m2 = f.census.area_m2;
+  facts.static_albedo = f.census.albedo;
+  return f;
+}
+
+// The bakers' presets with gi-bake's overrides; nullopt when the preset is unknown.
+struct PlanPresets {
+  LightAtlasSettings atlas;
+  PrmSettings prm;
+};
+std::optional<PlanPresets> presets(const PlanOptions& options) {
+  auto atlas = light_atlas_preset(options.preset);
+  auto prm = prm_preset(options.preset);
+  if (!atlas || !prm) return std::nullopt;
+  PlanPresets p{*atlas, *prm};
+  if (options.texels_per_metre > 0.0f) p.atlas.texels_per_metre = p.prm.texels_per_metre = options.texels_per_metre;
+  if (options.vpls > 0) p.atlas.vpl_count = options.vpls;
+  if (options.samples_per_vpl > 0) p.atlas.samples_per_vpl = options.samples_per_vpl;
+  if (options.bounces > 0) p.atlas.bounces = options.bounces;
+  return p;
+}
+
+// Light atlas: static light sources on static geometry.
+void plan_light_atlas(const PlanFacts& f, const std::optional<PlanPresets>& p, PlannedEffect& atlas) {
+  const std::size_t static_sources = f.static_lights.size() + f.emissive_meshes.size();
+  if (f.static_meshes.empty()) {
+    atlas.reason = "no static mesh: nothing for a light atlas to hold";
+    return;
+  }
+  if (static_sources == 0) {
+    atlas.reason =
+        "no static light (" + plural(f.moving_lights.size(), "light moves", "lights move") + ") -> no light atlas";
+    return;
+  }
+  atlas.enabled = true;
+  const std::string area = fixed(f.census.area_m2, 1) + " m^2";
+  const std::string meshes = plural(f.static_meshes.size(), "static mesh", "static meshes");
+  const std::string emitting = plural(f.emissive_meshes.size(), "emissive surface", "emissive surfaces");
+  if (f.static_lights.empty()) {
+    atlas.reason = emitting + (f.emissive_meshes.size() == 1 ? " lights " : " light ") + meshes + " (" + area + ")";
+  } else {
+    atlas.reason = plural(f.static_lights.size(), "static light", "static lights") +
+                   (f.static_lights.size() == 1 ? " lights " : " light ") + meshes + " (" + area +
+                   (f.emissive_meshes.empty() ? "" : "; " + emitting + " too") + ")";
+  }
+  atlas.targets = f.static_meshes;
+  if (!p) return;
+  const BakeWork w = light_atlas_work(f.census, p->atlas, f.points);
+  const AtlasTexelEstimate t = atlas_texels(f.census, p->atlas.texels_per_metre);
+  atlas.estimate = {w.bake_seconds, w.runtime_bytes, static_cast<std::uint64_t>(t.lit_texels),
+                    fixed(f.census.area_m2, 1) + " m^2 x " + fixed(p->atlas.texels_per_metre, 0) +
+                        "^2 texels/m^2 -> ~" + std::to_string(static_cast<long long>(t.lit_texels)) +
+                        " texels (atlas " + std::to_string(t.width) + "x" + std::to_string(t.height) + ") x " +
+                        std::to_string(p->atlas.vpl_count) + " VPLs, " + std::to_string(p->atlas.bounces) + " bounces"};
+}
+
+// PRM: moving lights over static geometry.
+void plan_prm(const PlanFacts& f, const std::optional<PlanPresets>& p, PlannedEffect& prm) {
+  if (f.moving_lights.empty()) {
+    prm.reason = "no light moves -> no PRM panes";
+    return;
+  }
+  if (f.static_meshes.empty()) {
+    prm.reason = "lights move but there is no static mesh to relight";
+    return;
+  }
+  prm.enabled = true;
+  std::vector<std::string> parts;
+  for (std::size_t i = 0; i < f.moving_lights.size() && i < 3; ++i)
+    parts.push_back("light '" + f.moving_lights[i] + "' moves (" + f.moving_why[i] + ")");
+  prm.reason =
+      list_names(parts, 3) + " -> PRM panes over " + plural(f.static_meshes.size(), "static mesh", "static meshes");
+  prm.targets = f.static_meshes;
+  if (!p) return;
+  double nodes = 0.0;
+  const BakeWork w = prm_work(f.census, p->prm, &nodes);
+  const AtlasTexelEstimate t = atlas_texels(f.census, p->prm.texels_per_metre);
+  prm.estimate = {w.bake_seconds, w.runtime_bytes, static_cast<std::uint64_t>(nodes),
+                  std::to_string(p->prm.entry_points) + " entry points x N_s " + fixed(p->prm.splitting, 0) +
+                      " at albedo " + fixed(f.census.albedo, 2) + " -> ~" +
+                      std::to_string(static_cast<long long>(nodes)) + " path nodes x ~" +
+                      std::to_string(static_cast<long long>(t.pane_texels)) + " pane texels; " +
+                      std::to_string(p->prm.clusters) + " panes as half floats"};
+}
+
+// Directional light maps: glossy static surfaces.
+void plan_dlm(const PlanFacts& f, const PlanOptions& options, PlannedEffect& dlm) {
+  const std::string threshold = fixed(options.glossy_roughness, 2);
+  if (f.glossy.empty()) {
+    dlm.reason = "no static surface has roughness < " + threshold + " -> no directional maps";
+    return;
+  }
+  dlm.enabled = true;
+  dlm.reason = "static surface " + list_names(f.glossy_why, 2) + " < " + threshold + " -> directional light maps";
+  dlm.targets = f.glossy;
+}
+
+// Antiradiance: flagged deforming or opening regions.
+void plan_antiradiance(const PlanFacts& f, PlannedEffect& anti) {
+  if (f.deforming.empty()) {
+    anti.reason = "no node is flagged gi.region \"deforming\" -> no antiradiance";
+    return;
+  }
+  anti.enabled = true;
+  anti.reason = plural(f.deforming.size(), "mesh is", "meshes are") + " flagged gi.region \"deforming\" (" +
+                quoted_list(f.deforming) + ") -> antiradiance for that region";
+  anti.targets = f.deforming;
+}
+
+// Basis radiance fields: the meshes of dynamic instances, once per mesh.
+void plan_brf(const BakeInput& input, const PlanFacts& f, const PlanOptions& options, int dynamic_instances,
+              PlannedEffect& brf) {
+  if (f.dynamic_by_mesh.empty()) {
+    brf.reason = "no dynamic mesh -> no basis radiance fields";
+    return;
+  }
+  brf.enabled = true;
+  std::vector<std::string> mesh_names, glossy_meshes;
+  std::size_t vertices = 0;
+  BakeWork total;
+  const auto brf_settings = brf_preset(options.preset);
+  const PcaBasisSettings basis = brf_settings ? brf_settings->basis : PcaBasisSettings{};
+  const RadianceFieldSettings field = brf_settings ? brf_settings->field : RadianceFieldSettings{};
+  for (const auto& [mesh, users] : f.dynamic_by_mesh) {
+    const BakeMesh& m = input.meshes[mesh];
+    mesh_names.push_back(m.name.empty() ? "mesh " + std::to_string(mesh) : m.name);
+    std::size_t v = 0, t = 0;
+    for (const BakePrimitive& p : m.primitives) v += p.positions.size(), t += p.indices.size() / 3;
+    vertices += v;
+    // A glossy material (brf_glossy_lobe) multiplies the field by 1 + its terms; the
+    // separation may keep one more term to keep an azimuthal pair whole.
+    const bool is_glossy = !m.primitives.empty() &&
+                           brf_glossy_lobe(bake_material(input, BakeInstance{}, m.primitives.front())).has_value();
+    const int terms = is_glossy ? 2 + (brf_settings ? brf_settings->glossy.terms : 4) : 1;
+    if (is_glossy) glossy_meshes.push_back(mesh_names.back());
+    const BakeWork w = brf_work(v, t, basis, field, terms);
+    total.bake_seconds += w.bake_seconds;
+    total.runtime_bytes += w.runtime_bytes;
+    total.units += w.units;
+  }
+  brf.reason =
+      plural(static_cast<std::size_t>(dynamic_instances), "dynamic entity uses ", "dynamic entities use ") +
+      plural(mesh_names.size(), "mesh", "meshes") + " (" + list_names(mesh_names) +
+      ") -> a basis and a field per mesh" +
+      (glossy_meshes.empty() ? std::string()
+                             : "; glossy metal (" + list_names(glossy_meshes) + ") -> its lobe in separable terms");
+  brf.targets = mesh_names;
+  brf.estimate = {total.bake_seconds, total.runtime_bytes, static_cast<std::uint64_t>(total.units),
+                  std::to_string(mesh_names.size()) + " meshes, " + std::to_string(vertices) + " vertices; per mesh " +
+                      std::to_string(field.spheres) + " spheres x 6 x " + std::to_string(field.face_resolution) +
+                      "^2 points x " + std::to_string(basis.basis) + " functions x " +
+                      std::to_string(field.sh_bands * field.sh_bands) + " SH coefficients x 4 B, " +
+                      std::to_string(field.directions) + " rays per point (brf_preset)"};
 }
 
 std::string estimate_line(double seconds, std::uint64_t bytes) {
@@ -150,10 +341,9 @@ std::string format_bytes(std::uint64_t b) {
   return fixed(v / 1e9, 2) + " GB";
 }
 
-EffectPlan plan(const engine::Scene& scene, const PlanOptions& options) {
-  const engine::Registry& reg = scene.registry;
+EffectPlan plan(const BakeInput& input, const PlanOptions& options) {
   EffectPlan out;
-  out.scene = scene.assets.source;
+  out.scene = input.name;
   out.preset = options.preset;
   out.glossy_roughness = options.glossy_roughness;
   for (int i = 0; i < kEffectMethodCount; ++i) {
@@ -162,235 +352,33 @@ EffectPlan plan(const engine::Scene& scene, const PlanOptions& options) {
     e.available = kAvailable[i];
     out.effects.push_back(std::move(e));
   }
-  auto& atlas = out.effects[0];
-  auto& prm = out.effects[1];
-  auto& dlm = out.effects[2];
-  auto& anti = out.effects[3];
-  auto& brf = out.effects[4];
-  SceneFacts& facts = out.facts;
+  const PlanFacts f = gather_facts(input, options, out);
+  const std::optional<PlanPresets> p = presets(options);
+  if (!p) out.warnings.push_back("unknown preset '" + options.preset + "' (preview, medium, high): no estimates");
 
-  EntityNodes nodes;
-  for (std::size_t i = 0; i < scene.node_entities.size(); ++i)
-    if (!scene.node_entities[i].is_null()) nodes.node_of[scene.node_entities[i].index] = static_cast<int>(i);
-
-  // Lights.
-  std::vector<std::string> static_lights, moving_lights, moving_why;
-  LightPointCount points;
-  reg.view<engine::Light>().each([&](engine::Entity e, const engine::Light& light) {
-    if (!light.enabled) {
-      ++facts.disabled_lights;
-      return;
-    }
-    const std::string name = name_of(reg, e);
-    bool only_by_node = false;
-    const std::string why = why_light_moves(scene, nodes, e, light, name, options, &only_by_node);
-    if (!why.empty()) {
-      moving_lights.push_back(name);
-      moving_why.push_back(why);
-      if (only_by_node)
-        out.warnings.push_back("light '" + name + "' " + why +
-                               " but is not flagged light_moves: the light atlas would bake it "
-                               "as static; set gi.light_moves");
-      return;
-    }
-    static_lights.push_back(name);
-    if (light.type == engine::LightType::Area)
-      ++points.sampled;
-    else if (light.type == engine::LightType::Directional)
-      ++points.directional;
-    else
-      ++points.punctual;
-  });
-  facts.static_lights = static_cast<int>(static_lights.size());
-  facts.moving_lights = static_cast<int>(moving_lights.size());
-
-  // Meshes.
-  std::vector<std::string> static_meshes, emissive_meshes, glossy, glossy_why, deforming;
-  std::map<std::uint32_t, std::vector<std::string>> dynamic_by_mesh;  // mesh -> entities
-  reg.view<engine::MeshRenderer>().each([&](engine::Entity e, const engine::MeshRenderer& mr) {
-    const std::string name = name_of(reg, e);
-    // Deforming regions: the flagged node and every mesh below it.
-    for (engine::Entity a = e; !a.is_null() && reg.valid(a);) {
-      const int n = nodes.node(a);
-      if (n >= 0 && scene.assets.nodes[static_cast<std::size_t>(n)].gi.region == engine::GiRegion::Deforming) {
-        deforming.push_back(name);
-        break;
-      }
-      const engine::Transform* t = reg.try_get<engine::Transform>(a);
-      a = t ? t->parent : engine::Entity{};
-    }
-    if (reg.has<engine::DynamicTag>(e)) {
-      ++facts.dynamic_meshes;
-      dynamic_by_mesh[mr.mesh].push_back(name);
-      return;
-    }
-    ++facts.static_meshes;
-    static_meshes.push_back(name);
-    if (emissive(scene.assets, mr)) emissive_meshes.push_back(name);
-    const auto [roughness, material] = min_roughness(scene.assets, mr);
-    if (roughness < options.glossy_roughness) {
-      glossy.push_back(name);
-      glossy_why.push_back("'" + name + "' (" + material + ") has roughness " + fixed(roughness, 2));
-    }
-  });
-  facts.emissive_surfaces = static_cast<int>(emissive_meshes.size());
-  points.sampled += 2 * facts.emissive_surfaces;  // emissive quads: two triangles each, typically
-
-  const StaticSurfaceCensus census = census_static_surfaces(scene);
-  facts.static_area_m2 = census.area_m2;
-  facts.static_albedo = census.albedo;
-
-  // Presets (the bakers' own), with gi-bake's overrides.
-  auto atlas_settings = light_atlas_preset(options.preset);
-  auto prm_settings = prm_preset(options.preset);
-  const bool estimates = atlas_settings && prm_settings;
-  if (!estimates)
-    out.warnings.push_back("unknown preset '" + options.preset + "' (preview, medium, high): no estimates");
-  if (estimates) {
-    if (options.texels_per_metre > 0.0f)
-      atlas_settings->texels_per_metre = prm_settings->texels_per_metre = options.texels_per_metre;
-    if (options.vpls > 0) atlas_settings->vpl_count = options.vpls;
-    if (options.samples_per_vpl > 0) atlas_settings->samples_per_vpl = options.samples_per_vpl;
-    if (options.bounces > 0) atlas_settings->bounces = options.bounces;
-  }
-
-  const bool any_light = !static_lights.empty() || !moving_lights.empty() || !emissive_meshes.empty();
-  if (!any_light) {
+  if (f.static_lights.empty() && f.moving_lights.empty() && f.emissive_meshes.empty()) {
     const std::string why =
-        facts.disabled_lights > 0
-            ? "no light is on (" + plural(static_cast<std::size_t>(facts.disabled_lights), "light is", "lights are") +
+        out.facts.disabled_lights > 0
+            ? "no light is on (" +
+                  plural(static_cast<std::size_t>(out.facts.disabled_lights), "light is", "lights are") +
                   " switched off) and no surface is emissive: nothing to bake"
             : "the scene has no light and no emissive surface: nothing to bake";
     for (PlannedEffect& e : out.effects) e.reason = why;
     return out;
   }
-
-  // Light atlas: static light sources on static geometry.
-  const std::size_t static_sources = static_lights.size() + emissive_meshes.size();
-  if (static_sources > 0 && !static_meshes.empty()) {
-    atlas.enabled = true;
-    const std::string area = fixed(census.area_m2, 1) + " m^2";
-    const std::string meshes = plural(static_meshes.size(), "static mesh", "static meshes");
-    const std::string emitting = plural(emissive_meshes.size(), "emissive surface", "emissive surfaces");
-    if (static_lights.empty()) {
-      atlas.reason = emitting + (emissive_meshes.size() == 1 ? " lights " : " light ") + meshes + " (" + area + ")";
-    } else {
-      atlas.reason = plural(static_lights.size(), "static light", "static lights") +
-                     (static_lights.size() == 1 ? " lights " : " light ") + meshes + " (" + area +
-                     (emissive_meshes.empty() ? "" : "; " + emitting + " too") + ")";
-    }
-    atlas.targets = static_meshes;
-    if (estimates) {
-      const BakeWork w = light_atlas_work(census, *atlas_settings, points);
-      const AtlasTexelEstimate t = atlas_texels(census, atlas_settings->texels_per_metre);
-      atlas.estimate = {w.bake_seconds, w.runtime_bytes, static_cast<std::uint64_t>(t.lit_texels),
-                        fixed(census.area_m2, 1) + " m^2 x " + fixed(atlas_settings->texels_per_metre, 0) +
-                            "^2 texels/m^2 -> ~" + std::to_string(static_cast<long long>(t.lit_texels)) +
-                            " texels (atlas " + std::to_string(t.width) + "x" + std::to_string(t.height) + ") x " +
-                            std::to_string(atlas_settings->vpl_count) + " VPLs, " +
-                            std::to_string(atlas_settings->bounces) + " bounces"};
-    }
-  } else if (static_meshes.empty()) {
-    atlas.reason = "no static mesh: nothing for a light atlas to hold";
-  } else {
-    atlas.reason =
-        "no static light (" + plural(moving_lights.size(), "light moves", "lights move") + ") -> no light atlas";
-  }
-
-  // PRM: moving lights over static geometry.
-  if (!moving_lights.empty() && !static_meshes.empty()) {
-    prm.enabled = true;
-    std::vector<std::string> parts;
-    for (std::size_t i = 0; i < moving_lights.size() && i < 3; ++i)
-      parts.push_back("light '" + moving_lights[i] + "' moves (" + moving_why[i] + ")");
-    prm.reason =
-        list_names(parts, 3) + " -> PRM panes over " + plural(static_meshes.size(), "static mesh", "static meshes");
-    prm.targets = static_meshes;
-    if (estimates) {
-      double nodes_est = 0.0;
-      const BakeWork w = prm_work(census, *prm_settings, &nodes_est);
-      const AtlasTexelEstimate t = atlas_texels(census, prm_settings->texels_per_metre);
-      prm.estimate = {w.bake_seconds, w.runtime_bytes, static_cast<std::uint64_t>(nodes_est),
-                      std::to_string(prm_settings->entry_points) + " entry points x N_s " +
-                          fixed(prm_settings->splitting, 0) + " at albedo " + fixed(census.albedo, 2) + " -> ~" +
-                          std::to_string(static_cast<long long>(nodes_est)) + " path nodes x ~" +
-                          std::to_string(static_cast<long long>(t.pane_texels)) + " pane texels; " +
-                          std::to_string(prm_settings->clusters) + " panes as half floats"};
-    }
-  } else if (moving_lights.empty()) {
-    prm.reason = "no light moves -> no PRM panes";
-  } else {
-    prm.reason = "lights move but there is no static mesh to relight";
-  }
-
-  // Directional light maps: glossy static surfaces.
-  const std::string threshold = fixed(options.glossy_roughness, 2);
-  if (!glossy.empty()) {
-    dlm.enabled = true;
-    dlm.reason = "static surface " + list_names(glossy_why, 2) + " < " + threshold + " -> directional light maps";
-    dlm.targets = glossy;
-  } else {
-    dlm.reason = "no static surface has roughness < " + threshold + " -> no directional maps";
-  }
-
-  // Antiradiance: flagged deforming or opening regions.
-  if (!deforming.empty()) {
-    anti.enabled = true;
-    anti.reason = plural(deforming.size(), "mesh is", "meshes are") + " flagged gi.region \"deforming\" (" +
-                  quoted_list(deforming) + ") -> antiradiance for that region";
-    anti.targets = deforming;
-  } else {
-    anti.reason = "no node is flagged gi.region \"deforming\" -> no antiradiance";
-  }
-
-  // Basis radiance fields: the meshes of dynamic entities, once per mesh.
-  if (!dynamic_by_mesh.empty()) {
-    brf.enabled = true;
-    std::vector<std::string> mesh_names, glossy_meshes;
-    std::size_t vertices = 0, triangles = 0;
-    BakeWork total;
-    const auto brf_settings = brf_preset(options.preset);
-    const PcaBasisSettings basis = brf_settings ? brf_settings->basis : PcaBasisSettings{};
-    const RadianceFieldSettings field = brf_settings ? brf_settings->field : RadianceFieldSettings{};
-    for (const auto& [mesh, users] : dynamic_by_mesh) {
-      if (mesh >= scene.assets.meshes.size()) continue;
-      const engine::Mesh& m = scene.assets.meshes[mesh];
-      mesh_names.push_back(m.name.empty() ? "mesh " + std::to_string(mesh) : m.name);
-      std::size_t v = 0, t = 0;
-      for (const engine::Primitive& p : m.primitives) v += p.positions.size(), t += p.indices.size() / 3;
-      vertices += v, triangles += t;
-      // A glossy material (brf_glossy_lobe) multiplies the field by 1 + its terms; the
-      // separation may keep one more term to keep an azimuthal pair whole.
-      const int material = m.primitives.empty() ? -1 : m.primitives.front().material;
-      const bool is_glossy = material >= 0 && static_cast<std::size_t>(material) < scene.assets.materials.size() &&
-                          brf_glossy_lobe(scene.assets.materials[static_cast<std::size_t>(material)]).has_value();
-      const int terms = is_glossy ? 2 + (brf_settings ? brf_settings->glossy.terms : 4) : 1;
-      if (is_glossy) glossy_meshes.push_back(mesh_names.back());
-      const BakeWork w = brf_work(v, t, basis, field, terms);
-      total.bake_seconds += w.bake_seconds;
-      total.runtime_bytes += w.runtime_bytes;
-      total.units += w.units;
-    }
-    brf.reason =
-        plural(static_cast<std::size_t>(facts.dynamic_meshes), "dynamic entity uses ", "dynamic entities use ") +
-        plural(mesh_names.size(), "mesh", "meshes") + " (" + list_names(mesh_names) +
-        ") -> a basis and a field per mesh" +
-        (glossy_meshes.empty() ? std::string()
-                               : "; glossy metal (" + list_names(glossy_meshes) + ") -> its lobe in separable terms");
-    brf.targets = mesh_names;
-    brf.estimate = {total.bake_seconds, total.runtime_bytes, static_cast<std::uint64_t>(total.units),
-                    std::to_string(mesh_names.size()) + " meshes, " + std::to_string(vertices) +
-                        " vertices; per mesh " + std::to_string(field.spheres) + " spheres x 6 x " +
-                        std::to_string(field.face_resolution) + "^2 points x " + std::to_string(basis.basis) +
-                        " functions x " + std::to_string(field.sh_bands * field.sh_bands) +
-                        " SH coefficients x 4 B, " + std::to_string(field.directions) + " rays per point (brf_preset)"};
-  } else {
-    brf.reason = "no dynamic mesh -> no basis radiance fields";
-  }
-
+  plan_light_atlas(f, p, out.effects[static_cast<int>(EffectMethod::LightAtlas)]);
+  plan_prm(f, p, out.effects[static_cast<int>(EffectMethod::Prm)]);
+  plan_dlm(f, options, out.effects[static_cast<int>(EffectMethod::DirectionalLightMaps)]);
+  plan_antiradiance(f, out.effects[static_cast<int>(EffectMethod::Antiradiance)]);
+  plan_brf(input, f, options, out.facts.dynamic_meshes,
+           out.effects[static_cast<int>(EffectMethod::BasisRadianceFields)]);
   for (PlannedEffect& e : out.effects)
     if (!e.enabled || !e.available) e.estimate = {};
   return out;
+}
+
+EffectPlan plan(const engine::Scene& scene, const PlanOptions& options) {
+  return plan(bake_input_from(scene), options);
 }
 
 std::string format_plan(const EffectPlan& p) {

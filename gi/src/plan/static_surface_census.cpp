@@ -99,47 +99,42 @@ void add_instance_charts(const std::vector<Triangle>& tris, std::vector<ChartExt
   }
 }
 
-double luminance(const glm::vec4& c) { return 0.2126 * double{c.x} + 0.7152 * double{c.y} + 0.0722 * double{c.z}; }
+double luminance(const glm::vec3& c) { return 0.2126 * double{c.x} + 0.7152 * double{c.y} + 0.0722 * double{c.z}; }
 
 }  // namespace
 
-StaticSurfaceCensus census_static_surfaces(const engine::Scene& scene) {
+StaticSurfaceCensus census_static_surfaces(const BakeInput& input) {
   StaticSurfaceCensus census;
   double albedo_area = 0.0;
-  const engine::SceneAsset& assets = scene.assets;
-  scene.registry.view<engine::MeshRenderer, engine::WorldTransform>().each(
-      [&](engine::Entity e, const engine::MeshRenderer& mr, const engine::WorldTransform& wt) {
-        if (scene.registry.has<engine::DynamicTag>(e) || mr.mesh >= assets.meshes.size()) return;
-        const glm::dmat4 m(wt.matrix);
-        std::vector<Triangle> tris;
-        for (const engine::Primitive& prim : assets.meshes[mr.mesh].primitives) {
-          const int mi = mr.material_override >= 0 ? mr.material_override : prim.material;
-          const glm::vec4 base = mi >= 0 && static_cast<std::size_t>(mi) < assets.materials.size()
-                                     ? assets.materials[static_cast<std::size_t>(mi)].base_color
-                                     : glm::vec4(1.0f);
-          const auto corner = [&](std::size_t k) {
-            const std::size_t i = prim.indices.empty() ? k : prim.indices[k];
-            return i < prim.positions.size() ? glm::dvec3(m * glm::dvec4(glm::dvec3(prim.positions[i]), 1.0))
-                                             : glm::dvec3(0.0);
-          };
-          const std::size_t corners = prim.indices.empty() ? prim.positions.size() : prim.indices.size();
-          for (std::size_t k = 0; k + 2 < corners; k += 3) {
-            Triangle t{{corner(k), corner(k + 1), corner(k + 2)}, glm::dvec3(0.0), 0.0, 0};
-            const glm::dvec3 c = glm::cross(t.p[1] - t.p[0], t.p[2] - t.p[0]);
-            const double len = glm::length(c);
-            if (!(len > 0.0) || !std::isfinite(len)) continue;
-            t.area = 0.5 * len;
-            t.normal = c / len;
-            std::uint64_t key = 0x51ed270b27d3c8f1ull;
-            for (int a = 0; a < 3; ++a) key = mix(key, cell(t.normal[a], 1.0 / kNormalCells));
-            t.plane = mix(key, cell(glm::dot(t.normal, t.p[0]), kOffsetCell_m));
-            census.area_m2 += t.area;
-            albedo_area += luminance(base) * t.area;
-            tris.push_back(t);
-          }
-        }
-        add_instance_charts(tris, census.charts);
-      });
+  for (const BakeInstance& inst : input.instances) {
+    if (inst.mobility != BakeMobility::Static || inst.mesh >= input.meshes.size()) continue;
+    const glm::dmat4 m(inst.object_to_world);
+    std::vector<Triangle> tris;
+    for (const BakePrimitive& prim : input.meshes[inst.mesh].primitives) {
+      const glm::vec3 base = bake_material(input, inst, prim).base_color;
+      const auto corner = [&](std::size_t k) {
+        const std::size_t i = prim.indices.empty() ? k : prim.indices[k];
+        return i < prim.positions.size() ? glm::dvec3(m * glm::dvec4(glm::dvec3(prim.positions[i]), 1.0))
+                                         : glm::dvec3(0.0);
+      };
+      const std::size_t corners = prim.indices.empty() ? prim.positions.size() : prim.indices.size();
+      for (std::size_t k = 0; k + 2 < corners; k += 3) {
+        Triangle t{{corner(k), corner(k + 1), corner(k + 2)}, glm::dvec3(0.0), 0.0, 0};
+        const glm::dvec3 c = glm::cross(t.p[1] - t.p[0], t.p[2] - t.p[0]);
+        const double len = glm::length(c);
+        if (!(len > 0.0) || !std::isfinite(len)) continue;
+        t.area = 0.5 * len;
+        t.normal = c / len;
+        std::uint64_t key = 0x51ed270b27d3c8f1ull;
+        for (int a = 0; a < 3; ++a) key = mix(key, cell(t.normal[a], 1.0 / kNormalCells));
+        t.plane = mix(key, cell(glm::dot(t.normal, t.p[0]), kOffsetCell_m));
+        census.area_m2 += t.area;
+        albedo_area += luminance(base) * t.area;
+        tris.push_back(t);
+      }
+    }
+    add_instance_charts(tris, census.charts);
+  }
   census.albedo = census.area_m2 > 0.0 ? albedo_area / census.area_m2 : 0.0;
   return census;
 }

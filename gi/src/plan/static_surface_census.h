@@ -3,10 +3,10 @@
 // scene (no ray traced, no layout built): world-space area, mean albedo, and an estimate of
 // the light-atlas charts (near-coplanar connected pieces of each static instance, with the
 // extent of each in its plane).
-//   gi::StaticSurfaceCensus c = gi::census_static_surfaces(scene);
+//   gi::StaticSurfaceCensus c = gi::census_static_surfaces(input);
 //   double texels = c.area_m2 * d * d;  // the plain estimate; charts add their rims
 
-#include <engine/scene.h>
+#include <gi/bake_input.h>
 
 #include <cstdint>
 #include <vector>
@@ -26,7 +26,7 @@ struct StaticSurfaceCensus {
   std::vector<ChartExtent> charts;
 };
 
-/// The static mesh entities of `scene` (MeshRenderer + WorldTransform, no DynamicTag).
-StaticSurfaceCensus census_static_surfaces(const engine::Scene& scene);
+/// The Static instances of `input`.
+StaticSurfaceCensus census_static_surfaces(const BakeInput& input);
 
 }  // namespace gi

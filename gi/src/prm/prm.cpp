@@ -7,13 +7,13 @@
 #include <numbers>
 #include <unordered_map>
 
-#include "transport/static_scene.h"
 #include "core/random.h"
 #include "core/thread_pool.h"
-#include "transport/point_emitters.h"
-#include "transport/vpl_set.h"
 #include "prm/entry_clusters.h"
 #include "raytrace/ray_offset.h"
+#include "transport/point_emitters.h"
+#include "transport/static_scene.h"
+#include "transport/vpl_set.h"
 #include "uv/atlas_density.h"
 #include "uv/atlas_dilation.h"
 #include "uv/atlas_input.h"
@@ -25,12 +25,13 @@ using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 engine::Status validate(const PrmSettings& s) {
-  const auto bad = [](std::string what) { return engine::Error{.message = "PRM settings: " + what}; };
+  const auto bad = [](std::string what) { return engine::invalid_request("PRM settings: " + what); };
   if (!(s.texels_per_metre > 0.0f) || s.texels_per_metre > kMaxTexelsPerMetre)
     return bad("texels_per_metre " + std::to_string(s.texels_per_metre) + " is outside (0, 10^4]");
   if (s.entry_points < 1 || s.entry_points > 1'000'000)
     return bad("entry_points " + std::to_string(s.entry_points) + " is outside 1..10^6");
-  if (s.clusters < 1 || s.clusters > 65536) return bad("clusters " + std::to_string(s.clusters) + " is outside 1..65536");
+  if (s.clusters < 1 || s.clusters > 65536)
+    return bad("clusters " + std::to_string(s.clusters) + " is outside 1..65536");
   if (!(s.splitting > 0.0f) || s.splitting > 1024.0f) return bad("splitting must be in (0, 1024]");
   if (s.max_path_nodes < 1 || s.max_path_nodes > 4096) return bad("max_path_nodes must be in 1..4096");
   return {};
@@ -93,14 +94,15 @@ std::vector<PathNode> random_walks(const VplSet& entries, std::size_t k, const S
 
 }  // namespace
 
-engine::Result<Prm> bake_prm(const engine::Scene& scene, const PrmSettings& settings) {
+engine::Result<Prm> bake_prm(const BakeInput& input, const PrmSettings& settings) {
   if (auto ok = validate(settings); !ok) return ok.error();
+  if (auto ok = validate_bake_input(input); !ok) return ok.error();
   const auto t_start = Clock::now();
-  const std::vector<AtlasInputMesh> inputs = atlas_inputs_from(scene.assets);
+  const std::vector<AtlasInputMesh> inputs = atlas_inputs_from(input);
   if (auto ok = validate_atlas_inputs(inputs); !ok) return ok.error();
   auto layout = build_atlas_layout(inputs, {.texels_per_metre = settings.texels_per_metre});
   if (!layout) return layout.error();
-  auto prepared = prepare_static_scene(scene, *layout, BakeLights::None);
+  auto prepared = prepare_static_scene(input, *layout, BakeLights::None);
   if (!prepared) return prepared.error();
   const StaticBakeScene& s = *prepared;
   ThreadPool pool(settings.threads);
@@ -113,7 +115,8 @@ engine::Result<Prm> bake_prm(const engine::Scene& scene, const PrmSettings& sett
 
   // Entry points: stratified by area over the static surfaces (one sample per patch of the
   // VPL distribution, so every chart keeps its exact area).
-  auto entries = distribute_vpls(s.scene, s.index, {.vpl_count = settings.entry_points, .samples_per_vpl = 1, .seed = settings.seed});
+  auto entries = distribute_vpls(s.scene, s.index,
+                                 {.vpl_count = settings.entry_points, .samples_per_vpl = 1, .seed = settings.seed});
   if (!entries) return entries.error();
   const std::size_t n_entries = entries->size();
   std::unordered_map<std::uint32_t, glm::vec3> material_albedo;
@@ -121,13 +124,15 @@ engine::Result<Prm> bake_prm(const engine::Scene& scene, const PrmSettings& sett
   for (std::size_t t = 0; t < triangle_albedo.size(); ++t) {
     const std::uint32_t m = s.index.triangles[t].material;
     auto it = material_albedo.find(m);
-    if (it == material_albedo.end()) it = material_albedo.emplace(m, engine::gltf_hemispherical_albedo(s.scene.materials[m].brdf).sum()).first;
+    if (it == material_albedo.end())
+      it = material_albedo.emplace(m, engine::gltf_hemispherical_albedo(s.scene.materials[m].brdf).sum()).first;
     triangle_albedo[t] = it->second;
   }
 
   // Clusters: the normal counts like a tenth of the scene's size.
-  const auto cluster_of = cluster_entry_points(entries->position, entries->normal, settings.clusters,
-                                               0.1f * std::max(s.index.scene_radius_m, 1e-6f), settings.kmeans ? 10 : 0);
+  const auto cluster_of =
+      cluster_entry_points(entries->position, entries->normal, settings.clusters,
+                           0.1f * std::max(s.index.scene_radius_m, 1e-6f), settings.kmeans ? 10 : 0);
   prm.cluster_count = 0;
   for (std::uint32_t c : cluster_of) prm.cluster_count = std::max(prm.cluster_count, static_cast<int>(c) + 1);
   prm.cluster_size.assign(static_cast<std::size_t>(prm.cluster_count), 0);
@@ -150,7 +155,7 @@ engine::Result<Prm> bake_prm(const engine::Scene& scene, const PrmSettings& sett
     prm.stats.path_nodes += walks[k].size();
   }
   prm.stats.walk_seconds = seconds_since(t0);
-  if (settings.progress && !settings.progress(0.05)) return engine::Error{.message = "PRM bake cancelled"};
+  if (settings.progress && !settings.progress(0.05)) return engine::cancelled_error("PRM bake");
 
   // Items (eq. 3): every virtual light connected to every reference point it sees, summed
   // per (cluster, texel). Parallel over texels; each texel visits the nodes in a fixed
@@ -181,7 +186,8 @@ engine::Result<Prm> bake_prm(const engine::Scene& scene, const PrmSettings& sett
               const float f = lambertian_kernel(v.position, v.normal, area, false, p, n, 0.0f);
               if (f <= 0.0f) continue;
               ++local;
-              if (segment_visible(*s.caster, p, n, v.position, v.normal)) item += glm::dvec3(v.power) * static_cast<double>(f);
+              if (segment_visible(*s.caster, p, n, v.position, v.normal))
+                item += glm::dvec3(v.power) * static_cast<double>(f);
             }
             sum[prm.entries[k].cluster] += item;
           }
@@ -190,7 +196,7 @@ engine::Result<Prm> bake_prm(const engine::Scene& scene, const PrmSettings& sett
         },
         4);
     if (settings.progress && !settings.progress(0.05 + 0.9 * static_cast<double>(b + 1) / static_cast<double>(batches)))
-      return engine::Error{.message = "PRM bake cancelled"};
+      return engine::cancelled_error("PRM bake");
   }
   prm.stats.rays += rays.load();
 
@@ -207,7 +213,8 @@ engine::Result<Prm> bake_prm(const engine::Scene& scene, const PrmSettings& sett
   for (std::size_t c = 0; c < clusters; ++c)
     for (std::size_t i = 0; i < prm.texels.size(); ++i)
       for (int ch = 0; ch < 3; ++ch)
-        prm.panes[(c * prm.texels.size() + i) * 3 + static_cast<std::size_t>(ch)] = full[c * tex.valid.size() + prm.texels[i]][ch];
+        prm.panes[(c * prm.texels.size() + i) * 3 + static_cast<std::size_t>(ch)] =
+            full[c * tex.valid.size() + prm.texels[i]][ch];
   prm.stats.pane_seconds = seconds_since(t0);
   prm.stats.total_seconds = seconds_since(t_start);
   return prm;
@@ -215,7 +222,8 @@ engine::Result<Prm> bake_prm(const engine::Scene& scene, const PrmSettings& sett
 
 engine::Result<PrmSettings> prm_preset(std::string_view name) {
   auto density = atlas_density_preset(name);
-  if (!density) return engine::Error{.message = "unknown PRM preset '" + std::string(name) + "' (preview, medium, high)"};
+  if (!density)
+    return engine::invalid_request("unknown PRM preset '" + std::string(name) + "' (preview, medium, high)");
   PrmSettings s;
   s.texels_per_metre = *density;
   if (name == "preview") {

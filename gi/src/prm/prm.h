@@ -11,15 +11,14 @@
 //   std::vector<float> w = gi::cluster_weights(prm, light, visibility);
 //   std::vector<glm::vec3> atlas = gi::sum_panes(prm, gi::select_clusters(w, 32));
 
+#include <engine/result.h>
+#include <gi/bake_input.h>
+#include <gi/progress.h>
+
 #include <cstdint>
+#include <glm/glm.hpp>
 #include <string_view>
 #include <vector>
-
-#include <glm/glm.hpp>
-
-#include <engine/result.h>
-#include <engine/scene.h>
-#include <gi/progress.h>
 
 #include "uv/atlas_layout.h"
 
@@ -81,8 +80,8 @@ struct Prm {
 /// light atlas preset of the same name, so both share one uv1 layout.
 engine::Result<PrmSettings> prm_preset(std::string_view name);
 
-/// Bakes the PRM of the static meshes of `scene`. Errors: no static geometry, settings out
+/// Bakes the PRM of the Static instances of `input`. Errors: no static geometry, settings out
 /// of range, cancelled.
-engine::Result<Prm> bake_prm(const engine::Scene& scene, const PrmSettings& settings);
+engine::Result<Prm> bake_prm(const BakeInput& input, const PrmSettings& settings);
 
 }  // namespace gi

@@ -76,7 +76,9 @@ std::string check_prm(const Prm& p) {
     if (!std::isfinite(v) || v < 0.0f) {
       const std::size_t c = j / (3 * n), i = (j / 3) % n;
       return "pane " + str(c) + " texel " + str(p.texels[i]) + " channel " + str(j % 3) + " is " +
-             (std::isnan(v) ? "NaN" : !std::isfinite(v) ? "infinite" : "negative (" + std::to_string(v) + ")") +
+             (std::isnan(v)       ? "NaN"
+              : !std::isfinite(v) ? "infinite"
+                                  : "negative (" + std::to_string(v) + ")") +
              ": panes must be finite and non-negative";
     }
   }
@@ -168,7 +170,8 @@ std::string encode_panes(const Prm& p, std::vector<float>& scales, std::vector<s
   planes.assign(total * 2, std::byte{0});
   for (std::size_t c = 0; c < scales.size(); ++c) {
     const auto first = p.panes.begin() + static_cast<std::ptrdiff_t>(c * per_pane);
-    const float max_value = per_pane == 0 ? 0.0f : *std::max_element(first, first + static_cast<std::ptrdiff_t>(per_pane));
+    const float max_value =
+        per_pane == 0 ? 0.0f : *std::max_element(first, first + static_cast<std::ptrdiff_t>(per_pane));
     const float scale = pane_scale(max_value);
     scales[c] = scale;
     for (std::size_t j = c * per_pane; j < (c + 1) * per_pane; ++j) {
@@ -295,9 +298,9 @@ engine::Result<PrmPaneFile> read_prm_panes(const fs::path& path) {
   const bool complete = r.get_string(f.geometry_hash) && r.get(s.texels_per_metre) && r.get(entry_points) &&
                         r.get(clusters) && r.get(s.splitting) && r.get(max_path_nodes) && r.get(kmeans) &&
                         r.get(seed) && r.get(threads) && r.get(width) && r.get(height) && r.get(cluster_count) &&
-                        r.get_array(p.texels) && r.get_array(position) && r.get_array(normal) &&
-                        r.get_array(area) && r.get_array(cluster) && r.get_array(p.cluster_size) &&
-                        r.get_array(scales) && r.get(pane_half_bytes) && r.get_array(frame);
+                        r.get_array(p.texels) && r.get_array(position) && r.get_array(normal) && r.get_array(area) &&
+                        r.get_array(cluster) && r.get_array(p.cluster_size) && r.get_array(scales) &&
+                        r.get(pane_half_bytes) && r.get_array(frame);
   const std::string location = "payload byte " + std::to_string(r.offset());
   if (!complete) return file_error(path, location, "truncated payload");
   if (r.remaining() != 0) return file_error(path, location, "unexpected data after the last field");
@@ -329,8 +332,9 @@ engine::Result<PrmPaneFile> read_prm_panes(const fs::path& path) {
                           " elements for " + std::to_string(cluster_count) + " clusters");
   for (std::size_t c = 0; c < scales.size(); ++c)
     if (!is_power_of_two(scales[c]))
-      return file_error(path, "pane_scale", "the scale of pane " + str(c) + " (" + std::to_string(scales[c]) +
-                                                ") is not a positive power of two");
+      return file_error(
+          path, "pane_scale",
+          "the scale of pane " + str(c) + " (" + std::to_string(scales[c]) + ") is not a positive power of two");
   const std::uint64_t values = static_cast<std::uint64_t>(cluster_count) * p.texels.size() * 3;
   if (pane_half_bytes != values * 2)
     return file_error(path, "pane_half_bytes",
@@ -356,8 +360,7 @@ engine::Result<PrmPaneFile> read_prm_panes(const fs::path& path) {
   if (ZSTD_isError(unpacked) != 0)
     return file_error(path, "panes", std::string("zstd decompression failed: ") + ZSTD_getErrorName(unpacked));
   if (unpacked != planes.size())
-    return file_error(path, "panes",
-                      "decompressed " + str(unpacked) + " bytes, " + str(planes.size()) + " expected");
+    return file_error(path, "panes", "decompressed " + str(unpacked) + " bytes, " + str(planes.size()) + " expected");
 
   const std::size_t total = static_cast<std::size_t>(values);
   const std::size_t per_pane = p.texels.size() * 3;
@@ -374,14 +377,14 @@ engine::Result<PrmPaneFile> read_prm_panes(const fs::path& path) {
   return f;
 }
 
-engine::Status save_prm(const fs::path& bundle_dir, const Prm& prm, const engine::SceneAsset& asset,
-                        const std::string& scene_name) {
+engine::Status save_prm(const fs::path& bundle_dir, const Prm& prm, const BakeInput& input) {
+  const std::string scene_name = fs::path(input.name).filename().string();
   const fs::path panes = bundle_dir / kPrmPanesFile;
   if (prm.width != prm.layout.width || prm.height != prm.layout.height)
     return file_error(panes, "",
-                      "cannot save the PRM: its size " + std::to_string(prm.width) + "x" +
-                          std::to_string(prm.height) + " differs from its layout's " +
-                          std::to_string(prm.layout.width) + "x" + std::to_string(prm.layout.height));
+                      "cannot save the PRM: its size " + std::to_string(prm.width) + "x" + std::to_string(prm.height) +
+                          " differs from its layout's " + std::to_string(prm.layout.width) + "x" +
+                          std::to_string(prm.layout.height));
   // Checked before the directory is made, so a bad PRM leaves nothing behind.
   if (std::string problem = check_prm(prm); !problem.empty())
     return file_error(panes, "", "cannot save the PRM: " + problem);
@@ -389,7 +392,7 @@ engine::Status save_prm(const fs::path& bundle_dir, const Prm& prm, const engine
   fs::create_directories(bundle_dir, ec);
   if (ec) return engine::Error{bundle_dir.string(), "", "cannot create the bundle directory: " + ec.message()};
 
-  const std::string geometry_hash = scene_geometry_hash(asset);
+  const std::string geometry_hash = scene_geometry_hash(input);
   if (engine::Status s = write_prm_panes(panes, prm, geometry_hash); !s) return s;
   auto sum = file_checksum(panes);
   if (!sum) return sum.error();
@@ -414,13 +417,13 @@ engine::Status save_prm(const fs::path& bundle_dir, const Prm& prm, const engine
   return update_manifest_method(bundle_dir, geometry_hash, scene_name, kPrmMethod, entry);
 }
 
-engine::Result<Prm> load_prm(const fs::path& bundle_dir, const engine::SceneAsset& asset) {
+engine::Result<Prm> load_prm(const fs::path& bundle_dir, const BakeInput& input) {
   auto manifest = read_manifest(bundle_dir);
   if (!manifest) return manifest.error();
   const fs::path manifest_file = bundle_dir / kManifestFileName;
-  const std::string scene_hash = scene_geometry_hash(asset);
+  const std::string scene_hash = scene_geometry_hash(input);
   if (manifest->geometry_hash != scene_hash) {
-    const std::string scene = asset.source.empty() ? std::string("the scene") : asset.source;
+    const std::string scene = input.name.empty() ? std::string("the scene") : input.name;
     return engine::Error{manifest_file.string(), "geometry_hash",
                          "stale bundle " + bundle_dir.string() + ": baked from geometry " + manifest->geometry_hash +
                              ", but " + scene + " hashes to " + scene_hash + " (re-bake the PRM)"};
@@ -450,7 +453,7 @@ engine::Result<Prm> load_prm(const fs::path& bundle_dir, const engine::SceneAsse
                              std::to_string(prm.width) + "x" + std::to_string(prm.height)};
 
   auto layout = build_atlas_layout(
-      atlas_inputs_from(asset),
+      atlas_inputs_from(input),
       AtlasSettings{.texels_per_metre = entry->requested_texels_per_metre, .padding_texels = entry->padding_texels});
   if (!layout) {
     engine::Error e = layout.error();
@@ -460,10 +463,9 @@ engine::Result<Prm> load_prm(const fs::path& bundle_dir, const engine::SceneAsse
   if (layout->width != entry->width || layout->height != entry->height ||
       layout->texels_per_metre != entry->texels_per_metre)
     return engine::Error{manifest_file.string(), prefix + ".layout",
-                         "the rebuilt layout (" + std::to_string(layout->width) + "x" +
-                             std::to_string(layout->height) + ") differs from the baked one (" +
-                             std::to_string(entry->width) + "x" + std::to_string(entry->height) +
-                             "); the atlas code changed since the bake (re-bake)"};
+                         "the rebuilt layout (" + std::to_string(layout->width) + "x" + std::to_string(layout->height) +
+                             ") differs from the baked one (" + std::to_string(entry->width) + "x" +
+                             std::to_string(entry->height) + "); the atlas code changed since the bake (re-bake)"};
   prm.layout = std::move(layout).value();
   prm.stats = entry->stats;
   return std::move(file->prm);

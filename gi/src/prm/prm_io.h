@@ -1,7 +1,7 @@
 #pragma once
 // Saving a baked PRM (precomputed radiance maps) into a bake bundle and loading it back.
-//   gi::save_prm("level.gibake", prm, asset, "level.gltf");
-//   auto prm = gi::load_prm("level.gibake", asset);   // checks the geometry hash
+//   gi::save_prm("level.gibake", prm, input);
+//   auto prm = gi::load_prm("level.gibake", input);   // checks the geometry hash
 //
 // Files (DESIGN.md §5, docs/bake-bundle.md):
 //   prm_panes.bin   the checksummed container of bake/blob_file.h, magic "GIPRMPAN", version 1.
@@ -45,7 +45,7 @@
 // normals), absolute 1.8e-12 max_c below. Exact zeros stay zero. A pane of zeros has s_c = 1.
 
 #include <engine/result.h>
-#include <engine/scene_asset.h>
+#include <gi/bake_input.h>
 
 #include <cstdint>
 #include <filesystem>
@@ -62,7 +62,7 @@ inline constexpr BlobMagic kPrmPanesMagic{"GIPRMPAN"};
 inline constexpr std::uint32_t kPrmPanesVersion = 1;
 
 /// Relative and pane-relative bounds of the half-float pane storage (see above).
-inline constexpr double kPrmPaneRelativeError = 1.0 / 2048.0;          // 2^-11
+inline constexpr double kPrmPaneRelativeError = 1.0 / 2048.0;               // 2^-11
 inline constexpr double kPrmPaneAbsoluteErrorOfMax = 1.0 / 549755813888.0;  // 2^-39
 
 /// What prm_panes.bin holds: a Prm without its layout (rebuilt from the scene) and stats
@@ -86,15 +86,14 @@ engine::Result<PrmPaneFile> read_prm_panes(const std::filesystem::path& path);
 /// Writes prm_panes.bin into `bundle_dir` (created if needed), then the manifest's "prm"
 /// entry (other methods' entries kept when the manifest has the same geometry hash). Error
 /// when the Prm is inconsistent (see write_prm_panes) or a file cannot be written.
-engine::Status save_prm(const std::filesystem::path& bundle_dir, const Prm& prm, const engine::SceneAsset& asset,
-                        const std::string& scene_name);
+engine::Status save_prm(const std::filesystem::path& bundle_dir, const Prm& prm, const BakeInput& input);
 
-/// Loads the PRM of `bundle_dir` for `asset`: rejects a stale bundle (geometry hash differs
-/// from scene_geometry_hash(asset); the message says "stale" and names both hashes), checks
+/// Loads the PRM of `bundle_dir` for `input`: rejects a stale bundle (geometry hash differs
+/// from scene_geometry_hash(input); the message says "stale" and names both hashes), checks
 /// the file against the manifest's checksum, reads it (read_prm_panes), rebuilds the layout
-/// from atlas_inputs_from(asset) with the manifest's requested density and padding and
+/// from atlas_inputs_from(input) with the manifest's requested density and padding and
 /// checks its size. Every error names the file and the problem.
-engine::Result<Prm> load_prm(const std::filesystem::path& bundle_dir, const engine::SceneAsset& asset);
+engine::Result<Prm> load_prm(const std::filesystem::path& bundle_dir, const BakeInput& input);
 
 /// Float -> IEEE binary16, round to nearest even (overflow gives infinity, NaN stays NaN).
 std::uint16_t float_to_half(float v);

@@ -3,10 +3,12 @@
 #include <span>
 
 #include "uv/atlas_dilation.h"
+#include "uv/atlas_input.h"
+#include "uv/atlas_layout.h"
 
 namespace gi {
 
-engine::Result<AtlasIrradiance> reference_atlas_irradiance(const engine::Scene& scene, const AtlasTexels& texels,
+engine::Result<AtlasIrradiance> reference_atlas_irradiance(const BakeInput& input, const AtlasTexels& texels,
                                                            const ReferenceSettings& settings) {
   std::vector<SurfacePoint> points;
   std::vector<std::size_t> texel_of_point;
@@ -15,7 +17,7 @@ engine::Result<AtlasIrradiance> reference_atlas_irradiance(const engine::Scene& 
     points.push_back({texels.position[i], texels.normal[i]});
     texel_of_point.push_back(i);
   }
-  auto e = reference_irradiance(scene, points, settings);
+  auto e = reference_irradiance(input, points, settings);
   if (!e) return e.error();
 
   AtlasIrradiance out;
@@ -35,6 +37,23 @@ engine::Result<AtlasIrradiance> reference_atlas_irradiance(const engine::Scene& 
   out.total.resize(out.direct.size());
   for (std::size_t i = 0; i < out.total.size(); ++i) out.total[i] = out.direct[i] + out.indirect[i];
   return out;
+}
+
+engine::Result<AtlasReference> reference_atlas(const BakeInput& input, float texels_per_metre,
+                                               const ReferenceSettings& settings) {
+  if (auto ok = validate_bake_input(input); !ok) return ok.error();
+  const std::vector<AtlasInputMesh> inputs = atlas_inputs_from(input);
+  auto layout = build_atlas_layout(inputs, {.texels_per_metre = texels_per_metre});
+  if (!layout) return layout.error();
+  auto truth = reference_atlas_irradiance(input, rasterize_atlas(*layout, inputs), settings);
+  if (!truth) return truth.error();
+  return AtlasReference{.width = truth->width,
+                        .height = truth->height,
+                        .texels_per_metre = layout->texels_per_metre,
+                        .direct = std::move(truth->direct),
+                        .indirect = std::move(truth->indirect),
+                        .total = std::move(truth->total),
+                        .valid = std::move(truth->valid)};
 }
 
 }  // namespace gi

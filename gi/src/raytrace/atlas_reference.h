@@ -6,14 +6,13 @@
 //   auto texels = gi::rasterize_atlas(layout, inputs);
 //   auto truth = gi::reference_atlas_irradiance(scene, texels, {.samples_per_pixel = 256});
 
-#include <cstdint>
-#include <vector>
-
-#include <glm/glm.hpp>
-
 #include <engine/result.h>
-#include <engine/scene.h>
+#include <gi/bake_input.h>
 #include <gi/reference.h>
+
+#include <cstdint>
+#include <glm/glm.hpp>
+#include <vector>
 
 #include "uv/atlas_rasterizer.h"
 
@@ -30,7 +29,7 @@ struct AtlasIrradiance {
 };
 
 /// samples_per_pixel of `settings` is per texel.
-engine::Result<AtlasIrradiance> reference_atlas_irradiance(const engine::Scene& scene, const AtlasTexels& texels,
+engine::Result<AtlasIrradiance> reference_atlas_irradiance(const BakeInput& input, const AtlasTexels& texels,
                                                            const ReferenceSettings& settings);
 
 }  // namespace gi

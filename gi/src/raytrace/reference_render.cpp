@@ -1,12 +1,12 @@
 #include "raytrace/reference_render.h"
 
+#include <engine/components.h>
+
 #include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <functional>
 #include <string>
-
-#include <engine/components.h>
 
 #include "core/random.h"
 #include "core/thread_pool.h"
@@ -17,7 +17,9 @@
 namespace gi {
 namespace {
 
-engine::Error settings_error(const std::string& message) { return engine::Error{"<reference settings>", "", message}; }
+engine::Error settings_error(const std::string& message) {
+  return engine::Error{"<reference settings>", "", message, engine::ErrorKind::Invalid};
+}
 
 engine::Status check_settings(const ReferenceSettings& s) {
   if (s.samples_per_pixel < 1 || s.samples_per_pixel > (1 << 20))
@@ -25,20 +27,6 @@ engine::Status check_settings(const ReferenceSettings& s) {
   if (s.max_bounces < -1) return settings_error("max_bounces must be -1 (unlimited) or >= 0");
   if (s.russian_roulette_start < 1) return settings_error("russian_roulette_start must be >= 1");
   return {};
-}
-
-// Runs fn(i) for i in [0, count) on the pool in batches, reporting progress between batches
-// from this thread; returns false when the callback cancelled.
-bool run_in_batches(ThreadPool& pool, std::size_t count, const ProgressCallback& progress,
-                    const std::function<void(std::size_t)>& fn) {
-  const std::size_t batches = std::clamp<std::size_t>(count / 256, 1, 200);
-  const std::size_t per_batch = (count + batches - 1) / batches;
-  for (std::size_t begin = 0; begin < count; begin += per_batch) {
-    const std::size_t n = std::min(per_batch, count - begin);
-    pool.parallel_for(n, [&](std::size_t i) { fn(begin + i); }, 4);
-    if (progress && !progress(static_cast<double>(begin + n) / static_cast<double>(count))) return false;
-  }
-  return true;
 }
 
 glm::vec3 finite_or_zero(const glm::vec3& v) {
@@ -79,8 +67,8 @@ engine::Result<engine::ImageRgbaF> render_reference(const ReferenceScene& scene,
   const PathTracer tracer(scene, prepared->index, *prepared->caster, tracer_settings(settings));
 
   const float tan_half = std::tan(0.5f * camera.yfov_rad);
-  const float aspect = camera.aspect > 0.0f ? camera.aspect
-                                            : static_cast<float>(camera.width) / static_cast<float>(camera.height);
+  const float aspect =
+      camera.aspect > 0.0f ? camera.aspect : static_cast<float>(camera.width) / static_cast<float>(camera.height);
   const glm::vec3 eye(camera.camera_to_world[3]);
   const glm::mat3 rot(camera.camera_to_world);
 
@@ -89,27 +77,29 @@ engine::Result<engine::ImageRgbaF> render_reference(const ReferenceScene& scene,
   image.height = camera.height;
   image.pixels.assign(static_cast<std::size_t>(camera.width) * static_cast<std::size_t>(camera.height) * 4, 1.0f);
   ThreadPool pool(settings.threads);
-  const bool completed = run_in_batches(pool, image.pixels.size() / 4, settings.progress, [&](std::size_t i) {
-    const int x = static_cast<int>(i % static_cast<std::size_t>(camera.width));
-    const int y = static_cast<int>(i / static_cast<std::size_t>(camera.width));
-    Pcg32 rng = Pcg32::for_item(settings.seed, i);
-    glm::dvec3 sum(0.0);
-    for (int s = 0; s < settings.samples_per_pixel; ++s) {
-      const float jx = settings.jitter_pixels ? rng.next_float() : 0.5f;
-      const float jy = settings.jitter_pixels ? rng.next_float() : 0.5f;
-      const float ndc_x = 2.0f * (static_cast<float>(x) + jx) / static_cast<float>(camera.width) - 1.0f;
-      const float ndc_y = 1.0f - 2.0f * (static_cast<float>(y) + jy) / static_cast<float>(camera.height);
-      const glm::vec3 dir = glm::normalize(rot * glm::vec3(ndc_x * tan_half * aspect, ndc_y * tan_half, -1.0f));
-      sum += glm::dvec3(finite_or_zero(tracer.radiance(Ray{eye, 0.0f, dir}, rng)));
-    }
-    const glm::dvec3 mean = sum / static_cast<double>(settings.samples_per_pixel);
-    for (int c = 0; c < 3; ++c) image.pixels[4 * i + static_cast<std::size_t>(c)] = static_cast<float>(mean[c]);
-  });
-  if (!completed) return settings_error("reference render cancelled");
+  const bool completed =
+      pool.parallel_for_with_progress(image.pixels.size() / 4, settings.progress, [&](std::size_t i) {
+        const int x = static_cast<int>(i % static_cast<std::size_t>(camera.width));
+        const int y = static_cast<int>(i / static_cast<std::size_t>(camera.width));
+        Pcg32 rng = Pcg32::for_item(settings.seed, i);
+        glm::dvec3 sum(0.0);
+        for (int s = 0; s < settings.samples_per_pixel; ++s) {
+          const float jx = settings.jitter_pixels ? rng.next_float() : 0.5f;
+          const float jy = settings.jitter_pixels ? rng.next_float() : 0.5f;
+          const float ndc_x = 2.0f * (static_cast<float>(x) + jx) / static_cast<float>(camera.width) - 1.0f;
+          const float ndc_y = 1.0f - 2.0f * (static_cast<float>(y) + jy) / static_cast<float>(camera.height);
+          const glm::vec3 dir = glm::normalize(rot * glm::vec3(ndc_x * tan_half * aspect, ndc_y * tan_half, -1.0f));
+          sum += glm::dvec3(finite_or_zero(tracer.radiance(Ray{eye, 0.0f, dir}, rng)));
+        }
+        const glm::dvec3 mean = sum / static_cast<double>(settings.samples_per_pixel);
+        for (int c = 0; c < 3; ++c) image.pixels[4 * i + static_cast<std::size_t>(c)] = static_cast<float>(mean[c]);
+      });
+  if (!completed) return engine::cancelled_error("reference render");
   return image;
 }
 
-engine::Result<IrradianceEstimate> estimate_irradiance(const ReferenceScene& scene, std::span<const SurfacePoint> points,
+engine::Result<IrradianceEstimate> estimate_irradiance(const ReferenceScene& scene,
+                                                       std::span<const SurfacePoint> points,
                                                        const ReferenceSettings& settings) {
   if (auto ok = check_settings(settings); !ok) return ok.error();
   for (std::size_t i = 0; i < points.size(); ++i) {
@@ -126,7 +116,7 @@ engine::Result<IrradianceEstimate> estimate_irradiance(const ReferenceScene& sce
   out.direct.assign(points.size(), glm::vec3(0.0f));
   out.indirect.assign(points.size(), glm::vec3(0.0f));
   ThreadPool pool(settings.threads);
-  const bool completed = run_in_batches(pool, points.size(), settings.progress, [&](std::size_t i) {
+  const bool completed = pool.parallel_for_with_progress(points.size(), settings.progress, [&](std::size_t i) {
     Pcg32 rng = Pcg32::for_item(settings.seed, i);
     glm::dvec3 direct(0.0), indirect(0.0);
     for (int s = 0; s < settings.samples_per_pixel; ++s) {
@@ -138,7 +128,7 @@ engine::Result<IrradianceEstimate> estimate_irradiance(const ReferenceScene& sce
     out.direct[i] = glm::vec3(direct / n);
     out.indirect[i] = glm::vec3(indirect / n);
   });
-  if (!completed) return settings_error("irradiance estimate cancelled");
+  if (!completed) return engine::cancelled_error("irradiance estimate");
   return out;
 }
 
@@ -149,17 +139,35 @@ engine::Result<engine::ImageRgbaF> render_reference_image(const engine::Scene& s
     return engine::Error{scene.assets.source, "camera", "no camera entity with Camera and WorldTransform"};
   const engine::Camera& cam = reg.get<engine::Camera>(camera);
   PinholeCamera pc;
-  pc.camera_to_world = reg.get<engine::WorldTransform>(camera).matrix;
-  pc.yfov_rad = cam.yfov_rad;
-  pc.aspect = cam.aspect;
-  pc.width = width;
-  pc.height = height;
-  return render_reference(reference_scene_from(scene), pc, settings);
+  return render_reference_image(bake_input_from(scene),
+                                {.camera_to_world = reg.get<engine::WorldTransform>(camera).matrix,
+                                 .yfov_rad = cam.yfov_rad,
+                                 .aspect = cam.aspect},
+                                width, height, settings);
 }
 
-engine::Result<IrradianceEstimate> reference_irradiance(const engine::Scene& scene, std::span<const SurfacePoint> points,
-                                                         const ReferenceSettings& settings) {
-  return estimate_irradiance(reference_scene_from(scene), points, settings);
+engine::Result<engine::ImageRgbaF> render_reference_image(const BakeInput& input, const ReferenceCamera& camera,
+                                                          int width, int height, const ReferenceSettings& settings) {
+  if (auto ok = validate_bake_input(input); !ok) return ok.error();
+  PinholeCamera pc;
+  pc.camera_to_world = camera.camera_to_world;
+  pc.yfov_rad = camera.yfov_rad;
+  pc.aspect = camera.aspect;
+  pc.width = width;
+  pc.height = height;
+  return render_reference(reference_scene_from(input), pc, settings);
+}
+
+engine::Result<IrradianceEstimate> reference_irradiance(const BakeInput& input, std::span<const SurfacePoint> points,
+                                                        const ReferenceSettings& settings) {
+  if (auto ok = validate_bake_input(input); !ok) return ok.error();
+  return estimate_irradiance(reference_scene_from(input), points, settings);
+}
+
+engine::Result<IrradianceEstimate> reference_irradiance(const engine::Scene& scene,
+                                                        std::span<const SurfacePoint> points,
+                                                        const ReferenceSettings& settings) {
+  return reference_irradiance(bake_input_from(scene), points, settings);
 }
 
 }  // namespace gi

@@ -1,29 +1,29 @@
 #pragma once
-// Fills gi's plain ray-tracing data from a live engine scene. The only place gi's ray
-// tracing reads the registry.
+// Fills gi's plain ray-tracing data from a BakeInput (gi/bake_input.h).
 //  - rt_scene_from: one geometry per mesh (its primitives concatenated), one instance per
-//    MeshRenderer entity with a WorldTransform; DynamicTag entities become dynamic instances.
-//  - reference_scene_from: the same geometry plus normals, materials (the renderer's rule,
-//    engine::Material defaults for primitives without one) and the enabled lights, for the
-//    reference path tracer. A snapshot: it does not follow later changes.
-//   gi::RtSceneData data = gi::rt_scene_from(scene);
-//   gi::ReferenceScene ref = gi::reference_scene_from(scene);
+//    BakeInstance, in order; Dynamic instances become dynamic ray-caster instances.
+//  - reference_scene_from: the same geometry plus normals, materials (glTF's BRDF, the
+//    default material for primitives without one) and the lights, for the reference path
+//    tracer. A snapshot: it does not follow later changes.
+//   gi::RtSceneData data = gi::rt_scene_from(input);
+//   gi::ReferenceScene ref = gi::reference_scene_from(input);
 
-#include <engine/scene.h>
+#include <engine/components.h>
+#include <gi/bake_input.h>
 
 #include "raytrace/reference_scene.h"
 #include "raytrace/rt_scene_data.h"
 
 namespace gi {
 
-RtSceneData rt_scene_from(const engine::Scene& scene);
+RtSceneData rt_scene_from(const BakeInput& input);
 
-ReferenceScene reference_scene_from(const engine::Scene& scene);
+ReferenceScene reference_scene_from(const BakeInput& input);
 
 /// A light component placed by `world` as the path tracer (and the bakers) see it.
 ReferenceLight reference_light(const engine::Light& light, const glm::mat4& world);
 
-/// The renderer's material rule as a path-tracer material.
-ReferenceMaterial reference_material(const engine::Material& material);
+/// A material's factors as a path-tracer material (glTF's BRDF).
+ReferenceMaterial reference_material(const BakeMaterial& material);
 
 }  // namespace gi

@@ -1,21 +1,21 @@
 #include "sweep/brf_sweep.h"
 
+#include <engine/components.h>
+#include <engine/scene.h>
+#include <gi/reference.h>
+
 #include <algorithm>
 #include <chrono>
 #include <limits>
 #include <optional>
 #include <string>
 
-#include <engine/components.h>
-#include <engine/scene.h>
-#include <gi/reference.h>
-
-#include "transport/static_scene.h"
 #include "brf/brf_mesh.h"
 #include "brf/brf_runtime.h"
-#include "transport/point_emitters.h"
 #include "raytrace/reference_render.h"
 #include "raytrace/scene_adapter.h"
+#include "transport/point_emitters.h"
+#include "transport/static_scene.h"
 
 namespace gi {
 namespace {
@@ -74,19 +74,18 @@ struct Objects {
   std::vector<Instance> instances;  // entity order within each source, sources in order
 };
 
-engine::Result<Objects> scene_objects(const engine::Scene& scene) {
-  auto sources = dynamic_brf_meshes(scene);
+engine::Result<Objects> scene_objects(const BakeInput& input) {
+  auto sources = dynamic_brf_meshes(input);
   if (!sources) return sources.error();
   Objects o;
   o.sources = std::move(sources).value();
-  if (o.sources.empty()) return engine::Error{.message = "the scene has no dynamic mesh (basis radiance fields need one)"};
+  if (o.sources.empty())
+    return engine::Error{.message = "the scene has no dynamic mesh (basis radiance fields need one)"};
   for (std::size_t s = 0; s < o.sources.size(); ++s) {
     const BrfSource& src = o.sources[s];
-    const glm::vec3 albedo = brf_source_albedo(scene.assets, src);
-    for (engine::Entity e : src.entities) {
-      const auto* wt = scene.registry.try_get<engine::WorldTransform>(e);
-      o.instances.push_back({s, wt ? wt->matrix : glm::mat4(1.0f), albedo, src.specular});
-    }
+    const glm::vec3 albedo = brf_source_albedo(input, src);
+    for (std::uint32_t i : src.instances)
+      o.instances.push_back({s, input.instances[i].object_to_world, albedo, src.specular});
   }
   return o;
 }
@@ -97,7 +96,8 @@ std::vector<SurfacePoint> vertex_points(const Objects& o) {
     const BrfMesh& mesh = o.sources[in.source].mesh;
     const glm::mat3 nm = glm::transpose(glm::inverse(glm::mat3(in.transform)));
     for (std::size_t j = 0; j < mesh.positions.size(); ++j)
-      points.push_back({glm::vec3(in.transform * glm::vec4(mesh.positions[j], 1.0f)), glm::normalize(nm * mesh.normals[j])});
+      points.push_back(
+          {glm::vec3(in.transform * glm::vec4(mesh.positions[j], 1.0f)), glm::normalize(nm * mesh.normals[j])});
   }
   return points;
 }
@@ -106,10 +106,13 @@ std::vector<SurfacePoint> vertex_points(const Objects& o) {
 
 void register_brf_sweep(SweepRegistry& registry) {
   registry.add_reference_provider(
-      {.kind = "brf_vertex_indirect", .version = "pt-1", .compute = [](const ReferenceJob& job) -> engine::Result<RgbField> {
+      {.kind = "brf_vertex_indirect",
+       .version = "pt-1",
+       .compute = [](const ReferenceJob& job) -> engine::Result<RgbField> {
          const engine::Scene scene =
              objects_only(job.scene.asset, job.request.param("objects") == "apart", job.request.param("metal"));
-         auto objects = scene_objects(scene);
+         const BakeInput input = bake_input_from(scene);
+         auto objects = scene_objects(input);
          if (!objects) return objects.error();
          const std::vector<SurfacePoint> points = vertex_points(*objects);
          ReferenceSettings rs;
@@ -117,7 +120,7 @@ void register_brf_sweep(SweepRegistry& registry) {
          rs.seed = kReferenceSeed;
          rs.threads = job.threads;
          rs.progress = job.progress;
-         auto truth = estimate_irradiance(reference_scene_from(scene), points, rs);
+         auto truth = estimate_irradiance(reference_scene_from(input), points, rs);
          if (!truth) return truth.error();
          const std::vector<std::uint8_t> valid(points.size(), 1);
          return RgbField::from_texels(static_cast<int>(points.size()), 1, truth->indirect, valid);
@@ -125,32 +128,80 @@ void register_brf_sweep(SweepRegistry& registry) {
 
   SweepMethod m;
   m.name = "brf";
-  m.description = "basis radiance fields (Iwasaki et al.): basis N x SH bands x spheres x face points x lights x bounces, dynamic objects' vertices";
+  m.description =
+      "basis radiance fields (Iwasaki et al.): basis N x SH bands x spheres x face points x lights x bounces, dynamic "
+      "objects' vertices";
   m.knobs = {
-      {.name = "basis", .description = "PCA basis functions N (mean included)", .kind = KnobKind::Integer,
-       .default_grid = {"4", "8", "16", "32"}, .min_value = 1, .max_value = 256},
-      {.name = "bands", .description = "spherical-harmonic bands of the field (3 or 4)", .kind = KnobKind::Integer,
-       .default_grid = {"3", "4"}, .min_value = 3, .max_value = 4},
-      {.name = "spheres", .description = "concentric sample spheres", .kind = KnobKind::Integer,
-       .default_grid = {"8", "16"}, .min_value = 2, .max_value = 64},
-      {.name = "face_res", .description = "sample points per sphere: 6 x face_res^2", .kind = KnobKind::Integer,
-       .default_grid = {"8", "16"}, .min_value = 1, .max_value = 64},
-      {.name = "lights", .description = "training point lights N_light", .kind = KnobKind::Integer,
-       .default_grid = {"256"}, .min_value = 1, .max_value = 65536},
-      {.name = "directions", .description = "rays per field sample point", .kind = KnobKind::Integer,
-       .default_grid = {"512"}, .min_value = 16, .max_value = 65536},
-      {.name = "bounces", .description = "bounces between the objects", .kind = KnobKind::Integer,
-       .default_grid = {"3"}, .min_value = 1, .max_value = 64},
-      {.name = "objects", .description = "which dynamic objects: apart (drop touching ones) or all", .kind = KnobKind::Choice,
-       .default_grid = {"apart"}, .choices = {"apart", "all"}},
-      {.name = "ref_spp", .description = "path-traced samples per vertex of the reference", .kind = KnobKind::Integer,
-       .default_grid = {"2048"}, .min_value = 1, .max_value = 1 << 20},
-      {.name = "metal", .description = "a material turned glossy metal (roughness 0.5): none or red_crate", .kind = KnobKind::Choice,
-       .default_grid = {"none"}, .choices = {"none", "red_crate"}},
-      {.name = "glossy_terms", .description = "glossy BRDF terms K of glossy meshes (SVD of the lobe)", .kind = KnobKind::Integer,
-       .default_grid = {"4"}, .min_value = 1, .max_value = kMaxGlossyTerms},
-      {.name = "brdf_res", .description = "hemisphere table of the BRDF separation: brdf_res^2 directions", .kind = KnobKind::Integer,
-       .default_grid = {"16"}, .min_value = 4, .max_value = 64},
+      {.name = "basis",
+       .description = "PCA basis functions N (mean included)",
+       .kind = KnobKind::Integer,
+       .default_grid = {"4", "8", "16", "32"},
+       .min_value = 1,
+       .max_value = 256},
+      {.name = "bands",
+       .description = "spherical-harmonic bands of the field (3 or 4)",
+       .kind = KnobKind::Integer,
+       .default_grid = {"3", "4"},
+       .min_value = 3,
+       .max_value = 4},
+      {.name = "spheres",
+       .description = "concentric sample spheres",
+       .kind = KnobKind::Integer,
+       .default_grid = {"8", "16"},
+       .min_value = 2,
+       .max_value = 64},
+      {.name = "face_res",
+       .description = "sample points per sphere: 6 x face_res^2",
+       .kind = KnobKind::Integer,
+       .default_grid = {"8", "16"},
+       .min_value = 1,
+       .max_value = 64},
+      {.name = "lights",
+       .description = "training point lights N_light",
+       .kind = KnobKind::Integer,
+       .default_grid = {"256"},
+       .min_value = 1,
+       .max_value = 65536},
+      {.name = "directions",
+       .description = "rays per field sample point",
+       .kind = KnobKind::Integer,
+       .default_grid = {"512"},
+       .min_value = 16,
+       .max_value = 65536},
+      {.name = "bounces",
+       .description = "bounces between the objects",
+       .kind = KnobKind::Integer,
+       .default_grid = {"3"},
+       .min_value = 1,
+       .max_value = 64},
+      {.name = "objects",
+       .description = "which dynamic objects: apart (drop touching ones) or all",
+       .kind = KnobKind::Choice,
+       .default_grid = {"apart"},
+       .choices = {"apart", "all"}},
+      {.name = "ref_spp",
+       .description = "path-traced samples per vertex of the reference",
+       .kind = KnobKind::Integer,
+       .default_grid = {"2048"},
+       .min_value = 1,
+       .max_value = 1 << 20},
+      {.name = "metal",
+       .description = "a material turned glossy metal (roughness 0.5): none or red_crate",
+       .kind = KnobKind::Choice,
+       .default_grid = {"none"},
+       .choices = {"none", "red_crate"}},
+      {.name = "glossy_terms",
+       .description = "glossy BRDF terms K of glossy meshes (SVD of the lobe)",
+       .kind = KnobKind::Integer,
+       .default_grid = {"4"},
+       .min_value = 1,
+       .max_value = kMaxGlossyTerms},
+      {.name = "brdf_res",
+       .description = "hemisphere table of the BRDF separation: brdf_res^2 directions",
+       .kind = KnobKind::Integer,
+       .default_grid = {"16"},
+       .min_value = 4,
+       .max_value = 64},
   };
   m.reference_for = [](const SweepScene&, const KnobSetting& k) {
     ReferenceRequest r;
@@ -163,7 +214,8 @@ void register_brf_sweep(SweepRegistry& registry) {
   m.run = [](const RunContext& ctx) -> engine::Result<MethodOutput> {
     const engine::Scene scene =
         objects_only(ctx.scene.asset, ctx.knobs.text("objects") == "apart", ctx.knobs.text("metal"));
-    auto objects = scene_objects(scene);
+    const BakeInput input = bake_input_from(scene);
+    auto objects = scene_objects(input);
     if (!objects) return objects.error();
     const auto t0 = std::chrono::steady_clock::now();
     std::vector<BrfBasis> bases;
@@ -180,8 +232,9 @@ void register_brf_sweep(SweepRegistry& registry) {
         glossy[s] = std::move(sep).value();
       }
       const BrdfSeparation* g = glossy[s] ? &*glossy[s] : nullptr;
-      auto basis = compute_pca_basis(mesh, {.lights = static_cast<int>(ctx.knobs.integer("lights")),
-                                            .basis = static_cast<int>(ctx.knobs.integer("basis"))},
+      auto basis = compute_pca_basis(mesh,
+                                     {.lights = static_cast<int>(ctx.knobs.integer("lights")),
+                                      .basis = static_cast<int>(ctx.knobs.integer("basis"))},
                                      g);
       if (!basis) return basis.error();
       auto field = compute_basis_radiance_field(mesh, *basis,
@@ -196,18 +249,19 @@ void register_brf_sweep(SweepRegistry& registry) {
       bases.push_back(std::move(basis).value());
       fields.push_back(std::move(field).value());
       if (!ctx.progress(0.9 * static_cast<double>(s + 1) / static_cast<double>(objects->sources.size())))
-        return engine::Error{.message = "cancelled"};
+        return engine::cancelled_error("BRF sweep run");
     }
     const double bake_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     std::vector<BrfObject> brf;
     for (const Objects::Instance& in : objects->instances)
       brf.push_back({&objects->sources[in.source].mesh, &bases[in.source], &fields[in.source], in.transform, in.albedo,
                      glossy[in.source] ? &*glossy[in.source] : nullptr, in.specular});
-    std::vector<ReferenceLight> lights = scene_lights(scene.registry, BakeLights::Static);
-    for (ReferenceLight& l : scene_lights(scene.registry, BakeLights::Moving)) lights.push_back(l);
+    std::vector<ReferenceLight> lights = bake_lights(input, BakeLights::Static);
+    for (ReferenceLight& l : bake_lights(input, BakeLights::Moving)) lights.push_back(l);
     const std::vector<PointEmitter> emitters = light_point_emitters(lights, 64, ctx.seed);
     const auto t1 = std::chrono::steady_clock::now();
-    const BrfResult r = update_brf(brf, emitters, {.bounces = static_cast<int>(ctx.knobs.integer("bounces")), .cull_threshold = 0.0f});
+    const BrfResult r =
+        update_brf(brf, emitters, {.bounces = static_cast<int>(ctx.knobs.integer("bounces")), .cull_threshold = 0.0f});
     const double frame_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t1).count();
     std::vector<glm::vec3> values;  // the irradiance: each object's first block
     for (std::size_t i = 0; i < r.indirect.size(); ++i)

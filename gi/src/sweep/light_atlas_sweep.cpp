@@ -9,18 +9,39 @@ namespace gi {
 void register_light_atlas_sweep(SweepRegistry& registry) {
   SweepMethod m;
   m.name = "light_atlas";
-  m.description = "light atlas by VPL shooting (Schärfig 2016): VPLs x bounces x texel density vs path-traced indirect irradiance";
+  m.description =
+      "light atlas by VPL shooting (Schärfig 2016): VPLs x bounces x texel density vs path-traced indirect irradiance";
   m.knobs = {
-      {.name = "vpls", .description = "target VPL count", .kind = KnobKind::Integer,
-       .default_grid = {"100", "300", "1000", "3000"}, .min_value = 1, .max_value = 1'000'000},
-      {.name = "bounces", .description = "indirect bounces carried by the atlas", .kind = KnobKind::Integer,
-       .default_grid = {"1", "2", "3", "5", "8"}, .min_value = 1, .max_value = 64},
-      {.name = "density", .description = "atlas texels per metre", .kind = KnobKind::Real,
-       .default_grid = {"32"}, .min_value = 0.01, .max_value = 1e4},
-      {.name = "samples", .description = "sample points per VPL", .kind = KnobKind::Integer,
-       .default_grid = {"10"}, .min_value = 1, .max_value = 1024},
-      {.name = "ref_spp", .description = "samples per texel of the path-traced reference", .kind = KnobKind::Integer,
-       .default_grid = {"4096"}, .min_value = 1, .max_value = 1 << 20},
+      {.name = "vpls",
+       .description = "target VPL count",
+       .kind = KnobKind::Integer,
+       .default_grid = {"100", "300", "1000", "3000"},
+       .min_value = 1,
+       .max_value = 1'000'000},
+      {.name = "bounces",
+       .description = "indirect bounces carried by the atlas",
+       .kind = KnobKind::Integer,
+       .default_grid = {"1", "2", "3", "5", "8"},
+       .min_value = 1,
+       .max_value = 64},
+      {.name = "density",
+       .description = "atlas texels per metre",
+       .kind = KnobKind::Real,
+       .default_grid = {"32"},
+       .min_value = 0.01,
+       .max_value = 1e4},
+      {.name = "samples",
+       .description = "sample points per VPL",
+       .kind = KnobKind::Integer,
+       .default_grid = {"10"},
+       .min_value = 1,
+       .max_value = 1024},
+      {.name = "ref_spp",
+       .description = "samples per texel of the path-traced reference",
+       .kind = KnobKind::Integer,
+       .default_grid = {"4096"},
+       .min_value = 1,
+       .max_value = 1 << 20},
   };
   m.reference_for = [](const SweepScene&, const KnobSetting& k) {
     return ReferenceRequest::atlas_indirect_irradiance(k.real("density"), static_cast<int>(k.integer("ref_spp")));
@@ -35,7 +56,7 @@ void register_light_atlas_sweep(SweepRegistry& registry) {
     s.threads = ctx.threads;
     s.progress = ctx.progress;
     const engine::Scene scene = engine::instantiate(ctx.scene.asset);
-    auto bake = bake_light_atlas(scene, s);
+    auto bake = bake_light_atlas(bake_input_from(scene), s);
     if (!bake) return bake.error();
     if (bake->width != ctx.reference.width || bake->height != ctx.reference.height)
       return engine::Error{.message = "the bake's atlas size differs from the reference's"};

@@ -1,18 +1,17 @@
 #include "sweep/prm_sweep.h"
 
-#include <chrono>
-#include <limits>
-#include <string>
-
-#include <glm/gtc/quaternion.hpp>
-
 #include <engine/scene.h>
 #include <gi/reference.h>
 
-#include "transport/static_scene.h"
+#include <chrono>
+#include <glm/gtc/quaternion.hpp>
+#include <limits>
+#include <string>
+
 #include "prm/prm.h"
 #include "prm/prm_runtime.h"
 #include "raytrace/atlas_reference.h"
+#include "transport/static_scene.h"
 #include "uv/atlas_input.h"
 #include "uv/atlas_layout.h"
 #include "uv/atlas_rasterizer.h"
@@ -28,7 +27,8 @@ engine::Result<engine::Scene> posed_scene(engine::SceneAsset asset, const std::s
   int chosen = -1;
   for (std::size_t n = 0; n < asset.nodes.size() && chosen < 0; ++n) {
     const int l = asset.nodes[n].light;
-    if (l >= 0 && static_cast<std::size_t>(l) < asset.lights.size() && asset.lights[static_cast<std::size_t>(l)].light.moves)
+    if (l >= 0 && static_cast<std::size_t>(l) < asset.lights.size() &&
+        asset.lights[static_cast<std::size_t>(l)].light.moves)
       chosen = static_cast<int>(n);
   }
   for (std::size_t n = 0; n < asset.nodes.size() && chosen < 0; ++n)
@@ -41,7 +41,7 @@ engine::Result<engine::Scene> posed_scene(engine::SceneAsset asset, const std::s
   light.moves = true;
   if (pose != "authored") {
     glm::vec3 lo(std::numeric_limits<float>::infinity()), hi(-lo);
-    for (const AtlasInputMesh& m : atlas_inputs_from(asset))
+    for (const AtlasInputMesh& m : atlas_inputs_from(bake_input_from(asset)))
       for (const glm::vec3& p : m.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
     const glm::vec3 size = hi - lo, centre = 0.5f * (lo + hi);
     glm::vec3 position, direction;
@@ -57,10 +57,12 @@ engine::Result<engine::Scene> posed_scene(engine::SceneAsset asset, const std::s
     } else {
       return engine::Error{.message = "unknown light pose '" + pose + "' (authored, corner, wall)"};
     }
-    if (node.parent >= 0) return engine::Error{.message = "the moving light has a parent node; pose it in world space first"};
+    if (node.parent >= 0)
+      return engine::Error{.message = "the moving light has a parent node; pose it in world space first"};
     node.translation = position;
     // Lights shine along their local -Z.
-    node.rotation = glm::quatLookAtRH(direction, std::abs(direction.y) > 0.9f ? glm::vec3(1, 0, 0) : glm::vec3(0, 1, 0));
+    node.rotation =
+        glm::quatLookAtRH(direction, std::abs(direction.y) > 0.9f ? glm::vec3(1, 0, 0) : glm::vec3(0, 1, 0));
   }
   return engine::instantiate(std::move(asset));
 }
@@ -69,10 +71,12 @@ engine::Result<engine::Scene> posed_scene(engine::SceneAsset asset, const std::s
 
 void register_prm_sweep(SweepRegistry& registry) {
   registry.add_reference_provider(
-      {.kind = "atlas_indirect_irradiance_posed", .version = "pt-2", .compute = [](const ReferenceJob& job) -> engine::Result<RgbField> {
+      {.kind = "atlas_indirect_irradiance_posed",
+       .version = "pt-2",
+       .compute = [](const ReferenceJob& job) -> engine::Result<RgbField> {
          auto scene = posed_scene(job.scene.asset, job.request.param("pose"));
          if (!scene) return scene.error();
-         const auto inputs = atlas_inputs_from(job.scene.asset);
+         const auto inputs = atlas_inputs_from(bake_input_from(job.scene.asset));
          auto layout = build_atlas_layout(inputs, {.texels_per_metre = std::stof(job.request.param("texels_per_m"))});
          if (!layout) return layout.error();
          ReferenceSettings rs;
@@ -80,32 +84,62 @@ void register_prm_sweep(SweepRegistry& registry) {
          rs.seed = kReferenceSeed;
          rs.threads = job.threads;
          rs.progress = job.progress;
-         auto truth = reference_atlas_irradiance(*scene, rasterize_atlas(*layout, inputs), rs);
+         auto truth = reference_atlas_irradiance(bake_input_from(*scene), rasterize_atlas(*layout, inputs), rs);
          if (!truth) return truth.error();
          return RgbField::from_texels(truth->width, truth->height, truth->indirect, truth->valid);
        }});
 
   SweepMethod m;
   m.name = "prm";
-  m.description = "precomputed radiance maps (Szécsi 2006): entry points x clusters x active K x density x splitting, moving light at several poses";
+  m.description =
+      "precomputed radiance maps (Szécsi 2006): entry points x clusters x active K x density x splitting, moving light "
+      "at several poses";
   m.knobs = {
-      {.name = "entries", .description = "entry points", .kind = KnobKind::Integer,
-       .default_grid = {"256", "1024", "4096"}, .min_value = 1, .max_value = 1'000'000},
-      {.name = "clusters", .description = "entry-point clusters (stored panes)", .kind = KnobKind::Integer,
-       .default_grid = {"32", "128"}, .min_value = 1, .max_value = 65536},
-      {.name = "active", .description = "clusters summed per frame (K heaviest; 0: all)", .kind = KnobKind::Integer,
-       .default_grid = {"0"}, .min_value = 0, .max_value = 65536},
-      {.name = "density", .description = "pane (atlas) texels per metre", .kind = KnobKind::Real,
-       .default_grid = {"4"}, .min_value = 0.01, .max_value = 1e4},
-      {.name = "splitting", .description = "paths per entry point per unit albedo (N_s)", .kind = KnobKind::Real,
-       .default_grid = {"4"}, .min_value = 0.01, .max_value = 1024},
-      {.name = "pose", .description = "moving light pose", .kind = KnobKind::Choice,
-       .default_grid = {"authored", "corner", "wall"}, .choices = {"authored", "corner", "wall"}},
-      {.name = "ref_spp", .description = "samples per texel of the path-traced reference", .kind = KnobKind::Integer,
-       .default_grid = {"4096"}, .min_value = 1, .max_value = 1 << 20},
+      {.name = "entries",
+       .description = "entry points",
+       .kind = KnobKind::Integer,
+       .default_grid = {"256", "1024", "4096"},
+       .min_value = 1,
+       .max_value = 1'000'000},
+      {.name = "clusters",
+       .description = "entry-point clusters (stored panes)",
+       .kind = KnobKind::Integer,
+       .default_grid = {"32", "128"},
+       .min_value = 1,
+       .max_value = 65536},
+      {.name = "active",
+       .description = "clusters summed per frame (K heaviest; 0: all)",
+       .kind = KnobKind::Integer,
+       .default_grid = {"0"},
+       .min_value = 0,
+       .max_value = 65536},
+      {.name = "density",
+       .description = "pane (atlas) texels per metre",
+       .kind = KnobKind::Real,
+       .default_grid = {"4"},
+       .min_value = 0.01,
+       .max_value = 1e4},
+      {.name = "splitting",
+       .description = "paths per entry point per unit albedo (N_s)",
+       .kind = KnobKind::Real,
+       .default_grid = {"4"},
+       .min_value = 0.01,
+       .max_value = 1024},
+      {.name = "pose",
+       .description = "moving light pose",
+       .kind = KnobKind::Choice,
+       .default_grid = {"authored", "corner", "wall"},
+       .choices = {"authored", "corner", "wall"}},
+      {.name = "ref_spp",
+       .description = "samples per texel of the path-traced reference",
+       .kind = KnobKind::Integer,
+       .default_grid = {"4096"},
+       .min_value = 1,
+       .max_value = 1 << 20},
   };
   m.reference_for = [](const SweepScene&, const KnobSetting& k) {
-    ReferenceRequest r = ReferenceRequest::atlas_indirect_irradiance(k.real("density"), static_cast<int>(k.integer("ref_spp")));
+    ReferenceRequest r =
+        ReferenceRequest::atlas_indirect_irradiance(k.real("density"), static_cast<int>(k.integer("ref_spp")));
     r.kind = "atlas_indirect_irradiance_posed";
     r.params.emplace_back("pose", k.text("pose"));
     return r;
@@ -121,15 +155,16 @@ void register_prm_sweep(SweepRegistry& registry) {
     s.seed = ctx.seed;
     s.threads = ctx.threads;
     s.progress = ctx.progress;
-    auto prm = bake_prm(*scene, s);
+    const BakeInput input = bake_input_from(*scene);
+    auto prm = bake_prm(input, s);
     if (!prm) return prm.error();
     if (prm->width != ctx.reference.width || prm->height != ctx.reference.height)
       return engine::Error{.message = "the PRM's atlas size differs from the reference's"};
-    auto caster = make_static_caster(*scene);
+    auto caster = make_static_caster(input);
     if (!caster) return caster.error();
     // Per-frame cost of a light change on the CPU: weights, selection and the pane sum.
     const auto t0 = std::chrono::steady_clock::now();
-    const auto picked = relight_clusters(*prm, scene_lights(scene->registry, BakeLights::Moving), **caster,
+    const auto picked = relight_clusters(*prm, bake_lights(input, BakeLights::Moving), **caster,
                                          static_cast<int>(ctx.knobs.integer("active")));
     const std::vector<glm::vec3> atlas = sum_panes(*prm, picked);
     const double frame_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();

@@ -14,13 +14,13 @@
 //   auto got = gi::fetch_reference(cache, provider, scene, request, 0, progress);
 
 #include <engine/result.h>
+#include <gi/rgb_field.h>
 
 #include <filesystem>
 #include <optional>
 #include <string>
 #include <string_view>
 
-#include "metrics/rgb_field.h"
 #include "sweep/sweep_method.h"
 
 namespace gi {

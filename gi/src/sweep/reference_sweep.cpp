@@ -1,10 +1,10 @@
 #include "sweep/reference_sweep.h"
 
-#include <chrono>
-#include <string>
-
 #include <engine/scene.h>
 #include <gi/reference.h>
+
+#include <chrono>
+#include <string>
 
 #include "raytrace/atlas_reference.h"
 #include "uv/atlas_input.h"
@@ -52,11 +52,8 @@ engine::Result<RgbField> render_camera(const SweepScene& s, const ReferenceReque
 }
 
 engine::Result<RgbField> atlas_indirect(const SweepScene& s, const ReferenceRequest& r, ReferenceSettings settings) {
-  const engine::Scene scene = engine::instantiate(s.asset);
-  const auto inputs = atlas_inputs_from(s.asset);
-  auto layout = build_atlas_layout(inputs, {.texels_per_metre = std::stof(r.param("texels_per_m"))});
-  if (!layout) return layout.error();
-  auto truth = reference_atlas_irradiance(scene, rasterize_atlas(*layout, inputs), settings);
+  auto truth =
+      reference_atlas(bake_input_from(engine::instantiate(s.asset)), std::stof(r.param("texels_per_m")), settings);
   if (!truth) return truth.error();
   return RgbField::from_texels(truth->width, truth->height, truth->indirect, truth->valid);
 }
@@ -86,12 +83,24 @@ void register_reference_sweep(SweepRegistry& registry) {
   pt.name = "pathtracer";
   pt.description = "the reference path tracer itself: samples per pixel and bounce limit vs a converged render";
   pt.knobs = {
-      {.name = "spp", .description = "samples per pixel", .kind = KnobKind::Integer,
-       .default_grid = {"1", "4", "16", "64", "256", "1024"}, .min_value = 1, .max_value = 1 << 20},
-      {.name = "bounces", .description = "indirect bounces (-1: unlimited, Russian roulette)",
-       .kind = KnobKind::Integer, .default_grid = {"-1"}, .min_value = -1, .max_value = 1000},
-      {.name = "size", .description = "image width and height, pixels", .kind = KnobKind::Integer,
-       .default_grid = {"128"}, .min_value = 8, .max_value = 4096},
+      {.name = "spp",
+       .description = "samples per pixel",
+       .kind = KnobKind::Integer,
+       .default_grid = {"1", "4", "16", "64", "256", "1024"},
+       .min_value = 1,
+       .max_value = 1 << 20},
+      {.name = "bounces",
+       .description = "indirect bounces (-1: unlimited, Russian roulette)",
+       .kind = KnobKind::Integer,
+       .default_grid = {"-1"},
+       .min_value = -1,
+       .max_value = 1000},
+      {.name = "size",
+       .description = "image width and height, pixels",
+       .kind = KnobKind::Integer,
+       .default_grid = {"128"},
+       .min_value = 8,
+       .max_value = 4096},
   };
   pt.reference_for = [](const SweepScene&, const KnobSetting& k) {
     const int size = static_cast<int>(k.integer("size"));

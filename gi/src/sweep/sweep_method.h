@@ -5,6 +5,7 @@
 //   registry.add_method(std::move(m));
 
 #include <engine/result.h>
+#include <gi/rgb_field.h>
 
 #include <cstdint>
 #include <functional>
@@ -12,7 +13,6 @@
 #include <string>
 #include <vector>
 
-#include "metrics/rgb_field.h"
 #include "sweep/knob_setting.h"
 #include "sweep/knob_spec.h"
 #include "sweep/reference_request.h"

@@ -5,6 +5,7 @@
 //   gi::write_file_atomically("out/sweep.csv", gi::sweep_csv(result->rows));
 
 #include <engine/result.h>
+#include <gi/error_metrics.h>
 
 #include <cstdint>
 #include <filesystem>
@@ -13,7 +14,6 @@
 #include <string>
 #include <vector>
 
-#include "metrics/error_metrics.h"
 #include "sweep/sweep_registry.h"
 
 namespace gi {

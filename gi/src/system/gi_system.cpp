@@ -1,27 +1,26 @@
 #include <GL/glcorearb.h>
+#include <engine/components.h>
+#include <engine/gpu/gl_objects.h>
 #include <gi/gi_system.h>
+#include <gi/plan.h>
 
 #include <chrono>
 #include <cstdio>
 #include <optional>
 #include <sstream>
 
-#include <engine/components.h>
-#include <engine/gpu/gl_objects.h>
-#include "system/light_atlas_lighting.h"
-#include <gi/plan.h>
-#include "system/prm_lighting.h"
-
-#include "bundle/manifest.h"
-#include "transport/static_scene.h"
-#include "brf/brf_lighting.h"
 #include "brf/brf_io.h"
+#include "brf/brf_lighting.h"
 #include "brf/brf_mesh.h"
 #include "brf/world_probes.h"
+#include "bundle/manifest.h"
 #include "light_atlas/light_atlas.h"
 #include "light_atlas/light_atlas_io.h"
 #include "prm/prm.h"
 #include "prm/prm_io.h"
+#include "system/light_atlas_lighting.h"
+#include "system/prm_lighting.h"
+#include "transport/static_scene.h"
 
 namespace gi {
 
@@ -64,25 +63,34 @@ engine::Result<std::unique_ptr<GISystem>> GISystem::load(const std::filesystem::
                          "the bundle holds no light atlas, PRM or basis radiance fields"};
   auto impl = std::make_unique<Impl>();
   std::ostringstream text;
+  // The scene as the bakers saw it: hashes, layouts and BRF sources are checked against it.
+  const BakeInput input = bake_input_from(scene);
   // What the scene calls for (gi::plan) next to what the bundle holds.
-  const EffectPlan wanted = plan(scene, {});
+  const EffectPlan wanted = plan(input, {});
   const auto in_bundle = [&](EffectMethod m) {
     switch (m) {
-      case EffectMethod::LightAtlas: return has_atlas;
-      case EffectMethod::Prm: return has_prm;
-      case EffectMethod::BasisRadianceFields: return has_brf;
-      default: return false;
+      case EffectMethod::LightAtlas:
+        return has_atlas;
+      case EffectMethod::Prm:
+        return has_prm;
+      case EffectMethod::BasisRadianceFields:
+        return has_brf;
+      default:
+        return false;
     }
   };
   for (const PlannedEffect& e : wanted.effects) {
     text << "plan " << effect_key(e.method) << ": "
-         << (!e.enabled ? "off" : !e.available ? "needed, not built" : in_bundle(e.method) ? "on" : "needed, NOT IN THE BUNDLE (re-bake)")
+         << (!e.enabled            ? "off"
+             : !e.available        ? "needed, not built"
+             : in_bundle(e.method) ? "on"
+                                   : "needed, NOT IN THE BUNDLE (re-bake)")
          << " - " << e.reason << '\n';
   }
 
   std::optional<LightAtlasBake> atlas;
   if (has_atlas) {
-    auto a = load_light_atlas(bundle_dir, scene.assets);
+    auto a = load_light_atlas(bundle_dir, input);
     if (!a) return a.error();
     atlas.emplace(std::move(a).value());
     text << "light atlas: " << atlas->width << "x" << atlas->height << ", static lights, " << atlas->settings.bounces
@@ -90,7 +98,7 @@ engine::Result<std::unique_ptr<GISystem>> GISystem::load(const std::filesystem::
   }
   std::optional<Prm> prm;
   if (has_prm) {
-    auto p = load_prm(bundle_dir, scene.assets);
+    auto p = load_prm(bundle_dir, input);
     if (!p) return p.error();
     prm.emplace(std::move(p).value());
     text << "PRM: " << prm->cluster_count << " clusters, K = " << settings.prm_active_clusters
@@ -100,7 +108,7 @@ engine::Result<std::unique_ptr<GISystem>> GISystem::load(const std::filesystem::
   // Basis radiance fields, coupled to the static world before the static meshes get uv1
   // (the atlas texels are those of the layout built from the original meshes).
   if (has_brf) {
-    auto sources = dynamic_brf_meshes(scene);
+    auto sources = dynamic_brf_meshes(input);
     if (!sources) return sources.error();
     auto loaded = load_brf(bundle_dir, *sources);
     if (!loaded) return loaded.error();
@@ -110,14 +118,15 @@ engine::Result<std::unique_ptr<GISystem>> GISystem::load(const std::filesystem::
       BrfSource& src = (*sources)[i];
       BrfMeshBake& b = loaded->meshes[i];
       const auto model = static_cast<std::uint32_t>(models.size());
-      const glm::vec3 albedo = brf_source_albedo(scene.assets, src);
-      for (engine::Entity e : src.entities) bindings.push_back({e, model, albedo, src.specular});
+      const glm::vec3 albedo = brf_source_albedo(input, src);
+      for (std::uint32_t k : src.instances)
+        bindings.push_back({input.instances[k].entity, model, albedo, src.specular});
       models.push_back({src.name, std::move(src.mesh), std::move(b.basis), std::move(b.field), std::move(b.glossy)});
     }
     BrfWorldLink world;
     const AtlasLayout* layout = atlas ? &atlas->layout : prm ? &prm->layout : nullptr;
     if (layout != nullptr) {
-      auto s = prepare_static_scene(scene, *layout, BakeLights::None);
+      auto s = prepare_static_scene(input, *layout, BakeLights::None);
       if (!s) return s.error();
       world.atlas_width = s->texels.width;
       world.atlas_height = s->texels.height;
@@ -128,12 +137,13 @@ engine::Result<std::unique_ptr<GISystem>> GISystem::load(const std::filesystem::
           world.receiver_normals.push_back(s->texels.normal[t]);
         }
       world.caster = std::move(s->caster);
-    } else if (auto c = make_static_caster(scene)) {
+    } else if (auto c = make_static_caster(input)) {
       world.caster = std::move(c).value();
     }
     if (atlas && world.caster) {
       const auto t0 = std::chrono::steady_clock::now();
-      auto probes = bake_world_probes(*world.caster, atlas->vpls, atlas->vpl_power, {.spacing_m = settings.probe_spacing_m});
+      auto probes =
+          bake_world_probes(*world.caster, atlas->vpls, atlas->vpl_power, {.spacing_m = settings.probe_spacing_m});
       if (!probes) return probes.error();
       world.probes.emplace(std::move(probes).value());
       impl->stats.load_probe_ms = static_cast<std::size_t>(
@@ -141,8 +151,9 @@ engine::Result<std::unique_ptr<GISystem>> GISystem::load(const std::filesystem::
     }
     const std::size_t receivers = world.receiver_texels.size();
     const std::size_t probe_count = world.probes ? world.probes->probe_count() : 0;
-    auto brf = BrfLighting::create(std::move(models), std::move(bindings), scene.registry, std::move(world),
-                                   {.update = {.bounces = settings.brf_bounces, .cull_threshold = settings.brf_cull_threshold}});
+    auto brf = BrfLighting::create(
+        std::move(models), std::move(bindings), scene.registry, std::move(world),
+        {.update = {.bounces = settings.brf_bounces, .cull_threshold = settings.brf_cull_threshold}});
     if (!brf) return brf.error();
     impl->brf = std::move(brf).value();
     const auto& st = impl->brf->stats();

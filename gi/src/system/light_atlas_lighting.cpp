@@ -1,5 +1,6 @@
-#include <GL/glcorearb.h>
 #include "system/light_atlas_lighting.h"
+
+#include <GL/glcorearb.h>
 
 #include "light_atlas/light_atlas.h"
 #include "light_atlas/light_atlas_io.h"
@@ -42,20 +43,6 @@ engine::Result<std::unique_ptr<LightAtlasLighting>> LightAtlasLighting::from_bak
   if (!with_uv1) return with_uv1.error();
   asset = std::move(with_uv1).value();
   return std::unique_ptr<LightAtlasLighting>(new LightAtlasLighting(bake.width, bake.height, rgba_of(bake)));
-}
-
-engine::Result<std::unique_ptr<LightAtlasLighting>> LightAtlasLighting::load(const std::filesystem::path& bundle_dir,
-                                                                             engine::SceneAsset& asset) {
-  auto bake = load_light_atlas(bundle_dir, asset);
-  if (!bake) return bake.error();
-  return from_bake(std::move(bake).value(), asset);
-}
-
-engine::Result<std::unique_ptr<LightAtlasLighting>> LightAtlasLighting::load(const std::filesystem::path& bundle_dir,
-                                                                             engine::Scene& scene) {
-  auto bake = load_light_atlas(bundle_dir, scene.assets);
-  if (!bake) return bake.error();
-  return from_bake(std::move(bake).value(), scene);
 }
 
 engine::Result<std::unique_ptr<LightAtlasLighting>> LightAtlasLighting::from_bake(const LightAtlasBake& bake,

@@ -1,21 +1,22 @@
-#include <GL/glcorearb.h>
 #include "system/prm_lighting.h"
+
+#include <GL/glcorearb.h>
 
 #include <chrono>
 #include <optional>
 #include <unordered_map>
 
-#include "transport/static_scene.h"
 #include "bundle/light_signature.h"
 #include "bundle/manifest.h"
 #include "light_atlas/light_atlas.h"
 #include "light_atlas/light_atlas_io.h"
-#include "transport/point_emitters.h"
 #include "prm/prm.h"
 #include "prm/prm_gpu_pass.h"
 #include "prm/prm_io.h"
 #include "prm/prm_runtime.h"
 #include "raytrace/scene_adapter.h"
+#include "transport/point_emitters.h"
+#include "transport/static_scene.h"
 #include "uv/atlas_scene_writer.h"
 
 namespace gi {
@@ -82,14 +83,15 @@ PrmLighting::PrmLighting(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 PrmLighting::~PrmLighting() = default;
 
 engine::Result<std::unique_ptr<PrmLighting>> PrmLighting::from_bake(Prm prm, const LightAtlasBake* base,
-                                                                    engine::Scene& scene, PrmLightingSettings settings) {
+                                                                    engine::Scene& scene,
+                                                                    PrmLightingSettings settings) {
   if (base && (base->width != prm.width || base->height != prm.height ||
                base->layout.texels_per_metre != prm.layout.texels_per_metre))
     return engine::Error{scene.assets.source, "PRM",
                          "the light atlas (" + std::to_string(base->width) + "x" + std::to_string(base->height) +
                              ") and the PRM (" + std::to_string(prm.width) + "x" + std::to_string(prm.height) +
                              ") were baked at different layouts; bake both at one density"};
-  auto caster = make_static_caster(scene);
+  auto caster = make_static_caster(bake_input_from(scene));
   if (!caster) return caster.error();
   if (engine::Status s = apply_atlas_uv1(scene, prm.layout); !s) return s.error();
   auto impl = std::make_unique<Impl>();
@@ -99,21 +101,6 @@ engine::Result<std::unique_ptr<PrmLighting>> PrmLighting::from_bake(Prm prm, con
   impl->caster = std::move(caster).value();
   impl->settings = settings;
   return std::unique_ptr<PrmLighting>(new PrmLighting(std::move(impl)));
-}
-
-engine::Result<std::unique_ptr<PrmLighting>> PrmLighting::load(const std::filesystem::path& bundle_dir,
-                                                               engine::Scene& scene, PrmLightingSettings settings) {
-  auto prm = load_prm(bundle_dir, scene.assets);
-  if (!prm) return prm.error();
-  auto manifest = read_manifest(bundle_dir);
-  if (!manifest) return manifest.error();
-  std::optional<LightAtlasBake> base;
-  if (manifest->methods.contains("light_atlas")) {
-    auto atlas = load_light_atlas(bundle_dir, scene.assets);
-    if (!atlas) return atlas.error();
-    base.emplace(std::move(atlas).value());
-  }
-  return from_bake(std::move(prm).value(), base ? &*base : nullptr, scene, settings);
 }
 
 const engine::IndirectLightFrame& PrmLighting::frame() {
@@ -139,12 +126,12 @@ const engine::IndirectLightFrame& PrmLighting::frame() {
   std::vector<glm::vec3> entry(m.prm.entries.size(), glm::vec3(0.0f));
   for (const auto& [id, c] : m.lights)
     for (std::size_t i = 0; i < entry.size() && i < c.entry.size(); ++i) entry[i] += c.entry[i];
-  const std::vector<ClusterWeight> picked =
-      select_clusters(cluster_weights(m.prm, entry), m.settings.active_clusters);
+  const std::vector<ClusterWeight> picked = select_clusters(cluster_weights(m.prm, entry), m.settings.active_clusters);
   m.stats.last_lights_recomputed = recomputed;
   m.stats.last_lights_reused = m.lights.size() - std::min(recomputed, m.lights.size());
   const auto t1 = Clock::now();
-  if (engine::Status s = m.pass->run(picked); !s) std::fprintf(stderr, "gi: PRM update failed: %s\n", s.error().to_string().c_str());
+  if (engine::Status s = m.pass->run(picked); !s)
+    std::fprintf(stderr, "gi: PRM update failed: %s\n", s.error().to_string().c_str());
   glFinish();
   const auto t2 = Clock::now();
   m.stats.last_weights_ms = std::chrono::duration<double, std::milli>(t1 - t0).count();

@@ -7,21 +7,20 @@
 // world; the other lights' is cached), sums them into the cluster weights, picks the K
 // heaviest clusters and re-sums their panes on the GPU. A frame where nothing moved does
 // nothing.
-//   auto gi = gi::PrmLighting::load("level.gibake", scene);  // before Renderer::create
-//   auto renderer = engine::Renderer::create(scene.assets, settings).value();
-//   renderer->set_indirect_light(gi.value().get());
+// Internal to GISystem, which loads bundles.
+//   auto gi = gi::PrmLighting::from_bake(std::move(prm), &atlas, scene).value();  // before Renderer::create
+//   renderer->set_indirect_light(gi.get());
 //
-// Loading gives the scene's static meshes TEXCOORD_1 (see LightAtlasLighting). The provider
+// It gives the scene's static meshes TEXCOORD_1 (see LightAtlasLighting). The provider
 // reads lights from `scene.registry`, which must outlive it. GL objects are created on the
 // first frame() (the context must be current) and deleted with the provider.
-
-#include <cstdint>
-#include <filesystem>
-#include <memory>
 
 #include <engine/indirect_light.h>
 #include <engine/result.h>
 #include <engine/scene.h>
+
+#include <cstdint>
+#include <memory>
 
 namespace gi {
 
@@ -34,13 +33,9 @@ struct PrmLightingSettings {
 
 class PrmLighting final : public engine::IndirectLightProvider {
  public:
-  /// Loads the bundle's PRM (and its light atlas as the static base when the bundle has one
-  /// at the same layout) for `scene`, and gives the scene uv1. Errors: stale or damaged
-  /// bundle, no PRM in it, a light atlas of another layout.
-  static engine::Result<std::unique_ptr<PrmLighting>> load(const std::filesystem::path& bundle_dir, engine::Scene& scene,
-                                                           PrmLightingSettings settings = {});
   /// From bakes in memory (base may be null). Same layout required.
-  static engine::Result<std::unique_ptr<PrmLighting>> from_bake(Prm prm, const LightAtlasBake* base, engine::Scene& scene,
+  static engine::Result<std::unique_ptr<PrmLighting>> from_bake(Prm prm, const LightAtlasBake* base,
+                                                                engine::Scene& scene,
                                                                 PrmLightingSettings settings = {});
 
   PrmLighting(const PrmLighting&) = delete;
@@ -53,9 +48,9 @@ class PrmLighting final : public engine::IndirectLightProvider {
 
   struct Stats {
     std::uint64_t frames = 0;
-    std::uint64_t updates = 0;        ///< Frames on which the atlas was recomputed.
-    double last_weights_ms = 0.0;     ///< CPU: entry weights, cluster means, selection.
-    double last_gpu_ms = 0.0;         ///< GPU pane sum (glFinish-timed: CPU time on llvmpipe).
+    std::uint64_t updates = 0;     ///< Frames on which the atlas was recomputed.
+    double last_weights_ms = 0.0;  ///< CPU: entry weights, cluster means, selection.
+    double last_gpu_ms = 0.0;      ///< GPU pane sum (glFinish-timed: CPU time on llvmpipe).
     std::size_t last_active_clusters = 0;
     std::size_t last_lights_recomputed = 0;  ///< Moving lights whose entry irradiance was recomputed last update,
     std::size_t last_lights_reused = 0;      ///< and those whose cached one was reused (they had not changed).

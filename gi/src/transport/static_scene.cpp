@@ -17,6 +17,16 @@ std::vector<ReferenceLight> scene_lights(const engine::Registry& registry, BakeL
   return kept;
 }
 
+std::vector<ReferenceLight> bake_lights(const BakeInput& input, BakeLights lights) {
+  std::vector<ReferenceLight> kept;
+  for (const BakeLight& l : input.lights) {
+    if (!l.light.enabled) continue;
+    const bool keep = lights == BakeLights::Static ? !l.light.moves : lights == BakeLights::Moving && l.light.moves;
+    if (keep) kept.push_back(reference_light(l.light, l.light_to_world));
+  }
+  return kept;
+}
+
 namespace {
 
 // The static instances of `data` with, per kept instance, its index in `data`.
@@ -33,17 +43,17 @@ RtSceneData static_only(const RtSceneData& data, std::vector<std::uint32_t>* kep
 
 }  // namespace
 
-engine::Result<std::unique_ptr<RayCaster>> make_static_caster(const engine::Scene& scene) {
-  const RtSceneData statics = static_only(rt_scene_from(scene), nullptr);
+engine::Result<std::unique_ptr<RayCaster>> make_static_caster(const BakeInput& input) {
+  const RtSceneData statics = static_only(rt_scene_from(input), nullptr);
   if (statics.instances.empty()) return engine::Error{.message = "the scene has no static mesh"};
   return make_embree_ray_caster(statics);
 }
 
-engine::Result<StaticBakeScene> prepare_static_scene(const engine::Scene& scene, const AtlasLayout& layout,
+engine::Result<StaticBakeScene> prepare_static_scene(const BakeInput& input, const AtlasLayout& layout,
                                                      BakeLights lights) {
   StaticBakeScene b;
-  b.scene = reference_scene_from(scene);
-  b.scene.lights = scene_lights(scene.registry, lights);
+  b.scene = reference_scene_from(input);
+  b.scene.lights = bake_lights(input, lights);
   auto index = index_reference_scene(b.scene);
   if (!index) return index.error();
   b.index = std::move(index).value();
@@ -52,7 +62,7 @@ engine::Result<StaticBakeScene> prepare_static_scene(const engine::Scene& scene,
   auto caster = make_embree_ray_caster(statics);
   if (!caster) return caster.error();
   b.caster = std::move(caster).value();
-  b.texels = rasterize_atlas(layout, atlas_inputs_from(scene.assets));
+  b.texels = rasterize_atlas(layout, atlas_inputs_from(input));
   return b;
 }
 

@@ -3,13 +3,14 @@
 // (triangles, materials, lights), a ray caster over the static instances only (dynamic
 // objects move, so they must not shadow baked data) and the light-atlas texels the bake
 // fills (its reference points).
-//   auto s = gi::prepare_static_scene(scene, layout, gi::BakeLights::Static).value();
+//   auto s = gi::prepare_static_scene(input, layout, gi::BakeLights::Static).value();
 //   bool lit = !s.caster->occluded(ray);
 
-#include <memory>
-
+#include <engine/registry.h>
 #include <engine/result.h>
-#include <engine/scene.h>
+#include <gi/bake_input.h>
+
+#include <memory>
 
 #include "raytrace/ray_caster.h"
 #include "raytrace/reference_scene.h"
@@ -31,7 +32,7 @@ struct StaticBakeScene {
   std::unique_ptr<RayCaster> caster;  ///< Static instances only.
   /// Caster instance -> snapshot instance (scene.geometry.instances index).
   std::vector<std::uint32_t> static_instance;
-  AtlasTexels texels;                 ///< The layout's texels.
+  AtlasTexels texels;  ///< The layout's texels.
 
   /// The index.triangles entry a hit of `caster` landed on.
   std::uint32_t triangle_of(const Hit& hit) const {
@@ -40,15 +41,18 @@ struct StaticBakeScene {
 };
 
 /// Errors: invalid scene data (non-finite values...), no static mesh instance.
-engine::Result<StaticBakeScene> prepare_static_scene(const engine::Scene& scene, const AtlasLayout& layout,
+engine::Result<StaticBakeScene> prepare_static_scene(const BakeInput& input, const AtlasLayout& layout,
                                                      BakeLights lights);
 
-/// A ray caster over the static mesh instances of `scene` (what a runtime relighting of the
+/// A ray caster over the static mesh instances of `input` (what a runtime relighting of the
 /// static world shadows with). Errors: no static instance, invalid data.
-engine::Result<std::unique_ptr<RayCaster>> make_static_caster(const engine::Scene& scene);
+engine::Result<std::unique_ptr<RayCaster>> make_static_caster(const BakeInput& input);
 
-/// The enabled lights of `registry` of the given kind, as the path tracer sees them, in
-/// registry order (what reference_scene_from() lists). Cheap: no geometry is read.
+/// The lights of `input` of the given kind, as the path tracer sees them, in order.
+std::vector<ReferenceLight> bake_lights(const BakeInput& input, BakeLights lights);
+
+/// The enabled lights of a live `registry` of the given kind, as the path tracer sees them,
+/// in registry order: what the runtime relights with every frame. Cheap: no geometry is read.
 std::vector<ReferenceLight> scene_lights(const engine::Registry& registry, BakeLights lights);
 
 }  // namespace gi

@@ -1,8 +1,8 @@
 #include "transport/vpl_transport.h"
 
 #include <algorithm>
-#include <cmath>
 #include <atomic>
+#include <cmath>
 #include <numeric>
 #include <unordered_map>
 
@@ -134,7 +134,8 @@ class FormFactorRows {
       const std::uint32_t l = vpls_.sample_first[i] + static_cast<std::uint32_t>(k) % m;
       const float u1 = rng.next_float(), u2 = rng.next_float();
       const glm::vec3 d = sample_cosine_hemisphere(vpls_.sample_normal[l], u1, u2);
-      hits += caster_.occluded(Ray{offset_ray_origin(vpls_.sample_position[l], vpls_.sample_normal[l]), 0.0f, d}) ? 1 : 0;
+      hits +=
+          caster_.occluded(Ray{offset_ray_origin(vpls_.sample_position[l], vpls_.sample_normal[l]), 0.0f, d}) ? 1 : 0;
     }
     rays_ += static_cast<std::uint64_t>(reach_rays_);
     const double scale = std::clamp(static_cast<double>(hits) / reach_rays_ / sum, 0.5, 2.0);
@@ -187,9 +188,10 @@ engine::Result<VplSolution> propagate(const VplSet& vpls, const std::vector<glm:
       for (std::size_t j = 0; j < n; ++j) next[j] += shot * f[j];  // eq. 8: R = F'_ij dE_i
       ++out.shots;
       if (settings.progress && (s % 64 == 63 || s + 1 == active)) {
-        const double done = (static_cast<double>(generation - 1) + static_cast<double>(s + 1) / static_cast<double>(active)) /
-                            static_cast<double>(settings.bounces - 1);
-        if (!settings.progress(done)) return engine::Error{.message = "light-atlas bake cancelled"};
+        const double done =
+            (static_cast<double>(generation - 1) + static_cast<double>(s + 1) / static_cast<double>(active)) /
+            static_cast<double>(settings.bounces - 1);
+        if (!settings.progress(done)) return engine::cancelled_error("light-atlas bake");
       }
     }
     for (std::size_t j = 0; j < n; ++j) out.irradiance[j] += next[j];

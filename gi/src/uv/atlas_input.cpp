@@ -3,24 +3,15 @@
 #include <engine/check.h>
 
 #include <cmath>
-#include <glm/gtc/quaternion.hpp>
 #include <string>
 
 namespace gi {
 namespace {
 
-glm::mat4 local_matrix(const engine::Node& n) {
-  const glm::mat4 t =
-      glm::mat4(glm::vec4(1, 0, 0, 0), glm::vec4(0, 1, 0, 0), glm::vec4(0, 0, 1, 0), glm::vec4(n.translation, 1.0f));
-  const glm::mat4 s = glm::mat4(glm::vec4(n.scale.x, 0, 0, 0), glm::vec4(0, n.scale.y, 0, 0),
-                                glm::vec4(0, 0, n.scale.z, 0), glm::vec4(0, 0, 0, 1));
-  return t * glm::mat4_cast(n.rotation) * s;
-}
-
 bool finite(glm::vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
 // Area-weighted vertex normals of one primitive (for primitives stored without normals).
-std::vector<glm::vec3> face_normals(const engine::Primitive& p) {
+std::vector<glm::vec3> face_normals(const BakePrimitive& p) {
   std::vector<glm::vec3> n(p.positions.size(), glm::vec3(0.0f));
   for (std::size_t t = 0; t + 2 < p.indices.size(); t += 3) {
     const std::uint32_t a = p.indices[t], b = p.indices[t + 1], c = p.indices[t + 2];
@@ -43,28 +34,15 @@ std::string input_name(std::size_t i, const AtlasInputMesh& m) {
 
 }  // namespace
 
-glm::mat4 node_world_matrix(const engine::SceneAsset& scene, int node) {
-  GI_EXPECTS(node >= 0 && static_cast<std::size_t>(node) < scene.nodes.size(), "node indexes scene.nodes");
-  glm::mat4 m(1.0f);
-  // Bounded walk: a malformed parent chain cannot loop forever.
-  std::size_t steps = 0;
-  for (int i = node; i >= 0 && static_cast<std::size_t>(i) < scene.nodes.size() && steps <= scene.nodes.size();
-       i = scene.nodes[static_cast<std::size_t>(i)].parent, ++steps)
-    m = local_matrix(scene.nodes[static_cast<std::size_t>(i)]) * m;
-  return m;
-}
-
-std::vector<AtlasInputMesh> atlas_inputs_from(const engine::SceneAsset& scene) {
+std::vector<AtlasInputMesh> atlas_inputs_from(const BakeInput& input) {
   std::vector<AtlasInputMesh> inputs;
-  for (std::size_t ni = 0; ni < scene.nodes.size(); ++ni) {
-    const engine::Node& node = scene.nodes[ni];
-    if (node.mesh < 0 || static_cast<std::size_t>(node.mesh) >= scene.meshes.size()) continue;
-    if (node.gi.mobility == engine::Mobility::Dynamic) continue;
-    const glm::mat4 world = node_world_matrix(scene, static_cast<int>(ni));
+  for (const BakeInstance& inst : input.instances) {
+    if (inst.mobility != BakeMobility::Static || inst.mesh >= input.meshes.size()) continue;
+    const glm::mat4& world = inst.object_to_world;
     const glm::mat3 normal_matrix = glm::transpose(glm::inverse(glm::mat3(world)));
     AtlasInputMesh in;
-    in.id = static_cast<std::int64_t>(ni);
-    for (const engine::Primitive& prim : scene.meshes[static_cast<std::size_t>(node.mesh)].primitives) {
+    in.id = inst.id;
+    for (const BakePrimitive& prim : input.meshes[inst.mesh].primitives) {
       const auto base = static_cast<std::uint32_t>(in.positions.size());
       for (const glm::vec3& p : prim.positions) in.positions.push_back(glm::vec3(world * glm::vec4(p, 1.0f)));
       const std::vector<glm::vec3> computed =

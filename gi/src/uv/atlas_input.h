@@ -1,12 +1,11 @@
 #pragma once
 // The plain-data input of light-atlas parameterization: one static mesh instance in world
-// space per entry. Bakers and the atlas builder never walk the registry; this adapter reads
-// a SceneAsset (the glTF data) instead.
-//   std::vector<gi::AtlasInputMesh> inputs = gi::atlas_inputs_from(asset);
+// space per entry, from a BakeInput (gi/bake_input.h).
+//   std::vector<gi::AtlasInputMesh> inputs = gi::atlas_inputs_from(input);
 //   auto layout = gi::build_atlas_layout(inputs, {.texels_per_metre = 32.0f});
 
 #include <engine/result.h>
-#include <engine/scene_asset.h>
+#include <gi/bake_input.h>
 
 #include <cstdint>
 #include <glm/glm.hpp>
@@ -22,21 +21,16 @@ struct AtlasInputMesh {
   std::vector<glm::vec3> positions;  ///< World space, metres.
   std::vector<glm::vec3> normals;    ///< World space shading normals (may be empty).
   std::vector<std::uint32_t> indices;
-  std::int64_t id = -1;  ///< The caller's id; atlas_inputs_from() stores the node index.
+  std::int64_t id = -1;  ///< The caller's id; atlas_inputs_from() stores the instance's id (a node index).
 };
 
-/// World matrix of `node`: the product of the local TRS matrices along its parent chain.
-/// Precondition: `node` indexes `scene.nodes` and parents come before children.
-glm::mat4 node_world_matrix(const engine::SceneAsset& scene, int node);
-
-/// One input per node that has a mesh and whose mobility is not Dynamic (Unspecified counts
-/// as static), in node order. The mesh's primitives are concatenated in order: vertex
-/// k = i + (vertex counts of the earlier primitives) is primitive p's vertex i, and indices
-/// are offset the same way (the engine's convention). Positions and normals are transformed
-/// to world space (normals by the inverse transpose and renormalized); a primitive without
-/// normals gets area-weighted face normals. Nothing is validated here (see
-/// validate_atlas_inputs); out-of-range indices are copied as they are.
-std::vector<AtlasInputMesh> atlas_inputs_from(const engine::SceneAsset& scene);
+/// One input per Static instance, in instance order. The mesh's primitives are concatenated
+/// in order: vertex k = i + (vertex counts of the earlier primitives) is primitive p's
+/// vertex i, and indices are offset the same way (the engine's convention). Positions and
+/// normals are transformed to world space (normals by the inverse transpose and
+/// renormalized); a primitive without normals gets area-weighted face normals. Nothing is
+/// validated here (see validate_atlas_inputs); out-of-range indices are copied as they are.
+std::vector<AtlasInputMesh> atlas_inputs_from(const BakeInput& input);
 
 /// Coordinates beyond this many metres are rejected: float spacing there (6 cm at 1e6 m) is
 /// too coarse for an atlas, and areas of such triangles overflow.

@@ -4,6 +4,7 @@
 #include "brf/brf_io.h"
 
 #include <engine/gltf.h>
+#include <engine/gltf_brdf.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -16,6 +17,7 @@
 
 #include "bundle/bundle.h"
 #include "io/byte_stream.h"
+#include "raytrace/scene_adapter.h"
 
 namespace {
 
@@ -38,7 +40,7 @@ const engine::Scene& crates_room() {
 }
 
 const std::vector<gi::BrfSource>& sources() {
-  static const std::vector<gi::BrfSource> s = gi::dynamic_brf_meshes(crates_room()).value();
+  static const std::vector<gi::BrfSource> s = gi::dynamic_brf_meshes(gi::bake_input_from(crates_room())).value();
   return s;
 }
 
@@ -65,7 +67,7 @@ const gi::BrfBake& baked() {
 // A bundle with the tiny bake saved into it.
 fs::path saved_bundle(const std::string& name) {
   const fs::path dir = scratch_dir(name);
-  const engine::Status s = gi::save_brf(dir, baked(), crates_room().assets, "crates_room.gltf");
+  const engine::Status s = gi::save_brf(dir, baked(), gi::bake_input_from(crates_room().assets));
   EXPECT_TRUE(s.ok()) << s.error().to_string();
   return dir;
 }
@@ -128,10 +130,11 @@ TEST(BrfMeshes, CratesRoomGivesOneSourcePerDynamicMeshAndSkipsStaticOnes) {
   ASSERT_EQ(s.size(), 2u);
   EXPECT_EQ(s[0].name, "crate_red");
   EXPECT_EQ(s[0].mesh_index, 5u);
-  EXPECT_EQ(s[0].entities.size(), 1u);
+  EXPECT_EQ(s[0].instances.size(), 1u);
   EXPECT_EQ(s[1].name, "crate");
   EXPECT_EQ(s[1].mesh_index, 4u);
-  EXPECT_EQ(s[1].entities.size(), 4u);
+  EXPECT_EQ(s[1].instances.size(), 4u);
+  const gi::BakeInput input = gi::bake_input_from(scene);
   for (const gi::BrfSource& src : s) {
     const engine::Mesh& mesh = scene.assets.meshes[src.mesh_index];
     std::size_t vertices = 0;
@@ -142,11 +145,16 @@ TEST(BrfMeshes, CratesRoomGivesOneSourcePerDynamicMeshAndSkipsStaticOnes) {
     // Object space, in primitive order: the renderer's per-vertex buffer order.
     EXPECT_TRUE(same_bits(src.mesh.positions[0], mesh.primitives[0].positions[0]));
     for (const glm::vec3& n : src.mesh.normals) EXPECT_NEAR(glm::length(n), 1.0f, 1e-5f);
-    const engine::Material& m = scene.assets.materials[static_cast<std::size_t>(mesh.primitives[0].material)];
-    EXPECT_NEAR(src.mesh.reflectance[0], 0.2126f * m.base_color.x + 0.7152f * m.base_color.y + 0.0722f * m.base_color.z,
-                1e-6f);
+    // The folded reflectance: the luminance of the material's hemispherical albedo (both lobes).
+    const gi::BakeMaterial& m = input.materials[static_cast<std::size_t>(mesh.primitives[0].material)];
+    const glm::vec3 rho = engine::gltf_hemispherical_albedo(gi::reference_material(m).brdf).sum();
+    EXPECT_NEAR(src.mesh.reflectance[0], 0.2126f * rho.x + 0.7152f * rho.y + 0.0722f * rho.z, 1e-6f);
+    EXPECT_GT(src.mesh.reflectance[0],
+              0.2126f * m.base_color.x + 0.7152f * m.base_color.y + 0.0722f * m.base_color.z - 0.05f);
     EXPECT_EQ(src.mesh_hash, gi::brf_mesh_hash(src.mesh));
-    for (engine::Entity e : src.entities) {
+    for (std::uint32_t i : src.instances) {
+      const engine::Entity e = input.instances[i].entity;
+      EXPECT_EQ(input.instances[i].mobility, gi::BakeMobility::Dynamic);
       EXPECT_TRUE(scene.registry.has<engine::DynamicTag>(e));
       EXPECT_EQ(scene.registry.get<engine::MeshRenderer>(e).mesh, src.mesh_index);
     }
@@ -158,7 +166,7 @@ TEST(BrfMeshes, DemoLevelSkipsTheLampPivotAndStaticMeshes) {
   auto a = engine::load_gltf(GI_SOURCE_DIR "/assets/demo_level.gltf");
   ASSERT_TRUE(a.ok()) << a.error().to_string();
   const engine::Scene scene = engine::instantiate(std::move(a).value());
-  auto s = gi::dynamic_brf_meshes(scene);
+  auto s = gi::dynamic_brf_meshes(gi::bake_input_from(scene));
   ASSERT_TRUE(s.ok()) << s.error().to_string();
   std::vector<std::string> names;
   for (const gi::BrfSource& src : *s) names.push_back(src.name);
@@ -178,7 +186,7 @@ TEST(BrfMeshes, HashFollowsGeometryAndReflectance) {
 
 TEST(BrfIo, RoundTripIsBitExact) {
   const fs::path dir = saved_bundle("round_trip");
-  auto loaded = gi::load_brf(dir, crates_room());
+  auto loaded = gi::load_brf(dir, gi::bake_input_from(crates_room()));
   ASSERT_TRUE(loaded.ok()) << loaded.error().to_string();
   const gi::BrfBake& a = baked();
   ASSERT_EQ(loaded->meshes.size(), a.meshes.size());
@@ -215,9 +223,9 @@ TEST(BrfIo, RoundTripIsBitExact) {
 TEST(BrfIo, ManifestDescribesEveryMeshAndKeepsOtherMethods) {
   const fs::path dir = scratch_dir("manifest");
   fs::create_directories(dir);
-  const std::string hash = gi::scene_geometry_hash(crates_room().assets);
+  const std::string hash = gi::scene_geometry_hash(gi::bake_input_from(crates_room().assets));
   ASSERT_TRUE(gi::update_manifest_method(dir, hash, "crates_room.gltf", "prm", {{"kept", true}}).ok());
-  ASSERT_TRUE(gi::save_brf(dir, baked(), crates_room().assets, "crates_room.gltf").ok());
+  ASSERT_TRUE(gi::save_brf(dir, baked(), gi::bake_input_from(crates_room().assets)).ok());
   auto m = gi::read_manifest(dir);
   ASSERT_TRUE(m.ok()) << m.error().to_string();
   EXPECT_TRUE(m->methods.contains("prm"));
@@ -260,12 +268,12 @@ TEST(BrfIo, MissingEntryOrFileIsRejected) {
   EXPECT_NE(r.error().to_string().find("barrel"), std::string::npos) << r.error().to_string();
 
   fs::remove(dir / "brf_crate.bin");
-  r = gi::load_brf(dir, crates_room());
+  r = gi::load_brf(dir, gi::bake_input_from(crates_room()));
   ASSERT_FALSE(r.ok());
   EXPECT_EQ(r.error().file, (dir / "brf_crate.bin").string());
   EXPECT_NE(r.error().message.find("not found"), std::string::npos) << r.error().to_string();
 
-  r = gi::load_brf(scratch_dir("no_bundle"), crates_room());
+  r = gi::load_brf(scratch_dir("no_bundle"), gi::bake_input_from(crates_room()));
   ASSERT_FALSE(r.ok());
   EXPECT_NE(r.error().file.find("manifest.json"), std::string::npos);
 }
@@ -286,7 +294,7 @@ TEST(BrfIo, DamagedContainersAreRejected) {
   poke_file(file, fs::file_size(file) - 5, 0xa5);  // payload bit flips
   EXPECT_NE(read_error(file).find("checksum"), std::string::npos);
   // Through the bundle the manifest's file checksum catches it first.
-  auto r = gi::load_brf(dir, crates_room());
+  auto r = gi::load_brf(dir, gi::bake_input_from(crates_room()));
   ASSERT_FALSE(r.ok());
   EXPECT_EQ(r.error().file, file.string());
   EXPECT_NE(r.error().message.find("checksum"), std::string::npos);
@@ -294,9 +302,7 @@ TEST(BrfIo, DamagedContainersAreRejected) {
   fs::resize_file(file, fs::file_size(file) - 10);
   EXPECT_NE(read_error(file).find("truncated"), std::string::npos);
   restore();
-  {
-    std::ofstream(file, std::ios::app | std::ios::binary) << "extra";
-  }
+  { std::ofstream(file, std::ios::app | std::ios::binary) << "extra"; }
   EXPECT_NE(read_error(file).find("trailing"), std::string::npos);
   restore();
   EXPECT_TRUE(gi::read_brf_mesh(file).ok());
@@ -365,20 +371,20 @@ TEST(BrfIo, InvalidBakeRefusesToSaveAndWritesNothing) {
   const fs::path dir = scratch_dir("invalid");
   gi::BrfBake bad = baked();
   bad.meshes[0].field.coefficients[7] = std::numeric_limits<float>::infinity();
-  auto s = gi::save_brf(dir, bad, crates_room().assets, "crates_room.gltf");
+  auto s = gi::save_brf(dir, bad, gi::bake_input_from(crates_room().assets));
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.error().to_string().find("brf_crate_red.bin"), std::string::npos) << s.error().to_string();
   EXPECT_FALSE(fs::exists(dir));
 
   bad = baked();
   bad.meshes[1].basis.a_inverse.pop_back();
-  s = gi::save_brf(dir, bad, crates_room().assets, "crates_room.gltf");
+  s = gi::save_brf(dir, bad, gi::bake_input_from(crates_room().assets));
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.error().to_string().find("a_inverse"), std::string::npos);
 
   bad = baked();
   bad.meshes[1].name = bad.meshes[0].name;
-  EXPECT_FALSE(gi::save_brf(dir, bad, crates_room().assets, "crates_room.gltf").ok());
+  EXPECT_FALSE(gi::save_brf(dir, bad, gi::bake_input_from(crates_room().assets)).ok());
   EXPECT_FALSE(fs::exists(dir));
 }
 

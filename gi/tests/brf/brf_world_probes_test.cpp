@@ -1,19 +1,18 @@
 // The static world as a light source for dynamic objects (gi/src/brf/world_probes.h):
 // probe irradiance from the light atlas's VPLs against the path tracer's indirect
 // irradiance at free points of a closed box, and probes inside walls not leaking.
+#include <engine/scene.h>
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <cstdio>
 
-#include <gtest/gtest.h>
-
-#include <engine/scene.h>
-
-#include "transport/static_scene.h"
 #include "brf/world_probes.h"
 #include "light_atlas/light_atlas.h"
+#include "light_atlas_scenes.h"
 #include "raytrace/reference_render.h"
 #include "raytrace/scene_adapter.h"
-#include "light_atlas_scenes.h"
+#include "transport/static_scene.h"
 
 namespace {
 
@@ -24,8 +23,8 @@ struct BoxWithProbes {
   BoxWithProbes() {
     gi::LightAtlasSettings s = gi::light_atlas_preset("medium").value();
     s.bounces = 16;
-    atlas = gi::bake_light_atlas(scene, s).value();
-    auto caster = gi::make_static_caster(scene).value();
+    atlas = gi::bake_light_atlas(gi::bake_input_from(scene), s).value();
+    auto caster = gi::make_static_caster(gi::bake_input_from(scene)).value();
     probes = gi::bake_world_probes(*caster, atlas.vpls, atlas.vpl_power, {.spacing_m = 0.5f}).value();
   }
 };
@@ -39,11 +38,13 @@ TEST(BrfWorldProbes, IrradianceAtFreePointsMatchesThePathTracer) {
   const BoxWithProbes& b = box_with_probes();
   std::vector<gi::SurfacePoint> points;
   for (glm::vec3 p : {glm::vec3(-0.4f, -0.5f, 0.3f), glm::vec3(0.2f, 0.1f, 0.45f), glm::vec3(-0.6f, 0.5f, -0.55f)})
-    for (glm::vec3 n : {glm::vec3(1, 0, 0), glm::vec3(-1, 0, 0), glm::vec3(0, 1, 0), glm::vec3(0, -1, 0), glm::vec3(0, 0, 1)})
+    for (glm::vec3 n :
+         {glm::vec3(1, 0, 0), glm::vec3(-1, 0, 0), glm::vec3(0, 1, 0), glm::vec3(0, -1, 0), glm::vec3(0, 0, 1)})
       points.push_back({p, n});
   gi::ReferenceSettings rs;
   rs.samples_per_pixel = 2048;
-  const auto truth = gi::estimate_irradiance(gi::reference_scene_from(b.scene), points, rs).value();
+  const auto truth =
+      gi::estimate_irradiance(gi::reference_scene_from(gi::bake_input_from(b.scene)), points, rs).value();
   double err = 0.0, norm = 0.0, ours_sum = 0.0, truth_sum = 0.0;
   for (std::size_t j = 0; j < points.size(); ++j) {
     const glm::vec3 e = b.probes.irradiance(points[j].position_m, points[j].normal);
@@ -80,7 +81,7 @@ TEST(BrfWorldProbes, ProbesOutsideTheRoomAreInvalidAndDoNotDarkenItsEdges) {
 
 TEST(BrfWorldProbes, BadInputIsAnError) {
   const engine::Scene scene = engine::instantiate(latest::closed_box(2.0f, 0.6f));
-  auto caster = gi::make_static_caster(scene).value();
+  auto caster = gi::make_static_caster(gi::bake_input_from(scene)).value();
   gi::VplSet vpls;
   vpls.position = {glm::vec3(0.0f)};
   vpls.normal = {glm::vec3(0, 1, 0)};

@@ -87,7 +87,7 @@ TEST(AtlasBadInput, EmptySceneIsAnError) {
   EXPECT_NE(error_of({}).find(expected), std::string::npos) << error_of({});
   gi::AtlasInputMesh empty;
   EXPECT_NE(error_of({empty}).find(expected), std::string::npos);
-  EXPECT_TRUE(gi::atlas_inputs_from(engine::SceneAsset{}).empty());
+  EXPECT_TRUE(gi::atlas_inputs_from(gi::bake_input_from(engine::SceneAsset{})).empty());
 }
 
 TEST(AtlasBadInput, TooManyChartsForTheMaxSizeIsAnError) {

@@ -76,7 +76,7 @@ TEST(AtlasDilation, ConstantIrradianceReadsBackConstantAtChartSeamsOfEveryScene)
     SCOPED_TRACE(file.filename().string());
     auto asset = engine::load_gltf(file, {.load_images = false});
     ASSERT_TRUE(asset.ok()) << asset.error().to_string();
-    const auto inputs = gi::atlas_inputs_from(asset.value());
+    const auto inputs = gi::atlas_inputs_from(gi::bake_input_from(asset.value()));
     auto layout = gi::build_atlas_layout(inputs, {.texels_per_metre = 8.0f});
     ASSERT_TRUE(layout.ok()) << layout.error().to_string();
     const gi::AtlasTexels texels = gi::rasterize_atlas(layout.value(), inputs);

@@ -30,7 +30,7 @@ std::vector<std::filesystem::path> scene_files() {
 std::vector<gi::AtlasInputMesh> inputs_of(const std::filesystem::path& file) {
   auto asset = engine::load_gltf(file, {.load_images = false});
   EXPECT_TRUE(asset.ok()) << (asset.ok() ? "" : asset.error().to_string());
-  return asset.ok() ? gi::atlas_inputs_from(asset.value()) : std::vector<gi::AtlasInputMesh>{};
+  return asset.ok() ? gi::atlas_inputs_from(gi::bake_input_from(asset.value())) : std::vector<gi::AtlasInputMesh>{};
 }
 
 float cross2(glm::vec2 a, glm::vec2 b, glm::vec2 p) { return (b.x - a.x) * (p.y - a.y) - (b.y - a.y) * (p.x - a.x); }

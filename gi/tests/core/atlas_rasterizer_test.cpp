@@ -60,7 +60,7 @@ TEST(AtlasRasterizer, SamplesLieOnTheSurfaceWithUnitNormals) {
 TEST(AtlasRasterizer, CentreInsideOwnershipGoesToTheLowestTriangle) {
   auto asset = engine::load_gltf(GI_SOURCE_DIR "/assets/crates_room.gltf", {.load_images = false});
   ASSERT_TRUE(asset.ok()) << asset.error().to_string();
-  const auto inputs = gi::atlas_inputs_from(asset.value());
+  const auto inputs = gi::atlas_inputs_from(gi::bake_input_from(asset.value()));
   auto layout = gi::build_atlas_layout(inputs, {.texels_per_metre = 8.0f});
   ASSERT_TRUE(layout.ok()) << layout.error().to_string();
   const gi::AtlasTexels t = gi::rasterize_atlas(layout.value(), inputs);

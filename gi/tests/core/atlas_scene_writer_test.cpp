@@ -36,7 +36,7 @@ engine::Primitive quad(glm::vec3 origin) {
 TEST(AtlasSceneWriter, CornellBoxRoundTripsUv1ThroughGltf) {
   auto asset = engine::load_gltf(GI_SOURCE_DIR "/assets/cornell_box.gltf");
   ASSERT_TRUE(asset.ok()) << asset.error().to_string();
-  const auto inputs = gi::atlas_inputs_from(asset.value());
+  const auto inputs = gi::atlas_inputs_from(gi::bake_input_from(asset.value()));
   auto layout = gi::build_atlas_layout(inputs, {.texels_per_metre = 32.0f});
   ASSERT_TRUE(layout.ok()) << layout.error().to_string();
   auto with_uv1 = gi::with_atlas_uv1(asset.value(), layout.value());
@@ -71,7 +71,7 @@ TEST(AtlasSceneWriter, CornellBoxRoundTripsUv1ThroughGltf) {
   EXPECT_EQ(static_meshes, inputs.size());
 
   // Same world triangles, in the same order, after splitting.
-  const auto again = gi::atlas_inputs_from(loaded.value());
+  const auto again = gi::atlas_inputs_from(gi::bake_input_from(loaded.value()));
   ASSERT_EQ(again.size(), inputs.size());
   for (std::size_t m = 0; m < inputs.size(); ++m) {
     ASSERT_EQ(again[m].indices.size(), inputs[m].indices.size());
@@ -101,7 +101,7 @@ TEST(AtlasSceneWriter, SharedMeshesAreDuplicatedPerStaticNodeAndDynamicOnesLeftA
   d.translation = glm::vec3(0, 5, 0);
   s.nodes = {a, b, c, d};
 
-  const auto inputs = gi::atlas_inputs_from(s);
+  const auto inputs = gi::atlas_inputs_from(gi::bake_input_from(s));
   ASSERT_EQ(inputs.size(), 3u);
   EXPECT_EQ(inputs[0].id, 0);
   EXPECT_EQ(inputs[1].id, 1);
@@ -154,7 +154,7 @@ TEST(AtlasSceneWriter, SplitVerticesStayInTheirPrimitive) {
   s.meshes = {engine::Mesh{"cube", {quad(glm::vec3(0, 0, -3)), cube}}};
   s.nodes = {engine::Node{"cube"}};
   s.nodes[0].mesh = 0;
-  const auto inputs = gi::atlas_inputs_from(s);
+  const auto inputs = gi::atlas_inputs_from(gi::bake_input_from(s));
   auto layout = gi::build_atlas_layout(inputs, {.texels_per_metre = 16.0f});
   ASSERT_TRUE(layout.ok()) << layout.error().to_string();
   auto out = gi::with_atlas_uv1(s, layout.value());

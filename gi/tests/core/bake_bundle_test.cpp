@@ -198,52 +198,53 @@ TEST(BundleGeometryHash, StableForTheSameScene) {
   const engine::SceneAsset a = cornell();
   engine::SceneAsset b = cornell();
   b.source = "/elsewhere/copy.gltf";
-  const std::string h = gi::scene_geometry_hash(a);
+  const std::string h = gi::scene_geometry_hash(gi::bake_input_from(a));
   EXPECT_EQ(h.size(), 16u);
-  EXPECT_EQ(h, gi::scene_geometry_hash(a));
-  EXPECT_EQ(h, gi::scene_geometry_hash(b)) << "independent of the file path";
+  EXPECT_EQ(h, gi::scene_geometry_hash(gi::bake_input_from(a)));
+  EXPECT_EQ(h, gi::scene_geometry_hash(gi::bake_input_from(b))) << "independent of the file path";
 }
 
 TEST(BundleGeometryHash, ChangesWithStaticGeometryAndAlbedo) {
   const engine::SceneAsset base = cornell();
-  const std::string h = gi::scene_geometry_hash(base);
+  const std::string h = gi::scene_geometry_hash(gi::bake_input_from(base));
 
   engine::SceneAsset moved_vertex = base;
   moved_vertex.meshes[1].primitives[0].positions[0].y += 0.01f;  // short_block, a static node
-  EXPECT_NE(gi::scene_geometry_hash(moved_vertex), h);
+  EXPECT_NE(gi::scene_geometry_hash(gi::bake_input_from(moved_vertex)), h);
 
   engine::SceneAsset moved_node = base;
   moved_node.nodes[2].translation.x += 0.01f;  // tall_block
-  EXPECT_NE(gi::scene_geometry_hash(moved_node), h);
+  EXPECT_NE(gi::scene_geometry_hash(gi::bake_input_from(moved_node)), h);
 
   engine::SceneAsset albedo = base;
   albedo.materials[0].base_color.x *= 0.9f;
-  EXPECT_NE(gi::scene_geometry_hash(albedo), h);
+  EXPECT_NE(gi::scene_geometry_hash(gi::bake_input_from(albedo)), h);
 
   engine::SceneAsset emissive = base;
   emissive.materials[3].emissive.y += 0.5f;
-  EXPECT_NE(gi::scene_geometry_hash(emissive), h);
+  EXPECT_NE(gi::scene_geometry_hash(gi::bake_input_from(emissive)), h);
 }
 
 TEST(BundleGeometryHash, IgnoresDynamicNodes) {
   engine::SceneAsset base = cornell();
   base.nodes[2].gi.mobility = engine::Mobility::Dynamic;  // the tall block becomes a movable prop
-  const std::string h = gi::scene_geometry_hash(base);
-  EXPECT_NE(h, gi::scene_geometry_hash(cornell())) << "what is static is part of the hash";
+  const std::string h = gi::scene_geometry_hash(gi::bake_input_from(base));
+  EXPECT_NE(h, gi::scene_geometry_hash(gi::bake_input_from(cornell()))) << "what is static is part of the hash";
 
   engine::SceneAsset moved = base;
   moved.nodes[2].translation.x += 0.3f;
   moved.nodes[2].rotation = glm::angleAxis(0.5f, glm::vec3(0, 1, 0));
-  EXPECT_EQ(gi::scene_geometry_hash(moved), h);
+  EXPECT_EQ(gi::scene_geometry_hash(gi::bake_input_from(moved)), h);
   moved.meshes[2].primitives[0].positions[0].y += 0.2f;  // its own mesh deforms
-  EXPECT_EQ(gi::scene_geometry_hash(moved), h);
+  EXPECT_EQ(gi::scene_geometry_hash(gi::bake_input_from(moved)), h);
 }
 
 TEST(BundleLightsHash, ChangesWithStaticLightsOnly) {
   const engine::SceneAsset base = cornell();
-  const std::string h = gi::static_lights_hash(base);
-  EXPECT_EQ(gi::static_lights_hash(cornell()), h);
-  EXPECT_EQ(gi::scene_geometry_hash(base), gi::scene_geometry_hash(base)) << "lights do not enter the geometry hash";
+  const std::string h = gi::static_lights_hash(gi::bake_input_from(base));
+  EXPECT_EQ(gi::static_lights_hash(gi::bake_input_from(cornell())), h);
+  EXPECT_EQ(gi::scene_geometry_hash(gi::bake_input_from(base)), gi::scene_geometry_hash(gi::bake_input_from(base)))
+      << "lights do not enter the geometry hash";
 
   int light_node = -1;
   for (std::size_t n = 0; n < base.nodes.size(); ++n)
@@ -254,17 +255,17 @@ TEST(BundleLightsHash, ChangesWithStaticLightsOnly) {
 
   engine::SceneAsset brighter = base;
   brighter.lights[li].light.intensity *= 2.0f;
-  EXPECT_NE(gi::static_lights_hash(brighter), h);
-  EXPECT_EQ(gi::scene_geometry_hash(brighter), gi::scene_geometry_hash(base));
+  EXPECT_NE(gi::static_lights_hash(gi::bake_input_from(brighter)), h);
+  EXPECT_EQ(gi::scene_geometry_hash(gi::bake_input_from(brighter)), gi::scene_geometry_hash(gi::bake_input_from(base)));
   engine::SceneAsset moved = base;
   moved.nodes[ln].translation.x += 0.01f;
-  EXPECT_NE(gi::static_lights_hash(moved), h);
+  EXPECT_NE(gi::static_lights_hash(gi::bake_input_from(moved)), h);
 
   // A light that moves at runtime is not part of a static bake: editing it keeps the hash.
   engine::SceneAsset dynamic = base;
   dynamic.lights[li].light.moves = true;
-  const std::string hd = gi::static_lights_hash(dynamic);
+  const std::string hd = gi::static_lights_hash(gi::bake_input_from(dynamic));
   dynamic.lights[li].light.intensity *= 3.0f;
   dynamic.nodes[ln].translation.y -= 0.1f;
-  EXPECT_EQ(gi::static_lights_hash(dynamic), hd);
+  EXPECT_EQ(gi::static_lights_hash(gi::bake_input_from(dynamic)), hd);
 }

@@ -1,11 +1,10 @@
 // Error metrics against hand-computed values (gi/src/metrics/error_metrics.h).
+#include <engine/display_transform.h>
+#include <gi/error_metrics.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <limits>
-
-#include "metrics/display_tonemap.h"
-#include "metrics/error_metrics.h"
 
 namespace {
 
@@ -133,18 +132,18 @@ TEST(ErrorMetrics, NaNAndInfInputsAreCountedAndReported) {
 TEST(ErrorMetrics, PsnrOfTonemappedImages) {
   // 1000 tonemaps to exactly 1 (ACES fit clamps), 0 to 0: one of two elements fully wrong
   // gives MSE 0.5 -> 10 log10(2) dB.
-  EXPECT_NEAR(gi::display_tonemap(1000.0, 1.0), 1.0, 1e-12);
-  EXPECT_EQ(gi::display_tonemap(0.0, 1.0), 0.0);
-  EXPECT_EQ(gi::display_tonemap(-5.0, 1.0), 0.0);
+  EXPECT_NEAR(engine::display_tonemap(1000.0, 1.0), 1.0, 1e-12);
+  EXPECT_EQ(engine::display_tonemap(0.0, 1.0), 0.0);
+  EXPECT_EQ(engine::display_tonemap(-5.0, 1.0), 0.0);
   const gi::RgbField r = field_of(2, 1, {1000.0f, 1000.0f, 1000.0f, 0.0f, 0.0f, 0.0f});
   const gi::RgbField a = gi::RgbField::filled(2, 1, 0.0f);
   EXPECT_NEAR(gi::tonemapped_psnr_db(a, r), 10.0 * std::log10(2.0), 1e-9);
   // Exposure scales before the curve: 0.18 at exposure 2 tonemaps like 0.36.
-  EXPECT_DOUBLE_EQ(gi::display_tonemap(0.18, 2.0), gi::display_tonemap(0.36, 1.0));
+  EXPECT_DOUBLE_EQ(engine::display_tonemap(0.18, 2.0), engine::display_tonemap(0.36, 1.0));
   // Matches the shader's curve at a mid-grey value.
   const double x = 0.18;
   const double aces = x * (2.51 * x + 0.03) / (x * (2.43 * x + 0.59) + 0.14);
-  EXPECT_NEAR(gi::display_tonemap(0.18, 1.0), 1.055 * std::pow(aces, 1.0 / 2.4) - 0.055, 1e-12);
+  EXPECT_NEAR(engine::display_tonemap(0.18, 1.0), 1.055 * std::pow(aces, 1.0 / 2.4) - 0.055, 1e-12);
 }
 
 TEST(ErrorMetricsDeathTest, DifferentLayoutsAreAProgrammerError) {

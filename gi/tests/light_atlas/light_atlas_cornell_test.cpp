@@ -1,14 +1,13 @@
 // The light-atlas baker against the reference path tracer's per-texel indirect irradiance:
 // the measured Cornell box and the corridor whose light needs several bounces.
-#include <cstdio>
-
-#include <gtest/gtest.h>
-
 #include <engine/gltf.h>
 #include <engine/scene.h>
+#include <gi/error_metrics.h>
+#include <gtest/gtest.h>
+
+#include <cstdio>
 
 #include "light_atlas/light_atlas.h"
-#include "metrics/error_metrics.h"
 #include "raytrace/atlas_reference.h"
 #include "uv/atlas_input.h"
 #include "uv/atlas_rasterizer.h"
@@ -22,14 +21,14 @@ engine::Scene load(const char* name) {
 }
 
 gi::AtlasIrradiance reference(const engine::Scene& scene, float density, int spp, int bounces = -1) {
-  const auto inputs = gi::atlas_inputs_from(scene.assets);
+  const auto inputs = gi::atlas_inputs_from(gi::bake_input_from(scene.assets));
   auto layout = gi::build_atlas_layout(inputs, {.texels_per_metre = density});
   EXPECT_TRUE(layout);
   gi::ReferenceSettings rs;
   rs.samples_per_pixel = spp;
   rs.seed = 77;
   rs.max_bounces = bounces;
-  auto truth = gi::reference_atlas_irradiance(scene, gi::rasterize_atlas(*layout, inputs), rs);
+  auto truth = gi::reference_atlas_irradiance(gi::bake_input_from(scene), gi::rasterize_atlas(*layout, inputs), rs);
   EXPECT_TRUE(truth);
   return std::move(truth).value();
 }
@@ -43,10 +42,11 @@ TEST(LightAtlasCornell, HighPresetMatchesReference) {
   const gi::AtlasIrradiance truth = reference(scene, 32.0f, 4096);
   gi::LightAtlasSettings s = gi::light_atlas_preset("high").value();
   s.texels_per_metre = 32.0f;
-  auto bake = gi::bake_light_atlas(scene, s);
+  auto bake = gi::bake_light_atlas(gi::bake_input_from(scene), s);
   ASSERT_TRUE(bake) << bake.error().to_string();
-  const gi::ErrorReport e = gi::compare_rgb(gi::RgbField::from_texels(bake->width, bake->height, bake->irradiance, bake->valid),
-                                            gi::RgbField::from_texels(truth.width, truth.height, truth.indirect, truth.valid));
+  const gi::ErrorReport e =
+      gi::compare_rgb(gi::RgbField::from_texels(bake->width, bake->height, bake->irradiance, bake->valid),
+                      gi::RgbField::from_texels(truth.width, truth.height, truth.indirect, truth.valid));
   std::printf("Cornell box, %zu VPLs, %d bounces: rel RMSE %.4f (scale fit %.4f, after fit %.4f), bake %.2f s\n",
               bake->stats.vpls, s.bounces, e.rel_rmse, e.fit_scale, e.fit_rel_rmse, bake->stats.total_seconds);
   EXPECT_LT(e.rel_rmse, 0.06);
@@ -65,7 +65,7 @@ TEST(LightAtlasCorridor, FiveBouncesReachTheCorridorOneBounceDoesNot) {
   const auto in_corridor = [](glm::vec3 p) { return p.x > 6.25f && (p.z > 4.25f || p.x > 7.85f); };
   double ref_sum = 0.0;
   std::vector<std::uint8_t> mask(truth.valid.size(), 0);
-  const auto inputs = gi::atlas_inputs_from(scene.assets);
+  const auto inputs = gi::atlas_inputs_from(gi::bake_input_from(scene.assets));
   const gi::AtlasTexels texels =
       gi::rasterize_atlas(gi::build_atlas_layout(inputs, {.texels_per_metre = density}).value(), inputs);
   for (std::size_t t = 0; t < mask.size(); ++t) {
@@ -79,14 +79,15 @@ TEST(LightAtlasCorridor, FiveBouncesReachTheCorridorOneBounceDoesNot) {
     s.texels_per_metre = density;
     s.vpl_count = 1500;
     s.bounces = b;
-    auto bake = gi::bake_light_atlas(scene, s);
+    auto bake = gi::bake_light_atlas(gi::bake_input_from(scene), s);
     ASSERT_TRUE(bake) << bake.error().to_string();
     double sum = 0.0;
     for (std::size_t t = 0; t < mask.size(); ++t)
       if (mask[t]) sum += static_cast<double>(bake->irradiance[t].y);
     ratio[b == 1 ? 0 : 1] = sum / ref_sum;
-    const gi::ErrorReport e = gi::compare_rgb(gi::RgbField::from_texels(bake->width, bake->height, bake->irradiance, mask),
-                                              gi::RgbField::from_texels(truth.width, truth.height, truth.indirect, mask));
+    const gi::ErrorReport e =
+        gi::compare_rgb(gi::RgbField::from_texels(bake->width, bake->height, bake->irradiance, mask),
+                        gi::RgbField::from_texels(truth.width, truth.height, truth.indirect, mask));
     std::printf("corridor, %d bounce(s): corridor irradiance / reference %.4f, rel RMSE there %.4f, bake %.2f s\n", b,
                 sum / ref_sum, e.rel_rmse, bake->stats.total_seconds);
   }

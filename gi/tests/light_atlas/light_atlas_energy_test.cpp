@@ -1,15 +1,14 @@
 // The light-atlas baker's energy bookkeeping in a closed box: the multi-bounce series.
+#include <engine/scene.h>
+#include <gtest/gtest.h>
+
 #include <cstdio>
 #include <numbers>
 
-#include <gtest/gtest.h>
-
-#include <engine/scene.h>
-
 #include "light_atlas/light_atlas.h"
-#include "transport/vpl_set.h"
 #include "light_atlas_scenes.h"
 #include "raytrace/scene_adapter.h"
+#include "transport/vpl_set.h"
 
 namespace {
 
@@ -19,13 +18,16 @@ namespace {
 TEST(LightAtlasEnergy, ClosedBoxMatchesGeometricSeries) {
   for (float base : {0.5f, 0.8f}) {
     const engine::Scene scene = engine::instantiate(latest::closed_box(2.0f, base, {0.3f, -0.2f, 0.1f}, 5.0f));
-    const double rho = double{engine::gltf_hemispherical_albedo(gi::reference_material(scene.assets.materials[0]).brdf).sum().y};
+    const double rho =
+        double{engine::gltf_hemispherical_albedo(gi::reference_material(gi::bake_input_from(scene).materials[0]).brdf)
+                   .sum()
+                   .y};
     gi::LightAtlasSettings s;
     s.texels_per_metre = 8.0f;
     s.vpl_count = 600;
     s.bounces = 64;
     s.unshot_threshold = 0.0f;
-    auto bake = gi::bake_light_atlas(scene, s);
+    auto bake = gi::bake_light_atlas(gi::bake_input_from(scene), s);
     ASSERT_TRUE(bake) << bake.error().to_string();
     double reflected = 0.0;
     for (const glm::vec3& e : bake->vpl_power) reflected += static_cast<double>(e.y);

@@ -14,8 +14,8 @@
 #include <string>
 
 #include "bundle/bundle.h"
-#include "light_atlas/light_atlas_vpl_file.h"
 #include "io/content_hash.h"
+#include "light_atlas/light_atlas_vpl_file.h"
 #include "uv/atlas_input.h"
 
 namespace {
@@ -38,7 +38,7 @@ engine::SceneAsset cornell() {
 // A bake made by hand: the real layout, a deterministic irradiance pattern, three VPLs.
 gi::LightAtlasBake fake_bake(const engine::SceneAsset& asset) {
   gi::LightAtlasBake b;
-  auto layout = gi::build_atlas_layout(gi::atlas_inputs_from(asset), {.texels_per_metre = 4.0f});
+  auto layout = gi::build_atlas_layout(gi::atlas_inputs_from(gi::bake_input_from(asset)), {.texels_per_metre = 4.0f});
   EXPECT_TRUE(layout.ok()) << layout.error().to_string();
   b.layout = std::move(layout).value();
   b.width = b.layout.width;
@@ -86,14 +86,13 @@ gi::LightAtlasBake fake_bake(const engine::SceneAsset& asset) {
 fs::path saved_bundle(const std::string& name) {
   const fs::path dir = scratch_dir(name);
   const engine::SceneAsset asset = cornell();
-  const engine::Status s =
-      gi::save_light_atlas(dir, fake_bake(asset), asset, "cornell_box.gltf");
+  const engine::Status s = gi::save_light_atlas(dir, fake_bake(asset), gi::bake_input_from(asset));
   EXPECT_TRUE(s.ok()) << s.error().to_string();
   return dir;
 }
 
 void expect_load_error(const fs::path& dir, const std::string& file, const std::string& what) {
-  auto r = gi::load_light_atlas(dir, cornell());
+  auto r = gi::load_light_atlas(dir, gi::bake_input_from(cornell()));
   ASSERT_FALSE(r.ok()) << "a bad bundle loaded (" << what << ")";
   std::printf("rejected as expected: %s\n", r.error().to_string().c_str());
   EXPECT_NE(r.error().to_string().find(file), std::string::npos) << r.error().to_string();
@@ -116,7 +115,7 @@ TEST(LightAtlasIo, RoundTripIsBitExact) {
   EXPECT_TRUE(fs::exists(dir / "light_atlas_vpls.bin"));
   EXPECT_TRUE(fs::exists(dir / "manifest.json"));
 
-  auto back = gi::load_light_atlas(dir, asset);
+  auto back = gi::load_light_atlas(dir, gi::bake_input_from(asset));
   ASSERT_TRUE(back.ok()) << back.error().to_string();
   EXPECT_EQ(back->width, bake.width);
   EXPECT_EQ(back->height, bake.height);
@@ -170,12 +169,12 @@ TEST(LightAtlasIo, StaleBundleIsRejectedWithBothHashes) {
   const fs::path dir = saved_bundle("stale");
   engine::SceneAsset changed = cornell();
   changed.meshes[1].primitives[0].positions[0].x += 0.02f;
-  auto r = gi::load_light_atlas(dir, changed);
+  auto r = gi::load_light_atlas(dir, gi::bake_input_from(changed));
   ASSERT_FALSE(r.ok());
   const std::string message = r.error().to_string();
   EXPECT_NE(message.find("stale"), std::string::npos) << message;
-  EXPECT_NE(message.find(gi::scene_geometry_hash(cornell())), std::string::npos) << message;
-  EXPECT_NE(message.find(gi::scene_geometry_hash(changed)), std::string::npos) << message;
+  EXPECT_NE(message.find(gi::scene_geometry_hash(gi::bake_input_from(cornell()))), std::string::npos) << message;
+  EXPECT_NE(message.find(gi::scene_geometry_hash(gi::bake_input_from(changed))), std::string::npos) << message;
   EXPECT_NE(message.find("manifest.json"), std::string::npos) << message;
 }
 
@@ -184,14 +183,14 @@ TEST(LightAtlasIo, AtlasBakedUnderOtherStaticLightsIsRejected) {
   engine::SceneAsset relit = cornell();
   ASSERT_FALSE(relit.lights.empty());
   relit.lights[0].light.intensity *= 1.5f;
-  auto r = gi::load_light_atlas(dir, relit);
+  auto r = gi::load_light_atlas(dir, gi::bake_input_from(relit));
   ASSERT_FALSE(r.ok());
   const std::string message = r.error().to_string();
   EXPECT_NE(message.find("stale light atlas"), std::string::npos) << message;
-  EXPECT_NE(message.find(gi::static_lights_hash(cornell())), std::string::npos) << message;
-  EXPECT_NE(message.find(gi::static_lights_hash(relit)), std::string::npos) << message;
+  EXPECT_NE(message.find(gi::static_lights_hash(gi::bake_input_from(cornell()))), std::string::npos) << message;
+  EXPECT_NE(message.find(gi::static_lights_hash(gi::bake_input_from(relit))), std::string::npos) << message;
   // The same bundle still loads for the scene it was baked from.
-  EXPECT_TRUE(gi::load_light_atlas(dir, cornell()).ok());
+  EXPECT_TRUE(gi::load_light_atlas(dir, gi::bake_input_from(cornell())).ok());
 }
 
 TEST(LightAtlasIo, MissingOrDamagedFilesAreRejected) {
@@ -296,7 +295,7 @@ TEST(LightAtlasIo, InconsistentVplsAreNotSaved) {
   gi::LightAtlasBake bake = fake_bake(asset);
   bake.vpls.sample_first = {0, 2, 1, 5};
   const fs::path dir = scratch_dir("bad_vpls");
-  const engine::Status s = gi::save_light_atlas(dir, bake, asset, "cornell_box.gltf");
+  const engine::Status s = gi::save_light_atlas(dir, bake, gi::bake_input_from(asset));
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.error().to_string().find("sample_first"), std::string::npos) << s.error().to_string();
   EXPECT_TRUE(!fs::exists(dir) || fs::is_empty(dir)) << "a failed save writes nothing";

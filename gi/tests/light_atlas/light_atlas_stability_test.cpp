@@ -1,17 +1,16 @@
 // The light-atlas baker on hard cases: albedo close to 1, a light touching a wall, tiny and
 // huge scenes, thread-count independence, lights that move, and the incremental update.
+#include <engine/scene.h>
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 
-#include <gtest/gtest.h>
-
-#include <engine/scene.h>
-
 #include "light_atlas/light_atlas.h"
-#include "transport/vpl_set.h"
 #include "light_atlas_scenes.h"
 #include "raytrace/scene_adapter.h"
+#include "transport/vpl_set.h"
 
 namespace {
 
@@ -58,10 +57,11 @@ double max_radiosity(const gi::LightAtlasBake& b) {
 
 TEST(LightAtlasStability, AlbedoNearOneKeepsTheSeries) {
   const engine::Scene scene = engine::instantiate(latest::closed_box(2.0f, 0.95f, {0.3f, -0.2f, 0.1f}, 5.0f));
-  const double rho = double{engine::gltf_hemispherical_albedo(gi::reference_material(scene.assets.materials[0]).brdf).sum().y};
+  const double rho = double{
+      engine::gltf_hemispherical_albedo(gi::reference_material(gi::bake_input_from(scene).materials[0]).brdf).sum().y};
   gi::LightAtlasSettings s = small_settings();
   s.bounces = 64;
-  const gi::LightAtlasBake b = gi::bake_light_atlas(scene, s).value();
+  const gi::LightAtlasBake b = gi::bake_light_atlas(gi::bake_input_from(scene), s).value();
   double reflected = 0.0;
   for (const glm::vec3& e : b.vpl_power) reflected += static_cast<double>(e.y);
   // 64 bounces of the series rho^k: the truncated sum, not the infinite one.
@@ -80,8 +80,8 @@ TEST(LightAtlasStability, LightOneMillimetreFromAWallIsBounded) {
   // The box spans [-1, 1]^3: the light sits 1 mm from the wall x = 1.
   const engine::Scene near = engine::instantiate(latest::closed_box(2.0f, 0.5f, {0.999f, 0.0f, 0.0f}, 5.0f));
   const engine::Scene mid = engine::instantiate(latest::closed_box(2.0f, 0.5f, {0.0f, 0.0f, 0.0f}, 5.0f));
-  const gi::LightAtlasBake a = gi::bake_light_atlas(near, small_settings()).value();
-  const gi::LightAtlasBake b = gi::bake_light_atlas(mid, small_settings()).value();
+  const gi::LightAtlasBake a = gi::bake_light_atlas(gi::bake_input_from(near), small_settings()).value();
+  const gi::LightAtlasBake b = gi::bake_light_atlas(gi::bake_input_from(mid), small_settings()).value();
   const AtlasSummary sa = summarize(a), sb = summarize(b);
   std::printf("light 1 mm from a wall: mean %.4f max %.4f (max radiosity %.4f); centred: mean %.4f max %.4f\n", sa.mean,
               sa.max, max_radiosity(a), sb.mean, sb.max);
@@ -101,10 +101,11 @@ TEST(LightAtlasStability, TinyAndHugeScenesScaleExactly) {
   const float sides[3] = {0.01f, 1.0f, 1000.0f};
   for (int k = 0; k < 3; ++k) {
     const float side = sides[k];
-    const engine::Scene scene = engine::instantiate(latest::closed_box(side, 0.6f, glm::vec3(0.1f, -0.2f, 0.15f) * side, 5.0f));
+    const engine::Scene scene =
+        engine::instantiate(latest::closed_box(side, 0.6f, glm::vec3(0.1f, -0.2f, 0.15f) * side, 5.0f));
     gi::LightAtlasSettings s = small_settings();
     s.texels_per_metre = 8.0f / side;
-    const gi::LightAtlasBake b = gi::bake_light_atlas(scene, s).value();
+    const gi::LightAtlasBake b = gi::bake_light_atlas(gi::bake_input_from(scene), s).value();
     const AtlasSummary a = summarize(b);
     EXPECT_TRUE(a.finite && a.non_negative) << "side " << side;
     scaled[k] = a.mean * static_cast<double>(side) * static_cast<double>(side);
@@ -118,11 +119,11 @@ TEST(LightAtlasStability, BitIdenticalForAnyThreadCount) {
   const engine::Scene scene = engine::instantiate(latest::closed_box(2.0f, 0.7f, {0.3f, -0.2f, 0.1f}, 5.0f));
   gi::LightAtlasSettings s = small_settings();
   s.threads = 1;
-  const gi::LightAtlasBake one = gi::bake_light_atlas(scene, s).value();
+  const gi::LightAtlasBake one = gi::bake_light_atlas(gi::bake_input_from(scene), s).value();
   s.threads = 2;
-  const gi::LightAtlasBake two = gi::bake_light_atlas(scene, s).value();
+  const gi::LightAtlasBake two = gi::bake_light_atlas(gi::bake_input_from(scene), s).value();
   s.threads = 5;
-  const gi::LightAtlasBake five = gi::bake_light_atlas(scene, s).value();
+  const gi::LightAtlasBake five = gi::bake_light_atlas(gi::bake_input_from(scene), s).value();
   EXPECT_TRUE(one.irradiance == two.irradiance);
   EXPECT_TRUE(one.irradiance == five.irradiance);
   EXPECT_TRUE(one.vpl_power == five.vpl_power);
@@ -133,7 +134,7 @@ TEST(LightAtlasStability, MovingLightsAreNotBaked) {
   const engine::Entity lamp = engine::find_by_name(scene.registry, "lamp");
   ASSERT_FALSE(lamp.is_null());
   scene.registry.write<engine::Light>(lamp).moves = true;
-  const gi::LightAtlasBake b = gi::bake_light_atlas(scene, small_settings()).value();
+  const gi::LightAtlasBake b = gi::bake_light_atlas(gi::bake_input_from(scene), small_settings()).value();
   EXPECT_EQ(summarize(b).max, 0.0);
 }
 
@@ -141,16 +142,16 @@ TEST(LightAtlasIncremental, ThresholdZeroEqualsFullRebakeAndThresholdSkipsVpls) 
   engine::Scene scene = engine::instantiate(latest::closed_box(2.0f, 0.6f, {0.3f, -0.2f, 0.1f}, 5.0f));
   gi::LightAtlasSettings s = small_settings();
   s.bounces = 8;
-  gi::LightAtlasBake bake = gi::bake_light_atlas(scene, s).value();
+  gi::LightAtlasBake bake = gi::bake_light_atlas(gi::bake_input_from(scene), s).value();
   gi::LightAtlasBake coarse = bake;
 
   // The lamp gets brighter and moves a little (a static light edited between bakes).
   const engine::Entity lamp = engine::find_by_name(scene.registry, "lamp");
   scene.registry.write<engine::Light>(lamp).intensity = 8.0f;
   scene.registry.write<engine::WorldTransform>(lamp).matrix[3] = glm::vec4(0.2f, -0.1f, 0.1f, 1.0f);
-  const gi::LightAtlasBake full = gi::bake_light_atlas(scene, s).value();
+  const gi::LightAtlasBake full = gi::bake_light_atlas(gi::bake_input_from(scene), s).value();
 
-  const auto update = gi::update_light_atlas(scene, bake, 0.0f);
+  const auto update = gi::update_light_atlas(gi::bake_input_from(scene), bake, 0.0f);
   ASSERT_TRUE(update) << update.error().to_string();
   double err = 0.0, norm = 0.0;
   for (std::size_t t = 0; t < full.irradiance.size(); ++t) {
@@ -162,7 +163,7 @@ TEST(LightAtlasIncremental, ThresholdZeroEqualsFullRebakeAndThresholdSkipsVpls) 
   EXPECT_LT(std::sqrt(err / norm), 1e-4);
   EXPECT_EQ(update->reshot_vpls, bake.vpls.size());
 
-  const auto partial = gi::update_light_atlas(scene, coarse, 0.05f);
+  const auto partial = gi::update_light_atlas(gi::bake_input_from(scene), coarse, 0.05f);
   ASSERT_TRUE(partial);
   err = 0.0;
   for (std::size_t t = 0; t < full.irradiance.size(); ++t) {

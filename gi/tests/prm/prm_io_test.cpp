@@ -48,7 +48,8 @@ const engine::SceneAsset& cornell() {
 // half range up to 2e5 (pane 3).
 gi::Prm fake_prm(float texels_per_metre = 4.0f) {
   gi::Prm p;
-  auto layout = gi::build_atlas_layout(gi::atlas_inputs_from(cornell()), {.texels_per_metre = texels_per_metre});
+  auto layout = gi::build_atlas_layout(gi::atlas_inputs_from(gi::bake_input_from(cornell())),
+                                       {.texels_per_metre = texels_per_metre});
   EXPECT_TRUE(layout.ok()) << layout.error().to_string();
   p.layout = std::move(layout).value();
   p.width = p.layout.width;
@@ -96,7 +97,7 @@ gi::Prm fake_prm(float texels_per_metre = 4.0f) {
 
 fs::path saved_bundle(const std::string& name, const gi::Prm& prm = fake_prm()) {
   const fs::path dir = scratch_dir(name);
-  const engine::Status s = gi::save_prm(dir, prm, cornell(), "cornell_box.gltf");
+  const engine::Status s = gi::save_prm(dir, prm, gi::bake_input_from(cornell()));
   EXPECT_TRUE(s.ok()) << s.error().to_string();
   return dir;
 }
@@ -108,7 +109,7 @@ void expect_error(const engine::Error& e, const std::string& file, const std::st
 }
 
 void expect_load_error(const fs::path& dir, const std::string& file, const std::string& what) {
-  auto r = gi::load_prm(dir, cornell());
+  auto r = gi::load_prm(dir, gi::bake_input_from(cornell()));
   ASSERT_FALSE(r.ok()) << "a bad bundle loaded (" << what << ")";
   expect_error(r.error(), file, what);
 }
@@ -167,8 +168,10 @@ PaneError pane_error(const gi::Prm& a, const gi::Prm& b) {
     for (std::size_t j = c * per_pane; j < (c + 1) * per_pane; ++j) {
       const double v = a.panes[j], d = b.panes[j];
       const double bound = gi::kPrmPaneRelativeError * v + gi::kPrmPaneAbsoluteErrorOfMax * max_c;
-      if (bound > 0.0) e.worst_of_bound = std::max(e.worst_of_bound, std::abs(d - v) / bound);
-      else EXPECT_EQ(d, v);
+      if (bound > 0.0)
+        e.worst_of_bound = std::max(e.worst_of_bound, std::abs(d - v) / bound);
+      else
+        EXPECT_EQ(d, v);
       if (v >= 1e-6 * max_c && v > 0.0) e.max_relative = std::max(e.max_relative, std::abs(d - v) / v);
     }
   }
@@ -203,7 +206,7 @@ TEST(PrmIo, RoundTripKeepsStructureExactAndPanesWithinTheHalfBound) {
   EXPECT_TRUE(fs::exists(dir / "prm_panes.bin"));
   EXPECT_TRUE(fs::exists(dir / "manifest.json"));
 
-  auto back = gi::load_prm(dir, cornell());
+  auto back = gi::load_prm(dir, gi::bake_input_from(cornell()));
   ASSERT_TRUE(back.ok()) << back.error().to_string();
   EXPECT_EQ(back->width, prm.width);
   EXPECT_EQ(back->height, prm.height);
@@ -251,7 +254,7 @@ TEST(PrmIo, RoundTripKeepsStructureExactAndPanesWithinTheHalfBound) {
   EXPECT_EQ(x.total_seconds, y.total_seconds);
 
   // Loading again gives the same values (the format is deterministic).
-  auto again = gi::load_prm(dir, cornell());
+  auto again = gi::load_prm(dir, gi::bake_input_from(cornell()));
   ASSERT_TRUE(again.ok());
   EXPECT_EQ(again->panes, back->panes);
 }
@@ -262,7 +265,7 @@ TEST(PrmIo, ManifestEntryDescribesTheBake) {
   auto m = gi::read_manifest(dir);
   ASSERT_TRUE(m.ok()) << m.error().to_string();
   EXPECT_EQ(m->scene, "cornell_box.gltf");
-  EXPECT_EQ(m->geometry_hash, gi::scene_geometry_hash(cornell()));
+  EXPECT_EQ(m->geometry_hash, gi::scene_geometry_hash(gi::bake_input_from(cornell())));
   const nlohmann::json& e = m->methods["prm"];
   std::printf("%s\n", e.dump(2).c_str());
   EXPECT_EQ(e["files"]["panes"]["file"], "prm_panes.bin");
@@ -297,10 +300,10 @@ TEST(PrmIo, ManifestEntryDescribesTheBake) {
 TEST(PrmIo, SavingKeepsOtherMethodsEntries) {
   const fs::path dir = scratch_dir("other_methods");
   fs::create_directories(dir);
-  ASSERT_TRUE(gi::update_manifest_method(dir, gi::scene_geometry_hash(cornell()), "cornell_box.gltf", "light_atlas",
-                                         nlohmann::json{{"marker", 7}})
+  ASSERT_TRUE(gi::update_manifest_method(dir, gi::scene_geometry_hash(gi::bake_input_from(cornell())),
+                                         "cornell_box.gltf", "light_atlas", nlohmann::json{{"marker", 7}})
                   .ok());
-  ASSERT_TRUE(gi::save_prm(dir, fake_prm(), cornell(), "cornell_box.gltf").ok());
+  ASSERT_TRUE(gi::save_prm(dir, fake_prm(), gi::bake_input_from(cornell())).ok());
   auto m = gi::read_manifest(dir);
   ASSERT_TRUE(m.ok());
   EXPECT_EQ(m->methods["light_atlas"]["marker"], 7);
@@ -334,7 +337,7 @@ TEST(PrmIo, CompressionShrinksSmoothPanes) {
               std::size_t{16}, n, half_bytes, file_bytes,
               static_cast<double>(half_bytes) / static_cast<double>(file_bytes), prm.panes.size() * 4);
   EXPECT_LT(file_bytes, half_bytes);
-  auto back = gi::load_prm(dir, cornell());
+  auto back = gi::load_prm(dir, gi::bake_input_from(cornell()));
   ASSERT_TRUE(back.ok()) << back.error().to_string();
   EXPECT_LE(pane_error(prm, *back).worst_of_bound, 1.0);
 
@@ -350,12 +353,12 @@ TEST(PrmIo, StaleBundleIsRejectedWithBothHashes) {
   const fs::path dir = saved_bundle("stale");
   engine::SceneAsset changed = cornell();
   changed.meshes[1].primitives[0].positions[0].x += 0.02f;
-  auto r = gi::load_prm(dir, changed);
+  auto r = gi::load_prm(dir, gi::bake_input_from(changed));
   ASSERT_FALSE(r.ok());
   const std::string message = r.error().to_string();
   EXPECT_NE(message.find("stale"), std::string::npos) << message;
-  EXPECT_NE(message.find(gi::scene_geometry_hash(cornell())), std::string::npos) << message;
-  EXPECT_NE(message.find(gi::scene_geometry_hash(changed)), std::string::npos) << message;
+  EXPECT_NE(message.find(gi::scene_geometry_hash(gi::bake_input_from(cornell()))), std::string::npos) << message;
+  EXPECT_NE(message.find(gi::scene_geometry_hash(gi::bake_input_from(changed))), std::string::npos) << message;
   EXPECT_NE(message.find("manifest.json"), std::string::npos) << message;
 }
 
@@ -364,7 +367,7 @@ TEST(PrmIo, EditedLightsDoNotMakeThePrmStale) {
   engine::SceneAsset relit = cornell();
   ASSERT_FALSE(relit.lights.empty());
   relit.lights[0].light.intensity *= 3.0f;
-  auto r = gi::load_prm(dir, relit);
+  auto r = gi::load_prm(dir, gi::bake_input_from(relit));
   EXPECT_TRUE(r.ok()) << r.error().to_string();
 }
 
@@ -551,7 +554,7 @@ TEST(PrmIo, RandomByteFlipsNeverCrash) {
       p[at] ^= static_cast<std::byte>(1u << (rng() % 8));
     }
     put_payload(dir, p);
-    auto r = gi::load_prm(dir, cornell());
+    auto r = gi::load_prm(dir, gi::bake_input_from(cornell()));
     if (r.ok()) {
       ++loaded;
       EXPECT_EQ(r->panes.size(), static_cast<std::size_t>(r->cluster_count) * r->texels.size() * 3);
@@ -567,7 +570,7 @@ TEST(PrmIo, RandomByteFlipsNeverCrash) {
 TEST(PrmIo, InvalidPrmRefusesToSaveAndWritesNothing) {
   const auto expect_refused = [](gi::Prm prm, const std::string& what) {
     const fs::path dir = scratch_dir("refused");
-    auto s = gi::save_prm(dir, prm, cornell(), "cornell_box.gltf");
+    auto s = gi::save_prm(dir, prm, gi::bake_input_from(cornell()));
     ASSERT_FALSE(s.ok()) << what;
     expect_error(s.error(), "prm_panes.bin", what);
     EXPECT_FALSE(fs::exists(dir)) << "nothing written";
@@ -575,10 +578,10 @@ TEST(PrmIo, InvalidPrmRefusesToSaveAndWritesNothing) {
     const fs::path existing = saved_bundle("refused_existing");
     const auto before = read_all(existing / "prm_panes.bin");
     const auto manifest_before = read_all(existing / "manifest.json");
-    ASSERT_FALSE(gi::save_prm(existing, prm, cornell(), "cornell_box.gltf").ok());
+    ASSERT_FALSE(gi::save_prm(existing, prm, gi::bake_input_from(cornell())).ok());
     EXPECT_EQ(read_all(existing / "prm_panes.bin"), before);
     EXPECT_EQ(read_all(existing / "manifest.json"), manifest_before);
-    EXPECT_TRUE(gi::load_prm(existing, cornell()).ok());
+    EXPECT_TRUE(gi::load_prm(existing, gi::bake_input_from(cornell())).ok());
   };
   gi::Prm p = fake_prm();
   p.panes[17] = std::numeric_limits<float>::quiet_NaN();

@@ -1,18 +1,18 @@
 // PRM (Szécsi 2006) on the spot chamber against the reference path tracer, and its hard cases.
-#include <cmath>
-#include <cstdio>
-
-#include <gtest/gtest.h>
+#include "prm/prm.h"
 
 #include <engine/gltf.h>
 #include <engine/scene.h>
+#include <gi/error_metrics.h>
+#include <gtest/gtest.h>
 
-#include "transport/static_scene.h"
-#include "metrics/error_metrics.h"
+#include <cmath>
+#include <cstdio>
+
 #include "prm/entry_clusters.h"
-#include "prm/prm.h"
 #include "prm/prm_runtime.h"
 #include "raytrace/atlas_reference.h"
+#include "transport/static_scene.h"
 #include "uv/atlas_input.h"
 
 namespace {
@@ -38,9 +38,10 @@ void place_spot(engine::Scene& scene, glm::vec3 position, glm::vec3 direction) {
 
 // The PRM's irradiance atlas for the scene's moving lights (all clusters).
 std::vector<glm::vec3> relight(const gi::Prm& prm, const engine::Scene& scene, int k = 0) {
-  auto caster = gi::make_static_caster(scene);
+  auto caster = gi::make_static_caster(gi::bake_input_from(scene));
   EXPECT_TRUE(caster);
-  return gi::sum_panes(prm, gi::relight_clusters(prm, gi::scene_lights(scene.registry, gi::BakeLights::Moving), **caster, k));
+  return gi::sum_panes(
+      prm, gi::relight_clusters(prm, gi::scene_lights(scene.registry, gi::BakeLights::Moving), **caster, k));
 }
 
 // The three positions include a light low in a corner, 0.3 m from two walls. Measured
@@ -51,25 +52,28 @@ TEST(PrmChamber, ThreeLightPositionsMatchTheReference) {
   // docs/sweeps/prm_spot_chamber_splitting_density.md).
   gi::PrmSettings ps = gi::prm_preset("high").value();
   ps.texels_per_metre = 4.0f;
-  auto prm = gi::bake_prm(scene, ps);
+  auto prm = gi::bake_prm(gi::bake_input_from(scene), ps);
   ASSERT_TRUE(prm) << prm.error().to_string();
   std::printf("PRM: %zu entry points, %d clusters, %zu paths, %zu nodes, %zu pane texels, bake %.2f s\n",
               prm->entries.size(), prm->cluster_count, prm->stats.paths, prm->stats.path_nodes, prm->pane_size(),
               prm->stats.total_seconds);
   const struct {
     glm::vec3 p, d;
-  } lights[] = {{{0, 2.9f, 0}, {0, -1, 0}}, {{1.5f, 1.2f, -1.2f}, {-1, -0.3f, 0.5f}}, {{-1.8f, 0.4f, 1.7f}, {0.2f, 0.1f, -1}}};
+  } lights[] = {
+      {{0, 2.9f, 0}, {0, -1, 0}}, {{1.5f, 1.2f, -1.2f}, {-1, -0.3f, 0.5f}}, {{-1.8f, 0.4f, 1.7f}, {0.2f, 0.1f, -1}}};
   for (const auto& l : lights) {
     place_spot(scene, l.p, l.d);
-    const auto inputs = gi::atlas_inputs_from(scene.assets);
+    const auto inputs = gi::atlas_inputs_from(gi::bake_input_from(scene.assets));
     gi::ReferenceSettings rs;
     rs.samples_per_pixel = 4096;
     rs.seed = 5;
-    auto truth = gi::reference_atlas_irradiance(scene, gi::rasterize_atlas(prm->layout, inputs), rs);
+    auto truth =
+        gi::reference_atlas_irradiance(gi::bake_input_from(scene), gi::rasterize_atlas(prm->layout, inputs), rs);
     ASSERT_TRUE(truth);
     const std::vector<glm::vec3> ours = relight(*prm, scene);
     const gi::ErrorReport e =
-        gi::compare_rgb(gi::RgbField::from_texels(prm->width, prm->height, ours, truth->valid), gi::RgbField::from_texels(truth->width, truth->height, truth->indirect, truth->valid));
+        gi::compare_rgb(gi::RgbField::from_texels(prm->width, prm->height, ours, truth->valid),
+                        gi::RgbField::from_texels(truth->width, truth->height, truth->indirect, truth->valid));
     std::printf("light at (%.1f %.1f %.1f): rel RMSE %.4f, scale fit %.4f, after fit %.4f\n", double{l.p.x},
                 double{l.p.y}, double{l.p.z}, e.rel_rmse, e.fit_scale, e.fit_rel_rmse);
     EXPECT_LT(e.rel_rmse, 0.10);
@@ -82,7 +86,7 @@ gi::Prm small_prm(const engine::Scene& scene, unsigned threads = 0) {
   ps.entry_points = 512;
   ps.clusters = 32;
   ps.threads = threads;
-  auto prm = gi::bake_prm(scene, ps);
+  auto prm = gi::bake_prm(gi::bake_input_from(scene), ps);
   EXPECT_TRUE(prm) << prm.error().to_string();
   return std::move(prm).value();
 }

@@ -1,15 +1,14 @@
 // The reference path tracer on the measured Cornell box (assets/cornell_box.gltf): energy
 // balance, determinism across thread counts, and its errors.
+#include <engine/gltf.h>
+#include <engine/scene.h>
+#include <gi/reference.h>
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <cstdio>
 #include <numbers>
 #include <vector>
-
-#include <gtest/gtest.h>
-
-#include <engine/gltf.h>
-#include <engine/scene.h>
-#include <gi/reference.h>
 
 #include "core/random.h"
 #include "raytrace/reference_render.h"
@@ -30,7 +29,7 @@ engine::Scene cornell_box() {
 // are made purely Lambertian so that absorption is (1 - albedo) E exactly.
 TEST(ReferenceCornellBox, EnergyBalance) {
   const engine::Scene scene = cornell_box();
-  gi::ReferenceScene s = gi::reference_scene_from(scene);
+  gi::ReferenceScene s = gi::reference_scene_from(gi::bake_input_from(scene));
   for (gi::ReferenceMaterial& m : s.materials) m.brdf = engine::gltf_lambertian(m.brdf.base_color);
   auto index = gi::index_reference_scene(s);
   ASSERT_TRUE(index) << index.error().to_string();
@@ -50,7 +49,10 @@ TEST(ReferenceCornellBox, EnergyBalance) {
     gi::Pcg32 rng = gi::Pcg32::for_item(99, t);
     for (int i = 0; i < n; ++i) {
       float u = rng.next_float(), v = rng.next_float();
-      if (u + v > 1.0f) { u = 1.0f - u; v = 1.0f - v; }
+      if (u + v > 1.0f) {
+        u = 1.0f - u;
+        v = 1.0f - v;
+      }
       points.push_back({tri.p0 + u * tri.e1 + v * tri.e2, tri.face_normal});
       weight.push_back(glm::dvec3(1.0f - s.materials[tri.material].brdf.base_color) *
                        (static_cast<double>(tri.area_m2) / n));
@@ -96,7 +98,10 @@ TEST(ReferenceCornellBox, ProgressIsReportedAndCancelStops) {
   gi::ReferenceSettings s;
   s.samples_per_pixel = 1;
   std::vector<double> seen;
-  s.progress = [&](double f) { seen.push_back(f); return true; };
+  s.progress = [&](double f) {
+    seen.push_back(f);
+    return true;
+  };
   ASSERT_TRUE(gi::render_reference_image(scene, engine::find_camera(scene.registry), 64, 64, s));
   ASSERT_GE(seen.size(), 2u);
   EXPECT_DOUBLE_EQ(seen.back(), 1.0);

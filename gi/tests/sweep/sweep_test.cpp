@@ -18,7 +18,6 @@
 #include "sweep/pareto_front.h"
 #include "sweep/reference_cache.h"
 #include "sweep/sweep_csv.h"
-#include "sweep/sweep_progress_bar.h"
 #include "sweep/sweep_runner.h"
 #include "sweep/sweep_summary.h"
 
@@ -474,15 +473,6 @@ TEST(SceneFingerprint, LoadsARealScene) {
   EXPECT_EQ(scene->display_name(), "cornell_box.gltf");
   EXPECT_FALSE(scene->asset.meshes.empty());
   EXPECT_FALSE(gi::load_sweep_scene(fs::path(GI_SOURCE_DIR) / "assets" / "no_such.gltf").ok());
-}
-
-TEST(SweepProgressBar, FormatsFractionAndEta) {
-  gi::SweepProgress p{.units_done = 1, .units_total = 4, .current = "run q=4", .current_fraction = 0.0};
-  // A quarter done after 10 s: 30 s to go.
-  const std::string line = gi::format_sweep_progress(p, 10.0, 8);
-  EXPECT_EQ(line, "[##......] 1/4  25%  run q=4 (0%)  elapsed 0:10  ETA 0:30");
-  EXPECT_EQ(gi::format_duration(3723.0), "1:02:03");
-  EXPECT_EQ(gi::format_duration(-1.0), "--:--");
 }
 
 TEST(BuiltinSweepMethods, RegisterOnlyRealMethods) {

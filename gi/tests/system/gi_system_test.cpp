@@ -3,29 +3,26 @@
 // recomputes only what changed (counters).
 #define GL_GLEXT_PROTOTYPES 1
 #include <GL/glcorearb.h>
+#include <engine/components.h>
+#include <engine/gltf.h>
+#include <engine/gpu/context.h>
+#include <engine/scene.h>
+#include <gi/gi_system.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <string>
 
-#include <unistd.h>
-
-#include <gtest/gtest.h>
-
-#include <engine/components.h>
-#include <engine/gltf.h>
-#include <engine/gpu/context.h>
-#include <engine/scene.h>
-#include <gi/gi_system.h>
-
-#include "transport/static_scene.h"
 #include "brf/brf_bake.h"
 #include "brf/brf_io.h"
 #include "brf/brf_mesh.h"
+#include "gl_readback.h"
 #include "light_atlas/light_atlas.h"
 #include "light_atlas/light_atlas_io.h"
-#include "gl_readback.h"
+#include "transport/static_scene.h"
 
 namespace {
 
@@ -51,13 +48,13 @@ struct Bundle {
     std::filesystem::remove_all(dir);
     engine::Scene scene = crates_room();
     gi::LightAtlasSettings s = gi::light_atlas_preset("preview").value();
-    atlas = gi::bake_light_atlas(scene, s).value();
-    EXPECT_TRUE(gi::save_light_atlas(dir, atlas, scene.assets, "crates_room.gltf"));
-    const auto sources = gi::dynamic_brf_meshes(scene).value();
+    atlas = gi::bake_light_atlas(gi::bake_input_from(scene), s).value();
+    EXPECT_TRUE(gi::save_light_atlas(dir, atlas, gi::bake_input_from(scene.assets)));
+    const auto sources = gi::dynamic_brf_meshes(gi::bake_input_from(scene)).value();
     gi::BrfBake brf;
     brf.settings = gi::brf_preset("preview").value();
     for (const gi::BrfSource& src : sources) brf.meshes.push_back(gi::bake_brf_mesh(src, brf.settings).value());
-    EXPECT_TRUE(gi::save_brf(dir, brf, scene.assets, "crates_room.gltf"));
+    EXPECT_TRUE(gi::save_brf(dir, brf, gi::bake_input_from(scene.assets)));
   }
 };
 
@@ -137,7 +134,8 @@ TEST(GISystem, TheRedCrateTurnsTheStatuePink) {
   ASSERT_TRUE(ctx) << "no headless GL context: " << ctx.error().to_string();
   engine::Scene scene = crates_room();
   // The statue's plinth faces +x at x = -0.85 (statue at (-1.2, 0, 1.2), half width 0.35).
-  auto layout_scene = gi::prepare_static_scene(scene, bundle().atlas.layout, gi::BakeLights::None).value();
+  auto layout_scene =
+      gi::prepare_static_scene(gi::bake_input_from(scene), bundle().atlas.layout, gi::BakeLights::None).value();
   std::vector<std::size_t> plinth;
   for (std::size_t t = 0; t < layout_scene.texels.valid.size(); ++t) {
     const glm::vec3 p = layout_scene.texels.position[t], n = layout_scene.texels.normal[t];
@@ -161,7 +159,7 @@ TEST(GISystem, TheRedCrateTurnsTheStatuePink) {
   const glm::dvec3 near = bounce_on_plinth();
   std::printf("bounce on the plinth (W/m^2): red crate far (%.4f, %.4f, %.4f), near (%.4f, %.4f, %.4f); base %.4f\n",
               far.x, far.y, far.z, near.x, near.y, near.z, double{bundle().atlas.irradiance[plinth[0]].x});
-  EXPECT_GT(near.x, 3.0 * near.y);           // red light
+  EXPECT_GT(near.x, 3.0 * near.y);                 // red light
   EXPECT_GT(near.x, 5.0 * std::max(far.x, 1e-6));  // from the crate that came close
   EXPECT_GE(std::min({far.x, far.y, far.z}), 0.0);
 }
@@ -195,14 +193,14 @@ TEST(GISystem, AMetalCrateBouncesAsAGlossyObject) {
   const std::filesystem::path dir =
       std::filesystem::temp_directory_path() / ("gi_system_glossy_" + std::to_string(::getpid()) + ".gibake");
   std::filesystem::remove_all(dir);
-  const auto sources = gi::dynamic_brf_meshes(scene).value();
+  const auto sources = gi::dynamic_brf_meshes(gi::bake_input_from(scene)).value();
   gi::BrfBake brf;
   brf.settings = gi::brf_preset("preview").value();
   for (const gi::BrfSource& src : sources) {
     brf.meshes.push_back(gi::bake_brf_mesh(src, brf.settings).value());
     EXPECT_EQ(brf.meshes.back().glossy.has_value(), src.name == "crate_red") << src.name;
   }
-  ASSERT_TRUE(gi::save_brf(dir, brf, scene.assets, "crates_room.gltf"));
+  ASSERT_TRUE(gi::save_brf(dir, brf, gi::bake_input_from(scene.assets)));
 
   auto loaded = gi::GISystem::load(dir, scene);
   ASSERT_TRUE(loaded) << loaded.error().to_string();
@@ -211,7 +209,7 @@ TEST(GISystem, AMetalCrateBouncesAsAGlossyObject) {
   // crate_2 stands at (-0.4, 0, -1.6), unturned: its +z face looks at where the red crate goes.
   const engine::Entity crate_2 = engine::find_by_name(scene.registry, "crate_2");
   const engine::MeshRenderer& mr = scene.registry.get<engine::MeshRenderer>(crate_2);
-  const gi::BrfMesh mesh = gi::brf_mesh_from_asset(scene.assets, mr.mesh).value();
+  const gi::BrfMesh mesh = gi::brf_mesh_from_input(gi::bake_input_from(scene.assets), mr.mesh).value();
   const auto facing_light = [&] {
     const std::uint32_t buffer = gi.frame().vertex_irradiance_buffer(crate_2);
     std::vector<glm::vec4> v(mesh.positions.size());
@@ -228,8 +226,8 @@ TEST(GISystem, AMetalCrateBouncesAsAGlossyObject) {
   const glm::dvec3 far = facing_light();
   move_to(scene, "crate_red", {-0.4f, 0.0f, -0.9f});  // 20 cm in front of crate_2's +z face
   const glm::dvec3 near = facing_light();
-  std::printf("crate_2's face toward the metal crate (W/m^2): far (%.4f, %.4f, %.4f), near (%.4f, %.4f, %.4f)\n", far.x, far.y,
-              far.z, near.x, near.y, near.z);
+  std::printf("crate_2's face toward the metal crate (W/m^2): far (%.4f, %.4f, %.4f), near (%.4f, %.4f, %.4f)\n", far.x,
+              far.y, far.z, near.x, near.y, near.z);
   EXPECT_GT(near.x - far.x, 3.0 * std::abs(near.y - far.y));  // the metal's red reflection
   EXPECT_GT(near.x - far.x, 0.05 * far.x);
   loaded->reset();

@@ -255,7 +255,7 @@ TEST(PlanCost, EstimatesAreWithinAFactorOfTwoOfTheCalibrationBakes) {
               "path nodes", "atlas side", "atlas cpu s", "prm cpu s");
   for (const Measured& r : runs) {
     const engine::Scene scene = load(r.scene);
-    const gi::StaticSurfaceCensus census = gi::census_static_surfaces(scene);
+    const gi::StaticSurfaceCensus census = gi::census_static_surfaces(gi::bake_input_from(scene));
     const gi::LightAtlasSettings as = gi::light_atlas_preset(r.preset).value();
     const gi::PrmSettings ps = gi::prm_preset(r.preset).value();
     const gi::AtlasTexelEstimate t = gi::atlas_texels(census, as.texels_per_metre);
@@ -268,8 +268,8 @@ TEST(PlanCost, EstimatesAreWithinAFactorOfTwoOfTheCalibrationBakes) {
     double nodes = 0.0;
     const gi::BakeWork pw = gi::prm_work(census, ps, &nodes);
     const double side = std::sqrt(static_cast<double>(t.width) * t.height);
-    auto layout =
-        gi::build_atlas_layout(gi::atlas_inputs_from(scene.assets), {.texels_per_metre = as.texels_per_metre});
+    auto layout = gi::build_atlas_layout(gi::atlas_inputs_from(gi::bake_input_from(scene.assets)),
+                                         {.texels_per_metre = as.texels_per_metre});
     ASSERT_TRUE(layout);
     std::printf("charts: %zu estimated, %zu in the layout; atlas %dx%d estimated, %dx%d laid out\n",
                 census.charts.size(), layout->charts.size(), t.width, t.height, layout->width, layout->height);

@@ -1,22 +1,21 @@
 // The PRM provider on llvmpipe: it re-sums the panes only when a moving light changed, and
 // the GPU atlas equals the CPU sum.
 #define GL_GLEXT_PROTOTYPES 1
+#include "system/prm_lighting.h"
+
 #include <GL/glcorearb.h>
+#include <engine/gltf.h>
+#include <engine/gpu/context.h>
+#include <engine/scene.h>
+#include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
 
-#include <gtest/gtest.h>
-
-#include <engine/gltf.h>
-#include <engine/gpu/context.h>
-#include <engine/scene.h>
-#include "system/prm_lighting.h"
-
-#include "transport/static_scene.h"
+#include "gl_readback.h"
 #include "prm/prm.h"
 #include "prm/prm_runtime.h"
-#include "gl_readback.h"
+#include "transport/static_scene.h"
 
 namespace {
 
@@ -35,15 +34,17 @@ TEST(PrmLighting, UpdatesOnlyWhenAMovingLightChangesAndMatchesTheCpuSum) {
   ps.texels_per_metre = 2.0f;
   ps.entry_points = 512;
   ps.clusters = 32;
-  gi::Prm prm = gi::bake_prm(scene, ps).value();
+  gi::Prm prm = gi::bake_prm(gi::bake_input_from(scene), ps).value();
   const gi::Prm cpu_copy = prm;
   auto provider = gi::PrmLighting::from_bake(std::move(prm), nullptr, scene, {.active_clusters = 16});
   ASSERT_TRUE(provider) << provider.error().to_string();
   gi::PrmLighting& gi = **provider;
 
   const auto cpu_atlas = [&] {
-    auto caster = gi::make_static_caster(scene).value();
-    return gi::sum_panes(cpu_copy, gi::relight_clusters(cpu_copy, gi::scene_lights(scene.registry, gi::BakeLights::Moving), *caster, 16));
+    auto caster = gi::make_static_caster(gi::bake_input_from(scene)).value();
+    return gi::sum_panes(
+        cpu_copy,
+        gi::relight_clusters(cpu_copy, gi::scene_lights(scene.registry, gi::BakeLights::Moving), *caster, 16));
   };
   const auto expect_matches_cpu = [&](const std::vector<glm::vec3>& gpu) {
     const std::vector<glm::vec3> cpu = cpu_atlas();
@@ -74,7 +75,8 @@ TEST(PrmLighting, UpdatesOnlyWhenAMovingLightChangesAndMatchesTheCpuSum) {
   EXPECT_NE(moved, first) << "the bounce light follows the lamp";
   expect_matches_cpu(moved);
   std::printf("update: weights %.3f ms (CPU), pane sum %.3f ms (llvmpipe), %zu clusters, %zu GPU bytes\n",
-              gi.stats().last_weights_ms, gi.stats().last_gpu_ms, gi.stats().last_active_clusters, gi.stats().gpu_bytes);
+              gi.stats().last_weights_ms, gi.stats().last_gpu_ms, gi.stats().last_active_clusters,
+              gi.stats().gpu_bytes);
 
   scene.registry.write<engine::Light>(spot).enabled = false;
   gi.frame();
@@ -105,7 +107,7 @@ TEST(PrmLighting, OnlyTheLightThatMovedIsRecomputed) {
   ps.texels_per_metre = 2.0f;
   ps.entry_points = 512;
   ps.clusters = 32;
-  gi::Prm prm = gi::bake_prm(scene, ps).value();
+  gi::Prm prm = gi::bake_prm(gi::bake_input_from(scene), ps).value();
   const gi::Prm cpu_copy = prm;
   auto provider = gi::PrmLighting::from_bake(std::move(prm), nullptr, scene, {.active_clusters = 0});
   ASSERT_TRUE(provider) << provider.error().to_string();
@@ -119,9 +121,9 @@ TEST(PrmLighting, OnlyTheLightThatMovedIsRecomputed) {
   EXPECT_EQ(gi.stats().updates, 2u);
   EXPECT_EQ(gi.stats().last_lights_recomputed, 1u);
   EXPECT_EQ(gi.stats().last_lights_reused, 1u);
-  auto caster = gi::make_static_caster(scene).value();
-  const std::vector<glm::vec3> cpu =
-      gi::sum_panes(cpu_copy, gi::relight_clusters(cpu_copy, gi::scene_lights(scene.registry, gi::BakeLights::Moving), *caster, 0));
+  auto caster = gi::make_static_caster(gi::bake_input_from(scene)).value();
+  const std::vector<glm::vec3> cpu = gi::sum_panes(
+      cpu_copy, gi::relight_clusters(cpu_copy, gi::scene_lights(scene.registry, gi::BakeLights::Moving), *caster, 0));
   const std::vector<glm::vec3> gpu = read_texture(tex, cpu_copy.width, cpu_copy.height);
   double err = 0.0, norm = 0.0;
   for (std::size_t t = 0; t < cpu.size(); ++t) {

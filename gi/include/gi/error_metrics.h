@@ -25,10 +25,10 @@
 // (GI_EXPECTS): whoever produces the fields owns their shape (the sweep harness checks a
 // method's output before comparing and reports a mismatch as that run's error).
 
+#include <gi/rgb_field.h>
+
 #include <cstddef>
 #include <string>
-
-#include "metrics/rgb_field.h"
 
 namespace gi {
 

@@ -2,13 +2,13 @@
 // The engine's display transform on the CPU, for metrics on what the player sees:
 // exposure, the ACES filmic fit by Narkowicz (2015) clamped to [0, 1], then the exact sRGB
 // encoding. Mirrors engine/shaders/tonemap.frag.glsl (renderer.h documents it).
-//   float ldr = gi::display_tonemap(radiance.r, /*exposure=*/1.0f);  // in [0, 1], sRGB-encoded
+//   float ldr = engine::display_tonemap(radiance.r, /*exposure=*/1.0f);  // in [0, 1], sRGB-encoded
 //   int byte = static_cast<int>(ldr * 255.0f + 0.5f);
 
 #include <algorithm>
 #include <cmath>
 
-namespace gi {
+namespace engine {
 
 /// ACES fitted (Narkowicz): x (2.51 x + 0.03) / (x (2.43 x + 0.59) + 0.14), clamped to [0, 1].
 inline double aces_narkowicz(double x) {
@@ -27,4 +27,4 @@ inline double display_tonemap(double linear, double exposure) {
   return std::clamp(srgb_encode(aces_narkowicz(std::max(linear, 0.0) * exposure)), 0.0, 1.0);
 }
 
-}  // namespace gi
+}  // namespace engine

@@ -1,0 +1,78 @@
+#pragma once
+// Baking a scene's GI data into a bake bundle: the API gi-bake is written on, for a
+// studio's own pipeline. It plans (gi::plan), bakes each method the plan calls for (or the
+// ones asked for) at a quality preset, writes one file per method plus manifest.json into
+// the bundle directory (docs/bake-bundle.md) and records the plan there. GISystem loads the
+// result (gi/gi_system.h).
+//   gi::BakeInput input = gi::bake_input_from(scene);              // or filled by hand
+//   auto report = gi::bake_bundle(input, "out/level.gibake", {.preset = "medium"},
+//                                 {.progress = draw_bar, .log = print_line});
+//   if (!report) std::cerr << report.error().to_string() << '\n';   // kind: Invalid, Cancelled, Failure
+//
+// Methods (gi::effect_key): "atlas" (light atlas, static lights), "prm" (precomputed
+// radiance maps, moving lights), "brf" (basis radiance fields, one per distinct dynamic
+// mesh). "atlas" and "prm" share one uv1 layout (the preset's atlas density). Methods the
+// plan calls for that this build cannot bake ("dlm", "antiradiance") are reported as
+// skipped, never silently dropped. Bit-identical output for any thread count.
+
+#include <engine/result.h>
+#include <gi/bake_input.h>
+#include <gi/log.h>
+#include <gi/plan.h>
+#include <gi/progress.h>
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace gi {
+
+/// What to bake and at what quality. Overrides of the preset are used when positive.
+struct BakeOptions {
+  std::string preset = "medium";           ///< preview | medium | high (docs/sweeps/README.md).
+  std::vector<std::string> methods;        ///< Method keys to bake; empty: what gi::plan calls for.
+  float texels_per_metre = 0.0f;           ///< Atlas density (atlas and PRM).
+  int vpls = 0;                            ///< Light atlas: VPL count.
+  int bounces = 0;                         ///< Light atlas: indirect bounces.
+  int samples_per_vpl = 0;                 ///< Light atlas: sample points per VPL.
+  int brf_basis = 0;                       ///< BRF: basis functions N.
+  int brf_spheres = 0;                     ///< BRF: field spheres.
+  bool include_direct = false;             ///< Light atlas: store direct + indirect (default: indirect only).
+  std::vector<std::string> moving_lights;  ///< Lights (by name) the game moves although not flagged (PlanOptions).
+  unsigned threads = 0;                    ///< Worker threads; 0: all hardware threads. Does not change the result.
+  std::uint64_t seed = 1;
+};
+
+/// The host's side of a bake: progress per stage (returning false cancels, and the bake
+/// returns an ErrorKind::Cancelled error) and a line per stage of what was done.
+struct BakeHost {
+  StageProgressCallback progress;
+  LogCallback log;
+};
+
+/// One method written into the bundle.
+struct BakedMethod {
+  std::string method;       ///< "atlas", "prm" or "brf".
+  double seconds = 0.0;     ///< Wall time of its bake and save.
+  std::uint64_t bytes = 0;  ///< Size of the files it wrote.
+};
+
+struct BakeReport {
+  EffectPlan plan;                   ///< The plan the bake followed (also in the manifest).
+  std::vector<BakedMethod> baked;    ///< In the order baked.
+  std::vector<std::string> skipped;  ///< Keys the plan calls for that this build cannot bake.
+};
+
+/// The method keys this build can bake, in gi::EffectMethod order.
+std::vector<std::string> bakeable_methods();
+
+/// Bakes `input` into `bundle_dir` (created if needed; files of other methods already there
+/// are kept when the geometry is the same). Errors: invalid input (validate_bake_input),
+/// an unknown preset or method key or an override out of range (ErrorKind::Invalid), a
+/// baker or file failure, cancellation. Nothing of a method that failed or was cancelled
+/// is written.
+engine::Result<BakeReport> bake_bundle(const BakeInput& input, const std::filesystem::path& bundle_dir,
+                                       const BakeOptions& options = {}, const BakeHost& host = {});
+
+}  // namespace gi

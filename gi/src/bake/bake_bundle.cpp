@@ -1,0 +1,221 @@
+// gi::bake_bundle: plan, bake each method, write the bundle (gi/bake.h).
+#include <gi/bake.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdarg>
+#include <cstdio>
+#include <string>
+
+#include "brf/brf_bake.h"
+#include "brf/brf_io.h"
+#include "brf/brf_mesh.h"
+#include "bundle/geometry_hash.h"
+#include "bundle/manifest.h"
+#include "light_atlas/light_atlas.h"
+#include "light_atlas/light_atlas_io.h"
+#include "plan/plan_json.h"
+#include "prm/prm.h"
+#include "prm/prm_io.h"
+
+namespace gi {
+
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+__attribute__((format(printf, 1, 2))) std::string format(const char* fmt, ...) {
+  char buf[512];
+  va_list args;
+  va_start(args, fmt);
+  std::vsnprintf(buf, sizeof buf, fmt, args);
+  va_end(args);
+  return buf;
+}
+
+// One stage of a bake: its log and progress under a name.
+struct Stage {
+  const BakeHost& host;
+  std::string name;
+
+  void log(const std::string& line) const {
+    if (host.log) host.log(LogLevel::Info, line);
+  }
+  ProgressCallback progress() const {
+    if (!host.progress) return {};
+    return [this](double f) { return host.progress(name, f); };
+  }
+};
+
+// Sum of the sizes of the files the manifest lists for `method` (entry.files.<k>.file).
+std::uint64_t method_bytes(const fs::path& bundle_dir, const std::string& method) {
+  auto manifest = read_manifest(bundle_dir);
+  if (!manifest || !manifest->methods.contains(method)) return 0;
+  const nlohmann::json& entry = manifest->methods[method];
+  if (!entry.contains("files") || !entry["files"].is_object()) return 0;
+  std::uint64_t bytes = 0;
+  for (const auto& [key, file] : entry["files"].items()) {
+    if (!file.is_object() || !file.contains("file") || !file["file"].is_string()) continue;
+    std::error_code ec;
+    const auto size = fs::file_size(bundle_dir / file["file"].get<std::string>(), ec);
+    if (!ec) bytes += static_cast<std::uint64_t>(size);
+  }
+  return bytes;
+}
+
+std::string scene_file_name(const BakeInput& input) {
+  return input.name.empty() ? std::string("the scene") : fs::path(input.name).filename().string();
+}
+
+engine::Status bake_atlas(const BakeInput& input, const fs::path& dir, const BakeOptions& o, const Stage& stage) {
+  auto settings = light_atlas_preset(o.preset);
+  if (!settings) return settings.error();
+  if (o.vpls > 0) settings->vpl_count = o.vpls;
+  if (o.bounces > 0) settings->bounces = o.bounces;
+  if (o.texels_per_metre > 0.0f) settings->texels_per_metre = o.texels_per_metre;
+  if (o.samples_per_vpl > 0) settings->samples_per_vpl = o.samples_per_vpl;
+  settings->include_direct = o.include_direct;
+  settings->threads = o.threads;
+  settings->seed = o.seed;
+  settings->progress = stage.progress();
+  stage.log(format("light atlas of %s, preset %s: %d VPLs x %d samples, %d bounces, %g texels/m",
+                   scene_file_name(input).c_str(), o.preset.c_str(), settings->vpl_count, settings->samples_per_vpl,
+                   settings->bounces, double{settings->texels_per_metre}));
+  auto bake = bake_light_atlas(input, *settings);
+  if (!bake) return bake.error();
+  const LightAtlasStats& st = bake->stats;
+  stage.log(
+      format("  atlas %dx%d at %g texels/m, %zu texels lit; %zu VPLs, %zu sample points, %zu light points, %zu shots",
+             bake->width, bake->height, double{bake->layout.texels_per_metre}, st.valid_texels, st.vpls,
+             st.sample_points, st.light_points, st.shots));
+  stage.log(
+      format("  time: VPLs %.2f s, direct %.2f s, propagation %.2f s, final shooting %.2f s; total %.2f s; %.1f M rays",
+             st.vpl_seconds, st.direct_seconds, st.propagate_seconds, st.final_seconds, st.total_seconds,
+             static_cast<double>(st.rays) * 1e-6));
+  return save_light_atlas(dir, *bake, input);
+}
+
+engine::Status bake_prm_method(const BakeInput& input, const fs::path& dir, const BakeOptions& o, const Stage& stage) {
+  auto settings = prm_preset(o.preset);
+  if (!settings) return settings.error();
+  if (o.texels_per_metre > 0.0f) settings->texels_per_metre = o.texels_per_metre;
+  settings->threads = o.threads;
+  settings->seed = o.seed;
+  settings->progress = stage.progress();
+  stage.log(format("PRM of %s, preset %s: %d entry points, %d clusters, splitting %g, %g texels/m",
+                   scene_file_name(input).c_str(), o.preset.c_str(), settings->entry_points, settings->clusters,
+                   double{settings->splitting}, double{settings->texels_per_metre}));
+  auto prm = bake_prm(input, *settings);
+  if (!prm) return prm.error();
+  const PrmStats& st = prm->stats;
+  stage.log(
+      format("  panes %dx%d, %zu texels each, %d clusters (%.1f MB as half floats); %zu paths, %zu virtual lights",
+             prm->width, prm->height, prm->pane_size(), prm->cluster_count,
+             static_cast<double>(prm->pane_size()) * prm->cluster_count * 6.0 / 1e6, st.paths, st.path_nodes));
+  stage.log(format("  time: walks %.2f s, panes %.2f s; total %.2f s; %.1f M rays", st.walk_seconds, st.pane_seconds,
+                   st.total_seconds, static_cast<double>(st.rays) * 1e-6));
+  return save_prm(dir, *prm, input);
+}
+
+engine::Status bake_brf_method(const BakeInput& input, const fs::path& dir, const BakeOptions& o,
+                               const BakeHost& host) {
+  auto settings = brf_preset(o.preset);
+  if (!settings) return settings.error();
+  if (o.brf_basis > 0) settings->basis.basis = o.brf_basis;
+  if (o.brf_spheres > 0) settings->field.spheres = o.brf_spheres;
+  settings->field.threads = o.threads;
+  auto sources = dynamic_brf_meshes(input);
+  if (!sources) return sources.error();
+  const Stage header{host, "BRF"};
+  const PcaBasisSettings& b = settings->basis;
+  const RadianceFieldSettings& f = settings->field;
+  header.log(
+      format("basis radiance fields of %s, preset %s: %zu dynamic meshes; %d lights, N = %d, %d spheres x 6x%dx%d "
+             "points, %d SH bands, %d directions",
+             scene_file_name(input).c_str(), o.preset.c_str(), sources->size(), b.lights, b.basis, f.spheres,
+             f.face_resolution, f.face_resolution, f.sh_bands, f.directions));
+  if (sources->empty()) {
+    header.log("  no dynamic mesh: nothing to bake");
+    return {};
+  }
+  BrfBake bake{.settings = *settings, .meshes = {}};
+  for (const BrfSource& s : *sources) {
+    const Stage stage{host, "BRF " + s.name};
+    auto mesh = bake_brf_mesh(s, *settings, stage.progress());
+    if (!mesh) return mesh.error();
+    stage.log(format("  %-16s %6zu vertices, %zu instances, basis %d of %d kept, condition %.3g, field %.2f MB, %.2f s",
+                     s.name.c_str(), s.mesh.positions.size(), s.instances.size(), mesh->basis.basis_count, b.basis,
+                     mesh->basis.condition, static_cast<double>(mesh->field.bytes()) / 1e6,
+                     mesh->basis_seconds + mesh->field_seconds));
+    if (mesh->glossy)
+      stage.log(format("  %-16s glossy (GGX alpha %.3f, f0 %.2f): %d BRDF terms, weighted BRDF error %.2f", "",
+                       static_cast<double>(mesh->glossy->lobe.alpha), static_cast<double>(mesh->glossy->lobe.f0),
+                       mesh->glossy->terms, static_cast<double>(mesh->glossy->relative_error)));
+    bake.meshes.push_back(std::move(mesh).value());
+  }
+  return save_brf(dir, bake, input);
+}
+
+// The manifest's method entry name of a plan key.
+std::string manifest_key(const std::string& key) { return key == "atlas" ? "light_atlas" : key; }
+
+}  // namespace
+
+std::vector<std::string> bakeable_methods() { return {"atlas", "prm", "brf"}; }
+
+engine::Result<BakeReport> bake_bundle(const BakeInput& input, const fs::path& bundle_dir, const BakeOptions& options,
+                                       const BakeHost& host) {
+  if (auto ok = validate_bake_input(input); !ok) return ok.error();
+  const std::vector<std::string> bakeable = bakeable_methods();
+  BakeReport report;
+  report.plan = plan(input, {.preset = options.preset,
+                             .moving_lights = options.moving_lights,
+                             .texels_per_metre = options.texels_per_metre,
+                             .vpls = options.vpls,
+                             .samples_per_vpl = options.samples_per_vpl,
+                             .bounces = options.bounces});
+  // The preset is checked before anything is baked or written.
+  if (auto density = light_atlas_preset(options.preset); !density) return density.error();
+
+  std::vector<std::string> methods = options.methods;
+  if (methods.empty()) {
+    for (const PlannedEffect& e : report.plan.effects) {
+      if (!e.enabled) continue;
+      const std::string key(effect_key(e.method));
+      if (std::find(bakeable.begin(), bakeable.end(), key) != bakeable.end() && e.available)
+        methods.push_back(key);
+      else
+        report.skipped.push_back(key);
+    }
+    for (const std::string& key : report.skipped)
+      if (host.log)
+        host.log(LogLevel::Warning, "skipping " + key + ": the scene calls for it but this build cannot bake it");
+  }
+  for (const std::string& key : methods)
+    if (std::find(bakeable.begin(), bakeable.end(), key) == bakeable.end())
+      return engine::invalid_request("method '" + key +
+                                     "' is not available in this build (available: atlas, prm, brf)");
+
+  for (const std::string& key : methods) {
+    const auto start = Clock::now();
+    engine::Status done = key == "atlas" ? bake_atlas(input, bundle_dir, options, {host, "light atlas"})
+                          : key == "prm" ? bake_prm_method(input, bundle_dir, options, {host, "PRM"})
+                                         : bake_brf_method(input, bundle_dir, options, host);
+    if (!done) return done.error();
+    report.baked.push_back({key, seconds_since(start), method_bytes(bundle_dir, manifest_key(key))});
+  }
+  if (!report.baked.empty()) {
+    std::error_code ec;
+    fs::create_directories(bundle_dir, ec);
+    if (auto ok = update_manifest_plan(bundle_dir, scene_geometry_hash(input), scene_file_name(input),
+                                       plan_to_json_value(report.plan));
+        !ok)
+      return ok.error();
+  }
+  return report;
+}
+
+}  // namespace gi

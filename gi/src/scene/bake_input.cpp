@@ -1,0 +1,247 @@
+#include <gi/bake_input.h>
+
+#include <algorithm>
+#include <cmath>
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/quaternion.hpp>
+#include <string>
+#include <unordered_map>
+
+namespace gi {
+
+namespace {
+
+bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+bool finite(const glm::mat4& m) {
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r)
+      if (!std::isfinite(m[c][r])) return false;
+  return true;
+}
+
+BakeMaterial material_from(const engine::Material& m) {
+  BakeMaterial b;
+  b.name = m.name;
+  b.base_color = glm::vec3(m.base_color);
+  b.metallic = m.metallic;
+  b.roughness = m.roughness;
+  b.specular = m.specular_factor;
+  b.specular_color = m.specular_color_factor;
+  b.emission = m.emissive;
+  b.double_sided = m.double_sided;
+  return b;
+}
+
+BakeMesh mesh_from(const engine::Mesh& m) {
+  BakeMesh b;
+  b.name = m.name;
+  for (const engine::Primitive& p : m.primitives)
+    b.primitives.push_back(
+        {.positions = p.positions, .normals = p.normals, .indices = p.indices, .material = p.material});
+  return b;
+}
+
+// A node flagged deforming, or one under such a node.
+bool deforming_node(const engine::SceneAsset& assets, int node) {
+  std::size_t steps = 0;
+  for (int n = node; n >= 0 && static_cast<std::size_t>(n) < assets.nodes.size() && steps++ <= assets.nodes.size();
+       n = assets.nodes[static_cast<std::size_t>(n)].parent)
+    if (assets.nodes[static_cast<std::size_t>(n)].gi.region == engine::GiRegion::Deforming) return true;
+  return false;
+}
+
+std::vector<engine::Entity> sorted(std::vector<engine::Entity> entities) {
+  std::sort(entities.begin(), entities.end(), [](engine::Entity a, engine::Entity b) { return a.index < b.index; });
+  return entities;
+}
+
+// The name of the nearest entity up `e`'s parent chain (itself included) that is dynamic
+// (DynamicTag or a node of Dynamic mobility), or empty. Bounded: a cycle cannot loop.
+std::string dynamic_ancestor(const engine::Scene& scene, const std::unordered_map<std::uint32_t, int>& node_of,
+                             engine::Entity e) {
+  const engine::Registry& reg = scene.registry;
+  for (std::size_t steps = 0; !e.is_null() && reg.valid(e) && steps < 4096; ++steps) {
+    const auto n = node_of.find(e.index);
+    const bool dynamic = reg.has<engine::DynamicTag>(e) ||
+                         (n != node_of.end() && scene.assets.nodes[static_cast<std::size_t>(n->second)].gi.mobility ==
+                                                    engine::Mobility::Dynamic);
+    if (dynamic) {
+      const engine::Name* name = reg.try_get<engine::Name>(e);
+      return name != nullptr && !name->value.empty() ? name->value : "entity " + std::to_string(e.index);
+    }
+    const engine::Transform* t = reg.try_get<engine::Transform>(e);
+    e = t != nullptr ? t->parent : engine::Entity{};
+  }
+  return {};
+}
+
+engine::Error input_error(const std::string& location, const std::string& message) {
+  return engine::Error{"<bake input>", location, message};
+}
+
+}  // namespace
+
+BakeMaterial bake_material(const BakeInput& input, const BakeInstance& instance, const BakePrimitive& p) {
+  const int m = instance.material_override >= 0 ? instance.material_override : p.material;
+  if (m >= 0 && static_cast<std::size_t>(m) < input.materials.size())
+    return input.materials[static_cast<std::size_t>(m)];
+  return material_from(engine::Material{});
+}
+
+glm::mat4 node_world_matrix(const engine::SceneAsset& asset, int node) {
+  GI_EXPECTS(node >= 0 && static_cast<std::size_t>(node) < asset.nodes.size(), "node indexes asset.nodes");
+  glm::mat4 m(1.0f);
+  std::size_t steps = 0;
+  for (int i = node; i >= 0 && static_cast<std::size_t>(i) < asset.nodes.size() && steps <= asset.nodes.size();
+       i = asset.nodes[static_cast<std::size_t>(i)].parent, ++steps) {
+    const engine::Node& n = asset.nodes[static_cast<std::size_t>(i)];
+    const glm::mat4 t = glm::translate(glm::mat4(1.0f), n.translation);
+    const glm::mat4 s = glm::scale(glm::mat4(1.0f), n.scale);
+    m = t * glm::mat4_cast(n.rotation) * s * m;
+  }
+  return m;
+}
+
+BakeInput bake_input_from(const engine::SceneAsset& asset) {
+  BakeInput in;
+  in.name = asset.source;
+  for (const engine::Mesh& m : asset.meshes) in.meshes.push_back(mesh_from(m));
+  for (const engine::Material& m : asset.materials) in.materials.push_back(material_from(m));
+  for (std::size_t ni = 0; ni < asset.nodes.size(); ++ni) {
+    const engine::Node& node = asset.nodes[ni];
+    if (node.mesh >= 0 && static_cast<std::size_t>(node.mesh) < asset.meshes.size()) {
+      BakeInstance inst;
+      inst.name = node.name;
+      inst.mesh = static_cast<std::uint32_t>(node.mesh);
+      inst.object_to_world = node_world_matrix(asset, static_cast<int>(ni));
+      inst.mobility = node.gi.mobility == engine::Mobility::Dynamic ? BakeMobility::Dynamic : BakeMobility::Static;
+      inst.deforming = deforming_node(asset, static_cast<int>(ni));
+      inst.id = static_cast<std::int64_t>(ni);
+      in.instances.push_back(std::move(inst));
+    }
+    if (node.light >= 0 && static_cast<std::size_t>(node.light) < asset.lights.size()) {
+      const engine::NamedLight& l = asset.lights[static_cast<std::size_t>(node.light)];
+      std::string dynamic_parent;
+      std::size_t steps = 0;
+      for (int a = static_cast<int>(ni); a >= 0 && static_cast<std::size_t>(a) < asset.nodes.size() &&
+                                         dynamic_parent.empty() && steps++ <= asset.nodes.size();
+           a = asset.nodes[static_cast<std::size_t>(a)].parent)
+        if (asset.nodes[static_cast<std::size_t>(a)].gi.mobility == engine::Mobility::Dynamic)
+          dynamic_parent = asset.nodes[static_cast<std::size_t>(a)].name;
+      in.lights.push_back({.name = node.name.empty() ? l.name : node.name,
+                           .light = l.light,
+                           .light_to_world = node_world_matrix(asset, static_cast<int>(ni)),
+                           .dynamic_parent = std::move(dynamic_parent)});
+    }
+  }
+  return in;
+}
+
+BakeInput bake_input_from(const engine::Scene& scene) {
+  const engine::Registry& reg = scene.registry;
+  BakeInput in;
+  in.name = scene.assets.source;
+  for (const engine::Mesh& m : scene.assets.meshes) in.meshes.push_back(mesh_from(m));
+  for (const engine::Material& m : scene.assets.materials) in.materials.push_back(material_from(m));
+
+  std::unordered_map<std::uint32_t, int> node_of;  // entity index -> node index
+  for (std::size_t i = 0; i < scene.node_entities.size(); ++i)
+    node_of[scene.node_entities[i].index] = static_cast<int>(i);
+  for (engine::Entity e : sorted(reg.view<engine::MeshRenderer, engine::WorldTransform>().entities())) {
+    const engine::MeshRenderer& mr = reg.get<engine::MeshRenderer>(e);
+    if (mr.mesh >= in.meshes.size()) continue;
+    BakeInstance inst;
+    if (const engine::Name* n = reg.try_get<engine::Name>(e)) inst.name = n->value;
+    inst.mesh = mr.mesh;
+    inst.object_to_world = reg.get<engine::WorldTransform>(e).matrix;
+    inst.mobility = reg.has<engine::DynamicTag>(e) ? BakeMobility::Dynamic : BakeMobility::Static;
+    inst.material_override = mr.material_override;
+    inst.entity = e;
+    const auto node = node_of.find(e.index);
+    if (node != node_of.end() && scene.node_entities[static_cast<std::size_t>(node->second)] == e) {
+      inst.id = node->second;
+      inst.deforming = deforming_node(scene.assets, node->second);
+    }
+    in.instances.push_back(std::move(inst));
+  }
+  for (engine::Entity e : sorted(reg.view<engine::Light, engine::WorldTransform>().entities())) {
+    const engine::Light& l = reg.get<engine::Light>(e);
+    BakeLight bl;
+    if (const engine::Name* n = reg.try_get<engine::Name>(e)) bl.name = n->value;
+    bl.light = l;
+    bl.light_to_world = reg.get<engine::WorldTransform>(e).matrix;
+    bl.dynamic_parent = dynamic_ancestor(scene, node_of, e);
+    in.lights.push_back(std::move(bl));
+  }
+  return in;
+}
+
+engine::Status validate_bake_input(const BakeInput& input) {
+  for (std::size_t mi = 0; mi < input.materials.size(); ++mi) {
+    const BakeMaterial& m = input.materials[mi];
+    const std::string where = "material " + std::to_string(mi) + " '" + m.name + "'";
+    if (!finite(m.base_color) || !finite(m.specular_color) || !finite(m.emission) || !std::isfinite(m.metallic) ||
+        !std::isfinite(m.roughness) || !std::isfinite(m.specular))
+      return input_error(where, "a factor is NaN or infinite");
+    if (glm::any(glm::lessThan(m.base_color, glm::vec3(0.0f))) ||
+        glm::any(glm::greaterThan(m.base_color, glm::vec3(1.0f))) || m.metallic < 0.0f || m.metallic > 1.0f ||
+        m.roughness < 0.0f || m.roughness > 1.0f || m.specular < 0.0f || m.specular > 1.0f ||
+        glm::any(glm::lessThan(m.specular_color, glm::vec3(0.0f))) ||
+        glm::any(glm::lessThan(m.emission, glm::vec3(0.0f))))
+      return input_error(where,
+                         "base colour, metallic, roughness and specular must be in [0, 1], specular colour and "
+                         "emission >= 0");
+  }
+  for (std::size_t mi = 0; mi < input.meshes.size(); ++mi) {
+    const BakeMesh& mesh = input.meshes[mi];
+    for (std::size_t pi = 0; pi < mesh.primitives.size(); ++pi) {
+      const BakePrimitive& p = mesh.primitives[pi];
+      const std::string where = "mesh " + std::to_string(mi) + " '" + mesh.name + "' primitive " + std::to_string(pi);
+      if (p.indices.size() % 3 != 0) return input_error(where, "the index count is not a multiple of 3");
+      if (!p.normals.empty() && p.normals.size() != p.positions.size())
+        return input_error(where, std::to_string(p.normals.size()) + " normals for " +
+                                      std::to_string(p.positions.size()) + " positions");
+      for (std::uint32_t i : p.indices)
+        if (i >= p.positions.size())
+          return input_error(where, "index " + std::to_string(i) + " out of range (" +
+                                        std::to_string(p.positions.size()) + " vertices)");
+      for (const glm::vec3& v : p.positions)
+        if (!finite(v)) return input_error(where, "a position is NaN or infinite");
+      for (const glm::vec3& v : p.normals)
+        if (!finite(v)) return input_error(where, "a normal is NaN or infinite");
+      if (p.material >= static_cast<int>(input.materials.size()))
+        return input_error(where, "material " + std::to_string(p.material) + " out of range (" +
+                                      std::to_string(input.materials.size()) + " materials)");
+    }
+  }
+  for (std::size_t ii = 0; ii < input.instances.size(); ++ii) {
+    const BakeInstance& inst = input.instances[ii];
+    const std::string where = "instance " + std::to_string(ii) + " '" + inst.name + "'";
+    if (inst.mesh >= input.meshes.size())
+      return input_error(where, "mesh " + std::to_string(inst.mesh) + " out of range (" +
+                                    std::to_string(input.meshes.size()) + " meshes)");
+    if (inst.material_override >= static_cast<int>(input.materials.size()))
+      return input_error(where, "material override " + std::to_string(inst.material_override) + " out of range");
+    if (!finite(inst.object_to_world)) return input_error(where, "the transform is NaN or infinite");
+    const float det = glm::determinant(glm::mat3(inst.object_to_world));
+    if (!std::isfinite(det) || std::fabs(det) < 1e-18f) return input_error(where, "the transform is not invertible");
+  }
+  for (std::size_t li = 0; li < input.lights.size(); ++li) {
+    const BakeLight& l = input.lights[li];
+    const std::string where = "light " + std::to_string(li) + " '" + l.name + "'";
+    if (!finite(l.light_to_world) || !finite(l.light.color) || !std::isfinite(l.light.intensity) ||
+        !std::isfinite(l.light.range_m) || !std::isfinite(l.light.inner_cone_rad) ||
+        !std::isfinite(l.light.outer_cone_rad) || !std::isfinite(l.light.area_size_m.x) ||
+        !std::isfinite(l.light.area_size_m.y))
+      return input_error(where, "a value is NaN or infinite");
+    if (l.light.intensity < 0.0f || glm::any(glm::lessThan(l.light.color, glm::vec3(0.0f))))
+      return input_error(where, "colour and intensity must be >= 0");
+  }
+  if (!finite(input.environment.sky_radiance) ||
+      glm::any(glm::lessThan(input.environment.sky_radiance, glm::vec3(0.0f))))
+    return input_error("environment", "the sky radiance must be finite and >= 0");
+  return {};
+}
+
+}  // namespace gi

@@ -1,0 +1,73 @@
+#include "tool_main.h"
+
+#include <gi/version.h>
+
+#include <csignal>
+#include <cstdio>
+#include <iostream>
+
+namespace tools {
+
+namespace {
+
+volatile std::sig_atomic_t g_interrupted = 0;
+
+extern "C" void on_interrupt(int signal) {
+  g_interrupted = 1;
+  std::signal(signal, SIG_DFL);
+}
+
+}  // namespace
+
+int exit_code(const engine::Error& error) {
+  switch (error.kind) {
+    case engine::ErrorKind::Invalid:
+      return kExitUsage;
+    case engine::ErrorKind::Cancelled:
+      return kExitCancelled;
+    case engine::ErrorKind::Failure:
+      return kExitFailure;
+  }
+  return kExitFailure;
+}
+
+int fail(std::string_view tool, const engine::Error& error) {
+  std::cerr << tool << ": " << error.to_string() << '\n';
+  return exit_code(error);
+}
+
+int fail(std::string_view tool, const std::string& message, int code) {
+  std::cerr << tool << ": " << message << '\n';
+  return code;
+}
+
+std::optional<int> parse(CLI::App& app, std::string_view tool, int argc, char** argv) {
+  app.set_version_flag("--version", std::string(tool) + " " + gi::kVersion + " (" + gi::kSourceRevision + ")");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    app.exit(e);
+    return kExitOk;
+  } catch (const CLI::CallForAllHelp& e) {
+    app.exit(e);
+    return kExitOk;
+  } catch (const CLI::CallForVersion& e) {
+    app.exit(e);
+    return kExitOk;
+  } catch (const CLI::ParseError& e) {
+    std::cerr << tool << ": " << e.what() << "\n"
+              << "Run with --help for more information.\n";
+    return kExitUsage;
+  }
+  return std::nullopt;
+}
+
+void install_interrupt_handler() {
+  g_interrupted = 0;
+  std::signal(SIGINT, on_interrupt);
+  std::signal(SIGTERM, on_interrupt);
+}
+
+bool interrupted() { return g_interrupted != 0; }
+
+}  // namespace tools

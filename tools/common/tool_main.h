@@ -1,0 +1,44 @@
+#pragma once
+// The contract every command-line tool keeps with its caller:
+//   exit 0 done, 1 failed (the error named on stderr), 2 bad usage (CLI11's parse errors
+//   included, which CLI11 would exit with 105+), 130 cancelled by Ctrl-C (SIGINT/SIGTERM:
+//   the work stops at its next progress check and nothing half-written is left; a second
+//   Ctrl-C ends the process at once);
+//   --version prints "<tool> <gi::kVersion> (<gi::kSourceRevision>)".
+//   CLI::App app{"..."};
+//   if (auto rc = tools::parse(app, "gi-bake", argc, argv)) return *rc;
+//   tools::install_interrupt_handler();
+//   if (!result) return tools::fail("gi-bake", result.error());
+
+#include <engine/result.h>
+
+#include <CLI/CLI.hpp>
+#include <optional>
+#include <string>
+#include <string_view>
+
+namespace tools {
+
+inline constexpr int kExitOk = 0;
+inline constexpr int kExitFailure = 1;
+inline constexpr int kExitUsage = 2;
+inline constexpr int kExitCancelled = 130;
+
+/// The exit code of an error: Invalid -> 2, Cancelled -> 130, anything else -> 1.
+int exit_code(const engine::Error& error);
+
+/// Prints "<tool>: <error>" on stderr and returns exit_code(error).
+int fail(std::string_view tool, const engine::Error& error);
+/// Prints "<tool>: <message>" on stderr and returns `code`.
+int fail(std::string_view tool, const std::string& message, int code);
+
+/// Adds --version, parses. nullopt: go on; otherwise the exit code to return now (0 after
+/// --help or --version, 2 after a parse error, which is printed with the usage hint).
+std::optional<int> parse(CLI::App& app, std::string_view tool, int argc, char** argv);
+
+/// SIGINT and SIGTERM set the flag interrupted() reads (and restore the default action, so
+/// a second signal ends the process).
+void install_interrupt_handler();
+bool interrupted();
+
+}  // namespace tools
