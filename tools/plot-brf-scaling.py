@@ -2,7 +2,7 @@
 """Basis radiance fields: per-frame milliseconds against the number of objects (pairs grow as
 n^2), from brf_bench's JSON output. Writes <out>.csv and <out>.png.
 
-    ./build/benchmarks/brf_bench --benchmark_format=json --benchmark_out=out/brf_bench.json \
+    ./build/gi/benchmarks/brf_bench --benchmark_format=json --benchmark_out=out/brf_bench.json \
         --benchmark_out_format=json
     /usr/bin/python3 tools/plot-brf-scaling.py out/brf_bench.json docs/sweeps/brf_scaling
 

@@ -4,12 +4,11 @@
 //   gi_demo --headless --script push_crates --frames 600 --record s.girec --no-render
 //   gi_demo --headless --replay tests/sessions/push_crates.girec
 //   gi_demo --gi-bundle out/demo_level.gibake        light the static world with its bake (light atlas, PRM)
-#include <cstdio>
-#include <iostream>
+#include <gi/gi_system.h>
 
 #include <CLI/CLI.hpp>
-
-#include <gi/gi_system.h>
+#include <cstdio>
+#include <iostream>
 
 #include "demo_run.h"
 
@@ -42,7 +41,11 @@ bool RunState::finish_recording(const std::string& path) const {
 bool load_indirect_light(const RunOptions& o, Simulation& sim, std::unique_ptr<gi::GISystem>& system) {
   system.reset();
   if (o.gi_bundle.empty()) return true;
-  auto loaded = gi::GISystem::load(o.gi_bundle, sim.scene());
+  gi::GISystemSettings settings;
+  settings.log = [](gi::LogLevel level, std::string_view message) {
+    std::cerr << "gi_demo: gi " << gi::log_level_name(level) << ": " << message << '\n';
+  };
+  auto loaded = gi::GISystem::load(o.gi_bundle, sim.scene(), settings);
   if (!loaded) {
     std::cerr << "gi_demo: cannot use --gi-bundle " << o.gi_bundle << ": " << loaded.error().to_string() << '\n';
     return false;
@@ -68,16 +71,20 @@ std::vector<std::string> gi_status_lines(const gi::GISystem* system) {
   }
   const gi::GISystem::Stats& st = system->stats();
   char line[256];
-  std::snprintf(line, sizeof line, "GI frames %llu: %llu idle, PRM re-lit %llu (%.2f ms), BRF updated %llu (%llu with motion)",
+  std::snprintf(line, sizeof line,
+                "GI frames %llu: %llu idle, PRM re-lit %llu (%.2f ms), BRF updated %llu (%llu with motion)",
                 static_cast<unsigned long long>(st.frames), static_cast<unsigned long long>(st.idle_frames),
                 static_cast<unsigned long long>(st.prm_updates), st.last_prm_ms,
                 static_cast<unsigned long long>(st.brf_updates), static_cast<unsigned long long>(st.brf_moves));
   lines.emplace_back(line);
   if (st.dynamic_objects > 0) {
-    std::snprintf(line, sizeof line, "BRF last update: %.2f ms CPU (direct, probes) + %.2f ms GPU; pairs %zu live, %zu reused, %zu culled",
-                  st.last_brf_cpu_ms, st.last_brf_gpu_ms, st.brf_pairs_evaluated, st.brf_pairs_reused, st.brf_pairs_culled);
+    std::snprintf(line, sizeof line,
+                  "BRF last update: %.2f ms CPU (direct, probes) + %.2f ms GPU; pairs %zu live, %zu reused, %zu culled",
+                  st.last_brf_cpu_ms, st.last_brf_gpu_ms, st.brf_pairs_evaluated, st.brf_pairs_reused,
+                  st.brf_pairs_culled);
     lines.emplace_back(line);
   }
+  for (const std::string& off : st.disabled) lines.push_back("off: " + off);
   return lines;
 }
 
@@ -93,7 +100,8 @@ int main(int argc, char** argv) {
   app.add_option("--out", o.out_dir, "Headless: write DIR/frame_NNNN.png (tonemapped)");
   auto* w = app.add_option("--width", o.width, "Render width in pixels")->check(CLI::Range(16, 8192));
   auto* h = app.add_option("--height", o.height, "Render height in pixels")->check(CLI::Range(16, 8192));
-  app.add_option("--exposure", o.exposure, "Linear exposure before tonemapping (default 0.3)")->check(CLI::PositiveNumber);
+  app.add_option("--exposure", o.exposure, "Linear exposure before tonemapping (default 0.3)")
+      ->check(CLI::PositiveNumber);
   app.add_option("--every", o.every, "Headless: write every K-th frame")->check(CLI::PositiveNumber);
   app.add_flag("--exr", o.exr, "Headless: also write DIR/frame_NNNN.exr (linear HDR)");
   app.add_flag("--no-render", o.no_render, "Headless: simulate only (no GPU), e.g. to record sessions");
@@ -128,7 +136,8 @@ int main(int argc, char** argv) {
       std::cerr << "gi_demo: " << session.error().to_string() << '\n';
       return 1;
     }
-    auto sim = simulation_for_session(*session, o.replay_file, o.scene.empty() ? std::filesystem::path() : resolve_scene_path(o.scene));
+    auto sim = simulation_for_session(*session, o.replay_file,
+                                      o.scene.empty() ? std::filesystem::path() : resolve_scene_path(o.scene));
     if (!sim) {
       std::cerr << "gi_demo: " << sim.error().to_string() << '\n';
       return 1;
@@ -169,7 +178,8 @@ int main(int argc, char** argv) {
   if (state.replay && status == 0) {
     const std::uint64_t played = state.sim->frame();
     if (played < state.replay->frames.size()) {
-      std::cout << "replay stopped after " << played << " of " << state.replay->frames.size() << " frames, all checksums matched\n";
+      std::cout << "replay stopped after " << played << " of " << state.replay->frames.size()
+                << " frames, all checksums matched\n";
     } else {
       std::cout << "replay OK: " << played << " frames, all checksums match\n";
     }

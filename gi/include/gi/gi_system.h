@@ -25,22 +25,27 @@
 // outlive the system; GL objects are created on the first frame() (context current) and
 // deleted with the system: destroy it before the GL context.
 
+#include <engine/indirect_light.h>
+#include <engine/result.h>
+#include <engine/scene.h>
+#include <gi/log.h>
+
 #include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <string>
-
-#include <engine/indirect_light.h>
-#include <engine/result.h>
-#include <engine/scene.h>
+#include <vector>
 
 namespace gi {
 
 struct GISystemSettings {
-  int prm_active_clusters = 32;   ///< PRM: panes summed per update (the heaviest K; 0: all).
-  int brf_bounces = 3;            ///< BRF: bounces between dynamic objects.
+  int prm_active_clusters = 32;      ///< PRM: panes summed per update (the heaviest K; 0: all).
+  int brf_bounces = 3;               ///< BRF: bounces between dynamic objects.
   float brf_cull_threshold = 1e-3f;  ///< BRF: skip object pairs below this share of the largest (§5.4).
-  float probe_spacing_m = 1.0f;   ///< BRF: spacing of the world-light probes for dynamic objects.
+  float probe_spacing_m = 1.0f;      ///< BRF: spacing of the world-light probes for dynamic objects.
+  /// Told when a method turns off at run time (e.g. its GPU pass cannot be created); the
+  /// system never prints. Stats::disabled keeps the same facts for a host without a log.
+  LogCallback log;
 };
 
 class GISystem final : public engine::IndirectLightProvider {
@@ -60,21 +65,24 @@ class GISystem final : public engine::IndirectLightProvider {
 
   struct Stats {
     std::uint64_t frames = 0;
-    std::uint64_t idle_frames = 0;       ///< Frames on which nothing was recomputed.
-    std::uint64_t prm_updates = 0;       ///< Frames on which a moving light re-summed the PRM.
-    std::uint64_t brf_updates = 0;       ///< Frames on which the dynamic objects' light was recomputed.
-    std::uint64_t brf_moves = 0;         ///< ... of which at least one object had moved.
-    std::uint64_t world_composites = 0;  ///< Frames on which the objects' bounce was re-added to the atlas.
-    std::size_t brf_pairs_evaluated = 0; ///< Last BRF update: object pairs with light between them,
-    std::size_t brf_pairs_reused = 0;    ///< ... of which their basis irradiance was reused (pose unchanged),
-    std::size_t brf_pairs_culled = 0;    ///< and pairs skipped by the I_c bound.
-    double last_prm_ms = 0.0;            ///< CPU weights + GPU sum (glFinish-timed).
-    double last_brf_cpu_ms = 0.0;        ///< Direct light at vertices, probes.
-    double last_brf_gpu_ms = 0.0;        ///< Interreflection pass (glFinish-timed).
+    std::uint64_t idle_frames = 0;        ///< Frames on which nothing was recomputed.
+    std::uint64_t prm_updates = 0;        ///< Frames on which a moving light re-summed the PRM.
+    std::uint64_t brf_updates = 0;        ///< Frames on which the dynamic objects' light was recomputed.
+    std::uint64_t brf_moves = 0;          ///< ... of which at least one object had moved.
+    std::uint64_t world_composites = 0;   ///< Frames on which the objects' bounce was re-added to the atlas.
+    std::size_t brf_pairs_evaluated = 0;  ///< Last BRF update: object pairs with light between them,
+    std::size_t brf_pairs_reused = 0;     ///< ... of which their basis irradiance was reused (pose unchanged),
+    std::size_t brf_pairs_culled = 0;     ///< and pairs skipped by the I_c bound.
+    double last_prm_ms = 0.0;             ///< CPU weights + GPU sum (glFinish-timed).
+    double last_brf_cpu_ms = 0.0;         ///< Direct light at vertices, probes.
+    double last_brf_gpu_ms = 0.0;         ///< Interreflection pass (glFinish-timed).
     std::size_t dynamic_objects = 0;
     std::size_t dynamic_vertices = 0;
-    std::size_t brf_field_bytes = 0;     ///< Basis + fields of all dynamic meshes (CPU copy).
-    std::size_t load_probe_ms = 0;       ///< Probe grid computed at load.
+    std::size_t brf_field_bytes = 0;  ///< Basis + fields of all dynamic meshes (CPU copy).
+    std::size_t load_probe_ms = 0;    ///< Probe grid computed at load.
+    /// Methods of the bundle that turned off at run time, with why: "PRM: <reason>",
+    /// "BRF: <reason>". The frame goes on without them (label() no longer names them).
+    std::vector<std::string> disabled;
   };
   const Stats& stats() const;
   /// One line per active method with what drives it, for overlays and logs.

@@ -1,23 +1,22 @@
-#include <GL/glcorearb.h>
-
 #include "brf/brf_lighting.h"
+
+#include <GL/glcorearb.h>
+#include <engine/components.h>
+#include <engine/gpu/gl_objects.h>
+#include <engine/gpu/shader_program.h>
 
 #include <chrono>
 #include <cstdio>
 #include <unordered_map>
 
-#include <engine/components.h>
-#include <engine/gpu/gl_objects.h>
-#include <engine/gpu/shader_program.h>
-
-#include "bundle/light_signature.h"
-#include "transport/static_scene.h"
 #include "brf/brf_gpu_pass.h"
 #include "brf/spherical_harmonics.h"
+#include "bundle/light_signature.h"
 #include "gpu/gi_shaders.h"
-#include "transport/point_emitters.h"
-#include "raytrace/ray_caster.h"
 #include "io/content_hash.h"
+#include "raytrace/ray_caster.h"
+#include "transport/point_emitters.h"
+#include "transport/static_scene.h"
 
 namespace gi {
 
@@ -29,7 +28,9 @@ constexpr std::uint32_t kGroupSize = 64;
 std::uint64_t lights_signature(const engine::Registry& registry) {
   ContentHash h;
   registry.view<engine::Light, engine::WorldTransform>().each(
-      [&](engine::Entity e, const engine::Light& l, const engine::WorldTransform& wt) { h.add_value(light_signature(e, l, wt)); });
+      [&](engine::Entity e, const engine::Light& l, const engine::WorldTransform& wt) {
+        h.add_value(light_signature(e, l, wt));
+      });
   return h.value();
 }
 
@@ -54,7 +55,7 @@ struct BrfLighting::Impl {
   std::optional<BrfGpuPass> pass;
   engine::ShaderProgram sum_program, composite_program;
   GLint sum_count = -1, composite_count = -1, composite_width = -1;  // uniform locations
-  std::vector<engine::GlBuffer> world_light, total;  // per instance
+  std::vector<engine::GlBuffer> world_light, total;                  // per instance
   engine::GlBuffer receiver_texels;
   bool gpu_failed = false;
 
@@ -64,17 +65,25 @@ struct BrfLighting::Impl {
   bool computed = false;
   Stats stats;
 
+  /// Turns the fields off for good, telling the host why. Returns false.
+  bool disable(std::string reason) {
+    stats.disabled = std::move(reason);
+    if (settings.log) settings.log(LogLevel::Warning, "basis radiance fields disabled: " + stats.disabled);
+    return false;
+  }
+
   bool create_gpu() {
     std::vector<BrfGpuModel> gm;
     for (const BrfModelData& m : models) gm.push_back({&m.mesh, &m.basis, &m.field, m.glossy ? &*m.glossy : nullptr});
     auto p = BrfGpuPass::create(gm);
-    auto sum = engine::ShaderProgramBuilder(gi_shader_files()).stage(engine::ShaderStage::Compute, "brf_vertex_sum.comp.glsl").build();
-    auto comp =
-        engine::ShaderProgramBuilder(gi_shader_files()).stage(engine::ShaderStage::Compute, "brf_world_composite.comp.glsl").build();
+    auto sum = engine::ShaderProgramBuilder(gi_shader_files())
+                   .stage(engine::ShaderStage::Compute, "brf_vertex_sum.comp.glsl")
+                   .build();
+    auto comp = engine::ShaderProgramBuilder(gi_shader_files())
+                    .stage(engine::ShaderStage::Compute, "brf_world_composite.comp.glsl")
+                    .build();
     if (!p || !sum || !comp) {
-      std::fprintf(stderr, "gi: basis radiance fields disabled: %s\n",
-                   (!p ? p.error() : !sum ? sum.error() : comp.error()).to_string().c_str());
-      return false;
+      return disable((!p ? p.error() : !sum ? sum.error() : comp.error()).to_string());
     }
     pass.emplace(std::move(p).value());
     sum_program = std::move(sum).value();
@@ -84,11 +93,10 @@ struct BrfLighting::Impl {
     composite_width = glGetUniformLocation(composite_program.id(), "u_atlas_width");
     if (!world.receiver_texels.empty()) {
       if (auto s = pass->set_static_receivers(world.receiver_positions, world.receiver_normals); !s) {
-        std::fprintf(stderr, "gi: basis radiance fields: %s\n", s.error().to_string().c_str());
-        return false;
+        return disable(s.error().to_string());
       }
-      receiver_texels = engine::GlBuffer::create(world.receiver_texels.size() * sizeof(std::uint32_t),
-                                                 world.receiver_texels.data());
+      receiver_texels =
+          engine::GlBuffer::create(world.receiver_texels.size() * sizeof(std::uint32_t), world.receiver_texels.data());
     }
     for (const BrfInstanceBinding& b : instances) {
       const std::size_t bytes = std::max<std::size_t>(models[b.model].mesh.positions.size(), 1) * sizeof(glm::vec4);
@@ -109,12 +117,13 @@ engine::Result<std::unique_ptr<BrfLighting>> BrfLighting::create(std::vector<Brf
                                                                  BrfLightingSettings settings) {
   for (const BrfModelData& m : models)
     if (m.basis.vertex_count != m.mesh.positions.size() || m.field.basis_count != m.basis.basis_count)
-      return engine::Error{.location = "basis radiance fields", .message = "model '" + m.name + "': mesh, basis and field do not belong together"};
+      return engine::Error{.location = "basis radiance fields",
+                           .message = "model '" + m.name + "': mesh, basis and field do not belong together"};
   for (const BrfInstanceBinding& b : instances)
     if (b.model >= models.size())
       return engine::Error{.location = "basis radiance fields",
-                           .message = "entity " + std::to_string(b.entity.id()) + " uses model " + std::to_string(b.model) +
-                                      " of " + std::to_string(models.size())};
+                           .message = "entity " + std::to_string(b.entity.id()) + " uses model " +
+                                      std::to_string(b.model) + " of " + std::to_string(models.size())};
   if (world.receiver_positions.size() != world.receiver_texels.size() ||
       world.receiver_normals.size() != world.receiver_texels.size())
     return engine::Error{.location = "basis radiance fields", .message = "static receiver arrays of different sizes"};
@@ -204,13 +213,14 @@ bool BrfLighting::update() {
         }
       std::vector<glm::vec4> packed(std::max<std::size_t>(v.positions.size(), 1), glm::vec4(0.0f));
       for (std::size_t j = 0; j < v.positions.size(); ++j) packed[j] = glm::vec4(m.world_incoming[i][j], 0.0f);
-      glNamedBufferSubData(m.world_light[i].id(), 0, static_cast<GLsizeiptr>(packed.size() * sizeof(glm::vec4)), packed.data());
+      glNamedBufferSubData(m.world_light[i].id(), 0, static_cast<GLsizeiptr>(packed.size() * sizeof(glm::vec4)),
+                           packed.data());
     }
     for (std::size_t j = 0; j < incoming[i].size(); ++j) incoming[i][j] += m.world_incoming[i][j];
   }
   const auto t1 = Clock::now();
   if (engine::Status s = m.pass->run(gpu_instances, incoming, m.settings.update); !s) {
-    std::fprintf(stderr, "gi: basis radiance fields update failed: %s\n", s.error().to_string().c_str());
+    m.gpu_failed = !m.disable("update failed: " + s.error().to_string());
     return false;
   }
   // Per vertex: world light + interreflected.

@@ -18,17 +18,17 @@
 //   if (brf->update()) brf->composite_world(base_texture, composite_texture, width, height);
 //   GLuint ssbo = brf->vertex_buffer(crate_entity);
 
+#include <engine/entity.h>
+#include <engine/registry.h>
+#include <engine/result.h>
+#include <gi/log.h>
+
 #include <cstdint>
+#include <glm/glm.hpp>
 #include <memory>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <glm/glm.hpp>
-
-#include <engine/entity.h>
-#include <engine/registry.h>
-#include <engine/result.h>
 
 #include "brf/brf_runtime.h"
 #include "brf/pca_basis.h"
@@ -59,8 +59,8 @@ struct BrfInstanceBinding {
 
 /// The static world's part (every member optional).
 struct BrfWorldLink {
-  std::unique_ptr<RayCaster> caster;       ///< Static shadows for the objects' direct light.
-  std::optional<WorldProbeGrid> probes;    ///< The world's light onto the objects.
+  std::unique_ptr<RayCaster> caster;     ///< Static shadows for the objects' direct light.
+  std::optional<WorldProbeGrid> probes;  ///< The world's light onto the objects.
   /// Static receivers: atlas texels (index y * width + x) with their world points and normals.
   std::vector<std::uint32_t> receiver_texels;
   std::vector<glm::vec3> receiver_positions;
@@ -72,6 +72,7 @@ struct BrfWorldLink {
 struct BrfLightingSettings {
   BrfUpdateSettings update;
   int area_light_samples = 16;  ///< Point emitters per area light for the direct light.
+  LogCallback log;              ///< Told when the GPU pass cannot run (the fields turn off).
 };
 
 class BrfLighting {
@@ -97,19 +98,20 @@ class BrfLighting {
   bool has_static_receivers() const;
 
   struct Stats {
-    std::uint64_t updates = 0;          ///< update() calls that computed something.
-    std::uint64_t skipped = 0;          ///< update() calls on which nothing had changed.
-    std::uint64_t objects_moved = 0;    ///< Updates with at least one moved object.
-    std::size_t pairs_evaluated = 0;    ///< Last update (GPU pass stats).
+    std::uint64_t updates = 0;        ///< update() calls that computed something.
+    std::uint64_t skipped = 0;        ///< update() calls on which nothing had changed.
+    std::uint64_t objects_moved = 0;  ///< Updates with at least one moved object.
+    std::size_t pairs_evaluated = 0;  ///< Last update (GPU pass stats).
     std::size_t pairs_culled = 0;
     std::size_t pairs_reused = 0;
-    double last_cpu_ms = 0.0;           ///< Direct light, probes, fits.
-    double last_gpu_ms = 0.0;           ///< GPU pass + vertex sums (glFinish-timed).
+    double last_cpu_ms = 0.0;  ///< Direct light, probes, fits.
+    double last_gpu_ms = 0.0;  ///< GPU pass + vertex sums (glFinish-timed).
     std::size_t instances = 0;
     std::size_t vertices = 0;
     std::size_t static_receivers = 0;
-    std::size_t field_bytes = 0;        ///< Precomputed data of all models (CPU copies).
+    std::size_t field_bytes = 0;  ///< Precomputed data of all models (CPU copies).
     std::size_t gpu_bytes = 0;
+    std::string disabled;  ///< Why the fields turned off (no GPU resources); empty: running.
   };
   const Stats& stats() const;
 

@@ -1,19 +1,21 @@
 #include "raytrace/embree_ray_caster.h"
 
+#include <embree3/rtcore.h>
+#include <engine/check.h>
+
 #include <cmath>
 #include <cstdio>
 #include <string>
 #include <vector>
 
-#include <embree3/rtcore.h>
-
-#include <engine/check.h>
-
 namespace gi {
 namespace {
 
-void embree_error(void* /*user*/, RTCError code, const char* message) {
-  std::fprintf(stderr, "embree error %d: %s\n", static_cast<int>(code), message ? message : "");
+// Embree's error callback: keeps the first message for the engine::Error that build()
+// returns (the library never prints). `user` is the caster's message string.
+void embree_error(void* user, RTCError code, const char* message) {
+  auto& first = *static_cast<std::string*>(user);
+  if (first.empty()) first = "error " + std::to_string(static_cast<int>(code)) + ": " + (message ? message : "");
 }
 
 // Move-only owners of Embree handles (RAII; moved-from state is empty).
@@ -81,7 +83,7 @@ class EmbreeRayCaster final : public RayCaster {
 
     device_ = DeviceHandle(rtcNewDevice(nullptr));
     if (!device_.h) return engine::Error{"", "embree", "rtcNewDevice failed"};
-    rtcSetDeviceErrorFunction(device_.h, embree_error, nullptr);
+    rtcSetDeviceErrorFunction(device_.h, embree_error, &embree_message_);
     top_ = SceneHandle(rtcNewScene(device_.h));
     rtcSetSceneBuildQuality(top_.h, RTC_BUILD_QUALITY_HIGH);
 
@@ -108,7 +110,9 @@ class EmbreeRayCaster final : public RayCaster {
       GI_EXPECTS(id == i, "Embree geometry ids follow instance order");
     }
     rtcCommitScene(top_.h);
-    if (rtcGetDeviceError(device_.h) != RTC_ERROR_NONE) return engine::Error{"", "embree", "scene build failed"};
+    if (rtcGetDeviceError(device_.h) != RTC_ERROR_NONE)
+      return engine::Error{"", "embree",
+                           "scene build failed" + (embree_message_.empty() ? "" : ": " + embree_message_)};
     return {};
   }
 
@@ -222,6 +226,7 @@ class EmbreeRayCaster final : public RayCaster {
   }
 
   RtSceneData data_;
+  std::string embree_message_;  // declared before the device, which may call back until released
   DeviceHandle device_;
   SceneHandle top_;
   std::vector<SceneHandle> blas_;

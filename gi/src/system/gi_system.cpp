@@ -46,6 +46,18 @@ struct GISystem::Impl {
   Stats stats;
   std::string label;
   std::string description;
+  bool prm_disabled = false;
+  bool brf_disabled = false;
+
+  // What runs: the PRM (or the plain atlas) and the BRF, less what turned off.
+  void relabel() {
+    label = prm && !prm_disabled ? prm->label() : atlas ? atlas->label() : "";
+    if (brf && !brf_disabled) label += label.empty() ? "BRF" : " + BRF";
+  }
+  // The providers have told the host through the log already; the stats keep it.
+  void turned_off(const char* method, const std::string& reason) {
+    stats.disabled.push_back(std::string(method) + ": " + reason);
+  }
 };
 
 GISystem::GISystem(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -151,9 +163,10 @@ engine::Result<std::unique_ptr<GISystem>> GISystem::load(const std::filesystem::
     }
     const std::size_t receivers = world.receiver_texels.size();
     const std::size_t probe_count = world.probes ? world.probes->probe_count() : 0;
-    auto brf = BrfLighting::create(
-        std::move(models), std::move(bindings), scene.registry, std::move(world),
-        {.update = {.bounces = settings.brf_bounces, .cull_threshold = settings.brf_cull_threshold}});
+    auto brf =
+        BrfLighting::create(std::move(models), std::move(bindings), scene.registry, std::move(world),
+                            {.update = {.bounces = settings.brf_bounces, .cull_threshold = settings.brf_cull_threshold},
+                             .log = settings.log});
     if (!brf) return brf.error();
     impl->brf = std::move(brf).value();
     const auto& st = impl->brf->stats();
@@ -166,7 +179,8 @@ engine::Result<std::unique_ptr<GISystem>> GISystem::load(const std::filesystem::
   }
 
   if (prm) {
-    auto p = PrmLighting::from_bake(std::move(*prm), atlas ? &*atlas : nullptr, scene, {settings.prm_active_clusters});
+    auto p = PrmLighting::from_bake(std::move(*prm), atlas ? &*atlas : nullptr, scene,
+                                    {.active_clusters = settings.prm_active_clusters, .log = settings.log});
     if (!p) return p.error();
     impl->prm = std::move(p).value();
   } else if (atlas) {
@@ -174,8 +188,7 @@ engine::Result<std::unique_ptr<GISystem>> GISystem::load(const std::filesystem::
     if (!a) return a.error();
     impl->atlas = std::move(a).value();
   }
-  impl->label = std::string(impl->prm ? impl->prm->label() : impl->atlas ? impl->atlas->label() : "");
-  if (impl->brf) impl->label += impl->label.empty() ? "BRF" : " + BRF";
+  impl->relabel();
   impl->description = text.str();
   impl->frame.brf = impl->brf.get();
   return std::unique_ptr<GISystem>(new GISystem(std::move(impl)));
@@ -190,6 +203,11 @@ const engine::IndirectLightFrame& GISystem::frame() {
   if (m.prm) {
     base = m.prm->frame().irradiance_atlas_texture;
     const PrmLighting::Stats& ps = m.prm->stats();
+    if (!ps.disabled.empty() && !m.prm_disabled) {
+      m.prm_disabled = true;
+      m.turned_off("PRM", ps.disabled);
+      m.relabel();
+    }
     if (ps.updates != m.seen_prm_updates) {
       m.seen_prm_updates = ps.updates;
       ++m.stats.prm_updates;
@@ -204,6 +222,11 @@ const engine::IndirectLightFrame& GISystem::frame() {
   bool objects_changed = false;
   if (m.brf) {
     objects_changed = m.brf->update();
+    if (!m.brf->stats().disabled.empty() && !m.brf_disabled) {
+      m.brf_disabled = true;
+      m.turned_off("BRF", m.brf->stats().disabled);
+      m.relabel();
+    }
     if (objects_changed) {
       work = true;
       const BrfLighting::Stats& bs = m.brf->stats();

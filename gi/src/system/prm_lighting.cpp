@@ -42,6 +42,15 @@ struct PrmLighting::Impl {
   };
   std::unordered_map<std::uint32_t, LightCache> lights;
 
+  // Turns the PRM off for good (the renderer falls back to its stand-in), telling the host why.
+  void disable(std::string reason) {
+    stats.disabled = std::move(reason);
+    prm.panes = {};
+    pass.reset();
+    frame.irradiance_atlas_texture = 0;
+    if (settings.log) settings.log(LogLevel::Warning, "PRM disabled: " + stats.disabled);
+  }
+
   // Brings every moving light's cached entry irradiance up to date; returns whether any
   // changed (appeared, changed, or disappeared) and counts the recomputed ones.
   bool refresh_lights(std::size_t& recomputed) {
@@ -106,12 +115,12 @@ engine::Result<std::unique_ptr<PrmLighting>> PrmLighting::from_bake(Prm prm, con
 const engine::IndirectLightFrame& PrmLighting::frame() {
   Impl& m = *impl_;
   ++m.stats.frames;
+  if (!m.stats.disabled.empty()) return m.frame;
   if (!m.pass) {
     auto pass = PrmGpuPass::create(m.prm);
     if (!pass) {
       // No GL resources: leave the frame empty (the renderer falls back to its stand-in).
-      std::fprintf(stderr, "gi: PRM disabled: %s\n", pass.error().to_string().c_str());
-      m.prm.panes = {};
+      m.disable(pass.error().to_string());
       return m.frame;
     }
     m.pass.emplace(std::move(pass).value());
@@ -130,8 +139,10 @@ const engine::IndirectLightFrame& PrmLighting::frame() {
   m.stats.last_lights_recomputed = recomputed;
   m.stats.last_lights_reused = m.lights.size() - std::min(recomputed, m.lights.size());
   const auto t1 = Clock::now();
-  if (engine::Status s = m.pass->run(picked); !s)
-    std::fprintf(stderr, "gi: PRM update failed: %s\n", s.error().to_string().c_str());
+  if (engine::Status s = m.pass->run(picked); !s) {
+    m.disable("update failed: " + s.error().to_string());
+    return m.frame;
+  }
   glFinish();
   const auto t2 = Clock::now();
   m.stats.last_weights_ms = std::chrono::duration<double, std::milli>(t1 - t0).count();

@@ -18,6 +18,7 @@
 #include <engine/indirect_light.h>
 #include <engine/result.h>
 #include <engine/scene.h>
+#include <gi/log.h>
 
 #include <cstdint>
 #include <memory>
@@ -29,6 +30,7 @@ struct LightAtlasBake;
 
 struct PrmLightingSettings {
   int active_clusters = 32;  ///< K: panes summed per update (the heaviest); 0: all.
+  LogCallback log;           ///< Told when the GPU pass cannot run (the PRM turns off).
 };
 
 class PrmLighting final : public engine::IndirectLightProvider {
@@ -55,6 +57,7 @@ class PrmLighting final : public engine::IndirectLightProvider {
     std::size_t last_lights_recomputed = 0;  ///< Moving lights whose entry irradiance was recomputed last update,
     std::size_t last_lights_reused = 0;      ///< and those whose cached one was reused (they had not changed).
     std::size_t gpu_bytes = 0;
+    std::string disabled;  ///< Why the PRM turned off (no GPU resources, a failed update); empty: running.
   };
   const Stats& stats() const;
 

@@ -1,0 +1,142 @@
+// The public bake API (gi/bake.h) as a studio's pipeline uses it: a BakeInput filled by the
+// pipeline's own code from its own scene data — no engine::Scene, no registry — baked into
+// a bundle that the runtime then accepts for the level the game instantiates.
+#include <engine/gltf.h>
+#include <engine/scene.h>
+#include <gi/bake.h>
+#include <gi/gi_system.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// A pipeline's converter from its scene format (here: the file's asset, read by the
+// engine's glTF loader, never instantiated) into the bakers' plain data.
+gi::BakeInput pipeline_input(const engine::SceneAsset& asset) {
+  gi::BakeInput in;
+  in.name = fs::path(asset.source).filename().string();
+  for (const engine::Mesh& m : asset.meshes) {
+    gi::BakeMesh mesh{.name = m.name, .primitives = {}};
+    for (const engine::Primitive& p : m.primitives)
+      mesh.primitives.push_back(
+          {.positions = p.positions, .normals = p.normals, .indices = p.indices, .material = p.material});
+    in.meshes.push_back(std::move(mesh));
+  }
+  for (const engine::Material& m : asset.materials)
+    in.materials.push_back({.name = m.name,
+                            .base_color = glm::vec3(m.base_color),
+                            .metallic = m.metallic,
+                            .roughness = m.roughness,
+                            .specular = m.specular_factor,
+                            .specular_color = m.specular_color_factor,
+                            .emission = m.emissive,
+                            .double_sided = m.double_sided});
+  for (std::size_t i = 0; i < asset.nodes.size(); ++i) {
+    const engine::Node& n = asset.nodes[i];
+    const glm::mat4 world = gi::node_world_matrix(asset, static_cast<int>(i));
+    if (n.mesh >= 0)
+      in.instances.push_back({.name = n.name,
+                              .mesh = static_cast<std::uint32_t>(n.mesh),
+                              .object_to_world = world,
+                              .mobility = n.gi.mobility == engine::Mobility::Dynamic ? gi::BakeMobility::Dynamic
+                                                                                     : gi::BakeMobility::Static,
+                              .deforming = n.gi.region == engine::GiRegion::Deforming,
+                              .id = static_cast<std::int64_t>(i)});  // the runtime matches static meshes by node
+    if (n.light >= 0)
+      in.lights.push_back(
+          {.name = n.name, .light = asset.lights[static_cast<std::size_t>(n.light)].light, .light_to_world = world});
+  }
+  return in;
+}
+
+fs::path fresh_dir(const std::string& name) {
+  const fs::path dir = fs::path(GI_BINARY_DIR) / "test_output" / "bake_api" / name;
+  fs::remove_all(dir);
+  return dir;
+}
+
+}  // namespace
+
+TEST(BakeApi, BakesTheDemoLevelFromPlainDataAndTheRuntimeAcceptsIt) {
+  auto asset = engine::load_gltf(GI_SOURCE_DIR "/assets/demo_level.gltf");
+  ASSERT_TRUE(asset) << asset.error().to_string();
+  const gi::BakeInput input = pipeline_input(*asset);
+  ASSERT_TRUE(gi::validate_bake_input(input)) << gi::validate_bake_input(input).error().to_string();
+
+  const fs::path dir = fresh_dir("demo_level.gibake");
+  std::vector<std::string> stages;
+  int log_lines = 0;
+  double last_fraction = -1.0;
+  bool monotonic = true;
+  const gi::BakeHost host{.progress =
+                              [&](std::string_view stage, double f) {
+                                if (stages.empty() || stages.back() != stage)
+                                  stages.emplace_back(stage), last_fraction = -1.0;
+                                monotonic = monotonic && f >= last_fraction && f <= 1.0;
+                                last_fraction = f;
+                                return true;
+                              },
+                          .log = [&](gi::LogLevel, std::string_view) { ++log_lines; }};
+  auto report = gi::bake_bundle(input, dir, {.preset = "preview", .methods = {"atlas"}}, host);
+  ASSERT_TRUE(report) << report.error().to_string();
+  ASSERT_EQ(report->baked.size(), 1u);
+  EXPECT_EQ(report->baked[0].method, "atlas");
+  EXPECT_GT(report->baked[0].bytes, 0u);
+  EXPECT_EQ(stages, std::vector<std::string>{"light atlas"});
+  EXPECT_TRUE(monotonic);
+  EXPECT_DOUBLE_EQ(last_fraction, 1.0);
+  EXPECT_GT(log_lines, 0);
+  EXPECT_FALSE(report->plan.effects.empty()) << "the plan of the demo level is reported";
+
+  // The game's level, instantiated by the engine: the bundle of the pipeline's data fits it.
+  engine::Scene scene = engine::instantiate(std::move(asset).value());
+  auto system = gi::GISystem::load(dir, scene);
+  ASSERT_TRUE(system) << system.error().to_string();
+  EXPECT_STREQ((*system)->label(), "light atlas");
+}
+
+TEST(BakeApi, ABakeCancelledByItsHostWritesNothing) {
+  auto asset = engine::load_gltf(GI_SOURCE_DIR "/assets/cornell_box.gltf");
+  ASSERT_TRUE(asset) << asset.error().to_string();
+  const fs::path dir = fresh_dir("cancelled.gibake");
+  int calls = 0;
+  auto report = gi::bake_bundle(pipeline_input(*asset), dir, {.preset = "preview", .methods = {"atlas"}},
+                                {.progress = [&](std::string_view, double) { return ++calls < 3; }});
+  ASSERT_FALSE(report);
+  EXPECT_EQ(report.error().kind, engine::ErrorKind::Cancelled) << report.error().to_string();
+  EXPECT_EQ(calls, 3) << "no progress is reported after the host said stop";
+  EXPECT_FALSE(fs::exists(dir));
+}
+
+TEST(BakeApi, BadInputIsRefusedNamingTheElement) {
+  auto asset = engine::load_gltf(GI_SOURCE_DIR "/assets/cornell_box.gltf");
+  ASSERT_TRUE(asset) << asset.error().to_string();
+  gi::BakeInput input = pipeline_input(*asset);
+  input.meshes[1].primitives[0].indices.push_back(100000);
+  input.meshes[1].primitives[0].indices.push_back(0);
+  input.meshes[1].primitives[0].indices.push_back(1);
+  const fs::path dir = fresh_dir("bad.gibake");
+  auto report = gi::bake_bundle(input, dir, {.preset = "preview"});
+  ASSERT_FALSE(report);
+  const std::string msg = report.error().to_string();
+  EXPECT_NE(msg.find("mesh 1"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("100000"), std::string::npos) << msg;
+  EXPECT_FALSE(fs::exists(dir));
+
+  input = pipeline_input(*asset);
+  input.instances[0].object_to_world[3][0] = std::nanf("");
+  report = gi::bake_bundle(input, dir, {.preset = "preview"});
+  ASSERT_FALSE(report);
+  EXPECT_NE(report.error().to_string().find("instance 0"), std::string::npos) << report.error().to_string();
+
+  report = gi::bake_bundle(pipeline_input(*asset), dir, {.preset = "preview", .methods = {"dlm"}});
+  ASSERT_FALSE(report);
+  EXPECT_EQ(report.error().kind, engine::ErrorKind::Invalid);
+  EXPECT_NE(report.error().to_string().find("dlm"), std::string::npos) << report.error().to_string();
+}

@@ -1,0 +1,176 @@
+// The command-line tools' contract (tools/common/tool_main.h): --version, exit codes 0 / 1 /
+// 2 / 130, Ctrl-C cancels cleanly; and the one progress bar's text. The tools run as real
+// processes, as a user or a build script runs them.
+#include <fcntl.h>
+#include <gi/version.h>
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "console_progress.h"
+#include "tool_main.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct ToolRun {
+  int exit_code = -1;  ///< The process's exit status; 128 + N when killed by signal N.
+  std::string output;  ///< stdout and stderr together.
+};
+
+/// Runs `exe args...` with stdout+stderr into a file; when `interrupt_after` is positive,
+/// sends SIGINT once the output contains `interrupt_when` (or that many seconds passed).
+ToolRun run(const std::string& exe, const std::vector<std::string>& args, double interrupt_after = 0.0,
+            const std::string& interrupt_when = {}) {
+  const fs::path log = fs::path(GI_BINARY_DIR) / "test_output" / "tools_test" /
+                       ("run-" + std::to_string(::getpid()) + "-" + std::to_string(std::rand()) + ".log");
+  fs::create_directories(log.parent_path());
+  const pid_t pid = fork();
+  if (pid == 0) {
+    const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    dup2(fd, 1);
+    dup2(fd, 2);
+    std::vector<char*> argv{const_cast<char*>(exe.c_str())};
+    for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    execv(exe.c_str(), argv.data());
+    _exit(127);
+  }
+  const auto slurp = [&] {
+    std::ifstream in(log);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+  };
+  int status = 0;
+  bool reaped = false;
+  if (interrupt_after > 0.0) {
+    const auto start = std::chrono::steady_clock::now();
+    while (!(reaped = waitpid(pid, &status, WNOHANG) == pid)) {
+      const double waited = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      if (waited >= interrupt_after || (!interrupt_when.empty() && slurp().find(interrupt_when) != std::string::npos)) {
+        kill(pid, SIGINT);
+        break;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+  }
+  if (!reaped) waitpid(pid, &status, 0);
+  ToolRun r;
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  r.output = slurp();
+  fs::remove(log);
+  return r;
+}
+
+const std::vector<std::string>& tools_under_test() {
+  static const std::vector<std::string> t{GI_BAKE_EXE, GI_REFERENCE_EXE, GI_SWEEP_EXE};
+  return t;
+}
+
+}  // namespace
+
+TEST(ConsoleProgress, FormatsFractionElapsedAndEta) {
+  // A quarter done after 10 s: 30 s to go.
+  EXPECT_EQ(tools::format_progress("bake", 0.25, 10.0, "texels", 8),
+            "bake [##......]  25%  texels  elapsed 0:10  ETA 0:30");
+  EXPECT_EQ(tools::format_progress("bake", 0.0, 3.0, {}, 4), "bake [....]   0%  elapsed 0:03  ETA --:--");
+  EXPECT_EQ(tools::format_progress("bake", 7.0, 3.0, {}, 4), "bake [####] 100%  elapsed 0:03  ETA 0:00");
+  EXPECT_EQ(tools::format_duration(3723.0), "1:02:03");
+  EXPECT_EQ(tools::format_duration(65.0), "1:05");
+  EXPECT_EQ(tools::format_duration(-1.0), "--:--");
+}
+
+TEST(ConsoleProgress, WritesOneLinePerStageOffTerminal) {
+  std::FILE* f = std::tmpfile();
+  ASSERT_NE(f, nullptr);
+  {
+    tools::ConsoleProgress bar(f, false);
+    const gi::ProgressCallback a = bar.stage("walks");
+    EXPECT_TRUE(a(0.5));
+    EXPECT_TRUE(a(1.0));
+    EXPECT_TRUE(bar.stages()("panes", 1.0));
+  }
+  std::rewind(f);
+  std::string text;
+  for (int c; (c = std::fgetc(f)) != EOF;) text += static_cast<char>(c);
+  std::fclose(f);
+  EXPECT_EQ(text.find('\r'), std::string::npos) << "no in-place redraws in a log";
+  EXPECT_NE(text.find("walks ["), std::string::npos) << text;
+  EXPECT_NE(text.find("panes [####################] 100%"), std::string::npos) << text;
+}
+
+TEST(ToolMain, ErrorKindsMapToExitCodes) {
+  EXPECT_EQ(tools::exit_code(engine::Error{"f", "w", "broken"}), tools::kExitFailure);
+  EXPECT_EQ(tools::exit_code(engine::invalid_request("unknown preset 'ultra'")), tools::kExitUsage);
+  EXPECT_EQ(tools::exit_code(engine::cancelled_error("the bake")), tools::kExitCancelled);
+}
+
+TEST(Tools, EveryToolAnswersVersion) {
+  for (const std::string& exe : tools_under_test()) {
+    const ToolRun r = run(exe, {"--version"});
+    EXPECT_EQ(r.exit_code, 0) << exe << "\n" << r.output;
+    const std::string name = fs::path(exe).filename().string();
+    EXPECT_EQ(r.output, name + " " + gi::kVersion + " (" + gi::kSourceRevision + ")\n") << exe;
+  }
+}
+
+TEST(Tools, EveryToolExitsTwoOnBadUsage) {
+  for (const std::string& exe : tools_under_test()) {
+    const ToolRun r = run(exe, {"--no-such-option"});
+    EXPECT_EQ(r.exit_code, 2) << exe << "\n" << r.output;
+    EXPECT_NE(r.output.find("--help"), std::string::npos) << exe << "\n" << r.output;
+  }
+  // A value CLI11 checks (a file that does not exist) and one the library refuses (a preset).
+  EXPECT_EQ(run(GI_BAKE_EXE, {"--scene", "/no/such/scene.gltf"}).exit_code, 2);
+  const ToolRun preset = run(GI_BAKE_EXE, {"--scene", GI_SOURCE_DIR "/assets/cornell_box.gltf", "--preset", "ultra",
+                                           "--out", GI_BINARY_DIR "/test_output/tools_test/never.gibake"});
+  EXPECT_EQ(preset.exit_code, 2) << preset.output;
+  EXPECT_NE(preset.output.find("ultra"), std::string::npos) << preset.output;
+  EXPECT_FALSE(fs::exists(GI_BINARY_DIR "/test_output/tools_test/never.gibake"));
+}
+
+TEST(Tools, AFailureExitsOneNamingTheFile) {
+  const fs::path bad = fs::path(GI_BINARY_DIR) / "test_output" / "tools_test" / "broken.gltf";
+  fs::create_directories(bad.parent_path());
+  std::ofstream(bad) << "{ \"asset\": { \"version\": \"2.0\" }, \"nodes\": [ {\"mesh\": 7} ] }";
+  for (const std::string& exe : {std::string(GI_BAKE_EXE), std::string(GI_REFERENCE_EXE)}) {
+    const ToolRun r = run(exe, {"--scene", bad.string(), "--out", (bad.parent_path() / "broken-out").string()});
+    EXPECT_EQ(r.exit_code, 1) << exe << "\n" << r.output;
+    EXPECT_NE(r.output.find("broken.gltf"), std::string::npos) << exe << "\n" << r.output;
+  }
+  EXPECT_FALSE(fs::exists(bad.parent_path() / "broken-out"));
+}
+
+TEST(Tools, CtrlCCancelsABakeAndLeavesNoBundle) {
+  const fs::path out = fs::path(GI_BINARY_DIR) / "test_output" / "tools_test" / "cancelled.gibake";
+  fs::remove_all(out);
+  // The high preset takes tens of seconds; the interrupt comes as soon as the bar shows.
+  const ToolRun r = run(GI_BAKE_EXE,
+                        {"--scene", GI_SOURCE_DIR "/assets/cornell_box.gltf", "--methods", "atlas", "--preset", "high",
+                         "--threads", "2", "--out", out.string()},
+                        20.0, "light atlas [");
+  EXPECT_EQ(r.exit_code, 130) << r.output;
+  EXPECT_NE(r.output.find("cancel"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(out)) << "a cancelled bake writes nothing";
+}
+
+TEST(Tools, CtrlCCancelsAReferenceRender) {
+  const fs::path out = fs::path(GI_BINARY_DIR) / "test_output" / "tools_test" / "cancelled-reference.exr";
+  fs::remove(out);
+  const ToolRun r =
+      run(GI_REFERENCE_EXE,
+          {"--scene", GI_SOURCE_DIR "/assets/cornell_box.gltf", "--spp", "100000", "--out", out.string()}, 20.0, "[");
+  EXPECT_EQ(r.exit_code, 130) << r.output;
+  EXPECT_FALSE(fs::exists(out)) << "a cancelled render writes no image";
+}
