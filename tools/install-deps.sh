@@ -8,7 +8,7 @@ packages=(
   libembree-dev libglm-dev libtinygltf-dev libdraco-dev libstb-dev nlohmann-json3-dev
   libglfw3-dev libegl-dev libgl-dev libgl1-mesa-dri libegl-mesa0 libgles-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  libeigen3-dev libzstd-dev libtinyexr-dev libcli11-dev libimgui-dev libtbb-dev
+  libeigen3-dev libzstd-dev libtinyexr-dev libcli11-dev libimgui-dev libtbb-dev libxxhash-dev
   xvfb xauth
   python3-matplotlib
 )

@@ -355,7 +355,7 @@ engine::Status save_brf(const fs::path& bundle_dir, const BrfBake& bake, const B
     if (!sum) return sum.error();
     const std::uintmax_t file_bytes = fs::file_size(file, ec);
     if (ec) return file_error(file, "", "cannot read the file size: " + ec.message());
-    files[m.name] = json{{"file", name}, {"fnv1a64", *sum}};
+    files[m.name] = json{{"file", name}, {"xxh3_64", *sum}};
     meshes[m.name] = json{{"mesh_hash", m.mesh_hash},
                           {"vertices", m.basis.vertex_count},
                           {"basis_requested", bake.settings.basis.basis},
@@ -393,7 +393,7 @@ engine::Result<BrfBake> load_brf(const fs::path& bundle_dir, std::span<const Brf
           manifest_file.string(), prefix + "." + key,
           "no basis radiance field for the scene's dynamic mesh \"" + source.name + "\" (re-bake with --methods brf)"};
     const std::string file_name = fields.get<std::string>(key + ".file");
-    const std::string checksum = fields.get<std::string>(key + ".fnv1a64");
+    const std::string checksum = fields.get<std::string>(key + ".xxh3_64");
     const double basis_seconds = fields.get<double>("meshes." + source.name + ".basis_seconds");
     const double field_seconds = fields.get<double>("meshes." + source.name + ".field_seconds");
     if (fields.error()) return *fields.error();

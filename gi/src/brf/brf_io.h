@@ -8,7 +8,7 @@
 //   brf_<name>.bin  the checksummed container of bake/blob_file.h, magic "GIBRFMSH", version 2;
 //                   <name> is BrfSource::name ([A-Za-z0-9_-], unique in the scene).
 //   manifest.json   methods.brf = {
-//     "files":    { "<name>": {"file": "brf_<name>.bin", "fnv1a64": "<hex of the whole file>"}, ... },
+//     "files":    { "<name>": {"file": "brf_<name>.bin", "xxh3_64": "<hex of the whole file>"}, ... },
 //     "settings": { "basis": { PcaBasisSettings' fields }, "field": { RadianceFieldSettings' fields } },
 //     "meshes":   { "<name>": { "mesh_hash", "mesh_index", "entities", "vertices", "basis_requested",
 //                               "basis_kept", "condition", "glossy_terms" (0: diffuse), "glossy_brdf_error",

@@ -44,7 +44,7 @@ struct BrfSource {
 /// tests, benchmarks and tools that need a rigid object without a scene.
 BrfMesh brf_box_mesh(glm::vec3 half, int n, float inset = 0.98f);
 
-/// 16 lowercase hex digits (FNV-1a 64) over the vertex count, positions, normals, indices
+/// 16 lowercase hex digits (XXH3-64) over the vertex count, positions, normals, indices
 /// and reflectance of `mesh`, in order, then the glossy lobe when there is one. A bake whose
 /// stored hash differs is stale.
 std::string brf_mesh_hash(const BrfMesh& mesh, const std::optional<GlossyLobe>& glossy = std::nullopt);

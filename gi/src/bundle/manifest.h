@@ -5,7 +5,7 @@
 //   auto m = gi::read_manifest("level.gibake");
 //   if (m && m->geometry_hash != gi::scene_geometry_hash(asset)) { /* stale */ }
 //
-//   { "format_version": 1, "geometry_hash": "0123456789abcdef", "scene": "level.gltf",
+//   { "format_version": 2, "geometry_hash": "0123456789abcdef", "scene": "level.gltf",
 //     "methods": { "light_atlas": { "files": {...}, "settings": {...}, ... } } }
 
 #include <engine/result.h>
@@ -16,7 +16,8 @@
 
 namespace gi {
 
-inline constexpr int kManifestFormatVersion = 1;
+// 2: XXH3-64 checksums and hashes ("xxh3_64"); 1 (FNV-1a) is refused with "re-bake".
+inline constexpr int kManifestFormatVersion = 2;
 inline constexpr const char* kManifestFileName = "manifest.json";
 
 struct Manifest {

@@ -119,7 +119,7 @@ engine::Status check_file_checksum(const std::filesystem::path& path, const std:
   if (!actual) return actual.error();
   if (*actual != expected)
     return engine::Error{path.string(), "",
-                         "checksum mismatch: the manifest expects FNV-1a " + expected + ", the file has " + *actual +
+                         "checksum mismatch: the manifest expects XXH3-64 " + expected + ", the file has " + *actual +
                              " (corrupt, or from another bake; re-bake)"};
   return {};
 }

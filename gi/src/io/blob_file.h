@@ -7,9 +7,9 @@
 //   offset  0  char[8]   magic      what the file holds ("GIVPLSET"...)
 //   offset  8  uint32    version    of the payload layout, per magic
 //   offset 12  uint64    size       payload bytes; the file is exactly 28 + size bytes
-//   offset 20  uint64    checksum   FNV-1a 64 of the payload bytes (gi::ContentHash)
+//   offset 20  uint64    checksum   XXH3-64 of the payload bytes (gi::ContentHash)
 //   offset 28  payload
-// FNV-1a detects truncation, bit flips and changed content; it is not cryptographic.
+// XXH3-64 detects truncation, bit flips and changed content; it is not cryptographic.
 
 #include <engine/result.h>
 
@@ -43,7 +43,7 @@ engine::Status write_file_atomic(const std::filesystem::path& path, std::span<co
 /// Reads a whole file. Error (naming it) when it is missing or unreadable.
 engine::Result<std::vector<std::byte>> read_file_bytes(const std::filesystem::path& path);
 
-/// FNV-1a 64 (gi::ContentHash) of a whole file as 16 hex digits: what a manifest records
+/// XXH3-64 (gi::ContentHash) of a whole file as 16 hex digits: what a manifest records
 /// for each file it references. Error (naming it) when it cannot be read.
 engine::Result<std::string> file_checksum(const std::filesystem::path& path);
 

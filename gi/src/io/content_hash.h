@@ -1,6 +1,7 @@
 #pragma once
-// A 64-bit FNV-1a hash for cache keys and file checksums (not cryptographic: it detects
-// truncation, bit flips and changed content, it does not resist deliberate collisions).
+// A 64-bit content hash for cache keys and file checksums: XXH3-64 (Debian's libxxhash),
+// streamed. Not cryptographic: it detects truncation, bit flips and changed content, it
+// does not resist deliberate collisions. Values are stable across runs and machines.
 //   gi::ContentHash h;
 //   h.add_bytes(data.data(), data.size()); std::string hex = h.hex();
 
@@ -11,17 +12,17 @@
 #include <string_view>
 #include <type_traits>
 
+#define XXH_STATIC_LINKING_ONLY  // XXH3_state_t by value: no allocation per hash
+#include <xxhash.h>
+
 namespace gi {
 
 class ContentHash {
  public:
+  ContentHash() { XXH3_64bits_reset(&state_); }
   /// Mixes `size` bytes into the hash.
   void add_bytes(const void* data, std::size_t size) {
-    const auto* p = static_cast<const unsigned char*>(data);
-    for (std::size_t i = 0; i < size; ++i) {
-      state_ ^= p[i];
-      state_ *= 0x100000001b3ull;
-    }
+    if (size > 0) XXH3_64bits_update(&state_, data, size);
   }
   /// Mixes a string, prefixed with its length so ("ab","c") and ("a","bc") differ.
   void add_string(std::string_view s) {
@@ -37,20 +38,26 @@ class ContentHash {
   template <class T>
   void add_values(std::span<const T> values) {
     add_value(static_cast<std::uint64_t>(values.size()));
-    for (const T& v : values) add_value(v);
+    if constexpr (std::is_arithmetic_v<T>) {
+      add_bytes(values.data(), values.size_bytes());  // same stream as value by value, in one call
+    } else {
+      for (const T& v : values) add_value(v);
+    }
   }
 
-  std::uint64_t value() const { return state_; }
-  /// 16 lowercase hex digits.
+  /// The hash of everything added so far (more may be added after).
+  std::uint64_t value() const { return XXH3_64bits_digest(&state_); }
+  /// value() as 16 lowercase hex digits.
   std::string hex() const {
     static constexpr char digits[] = "0123456789abcdef";
+    const std::uint64_t v = value();
     std::string s(16, '0');
-    for (int i = 0; i < 16; ++i) s[static_cast<std::size_t>(15 - i)] = digits[(state_ >> (4 * i)) & 0xfu];
+    for (int i = 0; i < 16; ++i) s[static_cast<std::size_t>(15 - i)] = digits[(v >> (4 * i)) & 0xfu];
     return s;
   }
 
  private:
-  std::uint64_t state_ = 0xcbf29ce484222325ull;
+  XXH3_state_t state_;
 };
 
 }  // namespace gi

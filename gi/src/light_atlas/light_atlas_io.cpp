@@ -75,9 +75,9 @@ engine::Result<EntryInfo> read_entry(const fs::path& manifest_file, const json& 
   JsonFields f(entry, manifest_file.string(), std::string("methods.") + kLightAtlasMethod);
   EntryInfo e;
   e.exr_file = f.get<std::string>("files.irradiance.file");
-  e.exr_checksum = f.get<std::string>("files.irradiance.fnv1a64");
+  e.exr_checksum = f.get<std::string>("files.irradiance.xxh3_64");
   e.vpls_file = f.get<std::string>("files.vpls.file");
-  e.vpls_checksum = f.get<std::string>("files.vpls.fnv1a64");
+  e.vpls_checksum = f.get<std::string>("files.vpls.xxh3_64");
   e.lights_hash = f.get<std::string>("lights_hash");
   e.requested_texels_per_metre = f.get<float>("layout.requested_texels_per_metre");
   e.texels_per_metre = f.get<float>("layout.texels_per_metre");
@@ -157,8 +157,8 @@ engine::Status save_light_atlas(const fs::path& bundle_dir, const LightAtlasBake
   if (!vpls_sum) return vpls_sum.error();
 
   const json entry{{"files",
-                    {{"irradiance", {{"file", kLightAtlasExrFile}, {"fnv1a64", *exr_sum}}},
-                     {"vpls", {{"file", kLightAtlasVplsFile}, {"fnv1a64", *vpls_sum}}}}},
+                    {{"irradiance", {{"file", kLightAtlasExrFile}, {"xxh3_64", *exr_sum}}},
+                     {"vpls", {{"file", kLightAtlasVplsFile}, {"xxh3_64", *vpls_sum}}}}},
                    {"lights_hash", static_lights_hash(input)},
                    {"settings", settings_json(bake.settings)},
                    {"layout",

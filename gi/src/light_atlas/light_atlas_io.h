@@ -8,12 +8,12 @@
 //                          column x: RGB = irradiance (W/m^2), A = 1 where valid, else 0.
 //   light_atlas_vpls.bin   settings + VPL solution (light_atlas_vpl_file.h).
 //   manifest.json          methods.light_atlas = {
-//     "files":    { "irradiance": {"file": "light_atlas.exr", "fnv1a64": "<hex>"},
-//                   "vpls":       {"file": "light_atlas_vpls.bin", "fnv1a64": "<hex>"} },
+//     "files":    { "irradiance": {"file": "light_atlas.exr", "xxh3_64": "<hex>"},
+//                   "vpls":       {"file": "light_atlas_vpls.bin", "xxh3_64": "<hex>"} },
 //     "settings": { LightAtlasSettings' scalar fields },
 //     "layout":   { "requested_texels_per_metre", "texels_per_metre", "padding_texels", "width", "height" },
 //     "stats":    { every LightAtlasStats field } }
-// The manifest is written last and names the FNV-1a 64 of both files, so a bundle whose
+// The manifest is written last and names the XXH3-64 of both files, so a bundle whose
 // bake was interrupted between files, or mixes files of two bakes, does not load.
 
 #include <engine/result.h>

@@ -139,7 +139,7 @@ engine::Result<EntryInfo> read_entry(const fs::path& manifest_file, const json& 
   JsonFields f(entry, manifest_file.string(), prefix);
   EntryInfo e;
   e.panes_file = f.get<std::string>("files.panes.file");
-  e.panes_checksum = f.get<std::string>("files.panes.fnv1a64");
+  e.panes_checksum = f.get<std::string>("files.panes.xxh3_64");
   e.requested_texels_per_metre = f.get<float>("layout.requested_texels_per_metre");
   e.texels_per_metre = f.get<float>("layout.texels_per_metre");
   e.padding_texels = f.get<int>("layout.padding_texels");
@@ -399,7 +399,7 @@ engine::Status save_prm(const fs::path& bundle_dir, const Prm& prm, const BakeIn
   const std::uintmax_t file_bytes = fs::file_size(panes, ec);
   if (ec) return file_error(panes, "", "cannot read the file size: " + ec.message());
 
-  const json entry{{"files", {{"panes", {{"file", kPrmPanesFile}, {"fnv1a64", *sum}}}}},
+  const json entry{{"files", {{"panes", {{"file", kPrmPanesFile}, {"xxh3_64", *sum}}}}},
                    {"settings", settings_json(prm.settings)},
                    {"layout",
                     {{"requested_texels_per_metre", prm.layout.requested_texels_per_metre},

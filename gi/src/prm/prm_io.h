@@ -6,7 +6,7 @@
 // Files (DESIGN.md §5, docs/bake-bundle.md):
 //   prm_panes.bin   the checksummed container of bake/blob_file.h, magic "GIPRMPAN", version 1.
 //   manifest.json   methods.prm = {
-//     "files":        { "panes": {"file": "prm_panes.bin", "fnv1a64": "<hex of the whole file>"} },
+//     "files":        { "panes": {"file": "prm_panes.bin", "xxh3_64": "<hex of the whole file>"} },
 //     "settings":     { PrmSettings' scalar fields (not progress) },
 //     "layout":       { "requested_texels_per_metre", "texels_per_metre", "padding_texels", "width", "height" },
 //     "entry_points", "clusters", "pane_texels",

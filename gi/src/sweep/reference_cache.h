@@ -7,7 +7,7 @@
 //         16   u64      payload length P
 //         24   K bytes  the full cache key (checked on load: a hash collision is never used)
 //       24+K   P bytes  payload: i32 width, i32 height, u32 has_mask, 3*w*h f32, [w*h u8 mask]
-//     24+K+P   u64      FNV-1a 64 checksum of every byte before it
+//     24+K+P   u64      XXH3-64 checksum of every byte before it
 // little-endian. Writes are atomic (write_file_atomically). A missing file is a miss; a
 // truncated, corrupt or mismatching file is reported with the reason and never used.
 //   gi::ReferenceCache cache("out/cache");

@@ -232,7 +232,7 @@ TEST(BrfIo, ManifestDescribesEveryMeshAndKeepsOtherMethods) {
   const nlohmann::json& e = m->methods["brf"];
   for (const gi::BrfMeshBake& b : baked().meshes) {
     EXPECT_EQ(e["files"][b.name]["file"], gi::brf_file_name(b.name));
-    EXPECT_EQ(e["files"][b.name]["fnv1a64"], gi::file_checksum(dir / gi::brf_file_name(b.name)).value());
+    EXPECT_EQ(e["files"][b.name]["xxh3_64"], gi::file_checksum(dir / gi::brf_file_name(b.name)).value());
     const nlohmann::json& s = e["meshes"][b.name];
     EXPECT_EQ(s["vertices"], b.basis.vertex_count);
     EXPECT_EQ(s["basis_kept"], b.basis.basis_count);

@@ -4,13 +4,16 @@
 #include <engine/gltf.h>
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstddef>
 #include <filesystem>
 #include <fstream>
+#include <span>
 #include <string>
 #include <vector>
 
 #include "bundle/bundle.h"
+#include "io/content_hash.h"
 
 namespace {
 
@@ -178,11 +181,14 @@ TEST(BundleManifest, RejectsBadManifestsNamingTheFile) {
   auto none = gi::read_manifest(dir);
   ASSERT_FALSE(none.ok());
   EXPECT_EQ(none.error().file, file.string());
-  expect_error("{ \"format_version\": 1, ", "malformed JSON");
+  expect_error("{ \"format_version\": 2, ", "malformed JSON");
   expect_error("[1, 2]", "not a JSON object");
-  expect_error(R"({"format_version": 2, "geometry_hash": "a", "scene": "s", "methods": {}})", "format_version 2");
-  expect_error(R"({"format_version": 1, "scene": "s", "methods": {}})", "geometry_hash: missing field");
-  expect_error(R"({"format_version": 1, "geometry_hash": "a", "scene": "s", "methods": []})", "methods");
+  // Version 1 bundles (FNV-1a checksums) and future ones are refused with what to do.
+  expect_error(R"({"format_version": 1, "geometry_hash": "a", "scene": "s", "methods": {}})", "format_version 1");
+  expect_error(R"({"format_version": 1, "geometry_hash": "a", "scene": "s", "methods": {}})", "re-bake");
+  expect_error(R"({"format_version": 3, "geometry_hash": "a", "scene": "s", "methods": {}})", "format_version 3");
+  expect_error(R"({"format_version": 2, "scene": "s", "methods": {}})", "geometry_hash: missing field");
+  expect_error(R"({"format_version": 2, "geometry_hash": "a", "scene": "s", "methods": []})", "methods");
   expect_error(R"({"format_version": "1", "geometry_hash": "a", "scene": "s", "methods": {}})", "integer");
 }
 
@@ -268,4 +274,22 @@ TEST(BundleLightsHash, ChangesWithStaticLightsOnly) {
   dynamic.lights[li].light.intensity *= 3.0f;
   dynamic.nodes[ln].translation.y -= 0.1f;
   EXPECT_EQ(gi::static_lights_hash(gi::bake_input_from(dynamic)), hd);
+}
+
+// Bundle checksums are XXH3-64: the published value of the empty input, independence from
+// how the bytes are split into calls, and a single flipped bit changing the hash.
+TEST(ContentHash, IsXxh3OfTheByteStream) {
+  EXPECT_EQ(gi::ContentHash().hex(), "2d06800538d394c2");  // XXH3_64bits("", 0), xxHash's test vector
+  std::vector<float> v(1000);
+  for (std::size_t i = 0; i < v.size(); ++i) v[i] = static_cast<float>(i) * 0.25f;
+  gi::ContentHash whole, one_by_one;
+  whole.add_values(std::span<const float>(v));
+  one_by_one.add_value(static_cast<std::uint64_t>(v.size()));
+  for (float f : v) one_by_one.add_value(f);
+  EXPECT_EQ(whole.value(), one_by_one.value());
+  v[517] = std::nextafter(v[517], 1e9f);
+  gi::ContentHash flipped;
+  flipped.add_values(std::span<const float>(v));
+  EXPECT_NE(flipped.value(), whole.value());
+  EXPECT_EQ(whole.hex().size(), 16u);
 }

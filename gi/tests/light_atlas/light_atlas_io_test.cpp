@@ -248,7 +248,7 @@ TEST(LightAtlasIo, WrongSizeOrInvalidTexelsInTheExrAreRejected) {
     const auto bytes = gi::read_file_bytes(dir / "light_atlas.exr").value();
     gi::ContentHash h;
     h.add_bytes(bytes.data(), bytes.size());
-    m->methods["light_atlas"]["files"]["irradiance"]["fnv1a64"] = h.hex();
+    m->methods["light_atlas"]["files"]["irradiance"]["xxh3_64"] = h.hex();
     ASSERT_TRUE(gi::write_manifest(dir, *m).ok());
   };
   const gi::LightAtlasBake bake = fake_bake(cornell());
@@ -285,7 +285,7 @@ TEST(LightAtlasIo, VplFileMustMatchTheManifestsGeometry) {
   const auto bytes = gi::read_file_bytes(dir / "light_atlas_vpls.bin").value();
   gi::ContentHash h;
   h.add_bytes(bytes.data(), bytes.size());
-  m->methods["light_atlas"]["files"]["vpls"]["fnv1a64"] = h.hex();
+  m->methods["light_atlas"]["files"]["vpls"]["xxh3_64"] = h.hex();
   ASSERT_TRUE(gi::write_manifest(dir, *m).ok());
   expect_load_error(dir, "light_atlas_vpls.bin", "0123456789abcdef");
 }

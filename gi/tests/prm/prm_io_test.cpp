@@ -129,7 +129,7 @@ void resign(const fs::path& dir) {
   const auto bytes = read_all(dir / "prm_panes.bin");
   gi::ContentHash h;
   h.add_bytes(bytes.data(), bytes.size());
-  m->methods["prm"]["files"]["panes"]["fnv1a64"] = h.hex();
+  m->methods["prm"]["files"]["panes"]["xxh3_64"] = h.hex();
   ASSERT_TRUE(gi::write_manifest(dir, *m).ok());
 }
 
@@ -272,7 +272,7 @@ TEST(PrmIo, ManifestEntryDescribesTheBake) {
   const auto bytes = read_all(dir / "prm_panes.bin");
   gi::ContentHash h;
   h.add_bytes(bytes.data(), bytes.size());
-  EXPECT_EQ(e["files"]["panes"]["fnv1a64"], h.hex());
+  EXPECT_EQ(e["files"]["panes"]["xxh3_64"], h.hex());
   EXPECT_EQ(e["settings"]["seed"], prm.settings.seed);
   EXPECT_EQ(e["settings"]["entry_points"], 7);
   EXPECT_EQ(e["settings"]["clusters"], 4);
