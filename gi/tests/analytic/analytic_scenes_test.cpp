@@ -51,8 +51,8 @@ gi::BakeInput plate_input(bool moving_light) {
   return in;
 }
 
-// Measured (16 texels/m, 17 x 17 samples): light atlas max 0.0?, path tracer max 0.0?,
-// PRM entry points max 0.0?. Bounds: see the EXPECTs.
+// Measured (16 texels/m, 17 x 17 samples): light atlas max 0.0034, path tracer 0.0000, PRM
+// entry points 0.056 (bounds at the EXPECTs).
 TEST(AnalyticPlate, DirectIrradiancePerTexel) {
   const gi::BakeInput input = plate_input(false);
   gi::LightAtlasSettings s;

@@ -50,7 +50,7 @@ TEST(FurnaceAlbedo, EngineBrdfEqualsTheSpecificationFormulas) {
 }
 
 // The table. Measured: engine (32 x 32 table, bilinear) vs this quadrature, largest absolute
-// difference 0.0?? (docs/analytic_truth.md). Metals never exceed 1; white dielectrics exceed 1
+// difference 0.0051 at 89 deg, 0.0044 below (docs/analytic_truth.md). Metals never exceed 1; white dielectrics exceed 1
 // at grazing angles (fresnel_mix is not energy conserving: glTF 2.0 Appendix B, "Coupling
 // Diffuse and Specular Reflection"), at most 1.83 at 89 degrees and roughness 0.05.
 TEST(FurnaceAlbedo, DirectionalAlbedoTable) {
@@ -81,14 +81,14 @@ TEST(FurnaceAlbedo, DirectionalAlbedoTable) {
           EXPECT_LE(engine_a, 1.85) << "dielectric, roughness " << r << ", " << deg << " deg";
         }
         // Engine table vs quadrature, per cell (largest measured difference, see the docs).
-        EXPECT_NEAR(engine_a, quad_a, deg >= 89.0 ? 0.03 : 0.01)
+        EXPECT_NEAR(engine_a, quad_a, deg >= 89.0 ? 0.02 : 0.006)
             << (metal ? "metal" : "dielectric") << ", roughness " << r << ", " << deg << " deg";
       }
       const double engine_h = static_cast<double>(engine::gltf_hemispherical_albedo(m).sum().y);
       const glm::dvec2 qh = analytic::spec_hemispherical_albedo(s);
       std::printf("   %8.4f|%8.4f\n", engine_h, qh.x + qh.y);
       worst_hemi = std::max(worst_hemi, std::fabs(engine_h - (qh.x + qh.y)));
-      EXPECT_NEAR(engine_h, qh.x + qh.y, 0.005);
+      EXPECT_NEAR(engine_h, qh.x + qh.y, 0.002);  // measured 0.0007
       if (metal)
         EXPECT_LE(engine_h, 1.0);
       else

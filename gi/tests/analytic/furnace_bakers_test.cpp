@@ -67,8 +67,9 @@ struct Case {
 constexpr Case kCases[] = {{false, 0.05f}, {false, 0.25f}, {false, 0.5f}, {false, 1.0f},
                            {true, 0.05f},  {true, 0.25f},  {true, 0.5f},  {true, 1.0f}};
 
-// Light atlas, 3 reflections, and the world probes built from its VPLs. Measured: atlas
-// per-texel max ?, RMS ?; probes max ?. Bounds below.
+// Light atlas, 3 reflections, and the world probes built from its VPLs. Measured: atlas interior
+// texels max 0.145, RMS 0.078, bias -0.076 (the emissive walls' point emitters near edges); edge
+// texels max 0.77; probes max 0.225, RMS 0.124.
 TEST(FurnaceBakers, LightAtlasAndWorldProbesFollowTheirFolding) {
   std::printf("furnace, bakers vs pi Le sum_{k<=b} rho^k per texel (rho: the folded hemispherical albedo)\n");
   for (const Case& c : kCases) {

@@ -61,9 +61,9 @@ glm::dvec2 albedo_range(const analytic::SpecBrdf& s) {
   return r;
 }
 
-// Measured (8192 paths per angle): bounce 0 largest relative error 0.0?? (dielectric,
-// roughness 0.05, 89 deg, where the GGX peak is a few hundredths of a degree wide); the
-// bound is 3% (5% at 85-89 deg). Bounces <= 2 always inside the bracket (with 3% noise).
+// Measured (8192 paths per angle, 48 cells): bounce 0 max 0.52%, RMS 0.28%, bias -0.23%
+// (standard errors 0.02-0.4%); bound 1.5% (2.5% at 85-89 deg). Bounces <= 2: all inside the bracket
+// (asserted with 3% margins).
 TEST(FurnacePathTracer, RadianceMatchesTheDirectionalAlbedo) {
   analytic::ErrorStats all0;
   std::printf(
@@ -94,7 +94,7 @@ TEST(FurnacePathTracer, RadianceMatchesTheDirectionalAlbedo) {
                     metal ? "metal" : "dielectric", double{r}, deg, a, l0, se0 / kLe, exact0, l2, lower, upper);
         e0.add(l0, exact0);
         all0.add(l0, exact0);
-        EXPECT_NEAR(l0, exact0, (deg >= 85.0 ? 0.05 : 0.03) * exact0)
+        EXPECT_NEAR(l0, exact0, (deg >= 85.0 ? 0.025 : 0.015) * exact0)
             << (metal ? "metal" : "dielectric") << " roughness " << r << " at " << deg << " deg";
         EXPECT_GE(l2, lower * 0.97) << (metal ? "metal" : "dielectric") << " roughness " << r << " " << deg;
         EXPECT_LE(l2, upper * 1.03) << (metal ? "metal" : "dielectric") << " roughness " << r << " " << deg;
