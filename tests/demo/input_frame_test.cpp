@@ -1,10 +1,9 @@
+#include <game_demo/input_frame.h>
+#include <gtest/gtest.h>
+
 #include <bit>
 #include <cmath>
 #include <limits>
-
-#include <gtest/gtest.h>
-
-#include <game_demo/input_frame.h>
 
 namespace {
 
@@ -18,7 +17,7 @@ TEST(InputFrame, SerializationRoundTripIsBitExact) {
       {.keys = 0x7f, .mouse_dx_px = -0.0f, .mouse_dy_px = std::numeric_limits<float>::denorm_min()},
       {.keys = game_demo::key_bit(Key::E), .mouse_dx_px = 1e30f, .mouse_dy_px = -123456.789f},
   };
-  std::vector<std::uint8_t> bytes;
+  std::vector<std::byte> bytes;
   for (const InputFrame& f : frames) game_demo::append_input_frame(bytes, f);
   ASSERT_EQ(bytes.size(), std::size(frames) * game_demo::kInputFrameBytes);
   for (std::size_t i = 0; i < std::size(frames); ++i) {
@@ -31,17 +30,18 @@ TEST(InputFrame, SerializationRoundTripIsBitExact) {
 }
 
 TEST(InputFrame, LayoutIsLittleEndian) {
-  std::vector<std::uint8_t> bytes;
+  std::vector<std::byte> bytes;
   game_demo::append_input_frame(bytes, {.keys = 0x41, .mouse_dx_px = 1.0f, .mouse_dy_px = 0.0f});
-  const std::vector<std::uint8_t> expected = {0x41, 0, 0, 0, 0x00, 0x00, 0x80, 0x3f, 0, 0, 0, 0};
-  EXPECT_EQ(bytes, expected);
+  const std::vector<int> expected = {0x41, 0, 0, 0, 0x00, 0x00, 0x80, 0x3f, 0, 0, 0, 0};
+  ASSERT_EQ(bytes.size(), expected.size());
+  for (std::size_t i = 0; i < bytes.size(); ++i) EXPECT_EQ(std::to_integer<int>(bytes[i]), expected[i]) << i;
 }
 
 TEST(InputFrame, RejectsShortBuffersAndUnknownKeys) {
-  std::vector<std::uint8_t> bytes;
+  std::vector<std::byte> bytes;
   game_demo::append_input_frame(bytes, {.keys = 1});
   EXPECT_FALSE(game_demo::read_input_frame(std::span(bytes).first(11)).has_value());
-  bytes[0] = 0x80;  // bit 7: no such key
+  bytes[0] = std::byte{0x80};  // bit 7: no such key
   EXPECT_FALSE(game_demo::read_input_frame(bytes).has_value());
 }
 

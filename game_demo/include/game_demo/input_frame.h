@@ -4,6 +4,7 @@
 //   game_demo::InputFrame in{.keys = game_demo::key_bit(game_demo::Key::W), .mouse_dx_px = 4.0f};
 //   if (in.held(game_demo::Key::W)) ...
 
+#include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <span>
@@ -41,10 +42,10 @@ inline constexpr std::size_t kInputFrameBytes = 12;
 
 /// Appends `in` as 12 little-endian bytes: u32 keys, f32 mouse_dx_px, f32 mouse_dy_px
 /// (floats by bit pattern, so the round trip is exact).
-void append_input_frame(std::vector<std::uint8_t>& out, const InputFrame& in);
+void append_input_frame(std::vector<std::byte>& out, const InputFrame& in);
 
 /// Reads one InputFrame from the first 12 bytes of `bytes`; nullopt when there are fewer
 /// bytes or the key mask has bits no key uses.
-std::optional<InputFrame> read_input_frame(std::span<const std::uint8_t> bytes);
+std::optional<InputFrame> read_input_frame(std::span<const std::byte> bytes);
 
 }  // namespace game_demo

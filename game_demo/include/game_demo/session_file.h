@@ -18,6 +18,7 @@
 //              N x 20   per frame: InputFrame (u32 keys, f32 mouse dx, f32 mouse dy), u64 state checksum
 // Nothing may follow the last frame.
 
+#include <cstddef>
 #include <cstdint>
 #include <filesystem>
 #include <span>
@@ -55,12 +56,12 @@ struct Session {
 };
 
 /// Serializes a session (layout above).
-std::vector<std::uint8_t> encode_session(const Session& session);
+std::vector<std::byte> encode_session(const Session& session);
 
 /// Parses a session; `file` names the source in errors. Rejects bad magic, other format
 /// versions, truncated or oversized data, absurd header values and checksum mismatches,
 /// each with a message saying which.
-engine::Result<Session> decode_session(std::span<const std::uint8_t> bytes, const std::string& file);
+engine::Result<Session> decode_session(std::span<const std::byte> bytes, const std::string& file);
 
 /// Writes a session to a temporary file beside `path`, then renames it into place.
 engine::Status save_session(const std::filesystem::path& path, const Session& session);

@@ -9,7 +9,7 @@
 #include <system_error>
 
 #include "bundle/bundle.h"
-#include "io/byte_stream.h"
+#include <engine/byte_stream.h>
 #include "io/json_fields.h"
 
 namespace gi {
@@ -216,7 +216,7 @@ engine::Status write_brf_mesh(const fs::path& path, const BrfMeshBake& bake, std
 
   const BrfBasis& b = bake.basis;
   const BasisRadianceField& f = bake.field;
-  ByteWriter w;
+  engine::ByteWriter w;
   w.put_string(bake.name);
   w.put_string(bake.mesh_hash);
   w.put(static_cast<std::uint64_t>(b.vertex_count));
@@ -256,7 +256,7 @@ engine::Status write_brf_mesh(const fs::path& path, const BrfMeshBake& bake, std
 engine::Result<BrfMeshBake> read_brf_mesh(const fs::path& path) {
   auto payload = read_blob(path, kBrfMeshMagic, kBrfMeshVersion);
   if (!payload) return payload.error();
-  ByteReader r(payload.value());
+  engine::ByteReader r(payload.value());
   BrfMeshBake out;
   BrfBasis& b = out.basis;
   BasisRadianceField& f = out.field;

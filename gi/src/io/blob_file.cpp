@@ -6,7 +6,7 @@
 #include <string>
 #include <string_view>
 
-#include "io/byte_stream.h"
+#include <engine/byte_stream.h>
 #include "io/atomic_file.h"
 #include "io/content_hash.h"
 
@@ -56,7 +56,7 @@ engine::Result<std::vector<std::byte>> read_file_bytes(const std::filesystem::pa
 
 engine::Status write_blob(const std::filesystem::path& path, BlobMagic magic, std::uint32_t version,
                           std::span<const std::byte> payload) {
-  ByteWriter w;
+  engine::ByteWriter w;
   for (char c : magic.chars) w.put(c);
   w.put(version);
   w.put(static_cast<std::uint64_t>(payload.size()));
@@ -82,7 +82,7 @@ engine::Result<std::vector<std::byte>> read_blob(const std::filesystem::path& pa
                       "wrong magic \"" + printable(head.first(8)) + "\", expected \"" + std::string(magic.view()) +
                           "\" (not this kind of bake file)");
   }
-  ByteReader r(head.subspan(8));
+  engine::ByteReader r(head.subspan(8));
   std::uint32_t file_version = 0;
   std::uint64_t size = 0, checksum = 0;
   r.get(file_version);

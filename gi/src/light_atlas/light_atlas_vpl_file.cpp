@@ -3,7 +3,7 @@
 #include <cmath>
 #include <span>
 
-#include "io/byte_stream.h"
+#include <engine/byte_stream.h>
 
 namespace gi {
 
@@ -55,7 +55,7 @@ engine::Status write_light_atlas_vpls(const std::filesystem::path& path, const L
     return engine::Error{path.string(), "", "cannot save the VPLs: " + problem};
   const LightAtlasSettings& s = bake.settings;
   const VplSet& v = bake.vpls;
-  ByteWriter w;
+  engine::ByteWriter w;
   w.put_string(geometry_hash);
   w.put(s.texels_per_metre);
   w.put(static_cast<std::int32_t>(s.vpl_count));
@@ -81,7 +81,7 @@ engine::Status write_light_atlas_vpls(const std::filesystem::path& path, const L
 engine::Result<LightAtlasVplFile> read_light_atlas_vpls(const std::filesystem::path& path) {
   auto payload = read_blob(path, kLightAtlasVplsMagic, kLightAtlasVplsVersion);
   if (!payload) return payload.error();
-  ByteReader r(payload.value());
+  engine::ByteReader r(payload.value());
   LightAtlasVplFile f;
   LightAtlasSettings& s = f.settings;
   VplSet& v = f.vpls;

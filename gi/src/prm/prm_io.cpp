@@ -11,7 +11,7 @@
 #include <system_error>
 
 #include "bundle/bundle.h"
-#include "io/byte_stream.h"
+#include <engine/byte_stream.h>
 #include "io/json_fields.h"
 #include "uv/atlas_input.h"
 
@@ -255,7 +255,7 @@ engine::Status write_prm_panes(const fs::path& path, const Prm& prm, const std::
     area.push_back(e.area_m2);
     cluster.push_back(e.cluster);
   }
-  ByteWriter w;
+  engine::ByteWriter w;
   w.put_string(geometry_hash);
   w.put(s.texels_per_metre);
   w.put(static_cast<std::int32_t>(s.entry_points));
@@ -283,7 +283,7 @@ engine::Status write_prm_panes(const fs::path& path, const Prm& prm, const std::
 engine::Result<PrmPaneFile> read_prm_panes(const fs::path& path) {
   auto payload = read_blob(path, kPrmPanesMagic, kPrmPanesVersion);
   if (!payload) return payload.error();
-  ByteReader r(payload.value());
+  engine::ByteReader r(payload.value());
   PrmPaneFile f;
   Prm& p = f.prm;
   PrmSettings& s = p.settings;

@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "bundle/bundle.h"
-#include "io/byte_stream.h"
+#include <engine/byte_stream.h>
 #include "raytrace/scene_adapter.h"
 
 namespace {

@@ -18,7 +18,7 @@
 #include <string>
 
 #include "bundle/bundle.h"
-#include "io/byte_stream.h"
+#include <engine/byte_stream.h>
 #include "io/content_hash.h"
 #include "uv/atlas_input.h"
 
@@ -524,7 +524,7 @@ TEST(PrmIo, InconsistentPayloadsAreRejected) {
       const std::size_t packed = ZSTD_compress(frame.data(), frame.size(), edited.data(), edited.size(), 3);
       ASSERT_EQ(ZSTD_isError(packed), 0u);
       std::vector<std::byte> q(p.begin(), p.begin() + static_cast<std::ptrdiff_t>(start) - 8);
-      gi::ByteWriter w;
+      engine::ByteWriter w;
       w.put(static_cast<std::uint64_t>(packed));
       q.insert(q.end(), w.bytes().begin(), w.bytes().end());
       q.insert(q.end(), frame.begin(), frame.begin() + static_cast<std::ptrdiff_t>(packed));

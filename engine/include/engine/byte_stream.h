@@ -1,8 +1,10 @@
 #pragma once
 // Little-endian packing of plain values and arrays into a byte payload, and bounds-checked
-// reading back. The host is little-endian (static_assert), so values are copied as they are.
-//   gi::ByteWriter w; w.put(std::uint32_t{7}); w.put_array(std::span<const glm::vec3>(positions));
-//   gi::ByteReader r(w.bytes()); std::uint32_t v = 0; if (!r.get(v)) { /* truncated */ }
+// reading back: the one byte I/O of every binary file (bake bundles, recorded sessions).
+// The host is little-endian (static_assert), so values are copied as they are.
+//   engine::ByteWriter w; w.put(std::uint32_t{7}); w.put_array(std::span<const glm::vec3>(positions));
+//   engine::ByteReader r(w.bytes()); std::uint32_t v = 0; if (!r.get(v)) { /* truncated */ }
+// Name the type when the argument's is not the field's: w.put<std::uint32_t>(count).
 
 #include <bit>
 #include <cstddef>
@@ -14,9 +16,9 @@
 #include <type_traits>
 #include <vector>
 
-namespace gi {
+namespace engine {
 
-static_assert(std::endian::native == std::endian::little, "bake files are little-endian; add byte swapping");
+static_assert(std::endian::native == std::endian::little, "binary files are little-endian; add byte swapping");
 
 static_assert(sizeof(glm::vec3) == 12 && sizeof(glm::vec4) == 16, "GLM vectors must be unpadded floats");
 
@@ -27,6 +29,13 @@ inline constexpr bool kPackable = std::is_arithmetic_v<T> || std::is_same_v<T, g
 
 class ByteWriter {
  public:
+  /// Writes into its own buffer (bytes(), take()).
+  ByteWriter() : out_(&own_) {}
+  /// Appends to `out`, which must outlive the writer.
+  explicit ByteWriter(std::vector<std::byte>& out) : out_(&out) {}
+  ByteWriter(const ByteWriter&) = delete;
+  ByteWriter& operator=(const ByteWriter&) = delete;
+
   template <class T>
   void put(const T& v) {
     static_assert(kPackable<T>, "pack fields one by one");
@@ -48,15 +57,20 @@ class ByteWriter {
     put(static_cast<std::uint64_t>(s.size()));
     append(s.data(), s.size());
   }
-  std::span<const std::byte> bytes() const { return bytes_; }
-  std::vector<std::byte> take() { return std::move(bytes_); }
+  /// Raw bytes, no count (a magic, a fixed-length field).
+  void put_bytes(const void* data, std::size_t n) { append(data, n); }
+  std::span<const std::byte> bytes() const { return *out_; }
+  std::vector<std::byte> take() { return std::move(*out_); }
 
  private:
   void append(const void* data, std::size_t n) {
-    const auto* p = static_cast<const std::byte*>(data);
-    bytes_.insert(bytes_.end(), p, p + n);
+    if (n == 0) return;
+    const std::size_t at = out_->size();
+    out_->resize(at + n);
+    std::memcpy(out_->data() + at, data, n);
   }
-  std::vector<std::byte> bytes_;
+  std::vector<std::byte> own_;
+  std::vector<std::byte>* out_;
 };
 
 /// Reads what ByteWriter wrote. Every getter returns false (and leaves the output alone)
@@ -84,6 +98,13 @@ class ByteReader {
     offset_ += static_cast<std::size_t>(n) * sizeof(T);
     return true;
   }
+  /// `n` characters, no count (the count was read before).
+  bool get_chars(std::string& out, std::size_t n) {
+    if (n > remaining()) return false;
+    out.assign(reinterpret_cast<const char*>(bytes_.data() + offset_), n);
+    offset_ += n;
+    return true;
+  }
   bool get_string(std::string& out) {
     std::uint64_t n = 0;
     if (!get(n) || n > remaining()) return false;
@@ -100,4 +121,4 @@ class ByteReader {
   std::size_t offset_ = 0;
 };
 
-}  // namespace gi
+}  // namespace engine
