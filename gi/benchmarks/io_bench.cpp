@@ -2,10 +2,10 @@
 // the same bytes (the yardstick: a checksum cannot be cheaper than reading the bytes once).
 //   ./build/gi/benchmarks/io_bench
 // The demo level's medium bundle is about 15 MB, so bytes/s here says what a load pays.
+#include <benchmark/benchmark.h>
+
 #include <cstring>
 #include <vector>
-
-#include <benchmark/benchmark.h>
 
 #include "io/content_hash.h"
 

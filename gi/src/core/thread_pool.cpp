@@ -1,69 +1,34 @@
 #include "core/thread_pool.h"
 
+#include <oneapi/tbb/blocked_range.h>
+#include <oneapi/tbb/parallel_for.h>
+
 #include <algorithm>
+#include <thread>
 
 namespace gi {
 
 ThreadPool::ThreadPool(unsigned threads) {
   if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
-  for (unsigned i = 1; i < threads; ++i) workers_.emplace_back([this] { worker_loop(); });
+  size_ = std::min(threads, kMaxThreads);
+  // One slot reserved for the calling thread (the default), the rest for TBB's workers.
+  arena_ = std::make_unique<tbb::task_arena>(static_cast<int>(size_));
 }
 
-ThreadPool::~ThreadPool() {
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    stop_ = true;
-  }
-  wake_.notify_all();
-  for (std::thread& t : workers_) t.join();
-}
-
-void ThreadPool::run_chunks() {
-  for (;;) {
-    const std::size_t begin = next_.fetch_add(grain_);
-    if (begin >= count_) return;
-    const std::size_t end = std::min(count_, begin + grain_);
-    for (std::size_t i = begin; i < end; ++i) (*job_)(i);
-  }
-}
-
-void ThreadPool::worker_loop() {
-  std::uint64_t seen = 0;
-  for (;;) {
-    {
-      std::unique_lock<std::mutex> lock(mutex_);
-      wake_.wait(lock, [&] { return stop_ || generation_ != seen; });
-      if (stop_) return;
-      seen = generation_;
-      ++busy_;
-    }
-    run_chunks();
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      --busy_;
-    }
-    done_.notify_all();
-  }
-}
+ThreadPool::~ThreadPool() = default;
 
 void ThreadPool::parallel_for(std::size_t count, const std::function<void(std::size_t)>& fn, std::size_t grain) {
   if (count == 0) return;
-  {
-    // Wait for stragglers of the previous call (workers still leaving run_chunks) before
-    // publishing the new job, so no worker reads count_/grain_ while they change.
-    std::unique_lock<std::mutex> lock(mutex_);
-    done_.wait(lock, [&] { return busy_ == 0; });
-    job_ = &fn;
-    count_ = count;
-    grain_ = std::max<std::size_t>(1, grain);
-    next_.store(0);
-    ++generation_;
+  if (size_ == 1) {  // the caller alone: no task overhead
+    for (std::size_t i = 0; i < count; ++i) fn(i);
+    return;
   }
-  wake_.notify_all();
-  run_chunks();
-  std::unique_lock<std::mutex> lock(mutex_);
-  done_.wait(lock, [&] { return busy_ == 0; });
-  job_ = nullptr;
+  arena_->execute([&] {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, std::max<std::size_t>(1, grain)),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        for (std::size_t i = r.begin(); i < r.end(); ++i) fn(i);
+                      });
+  });
 }
 
 bool ThreadPool::parallel_for_with_progress(std::size_t count, const ProgressCallback& progress,

@@ -1,36 +1,37 @@
 #pragma once
-// A fixed pool of worker threads for bakers and the reference renderer. Work is split into
-// items identified by index; results must be written per item (never accumulated across
-// items in completion order), so output is bit-identical for any thread count.
+// The bakers' and the reference renderer's parallel loop: a oneTBB task arena of a fixed
+// size (Debian's libtbb). Work is split into items identified by index; results must be
+// written per item (never accumulated across items in completion order), so output is
+// bit-identical for any thread count and any scheduling.
 //   gi::ThreadPool pool(4);
 //   pool.parallel_for(n, [&](std::size_t i) { out[i] = shade(i); });
+// An exception thrown by fn reaches the caller of parallel_for (the other items stop).
 
 #include <gi/progress.h>
+#include <oneapi/tbb/task_arena.h>
 
-#include <atomic>
-#include <condition_variable>
 #include <cstddef>
-#include <cstdint>
 #include <functional>
-#include <mutex>
-#include <thread>
-#include <vector>
+#include <memory>
 
 namespace gi {
 
 class ThreadPool {
  public:
-  /// `threads` = 0 uses std::thread::hardware_concurrency(). The calling thread also works,
-  /// so a pool of 1 runs everything on the caller.
+  /// At most this many threads, whatever is asked (a request is a setting, not a promise).
+  static constexpr unsigned kMaxThreads = 256;
+
+  /// `threads` = 0 uses the hardware's threads; more than kMaxThreads is clamped. The
+  /// calling thread works too, so a pool of 1 runs everything on the caller.
   explicit ThreadPool(unsigned threads = 0);
   ~ThreadPool();
   ThreadPool(const ThreadPool&) = delete;
   ThreadPool& operator=(const ThreadPool&) = delete;
 
-  unsigned size() const { return static_cast<unsigned>(workers_.size()) + 1; }
+  unsigned size() const { return size_; }
 
-  /// Calls fn(i) for every i in [0, count), items handed out in chunks of `grain`. Blocks
-  /// until all are done. Not re-entrant (fn must not call parallel_for on the same pool).
+  /// Calls fn(i) for every i in [0, count), in chunks of at least `grain` items. Blocks
+  /// until all are done.
   void parallel_for(std::size_t count, const std::function<void(std::size_t)>& fn, std::size_t grain = 1);
 
   /// parallel_for in batches (at most 200), calling `progress` (if set) with the fraction
@@ -40,20 +41,8 @@ class ThreadPool {
                                   const std::function<void(std::size_t)>& fn, std::size_t grain = 4);
 
  private:
-  void worker_loop();
-  void run_chunks();
-
-  std::vector<std::thread> workers_;
-  std::mutex mutex_;
-  std::condition_variable wake_;
-  std::condition_variable done_;
-  const std::function<void(std::size_t)>* job_ = nullptr;
-  std::size_t count_ = 0;
-  std::size_t grain_ = 1;
-  std::atomic<std::size_t> next_{0};
-  std::size_t busy_ = 0;
-  std::uint64_t generation_ = 0;
-  bool stop_ = false;
+  unsigned size_ = 1;
+  std::unique_ptr<tbb::task_arena> arena_;
 };
 
 }  // namespace gi

@@ -1,9 +1,13 @@
-#include <numeric>
+#include "core/thread_pool.h"
 
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <numeric>
+#include <stdexcept>
+#include <vector>
+
 #include "core/random.h"
-#include "core/thread_pool.h"
 
 namespace {
 
@@ -35,9 +39,26 @@ TEST(ThreadPool, ResultsAreBitIdenticalForAnyThreadCount) {
 TEST(ThreadPool, VisitsEveryItemExactlyOnce) {
   gi::ThreadPool pool(3);
   std::vector<std::atomic<int>> visits(5000);
-  pool.parallel_for(visits.size(), [&](std::size_t i) { visits[i].fetch_add(1); }, 7);
+  pool.parallel_for(
+      visits.size(), [&](std::size_t i) { visits[i].fetch_add(1); }, 7);
   for (const auto& v : visits) ASSERT_EQ(v.load(), 1);
   pool.parallel_for(0, [&](std::size_t) { FAIL() << "no items"; });
+}
+
+// Issue-20 inputs: an absurd thread count is clamped, not a crash; an exception thrown by
+// an item reaches the caller instead of terminating the process, and the pool stays usable.
+TEST(ThreadPool, AbsurdThreadCountsAreClampedAndItemExceptionsReachTheCaller) {
+  gi::ThreadPool huge(4000000000u);
+  EXPECT_EQ(huge.size(), gi::ThreadPool::kMaxThreads);
+  gi::ThreadPool pool(2);
+  EXPECT_THROW(pool.parallel_for(1000,
+                                 [](std::size_t i) {
+                                   if (i == 517) throw std::runtime_error("item 517");
+                                 }),
+               std::runtime_error);
+  std::vector<std::atomic<int>> visits(100);
+  pool.parallel_for(visits.size(), [&](std::size_t i) { visits[i].fetch_add(1); });
+  for (const auto& v : visits) ASSERT_EQ(v.load(), 1);
 }
 
 TEST(Pcg32, StreamsForDifferentItemsDiffer) {
