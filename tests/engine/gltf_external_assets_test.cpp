@@ -458,10 +458,8 @@ const std::map<std::string, std::string>& validator_allowlist() {
        "extension data the engine does not read"},
       {"ext/KHR_materials_dispersion/data/material/unexpected_extension.gltf",
        "extension data the engine does not read"},
-      {"ext/KHR_materials_specular/data/material/out_of_range.gltf",
-       "extension data the engine does not read"},
       {"ext/KHR_materials_specular/data/material/unexpected_extension.gltf",
-       "extension data the engine does not read"},
+       "the extension's factors are read wherever they appear (the validator wants it declared)"},
       {"ext/KHR_materials_emissive_strength/data/material/unexpected_extension.gltf",
        "extension data the engine does not read"},
       {"ext/KHR_materials_ior/data/material/out_of_range.gltf",
@@ -605,6 +603,19 @@ const std::map<std::string, std::string>& validator_valid_but_rejected() {
        "a mesh used by a node reads a buffer with no uri: its geometry is not in the file"},
   };
   return list;
+}
+
+// KHR_materials_specular feeds the one BRDF (engine/gltf_brdf.h), so out-of-range factors
+// are refused naming the material, not silently clamped.
+TEST(GltfExternalAssets, SpecularFactorsOutOfRangeAreRefused) {
+  SKIP_WITHOUT_ASSETS();
+  const fs::path p =
+      assets() / "edge-cases/glTF-Validator-test/ext/KHR_materials_specular/data/material/out_of_range.gltf";
+  auto r = engine::load_gltf(p);
+  ASSERT_FALSE(r.ok());
+  const std::string e = r.error().to_string();
+  EXPECT_NE(e.find(p.string()), std::string::npos) << e;
+  EXPECT_NE(e.find("material 0 KHR_materials_specular: specularFactor must be in [0, 1]"), std::string::npos) << e;
 }
 
 TEST(GltfExternalAssets, ValidatorSuiteNeverCrashesAndRejectsInvalidFiles) {
