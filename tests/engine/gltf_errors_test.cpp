@@ -108,6 +108,22 @@ TEST(GltfErrors, BadJson) {
   expect_error(write("noasset.gltf", R"({"nodes": []})"), {"asset.version"});
 }
 
+// A crafted file nesting 300,000 arrays in extras used to overflow the stack of the
+// recursive walks; real files nest a few levels, and 256 still load.
+TEST(GltfErrors, AbsurdlyDeepJsonIsRefusedNotACrash) {
+  const auto nested = [](int levels) {
+    json d = valid_doc();
+    std::string text = d.dump();
+    text.pop_back();  // the closing brace
+    text += ",\"extras\":" + std::string(static_cast<std::size_t>(levels), '[') +
+            std::string(static_cast<std::size_t>(levels), ']') + "}";
+    return text;
+  };
+  expect_error(write("deep.gltf", nested(300000)), {"nested deeper than 256 levels"});
+  auto ok = engine::load_gltf(write("deep_enough.gltf", nested(250)));
+  EXPECT_TRUE(ok.ok()) << ok.error().to_string();
+}
+
 TEST(GltfErrors, MissingBufferFile) {
   json d = valid_doc();
   d["buffers"][0]["uri"] = "nowhere.bin";

@@ -10,6 +10,8 @@
 #include <fstream>
 #include <system_error>
 
+#include <engine/json_depth.h>
+
 #include "gltf/gltf_load_internal.h"
 
 namespace engine::gltf_load {
@@ -464,6 +466,10 @@ Result<ParsedFile> parse_file(const Context& ctx, const fs::path& path) {
                          e.what());
   }
   if (!out.doc.is_object()) return ctx.error("JSON", "the root is not a JSON object");
+  // Real glTF nests a handful of levels (extras a few more); the walks below recurse.
+  constexpr std::size_t kMaxJsonDepth = 256;
+  if (engine::json_depth(out.doc, kMaxJsonDepth) > kMaxJsonDepth)
+    return ctx.error("JSON", "nested deeper than " + std::to_string(kMaxJsonDepth) + " levels");
   integralize(out.doc);
   if (auto ok = prevalidate(ctx, container, out); !ok) return ok.error();
   out.mesh_quantization = declares_extension(out.doc, "KHR_mesh_quantization");

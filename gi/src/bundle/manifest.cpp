@@ -1,5 +1,6 @@
 #include "bundle/manifest.h"
 
+#include <engine/json_depth.h>
 #include <string_view>
 
 #include "io/blob_file.h"
@@ -28,6 +29,10 @@ engine::Result<Manifest> read_manifest(const std::filesystem::path& bundle_dir) 
   nlohmann::json doc = nlohmann::json::parse(text, text + bytes->size(), nullptr, /*allow_exceptions=*/false);
   if (doc.is_discarded()) return manifest_error(bundle_dir, "", "malformed JSON");
   if (!doc.is_object()) return manifest_error(bundle_dir, "", "the top level is not a JSON object");
+  // Manifests nest a few levels; copying or walking a crafted deep one would exhaust the stack.
+  constexpr std::size_t kMaxManifestDepth = 64;
+  if (engine::json_depth(doc, kMaxManifestDepth) > kMaxManifestDepth)
+    return manifest_error(bundle_dir, "", "nested deeper than " + std::to_string(kMaxManifestDepth) + " levels");
 
   const auto field = [&](const char* name, bool (nlohmann::json::*is_type)() const noexcept,
                          const char* type) -> engine::Result<const nlohmann::json*> {

@@ -190,6 +190,10 @@ TEST(BundleManifest, RejectsBadManifestsNamingTheFile) {
   expect_error(R"({"format_version": 2, "scene": "s", "methods": {}})", "geometry_hash: missing field");
   expect_error(R"({"format_version": 2, "geometry_hash": "a", "scene": "s", "methods": []})", "methods");
   expect_error(R"({"format_version": "1", "geometry_hash": "a", "scene": "s", "methods": {}})", "integer");
+  // A crafted manifest nested 200,000 levels deep: refused, not a stack overflow.
+  expect_error(R"({"format_version": 2, "geometry_hash": "a", "scene": "s", "methods": {"x": )" +
+                   std::string(200000, '[') + std::string(200000, ']') + "}}",
+               "nested deeper than 64 levels");
 }
 
 TEST(BundleFileName, OnlyPlainNamesInsideTheBundle) {
