@@ -265,6 +265,9 @@ TEST(GltfErrors, InvalidLights) {
   d["extensionsUsed"] = json::array({"KHR_lights_punctual"});
   d["extensions"] = json::parse(R"({"KHR_lights_punctual": {"lights": [{"type": "point"}, {"type": "point", "intensity": -1}]}})");
   expect_error(write("negative.gltf", d.dump()), {"light 1", "negative"});
+  // Finite in the file, infinite as a float (the headless demo once wrote NaN/Inf frames).
+  d["extensions"]["KHR_lights_punctual"]["lights"][1] = json::parse(R"({"type": "point", "intensity": 1e39})");
+  expect_error(write("huge.gltf", d.dump()), {"light 1", "beyond any real light"});
   d["extensions"]["KHR_lights_punctual"]["lights"][1] = json::parse(R"({"type": "spot", "spot": {"innerConeAngle": 0.6, "outerConeAngle": 0.3}})");
   expect_error(write("cone.gltf", d.dump()), {"light 1", "innerConeAngle"});
   d["extensions"]["KHR_lights_punctual"]["lights"][1] = json::parse(R"({"type": "sphere"})");

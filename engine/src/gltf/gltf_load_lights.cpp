@@ -14,6 +14,9 @@
 namespace engine::gltf_load {
 namespace {
 
+constexpr double kMaxLightIntensity = 1e15;  // cd or lux
+
+
 /// A fixed-size array of finite numbers, e.g. a colour.
 template <int N>
 Result<glm::vec<N, float>> number_array(const Context& ctx, const Json& value, const std::string& where,
@@ -45,6 +48,11 @@ Result<NamedLight> convert_light(const Context& ctx, const Json& src, const std:
   if (!intensity) return intensity.error();
   if (!std::isfinite(*intensity) || *intensity < 0.0) {
     return ctx.error(where, "intensity " + std::to_string(*intensity) + " is negative or not finite");
+  }
+  // Finite as a double can still be infinite as a float, and squared distances and sums of
+  // lights multiply it further: far above any real light (the sun is 1.2e5 lux) is refused.
+  if (*intensity > kMaxLightIntensity) {
+    return ctx.error(where, "intensity " + std::to_string(*intensity) + " is beyond any real light (at most 1e15)");
   }
   if (const Json* color = find_member(src, "color")) {
     auto c = number_array<3>(ctx, *color, where, "color");

@@ -181,8 +181,9 @@ Result<std::vector<Material>> convert_materials(const Context& ctx, const Parsed
         auto strength = number_member(ctx, *strength_ext, "emissiveStrength", 1.0,
                                       where + " KHR_materials_emissive_strength");
         if (!strength) return strength.error();
-        if (!std::isfinite(*strength) || *strength < 0.0) {
-          return ctx.error(where, "emissiveStrength must be a finite number >= 0");
+        // Finite as a double can overflow as a float once it multiplies emissiveFactor.
+        if (!std::isfinite(*strength) || *strength < 0.0 || *strength > 1e15) {
+          return ctx.error(where, "emissiveStrength must be a finite number in [0, 1e15]");
         }
         m.emissive *= static_cast<float>(*strength);
       }
