@@ -7,9 +7,13 @@
 #include <gi/gi_system.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace fs = std::filesystem;
@@ -112,6 +116,37 @@ TEST(BakeApi, ABakeCancelledByItsHostWritesNothing) {
   EXPECT_EQ(report.error().kind, engine::ErrorKind::Cancelled) << report.error().to_string();
   EXPECT_EQ(calls, 3) << "no progress is reported after the host said stop";
   EXPECT_FALSE(fs::exists(dir));
+}
+
+// A re-bake that is cancelled (or fails, or is killed) half-way leaves the working bundle
+// as it was: every file byte for byte, and it still loads.
+TEST(BakeApi, ACancelledRebakeLeavesTheWorkingBundleIntact) {
+  auto asset = engine::load_gltf(GI_SOURCE_DIR "/assets/cornell_box.gltf");
+  ASSERT_TRUE(asset) << asset.error().to_string();
+  const gi::BakeInput input = pipeline_input(*asset);
+  const fs::path dir = fresh_dir("rebaked.gibake");
+  ASSERT_TRUE(gi::bake_bundle(input, dir, {.preset = "preview", .methods = {"atlas"}}));
+  const auto snapshot = [&] {
+    std::vector<std::pair<std::string, std::string>> files;
+    for (const auto& e : fs::directory_iterator(dir)) {
+      std::ifstream in(e.path(), std::ios::binary);
+      files.emplace_back(e.path().filename().string(), std::string(std::istreambuf_iterator<char>(in), {}));
+    }
+    std::sort(files.begin(), files.end());
+    return files;
+  };
+  const auto before = snapshot();
+  int calls = 0;
+  auto report = gi::bake_bundle(
+      input, dir, {.preset = "medium", .methods = {"atlas", "prm"}},
+      {.progress = [&](std::string_view stage, double) { return stage == "light atlas" || ++calls < 5; }});
+  ASSERT_FALSE(report);
+  EXPECT_EQ(report.error().kind, engine::ErrorKind::Cancelled);
+  EXPECT_EQ(snapshot(), before) << "the atlas baked before the cancel did not replace the working one";
+  EXPECT_FALSE(fs::exists(dir.parent_path() / ".rebaked.gibake.staging"));
+  engine::Scene scene = engine::instantiate(std::move(asset).value());
+  auto system = gi::GISystem::load(dir, scene);
+  EXPECT_TRUE(system) << system.error().to_string();
 }
 
 TEST(BakeApi, BadInputIsRefusedNamingTheElement) {

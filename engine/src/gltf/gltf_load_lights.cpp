@@ -2,12 +2,12 @@
 // KHR_lights_punctual lights are converted from photometric glTF units to the engine's
 // radiometric ones (engine/units.h); the "gi" extras schema is in docs/scene-format.md.
 
+#include <engine/units.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
-
-#include <engine/units.h>
 
 #include "gltf/gltf_load_internal.h"
 
@@ -15,7 +15,6 @@ namespace engine::gltf_load {
 namespace {
 
 constexpr double kMaxLightIntensity = 1e15;  // cd or lux
-
 
 /// A fixed-size array of finite numbers, e.g. a colour.
 template <int N>
@@ -40,7 +39,8 @@ Result<glm::vec<N, float>> number_array(const Context& ctx, const Json& value, c
 Result<NamedLight> convert_light(const Context& ctx, const Json& src, const std::string& where) {
   if (!src.is_object()) return ctx.error(where, "must be an object");
   NamedLight out;
-  if (const Json* name = find_member(src, "name"); name != nullptr && name->is_string()) out.name = name->get<std::string>();
+  if (const Json* name = find_member(src, "name"); name != nullptr && name->is_string())
+    out.name = name->get<std::string>();
   const Json* type = find_member(src, "type");
   if (type == nullptr || !type->is_string()) return ctx.error(where, "'type' is required and must be a string");
   const std::string t = type->get<std::string>();
@@ -119,7 +119,8 @@ Result<std::vector<NamedLight>> convert_punctual_lights(const Context& ctx, cons
   return lights;
 }
 
-Result<std::vector<NamedCamera>> convert_cameras(const Context& ctx, const ParsedFile& file, std::vector<int>& index_map) {
+Result<std::vector<NamedCamera>> convert_cameras(const Context& ctx, const ParsedFile& file,
+                                                 std::vector<int>& index_map) {
   std::vector<NamedCamera> cameras;
   index_map.assign(file.model.cameras.size(), -1);
   for (std::size_t i = 0; i < file.model.cameras.size(); ++i) {

@@ -68,10 +68,11 @@ struct BakeReport {
 std::vector<std::string> bakeable_methods();
 
 /// Bakes `input` into `bundle_dir` (created if needed; files of other methods already there
-/// are kept when the geometry is the same). Errors: invalid input (validate_bake_input),
-/// an unknown preset or method key or an override out of range (ErrorKind::Invalid), a
-/// baker or file failure, cancellation. Nothing of a method that failed or was cancelled
-/// is written.
+/// are kept when the geometry is the same). The bake writes into a staging copy next to it
+/// (".<name>.staging") that replaces the bundle in one atomic exchange at the end: after an
+/// error, a cancel or a killed process the previous bundle is exactly as it was. Errors:
+/// invalid input (validate_bake_input), an unknown preset or method key or an override out
+/// of range (ErrorKind::Invalid), a baker or file failure, cancellation.
 engine::Result<BakeReport> bake_bundle(const BakeInput& input, const std::filesystem::path& bundle_dir,
                                        const BakeOptions& options = {}, const BakeHost& host = {});
 

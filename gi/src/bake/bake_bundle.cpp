@@ -1,11 +1,15 @@
 // gi::bake_bundle: plan, bake each method, write the bundle (gi/bake.h).
+#include <fcntl.h>
 #include <gi/bake.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cstdarg>
 #include <cstdio>
+#include <cstring>
 #include <string>
+#include <utility>
 
 #include "brf/brf_bake.h"
 #include "brf/brf_io.h"
@@ -159,6 +163,59 @@ engine::Status bake_brf_method(const BakeInput& input, const fs::path& dir, cons
   return save_brf(dir, bake, input);
 }
 
+// A bake writes into a staging copy of the bundle ("<dir>/../.<name>.staging"), which takes
+// the bundle's place in one atomic exchange once every method is written: a bake that
+// fails, is cancelled or is killed leaves the previous bundle exactly as it was (a killed
+// one leaves the staging directory, which the next bake of that bundle clears).
+class StagedBundle {
+ public:
+  static engine::Result<StagedBundle> begin(const fs::path& dir) {
+    StagedBundle b;
+    b.dir_ = dir;
+    b.staging_ = dir.parent_path() / ("." + dir.filename().string() + ".staging");
+    std::error_code ec;
+    fs::remove_all(b.staging_, ec);
+    if (ec) return engine::Error{b.staging_.string(), "", "cannot clear the staging directory: " + ec.message()};
+    if (fs::exists(dir, ec)) {
+      if (!fs::is_directory(dir, ec)) return engine::Error{dir.string(), "", "exists and is not a bundle directory"};
+      fs::copy(dir, b.staging_, fs::copy_options::recursive, ec);
+    } else {
+      fs::create_directories(b.staging_, ec);
+    }
+    if (ec) return engine::Error{b.staging_.string(), "", "cannot prepare the staging directory: " + ec.message()};
+    b.active_ = true;
+    return b;
+  }
+  StagedBundle(StagedBundle&& o) noexcept
+      : dir_(std::move(o.dir_)), staging_(std::move(o.staging_)), active_(std::exchange(o.active_, false)) {}
+  StagedBundle& operator=(StagedBundle&&) = delete;
+  ~StagedBundle() {
+    if (!active_) return;
+    std::error_code ec;
+    fs::remove_all(staging_, ec);
+  }
+  const fs::path& path() const { return staging_; }
+
+  /// The staging directory becomes the bundle (renameat2 RENAME_EXCHANGE when one exists).
+  engine::Status commit() {
+    std::error_code ec;
+    if (!fs::exists(dir_, ec)) {
+      fs::rename(staging_, dir_, ec);
+      if (ec) return engine::Error{dir_.string(), "", "cannot move the baked bundle into place: " + ec.message()};
+    } else if (::renameat2(AT_FDCWD, staging_.c_str(), AT_FDCWD, dir_.c_str(), RENAME_EXCHANGE) != 0) {
+      return engine::Error{dir_.string(), "",
+                           std::string("cannot exchange the baked bundle with the old one: ") + std::strerror(errno)};
+    }
+    // staging_ now holds the previous bundle (or nothing).
+    return {};
+  }
+
+ private:
+  StagedBundle() = default;
+  fs::path dir_, staging_;
+  bool active_ = false;
+};
+
 // The manifest's method entry name of a plan key.
 std::string manifest_key(const std::string& key) { return key == "atlas" ? "light_atlas" : key; }
 
@@ -199,22 +256,23 @@ engine::Result<BakeReport> bake_bundle(const BakeInput& input, const fs::path& b
       return engine::invalid_request("method '" + key +
                                      "' is not available in this build (available: atlas, prm, brf)");
 
+  if (methods.empty()) return report;
+  auto staged = StagedBundle::begin(bundle_dir);
+  if (!staged) return staged.error();
+  const fs::path& dir = staged->path();
   for (const std::string& key : methods) {
     const auto start = Clock::now();
-    engine::Status done = key == "atlas" ? bake_atlas(input, bundle_dir, options, {host, "light atlas"})
-                          : key == "prm" ? bake_prm_method(input, bundle_dir, options, {host, "PRM"})
-                                         : bake_brf_method(input, bundle_dir, options, host);
+    engine::Status done = key == "atlas" ? bake_atlas(input, dir, options, {host, "light atlas"})
+                          : key == "prm" ? bake_prm_method(input, dir, options, {host, "PRM"})
+                                         : bake_brf_method(input, dir, options, host);
     if (!done) return done.error();
-    report.baked.push_back({key, seconds_since(start), method_bytes(bundle_dir, manifest_key(key))});
+    report.baked.push_back({key, seconds_since(start), method_bytes(dir, manifest_key(key))});
   }
-  if (!report.baked.empty()) {
-    std::error_code ec;
-    fs::create_directories(bundle_dir, ec);
-    if (auto ok = update_manifest_plan(bundle_dir, scene_geometry_hash(input), scene_file_name(input),
-                                       plan_to_json_value(report.plan));
-        !ok)
-      return ok.error();
-  }
+  if (auto ok = update_manifest_plan(dir, scene_geometry_hash(input), scene_file_name(input),
+                                     plan_to_json_value(report.plan));
+      !ok)
+    return ok.error();
+  if (auto ok = staged->commit(); !ok) return ok.error();
   return report;
 }
 
