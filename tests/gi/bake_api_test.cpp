@@ -175,3 +175,24 @@ TEST(BakeApi, BadInputIsRefusedNamingTheElement) {
   EXPECT_EQ(report.error().kind, engine::ErrorKind::Invalid);
   EXPECT_NE(report.error().to_string().find("dlm"), std::string::npos) << report.error().to_string();
 }
+
+// Two bakes of one bundle at a time would certify each other's files: the second is refused.
+TEST(BakeApi, ASecondBakeOfTheSameBundleIsRefusedWhileOneRuns) {
+  auto asset = engine::load_gltf(GI_SOURCE_DIR "/assets/cornell_box.gltf");
+  ASSERT_TRUE(asset) << asset.error().to_string();
+  const gi::BakeInput input = pipeline_input(*asset);
+  const fs::path dir = fresh_dir("locked.gibake");
+  std::string second_error;
+  auto first = gi::bake_bundle(
+      input, dir, {.preset = "preview", .methods = {"atlas"}}, {.progress = [&](std::string_view, double) {
+        if (second_error.empty()) {
+          auto second = gi::bake_bundle(input, dir, {.preset = "preview", .methods = {"atlas"}});
+          second_error = second ? "the second bake ran" : second.error().to_string();
+        }
+        return true;
+      }});
+  ASSERT_TRUE(first) << first.error().to_string();
+  EXPECT_NE(second_error.find("another bake of this bundle is running"), std::string::npos) << second_error;
+  // Released with the first: a third bake runs.
+  EXPECT_TRUE(gi::bake_bundle(input, dir, {.preset = "preview", .methods = {"atlas"}}));
+}

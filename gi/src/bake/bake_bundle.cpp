@@ -1,6 +1,8 @@
 // gi::bake_bundle: plan, bake each method, write the bundle (gi/bake.h).
 #include <fcntl.h>
 #include <gi/bake.h>
+#include <sys/file.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
@@ -174,6 +176,15 @@ class StagedBundle {
     b.dir_ = dir;
     b.staging_ = dir.parent_path() / ("." + dir.filename().string() + ".staging");
     std::error_code ec;
+    if (!dir.parent_path().empty()) fs::create_directories(dir.parent_path(), ec);
+    // One bake per bundle at a time: an advisory lock next to it (released by the kernel
+    // when the process ends, however it ends).
+    const fs::path lock = dir.parent_path() / ("." + dir.filename().string() + ".lock");
+    b.lock_fd_ = ::open(lock.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (b.lock_fd_ < 0)
+      return engine::Error{lock.string(), "", std::string("cannot open the bake lock: ") + std::strerror(errno)};
+    if (::flock(b.lock_fd_, LOCK_EX | LOCK_NB) != 0)
+      return engine::Error{dir.string(), "", "another bake of this bundle is running (lock " + lock.string() + ")"};
     fs::remove_all(b.staging_, ec);
     if (ec) return engine::Error{b.staging_.string(), "", "cannot clear the staging directory: " + ec.message()};
     if (fs::exists(dir, ec)) {
@@ -187,12 +198,17 @@ class StagedBundle {
     return b;
   }
   StagedBundle(StagedBundle&& o) noexcept
-      : dir_(std::move(o.dir_)), staging_(std::move(o.staging_)), active_(std::exchange(o.active_, false)) {}
+      : dir_(std::move(o.dir_)),
+        staging_(std::move(o.staging_)),
+        active_(std::exchange(o.active_, false)),
+        lock_fd_(std::exchange(o.lock_fd_, -1)) {}
   StagedBundle& operator=(StagedBundle&&) = delete;
   ~StagedBundle() {
-    if (!active_) return;
-    std::error_code ec;
-    fs::remove_all(staging_, ec);
+    if (active_) {
+      std::error_code ec;
+      fs::remove_all(staging_, ec);
+    }
+    if (lock_fd_ >= 0) ::close(lock_fd_);  // releases the lock
   }
   const fs::path& path() const { return staging_; }
 
@@ -214,6 +230,7 @@ class StagedBundle {
   StagedBundle() = default;
   fs::path dir_, staging_;
   bool active_ = false;
+  int lock_fd_ = -1;
 };
 
 // The manifest's method entry name of a plan key.

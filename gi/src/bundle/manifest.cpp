@@ -1,6 +1,8 @@
 #include "bundle/manifest.h"
 
 #include <engine/json_depth.h>
+
+#include <cstdint>
 #include <string_view>
 
 #include "io/blob_file.h"
@@ -44,10 +46,12 @@ engine::Result<Manifest> read_manifest(const std::filesystem::path& bundle_dir) 
   auto version = field("format_version", &nlohmann::json::is_number_integer, "an integer");
   if (!version) return version.error();
   Manifest m;
-  m.format_version = (*version)->get<int>();
-  if (m.format_version != kManifestFormatVersion) {
+  // Compared as read (64 bits): 2^32 + 1 must not narrow to a supported version.
+  const std::int64_t read_version = (*version)->get<std::int64_t>();
+  m.format_version = kManifestFormatVersion;
+  if (read_version != kManifestFormatVersion) {
     return manifest_error(bundle_dir, "format_version",
-                          "unsupported format_version " + std::to_string(m.format_version) + ", this build reads " +
+                          "unsupported format_version " + std::to_string(read_version) + ", this build reads " +
                               std::to_string(kManifestFormatVersion) + " (re-bake)");
   }
   auto hash = field("geometry_hash", &nlohmann::json::is_string, "a string");

@@ -187,6 +187,8 @@ TEST(BundleManifest, RejectsBadManifestsNamingTheFile) {
   expect_error(R"({"format_version": 1, "geometry_hash": "a", "scene": "s", "methods": {}})", "format_version 1");
   expect_error(R"({"format_version": 1, "geometry_hash": "a", "scene": "s", "methods": {}})", "re-bake");
   expect_error(R"({"format_version": 3, "geometry_hash": "a", "scene": "s", "methods": {}})", "format_version 3");
+  expect_error(R"({"format_version": 4294967298, "geometry_hash": "a", "scene": "s", "methods": {}})",
+               "format_version 4294967298");  // 2^32 + 2 does not narrow to 2
   expect_error(R"({"format_version": 2, "scene": "s", "methods": {}})", "geometry_hash: missing field");
   expect_error(R"({"format_version": 2, "geometry_hash": "a", "scene": "s", "methods": []})", "methods");
   expect_error(R"({"format_version": "1", "geometry_hash": "a", "scene": "s", "methods": {}})", "integer");
