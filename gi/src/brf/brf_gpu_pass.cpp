@@ -123,91 +123,65 @@ void BrfGpuPass::Buffer::upload(const void* data, std::size_t size) {
   if (size > 0) glNamedBufferSubData(buffer.id(), 0, static_cast<GLsizeiptr>(size), data);
 }
 
-engine::Result<BrfGpuPass> BrfGpuPass::create(std::span<const BrfGpuModel> models, const BrfGpuPassOptions& options) {
-  // Check the data before acquiring anything.
-  std::size_t limit = std::min(kSsboLimitBytes, gl_limit(GL_MAX_SHADER_STORAGE_BLOCK_SIZE));
-  if (options.max_buffer_bytes > 0) limit = std::min(limit, options.max_buffer_bytes);
-  if (!(options.pose_tolerance >= 0.0f)) return error("pose tolerance must be >= 0");
-  for (std::size_t m = 0; m < models.size(); ++m) {
-    const std::string which = "model " + std::to_string(m) + ": ";
-    const BrfGpuModel& model = models[m];
-    if (model.mesh == nullptr || model.basis == nullptr || model.field == nullptr)
-      return error(which + "mesh, basis and field must all be given");
-    const BrfMesh& mesh = *model.mesh;
-    const BrfBasis& basis = *model.basis;
-    const BasisRadianceField& f = *model.field;
-    const std::size_t nv = mesh.positions.size();
-    if (mesh.normals.size() != nv || basis.vertex_count != nv)
-      return error(which + "the mesh has " + std::to_string(nv) + " positions, " + std::to_string(mesh.normals.size()) +
-                   " normals, the basis " + std::to_string(basis.vertex_count) + " vertices");
-    if (basis.basis_count < 1 || basis.basis_count > kMaxBasis)
-      return error(which + "basis of " + std::to_string(basis.basis_count) + " functions (1 to " +
-                   std::to_string(kMaxBasis) + " supported)");
-    const auto nb = static_cast<std::size_t>(basis.basis_count);
-    if (basis.psi.size() != nb * nv || basis.a_inverse.size() != nb * nb)
-      return error(which + "basis arrays do not match its size");
-    if (f.basis_count != basis.basis_count) return error(which + "the field was computed for another basis");
-    if (model.glossy == nullptr && f.terms != 1)
-      return error(which + "a glossy field (" + std::to_string(f.terms) + " BRDF terms) but no glossy lobe");
-    if (model.glossy != nullptr) {
-      const BrdfSeparation& g = *model.glossy;
-      if (g.terms < 1 || g.terms > kMaxGlossyTerms || f.terms != 1 + g.terms)
-        return error(which + "the field has " + std::to_string(f.terms) + " BRDF terms, the glossy lobe " +
-                     std::to_string(g.terms) + " (+1 diffuse)");
-      if (g.lobe_sh.size() != static_cast<std::size_t>(g.terms) * kMaxShCoefficients)
-        return error(which + "the glossy lobe's SH do not match its terms");
-      for (float v : g.lobe_sh)
-        if (!std::isfinite(v)) return error(which + "non-finite glossy lobe SH");
-    }
-    const std::size_t channels = nb * static_cast<std::size_t>(f.terms);
-    if ((f.sh_bands != 3 && f.sh_bands != 4) || f.spheres < 1 || f.face_resolution < 1 || !(f.inner_radius > 0.0f) ||
-        !(f.outer_radius >= f.inner_radius) || !std::isfinite(f.outer_radius) || !finite(f.centre))
-      return error(which + "field settings out of range");
-    const std::size_t points = static_cast<std::size_t>(f.spheres) * 6 * static_cast<std::size_t>(f.face_resolution) *
-                               static_cast<std::size_t>(f.face_resolution);
-    if (f.coefficients.size() != points * channels * static_cast<std::size_t>(f.coefficient_count()))
-      return error(which + "field holds " + std::to_string(f.coefficients.size()) + " floats, expected " +
-                   std::to_string(points * channels * static_cast<std::size_t>(f.coefficient_count())));
-    if (f.bytes() > limit)
-      return error(which + "field of " + std::to_string(f.bytes()) + " bytes is above the SSBO limit of " +
-                   std::to_string(limit));
-    for (std::size_t j = 0; j < nv; ++j)
-      if (!finite(mesh.positions[j]) || !finite(mesh.normals[j]))
-        return error(which + "non-finite vertex " + std::to_string(j));
-    for (float v : basis.psi)
-      if (!std::isfinite(v)) return error(which + "non-finite basis value");
-    for (float v : basis.a_inverse)
-      if (!std::isfinite(v)) return error(which + "non-finite A^-1 value");
-    for (float v : f.coefficients)
-      if (!std::isfinite(v)) return error(which + "non-finite field coefficient");
-  }
+namespace {
 
-  BrfGpuPass pass;
-  pass.max_buffer_bytes_ = limit;
-  pass.pose_tolerance_ = options.pose_tolerance;
-  for (auto [program, file] :
-       {std::pair{&pass.programs_.phi, "brf_phi.comp.glsl"}, std::pair{&pass.programs_.fit, "brf_fit.comp.glsl"},
-        std::pair{&pass.programs_.gather, "brf_gather.comp.glsl"},
-        std::pair{&pass.programs_.static_gather, "brf_static_gather.comp.glsl"}}) {
-    auto built = build(file);
-    if (!built) return built.error();
-    *program = std::move(built).value();
+/// create()'s checks of model m (pointers, sizes, glossy terms, field settings, limit, finite data).
+engine::Status check_model(const BrfGpuModel& model, std::size_t m, std::size_t limit) {
+  const std::string which = "model " + std::to_string(m) + ": ";
+  if (model.mesh == nullptr || model.basis == nullptr || model.field == nullptr)
+    return error(which + "mesh, basis and field must all be given");
+  const BrfMesh& mesh = *model.mesh;
+  const BrfBasis& basis = *model.basis;
+  const BasisRadianceField& f = *model.field;
+  const std::size_t nv = mesh.positions.size();
+  if (mesh.normals.size() != nv || basis.vertex_count != nv)
+    return error(which + "the mesh has " + std::to_string(nv) + " positions, " + std::to_string(mesh.normals.size()) +
+                 " normals, the basis " + std::to_string(basis.vertex_count) + " vertices");
+  if (basis.basis_count < 1 || basis.basis_count > kMaxBasis)
+    return error(which + "basis of " + std::to_string(basis.basis_count) + " functions (1 to " +
+                 std::to_string(kMaxBasis) + " supported)");
+  const auto nb = static_cast<std::size_t>(basis.basis_count);
+  if (basis.psi.size() != nb * nv || basis.a_inverse.size() != nb * nb)
+    return error(which + "basis arrays do not match its size");
+  if (f.basis_count != basis.basis_count) return error(which + "the field was computed for another basis");
+  if (model.glossy == nullptr && f.terms != 1)
+    return error(which + "a glossy field (" + std::to_string(f.terms) + " BRDF terms) but no glossy lobe");
+  if (model.glossy != nullptr) {
+    const BrdfSeparation& g = *model.glossy;
+    if (g.terms < 1 || g.terms > kMaxGlossyTerms || f.terms != 1 + g.terms)
+      return error(which + "the field has " + std::to_string(f.terms) + " BRDF terms, the glossy lobe " +
+                   std::to_string(g.terms) + " (+1 diffuse)");
+    if (g.lobe_sh.size() != static_cast<std::size_t>(g.terms) * kMaxShCoefficients)
+      return error(which + "the glossy lobe's SH do not match its terms");
+    for (float v : g.lobe_sh)
+      if (!std::isfinite(v)) return error(which + "non-finite glossy lobe SH");
   }
-  {
-    auto built = engine::ShaderProgramBuilder(gi_shader_files())
-                     .define("BRF_GLOSSY_RECEIVER 1")
-                     .stage(engine::ShaderStage::Compute, "brf_phi.comp.glsl")
-                     .build();
-    if (!built) return built.error();
-    pass.programs_.phi_glossy = std::move(built).value();
-  }
+  const std::size_t channels = nb * static_cast<std::size_t>(f.terms);
+  if ((f.sh_bands != 3 && f.sh_bands != 4) || f.spheres < 1 || f.face_resolution < 1 || !(f.inner_radius > 0.0f) ||
+      !(f.outer_radius >= f.inner_radius) || !std::isfinite(f.outer_radius) || !finite(f.centre))
+    return error(which + "field settings out of range");
+  const std::size_t points = static_cast<std::size_t>(f.spheres) * 6 * static_cast<std::size_t>(f.face_resolution) *
+                             static_cast<std::size_t>(f.face_resolution);
+  if (f.coefficients.size() != points * channels * static_cast<std::size_t>(f.coefficient_count()))
+    return error(which + "field holds " + std::to_string(f.coefficients.size()) + " floats, expected " +
+                 std::to_string(points * channels * static_cast<std::size_t>(f.coefficient_count())));
+  if (f.bytes() > limit)
+    return error(which + "field of " + std::to_string(f.bytes()) + " bytes is above the SSBO limit of " +
+                 std::to_string(limit));
+  for (std::size_t j = 0; j < nv; ++j)
+    if (!finite(mesh.positions[j]) || !finite(mesh.normals[j]))
+      return error(which + "non-finite vertex " + std::to_string(j));
+  for (float v : basis.psi)
+    if (!std::isfinite(v)) return error(which + "non-finite basis value");
+  for (float v : basis.a_inverse)
+    if (!std::isfinite(v)) return error(which + "non-finite A^-1 value");
+  for (float v : f.coefficients)
+    if (!std::isfinite(v)) return error(which + "non-finite field coefficient");
+  return {};
+}
 
-  // Model tables, vertices, bases; fields grouped into buffers under the limit.
-  std::vector<GpuModel> table;
-  std::vector<glm::vec4> vertices;
-  std::vector<float> psi, a_inverse;
-  std::vector<std::size_t> field_group_bytes;
-  // SH rotation tables first (brf_phi.comp.glsl's kPinvOffset), then per glossy model.
+/// The head of sh_data_: the SH rotation directions as vec4s, then the pinv of bands 1..3.
+std::vector<float> sh_rotation_data() {
   const ShRotationTables& rotation = sh_rotation_tables();
   GI_EXPECTS(rotation.directions.size() == kShDirections, "ShRotation uses 26 fixed directions");
   std::vector<float> sh_data;
@@ -216,84 +190,140 @@ engine::Result<BrfGpuPass> BrfGpuPass::create(std::span<const BrfGpuModel> model
     sh_data.insert(sh_data.end(), rotation.pinv[static_cast<std::size_t>(l)].begin(),
                    rotation.pinv[static_cast<std::size_t>(l)].end());
   GI_EXPECTS(sh_data.size() == kShTableFloats, "SH rotation table layout");
-  for (const BrfGpuModel& model : models) {
-    const BasisRadianceField& f = *model.field;
-    GpuModel g;
-    g.centre_inner = glm::vec4(f.centre, f.inner_radius);
-    g.outer_radius = f.outer_radius;
-    const BrfBox box = brf_object_box(*model.mesh);
-    g.box_lo = glm::vec4(box.lo, 0.0f);
-    g.box_hi = glm::vec4(box.hi, 0.0f);
-    g.spheres = u32(static_cast<std::size_t>(f.spheres));
-    g.face_resolution = u32(static_cast<std::size_t>(f.face_resolution));
-    g.sh_bands = u32(static_cast<std::size_t>(f.sh_bands));
-    g.basis_count = u32(static_cast<std::size_t>(model.basis->basis_count));
-    g.vertex_offset = u32(vertices.size() / 2);
-    g.vertex_count = u32(model.mesh->positions.size());
-    g.psi_offset = u32(psi.size());
-    g.ainv_offset = u32(a_inverse.size());
-    if (field_group_bytes.empty() || field_group_bytes.back() + f.bytes() > limit) field_group_bytes.push_back(0);
-    g.field_buffer = u32(field_group_bytes.size() - 1);
-    g.terms = u32(static_cast<std::size_t>(f.terms));
-    g.field_offset = u32(field_group_bytes.back() / sizeof(float));
-    field_group_bytes.back() += f.bytes();
-    table.push_back(g);
-    for (std::size_t j = 0; j < model.mesh->positions.size(); ++j) {
-      vertices.emplace_back(model.mesh->positions[j], 1.0f);
-      vertices.emplace_back(model.mesh->normals[j], 0.0f);
-    }
-    psi.insert(psi.end(), model.basis->psi.begin(), model.basis->psi.end());
-    a_inverse.insert(a_inverse.end(), model.basis->a_inverse.begin(), model.basis->a_inverse.end());
-    ModelInfo info;
-    info.first_vertex = g.vertex_offset;
-    info.vertex_count = g.vertex_count;
-    info.basis_count = g.basis_count;
-    info.terms = g.terms;
-    info.field_buffer = g.field_buffer;
-    info.outer_radius = f.outer_radius;
-    info.field_centre = f.centre;
-    info.basis = model.basis;
-    info.mesh = model.mesh;
-    info.field = model.field;
-    info.glossy = model.glossy;
-    if (model.glossy != nullptr) {  // lobe SH (local frame), object-space tangent frames (columns t, b, n)
-      info.lobe_offset = u32(sh_data.size());
-      sh_data.insert(sh_data.end(), model.glossy->lobe_sh.begin(), model.glossy->lobe_sh.end());
-      info.frame_offset = u32(sh_data.size());
-      for (const glm::vec3& nrm : model.mesh->normals) {
-        const glm::mat3 frame = brf_tangent_frame(nrm);
-        for (int c = 0; c < 3; ++c) sh_data.insert(sh_data.end(), {frame[c].x, frame[c].y, frame[c].z});
-      }
-    }
-    pass.models_.push_back(info);
+  return sh_data;
+}
+
+}  // namespace
+
+/// The model data create() gathers on the CPU before uploading it (one GL buffer each).
+struct BrfGpuPass::ModelData {
+  std::vector<GpuModel> table;
+  std::vector<glm::vec4> vertices;  ///< Position, normal per model vertex.
+  std::vector<float> psi, a_inverse;
+  std::vector<std::size_t> field_group_bytes;  ///< Fields grouped into buffers under the limit.
+  std::vector<float> sh_data;                  ///< SH rotation tables first (kPinvOffset), then per glossy model.
+};
+
+engine::Result<BrfGpuPass> BrfGpuPass::create(std::span<const BrfGpuModel> models, const BrfGpuPassOptions& options) {
+  // Check the data before acquiring anything.
+  std::size_t limit = std::min(kSsboLimitBytes, gl_limit(GL_MAX_SHADER_STORAGE_BLOCK_SIZE));
+  if (options.max_buffer_bytes > 0) limit = std::min(limit, options.max_buffer_bytes);
+  if (!(options.pose_tolerance >= 0.0f)) return error("pose tolerance must be >= 0");
+  for (std::size_t m = 0; m < models.size(); ++m)
+    if (auto s = check_model(models[m], m, limit); !s) return s.error();
+
+  BrfGpuPass pass;
+  pass.max_buffer_bytes_ = limit;
+  pass.pose_tolerance_ = options.pose_tolerance;
+  if (auto s = pass.build_programs(); !s) return s.error();
+
+  // Model tables, vertices, bases; fields grouped into buffers under the limit.
+  ModelData data;
+  data.sh_data = sh_rotation_data();
+  for (const BrfGpuModel& model : models) pass.add_model(model, limit, data);
+  pass.upload_models(models, data);
+  if (glGetError() == GL_OUT_OF_MEMORY) return error("out of GPU memory uploading the models");
+  return pass;
+}
+
+engine::Status BrfGpuPass::build_programs() {
+  for (auto [program, file] :
+       {std::pair{&programs_.phi, "brf_phi.comp.glsl"}, std::pair{&programs_.fit, "brf_fit.comp.glsl"},
+        std::pair{&programs_.gather, "brf_gather.comp.glsl"},
+        std::pair{&programs_.static_gather, "brf_static_gather.comp.glsl"}}) {
+    auto built = build(file);
+    if (!built) return built.error();
+    *program = std::move(built).value();
   }
-  const auto upload_once = [&pass](const auto& v) {
+  auto built = engine::ShaderProgramBuilder(gi_shader_files())
+                   .define("BRF_GLOSSY_RECEIVER 1")
+                   .stage(engine::ShaderStage::Compute, "brf_phi.comp.glsl")
+                   .build();
+  if (!built) return built.error();
+  programs_.phi_glossy = std::move(built).value();
+  return {};
+}
+
+void BrfGpuPass::add_model(const BrfGpuModel& model, std::size_t limit, ModelData& data) {
+  const BasisRadianceField& f = *model.field;
+  GpuModel g;
+  g.centre_inner = glm::vec4(f.centre, f.inner_radius);
+  g.outer_radius = f.outer_radius;
+  const BrfBox box = brf_object_box(*model.mesh);
+  g.box_lo = glm::vec4(box.lo, 0.0f);
+  g.box_hi = glm::vec4(box.hi, 0.0f);
+  g.spheres = u32(static_cast<std::size_t>(f.spheres));
+  g.face_resolution = u32(static_cast<std::size_t>(f.face_resolution));
+  g.sh_bands = u32(static_cast<std::size_t>(f.sh_bands));
+  g.basis_count = u32(static_cast<std::size_t>(model.basis->basis_count));
+  g.vertex_offset = u32(data.vertices.size() / 2);
+  g.vertex_count = u32(model.mesh->positions.size());
+  g.psi_offset = u32(data.psi.size());
+  g.ainv_offset = u32(data.a_inverse.size());
+  std::vector<std::size_t>& groups = data.field_group_bytes;
+  if (groups.empty() || groups.back() + f.bytes() > limit) groups.push_back(0);
+  g.field_buffer = u32(groups.size() - 1);
+  g.terms = u32(static_cast<std::size_t>(f.terms));
+  g.field_offset = u32(groups.back() / sizeof(float));
+  groups.back() += f.bytes();
+  data.table.push_back(g);
+  for (std::size_t j = 0; j < model.mesh->positions.size(); ++j) {
+    data.vertices.emplace_back(model.mesh->positions[j], 1.0f);
+    data.vertices.emplace_back(model.mesh->normals[j], 0.0f);
+  }
+  data.psi.insert(data.psi.end(), model.basis->psi.begin(), model.basis->psi.end());
+  data.a_inverse.insert(data.a_inverse.end(), model.basis->a_inverse.begin(), model.basis->a_inverse.end());
+  ModelInfo info;
+  info.first_vertex = g.vertex_offset;
+  info.vertex_count = g.vertex_count;
+  info.basis_count = g.basis_count;
+  info.terms = g.terms;
+  info.field_buffer = g.field_buffer;
+  info.outer_radius = f.outer_radius;
+  info.field_centre = f.centre;
+  info.basis = model.basis;
+  info.mesh = model.mesh;
+  info.field = model.field;
+  info.glossy = model.glossy;
+  if (model.glossy != nullptr) {  // lobe SH (local frame), object-space tangent frames (columns t, b, n)
+    std::vector<float>& sh_data = data.sh_data;
+    info.lobe_offset = u32(sh_data.size());
+    sh_data.insert(sh_data.end(), model.glossy->lobe_sh.begin(), model.glossy->lobe_sh.end());
+    info.frame_offset = u32(sh_data.size());
+    for (const glm::vec3& nrm : model.mesh->normals) {
+      const glm::mat3 frame = brf_tangent_frame(nrm);
+      for (int c = 0; c < 3; ++c) sh_data.insert(sh_data.end(), {frame[c].x, frame[c].y, frame[c].z});
+    }
+  }
+  models_.push_back(info);
+}
+
+void BrfGpuPass::upload_models(std::span<const BrfGpuModel> models, const ModelData& data) {
+  const auto upload_once = [this](const auto& v) {
     using T = typename std::decay_t<decltype(v)>::value_type;
     std::vector<T> padded(v);
     padded.resize(std::max<std::size_t>(padded.size(), (16 + sizeof(T) - 1) / sizeof(T)));
-    pass.model_bytes_ += padded.size() * sizeof(T);
+    model_bytes_ += padded.size() * sizeof(T);
     return engine::GlBuffer::create(padded.size() * sizeof(T), padded.data());
   };
-  pass.model_table_ = upload_once(table);
-  pass.model_vertices_ = upload_once(vertices);
-  pass.psi_ = upload_once(psi);
-  pass.a_inverse_ = upload_once(a_inverse);
-  pass.sh_data_ = upload_once(sh_data);
-  for (std::size_t bytes : field_group_bytes) {
-    pass.fields_.push_back(engine::GlBuffer::create(std::max<std::size_t>(bytes, 16), nullptr, GL_DYNAMIC_STORAGE_BIT));
-    pass.model_bytes_ += std::max<std::size_t>(bytes, 16);
+  model_table_ = upload_once(data.table);
+  model_vertices_ = upload_once(data.vertices);
+  psi_ = upload_once(data.psi);
+  a_inverse_ = upload_once(data.a_inverse);
+  sh_data_ = upload_once(data.sh_data);
+  for (std::size_t bytes : data.field_group_bytes) {
+    fields_.push_back(engine::GlBuffer::create(std::max<std::size_t>(bytes, 16), nullptr, GL_DYNAMIC_STORAGE_BIT));
+    model_bytes_ += std::max<std::size_t>(bytes, 16);
   }
   for (std::size_t m = 0; m < models.size(); ++m) {
     const BasisRadianceField& f = *models[m].field;
-    glNamedBufferSubData(pass.fields_[table[m].field_buffer].id(),
-                         static_cast<GLintptr>(table[m].field_offset * sizeof(float)),
+    glNamedBufferSubData(fields_[data.table[m].field_buffer].id(),
+                         static_cast<GLintptr>(data.table[m].field_offset * sizeof(float)),
                          static_cast<GLsizeiptr>(f.bytes()), f.coefficients.data());
   }
-  if (pass.fields_.empty()) pass.fields_.push_back(engine::GlBuffer::create(16, nullptr, GL_DYNAMIC_STORAGE_BIT));
-  pass.static_out_.reserve(16);
-  pass.static_points_.reserve(16);
-  if (glGetError() == GL_OUT_OF_MEMORY) return error("out of GPU memory uploading the models");
-  return pass;
+  if (fields_.empty()) fields_.push_back(engine::GlBuffer::create(16, nullptr, GL_DYNAMIC_STORAGE_BIT));
+  static_out_.reserve(16);
+  static_points_.reserve(16);
 }
 
 engine::Status BrfGpuPass::set_static_receivers(std::span<const glm::vec3> positions,
@@ -338,7 +368,8 @@ engine::Status BrfGpuPass::reset_layout(std::span<const BrfGpuInstance> instance
       if (s == r) continue;
       pairs[s * n + r].phi_offset = u32(phi_floats);
       const ModelInfo& mr = models_[instances[r].model];
-      phi_floats += static_cast<std::size_t>(mr.vertex_count) * mr.terms * padded(models_[instances[s].model].channels());
+      phi_floats +=
+          static_cast<std::size_t>(mr.vertex_count) * mr.terms * padded(models_[instances[s].model].channels());
     }
   if (phi_floats * sizeof(float) > max_buffer_bytes_)
     return error(std::to_string(n) + " instances need " + std::to_string(phi_floats * sizeof(float)) +
@@ -415,10 +446,22 @@ void BrfGpuPass::dispatch_phi(std::span<const BrfPhiJob> jobs, bool static_kind)
 }
 
 engine::Status BrfGpuPass::update_static(std::span<const BrfGpuInstance> instances) {
+  const std::vector<std::uint8_t> moved = static_sources_moved(instances);
+  if (std::none_of(moved.begin(), moved.end(), [](std::uint8_t m) { return m != 0; })) return {};
+  std::size_t total_floats = 0;
+  std::vector<std::vector<std::uint32_t>> inside = static_receivers_inside(instances, moved, total_floats);
+  if (total_floats * sizeof(float) > max_buffer_bytes_)
+    return error("static receivers need " + std::to_string(total_floats * sizeof(float)) +
+                 " bytes of Phi, above the SSBO limit of " + std::to_string(max_buffer_bytes_));
+  relayout_static_phi(instances, moved, inside, total_floats);
+  upload_static_lists(instances);
+  return {};
+}
+
+std::vector<std::uint8_t> BrfGpuPass::static_sources_moved(std::span<const BrfGpuInstance> instances) {
   const std::size_t n = instances.size();
   stats_.static_sources_reused = 0;
   std::vector<std::uint8_t> moved(n, 0);
-  bool any = false;
   for (std::size_t s = 0; s < n; ++s) {
     StaticSlot& slot = static_slots_[s];
     const glm::mat4& m = instances[s].object_to_world;
@@ -427,13 +470,16 @@ engine::Status BrfGpuPass::update_static(std::span<const BrfGpuInstance> instanc
       continue;
     }
     moved[s] = 1;
-    any = true;
   }
-  if (!any) return {};
+  return moved;
+}
 
+std::vector<std::vector<std::uint32_t>> BrfGpuPass::static_receivers_inside(std::span<const BrfGpuInstance> instances,
+                                                                            std::span<const std::uint8_t> moved,
+                                                                            std::size_t& total_floats) const {
   // Which receivers lie inside each moved source's outermost sphere (as brf_interreflect tests it).
+  const std::size_t n = instances.size();
   std::vector<std::vector<std::uint32_t>> inside(n);
-  std::size_t total_floats = 0;
   for (std::size_t s = 0; s < n; ++s) {
     const ModelInfo& model = models_[instances[s].model];
     if (moved[s] != 0) {
@@ -448,11 +494,13 @@ engine::Status BrfGpuPass::update_static(std::span<const BrfGpuInstance> instanc
     }
     total_floats += inside[s].size() * padded(model.channels());
   }
-  if (total_floats * sizeof(float) > max_buffer_bytes_)
-    return error("static receivers need " + std::to_string(total_floats * sizeof(float)) +
-                 " bytes of Phi, above the SSBO limit of " + std::to_string(max_buffer_bytes_));
+  return inside;
+}
 
+void BrfGpuPass::relayout_static_phi(std::span<const BrfGpuInstance> instances, std::span<const std::uint8_t> moved,
+                                     std::span<std::vector<std::uint32_t>> inside, std::size_t total_floats) {
   // New layout; unmoved sources' Phi is copied over, moved ones are evaluated.
+  const std::size_t n = instances.size();
   static_phi_spare_.reserve(total_floats * sizeof(float));
   std::vector<std::uint32_t> indices;
   std::vector<BrfPhiJob> jobs;
@@ -489,8 +537,11 @@ engine::Status BrfGpuPass::update_static(std::span<const BrfGpuInstance> instanc
   std::swap(static_phi_, static_phi_spare_);
   static_indices_.upload(indices.data(), indices.size() * sizeof(std::uint32_t));
   dispatch_phi(jobs, true);
+}
 
+void BrfGpuPass::upload_static_lists(std::span<const BrfGpuInstance> instances) {
   // Per touched receiver, its sources in instance order.
+  const std::size_t n = instances.size();
   std::vector<std::uint32_t> count(static_count_, 0);
   for (std::size_t s = 0; s < n; ++s)
     for (std::uint32_t t : static_slots_[s].receivers) ++count[t];
@@ -514,13 +565,54 @@ engine::Status BrfGpuPass::update_static(std::span<const BrfGpuInstance> instanc
   static_touched_.upload(touched.data(), touched.size() * sizeof(glm::uvec4));
   static_entries_.upload(entries.data(), entries.size() * sizeof(glm::uvec4));
   static_touched_count_ = u32(touched.size());
-  return {};
 }
+
+/// run()'s CPU-side frame: the first weights, the culled pairs, the instance table, the live
+/// sources per receiver and the Phi jobs of the pairs that moved.
+struct BrfGpuPass::FrameData {
+  std::vector<glm::vec4> weights;    ///< First bounce's weights, rgb vec4 per channel; pads stay 0.
+  std::vector<std::uint8_t> culled;  ///< [source * n + receiver], as brf_pair_culling.
+  std::vector<GpuInstance> table;
+  std::vector<glm::uvec4> live;  ///< (source's first weight vec4, first Phi vec4, C4 / 4, source)
+  std::vector<BrfPhiJob> jobs;
+};
 
 engine::Status BrfGpuPass::run(std::span<const BrfGpuInstance> instances,
                                std::span<const std::vector<glm::vec3>> incoming, const BrfUpdateSettings& settings) {
   GI_EXPECTS(!programs_.phi.empty(), "BrfGpuPass::run on an empty (default or moved-from) pass");
   const auto t0 = std::chrono::steady_clock::now();
+  const std::size_t n = instances.size();
+  if (auto s = check_frame(instances, incoming); !s) return s;
+  bool same_layout = layout_models_.size() == n;
+  for (std::size_t i = 0; same_layout && i < n; ++i) same_layout = layout_models_[i] == instances[i].model;
+  if (!same_layout)
+    if (auto s = reset_layout(instances); !s) return s;
+
+  stats_ = Stats{};
+  if (n == 0) {
+    if (static_count_ > 0) glClearNamedBufferData(static_out_.buffer.id(), GL_R32F, GL_RED, GL_FLOAT, nullptr);
+    stats_.cpu_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    return {};
+  }
+
+  FrameData frame;
+  fit_first_and_cull(instances, incoming, settings.cull_threshold, frame);
+  plan_pairs(instances, frame);
+  dispatch_phi(frame.jobs, false);
+  upload_frame(incoming, frame);
+  for (int bounce = 0; bounce < settings.bounces; ++bounce) {
+    if (bounce > 0) dispatch_fit(0, n);
+    dispatch_gather(n);
+  }
+  if (static_count_ > 0)
+    if (auto s = gather_static(instances); !s) return s;
+  copy_outputs(n);
+  stats_.cpu_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  return {};
+}
+
+engine::Status BrfGpuPass::check_frame(std::span<const BrfGpuInstance> instances,
+                                       std::span<const std::vector<glm::vec3>> incoming) const {
   const std::size_t n = instances.size();
   if (incoming.size() != n)
     return error("incoming light for " + std::to_string(incoming.size()) + " instances, " + std::to_string(n) +
@@ -544,47 +636,42 @@ engine::Status BrfGpuPass::run(std::span<const BrfGpuInstance> instances,
     for (const glm::vec3& e : incoming[i])
       if (!finite(e)) return error(which + "non-finite incoming light");
   }
-  bool same_layout = layout_models_.size() == n;
-  for (std::size_t i = 0; same_layout && i < n; ++i) same_layout = layout_models_[i] == instances[i].model;
-  if (!same_layout)
-    if (auto s = reset_layout(instances); !s) return s;
+  return {};
+}
 
-  stats_ = Stats{};
-  if (n == 0) {
-    if (static_count_ > 0) glClearNamedBufferData(static_out_.buffer.id(), GL_R32F, GL_RED, GL_FLOAT, nullptr);
-    stats_.cpu_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-    return {};
-  }
-
+void BrfGpuPass::fit_first_and_cull(std::span<const BrfGpuInstance> instances,
+                                    std::span<const std::vector<glm::vec3>> incoming, float cull_threshold,
+                                    FrameData& frame) const {
   // First weights and pair culling on the CPU, exactly as brf_interreflect decides them.
+  const std::size_t n = instances.size();
   std::vector<BrfObject> objects(n);
   std::vector<std::array<std::vector<float>, 3>> first_weights(n);
   std::vector<glm::vec3> light;
-  std::vector<glm::vec4> weights(weight_offsets_[n], glm::vec4(0.0f));  // pads stay 0
+  frame.weights.assign(weight_offsets_[n], glm::vec4(0.0f));  // pads stay 0
   for (std::size_t i = 0; i < n; ++i) {
     const ModelInfo& m = models_[instances[i].model];
-    objects[i] = {m.mesh, m.basis, m.field, instances[i].object_to_world, instances[i].albedo, m.glossy,
-                  instances[i].specular};
+    objects[i] = {
+        m.mesh, m.basis, m.field, instances[i].object_to_world, instances[i].albedo, m.glossy, instances[i].specular};
     light.resize(incoming[i].size());  // reflect() of brf_runtime.cpp: albedo x E_0, specular x E_k
     for (std::size_t j = 0; j < light.size(); ++j)
       light[j] = (j < m.vertex_count ? instances[i].albedo : instances[i].specular) * incoming[i][j];
     first_weights[i] = brf_fit_rgb(*m.basis, light);
     for (std::size_t k = 0; k < m.channels(); ++k)
-      weights[weight_offsets_[i] + k] =
+      frame.weights[weight_offsets_[i] + k] =
           glm::vec4(first_weights[i][0][k], first_weights[i][1][k], first_weights[i][2][k], 0.0f);
   }
-  std::vector<std::uint8_t> culled;
-  if (!(settings.cull_threshold <= 0.0f)) {  // > 0 or NaN: as brf_interreflect
-    culled = brf_pair_culling(objects, first_weights, settings.cull_threshold);
+  if (!(cull_threshold <= 0.0f)) {  // > 0 or NaN: as brf_interreflect
+    frame.culled = brf_pair_culling(objects, first_weights, cull_threshold);
   } else {  // what brf_pair_culling returns for a threshold <= 0, without evaluating the bounds
-    culled.assign(n * n, 0);
-    for (std::size_t s = 0; s < n; ++s) culled[s * n + s] = 1;
+    frame.culled.assign(n * n, 0);
+    for (std::size_t s = 0; s < n; ++s) frame.culled[s * n + s] = 1;
   }
+}
 
+void BrfGpuPass::plan_pairs(std::span<const BrfGpuInstance> instances, FrameData& frame) {
   // Pairs whose relative pose changed (or never computed): Phi jobs; live sources per receiver.
-  std::vector<BrfPhiJob> jobs;
-  std::vector<glm::uvec4> live;  // (source's first weight vec4, first Phi vec4, C4 / 4, source)
-  std::vector<GpuInstance> table(n);
+  const std::size_t n = instances.size();
+  frame.table.assign(n, GpuInstance{});
   std::vector<glm::mat4> to_source(n);
   std::vector<glm::mat3> pure_to_source(n);  // uniform scale removed, as brf_basis_irradiance
   for (std::size_t s = 0; s < n; ++s) {
@@ -594,7 +681,7 @@ engine::Status BrfGpuPass::run(std::span<const BrfGpuInstance> instances,
   }
   for (std::size_t r = 0; r < n; ++r) {
     const ModelInfo& mr = models_[instances[r].model];
-    GpuInstance& g = table[r];
+    GpuInstance& g = frame.table[r];
     g.albedo = glm::vec4(instances[r].albedo, 0.0f);
     g.specular = glm::vec4(instances[r].specular, 0.0f);
     g.model = instances[r].model;
@@ -606,18 +693,18 @@ engine::Status BrfGpuPass::run(std::span<const BrfGpuInstance> instances,
     // A glossy receiver's frames: rot(M_r) x brf_tangent_frame(n), as brf_world_vertices.
     const glm::mat3 receiver_rot =
         glm::mat3(instances[r].object_to_world) / glm::length(glm::vec3(instances[r].object_to_world[0]));
-    g.live_first = u32(live.size());
+    g.live_first = u32(frame.live.size());
     for (std::size_t s = 0; s < n; ++s) {
       if (s == r) continue;
-      if (culled[s * n + r] != 0) {
+      if (frame.culled[s * n + r] != 0) {
         ++stats_.pairs_culled;
         continue;
       }
       ++stats_.pairs_evaluated;
       PairSlot& slot = pairs_[s * n + r];
       const glm::mat4 relative = to_source[s] * instances[r].object_to_world;
-      live.emplace_back(weight_offsets_[s], slot.phi_offset / 4, padded(models_[instances[s].model].channels()) / 4,
-                        u32(s));
+      frame.live.emplace_back(weight_offsets_[s], slot.phi_offset / 4,
+                              padded(models_[instances[s].model].channels()) / 4, u32(s));
       if (slot.valid && same_pose(slot.pose, relative, pose_tolerance_)) {
         ++stats_.pairs_reused;
         continue;
@@ -635,78 +722,82 @@ engine::Status BrfGpuPass::run(std::span<const BrfGpuInstance> instances,
         job.frame_offset = mr.frame_offset;
         job.lobe_offset = mr.lobe_offset;
       }
-      jobs.push_back(job);
+      frame.jobs.push_back(job);
       slot.valid = true;
       slot.pose = relative;
     }
-    g.live_count = u32(live.size()) - g.live_first;
+    g.live_count = u32(frame.live.size()) - g.live_first;
   }
-  dispatch_phi(jobs, false);
+}
 
-  // Frame inputs.
+void BrfGpuPass::upload_frame(std::span<const std::vector<glm::vec3>> incoming, const FrameData& frame) {
+  const std::size_t n = incoming.size();
   std::vector<glm::vec4> in4(value_offsets_[n]);
   for (std::size_t i = 0; i < n; ++i)
     for (std::size_t j = 0; j < incoming[i].size(); ++j) in4[value_offsets_[i] + j] = glm::vec4(incoming[i][j], 0.0f);
   incoming_.upload(in4.data(), in4.size() * sizeof(glm::vec4));
-  instance_table_.upload(table.data(), table.size() * sizeof(GpuInstance));
-  weights_.upload(weights.data(), weights.size() * sizeof(glm::vec4));
-  live_.upload(live.data(), live.size() * sizeof(glm::uvec4));
+  instance_table_.upload(frame.table.data(), frame.table.size() * sizeof(GpuInstance));
+  weights_.upload(frame.weights.data(), frame.weights.size() * sizeof(glm::vec4));
+  live_.upload(frame.live.data(), frame.live.size() * sizeof(glm::uvec4));
   glClearNamedBufferData(indirect_.buffer.id(), GL_R32F, GL_RED, GL_FLOAT, nullptr);
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+}
 
-  const auto fit = [&](std::uint32_t mode) {
-    const GLuint id = programs_.fit.id();
-    programs_.fit.use();
-    glProgramUniform1ui(id, glGetUniformLocation(id, "u_mode"), mode);
-    bind(0, instance_table_.buffer.id());
-    bind(1, model_table_.id());
-    bind(2, psi_.id());
-    bind(3, a_inverse_.id());
-    bind(4, incoming_.buffer.id());
-    bind(5, gathered_.buffer.id());
-    bind(6, indirect_.buffer.id());
-    bind(7, weights_.buffer.id());
-    glDispatchCompute(u32(n), 1, 1);
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-  };
-  const std::uint32_t vertex_total = vertex_offsets_[n];
-  for (int bounce = 0; bounce < settings.bounces; ++bounce) {
-    if (bounce > 0) fit(0);
-    const GLuint id = programs_.gather.id();
-    programs_.gather.use();
-    glProgramUniform1ui(id, glGetUniformLocation(id, "u_instance_count"), u32(n));
-    glProgramUniform1ui(id, glGetUniformLocation(id, "u_vertex_total"), vertex_total);
-    bind(0, instance_table_.buffer.id());
-    bind(1, model_table_.id());
-    bind(2, live_.buffer.id());
-    bind(3, weights_.buffer.id());
-    bind(4, phi_.buffer.id());
-    bind(5, gathered_.buffer.id());
-    bind(6, indirect_.buffer.id());
-    dispatch_groups((vertex_total + kGroupSize - 1) / kGroupSize);
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-  }
+void BrfGpuPass::dispatch_fit(std::uint32_t mode, std::size_t instance_count) {
+  const GLuint id = programs_.fit.id();
+  programs_.fit.use();
+  glProgramUniform1ui(id, glGetUniformLocation(id, "u_mode"), mode);
+  bind(0, instance_table_.buffer.id());
+  bind(1, model_table_.id());
+  bind(2, psi_.id());
+  bind(3, a_inverse_.id());
+  bind(4, incoming_.buffer.id());
+  bind(5, gathered_.buffer.id());
+  bind(6, indirect_.buffer.id());
+  bind(7, weights_.buffer.id());
+  glDispatchCompute(u32(instance_count), 1, 1);
+  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+}
 
-  if (static_count_ > 0) {
-    if (auto s = update_static(instances); !s) return s;
-    fit(1);
-    glClearNamedBufferData(static_out_.buffer.id(), GL_R32F, GL_RED, GL_FLOAT, nullptr);
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-    const GLuint id = programs_.static_gather.id();
-    programs_.static_gather.use();
-    glProgramUniform1ui(id, glGetUniformLocation(id, "u_touched_count"), static_touched_count_);
-    bind(0, static_touched_.buffer.id());
-    bind(1, static_entries_.buffer.id());
-    bind(2, instance_table_.buffer.id());
-    bind(3, model_table_.id());
-    bind(4, weights_.buffer.id());
-    bind(5, static_phi_.buffer.id());
-    bind(6, static_out_.buffer.id());
-    dispatch_groups((static_touched_count_ + kGroupSize - 1) / kGroupSize);
-  }
+void BrfGpuPass::dispatch_gather(std::size_t instance_count) {
+  const std::uint32_t vertex_total = vertex_offsets_[instance_count];
+  const GLuint id = programs_.gather.id();
+  programs_.gather.use();
+  glProgramUniform1ui(id, glGetUniformLocation(id, "u_instance_count"), u32(instance_count));
+  glProgramUniform1ui(id, glGetUniformLocation(id, "u_vertex_total"), vertex_total);
+  bind(0, instance_table_.buffer.id());
+  bind(1, model_table_.id());
+  bind(2, live_.buffer.id());
+  bind(3, weights_.buffer.id());
+  bind(4, phi_.buffer.id());
+  bind(5, gathered_.buffer.id());
+  bind(6, indirect_.buffer.id());
+  dispatch_groups((vertex_total + kGroupSize - 1) / kGroupSize);
+  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+}
 
+engine::Status BrfGpuPass::gather_static(std::span<const BrfGpuInstance> instances) {
+  if (auto s = update_static(instances); !s) return s;
+  dispatch_fit(1, instances.size());
+  glClearNamedBufferData(static_out_.buffer.id(), GL_R32F, GL_RED, GL_FLOAT, nullptr);
+  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+  const GLuint id = programs_.static_gather.id();
+  programs_.static_gather.use();
+  glProgramUniform1ui(id, glGetUniformLocation(id, "u_touched_count"), static_touched_count_);
+  bind(0, static_touched_.buffer.id());
+  bind(1, static_entries_.buffer.id());
+  bind(2, instance_table_.buffer.id());
+  bind(3, model_table_.id());
+  bind(4, weights_.buffer.id());
+  bind(5, static_phi_.buffer.id());
+  bind(6, static_out_.buffer.id());
+  dispatch_groups((static_touched_count_ + kGroupSize - 1) / kGroupSize);
+  return {};
+}
+
+void BrfGpuPass::copy_outputs(std::size_t instance_count) {
   glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-  for (std::size_t i = 0; i < n; ++i) {
+  for (std::size_t i = 0; i < instance_count; ++i) {
     const std::size_t bytes = static_cast<std::size_t>(value_offsets_[i + 1] - value_offsets_[i]) * sizeof(glm::vec4);
     if (bytes > 0)
       glCopyNamedBufferSubData(indirect_.buffer.id(), outputs_[i].id(),
@@ -714,8 +805,6 @@ engine::Status BrfGpuPass::run(std::span<const BrfGpuInstance> instances,
                                static_cast<GLsizeiptr>(bytes));
   }
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_VERTEX_ATTRIB_ARRAY_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
-  stats_.cpu_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-  return {};
 }
 
 std::uint32_t BrfGpuPass::vertex_buffer(std::size_t instance) const {

@@ -159,8 +159,8 @@ class BrfGpuPass {
     std::uint32_t first_vertex = 0;  ///< In the model-vertex buffer.
     std::uint32_t vertex_count = 0;
     std::uint32_t basis_count = 0;
-    std::uint32_t terms = 1;          ///< K: 1 + glossy terms.
-    std::uint32_t frame_offset = 0;   ///< Glossy: first float of its vertex frames / lobes in sh_data_.
+    std::uint32_t terms = 1;         ///< K: 1 + glossy terms.
+    std::uint32_t frame_offset = 0;  ///< Glossy: first float of its vertex frames / lobes in sh_data_.
     std::uint32_t lobe_offset = 0;
     std::uint32_t field_buffer = 0;
     float outer_radius = 0.0f;
@@ -189,9 +189,52 @@ class BrfGpuPass {
     engine::ShaderProgram phi, phi_glossy, fit, gather, static_gather;  ///< phi_glossy: jobs of K_r > 1 rows
   };
 
+  struct ModelData;  ///< create()'s model tables on the CPU before upload (brf_gpu_pass.cpp).
+  struct FrameData;  ///< run()'s per-frame CPU data: first weights, culling, Phi jobs (brf_gpu_pass.cpp).
+
+  // create()'s stages, in order (after the models are checked).
+  /// Compiles the compute programs (phi, fit, gather, static gather, then glossy phi).
+  engine::Status build_programs();
+  /// Appends one checked model to the CPU tables (field grouped under `limit`) and to models_.
+  void add_model(const BrfGpuModel& model, std::size_t limit, ModelData& data);
+  /// Uploads the tables once, the fields into their buffers; reserves the static buffers.
+  void upload_models(std::span<const BrfGpuModel> models, const ModelData& data);
+
+  // run()'s stages, in order (reset_layout() when the instances' models changed).
+  /// The frame's checks (sizes, model indices, finite and non-singular data); changes nothing.
+  engine::Status check_frame(std::span<const BrfGpuInstance> instances,
+                             std::span<const std::vector<glm::vec3>> incoming) const;
+  /// The first bounce's weights and the culled pairs on the CPU, as brf_interreflect.
+  void fit_first_and_cull(std::span<const BrfGpuInstance> instances, std::span<const std::vector<glm::vec3>> incoming,
+                          float cull_threshold, FrameData& frame) const;
+  /// Instance table, live sources per receiver, Phi jobs of moved pairs; updates pairs_, stats_.
+  void plan_pairs(std::span<const BrfGpuInstance> instances, FrameData& frame);
+  /// Uploads the incoming light, instance table, first weights and live lists; clears indirect_.
+  void upload_frame(std::span<const std::vector<glm::vec3>> incoming, const FrameData& frame);
+  /// One brf_fit.comp.glsl dispatch over all instances (u_mode 0: last bounce, 1: incoming + indirect).
+  void dispatch_fit(std::uint32_t mode, std::size_t instance_count);
+  /// One bounce's brf_gather.comp.glsl dispatch over all instance vertices.
+  void dispatch_gather(std::size_t instance_count);
+  /// Static receivers: update_static(), the fit of all light, brf_static_gather.comp.glsl.
+  engine::Status gather_static(std::span<const BrfGpuInstance> instances);
+  /// Copies each instance's terms from indirect_ into its vertex buffer; the final barriers.
+  void copy_outputs(std::size_t instance_count);
+
   engine::Status reset_layout(std::span<const BrfGpuInstance> instances);
   /// Static receivers' Phi of the sources that moved, the per-receiver source lists.
   engine::Status update_static(std::span<const BrfGpuInstance> instances);
+  // update_static()'s stages, in order.
+  /// Per source, 1 when its static-receiver Phi must be evaluated again; counts the reused ones.
+  std::vector<std::uint8_t> static_sources_moved(std::span<const BrfGpuInstance> instances);
+  /// Per source, the static receivers in its outermost sphere (kept for unmoved ones); adds their Phi floats.
+  std::vector<std::vector<std::uint32_t>> static_receivers_inside(std::span<const BrfGpuInstance> instances,
+                                                                  std::span<const std::uint8_t> moved,
+                                                                  std::size_t& total_floats) const;
+  /// Static Phi in its new layout: unmoved sources' copied over, moved ones' evaluated.
+  void relayout_static_phi(std::span<const BrfGpuInstance> instances, std::span<const std::uint8_t> moved,
+                           std::span<std::vector<std::uint32_t>> inside, std::size_t total_floats);
+  /// Per touched static receiver, its sources in instance order (static_touched_, static_entries_).
+  void upload_static_lists(std::span<const BrfGpuInstance> instances);
   /// Evaluates `jobs` (one dispatch per field buffer) into phi_ or, for static_kind, static_phi_.
   void dispatch_phi(std::span<const BrfPhiJob> jobs, bool static_kind);
 
