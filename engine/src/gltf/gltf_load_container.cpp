@@ -19,13 +19,12 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr std::uint32_t kGlbMagic = 0x46546C67;      // "glTF"
-constexpr std::uint32_t kChunkJson = 0x4E4F534A;     // "JSON"
-constexpr std::uint32_t kChunkBin = 0x004E4942;      // "BIN\0"
+constexpr std::uint32_t kGlbMagic = 0x46546C67;   // "glTF"
+constexpr std::uint32_t kChunkJson = 0x4E4F534A;  // "JSON"
+constexpr std::uint32_t kChunkBin = 0x004E4942;   // "BIN\0"
 
 std::uint32_t read_u32_le(const std::uint8_t* p) {
-  return std::uint32_t{p[0]} | (std::uint32_t{p[1]} << 8) | (std::uint32_t{p[2]} << 16) |
-         (std::uint32_t{p[3]} << 24);
+  return std::uint32_t{p[0]} | (std::uint32_t{p[1]} << 8) | (std::uint32_t{p[2]} << 16) | (std::uint32_t{p[3]} << 24);
 }
 
 void append_u32_le(std::vector<std::uint8_t>& out, std::uint32_t v) {
@@ -33,8 +32,7 @@ void append_u32_le(std::vector<std::uint8_t>& out, std::uint32_t v) {
 }
 
 /// Reads a whole regular file, refusing directories, special files and files over the limit.
-Result<std::vector<std::uint8_t>> read_regular_file(const Context& ctx, const fs::path& path,
-                                                    const std::string& what) {
+Result<std::vector<std::uint8_t>> read_regular_file(const Context& ctx, const fs::path& path, const std::string& what) {
   std::error_code ec;
   const fs::file_status status = fs::status(path, ec);
   if (ec || !fs::exists(status)) return ctx.error(what, "file does not exist: " + path.string());
@@ -65,15 +63,15 @@ struct Container {
 /// unknown chunk types are skipped as the spec requires.
 Result<Container> split_glb(const Context& ctx, const std::vector<std::uint8_t>& bytes) {
   if (bytes.size() < 12) {
-    return ctx.error("GLB header", "truncated: the 12-byte header needs 12 bytes, the file has " +
-                                       std::to_string(bytes.size()));
+    return ctx.error("GLB header",
+                     "truncated: the 12-byte header needs 12 bytes, the file has " + std::to_string(bytes.size()));
   }
   const std::uint32_t version = read_u32_le(bytes.data() + 4);
   const std::uint32_t length = read_u32_le(bytes.data() + 8);
   if (version != 2) return ctx.error("GLB header", "unsupported GLB version " + std::to_string(version));
   if (length > bytes.size()) {
-    return ctx.error("GLB header", "truncated: header says " + std::to_string(length) +
-                                       " bytes, the file has " + std::to_string(bytes.size()));
+    return ctx.error("GLB header", "truncated: header says " + std::to_string(length) + " bytes, the file has " +
+                                       std::to_string(bytes.size()));
   }
   // Bytes after `length` are not part of the GLB (the validator warns, it is not an error).
   if (length < 12) return ctx.error("GLB header", "length " + std::to_string(length) + " is shorter than the header");
@@ -90,8 +88,8 @@ Result<Container> split_glb(const Context& ctx, const std::vector<std::uint8_t>&
     const std::uint32_t chunk_type = read_u32_le(bytes.data() + offset + 4);
     offset += 8;
     if (chunk_length > length - offset) {
-      return ctx.error(where, "truncated chunk data: chunk says " + std::to_string(chunk_length) +
-                                  " bytes, " + std::to_string(length - offset) + " remain");
+      return ctx.error(where, "truncated chunk data: chunk says " + std::to_string(chunk_length) + " bytes, " +
+                                  std::to_string(length - offset) + " remain");
     }
     if (chunk_length % 4 != 0) {
       return ctx.error(where, "chunk length " + std::to_string(chunk_length) + " is not a multiple of 4");
@@ -151,9 +149,9 @@ std::string buffer_problem(const Container& container, const Json& buffer, std::
   const std::string u = uri->get<std::string>();
   if (u.rfind("data:", 0) == 0) {
     // The data URIs tinygltf decodes: base64 with these media types.
-    for (const char* prefix : {"data:application/octet-stream;base64,", "data:application/gltf-buffer;base64,",
-                               "data:image/jpeg;base64,", "data:image/png;base64,", "data:image/bmp;base64,",
-                               "data:image/gif;base64,", "data:text/plain;base64,"}) {
+    for (const char* prefix :
+         {"data:application/octet-stream;base64,", "data:application/gltf-buffer;base64,", "data:image/jpeg;base64,",
+          "data:image/png;base64,", "data:image/bmp;base64,", "data:image/gif;base64,", "data:text/plain;base64,"}) {
       if (u.rfind(prefix, 0) == 0) return "";
     }
     return "unsupported data URI encoding (base64 octet-stream or gltf-buffer expected)";
@@ -167,25 +165,30 @@ std::size_t array_size(const Json& doc, const char* key) {
   return a != nullptr && a->is_array() ? a->size() : 0;
 }
 
-/// Checks the references tinygltf follows while parsing without bounds checks: buffer views
-/// against their buffers (§3.6.1.1: byteOffset + byteLength <= buffer.byteLength) and image
-/// buffer views. Removes Draco extensions and primitive indices from `doc` into `out`, and
-/// turns buffers tinygltf cannot load (no URI, remote, unusual data URIs) into placeholders
-/// that are an error only when read.
-Status prevalidate(const Context& ctx, const Container& container, ParsedFile& out) {
-  Json& doc = out.doc;
+/// asset.version must be a 2.x string.
+Status check_asset(const Context& ctx, const Json& doc) {
   const Json* asset = find_member(doc, "asset");
   const Json* version = asset != nullptr ? find_member(*asset, "version") : nullptr;
   if (version == nullptr || !version->is_string()) return ctx.error("asset", "missing asset.version");
   if (version->get<std::string>().rfind("2.", 0) != 0) {
     return ctx.error("asset", "unsupported glTF version '" + version->get<std::string>() + "' (need 2.x)");
   }
+  return {};
+}
+
+/// The node count against the limit.
+Status check_node_count(const Context& ctx, const Json& doc) {
   if (array_size(doc, "nodes") > ctx.options.limits.max_nodes) {
     return ctx.error("nodes", std::to_string(array_size(doc, "nodes")) + " nodes exceed the limit of " +
                                   std::to_string(ctx.options.limits.max_nodes));
   }
-  for (const char* key : {"buffers", "bufferViews", "accessors", "meshes", "nodes", "materials", "images",
-                          "textures", "cameras", "scenes", "samplers"}) {
+  return {};
+}
+
+/// The top-level collections, where present, are arrays of objects.
+Status check_top_level_arrays(const Context& ctx, const Json& doc) {
+  for (const char* key : {"buffers", "bufferViews", "accessors", "meshes", "nodes", "materials", "images", "textures",
+                          "cameras", "scenes", "samplers"}) {
     const Json* a = find_member(doc, key);
     if (a != nullptr && !a->is_array()) return ctx.error(key, "must be an array");
     if (a == nullptr) continue;
@@ -193,6 +196,13 @@ Status prevalidate(const Context& ctx, const Container& container, ParsedFile& o
       if (!(*a)[i].is_object()) return ctx.error(std::string(key) + " " + std::to_string(i), "must be an object");
     }
   }
+  return {};
+}
+
+/// buffers: each byteLength (returned in order); buffers tinygltf cannot load become placeholders
+/// with their problem in out.buffer_problems.
+Result<std::vector<std::int64_t>> check_buffers(const Context& ctx, const Container& container, ParsedFile& out) {
+  Json& doc = out.doc;
   std::vector<std::int64_t> buffer_lengths;
   if (Json* buffers = doc.contains("buffers") ? &doc["buffers"] : nullptr) {
     for (std::size_t i = 0; i < buffers->size(); ++i) {
@@ -207,25 +217,36 @@ Status prevalidate(const Context& ctx, const Container& container, ParsedFile& o
       }
     }
   }
-  std::size_t view_count = 0;
-  std::vector<std::size_t> view_buffer;
+  return buffer_lengths;
+}
+
+/// The buffer views check_buffer_views() accepted.
+struct BufferViews {
+  std::size_t count = 0;
+  std::vector<std::size_t> buffer;  ///< Per view, its buffer.
+};
+
+/// bufferViews: buffer index, byte range inside the buffer (§3.6.1.1), byteStride (§5.11).
+Result<BufferViews> check_buffer_views(const Context& ctx, const Json& doc,
+                                       const std::vector<std::int64_t>& buffer_lengths) {
+  BufferViews out;
   if (const Json* views = find_member(doc, "bufferViews")) {
-    view_count = views->size();
+    out.count = views->size();
     for (std::size_t i = 0; i < views->size(); ++i) {
       const std::string where = "bufferView " + std::to_string(i);
       const Json& view = (*views)[i];
       auto buffer = index_member(ctx, view, "buffer", -1, where);
       if (!buffer) return buffer.error();
       if (*buffer < 0 || static_cast<std::size_t>(*buffer) >= buffer_lengths.size()) {
-        return ctx.error(where, "'buffer' missing or out of range (" + std::to_string(buffer_lengths.size()) +
-                                    " buffers)");
+        return ctx.error(where,
+                         "'buffer' missing or out of range (" + std::to_string(buffer_lengths.size()) + " buffers)");
       }
       auto offset = index_member(ctx, view, "byteOffset", 0, where);
       if (!offset) return offset.error();
       auto length = index_member(ctx, view, "byteLength", -1, where);
       if (!length) return length.error();
       if (*length < 1) return ctx.error(where, "'byteLength' is required and must be >= 1");
-      view_buffer.push_back(static_cast<std::size_t>(*buffer));
+      out.buffer.push_back(static_cast<std::size_t>(*buffer));
       const std::int64_t buffer_length = buffer_lengths[static_cast<std::size_t>(*buffer)];
       if (*offset > buffer_length || *length > buffer_length - *offset) {
         return ctx.error(where, "byte range [" + std::to_string(*offset) + ", " + std::to_string(*offset + *length) +
@@ -240,24 +261,37 @@ Status prevalidate(const Context& ctx, const Container& container, ParsedFile& o
       }
     }
   }
+  return out;
+}
+
+/// images: the buffer view in range and reading a buffer that has data.
+Status check_images(const Context& ctx, const Json& doc, const BufferViews& views,
+                    const std::vector<std::string>& buffer_problems) {
   if (const Json* images = find_member(doc, "images")) {
     for (std::size_t i = 0; i < images->size(); ++i) {
       const std::string where = "image " + std::to_string(i);
       auto view = index_member(ctx, (*images)[i], "bufferView", -1, where);
       if (!view) return view.error();
-      if (*view >= 0 && static_cast<std::size_t>(*view) >= view_count) {
+      if (*view >= 0 && static_cast<std::size_t>(*view) >= views.count) {
         return ctx.error(where, "'bufferView' " + std::to_string(*view) + " is out of range");
       }
       // tinygltf hands the view's bytes to the decoder without a check: a buffer without
       // data (a placeholder) must not be read here.
       if (*view >= 0) {
-        const std::size_t b = view_buffer[static_cast<std::size_t>(*view)];
-        if (!out.buffer_problems[b].empty()) {
-          return ctx.error(where, "reads buffer " + std::to_string(b) + ", which has no data: " + out.buffer_problems[b]);
+        const std::size_t b = views.buffer[static_cast<std::size_t>(*view)];
+        if (!buffer_problems[b].empty()) {
+          return ctx.error(where, "reads buffer " + std::to_string(b) + ", which has no data: " + buffer_problems[b]);
         }
       }
     }
   }
+  return {};
+}
+
+/// accessors: the buffer view in range; an unknown type or componentType becomes a harmless
+/// placeholder with its problem in out.accessor_problems.
+Status check_accessors(const Context& ctx, std::size_t view_count, ParsedFile& out) {
+  Json& doc = out.doc;
   if (Json* accessors = doc.contains("accessors") ? &doc["accessors"] : nullptr) {
     static const char* const kTypes[] = {"SCALAR", "VEC2", "VEC3", "VEC4", "MAT2", "MAT3", "MAT4"};
     for (std::size_t i = 0; i < accessors->size(); ++i) {
@@ -273,7 +307,8 @@ Status prevalidate(const Context& ctx, const Container& container, ParsedFile& o
       const Json* type = find_member(acc, "type");
       const Json* component = find_member(acc, "componentType");
       if (type == nullptr || !type->is_string() ||
-          std::none_of(std::begin(kTypes), std::end(kTypes), [&](const char* t) { return type->get<std::string>() == t; })) {
+          std::none_of(std::begin(kTypes), std::end(kTypes),
+                       [&](const char* t) { return type->get<std::string>() == t; })) {
         problem = "unknown or missing accessor type";
       }
       if (component == nullptr || !is_integer(*component) ||
@@ -288,6 +323,11 @@ Status prevalidate(const Context& ctx, const Container& container, ParsedFile& o
       out.accessor_problems.push_back(problem);
     }
   }
+  return {};
+}
+
+/// textures: source image and sampler in range.
+Status check_textures(const Context& ctx, const Json& doc) {
   if (const Json* textures = find_member(doc, "textures")) {
     for (std::size_t i = 0; i < textures->size(); ++i) {
       const std::string where = "texture " + std::to_string(i);
@@ -303,6 +343,75 @@ Status prevalidate(const Context& ctx, const Container& container, ParsedFile& o
       }
     }
   }
+  return {};
+}
+
+/// Primitive p of mesh m: material, indices and attribute accessors in range (§3.7.2.1); its
+/// indices move from the JSON into out.primitive_indices.
+Status check_primitive_references(const Context& ctx, std::size_t m, std::size_t p, Json& prim, ParsedFile& out) {
+  const Json& doc = out.doc;
+  const std::string pwhere = "mesh " + std::to_string(m) + " primitive " + std::to_string(p);
+  auto material = index_member(ctx, prim, "material", -1, pwhere);
+  if (!material) return material.error();
+  if (*material >= 0 && static_cast<std::size_t>(*material) >= array_size(doc, "materials")) {
+    return ctx.error(pwhere, "material " + std::to_string(*material) + " is out of range");
+  }
+  const std::size_t accessor_count = array_size(doc, "accessors");
+  auto indices_ref = index_member(ctx, prim, "indices", -1, pwhere);
+  if (!indices_ref) return indices_ref.error();
+  if (*indices_ref >= 0 && static_cast<std::size_t>(*indices_ref) >= accessor_count) {
+    return ctx.error(pwhere, "indices accessor " + std::to_string(*indices_ref) + " is out of range");
+  }
+  if (const Json* attrs = find_member(prim, "attributes"); attrs != nullptr && attrs->is_object()) {
+    for (const auto& [name, value] : attrs->items()) {
+      if (!is_integer(value) || value.get<std::int64_t>() < 0 || value.get<std::uint64_t>() >= accessor_count) {
+        return ctx.error(pwhere, "attribute " + name + " refers to a missing accessor");
+      }
+    }
+  }
+  if (prim.contains("indices")) {
+    auto indices =
+        index_member(ctx, prim, "indices", -1, "mesh " + std::to_string(m) + " primitive " + std::to_string(p));
+    if (!indices) return indices.error();
+    out.primitive_indices[{static_cast<int>(m), static_cast<int>(p)}] = static_cast<int>(*indices);
+    prim.erase("indices");
+  }
+  return {};
+}
+
+/// Primitive p of mesh m's KHR_draco_mesh_compression, if any: buffer view in range, attribute
+/// ids; moved from the JSON into out.draco.
+Status take_draco_extension(const Context& ctx, std::size_t m, std::size_t p, Json& prim, std::size_t view_count,
+                            ParsedFile& out) {
+  if (!prim.contains("extensions") || !prim["extensions"].is_object()) return {};
+  Json& exts = prim["extensions"];
+  if (!exts.contains("KHR_draco_mesh_compression")) return {};
+  const std::string where =
+      "mesh " + std::to_string(m) + " primitive " + std::to_string(p) + " KHR_draco_mesh_compression";
+  const Json& ext = exts["KHR_draco_mesh_compression"];
+  DracoRef ref;
+  auto view = index_member(ctx, ext, "bufferView", -1, where);
+  if (!view) return view.error();
+  if (*view < 0 || static_cast<std::size_t>(*view) >= view_count) {
+    return ctx.error(where, "'bufferView' missing or out of range");
+  }
+  ref.buffer_view = static_cast<int>(*view);
+  const Json* attrs = find_member(ext, "attributes");
+  if (attrs == nullptr || !attrs->is_object()) return ctx.error(where, "'attributes' must be an object");
+  for (const auto& [name, id] : attrs->items()) {
+    if (!is_integer(id) || id.get<std::int64_t>() < 0 || id.get<std::int64_t>() > 1 << 20) {
+      return ctx.error(where, "attribute '" + name + "' must be a non-negative integer id");
+    }
+    ref.attributes[name] = id.get<int>();
+  }
+  out.draco[{static_cast<int>(m), static_cast<int>(p)}] = std::move(ref);
+  exts.erase("KHR_draco_mesh_compression");
+  return {};
+}
+
+/// meshes: every primitive's references and Draco extension, used or not (§3.7.2.1).
+Status check_meshes(const Context& ctx, std::size_t view_count, ParsedFile& out) {
+  Json& doc = out.doc;
   if (Json* meshes = doc.contains("meshes") ? &doc["meshes"] : nullptr) {
     for (std::size_t m = 0; m < meshes->size(); ++m) {
       Json* prims = (*meshes)[m].contains("primitives") ? &(*meshes)[m]["primitives"] : nullptr;
@@ -311,58 +420,31 @@ Status prevalidate(const Context& ctx, const Container& container, ParsedFile& o
         Json& prim = (*prims)[p];
         if (!prim.is_object()) continue;
         // References are checked for every mesh, used or not (§3.7.2.1).
-        const std::string pwhere = "mesh " + std::to_string(m) + " primitive " + std::to_string(p);
-        auto material = index_member(ctx, prim, "material", -1, pwhere);
-        if (!material) return material.error();
-        if (*material >= 0 && static_cast<std::size_t>(*material) >= array_size(doc, "materials")) {
-          return ctx.error(pwhere, "material " + std::to_string(*material) + " is out of range");
-        }
-        const std::size_t accessor_count = array_size(doc, "accessors");
-        auto indices_ref = index_member(ctx, prim, "indices", -1, pwhere);
-        if (!indices_ref) return indices_ref.error();
-        if (*indices_ref >= 0 && static_cast<std::size_t>(*indices_ref) >= accessor_count) {
-          return ctx.error(pwhere, "indices accessor " + std::to_string(*indices_ref) + " is out of range");
-        }
-        if (const Json* attrs = find_member(prim, "attributes"); attrs != nullptr && attrs->is_object()) {
-          for (const auto& [name, value] : attrs->items()) {
-            if (!is_integer(value) || value.get<std::int64_t>() < 0 || value.get<std::uint64_t>() >= accessor_count) {
-              return ctx.error(pwhere, "attribute " + name + " refers to a missing accessor");
-            }
-          }
-        }
-        if (prim.contains("indices")) {
-          auto indices = index_member(ctx, prim, "indices", -1, "mesh " + std::to_string(m) + " primitive " + std::to_string(p));
-          if (!indices) return indices.error();
-          out.primitive_indices[{static_cast<int>(m), static_cast<int>(p)}] = static_cast<int>(*indices);
-          prim.erase("indices");
-        }
-        if (!prim.contains("extensions") || !prim["extensions"].is_object()) continue;
-        Json& exts = prim["extensions"];
-        if (!exts.contains("KHR_draco_mesh_compression")) continue;
-        const std::string where = "mesh " + std::to_string(m) + " primitive " + std::to_string(p) +
-                                  " KHR_draco_mesh_compression";
-        const Json& ext = exts["KHR_draco_mesh_compression"];
-        DracoRef ref;
-        auto view = index_member(ctx, ext, "bufferView", -1, where);
-        if (!view) return view.error();
-        if (*view < 0 || static_cast<std::size_t>(*view) >= view_count) {
-          return ctx.error(where, "'bufferView' missing or out of range");
-        }
-        ref.buffer_view = static_cast<int>(*view);
-        const Json* attrs = find_member(ext, "attributes");
-        if (attrs == nullptr || !attrs->is_object()) return ctx.error(where, "'attributes' must be an object");
-        for (const auto& [name, id] : attrs->items()) {
-          if (!is_integer(id) || id.get<std::int64_t>() < 0 || id.get<std::int64_t>() > 1 << 20) {
-            return ctx.error(where, "attribute '" + name + "' must be a non-negative integer id");
-          }
-          ref.attributes[name] = id.get<int>();
-        }
-        out.draco[{static_cast<int>(m), static_cast<int>(p)}] = std::move(ref);
-        exts.erase("KHR_draco_mesh_compression");
+        if (auto ok = check_primitive_references(ctx, m, p, prim, out); !ok) return ok;
+        if (auto ok = take_draco_extension(ctx, m, p, prim, view_count, out); !ok) return ok;
       }
     }
   }
   return {};
+}
+
+/// Checks the references tinygltf follows while parsing without bounds checks: buffer views
+/// against their buffers (§3.6.1.1: byteOffset + byteLength <= buffer.byteLength) and image
+/// buffer views. Removes Draco extensions and primitive indices from `doc` into `out`, and
+/// turns buffers tinygltf cannot load (no URI, remote, unusual data URIs) into placeholders
+/// that are an error only when read. One section after another, each stopping at its first error.
+Status prevalidate(const Context& ctx, const Container& container, ParsedFile& out) {
+  if (auto ok = check_asset(ctx, out.doc); !ok) return ok;
+  if (auto ok = check_node_count(ctx, out.doc); !ok) return ok;
+  if (auto ok = check_top_level_arrays(ctx, out.doc); !ok) return ok;
+  auto buffer_lengths = check_buffers(ctx, container, out);
+  if (!buffer_lengths) return buffer_lengths.error();
+  auto views = check_buffer_views(ctx, out.doc, *buffer_lengths);
+  if (!views) return views.error();
+  if (auto ok = check_images(ctx, out.doc, *views, out.buffer_problems); !ok) return ok;
+  if (auto ok = check_accessors(ctx, views->count, out); !ok) return ok;
+  if (auto ok = check_textures(ctx, out.doc); !ok) return ok;
+  return check_meshes(ctx, views->count, out);
 }
 
 // tinygltf file-system callbacks: no shell expansion of URIs, no reads of directories or
@@ -461,9 +543,9 @@ Result<ParsedFile> parse_file(const Context& ctx, const fs::path& path) {
     out.doc = Json::parse(container.json_text);
   } catch (const Json::exception& e) {
     const bool glb_extension = path.extension() == ".glb";
-    return ctx.error(glb_magic ? "GLB JSON chunk" : "JSON",
-                     std::string(glb_extension && !glb_magic ? "not a GLB (bad magic) and " : "") + "bad JSON: " +
-                         e.what());
+    return ctx.error(
+        glb_magic ? "GLB JSON chunk" : "JSON",
+        std::string(glb_extension && !glb_magic ? "not a GLB (bad magic) and " : "") + "bad JSON: " + e.what());
   }
   if (!out.doc.is_object()) return ctx.error("JSON", "the root is not a JSON object");
   // Real glTF nests a handful of levels (extras a few more); the walks below recurse.
@@ -477,7 +559,8 @@ Result<ParsedFile> parse_file(const Context& ctx, const fs::path& path) {
   // Lights are read from the JSON by the loader (gltf_load_lights.cpp); tinygltf's own
   // parser rejects valid spot lights that rely on the default cone angles.
   Json for_tinygltf = out.doc;
-  if (Json* exts = for_tinygltf.contains("extensions") ? &for_tinygltf["extensions"] : nullptr; exts != nullptr && exts->is_object()) {
+  if (Json* exts = for_tinygltf.contains("extensions") ? &for_tinygltf["extensions"] : nullptr;
+      exts != nullptr && exts->is_object()) {
     exts->erase("KHR_lights_punctual");
   }
   const std::string stripped = for_tinygltf.dump();
