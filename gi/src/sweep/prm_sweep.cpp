@@ -1,6 +1,7 @@
 #include "sweep/prm_sweep.h"
 
 #include <engine/scene.h>
+#include <gi/error_metrics.h>
 #include <gi/reference.h>
 
 #include <chrono>
@@ -22,8 +23,12 @@ namespace {
 constexpr std::uint64_t kReferenceSeed = 0x7072656665726e63ULL;
 
 // The scene with only its moving light on (the first light flagged as moving, else the
-// first light), flagged as moving, at `pose`. Errors: no light, unknown pose.
-engine::Result<engine::Scene> posed_scene(engine::SceneAsset asset, const std::string& pose) {
+// first light), flagged as moving, at `pose`, then swung by `swing_deg` degrees about Z the
+// way the demo's swinging lamp moves (gameplay.cpp swing_lamp): a light with a parent node
+// (a pivot) turns its parent, rest rotation x angleAxis(swing, local Z); a light without one
+// turns about the world Z axis through its own position (a spot's beam sweeps across the
+// room). Errors: no light, unknown pose.
+engine::Result<engine::Scene> posed_scene(engine::SceneAsset asset, const std::string& pose, double swing_deg = 0.0) {
   int chosen = -1;
   for (std::size_t n = 0; n < asset.nodes.size() && chosen < 0; ++n) {
     const int l = asset.nodes[n].light;
@@ -64,6 +69,15 @@ engine::Result<engine::Scene> posed_scene(engine::SceneAsset asset, const std::s
     node.rotation =
         glm::quatLookAtRH(direction, std::abs(direction.y) > 0.9f ? glm::vec3(1, 0, 0) : glm::vec3(0, 1, 0));
   }
+  if (swing_deg != 0.0) {
+    const glm::quat turn = glm::angleAxis(static_cast<float>(glm::radians(swing_deg)), glm::vec3(0, 0, 1));
+    if (node.parent >= 0) {
+      engine::Node& pivot = asset.nodes[static_cast<std::size_t>(node.parent)];
+      pivot.rotation = pivot.rotation * turn;
+    } else {
+      node.rotation = turn * node.rotation;
+    }
+  }
   return engine::instantiate(std::move(asset));
 }
 
@@ -74,7 +88,8 @@ void register_prm_sweep(SweepRegistry& registry) {
       {.kind = "atlas_indirect_irradiance_posed",
        .version = "pt-2",
        .compute = [](const ReferenceJob& job) -> engine::Result<RgbField> {
-         auto scene = posed_scene(job.scene.asset, job.request.param("pose"));
+         const std::string swing = job.request.param("swing");
+         auto scene = posed_scene(job.scene.asset, job.request.param("pose"), swing.empty() ? 0.0 : std::stod(swing));
          if (!scene) return scene.error();
          const auto inputs = atlas_inputs_from(bake_input_from(job.scene.asset));
          auto layout = build_atlas_layout(inputs, {.texels_per_metre = std::stof(job.request.param("texels_per_m"))});
@@ -130,6 +145,12 @@ void register_prm_sweep(SweepRegistry& registry) {
        .kind = KnobKind::Choice,
        .default_grid = {"authored", "corner", "wall"},
        .choices = {"authored", "corner", "wall"}},
+      {.name = "swing",
+       .description = "then the light swung about Z by this many degrees (its pivot if it has a parent)",
+       .kind = KnobKind::Real,
+       .default_grid = {"0"},
+       .min_value = -180,
+       .max_value = 180},
       {.name = "ref_spp",
        .description = "samples per texel of the path-traced reference",
        .kind = KnobKind::Integer,
@@ -142,10 +163,12 @@ void register_prm_sweep(SweepRegistry& registry) {
         ReferenceRequest::atlas_indirect_irradiance(k.real("density"), static_cast<int>(k.integer("ref_spp")));
     r.kind = "atlas_indirect_irradiance_posed";
     r.params.emplace_back("pose", k.text("pose"));
+    // Only a swung light names its swing, so unswung references keep their cache keys.
+    if (k.real("swing") != 0.0) r.params.emplace_back("swing", k.text("swing"));
     return r;
   };
   m.run = [](const RunContext& ctx) -> engine::Result<MethodOutput> {
-    auto scene = posed_scene(ctx.scene.asset, ctx.knobs.text("pose"));
+    auto scene = posed_scene(ctx.scene.asset, ctx.knobs.text("pose"), ctx.knobs.real("swing"));
     if (!scene) return scene.error();
     PrmSettings s;
     s.texels_per_metre = static_cast<float>(ctx.knobs.real("density"));
@@ -164,12 +187,33 @@ void register_prm_sweep(SweepRegistry& registry) {
     if (!caster) return caster.error();
     // Per-frame cost of a light change on the CPU: weights, selection and the pane sum.
     const auto t0 = std::chrono::steady_clock::now();
-    const auto picked = relight_clusters(*prm, bake_lights(input, BakeLights::Moving), **caster,
-                                         static_cast<int>(ctx.knobs.integer("active")));
+    const auto lights = bake_lights(input, BakeLights::Moving);
+    const auto picked = relight_clusters(*prm, lights, **caster, static_cast<int>(ctx.knobs.integer("active")));
     const std::vector<glm::vec3> atlas = sum_panes(*prm, picked);
     const double frame_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     MethodOutput out;
     out.field = RgbField::from_texels(prm->width, prm->height, atlas, ctx.reference.valid);
+    // What the K heaviest clusters leave out (not timed): the same relight with every lit
+    // cluster. dropped_energy = 1 - sum lum(K sum) / sum lum(all-cluster sum) over the valid
+    // texels (texels have one area at one density, so this is the share of reflected power the
+    // K-sum drops); rescaled_rel_rmse: the K-sum scaled by the inverse of the share kept, the
+    // error a runtime that rescaled to the full energy would have (the runtime does not).
+    const auto all = relight_clusters(*prm, lights, **caster, 0);
+    const std::vector<glm::vec3> full = sum_panes(*prm, all);
+    auto lum = [](const glm::vec3& c) {
+      return 0.2126 * static_cast<double>(c.x) + 0.7152 * static_cast<double>(c.y) + 0.0722 * static_cast<double>(c.z);
+    };
+    double kept = 0.0, total = 0.0;
+    for (std::size_t i = 0; i < atlas.size(); ++i) {
+      if (!ctx.reference.is_valid(i)) continue;
+      kept += lum(atlas[i]);
+      total += lum(full[i]);
+    }
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    out.extras = {{"clusters_lit", static_cast<double>(all.size())},
+                  {"clusters_summed", static_cast<double>(picked.size())},
+                  {"dropped_energy", total > 0.0 ? 1.0 - kept / total : nan},
+                  {"rescaled_rel_rmse", kept > 0.0 ? relative_rmse(out.field, ctx.reference, total / kept) : nan}};
     out.costs.bake_seconds = prm->stats.total_seconds;
     out.costs.frame_ms = frame_ms;
     out.costs.bytes = static_cast<std::uint64_t>(prm->cluster_count) * prm->pane_size() * 3u * 2u;  // half-float panes

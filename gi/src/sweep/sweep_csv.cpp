@@ -15,6 +15,7 @@ namespace {
 const char* const kMetricColumns[] = {"rel_rmse", "max_rel", "psnr_db", "fit_scale",     "fit_rel_rmse", "bake_s",
                                       "frame_ms", "bytes",   "wall_s",  "reference_key", "status"};
 constexpr std::string_view kKnobPrefix = "knob:";
+constexpr std::string_view kExtraPrefix = "extra:";
 
 std::string csv_field(std::string_view s) {
   if (s.find_first_of(",\"\r\n") == std::string_view::npos) return std::string(s);
@@ -42,9 +43,14 @@ std::string sweep_csv(std::span<const SweepRow> rows) {
   for (const SweepRow& r : rows)
     for (const auto& e : r.knobs.entries())
       if (std::find(knobs.begin(), knobs.end(), e.first) == knobs.end()) knobs.push_back(e.first);
+  std::vector<std::string> extras;
+  for (const SweepRow& r : rows)
+    for (const auto& e : r.extras)
+      if (std::find(extras.begin(), extras.end(), e.first) == extras.end()) extras.push_back(e.first);
   std::string out = "method,scene";
   for (const std::string& k : knobs) out += "," + csv_field(std::string(kKnobPrefix) + k);
   for (const char* c : kMetricColumns) out += std::string(",") + c;
+  for (const std::string& e : extras) out += "," + csv_field(std::string(kExtraPrefix) + e);
   out += "\n";
   for (const SweepRow& r : rows) {
     out += csv_field(r.method) + "," + csv_field(r.scene);
@@ -54,7 +60,12 @@ std::string sweep_csv(std::span<const SweepRow> rows) {
            format_number(r.error.psnr_db) + "," + format_number(r.error.fit_scale) + "," +
            format_number(r.error.fit_rel_rmse) + "," + format_number(c.bake_seconds) + "," +
            (std::isnan(c.frame_ms) ? std::string() : format_number(c.frame_ms)) + "," + std::to_string(c.bytes) + "," +
-           format_number(r.wall_seconds) + "," + csv_field(r.reference_key) + "," + csv_field(r.status) + "\n";
+           format_number(r.wall_seconds) + "," + csv_field(r.reference_key) + "," + csv_field(r.status);
+    for (const std::string& e : extras) {
+      const auto it = std::find_if(r.extras.begin(), r.extras.end(), [&](const auto& x) { return x.first == e; });
+      out += "," + (it == r.extras.end() ? std::string() : format_number(it->second));
+    }
+    out += "\n";
   }
   return out;
 }
@@ -126,9 +137,11 @@ engine::Result<std::vector<SweepRow>> parse_sweep_csv(std::string_view text, con
   const std::vector<std::string>& header = records->front();
   std::map<std::string, std::size_t> column;
   std::vector<std::pair<std::string, std::size_t>> knob_columns;
+  std::vector<std::pair<std::string, std::size_t>> extra_columns;
   for (std::size_t i = 0; i < header.size(); ++i) {
     column[header[i]] = i;
     if (header[i].starts_with(kKnobPrefix)) knob_columns.emplace_back(header[i].substr(kKnobPrefix.size()), i);
+    if (header[i].starts_with(kExtraPrefix)) extra_columns.emplace_back(header[i].substr(kExtraPrefix.size()), i);
   }
   for (const char* required : {"method", "scene"})
     if (!column.count(required)) return engine::Error{source, "header", std::string("missing column ") + required};
@@ -162,6 +175,13 @@ engine::Result<std::vector<SweepRow>> parse_sweep_csv(std::string_view text, con
     const auto br = std::from_chars(bytes.data(), bytes.data() + bytes.size(), row.costs.bytes);
     if (br.ec != std::errc() || br.ptr != bytes.data() + bytes.size()) {
       return engine::Error{source, where + ", column bytes", "'" + bytes + "' is not a byte count"};
+    }
+    for (const auto& [name, i] : extra_columns) {
+      if (f[i].empty()) continue;  // this row's method did not report it
+      double v = 0.0;
+      if (!parse_double(f[i], v))
+        return engine::Error{source, where + ", column extra:" + name, "'" + f[i] + "' is not a number"};
+      row.extras.emplace_back(name, v);
     }
     row.reference_key = f[column["reference_key"]];
     row.status = f[column["status"]];

@@ -2,7 +2,8 @@
 // Sweep rows as CSV (RFC 4180 quoting), one row per run, and back. Columns:
 //   method, scene, knob:<name> (one per knob, in order of first appearance), rel_rmse,
 //   max_rel, psnr_db, fit_scale, fit_rel_rmse, bake_s, frame_ms, bytes, wall_s,
-//   reference_key, status
+//   reference_key, status, then extra:<name> (a method's own measurements, in order of
+//   first appearance; only when some row has them)
 // Numbers are written in the shortest form that reads back exactly; "nan"/"inf" for
 // undefined/infinite metrics; frame_ms is empty when not applicable; a knob cell is empty
 // for a row whose method lacks that knob. tools/plot-sweep.py reads this format.
@@ -28,7 +29,7 @@ std::string sweep_csv(std::span<const SweepRow> rows);
 engine::Result<std::vector<std::vector<std::string>>> parse_csv(std::string_view text, const std::string& source);
 
 /// Reads rows written by sweep_csv. Restores method, scene, knobs, rel_rmse, max_rel,
-/// psnr_db, fit_scale, fit_rel_rmse, costs, wall time, reference key and status. Errors:
+/// psnr_db, fit_scale, fit_rel_rmse, costs, wall time, reference key, status and extras. Errors:
 /// malformed CSV, a missing column, a row with the wrong field count, a bad number.
 engine::Result<std::vector<SweepRow>> parse_sweep_csv(std::string_view text, const std::string& source);
 

@@ -11,6 +11,7 @@
 #include <functional>
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "sweep/knob_setting.h"
@@ -36,6 +37,9 @@ struct RunCosts {
 struct MethodOutput {
   RgbField field;
   RunCosts costs;
+  /// Method-specific measurements of this run (name, value), written as `extra:<name>`
+  /// columns of the CSV and the Markdown table; names as knob names. Empty for most methods.
+  std::vector<std::pair<std::string, double>> extras;
 };
 
 /// Everything a run may read. References stay valid for the duration of the call.

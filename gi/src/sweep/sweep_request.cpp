@@ -52,6 +52,26 @@ std::string file_stem_safe(std::string s) {
   return s;
 }
 
+// The gi-sweep command line that makes `r` (paths as given, so relative to where it ran).
+std::string sweep_command(const SweepRequest& r) {
+  auto arg = [](const std::string& s) {
+    return s.find_first_of(" \t'\"$\\") == std::string::npos ? s : "'" + s + "'";
+  };
+  std::string c = "gi-sweep --method " + arg(r.method) + " --scene " + arg(r.scene.generic_string());
+  for (const std::string& k : r.knobs) c += " --knob " + arg(k);
+  c += " --out " + arg(r.out_dir.generic_string());
+  if (!r.cache_dir.empty()) c += " --cache " + arg(r.cache_dir.generic_string());
+  c += " --threads " + std::to_string(r.threads);
+  if (r.seed != 1) c += " --seed " + std::to_string(r.seed);
+  if (r.frame_cost) c += " --cost frame";
+  const SweepRequest defaults;
+  if (!std::equal(std::begin(r.preset_targets), std::end(r.preset_targets), std::begin(defaults.preset_targets)))
+    c += " --presets " + format_number(r.preset_targets[0]) + "," + format_number(r.preset_targets[1]) + "," +
+         format_number(r.preset_targets[2]);
+  if (r.exposure != defaults.exposure) c += " --exposure " + format_number(r.exposure);
+  return c;
+}
+
 engine::Error invalid(const engine::Error& e) {
   engine::Error out = e;
   out.kind = engine::ErrorKind::Invalid;
@@ -131,7 +151,9 @@ engine::Result<SweepReport> run_sweep(const SweepRequest& request, const SweepHo
   report.csv = std::filesystem::path(stem).concat(".csv");
   report.markdown = std::filesystem::path(stem).concat(".md");
   const SweepSummary summary = summarize_sweep(
-      result->rows, {.cost = request.frame_cost ? SweepCost::FrameMs : SweepCost::BakeSeconds, .targets = targets});
+      result->rows, {.cost = request.frame_cost ? SweepCost::FrameMs : SweepCost::BakeSeconds,
+                     .targets = targets,
+                     .command = sweep_command(request)});
   if (engine::Status s = write_file_atomically(report.csv, sweep_csv(result->rows)); !s) return s.error();
   if (engine::Status s = write_file_atomically(report.markdown, sweep_summary_markdown(result->rows, summary)); !s)
     return s.error();

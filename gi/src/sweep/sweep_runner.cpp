@@ -88,6 +88,7 @@ engine::Result<SweepResult> run_sweep(const SweepRegistry& registry, const Sweep
       row.status = "run failed: " + out.error().to_string();
     } else {
       row.costs = out->costs;
+      row.extras = out->extras;
       if (std::string p = layout_problem(out->field, ref.field); !p.empty()) {
         row.status = p;
       } else {

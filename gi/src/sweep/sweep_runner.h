@@ -12,6 +12,7 @@
 #include <functional>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "sweep/sweep_registry.h"
@@ -32,6 +33,7 @@ struct SweepRow {
   KnobSetting knobs;
   ErrorReport error;          ///< Against the reference (NaN metrics when the run failed).
   RunCosts costs;             ///< As the method reported them.
+  std::vector<std::pair<std::string, double>> extras;  ///< MethodOutput::extras, as the method reported them.
   double wall_seconds = 0.0;  ///< Wall time of the run call, measured by the harness.
   std::string reference_key;  ///< The full reference cache key.
   std::string status = "ok";  ///< "ok", or why the run has no valid metrics.

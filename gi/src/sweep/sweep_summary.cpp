@@ -57,6 +57,15 @@ std::string sweep_summary_markdown(std::span<const SweepRow> rows, const SweepSu
   for (const SweepRow& r : rows)
     for (const auto& e : r.knobs.entries())
       if (std::find(knobs.begin(), knobs.end(), e.first) == knobs.end()) knobs.push_back(e.first);
+  std::vector<std::string> extras;
+  for (const SweepRow& r : rows)
+    for (const auto& e : r.extras)
+      if (std::find(extras.begin(), extras.end(), e.first) == extras.end()) extras.push_back(e.first);
+  auto extra_cell = [](const SweepRow& r, const std::string& name) {
+    for (const auto& e : r.extras)
+      if (e.first == name) return fixed(e.second, 4);
+    return std::string();
+  };
   auto preset_of = [&](std::size_t i) {
     std::string names;
     for (const PresetChoice& p : summary.presets)
@@ -71,6 +80,9 @@ std::string sweep_summary_markdown(std::span<const SweepRow> rows, const SweepSu
   const std::string method = rows.empty() ? std::string("(none)") : rows.front().method;
   const std::string scene = rows.empty() ? std::string("(none)") : rows.front().scene;
   md += "# Sweep: " + md_cell(method) + " on " + md_cell(scene) + "\n\n";
+  if (!summary.options.command.empty())
+    md += "Regenerate (from the repository root; `gi-sweep` is `build/tools/gi-sweep/gi-sweep`):\n\n```sh\n" +
+          summary.options.command + "\n```\n\n";
   if (!rows.empty()) md += "Reference: `" + rows.front().reference_key + "`\n\n";
   md +=
       "Error: relative RMSE of linear values, sqrt(sum (a-r)^2 / sum r^2) over valid elements and the three "
@@ -81,8 +93,10 @@ std::string sweep_summary_markdown(std::span<const SweepRow> rows, const SweepSu
   md += "## Runs\n\n|";
   for (const std::string& k : knobs) md += " " + md_cell(k) + " |";
   md +=
-      " rel RMSE | max rel | PSNR dB | fit s | fit rel RMSE | bake s | frame ms | bytes | front | preset | status |\n|";
-  for (std::size_t i = 0; i < knobs.size() + 11; ++i) md += "---|";
+      " rel RMSE | max rel | PSNR dB | fit s | fit rel RMSE | bake s | frame ms | bytes | front | preset | status |";
+  for (const std::string& e : extras) md += " " + md_cell(e) + " |";
+  md += "\n|";
+  for (std::size_t i = 0; i < knobs.size() + 11 + extras.size(); ++i) md += "---|";
   md += "\n";
   for (std::size_t i = 0; i < rows.size(); ++i) {
     const SweepRow& r = rows[i];
@@ -91,7 +105,9 @@ std::string sweep_summary_markdown(std::span<const SweepRow> rows, const SweepSu
     md += " " + fixed(r.error.rel_rmse, 4) + " | " + fixed(r.error.max_rel, 4) + " | " + fixed(r.error.psnr_db, 4) +
           " | " + fixed(r.error.fit_scale, 4) + " | " + fixed(r.error.fit_rel_rmse, 4) + " | " +
           fixed(r.costs.bake_seconds, 4) + " | " + fixed(r.costs.frame_ms, 4) + " | " + std::to_string(r.costs.bytes) +
-          " | " + (on_front(i) ? "yes" : "") + " | " + preset_of(i) + " | " + md_cell(r.status) + " |\n";
+          " | " + (on_front(i) ? "yes" : "") + " | " + preset_of(i) + " | " + md_cell(r.status) + " |";
+    for (const std::string& e : extras) md += " " + extra_cell(r, e) + " |";
+    md += "\n";
   }
 
   md += "\n## Pareto front\n\nRuns no other run beats on both relative RMSE and " + cost_name(summary.options.cost) +

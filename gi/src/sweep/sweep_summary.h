@@ -19,6 +19,7 @@ enum class SweepCost { BakeSeconds, FrameMs };
 struct SweepSummaryOptions {
   SweepCost cost = SweepCost::BakeSeconds;
   PresetTargets targets;
+  std::string command;  ///< The gi-sweep command that regenerates the files (Markdown states it); empty: none.
 };
 
 struct SweepSummary {

@@ -406,10 +406,17 @@ TEST(SweepCsv, RowsParseBack) {
   r.rows[1].status = "odd \"status\", with comma\nand newline";
   r.rows[2].costs.frame_ms = std::numeric_limits<double>::quiet_NaN();
   r.rows[3].error.psnr_db = std::numeric_limits<double>::infinity();
+  const std::string plain = gi::sweep_csv(r.rows);
+  EXPECT_EQ(plain.substr(0, plain.find('\n')),
+            "method,scene,knob:quality,knob:mode,rel_rmse,max_rel,psnr_db,fit_scale,fit_rel_rmse,bake_s,frame_ms,"
+            "bytes,wall_s,reference_key,status");
+  // A method's own measurements: extra:<name> columns after status, empty where a row lacks one.
+  r.rows[0].extras = {{"share", 0.25}};
+  r.rows[2].extras = {{"share", 0.5}, {"count", 3.0}};
   const std::string csv = gi::sweep_csv(r.rows);
   EXPECT_EQ(csv.substr(0, csv.find('\n')),
             "method,scene,knob:quality,knob:mode,rel_rmse,max_rel,psnr_db,fit_scale,fit_rel_rmse,bake_s,frame_ms,"
-            "bytes,wall_s,reference_key,status");
+            "bytes,wall_s,reference_key,status,extra:share,extra:count");
   auto back = gi::parse_sweep_csv(csv, "mem.csv");
   ASSERT_TRUE(back.ok()) << back.error().to_string();
   ASSERT_EQ(back->size(), r.rows.size());
@@ -433,6 +440,7 @@ TEST(SweepCsv, RowsParseBack) {
     EXPECT_EQ(b.wall_seconds, a.wall_seconds);
     EXPECT_EQ(b.reference_key, a.reference_key);
     EXPECT_EQ(b.status, a.status);
+    EXPECT_EQ(b.extras, a.extras);
   }
   EXPECT_FALSE(gi::parse_sweep_csv("method,scene\nx,\"unterminated\n", "bad.csv").ok());
   const auto missing = gi::parse_sweep_csv("method,scene\nx,y\n", "bad.csv");
@@ -451,6 +459,15 @@ TEST(SweepSummary, MarkdownListsFrontAndPresetsWithTheRule) {
   EXPECT_NE(md.find("Rule: each preset is the cheapest Pareto-front run"), std::string::npos);
   EXPECT_NE(md.find("**high**"), std::string::npos);
   EXPECT_NE(md.find("quality=16 mode=a"), std::string::npos);
+  EXPECT_EQ(md.find("Regenerate"), std::string::npos);  // no command given
+  gi::SweepSummaryOptions with_command;
+  with_command.command = "gi-sweep --method synthetic --scene s.gltf --out out";
+  gi::SweepResult extra = r;
+  extra.rows[1].extras = {{"dropped_energy", 0.125}};
+  const std::string md2 = gi::sweep_summary_markdown(extra.rows, gi::summarize_sweep(extra.rows, with_command));
+  EXPECT_NE(md2.find("```sh\ngi-sweep --method synthetic --scene s.gltf --out out\n```"), std::string::npos);
+  EXPECT_NE(md2.find("| status | dropped_energy |"), std::string::npos);
+  EXPECT_NE(md2.find("| 0.125 |"), std::string::npos);
 }
 
 TEST(SceneFingerprint, FileBytesAndLoadedContentBothCount) {
