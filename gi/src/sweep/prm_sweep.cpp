@@ -8,6 +8,7 @@
 #include <glm/gtc/quaternion.hpp>
 #include <limits>
 #include <string>
+#include <vector>
 
 #include "prm/prm.h"
 #include "prm/prm_runtime.h"
@@ -23,7 +24,9 @@ namespace {
 constexpr std::uint64_t kReferenceSeed = 0x7072656665726e63ULL;
 
 // The scene with only its moving light on (the first light flagged as moving, else the
-// first light), flagged as moving, at `pose`, then swung by `swing_deg` degrees about Z the
+// first light; every other light off and every emissive material dark, since the PRM relights
+// only the moving light and emissive surfaces belong to the static-light atlas), flagged as
+// moving, at `pose`, then swung by `swing_deg` degrees about Z the
 // way the demo's swinging lamp moves (gameplay.cpp swing_lamp): a light with a parent node
 // (a pivot) turns its parent, rest rotation x angleAxis(swing, local Z); a light without one
 // turns about the world Z axis through its own position (a spot's beam sweeps across the
@@ -40,6 +43,7 @@ engine::Result<engine::Scene> posed_scene(engine::SceneAsset asset, const std::s
     if (asset.nodes[n].light >= 0) chosen = static_cast<int>(n);
   if (chosen < 0) return engine::Error{.message = "the scene has no light to move"};
   for (engine::NamedLight& l : asset.lights) l.light.enabled = false;
+  for (auto& m : asset.materials) m.emissive = glm::vec3(0.0f);
   engine::Node& node = asset.nodes[static_cast<std::size_t>(chosen)];
   engine::Light& light = asset.lights[static_cast<std::size_t>(node.light)].light;
   light.enabled = true;
@@ -81,12 +85,23 @@ engine::Result<engine::Scene> posed_scene(engine::SceneAsset asset, const std::s
   return engine::instantiate(std::move(asset));
 }
 
+// The reference's world: every instance ("all"), or the static ones only ("static": what the
+// PRM's entry points, panes and shadow rays model; dynamic meshes such as the demo's lamp shade
+// or its crates then neither occlude nor reflect in the reference either).
+BakeInput reference_world(BakeInput input, const std::string& world) {
+  if (world == "static")
+    std::erase_if(input.instances, [](const BakeInstance& i) { return i.mobility == BakeMobility::Dynamic; });
+  return input;
+}
+
 }  // namespace
 
 void register_prm_sweep(SweepRegistry& registry) {
   registry.add_reference_provider(
       {.kind = "atlas_indirect_irradiance_posed",
-       .version = "pt-2",
+       // pt-3: emissive materials are dark too (pt-2 kept them, so a scene with an emissive
+       // surface, such as the demo level's ceiling panel, had its light in the reference).
+       .version = "pt-3",
        .compute = [](const ReferenceJob& job) -> engine::Result<RgbField> {
          const std::string swing = job.request.param("swing");
          auto scene = posed_scene(job.scene.asset, job.request.param("pose"), swing.empty() ? 0.0 : std::stod(swing));
@@ -99,7 +114,9 @@ void register_prm_sweep(SweepRegistry& registry) {
          rs.seed = kReferenceSeed;
          rs.threads = job.threads;
          rs.progress = job.progress;
-         auto truth = reference_atlas_irradiance(bake_input_from(*scene), rasterize_atlas(*layout, inputs), rs);
+         const std::string world = job.request.param("world");
+         auto truth = reference_atlas_irradiance(reference_world(bake_input_from(*scene), world.empty() ? "all" : world),
+                                                 rasterize_atlas(*layout, inputs), rs);
          if (!truth) return truth.error();
          return RgbField::from_texels(truth->width, truth->height, truth->indirect, truth->valid);
        }});
@@ -151,6 +168,11 @@ void register_prm_sweep(SweepRegistry& registry) {
        .default_grid = {"0"},
        .min_value = -180,
        .max_value = 180},
+      {.name = "world",
+       .description = "what the reference path-traces: all instances, or the static ones the PRM models",
+       .kind = KnobKind::Choice,
+       .default_grid = {"all"},
+       .choices = {"all", "static"}},
       {.name = "ref_spp",
        .description = "samples per texel of the path-traced reference",
        .kind = KnobKind::Integer,
@@ -165,6 +187,7 @@ void register_prm_sweep(SweepRegistry& registry) {
     r.params.emplace_back("pose", k.text("pose"));
     // Only a swung light names its swing, so unswung references keep their cache keys.
     if (k.real("swing") != 0.0) r.params.emplace_back("swing", k.text("swing"));
+    if (k.text("world") != "all") r.params.emplace_back("world", k.text("world"));
     return r;
   };
   m.run = [](const RunContext& ctx) -> engine::Result<MethodOutput> {
