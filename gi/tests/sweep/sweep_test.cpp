@@ -498,4 +498,27 @@ TEST(BuiltinSweepMethods, RegisterOnlyRealMethods) {
   for (const gi::SweepMethod& m : reg.methods()) EXPECT_TRUE(m.run) << m.name;
 }
 
+// The PRM's swing and world knobs name themselves in the reference key only when set, so the
+// references of unswung, all-instance runs keep the keys (and cache files) they had before.
+TEST(BuiltinSweepMethods, PrmSwingAndWorldKeepDefaultReferenceKeys) {
+  gi::SweepRegistry reg;
+  gi::register_builtin_sweep_methods(reg);
+  const gi::SweepMethod* prm = reg.find_method("prm");
+  ASSERT_NE(prm, nullptr);
+  const gi::SweepScene scene = make_scene();
+  const std::vector<std::string> plain = {"entries=256", "clusters=32", "pose=corner"};
+  auto grid = gi::make_knob_grid(*prm, plain);
+  ASSERT_TRUE(grid) << grid.error().to_string();
+  ASSERT_EQ(grid->settings().size(), 1u);
+  EXPECT_EQ(prm->reference_for(scene, grid->settings()[0]).key(),
+            "atlas_indirect_irradiance_posed(pose=corner,spp=4096,texels_per_m=4)");
+  const std::vector<std::string> swung = {"entries=256", "clusters=32", "pose=corner", "swing=-20", "world=static"};
+  auto grid2 = gi::make_knob_grid(*prm, swung);
+  ASSERT_TRUE(grid2) << grid2.error().to_string();
+  EXPECT_EQ(prm->reference_for(scene, grid2->settings()[0]).key(),
+            "atlas_indirect_irradiance_posed(pose=corner,spp=4096,swing=-20,texels_per_m=4,world=static)");
+  const std::vector<std::string> bad = {"world=some"};
+  EXPECT_FALSE(gi::make_knob_grid(*prm, bad));
+}
+
 }  // namespace
