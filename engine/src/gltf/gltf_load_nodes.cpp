@@ -2,6 +2,8 @@
 // parent-before-child order, with TRS transforms (a node matrix is decomposed), mesh /
 // camera / light references and the "gi" extras.
 
+#include <engine/finite.h>
+
 #include <cmath>
 #include <glm/gtx/matrix_decompose.hpp>
 
@@ -9,11 +11,6 @@
 
 namespace engine::gltf_load {
 namespace {
-
-bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
-bool finite(const glm::quat& q) {
-  return std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z) && std::isfinite(q.w);
-}
 
 /// Reads `count` numbers as floats; not an array of numbers -> Error; non-finite -> Error.
 Result<std::vector<float>> numbers(const Context& ctx, const Json& value, std::size_t count, const std::string& where,
@@ -37,8 +34,8 @@ Result<int> optional_index(const Context& ctx, const Json& node, const char* key
   if (v == nullptr) return -1;
   if (!(v->is_number_integer() || v->is_number_unsigned()) || v->get<std::int64_t>() < 0 ||
       static_cast<std::uint64_t>(v->get<std::int64_t>()) >= size) {
-    return ctx.error(where, std::string("'") + key + "' refers to a missing " + key + " (" + std::to_string(size) +
-                                " exist)");
+    return ctx.error(where,
+                     std::string("'") + key + "' refers to a missing " + key + " (" + std::to_string(size) + " exist)");
   }
   return v->get<int>();
 }
@@ -64,7 +61,8 @@ Status read_transform(const Context& ctx, const Json& src, const std::string& wh
     glm::vec3 skew;
     glm::vec4 perspective;
     if (!glm::decompose(mat, node.scale, node.rotation, node.translation, skew, perspective) ||
-        !finite(node.scale) || !finite(node.translation) || !finite(node.rotation)) {
+        !engine::all_finite(node.scale) || !engine::all_finite(node.translation) ||
+        !engine::all_finite(node.rotation)) {
       return ctx.error(where, "'matrix' is degenerate: its decomposition is not finite (NaN or Inf)");
     }
     node.rotation = glm::normalize(node.rotation);

@@ -2,19 +2,18 @@
 // KHR_draco_mesh_compression. The JSON is built with nlohmann::json, whose objects keep
 // their keys sorted, and floats are written in their shortest round-trip form, so the
 // same input always gives the same bytes.
+#include <engine/finite.h>
 #include <engine/gltf.h>
+#include <engine/units.h>
 
 #include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstring>
+#include <nlohmann/json.hpp>
 #include <set>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
-
-#include <engine/units.h>
 
 #include "gltf/draco_encode.h"
 #include "gltf/gltf_file_output.h"
@@ -41,8 +40,6 @@ json num(float f) {
 json vec(const glm::vec2& v) { return json::array({num(v.x), num(v.y)}); }
 json vec(const glm::vec3& v) { return json::array({num(v.x), num(v.y), num(v.z)}); }
 json vec(const glm::vec4& v) { return json::array({num(v.x), num(v.y), num(v.z), num(v.w)}); }
-
-bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
 // The binary buffer and its bufferViews, each view aligned to 4 bytes.
 class BinaryChunk {
@@ -138,7 +135,8 @@ class GltfBuilder {
                   {"metallicFactor", num(m.metallic)},
                   {"roughnessFactor", num(m.roughness)}};
       if (m.base_color_texture >= 0) pbr["baseColorTexture"] = {{"index", m.base_color_texture}};
-      if (m.metallic_roughness_texture >= 0) pbr["metallicRoughnessTexture"] = {{"index", m.metallic_roughness_texture}};
+      if (m.metallic_roughness_texture >= 0)
+        pbr["metallicRoughnessTexture"] = {{"index", m.metallic_roughness_texture}};
       json j = {{"pbrMetallicRoughness", std::move(pbr)}};
       if (!m.name.empty()) j["name"] = m.name;
       if (m.normal_texture >= 0) j["normalTexture"] = {{"index", m.normal_texture}};
@@ -175,7 +173,7 @@ class GltfBuilder {
     for (std::uint32_t i : p.indices)
       if (i >= n) return error(where, "index " + std::to_string(i) + " out of range");
     for (const glm::vec3& v : p.positions)
-      if (!finite(v)) return error(where, "position is NaN or infinite");
+      if (!engine::all_finite(v)) return error(where, "position is NaN or infinite");
     if (p.material >= static_cast<int>(scene_.materials.size())) return error(where, "material index out of range");
     return {};
   }
@@ -200,7 +198,10 @@ class GltfBuilder {
     json attributes;
     const int pos = add_attribute(p.positions, "VEC3");
     glm::vec3 lo = p.positions[0], hi = p.positions[0];
-    for (const glm::vec3& v : p.positions) { lo = glm::min(lo, v); hi = glm::max(hi, v); }
+    for (const glm::vec3& v : p.positions) {
+      lo = glm::min(lo, v);
+      hi = glm::max(hi, v);
+    }
     accessors_[static_cast<std::size_t>(pos)]["min"] = vec(lo);
     accessors_[static_cast<std::size_t>(pos)]["max"] = vec(hi);
     attributes["POSITION"] = pos;
@@ -239,7 +240,8 @@ class GltfBuilder {
       ids["TEXCOORD_1"] = d.uv1_id;
     }
     out = {{"attributes", std::move(attributes)}, {"mode", 4}};
-    out["indices"] = add_accessor(-1, d.vertex_count <= 0xFFFF ? kUnsignedShort : kUnsignedInt, d.index_count, "SCALAR");
+    out["indices"] =
+        add_accessor(-1, d.vertex_count <= 0xFFFF ? kUnsignedShort : kUnsignedInt, d.index_count, "SCALAR");
     out["extensions"]["KHR_draco_mesh_compression"] = {{"bufferView", view}, {"attributes", std::move(ids)}};
     used_.insert("KHR_draco_mesh_compression");
     required_.insert("KHR_draco_mesh_compression");
@@ -296,7 +298,8 @@ class GltfBuilder {
           j["type"] = "directional";
           j["intensity"] = num(units::w_per_m2_to_lux(l.intensity));
           break;
-        case LightType::Area: break;
+        case LightType::Area:
+          break;
       }
       if (l.type != LightType::Directional && l.range_m > 0.0f) j["range"] = num(l.range_m);
       khr_light_index_[i] = static_cast<int>(lights.size());
@@ -328,8 +331,10 @@ class GltfBuilder {
     for (int i = 0; i < count; ++i) {
       const int parent = scene_.nodes[static_cast<std::size_t>(i)].parent;
       if (parent >= i) return error("nodes[" + std::to_string(i) + "]", "parent must come before its child");
-      if (parent < 0) roots.push_back(i);
-      else children[static_cast<std::size_t>(parent)].push_back(i);
+      if (parent < 0)
+        roots.push_back(i);
+      else
+        children[static_cast<std::size_t>(parent)].push_back(i);
     }
     json nodes = json::array();
     for (int i = 0; i < count; ++i) {
@@ -337,8 +342,8 @@ class GltfBuilder {
       const std::string where = "nodes[" + std::to_string(i) + "]";
       json j;
       if (!n.name.empty()) j["name"] = n.name;
-      if (!finite(n.translation) || !finite(n.scale) || !std::isfinite(n.rotation.w) ||
-          !finite(glm::vec3(n.rotation.x, n.rotation.y, n.rotation.z)))
+      if (!engine::all_finite(n.translation) || !engine::all_finite(n.scale) || !std::isfinite(n.rotation.w) ||
+          !engine::all_finite(glm::vec3(n.rotation.x, n.rotation.y, n.rotation.z)))
         return error(where, "transform is NaN or infinite");
       if (n.translation != glm::vec3(0.0f)) j["translation"] = vec(n.translation);
       if (n.rotation != glm::quat(1.0f, 0.0f, 0.0f, 0.0f))

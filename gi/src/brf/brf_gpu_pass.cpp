@@ -1,6 +1,7 @@
 #include "brf/brf_gpu_pass.h"
 
 #include <GL/glcorearb.h>
+#include <engine/finite.h>
 
 #include <algorithm>
 #include <chrono>
@@ -52,15 +53,6 @@ std::size_t gl_limit(GLenum name) {
   GLint64 value = 0;
   glGetInteger64v(name, &value);
   return value > 0 ? static_cast<std::size_t>(value) : 0;
-}
-
-bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
-
-bool finite(const glm::mat4& m) {
-  for (int c = 0; c < 4; ++c)
-    for (int r = 0; r < 4; ++r)
-      if (!std::isfinite(m[c][r])) return false;
-  return true;
 }
 
 bool same_pose(const glm::mat4& a, const glm::mat4& b, float tolerance) {
@@ -158,7 +150,7 @@ engine::Status check_model(const BrfGpuModel& model, std::size_t m, std::size_t 
   }
   const std::size_t channels = nb * static_cast<std::size_t>(f.terms);
   if ((f.sh_bands != 3 && f.sh_bands != 4) || f.spheres < 1 || f.face_resolution < 1 || !(f.inner_radius > 0.0f) ||
-      !(f.outer_radius >= f.inner_radius) || !std::isfinite(f.outer_radius) || !finite(f.centre))
+      !(f.outer_radius >= f.inner_radius) || !std::isfinite(f.outer_radius) || !engine::all_finite(f.centre))
     return error(which + "field settings out of range");
   const std::size_t points = static_cast<std::size_t>(f.spheres) * 6 * static_cast<std::size_t>(f.face_resolution) *
                              static_cast<std::size_t>(f.face_resolution);
@@ -169,7 +161,7 @@ engine::Status check_model(const BrfGpuModel& model, std::size_t m, std::size_t 
     return error(which + "field of " + std::to_string(f.bytes()) + " bytes is above the SSBO limit of " +
                  std::to_string(limit));
   for (std::size_t j = 0; j < nv; ++j)
-    if (!finite(mesh.positions[j]) || !finite(mesh.normals[j]))
+    if (!engine::all_finite(mesh.positions[j]) || !engine::all_finite(mesh.normals[j]))
       return error(which + "non-finite vertex " + std::to_string(j));
   for (float v : basis.psi)
     if (!std::isfinite(v)) return error(which + "non-finite basis value");
@@ -334,7 +326,7 @@ engine::Status BrfGpuPass::set_static_receivers(std::span<const glm::vec3> posit
                  " normals");
   if (positions.size() >= (std::size_t{1} << 31)) return error("too many static receivers");
   for (std::size_t t = 0; t < positions.size(); ++t)
-    if (!finite(positions[t]) || !finite(normals[t]))
+    if (!engine::all_finite(positions[t]) || !engine::all_finite(normals[t]))
       return error("static receiver " + std::to_string(t) + " is not finite");
   std::vector<glm::vec4> points;
   points.reserve(2 * positions.size());
@@ -624,17 +616,17 @@ engine::Status BrfGpuPass::check_frame(std::span<const BrfGpuInstance> instances
     if (inst.model >= models_.size())
       return error(which + "model " + std::to_string(inst.model) + " does not exist (" +
                    std::to_string(models_.size()) + " models)");
-    if (!finite(inst.object_to_world)) return error(which + "non-finite transform");
+    if (!engine::all_finite(inst.object_to_world)) return error(which + "non-finite transform");
     const float det = glm::determinant(glm::mat3(inst.object_to_world));
     if (!(std::fabs(det) > 0.0f) || !std::isfinite(det)) return error(which + "singular transform");
-    if (!finite(inst.albedo)) return error(which + "non-finite albedo");
-    if (!finite(inst.specular)) return error(which + "non-finite specular colour");
+    if (!engine::all_finite(inst.albedo)) return error(which + "non-finite albedo");
+    if (!engine::all_finite(inst.specular)) return error(which + "non-finite specular colour");
     const ModelInfo& m = models_[inst.model];
     if (incoming[i].size() != static_cast<std::size_t>(m.terms) * m.vertex_count)
       return error(which + "incoming light of " + std::to_string(incoming[i].size()) + " values, the model needs " +
                    std::to_string(m.terms) + " x " + std::to_string(m.vertex_count) + " (terms x vertices)");
     for (const glm::vec3& e : incoming[i])
-      if (!finite(e)) return error(which + "non-finite incoming light");
+      if (!engine::all_finite(e)) return error(which + "non-finite incoming light");
   }
   return {};
 }

@@ -1,9 +1,10 @@
 #include "light_atlas/light_atlas_vpl_file.h"
 
+#include <engine/byte_stream.h>
+#include <engine/finite.h>
+
 #include <cmath>
 #include <span>
-
-#include <engine/byte_stream.h>
 
 namespace gi {
 
@@ -13,8 +14,6 @@ template <class T>
 std::span<const T> as_span(const std::vector<T>& v) {
   return std::span<const T>(v);
 }
-
-bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
 // Empty when the VPL arrays fit together, else what is wrong.
 std::string check_vpls(const VplSet& s, const std::vector<glm::vec3>& power) {
@@ -38,11 +37,12 @@ std::string check_vpls(const VplSet& s, const std::vector<glm::vec3>& power) {
       if (s.sample_first[j] > s.sample_first[j + 1]) return "sample_first decreases at VPL " + std::to_string(j);
   }
   for (std::size_t j = 0; j < n; ++j)
-    if (!finite(s.position[j]) || !finite(s.normal[j]) || !finite(s.albedo[j]) || !std::isfinite(s.area_m2[j]) ||
-        !finite(power[j]))
+    if (!engine::all_finite(s.position[j]) || !engine::all_finite(s.normal[j]) || !engine::all_finite(s.albedo[j]) ||
+        !std::isfinite(s.area_m2[j]) || !engine::all_finite(power[j]))
       return "VPL " + std::to_string(j) + " has a NaN or infinite value";
   for (std::size_t k = 0; k < samples; ++k)
-    if (!finite(s.sample_position[k]) || !finite(s.sample_normal[k]) || !std::isfinite(s.sample_area_m2[k]))
+    if (!engine::all_finite(s.sample_position[k]) || !engine::all_finite(s.sample_normal[k]) ||
+        !std::isfinite(s.sample_area_m2[k]))
       return "sample point " + std::to_string(k) + " has a NaN or infinite value";
   return {};
 }

@@ -2,6 +2,7 @@
 
 #include <embree3/rtcore.h>
 #include <engine/check.h>
+#include <engine/finite.h>
 
 #include <cmath>
 #include <cstdio>
@@ -53,13 +54,6 @@ struct SceneHandle {
   }
 };
 
-bool finite(const glm::mat4& m) {
-  for (int c = 0; c < 4; ++c)
-    for (int r = 0; r < 4; ++r)
-      if (!std::isfinite(m[c][r])) return false;
-  return true;
-}
-
 class EmbreeRayCaster final : public RayCaster {
  public:
   engine::Status build(const RtSceneData& data) {
@@ -77,7 +71,7 @@ class EmbreeRayCaster final : public RayCaster {
     for (std::size_t i = 0; i < data_.instances.size(); ++i) {
       if (data_.instances[i].geometry >= data_.geometries.size())
         return engine::Error{"", "instance " + std::to_string(i), "geometry index out of range"};
-      if (!finite(data_.instances[i].object_to_world))
+      if (!engine::all_finite(data_.instances[i].object_to_world))
         return engine::Error{"", "instance " + std::to_string(i), "non-finite transform"};
     }
 
@@ -155,7 +149,7 @@ class EmbreeRayCaster final : public RayCaster {
   void set_instance_transform(std::uint32_t instance, const glm::mat4& object_to_world) override {
     GI_EXPECTS(instance < data_.instances.size(), "instance index out of range");
     GI_EXPECTS(data_.instances[instance].dynamic, "only dynamic instances can move");
-    GI_EXPECTS(finite(object_to_world), "instance transforms must be finite");
+    GI_EXPECTS(engine::all_finite(object_to_world), "instance transforms must be finite");
     data_.instances[instance].object_to_world = object_to_world;
     RTCGeometry g = rtcGetGeometry(top_.h, instance);
     rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT4X4_COLUMN_MAJOR, &object_to_world[0][0]);

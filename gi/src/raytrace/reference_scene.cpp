@@ -1,13 +1,13 @@
 #include "raytrace/reference_scene.h"
 
+#include <engine/finite.h>
+
 #include <algorithm>
 #include <cmath>
 #include <string>
 
 namespace gi {
 namespace {
-
-bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
 float luminance(const glm::vec3& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 
@@ -44,14 +44,16 @@ engine::Result<ReferenceSceneIndex> index_reference_scene(const ReferenceScene& 
   for (std::size_t m = 0; m < scene.materials.size(); ++m) {
     const ReferenceMaterial& mat = scene.materials[m];
     const engine::GltfBrdf& b = mat.brdf;
-    if (!finite(b.base_color) || !finite(b.dielectric_f0) || !finite(mat.emission) || !std::isfinite(b.alpha) ||
-        !(b.alpha > 0.0f) || !(b.metallic >= 0.0f && b.metallic <= 1.0f) ||
-        !(b.specular_weight >= 0.0f && b.specular_weight <= 1.0f))
-      return scene_error("material " + std::to_string(m), "non-finite value, alpha <= 0, or metallic / specular weight outside [0, 1]");
+    if (!engine::all_finite(b.base_color) || !engine::all_finite(b.dielectric_f0) ||
+        !engine::all_finite(mat.emission) || !std::isfinite(b.alpha) || !(b.alpha > 0.0f) ||
+        !(b.metallic >= 0.0f && b.metallic <= 1.0f) || !(b.specular_weight >= 0.0f && b.specular_weight <= 1.0f))
+      return scene_error("material " + std::to_string(m),
+                         "non-finite value, alpha <= 0, or metallic / specular weight outside [0, 1]");
   }
   for (std::size_t i = 0; i < scene.lights.size(); ++i) {
     const ReferenceLight& l = scene.lights[i];
-    if (!finite(l.position) || !finite(l.direction) || !finite(l.radiant) || !finite(l.half_x) || !finite(l.half_y))
+    if (!engine::all_finite(l.position) || !engine::all_finite(l.direction) || !engine::all_finite(l.radiant) ||
+        !engine::all_finite(l.half_x) || !engine::all_finite(l.half_y))
       return scene_error("light " + std::to_string(i), "non-finite position, direction, size or intensity");
   }
 
@@ -76,14 +78,16 @@ engine::Result<ReferenceSceneIndex> index_reference_scene(const ReferenceScene& 
       std::uint32_t vi[3];
       for (int k = 0; k < 3; ++k) {
         vi[k] = geo.indices[3 * t + static_cast<std::size_t>(k)];
-        if (vi[k] >= geo.positions.size()) return scene_error(where, "triangle " + std::to_string(t) + ": index out of range");
+        if (vi[k] >= geo.positions.size())
+          return scene_error(where, "triangle " + std::to_string(t) + ": index out of range");
       }
       if (mats[t] >= scene.materials.size())
         return scene_error(where, "triangle " + std::to_string(t) + ": material index out of range");
       glm::vec3 p[3], n[3];
       for (int k = 0; k < 3; ++k) {
         p[k] = glm::vec3(m * glm::vec4(geo.positions[vi[k]], 1.0f));
-        if (!finite(p[k])) return scene_error(where, "triangle " + std::to_string(t) + ": non-finite position");
+        if (!engine::all_finite(p[k]))
+          return scene_error(where, "triangle " + std::to_string(t) + ": non-finite position");
         lo = glm::min(lo, p[k]);
         hi = glm::max(hi, p[k]);
       }

@@ -1,3 +1,4 @@
+#include <engine/finite.h>
 #include <gi/bake_input.h>
 
 #include <algorithm>
@@ -10,15 +11,6 @@
 namespace gi {
 
 namespace {
-
-bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
-
-bool finite(const glm::mat4& m) {
-  for (int c = 0; c < 4; ++c)
-    for (int r = 0; r < 4; ++r)
-      if (!std::isfinite(m[c][r])) return false;
-  return true;
-}
 
 BakeMaterial material_from(const engine::Material& m) {
   BakeMaterial b;
@@ -181,8 +173,8 @@ engine::Status validate_bake_input(const BakeInput& input) {
   for (std::size_t mi = 0; mi < input.materials.size(); ++mi) {
     const BakeMaterial& m = input.materials[mi];
     const std::string where = "material " + std::to_string(mi) + " '" + m.name + "'";
-    if (!finite(m.base_color) || !finite(m.specular_color) || !finite(m.emission) || !std::isfinite(m.metallic) ||
-        !std::isfinite(m.roughness) || !std::isfinite(m.specular))
+    if (!engine::all_finite(m.base_color) || !engine::all_finite(m.specular_color) || !engine::all_finite(m.emission) ||
+        !std::isfinite(m.metallic) || !std::isfinite(m.roughness) || !std::isfinite(m.specular))
       return input_error(where, "a factor is NaN or infinite");
     if (glm::any(glm::lessThan(m.base_color, glm::vec3(0.0f))) ||
         glm::any(glm::greaterThan(m.base_color, glm::vec3(1.0f))) || m.metallic < 0.0f || m.metallic > 1.0f ||
@@ -207,9 +199,9 @@ engine::Status validate_bake_input(const BakeInput& input) {
           return input_error(where, "index " + std::to_string(i) + " out of range (" +
                                         std::to_string(p.positions.size()) + " vertices)");
       for (const glm::vec3& v : p.positions)
-        if (!finite(v)) return input_error(where, "a position is NaN or infinite");
+        if (!engine::all_finite(v)) return input_error(where, "a position is NaN or infinite");
       for (const glm::vec3& v : p.normals)
-        if (!finite(v)) return input_error(where, "a normal is NaN or infinite");
+        if (!engine::all_finite(v)) return input_error(where, "a normal is NaN or infinite");
       if (p.material >= static_cast<int>(input.materials.size()))
         return input_error(where, "material " + std::to_string(p.material) + " out of range (" +
                                       std::to_string(input.materials.size()) + " materials)");
@@ -223,22 +215,22 @@ engine::Status validate_bake_input(const BakeInput& input) {
                                     std::to_string(input.meshes.size()) + " meshes)");
     if (inst.material_override >= static_cast<int>(input.materials.size()))
       return input_error(where, "material override " + std::to_string(inst.material_override) + " out of range");
-    if (!finite(inst.object_to_world)) return input_error(where, "the transform is NaN or infinite");
+    if (!engine::all_finite(inst.object_to_world)) return input_error(where, "the transform is NaN or infinite");
     const float det = glm::determinant(glm::mat3(inst.object_to_world));
     if (!std::isfinite(det) || std::fabs(det) < 1e-18f) return input_error(where, "the transform is not invertible");
   }
   for (std::size_t li = 0; li < input.lights.size(); ++li) {
     const BakeLight& l = input.lights[li];
     const std::string where = "light " + std::to_string(li) + " '" + l.name + "'";
-    if (!finite(l.light_to_world) || !finite(l.light.color) || !std::isfinite(l.light.intensity) ||
-        !std::isfinite(l.light.range_m) || !std::isfinite(l.light.inner_cone_rad) ||
-        !std::isfinite(l.light.outer_cone_rad) || !std::isfinite(l.light.area_size_m.x) ||
-        !std::isfinite(l.light.area_size_m.y))
+    if (!engine::all_finite(l.light_to_world) || !engine::all_finite(l.light.color) ||
+        !std::isfinite(l.light.intensity) || !std::isfinite(l.light.range_m) ||
+        !std::isfinite(l.light.inner_cone_rad) || !std::isfinite(l.light.outer_cone_rad) ||
+        !std::isfinite(l.light.area_size_m.x) || !std::isfinite(l.light.area_size_m.y))
       return input_error(where, "a value is NaN or infinite");
     if (l.light.intensity < 0.0f || glm::any(glm::lessThan(l.light.color, glm::vec3(0.0f))))
       return input_error(where, "colour and intensity must be >= 0");
   }
-  if (!finite(input.environment.sky_radiance) ||
+  if (!engine::all_finite(input.environment.sky_radiance) ||
       glm::any(glm::lessThan(input.environment.sky_radiance, glm::vec3(0.0f))))
     return input_error("environment", "the sky radiance must be finite and >= 0");
   return {};
