@@ -1,5 +1,7 @@
 #include "brf/brf_io.h"
 
+#include <engine/byte_stream.h>
+#include <engine/finite.h>
 #include <zstd.h>
 
 #include <cmath>
@@ -9,7 +11,6 @@
 #include <system_error>
 
 #include "bundle/bundle.h"
-#include <engine/byte_stream.h>
 #include "io/json_fields.h"
 
 namespace gi {
@@ -30,8 +31,6 @@ constexpr std::size_t kMaxSingularValues = 65536;
 constexpr std::uint64_t kMaxVertices = std::uint64_t{1} << 31;
 
 std::string str(std::uint64_t v) { return std::to_string(v); }
-
-bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
 engine::Error file_error(const fs::path& path, std::string location, std::string message) {
   return engine::Error{path.string(), std::move(location), std::move(message)};
@@ -100,7 +99,7 @@ std::string check_bake(const BrfMeshBake& b) {
     return "singular_values has " + str(s.singular_values.size()) + " values, at most 65536 expected";
   if (!std::isfinite(s.condition) || !(s.condition >= 1.0))
     return "condition " + std::to_string(s.condition) + " is not a finite number >= 1";
-  if (!finite(s.centre) || !std::isfinite(s.radius) || !(s.radius > 0.0f))
+  if (!engine::all_finite(s.centre) || !std::isfinite(s.radius) || !(s.radius > 0.0f))
     return "the basis's bounding sphere is not finite with a positive radius";
   if (std::size_t i = first_non_finite(s.psi); i != std::string::npos)
     return "psi value " + str(i) + " (function " + str(i / s.vertex_count) + ", vertex " + str(i % s.vertex_count) +
@@ -124,9 +123,11 @@ std::string check_bake(const BrfMeshBake& b) {
   if (f.basis_count != s.basis_count)
     return "the field has " + std::to_string(f.basis_count) + " basis functions, the basis " +
            std::to_string(s.basis_count);
-  if (!finite(f.centre) || !std::isfinite(f.inner_radius) || !std::isfinite(f.outer_radius) ||
-      !(f.inner_radius > 0.0f) || !(f.outer_radius >= f.inner_radius))
-    return "the field's centre and radii are not finite with 0 < inner_radius <= outer_radius";
+  // Radii from 1 micrometre to 1e6 m, at most 1e9 apart: log(outer / inner) and the lookups'
+  // r / inner stay finite (a subnormal inner radius made the sphere index NaN).
+  if (!engine::all_finite(f.centre) || !std::isfinite(f.inner_radius) || !std::isfinite(f.outer_radius) ||
+      !(f.inner_radius >= 1e-6f) || !(f.outer_radius >= f.inner_radius) || !(f.outer_radius <= 1e6f))
+    return "the field's centre and radii are not finite with 1e-6 m <= inner_radius <= outer_radius <= 1e6 m";
   if (f.coefficients.size() != values)
     return "the field has " + str(f.coefficients.size()) + " coefficients, " + std::to_string(f.spheres) +
            " spheres x 6 x " + std::to_string(f.face_resolution) + "^2 points x " + std::to_string(f.channel_count()) +

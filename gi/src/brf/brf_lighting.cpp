@@ -2,6 +2,7 @@
 
 #include <GL/glcorearb.h>
 #include <engine/components.h>
+#include <engine/finite.h>
 #include <engine/gpu/gl_objects.h>
 #include <engine/gpu/shader_program.h>
 
@@ -32,13 +33,6 @@ std::uint64_t lights_signature(const engine::Registry& registry) {
         h.add_value(light_signature(e, l, wt));
       });
   return h.value();
-}
-
-bool finite_matrix(const glm::mat4& m) {
-  for (int c = 0; c < 4; ++c)
-    for (int r = 0; r < 4; ++r)
-      if (!std::isfinite(m[c][r])) return false;
-  return true;
 }
 
 }  // namespace
@@ -160,7 +154,7 @@ bool BrfLighting::update() {
   bool any_moved = false;
   for (std::size_t i = 0; i < m.instances.size(); ++i) {
     const auto* wt = m.registry->try_get<engine::WorldTransform>(m.instances[i].entity);
-    if (wt == nullptr || !finite_matrix(wt->matrix)) continue;
+    if (wt == nullptr || !engine::all_finite(wt->matrix)) continue;
     if (!m.computed || wt->matrix != m.transforms[i]) {
       m.transforms[i] = wt->matrix;
       moved[i] = 1;

@@ -1,5 +1,7 @@
 #include "brf/brf_mesh.h"
 
+#include <engine/finite.h>
+
 #include <algorithm>
 #include <cmath>
 #include <set>
@@ -13,8 +15,6 @@
 namespace gi {
 
 namespace {
-
-bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
 float luminance(const glm::vec3& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 
@@ -112,7 +112,7 @@ engine::Result<BrfMesh> brf_mesh_from_input(const BakeInput& input, std::uint32_
                              "primitive " + std::to_string(pi) + " index " + std::to_string(i) + " is out of range (" +
                                  std::to_string(n) + " vertices)"};
     for (const glm::vec3& v : p.positions)
-      if (!finite(v)) return engine::Error{where, location, "a position is NaN or infinite"};
+      if (!engine::all_finite(v)) return engine::Error{where, location, "a position is NaN or infinite"};
     std::vector<glm::vec3> normals = p.normals;
     if (normals.empty()) {
       normals.assign(n, glm::vec3(0.0f));
@@ -123,7 +123,7 @@ engine::Result<BrfMesh> brf_mesh_from_input(const BakeInput& input, std::uint32_
       }
     }
     for (glm::vec3& v : normals) {
-      if (!finite(v)) return engine::Error{where, location, "a normal is NaN or infinite"};
+      if (!engine::all_finite(v)) return engine::Error{where, location, "a normal is NaN or infinite"};
       const float len = glm::length(v);
       v = len > 0.0f && std::isfinite(len) ? v / len : glm::vec3(0.0f, 0.0f, 1.0f);  // unused vertex or degenerate
     }

@@ -1,10 +1,11 @@
 #include "brf/pca_basis.h"
 
+#include <engine/finite.h>
+
+#include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
 #include <numbers>
-
-#include <Eigen/Dense>
 
 #include "brf/brdf_separation.h"
 #include "raytrace/embree_ray_caster.h"
@@ -22,12 +23,11 @@ std::vector<glm::vec3> sphere_points(int n) {
     const double z = 1.0 - (2.0 * i + 1.0) / n;
     const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
     const double phi = golden * i;
-    out.emplace_back(static_cast<float>(r * std::cos(phi)), static_cast<float>(r * std::sin(phi)), static_cast<float>(z));
+    out.emplace_back(static_cast<float>(r * std::cos(phi)), static_cast<float>(r * std::sin(phi)),
+                     static_cast<float>(z));
   }
   return out;
 }
-
-bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
 }  // namespace
 
@@ -80,7 +80,7 @@ engine::Result<BrfBasis> compute_pca_basis(const BrfMesh& mesh, const PcaBasisSe
   for (std::uint32_t i : mesh.indices)
     if (i >= nv) return engine::Error{.message = "basis radiance fields: index " + std::to_string(i) + " out of range"};
   for (std::size_t j = 0; j < nv; ++j)
-    if (!finite(mesh.positions[j]) || !finite(mesh.normals[j]))
+    if (!engine::all_finite(mesh.positions[j]) || !engine::all_finite(mesh.normals[j]))
       return engine::Error{.message = "basis radiance fields: vertex " + std::to_string(j) + " is not finite"};
   if (settings.lights < 2 || settings.lights > 65536 || settings.basis < 1 || settings.basis > 1024 ||
       !(settings.light_radius_scale >= 1.0f) || !(settings.rank_tolerance > 0.0f && settings.rank_tolerance < 1.0f) ||
@@ -117,11 +117,13 @@ engine::Result<BrfBasis> compute_pca_basis(const BrfMesh& mesh, const PcaBasisSe
     const glm::vec3 light = out.centre + dirs[static_cast<std::size_t>(k)] * (out.radius * settings.light_radius_scale);
     const std::vector<float> e = point_light_response(bare, **caster, light);  // irradiance
     for (std::size_t j = 0; j < nv; ++j)
-      c(static_cast<Eigen::Index>(j), k) = static_cast<double>((mesh.reflectance.empty() ? 1.0f : mesh.reflectance[j]) * e[j]);
+      c(static_cast<Eigen::Index>(j), k) =
+          static_cast<double>((mesh.reflectance.empty() ? 1.0f : mesh.reflectance[j]) * e[j]);
     for (int t = 1; t < terms; ++t)
       for (std::size_t j = 0; j < nv; ++j) {
         const glm::vec3 w = frames[j] * glm::normalize(light - mesh.positions[j]);
-        c(static_cast<Eigen::Index>(j), t * lights + k) = e[j] > 0.0f ? static_cast<double>(glossy->g_at(t - 1, w) * e[j]) : 0.0;
+        c(static_cast<Eigen::Index>(j), t * lights + k) =
+            e[j] > 0.0f ? static_cast<double>(glossy->g_at(t - 1, w) * e[j]) : 0.0;
       }
   }
   // Each glossy term's block scaled to the diffuse block's norm (a black diffuse part: 1).
@@ -142,7 +144,8 @@ engine::Result<BrfBasis> compute_pca_basis(const BrfMesh& mesh, const PcaBasisSe
   int components = 0;
   const double top = sigma.size() > 0 ? sigma(0) : 0.0;
   // (and no more functions than vertices: they could not be independent)
-  while (components + 1 < settings.basis && components < sigma.size() && static_cast<std::size_t>(components + 1) < nv &&
+  while (components + 1 < settings.basis && components < sigma.size() &&
+         static_cast<std::size_t>(components + 1) < nv &&
          sigma(components) > static_cast<double>(settings.rank_tolerance) * top)
     ++components;
   // The basis spans the mean and the kept components. Orthonormalized (modified
@@ -175,9 +178,10 @@ engine::Result<BrfBasis> compute_pca_basis(const BrfMesh& mesh, const PcaBasisSe
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(a);
   const Eigen::VectorXd& lambda = eig.eigenvalues();
   const double lambda_max = lambda.maxCoeff();
-  const double cutoff = std::max(static_cast<double>(settings.rank_tolerance) * static_cast<double>(settings.rank_tolerance),
-                                 1.0 / settings.max_condition) *
-                        lambda_max;
+  const double cutoff =
+      std::max(static_cast<double>(settings.rank_tolerance) * static_cast<double>(settings.rank_tolerance),
+               1.0 / settings.max_condition) *
+      lambda_max;
   Eigen::VectorXd inv = Eigen::VectorXd::Zero(lambda.size());
   double lambda_min_kept = lambda_max;
   for (Eigen::Index i = 0; i < lambda.size(); ++i)
@@ -187,7 +191,8 @@ engine::Result<BrfBasis> compute_pca_basis(const BrfMesh& mesh, const PcaBasisSe
   out.a_inverse.resize(n * n);
   for (std::size_t r = 0; r < n; ++r)
     for (std::size_t col = 0; col < n; ++col)
-      out.a_inverse[r * n + col] = static_cast<float>(a_inv(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(col)));
+      out.a_inverse[r * n + col] =
+          static_cast<float>(a_inv(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(col)));
   return out;
 }
 

@@ -72,7 +72,10 @@ void BasisRadianceField::sample(const glm::vec3& p, std::span<float> out) const 
   } else {
     sr = std::log(r / inner_radius) / std::log(outer_radius / inner_radius) * static_cast<float>(spheres - 1);
   }
-  const int s0 = std::min(static_cast<int>(sr), spheres - 1), s1 = std::min(s0 + 1, spheres - 1);
+  // NaN-safe (degenerate radii): the index stays within the spheres whatever sr is.
+  if (!(sr >= 0.0f)) sr = 0.0f;
+  sr = std::min(sr, static_cast<float>(spheres - 1));
+  const int s0 = static_cast<int>(sr), s1 = std::min(s0 + 1, spheres - 1);
   const float ts = sr - static_cast<float>(s0);
   int f = 0;
   float u = 0.0f, v = 0.0f;

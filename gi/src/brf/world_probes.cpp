@@ -1,5 +1,7 @@
 #include "brf/world_probes.h"
 
+#include <engine/finite.h>
+
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -13,15 +15,11 @@
 
 namespace gi {
 
-namespace {
-
-bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
-
-}  // namespace
+namespace {}  // namespace
 
 bool WorldProbeGrid::radiance(const glm::vec3& p, std::array<glm::vec3, 9>& out) const {
   out.fill(glm::vec3(0.0f));
-  if (radiance_sh.empty() || !finite(p)) return false;
+  if (radiance_sh.empty() || !engine::all_finite(p)) return false;
   const glm::vec3 g = (p - origin) / spacing;
   const glm::ivec3 last = dims - 1;
   const glm::vec3 clamped = glm::clamp(g, glm::vec3(0.0f), glm::vec3(last));
@@ -31,9 +29,10 @@ bool WorldProbeGrid::radiance(const glm::vec3& p, std::array<glm::vec3, 9>& out)
   for (int c = 0; c < 8; ++c) {
     const glm::ivec3 o(c & 1, (c >> 1) & 1, (c >> 2) & 1);
     const glm::ivec3 q = glm::min(i0 + o, last);
-    const std::size_t k = static_cast<std::size_t>(q.x) +
-                          static_cast<std::size_t>(dims.x) *
-                              (static_cast<std::size_t>(q.y) + static_cast<std::size_t>(dims.y) * static_cast<std::size_t>(q.z));
+    const std::size_t k =
+        static_cast<std::size_t>(q.x) +
+        static_cast<std::size_t>(dims.x) *
+            (static_cast<std::size_t>(q.y) + static_cast<std::size_t>(dims.y) * static_cast<std::size_t>(q.z));
     if (valid[k] == 0) continue;
     const float w = (o.x != 0 ? f.x : 1.0f - f.x) * (o.y != 0 ? f.y : 1.0f - f.y) * (o.z != 0 ? f.z : 1.0f - f.z);
     if (w <= 0.0f) continue;
@@ -47,7 +46,7 @@ bool WorldProbeGrid::radiance(const glm::vec3& p, std::array<glm::vec3, 9>& out)
 
 glm::vec3 WorldProbeGrid::irradiance(const glm::vec3& p, const glm::vec3& n) const {
   const float nl = glm::length(n);
-  if (!finite(n) || !(nl > 0.0f)) return glm::vec3(0.0f);
+  if (!engine::all_finite(n) || !(nl > 0.0f)) return glm::vec3(0.0f);
   std::array<glm::vec3, 9> l;
   if (!radiance(p, l)) return glm::vec3(0.0f);
   const auto lobe = sh_clamped_cosine(n / nl, 3);
@@ -62,26 +61,32 @@ engine::Result<WorldProbeGrid> bake_world_probes(const RayCaster& static_world, 
   const std::size_t n = vpls.size();
   if (vpl_power.size() != n || vpls.normal.size() != n || vpls.area_m2.size() != n)
     return engine::Error{.message = "world probes: VPL arrays of different sizes (" + std::to_string(n) + " VPLs, " +
-                                           std::to_string(vpl_power.size()) + " powers)"};
+                                    std::to_string(vpl_power.size()) + " powers)"};
   if (!(settings.spacing_m > 0.0f) || !std::isfinite(settings.spacing_m) || settings.max_probes < 8)
     return engine::Error{.message = "world probes: spacing must be positive and finite, max_probes >= 8"};
   WorldProbeGrid grid;
   if (n == 0) return grid;
   glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
   for (std::size_t i = 0; i < n; ++i) {
-    if (!finite(vpls.position[i]) || !finite(vpls.normal[i]) || !finite(vpl_power[i]) || !std::isfinite(vpls.area_m2[i]))
+    if (!engine::all_finite(vpls.position[i]) || !engine::all_finite(vpls.normal[i]) ||
+        !engine::all_finite(vpl_power[i]) || !std::isfinite(vpls.area_m2[i]))
       return engine::Error{.message = "world probes: VPL " + std::to_string(i) + " has a non-finite value"};
     lo = glm::min(lo, vpls.position[i]);
     hi = glm::max(hi, vpls.position[i]);
   }
-  float spacing = settings.spacing_m;
+  // Cells counted in double before any integer conversion: VPLs 2e9 m apart must widen the
+  // spacing, not overflow the dimensions.
+  const glm::dvec3 extent = glm::dvec3(hi) - glm::dvec3(lo);
+  double spacing_d = settings.spacing_m;
   for (;;) {
-    const glm::vec3 extent = hi - lo;
-    grid.dims = glm::ivec3(glm::ceil(extent / spacing)) + 1;
-    const double count = double(grid.dims.x) * double(grid.dims.y) * double(grid.dims.z);
-    if (count <= double(settings.max_probes)) break;
-    spacing *= 1.25f;
+    const glm::dvec3 cells = glm::ceil(extent / spacing_d) + 1.0;
+    if (cells.x * cells.y * cells.z <= double(settings.max_probes)) {
+      grid.dims = glm::ivec3(cells);
+      break;
+    }
+    spacing_d *= 1.25;
   }
+  const float spacing = static_cast<float>(spacing_d);
   grid.spacing = spacing;
   // Centre the grid on the VPLs' box.
   grid.origin = 0.5f * (lo + hi) - 0.5f * spacing * glm::vec3(grid.dims - 1);
@@ -91,32 +96,36 @@ engine::Result<WorldProbeGrid> bake_world_probes(const RayCaster& static_world, 
   grid.valid.assign(count, 0);
 
   ThreadPool pool(settings.threads);
-  pool.parallel_for(count, [&](std::size_t k) {
-    const std::size_t x = k % static_cast<std::size_t>(grid.dims.x);
-    const std::size_t y = (k / static_cast<std::size_t>(grid.dims.x)) % static_cast<std::size_t>(grid.dims.y);
-    const std::size_t z = k / (static_cast<std::size_t>(grid.dims.x) * static_cast<std::size_t>(grid.dims.y));
-    const glm::vec3 p = grid.origin + spacing * glm::vec3(static_cast<float>(x), static_cast<float>(y), static_cast<float>(z));
-    std::array<glm::vec3, 9> sh{};
-    bool any = false;
-    for (std::size_t i = 0; i < n; ++i) {
-      const glm::vec3 to_probe = p - vpls.position[i];
-      const float d2 = glm::dot(to_probe, to_probe);
-      if (!(d2 > 0.0f)) continue;
-      const float d = std::sqrt(d2);
-      const glm::vec3 w_out = to_probe / d;
-      const float cos_v = glm::dot(vpls.normal[i], w_out);
-      if (cos_v <= 0.0f) continue;
-      const glm::vec3 start = offset_ray_origin(vpls.position[i], vpls.normal[i]);
-      const glm::vec3 dir = p - start;
-      if (static_world.occluded(Ray{.origin = start, .t_min = 0.0f, .direction = dir, .t_max = 1.0f})) continue;
-      any = true;
-      const glm::vec3 flux = vpl_power[i] * (cos_v / (std::numbers::pi_v<float> * d2 + vpls.area_m2[i]));
-      const auto y_lm = sh_basis(-w_out);  // direction from the probe towards the VPL
-      for (std::size_t j = 0; j < 9; ++j) sh[j] += y_lm[j] * flux;
-    }
-    grid.radiance_sh[k] = sh;
-    grid.valid[k] = any ? 1 : 0;
-  }, 4);
+  pool.parallel_for(
+      count,
+      [&](std::size_t k) {
+        const std::size_t x = k % static_cast<std::size_t>(grid.dims.x);
+        const std::size_t y = (k / static_cast<std::size_t>(grid.dims.x)) % static_cast<std::size_t>(grid.dims.y);
+        const std::size_t z = k / (static_cast<std::size_t>(grid.dims.x) * static_cast<std::size_t>(grid.dims.y));
+        const glm::vec3 p =
+            grid.origin + spacing * glm::vec3(static_cast<float>(x), static_cast<float>(y), static_cast<float>(z));
+        std::array<glm::vec3, 9> sh{};
+        bool any = false;
+        for (std::size_t i = 0; i < n; ++i) {
+          const glm::vec3 to_probe = p - vpls.position[i];
+          const float d2 = glm::dot(to_probe, to_probe);
+          if (!(d2 > 0.0f)) continue;
+          const float d = std::sqrt(d2);
+          const glm::vec3 w_out = to_probe / d;
+          const float cos_v = glm::dot(vpls.normal[i], w_out);
+          if (cos_v <= 0.0f) continue;
+          const glm::vec3 start = offset_ray_origin(vpls.position[i], vpls.normal[i]);
+          const glm::vec3 dir = p - start;
+          if (static_world.occluded(Ray{.origin = start, .t_min = 0.0f, .direction = dir, .t_max = 1.0f})) continue;
+          any = true;
+          const glm::vec3 flux = vpl_power[i] * (cos_v / (std::numbers::pi_v<float> * d2 + vpls.area_m2[i]));
+          const auto y_lm = sh_basis(-w_out);  // direction from the probe towards the VPL
+          for (std::size_t j = 0; j < 9; ++j) sh[j] += y_lm[j] * flux;
+        }
+        grid.radiance_sh[k] = sh;
+        grid.valid[k] = any ? 1 : 0;
+      },
+      4);
   return grid;
 }
 

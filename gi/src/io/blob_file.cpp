@@ -1,12 +1,13 @@
 #include "io/blob_file.h"
 
+#include <engine/byte_stream.h>
+
 #include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <string>
 #include <string_view>
 
-#include <engine/byte_stream.h>
 #include "io/atomic_file.h"
 #include "io/content_hash.h"
 
@@ -49,6 +50,10 @@ engine::Result<std::vector<std::byte>> read_file_bytes(const std::filesystem::pa
   const std::streamoff size = in.tellg();
   in.seekg(0, std::ios::beg);
   if (size < 0) return blob_error(path, "", "cannot read the file size");
+  if (static_cast<std::uint64_t>(size) > kMaxBakeFileBytes)
+    return blob_error(path, "",
+                      std::to_string(size) + " bytes: larger than any bake file can be (at most " +
+                          std::to_string(kMaxBakeFileBytes) + ")");
   std::vector<std::byte> bytes(static_cast<std::size_t>(size));
   if (size > 0 && !in.read(reinterpret_cast<char*>(bytes.data()), size)) return blob_error(path, "", "read failed");
   return bytes;

@@ -40,7 +40,13 @@ inline constexpr std::size_t kBlobHeaderBytes = 28;
 /// `path` is untouched and the error names `path`. The parent directory must exist.
 engine::Status write_file_atomic(const std::filesystem::path& path, std::span<const std::byte> bytes);
 
-/// Reads a whole file. Error (naming it) when it is missing or unreadable.
+/// The largest file read_file_bytes reads (1 GiB; a demo-level bundle at the high preset
+/// is about 15 MB in all): a damaged or hostile file claiming terabytes is refused before
+/// anything is allocated.
+inline constexpr std::uint64_t kMaxBakeFileBytes = std::uint64_t{1} << 30;
+
+/// Reads a whole file. Error (naming it) when it is missing, unreadable or larger than
+/// kMaxBakeFileBytes.
 engine::Result<std::vector<std::byte>> read_file_bytes(const std::filesystem::path& path);
 
 /// XXH3-64 (gi::ContentHash) of a whole file as 16 hex digits: what a manifest records

@@ -1,5 +1,7 @@
 #include "prm/prm_io.h"
 
+#include <engine/byte_stream.h>
+#include <engine/finite.h>
 #include <zstd.h>
 
 #include <algorithm>
@@ -11,7 +13,6 @@
 #include <system_error>
 
 #include "bundle/bundle.h"
-#include <engine/byte_stream.h>
 #include "io/json_fields.h"
 #include "uv/atlas_input.h"
 
@@ -27,8 +28,6 @@ constexpr int kZstdLevel = 9;
 // Bounds a file may claim before anything is allocated (PrmSettings' limits).
 constexpr int kMaxClusters = 65536;
 constexpr int kMaxAtlasSide = 16384;
-
-bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
 std::string str(std::size_t v) { return std::to_string(v); }
 
@@ -58,7 +57,7 @@ std::string check_prm(const Prm& p) {
     const PrmEntryPoint& e = p.entries[k];
     if (e.cluster >= clusters)
       return "entry point " + str(k) + " is in cluster " + str(e.cluster) + ", there are " + str(clusters);
-    if (!finite(e.position) || !finite(e.normal) || !std::isfinite(e.area_m2))
+    if (!engine::all_finite(e.position) || !engine::all_finite(e.normal) || !std::isfinite(e.area_m2))
       return "entry point " + str(k) + " has a NaN or infinite value";
     if (e.area_m2 < 0.0f) return "entry point " + str(k) + " has a negative area";
     ++members[e.cluster];

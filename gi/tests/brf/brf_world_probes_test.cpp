@@ -6,7 +6,9 @@
 
 #include <cmath>
 #include <cstdio>
+#include <vector>
 
+#include "brf/radiance_field.h"
 #include "brf/world_probes.h"
 #include "light_atlas/light_atlas.h"
 #include "light_atlas_scenes.h"
@@ -95,3 +97,41 @@ TEST(BrfWorldProbes, BadInputIsAnError) {
 }
 
 }  // namespace
+
+// Two VPLs 2e9 m apart: the spacing widens until the grid fits (it overflowed the int
+// dimensions and threw std::length_error).
+TEST(BrfWorldProbes, FarApartVplsWidenTheSpacingInsteadOfOverflowing) {
+  const engine::Scene scene = engine::instantiate(latest::closed_box(2.0f, 0.6f, {0.3f, 0.4f, -0.2f}, 4.0f));
+  auto caster = gi::make_static_caster(gi::bake_input_from(scene)).value();
+  gi::VplSet vpls;
+  for (float x : {-1e9f, 1e9f}) {
+    vpls.position.push_back({x, 0.0f, 0.0f});
+    vpls.normal.push_back({0.0f, 1.0f, 0.0f});
+    vpls.albedo.push_back(glm::vec3(0.5f));
+    vpls.area_m2.push_back(1.0f);
+  }
+  vpls.sample_first = {0, 0, 0};
+  const std::vector<glm::vec3> power(2, glm::vec3(1.0f));
+  auto grid = gi::bake_world_probes(*caster, vpls, power, {.spacing_m = 1.0f, .max_probes = 4096, .threads = 1});
+  ASSERT_TRUE(grid) << grid.error().to_string();
+  EXPECT_LE(grid->probe_count(), 4096u);
+  EXPECT_GT(grid->spacing, 1e5f);
+}
+
+// A damaged field whose inner radius is subnormal: every lookup stays finite and in range
+// (the sphere index was NaN, then INT_MIN: a read far outside the coefficients).
+TEST(BrfRadianceField, DegenerateRadiiLookupsStayInRange) {
+  gi::BasisRadianceField f;
+  f.spheres = 3;
+  f.face_resolution = 2;
+  f.sh_bands = 1;
+  f.basis_count = 1;
+  f.inner_radius = 1e-38f;
+  f.outer_radius = 3e38f;
+  f.coefficients.assign(static_cast<std::size_t>(f.spheres) * 6 * 2 * 2, 1.0f);
+  std::vector<float> out(1, -1.0f);
+  for (glm::vec3 p : {glm::vec3(1, 0, 0), glm::vec3(1e20f, 0, 0), glm::vec3(1e-30f, 0, 0)}) {
+    f.sample(p, out);
+    EXPECT_TRUE(std::isfinite(out[0])) << p.x;
+  }
+}

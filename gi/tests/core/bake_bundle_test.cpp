@@ -119,6 +119,20 @@ TEST(BundleBlob, RejectsEveryCorruptionNamingTheFile) {
   EXPECT_TRUE(gi::read_blob(good, kMagic, 3).ok());
 }
 
+// A file claiming terabytes (here a sparse one: no disk used) is refused before anything is
+// allocated, naming the limit.
+TEST(BundleBlob, AFileLargerThanAnyBakeFileIsRefusedBeforeReading) {
+  const fs::path dir = scratch_dir("huge");
+  const fs::path path = dir / "prm_panes.bin";
+  std::ofstream(path) << "GIPRMPAN";
+  fs::resize_file(path, std::uintmax_t{4} << 40);  // 4 TiB, sparse
+  auto r = gi::read_blob(path, gi::BlobMagic{"GIPRMPAN"}, 1);
+  fs::remove(path);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.error().file, path.string());
+  EXPECT_NE(r.error().to_string().find("larger than any bake file can be"), std::string::npos) << r.error().to_string();
+}
+
 TEST(BundleAtomicWrite, FailedWritesLeaveNoFile) {
   const fs::path dir = scratch_dir("atomic");
   const auto payload = pattern(64);
