@@ -21,6 +21,8 @@ void add_material(ContentHash& h, const BakeMaterial& m) {
   add_vec(h, m.emission);
   h.add_value(m.specular);
   add_vec(h, m.specular_color);
+  // Back faces reflect and emit when double-sided: it changes the baked light (v4).
+  h.add_value(static_cast<std::uint8_t>(m.double_sided));
 }
 
 void add_primitive(ContentHash& h, const BakePrimitive& p) {
@@ -43,10 +45,10 @@ void add_primitive(ContentHash& h, const BakePrimitive& p) {
 
 std::string scene_geometry_hash(const BakeInput& input) {
   ContentHash h;
-  // v3: from BakeInput (instance ids, the material an override gives); v2: glTF's BRDF
+  // v4: a material's double_sided; v3: from BakeInput (instance ids, the material an override gives); v2: glTF's BRDF
   // (engine/gltf_brdf.h) replaced Lambert + GGX, so a bundle baked with the old reflectances
   // is stale even where the geometry is the same.
-  h.add_string("gi scene geometry v3");
+  h.add_string("gi scene geometry v4");
   for (const BakeInstance& inst : input.instances) {
     if (inst.mobility != BakeMobility::Static || inst.mesh >= input.meshes.size()) continue;
     h.add_value(inst.id);

@@ -34,13 +34,57 @@ BakeMesh mesh_from(const engine::Mesh& m) {
   return b;
 }
 
-// A node flagged deforming, or one under such a node.
-bool deforming_node(const engine::SceneAsset& assets, int node) {
-  std::size_t steps = 0;
-  for (int n = node; n >= 0 && static_cast<std::size_t>(n) < assets.nodes.size() && steps++ <= assets.nodes.size();
-       n = assets.nodes[static_cast<std::size_t>(n)].parent)
-    if (assets.nodes[static_cast<std::size_t>(n)].gi.region == engine::GiRegion::Deforming) return true;
-  return false;
+glm::mat4 local_matrix(const engine::Node& n) {
+  return glm::translate(glm::mat4(1.0f), n.translation) * glm::mat4_cast(n.rotation) *
+         glm::scale(glm::mat4(1.0f), n.scale);
+}
+
+// Per node, what its parent chain gives it, for all nodes at once in O(nodes) (walking each
+// node's chain was O(nodes x depth): a 2^20-node chain took 2^40 steps): its world matrix,
+// whether it or an ancestor is flagged deforming, its nearest dynamic ancestor (itself
+// included; -1: none). A chain that loops (the loader refuses those) ends where it loops.
+struct NodeChains {
+  std::vector<glm::mat4> world;
+  std::vector<std::uint8_t> deforming;
+  std::vector<int> dynamic_ancestor;
+};
+
+NodeChains node_chains(const engine::SceneAsset& asset) {
+  const std::size_t n = asset.nodes.size();
+  NodeChains c{std::vector<glm::mat4>(n, glm::mat4(1.0f)), std::vector<std::uint8_t>(n, 0), std::vector<int>(n, -1)};
+  enum : std::uint8_t { kTodo, kOnChain, kDone };
+  std::vector<std::uint8_t> state(n, kTodo);
+  std::vector<int> chain;
+  const auto in_range = [&](int i) { return i >= 0 && static_cast<std::size_t>(i) < n; };
+  for (std::size_t start = 0; start < n; ++start) {
+    chain.clear();
+    int i = static_cast<int>(start);
+    while (in_range(i) && state[static_cast<std::size_t>(i)] == kTodo) {
+      state[static_cast<std::size_t>(i)] = kOnChain;
+      chain.push_back(i);
+      i = asset.nodes[static_cast<std::size_t>(i)].parent;
+    }
+    int parent = in_range(i) && state[static_cast<std::size_t>(i)] == kDone ? i : -1;
+    for (auto it = chain.rbegin(); it != chain.rend(); ++it) {
+      const auto k = static_cast<std::size_t>(*it);
+      const engine::Node& node = asset.nodes[k];
+      const bool own_deforming = node.gi.region == engine::GiRegion::Deforming;
+      const bool own_dynamic = node.gi.mobility == engine::Mobility::Dynamic;
+      if (parent >= 0) {
+        const auto p = static_cast<std::size_t>(parent);
+        c.world[k] = c.world[p] * local_matrix(node);
+        c.deforming[k] = static_cast<std::uint8_t>(own_deforming || c.deforming[p] != 0);
+        c.dynamic_ancestor[k] = own_dynamic ? static_cast<int>(k) : c.dynamic_ancestor[p];
+      } else {
+        c.world[k] = local_matrix(node);
+        c.deforming[k] = static_cast<std::uint8_t>(own_deforming);
+        c.dynamic_ancestor[k] = own_dynamic ? static_cast<int>(k) : -1;
+      }
+      state[k] = kDone;
+      parent = static_cast<int>(k);
+    }
+  }
+  return c;
 }
 
 std::vector<engine::Entity> sorted(std::vector<engine::Entity> entities) {
@@ -100,31 +144,26 @@ BakeInput bake_input_from(const engine::SceneAsset& asset) {
   in.name = asset.source;
   for (const engine::Mesh& m : asset.meshes) in.meshes.push_back(mesh_from(m));
   for (const engine::Material& m : asset.materials) in.materials.push_back(material_from(m));
+  const NodeChains chains = node_chains(asset);
   for (std::size_t ni = 0; ni < asset.nodes.size(); ++ni) {
     const engine::Node& node = asset.nodes[ni];
     if (node.mesh >= 0 && static_cast<std::size_t>(node.mesh) < asset.meshes.size()) {
       BakeInstance inst;
       inst.name = node.name;
       inst.mesh = static_cast<std::uint32_t>(node.mesh);
-      inst.object_to_world = node_world_matrix(asset, static_cast<int>(ni));
+      inst.object_to_world = chains.world[ni];
       inst.mobility = node.gi.mobility == engine::Mobility::Dynamic ? BakeMobility::Dynamic : BakeMobility::Static;
-      inst.deforming = deforming_node(asset, static_cast<int>(ni));
+      inst.deforming = chains.deforming[ni] != 0;
       inst.id = static_cast<std::int64_t>(ni);
       in.instances.push_back(std::move(inst));
     }
     if (node.light >= 0 && static_cast<std::size_t>(node.light) < asset.lights.size()) {
       const engine::NamedLight& l = asset.lights[static_cast<std::size_t>(node.light)];
-      std::string dynamic_parent;
-      std::size_t steps = 0;
-      for (int a = static_cast<int>(ni); a >= 0 && static_cast<std::size_t>(a) < asset.nodes.size() &&
-                                         dynamic_parent.empty() && steps++ <= asset.nodes.size();
-           a = asset.nodes[static_cast<std::size_t>(a)].parent)
-        if (asset.nodes[static_cast<std::size_t>(a)].gi.mobility == engine::Mobility::Dynamic)
-          dynamic_parent = asset.nodes[static_cast<std::size_t>(a)].name;
+      const int dynamic = chains.dynamic_ancestor[ni];
       in.lights.push_back({.name = node.name.empty() ? l.name : node.name,
                            .light = l.light,
-                           .light_to_world = node_world_matrix(asset, static_cast<int>(ni)),
-                           .dynamic_parent = std::move(dynamic_parent)});
+                           .light_to_world = chains.world[ni],
+                           .dynamic_parent = dynamic >= 0 ? asset.nodes[static_cast<std::size_t>(dynamic)].name : ""});
     }
   }
   return in;
@@ -137,6 +176,7 @@ BakeInput bake_input_from(const engine::Scene& scene) {
   for (const engine::Mesh& m : scene.assets.meshes) in.meshes.push_back(mesh_from(m));
   for (const engine::Material& m : scene.assets.materials) in.materials.push_back(material_from(m));
 
+  const NodeChains chains = node_chains(scene.assets);
   std::unordered_map<std::uint32_t, int> node_of;  // entity index -> node index
   for (std::size_t i = 0; i < scene.node_entities.size(); ++i)
     node_of[scene.node_entities[i].index] = static_cast<int>(i);
@@ -153,7 +193,8 @@ BakeInput bake_input_from(const engine::Scene& scene) {
     const auto node = node_of.find(e.index);
     if (node != node_of.end() && scene.node_entities[static_cast<std::size_t>(node->second)] == e) {
       inst.id = node->second;
-      inst.deforming = deforming_node(scene.assets, node->second);
+      inst.deforming = static_cast<std::size_t>(node->second) < chains.deforming.size() &&
+                       chains.deforming[static_cast<std::size_t>(node->second)] != 0;
     }
     in.instances.push_back(std::move(inst));
   }

@@ -249,6 +249,11 @@ TEST(BundleGeometryHash, ChangesWithStaticGeometryAndAlbedo) {
   engine::SceneAsset emissive = base;
   emissive.materials[3].emissive.y += 0.5f;
   EXPECT_NE(gi::scene_geometry_hash(gi::bake_input_from(emissive)), h);
+
+  // A double-sided emitter lights through its back too: a bundle of the one-sided scene is stale.
+  engine::SceneAsset two_sided = base;
+  two_sided.materials[3].double_sided = !two_sided.materials[3].double_sided;
+  EXPECT_NE(gi::scene_geometry_hash(gi::bake_input_from(two_sided)), h);
 }
 
 TEST(BundleGeometryHash, IgnoresDynamicNodes) {
