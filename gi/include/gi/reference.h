@@ -80,6 +80,20 @@ engine::Result<IrradianceEstimate> reference_irradiance(const engine::Scene& sce
                                                         std::span<const SurfacePoint> points,
                                                         const ReferenceSettings& settings);
 
+/// Where a light-atlas texel's sample point (the surface point whose irradiance the texel
+/// holds) lies.
+enum class TexelPlacement : std::uint8_t {
+  /// On the surface a camera sees: 0.05 texel inside its triangle (never on the line where a
+  /// neighbouring surface begins) and moved in front of any back face within one texel (a
+  /// floor running under a wall). The light atlas's final gather bakes here.
+  VisibleSurface,
+  /// Where the rasterizer puts it: the texel centre on its triangle, or the triangle's point
+  /// closest to it, which may lie on a chart's border line or under other geometry. The VPL
+  /// final shooting and the PRM bake here (their estimates lack the near field that texels
+  /// moved next to concave edges need).
+  Raster,
+};
+
 /// The ground truth of a light atlas: irradiance (W/m^2) at every texel of the layout a bake
 /// of `input` gets at `texels_per_metre` (the static instances charted as the bakers chart
 /// them), width x height, texel (x, y) at y * width + x; texels no triangle covers hold
@@ -96,6 +110,7 @@ struct AtlasReference {
 /// samples_per_pixel of `settings` is per texel. Errors: no static triangle, a layout that
 /// cannot be built, bad settings, cancellation.
 engine::Result<AtlasReference> reference_atlas(const BakeInput& input, float texels_per_metre,
-                                               const ReferenceSettings& settings);
+                                               const ReferenceSettings& settings,
+                                               TexelPlacement placement = TexelPlacement::VisibleSurface);
 
 }  // namespace gi

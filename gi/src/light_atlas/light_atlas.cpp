@@ -42,7 +42,7 @@ struct BakeScene : StaticBakeScene {
 
 engine::Result<BakeScene> prepare(const BakeInput& input, const AtlasLayout& layout, const LightAtlasSettings& s) {
   // Lights that move belong to PRM (DESIGN.md 3): the atlas bakes the static ones only.
-  auto prepared = prepare_static_scene(input, layout, BakeLights::Static);
+  auto prepared = prepare_static_scene(input, layout, BakeLights::Static, texel_placement(s));
   if (!prepared) return prepared.error();
   BakeScene b{std::move(prepared).value(), {}};
   b.emitters = point_emitters(b.scene, b.index, s.area_light_samples, s.seed);
@@ -127,22 +127,37 @@ engine::Result<LightAtlasBake> bake_light_atlas(const BakeInput& input, const Li
   out.vpl_power = powers->power;
 
   t0 = Clock::now();
-  std::vector<std::uint32_t> shooters;
-  std::vector<glm::vec3> shot;
-  for (std::uint32_t i = 0; i < out.vpls.size(); ++i)
-    if (out.vpl_power[i] != glm::vec3(0.0f)) shooters.push_back(i), shot.push_back(out.vpl_power[i]);
-  // Texels are point samples of irradiance (as the reference's): no receiver area; the
-  // emitter's sample areas alone bound the near field.
-  auto final_result =
-      shoot_into_atlas(out.vpls, shooters, shot, b.texels, 0.0f, *b.caster, pool,
-                       {.seed = settings.seed, .progress = sub_progress(settings.progress, kFinalPhase)});
-  if (!final_result) return final_result.error();
-  out.irradiance = std::move(final_result->irradiance);
-  std::uint64_t rays = powers->rays + final_result->rays;
-  if (settings.include_direct) {
-    const float texel_area = 1.0f / (out.layout.texels_per_metre * out.layout.texels_per_metre);
-    const std::vector<glm::vec3> direct = direct_into_atlas(b.emitters, b.texels, texel_area, *b.caster, pool, &rays);
-    for (std::size_t t = 0; t < direct.size(); ++t) out.irradiance[t] += direct[t];
+  std::uint64_t rays = powers->rays;
+  if (settings.final_pass == LightAtlasSettings::FinalPass::TexelGather) {
+    TexelGatherSettings g = settings.gather;
+    g.seed = settings.seed;
+    g.progress = sub_progress(settings.progress, kFinalPhase);
+    auto gathered = gather_atlas(b, out.layout, g, pool);
+    if (!gathered) return gathered.error();
+    out.irradiance = std::move(gathered->indirect);
+    if (settings.include_direct)
+      for (std::size_t t = 0; t < out.irradiance.size(); ++t) out.irradiance[t] += gathered->direct[t];
+    rays += gathered->rays;
+    out.stats.gather_iterations = gathered->iterations;
+  } else {
+    std::vector<std::uint32_t> shooters;
+    std::vector<glm::vec3> shot;
+    for (std::uint32_t i = 0; i < out.vpls.size(); ++i)
+      if (out.vpl_power[i] != glm::vec3(0.0f)) shooters.push_back(i), shot.push_back(out.vpl_power[i]);
+    // Texels are point samples of irradiance (as the reference's): no receiver area; the
+    // emitter's sample areas alone bound the near field.
+    auto final_result =
+        shoot_into_atlas(out.vpls, shooters, shot, b.texels, 0.0f, *b.caster, pool,
+                         {.seed = settings.seed, .progress = sub_progress(settings.progress, kFinalPhase)});
+    if (!final_result) return final_result.error();
+    out.irradiance = std::move(final_result->irradiance);
+    rays += final_result->rays;
+    if (settings.include_direct) {
+      const float texel_area = 1.0f / (out.layout.texels_per_metre * out.layout.texels_per_metre);
+      const std::vector<glm::vec3> direct =
+          direct_into_atlas(b.emitters, b.texels, texel_area, *b.caster, pool, &rays);
+      for (std::size_t t = 0; t < direct.size(); ++t) out.irradiance[t] += direct[t];
+    }
   }
   out.stats.final_seconds = seconds_since(t0);
   out.valid = b.texels.valid;
@@ -218,6 +233,11 @@ engine::Result<LightAtlasSettings> light_atlas_preset(std::string_view name) {
     s.vpl_count = 3000, s.bounces = 16;
   }
   return s;
+}
+
+TexelPlacement texel_placement(const LightAtlasSettings& settings) {
+  return settings.final_pass == LightAtlasSettings::FinalPass::TexelGather ? TexelPlacement::VisibleSurface
+                                                                           : TexelPlacement::Raster;
 }
 
 std::vector<std::string> light_atlas_preset_names() { return {"preview", "medium", "high"}; }

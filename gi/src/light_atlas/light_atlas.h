@@ -29,6 +29,7 @@
 #include <string_view>
 #include <vector>
 
+#include "light_atlas/texel_gather.h"
 #include "transport/vpl_set.h"
 #include "uv/atlas_layout.h"
 
@@ -46,10 +47,21 @@ struct LightAtlasSettings {
   float unshot_threshold = 1e-4f;
   int area_light_samples = 64;  ///< Point samples per area light or emissive triangle (>= 1).
   bool include_direct = false;  ///< Add direct irradiance to the atlas (default: indirect only).
+  /// How step 4 fills the texels. VplShooting: the paper's final shooting (texels x VPLs
+  /// shadow rays). TexelGather: a final gather from every texel (texel_gather.h; `gather`
+  /// holds its knobs, its seed and progress are this struct's); the VPL solution of steps
+  /// 1-3 is then kept only for what reads it (BRF's world probes).
+  enum class FinalPass : std::uint8_t { VplShooting, TexelGather };
+  FinalPass final_pass = FinalPass::VplShooting;
+  TexelGatherSettings gather;
   std::uint64_t seed = 1;
   unsigned threads = 0;       ///< 0: all hardware threads. The result does not depend on it.
   ProgressCallback progress;  ///< Fraction done in [0, 1]; return false to cancel.
 };
+
+/// Where the bake's texel samples lie: VisibleSurface for the gather, Raster for the VPL
+/// final shooting (its near field is missing next to concave edges).
+TexelPlacement texel_placement(const LightAtlasSettings& settings);
 
 /// preview / medium / high, chosen from the measured Pareto front (docs/sweeps/).
 engine::Result<LightAtlasSettings> light_atlas_preset(std::string_view name);
@@ -65,7 +77,8 @@ struct LightAtlasStats {
   double vpl_seconds = 0.0;        ///< Distribution of VPLs and sample points.
   double direct_seconds = 0.0;     ///< Direct light to the VPLs.
   double propagate_seconds = 0.0;  ///< Progressive refinement.
-  double final_seconds = 0.0;      ///< Final shooting into the atlas.
+  double final_seconds = 0.0;      ///< Final shooting (or gather) into the atlas.
+  int gather_iterations = 0;       ///< TexelGather: bounces the kept-ray solve ran.
   double total_seconds = 0.0;      ///< Everything, layout and rasterization included.
 };
 

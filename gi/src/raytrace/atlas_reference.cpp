@@ -2,6 +2,7 @@
 
 #include <span>
 
+#include "raytrace/texel_samples.h"
 #include "uv/atlas_dilation.h"
 #include "uv/atlas_input.h"
 #include "uv/atlas_layout.h"
@@ -40,12 +41,14 @@ engine::Result<AtlasIrradiance> reference_atlas_irradiance(const BakeInput& inpu
 }
 
 engine::Result<AtlasReference> reference_atlas(const BakeInput& input, float texels_per_metre,
-                                               const ReferenceSettings& settings) {
+                                               const ReferenceSettings& settings, TexelPlacement placement) {
   if (auto ok = validate_bake_input(input); !ok) return ok.error();
   const std::vector<AtlasInputMesh> inputs = atlas_inputs_from(input);
   auto layout = build_atlas_layout(inputs, {.texels_per_metre = texels_per_metre});
   if (!layout) return layout.error();
-  auto truth = reference_atlas_irradiance(input, rasterize_atlas(*layout, inputs), settings);
+  auto texels = sample_atlas_texels(input, *layout, placement);
+  if (!texels) return texels.error();
+  auto truth = reference_atlas_irradiance(input, *texels, settings);
   if (!truth) return truth.error();
   return AtlasReference{.width = truth->width,
                         .height = truth->height,

@@ -2,6 +2,8 @@
 
 #include <engine/scene.h>
 
+#include <algorithm>
+
 #include "light_atlas/light_atlas.h"
 
 namespace gi {
@@ -10,7 +12,8 @@ void register_light_atlas_sweep(SweepRegistry& registry) {
   SweepMethod m;
   m.name = "light_atlas";
   m.description =
-      "light atlas by VPL shooting (Schärfig 2016): VPLs x bounces x texel density vs path-traced indirect irradiance";
+      "light atlas (Schärfig 2016): VPL final shooting or texel final gather, VPLs x bounces x rays x texel density vs "
+      "path-traced indirect irradiance";
   m.knobs = {
       {.name = "vpls",
        .description = "target VPL count",
@@ -36,6 +39,35 @@ void register_light_atlas_sweep(SweepRegistry& registry) {
        .default_grid = {"10"},
        .min_value = 1,
        .max_value = 1024},
+      {.name = "final",
+       .description = "step 4: shoot (the paper's VPL final shooting) or gather (texel final gather)",
+       .kind = KnobKind::Choice,
+       .default_grid = {"shoot"},
+       .choices = {"shoot", "gather"}},
+      {.name = "rays",
+       .description = "gather: fresh final-gather rays per texel (0: the kept-ray solve alone)",
+       .kind = KnobKind::Integer,
+       .default_grid = {"128"},
+       .min_value = 0,
+       .max_value = 1 << 20},
+      {.name = "solve_rays",
+       .description = "gather: kept rays per texel iterated for every bounce",
+       .kind = KnobKind::Integer,
+       .default_grid = {"64"},
+       .min_value = 1,
+       .max_value = 65536},
+      {.name = "direct_samples",
+       .description = "gather: light samples per texel on each area light and on the emitters",
+       .kind = KnobKind::Integer,
+       .default_grid = {"16"},
+       .min_value = 1,
+       .max_value = 65536},
+      {.name = "filter",
+       .description = "gather: world-space filter radius, texels (0: none)",
+       .kind = KnobKind::Real,
+       .default_grid = {"0"},
+       .min_value = 0,
+       .max_value = 16},
       {.name = "ref_spp",
        .description = "samples per texel of the path-traced reference",
        .kind = KnobKind::Integer,
@@ -44,7 +76,9 @@ void register_light_atlas_sweep(SweepRegistry& registry) {
        .max_value = 1 << 20},
   };
   m.reference_for = [](const SweepScene&, const KnobSetting& k) {
-    return ReferenceRequest::atlas_indirect_irradiance(k.real("density"), static_cast<int>(k.integer("ref_spp")));
+    return ReferenceRequest::atlas_indirect_irradiance(
+        k.real("density"), static_cast<int>(k.integer("ref_spp")),
+        k.text("final") == "gather" ? TexelPlacement::VisibleSurface : TexelPlacement::Raster);
   };
   m.run = [](const RunContext& ctx) -> engine::Result<MethodOutput> {
     LightAtlasSettings s;
@@ -52,6 +86,14 @@ void register_light_atlas_sweep(SweepRegistry& registry) {
     s.bounces = static_cast<int>(ctx.knobs.integer("bounces"));
     s.texels_per_metre = static_cast<float>(ctx.knobs.real("density"));
     s.samples_per_vpl = static_cast<int>(ctx.knobs.integer("samples"));
+    if (ctx.knobs.text("final") == "gather") {
+      s.final_pass = LightAtlasSettings::FinalPass::TexelGather;
+      s.gather.gather_rays = static_cast<int>(ctx.knobs.integer("rays"));
+      s.gather.solve_rays = static_cast<int>(ctx.knobs.integer("solve_rays"));
+      s.gather.direct_samples = static_cast<int>(ctx.knobs.integer("direct_samples"));
+      s.gather.filter_radius_texels = static_cast<float>(ctx.knobs.real("filter"));
+      s.gather.bounces = std::max(s.bounces, 1);
+    }
     s.seed = ctx.seed;
     s.threads = ctx.threads;
     s.progress = ctx.progress;

@@ -46,8 +46,12 @@ ReferenceRequest ReferenceRequest::camera_image(int camera_index, int width, int
            {"spp", std::to_string(spp)}}};
 }
 
-ReferenceRequest ReferenceRequest::atlas_indirect_irradiance(double texels_per_m, int spp) {
-  return {"atlas_indirect_irradiance", {{"texels_per_m", format_number(texels_per_m)}, {"spp", std::to_string(spp)}}};
+ReferenceRequest ReferenceRequest::atlas_indirect_irradiance(double texels_per_m, int spp, TexelPlacement placement) {
+  ReferenceRequest r{"atlas_indirect_irradiance",
+                     {{"texels_per_m", format_number(texels_per_m)}, {"spp", std::to_string(spp)}}};
+  // Raster keys (and cache files) are the ones from before the placement existed.
+  if (placement == TexelPlacement::VisibleSurface) r.params.emplace_back("texels", "visible_surface");
+  return r;
 }
 
 }  // namespace gi

@@ -4,6 +4,8 @@
 //   gi::ReferenceRequest r = gi::ReferenceRequest::camera_image(0, 256, 256, 4096);
 //   r.key();  // "camera_image(camera=0,height=256,spp=4096,width=256)"
 
+#include <gi/reference.h>
+
 #include <string>
 #include <string_view>
 #include <utility>
@@ -28,7 +30,9 @@ struct ReferenceRequest {
   static ReferenceRequest camera_image(int camera_index, int width, int height, int spp);
   /// Indirect irradiance at the light-atlas texels of the scene's uv1 layout at
   /// `texels_per_m` atlas density, `spp` samples per texel.
-  static ReferenceRequest atlas_indirect_irradiance(double texels_per_m, int spp);
+  /// `placement` enters the key only when it is VisibleSurface.
+  static ReferenceRequest atlas_indirect_irradiance(double texels_per_m, int spp,
+                                                    TexelPlacement placement = TexelPlacement::Raster);
 };
 
 }  // namespace gi

@@ -52,8 +52,10 @@ engine::Result<RgbField> render_camera(const SweepScene& s, const ReferenceReque
 }
 
 engine::Result<RgbField> atlas_indirect(const SweepScene& s, const ReferenceRequest& r, ReferenceSettings settings) {
-  auto truth =
-      reference_atlas(bake_input_from(engine::instantiate(s.asset)), std::stof(r.param("texels_per_m")), settings);
+  const TexelPlacement placement =
+      r.param("texels") == "visible_surface" ? TexelPlacement::VisibleSurface : TexelPlacement::Raster;
+  auto truth = reference_atlas(bake_input_from(engine::instantiate(s.asset)), std::stof(r.param("texels_per_m")),
+                               settings, placement);
   if (!truth) return truth.error();
   return RgbField::from_texels(truth->width, truth->height, truth->indirect, truth->valid);
 }

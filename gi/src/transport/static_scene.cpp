@@ -2,6 +2,7 @@
 
 #include "raytrace/embree_ray_caster.h"
 #include "raytrace/scene_adapter.h"
+#include "raytrace/texel_samples.h"
 #include "uv/atlas_input.h"
 
 namespace gi {
@@ -27,42 +28,28 @@ std::vector<ReferenceLight> bake_lights(const BakeInput& input, BakeLights light
   return kept;
 }
 
-namespace {
-
-// The static instances of `data` with, per kept instance, its index in `data`.
-RtSceneData static_only(const RtSceneData& data, std::vector<std::uint32_t>* kept) {
-  RtSceneData statics;
-  statics.geometries = data.geometries;
-  for (std::size_t i = 0; i < data.instances.size(); ++i) {
-    if (data.instances[i].dynamic) continue;
-    statics.instances.push_back(data.instances[i]);
-    if (kept) kept->push_back(static_cast<std::uint32_t>(i));
-  }
-  return statics;
-}
-
-}  // namespace
-
 engine::Result<std::unique_ptr<RayCaster>> make_static_caster(const BakeInput& input) {
-  const RtSceneData statics = static_only(rt_scene_from(input), nullptr);
+  const RtSceneData statics = static_instances(rt_scene_from(input), nullptr);
   if (statics.instances.empty()) return engine::Error{.message = "the scene has no static mesh"};
   return make_embree_ray_caster(statics);
 }
 
 engine::Result<StaticBakeScene> prepare_static_scene(const BakeInput& input, const AtlasLayout& layout,
-                                                     BakeLights lights) {
+                                                     BakeLights lights, TexelPlacement placement) {
   StaticBakeScene b;
   b.scene = reference_scene_from(input);
   b.scene.lights = bake_lights(input, lights);
   auto index = index_reference_scene(b.scene);
   if (!index) return index.error();
   b.index = std::move(index).value();
-  const RtSceneData statics = static_only(b.scene.geometry, &b.static_instance);
+  const RtSceneData statics = static_instances(b.scene.geometry, &b.static_instance);
   if (statics.instances.empty()) return engine::Error{.message = "the scene has no static mesh to bake"};
   auto caster = make_embree_ray_caster(statics);
   if (!caster) return caster.error();
   b.caster = std::move(caster).value();
-  b.texels = rasterize_atlas(layout, atlas_inputs_from(input));
+  auto texels = sample_atlas_texels(input, layout, placement, b.caster.get());
+  if (!texels) return texels.error();
+  b.texels = std::move(texels).value();
   return b;
 }
 

@@ -9,6 +9,7 @@
 #include <engine/registry.h>
 #include <engine/result.h>
 #include <gi/bake_input.h>
+#include <gi/reference.h>
 
 #include <memory>
 
@@ -41,8 +42,10 @@ struct StaticBakeScene {
 };
 
 /// Errors: invalid scene data (non-finite values...), no static mesh instance.
+/// `placement`: where the texels' samples lie (gi/reference.h).
 engine::Result<StaticBakeScene> prepare_static_scene(const BakeInput& input, const AtlasLayout& layout,
-                                                     BakeLights lights);
+                                                     BakeLights lights,
+                                                     TexelPlacement placement = TexelPlacement::Raster);
 
 /// A ray caster over the static mesh instances of `input` (what a runtime relighting of the
 /// static world shadows with). Errors: no static instance, invalid data.

@@ -12,6 +12,31 @@ namespace gi {
 namespace {
 
 constexpr float kTouchEpsilonTexels = 1e-4f;
+// `s` moved towards the triangle's centroid until it lies `inset` texels inside every edge
+// (or at the centroid of a triangle thinner than that). A sample on a chart's border is
+// on the line where the next surface begins (a floor's edge under a wall): rays from it
+// start on that wall's plane and slip behind it. Inside a chart the move stays on the
+// same surface.
+TrianglePoint inset_sample(const TrianglePoint& s, const glm::vec2 (&v)[3], double inset) {
+  const glm::dvec2 a(v[0]), b(v[1]), c(v[2]);
+  const double area2 = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+  if (!(std::fabs(area2) > 1e-12)) return s;
+  const double orient = area2 > 0.0 ? 1.0 : -1.0;
+  const glm::dvec2 g = (a + b + c) / 3.0, p(s.point);
+  const glm::dvec2 pts[3] = {a, b, c};
+  double t = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    const glm::dvec2 o = pts[k], e = pts[(k + 1) % 3] - o;
+    const double len = glm::length(e);
+    if (!(len > 0.0)) continue;
+    const auto dist = [&](glm::dvec2 q) { return orient * (e.x * (q.y - o.y) - e.y * (q.x - o.x)) / len; };
+    const double dp = dist(p), dg = dist(g);
+    if (dp < inset && dg > dp) t = std::max(t, (inset - dp) / (dg - dp));
+  }
+  if (!(t > 0.0)) return s;
+  const glm::vec2 moved(p + std::min(t, 1.0) * (g - p));
+  return {moved, triangle_barycentric(moved, v[0], v[1], v[2])};
+}
 
 glm::vec3 shading_normal(const AtlasInputMesh& in, const std::uint32_t v[3], glm::vec3 w, glm::vec3 chart_normal) {
   if (!in.normals.empty()) {
@@ -27,7 +52,7 @@ glm::vec3 shading_normal(const AtlasInputMesh& in, const std::uint32_t v[3], glm
 
 }  // namespace
 
-AtlasTexels rasterize_atlas(const AtlasLayout& layout, std::span<const AtlasInputMesh> inputs) {
+AtlasTexels rasterize_atlas(const AtlasLayout& layout, std::span<const AtlasInputMesh> inputs, float inset_texels) {
   GI_EXPECTS(inputs.size() == layout.meshes.size(), "inputs are the meshes the layout was built from");
   AtlasTexels out;
   out.width = layout.width;
@@ -82,6 +107,7 @@ AtlasTexels rasterize_atlas(const AtlasLayout& layout, std::span<const AtlasInpu
             if (!(d < distance[i])) continue;  // an earlier or closer triangle keeps it
             kind = TexelCoverage::Conservative;
           }
+          if (inset_texels > 0.0f) s = inset_sample(s, p, double{inset_texels});
           const glm::vec3 w = s.barycentric;
           distance[i] = d;
           out.coverage[i] = kind;

@@ -10,6 +10,10 @@
 // - Conservative: otherwise, when a triangle touches the texel square (closed, within 1e-4
 //   texel), the texel samples the point of that triangle closest to its centre. Among several
 //   such triangles the closest wins, then the first in (mesh, triangle) order.
+// - With inset_texels > 0, either sample then moves that far inside its triangle when it
+//   lies closer to an edge (towards the centroid): a sample on a chart's border would sit
+//   on the line where the next surface starts, and rays from it would slip behind that
+//   surface.
 // - Inside always beats Conservative. So every triangle's texel under its uv centroid is
 //   valid and owned by a triangle of the same chart (charts never share texels); a triangle
 //   too thin to own a texel of its own (a sliver next to others) reads its chart neighbour's
@@ -46,6 +50,7 @@ struct AtlasTexels {
 
 /// Samples every texel of `layout`. Precondition: `inputs` are the meshes the layout was
 /// built from (same count and vertex counts).
-AtlasTexels rasterize_atlas(const AtlasLayout& layout, std::span<const AtlasInputMesh> inputs);
+AtlasTexels rasterize_atlas(const AtlasLayout& layout, std::span<const AtlasInputMesh> inputs,
+                            float inset_texels = 0.0f);
 
 }  // namespace gi

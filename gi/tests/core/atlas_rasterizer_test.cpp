@@ -57,6 +57,33 @@ TEST(AtlasRasterizer, SamplesLieOnTheSurfaceWithUnitNormals) {
     }
 }
 
+TEST(AtlasRasterizer, InsetKeepsSamplesOffTheChartBorderAndOnTheSurface) {
+  const std::vector<gi::AtlasInputMesh> inputs{unit_quad_z0()};
+  auto layout = gi::build_atlas_layout(inputs, {.texels_per_metre = 16.0f});
+  ASSERT_TRUE(layout.ok()) << layout.error().to_string();
+  const gi::AtlasTexels raw = gi::rasterize_atlas(layout.value(), inputs);
+  const gi::AtlasTexels t = gi::rasterize_atlas(layout.value(), inputs, 0.05f);
+  ASSERT_EQ(t.valid, raw.valid);  // the inset moves samples, never the coverage
+  // 0.05 texel is 1/320 m at 16 texels/m: no sample on the square's border line, where a
+  // wall standing on it would begin.
+  constexpr float kInset = 0.05f / 16.0f - 1e-6f;
+  int on_border_before = 0, moved = 0;
+  for (std::size_t i = 0; i < t.valid.size(); ++i) {
+    if (!t.valid[i]) continue;
+    const glm::vec3 p = t.position[i], q = raw.position[i];
+    EXPECT_NEAR(p.z, 0.0f, 1e-6f);
+    EXPECT_GE(std::min(p.x, p.y), kInset) << "texel " << i;
+    EXPECT_LE(std::max(p.x, p.y), 1.0f - kInset) << "texel " << i;
+    on_border_before += std::min(std::min(q.x, q.y), 1.0f - std::max(q.x, q.y)) < 1e-5f;
+    // A sample moves towards the centroid of its triangle, a little more than the inset
+    // along that line (at most 0.16 texel in these right triangles, from a far vertex).
+    EXPECT_LE(glm::length(p - q), 0.2f / 16.0f) << "texel " << i;
+    moved += glm::length(p - q) > 0.0f;
+  }
+  EXPECT_GT(on_border_before, 0) << "the raw raster has samples on the border (the case the inset is for)";
+  EXPECT_GE(moved, on_border_before);
+}
+
 TEST(AtlasRasterizer, CentreInsideOwnershipGoesToTheLowestTriangle) {
   auto asset = engine::load_gltf(GI_SOURCE_DIR "/assets/crates_room.gltf", {.load_images = false});
   ASSERT_TRUE(asset.ok()) << asset.error().to_string();

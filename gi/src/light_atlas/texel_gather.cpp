@@ -1,0 +1,426 @@
+#include "light_atlas/texel_gather.h"
+
+#include <engine/gltf_brdf.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numbers>
+#include <unordered_map>
+
+#include "core/random.h"
+#include "raytrace/light_falloff.h"
+#include "raytrace/ray_offset.h"
+#include "raytrace/reference_brdf.h"
+#include "uv/atlas_dilation.h"
+
+namespace gi {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+constexpr float kPi = std::numbers::pi_v<float>;
+constexpr std::uint32_t kDark = 0xffffffffu;  // a ray into the surface, or nothing to read
+constexpr std::uint32_t kSky = 0xfffffffeu;   // the ray escaped
+constexpr std::uint32_t kBack = 0xfffffffdu;  // the back of a one-sided surface (black)
+// A texel whose kept rays see back faces this often lies inside or under geometry; the
+// filter neither reads nor smooths it.
+constexpr float kHiddenBackFraction = 0.1f;
+
+// Item ids of the three random streams of a texel.
+constexpr std::uint64_t kDirectStream = 0, kSolveStream = 1, kGatherStream = 2;
+std::uint64_t stream_id(std::uint64_t texel, std::uint64_t stream) { return texel * 4 + stream; }
+
+float radical_inverse(std::uint32_t i) {
+  i = (i << 16u) | (i >> 16u);
+  i = ((i & 0x55555555u) << 1u) | ((i & 0xAAAAAAAAu) >> 1u);
+  i = ((i & 0x33333333u) << 2u) | ((i & 0xCCCCCCCCu) >> 2u);
+  i = ((i & 0x0F0F0F0Fu) << 4u) | ((i & 0xF0F0F0F0u) >> 4u);
+  i = ((i & 0x00FF00FFu) << 8u) | ((i & 0xFF00FF00u) >> 8u);
+  return static_cast<float>(i >> 8) * 0x1p-24f;
+}
+
+// Point i of an n-point Hammersley set, shifted on the torus (Cranley-Patterson rotation):
+// stratified in both dimensions for any n, decorrelated between texels by the shift.
+glm::vec2 hammersley(std::uint32_t i, std::uint32_t n, glm::vec2 shift) {
+  const glm::vec2 u((static_cast<float>(i) + 0.5f) / static_cast<float>(n), radical_inverse(i));
+  glm::vec2 s = u + shift;
+  s -= glm::floor(s);
+  return glm::min(s, glm::vec2(0x1.fffffep-1f));
+}
+
+engine::Status validate(const TexelGatherSettings& s) {
+  const auto bad = [](const std::string& what) { return engine::invalid_request("texel gather settings: " + what); };
+  if (s.direct_samples < 1 || s.direct_samples > 65536) return bad("direct_samples is outside 1..65536");
+  if (s.solve_rays < 1 || s.solve_rays > 65536) return bad("solve_rays is outside 1..65536");
+  if (s.gather_rays < 0 || s.gather_rays > 1 << 20) return bad("gather_rays is outside 0..2^20");
+  if (s.bounces < 1 || s.bounces > 1024) return bad("bounces is outside 1..1024");
+  if (!(s.filter_radius_texels >= 0.0f) || s.filter_radius_texels > 16.0f)
+    return bad("filter_radius_texels is outside [0, 16]");
+  return {};
+}
+
+// What the gather knows of every texel of the atlas.
+struct TexelTable {
+  int width = 0, height = 0;
+  std::vector<std::uint32_t> work;  // valid texels in index order
+  std::vector<glm::vec3> albedo;    // per atlas texel: hemispherical albedo of its material
+  std::vector<glm::vec3> face;      // per atlas texel: unit geometric normal on the shading side
+  std::vector<std::uint32_t> redirect;  // per atlas texel: itself when valid, else a valid neighbour or kDark
+};
+
+engine::Result<TexelTable> texel_table(const StaticBakeScene& b, const AtlasLayout& layout) {
+  const AtlasTexels& tx = b.texels;
+  if (tx.width != layout.width || tx.height != layout.height || layout.meshes.size() != b.static_instance.size())
+    return engine::Error{.message = "texel gather: the atlas layout does not match the bake scene"};
+  for (std::size_t m = 0; m < layout.meshes.size(); ++m) {
+    const auto [first, end] = instance_triangles(b.index, b.static_instance[m]);
+    if (layout.meshes[m].indices.size() != 3u * (end - first))
+      return engine::Error{.message = "texel gather: atlas mesh " + std::to_string(m) +
+                                      " has another triangle count than its static instance"};
+  }
+  TexelTable t;
+  t.width = tx.width;
+  t.height = tx.height;
+  const std::size_t n = tx.valid.size();
+  t.albedo.assign(n, glm::vec3(0.0f));
+  t.face.assign(n, glm::vec3(0.0f));
+  t.redirect.assign(n, kDark);
+  std::unordered_map<std::uint32_t, glm::vec3> albedo_of;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!tx.valid[i]) continue;
+    t.work.push_back(static_cast<std::uint32_t>(i));
+    t.redirect[i] = static_cast<std::uint32_t>(i);
+    const std::uint32_t mesh = static_cast<std::uint32_t>(tx.mesh[i]);
+    const ShadingTriangle& tri =
+        b.index.triangles[b.index.instance_first[b.static_instance[mesh]] + static_cast<std::uint32_t>(tx.triangle[i])];
+    auto it = albedo_of.find(tri.material);
+    if (it == albedo_of.end())
+      it = albedo_of.emplace(tri.material, engine::gltf_hemispherical_albedo(b.scene.materials[tri.material].brdf).sum())
+               .first;
+    t.albedo[i] = it->second;
+    t.face[i] = glm::dot(tri.face_normal, tx.normal[i]) < 0.0f ? -tri.face_normal : tri.face_normal;
+  }
+  // Rays landing on an empty texel of a chart (its gutter, a sliver's corner) read the
+  // nearest valid one, found ring by ring in a fixed neighbour order.
+  for (int ring = 0; ring < std::max(3, layout.padding_texels); ++ring) {
+    std::vector<std::pair<std::size_t, std::uint32_t>> found;
+    for (int y = 0; y < t.height; ++y)
+      for (int x = 0; x < t.width; ++x) {
+        const std::size_t i = tx.index(x, y);
+        if (t.redirect[i] != kDark) continue;
+        for (int k = 0; k < 9; ++k) {
+          const int nx = x + k % 3 - 1, ny = y + k / 3 - 1;
+          if (nx < 0 || ny < 0 || nx >= t.width || ny >= t.height) continue;
+          const std::uint32_t r = t.redirect[tx.index(nx, ny)];
+          if (r == kDark) continue;
+          found.emplace_back(i, r);
+          break;
+        }
+      }
+    if (found.empty()) break;
+    for (const auto& [i, r] : found) t.redirect[i] = r;
+  }
+  return t;
+}
+
+glm::vec2 hit_uv(const AtlasLayout& layout, const Hit& h) {
+  const AtlasMeshUv& mu = layout.meshes[h.instance];
+  const std::uint32_t* idx = &mu.indices[3u * h.primitive];
+  const float u = h.barycentric.x, v = h.barycentric.y;
+  return (1.0f - u - v) * mu.uv1[idx[0]] + u * mu.uv1[idx[1]] + v * mu.uv1[idx[2]];
+}
+
+// Where a ray from a texel ends: kSky, kDark, or the atlas texel it reads.
+std::uint32_t landing(const StaticBakeScene& b, const AtlasLayout& layout, const TexelTable& t, const Ray& ray,
+                      glm::vec2* uv) {
+  const Hit h = b.caster->intersect(ray);
+  if (!h.valid()) return kSky;
+  const ShadingTriangle& tri = b.index.triangles[b.triangle_of(h)];
+  const bool front = glm::dot(tri.face_normal, ray.direction) < 0.0f;
+  if (!front && !b.scene.materials[tri.material].double_sided) return kBack;
+  const glm::vec2 u = hit_uv(layout, h);
+  if (uv) *uv = u;
+  const int x = std::clamp(static_cast<int>(u.x * static_cast<float>(t.width)), 0, t.width - 1);
+  const int y = std::clamp(static_cast<int>(u.y * static_cast<float>(t.height)), 0, t.height - 1);
+  return t.redirect[static_cast<std::size_t>(y) * static_cast<std::size_t>(t.width) + static_cast<std::size_t>(x)];
+}
+
+// Step 1 at one texel: every static light and the emissive triangles, light sampling only.
+glm::vec3 direct_at(const StaticBakeScene& b, const glm::vec3& p, const glm::vec3& n, const glm::vec3& face, int samples,
+                    Pcg32& rng, std::uint64_t* rays) {
+  const glm::vec3 origin = offset_ray_origin(p, face);
+  glm::dvec3 sum(0.0);
+  const auto inv = 1.0 / static_cast<double>(samples);
+  for (std::size_t i = 0; i < b.scene.lights.size(); ++i) {
+    const ReferenceLight& l = b.scene.lights[i];
+    if (l.type == ReferenceLight::Type::Area) {
+      if (b.index.light_has_proxy[i]) continue;  // its emissive geometry stands for it below
+      const float area = 4.0f * glm::length(l.half_x) * glm::length(l.half_y);
+      const glm::vec2 shift(rng.next_float(), rng.next_float());
+      for (int s = 0; s < samples; ++s) {
+        const glm::vec2 u = hammersley(static_cast<std::uint32_t>(s), static_cast<std::uint32_t>(samples), shift);
+        const glm::vec3 q = l.position + (2.0f * u.x - 1.0f) * l.half_x + (2.0f * u.y - 1.0f) * l.half_y;
+        const glm::vec3 to = q - p;
+        const float d2 = glm::dot(to, to);
+        if (!(d2 > 0.0f)) continue;
+        const glm::vec3 wi = to / std::sqrt(d2);
+        const float cos_l = -glm::dot(wi, l.direction), cos_r = glm::dot(wi, n);
+        if (cos_l <= 0.0f || cos_r <= 0.0f || glm::dot(wi, face) <= 0.0f) continue;
+        ++*rays;
+        if (b.caster->occluded(Ray{origin, 0.0f, q - origin, 1.0f})) continue;
+        sum += glm::dvec3(l.radiant * (cos_r * cos_l * area / d2)) * inv;
+      }
+      continue;
+    }
+    glm::vec3 wi;
+    float atten = 1.0f, t_max = 1.0f;
+    glm::vec3 dir;
+    if (l.type == ReferenceLight::Type::Directional) {
+      wi = -l.direction;
+      dir = wi;
+      t_max = std::numeric_limits<float>::infinity();
+    } else {
+      const glm::vec3 to = l.position - p;
+      const float d2 = std::max(glm::dot(to, to), 1e-12f);
+      const float d = std::sqrt(d2);
+      wi = to / d;
+      atten = range_window(d, l.range_m) / d2;
+      if (l.type == ReferenceLight::Type::Spot) atten *= spot_cone(l.direction, l.cos_outer, l.cos_inner, wi);
+      dir = l.position - origin;
+    }
+    const float cos_r = glm::dot(wi, n);
+    if (atten <= 0.0f || cos_r <= 0.0f || glm::dot(wi, face) <= 0.0f) continue;
+    ++*rays;
+    if (b.caster->occluded(Ray{origin, 0.0f, dir, t_max})) continue;
+    sum += glm::dvec3(l.radiant * (atten * cos_r));
+  }
+  const EmitterTable& em = b.index.emitters;
+  if (em.triangle.empty()) return glm::vec3(sum);
+  const glm::vec2 shift(rng.next_float(), rng.next_float());
+  const float pick_shift = rng.next_float();
+  for (int s = 0; s < samples; ++s) {
+    float u_pick = (static_cast<float>(s) + pick_shift) / static_cast<float>(samples);
+    u_pick = std::min(u_pick, 0x1.fffffep-1f);
+    const auto k = static_cast<std::size_t>(std::lower_bound(em.cdf.begin(), em.cdf.end(), u_pick) - em.cdf.begin());
+    const ShadingTriangle& tri = b.index.triangles[em.triangle[std::min(k, em.triangle.size() - 1)]];
+    const ReferenceMaterial& mat = b.scene.materials[tri.material];
+    const float prob = em.probability[std::min(k, em.triangle.size() - 1)];
+    const glm::vec2 u = hammersley(static_cast<std::uint32_t>(s), static_cast<std::uint32_t>(samples), shift);
+    const float su = std::sqrt(u.x);
+    const glm::vec3 q = tri.p0 + su * (1.0f - u.y) * tri.e1 + su * u.y * tri.e2;
+    const glm::vec3 to = q - p;
+    const float d2 = glm::dot(to, to);
+    if (!(d2 > 0.0f) || !(prob > 0.0f)) continue;
+    const glm::vec3 wi = to / std::sqrt(d2);
+    float cos_l = -glm::dot(wi, tri.face_normal);
+    if (mat.double_sided) cos_l = std::fabs(cos_l);
+    const float cos_r = glm::dot(wi, n);
+    if (cos_l <= 0.0f || cos_r <= 0.0f || glm::dot(wi, face) <= 0.0f) continue;
+    ++*rays;
+    if (b.caster->occluded(Ray{origin, 0.0f, q - origin, 0.9999f})) continue;
+    sum += glm::dvec3(mat.emission * (cos_r * cos_l * tri.area_m2 / (prob * d2))) * inv;
+  }
+  return glm::vec3(sum);
+}
+
+glm::vec3 bilinear(const std::vector<glm::vec3>& img, int w, int h, glm::vec2 uv) {
+  const float fx = uv.x * static_cast<float>(w) - 0.5f, fy = uv.y * static_cast<float>(h) - 0.5f;
+  const float x0f = std::floor(fx), y0f = std::floor(fy);
+  const float ax = fx - x0f, ay = fy - y0f;
+  const int x0 = static_cast<int>(x0f), y0 = static_cast<int>(y0f);
+  const auto at = [&](int x, int y) {
+    x = std::clamp(x, 0, w - 1);
+    y = std::clamp(y, 0, h - 1);
+    return img[static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)];
+  };
+  return (1.0f - ay) * ((1.0f - ax) * at(x0, y0) + ax * at(x0 + 1, y0)) +
+         ay * ((1.0f - ax) * at(x0, y0 + 1) + ax * at(x0 + 1, y0 + 1));
+}
+
+float max_abs(const glm::vec3& v) { return std::max(std::fabs(v.x), std::max(std::fabs(v.y), std::fabs(v.z))); }
+
+// Step 4: Gaussian over texels on the same plane within the radius, across chart borders.
+std::vector<glm::vec3> filter_world(const AtlasTexels& tx, const TexelTable& t, const std::vector<glm::vec3>& e,
+                                    const std::vector<std::uint8_t>& hidden, float radius_m, float texel_m,
+                                    ThreadPool& pool) {
+  const float cell = radius_m;
+  const auto key_of = [cell](const glm::vec3& p) {
+    const glm::ivec3 c(glm::floor(p / cell));
+    return glm::ivec3(c);
+  };
+  const auto hash = [](glm::ivec3 c) {
+    return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(c.x)) * 73856093ULL) ^
+           (static_cast<std::uint64_t>(static_cast<std::uint32_t>(c.y)) * 19349663ULL) ^
+           (static_cast<std::uint64_t>(static_cast<std::uint32_t>(c.z)) * 83492791ULL);
+  };
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> cells;
+  cells.reserve(t.work.size());
+  for (std::uint32_t i : t.work)
+    if (!hidden[i]) cells.emplace_back(hash(key_of(tx.position[i])), i);
+  std::sort(cells.begin(), cells.end());
+  std::vector<glm::vec3> out = e;
+  const float inv_r2 = 1.0f / (radius_m * radius_m);
+  pool.parallel_for(
+      t.work.size(),
+      [&](std::size_t w) {
+        const std::uint32_t i = t.work[w];
+        if (hidden[i]) return;
+        const glm::vec3 p = tx.position[i], n = tx.normal[i];
+        const glm::ivec3 c = key_of(p);
+        glm::dvec3 sum(0.0);
+        double weight = 0.0;
+        for (int dz = -1; dz <= 1; ++dz)
+          for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) {
+              const glm::ivec3 cc = c + glm::ivec3(dx, dy, dz);
+              const std::uint64_t h = hash(cc);
+              auto it = std::lower_bound(cells.begin(), cells.end(), std::make_pair(h, std::uint32_t{0}));
+              for (; it != cells.end() && it->first == h; ++it) {
+                const std::uint32_t j = it->second;
+                if (key_of(tx.position[j]) != cc) continue;  // a hash collision
+                const glm::vec3 d = tx.position[j] - p;
+                const float d2 = glm::dot(d, d);
+                if (d2 > radius_m * radius_m) continue;
+                if (glm::dot(tx.normal[j], n) < 0.95f || std::fabs(glm::dot(d, n)) > 0.5f * texel_m) continue;
+                const double wgt = std::exp(-2.0 * static_cast<double>(d2 * inv_r2));
+                sum += glm::dvec3(e[j]) * wgt;
+                weight += wgt;
+              }
+            }
+        out[i] = weight > 0.0 ? glm::vec3(sum / weight) : e[i];
+      },
+      64);
+  return out;
+}
+
+}  // namespace
+
+engine::Result<TexelGatherResult> gather_atlas(const StaticBakeScene& b, const AtlasLayout& layout,
+                                               const TexelGatherSettings& s, ThreadPool& pool) {
+  if (auto ok = validate(s); !ok) return ok.error();
+  auto table = texel_table(b, layout);
+  if (!table) return table.error();
+  const TexelTable& t = *table;
+  const AtlasTexels& tx = b.texels;
+  const std::size_t n = tx.valid.size(), work = t.work.size();
+  const auto phase = [&](double begin, double end) -> ProgressCallback {
+    if (!s.progress) return {};
+    return [&s, begin, end](double f) { return s.progress(begin + (end - begin) * f); };
+  };
+  TexelGatherResult out;
+  out.direct.assign(n, glm::vec3(0.0f));
+  out.indirect.assign(n, glm::vec3(0.0f));
+  std::vector<std::uint64_t> rays_of(work, 0);
+
+  // Step 1.
+  auto t0 = Clock::now();
+  if (!pool.parallel_for_with_progress(work, phase(0.0, 0.15), [&](std::size_t w) {
+        const std::uint32_t i = t.work[w];
+        Pcg32 rng = Pcg32::for_item(s.seed, stream_id(i, kDirectStream));
+        out.direct[i] = direct_at(b, tx.position[i], tx.normal[i], t.face[i], s.direct_samples, rng, &rays_of[w]);
+      }))
+    return engine::cancelled_error("light-atlas gather");
+  out.direct_seconds = seconds_since(t0);
+
+  // Step 2: cast and keep.
+  t0 = Clock::now();
+  const auto ns = static_cast<std::size_t>(s.solve_rays);
+  std::vector<std::uint32_t> kept(work * ns, kDark);
+  const glm::vec3 sky = b.scene.sky_radiance;
+  std::vector<std::uint8_t> hidden(n, 0);
+  if (!pool.parallel_for_with_progress(work, phase(0.15, 0.45), [&](std::size_t w) {
+        const std::uint32_t i = t.work[w];
+        Pcg32 rng = Pcg32::for_item(s.seed, stream_id(i, kSolveStream));
+        const glm::vec2 shift(rng.next_float(), rng.next_float());
+        const glm::vec3 origin = offset_ray_origin(tx.position[i], t.face[i]);
+        std::size_t escaped = 0, back = 0;
+        for (std::size_t r = 0; r < ns; ++r) {
+          const glm::vec2 u = hammersley(static_cast<std::uint32_t>(r), static_cast<std::uint32_t>(ns), shift);
+          const glm::vec3 wi = sample_cosine_hemisphere(tx.normal[i], u.x, u.y);
+          if (glm::dot(wi, t.face[i]) <= 0.0f) continue;  // below the surface: dark
+          ++rays_of[w];
+          const std::uint32_t land = landing(b, layout, t, Ray{origin, 0.0f, wi}, nullptr);
+          kept[w * ns + r] = land;
+          escaped += land == kSky;
+          back += land == kBack;
+        }
+        hidden[i] = static_cast<float>(back) > kHiddenBackFraction * static_cast<float>(ns) ? 1 : 0;
+        // Sky seen directly is direct light; cosine sampling: E = pi L x fraction escaping.
+        out.direct[i] += kPi * sky * (static_cast<float>(escaped) / static_cast<float>(ns));
+      }))
+    return engine::cancelled_error("light-atlas gather");
+
+  // Step 2: iterate. B = rho (E_d + E) per texel, the light a texel sends on (pi L).
+  std::vector<glm::vec3> reflected(n, glm::vec3(0.0f)), next(n, glm::vec3(0.0f));
+  std::vector<glm::vec3>& e = out.indirect;
+  for (int it = 0; it < s.bounces; ++it) {
+    for (std::uint32_t i : t.work) reflected[i] = t.albedo[i] * (out.direct[i] + e[i]);
+    pool.parallel_for(
+        work,
+        [&](std::size_t w) {
+          glm::dvec3 sum(0.0);
+          for (std::size_t r = 0; r < ns; ++r) {
+            const std::uint32_t land = kept[w * ns + r];
+            if (land < kBack) sum += glm::dvec3(reflected[land]);
+          }
+          next[t.work[w]] = glm::vec3(sum / static_cast<double>(ns));
+        },
+        256);
+    double added = 0.0, total = 0.0;
+    for (std::uint32_t i : t.work) {
+      added += static_cast<double>(max_abs(next[i] - e[i]));
+      total += static_cast<double>(max_abs(next[i]));
+    }
+    std::swap(e, next);
+    out.iterations = it + 1;
+    if (!(added > 1e-4 * total)) break;
+  }
+  out.solve_seconds = seconds_since(t0);
+  if (s.progress && !s.progress(0.5)) return engine::cancelled_error("light-atlas gather");
+
+  // Step 3.
+  t0 = Clock::now();
+  if (s.gather_rays > 0) {
+    for (std::uint32_t i : t.work) reflected[i] = t.albedo[i] * (out.direct[i] + e[i]);
+    dilate<glm::vec3>(reflected, t.width, t.height, tx.valid, std::max(3, layout.padding_texels));
+    const auto nf = static_cast<std::size_t>(s.gather_rays);
+    const double w_solve = static_cast<double>(ns) / static_cast<double>(ns + nf);
+    std::vector<glm::vec3> gathered(n, glm::vec3(0.0f));
+    if (!pool.parallel_for_with_progress(work, phase(0.5, 0.95), [&](std::size_t w) {
+          const std::uint32_t i = t.work[w];
+          Pcg32 rng = Pcg32::for_item(s.seed, stream_id(i, kGatherStream));
+          const glm::vec2 shift(rng.next_float(), rng.next_float());
+          const glm::vec3 origin = offset_ray_origin(tx.position[i], t.face[i]);
+          glm::dvec3 sum(0.0);
+          for (std::size_t r = 0; r < nf; ++r) {
+            const glm::vec2 u = hammersley(static_cast<std::uint32_t>(r), static_cast<std::uint32_t>(nf), shift);
+            const glm::vec3 wi = sample_cosine_hemisphere(tx.normal[i], u.x, u.y);
+            if (glm::dot(wi, t.face[i]) <= 0.0f) continue;
+            ++rays_of[w];
+            glm::vec2 uv;
+            const std::uint32_t land = landing(b, layout, t, Ray{origin, 0.0f, wi}, &uv);
+            if (land < kBack) sum += glm::dvec3(bilinear(reflected, t.width, t.height, uv));
+          }
+          const glm::dvec3 mean = sum / static_cast<double>(nf);
+          gathered[i] = glm::vec3(w_solve * glm::dvec3(e[i]) + (1.0 - w_solve) * mean);
+        }))
+      return engine::cancelled_error("light-atlas gather");
+    e = std::move(gathered);
+  }
+  out.gather_seconds = seconds_since(t0);
+
+  // Step 4.
+  t0 = Clock::now();
+  if (s.filter_radius_texels > 0.0f && layout.texels_per_metre > 0.0f) {
+    const float texel_m = 1.0f / layout.texels_per_metre;
+    e = filter_world(tx, t, e, hidden, s.filter_radius_texels * texel_m, texel_m, pool);
+  }
+  out.filter_seconds = seconds_since(t0);
+  for (std::uint64_t r : rays_of) out.rays += r;
+  if (s.progress && !s.progress(1.0)) return engine::cancelled_error("light-atlas gather");
+  return out;
+}
+
+}  // namespace gi

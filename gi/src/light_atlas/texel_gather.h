@@ -1,0 +1,64 @@
+#pragma once
+// Final gather into the light atlas: multi-bounce diffuse indirect irradiance estimated at
+// every texel by rays from the texel itself, reading the light that the atlas's own texels
+// reflect. It replaces the VPL final shooting (light_atlas.h step 4, texels x VPLs shadow
+// rays) where that is too slow for its error, and it has no near-field singularity: a texel
+// next to a concave edge reads the wall beside it where its rays hit it.
+//   gi::TexelGatherResult g = gi::gather_atlas(bake_scene, layout, {.gather_rays = 256}, pool).value();
+//
+// Steps:
+//   1. Direct irradiance E_d at every texel: punctual lights with one shadow ray, area
+//      lights and emissive triangles with `direct_samples` stratified samples (light
+//      sampling, unbiased), the sky from the misses of step 2.
+//   2. Kept-ray solve: `solve_rays` cosine-distributed, stratified rays per texel; the texel
+//      each ray lands on is kept, so every bounce after the first costs a lookup, not a ray.
+//      Jacobi iteration E_i+1 = T(E_d + E_i), T the kept rays' mean of the reflected
+//      rho (E_d + E_i) of the texels they hit, until a bounce adds less than 1e-4 of the
+//      total or after `bounces` iterations.
+//   3. Final gather: `gather_rays` fresh stratified rays per texel read rho (E_d + E) of the
+//      dilated atlas bilinearly where they hit; the result is averaged with step 2's, each
+//      weighted by its ray count (both estimate the same T(E_d + E)).
+//   4. Optional edge-aware filter in world space: texels within `filter_radius_texels` on
+//      the same plane (normals within ~18 degrees, plane distance below half a texel),
+//      across chart borders, Gaussian-weighted.
+// Surfaces reflect as diffuse with the glTF BRDF's hemispherical albedo (as the VPLs do).
+// Back faces of one-sided surfaces are black; rays that escape see the sky (direct light).
+// Deterministic for any thread count: every texel's random numbers come from (seed, texel).
+
+#include <engine/result.h>
+#include <gi/progress.h>
+
+#include <cstdint>
+#include <glm/glm.hpp>
+#include <vector>
+
+#include "core/thread_pool.h"
+#include "transport/static_scene.h"
+#include "uv/atlas_layout.h"
+
+namespace gi {
+
+struct TexelGatherSettings {
+  int direct_samples = 16;           ///< Samples per texel on each area light and on the emitters (>= 1).
+  int solve_rays = 64;               ///< Kept rays per texel, iterated for all bounces (>= 1).
+  int gather_rays = 128;             ///< Fresh final-gather rays per texel (0: the solve alone).
+  int bounces = 64;                  ///< Most iterations of the kept-ray solve (indirect bounces).
+  float filter_radius_texels = 0.0f; ///< World-space filter radius in texels (0: none).
+  std::uint64_t seed = 1;
+  ProgressCallback progress;         ///< Fraction done in [0, 1]; return false to cancel.
+};
+
+struct TexelGatherResult {
+  std::vector<glm::vec3> indirect;  ///< Per texel, W/m^2 (0 on empty texels, not dilated).
+  std::vector<glm::vec3> direct;    ///< Per texel, W/m^2 (step 1, sky included).
+  std::uint64_t rays = 0;
+  int iterations = 0;  ///< Bounces the solve ran.
+  double direct_seconds = 0.0, solve_seconds = 0.0, gather_seconds = 0.0, filter_seconds = 0.0;
+};
+
+/// Errors: invalid settings, cancelled, a layout that is not the one `scene.texels` were
+/// rasterized from.
+engine::Result<TexelGatherResult> gather_atlas(const StaticBakeScene& scene, const AtlasLayout& layout,
+                                               const TexelGatherSettings& settings, ThreadPool& pool);
+
+}  // namespace gi
