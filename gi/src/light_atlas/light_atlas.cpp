@@ -122,24 +122,46 @@ engine::Result<LightAtlasBake> bake_light_atlas(const BakeInput& input, const Li
   out.vpls = std::move(vpls).value();
   out.stats.vpl_seconds = seconds_since(t0);
 
-  auto powers = light_vpls(b, out.vpls, settings, pool, &out.stats);
-  if (!powers) return powers.error();
-  out.vpl_power = powers->power;
-
-  t0 = Clock::now();
-  std::uint64_t rays = powers->rays;
+  std::uint64_t rays = 0;
   if (settings.final_pass == LightAtlasSettings::FinalPass::TexelGather) {
+    t0 = Clock::now();
     TexelGatherSettings g = settings.gather;
     g.seed = settings.seed;
-    g.progress = sub_progress(settings.progress, kFinalPhase);
+    g.progress = sub_progress(settings.progress, Phase{kDirectPhase.begin, kFinalPhase.end});
     auto gathered = gather_atlas(b, out.layout, g, pool);
     if (!gathered) return gathered.error();
+    out.stats.direct_seconds = gathered->direct_seconds;
     out.irradiance = std::move(gathered->indirect);
-    if (settings.include_direct)
-      for (std::size_t t = 0; t < out.irradiance.size(); ++t) out.irradiance[t] += gathered->direct[t];
     rays += gathered->rays;
     out.stats.gather_iterations = gathered->iterations;
+    // The VPLs (what BRF's world probes read) take their light from the gathered atlas: the
+    // area-weighted mean of the total irradiance at their sample points' texels, instead of
+    // a VPL solution of their own (steps 2-3 cost more than the gather at 1000+ VPLs).
+    std::vector<glm::vec3> total(out.irradiance.size());
+    for (std::size_t t = 0; t < total.size(); ++t) total[t] = out.irradiance[t] + gathered->direct[t];
+    const std::vector<glm::vec3> at_samples =
+        irradiance_at_points(b.texels, total, out.layout.texels_per_metre, out.vpls.sample_position,
+                             out.vpls.sample_normal);
+    out.vpl_power.assign(out.vpls.size(), glm::vec3(0.0f));
+    for (std::size_t j = 0; j < out.vpls.size(); ++j) {
+      glm::dvec3 sum(0.0);
+      double area = 0.0;
+      for (std::uint32_t k = out.vpls.sample_first[j]; k < out.vpls.sample_first[j + 1]; ++k) {
+        sum += glm::dvec3(at_samples[k]) * static_cast<double>(out.vpls.sample_area_m2[k]);
+        area += static_cast<double>(out.vpls.sample_area_m2[k]);
+      }
+      if (area > 0.0) out.vpl_power[j] = out.vpls.albedo[j] * out.vpls.area_m2[j] * glm::vec3(sum / area);
+    }
+    if (settings.include_direct)
+      for (std::size_t t = 0; t < out.irradiance.size(); ++t) out.irradiance[t] += gathered->direct[t];
+    out.stats.final_seconds = seconds_since(t0) - gathered->direct_seconds;
   } else {
+    auto powers = light_vpls(b, out.vpls, settings, pool, &out.stats);
+    if (!powers) return powers.error();
+    out.vpl_power = powers->power;
+    out.stats.shots = powers->shots;
+    rays += powers->rays;
+    t0 = Clock::now();
     std::vector<std::uint32_t> shooters;
     std::vector<glm::vec3> shot;
     for (std::uint32_t i = 0; i < out.vpls.size(); ++i)
@@ -158,15 +180,14 @@ engine::Result<LightAtlasBake> bake_light_atlas(const BakeInput& input, const Li
           direct_into_atlas(b.emitters, b.texels, texel_area, *b.caster, pool, &rays);
       for (std::size_t t = 0; t < direct.size(); ++t) out.irradiance[t] += direct[t];
     }
+    out.stats.final_seconds = seconds_since(t0);
   }
-  out.stats.final_seconds = seconds_since(t0);
   out.valid = b.texels.valid;
   dilate<glm::vec3>(out.irradiance, out.width, out.height, out.valid, dilation_rings(out.layout));
 
   out.stats.vpls = out.vpls.size();
   out.stats.sample_points = out.vpls.sample_position.size();
   out.stats.light_points = b.emitters.size();
-  out.stats.shots = powers->shots;
   out.stats.valid_texels = static_cast<std::size_t>(std::count(out.valid.begin(), out.valid.end(), std::uint8_t{1}));
   out.stats.rays = rays;
   out.stats.total_seconds = seconds_since(t_start);
@@ -225,12 +246,26 @@ engine::Result<LightAtlasSettings> light_atlas_preset(std::string_view name) {
     return engine::invalid_request("unknown light-atlas preset '" + std::string(name) + "' (preview, medium, high)");
   LightAtlasSettings s;
   s.texels_per_metre = *density;
+  // Final gather (texel_gather.h), chosen from the Cornell-box sweep at 128 texels/m
+  // (docs/sweeps/light_atlas_cornell_box.md) and the demo level's frames (a 2.5-texel filter
+  // leaves no blotches at 8 texels/m; the
+  // high preset blurs less and gathers more); the VPLs only feed BRF's world probes.
+  s.final_pass = LightAtlasSettings::FinalPass::TexelGather;
+  s.gather.filter_radius_texels = 2.5f;
+  s.gather.direct_samples = 16;
   if (name == "preview") {
     s.vpl_count = 300, s.bounces = 8;
+    s.gather.solve_rays = 32;
+    s.gather.gather_rays = 0;
   } else if (name == "medium") {
     s.vpl_count = 1000, s.bounces = 16;
+    s.gather.solve_rays = 64;
+    s.gather.gather_rays = 128;
   } else {
     s.vpl_count = 3000, s.bounces = 16;
+    s.gather.solve_rays = 128;
+    s.gather.gather_rays = 512;
+    s.gather.filter_radius_texels = 1.5f;  // more rays, less blur: 4.7 cm at 32 texels/m
   }
   return s;
 }

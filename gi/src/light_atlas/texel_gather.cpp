@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <numbers>
+#include <span>
 #include <unordered_map>
 
 #include "core/random.h"
@@ -241,55 +242,68 @@ glm::vec3 bilinear(const std::vector<glm::vec3>& img, int w, int h, glm::vec2 uv
 
 float max_abs(const glm::vec3& v) { return std::max(std::fabs(v.x), std::max(std::fabs(v.y), std::fabs(v.z))); }
 
+// Valid texels bucketed by their sample position in cubic cells (sorted, for a fixed
+// neighbour order): the world-space neighbourhoods of the filter and of point lookups.
+class TexelGrid {
+ public:
+  TexelGrid(const AtlasTexels& tx, const std::vector<std::uint32_t>& texels, float cell_m) : tx_(tx), cell_(cell_m) {
+    cells_.reserve(texels.size());
+    for (std::uint32_t i : texels) cells_.emplace_back(hash(cell_of(tx.position[i])), i);
+    std::sort(cells_.begin(), cells_.end());
+  }
+  // Calls fn(j) for every texel in the 27 cells around p (those within one cell of it).
+  template <class Fn>
+  void for_near(const glm::vec3& p, Fn&& fn) const {
+    const glm::ivec3 c = cell_of(p);
+    for (int dz = -1; dz <= 1; ++dz)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          const glm::ivec3 cc = c + glm::ivec3(dx, dy, dz);
+          const std::uint64_t h = hash(cc);
+          auto it = std::lower_bound(cells_.begin(), cells_.end(), std::make_pair(h, std::uint32_t{0}));
+          for (; it != cells_.end() && it->first == h; ++it)
+            if (cell_of(tx_.position[it->second]) == cc) fn(it->second);  // else a hash collision
+        }
+  }
+
+ private:
+  glm::ivec3 cell_of(const glm::vec3& p) const { return glm::ivec3(glm::floor(p / cell_)); }
+  static std::uint64_t hash(glm::ivec3 c) {
+    return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(c.x)) * 73856093ULL) ^
+           (static_cast<std::uint64_t>(static_cast<std::uint32_t>(c.y)) * 19349663ULL) ^
+           (static_cast<std::uint64_t>(static_cast<std::uint32_t>(c.z)) * 83492791ULL);
+  }
+  const AtlasTexels& tx_;
+  float cell_;
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> cells_;
+};
+
 // Step 4: Gaussian over texels on the same plane within the radius, across chart borders.
 std::vector<glm::vec3> filter_world(const AtlasTexels& tx, const TexelTable& t, const std::vector<glm::vec3>& e,
                                     const std::vector<std::uint8_t>& hidden, float radius_m, float texel_m,
                                     ThreadPool& pool) {
-  const float cell = radius_m;
-  const auto key_of = [cell](const glm::vec3& p) {
-    const glm::ivec3 c(glm::floor(p / cell));
-    return glm::ivec3(c);
-  };
-  const auto hash = [](glm::ivec3 c) {
-    return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(c.x)) * 73856093ULL) ^
-           (static_cast<std::uint64_t>(static_cast<std::uint32_t>(c.y)) * 19349663ULL) ^
-           (static_cast<std::uint64_t>(static_cast<std::uint32_t>(c.z)) * 83492791ULL);
-  };
-  std::vector<std::pair<std::uint64_t, std::uint32_t>> cells;
-  cells.reserve(t.work.size());
+  std::vector<std::uint32_t> visible;
   for (std::uint32_t i : t.work)
-    if (!hidden[i]) cells.emplace_back(hash(key_of(tx.position[i])), i);
-  std::sort(cells.begin(), cells.end());
+    if (!hidden[i]) visible.push_back(i);
+  const TexelGrid grid(tx, visible, radius_m);
   std::vector<glm::vec3> out = e;
-  const float inv_r2 = 1.0f / (radius_m * radius_m);
+  const float r2 = radius_m * radius_m;
   pool.parallel_for(
-      t.work.size(),
+      visible.size(),
       [&](std::size_t w) {
-        const std::uint32_t i = t.work[w];
-        if (hidden[i]) return;
+        const std::uint32_t i = visible[w];
         const glm::vec3 p = tx.position[i], n = tx.normal[i];
-        const glm::ivec3 c = key_of(p);
         glm::dvec3 sum(0.0);
         double weight = 0.0;
-        for (int dz = -1; dz <= 1; ++dz)
-          for (int dy = -1; dy <= 1; ++dy)
-            for (int dx = -1; dx <= 1; ++dx) {
-              const glm::ivec3 cc = c + glm::ivec3(dx, dy, dz);
-              const std::uint64_t h = hash(cc);
-              auto it = std::lower_bound(cells.begin(), cells.end(), std::make_pair(h, std::uint32_t{0}));
-              for (; it != cells.end() && it->first == h; ++it) {
-                const std::uint32_t j = it->second;
-                if (key_of(tx.position[j]) != cc) continue;  // a hash collision
-                const glm::vec3 d = tx.position[j] - p;
-                const float d2 = glm::dot(d, d);
-                if (d2 > radius_m * radius_m) continue;
-                if (glm::dot(tx.normal[j], n) < 0.95f || std::fabs(glm::dot(d, n)) > 0.5f * texel_m) continue;
-                const double wgt = std::exp(-2.0 * static_cast<double>(d2 * inv_r2));
-                sum += glm::dvec3(e[j]) * wgt;
-                weight += wgt;
-              }
-            }
-        out[i] = weight > 0.0 ? glm::vec3(sum / weight) : e[i];
+        grid.for_near(p, [&](std::uint32_t j) {
+          const glm::vec3 d = tx.position[j] - p;
+          const float d2 = glm::dot(d, d);
+          if (d2 > r2 || glm::dot(tx.normal[j], n) < 0.95f || std::fabs(glm::dot(d, n)) > 0.5f * texel_m) return;
+          const double wgt = std::exp(-2.0 * static_cast<double>(d2 / r2));
+          sum += glm::dvec3(e[j]) * wgt;
+          weight += wgt;
+        });
+        if (weight > 0.0) out[i] = glm::vec3(sum / weight);
       },
       64);
   return out;
@@ -382,8 +396,14 @@ engine::Result<TexelGatherResult> gather_atlas(const StaticBakeScene& b, const A
 
   // Step 3.
   t0 = Clock::now();
+  const float texel_m = layout.texels_per_metre > 0.0f ? 1.0f / layout.texels_per_metre : 0.0f;
+  const bool filtering = s.filter_radius_texels > 0.0f && texel_m > 0.0f;
   if (s.gather_rays > 0) {
-    for (std::uint32_t i : t.work) reflected[i] = t.albedo[i] * (out.direct[i] + e[i]);
+    // The gather reads the solve's light filtered too: its noise would otherwise come back
+    // as blotches a few texels wide (a bright texel lights its neighbours' rays).
+    const std::vector<glm::vec3> source =
+        filtering ? filter_world(tx, t, e, hidden, s.filter_radius_texels * texel_m, texel_m, pool) : e;
+    for (std::uint32_t i : t.work) reflected[i] = t.albedo[i] * (out.direct[i] + source[i]);
     dilate<glm::vec3>(reflected, t.width, t.height, tx.valid, std::max(3, layout.padding_texels));
     const auto nf = static_cast<std::size_t>(s.gather_rays);
     const double w_solve = static_cast<double>(ns) / static_cast<double>(ns + nf);
@@ -413,13 +433,35 @@ engine::Result<TexelGatherResult> gather_atlas(const StaticBakeScene& b, const A
 
   // Step 4.
   t0 = Clock::now();
-  if (s.filter_radius_texels > 0.0f && layout.texels_per_metre > 0.0f) {
-    const float texel_m = 1.0f / layout.texels_per_metre;
+  if (filtering) {
     e = filter_world(tx, t, e, hidden, s.filter_radius_texels * texel_m, texel_m, pool);
   }
   out.filter_seconds = seconds_since(t0);
   for (std::uint64_t r : rays_of) out.rays += r;
   if (s.progress && !s.progress(1.0)) return engine::cancelled_error("light-atlas gather");
+  return out;
+}
+
+
+std::vector<glm::vec3> irradiance_at_points(const AtlasTexels& texels, const std::vector<glm::vec3>& irradiance,
+                                            float texels_per_metre, std::span<const glm::vec3> points,
+                                            std::span<const glm::vec3> normals) {
+  std::vector<std::uint32_t> valid;
+  for (std::size_t i = 0; i < texels.valid.size(); ++i)
+    if (texels.valid[i]) valid.push_back(static_cast<std::uint32_t>(i));
+  const float reach = 2.0f / texels_per_metre;
+  const TexelGrid grid(texels, valid, reach);
+  std::vector<glm::vec3> out(points.size(), glm::vec3(0.0f));
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    float best = reach * reach;
+    std::uint32_t found = kDark;
+    grid.for_near(points[k], [&](std::uint32_t j) {
+      const glm::vec3 d = texels.position[j] - points[k];
+      const float d2 = glm::dot(d, d);
+      if (d2 < best && glm::dot(texels.normal[j], normals[k]) > 0.5f) best = d2, found = j;
+    });
+    if (found != kDark) out[k] = irradiance[found];
+  }
   return out;
 }
 

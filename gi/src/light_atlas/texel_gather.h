@@ -29,6 +29,7 @@
 #include <gi/progress.h>
 
 #include <cstdint>
+#include <span>
 #include <glm/glm.hpp>
 #include <vector>
 
@@ -60,5 +61,12 @@ struct TexelGatherResult {
 /// rasterized from.
 engine::Result<TexelGatherResult> gather_atlas(const StaticBakeScene& scene, const AtlasLayout& layout,
                                                const TexelGatherSettings& settings, ThreadPool& pool);
+
+/// Irradiance at surface points read from a texel field: each point takes the nearest
+/// valid texel within two texels whose normal faces its own (within 60 degrees); 0 where
+/// none does. For the VPLs a gathered atlas still feeds (BRF's world probes).
+std::vector<glm::vec3> irradiance_at_points(const AtlasTexels& texels, const std::vector<glm::vec3>& irradiance,
+                                            float texels_per_metre, std::span<const glm::vec3> points,
+                                            std::span<const glm::vec3> normals);
 
 }  // namespace gi

@@ -9,6 +9,7 @@
 
 #include "light_atlas/light_atlas.h"
 #include "raytrace/atlas_reference.h"
+#include "raytrace/texel_samples.h"
 #include "uv/atlas_input.h"
 #include "uv/atlas_rasterizer.h"
 
@@ -20,7 +21,8 @@ engine::Scene load(const char* name) {
   return engine::instantiate(std::move(asset.value()));
 }
 
-gi::AtlasIrradiance reference(const engine::Scene& scene, float density, int spp, int bounces = -1) {
+gi::AtlasIrradiance reference(const engine::Scene& scene, float density, int spp, int bounces = -1,
+                              gi::TexelPlacement placement = gi::TexelPlacement::Raster) {
   const auto inputs = gi::atlas_inputs_from(gi::bake_input_from(scene.assets));
   auto layout = gi::build_atlas_layout(inputs, {.texels_per_metre = density});
   EXPECT_TRUE(layout);
@@ -28,29 +30,31 @@ gi::AtlasIrradiance reference(const engine::Scene& scene, float density, int spp
   rs.samples_per_pixel = spp;
   rs.seed = 77;
   rs.max_bounces = bounces;
-  auto truth = gi::reference_atlas_irradiance(gi::bake_input_from(scene), gi::rasterize_atlas(*layout, inputs), rs);
+  auto texels = gi::sample_atlas_texels(gi::bake_input_from(scene), *layout, placement);
+  EXPECT_TRUE(texels);
+  auto truth = gi::reference_atlas_irradiance(gi::bake_input_from(scene), *texels, rs);
   EXPECT_TRUE(truth);
   return std::move(truth).value();
 }
 
-// The high preset's VPL count and bounces. The reference (4096 samples per texel) carries
-// about 2.5% relative RMSE of its own noise. Measured: rel RMSE 0.052, scale 2.5% low (the
-// issue asks for 5%: within the reference's noise of it, not under it). Texels on chart edges
-// (corners) lose some near-field light to the regularization (docs/light_atlas.md).
+// The high preset (final gather: 64 kept + 256 fresh rays per texel, 1.5-texel filter) at
+// 32 texels/m against 4096 samples per texel at the same, visible-surface texel samples. The
+// reference carries about 2% relative RMSE of its own noise. Measured: rel RMSE 0.031, scale
+// 0.994 (VPL shooting at 3000 VPLs, raster samples: 0.052, 2.5% low).
 TEST(LightAtlasCornell, HighPresetMatchesReference) {
   const engine::Scene scene = load("cornell_box.gltf");
-  const gi::AtlasIrradiance truth = reference(scene, 32.0f, 4096);
   gi::LightAtlasSettings s = gi::light_atlas_preset("high").value();
   s.texels_per_metre = 32.0f;
+  const gi::AtlasIrradiance truth = reference(scene, 32.0f, 4096, -1, gi::texel_placement(s));
   auto bake = gi::bake_light_atlas(gi::bake_input_from(scene), s);
   ASSERT_TRUE(bake) << bake.error().to_string();
   const gi::ErrorReport e =
       gi::compare_rgb(gi::RgbField::from_texels(bake->width, bake->height, bake->irradiance, bake->valid),
                       gi::RgbField::from_texels(truth.width, truth.height, truth.indirect, truth.valid));
-  std::printf("Cornell box, %zu VPLs, %d bounces: rel RMSE %.4f (scale fit %.4f, after fit %.4f), bake %.2f s\n",
-              bake->stats.vpls, s.bounces, e.rel_rmse, e.fit_scale, e.fit_rel_rmse, bake->stats.total_seconds);
-  EXPECT_LT(e.rel_rmse, 0.06);
-  EXPECT_NEAR(e.fit_scale, 1.0, 0.04);
+  std::printf("Cornell box, high preset: rel RMSE %.4f (scale fit %.4f, after fit %.4f), bake %.2f s\n", e.rel_rmse,
+              e.fit_scale, e.fit_rel_rmse, bake->stats.total_seconds);
+  EXPECT_LT(e.rel_rmse, 0.035);
+  EXPECT_NEAR(e.fit_scale, 1.0, 0.02);
 }
 
 // The corridor's floor and walls see neither the lamp nor anything it lights directly
