@@ -41,7 +41,7 @@ int main(int argc, char** argv) {
   app.add_flag("--plan", plan_only, "Print the effect plan with estimates for --preset and exit (docs/plan.md)");
   app.add_option("--out", out_dir, "Bundle directory (default: out/<scene>.gibake)");
   app.add_option("--methods", methods,
-                 "Comma-separated methods to bake: atlas, prm, brf (default: what the plan calls for)");
+                 "Comma-separated methods to bake: atlas, prm, dlm, brf (default: what the plan calls for)");
   app.add_option("--preset", o.preset, "Quality preset: preview, medium, high (docs/sweeps/README.md)");
   app.add_option("--vpls", o.vpls, "Override the preset's VPL count")->check(CLI::PositiveNumber);
   app.add_option("--bounces", o.bounces, "Override the preset's indirect bounces")->check(CLI::Range(1, 64));
@@ -50,6 +50,9 @@ int main(int argc, char** argv) {
   app.add_option("--samples", o.samples_per_vpl, "Override the sample points per VPL")->check(CLI::Range(1, 1024));
   app.add_option("--brf-basis", o.brf_basis, "Override the preset's BRF basis functions N")->check(CLI::Range(1, 1024));
   app.add_option("--brf-spheres", o.brf_spheres, "Override the preset's BRF field spheres")->check(CLI::Range(1, 256));
+  app.add_option("--dlm-directions", o.dlm_directions, "Override the DLM's direction count")
+      ->check(CLI::Range(8, 256));
+  app.add_option("--dlm-photons", o.dlm_photons, "Override the DLM's photon paths")->check(CLI::PositiveNumber);
   app.add_flag("--include-direct", o.include_direct, "Store direct + indirect irradiance (default: indirect only)");
   app.add_option("--threads", o.threads, "Worker threads (0: all); the result does not depend on it");
   app.add_option("--seed", o.seed, "Random seed");

@@ -11,8 +11,9 @@
 //
 // Methods (gi::effect_key): "atlas" (light atlas, static lights), "prm" (precomputed
 // radiance maps, moving lights), "brf" (basis radiance fields, one per distinct dynamic
-// mesh). "atlas" and "prm" share one uv1 layout (the preset's atlas density). Methods the
-// plan calls for that this build cannot bake ("dlm", "antiradiance") are reported as
+// mesh), "dlm" (directional light maps of the glossy static surfaces, docs/dlm.md). "atlas",
+// "prm" and "dlm" share one uv1 layout (the preset's atlas density). Methods the
+// plan calls for that this build cannot bake ("antiradiance") are reported as
 // skipped, never silently dropped. Bit-identical output for any thread count.
 
 #include <engine/result.h>
@@ -38,6 +39,8 @@ struct BakeOptions {
   int samples_per_vpl = 0;                 ///< Light atlas: sample points per VPL.
   int brf_basis = 0;                       ///< BRF: basis functions N.
   int brf_spheres = 0;                     ///< BRF: field spheres.
+  int dlm_directions = 0;                  ///< DLM: directions in the global set (8..256).
+  std::uint64_t dlm_photons = 0;           ///< DLM: photon paths.
   bool include_direct = false;             ///< Light atlas: store direct + indirect (default: indirect only).
   std::vector<std::string> moving_lights;  ///< Lights (by name) the game moves although not flagged (PlanOptions).
   unsigned threads = 0;                    ///< Worker threads; 0: all hardware threads. Does not change the result.
@@ -53,7 +56,7 @@ struct BakeHost {
 
 /// One method written into the bundle.
 struct BakedMethod {
-  std::string method;       ///< "atlas", "prm" or "brf".
+  std::string method;       ///< "atlas", "prm", "dlm" or "brf".
   double seconds = 0.0;     ///< Wall time of its bake and save.
   std::uint64_t bytes = 0;  ///< Size of the files it wrote.
 };

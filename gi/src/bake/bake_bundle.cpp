@@ -18,6 +18,8 @@
 #include "brf/brf_mesh.h"
 #include "bundle/geometry_hash.h"
 #include "bundle/manifest.h"
+#include "dlm/dlm.h"
+#include "dlm/dlm_io.h"
 #include "light_atlas/light_atlas.h"
 #include "light_atlas/light_atlas_io.h"
 #include "plan/plan_json.h"
@@ -165,6 +167,31 @@ engine::Status bake_brf_method(const BakeInput& input, const fs::path& dir, cons
   return save_brf(dir, bake, input);
 }
 
+engine::Status bake_dlm_method(const BakeInput& input, const fs::path& dir, const BakeOptions& o, const Stage& stage) {
+  auto settings = dlm_preset(o.preset);
+  if (!settings) return settings.error();
+  if (o.texels_per_metre > 0.0f) settings->texels_per_metre = o.texels_per_metre;
+  if (o.dlm_directions > 0) settings->directions = o.dlm_directions;
+  if (o.dlm_photons > 0) settings->photons = o.dlm_photons;
+  settings->threads = o.threads;
+  settings->seed = o.seed;
+  settings->progress = stage.progress();
+  stage.log(format("directional light maps of %s, preset %s: %d directions, %llu photons, splat radius %g texels, "
+                   "%g texels/m, roughness < %g",
+                   scene_file_name(input).c_str(), o.preset.c_str(), settings->directions,
+                   static_cast<unsigned long long>(settings->photons), double{settings->splat_radius_texels},
+                   double{settings->texels_per_metre}, double{settings->glossy_roughness}));
+  auto dlm = bake_dlm(input, *settings);
+  if (!dlm) return dlm.error();
+  const DlmStats& st = dlm->stats;
+  stage.log(format("  %zu glossy texels, %zu stored (%.2f MB as halves, %zu B per texel); %llu deposits, %.1f M rays",
+                   st.glossy_texels, dlm->texel_count(),
+                   static_cast<double>(dlm->radiance.size()) * 2.0 / 1e6, dlm->directions.size() * 6,
+                   static_cast<unsigned long long>(st.deposits), static_cast<double>(st.rays) * 1e-6));
+  stage.log(format("  time: photons %.2f s; total %.2f s", st.trace_seconds, st.total_seconds));
+  return save_dlm(dir, *dlm, input);
+}
+
 // A bake writes into a staging copy of the bundle ("<dir>/../.<name>.staging"), which takes
 // the bundle's place in one atomic exchange once every method is written: a bake that
 // fails, is cancelled or is killed leaves the previous bundle exactly as it was (a killed
@@ -238,7 +265,7 @@ std::string manifest_key(const std::string& key) { return key == "atlas" ? "ligh
 
 }  // namespace
 
-std::vector<std::string> bakeable_methods() { return {"atlas", "prm", "brf"}; }
+std::vector<std::string> bakeable_methods() { return {"atlas", "prm", "dlm", "brf"}; }
 
 engine::Result<BakeReport> bake_bundle(const BakeInput& input, const fs::path& bundle_dir, const BakeOptions& options,
                                        const BakeHost& host) {
@@ -271,7 +298,7 @@ engine::Result<BakeReport> bake_bundle(const BakeInput& input, const fs::path& b
   for (const std::string& key : methods)
     if (std::find(bakeable.begin(), bakeable.end(), key) == bakeable.end())
       return engine::invalid_request("method '" + key +
-                                     "' is not available in this build (available: atlas, prm, brf)");
+                                     "' is not available in this build (available: atlas, prm, dlm, brf)");
 
   if (methods.empty()) return report;
   auto staged = StagedBundle::begin(bundle_dir);
@@ -281,6 +308,7 @@ engine::Result<BakeReport> bake_bundle(const BakeInput& input, const fs::path& b
     const auto start = Clock::now();
     engine::Status done = key == "atlas" ? bake_atlas(input, dir, options, {host, "light atlas"})
                           : key == "prm" ? bake_prm_method(input, dir, options, {host, "PRM"})
+                          : key == "dlm" ? bake_dlm_method(input, dir, options, {host, "DLM"})
                                          : bake_brf_method(input, dir, options, host);
     if (!done) return done.error();
     report.baked.push_back({key, seconds_since(start), method_bytes(dir, manifest_key(key))});

@@ -188,12 +188,14 @@ engine::Result<DlmSettings> dlm_preset(std::string_view name) {
   if (!density) return engine::invalid_request("unknown DLM preset '" + std::string(name) + "' (preview, medium, high)");
   DlmSettings s;
   s.texels_per_metre = *density;
+  // The photons a texel-bin receives fall with the density squared: the counts keep roughly
+  // the preview's deposits per texel and bin (docs/dlm.md).
   if (name == "preview") {
-    s.directions = 32, s.photons = 300'000, s.splat_radius_texels = 2.0f;
+    s.directions = 32, s.photons = 2'000'000, s.splat_radius_texels = 2.0f;
   } else if (name == "medium") {
-    s.directions = 32, s.photons = 1'000'000, s.splat_radius_texels = 2.0f;
+    s.directions = 32, s.photons = 6'000'000, s.splat_radius_texels = 2.0f;
   } else {
-    s.directions = 32, s.photons = 4'000'000, s.splat_radius_texels = 2.0f;
+    s.directions = 32, s.photons = 16'000'000, s.splat_radius_texels = 2.5f;
   }
   return s;
 }

@@ -16,8 +16,8 @@ namespace gi {
 namespace {
 
 constexpr std::string_view kKeys[kEffectMethodCount] = {"atlas", "prm", "dlm", "antiradiance", "brf"};
-// What this build can bake (gi-bake --methods). DLM and antiradiance are not built yet.
-constexpr bool kAvailable[kEffectMethodCount] = {true, true, false, false, true};
+// What this build can bake (gi-bake --methods). Antiradiance is not built yet.
+constexpr bool kAvailable[kEffectMethodCount] = {true, true, true, false, true};
 
 std::string plural(std::size_t n, const char* one, const char* many) {
   return std::to_string(n) + " " + (n == 1 ? one : many);
@@ -84,6 +84,7 @@ std::pair<float, std::string> min_roughness(const BakeInput& input, const BakeIn
 struct PlanFacts {
   std::vector<std::string> static_lights, moving_lights, moving_why;
   std::vector<std::string> static_meshes, emissive_meshes, glossy, glossy_why, deforming;
+  std::vector<std::size_t> glossy_instances;  // indices into BakeInput::instances
   std::map<std::uint32_t, std::vector<std::string>> dynamic_by_mesh;  // mesh -> instances
   LightPointCount points;
   StaticSurfaceCensus census;
@@ -137,6 +138,7 @@ PlanFacts gather_facts(const BakeInput& input, const PlanOptions& options, Effec
     const auto [roughness, material] = min_roughness(input, inst);
     if (roughness < options.glossy_roughness) {
       f.glossy.push_back(name);
+      f.glossy_instances.push_back(i);
       f.glossy_why.push_back("'" + name + "' (" + material + ") has roughness " + fixed(roughness, 2));
     }
   }
@@ -152,13 +154,17 @@ PlanFacts gather_facts(const BakeInput& input, const PlanOptions& options, Effec
 struct PlanPresets {
   LightAtlasSettings atlas;
   PrmSettings prm;
+  DlmSettings dlm;
 };
 std::optional<PlanPresets> presets(const PlanOptions& options) {
   auto atlas = light_atlas_preset(options.preset);
   auto prm = prm_preset(options.preset);
-  if (!atlas || !prm) return std::nullopt;
-  PlanPresets p{*atlas, *prm};
-  if (options.texels_per_metre > 0.0f) p.atlas.texels_per_metre = p.prm.texels_per_metre = options.texels_per_metre;
+  auto dlm = dlm_preset(options.preset);
+  if (!atlas || !prm || !dlm) return std::nullopt;
+  PlanPresets p{*atlas, *prm, *dlm};
+  p.dlm.glossy_roughness = options.glossy_roughness;
+  if (options.texels_per_metre > 0.0f)
+    p.atlas.texels_per_metre = p.prm.texels_per_metre = p.dlm.texels_per_metre = options.texels_per_metre;
   if (options.vpls > 0) p.atlas.vpl_count = options.vpls;
   if (options.samples_per_vpl > 0) p.atlas.samples_per_vpl = options.samples_per_vpl;
   if (options.bounces > 0) p.atlas.bounces = options.bounces;
@@ -229,7 +235,8 @@ void plan_prm(const PlanFacts& f, const std::optional<PlanPresets>& p, PlannedEf
 }
 
 // Directional light maps: glossy static surfaces.
-void plan_dlm(const PlanFacts& f, const PlanOptions& options, PlannedEffect& dlm) {
+void plan_dlm(const BakeInput& input, const PlanFacts& f, const PlanOptions& options,
+              const std::optional<PlanPresets>& p, PlannedEffect& dlm) {
   const std::string threshold = fixed(options.glossy_roughness, 2);
   if (f.glossy.empty()) {
     dlm.reason = "no static surface has roughness < " + threshold + " -> no directional maps";
@@ -238,6 +245,21 @@ void plan_dlm(const PlanFacts& f, const PlanOptions& options, PlannedEffect& dlm
   dlm.enabled = true;
   dlm.reason = "static surface " + list_names(f.glossy_why, 2) + " < " + threshold + " -> directional light maps";
   dlm.targets = f.glossy;
+  if (!p) return;
+  // The glossy instances' own charts: the texels that get a map per direction.
+  BakeInput glossy_only;
+  glossy_only.meshes = input.meshes;
+  glossy_only.materials = input.materials;
+  for (std::size_t i : f.glossy_instances) glossy_only.instances.push_back(input.instances[i]);
+  const StaticSurfaceCensus glossy = census_static_surfaces(glossy_only);
+  double texels = 0.0, per_texel = 0.0;
+  const BakeWork w = dlm_work(glossy, f.census.albedo, atlas_texels(f.census, p->dlm.texels_per_metre), p->dlm,
+                              &texels, &per_texel);
+  dlm.estimate = {w.bake_seconds, w.runtime_bytes, static_cast<std::uint64_t>(texels),
+                  fixed(glossy.area_m2, 1) + " m^2 glossy -> ~" + std::to_string(static_cast<long long>(texels)) +
+                      " texels x " + std::to_string(p->dlm.directions) + " directions x 8 B = " +
+                      format_bytes(static_cast<std::uint64_t>(per_texel)) + " per texel; " +
+                      std::to_string(p->dlm.photons) + " photons"};
 }
 
 // Antiradiance: flagged deforming or opening regions.
@@ -368,7 +390,7 @@ EffectPlan plan(const BakeInput& input, const PlanOptions& options) {
   }
   plan_light_atlas(f, p, out.effects[static_cast<int>(EffectMethod::LightAtlas)]);
   plan_prm(f, p, out.effects[static_cast<int>(EffectMethod::Prm)]);
-  plan_dlm(f, options, out.effects[static_cast<int>(EffectMethod::DirectionalLightMaps)]);
+  plan_dlm(input, f, options, p, out.effects[static_cast<int>(EffectMethod::DirectionalLightMaps)]);
   plan_antiradiance(f, out.effects[static_cast<int>(EffectMethod::Antiradiance)]);
   plan_brf(input, f, options, out.facts.dynamic_meshes,
            out.effects[static_cast<int>(EffectMethod::BasisRadianceFields)]);

@@ -57,6 +57,13 @@ constexpr double kBrfCpuPerMadd = 1.0e-9;
 constexpr double kAtlasTexelBytes = 16.0;
 constexpr double kPaneTexelBytes = 6.0;
 
+// Directional light maps (gi/src/dlm): every photon casts 1 + a / (1 - a) rays for a mean
+// albedo a (Russian roulette with the albedo), and every hit on a glossy texel after a bounce
+// is splatted into ~(2r)^2 texels.
+constexpr double kDlmCpuPerRay = 3.5e-7;  // s; incoherent rays + splats: see docs/dlm.md (calibration)
+constexpr double kDlmCpuOverhead = 0.05;  // s; layout, rasterization, the splat normalizer, dilation
+constexpr double kDlmTexelBytesPerDirection = 8.0;
+
 double wall_seconds(double parallel_cpu, double serial_cpu) { return parallel_cpu / 2.0 + serial_cpu; }
 
 }  // namespace
@@ -138,6 +145,26 @@ BakeWork brf_work(std::size_t vertex_count, std::size_t triangle_count, const Pc
   const double nb = basis.basis;
   w.runtime_bytes = static_cast<std::uint64_t>(samples * n * coefficients * 4.0 +
                                                nb * static_cast<double>(vertex_count) * 4.0 + nb * nb * 4.0);
+  return w;
+}
+
+BakeWork dlm_work(const StaticSurfaceCensus& glossy, double albedo, const AtlasTexelEstimate& atlas,
+                  const DlmSettings& s, double* stored_texels, double* bytes_per_texel) {
+  BakeWork w;
+  const AtlasTexelEstimate t = atlas_texels(glossy, s.texels_per_metre);
+  const double a = std::clamp(albedo, 0.0, 0.95);
+  w.rays = static_cast<double>(s.photons) * (1.0 + a / (1.0 - a));
+  w.units = static_cast<double>(s.photons);
+  const double parallel = w.rays * kDlmCpuPerRay;
+  w.cpu_seconds = parallel + kDlmCpuOverhead;
+  w.bake_seconds = wall_seconds(parallel, kDlmCpuOverhead);
+  const double per_texel = kDlmTexelBytesPerDirection * s.directions;
+  // Stored texels: the glossy texels and one gutter ring around each chart.
+  const double texels = t.lit_texels + (t.pane_texels - t.lit_texels) / (2.0 * kPaneRings);
+  if (stored_texels) *stored_texels = texels;
+  if (bytes_per_texel) *bytes_per_texel = per_texel;
+  w.runtime_bytes = static_cast<std::uint64_t>(texels * per_texel +
+                                               4.0 * static_cast<double>(atlas.width) * atlas.height);
   return w;
 }
 

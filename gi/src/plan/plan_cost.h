@@ -11,6 +11,7 @@
 
 #include "brf/pca_basis.h"
 #include "brf/radiance_field.h"
+#include "dlm/dlm.h"
 #include "light_atlas/light_atlas.h"
 #include "plan/static_surface_census.h"
 #include "prm/prm.h"
@@ -51,5 +52,13 @@ BakeWork prm_work(const StaticSurfaceCensus& census, const PrmSettings& settings
 /// `terms`: 1 for a diffuse mesh, 1 + glossy terms for a glossy one.
 BakeWork brf_work(std::size_t vertex_count, std::size_t triangle_count, const PcaBasisSettings& basis,
                   const RadianceFieldSettings& field, int terms = 1);
+
+/// Directional light maps over the glossy surfaces (`glossy`: the census of the glossy static
+/// instances alone; `albedo`: the scene's mean albedo, which sets the photons' path length).
+/// runtime_bytes: N directions x 8 B per stored texel (RGB halves padded to 8 bytes) plus the
+/// atlas-sized texel index map (4 B per atlas texel of the scene's layout, `atlas`).
+/// `bytes_per_texel` out: N x 8.
+BakeWork dlm_work(const StaticSurfaceCensus& glossy, double albedo, const AtlasTexelEstimate& atlas,
+                  const DlmSettings& settings, double* stored_texels = nullptr, double* bytes_per_texel = nullptr);
 
 }  // namespace gi
