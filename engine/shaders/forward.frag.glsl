@@ -22,6 +22,7 @@
 
 #include "lighting_common.glsl"
 #include "shadow_common.glsl"
+#include "directional_radiance.glsl"
 
 in vec3 v_world;
 in vec3 v_normal;
@@ -43,12 +44,16 @@ layout(location = 25) uniform int u_use_glossy;
 layout(location = 26) uniform int u_double_sided;
 layout(location = 27) uniform float u_specular_factor;       // KHR_materials_specular
 layout(location = 28) uniform vec3 u_specular_color_factor;  // KHR_materials_specular
+// Directional radiance of static surfaces (engine/indirect_light.h): bins and elements, 0: none.
+layout(location = 29) uniform int u_directional_bins;
+layout(location = 30) uniform int u_directional_elements;
 
 layout(binding = 0) uniform sampler2D u_base_color_texture;
 layout(binding = 1) uniform sampler2D u_metallic_roughness_texture;
 layout(binding = 2) uniform sampler2D u_emissive_texture;
 layout(binding = 3) uniform sampler2D u_irradiance_atlas;
 layout(binding = 6) uniform sampler2D u_glossy_radiance;
+layout(binding = 7) uniform isampler2D u_directional_index;
 
 layout(location = 0) out vec4 o_radiance;
 
@@ -94,13 +99,22 @@ void main() {
   if (gl_FragCoord.x >= u_split_x && u_indirect_mode != 0) {
     // Indirect irradiance E (W/m^2) without direction information, reflected as uniformly
     // arriving light is: E / pi x the BRDF's directional albedo, per lobe. A provider's
-    // glossy texture replaces the specular lobe's share where its alpha (coverage) says so.
+    // glossy texture replaces the specular lobe's share where its alpha (coverage) says so;
+    // on a static texel with directional radiance, the specular lobe integrated against it
+    // replaces that share (the diffuse lobe keeps E).
     vec3 e = vec3(0.0);
     if (u_indirect_mode == 1) e = vec3(PI * u_ambient_radiance);
     if (u_indirect_mode == 2) e = texture(u_irradiance_atlas, v_uv1).rgb;
     if (u_indirect_mode == 3) e = v_vertex_irradiance;
     GltfBrdfValue albedo = gltf_directional_albedo(s.brdf, dot(s.normal, s.view));
     vec3 specular = e / PI * albedo.specular;
+    if (u_indirect_mode == 2 && u_directional_bins > 0) {
+      ivec2 size = textureSize(u_directional_index, 0);
+      ivec2 texel = clamp(ivec2(floor(v_uv1 * vec2(size))), ivec2(0), size - 1);
+      int element = texelFetch(u_directional_index, texel, 0).r;
+      if (element >= 0)
+        specular = directional_specular(s.brdf, s.normal, s.view, element, u_directional_bins, u_directional_elements);
+    }
     if (u_use_glossy != 0) {
       vec4 glossy = texelFetch(u_glossy_radiance, ivec2(gl_FragCoord.xy), 0);
       specular = mix(specular, glossy.rgb, clamp(glossy.a, 0.0, 1.0));

@@ -26,6 +26,23 @@ struct IndirectLightFrame {
   /// reflected radiance (rgb) and coverage (a): where a = 1 it replaces the specular lobe's
   /// share of the direction-less irradiance above. 0: none.
   std::uint32_t glossy_radiance_texture = 0;
+  /// Optional directional radiance of static surfaces at TEXCOORD_1 (a provider's
+  /// view-dependent term for glossy static surfaces; gi fills it from directional light
+  /// maps). Where a static mesh's texel has an element, the specular lobe of the glTF BRDF is
+  /// integrated against the element's bins (engine/directional_radiance.h, the GLSL twin
+  /// engine/shaders/directional_radiance.glsl) instead of taking the specular share of the
+  /// irradiance atlas, so that share is not counted twice; the diffuse lobe keeps the atlas.
+  ///   directional_index_texture      R32I texture of the irradiance atlas's size: the element
+  ///                                  index of each texel, -1 where there is none (read nearest)
+  ///   directional_radiance_buffer    SSBO, uvec2 per (bin, element), bin-major: packHalf2x16(r, g),
+  ///                                  packHalf2x16(b, 0), mean incoming radiance / the bin's scale
+  ///   directional_direction_buffer   SSBO, vec4 per bin: unit direction (xyz), the bin's scale (w)
+  /// 0 / 0 counts: none.
+  std::uint32_t directional_index_texture = 0;
+  std::uint32_t directional_radiance_buffer = 0;
+  std::uint32_t directional_direction_buffer = 0;
+  int directional_bin_count = 0;
+  int directional_element_count = 0;
 
   IndirectLightFrame() = default;
   IndirectLightFrame(const IndirectLightFrame&) = default;

@@ -39,9 +39,23 @@ enum TextureUnit : GLuint {
   kShadowMapsUnit = 4,
   kPointShadowMapsUnit = 5,
   kGlossyUnit = 6,
+  kDirectionalIndexUnit = 7,
 };
 constexpr GLuint kLightsBinding = 0;
 constexpr GLuint kVertexIrradianceBinding = 1;
+constexpr GLuint kDirectionalRadianceBinding = 2;  // directional_radiance.glsl
+constexpr GLuint kDirectionalDirectionBinding = 3;
+
+// A 1x1 R32I texture holding -1 ("no element"): what the directional index sampler reads
+// when the provider has no directional radiance.
+GlTexture no_directional_index() {
+  GlTexture t = GlTexture::create_2d(GL_R32I, 1, 1);
+  const GLint none = -1;
+  glTextureSubImage2D(t.id(), 0, 0, 0, 1, 1, GL_RED_INTEGER, GL_INT, &none);
+  glTextureParameteri(t.id(), GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  glTextureParameteri(t.id(), GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  return t;
+}
 
 enum IndirectMode : int { kIndirectNone = 0, kIndirectAmbient = 1, kIndirectAtlas = 2, kIndirectVertex = 3 };
 
@@ -80,7 +94,8 @@ class ForwardRenderer final : public Renderer {
         tonemap_(std::move(tonemap)),
         lights_buffer_(GlBuffer::create()),
         empty_vao_(GlVertexArray::create()),
-        albedo_table_(upload_gltf_albedo_table()) {
+        albedo_table_(upload_gltf_albedo_table()),
+        no_directional_index_(no_directional_index()) {
     forward_variants_.emplace(LightCounts{0, 0, 0, 0, 3}, std::move(forward));
     ensure_targets();
   }
@@ -115,6 +130,7 @@ class ForwardRenderer final : public Renderer {
   GlBuffer lights_buffer_;
   GlVertexArray empty_vao_;
   GlTexture albedo_table_;  // gltf_brdf.glsl's directional albedo table
+  GlTexture no_directional_index_;
   GlTexture hdr_;
   GlTexture depth_;
   GlTexture ldr_;
@@ -238,6 +254,17 @@ void ForwardRenderer::forward_pass(const Registry& registry, Entity camera, cons
   glBindTextureUnit(kIrradianceAtlasUnit, atlas != 0 ? atlas : scene_.white_texture());
   glBindTextureUnit(kGlossyUnit, glossy != 0 ? glossy : scene_.white_texture());
   glBindTextureUnit(kGltfAlbedoTableUnit, albedo_table_.id());
+  // Directional radiance of static surfaces (IndirectLightFrame::directional_*), when provided.
+  const bool directional = indirect != nullptr && indirect->directional_index_texture != 0 &&
+                           indirect->directional_radiance_buffer != 0 && indirect->directional_direction_buffer != 0 &&
+                           indirect->directional_bin_count > 0 && indirect->directional_element_count > 0;
+  glBindTextureUnit(kDirectionalIndexUnit, directional ? indirect->directional_index_texture : no_directional_index_.id());
+  if (directional) {
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kDirectionalRadianceBinding, indirect->directional_radiance_buffer);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kDirectionalDirectionBinding, indirect->directional_direction_buffer);
+  }
+  glUniform1i(29, directional ? indirect->directional_bin_count : 0);
+  glUniform1i(30, directional ? indirect->directional_element_count : 0);
 
   glUniformMatrix4fv(8, 1, GL_FALSE, glm::value_ptr(view_proj));
   glUniform3fv(16, 1, glm::value_ptr(camera_position));
