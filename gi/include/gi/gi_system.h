@@ -13,6 +13,8 @@
 //   light atlas  static world, static lights: uploaded once;
 //   PRM          moving lights: entry weights and the pane sum only on frames where a
 //                moving light changed;
+//   DLM          glossy static surfaces (directional light maps): uploaded once; the
+//                renderer integrates the specular lobe against them for the view, per pixel;
 //   BRF          dynamic rigid objects: per-vertex indirect light (world probes + light
 //                interreflected between objects, GPU), their bounce added into the static
 //                atlas; only on frames where an object moved or any light changed, and the
@@ -60,7 +62,7 @@ class GISystem final : public engine::IndirectLightProvider {
 
   /// Indirect light for the frame about to be drawn (GL context current).
   const engine::IndirectLightFrame& frame() override;
-  /// "light atlas", "light atlas + PRM", "light atlas + PRM + BRF", ...
+  /// "light atlas", "light atlas + PRM", "light atlas + PRM + BRF + DLM", ...
   const char* label() const override;
 
   struct Stats {
@@ -80,6 +82,8 @@ class GISystem final : public engine::IndirectLightProvider {
     std::size_t dynamic_vertices = 0;
     std::size_t brf_field_bytes = 0;  ///< Basis + fields of all dynamic meshes (CPU copy).
     std::size_t load_probe_ms = 0;    ///< Probe grid computed at load.
+    std::size_t dlm_texels = 0;       ///< Directional light maps: stored texels (glossy + gutter); 0: none.
+    std::size_t dlm_gpu_bytes = 0;    ///< ... their radiance, directions and index texture on the GPU.
     /// Methods of the bundle that turned off at run time, with why: "PRM: <reason>",
     /// "BRF: <reason>". The frame goes on without them (label() no longer names them).
     std::vector<std::string> disabled;

@@ -14,10 +14,12 @@
 #include "brf/brf_mesh.h"
 #include "brf/world_probes.h"
 #include "bundle/manifest.h"
+#include "dlm/dlm_io.h"
 #include "light_atlas/light_atlas.h"
 #include "light_atlas/light_atlas_io.h"
 #include "prm/prm.h"
 #include "prm/prm_io.h"
+#include "system/dlm_lighting.h"
 #include "system/light_atlas_lighting.h"
 #include "system/prm_lighting.h"
 #include "transport/static_scene.h"
@@ -38,6 +40,7 @@ struct GISystem::Impl {
   std::unique_ptr<LightAtlasLighting> atlas;
   std::unique_ptr<PrmLighting> prm;
   std::unique_ptr<BrfLighting> brf;
+  std::unique_ptr<DlmLighting> dlm;  // directional light maps of the glossy static surfaces
   engine::GlTexture composite;
   int width = 0, height = 0;
   std::uint64_t seen_prm_updates = 0;
@@ -53,6 +56,7 @@ struct GISystem::Impl {
   void relabel() {
     label = prm && !prm_disabled ? prm->label() : atlas ? atlas->label() : "";
     if (brf && !brf_disabled) label += label.empty() ? "BRF" : " + BRF";
+    if (dlm) label += " + DLM";
   }
   // The providers have told the host through the log already; the stats keep it.
   void turned_off(const char* method, const std::string& reason) {
@@ -70,9 +74,10 @@ engine::Result<std::unique_ptr<GISystem>> GISystem::load(const std::filesystem::
   const bool has_atlas = manifest->methods.contains("light_atlas");
   const bool has_prm = manifest->methods.contains("prm");
   const bool has_brf = manifest->methods.contains("brf");
-  if (!has_atlas && !has_prm && !has_brf)
+  const bool has_dlm = manifest->methods.contains(kDlmMethod);
+  if (!has_atlas && !has_prm && !has_brf && !has_dlm)
     return engine::Error{(bundle_dir / "manifest.json").string(), "methods",
-                         "the bundle holds no light atlas, PRM or basis radiance fields"};
+                         "the bundle holds no light atlas, PRM, basis radiance fields or directional light maps"};
   auto impl = std::make_unique<Impl>();
   std::ostringstream text;
   // The scene as the bakers saw it: hashes, layouts and BRF sources are checked against it.
@@ -87,6 +92,8 @@ engine::Result<std::unique_ptr<GISystem>> GISystem::load(const std::filesystem::
         return has_prm;
       case EffectMethod::BasisRadianceFields:
         return has_brf;
+      case EffectMethod::DirectionalLightMaps:
+        return has_dlm;
       default:
         return false;
     }
@@ -115,6 +122,32 @@ engine::Result<std::unique_ptr<GISystem>> GISystem::load(const std::filesystem::
     prm.emplace(std::move(p).value());
     text << "PRM: " << prm->cluster_count << " clusters, K = " << settings.prm_active_clusters
          << ", relit when a moving light changes\n";
+  }
+
+  // Directional light maps: drawn at the uv1 of the light atlas's (or PRM's) layout.
+  if (has_dlm) {
+    auto d = load_dlm(bundle_dir, input);
+    if (!d) return d.error();
+    const int w = atlas ? atlas->width : prm ? prm->width : 0;
+    const int h = atlas ? atlas->height : prm ? prm->height : 0;
+    if (w == 0)
+      return engine::Error{(bundle_dir / kDlmFile).string(), "",
+                           "directional light maps need the light atlas's (or PRM's) uv1 layout, and the bundle has "
+                           "neither (bake atlas too)"};
+    const int directions = static_cast<int>(d->directions.size());
+    const std::size_t glossy = d->stats.glossy_texels;
+    auto l = DlmLighting::from_bake(std::move(d).value(), w, h);
+    if (!l) {
+      engine::Error e = l.error();
+      e.file = (bundle_dir / kDlmFile).string();
+      return e;
+    }
+    impl->dlm = std::move(l).value();
+    impl->stats.dlm_texels = impl->dlm->texels();
+    impl->stats.dlm_gpu_bytes = impl->dlm->gpu_bytes();
+    text << "DLM: " << directions << " directions x " << impl->dlm->texels() << " texels (" << glossy
+         << " on glossy static surfaces, " << static_cast<double>(impl->dlm->gpu_bytes()) / 1e6
+         << " MB on the GPU); specular lobe vs the view, per pixel\n";
   }
 
   // Basis radiance fields, coupled to the static world before the static meshes get uv1
@@ -259,6 +292,7 @@ const engine::IndirectLightFrame& GISystem::frame() {
     m.frame.irradiance_atlas_texture = m.composite.id();
   }
   m.composed = true;
+  if (m.dlm) m.dlm->fill(m.frame);
   if (!work) ++m.stats.idle_frames;
   return m.frame;
 }
