@@ -10,10 +10,15 @@
 #include <engine/gpu/context.h>
 #include <engine/renderer.h>
 #include <engine/scene.h>
+#include <gi/bake.h>
+#include <gi/gi_system.h>
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <glm/gtc/matrix_transform.hpp>
 #include <limits>
 #include <optional>
@@ -257,6 +262,51 @@ TEST(DlmLighting, DirectionalBinsMatchTheCppTwinAtPixels) {
   }
   std::printf("directional bins: %d pixels checked, worst relative difference GPU vs C++ %.3g\n", checked, worst);
   EXPECT_GT(checked, 50);
+}
+
+// The glossy room baked through the public API (atlas + dlm), loaded by GISystem: the maps
+// reach the renderer's frame, label(), describe() and stats() name them, and a damaged
+// dlm.bin is refused naming the file.
+TEST(DlmLighting, GISystemLoadsTheGlossyRoomsMapsAndRefusesADamagedFile) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("dlm_lighting_test_" + std::to_string(::getpid()) + ".gibake");
+  fs::remove_all(dir);
+  auto asset = engine::load_gltf(GI_SOURCE_DIR "/assets/glossy_room.gltf");
+  ASSERT_TRUE(asset) << asset.error().to_string();
+  engine::Scene scene = engine::instantiate(std::move(asset).value());
+  auto report = gi::bake_bundle(gi::bake_input_from(scene), dir,
+                                {.preset = "preview", .methods = {"atlas", "dlm"}, .dlm_photons = 100'000});
+  ASSERT_TRUE(report) << report.error().to_string();
+  ASSERT_EQ(report->baked.size(), 2u);
+  EXPECT_EQ(report->baked[1].method, "dlm");
+  EXPECT_GT(report->baked[1].bytes, 0u);
+  {
+    auto ctx = engine::GpuContext::create_headless();
+    ASSERT_TRUE(ctx.ok()) << ctx.error().to_string();
+    auto gi_system = gi::GISystem::load(dir, scene);
+    ASSERT_TRUE(gi_system) << gi_system.error().to_string();
+    EXPECT_NE(std::string((*gi_system)->label()).find("DLM"), std::string::npos) << (*gi_system)->label();
+    EXPECT_NE((*gi_system)->describe().find("DLM: 32 directions"), std::string::npos) << (*gi_system)->describe();
+    EXPECT_NE((*gi_system)->describe().find("plan dlm: on"), std::string::npos) << (*gi_system)->describe();
+    EXPECT_GT((*gi_system)->stats().dlm_texels, 0u);
+    EXPECT_GT((*gi_system)->stats().dlm_gpu_bytes, 0u);
+    const engine::IndirectLightFrame& frame = (*gi_system)->frame();
+    EXPECT_NE(frame.directional_index_texture, 0u);
+    EXPECT_EQ(frame.directional_bin_count, 32);
+    EXPECT_EQ(static_cast<std::size_t>(frame.directional_element_count), (*gi_system)->stats().dlm_texels);
+  }
+  {
+    std::fstream f(dir / "dlm.bin", std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(100);
+    f.put('\x5a');
+  }
+  auto reload = engine::load_gltf(GI_SOURCE_DIR "/assets/glossy_room.gltf");
+  ASSERT_TRUE(reload);
+  engine::Scene again = engine::instantiate(std::move(reload).value());
+  auto damaged = gi::GISystem::load(dir, again);
+  ASSERT_FALSE(damaged);
+  EXPECT_NE(damaged.error().to_string().find("dlm.bin"), std::string::npos) << damaged.error().to_string();
+  fs::remove_all(dir);
 }
 
 }  // namespace
