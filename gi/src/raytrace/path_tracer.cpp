@@ -172,6 +172,11 @@ glm::vec3 PathTracer::radiance(const Ray& ray, Pcg32& rng) const {
   return t.emitted + t.reflected;
 }
 
+glm::vec3 PathTracer::reflected_radiance(const Ray& ray, Pcg32& rng) const {
+  const int max_e = settings_.max_bounces < 0 ? kUnlimited : settings_.max_bounces + 2;
+  return trace(ray, 0.0f, max_e, rng).reflected;
+}
+
 PathTracer::Irradiance PathTracer::irradiance(const glm::vec3& p, const glm::vec3& n, Pcg32& rng) const {
   // The receiver is a cosine lobe: "BRDF x cos" = cos, sampled with density cos / pi.
   ReferenceBrdf receiver;

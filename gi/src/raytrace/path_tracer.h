@@ -32,6 +32,11 @@ class PathTracer {
   /// and indirect reflected light.
   glm::vec3 radiance(const Ray& ray, Pcg32& rng) const;
 
+  /// radiance() without the emission (and sky) found at the ray's first hit: the light that
+  /// surface reflects towards the ray's origin, i.e. the indirect light arriving there along
+  /// the ray (what directional light maps hold).
+  glm::vec3 reflected_radiance(const Ray& ray, Pcg32& rng) const;
+
   struct Irradiance {
     glm::vec3 direct{0.0f};
     glm::vec3 indirect{0.0f};

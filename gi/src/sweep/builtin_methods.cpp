@@ -1,6 +1,7 @@
 #include "sweep/builtin_methods.h"
 
 #include "sweep/brf_sweep.h"
+#include "sweep/dlm_sweep.h"
 #include "sweep/light_atlas_sweep.h"
 #include "sweep/prm_sweep.h"
 #include "sweep/reference_sweep.h"
@@ -14,6 +15,7 @@ void register_builtin_sweep_methods(SweepRegistry& registry) {
   register_light_atlas_sweep(registry);
   register_prm_sweep(registry);
   register_brf_sweep(registry);
+  register_dlm_sweep(registry);
   //
   // GI METHODS (light atlas, PRM, DLM, BRF, antiradiance) register here as they land, one
   // add_method per method, with every quality knob declared (DESIGN.md 3, "Accuracy and its
