@@ -11,25 +11,66 @@ float directional_bin_alpha(int bin_count) {
   return std::tan(0.5f * theta);
 }
 
+glm::vec2 directional_lobe_sample_point(int j) {
+  // Hammersley: (j + 1/2) / M and the radical inverse of j in base 2.
+  std::uint32_t bits = static_cast<std::uint32_t>(j);
+  bits = (bits << 16u) | (bits >> 16u);
+  bits = ((bits & 0x55555555u) << 1u) | ((bits & 0xAAAAAAAAu) >> 1u);
+  bits = ((bits & 0x33333333u) << 2u) | ((bits & 0xCCCCCCCCu) >> 2u);
+  bits = ((bits & 0x0F0F0F0Fu) << 4u) | ((bits & 0xF0F0F0F0u) >> 4u);
+  bits = ((bits & 0x00FF00FFu) << 8u) | ((bits & 0xFF00FF00u) >> 8u);
+  return {(static_cast<float>(j) + 0.5f) / static_cast<float>(kDirectionalLobeSamples),
+          static_cast<float>(bits) * 2.3283064365386963e-10f};
+}
+
+int directional_bin_of(std::span<const glm::vec3> directions, const glm::vec3& n, const glm::vec3& l) {
+  int best = -1;
+  float best_dot = -2.0f;
+  for (std::size_t k = 0; k < directions.size(); ++k) {
+    if (!(glm::dot(n, directions[k]) > kDirectionalMinCos)) continue;
+    const float d = glm::dot(l, directions[k]);
+    if (d > best_dot) best_dot = d, best = static_cast<int>(k);
+  }
+  return best;
+}
+
 glm::vec3 directional_specular(const GltfBrdf& m, const glm::vec3& n, const glm::vec3& v,
                                std::span<const glm::vec3> directions, std::span<const glm::vec3> radiance) {
-  const float a_bin = directional_bin_alpha(static_cast<int>(directions.size()));
+  const float a_bin = kDirectionalLobeWidening * directional_bin_alpha(static_cast<int>(directions.size()));
   const float a = std::sqrt(m.alpha * m.alpha + a_bin * a_bin);
   const float n_dot_v = std::max(glm::dot(n, v), 1e-4f);
+  // The frame (t, b, n) and v in it.
+  glm::vec3 t = std::fabs(n.x) > 0.9f ? glm::vec3(0.0f, 1.0f, 0.0f) : glm::vec3(1.0f, 0.0f, 0.0f);
+  t = glm::normalize(t - n * glm::dot(n, t));
+  const glm::vec3 b = glm::cross(n, t);
+  const glm::vec3 ve(glm::dot(v, t), glm::dot(v, b), n_dot_v);
+  // Heitz 2018, "Sampling the GGX Distribution of Visible Normals".
+  const glm::vec3 vh = glm::normalize(glm::vec3(a * ve.x, a * ve.y, ve.z));
+  const float lensq = vh.x * vh.x + vh.y * vh.y;
+  const glm::vec3 t1 = lensq > 0.0f ? glm::vec3(-vh.y, vh.x, 0.0f) / std::sqrt(lensq) : glm::vec3(1.0f, 0.0f, 0.0f);
+  const glm::vec3 t2 = glm::cross(vh, t1);
+  const float g1 = 2.0f * n_dot_v / (n_dot_v + std::sqrt(a * a + (1.0f - a * a) * n_dot_v * n_dot_v));
+  const std::size_t count = std::min(directions.size(), radiance.size());
   float sum_w = 0.0f;
   glm::vec3 sum(0.0f);
-  const std::size_t count = std::min(directions.size(), radiance.size());
-  for (std::size_t k = 0; k < count; ++k) {
-    const glm::vec3 l = directions[k];
+  for (int j = 0; j < kDirectionalLobeSamples; ++j) {
+    const glm::vec2 u = directional_lobe_sample_point(j);
+    const float r = std::sqrt(u.x), phi = 6.28318530718f * u.y;
+    const float p1 = r * std::cos(phi);
+    const float s = 0.5f * (1.0f + vh.z);
+    const float p2 = (1.0f - s) * std::sqrt(std::max(0.0f, 1.0f - p1 * p1)) + s * r * std::sin(phi);
+    const glm::vec3 nh = p1 * t1 + p2 * t2 + std::sqrt(std::max(0.0f, 1.0f - p1 * p1 - p2 * p2)) * vh;
+    const glm::vec3 ne = glm::normalize(glm::vec3(a * nh.x, a * nh.y, std::max(0.0f, nh.z)));
+    const glm::vec3 h = ne.x * t + ne.y * b + ne.z * n;
+    const glm::vec3 l = 2.0f * glm::dot(v, h) * h - v;
     const float n_dot_l = glm::dot(n, l);
-    if (!(n_dot_l > kDirectionalMinCos)) continue;
-    const glm::vec3 s = l + v;
-    const float len2 = glm::dot(s, s);
-    const glm::vec3 h = len2 > 1e-12f ? s / std::sqrt(len2) : n;
-    const float n_dot_h = std::clamp(glm::dot(n, h), 0.0f, 1.0f);
-    const float w = gltf_ggx_distribution(n_dot_h, a) * gltf_smith_visibility(n_dot_v, n_dot_l, a) * n_dot_l;
+    if (!(n_dot_l > 0.0f)) continue;
+    const int k = directional_bin_of(directions.first(count), n, l);
+    if (k < 0) continue;
+    // f cos / pdf of the visible-normal sampling, without Fresnel: G2(v, l) / G1(v).
+    const float w = 4.0f * n_dot_l * n_dot_v * gltf_smith_visibility(n_dot_v, n_dot_l, a) / g1;
     sum_w += w;
-    sum += w * radiance[k];
+    sum += w * radiance[static_cast<std::size_t>(k)];
   }
   if (!(sum_w > 0.0f)) return glm::vec3(0.0f);
   return gltf_directional_albedo(m, glm::dot(n, v)).specular * (sum / sum_w);

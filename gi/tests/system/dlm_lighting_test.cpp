@@ -208,7 +208,7 @@ TEST(DlmLighting, DirectionalBinsMatchTheCppTwinAtPixels) {
   const glm::dmat4 inv(glm::inverse(glm::perspective(cam.yfov_rad, cam.aspect > 0.0f ? cam.aspect : 1.0f, cam.znear_m,
                                                      cam.zfar_m) *
                                     glm::inverse(world)));
-  int checked = 0;
+  int checked = 0, on_boundary = 0;
   double worst = 0.0;
   for (int py = 4; py < kSize; py += 7) {
     for (int px = 4; px < kSize; px += 7) {
@@ -246,6 +246,20 @@ TEST(DlmLighting, DirectionalBinsMatchTheCppTwinAtPixels) {
       std::vector<glm::vec3> stored;
       for (const glm::vec3& l : radiance) stored.push_back(l);
       const glm::vec3 expected = engine::directional_specular(brdf, n, v, dirs, stored);
+      // A lobe sample lying on the boundary between two bins switches bins under the
+      // rasterizer's interpolation error of v (checked at 6e-3): such pixels are counted, not compared.
+      bool boundary = false;
+      const glm::vec3 tu = glm::normalize(glm::cross(n, std::fabs(n.x) > 0.9f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0)));
+      const glm::vec3 tv = glm::cross(n, tu);
+      for (const glm::vec3 dv : {6e-3f * tu, -6e-3f * tu, 6e-3f * tv, -6e-3f * tv}) {
+        const glm::vec3 e2 = engine::directional_specular(brdf, n, glm::normalize(v + dv), dirs, stored);
+        for (int ch = 0; ch < 3; ++ch)
+          boundary = boundary || std::fabs(e2[ch] - expected[ch]) > 3e-2f * expected[ch] + 1e-5f;
+      }
+      if (boundary) {
+        ++on_boundary;
+        continue;
+      }
       const std::size_t i = static_cast<std::size_t>(py * kSize + px) * 4;  // rows top to bottom
       const glm::vec3 got(img.pixels[i], img.pixels[i + 1], img.pixels[i + 2]);
       for (int ch = 0; ch < 3; ++ch) {
@@ -254,14 +268,17 @@ TEST(DlmLighting, DirectionalBinsMatchTheCppTwinAtPixels) {
         // Half-float storage of the bins (2^-11) and of the HDR target (2^-11), and the
         // rasterizer's interpolated position and normal against the CPU's ray cast: the view
         // angle differs slightly, which moves the specular albedo by up to ~2% on the walls
-        // seen at grazing angles (measured worst 0.0197; a constant channel shows it alone).
+        // seen at grazing angles (a constant channel shows it alone).
         EXPECT_NEAR(g, e, 3e-2 * e + 1e-5) << "pixel " << px << ", " << py << " channel " << ch << " mesh " << bm;
       }
       ++checked;
     }
   }
-  std::printf("directional bins: %d pixels checked, worst relative difference GPU vs C++ %.3g\n", checked, worst);
+  std::printf("directional bins: %d pixels checked (%d on a bin boundary skipped), worst relative difference GPU vs "
+              "C++ %.3g\n",
+              checked, on_boundary, worst);
   EXPECT_GT(checked, 50);
+  EXPECT_LT(on_boundary, checked / 5);
 }
 
 // The glossy room baked through the public API (atlas + dlm), loaded by GISystem: the maps
