@@ -2,6 +2,7 @@
 
 #include <engine/directional_radiance.h>
 #include <engine/scene.h>
+#include <gi/error_metrics.h>
 
 #include <cmath>
 #include <string>
@@ -170,6 +171,10 @@ void register_dlm_sweep(SweepRegistry& registry) {
     // The renderer's evaluation (engine::directional_specular) at every stored glossy texel.
     const AtlasTexels& tex = g->s.texels;
     std::vector<glm::vec3> values(tex.valid.size(), glm::vec3(0.0f));
+    // The direction-less alternative on the same texels: the maps' own irradiance
+    // E = sum_k L_k C_k reflected as E / pi x the specular albedo (what the renderer draws
+    // without DLM from a perfect atlas): the "atlas_rel_rmse" extra.
+    std::vector<glm::vec3> atlas_values(tex.valid.size(), glm::vec3(0.0f));
     std::vector<std::uint8_t> mask(tex.valid.size(), 0);
     std::vector<glm::vec3> l(dlm->directions.size());
     for (std::size_t i = 0; i < dlm->texels.size(); ++i) {
@@ -181,15 +186,22 @@ void register_dlm_sweep(SweepRegistry& registry) {
       }
       const glm::vec3 v = glm::normalize(g->eye - tex.position[t]);
       values[t] = engine::directional_specular(g->brdf[t], tex.normal[t], v, dlm->directions, l);
+      const std::vector<float> c = dlm_bin_cosine_weights(dlm->directions, tex.normal[t]);
+      glm::vec3 e(0.0f);
+      for (std::size_t k = 0; k < l.size(); ++k) e += c[k] * l[k];
+      atlas_values[t] = e / 3.14159265f *
+                        engine::gltf_directional_albedo(g->brdf[t], glm::dot(tex.normal[t], v)).specular;
       mask[t] = 1;
     }
     MethodOutput out;
+    const RgbField atlas_field = RgbField::from_texels(tex.width, tex.height, atlas_values, mask);
     out.field = RgbField::from_texels(tex.width, tex.height, values, std::move(mask));
     out.costs.bake_seconds = dlm->stats.total_seconds;
     // What the runtime uploads: texels x directions x 8 B + the R32I index map.
     out.costs.bytes = static_cast<std::uint64_t>(dlm->texels.size()) * dlm->directions.size() * 8u +
                       static_cast<std::uint64_t>(dlm->width) * static_cast<std::uint64_t>(dlm->height) * 4u;
-    out.extras = {{"glossy_texels", static_cast<double>(dlm->stats.glossy_texels)},
+    out.extras = {{"atlas_rel_rmse", relative_rmse(atlas_field, ctx.reference)},
+                  {"glossy_texels", static_cast<double>(dlm->stats.glossy_texels)},
                   {"deposits", static_cast<double>(dlm->stats.deposits)}};
     return out;
   };
