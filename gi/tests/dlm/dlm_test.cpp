@@ -373,8 +373,10 @@ double specular_error(float roughness, float cos_view, std::uint64_t photons, do
   return std::sqrt(err2 / std::max(ref2, 1e-30));
 }
 
-// Measured (200k photons, 4 texels/m, 32 directions): see docs/dlm.md. The bounds leave ~1.5x
-// headroom over the measured errors.
+// Measured (200k photons, 4 texels/m, 32 directions; docs/dlm.md): rel RMSE 0.141 at cos_v 0.7
+// (mean 0.1016 vs 0.0993), 0.383 at cos_v 0.1 (mean +34%: grazing views read the bins next to
+// the horizon, whose mean includes brighter directions above). The bounds leave ~1.3-2.5x
+// headroom; the bake is deterministic, so they guard against regressions, not noise.
 TEST(DlmReference, GlossyFloorUnderOnePointLight) {
   double d = 0.0, r = 0.0;
   const double e = specular_error(0.15f, 0.7f, 200'000, &d, &r);
