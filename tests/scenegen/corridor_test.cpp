@@ -72,3 +72,34 @@ TEST(CorridorScene, CorridorFloorSeesNeitherTheLampNorAnythingTheLampLights) {
 }
 
 }  // namespace
+
+namespace {
+
+// The door is the antiradiance region (gi.region "deforming") and is hinged at its node's
+// origin about local +y: rotated back to 0 degrees it fills the doorway (x = 6, z in
+// [4.4, 5.4]) up to the 1 cm gaps at the jambs, whatever angle it was authored at.
+TEST(CorridorScene, DoorIsADeformingRegionHingedAtItsOrigin) {
+  const engine::SceneAsset scene = scenegen::corridor();
+  const auto door = std::find_if(scene.nodes.begin(), scene.nodes.end(), [](const engine::Node& n) { return n.name == "door"; });
+  ASSERT_NE(door, scene.nodes.end());
+  EXPECT_EQ(door->gi.region, engine::GiRegion::Deforming);
+  EXPECT_EQ(door->translation, glm::vec3(6.0f, 0.0f, 5.4f));
+  // Only a rotation about y: the hinge axis.
+  EXPECT_NEAR(door->rotation.x, 0.0f, 1e-6f);
+  EXPECT_NEAR(door->rotation.z, 0.0f, 1e-6f);
+  ASSERT_GE(door->mesh, 0);
+  glm::vec3 lo(1e9f), hi(-1e9f);
+  for (const engine::Primitive& p : scene.meshes[static_cast<std::size_t>(door->mesh)].primitives)
+    for (const glm::vec3& v : p.positions) {
+      const glm::vec3 w = v + door->translation;  // closed: rotation 0
+      lo = glm::min(lo, w);
+      hi = glm::max(hi, w);
+    }
+  EXPECT_NEAR(lo.z, 4.41f, 1e-4f);
+  EXPECT_NEAR(hi.z, 5.39f, 1e-4f);
+  EXPECT_NEAR(lo.y, 0.0f, 1e-4f);
+  EXPECT_NEAR(hi.y, 2.05f, 1e-4f);
+  EXPECT_LE(hi.x - lo.x, 0.05f);
+}
+
+}  // namespace

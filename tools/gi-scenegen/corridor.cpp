@@ -67,11 +67,16 @@ engine::SceneAsset corridor() {
   b.add_mesh_node("corridor_floor", corridor_floor, engine::Mobility::Static);
 
   // The door, left ajar: hinged at the room side of the doorway (x = 6, z = 5.4), swung
-  // 50 degrees into the room.
+  // 50 degrees into the room. The node's origin is the hinge and its local +y the hinge
+  // axis, so a game opens or closes it by rotating the node about y alone (0 degrees: shut,
+  // the leaf spanning the doorway's z [4.41, 5.39]). Flagged gi.region "deforming": its
+  // light exchange with the room and corridor is solved at runtime by antiradiance
+  // (docs/antiradiance.md), not baked.
   MeshBuilder door;
   door.box(door_mat, {-0.02f, 1.025f, -0.5f}, {0.02f, 1.025f, 0.49f});
-  b.add_mesh_node("door", door, engine::Mobility::Static, {kRoomSize, 0.0f, 5.4f},
-                  glm::angleAxis(glm::radians(50.0f), glm::vec3(0, 1, 0)));
+  const int door_node = b.add_mesh_node("door", door, engine::Mobility::Static, {kRoomSize, 0.0f, 5.4f},
+                                        glm::angleAxis(glm::radians(50.0f), glm::vec3(0, 1, 0)));
+  b.asset().nodes[static_cast<std::size_t>(door_node)].gi.region = engine::GiRegion::Deforming;
 
   // The lamp: 0.8 x 0.8 m on the alcove's room-side wall, facing +x (away from the room).
   const float x_lamp = kAnnexX + 1e-4f;
