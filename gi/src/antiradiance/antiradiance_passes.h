@@ -1,0 +1,82 @@
+#pragma once
+// The four operations of one antiradiance iteration (Dachsbacher et al. 2007, §3.1-3.2,
+// §4.2) as an interface with two implementations: the CPU twin (CpuAntiradiancePasses,
+// here) and the compute shaders (AntiradianceGpuPass, antiradiance_gpu_pass.h). Both keep
+// the same tables and sum in the same order, so the tests compare them value by value;
+// run_antiradiance() (antiradiance_solver.h) drives either through the same schedule.
+//
+// Tables (bins = m, nodes and leaves of the hierarchy, RGB per entry):
+//   I_ex[node][bin]   exitant intensity I_L - I_A (W/sr): leaves from the local pass, inner
+//                     nodes the sum of their leaves (pull)
+//   L_in[node][bin]   incident radiance gathered over the node's links (global pass)
+//   L_leaf[leaf][bin] incident radiance at a leaf: its own plus its ancestors' (push)
+//   I_L, I_A[leaf][bin]  reflected intensity (eq. 18, diffuse) and antiradiance (eq. 19)
+//   E[leaf]           indirect irradiance (W/m^2) gathered by the last radiance step
+//
+//   gi::CpuAntiradiancePasses cpu(hierarchy, bins, links);
+//   cpu.reset(direct);  cpu.global();  cpu.push();  cpu.local(true, true);  cpu.pull();
+
+#include <span>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "antiradiance/directional_bins.h"
+#include "antiradiance/element_hierarchy.h"
+#include "antiradiance/link_mesh.h"
+
+namespace gi {
+
+/// Sums of a local pass over all leaves (each leaf's partial sum in float, bins then
+/// channels; leaves summed in double in leaf order).
+struct LocalPassSums {
+  double change = 0.0;     ///< sum |I_ex new - I_ex old|
+  double magnitude = 0.0;  ///< sum |I_ex new|
+};
+
+class AntiradiancePasses {
+ public:
+  virtual ~AntiradiancePasses() = default;
+  /// Starts from the direct light: I_L = a <n|w>+ albedo/pi E_direct (eq. 18 with the direct
+  /// irradiance, no antiradiance: "shadowing of the direct illumination is done by the
+  /// shadow map", §3.3), I_A = 0, E = 0; pulls. `direct`: W/m^2 per leaf.
+  virtual void reset(std::span<const glm::vec3> direct) = 0;
+  /// Global pass (operator U, eq. 16): L_in[r][bin] = sum over r's links of F I_ex[s][bin].
+  virtual void global() = 0;
+  /// Push: L_leaf = L_in of the leaf and of all its ancestors (leaf first, then up).
+  virtual void push() = 0;
+  /// Local pass: K (eq. 18, diffuse: E = sum_b <n|-w_b>+ L_leaf[b] omega_b, I_L[b] =
+  /// a <n|w_b>+ albedo/pi (E + E_direct)) when `radiance`, J (eq. 19: I_A[b] =
+  /// a <n|-w_b>+ L_leaf[b]) when `antiradiance`; I_ex = I_L - I_A at the leaves.
+  virtual LocalPassSums local(bool radiance, bool antiradiance) = 0;
+  /// Pull: I_ex of every inner node = the sum of its leaves' I_ex.
+  virtual void pull() = 0;
+  /// Indirect irradiance per leaf (W/m^2) from the last radiance step.
+  virtual std::vector<glm::vec3> irradiance() const = 0;
+};
+
+/// The CPU twin: plain loops over the tables, single-threaded, float sums in the shaders' order.
+class CpuAntiradiancePasses final : public AntiradiancePasses {
+ public:
+  /// Keeps references: the hierarchy, bins and links must outlive it (their sizes must not change).
+  CpuAntiradiancePasses(const ElementHierarchy& h, const DirectionalBins& bins, const LinkMesh& links);
+  void reset(std::span<const glm::vec3> direct) override;
+  void global() override;
+  void push() override;
+  LocalPassSums local(bool radiance, bool antiradiance) override;
+  void pull() override;
+  std::vector<glm::vec3> irradiance() const override { return e_; }
+
+  /// The tables, for tests (RGB triples, row-major [row][bin]).
+  const std::vector<glm::vec3>& exitant() const { return i_ex_; }
+  const std::vector<glm::vec3>& incident_leaf() const { return l_leaf_; }
+
+ private:
+  const ElementHierarchy& h_;
+  const DirectionalBins& bins_;
+  const LinkMesh& links_;
+  int m_ = 0;
+  std::vector<glm::vec3> i_ex_, l_in_, l_leaf_, i_l_, i_a_, e_, direct_;
+};
+
+}  // namespace gi

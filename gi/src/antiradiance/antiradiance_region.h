@@ -1,0 +1,93 @@
+#pragma once
+// One deforming region solved by antiradiance (Dachsbacher et al. 2007) on the CPU: the
+// elements, bins and links (element_hierarchy.h, directional_bins.h, link_mesh.h), the
+// direct light at the elements (antiradiance_direct_light.h) and the iteration
+// (antiradiance_solver.h). A frame where a deforming instance moved: set its transform,
+// then update(): relinks only the moved groups, recomputes the direct light and solves.
+// The GPU twin (antiradiance_gpu_pass.h) runs the same passes over the region's tables.
+//
+// What it outputs (a deviation from the paper, docs/antiradiance.md): the static world's
+// light is baked with visibility (light atlas, PRM) without the deforming instances; the
+// region adds the change its instances make. At creation it solves the baseline once: the
+// same elements and static-static links without the deforming groups, direct light
+// without their shadows. delta() = E(now) - E(baseline) at the static leaves and E(now) at
+// the deforming ones. Antiradiance's discretization leaks (light through walls, §5, Fig.
+// 13) are then the same in both solves and cancel in the static part of the delta, instead
+// of adding light the baked atlas already shadows correctly.
+//   auto region = gi::AntiradianceRegion::create(input, settings).value();
+//   region.set_instance_transform(door, m);  region.update();
+//   std::vector<glm::vec3> e = region.irradiance();   // indirect W/m^2 per leaf
+
+#include <memory>
+#include <vector>
+
+#include <engine/result.h>
+#include <gi/bake_input.h>
+
+#include "antiradiance/antiradiance_direct_light.h"
+#include "antiradiance/antiradiance_passes.h"
+#include "antiradiance/antiradiance_settings.h"
+#include "antiradiance/antiradiance_solver.h"
+#include "antiradiance/directional_bins.h"
+#include "antiradiance/element_hierarchy.h"
+#include "antiradiance/link_mesh.h"
+
+namespace gi {
+
+/// Counters of the last update().
+struct AntiradianceUpdateCounters {
+  std::size_t moved_groups = 0;
+  std::size_t relinked_elements = 0;  ///< Elements whose links were rebuilt.
+  std::size_t links_made = 0;         ///< Links built by the relink.
+  std::size_t links = 0;              ///< Links in all after it.
+};
+
+class AntiradianceRegion {
+ public:
+  /// Errors: see build_element_hierarchy and AntiradianceDirectLight::create; bins_per_side
+  /// outside [1, 64].
+  static engine::Result<AntiradianceRegion> create(const BakeInput& input, const AntiradianceSettings& settings);
+
+  /// Moves deforming instance `instance` (BakeInput index). Returns false (and does nothing)
+  /// when it is not a deforming instance of the region or the matrix equals the current one.
+  bool set_instance_transform(std::uint32_t instance, const glm::mat4& object_to_world);
+  /// Relinks what moved since the last update (nothing when nothing moved) and recomputes
+  /// the direct light; then solves on the CPU unless `solve` is false (the GPU twin solves).
+  AntiradianceSolveReport update(bool solve = true);
+
+  /// Indirect irradiance (W/m^2) per leaf of the last CPU solve (its energy guard applied).
+  std::vector<glm::vec3> irradiance() const {
+    std::vector<glm::vec3> e = cpu_->irradiance();
+    for (glm::vec3& v : e) v *= last_.output_scale;
+    return e;
+  }
+  /// The report of the last CPU solve.
+  const AntiradianceSolveReport& last_report() const { return last_; }
+  /// The baseline's indirect irradiance per leaf (the world without the region; 0 at the
+  /// region's leaves).
+  const std::vector<glm::vec3>& baseline() const { return baseline_; }
+  /// What the region adds: `irradiance` (a solve's result per leaf) minus the baseline.
+  std::vector<glm::vec3> delta(const std::vector<glm::vec3>& irradiance) const;
+  const std::vector<glm::vec3>& direct() const { return direct_; }
+  const ElementHierarchy& hierarchy() const { return *hierarchy_; }
+  const DirectionalBins& bins() const { return *bins_; }
+  const LinkMesh& links() const { return *links_; }
+  const AntiradianceSettings& settings() const { return settings_; }
+  const AntiradianceUpdateCounters& counters() const { return counters_; }
+
+ private:
+  AntiradianceSettings settings_;
+  // Held by pointer so the CPU passes' references stay valid when the region moves.
+  std::unique_ptr<DirectionalBins> bins_;
+  std::unique_ptr<ElementHierarchy> hierarchy_;
+  std::unique_ptr<LinkMesh> links_;
+  std::unique_ptr<AntiradianceDirectLight> direct_light_;
+  std::unique_ptr<CpuAntiradiancePasses> cpu_;
+  std::vector<glm::vec3> direct_;
+  std::vector<glm::vec3> baseline_;
+  std::vector<int> moved_;
+  AntiradianceSolveReport last_;
+  AntiradianceUpdateCounters counters_;
+};
+
+}  // namespace gi

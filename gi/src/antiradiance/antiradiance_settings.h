@@ -1,0 +1,43 @@
+#pragma once
+// The quality knobs of the antiradiance solver (Dachsbacher et al. 2007), one struct so the
+// bake, the runtime and the sweep read the same names.
+//   gi::AntiradianceSettings s;  s.bins_per_side = 8;  s.iterations = 4;
+
+#include <cstdint>
+
+namespace gi {
+
+/// Which iteration of §2.2 solves eqs. 11-12.
+enum class AntiradianceScheme : std::uint8_t {
+  Symmetric,   ///< Alternate eq. 13 and eq. 14 (one global pass per iteration; the paper's choice).
+  Asymmetric,  ///< Per radiance step (eq. 13), `antiradiance_steps` steps of eq. 14 with L frozen.
+};
+
+struct AntiradianceSettings {
+  /// Octahedral cells per side: bins = n^2 (8: the paper's 128 bins).
+  int bins_per_side = 8;
+  /// Leaves are triangle pieces whose longest edge is at most this (metres).
+  float patch_size_m = 0.5f;
+  /// Static triangles within this distance of the deforming region's swept bounds exchange
+  /// light with it (metres).
+  float exchange_radius_m = 8.0f;
+  /// The oracle links two elements when each one's solid angle seen from the other is at
+  /// most oracle_scale x the smallest bin solid angle (1: the paper's rule).
+  float oracle_scale = 1.0f;
+  /// Iterations (global + push + local + pull each); asymmetric: radiance steps.
+  int iterations = 8;
+  /// Asymmetric: antiradiance steps (eq. 14) before each radiance step (eq. 13).
+  int antiradiance_steps = 4;
+  AntiradianceScheme scheme = AntiradianceScheme::Symmetric;
+  /// Stop early when the relative residual (sum |Delta I_ex| / sum |I_ex|) drops below it;
+  /// 0: always run `iterations`.
+  double residual_tolerance = 0.0;
+  /// Symmetric: fall back to the asymmetric scheme (restarted from the direct light) when
+  /// the residual grew this many iterations in a row, or the intensities exceed the bound.
+  int growth_limit = 2;
+  /// Stratified points per area light / emissive triangle for the direct light.
+  int area_light_samples = 16;
+  std::uint64_t seed = 1;
+};
+
+}  // namespace gi

@@ -1,0 +1,189 @@
+#include "antiradiance/link_mesh.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <glm/gtc/constants.hpp>
+
+namespace gi {
+
+namespace {
+
+// 16 points on the unit disc: the centre, rings of 5 at r = 0.5 and 10 at r = 0.85 (equal
+// area strata, fixed so links are deterministic).
+constexpr int kSamples = 16;
+struct DiscPoint {
+  float x, y;
+};
+constexpr DiscPoint kDisc[kSamples] = {
+    {0.0f, 0.0f},          {0.5f, 0.0f},           {0.1545f, 0.4755f},    {-0.4045f, 0.2939f},
+    {-0.4045f, -0.2939f},  {0.1545f, -0.4755f},    {0.8084f, 0.2627f},    {0.5f, 0.6877f},
+    {0.0f, 0.85f},         {-0.5f, 0.6877f},       {-0.8084f, 0.2627f},   {-0.8084f, -0.2627f},
+    {-0.5f, -0.6877f},     {0.0f, -0.85f},         {0.5f, -0.6877f},      {0.8084f, -0.2627f}};
+
+struct Linker {
+  const ElementHierarchy& h;
+  const DirectionalBins& bins;
+  float threshold_sr;
+  std::vector<Link>& out;
+
+  const ElementNode& node(std::int32_t i) const { return h.nodes[static_cast<std::size_t>(i)]; }
+
+  static float regularizer(const ElementNode& n) {
+    return std::min(n.area_m2 / glm::pi<float>(), n.radius_m * n.radius_m);
+  }
+
+  // Receiver r, sender s wholly behind r's plane: nothing to receive.
+  bool behind(const ElementNode& r, const ElementNode& s) const {
+    if (r.normal == glm::vec3(0.0f)) return false;
+    return glm::dot(r.normal, s.center - r.center) < -s.radius_m;
+  }
+
+  // Directed link r <- s, spread over the bins the sender covers as seen from the receiver
+  // (§3.1: "the precise computation of exchanges between all pairs of bins in the cone
+  // subtended by the sender"): kSamples fixed points on a disc standing for the sender (in
+  // its plane with its area for a surface element; facing the receiver with its bounding
+  // radius for a cluster), each direction point -> receiver centre picks a bin; a bin gets
+  // the share of samples that fell in it. One record per (receiver, sender, bin).
+  void directed(std::int32_t r, std::int32_t s) {
+    const ElementNode& rn = node(r);
+    const ElementNode& sn = node(s);
+    if (behind(rn, sn)) return;
+    const glm::vec3 d = rn.center - sn.center;
+    const float d2 = glm::dot(d, d);
+    const glm::vec3 axis = d2 > 0.0f ? d / std::sqrt(d2) : (rn.normal != glm::vec3(0.0f) ? -rn.normal : glm::vec3(0, 0, 1));
+    const bool surface = sn.normal != glm::vec3(0.0f);
+    const glm::vec3 disc_normal = surface ? sn.normal : axis;
+    const float disc_radius = surface ? std::sqrt(sn.area_m2 / glm::pi<float>()) : sn.radius_m;
+    const glm::vec3 t = glm::normalize(std::abs(disc_normal.x) < 0.9f ? glm::cross(disc_normal, glm::vec3(1, 0, 0))
+                                                                       : glm::cross(disc_normal, glm::vec3(0, 1, 0)));
+    const glm::vec3 bt = glm::cross(disc_normal, t);
+    const float sep = std::sqrt(d2);
+    const bool overlap = sep < rn.radius_m + sn.radius_m;
+    const float reg = d2 + (overlap ? regularizer(rn) + regularizer(sn) : 0.0f);
+    int bins_hit[kSamples];
+    for (int k = 0; k < kSamples; ++k) {
+      const glm::vec3 p = sn.center + disc_radius * (kDisc[k].x * t + kDisc[k].y * bt);
+      const glm::vec3 dir = rn.center - p;
+      bins_hit[k] = glm::dot(dir, dir) > 0.0f ? bins.bin_of(glm::normalize(dir)) : bins.bin_of(axis);
+    }
+    std::sort(bins_hit, bins_hit + kSamples);
+    for (int k = 0; k < kSamples;) {
+      int e = k;
+      while (e < kSamples && bins_hit[e] == bins_hit[k]) ++e;
+      const float share = static_cast<float>(e - k) / static_cast<float>(kSamples);
+      out.push_back({r, s, bins_hit[k], share / (reg * bins.solid_angle(bins_hit[k]))});
+      k = e;
+    }
+  }
+
+  void link(std::int32_t a, std::int32_t b) {
+    directed(a, b);
+    directed(b, a);
+  }
+
+  void refine(std::int32_t a, std::int32_t b) {
+    const ElementNode& an = node(a);
+    const ElementNode& bn = node(b);
+    if (behind(an, bn) && behind(bn, an)) return;  // back to back: no exchange either way
+    const float d2 = glm::dot(an.center - bn.center, an.center - bn.center);
+    const float d = std::sqrt(d2);
+    const bool a_leaf = an.child_count == 0, b_leaf = bn.child_count == 0;
+    const float sa = glm::pi<float>() * an.radius_m * an.radius_m / std::max(d2, 1e-30f);
+    const float sb = glm::pi<float>() * bn.radius_m * bn.radius_m / std::max(d2, 1e-30f);
+    const bool fine = d > an.radius_m + bn.radius_m && std::max(sa, sb) <= threshold_sr;
+    if (fine || (a_leaf && b_leaf)) {
+      link(a, b);
+      return;
+    }
+    const bool split_a = b_leaf || (!a_leaf && an.radius_m >= bn.radius_m);
+    const std::int32_t split = split_a ? a : b, other = split_a ? b : a;
+    const ElementNode& sn = node(split);
+    for (std::int32_t c = 0; c < sn.child_count; ++c)
+      refine(h.children[static_cast<std::size_t>(sn.first_child + c)], other);
+  }
+
+  // Self-links are always subdivided: all pairs of children, each child with itself.
+  void self(std::int32_t a) {
+    const ElementNode& an = node(a);
+    for (std::int32_t i = 0; i < an.child_count; ++i) {
+      const std::int32_t ci = h.children[static_cast<std::size_t>(an.first_child + i)];
+      self(ci);
+      for (std::int32_t j = i + 1; j < an.child_count; ++j)
+        refine(ci, h.children[static_cast<std::size_t>(an.first_child + j)]);
+    }
+  }
+};
+
+void sort_and_index(const ElementHierarchy& h, LinkMesh& mesh) {
+  std::sort(mesh.links.begin(), mesh.links.end(), [](const Link& x, const Link& y) {
+    if (x.receiver != y.receiver) return x.receiver < y.receiver;
+    return x.sender != y.sender ? x.sender < y.sender : x.bin < y.bin;
+  });
+  mesh.offsets.assign(h.nodes.size() + 1, 0u);
+  for (const Link& l : mesh.links) ++mesh.offsets[static_cast<std::size_t>(l.receiver) + 1];
+  for (std::size_t i = 1; i < mesh.offsets.size(); ++i) mesh.offsets[i] += mesh.offsets[i - 1];
+}
+
+float threshold(const DirectionalBins& bins, const AntiradianceSettings& s) {
+  return std::max(s.oracle_scale, 1e-6f) * 4.0f * glm::pi<float>() / static_cast<float>(bins.count());
+}
+
+}  // namespace
+
+LinkMesh link_elements(const ElementHierarchy& h, const DirectionalBins& bins, const AntiradianceSettings& settings) {
+  LinkMesh mesh;
+  Linker linker{h, bins, threshold(bins, settings), mesh.links};
+  linker.self(0);
+  sort_and_index(h, mesh);
+  mesh.relinked_elements = h.nodes.size();
+  mesh.links_made = mesh.links.size();
+  return mesh;
+}
+
+LinkMesh static_links(const ElementHierarchy& h, const LinkMesh& mesh) {
+  LinkMesh out;
+  for (const Link& l : mesh.links)
+    if (h.nodes[static_cast<std::size_t>(l.receiver)].group == 0 && h.nodes[static_cast<std::size_t>(l.sender)].group == 0)
+      out.links.push_back(l);
+  sort_and_index(h, out);
+  out.links_made = out.links.size();
+  return out;
+}
+
+void relink_moved(const ElementHierarchy& h, const DirectionalBins& bins, const AntiradianceSettings& settings,
+                  const std::vector<int>& moved, LinkMesh& mesh) {
+  std::vector<char> is_moved(static_cast<std::size_t>(h.group_count()), 0);
+  for (int g : moved)
+    if (g >= 1 && g < h.group_count() && h.group_root[static_cast<std::size_t>(g)] >= 0)
+      is_moved[static_cast<std::size_t>(g)] = 1;
+  mesh.relinked_elements = 0;
+  mesh.links_made = 0;
+  auto group_moved = [&](std::int32_t node) {
+    const std::int32_t g = h.nodes[static_cast<std::size_t>(node)].group;
+    return g >= 1 && is_moved[static_cast<std::size_t>(g)] != 0;
+  };
+  // Drop every link with an end in a moved group (a rigid motion keeps a group's own form
+  // factors but turns their directions, hence their bins); links between unmoved groups stay.
+  std::erase_if(mesh.links, [&](const Link& l) { return group_moved(l.receiver) || group_moved(l.sender); });
+  const std::size_t kept = mesh.links.size();
+  Linker linker{h, bins, threshold(bins, settings), mesh.links};
+  for (int a = 0; a < h.group_count(); ++a)
+    for (int b = a + 1; b < h.group_count(); ++b) {
+      if (!is_moved[static_cast<std::size_t>(a)] && !is_moved[static_cast<std::size_t>(b)]) continue;
+      const std::int32_t ra = h.group_root[static_cast<std::size_t>(a)], rb = h.group_root[static_cast<std::size_t>(b)];
+      if (ra < 0 || rb < 0) continue;
+      linker.refine(ra, rb);
+    }
+  for (int g = 1; g < h.group_count(); ++g)
+    if (is_moved[static_cast<std::size_t>(g)]) linker.self(h.group_root[static_cast<std::size_t>(g)]);
+  for (int g = 1; g < h.group_count(); ++g)
+    if (is_moved[static_cast<std::size_t>(g)]) {
+      const std::int32_t r = h.group_root[static_cast<std::size_t>(g)];
+      mesh.relinked_elements += static_cast<std::size_t>(h.nodes[static_cast<std::size_t>(r)].end - r);
+    }
+  mesh.links_made = mesh.links.size() - kept;
+  sort_and_index(h, mesh);
+}
+
+}  // namespace gi

@@ -1,0 +1,65 @@
+#pragma once
+// Links of an antiradiance solve (Dachsbacher et al. 2007, §3.1-3.2): which element
+// exchanges light with which, through which directional bin, with which form factor.
+// Refinement starts from the root's self-link (always subdivided) and uses the paper's
+// oracle: a pair is linked when each element's bounding-sphere solid angle seen from the
+// other is at most oracle_scale x the smallest bin's solid angle (and the spheres do not
+// overlap); otherwise the larger element is subdivided; two leaves are linked regardless.
+// No visibility anywhere: antiradiance stands for it.
+//
+// Form factor, eq. 17: F = 1 / (d^2 omega_bin), spread over the bins the sender covers as
+// seen from the receiver (the paper's "precise computation ... between all pairs of bins in
+// the cone subtended by the sender", §3.1, with 16 fixed sample points on a disc standing
+// for the sender instead of its exact cone): bin b gets share_b / (d^2 omega_b).
+// Deviation: when the two bounding spheres overlap (only leaves can be linked then), d^2 is
+// regularized to d^2 + min(a_r/pi, r_r^2) + min(a_s/pi, r_s^2) (the disc form factor of
+// point_emitters.h), so touching leaves (a door against its frame) stay bounded.
+// Links are directed (receiver <- sender); a receiver with a normal (a surface element)
+// gets no link from a sender wholly behind its plane: solid objects receive light only in
+// their positive hemisphere (§3.1, Fig. 7).
+//
+// Relinking (§3.3 "Moving Objects"): links between two static elements never change; when
+// groups move only the links with an end in a moved group are rebuilt (its links to itself
+// too: a rigid motion keeps their form factors but turns their bins).
+//   gi::LinkMesh links = gi::link_elements(hierarchy, bins, settings);
+//   gi::relink_moved(hierarchy, bins, settings, {1}, links);  // group 1 (the door) moved
+
+#include <cstdint>
+#include <vector>
+
+#include "antiradiance/antiradiance_settings.h"
+#include "antiradiance/directional_bins.h"
+#include "antiradiance/element_hierarchy.h"
+
+namespace gi {
+
+struct Link {
+  std::int32_t receiver = 0;
+  std::int32_t sender = 0;
+  std::int32_t bin = 0;       ///< Bin of the direction sender -> receiver (same global bins at both ends).
+  float form_factor = 0.0f;   ///< 1 / (d^2_regularized omega_bin), 1/(m^2 sr).
+};
+
+/// Links sorted by (receiver, sender): receiver r's links are [offsets[r], offsets[r+1]).
+struct LinkMesh {
+  std::vector<Link> links;
+  std::vector<std::uint32_t> offsets;  ///< nodes + 1 entries.
+  /// Counters of the last (re)link: elements whose links were rebuilt, links made.
+  std::size_t relinked_elements = 0;
+  std::size_t links_made = 0;
+};
+
+/// All links of the hierarchy (counters: every element, every link).
+LinkMesh link_elements(const ElementHierarchy& h, const DirectionalBins& bins, const AntiradianceSettings& settings);
+
+/// The links of `mesh` between two static elements (group 0): the world without its
+/// deforming region, the baseline the region's change is measured against.
+LinkMesh static_links(const ElementHierarchy& h, const LinkMesh& mesh);
+
+/// Rebuilds the links with an end in a group of `moved` (deforming groups, >= 1, whose
+/// elements already moved: set_group_transform), keeps the rest; the counters say how many
+/// elements' links and how many links were rebuilt.
+void relink_moved(const ElementHierarchy& h, const DirectionalBins& bins, const AntiradianceSettings& settings,
+                  const std::vector<int>& moved, LinkMesh& mesh);
+
+}  // namespace gi
