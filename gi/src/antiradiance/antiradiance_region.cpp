@@ -4,36 +4,72 @@
 
 namespace gi {
 
-engine::Result<AntiradianceRegion> AntiradianceRegion::create(const BakeInput& input,
-                                                              const AntiradianceSettings& settings) {
+engine::Result<AntiradianceBake> bake_antiradiance(const BakeInput& input, const AntiradianceSettings& settings) {
   if (settings.bins_per_side < 1 || settings.bins_per_side > 64)
-    return engine::Error{"", "antiradiance region", "bins_per_side must lie in [1, 64]"};
+    return engine::Error{"", "antiradiance bake", "bins_per_side must lie in [1, 64]"};
   auto h = build_element_hierarchy(input, settings);
   if (!h) return h.error();
-  auto direct = AntiradianceDirectLight::create(input, settings);
+  AntiradianceBake bake;
+  bake.settings = settings;
+  bake.hierarchy = std::move(h).value();
+  const DirectionalBins bins(settings.bins_per_side);
+  const LinkMesh all = link_elements(bake.hierarchy, bins, settings);
+  bake.static_links = static_links(bake.hierarchy, all);
+  // The baseline: static links only, direct light without the region's shadows, solved once.
+  auto unshadowed = AntiradianceDirectLight::create(input, settings, true);
+  if (!unshadowed) return unshadowed.error();
+  std::vector<glm::vec3> direct = unshadowed->irradiance(bake.hierarchy);
+  for (std::size_t l = 0; l < direct.size(); ++l)
+    if (bake.hierarchy.nodes[static_cast<std::size_t>(bake.hierarchy.leaves[l])].group != 0) direct[l] = glm::vec3(0.0f);
+  CpuAntiradiancePasses base(bake.hierarchy, bins, bake.static_links);
+  const AntiradianceSolveReport rep = run_antiradiance(base, direct, settings, bake.hierarchy);
+  bake.baseline = base.irradiance();
+  for (glm::vec3& v : bake.baseline) v *= rep.output_scale;
+  return bake;
+}
+
+engine::Result<AntiradianceRegion> AntiradianceRegion::create(const BakeInput& input,
+                                                              const AntiradianceSettings& settings) {
+  auto bake = bake_antiradiance(input, settings);
+  if (!bake) return bake.error();
+  return create(input, std::move(bake).value());
+}
+
+engine::Result<AntiradianceRegion> AntiradianceRegion::create(const BakeInput& input, AntiradianceBake bake) {
+  const ElementHierarchy& bh = bake.hierarchy;
+  for (std::size_t g = 0; g < bh.deforming_instances.size(); ++g) {
+    const std::uint32_t i = bh.deforming_instances[g];
+    if (i >= input.instances.size() || !input.instances[i].deforming)
+      return engine::Error{"", "antiradiance region",
+                           "the bake's deforming instance " + std::to_string(i) + " is not a deforming instance of " +
+                               (input.name.empty() ? std::string("the scene") : input.name)};
+  }
+  std::size_t deforming = 0;
+  for (const BakeInstance& inst : input.instances) deforming += inst.deforming ? 1 : 0;
+  if (deforming != bh.deforming_instances.size())
+    return engine::Error{"", "antiradiance region",
+                         "the scene has " + std::to_string(deforming) + " deforming instances, the bake " +
+                             std::to_string(bh.deforming_instances.size())};
+  auto direct = AntiradianceDirectLight::create(input, bake.settings);
   if (!direct) return direct.error();
   AntiradianceRegion r;
-  r.settings_ = settings;
-  r.bins_ = std::make_unique<DirectionalBins>(settings.bins_per_side);
-  r.hierarchy_ = std::make_unique<ElementHierarchy>(std::move(h).value());
-  r.links_ = std::make_unique<LinkMesh>(link_elements(*r.hierarchy_, *r.bins_, settings));
+  r.settings_ = bake.settings;
+  r.bins_ = std::make_unique<DirectionalBins>(bake.settings.bins_per_side);
+  r.hierarchy_ = std::make_unique<ElementHierarchy>(std::move(bake.hierarchy));
+  r.baseline_ = std::move(bake.baseline);
+  r.links_ = std::make_unique<LinkMesh>(std::move(bake.static_links));
   r.direct_light_ = std::make_unique<AntiradianceDirectLight>(std::move(direct).value());
+  // Place the deforming groups where `input` has them and link them.
+  std::vector<int> groups;
+  for (int g = 1; g < r.hierarchy_->group_count(); ++g) {
+    const std::uint32_t i = r.hierarchy_->deforming_instances[static_cast<std::size_t>(g - 1)];
+    r.hierarchy_->set_group_transform(g, input.instances[i].object_to_world);
+    groups.push_back(g);
+  }
+  relink_moved(*r.hierarchy_, *r.bins_, r.settings_, groups, *r.links_);
   r.cpu_ = std::make_unique<CpuAntiradiancePasses>(*r.hierarchy_, *r.bins_, *r.links_);
   r.direct_ = r.direct_light_->irradiance(*r.hierarchy_);
-  // The baseline: static links only, direct light without the region's shadows, solved once.
-  {
-    auto unshadowed = AntiradianceDirectLight::create(input, settings, true);
-    if (!unshadowed) return unshadowed.error();
-    std::vector<glm::vec3> base_direct = unshadowed->irradiance(*r.hierarchy_);
-    for (std::size_t l = 0; l < base_direct.size(); ++l)
-      if (r.hierarchy_->nodes[static_cast<std::size_t>(r.hierarchy_->leaves[l])].group != 0) base_direct[l] = glm::vec3(0.0f);
-    const LinkMesh links = static_links(*r.hierarchy_, *r.links_);
-    CpuAntiradiancePasses base(*r.hierarchy_, *r.bins_, links);
-    const AntiradianceSolveReport rep = run_antiradiance(base, base_direct, settings, *r.hierarchy_);
-    r.baseline_ = base.irradiance();
-    for (glm::vec3& v : r.baseline_) v *= rep.output_scale;
-  }
-  r.counters_ = {0, r.links_->relinked_elements, r.links_->links_made, r.links_->links.size()};
+  r.counters_ = {groups.size(), r.links_->relinked_elements, r.links_->links_made, r.links_->links.size()};
   return r;
 }
 

@@ -34,6 +34,20 @@
 
 namespace gi {
 
+/// What a bake precomputes for a region (and a bundle stores, antiradiance_io.h): the
+/// elements, the links between static elements and the baseline solve. The links with an
+/// end in a deforming group are rebuilt when the region is made (they depend on the pose).
+struct AntiradianceBake {
+  AntiradianceSettings settings;
+  ElementHierarchy hierarchy;
+  LinkMesh static_links;
+  std::vector<glm::vec3> baseline;  ///< Indirect irradiance per leaf without the region.
+};
+
+/// Builds the elements, links the static ones and solves the baseline. Errors: see
+/// build_element_hierarchy and AntiradianceDirectLight::create; bins_per_side outside [1, 64].
+engine::Result<AntiradianceBake> bake_antiradiance(const BakeInput& input, const AntiradianceSettings& settings);
+
 /// Counters of the last update().
 struct AntiradianceUpdateCounters {
   std::size_t moved_groups = 0;
@@ -47,6 +61,10 @@ class AntiradianceRegion {
   /// Errors: see build_element_hierarchy and AntiradianceDirectLight::create; bins_per_side
   /// outside [1, 64].
   static engine::Result<AntiradianceRegion> create(const BakeInput& input, const AntiradianceSettings& settings);
+  /// From a bake (made for `input`'s geometry): links the deforming groups at the poses
+  /// `input` gives them, computes the direct light. Errors: the bake's deforming instances
+  /// are not `input`'s, ray caster failures.
+  static engine::Result<AntiradianceRegion> create(const BakeInput& input, AntiradianceBake bake);
 
   /// Moves deforming instance `instance` (BakeInput index). Returns false (and does nothing)
   /// when it is not a deforming instance of the region or the matrix equals the current one.

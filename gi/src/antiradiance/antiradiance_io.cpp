@@ -1,0 +1,278 @@
+#include "antiradiance/antiradiance_io.h"
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <cstring>
+#include <type_traits>
+
+#include "bundle/geometry_hash.h"
+#include "bundle/manifest.h"
+
+namespace gi {
+
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+static_assert(sizeof(ElementNode) == 72, "ElementNode is written as 18 x 4 bytes");
+static_assert(sizeof(Link) == 16, "Link is written as 4 x 4 bytes");
+static_assert(sizeof(glm::vec3) == 12 && sizeof(glm::mat4) == 64, "packed GLM types");
+
+engine::Error file_error(const fs::path& path, std::string location, std::string message) {
+  return engine::Error{path.string(), std::move(location), std::move(message)};
+}
+
+class Writer {
+ public:
+  template <class T>
+  void put(const T& v) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    const std::size_t at = bytes.size();
+    bytes.resize(at + sizeof(T));
+    std::memcpy(bytes.data() + at, &v, sizeof(T));
+  }
+  template <class T>
+  void array(const std::vector<T>& v) {
+    put(static_cast<std::uint64_t>(v.size()));
+    const std::size_t at = bytes.size();
+    bytes.resize(at + v.size() * sizeof(T));
+    if (!v.empty()) std::memcpy(bytes.data() + at, v.data(), v.size() * sizeof(T));
+  }
+  void string(const std::string& s) {
+    put(static_cast<std::uint64_t>(s.size()));
+    const std::size_t at = bytes.size();
+    bytes.resize(at + s.size());
+    if (!s.empty()) std::memcpy(bytes.data() + at, s.data(), s.size());
+  }
+  std::vector<std::byte> bytes;
+};
+
+class Reader {
+ public:
+  explicit Reader(const std::vector<std::byte>& b) : b_(b) {}
+  template <class T>
+  bool get(T& v) {
+    if (b_.size() - at_ < sizeof(T)) return false;
+    std::memcpy(&v, b_.data() + at_, sizeof(T));
+    at_ += sizeof(T);
+    return true;
+  }
+  template <class T>
+  bool array(std::vector<T>& v) {
+    std::uint64_t n = 0;
+    if (!get(n) || n > (b_.size() - at_) / sizeof(T)) return false;
+    v.resize(static_cast<std::size_t>(n));
+    if (n > 0) std::memcpy(v.data(), b_.data() + at_, static_cast<std::size_t>(n) * sizeof(T));
+    at_ += static_cast<std::size_t>(n) * sizeof(T);
+    return true;
+  }
+  bool string(std::string& s) {
+    std::uint64_t n = 0;
+    if (!get(n) || n > b_.size() - at_) return false;
+    s.assign(reinterpret_cast<const char*>(b_.data() + at_), static_cast<std::size_t>(n));
+    at_ += static_cast<std::size_t>(n);
+    return true;
+  }
+  bool done() const { return at_ == b_.size(); }
+
+ private:
+  const std::vector<std::byte>& b_;
+  std::size_t at_ = 0;
+};
+
+bool finite3(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+// Empty when the bake's arrays fit together and its values are valid, else what is wrong.
+std::string check_bake(const AntiradianceBake& b) {
+  const AntiradianceSettings& s = b.settings;
+  if (s.bins_per_side < 1 || s.bins_per_side > 64) return "bins_per_side outside 1..64";
+  if (!(s.patch_size_m > 0.0f) || !std::isfinite(s.patch_size_m)) return "patch_size_m must be positive";
+  if (s.scheme != AntiradianceScheme::Symmetric && s.scheme != AntiradianceScheme::Asymmetric) return "unknown scheme";
+  const ElementHierarchy& h = b.hierarchy;
+  const std::size_t n = h.nodes.size();
+  const auto in_nodes = [n](std::int64_t i) { return i >= 0 && static_cast<std::size_t>(i) < n; };
+  if (n == 0) return "no element";
+  if (h.node_instance.size() != n || h.object_center.size() != n || h.object_normal.size() != n ||
+      h.object_radius.size() != n || h.object_area.size() != n)
+    return "per-element arrays differ in size from the " + std::to_string(n) + " elements";
+  if (h.group_transform.size() != h.deforming_instances.size() || h.group_root.size() != h.deforming_instances.size() + 1)
+    return "group arrays do not match the " + std::to_string(h.deforming_instances.size()) + " deforming instances";
+  for (std::int32_t r : h.group_root)
+    if (r != -1 && !in_nodes(r)) return "a group root is out of range";
+  for (std::int32_t c : h.children)
+    if (!in_nodes(c)) return "a child index is out of range";
+  for (std::int32_t l : h.leaves)
+    if (!in_nodes(l) || h.nodes[static_cast<std::size_t>(l)].child_count != 0) return "a leaf index is not a leaf";
+  for (std::size_t i = 0; i < n; ++i) {
+    const ElementNode& e = h.nodes[i];
+    if (!finite3(e.center) || !finite3(e.normal) || !finite3(e.albedo) || !std::isfinite(e.radius_m) ||
+        !std::isfinite(e.area_m2) || e.area_m2 < 0.0f || !finite3(h.object_center[i]) || !finite3(h.object_normal[i]) ||
+        !std::isfinite(h.object_radius[i]) || !std::isfinite(h.object_area[i]))
+      return "element " + std::to_string(i) + " has a NaN, infinite or negative value";
+    if ((e.parent != -1 && !in_nodes(e.parent)) || e.child_count < 0 || e.first_child < 0 ||
+        static_cast<std::size_t>(e.first_child) + static_cast<std::size_t>(e.child_count) > h.children.size() ||
+        e.leaf_begin < 0 || e.leaf_end < e.leaf_begin || static_cast<std::size_t>(e.leaf_end) > h.leaves.size() ||
+        e.end <= static_cast<std::int32_t>(i) || static_cast<std::size_t>(e.end) > n ||
+        e.group < -1 || e.group > static_cast<std::int32_t>(h.deforming_instances.size()))
+      return "element " + std::to_string(i) + " has an index out of range";
+    if (i > 0 && e.parent >= static_cast<std::int32_t>(i)) return "element " + std::to_string(i) + " follows its parent";
+  }
+  const std::int32_t bins = s.bins_per_side * s.bins_per_side;
+  for (std::size_t k = 0; k < b.static_links.links.size(); ++k) {
+    const Link& l = b.static_links.links[k];
+    if (!in_nodes(l.receiver) || !in_nodes(l.sender) || l.bin < 0 || l.bin >= bins || !std::isfinite(l.form_factor) ||
+        l.form_factor < 0.0f)
+      return "static link " + std::to_string(k) + " is out of range";
+    if (h.nodes[static_cast<std::size_t>(l.receiver)].group != 0 || h.nodes[static_cast<std::size_t>(l.sender)].group != 0)
+      return "static link " + std::to_string(k) + " has an end in a deforming group";
+    if (k > 0) {
+      const Link& p = b.static_links.links[k - 1];
+      if (p.receiver > l.receiver) return "static links are not sorted by receiver";
+    }
+  }
+  if (b.baseline.size() != h.leaves.size()) return "the baseline has " + std::to_string(b.baseline.size()) + " values for " + std::to_string(h.leaves.size()) + " leaves";
+  for (const glm::vec3& v : b.baseline)
+    if (!finite3(v)) return "the baseline holds a NaN or infinite value";
+  return {};
+}
+
+// CSR offsets of sorted links.
+void index_links(std::size_t nodes, LinkMesh& mesh) {
+  mesh.offsets.assign(nodes + 1, 0u);
+  for (const Link& l : mesh.links) ++mesh.offsets[static_cast<std::size_t>(l.receiver) + 1];
+  for (std::size_t i = 1; i < mesh.offsets.size(); ++i) mesh.offsets[i] += mesh.offsets[i - 1];
+}
+
+json settings_json(const AntiradianceSettings& s) {
+  return json{{"bins_per_side", s.bins_per_side},         {"patch_size_m", s.patch_size_m},
+              {"exchange_radius_m", s.exchange_radius_m}, {"oracle_scale", s.oracle_scale},
+              {"iterations", s.iterations},               {"antiradiance_steps", s.antiradiance_steps},
+              {"scheme", s.scheme == AntiradianceScheme::Symmetric ? "symmetric" : "asymmetric"},
+              {"residual_tolerance", s.residual_tolerance}, {"growth_limit", s.growth_limit},
+              {"area_light_samples", s.area_light_samples}, {"seed", s.seed}};
+}
+
+}  // namespace
+
+engine::Status write_antiradiance(const fs::path& path, const AntiradianceBake& b, const std::string& geometry_hash) {
+  if (std::string problem = check_bake(b); !problem.empty())
+    return file_error(path, "", "cannot save the antiradiance bake: " + problem);
+  Writer w;
+  w.string(geometry_hash);
+  const AntiradianceSettings& s = b.settings;
+  w.put(static_cast<std::int32_t>(s.bins_per_side));
+  w.put(s.patch_size_m);
+  w.put(s.exchange_radius_m);
+  w.put(s.oracle_scale);
+  w.put(static_cast<std::int32_t>(s.iterations));
+  w.put(static_cast<std::int32_t>(s.antiradiance_steps));
+  w.put(static_cast<std::uint8_t>(s.scheme));
+  w.put(s.residual_tolerance);
+  w.put(static_cast<std::int32_t>(s.growth_limit));
+  w.put(static_cast<std::int32_t>(s.area_light_samples));
+  w.put(static_cast<std::uint64_t>(s.seed));
+  const ElementHierarchy& h = b.hierarchy;
+  w.array(h.deforming_instances);
+  w.array(h.group_transform);
+  w.array(h.nodes);
+  w.array(h.children);
+  w.array(h.leaves);
+  w.array(h.group_root);
+  w.array(h.node_instance);
+  w.array(h.object_center);
+  w.array(h.object_normal);
+  w.array(h.object_radius);
+  w.array(h.object_area);
+  w.array(b.static_links.links);
+  w.array(b.baseline);
+  return write_blob(path, kAntiradianceMagic, kAntiradianceVersion, w.bytes);
+}
+
+engine::Result<AntiradianceFile> read_antiradiance(const fs::path& path) {
+  auto payload = read_blob(path, kAntiradianceMagic, kAntiradianceVersion);
+  if (!payload) return payload.error();
+  Reader r(*payload);
+  AntiradianceFile f;
+  AntiradianceSettings& s = f.bake.settings;
+  ElementHierarchy& h = f.bake.hierarchy;
+  std::int32_t bins = 0, iterations = 0, steps = 0, growth = 0, samples = 0;
+  std::uint8_t scheme = 0;
+  std::uint64_t seed = 0;
+  const bool ok = r.string(f.geometry_hash) && r.get(bins) && r.get(s.patch_size_m) && r.get(s.exchange_radius_m) &&
+                  r.get(s.oracle_scale) && r.get(iterations) && r.get(steps) && r.get(scheme) &&
+                  r.get(s.residual_tolerance) && r.get(growth) && r.get(samples) && r.get(seed) &&
+                  r.array(h.deforming_instances) && r.array(h.group_transform) && r.array(h.nodes) &&
+                  r.array(h.children) && r.array(h.leaves) && r.array(h.group_root) && r.array(h.node_instance) &&
+                  r.array(h.object_center) && r.array(h.object_normal) && r.array(h.object_radius) &&
+                  r.array(h.object_area) && r.array(f.bake.static_links.links) && r.array(f.bake.baseline);
+  if (!ok) return file_error(path, "", "truncated: a field or array runs past the end of the payload");
+  if (!r.done()) return file_error(path, "", "trailing bytes after the last array");
+  s.bins_per_side = bins;
+  s.iterations = iterations;
+  s.antiradiance_steps = steps;
+  s.scheme = static_cast<AntiradianceScheme>(scheme);
+  s.growth_limit = growth;
+  s.area_light_samples = samples;
+  s.seed = seed;
+  if (std::string problem = check_bake(f.bake); !problem.empty()) return file_error(path, "", problem);
+  index_links(h.nodes.size(), f.bake.static_links);
+  f.bake.static_links.links_made = f.bake.static_links.links.size();
+  return f;
+}
+
+engine::Status save_antiradiance(const fs::path& bundle_dir, const AntiradianceBake& bake, const BakeInput& input) {
+  const fs::path file = bundle_dir / kAntiradianceFile;
+  if (std::string problem = check_bake(bake); !problem.empty())
+    return file_error(file, "", "cannot save the antiradiance bake: " + problem);
+  std::error_code ec;
+  fs::create_directories(bundle_dir, ec);
+  if (ec) return engine::Error{bundle_dir.string(), "", "cannot create the bundle directory: " + ec.message()};
+  const std::string geometry_hash = scene_geometry_hash(input);
+  if (engine::Status st = write_antiradiance(file, bake, geometry_hash); !st) return st;
+  auto sum = file_checksum(file);
+  if (!sum) return sum.error();
+  const std::uintmax_t bytes = fs::file_size(file, ec);
+  if (ec) return file_error(file, "", "cannot read the file size: " + ec.message());
+  const json entry{{"files", {{"elements", {{"file", kAntiradianceFile}, {"xxh3_64", *sum}}}}},
+                   {"settings", settings_json(bake.settings)},
+                   {"elements", bake.hierarchy.nodes.size()},
+                   {"leaves", bake.hierarchy.leaves.size()},
+                   {"static_links", bake.static_links.links.size()},
+                   {"deforming_instances", bake.hierarchy.deforming_instances},
+                   {"memory", {{"file_bytes", static_cast<std::uint64_t>(bytes)}}}};
+  return update_manifest_method(bundle_dir, geometry_hash, fs::path(input.name).filename().string(), kAntiradianceMethod,
+                                entry);
+}
+
+engine::Result<AntiradianceBake> load_antiradiance(const fs::path& bundle_dir, const BakeInput& input) {
+  auto manifest = read_manifest(bundle_dir);
+  if (!manifest) return manifest.error();
+  const fs::path manifest_file = bundle_dir / kManifestFileName;
+  const std::string scene_hash = scene_geometry_hash(input);
+  if (manifest->geometry_hash != scene_hash) {
+    const std::string scene = input.name.empty() ? std::string("the scene") : input.name;
+    return engine::Error{manifest_file.string(), "geometry_hash",
+                         "stale bundle " + bundle_dir.string() + ": baked from geometry " + manifest->geometry_hash +
+                             ", but " + scene + " hashes to " + scene_hash + " (re-bake the antiradiance region)"};
+  }
+  auto entry = manifest_method(bundle_dir, *manifest, kAntiradianceMethod);
+  if (!entry) return entry.error();
+  const std::string where = std::string("methods.") + kAntiradianceMethod + ".files.elements";
+  const json* file = nullptr;
+  if (entry->contains("files") && (*entry)["files"].is_object() && (*entry)["files"].contains("elements"))
+    file = &(*entry)["files"]["elements"];
+  if (file == nullptr || !file->is_object() || !file->contains("file") || !(*file)["file"].is_string() ||
+      !file->contains("xxh3_64") || !(*file)["xxh3_64"].is_string())
+    return engine::Error{manifest_file.string(), where, "missing or malformed (needs \"file\" and \"xxh3_64\" strings)"};
+  const fs::path path = bundle_dir / (*file)["file"].get<std::string>();
+  if (engine::Status st = check_file_checksum(path, (*file)["xxh3_64"].get<std::string>()); !st) return st.error();
+  auto f = read_antiradiance(path);
+  if (!f) return f.error();
+  if (f->geometry_hash != manifest->geometry_hash)
+    return file_error(path, "", "belongs to geometry " + f->geometry_hash + ", the manifest to " + manifest->geometry_hash);
+  return std::move(f->bake);
+}
+
+}  // namespace gi

@@ -1,0 +1,74 @@
+#pragma once
+// Saving an antiradiance bake (antiradiance_region.h: elements, static links, baseline)
+// into a bake bundle and loading it back, with the bundle's checksum and stale rules.
+//   gi::save_antiradiance("level.gibake", bake, input);
+//   auto bake = gi::load_antiradiance("level.gibake", input);   // checks the geometry hash
+//
+// Files (DESIGN.md §5, docs/bake-bundle.md):
+//   antiradiance.bin  the checksummed container of io/blob_file.h, magic "GIANTIRA", version 1.
+//   manifest.json     methods.antiradiance = {
+//     "files":    { "elements": {"file": "antiradiance.bin", "xxh3_64": "<hex of the whole file>"} },
+//     "settings": { AntiradianceSettings' fields }, "elements", "leaves", "static_links",
+//     "deforming_instances", "memory": { "file_bytes" } }
+// The bake depends on the geometry and the materials (element albedos) and on the static
+// lights (the baseline's direct light), so the geometry hash of the manifest makes it stale
+// like every other file; a light edit needs a re-bake (docs/antiradiance.md).
+//
+// antiradiance.bin payload (little-endian; "array" = uint64 count then the elements;
+// vec3 = 3 x float32, mat4 = 16 x float32 column-major):
+//   string   geometry_hash                 uint64 length + chars
+//   int32 bins_per_side, float32 patch_size_m, float32 exchange_radius_m, float32 oracle_scale,
+//   int32 iterations, int32 antiradiance_steps, uint8 scheme, float64 residual_tolerance,
+//   int32 growth_limit, int32 area_light_samples, uint64 seed      AntiradianceSettings
+//   array<uint32> deforming_instances      BakeInput instance of each deforming group
+//   array<mat4>   group_transform          the pose each group was baked at
+//   array<node>   nodes                    ElementNode, 18 x 4 bytes: center vec3, radius,
+//                                          normal vec3, area, albedo vec3, parent, first_child,
+//                                          child_count, leaf_begin, leaf_end, group, end (int32s)
+//   array<int32>  children, leaves, group_root, node_instance
+//   array<vec3>   object_center, object_normal;  array<float32> object_radius, object_area
+//   array<link>   static_links             receiver, sender, bin (int32), form_factor (float32)
+//   array<vec3>   baseline                 one per leaf
+// Nothing follows (trailing bytes are an error). The reader checks every index against the
+// arrays it points into, every value for NaN/infinity, and the sizes against each other.
+
+#include <engine/result.h>
+#include <gi/bake_input.h>
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+
+#include "antiradiance/antiradiance_region.h"
+#include "io/blob_file.h"
+
+namespace gi {
+
+inline constexpr const char* kAntiradianceMethod = "antiradiance";
+inline constexpr const char* kAntiradianceFile = "antiradiance.bin";
+inline constexpr BlobMagic kAntiradianceMagic{"GIANTIRA"};
+inline constexpr std::uint32_t kAntiradianceVersion = 1;
+
+/// What antiradiance.bin holds.
+struct AntiradianceFile {
+  std::string geometry_hash;
+  AntiradianceBake bake;
+};
+
+/// Writes `bake` to `path` atomically. Error (naming the file, writing nothing) when the
+/// bake is inconsistent (see read_antiradiance's checks).
+engine::Status write_antiradiance(const std::filesystem::path& path, const AntiradianceBake& bake,
+                                  const std::string& geometry_hash);
+/// Reads and checks antiradiance.bin (container, complete fields, sizes, indices, values).
+engine::Result<AntiradianceFile> read_antiradiance(const std::filesystem::path& path);
+
+/// Writes antiradiance.bin into `bundle_dir` (created if needed) and the manifest's
+/// "antiradiance" entry (other methods' entries kept when the geometry hash is the same).
+engine::Status save_antiradiance(const std::filesystem::path& bundle_dir, const AntiradianceBake& bake,
+                                 const BakeInput& input);
+/// Loads the bake of `bundle_dir` for `input`: rejects a stale bundle (the message says
+/// "stale" and names both hashes), checks the file against the manifest's checksum, reads it.
+/// Every error names the file and the problem.
+engine::Result<AntiradianceBake> load_antiradiance(const std::filesystem::path& bundle_dir, const BakeInput& input);
+
+}  // namespace gi
