@@ -41,7 +41,7 @@ int main(int argc, char** argv) {
   app.add_flag("--plan", plan_only, "Print the effect plan with estimates for --preset and exit (docs/plan.md)");
   app.add_option("--out", out_dir, "Bundle directory (default: out/<scene>.gibake)");
   app.add_option("--methods", methods,
-                 "Comma-separated methods to bake: atlas, prm, dlm, brf (default: what the plan calls for)");
+                 "Comma-separated methods to bake: atlas, prm, dlm, brf, antiradiance (default: what the plan calls for)");
   app.add_option("--preset", o.preset, "Quality preset: preview, medium, high (docs/sweeps/README.md)");
   app.add_option("--vpls", o.vpls, "Override the preset's VPL count")->check(CLI::PositiveNumber);
   app.add_option("--bounces", o.bounces, "Override the preset's indirect bounces")->check(CLI::Range(1, 64));

@@ -53,7 +53,7 @@ struct EffectEstimate {
 struct PlannedEffect {
   EffectMethod method = EffectMethod::LightAtlas;
   bool enabled = false;              ///< The scene calls for it.
-  bool available = false;            ///< This build can bake it (atlas, prm, dlm, brf); antiradiance: not yet.
+  bool available = false;            ///< This build can bake it (all five methods today).
   std::string reason;                ///< One line naming the facts ("light 'swinging_lamp' moves").
   std::vector<std::string> targets;  ///< Entity names (atlas, prm, dlm, antiradiance) or mesh names (brf).
   EffectEstimate estimate;           ///< Filled when enabled and available.

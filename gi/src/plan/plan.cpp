@@ -16,8 +16,8 @@ namespace gi {
 namespace {
 
 constexpr std::string_view kKeys[kEffectMethodCount] = {"atlas", "prm", "dlm", "antiradiance", "brf"};
-// What this build can bake (gi-bake --methods). Antiradiance is not built yet.
-constexpr bool kAvailable[kEffectMethodCount] = {true, true, true, false, true};
+// What this build can bake (gi-bake --methods): every method.
+constexpr bool kAvailable[kEffectMethodCount] = {true, true, true, true, true};
 
 std::string plural(std::size_t n, const char* one, const char* many) {
   return std::to_string(n) + " " + (n == 1 ? one : many);

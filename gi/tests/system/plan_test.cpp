@@ -174,7 +174,7 @@ TEST(Plan, DeformingRegionsFromTheFileGetAntiradiance) {
   const gi::EffectPlan p = gi::plan(engine::instantiate(std::move(reloaded).value()));
   const gi::PlannedEffect& anti = p.effect(EffectMethod::Antiradiance);
   EXPECT_TRUE(anti.enabled);
-  EXPECT_FALSE(anti.available);
+  EXPECT_TRUE(anti.available);
   EXPECT_EQ(anti.targets, std::vector<std::string>{"door"});
   EXPECT_TRUE(contains(anti.reason, "'door'")) << anti.reason;
 }
