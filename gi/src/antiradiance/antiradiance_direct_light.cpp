@@ -11,8 +11,7 @@
 namespace gi {
 
 engine::Result<AntiradianceDirectLight> AntiradianceDirectLight::create(const BakeInput& input,
-                                                                        const AntiradianceSettings& settings,
-                                                                        bool without_deforming) {
+                                                                        const AntiradianceSettings& settings) {
   if (engine::Status st = validate_bake_input(input); !st) return st.error();
   const ReferenceScene scene = reference_scene_from(input);
   auto index = index_reference_scene(scene);
@@ -26,13 +25,6 @@ engine::Result<AntiradianceDirectLight> AntiradianceDirectLight::create(const Ba
       data.instances[i].dynamic = true;
       out.deforming_[i] = 1;
     }
-  if (without_deforming) {
-    std::vector<RtInstance> kept;
-    for (std::size_t i = 0; i < data.instances.size(); ++i)
-      if (i >= input.instances.size() || !input.instances[i].deforming) kept.push_back(data.instances[i]);
-    data.instances = std::move(kept);
-    std::fill(out.deforming_.begin(), out.deforming_.end(), 0);
-  }
   auto caster = make_embree_ray_caster(data);
   if (!caster) return caster.error();
   out.caster_ = std::move(caster).value();

@@ -25,10 +25,8 @@ namespace gi {
 
 class AntiradianceDirectLight {
  public:
-  /// Errors: invalid input, ray caster construction failures. `without_deforming`: the
-  /// deforming instances cast no shadow (the world without its region: the baseline).
-  static engine::Result<AntiradianceDirectLight> create(const BakeInput& input, const AntiradianceSettings& settings,
-                                                        bool without_deforming = false);
+  /// Errors: invalid input, ray caster construction failures.
+  static engine::Result<AntiradianceDirectLight> create(const BakeInput& input, const AntiradianceSettings& settings);
 
   /// Moves deforming instance `instance` (a BakeInput index flagged deforming) in the caster;
   /// takes effect at the next irradiance().

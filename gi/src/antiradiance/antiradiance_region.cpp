@@ -15,13 +15,12 @@ engine::Result<AntiradianceBake> bake_antiradiance(const BakeInput& input, const
   const DirectionalBins bins(settings.bins_per_side);
   const LinkMesh all = link_elements(bake.hierarchy, bins, settings);
   bake.static_links = static_links(bake.hierarchy, all);
-  // The baseline: static links only, direct light without the region's shadows, solved once.
-  auto unshadowed = AntiradianceDirectLight::create(input, settings, true);
-  if (!unshadowed) return unshadowed.error();
-  std::vector<glm::vec3> direct = unshadowed->irradiance(bake.hierarchy);
-  for (std::size_t l = 0; l < direct.size(); ++l)
-    if (bake.hierarchy.nodes[static_cast<std::size_t>(bake.hierarchy.leaves[l])].group != 0) direct[l] = glm::vec3(0.0f);
-  CpuAntiradiancePasses base(bake.hierarchy, bins, bake.static_links);
+  // The baseline: the region at the pose it is baked at (the pose the light atlas and the
+  // PRM bake it at), direct light shadowed by it, all links; solved once.
+  auto direct_light = AntiradianceDirectLight::create(input, settings);
+  if (!direct_light) return direct_light.error();
+  const std::vector<glm::vec3> direct = direct_light->irradiance(bake.hierarchy);
+  CpuAntiradiancePasses base(bake.hierarchy, bins, all);
   const AntiradianceSolveReport rep = run_antiradiance(base, direct, settings, bake.hierarchy);
   bake.baseline = base.irradiance();
   for (glm::vec3& v : bake.baseline) v *= rep.output_scale;
@@ -63,7 +62,10 @@ engine::Result<AntiradianceRegion> AntiradianceRegion::create(const BakeInput& i
   std::vector<int> groups;
   for (int g = 1; g < r.hierarchy_->group_count(); ++g) {
     const std::uint32_t i = r.hierarchy_->deforming_instances[static_cast<std::size_t>(g - 1)];
-    r.hierarchy_->set_group_transform(g, input.instances[i].object_to_world);
+    // At the baked pose the elements keep their baked world values (bit for bit the
+    // baseline's); elsewhere they are placed from object space.
+    if (r.hierarchy_->group_transform[static_cast<std::size_t>(g - 1)] != input.instances[i].object_to_world)
+      r.hierarchy_->set_group_transform(g, input.instances[i].object_to_world);
     groups.push_back(g);
   }
   relink_moved(*r.hierarchy_, *r.bins_, r.settings_, groups, *r.links_);

@@ -6,14 +6,16 @@
 // then update(): relinks only the moved groups, recomputes the direct light and solves.
 // The GPU twin (antiradiance_gpu_pass.h) runs the same passes over the region's tables.
 //
-// What it outputs (a deviation from the paper, docs/antiradiance.md): the static world's
-// light is baked with visibility (light atlas, PRM) without the deforming instances; the
-// region adds the change its instances make. At creation it solves the baseline once: the
-// same elements and static-static links without the deforming groups, direct light
-// without their shadows. delta() = E(now) - E(baseline) at the static leaves and E(now) at
-// the deforming ones. Antiradiance's discretization leaks (light through walls, §5, Fig.
-// 13) are then the same in both solves and cancel in the static part of the delta, instead
-// of adding light the baked atlas already shadows correctly.
+// What it outputs (a deviation from the paper, docs/antiradiance.md): the light atlas (and
+// the PRM) bake the world with its deforming instances at their authored pose, with
+// visibility; the region adds the change their motion makes. The bake solves the baseline
+// once, at the authored pose; delta() = E(now) - E(baseline) per leaf, 0 while nothing has
+// moved. Nothing is counted twice (the atlas holds the authored pose, the delta only the
+// change) and nothing goes stale (the delta covers the moved instances' own leaves and
+// every static leaf they exchange light with). Antiradiance's discretization leaks (light
+// through walls, the paper's §5 and Fig. 13) are the same in both solves wherever the
+// geometry did not move and cancel in the delta, instead of adding light the baked atlas
+// already shadows correctly.
 //   auto region = gi::AntiradianceRegion::create(input, settings).value();
 //   region.set_instance_transform(door, m);  region.update();
 //   std::vector<glm::vec3> e = region.irradiance();   // indirect W/m^2 per leaf
@@ -41,7 +43,7 @@ struct AntiradianceBake {
   AntiradianceSettings settings;
   ElementHierarchy hierarchy;
   LinkMesh static_links;
-  std::vector<glm::vec3> baseline;  ///< Indirect irradiance per leaf without the region.
+  std::vector<glm::vec3> baseline;  ///< Indirect irradiance per leaf with the region at its baked pose.
 };
 
 /// Builds the elements, links the static ones and solves the baseline. Errors: see
@@ -81,8 +83,7 @@ class AntiradianceRegion {
   }
   /// The report of the last CPU solve.
   const AntiradianceSolveReport& last_report() const { return last_; }
-  /// The baseline's indirect irradiance per leaf (the world without the region; 0 at the
-  /// region's leaves).
+  /// The baseline's indirect irradiance per leaf (the region at its baked pose).
   const std::vector<glm::vec3>& baseline() const { return baseline_; }
   /// What the region adds: `irradiance` (a solve's result per leaf) minus the baseline.
   std::vector<glm::vec3> delta(const std::vector<glm::vec3>& irradiance) const;

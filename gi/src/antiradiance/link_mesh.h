@@ -52,8 +52,8 @@ struct LinkMesh {
 /// All links of the hierarchy (counters: every element, every link).
 LinkMesh link_elements(const ElementHierarchy& h, const DirectionalBins& bins, const AntiradianceSettings& settings);
 
-/// The links of `mesh` between two static elements (group 0): the world without its
-/// deforming region, the baseline the region's change is measured against.
+/// The links of `mesh` between two static elements (group 0): the ones no motion changes,
+/// which a bake stores.
 LinkMesh static_links(const ElementHierarchy& h, const LinkMesh& mesh);
 
 /// Rebuilds the links with an end in a group of `moved` (deforming groups, >= 1, whose
