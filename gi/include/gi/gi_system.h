@@ -18,7 +18,10 @@
 //   BRF          dynamic rigid objects: per-vertex indirect light (world probes + light
 //                interreflected between objects, GPU), their bounce added into the static
 //                atlas; only on frames where an object moved or any light changed, and the
-//                basis irradiance only for pairs whose relative pose changed.
+//                basis irradiance only for pairs whose relative pose changed;
+//   antiradiance deforming regions (a door): on frames where a deforming node moved, its
+//                elements relinked, the iteration on the GPU, the change against the baked
+//                pose added into the atlas (docs/antiradiance.md).
 // A frame where nothing changed does no work (Stats counts it).
 //
 // Loading checks every file against the scene (a bundle baked from other geometry, or from
@@ -62,7 +65,7 @@ class GISystem final : public engine::IndirectLightProvider {
 
   /// Indirect light for the frame about to be drawn (GL context current).
   const engine::IndirectLightFrame& frame() override;
-  /// "light atlas", "light atlas + PRM", "light atlas + PRM + BRF + DLM", ...
+  /// "light atlas", "light atlas + PRM", "light atlas + PRM + BRF + DLM", "... + antiradiance"
   const char* label() const override;
 
   struct Stats {
@@ -84,6 +87,9 @@ class GISystem final : public engine::IndirectLightProvider {
     std::size_t load_probe_ms = 0;    ///< Probe grid computed at load.
     std::size_t dlm_texels = 0;       ///< Directional light maps: stored texels (glossy + gutter); 0: none.
     std::size_t dlm_gpu_bytes = 0;    ///< ... their radiance, directions and index texture on the GPU.
+    std::uint64_t antiradiance_updates = 0;          ///< Frames on which a deforming node moved and was solved.
+    std::size_t antiradiance_relinked_elements = 0;  ///< Last such frame: elements whose links were rebuilt.
+    double last_antiradiance_ms = 0.0;               ///< Relink + direct light + GPU iteration (glFinish-timed).
     /// Methods of the bundle that turned off at run time, with why: "PRM: <reason>",
     /// "BRF: <reason>". The frame goes on without them (label() no longer names them).
     std::vector<std::string> disabled;

@@ -9,6 +9,7 @@
 #include <optional>
 #include <sstream>
 
+#include "antiradiance/antiradiance_io.h"
 #include "brf/brf_io.h"
 #include "brf/brf_lighting.h"
 #include "brf/brf_mesh.h"
@@ -20,6 +21,7 @@
 #include "prm/prm.h"
 #include "prm/prm_io.h"
 #include "system/dlm_lighting.h"
+#include "system/antiradiance_lighting.h"
 #include "system/light_atlas_lighting.h"
 #include "system/prm_lighting.h"
 #include "transport/static_scene.h"
@@ -41,6 +43,10 @@ struct GISystem::Impl {
   std::unique_ptr<PrmLighting> prm;
   std::unique_ptr<BrfLighting> brf;
   std::unique_ptr<DlmLighting> dlm;  // directional light maps of the glossy static surfaces
+  std::unique_ptr<AntiradianceLighting> anti;
+  engine::GlTexture anti_out;
+  bool anti_composed = false;
+  bool anti_disabled = false;
   engine::GlTexture composite;
   int width = 0, height = 0;
   std::uint64_t seen_prm_updates = 0;
@@ -57,6 +63,7 @@ struct GISystem::Impl {
     label = prm && !prm_disabled ? prm->label() : atlas ? atlas->label() : "";
     if (brf && !brf_disabled) label += label.empty() ? "BRF" : " + BRF";
     if (dlm) label += " + DLM";
+    if (anti && !anti_disabled) label += label.empty() ? "antiradiance" : " + antiradiance";
   }
   // The providers have told the host through the log already; the stats keep it.
   void turned_off(const char* method, const std::string& reason) {
@@ -75,6 +82,7 @@ engine::Result<std::unique_ptr<GISystem>> GISystem::load(const std::filesystem::
   const bool has_prm = manifest->methods.contains("prm");
   const bool has_brf = manifest->methods.contains("brf");
   const bool has_dlm = manifest->methods.contains(kDlmMethod);
+  const bool has_anti = manifest->methods.contains(kAntiradianceMethod);
   if (!has_atlas && !has_prm && !has_brf && !has_dlm)
     return engine::Error{(bundle_dir / "manifest.json").string(), "methods",
                          "the bundle holds no light atlas, PRM, basis radiance fields or directional light maps"};
@@ -94,6 +102,8 @@ engine::Result<std::unique_ptr<GISystem>> GISystem::load(const std::filesystem::
         return has_brf;
       case EffectMethod::DirectionalLightMaps:
         return has_dlm;
+      case EffectMethod::Antiradiance:
+        return has_anti;
       default:
         return false;
     }
@@ -211,6 +221,22 @@ engine::Result<std::unique_ptr<GISystem>> GISystem::load(const std::filesystem::
          << " bounces; world light from " << probe_count << " probes; bounce onto " << receivers << " atlas texels\n";
   }
 
+  // Antiradiance: the deforming region's change, added into the atlas of the same layout.
+  if (has_anti) {
+    const AtlasLayout* layout = atlas ? &atlas->layout : prm ? &prm->layout : nullptr;
+    if (layout == nullptr)
+      return engine::Error{(bundle_dir / "manifest.json").string(), "methods.antiradiance",
+                           "antiradiance adds into the light atlas: the bundle needs a light atlas or a PRM too"};
+    auto bake = load_antiradiance(bundle_dir, input);
+    if (!bake) return bake.error();
+    auto anti = AntiradianceLighting::create(std::move(bake).value(), input, *layout, scene.registry);
+    if (!anti) return anti.error();
+    impl->anti = std::move(anti).value();
+    const auto& st = impl->anti->stats();
+    text << "antiradiance: " << st.elements << " elements, " << st.links << " links, " << st.covered_texels
+         << " atlas texels; solved on frames where a deforming node moves\n";
+  }
+
   if (prm) {
     auto p = PrmLighting::from_bake(std::move(*prm), atlas ? &*atlas : nullptr, scene,
                                     {.active_clusters = settings.prm_active_clusters, .log = settings.log});
@@ -290,6 +316,37 @@ const engine::IndirectLightFrame& GISystem::frame() {
       m.composed = true;
     }
     m.frame.irradiance_atlas_texture = m.composite.id();
+  }
+  if (m.anti && !m.anti_disabled && m.frame.irradiance_atlas_texture != 0) {
+    const bool moved = m.anti->update();
+    if (!m.anti->disabled().empty()) {
+      m.anti_disabled = true;
+      m.turned_off("antiradiance", m.anti->disabled());
+      m.relabel();
+    } else {
+      const std::uint32_t src = m.frame.irradiance_atlas_texture;
+      if (m.anti_out.empty()) {
+        GLint w = 0, h = 0;
+        glGetTextureLevelParameteriv(src, 0, GL_TEXTURE_WIDTH, &w);
+        glGetTextureLevelParameteriv(src, 0, GL_TEXTURE_HEIGHT, &h);
+        m.anti_out = engine::GlTexture::create_2d(GL_RGBA32F, w, h);
+        glTextureParameteri(m.anti_out.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+        glTextureParameteri(m.anti_out.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+        glTextureParameteri(m.anti_out.id(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+        glTextureParameteri(m.anti_out.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+      }
+      if (moved || base_changed || objects_changed || !m.anti_composed) {
+        m.anti->composite(src, m.anti_out.id());
+        m.anti_composed = true;
+      }
+      m.frame.irradiance_atlas_texture = m.anti_out.id();
+      if (moved) {
+        work = true;
+        ++m.stats.antiradiance_updates;
+        m.stats.antiradiance_relinked_elements = m.anti->stats().relinked_elements;
+        m.stats.last_antiradiance_ms = m.anti->stats().last_ms;
+      }
+    }
   }
   m.composed = true;
   if (m.dlm) m.dlm->fill(m.frame);

@@ -1,0 +1,181 @@
+#include "system/antiradiance_lighting.h"
+
+#include <GL/glcorearb.h>
+
+#include <engine/components.h>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <limits>
+
+#include "gpu/gi_shaders.h"
+#include "uv/atlas_input.h"
+#include "uv/atlas_rasterizer.h"
+
+namespace gi {
+
+namespace {
+
+using TexelBlend = AntiradianceLighting::TexelBlendHost;
+static_assert(sizeof(TexelBlend) == 48, "must match TexelBlend in antiradiance_composite.comp.glsl (std430)");
+
+constexpr std::uint32_t kGroupSize = 64;
+
+// Every covered atlas texel's up-to-four nearest leaves of its own instance facing its way
+// (normals within ~45 degrees), weighted by 1 / (d^2 + (r/2)^2) of the leaf radius r.
+std::vector<AntiradianceLighting::TexelBlendHost> antiradiance_texel_blends(const ElementHierarchy& h, const BakeInput& input, const AtlasLayout& layout) {
+  const std::vector<AtlasInputMesh> inputs = atlas_inputs_from(input);
+  const AtlasTexels texels = rasterize_atlas(layout, inputs);
+  std::vector<std::int32_t> static_instance;  // atlas input mesh -> BakeInput instance
+  for (std::size_t i = 0; i < input.instances.size(); ++i)
+    if (input.instances[i].mobility == BakeMobility::Static) static_instance.push_back(static_cast<std::int32_t>(i));
+  std::vector<std::vector<std::int32_t>> leaves_of(input.instances.size());
+  for (std::size_t l = 0; l < h.leaf_count(); ++l) {
+    const std::int32_t inst = h.node_instance[static_cast<std::size_t>(h.leaves[l])];
+    if (inst >= 0 && static_cast<std::size_t>(inst) < leaves_of.size())
+      leaves_of[static_cast<std::size_t>(inst)].push_back(static_cast<std::int32_t>(l));
+  }
+  std::vector<TexelBlend> out;
+  for (std::size_t t = 0; t < texels.valid.size(); ++t) {
+    if (texels.valid[t] == 0 || texels.mesh[t] < 0 || static_cast<std::size_t>(texels.mesh[t]) >= static_instance.size())
+      continue;
+    const auto inst = static_cast<std::size_t>(static_instance[static_cast<std::size_t>(texels.mesh[t])]);
+    const std::vector<std::int32_t>& candidates = leaves_of[inst];
+    if (candidates.empty()) continue;
+    std::array<std::pair<float, std::int32_t>, 4> best;
+    best.fill({std::numeric_limits<float>::infinity(), -1});
+    for (std::int32_t l : candidates) {
+      const ElementNode& n = h.nodes[static_cast<std::size_t>(h.leaves[static_cast<std::size_t>(l)])];
+      if (glm::dot(n.normal, texels.normal[t]) < 0.7f) continue;
+      const glm::vec3 d = texels.position[t] - n.center;
+      const float d2 = glm::dot(d, d);
+      if (d2 >= best[3].first) continue;
+      best[3] = {d2, l};
+      std::sort(best.begin(), best.end());
+    }
+    if (best[0].second < 0) continue;
+    TexelBlend b;
+    b.texel = static_cast<std::uint32_t>(t);
+    float total = 0.0f;
+    for (int k = 0; k < 4; ++k) {
+      if (best[static_cast<std::size_t>(k)].second < 0) continue;
+      const ElementNode& n =
+          h.nodes[static_cast<std::size_t>(h.leaves[static_cast<std::size_t>(best[static_cast<std::size_t>(k)].second)])];
+      const float w = 1.0f / (best[static_cast<std::size_t>(k)].first + 0.25f * n.radius_m * n.radius_m);
+      b.leaves[k] = best[static_cast<std::size_t>(k)].second;
+      b.weights[k] = w;
+      total += w;
+    }
+    b.weights /= total;
+    out.push_back(b);
+  }
+  return out;
+}
+
+}  // namespace
+
+engine::Result<std::unique_ptr<AntiradianceLighting>> AntiradianceLighting::create(AntiradianceBake bake,
+                                                                                   const BakeInput& input,
+                                                                                   const AtlasLayout& layout,
+                                                                                   const engine::Registry& registry) {
+  auto region = AntiradianceRegion::create(input, std::move(bake));
+  if (!region) return region.error();
+  std::unique_ptr<AntiradianceLighting> a(new AntiradianceLighting());
+  a->region_ = std::make_unique<AntiradianceRegion>(std::move(region).value());
+  a->registry_ = &registry;
+  for (std::uint32_t i : a->region_->hierarchy().deforming_instances) a->deforming_.emplace_back(i, input.instances[i].entity);
+  std::vector<TexelBlend> blends = antiradiance_texel_blends(a->region_->hierarchy(), input, layout);
+  a->blend_count_ = static_cast<std::uint32_t>(blends.size());
+  a->width_ = layout.width;
+  a->height_ = layout.height;
+  a->stats_.elements = a->region_->hierarchy().nodes.size();
+  a->stats_.covered_texels = blends.size();
+  a->stats_.links = a->region_->links().links.size();
+  a->blends_host_ = std::move(blends);  // uploaded on the first frame (GL context current)
+  return a;
+}
+
+bool AntiradianceLighting::ensure_gpu() {
+  if (!disabled_.empty()) return false;
+  if (gpu_) return true;
+  auto program = engine::ShaderProgramBuilder(gi_shader_files())
+                     .stage(engine::ShaderStage::Compute, "antiradiance_composite.comp.glsl")
+                     .build();
+  if (!program) {
+    disabled_ = program.error().to_string();
+    return false;
+  }
+  auto gpu = AntiradianceGpuPass::create(region_->hierarchy(), region_->bins(), region_->links());
+  if (!gpu) {
+    disabled_ = gpu.error().to_string();
+    return false;
+  }
+  program_ = std::move(program).value();
+  gpu_.emplace(std::move(gpu).value());
+  blends_ = engine::GlBuffer::create();
+  glNamedBufferData(blends_.id(), static_cast<GLsizeiptr>(std::max<std::size_t>(blends_host_.size(), 1) * sizeof(TexelBlend)),
+                    nullptr, GL_STATIC_DRAW);
+  if (!blends_host_.empty())
+    glNamedBufferSubData(blends_.id(), 0, static_cast<GLsizeiptr>(blends_host_.size() * sizeof(TexelBlend)),
+                         blends_host_.data());
+  delta_ = engine::GlBuffer::create();
+  glNamedBufferData(delta_.id(), static_cast<GLsizeiptr>(std::max<std::size_t>(region_->hierarchy().leaf_count(), 1) * 16),
+                    nullptr, GL_DYNAMIC_DRAW);
+  glClearNamedBufferData(delta_.id(), GL_R32F, GL_RED, GL_FLOAT, nullptr);  // baked pose: no change
+  return true;
+}
+
+void AntiradianceLighting::upload_delta(const std::vector<glm::vec3>& irradiance, float scale) {
+  const std::vector<glm::vec3>& base = region_->baseline();
+  std::vector<glm::vec4> d(irradiance.size());
+  for (std::size_t l = 0; l < d.size(); ++l)
+    d[l] = glm::vec4(scale * irradiance[l] - (l < base.size() ? base[l] : glm::vec3(0.0f)), 0.0f);
+  if (!d.empty()) glNamedBufferSubData(delta_.id(), 0, static_cast<GLsizeiptr>(d.size() * sizeof(glm::vec4)), d.data());
+}
+
+bool AntiradianceLighting::update() {
+  if (!ensure_gpu()) return false;
+  bool moved = false;
+  for (const auto& [instance, entity] : deforming_) {
+    const auto* wt = registry_->try_get<engine::WorldTransform>(entity);
+    if (wt != nullptr && region_->set_instance_transform(instance, wt->matrix)) moved = true;
+  }
+  if (!moved) return false;
+  const auto t0 = std::chrono::steady_clock::now();
+  region_->update(false);  // relink the moved groups, direct light at the elements
+  if (engine::Status st = gpu_->set_links(region_->links()); !st) {
+    disabled_ = st.error().to_string();
+    return false;
+  }
+  const AntiradianceSolveReport report =
+      run_antiradiance(*gpu_, region_->direct(), region_->settings(), region_->hierarchy());
+  upload_delta(gpu_->irradiance(), report.output_scale);
+  glFinish();
+  ++stats_.updates;
+  stats_.relinked_elements = region_->counters().relinked_elements;
+  stats_.links = region_->counters().links;
+  stats_.fell_back = report.fell_back;
+  stats_.last_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  return true;
+}
+
+void AntiradianceLighting::composite(std::uint32_t base_texture, std::uint32_t out_texture) {
+  glCopyImageSubData(base_texture, GL_TEXTURE_2D, 0, 0, 0, 0, out_texture, GL_TEXTURE_2D, 0, 0, 0, 0, width_, height_, 1);
+  if (!ensure_gpu() || blend_count_ == 0) return;
+  glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
+  program_.use();
+  glProgramUniform1ui(program_.id(), glGetUniformLocation(program_.id(), "u_count"), blend_count_);
+  glProgramUniform1ui(program_.id(), glGetUniformLocation(program_.id(), "u_width"), static_cast<GLuint>(width_));
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, blends_.id());
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, delta_.id());
+  glBindImageTexture(0, out_texture, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+  glBindImageTexture(1, base_texture, 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
+  const std::uint32_t groups = (blend_count_ + kGroupSize - 1) / kGroupSize;
+  const std::uint32_t gx = std::min<std::uint32_t>(groups, 65535u);
+  glDispatchCompute(gx, (groups + gx - 1) / gx, 1);
+  glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT |
+                  GL_FRAMEBUFFER_BARRIER_BIT | GL_PIXEL_BUFFER_BARRIER_BIT);
+}
+
+}  // namespace gi

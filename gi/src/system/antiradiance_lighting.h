@@ -1,0 +1,80 @@
+#pragma once
+// The runtime of an antiradiance region (docs/antiradiance.md) inside GISystem: watches
+// the deforming instances' entities, and on a frame where one moved relinks only its
+// elements, recomputes the direct light at the elements, runs the iteration on the GPU
+// (antiradiance_gpu_pass.h) and adds the change against the baked pose into the
+// irradiance atlas (antiradiance_composite.comp.glsl). A frame where nothing moved does
+// nothing; composite() re-adds the last change when the base atlas changed.
+//   auto a = gi::AntiradianceLighting::create(std::move(bake), input, layout, scene.registry).value();
+//   if (a->update()) { /* moved */ }  a->composite(base_texture, out_texture);
+
+#include <engine/gpu/gl_objects.h>
+#include <engine/gpu/shader_program.h>
+#include <engine/registry.h>
+#include <engine/result.h>
+#include <gi/bake_input.h>
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "antiradiance/antiradiance_gpu_pass.h"
+#include "antiradiance/antiradiance_region.h"
+#include "uv/atlas_layout.h"
+
+namespace gi {
+
+class AntiradianceLighting {
+ public:
+  /// One covered atlas texel: its leaves and blend weights (std430 TexelBlend of the shader).
+  struct TexelBlendHost {
+    std::uint32_t texel = 0, pad0 = 0, pad1 = 0, pad2 = 0;
+    glm::ivec4 leaves{-1};
+    glm::vec4 weights{0.0f};
+  };
+  struct Stats {
+    std::uint64_t updates = 0;            ///< Frames on which a deforming instance moved.
+    std::size_t relinked_elements = 0;    ///< Last update: elements whose links were rebuilt.
+    std::size_t links = 0;                ///< Links after it.
+    std::size_t elements = 0;             ///< Elements of the region.
+    std::size_t covered_texels = 0;       ///< Atlas texels the region's change reaches.
+    double last_ms = 0.0;                 ///< Last update: relink + direct light + GPU iteration (glFinish-timed).
+    bool fell_back = false;               ///< Last update: the symmetric iteration grew.
+  };
+
+  /// Errors: the bake does not fit `input` (AntiradianceRegion::create).
+  static engine::Result<std::unique_ptr<AntiradianceLighting>> create(AntiradianceBake bake, const BakeInput& input,
+                                                                      const AtlasLayout& layout,
+                                                                      const engine::Registry& registry);
+
+  /// Reads the deforming entities' world transforms; when one changed, solves (GL context
+  /// current). True when it did. Errors of the GPU pass disable the method (stats().disabled).
+  bool update();
+  /// out = base + the region's change at the texels it covers, base elsewhere. Both
+  /// textures RGBA32F of the atlas's size.
+  void composite(std::uint32_t base_texture, std::uint32_t out_texture);
+
+  const Stats& stats() const { return stats_; }
+  const std::string& disabled() const { return disabled_; }
+
+ private:
+  AntiradianceLighting() = default;
+  /// GL objects on first use (a context is current in frame()). False: disabled.
+  bool ensure_gpu();
+  /// Uploads delta = E(now) - baseline per leaf.
+  void upload_delta(const std::vector<glm::vec3>& irradiance, float scale);
+  std::vector<TexelBlendHost> blends_host_;
+  std::unique_ptr<AntiradianceRegion> region_;
+  const engine::Registry* registry_ = nullptr;
+  std::vector<std::pair<std::uint32_t, engine::Entity>> deforming_;  ///< BakeInput instance, entity.
+  std::optional<AntiradianceGpuPass> gpu_;
+  engine::ShaderProgram program_;
+  engine::GlBuffer blends_, delta_;
+  std::uint32_t blend_count_ = 0;
+  int width_ = 0, height_ = 0;
+  Stats stats_;
+  std::string disabled_;
+};
+
+}  // namespace gi
