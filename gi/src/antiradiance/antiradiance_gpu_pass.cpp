@@ -121,9 +121,20 @@ engine::Status AntiradianceGpuPass::set_links(const LinkMesh& links) {
   for (std::size_t k = 0; k < data.size(); ++k)
     data[k] = {static_cast<std::uint32_t>(links.links[k].sender), static_cast<std::uint32_t>(links.links[k].bin),
                links.links[k].form_factor, 0u};
-  offsets_ = buffer(links.offsets.size() * sizeof(std::uint32_t), links.offsets.data());
+  // One run per (receiver, bin): first link, count, destination entry.
+  std::vector<glm::uvec4> runs;
+  for (std::size_t k = 0; k < links.links.size();) {
+    const Link& first = links.links[k];
+    std::size_t e = k + 1;
+    while (e < links.links.size() && links.links[e].receiver == first.receiver && links.links[e].bin == first.bin) ++e;
+    runs.emplace_back(static_cast<std::uint32_t>(k), static_cast<std::uint32_t>(e - k),
+                      static_cast<std::uint32_t>(first.receiver) * m_ + static_cast<std::uint32_t>(first.bin), 0u);
+    k = e;
+  }
+  runs_count_ = static_cast<std::uint32_t>(runs.size());
+  runs_ = buffer(runs.size() * sizeof(glm::uvec4), runs.data());
   links_ = buffer(data.size() * sizeof(GpuLink), data.data());
-  link_bytes_ = links.offsets.size() * 4 + data.size() * sizeof(GpuLink);
+  link_bytes_ = runs.size() * sizeof(glm::uvec4) + data.size() * sizeof(GpuLink);
   return {};
 }
 
@@ -155,11 +166,13 @@ void AntiradianceGpuPass::reset(std::span<const glm::vec3> direct) {
 }
 
 void AntiradianceGpuPass::global() {
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, offsets_.id());
+  glClearNamedBufferData(l_in_.id(), GL_R32F, GL_RED, GL_FLOAT, nullptr);
+  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, runs_.id());
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, links_.id());
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, i_ex_.id());
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, l_in_.id());
-  dispatch(global_, nodes_);
+  dispatch(global_, runs_count_);
 }
 
 void AntiradianceGpuPass::push() {

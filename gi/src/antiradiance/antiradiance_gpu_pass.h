@@ -63,7 +63,8 @@ class AntiradianceGpuPass final : public AntiradiancePasses {
   std::uint32_t leaves_ = 0;
   std::uint32_t inner_count_ = 0;
   engine::ShaderProgram global_, push_, local_, pull_;
-  engine::GlBuffer offsets_, links_, parents_, leaf_nodes_, inner_, bins_, leaf_data_;
+  std::uint32_t runs_count_ = 0;
+  engine::GlBuffer runs_, links_, parents_, leaf_nodes_, inner_, bins_, leaf_data_;
   engine::GlBuffer i_ex_, l_in_, l_leaf_, i_l_, i_a_, irradiance_, residual_;
   std::size_t bytes_ = 0;
   std::size_t link_bytes_ = 0;

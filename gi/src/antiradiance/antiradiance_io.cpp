@@ -129,7 +129,8 @@ std::string check_bake(const AntiradianceBake& b) {
       return "static link " + std::to_string(k) + " has an end in a deforming group";
     if (k > 0) {
       const Link& p = b.static_links.links[k - 1];
-      if (p.receiver > l.receiver) return "static links are not sorted by receiver";
+      if (p.receiver > l.receiver || (p.receiver == l.receiver && p.bin > l.bin))
+        return "static links are not sorted by receiver and bin";
     }
   }
   if (b.baseline.size() != h.leaves.size()) return "the baseline has " + std::to_string(b.baseline.size()) + " values for " + std::to_string(h.leaves.size()) + " leaves";

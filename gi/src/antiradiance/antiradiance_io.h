@@ -27,7 +27,8 @@
 //                                          child_count, leaf_begin, leaf_end, group, end (int32s)
 //   array<int32>  children, leaves, group_root, node_instance
 //   array<vec3>   object_center, object_normal;  array<float32> object_radius, object_area
-//   array<link>   static_links             receiver, sender, bin (int32), form_factor (float32)
+//   array<link>   static_links             receiver, sender, bin (int32), form_factor (float32),
+//                                          sorted by (receiver, bin, sender)
 //   array<vec3>   baseline                 one per leaf
 // Nothing follows (trailing bytes are an error). The reader checks every index against the
 // arrays it points into, every value for NaN/infinity, and the sizes against each other.

@@ -37,6 +37,8 @@ void CpuAntiradiancePasses::global() {
   for (std::size_t r = 0; r < h_.nodes.size(); ++r) {
     glm::vec3* row = &l_in_[r * m];
     std::fill(row, row + m, glm::vec3(0.0f));
+    // Links of r sorted by (bin, sender): each bin's sum runs in link order from zero, as
+    // one invocation of antiradiance_global.comp.glsl sums it.
     for (std::uint32_t k = links_.offsets[r]; k < links_.offsets[r + 1]; ++k) {
       const Link& l = links_.links[k];
       const auto b = static_cast<std::size_t>(l.bin);

@@ -118,7 +118,7 @@ struct Linker {
 void sort_and_index(const ElementHierarchy& h, LinkMesh& mesh) {
   std::sort(mesh.links.begin(), mesh.links.end(), [](const Link& x, const Link& y) {
     if (x.receiver != y.receiver) return x.receiver < y.receiver;
-    return x.sender != y.sender ? x.sender < y.sender : x.bin < y.bin;
+    return x.bin != y.bin ? x.bin < y.bin : x.sender < y.sender;
   });
   mesh.offsets.assign(h.nodes.size() + 1, 0u);
   for (const Link& l : mesh.links) ++mesh.offsets[static_cast<std::size_t>(l.receiver) + 1];

@@ -40,7 +40,9 @@ struct Link {
   float form_factor = 0.0f;   ///< 1 / (d^2_regularized omega_bin), 1/(m^2 sr).
 };
 
-/// Links sorted by (receiver, sender): receiver r's links are [offsets[r], offsets[r+1]).
+/// Links sorted by (receiver, bin, sender): receiver r's links are [offsets[r], offsets[r+1]),
+/// and within them each bin's links are contiguous (the GPU sums one (receiver, bin) run
+/// per invocation; the CPU twin sums in the same order).
 struct LinkMesh {
   std::vector<Link> links;
   std::vector<std::uint32_t> offsets;  ///< nodes + 1 entries.

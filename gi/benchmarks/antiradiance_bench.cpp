@@ -1,0 +1,90 @@
+// Per-frame cost of the antiradiance region of assets/corridor.gltf (the door) at the
+// preview bake settings (0.8 m elements, 64 bins): what a frame where the door moved costs,
+// phase by phase. llvmpipe timings are CPU timings (DESIGN.md §4); GPU phases end in glFinish.
+//   ./build/gi/benchmarks/antiradiance_bench
+#include <GL/glcorearb.h>
+#include <benchmark/benchmark.h>
+#include <engine/gltf.h>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "antiradiance/antiradiance_gpu_pass.h"
+#include "antiradiance/antiradiance_region.h"
+#include "bench_gl.h"
+
+namespace {
+
+glm::mat4 door(float degrees) {
+  return glm::rotate(glm::translate(glm::mat4(1.0f), glm::vec3(6.0f, 0.0f, 5.4f)), glm::radians(degrees),
+                     glm::vec3(0.0f, 1.0f, 0.0f));
+}
+
+struct Corridor {
+  gi::BakeInput input;
+  std::uint32_t door_instance = 0;
+  std::unique_ptr<gi::AntiradianceRegion> region;
+  Corridor() {
+    auto asset = engine::load_gltf(GI_SOURCE_DIR "/assets/corridor.gltf");
+    if (!asset) std::exit(1);
+    input = gi::bake_input_from(*asset);
+    for (std::size_t i = 0; i < input.instances.size(); ++i)
+      if (input.instances[i].deforming) door_instance = static_cast<std::uint32_t>(i);
+    gi::AntiradianceSettings s;
+    s.patch_size_m = 0.8f;
+    region = std::make_unique<gi::AntiradianceRegion>(gi::AntiradianceRegion::create(input, s).value());
+  }
+};
+
+Corridor& corridor() {
+  static Corridor c;
+  return c;
+}
+
+// Relink of the door's elements + direct light at all elements (the CPU part of a move).
+void BM_AntiradianceMoveCpu(benchmark::State& state) {
+  Corridor& c = corridor();
+  float angle = 50.0f;
+  for (auto _ : state) {
+    angle = angle > 100.0f ? 10.0f : angle + 7.0f;
+    c.region->set_instance_transform(c.door_instance, door(angle));
+    c.region->update(false);
+  }
+  state.counters["relinked"] = static_cast<double>(c.region->counters().relinked_elements);
+  state.counters["links"] = static_cast<double>(c.region->counters().links);
+}
+BENCHMARK(BM_AntiradianceMoveCpu)->Unit(benchmark::kMillisecond)->Iterations(5);
+
+// One iteration (global, push, local, pull) on the GPU, and the CPU twin's.
+void BM_AntiradianceIterationGpu(benchmark::State& state) {
+  (void)bench::gl_context();
+  Corridor& c = corridor();
+  auto gpu = gi::AntiradianceGpuPass::create(c.region->hierarchy(), c.region->bins(), c.region->links()).value();
+  gpu.reset(c.region->direct());
+  for (auto _ : state) {
+    gpu.global();
+    gpu.push();
+    gpu.local(true, true);
+    gpu.pull();
+    glFinish();
+  }
+  state.counters["link_records"] = static_cast<double>(c.region->links().links.size());
+  state.counters["leaves"] = static_cast<double>(c.region->hierarchy().leaf_count());
+}
+BENCHMARK(BM_AntiradianceIterationGpu)->Unit(benchmark::kMillisecond)->Iterations(5);
+
+void BM_AntiradianceIterationCpu(benchmark::State& state) {
+  Corridor& c = corridor();
+  gi::CpuAntiradiancePasses cpu(c.region->hierarchy(), c.region->bins(), c.region->links());
+  cpu.reset(c.region->direct());
+  for (auto _ : state) {
+    cpu.global();
+    cpu.push();
+    cpu.local(true, true);
+    cpu.pull();
+  }
+}
+BENCHMARK(BM_AntiradianceIterationCpu)->Unit(benchmark::kMillisecond)->Iterations(5);
+
+}  // namespace
+
+BENCHMARK_MAIN();
