@@ -72,6 +72,24 @@ void BM_AntiradianceIterationGpu(benchmark::State& state) {
 }
 BENCHMARK(BM_AntiradianceIterationGpu)->Unit(benchmark::kMillisecond)->Iterations(5);
 
+// The four GPU passes one by one (arg: 0 global, 1 push, 2 local, 3 pull).
+void BM_AntiradiancePassGpu(benchmark::State& state) {
+  (void)bench::gl_context();
+  Corridor& c = corridor();
+  auto gpu = gi::AntiradianceGpuPass::create(c.region->hierarchy(), c.region->bins(), c.region->links()).value();
+  gpu.reset(c.region->direct());
+  for (auto _ : state) {
+    switch (state.range(0)) {
+      case 0: gpu.global(); break;
+      case 1: gpu.push(); break;
+      case 2: gpu.local(true, true); break;
+      default: gpu.pull(); break;
+    }
+    glFinish();
+  }
+}
+BENCHMARK(BM_AntiradiancePassGpu)->Arg(0)->Arg(1)->Arg(2)->Arg(3)->Unit(benchmark::kMillisecond)->Iterations(5);
+
 void BM_AntiradianceIterationCpu(benchmark::State& state) {
   Corridor& c = corridor();
   gi::CpuAntiradiancePasses cpu(c.region->hierarchy(), c.region->bins(), c.region->links());

@@ -1,8 +1,9 @@
 #version 450 core
 // Local pass (Dachsbacher et al. 2007 §3.1 eq. 18-19, diffuse BRDF), one invocation per leaf:
-//   E        = sum_b <n|-w_b>+ omega_b L_leaf[b]                 (gathered indirect irradiance)
+// (L = L_in at the leaf's node after push: all the light arriving at the leaf)
+//   E        = sum_b <n|-w_b>+ omega_b L[b]                      (gathered indirect irradiance)
 //   I_L[b]   = a <n|w_b>+ albedo/pi (E + E_direct)               when u_radiance   (operator K)
-//   I_A[b]   = a <n|-w_b>+ L_leaf[b]                             when u_antiradiance (operator J)
+//   I_A[b]   = a <n|-w_b>+ L[b]                                  when u_antiradiance (operator J)
 //   I_ex[b]  = I_L[b] - I_A[b] at the leaf's node
 // and the leaf's residual terms sum_b |I_ex new - I_ex old| and sum_b |I_ex new| (float,
 // bins then channels; the host sums the leaves in double). The twin of
@@ -19,7 +20,7 @@ struct Leaf {
 layout(std430, binding = 0) readonly buffer LeafData { Leaf leaf_data[]; };
 layout(std430, binding = 1) readonly buffer LeafNodes { int leaves[]; };
 layout(std430, binding = 2) readonly buffer Bins { vec4 bins[]; };  // direction, solid angle
-layout(std430, binding = 3) readonly buffer IncidentLeaf { float l_leaf[]; };
+layout(std430, binding = 3) readonly buffer Incident { float l_in[]; };
 layout(std430, binding = 4) buffer Reflected { float i_l[]; };
 layout(std430, binding = 5) buffer Anti { float i_a[]; };
 layout(std430, binding = 6) buffer Exitant { float i_ex[]; };
@@ -42,8 +43,8 @@ void main() {
   vec3 e = vec3(0.0);
   for (uint b = 0u; b < u_bins; ++b) {
     const float cos_minus = max(0.0, -dot(n, bins[b].xyz));
-    const uint k = leaf_row + b * 3u;
-    e += (cos_minus * bins[b].w) * vec3(l_leaf[k], l_leaf[k + 1u], l_leaf[k + 2u]);
+    const uint j = node_row + b * 3u;
+    e += (cos_minus * bins[b].w) * vec3(l_in[j], l_in[j + 1u], l_in[j + 2u]);
   }
   const vec3 reflected = d.albedo.rgb * kInvPi * (e + d.direct.rgb);
   if (u_radiance != 0u) irradiance[l] = vec4(e, 1.0);
@@ -61,7 +62,8 @@ void main() {
       i_l[k + 2u] = il.z;
     }
     if (u_antiradiance != 0u) {
-      ia = (area * max(0.0, -c)) * vec3(l_leaf[k], l_leaf[k + 1u], l_leaf[k + 2u]);
+      const uint j = node_row + b * 3u;
+      ia = (area * max(0.0, -c)) * vec3(l_in[j], l_in[j + 1u], l_in[j + 2u]);
       i_a[k] = ia.x;
       i_a[k + 1u] = ia.y;
       i_a[k + 2u] = ia.z;

@@ -1,26 +1,31 @@
 #version 450 core
-// Pull (Dachsbacher et al. 2007 §3.2, §4.2): an inner node's exitant intensity is the sum of
-// its leaves' (intensities add up the hierarchy), summed in leaf order as the CPU twin does:
-//   I_ex[node][bin] = sum over leaves i in [leaf_begin, leaf_end) of I_ex[leaves[i]][bin]
-// One invocation per (inner node, bin); the inner nodes are listed in `inner`.
+// Pull (Dachsbacher et al. 2007 §3.2, §4.2): intensities add up the hierarchy, one level
+// per dispatch from the deepest inner nodes up (the CPU twin walks the same order):
+//   I_ex[n][bin] = sum over n's children c (in child order) of I_ex[c][bin]
+// One invocation per (node of the level, bin); leaves of the level are skipped.
 
 #include "antiradiance_common.glsl"
 
-layout(std430, binding = 0) readonly buffer Inner { ivec4 inner[]; };  // node, leaf_begin, leaf_end, 0
-layout(std430, binding = 1) readonly buffer Leaves { int leaves[]; };
-layout(std430, binding = 2) buffer Exitant { float i_ex[]; };
+layout(std430, binding = 0) readonly buffer Nodes { ivec2 child_range[]; };  // first child, child count
+layout(std430, binding = 1) readonly buffer Children { int children[]; };
+layout(std430, binding = 2) readonly buffer ByLevel { int by_level[]; };
+layout(std430, binding = 3) buffer Exitant { float i_ex[]; };
+
+uniform uint u_first;  // this level's first entry in by_level
 
 void main() {
   const uint item = item_index();
   if (item >= u_items) return;
-  const ivec4 node = inner[item / u_bins];
+  const uint n = uint(by_level[u_first + item / u_bins]);
   const uint bin = item % u_bins;
+  const ivec2 range = child_range[n];
+  if (range.y == 0) return;
   vec3 sum = vec3(0.0);
-  for (int i = node.y; i < node.z; ++i) {
-    const uint src = (uint(leaves[i]) * u_bins + bin) * 3u;
+  for (int c = 0; c < range.y; ++c) {
+    const uint src = (uint(children[range.x + c]) * u_bins + bin) * 3u;
     sum += vec3(i_ex[src], i_ex[src + 1u], i_ex[src + 2u]);
   }
-  const uint dst = (uint(node.x) * u_bins + bin) * 3u;
+  const uint dst = (n * u_bins + bin) * 3u;
   i_ex[dst] = sum.x;
   i_ex[dst + 1u] = sum.y;
   i_ex[dst + 2u] = sum.z;

@@ -1,28 +1,28 @@
 #version 450 core
 // Push (Dachsbacher et al. 2007 §3.2 "Maintenance of the hierarchy"): the incident radiance
-// gathered at inner nodes goes down to the leaves,
-//   L_leaf[leaf][bin] = L_in[leaf's node][bin] + L_in[parent][bin] + ... + L_in[root][bin]
-// (leaf first, then up, as the CPU twin sums). One invocation per (leaf, bin).
+// gathered at inner nodes goes down the hierarchy, one level per dispatch from the root's
+// children down (the CPU twin walks the same order):
+//   L_in[n][bin] += L_in[parent(n)][bin]      for the nodes n of this level
+// so that after the deepest level every leaf holds all the light arriving there.
+// One invocation per (node of the level, bin).
 
 #include "antiradiance_common.glsl"
 
 layout(std430, binding = 0) readonly buffer Parents { int parents[]; };
-layout(std430, binding = 1) readonly buffer Leaves { int leaves[]; };
-layout(std430, binding = 2) readonly buffer Incident { float l_in[]; };
-layout(std430, binding = 3) writeonly buffer IncidentLeaf { float l_leaf[]; };
+layout(std430, binding = 1) readonly buffer ByLevel { int by_level[]; };
+layout(std430, binding = 2) buffer Incident { float l_in[]; };
+
+uniform uint u_first;  // this level's first entry in by_level
 
 void main() {
   const uint item = item_index();
   if (item >= u_items) return;
-  const uint leaf = item / u_bins;
+  const uint n = uint(by_level[u_first + item / u_bins]);
   const uint bin = item % u_bins;
-  vec3 sum = vec3(0.0);
-  for (int a = leaves[leaf]; a >= 0; a = parents[a]) {
-    const uint src = (uint(a) * u_bins + bin) * 3u;
-    sum += vec3(l_in[src], l_in[src + 1u], l_in[src + 2u]);
-  }
-  const uint dst = item * 3u;
-  l_leaf[dst] = sum.x;
-  l_leaf[dst + 1u] = sum.y;
-  l_leaf[dst + 2u] = sum.z;
+  const uint p = uint(parents[n]);
+  const uint dst = (n * u_bins + bin) * 3u;
+  const uint src = (p * u_bins + bin) * 3u;
+  l_in[dst] = l_in[dst] + l_in[src];
+  l_in[dst + 1u] = l_in[dst + 1u] + l_in[src + 1u];
+  l_in[dst + 2u] = l_in[dst + 2u] + l_in[src + 2u];
 }

@@ -82,32 +82,33 @@ engine::Result<AntiradianceGpuPass> AntiradianceGpuPass::create(const ElementHie
   }
 
   std::vector<std::int32_t> parents(h.nodes.size());
-  std::vector<glm::ivec4> inner;
+  std::vector<glm::ivec2> child_range(h.nodes.size());
   for (std::size_t n = 0; n < h.nodes.size(); ++n) {
     parents[n] = h.nodes[n].parent;
-    if (h.nodes[n].child_count > 0)
-      inner.emplace_back(static_cast<int>(n), h.nodes[n].leaf_begin, h.nodes[n].leaf_end, 0);
+    child_range[n] = glm::ivec2(h.nodes[n].first_child, h.nodes[n].child_count);
   }
-  pass.inner_count_ = static_cast<std::uint32_t>(inner.size());
+  std::vector<std::int32_t> by_level;
+  nodes_by_level(h, by_level, pass.level_offsets_);
   std::vector<glm::vec4> bin_data(m);
   for (std::size_t b = 0; b < m; ++b)
     bin_data[b] = glm::vec4(bins.direction(static_cast<int>(b)), bins.solid_angle(static_cast<int>(b)));
 
   pass.parents_ = buffer(parents.size() * sizeof(std::int32_t), parents.data());
   pass.leaf_nodes_ = buffer(h.leaves.size() * sizeof(std::int32_t), h.leaves.data());
-  pass.inner_ = buffer(inner.size() * sizeof(glm::ivec4), inner.data());
+  pass.child_range_ = buffer(child_range.size() * sizeof(glm::ivec2), child_range.data());
+  pass.children_ = buffer(h.children.size() * sizeof(std::int32_t), h.children.data());
+  pass.by_level_ = buffer(by_level.size() * sizeof(std::int32_t), by_level.data());
   pass.bins_ = buffer(bin_data.size() * sizeof(glm::vec4), bin_data.data());
   pass.leaf_data_ = buffer(h.leaf_count() * sizeof(GpuLeaf), nullptr);
   const std::size_t leaf_table = h.leaf_count() * m * 3 * sizeof(float);
   pass.i_ex_ = buffer(table, nullptr);
   pass.l_in_ = buffer(table, nullptr);
-  pass.l_leaf_ = buffer(leaf_table, nullptr);
   pass.i_l_ = buffer(leaf_table, nullptr);
   pass.i_a_ = buffer(leaf_table, nullptr);
   pass.irradiance_ = buffer(h.leaf_count() * sizeof(glm::vec4), nullptr);
   pass.residual_ = buffer(h.leaf_count() * sizeof(glm::vec2), nullptr);
-  pass.bytes_ = parents.size() * 4 + h.leaves.size() * 4 + inner.size() * 16 + m * 16 + h.leaf_count() * 48 +
-                2 * table + 3 * leaf_table + h.leaf_count() * 24;
+  pass.bytes_ = parents.size() * 4 + h.leaves.size() * 4 + child_range.size() * 8 + h.children.size() * 4 +
+                by_level.size() * 4 + m * 16 + h.leaf_count() * 48 + 2 * table + 2 * leaf_table + h.leaf_count() * 24;
   if (engine::Status st = pass.set_links(links); !st) return st.error();
   if (glGetError() == GL_OUT_OF_MEMORY) return error("out of GPU memory allocating the tables");
   return pass;
@@ -159,7 +160,7 @@ void AntiradianceGpuPass::reset(std::span<const glm::vec3> direct) {
   }
   glNamedBufferSubData(leaf_data_.id(), 0, static_cast<GLsizeiptr>(data.size() * sizeof(GpuLeaf)), data.data());
   // The local pass over zero incident light writes I_L from the direct light, I_A = 0, E = 0.
-  for (const engine::GlBuffer* b : {&l_leaf_, &i_a_, &i_ex_})
+  for (const engine::GlBuffer* b : {&l_in_, &i_a_, &i_ex_})
     glClearNamedBufferData(b->id(), GL_R32F, GL_RED, GL_FLOAT, nullptr);
   local(true, true);
   pull();
@@ -175,19 +176,25 @@ void AntiradianceGpuPass::global() {
   dispatch(global_, runs_count_);
 }
 
+void AntiradianceGpuPass::set_first(const engine::ShaderProgram& program, std::uint32_t first) {
+  glProgramUniform1ui(program.id(), glGetUniformLocation(program.id(), "u_first"), first);
+}
+
 void AntiradianceGpuPass::push() {
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, parents_.id());
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, leaf_nodes_.id());
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, by_level_.id());
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, l_in_.id());
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, l_leaf_.id());
-  dispatch(push_, leaves_ * m_);
+  for (std::size_t d = 1; d + 1 < level_offsets_.size(); ++d) {
+    set_first(push_, level_offsets_[d]);
+    dispatch(push_, (level_offsets_[d + 1] - level_offsets_[d]) * m_);
+  }
 }
 
 LocalPassSums AntiradianceGpuPass::local(bool radiance, bool antiradiance) {
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, leaf_data_.id());
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, leaf_nodes_.id());
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, bins_.id());
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, l_leaf_.id());
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, l_in_.id());
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, i_l_.id());
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, i_a_.id());
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, i_ex_.id());
@@ -207,10 +214,14 @@ LocalPassSums AntiradianceGpuPass::local(bool radiance, bool antiradiance) {
 }
 
 void AntiradianceGpuPass::pull() {
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, inner_.id());
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, leaf_nodes_.id());
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, i_ex_.id());
-  dispatch(pull_, inner_count_ * m_);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, child_range_.id());
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, children_.id());
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, by_level_.id());
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, i_ex_.id());
+  for (std::size_t d = level_offsets_.size() - 1; d-- > 0;) {
+    set_first(pull_, level_offsets_[d]);
+    dispatch(pull_, (level_offsets_[d + 1] - level_offsets_[d]) * m_);
+  }
 }
 
 std::vector<glm::vec3> AntiradianceGpuPass::irradiance() const {

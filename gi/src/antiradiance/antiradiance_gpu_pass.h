@@ -56,16 +56,17 @@ class AntiradianceGpuPass final : public AntiradiancePasses {
  private:
   explicit AntiradianceGpuPass(const ElementHierarchy& h) : h_(&h) {}
   void dispatch(const engine::ShaderProgram& program, std::uint32_t items);
+  void set_first(const engine::ShaderProgram& program, std::uint32_t first);
 
   const ElementHierarchy* h_;
   std::uint32_t m_ = 0;
   std::uint32_t nodes_ = 0;
   std::uint32_t leaves_ = 0;
-  std::uint32_t inner_count_ = 0;
   engine::ShaderProgram global_, push_, local_, pull_;
   std::uint32_t runs_count_ = 0;
-  engine::GlBuffer runs_, links_, parents_, leaf_nodes_, inner_, bins_, leaf_data_;
-  engine::GlBuffer i_ex_, l_in_, l_leaf_, i_l_, i_a_, irradiance_, residual_;
+  engine::GlBuffer runs_, links_, parents_, leaf_nodes_, child_range_, children_, by_level_, bins_, leaf_data_;
+  engine::GlBuffer i_ex_, l_in_, i_l_, i_a_, irradiance_, residual_;
+  std::vector<std::uint32_t> level_offsets_;
   std::size_t bytes_ = 0;
   std::size_t link_bytes_ = 0;
 };

@@ -8,8 +8,9 @@
 // Tables (bins = m, nodes and leaves of the hierarchy, RGB per entry):
 //   I_ex[node][bin]   exitant intensity I_L - I_A (W/sr): leaves from the local pass, inner
 //                     nodes the sum of their leaves (pull)
-//   L_in[node][bin]   incident radiance gathered over the node's links (global pass)
-//   L_leaf[leaf][bin] incident radiance at a leaf: its own plus its ancestors' (push)
+//   L_in[node][bin]   incident radiance gathered over the node's links (global pass), then
+//                     plus its ancestors' (push, level by level from the root: at a leaf it
+//                     is all the light arriving there)
 //   I_L, I_A[leaf][bin]  reflected intensity (eq. 18, diffuse) and antiradiance (eq. 19)
 //   E[leaf]           indirect irradiance (W/m^2) gathered by the last radiance step
 //
@@ -27,6 +28,10 @@
 
 namespace gi {
 
+/// The nodes of `h` ordered by depth (root first) and each depth's range in that order
+/// (offsets has depth count + 1 entries): what push and pull walk level by level.
+void nodes_by_level(const ElementHierarchy& h, std::vector<std::int32_t>& nodes, std::vector<std::uint32_t>& offsets);
+
 /// Sums of a local pass over all leaves (each leaf's partial sum in float, bins then
 /// channels; leaves summed in double in leaf order).
 struct LocalPassSums {
@@ -43,13 +48,14 @@ class AntiradiancePasses {
   virtual void reset(std::span<const glm::vec3> direct) = 0;
   /// Global pass (operator U, eq. 16): L_in[r][bin] = sum over r's links of F I_ex[s][bin].
   virtual void global() = 0;
-  /// Push: L_leaf = L_in of the leaf and of all its ancestors (leaf first, then up).
+  /// Push: level by level from the root's children down, L_in[n] += L_in[parent(n)].
   virtual void push() = 0;
-  /// Local pass: K (eq. 18, diffuse: E = sum_b <n|-w_b>+ L_leaf[b] omega_b, I_L[b] =
-  /// a <n|w_b>+ albedo/pi (E + E_direct)) when `radiance`, J (eq. 19: I_A[b] =
-  /// a <n|-w_b>+ L_leaf[b]) when `antiradiance`; I_ex = I_L - I_A at the leaves.
+  /// Local pass at the leaves (L = L_in of the leaf's node after push): K (eq. 18, diffuse:
+  /// E = sum_b <n|-w_b>+ L[b] omega_b, I_L[b] = a <n|w_b>+ albedo/pi (E + E_direct)) when
+  /// `radiance`, J (eq. 19: I_A[b] = a <n|-w_b>+ L[b]) when `antiradiance`; I_ex = I_L - I_A.
   virtual LocalPassSums local(bool radiance, bool antiradiance) = 0;
-  /// Pull: I_ex of every inner node = the sum of its leaves' I_ex.
+  /// Pull: level by level from the deepest up, I_ex of an inner node = the sum of its
+  /// children's I_ex (in child order).
   virtual void pull() = 0;
   /// Indirect irradiance per leaf (W/m^2) from the last radiance step.
   virtual std::vector<glm::vec3> irradiance() const = 0;
@@ -69,14 +75,15 @@ class CpuAntiradiancePasses final : public AntiradiancePasses {
 
   /// The tables, for tests (RGB triples, row-major [row][bin]).
   const std::vector<glm::vec3>& exitant() const { return i_ex_; }
-  const std::vector<glm::vec3>& incident_leaf() const { return l_leaf_; }
 
  private:
   const ElementHierarchy& h_;
   const DirectionalBins& bins_;
   const LinkMesh& links_;
   int m_ = 0;
-  std::vector<glm::vec3> i_ex_, l_in_, l_leaf_, i_l_, i_a_, e_, direct_;
+  std::vector<glm::vec3> i_ex_, l_in_, i_l_, i_a_, e_, direct_;
+  std::vector<std::int32_t> by_level_;        ///< Nodes ordered by depth (root first).
+  std::vector<std::uint32_t> level_offsets_;  ///< by_level_ range of each depth.
 };
 
 }  // namespace gi
