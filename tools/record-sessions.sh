@@ -11,7 +11,8 @@ demo="$build_dir/game_demo/gi_demo"
 [ -x "$demo" ] || { echo "record-sessions: $demo not built (BUILD_DIR=$build_dir bash tools/build.sh)" >&2; exit 1; }
 mkdir -p tests/sessions
 # name:script:frames. The scene path is stored as given, relative to the source tree.
-for spec in walk_flashlight:walk_flashlight:900 push_crates:push_crates:900 split_screen:split_screen:600; do
+for spec in walk_flashlight:walk_flashlight:900 push_crates:push_crates:900 split_screen:split_screen:600 \
+            open_door:open_door:160; do
   IFS=: read -r name script frames <<<"$spec"
   "$demo" --headless --no-render --scene assets/demo_level.gltf --script "$script" --frames "$frames" \
           --width 320 --height 180 --record "tests/sessions/$name.girec" >/dev/null

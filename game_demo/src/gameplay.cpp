@@ -112,6 +112,15 @@ void toggle_flashlight(engine::Registry& reg, GameplayContext& ctx) {
   light.enabled = !light.enabled;
 }
 
+// O swings the door between its authored rotation and closed (rotation about its hinge,
+// the node origin, to identity) at once.
+void toggle_door(engine::Registry& reg, GameplayContext& ctx) {
+  if (!ctx.pressed(Key::O) || !ctx.door || !reg.has<engine::Transform>(ctx.door)) return;
+  ctx.door_closed = !ctx.door_closed;
+  reg.write<engine::Transform>(ctx.door).rotation =
+      ctx.door_closed ? glm::quat(1.0f, 0.0f, 0.0f, 0.0f) : ctx.door_open_rotation;
+}
+
 void push_crate(engine::Registry& reg, GameplayContext& ctx) {
   if (!ctx.pressed(Key::E) || !ctx.camera) return;
   const glm::vec3 eye = reg.get<engine::Transform>(ctx.camera).position;  // the player walks in world space
@@ -245,6 +254,13 @@ GameplayContext prepare_scene(engine::Scene& scene, const GameplayTuning& tuning
   else
     ctx.swinging_pivot = engine::kNullEntity;
 
+  // The corridor door (demo level), if the scene has one.
+  ctx.door = engine::find_by_name(reg, "corridor_door");
+  if (ctx.door && reg.has<engine::Transform>(ctx.door))
+    ctx.door_open_rotation = reg.get<engine::Transform>(ctx.door).rotation;
+  else
+    ctx.door = engine::kNullEntity;
+
   // Crates: collision boxes from their meshes.
   for (engine::Entity c : crates_of(reg)) {
     const Aabb box = mesh_world_bounds(scene, c);
@@ -271,6 +287,7 @@ void add_gameplay_systems(engine::SystemSchedule& schedule, GameplayContext& ctx
                [c](engine::Registry& r, const engine::FrameTime&) { push_crate(r, *c); });
   schedule.add(engine::Stage::Gameplay, "swinging_lamp",
                [c](engine::Registry& r, const engine::FrameTime& t) { swing_lamp(r, t, *c); });
+  schedule.add(engine::Stage::Gameplay, "door", [c](engine::Registry& r, const engine::FrameTime&) { toggle_door(r, *c); });
   schedule.add(engine::Stage::Physics, "rigid_bodies",
                [c](engine::Registry& r, const engine::FrameTime& t) { integrate_rigid_bodies(r, t, *c); });
   schedule.add(engine::Stage::Transform, "world_transforms",

@@ -84,6 +84,12 @@ std::vector<std::string> gi_status_lines(const gi::GISystem* system) {
                   st.brf_pairs_culled);
     lines.emplace_back(line);
   }
+  if (st.antiradiance_updates > 0) {
+    std::snprintf(line, sizeof line, "antiradiance: %llu door moves solved, last %.0f ms (%zu elements relinked)",
+                  static_cast<unsigned long long>(st.antiradiance_updates), st.last_antiradiance_ms,
+                  st.antiradiance_relinked_elements);
+    lines.emplace_back(line);
+  }
   for (const std::string& off : st.disabled) lines.push_back("off: " + off);
   return lines;
 }
@@ -107,7 +113,7 @@ int main(int argc, char** argv) {
   app.add_flag("--no-render", o.no_render, "Headless: simulate only (no GPU), e.g. to record sessions");
   auto* rec = app.add_option("--record", o.record_file, "Record the inputs and checksums into a .girec session");
   app.add_option("--replay", o.replay_file, "Replay a .girec session, checking every frame's checksum")->excludes(rec);
-  app.add_option("--script", o.script, "Headless input script: tour, walk_flashlight, push_crates, split_screen");
+  app.add_option("--script", o.script, "Headless input script: tour, walk_flashlight, push_crates, split_screen, open_door");
   app.add_option("--seed", o.seed, "Session seed (recorded in the header and the checksum)");
   app.add_flag("--only-written-frames", o.only_written,
                "Headless: render only the frames --out/--every write (fast golden and approval runs)");

@@ -45,7 +45,7 @@ std::vector<std::size_t> visiting_order(const glm::vec3& from, const std::vector
 }  // namespace
 
 std::optional<Script> script_from_name(std::string_view name) {
-  for (Script s : {Script::Tour, Script::WalkFlashlight, Script::PushCrates, Script::SplitScreen})
+  for (Script s : {Script::Tour, Script::WalkFlashlight, Script::PushCrates, Script::SplitScreen, Script::OpenDoor})
     if (script_name(s) == name) return s;
   return std::nullopt;
 }
@@ -56,6 +56,7 @@ std::string_view script_name(Script s) {
     case Script::WalkFlashlight: return "walk_flashlight";
     case Script::PushCrates: return "push_crates";
     case Script::SplitScreen: return "split_screen";
+    case Script::OpenDoor: return "open_door";
   }
   return "?";
 }
@@ -154,6 +155,9 @@ ScriptedPilot::ScriptedPilot(const Simulation& sim, Script script, std::uint64_t
     case Script::SplitScreen:
       add(rooms, false, rooms.size());
       key_presses_[static_cast<int>(Key::G)] = {20, n / 2, 3 * n / 4};
+      break;
+    case Script::OpenDoor:  // no waypoints: the start faces the door
+      key_presses_[static_cast<int>(Key::O)] = {n / 5, 5 * n / 8};
       break;
   }
 }

@@ -31,7 +31,7 @@ InputFrame live_keys(GLFWwindow* window) {
   InputFrame in;
   const std::pair<int, Key> map[] = {{GLFW_KEY_W, Key::W}, {GLFW_KEY_A, Key::A}, {GLFW_KEY_S, Key::S},
                                      {GLFW_KEY_D, Key::D}, {GLFW_KEY_F, Key::F}, {GLFW_KEY_E, Key::E},
-                                     {GLFW_KEY_G, Key::G}};
+                                     {GLFW_KEY_G, Key::G}, {GLFW_KEY_O, Key::O}};
   if (ImGui::GetIO().WantCaptureKeyboard) return in;
   for (const auto& [glfw_key, key] : map)
     if (glfwGetKey(window, glfw_key) == GLFW_PRESS) in.keys |= key_bit(key);

@@ -27,6 +27,7 @@ void expect_replays(const std::string& name, std::size_t min_frames) {
 TEST(CommittedSessions, WalkFlashlightReplaysToIdenticalChecksums) { expect_replays("walk_flashlight", 600); }
 TEST(CommittedSessions, PushCratesReplaysToIdenticalChecksums) { expect_replays("push_crates", 600); }
 TEST(CommittedSessions, SplitScreenReplaysToIdenticalChecksums) { expect_replays("split_screen", 300); }
+TEST(CommittedSessions, OpenDoorReplaysToIdenticalChecksums) { expect_replays("open_door", 160); }
 
 TEST(CommittedSessions, SessionsExerciseTheirFeatures) {
   // The scripted streams really contain what their names promise.
@@ -45,6 +46,27 @@ TEST(CommittedSessions, SessionsExerciseTheirFeatures) {
   EXPECT_EQ(count_presses("walk_flashlight", game_demo::Key::F), 2);
   EXPECT_GE(count_presses("push_crates", game_demo::Key::E), 2);
   EXPECT_EQ(count_presses("split_screen", game_demo::Key::G), 3);
+  EXPECT_EQ(count_presses("open_door", game_demo::Key::O), 2);
+}
+
+// open_door closes the corridor door (rotation about its hinge to identity), then opens it
+// again to its authored rotation.
+TEST(CommittedSessions, OpenDoorClosesAndReopensTheDoor) {
+  const std::filesystem::path file = sessions_dir() / "open_door.girec";
+  auto session = game_demo::load_session(file);
+  ASSERT_TRUE(session) << session.error().to_string();
+  auto sim = game_demo::simulation_for_session(*session, file.string());
+  ASSERT_TRUE(sim) << sim.error().to_string();
+  const engine::Entity door = engine::find_by_name(sim->registry(), "corridor_door");
+  ASSERT_FALSE(door.is_null());
+  const glm::quat open = sim->registry().get<engine::Transform>(door).rotation;
+  bool was_closed = false;
+  for (const auto& f : session->frames) {
+    sim->step(f.input);
+    was_closed = was_closed || sim->registry().get<engine::Transform>(door).rotation == glm::quat(1, 0, 0, 0);
+  }
+  EXPECT_TRUE(was_closed);
+  EXPECT_EQ(sim->registry().get<engine::Transform>(door).rotation, open);
 }
 
 TEST(CommittedSessions, PushCratesMovesCrates) {

@@ -184,7 +184,7 @@ TEST(SplitScreen, GTogglesOnPress) {
 TEST(Schedule, GameplaySystemsRunInTheDocumentedOrder) {
   game_demo::Simulation sim(demo_test::make_room({}));
   const std::vector<std::string> expected = {"player_controller", "flashlight", "split_screen",
-                                             "push", "swinging_lamp", "rigid_bodies", "world_transforms"};
+                                             "push", "swinging_lamp", "door", "rigid_bodies", "world_transforms"};
   EXPECT_EQ(sim.schedule().order(), expected);
 }
 

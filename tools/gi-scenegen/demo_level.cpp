@@ -6,7 +6,7 @@
 //   z [8.2, 16.2]   corridor     x [3, 5]    (glossy floor, roughness 0.15)
 //   z [0, 8]        hub          x [0, 8]    + crate room x [8.2, 14.2], z [1, 7] to the east
 // Walls between spaces are 0.2 m thick; doorways are 1.6 m (hub-corridor-lamp room) and
-// 1.2 m (hub-crate room) wide.
+// 1.2 m (hub-crate room) wide; the hub-corridor doorway has a door (deforming, key O).
 #include <glm/gtc/constants.hpp>
 
 #include "rooms.h"
@@ -102,6 +102,17 @@ engine::SceneAsset demo_level() {
                    glm::quat(1, 0, 0, 0), pivot);
 
   b.add_camera_node("camera", {4.0f, 1.7f, 1.0f}, {4.0f, 1.3f, 8.0f}, glm::radians(65.0f));
+
+  // The corridor's door (added last, so the other nodes keep their indices): a 4 cm leaf
+  // filling the hub-corridor doorway (x [3.2, 4.8], y [0, 2.4]) on its corridor side
+  // (z = 8.2), hinged at x = 3.2 about +y. Authored open: swung 90 degrees into the
+  // corridor, against its west wall; rotation 0 closes it. Flagged gi.region "deforming":
+  // antiradiance lights the change when the game (key O) swings it (docs/antiradiance.md).
+  MeshBuilder door;
+  door.box(wood, {0.8f, 1.19f, 0.02f}, {0.79f, 1.19f, 0.02f});
+  const int door_node = b.add_mesh_node("corridor_door", door, engine::Mobility::Static, {3.2f, 0.0f, 8.2f},
+                                        glm::angleAxis(glm::radians(-90.0f), glm::vec3(0, 1, 0)));
+  b.asset().nodes[static_cast<std::size_t>(door_node)].gi.region = engine::GiRegion::Deforming;
   return b.take();
 }
 

@@ -62,6 +62,9 @@ struct GameplayContext {
   InputFrame input;                  ///< This step's input (set before each run).
   std::uint32_t previous_keys = 0;   ///< Last step's held keys.
   bool split_view = false;           ///< Toggled by G; the renderer reads it.
+  engine::Entity door;               ///< "corridor_door" when the scene has one, else null.
+  glm::quat door_open_rotation{1.0f, 0.0f, 0.0f, 0.0f};  ///< Its authored (open) rotation; closed is identity.
+  bool door_closed = false;          ///< Toggled by O.
 
   bool pressed(Key k) const { return input.held(k) && (previous_keys & key_bit(k)) == 0; }
 };
@@ -71,11 +74,13 @@ struct GameplayContext {
 /// PlayerController, adds a flashlight (a Spot light child of the camera, moves = true,
 /// switched off) unless a Light entity named "flashlight" exists, gives each DynamicTag
 /// RigidBody a CrateShape and half extents from its mesh bounds, and builds the static
-/// collision world. Leaves world transforms up to date.
+/// collision world; finds the door ("corridor_door", hinged at its origin; O swings it
+/// between its authored rotation and closed). Leaves world transforms up to date. The
+/// collision world keeps the door where it was authored (open).
 GameplayContext prepare_scene(engine::Scene& scene, const GameplayTuning& tuning = {});
 
-/// Adds, in this order: player_controller (Input), flashlight, split_screen, push and
-/// swinging_lamp (Gameplay), rigid_bodies (Physics), world_transforms (Transform).
+/// Adds, in this order: player_controller (Input), flashlight, split_screen, push,
+/// swinging_lamp and door (Gameplay), rigid_bodies (Physics), world_transforms (Transform).
 void add_gameplay_systems(engine::SystemSchedule& schedule, GameplayContext& context);
 
 /// The pushable crates: root entities with DynamicTag, RigidBody and Transform.

@@ -12,7 +12,7 @@
 
 namespace game_demo {
 
-/// The keys the demo reacts to. Movement keys act while held; F, E and G act on the step
+/// The keys the demo reacts to. Movement keys act while held; F, E, G and O act on the step
 /// where they go from released to held (edge-triggered in the gameplay systems).
 enum class Key : std::uint8_t {
   W = 0,  ///< forward
@@ -22,8 +22,9 @@ enum class Key : std::uint8_t {
   F = 4,  ///< toggle the flashlight
   E = 5,  ///< push the crate in front of the camera
   G = 6,  ///< toggle the split screen (direct only | full)
+  O = 7,  ///< close / open the corridor door (a deforming node: antiradiance relights it)
 };
-inline constexpr int kKeyCount = 7;
+inline constexpr int kKeyCount = 8;
 
 /// The bit of `k` in InputFrame::keys.
 constexpr std::uint32_t key_bit(Key k) { return 1u << static_cast<std::uint32_t>(k); }

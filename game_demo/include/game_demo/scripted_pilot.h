@@ -23,9 +23,10 @@ enum class Script : std::uint8_t {
   WalkFlashlight,  ///< walk from room to room, flashlight on then off again
   PushCrates,      ///< walk to each crate in turn and push it
   SplitScreen,     ///< walk the rooms toggling the split screen on and off
+  OpenDoor,        ///< stand at the start facing the corridor door: close it, then open it
 };
 
-/// "tour", "walk_flashlight", "push_crates", "split_screen".
+/// "tour", "walk_flashlight", "push_crates", "split_screen", "open_door".
 std::optional<Script> script_from_name(std::string_view name);
 std::string_view script_name(Script s);
 
