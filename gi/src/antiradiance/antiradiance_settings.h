@@ -14,7 +14,7 @@ enum class AntiradianceScheme : std::uint8_t {
 };
 
 struct AntiradianceSettings {
-  /// Octahedral cells per side: bins = n^2 (8: the paper's 128 bins).
+  /// Octahedral cells per side: bins = n^2 (8: 64 bins; the paper uses 128, n = 11 or 12 comes closest).
   int bins_per_side = 8;
   /// Leaves are triangle pieces whose longest edge is at most this (metres).
   float patch_size_m = 0.5f;

@@ -1,7 +1,7 @@
 #pragma once
 // The directional discretization of antiradiance (Dachsbacher et al. 2007, §3.1): the sphere
 // of directions split into m bins Omega_j with main directions omega_j. We use an
-// octahedral map of n x n cells (m = n^2; n = 8 gives the paper's 128 bins): a direction
+// octahedral map of n x n cells (m = n^2; n = 8: 64 bins, the paper uses 128): a direction
 // finds its bin in O(1) and every bin is a connected patch of the sphere. The cells are not
 // of exactly equal solid angle (max/min ~ 2.5 for n = 8), so each bin carries its own solid
 // angle omega_bin(j), measured by sub-sampling at construction, instead of the paper's
