@@ -256,11 +256,11 @@ engine::Result<LightAtlasSettings> light_atlas_preset(std::string_view name) {
   if (name == "preview") {
     s.vpl_count = 300, s.bounces = 8;
     s.gather.solve_rays = 32;
-    s.gather.gather_rays = 0;
+    s.gather.gather_rays = 128;
   } else if (name == "medium") {
     s.vpl_count = 1000, s.bounces = 16;
     s.gather.solve_rays = 64;
-    s.gather.gather_rays = 128;
+    s.gather.gather_rays = 256;
   } else {
     s.vpl_count = 3000, s.bounces = 16;
     s.gather.solve_rays = 128;
