@@ -202,7 +202,11 @@ void plan_light_atlas(const PlanFacts& f, const std::optional<PlanPresets>& p, P
                     fixed(f.census.area_m2, 1) + " m^2 x " + fixed(p->atlas.texels_per_metre, 0) +
                         "^2 texels/m^2 -> ~" + std::to_string(static_cast<long long>(t.lit_texels)) +
                         " texels (atlas " + std::to_string(t.width) + "x" + std::to_string(t.height) + ") x " +
-                        std::to_string(p->atlas.vpl_count) + " VPLs, " + std::to_string(p->atlas.bounces) + " bounces"};
+                        (p->atlas.final_pass == LightAtlasSettings::FinalPass::TexelGather
+                             ? std::to_string(p->atlas.gather.solve_rays) + " kept + " +
+                                   std::to_string(p->atlas.gather.gather_rays) + " gather rays"
+                             : std::to_string(p->atlas.vpl_count) + " VPLs, " + std::to_string(p->atlas.bounces) +
+                                   " bounces")};
 }
 
 // PRM: moving lights over static geometry.
