@@ -248,16 +248,9 @@ engine::Status save_antiradiance(const fs::path& bundle_dir, const AntiradianceB
 }
 
 engine::Result<AntiradianceBake> load_antiradiance(const fs::path& bundle_dir, const BakeInput& input) {
-  auto manifest = read_manifest(bundle_dir);
+  auto manifest = read_current_manifest(bundle_dir, input, "re-bake the antiradiance region");
   if (!manifest) return manifest.error();
   const fs::path manifest_file = bundle_dir / kManifestFileName;
-  const std::string scene_hash = scene_geometry_hash(input);
-  if (manifest->geometry_hash != scene_hash) {
-    const std::string scene = input.name.empty() ? std::string("the scene") : input.name;
-    return engine::Error{manifest_file.string(), "geometry_hash",
-                         "stale bundle " + bundle_dir.string() + ": baked from geometry " + manifest->geometry_hash +
-                             ", but " + scene + " hashes to " + scene_hash + " (re-bake the antiradiance region)"};
-  }
   auto entry = manifest_method(bundle_dir, *manifest, kAntiradianceMethod);
   if (!entry) return entry.error();
   const std::string where = std::string("methods.") + kAntiradianceMethod + ".files.elements";

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <string_view>
 
+#include "bundle/geometry_hash.h"
 #include "io/blob_file.h"
 
 namespace gi {
@@ -116,6 +117,20 @@ engine::Result<nlohmann::json> manifest_method(const std::filesystem::path& bund
   }
   if (!it->is_object()) return manifest_error(bundle_dir, "methods." + method, "must be an object");
   return *it;
+}
+
+engine::Result<Manifest> read_current_manifest(const std::filesystem::path& bundle_dir, const BakeInput& input,
+                                               const std::string& rebake) {
+  auto manifest = read_manifest(bundle_dir);
+  if (!manifest) return manifest.error();
+  const std::string scene_hash = scene_geometry_hash(input);
+  if (manifest->geometry_hash != scene_hash) {
+    const std::string scene = input.name.empty() ? std::string("the scene") : input.name;
+    return engine::Error{(bundle_dir / kManifestFileName).string(), "geometry_hash",
+                         "stale bundle " + bundle_dir.string() + ": baked from geometry " + manifest->geometry_hash +
+                             ", but " + scene + " hashes to " + scene_hash + " (" + rebake + ")"};
+  }
+  return manifest;
 }
 
 }  // namespace gi

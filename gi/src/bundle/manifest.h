@@ -9,6 +9,7 @@
 //     "methods": { "light_atlas": { "files": {...}, "settings": {...}, ... } } }
 
 #include <engine/result.h>
+#include <gi/bake_input.h>
 
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -32,6 +33,12 @@ struct Manifest {
 /// Reads DIR/manifest.json. Errors (naming the file): missing, malformed JSON, a
 /// format_version this build does not read, missing or mistyped fields.
 engine::Result<Manifest> read_manifest(const std::filesystem::path& bundle_dir);
+
+/// read_manifest, then the check every loader makes first: the bundle was baked from the
+/// geometry of `input`. Error otherwise, naming manifest.json, both hashes and what to do
+/// (`rebake`, e.g. "re-bake the PRM").
+engine::Result<Manifest> read_current_manifest(const std::filesystem::path& bundle_dir, const BakeInput& input,
+                                               const std::string& rebake);
 
 /// Writes DIR/manifest.json atomically (pretty-printed, keys sorted). DIR must exist.
 engine::Status write_manifest(const std::filesystem::path& bundle_dir, const Manifest& manifest);
