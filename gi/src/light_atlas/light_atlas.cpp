@@ -99,9 +99,7 @@ engine::Result<LightAtlasBake> bake_light_atlas(const BakeInput& input, const Li
   if (auto ok = validate(settings); !ok) return ok.error();
   if (auto ok = validate_bake_input(input); !ok) return ok.error();
   const auto t_start = Clock::now();
-  const std::vector<AtlasInputMesh> inputs = atlas_inputs_from(input);
-  if (auto ok = validate_atlas_inputs(inputs); !ok) return ok.error();
-  auto layout = build_atlas_layout(inputs, {.texels_per_metre = settings.texels_per_metre});
+  auto layout = static_world_layout(input, settings.texels_per_metre);
   if (!layout) return layout.error();
 
   ThreadPool pool(settings.threads);

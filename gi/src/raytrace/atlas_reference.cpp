@@ -43,8 +43,7 @@ engine::Result<AtlasIrradiance> reference_atlas_irradiance(const BakeInput& inpu
 engine::Result<AtlasReference> reference_atlas(const BakeInput& input, float texels_per_metre,
                                                const ReferenceSettings& settings, TexelPlacement placement) {
   if (auto ok = validate_bake_input(input); !ok) return ok.error();
-  const std::vector<AtlasInputMesh> inputs = atlas_inputs_from(input);
-  auto layout = build_atlas_layout(inputs, {.texels_per_metre = texels_per_metre});
+  auto layout = static_world_layout(input, texels_per_metre);
   if (!layout) return layout.error();
   auto texels = sample_atlas_texels(input, *layout, placement);
   if (!texels) return texels.error();

@@ -161,4 +161,8 @@ engine::Result<AtlasLayout> build_atlas_layout(std::span<const AtlasInputMesh> i
   return layout;
 }
 
+engine::Result<AtlasLayout> static_world_layout(const BakeInput& input, float texels_per_metre) {
+  return build_atlas_layout(atlas_inputs_from(input), {.texels_per_metre = texels_per_metre});
+}
+
 }  // namespace gi

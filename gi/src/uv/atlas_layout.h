@@ -81,4 +81,8 @@ struct AtlasLayout {
 engine::Result<AtlasLayout> build_atlas_layout(std::span<const AtlasInputMesh> inputs,
                                                const AtlasSettings& settings = {});
 
+/// The layout every baker of the static world builds: build_atlas_layout of
+/// atlas_inputs_from(input) at `texels_per_metre`, other settings at their defaults.
+engine::Result<AtlasLayout> static_world_layout(const BakeInput& input, float texels_per_metre);
+
 }  // namespace gi
