@@ -1,7 +1,11 @@
 #include <engine/gltf_brdf.h>
 
 #include <algorithm>
+#include <bit>
+#include <cstdint>
 #include <cmath>
+#include <map>
+#include <mutex>
 #include <numbers>
 
 namespace engine {
@@ -193,7 +197,16 @@ GltfBrdfValue gltf_directional_albedo(const GltfBrdf& m, float n_dot_v) {
 
 GltfBrdfValue gltf_hemispherical_albedo(const GltfBrdf& m) {
   // Midpoint rule in cos(theta_v) with the weight 2 cos(theta_v); the integrals at the
-  // material's own alpha (not the table's interpolation).
+  // material's own alpha (not the table's interpolation). They depend on alpha alone and
+  // cost ~400k BRDF evaluations, so each alpha is integrated once per process (the bakers
+  // ask per material, from several threads, on every bake).
+  static std::mutex mutex;
+  static std::map<std::uint32_t, glm::vec3> integrals_of_alpha;
+  const std::uint32_t key = std::bit_cast<std::uint32_t>(m.alpha);
+  {
+    const std::lock_guard lock(mutex);
+    if (auto it = integrals_of_alpha.find(key); it != integrals_of_alpha.end()) return albedo_from_integrals(m, it->second);
+  }
   constexpr int kCos = 48;
   glm::dvec3 sum(0.0);
   for (int i = 0; i < kCos; ++i) {
@@ -201,6 +214,10 @@ GltfBrdfValue gltf_hemispherical_albedo(const GltfBrdf& m) {
     sum += 2.0 * static_cast<double>(mu) * glm::dvec3(gltf_albedo_integrals(mu, m.alpha));
   }
   const glm::vec3 abp(sum / static_cast<double>(kCos));
+  {
+    const std::lock_guard lock(mutex);
+    integrals_of_alpha.emplace(key, abp);
+  }
   return albedo_from_integrals(m, abp);
 }
 
