@@ -16,6 +16,7 @@
 
 #include "core/random.h"
 #include "core/thread_pool.h"
+#include "light_atlas/light_atlas.h"
 #include "light_atlas/texel_gather.h"
 #include "raytrace/ray_offset.h"
 #include "raytrace/reference_brdf.h"
@@ -110,8 +111,54 @@ void BM_RawClosestHitRays(benchmark::State& state) {
   state.counters["Mrays/s"] = benchmark::Counter(static_cast<double>(rays) * 1e-6, benchmark::Counter::kIsRate);
 }
 
+// A whole bake (gi-bake's path: layout, scene preparation, VPLs, gather) on the Cornell box
+// at 128 texels/m (33.5k texels, the table), by stage: the fixed costs that a
+// preview bake cannot ray-count its way out of. Args: kept rays, fresh rays, filter (tenths
+// of a texel). Process CPU time is reported too: the machine is shared.
+void BM_BakeEndToEnd(benchmark::State& state) {
+  static const gi::BakeInput input = [] {
+    auto asset = engine::load_gltf(std::string(GI_SOURCE_DIR) + "/assets/cornell_box.gltf");
+    if (!asset) {
+      std::fprintf(stderr, "%s\n", asset.error().to_string().c_str());
+      std::abort();
+    }
+    return gi::bake_input_from(engine::instantiate(std::move(asset).value()));
+  }();
+  gi::LightAtlasSettings s;
+  s.texels_per_metre = 128.0f;
+  s.vpl_count = 300;
+  s.final_pass = gi::LightAtlasSettings::FinalPass::TexelGather;
+  s.gather.solve_rays = static_cast<int>(state.range(0));
+  s.gather.gather_rays = static_cast<int>(state.range(1));
+  s.gather.filter_radius_texels = static_cast<float>(state.range(2)) / 10.0f;
+  s.threads = 2;
+  gi::LightAtlasStats st;
+  for (auto _ : state) {
+    auto bake = gi::bake_light_atlas(input, s);
+    if (!bake) {
+      state.SkipWithError(bake.error().to_string().c_str());
+      return;
+    }
+    st = bake->stats;
+    benchmark::DoNotOptimize(bake->irradiance.data());
+  }
+  state.counters["layout_s"] = st.layout_seconds;
+  state.counters["prepare_s"] = st.prepare_seconds;
+  state.counters["vpl_s"] = st.vpl_seconds;
+  state.counters["direct_s"] = st.direct_seconds;
+  state.counters["final_s"] = st.final_seconds;
+  state.counters["total_s"] = st.total_seconds;
+}
+
 }  // namespace
 
+BENCHMARK(BM_BakeEndToEnd)
+    ->Args({4, 0, 25})
+    ->Args({16, 0, 25})
+    ->Args({64, 256, 25})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MeasureProcessCPUTime();
 // (kept rays, fresh rays): the medium and high presets' ray counts.
 BENCHMARK(BM_GatherStages)->Args({64, 256})->Args({128, 512})->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_RawClosestHitRays)->Arg(320)->Unit(benchmark::kMillisecond)->UseRealTime();

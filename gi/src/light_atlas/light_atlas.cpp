@@ -101,18 +101,22 @@ engine::Result<LightAtlasBake> bake_light_atlas(const BakeInput& input, const Li
   const auto t_start = Clock::now();
   auto layout = static_world_layout(input, settings.texels_per_metre);
   if (!layout) return layout.error();
+  const double layout_seconds = seconds_since(t_start);
 
   ThreadPool pool(settings.threads);
+  auto t0 = Clock::now();
   auto prepared = prepare(input, *layout, settings);
   if (!prepared) return prepared.error();
   const BakeScene& b = *prepared;
 
   LightAtlasBake out;
+  out.stats.layout_seconds = layout_seconds;
+  out.stats.prepare_seconds = seconds_since(t0);
   out.settings = settings;
   out.layout = std::move(layout).value();
   out.width = out.layout.width;
   out.height = out.layout.height;
-  auto t0 = Clock::now();
+  t0 = Clock::now();
   auto vpls = distribute_vpls(
       b.scene, b.index,
       {.vpl_count = settings.vpl_count, .samples_per_vpl = settings.samples_per_vpl, .seed = settings.seed});

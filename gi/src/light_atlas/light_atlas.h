@@ -74,6 +74,8 @@ struct LightAtlasStats {
   std::size_t shots = 0;         ///< VPL-to-VPL shooting steps (§3.3).
   std::size_t valid_texels = 0;
   std::uint64_t rays = 0;          ///< Shadow rays cast in total.
+  double layout_seconds = 0.0;     ///< Charting, packing and rasterizing the atlas.
+  double prepare_seconds = 0.0;    ///< Ray-tracing scene, texel sample points, emitters.
   double vpl_seconds = 0.0;        ///< Distribution of VPLs and sample points.
   double direct_seconds = 0.0;     ///< Direct light to the VPLs.
   double propagate_seconds = 0.0;  ///< Progressive refinement.
