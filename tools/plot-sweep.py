@@ -6,6 +6,8 @@ the Pareto front highlighted. Writes <csv stem>.png next to each CSV.
 
 Needs Debian's python3-matplotlib. Reads the columns written by gi/src/sweep/sweep_csv.h;
 failed runs (status != ok) and non-positive values (no log scale for them) are skipped.
+When the reference carried its own variance (column extra:truth_rel_rmse), the error axis is
+the error against the noise-free truth, as the front and presets of the Markdown summary.
 """
 import argparse
 import csv
@@ -54,6 +56,8 @@ def plot(csv_path, cost_axis):
     cost_col, cost_unit = ("bake_s", "bake time (s)") if cost_axis == "bake" else ("frame_ms", "frame time (ms)")
     fig, ax = plt.subplots(figsize=(7, 5), dpi=120)
     methods = sorted({r["method"] for r in rows})
+    truth = any(r.get("extra:truth_rel_rmse", "") for r in rows)
+    error_col = "extra:truth_rel_rmse" if truth else "rel_rmse"
     plotted = 0
     for m in methods:
         pts, labels = [], []
@@ -61,7 +65,7 @@ def plot(csv_path, cost_axis):
         for r in rows:
             if r["method"] != m or r["status"] != "ok":
                 continue
-            e, c = number(r["rel_rmse"]), number(r[cost_col])
+            e, c = number(r.get(error_col, "")), number(r[cost_col])
             if not (e > 0 and c > 0 and math.isfinite(e) and math.isfinite(c)):
                 continue
             pts.append((e, c))
@@ -78,7 +82,7 @@ def plot(csv_path, cost_axis):
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel(cost_unit)
-    ax.set_ylabel("relative RMSE vs reference")
+    ax.set_ylabel("relative RMSE vs truth (reference noise removed)" if truth else "relative RMSE vs reference")
     scene = rows[0]["scene"] if rows else ""
     ax.set_title(f"Accuracy vs cost: {scene}")
     ax.grid(True, which="both", alpha=0.3)

@@ -18,6 +18,14 @@
 //                     +infinity when the tonemapped images are identical.
 //   scale fit       = s minimising sum |s a - r|^2, i.e. s = sum a.r / sum a.a (s = 1 when
 //                     a is zero everywhere); the fit_* metrics are the above for s a.
+//   reference noise = sqrt( sum_i sum_c v_ic / sum_i sum_c r_ic^2 ), v = the reference's
+//                     sampling variance (RgbField::variance): its own relative RMSE from
+//                     the truth it estimates.
+//   truth rel RMSE  = sqrt( max(0, sum (a - r)^2 - sum v) / (sum r^2 - sum v) ): the
+//                     relative RMSE against the noise-free truth t. With r = t + noise
+//                     independent of a, E[(a - r)^2] = (a - t)^2 + v and E[r^2] = t^2 + v,
+//                     so both sums are unbiased; it removes the floor a noisy reference puts
+//                     under every method's rel RMSE. NaN without a variance.
 // Problems make a report not ok() and its metrics NaN -- never silently averaged:
 // non-finite (NaN/Inf) values among compared elements (counted per side), no compared
 // elements (empty masks), or a reference that is zero on every compared element (relative
@@ -52,6 +60,8 @@ struct ErrorReport {
   double fit_rel_rmse = 0.0;
   double fit_max_rel = 0.0;
   double fit_psnr_db = 0.0;
+  double reference_noise = 0.0;  ///< NaN when the reference carries no variance.
+  double truth_rel_rmse = 0.0;   ///< NaN when the reference carries no variance.
 
   bool ok() const { return problem.empty(); }
 };

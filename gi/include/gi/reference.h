@@ -71,6 +71,9 @@ struct SurfacePoint {
 struct IrradianceEstimate {
   std::vector<glm::vec3> direct;
   std::vector<glm::vec3> indirect;
+  /// Per point and channel: the sampling variance of `indirect` (sample variance / samples),
+  /// the estimate's own noise. 0 with a single sample.
+  std::vector<glm::vec3> indirect_variance;
 };
 
 /// Estimates the irradiance at each point (samples_per_pixel samples each).
@@ -106,6 +109,7 @@ struct AtlasReference {
   std::vector<glm::vec3> indirect;
   std::vector<glm::vec3> total;
   std::vector<std::uint8_t> valid;
+  std::vector<glm::vec3> indirect_variance;  ///< Sampling variance of `indirect` (0 off the valid texels).
 };
 /// samples_per_pixel of `settings` is per texel. Errors: no static triangle, a layout that
 /// cannot be built, bad settings, cancellation.

@@ -19,6 +19,10 @@ struct RgbField {
   int height = 0;
   std::vector<float> rgb;           ///< 3 * width * height values.
   std::vector<std::uint8_t> valid;  ///< Empty (every element valid) or width * height flags, nonzero = valid.
+  /// Empty, or 3 * width * height values: the sampling variance of each value as an estimate
+  /// of its expectation (a Monte Carlo reference's own noise, Var of the mean). Lets
+  /// compare_rgb estimate the error against the noise-free truth (error_metrics.h).
+  std::vector<float> variance;
 
   /// Number of elements (pixels / texels).
   std::size_t count() const { return static_cast<std::size_t>(width) * static_cast<std::size_t>(height); }
@@ -26,7 +30,8 @@ struct RgbField {
   bool is_valid(std::size_t i) const { return valid.empty() || valid[i] != 0; }
   /// True when the vector sizes agree with width and height.
   bool consistent() const {
-    return width >= 0 && height >= 0 && rgb.size() == 3 * count() && (valid.empty() || valid.size() == count());
+    return width >= 0 && height >= 0 && rgb.size() == 3 * count() && (valid.empty() || valid.size() == count()) &&
+           (variance.empty() || variance.size() == 3 * count());
   }
   /// True when two fields can be compared element by element (same width and height).
   bool same_layout(const RgbField& other) const { return width == other.width && height == other.height; }

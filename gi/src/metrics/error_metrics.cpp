@@ -132,9 +132,25 @@ ErrorReport compare_rgb(const RgbField& a, const RgbField& r, const MetricOption
   } else if (!(ref2 > 0.0) || !std::isfinite(ref2)) {
     e.problem = "the reference is zero on every compared element: relative error is undefined";
   }
+  e.reference_noise = e.truth_rel_rmse = kNaN;
   if (!e.ok()) {
     e.rel_rmse = e.max_rel = e.psnr_db = e.fit_scale = e.fit_rel_rmse = e.fit_max_rel = e.fit_psnr_db = kNaN;
     return e;
+  }
+  if (!r.variance.empty()) {
+    double diff2 = 0.0, var = 0.0;
+    for (std::size_t i = 0; i < a.count(); ++i) {
+      if (!compared(a, r, i)) continue;
+      for (std::size_t c = 0; c < 3; ++c) {
+        const double d = at(a, 3 * i + c) - at(r, 3 * i + c);
+        diff2 += d * d;
+        var += static_cast<double>(r.variance[3 * i + c]);
+      }
+    }
+    if (std::isfinite(var) && var >= 0.0) {
+      e.reference_noise = std::sqrt(var / ref2);
+      if (ref2 > var) e.truth_rel_rmse = std::sqrt(std::max(0.0, diff2 - var) / (ref2 - var));
+    }
   }
   e.rel_rmse = relative_rmse(a, r);
   e.max_rel = max_relative_error(a, r, options.max_rel_floor_eps);

@@ -27,9 +27,11 @@ engine::Result<AtlasIrradiance> reference_atlas_irradiance(const BakeInput& inpu
   out.valid = texels.valid;
   out.direct.assign(texels.valid.size(), glm::vec3(0.0f));
   out.indirect.assign(texels.valid.size(), glm::vec3(0.0f));
+  out.indirect_variance.assign(texels.valid.size(), glm::vec3(0.0f));
   for (std::size_t k = 0; k < points.size(); ++k) {
     out.direct[texel_of_point[k]] = e->direct[k];
     out.indirect[texel_of_point[k]] = e->indirect[k];
+    out.indirect_variance[texel_of_point[k]] = e->indirect_variance[k];
   }
   // Enough rings to cover any padding the layout may use.
   constexpr int kDilationRings = 4;
@@ -55,7 +57,8 @@ engine::Result<AtlasReference> reference_atlas(const BakeInput& input, float tex
                         .direct = std::move(truth->direct),
                         .indirect = std::move(truth->indirect),
                         .total = std::move(truth->total),
-                        .valid = std::move(truth->valid)};
+                        .valid = std::move(truth->valid),
+                        .indirect_variance = std::move(truth->indirect_variance)};
 }
 
 }  // namespace gi

@@ -26,6 +26,7 @@ struct AtlasIrradiance {
   std::vector<glm::vec3> indirect;
   std::vector<glm::vec3> total;
   std::vector<std::uint8_t> valid;  ///< Texels a triangle covers (the others hold dilated values or 0).
+  std::vector<glm::vec3> indirect_variance;  ///< Sampling variance of `indirect` (0 off the valid texels).
 };
 
 /// samples_per_pixel of `settings` is per texel.

@@ -115,18 +115,25 @@ engine::Result<IrradianceEstimate> estimate_irradiance(const ReferenceScene& sce
   IrradianceEstimate out;
   out.direct.assign(points.size(), glm::vec3(0.0f));
   out.indirect.assign(points.size(), glm::vec3(0.0f));
+  out.indirect_variance.assign(points.size(), glm::vec3(0.0f));
   ThreadPool pool(settings.threads);
   const bool completed = pool.parallel_for_with_progress(points.size(), settings.progress, [&](std::size_t i) {
     Pcg32 rng = Pcg32::for_item(settings.seed, i);
-    glm::dvec3 direct(0.0), indirect(0.0);
+    glm::dvec3 direct(0.0), indirect(0.0), indirect2(0.0);
     for (int s = 0; s < settings.samples_per_pixel; ++s) {
       const PathTracer::Irradiance e = tracer.irradiance(points[i].position_m, points[i].normal, rng);
       direct += glm::dvec3(finite_or_zero(e.direct));
-      indirect += glm::dvec3(finite_or_zero(e.indirect));
+      const glm::dvec3 ind(finite_or_zero(e.indirect));
+      indirect += ind;
+      indirect2 += ind * ind;
     }
     const double n = static_cast<double>(settings.samples_per_pixel);
     out.direct[i] = glm::vec3(direct / n);
     out.indirect[i] = glm::vec3(indirect / n);
+    if (n > 1.0) {
+      const glm::dvec3 mean = indirect / n;
+      out.indirect_variance[i] = glm::vec3(glm::max((indirect2 / n - mean * mean) * (n / (n - 1.0)), 0.0) / n);
+    }
   });
   if (!completed) return engine::cancelled_error("irradiance estimate");
   return out;

@@ -18,7 +18,9 @@ namespace {
 static_assert(std::endian::native == std::endian::little, "the cache format is little-endian");
 
 constexpr char kMagic[8] = {'G', 'I', 'R', 'E', 'F', 'C', 'H', '\0'};
-constexpr std::uint32_t kVersion = 1;
+// Version 2: the flags word carries bit 1 = a variance block follows the mask.
+constexpr std::uint32_t kVersion = 2;
+constexpr std::uint32_t kHasMask = 1u, kHasVariance = 2u;
 constexpr std::size_t kHeaderBytes = 24;
 
 template <class T>
@@ -49,8 +51,8 @@ std::string reference_cache_key(const SweepScene& scene, const ReferenceProvider
 
 std::string encode_reference(std::string_view key, const RgbField& field) {
   GI_EXPECTS(field.consistent(), "encode_reference: rgb/valid sizes must match width x height");
-  const std::uint32_t has_mask = field.valid.empty() ? 0u : 1u;
-  const std::uint64_t payload = 12 + 4 * field.rgb.size() + field.valid.size();
+  const std::uint32_t flags = (field.valid.empty() ? 0u : kHasMask) | (field.variance.empty() ? 0u : kHasVariance);
+  const std::uint64_t payload = 12 + 4 * field.rgb.size() + field.valid.size() + 4 * field.variance.size();
   std::string out;
   out.reserve(kHeaderBytes + key.size() + payload + 8);
   out.append(kMagic, sizeof(kMagic));
@@ -60,9 +62,10 @@ std::string encode_reference(std::string_view key, const RgbField& field) {
   out.append(key);
   put(out, static_cast<std::int32_t>(field.width));
   put(out, static_cast<std::int32_t>(field.height));
-  put(out, has_mask);
+  put(out, flags);
   out.append(reinterpret_cast<const char*>(field.rgb.data()), 4 * field.rgb.size());
   out.append(reinterpret_cast<const char*>(field.valid.data()), field.valid.size());
+  out.append(reinterpret_cast<const char*>(field.variance.data()), 4 * field.variance.size());
   put(out, checksum(out));
   return out;
 }
@@ -100,10 +103,12 @@ engine::Result<RgbField> decode_reference(std::string_view bytes, std::string_vi
   RgbField field;
   field.width = get<std::int32_t>(bytes, p);
   field.height = get<std::int32_t>(bytes, p + 4);
-  const auto has_mask = get<std::uint32_t>(bytes, p + 8);
-  if (field.width < 0 || field.height < 0 || has_mask > 1) return fail("payload", "bad dimensions or mask flag");
+  const auto flags = get<std::uint32_t>(bytes, p + 8);
+  if (field.width < 0 || field.height < 0 || flags > (kHasMask | kHasVariance))
+    return fail("payload", "bad dimensions or flags");
+  const bool has_mask = (flags & kHasMask) != 0, has_variance = (flags & kHasVariance) != 0;
   const std::uint64_t n = field.count();
-  if (payload != 12 + 12 * n + (has_mask ? n : 0)) {
+  if (payload != 12 + 12 * n + (has_mask ? n : 0) + (has_variance ? 12 * n : 0)) {
     return fail("payload",
                 "payload size does not match " + std::to_string(field.width) + "x" + std::to_string(field.height));
   }
@@ -112,6 +117,10 @@ engine::Result<RgbField> decode_reference(std::string_view bytes, std::string_vi
   if (has_mask)
     field.valid.assign(bytes.begin() + static_cast<std::ptrdiff_t>(p + 12 + 12 * n),
                        bytes.begin() + static_cast<std::ptrdiff_t>(p + 12 + 13 * n));
+  if (has_variance) {
+    field.variance.resize(3 * n);
+    std::memcpy(field.variance.data(), bytes.data() + p + 12 + 12 * n + (has_mask ? n : 0), 12 * n);
+  }
   return field;
 }
 

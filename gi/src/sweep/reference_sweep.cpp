@@ -57,7 +57,10 @@ engine::Result<RgbField> atlas_indirect(const SweepScene& s, const ReferenceRequ
   auto truth = reference_atlas(bake_input_from(engine::instantiate(s.asset)), std::stof(r.param("texels_per_m")),
                                settings, placement);
   if (!truth) return truth.error();
-  return RgbField::from_texels(truth->width, truth->height, truth->indirect, truth->valid);
+  RgbField f = RgbField::from_texels(truth->width, truth->height, truth->indirect, truth->valid);
+  f.variance.reserve(3 * truth->indirect_variance.size());
+  for (const glm::vec3& v : truth->indirect_variance) f.variance.insert(f.variance.end(), {v.x, v.y, v.z});
+  return f;
 }
 
 // Converged-reference settings: the request's spp, the reference seed, unlimited bounces.
@@ -77,7 +80,7 @@ void register_reference_sweep(SweepRegistry& registry) {
                                      return render_camera(job.scene, job.request, reference_settings(job));
                                    }});
   registry.add_reference_provider(
-      {.kind = "atlas_indirect_irradiance", .version = "pt-1", .compute = [](const ReferenceJob& job) {
+      {.kind = "atlas_indirect_irradiance", .version = "pt-2", .compute = [](const ReferenceJob& job) {
          return atlas_indirect(job.scene, job.request, reference_settings(job));
        }});
 

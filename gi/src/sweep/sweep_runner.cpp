@@ -1,6 +1,7 @@
 #include "sweep/sweep_runner.h"
 
 #include <chrono>
+#include <cmath>
 #include <limits>
 #include <map>
 
@@ -94,6 +95,12 @@ engine::Result<SweepResult> run_sweep(const SweepRegistry& registry, const Sweep
       } else {
         row.error = compare_rgb(out->field, ref.field, options.metrics);
         if (!row.error.ok()) row.status = row.error.problem;
+        // A reference that knows its own noise: the error against the truth (error_metrics.h).
+        if (row.error.ok() && std::isfinite(row.error.reference_noise)) {
+          row.extras.emplace_back(std::string(kReferenceNoiseExtra), row.error.reference_noise);
+          if (std::isfinite(row.error.truth_rel_rmse))
+            row.extras.emplace_back(std::string(kTruthErrorExtra), row.error.truth_rel_rmse);
+        }
       }
     }
     result.rows.push_back(std::move(row));

@@ -12,12 +12,18 @@
 #include <functional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
 #include "sweep/sweep_registry.h"
 
 namespace gi {
+
+/// Extras the harness adds to a row when the reference carries its sampling variance
+/// (RgbField::variance): the reference's own relative noise and the error against the truth.
+inline constexpr std::string_view kReferenceNoiseExtra = "ref_noise";
+inline constexpr std::string_view kTruthErrorExtra = "truth_rel_rmse";
 
 struct SweepOptions {
   std::filesystem::path cache_dir;  ///< Reference cache; empty: references are not cached on disk.
@@ -33,7 +39,7 @@ struct SweepRow {
   KnobSetting knobs;
   ErrorReport error;          ///< Against the reference (NaN metrics when the run failed).
   RunCosts costs;             ///< As the method reported them.
-  std::vector<std::pair<std::string, double>> extras;  ///< MethodOutput::extras, as the method reported them.
+  std::vector<std::pair<std::string, double>> extras;  ///< MethodOutput::extras, as the method reported them (+ the harness's, above).
   double wall_seconds = 0.0;  ///< Wall time of the run call, measured by the harness.
   std::string reference_key;  ///< The full reference cache key.
   std::string status = "ok";  ///< "ok", or why the run has no valid metrics.

@@ -40,13 +40,17 @@ double sweep_cost(const SweepRow& row, SweepCost cost) {
   return cost == SweepCost::BakeSeconds ? row.costs.bake_seconds : row.costs.frame_ms;
 }
 
+double sweep_error(const SweepRow& row) {
+  if (!row.ok()) return std::numeric_limits<double>::quiet_NaN();
+  for (const auto& [name, value] : row.extras)
+    if (name == kTruthErrorExtra) return value;
+  return row.error.rel_rmse;
+}
+
 SweepSummary summarize_sweep(std::span<const SweepRow> rows, const SweepSummaryOptions& options) {
   SweepSummary s;
   s.options = options;
-  for (const SweepRow& r : rows) {
-    s.points.push_back(
-        {r.ok() ? r.error.rel_rmse : std::numeric_limits<double>::quiet_NaN(), sweep_cost(r, options.cost)});
-  }
+  for (const SweepRow& r : rows) s.points.push_back({sweep_error(r), sweep_cost(r, options.cost)});
   s.front = pareto_front(s.points);
   s.presets = choose_presets(s.points, s.front, options.targets);
   return s;
@@ -89,6 +93,15 @@ std::string sweep_summary_markdown(std::span<const SweepRow> rows, const SweepSu
       "channels summed; max rel: max |a-r| / max(|r|, 0.01 mean |r|) per element (RGB norms); PSNR of the "
       "tonemapped images (dB); fit: after the least-squares scale s. Trade-off cost: " +
       cost_name(summary.options.cost) + ".\n\n";
+  const bool truth = std::any_of(rows.begin(), rows.end(), [](const SweepRow& r) {
+    return std::any_of(r.extras.begin(), r.extras.end(), [](const auto& e) { return e.first == kTruthErrorExtra; });
+  });
+  if (truth)
+    md +=
+        "The reference carries its own sampling variance v per element: ref_noise = sqrt(sum v / sum r^2) is its "
+        "relative RMSE from the truth, and truth_rel_rmse = sqrt(max(0, sum (a-r)^2 - sum v) / (sum r^2 - sum v)) "
+        "the error against the noise-free truth (both sums unbiased when the method's noise is independent of the "
+        "reference's). The front and the presets use truth_rel_rmse.\n\n";
 
   md += "## Runs\n\n|";
   for (const std::string& k : knobs) md += " " + md_cell(k) + " |";
@@ -110,18 +123,19 @@ std::string sweep_summary_markdown(std::span<const SweepRow> rows, const SweepSu
     md += "\n";
   }
 
-  md += "\n## Pareto front\n\nRuns no other run beats on both relative RMSE and " + cost_name(summary.options.cost) +
+  const std::string error_name = truth ? "truth_rel_rmse" : "rel RMSE";
+  md += "\n## Pareto front\n\nRuns no other run beats on both " + error_name + " and " + cost_name(summary.options.cost) +
         " (failed runs excluded), cheapest first:\n\n";
   if (summary.front.empty()) md += "(empty: no run produced a valid error and cost)\n";
   for (std::size_t i : summary.front) {
-    md += "- " + (rows[i].knobs.label().empty() ? std::string("(no knobs)") : rows[i].knobs.label()) + ": rel RMSE " +
+    md += "- " + (rows[i].knobs.label().empty() ? std::string("(no knobs)") : rows[i].knobs.label()) + ": " + error_name + " " +
           fixed(summary.points[i].error, 4) + ", " + fixed(summary.points[i].cost, 4) + " " +
           (summary.options.cost == SweepCost::BakeSeconds ? "s" : "ms") + "\n";
   }
 
   const PresetTargets& t = summary.options.targets;
   md +=
-      "\n## Suggested presets\n\nRule: each preset is the cheapest Pareto-front run whose relative RMSE is at or "
+      "\n## Suggested presets\n\nRule: each preset is the cheapest Pareto-front run whose " + error_name + " is at or "
       "below its target (preview " +
       format_number(t.preview) + ", medium " + format_number(t.medium) + ", high " + format_number(t.high) +
       "); when no front run reaches a target, the most accurate front run is suggested and "
@@ -130,7 +144,7 @@ std::string sweep_summary_markdown(std::span<const SweepRow> rows, const SweepSu
   for (const PresetChoice& p : summary.presets) {
     const SweepRow& r = rows[p.index];
     md += "- **" + p.name + "**: " + (r.knobs.label().empty() ? std::string("(no knobs)") : r.knobs.label()) +
-          " (rel RMSE " + fixed(r.error.rel_rmse, 4) + ", " + fixed(summary.points[p.index].cost, 4) + " " +
+          " (" + error_name + " " + fixed(summary.points[p.index].error, 4) + ", " + fixed(summary.points[p.index].cost, 4) + " " +
           (summary.options.cost == SweepCost::BakeSeconds ? "s" : "ms") + ")" +
           (p.target_met ? "" : " -- target " + format_number(p.target) + " not met") + "\n";
   }

@@ -31,6 +31,9 @@ struct SweepSummary {
 
 /// The cost of a row on the chosen axis (NaN when not applicable or the run failed).
 double sweep_cost(const SweepRow& row, SweepCost cost);
+/// The error of a row on the front's axis: the error against the truth when the harness
+/// could estimate it (kTruthErrorExtra), else rel RMSE against the reference; NaN if failed.
+double sweep_error(const SweepRow& row);
 /// Front and presets of the rows (failed rows never take part).
 SweepSummary summarize_sweep(std::span<const SweepRow> rows, const SweepSummaryOptions& options);
 /// The Markdown document.

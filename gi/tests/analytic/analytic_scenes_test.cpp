@@ -222,6 +222,41 @@ gi::BakeInput box_input(bool moving_light) {
   return in;
 }
 
+// The path tracer's own noise estimate (IrradianceEstimate::indirect_variance, what the
+// sweeps' truth error subtracts): two estimates with independent seeds differ, squared and
+// summed over points and channels, by the sum of their two variances.
+TEST(AnalyticClosedBox, ReferenceVarianceMatchesTheSpreadOfIndependentEstimates) {
+  const gi::BakeInput input = box_input(false);
+  std::vector<gi::SurfacePoint> points;
+  for (int axis = 0; axis < 3; ++axis)
+    for (float side : {-1.0f, 1.0f})
+      for (int i = 0; i < 10; ++i)
+        for (int j = 0; j < 10; ++j) {
+          glm::vec3 p(0.0f), n(0.0f);
+          p[axis] = side;
+          p[(axis + 1) % 3] = -0.95f + 0.19f * static_cast<float>(i) + 0.005f;
+          p[(axis + 2) % 3] = -0.95f + 0.19f * static_cast<float>(j) + 0.005f;
+          n[axis] = -side;
+          points.push_back({p, n});
+        }
+  gi::ReferenceSettings a = reference(64, -1), b = a;
+  b.seed = 4;
+  auto ea = gi::reference_irradiance(input, points, a);
+  auto eb = gi::reference_irradiance(input, points, b);
+  ASSERT_TRUE(ea && eb);
+  double spread = 0.0, variance = 0.0;
+  for (std::size_t k = 0; k < points.size(); ++k)
+    for (int c = 0; c < 3; ++c) {
+      const double d = static_cast<double>(ea->indirect[k][c] - eb->indirect[k][c]);
+      spread += d * d;
+      variance += static_cast<double>(ea->indirect_variance[k][c] + eb->indirect_variance[k][c]);
+    }
+  std::printf("closed box, 600 points x 64 spp, two seeds: sum (a-b)^2 / sum (var a + var b) = %.3f\n",
+              spread / variance);
+  EXPECT_GT(variance, 0.0);
+  EXPECT_NEAR(spread / variance, 1.0, 0.15);
+}
+
 // Mean over the box's area by the midpoint rule (8 x 8 cells per wall) of the path tracer's
 // indirect irradiance, against the closed form; then the bakers per texel against the path
 // tracer (interior texels; texels on the box's edges apart, see the furnace test).

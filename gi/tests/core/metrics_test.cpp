@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <limits>
+#include <random>
 
 namespace {
 
@@ -40,6 +41,33 @@ TEST(ErrorMetrics, KnownOffsetGivesKnownRelativeRmse) {
   gi::RgbField b = r;
   b.rgb[0] = 3.0f;  // error 2 in one of 12 values: sqrt(4 / 12)
   EXPECT_NEAR(gi::relative_rmse(b, r), std::sqrt(4.0 / 12.0), 1e-9);
+}
+
+// A noisy reference r = t + n with known variance v: rel RMSE carries the reference's noise,
+// truth_rel_rmse removes it and finds the approximation's own 2% error.
+TEST(ErrorMetrics, TruthErrorRemovesTheReferencesOwnNoise) {
+  constexpr int kW = 100, kH = 60;
+  constexpr float kSigma = 0.05f;
+  gi::RgbField r = gi::RgbField::filled(kW, kH, 1.0f);
+  const gi::RgbField a = gi::RgbField::filled(kW, kH, 1.02f);
+  std::mt19937 rng(11);
+  std::normal_distribution<float> noise(0.0f, kSigma);
+  for (float& v : r.rgb) v += noise(rng);
+  gi::ErrorReport plain = gi::compare_rgb(a, r);
+  ASSERT_TRUE(plain.ok());
+  EXPECT_TRUE(std::isnan(plain.truth_rel_rmse));
+  EXPECT_TRUE(std::isnan(plain.reference_noise));
+  EXPECT_NEAR(plain.rel_rmse, std::sqrt(0.02 * 0.02 + 0.05 * 0.05), 0.003);
+
+  r.variance.assign(r.rgb.size(), kSigma * kSigma);
+  const gi::ErrorReport e = gi::compare_rgb(a, r);
+  ASSERT_TRUE(e.ok()) << e.problem;
+  EXPECT_EQ(e.rel_rmse, plain.rel_rmse);
+  EXPECT_NEAR(e.reference_noise, 0.05, 0.002);
+  EXPECT_NEAR(e.truth_rel_rmse, 0.02, 0.003);
+  // The reference against itself-plus-nothing: the truth error of the truth is ~0.
+  gi::RgbField t = gi::RgbField::filled(kW, kH, 1.0f);
+  EXPECT_LT(gi::compare_rgb(t, r).truth_rel_rmse, 0.006);
 }
 
 TEST(ErrorMetrics, MaxRelativeUsesTheFloorForNearBlackElements) {

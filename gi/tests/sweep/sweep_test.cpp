@@ -283,6 +283,24 @@ TEST(ReferenceCache, EveryTruncationAndTheWrongKeyAreRejected) {
   EXPECT_FALSE(gi::decode_reference(bytes + "x", "key-a", "mem").ok());
 }
 
+TEST(ReferenceCache, TheVarianceBlockRoundTripsAndIsCheckedLikeTheRest) {
+  gi::RgbField f = gi::RgbField::filled(2, 2, 0.5f);
+  f.valid = {1, 1, 0, 1};
+  f.variance = {1e-4f, 2e-4f, 3e-4f, 0.0f, 0.0f, 0.0f, 5e-5f, 6e-5f, 7e-5f, 1.0f, 2.0f, 3.0f};
+  const std::string bytes = gi::encode_reference("key-v", f);
+  auto back = gi::decode_reference(bytes, "key-v", "mem");
+  ASSERT_TRUE(back.ok()) << back.error().to_string();
+  EXPECT_EQ(back->variance, f.variance);
+  EXPECT_EQ(back->valid, f.valid);
+  EXPECT_EQ(back->rgb, f.rgb);
+  for (std::size_t n = 0; n < bytes.size(); n += 7)
+    EXPECT_FALSE(gi::decode_reference(bytes.substr(0, n), "key-v", "mem").ok()) << "truncated to " << n;
+  gi::RgbField plain = gi::RgbField::filled(2, 2, 0.5f);
+  auto no_variance = gi::decode_reference(gi::encode_reference("k", plain), "k", "mem");
+  ASSERT_TRUE(no_variance.ok());
+  EXPECT_TRUE(no_variance->variance.empty());
+}
+
 TEST(AtomicFile, ReplacesWholeFileOrLeavesNothingBehind) {
   TempDir dir("atomic");
   const fs::path target = dir.path() / "out.csv";
