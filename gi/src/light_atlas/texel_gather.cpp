@@ -279,33 +279,69 @@ class TexelGrid {
 };
 
 // Step 4: Gaussian over texels on the same plane within the radius, across chart borders.
+// Texels are sorted into cubic cells of the radius (exact integer cells); each cell gathers
+// its 27 neighbour cells' texels once and filters all of its texels against them, in a
+// fixed order (bit-identical for any thread count).
 std::vector<glm::vec3> filter_world(const AtlasTexels& tx, const TexelTable& t, const std::vector<glm::vec3>& e,
                                     const std::vector<std::uint8_t>& hidden, float radius_m, float texel_m,
                                     ThreadPool& pool) {
-  std::vector<std::uint32_t> visible;
+  struct Entry {
+    glm::ivec3 cell;
+    std::uint32_t texel;
+  };
+  const auto before = [](const glm::ivec3& a, const glm::ivec3& b) {
+    return a.z != b.z ? a.z < b.z : a.y != b.y ? a.y < b.y : a.x < b.x;
+  };
+  std::vector<Entry> entries;
   for (std::uint32_t i : t.work)
-    if (!hidden[i]) visible.push_back(i);
-  const TexelGrid grid(tx, visible, radius_m);
+    if (!hidden[i]) entries.push_back({glm::ivec3(glm::floor(tx.position[i] / radius_m)), i});
+  std::sort(entries.begin(), entries.end(), [&](const Entry& a, const Entry& b) {
+    return before(a.cell, b.cell) || (a.cell == b.cell && a.texel < b.texel);
+  });
+  std::vector<glm::ivec3> cells;
+  std::vector<std::size_t> first;
+  for (std::size_t k = 0; k < entries.size(); ++k)
+    if (k == 0 || entries[k].cell != entries[k - 1].cell) cells.push_back(entries[k].cell), first.push_back(k);
+  first.push_back(entries.size());
+
   std::vector<glm::vec3> out = e;
-  const float r2 = radius_m * radius_m;
+  const float r2 = radius_m * radius_m, plane = 0.5f * texel_m;
   pool.parallel_for(
-      visible.size(),
-      [&](std::size_t w) {
-        const std::uint32_t i = visible[w];
-        const glm::vec3 p = tx.position[i], n = tx.normal[i];
-        glm::dvec3 sum(0.0);
-        double weight = 0.0;
-        grid.for_near(p, [&](std::uint32_t j) {
-          const glm::vec3 d = tx.position[j] - p;
-          const float d2 = glm::dot(d, d);
-          if (d2 > r2 || glm::dot(tx.normal[j], n) < 0.95f || std::fabs(glm::dot(d, n)) > 0.5f * texel_m) return;
-          const double wgt = std::exp(-2.0 * static_cast<double>(d2 / r2));
-          sum += glm::dvec3(e[j]) * wgt;
-          weight += wgt;
-        });
-        if (weight > 0.0) out[i] = glm::vec3(sum / weight);
+      cells.size(),
+      [&](std::size_t c) {
+        struct Candidate {
+          glm::vec3 position, normal, value;
+        };
+        std::vector<Candidate> near;
+        for (int dz = -1; dz <= 1; ++dz)
+          for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) {
+              const glm::ivec3 cc = cells[c] + glm::ivec3(dx, dy, dz);
+              const auto it = std::lower_bound(cells.begin(), cells.end(), cc, before);
+              if (it == cells.end() || *it != cc) continue;
+              const auto k = static_cast<std::size_t>(it - cells.begin());
+              for (std::size_t m = first[k]; m < first[k + 1]; ++m) {
+                const std::uint32_t j = entries[m].texel;
+                near.push_back({tx.position[j], tx.normal[j], e[j]});
+              }
+            }
+        for (std::size_t m = first[c]; m < first[c + 1]; ++m) {
+          const std::uint32_t i = entries[m].texel;
+          const glm::vec3 p = tx.position[i], n = tx.normal[i];
+          glm::vec3 sum(0.0f);
+          float weight = 0.0f;
+          for (const Candidate& q : near) {
+            const glm::vec3 d = q.position - p;
+            const float d2 = glm::dot(d, d);
+            if (d2 > r2 || glm::dot(q.normal, n) < 0.95f || std::fabs(glm::dot(d, n)) > plane) continue;
+            const float w = std::exp(-2.0f * d2 / r2);
+            sum += q.value * w;
+            weight += w;
+          }
+          if (weight > 0.0f) out[i] = sum / weight;
+        }
       },
-      64);
+      4);
   return out;
 }
 
