@@ -6,6 +6,8 @@
 //   gi::SweepRegistry registry;
 //   gi::register_reference_sweep(registry);
 
+#include <gi/bake_input.h>
+
 #include "sweep/sweep_registry.h"
 
 namespace gi {
@@ -16,5 +18,10 @@ namespace gi {
 inline constexpr int kConvergedReferenceSpp = 4096;
 
 void register_reference_sweep(SweepRegistry& registry);
+
+/// What the light atlas bakes, and so the world of its "atlas_indirect_irradiance"
+/// reference: `input` without the lights that move (the PRM's) and the dynamic instances
+/// (BRF's). Deforming regions stay (baked at their authored pose).
+BakeInput static_world(BakeInput input);
 
 }  // namespace gi

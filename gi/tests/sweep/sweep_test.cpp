@@ -2,6 +2,8 @@
 // Pareto front and presets, CSV round trips, the reference cache's integrity checks and
 // atomic writes. The method and the reference provider here are synthetic and exist in
 // this test only.
+#include <engine/scene.h>
+#include <gi/bake_input.h>
 #include <gi/sweep.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -18,6 +20,7 @@
 #include "sweep/knob_grid.h"
 #include "sweep/pareto_front.h"
 #include "sweep/reference_cache.h"
+#include "sweep/reference_sweep.h"
 #include "sweep/sweep_csv.h"
 #include "sweep/sweep_runner.h"
 #include "sweep/sweep_summary.h"
@@ -509,6 +512,27 @@ TEST(SceneFingerprint, LoadsARealScene) {
   EXPECT_EQ(scene->display_name(), "cornell_box.gltf");
   EXPECT_FALSE(scene->asset.meshes.empty());
   EXPECT_FALSE(gi::load_sweep_scene(fs::path(GI_SOURCE_DIR) / "assets" / "no_such.gltf").ok());
+}
+
+// The light atlas's reference world: the crates room without its five dynamic crates, the
+// same static instances; a moving light dropped, a static one kept.
+TEST(ReferenceSweep, TheAtlasReferenceWorldIsTheStaticOne) {
+  auto scene = gi::load_sweep_scene(fs::path(GI_SOURCE_DIR) / "assets" / "crates_room.gltf");
+  ASSERT_TRUE(scene.ok()) << scene.error().to_string();
+  gi::BakeInput input = gi::bake_input_from(engine::instantiate(scene->asset));
+  gi::BakeLight moving, fixed;
+  moving.light.moves = true;
+  input.lights.push_back(moving);
+  input.lights.push_back(fixed);
+  const gi::BakeInput world = gi::static_world(input);
+  std::size_t statics = 0;
+  for (const gi::BakeInstance& i : input.instances) statics += i.mobility == gi::BakeMobility::Static;
+  EXPECT_GE(input.instances.size(), statics + 5);
+  ASSERT_EQ(world.instances.size(), statics);
+  for (const gi::BakeInstance& i : world.instances) EXPECT_EQ(i.mobility, gi::BakeMobility::Static) << i.name;
+  EXPECT_EQ(world.lights.size(), input.lights.size() - 1);
+  for (const gi::BakeLight& l : world.lights) EXPECT_FALSE(l.light.moves);
+  EXPECT_EQ(world.meshes.size(), input.meshes.size());
 }
 
 TEST(BuiltinSweepMethods, RegisterOnlyRealMethods) {
