@@ -248,27 +248,32 @@ engine::Result<LightAtlasSettings> light_atlas_preset(std::string_view name) {
     return engine::invalid_request("unknown light-atlas preset '" + std::string(name) + "' (preview, medium, high)");
   LightAtlasSettings s;
   s.texels_per_metre = *density;
-  // Final gather (texel_gather.h), chosen from the Cornell-box sweep at 128 texels/m
-  // (docs/sweeps/light_atlas_cornell_box.md) and the demo level's frames (a 2.5-texel filter
-  // leaves no blotches at 8 texels/m; the
-  // high preset gathers more and does not blur); the VPLs only feed BRF's world probes.
+  // Final gather (texel_gather.h), chosen from the sweeps against the truth (the
+  // reference's own noise removed, docs/light_atlas.md) on the Cornell box at 128 texels/m
+  // (docs/sweeps/light_atlas_128) and the demo level at 16 texels/m, and from the demo's
+  // frames: kept rays alone with the 2.5-texel filter reach the same error for less, but
+  // leave blotches a few texels wide where few bright texels light a wall (the crate room
+  // at 16 kept rays); a few fresh gather rays reading the filtered solve remove them. The
+  // high preset gathers enough not to blur. The VPLs only feed BRF's world probes.
   s.final_pass = LightAtlasSettings::FinalPass::TexelGather;
   s.gather.filter_radius_texels = 2.5f;
-  s.gather.direct_samples = 16;
   if (name == "preview") {
     s.vpl_count = 300, s.bounces = 8;
     s.gather.solve_rays = 32;
     s.gather.gather_rays = 128;
+    s.gather.direct_samples = 4;
   } else if (name == "medium") {
     s.vpl_count = 1000, s.bounces = 16;
-    s.gather.solve_rays = 64;
-    s.gather.gather_rays = 256;
+    s.gather.solve_rays = 32;
+    s.gather.gather_rays = 128;  // demo level 0.03 (VPL shooting's medium: 0.10); 16 + 64 rays mottled
+    s.gather.direct_samples = 8;
   } else {
     s.vpl_count = 3000, s.bounces = 16;
     s.gather.solve_rays = 128;
-    s.gather.gather_rays = 512;
-    // Enough rays to need no blur: against a 65536-spp reference at 32 texels/m the filter's
-    // bias costs more than its noise saves (0.022 with 1.5 texels, 0.015 without).
+    s.gather.gather_rays = 1024;  // Cornell at 128 texels/m: below 0.01 (128 + 512: 0.0105)
+    s.gather.direct_samples = 16;
+    // At 32 texels/m the filter's bias costs more than its noise saves (against a 65536-spp
+    // reference, 0.022 with 1.5 texels, 0.015 without).
     s.gather.filter_radius_texels = 0.0f;
   }
   return s;
