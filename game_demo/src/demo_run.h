@@ -33,7 +33,7 @@ struct RunOptions {
   bool no_render = false;
   std::string record_file;
   std::string replay_file;
-  std::string script = "tour";
+  std::string script;  ///< Empty: "tour" on the demo level, "none" (a still camera) on any other scene.
   std::uint64_t seed = 0;
   bool verbose = false;
   bool only_written = false;  ///< Headless: render only the frames written to --out.

@@ -113,7 +113,9 @@ int main(int argc, char** argv) {
   app.add_flag("--no-render", o.no_render, "Headless: simulate only (no GPU), e.g. to record sessions");
   auto* rec = app.add_option("--record", o.record_file, "Record the inputs and checksums into a .girec session");
   app.add_option("--replay", o.replay_file, "Replay a .girec session, checking every frame's checksum")->excludes(rec);
-  app.add_option("--script", o.script, "Headless input script: tour, walk_flashlight, push_crates, split_screen, open_door");
+  app.add_option("--script", o.script,
+                 "Headless input script: tour, walk_flashlight, push_crates, split_screen, open_door, none (a still "
+                 "camera; default: tour on the demo level, none on any other --scene)");
   app.add_option("--seed", o.seed, "Session seed (recorded in the header and the checksum)");
   app.add_flag("--only-written-frames", o.only_written,
                "Headless: render only the frames --out/--every write (fast golden and approval runs)");
@@ -126,6 +128,7 @@ int main(int argc, char** argv) {
     std::cerr << "gi_demo: unknown --script \"" << o.script << "\"\n";
     return 2;
   }
+  if (o.script.empty()) o.script = std::string(script_name(default_script(o.scene)));
   if (o.no_render && !o.out_dir.empty()) {
     std::cerr << "gi_demo: --no-render cannot write frames (--out)\n";
     return 2;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <filesystem>
 #include <limits>
 
 #include <engine/components.h>
@@ -45,9 +46,16 @@ std::vector<std::size_t> visiting_order(const glm::vec3& from, const std::vector
 }  // namespace
 
 std::optional<Script> script_from_name(std::string_view name) {
-  for (Script s : {Script::Tour, Script::WalkFlashlight, Script::PushCrates, Script::SplitScreen, Script::OpenDoor})
+  for (Script s : {Script::Tour, Script::WalkFlashlight, Script::PushCrates, Script::SplitScreen, Script::OpenDoor,
+                   Script::None})
     if (script_name(s) == name) return s;
   return std::nullopt;
+}
+
+Script default_script(std::string_view scene_as_given) {
+  if (scene_as_given.empty()) return Script::Tour;
+  const std::string file = std::filesystem::path(scene_as_given).filename().string();
+  return file.starts_with("demo_level.") ? Script::Tour : Script::None;
 }
 
 std::string_view script_name(Script s) {
@@ -57,6 +65,7 @@ std::string_view script_name(Script s) {
     case Script::PushCrates: return "push_crates";
     case Script::SplitScreen: return "split_screen";
     case Script::OpenDoor: return "open_door";
+    case Script::None: return "none";
   }
   return "?";
 }
@@ -159,6 +168,8 @@ ScriptedPilot::ScriptedPilot(const Simulation& sim, Script script, std::uint64_t
     case Script::OpenDoor:  // no waypoints: the start faces the door
       key_presses_[static_cast<int>(Key::O)] = {n / 5, 5 * n / 8};
       break;
+    case Script::None:  // no waypoints, no keys
+      break;
   }
 }
 
@@ -240,6 +251,7 @@ void ScriptedPilot::start_target(const Simulation& sim) {
 InputFrame ScriptedPilot::next(const Simulation& sim) {
   frame_ = sim.frame();
   InputFrame in;
+  if (script_ == Script::None) return in;  // not even the pitch levelling: the scene's camera as authored
   for (int k = 0; k < kKeyCount; ++k)
     if (std::find(key_presses_[k].begin(), key_presses_[k].end(), frame_) != key_presses_[k].end())
       in.keys |= key_bit(static_cast<Key>(k));

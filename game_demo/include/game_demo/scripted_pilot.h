@@ -24,11 +24,15 @@ enum class Script : std::uint8_t {
   PushCrates,      ///< walk to each crate in turn and push it
   SplitScreen,     ///< walk the rooms toggling the split screen on and off
   OpenDoor,        ///< stand at the start facing the corridor door: close it, then open it
+  None,            ///< no input at all: the scene's own camera, still (gi_demo's default but on the demo level)
 };
 
-/// "tour", "walk_flashlight", "push_crates", "split_screen", "open_door".
+/// "tour", "walk_flashlight", "push_crates", "split_screen", "open_door", "none".
 std::optional<Script> script_from_name(std::string_view name);
 std::string_view script_name(Script s);
+/// gi_demo's script when --script is not given: Tour for the demo level (no --scene, or a
+/// file named demo_level.*), None (the scene's own camera, still) for any other scene.
+Script default_script(std::string_view scene_as_given);
 
 class ScriptedPilot {
  public:
