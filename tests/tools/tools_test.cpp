@@ -2,6 +2,7 @@
 // 2 / 130, Ctrl-C cancels cleanly; and the one progress bar's text. The tools run as real
 // processes, as a user or a build script runs them.
 #include <fcntl.h>
+#include <engine/gltf.h>
 #include <gi/version.h>
 #include <gtest/gtest.h>
 #include <signal.h>
@@ -11,6 +12,7 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -173,4 +175,30 @@ TEST(Tools, CtrlCCancelsAReferenceRender) {
           {"--scene", GI_SOURCE_DIR "/assets/cornell_box.gltf", "--spp", "100000", "--out", out.string()}, 20.0, "[");
   EXPECT_EQ(r.exit_code, 130) << r.output;
   EXPECT_FALSE(fs::exists(out)) << "a cancelled render writes no image";
+}
+
+// gi-bake --export-uv1: the scene with the light-atlas UVs as TEXCOORD_1, nothing baked
+// (tests/gi/light_atlas_uv_test.cpp checks they are the runtime's).
+TEST(GiBake, ExportUv1WritesTheSceneWithLightmapUvs) {
+  const fs::path dir = fs::path(GI_BINARY_DIR) / "test_output" / "tools_test" / "export_uv1";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path out = dir / "cornell_box_uv1.glb";
+  const ToolRun r = run(GI_BAKE_EXE, {"--scene", GI_SOURCE_DIR "/assets/cornell_box.gltf", "--preset", "preview",
+                                      "--export-uv1", out.string()});
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("TEXCOORD_1"), std::string::npos) << r.output;
+  auto asset = engine::load_gltf(out);
+  ASSERT_TRUE(asset) << asset.error().to_string();
+  std::size_t static_meshes = 0;
+  for (const engine::Node& n : asset->nodes) {
+    if (n.mesh < 0) continue;
+    ++static_meshes;
+    for (const engine::Primitive& p : asset->meshes[static_cast<std::size_t>(n.mesh)].primitives) {
+      ASSERT_EQ(p.uv1.size(), p.positions.size()) << n.name;
+      for (const glm::vec2& uv : p.uv1) EXPECT_TRUE(uv.x >= 0.0f && uv.x <= 1.0f && uv.y >= 0.0f && uv.y <= 1.0f);
+    }
+  }
+  EXPECT_EQ(static_meshes, 4u);  // walls, two blocks, the lamp's quad
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 1) << "nothing but the export";
 }

@@ -1,11 +1,13 @@
 // gi-bake: bakes the GI data of a scene into a bake bundle (gi::bake_bundle, gi/bake.h).
 //   gi-bake --scene assets/cornell_box.gltf --methods atlas --preset high --out out/cornell_box.gibake
 //   gi-bake --plan assets/demo_level.gltf --preset preview    # print the effect plan, bake nothing
+//   gi-bake --scene level.gltf --preset medium --export-uv1 out/level_uv1.gltf   # the lightmap UVs
 // Without --methods it bakes what gi::plan (gi/plan.h) calls for and says what it skips;
 // the plan goes into the manifest either way. Exit codes: tools/common/tool_main.h.
 #include <engine/gltf.h>
 #include <engine/scene.h>
 #include <gi/bake.h>
+#include <gi/light_atlas_uv.h>
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
@@ -33,12 +35,15 @@ std::vector<std::string> split(const std::string& list) {
 
 int main(int argc, char** argv) {
   CLI::App app{"Bakes a scene's GI data into a bake bundle (manifest.json + one file per method)"};
-  std::string scene_path, positional_scene, out_dir, methods;
+  std::string scene_path, positional_scene, out_dir, methods, export_uv1;
   bool plan_only = false;
   gi::BakeOptions o;
   app.add_option("--scene", scene_path, "glTF/GLB scene")->check(CLI::ExistingFile);
   app.add_option("scene", positional_scene, "glTF/GLB scene (instead of --scene)")->check(CLI::ExistingFile);
   app.add_flag("--plan", plan_only, "Print the effect plan with estimates for --preset and exit (docs/plan.md)");
+  app.add_option("--export-uv1", export_uv1,
+                 "Write the scene with the light-atlas UVs of --preset/--density as TEXCOORD_1 to this .gltf/.glb "
+                 "(bakes nothing unless --out is given too)");
   app.add_option("--out", out_dir, "Bundle directory (default: out/<scene>.gibake)");
   app.add_option("--methods", methods,
                  "Comma-separated methods to bake: atlas, prm, dlm, brf, antiradiance (default: what the plan calls for)");
@@ -63,6 +68,16 @@ int main(int argc, char** argv) {
 
   auto asset = engine::load_gltf(scene_path);
   if (!asset) return tools::fail(kTool, asset.error());
+  if (!export_uv1.empty()) {
+    auto uv = gi::with_light_atlas_uv1(*asset, {.preset = o.preset, .texels_per_metre = o.texels_per_metre});
+    if (!uv) return tools::fail(kTool, uv.error());
+    const bool glb = std::filesystem::path(export_uv1).extension() == ".glb";
+    if (auto written = engine::write_gltf(uv->scene, export_uv1, {.binary = glb}); !written)
+      return tools::fail(kTool, written.error());
+    std::printf("%s: wrote %s: TEXCOORD_1 of the static meshes, %zu charts in a %dx%d atlas at %g texels/m\n", kTool,
+                export_uv1.c_str(), uv->charts, uv->width, uv->height, double{uv->texels_per_metre});
+    if (out_dir.empty() && !plan_only) return tools::kExitOk;
+  }
   const engine::Scene scene = engine::instantiate(std::move(asset).value());
   const gi::BakeInput input = gi::bake_input_from(scene);
 
