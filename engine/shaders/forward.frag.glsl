@@ -47,6 +47,8 @@ layout(location = 28) uniform vec3 u_specular_color_factor;  // KHR_materials_sp
 // Directional radiance of static surfaces (engine/indirect_light.h): bins and elements, 0: none.
 layout(location = 29) uniform int u_directional_bins;
 layout(location = 30) uniform int u_directional_elements;
+// The scene's sky (RenderSettings::sky_radiance), W/(m^2 sr): unshadowed ambient direct light.
+layout(location = 31) uniform vec3 u_sky_radiance;
 
 layout(binding = 0) uniform sampler2D u_base_color_texture;
 layout(binding = 1) uniform sampler2D u_metallic_roughness_texture;
@@ -95,6 +97,13 @@ void main() {
     radiance += area_light_radiance(lights[i], s) * shadow_2d(lights[i], s.position, s.normal, to_light, 2.0);
   }
 #endif
+
+  // The sky as direct light from every direction (no visibility): E = pi L, reflected as
+  // uniformly arriving light is (E / pi x directional albedo). Both halves of a split view.
+  if (any(greaterThan(u_sky_radiance, vec3(0.0)))) {
+    GltfBrdfValue sky_albedo = gltf_directional_albedo(s.brdf, dot(s.normal, s.view));
+    radiance += u_sky_radiance * (sky_albedo.diffuse + sky_albedo.specular);
+  }
 
   if (gl_FragCoord.x >= u_split_x && u_indirect_mode != 0) {
     // Indirect irradiance E (W/m^2) without direction information, reflected as uniformly

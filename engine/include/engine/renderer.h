@@ -50,6 +50,12 @@ struct RenderSettings {
   /// grows about linearly with n^2 (9 points: ~2/3 of an area light's cost); the diffuse
   /// part is exact whatever n.
   int area_specular_samples_per_side = 3;
+  /// The scene's sky (SceneAsset::environment.sky_radiance, W/(m^2 sr); Renderer::create
+  /// copies it from the assets). Drawn as direct light: an ambient term without sky
+  /// visibility, E = pi x radiance reflected as uniformly arriving light is, on both halves
+  /// of a split view. Its shadowed share and its bounces come from the indirect provider
+  /// (a light atlas baked with the sky). docs/scene-format.md.
+  glm::vec3 sky_radiance{0.0f};
 };
 
 /// Wall time of one render pass (GPU work measured with glFinish + a steady clock on

@@ -98,6 +98,20 @@ struct NamedCamera {
   Camera camera;
 };
 
+/// Light from outside the scene: the glTF scene's "gi" extras (docs/scene-format.md, "The
+/// "gi" scene extras"). The sun is loaded as a directional light on a node of its own,
+/// appended after the file's nodes, so every consumer of lights (renderer, bakers, path
+/// tracer) sees it as one.
+struct Environment {
+  /// Uniform radiance of every direction no geometry covers, W/(m^2 sr) (0: no sky).
+  glm::vec3 sky_radiance{0.0f};
+  int sun_light = -1;  ///< Index into SceneAsset::lights of the sun, or -1.
+  int sun_node = -1;   ///< Index into SceneAsset::nodes of the sun's node, or -1.
+  /// Angular radius of the sun's disc (radians). Recorded and written back; the renderer
+  /// and the bakers treat the sun as a direction (hard shadows).
+  float sun_angular_radius_rad = 0.0f;
+};
+
 /// Everything a glTF scene file holds that the engine uses.
 struct SceneAsset {
   std::string source;  ///< The file it was loaded from (for messages), or empty.
@@ -107,6 +121,7 @@ struct SceneAsset {
   std::vector<NamedLight> lights;
   std::vector<NamedCamera> cameras;
   std::vector<Node> nodes;  ///< Parents come before their children.
+  Environment environment;
 };
 
 }  // namespace engine

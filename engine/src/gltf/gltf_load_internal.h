@@ -136,6 +136,10 @@ struct GiExtras {
   std::optional<NamedLight> area_light;
 };
 Result<GiExtras> parse_gi_extras(const Context& ctx, const Json& node, const std::string& location);
+/// The "gi" object of the chosen scene's extras: the sky into scene.environment, the sun
+/// as a directional light on a new root node appended to scene.nodes.
+Status parse_scene_environment(const Context& ctx, const Json& scene_json, const std::string& location,
+                               SceneAsset& scene);
 
 // gltf_load_nodes.cpp
 /// Fills scene.nodes (parents first) and appends area lights to scene.lights.

@@ -9,6 +9,9 @@
 #include <cstdio>
 #include <numbers>
 
+#include <glm/gtc/quaternion.hpp>
+#include <glm/gtx/quaternion.hpp>
+
 #include "gltf/gltf_load_internal.h"
 
 namespace engine::gltf_load {
@@ -200,6 +203,66 @@ Result<GiExtras> parse_gi_extras(const Context& ctx, const Json& node, const std
     out.area_light = std::move(light);
   }
   return out;
+}
+
+Status parse_scene_environment(const Context& ctx, const Json& scene_json, const std::string& location,
+                               SceneAsset& scene) {
+  const Json* extras = find_member(scene_json, "extras");
+  const Json* gi = extras != nullptr && extras->is_object() ? find_member(*extras, "gi") : nullptr;
+  if (gi == nullptr) return {};
+  const std::string where = location + " extras.gi";
+  if (!gi->is_object()) return ctx.error(where, "must be an object");
+  if (const Json* sky = find_member(*gi, "sky")) {
+    const std::string swhere = where + ".sky";
+    if (!sky->is_object()) return ctx.error(swhere, "must be an object");
+    const Json* radiance = find_member(*sky, "radiance");
+    if (radiance == nullptr) return ctx.error(swhere, "needs 'radiance'");
+    auto r = number_array<3>(ctx, *radiance, swhere, "radiance");
+    if (!r) return r.error();
+    if (r->x < 0.0f || r->y < 0.0f || r->z < 0.0f) return ctx.error(swhere, "'radiance' has a negative component");
+    if (std::max({r->x, r->y, r->z}) > static_cast<float>(kMaxLightIntensity))
+      return ctx.error(swhere, "'radiance' is beyond any real sky (at most 1e15)");
+    scene.environment.sky_radiance = *r;
+  }
+  if (const Json* sun = find_member(*gi, "sun")) {
+    const std::string swhere = where + ".sun";
+    if (!sun->is_object()) return ctx.error(swhere, "must be an object");
+    const Json* direction = find_member(*sun, "direction");
+    const Json* irradiance = find_member(*sun, "irradiance");
+    if (direction == nullptr || irradiance == nullptr) return ctx.error(swhere, "needs 'direction' and 'irradiance'");
+    auto d = number_array<3>(ctx, *direction, swhere, "direction");
+    if (!d) return d.error();
+    auto e = number_array<3>(ctx, *irradiance, swhere, "irradiance");
+    if (!e) return e.error();
+    if (!(glm::length(*d) > 1e-6f)) return ctx.error(swhere, "'direction' must not be zero");
+    if (e->x < 0.0f || e->y < 0.0f || e->z < 0.0f) return ctx.error(swhere, "'irradiance' has a negative component");
+    if (std::max({e->x, e->y, e->z}) > static_cast<float>(kMaxLightIntensity))
+      return ctx.error(swhere, "'irradiance' is beyond any real sun (at most 1e15)");
+    auto radius = number_member(ctx, *sun, "angular_radius_deg", 0.27, swhere);
+    if (!radius) return radius.error();
+    if (!(*radius >= 0.0 && *radius <= 45.0)) return ctx.error(swhere, "'angular_radius_deg' must lie in [0, 45]");
+    // A directional light shines along its node's local -Z: rotate -Z onto `direction`.
+    const glm::vec3 to = glm::normalize(*d);
+    const glm::vec3 from(0.0f, 0.0f, -1.0f);
+    glm::quat q = glm::dot(from, to) < -0.999999f ? glm::angleAxis(static_cast<float>(std::numbers::pi), glm::vec3(1, 0, 0))
+                                                  : glm::rotation(from, to);
+    NamedLight light;
+    light.name = "sun";
+    light.light.type = LightType::Directional;
+    const float peak = std::max({e->x, e->y, e->z});
+    light.light.intensity = peak;  // W/m^2 on a surface facing the sun
+    light.light.color = peak > 0.0f ? *e / peak : glm::vec3(1.0f);
+    Node node;
+    node.name = "sun";
+    node.rotation = glm::normalize(q);
+    node.light = static_cast<int>(scene.lights.size());
+    scene.environment.sun_light = node.light;
+    scene.environment.sun_node = static_cast<int>(scene.nodes.size());
+    scene.environment.sun_angular_radius_rad = static_cast<float>(*radius * std::numbers::pi / 180.0);
+    scene.lights.push_back(std::move(light));
+    scene.nodes.push_back(std::move(node));
+  }
+  return {};
 }
 
 }  // namespace engine::gltf_load

@@ -232,6 +232,10 @@ Status convert_nodes(const Context& ctx, const ParsedFile& file, const std::vect
     scene.nodes.push_back(std::move(node));
     for (auto c = fn.children.rbegin(); c != fn.children.rend(); ++c) stack.emplace_back(*c, out_index);
   }
+  // The scene's environment (sky, sun), after the nodes: the sun's node comes last.
+  if (scene_index >= 0)
+    return parse_scene_environment(ctx, (*scenes)[static_cast<std::size_t>(scene_index)],
+                                   "scene " + std::to_string(scene_index), scene);
   return {};
 }
 

@@ -282,6 +282,7 @@ class GltfBuilder {
     for (std::size_t i = 0; i < scene_.lights.size(); ++i) {
       const Light& l = scene_.lights[i].light;
       if (l.type == LightType::Area) continue;  // written as node extras
+      if (sun_in_extras() && static_cast<int>(i) == scene_.environment.sun_light) continue;  // scene extras
       json j = {{"color", vec(l.color)}};
       if (!scene_.lights[i].name.empty()) j["name"] = scene_.lights[i].name;
       switch (l.type) {
@@ -324,8 +325,37 @@ class GltfBuilder {
     doc_["cameras"] = std::move(cameras);
   }
 
+  /// The environment's sun is written back as the scene's gi.sun when it is what the loader
+  /// made of one: a root directional light on the last node, with no children. Otherwise
+  /// (the scene was edited) it stays an ordinary directional light node.
+  bool sun_in_extras() const {
+    const Environment& env = scene_.environment;
+    if (env.sun_node < 0 || env.sun_node + 1 != static_cast<int>(scene_.nodes.size())) return false;
+    if (env.sun_light < 0 || env.sun_light >= static_cast<int>(scene_.lights.size())) return false;
+    const Node& n = scene_.nodes[static_cast<std::size_t>(env.sun_node)];
+    for (const Node& other : scene_.nodes)
+      if (&other != &n && other.light == env.sun_light) return false;
+    return n.parent < 0 && n.light == env.sun_light && n.mesh < 0 && n.camera < 0 &&
+           scene_.lights[static_cast<std::size_t>(env.sun_light)].light.type == LightType::Directional;
+  }
+
+  /// The scene's "gi" extras: sky and sun (docs/scene-format.md).
+  json scene_extras() const {
+    const Environment& env = scene_.environment;
+    json gi = json::object();
+    if (env.sky_radiance != glm::vec3(0.0f)) gi["sky"] = {{"radiance", vec(env.sky_radiance)}};
+    if (sun_in_extras()) {
+      const Node& n = scene_.nodes[static_cast<std::size_t>(env.sun_node)];
+      const Light& l = scene_.lights[static_cast<std::size_t>(env.sun_light)].light;
+      gi["sun"] = {{"direction", vec(n.rotation * glm::vec3(0.0f, 0.0f, -1.0f))},
+                   {"irradiance", vec(l.color * l.intensity)},
+                   {"angular_radius_deg", num(env.sun_angular_radius_rad * 57.29577951308232f)}};
+    }
+    return gi;
+  }
+
   Status write_nodes() {
-    const int count = static_cast<int>(scene_.nodes.size());
+    const int count = static_cast<int>(scene_.nodes.size()) - (sun_in_extras() ? 1 : 0);
     std::vector<json> children(scene_.nodes.size(), json::array());
     json roots = json::array();
     for (int i = 0; i < count; ++i) {
@@ -372,7 +402,9 @@ class GltfBuilder {
       nodes.push_back(std::move(j));
     }
     if (!nodes.empty()) doc_["nodes"] = std::move(nodes);
-    doc_["scenes"] = json::array({{{"nodes", std::move(roots)}}});
+    json scene = {{"nodes", std::move(roots)}};
+    if (json gi = scene_extras(); !gi.empty()) scene["extras"]["gi"] = std::move(gi);
+    doc_["scenes"] = json::array({std::move(scene)});
     doc_["scene"] = 0;
     return {};
   }

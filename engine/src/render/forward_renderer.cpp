@@ -269,6 +269,7 @@ void ForwardRenderer::forward_pass(const Registry& registry, Entity camera, cons
   glUniformMatrix4fv(8, 1, GL_FALSE, glm::value_ptr(view_proj));
   glUniform3fv(16, 1, glm::value_ptr(camera_position));
   glUniform1f(23, settings_.stand_in_ambient);
+  glUniform3fv(31, 1, glm::value_ptr(settings_.sky_radiance));
   glUniform1f(24, settings_.split == SplitView::DirectLeftFullRight ? 0.5f * static_cast<float>(width_) : -1.0f);
   glUniform1i(25, glossy != 0 ? 1 : 0);
 
@@ -400,9 +401,11 @@ Result<std::unique_ptr<Renderer>> Renderer::create(const SceneAsset& assets, con
   auto scene = GpuScene::upload(assets);
   if (!scene) return scene.error();
   glEnable(GL_TEXTURE_CUBE_MAP_SEAMLESS);
+  RenderSettings with_sky = settings;
+  with_sky.sky_radiance = assets.environment.sky_radiance;
   return std::unique_ptr<Renderer>(std::make_unique<ForwardRenderer>(std::move(scene.value()), std::move(forward.value()),
                                                                      std::move(depth.value()), std::move(shadow.value()),
-                                                                     std::move(tonemap.value()), settings));
+                                                                     std::move(tonemap.value()), with_sky));
 }
 
 }  // namespace engine
