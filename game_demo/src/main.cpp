@@ -121,14 +121,18 @@ int main(int argc, char** argv) {
                "Headless: render only the frames --out/--every write (fast golden and approval runs)");
   app.add_option("--gi-bundle", o.gi_bundle,
                  "Light the static world with the light atlas of this bake bundle (scene.gibake/)");
+  app.add_option("--sky", o.sky, "R,G,B: light the scene with a uniform sky of this radiance, W/(m^2 sr) (as gi-bake --sky)")
+      ->delimiter(',')
+      ->expected(3)
+      ->check(CLI::NonNegativeNumber);
   app.add_flag("--verbose", o.verbose, "Headless: print the script's waypoints and the player's position each second");
   CLI11_PARSE(app, argc, argv);
   o.size_given = w->count() > 0 || h->count() > 0;
+  if (o.script.empty()) o.script = std::string(script_name(default_script(o.scene)));
   if (!script_from_name(o.script)) {
     std::cerr << "gi_demo: unknown --script \"" << o.script << "\"\n";
     return 2;
   }
-  if (o.script.empty()) o.script = std::string(script_name(default_script(o.scene)));
   if (o.no_render && !o.out_dir.empty()) {
     std::cerr << "gi_demo: --no-render cannot write frames (--out)\n";
     return 2;
@@ -182,6 +186,8 @@ int main(int argc, char** argv) {
       state.record = std::move(s);
     }
   }
+  if (o.sky.size() == 3)  // before the renderer and the GI system read the scene
+    state.sim->scene().assets.environment.sky_radiance = glm::vec3(o.sky[0], o.sky[1], o.sky[2]);
   const int status = o.headless ? run_headless(o, state) : run_windowed(o, state);
   if (!state.finish_recording(o.record_file)) return 1;
   if (state.replay && status == 0) {

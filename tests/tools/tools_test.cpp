@@ -177,6 +177,36 @@ TEST(Tools, CtrlCCancelsAReferenceRender) {
   EXPECT_FALSE(fs::exists(out)) << "a cancelled render writes no image";
 }
 
+// gi-bake --sky: a scene without lights (the Avocado, as Khronos ships it) plans and bakes
+// the light atlas under a uniform sky. Skips without the external assets.
+TEST(GiBake, SkyMakesASceneWithoutLightsBakeable) {
+  const fs::path avocado = fs::path(GI_EXTERNAL_ASSETS_DIR) / "Avocado" / "glTF-Draco" / "Avocado.gltf";
+  if (!fs::exists(avocado)) GTEST_SKIP() << "external asset not found: " << avocado;
+  const ToolRun dark = run(GI_BAKE_EXE, {"--plan", avocado.string(), "--preset", "preview"});
+  EXPECT_EQ(dark.exit_code, 0) << dark.output;
+  EXPECT_NE(dark.output.find("no light and no emissive surface"), std::string::npos) << dark.output;
+  const ToolRun plan = run(GI_BAKE_EXE, {"--plan", avocado.string(), "--preset", "preview", "--sky", "1,1,1"});
+  EXPECT_EQ(plan.exit_code, 0) << plan.output;
+  EXPECT_NE(plan.output.find("the sky lights"), std::string::npos) << plan.output;
+  EXPECT_NE(plan.output.find("bake: atlas"), std::string::npos) << plan.output;
+
+  const fs::path out = fs::path(GI_BINARY_DIR) / "test_output" / "tools_test" / "avocado_sky.gibake";
+  fs::remove_all(out);
+  const ToolRun bake = run(GI_BAKE_EXE, {"--scene", avocado.string(), "--preset", "preview", "--sky", "0.8,0.9,1.0",
+                                         "--out", out.string()});
+  EXPECT_EQ(bake.exit_code, 0) << bake.output;
+  EXPECT_NE(bake.output.find("gi-bake: atlas:"), std::string::npos) << bake.output;
+  EXPECT_TRUE(fs::exists(out / "manifest.json")) << bake.output;
+}
+
+TEST(GiBake, BadSkyIsAUsageError) {
+  for (const char* sky : {"1,2", "1,-1,1", "a,b,c", "1,1,1,1"}) {
+    const ToolRun r = run(GI_BAKE_EXE, {"--plan", GI_SOURCE_DIR "/assets/cornell_box.gltf", "--sky", sky});
+    EXPECT_EQ(r.exit_code, 2) << sky << "\n" << r.output;
+    EXPECT_NE(r.output.find("--sky"), std::string::npos) << sky << "\n" << r.output;
+  }
+}
+
 // gi-bake --export-uv1: the scene with the light-atlas UVs as TEXCOORD_1, nothing baked
 // (tests/gi/light_atlas_uv_test.cpp checks they are the runtime's).
 TEST(GiBake, ExportUv1WritesTheSceneWithLightmapUvs) {

@@ -2,6 +2,7 @@
 //   gi-bake --scene assets/cornell_box.gltf --methods atlas --preset high --out out/cornell_box.gibake
 //   gi-bake --plan assets/demo_level.gltf --preset preview    # print the effect plan, bake nothing
 //   gi-bake --scene level.gltf --preset medium --export-uv1 out/level_uv1.gltf   # the lightmap UVs
+//   gi-bake --scene Avocado.glb --sky 0.8,0.9,1.0 --out out/avocado.gibake      # lit by a uniform sky
 // Without --methods it bakes what gi::plan (gi/plan.h) calls for and says what it skips;
 // the plan goes into the manifest either way. Exit codes: tools/common/tool_main.h.
 #include <engine/gltf.h>
@@ -10,7 +11,9 @@
 #include <gi/light_atlas_uv.h>
 
 #include <CLI/CLI.hpp>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <sstream>
 #include <string>
@@ -35,7 +38,7 @@ std::vector<std::string> split(const std::string& list) {
 
 int main(int argc, char** argv) {
   CLI::App app{"Bakes a scene's GI data into a bake bundle (manifest.json + one file per method)"};
-  std::string scene_path, positional_scene, out_dir, methods, export_uv1;
+  std::string scene_path, positional_scene, out_dir, methods, export_uv1, sky;
   bool plan_only = false;
   gi::BakeOptions o;
   app.add_option("--scene", scene_path, "glTF/GLB scene")->check(CLI::ExistingFile);
@@ -44,6 +47,9 @@ int main(int argc, char** argv) {
   app.add_option("--export-uv1", export_uv1,
                  "Write the scene with the light-atlas UVs of --preset/--density as TEXCOORD_1 to this .gltf/.glb "
                  "(bakes nothing unless --out is given too)");
+  app.add_option("--sky", sky,
+                 "R,G,B: a uniform sky of this radiance, W/(m^2 sr), for scenes that carry none (replaces the "
+                 "scene's gi.sky; docs/scene-format.md)");
   app.add_option("--out", out_dir, "Bundle directory (default: out/<scene>.gibake)");
   app.add_option("--methods", methods,
                  "Comma-separated methods to bake: atlas, prm, dlm, brf, antiradiance (default: what the plan calls for)");
@@ -68,6 +74,20 @@ int main(int argc, char** argv) {
 
   auto asset = engine::load_gltf(scene_path);
   if (!asset) return tools::fail(kTool, asset.error());
+  if (!sky.empty()) {
+    const std::vector<std::string> rgb = split(sky);
+    glm::vec3 radiance(0.0f);
+    bool ok = rgb.size() == 3;
+    for (std::size_t i = 0; ok && i < 3; ++i) {
+      char* end = nullptr;
+      radiance[static_cast<int>(i)] = std::strtof(rgb[i].c_str(), &end);
+      ok = end != rgb[i].c_str() && *end == '\0' && std::isfinite(radiance[static_cast<int>(i)]) &&
+           radiance[static_cast<int>(i)] >= 0.0f;
+    }
+    if (!ok) return tools::fail(kTool, "--sky wants R,G,B: three finite radiances >= 0, got '" + sky + "'",
+                                tools::kExitUsage);
+    asset->environment.sky_radiance = radiance;
+  }
   if (!export_uv1.empty()) {
     auto uv = gi::with_light_atlas_uv1(*asset, {.preset = o.preset, .texels_per_metre = o.texels_per_metre});
     if (!uv) return tools::fail(kTool, uv.error());

@@ -88,6 +88,7 @@ struct PlanFacts {
   std::map<std::uint32_t, std::vector<std::string>> dynamic_by_mesh;  // mesh -> instances
   LightPointCount points;
   StaticSurfaceCensus census;
+  bool sky = false;  // the environment's sky lights the scene (an outdoor scene)
 };
 
 PlanFacts gather_facts(const BakeInput& input, const PlanOptions& options, EffectPlan& out) {
@@ -121,6 +122,7 @@ PlanFacts gather_facts(const BakeInput& input, const PlanOptions& options, Effec
   }
   facts.static_lights = static_cast<int>(f.static_lights.size());
   facts.moving_lights = static_cast<int>(f.moving_lights.size());
+  f.sky = glm::any(glm::greaterThan(input.environment.sky_radiance, glm::vec3(0.0f)));
 
   for (std::size_t i = 0; i < input.instances.size(); ++i) {
     const BakeInstance& inst = input.instances[i];
@@ -173,7 +175,7 @@ std::optional<PlanPresets> presets(const PlanOptions& options) {
 
 // Light atlas: static light sources on static geometry.
 void plan_light_atlas(const PlanFacts& f, const std::optional<PlanPresets>& p, PlannedEffect& atlas) {
-  const std::size_t static_sources = f.static_lights.size() + f.emissive_meshes.size();
+  const std::size_t static_sources = f.static_lights.size() + f.emissive_meshes.size() + (f.sky ? 1 : 0);
   if (f.static_meshes.empty()) {
     atlas.reason = "no static mesh: nothing for a light atlas to hold";
     return;
@@ -187,12 +189,15 @@ void plan_light_atlas(const PlanFacts& f, const std::optional<PlanPresets>& p, P
   const std::string area = fixed(f.census.area_m2, 1) + " m^2";
   const std::string meshes = plural(f.static_meshes.size(), "static mesh", "static meshes");
   const std::string emitting = plural(f.emissive_meshes.size(), "emissive surface", "emissive surfaces");
-  if (f.static_lights.empty()) {
-    atlas.reason = emitting + (f.emissive_meshes.size() == 1 ? " lights " : " light ") + meshes + " (" + area + ")";
+  const std::string sky = f.sky ? "; the sky too" : "";
+  if (f.static_lights.empty() && f.emissive_meshes.empty()) {
+    atlas.reason = "the sky lights " + meshes + " (" + area + ")";
+  } else if (f.static_lights.empty()) {
+    atlas.reason = emitting + (f.emissive_meshes.size() == 1 ? " lights " : " light ") + meshes + " (" + area + sky + ")";
   } else {
     atlas.reason = plural(f.static_lights.size(), "static light", "static lights") +
                    (f.static_lights.size() == 1 ? " lights " : " light ") + meshes + " (" + area +
-                   (f.emissive_meshes.empty() ? "" : "; " + emitting + " too") + ")";
+                   (f.emissive_meshes.empty() ? "" : "; " + emitting + " too") + sky + ")";
   }
   atlas.targets = f.static_meshes;
   if (!p) return;
@@ -382,7 +387,7 @@ EffectPlan plan(const BakeInput& input, const PlanOptions& options) {
   const std::optional<PlanPresets> p = presets(options);
   if (!p) out.warnings.push_back("unknown preset '" + options.preset + "' (preview, medium, high): no estimates");
 
-  if (f.static_lights.empty() && f.moving_lights.empty() && f.emissive_meshes.empty()) {
+  if (f.static_lights.empty() && f.moving_lights.empty() && f.emissive_meshes.empty() && !f.sky) {
     const std::string why =
         out.facts.disabled_lights > 0
             ? "no light is on (" +

@@ -142,6 +142,7 @@ glm::mat4 node_world_matrix(const engine::SceneAsset& asset, int node) {
 BakeInput bake_input_from(const engine::SceneAsset& asset) {
   BakeInput in;
   in.name = asset.source;
+  in.environment.sky_radiance = asset.environment.sky_radiance;  // the sun is a light of a node
   for (const engine::Mesh& m : asset.meshes) in.meshes.push_back(mesh_from(m));
   for (const engine::Material& m : asset.materials) in.materials.push_back(material_from(m));
   const NodeChains chains = node_chains(asset);
@@ -173,6 +174,7 @@ BakeInput bake_input_from(const engine::Scene& scene) {
   const engine::Registry& reg = scene.registry;
   BakeInput in;
   in.name = scene.assets.source;
+  in.environment.sky_radiance = scene.assets.environment.sky_radiance;  // the sun is a light entity
   for (const engine::Mesh& m : scene.assets.meshes) in.meshes.push_back(mesh_from(m));
   for (const engine::Material& m : scene.assets.materials) in.materials.push_back(material_from(m));
 

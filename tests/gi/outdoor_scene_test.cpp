@@ -1,0 +1,110 @@
+// Scenes as artists deliver them: no KHR_lights_punctual, lit by a sky (the glTF scene's
+// gi.sky, or gi-bake --sky). The planner plans the light atlas for them, the bake lights it,
+// the runtime and the renderer draw it. The Avocado (Khronos sample, Draco-compressed) is
+// read from GI_EXTERNAL_ASSETS_DIR, never copied; the test skips with a message without it.
+#include <engine/components.h>
+#include <engine/gltf.h>
+#include <engine/gpu/context.h>
+#include <engine/renderer.h>
+#include <engine/scene.h>
+#include <gi/bake.h>
+#include <gi/gi_system.h>
+#include <gi/plan.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+engine::SceneAsset cornell_box_without_lamp() {
+  auto asset = engine::load_gltf(GI_SOURCE_DIR "/assets/cornell_box.gltf");
+  EXPECT_TRUE(asset) << asset.error().to_string();
+  engine::SceneAsset a = std::move(asset).value();
+  for (engine::Node& n : a.nodes) n.light = -1;
+  a.lights.clear();
+  for (engine::Material& m : a.materials) m.emissive = glm::vec3(0.0f);
+  return a;
+}
+
+}  // namespace
+
+TEST(OutdoorScene, TheSkyAloneMakesThePlannerPlanTheLightAtlas) {
+  engine::SceneAsset a = cornell_box_without_lamp();
+  const gi::EffectPlan dark = gi::plan(gi::bake_input_from(a), {.preset = "preview"});
+  EXPECT_FALSE(dark.effect(gi::EffectMethod::LightAtlas).enabled);
+  EXPECT_NE(dark.effect(gi::EffectMethod::LightAtlas).reason.find("no light"), std::string::npos);
+  a.environment.sky_radiance = glm::vec3(0.5f, 0.6f, 1.0f);
+  const gi::EffectPlan lit = gi::plan(gi::bake_input_from(a), {.preset = "preview"});
+  const gi::PlannedEffect& atlas = lit.effect(gi::EffectMethod::LightAtlas);
+  EXPECT_TRUE(atlas.enabled) << atlas.reason;
+  EXPECT_NE(atlas.reason.find("the sky lights"), std::string::npos) << atlas.reason;
+  EXPECT_EQ(lit.methods_to_bake(), std::vector<std::string>{"atlas"});
+}
+
+TEST(OutdoorScene, AvocadoUnderASkyIsBakedLoadedAndRenderedHeadless) {
+  const fs::path file = fs::path(GI_EXTERNAL_ASSETS_DIR) / "Avocado" / "glTF-Draco" / "Avocado.gltf";
+  if (!fs::exists(file)) GTEST_SKIP() << "external asset not found: " << file;
+  auto loaded = engine::load_gltf(file);
+  ASSERT_TRUE(loaded) << loaded.error().to_string();
+  engine::SceneAsset a = std::move(loaded).value();
+  ASSERT_TRUE(a.lights.empty());
+  const gi::EffectPlan unlit = gi::plan(gi::bake_input_from(a), {.preset = "preview"});
+  EXPECT_FALSE(unlit.effect(gi::EffectMethod::LightAtlas).enabled);
+  a.environment.sky_radiance = glm::vec3(1.0f);  // what gi-bake --sky 1,1,1 does
+
+  // A camera in front of it (the file has none), framing its bounds.
+  glm::vec3 lo(1e9f), hi(-1e9f);
+  for (const engine::Mesh& m : a.meshes)
+    for (const engine::Primitive& p : m.primitives)
+      for (const glm::vec3& v : p.positions) lo = glm::min(lo, v), hi = glm::max(hi, v);
+  const glm::vec3 centre = 0.5f * (lo + hi);
+  const float radius = 0.5f * glm::length(hi - lo);
+  a.cameras.push_back({"camera", engine::Camera{.yfov_rad = 0.8f, .znear_m = radius * 0.05f, .zfar_m = radius * 20.0f}});
+  engine::Node cam;
+  cam.name = "camera";
+  cam.camera = 0;
+  cam.translation = centre + glm::vec3(0.0f, 0.0f, 3.0f * radius);
+  a.nodes.push_back(cam);
+
+  const fs::path bundle = fs::path(GI_BINARY_DIR) / "test_output" / "outdoor_scene" / "avocado.gibake";
+  fs::remove_all(bundle);
+  auto baked = gi::bake_bundle(gi::bake_input_from(a), bundle, {.preset = "preview"});
+  ASSERT_TRUE(baked) << baked.error().to_string();
+  ASSERT_EQ(baked->baked.size(), 1u);
+  EXPECT_EQ(baked->baked[0].method, "atlas");
+
+  engine::Scene scene = engine::instantiate(a);
+  auto gpu = engine::GpuContext::create_headless();
+  ASSERT_TRUE(gpu) << gpu.error().to_string();
+  auto system = gi::GISystem::load(bundle, scene);
+  ASSERT_TRUE(system) << system.error().to_string();
+  auto renderer = engine::Renderer::create(scene.assets, {.width = 96, .height = 96});
+  ASSERT_TRUE(renderer) << renderer.error().to_string();
+  EXPECT_EQ((*renderer)->settings().sky_radiance, glm::vec3(1.0f));
+  (*renderer)->set_indirect_light(system->get());
+  (*renderer)->render(scene.registry, engine::find_camera(scene.registry));
+  const engine::ImageRgbaF lit = (*renderer)->read_hdr();
+
+  // The same frame without the sky's direct term: the atlas's bounce light alone.
+  (*renderer)->settings().sky_radiance = glm::vec3(0.0f);
+  (*renderer)->render(scene.registry, engine::find_camera(scene.registry));
+  const engine::ImageRgbaF bounce = (*renderer)->read_hdr();
+
+  std::size_t finite = 0, covered = 0;
+  double sum_lit = 0.0, sum_bounce = 0.0;
+  for (std::size_t i = 0; i < lit.pixels.size(); i += 4) {
+    finite += std::isfinite(lit.pixels[i]) && std::isfinite(lit.pixels[i + 1]) && std::isfinite(lit.pixels[i + 2]);
+    covered += lit.pixels[i + 1] > 0.0f;
+    sum_lit += static_cast<double>(lit.pixels[i + 1]);
+    sum_bounce += static_cast<double>(bounce.pixels[i + 1]);
+  }
+  EXPECT_EQ(finite, lit.pixels.size() / 4);
+  EXPECT_GT(covered, lit.pixels.size() / 4 / 10) << "the avocado should fill a good part of the frame";
+  EXPECT_GT(sum_bounce, 0.0) << "the baked atlas adds the sky's bounce light";
+  EXPECT_GT(sum_lit, sum_bounce) << "the sky's direct term lights it";
+  EXPECT_TRUE((*system)->stats().disabled.empty());
+  system->reset();
+}
