@@ -216,9 +216,17 @@ GameplayContext prepare_scene(engine::Scene& scene, const GameplayTuning& tuning
     reg.emplace<engine::Name>(ctx.camera, engine::Name{"camera"});
     const Aabb& b = ctx.collision.level_bounds();
     engine::Transform t;
+    engine::Camera camera;
     if (!b.empty()) t.position = glm::vec3(b.center().x, b.min.y + 1.6f, b.center().z);
+    // A single object rather than a level (a model as artists ship it, no camera): framed
+    // from +Z, its bounding sphere filling the view.
+    const float radius = b.empty() ? 0.0f : 0.5f * glm::length(b.max - b.min);
+    if (radius > 0.0f && radius < 1.0f) {
+      t.position = b.center() + glm::vec3(0.0f, 0.0f, 1.6f * radius / std::tan(0.5f * camera.yfov_rad));
+      camera.znear_m = std::min(camera.znear_m, 0.1f * radius);
+    }
     reg.emplace<engine::Transform>(ctx.camera, t);
-    reg.emplace<engine::Camera>(ctx.camera);
+    reg.emplace<engine::Camera>(ctx.camera, camera);
   }
   const glm::quat q = reg.get<engine::Transform>(ctx.camera).rotation;
   const glm::vec3 f = q * glm::vec3(0, 0, -1);

@@ -36,3 +36,23 @@ TEST(ScriptedPilot, NoneLeavesTheCameraStillTheFlashlightOffAndOneView) {
     EXPECT_EQ(sim.context().split_view, script == Script::Tour);
   }
 }
+
+// A model without a camera (the Avocado): the camera frames the object instead of standing
+// 1.6 m above its floor, so --script none shows it.
+TEST(ScriptedPilot, ASmallObjectWithoutACameraIsFramed) {
+  engine::SceneAsset a;
+  a.meshes.push_back(demo_test::box_mesh(glm::vec3(0.05f)));
+  engine::Node n;
+  n.name = "model";
+  n.mesh = 0;
+  n.translation = {0.2f, 0.05f, -0.1f};
+  a.nodes.push_back(n);
+  game_demo::Simulation sim(engine::instantiate(std::move(a)));
+  const engine::Entity camera = sim.context().camera;
+  const engine::Transform& t = sim.registry().get<engine::Transform>(camera);
+  const glm::vec3 to_model = glm::vec3(0.2f, 0.05f, -0.1f) - t.position;
+  const glm::vec3 forward = t.rotation * glm::vec3(0.0f, 0.0f, -1.0f);
+  EXPECT_GT(glm::dot(glm::normalize(to_model), forward), 0.999f) << "looking at it";
+  EXPECT_LT(glm::length(to_model), 1.0f) << "close to it";
+  EXPECT_LT(sim.registry().get<engine::Camera>(camera).znear_m, 0.01f);
+}
