@@ -97,12 +97,15 @@ TEST(OutdoorScene, AvocadoUnderASkyIsBakedLoadedAndRenderedHeadless) {
   double sum_lit = 0.0, sum_bounce = 0.0;
   for (std::size_t i = 0; i < lit.pixels.size(); i += 4) {
     finite += std::isfinite(lit.pixels[i]) && std::isfinite(lit.pixels[i + 1]) && std::isfinite(lit.pixels[i + 2]);
-    covered += lit.pixels[i + 1] > 0.0f;
+    covered += lit.pixels[i + 1] != 1.0f;  // the background shows the sky, radiance 1
     sum_lit += static_cast<double>(lit.pixels[i + 1]);
     sum_bounce += static_cast<double>(bounce.pixels[i + 1]);
   }
   EXPECT_EQ(finite, lit.pixels.size() / 4);
   EXPECT_GT(covered, lit.pixels.size() / 4 / 10) << "the avocado should fill a good part of the frame";
+  EXPECT_LT(covered, lit.pixels.size() / 4) << "the sky should show around it";
+  EXPECT_EQ(lit.pixels[1], 1.0f) << "a corner pixel sees the sky";
+  EXPECT_EQ(bounce.pixels[1], 0.0f) << "and black without one";
   EXPECT_GT(sum_bounce, 0.0) << "the baked atlas adds the sky's bounce light";
   EXPECT_GT(sum_lit, sum_bounce) << "the sky's direct term lights it";
   EXPECT_TRUE((*system)->stats().disabled.empty());

@@ -54,7 +54,8 @@ struct RenderSettings {
   /// copies it from the assets). Drawn as direct light: an ambient term without sky
   /// visibility, E = pi x radiance reflected as uniformly arriving light is, on both halves
   /// of a split view. Its shadowed share and its bounces come from the indirect provider
-  /// (a light atlas baked with the sky). docs/scene-format.md.
+  /// (a light atlas baked with the sky). Pixels no geometry covers show it (the background).
+  /// docs/scene-format.md.
   glm::vec3 sky_radiance{0.0f};
 };
 

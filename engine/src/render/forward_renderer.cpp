@@ -231,9 +231,10 @@ void ForwardRenderer::forward_pass(const Registry& registry, Entity camera, cons
 
   glBindFramebuffer(GL_FRAMEBUFFER, hdr_fbo_.id());
   glViewport(0, 0, width_, height_);
-  const float black[4] = {0.0f, 0.0f, 0.0f, 1.0f};
+  // Where no geometry is, the camera sees the sky (black without one), as the path tracer does.
+  const float background[4] = {settings_.sky_radiance.x, settings_.sky_radiance.y, settings_.sky_radiance.z, 1.0f};
   const float far_depth = 1.0f;
-  glClearNamedFramebufferfv(hdr_fbo_.id(), GL_COLOR, 0, black);
+  glClearNamedFramebufferfv(hdr_fbo_.id(), GL_COLOR, 0, background);
   glClearNamedFramebufferfv(hdr_fbo_.id(), GL_DEPTH, 0, &far_depth);
   glEnable(GL_DEPTH_TEST);
   glDisable(GL_BLEND);
