@@ -221,7 +221,7 @@ GameplayContext prepare_scene(engine::Scene& scene, const GameplayTuning& tuning
     // A single object rather than a level (a model as artists ship it, no camera): framed
     // from +Z, its bounding sphere filling the view.
     const float radius = b.empty() ? 0.0f : 0.5f * glm::length(b.max - b.min);
-    if (radius > 0.0f && radius < 1.0f) {
+    if (radius > 0.0f && radius < 2.5f) {
       t.position = b.center() + glm::vec3(0.0f, 0.0f, 1.6f * radius / std::tan(0.5f * camera.yfov_rad));
       camera.znear_m = std::min(camera.znear_m, 0.1f * radius);
     }

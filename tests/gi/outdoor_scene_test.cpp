@@ -111,3 +111,48 @@ TEST(OutdoorScene, AvocadoUnderASkyIsBakedLoadedAndRenderedHeadless) {
   EXPECT_TRUE((*system)->stats().disabled.empty());
   system->reset();
 }
+
+// A Khronos sample that ships its own KHR_lights_punctual lights and emissive textures (a
+// street lamp, no camera, no floor): planned, baked, loaded and drawn as delivered.
+TEST(OutdoorScene, KhronosLampWithItsOwnLightsIsBakedLoadedAndRenderedHeadless) {
+  const fs::path file = fs::path(GI_EXTERNAL_ASSETS_DIR) / "LightsPunctualLamp" / "glTF" / "LightsPunctualLamp.gltf";
+  if (!fs::exists(file)) GTEST_SKIP() << "external asset not found: " << file;
+  auto loaded = engine::load_gltf(file);
+  ASSERT_TRUE(loaded) << loaded.error().to_string();
+  engine::SceneAsset a = std::move(loaded).value();
+  ASSERT_FALSE(a.lights.empty());
+  const gi::EffectPlan p = gi::plan(gi::bake_input_from(a), {.preset = "preview"});
+  ASSERT_TRUE(p.effect(gi::EffectMethod::LightAtlas).enabled) << p.effect(gi::EffectMethod::LightAtlas).reason;
+  EXPECT_EQ(p.methods_to_bake(), std::vector<std::string>{"atlas"});
+  a.cameras.push_back({"camera", engine::Camera{}});
+  engine::Node cam;
+  cam.name = "camera";
+  cam.camera = 0;
+  cam.translation = {0.0f, 0.8f, 4.0f};
+  a.nodes.push_back(cam);
+
+  const fs::path bundle = fs::path(GI_BINARY_DIR) / "test_output" / "outdoor_scene" / "lamp.gibake";
+  fs::remove_all(bundle);
+  auto baked = gi::bake_bundle(gi::bake_input_from(a), bundle, {.preset = "preview"});
+  ASSERT_TRUE(baked) << baked.error().to_string();
+  engine::Scene scene = engine::instantiate(a);
+  auto gpu = engine::GpuContext::create_headless();
+  ASSERT_TRUE(gpu) << gpu.error().to_string();
+  auto system = gi::GISystem::load(bundle, scene);
+  ASSERT_TRUE(system) << system.error().to_string();
+  auto renderer = engine::Renderer::create(scene.assets, {.width = 96, .height = 96});
+  ASSERT_TRUE(renderer) << renderer.error().to_string();
+  (*renderer)->set_indirect_light(system->get());
+  (*renderer)->render(scene.registry, engine::find_camera(scene.registry));
+  const engine::ImageRgbaF img = (*renderer)->read_hdr();
+  std::size_t finite = 0, lit = 0;
+  for (std::size_t i = 0; i < img.pixels.size(); i += 4) {
+    finite += std::isfinite(img.pixels[i]) && std::isfinite(img.pixels[i + 1]) && std::isfinite(img.pixels[i + 2]);
+    lit += img.pixels[i] > 0.0f;
+  }
+  EXPECT_EQ(finite, img.pixels.size() / 4);
+  EXPECT_GT(lit, 0u);
+  EXPECT_EQ((*system)->label(), std::string("light atlas"));
+  EXPECT_TRUE((*system)->stats().disabled.empty());
+  system->reset();
+}
