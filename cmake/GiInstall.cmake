@@ -21,12 +21,18 @@ set(GI_INSTALL_CMAKEDIR ${CMAKE_INSTALL_LIBDIR}/cmake/gi)
 # gi_sweep's public header is gi/sweep.h; the installed target finds it under include/.
 set_property(TARGET gi_sweep APPEND PROPERTY INTERFACE_INCLUDE_DIRECTORIES "$<INSTALL_INTERFACE:include>")
 
-set(_gi_export_targets
-    engine gi gi_sweep
-    gi_core gi_raytrace gi_transport gi_light_atlas gi_prm gi_brf gi_dlm gi_antiradiance
-    # Link-only INTERFACE helpers every project target names (no compile options reach a
-    # consumer through LINK_ONLY; a sanitizer build's link options do, as they must).
-    gi_warnings gi_sanitize)
+# Every target gi_layer() made (gi/CMakeLists.txt records "<target>:<folder>"), so a new
+# method's gi_<method> is installed and exported without an edit here.
+get_property(_gi_layer_folders GLOBAL PROPERTY GI_LAYER_FOLDERS)
+set(_gi_export_targets engine)
+foreach(_entry ${_gi_layer_folders})
+  string(REGEX REPLACE ":.*$" "" _target "${_entry}")
+  list(APPEND _gi_export_targets ${_target})
+endforeach()
+list(REMOVE_DUPLICATES _gi_export_targets)
+# Link-only INTERFACE helpers every project target names (no compile options reach a
+# consumer through LINK_ONLY; a sanitizer build's link options do, as they must).
+list(APPEND _gi_export_targets gi_warnings gi_sanitize)
 if(TARGET gi_draco)
   list(APPEND _gi_export_targets gi_draco)
 endif()
