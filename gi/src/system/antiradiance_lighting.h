@@ -21,18 +21,15 @@
 
 #include "antiradiance/antiradiance_gpu_pass.h"
 #include "antiradiance/antiradiance_region.h"
+#include "antiradiance/antiradiance_texel_blend.h"
 #include "uv/atlas_layout.h"
 
 namespace gi {
 
 class AntiradianceLighting {
  public:
-  /// One covered atlas texel: its leaves and blend weights (std430 TexelBlend of the shader).
-  struct TexelBlendHost {
-    std::uint32_t texel = 0, pad0 = 0, pad1 = 0, pad2 = 0;
-    glm::ivec4 leaves{-1};
-    glm::vec4 weights{0.0f};
-  };
+  /// One covered atlas texel: its leaves and blend weights (antiradiance_texel_blend.h).
+  using TexelBlendHost = AntiradianceTexelBlend;
   struct Stats {
     std::uint64_t updates = 0;            ///< Frames on which a deforming instance moved.
     std::size_t relinked_elements = 0;    ///< Last update: elements whose links were rebuilt.

@@ -1,0 +1,70 @@
+#include "antiradiance/antiradiance_texel_blend.h"
+
+#include <algorithm>
+#include <array>
+#include <limits>
+
+#include "uv/atlas_input.h"
+#include "uv/atlas_rasterizer.h"
+
+namespace gi {
+
+std::vector<AntiradianceTexelBlend> antiradiance_texel_blends(const ElementHierarchy& h, const BakeInput& input, const AtlasLayout& layout) {
+  const std::vector<AtlasInputMesh> inputs = atlas_inputs_from(input);
+  const AtlasTexels texels = rasterize_atlas(layout, inputs);
+  std::vector<std::int32_t> static_instance;  // atlas input mesh -> BakeInput instance
+  for (std::size_t i = 0; i < input.instances.size(); ++i)
+    if (input.instances[i].mobility == BakeMobility::Static) static_instance.push_back(static_cast<std::int32_t>(i));
+  std::vector<std::vector<std::int32_t>> leaves_of(input.instances.size());
+  for (std::size_t l = 0; l < h.leaf_count(); ++l) {
+    const std::int32_t inst = h.node_instance[static_cast<std::size_t>(h.leaves[l])];
+    if (inst >= 0 && static_cast<std::size_t>(inst) < leaves_of.size())
+      leaves_of[static_cast<std::size_t>(inst)].push_back(static_cast<std::int32_t>(l));
+  }
+  std::vector<AntiradianceTexelBlend> out;
+  for (std::size_t t = 0; t < texels.valid.size(); ++t) {
+    if (texels.valid[t] == 0 || texels.mesh[t] < 0 || static_cast<std::size_t>(texels.mesh[t]) >= static_instance.size())
+      continue;
+    const auto inst = static_cast<std::size_t>(static_instance[static_cast<std::size_t>(texels.mesh[t])]);
+    const std::vector<std::int32_t>& candidates = leaves_of[inst];
+    if (candidates.empty()) continue;
+    std::array<std::pair<float, std::int32_t>, 4> best;
+    best.fill({std::numeric_limits<float>::infinity(), -1});
+    for (std::int32_t l : candidates) {
+      const ElementNode& n = h.nodes[static_cast<std::size_t>(h.leaves[static_cast<std::size_t>(l)])];
+      if (glm::dot(n.normal, texels.normal[t]) < 0.7f) continue;
+      const glm::vec3 d = texels.position[t] - n.center;
+      const float d2 = glm::dot(d, d);
+      if (d2 >= best[3].first) continue;
+      best[3] = {d2, l};
+      std::sort(best.begin(), best.end());
+    }
+    if (best[0].second < 0) continue;
+    AntiradianceTexelBlend b;
+    b.texel = static_cast<std::uint32_t>(t);
+    float total = 0.0f;
+    for (int k = 0; k < 4; ++k) {
+      if (best[static_cast<std::size_t>(k)].second < 0) continue;
+      const ElementNode& n =
+          h.nodes[static_cast<std::size_t>(h.leaves[static_cast<std::size_t>(best[static_cast<std::size_t>(k)].second)])];
+      const float w = 1.0f / (best[static_cast<std::size_t>(k)].first + 0.25f * n.radius_m * n.radius_m);
+      b.leaves[k] = best[static_cast<std::size_t>(k)].second;
+      b.weights[k] = w;
+      total += w;
+    }
+    b.weights /= total;
+    out.push_back(b);
+  }
+  return out;
+}
+
+glm::vec3 blend_leaves(const AntiradianceTexelBlend& b, std::span<const glm::vec3> per_leaf) {
+  glm::vec3 e(0.0f);
+  for (int k = 0; k < 4; ++k) {
+    const int l = b.leaves[k];
+    if (l >= 0 && static_cast<std::size_t>(l) < per_leaf.size()) e += b.weights[k] * per_leaf[static_cast<std::size_t>(l)];
+  }
+  return e;
+}
+
+}  // namespace gi
