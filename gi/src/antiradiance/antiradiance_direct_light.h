@@ -34,13 +34,36 @@ class AntiradianceDirectLight {
   /// Direct irradiance (W/m^2) at every leaf of `h`, in leaf order. Deterministic (each leaf
   /// on its own, any thread count).
   std::vector<glm::vec3> irradiance(const ElementHierarchy& h);
+  /// The same values, recomputing only what a motion since the last irradiance() or update()
+  /// can change: the leaves of deforming instances, and the static leaves with a shadow ray
+  /// (to any emitter) through a moved instance's bounds before or after its motion (1 cm
+  /// margin). The others keep their last value, which a full computation would reproduce bit
+  /// for bit (each leaf is computed on its own). The first call (or one for a hierarchy of
+  /// another leaf count) computes every leaf. Precondition: `h` is the hierarchy of the
+  /// previous calls, its static leaves unmoved.
+  const std::vector<glm::vec3>& update(const ElementHierarchy& h);
+  /// Leaves the last irradiance() or update() computed.
+  std::size_t last_recomputed() const { return last_recomputed_; }
 
   std::size_t emitter_count() const { return emitters_.size(); }
 
  private:
+  struct Box {
+    glm::vec3 lo, hi;
+  };
+  /// The world bounds of deforming instance `instance` at `m`.
+  Box world_bounds(std::uint32_t instance, const glm::mat4& m) const;
+  /// The leaves' values into `out` for the leaves where `todo` is 1 (all when empty).
+  void compute(const ElementHierarchy& h, const std::vector<char>& todo, std::vector<glm::vec3>& out) const;
+
   std::vector<PointEmitter> emitters_;
   std::unique_ptr<RayCaster> caster_;
   std::vector<char> deforming_;
+  std::vector<Box> object_bounds_;     ///< Per BakeInput instance (deforming ones only meaningful).
+  std::vector<glm::mat4> transform_;   ///< Per BakeInput instance: its current transform.
+  std::vector<Box> swept_;             ///< Moved instances' bounds, before and after, since the last update.
+  std::vector<glm::vec3> last_;
+  std::size_t last_recomputed_ = 0;
   bool dirty_ = false;
 };
 

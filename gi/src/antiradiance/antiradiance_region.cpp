@@ -101,7 +101,8 @@ AntiradianceSolveReport AntiradianceRegion::update(bool solve) {
     counters_.moved_groups = moved_.size();
     counters_.relinked_elements = links_->relinked_elements;
     counters_.links_made = links_->links_made;
-    direct_ = direct_light_->irradiance(*hierarchy_);
+    direct_ = direct_light_->update(*hierarchy_);  // only the leaves the motion can change
+    counters_.direct_leaves = direct_light_->last_recomputed();
     moved_.clear();
   }
   counters_.links = links_->links.size();

@@ -56,6 +56,7 @@ struct AntiradianceUpdateCounters {
   std::size_t relinked_elements = 0;  ///< Elements whose links were rebuilt.
   std::size_t links_made = 0;         ///< Links built by the relink.
   std::size_t links = 0;              ///< Links in all after it.
+  std::size_t direct_leaves = 0;      ///< Leaves whose direct light was recomputed (the others cannot change).
 };
 
 class AntiradianceRegion {

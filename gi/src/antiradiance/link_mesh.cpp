@@ -115,14 +115,22 @@ struct Linker {
   }
 };
 
-void sort_and_index(const ElementHierarchy& h, LinkMesh& mesh) {
-  std::sort(mesh.links.begin(), mesh.links.end(), [](const Link& x, const Link& y) {
-    if (x.receiver != y.receiver) return x.receiver < y.receiver;
-    return x.bin != y.bin ? x.bin < y.bin : x.sender < y.sender;
-  });
+// (receiver, bin, sender): a total order, since refinement links a pair once and a pair's
+// links differ in their bins.
+bool link_less(const Link& x, const Link& y) {
+  if (x.receiver != y.receiver) return x.receiver < y.receiver;
+  return x.bin != y.bin ? x.bin < y.bin : x.sender < y.sender;
+}
+
+void index_links(const ElementHierarchy& h, LinkMesh& mesh) {
   mesh.offsets.assign(h.nodes.size() + 1, 0u);
   for (const Link& l : mesh.links) ++mesh.offsets[static_cast<std::size_t>(l.receiver) + 1];
   for (std::size_t i = 1; i < mesh.offsets.size(); ++i) mesh.offsets[i] += mesh.offsets[i - 1];
+}
+
+void sort_and_index(const ElementHierarchy& h, LinkMesh& mesh) {
+  std::sort(mesh.links.begin(), mesh.links.end(), link_less);
+  index_links(h, mesh);
 }
 
 float threshold(const DirectionalBins& bins, const AntiradianceSettings& s) {
@@ -183,7 +191,12 @@ void relink_moved(const ElementHierarchy& h, const DirectionalBins& bins, const 
       mesh.relinked_elements += static_cast<std::size_t>(h.nodes[static_cast<std::size_t>(r)].end - r);
     }
   mesh.links_made = mesh.links.size() - kept;
-  sort_and_index(h, mesh);
+  // The kept links are still sorted (erase_if keeps their order): sort only the new ones and
+  // merge (the same order a full sort gives, the order being total), instead of sorting all.
+  std::sort(mesh.links.begin() + static_cast<std::ptrdiff_t>(kept), mesh.links.end(), link_less);
+  std::inplace_merge(mesh.links.begin(), mesh.links.begin() + static_cast<std::ptrdiff_t>(kept), mesh.links.end(),
+                     link_less);
+  index_links(h, mesh);
 }
 
 }  // namespace gi
