@@ -1,5 +1,6 @@
 #include "sweep/builtin_methods.h"
 
+#include "sweep/antiradiance_sweep.h"
 #include "sweep/brf_sweep.h"
 #include "sweep/dlm_sweep.h"
 #include "sweep/light_atlas_sweep.h"
@@ -16,6 +17,7 @@ void register_builtin_sweep_methods(SweepRegistry& registry) {
   register_prm_sweep(registry);
   register_brf_sweep(registry);
   register_dlm_sweep(registry);
+  register_antiradiance_sweep(registry);
   //
   // GI METHODS (light atlas, PRM, DLM, BRF, antiradiance) register here as they land, one
   // add_method per method, with every quality knob declared (DESIGN.md 3, "Accuracy and its

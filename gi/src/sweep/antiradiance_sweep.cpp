@@ -1,0 +1,377 @@
+#include "sweep/antiradiance_sweep.h"
+
+#include <GL/glcorearb.h>
+
+#include <engine/gpu/context.h>
+#include <gi/error_metrics.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "antiradiance/antiradiance_gpu_pass.h"
+#include "antiradiance/antiradiance_io.h"
+#include "antiradiance/antiradiance_region.h"
+#include "antiradiance/antiradiance_texel_blend.h"
+#include "raytrace/atlas_reference.h"
+#include "uv/atlas_input.h"
+#include "uv/atlas_layout.h"
+#include "uv/atlas_rasterizer.h"
+
+namespace gi {
+namespace {
+
+// Other random streams than any bake's (see reference_sweep.cpp). The same for every pose,
+// so a texel's paths that never meet the door are the same in every pose.
+constexpr std::uint64_t kReferenceSeed = 0x616e746972616469ULL;
+
+// Swings about the door's local Y from its authored (baked) pose, degrees. The corridor's
+// door is authored at 50 degrees open: 0 (shut), 25 and 100.
+constexpr float kSwings[] = {-50.0f, -25.0f, 50.0f};
+constexpr const char* kSwingsKey = "-50+-25+50";
+constexpr std::size_t kPoses = 1 + std::size(kSwings);
+
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+// The scene at the baked pose, its atlas and the compared texels.
+struct DoorSetup {
+  BakeInput input;
+  std::uint32_t door = 0;
+  glm::mat4 authored{1.0f};
+  AtlasLayout layout;
+  AtlasTexels texels;
+  std::vector<std::uint8_t> mask;  // per texel: compared
+  std::size_t compared = 0;
+
+  glm::mat4 pose(float swing_deg) const {
+    return authored * glm::rotate(glm::mat4(1.0f), glm::radians(swing_deg), glm::vec3(0.0f, 1.0f, 0.0f));
+  }
+  BakeInput posed(float swing_deg) const {
+    BakeInput in = input;
+    in.instances[door].object_to_world = pose(swing_deg);
+    return in;
+  }
+};
+
+engine::Result<DoorSetup> door_setup(const SweepScene& scene, double density, double radius) {
+  DoorSetup d;
+  d.input = bake_input_from(scene.asset);
+  bool found = false;
+  for (std::size_t i = 0; i < d.input.instances.size() && !found; ++i)
+    if (d.input.instances[i].deforming) {
+      d.door = static_cast<std::uint32_t>(i);
+      found = true;
+    }
+  if (!found) return engine::Error{.message = "the scene has no deforming instance (gi.region \"deforming\")"};
+  d.authored = d.input.instances[d.door].object_to_world;
+  const std::vector<AtlasInputMesh> inputs = atlas_inputs_from(d.input);
+  auto layout = build_atlas_layout(inputs, {.texels_per_metre = static_cast<float>(density)});
+  if (!layout) return layout.error();
+  d.layout = std::move(layout).value();
+  d.texels = rasterize_atlas(d.layout, inputs);
+  // The door's swept bounds over the baked pose and every swing.
+  glm::vec3 lo(std::numeric_limits<float>::infinity()), hi(-lo);
+  const BakeMesh& mesh = d.input.meshes[d.input.instances[d.door].mesh];
+  for (float swing : {0.0f, kSwings[0], kSwings[1], kSwings[2]}) {
+    const glm::mat4 m = d.pose(swing);
+    for (const BakePrimitive& p : mesh.primitives)
+      for (const glm::vec3& v : p.positions) {
+        const glm::vec3 w(m * glm::vec4(v, 1.0f));
+        lo = glm::min(lo, w);
+        hi = glm::max(hi, w);
+      }
+  }
+  std::vector<std::int32_t> static_instance;  // atlas input mesh -> BakeInput instance
+  for (std::size_t i = 0; i < d.input.instances.size(); ++i)
+    if (d.input.instances[i].mobility == BakeMobility::Static) static_instance.push_back(static_cast<std::int32_t>(i));
+  d.mask.assign(d.texels.valid.size(), 0);
+  for (std::size_t t = 0; t < d.texels.valid.size(); ++t) {
+    if (!d.texels.valid[t] || d.texels.mesh[t] < 0 || static_cast<std::size_t>(d.texels.mesh[t]) >= static_instance.size())
+      continue;
+    const auto inst = static_cast<std::size_t>(static_instance[static_cast<std::size_t>(d.texels.mesh[t])]);
+    if (d.input.instances[inst].deforming) continue;
+    const glm::vec3 p = d.texels.position[t];
+    const glm::vec3 outside = glm::max(glm::max(lo - p, p - hi), glm::vec3(0.0f));
+    if (glm::length(outside) > static_cast<float>(radius)) continue;
+    d.mask[t] = 1;
+    ++d.compared;
+  }
+  if (d.compared == 0) return engine::Error{.message = "no static atlas texel lies within the radius of the door"};
+  return d;
+}
+
+engine::Result<RgbField> door_reference(const ReferenceJob& job) {
+  const ReferenceRequest& r = job.request;
+  if (r.param("swings") != kSwingsKey) return engine::Error{"<sweep>", r.key(), "unknown swings"};
+  auto d = door_setup(job.scene, std::stod(r.param("texels_per_m")), std::stod(r.param("radius")));
+  if (!d) return engine::Error{"<sweep>", r.key(), d.error().message};
+  AtlasTexels masked = d->texels;
+  masked.valid = d->mask;
+  const std::size_t n = masked.valid.size();
+  std::vector<glm::vec3> values(n * kPoses, glm::vec3(0.0f));
+  std::vector<std::uint8_t> valid(n * kPoses, 0);
+  for (std::size_t k = 0; k < kPoses; ++k) {
+    ReferenceSettings rs;
+    rs.samples_per_pixel = std::stoi(r.param("spp"));
+    rs.seed = kReferenceSeed;
+    rs.threads = job.threads;
+    const ProgressFn& outer = job.progress;
+    rs.progress = [&outer, k](double f) {
+      return !outer || outer((static_cast<double>(k) + f) / static_cast<double>(kPoses));
+    };
+    auto truth = reference_atlas_irradiance(d->posed(k == 0 ? 0.0f : kSwings[k - 1]), masked, rs);
+    if (!truth) return truth.error();
+    for (std::size_t t = 0; t < n; ++t)
+      if (d->mask[t]) {
+        values[k * n + t] = truth->indirect[t];
+        valid[k * n + t] = 1;
+      }
+  }
+  return RgbField::from_texels(d->texels.width, d->texels.height * static_cast<int>(kPoses), values, std::move(valid));
+}
+
+// The shared headless GL context of the GPU timings (nullptr when none can be made).
+const engine::GpuContext* gl_context() {
+  static std::optional<engine::GpuContext> ctx = []() -> std::optional<engine::GpuContext> {
+    auto c = engine::GpuContext::create_headless();
+    if (!c) return std::nullopt;
+    return std::move(c).value();
+  }();
+  return ctx ? &*ctx : nullptr;
+}
+
+glm::vec3 ref_at(const RgbField& f, std::size_t i) { return {f.rgb[3 * i], f.rgb[3 * i + 1], f.rgb[3 * i + 2]}; }
+
+}  // namespace
+
+void register_antiradiance_sweep(SweepRegistry& registry) {
+  registry.add_reference_provider({.kind = "atlas_indirect_irradiance_door", .version = "pt-1", .compute = door_reference});
+
+  SweepMethod m;
+  m.name = "antiradiance";
+  m.description =
+      "antiradiance (Dachsbacher 2007): element size x bins x iterations vs the path-traced change of indirect "
+      "irradiance when the deforming node swings -50, -25, +50 degrees from its baked pose";
+  m.knobs = {
+      {.name = "patch",
+       .description = "leaf element size: longest triangle-piece edge, metres (sets the hierarchy's depth)",
+       .kind = KnobKind::Real,
+       .default_grid = {"0.4", "0.6", "0.8"},
+       .min_value = 0.05,
+       .max_value = 10},
+      {.name = "bins",
+       .description = "octahedral bins per side (n x n directional bins)",
+       .kind = KnobKind::Integer,
+       .default_grid = {"6", "8", "11"},
+       .min_value = 1,
+       .max_value = 64},
+      {.name = "iterations",
+       .description = "iterations (global + push + local + pull each; asymmetric: radiance steps)",
+       .kind = KnobKind::Integer,
+       .default_grid = {"2", "4", "8"},
+       .min_value = 1,
+       .max_value = 256},
+      {.name = "scheme",
+       .description = "iteration of the paper's 2.2 (asymmetric: 4 antiradiance steps per radiance step)",
+       .kind = KnobKind::Choice,
+       .default_grid = {"symmetric"},
+       .choices = {"symmetric", "asymmetric"}},
+      {.name = "oracle",
+       .description = "link oracle scale (x the smallest bin solid angle; 1: the paper's rule)",
+       .kind = KnobKind::Real,
+       .default_grid = {"1"},
+       .min_value = 0.01,
+       .max_value = 100},
+      {.name = "gpu",
+       .description = "also time the door move with the GPU passes (compute shaders; headless GL)",
+       .kind = KnobKind::Choice,
+       .default_grid = {"on"},
+       .choices = {"on", "off"}},
+      {.name = "density",
+       .description = "atlas texels per metre where the change is compared",
+       .kind = KnobKind::Real,
+       .default_grid = {"8"},
+       .min_value = 0.01,
+       .max_value = 1e4},
+      {.name = "radius",
+       .description = "compared texels lie within this many metres of the door's swept bounds",
+       .kind = KnobKind::Real,
+       .default_grid = {"1"},
+       .min_value = 0,
+       .max_value = 1e4},
+      {.name = "ref_spp",
+       .description = "samples per texel and pose of the path-traced reference",
+       .kind = KnobKind::Integer,
+       .default_grid = {"4096"},
+       .min_value = 1,
+       .max_value = 1 << 20},
+  };
+  m.reference_for = [](const SweepScene&, const KnobSetting& k) {
+    ReferenceRequest r;
+    r.kind = "atlas_indirect_irradiance_door";
+    r.params = {{"texels_per_m", k.text("density")},
+                {"radius", k.text("radius")},
+                {"spp", std::to_string(k.integer("ref_spp"))},
+                {"swings", kSwingsKey}};
+    return r;
+  };
+  m.run = [](const RunContext& ctx) -> engine::Result<MethodOutput> {
+    auto d = door_setup(ctx.scene, ctx.knobs.real("density"), ctx.knobs.real("radius"));
+    if (!d) return d.error();
+    const std::size_t n = d->texels.valid.size();
+    if (ctx.reference.width != d->texels.width || ctx.reference.height != d->texels.height * static_cast<int>(kPoses))
+      return engine::Error{.message = "the atlas size differs from the reference's"};
+    AntiradianceSettings s;
+    s.patch_size_m = static_cast<float>(ctx.knobs.real("patch"));
+    s.bins_per_side = static_cast<int>(ctx.knobs.integer("bins"));
+    s.iterations = static_cast<int>(ctx.knobs.integer("iterations"));
+    s.scheme = ctx.knobs.text("scheme") == "asymmetric" ? AntiradianceScheme::Asymmetric : AntiradianceScheme::Symmetric;
+    s.oracle_scale = static_cast<float>(ctx.knobs.real("oracle"));
+    s.seed = ctx.seed;
+
+    const auto t_bake = Clock::now();
+    auto bake = bake_antiradiance(d->input, s);
+    if (!bake) return bake.error();
+    MethodOutput out;
+    out.costs.bake_seconds = ms_since(t_bake) / 1000.0;
+    if (ctx.progress && !ctx.progress(0.3)) return engine::cancelled_error("antiradiance run");
+    // What the bundle stores: antiradiance.bin as gi-bake writes it.
+    {
+      const std::filesystem::path file = std::filesystem::temp_directory_path() /
+                                         ("gi-sweep-antiradiance-" + std::to_string(ctx.seed) + "-" +
+                                          std::to_string(reinterpret_cast<std::uintptr_t>(&out)) + ".bin");
+      if (engine::Status st = write_antiradiance(file, *bake, "sweep"); !st) return st.error();
+      std::error_code ec;
+      out.costs.bytes = static_cast<std::uint64_t>(std::filesystem::file_size(file, ec));
+      std::filesystem::remove(file, ec);
+    }
+    auto region = AntiradianceRegion::create(d->input, std::move(bake).value());
+    if (!region) return region.error();
+    const std::vector<AntiradianceTexelBlend> blends = antiradiance_texel_blends(region->hierarchy(), d->input, d->layout);
+
+    // Each door move on the CPU twin: relink + direct light (update(false)), then the solve.
+    std::vector<glm::vec3> values(n * kPoses, glm::vec3(0.0f));
+    std::vector<std::uint8_t> valid(n * kPoses, 0);
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    double move_ms = 0.0, solve_ms = 0.0;
+    double so = 0.0, sr = 0.0, soo = 0.0, srr = 0.0, sor = 0.0, samples = 0.0;  // change correlation
+    double level = 0.0;  // mean |E_ref(baked)| per channel over the compared texels
+    for (std::size_t t = 0; t < n; ++t)
+      if (d->mask[t]) {
+        const glm::vec3 e = ref_at(ctx.reference, t);
+        level += static_cast<double>(e.x + e.y + e.z);
+      }
+    level /= 3.0 * static_cast<double>(d->compared);
+    std::vector<std::pair<std::string, double>> per_angle;
+    for (std::size_t k = 1; k < kPoses; ++k) {
+      region->set_instance_transform(d->door, d->pose(kSwings[k - 1]));
+      const auto t0 = Clock::now();
+      region->update(false);
+      move_ms += ms_since(t0);
+      const auto t1 = Clock::now();
+      const AntiradianceSolveReport rep = region->update(true);  // nothing moved since: the solve only
+      solve_ms += ms_since(t1);
+      (void)rep;
+      const std::vector<glm::vec3> delta = region->delta(region->irradiance());
+      std::vector<glm::vec3> dt(n, glm::vec3(0.0f));
+      for (const AntiradianceTexelBlend& b : blends) dt[b.texel] = blend_leaves(b, delta);
+      double err2 = 0.0, change2 = 0.0, mean_o = 0.0, mean_r = 0.0;
+      for (std::size_t t = 0; t < n; ++t) {
+        if (!d->mask[t]) continue;
+        const glm::vec3 base = ref_at(ctx.reference, t);
+        values[k * n + t] = base + dt[t];
+        valid[k * n + t] = 1;
+        const glm::vec3 e = dt[t] - (ref_at(ctx.reference, k * n + t) - base);
+        err2 += static_cast<double>(glm::dot(e, e));
+        const glm::vec3 c = ref_at(ctx.reference, k * n + t) - base;
+        change2 += static_cast<double>(glm::dot(c, c));
+        for (int ch = 0; ch < 3; ++ch) {
+          const double o = static_cast<double>(dt[t][ch]), r = static_cast<double>(c[ch]);
+          mean_o += o, mean_r += r;
+          so += o, sr += r, soo += o * o, srr += r * r, sor += o * r, samples += 1.0;
+        }
+      }
+      const double nrmse = std::sqrt(err2 / (3.0 * static_cast<double>(d->compared))) / level;
+      const int swing = static_cast<int>(kSwings[k - 1]);
+      const std::string name = std::string(swing < 0 ? "m" : "p") + std::to_string(std::abs(swing));
+      per_angle.emplace_back("change_nrmse_swing_" + name, nrmse);
+      // What leaving the baked atlas unchanged scores by the same measure: the true change.
+      per_angle.emplace_back("nothing_nrmse_swing_" + name,
+                             std::sqrt(change2 / (3.0 * static_cast<double>(d->compared))) / level);
+      // The mean over the compared texels (zone averages, as the corridor test compares them):
+      // the true mean change and the error of the method's, both / level.
+      const double count = 3.0 * static_cast<double>(d->compared);
+      per_angle.emplace_back("true_mean_change_swing_" + name, mean_r / count / level);
+      per_angle.emplace_back("mean_change_error_swing_" + name, (mean_o - mean_r) / count / level);
+      if (ctx.progress && !ctx.progress(0.3 + 0.5 * static_cast<double>(k) / static_cast<double>(kPoses - 1)))
+        return engine::cancelled_error("antiradiance run");
+    }
+    const double moves = static_cast<double>(kPoses - 1);
+    out.costs.frame_ms = (move_ms + solve_ms) / moves;
+    out.field = RgbField::from_texels(d->texels.width, d->texels.height * static_cast<int>(kPoses), values, std::move(valid));
+
+    // What changing nothing scores (the baked atlas left as it is) on the same texels.
+    RgbField nothing = out.field;
+    for (std::size_t k = 1; k < kPoses; ++k)
+      for (std::size_t t = 0; t < n; ++t)
+        if (d->mask[t])
+          for (int c = 0; c < 3; ++c) nothing.rgb[3 * (k * n + t) + static_cast<std::size_t>(c)] = ctx.reference.rgb[3 * t + static_cast<std::size_t>(c)];
+
+    double gpu_ms = nan, gpu_bytes = nan, gpu_cpu_diff = nan;
+    if (ctx.knobs.text("gpu") == "on") {
+      if (const engine::GpuContext* gl = gl_context()) {
+        gl->make_current();
+        auto gpu = AntiradianceGpuPass::create(region->hierarchy(), region->bins(), region->links());
+        if (gpu) {
+        // The runtime's door move (AntiradianceLighting::update): relink + direct light on
+        // the CPU, link upload, the iteration, the result read back; back to the first swing.
+        region->set_instance_transform(d->door, d->pose(kSwings[0]));
+        const auto t0 = Clock::now();
+        region->update(false);
+        if (engine::Status st = gpu->set_links(region->links()); !st) return st.error();
+        const AntiradianceSolveReport rep = run_antiradiance(*gpu, region->direct(), region->settings(), region->hierarchy());
+        std::vector<glm::vec3> e = gpu->irradiance();
+        glFinish();
+        gpu_ms = ms_since(t0);
+        gpu_bytes = static_cast<double>(gpu->gpu_bytes());
+        region->update(true);
+        const std::vector<glm::vec3> cpu = region->irradiance();
+        double diff = 0.0, scale = 0.0;
+        for (std::size_t l = 0; l < e.size() && l < cpu.size(); ++l) {
+          diff = std::max(diff, static_cast<double>(glm::length(rep.output_scale * e[l] - cpu[l])));
+          scale = std::max(scale, static_cast<double>(glm::length(cpu[l])));
+        }
+        gpu_cpu_diff = scale > 0.0 ? diff / scale : 0.0;
+        }  // else: above the SSBO limit (or no compute shaders): the GPU columns stay empty
+      }
+    }
+    const double cov = sor - so * sr / samples, var_o = soo - so * so / samples, var_r = srr - sr * sr / samples;
+    out.extras = {{"nothing_rel_rmse", compare_rgb(nothing, ctx.reference).rel_rmse},
+                  {"change_correlation", var_o > 0.0 && var_r > 0.0 ? cov / std::sqrt(var_o * var_r) : nan},
+                  {"change_fit_scale", soo > 0.0 ? sor / soo : nan}};
+    out.extras.insert(out.extras.end(), per_angle.begin(), per_angle.end());
+    out.extras.insert(out.extras.end(),
+                      {{"cpu_move_ms", move_ms / moves},
+                       {"cpu_solve_ms", solve_ms / moves},
+                       {"gpu_frame_ms", gpu_ms},
+                       {"gpu_bytes", gpu_bytes},
+                       {"gpu_cpu_rel_diff", gpu_cpu_diff},
+                       {"elements", static_cast<double>(region->hierarchy().nodes.size())},
+                       {"leaves", static_cast<double>(region->hierarchy().leaf_count())},
+                       {"links", static_cast<double>(region->links().links.size())},
+                       {"compared_texels", static_cast<double>(d->compared)},
+                       {"level", level}});
+    return out;
+  };
+  registry.add_method(std::move(m));
+}
+
+}  // namespace gi
