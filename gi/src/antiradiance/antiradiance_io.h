@@ -5,7 +5,8 @@
 //   auto bake = gi::load_antiradiance("level.gibake", input);   // checks the geometry hash
 //
 // Files (DESIGN.md §5, docs/bake-bundle.md):
-//   antiradiance.bin  the checksummed container of io/blob_file.h, magic "GIANTIRA", version 1.
+//   antiradiance.bin  the checksummed container of io/blob_file.h, magic "GIANTIRA", version 2
+//                     (version 1 stored the links as 16-byte records: 2.5-3x larger; re-bake).
 //   manifest.json     methods.antiradiance = {
 //     "files":    { "elements": {"file": "antiradiance.bin", "xxh3_64": "<hex of the whole file>"} },
 //     "settings": { AntiradianceSettings' fields }, "elements", "leaves", "static_links",
@@ -27,8 +28,12 @@
 //                                          child_count, leaf_begin, leaf_end, group, end (int32s)
 //   array<int32>  children, leaves, group_root, node_instance
 //   array<vec3>   object_center, object_normal;  array<float32> object_radius, object_area
-//   array<link>   static_links             receiver, sender, bin (int32), form_factor (float32),
-//                                          sorted by (receiver, bin, sender)
+//   uint64        link_count               the static links, sorted by (receiver, bin, sender)
+//   array<uint8>  link_frame               one zstd frame of link_count x 14 bytes, lossless planes:
+//                                          receiver - previous receiver (uint32), bin (uint16),
+//                                          sender - previous sender within a (receiver, bin) run
+//                                          else sender (uint32), then the form factor's float32
+//                                          bits as four byte planes (low byte first)
 //   array<vec3>   baseline                 one per leaf
 // Nothing follows (trailing bytes are an error). The reader checks every index against the
 // arrays it points into, every value for NaN/infinity, and the sizes against each other.
@@ -48,7 +53,7 @@ namespace gi {
 inline constexpr const char* kAntiradianceMethod = "antiradiance";
 inline constexpr const char* kAntiradianceFile = "antiradiance.bin";
 inline constexpr BlobMagic kAntiradianceMagic{"GIANTIRA"};
-inline constexpr std::uint32_t kAntiradianceVersion = 1;
+inline constexpr std::uint32_t kAntiradianceVersion = 2;
 
 /// What antiradiance.bin holds.
 struct AntiradianceFile {
