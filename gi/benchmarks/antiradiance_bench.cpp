@@ -8,8 +8,12 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include <algorithm>
+#include <vector>
+
 #include "antiradiance/antiradiance_gpu_pass.h"
 #include "antiradiance/antiradiance_region.h"
+#include "antiradiance/antiradiance_solver.h"
 #include "bench_gl.h"
 
 namespace {
@@ -102,6 +106,67 @@ void BM_AntiradianceIterationCpu(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_AntiradianceIterationCpu)->Unit(benchmark::kMillisecond)->Iterations(5);
+
+// A whole frame where the door moved, as the runtime runs it (AntiradianceLighting::update):
+// relink + direct light on the CPU, link upload, the iteration on the GPU (the settings'
+// iterations), the result read back. Arg: iterations.
+void BM_AntiradianceDoorMoveGpu(benchmark::State& state) {
+  (void)bench::gl_context();
+  Corridor& c = corridor();
+  gi::AntiradianceSettings s = c.region->settings();
+  s.iterations = static_cast<int>(state.range(0));
+  auto gpu = gi::AntiradianceGpuPass::create(c.region->hierarchy(), c.region->bins(), c.region->links()).value();
+  float angle = 50.0f;
+  for (auto _ : state) {
+    angle = angle > 100.0f ? 10.0f : angle + 7.0f;
+    c.region->set_instance_transform(c.door_instance, door(angle));
+    c.region->update(false);
+    (void)gpu.set_links(c.region->links());
+    (void)gi::run_antiradiance(gpu, c.region->direct(), s, c.region->hierarchy());
+    benchmark::DoNotOptimize(gpu.irradiance());
+    glFinish();
+  }
+}
+BENCHMARK(BM_AntiradianceDoorMoveGpu)->Arg(8)->Arg(4)->Arg(2)->Unit(benchmark::kMillisecond)->Iterations(3);
+
+// The same frame with the CPU twin solving. Arg: iterations.
+void BM_AntiradianceDoorMoveCpu(benchmark::State& state) {
+  Corridor& c = corridor();
+  gi::AntiradianceSettings s = c.region->settings();
+  s.iterations = static_cast<int>(state.range(0));
+  gi::CpuAntiradiancePasses cpu(c.region->hierarchy(), c.region->bins(), c.region->links());
+  float angle = 50.0f;
+  for (auto _ : state) {
+    angle = angle > 100.0f ? 10.0f : angle + 7.0f;
+    c.region->set_instance_transform(c.door_instance, door(angle));
+    c.region->update(false);
+    (void)gi::run_antiradiance(cpu, c.region->direct(), s, c.region->hierarchy());
+    benchmark::DoNotOptimize(cpu.irradiance());
+  }
+}
+BENCHMARK(BM_AntiradianceDoorMoveCpu)->Arg(8)->Arg(4)->Arg(2)->Unit(benchmark::kMillisecond)->Iterations(3);
+
+// The yardstick for ratios on shared cores: sorting 1.6 M random 16-byte records by
+// (receiver, bin, sender) -- the job a relink did in full before it merged (a fixed
+// amount of memory-bound CPU work, unaffected by the method's code).
+void BM_Yardstick(benchmark::State& state) {
+  std::vector<gi::Link> base(1'600'000);
+  std::uint64_t x = 12345;
+  for (gi::Link& l : base) {
+    x = x * 6364136223846793005ULL + 1442695040888963407ULL;
+    l = {static_cast<std::int32_t>(x >> 40) % 5000, static_cast<std::int32_t>(x >> 20) % 5000,
+         static_cast<std::int32_t>(x >> 10) % 64, 1.0f};
+  }
+  for (auto _ : state) {
+    std::vector<gi::Link> v = base;
+    std::sort(v.begin(), v.end(), [](const gi::Link& a, const gi::Link& b) {
+      if (a.receiver != b.receiver) return a.receiver < b.receiver;
+      return a.bin != b.bin ? a.bin < b.bin : a.sender < b.sender;
+    });
+    benchmark::DoNotOptimize(v.data());
+  }
+}
+BENCHMARK(BM_Yardstick)->Unit(benchmark::kMillisecond)->Iterations(5);
 
 }  // namespace
 
