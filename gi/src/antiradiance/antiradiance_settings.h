@@ -4,6 +4,7 @@
 //   gi::AntiradianceSettings s;  s.bins_per_side = 8;  s.iterations = 4;
 
 #include <cstdint>
+#include <string_view>
 
 namespace gi {
 
@@ -39,5 +40,12 @@ struct AntiradianceSettings {
   int area_light_samples = 16;
   std::uint64_t seed = 1;
 };
+
+/// The leaf size gi-bake bakes a preset at: 0.8 / 0.6 / 0.4 m at preview / medium / high
+/// (docs/sweeps/antiradiance_corridor.md: the element size barely moves the error; bins and
+/// iterations do).
+inline float antiradiance_preset_patch_size(std::string_view preset) {
+  return preset == "high" ? 0.4f : preset == "medium" ? 0.6f : 0.8f;
+}
 
 }  // namespace gi

@@ -135,7 +135,7 @@ engine::Status bake_prm_method(const BakeInput& input, const fs::path& dir, cons
 engine::Status bake_antiradiance_method(const BakeInput& input, const fs::path& dir, const BakeOptions& o,
                                         const Stage& stage) {
   AntiradianceSettings s;
-  s.patch_size_m = o.preset == "high" ? 0.4f : o.preset == "medium" ? 0.6f : 0.8f;
+  s.patch_size_m = antiradiance_preset_patch_size(o.preset);
   s.seed = o.seed;
   const auto start = Clock::now();
   auto bake = bake_antiradiance(input, s);

@@ -7,6 +7,7 @@
 #include <optional>
 #include <set>
 
+#include "antiradiance/element_hierarchy.h"
 #include "brf/brf_bake.h"
 #include "plan/plan_cost.h"
 #include "plan/static_surface_census.h"
@@ -272,7 +273,8 @@ void plan_dlm(const BakeInput& input, const PlanFacts& f, const PlanOptions& opt
 }
 
 // Antiradiance: flagged deforming or opening regions.
-void plan_antiradiance(const PlanFacts& f, PlannedEffect& anti) {
+void plan_antiradiance(const BakeInput& input, const PlanFacts& f, const PlanOptions& options, bool known_preset,
+                       PlannedEffect& anti) {
   if (f.deforming.empty()) {
     anti.reason = "no node is flagged gi.region \"deforming\" -> no antiradiance";
     return;
@@ -281,6 +283,20 @@ void plan_antiradiance(const PlanFacts& f, PlannedEffect& anti) {
   anti.reason = plural(f.deforming.size(), "mesh is", "meshes are") + " flagged gi.region \"deforming\" (" +
                 quoted_list(f.deforming) + ") -> antiradiance for that region";
   anti.targets = f.deforming;
+  if (!known_preset) return;
+  // The elements as the bake builds them (cheap: triangle pieces and a cluster tree); the
+  // links, the bake time and the GPU bytes from the cost model.
+  AntiradianceSettings s;
+  s.patch_size_m = antiradiance_preset_patch_size(options.preset);
+  auto h = build_element_hierarchy(input, s);
+  if (!h) return;
+  double links = 0.0, file = 0.0;
+  const BakeWork w = antiradiance_work(h->nodes.size(), h->leaf_count(), s, &links, &file);
+  anti.estimate = {w.bake_seconds, w.runtime_bytes, static_cast<std::uint64_t>(links),
+                   std::to_string(h->nodes.size()) + " elements (" + std::to_string(h->leaf_count()) + " leaves of " +
+                       fixed(s.patch_size_m, 1) + " m) x " + std::to_string(s.bins_per_side * s.bins_per_side) +
+                       " bins -> ~" + fixed(links * 1e-6, 1) + " M links; GPU tables + links; file ~" +
+                       format_bytes(static_cast<std::uint64_t>(file))};
 }
 
 // Basis radiance fields: the meshes of dynamic instances, once per mesh.
@@ -400,7 +416,7 @@ EffectPlan plan(const BakeInput& input, const PlanOptions& options) {
   plan_light_atlas(f, p, out.effects[static_cast<int>(EffectMethod::LightAtlas)]);
   plan_prm(f, p, out.effects[static_cast<int>(EffectMethod::Prm)]);
   plan_dlm(input, f, options, p, out.effects[static_cast<int>(EffectMethod::DirectionalLightMaps)]);
-  plan_antiradiance(f, out.effects[static_cast<int>(EffectMethod::Antiradiance)]);
+  plan_antiradiance(input, f, options, p.has_value(), out.effects[static_cast<int>(EffectMethod::Antiradiance)]);
   plan_brf(input, f, options, out.facts.dynamic_meshes,
            out.effects[static_cast<int>(EffectMethod::BasisRadianceFields)]);
   for (PlannedEffect& e : out.effects)

@@ -182,4 +182,40 @@ BakeWork dlm_work(const StaticSurfaceCensus& glossy, double albedo, const AtlasT
   return w;
 }
 
+namespace {
+
+// Antiradiance (gi/src/antiradiance; measured by gi-sweep on the corridor, docs/sweeps/
+// antiradiance_corridor.csv, 0.4-0.8 m elements x 36-121 bins, and gi-bake on the demo level).
+// Links per element and bin: 4.57 at 0.6-0.8 m on the corridor, 3.85 at 0.4 m, 3.77 on the
+// demo level at preview (13259 elements, 3.2 M links).
+constexpr double kArLinksPerElementBin = 4.2;
+// Bake wall seconds per link (linking + the baseline solve at 8 iterations + the direct
+// light), 2 threads shared: 0.55-0.65 us over the corridor grid (bake_s / links).
+constexpr double kArSecondsPerLink = 6.0e-7;
+constexpr double kArSecondsOverhead = 0.05;
+// GPU bytes per link: the 16-byte record plus its share of the 16-byte (receiver, bin) runs
+// (0.12 runs per link measured: 41.4 MB for 1.60 M links, 5475 elements, 64 bins).
+constexpr double kArGpuBytesPerLink = 17.9;
+// antiradiance.bin: 4.8 bytes per link (zstd planes, AntiradianceIo test) + 72 per element
+// and 12 per leaf.
+constexpr double kArFileBytesPerLink = 4.8;
+
+}  // namespace
+
+BakeWork antiradiance_work(std::size_t elements, std::size_t leaves, const AntiradianceSettings& s, double* links,
+                           double* file_bytes) {
+  BakeWork w;
+  const double m = static_cast<double>(s.bins_per_side) * s.bins_per_side;
+  const double n = static_cast<double>(elements), l = static_cast<double>(leaves);
+  const double k = kArLinksPerElementBin * m * n;
+  w.units = k;
+  // The baseline solve is ~20% of it at 8 iterations (cpu_solve_ms / bake_s in the sweep).
+  w.cpu_seconds = k * kArSecondsPerLink * (0.8 + 0.2 * std::max(1, s.iterations) / 8.0) + kArSecondsOverhead;
+  w.bake_seconds = w.cpu_seconds;
+  w.runtime_bytes = static_cast<std::uint64_t>(24.0 * m * (n + l) + kArGpuBytesPerLink * k);
+  if (links) *links = k;
+  if (file_bytes) *file_bytes = kArFileBytesPerLink * k + 72.0 * n + 12.0 * l;
+  return w;
+}
+
 }  // namespace gi

@@ -179,6 +179,32 @@ TEST(Plan, DeformingRegionsFromTheFileGetAntiradiance) {
   EXPECT_TRUE(contains(anti.reason, "'door'")) << anti.reason;
 }
 
+// The antiradiance estimate against what was measured at the preview preset (0.8 m
+// elements, 64 bins): the corridor (gi-sweep, docs/sweeps/antiradiance_corridor.csv: 5475
+// elements, 1.60 M links, bake 0.88-0.97 s on 2 shared cores, 41.4 MB on the GPU) and the
+// demo level (gi-bake: 13259 elements, 3.2 M links).
+TEST(PlanCost, AntiradianceEstimateIsWithinTheMeasuredLinksBakeTimeAndGpuBytes) {
+  const gi::EffectPlan corridor = gi::plan(load("corridor.gltf"), {.preset = "preview"});
+  const gi::PlannedEffect& anti = corridor.effect(EffectMethod::Antiradiance);
+  ASSERT_TRUE(anti.enabled) << anti.reason;
+  std::printf("corridor: %s; ~%.2f s, %.1f MB\n", anti.estimate.basis.c_str(), anti.estimate.bake_seconds,
+              static_cast<double>(anti.estimate.runtime_bytes) / 1e6);
+  EXPECT_NEAR(static_cast<double>(anti.estimate.work_units), 1.60e6, 0.25 * 1.60e6);
+  EXPECT_GT(anti.estimate.bake_seconds, 0.5 * 0.9);
+  EXPECT_LT(anti.estimate.bake_seconds, 2.0 * 0.9);
+  EXPECT_NEAR(static_cast<double>(anti.estimate.runtime_bytes), 41.4e6, 0.25 * 41.4e6);
+  EXPECT_TRUE(contains(anti.estimate.basis, "5475 elements")) << anti.estimate.basis;
+  const gi::EffectPlan demo = gi::plan(load("demo_level.gltf"), {.preset = "preview"});
+  const gi::PlannedEffect& demo_anti = demo.effect(EffectMethod::Antiradiance);
+  ASSERT_TRUE(demo_anti.enabled) << demo_anti.reason;
+  std::printf("demo level: %s; ~%.2f s, %.1f MB\n", demo_anti.estimate.basis.c_str(), demo_anti.estimate.bake_seconds,
+              static_cast<double>(demo_anti.estimate.runtime_bytes) / 1e6);
+  EXPECT_NEAR(static_cast<double>(demo_anti.estimate.work_units), 3.2e6, 0.25 * 3.2e6);
+  // An unknown preset gives no estimate.
+  EXPECT_EQ(gi::plan(load("corridor.gltf"), {.preset = "ultra"}).effect(EffectMethod::Antiradiance).estimate.work_units,
+            0u);
+}
+
 TEST(Plan, LightUnderADynamicNodeMovesWithAWarningWhenNotFlagged) {
   auto asset = engine::load_gltf(std::string(GI_SOURCE_DIR) + "/assets/demo_level.gltf");
   ASSERT_TRUE(asset);
