@@ -93,8 +93,8 @@ int main(int argc, char** argv) {
                kTool, report->csv.c_str(), report->markdown.c_str(), report->runs, report->failures.size(),
                report->references_computed, report->references_from_cache);
   std::fprintf(stderr, "%s\n",
-               (no_plot ? "plots: skipped; to plot, run:\n  " + gi_sweep::plot_command(report->csv)
-                        : gi_sweep::plot_sweep_csv(report->csv))
+               (no_plot ? "plots: skipped; to plot, run:\n  " + gi_sweep::plot_command(report->csv, request.frame_cost)
+                        : gi_sweep::plot_sweep_csv(report->csv, request.frame_cost))
                    .c_str());
   if (report->cancelled) {
     std::fprintf(stderr, "%s: interrupted; the files hold the runs completed so far\n", kTool);

@@ -22,24 +22,25 @@ std::string python_with_matplotlib() {
   return {};
 }
 
-std::string command_with(const std::string& python, const std::filesystem::path& csv) {
-  return python + " " + shell_quote(GI_PLOT_SCRIPT) + " " + shell_quote(csv.string());
+std::string command_with(const std::string& python, const std::filesystem::path& csv, bool frame_cost) {
+  return python + " " + shell_quote(GI_PLOT_SCRIPT) + " " + shell_quote(csv.string()) +
+         (frame_cost ? " --cost frame" : "");
 }
 
 }  // namespace
 
-std::string plot_command(const std::filesystem::path& csv) {
+std::string plot_command(const std::filesystem::path& csv, bool frame_cost) {
   const std::string python = python_with_matplotlib();
-  return command_with(python.empty() ? std::string("python3") : python, csv);
+  return command_with(python.empty() ? std::string("python3") : python, csv, frame_cost);
 }
 
-std::string plot_sweep_csv(const std::filesystem::path& csv) {
+std::string plot_sweep_csv(const std::filesystem::path& csv, bool frame_cost) {
   const std::string python = python_with_matplotlib();
   if (python.empty()) {
     return "plots: python3 with matplotlib (Debian: python3-matplotlib) is not available; to plot, run:\n  " +
-           command_with("python3", csv);
+           command_with("python3", csv, frame_cost);
   }
-  const std::string cmd = command_with(python, csv);
+  const std::string cmd = command_with(python, csv, frame_cost);
   if (std::system((cmd + " >/dev/null").c_str()) != 0) {
     return "plots: the plot script failed; run it to see why:\n  " + cmd;
   }

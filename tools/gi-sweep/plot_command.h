@@ -8,11 +8,12 @@
 
 namespace gi_sweep {
 
-/// The shell command that plots `csv` (the PNG goes next to it, same stem).
-std::string plot_command(const std::filesystem::path& csv);
+/// The shell command that plots `csv` (the PNG goes next to it, same stem); `frame_cost`:
+/// against per-frame milliseconds (`--cost frame`, as the sweep's front) instead of bake time.
+std::string plot_command(const std::filesystem::path& csv, bool frame_cost = false);
 
 /// Runs plot_command(csv) when `python3 -c "import matplotlib"` succeeds. Returns a line for
 /// the user: where the plot went, or why there is none and the command to run. Never fails.
-std::string plot_sweep_csv(const std::filesystem::path& csv);
+std::string plot_sweep_csv(const std::filesystem::path& csv, bool frame_cost = false);
 
 }  // namespace gi_sweep
