@@ -7,11 +7,10 @@
 
 #include "antiradiance_common.glsl"
 
+// A link's bin is its run's (run.z = receiver * bins + bin), so a link is 8 bytes.
 struct Link {
   uint sender;
-  uint bin;
   float form_factor;
-  uint pad;
 };
 
 layout(std430, binding = 0) readonly buffer Runs { uvec4 runs[]; };  // first link, count, destination entry, 0
@@ -23,10 +22,11 @@ void main() {
   const uint i = item_index();
   if (i >= u_items) return;
   const uvec4 run = runs[i];
+  const uint bin = run.z % u_bins;
   vec3 sum = vec3(0.0);
   for (uint k = run.x; k < run.x + run.y; ++k) {
     const Link l = links[k];
-    const uint src = (l.sender * u_bins + l.bin) * 3u;
+    const uint src = (l.sender * u_bins + bin) * 3u;
     sum += l.form_factor * vec3(i_ex[src], i_ex[src + 1u], i_ex[src + 2u]);
   }
   const uint dst = run.z * 3u;

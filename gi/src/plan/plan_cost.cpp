@@ -193,9 +193,10 @@ constexpr double kArLinksPerElementBin = 4.2;
 // light), 2 threads shared: 0.55-0.65 us over the corridor grid (bake_s / links).
 constexpr double kArSecondsPerLink = 6.0e-7;
 constexpr double kArSecondsOverhead = 0.05;
-// GPU bytes per link: the 16-byte record plus its share of the 16-byte (receiver, bin) runs
-// (0.12 runs per link measured: 41.4 MB for 1.60 M links, 5475 elements, 64 bins).
-constexpr double kArGpuBytesPerLink = 17.9;
+// GPU bytes per link: the 8-byte record (sender, form factor) plus its share of the 16-byte
+// (receiver, bin) runs (0.12 runs per link: 28.5 MB measured for 1.62 M links, 5475
+// elements, 64 bins, of which 12.6 MB are the tables).
+constexpr double kArGpuBytesPerLink = 9.8;
 // antiradiance.bin: 4.8 bytes per link (zstd planes, AntiradianceIo test) + 72 per element
 // and 12 per leaf.
 constexpr double kArFileBytesPerLink = 4.8;

@@ -65,8 +65,8 @@ BakeWork dlm_work(const StaticSurfaceCensus& glossy, double albedo, const AtlasT
 /// Antiradiance over a deforming region of `elements` hierarchy nodes, `leaves` of them
 /// leaves (build_element_hierarchy's counts): links ~ 4.2 x bins per element; the bake links
 /// them and solves the baseline. runtime_bytes: the GPU tables (exitant and incident per
-/// node and bin, I_L and I_A per leaf and bin: 12 B each) and the link records with their
-/// (receiver, bin) runs. `links` out: the link estimate; `file_bytes` out: antiradiance.bin.
+/// node and bin, I_L and I_A per leaf and bin: 12 B each) and the 8-byte link records with
+/// their (receiver, bin) runs. `links` out: the link estimate; `file_bytes` out: antiradiance.bin.
 BakeWork antiradiance_work(std::size_t elements, std::size_t leaves, const AntiradianceSettings& settings,
                            double* links = nullptr, double* file_bytes = nullptr);
 
