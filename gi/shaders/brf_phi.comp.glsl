@@ -12,7 +12,8 @@
 // the receiver's g_k' cos lobe (lobe SH in the vertex's tangent frame) rotated into the
 // source's space as ShRotation does (least squares over fixed directions), or 0 behind
 // (C4: C padded to a multiple of 4, the pads written 0)
-// the twin of brf_basis_irradiance (brf_runtime.cpp). Built twice: without
+// the twin of brf_basis_irradiance (brf_runtime.cpp); static points' rows are scaled by their
+// visibility of the source (binding 9). Built twice: without
 // BRF_GLOSSY_RECEIVER for jobs of one row, with it for glossy receivers (the rotation's local
 // arrays would slow the diffuse jobs on llvmpipe). Work groups map to (job, first point)
 // through the group table, so a dispatch covers many jobs of different lengths.
@@ -33,6 +34,18 @@ struct PhiJob {
   uint frame_offset;      // glossy receiver: first float of its vertex frames (t, b, n per vertex) in sh_data
   uint lobe_offset;       // glossy receiver: first float of its lobe SH (16 per glossy term) in sh_data
   uint pad0;
+  uint occluder_offset;   // first record in occluders (kind 0): boxes of objects in the pair's way
+  uint occluder_count;
+  uint pad1;
+  uint pad2;
+};
+
+// A dynamic object's box standing between a pair (brf_pair_occluders): to_occluder maps the
+// source's object space into the box's.
+struct BrfOccluderRecord {
+  mat4 to_occluder;
+  vec4 lo;
+  vec4 hi;
 };
 
 layout(std430, binding = 0) readonly buffer Models { BrfModel models[]; };
@@ -46,6 +59,10 @@ layout(std430, binding = 7) writeonly buffer Phi { float phi[]; };
 // sh_rotation_tables(): 26 directions (vec4 each, 104 floats), the pinv of bands 1..3
 // (3, 5, 7 rows x 26, row-major), then the glossy models' lobe SH and vertex frames.
 layout(std430, binding = 8) readonly buffer ShData { float sh_data[]; };
+// u_kind 1: per static_indices entry, the fraction of the source that receiver sees past the
+// static world (brf_static_visibility); the row is scaled by it.
+layout(std430, binding = 9) readonly buffer StaticVisibility { float static_visibility[]; };
+layout(std430, binding = 10) readonly buffer Occluders { BrfOccluderRecord occluders[]; };
 
 uniform uint u_first_group;
 uniform uint u_group_count;
@@ -54,6 +71,54 @@ uniform uint u_kind;  // 0: instance vertices, 1: static receivers
 const uint kDirections = 26u;
 const uint kPinvOffset[4] = uint[4](0u, 104u, 182u, 312u);
 const uint kMaxRows = 16u;  // 1 + kMaxGlossyTerms
+
+// brf_segment_clear (brf_visibility.cpp): the segment a -> b misses every box of the job's occluders.
+bool segment_clear(vec3 a, vec3 b, uint first, uint count) {
+  for (uint o = first; o < first + count; ++o) {
+    const vec3 p = (occluders[o].to_occluder * vec4(a, 1.0)).xyz;
+    const vec3 d = (occluders[o].to_occluder * vec4(b, 1.0)).xyz - p;
+    float t0 = 0.0, t1 = 1.0;
+    bool miss = false;
+    for (int k = 0; k < 3 && !miss; ++k) {
+      if (abs(d[k]) < 1e-12) {
+        miss = p[k] < occluders[o].lo[k] || p[k] > occluders[o].hi[k];
+        continue;
+      }
+      const float inv = 1.0 / d[k];
+      float ta = (occluders[o].lo[k] - p[k]) * inv, tb = (occluders[o].hi[k] - p[k]) * inv;
+      if (ta > tb) {
+        const float t = ta;
+        ta = tb;
+        tb = t;
+      }
+      t0 = max(t0, ta);
+      t1 = min(t1, tb);
+      miss = t0 > t1;
+    }
+    if (!miss) return false;
+  }
+  return true;
+}
+
+// brf_weighted_visibility over brf_visibility_targets (brf_visibility.h): the cosine-weighted
+// fraction of the source's 9 target points (box centre, corners pulled to 0.7) that p sees.
+float occluded_visibility(BrfModel m, vec3 p, vec3 n, uint first, uint count) {
+  const vec3 c = 0.5 * (m.box_lo.xyz + m.box_hi.xyz), h = 0.7 * 0.5 * (m.box_hi.xyz - m.box_lo.xyz);
+  float all = 0.0, seen = 0.0;
+  for (int i = 0; i < 9; ++i) {
+    const vec3 t = i == 0 ? c
+                          : c + vec3((((i - 1) & 1) != 0) ? h.x : -h.x, (((i - 1) & 2) != 0) ? h.y : -h.y,
+                                     (((i - 1) & 4) != 0) ? h.z : -h.z);
+    const vec3 d = t - p;
+    const float len = length(d);
+    if (!(len > 0.0)) continue;
+    const float cs = dot(n, d) / len;
+    if (cs <= 0.0) continue;
+    all += cs;
+    if (segment_clear(p, t, first, count)) seen += cs;
+  }
+  return all > 0.0 ? seen / all : 0.0;
+}
 
 void main() {
   const uint group = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
@@ -85,6 +150,12 @@ void main() {
     for (uint i = 0u; i < rows * c4; ++i) phi[row0 + i] = 0.0;
     return;
   }
+  // What the point sees of the source past the objects in the pair's way (1 without any).
+  const float vis = job.occluder_count == 0u ? 1.0 : occluded_visibility(m, p, n, job.occluder_offset, job.occluder_count);
+  if (vis == 0.0) {
+    for (uint i = 0u; i < rows * c4; ++i) phi[row0 + i] = 0.0;
+    return;
+  }
   float lobe[16];
   if (side == 1u)
     brf_cosine(n, lobe);
@@ -99,6 +170,7 @@ void main() {
 
 #ifndef BRF_GLOSSY_RECEIVER
   {  // a diffuse receiver or static point: the irradiance row only
+    const float scale = u_kind == 1u ? static_visibility[job.point_offset + k] : vis;
     for (uint i = 0u; i < nc; ++i) {
       float sum = 0.0;
       if (inside)
@@ -109,7 +181,7 @@ void main() {
           for (uint q = 0u; q < cc; ++q) d += field[at + q] * lobe[q];
           sum += weight[c] * d;
         }
-      phi[row0 + i] = sum;
+      phi[row0 + i] = sum * scale;
     }
     return;
   }
@@ -162,7 +234,7 @@ void main() {
     for (uint r = 0u; r < rows; ++r) {
       float d = 0.0;
       for (uint q = 0u; q < cc; ++q) d += coeffs[q] * lobes[r * 16u + q];
-      phi[row0 + r * c4 + i] = d;
+      phi[row0 + r * c4 + i] = d * vis;
     }
   }
 #endif

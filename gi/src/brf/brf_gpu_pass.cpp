@@ -9,6 +9,7 @@
 #include <string>
 #include <utility>
 
+#include "brf/brf_visibility.h"
 #include "gpu/gi_shaders.h"
 
 namespace gi {
@@ -99,8 +100,17 @@ struct BrfPhiJob {
   std::uint32_t source_model = 0, point_offset = 0, point_count = 0, phi_offset = 0;
   glm::mat4 frame_to_source{1.0f};  // glossy receiver: its object space's rotation into the source's
   std::uint32_t rows = 1, frame_offset = 0, lobe_offset = 0, pad0 = 0;
+  std::uint32_t occluder_offset = 0, occluder_count = 0, pad1 = 0, pad2 = 0;  // into the occluder records
 };
-static_assert(sizeof(BrfPhiJob) == 224, "must match PhiJob in brf_phi.comp.glsl (std430)");
+static_assert(sizeof(BrfPhiJob) == 240, "must match PhiJob in brf_phi.comp.glsl (std430)");
+
+/// BrfOccluderRecord in brf_phi.comp.glsl (std430): a box in the way of a pair, with the map
+/// from the source's object space into the box's.
+struct GpuOccluder {
+  glm::mat4 to_occluder{1.0f};
+  glm::vec4 lo{0.0f}, hi{0.0f};
+};
+static_assert(sizeof(GpuOccluder) == 96, "must match BrfOccluderRecord in brf_phi.comp.glsl (std430)");
 
 void BrfGpuPass::Buffer::reserve(std::size_t size) {
   size = std::max<std::size_t>(size, 16);
@@ -319,7 +329,7 @@ void BrfGpuPass::upload_models(std::span<const BrfGpuModel> models, const ModelD
 }
 
 engine::Status BrfGpuPass::set_static_receivers(std::span<const glm::vec3> positions,
-                                                std::span<const glm::vec3> normals) {
+                                                std::span<const glm::vec3> normals, const RayCaster* world) {
   GI_EXPECTS(!programs_.phi.empty(), "BrfGpuPass::set_static_receivers on an empty (default or moved-from) pass");
   if (positions.size() != normals.size())
     return error(std::to_string(positions.size()) + " static receiver positions but " + std::to_string(normals.size()) +
@@ -336,6 +346,8 @@ engine::Status BrfGpuPass::set_static_receivers(std::span<const glm::vec3> posit
   }
   static_points_.upload(points.data(), points.size() * sizeof(glm::vec4));
   static_positions_.assign(positions.begin(), positions.end());
+  static_normals_.assign(normals.begin(), normals.end());
+  static_world_ = world;
   static_count_ = positions.size();
   static_out_.reserve(static_count_ * sizeof(glm::vec4));
   glClearNamedBufferData(static_out_.buffer.id(), GL_R32F, GL_RED, GL_FLOAT, nullptr);
@@ -421,6 +433,8 @@ void BrfGpuPass::dispatch_phi(std::span<const BrfPhiJob> jobs, bool static_kind)
   bind(5, groups_.buffer.id());
   bind(7, static_kind ? static_phi_.buffer.id() : phi_.buffer.id());
   bind(8, sh_data_.id());
+  bind(9, static_visibility_.buffer.empty() ? static_points_.buffer.id() : static_visibility_.buffer.id());
+  bind(10, occluders_.buffer.empty() ? static_points_.buffer.id() : occluders_.buffer.id());
   for (std::size_t v = 0; v < 2; ++v) {
     const engine::ShaderProgram& program = v == 0 ? programs_.phi : programs_.phi_glossy;
     const GLuint id = program.id();
@@ -441,11 +455,12 @@ engine::Status BrfGpuPass::update_static(std::span<const BrfGpuInstance> instanc
   const std::vector<std::uint8_t> moved = static_sources_moved(instances);
   if (std::none_of(moved.begin(), moved.end(), [](std::uint8_t m) { return m != 0; })) return {};
   std::size_t total_floats = 0;
-  std::vector<std::vector<std::uint32_t>> inside = static_receivers_inside(instances, moved, total_floats);
+  std::vector<std::vector<float>> visibility;
+  std::vector<std::vector<std::uint32_t>> inside = static_receivers_inside(instances, moved, visibility, total_floats);
   if (total_floats * sizeof(float) > max_buffer_bytes_)
     return error("static receivers need " + std::to_string(total_floats * sizeof(float)) +
                  " bytes of Phi, above the SSBO limit of " + std::to_string(max_buffer_bytes_));
-  relayout_static_phi(instances, moved, inside, total_floats);
+  relayout_static_phi(instances, moved, inside, visibility, total_floats);
   upload_static_lists(instances);
   return {};
 }
@@ -468,10 +483,13 @@ std::vector<std::uint8_t> BrfGpuPass::static_sources_moved(std::span<const BrfGp
 
 std::vector<std::vector<std::uint32_t>> BrfGpuPass::static_receivers_inside(std::span<const BrfGpuInstance> instances,
                                                                             std::span<const std::uint8_t> moved,
-                                                                            std::size_t& total_floats) const {
+                                                                            std::vector<std::vector<float>>& visibility,
+                                                                            std::size_t& total_floats) {
   // Which receivers lie inside each moved source's outermost sphere (as brf_interreflect tests it).
   const std::size_t n = instances.size();
   std::vector<std::vector<std::uint32_t>> inside(n);
+  visibility.assign(n, {});
+  std::vector<glm::vec3> pos, nrm;
   for (std::size_t s = 0; s < n; ++s) {
     const ModelInfo& model = models_[instances[s].model];
     if (moved[s] != 0) {
@@ -481,8 +499,35 @@ std::vector<std::vector<std::uint32_t>> BrfGpuPass::static_receivers_inside(std:
       const float reach = model.outer_radius * scale;
       for (std::size_t t = 0; t < static_count_; ++t)
         if (glm::length(static_positions_[t] - centre) <= reach) inside[s].push_back(u32(t));
+      visibility[s].assign(inside[s].size(), 1.0f);
+      if (static_world_ != nullptr && !inside[s].empty()) {
+        const auto t0 = std::chrono::steady_clock::now();
+        // What each receiver sees of the source past the static world; those that see
+        // nothing are dropped (their Phi would be scaled to 0).
+        std::array<glm::vec3, kBrfVisibilityTargets> targets = brf_visibility_targets(brf_object_box(*model.mesh));
+        for (glm::vec3& t : targets) t = glm::vec3(m * glm::vec4(t, 1.0f));
+        pos.clear();
+        nrm.clear();
+        for (std::uint32_t t : inside[s]) {
+          pos.push_back(static_positions_[t]);
+          nrm.push_back(static_normals_[t]);
+        }
+        brf_static_visibility(*static_world_, targets, pos, nrm, visibility[s]);
+        std::size_t kept = 0;
+        for (std::size_t k = 0; k < inside[s].size(); ++k)
+          if (visibility[s][k] > 0.0f) {
+            inside[s][kept] = inside[s][k];
+            visibility[s][kept++] = visibility[s][k];
+          }
+        stats_.static_receivers_hidden += inside[s].size() - kept;
+        inside[s].resize(kept);
+        visibility[s].resize(kept);
+        stats_.static_visibility_ms +=
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+      }
     } else {
       inside[s] = static_slots_[s].receivers;
+      visibility[s] = static_slots_[s].visibility;
     }
     total_floats += inside[s].size() * padded(model.channels());
   }
@@ -490,11 +535,13 @@ std::vector<std::vector<std::uint32_t>> BrfGpuPass::static_receivers_inside(std:
 }
 
 void BrfGpuPass::relayout_static_phi(std::span<const BrfGpuInstance> instances, std::span<const std::uint8_t> moved,
-                                     std::span<std::vector<std::uint32_t>> inside, std::size_t total_floats) {
+                                     std::span<std::vector<std::uint32_t>> inside,
+                                     std::span<std::vector<float>> visibility, std::size_t total_floats) {
   // New layout; unmoved sources' Phi is copied over, moved ones are evaluated.
   const std::size_t n = instances.size();
   static_phi_spare_.reserve(total_floats * sizeof(float));
   std::vector<std::uint32_t> indices;
+  std::vector<float> vis;
   std::vector<BrfPhiJob> jobs;
   std::uint32_t phi_offset = 0;
   for (std::size_t s = 0; s < n; ++s) {
@@ -512,6 +559,7 @@ void BrfGpuPass::relayout_static_phi(std::span<const BrfGpuInstance> instances, 
       slot.valid = true;
       slot.pose = instances[s].object_to_world;
       slot.receivers = std::move(inside[s]);
+      slot.visibility = std::move(visibility[s]);
       if (count > 0) {
         BrfPhiJob job;
         job.to_source = glm::inverse(instances[s].object_to_world);
@@ -524,10 +572,12 @@ void BrfGpuPass::relayout_static_phi(std::span<const BrfGpuInstance> instances, 
       }
     }
     indices.insert(indices.end(), slot.receivers.begin(), slot.receivers.end());
+    vis.insert(vis.end(), slot.visibility.begin(), slot.visibility.end());
     phi_offset += u32(count * padded(model.channels()));
   }
   std::swap(static_phi_, static_phi_spare_);
   static_indices_.upload(indices.data(), indices.size() * sizeof(std::uint32_t));
+  static_visibility_.upload(vis.data(), vis.size() * sizeof(float));
   dispatch_phi(jobs, true);
 }
 
@@ -567,6 +617,8 @@ struct BrfGpuPass::FrameData {
   std::vector<GpuInstance> table;
   std::vector<glm::uvec4> live;  ///< (source's first weight vec4, first Phi vec4, C4 / 4, source)
   std::vector<BrfPhiJob> jobs;
+  std::vector<GpuOccluder> occluders;  ///< The jobs' occluder records.
+  bool occlusion = true;               ///< BrfUpdateSettings::occlusion.
 };
 
 engine::Status BrfGpuPass::run(std::span<const BrfGpuInstance> instances,
@@ -588,8 +640,10 @@ engine::Status BrfGpuPass::run(std::span<const BrfGpuInstance> instances,
   }
 
   FrameData frame;
+  frame.occlusion = settings.occlusion;
   fit_first_and_cull(instances, incoming, settings.cull_threshold, frame);
   plan_pairs(instances, frame);
+  occluders_.upload(frame.occluders.data(), frame.occluders.size() * sizeof(GpuOccluder));
   dispatch_phi(frame.jobs, false);
   upload_frame(incoming, frame);
   for (int bounce = 0; bounce < settings.bounces; ++bounce) {
@@ -666,11 +720,15 @@ void BrfGpuPass::plan_pairs(std::span<const BrfGpuInstance> instances, FrameData
   frame.table.assign(n, GpuInstance{});
   std::vector<glm::mat4> to_source(n);
   std::vector<glm::mat3> pure_to_source(n);  // uniform scale removed, as brf_basis_irradiance
+  std::vector<BrfSphere> spheres(n);
   for (std::size_t s = 0; s < n; ++s) {
     to_source[s] = glm::inverse(instances[s].object_to_world);
     const glm::mat3 rot = glm::mat3(to_source[s]);
     pure_to_source[s] = rot / glm::length(rot[0]);
+    spheres[s] = brf_bounding_sphere(brf_object_box(*models_[instances[s].model].mesh), instances[s].object_to_world);
   }
+  std::vector<std::uint32_t> ids;
+  std::vector<glm::mat4> poses;
   for (std::size_t r = 0; r < n; ++r) {
     const ModelInfo& mr = models_[instances[r].model];
     GpuInstance& g = frame.table[r];
@@ -697,7 +755,19 @@ void BrfGpuPass::plan_pairs(std::span<const BrfGpuInstance> instances, FrameData
       const glm::mat4 relative = to_source[s] * instances[r].object_to_world;
       frame.live.emplace_back(weight_offsets_[s], slot.phi_offset / 4,
                               padded(models_[instances[s].model].channels()) / 4, u32(s));
-      if (slot.valid && same_pose(slot.pose, relative, pose_tolerance_)) {
+      // The objects in the way and their poses relative to the source: the pair's Phi is
+      // kept only while these are unchanged too.
+      ids.clear();
+      poses.clear();
+      if (frame.occlusion)
+        for (std::uint32_t o : brf_pair_occluders(spheres, s, r)) {
+          ids.push_back(o);
+          poses.push_back(to_source[o] * instances[s].object_to_world);
+        }
+      bool same_occluders = slot.occluders == ids;
+      for (std::size_t k = 0; same_occluders && k < ids.size(); ++k)
+        same_occluders = same_pose(slot.occluder_poses[k], poses[k], pose_tolerance_);
+      if (slot.valid && same_pose(slot.pose, relative, pose_tolerance_) && same_occluders) {
         ++stats_.pairs_reused;
         continue;
       }
@@ -714,9 +784,17 @@ void BrfGpuPass::plan_pairs(std::span<const BrfGpuInstance> instances, FrameData
         job.frame_offset = mr.frame_offset;
         job.lobe_offset = mr.lobe_offset;
       }
+      job.occluder_offset = u32(frame.occluders.size());
+      job.occluder_count = u32(ids.size());
+      for (std::size_t k = 0; k < ids.size(); ++k) {
+        const BrfBox box = brf_object_box(*models_[instances[ids[k]].model].mesh);
+        frame.occluders.push_back({poses[k], glm::vec4(box.lo, 0.0f), glm::vec4(box.hi, 0.0f)});
+      }
       frame.jobs.push_back(job);
       slot.valid = true;
       slot.pose = relative;
+      slot.occluders = ids;
+      slot.occluder_poses = poses;
     }
     g.live_count = u32(frame.live.size()) - g.live_first;
   }
@@ -823,7 +901,7 @@ std::size_t BrfGpuPass::gpu_bytes() const {
   std::size_t bytes = model_bytes_ + output_bytes_;
   for (const Buffer* b :
        {&static_points_, &instance_table_, &incoming_, &gathered_, &indirect_, &weights_, &phi_, &live_, &jobs_,
-        &groups_, &static_indices_, &static_phi_, &static_phi_spare_, &static_touched_, &static_entries_, &static_out_})
+        &groups_, &occluders_, &static_indices_, &static_visibility_, &static_phi_, &static_phi_spare_, &static_touched_, &static_entries_, &static_out_})
     bytes += b->bytes;
   return bytes;
 }

@@ -6,7 +6,9 @@
 // BrfObject::glossy) carry K = 1 + glossy terms values per vertex ([k x V + j], brf_runtime.h),
 // have fields with K x N channels and get K Phi rows per vertex as receivers:
 //   - brf_phi.comp.glsl: the basis irradiance Phi of every (source, receiver) pair whose
-//     relative pose changed, all such pairs in one dispatch (a group table maps work groups
+//     relative pose changed (or the pose of an object in its way, brf_pair_occluders: Phi is
+//     scaled per vertex by how much of the source it sees past their boxes, with
+//     BrfUpdateSettings::occlusion), all such pairs in one dispatch (a group table maps work groups
 //     to pairs); Phi stays on the GPU between frames, so a frame where nothing moved
 //     evaluates no field (a pair culled for a while keeps its slot and is reused if its pose
 //     is unchanged when it comes back);
@@ -39,7 +41,7 @@
 // kMaxGlossyTerms terms (16 values per vertex with the diffuse one).
 //
 // GL state: create(), run(), set_static_receivers() and the read-backs need the creating
-// context current; they change the bound program and shader-storage bindings 0-8.
+// context current; they change the bound program and shader-storage bindings 0-10.
 
 #include <engine/gpu/gl_objects.h>
 #include <engine/gpu/shader_program.h>
@@ -55,6 +57,7 @@
 
 namespace gi {
 
+class RayCaster;
 struct BrfPhiJob;  // one batched Phi evaluation (brf_gpu_pass.cpp)
 
 /// One kind of rigid object: its mesh, basis and field belong together (not owned; read at
@@ -105,8 +108,13 @@ class BrfGpuPass {
   ~BrfGpuPass() = default;
 
   /// Static-world receiver points (world space, unit normals), e.g. light-atlas texels;
-  /// uploaded once, replacing earlier ones (empty: none). Errors: sizes differ, non-finite.
-  engine::Status set_static_receivers(std::span<const glm::vec3> positions, std::span<const glm::vec3> normals);
+  /// uploaded once, replacing earlier ones (empty: none). With `world` (the static scene, not
+  /// owned, kept until the next call), each source's bounce at a receiver is scaled by the
+  /// fraction of the source it sees past the world (brf_static_visibility, computed on the
+  /// CPU when the source moves; receivers that see none of it are left out), as
+  /// BrfStaticReceivers::world does for the CPU twin. Errors: sizes differ, non-finite.
+  engine::Status set_static_receivers(std::span<const glm::vec3> positions, std::span<const glm::vec3> normals,
+                                      const RayCaster* world = nullptr);
 
   /// One frame. incoming[i][k x V + j]: light (W/m^2, RGB) arriving at instance i's vertex j
   /// from outside the objects (direct + world): k = 0 the irradiance, k >= 1 (glossy models
@@ -139,6 +147,10 @@ class BrfGpuPass {
     std::size_t pairs_culled = 0;
     std::size_t pairs_reused = 0;           ///< Live pairs whose Phi was kept (relative pose unchanged).
     std::size_t static_sources_reused = 0;  ///< Sources whose static-receiver Phi was kept.
+    /// Static receivers inside a moved source's field that see none of it past the world
+    /// (set_static_receivers' world), so get none of its bounce; counted per source.
+    std::size_t static_receivers_hidden = 0;
+    double static_visibility_ms = 0.0;  ///< CPU time of their visibility rays.
     double cpu_ms = 0.0;                    ///< Wall time of the last run() on the CPU.
   };
   const Stats& stats() const { return stats_; }
@@ -176,12 +188,15 @@ class BrfGpuPass {
     std::uint32_t phi_offset = 0;  ///< First float in phi_.
     bool valid = false;            ///< Phi holds the basis irradiance at `pose`.
     glm::mat4 pose{1.0f};          ///< inverse(M_source) x M_receiver when computed.
+    std::vector<std::uint32_t> occluders;  ///< Instances in the way (brf_pair_occluders) when computed.
+    std::vector<glm::mat4> occluder_poses;  ///< inverse(M_occluder) x M_source of each.
   };
   /// One source's static-receiver Phi.
   struct StaticSlot {
     bool valid = false;
     glm::mat4 pose{1.0f};                  ///< M_source when computed.
-    std::vector<std::uint32_t> receivers;  ///< Static receivers inside its outermost sphere.
+    std::vector<std::uint32_t> receivers;  ///< Static receivers inside its outermost sphere (that see it).
+    std::vector<float> visibility;         ///< Per receiver, the fraction of the source it sees (1 without a world).
     std::uint32_t index_offset = 0;        ///< First entry in static_indices_.
     std::uint32_t phi_offset = 0;          ///< First float in static_phi_.
   };
@@ -226,13 +241,16 @@ class BrfGpuPass {
   // update_static()'s stages, in order.
   /// Per source, 1 when its static-receiver Phi must be evaluated again; counts the reused ones.
   std::vector<std::uint8_t> static_sources_moved(std::span<const BrfGpuInstance> instances);
-  /// Per source, the static receivers in its outermost sphere (kept for unmoved ones); adds their Phi floats.
+  /// Per source, the static receivers in its outermost sphere that see it (kept for unmoved
+  /// ones) and, in `visibility`, how much of it they see; adds their Phi floats.
   std::vector<std::vector<std::uint32_t>> static_receivers_inside(std::span<const BrfGpuInstance> instances,
                                                                   std::span<const std::uint8_t> moved,
-                                                                  std::size_t& total_floats) const;
+                                                                  std::vector<std::vector<float>>& visibility,
+                                                                  std::size_t& total_floats);
   /// Static Phi in its new layout: unmoved sources' copied over, moved ones' evaluated.
   void relayout_static_phi(std::span<const BrfGpuInstance> instances, std::span<const std::uint8_t> moved,
-                           std::span<std::vector<std::uint32_t>> inside, std::size_t total_floats);
+                           std::span<std::vector<std::uint32_t>> inside, std::span<std::vector<float>> visibility,
+                           std::size_t total_floats);
   /// Per touched static receiver, its sources in instance order (static_touched_, static_entries_).
   void upload_static_lists(std::span<const BrfGpuInstance> instances);
   /// Evaluates `jobs` (one dispatch per field buffer) into phi_ or, for static_kind, static_phi_.
@@ -254,6 +272,8 @@ class BrfGpuPass {
   Buffer static_points_;
   std::size_t static_count_ = 0;
   std::vector<glm::vec3> static_positions_;  ///< CPU copy for the inside-the-field test.
+  std::vector<glm::vec3> static_normals_;    ///< CPU copy for the visibility rays.
+  const RayCaster* static_world_ = nullptr;  ///< Occludes sources from static receivers (not owned).
 
   // Per layout (instance count and models).
   std::vector<std::uint32_t> layout_models_;
@@ -264,8 +284,9 @@ class BrfGpuPass {
   std::vector<StaticSlot> static_slots_;
   std::vector<engine::GlBuffer> outputs_;  ///< Per instance: vec4 per vertex.
   std::size_t output_bytes_ = 0;
+  Buffer occluders_;  ///< This frame's Phi jobs' occluder records.
   Buffer instance_table_, incoming_, gathered_, indirect_, weights_, phi_, live_, jobs_, groups_;
-  Buffer static_indices_, static_phi_, static_phi_spare_, static_touched_, static_entries_, static_out_;
+  Buffer static_indices_, static_visibility_, static_phi_, static_phi_spare_, static_touched_, static_entries_, static_out_;
   std::uint32_t static_touched_count_ = 0;
 
   Stats stats_;

@@ -86,7 +86,7 @@ struct BrfLighting::Impl {
     composite_count = glGetUniformLocation(composite_program.id(), "u_count");
     composite_width = glGetUniformLocation(composite_program.id(), "u_atlas_width");
     if (!world.receiver_texels.empty()) {
-      if (auto s = pass->set_static_receivers(world.receiver_positions, world.receiver_normals); !s) {
+      if (auto s = pass->set_static_receivers(world.receiver_positions, world.receiver_normals, world.caster.get()); !s) {
         return disable(s.error().to_string());
       }
       receiver_texels =
@@ -235,6 +235,8 @@ bool BrfLighting::update() {
   m.stats.pairs_evaluated = ps.pairs_evaluated;
   m.stats.pairs_culled = ps.pairs_culled;
   m.stats.pairs_reused = ps.pairs_reused;
+  m.stats.static_hidden = ps.static_receivers_hidden;
+  m.stats.last_visibility_ms = ps.static_visibility_ms;
   m.stats.last_cpu_ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
   m.stats.last_gpu_ms = std::chrono::duration<double, std::milli>(t2 - t1).count();
   m.stats.gpu_bytes = m.pass->gpu_bytes();

@@ -10,7 +10,8 @@
 //     (world_probes.h) when an object moved;
 //   - the interreflection on the GPU (brf_gpu_pass.h): weights, basis irradiance of pairs
 //     whose relative pose changed (the others are reused), bounces, and the bounce onto the
-//     static receivers (atlas texels) inside each object's field;
+//     static receivers (atlas texels) inside each object's field, scaled by how much of the
+//     object each texel sees past the static world (rays when the object moved);
 //   - per vertex: world light + interreflected light (brf_vertex_sum.comp.glsl).
 // composite_world() writes base atlas + bounce into the caller's atlas texture
 // (brf_world_composite.comp.glsl).
@@ -59,7 +60,9 @@ struct BrfInstanceBinding {
 
 /// The static world's part (every member optional).
 struct BrfWorldLink {
-  std::unique_ptr<RayCaster> caster;     ///< Static shadows for the objects' direct light.
+  /// The static world: shadows for the objects' direct light, and what hides an object from
+  /// the static receivers (brf_static_visibility: no bounce through walls).
+  std::unique_ptr<RayCaster> caster;
   std::optional<WorldProbeGrid> probes;  ///< The world's light onto the objects.
   /// Static receivers: atlas texels (index y * width + x) with their world points and normals.
   std::vector<std::uint32_t> receiver_texels;
@@ -104,6 +107,8 @@ class BrfLighting {
     std::size_t pairs_evaluated = 0;  ///< Last update (GPU pass stats).
     std::size_t pairs_culled = 0;
     std::size_t pairs_reused = 0;
+    std::size_t static_hidden = 0;       ///< Last update: atlas texels in a moved object's field that do not see it.
+    double last_visibility_ms = 0.0;     ///< Last update: their rays against the static world (in last_gpu_ms).
     double last_cpu_ms = 0.0;  ///< Direct light, probes, fits.
     double last_gpu_ms = 0.0;  ///< GPU pass + vertex sums (glFinish-timed).
     std::size_t instances = 0;

@@ -5,6 +5,7 @@
 #include <limits>
 #include <numbers>
 
+#include "brf/brf_visibility.h"
 #include "brf/spherical_harmonics.h"
 #include "raytrace/embree_ray_caster.h"
 
@@ -67,7 +68,8 @@ BrfHorizon brf_horizon(const BrfBox& box, const glm::vec3& p, const glm::vec3& n
 
 void brf_basis_irradiance(const BrfObject& source, std::span<const glm::vec3> positions,
                           std::span<const glm::vec3> normals, std::vector<float>& out,
-                          const BrdfSeparation* receiver_glossy, std::span<const glm::mat3> frames) {
+                          const BrdfSeparation* receiver_glossy, std::span<const glm::mat3> frames,
+                          std::span<const BrfOccluder> occluders) {
   const BasisRadianceField& f = *source.field;
   const auto cc = static_cast<std::size_t>(f.coefficient_count());
   const auto channels = static_cast<std::size_t>(f.channel_count());
@@ -86,23 +88,34 @@ void brf_basis_irradiance(const BrfObject& source, std::span<const glm::vec3> po
   // faces that see nothing, such as the tops of crates beside each other). A glossy
   // receiver's g_k cos lobes are projected on the hemisphere and rotated as they are.
   const BrfBox box = brf_object_box(*source.mesh);
+  const auto targets = brf_visibility_targets(box);
   std::array<float, kMaxShCoefficients> rotated{};
   for (std::size_t j = 0; j < positions.size(); ++j) {
     const glm::vec3 p = glm::vec3(to_source * glm::vec4(positions[j], 1.0f));
     const glm::vec3 n = glm::normalize(rot * normals[j]);
     const BrfHorizon side = brf_horizon(box, p, n);
     if (side == BrfHorizon::Behind) continue;
+    // What the point sees of the source past the other objects (the GPU's brf_phi twin).
+    const float v = occluders.empty() ? 1.0f
+                                      : brf_weighted_visibility(p, n, targets, [&](std::size_t, const glm::vec3& a,
+                                                                                   const glm::vec3& b) {
+                                          return brf_segment_clear(a, b, occluders);
+                                        });
+    if (v == 0.0f) continue;
     f.sample(p, coeffs);
     const auto lobe = side == BrfHorizon::InFront ? sh_cosine(n) : sh_clamped_cosine(n, f.sh_bands);
     float* row = out.data() + j * kr * channels;
     for (std::size_t c = 0; c < channels; ++c) row[c] = sh_dot(std::span<const float>(coeffs).subspan(c * cc), lobe, cc);
-    if (kr == 1) continue;
-    const ShRotation to_source_frame(pure * frames[j]);
-    for (std::size_t k = 1; k < kr; ++k) {
-      to_source_frame.apply(receiver_glossy->lobe_coefficients(static_cast<int>(k - 1)), rotated, f.sh_bands);
-      for (std::size_t c = 0; c < channels; ++c)
-        row[k * channels + c] = sh_dot(std::span<const float>(coeffs).subspan(c * cc), rotated, cc);
+    if (kr > 1) {
+      const ShRotation to_source_frame(pure * frames[j]);
+      for (std::size_t k = 1; k < kr; ++k) {
+        to_source_frame.apply(receiver_glossy->lobe_coefficients(static_cast<int>(k - 1)), rotated, f.sh_bands);
+        for (std::size_t c = 0; c < channels; ++c)
+          row[k * channels + c] = sh_dot(std::span<const float>(coeffs).subspan(c * cc), rotated, cc);
+      }
     }
+    if (v != 1.0f)
+      for (std::size_t c = 0; c < kr * channels; ++c) row[c] *= v;
   }
 }
 
@@ -245,8 +258,15 @@ BrfResult brf_interreflect(std::span<const BrfObject> objects, std::span<const s
   for (std::size_t s = 0; s < n; ++s) w[s] = brf_fit_rgb(*objects[s].basis, light[s]);
   const std::vector<std::uint8_t> culled = brf_pair_culling(objects, w, settings.cull_threshold);
 
-  // Basis irradiance of every live pair, once per frame.
+  // Basis irradiance of every live pair, once per frame, seen past the objects in between.
+  std::vector<BrfBox> boxes(n);
+  std::vector<BrfSphere> spheres(n);
+  for (std::size_t o = 0; o < n; ++o) {
+    boxes[o] = brf_object_box(*objects[o].mesh);
+    spheres[o] = brf_bounding_sphere(boxes[o], objects[o].object_to_world);
+  }
   std::vector<std::vector<float>> phi(n * n);
+  std::vector<BrfOccluder> occluders;
   for (std::size_t s = 0; s < n; ++s)
     for (std::size_t r = 0; r < n; ++r) {
       if (s == r) continue;
@@ -255,7 +275,12 @@ BrfResult brf_interreflect(std::span<const BrfObject> objects, std::span<const s
         continue;
       }
       ++out.pairs_evaluated;
-      brf_basis_irradiance(objects[s], wv[r].positions, wv[r].normals, phi[s * n + r], objects[r].glossy, wv[r].frames);
+      occluders.clear();
+      if (settings.occlusion)
+        for (std::uint32_t o : brf_pair_occluders(spheres, s, r))
+          occluders.push_back({boxes[o], glm::inverse(objects[o].object_to_world) * objects[s].object_to_world});
+      brf_basis_irradiance(objects[s], wv[r].positions, wv[r].normals, phi[s * n + r], objects[r].glossy, wv[r].frames,
+                           occluders);
     }
 
   for (int bounce = 0; bounce < settings.bounces; ++bounce) {
@@ -282,6 +307,7 @@ BrfResult brf_interreflect(std::span<const BrfObject> objects, std::span<const s
     std::vector<std::size_t> index;
     std::vector<float> phi_static;
     std::vector<glm::vec3> e;
+    std::vector<float> visibility;
     for (std::size_t s = 0; s < n; ++s) {
       const BasisRadianceField& f = *objects[s].field;
       const glm::vec3 centre = glm::vec3(objects[s].object_to_world * glm::vec4(f.centre, 1.0f));
@@ -297,11 +323,18 @@ BrfResult brf_interreflect(std::span<const BrfObject> objects, std::span<const s
           index.push_back(t);
         }
       if (index.empty()) continue;
+      visibility.assign(index.size(), 1.0f);
+      if (receivers.world != nullptr) {
+        std::array<glm::vec3, kBrfVisibilityTargets> targets = brf_visibility_targets(brf_object_box(*objects[s].mesh));
+        for (glm::vec3& t : targets) t = glm::vec3(objects[s].object_to_world * glm::vec4(t, 1.0f));
+        brf_static_visibility(*receivers.world, targets, pos, nrm, visibility);
+      }
       brf_basis_irradiance(objects[s], pos, nrm, phi_static);
       const auto wt = brf_fit_rgb(*objects[s].basis, total[s]);
       e.assign(index.size(), glm::vec3(0.0f));
       gather(phi_static, static_cast<std::size_t>(f.channel_count()), 1, wt, e);
-      for (std::size_t k = 0; k < index.size(); ++k) out.static_irradiance[index[k]] += e[k];
+      for (std::size_t k = 0; k < index.size(); ++k)
+        if (visibility[k] > 0.0f) out.static_irradiance[index[k]] += visibility[k] * e[k];
     }
   }
   return out;

@@ -16,7 +16,8 @@
 //         radiosity B = albedo x E (eq. 12) is fitted again for the next bounce;
 //      d. static receivers (points of the static world, e.g. light-atlas texels) inside a
 //         source's outermost field sphere get that source's bounce from its total radiosity
-//         albedo x (incoming + interreflected).
+//         albedo x (incoming + interreflected), times the fraction of the source they see
+//         past the static world when BrfStaticReceivers::world is given.
 // Pairs whose bound contribution I_c (§5.4) — the first bounce's irradiance at the
 // receiver's centre, facing the source, summed over the channels in absolute value — is below `cull_threshold` x the largest pair's are
 // skipped for the whole frame (brf_pair_culling).
@@ -67,12 +68,20 @@ struct BrfUpdateSettings {
   /// Skip a (source, receiver) pair when its bound contribution I_c is below this fraction
   /// of the largest pair's (0: evaluate every pair).
   float cull_threshold = 1e-3f;
+  /// Occlusion between the objects: a pair's basis irradiance is scaled, per receiver point,
+  /// by the fraction of the source it sees past the boxes of the objects in between
+  /// (brf_pair_occluders, brf_box_visibility). Off: light passes through objects.
+  bool occlusion = true;
 };
 
 /// Points of the static world that take the objects' bounce (world space, unit normals).
 struct BrfStaticReceivers {
   std::span<const glm::vec3> positions;
   std::span<const glm::vec3> normals;
+  /// The static world (not the objects). When given, each source's bounce at a receiver is
+  /// scaled by the fraction of the source the receiver sees past it (brf_static_visibility,
+  /// brf_visibility.h): a receiver behind a wall gets exactly 0.
+  const RayCaster* world = nullptr;
 };
 
 struct BrfResult {
@@ -102,6 +111,14 @@ struct BrfBox {
 };
 BrfBox brf_object_box(const BrfMesh& mesh);
 
+/// A dynamic object standing in the way of a (source, receiver) pair, as its box: `box` in its
+/// own object space, `to_occluder` maps the space the test runs in (the source's object space
+/// in brf_basis_irradiance) into it.
+struct BrfOccluder {
+  BrfBox box;
+  glm::mat4 to_occluder{1.0f};
+};
+
 /// Where an object (its box, object space) lies relative to the tangent plane of a receiver
 /// point p with unit normal n (object space): wholly behind it (no light can arrive), wholly
 /// in front (the unclamped cosine is exact), or straddling it.
@@ -114,9 +131,13 @@ BrfHorizon brf_horizon(const BrfBox& box, const glm::vec3& p, const glm::vec3& n
 /// unclamped cosine where the source is wholly in front (brf_horizon), else the clamped
 /// cosine; for k' >= 1 (a glossy receiver: `receiver_glossy` and world `frames` given,
 /// K_r = 1 + its terms) the projection of g_k' cos rotated from the vertex's frame. out is resized.
+/// With `occluders` (boxes of other objects, to_occluder from the source's object space), each
+/// point's rows are scaled by the fraction of the source it sees past them
+/// (brf_box_visibility, brf_visibility.h; the V of eq. 12-13 taken out of the integral).
 void brf_basis_irradiance(const BrfObject& source, std::span<const glm::vec3> positions,
                           std::span<const glm::vec3> normals, std::vector<float>& out,
-                          const BrdfSeparation* receiver_glossy = nullptr, std::span<const glm::mat3> frames = {});
+                          const BrdfSeparation* receiver_glossy = nullptr, std::span<const glm::mat3> frames = {},
+                          std::span<const BrfOccluder> occluders = {});
 
 /// Radiance (W/(m^2 sr), RGB) leaving vertex j of `object` toward world direction w_out,
 /// from its per-vertex values `light` ([k x V + j], incoming light of all kinds summed).

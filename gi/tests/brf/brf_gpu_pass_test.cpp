@@ -228,7 +228,9 @@ TEST(BrfGpuPass, MovingOneObjectRecomputesOnlyItsPairs) {
   const StaticPoints floor = static_points();
   ASSERT_TRUE(pass.set_static_receivers(floor.positions, floor.normals).ok());
   auto instances = three_objects();
-  const gi::BrfUpdateSettings settings{.bounces = 2, .cull_threshold = 0.0f};
+  // The relative-pose cache alone: with occlusion the moved object stands between the other
+  // two and their pair is evaluated again too (BrfOcclusion.GpuPassMatchesItsTwin...).
+  const gi::BrfUpdateSettings settings{.bounces = 2, .cull_threshold = 0.0f, .occlusion = false};
   ASSERT_TRUE(pass.run(instances, incoming_light(instances, {-1.0f, 1.5f, 0.8f}), settings).ok());
 
   instances[1].object_to_world = pose({0.5f, 0.15f, 0.1f}, 0.5f, {1, 1, 0}, 1.1f);
@@ -526,9 +528,10 @@ TEST(BrfGpuPass, GlossyWithCullingAndPoseCache) {
               pass.stats().pairs_culled);
   EXPECT_LT(e, kGlossyTolerance);
 
-  // Close again, no culling; then the diffuse cube moves: the glossy pair (both ways) is kept.
+  // Close again, no culling; then the diffuse cube moves: the glossy pair (both ways) is kept
+  // (the relative-pose cache alone, as in MovingOneObjectRecomputesOnlyItsPairs).
   instances = glossy_objects();
-  const gi::BrfUpdateSettings settings{.bounces = 2, .cull_threshold = 0.0f};
+  const gi::BrfUpdateSettings settings{.bounces = 2, .cull_threshold = 0.0f, .occlusion = false};
   ASSERT_TRUE(pass.run(instances, glossy_incoming(instances, {-1.0f, 1.5f, 0.8f}), settings).ok());
   instances[2].object_to_world = pose({0.05f, 0.15f, 0.75f}, -0.5f, {0, 1, 1}, 0.8f);
   incoming = glossy_incoming(instances, {-1.0f, 1.5f, 0.8f});

@@ -89,14 +89,15 @@ TEST(GISystem, RecomputesOnlyWhatChanged) {
   EXPECT_EQ(gi.stats().idle_frames, 2u);
   EXPECT_EQ(gi.stats().world_composites, 1u);
 
-  // One crate moves: only the pairs with it get new basis irradiance.
+  // One crate moves: only the pairs with it (8) and the pairs it may stand between (of the 12
+  // among the other four, those whose capsule its sphere reaches, brf_pair_occluders) get new
+  // basis irradiance; the others' is reused.
   move_to(scene, "crate_3", {2.0f, 0.0f, -1.5f});
   gi.frame();
   EXPECT_EQ(gi.stats().brf_updates, 2u);
   EXPECT_EQ(gi.stats().brf_moves, 2u);
   std::printf("crate_3 moved: %zu pairs evaluated, %zu reused, %zu culled\n", gi.stats().brf_pairs_evaluated,
               gi.stats().brf_pairs_reused, gi.stats().brf_pairs_culled);
-  EXPECT_GE(gi.stats().brf_pairs_reused + 8u, gi.stats().brf_pairs_evaluated);
   EXPECT_GT(gi.stats().brf_pairs_reused, 0u);
   EXPECT_EQ(gi.stats().world_composites, 2u);
 

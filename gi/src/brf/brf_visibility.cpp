@@ -1,0 +1,100 @@
+#include "brf/brf_visibility.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "raytrace/ray_caster.h"
+#include "raytrace/ray_offset.h"
+
+namespace gi {
+
+std::array<glm::vec3, kBrfVisibilityTargets> brf_visibility_targets(const BrfBox& box) {
+  const glm::vec3 c = 0.5f * (box.lo + box.hi), h = kBrfCornerPull * 0.5f * (box.hi - box.lo);
+  std::array<glm::vec3, kBrfVisibilityTargets> t{};
+  t[0] = c;
+  for (int k = 0; k < 8; ++k)
+    t[static_cast<std::size_t>(k) + 1] =
+        c + glm::vec3((k & 1) != 0 ? h.x : -h.x, (k & 2) != 0 ? h.y : -h.y, (k & 4) != 0 ? h.z : -h.z);
+  return t;
+}
+
+void brf_static_visibility(const RayCaster& world, std::span<const glm::vec3> targets,
+                           std::span<const glm::vec3> positions, std::span<const glm::vec3> normals,
+                           std::span<float> out) {
+  // All rays of all receivers in one stream, then the weighted fractions per receiver.
+  std::vector<Ray> rays;
+  rays.reserve(positions.size() * targets.size());
+  for (std::size_t j = 0; j < positions.size(); ++j) {
+    const glm::vec3 o = offset_ray_origin(positions[j], normals[j]);
+    brf_weighted_visibility(positions[j], normals[j], targets, [&](std::size_t, const glm::vec3&, const glm::vec3& t) {
+      rays.push_back(Ray{o, 0.0f, t - o, 1.0f});
+      return false;
+    });
+  }
+  std::vector<std::uint8_t> blocked(rays.size(), 0);
+  world.occluded_many(rays, blocked);
+  std::size_t next = 0;
+  for (std::size_t j = 0; j < positions.size(); ++j)
+    out[j] = brf_weighted_visibility(positions[j], normals[j], targets,
+                                     [&](std::size_t, const glm::vec3&, const glm::vec3&) { return blocked[next++] == 0; });
+}
+
+BrfSphere brf_bounding_sphere(const BrfBox& box, const glm::mat4& object_to_world) {
+  const glm::vec3 c = 0.5f * (box.lo + box.hi);
+  const float scale = glm::length(glm::vec3(object_to_world[0]));
+  return {glm::vec3(object_to_world * glm::vec4(c, 1.0f)), scale * glm::length(0.5f * (box.hi - box.lo))};
+}
+
+std::vector<std::uint32_t> brf_pair_occluders(std::span<const BrfSphere> spheres, std::size_t source,
+                                              std::size_t receiver) {
+  std::vector<std::uint32_t> out;
+  const glm::vec3 a = spheres[receiver].centre, b = spheres[source].centre;
+  const float reach = std::max(spheres[receiver].radius, spheres[source].radius);
+  const glm::vec3 ab = b - a;
+  const float len2 = glm::dot(ab, ab);
+  for (std::size_t o = 0; o < spheres.size(); ++o) {
+    if (o == source || o == receiver) continue;
+    const float t = len2 > 0.0f ? std::clamp(glm::dot(spheres[o].centre - a, ab) / len2, 0.0f, 1.0f) : 0.0f;
+    if (glm::length(spheres[o].centre - (a + t * ab)) < spheres[o].radius + reach)
+      out.push_back(static_cast<std::uint32_t>(o));
+  }
+  return out;
+}
+
+bool brf_segment_clear(const glm::vec3& a, const glm::vec3& b, std::span<const BrfOccluder> occluders) {
+  // Slab test in each occluder's object space for t in [0, 1]; the same arithmetic as
+  // brf_segment_clear in brf_common.glsl.
+  for (const BrfOccluder& o : occluders) {
+    const glm::vec3 p = glm::vec3(o.to_occluder * glm::vec4(a, 1.0f));
+    const glm::vec3 d = glm::vec3(o.to_occluder * glm::vec4(b, 1.0f)) - p;
+    float t0 = 0.0f, t1 = 1.0f;
+    bool miss = false;
+    for (int k = 0; k < 3 && !miss; ++k) {
+      if (std::fabs(d[k]) < 1e-12f) {
+        miss = p[k] < o.box.lo[k] || p[k] > o.box.hi[k];
+        continue;
+      }
+      const float inv = 1.0f / d[k];
+      float ta = (o.box.lo[k] - p[k]) * inv, tb = (o.box.hi[k] - p[k]) * inv;
+      if (ta > tb) std::swap(ta, tb);
+      t0 = std::max(t0, ta);
+      t1 = std::min(t1, tb);
+      miss = t0 > t1;
+    }
+    if (!miss) return false;
+  }
+  return true;
+}
+
+void brf_box_visibility(std::span<const BrfOccluder> occluders, std::span<const glm::vec3> targets,
+                        std::span<const glm::vec3> positions, std::span<const glm::vec3> normals,
+                        std::span<float> out) {
+  for (std::size_t j = 0; j < positions.size(); ++j)
+    out[j] = occluders.empty() ? 1.0f
+                               : brf_weighted_visibility(positions[j], normals[j], targets,
+                                                         [&](std::size_t, const glm::vec3& p, const glm::vec3& t) {
+                                                           return brf_segment_clear(p, t, occluders);
+                                                         });
+}
+
+}  // namespace gi

@@ -1,0 +1,184 @@
+// Visibility of basis radiance fields (brf_visibility.h): a dynamic object's bounce reaches
+// only the static receivers that see it past the static world. A lit red crate, a wall, a
+// floor patch behind the wall: the patch receives exactly 0 from the crate on the CPU twin
+// and on the GPU pass, while without the wall's rays the field leaks light onto it (so the
+// test can fail); receivers on the crate's side of the wall keep every bit of the bounce.
+#include "brf/brf_visibility.h"
+
+#include <engine/gpu/context.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <glm/gtc/matrix_transform.hpp>
+#include <vector>
+
+#include "brf/brf_gpu_pass.h"
+#include "brf/brf_runtime.h"
+#include "brf_scenes.h"
+#include "raytrace/embree_ray_caster.h"
+
+namespace {
+
+engine::GpuContext headless_or_fail() {
+  auto ctx = engine::GpuContext::create_headless();
+  if (!ctx) {
+    ADD_FAILURE() << "headless GL context creation failed: " << ctx.error().to_string();
+    std::abort();
+  }
+  return std::move(ctx).value();
+}
+
+struct Crate {
+  gi::BrfMesh mesh = brftest::box({0.3f, 0.3f, 0.3f}, 3);
+  gi::BrfBasis basis = gi::compute_pca_basis(mesh, {.lights = 64, .basis = 8}).value();
+  gi::BasisRadianceField field =
+      gi::compute_basis_radiance_field(mesh, basis, {.spheres = 6, .face_resolution = 6, .sh_bands = 3, .directions = 64})
+          .value();
+};
+
+const Crate& crate() {
+  static const Crate c;
+  return c;
+}
+
+// Static world: a floor slab (top at y = 0) and a wall 0.2 m thick at x in [-0.1, 0.1], 2 m high.
+std::unique_ptr<gi::RayCaster> wall_and_floor(bool with_wall) {
+  gi::RtSceneData data;
+  const auto add_box = [&](glm::vec3 lo, glm::vec3 hi) {
+    const gi::BrfMesh b = gi::brf_box_mesh(0.5f * (hi - lo), 1, 1.0f);
+    data.geometries.push_back({b.positions, b.indices});
+    data.instances.push_back({static_cast<std::uint32_t>(data.geometries.size() - 1),
+                              glm::translate(glm::mat4(1.0f), 0.5f * (lo + hi)), false, 0});
+  };
+  add_box({-4.0f, -0.2f, -4.0f}, {4.0f, 0.0f, 4.0f});
+  if (with_wall) add_box({-0.1f, 0.0f, -4.0f}, {0.1f, 2.0f, 4.0f});
+  return gi::make_embree_ray_caster(data).value();
+}
+
+struct Receivers {
+  std::vector<glm::vec3> positions, normals;
+  std::size_t near_count = 0;  ///< The first near_count are on the crate's side of the wall.
+};
+
+// Floor points on the crate's side of the wall (beyond the crate), then a patch behind the wall.
+Receivers floor_receivers() {
+  Receivers r;
+  for (int i = 0; i < 4; ++i)
+    for (int k = 0; k < 8; ++k) {
+      r.positions.emplace_back(-1.35f + 0.09f * static_cast<float>(i), 0.0f, -0.71f + 0.2f * static_cast<float>(k));
+      r.normals.emplace_back(0.0f, 1.0f, 0.0f);
+    }
+  r.near_count = r.positions.size();
+  for (int i = 0; i < 8; ++i)
+    for (int k = 0; k < 8; ++k) {
+      r.positions.emplace_back(0.23f + 0.17f * static_cast<float>(i), 0.0f, -0.71f + 0.2f * static_cast<float>(k));
+      r.normals.emplace_back(0.0f, 1.0f, 0.0f);
+    }
+  return r;
+}
+
+// The crate stands 10 cm from the wall.
+const glm::mat4 kCratePose = glm::rotate(glm::translate(glm::mat4(1.0f), {-0.5f, 0.3f, 0.05f}), 0.2f, {0, 1, 0});
+const glm::vec3 kRed(0.8f, 0.1f, 0.1f);
+
+// A lamp above the crate's side toward the wall (unshadowed) plus a constant sky term.
+std::vector<std::vector<glm::vec3>> crate_light(const gi::BrfObject& o) {
+  const gi::BrfWorldVertices v = gi::brf_world_vertices(o);
+  std::vector<std::vector<glm::vec3>> in(1);
+  const glm::vec3 lamp(-0.25f, 1.4f, 0.3f);
+  for (std::size_t j = 0; j < v.positions.size(); ++j) {
+    const glm::vec3 d = lamp - v.positions[j];
+    const float c = std::max(0.0f, glm::dot(v.normals[j], glm::normalize(d)));
+    in[0].push_back(glm::vec3(8.0f * c / glm::dot(d, d)) + glm::vec3(0.05f));
+  }
+  return in;
+}
+
+TEST(BrfVisibility, TargetsAndSegmentsFollowTheBox) {
+  const gi::BrfBox box{{-1.0f, -2.0f, -3.0f}, {1.0f, 2.0f, 3.0f}};
+  const auto t = gi::brf_visibility_targets(box);
+  EXPECT_EQ(t[0], glm::vec3(0.0f));
+  for (std::size_t i = 1; i < t.size(); ++i)
+    EXPECT_NEAR(glm::length(glm::abs(t[i]) - gi::kBrfCornerPull * glm::vec3(1.0f, 2.0f, 3.0f)), 0.0f, 1e-6f);
+  const gi::BrfOccluder o{box, glm::inverse(glm::translate(glm::mat4(1.0f), {5.0f, 0.0f, 0.0f}))};
+  EXPECT_FALSE(gi::brf_segment_clear({0, 0, 0}, {10, 0, 0}, std::span(&o, 1)));   // straight through
+  EXPECT_TRUE(gi::brf_segment_clear({0, 0, 0}, {3.9f, 0, 0}, std::span(&o, 1)));  // stops short
+  EXPECT_TRUE(gi::brf_segment_clear({0, 2.1f, 0}, {10, 2.1f, 0}, std::span(&o, 1)));  // passes above
+  EXPECT_FALSE(gi::brf_segment_clear({5, 0, 0}, {5, 0, 0}, std::span(&o, 1)));     // a point inside
+}
+
+TEST(BrfVisibility, NoBounceThroughAWallOnTheCpuTwinAndTheGpu) {
+  auto ctx = headless_or_fail();
+  const Crate& c = crate();
+  const gi::BrfObject object{&c.mesh, &c.basis, &c.field, kCratePose, kRed};
+  const auto incoming = crate_light(object);
+  const Receivers r = floor_receivers();
+  const auto wall = wall_and_floor(true);
+  const auto no_wall = wall_and_floor(false);
+  const std::span<const gi::BrfObject> objects(&object, 1);
+  const gi::BrfUpdateSettings settings{.bounces = 2, .cull_threshold = 0.0f};
+  const gi::BrfResult blind = gi::brf_interreflect(objects, incoming, settings, {r.positions, r.normals});
+  const gi::BrfResult open = gi::brf_interreflect(objects, incoming, settings, {r.positions, r.normals, no_wall.get()});
+  const gi::BrfResult walled = gi::brf_interreflect(objects, incoming, settings, {r.positions, r.normals, wall.get()});
+
+  // Without visibility the field leaks onto the far patch: what the wall must stop.
+  float leak = 0.0f;
+  for (std::size_t t = r.near_count; t < r.positions.size(); ++t) leak = std::max(leak, blind.static_irradiance[t].x);
+  EXPECT_GT(leak, 1e-3f) << "the far patch is outside the crate's field: the test would pass without visibility";
+  for (std::size_t t = r.near_count; t < r.positions.size(); ++t) {
+    EXPECT_EQ(walled.static_irradiance[t], glm::vec3(0.0f)) << "far receiver " << t;
+    if (blind.static_irradiance[t].x > 0.0f) {  // inside the field: it sees the crate when there is no wall
+      EXPECT_EQ(open.static_irradiance[t], blind.static_irradiance[t]) << "far receiver " << t;
+    }
+  }
+  // The crate's side: nothing is in the way, so all of the bounce arrives.
+  float near = 0.0f;
+  for (std::size_t t = 0; t < r.near_count; ++t) {
+    EXPECT_EQ(walled.static_irradiance[t], blind.static_irradiance[t]) << "near receiver " << t;
+    near = std::max(near, walled.static_irradiance[t].x);
+  }
+  EXPECT_GT(near, 1e-3f);
+
+  // The GPU pass: the same zeros, the same near light (float32 twin, rel. RMSE < 1e-3).
+  auto pass = gi::BrfGpuPass::create(std::vector<gi::BrfGpuModel>{{&c.mesh, &c.basis, &c.field}}).value();
+  ASSERT_TRUE(pass.set_static_receivers(r.positions, r.normals, wall.get()).ok());
+  const gi::BrfGpuInstance inst{0, kCratePose, kRed};
+  ASSERT_TRUE(pass.run(std::span(&inst, 1), incoming, settings).ok());
+  const std::vector<glm::vec3> gpu = pass.read_back_static();
+  ASSERT_EQ(gpu.size(), r.positions.size());
+  double err = 0.0, norm = 0.0;
+  for (std::size_t t = 0; t < gpu.size(); ++t) {
+    if (t >= r.near_count) {
+      EXPECT_EQ(gpu[t], glm::vec3(0.0f)) << "far receiver " << t << " on the GPU";
+    }
+    const glm::dvec3 d = glm::dvec3(gpu[t]) - glm::dvec3(walled.static_irradiance[t]);
+    err += glm::dot(d, d);
+    norm += glm::dot(glm::dvec3(walled.static_irradiance[t]), glm::dvec3(walled.static_irradiance[t]));
+  }
+  ASSERT_GT(norm, 0.0);
+  EXPECT_LT(std::sqrt(err / norm), 1e-3);
+}
+
+// A receiver that sees part of the source gets that part: a low wall (20 cm) hides the crate's
+// lower targets from a floor point 1 m behind it; right behind the wall it hides all of them.
+TEST(BrfVisibility, PartlyHiddenReceiversGetTheVisibleFraction) {
+  gi::RtSceneData data;
+  const gi::BrfMesh b = gi::brf_box_mesh({0.1f, 0.1f, 2.0f}, 1, 1.0f);
+  data.geometries.push_back({b.positions, b.indices});
+  data.instances.push_back({0, glm::translate(glm::mat4(1.0f), {0.0f, 0.1f, 0.0f}), false, 0});
+  const auto low_wall = gi::make_embree_ray_caster(data).value();
+  std::array<glm::vec3, gi::kBrfVisibilityTargets> targets =
+      gi::brf_visibility_targets(gi::brf_object_box(crate().mesh));
+  for (glm::vec3& t : targets) t = glm::vec3(kCratePose * glm::vec4(t, 1.0f));
+  const std::vector<glm::vec3> p{{1.0f, 0.0f, 0.0f}, {-1.2f, 0.0f, 0.0f}, {0.15f, 0.0f, 0.0f}};
+  const std::vector<glm::vec3> n(3, glm::vec3(0.0f, 1.0f, 0.0f));
+  std::vector<float> v(3);
+  gi::brf_static_visibility(*low_wall, targets, p, n, v);
+  EXPECT_GT(v[0], 0.0f);
+  EXPECT_LT(v[0], 1.0f);
+  EXPECT_EQ(v[1], 1.0f);  // the crate's side of the wall
+  EXPECT_EQ(v[2], 0.0f);  // right behind it
+}
+
+}  // namespace
