@@ -351,6 +351,8 @@ engine::Status BrfGpuPass::set_static_receivers(std::span<const glm::vec3> posit
   static_count_ = positions.size();
   static_out_.reserve(static_count_ * sizeof(glm::vec4));
   glClearNamedBufferData(static_out_.buffer.id(), GL_R32F, GL_RED, GL_FLOAT, nullptr);
+  static_occlusion_.reserve(std::max<std::size_t>(static_count_, 4) * sizeof(float));
+  glClearNamedBufferData(static_occlusion_.buffer.id(), GL_R32F, GL_RED, GL_FLOAT, nullptr);
   for (StaticSlot& s : static_slots_) s = StaticSlot{};
   static_touched_count_ = 0;
   return {};
@@ -560,6 +562,12 @@ void BrfGpuPass::relayout_static_phi(std::span<const BrfGpuInstance> instances, 
       slot.pose = instances[s].object_to_world;
       slot.receivers = std::move(inside[s]);
       slot.visibility = std::move(visibility[s]);
+      const BrfBox box = brf_object_box(*model.mesh);
+      slot.occlusion.resize(slot.receivers.size());
+      for (std::size_t k = 0; k < slot.receivers.size(); ++k)
+        slot.occlusion[k] = slot.visibility[k] * brf_box_form_factor(box, instances[s].object_to_world,
+                                                                     static_positions_[slot.receivers[k]],
+                                                                     static_normals_[slot.receivers[k]]);
       if (count > 0) {
         BrfPhiJob job;
         job.to_source = glm::inverse(instances[s].object_to_world);
@@ -605,6 +613,13 @@ void BrfGpuPass::upload_static_lists(std::span<const BrfGpuInstance> instances) 
           glm::uvec4(weight_offsets_[s], (slot.phi_offset + u32(k) * nb) / 4, nb / 4, u32(s));
   }
   static_touched_.upload(touched.data(), touched.size() * sizeof(glm::uvec4));
+  // The objects' occlusion of the baked light, summed per receiver in instance order.
+  std::vector<float> occlusion(std::max<std::size_t>(static_count_, 1), 0.0f);
+  for (std::size_t s = 0; s < n; ++s)
+    for (std::size_t k = 0; k < static_slots_[s].receivers.size(); ++k)
+      occlusion[static_slots_[s].receivers[k]] += static_slots_[s].occlusion[k];
+  for (float& o : occlusion) o = std::min(o, 1.0f);
+  static_occlusion_.upload(occlusion.data(), occlusion.size() * sizeof(float));
   static_entries_.upload(entries.data(), entries.size() * sizeof(glm::uvec4));
   static_touched_count_ = u32(touched.size());
 }
@@ -634,7 +649,10 @@ engine::Status BrfGpuPass::run(std::span<const BrfGpuInstance> instances,
 
   stats_ = Stats{};
   if (n == 0) {
-    if (static_count_ > 0) glClearNamedBufferData(static_out_.buffer.id(), GL_R32F, GL_RED, GL_FLOAT, nullptr);
+    if (static_count_ > 0) {
+      glClearNamedBufferData(static_out_.buffer.id(), GL_R32F, GL_RED, GL_FLOAT, nullptr);
+      glClearNamedBufferData(static_occlusion_.buffer.id(), GL_R32F, GL_RED, GL_FLOAT, nullptr);
+    }
     stats_.cpu_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     return {};
   }
@@ -897,11 +915,19 @@ std::vector<glm::vec3> BrfGpuPass::read_back_static() const {
   return read_back_vec4s(static_out_.buffer.id(), static_count_);
 }
 
+std::vector<float> BrfGpuPass::read_back_static_occlusion() const {
+  std::vector<float> out(static_count_, 0.0f);
+  if (!out.empty())
+    glGetNamedBufferSubData(static_occlusion_.buffer.id(), 0, static_cast<GLsizeiptr>(out.size() * sizeof(float)),
+                            out.data());
+  return out;
+}
+
 std::size_t BrfGpuPass::gpu_bytes() const {
   std::size_t bytes = model_bytes_ + output_bytes_;
   for (const Buffer* b :
        {&static_points_, &instance_table_, &incoming_, &gathered_, &indirect_, &weights_, &phi_, &live_, &jobs_,
-        &groups_, &occluders_, &static_indices_, &static_visibility_, &static_phi_, &static_phi_spare_, &static_touched_, &static_entries_, &static_out_})
+        &groups_, &occluders_, &static_occlusion_, &static_indices_, &static_visibility_, &static_phi_, &static_phi_spare_, &static_touched_, &static_entries_, &static_out_})
     bytes += b->bytes;
   return bytes;
 }

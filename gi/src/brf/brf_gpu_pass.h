@@ -134,6 +134,11 @@ class BrfGpuPass {
   std::uint32_t vertex_buffer(std::size_t instance) const;
   /// GL buffer: vec4 per static receiver, xyz = irradiance from all objects (W/m^2).
   std::uint32_t static_receiver_buffer() const { return static_out_.buffer.id(); }
+  /// GL buffer: float per static receiver, the share of its baked light the objects block
+  /// (BrfResult::static_occlusion); computed on the CPU when a source moves.
+  std::uint32_t static_occlusion_buffer() const { return static_occlusion_.buffer.id(); }
+  /// static_occlusion_buffer() read back.
+  std::vector<float> read_back_static_occlusion() const;
   /// vertex_buffer(i) read back (for tests and tools): the irradiance, V values.
   std::vector<glm::vec3> read_back_vertices(std::size_t instance) const;
   /// All terms of instance i, K x V values [k x V + j] as BrfResult::indirect holds them (V
@@ -197,6 +202,7 @@ class BrfGpuPass {
     glm::mat4 pose{1.0f};                  ///< M_source when computed.
     std::vector<std::uint32_t> receivers;  ///< Static receivers inside its outermost sphere (that see it).
     std::vector<float> visibility;         ///< Per receiver, the fraction of the source it sees (1 without a world).
+    std::vector<float> occlusion;          ///< Per receiver, visibility x the source box's form factor.
     std::uint32_t index_offset = 0;        ///< First entry in static_indices_.
     std::uint32_t phi_offset = 0;          ///< First float in static_phi_.
   };
@@ -286,6 +292,7 @@ class BrfGpuPass {
   std::size_t output_bytes_ = 0;
   Buffer occluders_;  ///< This frame's Phi jobs' occluder records.
   Buffer instance_table_, incoming_, gathered_, indirect_, weights_, phi_, live_, jobs_, groups_;
+  Buffer static_occlusion_;  ///< Per static receiver, the objects' occlusion of its baked light.
   Buffer static_indices_, static_visibility_, static_phi_, static_phi_spare_, static_touched_, static_entries_, static_out_;
   std::uint32_t static_touched_count_ = 0;
 

@@ -267,6 +267,7 @@ void BrfLighting::composite_world(std::uint32_t base_texture, std::uint32_t comp
   glProgramUniform1ui(m.composite_program.id(), m.composite_width, static_cast<GLuint>(m.world.atlas_width));
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, m.receiver_texels.id());
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, m.pass->static_receiver_buffer());
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, m.pass->static_occlusion_buffer());
   glBindImageTexture(0, composite_texture, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
   glDispatchCompute((count + kGroupSize - 1) / kGroupSize, 1, 1);
   glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);

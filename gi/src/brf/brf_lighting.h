@@ -96,7 +96,8 @@ class BrfLighting {
   /// The per-vertex indirect irradiance SSBO of `e` (vec4 per vertex), 0 for other entities.
   std::uint32_t vertex_buffer(engine::Entity e) const;
   /// Copies `base_texture` (RGBA32F atlas, width x height) into `composite_texture` (same
-  /// size and format) and adds the objects' bounce at the static receivers.
+  /// size and format), darkens it where the objects block the baked light
+  /// (BrfResult::static_occlusion) and adds their bounce at the static receivers.
   void composite_world(std::uint32_t base_texture, std::uint32_t composite_texture) const;
   bool has_static_receivers() const;
 

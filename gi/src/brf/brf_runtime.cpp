@@ -239,6 +239,7 @@ BrfResult brf_interreflect(std::span<const BrfObject> objects, std::span<const s
   const std::size_t n = objects.size();
   out.indirect.resize(n);
   out.static_irradiance.assign(receivers.positions.size(), glm::vec3(0.0f));
+  out.static_occlusion.assign(receivers.positions.size(), 0.0f);
   if (n == 0) return out;
 
   std::vector<BrfWorldVertices> wv(n);
@@ -333,10 +334,16 @@ BrfResult brf_interreflect(std::span<const BrfObject> objects, std::span<const s
       const auto wt = brf_fit_rgb(*objects[s].basis, total[s]);
       e.assign(index.size(), glm::vec3(0.0f));
       gather(phi_static, static_cast<std::size_t>(f.channel_count()), 1, wt, e);
+      const BrfBox box = brf_object_box(*objects[s].mesh);
       for (std::size_t k = 0; k < index.size(); ++k)
-        if (visibility[k] > 0.0f) out.static_irradiance[index[k]] += visibility[k] * e[k];
+        if (visibility[k] > 0.0f) {
+          out.static_irradiance[index[k]] += visibility[k] * e[k];
+          out.static_occlusion[index[k]] +=
+              visibility[k] * brf_box_form_factor(box, objects[s].object_to_world, pos[k], nrm[k]);
+        }
     }
   }
+  for (float& o : out.static_occlusion) o = std::min(o, 1.0f);
   return out;
 }
 

@@ -89,6 +89,11 @@ struct BrfResult {
   std::vector<std::vector<glm::vec3>> direct;    ///< Direct light (update_brf only).
   std::vector<std::vector<glm::vec3>> indirect;  ///< Interreflected light.
   std::vector<glm::vec3> static_irradiance;      ///< [static receiver] irradiance from all objects.
+  /// [static receiver] the share of its baked indirect light the objects block, in [0, 1]: the
+  /// sum over sources whose field holds it of the source box's form factor
+  /// (brf_box_form_factor) x its visibility, clamped. The world's light there is
+  /// baked x (1 - static_occlusion) + static_irradiance.
+  std::vector<float> static_occlusion;
   std::size_t pairs_evaluated = 0;
   std::size_t pairs_culled = 0;
 };

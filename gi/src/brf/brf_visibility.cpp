@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 #include "raytrace/ray_caster.h"
 #include "raytrace/ray_offset.h"
@@ -37,6 +38,46 @@ void brf_static_visibility(const RayCaster& world, std::span<const glm::vec3> ta
   for (std::size_t j = 0; j < positions.size(); ++j)
     out[j] = brf_weighted_visibility(positions[j], normals[j], targets,
                                      [&](std::size_t, const glm::vec3&, const glm::vec3&) { return blocked[next++] == 0; });
+}
+
+float brf_box_form_factor(const BrfBox& box, const glm::mat4& object_to_world, const glm::vec3& p,
+                          const glm::vec3& n) {
+  const glm::vec3 local = glm::vec3(glm::inverse(object_to_world) * glm::vec4(p, 1.0f));
+  if (glm::all(glm::greaterThan(local, box.lo)) && glm::all(glm::lessThan(local, box.hi))) return 1.0f;
+  // Faces as corner indices (bit 0: x, 1: y, 2: z high) with the axis and side they face.
+  static constexpr int kFaces[6][4] = {{0, 2, 6, 4}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 3, 7, 6}, {0, 1, 3, 2}, {4, 5, 7, 6}};
+  std::array<glm::vec3, 8> corner;
+  for (int k = 0; k < 8; ++k)
+    corner[static_cast<std::size_t>(k)] = glm::vec3(
+        object_to_world * glm::vec4((k & 1) != 0 ? box.hi.x : box.lo.x, (k & 2) != 0 ? box.hi.y : box.lo.y,
+                                    (k & 4) != 0 ? box.hi.z : box.lo.z, 1.0f));
+  float total = 0.0f;
+  for (int f = 0; f < 6; ++f) {
+    const int axis = f / 2;
+    const bool high = (f % 2) == 1;
+    // p sees the face when it lies beyond the face's plane (object space).
+    if (high ? local[axis] <= box.hi[axis] : local[axis] >= box.lo[axis]) continue;
+    // Lambert: sum over edges of angle x (n . edge plane normal) / 2 pi; the same sum against
+    // the direction to the face's centre (wholly in front) gives the winding's sign.
+    glm::vec3 centre(0.0f);
+    for (int e = 0; e < 4; ++e) centre += 0.25f * corner[static_cast<std::size_t>(kFaces[f][e])];
+    const glm::vec3 towards = glm::normalize(centre - p);
+    float sum = 0.0f, sign = 0.0f;
+    for (int e = 0; e < 4; ++e) {
+      const glm::vec3 a = glm::normalize(corner[static_cast<std::size_t>(kFaces[f][e])] - p);
+      const glm::vec3 b = glm::normalize(corner[static_cast<std::size_t>(kFaces[f][(e + 1) % 4])] - p);
+      const glm::vec3 c = glm::cross(a, b);
+      const float len = glm::length(c);
+      if (!(len > 0.0f)) continue;
+      const float angle = std::acos(std::clamp(glm::dot(a, b), -1.0f, 1.0f));
+      sum += angle * glm::dot(n, c / len);
+      sign += angle * glm::dot(towards, c / len);
+    }
+    // Parts of a face below p's horizon count negative in the formula: a face mostly below
+    // it adds nothing.
+    total += std::clamp((sign < 0.0f ? -sum : sum) / (2.0f * std::numbers::pi_v<float>), 0.0f, 1.0f);
+  }
+  return std::clamp(total, 0.0f, 1.0f);
 }
 
 BrfSphere brf_bounding_sphere(const BrfBox& box, const glm::mat4& object_to_world) {

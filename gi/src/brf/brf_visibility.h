@@ -60,6 +60,14 @@ void brf_box_visibility(std::span<const BrfOccluder> occluders, std::span<const 
                         std::span<const glm::vec3> positions, std::span<const glm::vec3> normals,
                         std::span<float> out);
 
+/// The form factor (cosine-weighted solid angle / pi) of an object's box (object space, placed
+/// by `object_to_world`) seen from world point p with unit normal n: the share of p's
+/// irradiance from a uniformly bright sky that the box blocks. Sum over the box faces p sees
+/// of Lambert's polygon formula, each face clamped to [0, 1], the sum too; 1 inside the box.
+/// What the static world's baked indirect light loses under and around a dynamic object
+/// (BrfResult::static_occlusion).
+float brf_box_form_factor(const BrfBox& box, const glm::mat4& object_to_world, const glm::vec3& p, const glm::vec3& n);
+
 /// A bounding sphere in world space.
 struct BrfSphere {
   glm::vec3 centre{0.0f};
