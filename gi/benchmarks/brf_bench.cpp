@@ -8,7 +8,8 @@
 //   BM_BrfGpu: BrfGpuPass::run on llvmpipe (DESIGN.md §4: these are CPU timings; compare
 //   them as ratios), glFinish inside the timed region, with every crate moving each run (all
 //   pairs' Phi re-evaluated) or none moving (every Phi reused; only the bounces run);
-//   BM_BrfGpuGlossy: the GPU pass with every crate a glossy metal, all moving.
+//   BM_BrfGpuGlossy: the GPU pass with every crate a glossy metal, all moving;
+//   BM_BrfGpuOcclusion: the GPU pass with occlusion between the crates off and on.
 //   ./build/benchmarks/brf_bench --benchmark_counters_tabular=true
 #include <GL/glcorearb.h>
 
@@ -162,6 +163,42 @@ void BM_BrfGpu(benchmark::State& state) {
   state.counters["gpu_MB"] = static_cast<double>(pass->gpu_bytes()) / 1e6;
 }
 BENCHMARK(BM_BrfGpu)->ArgsProduct({{1, 5, 10, 30}, {0, 1}, {0, 1}})->Unit(benchmark::kMillisecond);
+
+// Occlusion between the crates (BrfUpdateSettings::occlusion, brf_visibility.h) on and off in
+// the same run: crates, moving, occlusion; no culling. On, a pair's Phi also depends on the
+// poses of the crates in its way (brf_pair_occluders) and each of its vertices tests 9 lines
+// of sight against their boxes.
+void BM_BrfGpuOcclusion(benchmark::State& state) {
+  (void)bench::gl_context();
+  const Shared& s = shared();
+  const int n = static_cast<int>(state.range(0));
+  const bool moving = state.range(1) != 0;
+  const gi::BrfGpuModel model{&s.mesh, &s.basis, &s.field};
+  auto pass = gi::BrfGpuPass::create(std::span(&model, 1));
+  if (!pass) {
+    state.SkipWithError(pass.error().to_string().c_str());
+    return;
+  }
+  const gi::PointEmitter light = grid_light(n);
+  std::vector<gi::BrfGpuInstance> poses[2];
+  for (int k = 0; k < 2; ++k)
+    for (const gi::BrfObject& o : crates(n, 0.02f * static_cast<float>(k)))
+      poses[k].push_back({0, o.object_to_world, o.albedo});
+  const auto incoming = gi::brf_direct_light(crates(n), std::span<const gi::PointEmitter>(&light, 1), nullptr);
+  const gi::BrfUpdateSettings settings{.bounces = 3, .cull_threshold = 0.0f, .occlusion = state.range(2) != 0};
+  if (!pass->run(poses[1], incoming, settings)) state.SkipWithError("run failed");
+  glFinish();
+  std::size_t frame = 0;
+  for (auto _ : state) {
+    const auto status = pass->run(poses[moving ? frame % 2 : 1], incoming, settings);
+    glFinish();
+    if (!status) state.SkipWithError(status.error().to_string().c_str());
+    ++frame;
+  }
+  state.counters["pairs_evaluated"] = static_cast<double>(pass->stats().pairs_evaluated);
+  state.counters["pairs_reused"] = static_cast<double>(pass->stats().pairs_reused);
+}
+BENCHMARK(BM_BrfGpuOcclusion)->ArgsProduct({{10, 30}, {0, 1}, {0, 1}})->Unit(benchmark::kMillisecond);
 
 // Every crate a glossy metal (SharedGlossy), every crate moving each run.
 void BM_BrfGpuGlossy(benchmark::State& state) {
