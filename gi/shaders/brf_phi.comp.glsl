@@ -120,6 +120,33 @@ float occluded_visibility(BrfModel m, vec3 p, vec3 n, uint first, uint count) {
   return all > 0.0 ? seen / all : 0.0;
 }
 
+// brf_contact_visibility (brf_visibility.cpp): t / gap where the normal runs into the source's
+// box within gap = 0.25 x its mean half extent, 0 inside it, 1 otherwise.
+float contact_visibility(BrfModel m, vec3 p, vec3 n) {
+  const vec3 half_extent = 0.5 * (m.box_hi.xyz - m.box_lo.xyz);
+  const float gap = 0.25 * (half_extent.x + half_extent.y + half_extent.z) / 3.0;
+  const float inf = uintBitsToFloat(0x7f800000u);
+  float t0 = -inf, t1 = inf;
+  for (int k = 0; k < 3; ++k) {
+    if (abs(n[k]) < 1e-12) {
+      if (p[k] < m.box_lo[k] || p[k] > m.box_hi[k]) return 1.0;
+      continue;
+    }
+    const float inv = 1.0 / n[k];
+    float ta = (m.box_lo[k] - p[k]) * inv, tb = (m.box_hi[k] - p[k]) * inv;
+    if (ta > tb) {
+      const float t = ta;
+      ta = tb;
+      tb = t;
+    }
+    t0 = max(t0, ta);
+    t1 = min(t1, tb);
+  }
+  if (t0 > t1 || t1 < 0.0) return 1.0;
+  if (t0 <= 0.0) return 0.0;
+  return t0 >= gap ? 1.0 : t0 / gap;
+}
+
 void main() {
   const uint group = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
   if (group >= u_group_count) return;
@@ -151,7 +178,8 @@ void main() {
     return;
   }
   // What the point sees of the source past the objects in the pair's way (1 without any).
-  const float vis = job.occluder_count == 0u ? 1.0 : occluded_visibility(m, p, n, job.occluder_offset, job.occluder_count);
+  const float vis = contact_visibility(m, p, n) *
+                    (job.occluder_count == 0u ? 1.0 : occluded_visibility(m, p, n, job.occluder_offset, job.occluder_count));
   if (vis == 0.0) {
     for (uint i = 0u; i < rows * c4; ++i) phi[row0 + i] = 0.0;
     return;
@@ -170,7 +198,7 @@ void main() {
 
 #ifndef BRF_GLOSSY_RECEIVER
   {  // a diffuse receiver or static point: the irradiance row only
-    const float scale = u_kind == 1u ? static_visibility[job.point_offset + k] : vis;
+    const float scale = (u_kind == 1u ? static_visibility[job.point_offset + k] : 1.0) * vis;
     for (uint i = 0u; i < nc; ++i) {
       float sum = 0.0;
       if (inside)

@@ -96,11 +96,12 @@ void brf_basis_irradiance(const BrfObject& source, std::span<const glm::vec3> po
     const BrfHorizon side = brf_horizon(box, p, n);
     if (side == BrfHorizon::Behind) continue;
     // What the point sees of the source past the other objects (the GPU's brf_phi twin).
-    const float v = occluders.empty() ? 1.0f
-                                      : brf_weighted_visibility(p, n, targets, [&](std::size_t, const glm::vec3& a,
-                                                                                   const glm::vec3& b) {
-                                          return brf_segment_clear(a, b, occluders);
-                                        });
+    const float v = brf_contact_visibility(box, p, n) *
+                    (occluders.empty() ? 1.0f
+                                       : brf_weighted_visibility(p, n, targets, [&](std::size_t, const glm::vec3& a,
+                                                                                    const glm::vec3& b) {
+                                           return brf_segment_clear(a, b, occluders);
+                                         }));
     if (v == 0.0f) continue;
     f.sample(p, coeffs);
     const auto lobe = side == BrfHorizon::InFront ? sh_cosine(n) : sh_clamped_cosine(n, f.sh_bands);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include "raytrace/ray_caster.h"
@@ -78,6 +79,27 @@ float brf_box_form_factor(const BrfBox& box, const glm::mat4& object_to_world, c
     total += std::clamp((sign < 0.0f ? -sum : sum) / (2.0f * std::numbers::pi_v<float>), 0.0f, 1.0f);
   }
   return std::clamp(total, 0.0f, 1.0f);
+}
+
+float brf_contact_visibility(const BrfBox& box, const glm::vec3& p, const glm::vec3& n) {
+  // Slab test of the ray p + t n, t >= 0 (the same arithmetic as brf_phi.comp.glsl).
+  const glm::vec3 half = 0.5f * (box.hi - box.lo);
+  const float gap = kBrfContactGap * (half.x + half.y + half.z) / 3.0f;
+  float t0 = -std::numeric_limits<float>::infinity(), t1 = std::numeric_limits<float>::infinity();
+  for (int k = 0; k < 3; ++k) {
+    if (std::fabs(n[k]) < 1e-12f) {
+      if (p[k] < box.lo[k] || p[k] > box.hi[k]) return 1.0f;
+      continue;
+    }
+    const float inv = 1.0f / n[k];
+    float ta = (box.lo[k] - p[k]) * inv, tb = (box.hi[k] - p[k]) * inv;
+    if (ta > tb) std::swap(ta, tb);
+    t0 = std::max(t0, ta);
+    t1 = std::min(t1, tb);
+  }
+  if (t0 > t1 || t1 < 0.0f) return 1.0f;  // the normal misses the box (or it lies behind)
+  if (t0 <= 0.0f) return 0.0f;             // inside the box
+  return t0 >= gap ? 1.0f : t0 / gap;
 }
 
 BrfSphere brf_bounding_sphere(const BrfBox& box, const glm::mat4& object_to_world) {

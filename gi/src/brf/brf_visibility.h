@@ -68,6 +68,15 @@ void brf_box_visibility(std::span<const BrfOccluder> occluders, std::span<const 
 /// (BrfResult::static_occlusion).
 float brf_box_form_factor(const BrfBox& box, const glm::mat4& object_to_world, const glm::vec3& p, const glm::vec3& n);
 
+/// Contact (docs/brf.md, "Contact"): a receiver point p (unit normal n, both in the source's
+/// object space) whose normal runs into the source's box within kBrfContactGap x the box's
+/// mean half extent sees only the source's surface right in front of it, which the receiver
+/// itself keeps dark: t / gap for a hit at distance t along n, 0 for a point inside the box,
+/// 1 when n misses the box or hits it farther away. brf_basis_irradiance and brf_phi.comp.glsl
+/// multiply Phi by it.
+inline constexpr float kBrfContactGap = 0.25f;
+float brf_contact_visibility(const BrfBox& box, const glm::vec3& p, const glm::vec3& n);
+
 /// A bounding sphere in world space.
 struct BrfSphere {
   glm::vec3 centre{0.0f};
