@@ -179,6 +179,11 @@ void register_brf_sweep(SweepRegistry& registry) {
        .kind = KnobKind::Choice,
        .default_grid = {"apart"},
        .choices = {"apart", "all"}},
+      {.name = "occlusion",
+       .description = "occlusion between the objects (BrfUpdateSettings::occlusion; the contact factor stays on): on or off",
+       .kind = KnobKind::Choice,
+       .default_grid = {"on"},
+       .choices = {"on", "off"}},
       {.name = "ref_spp",
        .description = "path-traced samples per vertex of the reference",
        .kind = KnobKind::Integer,
@@ -261,7 +266,10 @@ void register_brf_sweep(SweepRegistry& registry) {
     const std::vector<PointEmitter> emitters = light_point_emitters(lights, 64, ctx.seed);
     const auto t1 = std::chrono::steady_clock::now();
     const BrfResult r =
-        update_brf(brf, emitters, {.bounces = static_cast<int>(ctx.knobs.integer("bounces")), .cull_threshold = 0.0f});
+        update_brf(brf, emitters,
+                   {.bounces = static_cast<int>(ctx.knobs.integer("bounces")),
+                    .cull_threshold = 0.0f,
+                    .occlusion = ctx.knobs.text("occlusion") == "on"});
     const double frame_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t1).count();
     std::vector<glm::vec3> values;  // the irradiance: each object's first block
     for (std::size_t i = 0; i < r.indirect.size(); ++i)
