@@ -207,6 +207,21 @@ TEST(GiBake, BadSkyIsAUsageError) {
   }
 }
 
+// gi-reference --sky: the same parser (tools/common), so the reference of a sky-lit bake can be
+// rendered from the same command line; a sky the scene lacks shows in the image.
+TEST(GiReference, SkyOptionIsParsedAsGiBakes) {
+  const ToolRun bad =
+      run(GI_REFERENCE_EXE, {"--scene", GI_SOURCE_DIR "/assets/cornell_box.gltf", "--sky", "1,1", "--out", "x.exr"});
+  EXPECT_EQ(bad.exit_code, 2) << bad.output;
+  EXPECT_NE(bad.output.find("--sky"), std::string::npos) << bad.output;
+  const fs::path out = fs::path(GI_BINARY_DIR) / "test_output" / "tools_test" / "reference_sky.exr";
+  fs::create_directories(out.parent_path());
+  const ToolRun ok = run(GI_REFERENCE_EXE, {"--scene", GI_SOURCE_DIR "/assets/cornell_box.gltf", "--sky", "0.5,0.5,0.5",
+                                            "--width", "8", "--height", "8", "--spp", "2", "--out", out.string()});
+  EXPECT_EQ(ok.exit_code, 0) << ok.output;
+  EXPECT_TRUE(fs::exists(out));
+}
+
 // gi-bake --export-uv1: the scene with the light-atlas UVs as TEXCOORD_1, nothing baked
 // (tests/gi/light_atlas_uv_test.cpp checks they are the runtime's).
 TEST(GiBake, ExportUv1WritesTheSceneWithLightmapUvs) {

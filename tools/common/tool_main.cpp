@@ -2,9 +2,13 @@
 
 #include <gi/version.h>
 
+#include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <iostream>
+#include <sstream>
+#include <vector>
 
 namespace tools {
 
@@ -69,5 +73,20 @@ void install_interrupt_handler() {
 }
 
 bool interrupted() { return g_interrupted != 0; }
+
+std::optional<glm::vec3> parse_sky(const std::string& text) {
+  std::vector<std::string> parts;
+  std::stringstream ss(text);
+  for (std::string item; std::getline(ss, item, ',');) parts.push_back(item);
+  if (parts.size() != 3) return std::nullopt;
+  glm::vec3 radiance(0.0f);
+  for (int i = 0; i < 3; ++i) {
+    const std::string& p = parts[static_cast<std::size_t>(i)];
+    char* end = nullptr;
+    radiance[i] = std::strtof(p.c_str(), &end);
+    if (end == p.c_str() || *end != '\0' || !std::isfinite(radiance[i]) || radiance[i] < 0.0f) return std::nullopt;
+  }
+  return radiance;
+}
 
 }  // namespace tools

@@ -11,6 +11,7 @@
 //   if (!result) return tools::fail("gi-bake", result.error());
 
 #include <engine/result.h>
+#include <glm/vec3.hpp>
 
 #include <CLI/CLI.hpp>
 #include <optional>
@@ -38,6 +39,9 @@ std::optional<int> parse(CLI::App& app, std::string_view tool, int argc, char** 
 
 /// SIGINT and SIGTERM set the flag interrupted() reads (and restore the default action, so
 /// a second signal ends the process).
+/// `--sky R,G,B`: three finite radiances >= 0 (W/(m^2 sr)), else nothing.
+std::optional<glm::vec3> parse_sky(const std::string& text);
+
 void install_interrupt_handler();
 bool interrupted();
 

@@ -75,18 +75,10 @@ int main(int argc, char** argv) {
   auto asset = engine::load_gltf(scene_path);
   if (!asset) return tools::fail(kTool, asset.error());
   if (!sky.empty()) {
-    const std::vector<std::string> rgb = split(sky);
-    glm::vec3 radiance(0.0f);
-    bool ok = rgb.size() == 3;
-    for (std::size_t i = 0; ok && i < 3; ++i) {
-      char* end = nullptr;
-      radiance[static_cast<int>(i)] = std::strtof(rgb[i].c_str(), &end);
-      ok = end != rgb[i].c_str() && *end == '\0' && std::isfinite(radiance[static_cast<int>(i)]) &&
-           radiance[static_cast<int>(i)] >= 0.0f;
-    }
-    if (!ok) return tools::fail(kTool, "--sky wants R,G,B: three finite radiances >= 0, got '" + sky + "'",
-                                tools::kExitUsage);
-    asset->environment.sky_radiance = radiance;
+    const std::optional<glm::vec3> radiance = tools::parse_sky(sky);
+    if (!radiance)
+      return tools::fail(kTool, "--sky wants R,G,B: three finite radiances >= 0, got '" + sky + "'", tools::kExitUsage);
+    asset->environment.sky_radiance = *radiance;
   }
   if (!export_uv1.empty()) {
     auto uv = gi::with_light_atlas_uv1(*asset, {.preset = o.preset, .texels_per_metre = o.texels_per_metre});

@@ -2,6 +2,7 @@
 // tonemapped PNG on request), or the ground-truth irradiance of its light-atlas texels.
 //   gi-reference --scene assets/cornell_box.gltf --width 256 --height 256 --spp 256 --out cbox.exr
 //   gi-reference --scene assets/cornell_box.gltf --atlas-density 64 --spp 256 --atlas-out out/cbox_atlas
+//   gi-reference --scene Avocado.glb --sky 0.8,0.9,1.0 --width 256 --height 256 --out avocado.exr
 // Exit codes: tools/common/tool_main.h.
 #include <engine/display_transform.h>
 #include <engine/gltf.h>
@@ -45,7 +46,7 @@ engine::ImageRgbaF rgb_image(int w, int h, const std::vector<glm::vec3>& v, cons
 
 int main(int argc, char** argv) {
   CLI::App app{"Reference path tracer: camera images and light-atlas ground truth"};
-  std::string scene_path, out_path, png_path, atlas_out, camera_name;
+  std::string scene_path, out_path, png_path, atlas_out, camera_name, sky;
   int width = 256, height = 256, spp = 64, bounces = -1;
   unsigned threads = 0;
   std::uint64_t seed = 1;
@@ -62,6 +63,8 @@ int main(int argc, char** argv) {
   app.add_option("--png", png_path, "tonemapped PNG of the camera image (the renderer's display transform)");
   app.add_option("--exposure", exposure, "exposure for --png");
   app.add_option("--atlas-density", atlas_density, "light-atlas texels per metre (enables the atlas output)");
+  app.add_option("--sky", sky,
+                 "R,G,B: a uniform sky of this radiance, W/(m^2 sr), replacing the scene's gi.sky (as gi-bake --sky)");
   app.add_option("--atlas-out", atlas_out, "folder for atlas_direct.exr, atlas_indirect.exr, atlas_total.exr");
   if (auto rc = tools::parse(app, kTool, argc, argv)) return *rc;
   if (out_path.empty() && png_path.empty() && atlas_out.empty())
@@ -71,6 +74,12 @@ int main(int argc, char** argv) {
 
   auto asset = engine::load_gltf(scene_path);
   if (!asset) return tools::fail(kTool, asset.error());
+  if (!sky.empty()) {
+    const std::optional<glm::vec3> radiance = tools::parse_sky(sky);
+    if (!radiance)
+      return tools::fail(kTool, "--sky wants R,G,B: three finite radiances >= 0, got '" + sky + "'", tools::kExitUsage);
+    asset->environment.sky_radiance = *radiance;
+  }
   engine::Scene scene = engine::instantiate(std::move(asset).value());
   tools::install_interrupt_handler();
   tools::ConsoleProgress bar;
