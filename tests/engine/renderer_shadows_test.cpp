@@ -234,3 +234,56 @@ TEST(RendererIndirect, AtlasForStaticAndVertexBufferForDynamicMeshes) {
 }
 
 }  // namespace
+
+namespace {
+
+bool same_pixels(const engine::ImageRgbaF& a, const engine::ImageRgbaF& b) {
+  return a.width == b.width && a.height == b.height && a.pixels == b.pixels;
+}
+
+// Shadow maps are kept while neither their light nor a caster that can reach them moved:
+// a second frame re-renders none and draws the same pixels; moving the box re-renders the
+// views it can reach and draws what a fresh renderer draws; moving it back restores the
+// first frame exactly. A spot (2-D map) and a point light (6 cube faces).
+TEST(RendererShadows, MapsAreReRenderedOnlyWhenTheirLightOrACasterMoves) {
+  engine::GpuContext ctx = headless_context();
+  OccluderScene s;
+  add_light(s.reg, engine::Light{.type = engine::LightType::Spot, .intensity = 10.0f, .outer_cone_rad = 0.7f},
+            {-1.5f, 2.0f, 0.0f}, {0.0f, 0.0f, 0.0f});
+  add_light(s.reg, engine::Light{.type = engine::LightType::Point, .intensity = 5.0f}, {1.5f, 2.0f, 0.5f},
+            {0.0f, 0.0f, 0.0f});
+  const engine::Entity camera = s.cam.add_to(s.reg);
+  auto r = make_renderer(s.assets, s.cam.size, kAmbient);
+  ASSERT_TRUE(r);
+  r->render(s.reg, camera);
+  EXPECT_EQ(r->last_timings().front().name, "shadow maps (7 views)");
+  EXPECT_EQ(r->last_shadow_maps_rendered(), 7);
+  const engine::ImageRgbaF first = r->read_hdr();
+  r->render(s.reg, camera);
+  EXPECT_EQ(r->last_shadow_maps_rendered(), 0);
+  EXPECT_TRUE(same_pixels(r->read_hdr(), first));
+
+  engine::Entity box{};
+  s.reg.view<engine::MeshRenderer>().each([&](engine::Entity e, const engine::MeshRenderer& mr) {
+    if (mr.mesh == 1) box = e;
+  });
+  ASSERT_FALSE(box.is_null());
+  const glm::mat4 moved = glm::translate(glm::mat4(1.0f), glm::vec3(0.6f, 0.8f, 0.3f));
+  const glm::mat4 original = s.reg.get<engine::WorldTransform>(box).matrix;
+  s.reg.write<engine::WorldTransform>(box).matrix = moved;
+  r->render(s.reg, camera);
+  const int redrawn = r->last_shadow_maps_rendered();
+  EXPECT_GT(redrawn, 0);
+  const engine::ImageRgbaF after_move = r->read_hdr();
+  EXPECT_FALSE(same_pixels(after_move, first));
+  auto fresh = make_renderer(s.assets, s.cam.size, kAmbient);
+  ASSERT_TRUE(fresh);
+  fresh->render(s.reg, camera);
+  EXPECT_TRUE(same_pixels(after_move, fresh->read_hdr())) << redrawn << " views redrawn";
+
+  s.reg.write<engine::WorldTransform>(box).matrix = original;
+  r->render(s.reg, camera);
+  EXPECT_TRUE(same_pixels(r->read_hdr(), first));
+}
+
+}  // namespace

@@ -112,6 +112,10 @@ class Renderer {
   /// "forward + constant ambient (stand-in)" or "forward + indirect (<provider label>)"
   /// (includes the depth pre-pass), "tonemap (...)".
   virtual const std::vector<PassTiming>& last_timings() const = 0;
+  /// Shadow-map views (2-D maps and cube faces) the last render() drew. A view is kept while
+  /// neither its light nor a caster that can reach it (not wholly outside its clip volume)
+  /// moved: static lights over static casters are drawn once.
+  virtual int last_shadow_maps_rendered() const = 0;
 };
 
 }  // namespace engine

@@ -111,6 +111,7 @@ class ForwardRenderer final : public Renderer {
   void set_indirect_light(IndirectLightProvider* provider) override { provider_ = provider; }
   RenderSettings& settings() override { return settings_; }
   const std::vector<PassTiming>& last_timings() const override { return timings_; }
+  int last_shadow_maps_rendered() const override { return shadow_maps_rendered_; }
 
  private:
   void ensure_targets();
@@ -127,6 +128,7 @@ class ForwardRenderer final : public Renderer {
   ShaderProgram shadow_;
   ShaderProgram tonemap_;
   render::ShadowMaps shadow_maps_;
+  int shadow_maps_rendered_ = 0;
   GlBuffer lights_buffer_;
   GlVertexArray empty_vao_;
   GlTexture albedo_table_;  // gltf_brdf.glsl's directional albedo table
@@ -201,7 +203,7 @@ void ForwardRenderer::render(const Registry& registry, Entity camera) {
   capacity.cube_size = std::max(16, settings_.shadow_map_size / 2);
   const render::LightList lights = render::collect_lights(registry, render::scene_bounds(items), capacity);
   shadow_maps_.reserve(capacity.map_size, lights.layers_2d, capacity.cube_size, lights.cubes);
-  shadow_maps_.render(lights.shadow_views, items, scene_, shadow_);
+  shadow_maps_rendered_ = shadow_maps_.render(lights.shadow_views, items, scene_, shadow_);
   timings_.push_back({"shadow maps (" + std::to_string(lights.shadow_views.size()) + " views)", timer.lap_ms()});
 
   glNamedBufferData(lights_buffer_.id(),

@@ -18,14 +18,26 @@ class ShadowMaps {
   /// Makes room for `layers_2d` maps of map_size^2 and `cubes` cube maps of cube_size^2
   /// per face (at least one of each so the samplers are always complete).
   void reserve(int map_size, int layers_2d, int cube_size, int cubes);
-  /// Renders every view's casters into its layer.
-  void render(const std::vector<ShadowView>& views, const std::vector<DrawItem>& items, const GpuScene& scene,
-              const ShaderProgram& program);
+  /// Renders into each view's layer the casters that can reach it (for perspective views,
+  /// those whose bounds come within the view's far distance of its eye; every caster for
+  /// orthographic ones). A layer whose view and reaching casters (mesh and transform) are
+  /// what they were when it was last rendered is kept: static lights over static casters
+  /// render once. Returns the number of views rendered.
+  int render(const std::vector<ShadowView>& views, const std::vector<DrawItem>& items, const GpuScene& scene,
+             const ShaderProgram& program);
 
   std::uint32_t maps_2d() const { return maps_2d_.id(); }
   std::uint32_t cube_maps() const { return cube_maps_.id(); }
 
  private:
+  /// What a layer holds: the view and its casters as last rendered.
+  struct LayerContent {
+    ShadowView view;
+    std::vector<std::pair<const GpuMesh*, glm::mat4>> casters;
+    bool operator==(const LayerContent& o) const;
+  };
+  std::vector<LayerContent> content_2d_, content_cube_;  ///< Per 2-D layer / cube layer (cube * 6 + face).
+
   GlTexture maps_2d_;
   GlTexture cube_maps_;
   GlFramebuffer framebuffer_;
