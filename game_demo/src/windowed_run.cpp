@@ -27,14 +27,27 @@ namespace {
 
 constexpr int kMaxStepsPerFrame = 8;  // beyond this the simulation slows down instead of spiralling
 
+constexpr std::pair<int, Key> kKeyMap[] = {{GLFW_KEY_W, Key::W}, {GLFW_KEY_A, Key::A}, {GLFW_KEY_S, Key::S},
+                                           {GLFW_KEY_D, Key::D}, {GLFW_KEY_F, Key::F}, {GLFW_KEY_E, Key::E},
+                                           {GLFW_KEY_G, Key::G}, {GLFW_KEY_O, Key::O}};
+
+// Presses between two polls (GLFW queues key events; a tap is over before the next frame at
+// 2-3 frames/s). One window, so one latch.
+KeyLatch g_latch;
+
+void on_key(GLFWwindow*, int key, int, int action, int) {
+  if (action != GLFW_PRESS || ImGui::GetCurrentContext() == nullptr || ImGui::GetIO().WantCaptureKeyboard) return;
+  for (const auto& [glfw_key, k] : kKeyMap)
+    if (glfw_key == key) g_latch.press(k);
+}
+
 InputFrame live_keys(GLFWwindow* window) {
   InputFrame in;
-  const std::pair<int, Key> map[] = {{GLFW_KEY_W, Key::W}, {GLFW_KEY_A, Key::A}, {GLFW_KEY_S, Key::S},
-                                     {GLFW_KEY_D, Key::D}, {GLFW_KEY_F, Key::F}, {GLFW_KEY_E, Key::E},
-                                     {GLFW_KEY_G, Key::G}, {GLFW_KEY_O, Key::O}};
   if (ImGui::GetIO().WantCaptureKeyboard) return in;
-  for (const auto& [glfw_key, key] : map)
-    if (glfwGetKey(window, glfw_key) == GLFW_PRESS) in.keys |= key_bit(key);
+  std::uint32_t held = 0;
+  for (const auto& [glfw_key, key] : kKeyMap)
+    if (glfwGetKey(window, glfw_key) == GLFW_PRESS) held |= key_bit(key);
+  in.keys = g_latch.keys(held);
   return in;
 }
 
@@ -43,9 +56,14 @@ void draw_overlay(const RunOptions& o, const RunState& state, const engine::Rend
   const Simulation& sim = *state.sim;
   ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_Always);
   ImGui::SetNextWindowBgAlpha(0.6f);
+  // At most 45% of the window's width and 40% of its height: long lines wrap, the rest clips.
+  const ImVec2 screen = ImGui::GetIO().DisplaySize;
+  ImGui::SetNextWindowSizeConstraints(ImVec2(0, 0), ImVec2(0.45f * screen.x, 0.4f * screen.y));
   ImGui::Begin("gi_demo", nullptr,
                ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoInputs);
-  ImGui::Text("%.1f fps   frame %.2f ms   step %llu", fps, frame_ms, static_cast<unsigned long long>(sim.frame()));
+  ImGui::PushTextWrapPos(0.45f * screen.x - 20.0f);
+  ImGui::Text("%.1f frames/s   last frame %.0f ms   step %llu", fps, frame_ms,
+              static_cast<unsigned long long>(sim.frame()));
   ImGui::Separator();
   ImGui::Text("indirect light: %s", indirect.c_str());
   for (const std::string& line : gi_status_lines(gi)) ImGui::TextUnformatted(line.c_str());
@@ -61,6 +79,7 @@ void draw_overlay(const RunOptions& o, const RunState& state, const engine::Rend
   for (const auto& p : renderer.last_timings()) ImGui::Text("  %-20s %7.3f", p.name.c_str(), p.ms);
   ImGui::TextUnformatted("systems (CPU ms, last step)");
   for (const auto& t : sim.schedule().last_timings()) ImGui::Text("  %-20s %7.3f", t.name.c_str(), t.cpu_ms);
+  ImGui::PopTextWrapPos();
   ImGui::End();
 }
 
@@ -92,6 +111,7 @@ int run_windowed(const RunOptions& o, RunState& state) {
   IMGUI_CHECKVERSION();
   ImGui::CreateContext();
   ImGui::GetIO().IniFilename = nullptr;
+  glfwSetKeyCallback(window, on_key);  // before ImGui's backend, which chains to it
   ImGui_ImplGlfw_InitForOpenGL(window, true);
   ImGui_ImplOpenGL3_Init("#version 450");
 
@@ -99,13 +119,22 @@ int run_windowed(const RunOptions& o, RunState& state) {
   double cursor_x = 0, cursor_y = 0;
   glfwGetCursorPos(window, &cursor_x, &cursor_y);
   double last = glfwGetTime(), accumulator = 0.0, fps = 0.0, frame_ms = 0.0;
+  // Frames per second over the last half second or more (frames counted / wall time): an
+  // average of per-frame rates started from the first, nearly empty frame read 150 at 3.
+  double fps_window_start = last;
+  int fps_window_frames = 0;
   int status = 0;
   while (!glfwWindowShouldClose(window)) {
     glfwPollEvents();
     if (glfwGetKey(window, GLFW_KEY_ESCAPE) == GLFW_PRESS) break;
     const double now = glfwGetTime();
     frame_ms = (now - last) * 1000.0;
-    fps = fps == 0.0 ? 1000.0 / std::max(frame_ms, 1e-3) : 0.95 * fps + 0.05 * 1000.0 / std::max(frame_ms, 1e-3);
+    ++fps_window_frames;
+    if (now - fps_window_start >= 0.5) {
+      fps = fps_window_frames / (now - fps_window_start);
+      fps_window_start = now;
+      fps_window_frames = 0;
+    }
     accumulator = std::min(accumulator + (now - last), kMaxStepsPerFrame * dt);
     last = now;
 
@@ -132,6 +161,7 @@ int run_windowed(const RunOptions& o, RunState& state) {
         }
       } else {
         state.step(live);
+        g_latch.stepped();
         live.mouse_dx_px = live.mouse_dy_px = 0.0f;  // the mouse moved once, not once per step
       }
       if (o.frames > 0 && sim.frame() >= o.frames) done = true;

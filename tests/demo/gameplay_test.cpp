@@ -213,3 +213,35 @@ TEST(RigidBodies, UnsupportedCrateFallsToTheFloorAndStackedCrateRests) {
 }
 
 }  // namespace
+
+namespace {
+
+// The windowed front end polls keys once per rendered frame (2-3 frames/s on llvmpipe): a
+// quick F tap between two polls is not held at either, but the key callback's press reaches
+// the next step through KeyLatch and toggles the flashlight once; a second tap toggles it back.
+TEST(Flashlight, ATapBetweenTwoPollsTogglesItOnce) {
+  game_demo::Simulation sim(demo_test::make_room({}));
+  const engine::Entity torch = sim.context().flashlight;
+  game_demo::KeyLatch latch;
+  const auto frame = [&](int steps) {
+    for (int i = 0; i < steps; ++i) {
+      sim.step(game_demo::InputFrame{.keys = latch.keys(0)});
+      latch.stepped();
+    }
+  };
+  frame(2);
+  EXPECT_FALSE(sim.registry().get<engine::Light>(torch).enabled);
+  latch.press(Key::F);  // pressed and released before the next poll: never held
+  frame(0);             // a fast frame that ran no step keeps the press
+  frame(3);
+  EXPECT_TRUE(sim.registry().get<engine::Light>(torch).enabled);
+  frame(3);
+  EXPECT_TRUE(sim.registry().get<engine::Light>(torch).enabled);
+  latch.press(Key::F);
+  frame(1);
+  EXPECT_FALSE(sim.registry().get<engine::Light>(torch).enabled);
+  // Held keys pass through unchanged.
+  EXPECT_EQ(latch.keys(game_demo::key_bit(Key::W)), game_demo::key_bit(Key::W));
+}
+
+}  // namespace

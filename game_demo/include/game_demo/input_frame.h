@@ -38,6 +38,21 @@ struct InputFrame {
   friend bool operator==(const InputFrame&, const InputFrame&) = default;
 };
 
+/// Live keys for a front end that polls once per rendered frame while the simulation steps
+/// at a fixed rate: at 2-3 frames/s a key pressed and released between two polls was never
+/// seen (the flashlight ignored a quick F). press() on every key-down event (GLFW's key
+/// callback queues them); keys(held) is what is held now plus what was pressed since the
+/// last step that used it; stepped() after a simulation step consumed the keys.
+class KeyLatch {
+ public:
+  void press(Key k) { pressed_ |= key_bit(k); }
+  std::uint32_t keys(std::uint32_t held) const { return held | pressed_; }
+  void stepped() { pressed_ = 0; }
+
+ private:
+  std::uint32_t pressed_ = 0;
+};
+
 /// Size of one serialized InputFrame in bytes.
 inline constexpr std::size_t kInputFrameBytes = 12;
 
