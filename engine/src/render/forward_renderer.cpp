@@ -185,6 +185,7 @@ std::vector<DrawItem> ForwardRenderer::draw_items(const Registry& registry) cons
     item.material_override = mr.material_override;
     item.cast_shadows = mr.cast_shadows;
     item.is_static = registry.has<StaticTag>(e);
+    item.bounds = render::item_bounds(*item.mesh, item.model);
     items.push_back(item);
   });
   return items;

@@ -14,6 +14,13 @@
 namespace engine::render {
 
 /// One MeshRenderer entity to draw.
+/// World-space axis-aligned bounds (of one draw item, or of all).
+struct SceneBounds {
+  glm::vec3 min{0.0f};
+  glm::vec3 max{0.0f};
+  bool empty = true;
+};
+
 struct DrawItem {
   Entity entity;
   const GpuMesh* mesh = nullptr;
@@ -21,14 +28,11 @@ struct DrawItem {
   std::int32_t material_override = -1;
   bool cast_shadows = true;
   bool is_static = false;  ///< StaticTag: indirect light from the atlas (TEXCOORD_1).
+  SceneBounds bounds;      ///< item_bounds(*mesh, model), computed once per frame.
 };
 
-/// World-space axis-aligned bounds of every draw item.
-struct SceneBounds {
-  glm::vec3 min{0.0f};
-  glm::vec3 max{0.0f};
-  bool empty = true;
-};
+/// The box of the mesh's bounds' 8 corners placed by `model`.
+SceneBounds item_bounds(const GpuMesh& mesh, const glm::mat4& model);
 
 /// One shadow-map render: a camera and the layer it writes.
 struct ShadowView {

@@ -29,18 +29,26 @@ float farthest_corner(const glm::vec3& p, const SceneBounds& b) {
 
 }  // namespace
 
+SceneBounds item_bounds(const GpuMesh& mesh, const glm::mat4& model) {
+  SceneBounds b;
+  for (int i = 0; i < 8; ++i) {
+    const glm::vec3& lo = mesh.bounds_min;
+    const glm::vec3& hi = mesh.bounds_max;
+    const glm::vec3 c((i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z);
+    const glm::vec3 w = glm::vec3(model * glm::vec4(c, 1.0f));
+    b.min = b.empty ? w : glm::min(b.min, w);
+    b.max = b.empty ? w : glm::max(b.max, w);
+    b.empty = false;
+  }
+  return b;
+}
+
 SceneBounds scene_bounds(const std::vector<DrawItem>& items) {
   SceneBounds b;
   for (const DrawItem& item : items) {
-    for (int i = 0; i < 8; ++i) {
-      const glm::vec3& lo = item.mesh->bounds_min;
-      const glm::vec3& hi = item.mesh->bounds_max;
-      const glm::vec3 c((i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z);
-      const glm::vec3 w = glm::vec3(item.model * glm::vec4(c, 1.0f));
-      b.min = b.empty ? w : glm::min(b.min, w);
-      b.max = b.empty ? w : glm::max(b.max, w);
-      b.empty = false;
-    }
+    b.min = b.empty ? item.bounds.min : glm::min(b.min, item.bounds.min);
+    b.max = b.empty ? item.bounds.max : glm::max(b.max, item.bounds.max);
+    b.empty = false;
   }
   return b;
 }

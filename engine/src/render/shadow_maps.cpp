@@ -66,15 +66,8 @@ int ShadowMaps::render(const std::vector<ShadowView>& views, const std::vector<D
     const glm::vec4 planes[6] = {r3 + r0, r3 - r0, r3 + r1, r3 - r1, r3 + r2, r3 - r2};
     for (const DrawItem& item : items) {
       if (!item.cast_shadows) continue;
-      glm::vec3 lo(0.0f), hi(0.0f);
-      for (int i = 0; i < 8; ++i) {
-        const glm::vec3& a = item.mesh->bounds_min;
-        const glm::vec3& b = item.mesh->bounds_max;
-        const glm::vec3 c((i & 1) ? b.x : a.x, (i & 2) ? b.y : a.y, (i & 4) ? b.z : a.z);
-        const glm::vec3 w = glm::vec3(item.model * glm::vec4(c, 1.0f));
-        lo = i == 0 ? w : glm::min(lo, w);
-        hi = i == 0 ? w : glm::max(hi, w);
-      }
+      const glm::vec3& lo = item.bounds.min;
+      const glm::vec3& hi = item.bounds.max;
       bool outside = false;
       for (const glm::vec4& p : planes) {
         // The box corner furthest along the plane's normal.
