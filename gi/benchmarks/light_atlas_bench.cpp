@@ -31,15 +31,21 @@ struct Fixture {
   gi::StaticBakeScene scene;
 };
 
-const Fixture& cornell(float density) {
-  static Fixture f = [density] {
+const gi::BakeInput& cornell_input() {
+  static const gi::BakeInput input = [] {
     auto asset = engine::load_gltf(std::string(GI_SOURCE_DIR) + "/assets/cornell_box.gltf");
     if (!asset) {
       std::fprintf(stderr, "%s\n", asset.error().to_string().c_str());
       std::abort();
     }
-    const engine::Scene scene = engine::instantiate(std::move(asset).value());
-    const gi::BakeInput input = gi::bake_input_from(scene);
+    return gi::bake_input_from(engine::instantiate(std::move(asset).value()));
+  }();
+  return input;
+}
+
+const Fixture& cornell(float density) {
+  static Fixture f = [density] {
+    const gi::BakeInput& input = cornell_input();
     Fixture out;
     out.layout = gi::build_atlas_layout(gi::atlas_inputs_from(input), {.texels_per_metre = density}).value();
     out.scene = gi::prepare_static_scene(input, out.layout, gi::BakeLights::Static,
@@ -116,14 +122,7 @@ void BM_RawClosestHitRays(benchmark::State& state) {
 // preview bake cannot ray-count its way out of. Args: kept rays, fresh rays, filter (tenths
 // of a texel). Process CPU time is reported too: the machine is shared.
 void BM_BakeEndToEnd(benchmark::State& state) {
-  static const gi::BakeInput input = [] {
-    auto asset = engine::load_gltf(std::string(GI_SOURCE_DIR) + "/assets/cornell_box.gltf");
-    if (!asset) {
-      std::fprintf(stderr, "%s\n", asset.error().to_string().c_str());
-      std::abort();
-    }
-    return gi::bake_input_from(engine::instantiate(std::move(asset).value()));
-  }();
+  const gi::BakeInput& input = cornell_input();
   gi::LightAtlasSettings s;
   s.texels_per_metre = 128.0f;
   s.vpl_count = 300;

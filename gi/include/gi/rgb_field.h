@@ -45,15 +45,19 @@ struct RgbField {
     return f;
   }
 
-  /// A width x height field from RGB triples (row-major, width * height of them) and a
-  /// mask (empty: every element valid). Precondition: the sizes agree.
-  static RgbField from_texels(int w, int h, std::span<const glm::vec3> values, std::vector<std::uint8_t> mask = {}) {
+  /// A width x height field from RGB triples (row-major, width * height of them), a mask
+  /// (empty: every element valid) and per-channel sampling variances (empty: unknown).
+  /// Precondition: the sizes agree.
+  static RgbField from_texels(int w, int h, std::span<const glm::vec3> values, std::vector<std::uint8_t> mask = {},
+                              std::span<const glm::vec3> variances = {}) {
     RgbField f;
     f.width = w;
     f.height = h;
     f.valid = std::move(mask);
     f.rgb.reserve(3 * values.size());
     for (const glm::vec3& v : values) f.rgb.insert(f.rgb.end(), {v.x, v.y, v.z});
+    f.variance.reserve(3 * variances.size());
+    for (const glm::vec3& v : variances) f.variance.insert(f.variance.end(), {v.x, v.y, v.z});
     return f;
   }
 };

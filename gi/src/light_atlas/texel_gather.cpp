@@ -242,91 +242,75 @@ glm::vec3 bilinear(const std::vector<glm::vec3>& img, int w, int h, glm::vec2 uv
 
 float max_abs(const glm::vec3& v) { return std::max(std::fabs(v.x), std::max(std::fabs(v.y), std::fabs(v.z))); }
 
-// Valid texels bucketed by their sample position in cubic cells (sorted, for a fixed
-// neighbour order): the world-space neighbourhoods of the filter and of point lookups.
-class TexelGrid {
+// Texels bucketed by their sample position into cubic cells (exact integer cells, sorted,
+// texels ascending within a cell): the world-space neighbourhoods of the filter and of point
+// lookups, visited in a fixed order (bit-identical for any thread count).
+class TexelCells {
  public:
-  TexelGrid(const AtlasTexels& tx, const std::vector<std::uint32_t>& texels, float cell_m) : tx_(tx), cell_(cell_m) {
-    cells_.reserve(texels.size());
-    for (std::uint32_t i : texels) cells_.emplace_back(hash(cell_of(tx.position[i])), i);
-    std::sort(cells_.begin(), cells_.end());
+  TexelCells(const AtlasTexels& tx, std::span<const std::uint32_t> texels, float cell_m) : cell_(cell_m) {
+    for (std::uint32_t i : texels) entries_.push_back({cell_of(tx.position[i]), i});
+    std::sort(entries_.begin(), entries_.end(), [](const Entry& a, const Entry& b) {
+      return before(a.cell, b.cell) || (a.cell == b.cell && a.texel < b.texel);
+    });
+    for (std::size_t k = 0; k < entries_.size(); ++k)
+      if (k == 0 || entries_[k].cell != entries_[k - 1].cell) cells_.push_back(entries_[k].cell), first_.push_back(k);
+    first_.push_back(entries_.size());
   }
-  // Calls fn(j) for every texel in the 27 cells around p (those within one cell of it).
+  std::size_t cell_count() const { return cells_.size(); }
+  /// Calls fn(texel) for every texel of cell k.
   template <class Fn>
-  void for_near(const glm::vec3& p, Fn&& fn) const {
-    const glm::ivec3 c = cell_of(p);
+  void for_cell(std::size_t k, Fn&& fn) const {
+    for (std::size_t m = first_[k]; m < first_[k + 1]; ++m) fn(entries_[m].texel);
+  }
+  /// Calls fn(texel) for every texel in the 27 cells around cell c (dz, dy, dx order).
+  template <class Fn>
+  void for_around(const glm::ivec3& c, Fn&& fn) const {
     for (int dz = -1; dz <= 1; ++dz)
       for (int dy = -1; dy <= 1; ++dy)
         for (int dx = -1; dx <= 1; ++dx) {
           const glm::ivec3 cc = c + glm::ivec3(dx, dy, dz);
-          const std::uint64_t h = hash(cc);
-          auto it = std::lower_bound(cells_.begin(), cells_.end(), std::make_pair(h, std::uint32_t{0}));
-          for (; it != cells_.end() && it->first == h; ++it)
-            if (cell_of(tx_.position[it->second]) == cc) fn(it->second);  // else a hash collision
+          const auto it = std::lower_bound(cells_.begin(), cells_.end(), cc, before);
+          if (it != cells_.end() && *it == cc) for_cell(static_cast<std::size_t>(it - cells_.begin()), fn);
         }
   }
+  const glm::ivec3& cell(std::size_t k) const { return cells_[k]; }
+  glm::ivec3 cell_of(const glm::vec3& p) const { return glm::ivec3(glm::floor(p / cell_)); }
 
  private:
-  glm::ivec3 cell_of(const glm::vec3& p) const { return glm::ivec3(glm::floor(p / cell_)); }
-  static std::uint64_t hash(glm::ivec3 c) {
-    return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(c.x)) * 73856093ULL) ^
-           (static_cast<std::uint64_t>(static_cast<std::uint32_t>(c.y)) * 19349663ULL) ^
-           (static_cast<std::uint64_t>(static_cast<std::uint32_t>(c.z)) * 83492791ULL);
-  }
-  const AtlasTexels& tx_;
-  float cell_;
-  std::vector<std::pair<std::uint64_t, std::uint32_t>> cells_;
-};
-
-// Step 4: Gaussian over texels on the same plane within the radius, across chart borders.
-// Texels are sorted into cubic cells of the radius (exact integer cells); each cell gathers
-// its 27 neighbour cells' texels once and filters all of its texels against them, in a
-// fixed order (bit-identical for any thread count).
-std::vector<glm::vec3> filter_world(const AtlasTexels& tx, const TexelTable& t, const std::vector<glm::vec3>& e,
-                                    const std::vector<std::uint8_t>& hidden, float radius_m, float texel_m,
-                                    ThreadPool& pool) {
   struct Entry {
     glm::ivec3 cell;
     std::uint32_t texel;
   };
-  const auto before = [](const glm::ivec3& a, const glm::ivec3& b) {
+  static bool before(const glm::ivec3& a, const glm::ivec3& b) {
     return a.z != b.z ? a.z < b.z : a.y != b.y ? a.y < b.y : a.x < b.x;
-  };
-  std::vector<Entry> entries;
-  for (std::uint32_t i : t.work)
-    if (!hidden[i]) entries.push_back({glm::ivec3(glm::floor(tx.position[i] / radius_m)), i});
-  std::sort(entries.begin(), entries.end(), [&](const Entry& a, const Entry& b) {
-    return before(a.cell, b.cell) || (a.cell == b.cell && a.texel < b.texel);
-  });
-  std::vector<glm::ivec3> cells;
-  std::vector<std::size_t> first;
-  for (std::size_t k = 0; k < entries.size(); ++k)
-    if (k == 0 || entries[k].cell != entries[k - 1].cell) cells.push_back(entries[k].cell), first.push_back(k);
-  first.push_back(entries.size());
+  }
+  float cell_;
+  std::vector<Entry> entries_;
+  std::vector<glm::ivec3> cells_;
+  std::vector<std::size_t> first_;  // cell k holds entries_[first_[k], first_[k + 1])
+};
 
+// Step 4: Gaussian over texels on the same plane within the radius, across chart borders.
+// Each cell (of the radius) gathers its 27 neighbour cells' texels once and filters all of
+// its own texels against them.
+std::vector<glm::vec3> filter_world(const AtlasTexels& tx, const TexelTable& t, const std::vector<glm::vec3>& e,
+                                    const std::vector<std::uint8_t>& hidden, float radius_m, float texel_m,
+                                    ThreadPool& pool) {
+  std::vector<std::uint32_t> visible;
+  for (std::uint32_t i : t.work)
+    if (!hidden[i]) visible.push_back(i);
+  const TexelCells cells(tx, visible, radius_m);
   std::vector<glm::vec3> out = e;
   const float r2 = radius_m * radius_m, plane = 0.5f * texel_m;
   pool.parallel_for(
-      cells.size(),
+      cells.cell_count(),
       [&](std::size_t c) {
         struct Candidate {
           glm::vec3 position, normal, value;
         };
         std::vector<Candidate> near;
-        for (int dz = -1; dz <= 1; ++dz)
-          for (int dy = -1; dy <= 1; ++dy)
-            for (int dx = -1; dx <= 1; ++dx) {
-              const glm::ivec3 cc = cells[c] + glm::ivec3(dx, dy, dz);
-              const auto it = std::lower_bound(cells.begin(), cells.end(), cc, before);
-              if (it == cells.end() || *it != cc) continue;
-              const auto k = static_cast<std::size_t>(it - cells.begin());
-              for (std::size_t m = first[k]; m < first[k + 1]; ++m) {
-                const std::uint32_t j = entries[m].texel;
-                near.push_back({tx.position[j], tx.normal[j], e[j]});
-              }
-            }
-        for (std::size_t m = first[c]; m < first[c + 1]; ++m) {
-          const std::uint32_t i = entries[m].texel;
+        cells.for_around(cells.cell(c), [&](std::uint32_t j) { near.push_back({tx.position[j], tx.normal[j], e[j]}); });
+        cells.for_cell(c, [&](std::uint32_t i) {
           const glm::vec3 p = tx.position[i], n = tx.normal[i];
           glm::vec3 sum(0.0f);
           float weight = 0.0f;
@@ -339,7 +323,7 @@ std::vector<glm::vec3> filter_world(const AtlasTexels& tx, const TexelTable& t, 
             weight += w;
           }
           if (weight > 0.0f) out[i] = sum / weight;
-        }
+        });
       },
       4);
   return out;
@@ -486,12 +470,12 @@ std::vector<glm::vec3> irradiance_at_points(const AtlasTexels& texels, const std
   for (std::size_t i = 0; i < texels.valid.size(); ++i)
     if (texels.valid[i]) valid.push_back(static_cast<std::uint32_t>(i));
   const float reach = 2.0f / texels_per_metre;
-  const TexelGrid grid(texels, valid, reach);
+  const TexelCells cells(texels, valid, reach);
   std::vector<glm::vec3> out(points.size(), glm::vec3(0.0f));
   for (std::size_t k = 0; k < points.size(); ++k) {
     float best = reach * reach;
     std::uint32_t found = kDark;
-    grid.for_near(points[k], [&](std::uint32_t j) {
+    cells.for_around(cells.cell_of(points[k]), [&](std::uint32_t j) {
       const glm::vec3 d = texels.position[j] - points[k];
       const float d2 = glm::dot(d, d);
       if (d2 < best && glm::dot(texels.normal[j], normals[k]) > 0.5f) best = d2, found = j;

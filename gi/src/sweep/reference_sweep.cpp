@@ -60,10 +60,7 @@ engine::Result<RgbField> atlas_indirect(const SweepScene& s, const ReferenceRequ
   auto truth = reference_atlas(static_world(bake_input_from(engine::instantiate(s.asset))),
                                std::stof(r.param("texels_per_m")), settings, placement);
   if (!truth) return truth.error();
-  RgbField f = RgbField::from_texels(truth->width, truth->height, truth->indirect, truth->valid);
-  f.variance.reserve(3 * truth->indirect_variance.size());
-  for (const glm::vec3& v : truth->indirect_variance) f.variance.insert(f.variance.end(), {v.x, v.y, v.z});
-  return f;
+  return RgbField::from_texels(truth->width, truth->height, truth->indirect, truth->valid, truth->indirect_variance);
 }
 
 // Converged-reference settings: the request's spp, the reference seed, unlimited bounces.

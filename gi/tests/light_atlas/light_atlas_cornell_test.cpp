@@ -49,8 +49,8 @@ TEST(LightAtlasCornell, HighPresetMatchesReference) {
   const gi::AtlasIrradiance truth = reference(scene, 32.0f, 4096, -1, gi::texel_placement(s));
   auto bake = gi::bake_light_atlas(gi::bake_input_from(scene), s);
   ASSERT_TRUE(bake) << bake.error().to_string();
-  gi::RgbField ref = gi::RgbField::from_texels(truth.width, truth.height, truth.indirect, truth.valid);
-  for (const glm::vec3& v : truth.indirect_variance) ref.variance.insert(ref.variance.end(), {v.x, v.y, v.z});
+  const gi::RgbField ref =
+      gi::RgbField::from_texels(truth.width, truth.height, truth.indirect, truth.valid, truth.indirect_variance);
   const gi::ErrorReport e =
       gi::compare_rgb(gi::RgbField::from_texels(bake->width, bake->height, bake->irradiance, bake->valid), ref);
   std::printf("Cornell box, high preset: rel RMSE %.4f (reference noise %.4f, against the truth %.4f; scale fit %.4f), "
