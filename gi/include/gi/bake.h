@@ -14,7 +14,8 @@
 // mesh), "dlm" (directional light maps of the glossy static surfaces, docs/dlm.md). "atlas",
 // "prm" and "dlm" share one uv1 layout (the preset's atlas density). Methods the
 // plan calls for that this build cannot bake ("antiradiance") are reported as
-// skipped, never silently dropped. Bit-identical output for any thread count.
+// skipped, never silently dropped. Byte-identical files for any thread count and run (but
+// bake_stats.json, see below).
 
 #include <engine/result.h>
 #include <gi/bake_input.h>
@@ -53,6 +54,11 @@ struct BakeHost {
   StageProgressCallback progress;
   LogCallback log;
 };
+
+/// The bundle's one informative file: per method, when, where, with how many threads and
+/// how long each stage took. No loader reads it; it is the only file that differs between
+/// two bakes of the same scene, options and seed (any thread count, any machine).
+inline constexpr const char* kBakeStatsFileName = "bake_stats.json";
 
 /// One method written into the bundle.
 struct BakedMethod {

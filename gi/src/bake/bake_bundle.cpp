@@ -10,8 +10,11 @@
 #include <cstdarg>
 #include <cstdio>
 #include <cstring>
+#include <ctime>
 #include <string>
 #include <utility>
+
+#include <thread>
 
 #include "antiradiance/antiradiance_io.h"
 #include "antiradiance/antiradiance_region.h"
@@ -22,6 +25,9 @@
 #include "bundle/manifest.h"
 #include "dlm/dlm.h"
 #include "dlm/dlm_io.h"
+#include "core/thread_pool.h"
+#include "io/atomic_file.h"
+#include "io/blob_file.h"
 #include "light_atlas/light_atlas.h"
 #include "light_atlas/light_atlas_io.h"
 #include "plan/plan_json.h"
@@ -80,7 +86,11 @@ std::string scene_file_name(const BakeInput& input) {
   return input.name.empty() ? std::string("the scene") : fs::path(input.name).filename().string();
 }
 
-engine::Status bake_atlas(const BakeInput& input, const fs::path& dir, const BakeOptions& o, const Stage& stage) {
+// What a method's bake cost, for bake_stats.json (stage name -> seconds).
+using Timings = nlohmann::json;
+
+engine::Status bake_atlas(const BakeInput& input, const fs::path& dir, const BakeOptions& o, const Stage& stage,
+                          Timings& timings) {
   auto settings = light_atlas_preset(o.preset);
   if (!settings) return settings.error();
   if (o.vpls > 0) settings->vpl_count = o.vpls;
@@ -105,10 +115,16 @@ engine::Status bake_atlas(const BakeInput& input, const fs::path& dir, const Bak
       format("  time: VPLs %.2f s, direct %.2f s, propagation %.2f s, final shooting %.2f s; total %.2f s; %.1f M rays",
              st.vpl_seconds, st.direct_seconds, st.propagate_seconds, st.final_seconds, st.total_seconds,
              static_cast<double>(st.rays) * 1e-6));
+  timings = {{"vpl_seconds", st.vpl_seconds},
+             {"direct_seconds", st.direct_seconds},
+             {"propagate_seconds", st.propagate_seconds},
+             {"final_seconds", st.final_seconds},
+             {"total_seconds", st.total_seconds}};
   return save_light_atlas(dir, *bake, input);
 }
 
-engine::Status bake_prm_method(const BakeInput& input, const fs::path& dir, const BakeOptions& o, const Stage& stage) {
+engine::Status bake_prm_method(const BakeInput& input, const fs::path& dir, const BakeOptions& o, const Stage& stage,
+                               Timings& timings) {
   auto settings = prm_preset(o.preset);
   if (!settings) return settings.error();
   if (o.texels_per_metre > 0.0f) settings->texels_per_metre = o.texels_per_metre;
@@ -127,6 +143,7 @@ engine::Status bake_prm_method(const BakeInput& input, const fs::path& dir, cons
              static_cast<double>(prm->pane_size()) * prm->cluster_count * 6.0 / 1e6, st.paths, st.path_nodes));
   stage.log(format("  time: walks %.2f s, panes %.2f s; total %.2f s; %.1f M rays", st.walk_seconds, st.pane_seconds,
                    st.total_seconds, static_cast<double>(st.rays) * 1e-6));
+  timings = {{"walk_seconds", st.walk_seconds}, {"pane_seconds", st.pane_seconds}, {"total_seconds", st.total_seconds}};
   return save_prm(dir, *prm, input);
 }
 
@@ -147,8 +164,8 @@ engine::Status bake_antiradiance_method(const BakeInput& input, const fs::path& 
   return save_antiradiance(dir, *bake, input);
 }
 
-engine::Status bake_brf_method(const BakeInput& input, const fs::path& dir, const BakeOptions& o,
-                               const BakeHost& host) {
+engine::Status bake_brf_method(const BakeInput& input, const fs::path& dir, const BakeOptions& o, const BakeHost& host,
+                               Timings& timings) {
   auto settings = brf_preset(o.preset);
   if (!settings) return settings.error();
   if (o.brf_basis > 0) settings->basis.basis = o.brf_basis;
@@ -181,12 +198,14 @@ engine::Status bake_brf_method(const BakeInput& input, const fs::path& dir, cons
       stage.log(format("  %-16s glossy (GGX alpha %.3f, f0 %.2f): %d BRDF terms, weighted BRDF error %.2f", "",
                        static_cast<double>(mesh->glossy->lobe.alpha), static_cast<double>(mesh->glossy->lobe.f0),
                        mesh->glossy->terms, static_cast<double>(mesh->glossy->relative_error)));
+    timings[s.name] = {{"basis_seconds", mesh->basis_seconds}, {"field_seconds", mesh->field_seconds}};
     bake.meshes.push_back(std::move(mesh).value());
   }
   return save_brf(dir, bake, input);
 }
 
-engine::Status bake_dlm_method(const BakeInput& input, const fs::path& dir, const BakeOptions& o, const Stage& stage) {
+engine::Status bake_dlm_method(const BakeInput& input, const fs::path& dir, const BakeOptions& o, const Stage& stage,
+                               Timings& timings) {
   auto settings = dlm_preset(o.preset);
   if (!settings) return settings.error();
   if (o.texels_per_metre > 0.0f) settings->texels_per_metre = o.texels_per_metre;
@@ -208,7 +227,30 @@ engine::Status bake_dlm_method(const BakeInput& input, const fs::path& dir, cons
                    static_cast<double>(dlm->radiance.size()) * 2.0 / 1e6, dlm->directions.size() * 6,
                    static_cast<unsigned long long>(st.deposits), static_cast<double>(st.rays) * 1e-6));
   stage.log(format("  time: photons %.2f s; total %.2f s", st.trace_seconds, st.total_seconds));
+  timings = {{"trace_seconds", st.trace_seconds}, {"total_seconds", st.total_seconds}};
   return save_dlm(dir, *dlm, input);
+}
+
+// fsync of one file or directory.
+engine::Status sync_path(const fs::path& path, int flags) {
+  const int fd = ::open(path.c_str(), flags | O_CLOEXEC);
+  if (fd < 0) return engine::Error{path.string(), "", std::string("cannot open to flush: ") + std::strerror(errno)};
+  const bool ok = ::fsync(fd) == 0;
+  const int err = errno;
+  ::close(fd);
+  if (!ok) return engine::Error{path.string(), "", std::string("cannot flush to disk: ") + std::strerror(err)};
+  return {};
+}
+
+// The files a bake copied or wrote into `dir` (one level: bundles have no subdirectories),
+// then the directory itself, flushed to disk.
+engine::Status sync_tree(const fs::path& dir) {
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(dir, ec))
+    if (e.is_regular_file(ec))
+      if (auto ok = sync_path(e.path(), O_RDONLY); !ok) return ok;
+  if (ec) return engine::Error{dir.string(), "", "cannot list the staging directory: " + ec.message()};
+  return sync_path(dir, O_RDONLY | O_DIRECTORY);
 }
 
 // A bake writes into a staging copy of the bundle ("<dir>/../.<name>.staging"), which takes
@@ -258,9 +300,11 @@ class StagedBundle {
   }
   const fs::path& path() const { return staging_; }
 
-  /// The staging directory becomes the bundle (renameat2 RENAME_EXCHANGE when one exists).
+  /// The staging directory becomes the bundle (renameat2 RENAME_EXCHANGE when one exists),
+  /// its files and directory flushed to disk first and the exchange after.
   engine::Status commit() {
     std::error_code ec;
+    if (auto ok = sync_tree(staging_); !ok) return ok;
     if (!fs::exists(dir_, ec)) {
       fs::rename(staging_, dir_, ec);
       if (ec) return engine::Error{dir_.string(), "", "cannot move the baked bundle into place: " + ec.message()};
@@ -269,7 +313,7 @@ class StagedBundle {
                            std::string("cannot exchange the baked bundle with the old one: ") + std::strerror(errno)};
     }
     // staging_ now holds the previous bundle (or nothing).
-    return {};
+    return sync_path(dir_.parent_path().empty() ? fs::path(".") : dir_.parent_path(), O_RDONLY | O_DIRECTORY);
   }
 
  private:
@@ -281,6 +325,56 @@ class StagedBundle {
 
 // The manifest's method entry name of a plan key.
 std::string manifest_key(const std::string& key) { return key == "atlas" ? "light_atlas" : key; }
+
+std::string utc_now() {
+  const std::time_t t = std::time(nullptr);
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
+  return buf;
+}
+
+std::string host_name() {
+  char buf[256] = {};
+  return ::gethostname(buf, sizeof buf - 1) == 0 ? std::string(buf) : std::string();
+}
+
+// bake_stats.json (docs/bake-bundle.md): per method, when and where it was baked, with how
+// many threads and how long each stage took. Everything that differs between two bakes of
+// the same scene, settings and seed lives here and nowhere else, so the manifest and the
+// method files are byte-identical across runs and thread counts. No loader reads it.
+// Entries of methods baked earlier are kept while the manifest still lists them.
+engine::Status update_bake_stats(const fs::path& dir, const nlohmann::json& baked, unsigned threads_requested) {
+  const fs::path path = dir / kBakeStatsFileName;
+  nlohmann::json methods = nlohmann::json::object();
+  if (auto old = read_file_bytes(path)) {
+    const auto* text = reinterpret_cast<const char*>(old->data());
+    nlohmann::json doc = nlohmann::json::parse(text, text + old->size(), nullptr, /*allow_exceptions=*/false);
+    if (doc.is_object() && doc.contains("methods") && doc["methods"].is_object()) methods = doc["methods"];
+  }
+  auto manifest = read_manifest(dir);
+  for (auto it = methods.begin(); it != methods.end();) {
+    if (manifest && manifest->methods.contains(it.key()))
+      ++it;
+    else
+      it = methods.erase(it);
+  }
+  const unsigned hardware = std::max(1u, std::thread::hardware_concurrency());
+  const unsigned used = std::min(threads_requested == 0 ? hardware : threads_requested, ThreadPool::kMaxThreads);
+  const std::string when = utc_now();
+  const std::string host = host_name();
+  for (const auto& [method, entry] : baked.items()) {
+    nlohmann::json e = entry;
+    e["threads"] = used;
+    e["hardware_threads"] = hardware;
+    e["host"] = host;
+    e["baked_utc"] = when;
+    methods[method] = std::move(e);
+  }
+  const nlohmann::json doc{{"methods", methods}};
+  return write_file_atomically(path, doc.dump(2) + "\n");
+}
 
 }  // namespace
 
@@ -323,20 +417,24 @@ engine::Result<BakeReport> bake_bundle(const BakeInput& input, const fs::path& b
   auto staged = StagedBundle::begin(bundle_dir);
   if (!staged) return staged.error();
   const fs::path& dir = staged->path();
+  nlohmann::json method_stats = nlohmann::json::object();
   for (const std::string& key : methods) {
     const auto start = Clock::now();
-    engine::Status done = key == "atlas" ? bake_atlas(input, dir, options, {host, "light atlas"})
-                          : key == "prm" ? bake_prm_method(input, dir, options, {host, "PRM"})
-                          : key == "dlm" ? bake_dlm_method(input, dir, options, {host, "DLM"})
+    Timings timings = nlohmann::json::object();
+    engine::Status done = key == "atlas" ? bake_atlas(input, dir, options, {host, "light atlas"}, timings)
+                          : key == "prm" ? bake_prm_method(input, dir, options, {host, "PRM"}, timings)
+                          : key == "dlm" ? bake_dlm_method(input, dir, options, {host, "DLM"}, timings)
                           : key == "antiradiance" ? bake_antiradiance_method(input, dir, options, {host, "antiradiance"})
-                                         : bake_brf_method(input, dir, options, host);
+                                         : bake_brf_method(input, dir, options, host, timings);
     if (!done) return done.error();
     report.baked.push_back({key, seconds_since(start), method_bytes(dir, manifest_key(key))});
+    method_stats[manifest_key(key)] = {{"seconds", report.baked.back().seconds}, {"stages", timings}};
   }
   if (auto ok = update_manifest_plan(dir, scene_geometry_hash(input), scene_file_name(input),
                                      plan_to_json_value(report.plan));
       !ok)
     return ok.error();
+  if (auto ok = update_bake_stats(dir, method_stats, options.threads); !ok) return ok.error();
   if (auto ok = staged->commit(); !ok) return ok.error();
   return report;
 }

@@ -173,8 +173,7 @@ json settings_json(const BrfSettings& s) {
                 {"sh_bands", s.field.sh_bands},
                 {"inner_radius_scale", s.field.inner_radius_scale},
                 {"outer_radius_scale", s.field.outer_radius_scale},
-                {"directions", s.field.directions},
-                {"threads", s.field.threads}}}};
+                {"directions", s.field.directions}}}};
 }
 
 BrfSettings read_settings(JsonFields& f) {
@@ -190,7 +189,6 @@ BrfSettings read_settings(JsonFields& f) {
   s.field.inner_radius_scale = f.get<float>("settings.field.inner_radius_scale");
   s.field.outer_radius_scale = f.get<float>("settings.field.outer_radius_scale");
   s.field.directions = f.get<int>("settings.field.directions");
-  s.field.threads = f.get<unsigned>("settings.field.threads");
   return s;
 }
 
@@ -366,10 +364,7 @@ engine::Status save_brf(const fs::path& bundle_dir, const BrfBake& bake, const B
                           {"glossy_brdf_error", m.glossy ? static_cast<double>(m.glossy->relative_error) : 0.0},
                           {"field_bytes", static_cast<std::uint64_t>(m.field.bytes())},
                           {"field_compressed_bytes", compressed},
-                          {"file_bytes", static_cast<std::uint64_t>(file_bytes)},
-                          {"basis_seconds", m.basis_seconds},
-                          {"field_seconds", m.field_seconds},
-                          {"bake_seconds", m.basis_seconds + m.field_seconds}};
+                          {"file_bytes", static_cast<std::uint64_t>(file_bytes)}};
   }
   const json entry{{"files", files}, {"settings", settings_json(bake.settings)}, {"meshes", meshes}};
   return update_manifest_method(bundle_dir, scene_geometry_hash(input), scene_name, kBrfMethod, entry);
@@ -395,8 +390,6 @@ engine::Result<BrfBake> load_brf(const fs::path& bundle_dir, std::span<const Brf
           "no basis radiance field for the scene's dynamic mesh \"" + source.name + "\" (re-bake with --methods brf)"};
     const std::string file_name = fields.get<std::string>(key + ".file");
     const std::string checksum = fields.get<std::string>(key + ".xxh3_64");
-    const double basis_seconds = fields.get<double>("meshes." + source.name + ".basis_seconds");
-    const double field_seconds = fields.get<double>("meshes." + source.name + ".field_seconds");
     if (fields.error()) return *fields.error();
     if (!is_bundle_file_name(file_name))
       return engine::Error{manifest_file.string(), prefix + "." + key + ".file",
@@ -417,8 +410,6 @@ engine::Result<BrfBake> load_brf(const fs::path& bundle_dir, std::span<const Brf
       return file_error(path, "vertex_count",
                         "the basis has " + str(mesh->basis.vertex_count) + " vertices, mesh \"" + source.name + "\" " +
                             str(source.mesh.positions.size()));
-    mesh->basis_seconds = basis_seconds;
-    mesh->field_seconds = field_seconds;
     out.meshes.push_back(std::move(mesh).value());
   }
   return out;

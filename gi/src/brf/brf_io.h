@@ -13,8 +13,8 @@
 //     "meshes":   { "<name>": { "mesh_hash", "mesh_index", "entities", "vertices", "basis_requested",
 //                               "basis_kept", "condition", "glossy_terms" (0: diffuse), "glossy_brdf_error",
 //                               "field_bytes" (raw float32 coefficients),
-//                               "field_compressed_bytes" (their zstd frame), "file_bytes",
-//                               "basis_seconds", "field_seconds", "bake_seconds" }, ... } }
+//                               "field_compressed_bytes" (their zstd frame), "file_bytes" }, ... } }
+// Timings and thread counts are not in the bundle's files: bake_stats.json (gi/bake.h) has them.
 // A BRF depends on its mesh only (object space), not on the static world or the lights, so
 // the scene's geometry hash is not checked on load (it covers static nodes only anyway);
 // each file's mesh hash is, against the scene's mesh (gi::brf_mesh_hash).

@@ -79,8 +79,7 @@ json settings_json(const DlmSettings& s) {
               {"glossy_roughness", s.glossy_roughness},
               {"max_bounces", s.max_bounces},
               {"area_light_samples", s.area_light_samples},
-              {"seed", s.seed},
-              {"threads", s.threads}};
+              {"seed", s.seed}};
 }
 
 json stats_json(const DlmStats& s) {
@@ -89,9 +88,7 @@ json stats_json(const DlmStats& s) {
               {"deposits", s.deposits},
               {"lost_deposits", s.lost_deposits},
               {"emitted_watts", s.emitted_watts},
-              {"glossy_texels", s.glossy_texels},
-              {"trace_seconds", s.trace_seconds},
-              {"total_seconds", s.total_seconds}};
+              {"glossy_texels", s.glossy_texels}};
 }
 
 struct EntryInfo {
@@ -125,8 +122,6 @@ engine::Result<EntryInfo> read_entry(const fs::path& manifest_file, const json& 
   e.stats.lost_deposits = f.get<std::uint64_t>("stats.lost_deposits");
   e.stats.emitted_watts = f.get<double>("stats.emitted_watts");
   e.stats.glossy_texels = f.get<std::size_t>("stats.glossy_texels");
-  e.stats.trace_seconds = f.get<double>("stats.trace_seconds");
-  e.stats.total_seconds = f.get<double>("stats.total_seconds");
   if (f.error()) return *f.error();
   if (!is_bundle_file_name(e.file))
     return engine::Error{manifest_file.string(), prefix + ".files.maps.file",

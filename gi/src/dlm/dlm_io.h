@@ -7,10 +7,10 @@
 //   dlm.bin         the checksummed container of io/blob_file.h, magic "GIDLMAPS", version 1.
 //   manifest.json   methods.dlm = {
 //     "files":    { "maps": {"file": "dlm.bin", "xxh3_64": "<hex of the whole file>"} },
-//     "settings": { DlmSettings' scalar fields (not progress) },
+//     "settings": { DlmSettings' scalar fields but threads and progress },
 //     "layout":   { "requested_texels_per_metre", "texels_per_metre", "padding_texels", "width", "height" },
 //     "directions", "texels",
-//     "stats":    { every DlmStats field },
+//     "stats":    { DlmStats' counts (timings: bake_stats.json) },
 //     "memory":   { "gpu_bytes": texels x directions x 8 (RGB halves padded to 8 bytes) + width x height x 4
 //                   (the texel index map), "bytes_per_texel": directions x 6 (stored halves),
 //                   "file_bytes": size of dlm.bin } }

@@ -26,8 +26,7 @@ json settings_json(const LightAtlasSettings& s) {
               {"unshot_threshold", s.unshot_threshold},
               {"area_light_samples", s.area_light_samples},
               {"include_direct", s.include_direct},
-              {"seed", s.seed},
-              {"threads", s.threads}};
+              {"seed", s.seed}};
 }
 
 json stats_json(const LightAtlasStats& s) {
@@ -36,12 +35,7 @@ json stats_json(const LightAtlasStats& s) {
               {"light_points", s.light_points},
               {"shots", s.shots},
               {"valid_texels", s.valid_texels},
-              {"rays", s.rays},
-              {"vpl_seconds", s.vpl_seconds},
-              {"direct_seconds", s.direct_seconds},
-              {"propagate_seconds", s.propagate_seconds},
-              {"final_seconds", s.final_seconds},
-              {"total_seconds", s.total_seconds}};
+              {"rays", s.rays}};
 }
 
 LightAtlasStats read_stats(JsonFields& f) {
@@ -52,11 +46,6 @@ LightAtlasStats read_stats(JsonFields& f) {
   s.shots = f.get<std::size_t>("stats.shots");
   s.valid_texels = f.get<std::size_t>("stats.valid_texels");
   s.rays = f.get<std::uint64_t>("stats.rays");
-  s.vpl_seconds = f.get<double>("stats.vpl_seconds");
-  s.direct_seconds = f.get<double>("stats.direct_seconds");
-  s.propagate_seconds = f.get<double>("stats.propagate_seconds");
-  s.final_seconds = f.get<double>("stats.final_seconds");
-  s.total_seconds = f.get<double>("stats.total_seconds");
   return s;
 }
 

@@ -10,9 +10,9 @@
 //   manifest.json          methods.light_atlas = {
 //     "files":    { "irradiance": {"file": "light_atlas.exr", "xxh3_64": "<hex>"},
 //                   "vpls":       {"file": "light_atlas_vpls.bin", "xxh3_64": "<hex>"} },
-//     "settings": { LightAtlasSettings' scalar fields },
+//     "settings": { LightAtlasSettings' scalar fields but threads },
 //     "layout":   { "requested_texels_per_metre", "texels_per_metre", "padding_texels", "width", "height" },
-//     "stats":    { every LightAtlasStats field } }
+//     "stats":    { LightAtlasStats' counts (timings: bake_stats.json) } }
 // The manifest is written last and names the XXH3-64 of both files, so a bundle whose
 // bake was interrupted between files, or mixes files of two bakes, does not load.
 

@@ -65,7 +65,6 @@ engine::Status write_light_atlas_vpls(const std::filesystem::path& path, const L
   w.put(static_cast<std::int32_t>(s.area_light_samples));
   w.put(static_cast<std::uint8_t>(s.include_direct ? 1 : 0));
   w.put(static_cast<std::uint64_t>(s.seed));
-  w.put(static_cast<std::uint32_t>(s.threads));
   w.put_array(as_span(v.position));
   w.put_array(as_span(v.normal));
   w.put_array(as_span(v.albedo));
@@ -88,10 +87,9 @@ engine::Result<LightAtlasVplFile> read_light_atlas_vpls(const std::filesystem::p
   std::int32_t vpl_count = 0, samples_per_vpl = 0, bounces = 0, area_light_samples = 0;
   std::uint8_t include_direct = 0;
   std::uint64_t seed = 0;
-  std::uint32_t threads = 0;
   const bool complete = r.get_string(f.geometry_hash) && r.get(s.texels_per_metre) && r.get(vpl_count) &&
                         r.get(samples_per_vpl) && r.get(bounces) && r.get(s.unshot_threshold) &&
-                        r.get(area_light_samples) && r.get(include_direct) && r.get(seed) && r.get(threads) &&
+                        r.get(area_light_samples) && r.get(include_direct) && r.get(seed) &&
                         r.get_array(v.position) && r.get_array(v.normal) && r.get_array(v.albedo) &&
                         r.get_array(v.area_m2) && r.get_array(v.sample_first) && r.get_array(v.sample_position) &&
                         r.get_array(v.sample_normal) && r.get_array(v.sample_area_m2) && r.get_array(f.vpl_power);
@@ -105,7 +103,6 @@ engine::Result<LightAtlasVplFile> read_light_atlas_vpls(const std::filesystem::p
   s.area_light_samples = area_light_samples;
   s.include_direct = include_direct != 0;
   s.seed = seed;
-  s.threads = threads;
   if (std::string problem = check_vpls(v, f.vpl_power); !problem.empty())
     return engine::Error{path.string(), "VPLs", problem};
   return f;

@@ -108,17 +108,13 @@ json settings_json(const PrmSettings& s) {
               {"splitting", s.splitting},
               {"max_path_nodes", s.max_path_nodes},
               {"kmeans", s.kmeans},
-              {"seed", s.seed},
-              {"threads", s.threads}};
+              {"seed", s.seed}};
 }
 
 json stats_json(const PrmStats& s) {
   return json{{"paths", s.paths},
               {"path_nodes", s.path_nodes},
-              {"rays", s.rays},
-              {"walk_seconds", s.walk_seconds},
-              {"pane_seconds", s.pane_seconds},
-              {"total_seconds", s.total_seconds}};
+              {"rays", s.rays}};
 }
 
 // What the manifest entry says about the file, the layout and the sizes.
@@ -150,9 +146,6 @@ engine::Result<EntryInfo> read_entry(const fs::path& manifest_file, const json& 
   e.stats.paths = f.get<std::size_t>("stats.paths");
   e.stats.path_nodes = f.get<std::size_t>("stats.path_nodes");
   e.stats.rays = f.get<std::uint64_t>("stats.rays");
-  e.stats.walk_seconds = f.get<double>("stats.walk_seconds");
-  e.stats.pane_seconds = f.get<double>("stats.pane_seconds");
-  e.stats.total_seconds = f.get<double>("stats.total_seconds");
   if (f.error()) return *f.error();
   if (!is_bundle_file_name(e.panes_file))
     return engine::Error{manifest_file.string(), prefix + ".files.panes.file",
@@ -263,7 +256,6 @@ engine::Status write_prm_panes(const fs::path& path, const Prm& prm, const std::
   w.put(static_cast<std::int32_t>(s.max_path_nodes));
   w.put(static_cast<std::uint8_t>(s.kmeans ? 1 : 0));
   w.put(static_cast<std::uint64_t>(s.seed));
-  w.put(static_cast<std::uint32_t>(s.threads));
   w.put(static_cast<std::int32_t>(prm.width));
   w.put(static_cast<std::int32_t>(prm.height));
   w.put(static_cast<std::int32_t>(prm.cluster_count));
@@ -289,14 +281,13 @@ engine::Result<PrmPaneFile> read_prm_panes(const fs::path& path) {
   std::int32_t entry_points = 0, clusters = 0, max_path_nodes = 0, width = 0, height = 0, cluster_count = 0;
   std::uint8_t kmeans = 0;
   std::uint64_t seed = 0, pane_half_bytes = 0;
-  std::uint32_t threads = 0;
   std::vector<glm::vec3> position, normal;
   std::vector<float> area, scales;
   std::vector<std::uint32_t> cluster;
   std::vector<std::uint8_t> frame;
   const bool complete = r.get_string(f.geometry_hash) && r.get(s.texels_per_metre) && r.get(entry_points) &&
                         r.get(clusters) && r.get(s.splitting) && r.get(max_path_nodes) && r.get(kmeans) &&
-                        r.get(seed) && r.get(threads) && r.get(width) && r.get(height) && r.get(cluster_count) &&
+                        r.get(seed) && r.get(width) && r.get(height) && r.get(cluster_count) &&
                         r.get_array(p.texels) && r.get_array(position) && r.get_array(normal) && r.get_array(area) &&
                         r.get_array(cluster) && r.get_array(p.cluster_size) && r.get_array(scales) &&
                         r.get(pane_half_bytes) && r.get_array(frame);
@@ -309,7 +300,6 @@ engine::Result<PrmPaneFile> read_prm_panes(const fs::path& path) {
   s.max_path_nodes = max_path_nodes;
   s.kmeans = kmeans != 0;
   s.seed = seed;
-  s.threads = threads;
   p.width = width;
   p.height = height;
   p.cluster_count = cluster_count;

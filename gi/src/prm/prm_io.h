@@ -4,13 +4,13 @@
 //   auto prm = gi::load_prm("level.gibake", input);   // checks the geometry hash
 //
 // Files (DESIGN.md §5, docs/bake-bundle.md):
-//   prm_panes.bin   the checksummed container of bake/blob_file.h, magic "GIPRMPAN", version 1.
+//   prm_panes.bin   the checksummed container of bake/blob_file.h, magic "GIPRMPAN", version 2.
 //   manifest.json   methods.prm = {
 //     "files":        { "panes": {"file": "prm_panes.bin", "xxh3_64": "<hex of the whole file>"} },
-//     "settings":     { PrmSettings' scalar fields (not progress) },
+//     "settings":     { PrmSettings' scalar fields but threads and progress },
 //     "layout":       { "requested_texels_per_metre", "texels_per_metre", "padding_texels", "width", "height" },
 //     "entry_points", "clusters", "pane_texels",
-//     "stats":        { every PrmStats field, timings in seconds },
+//     "stats":        { PrmStats' counts (timings: bake_stats.json) },
 //     "memory":       { "pane_bytes_half": clusters x pane_texels x 3 x 2 (the panes as GPU halves),
 //                       "file_bytes": size of prm_panes.bin } }
 // The PRM depends on the static geometry and materials only (entry points stand for any
@@ -20,8 +20,8 @@
 // vec3 = 3 x float32):
 //   string        geometry_hash        uint64 length + chars: the scene the PRM belongs to
 //   float32 texels_per_metre, int32 entry_points, int32 clusters, float32 splitting,
-//   int32 max_path_nodes, uint8 kmeans, uint64 seed, uint32 threads
-//                                      PrmSettings' scalar fields
+//   int32 max_path_nodes, uint8 kmeans, uint64 seed
+//                                      PrmSettings' scalar fields (not threads: no file depends on them)
 //   int32 width, int32 height          atlas size (the layout is rebuilt from the scene)
 //   int32 cluster_count
 //   array<uint32> texels               ascending atlas texel indices, each < width x height
@@ -59,7 +59,8 @@ namespace gi {
 inline constexpr const char* kPrmMethod = "prm";
 inline constexpr const char* kPrmPanesFile = "prm_panes.bin";
 inline constexpr BlobMagic kPrmPanesMagic{"GIPRMPAN"};
-inline constexpr std::uint32_t kPrmPanesVersion = 1;
+// 2: the thread count left out (a bundle does not depend on it; bake_stats.json says it).
+inline constexpr std::uint32_t kPrmPanesVersion = 2;
 
 /// Relative and pane-relative bounds of the half-float pane storage (see above).
 inline constexpr double kPrmPaneRelativeError = 1.0 / 2048.0;               // 2^-11

@@ -215,8 +215,8 @@ TEST(BrfIo, RoundTripIsBitExact) {
     EXPECT_EQ(std::memcmp(&y.field.inner_radius, &x.field.inner_radius, sizeof(float)), 0);
     EXPECT_EQ(std::memcmp(&y.field.outer_radius, &x.field.outer_radius, sizeof(float)), 0);
     EXPECT_TRUE(same_bits(y.field.coefficients, x.field.coefficients));
-    EXPECT_EQ(y.basis_seconds, x.basis_seconds);
-    EXPECT_EQ(y.field_seconds, x.field_seconds);
+    EXPECT_EQ(y.basis_seconds, 0.0) << "timings are in bake_stats.json, not in the bundle's files";
+    EXPECT_EQ(y.field_seconds, 0.0);
   }
 }
 

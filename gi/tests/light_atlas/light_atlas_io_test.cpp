@@ -143,7 +143,7 @@ TEST(LightAtlasIo, RoundTripIsBitExact) {
   EXPECT_EQ(s.area_light_samples, t.area_light_samples);
   EXPECT_EQ(s.include_direct, t.include_direct);
   EXPECT_EQ(s.seed, t.seed);
-  EXPECT_EQ(s.threads, t.threads);
+  EXPECT_EQ(s.threads, 0u) << "the thread count is not part of a bundle (bake_stats.json holds it)";
 
   const gi::LightAtlasStats &x = back->stats, &y = bake.stats;
   EXPECT_EQ(x.vpls, y.vpls);
@@ -152,11 +152,9 @@ TEST(LightAtlasIo, RoundTripIsBitExact) {
   EXPECT_EQ(x.shots, y.shots);
   EXPECT_EQ(x.valid_texels, y.valid_texels);
   EXPECT_EQ(x.rays, y.rays);
-  EXPECT_EQ(x.vpl_seconds, y.vpl_seconds);
-  EXPECT_EQ(x.direct_seconds, y.direct_seconds);
-  EXPECT_EQ(x.propagate_seconds, y.propagate_seconds);
-  EXPECT_EQ(x.final_seconds, y.final_seconds);
-  EXPECT_EQ(x.total_seconds, y.total_seconds);
+  // Timings are not part of a bundle (bake_stats.json holds them): a load reads none.
+  EXPECT_EQ(x.total_seconds, 0.0);
+  EXPECT_NE(y.total_seconds, 0.0);
 
   auto manifest = gi::read_manifest(dir);
   ASSERT_TRUE(manifest.ok()) << manifest.error().to_string();
