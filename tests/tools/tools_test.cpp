@@ -3,6 +3,8 @@
 // processes, as a user or a build script runs them.
 #include <fcntl.h>
 #include <engine/gltf.h>
+#include <engine/scene.h>
+#include <gi/gi_system.h>
 #include <gi/version.h>
 #include <gtest/gtest.h>
 #include <signal.h>
@@ -13,6 +15,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -31,9 +34,10 @@ struct ToolRun {
 };
 
 /// Runs `exe args...` with stdout+stderr into a file; when `interrupt_after` is positive,
-/// sends SIGINT once the output contains `interrupt_when` (or that many seconds passed).
+/// sends `signal` (SIGINT: Ctrl-C) once the output contains `interrupt_when` (or that many
+/// seconds passed).
 ToolRun run(const std::string& exe, const std::vector<std::string>& args, double interrupt_after = 0.0,
-            const std::string& interrupt_when = {}) {
+            const std::string& interrupt_when = {}, int signal = SIGINT) {
   const fs::path log = fs::path(GI_BINARY_DIR) / "test_output" / "tools_test" /
                        ("run-" + std::to_string(::getpid()) + "-" + std::to_string(std::rand()) + ".log");
   fs::create_directories(log.parent_path());
@@ -61,7 +65,7 @@ ToolRun run(const std::string& exe, const std::vector<std::string>& args, double
     while (!(reaped = waitpid(pid, &status, WNOHANG) == pid)) {
       const double waited = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       if (waited >= interrupt_after || (!interrupt_when.empty() && slurp().find(interrupt_when) != std::string::npos)) {
-        kill(pid, SIGINT);
+        kill(pid, signal);
         break;
       }
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
@@ -246,4 +250,81 @@ TEST(GiBake, ExportUv1WritesTheSceneWithLightmapUvs) {
   }
   EXPECT_EQ(static_meshes, 4u);  // walls, two blocks, the lamp's quad
   EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 1) << "nothing but the export";
+}
+
+namespace {
+
+// A bundle's files but bake_stats.json (when and how long; it differs between any two bakes).
+std::map<std::string, std::string> bundle_bytes(const fs::path& dir) {
+  std::map<std::string, std::string> out;
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(dir, ec)) {
+    if (e.path().filename() == "bake_stats.json") continue;
+    std::ifstream in(e.path(), std::ios::binary);
+    out[e.path().filename().string()] = std::string(std::istreambuf_iterator<char>(in), {});
+  }
+  return out;
+}
+
+}  // namespace
+
+// gi-bake killed (SIGKILL: no handler runs) at several points of a re-bake over a working
+// bundle: what is left is, byte for byte, the old bundle or the finished new one — never a
+// mix — and it loads; the next bake clears what the killed one left and succeeds.
+TEST(GiBake, AKilledRebakeLeavesTheOldBundleOrTheNewOneNeverAMix) {
+  const fs::path root = fs::path(GI_BINARY_DIR) / "test_output" / "tools_test" / "killed";
+  fs::remove_all(root);
+  fs::create_directories(root);
+  const fs::path dir = root / "cornell.gibake";
+  const std::string scene = GI_SOURCE_DIR "/assets/cornell_box.gltf";
+  const std::vector<std::string> old_bake{"--scene", scene,         "--preset", "preview", "--methods",
+                                          "atlas,prm", "--threads", "2",        "--out",   dir.string()};
+  const std::vector<std::string> new_bake{"--scene", scene,         "--preset", "medium", "--methods",
+                                          "atlas,prm", "--threads", "2",        "--out",  dir.string()};
+  // The new bundle, baked once without interruption (to know its bytes), then the old one.
+  ASSERT_EQ(run(GI_BAKE_EXE, new_bake).exit_code, 0);
+  const auto new_files = bundle_bytes(dir);
+  ASSERT_EQ(run(GI_BAKE_EXE, old_bake).exit_code, 0);
+  const auto old_files = bundle_bytes(dir);
+  ASSERT_NE(old_files, new_files);
+
+  auto asset = engine::load_gltf(scene);
+  ASSERT_TRUE(asset) << asset.error().to_string();
+  struct KillPoint {
+    const char* when;  // output text that triggers the kill ("" = after `seconds`)
+    double seconds;
+  };
+  const KillPoint points[] = {
+      {"", 0.01},                      // while starting: lock, staging copy
+      {"light atlas of", 30.0},        // the atlas baking
+      {"PRM of", 30.0},                // the atlas written into staging, the PRM baking
+      {"time: walks", 30.0},           // the PRM being saved
+      {"", 1.5},                       // wherever the clock says
+      {"gi-bake: atlas:", 30.0},       // after the exchange, while reporting
+  };
+  int saw_old = 0, saw_new = 0;
+  for (const KillPoint& p : points) {
+    const ToolRun r = run(GI_BAKE_EXE, new_bake, p.seconds, p.when, SIGKILL);
+    const auto left = bundle_bytes(dir);
+    const bool is_old = left == old_files, is_new = left == new_files;
+    EXPECT_TRUE(is_old || is_new) << "killed at \"" << p.when << "\" / " << p.seconds
+                                  << " s: the bundle is neither the old nor the new one\n"
+                                  << r.output;
+    saw_old += is_old;
+    saw_new += is_new;
+    engine::Scene s = engine::instantiate(*asset);
+    auto loaded = gi::GISystem::load(dir, s);
+    EXPECT_TRUE(loaded) << "killed at \"" << p.when << "\": " << loaded.error().to_string();
+    // Put the old bundle back for the next kill (over a possibly left staging directory).
+    if (!is_old) {
+      ASSERT_EQ(run(GI_BAKE_EXE, old_bake).exit_code, 0);
+    }
+  }
+  std::printf("%d kills left the old bundle, %d the new one\n", saw_old, saw_new);
+  EXPECT_GT(saw_old, 0);
+  EXPECT_GT(saw_new, 0) << "the kill after the exchange must find the new bundle";
+  // A finished bake after the kills: the new bundle, and no staging directory left behind.
+  ASSERT_EQ(run(GI_BAKE_EXE, new_bake).exit_code, 0);
+  EXPECT_EQ(bundle_bytes(dir), new_files);
+  EXPECT_FALSE(fs::exists(root / ".cornell.gibake.staging"));
 }
