@@ -22,6 +22,9 @@
 
 #include <engine/entity.h>
 #include <engine/image.h>
+#include <functional>
+#include <string>
+
 #include <engine/indirect_light.h>
 #include <engine/registry.h>
 #include <engine/result.h>
@@ -57,6 +60,10 @@ struct RenderSettings {
   /// (a light atlas baked with the sky). Pixels no geometry covers show it (the background).
   /// docs/scene-format.md.
   glm::vec3 sky_radiance{0.0f};
+  /// Told once when a light or mesh entity starts being skipped because its world transform
+  /// or light values are not usable (engine/runtime_limits.h: NaN, infinite, absurd); again
+  /// only if it recovers and fails anew. Unset: skipped silently (last_skipped_entities()).
+  std::function<void(const std::string&)> warn;
 };
 
 /// Wall time of one render pass (GPU work measured with glFinish + a steady clock on
@@ -116,6 +123,9 @@ class Renderer {
   /// neither its light nor a caster that can reach it (not wholly outside its clip volume)
   /// moved: static lights over static casters are drawn once.
   virtual int last_shadow_maps_rendered() const = 0;
+  /// Light and mesh entities the last render() left out as unusable (see RenderSettings::warn).
+  /// A camera whose transform is unusable is replaced by its last usable one.
+  virtual int last_skipped_entities() const = 0;
 };
 
 }  // namespace engine

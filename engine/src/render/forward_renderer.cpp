@@ -6,6 +6,8 @@
 #include <array>
 #include <cstdio>
 #include <map>
+#include <set>
+#include <utility>
 #include <string>
 
 #include <GL/glcorearb.h>
@@ -13,6 +15,7 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include <engine/components.h>
+#include <engine/runtime_limits.h>
 #include <engine/gpu/gl_objects.h>
 #include <engine/gpu/gltf_brdf_texture.h>
 #include <engine/gpu/gpu_timer.h>
@@ -112,10 +115,12 @@ class ForwardRenderer final : public Renderer {
   RenderSettings& settings() override { return settings_; }
   const std::vector<PassTiming>& last_timings() const override { return timings_; }
   int last_shadow_maps_rendered() const override { return shadow_maps_rendered_; }
+  int last_skipped_entities() const override { return skipped_entities_; }
 
  private:
   void ensure_targets();
-  std::vector<DrawItem> draw_items(const Registry& registry) const;
+  std::vector<DrawItem> draw_items(const Registry& registry, std::vector<std::pair<Entity, const char*>>& skipped) const;
+  void report_skipped(const Registry& registry, const std::vector<std::pair<Entity, const char*>>& skipped);
   void forward_pass(const Registry& registry, Entity camera, const std::vector<DrawItem>& items, const LightCounts& counts);
   const ShaderProgram& forward_program(const LightCounts& counts);
   void depth_prepass(const glm::mat4& view_proj, const std::vector<DrawItem>& items);
@@ -129,6 +134,9 @@ class ForwardRenderer final : public Renderer {
   ShaderProgram tonemap_;
   render::ShadowMaps shadow_maps_;
   int shadow_maps_rendered_ = 0;
+  int skipped_entities_ = 0;
+  std::set<std::uint32_t> warned_;  // entity ids skipped and reported, while they stay unusable
+  glm::mat4 last_camera_world_{1.0f};
   GlBuffer lights_buffer_;
   GlVertexArray empty_vao_;
   GlTexture albedo_table_;  // gltf_brdf.glsl's directional albedo table
@@ -174,10 +182,15 @@ void ForwardRenderer::ensure_targets() {
   GI_EXPECTS(hdr_fbo_.complete() && ldr_fbo_.complete(), "render targets must be complete");
 }
 
-std::vector<DrawItem> ForwardRenderer::draw_items(const Registry& registry) const {
+std::vector<DrawItem> ForwardRenderer::draw_items(const Registry& registry,
+                                                  std::vector<std::pair<Entity, const char*>>& skipped) const {
   std::vector<DrawItem> items;
   registry.view<MeshRenderer, WorldTransform>().each([&](Entity e, const MeshRenderer& mr, const WorldTransform& wt) {
     GI_EXPECTS(mr.mesh < scene_.meshes().size(), "MeshRenderer::mesh must index the renderer's SceneAsset meshes");
+    if (const char* why = unusable_world_matrix(wt.matrix)) {
+      skipped.emplace_back(e, why);
+      return;
+    }
     DrawItem item;
     item.entity = e;
     item.mesh = &scene_.meshes()[mr.mesh];
@@ -191,6 +204,20 @@ std::vector<DrawItem> ForwardRenderer::draw_items(const Registry& registry) cons
   return items;
 }
 
+// One warning per entity when it starts being skipped; forgotten when it is usable again.
+void ForwardRenderer::report_skipped(const Registry& registry, const std::vector<std::pair<Entity, const char*>>& skipped) {
+  skipped_entities_ = static_cast<int>(skipped.size());
+  std::set<std::uint32_t> now;
+  for (const auto& [e, why] : skipped) {
+    now.insert(e.id());
+    if (warned_.contains(e.id()) || !settings_.warn) continue;
+    const Name* name = registry.try_get<Name>(e);
+    settings_.warn("renderer: " + std::string(registry.has<Light>(e) ? "light" : "mesh") + " '" +
+                   (name ? name->value : "entity " + std::to_string(e.id())) + "' skipped: " + why);
+  }
+  warned_ = std::move(now);
+}
+
 void ForwardRenderer::render(const Registry& registry, Entity camera) {
   GI_EXPECTS(registry.valid(camera) && registry.has<Camera>(camera) && registry.has<WorldTransform>(camera),
              "render() needs a camera entity with Camera and WorldTransform");
@@ -198,11 +225,13 @@ void ForwardRenderer::render(const Registry& registry, Entity camera) {
   timings_.clear();
   GpuTimer timer;
 
-  const std::vector<DrawItem> items = draw_items(registry);
+  std::vector<std::pair<Entity, const char*>> skipped;
+  const std::vector<DrawItem> items = draw_items(registry, skipped);
   render::ShadowCapacity capacity;
   capacity.map_size = std::max(16, settings_.shadow_map_size);
   capacity.cube_size = std::max(16, settings_.shadow_map_size / 2);
-  const render::LightList lights = render::collect_lights(registry, render::scene_bounds(items), capacity);
+  const render::LightList lights = render::collect_lights(registry, render::scene_bounds(items), capacity, &skipped);
+  report_skipped(registry, skipped);
   shadow_maps_.reserve(capacity.map_size, lights.layers_2d, capacity.cube_size, lights.cubes);
   shadow_maps_rendered_ = shadow_maps_.render(lights.shadow_views, items, scene_, shadow_);
   timings_.push_back({"shadow maps (" + std::to_string(lights.shadow_views.size()) + " views)", timer.lap_ms()});
@@ -225,7 +254,9 @@ void ForwardRenderer::forward_pass(const Registry& registry, Entity camera, cons
                                    const LightCounts& counts) {
   const ShaderProgram& program = forward_program(counts);
   const Camera& cam = registry.get<Camera>(camera);
-  const glm::mat4& camera_world = registry.get<WorldTransform>(camera).matrix;
+  const glm::mat4& camera_now = registry.get<WorldTransform>(camera).matrix;
+  if (unusable_world_matrix(camera_now) == nullptr) last_camera_world_ = camera_now;
+  const glm::mat4& camera_world = last_camera_world_;
   const float aspect = cam.aspect > 0.0f ? cam.aspect : static_cast<float>(width_) / static_cast<float>(height_);
   const glm::mat4 view_proj = glm::perspective(cam.yfov_rad, aspect, cam.znear_m, cam.zfar_m) * glm::inverse(camera_world);
   const glm::vec3 camera_position(camera_world[3]);

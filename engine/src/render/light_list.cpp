@@ -1,5 +1,7 @@
 #include "render/light_list.h"
 
+#include <engine/runtime_limits.h>
+
 #include <algorithm>
 #include <cmath>
 
@@ -53,10 +55,15 @@ SceneBounds scene_bounds(const std::vector<DrawItem>& items) {
   return b;
 }
 
-LightList collect_lights(const Registry& registry, const SceneBounds& bounds, const ShadowCapacity& capacity) {
+LightList collect_lights(const Registry& registry, const SceneBounds& bounds, const ShadowCapacity& capacity,
+                         std::vector<std::pair<Entity, const char*>>* skipped) {
   LightList out;
-  registry.view<Light, WorldTransform>().each([&](Entity, const Light& light, const WorldTransform& wt) {
+  registry.view<Light, WorldTransform>().each([&](Entity e, const Light& light, const WorldTransform& wt) {
     if (!light.enabled) return;
+    if (const char* why = unusable_light(light, wt.matrix)) {
+      if (skipped) skipped->emplace_back(e, why);
+      return;
+    }
     const glm::mat4& m = wt.matrix;
     const glm::vec3 position(m[3]);
     const glm::vec3 axis_x = glm::normalize(glm::vec3(m[0]));

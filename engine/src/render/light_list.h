@@ -6,6 +6,7 @@
 // point (a cube-map-array slice, six 90 degree faces).
 
 #include <array>
+#include <utility>
 #include <vector>
 
 #include <engine/registry.h>
@@ -32,6 +33,9 @@ struct LightList {
   int cubes = 0;
 };
 
-LightList collect_lights(const Registry& registry, const SceneBounds& bounds, const ShadowCapacity& capacity);
+/// Lights whose values or world transform are unusable (engine/runtime_limits.h) are left
+/// out and, when `skipped` is set, listed there with why.
+LightList collect_lights(const Registry& registry, const SceneBounds& bounds, const ShadowCapacity& capacity,
+                         std::vector<std::pair<Entity, const char*>>* skipped = nullptr);
 
 }  // namespace engine::render

@@ -90,6 +90,11 @@ class GISystem final : public engine::IndirectLightProvider {
     std::uint64_t antiradiance_updates = 0;          ///< Frames on which a deforming node moved and was solved.
     std::size_t antiradiance_relinked_elements = 0;  ///< Last such frame: elements whose links were rebuilt.
     double last_antiradiance_ms = 0.0;               ///< Relink + direct light + GPU iteration (glFinish-timed).
+    /// Light and dynamic-object entities left out of the last frame's GI because their world
+    /// transform or light values are unusable (NaN, infinite, absurd: engine/runtime_limits.h).
+    /// A skipped light gives no light; a skipped object keeps its last usable pose. Each is
+    /// told once to GISystemSettings::log (a warning) when it starts being skipped.
+    std::size_t skipped_entities = 0;
     /// Methods of the bundle that turned off at run time, with why: "PRM: <reason>",
     /// "BRF: <reason>". The frame goes on without them (label() no longer names them).
     std::vector<std::string> disabled;

@@ -3,6 +3,7 @@
 #include <GL/glcorearb.h>
 #include <engine/components.h>
 #include <engine/finite.h>
+#include <engine/runtime_limits.h>
 #include <engine/gpu/gl_objects.h>
 #include <engine/gpu/shader_program.h>
 
@@ -149,12 +150,13 @@ bool BrfLighting::update() {
   }
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();
-  // What changed: object transforms (NaN transforms keep the last valid pose) and lights.
+  // What changed: object transforms (NaN or absurd ones keep the last usable pose; GISystem
+  // warns once) and lights.
   std::vector<std::uint8_t> moved(m.instances.size(), 0);
   bool any_moved = false;
   for (std::size_t i = 0; i < m.instances.size(); ++i) {
     const auto* wt = m.registry->try_get<engine::WorldTransform>(m.instances[i].entity);
-    if (wt == nullptr || !engine::all_finite(wt->matrix)) continue;
+    if (wt == nullptr || engine::unusable_world_matrix(wt->matrix)) continue;
     if (!m.computed || wt->matrix != m.transforms[i]) {
       m.transforms[i] = wt->matrix;
       moved[i] = 1;

@@ -3,6 +3,7 @@
 #include <GL/glcorearb.h>
 
 #include <engine/components.h>
+#include <engine/runtime_limits.h>
 
 #include <algorithm>
 #include <array>
@@ -86,7 +87,10 @@ bool AntiradianceLighting::update() {
   bool moved = false;
   for (const auto& [instance, entity] : deforming_) {
     const auto* wt = registry_->try_get<engine::WorldTransform>(entity);
-    if (wt != nullptr && region_->set_instance_transform(instance, wt->matrix)) moved = true;
+    // NaN or absurd transforms keep the last usable pose (GISystem warns once).
+    if (wt != nullptr && !engine::unusable_world_matrix(wt->matrix) &&
+        region_->set_instance_transform(instance, wt->matrix))
+      moved = true;
   }
   if (!moved) return false;
   const auto t0 = std::chrono::steady_clock::now();

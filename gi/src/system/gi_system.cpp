@@ -1,6 +1,7 @@
 #include <GL/glcorearb.h>
 #include <engine/components.h>
 #include <engine/gpu/gl_objects.h>
+#include <engine/runtime_limits.h>
 #include <gi/gi_system.h>
 #include <gi/plan.h>
 
@@ -8,6 +9,7 @@
 #include <cstdio>
 #include <optional>
 #include <sstream>
+#include <unordered_set>
 
 #include "antiradiance/antiradiance_io.h"
 #include "brf/brf_io.h"
@@ -57,6 +59,33 @@ struct GISystem::Impl {
   std::string description;
   bool prm_disabled = false;
   bool brf_disabled = false;
+  const engine::Registry* registry = nullptr;
+  LogCallback log;
+  std::unordered_set<std::uint32_t> warned;  // entities skipped and told, while they stay unusable
+
+  // Lights and dynamic objects the providers leave out this frame (engine/runtime_limits.h):
+  // counted, and each told once when it starts being skipped.
+  void check_runtime_inputs() {
+    std::unordered_set<std::uint32_t> now;
+    const auto skip = [&](engine::Entity e, const char* what, const char* why) {
+      now.insert(e.id());
+      if (warned.contains(e.id()) || !log) return;
+      const auto* name = registry->try_get<engine::Name>(e);
+      log(LogLevel::Warning, std::string("GI: ") + what + " '" + (name ? name->value : "entity " + std::to_string(e.id())) +
+                                 "' skipped: " + why);
+    };
+    registry->view<engine::Light, engine::WorldTransform>().each(
+        [&](engine::Entity e, const engine::Light& l, const engine::WorldTransform& wt) {
+          if (!l.enabled) return;
+          if (const char* why = engine::unusable_light(l, wt.matrix)) skip(e, "light", why);
+        });
+    registry->view<engine::DynamicTag, engine::WorldTransform>().each(
+        [&](engine::Entity e, const engine::DynamicTag&, const engine::WorldTransform& wt) {
+          if (const char* why = engine::unusable_world_matrix(wt.matrix)) skip(e, "dynamic object", why);
+        });
+    stats.skipped_entities = now.size();
+    warned = std::move(now);
+  }
 
   // What runs: the PRM (or the plain atlas) and the BRF, less what turned off.
   void relabel() {
@@ -247,6 +276,8 @@ engine::Result<std::unique_ptr<GISystem>> GISystem::load(const std::filesystem::
     if (!a) return a.error();
     impl->atlas = std::move(a).value();
   }
+  impl->registry = &scene.registry;
+  impl->log = settings.log;
   impl->relabel();
   impl->description = text.str();
   impl->frame.brf = impl->brf.get();
@@ -256,6 +287,7 @@ engine::Result<std::unique_ptr<GISystem>> GISystem::load(const std::filesystem::
 const engine::IndirectLightFrame& GISystem::frame() {
   Impl& m = *impl_;
   ++m.stats.frames;
+  m.check_runtime_inputs();
   bool work = false;
   std::uint32_t base = 0;
   bool base_changed = false;

@@ -1,6 +1,7 @@
 #include "system/prm_lighting.h"
 
 #include <GL/glcorearb.h>
+#include <engine/runtime_limits.h>
 
 #include <chrono>
 #include <optional>
@@ -67,7 +68,8 @@ struct PrmLighting::Impl {
           c.signature = sig;
           changed = true;
           ++recomputed;
-          if (!l.enabled) {
+          // Off, or NaN / absurd at run time (GISystem warns once): no light.
+          if (!l.enabled || engine::unusable_light(l, wt.matrix)) {
             c.entry.assign(prm.entries.size(), glm::vec3(0.0f));
             return;
           }

@@ -1,5 +1,7 @@
 #include "transport/static_scene.h"
 
+#include <engine/runtime_limits.h>
+
 #include "raytrace/embree_ray_caster.h"
 #include "raytrace/scene_adapter.h"
 #include "raytrace/texel_samples.h"
@@ -12,6 +14,7 @@ std::vector<ReferenceLight> scene_lights(const engine::Registry& registry, BakeL
   registry.view<engine::Light, engine::WorldTransform>().each(
       [&](engine::Entity, const engine::Light& light, const engine::WorldTransform& wt) {
         if (!light.enabled) return;
+        if (engine::unusable_light(light, wt.matrix)) return;  // NaN or absurd at run time: as if off
         const bool keep = lights == BakeLights::Static ? !light.moves : lights == BakeLights::Moving && light.moves;
         if (keep) kept.push_back(reference_light(light, wt.matrix));
       });
