@@ -59,7 +59,12 @@ int run_headless(const RunOptions& o, RunState& state) {
     }
     gpu.emplace(std::move(ctx).value());
     if (!load_indirect_light(o, sim, indirect)) return 1;  // before the renderer: it adds TEXCOORD_1
-    auto r = engine::Renderer::create(sim.scene().assets, engine::RenderSettings{.width = o.width, .height = o.height, .exposure = o.exposure});
+    auto r = engine::Renderer::create(
+        sim.scene().assets,
+        engine::RenderSettings{.width = o.width,
+                               .height = o.height,
+                               .exposure = o.exposure,
+                               .warn = [](const std::string& line) { std::cerr << "gi_demo: " << line << '\n'; }});
     if (!r) {
       std::cerr << "gi_demo: " << r.error().to_string() << '\n';
       return 1;
