@@ -343,3 +343,36 @@ TEST(GltfErrors, TruncatedAndBitFlippedFilesNeverCrash) {
 }
 
 }  // namespace
+
+// Budgets across the whole file, not only per primitive: 64 primitives of 131070 zero
+// vertices each (no bufferView, glTF §3.6.2.3) are 8.4 M elements no byte of the file pays for.
+TEST(GltfErrors, AccessorBudgetsHoldAcrossPrimitives) {
+  json d = valid_doc();
+  d["accessors"].push_back({{"componentType", 5126}, {"count", 131070}, {"type", "VEC3"}});
+  json prims = json::array();
+  for (int i = 0; i < 64; ++i) prims.push_back({{"attributes", {{"POSITION", 2}}}});
+  d["meshes"][0]["primitives"] = prims;
+  expect_error(write("zeros.gltf", d.dump()), {"accessor 2", "without a bufferView", "budget"});
+
+  // Every element counts towards the file's budget: 6 per primitive here, so 8 stops the second.
+  engine::GltfLoadOptions small;
+  small.limits.max_scene_elements = 8;
+  json twice = valid_doc();
+  twice["meshes"][0]["primitives"].push_back(twice["meshes"][0]["primitives"][0]);
+  expect_error(write("twice.gltf", twice.dump()), {"budget of 8 elements"}, small);
+  small.limits.max_scene_elements = 12;
+  EXPECT_TRUE(engine::load_gltf(write("twice_ok.gltf", twice.dump()), small).ok());
+}
+
+// Images no material samples are not decoded: a broken one is no error and costs nothing.
+TEST(GltfErrors, ImagesNoMaterialUsesAreNotDecoded) {
+  json d = valid_doc();
+  std::ofstream(dir() / "garbage.png") << "this is not a PNG";
+  d["images"] = json::parse(R"([{"uri": "garbage.png"}])");
+  d["textures"] = json::parse(R"([{"source": 0}])");
+  auto r = engine::load_gltf(write("unused.gltf", d.dump()));
+  ASSERT_TRUE(r.ok()) << r.error().to_string();
+  ASSERT_EQ(r->images.size(), 1u);
+  EXPECT_EQ(r->images[0].width, 0);
+  EXPECT_TRUE(r->images[0].rgba8.empty());
+}

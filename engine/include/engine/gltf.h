@@ -19,6 +19,12 @@ struct GltfLoadLimits {
   std::size_t max_indices_per_primitive = 3u << 26;
   std::size_t max_nodes = 1u << 20;
   int max_image_dimension = 16384;
+  /// Accessor elements (vertex attributes, indices) read in the whole file: 2^28 (268 M).
+  /// With the per-primitive limits it bounds the loader's time and memory for any file.
+  std::size_t max_scene_elements = std::size_t{1} << 28;
+  /// Of those, elements of accessors without a bufferView (zeros, glTF §3.6.2.3) in the whole
+  /// file: 2^22 (4 M). They cost memory that no byte of the file pays for.
+  std::size_t max_unbacked_elements = std::size_t{1} << 22;
 };
 
 struct GltfLoadOptions {

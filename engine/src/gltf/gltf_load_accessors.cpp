@@ -149,6 +149,19 @@ Result<std::vector<double>> read_accessor(const Context& ctx, const ParsedFile& 
   }
   const std::size_t n = static_cast<std::size_t>(ncomp);
   const std::size_t element_size = csize * n;
+  // Budgets across the whole file: a thousand primitives each under the per-primitive limit
+  // must not add up to an exhausted machine, least of all with zeros no byte of the file backs.
+  const GltfLoadLimits& limits = ctx.options.limits;
+  ctx.elements_read += acc.count;
+  if (ctx.elements_read > limits.max_scene_elements)
+    return ctx.error(where, "the file's accessors exceed the budget of " + std::to_string(limits.max_scene_elements) +
+                                " elements in all");
+  if (acc.bufferView < 0) {
+    ctx.unbacked_elements_read += acc.count;
+    if (ctx.unbacked_elements_read > limits.max_unbacked_elements)
+      return ctx.error(where, "accessors without a bufferView (zeros) exceed the budget of " +
+                                  std::to_string(limits.max_unbacked_elements) + " elements in all");
+  }
   std::vector<double> values;
   if (acc.bufferView >= 0) {
     // Located before allocating, so the count is bounded by real data.

@@ -160,6 +160,42 @@ std::string buffer_problem(const Container& container, const Json& buffer, std::
   return "";
 }
 
+namespace {
+
+// Images a material's texture samples (the slots the loader reads: base colour,
+// metallic-roughness, normal, emissive): only these are decoded, so a file's unused
+// images cost neither time nor memory.
+std::vector<bool> used_images(const Json& doc, std::size_t image_count) {
+  std::vector<bool> used(image_count, false);
+  const Json* materials = find_member(doc, "materials");
+  const Json* textures = find_member(doc, "textures");
+  if (materials == nullptr || !materials->is_array() || textures == nullptr || !textures->is_array()) return used;
+  const auto mark = [&](const Json* info) {
+    if (info == nullptr || !info->is_object()) return;
+    const Json* index = find_member(*info, "index");
+    if (index == nullptr || !index->is_number_integer()) return;
+    const auto t = index->get<std::int64_t>();
+    if (t < 0 || static_cast<std::size_t>(t) >= textures->size()) return;
+    const Json& texture = (*textures)[static_cast<std::size_t>(t)];
+    const Json* source = texture.is_object() ? find_member(texture, "source") : nullptr;
+    if (source == nullptr || !source->is_number_integer()) return;
+    const auto s = source->get<std::int64_t>();
+    if (s >= 0 && static_cast<std::size_t>(s) < image_count) used[static_cast<std::size_t>(s)] = true;
+  };
+  for (const Json& m : *materials) {
+    if (!m.is_object()) continue;
+    if (const Json* pbr = find_member(m, "pbrMetallicRoughness"); pbr != nullptr && pbr->is_object()) {
+      mark(find_member(*pbr, "baseColorTexture"));
+      mark(find_member(*pbr, "metallicRoughnessTexture"));
+    }
+    mark(find_member(m, "normalTexture"));
+    mark(find_member(m, "emissiveTexture"));
+  }
+  return used;
+}
+
+}  // namespace
+
 std::size_t array_size(const Json& doc, const char* key) {
   const Json* a = find_member(doc, key);
   return a != nullptr && a->is_array() ? a->size() : 0;
@@ -570,6 +606,7 @@ Result<ParsedFile> parse_file(const Context& ctx, const fs::path& path) {
   const std::size_t image_count = array_size(out.doc, "images");
   images.failures.resize(image_count);
   images.delivered.resize(image_count, false);
+  images.used = used_images(out.doc, image_count);
 
   tinygltf::TinyGLTF loader;
   loader.SetImageLoader(&decode_image_callback, &images);

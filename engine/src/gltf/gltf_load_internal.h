@@ -46,6 +46,10 @@ using Json = nlohmann::json;
 struct Context {
   std::string file;
   GltfLoadOptions options;
+  /// Accessor elements read so far for the whole file (GltfLoadLimits::max_scene_elements),
+  /// and of those, elements without a bufferView (zero-filled, max_unbacked_elements).
+  mutable std::size_t elements_read = 0;
+  mutable std::size_t unbacked_elements_read = 0;
 
   Error error(std::string location, std::string message) const {
     return Error{file, std::move(location), std::move(message)};
@@ -68,6 +72,7 @@ struct ImageDecodeState {
   int max_dimension = 16384;
   std::vector<std::string> failures;  ///< per image index: empty, or why it failed
   std::vector<bool> delivered;        ///< per image index: bytes were found
+  std::vector<bool> used;             ///< per image index: a material's texture samples it (decoded only then)
 };
 
 struct ParsedFile {

@@ -19,7 +19,7 @@ bool decode_image_callback(tinygltf::Image* image, int image_idx, std::string* /
   if (image_idx < 0 || static_cast<std::size_t>(image_idx) >= state->delivered.size()) return false;
   const auto idx = static_cast<std::size_t>(image_idx);
   state->delivered[idx] = true;
-  if (!state->decode) return true;
+  if (!state->decode || idx >= state->used.size() || !state->used[idx]) return true;  // unused: not decoded
   if (bytes == nullptr || size <= 0) {
     state->failures[idx] = "image data is empty";
     return true;
@@ -67,7 +67,7 @@ Result<std::vector<Image>> convert_images(const Context& ctx, const ParsedFile& 
     Image img;
     img.name = src.name;
     img.uri = src.uri;
-    if (ctx.options.load_images) {
+    if (ctx.options.load_images && !src.image.empty()) {  // decoded (images no material uses are not)
       img.width = src.width;
       img.height = src.height;
       img.rgba8 = src.image;
