@@ -288,6 +288,10 @@ engine::Result<AntiradianceFile> read_antiradiance(const fs::path& path) {
   const unsigned long long content = ZSTD_getFrameContentSize(frame.data(), frame.size());
   if (content == ZSTD_CONTENTSIZE_ERROR || content == ZSTD_CONTENTSIZE_UNKNOWN)
     return file_error(path, "static_links", "the link data is not a zstd frame with a recorded size (corrupt)");
+  if (content > kMaxDecompressedBytes)
+    return file_error(path, "static_links",
+                      "the zstd frame would decompress to " + std::to_string(content) + " bytes, above the " +
+                          std::to_string(kMaxDecompressedBytes) + "-byte limit of a bake stream");
   if (link_count > (std::uint64_t{1} << 40) / kLinkPlaneBytes || content != link_count * kLinkPlaneBytes)
     return file_error(path, "static_links",
                       "the zstd frame holds " + std::to_string(content) + " bytes, " + std::to_string(link_count) +

@@ -305,6 +305,10 @@ engine::Result<BrfMeshBake> read_brf_mesh(const fs::path& path) {
   const unsigned long long content = ZSTD_getFrameContentSize(frame.data(), frame.size());
   if (content == ZSTD_CONTENTSIZE_ERROR || content == ZSTD_CONTENTSIZE_UNKNOWN)
     return file_error(path, "coefficients", "not a zstd frame with a recorded size (corrupt)");
+  if (content > kMaxDecompressedBytes)
+    return file_error(path, "coefficients",
+                      "the zstd frame would decompress to " + str(content) + " bytes, above the " +
+                          str(kMaxDecompressedBytes) + "-byte limit of a bake stream");
   if (content != coefficient_bytes)
     return file_error(path, "coefficients",
                       "the zstd frame holds " + str(content) + " bytes, the header says " + str(coefficient_bytes));

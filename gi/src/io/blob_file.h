@@ -44,6 +44,10 @@ engine::Status write_file_atomic(const std::filesystem::path& path, std::span<co
 /// is about 15 MB in all): a damaged or hostile file claiming terabytes is refused before
 /// anything is allocated.
 inline constexpr std::uint64_t kMaxBakeFileBytes = std::uint64_t{1} << 30;
+/// The largest stream a bake file may decompress to (PRM panes, BRF coefficients,
+/// antiradiance links): 4 GiB, checked against the frame's recorded size before allocating,
+/// so a small crafted file cannot ask for more memory than any real bake uses.
+inline constexpr std::uint64_t kMaxDecompressedBytes = std::uint64_t{4} << 30;
 
 /// Reads a whole file. Error (naming it) when it is missing, unreadable or larger than
 /// kMaxBakeFileBytes.

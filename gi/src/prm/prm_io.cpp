@@ -333,6 +333,10 @@ engine::Result<PrmPaneFile> read_prm_panes(const fs::path& path) {
   const unsigned long long content = ZSTD_getFrameContentSize(frame.data(), frame.size());
   if (content == ZSTD_CONTENTSIZE_ERROR || content == ZSTD_CONTENTSIZE_UNKNOWN)
     return file_error(path, "panes", "the pane data is not a zstd frame with a recorded size (corrupt)");
+  if (content > kMaxDecompressedBytes)
+    return file_error(path, "panes",
+                      "the zstd frame would decompress to " + std::to_string(content) + " bytes, above the " +
+                          std::to_string(kMaxDecompressedBytes) + "-byte limit of a bake stream");
   if (content != pane_half_bytes)
     return file_error(path, "panes",
                       "the zstd frame holds " + std::to_string(content) + " bytes, the header says " +
