@@ -29,6 +29,9 @@ in vec3 v_normal;
 in vec2 v_uv0;
 in vec2 v_uv1;
 in vec3 v_vertex_irradiance;
+// Per-vertex view-dependent indirect light (forward.vert.glsl, vertex_radiance_lobes): terms > 0: use v_lobe_radiance.
+in vec3 v_lobe_radiance;
+layout(location = 40) uniform int u_lobe_terms;
 
 layout(location = 16) uniform vec3 u_camera_position;
 layout(location = 18) uniform vec4 u_base_color;
@@ -124,6 +127,8 @@ void main() {
       if (element >= 0)
         specular = directional_specular(s.brdf, s.normal, s.view, element, u_directional_bins, u_directional_elements);
     }
+    // A dynamic mesh's per-vertex radiance lobes replace the specular lobe's share (the diffuse keeps E).
+    if (u_indirect_mode == 3 && u_lobe_terms > 0) specular = v_lobe_radiance;
     if (u_use_glossy != 0) {
       vec4 glossy = texelFetch(u_glossy_radiance, ivec2(gl_FragCoord.xy), 0);
       specular = mix(specular, glossy.rgb, clamp(glossy.a, 0.0, 1.0));

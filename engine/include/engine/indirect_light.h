@@ -22,6 +22,30 @@ struct IndirectLightFrame {
   /// xyz), one per vertex of the entity's mesh, primitives concatenated in order.
   /// Returns 0 when the entity has none.
   virtual std::uint32_t vertex_irradiance_buffer(Entity) const { return 0; }
+  /// Optional view-dependent indirect light of a dynamic mesh entity (a glossy object's
+  /// reflection of its surroundings), per vertex j as `terms` coefficients and shared lobes:
+  ///   L_spec(w) = sum_{k < terms} c[first + k * stride + j].rgb * h_k(w_local)   (W/(m^2 sr))
+  ///   coefficient_buffer  SSBO of vec4 c (rgb used)
+  ///   lobe_buffer         SSBO of float, h_k at [k * R * R + v * R + u]: an R x R octahedral map
+  ///                       of the upper hemisphere (s = (x + y, x - y) / (|x| + |y| + z), cell
+  ///                       (u, v) centred at s = ((u, v) + 0.5) / R * 2 - 1), bilinear between
+  ///                       cell centres, clamped at the edges; 0 below the horizon
+  ///   w_local             the outgoing (view) direction in the vertex's frame: t, b, n with n the
+  ///                       object-space vertex normal and t, b from n as in Duff et al. 2017
+  ///                       ("Building an orthonormal basis, revisited"); world directions are
+  ///                       turned into object space by the model matrix's rotation
+  /// The renderer evaluates L_spec at the vertices toward the camera, interpolates it over the
+  /// triangle and uses it in place of the specular lobe's share of vertex_irradiance_buffer's
+  /// irradiance (the diffuse lobe keeps that). terms == 0: none.
+  struct VertexRadianceLobes {
+    std::uint32_t coefficient_buffer = 0;
+    std::uint32_t lobe_buffer = 0;
+    int first = 0;
+    int stride = 0;
+    int terms = 0;
+    int resolution = 0;
+  };
+  virtual VertexRadianceLobes vertex_radiance_lobes(Entity) const { return {}; }
   /// Optional glossy (view-dependent) indirect term: an RGBA16F screen-sized texture of
   /// reflected radiance (rgb) and coverage (a): where a = 1 it replaces the specular lobe's
   /// share of the direction-less irradiance above. 0: none.

@@ -108,6 +108,8 @@ class Renderer {
   ///    mesh with the primitives concatenated in order (primitive p's vertex i has
   ///    k = i + sum of the vertex counts of primitives 0..p-1); the shader reads it as
   ///    gl_VertexID - (scene vertex where the mesh starts). The SSBO is bound at binding 1;
+  ///  - for those entities, vertex_radiance_lobes(entity) (if terms > 0) replaces the specular
+  ///    lobe's share by the lobes' radiance toward the camera, evaluated per vertex;
   ///  - glossy_radiance_texture (if not 0, texelFetch at the pixel) replaces the specular
   ///    lobe's share by its rgb in proportion to its alpha (coverage).
   /// Without a provider every entity gets E = pi x stand_in_ambient (the irradiance of a

@@ -48,6 +48,8 @@ constexpr GLuint kLightsBinding = 0;
 constexpr GLuint kVertexIrradianceBinding = 1;
 constexpr GLuint kDirectionalRadianceBinding = 2;  // directional_radiance.glsl
 constexpr GLuint kDirectionalDirectionBinding = 3;
+constexpr GLuint kLobeCoefficientsBinding = 6;  // forward.vert.glsl: IndirectLightFrame::vertex_radiance_lobes
+constexpr GLuint kLobeTableBinding = 7;
 
 // A 1x1 R32I texture holding -1 ("no element"): what the directional index sampler reads
 // when the provider has no directional radiance.
@@ -321,6 +323,19 @@ void ForwardRenderer::forward_pass(const Registry& registry, Entity camera, cons
       }
     }
     if (vertex_buffer != 0) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kVertexIrradianceBinding, vertex_buffer);
+    // Per-vertex view-dependent indirect light (IndirectLightFrame::vertex_radiance_lobes).
+    IndirectLightFrame::VertexRadianceLobes lobes;
+    if (vertex_buffer != 0) lobes = indirect->vertex_radiance_lobes(item.entity);
+    const bool use_lobes = lobes.terms > 0 && lobes.resolution > 0 && lobes.coefficient_buffer != 0 &&
+                           lobes.lobe_buffer != 0 && lobes.first >= 0 && lobes.stride >= 0;
+    if (use_lobes) {
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kLobeCoefficientsBinding, lobes.coefficient_buffer);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kLobeTableBinding, lobes.lobe_buffer);
+    }
+    glUniform1i(40, use_lobes ? lobes.terms : 0);
+    glUniform1i(41, lobes.resolution);
+    glUniform1i(42, lobes.first);
+    glUniform1i(43, lobes.stride);
     glUniform1i(12, item.mesh->first_vertex);
     glUniform1i(13, vertex_buffer != 0 ? 1 : 0);
     glUniform1i(22, mode);

@@ -50,7 +50,11 @@ struct BrfLighting::Impl {
   std::optional<BrfGpuPass> pass;
   engine::ShaderProgram sum_program, composite_program;
   GLint sum_count = -1, composite_count = -1, composite_width = -1;  // uniform locations
-  std::vector<engine::GlBuffer> world_light, total;                  // per instance
+  GLint sum_first_glossy = -1, sum_specular = -1;
+  // Per instance, K x V vec4s ([k x V + j]; K = 1 for a diffuse model): the world's light and
+  // what the renderer reads (irradiance, then the glossy terms' E_k x the glossy colour).
+  std::vector<engine::GlBuffer> world_light, total;
+  std::vector<engine::GlBuffer> lobe_tables;  // per model: its h_k (glossy models only)
   engine::GlBuffer receiver_texels;
   bool gpu_failed = false;
 
@@ -84,6 +88,8 @@ struct BrfLighting::Impl {
     sum_program = std::move(sum).value();
     composite_program = std::move(comp).value();
     sum_count = glGetUniformLocation(sum_program.id(), "u_count");
+    sum_first_glossy = glGetUniformLocation(sum_program.id(), "u_first_glossy");
+    sum_specular = glGetUniformLocation(sum_program.id(), "u_specular");
     composite_count = glGetUniformLocation(composite_program.id(), "u_count");
     composite_width = glGetUniformLocation(composite_program.id(), "u_atlas_width");
     if (!world.receiver_texels.empty()) {
@@ -93,8 +99,17 @@ struct BrfLighting::Impl {
       receiver_texels =
           engine::GlBuffer::create(world.receiver_texels.size() * sizeof(std::uint32_t), world.receiver_texels.data());
     }
+    for (const BrfModelData& model : models) {
+      if (!model.glossy) {
+        lobe_tables.emplace_back();
+        continue;
+      }
+      lobe_tables.push_back(engine::GlBuffer::create(model.glossy->h.size() * sizeof(float), model.glossy->h.data(), 0));
+    }
     for (const BrfInstanceBinding& b : instances) {
-      const std::size_t bytes = std::max<std::size_t>(models[b.model].mesh.positions.size(), 1) * sizeof(glm::vec4);
+      const std::size_t terms = static_cast<std::size_t>(models[b.model].field.terms);
+      const std::size_t bytes =
+          std::max<std::size_t>(models[b.model].mesh.positions.size() * terms, 1) * sizeof(glm::vec4);
       const std::vector<glm::vec4> zeros(bytes / sizeof(glm::vec4), glm::vec4(0.0f));
       world_light.push_back(engine::GlBuffer::create(bytes, zeros.data(), GL_DYNAMIC_STORAGE_BIT));
       total.push_back(engine::GlBuffer::create(bytes, zeros.data(), 0));
@@ -207,8 +222,8 @@ bool BrfLighting::update() {
             m.world_incoming[i][static_cast<std::size_t>(k) * nv + j] = e;
           }
         }
-      std::vector<glm::vec4> packed(std::max<std::size_t>(v.positions.size(), 1), glm::vec4(0.0f));
-      for (std::size_t j = 0; j < v.positions.size(); ++j) packed[j] = glm::vec4(m.world_incoming[i][j], 0.0f);
+      std::vector<glm::vec4> packed(std::max<std::size_t>(m.world_incoming[i].size(), 1), glm::vec4(0.0f));
+      for (std::size_t j = 0; j < m.world_incoming[i].size(); ++j) packed[j] = glm::vec4(m.world_incoming[i][j], 0.0f);
       glNamedBufferSubData(m.world_light[i].id(), 0, static_cast<GLsizeiptr>(packed.size() * sizeof(glm::vec4)),
                            packed.data());
     }
@@ -223,8 +238,13 @@ bool BrfLighting::update() {
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
   m.sum_program.use();
   for (std::size_t i = 0; i < m.instances.size(); ++i) {
-    const auto count = static_cast<std::uint32_t>(m.models[m.instances[i].model].mesh.positions.size());
+    const BrfModelData& model = m.models[m.instances[i].model];
+    const auto vertices = static_cast<std::uint32_t>(model.mesh.positions.size());
+    const auto count = vertices * static_cast<std::uint32_t>(model.field.terms);
     glProgramUniform1ui(m.sum_program.id(), m.sum_count, count);
+    glProgramUniform1ui(m.sum_program.id(), m.sum_first_glossy, vertices);
+    const glm::vec3 specular = m.instances[i].specular;
+    glProgramUniform3f(m.sum_program.id(), m.sum_specular, specular.x, specular.y, specular.z);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, m.world_light[i].id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, m.pass->vertex_buffer(i));
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, m.total[i].id());
@@ -253,6 +273,21 @@ std::uint32_t BrfLighting::vertex_buffer(engine::Entity e) const {
   const auto it = m.instance_of.find(e.id());
   if (it == m.instance_of.end() || it->second >= m.total.size() || !m.computed) return 0;
   return m.total[it->second].id();
+}
+
+engine::IndirectLightFrame::VertexRadianceLobes BrfLighting::vertex_lobes(engine::Entity e) const {
+  const Impl& m = *impl_;
+  const auto it = m.instance_of.find(e.id());
+  if (it == m.instance_of.end() || it->second >= m.total.size() || !m.computed) return {};
+  const BrfModelData& model = m.models[m.instances[it->second].model];
+  if (!model.glossy || model.glossy->terms <= 0) return {};
+  const int vertices = static_cast<int>(model.mesh.positions.size());
+  return {.coefficient_buffer = m.total[it->second].id(),
+          .lobe_buffer = m.lobe_tables[m.instances[it->second].model].id(),
+          .first = vertices,
+          .stride = vertices,
+          .terms = model.glossy->terms,
+          .resolution = model.glossy->resolution};
 }
 
 bool BrfLighting::has_static_receivers() const { return !impl_->world.receiver_texels.empty(); }

@@ -20,6 +20,7 @@
 //   GLuint ssbo = brf->vertex_buffer(crate_entity);
 
 #include <engine/entity.h>
+#include <engine/indirect_light.h>
 #include <engine/registry.h>
 #include <engine/result.h>
 #include <gi/log.h>
@@ -94,7 +95,13 @@ class BrfLighting {
   /// so their bounce onto the world) changed this call. The first call always computes.
   bool update();
   /// The per-vertex indirect irradiance SSBO of `e` (vec4 per vertex), 0 for other entities.
+  /// A glossy model's buffer goes on with its glossy terms, [k x V + j] for k = 1..K-1: E_k
+  /// (world light + interreflected) times the instance's glossy colour.
   std::uint32_t vertex_buffer(engine::Entity e) const;
+  /// A glossy entity's view-dependent indirect light for the renderer: the glossy terms of
+  /// vertex_buffer(e) against the lobe's h_k table (BrdfSeparation::h, its octahedral map and
+  /// brf_tangent_frame are the engine's convention). Empty (terms 0) for diffuse entities.
+  engine::IndirectLightFrame::VertexRadianceLobes vertex_lobes(engine::Entity e) const;
   /// Copies `base_texture` (RGBA32F atlas, width x height) into `composite_texture` (same
   /// size and format), darkens it where the objects block the baked light
   /// (BrfResult::static_occlusion) and adds their bounce at the static receivers.

@@ -36,6 +36,10 @@ namespace {
 struct SystemFrame final : engine::IndirectLightFrame {
   const BrfLighting* brf = nullptr;
   std::uint32_t vertex_irradiance_buffer(engine::Entity e) const override { return brf ? brf->vertex_buffer(e) : 0; }
+  // A glossy dynamic object's view-dependent indirect light (BRF glossy terms).
+  VertexRadianceLobes vertex_radiance_lobes(engine::Entity e) const override {
+    return brf ? brf->vertex_lobes(e) : VertexRadianceLobes{};
+  }
 };
 
 }  // namespace
