@@ -79,7 +79,7 @@ engine::Result<WorldProbeGrid> bake_world_probes(const RayCaster& static_world, 
   const glm::dvec3 extent = glm::dvec3(hi) - glm::dvec3(lo);
   double spacing_d = settings.spacing_m;
   for (;;) {
-    const glm::dvec3 cells = glm::ceil(extent / spacing_d) + 1.0;
+    const glm::dvec3 cells = glm::max(glm::ceil(extent / spacing_d), glm::dvec3(1.0));
     if (cells.x * cells.y * cells.z <= double(settings.max_probes)) {
       grid.dims = glm::ivec3(cells);
       break;
@@ -88,7 +88,11 @@ engine::Result<WorldProbeGrid> bake_world_probes(const RayCaster& static_world, 
   }
   const float spacing = static_cast<float>(spacing_d);
   grid.spacing = spacing;
-  // Centre the grid on the VPLs' box.
+  // Centre the grid on the VPLs' box, one probe per cell at its centre: no probe lies on the
+  // box's faces, which are a room's walls, floor and ceiling. (With probes on the box's
+  // corners, a probe on a wall saw almost none of the room, came out valid but dark and
+  // darkened every point near a wall: 20 cm from one, 0.23 W/m^2 against the path tracer's 1.12.)
+  // Points between the outer probes and the walls take the outer probes' light (clamped).
   grid.origin = 0.5f * (lo + hi) - 0.5f * spacing * glm::vec3(grid.dims - 1);
   const std::size_t count = static_cast<std::size_t>(grid.dims.x) * static_cast<std::size_t>(grid.dims.y) *
                             static_cast<std::size_t>(grid.dims.z);
@@ -106,6 +110,17 @@ engine::Result<WorldProbeGrid> bake_world_probes(const RayCaster& static_world, 
             grid.origin + spacing * glm::vec3(static_cast<float>(x), static_cast<float>(y), static_cast<float>(z));
         std::array<glm::vec3, 9> sh{};
         bool any = false;
+        // A probe that sees the back of a surface stands behind a wall or inside an object:
+        // its light is not that of the space its neighbours interpolate into (valid = 0).
+        constexpr int kInsideRays = 64;
+        for (int r = 0; r < kInsideRays; ++r) {
+          const float cz = 1.0f - (2.0f * static_cast<float>(r) + 1.0f) / kInsideRays;
+          const float rho = std::sqrt(std::max(0.0f, 1.0f - cz * cz));
+          const float phi = 2.399963229728653f * static_cast<float>(r);
+          const glm::vec3 dir(rho * std::cos(phi), rho * std::sin(phi), cz);
+          const Hit hit = static_world.intersect(Ray{.origin = p, .t_min = 0.0f, .direction = dir});
+          if (hit.valid() && glm::dot(hit.geometric_normal, dir) > 0.0f) return;
+        }
         for (std::size_t i = 0; i < n; ++i) {
           const glm::vec3 to_probe = p - vpls.position[i];
           const float d2 = glm::dot(to_probe, to_probe);

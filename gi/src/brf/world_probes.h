@@ -15,8 +15,10 @@
 // reflected once plus the atlas's bounces, static lights only (moving lights' bounce off
 // the world, PRM's domain, is not in the probes).
 //
-// Probes inside geometry see no VPL; they get weight 0 and interpolation renormalizes over
-// the probes that do, so walls do not leak darkness into rooms. A point whose 8 probes are
+// One probe per grid cell, at its centre (none on the faces of the VPLs' box: a room's walls,
+// floor and ceiling). Probes that see the back of a surface (behind a wall, inside an object)
+// or no VPL get weight 0 and interpolation renormalizes over the others, so walls do not leak
+// darkness into rooms. A point whose 8 probes are
 // all invalid gets no world light.
 
 #include <array>
@@ -57,7 +59,7 @@ struct WorldProbeGrid {
   bool radiance(const glm::vec3& p, std::array<glm::vec3, 9>& out) const;
 };
 
-/// Probes over the bounding box of the VPLs (one spacing of margin). Errors: VPL arrays of
+/// Probes over the bounding box of the VPLs, at the centres of its cells. Errors: VPL arrays of
 /// different sizes, non-finite values, spacing not positive.
 engine::Result<WorldProbeGrid> bake_world_probes(const RayCaster& static_world, const VplSet& vpls,
                                                  std::span<const glm::vec3> vpl_power,
