@@ -88,6 +88,41 @@ double cell_solid_angle(int u, int v, int res) {
 float BrdfSeparation::g_at(int k, const glm::vec3& local) const { return lookup(g, k, resolution, local); }
 float BrdfSeparation::h_at(int k, const glm::vec3& local) const { return lookup(h, k, resolution, local); }
 
+std::vector<float> BrdfSeparation::albedo_corrected_h() const {
+  std::vector<float> out = h;
+  if (terms <= 0 || resolution <= 0) return out;
+  // G_k = int g_k(w) cos dw and each cell's exact albedo, by a 64 x 64 midpoint rule in
+  // (cos theta, phi) (uniform in solid angle).
+  constexpr int kN = 64;
+  std::vector<glm::vec3> dirs;
+  dirs.reserve(kN * kN);
+  for (int a = 0; a < kN; ++a)
+    for (int b = 0; b < kN; ++b) {
+      const float z = (static_cast<float>(a) + 0.5f) / kN;
+      const float r = std::sqrt(std::max(0.0f, 1.0f - z * z));
+      const float phi = 2.0f * std::numbers::pi_v<float> * (static_cast<float>(b) + 0.5f) / kN;
+      dirs.emplace_back(r * std::cos(phi), r * std::sin(phi), z);
+    }
+  const double dw = 2.0 * std::numbers::pi / (kN * kN);
+  std::vector<double> g_integral(static_cast<std::size_t>(terms), 0.0);
+  for (int k = 0; k < terms; ++k)
+    for (const glm::vec3& w : dirs) g_integral[static_cast<std::size_t>(k)] += dw * double{g_at(k, w)} * double{w.z};
+  const std::size_t cells = static_cast<std::size_t>(resolution) * static_cast<std::size_t>(resolution);
+  for (int v = 0; v < resolution; ++v)
+    for (int u = 0; u < resolution; ++u) {
+      const std::size_t c = static_cast<std::size_t>(v * resolution + u);
+      const glm::vec3 wo = square_to_hemisphere(cell_centre(u, v, resolution));
+      double exact = 0.0, separated = 0.0;
+      for (const glm::vec3& w : dirs) exact += dw * double{glossy_lobe_brdf(lobe, w, wo)} * double{w.z};
+      for (int k = 0; k < terms; ++k)
+        separated += double{h[static_cast<std::size_t>(k) * cells + c]} * g_integral[static_cast<std::size_t>(k)];
+      if (!(separated > 0.0)) continue;
+      const double scale = std::clamp(exact / separated, 0.25, 4.0);
+      for (int k = 0; k < terms; ++k) out[static_cast<std::size_t>(k) * cells + c] *= static_cast<float>(scale);
+    }
+  return out;
+}
+
 float BrdfSeparation::eval(const glm::vec3& w_in, const glm::vec3& w_out) const {
   float s = 0.0f;
   for (int k = 0; k < terms; ++k) s += g_at(k, w_in) * h_at(k, w_out);

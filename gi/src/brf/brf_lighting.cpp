@@ -104,7 +104,9 @@ struct BrfLighting::Impl {
         lobe_tables.emplace_back();
         continue;
       }
-      lobe_tables.push_back(engine::GlBuffer::create(model.glossy->h.size() * sizeof(float), model.glossy->h.data(), 0));
+      // What the renderer draws toward the eye: h rescaled to the lobe's directional albedo.
+      const std::vector<float> h = model.glossy->albedo_corrected_h();
+      lobe_tables.push_back(engine::GlBuffer::create(h.size() * sizeof(float), h.data(), 0));
     }
     for (const BrfInstanceBinding& b : instances) {
       const std::size_t terms = static_cast<std::size_t>(models[b.model].field.terms);

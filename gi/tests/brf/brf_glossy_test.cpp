@@ -327,3 +327,40 @@ TEST(BrfGlossy, BakeFileKeepsTheSeparationAndRejectsDamage) {
 }
 
 }  // namespace
+
+namespace {
+
+// The truncated separation does not keep the lobe's directional albedo (what a uniform
+// environment reflects toward w_o); albedo_corrected_h rescales h per outgoing direction.
+TEST(BrfGlossySeparation, AlbedoCorrectedLobesReflectAUniformEnvironmentExactly) {
+  const gi::BrdfSeparation sep =
+      gi::separate_glossy_brdf({.f0 = 0.9f, .alpha = 0.25f}, {.terms = 4, .resolution = 16}).value();
+  gi::BrdfSeparation corrected = sep;
+  corrected.h = sep.albedo_corrected_h();
+  ASSERT_EQ(corrected.h.size(), sep.h.size());
+  constexpr int kN = 200;  // a different rule from the correction's (64 x 64)
+  for (float deg : {5.0f, 18.0f, 30.0f, 49.0f, 65.0f}) {
+    const float t = deg * std::numbers::pi_v<float> / 180.0f;
+    // Rotated about z so that w_o lies off the table's cell centres.
+    const glm::vec3 wo(std::sin(t) * 0.8f, std::sin(t) * 0.6f, std::cos(t));
+    double exact = 0.0, separated = 0.0, fixed = 0.0;
+    for (int a = 0; a < kN; ++a)
+      for (int b = 0; b < kN; ++b) {
+        const float z = (static_cast<float>(a) + 0.5f) / kN, r = std::sqrt(1.0f - z * z);
+        const float phi = 2.0f * std::numbers::pi_v<float> * (static_cast<float>(b) + 0.5f) / kN;
+        const glm::vec3 wi(r * std::cos(phi), r * std::sin(phi), z);
+        const double w = 2.0 * std::numbers::pi / (kN * kN) * double{z};
+        exact += w * double{gi::glossy_lobe_brdf(sep.lobe, wi, wo)};
+        separated += w * double{sep.eval(wi, wo)};
+        fixed += w * double{corrected.eval(wi, wo)};
+      }
+    std::printf("%.0f deg: directional albedo exact %.4f, separated %.4f, corrected %.4f\n", double{deg}, exact,
+                separated, fixed);
+    EXPECT_NEAR(fixed / exact, 1.0, 0.04) << deg;
+    if (deg == 18.0f || deg == 49.0f) {
+      EXPECT_GT(std::abs(separated / exact - 1.0), 0.1) << deg;  // what it fixes
+    }
+  }
+}
+
+}  // namespace
