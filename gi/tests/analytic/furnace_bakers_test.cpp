@@ -69,7 +69,10 @@ constexpr Case kCases[] = {{false, 0.05f}, {false, 0.25f}, {false, 0.5f}, {false
 
 // Light atlas, 3 reflections, and the world probes built from its VPLs. Measured: atlas interior
 // texels max 0.145, RMS 0.078, bias -0.076 (the emissive walls' point emitters near edges); edge
-// texels max 0.77; probes max 0.225, RMS 0.124.
+// texels max 0.77; probes max 0.283, RMS 0.166 (0.225 / 0.124 while the probe grid had its outer
+// layer on the walls; at cell centres the outer probes sit half a spacing, 0.25 m, from the walls,
+// where the VPLs' regularized kernel under-estimates a little more, and near-wall points of real
+// rooms are no longer 4x too dark: docs/brf.md, "World probes on cell centres").
 TEST(FurnaceBakers, LightAtlasAndWorldProbesFollowTheirFolding) {
   std::printf("furnace, bakers vs pi Le sum_{k<=b} rho^k per texel (rho: the folded hemispherical albedo)\n");
   for (const Case& c : kCases) {
@@ -107,8 +110,8 @@ TEST(FurnaceBakers, LightAtlasAndWorldProbesFollowTheirFolding) {
     EXPECT_LT(atlas.max_rel, 0.18);
     EXPECT_LT(atlas.rms(), 0.10);
     EXPECT_LT(edge.max_rel, 0.80);  // the edge defect, bounded so a change either way shows
-    EXPECT_LT(probe.max_rel, 0.27);
-    EXPECT_LT(probe.rms(), 0.15);
+    EXPECT_LT(probe.max_rel, 0.31);
+    EXPECT_LT(probe.rms(), 0.19);
   }
 }
 
