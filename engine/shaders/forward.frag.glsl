@@ -52,6 +52,9 @@ layout(location = 29) uniform int u_directional_bins;
 layout(location = 30) uniform int u_directional_elements;
 // The scene's sky (RenderSettings::sky_radiance), W/(m^2 sr): unshadowed ambient direct light.
 layout(location = 31) uniform vec3 u_sky_radiance;
+// The sky's gradient (RenderSettings::sky_gradient, engine/sky.h): horizon, zenith - horizon,
+// ground - horizon.
+layout(location = 61) uniform vec3 u_sky_gradient[3];
 
 layout(binding = 0) uniform sampler2D u_base_color_texture;
 layout(binding = 1) uniform sampler2D u_metallic_roughness_texture;
@@ -101,11 +104,19 @@ void main() {
   }
 #endif
 
-  // The sky as direct light from every direction (no visibility): E = pi L, reflected as
-  // uniformly arriving light is (E / pi x directional albedo). Both halves of a split view.
-  if (any(greaterThan(u_sky_radiance, vec3(0.0)))) {
+  // The sky as direct light from every direction: E = pi L, reflected as uniformly arriving
+  // light is (E / pi x directional albedo). Both halves of a split view. A gradient adds its
+  // irradiance at this normal, E / pi as a uniform radiance (engine::sky_irradiance:
+  // E = pi horizon + (zenith - horizon) K(t) + (ground - horizon) K(pi - t), t = acos(n.y),
+  // K(t) = 2/3 ((pi - t) cos t + sin t)). Unshadowed.
+  float sky_t = acos(clamp(s.normal.y, -1.0, 1.0));
+  float sky_k_up = (2.0 / 3.0) * ((PI - sky_t) * cos(sky_t) + sin(sky_t));
+  float sky_k_down = (2.0 / 3.0) * (sky_t * cos(PI - sky_t) + sin(sky_t));
+  vec3 sky_l = u_sky_radiance + max(u_sky_gradient[0] + (u_sky_gradient[1] * sky_k_up + u_sky_gradient[2] * sky_k_down) / PI,
+                                    vec3(0.0));
+  if (any(greaterThan(sky_l, vec3(0.0)))) {
     GltfBrdfValue sky_albedo = gltf_directional_albedo(s.brdf, dot(s.normal, s.view));
-    radiance += u_sky_radiance * (sky_albedo.diffuse + sky_albedo.specular);
+    radiance += sky_l * (sky_albedo.diffuse + sky_albedo.specular);
   }
 
   if (gl_FragCoord.x >= u_split_x && u_indirect_mode != 0) {

@@ -3,16 +3,19 @@
 // back by engine::write_gltf, and refused with a message naming what is wrong.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include <glm/gtc/quaternion.hpp>
 #include <nlohmann/json.hpp>
 
 #include <engine/gltf.h>
+#include <engine/sky.h>
 
 namespace {
 
@@ -112,7 +115,9 @@ TEST(GltfEnvironment, MalformedSkyOrSunIsAnErrorNamingIt) {
       {R"({"sky": {"radiance": [1, -1, 1]}})", "scene 0 extras.gi.sky"},
       {R"({"sky": {"radiance": [1, 1]}})", "radiance"},
       {R"({"sky": 3})", "scene 0 extras.gi.sky"},
-      {R"({"sky": {}})", "needs 'radiance'"},
+      {R"({"sky": {}})", "needs 'radiance' or 'zenith', 'horizon' and 'ground'"},
+      {R"({"sky": {"zenith": [1, 1, 1], "horizon": [1, 1, 1]}})", "needs all of 'zenith', 'horizon' and 'ground'"},
+      {R"({"sky": {"zenith": [1, 1, 1], "horizon": [1, 1, 1], "ground": [0, -1, 0]}})", "'ground' has a negative"},
       {R"({"sun": {"direction": [0, 0, 0], "irradiance": [1, 1, 1]}})", "'direction' must not be zero"},
       {R"({"sun": {"direction": [0, -1, 0]}})", "needs 'direction' and 'irradiance'"},
       {R"({"sun": {"direction": [0, -1, 0], "irradiance": [1, 1, 1], "angular_radius_deg": 90}})",
@@ -124,5 +129,76 @@ TEST(GltfEnvironment, MalformedSkyOrSunIsAnErrorNamingIt) {
     auto a = engine::load_gltf(with_scene_gi("bad_" + std::to_string(i++) + ".gltf", json::parse(c.gi)));
     ASSERT_FALSE(a) << c.gi;
     EXPECT_NE(a.error().to_string().find(c.expect), std::string::npos) << c.gi << " -> " << a.error().to_string();
+  }
+}
+
+// A gradient sky (engine/sky.h): zenith, horizon and ground radiance, alone or added to a
+// uniform radiance; loaded, evaluated as documented and written back.
+TEST(GltfEnvironment, GradientSkyLoadsEvaluatesAndRoundTrips) {
+  auto a = engine::load_gltf(with_scene_gi(
+      "gradient.gltf",
+      json::parse(R"({"sky": {"zenith": [0.2, 0.4, 1.0], "horizon": [0.8, 0.9, 1.0], "ground": [0.1, 0.1, 0.05]}})")));
+  ASSERT_TRUE(a) << a.error().to_string();
+  const engine::Environment& env = a->environment;
+  EXPECT_EQ(env.sky_radiance, glm::vec3(0.0f));
+  EXPECT_EQ(env.sky_gradient.zenith, glm::vec3(0.2f, 0.4f, 1.0f));
+  EXPECT_EQ(env.sky_gradient.horizon, glm::vec3(0.8f, 0.9f, 1.0f));
+  EXPECT_EQ(env.sky_gradient.ground, glm::vec3(0.1f, 0.1f, 0.05f));
+  const auto at = [&](glm::vec3 d) { return engine::sky_radiance(env.sky_radiance, env.sky_gradient, glm::normalize(d)); };
+  const auto near = [](glm::vec3 p, glm::vec3 q) { return glm::length(p - q) < 1e-6f; };
+  EXPECT_TRUE(near(at({0, 1, 0}), env.sky_gradient.zenith));
+  EXPECT_TRUE(near(at({1, 0, 0}), env.sky_gradient.horizon));
+  EXPECT_TRUE(near(at({0, -1, 0}), env.sky_gradient.ground));
+  const glm::vec3 up30 = at({std::cos(0.5235988f), std::sin(0.5235988f), 0});  // elevation 30 degrees: halfway
+  EXPECT_NEAR(up30.x, 0.5f, 1e-5f);
+  const glm::vec3 down30 = at({0, -std::sin(0.5235988f), std::cos(0.5235988f)});
+  EXPECT_NEAR(down30.x, 0.45f, 1e-5f);
+
+  const fs::path out = dir() / "gradient_out.gltf";
+  ASSERT_TRUE(engine::write_gltf(*a, out));
+  auto b = engine::load_gltf(out);
+  ASSERT_TRUE(b) << b.error().to_string();
+  EXPECT_EQ(b->environment.sky_gradient, env.sky_gradient);
+  EXPECT_EQ(b->environment.sky_radiance, glm::vec3(0.0f));
+
+  auto both = engine::load_gltf(with_scene_gi(
+      "gradient_plus_uniform.gltf",
+      json::parse(R"({"sky": {"radiance": [1, 1, 1], "zenith": [1, 0, 0], "horizon": [0, 0, 0], "ground": [0, 0, 0]}})")));
+  ASSERT_TRUE(both) << both.error().to_string();
+  EXPECT_EQ(engine::sky_radiance(both->environment.sky_radiance, both->environment.sky_gradient, {0, 1, 0}),
+            glm::vec3(2, 1, 1));
+}
+
+// The closed forms of engine/sky.h (mean radiance, irradiance of any normal) against numeric
+// integration over the sphere.
+TEST(GltfEnvironment, GradientSkyIrradianceFormulasMatchNumericIntegration) {
+  const glm::vec3 uniform(0.3f, 0.0f, 0.0f);
+  const engine::SkyGradient g{.zenith = {0.2f, 1.0f, 0.0f}, .horizon = {0.8f, 0.1f, 0.5f}, .ground = {0.1f, 0.6f, 2.0f}};
+  const int n = 400;  // midpoint rule over (theta, phi)
+  const double pi = 3.141592653589793;
+  const glm::dvec3 normals[] = {{0, 1, 0}, {0, -1, 0}, {1, 0, 0}, {0.6, 0.8, 0}, {0, -0.6, 0.8}};
+  glm::dvec3 mean(0.0);
+  std::vector<glm::dvec3> irradiance(std::size(normals), glm::dvec3(0.0));
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < 2 * n; ++j) {
+      const double theta = (i + 0.5) * pi / n, phi = (j + 0.5) * pi / n;
+      const double dw = std::sin(theta) * (pi / n) * (pi / n);
+      const glm::dvec3 d(std::sin(theta) * std::cos(phi), std::cos(theta), std::sin(theta) * std::sin(phi));
+      const glm::dvec3 l(engine::sky_radiance(uniform, g, glm::vec3(d)));
+      mean += l * dw / (4.0 * pi);
+      for (std::size_t k = 0; k < std::size(normals); ++k)
+        irradiance[k] += l * std::max(0.0, glm::dot(d, normals[k])) * dw;
+    }
+  const glm::vec3 m = engine::sky_mean_radiance(uniform, g);
+  const glm::vec3 up = engine::sky_irradiance_up(uniform, g);
+
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_NEAR(static_cast<double>(m[c]), mean[c], 1e-3);
+    EXPECT_NEAR(static_cast<double>(up[c]), irradiance[0][c], 2e-3 * (1.0 + irradiance[0][c]));
+    for (std::size_t k = 0; k < std::size(normals); ++k) {
+      const double e = static_cast<double>(engine::sky_irradiance(uniform, g, glm::vec3(normals[k]))[c]);
+      EXPECT_NEAR(e, irradiance[k][c], 2e-3 * (1.0 + irradiance[k][c])) << "normal " << k << " channel " << c;
+    }
+    EXPECT_NEAR(static_cast<double>(engine::sky_irradiance(uniform, g, {0, 1, 0})[c]), static_cast<double>(up[c]), 1e-4);
   }
 }

@@ -204,11 +204,21 @@ TEST(GiBake, SkyMakesASceneWithoutLightsBakeable) {
 }
 
 TEST(GiBake, BadSkyIsAUsageError) {
-  for (const char* sky : {"1,2", "1,-1,1", "a,b,c", "1,1,1,1"}) {
+  for (const char* sky : {"1,2", "1,-1,1", "a,b,c", "1,1,1,1", "zenith:1,1,1;horizon:1,1,1",
+                          "zenith:1,1,1;horizon:1,1,1;ground:1,1", "zenith:1,1,1;horizon:1,1,1;ground:1,1,1;ground:1,1,1",
+                          "zenith:1,1,1;horizon:1,1,1;sun:1,1,1", "zenith:1,1,1;horizon:1,1,1;ground:-1,1,1"}) {
     const ToolRun r = run(GI_BAKE_EXE, {"--plan", GI_SOURCE_DIR "/assets/cornell_box.gltf", "--sky", sky});
     EXPECT_EQ(r.exit_code, 2) << sky << "\n" << r.output;
     EXPECT_NE(r.output.find("--sky"), std::string::npos) << sky << "\n" << r.output;
   }
+}
+
+// The gradient form of --sky (docs/scene-format.md): the planner counts it as the sky.
+TEST(GiBake, GradientSkyIsAcceptedAndPlanned) {
+  const ToolRun plan = run(GI_BAKE_EXE, {"--plan", GI_SOURCE_DIR "/assets/cornell_box.gltf", "--preset", "preview",
+                                         "--sky", "horizon:0.8,0.9,1;zenith:0.2,0.4,1;ground:0.1,0.1,0.1"});
+  EXPECT_EQ(plan.exit_code, 0) << plan.output;
+  EXPECT_NE(plan.output.find("the sky too"), std::string::npos) << plan.output;
 }
 
 // gi-reference --sky: the same parser (tools/common), so the reference of a sky-lit bake can be

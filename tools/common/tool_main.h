@@ -11,6 +11,7 @@
 //   if (!result) return tools::fail("gi-bake", result.error());
 
 #include <engine/result.h>
+#include <engine/scene_asset.h>
 #include <glm/vec3.hpp>
 
 #include <CLI/CLI.hpp>
@@ -41,6 +42,14 @@ std::optional<int> parse(CLI::App& app, std::string_view tool, int argc, char** 
 /// a second signal ends the process).
 /// `--sky R,G,B`: three finite radiances >= 0 (W/(m^2 sr)), else nothing.
 std::optional<glm::vec3> parse_sky(const std::string& text);
+
+/// `--sky` in either form, replacing the scene's sky (docs/scene-format.md):
+///   "R,G,B"                                        a uniform sky (parse_sky);
+///   "zenith:R,G,B;horizon:R,G,B;ground:R,G,B"      a gradient over the elevation (engine/sky.h),
+/// the three keys in any order, each once. False (env untouched) when malformed.
+bool set_sky(engine::Environment& env, const std::string& text);
+inline constexpr const char* kSkyUsage =
+    "--sky wants R,G,B or 'zenith:R,G,B;horizon:R,G,B;ground:R,G,B': finite radiances >= 0";
 
 void install_interrupt_handler();
 bool interrupted();

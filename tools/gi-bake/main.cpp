@@ -48,8 +48,9 @@ int main(int argc, char** argv) {
                  "Write the scene with the light-atlas UVs of --preset/--density as TEXCOORD_1 to this .gltf/.glb "
                  "(bakes nothing unless --out is given too)");
   app.add_option("--sky", sky,
-                 "R,G,B: a uniform sky of this radiance, W/(m^2 sr), for scenes that carry none (replaces the "
-                 "scene's gi.sky; docs/scene-format.md)");
+                 "R,G,B: a uniform sky of this radiance, W/(m^2 sr), or 'zenith:R,G,B;horizon:R,G,B;ground:R,G,B' "
+                 "a gradient over the elevation, for scenes that carry none (replaces the scene's gi.sky; "
+                 "docs/scene-format.md)");
   app.add_option("--out", out_dir, "Bundle directory (default: out/<scene>.gibake)");
   app.add_option("--methods", methods,
                  "Comma-separated methods to bake: atlas, prm, dlm, brf, antiradiance (default: what the plan calls for)");
@@ -75,10 +76,8 @@ int main(int argc, char** argv) {
   auto asset = engine::load_gltf(scene_path);
   if (!asset) return tools::fail(kTool, asset.error());
   if (!sky.empty()) {
-    const std::optional<glm::vec3> radiance = tools::parse_sky(sky);
-    if (!radiance)
-      return tools::fail(kTool, "--sky wants R,G,B: three finite radiances >= 0, got '" + sky + "'", tools::kExitUsage);
-    asset->environment.sky_radiance = *radiance;
+    if (!tools::set_sky(asset->environment, sky))
+      return tools::fail(kTool, std::string(tools::kSkyUsage) + ", got '" + sky + "'", tools::kExitUsage);
   }
   if (!export_uv1.empty()) {
     auto uv = gi::with_light_atlas_uv1(*asset, {.preset = o.preset, .texels_per_metre = o.texels_per_metre});

@@ -64,7 +64,8 @@ int main(int argc, char** argv) {
   app.add_option("--exposure", exposure, "exposure for --png");
   app.add_option("--atlas-density", atlas_density, "light-atlas texels per metre (enables the atlas output)");
   app.add_option("--sky", sky,
-                 "R,G,B: a uniform sky of this radiance, W/(m^2 sr), replacing the scene's gi.sky (as gi-bake --sky)");
+                 "R,G,B (uniform) or 'zenith:R,G,B;horizon:R,G,B;ground:R,G,B' (gradient): a sky replacing the "
+                 "scene's gi.sky (as gi-bake --sky)");
   app.add_option("--atlas-out", atlas_out, "folder for atlas_direct.exr, atlas_indirect.exr, atlas_total.exr");
   if (auto rc = tools::parse(app, kTool, argc, argv)) return *rc;
   if (out_path.empty() && png_path.empty() && atlas_out.empty())
@@ -75,10 +76,8 @@ int main(int argc, char** argv) {
   auto asset = engine::load_gltf(scene_path);
   if (!asset) return tools::fail(kTool, asset.error());
   if (!sky.empty()) {
-    const std::optional<glm::vec3> radiance = tools::parse_sky(sky);
-    if (!radiance)
-      return tools::fail(kTool, "--sky wants R,G,B: three finite radiances >= 0, got '" + sky + "'", tools::kExitUsage);
-    asset->environment.sky_radiance = *radiance;
+    if (!tools::set_sky(asset->environment, sky))
+      return tools::fail(kTool, std::string(tools::kSkyUsage) + ", got '" + sky + "'", tools::kExitUsage);
   }
   engine::Scene scene = engine::instantiate(std::move(asset).value());
   tools::install_interrupt_handler();

@@ -60,6 +60,11 @@ struct RenderSettings {
   /// (a light atlas baked with the sky). Pixels no geometry covers show it (the background).
   /// docs/scene-format.md.
   glm::vec3 sky_radiance{0.0f};
+  /// The sky's gradient over the elevation, added to sky_radiance (engine/sky.h;
+  /// SceneAsset::environment.sky_gradient, copied by Renderer::create). Its ambient term is
+  /// the exact unoccluded irradiance of the surface's normal (engine::sky_irradiance); the
+  /// background shows the horizon's radiance.
+  SkyGradient sky_gradient;
   /// Told once when a light or mesh entity starts being skipped because its world transform
   /// or light values are not usable (engine/runtime_limits.h: NaN, infinite, absurd); again
   /// only if it recovers and fails anew. Unset: skipped silently (last_skipped_entities()).

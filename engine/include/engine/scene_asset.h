@@ -14,6 +14,7 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include <engine/components.h>
+#include <engine/sky.h>
 
 namespace engine {
 
@@ -105,6 +106,9 @@ struct NamedCamera {
 struct Environment {
   /// Uniform radiance of every direction no geometry covers, W/(m^2 sr) (0: no sky).
   glm::vec3 sky_radiance{0.0f};
+  /// A gradient over the elevation added to it (engine/sky.h; all zero: none). Evaluate the
+  /// sky with engine::sky_radiance(sky_radiance, sky_gradient, direction).
+  SkyGradient sky_gradient;
   int sun_light = -1;  ///< Index into SceneAsset::lights of the sun, or -1.
   int sun_node = -1;   ///< Index into SceneAsset::nodes of the sun's node, or -1.
   /// Angular radius of the sun's disc (radians). Recorded and written back; the renderer

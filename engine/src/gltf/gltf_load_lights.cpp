@@ -215,14 +215,29 @@ Status parse_scene_environment(const Context& ctx, const Json& scene_json, const
   if (const Json* sky = find_member(*gi, "sky")) {
     const std::string swhere = where + ".sky";
     if (!sky->is_object()) return ctx.error(swhere, "must be an object");
-    const Json* radiance = find_member(*sky, "radiance");
-    if (radiance == nullptr) return ctx.error(swhere, "needs 'radiance'");
-    auto r = number_array<3>(ctx, *radiance, swhere, "radiance");
-    if (!r) return r.error();
-    if (r->x < 0.0f || r->y < 0.0f || r->z < 0.0f) return ctx.error(swhere, "'radiance' has a negative component");
-    if (std::max({r->x, r->y, r->z}) > static_cast<float>(kMaxLightIntensity))
-      return ctx.error(swhere, "'radiance' is beyond any real sky (at most 1e15)");
-    scene.environment.sky_radiance = *r;
+    // A uniform 'radiance', a gradient ('zenith', 'horizon', 'ground'; engine/sky.h), or both (they add).
+    const auto sky_colour = [&](const char* key, glm::vec3& out) -> Status {
+      const Json* value = find_member(*sky, key);
+      if (value == nullptr) return {};
+      auto r = number_array<3>(ctx, *value, swhere, key);
+      if (!r) return r.error();
+      if (r->x < 0.0f || r->y < 0.0f || r->z < 0.0f)
+        return ctx.error(swhere, "'" + std::string(key) + "' has a negative component");
+      if (std::max({r->x, r->y, r->z}) > static_cast<float>(kMaxLightIntensity))
+        return ctx.error(swhere, "'" + std::string(key) + "' is beyond any real sky (at most 1e15)");
+      out = *r;
+      return {};
+    };
+    const int gradient_keys = (find_member(*sky, "zenith") != nullptr) + (find_member(*sky, "horizon") != nullptr) +
+                              (find_member(*sky, "ground") != nullptr);
+    if (find_member(*sky, "radiance") == nullptr && gradient_keys == 0)
+      return ctx.error(swhere, "needs 'radiance' or 'zenith', 'horizon' and 'ground'");
+    if (gradient_keys != 0 && gradient_keys != 3)
+      return ctx.error(swhere, "a gradient needs all of 'zenith', 'horizon' and 'ground'");
+    if (Status s = sky_colour("radiance", scene.environment.sky_radiance); !s) return s;
+    if (Status s = sky_colour("zenith", scene.environment.sky_gradient.zenith); !s) return s;
+    if (Status s = sky_colour("horizon", scene.environment.sky_gradient.horizon); !s) return s;
+    if (Status s = sky_colour("ground", scene.environment.sky_gradient.ground); !s) return s;
   }
   if (const Json* sun = find_member(*gi, "sun")) {
     const std::string swhere = where + ".sun";

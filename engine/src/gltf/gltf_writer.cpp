@@ -344,6 +344,12 @@ class GltfBuilder {
     const Environment& env = scene_.environment;
     json gi = json::object();
     if (env.sky_radiance != glm::vec3(0.0f)) gi["sky"] = {{"radiance", vec(env.sky_radiance)}};
+    if (!env.sky_gradient.empty()) {
+      if (!gi.contains("sky")) gi["sky"] = json::object();
+      gi["sky"]["zenith"] = vec(env.sky_gradient.zenith);
+      gi["sky"]["horizon"] = vec(env.sky_gradient.horizon);
+      gi["sky"]["ground"] = vec(env.sky_gradient.ground);
+    }
     if (sun_in_extras()) {
       const Node& n = scene_.nodes[static_cast<std::size_t>(env.sun_node)];
       const Light& l = scene_.lights[static_cast<std::size_t>(env.sun_light)].light;

@@ -268,7 +268,9 @@ void ForwardRenderer::forward_pass(const Registry& registry, Entity camera, cons
   glBindFramebuffer(GL_FRAMEBUFFER, hdr_fbo_.id());
   glViewport(0, 0, width_, height_);
   // Where no geometry is, the camera sees the sky (black without one), as the path tracer does.
-  const float background[4] = {settings_.sky_radiance.x, settings_.sky_radiance.y, settings_.sky_radiance.z, 1.0f};
+  // With a gradient, the horizon's radiance (what a level camera sees at the image's centre).
+  const glm::vec3 sky_bg = sky_radiance(settings_.sky_radiance, settings_.sky_gradient, glm::vec3(1.0f, 0.0f, 0.0f));
+  const float background[4] = {sky_bg.x, sky_bg.y, sky_bg.z, 1.0f};
   const float far_depth = 1.0f;
   glClearNamedFramebufferfv(hdr_fbo_.id(), GL_COLOR, 0, background);
   glClearNamedFramebufferfv(hdr_fbo_.id(), GL_DEPTH, 0, &far_depth);
@@ -307,6 +309,11 @@ void ForwardRenderer::forward_pass(const Registry& registry, Entity camera, cons
   glUniform3fv(16, 1, glm::value_ptr(camera_position));
   glUniform1f(23, settings_.stand_in_ambient);
   glUniform3fv(31, 1, glm::value_ptr(settings_.sky_radiance));
+  {  // The sky's gradient (engine/sky.h): horizon, zenith - horizon, ground - horizon.
+    const SkyGradient& g = settings_.sky_gradient;
+    const glm::vec3 terms[3] = {g.horizon, g.zenith - g.horizon, g.ground - g.horizon};
+    glUniform3fv(61, 3, glm::value_ptr(terms[0]));
+  }
   glUniform1f(24, settings_.split == SplitView::DirectLeftFullRight ? 0.5f * static_cast<float>(width_) : -1.0f);
   glUniform1i(25, glossy != 0 ? 1 : 0);
 
@@ -453,6 +460,7 @@ Result<std::unique_ptr<Renderer>> Renderer::create(const SceneAsset& assets, con
   glEnable(GL_TEXTURE_CUBE_MAP_SEAMLESS);
   RenderSettings with_sky = settings;
   with_sky.sky_radiance = assets.environment.sky_radiance;
+  with_sky.sky_gradient = assets.environment.sky_gradient;
   return std::unique_ptr<Renderer>(std::make_unique<ForwardRenderer>(std::move(scene.value()), std::move(forward.value()),
                                                                      std::move(depth.value()), std::move(shadow.value()),
                                                                      std::move(tonemap.value()), with_sky));

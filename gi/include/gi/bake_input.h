@@ -13,6 +13,7 @@
 #include <engine/components.h>
 #include <engine/result.h>
 #include <engine/scene.h>
+#include <engine/sky.h>
 
 #include <cstdint>
 #include <glm/glm.hpp>
@@ -83,6 +84,9 @@ struct BakeLight {
 /// Light from outside the scene.
 struct BakeEnvironment {
   glm::vec3 sky_radiance{0.0f};  ///< Uniform radiance of rays that leave the scene, W/(m^2 sr).
+  /// Added to it: a gradient over the elevation (engine/sky.h; all zero: none). The sky of
+  /// direction d is engine::sky_radiance(sky_radiance, sky_gradient, d).
+  engine::SkyGradient sky_gradient;
 };
 
 /// A scene as the bakers read it.

@@ -83,6 +83,16 @@ std::string static_lights_hash(const BakeInput& input) {
     h.add_value(l.area_size_m.x);
     h.add_value(l.area_size_m.y);
   }
+  // The sky is a static source too; hashed only when there is one, so the hashes of
+  // bundles of sky-less scenes stay what they were.
+  const BakeEnvironment& env = input.environment;
+  if (engine::sky_lit(env.sky_radiance, env.sky_gradient)) {
+    h.add_string("sky");
+    add_vec(h, env.sky_radiance);
+    add_vec(h, env.sky_gradient.zenith);
+    add_vec(h, env.sky_gradient.horizon);
+    add_vec(h, env.sky_gradient.ground);
+  }
   return h.hex();
 }
 

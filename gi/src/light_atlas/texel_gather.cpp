@@ -363,6 +363,7 @@ engine::Result<TexelGatherResult> gather_atlas(const StaticBakeScene& b, const A
   const auto ns = static_cast<std::size_t>(s.solve_rays);
   std::vector<std::uint32_t> kept(work * ns, kDark);
   const glm::vec3 sky = b.scene.sky_radiance;
+  const engine::SkyGradient& sky_gradient = b.scene.sky_gradient;  // engine/sky.h: by the escaping direction
   std::vector<std::uint8_t> hidden(n, 0);
   if (!pool.parallel_for_with_progress(work, phase(0.15, 0.45), [&](std::size_t w) {
         const std::uint32_t i = t.work[w];
@@ -370,6 +371,7 @@ engine::Result<TexelGatherResult> gather_atlas(const StaticBakeScene& b, const A
         const glm::vec2 shift(rng.next_float(), rng.next_float());
         const glm::vec3 origin = offset_ray_origin(tx.position[i], t.face[i]);
         std::size_t escaped = 0, back = 0;
+        glm::vec3 gradient_seen(0.0f);  // sum over escaped rays of the sky gradient's radiance
         for (std::size_t r = 0; r < ns; ++r) {
           const glm::vec2 u = hammersley(static_cast<std::uint32_t>(r), static_cast<std::uint32_t>(ns), shift);
           const glm::vec3 wi = sample_cosine_hemisphere(tx.normal[i], u.x, u.y);
@@ -378,11 +380,14 @@ engine::Result<TexelGatherResult> gather_atlas(const StaticBakeScene& b, const A
           const std::uint32_t land = landing(b, layout, t, Ray{origin, 0.0f, wi}, nullptr);
           kept[w * ns + r] = land;
           escaped += land == kSky;
+          if (land == kSky && !sky_gradient.empty())
+            gradient_seen += engine::sky_radiance(glm::vec3(0.0f), sky_gradient, wi);
           back += land == kBack;
         }
         hidden[i] = static_cast<float>(back) > kHiddenBackFraction * static_cast<float>(ns) ? 1 : 0;
         // Sky seen directly is direct light; cosine sampling: E = pi L x fraction escaping.
         out.direct[i] += kPi * sky * (static_cast<float>(escaped) / static_cast<float>(ns));
+        out.direct[i] += kPi * gradient_seen / static_cast<float>(ns);
       }))
     return engine::cancelled_error("light-atlas gather");
 

@@ -123,7 +123,7 @@ PlanFacts gather_facts(const BakeInput& input, const PlanOptions& options, Effec
   }
   facts.static_lights = static_cast<int>(f.static_lights.size());
   facts.moving_lights = static_cast<int>(f.moving_lights.size());
-  f.sky = glm::any(glm::greaterThan(input.environment.sky_radiance, glm::vec3(0.0f)));
+  f.sky = engine::sky_lit(input.environment.sky_radiance, input.environment.sky_gradient);
 
   for (std::size_t i = 0; i < input.instances.size(); ++i) {
     const BakeInstance& inst = input.instances[i];

@@ -122,7 +122,8 @@ PathTracer::Traced PathTracer::trace(Ray ray, float prev_pdf, int max_light_vert
     glm::vec3& sink = k == 1 ? out.emitted : out.reflected;
     const Hit hit = caster_.intersect(ray);
     if (!hit.valid()) {
-      if (k <= max_light_vertex) sink += beta * scene_.sky_radiance;
+      if (k <= max_light_vertex)
+        sink += beta * engine::sky_radiance(scene_.sky_radiance, scene_.sky_gradient, glm::normalize(ray.direction));
       break;
     }
     const ShadingTriangle& tri = index_.triangles[index_.instance_first[hit.instance] + hit.primitive];

@@ -13,6 +13,7 @@
 #include <glm/glm.hpp>
 
 #include <engine/result.h>
+#include <engine/sky.h>
 
 #include "raytrace/reference_brdf.h"
 #include "raytrace/rt_scene_data.h"
@@ -49,6 +50,7 @@ struct ReferenceScene {
   std::vector<ReferenceMaterial> materials;
   std::vector<ReferenceLight> lights;
   glm::vec3 sky_radiance{0.0f};  ///< Radiance of rays that escape, W/(m^2 sr) (a uniform sky).
+  engine::SkyGradient sky_gradient;  ///< Added to it by the escaping direction's elevation (engine/sky.h).
 };
 
 /// One world-space triangle with what shading needs.

@@ -110,6 +110,7 @@ ReferenceScene reference_scene_from(const BakeInput& input) {
   for (const BakeLight& l : input.lights)
     if (l.light.enabled) out.lights.push_back(reference_light(l.light, l.light_to_world));
   out.sky_radiance = input.environment.sky_radiance;
+  out.sky_gradient = input.environment.sky_gradient;
   return out;
 }
 

@@ -143,6 +143,7 @@ BakeInput bake_input_from(const engine::SceneAsset& asset) {
   BakeInput in;
   in.name = asset.source;
   in.environment.sky_radiance = asset.environment.sky_radiance;  // the sun is a light of a node
+  in.environment.sky_gradient = asset.environment.sky_gradient;
   for (const engine::Mesh& m : asset.meshes) in.meshes.push_back(mesh_from(m));
   for (const engine::Material& m : asset.materials) in.materials.push_back(material_from(m));
   const NodeChains chains = node_chains(asset);
@@ -175,6 +176,7 @@ BakeInput bake_input_from(const engine::Scene& scene) {
   BakeInput in;
   in.name = scene.assets.source;
   in.environment.sky_radiance = scene.assets.environment.sky_radiance;  // the sun is a light entity
+  in.environment.sky_gradient = scene.assets.environment.sky_gradient;
   for (const engine::Mesh& m : scene.assets.meshes) in.meshes.push_back(mesh_from(m));
   for (const engine::Material& m : scene.assets.materials) in.materials.push_back(material_from(m));
 
@@ -276,6 +278,10 @@ engine::Status validate_bake_input(const BakeInput& input) {
   if (!engine::all_finite(input.environment.sky_radiance) ||
       glm::any(glm::lessThan(input.environment.sky_radiance, glm::vec3(0.0f))))
     return input_error("environment", "the sky radiance must be finite and >= 0");
+  for (const glm::vec3& g : {input.environment.sky_gradient.zenith, input.environment.sky_gradient.horizon,
+                             input.environment.sky_gradient.ground})
+    if (!engine::all_finite(g) || glm::any(glm::lessThan(g, glm::vec3(0.0f))))
+      return input_error("environment", "the sky gradient's zenith, horizon and ground must be finite and >= 0");
   return {};
 }
 

@@ -103,6 +103,16 @@ void add_asset(ContentHash& h, const engine::SceneAsset& a) {
     h.add_value(n.camera);
     h.add_value(n.gi.mobility);
   }
+  // The sky (set in code, e.g. by --sky, or from the file), only when there is one: the
+  // fingerprints of sky-less scenes are unchanged.
+  const engine::Environment& env = a.environment;
+  if (env.sky_radiance != glm::vec3(0.0f) || !env.sky_gradient.empty()) {
+    h.add_string("sky");
+    add_vec(h, env.sky_radiance);
+    add_vec(h, env.sky_gradient.zenith);
+    add_vec(h, env.sky_gradient.horizon);
+    add_vec(h, env.sky_gradient.ground);
+  }
 }
 
 }  // namespace

@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 
+#include <engine/sky.h>
+
 #include "core/random.h"
 #include "raytrace/embree_ray_caster.h"
 #include "raytrace/path_tracer.h"
@@ -151,6 +153,38 @@ TEST(ReferenceSky, LambertianPlaneUnderUniformSky) {
   double mean = 0.0;
   for (const glm::vec3& v : half->direct) mean += static_cast<double>(v.x) / 16.0;
   EXPECT_NEAR(mean, kPiD * 1.5 / 2.0, 0.01 * kPiD * 1.5);
+}
+
+// A gradient sky (engine/sky.h) over a Lambertian plane: E = pi/3 horizon + 2 pi/3 zenith
+// (the plane hides the ground half), outgoing rho E / pi; a camera looking straight up sees
+// the zenith, one looking level the horizon.
+TEST(ReferenceSky, LambertianPlaneUnderGradientSky) {
+  gi::ReferenceScene s = reftest::plane_scene(0.6f);
+  s.sky_gradient = {.zenith = {0.2f, 0.4f, 1.0f}, .horizon = {1.0f, 0.9f, 0.7f}, .ground = {5.0f, 5.0f, 5.0f}};
+  const glm::vec3 expected = engine::sky_irradiance_up(glm::vec3(0.0f), s.sky_gradient);
+  const auto pts = points_on_floor(0.0f, 4, 5.0f);
+  auto e = gi::estimate_irradiance(s, pts, settings(4096));
+  ASSERT_TRUE(e);
+  for (int c = 0; c < 3; ++c) {
+    double mean = 0.0;
+    for (std::size_t i = 0; i < pts.size(); ++i) mean += static_cast<double>(e->direct[i][c]) / static_cast<double>(pts.size());
+    EXPECT_NEAR(mean, static_cast<double>(expected[c]), 0.005 * static_cast<double>(expected[c])) << "channel " << c;
+  }
+  for (std::size_t i = 0; i < pts.size(); ++i) EXPECT_EQ(e->indirect[i], glm::vec3(0.0f));
+
+  gi::PinholeCamera cam;
+  cam.width = cam.height = 1;
+  cam.yfov_rad = 0.002f;
+  cam.camera_to_world = glm::mat4(glm::vec4(1, 0, 0, 0), glm::vec4(0, 0, 1, 0), glm::vec4(0, -1, 0, 0),
+                                  glm::vec4(0, 3, 0, 1));  // looking straight up (-Z = +Y)
+  auto up = gi::render_reference(s, cam, settings(4));
+  ASSERT_TRUE(up);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(up->pixels[static_cast<std::size_t>(c)], s.sky_gradient.zenith[c], 1e-3f);
+  cam.camera_to_world = glm::mat4(1.0f);
+  cam.camera_to_world[3] = glm::vec4(0, 3, 0, 1);  // looking along -Z, level
+  auto level = gi::render_reference(s, cam, settings(4));
+  ASSERT_TRUE(level);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(level->pixels[static_cast<std::size_t>(c)], s.sky_gradient.horizon[c], 1e-2f);
 }
 
 }  // namespace
