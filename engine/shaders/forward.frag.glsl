@@ -93,7 +93,8 @@ void main() {
   for (int k = 0; k < DIRECTIONAL_LIGHTS; ++k) {
     const int i = POINT_LIGHTS + SPOT_LIGHTS + k;
     radiance += directional_light_radiance(lights[i], s, to_light) *
-                shadow_2d(lights[i], s.position, s.normal, to_light, 1.0);
+                (lights[i].radiant.w > 0.0 ? shadow_2d_disc(lights[i], s.position, s.normal, to_light)  // the sun's disc
+                                           : shadow_2d(lights[i], s.position, s.normal, to_light, 1.0));
   }
 #endif
 #if AREA_LIGHTS > 0

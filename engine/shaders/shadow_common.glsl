@@ -6,6 +6,7 @@
 
 layout(binding = 4) uniform sampler2DArrayShadow u_shadow_maps;
 layout(binding = 5) uniform samplerCubeArrayShadow u_point_shadow_maps;
+layout(binding = 12) uniform sampler2DArray u_shadow_depths;  // the same 2-D maps, raw depths
 
 float slope_tangent(vec3 n, vec3 to_light) {
   float n_dot_l = clamp(dot(n, to_light), 0.05, 1.0);
@@ -58,4 +59,45 @@ float shadow_cube(GpuLight light, vec3 p, vec3 n, vec3 to_light) {
     for (int x = -1; x <= 1; ++x)
       sum += texture(u_point_shadow_maps, vec4(d + (float(x) * t + float(y) * b) * texel, float(cube)), ref);
   return sum / 9.0;
+}
+
+// A directional light with a disc (the sun; light.radiant.w = tan r, r its angular radius):
+// the penumbra a blocker at distance b in front of the receiver casts is 2 b tan r wide, so
+// (as PCSS does) the mean depth of the blockers in a search window of half-width d tan r (d
+// the receiver's depth: the widest any blocker can make) gives b, and a 5x5 grid of compare
+// taps spans the penumbra, b tan r either side. Ortho maps only (directional lights).
+float shadow_2d_disc(GpuLight light, vec3 p, vec3 n, vec3 to_light) {
+  int layer = int(light.cone.z);
+  if (layer < 0) return 1.0;
+  float tan_r = light.radiant.w;
+  vec3 eye = light.shadow_eye.xyz;
+  float far_m = light.shadow_eye.w;
+  vec3 axis = light.direction_range.xyz;
+  float texel = light.shadow_params.y;  // metres per texel of the ortho map
+  vec3 po = p + n * texel;
+  vec4 clip = light.shadow_view_proj * vec4(po, 1.0);
+  vec2 uv = clip.xy / clip.w * 0.5 + 0.5;
+  if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)))) return 1.0;
+  float d = dot(po - eye, axis);
+  float bias = texel * (1.0 + slope_tangent(n, to_light));
+  float ref = (d - bias) / far_m;
+  vec2 texel_uv = 1.0 / vec2(textureSize(u_shadow_maps, 0).xy);
+  float search = clamp(d * tan_r / texel, 1.0, 24.0);  // texels
+  float blockers = 0.0, blocker_depth = 0.0;
+  for (int y = -2; y <= 2; ++y)
+    for (int x = -2; x <= 2; ++x) {
+      float z = texture(u_shadow_depths, vec3(uv + vec2(x, y) * (0.5 * search) * texel_uv, float(layer))).r;
+      if (z < ref) {
+        blockers += 1.0;
+        blocker_depth += z;
+      }
+    }
+  if (blockers == 0.0) return 1.0;
+  float b = max(d - blocker_depth / blockers * far_m, 0.0);  // receiver - blocker, metres
+  float radius = clamp(b * tan_r / texel, 1.0, 24.0);       // penumbra half-width, texels
+  float sum = 0.0;
+  for (int y = -2; y <= 2; ++y)
+    for (int x = -2; x <= 2; ++x)
+      sum += texture(u_shadow_maps, vec4(uv + vec2(x, y) * (0.5 * radius) * texel_uv, float(layer), ref));
+  return sum / 25.0;
 }

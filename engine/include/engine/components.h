@@ -58,6 +58,11 @@ struct Light {
   float outer_cone_rad = 0.7853982f;
   /// Area light rectangle size in metres (local X by local Y).
   glm::vec2 area_size_m{1.0f, 1.0f};
+  /// Directional: angular radius (radians) of the source's disc, e.g. the sun's 0.0047;
+  /// 0: a single direction (hard shadows). The bakers sample the disc (soft shadows); the
+  /// renderer widens its shadow filter by it (docs/scene-format.md). `intensity` stays the
+  /// irradiance of a surface facing the disc's centre.
+  float angular_radius_rad = 0.0f;
   /// The light moves or changes at runtime (flashlight, scripted lamp): GI must not bake it.
   bool moves = false;
   bool cast_shadows = true;

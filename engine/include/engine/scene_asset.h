@@ -111,8 +111,8 @@ struct Environment {
   SkyGradient sky_gradient;
   int sun_light = -1;  ///< Index into SceneAsset::lights of the sun, or -1.
   int sun_node = -1;   ///< Index into SceneAsset::nodes of the sun's node, or -1.
-  /// Angular radius of the sun's disc (radians). Recorded and written back; the renderer
-  /// and the bakers treat the sun as a direction (hard shadows).
+  /// Angular radius of the sun's disc (radians), also the sun light's
+  /// Light::angular_radius_rad, which the bakers and the renderer read (soft shadows).
   float sun_angular_radius_rad = 0.0f;
 };
 

@@ -267,6 +267,7 @@ Status parse_scene_environment(const Context& ctx, const Json& scene_json, const
     const float peak = std::max({e->x, e->y, e->z});
     light.light.intensity = peak;  // W/m^2 on a surface facing the sun
     light.light.color = peak > 0.0f ? *e / peak : glm::vec3(1.0f);
+    light.light.angular_radius_rad = static_cast<float>(*radius * std::numbers::pi / 180.0);  // the disc
     Node node;
     node.name = "sun";
     node.rotation = glm::normalize(q);

@@ -43,6 +43,7 @@ enum TextureUnit : GLuint {
   kPointShadowMapsUnit = 5,
   kGlossyUnit = 6,
   kDirectionalIndexUnit = 7,
+  kShadowDepthUnit = 12,  // the 2-D shadow maps again, raw depth (shadow_common.glsl's sun disc)
 };
 constexpr GLuint kLightsBinding = 0;
 constexpr GLuint kVertexIrradianceBinding = 1;
@@ -50,6 +51,18 @@ constexpr GLuint kDirectionalRadianceBinding = 2;  // directional_radiance.glsl
 constexpr GLuint kDirectionalDirectionBinding = 3;
 constexpr GLuint kLobeCoefficientsBinding = 6;  // forward.vert.glsl: IndirectLightFrame::vertex_radiance_lobes
 constexpr GLuint kLobeTableBinding = 7;
+
+// Nearest, clamped, no depth comparison: the 2-D shadow maps read as depths (the blocker
+// search of a directional light with a disc, shadow_common.glsl).
+GlSampler raw_depth_sampler() {
+  GlSampler s = GlSampler::create();
+  glSamplerParameteri(s.id(), GL_TEXTURE_COMPARE_MODE, GL_NONE);
+  glSamplerParameteri(s.id(), GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  glSamplerParameteri(s.id(), GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  glSamplerParameteri(s.id(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glSamplerParameteri(s.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  return s;
+}
 
 // A 1x1 R32I texture holding -1 ("no element"): what the directional index sampler reads
 // when the provider has no directional radiance.
@@ -100,7 +113,8 @@ class ForwardRenderer final : public Renderer {
         lights_buffer_(GlBuffer::create()),
         empty_vao_(GlVertexArray::create()),
         albedo_table_(upload_gltf_albedo_table()),
-        no_directional_index_(no_directional_index()) {
+        no_directional_index_(no_directional_index()),
+        shadow_depth_sampler_(raw_depth_sampler()) {
     forward_variants_.emplace(LightCounts{0, 0, 0, 0, 3}, std::move(forward));
     ensure_targets();
   }
@@ -143,6 +157,7 @@ class ForwardRenderer final : public Renderer {
   GlVertexArray empty_vao_;
   GlTexture albedo_table_;  // gltf_brdf.glsl's directional albedo table
   GlTexture no_directional_index_;
+  GlSampler shadow_depth_sampler_;  // no depth compare: the sun disc's blocker search reads depths
   GlTexture hdr_;
   GlTexture depth_;
   GlTexture ldr_;
@@ -288,6 +303,8 @@ void ForwardRenderer::forward_pass(const Registry& registry, Entity camera, cons
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kLightsBinding, lights_buffer_.id());
   glBindTextureUnit(kShadowMapsUnit, shadow_maps_.maps_2d());
   glBindTextureUnit(kPointShadowMapsUnit, shadow_maps_.cube_maps());
+  glBindTextureUnit(kShadowDepthUnit, shadow_maps_.maps_2d());
+  glBindSampler(kShadowDepthUnit, shadow_depth_sampler_.id());
   const GLuint atlas = indirect ? indirect->irradiance_atlas_texture : 0;
   const GLuint glossy = indirect ? indirect->glossy_radiance_texture : 0;
   glBindTextureUnit(kIrradianceAtlasUnit, atlas != 0 ? atlas : scene_.white_texture());

@@ -10,7 +10,7 @@ enum class GpuLightType : int { Point = 0, Spot = 1, Directional = 2, Area = 3 }
 struct GpuLight {
   glm::vec4 position_type{0.0f};     ///< xyz world position (m), w type
   glm::vec4 direction_range{0.0f};   ///< xyz unit emission direction, w range (m; 0 unlimited)
-  glm::vec4 radiant{0.0f};           ///< rgb colour x intensity (engine units), w unused
+  glm::vec4 radiant{0.0f};           ///< rgb colour x intensity (engine units), w directional: tan(disc radius)
   glm::vec4 cone{0.0f, 0.0f, -1.0f, -1.0f};  ///< cos outer, cos inner, 2-D shadow layer, shadow cube
   glm::vec4 area_half_x{0.0f};       ///< half extent along the light's X (m)
   glm::vec4 area_half_y{0.0f};       ///< half extent along the light's Y (m)

@@ -82,6 +82,7 @@ std::string static_lights_hash(const BakeInput& input) {
     h.add_value(l.outer_cone_rad);
     h.add_value(l.area_size_m.x);
     h.add_value(l.area_size_m.y);
+    if (l.angular_radius_rad > 0.0f) h.add_value(l.angular_radius_rad);  // the sun's disc
   }
   // The sky is a static source too; hashed only when there is one, so the hashes of
   // bundles of sky-less scenes stay what they were.

@@ -22,8 +22,9 @@ std::string scene_geometry_hash(const BakeInput& input);
 
 /// 16 hex digits over the lights a static bake (the light atlas) depends on: for every
 /// light that does not move, in order, its place among them, its world matrix and its type,
-/// colour, intensity, range, cone angles and area size. Moving lights and names do not
-/// enter. A light-atlas bundle whose lights hash differs from the scene's was baked under
+/// colour, intensity, range, cone angles and area size (and a directional light's disc when
+/// it has one), then the sky when there is one (uniform and gradient). Moving lights and
+/// names do not enter. A light-atlas bundle whose lights hash differs from the scene's was baked under
 /// other lights.
 std::string static_lights_hash(const BakeInput& input);
 

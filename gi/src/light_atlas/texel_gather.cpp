@@ -175,6 +175,21 @@ glm::vec3 direct_at(const StaticBakeScene& b, const glm::vec3& p, const glm::vec
       }
       continue;
     }
+    if (l.type == ReferenceLight::Type::Directional && l.cos_disc < 1.0f) {
+      // A disc (the sun's angular radius): `samples` stratified directions uniform over its
+      // cone, each carrying radiant / samples; soft shadows (docs/scene-format.md).
+      const glm::vec2 shift(rng.next_float(), rng.next_float());
+      for (int s = 0; s < samples; ++s) {
+        const glm::vec2 u = hammersley(static_cast<std::uint32_t>(s), static_cast<std::uint32_t>(samples), shift);
+        const glm::vec3 wi = sample_cone(-l.direction, l.cos_disc, u.x, u.y);
+        const float cos_r = glm::dot(wi, n);
+        if (cos_r <= 0.0f || glm::dot(wi, face) <= 0.0f) continue;
+        ++*rays;
+        if (b.caster->occluded(Ray{origin, 0.0f, wi, std::numeric_limits<float>::infinity()})) continue;
+        sum += glm::dvec3(l.radiant * cos_r) * inv;
+      }
+      continue;
+    }
     glm::vec3 wi;
     float atten = 1.0f, t_max = 1.0f;
     glm::vec3 dir;

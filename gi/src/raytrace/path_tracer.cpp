@@ -59,7 +59,11 @@ glm::vec3 PathTracer::direct_light(const glm::vec3& origin, const glm::vec3& p, 
         break;
       }
       case ReferenceLight::Type::Directional: {
-        const glm::vec3 wi = -l.direction;
+        glm::vec3 wi = -l.direction;
+        if (l.cos_disc < 1.0f) {  // a disc (the sun's): a direction uniform over its cone
+          const float u = rng.next_float();
+          wi = sample_cone(-l.direction, l.cos_disc, u, rng.next_float());
+        }
         const glm::vec3 fcos = brdf.eval_cos(wo, wi);
         if (fcos == glm::vec3(0.0f)) break;
         if (caster_.occluded(Ray{origin, 0.0f, wi})) break;

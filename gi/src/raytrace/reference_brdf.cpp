@@ -52,6 +52,15 @@ glm::vec3 sample_cosine_hemisphere(const glm::vec3& n, float u1, float u2) {
   return glm::normalize(r * std::cos(phi) * t + r * std::sin(phi) * b + z * n);
 }
 
+glm::vec3 sample_cone(const glm::vec3& axis, float cos_max, float u1, float u2) {
+  glm::vec3 t, b;
+  orthonormal_basis(axis, t, b);
+  const float z = 1.0f - u1 * (1.0f - cos_max);  // cos theta uniform on [cos_max, 1]: uniform in solid angle
+  const float r = std::sqrt(std::max(0.0f, 1.0f - z * z));
+  const float phi = 2.0f * kPi * u2;
+  return glm::normalize(r * std::cos(phi) * t + r * std::sin(phi) * b + z * axis);
+}
+
 float ReferenceBrdf::specular_probability(const glm::vec3& wo) const {
   const engine::GltfBrdfValue albedo =
       engine::gltf_directional_albedo(material, std::clamp(glm::dot(normal, wo), 0.0f, 1.0f));

@@ -42,4 +42,8 @@ void orthonormal_basis(const glm::vec3& n, glm::vec3& t, glm::vec3& b);
 /// Cosine-weighted direction around unit n from two uniform numbers; pdf = cos / pi.
 glm::vec3 sample_cosine_hemisphere(const glm::vec3& n, float u1, float u2);
 
+/// A direction uniform over the solid angle of the cone of half-angle acos(cos_max) around
+/// unit `axis` (a light's disc), from two uniform numbers in [0, 1).
+glm::vec3 sample_cone(const glm::vec3& axis, float cos_max, float u1, float u2);
+
 }  // namespace gi

@@ -39,6 +39,10 @@ struct ReferenceLight {
   float range_m = 0.0f;     ///< glTF range window; 0: unlimited.
   float cos_outer = 0.0f;   ///< Spot cone.
   float cos_inner = 1.0f;
+  /// Directional: cos of the angular radius of the source's disc (engine::Light::
+  /// angular_radius_rad); 1: a single direction. Light arrives uniformly from the cone
+  /// around -direction (sample_cone), `radiant` being the total irradiance.
+  float cos_disc = 1.0f;
 };
 
 /// Everything the path tracer reads. Per geometry: world-independent shading data

@@ -68,6 +68,7 @@ ReferenceLight reference_light(const engine::Light& light, const glm::mat4& m) {
       break;
     case engine::LightType::Directional:
       l.type = ReferenceLight::Type::Directional;
+      l.cos_disc = light.angular_radius_rad > 0.0f ? std::cos(std::min(light.angular_radius_rad, 1.5707963f)) : 1.0f;
       break;
     case engine::LightType::Area:
       l.type = ReferenceLight::Type::Area;

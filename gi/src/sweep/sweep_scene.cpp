@@ -79,6 +79,7 @@ void add_asset(ContentHash& h, const engine::SceneAsset& a) {
     h.add_value(l.moves);
     h.add_value(l.cast_shadows);
     h.add_value(l.enabled);
+    if (l.angular_radius_rad > 0.0f) h.add_value(l.angular_radius_rad);  // only then: older keys stay valid
   }
   h.add_value(static_cast<std::uint64_t>(a.cameras.size()));
   for (const engine::NamedCamera& c : a.cameras) {
