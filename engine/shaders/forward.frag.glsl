@@ -55,6 +55,10 @@ layout(location = 31) uniform vec3 u_sky_radiance;
 // The sky's gradient (RenderSettings::sky_gradient, engine/sky.h): horizon, zenith - horizon,
 // ground - horizon.
 layout(location = 61) uniform vec3 u_sky_gradient[3];
+// The sky's visibility on this item (IndirectLightFrame::sky_visibility; 1 = unoccluded):
+// an ambient cube, +X +Y +Z faces and -X -Y -Z faces.
+layout(location = 64) uniform vec3 u_sky_visibility_pos;
+layout(location = 65) uniform vec3 u_sky_visibility_neg;
 
 layout(binding = 0) uniform sampler2D u_base_color_texture;
 layout(binding = 1) uniform sampler2D u_metallic_roughness_texture;
@@ -109,12 +113,15 @@ void main() {
   // light is (E / pi x directional albedo). Both halves of a split view. A gradient adds its
   // irradiance at this normal, E / pi as a uniform radiance (engine::sky_irradiance:
   // E = pi horizon + (zenith - horizon) K(t) + (ground - horizon) K(pi - t), t = acos(n.y),
-  // K(t) = 2/3 ((pi - t) cos t + sin t)). Unshadowed.
+  // K(t) = 2/3 ((pi - t) cos t + sin t)). Unshadowed on static surfaces; on a dynamic entity
+  // scaled by the provider's measured sky visibility.
   float sky_t = acos(clamp(s.normal.y, -1.0, 1.0));
   float sky_k_up = (2.0 / 3.0) * ((PI - sky_t) * cos(sky_t) + sin(sky_t));
   float sky_k_down = (2.0 / 3.0) * (sky_t * cos(PI - sky_t) + sin(sky_t));
   vec3 sky_l = u_sky_radiance + max(u_sky_gradient[0] + (u_sky_gradient[1] * sky_k_up + u_sky_gradient[2] * sky_k_down) / PI,
                                     vec3(0.0));
+  vec3 n2 = s.normal * s.normal;
+  sky_l *= dot(n2, mix(u_sky_visibility_neg, u_sky_visibility_pos, step(vec3(0.0), s.normal)));
   if (any(greaterThan(sky_l, vec3(0.0)))) {
     GltfBrdfValue sky_albedo = gltf_directional_albedo(s.brdf, dot(s.normal, s.view));
     radiance += sky_l * (sky_albedo.diffuse + sky_albedo.specular);

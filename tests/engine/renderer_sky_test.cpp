@@ -1,6 +1,6 @@
 // The renderer's sky term (RenderSettings::sky_radiance / sky_gradient, docs/scene-format.md):
-// a gradient sky lights an upward plane with its analytic irradiance, and the sun's disc
-// widens the shadow edge.
+// a gradient sky lights an upward plane with its analytic irradiance, and a provider's sky visibility (IndirectLightFrame::sky_visibility) darkens the sky
+// term of a dynamic entity and of nothing else.
 #define GL_GLEXT_PROTOTYPES 1
 #include <GL/glcorearb.h>
 #include <engine/gltf_brdf.h>
@@ -16,6 +16,23 @@ namespace {
 using namespace renderer_test;
 
 constexpr float kAlbedo = 0.6f;
+
+// No atlas, no vertex buffer; the dynamic entity's +Y face sees a quarter of the sky.
+class SkyOcclusion : public engine::IndirectLightProvider {
+ public:
+  struct Frame : engine::IndirectLightFrame {
+    engine::Entity dynamic;
+    bool sky_visibility(engine::Entity e, float (&axes)[6]) const override {
+      if (e != dynamic) return false;
+      for (float& a : axes) a = 1.0f;
+      axes[2] = 0.25f;  // +Y
+      return true;
+    }
+  };
+  const engine::IndirectLightFrame& frame() override { return frame_; }
+  const char* label() const override { return "test sky occlusion"; }
+  Frame frame_;
+};
 
 struct TwoPlanes {
   engine::SceneAsset assets;
@@ -51,6 +68,23 @@ TEST(RendererSky, GradientSkyLightsAnUpwardPlaneWithItsIrradiance) {
   const float e_up = engine::sky_irradiance_up(glm::vec3(0.0f), s.assets.environment.sky_gradient).x;
   const float expected = e_up / kPi * s.albedo_at(1.2f);
   EXPECT_NEAR(red(img, s.cam.pixel_of({-1.2f, 0, 0})), expected, 0.01f * expected);
+  EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
+}
+
+TEST(RendererSky, ProviderSkyVisibilityDarkensOnlyTheDynamicEntity) {
+  engine::GpuContext ctx = headless_context();
+  TwoPlanes s;
+  s.assets.environment.sky_radiance = glm::vec3(1.0f);
+  auto r = make_renderer(s.assets, s.cam.size, 0.0f);
+  ASSERT_NE(r, nullptr);
+  SkyOcclusion provider;
+  provider.frame_.dynamic = s.dynamic;
+  r->set_indirect_light(&provider);
+  r->render(s.reg, s.camera);
+  const engine::ImageRgbaF img = r->read_hdr();
+  const float open = 1.0f * s.albedo_at(1.2f);  // L x directional albedo
+  EXPECT_NEAR(red(img, s.cam.pixel_of({-1.2f, 0, 0})), open, 0.01f * open) << "static: unoccluded";
+  EXPECT_NEAR(red(img, s.cam.pixel_of({1.2f, 0, 0})), 0.25f * open, 0.01f * open) << "dynamic: its +Y visibility";
   EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
 }
 

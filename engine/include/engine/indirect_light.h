@@ -68,6 +68,13 @@ struct IndirectLightFrame {
   int directional_bin_count = 0;
   int directional_element_count = 0;
 
+  /// Optional sky occlusion of a dynamic mesh entity (the sky is drawn as unshadowed ambient
+  /// light, RenderSettings::sky_radiance): the share (0..1) of the sky's unoccluded
+  /// irradiance a surface facing +X, -X, +Y, -Y, +Z, -Z gets at the entity, an ambient cube
+  /// the provider measured. The renderer scales the entity's sky term by it, blended by the
+  /// normal's squared components. False: not provided (unoccluded).
+  virtual bool sky_visibility(Entity, float (&/*axes*/)[6]) const { return false; }
+
   IndirectLightFrame() = default;
   IndirectLightFrame(const IndirectLightFrame&) = default;
   IndirectLightFrame& operator=(const IndirectLightFrame&) = default;

@@ -346,6 +346,12 @@ void ForwardRenderer::forward_pass(const Registry& registry, Entity camera, cons
         if (vertex_buffer != 0) mode = kIndirectVertex;
       }
     }
+    {  // The sky's occlusion on a dynamic entity, when the provider measured it (indirect_light.h).
+      float axes[6] = {1.0f, 1.0f, 1.0f, 1.0f, 1.0f, 1.0f};
+      if (indirect != nullptr && !item.is_static) (void)indirect->sky_visibility(item.entity, axes);
+      glUniform3f(64, axes[0], axes[2], axes[4]);
+      glUniform3f(65, axes[1], axes[3], axes[5]);
+    }
     if (vertex_buffer != 0) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kVertexIrradianceBinding, vertex_buffer);
     // Per-vertex view-dependent indirect light (IndirectLightFrame::vertex_radiance_lobes).
     IndirectLightFrame::VertexRadianceLobes lobes;

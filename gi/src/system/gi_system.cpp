@@ -26,6 +26,7 @@
 #include "system/antiradiance_lighting.h"
 #include "system/light_atlas_lighting.h"
 #include "system/prm_lighting.h"
+#include "system/sky_visibility.h"
 #include "transport/static_scene.h"
 
 namespace gi {
@@ -40,6 +41,9 @@ struct SystemFrame final : engine::IndirectLightFrame {
   VertexRadianceLobes vertex_radiance_lobes(engine::Entity e) const override {
     return brf ? brf->vertex_lobes(e) : VertexRadianceLobes{};
   }
+  // The sky's occlusion on dynamic entities (system/sky_visibility.h), under a sky only.
+  const SkyVisibility* sky = nullptr;
+  bool sky_visibility(engine::Entity e, float (&axes)[6]) const override { return sky && sky->get(e, axes); }
 };
 
 }  // namespace
@@ -50,6 +54,7 @@ struct GISystem::Impl {
   std::unique_ptr<BrfLighting> brf;
   std::unique_ptr<DlmLighting> dlm;  // directional light maps of the glossy static surfaces
   std::unique_ptr<AntiradianceLighting> anti;
+  std::unique_ptr<SkyVisibility> sky;  // dynamic entities' sky occlusion, when the scene has a sky
   engine::GlTexture anti_out;
   bool anti_composed = false;
   bool anti_disabled = false;
@@ -285,6 +290,12 @@ engine::Result<std::unique_ptr<GISystem>> GISystem::load(const std::filesystem::
   impl->relabel();
   impl->description = text.str();
   impl->frame.brf = impl->brf.get();
+  if (engine::sky_lit(scene.assets.environment.sky_radiance, scene.assets.environment.sky_gradient)) {
+    auto sky = SkyVisibility::create(scene);  // the renderer's sky term on dynamic entities
+    if (!sky) return sky.error();
+    impl->sky = std::move(sky).value();
+    impl->frame.sky = impl->sky.get();
+  }
   return std::unique_ptr<GISystem>(new GISystem(std::move(impl)));
 }
 
@@ -385,6 +396,7 @@ const engine::IndirectLightFrame& GISystem::frame() {
     }
   }
   m.composed = true;
+  if (m.sky) m.sky->update();
   if (m.dlm) m.dlm->fill(m.frame);
   if (!work) ++m.stats.idle_frames;
   return m.frame;
