@@ -413,6 +413,18 @@ engine::Result<BakeReport> bake_bundle(const BakeInput& input, const fs::path& b
       return engine::invalid_request("method '" + key +
                                      "' is not available in this build (available: atlas, prm, dlm, brf, antiradiance)");
 
+  // The sky in a PRM bake (docs/prm.md "The sky"): the sky is a static source, so its light
+  // lives in the light atlas the PRM provider composes with (the atlas's final gather
+  // resolves it per texel, the PRM's entry points only per cluster and compete for the K
+  // active panes). A PRM asked for alone on a sky-lit scene bakes that atlas too, first.
+  if (engine::sky_lit(input.environment.sky_radiance, input.environment.sky_gradient) &&
+      std::find(methods.begin(), methods.end(), "prm") != methods.end() &&
+      std::find(methods.begin(), methods.end(), "atlas") == methods.end()) {
+    methods.insert(methods.begin(), "atlas");
+    if (host.log)
+      host.log(LogLevel::Info, "baking the light atlas too: it carries the sky the PRM composes with (docs/prm.md)");
+  }
+
   if (methods.empty()) return report;
   auto staged = StagedBundle::begin(bundle_dir);
   if (!staged) return staged.error();
