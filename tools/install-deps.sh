@@ -1,6 +1,9 @@
 #!/usr/bin/env bash
 # Installs every build and test dependency of the project from Debian's packages.
 # Idempotent: packages already present are left alone; `apt-get update` runs once.
+# clang, libclang-rt-14-dev (libFuzzer and clang's sanitizer runtimes, only recommended by
+# clang) and llvm (llvm-symbolizer for sanitizer stack traces) build the fuzz targets
+# (tools/fuzz.sh); the regular build stays GCC.
 # python3-matplotlib draws the sweep plots (tools/plot-sweep.py); nothing in the build needs it.
 set -euo pipefail
 packages=(
@@ -10,6 +13,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libeigen3-dev libzstd-dev libtinyexr-dev libcli11-dev libimgui-dev libtbb-dev libxxhash-dev
   xvfb xauth
+  clang libclang-rt-14-dev llvm
   python3-matplotlib
 )
 missing=()

@@ -1,0 +1,69 @@
+#!/usr/bin/env bash
+# Regenerates the fuzz seed corpus tests/fuzz/corpus/ (tests/fuzz/README.md) from the project's
+# assets and tiny bakes by the built gi-bake (GI_BAKE, or BUILD_DIR/tools/gi-bake/gi-bake, build/ by default): run it after a bundle
+# file format changes (the ctest Fuzz.<target>.ReplaysSeedsAndRegressions then refuses a seed).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+root=$(pwd)
+bake=${GI_BAKE:-"$root/${BUILD_DIR:-build}/tools/gi-bake/gi-bake"}
+[ -x "$bake" ] || { echo "fuzz-seeds.sh: build gi-bake first ($bake)" >&2; exit 1; }
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+corpus="$root/tests/fuzz/corpus"
+
+python3 - "$root/assets" "$tmp" <<'PY'
+import base64, json, struct, sys
+assets, out = sys.argv[1] + "/", sys.argv[2] + "/"
+# The Cornell box with its buffer as a data URI (a .gltf that needs no other file).
+g = json.load(open(assets + "cornell_box.gltf"))
+b = open(assets + g["buffers"][0]["uri"], "rb").read()
+g["buffers"][0]["uri"] = "data:application/octet-stream;base64," + base64.b64encode(b).decode()
+open(out + "cornell_box_embedded.gltf", "w").write(json.dumps(g, separators=(",", ":")))
+# The spot chamber packed as a GLB.
+g = json.load(open(assets + "spot_chamber.gltf"))
+b = open(assets + g["buffers"][0]["uri"], "rb").read()
+del g["buffers"][0]["uri"]
+j = json.dumps(g, separators=(",", ":")).encode()
+j += b" " * ((4 - len(j) % 4) % 4)
+b += b"\0" * ((4 - len(b) % 4) % 4)
+glb = struct.pack("<4sII", b"glTF", 2, 12 + 8 + len(j) + 8 + len(b)) + struct.pack("<I4s", len(j), b"JSON") + j
+glb += struct.pack("<I4s", len(b), b"BIN\0") + b
+open(out + "spot_chamber.glb", "wb").write(glb)
+# The Cornell box with its short block deforming (antiradiance) and a glossy red wall (DLM).
+g = json.load(open(assets + "cornell_box.gltf"))
+short = [i for i, m in enumerate(g["meshes"]) if m["name"] == "short_block"][0]
+for n in g["nodes"]:
+    if n.get("mesh") == short:
+        n.setdefault("extras", {}).setdefault("gi", {})["region"] = "deforming"
+g["materials"][1]["pbrMetallicRoughness"]["roughnessFactor"] = 0.2
+json.dump(g, open(out + "cb_deform.gltf", "w"))
+PY
+cp assets/cornell_box.bin "$tmp/"
+
+"$bake" --scene assets/cornell_box.gltf --preset preview --methods atlas,prm --density 2 --vpls 16 --samples 2 \
+  --threads 1 --out "$tmp/atlas_prm.gibake" >/dev/null
+"$bake" --scene assets/crates_room.gltf --preset preview --methods brf --brf-basis 2 --brf-spheres 1 \
+  --threads 1 --out "$tmp/brf.gibake" >/dev/null
+"$bake" --scene "$tmp/cb_deform.gltf" --preset preview --methods antiradiance,dlm --density 2 --dlm-directions 8 \
+  --dlm-photons 2000 --threads 1 --out "$tmp/ar_dlm.gibake" >/dev/null
+"$bake" --scene assets/cornell_box.gltf --preset preview --methods atlas,dlm --density 3 --vpls 64 --dlm-directions 8 \
+  --dlm-photons 2000 --threads 1 --out "$tmp/no_dlm_texels.gibake" >/dev/null
+
+rm -rf "$corpus"
+mkdir -p "$corpus"/{gltf,exr,session,blob,manifest,light_atlas_vpls,prm_panes,brf_mesh,antiradiance,dlm}
+cp assets/crates_room.draco.glb assets/demo_level.draco.glb "$tmp/spot_chamber.glb" "$tmp/cornell_box_embedded.gltf" \
+  "$corpus/gltf/"
+cp "$tmp/atlas_prm.gibake/light_atlas.exr" "$corpus/exr/"
+cp tests/sessions/open_door.girec "$corpus/session/"
+cp "$tmp/ar_dlm.gibake/dlm.bin" "$corpus/blob/dlm.bin"
+cp "$tmp/no_dlm_texels.gibake/dlm.bin" "$corpus/blob/dlm_empty.bin"
+cp "$tmp/atlas_prm.gibake/manifest.json" "$corpus/manifest/atlas_prm.json"
+cp "$tmp/brf.gibake/manifest.json" "$corpus/manifest/brf.json"
+cp "$tmp/ar_dlm.gibake/manifest.json" "$corpus/manifest/antiradiance_dlm.json"
+cp "$tmp/atlas_prm.gibake/light_atlas_vpls.bin" "$corpus/light_atlas_vpls/"
+cp "$tmp/atlas_prm.gibake/prm_panes.bin" "$corpus/prm_panes/"
+cp "$tmp/brf.gibake/brf_crate.bin" "$corpus/brf_mesh/"
+cp "$tmp/ar_dlm.gibake/antiradiance.bin" "$corpus/antiradiance/"
+cp "$tmp/ar_dlm.gibake/dlm.bin" "$corpus/dlm/"
+cp "$tmp/no_dlm_texels.gibake/dlm.bin" "$corpus/dlm/dlm_no_texels.bin"
+echo "fuzz-seeds.sh: $(find "$corpus" -type f | wc -l) seeds, $(du -sh "$corpus" | cut -f1) in $corpus"
