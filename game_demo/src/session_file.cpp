@@ -80,6 +80,8 @@ engine::Result<Session> decode_session(std::span<const std::byte> bytes, const s
                               std::to_string(kSessionFormatVersion) + ")");
   if (!r.get<std::uint32_t>(reserved) || !r.get<std::uint64_t>(stored_sum))
     return fail("header", "truncated: file ends inside the header");
+  // Outside the checksum: a nonzero value would load and be re-saved as 0 (found by fuzzing).
+  if (reserved != 0) return fail("header", "reserved field is " + std::to_string(reserved) + ", must be 0");
 
   Session s;
   SessionHeader& h = s.header;
