@@ -241,6 +241,38 @@ TEST(GltfWriter, RoundTripsEveryFeatureThroughGlb) {
   expect_round_trip(scene, *loaded);
 }
 
+TEST(GltfWriter, MeshWithoutPrimitivesIsLeftOutAndItsNodesKeepNoMesh) {
+  // Found by fuzz_gltf (tests/fuzz/regressions/gltf/): the loader keeps a mesh of only points
+  // or lines (or an unused undecodable one) with no primitives; the writer refused the scene.
+  engine::SceneAsset scene = feature_scene();
+  const std::size_t meshes = scene.meshes.size();
+  ASSERT_GE(meshes, 1u);
+  scene.meshes.insert(scene.meshes.begin(), engine::Mesh{.name = "lines_only"});
+  for (engine::Node& n : scene.nodes)
+    if (n.mesh >= 0) ++n.mesh;
+  scene.nodes.push_back(engine::Node{.name = "wire", .mesh = 0});
+  const fs::path path = temp_dir("empty_mesh") / "scene.glb";
+  const engine::Status st = engine::write_gltf(scene, path, {.binary = true});
+  ASSERT_TRUE(st) << st.error().to_string();
+  auto loaded = engine::load_gltf(path);
+  ASSERT_TRUE(loaded) << loaded.error().to_string();
+  EXPECT_EQ(loaded->meshes.size(), meshes);
+  ASSERT_EQ(loaded->nodes.size(), scene.nodes.size());
+  for (const engine::Node& n : loaded->nodes) {
+    if (n.name == "wire") {
+      EXPECT_EQ(n.mesh, -1);
+    }
+  }
+  // The other nodes still name their meshes, shifted back by the one left out.
+  for (std::size_t i = 0; i + 1 < scene.nodes.size(); ++i) {
+    const engine::Node& before = scene.nodes[i];
+    const auto it = std::find_if(loaded->nodes.begin(), loaded->nodes.end(),
+                                 [&](const engine::Node& n) { return n.name == before.name; });
+    ASSERT_NE(it, loaded->nodes.end()) << before.name;
+    EXPECT_EQ(it->mesh, before.mesh >= 0 ? before.mesh - 1 : -1) << before.name;
+  }
+}
+
 TEST(GltfWriter, WritesPhotometricUnitsAndEmissiveStrength) {
   const fs::path path = temp_dir("units") / "scene.gltf";
   ASSERT_TRUE(engine::write_gltf(feature_scene(), path));

@@ -251,6 +251,7 @@ class GltfBuilder {
   Status write_meshes() {
     if (scene_.meshes.empty()) return {};
     json meshes = json::array();
+    mesh_index_.assign(scene_.meshes.size(), -1);
     for (std::size_t m = 0; m < scene_.meshes.size(); ++m) {
       const Mesh& mesh = scene_.meshes[m];
       json prims = json::array();
@@ -267,12 +268,16 @@ class GltfBuilder {
         if (p.material >= 0) j["material"] = p.material;
         prims.push_back(std::move(j));
       }
-      if (prims.empty()) return error("meshes[" + std::to_string(m) + "]", "mesh has no primitives");
+      // A mesh the loader kept without drawable primitives (only points or lines, or unused
+      // and undecodable) has nothing to write, and glTF wants at least one primitive: it is
+      // left out and its nodes keep no mesh (found by fuzz_gltf: the scene loaded, the write failed).
+      if (prims.empty()) continue;
+      mesh_index_[m] = static_cast<int>(meshes.size());
       json j = {{"primitives", std::move(prims)}};
       if (!mesh.name.empty()) j["name"] = mesh.name;
       meshes.push_back(std::move(j));
     }
-    doc_["meshes"] = std::move(meshes);
+    if (!meshes.empty()) doc_["meshes"] = std::move(meshes);
     return {};
   }
 
@@ -389,7 +394,8 @@ class GltfBuilder {
       if (n.mesh >= static_cast<int>(scene_.meshes.size())) return error(where, "mesh index out of range");
       if (n.camera >= static_cast<int>(scene_.cameras.size())) return error(where, "camera index out of range");
       if (n.light >= static_cast<int>(scene_.lights.size())) return error(where, "light index out of range");
-      if (n.mesh >= 0) j["mesh"] = n.mesh;
+      if (n.mesh >= 0 && mesh_index_[static_cast<std::size_t>(n.mesh)] >= 0)
+        j["mesh"] = mesh_index_[static_cast<std::size_t>(n.mesh)];
       if (n.camera >= 0) j["camera"] = n.camera;
       json gi = json::object();
       if (n.gi.mobility == Mobility::Static) gi["mobility"] = "static";
@@ -422,6 +428,7 @@ class GltfBuilder {
   json accessors_ = json::array();
   BinaryChunk bin_;
   std::vector<int> khr_light_index_;
+  std::vector<int> mesh_index_;  ///< SceneAsset mesh -> written mesh, -1 when left out (no primitives).
   std::set<std::string> used_;
   std::set<std::string> required_;
 };
