@@ -25,6 +25,7 @@ if command -v ccache >/dev/null; then
 fi
 mkdir -p "$build_dir"
 cmake -S . -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g1 -DNDEBUG" -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O2 -g1 -DNDEBUG" \
   -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ -DGI_FUZZ=ON \
   -DGI_BUILD_TESTS=OFF -DGI_BUILD_TOOLS=OFF -DGI_BUILD_BENCHMARKS=OFF -DGI_BUILD_DEMO=ON \
   "${launcher[@]}" >"$build_dir/configure.log" 2>&1 || { cat "$build_dir/configure.log"; exit 1; }

@@ -167,6 +167,7 @@ int main(int argc, char** argv) {
     for (float v : (*renderer)->read_hdr().pixels) non_finite += !std::isfinite(v);
     if (f + 1 == warmup) baseline = rss_mb();
     if (f + 1 > warmup) peak_growth = std::max(peak_growth, rss_mb() - baseline);
+    if ((f + 1) % std::max(1, frames / 10) == 0) std::printf("gi-stress: frame %d, resident %.1f MB\n", f + 1, rss_mb());
   }
   const double end = rss_mb();
   const gi::GISystem::Stats& st = (*gi)->stats();

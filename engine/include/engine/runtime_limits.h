@@ -8,7 +8,7 @@
 // Limits (docs/reliability.md): world coordinates within +-1e6 m (1000 km); every axis of a
 // transform scaled by 1e-6..1e6; light intensity and colour x intensity finite, >= 0 and at
 // most 1e15 (what the glTF reader refuses beyond); range >= 0; cone angles in [0, pi/2];
-// area-light sides in 1e-6..1e6 m.
+// a sun's angular radius in [0, pi/4]; area-light sides in 1e-6..1e6 m.
 
 #include <engine/components.h>
 
@@ -48,6 +48,8 @@ inline const char* unusable_light(const Light& l) {
   if (!(l.inner_cone_rad >= 0.0f && l.inner_cone_rad <= kHalfPi && l.outer_cone_rad >= 0.0f &&
         l.outer_cone_rad <= kHalfPi))
     return "its cone angles are not in [0, pi/2]";
+  if (!(l.angular_radius_rad >= 0.0f && l.angular_radius_rad <= 0.7853982f))
+    return "its angular radius is not in [0, pi/4]";
   if (l.type == LightType::Area)
     for (int i = 0; i < 2; ++i)
       if (!(l.area_size_m[i] >= kMinAxisScale && l.area_size_m[i] <= kMaxAxisScale))
