@@ -1,11 +1,17 @@
 #include "light_atlas/light_atlas.h"
 
+#include <engine/sky.h>
+
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <span>
 
+#include "core/random.h"
 #include "light_atlas/final_shooting.h"
+#include "raytrace/ray_offset.h"
+#include "raytrace/reference_brdf.h"
 #include "transport/point_emitters.h"
 #include "transport/static_scene.h"
 #include "transport/vpl_transport.h"
@@ -66,13 +72,52 @@ struct VplPowers {
   std::uint64_t rays = 0;
 };
 
+// The sky's direct light on every VPL, area-weighted over its sample points: cosine-sampled
+// rays (stratified, one random stream per VPL) that escape the static world bring the sky's radiance,
+// E = pi / M x sum of L(w) over escaping rays. With it the VPL solution — the VPL-shooting
+// atlas's bounces and the world probes built from the VPLs at load, which light dynamic
+// objects — carries the sky's bounce off the static world, as the gather does per texel.
+void add_sky_to_vpls(const BakeScene& b, const VplSet& vpls, std::uint64_t seed, ThreadPool& pool,
+                     std::vector<glm::vec3>& direct, std::uint64_t* rays) {
+  const glm::vec3 uniform = b.scene.sky_radiance;
+  const engine::SkyGradient& gradient = b.scene.sky_gradient;
+  if (!engine::sky_lit(uniform, gradient)) return;
+  constexpr std::uint32_t kRaysPerSample = 16;
+  constexpr std::uint64_t kSkyStream = 0x736b79u;  // "sky"
+  std::atomic<std::uint64_t> traced{0};
+  pool.parallel_for(
+      vpls.size(),
+      [&](std::size_t j) {
+        Pcg32 rng = Pcg32::for_item(seed ^ kSkyStream, j);
+        glm::dvec3 sum(0.0);
+        std::uint64_t local = 0;
+        for (std::uint32_t k = vpls.sample_first[j]; k < vpls.sample_first[j + 1]; ++k) {
+          const glm::vec3& n = vpls.sample_normal[k];
+          const glm::vec3 origin = offset_ray_origin(vpls.sample_position[k], n);
+          glm::vec3 seen(0.0f);
+          for (std::uint32_t r = 0; r < kRaysPerSample; ++r) {  // stratified in the first dimension
+            const float u1 = std::min((static_cast<float>(r) + rng.next_float()) / kRaysPerSample, 0x1.fffffep-1f);
+            const glm::vec3 wi = sample_cosine_hemisphere(n, u1, rng.next_float());
+            ++local;
+            if (!b.caster->occluded(Ray{origin, 0.0f, wi})) seen += engine::sky_radiance(uniform, gradient, wi);
+          }
+          sum += glm::dvec3(seen) * (3.14159265358979 / kRaysPerSample) * static_cast<double>(vpls.sample_area_m2[k]);
+        }
+        direct[j] += glm::vec3(sum / static_cast<double>(vpls.area_m2[j]));
+        traced += local;
+      },
+      16);
+  if (rays) *rays += traced.load();
+}
+
 // Steps 2-3: direct light into the VPLs, then progressive refinement; returns every VPL's
 // reflected power E_i = rho_i A_i I_i.
 engine::Result<VplPowers> light_vpls(const BakeScene& b, const VplSet& vpls, const LightAtlasSettings& s,
                                      ThreadPool& pool, LightAtlasStats* stats) {
   VplPowers out;
   auto t0 = Clock::now();
-  const std::vector<glm::vec3> direct = direct_to_vpls(vpls, b.emitters, *b.caster, pool, &out.rays);
+  std::vector<glm::vec3> direct = direct_to_vpls(vpls, b.emitters, *b.caster, pool, &out.rays);
+  add_sky_to_vpls(b, vpls, s.seed, pool, direct, &out.rays);
   if (stats) stats->direct_seconds = seconds_since(t0);
   if (s.progress && !s.progress(kDirectPhase.end)) return engine::cancelled_error("light-atlas bake");
   t0 = Clock::now();

@@ -169,3 +169,54 @@ TEST(BrfRadianceField, DegenerateRadiiLookupsStayInRange) {
     EXPECT_TRUE(std::isfinite(out[0])) << p.x;
   }
 }
+
+// The sky's bounce reaches dynamic objects: under an open uniform sky of radiance L, a
+// 20 x 20 m floor of albedo 0.5 reflects about 0.5 L (Lambertian), so a point 1 m above its
+// middle facing down gets E = pi x 0.5 L x (the floor's view factor, 0.98) from the world
+// probes — which come from the atlas's VPLs, whose direct light now includes the sky. Facing
+// up it gets none from the world (the sky itself is the renderer's term, not the probes').
+// Without the sky in the VPLs' direct light both are 0.
+TEST(BrfWorldProbes, TheSkysBounceOffTheFloorReachesThem) {
+  engine::SceneAsset a;
+  engine::Primitive p;
+  p.positions = {{-10, 0, -10}, {10, 0, -10}, {10, 0, 10}, {-10, 0, 10}};
+  p.normals.assign(4, glm::vec3(0, 1, 0));
+  p.indices = {0, 3, 2, 0, 2, 1};
+  p.material = 0;
+  a.materials.push_back({.name = "grey", .base_color = glm::vec4(0.5f, 0.5f, 0.5f, 1.0f)});
+  // A 0.2 m tile 4 m up in a corner, facing down: the VPLs' bounds (and the probe grid) get
+  // a height; it casts no shadow worth counting.
+  engine::Primitive tile = p;
+  tile.positions = {{9.6f, 4, 9.6f}, {9.8f, 4, 9.6f}, {9.8f, 4, 9.8f}, {9.6f, 4, 9.8f}};
+  tile.normals.assign(4, glm::vec3(0, -1, 0));
+  tile.indices = {0, 1, 2, 0, 2, 3};
+  a.meshes.push_back({.name = "floor", .primitives = {p, tile}});
+  engine::Node n;
+  n.name = "floor";
+  n.mesh = 0;
+  n.gi.mobility = engine::Mobility::Static;
+  a.nodes.push_back(n);
+  a.environment.sky_radiance = glm::vec3(1.0f);
+  const gi::BakeInput input = gi::bake_input_from(a);
+  gi::LightAtlasSettings s = gi::light_atlas_preset("preview").value();
+  s.texels_per_metre = 2.0f;
+  auto atlas = gi::bake_light_atlas(input, s);
+  ASSERT_TRUE(atlas) << atlas.error().to_string();
+  auto caster = gi::make_static_caster(input);
+  ASSERT_TRUE(caster);
+  auto probes = gi::bake_world_probes(**caster, atlas->vpls, atlas->vpl_power, {.spacing_m = 1.0f});
+  ASSERT_TRUE(probes) << probes.error().to_string();
+  glm::dvec3 power(0.0);
+  for (const glm::vec3& v : atlas->vpl_power) power += glm::dvec3(v);
+  std::printf("%zu VPLs, total power %.2f W; probe grid %d x %d x %d from (%.2f %.2f %.2f)\n", atlas->vpls.size(), power.y,
+              probes->dims.x, probes->dims.y, probes->dims.z, double{probes->origin.x}, double{probes->origin.y},
+              double{probes->origin.z});
+  const glm::vec3 down = probes->irradiance({0.3f, 1.0f, 0.2f}, {0, -1, 0});
+  const glm::vec3 up = probes->irradiance({0.3f, 1.0f, 0.2f}, {0, 1, 0});
+  const float expected = 3.14159265f * 0.5f * 0.98f;
+  std::printf("1 m over the floor under the sky: E facing down %.3f (expected ~%.3f), facing up %.3f\n",
+              double{down.y}, double{expected}, double{up.y});
+  EXPECT_GT(down.y, 0.7f * expected);
+  EXPECT_LT(down.y, 1.3f * expected);
+  EXPECT_LT(up.y, 0.15f * expected);
+}
