@@ -12,7 +12,7 @@ demo="$build_dir/game_demo/gi_demo"
 mkdir -p tests/sessions
 # name:script:frames. The scene path is stored as given, relative to the source tree.
 for spec in walk_flashlight:walk_flashlight:900 push_crates:push_crates:900 split_screen:split_screen:600 \
-            open_door:open_door:160; do
+            open_door:open_door:160 push_crates_wall:crate_to_wall:720; do
   IFS=: read -r name script frames <<<"$spec"
   "$demo" --headless --no-render --scene assets/demo_level.gltf --script "$script" --frames "$frames" \
           --width 320 --height 180 --record "tests/sessions/$name.girec" >/dev/null

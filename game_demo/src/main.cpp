@@ -114,8 +114,8 @@ int main(int argc, char** argv) {
   auto* rec = app.add_option("--record", o.record_file, "Record the inputs and checksums into a .girec session");
   app.add_option("--replay", o.replay_file, "Replay a .girec session, checking every frame's checksum")->excludes(rec);
   app.add_option("--script", o.script,
-                 "Headless input script: tour, walk_flashlight, push_crates, split_screen, open_door, none (a still "
-                 "camera; default: tour on the demo level, none on any other --scene)");
+                 "Headless input script: tour, walk_flashlight, push_crates, split_screen, open_door, crate_to_wall, "
+                 "none (a still camera; default: tour on the demo level, none on any other --scene)");
   app.add_option("--seed", o.seed, "Session seed (recorded in the header and the checksum)");
   app.add_flag("--only-written-frames", o.only_written,
                "Headless: render only the frames --out/--every write (fast golden and approval runs)");

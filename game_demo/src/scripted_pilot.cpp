@@ -13,7 +13,6 @@ namespace game_demo {
 namespace {
 
 constexpr float kPi = 3.14159265358979f;
-constexpr float kWantedPitchRad = -0.12f;  // look slightly down: floor, crates and walls in view
 constexpr std::uint64_t kGiveUpFrames = 60 * 25;
 constexpr std::uint64_t kStuckFrames = 45;
 
@@ -47,7 +46,7 @@ std::vector<std::size_t> visiting_order(const glm::vec3& from, const std::vector
 
 std::optional<Script> script_from_name(std::string_view name) {
   for (Script s : {Script::Tour, Script::WalkFlashlight, Script::PushCrates, Script::SplitScreen, Script::OpenDoor,
-                   Script::None})
+                   Script::CrateToWall, Script::None})
     if (script_name(s) == name) return s;
   return std::nullopt;
 }
@@ -65,6 +64,7 @@ std::string_view script_name(Script s) {
     case Script::PushCrates: return "push_crates";
     case Script::SplitScreen: return "split_screen";
     case Script::OpenDoor: return "open_door";
+    case Script::CrateToWall: return "crate_to_wall";
     case Script::None: return "none";
   }
   return "?";
@@ -74,7 +74,6 @@ ScriptedPilot::ScriptedPilot(const Simulation& sim, Script script, std::uint64_t
     : script_(script), budget_(frames) {
   const engine::Registry& reg = sim.registry();
   const GameplayContext& ctx = sim.context();
-  const PlayerController& pc = reg.get<PlayerController>(ctx.camera);
   const glm::vec3 eye = reg.get<engine::Transform>(ctx.camera).position;
 
   // Walkability grid over the level bounds at eye height.
@@ -88,19 +87,7 @@ ScriptedPilot::ScriptedPilot(const Simulation& sim, Script script, std::uint64_t
     origin_ = glm::vec3(level.min.x, eye.y, level.min.z);
     nx_ = static_cast<int>(std::ceil((level.max.x - level.min.x) / cell_m_)) + 1;
     nz_ = static_cast<int>(std::ceil((level.max.z - level.min.z) / cell_m_)) + 1;
-    free_.assign(static_cast<std::size_t>(nx_) * static_cast<std::size_t>(nz_), 0);
-    std::vector<Aabb> crates;
-    for (engine::Entity c : crates_of(reg)) crates.push_back(crate_box(reg, c, 0.0f));
-    for (int z = 0; z < nz_; ++z)
-      for (int x = 0; x < nx_; ++x) {
-        const glm::vec3 p = cell_center({x, z});
-        // A slightly fattened player box keeps the walk off the walls.
-        const Aabb box{p + pc.box_min_from_eye_m - glm::vec3(0.1f, 0, 0.1f), p + pc.box_max_from_eye_m + glm::vec3(0.1f, 0, 0.1f)};
-        bool ok = box.min.x >= level.min.x && box.max.x <= level.max.x && box.min.z >= level.min.z &&
-                  box.max.z <= level.max.z && !ctx.collision.overlaps_wall(box);
-        for (const Aabb& c : crates) ok = ok && !c.overlaps(box);
-        free_[static_cast<std::size_t>(z) * static_cast<std::size_t>(nx_) + static_cast<std::size_t>(x)] = ok ? 1 : 0;
-      }
+    mark_walkable(sim);
   }
 
   // Waypoints: the centres of large static meshes at eye height (rooms), then crates.
@@ -168,9 +155,124 @@ ScriptedPilot::ScriptedPilot(const Simulation& sim, Script script, std::uint64_t
     case Script::OpenDoor:  // no waypoints: the start faces the door
       key_presses_[static_cast<int>(Key::O)] = {n / 5, 5 * n / 8};
       break;
+    case Script::CrateToWall: {  // no waypoints: next_crate_to_wall plans on the live crate
+      const std::vector<engine::Entity> all = crates_of(reg);
+      for (engine::Entity c : all)
+        if (reg.has<engine::Name>(c) && reg.get<engine::Name>(c).value == "crate_red") wall_crate_ = c;
+      if (!wall_crate_ && !all.empty()) wall_crate_ = all.front();
+      if (wall_crate_) {
+        glm::vec3 d = eye - crate_box(reg, wall_crate_, 0.0f).center();
+        d.y = 0.0f;
+        wall_push_dir_ = glm::length(d) > 1e-4f ? glm::normalize(d) : glm::vec3(-1, 0, 0);
+      }
+      break;
+    }
     case Script::None:  // no waypoints, no keys
       break;
   }
+}
+
+bool ScriptedPilot::follow_path(const glm::vec3& eye, float yaw_rad, float look_rad_per_px, InputFrame& in) {
+  if (path_.empty()) return true;
+  std::size_t best = path_index_;
+  float best_d = std::numeric_limits<float>::max();
+  for (std::size_t k = path_index_; k < std::min(path_.size(), path_index_ + 12); ++k)
+    if (horizontal_distance(eye, path_[k]) < best_d) best_d = horizontal_distance(eye, path_[k]), best = k;
+  path_index_ = best;
+  std::size_t aim_index = path_index_;
+  while (aim_index + 1 < path_.size() && horizontal_distance(eye, path_[aim_index]) < 0.75f) ++aim_index;
+  const glm::vec3 aim = aim_index + 1 >= path_.size() ? path_.back() : path_[aim_index];
+  if (aim_index + 1 >= path_.size() && horizontal_distance(eye, path_.back()) < 0.3f) return true;
+  const float err = wrap_angle(yaw_towards(eye, aim) - yaw_rad);
+  in.mouse_dx_px = std::clamp(-err / look_rad_per_px * 0.2f, -14.0f, 14.0f);
+  if (std::abs(in.mouse_dx_px) < 0.05f) in.mouse_dx_px = 0.0f;
+  if (std::abs(err) < 0.5f) in.keys |= key_bit(Key::W);
+  return false;
+}
+
+// Push the crate along wall_push_dir_ (toward where the player started) until a push moves
+// it less than 5 cm or more than 15 degrees off the push (a wall stopped it or it slid along
+// one), at most six times; then walk to 2.8 m past the crate
+// along the push (the wall's other side) and look back and down at the crate through the wall.
+void ScriptedPilot::next_crate_to_wall(const Simulation& sim, InputFrame& in) {
+  const engine::Registry& reg = sim.registry();
+  if (!wall_crate_) return;
+  const PlayerController& pc = reg.get<PlayerController>(sim.context().camera);
+  const glm::vec3 eye = reg.get<engine::Transform>(sim.context().camera).position;
+  glm::vec3 crate = crate_box(reg, wall_crate_, 0.0f).center();
+  crate.y = eye.y;
+  ++wall_phase_frames_;
+  auto turn_to = [&](float yaw) {
+    const float err = wrap_angle(yaw - pc.yaw_rad);
+    in.mouse_dx_px = std::clamp(-err / pc.look_rad_per_px * 0.2f, -14.0f, 14.0f);
+    if (std::abs(in.mouse_dx_px) < 0.05f) in.mouse_dx_px = 0.0f;
+    return std::abs(err);
+  };
+  auto go = [&](int phase, std::optional<glm::vec3> to) {
+    if (to) mark_walkable(sim);  // the crates have moved since the grid was made
+    wall_phase_ = phase;
+    wall_phase_frames_ = 0;
+    path_ = to ? find_path(eye, *to) : std::vector<glm::vec3>{};
+    path_index_ = 0;
+  };
+  const float push_yaw = yaw_towards(glm::vec3(0.0f), wall_push_dir_);
+  switch (wall_phase_) {
+    case 0:  // walk behind the crate
+      if (wall_phase_frames_ == 1) {
+        mark_walkable(sim);
+        path_ = find_path(eye, crate - wall_push_dir_ * 1.1f);
+        path_index_ = 0;
+      }
+      if (follow_path(eye, pc.yaw_rad, pc.look_rad_per_px, in) || wall_phase_frames_ > kGiveUpFrames) go(1, std::nullopt);
+      break;
+    case 1:  // face along the push and push
+      if (turn_to(push_yaw) < 0.03f) {
+        in.keys |= key_bit(Key::E);
+        wall_crate_at_push_ = crate;
+        ++wall_pushes_;
+        go(2, std::nullopt);
+      }
+      break;
+    case 2:  // watch it slide to rest
+      if (wall_phase_frames_ < 90) break;
+      // Free: the crate went on along the push. Blocked (a wall): it stopped or slid aside.
+      if (const glm::vec3 moved = crate - wall_crate_at_push_;
+          glm::length(moved) > 0.05f && glm::dot(glm::normalize(moved), wall_push_dir_) > 0.966f && wall_pushes_ < 6) {
+        go(0, std::nullopt);
+      } else {
+        go(3, crate + wall_push_dir_ * 2.8f);
+      }
+      break;
+    case 3:  // the wall's other side
+      if (follow_path(eye, pc.yaw_rad, pc.look_rad_per_px, in) || wall_phase_frames_ > kGiveUpFrames) go(4, std::nullopt);
+      break;
+    default: {  // look at the crate's place through the wall, down to the floor where it stands
+      turn_to(yaw_towards(eye, crate));
+      const glm::vec3 bottom = crate_box(reg, wall_crate_, 0.0f).center();
+      wanted_pitch_rad_ = std::atan2(bottom.y - eye.y, std::max(horizontal_distance(eye, crate), 0.5f));
+      break;
+    }
+  }
+}
+
+void ScriptedPilot::mark_walkable(const Simulation& sim) {
+  const engine::Registry& reg = sim.registry();
+  const GameplayContext& ctx = sim.context();
+  const PlayerController& pc = reg.get<PlayerController>(ctx.camera);
+  const Aabb& level = ctx.collision.level_bounds();
+  free_.assign(static_cast<std::size_t>(nx_) * static_cast<std::size_t>(nz_), 0);
+  std::vector<Aabb> crates;
+  for (engine::Entity c : crates_of(reg)) crates.push_back(crate_box(reg, c, 0.0f));
+  for (int z = 0; z < nz_; ++z)
+    for (int x = 0; x < nx_; ++x) {
+      const glm::vec3 p = cell_center({x, z});
+      // A slightly fattened player box keeps the walk off the walls.
+      const Aabb box{p + pc.box_min_from_eye_m - glm::vec3(0.1f, 0, 0.1f), p + pc.box_max_from_eye_m + glm::vec3(0.1f, 0, 0.1f)};
+      bool ok = box.min.x >= level.min.x && box.max.x <= level.max.x && box.min.z >= level.min.z &&
+                box.max.z <= level.max.z && !ctx.collision.overlaps_wall(box);
+      for (const Aabb& c : crates) ok = ok && !c.overlaps(box);
+      free_[static_cast<std::size_t>(z) * static_cast<std::size_t>(nx_) + static_cast<std::size_t>(x)] = ok ? 1 : 0;
+    }
 }
 
 bool ScriptedPilot::walkable(int x, int z) const {
@@ -259,8 +361,12 @@ InputFrame ScriptedPilot::next(const Simulation& sim) {
   const engine::Registry& reg = sim.registry();
   const PlayerController& pc = reg.get<PlayerController>(sim.context().camera);
   const glm::vec3 eye = reg.get<engine::Transform>(sim.context().camera).position;
-  in.mouse_dy_px = std::clamp(-(kWantedPitchRad - pc.pitch_rad) / pc.look_rad_per_px * 0.1f, -6.0f, 6.0f);
+  in.mouse_dy_px = std::clamp(-(wanted_pitch_rad_ - pc.pitch_rad) / pc.look_rad_per_px * 0.1f, -6.0f, 6.0f);
   if (std::abs(in.mouse_dy_px) < 0.05f) in.mouse_dy_px = 0.0f;
+  if (script_ == Script::CrateToWall) {
+    next_crate_to_wall(sim, in);
+    return in;
+  }
   if (frame_ < wait_until_ || waypoints_.empty()) return in;
   if (!has_target_) start_target(sim);
   if (!has_target_) return in;

@@ -28,6 +28,7 @@ TEST(CommittedSessions, WalkFlashlightReplaysToIdenticalChecksums) { expect_repl
 TEST(CommittedSessions, PushCratesReplaysToIdenticalChecksums) { expect_replays("push_crates", 600); }
 TEST(CommittedSessions, SplitScreenReplaysToIdenticalChecksums) { expect_replays("split_screen", 300); }
 TEST(CommittedSessions, OpenDoorReplaysToIdenticalChecksums) { expect_replays("open_door", 160); }
+TEST(CommittedSessions, PushCratesWallReplaysToIdenticalChecksums) { expect_replays("push_crates_wall", 300); }
 
 TEST(CommittedSessions, SessionsExerciseTheirFeatures) {
   // The scripted streams really contain what their names promise.
@@ -83,6 +84,29 @@ TEST(CommittedSessions, PushCratesMovesCrates) {
   for (std::size_t i = 0; i < crates.size(); ++i)
     if (glm::length(sim->registry().get<engine::Transform>(crates[i]).position - before[i]) > 0.3f) ++moved;
   EXPECT_GE(moved, 2);
+}
+
+// push_crates_wall (script crate_to_wall) leaves the red crate against the crate room's wall
+// x = 8.2 and the camera on the hub's side of that wall (x < 8), facing it: its golden frame
+// (tests/golden/goldens.txt) is the wall seen from outside with the crate right behind it.
+TEST(CommittedSessions, PushCratesWallPutsTheRedCrateAgainstTheWallAndTheCameraBehindIt) {
+  const std::filesystem::path file = sessions_dir() / "push_crates_wall.girec";
+  auto session = game_demo::load_session(file);
+  ASSERT_TRUE(session) << session.error().to_string();
+  auto sim = game_demo::simulation_for_session(*session, file.string());
+  ASSERT_TRUE(sim) << sim.error().to_string();
+  const engine::Entity red = engine::find_by_name(sim->registry(), "crate_red");
+  ASSERT_FALSE(red.is_null());
+  (void)game_demo::replay_inputs(*sim, *session);
+  const game_demo::Aabb box = game_demo::crate_box(sim->registry(), red, 0.0f);
+  EXPECT_NEAR(box.min.x, 8.2f, 0.05f);              // against the wall
+  EXPECT_TRUE(box.max.z < 3.4f || box.min.z > 4.6f);  // beside the doorway (z 3.4..4.6), not in it
+  const glm::vec3 eye = sim->registry().get<engine::Transform>(sim->context().camera).position;
+  EXPECT_LT(eye.x, 7.9f);
+  const glm::vec3 view = game_demo::forward_of_yaw(sim->registry().get<game_demo::PlayerController>(sim->context().camera).yaw_rad);
+  glm::vec3 to_crate = box.center() - eye;
+  to_crate.y = 0.0f;
+  EXPECT_GT(glm::dot(glm::normalize(to_crate), view), 0.98f);
 }
 
 }  // namespace

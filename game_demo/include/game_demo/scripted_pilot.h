@@ -24,10 +24,12 @@ enum class Script : std::uint8_t {
   PushCrates,      ///< walk to each crate in turn and push it
   SplitScreen,     ///< walk the rooms toggling the split screen on and off
   OpenDoor,        ///< stand at the start facing the corridor door: close it, then open it
+  CrateToWall,     ///< push the red crate (else the first) toward the start until a wall stops it, then
+                   ///< walk round to the wall's other side and look at it where the crate stands
   None,            ///< no input at all: the scene's own camera, still (gi_demo's default but on the demo level)
 };
 
-/// "tour", "walk_flashlight", "push_crates", "split_screen", "open_door", "none".
+/// "tour", "walk_flashlight", "push_crates", "split_screen", "open_door", "crate_to_wall", "none".
 std::optional<Script> script_from_name(std::string_view name);
 std::string_view script_name(Script s);
 /// gi_demo's script when --script is not given: Tour for the demo level (no --scene, or a
@@ -51,11 +53,18 @@ class ScriptedPilot {
   struct Cell {
     int x = 0, z = 0;
   };
+  /// Marks the grid's cells where the (fattened) player box meets no wall and no crate, at
+  /// the crates' current places.
+  void mark_walkable(const Simulation& sim);
   bool walkable(int x, int z) const;
   std::optional<Cell> nearest_walkable(const glm::vec3& p) const;
   glm::vec3 cell_center(Cell c) const;
   std::vector<glm::vec3> find_path(const glm::vec3& from, const glm::vec3& to) const;
   void start_target(const Simulation& sim);
+  /// CrateToWall's phases (see the enum); returns the input for this frame.
+  void next_crate_to_wall(const Simulation& sim, InputFrame& in);
+  /// Walks along path_ toward its end; true when there (within 0.3 m).
+  bool follow_path(const glm::vec3& eye, float yaw_rad, float look_rad_per_px, InputFrame& in);
 
   Script script_;
   std::uint64_t budget_;
@@ -77,6 +86,15 @@ class ScriptedPilot {
   std::uint64_t target_frames_ = 0;
   std::uint64_t wait_until_ = 0;
   std::vector<std::uint64_t> key_presses_[kKeyCount];
+  // CrateToWall: 0 walk behind the crate, 1 turn and push, 2 watch it slide, 3 walk to the
+  // wall's other side, 4 look at the wall.
+  int wall_phase_ = 0;
+  engine::Entity wall_crate_;
+  glm::vec3 wall_push_dir_{0.0f};
+  glm::vec3 wall_crate_at_push_{0.0f};
+  int wall_pushes_ = 0;
+  float wanted_pitch_rad_ = -0.12f;  // look slightly down: floor, crates and walls in view
+  std::uint64_t wall_phase_frames_ = 0;
 };
 
 }  // namespace game_demo
