@@ -144,4 +144,81 @@ engine::Result<WorldProbeGrid> bake_world_probes(const RayCaster& static_world, 
   return grid;
 }
 
+engine::Result<WorldProbeTransfer> bake_world_probe_transfer(const RayCaster& static_world, const WorldProbeGrid& grid,
+                                                             std::span<const glm::vec3> position,
+                                                             std::span<const glm::vec3> normal,
+                                                             std::span<const float> area_m2, unsigned threads) {
+  const std::size_t n = position.size();
+  if (normal.size() != n || area_m2.size() != n)
+    return engine::Error{.message = "world probe transfer: emitter arrays of different sizes (" + std::to_string(n) +
+                                    " positions, " + std::to_string(normal.size()) + " normals, " +
+                                    std::to_string(area_m2.size()) + " areas)"};
+  for (std::size_t i = 0; i < n; ++i)
+    if (!engine::all_finite(position[i]) || !engine::all_finite(normal[i]) || !std::isfinite(area_m2[i]))
+      return engine::Error{.message = "world probe transfer: emitter " + std::to_string(i) + " has a non-finite value"};
+  WorldProbeTransfer t;
+  t.emitter_count = n;
+  const std::size_t count = grid.probe_count();
+  std::vector<std::vector<std::uint32_t>> seen(count);
+  std::vector<std::vector<std::array<float, 9>>> coeff(count);
+  ThreadPool pool(threads);
+  pool.parallel_for(
+      count,
+      [&](std::size_t k) {
+        if (grid.valid[k] == 0) return;
+        const std::size_t x = k % static_cast<std::size_t>(grid.dims.x);
+        const std::size_t y = (k / static_cast<std::size_t>(grid.dims.x)) % static_cast<std::size_t>(grid.dims.y);
+        const std::size_t z = k / (static_cast<std::size_t>(grid.dims.x) * static_cast<std::size_t>(grid.dims.y));
+        const glm::vec3 p =
+            grid.origin + grid.spacing * glm::vec3(static_cast<float>(x), static_cast<float>(y), static_cast<float>(z));
+        for (std::size_t i = 0; i < n; ++i) {  // as bake_world_probes, with the power left out
+          const glm::vec3 to_probe = p - position[i];
+          const float d2 = glm::dot(to_probe, to_probe);
+          if (!(d2 > 0.0f)) continue;
+          const glm::vec3 w_out = to_probe / std::sqrt(d2);
+          const float cos_v = glm::dot(normal[i], w_out);
+          if (cos_v <= 0.0f) continue;
+          const glm::vec3 start = offset_ray_origin(position[i], normal[i]);
+          if (static_world.occluded(Ray{.origin = start, .t_min = 0.0f, .direction = p - start, .t_max = 1.0f})) continue;
+          const float kernel = cos_v / (std::numbers::pi_v<float> * d2 + area_m2[i]);
+          const auto y_lm = sh_basis(-w_out);
+          std::array<float, 9> c{};
+          for (std::size_t j = 0; j < 9; ++j) c[j] = y_lm[j] * kernel;
+          seen[k].push_back(static_cast<std::uint32_t>(i));
+          coeff[k].push_back(c);
+        }
+      },
+      4);
+  t.first.assign(count + 1, 0);
+  for (std::size_t k = 0; k < count; ++k) t.first[k + 1] = t.first[k] + static_cast<std::uint32_t>(seen[k].size());
+  t.emitter.reserve(t.first[count]);
+  t.coefficient.reserve(t.first[count]);
+  for (std::size_t k = 0; k < count; ++k) {
+    t.emitter.insert(t.emitter.end(), seen[k].begin(), seen[k].end());
+    t.coefficient.insert(t.coefficient.end(), coeff[k].begin(), coeff[k].end());
+  }
+  return t;
+}
+
+engine::Result<std::vector<std::array<glm::vec3, 9>>> reproject_world_probes(const WorldProbeTransfer& transfer,
+                                                                             std::span<const glm::vec3> power) {
+  if (power.size() != transfer.emitter_count)
+    return engine::Error{.message = "world probe reprojection: " + std::to_string(power.size()) + " powers for " +
+                                    std::to_string(transfer.emitter_count) + " emitters"};
+  for (std::size_t i = 0; i < power.size(); ++i)
+    if (!engine::all_finite(power[i]))
+      return engine::Error{.message = "world probe reprojection: emitter " + std::to_string(i) + " has a non-finite power"};
+  const std::size_t count = transfer.first.empty() ? 0 : transfer.first.size() - 1;
+  std::vector<std::array<glm::vec3, 9>> sh(count);
+  for (std::size_t k = 0; k < count; ++k) {
+    std::array<glm::vec3, 9> acc{};
+    for (std::uint32_t e = transfer.first[k]; e < transfer.first[k + 1]; ++e) {
+      const glm::vec3 phi = power[transfer.emitter[e]];
+      for (std::size_t j = 0; j < 9; ++j) acc[j] += transfer.coefficient[e][j] * phi;
+    }
+    sh[k] = acc;
+  }
+  return sh;
+}
+
 }  // namespace gi

@@ -65,4 +65,33 @@ engine::Result<WorldProbeGrid> bake_world_probes(const RayCaster& static_world, 
                                                  std::span<const glm::vec3> vpl_power,
                                                  const WorldProbeSettings& settings);
 
+/// The probes' light from other emitters than the atlas's VPLs, whose power changes at run
+/// time (the PRM's entry points lit by moving lights: albedo x irradiance x area is the first
+/// bounce's power, docs/brf.md): a sparse linear map from emitter power to each valid probe's
+/// radiance SH, with the same regularized kernel and shadow rays as bake_world_probes. Built
+/// once; re-projecting new powers casts no ray.
+//   auto t = gi::bake_world_probe_transfer(*caster, grid, pos, nrm, area).value();
+//   auto sh = gi::reproject_world_probes(t, power).value();   // per probe, add to grid.radiance_sh
+struct WorldProbeTransfer {
+  std::vector<std::uint32_t> first;                ///< probe_count + 1: probe p's entries [first[p], first[p + 1]).
+  std::vector<std::uint32_t> emitter;              ///< Per entry: the emitter it sees.
+  std::vector<std::array<float, 9>> coefficient;  ///< Per entry: cos / (pi d^2 + A) x Y_j(probe -> emitter).
+  std::size_t emitter_count = 0;
+  std::size_t bytes() const {
+    return first.size() * sizeof(first[0]) + emitter.size() * sizeof(emitter[0]) + coefficient.size() * sizeof(coefficient[0]);
+  }
+};
+
+/// For every valid probe of `grid`, the emitters (position, unit normal, area) it sees past the
+/// static world. Errors: arrays of different sizes, non-finite values.
+engine::Result<WorldProbeTransfer> bake_world_probe_transfer(const RayCaster& static_world, const WorldProbeGrid& grid,
+                                                             std::span<const glm::vec3> position,
+                                                             std::span<const glm::vec3> normal,
+                                                             std::span<const float> area_m2, unsigned threads = 0);
+
+/// Radiance SH per probe (zeros for invalid probes) from the emitters' power (W, RGB).
+/// Errors: a power count other than the transfer's emitter count, non-finite power.
+engine::Result<std::vector<std::array<glm::vec3, 9>>> reproject_world_probes(const WorldProbeTransfer& transfer,
+                                                                             std::span<const glm::vec3> power);
+
 }  // namespace gi

@@ -115,6 +115,43 @@ TEST(BrfWorldProbes, ProbesSitInsideTheRoomAndOutsideOnesAreInvalid) {
   EXPECT_EQ(b.probes.irradiance({NAN, 0.0f, 0.0f}, {0, 1, 0}), glm::vec3(0.0f));
 }
 
+// The transfer is bake_world_probes with the power factored out: re-projecting the atlas's
+// VPL powers gives the baked probes' SH, and re-projecting other powers (a "moving light"
+// relighting a few VPLs) gives what baking with those powers gives, with no ray cast.
+TEST(BrfWorldProbes, TransferReprojectsWhatBakingWithThePowersGives) {
+  const auto& b = box_with_probes();
+  auto caster = gi::make_static_caster(gi::bake_input_from(b.scene)).value();
+  const gi::VplSet& v = b.atlas.vpls;
+  const gi::WorldProbeTransfer t =
+      gi::bake_world_probe_transfer(*caster, b.probes, v.position, v.normal, v.area_m2).value();
+  std::size_t valid = 0;
+  for (std::uint8_t f : b.probes.valid) valid += f;
+  std::printf("transfer: %zu probes (%zu valid), %zu VPLs, %zu entries, %.2f MB\n", b.probes.probe_count(), valid, v.size(),
+              t.emitter.size(), static_cast<double>(t.bytes()) / 1e6);
+  const auto check = [&](const std::vector<glm::vec3>& power, const gi::WorldProbeGrid& baked) {
+    const auto sh = gi::reproject_world_probes(t, power).value();
+    ASSERT_EQ(sh.size(), baked.probe_count());
+    double worst = 0.0, largest = 0.0;
+    for (std::size_t k = 0; k < sh.size(); ++k)
+      for (std::size_t j = 0; j < 9; ++j) {
+        if (baked.valid[k] == 0) continue;
+        worst = std::max(worst, double{glm::length(sh[k][j] - baked.radiance_sh[k][j])});
+        largest = std::max(largest, double{glm::length(baked.radiance_sh[k][j])});
+      }
+    EXPECT_GT(largest, 0.0);
+    EXPECT_LT(worst, 1e-4 * largest);
+  };
+  check(b.atlas.vpl_power, b.probes);
+  std::vector<glm::vec3> relit(v.size(), glm::vec3(0.0f));
+  for (std::size_t i = 0; i < v.size(); i += 7) relit[i] = glm::vec3(3.0f, 1.0f, 0.5f) * (1.0f + static_cast<float>(i % 5));
+  check(relit, gi::bake_world_probes(*caster, v, relit, {.spacing_m = 0.5f}).value());
+  EXPECT_FALSE(gi::reproject_world_probes(t, std::vector<glm::vec3>(v.size() + 1)).ok());
+  std::vector<glm::vec3> nan_power(v.size(), glm::vec3(0.0f));
+  nan_power[0].x = std::nanf("");
+  EXPECT_FALSE(gi::reproject_world_probes(t, nan_power).ok());
+  EXPECT_FALSE(gi::bake_world_probe_transfer(*caster, b.probes, v.position, v.normal, std::span<const float>()).ok());
+}
+
 TEST(BrfWorldProbes, BadInputIsAnError) {
   const engine::Scene scene = engine::instantiate(latest::closed_box(2.0f, 0.6f));
   auto caster = gi::make_static_caster(gi::bake_input_from(scene)).value();
