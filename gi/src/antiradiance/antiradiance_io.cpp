@@ -9,6 +9,7 @@
 
 #include "bundle/geometry_hash.h"
 #include "bundle/manifest.h"
+#include "io/zstd_stream.h"
 
 namespace gi {
 
@@ -285,32 +286,11 @@ engine::Result<AntiradianceFile> read_antiradiance(const fs::path& path) {
     return file_error(path, "", "truncated: a field or array runs past the end of the payload");
   if (!r.done()) return file_error(path, "", "trailing bytes after the last array");
   // The link planes: one zstd frame of exactly link_count x 14 bytes.
-  const unsigned long long content = ZSTD_getFrameContentSize(frame.data(), frame.size());
-  if (content == ZSTD_CONTENTSIZE_ERROR || content == ZSTD_CONTENTSIZE_UNKNOWN)
-    return file_error(path, "static_links", "the link data is not a zstd frame with a recorded size (corrupt)");
-  if (content > kMaxDecompressedBytes)
-    return file_error(path, "static_links",
-                      "the zstd frame would decompress to " + std::to_string(content) + " bytes, above the " +
-                          std::to_string(kMaxDecompressedBytes) + "-byte limit of a bake stream");
-  if (link_count > (std::uint64_t{1} << 40) / kLinkPlaneBytes || content != link_count * kLinkPlaneBytes)
-    return file_error(path, "static_links",
-                      "the zstd frame holds " + std::to_string(content) + " bytes, " + std::to_string(link_count) +
-                          " links need " + std::to_string(link_count * kLinkPlaneBytes));
-  const std::size_t frame_bytes = ZSTD_findFrameCompressedSize(frame.data(), frame.size());
-  if (ZSTD_isError(frame_bytes) != 0 || frame_bytes != frame.size())
-    return file_error(path, "static_links", "the link data is not exactly one zstd frame (corrupt)");
-  // A zstd block holds at most 128 KiB and takes at least 4 bytes: a frame claiming more is
-  // corrupt (checked before allocating what it claims).
-  if (content / 131072 > frame.size() / 4 + 1)
-    return file_error(path, "static_links", "the zstd frame is too small for the size it claims (corrupt)");
-  std::vector<std::uint8_t> planes(static_cast<std::size_t>(content));
-  const std::size_t unpacked = ZSTD_decompress(planes.data(), planes.size(), frame.data(), frame.size());
-  if (ZSTD_isError(unpacked) != 0)
-    return file_error(path, "static_links", std::string("zstd decompression failed: ") + ZSTD_getErrorName(unpacked));
-  if (unpacked != planes.size())
-    return file_error(path, "static_links",
-                      "decompressed " + std::to_string(unpacked) + " bytes, " + std::to_string(planes.size()) + " expected");
-  f.bake.static_links.links = links_from_planes(planes, static_cast<std::size_t>(link_count));
+  if (link_count > (std::uint64_t{1} << 40) / kLinkPlaneBytes)
+    return file_error(path, "static_links", std::to_string(link_count) + " links is beyond any bake (corrupt)");
+  auto planes = read_zstd_stream(path, "static_links", frame, link_count * kLinkPlaneBytes);
+  if (!planes) return planes.error();
+  f.bake.static_links.links = links_from_planes(*planes, static_cast<std::size_t>(link_count));
   s.bins_per_side = bins;
   s.iterations = iterations;
   s.antiradiance_steps = steps;

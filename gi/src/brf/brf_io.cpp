@@ -12,6 +12,7 @@
 
 #include "bundle/bundle.h"
 #include "io/json_fields.h"
+#include "io/zstd_stream.h"
 
 namespace gi {
 
@@ -302,31 +303,9 @@ engine::Result<BrfMeshBake> read_brf_mesh(const fs::path& path) {
     return file_error(path, "coefficient_bytes",
                       "the file says " + str(coefficient_bytes) + " coefficient bytes, " + str(values) +
                           " float32 values (" + str(values * 4) + " bytes) expected");
-  const unsigned long long content = ZSTD_getFrameContentSize(frame.data(), frame.size());
-  if (content == ZSTD_CONTENTSIZE_ERROR || content == ZSTD_CONTENTSIZE_UNKNOWN)
-    return file_error(path, "coefficients", "not a zstd frame with a recorded size (corrupt)");
-  if (content > kMaxDecompressedBytes)
-    return file_error(path, "coefficients",
-                      "the zstd frame would decompress to " + str(content) + " bytes, above the " +
-                          str(kMaxDecompressedBytes) + "-byte limit of a bake stream");
-  if (content != coefficient_bytes)
-    return file_error(path, "coefficients",
-                      "the zstd frame holds " + str(content) + " bytes, the header says " + str(coefficient_bytes));
-  const std::size_t frame_bytes = ZSTD_findFrameCompressedSize(frame.data(), frame.size());
-  if (ZSTD_isError(frame_bytes) != 0 || frame_bytes != frame.size())
-    return file_error(path, "coefficients", "not exactly one zstd frame (corrupt)");
-  // A zstd block holds at most 128 KiB and takes at least 4 bytes, so a frame claiming more
-  // than that is corrupt: checked before allocating what it claims.
-  if (content / 131072 > frame.size() / 4 + 1)
-    return file_error(path, "coefficients", "the zstd frame is too small for the size it claims (corrupt)");
-  std::vector<std::uint8_t> planes(static_cast<std::size_t>(coefficient_bytes));
-  const std::size_t unpacked = ZSTD_decompress(planes.data(), planes.size(), frame.data(), frame.size());
-  if (ZSTD_isError(unpacked) != 0)
-    return file_error(path, "coefficients", std::string("zstd decompression failed: ") + ZSTD_getErrorName(unpacked));
-  if (unpacked != planes.size())
-    return file_error(path, "coefficients",
-                      "decompressed " + str(unpacked) + " bytes, " + str(planes.size()) + " expected");
-  f.coefficients = from_planes(planes);
+  auto planes = read_zstd_stream(path, "coefficients", frame, coefficient_bytes);
+  if (!planes) return planes.error();
+  f.coefficients = from_planes(*planes);
   if (std::string problem = check_bake(out); !problem.empty()) return file_error(path, "", problem);
   return out;
 }

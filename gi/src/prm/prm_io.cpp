@@ -14,6 +14,7 @@
 
 #include "bundle/bundle.h"
 #include "io/json_fields.h"
+#include "io/zstd_stream.h"
 #include "uv/atlas_input.h"
 
 namespace gi {
@@ -330,30 +331,9 @@ engine::Result<PrmPaneFile> read_prm_panes(const fs::path& path) {
                       "the file says " + std::to_string(pane_half_bytes) + " bytes of halves, " +
                           std::to_string(cluster_count) + " clusters x " + str(p.texels.size()) +
                           " texels x 3 x 2 = " + std::to_string(values * 2) + " expected");
-  const unsigned long long content = ZSTD_getFrameContentSize(frame.data(), frame.size());
-  if (content == ZSTD_CONTENTSIZE_ERROR || content == ZSTD_CONTENTSIZE_UNKNOWN)
-    return file_error(path, "panes", "the pane data is not a zstd frame with a recorded size (corrupt)");
-  if (content > kMaxDecompressedBytes)
-    return file_error(path, "panes",
-                      "the zstd frame would decompress to " + std::to_string(content) + " bytes, above the " +
-                          std::to_string(kMaxDecompressedBytes) + "-byte limit of a bake stream");
-  if (content != pane_half_bytes)
-    return file_error(path, "panes",
-                      "the zstd frame holds " + std::to_string(content) + " bytes, the header says " +
-                          std::to_string(pane_half_bytes));
-  const std::size_t frame_bytes = ZSTD_findFrameCompressedSize(frame.data(), frame.size());
-  if (ZSTD_isError(frame_bytes) != 0 || frame_bytes != frame.size())
-    return file_error(path, "panes", "the pane data is not exactly one zstd frame (corrupt)");
-  // A zstd block holds at most 128 KiB and takes at least 4 bytes (an RLE block), so a frame
-  // claiming more is corrupt: checked before allocating what it claims.
-  if (content / 131072 > frame.size() / 4 + 1)
-    return file_error(path, "panes", "the zstd frame is too small for the size it claims (corrupt)");
-  std::vector<std::uint8_t> planes(static_cast<std::size_t>(pane_half_bytes));
-  const std::size_t unpacked = ZSTD_decompress(planes.data(), planes.size(), frame.data(), frame.size());
-  if (ZSTD_isError(unpacked) != 0)
-    return file_error(path, "panes", std::string("zstd decompression failed: ") + ZSTD_getErrorName(unpacked));
-  if (unpacked != planes.size())
-    return file_error(path, "panes", "decompressed " + str(unpacked) + " bytes, " + str(planes.size()) + " expected");
+  auto unpacked = read_zstd_stream(path, "panes", frame, pane_half_bytes);
+  if (!unpacked) return unpacked.error();
+  const std::vector<std::uint8_t>& planes = *unpacked;
 
   const std::size_t total = static_cast<std::size_t>(values);
   const std::size_t per_pane = p.texels.size() * 3;
