@@ -12,9 +12,8 @@
 #include <cstring>
 #include <ctime>
 #include <string>
-#include <utility>
-
 #include <thread>
+#include <utility>
 
 #include "antiradiance/antiradiance_io.h"
 #include "antiradiance/antiradiance_region.h"
@@ -23,9 +22,9 @@
 #include "brf/brf_mesh.h"
 #include "bundle/geometry_hash.h"
 #include "bundle/manifest.h"
+#include "core/thread_pool.h"
 #include "dlm/dlm.h"
 #include "dlm/dlm_io.h"
-#include "core/thread_pool.h"
 #include "io/atomic_file.h"
 #include "io/blob_file.h"
 #include "light_atlas/light_atlas.h"
