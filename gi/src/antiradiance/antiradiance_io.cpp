@@ -1,7 +1,6 @@
 #include "antiradiance/antiradiance_io.h"
 
 #include <nlohmann/json.hpp>
-#include <zstd.h>
 
 #include <cmath>
 #include <cstring>
@@ -246,19 +245,10 @@ engine::Status write_antiradiance(const fs::path& path, const AntiradianceBake& 
   w.array(h.object_area);
   // The static links, most of the file: their planes as one zstd frame.
   const std::vector<std::uint8_t> planes = link_planes(b.static_links.links);
-  std::vector<std::uint8_t> frame(ZSTD_compressBound(planes.size()));
-  ZSTD_CCtx* cctx = ZSTD_createCCtx();
-  if (cctx == nullptr) return file_error(path, "", "cannot create a zstd compression context");
-  ZSTD_CCtx_setParameter(cctx, ZSTD_c_compressionLevel, kZstdLevel);
-  ZSTD_CCtx_setParameter(cctx, ZSTD_c_checksumFlag, 1);
-  ZSTD_CCtx_setParameter(cctx, ZSTD_c_contentSizeFlag, 1);
-  const std::size_t packed = ZSTD_compress2(cctx, frame.data(), frame.size(), planes.data(), planes.size());
-  ZSTD_freeCCtx(cctx);
-  if (ZSTD_isError(packed) != 0)
-    return file_error(path, "", std::string("zstd compression failed: ") + ZSTD_getErrorName(packed));
-  frame.resize(packed);
+  auto frame = write_zstd_stream(path, planes, kZstdLevel);
+  if (!frame) return frame.error();
   w.put(static_cast<std::uint64_t>(b.static_links.links.size()));
-  w.array(frame);
+  w.array(*frame);
   w.array(b.baseline);
   return write_blob(path, kAntiradianceMagic, kAntiradianceVersion, w.bytes);
 }

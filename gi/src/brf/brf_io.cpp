@@ -2,7 +2,6 @@
 
 #include <engine/byte_stream.h>
 #include <engine/finite.h>
-#include <zstd.h>
 
 #include <cmath>
 #include <cstring>
@@ -201,18 +200,10 @@ engine::Status write_brf_mesh(const fs::path& path, const BrfMeshBake& bake, std
   if (std::string problem = check_bake(bake); !problem.empty())
     return file_error(path, "", "cannot save the basis radiance field: " + problem);
   const std::vector<std::uint8_t> planes = to_planes(bake.field.coefficients);
-  std::vector<std::uint8_t> frame(ZSTD_compressBound(planes.size()));
-  ZSTD_CCtx* cctx = ZSTD_createCCtx();
-  if (cctx == nullptr) return file_error(path, "", "cannot create a zstd compression context");
-  ZSTD_CCtx_setParameter(cctx, ZSTD_c_compressionLevel, kZstdLevel);
-  ZSTD_CCtx_setParameter(cctx, ZSTD_c_checksumFlag, 1);
-  ZSTD_CCtx_setParameter(cctx, ZSTD_c_contentSizeFlag, 1);
-  const std::size_t packed = ZSTD_compress2(cctx, frame.data(), frame.size(), planes.data(), planes.size());
-  ZSTD_freeCCtx(cctx);
-  if (ZSTD_isError(packed) != 0)
-    return file_error(path, "", std::string("zstd compression failed: ") + ZSTD_getErrorName(packed));
-  frame.resize(packed);
-  if (compressed_bytes != nullptr) *compressed_bytes = packed;
+  auto packed = write_zstd_stream(path, planes, kZstdLevel);
+  if (!packed) return packed.error();
+  const std::vector<std::uint8_t>& frame = *packed;
+  if (compressed_bytes != nullptr) *compressed_bytes = frame.size();
 
   const BrfBasis& b = bake.basis;
   const BasisRadianceField& f = bake.field;

@@ -1,6 +1,8 @@
 #pragma once
-// The one zstd stream a bake file may hold (PRM panes, BRF coefficients, antiradiance links),
-// checked before anything is allocated for it and then decompressed:
+// The one zstd stream a bake file may hold (PRM panes, BRF coefficients, antiradiance links):
+// written as one frame recording its size and checksum, read back checked before anything
+// is allocated for it:
+//   auto frame = gi::write_zstd_stream(path, planes, 9);
 //   auto planes = gi::read_zstd_stream(path, "panes", frame, clusters * texels * 6);
 //   if (!planes) return planes.error();
 // Header-only: the readers that use it link zstd (gi_core does not).
@@ -17,6 +19,24 @@
 #include "io/blob_file.h"
 
 namespace gi {
+
+/// Compresses `bytes` at `level` into one zstd frame with its content size and checksum
+/// recorded (what read_zstd_stream requires). Errors name `path`.
+inline engine::Result<std::vector<std::uint8_t>> write_zstd_stream(const std::filesystem::path& path,
+                                                                   std::span<const std::uint8_t> bytes, int level) {
+  const auto error = [&](const std::string& message) { return engine::Error{path.string(), "", message}; };
+  std::vector<std::uint8_t> frame(ZSTD_compressBound(bytes.size()));
+  ZSTD_CCtx* cctx = ZSTD_createCCtx();
+  if (cctx == nullptr) return error("cannot create a zstd compression context");
+  ZSTD_CCtx_setParameter(cctx, ZSTD_c_compressionLevel, level);
+  ZSTD_CCtx_setParameter(cctx, ZSTD_c_checksumFlag, 1);
+  ZSTD_CCtx_setParameter(cctx, ZSTD_c_contentSizeFlag, 1);
+  const std::size_t packed = ZSTD_compress2(cctx, frame.data(), frame.size(), bytes.data(), bytes.size());
+  ZSTD_freeCCtx(cctx);
+  if (ZSTD_isError(packed) != 0) return error(std::string("zstd compression failed: ") + ZSTD_getErrorName(packed));
+  frame.resize(packed);
+  return frame;
+}
 
 /// Decompresses `frame`, which must be exactly one zstd frame recording its content size,
 /// that size equal to `expected` (what the file's own counts need) and at most

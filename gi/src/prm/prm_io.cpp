@@ -2,7 +2,6 @@
 
 #include <engine/byte_stream.h>
 #include <engine/finite.h>
-#include <zstd.h>
 
 #include <algorithm>
 #include <bit>
@@ -226,17 +225,10 @@ engine::Status write_prm_panes(const fs::path& path, const Prm& prm, const std::
   if (std::string problem = encode_panes(prm, scales, planes); !problem.empty())
     return file_error(path, "", "cannot save the PRM: " + problem);
 
-  std::vector<std::byte> frame(ZSTD_compressBound(planes.size()));
-  ZSTD_CCtx* cctx = ZSTD_createCCtx();
-  if (cctx == nullptr) return file_error(path, "", "cannot create a zstd compression context");
-  ZSTD_CCtx_setParameter(cctx, ZSTD_c_compressionLevel, kZstdLevel);
-  ZSTD_CCtx_setParameter(cctx, ZSTD_c_checksumFlag, 1);
-  ZSTD_CCtx_setParameter(cctx, ZSTD_c_contentSizeFlag, 1);
-  const std::size_t packed = ZSTD_compress2(cctx, frame.data(), frame.size(), planes.data(), planes.size());
-  ZSTD_freeCCtx(cctx);
-  if (ZSTD_isError(packed) != 0)
-    return file_error(path, "", std::string("zstd compression failed: ") + ZSTD_getErrorName(packed));
-  frame.resize(packed);
+  auto packed = write_zstd_stream(
+      path, std::span<const std::uint8_t>(reinterpret_cast<const std::uint8_t*>(planes.data()), planes.size()), kZstdLevel);
+  if (!packed) return packed.error();
+  const std::vector<std::uint8_t>& frame = *packed;
 
   const PrmSettings& s = prm.settings;
   std::vector<glm::vec3> position, normal;
@@ -268,7 +260,7 @@ engine::Status write_prm_panes(const fs::path& path, const Prm& prm, const std::
   w.put_array(prm.cluster_size);
   w.put_array(scales);
   w.put(static_cast<std::uint64_t>(planes.size()));
-  w.put_array(std::span<const std::uint8_t>(reinterpret_cast<const std::uint8_t*>(frame.data()), frame.size()));
+  w.put_array(std::span<const std::uint8_t>(frame));
   return write_blob(path, kPrmPanesMagic, kPrmPanesVersion, w.bytes());
 }
 
