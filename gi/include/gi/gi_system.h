@@ -72,6 +72,8 @@ class GISystem final : public engine::IndirectLightProvider {
     std::uint64_t frames = 0;
     std::uint64_t idle_frames = 0;        ///< Frames on which nothing was recomputed.
     std::uint64_t prm_updates = 0;        ///< Frames on which a moving light re-summed the PRM.
+    std::uint64_t prm_probe_updates = 0;  ///< ... and re-projected its entry points into the BRF world probes.
+    double last_prm_probe_ms = 0.0;       ///< That re-projection (CPU).
     std::uint64_t brf_updates = 0;        ///< Frames on which the dynamic objects' light was recomputed.
     std::uint64_t brf_moves = 0;          ///< ... of which at least one object had moved.
     std::uint64_t world_composites = 0;   ///< Frames on which the objects' bounce was re-added to the atlas.

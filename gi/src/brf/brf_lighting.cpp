@@ -62,6 +62,9 @@ struct BrfLighting::Impl {
   std::vector<std::vector<glm::vec3>> world_incoming;  // probe light per instance vertex
   std::uint64_t last_lights = 0;
   bool computed = false;
+  // The probes' static light (as baked), kept when moving light is added on top of it.
+  std::vector<std::array<glm::vec3, 9>> static_probe_sh;
+  bool world_light_changed = false;  // set_moving_world_light since the last update
   Stats stats;
 
   /// Turns the fields off for good, telling the host why. Returns false.
@@ -181,7 +184,9 @@ bool BrfLighting::update() {
     }
   }
   const std::uint64_t lights = lights_signature(*m.registry);
-  if (m.computed && !any_moved && lights == m.last_lights) {
+  const bool world_changed = m.world_light_changed;
+  m.world_light_changed = false;
+  if (m.computed && !any_moved && !world_changed && lights == m.last_lights) {
     ++m.stats.skipped;
     return false;
   }
@@ -200,9 +205,10 @@ bool BrfLighting::update() {
   for (ReferenceLight& l : scene_lights(*m.registry, BakeLights::Moving)) all.push_back(l);
   const std::vector<PointEmitter> emitters = light_point_emitters(all, m.settings.area_light_samples, 1);
   std::vector<std::vector<glm::vec3>> incoming = brf_direct_light(objects, emitters, m.world.caster.get());
-  // The static world's light, re-read from the probes where an object moved.
+  // The static world's light, re-read from the probes where an object moved (everywhere when
+  // the probes' light changed).
   for (std::size_t i = 0; i < objects.size(); ++i) {
-    if (moved[i] != 0) {
+    if (moved[i] != 0 || world_changed) {
       const BrfWorldVertices v = brf_world_vertices(objects[i]);
       const std::size_t nv = v.positions.size();
       m.world_incoming[i].assign(incoming[i].size(), glm::vec3(0.0f));
@@ -266,6 +272,7 @@ bool BrfLighting::update() {
   m.stats.gpu_bytes = m.pass->gpu_bytes();
   ++m.stats.updates;
   if (any_moved) ++m.stats.objects_moved;
+  if (world_changed) ++m.stats.world_light_changes;
   m.computed = true;
   return true;
 }
@@ -290,6 +297,17 @@ engine::IndirectLightFrame::VertexRadianceLobes BrfLighting::vertex_lobes(engine
           .stride = vertices,
           .terms = model.glossy->terms,
           .resolution = model.glossy->resolution};
+}
+
+bool BrfLighting::set_moving_world_light(std::span<const std::array<glm::vec3, 9>> radiance_sh) {
+  Impl& m = *impl_;
+  if (!m.world.probes || radiance_sh.size() != m.world.probes->probe_count()) return false;
+  if (m.static_probe_sh.empty()) m.static_probe_sh = m.world.probes->radiance_sh;
+  for (std::size_t k = 0; k < radiance_sh.size(); ++k)
+    for (std::size_t j = 0; j < 9; ++j)
+      m.world.probes->radiance_sh[k][j] = m.static_probe_sh[k][j] + radiance_sh[k][j];
+  m.world_light_changed = true;
+  return true;
 }
 
 bool BrfLighting::has_static_receivers() const { return !impl_->world.receiver_texels.empty(); }

@@ -29,6 +29,7 @@
 #include <glm/glm.hpp>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -107,11 +108,17 @@ class BrfLighting {
   /// (BrfResult::static_occlusion) and adds their bounce at the static receivers.
   void composite_world(std::uint32_t base_texture, std::uint32_t composite_texture) const;
   bool has_static_receivers() const;
+  /// Light added to the world probes' static light (the moving lights' first bounce off the
+  /// static world, system/prm_probe_light.h): radiance SH per probe of BrfWorldLink::probes,
+  /// replacing the last call's. Every object's world light is re-gathered on the next
+  /// update(). False (nothing changed) without probes or for another probe count.
+  bool set_moving_world_light(std::span<const std::array<glm::vec3, 9>> radiance_sh);
 
   struct Stats {
     std::uint64_t updates = 0;        ///< update() calls that computed something.
     std::uint64_t skipped = 0;        ///< update() calls on which nothing had changed.
     std::uint64_t objects_moved = 0;  ///< Updates with at least one moved object.
+    std::uint64_t world_light_changes = 0;  ///< Updates that re-gathered every object's world light (set_moving_world_light).
     std::size_t pairs_evaluated = 0;  ///< Last update (GPU pass stats).
     std::size_t pairs_culled = 0;
     std::size_t pairs_reused = 0;

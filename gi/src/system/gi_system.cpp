@@ -26,6 +26,7 @@
 #include "system/antiradiance_lighting.h"
 #include "system/light_atlas_lighting.h"
 #include "system/prm_lighting.h"
+#include "system/prm_probe_light.h"
 #include "system/sky_visibility.h"
 #include "transport/static_scene.h"
 
@@ -52,6 +53,7 @@ struct GISystem::Impl {
   std::unique_ptr<LightAtlasLighting> atlas;
   std::unique_ptr<PrmLighting> prm;
   std::unique_ptr<BrfLighting> brf;
+  std::unique_ptr<PrmProbeLight> prm_probe;  // the moving lights' first bounce in the BRF world probes
   std::unique_ptr<DlmLighting> dlm;  // directional light maps of the glossy static surfaces
   std::unique_ptr<AntiradianceLighting> anti;
   std::unique_ptr<SkyVisibility> sky;  // dynamic entities' sky occlusion, when the scene has a sky
@@ -218,9 +220,11 @@ engine::Result<std::unique_ptr<GISystem>> GISystem::load(const std::filesystem::
     }
     BrfWorldLink world;
     const AtlasLayout* layout = atlas ? &atlas->layout : prm ? &prm->layout : nullptr;
+    std::vector<glm::vec3> entry_albedo;  // the PRM's entry points' surfaces, for the probes' moving light
     if (layout != nullptr) {
       auto s = prepare_static_scene(input, *layout, BakeLights::None);
       if (!s) return s.error();
+      if (prm) entry_albedo = prm_entry_albedo(*s, prm->entries);
       world.atlas_width = s->texels.width;
       world.atlas_height = s->texels.height;
       for (std::size_t t = 0; t < s->texels.valid.size(); ++t)
@@ -242,6 +246,29 @@ engine::Result<std::unique_ptr<GISystem>> GISystem::load(const std::filesystem::
       impl->stats.load_probe_ms = static_cast<std::size_t>(
           std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
     }
+    // The moving lights' first bounce in the probes: the PRM's entry points as emitters
+    // (system/prm_probe_light.h). Without a light atlas the probes stand on the entry points
+    // alone (no static light).
+    if (prm && world.caster && !entry_albedo.empty()) {
+      const auto t0 = std::chrono::steady_clock::now();
+      if (!world.probes) {
+        VplSet at_entries;
+        for (const PrmEntryPoint& e : prm->entries) {
+          at_entries.position.push_back(e.position);
+          at_entries.normal.push_back(e.normal);
+          at_entries.area_m2.push_back(e.area_m2);
+        }
+        const std::vector<glm::vec3> dark(at_entries.position.size(), glm::vec3(0.0f));
+        auto probes = bake_world_probes(*world.caster, at_entries, dark, {.spacing_m = settings.probe_spacing_m});
+        if (!probes) return probes.error();
+        world.probes.emplace(std::move(probes).value());
+      }
+      auto moving = PrmProbeLight::create(*world.caster, *world.probes, prm->entries, std::move(entry_albedo));
+      if (!moving) return moving.error();
+      impl->prm_probe = std::make_unique<PrmProbeLight>(std::move(moving).value());
+      impl->stats.load_probe_ms += static_cast<std::size_t>(
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    }
     const std::size_t receivers = world.receiver_texels.size();
     const std::size_t probe_count = world.probes ? world.probes->probe_count() : 0;
     auto brf =
@@ -257,6 +284,10 @@ engine::Result<std::unique_ptr<GISystem>> GISystem::load(const std::filesystem::
     text << "BRF: " << st.instances << " dynamic objects (" << st.vertices << " vertices, "
          << static_cast<double>(st.field_bytes) / 1e6 << " MB of basis + fields), " << settings.brf_bounces
          << " bounces; world light from " << probe_count << " probes; bounce onto " << receivers << " atlas texels\n";
+    if (impl->prm_probe)
+      text << "BRF world probes: + moving lights' first bounce from the PRM's entry points ("
+           << impl->prm_probe->stats().transfer_entries << " probe-entry links, "
+           << static_cast<double>(impl->prm_probe->stats().transfer_bytes) / 1e6 << " MB), re-projected when a moving light changes\n";
   }
 
   // Antiradiance: the deforming region's change, added into the atlas of the same layout.
@@ -320,6 +351,12 @@ const engine::IndirectLightFrame& GISystem::frame() {
       m.stats.last_prm_ms = ps.last_weights_ms + ps.last_gpu_ms;
       base_changed = true;
       work = true;
+    }
+    // The moving lights' first bounce in the BRF world probes, re-projected only when the PRM's
+    // entry irradiance changed.
+    if (m.prm_probe && m.brf && m.prm_probe->update(*m.prm) && m.brf->set_moving_world_light(m.prm_probe->radiance_sh())) {
+      ++m.stats.prm_probe_updates;
+      m.stats.last_prm_probe_ms = m.prm_probe->stats().last_ms;
     }
   } else if (m.atlas) {
     base = m.atlas->frame().irradiance_atlas_texture;

@@ -159,4 +159,13 @@ const char* PrmLighting::label() const { return impl_->base.empty() ? "PRM" : "l
 
 const PrmLighting::Stats& PrmLighting::stats() const { return impl_->stats; }
 
+std::span<const PrmEntryPoint> PrmLighting::entry_points() const { return impl_->prm.entries; }
+
+std::vector<glm::vec3> PrmLighting::moving_entry_irradiance() const {
+  std::vector<glm::vec3> sum(impl_->prm.entries.size(), glm::vec3(0.0f));
+  for (const auto& [id, c] : impl_->lights)
+    for (std::size_t i = 0; i < sum.size() && i < c.entry.size(); ++i) sum[i] += c.entry[i];
+  return sum;
+}
+
 }  // namespace gi

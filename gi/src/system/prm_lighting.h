@@ -21,11 +21,15 @@
 #include <gi/log.h>
 
 #include <cstdint>
+#include <glm/glm.hpp>
 #include <memory>
+#include <span>
+#include <vector>
 
 namespace gi {
 
 struct Prm;
+struct PrmEntryPoint;
 struct LightAtlasBake;
 
 struct PrmLightingSettings {
@@ -60,6 +64,16 @@ class PrmLighting final : public engine::IndirectLightProvider {
     std::string disabled;  ///< Why the PRM turned off (no GPU resources, a failed update); empty: running.
   };
   const Stats& stats() const;
+
+  // Read-only, for the world probes that light dynamic objects (system/prm_probe_light.h):
+  // the moving lights' first bounce off the static world as emitters.
+  /// The PRM's entry points (where moving lights first hit the static world).
+  std::span<const PrmEntryPoint> entry_points() const;
+  /// Per entry point, the moving lights' irradiance (W/m^2) as of the last update (the cached
+  /// per-light values summed); zeros before the first frame.
+  std::vector<glm::vec3> moving_entry_irradiance() const;
+  /// Changes whenever the entry irradiance does (the update counter).
+  std::uint64_t entry_version() const { return stats().updates; }
 
  private:
   struct Impl;
