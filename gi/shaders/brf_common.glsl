@@ -106,6 +106,30 @@ void brf_cube_face(vec3 d, out uint f, out float u, out float v) {
   }
 }
 
+// Cube face f's point (u, v) in [-1, 1]^2 as a direction (radiance_field.cpp's cube_direction).
+vec3 brf_cube_direction(uint f, float u, float v) {
+  if (f == 0u) return vec3(1.0, v, -u);
+  if (f == 1u) return vec3(-1.0, v, u);
+  if (f == 2u) return vec3(u, 1.0, -v);
+  if (f == 3u) return vec3(u, -1.0, v);
+  if (f == 4u) return vec3(u, v, 1.0);
+  return vec3(-u, v, -1.0);
+}
+
+// Cell (iu, iv) of face f, one cell beyond the face allowed: the neighbouring face's cell
+// holding the direction of its centre (radiance_field.cpp's seam_cell).
+void brf_seam_cell(uint res, inout uint f, inout int iu, inout int iv) {
+  const int r = int(res);
+  if (iu >= 0 && iu < r && iv >= 0 && iv < r) return;
+  const float n = float(res);
+  const float cu = (float(iu) + 0.5) / n * 2.0 - 1.0;
+  const float cv = (float(iv) + 0.5) / n * 2.0 - 1.0;
+  float u, v;
+  brf_cube_face(brf_cube_direction(f, cu, cv), f, u, v);
+  iu = clamp(int(floor((u + 1.0) * 0.5 * n)), 0, r - 1);
+  iv = clamp(int(floor((v + 1.0) * 0.5 * n)), 0, r - 1);
+}
+
 float brf_sphere_radius(BrfModel m, uint s) {
   if (m.spheres <= 1u) return m.centre_inner.w;
   return m.centre_inner.w * pow(m.outer_radius / m.centre_inner.w, float(s) / float(m.spheres - 1u));
@@ -140,21 +164,25 @@ bool brf_field_corners(BrfModel m, vec3 p, out uint base[8], out float weight[8]
   float u, v;
   brf_cube_face(d, f, u, v);
   const float n = float(m.face_resolution);
-  const float fu = clamp((u + 1.0) * 0.5 * n - 0.5, 0.0, n - 1.0);
-  const float fv = clamp((v + 1.0) * 0.5 * n - 0.5, 0.0, n - 1.0);
-  const uint u0 = uint(fu), v0 = uint(fv);
-  const uint u1 = min(u0 + 1u, m.face_resolution - 1u), v1 = min(v0 + 1u, m.face_resolution - 1u);
+  // Across a face's edge the outer neighbours lie on the next face (brf_seam_cell).
+  const float fu = clamp((u + 1.0) * 0.5 * n - 0.5, -0.5, n - 0.5);
+  const float fv = clamp((v + 1.0) * 0.5 * n - 0.5, -0.5, n - 0.5);
+  const int u0 = int(floor(fu)), v0 = int(floor(fv));
+  const int u1 = u0 + 1, v1 = v0 + 1;
   const float tu = fu - float(u0), tv = fv - float(v0);
   const uint per_point = m.terms * m.basis_count * m.sh_bands * m.sh_bands;
   const bool between = r > inner && r < outer && m.spheres > 1u;
   const uint cs[8] = uint[8](s0, s0, s0, s0, s1, s1, s1, s1);
-  const uint cu[8] = uint[8](u0, u1, u0, u1, u0, u1, u0, u1);
-  const uint cv[8] = uint[8](v0, v0, v1, v1, v0, v0, v1, v1);
+  const int cu[8] = int[8](u0, u1, u0, u1, u0, u1, u0, u1);
+  const int cv[8] = int[8](v0, v0, v1, v1, v0, v0, v1, v1);
   const float cw[8] = float[8]((1.0 - ts) * (1.0 - tu) * (1.0 - tv), (1.0 - ts) * tu * (1.0 - tv),
                                (1.0 - ts) * (1.0 - tu) * tv, (1.0 - ts) * tu * tv, ts * (1.0 - tu) * (1.0 - tv),
                                ts * tu * (1.0 - tv), ts * (1.0 - tu) * tv, ts * tu * tv);
   for (int k = 0; k < 8; ++k) {
-    const uint idx = ((cs[k] * 6u + f) * m.face_resolution + cv[k]) * m.face_resolution + cu[k];
+    uint ff = f;
+    int iu = cu[k], iv = cv[k];
+    brf_seam_cell(m.face_resolution, ff, iu, iv);
+    const uint idx = ((cs[k] * 6u + ff) * m.face_resolution + uint(iv)) * m.face_resolution + uint(iu);
     base[k] = idx * per_point;
     const float rs = brf_sphere_radius(m, cs[k]);
     weight[k] = cw[k] * falloff * (between ? (rs / r) * (rs / r) : 1.0);
