@@ -29,6 +29,8 @@
 #include "prm/prm_io.h"
 #include "raytrace/reference_render.h"
 #include "raytrace/scene_adapter.h"
+#include "system/prm_probe_light.h"
+#include "transport/static_scene.h"
 
 namespace {
 
@@ -191,6 +193,39 @@ TEST(BrfMovingLight, ACrateBesideTheMovingLampGetsItsBounceOffTheFloor) {
   EXPECT_EQ(gi.stats().prm_probe_updates, 3u);
   EXPECT_LT(sum_x(moved) - sum_x(off), 0.7 * o);
   std::printf("lamp 2 m farther: %.4f; re-projection %.3f ms\n", sum_x(moved) - sum_x(off), gi.stats().last_prm_probe_ms);
+}
+
+// The entry points' albedo (prm_entry_albedo): every entry point of the spot chamber finds the
+// static triangle it lies on, and gets its material's hemispherical albedo: the floor's
+// (0.6, 0.58, 0.55 base colour) below 1 cm height, the walls' or the pedestal's elsewhere.
+TEST(BrfMovingLight, EntryPointsTakeTheAlbedoOfTheSurfaceTheyLieOn) {
+  auto asset = engine::load_gltf(GI_SOURCE_DIR "/assets/spot_chamber.gltf");
+  ASSERT_TRUE(asset);
+  engine::Scene scene = engine::instantiate(std::move(asset.value()));
+  const gi::BakeInput input = gi::bake_input_from(scene);
+  gi::PrmSettings ps;
+  ps.texels_per_metre = 2.0f;
+  ps.entry_points = 256;
+  ps.clusters = 8;
+  const gi::Prm prm = gi::bake_prm(input, ps).value();
+  const auto statics = gi::prepare_static_scene(input, prm.layout, gi::BakeLights::None).value();
+  std::size_t missed = 99;
+  const std::vector<glm::vec3> albedo = gi::prm_entry_albedo(statics, prm.entries, &missed);
+  ASSERT_EQ(albedo.size(), prm.entries.size());
+  EXPECT_EQ(missed, 0u);
+  float floor_y = 1e9f;
+  for (const gi::PrmEntryPoint& e : prm.entries) floor_y = std::min(floor_y, e.position.y);
+  std::size_t on_floor = 0;
+  for (std::size_t i = 0; i < albedo.size(); ++i) {
+    EXPECT_GT(albedo[i].x, 0.3f) << i;
+    EXPECT_LT(albedo[i].x, 0.8f) << i;
+    if (prm.entries[i].normal.y > 0.99f && prm.entries[i].position.y < floor_y + 0.01f) {
+      ++on_floor;
+      // Red over blue as the floor's base colour (0.6 / 0.55), not the walls' grey.
+      EXPECT_NEAR(albedo[i].x / albedo[i].z, 0.6f / 0.55f, 0.02f) << i;
+    }
+  }
+  EXPECT_GT(on_floor, 0u);
 }
 
 }  // namespace
