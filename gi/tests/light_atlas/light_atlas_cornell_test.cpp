@@ -5,6 +5,7 @@
 #include <gi/error_metrics.h>
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 
 #include "light_atlas/light_atlas.h"
@@ -65,22 +66,33 @@ TEST(LightAtlasCornell, HighPresetMatchesReference) {
 // (assets/README.md): one bounce leaves them dark; five bounces match the reference path
 // tracer limited to five bounces. (With albedo 0.7 and light arriving after 3-4 bounces, the
 // unlimited series is about twice the 5-bounce sum, so the bounce-limited reference is the
-// fair comparison.)
+// fair comparison.) The reference's corridor sum is itself noisy at 1024 samples (paths of
+// 3-5 bounces through the doorway are rare): its standard error, from the path tracer's
+// per-texel variance, is 7.8% of it, and a clang build (other random streams: argument
+// evaluation order) measured 1.18x the GCC build's sum. The bound is 10% plus three of
+// those standard errors (0.33 here; 4096 samples would halve the 3 x 7.8% at 4x the
+// reference's time, too slow under the sanitizers). Measured: 1.024 (GCC), 0.859 (clang, ASan).
 TEST(LightAtlasCorridor, FiveBouncesReachTheCorridorOneBounceDoesNot) {
   const engine::Scene scene = load("corridor.gltf");
   const float density = 4.0f;
   const gi::AtlasIrradiance truth = reference(scene, density, 1024, 5);
   const auto in_corridor = [](glm::vec3 p) { return p.x > 6.25f && (p.z > 4.25f || p.x > 7.85f); };
-  double ref_sum = 0.0;
+  double ref_sum = 0.0, ref_variance = 0.0;
   std::vector<std::uint8_t> mask(truth.valid.size(), 0);
   const auto inputs = gi::atlas_inputs_from(gi::bake_input_from(scene.assets));
   const gi::AtlasTexels texels =
       gi::rasterize_atlas(gi::build_atlas_layout(inputs, {.texels_per_metre = density}).value(), inputs);
   for (std::size_t t = 0; t < mask.size(); ++t) {
     mask[t] = texels.valid[t] && in_corridor(texels.position[t]) ? 1 : 0;
-    if (mask[t]) ref_sum += static_cast<double>(truth.indirect[t].y);
+    if (mask[t]) {
+      ref_sum += static_cast<double>(truth.indirect[t].y);
+      ref_variance += static_cast<double>(truth.indirect_variance[t].y);
+    }
   }
   ASSERT_GT(ref_sum, 0.0);
+  const double ref_error = std::sqrt(ref_variance) / ref_sum;
+  std::printf("corridor reference: sum %.4f, standard error %.4f of it\n", ref_sum, ref_error);
+  ASSERT_LT(ref_error, 0.1) << "the reference is too noisy to judge the bake";
   double ratio[2] = {0.0, 0.0};
   for (int b : {1, 5}) {
     gi::LightAtlasSettings s;
@@ -99,7 +111,7 @@ TEST(LightAtlasCorridor, FiveBouncesReachTheCorridorOneBounceDoesNot) {
     std::printf("corridor, %d bounce(s): corridor irradiance / reference %.4f, rel RMSE there %.4f, bake %.2f s\n", b,
                 sum / ref_sum, e.rel_rmse, bake->stats.total_seconds);
   }
-  EXPECT_NEAR(ratio[1], 1.0, 0.10);
+  EXPECT_NEAR(ratio[1], 1.0, 0.10 + 3.0 * ref_error);
   EXPECT_LT(ratio[0], 0.05);
 }
 
