@@ -1,13 +1,15 @@
 #!/usr/bin/env bash
 # Fuzzes every reader of the project for SECONDS each (libFuzzer, ASan + UBSan with
-# float-cast-overflow; tests/fuzz/README.md). Builds only the fuzz targets, with clang, in
-# build-fuzz/ (FUZZ_BUILD_DIR), then runs each over its seed corpus (tests/fuzz/corpus/<name>/,
-# read only; inputs it finds go to build-fuzz/corpus/<name>/) and prints a table.
+# float-cast-overflow; tests/fuzz/README.md). Builds only the fuzz targets in the instrumented
+# build the sanitizer leg shares (tools/configure-sanitized.sh: clang, build-san/, FUZZ_BUILD_DIR),
+# then runs each over its seed corpus and the inputs of fixed findings (tests/fuzz/corpus/<name>/
+# and tests/fuzz/regressions/<name>/, read only; inputs it finds go to build-san/corpus/<name>/)
+# and prints a table.
 #   tools/fuzz.sh 120                 # every target, 120 s each
 #   tools/fuzz.sh 30 gltf session     # only these targets
 # Exit status 1 when any target reports a finding (crash, sanitizer report, leak, timeout,
-# out of memory, a failed check): the input is in build-fuzz/findings/<name>/ and its log
-# in build-fuzz/logs/<name>.log. Reproduce with: build-fuzz/.../fuzz_<name> <input>.
+# out of memory, a failed check): the input is in build-san/findings/<name>/ and its log
+# in build-san/logs/<name>.log. Reproduce with: build-san/.../fuzz_<name> <input>.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 if [ $# -lt 1 ] || ! [[ $1 =~ ^[0-9]+$ ]] || [ "$1" -lt 1 ]; then
@@ -16,19 +18,9 @@ if [ $# -lt 1 ] || ! [[ $1 =~ ^[0-9]+$ ]] || [ "$1" -lt 1 ]; then
 fi
 seconds=$1
 shift
-build_dir=${FUZZ_BUILD_DIR:-build-fuzz}
+build_dir=${FUZZ_BUILD_DIR:-build-san}
 root=$(pwd)
-
-launcher=()
-if command -v ccache >/dev/null; then
-  launcher=(-DCMAKE_C_COMPILER_LAUNCHER=ccache -DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
-fi
-mkdir -p "$build_dir"
-cmake -S . -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g1 -DNDEBUG" -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O2 -g1 -DNDEBUG" \
-  -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ -DGI_FUZZ=ON \
-  -DGI_BUILD_TESTS=OFF -DGI_BUILD_TOOLS=OFF -DGI_BUILD_BENCHMARKS=OFF -DGI_BUILD_DEMO=ON \
-  "${launcher[@]}" >"$build_dir/configure.log" 2>&1 || { cat "$build_dir/configure.log"; exit 1; }
+bash tools/configure-sanitized.sh "$build_dir"
 build_start=$(date +%s)
 cmake --build "$build_dir" --target fuzz_targets -j "$(nproc)"
 echo "fuzz.sh: fuzz targets built in $(( $(date +%s) - build_start )) s"
@@ -62,7 +54,9 @@ for n in "${names[@]}"; do
   # -rss_limit_mb: a reader that allocates 2 GB for an input of a few KB is a finding.
   # -timeout: one input taking 25 s is a hang. Seeds are read from the source tree, new
   # inputs written to the build directory's corpus only.
-  "${program[$n]}" "$work" "$root/tests/fuzz/corpus/$n" -max_total_time="$seconds" -rss_limit_mb=2048 \
+  regressions=()
+  [ -d "$root/tests/fuzz/regressions/$n" ] && regressions=("$root/tests/fuzz/regressions/$n")
+  "${program[$n]}" "$work" "$root/tests/fuzz/corpus/$n" "${regressions[@]}" -max_total_time="$seconds" -rss_limit_mb=2048 \
     -timeout=25 -print_final_stats=1 -artifact_prefix="$findings/" >"$log" 2>&1
   rc=$?
   set -e

@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
-# The sanitizer leg: the whole ctest suite built with -DGI_SANITIZE=ON (GCC's AddressSanitizer
-# + UndefinedBehaviorSanitizer, every UB report fatal) in build-asan/ (SANITIZE_BUILD_DIR),
-# GL tests included on llvmpipe, leak detection on. Extra arguments go to ctest
-# (tools/sanitize.sh -R Gltf).
+# The sanitizer leg: the whole ctest suite built instrumented (tools/configure-sanitized.sh:
+# clang, AddressSanitizer + UndefinedBehaviorSanitizer with float-cast-overflow, every report
+# fatal) in build-san/ (SANITIZE_BUILD_DIR), the build the fuzz leg shares, GL tests included
+# on llvmpipe, leak detection on. Extra arguments go to ctest (tools/sanitize.sh -R Gltf).
 #
 # The test environment (docs/reliability.md "CI legs"):
 #  - LD_PRELOAD of Mesa's DRI driver (swrast_dri.so, llvmpipe). Every test that makes a GL
@@ -16,24 +16,16 @@
 #    in a driver module, now that its frames have names, would be suppressed there by module.
 #  - ASAN_OPTIONS=verify_asan_link_order=0 lets the preloaded driver come before the ASan
 #    runtime (which the executables link; the driver is not instrumented).
-# GI_WERROR is off here: GCC 12 raises false -Wmaybe-uninitialized warnings in libstdc++
-# (<regex>, <functional>) under -fsanitize=address.
+# A GCC build with -DGI_SANITIZE=ON (ASan + UBSan without float-cast-overflow) is the same
+# check for a team without clang: SANITIZE_BUILD_DIR=build-asan with that configure.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$(pwd)
-build_dir=${SANITIZE_BUILD_DIR:-build-asan}
-
-launcher=()
-if command -v ccache >/dev/null; then
-  launcher=(-DCMAKE_C_COMPILER_LAUNCHER=ccache -DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
-fi
+build_dir=${SANITIZE_BUILD_DIR:-build-san}
+bash tools/configure-sanitized.sh "$build_dir"
 build_start=$(date +%s)
-# -g1 (line tables): the reports keep file:line, the build and its links take far less time
-# than with full debug info (CI's time budget, docs/reliability.md "Times").
-cmake -S . -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DGI_SANITIZE=ON -DGI_WERROR=OFF \
-  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g1 -DNDEBUG" -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O2 -g1 -DNDEBUG" \
-  -DGI_BUILD_BENCHMARKS=OFF "${launcher[@]}"
-# SANITIZE_TARGETS: build only these targets (e.g. "engine_tests"; default: everything).
+# SANITIZE_TARGETS: build only these targets (e.g. "engine_tests"; default: everything, the
+# fuzz targets included).
 # shellcheck disable=SC2086
 cmake --build "$build_dir" -j "$(nproc)" ${SANITIZE_TARGETS:+--target $SANITIZE_TARGETS}
 echo "sanitize.sh: built in $(( $(date +%s) - build_start )) s"

@@ -68,8 +68,8 @@ TEST(LightAtlasCornell, HighPresetMatchesReference) {
 // unlimited series is about twice the 5-bounce sum, so the bounce-limited reference is the
 // fair comparison.) The reference's corridor sum is itself noisy at 1024 samples (paths of
 // 3-5 bounces through the doorway are rare): its standard error, from the path tracer's
-// per-texel variance, is 7.8% of it, and a clang build (other random streams: argument
-// evaluation order) measured 1.18x the GCC build's sum. The bound is 10% plus three of
+// per-texel variance, is 7.8% of it, and a clang build (whose random draws differ: the bake
+// moved by 1%) measured 1.18x the GCC build's sum. The bound is 10% plus three of
 // those standard errors (0.33 here; 4096 samples would halve the 3 x 7.8% at 4x the
 // reference's time, too slow under the sanitizers). Measured: 1.024 (GCC), 0.859 (clang, ASan).
 TEST(LightAtlasCorridor, FiveBouncesReachTheCorridorOneBounceDoesNot) {
