@@ -39,7 +39,7 @@ function(gi_fuzz_target name source)
     add_test(NAME Fuzz.${name}.ReplaysSeedsAndRegressions
              COMMAND fuzz_${name}_replay --seeds ${GI_FUZZ_CORPUS_DIR}/${name}
                      --regressions ${GI_FUZZ_REGRESSIONS_DIR}/${name})
-    set_tests_properties(Fuzz.${name}.ReplaysSeedsAndRegressions PROPERTIES LABELS fuzz TIMEOUT 300)
+    set_tests_properties(Fuzz.${name}.ReplaysSeedsAndRegressions PROPERTIES LABELS fuzz TIMEOUT ${GI_TEST_TIMEOUT})
   endif()
 endfunction()
 
