@@ -3,6 +3,8 @@
 //   gi-bake --plan assets/demo_level.gltf --preset preview    # print the effect plan, bake nothing
 //   gi-bake --scene level.gltf --preset medium --export-uv1 out/level_uv1.gltf   # the lightmap UVs
 //   gi-bake --scene Avocado.glb --sky 0.8,0.9,1.0 --out out/avocado.gibake      # lit by a uniform sky
+//   gi-bake --scene level.gltf --out out/level.gibake --shard 3/8   # one shard of a distributed bake
+//   gi-bake --scene level.gltf --out out/level.gibake --merge       # the bundle from all 8 shards
 // Without --methods it bakes what gi::plan (gi/plan.h) calls for and says what it skips;
 // the plan goes into the manifest either way. Exit codes: tools/common/tool_main.h.
 #include <engine/gltf.h>
@@ -68,7 +70,25 @@ int main(int argc, char** argv) {
   app.add_flag("--include-direct", o.include_direct, "Store direct + indirect irradiance (default: indirect only)");
   app.add_option("--threads", o.threads, "Worker threads (0: all); the result does not depend on it");
   app.add_option("--seed", o.seed, "Random seed");
+  // Distributed bakes (docs/distributed-bake.md).
+  std::string shard;
+  app.add_option("--shard", shard,
+                 "I/N: bake only shard I (0-based) of N of the light atlas and PRM into <out>.shards/ "
+                 "(docs/distributed-bake.md)");
+  app.add_flag("--merge", o.merge_shards,
+               "Write the bundle from the shards in <out>.shards/ (every one of 0..N-1 once, of this scene and "
+               "options), baking the other methods here");
   if (auto rc = tools::parse(app, kTool, argc, argv)) return *rc;
+  if (!shard.empty()) {
+    unsigned index = 0, count = 0;
+    char tail = 0;
+    if (o.merge_shards || std::sscanf(shard.c_str(), "%u/%u%c", &index, &count, &tail) != 2 || count == 0 ||
+        index >= count || count > 65536)
+      return tools::fail(kTool, "--shard takes I/N with 0 <= I < N <= 65536 and no --merge, got '" + shard + "'",
+                         tools::kExitUsage);
+    o.shard_index = index;
+    o.shard_count = count;
+  }
   if (scene_path.empty()) scene_path = positional_scene;
   if (scene_path.empty()) return tools::fail(kTool, "no scene (--scene FILE or FILE)", tools::kExitUsage);
   o.methods = split(methods);
@@ -120,6 +140,7 @@ int main(int argc, char** argv) {
   auto report = gi::bake_bundle(input, out_dir, o, host);
   bar.finish();
   if (!report) return tools::fail(kTool, report.error());
+  if (o.shard_count > 0 && !o.merge_shards) return tools::kExitOk;  // the bake's log named the shard file
   if (report->baked.empty()) {
     std::printf("%s: the plan calls for nothing this build can bake; no bundle written (gi-bake --plan says why)\n",
                 kTool);

@@ -46,7 +46,22 @@ struct BakeOptions {
   std::vector<std::string> moving_lights;  ///< Lights (by name) the game moves although not flagged (PlanOptions).
   unsigned threads = 0;                    ///< Worker threads; 0: all hardware threads. Does not change the result.
   std::uint64_t seed = 1;
+  /// Distributed bakes (docs/distributed-bake.md). shard_count > 0 and !merge_shards: bake
+  /// only shard `shard_index` (0-based) of `shard_count` of the sharded methods' work (light
+  /// atlas final gather, PRM panes, by texel blocks) into shard_directory(bundle_dir) /
+  /// shard_file_name(I, N); no bundle is written. merge_shards: check that every shard
+  /// 0..N-1 is there once, of this scene and these options, and write the bundle from them
+  /// (the other methods baked here) through the same staging + swap as a whole bake: byte-
+  /// identical files to a one-process bake. shard_count = 0 with merge_shards: N from the shards.
+  std::uint32_t shard_index = 0;
+  std::uint32_t shard_count = 0;
+  bool merge_shards = false;
 };
+
+/// Where the shards of the bundle `bundle_dir` go: a directory beside it, "<bundle>.shards".
+std::filesystem::path shard_directory(const std::filesystem::path& bundle_dir);
+/// "shard-0003-of-0007.gishard" for shard 3 of 7.
+std::string shard_file_name(std::uint32_t index, std::uint32_t count);
 
 /// The host's side of a bake: progress per stage (returning false cancels, and the bake
 /// returns an ErrorKind::Cancelled error) and a line per stage of what was done.

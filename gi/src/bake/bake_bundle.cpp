@@ -11,11 +11,13 @@
 #include <cstdio>
 #include <cstring>
 #include <ctime>
+#include <optional>
 #include <string>
 #include <thread>
 #include <utility>
 
 #include "antiradiance/antiradiance_io.h"
+#include "bake/bake_shard.h"
 #include "antiradiance/antiradiance_region.h"
 #include "brf/brf_bake.h"
 #include "brf/brf_io.h"
@@ -27,6 +29,7 @@
 #include "dlm/dlm_io.h"
 #include "io/atomic_file.h"
 #include "io/blob_file.h"
+#include "io/content_hash.h"
 #include "light_atlas/light_atlas.h"
 #include "light_atlas/light_atlas_io.h"
 #include "plan/plan_json.h"
@@ -88,8 +91,13 @@ std::string scene_file_name(const BakeInput& input) {
 // What a method's bake cost, for bake_stats.json (stage name -> seconds).
 using Timings = nlohmann::json;
 
-engine::Status bake_atlas(const BakeInput& input, const fs::path& dir, const BakeOptions& o, const Stage& stage,
-                          Timings& timings) {
+// The shards' parts a merge bakes the sharded methods from (docs/distributed-bake.md).
+struct MergedParts {
+  std::vector<LightAtlasShardPart> atlas;
+  std::vector<PrmShardPart> prm;
+};
+
+engine::Result<LightAtlasSettings> atlas_settings(const BakeOptions& o, const Stage& stage) {
   auto settings = light_atlas_preset(o.preset);
   if (!settings) return settings.error();
   if (o.vpls > 0) settings->vpl_count = o.vpls;
@@ -100,10 +108,17 @@ engine::Status bake_atlas(const BakeInput& input, const fs::path& dir, const Bak
   settings->threads = o.threads;
   settings->seed = o.seed;
   settings->progress = stage.progress();
+  return settings;
+}
+
+engine::Status bake_atlas(const BakeInput& input, const fs::path& dir, const BakeOptions& o, const Stage& stage,
+                          Timings& timings, const MergedParts* merged = nullptr) {
+  auto settings = atlas_settings(o, stage);
+  if (!settings) return settings.error();
   stage.log(format("light atlas of %s, preset %s: %d VPLs x %d samples, %d bounces, %g texels/m",
                    scene_file_name(input).c_str(), o.preset.c_str(), settings->vpl_count, settings->samples_per_vpl,
                    settings->bounces, double{settings->texels_per_metre}));
-  auto bake = bake_light_atlas(input, *settings);
+  auto bake = merged ? merge_light_atlas(input, *settings, merged->atlas) : bake_light_atlas(input, *settings);
   if (!bake) return bake.error();
   const LightAtlasStats& st = bake->stats;
   stage.log(
@@ -122,18 +137,24 @@ engine::Status bake_atlas(const BakeInput& input, const fs::path& dir, const Bak
   return save_light_atlas(dir, *bake, input);
 }
 
-engine::Status bake_prm_method(const BakeInput& input, const fs::path& dir, const BakeOptions& o, const Stage& stage,
-                               Timings& timings) {
+engine::Result<PrmSettings> prm_settings(const BakeOptions& o, const Stage& stage) {
   auto settings = prm_preset(o.preset);
   if (!settings) return settings.error();
   if (o.texels_per_metre > 0.0f) settings->texels_per_metre = o.texels_per_metre;
   settings->threads = o.threads;
   settings->seed = o.seed;
   settings->progress = stage.progress();
+  return settings;
+}
+
+engine::Status bake_prm_method(const BakeInput& input, const fs::path& dir, const BakeOptions& o, const Stage& stage,
+                               Timings& timings, const MergedParts* merged = nullptr) {
+  auto settings = prm_settings(o, stage);
+  if (!settings) return settings.error();
   stage.log(format("PRM of %s, preset %s: %d entry points, %d clusters, splitting %g, %g texels/m",
                    scene_file_name(input).c_str(), o.preset.c_str(), settings->entry_points, settings->clusters,
                    double{settings->splitting}, double{settings->texels_per_metre}));
-  auto prm = bake_prm(input, *settings);
+  auto prm = merged ? merge_prm(input, *settings, merged->prm) : bake_prm(input, *settings);
   if (!prm) return prm.error();
   const PrmStats& st = prm->stats;
   stage.log(
@@ -375,24 +396,11 @@ engine::Status update_bake_stats(const fs::path& dir, const nlohmann::json& bake
   return write_file_atomically(path, doc.dump(2) + "\n");
 }
 
-}  // namespace
-
-std::vector<std::string> bakeable_methods() { return {"atlas", "prm", "dlm", "brf", "antiradiance"}; }
-
-engine::Result<BakeReport> bake_bundle(const BakeInput& input, const fs::path& bundle_dir, const BakeOptions& options,
-                                       const BakeHost& host) {
-  if (auto ok = validate_bake_input(input); !ok) return ok.error();
+// The methods a bake bakes, in order: options.methods, or what the plan calls for and this
+// build can bake (the rest in report.skipped); a sky-lit PRM brings the atlas with it.
+engine::Result<std::vector<std::string>> methods_to_bake(const BakeInput& input, const BakeOptions& options,
+                                                         const BakeHost& host, BakeReport& report) {
   const std::vector<std::string> bakeable = bakeable_methods();
-  BakeReport report;
-  report.plan = plan(input, {.preset = options.preset,
-                             .moving_lights = options.moving_lights,
-                             .texels_per_metre = options.texels_per_metre,
-                             .vpls = options.vpls,
-                             .samples_per_vpl = options.samples_per_vpl,
-                             .bounces = options.bounces});
-  // The preset is checked before anything is baked or written.
-  if (auto density = light_atlas_preset(options.preset); !density) return density.error();
-
   std::vector<std::string> methods = options.methods;
   if (methods.empty()) {
     for (const PlannedEffect& e : report.plan.effects) {
@@ -423,6 +431,205 @@ engine::Result<BakeReport> bake_bundle(const BakeInput& input, const fs::path& b
     if (host.log)
       host.log(LogLevel::Info, "baking the light atlas too: it carries the sky the PRM composes with (docs/prm.md)");
   }
+  return methods;
+}
+
+// ---- distributed bakes (docs/distributed-bake.md) ----
+
+// The hash of every option that changes a bake's files (not threads, not the shard fields).
+std::string bake_settings_hash(const BakeOptions& o) {
+  ContentHash h;
+  h.add_string("gi-bake settings v1");
+  h.add_string(o.preset);
+  h.add_value(static_cast<std::uint64_t>(o.methods.size()));
+  for (const std::string& m : o.methods) h.add_string(m);
+  h.add_value(o.texels_per_metre);
+  h.add_value(o.vpls);
+  h.add_value(o.bounces);
+  h.add_value(o.samples_per_vpl);
+  h.add_value(o.brf_basis);
+  h.add_value(o.brf_spheres);
+  h.add_value(o.dlm_directions);
+  h.add_value(o.dlm_photons);
+  h.add_value(static_cast<std::uint8_t>(o.include_direct ? 1 : 0));
+  h.add_value(static_cast<std::uint64_t>(o.moving_lights.size()));
+  for (const std::string& l : o.moving_lights) h.add_string(l);
+  h.add_value(o.seed);
+  return h.hex();
+}
+
+bool has_method(const std::vector<std::string>& methods, const char* key) {
+  return std::find(methods.begin(), methods.end(), key) != methods.end();
+}
+
+ShardFile shard_header(const BakeInput& input, const BakeOptions& options, const std::vector<std::string>& methods,
+                       std::uint32_t index, std::uint32_t count) {
+  ShardFile f;
+  f.index = index;
+  f.count = count;
+  f.geometry_hash = scene_geometry_hash(input);
+  f.lights_hash = static_lights_hash(input);
+  f.settings_hash = bake_settings_hash(options);
+  f.seed = options.seed;
+  f.methods = methods;
+  return f;
+}
+
+// gi-bake --shard I/N: the sharded methods' work of shard I into its shard file.
+engine::Result<BakeReport> bake_shard(const BakeInput& input, const fs::path& bundle_dir, const BakeOptions& options,
+                                      const BakeHost& host, const std::vector<std::string>& methods,
+                                      BakeReport report) {
+  const std::uint32_t index = options.shard_index, count = options.shard_count;
+  if (index >= count)
+    return engine::invalid_request("shard " + std::to_string(index) + "/" + std::to_string(count) +
+                                   " does not exist (shards are 0..N-1)");
+  ShardFile file = shard_header(input, options, methods, index, count);
+  const WorkShard shard{.index = index, .count = count};
+  const Stage log{host, "shard"};
+  if (has_method(methods, "atlas")) {
+    const Stage stage{host, "light atlas"};
+    auto settings = atlas_settings(options, stage);
+    if (!settings) return settings.error();
+    const auto start = Clock::now();
+    auto part = bake_light_atlas_shard(input, *settings, shard);
+    if (!part) return part.error();
+    stage.log(format("light atlas shard %u/%u: %zu texels gathered, %.2f s", index, count, part->texels.size(),
+                     seconds_since(start)));
+    report.baked.push_back({"atlas", seconds_since(start), 0});
+    file.atlas = std::move(part).value();
+  }
+  if (has_method(methods, "prm")) {
+    const Stage stage{host, "PRM"};
+    auto settings = prm_settings(options, stage);
+    if (!settings) return settings.error();
+    const auto start = Clock::now();
+    auto part = bake_prm_shard(input, *settings, shard);
+    if (!part) return part.error();
+    stage.log(format("PRM shard %u/%u: %zu texels x %d clusters, %.2f s", index, count, part->texels.size(),
+                     part->cluster_count, seconds_since(start)));
+    report.baked.push_back({"prm", seconds_since(start), 0});
+    file.prm = std::move(part).value();
+  }
+  for (const std::string& m : methods)
+    if (m != "atlas" && m != "prm") log.log(m + ": not sharded, baked by the merge (docs/distributed-bake.md)");
+  const fs::path dir = shard_directory(bundle_dir);
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) return engine::Error{dir.string(), "", "cannot create the shard directory: " + ec.message()};
+  const fs::path path = dir / shard_file_name(index, count);
+  if (auto ok = write_shard_file(path, file); !ok) return ok.error();
+  std::error_code size_ec;
+  const auto bytes = fs::file_size(path, size_ec);
+  for (BakedMethod& m : report.baked) m.bytes = size_ec ? 0 : static_cast<std::uint64_t>(bytes);
+  log.log("wrote " + path.string());
+  return report;
+}
+
+// gi-bake --merge: every shard file beside the bundle, checked (present once each, of this
+// scene and these options), its parts in shard order. Errors name the shard file.
+engine::Result<MergedParts> read_shards(const BakeInput& input, const fs::path& bundle_dir, const BakeOptions& options,
+                                        const std::vector<std::string>& methods, const BakeHost& host) {
+  const fs::path dir = shard_directory(bundle_dir);
+  std::error_code ec;
+  std::vector<fs::path> files;
+  for (const auto& e : fs::directory_iterator(dir, ec))
+    if (e.path().extension() == ".gishard") files.push_back(e.path());
+  if (ec) return engine::Error{dir.string(), "", "cannot list the shard directory: " + ec.message()};
+  std::sort(files.begin(), files.end());
+  if (files.empty()) return engine::Error{dir.string(), "", "no shard file (*.gishard) to merge"};
+  const ShardFile expected = shard_header(input, options, methods, 0, options.shard_count);
+  std::uint32_t count = options.shard_count;
+  std::vector<std::optional<ShardFile>> shards;
+  std::vector<fs::path> where;
+  for (const fs::path& path : files) {
+    auto file = read_shard_file(path);
+    if (!file) return file.error();
+    const auto foreign = [&](const std::string& what) {
+      return engine::Error{path.string(), "", "foreign shard: " + what + "; bake it again with this scene and options"};
+    };
+    if (count == 0) count = file->count;
+    if (file->count != count)
+      return foreign("shard " + std::to_string(file->index) + " of " + std::to_string(file->count) +
+                     ", the merge is of " + std::to_string(count));
+    if (file->geometry_hash != expected.geometry_hash)
+      return foreign("baked from other geometry (hash " + file->geometry_hash + ", the scene's " +
+                     expected.geometry_hash + ")");
+    if (file->lights_hash != expected.lights_hash)
+      return foreign("baked under other static lights (hash " + file->lights_hash + ", the scene's " +
+                     expected.lights_hash + ")");
+    if (file->settings_hash != expected.settings_hash || file->seed != expected.seed)
+      return foreign("baked with other settings (settings hash " + file->settings_hash + " seed " +
+                     std::to_string(file->seed) + ", this merge's " + expected.settings_hash + " seed " +
+                     std::to_string(expected.seed) + ")");
+    if (file->methods != expected.methods || file->atlas.has_value() != has_method(methods, "atlas") ||
+        file->prm.has_value() != has_method(methods, "prm"))
+      return foreign("its methods differ from this merge's");
+    if (shards.empty()) shards.resize(count), where.resize(count);
+    const std::uint32_t i = file->index;
+    if (shards[i])
+      return engine::Error{path.string(), "", "duplicate shard " + std::to_string(i) + " of " + std::to_string(count) +
+                                                  " (also in " + where[i].string() + ")"};
+    shards[i] = std::move(file).value();
+    where[i] = path;
+  }
+  MergedParts merged;
+  for (std::uint32_t i = 0; i < count; ++i) {
+    if (!shards[i])
+      return engine::Error{(dir / shard_file_name(i, count)).string(), "",
+                           "shard " + std::to_string(i) + " of " + std::to_string(count) + " is missing"};
+    if (shards[i]->atlas) merged.atlas.push_back(std::move(*shards[i]->atlas));
+    if (shards[i]->prm) merged.prm.push_back(std::move(*shards[i]->prm));
+  }
+  if (host.log)
+    host.log(LogLevel::Info, format("merging %u shards from %s", count, dir.string().c_str()));
+  return merged;
+}
+
+// ---- end of distributed bakes ----
+
+}  // namespace
+
+std::vector<std::string> bakeable_methods() { return {"atlas", "prm", "dlm", "brf", "antiradiance"}; }
+
+fs::path shard_directory(const fs::path& bundle_dir) {
+  fs::path dir = bundle_dir;
+  if (!dir.has_filename()) dir = dir.parent_path();  // "out/level.gibake/"
+  return dir.parent_path() / (dir.filename().string() + ".shards");
+}
+
+std::string shard_file_name(std::uint32_t index, std::uint32_t count) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "shard-%04u-of-%04u.gishard", index, count);
+  return buf;
+}
+
+engine::Result<BakeReport> bake_bundle(const BakeInput& input, const fs::path& bundle_dir, const BakeOptions& options,
+                                       const BakeHost& host) {
+  if (auto ok = validate_bake_input(input); !ok) return ok.error();
+  BakeReport report;
+  report.plan = plan(input, {.preset = options.preset,
+                             .moving_lights = options.moving_lights,
+                             .texels_per_metre = options.texels_per_metre,
+                             .vpls = options.vpls,
+                             .samples_per_vpl = options.samples_per_vpl,
+                             .bounces = options.bounces});
+  // The preset is checked before anything is baked or written.
+  if (auto density = light_atlas_preset(options.preset); !density) return density.error();
+
+  auto resolved = methods_to_bake(input, options, host, report);
+  if (!resolved) return resolved.error();
+  const std::vector<std::string> methods = std::move(resolved).value();
+
+  // Distributed bakes (docs/distributed-bake.md): one shard's work into its shard file, or
+  // the merge of every shard's, which then bakes through the same staging + swap below.
+  if (options.shard_count > 0 && !options.merge_shards)
+    return bake_shard(input, bundle_dir, options, host, methods, std::move(report));
+  std::optional<MergedParts> merged;
+  if (options.merge_shards) {
+    auto parts = read_shards(input, bundle_dir, options, methods, host);
+    if (!parts) return parts.error();
+    merged = std::move(parts).value();
+  }
 
   if (methods.empty()) return report;
   auto staged = StagedBundle::begin(bundle_dir);
@@ -432,8 +639,9 @@ engine::Result<BakeReport> bake_bundle(const BakeInput& input, const fs::path& b
   for (const std::string& key : methods) {
     const auto start = Clock::now();
     Timings timings = nlohmann::json::object();
-    engine::Status done = key == "atlas" ? bake_atlas(input, dir, options, {host, "light atlas"}, timings)
-                          : key == "prm" ? bake_prm_method(input, dir, options, {host, "PRM"}, timings)
+    const MergedParts* parts = merged ? &*merged : nullptr;
+    engine::Status done = key == "atlas" ? bake_atlas(input, dir, options, {host, "light atlas"}, timings, parts)
+                          : key == "prm" ? bake_prm_method(input, dir, options, {host, "PRM"}, timings, parts)
                           : key == "dlm" ? bake_dlm_method(input, dir, options, {host, "DLM"}, timings)
                           : key == "antiradiance" ? bake_antiradiance_method(input, dir, options, {host, "antiradiance"})
                                          : bake_brf_method(input, dir, options, host, timings);

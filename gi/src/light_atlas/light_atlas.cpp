@@ -140,7 +140,78 @@ int dilation_rings(const AtlasLayout& layout) { return std::max(4, layout.paddin
 
 }  // namespace
 
-engine::Result<LightAtlasBake> bake_light_atlas(const BakeInput& input, const LightAtlasSettings& settings) {
+namespace {
+
+// How bake_light_atlas runs: whole, as one shard (steps 1-3 of texel_gather.h, step 3 for
+// the shard's texels, nothing after), or as the merge of the shards' parts.
+struct ShardRun {
+  WorkShard shard;                                          // with part: whose texel blocks
+  LightAtlasShardPart* part = nullptr;
+  const std::vector<LightAtlasShardPart>* parts = nullptr;  // set: the merge
+};
+
+// The gather's valid texels in index order (what WorkShard items index), as texel_gather.cpp.
+std::vector<std::uint32_t> gather_work(const AtlasTexels& texels) {
+  std::vector<std::uint32_t> work;
+  for (std::size_t i = 0; i < texels.valid.size(); ++i)
+    if (texels.valid[i]) work.push_back(static_cast<std::uint32_t>(i));
+  return work;
+}
+
+// The merge: the gather result of a whole bake before its filter, assembled from the parts.
+engine::Result<TexelGatherResult> assemble_parts(const AtlasTexels& texels,
+                                                 const std::vector<LightAtlasShardPart>& parts) {
+  const std::vector<std::uint32_t> work = gather_work(texels);
+  const std::size_t n = texels.valid.size();
+  TexelGatherResult out;
+  out.indirect.assign(n, glm::vec3(0.0f));
+  out.direct.assign(n, glm::vec3(0.0f));
+  out.hidden.assign(n, 0);
+  const auto count = static_cast<std::uint32_t>(parts.size());
+  for (std::uint32_t i = 0; i < count; ++i) {
+    const LightAtlasShardPart& p = parts[i];
+    const WorkShard shard{.index = i, .count = count};
+    std::vector<std::uint32_t> expected;
+    for (std::size_t w = 0; w < work.size(); ++w)
+      if (shard.owns(w)) expected.push_back(work[w]);
+    if (p.texels != expected || p.indirect.size() != expected.size() || p.direct.size() != expected.size() ||
+        p.hidden.size() != expected.size())
+      return engine::Error{.message = "light-atlas shard " + std::to_string(i) + " of " + std::to_string(count) +
+                                      ": its texels are not that shard's texels of this scene's atlas"};
+    for (std::size_t k = 0; k < expected.size(); ++k) {
+      out.indirect[expected[k]] = p.indirect[k];
+      out.direct[expected[k]] = p.direct[k];
+      out.hidden[expected[k]] = p.hidden[k];
+    }
+    out.own_rays += p.own_rays;
+  }
+  out.shared_rays = parts.empty() ? 0 : parts.front().shared_rays;
+  out.rays = out.shared_rays + out.own_rays;
+  return out;
+}
+
+engine::Result<LightAtlasBake> bake_light_atlas_run(const BakeInput& input, const LightAtlasSettings& settings,
+                                                    const ShardRun& run);
+
+}  // namespace
+
+engine::Result<LightAtlasShardPart> bake_light_atlas_shard(const BakeInput& input, const LightAtlasSettings& settings,
+                                                           WorkShard shard) {
+  if (shard.count == 0 || shard.index >= shard.count)
+    return engine::invalid_request("light-atlas shard " + std::to_string(shard.index) + " of " +
+                                   std::to_string(shard.count) + " does not exist");
+  if (settings.final_pass != LightAtlasSettings::FinalPass::TexelGather)
+    return engine::invalid_request("the light atlas's VPL final shooting cannot be sharded (the presets gather)");
+  LightAtlasShardPart part;
+  auto done = bake_light_atlas_run(input, settings, ShardRun{.shard = shard, .part = &part, .parts = nullptr});
+  if (!done) return done.error();
+  return part;
+}
+
+namespace {
+
+engine::Result<LightAtlasBake> bake_light_atlas_run(const BakeInput& input, const LightAtlasSettings& settings,
+                                                    const ShardRun& run) {
   if (auto ok = validate(settings); !ok) return ok.error();
   if (auto ok = validate_bake_input(input); !ok) return ok.error();
   const auto t_start = Clock::now();
@@ -153,6 +224,29 @@ engine::Result<LightAtlasBake> bake_light_atlas(const BakeInput& input, const Li
   auto prepared = prepare(input, *layout, settings);
   if (!prepared) return prepared.error();
   const BakeScene& b = *prepared;
+
+  if (run.part) {  // one shard: steps 1-3 of the gather, step 3 for its texel blocks
+    TexelGatherSettings g = settings.gather;
+    g.seed = settings.seed;
+    g.progress = settings.progress;
+    g.shard = run.shard;
+    g.part_only = true;
+    auto gathered = gather_atlas(b, *layout, g, pool);
+    if (!gathered) return gathered.error();
+    const std::vector<std::uint32_t> work = gather_work(b.texels);
+    LightAtlasShardPart& p = *run.part;
+    for (std::size_t w = 0; w < work.size(); ++w) {
+      if (!run.shard.owns(w)) continue;
+      const std::uint32_t i = work[w];
+      p.texels.push_back(i);
+      p.indirect.push_back(gathered->indirect[i]);
+      p.direct.push_back(gathered->direct[i]);
+      p.hidden.push_back(gathered->hidden[i]);
+    }
+    p.shared_rays = gathered->shared_rays;
+    p.own_rays = gathered->own_rays;
+    return LightAtlasBake{};
+  }
 
   LightAtlasBake out;
   out.stats.layout_seconds = layout_seconds;
@@ -175,8 +269,12 @@ engine::Result<LightAtlasBake> bake_light_atlas(const BakeInput& input, const Li
     TexelGatherSettings g = settings.gather;
     g.seed = settings.seed;
     g.progress = sub_progress(settings.progress, Phase{kDirectPhase.begin, kFinalPhase.end});
-    auto gathered = gather_atlas(b, out.layout, g, pool);
+    auto gathered = run.parts ? assemble_parts(b.texels, *run.parts) : gather_atlas(b, out.layout, g, pool);
     if (!gathered) return gathered.error();
+    if (run.parts) {  // the merge: the whole bake's last gather step on the shards' texels
+      if (auto ok = filter_gathered(b, out.layout, g, pool, *gathered); !ok) return ok.error();
+      if (g.progress && !g.progress(1.0)) return engine::cancelled_error("light-atlas merge");
+    }
     out.stats.direct_seconds = gathered->direct_seconds;
     out.irradiance = std::move(gathered->indirect);
     rays += gathered->rays;
@@ -239,6 +337,20 @@ engine::Result<LightAtlasBake> bake_light_atlas(const BakeInput& input, const Li
   out.stats.rays = rays;
   out.stats.total_seconds = seconds_since(t_start);
   return out;
+}
+
+}  // namespace
+
+engine::Result<LightAtlasBake> bake_light_atlas(const BakeInput& input, const LightAtlasSettings& settings) {
+  return bake_light_atlas_run(input, settings, {});
+}
+
+engine::Result<LightAtlasBake> merge_light_atlas(const BakeInput& input, const LightAtlasSettings& settings,
+                                                 const std::vector<LightAtlasShardPart>& parts) {
+  if (parts.empty()) return engine::invalid_request("light-atlas merge: no shard");
+  if (settings.final_pass != LightAtlasSettings::FinalPass::TexelGather)
+    return engine::invalid_request("the light atlas's VPL final shooting cannot be sharded (the presets gather)");
+  return bake_light_atlas_run(input, settings, {.shard = {}, .part = nullptr, .parts = &parts});
 }
 
 engine::Result<LightAtlasUpdateStats> update_light_atlas(const BakeInput& input, LightAtlasBake& previous,

@@ -106,6 +106,30 @@ struct LightAtlasBake {
 /// cancellation, or a layout that cannot be built.
 engine::Result<LightAtlasBake> bake_light_atlas(const BakeInput& input, const LightAtlasSettings& settings);
 
+/// What one shard of a distributed bake computed (docs/distributed-bake.md): the final
+/// gather (texel_gather.h step 3) of its texel blocks (WorkShard over the gather's valid
+/// texels in index order), unfiltered, with the direct light and the hidden flag of those
+/// texels. The layout, the texels, steps 1-2 and the VPLs are repeated bit for bit by every
+/// shard and by the merge instead of being shipped (measured in docs/distributed-bake.md).
+struct LightAtlasShardPart {
+  std::vector<std::uint32_t> texels;   ///< Atlas texel indices, ascending.
+  std::vector<glm::vec3> indirect;     ///< Per texel of `texels`: steps 2-3's irradiance.
+  std::vector<glm::vec3> direct;       ///< Per texel of `texels`: step 1 (sky included).
+  std::vector<std::uint8_t> hidden;    ///< Per texel of `texels`.
+  std::uint64_t shared_rays = 0;       ///< Rays of steps 1-2 (the same in every shard).
+  std::uint64_t own_rays = 0;          ///< Rays of step 3 for `texels`.
+};
+
+/// Shard `shard` of bake_light_atlas(input, settings) (a TexelGather final pass; the VPL
+/// shooting pass cannot be sharded: ErrorKind::Invalid).
+engine::Result<LightAtlasShardPart> bake_light_atlas_shard(const BakeInput& input, const LightAtlasSettings& settings,
+                                                           WorkShard shard);
+
+/// The bake of bake_light_atlas(input, settings), bit for bit, from the parts of shards
+/// 0..N-1 (parts[i] of shard i). Error when a part's texels are not its shard's.
+engine::Result<LightAtlasBake> merge_light_atlas(const BakeInput& input, const LightAtlasSettings& settings,
+                                                 const std::vector<LightAtlasShardPart>& parts);
+
 struct LightAtlasUpdateStats {
   std::size_t reshot_vpls = 0;  ///< VPLs whose power change passed the threshold.
   double seconds = 0.0;

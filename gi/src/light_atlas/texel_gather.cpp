@@ -448,7 +448,10 @@ engine::Result<TexelGatherResult> gather_atlas(const StaticBakeScene& b, const A
     const auto nf = static_cast<std::size_t>(s.gather_rays);
     const double w_solve = static_cast<double>(ns) / static_cast<double>(ns + nf);
     std::vector<glm::vec3> gathered(n, glm::vec3(0.0f));
-    if (!pool.parallel_for_with_progress(work, phase(0.5, 0.95), [&](std::size_t w) {
+    const std::vector<std::size_t> mine = s.shard.items(work);  // all of them in a whole bake
+    std::vector<std::uint64_t> gather_rays_of(work, 0);
+    if (!pool.parallel_for_with_progress(mine.size(), phase(0.5, 0.95), [&](std::size_t m) {
+          const std::size_t w = mine[m];
           const std::uint32_t i = t.work[w];
           Pcg32 rng = Pcg32::for_item(s.seed, stream_id(i, kGatherStream));
           const glm::vec2 shift(rng.next_float(), rng.next_float());
@@ -458,7 +461,7 @@ engine::Result<TexelGatherResult> gather_atlas(const StaticBakeScene& b, const A
             const glm::vec2 u = hammersley(static_cast<std::uint32_t>(r), static_cast<std::uint32_t>(nf), shift);
             const glm::vec3 wi = sample_cosine_hemisphere(tx.normal[i], u.x, u.y);
             if (glm::dot(wi, t.face[i]) <= 0.0f) continue;
-            ++rays_of[w];
+            ++gather_rays_of[w];
             glm::vec2 uv;
             const std::uint32_t land = landing(b, layout, t, Ray{origin, 0.0f, wi}, &uv);
             if (land < kBack) sum += glm::dvec3(bilinear(reflected, t.width, t.height, uv));
@@ -468,18 +471,37 @@ engine::Result<TexelGatherResult> gather_atlas(const StaticBakeScene& b, const A
         }))
       return engine::cancelled_error("light-atlas gather");
     e = std::move(gathered);
+    for (std::uint64_t r : gather_rays_of) out.own_rays += r;
+  } else if (!s.shard.whole()) {
+    for (std::size_t w = 0; w < work; ++w)
+      if (!s.shard.owns(w)) e[t.work[w]] = glm::vec3(0.0f);
   }
   out.gather_seconds = seconds_since(t0);
+  for (std::uint64_t r : rays_of) out.shared_rays += r;
+  out.rays = out.shared_rays + out.own_rays;
+  out.hidden = std::move(hidden);
 
-  // Step 4.
-  t0 = Clock::now();
-  if (filtering) {
-    e = filter_world(tx, t, e, hidden, s.filter_radius_texels * texel_m, texel_m, pool);
-  }
-  out.filter_seconds = seconds_since(t0);
-  for (std::uint64_t r : rays_of) out.rays += r;
+  // Step 4 (a shard leaves it to the merge).
+  if (s.part_only) return out;
+  if (auto ok = filter_gathered(b, layout, s, pool, out); !ok) return ok.error();
   if (s.progress && !s.progress(1.0)) return engine::cancelled_error("light-atlas gather");
   return out;
+}
+
+engine::Status filter_gathered(const StaticBakeScene& b, const AtlasLayout& layout, const TexelGatherSettings& s,
+                               ThreadPool& pool, TexelGatherResult& out) {
+  const auto t0 = Clock::now();
+  const float texel_m = layout.texels_per_metre > 0.0f ? 1.0f / layout.texels_per_metre : 0.0f;
+  if (s.filter_radius_texels > 0.0f && texel_m > 0.0f) {
+    auto table = texel_table(b, layout);
+    if (!table) return table.error();
+    if (out.indirect.size() != b.texels.valid.size() || out.hidden.size() != b.texels.valid.size())
+      return engine::Error{.message = "texel gather: the result to filter does not match the atlas"};
+    out.indirect = filter_world(b.texels, *table, out.indirect, out.hidden, s.filter_radius_texels * texel_m, texel_m,
+                                pool);
+  }
+  out.filter_seconds = seconds_since(t0);
+  return {};
 }
 
 

@@ -34,6 +34,7 @@
 #include <vector>
 
 #include "core/thread_pool.h"
+#include "core/work_shard.h"
 #include "transport/static_scene.h"
 #include "uv/atlas_layout.h"
 
@@ -47,12 +48,21 @@ struct TexelGatherSettings {
   float filter_radius_texels = 0.0f; ///< World-space filter radius in texels (0: none).
   std::uint64_t seed = 1;
   ProgressCallback progress;         ///< Fraction done in [0, 1]; return false to cancel.
+  /// A distributed bake's shard (docs/distributed-bake.md): steps 1-2 run for every texel
+  /// (every shard repeats them, bit for bit), step 3 only for the shard's texel blocks
+  /// (the others stay 0), and with `part_only` step 4 not at all (filter_gathered runs it
+  /// on the merged result).
+  WorkShard shard;
+  bool part_only = false;
 };
 
 struct TexelGatherResult {
   std::vector<glm::vec3> indirect;  ///< Per texel, W/m^2 (0 on empty texels, not dilated).
   std::vector<glm::vec3> direct;    ///< Per texel, W/m^2 (step 1, sky included).
   std::uint64_t rays = 0;
+  std::uint64_t shared_rays = 0;  ///< Of `rays`: steps 1-2 (every texel, in every shard).
+  std::uint64_t own_rays = 0;     ///< Of `rays`: step 3 for the shard's texels.
+  std::vector<std::uint8_t> hidden;  ///< Per texel: seen from behind geometry; the filter skips it.
   int iterations = 0;  ///< Bounces the solve ran.
   double direct_seconds = 0.0, solve_seconds = 0.0, gather_seconds = 0.0, filter_seconds = 0.0;
 };
@@ -61,6 +71,12 @@ struct TexelGatherResult {
 /// rasterized from.
 engine::Result<TexelGatherResult> gather_atlas(const StaticBakeScene& scene, const AtlasLayout& layout,
                                                const TexelGatherSettings& settings, ThreadPool& pool);
+
+/// Step 4 on a result whose steps 1-3 ran (merged from shards): the world-space filter of
+/// `result.indirect` when settings.filter_radius_texels > 0. gather_atlas of a whole bake
+/// ends with exactly this call.
+engine::Status filter_gathered(const StaticBakeScene& scene, const AtlasLayout& layout,
+                               const TexelGatherSettings& settings, ThreadPool& pool, TexelGatherResult& result);
 
 /// Irradiance at surface points read from a texel field: each point takes the nearest
 /// valid texel within two texels whose normal faces its own (within 60 degrees); 0 where

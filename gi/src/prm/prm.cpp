@@ -92,9 +92,15 @@ std::vector<PathNode> random_walks(const VplSet& entries, std::size_t k, const S
   return nodes;
 }
 
-}  // namespace
+// How bake_prm runs: whole, as one shard (fills *part, stops before dilation), or as the
+// merge of the shards' parts (no walks, no shadow rays).
+struct PrmRun {
+  WorkShard shard;
+  PrmShardPart* part = nullptr;
+  const std::vector<PrmShardPart>* parts = nullptr;
+};
 
-engine::Result<Prm> bake_prm(const BakeInput& input, const PrmSettings& settings) {
+engine::Result<Prm> bake_prm_run(const BakeInput& input, const PrmSettings& settings, const PrmRun& run) {
   if (auto ok = validate(settings); !ok) return ok.error();
   if (auto ok = validate_bake_input(input); !ok) return ok.error();
   const auto t_start = Clock::now();
@@ -139,64 +145,110 @@ engine::Result<Prm> bake_prm(const BakeInput& input, const PrmSettings& settings
     ++prm.cluster_size[cluster_of[k]];
   }
 
-  // Random walks, per entry point in parallel (each from its own stream).
-  auto t0 = Clock::now();
-  std::vector<std::vector<PathNode>> walks(n_entries);
-  std::vector<std::uint64_t> walk_rays(n_entries, 0);
-  std::vector<std::size_t> walk_paths(n_entries, 0);
-  pool.parallel_for(n_entries, [&](std::size_t k) {
-    walks[k] = random_walks(*entries, k, s, triangle_albedo, settings, walk_rays[k], walk_paths[k]);
-  });
-  for (std::size_t k = 0; k < n_entries; ++k) {
-    prm.stats.rays += walk_rays[k];
-    prm.stats.paths += walk_paths[k];
-    prm.stats.path_nodes += walks[k].size();
-  }
-  prm.stats.walk_seconds = seconds_since(t0);
-  if (settings.progress && !settings.progress(0.05)) return engine::cancelled_error("PRM bake");
-
-  // Items (eq. 3): every virtual light connected to every reference point it sees, summed
-  // per (cluster, texel). Parallel over texels; each texel visits the nodes in a fixed
-  // order, so the sums do not depend on the thread count. The near field is regularized by
-  // the entry point's area (cos cos / (pi d^2 + A), point_emitters.h).
-  t0 = Clock::now();
   const AtlasTexels& tex = s.texels;
   std::vector<std::uint32_t> valid;
   for (std::size_t t = 0; t < tex.valid.size(); ++t)
     if (tex.valid[t]) valid.push_back(static_cast<std::uint32_t>(t));
   const auto clusters = static_cast<std::size_t>(prm.cluster_count);
   std::vector<glm::vec3> full(clusters * tex.valid.size(), glm::vec3(0.0f));  // [cluster][texel]
-  std::atomic<std::uint64_t> rays{0};
-  const std::size_t batches = std::clamp<std::size_t>(valid.size() / 64, 1, 100);
-  for (std::size_t b = 0; b < batches; ++b) {
-    const std::size_t begin = valid.size() * b / batches, end = valid.size() * (b + 1) / batches;
-    pool.parallel_for(
-        end - begin,
-        [&](std::size_t w) {
-          const std::uint32_t t = valid[begin + w];
-          const glm::vec3 p = tex.position[t], n = tex.normal[t];
-          std::vector<glm::dvec3> sum(clusters, glm::dvec3(0.0));
-          std::uint64_t local = 0;
-          for (std::size_t k = 0; k < n_entries; ++k) {
-            const float area = prm.entries[k].area_m2 / settings.splitting;
-            glm::dvec3 item(0.0);
-            for (const PathNode& v : walks[k]) {
-              const float f = lambertian_kernel(v.position, v.normal, area, false, p, n, 0.0f);
-              if (f <= 0.0f) continue;
-              ++local;
-              if (segment_visible(*s.caster, p, n, v.position, v.normal))
-                item += glm::dvec3(v.power) * static_cast<double>(f);
+  auto t0 = Clock::now();
+  if (run.parts) {  // the merge: the shards' items in place of the walks and shadow rays
+    const auto count = static_cast<std::uint32_t>(run.parts->size());
+    for (std::uint32_t i = 0; i < count; ++i) {
+      const PrmShardPart& p = (*run.parts)[i];
+      const WorkShard shard{.index = i, .count = count};
+      std::vector<std::uint32_t> expected;
+      for (std::size_t w = 0; w < valid.size(); ++w)
+        if (shard.owns(w)) expected.push_back(valid[w]);
+      if (p.texels != expected || p.cluster_count != prm.cluster_count ||
+          p.values.size() != expected.size() * clusters * 3)
+        return engine::Error{.message = "PRM shard " + std::to_string(i) + " of " + std::to_string(count) +
+                                        ": its texels or clusters are not that shard's of this scene's atlas"};
+      for (std::size_t k = 0; k < expected.size(); ++k)
+        for (std::size_t c = 0; c < clusters; ++c)
+          full[c * tex.valid.size() + expected[k]] =
+              glm::vec3(p.values[(k * clusters + c) * 3], p.values[(k * clusters + c) * 3 + 1],
+                        p.values[(k * clusters + c) * 3 + 2]);
+      prm.stats.rays += p.pane_rays;
+    }
+    if (count > 0) {
+      const PrmShardPart& first = run.parts->front();
+      prm.stats.rays += first.walk_rays;
+      prm.stats.paths = first.paths;
+      prm.stats.path_nodes = first.path_nodes;
+    }
+    if (settings.progress && !settings.progress(0.95)) return engine::cancelled_error("PRM merge");
+  } else {
+    // Random walks, per entry point in parallel (each from its own stream).
+    std::vector<std::vector<PathNode>> walks(n_entries);
+    std::vector<std::uint64_t> walk_rays(n_entries, 0);
+    std::vector<std::size_t> walk_paths(n_entries, 0);
+    pool.parallel_for(n_entries, [&](std::size_t k) {
+      walks[k] = random_walks(*entries, k, s, triangle_albedo, settings, walk_rays[k], walk_paths[k]);
+    });
+    for (std::size_t k = 0; k < n_entries; ++k) {
+      prm.stats.rays += walk_rays[k];
+      prm.stats.paths += walk_paths[k];
+      prm.stats.path_nodes += walks[k].size();
+    }
+    prm.stats.walk_seconds = seconds_since(t0);
+    if (settings.progress && !settings.progress(0.05)) return engine::cancelled_error("PRM bake");
+
+    // Items (eq. 3): every virtual light connected to every reference point it sees, summed
+    // per (cluster, texel). Parallel over texels; each texel visits the nodes in a fixed
+    // order, so the sums do not depend on the thread count. The near field is regularized by
+    // the entry point's area (cos cos / (pi d^2 + A), point_emitters.h).
+    t0 = Clock::now();
+    const std::vector<std::size_t> mine = run.shard.items(valid.size());  // all of them in a whole bake
+    std::atomic<std::uint64_t> rays{0};
+    const std::size_t batches = std::clamp<std::size_t>(mine.size() / 64, 1, 100);
+    for (std::size_t b = 0; b < batches; ++b) {
+      const std::size_t begin = mine.size() * b / batches, end = mine.size() * (b + 1) / batches;
+      pool.parallel_for(
+          end - begin,
+          [&](std::size_t w) {
+            const std::uint32_t t = valid[mine[begin + w]];
+            const glm::vec3 p = tex.position[t], n = tex.normal[t];
+            std::vector<glm::dvec3> sum(clusters, glm::dvec3(0.0));
+            std::uint64_t local = 0;
+            for (std::size_t k = 0; k < n_entries; ++k) {
+              const float area = prm.entries[k].area_m2 / settings.splitting;
+              glm::dvec3 item(0.0);
+              for (const PathNode& v : walks[k]) {
+                const float f = lambertian_kernel(v.position, v.normal, area, false, p, n, 0.0f);
+                if (f <= 0.0f) continue;
+                ++local;
+                if (segment_visible(*s.caster, p, n, v.position, v.normal))
+                  item += glm::dvec3(v.power) * static_cast<double>(f);
+              }
+              sum[prm.entries[k].cluster] += item;
             }
-            sum[prm.entries[k].cluster] += item;
-          }
-          for (std::size_t c = 0; c < clusters; ++c) full[c * tex.valid.size() + t] = glm::vec3(sum[c]);
-          rays += local;
-        },
-        4);
-    if (settings.progress && !settings.progress(0.05 + 0.9 * static_cast<double>(b + 1) / static_cast<double>(batches)))
-      return engine::cancelled_error("PRM bake");
+            for (std::size_t c = 0; c < clusters; ++c) full[c * tex.valid.size() + t] = glm::vec3(sum[c]);
+            rays += local;
+          },
+          4);
+      if (settings.progress && !settings.progress(0.05 + 0.9 * static_cast<double>(b + 1) / static_cast<double>(batches)))
+        return engine::cancelled_error("PRM bake");
+    }
+    if (run.part) {
+      PrmShardPart& p = *run.part;
+      p.cluster_count = prm.cluster_count;
+      p.paths = prm.stats.paths;
+      p.path_nodes = prm.stats.path_nodes;
+      p.walk_rays = prm.stats.rays;
+      p.pane_rays = rays.load();
+      p.texels.reserve(mine.size());
+      p.values.reserve(mine.size() * clusters * 3);
+      for (std::size_t w : mine) {
+        const std::uint32_t t = valid[w];
+        p.texels.push_back(t);
+        for (std::size_t c = 0; c < clusters; ++c)
+          for (int ch = 0; ch < 3; ++ch) p.values.push_back(full[c * tex.valid.size() + t][ch]);
+      }
+      return Prm{};
+    }
+    prm.stats.rays += rays.load();
   }
-  prm.stats.rays += rays.load();
 
   // Dilation is linear: dilate every pane like the light atlas, keep the filled texels.
   const int rings = std::max(4, prm.layout.padding_texels);
@@ -216,6 +268,28 @@ engine::Result<Prm> bake_prm(const BakeInput& input, const PrmSettings& settings
   prm.stats.pane_seconds = seconds_since(t0);
   prm.stats.total_seconds = seconds_since(t_start);
   return prm;
+}
+
+}  // namespace
+
+engine::Result<Prm> bake_prm(const BakeInput& input, const PrmSettings& settings) {
+  return bake_prm_run(input, settings, {});
+}
+
+engine::Result<PrmShardPart> bake_prm_shard(const BakeInput& input, const PrmSettings& settings, WorkShard shard) {
+  if (shard.count == 0 || shard.index >= shard.count)
+    return engine::invalid_request("PRM shard " + std::to_string(shard.index) + " of " + std::to_string(shard.count) +
+                                   " does not exist");
+  PrmShardPart part;
+  auto done = bake_prm_run(input, settings, {.shard = shard, .part = &part, .parts = nullptr});
+  if (!done) return done.error();
+  return part;
+}
+
+engine::Result<Prm> merge_prm(const BakeInput& input, const PrmSettings& settings,
+                              const std::vector<PrmShardPart>& parts) {
+  if (parts.empty()) return engine::invalid_request("PRM merge: no shard");
+  return bake_prm_run(input, settings, {.shard = {}, .part = nullptr, .parts = &parts});
 }
 
 engine::Result<PrmSettings> prm_preset(std::string_view name) {

@@ -20,6 +20,7 @@
 #include <string_view>
 #include <vector>
 
+#include "core/work_shard.h"
 #include "uv/atlas_layout.h"
 
 namespace gi {
@@ -75,6 +76,28 @@ struct Prm {
 
   std::size_t pane_size() const { return texels.size(); }
 };
+
+/// What one shard of a distributed bake computed (docs/distributed-bake.md): the items of
+/// its texel blocks (WorkShard over the valid atlas texels in index order), every cluster's
+/// sum, before dilation. Entry points, clustering and the random walks are repeated bit for
+/// bit by every shard (and the entry points and clusters by the merge) instead of shipped.
+struct PrmShardPart {
+  std::vector<std::uint32_t> texels;  ///< Atlas texel indices, ascending.
+  int cluster_count = 0;
+  /// Texel k of `texels`, cluster c, channel ch at values[(k * cluster_count + c) * 3 + ch].
+  std::vector<float> values;
+  std::size_t paths = 0, path_nodes = 0;  ///< Of the walks (the same in every shard).
+  std::uint64_t walk_rays = 0;            ///< Rays of the walks (the same in every shard).
+  std::uint64_t pane_rays = 0;            ///< Shadow rays of this shard's texels.
+};
+
+/// Shard `shard` of bake_prm(input, settings).
+engine::Result<PrmShardPart> bake_prm_shard(const BakeInput& input, const PrmSettings& settings, WorkShard shard);
+
+/// bake_prm(input, settings), bit for bit, from the parts of shards 0..N-1 (parts[i] of
+/// shard i). Error when a part's texels or clusters are not its shard's.
+engine::Result<Prm> merge_prm(const BakeInput& input, const PrmSettings& settings,
+                              const std::vector<PrmShardPart>& parts);
 
 /// preview / medium / high (docs/sweeps/prm_spot_chamber.md). The pane density follows the
 /// light atlas preset of the same name, so both share one uv1 layout.
