@@ -5,6 +5,8 @@
 # clang) and llvm (llvm-symbolizer for sanitizer stack traces) build the fuzz targets
 # (tools/fuzz.sh); the regular build stays GCC.
 # python3-matplotlib draws the sweep plots (tools/plot-sweep.py); nothing in the build needs it.
+# slurmctld, slurmd, slurm-client and munge run the CI leg "slurm": a single-node Slurm on
+# localhost for the distributed bake's test (tools/slurm/ci-test.sh); nothing in the build needs them.
 set -euo pipefail
 packages=(
   build-essential cmake ninja-build pkg-config git
@@ -15,6 +17,7 @@ packages=(
   xvfb xauth
   clang libclang-rt-14-dev llvm
   python3-matplotlib
+  slurmctld slurmd slurm-client munge
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -1,0 +1,149 @@
+#!/usr/bin/env bash
+# CI leg "slurm" (docs/distributed-bake.md): a single-node Slurm on localhost — munged with a
+# generated key, slurmctld and slurmd (Debian's slurm-wlm 22.05, tools/install-deps.sh) with
+# a generated slurm.conf, everything in a temporary directory — runs tools/slurm/submit.sh's
+# array job (3 shards + the dependent merge) for the Cornell box's light atlas and PRM and
+# compares the merged bundle byte for byte with a local one-process bake. It stops the
+# daemons it started (trap), prints their logs on failure, and gives every wait a timeout.
+#   bash tools/slurm/ci-test.sh [BUILD_DIR]      # needs BUILD_DIR/tools/gi-bake/gi-bake
+set -euo pipefail
+repo=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
+build=$(cd "${1:-$repo/build}" && pwd)
+gi_bake=$build/tools/gi-bake/gi-bake
+shards=${GI_SLURM_SHARDS:-3}
+start_time=$(date +%s)
+say() { echo "slurm-ci: $*"; }
+die() { echo "slurm-ci: FAIL: $*" >&2; exit 1; }
+
+[ -x "$gi_bake" ] || die "$gi_bake not built (cmake --build $build --target gi-bake)"
+for tool in munged munge slurmctld slurmd sbatch squeue scontrol sinfo; do
+  command -v "$tool" > /dev/null || die "$tool not found: install slurmctld slurmd slurm-client munge (tools/install-deps.sh)"
+done
+
+work=$(mktemp -d /tmp/gi-slurm-ci.XXXXXX)
+chmod 755 "$work"
+pids=()
+declare -A daemon=()  # PID -> name, for the messages
+status=1
+cleanup() {
+  local rc=$?
+  for pid in "${pids[@]}"; do kill "$pid" 2> /dev/null || true; done
+  for pid in "${pids[@]}"; do
+    for _ in $(seq 50); do kill -0 "$pid" 2> /dev/null || break; sleep 0.1; done
+    kill -9 "$pid" 2> /dev/null || true
+  done
+  if [ "$status" -ne 0 ] || [ "$rc" -ne 0 ]; then
+    for log in "$work"/*.log "$work"/logs/*.log; do
+      [ -f "$log" ] || continue
+      echo "----- $log (last 40 lines)" >&2
+      tail -n 40 "$log" >&2
+    done
+    echo "slurm-ci: files kept in $work" >&2
+  else
+    rm -rf "$work"
+  fi
+}
+trap cleanup EXIT
+
+# wait_for SECONDS WHAT PID COMMAND...: polls COMMAND every 0.2 s; fails at once when the
+# daemon PID (- for none) has exited.
+wait_for() {
+  local seconds=$1 what=$2 pid=$3
+  shift 3
+  local deadline=$(($(date +%s) + seconds))
+  until "$@" > /dev/null 2>&1; do
+    [ "$pid" = - ] || kill -0 "$pid" 2> /dev/null || die "${daemon[$pid]:-the daemon} (PID $pid) exited while waiting for $what (logs below)"
+    [ "$(date +%s)" -lt "$deadline" ] || die "timed out after ${seconds} s waiting for $what"
+    sleep 0.2
+  done
+}
+
+# munge: a fresh key, its own socket.
+dd if=/dev/urandom of="$work/munge.key" bs=1024 count=1 status=none
+chmod 400 "$work/munge.key"
+munged -F --force --key-file="$work/munge.key" --socket="$work/munge.sock" --pid-file="$work/munged.pid" \
+  --log-file="$work/munged.log" --seed-file="$work/munged.seed" > "$work/munged.log" 2>&1 &
+pids+=($!) && daemon[$!]=munged
+wait_for 10 "munged's socket" "${pids[-1]}" test -S "$work/munge.sock"
+
+# slurm.conf: one node (this host, all its CPUs), one partition, ports from the PID.
+node=$(hostname -s)
+cpus=$(nproc)
+port=$((20000 + ($$ % 2000) * 2))
+mkdir -p "$work/state" "$work/spool" "$work/logs"
+cat > "$work/slurm.conf" << CONF
+ClusterName=gi-ci
+SlurmctldHost=$node(127.0.0.1)
+SlurmctldPort=$port
+SlurmdPort=$((port + 1))
+SlurmUser=root
+SlurmdUser=root
+AuthType=auth/munge
+CredType=cred/munge
+AuthInfo=socket=$work/munge.sock
+StateSaveLocation=$work/state
+SlurmdSpoolDir=$work/spool
+SlurmctldPidFile=$work/slurmctld.pid
+SlurmdPidFile=$work/slurmd.pid
+SlurmctldLogFile=$work/slurmctld.log
+SlurmdLogFile=$work/slurmd.log
+SlurmctldDebug=info
+SlurmdDebug=info
+ProctrackType=proctrack/linuxproc
+TaskPlugin=task/none
+JobAcctGatherType=jobacct_gather/none
+AccountingStorageType=accounting_storage/none
+SchedulerType=sched/builtin
+SelectType=select/cons_tres
+SelectTypeParameters=CR_CPU
+ReturnToService=2
+MpiDefault=none
+MinJobAge=600
+NodeName=$node NodeAddr=127.0.0.1 CPUs=$cpus State=UNKNOWN
+PartitionName=ci Nodes=$node Default=YES MaxTime=30 State=UP
+CONF
+export SLURM_CONF=$work/slurm.conf
+
+slurmctld -D -i -f "$SLURM_CONF" > "$work/slurmctld.out.log" 2>&1 &
+pids+=($!) && daemon[$!]=slurmctld
+wait_for 20 "slurmctld to answer" "${pids[-1]}" scontrol ping
+slurmd -D -f "$SLURM_CONF" -N "$node" > "$work/slurmd.out.log" 2>&1 &
+pids+=($!) && daemon[$!]=slurmd
+node_idle() { sinfo -h -n "$node" -o %T | grep -qx idle; }
+wait_for 30 "node $node to be idle" "${pids[-1]}" node_idle
+say "Slurm up on $node ($cpus CPUs) in $(($(date +%s) - start_time)) s"
+
+# The bake both ways.
+scene=$repo/assets/cornell_box.gltf
+opts=(--preset preview --methods atlas,prm --density 10 --seed 3)
+"$gi_bake" --scene "$scene" --out "$work/local.gibake" "${opts[@]}" > "$work/local-bake.log" 2>&1 ||
+  die "the local bake failed"
+read -r array merge < <(bash "$repo/tools/slurm/submit.sh" --shards "$shards" --gi-bake "$gi_bake" --scene "$scene" \
+  --out "$work/slurm.gibake" --logs "$work/logs" -- "${opts[@]}")
+say "submitted array job $array ($shards shards) and merge job $merge"
+
+job_state() { scontrol -o show job "$1" 2> /dev/null | grep -o 'JobState=[A-Z_]*' | head -n 1 | cut -d= -f2; }
+merge_done() {
+  case $(job_state "$merge") in
+    COMPLETED | FAILED | CANCELLED | TIMEOUT | NODE_FAIL | OUT_OF_MEMORY | BOOT_FAIL | DEADLINE) return 0 ;;
+    *) return 1 ;;
+  esac
+}
+wait_for 90 "the merge job $merge" "${pids[-1]}" merge_done
+state=$(job_state "$merge")
+scontrol -o show job "$array" | sed -E 's/.*JobId=([0-9]+).*ArrayTaskId=([0-9]+).*JobState=([A-Z_]+).*/slurm-ci: shard task \2 (job \1) \3/' || true
+[ "$state" = COMPLETED ] || die "merge job $merge ended $state"
+
+# Byte for byte (bake_stats.json holds the timings and hosts and differs by design).
+[ -f "$work/slurm.gibake/manifest.json" ] || die "no merged bundle"
+files=0
+for f in "$work/local.gibake"/*; do
+  name=$(basename "$f")
+  [ "$name" = bake_stats.json ] && continue
+  cmp "$f" "$work/slurm.gibake/$name" || die "$name differs between the Slurm bake and the local bake"
+  files=$((files + 1))
+done
+[ "$(ls "$work/slurm.gibake" | wc -l)" -eq "$(ls "$work/local.gibake" | wc -l)" ] || die "the bundles hold other files"
+[ "$files" -ge 4 ] || die "only $files files compared"
+status=0
+say "PASS: $shards shards through Slurm, $files files byte-identical to the local bake, $(($(date +%s) - start_time)) s"
