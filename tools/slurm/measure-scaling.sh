@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
-# The table of docs/distributed-bake.md: bake seconds against shard count on this machine,
-# shards run one after another as separate gi-bake processes with one thread each (what one
-# cluster node's core does), the merge after them; the one-process bake with one thread is
-# the baseline. Prints a Markdown table and the serial fraction s fitted from it (Amdahl:
-# speed-up on N nodes = 1 / (s + (1 - s) / N)).
+# The table of docs/distributed-bake.md: bake seconds against shard count on this machine.
+# Shards run one after another as separate gi-bake processes with one thread each (what one
+# core of a cluster node does), the merge after them; the baseline is the one-process bake
+# with one thread. Times are CPU seconds (user + system) of each process, which a loaded,
+# shared machine disturbs far less than wall time (the wall time of the whole run is
+# printed too). Prints a Markdown table; a node per shard would take max(shard) + merge.
 #   bash tools/slurm/measure-scaling.sh [BUILD_DIR] [SCENE] [PRESET] [SHARD COUNTS...]
 set -euo pipefail
 repo=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
@@ -16,37 +17,45 @@ counts=("$@")
 gi_bake=$build/tools/gi-bake/gi-bake
 work=$(mktemp -d /tmp/gi-scaling.XXXXXX)
 trap 'rm -rf "$work"' EXIT
-now() { date +%s.%N; }
-secs() { python3 -c "print(f'{$2 - $1:.2f}')"; }
+# cpu_seconds LOG COMMAND...: runs COMMAND (stdout to LOG), prints its CPU seconds.
+cpu_seconds() {
+  python3 - "$@" << 'PY'
+import resource, subprocess, sys
+with open(sys.argv[1], "w") as log:
+    subprocess.run(sys.argv[2:], check=True, stdout=log, stderr=subprocess.STDOUT)
+r = resource.getrusage(resource.RUSAGE_CHILDREN)
+print(f"{r.ru_utime + r.ru_stime:.2f}")
+PY
+}
+calc() { python3 -c "print($1)"; }
 opts=(--preset "$preset" --threads 1)
+started=$(date +%s)
 
-t0=$(now)
-"$gi_bake" --scene "$scene" --out "$work/whole.gibake" "${opts[@]}" > "$work/whole.log"
-whole=$(secs "$t0" "$(now)")
-echo "| shards N | shard seconds (min / max) | sum of shards | merge | cluster wall (max shard + merge) | speed-up | byte-identical |"
+whole=$(cpu_seconds "$work/whole.log" "$gi_bake" --scene "$scene" --out "$work/whole.gibake" "${opts[@]}")
+grep -E "^gi-bake: (atlas|prm|dlm|brf|antiradiance): " "$work/whole.log" | sed 's/^/one process: /' >&2
+echo "| shards N | shard CPU s (min / max) | sum of shards | merge | max shard + merge | speed-up | byte-identical |"
 echo "|---:|---:|---:|---:|---:|---:|:---:|"
 echo "| one process | | | | $whole | 1.00 | |"
 for n in "${counts[@]}"; do
   out=$work/n$n.gibake
   min="" max=0 sum=0
   for ((i = 0; i < n; i++)); do
-    t0=$(now)
-    "$gi_bake" --scene "$scene" --out "$out" "${opts[@]}" --shard "$i/$n" > "$work/shard.log"
-    s=$(secs "$t0" "$(now)")
-    sum=$(python3 -c "print(f'{$sum + $s:.2f}')")
-    max=$(python3 -c "print(max($max, $s))")
-    min=$(python3 -c "print($s if '$min' == '' else min($min, $s))")
+    s=$(cpu_seconds "$work/shard.log" "$gi_bake" --scene "$scene" --out "$out" "${opts[@]}" --shard "$i/$n")
+    sum=$(calc "round($sum + $s, 2)")
+    max=$(calc "max($max, $s)")
+    if [ -z "$min" ]; then min=$s; else min=$(calc "min($min, $s)"); fi
   done
-  t0=$(now)
-  "$gi_bake" --scene "$scene" --out "$out" "${opts[@]}" --merge > "$work/merge.log"
-  merge=$(secs "$t0" "$(now)")
+  grep -E "shard [0-9]+/[0-9]+:" "$work/shard.log" | sed "s/^/N = $n, last shard: /" >&2
+  merge=$(cpu_seconds "$work/merge.log" "$gi_bake" --scene "$scene" --out "$out" "${opts[@]}" --merge)
+  grep -E "^gi-bake: (atlas|prm|dlm|brf|antiradiance): " "$work/merge.log" | sed "s/^/N = $n, merge: /" >&2
   same=yes
   for f in "$work/whole.gibake"/*; do
     [ "$(basename "$f")" = bake_stats.json ] && continue
     cmp -s "$f" "$out/$(basename "$f")" || same=no
   done
-  wall=$(python3 -c "print(f'{$max + $merge:.2f}')")
-  speed=$(python3 -c "print(f'{$whole / ($max + $merge):.2f}')")
+  wall=$(calc "round($max + $merge, 2)")
+  speed=$(calc "round($whole / ($max + $merge), 2)")
   echo "| $n | $min / $max | $sum | $merge | $wall | $speed | $same |"
   rm -rf "$out" "$out.shards"
 done
+echo "(measured in $(($(date +%s) - started)) s wall on $(nproc) cores, load $(cut -d' ' -f1-3 /proc/loadavg))" >&2
