@@ -6,6 +6,7 @@
 # shared machine disturbs far less than wall time (the wall time of the whole run is
 # printed too). Prints a Markdown table; a node per shard would take max(shard) + merge.
 #   bash tools/slurm/measure-scaling.sh [BUILD_DIR] [SCENE] [PRESET] [SHARD COUNTS...]
+#   GI_BAKE_OPTS="--methods atlas,prm" bash tools/slurm/measure-scaling.sh   # more gi-bake options
 set -euo pipefail
 repo=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
 build=$(cd "${1:-$repo/build}" && pwd)
@@ -28,7 +29,8 @@ print(f"{r.ru_utime + r.ru_stime:.2f}")
 PY
 }
 calc() { python3 -c "print($1)"; }
-opts=(--preset "$preset" --threads 1)
+# shellcheck disable=SC2206  # GI_BAKE_OPTS is a list of options
+opts=(--preset "$preset" --threads 1 ${GI_BAKE_OPTS:-})
 started=$(date +%s)
 
 whole=$(cpu_seconds "$work/whole.log" "$gi_bake" --scene "$scene" --out "$work/whole.gibake" "${opts[@]}")
