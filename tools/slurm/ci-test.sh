@@ -118,8 +118,11 @@ scene=$repo/assets/cornell_box.gltf
 opts=(--preset preview --methods atlas,prm --density 10 --seed 3)
 "$gi_bake" --scene "$scene" --out "$work/local.gibake" "${opts[@]}" > "$work/local-bake.log" 2>&1 ||
   die "the local bake failed"
-read -r array merge < <(bash "$repo/tools/slurm/submit.sh" --shards "$shards" --gi-bake "$gi_bake" --scene "$scene" \
-  --out "$work/slurm.gibake" --logs "$work/logs" -- "${opts[@]}")
+jobs=$(bash "$repo/tools/slurm/submit.sh" --shards "$shards" --gi-bake "$gi_bake" --scene "$scene" \
+  --out "$work/slurm.gibake" --logs "$work/logs" -- "${opts[@]}" 2> "$work/submit.log") ||
+  die "submit.sh failed: $(cat "$work/submit.log")"
+read -r array merge <<< "$jobs"
+[[ $array =~ ^[0-9]+$ && $merge =~ ^[0-9]+$ ]] || die "submit.sh printed '$jobs', not two job ids"
 say "submitted array job $array ($shards shards) and merge job $merge"
 
 job_state() { scontrol -o show job "$1" 2> /dev/null | grep -o 'JobState=[A-Z_]*' | head -n 1 | cut -d= -f2; }
@@ -131,7 +134,7 @@ merge_done() {
 }
 wait_for 90 "the merge job $merge" "${pids[-1]}" merge_done
 state=$(job_state "$merge")
-scontrol -o show job "$array" | sed -E 's/.*JobId=([0-9]+).*ArrayTaskId=([0-9]+).*JobState=([A-Z_]+).*/slurm-ci: shard task \2 (job \1) \3/' || true
+scontrol -o show job "$array" | sed -E 's/.*JobId=([0-9]+).*ArrayTaskId=([0-9]+).*JobState=([A-Z_]+).*/slurm-ci: shard task \2 of array job \1: \3/' || true
 [ "$state" = COMPLETED ] || die "merge job $merge ended $state"
 
 # Byte for byte (bake_stats.json holds the timings and hosts and differs by design).
