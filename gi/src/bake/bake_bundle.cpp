@@ -17,8 +17,8 @@
 #include <utility>
 
 #include "antiradiance/antiradiance_io.h"
-#include "bake/bake_shard.h"
 #include "antiradiance/antiradiance_region.h"
+#include "bake/bake_shard.h"
 #include "brf/brf_bake.h"
 #include "brf/brf_io.h"
 #include "brf/brf_mesh.h"

@@ -95,8 +95,8 @@ engine::Result<ShardFile> read_shard_file(const std::filesystem::path& path) {
   if (r.remaining() != 0) return engine::Error{path.string(), location, "unexpected data after the last field"};
   if (parts > (kHasAtlas | kHasPrm)) return engine::Error{path.string(), "parts", "unknown part flags"};
   if (f.count == 0 || f.index >= f.count)
-    return engine::Error{path.string(), "shard", "shard " + std::to_string(f.index) + " of " +
-                                                     std::to_string(f.count) + " does not exist"};
+    return engine::Error{path.string(), "shard",
+                         "shard " + std::to_string(f.index) + " of " + std::to_string(f.count) + " does not exist"};
   if (f.atlas) {
     const LightAtlasShardPart& a = *f.atlas;
     const std::size_t n = a.texels.size();

@@ -22,9 +22,9 @@ namespace gi {
 struct ShardFile {
   std::uint32_t index = 0;
   std::uint32_t count = 1;
-  std::string geometry_hash;   ///< scene_geometry_hash of the input.
-  std::string lights_hash;     ///< static_lights_hash of the input.
-  std::string settings_hash;   ///< Of the BakeOptions that change the result (not threads).
+  std::string geometry_hash;  ///< scene_geometry_hash of the input.
+  std::string lights_hash;    ///< static_lights_hash of the input.
+  std::string settings_hash;  ///< Of the BakeOptions that change the result (not threads).
   std::uint64_t seed = 1;
   std::vector<std::string> methods;  ///< Every method of the bake (the merge bakes the others).
   std::optional<LightAtlasShardPart> atlas;

@@ -145,7 +145,7 @@ namespace {
 // How bake_light_atlas runs: whole, as one shard (steps 1-3 of texel_gather.h, step 3 for
 // the shard's texels, nothing after), or as the merge of the shards' parts.
 struct ShardRun {
-  WorkShard shard;                                          // with part: whose texel blocks
+  WorkShard shard;  // with part: whose texel blocks
   LightAtlasShardPart* part = nullptr;
   const std::vector<LightAtlasShardPart>* parts = nullptr;  // set: the merge
 };

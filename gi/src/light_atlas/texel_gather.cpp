@@ -483,11 +483,14 @@ engine::Result<TexelGatherResult> gather_atlas(const StaticBakeScene& b, const A
 
   // Step 4 (a shard leaves it to the merge).
   if (s.part_only) return out;
-  if (auto ok = filter_gathered(b, layout, s, pool, out); !ok) return ok.error();
+  t0 = Clock::now();
+  if (filtering) out.indirect = filter_world(tx, t, e, out.hidden, s.filter_radius_texels * texel_m, texel_m, pool);
+  out.filter_seconds = seconds_since(t0);
   if (s.progress && !s.progress(1.0)) return engine::cancelled_error("light-atlas gather");
   return out;
 }
 
+// The same filter call as gather_atlas's step 4, for a result merged from shards.
 engine::Status filter_gathered(const StaticBakeScene& b, const AtlasLayout& layout, const TexelGatherSettings& s,
                                ThreadPool& pool, TexelGatherResult& out) {
   const auto t0 = Clock::now();

@@ -73,8 +73,8 @@ engine::Result<TexelGatherResult> gather_atlas(const StaticBakeScene& scene, con
                                                const TexelGatherSettings& settings, ThreadPool& pool);
 
 /// Step 4 on a result whose steps 1-3 ran (merged from shards): the world-space filter of
-/// `result.indirect` when settings.filter_radius_texels > 0. gather_atlas of a whole bake
-/// ends with exactly this call.
+/// `result.indirect` when settings.filter_radius_texels > 0: the same filter, on the same
+/// values, as a whole bake's gather_atlas ends with.
 engine::Status filter_gathered(const StaticBakeScene& scene, const AtlasLayout& layout,
                                const TexelGatherSettings& settings, ThreadPool& pool, TexelGatherResult& result);
 

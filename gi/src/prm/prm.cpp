@@ -227,7 +227,8 @@ engine::Result<Prm> bake_prm_run(const BakeInput& input, const PrmSettings& sett
             rays += local;
           },
           4);
-      if (settings.progress && !settings.progress(0.05 + 0.9 * static_cast<double>(b + 1) / static_cast<double>(batches)))
+      if (settings.progress &&
+          !settings.progress(0.05 + 0.9 * static_cast<double>(b + 1) / static_cast<double>(batches)))
         return engine::cancelled_error("PRM bake");
     }
     if (run.part) {
