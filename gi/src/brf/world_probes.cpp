@@ -74,6 +74,15 @@ engine::Result<WorldProbeGrid> bake_world_probes(const RayCaster& static_world, 
     lo = glm::min(lo, vpls.position[i]);
     hi = glm::max(hi, vpls.position[i]);
   }
+  // VPLs on one plane (an open floor, flat terrain) made a grid one probe thick lying in that
+  // plane, where every probe sees the VPLs edge-on: objects standing on the floor got no world
+  // light at all. Every axis spans at least two cells, grown on both sides (the probe below a
+  // floor sees none of it and stays invalid; the one above it lights what stands there).
+  {
+    const glm::vec3 grow = glm::max(glm::vec3(2.0f * settings.spacing_m) - (hi - lo), glm::vec3(0.0f)) * 0.5f;
+    lo -= grow;
+    hi += grow;
+  }
   // Cells counted in double before any integer conversion: VPLs 2e9 m apart must widen the
   // spacing, not overflow the dimensions.
   const glm::dvec3 extent = glm::dvec3(hi) - glm::dvec3(lo);
