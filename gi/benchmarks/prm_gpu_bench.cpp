@@ -1,10 +1,19 @@
 // The PRM pane sum on the GPU (PrmGpuPass::run): milliseconds per run for T pane texels and K
 // selected clusters, with glFinish inside the timed region (DESIGN.md §4: on llvmpipe these
-// are CPU timings; compare them as ratios). Counters: pane texel x cluster products per
-// second and the half-float pane bytes read per second.
-//   ./build/benchmarks/prm_gpu_bench --benchmark_counters_tabular=true
+// are CPU timings; compare them as ratios). The yardstick is measured in the same loop,
+// interleaved with the pane sum (one of each per iteration, so machine load hits both
+// alike): a plain compute kernel streaming the same bytes (the K half-float panes, T x K x 6
+// bytes) as vec4 loads into a vec4 buffer of the same size (read + write). Counters:
+//   pane_GB/s     pane bytes read per second by the pane sum (median iteration);
+//   stream_GB/s   the same bytes read per second by the yardstick (median iteration);
+//   vs_stream     pane_GB/s / stream_GB/s: the share of the device's streaming bandwidth
+//                 (issue 23 target >= 0.5);
+//   Mtexel_clusters/s  pane texel x cluster products per second.
+//   ./build/gi/benchmarks/prm_gpu_bench --benchmark_counters_tabular=true
 #include <GL/glcorearb.h>
 
+#include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <map>
@@ -13,6 +22,8 @@
 
 #include <benchmark/benchmark.h>
 #include <engine/gpu/context.h>
+#include <engine/gpu/gl_objects.h>
+#include <engine/gpu/shader_program.h>
 
 #include "bench_gl.h"
 
@@ -56,28 +67,98 @@ gi::PrmGpuPass& pass_for(std::size_t texels) {
   return *p;
 }
 
+// The yardstick: dst[i] = src[i] * scale over vec4s, one vec4 per invocation (the simplest
+// streaming kernel; the multiply keeps the copy from being a plain memcpy).
+constexpr const char* kStreamShader = R"(#version 450 core
+layout(local_size_x = 64) in;
+layout(std430, binding = 0) readonly buffer Src { vec4 src[]; };
+layout(std430, binding = 1) writeonly buffer Dst { vec4 dst[]; };
+uniform uint u_count;
+uniform float u_scale;
+void main() {
+  const uint i = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * 64u + gl_LocalInvocationIndex;
+  if (i < u_count) dst[i] = src[i] * u_scale;
+}
+)";
+
+struct StreamKernel {
+  engine::ShaderProgram program;
+  engine::GlBuffer src, dst;
+  std::uint32_t count = 0;  // vec4s
+  int count_location = -1, scale_location = -1;
+
+  explicit StreamKernel(std::size_t bytes) {
+    const engine::ShaderFile file{"stream_yardstick.comp.glsl", "gi/benchmarks/prm_gpu_bench.cpp", kStreamShader};
+    auto built = engine::ShaderProgramBuilder(std::span(&file, 1)).stage(engine::ShaderStage::Compute, file.name).build();
+    if (!built) {
+      std::fprintf(stderr, "%s\n", built.error().to_string().c_str());
+      std::exit(1);
+    }
+    program = std::move(built).value();
+    count = static_cast<std::uint32_t>((bytes + 15) / 16);
+    std::vector<float> data(std::size_t{count} * 4);
+    gi::Pcg32 rng(9, 1);
+    for (float& v : data) v = rng.next_float();
+    src = engine::GlBuffer::create(data.size() * sizeof(float), data.data());
+    dst = engine::GlBuffer::create(data.size() * sizeof(float), nullptr);
+    count_location = glGetUniformLocation(program.id(), "u_count");
+    scale_location = glGetUniformLocation(program.id(), "u_scale");
+  }
+  void run() const {
+    program.use();
+    glProgramUniform1ui(program.id(), count_location, count);
+    glProgramUniform1f(program.id(), scale_location, 0.5f);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, src.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, dst.id());
+    const std::uint32_t groups = (count + 63) / 64;
+    const std::uint32_t gx = std::min<std::uint32_t>(groups, 65535);
+    glDispatchCompute(gx, (groups + gx - 1) / gx, 1);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+  }
+};
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0.0 : v[v.size() / 2];
+}
+
 void BM_PrmGpuSum(benchmark::State& state) {
+  using Clock = std::chrono::steady_clock;
   const auto texels = static_cast<std::size_t>(state.range(0));
   const auto k = static_cast<int>(state.range(1));
   gi::PrmGpuPass& pass = pass_for(texels);
+  const double pane_bytes = double(texels) * double(k) * 6.0;
+  const StreamKernel stream(static_cast<std::size_t>(pane_bytes));
   std::vector<gi::ClusterWeight> selected;
   for (int i = 0; i < k; ++i)
     selected.push_back({static_cast<std::uint32_t>(i * (kClusters / k)), glm::vec3(0.5f, 0.25f, 1.0f)});
   (void)pass.run(selected);  // warm-up: first-dispatch shader compilation in llvmpipe
+  stream.run();
   glFinish();
+  std::vector<double> sum_s, stream_s;
   for (auto _ : state) {
+    const auto t0 = Clock::now();
+    stream.run();
+    glFinish();
+    const auto t1 = Clock::now();
     if (!pass.run(selected)) state.SkipWithError("PrmGpuPass::run failed");
     glFinish();
+    const auto t2 = Clock::now();
+    stream_s.push_back(std::chrono::duration<double>(t1 - t0).count());
+    sum_s.push_back(std::chrono::duration<double>(t2 - t1).count());
+    state.SetIterationTime(sum_s.back());
   }
-  const double products = double(texels) * double(k) * double(state.iterations());
-  state.counters["Mtexel_clusters/s"] = benchmark::Counter(products * 1e-6, benchmark::Counter::kIsRate);
-  state.counters["pane_GB/s"] = benchmark::Counter(products * 6.0 * 1e-9, benchmark::Counter::kIsRate);
+  const double sum_median = median(sum_s), stream_median = median(stream_s);
+  state.counters["Mtexel_clusters/s"] = double(texels) * double(k) * 1e-6 / sum_median;
+  state.counters["pane_GB/s"] = pane_bytes * 1e-9 / sum_median;
+  state.counters["stream_GB/s"] = pane_bytes * 1e-9 / stream_median;
+  state.counters["vs_stream"] = stream_median / sum_median;
 }
 BENCHMARK(BM_PrmGpuSum)
     ->ArgNames({"T", "K"})
-    ->ArgsProduct({{64 << 10, 256 << 10}, {8, 32, 128}})
+    ->ArgsProduct({{64 << 10, 256 << 10}, {8, 16, 32, 128}})
     ->Unit(benchmark::kMillisecond)
-    ->UseRealTime();
+    ->UseManualTime();
 
 }  // namespace
 

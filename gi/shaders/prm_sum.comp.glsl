@@ -1,16 +1,18 @@
 #version 450 core
 // PRM runtime sum (Szécsi et al. 2006, §5.2): for every pane element i,
 //   E(texels[i]) = [base(texels[i])] + sum over the selected clusters k of weight_k * pane_k[i]
-// written into the irradiance atlas at texel (texels[i] % width, texels[i] / width). One
-// invocation per pane element; work groups on a 2-D grid when one row would exceed 65535.
+// written into the irradiance atlas at texel (texels[i] % width, texels[i] / width). Work
+// groups on a 2-D grid when one row would exceed 65535.
 //
 // Pane storage (prm_gpu_pass.cpp writes it): each pane is a run of half floats, three per
-// element (R, G, B) packed tightly, two halves per uint (low half first): element i's halves
-// are 3i..3i+2, so the pair of elements (2j, 2j+1) fills words 3j..3j+2 exactly. One
-// invocation sums one pair: three word loads for two elements (llvmpipe gathers SSBO loads
-// lane by lane, so loads per element set the speed). Every pane was scaled by a power of two before packing so its
-// largest value sits just below 2^15 (no overflow, full half precision); the inverse scale
-// is folded into the weight, so weight * unpacked value is the true contribution.
+// element (R, G, B) packed tightly, two halves per uint (low half first), read as uvec4s:
+// eight elements (24 halves) fill three uvec4s exactly. One invocation sums one such block
+// of eight elements: per cluster three 16-byte loads (llvmpipe gathers SSBO loads lane by
+// lane, so bytes per load set the speed: the 4-byte loads of one element pair per
+// invocation streamed a fifth of what a plain vec4 copy does, gi/benchmarks/prm_gpu_bench).
+// Every pane was scaled by a power of two before packing so its largest value sits just
+// below 2^15 (no overflow, full half precision); the inverse scale is folded into the
+// weight, so weight * unpacked value is the true contribution.
 //
 // Several dispatches may cover one run when the panes live in several buffers (SSBO size
 // limit): the first writes (mode 0: from zero, mode 1: from base), later ones accumulate
@@ -20,11 +22,11 @@ layout(local_size_x = 64) in;
 
 struct PaneWeight {
   vec3 weight;       // RGB weight of the cluster times its pane's inverse packing scale
-  uint pane_offset;  // first word of the cluster's pane in the bound pane buffer
+  uint pane_offset;  // first uvec4 of the cluster's pane in the bound pane buffer
 };
 
-layout(std430, binding = 0) readonly buffer Texels { uint texels[]; };
-layout(std430, binding = 1) readonly buffer Panes { uint pane_words[]; };
+layout(std430, binding = 0) readonly buffer Texels { uvec4 texels[]; };  // padded to whole blocks of 8
+layout(std430, binding = 1) readonly buffer Panes { uvec4 pane_blocks[]; };
 layout(std430, binding = 2) readonly buffer Weights { PaneWeight weights[]; };
 
 layout(rgba32f, binding = 0) uniform image2D out_image;
@@ -39,37 +41,49 @@ uniform uint u_mode;           // 0: start from zero, 1: start from base_image, 
 const uint kModeZero = 0u;
 const uint kModeBase = 1u;
 const uint kModeAccumulate = 2u;
+const uint kBlock = 8u;  // elements per invocation
+
+ivec2 coord_of(uint texel) { return ivec2(int(texel % u_atlas_width), int(texel / u_atlas_width)); }
 
 void main() {
   const uint group = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
-  const uint pair = group * gl_WorkGroupSize.x + gl_LocalInvocationIndex;
-  const uint first = 2u * pair;
+  const uint block = group * gl_WorkGroupSize.x + gl_LocalInvocationIndex;
+  const uint first = kBlock * block;
   if (first >= u_element_count) return;
-  const bool has_second = first + 1u < u_element_count;
+  const uint count = min(kBlock, u_element_count - first);
 
-  const uint texel0 = texels[first];
-  const uint texel1 = has_second ? texels[first + 1u] : texel0;
-  const ivec2 coord0 = ivec2(int(texel0 % u_atlas_width), int(texel0 / u_atlas_width));
-  const ivec2 coord1 = ivec2(int(texel1 % u_atlas_width), int(texel1 / u_atlas_width));
+  uint texel[8];
+  const uvec4 t0 = texels[2u * block];
+  const uvec4 t1 = texels[2u * block + 1u];
+  texel[0] = t0.x; texel[1] = t0.y; texel[2] = t0.z; texel[3] = t0.w;
+  texel[4] = t1.x; texel[5] = t1.y; texel[6] = t1.z; texel[7] = t1.w;
 
-  vec3 sum0 = vec3(0.0);
-  vec3 sum1 = vec3(0.0);
-  if (u_mode == kModeBase) {
-    sum0 = imageLoad(base_image, coord0).xyz;
-    sum1 = imageLoad(base_image, coord1).xyz;
-  } else if (u_mode == kModeAccumulate) {
-    sum0 = imageLoad(out_image, coord0).xyz;
-    sum1 = imageLoad(out_image, coord1).xyz;
+  vec3 sum[8];
+  for (uint e = 0u; e < kBlock; ++e) {
+    sum[e] = vec3(0.0);
+    if (e < count) {
+      if (u_mode == kModeBase) sum[e] = imageLoad(base_image, coord_of(texel[e])).xyz;
+      else if (u_mode == kModeAccumulate) sum[e] = imageLoad(out_image, coord_of(texel[e])).xyz;
+    }
   }
   for (uint k = 0u; k < u_weight_count; ++k) {
     const PaneWeight w = weights[u_first_weight + k];
-    const uint word = w.pane_offset + 3u * pair;  // the pair's six halves: R0 G0 | B0 R1 | G1 B1
-    const vec2 a = unpackHalf2x16(pane_words[word]);
-    const vec2 b = unpackHalf2x16(pane_words[word + 1u]);
-    const vec2 c = unpackHalf2x16(pane_words[word + 2u]);
-    sum0 += w.weight * vec3(a.x, a.y, b.x);
-    sum1 += w.weight * vec3(b.y, c.x, c.y);
+    const uint at = w.pane_offset + 3u * block;  // 24 halves: R0 G0 B0 R1 ... B7
+    const uvec4 a = pane_blocks[at];
+    const uvec4 b = pane_blocks[at + 1u];
+    const uvec4 c = pane_blocks[at + 2u];
+    const vec2 h0 = unpackHalf2x16(a.x), h1 = unpackHalf2x16(a.y), h2 = unpackHalf2x16(a.z), h3 = unpackHalf2x16(a.w);
+    const vec2 h4 = unpackHalf2x16(b.x), h5 = unpackHalf2x16(b.y), h6 = unpackHalf2x16(b.z), h7 = unpackHalf2x16(b.w);
+    const vec2 h8 = unpackHalf2x16(c.x), h9 = unpackHalf2x16(c.y), h10 = unpackHalf2x16(c.z), h11 = unpackHalf2x16(c.w);
+    sum[0] += w.weight * vec3(h0.x, h0.y, h1.x);
+    sum[1] += w.weight * vec3(h1.y, h2.x, h2.y);
+    sum[2] += w.weight * vec3(h3.x, h3.y, h4.x);
+    sum[3] += w.weight * vec3(h4.y, h5.x, h5.y);
+    sum[4] += w.weight * vec3(h6.x, h6.y, h7.x);
+    sum[5] += w.weight * vec3(h7.y, h8.x, h8.y);
+    sum[6] += w.weight * vec3(h9.x, h9.y, h10.x);
+    sum[7] += w.weight * vec3(h10.y, h11.x, h11.y);
   }
-  imageStore(out_image, coord0, vec4(sum0, 1.0));
-  if (has_second) imageStore(out_image, coord1, vec4(sum1, 1.0));
+  for (uint e = 0u; e < kBlock; ++e)
+    if (e < count) imageStore(out_image, coord_of(texel[e]), vec4(sum[e], 1.0));
 }

@@ -17,13 +17,14 @@ namespace {
 
 constexpr const char* kWhere = "PRM GPU pass";
 constexpr std::size_t kSsboLimitBytes = std::size_t{128} << 20;  // DESIGN.md §4 (llvmpipe)
-constexpr std::uint32_t kGroupSize = 64;  // local_size_x of prm_sum.comp.glsl; an invocation sums 2 elements
+constexpr std::uint32_t kGroupSize = 64;  // local_size_x of prm_sum.comp.glsl
+constexpr std::size_t kBlock = 8;         // elements an invocation sums (three uvec4s of halves per pane)
 constexpr std::uint32_t kMaxGroupsPerDimension = 65535;
 
 /// The weight of one selected cluster as prm_sum.comp.glsl reads it (std430 PaneWeight).
 struct GpuPaneWeight {
   float r = 0.0f, g = 0.0f, b = 0.0f;  // weight x the pane's inverse packing scale
-  std::uint32_t pane_offset = 0;       // first word of the pane in its buffer
+  std::uint32_t pane_offset = 0;       // first uvec4 of the pane in its buffer
 };
 static_assert(sizeof(GpuPaneWeight) == 16, "must match PaneWeight in prm_sum.comp.glsl (std430)");
 static_assert(sizeof(glm::vec3) == 12, "set_base and read_back move glm::vec3 arrays as packed RGB floats");
@@ -32,12 +33,10 @@ enum class SumMode : std::uint32_t { Zero = 0, Base = 1, Accumulate = 2 };
 
 engine::Error error(std::string message) { return engine::Error{"", kWhere, std::move(message)}; }
 
-/// Words of one packed pane: 3 halves per element, two per word, whole element pairs (the
-/// shader reads a pair's three words even for a lone last element), rounded up to 16 bytes.
-std::size_t pane_stride_words(std::size_t elements) {
-  const std::size_t words = 3 * ((elements + 1) / 2);
-  return (words + 3) / 4 * 4;
-}
+/// Words of one packed pane: 3 halves per element, two per word, whole blocks of eight
+/// elements (12 words, three uvec4s: the shader reads a block's three even for a short last
+/// block), so every pane starts on a 16-byte boundary.
+std::size_t pane_stride_words(std::size_t elements) { return 12 * ((elements + kBlock - 1) / kBlock); }
 
 /// The power of two exponent s such that the pane's largest |value| x 2^s lies in
 /// [2^14, 2^15): the top of the half range without overflow. 0 for an all-zero pane.
@@ -96,7 +95,7 @@ engine::Result<PrmGpuPass> PrmGpuPass::create(const Prm& prm, const PrmGpuPassOp
 
   std::size_t buffer_limit = std::min(kSsboLimitBytes, gl_limit(GL_MAX_SHADER_STORAGE_BLOCK_SIZE));
   if (options.max_buffer_bytes > 0) buffer_limit = std::min(buffer_limit, options.max_buffer_bytes);
-  const std::size_t texel_bytes = elements * sizeof(std::uint32_t);
+  const std::size_t texel_bytes = (elements + kBlock - 1) / kBlock * kBlock * sizeof(std::uint32_t);
   if (texel_bytes > buffer_limit)
     return error(std::to_string(elements) + " pane texels need " + std::to_string(texel_bytes) +
                  " bytes, above the SSBO limit of " + std::to_string(buffer_limit));
@@ -150,7 +149,7 @@ engine::Result<PrmGpuPass> PrmGpuPass::create(const Prm& prm, const PrmGpuPassOp
   }
 
   std::vector<std::uint32_t> texels(prm.texels);
-  texels.resize(std::max<std::size_t>(elements, 4), 0u);  // GL buffers cannot be empty
+  texels.resize(std::max<std::size_t>((elements + kBlock - 1) / kBlock * kBlock, kBlock), 0u);  // whole blocks; never empty
   pass.texels_ = engine::GlBuffer::create(texels.size() * sizeof(std::uint32_t), texels.data());
   pass.weights_ = engine::GlBuffer::create();
 
@@ -183,7 +182,7 @@ engine::Status PrmGpuPass::run(std::span<const ClusterWeight> selected) {
       const PaneLocation& p = panes_[w.cluster];
       if (p.buffer != b) continue;
       const glm::vec3 scaled = w.weight * p.inverse_scale;
-      weights.push_back({scaled.x, scaled.y, scaled.z, p.word_offset});
+      weights.push_back({scaled.x, scaled.y, scaled.z, p.word_offset / 4});
     }
     ranges[b].second = static_cast<std::uint32_t>(weights.size()) - ranges[b].first;
   }
@@ -200,8 +199,8 @@ engine::Status PrmGpuPass::run(std::span<const ClusterWeight> selected) {
   glBindImageTexture(0, output_.id(), 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
   glBindImageTexture(1, base_.id(), 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
 
-  const std::uint32_t pairs = element_count_ / 2 + element_count_ % 2;
-  const std::uint32_t groups = (pairs + kGroupSize - 1) / kGroupSize;
+  const auto blocks = static_cast<std::uint32_t>((element_count_ + kBlock - 1) / kBlock);
+  const std::uint32_t groups = (blocks + kGroupSize - 1) / kGroupSize;
   const std::uint32_t groups_x = std::min(groups, max_groups_x_);
   const std::uint32_t groups_y = (groups + groups_x - 1) / groups_x;
 
@@ -253,7 +252,8 @@ std::vector<glm::vec3> PrmGpuPass::read_back() const {
 
 std::size_t PrmGpuPass::gpu_bytes() const {
   const std::size_t atlas_bytes = static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_) * 16;
-  std::size_t bytes = std::max<std::size_t>(element_count_, 4) * sizeof(std::uint32_t) + weights_bytes_;
+  std::size_t bytes = std::max<std::size_t>((element_count_ + kBlock - 1) / kBlock * kBlock, kBlock) * sizeof(std::uint32_t) +
+                      weights_bytes_;
   for (std::size_t b : pane_buffer_bytes_) bytes += b;
   if (!output_.empty()) bytes += atlas_bytes;
   if (!base_.empty()) bytes += atlas_bytes;
