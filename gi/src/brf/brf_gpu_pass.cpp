@@ -659,7 +659,7 @@ engine::Status BrfGpuPass::run(std::span<const BrfGpuInstance> instances,
 
   FrameData frame;
   frame.occlusion = settings.occlusion;
-  fit_first_and_cull(instances, incoming, settings.cull_threshold, frame);
+  fit_first_and_cull(instances, incoming, settings.cull_threshold, settings.influence_scale, frame);
   plan_pairs(instances, frame);
   occluders_.upload(frame.occluders.data(), frame.occluders.size() * sizeof(GpuOccluder));
   dispatch_phi(frame.jobs, false);
@@ -705,7 +705,7 @@ engine::Status BrfGpuPass::check_frame(std::span<const BrfGpuInstance> instances
 
 void BrfGpuPass::fit_first_and_cull(std::span<const BrfGpuInstance> instances,
                                     std::span<const std::vector<glm::vec3>> incoming, float cull_threshold,
-                                    FrameData& frame) const {
+                                    float influence_scale, FrameData& frame) const {
   // First weights and pair culling on the CPU, exactly as brf_interreflect decides them.
   const std::size_t n = instances.size();
   std::vector<BrfObject> objects(n);
@@ -724,12 +724,8 @@ void BrfGpuPass::fit_first_and_cull(std::span<const BrfGpuInstance> instances,
       frame.weights[weight_offsets_[i] + k] =
           glm::vec4(first_weights[i][0][k], first_weights[i][1][k], first_weights[i][2][k], 0.0f);
   }
-  if (!(cull_threshold <= 0.0f)) {  // > 0 or NaN: as brf_interreflect
-    frame.culled = brf_pair_culling(objects, first_weights, cull_threshold);
-  } else {  // what brf_pair_culling returns for a threshold <= 0, without evaluating the bounds
-    frame.culled.assign(n * n, 0);
-    for (std::size_t s = 0; s < n; ++s) frame.culled[s * n + s] = 1;
-  }
+  // As brf_interreflect: the influence grid, then the bounds of the pairs inside (threshold > 0 or NaN).
+  frame.culled = brf_pair_culling(objects, first_weights, cull_threshold, influence_scale);
 }
 
 void BrfGpuPass::plan_pairs(std::span<const BrfGpuInstance> instances, FrameData& frame) {

@@ -227,7 +227,7 @@ class BrfGpuPass {
                              std::span<const std::vector<glm::vec3>> incoming) const;
   /// The first bounce's weights and the culled pairs on the CPU, as brf_interreflect.
   void fit_first_and_cull(std::span<const BrfGpuInstance> instances, std::span<const std::vector<glm::vec3>> incoming,
-                          float cull_threshold, FrameData& frame) const;
+                          float cull_threshold, float influence_scale, FrameData& frame) const;
   /// Instance table, live sources per receiver, Phi jobs of moved pairs; updates pairs_, stats_.
   void plan_pairs(std::span<const BrfGpuInstance> instances, FrameData& frame);
   /// Uploads the incoming light, instance table, first weights and live lists; clears indirect_.

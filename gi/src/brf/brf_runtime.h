@@ -72,6 +72,13 @@ struct BrfUpdateSettings {
   /// by the fraction of the source it sees past the boxes of the objects in between
   /// (brf_pair_occluders, brf_box_visibility). Off: light passes through objects.
   bool occlusion = true;
+  /// A source's influence: its outermost field sphere (the reach its static receivers get
+  /// its bounce in, d. above) times this. A pair whose receiver's bounding sphere lies wholly
+  /// outside its source's influence is skipped without evaluating anything: a uniform grid
+  /// over the objects finds the pairs inside (brf_pair_influence), so the pairs a frame
+  /// touches grow with the objects' neighbours, not with n^2. 0 (or below, or not finite):
+  /// no limit, every pair is a candidate.
+  float influence_scale = 1.0f;
 };
 
 /// Points of the static world that take the objects' bounce (world space, unit normals).
@@ -144,6 +151,12 @@ void brf_basis_irradiance(const BrfObject& source, std::span<const glm::vec3> po
                           const BrdfSeparation* receiver_glossy = nullptr, std::span<const glm::mat3> frames = {},
                           std::span<const BrfOccluder> occluders = {});
 
+/// One bounce of one pair (step c): out[k x V + j] += sum_c w[rgb][c] x phi[(j K_r + k) C + c]
+/// (clamped at 0 for k = 0), phi as brf_basis_irradiance writes it (C = `channels`, K_r =
+/// `receiver_terms`, V = out.size() / K_r), w the source's fitted weights per colour.
+void brf_gather(std::span<const float> phi, std::size_t channels, std::size_t receiver_terms,
+                const std::array<std::vector<float>, 3>& w, std::span<glm::vec3> out);
+
 /// Radiance (W/(m^2 sr), RGB) leaving vertex j of `object` toward world direction w_out,
 /// from its per-vertex values `light` ([k x V + j], incoming light of all kinds summed).
 glm::vec3 brf_outgoing_radiance(const BrfObject& object, const BrfWorldVertices& vertices,
@@ -151,10 +164,22 @@ glm::vec3 brf_outgoing_radiance(const BrfObject& object, const BrfWorldVertices&
 
 /// Pair culling (§5.4): culled[s * n + r] != 0 when the bound irradiance of source s at
 /// receiver r's centre (facing s, weights `weights[s]`; sum over channels of |w Phi|, so
-/// terms of opposite sign cannot cancel) is at most threshold x the largest pair's. The diagonal is always culled.
+/// terms of opposite sign cannot cancel) is at most threshold x the largest pair's. The diagonal is always culled,
+/// and so are the pairs outside each other's influence (brf_pair_influence with
+/// `influence_scale`), whose bounds are not evaluated (the largest is over the pairs inside).
+/// threshold <= 0: no bound is evaluated, only the influence culls.
 std::vector<std::uint8_t> brf_pair_culling(std::span<const BrfObject> objects,
                                            std::span<const std::array<std::vector<float>, 3>> weights,
-                                           float threshold);
+                                           float threshold, float influence_scale = 0.0f);
+
+/// The pairs outside each other's influence (BrfUpdateSettings::influence_scale):
+/// outside[s * n + r] != 0 when receiver r's bounding sphere (brf_bounding_sphere) lies wholly
+/// outside source s's outermost field sphere (world space) x `influence_scale`, and on the
+/// diagonal. The others are found through a uniform grid of the receivers' centres (cell: the
+/// largest reach), O(n + candidate pairs) sphere tests; `influence_scale` <= 0 or not finite:
+/// only the diagonal. `candidates` (optional): the pairs inside, s != r.
+std::vector<std::uint8_t> brf_pair_influence(std::span<const BrfObject> objects, float influence_scale,
+                                             std::size_t* candidates = nullptr);
 
 /// Direct irradiance at every object's vertices from point/spot emitters (world space),
 /// shadowed by all the objects and, when given, by `world` (the static scene).

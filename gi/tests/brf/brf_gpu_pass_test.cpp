@@ -618,3 +618,28 @@ TEST(BrfGpuPass, GlossyModelsAndLightMustMatch) {
 }
 
 }  // namespace
+
+// Four objects in a row 3 m apart: each source's influence (its outermost field sphere,
+// ~4.2 m for the cube, ~4.1 m for the slab) reaches its neighbours only, so 6 of the 12
+// pairs are candidates; the GPU pass skips the others exactly as its twin does, and with the
+// limit off every pair is evaluated again.
+TEST(BrfGpuPass, PairsOutsideTheInfluenceAreSkippedAsByTheTwin) {
+  auto ctx = headless_or_fail();
+  gi::BrfGpuPass pass = make_pass();
+  std::vector<gi::BrfGpuInstance> instances;
+  for (int i = 0; i < 4; ++i)
+    instances.push_back({static_cast<std::uint32_t>(i % 2), pose({3.0f * static_cast<float>(i), 0.0f, 0.1f * static_cast<float>(i)}, 0.3f * static_cast<float>(i), {0, 1, 0}),
+                         {0.8f, 0.6f, 0.4f}});
+  const auto incoming = incoming_light(instances, {4.5f, 2.0f, 0.5f}, 20.0f);
+  for (float cull : {0.0f, 1e-3f}) {
+    const gi::BrfUpdateSettings limited{.bounces = 2, .cull_threshold = cull};
+    ASSERT_TRUE(pass.run(instances, incoming, limited).ok());
+    EXPECT_EQ(pass.stats().pairs_evaluated, 6u) << "cull " << cull;
+    EXPECT_EQ(pass.stats().pairs_culled, 6u) << "cull " << cull;
+    EXPECT_LT(vertices_error(pass, cpu(instances, incoming, limited)), kTolerance) << "cull " << cull;
+  }
+  const gi::BrfUpdateSettings unlimited{.bounces = 2, .cull_threshold = 0.0f, .influence_scale = 0.0f};
+  ASSERT_TRUE(pass.run(instances, incoming, unlimited).ok());
+  EXPECT_EQ(pass.stats().pairs_evaluated, 12u);
+  EXPECT_LT(vertices_error(pass, cpu(instances, incoming, unlimited)), kTolerance);
+}
