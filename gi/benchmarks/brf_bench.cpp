@@ -9,12 +9,21 @@
 //   them as ratios), glFinish inside the timed region, with every crate moving each run (all
 //   pairs' Phi re-evaluated) or none moving (every Phi reused; only the bounces run);
 //   BM_BrfGpuGlossy: the GPU pass with every crate a glossy metal, all moving;
-//   BM_BrfGpuOcclusion: the GPU pass with occlusion between the crates off and on.
+//   BM_BrfGpuOcclusion: the GPU pass with occlusion between the crates off and on;
+//   BM_BrfGpuInfluence: the GPU pass, every crate moving, the runtime's default culling,
+//   with the influence limit (BrfUpdateSettings::influence_scale) off and on, 10 to 100
+//   crates: the pairs evaluated and the time against the crate count;
+//   BM_BrfGatherCpu: the CPU twin's bounce loop (brf_gather over every pair's Phi) against
+//   a memcpy of the same bytes, interleaved in one loop (vs_memcpy: its share of the host's
+//   memory bandwidth).
 //   ./build/benchmarks/brf_bench --benchmark_counters_tabular=true
 #include <GL/glcorearb.h>
 
+#include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <vector>
 
 #include <benchmark/benchmark.h>
@@ -199,6 +208,96 @@ void BM_BrfGpuOcclusion(benchmark::State& state) {
   state.counters["pairs_reused"] = static_cast<double>(pass->stats().pairs_reused);
 }
 BENCHMARK(BM_BrfGpuOcclusion)->ArgsProduct({{10, 30}, {0, 1}, {0, 1}})->Unit(benchmark::kMillisecond);
+
+// Sub-quadratic pairs: all crates moving (relative poses change every run), the runtime's
+// default culling (1e-3), influence limit off (0) and on (1: each source's outermost field
+// sphere). Args: crates, influence on.
+void BM_BrfGpuInfluence(benchmark::State& state) {
+  (void)bench::gl_context();
+  const Shared& s = shared();
+  const int n = static_cast<int>(state.range(0));
+  const gi::BrfGpuModel model{&s.mesh, &s.basis, &s.field};
+  auto pass = gi::BrfGpuPass::create(std::span(&model, 1));
+  if (!pass) {
+    state.SkipWithError(pass.error().to_string().c_str());
+    return;
+  }
+  const gi::PointEmitter light = grid_light(n);
+  std::vector<gi::BrfGpuInstance> poses[2];
+  for (int k = 0; k < 2; ++k)
+    for (const gi::BrfObject& o : crates(n, 0.02f * static_cast<float>(k)))
+      poses[k].push_back({0, o.object_to_world, o.albedo});
+  const auto incoming = gi::brf_direct_light(crates(n), std::span<const gi::PointEmitter>(&light, 1), nullptr);
+  const gi::BrfUpdateSettings settings{.bounces = 3, .influence_scale = static_cast<float>(state.range(1))};
+  if (!pass->run(poses[1], incoming, settings)) state.SkipWithError("run failed");
+  glFinish();
+  std::size_t frame = 0;
+  for (auto _ : state) {
+    const auto status = pass->run(poses[frame % 2], incoming, settings);
+    glFinish();
+    if (!status) state.SkipWithError(status.error().to_string().c_str());
+    ++frame;
+  }
+  state.counters["crates"] = n;
+  state.counters["pairs_evaluated"] = static_cast<double>(pass->stats().pairs_evaluated);
+  state.counters["pairs_culled"] = static_cast<double>(pass->stats().pairs_culled);
+  state.counters["all_pairs"] = n * (n - 1);
+}
+BENCHMARK(BM_BrfGpuInfluence)->ArgsProduct({{10, 30, 60, 100}, {0, 1}})->Unit(benchmark::kMillisecond);
+
+// The CPU twin's bounce loop: brf_gather over every ordered pair's Phi of 30 crates (Phi
+// computed once) and, in the same iteration, a memcpy of the same bytes. Counters: GB/s of
+// Phi streamed by each (medians over the iterations) and their ratio.
+void BM_BrfGatherCpu(benchmark::State& state) {
+  using Clock = std::chrono::steady_clock;
+  const int n = static_cast<int>(state.range(0));
+  const std::vector<gi::BrfObject> objects = crates(n);
+  std::vector<gi::BrfWorldVertices> wv;
+  for (const gi::BrfObject& o : objects) wv.push_back(gi::brf_world_vertices(o));
+  std::vector<std::vector<float>> phi;
+  std::vector<std::size_t> source;
+  std::size_t bytes = 0;
+  for (int s = 0; s < n; ++s)
+    for (int r = 0; r < n; ++r) {
+      if (s == r) continue;
+      gi::brf_basis_irradiance(objects[static_cast<std::size_t>(s)], wv[static_cast<std::size_t>(r)].positions,
+                               wv[static_cast<std::size_t>(r)].normals, phi.emplace_back());
+      source.push_back(static_cast<std::size_t>(s));
+      bytes += phi.back().size() * sizeof(float);
+    }
+  std::vector<std::array<std::vector<float>, 3>> w;
+  for (const gi::BrfObject& o : objects)
+    w.push_back(gi::brf_fit_rgb(*o.basis, std::vector<glm::vec3>(o.mesh->positions.size(), glm::vec3(1.0f, 0.5f, 0.2f))));
+  const std::size_t channels = static_cast<std::size_t>(shared().field.channel_count());
+  std::vector<glm::vec3> out(objects[0].mesh->positions.size());
+  std::vector<float> copy(bytes / sizeof(float));
+  std::vector<double> gather_s, copy_s;
+  for (auto _ : state) {
+    const auto t0 = Clock::now();
+    for (std::size_t p = 0; p < phi.size(); ++p) gi::brf_gather(phi[p], channels, 1, w[source[p]], out);
+    benchmark::DoNotOptimize(out.data());
+    const auto t1 = Clock::now();
+    std::size_t at = 0;
+    for (const std::vector<float>& p : phi) {
+      std::memcpy(copy.data() + at, p.data(), p.size() * sizeof(float));
+      at += p.size();
+    }
+    benchmark::DoNotOptimize(copy.data());
+    benchmark::ClobberMemory();
+    const auto t2 = Clock::now();
+    gather_s.push_back(std::chrono::duration<double>(t1 - t0).count());
+    copy_s.push_back(std::chrono::duration<double>(t2 - t1).count());
+  }
+  auto median = [](std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v.empty() ? 0.0 : v[v.size() / 2];
+  };
+  state.counters["phi_MB"] = static_cast<double>(bytes) * 1e-6;
+  state.counters["gather_GB/s"] = static_cast<double>(bytes) * 1e-9 / median(gather_s);
+  state.counters["memcpy_GB/s"] = static_cast<double>(bytes) * 1e-9 / median(copy_s);
+  state.counters["vs_memcpy"] = median(copy_s) / median(gather_s);
+}
+BENCHMARK(BM_BrfGatherCpu)->Arg(30)->Unit(benchmark::kMillisecond);
 
 // Every crate a glossy metal (SharedGlossy), every crate moving each run.
 void BM_BrfGpuGlossy(benchmark::State& state) {
