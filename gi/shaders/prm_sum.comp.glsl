@@ -1,8 +1,10 @@
 #version 450 core
 // PRM runtime sum (Szécsi et al. 2006, §5.2): for every pane element i,
 //   E(texels[i]) = [base(texels[i])] + sum over the selected clusters k of weight_k * pane_k[i]
-// written into the irradiance atlas at texel (texels[i] % width, texels[i] / width). Work
-// groups on a 2-D grid when one row would exceed 65535.
+// written into the irradiance atlas at texel (x, y) = (texels[i] & 0xffff, texels[i] >> 16)
+// (prm_gpu_pass.cpp packs each texel's coordinates once: a per-lane integer division by the
+// width cost llvmpipe a scalar loop per invocation). Work groups on a 2-D grid when one row
+// would exceed 65535.
 //
 // Pane storage (prm_gpu_pass.cpp writes it): each pane is a run of half floats, three per
 // element (R, G, B) packed tightly, two halves per uint (low half first), read as uvec4s:
@@ -25,7 +27,7 @@ struct PaneWeight {
   uint pane_offset;  // first uvec4 of the cluster's pane in the bound pane buffer
 };
 
-layout(std430, binding = 0) readonly buffer Texels { uvec4 texels[]; };  // padded to whole blocks of 8
+layout(std430, binding = 0) readonly buffer Texels { uvec4 texels[]; };  // x | y << 16, padded to whole blocks of 8
 layout(std430, binding = 1) readonly buffer Panes { uvec4 pane_blocks[]; };
 layout(std430, binding = 2) readonly buffer Weights { PaneWeight weights[]; };
 
@@ -33,7 +35,6 @@ layout(rgba32f, binding = 0) uniform image2D out_image;
 layout(rgba32f, binding = 1) readonly uniform image2D base_image;
 
 uniform uint u_element_count;  // T: pane elements
-uniform uint u_atlas_width;
 uniform uint u_first_weight;   // this dispatch sums weights[u_first_weight .. + u_weight_count)
 uniform uint u_weight_count;
 uniform uint u_mode;           // 0: start from zero, 1: start from base_image, 2: accumulate
@@ -43,7 +44,7 @@ const uint kModeBase = 1u;
 const uint kModeAccumulate = 2u;
 const uint kBlock = 8u;  // elements per invocation
 
-ivec2 coord_of(uint texel) { return ivec2(int(texel % u_atlas_width), int(texel / u_atlas_width)); }
+ivec2 coord_of(uint texel) { return ivec2(int(texel & 0xffffu), int(texel >> 16)); }
 
 void main() {
   const uint group = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;

@@ -72,9 +72,9 @@ engine::Result<PrmGpuPass> PrmGpuPass::create(const Prm& prm, const PrmGpuPassOp
   const std::size_t atlas_texels = static_cast<std::size_t>(prm.width) * static_cast<std::size_t>(prm.height);
   if (atlas_texels > std::numeric_limits<std::uint32_t>::max()) return error("atlas has more than 2^32 texels");
   const std::size_t max_texture = gl_limit(GL_MAX_TEXTURE_SIZE);
-  if (static_cast<std::size_t>(std::max(prm.width, prm.height)) > max_texture)
+  if (static_cast<std::size_t>(std::max(prm.width, prm.height)) > std::min<std::size_t>(max_texture, 65536))
     return error("atlas size " + std::to_string(prm.width) + "x" + std::to_string(prm.height) +
-                 " exceeds GL_MAX_TEXTURE_SIZE " + std::to_string(max_texture));
+                 " exceeds GL_MAX_TEXTURE_SIZE " + std::to_string(max_texture) + " (or 65536)");
   const std::size_t elements = prm.texels.size();
   for (std::size_t i = 0; i < elements; ++i) {
     if (prm.texels[i] >= atlas_texels)
@@ -118,9 +118,8 @@ engine::Result<PrmGpuPass> PrmGpuPass::create(const Prm& prm, const PrmGpuPassOp
   if (!program) return program.error();
   pass.program_ = std::move(program).value();
   const GLuint id = pass.program_.id();
-  pass.uniforms_ = {glGetUniformLocation(id, "u_element_count"), glGetUniformLocation(id, "u_atlas_width"),
-                    glGetUniformLocation(id, "u_first_weight"), glGetUniformLocation(id, "u_weight_count"),
-                    glGetUniformLocation(id, "u_mode")};
+  pass.uniforms_ = {glGetUniformLocation(id, "u_element_count"), glGetUniformLocation(id, "u_first_weight"),
+                    glGetUniformLocation(id, "u_weight_count"), glGetUniformLocation(id, "u_mode")};
 
   // Whole panes per buffer, as many as fit under the limit.
   const std::size_t panes_per_buffer = std::max<std::size_t>(1, buffer_limit / std::max<std::size_t>(pane_bytes, 1));
@@ -148,7 +147,12 @@ engine::Result<PrmGpuPass> PrmGpuPass::create(const Prm& prm, const PrmGpuPassOp
     pass.pane_buffer_bytes_.push_back(sizeof(zeros));
   }
 
+  // The shader reads texel coordinates packed x | y << 16 (no division per lane).
   std::vector<std::uint32_t> texels(prm.texels);
+  for (std::uint32_t& t : texels) {
+    const auto w = static_cast<std::uint32_t>(prm.width);
+    t = (t % w) | ((t / w) << 16);
+  }
   texels.resize(std::max<std::size_t>((elements + kBlock - 1) / kBlock * kBlock, kBlock), 0u);  // whole blocks; never empty
   pass.texels_ = engine::GlBuffer::create(texels.size() * sizeof(std::uint32_t), texels.data());
   pass.weights_ = engine::GlBuffer::create();
@@ -193,7 +197,6 @@ engine::Status PrmGpuPass::run(std::span<const ClusterWeight> selected) {
 
   program_.use();
   glProgramUniform1ui(program_.id(), uniforms_.element_count, element_count_);
-  glProgramUniform1ui(program_.id(), uniforms_.atlas_width, static_cast<GLuint>(width_));
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, texels_.id());
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, weights_.id());
   glBindImageTexture(0, output_.id(), 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);

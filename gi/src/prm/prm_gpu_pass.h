@@ -94,7 +94,6 @@ class PrmGpuPass {
   };
   struct Uniforms {
     int element_count = -1;
-    int atlas_width = -1;
     int first_weight = -1;
     int weight_count = -1;
     int mode = -1;
