@@ -4,6 +4,10 @@
 // from (global seed, work-item id), so results do not depend on which thread ran the item.
 //   gi::Pcg32 rng = gi::Pcg32::for_item(settings.seed, texel_index);
 //   float u = rng.next_float();
+// Never two draws in the arguments of one call or constructor: their order is unspecified
+// (GCC evaluated them right to left, clang left to right), so a bake, its reference and the
+// golden frames depended on the compiler. Draw into named variables first; the sites that
+// had two keep GCC's order (the second argument drawn first), so GCC's bakes are unchanged.
 
 #include <cstdint>
 

@@ -159,7 +159,8 @@ glm::vec3 direct_at(const StaticBakeScene& b, const glm::vec3& p, const glm::vec
     if (l.type == ReferenceLight::Type::Area) {
       if (b.index.light_has_proxy[i]) continue;  // its emissive geometry stands for it below
       const float area = 4.0f * glm::length(l.half_x) * glm::length(l.half_y);
-      const glm::vec2 shift(rng.next_float(), rng.next_float());
+      const float shift_y = rng.next_float();  // drawn first: see random.h
+      const glm::vec2 shift(rng.next_float(), shift_y);
       for (int s = 0; s < samples; ++s) {
         const glm::vec2 u = hammersley(static_cast<std::uint32_t>(s), static_cast<std::uint32_t>(samples), shift);
         const glm::vec3 q = l.position + (2.0f * u.x - 1.0f) * l.half_x + (2.0f * u.y - 1.0f) * l.half_y;
@@ -178,7 +179,8 @@ glm::vec3 direct_at(const StaticBakeScene& b, const glm::vec3& p, const glm::vec
     if (l.type == ReferenceLight::Type::Directional && l.cos_disc < 1.0f) {
       // A disc (the sun's angular radius): `samples` stratified directions uniform over its
       // cone, each carrying radiant / samples; soft shadows (docs/scene-format.md).
-      const glm::vec2 shift(rng.next_float(), rng.next_float());
+      const float shift_y = rng.next_float();  // drawn first: see random.h
+      const glm::vec2 shift(rng.next_float(), shift_y);
       for (int s = 0; s < samples; ++s) {
         const glm::vec2 u = hammersley(static_cast<std::uint32_t>(s), static_cast<std::uint32_t>(samples), shift);
         const glm::vec3 wi = sample_cone(-l.direction, l.cos_disc, u.x, u.y);
@@ -214,7 +216,8 @@ glm::vec3 direct_at(const StaticBakeScene& b, const glm::vec3& p, const glm::vec
   }
   const EmitterTable& em = b.index.emitters;
   if (em.triangle.empty()) return glm::vec3(sum);
-  const glm::vec2 shift(rng.next_float(), rng.next_float());
+  const float shift_y = rng.next_float();  // drawn first: see random.h
+  const glm::vec2 shift(rng.next_float(), shift_y);
   const float pick_shift = rng.next_float();
   for (int s = 0; s < samples; ++s) {
     float u_pick = (static_cast<float>(s) + pick_shift) / static_cast<float>(samples);
@@ -383,7 +386,8 @@ engine::Result<TexelGatherResult> gather_atlas(const StaticBakeScene& b, const A
   if (!pool.parallel_for_with_progress(work, phase(0.15, 0.45), [&](std::size_t w) {
         const std::uint32_t i = t.work[w];
         Pcg32 rng = Pcg32::for_item(s.seed, stream_id(i, kSolveStream));
-        const glm::vec2 shift(rng.next_float(), rng.next_float());
+        const float shift_y = rng.next_float();  // drawn first: see random.h
+        const glm::vec2 shift(rng.next_float(), shift_y);
         const glm::vec3 origin = offset_ray_origin(tx.position[i], t.face[i]);
         std::size_t escaped = 0, back = 0;
         glm::vec3 gradient_seen(0.0f);  // sum over escaped rays of the sky gradient's radiance
@@ -454,7 +458,8 @@ engine::Result<TexelGatherResult> gather_atlas(const StaticBakeScene& b, const A
           const std::size_t w = mine[m];
           const std::uint32_t i = t.work[w];
           Pcg32 rng = Pcg32::for_item(s.seed, stream_id(i, kGatherStream));
-          const glm::vec2 shift(rng.next_float(), rng.next_float());
+          const float shift_y = rng.next_float();  // drawn first: see random.h
+          const glm::vec2 shift(rng.next_float(), shift_y);
           const glm::vec3 origin = offset_ray_origin(tx.position[i], t.face[i]);
           glm::dvec3 sum(0.0);
           for (std::size_t r = 0; r < nf; ++r) {

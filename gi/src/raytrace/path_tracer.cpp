@@ -190,7 +190,9 @@ PathTracer::Irradiance PathTracer::irradiance(const glm::vec3& p, const glm::vec
   const glm::vec3 origin = offset_ray_origin(p, n);
   Irradiance e;
   e.direct = direct_light(origin, p, receiver, n, rng);
-  const glm::vec3 wi = sample_cosine_hemisphere(n, rng.next_float(), rng.next_float());
+  const float u2 = rng.next_float();  // drawn first: see random.h
+  const float u1 = rng.next_float();
+  const glm::vec3 wi = sample_cosine_hemisphere(n, u1, u2);
   const float pdf = std::max(glm::dot(wi, n), 0.0f) / kPi;
   if (!(pdf > 0.0f)) return e;
   const int max_e = settings_.max_bounces < 0 ? kUnlimited : settings_.max_bounces + 1;

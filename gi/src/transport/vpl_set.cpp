@@ -80,7 +80,8 @@ struct Sample {
 std::vector<Sample> jittered_points(const Chart& chart, const ChartPlane& plane, const ReferenceSceneIndex& index,
                                     std::uint32_t first_triangle, float h, Pcg32& rng) {
   std::vector<Sample> out;
-  const glm::vec2 offset(rng.next_float() * h, rng.next_float() * h);
+  const float offset_y = rng.next_float() * h;  // drawn first: see random.h
+  const glm::vec2 offset(rng.next_float() * h, offset_y);
   const int nx = static_cast<int>(std::ceil((chart.size_m.x + offset.x) / h));
   const int ny = static_cast<int>(std::ceil((chart.size_m.y + offset.y) / h));
   for (int y = 0; y < ny; ++y) {
