@@ -2,7 +2,10 @@
 # box with the installed gi-bake, configure and build tests/consumer against the prefix alone
 # (find_package(gi)), run it. Any missing header, library, exported dependency or tool fails
 # one of the steps.
-#   cmake -DBUILD_DIR=... -DSOURCE_DIR=... -DWORK_DIR=... [-DCXX=... -DLAUNCHER=... -DGENERATOR=...] -P run.cmake
+#   cmake -DBUILD_DIR=... -DSOURCE_DIR=... -DWORK_DIR=... [-DCXX=... -DLAUNCHER=... -DGENERATOR=...
+#         -DLINK_FLAGS=...] -P run.cmake
+# LINK_FLAGS: what an instrumented build's static libraries need at the consumer's link
+# (their sanitizer runtimes, tools/configure-sanitized.sh); empty for a regular build.
 foreach(_v BUILD_DIR SOURCE_DIR WORK_DIR)
   if(NOT DEFINED ${_v})
     message(FATAL_ERROR "run.cmake needs -D${_v}=...")
@@ -36,6 +39,9 @@ if(CXX)
 endif()
 if(LAUNCHER)
   list(APPEND _configure -DCMAKE_CXX_COMPILER_LAUNCHER=${LAUNCHER})
+endif()
+if(LINK_FLAGS)
+  list(APPEND _configure "-DCMAKE_EXE_LINKER_FLAGS=${LINK_FLAGS}")
 endif()
 step(${_configure})
 step(${CMAKE_COMMAND} --build ${WORK_DIR}/build)
