@@ -19,6 +19,10 @@
 #ifndef AREA_LIGHTS
 #define AREA_LIGHTS 0
 #endif
+// 1: area lights soft-shadowed over their rectangle (shadow_area), 0: from their centre.
+#ifndef AREA_SOFT_SHADOWS
+#define AREA_SOFT_SHADOWS 1
+#endif
 
 #include "lighting_common.glsl"
 #include "shadow_common.glsl"
@@ -105,7 +109,12 @@ void main() {
   for (int k = 0; k < AREA_LIGHTS; ++k) {
     const int i = POINT_LIGHTS + SPOT_LIGHTS + DIRECTIONAL_LIGHTS + k;
     to_light = normalize(lights[i].position_type.xyz - s.position);
-    radiance += area_light_radiance(lights[i], s) * shadow_2d(lights[i], s.position, s.normal, to_light, 2.0);
+    radiance += area_light_radiance(lights[i], s) *
+#if AREA_SOFT_SHADOWS
+                shadow_area(lights[i], s.position, s.normal, to_light);
+#else
+                shadow_2d(lights[i], s.position, s.normal, to_light, 2.0);
+#endif
   }
 #endif
 

@@ -3,6 +3,9 @@
 // direction / far for directional lights. Filtering: hardware 2x2 compare (bilinear PCF)
 // over a 3x3 grid; the receiver is offset along its normal by one texel and the depth
 // reference is biased by texel * (1 + spacing * tan(theta)) (slope-scaled).
+// Lights with a size are soft-shadowed PCSS-style: the sun's disc (shadow_2d_disc) and
+// rectangular area lights (shadow_area) search the map for blockers, then spread their
+// compare taps over the light's shape as seen through the blockers' depth.
 
 layout(binding = 4) uniform sampler2DArrayShadow u_shadow_maps;
 layout(binding = 5) uniform samplerCubeArrayShadow u_point_shadow_maps;
@@ -61,11 +64,31 @@ float shadow_cube(GpuLight light, vec3 p, vec3 n, vec3 to_light) {
   return sum / 9.0;
 }
 
+// Points spread uniformly over the unit disc (Vogel's spiral, golden-angle steps): the
+// fraction of them behind a straight edge follows the fraction of the disc's area there,
+// so a filter over them has the penumbra profile of a disc-shaped light.
+const vec2 kDisc16[16] = vec2[16](
+    vec2(0.1768, 0.0000), vec2(-0.2258, 0.2068), vec2(0.0346, -0.3938), vec2(0.2846, 0.3712),
+    vec2(-0.5222, -0.0924), vec2(0.4947, -0.3147), vec2(-0.1655, 0.6155), vec2(-0.3156, -0.6076),
+    vec2(0.6846, 0.2500), vec2(-0.7123, 0.2940), vec2(0.3434, -0.7337), vec2(0.2537, 0.8089),
+    vec2(-0.7647, -0.4432), vec2(0.8971, -0.1972), vec2(-0.5475, 0.7788), vec2(-0.1265, -0.9761));
+const vec2 kDisc24[24] = vec2[24](
+    vec2(0.1443, 0.0000), vec2(-0.1843, 0.1689), vec2(0.0282, -0.3215), vec2(0.2324, 0.3031),
+    vec2(-0.4264, -0.0754), vec2(0.4039, -0.2569), vec2(-0.1351, 0.5026), vec2(-0.2577, -0.4961),
+    vec2(0.5590, 0.2041), vec2(-0.5816, 0.2401), vec2(0.2803, -0.5991), vec2(0.2072, 0.6605),
+    vec2(-0.6244, -0.3619), vec2(0.7325, -0.1610), vec2(-0.4470, 0.6359), vec2(-0.1033, -0.7970),
+    vec2(0.6340, 0.5343), vec2(-0.8532, 0.0353), vec2(0.6223, -0.6193), vec2(-0.0416, 0.9004),
+    vec2(-0.5922, -0.7096), vec2(0.9380, 0.1262), vec2(-0.7948, 0.5530), vec2(0.2172, -0.9654));
+
 // A directional light with a disc (the sun; light.radiant.w = tan r, r its angular radius):
 // the penumbra a blocker at distance b in front of the receiver casts is 2 b tan r wide, so
-// (as PCSS does) the mean depth of the blockers in a search window of half-width d tan r (d
-// the receiver's depth: the widest any blocker can make) gives b, and a 5x5 grid of compare
-// taps spans the penumbra, b tan r either side. Ortho maps only (directional lights).
+// (as PCSS does) the mean depth of the blockers in a search disc of radius d tan r (d the
+// receiver's depth: the widest any blocker can make) gives b, and 24 compare taps spread
+// uniformly over a disc of radius b tan r (kDisc24) average the visibility of the sun's
+// disc: their fraction behind an edge follows the disc's area, so the 10-90% width of the
+// edge is the disc's 1.37 b tan r (a square grid of taps spread it over 2 b tan r).
+// Ortho maps only (directional lights).
+const float kSunMaxTexels = 48.0;
 float shadow_2d_disc(GpuLight light, vec3 p, vec3 n, vec3 to_light) {
   int layer = int(light.cone.z);
   if (layer < 0) return 1.0;
@@ -82,22 +105,93 @@ float shadow_2d_disc(GpuLight light, vec3 p, vec3 n, vec3 to_light) {
   float bias = texel * (1.0 + slope_tangent(n, to_light));
   float ref = (d - bias) / far_m;
   vec2 texel_uv = 1.0 / vec2(textureSize(u_shadow_maps, 0).xy);
-  float search = clamp(d * tan_r / texel, 1.0, 24.0);  // texels
+  float search = clamp(d * tan_r / texel, 1.0, kSunMaxTexels);  // texels
   float blockers = 0.0, blocker_depth = 0.0;
-  for (int y = -2; y <= 2; ++y)
-    for (int x = -2; x <= 2; ++x) {
-      float z = texture(u_shadow_depths, vec3(uv + vec2(x, y) * (0.5 * search) * texel_uv, float(layer))).r;
-      if (z < ref) {
-        blockers += 1.0;
-        blocker_depth += z;
-      }
+  for (int i = 0; i < 16; ++i) {
+    float z = texture(u_shadow_depths, vec3(uv + kDisc16[i] * search * texel_uv, float(layer))).r;
+    if (z < ref) {
+      blockers += 1.0;
+      blocker_depth += z;
     }
+  }
   if (blockers == 0.0) return 1.0;
   float b = max(d - blocker_depth / blockers * far_m, 0.0);  // receiver - blocker, metres
-  float radius = clamp(b * tan_r / texel, 1.0, 24.0);       // penumbra half-width, texels
+  float radius = clamp(b * tan_r / texel, 1.0, kSunMaxTexels);  // penumbra half-width, texels
   float sum = 0.0;
-  for (int y = -2; y <= 2; ++y)
-    for (int x = -2; x <= 2; ++x)
-      sum += texture(u_shadow_maps, vec4(uv + vec2(x, y) * (0.5 * radius) * texel_uv, float(layer), ref));
-  return sum / 25.0;
+  for (int i = 0; i < 24; ++i) sum += texture(u_shadow_maps, vec4(uv + kDisc24[i] * radius * texel_uv, float(layer), ref));
+  return sum / 24.0;
+}
+
+// 16 points over the square [-1, 1]^2, one in each row and each column of a 16 x 16 grid
+// (Hammersley), so a penumbra along either axis of a rectangle gets 16 steps, not 4.
+const vec2 kRect16[16] = vec2[16](
+    vec2(-0.9375, -0.9375), vec2(-0.8125, 0.0625), vec2(-0.6875, -0.4375), vec2(-0.5625, 0.5625),
+    vec2(-0.4375, -0.6875), vec2(-0.3125, 0.3125), vec2(-0.1875, -0.1875), vec2(-0.0625, 0.8125),
+    vec2(0.0625, -0.8125), vec2(0.1875, 0.1875), vec2(0.3125, -0.3125), vec2(0.4375, 0.6875),
+    vec2(0.5625, -0.5625), vec2(0.6875, 0.4375), vec2(0.8125, -0.0625), vec2(0.9375, 0.9375));
+
+// Rectangular area light, soft-shadowed over its rectangle (PCSS). The light's 2-D map is a
+// perspective distance map from the rectangle's centre c. The light's point
+// c + s hx + t hy (s, t in [-1, 1]) is hidden from the receiver p (at distance d) by a
+// blocker at distance b from c where the segment between them crosses it. Clip space is
+// linear along the segment and the rectangle lies in the eye's plane (w = 0), so that
+// crossing is at uv_p + k (s ax + t ay), k = (d - b) / b, ax and ay the half axes projected
+// at the receiver. A blocker search over the rectangle's footprint (at the k of a blocker
+// kSearchTexels away) gives the mean blocker distance, then 16 compare taps over the
+// footprint at that k average the visibility of 16 points of the light. Each tap compares
+// against the receiver's tangent plane along its own ray from c (receiver-plane depth), so
+// a wide footprint on a slanted receiver does not shadow the receiver itself.
+// How far from the light's centre the ray towards `ray` meets the receiver's tangent plane
+// (normal n, at `plane` = dot(n, receiver - centre)): the depth a tap off the receiver's own
+// texel compares against, so a slanted receiver does not shadow itself. The receiver's
+// distance d when the centre is behind the plane or the ray nearly parallel to it.
+float receiver_plane_distance(vec3 ray, vec3 n, float plane, float d) {
+  float along = dot(n, ray);
+  return plane > 0.0 && along > 0.25 * plane ? plane * length(ray) / along : d;
+}
+
+const float kAreaSearchTexels = 24.0;
+const float kAreaFilterTexels = 32.0;
+float shadow_area(GpuLight light, vec3 p, vec3 n, vec3 to_light) {
+  int layer = int(light.cone.z);
+  if (layer < 0) return 1.0;
+  vec3 eye = light.shadow_eye.xyz;
+  float far_m = light.shadow_eye.w;
+  float texel = light.shadow_params.y * length(p - eye);
+  vec3 po = p + n * texel;
+  vec4 clip = light.shadow_view_proj * vec4(po, 1.0);
+  if (clip.w <= 0.0) return 1.0;
+  vec2 uv = clip.xy / clip.w * 0.5 + 0.5;
+  if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)))) return 1.0;
+  vec3 rel = po - eye;
+  float d = length(rel);
+  float bias = texel * (1.0 + slope_tangent(n, to_light));
+  float ref = (d - bias) / far_m;
+  vec2 size = vec2(textureSize(u_shadow_maps, 0).xy);
+  vec3 hx = light.area_half_x.xyz;
+  vec3 hy = light.area_half_y.xyz;
+  vec2 ax = 0.5 * (light.shadow_view_proj * vec4(hx, 0.0)).xy / clip.w;
+  vec2 ay = 0.5 * (light.shadow_view_proj * vec4(hy, 0.0)).xy / clip.w;
+  float reach = max(length((abs(ax) + abs(ay)) * size), 1e-4);  // texels of the footprint's half-extent at k = 1
+  float k_search = kAreaSearchTexels / reach;
+  float blockers = 0.0, blocker_depth = 0.0;
+  float plane = dot(n, rel);  // the receiver's tangent plane (through po)
+  for (int i = 0; i < 16; ++i) {
+    vec2 st = kDisc16[i] * 1.41421356;  // the disc around the square's corners
+    float z = texture(u_shadow_depths, vec3(uv + k_search * (st.x * ax + st.y * ay), float(layer))).r;
+    if (z < (receiver_plane_distance(rel + k_search * (st.x * hx + st.y * hy), n, plane, d) - bias) / far_m) {
+      blockers += 1.0;
+      blocker_depth += z;
+    }
+  }
+  if (blockers == 0.0) return 1.0;
+  float b = max(blocker_depth / blockers * far_m, 1e-3);
+  float k = clamp((d - b) / b, 1.0 / reach, kAreaFilterTexels / reach);
+  float sum = 0.0;
+  for (int i = 0; i < 16; ++i) {
+    vec2 st = kRect16[i];
+    float tap_d = receiver_plane_distance(rel + k * (st.x * hx + st.y * hy), n, plane, d);
+    sum += texture(u_shadow_maps, vec4(uv + k * (st.x * ax + st.y * ay), float(layer), (tap_d - bias) / far_m));
+  }
+  return sum / 16.0;
 }

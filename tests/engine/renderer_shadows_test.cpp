@@ -2,7 +2,9 @@
 #define GL_GLEXT_PROTOTYPES
 #include <GL/glcorearb.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include <engine/gltf_brdf.h>
 
@@ -287,3 +289,75 @@ TEST(RendererShadows, MapsAreReRenderedOnlyWhenTheirLightOrACasterMoves) {
 }
 
 }  // namespace
+
+namespace {
+
+// A square area light of side W facing down at height H, a plate at height hb covering x < 0
+// and a floor: the floor point at x sees the part of the light with
+// light x >= -x (H - hb) / hb, so its penumbra is a ramp W hb / (H - hb) wide (linear for a
+// rectangle, up to the cos^2 / d^2 weights over it). Returns the 10-90% width of the edge
+// along the image row through the origin, measured on the rendered frame.
+engine::ImageRgbaF area_light_frame(bool soft, bool with_plate, float side_m, float height_m, float plate_m,
+                                    const TestCamera& cam) {
+  engine::SceneAsset assets;
+  assets.materials.push_back(diffuse_material(kAlbedo));
+  assets.meshes.push_back(plane_mesh(3.0f, 0));
+  engine::Mesh plate;
+  plate.name = "plate";
+  plate.primitives.emplace_back();
+  plate.primitives[0].material = 0;
+  add_quad(plate.primitives[0], glm::vec3(-1.5f, plate_m, 0.0f), glm::vec3(0, 0, 1.5f), glm::vec3(1.5f, 0, 0));
+  assets.meshes.push_back(plate);
+  engine::Registry reg;
+  add_mesh(reg, 0, glm::mat4(1.0f));
+  if (with_plate) add_mesh(reg, 1, glm::mat4(1.0f));
+  add_light(reg, engine::Light{.type = engine::LightType::Area, .intensity = 20.0f, .area_size_m = {side_m, side_m}},
+            {0.0f, height_m, 0.0f}, {0.0f, 0.0f, 0.0f});
+  const engine::Entity camera = cam.add_to(reg);
+  auto r = make_renderer(assets, cam.size, 0.0f);
+  if (!r) return {};
+  r->settings().shadow_map_size = 1024;
+  r->settings().area_soft_shadows = soft;
+  r->render(reg, camera);
+  EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
+  return r->read_hdr();
+}
+
+double area_edge_width(bool soft, float side_m, float height_m, float plate_m) {
+  const TestCamera cam{{0.0f, 0.9f, 1.5f}, {0.0f, 0.0f, 0.0f}, 0.9f, 161};
+  const engine::ImageRgbaF img = area_light_frame(soft, true, side_m, height_m, plate_m, cam);
+  const engine::ImageRgbaF open = area_light_frame(soft, false, side_m, height_m, plate_m, cam);
+  if (img.pixels.empty() || open.pixels.empty()) return 0.0;
+  EXPECT_LT(red(img, cam.pixel_of({-0.6f, 0, 0})), 0.02f * red(open, cam.pixel_of({-0.6f, 0, 0})));
+  EXPECT_NEAR(red(img, cam.pixel_of({0.6f, 0, 0})), red(open, cam.pixel_of({0.6f, 0, 0})),
+              0.02f * red(open, cam.pixel_of({0.6f, 0, 0})));
+  // Along the image row through the origin: x of each pixel on the floor and its lit
+  // fraction (the frame with the plate over the one without).
+  const glm::ivec2 centre = cam.pixel_of({0, 0, 0});
+  double x10 = 0.0, x90 = 0.0, prev_x = -1.0, prev_f = 0.0;
+  for (int px = 0; px < cam.size; ++px) {
+    const double x = static_cast<double>(cam.plane_point(px, centre.y).x);
+    const double f = static_cast<double>(red(img, px, centre.y) / std::max(red(open, px, centre.y), 1e-6f));
+    if (px > 0 && prev_f < 0.1 && f >= 0.1) x10 = prev_x + (0.1 - prev_f) / (f - prev_f) * (x - prev_x);
+    if (px > 0 && prev_f < 0.9 && f >= 0.9) x90 = prev_x + (0.9 - prev_f) / (f - prev_f) * (x - prev_x);
+    prev_x = x;
+    prev_f = f;
+  }
+  return x90 - x10;
+}
+
+}  // namespace
+
+// RenderSettings::area_soft_shadows: the penumbra of an area light follows its size (a 0.6 m
+// light 2 m up, a plate 1 m up: a 0.6 m ramp, 0.48 m from 10% to 90%), where the shadow seen
+// from the light's centre alone is a few texels wide.
+TEST(RendererShadows, AreaLightPenumbraFollowsTheLightsSize) {
+  engine::GpuContext ctx = headless_context();
+  const double ramp = 0.6 * 1.0 / (2.0 - 1.0);
+  const double soft = area_edge_width(true, 0.6f, 2.0f, 1.0f);
+  const double hard = area_edge_width(false, 0.6f, 2.0f, 1.0f);
+  std::printf("area light 0.6 m, 10-90%% shadow edge: soft %.4f m, from the centre %.4f m (geometry 0.8 x %.3f = %.4f)\n",
+              soft, hard, ramp, 0.8 * ramp);
+  EXPECT_NEAR(soft, 0.8 * ramp, 0.2 * 0.8 * ramp);
+  EXPECT_LT(hard, 0.25 * soft);
+}

@@ -53,6 +53,11 @@ struct RenderSettings {
   /// grows about linearly with n^2 (9 points: ~2/3 of an area light's cost); the diffuse
   /// part is exact whatever n.
   int area_specular_samples_per_side = 3;
+  /// Shadows of area lights: true, soft over the rectangle (a blocker search and 16 compare
+  /// taps over the rectangle's footprint in its shadow map, PCSS); false, from the
+  /// rectangle's centre (a 3x3 grid of bilinear compare taps, cheaper, hard-edged and dark
+  /// where the centre is hidden but part of the rectangle is not).
+  bool area_soft_shadows = true;
   /// The scene's sky (SceneAsset::environment.sky_radiance, W/(m^2 sr); Renderer::create
   /// copies it from the assets). Drawn as direct light: an ambient term without sky
   /// visibility, E = pi x radiance reflected as uniformly arriving light is, on both halves

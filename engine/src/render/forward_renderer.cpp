@@ -84,8 +84,9 @@ Result<ShaderProgram> build(const char* vertex, const char* fragment) {
       .build();
 }
 
-// Point, spot, directional and area light counts, then area specular samples per side.
-using LightCounts = std::array<int, 5>;
+// Point, spot, directional and area light counts, then area specular samples per side and
+// whether area lights are soft-shadowed (RenderSettings::area_soft_shadows).
+using LightCounts = std::array<int, 6>;
 
 // The forward program for one combination of light counts (see forward.frag.glsl).
 Result<ShaderProgram> build_forward(const LightCounts& n) {
@@ -97,6 +98,7 @@ Result<ShaderProgram> build_forward(const LightCounts& n) {
       .define("DIRECTIONAL_LIGHTS " + std::to_string(n[2]))
       .define("AREA_LIGHTS " + std::to_string(n[3]))
       .define("AREA_SPECULAR_SIDE " + std::to_string(n[4]))
+      .define("AREA_SOFT_SHADOWS " + std::to_string(n[5]))
       .build();
 }
 
@@ -115,7 +117,7 @@ class ForwardRenderer final : public Renderer {
         albedo_table_(upload_gltf_albedo_table()),
         no_directional_index_(no_directional_index()),
         shadow_depth_sampler_(raw_depth_sampler()) {
-    forward_variants_.emplace(LightCounts{0, 0, 0, 0, 3}, std::move(forward));
+    forward_variants_.emplace(LightCounts{0, 0, 0, 0, 3, 1}, std::move(forward));
     ensure_targets();
   }
 
@@ -257,7 +259,8 @@ void ForwardRenderer::render(const Registry& registry, Entity camera) {
                     static_cast<GLsizeiptr>(std::max<std::size_t>(1, lights.lights.size()) * sizeof(render::GpuLight)),
                     lights.lights.empty() ? nullptr : lights.lights.data(), GL_STREAM_DRAW);
   const LightCounts variant{lights.count_by_type[0], lights.count_by_type[1], lights.count_by_type[2],
-                            lights.count_by_type[3], std::clamp(settings_.area_specular_samples_per_side, 1, 4)};
+                            lights.count_by_type[3], std::clamp(settings_.area_specular_samples_per_side, 1, 4),
+                            settings_.area_soft_shadows ? 1 : 0};
   forward_pass(registry, camera, items, variant);
   timings_.push_back({provider_ ? std::string("forward + indirect (") + provider_->label() + ")"
                                 : std::string("forward + constant ambient (stand-in)"),
@@ -470,7 +473,7 @@ Result<std::unique_ptr<Renderer>> Renderer::create(const SceneAsset& assets, con
   GI_EXPECTS(settings.width > 0 && settings.height > 0, "RenderSettings width and height must be positive");
   if (glGetString(GL_VERSION) == nullptr)
     return Error{assets.source, "renderer", "no current OpenGL context (create an engine::GpuContext first)"};
-  auto forward = build_forward(LightCounts{0, 0, 0, 0, 3});
+  auto forward = build_forward(LightCounts{0, 0, 0, 0, 3, 1});
   if (!forward) return forward.error();
   auto depth = build("shadow.vert.glsl", "depth_only.frag.glsl");
   if (!depth) return depth.error();

@@ -2,7 +2,7 @@
 // Turns the registry's enabled lights into GpuLight records and plans their shadow maps:
 // directional (orthographic, fitted to the scene bounds), spot (perspective, the cone),
 // area (perspective with a 150 degree field of view from the rectangle's centre; the shader
-// softens it with a 5x5 instead of 3x3 PCF kernel),
+// soft-shadows it over the rectangle, shadow_common.glsl's shadow_area),
 // point (a cube-map-array slice, six 90 degree faces).
 
 #include <array>
