@@ -53,6 +53,11 @@ struct RenderSettings {
   /// grows about linearly with n^2 (9 points: ~2/3 of an area light's cost); the diffuse
   /// part is exact whatever n.
   int area_specular_samples_per_side = 3;
+  /// Dielectrics with roughness >= 0.9 and no roughness texture take one specular point per
+  /// rectangle whatever area_specular_samples_per_side says: their lobe is far wider than
+  /// the light's spread of directions (about 1% of their radiance at worst), and
+  /// the area light's specular is the costliest part of the forward pass on llvmpipe.
+  bool area_specular_one_point_on_rough = true;
   /// Shadows of area lights: true, soft over the rectangle (a blocker search and 16 compare
   /// taps over the rectangle's footprint in its shadow map, PCSS); false, from the
   /// rectangle's centre (a 3x3 grid of bilinear compare taps, cheaper, hard-edged and dark

@@ -270,15 +270,24 @@ void ForwardRenderer::render(const Registry& registry, Entity camera) {
   timings_.push_back({"tonemap (exposure, ACES fitted, sRGB)", timer.lap_ms()});
 }
 
+// A dielectric whose roughness is at least kRoughForOnePoint everywhere (no roughness texture):
+// its GGX lobe is far wider than the spread of directions to an area light's points, so one
+// specular point per rectangle (the centre) gives its radiance within about 1% (1.02% worst
+// at roughness 0.9, RendererAreaLight.RoughDielectricsTakeOneSpecularPoint).
+constexpr float kRoughForOnePoint = 0.9f;
+bool rough_dielectric(const render::GpuMaterial& m, GLuint white_texture) {
+  return m.metallic == 0.0f && m.roughness >= kRoughForOnePoint && m.metallic_roughness_texture == white_texture;
+}
+
 void ForwardRenderer::forward_pass(const Registry& registry, Entity camera, const std::vector<DrawItem>& items,
                                    const LightCounts& counts) {
-  const ShaderProgram& program = forward_program(counts);
   const Camera& cam = registry.get<Camera>(camera);
   const glm::mat4& camera_now = registry.get<WorldTransform>(camera).matrix;
   if (unusable_world_matrix(camera_now) == nullptr) last_camera_world_ = camera_now;
   const glm::mat4& camera_world = last_camera_world_;
   const float aspect = cam.aspect > 0.0f ? cam.aspect : static_cast<float>(width_) / static_cast<float>(height_);
-  const glm::mat4 view_proj = glm::perspective(cam.yfov_rad, aspect, cam.znear_m, cam.zfar_m) * glm::inverse(camera_world);
+  const glm::mat4 view_proj =
+      glm::perspective(cam.yfov_rad, aspect, cam.znear_m, cam.zfar_m) * glm::inverse(camera_world);
   const glm::vec3 camera_position(camera_world[3]);
 
   const IndirectLightFrame* indirect = provider_ ? &provider_->frame() : nullptr;
@@ -302,7 +311,6 @@ void ForwardRenderer::forward_pass(const Registry& registry, Entity camera, cons
   glDepthFunc(GL_EQUAL);
   glDepthMask(GL_FALSE);
 
-  program.use();
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kLightsBinding, lights_buffer_.id());
   glBindTextureUnit(kShadowMapsUnit, shadow_maps_.maps_2d());
   glBindTextureUnit(kPointShadowMapsUnit, shadow_maps_.cube_maps());
@@ -317,83 +325,105 @@ void ForwardRenderer::forward_pass(const Registry& registry, Entity camera, cons
   const bool directional = indirect != nullptr && indirect->directional_index_texture != 0 &&
                            indirect->directional_radiance_buffer != 0 && indirect->directional_direction_buffer != 0 &&
                            indirect->directional_bin_count > 0 && indirect->directional_element_count > 0;
-  glBindTextureUnit(kDirectionalIndexUnit, directional ? indirect->directional_index_texture : no_directional_index_.id());
+  glBindTextureUnit(kDirectionalIndexUnit,
+                    directional ? indirect->directional_index_texture : no_directional_index_.id());
   if (directional) {
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kDirectionalRadianceBinding, indirect->directional_radiance_buffer);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kDirectionalDirectionBinding, indirect->directional_direction_buffer);
   }
-  glUniform1i(29, directional ? indirect->directional_bin_count : 0);
-  glUniform1i(30, directional ? indirect->directional_element_count : 0);
 
-  glUniformMatrix4fv(8, 1, GL_FALSE, glm::value_ptr(view_proj));
-  glUniform3fv(16, 1, glm::value_ptr(camera_position));
-  glUniform1f(23, settings_.stand_in_ambient);
-  glUniform3fv(31, 1, glm::value_ptr(settings_.sky_radiance));
-  {  // The sky's gradient (engine/sky.h): horizon, zenith - horizon, ground - horizon.
-    const SkyGradient& g = settings_.sky_gradient;
-    const glm::vec3 terms[3] = {g.horizon, g.zenith - g.horizon, g.ground - g.horizon};
-    glUniform3fv(61, 3, glm::value_ptr(terms[0]));
-  }
-  glUniform1f(24, settings_.split == SplitView::DirectLeftFullRight ? 0.5f * static_cast<float>(width_) : -1.0f);
-  glUniform1i(25, glossy != 0 ? 1 : 0);
+  // Rough dielectrics draw with the one-specular-point variant of area lights (rough_dielectric),
+  // the other materials with RenderSettings::area_specular_samples_per_side: two passes over the
+  // items, each with its program, when that makes a difference.
+  LightCounts rough_counts = counts;
+  rough_counts[4] = 1;
+  const bool split_rough = counts[3] > 0 && counts[4] > 1 && settings_.area_specular_one_point_on_rough;
+  for (int pass = 0; pass < (split_rough ? 2 : 1); ++pass) {
+    const ShaderProgram& program = forward_program(pass == 0 ? counts : rough_counts);
+    program.use();
+    glUniform1i(29, directional ? indirect->directional_bin_count : 0);
+    glUniform1i(30, directional ? indirect->directional_element_count : 0);
 
-  for (const DrawItem& item : items) {
-    int mode = kIndirectAmbient;
-    GLuint vertex_buffer = 0;
-    if (indirect != nullptr) {
-      mode = kIndirectNone;
-      if (item.is_static && atlas != 0) {
-        mode = kIndirectAtlas;
-      } else if (!item.is_static) {
-        vertex_buffer = indirect->vertex_irradiance_buffer(item.entity);
-        if (vertex_buffer != 0) mode = kIndirectVertex;
-      }
+    glUniformMatrix4fv(8, 1, GL_FALSE, glm::value_ptr(view_proj));
+    glUniform3fv(16, 1, glm::value_ptr(camera_position));
+    glUniform1f(23, settings_.stand_in_ambient);
+    glUniform3fv(31, 1, glm::value_ptr(settings_.sky_radiance));
+    {  // The sky's gradient (engine/sky.h): horizon, zenith - horizon, ground - horizon.
+      const SkyGradient& g = settings_.sky_gradient;
+      const glm::vec3 terms[3] = {g.horizon, g.zenith - g.horizon, g.ground - g.horizon};
+      glUniform3fv(61, 3, glm::value_ptr(terms[0]));
     }
-    {  // The sky's occlusion on a dynamic entity, when the provider measured it (indirect_light.h).
-      float axes[6] = {1.0f, 1.0f, 1.0f, 1.0f, 1.0f, 1.0f};
-      if (indirect != nullptr && !item.is_static) (void)indirect->sky_visibility(item.entity, axes);
-      glUniform3f(64, axes[0], axes[2], axes[4]);
-      glUniform3f(65, axes[1], axes[3], axes[5]);
-    }
-    if (vertex_buffer != 0) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kVertexIrradianceBinding, vertex_buffer);
-    // Per-vertex view-dependent indirect light (IndirectLightFrame::vertex_radiance_lobes).
-    IndirectLightFrame::VertexRadianceLobes lobes;
-    if (vertex_buffer != 0) lobes = indirect->vertex_radiance_lobes(item.entity);
-    const bool use_lobes = lobes.terms > 0 && lobes.resolution > 0 && lobes.coefficient_buffer != 0 &&
-                           lobes.lobe_buffer != 0 && lobes.first >= 0 && lobes.stride >= 0;
-    if (use_lobes) {
-      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kLobeCoefficientsBinding, lobes.coefficient_buffer);
-      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kLobeTableBinding, lobes.lobe_buffer);
-    }
-    glUniform1i(40, use_lobes ? lobes.terms : 0);
-    glUniform1i(41, lobes.resolution);
-    glUniform1i(42, lobes.first);
-    glUniform1i(43, lobes.stride);
-    glUniform1i(12, item.mesh->first_vertex);
-    glUniform1i(13, vertex_buffer != 0 ? 1 : 0);
-    glUniform1i(22, mode);
-    glUniformMatrix4fv(0, 1, GL_FALSE, glm::value_ptr(item.model));
-    const glm::mat4 normal_matrix(glm::transpose(glm::inverse(glm::mat3(item.model))));
-    glUniformMatrix4fv(4, 1, GL_FALSE, glm::value_ptr(normal_matrix));
-    for (const render::GpuPrimitive& p : item.mesh->primitives) {
+    glUniform1f(24, settings_.split == SplitView::DirectLeftFullRight ? 0.5f * static_cast<float>(width_) : -1.0f);
+    glUniform1i(25, glossy != 0 ? 1 : 0);
+
+    const auto in_pass = [&](const DrawItem& item, const render::GpuPrimitive& p) {
+      if (!split_rough) return true;
       const render::GpuMaterial& m = scene_.material(item.material_override >= 0 ? item.material_override : p.material);
-      if (m.double_sided)
-        glDisable(GL_CULL_FACE);
-      else
-        glEnable(GL_CULL_FACE);
-      glUniform4fv(18, 1, glm::value_ptr(m.base_color));
-      glUniform1f(19, m.metallic);
-      glUniform1f(20, m.roughness);
-      glUniform3fv(21, 1, glm::value_ptr(m.emissive));
-      glUniform1i(26, m.double_sided ? 1 : 0);
-      glUniform1f(27, m.specular_factor);
-      glUniform3fv(28, 1, glm::value_ptr(m.specular_color_factor));
-      glBindTextureUnit(kBaseColorUnit, m.base_color_texture);
-      glBindTextureUnit(kMetallicRoughnessUnit, m.metallic_roughness_texture);
-      glBindTextureUnit(kEmissiveUnit, m.emissive_texture);
-      glDrawElementsBaseVertex(GL_TRIANGLES, static_cast<GLsizei>(p.index_count), GL_UNSIGNED_INT,
-                               reinterpret_cast<const void*>(static_cast<std::uintptr_t>(p.first_index) * 4u),
-                               p.base_vertex);
+      return rough_dielectric(m, scene_.white_texture()) == (pass == 1);
+    };
+    for (const DrawItem& item : items) {
+      if (std::none_of(item.mesh->primitives.begin(), item.mesh->primitives.end(),
+                       [&](const render::GpuPrimitive& p) { return in_pass(item, p); }))
+        continue;
+      int mode = kIndirectAmbient;
+      GLuint vertex_buffer = 0;
+      if (indirect != nullptr) {
+        mode = kIndirectNone;
+        if (item.is_static && atlas != 0) {
+          mode = kIndirectAtlas;
+        } else if (!item.is_static) {
+          vertex_buffer = indirect->vertex_irradiance_buffer(item.entity);
+          if (vertex_buffer != 0) mode = kIndirectVertex;
+        }
+      }
+      {  // The sky's occlusion on a dynamic entity, when the provider measured it (indirect_light.h).
+        float axes[6] = {1.0f, 1.0f, 1.0f, 1.0f, 1.0f, 1.0f};
+        if (indirect != nullptr && !item.is_static) (void)indirect->sky_visibility(item.entity, axes);
+        glUniform3f(64, axes[0], axes[2], axes[4]);
+        glUniform3f(65, axes[1], axes[3], axes[5]);
+      }
+      if (vertex_buffer != 0) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kVertexIrradianceBinding, vertex_buffer);
+      // Per-vertex view-dependent indirect light (IndirectLightFrame::vertex_radiance_lobes).
+      IndirectLightFrame::VertexRadianceLobes lobes;
+      if (vertex_buffer != 0) lobes = indirect->vertex_radiance_lobes(item.entity);
+      const bool use_lobes = lobes.terms > 0 && lobes.resolution > 0 && lobes.coefficient_buffer != 0 &&
+                             lobes.lobe_buffer != 0 && lobes.first >= 0 && lobes.stride >= 0;
+      if (use_lobes) {
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kLobeCoefficientsBinding, lobes.coefficient_buffer);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kLobeTableBinding, lobes.lobe_buffer);
+      }
+      glUniform1i(40, use_lobes ? lobes.terms : 0);
+      glUniform1i(41, lobes.resolution);
+      glUniform1i(42, lobes.first);
+      glUniform1i(43, lobes.stride);
+      glUniform1i(12, item.mesh->first_vertex);
+      glUniform1i(13, vertex_buffer != 0 ? 1 : 0);
+      glUniform1i(22, mode);
+      glUniformMatrix4fv(0, 1, GL_FALSE, glm::value_ptr(item.model));
+      const glm::mat4 normal_matrix(glm::transpose(glm::inverse(glm::mat3(item.model))));
+      glUniformMatrix4fv(4, 1, GL_FALSE, glm::value_ptr(normal_matrix));
+      for (const render::GpuPrimitive& p : item.mesh->primitives) {
+        if (!in_pass(item, p)) continue;
+        const render::GpuMaterial& m =
+            scene_.material(item.material_override >= 0 ? item.material_override : p.material);
+        if (m.double_sided)
+          glDisable(GL_CULL_FACE);
+        else
+          glEnable(GL_CULL_FACE);
+        glUniform4fv(18, 1, glm::value_ptr(m.base_color));
+        glUniform1f(19, m.metallic);
+        glUniform1f(20, m.roughness);
+        glUniform3fv(21, 1, glm::value_ptr(m.emissive));
+        glUniform1i(26, m.double_sided ? 1 : 0);
+        glUniform1f(27, m.specular_factor);
+        glUniform3fv(28, 1, glm::value_ptr(m.specular_color_factor));
+        glBindTextureUnit(kBaseColorUnit, m.base_color_texture);
+        glBindTextureUnit(kMetallicRoughnessUnit, m.metallic_roughness_texture);
+        glBindTextureUnit(kEmissiveUnit, m.emissive_texture);
+        glDrawElementsBaseVertex(GL_TRIANGLES, static_cast<GLsizei>(p.index_count), GL_UNSIGNED_INT,
+                                 reinterpret_cast<const void*>(static_cast<std::uintptr_t>(p.first_index) * 4u),
+                                 p.base_vertex);
+      }
     }
   }
   glDisable(GL_CULL_FACE);
