@@ -27,6 +27,7 @@ struct RunOptions {
   int width = 960;
   int height = 540;
   float exposure = kDemoExposure;  ///< Linear scale before tonemapping.
+  bool area_soft_shadows = true;   ///< --area-shadows soft|centre (engine::RenderSettings::area_soft_shadows).
   bool size_given = false;
   std::uint64_t every = 1;
   bool exr = false;

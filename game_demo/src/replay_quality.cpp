@@ -76,7 +76,10 @@ int main(int argc, char** argv) {
   CLI::App app{
       "Replays a session with GI bakes of different quality: frame time vs image error against the path tracer"};
   app.add_option("--session", session_path, "Recorded session (.girec)")->required()->check(CLI::ExistingFile);
-  app.add_option("--bundle", bundles, "NAME=DIR of a bake bundle, or 'none' for the stand-in (repeatable)")->required();
+  app.add_option("--bundle", bundles,
+                 "NAME=DIR of a bake bundle, or 'none' for the stand-in (repeatable); NAME=DIR,area-shadows=centre "
+                 "shadows area lights from their centre only (default soft)")
+      ->required();
   app.add_option("--frames", frames_text, "Comma-separated frames compared with the path tracer");
   app.add_option("--width", width)->check(CLI::Range(16, 4096));
   app.add_option("--height", height)->check(CLI::Range(16, 4096));
@@ -138,6 +141,18 @@ int main(int argc, char** argv) {
     const std::size_t eq = spec.find('=');
     row.name = eq == std::string::npos ? spec : spec.substr(0, eq);
     row.bundle = eq == std::string::npos ? "" : spec.substr(eq + 1);
+    // Renderer choices after the bundle: ",area-shadows=centre" (RenderSettings::area_soft_shadows off).
+    bool area_soft_shadows = true;
+    if (const std::size_t opt = row.bundle.find(",area-shadows="); opt != std::string::npos) {
+      const std::string value = row.bundle.substr(opt + 14);
+      if (value != "soft" && value != "centre") {
+        std::cerr << "gi-replay-quality: area-shadows must be soft or centre, not '" << value << "'\n";
+        return 2;
+      }
+      area_soft_shadows = value == "soft";
+      row.bundle = row.bundle.substr(0, opt);
+    }
+    if (row.bundle == "none") row.bundle.clear();
     auto sim = game_demo::simulation_for_session(*session, session_path);
     if (!sim) {
       std::cerr << "gi-replay-quality: " << sim.error().to_string() << '\n';
@@ -154,7 +169,8 @@ int main(int argc, char** argv) {
     }
     auto renderer = engine::Renderer::create(
         sim->scene().assets,
-        engine::RenderSettings{.width = width, .height = height, .exposure = game_demo::kDemoExposure});
+        engine::RenderSettings{.width = width, .height = height, .exposure = game_demo::kDemoExposure,
+                               .area_soft_shadows = area_soft_shadows});
     if (!renderer) {
       std::cerr << "gi-replay-quality: " << renderer.error().to_string() << '\n';
       return 1;

@@ -101,6 +101,7 @@ int run_windowed(const RunOptions& o, RunState& state) {
         engine::RenderSettings{.width = o.width,
                                .height = o.height,
                                .exposure = o.exposure,
+                               .area_soft_shadows = o.area_soft_shadows,
                                .warn = [](const std::string& line) { std::cerr << "gi_demo: " << line << '\n'; }});
   if (!r) {
     std::cerr << "gi_demo: " << r.error().to_string() << '\n';
