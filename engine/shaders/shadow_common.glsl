@@ -133,8 +133,11 @@ const vec2 kRect12[12] = vec2[12](
     vec2(-0.9167, -0.9167), vec2(-0.7500, -0.0833), vec2(-0.5833, 0.7500), vec2(-0.4167, -0.4167),
     vec2(-0.2500, 0.4167), vec2(-0.0833, -0.7500), vec2(0.0833, 0.0833), vec2(0.2500, 0.9167),
     vec2(0.4167, -0.2500), vec2(0.5833, 0.5833), vec2(0.7500, -0.5833), vec2(0.9167, 0.2500));
-// Where the blocker search gathers 2 x 2 texels (a rotated grid over the rectangle's disc).
-const vec2 kSearch4[4] = vec2[4](vec2(-0.35, -1.05), vec2(1.05, -0.35), vec2(0.35, 1.05), vec2(-1.05, 0.35));
+// Where the blocker search gathers 2 x 2 texels: the receiver's own texels, then two rotated
+// rings over the rectangle's disc (a ring alone misses a blocker smaller than its radius).
+const vec2 kSearch9[9] = vec2[9](vec2(0.0, 0.0), vec2(-0.15, -0.45), vec2(0.45, -0.15), vec2(0.15, 0.45),
+                                 vec2(-0.45, 0.15), vec2(-0.35, -1.05), vec2(1.05, -0.35), vec2(0.35, 1.05),
+                                 vec2(-1.05, 0.35));
 
 // Rectangular area light, soft-shadowed over its rectangle (PCSS). The light's 2-D map is a
 // perspective distance map from the rectangle's centre c. The light's point
@@ -142,20 +145,21 @@ const vec2 kSearch4[4] = vec2[4](vec2(-0.35, -1.05), vec2(1.05, -0.35), vec2(0.3
 // blocker at distance b from c where the segment between them crosses it. Clip space is
 // linear along the segment and the rectangle lies in the eye's plane (w = 0), so that
 // crossing is at uv_p + k (s ax + t ay), k = (d - b) / b, ax and ay the half axes projected
-// at the receiver. A blocker search over the rectangle's footprint (4 gathers of 2 x 2
+// at the receiver. A blocker search over the rectangle's footprint (9 gathers of 2 x 2
 // depths, at the k of a blocker kAreaSearchTexels away) gives the mean blocker distance,
 // then 12 compare taps over the footprint at that k average the visibility of 12 points of
 // the light. Each tap compares against the receiver's tangent plane (its depth along the
 // tap's ray from c, linear in s and t), so a wide footprint on a slanted receiver does not
 // shadow the receiver itself. On llvmpipe every fragment pays every tap (no branch skips
-// work), so the tap counts are the cost: 16 lookups against the centre filter's 9.
+// work), so the tap counts are the cost: 21 lookups against the centre filter's 9.
 // How far from the light's centre the ray towards `ray` meets the receiver's tangent plane
-// (normal n, at `plane` = dot(n, receiver - centre)): the depth a tap off the receiver's own
-// texel compares against, so a slanted receiver does not shadow itself. The receiver's
-// distance d when the centre is behind the plane or the ray nearly parallel to it.
+// (normal n, at `plane` = dot(n, receiver - centre), negative when the centre is in front of
+// the receiver): the depth a tap off the receiver's own texel compares against, so a slanted
+// receiver does not shadow itself. The receiver's distance d when the centre is behind the
+// plane or the ray nearly parallel to it.
 float receiver_plane_distance(vec3 ray, vec3 n, float plane, float d) {
   float along = dot(n, ray);
-  return plane > 0.0 && along > 0.25 * plane ? plane * length(ray) / along : d;
+  return plane < 0.0 && along < 0.25 * plane ? plane * length(ray) / along : d;
 }
 
 const float kAreaSearchTexels = 24.0;
@@ -183,8 +187,8 @@ float shadow_area(GpuLight light, vec3 p, vec3 n, vec3 to_light) {
   float k_search = kAreaSearchTexels / reach;
   float plane = dot(n, rel);  // the receiver's tangent plane (through po)
   float blockers = 0.0, blocker_depth = 0.0;
-  for (int i = 0; i < 4; ++i) {
-    vec2 st = kSearch4[i];
+  for (int i = 0; i < 9; ++i) {
+    vec2 st = kSearch9[i];
     float r = (receiver_plane_distance(rel + k_search * (st.x * hx + st.y * hy), n, plane, d) - bias) / far_m;
     vec4 z = textureGather(u_shadow_depths, vec3(uv + k_search * (st.x * ax + st.y * ay), float(layer)));
     vec4 hit = vec4(lessThan(z, vec4(r)));

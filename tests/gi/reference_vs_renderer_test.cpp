@@ -66,11 +66,12 @@ TEST(ReferenceVsRenderer, CornellBoxDirectLightMatchesPerPixel) {
               "80th percentile %.4f, 90th percentile %.4f\n", sum_raster / sum_traced, median, p80, p90);
   EXPECT_NEAR(sum_raster / sum_traced, 1.0, 0.02);
   EXPECT_LT(median, 0.03);
-  // The tail is the renderer's shadow map, not light units: PCF penumbrae from the light's
-  // centre differ from the exact soft shadows near the blocks, and the tall block's front
-  // face, lit at grazing angles, comes out ~20% darker (shadow bias at grazing incidence).
+  // The tail is the renderer's shadow map, not light units: its soft shadows are PCSS in one
+  // map from the light's centre, not the exact visibility of the rectangle. With the area
+  // light shadowed from its centre only (RenderSettings::area_soft_shadows off) the tall
+  // block's front face came out ~20% dark and the 90th percentile was 0.114; soft, 0.071.
   EXPECT_LT(p80, 0.05);
-  EXPECT_LT(p90, 0.15);
+  EXPECT_LT(p90, 0.10);
   if (::testing::Test::HasFailure()) {
     // Both images and a difference map (red: renderer brighter, blue: darker, 100% = full).
     const std::filesystem::path dir = GI_BINARY_DIR "/test-output/reference_vs_renderer";
