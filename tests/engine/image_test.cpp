@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <string>
 
 #include <engine/image.h>
 
@@ -91,6 +92,31 @@ TEST(ImageFiles, ReadingMissingOrCorruptFilesReturnsErrors) {
   ASSERT_FALSE(bad.ok());
   EXPECT_EQ(bad.error().file, (dir / "bad.exr").string());
   EXPECT_FALSE(engine::load_png(dir / "bad.exr").ok());
+}
+
+// The fuzz leg's finding (tests/fuzz/regressions/exr/): a scanline EXR whose data window's
+// height overflows tinyexr's int arithmetic (max_y - min_y + 1 = 2,315,255,824 as unsigned)
+// made Debian's tinyexr 1.0.1 size its offset table at 2^63 bytes (std::bad_alloc, or an
+// ASan abort). load_exr judges the header first; the message names the window and the limits.
+TEST(ImageExr, AHeaderOutsideTheLimitsIsRefusedBeforeTinyexrSizesAnything) {
+  const fs::path file = fs::path(GI_SOURCE_DIR) / "tests/fuzz/regressions/exr/tinyexr_data_window_overflow.exr";
+  ASSERT_TRUE(fs::exists(file));
+  auto image = engine::load_exr(file);
+  ASSERT_FALSE(image.ok());
+  EXPECT_EQ(image.error().file, file.string());
+  EXPECT_NE(image.error().message.find("data window 32 x 2315255824 outside 1..32768 per side"), std::string::npos)
+      << image.error().to_string();
+  // A well-formed file still loads after the header checks.
+  const fs::path dir = scratch_dir("limits");
+  engine::ImageRgbaF small;
+  small.width = 3;
+  small.height = 2;
+  small.pixels.assign(3 * 2 * 4, 0.5f);
+  ASSERT_TRUE(engine::save_exr(dir / "small.exr", small, engine::ExrPixelType::Float).ok());
+  auto back = engine::load_exr(dir / "small.exr");
+  ASSERT_TRUE(back.ok()) << back.error().to_string();
+  EXPECT_EQ(back->width, 3);
+  EXPECT_EQ(back->height, 2);
 }
 
 }  // namespace

@@ -37,7 +37,13 @@ enum class ExrPixelType : std::uint8_t {
 
 /// Writes a linear OpenEXR (RGBA; temporary file + rename, so readers never see a half file).
 Status save_exr(const std::filesystem::path& path, const ImageRgbaF& image, ExrPixelType type = ExrPixelType::Half);
-/// Reads an OpenEXR into RGBA32F.
+/// What load_exr accepts: one scanline part (no tiles, parts or deep data) of at most
+/// kMaxExrSide texels per side and kMaxExrPixels in all, in a file of at most kMaxExrFileBytes.
+inline constexpr std::int64_t kMaxExrSide = 32768;
+inline constexpr std::int64_t kMaxExrPixels = std::int64_t{1} << 28;
+inline constexpr std::uintmax_t kMaxExrFileBytes = std::uintmax_t{4} << 30;
+/// Reads an OpenEXR into RGBA32F. The header is checked against the limits above before
+/// anything is sized from it; errors name the file.
 Result<ImageRgbaF> load_exr(const std::filesystem::path& path);
 
 }  // namespace engine
