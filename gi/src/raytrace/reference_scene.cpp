@@ -33,6 +33,37 @@ bool is_proxy_of(const ShadingTriangle& t, const ReferenceLight& l) {
   return true;
 }
 
+// The emitter table over the emissive triangles (of the static instances only, if asked),
+// sampled in proportion to power; each triangle's `emitter` points into it or is -1.
+void index_emitters(const ReferenceScene& scene, ReferenceSceneIndex& index, bool static_only) {
+  index.emitters = {};
+  std::vector<double> power;
+  const auto& instances = scene.geometry.instances;
+  for (std::size_t k = 0; k < index.instance_first.size(); ++k) {
+    const auto [first, end] = instance_triangles(index, k);
+    const bool skip = static_only && k < instances.size() && instances[k].dynamic;
+    for (std::uint32_t t = first; t < end; ++t) {
+      ShadingTriangle& tri = index.triangles[t];
+      tri.emitter = -1;
+      const ReferenceMaterial& mat = scene.materials[tri.material];
+      const float lum = luminance(mat.emission);
+      if (skip || !(lum > 0.0f) || !(tri.area_m2 > 0.0f)) continue;
+      tri.emitter = static_cast<std::int32_t>(index.emitters.triangle.size());
+      index.emitters.triangle.push_back(t);
+      power.push_back(static_cast<double>(lum) * static_cast<double>(tri.area_m2) * (mat.double_sided ? 2.0 : 1.0));
+    }
+  }
+  double total = 0.0;
+  for (double p : power) total += p;
+  double running = 0.0;
+  for (double p : power) {
+    running += p;
+    index.emitters.probability.push_back(static_cast<float>(p / total));
+    index.emitters.cdf.push_back(static_cast<float>(running / total));
+  }
+  if (!index.emitters.cdf.empty()) index.emitters.cdf.back() = 1.0f;
+}
+
 }  // namespace
 
 engine::Result<ReferenceSceneIndex> index_reference_scene(const ReferenceScene& scene) {
@@ -115,29 +146,18 @@ engine::Result<ReferenceSceneIndex> index_reference_scene(const ReferenceScene& 
   index.scene_radius_m = index.triangles.empty() ? 1.0f : 0.5f * glm::length(hi - lo);
 
   index.light_has_proxy.assign(scene.lights.size(), false);
-  std::vector<double> power;
-  for (std::uint32_t t = 0; t < index.triangles.size(); ++t) {
-    ShadingTriangle& tri = index.triangles[t];
-    const ReferenceMaterial& mat = scene.materials[tri.material];
-    const float lum = luminance(mat.emission);
-    if (!(lum > 0.0f) || !(tri.area_m2 > 0.0f)) continue;
+  for (const ShadingTriangle& tri : index.triangles) {
+    if (!(luminance(scene.materials[tri.material].emission) > 0.0f) || !(tri.area_m2 > 0.0f)) continue;
     for (std::size_t l = 0; l < scene.lights.size(); ++l)
       if (scene.lights[l].type == ReferenceLight::Type::Area && is_proxy_of(tri, scene.lights[l]))
         index.light_has_proxy[l] = true;
-    tri.emitter = static_cast<std::int32_t>(index.emitters.triangle.size());
-    index.emitters.triangle.push_back(t);
-    power.push_back(static_cast<double>(lum) * static_cast<double>(tri.area_m2) * (mat.double_sided ? 2.0 : 1.0));
   }
-  double total = 0.0;
-  for (double p : power) total += p;
-  double running = 0.0;
-  for (double p : power) {
-    running += p;
-    index.emitters.probability.push_back(static_cast<float>(p / total));
-    index.emitters.cdf.push_back(static_cast<float>(running / total));
-  }
-  if (!index.emitters.cdf.empty()) index.emitters.cdf.back() = 1.0f;
+  index_emitters(scene, index, /*static_only=*/false);
   return index;
+}
+
+void keep_static_emitters(const ReferenceScene& scene, ReferenceSceneIndex& index) {
+  index_emitters(scene, index, /*static_only=*/true);
 }
 
 ReferenceBrdf shading_brdf(const ReferenceScene& scene, const ShadingTriangle& tri, glm::vec2 uv, bool front) {

@@ -97,6 +97,11 @@ inline std::pair<std::uint32_t, std::uint32_t> instance_triangles(const Referenc
 /// Flattens the scene. Errors: inconsistent sizes, indices out of range, non-finite values.
 engine::Result<ReferenceSceneIndex> index_reference_scene(const ReferenceScene& scene);
 
+/// Rebuilds index.emitters (and each triangle's `emitter`) from the emissive triangles of the
+/// static instances only: a bake of the static world must not sample the light of a dynamic
+/// object's emissive surface at its authored pose (it moves; its caster is not in the bake).
+void keep_static_emitters(const ReferenceScene& scene, ReferenceSceneIndex& index);
+
 /// The BRDF of a hit on triangle `tri` at barycentrics (u, v), seen from the side of wo.
 /// `front` says whether wo lies on the front side.
 ReferenceBrdf shading_brdf(const ReferenceScene& scene, const ShadingTriangle& tri, glm::vec2 uv, bool front);

@@ -45,6 +45,7 @@ engine::Result<StaticBakeScene> prepare_static_scene(const BakeInput& input, con
   auto index = index_reference_scene(b.scene);
   if (!index) return index.error();
   b.index = std::move(index).value();
+  keep_static_emitters(b.scene, b.index);  // a dynamic object's glow moves with it: not the static bake's light
   const RtSceneData statics = static_instances(b.scene.geometry, &b.static_instance);
   if (statics.instances.empty()) return engine::Error{.message = "the scene has no static mesh to bake"};
   auto caster = make_embree_ray_caster(statics);
