@@ -3,7 +3,9 @@
 // state (docs/replay_quality.md).
 //   gi-replay-quality --session tests/sessions/walk_flashlight.girec --bundle none
 //       --bundle preview=out/dl_preview.gibake --bundle medium=out/dl_medium.gibake
-//       --frames 150,300,450 --spp 256 --out docs/replay_quality.md
+//       --frames 150,300,450 --spp 256 --out docs/replay_quality.md [--images out/rq]
+// --images DIR also writes each compared frame as linear half-float EXR (ref_f<N>.exr and
+// <name>_f<N>.exr), to see where a row's error lies.
 // "none" is the renderer's constant-ambient stand-in. The error is the relative RMSE of linear
 // radiance over the frame (the renderer's HDR target against the path tracer's image), so it
 // includes the rasterizer's own approximations (shadow maps, light falloff), which the
@@ -19,6 +21,7 @@
 #include <gi/gi_system.h>
 #include <gi/reference.h>
 #include <gi/rgb_field.h>
+#include <engine/image.h>
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -67,10 +70,23 @@ struct Row {
   std::uint64_t gi_idle = 0, gi_frames = 0;
 };
 
+// Writes DIR/<name>_f<frame>.exr when --images is given; false (after saying why) on failure.
+bool save_frame(const std::string& dir, const std::string& name, std::uint64_t frame, const engine::ImageRgbaF& image) {
+  if (dir.empty()) return true;
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  const std::filesystem::path path = std::filesystem::path(dir) / (name + "_f" + std::to_string(frame) + ".exr");
+  if (const engine::Status st = engine::save_exr(path, image); !st) {
+    std::cerr << "gi-replay-quality: " << st.error().to_string() << '\n';
+    return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string session_path, out_path, frames_text = "150,300,450";
+  std::string session_path, out_path, images_dir, frames_text = "150,300,450";
   std::vector<std::string> bundles;
   int width = 320, height = 180, spp = 256;
   CLI::App app{
@@ -85,6 +101,7 @@ int main(int argc, char** argv) {
   app.add_option("--height", height)->check(CLI::Range(16, 4096));
   app.add_option("--spp", spp, "Path-tracer samples per pixel of the reference frames")->check(CLI::PositiveNumber);
   app.add_option("--out", out_path, "Markdown table to write (also printed)");
+  app.add_option("--images", images_dir, "Directory for the compared frames as EXR (reference and each row)");
   CLI11_PARSE(app, argc, argv);
 
   std::vector<std::uint64_t> picked;
@@ -122,6 +139,7 @@ int main(int argc, char** argv) {
         std::cerr << "gi-replay-quality: " << image.error().to_string() << '\n';
         return 1;
       }
+      if (!save_frame(images_dir, "ref", f, *image)) return 1;
       std::size_t bad = 0;
       reference.emplace(f, field_of(*image, &bad));
       std::printf("reference frame %llu: %.1f s, %zu non-finite pixels masked\n", static_cast<unsigned long long>(f),
@@ -184,8 +202,10 @@ int main(int argc, char** argv) {
       glFinish();
       ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
       if (const auto it = reference.find(f); it != reference.end()) {
+        const engine::ImageRgbaF hdr = (*renderer)->read_hdr();
+        if (!save_frame(images_dir, row.name, f, hdr)) return 1;
         std::size_t bad = 0;
-        gi::RgbField mine = masked(field_of((*renderer)->read_hdr(), &bad), it->second);
+        gi::RgbField mine = masked(field_of(hdr, &bad), it->second);
         gi::RgbField ref = it->second;
         for (std::size_t i = 0; i < ref.valid.size(); ++i)
           if (!mine.is_valid(i)) ref.valid[i] = 0;
