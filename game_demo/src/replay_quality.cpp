@@ -4,12 +4,18 @@
 //   gi-replay-quality --session tests/sessions/walk_flashlight.girec --bundle none
 //       --bundle preview=out/dl_preview.gibake --bundle medium=out/dl_medium.gibake
 //       --frames 150,300,450 --spp 256 --out docs/replay_quality.md [--images out/rq]
-// --images DIR also writes each compared frame as linear half-float EXR (ref_f<N>.exr and
-// <name>_f<N>.exr), to see where a row's error lies.
+// --images DIR also writes each compared frame as linear half-float EXR and a PNG at the
+// demo's exposure (ref_f<N>, <name>_f<N>) and each row's luminance ratio to the reference
+// (<name>_f<N>_diff.png), to see where a row's error lies.
 // "none" is the renderer's constant-ambient stand-in. The error is the relative RMSE of linear
 // radiance over the frame (the renderer's HDR target against the path tracer's image), so it
 // includes the rasterizer's own approximations (shadow maps, light falloff), which the
-// stand-in row shows on its own.
+// stand-in row shows on its own. The path tracer's camera rays pass through the pixel centres,
+// as the rasterizer's do (no anti-aliasing on either side: an edge of the bright ceiling
+// panel would otherwise count as error). Each error is also given against the noise-free truth the
+// path tracer estimates (its per-pixel variance removed, gi/error_metrics.h): at a few hundred
+// samples per pixel the reference's own noise is a large part of the plain figure in rooms lit
+// only indirectly.
 #define GL_GLEXT_PROTOTYPES 1
 #include <GL/glcorearb.h>
 #include <engine/gpu/context.h>
@@ -66,17 +72,54 @@ gi::RgbField masked(gi::RgbField f, const gi::RgbField& reference) {
 struct Row {
   std::string name, bundle;
   double mean_ms = 0.0, p95_ms = 0.0;
-  std::vector<double> errors;
+  std::vector<double> errors;        ///< Relative RMSE against the reference, per compared frame.
+  std::vector<double> truth_errors;  ///< The same against the noise-free truth (the reference's variance removed).
   std::uint64_t gi_idle = 0, gi_frames = 0;
 };
 
-// Writes DIR/<name>_f<frame>.exr when --images is given; false (after saying why) on failure.
+// Writes DIR/<name>_f<frame>.exr (linear) and .png (the demo's exposure, clamped, sRGB) when
+// --images is given; false (after saying why) on failure.
 bool save_frame(const std::string& dir, const std::string& name, std::uint64_t frame, const engine::ImageRgbaF& image) {
   if (dir.empty()) return true;
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
-  const std::filesystem::path path = std::filesystem::path(dir) / (name + "_f" + std::to_string(frame) + ".exr");
-  if (const engine::Status st = engine::save_exr(path, image); !st) {
+  const std::filesystem::path base = std::filesystem::path(dir) / (name + "_f" + std::to_string(frame));
+  engine::ImageRgba8 png{.width = image.width, .height = image.height, .pixels = {}};
+  png.pixels.resize(image.pixels.size());
+  for (std::size_t i = 0; i < image.pixels.size(); ++i) {
+    const float v = i % 4 == 3 ? 1.0f : std::clamp(image.pixels[i] * game_demo::kDemoExposure, 0.0f, 1.0f);
+    const float srgb = v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
+    png.pixels[i] = static_cast<std::uint8_t>(std::lround(255.0f * (std::isfinite(srgb) ? srgb : 0.0f)));
+  }
+  for (const engine::Status& st : {engine::save_exr(base.string() + ".exr", image), engine::save_png(base.string() + ".png", png)})
+    if (!st) {
+      std::cerr << "gi-replay-quality: " << st.error().to_string() << '\n';
+      return false;
+    }
+  return true;
+}
+
+// DIR/<name>_f<frame>_diff.png: each pixel's luminance against the reference's, log2 ratio
+// from -1 (blue: half as bright) through white to +1 (red: twice as bright).
+bool save_difference(const std::string& dir, const std::string& name, std::uint64_t frame,
+                     const engine::ImageRgbaF& mine, const gi::RgbField& ref) {
+  if (dir.empty()) return true;
+  engine::ImageRgba8 png{.width = mine.width, .height = mine.height, .pixels = {}};
+  png.pixels.assign(mine.pixels.size(), 255);
+  for (std::size_t p = 0; p * 4 < mine.pixels.size() && 3 * p + 2 < ref.rgb.size(); ++p) {
+    const float* m = &mine.pixels[4 * p];
+    const float lm = 0.2126f * m[0] + 0.7152f * m[1] + 0.0722f * m[2];
+    const float* r = &ref.rgb[3 * p];
+    const float lr = 0.2126f * r[0] + 0.7152f * r[1] + 0.0722f * r[2];
+    const float t = std::clamp(std::log2((lm + 1e-3f) / (lr + 1e-3f)), -1.0f, 1.0f);
+    const auto fade = static_cast<std::uint8_t>(std::lround(255.0f * (1.0f - std::fabs(t))));
+    std::uint8_t* o = &png.pixels[4 * p];
+    o[0] = t < 0.0f ? fade : 255;
+    o[1] = fade;
+    o[2] = t > 0.0f ? fade : 255;
+  }
+  const std::filesystem::path path = std::filesystem::path(dir) / (name + "_f" + std::to_string(frame) + "_diff.png");
+  if (const engine::Status st = engine::save_png(path, png); !st) {
     std::cerr << "gi-replay-quality: " << st.error().to_string() << '\n';
     return false;
   }
@@ -132,16 +175,34 @@ int main(int argc, char** argv) {
       sim->step(session->frames[f].input);
       if (!std::binary_search(picked.begin(), picked.end(), f)) continue;
       const auto t0 = std::chrono::steady_clock::now();
-      gi::ReferenceSettings rs;
-      rs.samples_per_pixel = spp;
-      auto image = gi::render_reference_image(sim->scene(), sim->context().camera, width, height, rs);
-      if (!image) {
-        std::cerr << "gi-replay-quality: " << image.error().to_string() << '\n';
-        return 1;
+      // Two independent halves (seeds 1 and 2): their mean is the reference, and per pixel
+      // (a - b)^2 / 4 estimates its sampling variance without bias, so the table can also give
+      // each row's error against the noise-free truth (gi::compare_rgb, truth_rel_rmse).
+      engine::ImageRgbaF half[2];
+      for (int h = 0; h < 2; ++h) {
+        gi::ReferenceSettings rs;
+        rs.samples_per_pixel = std::max(1, spp / 2);
+        rs.seed = static_cast<std::uint64_t>(h + 1);
+        rs.jitter_pixels = false;  // through the pixel centres, as the rasterizer samples: light, not aliasing
+        auto image = gi::render_reference_image(sim->scene(), sim->context().camera, width, height, rs);
+        if (!image) {
+          std::cerr << "gi-replay-quality: " << image.error().to_string() << '\n';
+          return 1;
+        }
+        half[h] = std::move(image).value();
       }
-      if (!save_frame(images_dir, "ref", f, *image)) return 1;
+      engine::ImageRgbaF image = half[0];
+      for (std::size_t i = 0; i < image.pixels.size(); ++i) image.pixels[i] = 0.5f * (half[0].pixels[i] + half[1].pixels[i]);
+      if (!save_frame(images_dir, "ref", f, image)) return 1;
       std::size_t bad = 0;
-      reference.emplace(f, field_of(*image, &bad));
+      gi::RgbField field = field_of(image, &bad);
+      field.variance.assign(field.rgb.size(), 0.0f);
+      for (std::size_t p = 0; 4 * p < image.pixels.size(); ++p)
+        for (std::size_t c = 0; c < 3; ++c) {
+          const float d = half[0].pixels[4 * p + c] - half[1].pixels[4 * p + c];
+          field.variance[3 * p + c] = std::isfinite(d) ? 0.25f * d * d : 0.0f;
+        }
+      reference.emplace(f, std::move(field));
       std::printf("reference frame %llu: %.1f s, %zu non-finite pixels masked\n", static_cast<unsigned long long>(f),
                   std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), bad);
       std::fflush(stdout);
@@ -154,6 +215,7 @@ int main(int argc, char** argv) {
     return 1;
   }
   std::vector<Row> rows;
+  std::map<std::uint64_t, double> reference_noise;  // relative RMSE of the reference's own noise, per frame
   for (const std::string& spec : bundles) {
     Row row;
     const std::size_t eq = spec.find('=');
@@ -206,13 +268,17 @@ int main(int argc, char** argv) {
         if (!save_frame(images_dir, row.name, f, hdr)) return 1;
         std::size_t bad = 0;
         gi::RgbField mine = masked(field_of(hdr, &bad), it->second);
+        if (!save_difference(images_dir, row.name, f, hdr, it->second)) return 1;
         gi::RgbField ref = it->second;
         for (std::size_t i = 0; i < ref.valid.size(); ++i)
           if (!mine.is_valid(i)) ref.valid[i] = 0;
         if (bad > 0)
           std::printf("%s frame %llu: %zu non-finite pixels masked\n", row.name.c_str(),
                       static_cast<unsigned long long>(f), bad);
-        row.errors.push_back(gi::relative_rmse(mine, ref));
+        const gi::ErrorReport e = gi::compare_rgb(mine, ref);
+        row.errors.push_back(e.rel_rmse);
+        row.truth_errors.push_back(e.truth_rel_rmse);
+        reference_noise[f] = e.reference_noise;
       }
     }
     row.mean_ms = std::accumulate(ms.begin(), ms.end(), 0.0) / static_cast<double>(ms.size());
@@ -223,26 +289,38 @@ int main(int argc, char** argv) {
     std::printf("%s: %.2f ms mean per frame\n", row.name.c_str(), row.mean_ms);
   }
 
+  // Each cell: relative RMSE against the path tracer's image, and in brackets against the
+  // truth it estimates (its sampling noise removed; see gi/error_metrics.h).
   std::ostringstream md;
   md << "| GI | frame ms (mean / p95) | GI idle frames |";
-  for (std::uint64_t f : picked) md << " rel RMSE f" << f << " |";
-  md << " mean rel RMSE |\n|---|---|---|";
+  for (std::uint64_t f : picked) md << " rel RMSE f" << f << " (truth) |";
+  md << " mean rel RMSE (truth) |\n|---|---|---|";
   for (std::size_t i = 0; i < picked.size(); ++i) md << "---|";
   md << "---|\n";
   for (const Row& r : rows) {
-    char buf[128];
+    char buf[160];
     std::snprintf(buf, sizeof buf, "| %s | %.1f / %.1f | %llu of %llu |", r.name.c_str(), r.mean_ms, r.p95_ms,
                   static_cast<unsigned long long>(r.gi_idle), static_cast<unsigned long long>(r.gi_frames));
     md << buf;
-    double sum = 0.0;
-    for (double e : r.errors) {
-      std::snprintf(buf, sizeof buf, " %.3f |", e);
+    double sum = 0.0, truth_sum = 0.0;
+    for (std::size_t i = 0; i < r.errors.size(); ++i) {
+      std::snprintf(buf, sizeof buf, " %.3f (%.3f) |", r.errors[i], r.truth_errors[i]);
       md << buf;
-      sum += e;
+      sum += r.errors[i];
+      truth_sum += r.truth_errors[i];
     }
-    std::snprintf(buf, sizeof buf, " %.3f |\n", sum / static_cast<double>(std::max<std::size_t>(r.errors.size(), 1)));
+    const double n = static_cast<double>(std::max<std::size_t>(r.errors.size(), 1));
+    std::snprintf(buf, sizeof buf, " %.3f (%.3f) |\n", sum / n, truth_sum / n);
     md << buf;
   }
+  md << "\nThe reference's own noise (relative RMSE of its sampling variance, estimated from two independent halves "
+        "of its samples):";
+  for (const auto& [f, noise] : reference_noise) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, " f%llu %.3f;", static_cast<unsigned long long>(f), noise);
+    md << buf;
+  }
+  md << " at " << spp << " samples per pixel.\n";
   std::cout << md.str();
   if (!out_path.empty()) {
     std::ofstream out(out_path);
