@@ -28,6 +28,7 @@ struct RunOptions {
   int height = 540;
   float exposure = kDemoExposure;  ///< Linear scale before tonemapping.
   bool area_soft_shadows = true;   ///< --area-shadows soft|centre (engine::RenderSettings::area_soft_shadows).
+  bool light_reach_culling = true;  ///< --light-reach on|off (engine::RenderSettings::light_reach_culling).
   bool size_given = false;
   std::uint64_t every = 1;
   bool exr = false;

@@ -100,6 +100,7 @@ int main(int argc, char** argv) {
   using namespace game_demo;
   RunOptions o;
   std::string area_shadows = "soft";
+  std::string light_reach = "on";
   CLI::App app{"gi_demo: the playable demo level of the GI module"};
   app.add_option("--scene", o.scene, "glTF scene to play (default: assets/demo_level.gltf)");
   app.add_flag("--headless", o.headless, "Run without a window (EGL surfaceless), driven by --script or --replay");
@@ -112,6 +113,10 @@ int main(int argc, char** argv) {
   app.add_option("--area-shadows", area_shadows,
                  "soft: area lights soft-shadowed over their rectangle (default); centre: from their centre only (cheaper)")
       ->check(CLI::IsMember({"soft", "centre"}));
+  app.add_option("--light-reach", light_reach,
+                 "on: static lights shade only where static geometry lets them reach (default); off: every light "
+                 "on every pixel (engine::RenderSettings::light_reach_culling)")
+      ->check(CLI::IsMember({"on", "off"}));
   app.add_option("--every", o.every, "Headless: write every K-th frame")->check(CLI::PositiveNumber);
   app.add_flag("--exr", o.exr, "Headless: also write DIR/frame_NNNN.exr (linear HDR)");
   app.add_flag("--no-render", o.no_render, "Headless: simulate only (no GPU), e.g. to record sessions");
@@ -132,6 +137,7 @@ int main(int argc, char** argv) {
   app.add_flag("--verbose", o.verbose, "Headless: print the script's waypoints and the player's position each second");
   CLI11_PARSE(app, argc, argv);
   o.area_soft_shadows = area_shadows == "soft";
+  o.light_reach_culling = light_reach == "on";
   o.size_given = w->count() > 0 || h->count() > 0;
   if (o.script.empty()) o.script = std::string(script_name(default_script(o.scene)));
   if (!script_from_name(o.script)) {

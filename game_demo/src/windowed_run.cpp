@@ -102,6 +102,7 @@ int run_windowed(const RunOptions& o, RunState& state) {
                                .height = o.height,
                                .exposure = o.exposure,
                                .area_soft_shadows = o.area_soft_shadows,
+                               .light_reach_culling = o.light_reach_culling,
                                .warn = [](const std::string& line) { std::cerr << "gi_demo: " << line << '\n'; }});
   if (!r) {
     std::cerr << "gi_demo: " << r.error().to_string() << '\n';

@@ -63,6 +63,12 @@ struct RenderSettings {
   /// rectangle's centre (a 3x3 grid of bilinear compare taps, cheaper, hard-edged and dark
   /// where the centre is hidden but part of the rectangle is not).
   bool area_soft_shadows = true;
+  /// Static lights shade only where static geometry lets them reach (engine/light_reach.h):
+  /// a voxel grid of light masks built from the static shadow casters when they or the
+  /// static lights change, written to the stencil by the depth pre-pass; each pixel is
+  /// shaded once with the lights of its mask. Lights that move (Light::moves), directional
+  /// and unshadowed lights are shaded everywhere. Off: every light on every pixel.
+  bool light_reach_culling = true;
   /// The scene's sky (SceneAsset::environment.sky_radiance, W/(m^2 sr); Renderer::create
   /// copies it from the assets). Drawn as direct light: an ambient term without sky
   /// visibility, E = pi x radiance reflected as uniformly arriving light is, on both halves
@@ -143,6 +149,10 @@ class Renderer {
   /// Light and mesh entities the last render() left out as unusable (see RenderSettings::warn).
   /// A camera whose transform is unusable is replaced by its last usable one.
   virtual int last_skipped_entities() const = 0;
+  /// Light sets the last render() shaded pixels with (RenderSettings::light_reach_culling):
+  /// one per light-reach mask in the scene's grid, each drawn over the pixels of its mask;
+  /// 1 when every pixel got every light.
+  virtual int last_light_groups() const { return 1; }
 };
 
 }  // namespace engine

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdio>
+#include <cstring>
 #include <map>
 #include <set>
 #include <utility>
@@ -15,6 +16,7 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include <engine/components.h>
+#include <engine/light_reach.h>
 #include <engine/runtime_limits.h>
 #include <engine/gpu/gl_objects.h>
 #include <engine/gpu/gltf_brdf_texture.h>
@@ -51,6 +53,8 @@ constexpr GLuint kDirectionalRadianceBinding = 2;  // directional_radiance.glsl
 constexpr GLuint kDirectionalDirectionBinding = 3;
 constexpr GLuint kLobeCoefficientsBinding = 6;  // forward.vert.glsl: IndirectLightFrame::vertex_radiance_lobes
 constexpr GLuint kLobeTableBinding = 7;
+constexpr GLuint kReachUnit = 0;  // depth_reach.frag.glsl (the pre-pass binds no material texture)
+constexpr float kReachVoxelM = 0.5f;  // light reach grid spacing (engine/light_reach.h)
 
 // Nearest, clamped, no depth comparison: the 2-D shadow maps read as depths (the blocker
 // search of a directional light with a disc, shadow_common.glsl).
@@ -102,13 +106,36 @@ Result<ShaderProgram> build_forward(const LightCounts& n) {
       .build();
 }
 
+// The lights one set of pixels is shaded with: those of one light-reach mask (the stencil
+// value the pre-pass wrote), as a range of the lights buffer.
+struct LightGroup {
+  int mask = -1;  ///< stencil value; -1: no stencil test (no reach grid)
+  std::vector<render::GpuLight> lights;  ///< sorted by type, like LightList::lights
+  std::array<int, 4> count_by_type{};
+  render::SceneBounds bounds;  ///< where the mask's voxels are; empty: everywhere
+  GLintptr offset = 0;         ///< into the lights buffer (bytes)
+};
+
+// The static shadow casters and static lights a reach grid was built from, and the grid.
+struct ReachState {
+  std::vector<float> light_key;  // the cullable lights' entity ids and geometry
+  std::map<std::uint32_t, glm::mat4> static_models;  // static occluders at the build
+  std::set<std::uint32_t> moved;  // static entities seen moving: never occluders again
+  LightReachGrid grid;
+  std::vector<int> mask_bounds_index;  // per mask value: index into bounds, -1 none
+  std::vector<render::SceneBounds> bounds;
+  GlTexture texture;
+  int builds = 0;
+};
+
 class ForwardRenderer final : public Renderer {
  public:
-  ForwardRenderer(GpuScene scene, ShaderProgram forward, ShaderProgram depth, ShaderProgram shadow,
-                  ShaderProgram tonemap, const RenderSettings& settings)
+  ForwardRenderer(GpuScene scene, ShaderProgram forward, ShaderProgram depth, ShaderProgram depth_reach,
+                  ShaderProgram shadow, ShaderProgram tonemap, const RenderSettings& settings)
       : settings_(settings),
         scene_(std::move(scene)),
         depth_only_(std::move(depth)),
+        depth_reach_(std::move(depth_reach)),
 
         shadow_(std::move(shadow)),
         tonemap_(std::move(tonemap)),
@@ -134,25 +161,34 @@ class ForwardRenderer final : public Renderer {
   const std::vector<PassTiming>& last_timings() const override { return timings_; }
   int last_shadow_maps_rendered() const override { return shadow_maps_rendered_; }
   int last_skipped_entities() const override { return skipped_entities_; }
+  int last_light_groups() const override { return light_groups_; }
 
  private:
   void ensure_targets();
   std::vector<DrawItem> draw_items(const Registry& registry, std::vector<std::pair<Entity, const char*>>& skipped) const;
   void report_skipped(const Registry& registry, const std::vector<std::pair<Entity, const char*>>& skipped);
-  void forward_pass(const Registry& registry, Entity camera, const std::vector<DrawItem>& items, const LightCounts& counts);
+  void forward_pass(const Registry& registry, Entity camera, const std::vector<DrawItem>& items,
+                    const std::vector<LightGroup>& groups);
   const ShaderProgram& forward_program(const LightCounts& counts);
-  void depth_prepass(const glm::mat4& view_proj, const std::vector<DrawItem>& items);
+  void depth_prepass(const glm::mat4& view_proj, const std::vector<DrawItem>& items, bool reach);
+  std::vector<LightGroup> light_groups(const Registry& registry, const std::vector<DrawItem>& items,
+                                       const render::LightList& lights);
+  void update_reach(const Registry& registry, const std::vector<DrawItem>& items, const render::LightList& lights,
+                    const std::vector<int>& cullable);
   void tonemap_pass();
 
   RenderSettings settings_;
   GpuScene scene_;
   std::map<LightCounts, ShaderProgram> forward_variants_;
   ShaderProgram depth_only_;
+  ShaderProgram depth_reach_;
+  ReachState reach_;
   ShaderProgram shadow_;
   ShaderProgram tonemap_;
   render::ShadowMaps shadow_maps_;
   int shadow_maps_rendered_ = 0;
   int skipped_entities_ = 0;
+  int light_groups_ = 1;
   std::set<std::uint32_t> warned_;  // entity ids skipped and reported, while they stay unusable
   glm::mat4 last_camera_world_{1.0f};
   GlBuffer lights_buffer_;
@@ -187,7 +223,7 @@ void ForwardRenderer::ensure_targets() {
   width_ = settings_.width;
   height_ = settings_.height;
   hdr_ = GlTexture::create_2d(GL_RGBA16F, width_, height_);
-  depth_ = GlTexture::create_2d(GL_DEPTH_COMPONENT32F, width_, height_);
+  depth_ = GlTexture::create_2d(GL_DEPTH32F_STENCIL8, width_, height_);  // stencil: light reach masks
   ldr_ = GlTexture::create_2d(GL_RGBA8, width_, height_);
   for (GLuint t : {hdr_.id(), ldr_.id()}) {
     glTextureParameteri(t, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
@@ -195,7 +231,7 @@ void ForwardRenderer::ensure_targets() {
   }
   hdr_fbo_ = GlFramebuffer::create();
   glNamedFramebufferTexture(hdr_fbo_.id(), GL_COLOR_ATTACHMENT0, hdr_.id(), 0);
-  glNamedFramebufferTexture(hdr_fbo_.id(), GL_DEPTH_ATTACHMENT, depth_.id(), 0);
+  glNamedFramebufferTexture(hdr_fbo_.id(), GL_DEPTH_STENCIL_ATTACHMENT, depth_.id(), 0);
   ldr_fbo_ = GlFramebuffer::create();
   glNamedFramebufferTexture(ldr_fbo_.id(), GL_COLOR_ATTACHMENT0, ldr_.id(), 0);
   GI_EXPECTS(hdr_fbo_.complete() && ldr_fbo_.complete(), "render targets must be complete");
@@ -255,19 +291,156 @@ void ForwardRenderer::render(const Registry& registry, Entity camera) {
   shadow_maps_rendered_ = shadow_maps_.render(lights.shadow_views, items, scene_, shadow_);
   timings_.push_back({"shadow maps (" + std::to_string(lights.shadow_views.size()) + " views)", timer.lap_ms()});
 
-  glNamedBufferData(lights_buffer_.id(),
-                    static_cast<GLsizeiptr>(std::max<std::size_t>(1, lights.lights.size()) * sizeof(render::GpuLight)),
-                    lights.lights.empty() ? nullptr : lights.lights.data(), GL_STREAM_DRAW);
-  const LightCounts variant{lights.count_by_type[0], lights.count_by_type[1], lights.count_by_type[2],
-                            lights.count_by_type[3], std::clamp(settings_.area_specular_samples_per_side, 1, 4),
-                            settings_.area_soft_shadows ? 1 : 0};
-  forward_pass(registry, camera, items, variant);
+  std::vector<LightGroup> groups = light_groups(registry, items, lights);
+  light_groups_ = static_cast<int>(groups.size());
+  {  // Every group's lights, one after the other (each at an SSBO offset alignment).
+    GLint align = 16;
+    glGetIntegerv(GL_SHADER_STORAGE_BUFFER_OFFSET_ALIGNMENT, &align);
+    const std::size_t a = static_cast<std::size_t>(std::max(align, 1));
+    std::vector<std::uint8_t> bytes;
+    for (LightGroup& g : groups) {
+      const std::size_t at = (bytes.size() + a - 1) / a * a;
+      g.offset = static_cast<GLintptr>(at);
+      const std::size_t n = std::max<std::size_t>(1, g.lights.size()) * sizeof(render::GpuLight);
+      bytes.resize(at + n, 0);
+      if (!g.lights.empty()) std::memcpy(bytes.data() + at, g.lights.data(), g.lights.size() * sizeof(render::GpuLight));
+    }
+    glNamedBufferData(lights_buffer_.id(), static_cast<GLsizeiptr>(bytes.size()), bytes.data(), GL_STREAM_DRAW);
+  }
+  forward_pass(registry, camera, items, groups);
   timings_.push_back({provider_ ? std::string("forward + indirect (") + provider_->label() + ")"
                                 : std::string("forward + constant ambient (stand-in)"),
                       timer.lap_ms()});
 
   tonemap_pass();
   timings_.push_back({"tonemap (exposure, ACES fitted, sRGB)", timer.lap_ms()});
+}
+
+std::vector<LightGroup> ForwardRenderer::light_groups(const Registry& registry, const std::vector<DrawItem>& items,
+                                                      const render::LightList& lights) {
+  // Culled by reach: static (not Light::moves), shadowed point, spot and area lights (an
+  // unshadowed light shines through walls in this renderer; a directional one reaches
+  // everything it is not shadowed from). The first LightReachGrid::kMaxLights of them.
+  std::vector<int> cullable;
+  if (settings_.light_reach_culling)
+    for (std::size_t i = 0; i < lights.lights.size() && cullable.size() < LightReachGrid::kMaxLights; ++i) {
+      const render::GpuLight& g = lights.lights[i];
+      const Light* l = registry.try_get<Light>(lights.entities[i]);
+      const bool shadowed = g.cone.z >= 0.0f || g.cone.w >= 0.0f;
+      if (l != nullptr && !l->moves && shadowed && l->type != LightType::Directional)
+        cullable.push_back(static_cast<int>(i));
+    }
+  LightGroup everything;
+  everything.lights = lights.lights;
+  everything.count_by_type = lights.count_by_type;
+  if (cullable.empty()) return {everything};
+  update_reach(registry, items, lights, cullable);
+  if (reach_.grid.empty()) return {everything};
+  std::vector<LightGroup> groups;
+  for (int mask = 0; mask < 256; ++mask) {
+    const int bi = reach_.mask_bounds_index[static_cast<std::size_t>(mask)];
+    if (bi < 0 && mask != reach_.grid.all) continue;
+    LightGroup g;
+    g.mask = mask;
+    // The all-lights mask also covers everything outside the grid: no bounds.
+    if (mask != reach_.grid.all) g.bounds = reach_.bounds[static_cast<std::size_t>(bi)];
+    for (std::size_t i = 0; i < lights.lights.size(); ++i) {
+      const auto it = std::find(cullable.begin(), cullable.end(), static_cast<int>(i));
+      if (it != cullable.end() && (mask & (1 << (it - cullable.begin()))) == 0) continue;
+      g.lights.push_back(lights.lights[i]);
+      ++g.count_by_type[static_cast<std::size_t>(lights.lights[i].position_type.w)];
+    }
+    groups.push_back(std::move(g));
+  }
+  return groups;
+}
+
+// Rebuilds the reach grid when the cullable lights or the static shadow casters changed
+// since the last build. A static item seen at a new transform is never an occluder again
+// (a door that swings): the grid stays conservative while it moves, and is not rebuilt for
+// it every frame.
+void ForwardRenderer::update_reach(const Registry& registry, const std::vector<DrawItem>& items,
+                                   const render::LightList& lights, const std::vector<int>& cullable) {
+  (void)registry;
+  std::vector<float> key;
+  std::vector<ReachLight> reach_lights;
+  for (int i : cullable) {
+    const render::GpuLight& g = lights.lights[static_cast<std::size_t>(i)];
+    ReachLight r;
+    r.position = glm::vec3(g.position_type);
+    r.direction = glm::vec3(g.direction_range);
+    if (static_cast<int>(g.position_type.w) == static_cast<int>(render::GpuLightType::Area)) {
+      r.half_x = glm::vec3(g.area_half_x);
+      r.half_y = glm::vec3(g.area_half_y);
+    }
+    reach_lights.push_back(r);
+    key.push_back(static_cast<float>(lights.entities[static_cast<std::size_t>(i)].id()));
+    for (const glm::vec3& v : {r.position, r.direction, r.half_x, r.half_y}) key.insert(key.end(), {v.x, v.y, v.z});
+  }
+  std::map<std::uint32_t, glm::mat4> models;
+  for (const DrawItem& item : items)
+    if (item.is_static && item.cast_shadows && !reach_.moved.contains(item.entity.id())) models[item.entity.id()] = item.model;
+  const bool built = reach_.builds > 0;
+  if (built && key == reach_.light_key && models == reach_.static_models) return;
+  if (built)
+    for (const auto& [id, m] : models) {
+      const auto it = reach_.static_models.find(id);
+      if (it != reach_.static_models.end() && it->second != m) reach_.moved.insert(id);
+    }
+  for (std::uint32_t id : reach_.moved) models.erase(id);
+
+  std::vector<ReachOccluder> occluders;
+  render::SceneBounds statics;
+  for (const DrawItem& item : items) {
+    if (!item.is_static) continue;
+    statics.min = statics.empty ? item.bounds.min : glm::min(statics.min, item.bounds.min);
+    statics.max = statics.empty ? item.bounds.max : glm::max(statics.max, item.bounds.max);
+    statics.empty = false;
+    if (!models.contains(item.entity.id())) continue;
+    ReachOccluder o;
+    o.min = item.bounds.min;
+    o.max = item.bounds.max;
+    const std::vector<glm::vec3>& c = item.mesh->triangle_corners;
+    for (std::size_t t = 0; t + 2 < c.size(); t += 3)
+      o.triangles.push_back({glm::vec3(item.model * glm::vec4(c[t], 1.0f)), glm::vec3(item.model * glm::vec4(c[t + 1], 1.0f)),
+                             glm::vec3(item.model * glm::vec4(c[t + 2], 1.0f))});
+    occluders.push_back(std::move(o));
+  }
+  reach_.light_key = std::move(key);
+  reach_.static_models = std::move(models);
+  ++reach_.builds;
+  reach_.grid = statics.empty ? LightReachGrid{}
+                              : build_light_reach_grid(occluders, reach_lights, statics.min, statics.max, kReachVoxelM);
+  reach_.mask_bounds_index.assign(256, -1);
+  reach_.bounds.clear();
+  if (reach_.grid.empty()) return;
+  const LightReachGrid& g = reach_.grid;
+  for (int z = 0; z < g.dims.z; ++z)
+    for (int y = 0; y < g.dims.y; ++y)
+      for (int x = 0; x < g.dims.x; ++x) {
+        const std::uint8_t m = g.masks[static_cast<std::size_t>((z * g.dims.y + y) * g.dims.x + x)];
+        int& bi = reach_.mask_bounds_index[m];
+        if (bi < 0) {
+          bi = static_cast<int>(reach_.bounds.size());
+          reach_.bounds.emplace_back();
+        }
+        render::SceneBounds& b = reach_.bounds[static_cast<std::size_t>(bi)];
+        const glm::vec3 lo = g.origin + glm::vec3(x, y, z) * g.voxel_m;
+        const glm::vec3 hi = lo + glm::vec3(g.voxel_m);
+        b.min = b.empty ? lo : glm::min(b.min, lo);
+        b.max = b.empty ? hi : glm::max(b.max, hi);
+        b.empty = false;
+      }
+  reach_.texture = GlTexture::create(GL_TEXTURE_3D);
+  glTextureStorage3D(reach_.texture.id(), 1, GL_R8UI, g.dims.x, g.dims.y, g.dims.z);
+  GLint unpack = 4;
+  glGetIntegerv(GL_UNPACK_ALIGNMENT, &unpack);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glTextureSubImage3D(reach_.texture.id(), 0, 0, 0, 0, g.dims.x, g.dims.y, g.dims.z, GL_RED_INTEGER, GL_UNSIGNED_BYTE,
+                      g.masks.data());
+  glPixelStorei(GL_UNPACK_ALIGNMENT, unpack);
+  glTextureParameteri(reach_.texture.id(), GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  glTextureParameteri(reach_.texture.id(), GL_TEXTURE_MAG_FILTER, GL_NEAREST);
 }
 
 // A dielectric whose roughness is at least kRoughForOnePoint everywhere (no roughness texture):
@@ -280,7 +453,7 @@ bool rough_dielectric(const render::GpuMaterial& m, GLuint white_texture) {
 }
 
 void ForwardRenderer::forward_pass(const Registry& registry, Entity camera, const std::vector<DrawItem>& items,
-                                   const LightCounts& counts) {
+                                   const std::vector<LightGroup>& groups) {
   const Camera& cam = registry.get<Camera>(camera);
   const glm::mat4& camera_now = registry.get<WorldTransform>(camera).matrix;
   if (unusable_world_matrix(camera_now) == nullptr) last_camera_world_ = camera_now;
@@ -300,18 +473,23 @@ void ForwardRenderer::forward_pass(const Registry& registry, Entity camera, cons
   const float background[4] = {sky_bg.x, sky_bg.y, sky_bg.z, 1.0f};
   const float far_depth = 1.0f;
   glClearNamedFramebufferfv(hdr_fbo_.id(), GL_COLOR, 0, background);
-  glClearNamedFramebufferfv(hdr_fbo_.id(), GL_DEPTH, 0, &far_depth);
+  glClearNamedFramebufferfi(hdr_fbo_.id(), GL_DEPTH_STENCIL, 0, far_depth, 0);
   glEnable(GL_DEPTH_TEST);
   glDisable(GL_BLEND);
   glFrontFace(GL_CCW);
   glCullFace(GL_BACK);
   glBindVertexArray(scene_.vertex_array());
-  depth_prepass(view_proj, items);
+  const bool reach = !groups.empty() && groups.front().mask >= 0;
+  depth_prepass(view_proj, items, reach);
   // Shade only the visible surface of each pixel (llvmpipe pays per shaded fragment).
   glDepthFunc(GL_EQUAL);
   glDepthMask(GL_FALSE);
+  if (reach) {  // ... with the lights of its reach mask (the stencil the pre-pass wrote)
+    glEnable(GL_STENCIL_TEST);
+    glStencilMask(0);
+    glStencilOp(GL_KEEP, GL_KEEP, GL_KEEP);
+  }
 
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kLightsBinding, lights_buffer_.id());
   glBindTextureUnit(kShadowMapsUnit, shadow_maps_.maps_2d());
   glBindTextureUnit(kPointShadowMapsUnit, shadow_maps_.cube_maps());
   glBindTextureUnit(kShadowDepthUnit, shadow_maps_.maps_2d());
@@ -332,111 +510,136 @@ void ForwardRenderer::forward_pass(const Registry& registry, Entity camera, cons
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kDirectionalDirectionBinding, indirect->directional_direction_buffer);
   }
 
-  // Rough dielectrics draw with the one-specular-point variant of area lights (rough_dielectric),
-  // the other materials with RenderSettings::area_specular_samples_per_side: two passes over the
-  // items, each with its program, when that makes a difference.
-  LightCounts rough_counts = counts;
-  rough_counts[4] = 1;
-  const bool split_rough = counts[3] > 0 && counts[4] > 1 && settings_.area_specular_one_point_on_rough;
-  for (int pass = 0; pass < (split_rough ? 2 : 1); ++pass) {
-    const ShaderProgram& program = forward_program(pass == 0 ? counts : rough_counts);
-    program.use();
-    glUniform1i(29, directional ? indirect->directional_bin_count : 0);
-    glUniform1i(30, directional ? indirect->directional_element_count : 0);
+  for (const LightGroup& group : groups) {
+    if (reach) glStencilFunc(GL_EQUAL, group.mask, 0xFF);
+    glBindBufferRange(GL_SHADER_STORAGE_BUFFER, kLightsBinding, lights_buffer_.id(), group.offset,
+                      static_cast<GLsizeiptr>(std::max<std::size_t>(1, group.lights.size()) * sizeof(render::GpuLight)));
+    const LightCounts counts{group.count_by_type[0], group.count_by_type[1], group.count_by_type[2],
+                             group.count_by_type[3], std::clamp(settings_.area_specular_samples_per_side, 1, 4),
+                             settings_.area_soft_shadows ? 1 : 0};
+    // Rough dielectrics draw with the one-specular-point variant of area lights (rough_dielectric),
+    // the other materials with RenderSettings::area_specular_samples_per_side: two passes over the
+    // items, each with its program, when that makes a difference.
+    LightCounts rough_counts = counts;
+    rough_counts[4] = 1;
+    const bool split_rough = counts[3] > 0 && counts[4] > 1 && settings_.area_specular_one_point_on_rough;
+    for (int pass = 0; pass < (split_rough ? 2 : 1); ++pass) {
+      const ShaderProgram& program = forward_program(pass == 0 ? counts : rough_counts);
+      program.use();
+      glUniform1i(29, directional ? indirect->directional_bin_count : 0);
+      glUniform1i(30, directional ? indirect->directional_element_count : 0);
 
-    glUniformMatrix4fv(8, 1, GL_FALSE, glm::value_ptr(view_proj));
-    glUniform3fv(16, 1, glm::value_ptr(camera_position));
-    glUniform1f(23, settings_.stand_in_ambient);
-    glUniform3fv(31, 1, glm::value_ptr(settings_.sky_radiance));
-    {  // The sky's gradient (engine/sky.h): horizon, zenith - horizon, ground - horizon.
-      const SkyGradient& g = settings_.sky_gradient;
-      const glm::vec3 terms[3] = {g.horizon, g.zenith - g.horizon, g.ground - g.horizon};
-      glUniform3fv(61, 3, glm::value_ptr(terms[0]));
-    }
-    glUniform1f(24, settings_.split == SplitView::DirectLeftFullRight ? 0.5f * static_cast<float>(width_) : -1.0f);
-    glUniform1i(25, glossy != 0 ? 1 : 0);
+      glUniformMatrix4fv(8, 1, GL_FALSE, glm::value_ptr(view_proj));
+      glUniform3fv(16, 1, glm::value_ptr(camera_position));
+      glUniform1f(23, settings_.stand_in_ambient);
+      glUniform3fv(31, 1, glm::value_ptr(settings_.sky_radiance));
+      {  // The sky's gradient (engine/sky.h): horizon, zenith - horizon, ground - horizon.
+        const SkyGradient& g = settings_.sky_gradient;
+        const glm::vec3 terms[3] = {g.horizon, g.zenith - g.horizon, g.ground - g.horizon};
+        glUniform3fv(61, 3, glm::value_ptr(terms[0]));
+      }
+      glUniform1f(24, settings_.split == SplitView::DirectLeftFullRight ? 0.5f * static_cast<float>(width_) : -1.0f);
+      glUniform1i(25, glossy != 0 ? 1 : 0);
 
-    const auto in_pass = [&](const DrawItem& item, const render::GpuPrimitive& p) {
-      if (!split_rough) return true;
-      const render::GpuMaterial& m = scene_.material(item.material_override >= 0 ? item.material_override : p.material);
-      return rough_dielectric(m, scene_.white_texture()) == (pass == 1);
-    };
-    for (const DrawItem& item : items) {
-      if (std::none_of(item.mesh->primitives.begin(), item.mesh->primitives.end(),
-                       [&](const render::GpuPrimitive& p) { return in_pass(item, p); }))
-        continue;
-      int mode = kIndirectAmbient;
-      GLuint vertex_buffer = 0;
-      if (indirect != nullptr) {
-        mode = kIndirectNone;
-        if (item.is_static && atlas != 0) {
-          mode = kIndirectAtlas;
-        } else if (!item.is_static) {
-          vertex_buffer = indirect->vertex_irradiance_buffer(item.entity);
-          if (vertex_buffer != 0) mode = kIndirectVertex;
+      const auto in_pass = [&](const DrawItem& item, const render::GpuPrimitive& p) {
+        if (!split_rough) return true;
+        const render::GpuMaterial& m = scene_.material(item.material_override >= 0 ? item.material_override : p.material);
+        return rough_dielectric(m, scene_.white_texture()) == (pass == 1);
+      };
+      for (const DrawItem& item : items) {
+        const render::SceneBounds& gb = group.bounds;
+        if (!gb.empty && (glm::any(glm::lessThan(item.bounds.max, gb.min)) || glm::any(glm::greaterThan(item.bounds.min, gb.max))))
+          continue;  // none of this group's pixels can be on the item
+        if (std::none_of(item.mesh->primitives.begin(), item.mesh->primitives.end(),
+                         [&](const render::GpuPrimitive& p) { return in_pass(item, p); }))
+          continue;
+        int mode = kIndirectAmbient;
+        GLuint vertex_buffer = 0;
+        if (indirect != nullptr) {
+          mode = kIndirectNone;
+          if (item.is_static && atlas != 0) {
+            mode = kIndirectAtlas;
+          } else if (!item.is_static) {
+            vertex_buffer = indirect->vertex_irradiance_buffer(item.entity);
+            if (vertex_buffer != 0) mode = kIndirectVertex;
+          }
         }
-      }
-      {  // The sky's occlusion on a dynamic entity, when the provider measured it (indirect_light.h).
-        float axes[6] = {1.0f, 1.0f, 1.0f, 1.0f, 1.0f, 1.0f};
-        if (indirect != nullptr && !item.is_static) (void)indirect->sky_visibility(item.entity, axes);
-        glUniform3f(64, axes[0], axes[2], axes[4]);
-        glUniform3f(65, axes[1], axes[3], axes[5]);
-      }
-      if (vertex_buffer != 0) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kVertexIrradianceBinding, vertex_buffer);
-      // Per-vertex view-dependent indirect light (IndirectLightFrame::vertex_radiance_lobes).
-      IndirectLightFrame::VertexRadianceLobes lobes;
-      if (vertex_buffer != 0) lobes = indirect->vertex_radiance_lobes(item.entity);
-      const bool use_lobes = lobes.terms > 0 && lobes.resolution > 0 && lobes.coefficient_buffer != 0 &&
-                             lobes.lobe_buffer != 0 && lobes.first >= 0 && lobes.stride >= 0;
-      if (use_lobes) {
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kLobeCoefficientsBinding, lobes.coefficient_buffer);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kLobeTableBinding, lobes.lobe_buffer);
-      }
-      glUniform1i(40, use_lobes ? lobes.terms : 0);
-      glUniform1i(41, lobes.resolution);
-      glUniform1i(42, lobes.first);
-      glUniform1i(43, lobes.stride);
-      glUniform1i(12, item.mesh->first_vertex);
-      glUniform1i(13, vertex_buffer != 0 ? 1 : 0);
-      glUniform1i(22, mode);
-      glUniformMatrix4fv(0, 1, GL_FALSE, glm::value_ptr(item.model));
-      const glm::mat4 normal_matrix(glm::transpose(glm::inverse(glm::mat3(item.model))));
-      glUniformMatrix4fv(4, 1, GL_FALSE, glm::value_ptr(normal_matrix));
-      for (const render::GpuPrimitive& p : item.mesh->primitives) {
-        if (!in_pass(item, p)) continue;
-        const render::GpuMaterial& m =
-            scene_.material(item.material_override >= 0 ? item.material_override : p.material);
-        if (m.double_sided)
-          glDisable(GL_CULL_FACE);
-        else
-          glEnable(GL_CULL_FACE);
-        glUniform4fv(18, 1, glm::value_ptr(m.base_color));
-        glUniform1f(19, m.metallic);
-        glUniform1f(20, m.roughness);
-        glUniform3fv(21, 1, glm::value_ptr(m.emissive));
-        glUniform1i(26, m.double_sided ? 1 : 0);
-        glUniform1f(27, m.specular_factor);
-        glUniform3fv(28, 1, glm::value_ptr(m.specular_color_factor));
-        glBindTextureUnit(kBaseColorUnit, m.base_color_texture);
-        glBindTextureUnit(kMetallicRoughnessUnit, m.metallic_roughness_texture);
-        glBindTextureUnit(kEmissiveUnit, m.emissive_texture);
-        glDrawElementsBaseVertex(GL_TRIANGLES, static_cast<GLsizei>(p.index_count), GL_UNSIGNED_INT,
-                                 reinterpret_cast<const void*>(static_cast<std::uintptr_t>(p.first_index) * 4u),
-                                 p.base_vertex);
+        {  // The sky's occlusion on a dynamic entity, when the provider measured it (indirect_light.h).
+          float axes[6] = {1.0f, 1.0f, 1.0f, 1.0f, 1.0f, 1.0f};
+          if (indirect != nullptr && !item.is_static) (void)indirect->sky_visibility(item.entity, axes);
+          glUniform3f(64, axes[0], axes[2], axes[4]);
+          glUniform3f(65, axes[1], axes[3], axes[5]);
+        }
+        if (vertex_buffer != 0) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kVertexIrradianceBinding, vertex_buffer);
+        // Per-vertex view-dependent indirect light (IndirectLightFrame::vertex_radiance_lobes).
+        IndirectLightFrame::VertexRadianceLobes lobes;
+        if (vertex_buffer != 0) lobes = indirect->vertex_radiance_lobes(item.entity);
+        const bool use_lobes = lobes.terms > 0 && lobes.resolution > 0 && lobes.coefficient_buffer != 0 &&
+                               lobes.lobe_buffer != 0 && lobes.first >= 0 && lobes.stride >= 0;
+        if (use_lobes) {
+          glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kLobeCoefficientsBinding, lobes.coefficient_buffer);
+          glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kLobeTableBinding, lobes.lobe_buffer);
+        }
+        glUniform1i(40, use_lobes ? lobes.terms : 0);
+        glUniform1i(41, lobes.resolution);
+        glUniform1i(42, lobes.first);
+        glUniform1i(43, lobes.stride);
+        glUniform1i(12, item.mesh->first_vertex);
+        glUniform1i(13, vertex_buffer != 0 ? 1 : 0);
+        glUniform1i(22, mode);
+        glUniformMatrix4fv(0, 1, GL_FALSE, glm::value_ptr(item.model));
+        const glm::mat4 normal_matrix(glm::transpose(glm::inverse(glm::mat3(item.model))));
+        glUniformMatrix4fv(4, 1, GL_FALSE, glm::value_ptr(normal_matrix));
+        for (const render::GpuPrimitive& p : item.mesh->primitives) {
+          if (!in_pass(item, p)) continue;
+          const render::GpuMaterial& m =
+              scene_.material(item.material_override >= 0 ? item.material_override : p.material);
+          if (m.double_sided)
+            glDisable(GL_CULL_FACE);
+          else
+            glEnable(GL_CULL_FACE);
+          glUniform4fv(18, 1, glm::value_ptr(m.base_color));
+          glUniform1f(19, m.metallic);
+          glUniform1f(20, m.roughness);
+          glUniform3fv(21, 1, glm::value_ptr(m.emissive));
+          glUniform1i(26, m.double_sided ? 1 : 0);
+          glUniform1f(27, m.specular_factor);
+          glUniform3fv(28, 1, glm::value_ptr(m.specular_color_factor));
+          glBindTextureUnit(kBaseColorUnit, m.base_color_texture);
+          glBindTextureUnit(kMetallicRoughnessUnit, m.metallic_roughness_texture);
+          glBindTextureUnit(kEmissiveUnit, m.emissive_texture);
+          glDrawElementsBaseVertex(GL_TRIANGLES, static_cast<GLsizei>(p.index_count), GL_UNSIGNED_INT,
+                                   reinterpret_cast<const void*>(static_cast<std::uintptr_t>(p.first_index) * 4u),
+                                   p.base_vertex);
+        }
       }
     }
   }
+  glDisable(GL_STENCIL_TEST);
+  glStencilMask(0xFF);
   glDisable(GL_CULL_FACE);
   glDepthFunc(GL_LESS);
   glDepthMask(GL_TRUE);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }
 
-void ForwardRenderer::depth_prepass(const glm::mat4& view_proj, const std::vector<DrawItem>& items) {
+void ForwardRenderer::depth_prepass(const glm::mat4& view_proj, const std::vector<DrawItem>& items, bool reach) {
   glDepthFunc(GL_LESS);
   glDepthMask(GL_TRUE);
   glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
-  depth_only_.use();
+  if (reach) {  // the nearest surface's reach mask into the stencil
+    depth_reach_.use();
+    glEnable(GL_STENCIL_TEST);
+    glStencilMask(0xFF);
+    glStencilFunc(GL_ALWAYS, 0, 0xFF);
+    glStencilOp(GL_KEEP, GL_KEEP, GL_REPLACE);
+    glBindTextureUnit(kReachUnit, reach_.texture.id());
+    glUniform3fv(50, 1, glm::value_ptr(reach_.grid.origin));
+    glUniform1f(51, 1.0f / reach_.grid.voxel_m);
+    glUniform1i(52, reach_.grid.all);
+  } else {
+    depth_only_.use();
+  }
   glUniformMatrix4fv(8, 1, GL_FALSE, glm::value_ptr(view_proj));
   for (const DrawItem& item : items) {
     glUniformMatrix4fv(0, 1, GL_FALSE, glm::value_ptr(item.model));
@@ -452,6 +655,7 @@ void ForwardRenderer::depth_prepass(const glm::mat4& view_proj, const std::vecto
     }
   }
   glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  glDisable(GL_STENCIL_TEST);
 }
 
 void ForwardRenderer::tonemap_pass() {
@@ -507,6 +711,8 @@ Result<std::unique_ptr<Renderer>> Renderer::create(const SceneAsset& assets, con
   if (!forward) return forward.error();
   auto depth = build("shadow.vert.glsl", "depth_only.frag.glsl");
   if (!depth) return depth.error();
+  auto depth_reach = build("shadow.vert.glsl", "depth_reach.frag.glsl");
+  if (!depth_reach) return depth_reach.error();
   auto shadow = build("shadow.vert.glsl", "shadow.frag.glsl");
   if (!shadow) return shadow.error();
   auto tonemap = build("fullscreen.vert.glsl", "tonemap.frag.glsl");
@@ -518,7 +724,8 @@ Result<std::unique_ptr<Renderer>> Renderer::create(const SceneAsset& assets, con
   with_sky.sky_radiance = assets.environment.sky_radiance;
   with_sky.sky_gradient = assets.environment.sky_gradient;
   return std::unique_ptr<Renderer>(std::make_unique<ForwardRenderer>(std::move(scene.value()), std::move(forward.value()),
-                                                                     std::move(depth.value()), std::move(shadow.value()),
+                                                                     std::move(depth.value()), std::move(depth_reach.value()),
+                                                                     std::move(shadow.value()),
                                                                      std::move(tonemap.value()), with_sky));
 }
 

@@ -96,6 +96,7 @@ Result<GpuScene> GpuScene::upload(const SceneAsset& assets) {
         gm.bounds_max = glm::max(gm.bounds_max, p.positions[i]);
       }
       indices.insert(indices.end(), prim_indices.begin(), prim_indices.end());
+      for (std::uint32_t i : prim_indices) gm.triangle_corners.push_back(p.positions[i]);
       gm.primitives.push_back(gp);
     }
     gm.vertex_count = static_cast<std::uint32_t>(vertices.size()) - static_cast<std::uint32_t>(gm.first_vertex);

@@ -35,6 +35,9 @@ struct GpuMesh {
   glm::vec3 bounds_min{0.0f};
   glm::vec3 bounds_max{0.0f};
   std::vector<GpuPrimitive> primitives;
+  /// Every triangle's corners in the mesh's space (3 per triangle, all primitives): the CPU
+  /// copy the light reach grid tests shadow rays against (engine/light_reach.h).
+  std::vector<glm::vec3> triangle_corners;
 };
 
 struct GpuMaterial {

@@ -58,6 +58,7 @@ SceneBounds scene_bounds(const std::vector<DrawItem>& items) {
 LightList collect_lights(const Registry& registry, const SceneBounds& bounds, const ShadowCapacity& capacity,
                          std::vector<std::pair<Entity, const char*>>* skipped) {
   LightList out;
+  std::vector<std::pair<GpuLight, Entity>> collected;
   registry.view<Light, WorldTransform>().each([&](Entity e, const Light& light, const WorldTransform& wt) {
     if (!light.enabled) return;
     if (const char* why = unusable_light(light, wt.matrix)) {
@@ -141,12 +142,17 @@ LightList collect_lights(const Registry& registry, const SceneBounds& bounds, co
       g.shadow_eye = glm::vec4(v.eye, v.far_m);
       g.shadow_params = glm::vec4(v.ortho ? 0.0f : 1.0f, texel, 0.0f, 0.0f);
     }
-    out.lights.push_back(g);
+    collected.emplace_back(g, e);
   });
   // Sorted by type (point, spot, directional, area): the forward shader loops over each
   // type with a compile-time count.
-  std::stable_sort(out.lights.begin(), out.lights.end(),
-                   [](const GpuLight& a, const GpuLight& b) { return a.position_type.w < b.position_type.w; });
+  std::stable_sort(collected.begin(), collected.end(), [](const auto& a, const auto& b) {
+    return a.first.position_type.w < b.first.position_type.w;
+  });
+  for (const auto& [g, e] : collected) {
+    out.lights.push_back(g);
+    out.entities.push_back(e);
+  }
   for (const GpuLight& g : out.lights) ++out.count_by_type[static_cast<std::size_t>(g.position_type.w)];
   return out;
 }

@@ -26,6 +26,8 @@ struct ShadowCapacity {
 struct LightList {
   /// Sorted by GpuLightType: points, then spots, directionals, areas.
   std::vector<GpuLight> lights;
+  /// The entity of each of `lights` (same order).
+  std::vector<Entity> entities;
   /// Number of lights of each GpuLightType.
   std::array<int, 4> count_by_type{};
   std::vector<ShadowView> shadow_views;
