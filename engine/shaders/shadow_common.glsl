@@ -1,7 +1,7 @@
 // Shadow-map lookups of the forward pass. Every shadow map stores a linear depth:
 // distance from the light / far for point, spot and area lights, distance along the light
 // direction / far for directional lights. Filtering: hardware 2x2 compare (bilinear PCF)
-// over a 3x3 grid (2-D maps) or a 2x2 grid (cube maps); the receiver is offset along its
+// over a 3x3 grid (2-D maps) or one tap (cube maps); the receiver is offset along its
 // normal by one texel and the depth reference is biased by texel * (1 + spacing * tan(theta))
 // (slope-scaled).
 // Lights with a size are soft-shadowed PCSS-style: the sun's disc (shadow_2d_disc) and
@@ -53,19 +53,14 @@ float shadow_cube(GpuLight light, vec3 p, vec3 n, vec3 to_light) {
   vec3 po = p + n * texel;
   vec3 d = po - eye;
   float dist = length(d);
-  vec3 w = d / max(dist, 1e-8);
-  vec3 t = normalize(cross(abs(w.y) < 0.9 ? vec3(0, 1, 0) : vec3(1, 0, 0), w));
-  vec3 b = cross(w, t);
   float bias = texel * (1.0 + slope_tangent(n, to_light));
   float ref = (dist - bias) / far_m;
-  // 2 x 2 bilinear compare taps 1.5 texels apart (a 3.5-texel footprint): cube-array compare
-  // lookups are the costliest taps on llvmpipe, and a 3 x 3 grid of them one texel apart
-  // cost ~10% more of the demo level's frame for the same softness.
-  float sum = 0.0;
-  for (int y = 0; y < 2; ++y)
-    for (int x = 0; x < 2; ++x)
-      sum += texture(u_point_shadow_maps, vec4(d + (float(2 * x - 1) * t + float(2 * y - 1) * b) * (0.75 * texel), float(cube)), ref);
-  return sum / 4.0;
+  // One bilinear compare tap (a 2 x 2 texel footprint). A point light's shadow is hard: the
+  // bilinear weights only anti-alias its edge. Cube-array compare lookups are the costliest
+  // taps on llvmpipe: a 2 x 2 grid of them 1.5 texels apart (the previous filter) cost ~10%
+  // of the demo level's frame CPU for a wider, softer edge than a point light casts
+  // (docs/performance-frame.md).
+  return texture(u_point_shadow_maps, vec4(d, float(cube)), ref);
 }
 
 // Points spread uniformly over the unit disc (Vogel's spiral, golden-angle steps): the
