@@ -94,7 +94,7 @@ void main() {
 #if SPOT_LIGHTS > 0
   for (int k = 0; k < SPOT_LIGHTS; ++k) {
     const int i = POINT_LIGHTS + k;
-    radiance += spot_light_radiance(lights[i], s, to_light) * shadow_2d(lights[i], s.position, s.normal, to_light, 1.0);
+    radiance += spot_light_radiance(lights[i], s, to_light) * shadow_2d_point(lights[i], s.position, s.normal, to_light);
   }
 #endif
 #if DIRECTIONAL_LIGHTS > 0

@@ -1,7 +1,8 @@
 // Shadow-map lookups of the forward pass. Every shadow map stores a linear depth:
 // distance from the light / far for point, spot and area lights, distance along the light
 // direction / far for directional lights. Filtering: hardware 2x2 compare (bilinear PCF)
-// over a 3x3 grid (2-D maps) or one tap (cube maps); the receiver is offset along its
+// over a 3x3 grid (2-D maps of directional and centre-shadowed area lights) or one tap
+// (point lights' cube maps, spot lights' maps); the receiver is offset along its
 // normal by one texel and the depth reference is biased by texel * (1 + spacing * tan(theta))
 // (slope-scaled).
 // Lights with a size are soft-shadowed PCSS-style: the sun's disc (shadow_2d_disc) and
@@ -42,6 +43,25 @@ float shadow_2d(GpuLight light, vec3 p, vec3 n, vec3 to_light, float spacing) {
     for (int x = -1; x <= 1; ++x)
       sum += texture(u_shadow_maps, vec4(uv + vec2(x, y) * spacing * texel_uv, float(layer), ref));
   return sum / 9.0;
+}
+
+// A spot light's 2-D map: one bilinear compare tap. The spot is a point source, its shadow
+// hard: the bilinear weights anti-alias the edge (shadow_2d's 3 x 3 grid widened it to 4 x 4
+// texels for 9 lookups on every pixel the flashlight covers).
+float shadow_2d_point(GpuLight light, vec3 p, vec3 n, vec3 to_light) {
+  int layer = int(light.cone.z);
+  if (layer < 0) return 1.0;
+  vec3 eye = light.shadow_eye.xyz;
+  float far_m = light.shadow_eye.w;
+  float dist = length(p - eye);
+  float texel = light.shadow_params.y * dist;
+  vec3 po = p + n * texel;
+  vec4 clip = light.shadow_view_proj * vec4(po, 1.0);
+  if (clip.w <= 0.0) return 1.0;
+  vec2 uv = clip.xy / clip.w * 0.5 + 0.5;
+  if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)))) return 1.0;
+  float bias = texel * (1.0 + slope_tangent(n, to_light));
+  return texture(u_shadow_maps, vec4(uv, float(layer), (length(po - eye) - bias) / far_m));
 }
 
 float shadow_cube(GpuLight light, vec3 p, vec3 n, vec3 to_light) {
