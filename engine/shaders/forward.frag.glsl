@@ -23,6 +23,10 @@
 #ifndef AREA_SOFT_SHADOWS
 #define AREA_SOFT_SHADOWS 1
 #endif
+// 0: the scene has no sky (radiance and gradient all zero): its term is zero and left out.
+#ifndef SKY_TERM
+#define SKY_TERM 1
+#endif
 
 #include "lighting_common.glsl"
 #include "shadow_common.glsl"
@@ -124,6 +128,7 @@ void main() {
   // E = pi horizon + (zenith - horizon) K(t) + (ground - horizon) K(pi - t), t = acos(n.y),
   // K(t) = 2/3 ((pi - t) cos t + sin t)). Unshadowed on static surfaces; on a dynamic entity
   // scaled by the provider's measured sky visibility.
+#if SKY_TERM
   float sky_t = acos(clamp(s.normal.y, -1.0, 1.0));
   float sky_k_up = (2.0 / 3.0) * ((PI - sky_t) * cos(sky_t) + sin(sky_t));
   float sky_k_down = (2.0 / 3.0) * (sky_t * cos(PI - sky_t) + sin(sky_t));
@@ -135,6 +140,7 @@ void main() {
     GltfBrdfValue sky_albedo = gltf_directional_albedo(s.brdf, dot(s.normal, s.view));
     radiance += sky_l * (sky_albedo.diffuse + sky_albedo.specular);
   }
+#endif
 
   if (gl_FragCoord.x >= u_split_x && u_indirect_mode != 0) {
     // Indirect irradiance E (W/m^2) without direction information, reflected as uniformly

@@ -88,9 +88,10 @@ Result<ShaderProgram> build(const char* vertex, const char* fragment) {
       .build();
 }
 
-// Point, spot, directional and area light counts, then area specular samples per side and
-// whether area lights are soft-shadowed (RenderSettings::area_soft_shadows).
-using LightCounts = std::array<int, 6>;
+// Point, spot, directional and area light counts, then area specular samples per side,
+// whether area lights are soft-shadowed (RenderSettings::area_soft_shadows) and whether the
+// scene has a sky term (0: its radiance and gradient are zero, the shader leaves it out).
+using LightCounts = std::array<int, 7>;
 
 // The forward program for one combination of light counts (see forward.frag.glsl).
 Result<ShaderProgram> build_forward(const LightCounts& n) {
@@ -103,6 +104,7 @@ Result<ShaderProgram> build_forward(const LightCounts& n) {
       .define("AREA_LIGHTS " + std::to_string(n[3]))
       .define("AREA_SPECULAR_SIDE " + std::to_string(n[4]))
       .define("AREA_SOFT_SHADOWS " + std::to_string(n[5]))
+      .define("SKY_TERM " + std::to_string(n[6]))
       .build();
 }
 
@@ -148,7 +150,7 @@ class ForwardRenderer final : public Renderer {
         albedo_table_(upload_gltf_albedo_table()),
         no_directional_index_(no_directional_index()),
         shadow_depth_sampler_(raw_depth_sampler()) {
-    forward_variants_.emplace(LightCounts{0, 0, 0, 0, 3, 1}, std::move(forward));
+    forward_variants_.emplace(LightCounts{0, 0, 0, 0, 3, 1, 1}, std::move(forward));
     ensure_targets();
   }
 
@@ -541,13 +543,17 @@ void ForwardRenderer::forward_pass(const Registry& registry, Entity camera, cons
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kDirectionalDirectionBinding, indirect->directional_direction_buffer);
   }
 
+  const SkyGradient& sky = settings_.sky_gradient;
+  const glm::vec3 zero(0.0f);
+  const bool has_sky = glm::any(glm::notEqual(settings_.sky_radiance, zero)) || glm::any(glm::notEqual(sky.horizon, zero)) ||
+                       glm::any(glm::notEqual(sky.zenith, zero)) || glm::any(glm::notEqual(sky.ground, zero));
   for (const LightGroup& group : groups) {
     if (reach) glStencilFunc(GL_EQUAL, group.mask, 0xFF);
     glBindBufferRange(GL_SHADER_STORAGE_BUFFER, kLightsBinding, lights_buffer_.id(), group.offset,
                       static_cast<GLsizeiptr>(std::max<std::size_t>(1, group.lights.size()) * sizeof(render::GpuLight)));
     const LightCounts counts{group.count_by_type[0], group.count_by_type[1], group.count_by_type[2],
                              group.count_by_type[3], std::clamp(settings_.area_specular_samples_per_side, 1, 4),
-                             settings_.area_soft_shadows ? 1 : 0};
+                             settings_.area_soft_shadows ? 1 : 0, has_sky ? 1 : 0};
     // Rough dielectrics draw with the one-specular-point variant of area lights (rough_dielectric),
     // the other materials with RenderSettings::area_specular_samples_per_side: two passes over the
     // items, each with its program, when that makes a difference.
@@ -738,7 +744,7 @@ Result<std::unique_ptr<Renderer>> Renderer::create(const SceneAsset& assets, con
   GI_EXPECTS(settings.width > 0 && settings.height > 0, "RenderSettings width and height must be positive");
   if (glGetString(GL_VERSION) == nullptr)
     return Error{assets.source, "renderer", "no current OpenGL context (create an engine::GpuContext first)"};
-  auto forward = build_forward(LightCounts{0, 0, 0, 0, 3, 1});
+  auto forward = build_forward(LightCounts{0, 0, 0, 0, 3, 1, 1});
   if (!forward) return forward.error();
   auto depth = build("shadow.vert.glsl", "depth_only.frag.glsl");
   if (!depth) return depth.error();
