@@ -88,7 +88,7 @@ int run_headless(const RunOptions& o, RunState& state) {
   Summary step_ms, render_ms, write_ms, total_ms;
   std::map<std::string, Summary> systems, passes;
   std::vector<std::string> system_order, pass_order;
-  std::uint64_t shadow_views_drawn = 0, rendered_frames = 0;
+  std::uint64_t shadow_views_drawn = 0, rendered_frames = 0, light_groups = 0;
   const auto run_t0 = Clock::now();
   for (std::uint64_t i = 0; i < frames; ++i) {
     const auto t0 = Clock::now();
@@ -116,6 +116,7 @@ int run_headless(const RunOptions& o, RunState& state) {
         passes[p.name].add(p.ms);
       }
       shadow_views_drawn += static_cast<std::uint64_t>(renderer->last_shadow_maps_rendered());
+      light_groups += static_cast<std::uint64_t>(renderer->last_light_groups());
       ++rendered_frames;
       if (written) {
         const auto t2 = Clock::now();
@@ -148,6 +149,10 @@ int run_headless(const RunOptions& o, RunState& state) {
   if (rendered_frames > 0)
     std::printf("  shadow-map views drawn per frame: %.2f (the others kept: their light and casters did not move)\n",
                 static_cast<double>(shadow_views_drawn) / static_cast<double>(rendered_frames));
+  if (rendered_frames > 0)
+    std::printf("  light sets per frame: %.2f (pixels shaded with only the lights that can reach them; 1: every light "
+                "everywhere)\n",
+                static_cast<double>(light_groups) / static_cast<double>(rendered_frames));
   for (const std::string& line : gi_status_lines(indirect.get())) std::printf("%s\n", line.c_str());
   std::printf("final state checksum 0x%016llx after frame %llu\n", static_cast<unsigned long long>(sim.checksum()),
               static_cast<unsigned long long>(sim.frame()));

@@ -137,7 +137,8 @@ int main(int argc, char** argv) {
   app.add_option("--session", session_path, "Recorded session (.girec)")->required()->check(CLI::ExistingFile);
   app.add_option("--bundle", bundles,
                  "NAME=DIR of a bake bundle, or 'none' for the stand-in (repeatable); NAME=DIR,area-shadows=centre "
-                 "shadows area lights from their centre only (default soft)")
+                 "shadows area lights from their centre only (default soft); NAME=DIR,light-reach=off[,area-shadows=...] "
+                 "shades every light on every pixel (default on)")
       ->required();
   app.add_option("--frames", frames_text, "Comma-separated frames compared with the path tracer");
   app.add_option("--width", width)->check(CLI::Range(16, 4096));
@@ -232,6 +233,17 @@ int main(int argc, char** argv) {
       area_soft_shadows = value == "soft";
       row.bundle = row.bundle.substr(0, opt);
     }
+    // ",light-reach=off" (RenderSettings::light_reach_culling off), before ",area-shadows=".
+    bool light_reach = true;
+    if (const std::size_t opt = row.bundle.find(",light-reach="); opt != std::string::npos) {
+      const std::string value = row.bundle.substr(opt + 13);
+      if (value != "on" && value != "off") {
+        std::cerr << "gi-replay-quality: light-reach must be on or off, not '" << value << "'\n";
+        return 2;
+      }
+      light_reach = value == "on";
+      row.bundle = row.bundle.substr(0, opt);
+    }
     if (row.bundle == "none") row.bundle.clear();
     auto sim = game_demo::simulation_for_session(*session, session_path);
     if (!sim) {
@@ -250,7 +262,8 @@ int main(int argc, char** argv) {
     auto renderer = engine::Renderer::create(
         sim->scene().assets,
         engine::RenderSettings{.width = width, .height = height, .exposure = game_demo::kDemoExposure,
-                               .area_soft_shadows = area_soft_shadows});
+                               .area_soft_shadows = area_soft_shadows,
+                               .light_reach_culling = light_reach});
     if (!renderer) {
       std::cerr << "gi-replay-quality: " << renderer.error().to_string() << '\n';
       return 1;
