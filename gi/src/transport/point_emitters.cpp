@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <memory>
+#include <mutex>
 #include <numbers>
 
 #include "core/random.h"
@@ -143,28 +146,63 @@ glm::vec3 emitter_irradiance(const PointEmitter& e, const glm::vec3& p, const gl
   return e.radiant * atten;
 }
 
+namespace {
+
+// The side^2 stratified directions of punctual_lit_solid_angle (the same floats every call:
+// computed once per side, kept for the process; a few sides are ever used).
+const std::vector<glm::vec3>& sphere_directions(int side) {
+  static std::mutex mutex;
+  static std::map<int, std::unique_ptr<const std::vector<glm::vec3>>> tables;
+  const std::lock_guard<std::mutex> lock(mutex);
+  auto& table = tables[side];
+  if (!table) {
+    std::vector<glm::vec3> dirs;
+    dirs.reserve(static_cast<std::size_t>(side) * static_cast<std::size_t>(side));
+    for (int a = 0; a < side; ++a)
+      for (int b = 0; b < side; ++b) {
+        const float z = 1.0f - 2.0f * (static_cast<float>(a) + 0.5f) / static_cast<float>(side);
+        const float phi = 2.0f * kPi * (static_cast<float>(b) + 0.5f) / static_cast<float>(side);
+        const float r = std::sqrt(std::max(0.0f, 1.0f - z * z));
+        dirs.emplace_back(r * std::cos(phi), r * std::sin(phi), z);
+      }
+    table = std::make_unique<const std::vector<glm::vec3>>(std::move(dirs));
+  }
+  return *table;
+}
+
+}  // namespace
+
 double punctual_lit_solid_angle(const PointEmitter& e, const RayCaster& caster, int side,
                                 std::vector<LitDirection>* hits) {
-  double sum = 0.0;
   const float per_direction = 4.0f * kPi / static_cast<float>(side * side);
-  for (int a = 0; a < side; ++a)
-    for (int b = 0; b < side; ++b) {
-      const float z = 1.0f - 2.0f * (static_cast<float>(a) + 0.5f) / static_cast<float>(side);
-      const float phi = 2.0f * kPi * (static_cast<float>(b) + 0.5f) / static_cast<float>(side);
-      const float r = std::sqrt(std::max(0.0f, 1.0f - z * z));
-      const glm::vec3 w(r * std::cos(phi), r * std::sin(phi), z);
-      float weight = e.spot ? spot_cone(e.direction, e.cos_outer, e.cos_inner, -w) : 1.0f;
-      if (weight <= 0.0f) continue;
-      const Hit h = caster.intersect(Ray{e.position, 0.0f, w});
-      if (!h.valid()) continue;
-      // The back of a one-sided surface receives nothing (a light inside a closed box or
-      // behind a wall lights only those).
-      const glm::vec3 n = glm::normalize(h.geometric_normal);
-      if (glm::dot(n, w) >= 0.0f) continue;
-      weight *= range_window(h.t, e.range_m);
-      sum += static_cast<double>(weight);
-      if (hits && weight > 0.0f) hits->push_back({e.position + w * h.t, n, weight * per_direction});
-    }
+  // The directions inside the spot cone (all for a point light), traced as one stream: all
+  // leave one point, so the caster may trace them as packets.
+  const std::vector<glm::vec3>& dirs = sphere_directions(side);
+  std::vector<Ray> rays;
+  std::vector<float> weights;
+  rays.reserve(dirs.size());
+  weights.reserve(dirs.size());
+  for (const glm::vec3& w : dirs) {
+    const float weight = e.spot ? spot_cone(e.direction, e.cos_outer, e.cos_inner, -w) : 1.0f;
+    if (weight <= 0.0f) continue;
+    rays.push_back(Ray{e.position, 0.0f, w});
+    weights.push_back(weight);
+  }
+  std::vector<Hit> found(rays.size());
+  caster.intersect_many(rays, found);
+  double sum = 0.0;
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    const Hit& h = found[i];
+    if (!h.valid()) continue;
+    const glm::vec3& w = rays[i].direction;
+    // The back of a one-sided surface receives nothing (a light inside a closed box or
+    // behind a wall lights only those).
+    const glm::vec3 n = glm::normalize(h.geometric_normal);
+    if (glm::dot(n, w) >= 0.0f) continue;
+    const float weight = weights[i] * range_window(h.t, e.range_m);
+    sum += static_cast<double>(weight);
+    if (hits && weight > 0.0f) hits->push_back({e.position + w * h.t, n, weight * per_direction});
+  }
   return static_cast<double>(per_direction) * sum;
 }
 

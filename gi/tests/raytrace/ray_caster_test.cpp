@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -96,6 +97,31 @@ TEST(EmbreeRayCaster, StreamQueriesMatchSingleRays) {
     EXPECT_EQ(single.t, hits[i].t);
     EXPECT_EQ(occ[i] != 0, single.valid());
   }
+  // A coherent stream (the flux check's: every ray from one point, neighbouring directions;
+  // intersect_many traces it in packets) gives the very hits of single rays: triangle,
+  // distance, barycentrics and normal. 1021 rays: the last packet is partial.
+  std::vector<gi::Ray> fan;
+  for (int i = 0; i < 1021; ++i) {
+    const float z = 1.0f - 2.0f * (static_cast<float>(i) + 0.5f) / 1021.0f;
+    const float phi = 2.39996323f * static_cast<float>(i);
+    const float r = std::sqrt(std::max(0.0f, 1.0f - z * z));
+    fan.push_back(gi::Ray{glm::vec3(0.3f, 0.2f, -0.1f), 0.0f, glm::vec3(r * std::cos(phi), r * std::sin(phi), z)});
+  }
+  std::vector<gi::Hit> fan_hits(fan.size());
+  (*rc)->intersect_many(fan, fan_hits);
+  int fan_hit_count = 0;
+  for (std::size_t i = 0; i < fan.size(); ++i) {
+    const gi::Hit single = (*rc)->intersect(fan[i]);
+    ASSERT_EQ(single.valid(), fan_hits[i].valid()) << i;
+    if (!single.valid()) continue;
+    ++fan_hit_count;
+    EXPECT_EQ(single.t, fan_hits[i].t) << i;
+    EXPECT_EQ(single.instance, fan_hits[i].instance) << i;
+    EXPECT_EQ(single.primitive, fan_hits[i].primitive) << i;
+    EXPECT_EQ(single.barycentric, fan_hits[i].barycentric) << i;
+    EXPECT_EQ(single.geometric_normal, fan_hits[i].geometric_normal) << i;
+  }
+  EXPECT_GT(fan_hit_count, 100);  // the fan must hit the cubes, not only miss them
 }
 
 TEST(EmbreeRayCaster, MovingDynamicInstanceUpdatesHits) {
