@@ -11,7 +11,13 @@
 // before the loop), vs_rebake = atlas_rebake_ms / (cpu_ms + gpu_ms) (issue 23 target >= 1000),
 // clusters (selected), texels (pane elements), gpu_k0_ms (the pane sum with no cluster: its
 // fixed part, the texel list read and every texel written), nonzero_blocks (share of the
-// panes' blocks of 8 elements holding any non-zero value).
+// panes' blocks of 8 elements holding any non-zero value), picked_nonzero_blocks (the same
+// over the last change's clusters), picked_zero_runs64 (share of those clusters' runs of 64
+// elements, one 8-lane SIMD group of 8-element blocks on llvmpipe, that are all zero: all a
+// zero-block skip could drop there); cpu_cpu_time_ms, gpu_cpu_time_ms,
+// gpu_k0_cpu_time_ms: the same parts in process CPU time (all threads, llvmpipe's included),
+// steadier than wall time when other jobs share the cores. BM_PrmFluxCheck and
+// BM_PrmEntryShadowRays time the CPU part's two ray sets alone.
 #include <GL/glcorearb.h>
 
 #include <algorithm>
@@ -19,6 +25,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <memory>
 #include <string>
 #include <vector>
@@ -86,6 +93,13 @@ const DemoLevel& demo_level() {
   return d;
 }
 
+// CPU time of the whole process (every thread: llvmpipe's shader threads included), ms.
+double process_cpu_ms() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) * 1e-6;
+}
+
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   return v.empty() ? 0.0 : v[v.size() / 2];
@@ -113,9 +127,11 @@ void BM_PrmLightChange(benchmark::State& state) {
   }
   (void)pass.run({});  // first-dispatch shader compilation in llvmpipe
   glFinish();
-  std::vector<double> cpu, gpu;
+  std::vector<double> cpu, gpu, cpu_time, gpu_time;
   std::size_t frame = 0, clusters = 0;
+  std::vector<gi::ClusterWeight> last_picked;
   for (auto _ : state) {
+    const double c0 = process_cpu_ms();
     const auto t0 = Clock::now();
     const gi::ReferenceLight ref = gi::reference_light(d.lamp, poses[frame++ % poses.size()]);
     const std::vector<gi::PointEmitter> emitters =
@@ -123,22 +139,33 @@ void BM_PrmLightChange(benchmark::State& state) {
     const std::vector<glm::vec3> entry = gi::entry_irradiance(d.prm, emitters, *d.caster);
     const std::vector<gi::ClusterWeight> picked = gi::select_clusters(gi::cluster_weights(d.prm, entry), kActive);
     const auto t1 = Clock::now();
+    const double c1 = process_cpu_ms();
     if (!pass.run(picked)) state.SkipWithError("PrmGpuPass::run failed");
     glFinish();
     const auto t2 = Clock::now();
+    const double c2 = process_cpu_ms();
+    cpu_time.push_back(c1 - c0);
+    gpu_time.push_back(c2 - c1);
     cpu.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
     gpu.push_back(std::chrono::duration<double, std::milli>(t2 - t1).count());
     clusters = picked.size();
+    last_picked = picked;
   }
   // The pane sum's fixed part: no cluster selected (the texel list read, every texel written).
-  std::vector<double> empty;
+  std::vector<double> empty, empty_time;
   for (int i = 0; i < 20; ++i) {
+    const double c0 = process_cpu_ms();
     const auto t0 = Clock::now();
     (void)pass.run({});
     glFinish();
     empty.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
+    empty_time.push_back(process_cpu_ms() - c0);
   }
   state.counters["gpu_k0_ms"] = median(empty);
+  state.counters["gpu_k0_cpu_time_ms"] = median(empty_time);
+  // Process CPU time (all threads) of each part: steadier than wall time under load.
+  state.counters["cpu_cpu_time_ms"] = median(cpu_time);
+  state.counters["gpu_cpu_time_ms"] = median(gpu_time);
   const double cpu_ms = median(cpu), gpu_ms = median(gpu);
   state.counters["cpu_ms"] = cpu_ms;
   state.counters["gpu_ms"] = gpu_ms;
@@ -147,6 +174,7 @@ void BM_PrmLightChange(benchmark::State& state) {
   state.counters["vs_rebake"] = rebake_ms / (cpu_ms + gpu_ms);
   state.counters["clusters"] = static_cast<double>(clusters);
   state.counters["texels"] = static_cast<double>(d.prm.texels.size());
+  state.counters["atlas_texels"] = static_cast<double>(d.prm.width) * static_cast<double>(d.prm.height);
   state.counters["entries"] = static_cast<double>(d.prm.entries.size());
   {
     const std::size_t n = d.prm.texels.size();
@@ -159,9 +187,67 @@ void BM_PrmLightChange(benchmark::State& state) {
         nonzero += any;
       }
     state.counters["nonzero_blocks"] = double(nonzero) / double(total);
+    // The same share over the clusters the last change summed (what the GPU pass reads).
+    std::size_t picked_nonzero = 0, picked_total = 0;
+    for (const gi::ClusterWeight& w : last_picked)
+      for (std::size_t first = 0; first < n; first += 8, ++picked_total) {
+        bool any = false;
+        for (std::size_t i = first; i < std::min(n, first + 8) && !any; ++i)
+          for (int ch = 0; ch < 3; ++ch) any |= d.prm.panes[(std::size_t(w.cluster) * n + i) * 3 + ch] != 0.0f;
+        picked_nonzero += any;
+      }
+    // Runs of 8 blocks (64 elements, one 8-lane SIMD group of llvmpipe) all zero: what the skip can drop.
+    std::size_t zero_runs = 0, runs = 0;
+    for (const gi::ClusterWeight& w : last_picked)
+      for (std::size_t first = 0; first < n; first += 64, ++runs) {
+        bool any = false;
+        for (std::size_t i = first; i < std::min(n, first + 64) && !any; ++i)
+          for (int ch = 0; ch < 3; ++ch) any |= d.prm.panes[(std::size_t(w.cluster) * n + i) * 3 + ch] != 0.0f;
+        zero_runs += !any;
+      }
+    state.counters["picked_zero_runs64"] = runs ? double(zero_runs) / double(runs) : 0.0;
+    state.counters["picked_nonzero_blocks"] = picked_total ? double(picked_nonzero) / double(picked_total) : 0.0;
   }
 }
 BENCHMARK(BM_PrmLightChange)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
+
+// The CPU part's two ray sets alone, on the same poses: the flux check (64^2 directions from
+// the lamp, closest hits) and the entry points' shadow rays with their kernels (no flux check).
+std::vector<gi::PointEmitter> lamp_emitters(const DemoLevel& d, int pose) {
+  const glm::vec3 pivot = glm::vec3(d.lamp_world[3]) + glm::vec3(0.0f, 1.35f, 0.0f);
+  const float angle = glm::radians(-20.0f + 5.0f * static_cast<float>(pose % 8));
+  const glm::mat4 m = glm::translate(glm::mat4(1.0f), pivot) * glm::rotate(glm::mat4(1.0f), angle, glm::vec3(0, 0, 1)) *
+                      glm::translate(glm::mat4(1.0f), -pivot) * d.lamp_world;
+  const gi::ReferenceLight ref = gi::reference_light(d.lamp, m);
+  return gi::light_point_emitters(std::span<const gi::ReferenceLight>(&ref, 1), 16, d.prm.settings.seed);
+}
+
+void BM_PrmFluxCheck(benchmark::State& state) {
+  const DemoLevel& d = demo_level();
+  int pose = 0;
+  for (auto _ : state) {
+    const std::vector<gi::PointEmitter> e = lamp_emitters(d, pose++);
+    std::vector<gi::LitDirection> hits;
+    benchmark::DoNotOptimize(gi::punctual_lit_solid_angle(e[0], *d.caster, 64, &hits));
+  }
+}
+BENCHMARK(BM_PrmFluxCheck)->Unit(benchmark::kMicrosecond)->UseRealTime()->MinTime(1.0);
+
+void BM_PrmEntryShadowRays(benchmark::State& state) {
+  const DemoLevel& d = demo_level();
+  int pose = 0;
+  for (auto _ : state) {
+    const std::vector<gi::PointEmitter> e = lamp_emitters(d, pose++);
+    std::size_t lit = 0;
+    for (const gi::PrmEntryPoint& p : d.prm.entries) {
+      const glm::vec3 irr = gi::emitter_irradiance(e[0], p.position, p.normal, p.area_m2);
+      if (irr == glm::vec3(0.0f)) continue;
+      lit += gi::emitter_visible(*d.caster, e[0], p.position, p.normal);
+    }
+    benchmark::DoNotOptimize(lit);
+  }
+}
+BENCHMARK(BM_PrmEntryShadowRays)->Unit(benchmark::kMicrosecond)->UseRealTime()->MinTime(1.0);
 
 }  // namespace
 
