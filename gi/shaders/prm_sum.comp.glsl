@@ -9,27 +9,31 @@
 // Pane storage (prm_gpu_pass.cpp writes it): each pane is a run of half floats, three per
 // element (R, G, B) packed tightly, two halves per uint (low half first), read as uvec4s:
 // eight elements (24 halves) fill three uvec4s exactly. One invocation sums one such block
-// of eight elements: per cluster three 16-byte loads (llvmpipe gathers SSBO loads lane by
-// lane, so bytes per load set the speed: the 4-byte loads of one element pair per
-// invocation streamed a fifth of what a plain vec4 copy does, gi/benchmarks/prm_gpu_bench).
+// of eight elements: per cluster three 16-byte texel fetches (llvmpipe gathers SSBO loads
+// lane by lane and component by component, so bytes per load set the speed: the 4-byte
+// loads of one element pair per invocation streamed a fifth of what a plain vec4 copy does,
+// gi/benchmarks/prm_gpu_bench; buffer-texture fetches run as straight-line vector code and
+// took the demo level's sum ~30% below the same loads from SSBOs, prm_relight_bench).
 // Every pane was scaled by a power of two before packing so its largest value sits just
 // below 2^15 (no overflow, full half precision); the inverse scale is folded into the
 // weight, so weight * unpacked value is the true contribution.
 //
-// Several dispatches may cover one run when the panes live in several buffers (SSBO size
+// Several dispatches may cover one run when the panes live in several buffers (buffer size
 // limit): the first writes (mode 0: from zero, mode 1: from base), later ones accumulate
 // (mode 2: onto what out_image holds).
 
 layout(local_size_x = 64) in;
 
-struct PaneWeight {
-  vec3 weight;       // RGB weight of the cluster times its pane's inverse packing scale
-  uint pane_offset;  // first uvec4 of the cluster's pane in the bound pane buffer
-};
-
-layout(std430, binding = 0) readonly buffer Texels { uvec4 texels[]; };  // x | y << 16, padded to whole blocks of 8
-layout(std430, binding = 1) readonly buffer Panes { uvec4 pane_blocks[]; };
-layout(std430, binding = 2) readonly buffer Weights { PaneWeight weights[]; };
+// All three inputs are RGBA32UI buffer textures over the buffers prm_gpu_pass.cpp fills:
+// llvmpipe fetches texels with straight-line vector code, where an SSBO load runs a loop
+// over lanes and components.
+// Texel coordinates x | y << 16, four per texel, padded to whole blocks of 8.
+layout(binding = 0) uniform usamplerBuffer texels;
+// The bound pane buffer's uvec4s.
+layout(binding = 1) uniform usamplerBuffer pane_blocks;
+// Per selected cluster: (RGB weight x its pane's inverse packing scale as float bits, first
+// uvec4 of its pane in the bound pane buffer).
+layout(binding = 2) uniform usamplerBuffer weights;
 
 layout(rgba32f, binding = 0) uniform image2D out_image;
 layout(rgba32f, binding = 1) readonly uniform image2D base_image;
@@ -54,8 +58,8 @@ void main() {
   const uint count = min(kBlock, u_element_count - first);
 
   uint texel[8];
-  const uvec4 t0 = texels[2u * block];
-  const uvec4 t1 = texels[2u * block + 1u];
+  const uvec4 t0 = texelFetch(texels, int(2u * block));
+  const uvec4 t1 = texelFetch(texels, int(2u * block + 1u));
   texel[0] = t0.x; texel[1] = t0.y; texel[2] = t0.z; texel[3] = t0.w;
   texel[4] = t1.x; texel[5] = t1.y; texel[6] = t1.z; texel[7] = t1.w;
 
@@ -68,22 +72,23 @@ void main() {
     }
   }
   for (uint k = 0u; k < u_weight_count; ++k) {
-    const PaneWeight w = weights[u_first_weight + k];
-    const uint at = w.pane_offset + 3u * block;  // 24 halves: R0 G0 B0 R1 ... B7
-    const uvec4 a = pane_blocks[at];
-    const uvec4 b = pane_blocks[at + 1u];
-    const uvec4 c = pane_blocks[at + 2u];
+    const uvec4 wk = texelFetch(weights, int(u_first_weight + k));
+    const vec3 weight = uintBitsToFloat(wk.xyz);
+    const uint at = wk.w + 3u * block;  // 24 halves: R0 G0 B0 R1 ... B7
+    const uvec4 a = texelFetch(pane_blocks, int(at));
+    const uvec4 b = texelFetch(pane_blocks, int(at + 1u));
+    const uvec4 c = texelFetch(pane_blocks, int(at + 2u));
     const vec2 h0 = unpackHalf2x16(a.x), h1 = unpackHalf2x16(a.y), h2 = unpackHalf2x16(a.z), h3 = unpackHalf2x16(a.w);
     const vec2 h4 = unpackHalf2x16(b.x), h5 = unpackHalf2x16(b.y), h6 = unpackHalf2x16(b.z), h7 = unpackHalf2x16(b.w);
     const vec2 h8 = unpackHalf2x16(c.x), h9 = unpackHalf2x16(c.y), h10 = unpackHalf2x16(c.z), h11 = unpackHalf2x16(c.w);
-    sum[0] += w.weight * vec3(h0.x, h0.y, h1.x);
-    sum[1] += w.weight * vec3(h1.y, h2.x, h2.y);
-    sum[2] += w.weight * vec3(h3.x, h3.y, h4.x);
-    sum[3] += w.weight * vec3(h4.y, h5.x, h5.y);
-    sum[4] += w.weight * vec3(h6.x, h6.y, h7.x);
-    sum[5] += w.weight * vec3(h7.y, h8.x, h8.y);
-    sum[6] += w.weight * vec3(h9.x, h9.y, h10.x);
-    sum[7] += w.weight * vec3(h10.y, h11.x, h11.y);
+    sum[0] += weight * vec3(h0.x, h0.y, h1.x);
+    sum[1] += weight * vec3(h1.y, h2.x, h2.y);
+    sum[2] += weight * vec3(h3.x, h3.y, h4.x);
+    sum[3] += weight * vec3(h4.y, h5.x, h5.y);
+    sum[4] += weight * vec3(h6.x, h6.y, h7.x);
+    sum[5] += weight * vec3(h7.y, h8.x, h8.y);
+    sum[6] += weight * vec3(h9.x, h9.y, h10.x);
+    sum[7] += weight * vec3(h10.y, h11.x, h11.y);
   }
   for (uint e = 0u; e < kBlock; ++e)
     if (e < count) imageStore(out_image, coord_of(texel[e]), vec4(sum[e], 1.0));

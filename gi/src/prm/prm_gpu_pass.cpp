@@ -16,7 +16,7 @@ namespace gi {
 namespace {
 
 constexpr const char* kWhere = "PRM GPU pass";
-constexpr std::size_t kSsboLimitBytes = std::size_t{128} << 20;  // DESIGN.md §4 (llvmpipe)
+constexpr std::size_t kSsboLimitBytes = std::size_t{128} << 20;  // DESIGN.md §4 (llvmpipe): per buffer
 constexpr std::uint32_t kGroupSize = 64;  // local_size_x of prm_sum.comp.glsl
 constexpr std::size_t kBlock = 8;         // elements an invocation sums (three uvec4s of halves per pane)
 constexpr std::uint32_t kMaxGroupsPerDimension = 65535;
@@ -93,17 +93,19 @@ engine::Result<PrmGpuPass> PrmGpuPass::create(const Prm& prm, const PrmGpuPassOp
       return error("pane " + std::to_string(f / 3 / elements) + " element " + std::to_string(f / 3 % elements) +
                    " is not finite");
 
-  std::size_t buffer_limit = std::min(kSsboLimitBytes, gl_limit(GL_MAX_SHADER_STORAGE_BLOCK_SIZE));
+  // Every input is read through an RGBA32UI buffer texture: at most GL_MAX_TEXTURE_BUFFER_SIZE
+  // texels of 16 bytes each.
+  std::size_t buffer_limit = std::min(kSsboLimitBytes, gl_limit(GL_MAX_TEXTURE_BUFFER_SIZE) * 16);
   if (options.max_buffer_bytes > 0) buffer_limit = std::min(buffer_limit, options.max_buffer_bytes);
   const std::size_t texel_bytes = (elements + kBlock - 1) / kBlock * kBlock * sizeof(std::uint32_t);
   if (texel_bytes > buffer_limit)
     return error(std::to_string(elements) + " pane texels need " + std::to_string(texel_bytes) +
-                 " bytes, above the SSBO limit of " + std::to_string(buffer_limit));
+                 " bytes, above the buffer limit of " + std::to_string(buffer_limit));
   const std::size_t stride = pane_stride_words(elements);
   const std::size_t pane_bytes = stride * sizeof(std::uint32_t);
   if (pane_bytes > buffer_limit)
     return error("one pane of " + std::to_string(elements) + " texels needs " + std::to_string(pane_bytes) +
-                 " bytes, above the SSBO limit of " + std::to_string(buffer_limit));
+                 " bytes, above the buffer limit of " + std::to_string(buffer_limit));
 
   PrmGpuPass pass;
   pass.width_ = prm.width;
@@ -140,11 +142,15 @@ engine::Result<PrmGpuPass> PrmGpuPass::create(const Prm& prm, const PrmGpuPassOp
     words.resize(bytes / sizeof(std::uint32_t), 0u);
     pass.pane_buffers_.push_back(engine::GlBuffer::create(bytes, words.data()));
     pass.pane_buffer_bytes_.push_back(bytes);
+    pass.pane_textures_.push_back(engine::GlTexture::create(GL_TEXTURE_BUFFER));
+    glTextureBuffer(pass.pane_textures_.back().id(), GL_RGBA32UI, pass.pane_buffers_.back().id());
   }
   if (pass.pane_buffers_.empty()) {  // no clusters: a stub so binding 1 always holds a buffer
     const std::uint32_t zeros[4] = {};
     pass.pane_buffers_.push_back(engine::GlBuffer::create(sizeof(zeros), zeros));
     pass.pane_buffer_bytes_.push_back(sizeof(zeros));
+    pass.pane_textures_.push_back(engine::GlTexture::create(GL_TEXTURE_BUFFER));
+    glTextureBuffer(pass.pane_textures_.back().id(), GL_RGBA32UI, pass.pane_buffers_.back().id());
   }
 
   // The shader reads texel coordinates packed x | y << 16 (no division per lane).
@@ -155,7 +161,11 @@ engine::Result<PrmGpuPass> PrmGpuPass::create(const Prm& prm, const PrmGpuPassOp
   }
   texels.resize(std::max<std::size_t>((elements + kBlock - 1) / kBlock * kBlock, kBlock), 0u);  // whole blocks; never empty
   pass.texels_ = engine::GlBuffer::create(texels.size() * sizeof(std::uint32_t), texels.data());
+  pass.texels_texture_ = engine::GlTexture::create(GL_TEXTURE_BUFFER);
+  glTextureBuffer(pass.texels_texture_.id(), GL_RGBA32UI, pass.texels_.id());
   pass.weights_ = engine::GlBuffer::create();
+  pass.weights_texture_ = engine::GlTexture::create(GL_TEXTURE_BUFFER);
+  pass.max_weights_ = buffer_limit / sizeof(GpuPaneWeight);
 
   pass.output_ = engine::GlTexture::create_2d(GL_RGBA32F, prm.width, prm.height);
   glClearTexImage(pass.output_.id(), 0, GL_RGBA, GL_FLOAT, nullptr);
@@ -176,6 +186,9 @@ engine::Status PrmGpuPass::run(std::span<const ClusterWeight> selected) {
       return error("selected cluster " + std::to_string(w.cluster) + " does not exist (" +
                    std::to_string(panes_.size()) + " clusters)");
 
+  if (selected.size() > max_weights_)
+    return error(std::to_string(selected.size()) + " selected clusters, above the weight buffer's limit of " +
+                 std::to_string(max_weights_));
   // Weights grouped by pane buffer: one dispatch per buffer that holds a selected pane.
   std::vector<GpuPaneWeight> weights;
   weights.reserve(std::max<std::size_t>(selected.size(), 1));
@@ -193,12 +206,13 @@ engine::Status PrmGpuPass::run(std::span<const ClusterWeight> selected) {
   if (weights.empty()) weights.emplace_back();  // GL buffers cannot be empty
   weights_bytes_ = weights.size() * sizeof(GpuPaneWeight);
   glNamedBufferData(weights_.id(), static_cast<GLsizeiptr>(weights_bytes_), weights.data(), GL_STREAM_DRAW);
+  glTextureBuffer(weights_texture_.id(), GL_RGBA32UI, weights_.id());
   if (element_count_ == 0) return {};
 
   program_.use();
   glProgramUniform1ui(program_.id(), uniforms_.element_count, element_count_);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, texels_.id());
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, weights_.id());
+  glBindTextureUnit(0, texels_texture_.id());
+  glBindTextureUnit(2, weights_texture_.id());
   glBindImageTexture(0, output_.id(), 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
   glBindImageTexture(1, base_.id(), 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
 
@@ -220,7 +234,7 @@ engine::Status PrmGpuPass::run(std::span<const ClusterWeight> selected) {
     glProgramUniform1ui(program_.id(), uniforms_.mode, static_cast<GLuint>(mode));
     glProgramUniform1ui(program_.id(), uniforms_.first_weight, ranges[b].first);
     glProgramUniform1ui(program_.id(), uniforms_.weight_count, ranges[b].second);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, pane_buffers_[b].id());
+    glBindTextureUnit(1, pane_textures_[b].id());
     glDispatchCompute(groups_x, groups_y, 1);
   }
   glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT |

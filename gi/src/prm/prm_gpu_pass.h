@@ -15,7 +15,7 @@
 // rounding.
 //
 // GL state: create(), run(), set_base() and read_back() need the creating context current
-// and change the bound program, shader-storage bindings 0-2 and image units 0-1.
+// and change the bound program, texture units 0-2 (buffer textures) and image units 0-1.
 
 #include <cstddef>
 #include <cstdint>
@@ -34,9 +34,9 @@
 namespace gi {
 
 struct PrmGpuPassOptions {
-  /// Largest pane buffer (bytes) bound as one SSBO; panes are split over several buffers
-  /// (whole panes each) above it. 0: the driver's GL_MAX_SHADER_STORAGE_BLOCK_SIZE, at most
-  /// 128 MiB. Tests set it small to exercise the split.
+  /// Largest pane buffer (bytes) read as one buffer texture; panes are split over several
+  /// buffers (whole panes each) above it. 0: the driver's GL_MAX_TEXTURE_BUFFER_SIZE x 16
+  /// bytes, at most 128 MiB. Tests set it small to exercise the split.
   std::size_t max_buffer_bytes = 0;
   /// Work groups along x before the grid wraps into y. 0: GL's minimum limit, 65535. Tests
   /// set it small to exercise the 2-D grid.
@@ -52,7 +52,7 @@ class PrmGpuPass {
   /// Compiles the shader, uploads `prm`'s texels and all its panes and creates the
   /// width x height RGBA32F output texture (linear filtering, clamped, all zero). Errors:
   /// inconsistent sizes, texels not ascending or outside the atlas, non-finite pane values,
-  /// one pane or the texel list larger than the SSBO limit, atlas above the texture limit,
+  /// one pane or the texel list larger than the buffer limit, atlas above the texture limit,
   /// shader build failure.
   static engine::Result<PrmGpuPass> create(const Prm& prm, const PrmGpuPassOptions& options = {});
 
@@ -66,7 +66,8 @@ class PrmGpuPass {
   /// Writes base + sum over `selected` of weight x pane into every pane texel (texels outside
   /// the panes keep 0). Overwrites the previous run. K = 0 writes the base (or 0). A cluster
   /// listed twice counts twice. Ends with a memory barrier for texture fetches, image access
-  /// and read-back. Error: a cluster index >= cluster_count.
+  /// and read-back. Errors: a cluster index >= cluster_count; more clusters than the weight
+  /// buffer texture holds (the buffer limit / 16 bytes).
   engine::Status run(std::span<const ClusterWeight> selected);
 
   /// A base irradiance atlas (width x height texels, row-major) added at the pane texels by
@@ -82,7 +83,7 @@ class PrmGpuPass {
 
   int width() const { return width_; }
   int height() const { return height_; }
-  /// Pane buffers the panes were split over (1 unless they exceed the SSBO limit).
+  /// Pane buffers the panes were split over (1 unless they exceed the buffer limit).
   std::size_t pane_buffer_count() const { return pane_buffers_.size(); }
 
  private:
@@ -104,8 +105,12 @@ class PrmGpuPass {
   engine::GlBuffer texels_;
   std::vector<engine::GlBuffer> pane_buffers_;
   std::vector<std::size_t> pane_buffer_bytes_;
+  std::vector<engine::GlTexture> pane_textures_;  ///< Each pane buffer as an RGBA32UI buffer texture.
   std::vector<PaneLocation> panes_;
   engine::GlBuffer weights_;
+  engine::GlTexture texels_texture_;   ///< texels_ as an RGBA32UI buffer texture.
+  engine::GlTexture weights_texture_;  ///< weights_ as an RGBA32UI buffer texture.
+  std::size_t max_weights_ = 0;        ///< Weights one run can upload (the buffer limit).
   std::size_t weights_bytes_ = 0;  ///< Size of the last weight upload.
   engine::GlTexture output_;
   engine::GlTexture base_;

@@ -298,7 +298,7 @@ TEST(PrmGpuPass, RejectsInconsistentInput) {
   {
     auto pass = gi::PrmGpuPass::create(good, {.max_buffer_bytes = 1024});
     ASSERT_FALSE(pass.ok());
-    EXPECT_NE(pass.error().message.find("above the SSBO limit"), std::string::npos) << pass.error().to_string();
+    EXPECT_NE(pass.error().message.find("above the buffer limit"), std::string::npos) << pass.error().to_string();
   }
   auto pass = gi::PrmGpuPass::create(good);
   ASSERT_TRUE(pass.ok()) << pass.error().to_string();
