@@ -300,6 +300,19 @@ TEST(PrmGpuPass, RejectsInconsistentInput) {
     ASSERT_FALSE(pass.ok());
     EXPECT_NE(pass.error().message.find("above the buffer limit"), std::string::npos) << pass.error().to_string();
   }
+  {
+    // The weights travel in one buffer texture of at most the buffer limit: 16 bytes each.
+    const std::size_t pane_bytes = (good.texels.size() + 7) / 8 * 48;
+    auto small = gi::PrmGpuPass::create(good, {.max_buffer_bytes = pane_bytes});
+    ASSERT_TRUE(small.ok()) << small.error().to_string();
+    std::vector<gi::ClusterWeight> many(pane_bytes / 16, gi::ClusterWeight{1, glm::vec3(0.5f)});
+    EXPECT_TRUE(small->run(many).ok());
+    many.push_back(many.back());
+    const auto refused = small->run(many);
+    ASSERT_FALSE(refused.ok());
+    EXPECT_NE(refused.error().message.find("above the weight buffer's limit"), std::string::npos)
+        << refused.error().to_string();
+  }
   auto pass = gi::PrmGpuPass::create(good);
   ASSERT_TRUE(pass.ok()) << pass.error().to_string();
   const std::vector<gi::ClusterWeight> bad{{20, glm::vec3(1.0f)}};
