@@ -383,3 +383,69 @@ TEST(GiBake, ShardAndMergeGiveTheOneProcessBundle) {
     EXPECT_TRUE(da == db) << name << " differs between the merged and the one-process bundle";
   }
 }
+
+// Distributed references through the CLI (docs/distributed-bake.md): gi-reference --shard I/N
+// writes a shard file and no image or atlas, --merge writes files byte-identical to one
+// process's; a merge with a shard missing exits 1 naming it and writes nothing.
+TEST(GiReference, ShardAndMergeGiveTheOneProcessFiles) {
+  const fs::path root = fs::path(GI_BINARY_DIR) / "test_output" / "tools_test" / "reference_shards";
+  std::error_code ec;
+  fs::remove_all(root, ec);
+  fs::create_directories(root);
+  const auto with = [&](const std::string& name, std::vector<std::string> extra) {
+    std::vector<std::string> a{"--scene",  GI_SOURCE_DIR "/assets/cornell_box.gltf",
+                               "--spp",    "2",
+                               "--bounces", "2",
+                               "--seed",   "4",
+                               "--width",  "20",
+                               "--height", "16",
+                               "--atlas-density", "10",
+                               "--out",    (root / (name + ".exr")).string(),
+                               "--png",    (root / (name + ".png")).string(),
+                               "--atlas-out", (root / (name + "_atlas")).string()};
+    a.insert(a.end(), extra.begin(), extra.end());
+    return a;
+  };
+  for (const char* bad : {"2/2", "1", "a/3", "1/0", "1/3x"}) {
+    const ToolRun r = run(GI_REFERENCE_EXE, with("bad", {"--shard", bad}));
+    EXPECT_EQ(r.exit_code, 2) << bad << "\n" << r.output;
+  }
+  EXPECT_EQ(run(GI_REFERENCE_EXE, with("bad", {"--shard", "0/2", "--merge"})).exit_code, 2);
+  EXPECT_FALSE(fs::exists(root / "bad_atlas.shards"));
+
+  ASSERT_EQ(run(GI_REFERENCE_EXE, with("whole", {})).exit_code, 0);
+  const ToolRun s0 = run(GI_REFERENCE_EXE, with("sharded", {"--shard", "0/3", "--threads", "1"}));
+  ASSERT_EQ(s0.exit_code, 0) << s0.output;
+  EXPECT_TRUE(fs::exists(root / "sharded_atlas.shards" / "shard-0000-of-0003.girefshard")) << s0.output;
+  EXPECT_FALSE(fs::exists(root / "sharded.exr"));
+  EXPECT_FALSE(fs::exists(root / "sharded_atlas"));
+  ASSERT_EQ(run(GI_REFERENCE_EXE, with("sharded", {"--shard", "2/3"})).exit_code, 0);
+  const ToolRun early = run(GI_REFERENCE_EXE, with("sharded", {"--merge"}));
+  EXPECT_EQ(early.exit_code, 1) << early.output;
+  EXPECT_NE(early.output.find("shard-0001-of-0003.girefshard"), std::string::npos) << early.output;
+  EXPECT_FALSE(fs::exists(root / "sharded.exr"));
+  EXPECT_FALSE(fs::exists(root / "sharded.png"));
+  EXPECT_FALSE(fs::exists(root / "sharded_atlas"));
+  ASSERT_EQ(run(GI_REFERENCE_EXE, with("sharded", {"--shard", "1/3"})).exit_code, 0);
+  const ToolRun merged = run(GI_REFERENCE_EXE, with("sharded", {"--merge"}));
+  ASSERT_EQ(merged.exit_code, 0) << merged.output;
+  const auto bytes = [](const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    return std::string((std::istreambuf_iterator<char>(in)), {});
+  };
+  for (const std::string file : {".exr", ".png", "_atlas/atlas_direct.exr", "_atlas/atlas_indirect.exr",
+                                 "_atlas/atlas_total.exr"}) {
+    const std::string a = bytes(root / ("whole" + file)), b = bytes(root / ("sharded" + file));
+    EXPECT_FALSE(a.empty()) << file;
+    EXPECT_TRUE(a == b) << file << " differs between the merged and the one-process reference";
+  }
+  // An explicit --shard-dir, and a merge of other settings refused as foreign.
+  const std::string dir = (root / "explicit").string();
+  ASSERT_EQ(run(GI_REFERENCE_EXE, with("x", {"--shard", "0/1", "--shard-dir", dir})).exit_code, 0);
+  std::vector<std::string> other = with("x", {"--merge", "--shard-dir", dir});
+  other[3] = "3";  // --spp 3
+  const ToolRun foreign = run(GI_REFERENCE_EXE, other);
+  EXPECT_EQ(foreign.exit_code, 1) << foreign.output;
+  EXPECT_NE(foreign.output.find("foreign shard"), std::string::npos) << foreign.output;
+  EXPECT_FALSE(fs::exists(root / "x.exr"));
+}

@@ -3,16 +3,22 @@
 //   gi-reference --scene assets/cornell_box.gltf --width 256 --height 256 --spp 256 --out cbox.exr
 //   gi-reference --scene assets/cornell_box.gltf --atlas-density 64 --spp 256 --atlas-out out/cbox_atlas
 //   gi-reference --scene Avocado.glb --sky 0.8,0.9,1.0 --width 256 --height 256 --out avocado.exr
+//   gi-reference --scene level.gltf --atlas-density 32 --spp 1024 --atlas-out out/truth --shard 3/8  # one shard
+//   gi-reference --scene level.gltf --atlas-density 32 --spp 1024 --atlas-out out/truth --merge      # the 8 merged
+// Sharded runs (docs/distributed-bake.md) split the pixels and atlas texels into blocks of 64;
+// the merge writes files byte-identical to one process's.
 // Exit codes: tools/common/tool_main.h.
 #include <engine/display_transform.h>
 #include <engine/gltf.h>
 #include <engine/image.h>
 #include <engine/scene.h>
 #include <gi/reference.h>
+#include <gi/reference_shard.h>
 
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -42,6 +48,26 @@ engine::ImageRgbaF rgb_image(int w, int h, const std::vector<glm::vec3>& v, cons
   return img;
 }
 
+// Writes through "<path>.partial" renamed over `path`: a run that fails or is killed while
+// writing leaves no half-written output.
+template <class Save>
+engine::Status save_atomically(const std::filesystem::path& path, Save save) {
+  std::filesystem::path partial = path;
+  partial += ".partial";
+  if (auto ok = save(partial); !ok) {
+    std::error_code ec;
+    std::filesystem::remove(partial, ec);
+    return ok;
+  }
+  std::error_code ec;
+  std::filesystem::rename(partial, path, ec);
+  if (ec) {
+    std::filesystem::remove(partial, ec);
+    return engine::Error{path.string(), "", "cannot move the written file into place: " + ec.message()};
+  }
+  return {};
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -67,11 +93,37 @@ int main(int argc, char** argv) {
                  "R,G,B (uniform) or 'zenith:R,G,B;horizon:R,G,B;ground:R,G,B' (gradient): a sky replacing the "
                  "scene's gi.sky (as gi-bake --sky)");
   app.add_option("--atlas-out", atlas_out, "folder for atlas_direct.exr, atlas_indirect.exr, atlas_total.exr");
+  // Distributed references (docs/distributed-bake.md).
+  std::string shard, shard_dir;
+  bool merge = false;
+  app.add_option("--shard", shard,
+                 "I/N: compute only shard I (0-based) of N (blocks of 64 pixels / atlas texels) into the shard "
+                 "directory; no image or atlas is written");
+  app.add_flag("--merge", merge, "write the outputs from the N shard files in the shard directory");
+  app.add_option("--shard-dir", shard_dir,
+                 "shard directory (default: <atlas-out>.shards, else <out>.shards, else <png>.shards)");
   if (auto rc = tools::parse(app, kTool, argc, argv)) return *rc;
+  std::uint32_t shard_index = 0, shard_count = 0;
+  if (!shard.empty()) {
+    unsigned index = 0, count = 0;
+    char tail = 0;
+    if (merge || std::sscanf(shard.c_str(), "%u/%u%c", &index, &count, &tail) != 2 || count == 0 || index >= count ||
+        count > 65536)
+      return tools::fail(kTool, "--shard takes I/N with 0 <= I < N <= 65536 and no --merge, got '" + shard + "'",
+                         tools::kExitUsage);
+    shard_index = index;
+    shard_count = count;
+  }
   if (out_path.empty() && png_path.empty() && atlas_out.empty())
     return tools::fail(kTool, "nothing to do: give --out, --png or --atlas-out", tools::kExitUsage);
   if (!atlas_out.empty() && !(atlas_density > 0.0f))
     return tools::fail(kTool, "--atlas-out needs --atlas-density > 0", tools::kExitUsage);
+  if (shard_dir.empty()) {
+    std::filesystem::path main_output = !atlas_out.empty() ? atlas_out : !out_path.empty() ? out_path : png_path;
+    if (!main_output.has_filename()) main_output = main_output.parent_path();  // "out/truth/"
+    shard_dir = main_output.string() + ".shards";
+  }
+  const bool distributed = shard_count > 0 || merge;
 
   auto asset = engine::load_gltf(scene_path);
   if (!asset) return tools::fail(kTool, asset.error());
@@ -89,52 +141,102 @@ int main(int argc, char** argv) {
   settings.threads = threads;
   settings.seed = seed;
 
+  gi::ReferenceJob job;
+  job.settings = settings;
   if (!out_path.empty() || !png_path.empty()) {
     const engine::Entity camera =
         camera_name.empty() ? engine::find_camera(scene.registry) : engine::find_by_name(scene.registry, camera_name);
-    if (camera.is_null())
+    if (camera.is_null() || !scene.registry.has<engine::Camera>(camera) ||
+        !scene.registry.has<engine::WorldTransform>(camera))
       return tools::fail(kTool, scene_path + ": no camera" + (camera_name.empty() ? "" : " named " + camera_name),
                          tools::kExitUsage);
-    settings.progress = bar.stage("render");
+    const engine::Camera& cam = scene.registry.get<engine::Camera>(camera);
+    job.image = gi::ReferenceImageJob{.camera = {.camera_to_world = scene.registry.get<engine::WorldTransform>(camera).matrix,
+                                                 .yfov_rad = cam.yfov_rad,
+                                                 .aspect = cam.aspect},
+                                      .width = width,
+                                      .height = height};
+  }
+  if (!atlas_out.empty()) job.atlas = gi::ReferenceAtlasJob{.texels_per_metre = atlas_density};
+  const gi::BakeInput input = gi::bake_input_from(scene);
+
+  // Shard I of N: its blocks into the shard directory, nothing else written.
+  if (shard_count > 0) {
     const auto start = Clock::now();
-    auto image = gi::render_reference_image(scene, camera, width, height, settings);
+    job.settings.progress = bar.stage("shard");
+    auto path = gi::reference_shard(input, job, shard_index, shard_count, shard_dir);
+    bar.finish();
+    if (!path) return tools::fail(kTool, path.error());
+    std::printf("shard %u/%u at %d spp in %.2f s: %s\n", shard_index, shard_count, spp, seconds_since(start),
+                path->string().c_str());
+    return tools::kExitOk;
+  }
+
+  // Everything is computed (or merged and checked) before any file is written.
+  gi::ReferenceOutputs outputs;
+  if (merge) {
+    job.settings.progress = bar.stage("merge");
+    auto merged = gi::merge_reference_shards(input, job, shard_dir);
+    bar.finish();
+    if (!merged) return tools::fail(kTool, merged.error());
+    outputs = std::move(merged).value();
+    std::printf("merged the shards in %s\n", shard_dir.c_str());
+  }
+  if (job.image && !distributed) {
+    gi::ReferenceJob part{.image = job.image, .atlas = {}, .settings = settings};
+    part.settings.progress = bar.stage("render");
+    const auto start = Clock::now();
+    auto image = gi::render_reference_job(input, part);
     bar.finish();
     if (!image) return tools::fail(kTool, image.error());
     const double secs = seconds_since(start);
     std::printf("rendered %dx%d at %d spp in %.2f s (%.3f Mpaths/s)\n", width, height, spp, secs,
                 static_cast<double>(width) * height * spp / secs * 1e-6);
-    if (!out_path.empty())
-      if (auto ok = engine::save_exr(out_path, *image); !ok) return tools::fail(kTool, ok.error());
-    if (!png_path.empty()) {
-      engine::ImageRgba8 ldr{image->width, image->height, std::vector<std::uint8_t>(image->pixels.size())};
-      for (std::size_t i = 0; i < image->pixels.size(); ++i)
-        ldr.pixels[i] = i % 4 == 3
-                            ? 255
-                            : static_cast<std::uint8_t>(std::lround(
-                                  255.0 * engine::display_tonemap(static_cast<double>(image->pixels[i]), exposure)));
-      if (auto ok = engine::save_png(png_path, ldr); !ok) return tools::fail(kTool, ok.error());
-    }
+    outputs.image = std::move(image->image);
   }
-
-  if (!atlas_out.empty()) {
+  if (job.atlas && !distributed) {
+    gi::ReferenceJob part{.image = {}, .atlas = job.atlas, .settings = settings};
+    part.settings.progress = bar.stage("atlas");
     const auto start = Clock::now();
-    settings.progress = bar.stage("atlas");
-    auto truth = gi::reference_atlas(gi::bake_input_from(scene), atlas_density, settings);
+    auto truth = gi::render_reference_job(input, part);
     bar.finish();
     if (!truth) return tools::fail(kTool, truth.error());
     std::size_t valid = 0;
-    for (std::uint8_t v : truth->valid) valid += v;
-    std::printf("atlas %dx%d at %.1f texels/m (%zu valid texels) at %d spp in %.2f s\n", truth->width, truth->height,
-                static_cast<double>(truth->texels_per_metre), valid, spp, seconds_since(start));
+    for (std::uint8_t v : truth->atlas->valid) valid += v;
+    std::printf("atlas %dx%d at %.1f texels/m (%zu valid texels) at %d spp in %.2f s\n", truth->atlas->width,
+                truth->atlas->height, static_cast<double>(truth->atlas->texels_per_metre), valid, spp,
+                seconds_since(start));
+    outputs.atlas = std::move(truth->atlas);
+  }
+
+  if (outputs.image) {
+    const engine::ImageRgbaF& image = *outputs.image;
+    if (!out_path.empty())
+      if (auto ok = save_atomically(out_path, [&](const auto& p) { return engine::save_exr(p, image); }); !ok)
+        return tools::fail(kTool, ok.error());
+    if (!png_path.empty()) {
+      engine::ImageRgba8 ldr{image.width, image.height, std::vector<std::uint8_t>(image.pixels.size())};
+      for (std::size_t i = 0; i < image.pixels.size(); ++i)
+        ldr.pixels[i] = i % 4 == 3
+                            ? 255
+                            : static_cast<std::uint8_t>(std::lround(
+                                  255.0 * engine::display_tonemap(static_cast<double>(image.pixels[i]), exposure)));
+      if (auto ok = save_atomically(png_path, [&](const auto& p) { return engine::save_png(p, ldr); }); !ok)
+        return tools::fail(kTool, ok.error());
+    }
+  }
+  if (outputs.atlas) {
+    const gi::AtlasReference& truth = *outputs.atlas;
     std::error_code ec;
     std::filesystem::create_directories(atlas_out, ec);
     if (ec) return tools::fail(kTool, atlas_out + ": cannot create folder: " + ec.message(), tools::kExitFailure);
-    const std::pair<const char*, const std::vector<glm::vec3>*> files[] = {{"atlas_direct.exr", &truth->direct},
-                                                                           {"atlas_indirect.exr", &truth->indirect},
-                                                                           {"atlas_total.exr", &truth->total}};
+    const std::pair<const char*, const std::vector<glm::vec3>*> files[] = {{"atlas_direct.exr", &truth.direct},
+                                                                           {"atlas_indirect.exr", &truth.indirect},
+                                                                           {"atlas_total.exr", &truth.total}};
     for (const auto& [name, values] : files) {
       const auto path = std::filesystem::path(atlas_out) / name;
-      if (auto ok = engine::save_exr(path, rgb_image(truth->width, truth->height, *values, truth->valid)); !ok)
+      const engine::ImageRgbaF img = rgb_image(truth.width, truth.height, *values, truth.valid);
+      if (auto ok = save_atomically(path, [&](const auto& p) { return engine::save_exr(p, img); }); !ok)
         return tools::fail(kTool, ok.error());
     }
   }

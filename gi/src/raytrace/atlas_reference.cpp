@@ -9,18 +9,14 @@
 
 namespace gi {
 
-engine::Result<AtlasIrradiance> reference_atlas_irradiance(const BakeInput& input, const AtlasTexels& texels,
-                                                           const ReferenceSettings& settings) {
+std::vector<SurfacePoint> atlas_sample_points(const AtlasTexels& texels) {
   std::vector<SurfacePoint> points;
-  std::vector<std::size_t> texel_of_point;
-  for (std::size_t i = 0; i < texels.valid.size(); ++i) {
-    if (!texels.valid[i]) continue;
-    points.push_back({texels.position[i], texels.normal[i]});
-    texel_of_point.push_back(i);
-  }
-  auto e = reference_irradiance(input, points, settings);
-  if (!e) return e.error();
+  for (std::size_t i = 0; i < texels.valid.size(); ++i)
+    if (texels.valid[i]) points.push_back({texels.position[i], texels.normal[i]});
+  return points;
+}
 
+AtlasIrradiance assemble_atlas_irradiance(const AtlasTexels& texels, const IrradianceEstimate& e) {
   AtlasIrradiance out;
   out.width = texels.width;
   out.height = texels.height;
@@ -28,10 +24,13 @@ engine::Result<AtlasIrradiance> reference_atlas_irradiance(const BakeInput& inpu
   out.direct.assign(texels.valid.size(), glm::vec3(0.0f));
   out.indirect.assign(texels.valid.size(), glm::vec3(0.0f));
   out.indirect_variance.assign(texels.valid.size(), glm::vec3(0.0f));
-  for (std::size_t k = 0; k < points.size(); ++k) {
-    out.direct[texel_of_point[k]] = e->direct[k];
-    out.indirect[texel_of_point[k]] = e->indirect[k];
-    out.indirect_variance[texel_of_point[k]] = e->indirect_variance[k];
+  std::size_t k = 0;
+  for (std::size_t i = 0; i < texels.valid.size(); ++i) {
+    if (!texels.valid[i]) continue;
+    out.direct[i] = e.direct[k];
+    out.indirect[i] = e.indirect[k];
+    out.indirect_variance[i] = e.indirect_variance[k];
+    ++k;
   }
   // Enough rings to cover any padding the layout may use.
   constexpr int kDilationRings = 4;
@@ -40,6 +39,14 @@ engine::Result<AtlasIrradiance> reference_atlas_irradiance(const BakeInput& inpu
   out.total.resize(out.direct.size());
   for (std::size_t i = 0; i < out.total.size(); ++i) out.total[i] = out.direct[i] + out.indirect[i];
   return out;
+}
+
+engine::Result<AtlasIrradiance> reference_atlas_irradiance(const BakeInput& input, const AtlasTexels& texels,
+                                                           const ReferenceSettings& settings) {
+  const std::vector<SurfacePoint> points = atlas_sample_points(texels);
+  auto e = reference_irradiance(input, points, settings);
+  if (!e) return e.error();
+  return assemble_atlas_irradiance(texels, *e);
 }
 
 engine::Result<AtlasReference> reference_atlas(const BakeInput& input, float texels_per_metre,

@@ -29,6 +29,14 @@ struct AtlasIrradiance {
   std::vector<glm::vec3> indirect_variance;  ///< Sampling variance of `indirect` (0 off the valid texels).
 };
 
+/// The sample points of `texels`: its valid texels in index order (a texel's point index is
+/// its place among them, what its random stream and shard block are numbered by).
+std::vector<SurfacePoint> atlas_sample_points(const AtlasTexels& texels);
+
+/// The atlas from the estimate at atlas_sample_points(texels): values put in place, dilated,
+/// total = direct + indirect. What reference_atlas_irradiance and a merge of shards both run.
+AtlasIrradiance assemble_atlas_irradiance(const AtlasTexels& texels, const IrradianceEstimate& estimate);
+
 /// samples_per_pixel of `settings` is per texel.
 engine::Result<AtlasIrradiance> reference_atlas_irradiance(const BakeInput& input, const AtlasTexels& texels,
                                                            const ReferenceSettings& settings);

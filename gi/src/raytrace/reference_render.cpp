@@ -56,7 +56,7 @@ PathTracerSettings tracer_settings(const ReferenceSettings& s) {
 }  // namespace
 
 engine::Result<engine::ImageRgbaF> render_reference(const ReferenceScene& scene, const PinholeCamera& camera,
-                                                    const ReferenceSettings& settings) {
+                                                    const ReferenceSettings& settings, const WorkShard& shard) {
   if (auto ok = check_settings(settings); !ok) return ok.error();
   if (camera.width < 1 || camera.height < 1 || camera.width > 16384 || camera.height > 16384)
     return settings_error("image size must be in [1, 16384]^2, got " + std::to_string(camera.width) + "x" +
@@ -76,9 +76,16 @@ engine::Result<engine::ImageRgbaF> render_reference(const ReferenceScene& scene,
   image.width = camera.width;
   image.height = camera.height;
   image.pixels.assign(static_cast<std::size_t>(camera.width) * static_cast<std::size_t>(camera.height) * 4, 1.0f);
+  // A whole image needs no item list (16384^2 pixels would be 2 GB of indices).
+  const std::vector<std::size_t> items = shard.whole() ? std::vector<std::size_t>{} : shard.items(image.pixels.size() / 4);
+  const std::size_t count = shard.whole() ? image.pixels.size() / 4 : items.size();
+  if (!shard.whole())
+    for (std::size_t i = 0; i < image.pixels.size(); ++i)
+      if (i % 4 != 3) image.pixels[i] = 0.0f;
   ThreadPool pool(settings.threads);
   const bool completed =
-      pool.parallel_for_with_progress(image.pixels.size() / 4, settings.progress, [&](std::size_t i) {
+      pool.parallel_for_with_progress(count, settings.progress, [&](std::size_t k) {
+        const std::size_t i = shard.whole() ? k : items[k];
         const int x = static_cast<int>(i % static_cast<std::size_t>(camera.width));
         const int y = static_cast<int>(i / static_cast<std::size_t>(camera.width));
         Pcg32 rng = Pcg32::for_item(settings.seed, i);
@@ -100,7 +107,7 @@ engine::Result<engine::ImageRgbaF> render_reference(const ReferenceScene& scene,
 
 engine::Result<IrradianceEstimate> estimate_irradiance(const ReferenceScene& scene,
                                                        std::span<const SurfacePoint> points,
-                                                       const ReferenceSettings& settings) {
+                                                       const ReferenceSettings& settings, const WorkShard& shard) {
   if (auto ok = check_settings(settings); !ok) return ok.error();
   for (std::size_t i = 0; i < points.size(); ++i) {
     const glm::vec3 p = points[i].position_m;
@@ -116,8 +123,11 @@ engine::Result<IrradianceEstimate> estimate_irradiance(const ReferenceScene& sce
   out.direct.assign(points.size(), glm::vec3(0.0f));
   out.indirect.assign(points.size(), glm::vec3(0.0f));
   out.indirect_variance.assign(points.size(), glm::vec3(0.0f));
+  const std::vector<std::size_t> items = shard.whole() ? std::vector<std::size_t>{} : shard.items(points.size());
+  const std::size_t count = shard.whole() ? points.size() : items.size();
   ThreadPool pool(settings.threads);
-  const bool completed = pool.parallel_for_with_progress(points.size(), settings.progress, [&](std::size_t i) {
+  const bool completed = pool.parallel_for_with_progress(count, settings.progress, [&](std::size_t k) {
+    const std::size_t i = shard.whole() ? k : items[k];
     Pcg32 rng = Pcg32::for_item(settings.seed, i);
     glm::dvec3 direct(0.0), indirect(0.0), indirect2(0.0);
     for (int s = 0; s < settings.samples_per_pixel; ++s) {

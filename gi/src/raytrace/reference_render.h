@@ -14,6 +14,7 @@
 #include <engine/result.h>
 #include <gi/reference.h>
 
+#include "core/work_shard.h"
 #include "raytrace/reference_scene.h"
 
 namespace gi {
@@ -27,10 +28,13 @@ struct PinholeCamera {
   int height = 256;
 };
 
+/// `shard` (docs/distributed-bake.md): only the pixels of the shard's blocks of 64 (in row-
+/// major order) are traced, each exactly as in the whole image; the others keep RGB 0.
 engine::Result<engine::ImageRgbaF> render_reference(const ReferenceScene& scene, const PinholeCamera& camera,
-                                                    const ReferenceSettings& settings);
+                                                    const ReferenceSettings& settings, const WorkShard& shard = {});
 
+/// `shard`: only the points of the shard's blocks of 64 are estimated (the others stay 0).
 engine::Result<IrradianceEstimate> estimate_irradiance(const ReferenceScene& scene, std::span<const SurfacePoint> points,
-                                                       const ReferenceSettings& settings);
+                                                       const ReferenceSettings& settings, const WorkShard& shard = {});
 
 }  // namespace gi
