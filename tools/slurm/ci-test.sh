@@ -3,19 +3,22 @@
 # generated key, slurmctld and slurmd (Debian's slurm-wlm 22.05, tools/install-deps.sh) with
 # a generated slurm.conf, everything in a temporary directory — runs tools/slurm/submit.sh's
 # array job (3 shards + the dependent merge) for the Cornell box's light atlas and PRM and
-# compares the merged bundle byte for byte with a local one-process bake. It stops the
+# compares the merged bundle byte for byte with a local one-process bake, then the same for a
+# path-traced reference (a small image and the atlas's ground truth, gi-reference --shard). It stops the
 # daemons it started (trap), prints their logs on failure, and gives every wait a timeout.
 #   bash tools/slurm/ci-test.sh [BUILD_DIR]      # needs BUILD_DIR/tools/gi-bake/gi-bake
 set -euo pipefail
 repo=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
 build=$(cd "${1:-$repo/build}" && pwd)
 gi_bake=$build/tools/gi-bake/gi-bake
+gi_reference=$build/tools/gi-reference/gi-reference
 shards=${GI_SLURM_SHARDS:-3}
 start_time=$(date +%s)
 say() { echo "slurm-ci: $*"; }
 die() { echo "slurm-ci: FAIL: $*" >&2; exit 1; }
 
 [ -x "$gi_bake" ] || die "$gi_bake not built (cmake --build $build --target gi-bake)"
+[ -x "$gi_reference" ] || die "$gi_reference not built (cmake --build $build --target gi-reference)"
 for tool in munged munge slurmctld slurmd sbatch squeue scontrol sinfo; do
   command -v "$tool" > /dev/null || die "$tool not found: install slurmctld slurmd slurm-client munge (tools/install-deps.sh)"
 done
@@ -132,10 +135,16 @@ merge_done() {
     *) return 1 ;;
   esac
 }
-wait_for 90 "the merge job $merge" "${pids[-1]}" merge_done
-state=$(job_state "$merge")
-scontrol -o show job "$array" | sed -E 's/.*JobId=([0-9]+).*ArrayTaskId=([0-9]+).*JobState=([A-Z_]+).*/slurm-ci: shard task \2 of array job \1: \3/' || true
-[ "$state" = COMPLETED ] || die "merge job $merge ended $state"
+# wait_merge ARRAY MERGE: until the merge job ended; lists the array's tasks; fails unless COMPLETED.
+wait_merge() {
+  merge=$2
+  wait_for 90 "the merge job $merge" "${pids[-1]}" merge_done
+  local state
+  state=$(job_state "$merge")
+  scontrol -o show job "$1" | sed -E 's/.*JobId=([0-9]+).*ArrayTaskId=([0-9]+).*JobState=([A-Z_]+).*/slurm-ci: shard task \2 of array job \1: \3/' || true
+  [ "$state" = COMPLETED ] || die "merge job $merge ended $state"
+}
+wait_merge "$array" "$merge"
 
 # Byte for byte (bake_stats.json holds the timings and hosts and differs by design).
 [ -f "$work/slurm.gibake/manifest.json" ] || die "no merged bundle"
@@ -148,5 +157,26 @@ for f in "$work/local.gibake"/*; do
 done
 [ "$(ls "$work/slurm.gibake" | wc -l)" -eq "$(ls "$work/local.gibake" | wc -l)" ] || die "the bundles hold other files"
 [ "$files" -ge 4 ] || die "only $files files compared"
+say "bake: $shards shards through Slurm, $files files byte-identical to the local bake"
+
+# A path-traced reference both ways: a small camera image and the atlas's ground truth.
+ref_opts=(--spp 2 --bounces 2 --seed 3 --width 32 --height 24 --atlas-density 10)
+"$gi_reference" --scene "$scene" "${ref_opts[@]}" --out "$work/local-ref.exr" --atlas-out "$work/local-ref_atlas" \
+  > "$work/local-reference.log" 2>&1 ||
+  die "the local reference failed"
+jobs=$(bash "$repo/tools/slurm/submit.sh" --shards "$shards" --gi-reference "$gi_reference" --scene "$scene" \
+  --out "$work/slurm-ref.shards" --logs "$work/logs" -- "${ref_opts[@]}" --out "$work/slurm-ref.exr" \
+  --atlas-out "$work/slurm-ref_atlas" 2> "$work/submit.log") ||
+  die "submit.sh --gi-reference failed: $(cat "$work/submit.log")"
+read -r array merge <<< "$jobs"
+[[ $array =~ ^[0-9]+$ && $merge =~ ^[0-9]+$ ]] || die "submit.sh --gi-reference printed '$jobs', not two job ids"
+say "submitted reference array job $array ($shards shards) and merge job $merge"
+wait_merge "$array" "$merge"
+ref_files=0
+for f in local-ref.exr local-ref_atlas/atlas_direct.exr local-ref_atlas/atlas_indirect.exr local-ref_atlas/atlas_total.exr; do
+  [ -s "$work/$f" ] || die "the local reference wrote no $f"
+  cmp "$work/$f" "$work/${f//local-ref/slurm-ref}" || die "$f differs between the Slurm reference and the local one"
+  ref_files=$((ref_files + 1))
+done
 status=0
-say "PASS: $shards shards through Slurm, $files files byte-identical to the local bake, $(($(date +%s) - start_time)) s"
+say "PASS: $shards shards through Slurm: $files bundle files and $ref_files reference files byte-identical to local runs, $(($(date +%s) - start_time)) s"
