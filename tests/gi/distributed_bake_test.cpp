@@ -223,3 +223,43 @@ TEST_F(DistributedBake, ShardOutOfRangeIsInvalid) {
 }
 
 }  // namespace
+
+// Antiradiance's links are sharded by receiver element blocks; the merge solves the baseline
+// from all of them: the corridor (a door) bakes to the same antiradiance.bin for N = 1, 2, 7.
+TEST_F(DistributedBake, AntiradianceMergedBundleIsByteIdenticalForOneTwoAndSevenShards) {
+  auto asset = engine::load_gltf(GI_SOURCE_DIR "/assets/corridor.gltf");
+  ASSERT_TRUE(asset.ok()) << asset.error().to_string();
+  input_ = gi::bake_input_from(*asset);
+  const gi::BakeOptions options{.preset = "preview", .methods = {"antiradiance"}, .threads = 2, .seed = 5};
+  const fs::path whole = root_ / "whole.gibake";
+  auto w = gi::bake_bundle(input_, whole, options);
+  ASSERT_TRUE(w.ok()) << w.error().to_string();
+  const auto expected = bundle_files(whole);
+  ASSERT_TRUE(expected.contains("antiradiance.bin"));
+  for (std::uint32_t n : {1u, 2u, 7u}) {
+    const fs::path dir = root_ / ("merged_" + std::to_string(n) + ".gibake");
+    bake_shards(dir, n, options);
+    auto m = merge(dir, options);
+    ASSERT_TRUE(m.ok()) << "N = " << n << ": " << m.error().to_string();
+    const auto got = bundle_files(dir);
+    ASSERT_EQ(got.size(), expected.size()) << "N = " << n;
+    for (const auto& [name, bytes] : expected) {
+      if (name == gi::kBakeStatsFileName) continue;
+      ASSERT_TRUE(got.contains(name)) << name << " missing for N = " << n;
+      EXPECT_TRUE(got.at(name) == bytes) << name << " differs from the one-process bake for N = " << n;
+    }
+  }
+  // A shard of the atlas-only bake is foreign to this one (its methods differ).
+  const fs::path mixed = root_ / "mixed.gibake";
+  bake_shards(mixed, 2, options);
+  gi::BakeOptions atlas_only = small_options();
+  atlas_only.methods = {"atlas"};
+  atlas_only.seed = 5;
+  atlas_only.shard_index = 1;
+  atlas_only.shard_count = 2;
+  ASSERT_TRUE(gi::bake_bundle(input_, mixed, atlas_only).ok());
+  auto m = merge(mixed, options);
+  ASSERT_FALSE(m.ok());
+  EXPECT_NE(m.error().to_string().find("foreign shard"), std::string::npos) << m.error().to_string();
+  EXPECT_FALSE(fs::exists(mixed));
+}

@@ -340,4 +340,18 @@ engine::Result<AntiradianceBake> load_antiradiance(const fs::path& bundle_dir, c
   return std::move(f->bake);
 }
 
+engine::Result<std::vector<std::uint8_t>> pack_link_shard(const fs::path& path, const std::vector<Link>& links) {
+  const std::vector<std::uint8_t> planes = link_planes(links);
+  return write_zstd_stream(path, planes, kZstdLevel);
+}
+
+engine::Result<std::vector<Link>> unpack_link_shard(const fs::path& path, std::span<const std::uint8_t> frame,
+                                                    std::uint64_t link_count) {
+  if (link_count > (std::uint64_t{1} << 40) / kLinkPlaneBytes)
+    return file_error(path, "antiradiance links", std::to_string(link_count) + " links is beyond any bake (corrupt)");
+  auto planes = read_zstd_stream(path, "antiradiance links", frame, link_count * kLinkPlaneBytes);
+  if (!planes) return planes.error();
+  return links_from_planes(*planes, static_cast<std::size_t>(link_count));
+}
+
 }  // namespace gi

@@ -43,6 +43,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <span>
 #include <string>
 
 #include "antiradiance/antiradiance_region.h"
@@ -76,5 +77,14 @@ engine::Status save_antiradiance(const std::filesystem::path& bundle_dir, const 
 /// "stale" and names both hashes), checks the file against the manifest's checksum, reads it.
 /// Every error names the file and the problem.
 engine::Result<AntiradianceBake> load_antiradiance(const std::filesystem::path& bundle_dir, const BakeInput& input);
+
+/// Distributed bakes (docs/distributed-bake.md): a shard's links (link_elements_shard), sorted,
+/// as one zstd frame of the link planes antiradiance.bin stores. Errors name `path`.
+engine::Result<std::vector<std::uint8_t>> pack_link_shard(const std::filesystem::path& path,
+                                                          const std::vector<Link>& links);
+/// The links of pack_link_shard's frame, which must hold exactly `link_count` of them.
+/// Errors name `path`: a corrupt frame, another size.
+engine::Result<std::vector<Link>> unpack_link_shard(const std::filesystem::path& path,
+                                                    std::span<const std::uint8_t> frame, std::uint64_t link_count);
 
 }  // namespace gi

@@ -4,16 +4,21 @@
 
 namespace gi {
 
-engine::Result<AntiradianceBake> bake_antiradiance(const BakeInput& input, const AntiradianceSettings& settings) {
+namespace {
+
+engine::Status check_bins(const AntiradianceSettings& settings) {
   if (settings.bins_per_side < 1 || settings.bins_per_side > 64)
     return engine::Error{"", "antiradiance bake", "bins_per_side must lie in [1, 64]"};
-  auto h = build_element_hierarchy(input, settings);
-  if (!h) return h.error();
+  return {};
+}
+
+// The bake from the hierarchy and all its links (link_elements, or the merge of its shards).
+engine::Result<AntiradianceBake> solve_baseline(const BakeInput& input, const AntiradianceSettings& settings,
+                                                ElementHierarchy hierarchy, const LinkMesh& all) {
   AntiradianceBake bake;
   bake.settings = settings;
-  bake.hierarchy = std::move(h).value();
+  bake.hierarchy = std::move(hierarchy);
   const DirectionalBins bins(settings.bins_per_side);
-  const LinkMesh all = link_elements(bake.hierarchy, bins, settings);
   bake.static_links = static_links(bake.hierarchy, all);
   // The baseline: the region at the pose it is baked at (the pose the light atlas and the
   // PRM bake it at), direct light shadowed by it, all links; solved once.
@@ -25,6 +30,37 @@ engine::Result<AntiradianceBake> bake_antiradiance(const BakeInput& input, const
   bake.baseline = base.irradiance();
   for (glm::vec3& v : bake.baseline) v *= rep.output_scale;
   return bake;
+}
+
+}  // namespace
+
+engine::Result<AntiradianceBake> bake_antiradiance(const BakeInput& input, const AntiradianceSettings& settings) {
+  if (auto ok = check_bins(settings); !ok) return ok.error();
+  auto h = build_element_hierarchy(input, settings);
+  if (!h) return h.error();
+  const DirectionalBins bins(settings.bins_per_side);
+  const LinkMesh all = link_elements(*h, bins, settings);
+  return solve_baseline(input, settings, std::move(h).value(), all);
+}
+
+engine::Result<LinkMesh> bake_antiradiance_links_shard(const BakeInput& input, const AntiradianceSettings& settings,
+                                                       const WorkShard& shard) {
+  if (auto ok = check_bins(settings); !ok) return ok.error();
+  auto h = build_element_hierarchy(input, settings);
+  if (!h) return h.error();
+  const DirectionalBins bins(settings.bins_per_side);
+  return link_elements_shard(*h, bins, settings, shard);
+}
+
+engine::Result<AntiradianceBake> bake_antiradiance_from_link_shards(const BakeInput& input,
+                                                                    const AntiradianceSettings& settings,
+                                                                    const std::vector<std::vector<Link>>& parts) {
+  if (auto ok = check_bins(settings); !ok) return ok.error();
+  auto h = build_element_hierarchy(input, settings);
+  if (!h) return h.error();
+  auto all = merge_link_shards(*h, parts);
+  if (!all) return all.error();
+  return solve_baseline(input, settings, std::move(h).value(), *all);
 }
 
 engine::Result<AntiradianceRegion> AntiradianceRegion::create(const BakeInput& input,

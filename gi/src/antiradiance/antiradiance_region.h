@@ -50,6 +50,16 @@ struct AntiradianceBake {
 /// build_element_hierarchy and AntiradianceDirectLight::create; bins_per_side outside [1, 64].
 engine::Result<AntiradianceBake> bake_antiradiance(const BakeInput& input, const AntiradianceSettings& settings);
 
+/// Distributed bakes (docs/distributed-bake.md): shard `shard`'s part of the linking, most of
+/// the bake (link_elements_shard over the hierarchy bake_antiradiance builds).
+engine::Result<LinkMesh> bake_antiradiance_links_shard(const BakeInput& input, const AntiradianceSettings& settings,
+                                                       const WorkShard& shard);
+/// The bake from every shard's links (parts[i] of shard i of parts.size()): the same bake,
+/// bit for bit, as bake_antiradiance. Errors: bake_antiradiance's and merge_link_shards'.
+engine::Result<AntiradianceBake> bake_antiradiance_from_link_shards(const BakeInput& input,
+                                                                    const AntiradianceSettings& settings,
+                                                                    const std::vector<std::vector<Link>>& parts);
+
 /// Counters of the last update().
 struct AntiradianceUpdateCounters {
   std::size_t moved_groups = 0;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 #include <glm/gtc/constants.hpp>
 
@@ -26,6 +27,19 @@ struct Linker {
   const DirectionalBins& bins;
   float threshold_sr;
   std::vector<Link>& out;
+  /// Distributed bakes: only links to receivers of this shard (whole: every link).
+  WorkShard shard{};
+
+  // Does the subtree of node a hold a receiver of the shard? (Subtrees are index ranges.)
+  bool subtree_owned(std::int32_t a) const {
+    if (shard.whole()) return true;
+    const std::size_t lo = static_cast<std::size_t>(a), hi = static_cast<std::size_t>(node(a).end);
+    const std::size_t block = WorkShard::kBlockItems;
+    if (hi - lo >= block * shard.count) return true;
+    for (std::size_t b = lo / block; b * block < hi; ++b)
+      if (b % shard.count == shard.index) return true;
+    return false;
+  }
 
   const ElementNode& node(std::int32_t i) const { return h.nodes[static_cast<std::size_t>(i)]; }
 
@@ -46,6 +60,7 @@ struct Linker {
   // radius for a cluster), each direction point -> receiver centre picks a bin; a bin gets
   // the share of samples that fell in it. One record per (receiver, sender, bin).
   void directed(std::int32_t r, std::int32_t s) {
+    if (!shard.owns(static_cast<std::size_t>(r))) return;
     const ElementNode& rn = node(r);
     const ElementNode& sn = node(s);
     if (behind(rn, sn)) return;
@@ -83,6 +98,7 @@ struct Linker {
   }
 
   void refine(std::int32_t a, std::int32_t b) {
+    if (!subtree_owned(a) && !subtree_owned(b)) return;  // no link of the shard below
     const ElementNode& an = node(a);
     const ElementNode& bn = node(b);
     if (behind(an, bn) && behind(bn, an)) return;  // back to back: no exchange either way
@@ -105,6 +121,7 @@ struct Linker {
 
   // Self-links are always subdivided: all pairs of children, each child with itself.
   void self(std::int32_t a) {
+    if (!subtree_owned(a)) return;
     const ElementNode& an = node(a);
     for (std::int32_t i = 0; i < an.child_count; ++i) {
       const std::int32_t ci = h.children[static_cast<std::size_t>(an.first_child + i)];
@@ -149,12 +166,63 @@ LinkMesh link_elements(const ElementHierarchy& h, const DirectionalBins& bins, c
   return mesh;
 }
 
+LinkMesh link_elements_shard(const ElementHierarchy& h, const DirectionalBins& bins,
+                             const AntiradianceSettings& settings, const WorkShard& shard) {
+  LinkMesh mesh;
+  Linker linker{h, bins, threshold(bins, settings), mesh.links, shard};
+  linker.self(0);
+  sort_and_index(h, mesh);
+  mesh.relinked_elements = shard.items(h.nodes.size()).size();
+  mesh.links_made = mesh.links.size();
+  return mesh;
+}
+
+engine::Result<LinkMesh> merge_link_shards(const ElementHierarchy& h, const std::vector<std::vector<Link>>& parts) {
+  const auto count = static_cast<std::uint32_t>(parts.size());
+  const std::size_t nodes = h.nodes.size();
+  const auto error = [&](std::uint32_t i, const std::string& what) {
+    return engine::Error{"", "antiradiance shard " + std::to_string(i) + " of " + std::to_string(count), what};
+  };
+  std::size_t total = 0;
+  for (std::uint32_t i = 0; i < count; ++i) {
+    const WorkShard shard{.index = i, .count = count};
+    const std::vector<Link>& p = parts[i];
+    for (std::size_t k = 0; k < p.size(); ++k) {
+      const Link& l = p[k];
+      if (l.receiver < 0 || static_cast<std::size_t>(l.receiver) >= nodes || l.sender < 0 ||
+          static_cast<std::size_t>(l.sender) >= nodes || !shard.owns(static_cast<std::size_t>(l.receiver)))
+        return error(i, "link " + std::to_string(k) + " has a receiver that is not the shard's or an element out of range");
+      if (k > 0 && !link_less(p[k - 1], l)) return error(i, "its links are not sorted");
+    }
+    total += p.size();
+  }
+  // Receiver r's links are the run of r in the part of its shard: copied in receiver order.
+  LinkMesh mesh;
+  mesh.links.reserve(total);
+  std::vector<std::size_t> cursor(count, 0);
+  for (std::size_t r = 0; r < nodes; ++r) {
+    const std::uint32_t i = count <= 1 ? 0 : static_cast<std::uint32_t>((r / WorkShard::kBlockItems) % count);
+    const std::vector<Link>& p = parts[i];
+    std::size_t& k = cursor[i];
+    while (k < p.size() && static_cast<std::size_t>(p[k].receiver) == r) mesh.links.push_back(p[k++]);
+  }
+  index_links(h, mesh);
+  mesh.relinked_elements = nodes;
+  mesh.links_made = mesh.links.size();
+  return mesh;
+}
+
 LinkMesh static_links(const ElementHierarchy& h, const LinkMesh& mesh) {
   LinkMesh out;
   for (const Link& l : mesh.links)
     if (h.nodes[static_cast<std::size_t>(l.receiver)].group == 0 && h.nodes[static_cast<std::size_t>(l.sender)].group == 0)
       out.links.push_back(l);
-  sort_and_index(h, out);
+  // A LinkMesh's links are sorted (a total order), so the filtered ones are too: the sort
+  // (most of this function's time on 3 M links) only runs for a mesh that is not.
+  if (std::is_sorted(out.links.begin(), out.links.end(), link_less))
+    index_links(h, out);
+  else
+    sort_and_index(h, out);
   out.links_made = out.links.size();
   return out;
 }

@@ -24,12 +24,15 @@
 //   gi::LinkMesh links = gi::link_elements(hierarchy, bins, settings);
 //   gi::relink_moved(hierarchy, bins, settings, {1}, links);  // group 1 (the door) moved
 
+#include <engine/result.h>
+
 #include <cstdint>
 #include <vector>
 
 #include "antiradiance/antiradiance_settings.h"
 #include "antiradiance/directional_bins.h"
 #include "antiradiance/element_hierarchy.h"
+#include "core/work_shard.h"
 
 namespace gi {
 
@@ -53,6 +56,19 @@ struct LinkMesh {
 
 /// All links of the hierarchy (counters: every element, every link).
 LinkMesh link_elements(const ElementHierarchy& h, const DirectionalBins& bins, const AntiradianceSettings& settings);
+
+/// Distributed bakes (docs/distributed-bake.md): the links of link_elements whose receiver
+/// node is in `shard`'s blocks of 64 node indices, sorted as a LinkMesh, each one computed as
+/// the whole refinement computes it (pairs whose subtrees hold no receiver of the shard are
+/// not visited). Counters: the shard's receivers, its links.
+LinkMesh link_elements_shard(const ElementHierarchy& h, const DirectionalBins& bins,
+                             const AntiradianceSettings& settings, const WorkShard& shard);
+
+/// The whole link mesh from the `parts[i]` = link_elements_shard(..., {i, parts.size()}):
+/// each receiver's run taken from its shard, in linear time; equal to link_elements
+/// (counters included). Error (naming "antiradiance shard i of N") when a part holds a
+/// receiver outside its shard's blocks or out of range, or is not sorted.
+engine::Result<LinkMesh> merge_link_shards(const ElementHierarchy& h, const std::vector<std::vector<Link>>& parts);
 
 /// The links of `mesh` between two static elements (group 0): the ones no motion changes,
 /// which a bake stores.

@@ -95,6 +95,7 @@ using Timings = nlohmann::json;
 struct MergedParts {
   std::vector<LightAtlasShardPart> atlas;
   std::vector<PrmShardPart> prm;
+  std::vector<std::vector<Link>> antiradiance;  ///< Each shard's links, unpacked.
 };
 
 engine::Result<LightAtlasSettings> atlas_settings(const BakeOptions& o, const Stage& stage) {
@@ -169,13 +170,21 @@ engine::Status bake_prm_method(const BakeInput& input, const fs::path& dir, cons
 
 // Antiradiance (docs/antiradiance.md): the elements, static links and baseline of the
 // deforming region; elements of 0.8 / 0.6 / 0.4 m at preview / medium / high.
-engine::Status bake_antiradiance_method(const BakeInput& input, const fs::path& dir, const BakeOptions& o,
-                                        const Stage& stage) {
+AntiradianceSettings antiradiance_settings(const BakeOptions& o) {
   AntiradianceSettings s;
   s.patch_size_m = antiradiance_preset_patch_size(o.preset);
   s.seed = o.seed;
+  return s;
+}
+
+engine::Status bake_antiradiance_method(const BakeInput& input, const fs::path& dir, const BakeOptions& o,
+                                        const Stage& stage, const MergedParts* parts = nullptr) {
+  const AntiradianceSettings s = antiradiance_settings(o);
   const auto start = Clock::now();
-  auto bake = bake_antiradiance(input, s);
+  // A merge (docs/distributed-bake.md): the links from the shards, the rest baked here.
+  auto bake = parts != nullptr && !parts->antiradiance.empty()
+                  ? bake_antiradiance_from_link_shards(input, s, parts->antiradiance)
+                  : bake_antiradiance(input, s);
   if (!bake) return bake.error();
   stage.log(format("antiradiance of %s, preset %s: %zu elements (%zu leaves), %d bins, %zu static links, %.2f s",
                    scene_file_name(input).c_str(), o.preset.c_str(), bake->hierarchy.nodes.size(),
@@ -510,8 +519,22 @@ engine::Result<BakeReport> bake_shard(const BakeInput& input, const fs::path& bu
     report.baked.push_back({"prm", seconds_since(start), 0});
     file.prm = std::move(part).value();
   }
+  if (has_method(methods, "antiradiance")) {
+    const Stage stage{host, "antiradiance"};
+    const auto start = Clock::now();
+    auto links = bake_antiradiance_links_shard(input, antiradiance_settings(options), shard);
+    if (!links) return links.error();
+    const fs::path path = shard_directory(bundle_dir) / shard_file_name(index, count);
+    auto frame = pack_link_shard(path, links->links);
+    if (!frame) return frame.error();
+    stage.log(format("antiradiance shard %u/%u: links of %zu elements, %zu links, %.2f s", index, count,
+                     links->relinked_elements, links->links.size(), seconds_since(start)));
+    report.baked.push_back({"antiradiance", seconds_since(start), 0});
+    file.antiradiance = AntiradianceShardPart{.links = links->links.size(), .frame = std::move(frame).value()};
+  }
   for (const std::string& m : methods)
-    if (m != "atlas" && m != "prm") log.log(m + ": not sharded, baked by the merge (docs/distributed-bake.md)");
+    if (m != "atlas" && m != "prm" && m != "antiradiance")
+      log.log(m + ": not sharded, baked by the merge (docs/distributed-bake.md)");
   const fs::path dir = shard_directory(bundle_dir);
   std::error_code ec;
   fs::create_directories(dir, ec);
@@ -562,7 +585,8 @@ engine::Result<MergedParts> read_shards(const BakeInput& input, const fs::path& 
                      std::to_string(file->seed) + ", this merge's " + expected.settings_hash + " seed " +
                      std::to_string(expected.seed) + ")");
     if (file->methods != expected.methods || file->atlas.has_value() != has_method(methods, "atlas") ||
-        file->prm.has_value() != has_method(methods, "prm"))
+        file->prm.has_value() != has_method(methods, "prm") ||
+        file->antiradiance.has_value() != has_method(methods, "antiradiance"))
       return foreign("its methods differ from this merge's");
     if (shards.empty()) shards.resize(count), where.resize(count);
     const std::uint32_t i = file->index;
@@ -579,6 +603,11 @@ engine::Result<MergedParts> read_shards(const BakeInput& input, const fs::path& 
                            "shard " + std::to_string(i) + " of " + std::to_string(count) + " is missing"};
     if (shards[i]->atlas) merged.atlas.push_back(std::move(*shards[i]->atlas));
     if (shards[i]->prm) merged.prm.push_back(std::move(*shards[i]->prm));
+    if (shards[i]->antiradiance) {
+      auto links = unpack_link_shard(where[i], shards[i]->antiradiance->frame, shards[i]->antiradiance->links);
+      if (!links) return links.error();
+      merged.antiradiance.push_back(std::move(links).value());
+    }
   }
   if (host.log)
     host.log(LogLevel::Info, format("merging %u shards from %s", count, dir.string().c_str()));
@@ -643,7 +672,7 @@ engine::Result<BakeReport> bake_bundle(const BakeInput& input, const fs::path& b
     engine::Status done = key == "atlas" ? bake_atlas(input, dir, options, {host, "light atlas"}, timings, parts)
                           : key == "prm" ? bake_prm_method(input, dir, options, {host, "PRM"}, timings, parts)
                           : key == "dlm" ? bake_dlm_method(input, dir, options, {host, "DLM"}, timings)
-                          : key == "antiradiance" ? bake_antiradiance_method(input, dir, options, {host, "antiradiance"})
+                          : key == "antiradiance" ? bake_antiradiance_method(input, dir, options, {host, "antiradiance"}, parts)
                                          : bake_brf_method(input, dir, options, host, timings);
     if (!done) return done.error();
     report.baked.push_back({key, seconds_since(start), method_bytes(dir, manifest_key(key))});

@@ -15,7 +15,7 @@ namespace {
 
 constexpr BlobMagic kShardMagic{"GISHARD1"};
 constexpr std::uint32_t kShardVersion = 1;
-constexpr std::uint8_t kHasAtlas = 1, kHasPrm = 2;
+constexpr std::uint8_t kHasAtlas = 1, kHasPrm = 2, kHasAntiradiance = 4;
 
 bool ascending(const std::vector<std::uint32_t>& v) {
   for (std::size_t i = 1; i < v.size(); ++i)
@@ -35,7 +35,8 @@ engine::Status write_shard_file(const std::filesystem::path& path, const ShardFi
   w.put(f.seed);
   w.put<std::uint32_t>(static_cast<std::uint32_t>(f.methods.size()));
   for (const std::string& m : f.methods) w.put_string(m);
-  w.put<std::uint8_t>(static_cast<std::uint8_t>((f.atlas ? kHasAtlas : 0) | (f.prm ? kHasPrm : 0)));
+  w.put<std::uint8_t>(static_cast<std::uint8_t>((f.atlas ? kHasAtlas : 0) | (f.prm ? kHasPrm : 0) |
+                                                (f.antiradiance ? kHasAntiradiance : 0)));
   if (f.atlas) {
     const LightAtlasShardPart& a = *f.atlas;
     w.put_array(a.texels);
@@ -54,6 +55,10 @@ engine::Status write_shard_file(const std::filesystem::path& path, const ShardFi
     w.put<std::uint64_t>(p.path_nodes);
     w.put(p.walk_rays);
     w.put(p.pane_rays);
+  }
+  if (f.antiradiance) {
+    w.put(f.antiradiance->links);
+    w.put_array(f.antiradiance->frame);
   }
   return write_blob(path, kShardMagic, kShardVersion, w.bytes());
 }
@@ -90,10 +95,15 @@ engine::Result<ShardFile> read_shard_file(const std::filesystem::path& path) {
     p.path_nodes = static_cast<std::size_t>(nodes);
     f.prm = std::move(p);
   }
+  if (complete && (parts & kHasAntiradiance)) {
+    AntiradianceShardPart a;
+    complete = r.get(a.links) && r.get_array(a.frame);
+    f.antiradiance = std::move(a);
+  }
   const std::string location = "payload byte " + std::to_string(r.offset());
   if (!complete) return engine::Error{path.string(), location, "truncated payload"};
   if (r.remaining() != 0) return engine::Error{path.string(), location, "unexpected data after the last field"};
-  if (parts > (kHasAtlas | kHasPrm)) return engine::Error{path.string(), "parts", "unknown part flags"};
+  if (parts > (kHasAtlas | kHasPrm | kHasAntiradiance)) return engine::Error{path.string(), "parts", "unknown part flags"};
   if (f.count == 0 || f.index >= f.count)
     return engine::Error{path.string(), "shard",
                          "shard " + std::to_string(f.index) + " of " + std::to_string(f.count) + " does not exist"};

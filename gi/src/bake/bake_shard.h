@@ -1,6 +1,6 @@
 #pragma once
 // The shard file of a distributed bake (docs/distributed-bake.md): what `gi-bake --shard
-// I/N` computed of the sharded methods (light atlas, PRM), checksummed like every bake file
+// I/N` computed of the sharded methods (light atlas, PRM, antiradiance links), checksummed like every bake file
 // (io/blob_file.h, magic "GISHARD1"), with what the merge checks it against: the scene's
 // geometry and static-lights hashes, the bake settings' hash, the seed, I and N, and the
 // method list the shard's plan called for.
@@ -19,6 +19,13 @@
 
 namespace gi {
 
+/// A shard's antiradiance links (link_elements_shard: the links to the receivers of its
+/// blocks of 64 elements) as antiradiance_io's pack_link_shard frame.
+struct AntiradianceShardPart {
+  std::uint64_t links = 0;
+  std::vector<std::uint8_t> frame;
+};
+
 struct ShardFile {
   std::uint32_t index = 0;
   std::uint32_t count = 1;
@@ -29,6 +36,7 @@ struct ShardFile {
   std::vector<std::string> methods;  ///< Every method of the bake (the merge bakes the others).
   std::optional<LightAtlasShardPart> atlas;
   std::optional<PrmShardPart> prm;
+  std::optional<AntiradianceShardPart> antiradiance;
 };
 
 /// Writes `file` atomically (write_blob). Errors name `path`.
