@@ -1,10 +1,14 @@
 #include "antiradiance/antiradiance_region.h"
 
 #include <algorithm>
+#include <chrono>
 
 namespace gi {
 
 namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
 engine::Status check_bins(const AntiradianceSettings& settings) {
   if (settings.bins_per_side < 1 || settings.bins_per_side > 64)
@@ -14,21 +18,28 @@ engine::Status check_bins(const AntiradianceSettings& settings) {
 
 // The bake from the hierarchy and all its links (link_elements, or the merge of its shards).
 engine::Result<AntiradianceBake> solve_baseline(const BakeInput& input, const AntiradianceSettings& settings,
-                                                ElementHierarchy hierarchy, const LinkMesh& all) {
+                                                ElementHierarchy hierarchy, const LinkMesh& all, double link_seconds) {
   AntiradianceBake bake;
   bake.settings = settings;
   bake.hierarchy = std::move(hierarchy);
+  bake.seconds.links = link_seconds;
   const DirectionalBins bins(settings.bins_per_side);
+  auto t = Clock::now();
   bake.static_links = static_links(bake.hierarchy, all);
+  bake.seconds.static_links = seconds_since(t);
   // The baseline: the region at the pose it is baked at (the pose the light atlas and the
   // PRM bake it at), direct light shadowed by it, all links; solved once.
+  t = Clock::now();
   auto direct_light = AntiradianceDirectLight::create(input, settings);
   if (!direct_light) return direct_light.error();
   const std::vector<glm::vec3> direct = direct_light->irradiance(bake.hierarchy);
+  bake.seconds.direct = seconds_since(t);
+  t = Clock::now();
   CpuAntiradiancePasses base(bake.hierarchy, bins, all);
   const AntiradianceSolveReport rep = run_antiradiance(base, direct, settings, bake.hierarchy);
   bake.baseline = base.irradiance();
   for (glm::vec3& v : bake.baseline) v *= rep.output_scale;
+  bake.seconds.solve = seconds_since(t);
   return bake;
 }
 
@@ -39,8 +50,9 @@ engine::Result<AntiradianceBake> bake_antiradiance(const BakeInput& input, const
   auto h = build_element_hierarchy(input, settings);
   if (!h) return h.error();
   const DirectionalBins bins(settings.bins_per_side);
+  const auto t = Clock::now();
   const LinkMesh all = link_elements(*h, bins, settings);
-  return solve_baseline(input, settings, std::move(h).value(), all);
+  return solve_baseline(input, settings, std::move(h).value(), all, seconds_since(t));
 }
 
 engine::Result<LinkMesh> bake_antiradiance_links_shard(const BakeInput& input, const AntiradianceSettings& settings,
@@ -58,9 +70,10 @@ engine::Result<AntiradianceBake> bake_antiradiance_from_link_shards(const BakeIn
   if (auto ok = check_bins(settings); !ok) return ok.error();
   auto h = build_element_hierarchy(input, settings);
   if (!h) return h.error();
+  const auto t = Clock::now();
   auto all = merge_link_shards(*h, parts);
   if (!all) return all.error();
-  return solve_baseline(input, settings, std::move(h).value(), *all);
+  return solve_baseline(input, settings, std::move(h).value(), *all, seconds_since(t));
 }
 
 engine::Result<AntiradianceRegion> AntiradianceRegion::create(const BakeInput& input,

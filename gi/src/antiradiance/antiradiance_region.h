@@ -44,6 +44,12 @@ struct AntiradianceBake {
   ElementHierarchy hierarchy;
   LinkMesh static_links;
   std::vector<glm::vec3> baseline;  ///< Indirect irradiance per leaf with the region at its baked pose.
+  /// What the bake's stages took (wall seconds; bake_stats.json, not the bundle's files):
+  /// the links (or, in a merge of shards, putting the shards' links in place), the static
+  /// links' filter, the direct light and the baseline solve.
+  struct StageSeconds {
+    double links = 0.0, static_links = 0.0, direct = 0.0, solve = 0.0;
+  } seconds;
 };
 
 /// Builds the elements, links the static ones and solves the baseline. Errors: see

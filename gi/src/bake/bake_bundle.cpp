@@ -178,7 +178,7 @@ AntiradianceSettings antiradiance_settings(const BakeOptions& o) {
 }
 
 engine::Status bake_antiradiance_method(const BakeInput& input, const fs::path& dir, const BakeOptions& o,
-                                        const Stage& stage, const MergedParts* parts = nullptr) {
+                                        const Stage& stage, Timings& timings, const MergedParts* parts = nullptr) {
   const AntiradianceSettings s = antiradiance_settings(o);
   const auto start = Clock::now();
   // A merge (docs/distributed-bake.md): the links from the shards, the rest baked here.
@@ -190,7 +190,15 @@ engine::Status bake_antiradiance_method(const BakeInput& input, const fs::path& 
                    scene_file_name(input).c_str(), o.preset.c_str(), bake->hierarchy.nodes.size(),
                    bake->hierarchy.leaf_count(), s.bins_per_side * s.bins_per_side, bake->static_links.links.size(),
                    seconds_since(start)));
-  return save_antiradiance(dir, *bake, input);
+  // links_seconds: linking (a merge: putting the shards' links in place).
+  timings["links_seconds"] = bake->seconds.links;
+  timings["static_links_seconds"] = bake->seconds.static_links;
+  timings["direct_seconds"] = bake->seconds.direct;
+  timings["solve_seconds"] = bake->seconds.solve;
+  const auto save_start = Clock::now();
+  auto saved = save_antiradiance(dir, *bake, input);
+  timings["save_seconds"] = seconds_since(save_start);
+  return saved;
 }
 
 engine::Status bake_brf_method(const BakeInput& input, const fs::path& dir, const BakeOptions& o, const BakeHost& host,
@@ -672,7 +680,7 @@ engine::Result<BakeReport> bake_bundle(const BakeInput& input, const fs::path& b
     engine::Status done = key == "atlas" ? bake_atlas(input, dir, options, {host, "light atlas"}, timings, parts)
                           : key == "prm" ? bake_prm_method(input, dir, options, {host, "PRM"}, timings, parts)
                           : key == "dlm" ? bake_dlm_method(input, dir, options, {host, "DLM"}, timings)
-                          : key == "antiradiance" ? bake_antiradiance_method(input, dir, options, {host, "antiradiance"}, parts)
+                          : key == "antiradiance" ? bake_antiradiance_method(input, dir, options, {host, "antiradiance"}, timings, parts)
                                          : bake_brf_method(input, dir, options, host, timings);
     if (!done) return done.error();
     report.baked.push_back({key, seconds_since(start), method_bytes(dir, manifest_key(key))});
