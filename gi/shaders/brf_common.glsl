@@ -137,16 +137,19 @@ float brf_sphere_radius(BrfModel m, uint s) {
 
 // The 8 samples around object-space point p, as in BasisRadianceField::sample: first float
 // of each sample's [term][basis][coefficient] block (relative to the field) and its weight
-// (trilinear weight x falloff x (r_s / r)^2 between spheres). Returns false at the centre
-// or for non-finite points (the sample is zero there).
-bool brf_field_corners(BrfModel m, vec3 p, out uint base[8], out float weight[8]) {
+// (trilinear weight x falloff x (r_s / r)^2 between spheres). Returns how many of them carry
+// weight: 8 between two spheres, 4 inside the innermost or beyond the outermost sphere (one
+// shell: samples 4-7 have weight 0, so callers loop over the first `taps` only, which lets
+// llvmpipe leave the loop for the whole SIMD group), 0 at the centre or for non-finite
+// points (the sample is zero there).
+uint brf_field_corners(BrfModel m, vec3 p, out uint base[8], out float weight[8]) {
   for (int k = 0; k < 8; ++k) {
     base[k] = 0u;
     weight[k] = 0.0;
   }
   const vec3 d = p - m.centre_inner.xyz;
   const float r = length(d);
-  if (!(r > 0.0) || isinf(r) || isnan(r)) return false;
+  if (!(r > 0.0) || isinf(r) || isnan(r)) return 0u;
   const float inner = m.centre_inner.w, outer = m.outer_radius;
   float falloff = 1.0;
   float sr = 0.0;
@@ -178,14 +181,17 @@ bool brf_field_corners(BrfModel m, vec3 p, out uint base[8], out float weight[8]
   const float cw[8] = float[8]((1.0 - ts) * (1.0 - tu) * (1.0 - tv), (1.0 - ts) * tu * (1.0 - tv),
                                (1.0 - ts) * (1.0 - tu) * tv, (1.0 - ts) * tu * tv, ts * (1.0 - tu) * (1.0 - tv),
                                ts * tu * (1.0 - tv), ts * (1.0 - tu) * tv, ts * tu * tv);
-  for (int k = 0; k < 8; ++k) {
+  // The two shells' (r_s / r)^2 (brf_sphere_radius per shell, not per sample: the same values).
+  const float rs0 = brf_sphere_radius(m, s0), rs1 = brf_sphere_radius(m, s1);
+  const float shell[2] = float[2](between ? (rs0 / r) * (rs0 / r) : 1.0, between ? (rs1 / r) * (rs1 / r) : 1.0);
+  const uint taps = between ? 8u : 4u;
+  for (uint k = 0u; k < taps; ++k) {
     uint ff = f;
     int iu = cu[k], iv = cv[k];
     brf_seam_cell(m.face_resolution, ff, iu, iv);
     const uint idx = ((cs[k] * 6u + ff) * m.face_resolution + uint(iv)) * m.face_resolution + uint(iu);
     base[k] = idx * per_point;
-    const float rs = brf_sphere_radius(m, cs[k]);
-    weight[k] = cw[k] * falloff * (between ? (rs / r) * (rs / r) : 1.0);
+    weight[k] = cw[k] * falloff * shell[k / 4u];
   }
-  return true;
+  return taps;
 }

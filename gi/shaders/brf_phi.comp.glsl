@@ -191,7 +191,7 @@ void main() {
     brf_clamped_cosine(n, m.sh_bands, lobe);
   uint base[8];
   float weight[8];
-  const bool inside = brf_field_corners(m, p, base, weight);
+  const uint taps = brf_field_corners(m, p, base, weight);
   const uint cc = m.sh_bands * m.sh_bands;
   for (uint r = 0u; r < rows; ++r)
     for (uint i = nc; i < c4; ++i) phi[row0 + r * c4 + i] = 0.0;
@@ -199,16 +199,20 @@ void main() {
 #ifndef BRF_GLOSSY_RECEIVER
   {  // a diffuse receiver or static point: the irradiance row only
     const float scale = (u_kind == 1u ? static_visibility[job.point_offset + k] : 1.0) * vis;
+    // The unclamped cosine in front is band 1 only: coefficients 1-3 (the others are 0, so
+    // skipping them changes no sum). Loops with per-invocation bounds rather than `continue`:
+    // llvmpipe leaves a loop once every lane of the SIMD group is done, where a skipped
+    // iteration would still run masked. The mesh's vertices come face by face, so a group's
+    // lanes mostly share the side and the tap count.
+    const uint q0 = side == 1u ? 1u : 0u, q1 = side == 1u ? 4u : cc;
     for (uint i = 0u; i < nc; ++i) {
       float sum = 0.0;
-      if (inside)
-        for (int c = 0; c < 8; ++c) {
-          if (weight[c] == 0.0) continue;
-          const uint at = m.field_offset + base[c] + i * cc;
-          float d = 0.0;
-          for (uint q = 0u; q < cc; ++q) d += field[at + q] * lobe[q];
-          sum += weight[c] * d;
-        }
+      for (uint c = 0u; c < taps; ++c) {
+        const uint at = m.field_offset + base[c] + i * cc;
+        float d = 0.0;
+        for (uint q = q0; q < q1; ++q) d += field[at + q] * lobe[q];
+        sum += weight[c] * d;
+      }
       phi[row0 + i] = sum * scale;
     }
     return;
@@ -253,12 +257,10 @@ void main() {
   for (uint i = 0u; i < nc; ++i) {
     float coeffs[16];
     for (uint q = 0u; q < cc; ++q) coeffs[q] = 0.0;
-    if (inside)
-      for (int c = 0; c < 8; ++c) {
-        if (weight[c] == 0.0) continue;
-        const uint at = m.field_offset + base[c] + i * cc;
-        for (uint q = 0u; q < cc; ++q) coeffs[q] += weight[c] * field[at + q];
-      }
+    for (uint c = 0u; c < taps; ++c) {
+      const uint at = m.field_offset + base[c] + i * cc;
+      for (uint q = 0u; q < cc; ++q) coeffs[q] += weight[c] * field[at + q];
+    }
     for (uint r = 0u; r < rows; ++r) {
       float d = 0.0;
       for (uint q = 0u; q < cc; ++q) d += coeffs[q] * lobes[r * 16u + q];
