@@ -367,19 +367,6 @@ engine::Status BrfGpuPass::reset_layout(std::span<const BrfGpuInstance> instance
     value_offsets[i + 1] = value_offsets[i] + m.terms * m.vertex_count;
     weight_offsets[i + 1] = weight_offsets[i] + padded(m.channels());  // rgb vec4 per channel
   }
-  std::vector<PairSlot> pairs(n * n);
-  std::size_t phi_floats = 0;
-  for (std::size_t s = 0; s < n; ++s)
-    for (std::size_t r = 0; r < n; ++r) {
-      if (s == r) continue;
-      pairs[s * n + r].phi_offset = u32(phi_floats);
-      const ModelInfo& mr = models_[instances[r].model];
-      phi_floats +=
-          static_cast<std::size_t>(mr.vertex_count) * mr.terms * padded(models_[instances[s].model].channels());
-    }
-  if (phi_floats * sizeof(float) > max_buffer_bytes_)
-    return error(std::to_string(n) + " instances need " + std::to_string(phi_floats * sizeof(float)) +
-                 " bytes of pair Phi, above the SSBO limit of " + std::to_string(max_buffer_bytes_));
   if (static_cast<std::size_t>(value_offsets[n]) * sizeof(glm::vec4) > max_buffer_bytes_)
     return error("the instances' vertices exceed the SSBO limit");
 
@@ -388,13 +375,15 @@ engine::Status BrfGpuPass::reset_layout(std::span<const BrfGpuInstance> instance
   vertex_offsets_ = std::move(vertex_offsets);
   value_offsets_ = std::move(value_offsets);
   weight_offsets_ = std::move(weight_offsets);
-  pairs_ = std::move(pairs);
+  pair_keys_.clear();  // the Phi slots follow the pairs in reach (layout_pairs)
+  pairs_.clear();
+  phi_floats_ = 0;
+  phi_.reserve(0);  // bound even with no pair in reach
   static_slots_.assign(n, StaticSlot{});
   static_touched_count_ = 0;
   const std::size_t value_bytes = static_cast<std::size_t>(value_offsets_[n]) * sizeof(glm::vec4);
   for (Buffer* b : {&incoming_, &gathered_, &indirect_}) b->reserve(value_bytes);
   weights_.reserve(weight_offsets_[n] * sizeof(glm::vec4));
-  phi_.reserve(phi_floats * sizeof(float));
   outputs_.clear();
   output_bytes_ = 0;
   for (std::size_t i = 0; i < n; ++i) {
@@ -629,6 +618,7 @@ void BrfGpuPass::upload_static_lists(std::span<const BrfGpuInstance> instances) 
 struct BrfGpuPass::FrameData {
   std::vector<glm::vec4> weights;    ///< First bounce's weights, rgb vec4 per channel; pads stay 0.
   std::vector<std::uint8_t> culled;  ///< [source * n + receiver], as brf_pair_culling.
+  std::vector<std::uint64_t> in_reach;  ///< Keys source x n + receiver of the pairs in reach, sorted.
   std::vector<GpuInstance> table;
   std::vector<glm::uvec4> live;  ///< (source's first weight vec4, first Phi vec4, C4 / 4, source)
   std::vector<BrfPhiJob> jobs;
@@ -660,6 +650,7 @@ engine::Status BrfGpuPass::run(std::span<const BrfGpuInstance> instances,
   FrameData frame;
   frame.occlusion = settings.occlusion;
   fit_first_and_cull(instances, incoming, settings.cull_threshold, settings.influence_scale, frame);
+  if (auto s = layout_pairs(n, frame); !s) return s;
   plan_pairs(instances, frame);
   occluders_.upload(frame.occluders.data(), frame.occluders.size() * sizeof(GpuOccluder));
   dispatch_phi(frame.jobs, false);
@@ -726,6 +717,68 @@ void BrfGpuPass::fit_first_and_cull(std::span<const BrfGpuInstance> instances,
   }
   // As brf_interreflect: the influence grid, then the bounds of the pairs inside (threshold > 0 or NaN).
   frame.culled = brf_pair_culling(objects, first_weights, cull_threshold, influence_scale);
+  // The pairs that hold a Phi slot: those in reach, culled by their bound or not.
+  const std::vector<std::uint8_t> outside = brf_pair_influence(objects, influence_scale);
+  for (std::size_t s = 0; s < n; ++s)
+    for (std::size_t r = 0; r < n; ++r)
+      if (outside[s * n + r] == 0) frame.in_reach.push_back(std::uint64_t{s} * n + r);
+}
+
+engine::Status BrfGpuPass::layout_pairs(std::size_t instance_count, const FrameData& frame) {
+  stats_.pair_slots = frame.in_reach.size();
+  if (frame.in_reach == pair_keys_) return {};
+  // New packed layout in key order; kept pairs keep their state and Phi (copied below).
+  const std::size_t n = instance_count;
+  std::vector<PairSlot> slots(frame.in_reach.size());
+  std::size_t floats = 0;
+  struct Copy {
+    std::size_t from, to, count;
+  };
+  std::vector<Copy> copies;
+  std::size_t old = 0;
+  for (std::size_t k = 0; k < frame.in_reach.size(); ++k) {
+    const std::uint64_t key = frame.in_reach[k];
+    const std::size_t s = key / n, r = key % n;
+    const ModelInfo& mr = models_[layout_models_[r]];
+    const std::size_t size =
+        static_cast<std::size_t>(mr.vertex_count) * mr.terms * padded(models_[layout_models_[s]].channels());
+    while (old < pair_keys_.size() && pair_keys_[old] < key) ++old;
+    if (old < pair_keys_.size() && pair_keys_[old] == key && pairs_[old].valid) {
+      slots[k] = std::move(pairs_[old]);
+      if (!copies.empty() && copies.back().from + copies.back().count == slots[k].phi_offset &&
+          copies.back().to + copies.back().count == floats)
+        copies.back().count += size;  // runs of kept slots move as one copy
+      else
+        copies.push_back({slots[k].phi_offset, floats, size});
+    }
+    slots[k].phi_offset = u32(floats);
+    floats += size;
+  }
+  if (floats * sizeof(float) > max_buffer_bytes_)
+    return error(std::to_string(frame.in_reach.size()) + " pairs in reach need " +
+                 std::to_string(floats * sizeof(float)) + " bytes of pair Phi, above the SSBO limit of " +
+                 std::to_string(max_buffer_bytes_));
+  if (copies.empty()) {
+    phi_.reserve(floats * sizeof(float));
+  } else {
+    phi_spare_.reserve(floats * sizeof(float));
+    for (const Copy& c : copies)
+      glCopyNamedBufferSubData(phi_.buffer.id(), phi_spare_.buffer.id(), static_cast<GLintptr>(c.from * sizeof(float)),
+                               static_cast<GLintptr>(c.to * sizeof(float)),
+                               static_cast<GLsizeiptr>(c.count * sizeof(float)));
+    std::swap(phi_, phi_spare_);
+    phi_spare_ = Buffer{};
+  }
+  pair_keys_ = frame.in_reach;
+  pairs_ = std::move(slots);
+  phi_floats_ = floats;
+  return {};
+}
+
+BrfGpuPass::PairSlot& BrfGpuPass::pair_slot(std::uint64_t key) {
+  const auto it = std::lower_bound(pair_keys_.begin(), pair_keys_.end(), key);
+  GI_EXPECTS(it != pair_keys_.end() && *it == key, "BrfGpuPass: a live pair without a Phi slot");
+  return pairs_[static_cast<std::size_t>(it - pair_keys_.begin())];
 }
 
 void BrfGpuPass::plan_pairs(std::span<const BrfGpuInstance> instances, FrameData& frame) {
@@ -765,7 +818,7 @@ void BrfGpuPass::plan_pairs(std::span<const BrfGpuInstance> instances, FrameData
         continue;
       }
       ++stats_.pairs_evaluated;
-      PairSlot& slot = pairs_[s * n + r];
+      PairSlot& slot = pair_slot(std::uint64_t{s} * n + r);
       const glm::mat4 relative = to_source[s] * instances[r].object_to_world;
       frame.live.emplace_back(weight_offsets_[s], slot.phi_offset / 4,
                               padded(models_[instances[s].model].channels()) / 4, u32(s));

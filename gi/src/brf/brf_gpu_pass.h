@@ -32,10 +32,14 @@
 // Precision: float32 throughout; the fits sum in float where the CPU sums in double. Relative
 // RMSE against brf_interreflect is ~2e-7 on the test scenes (tests/gi/brf_gpu_pass_test.cpp).
 //
-// Limits: every pair's Phi slot (receiver vertices V_r x receiver terms K_r x source channels
-// C_s = K_s N_s, C_s padded to a multiple of 4) lives in one SSBO, at most 128 MiB (or
-// GL_MAX_SHADER_STORAGE_BLOCK_SIZE): run() reports an error above it (about 115 diffuse
-// instances of 150 vertices and 16 basis functions; glossy pairs take K_r K_s times that).
+// Limits: the Phi slots (receiver vertices V_r x receiver terms K_r x source channels
+// C_s = K_s N_s, C_s padded to a multiple of 4) of the pairs in each other's reach
+// (brf_pair_influence; every ordered pair with the influence limit off) live in one SSBO, at
+// most 128 MiB (or GL_MAX_SHADER_STORAGE_BLOCK_SIZE): run() reports an error above it. A
+// diffuse pair of 150 vertices and 16 basis functions takes 9.6 kB: about 13 900 pairs in
+// reach, e.g. 200+ crates 1.2 m apart (~40 neighbours each); glossy pairs take K_r K_s times
+// that. When the set of pairs in reach changes, the kept slots are copied into a new packed
+// layout (a second buffer of the same size for the copy, released after it).
 // Fields are grouped into buffers under the same limit (one Phi dispatch per buffer); one
 // field above it is an error. A basis has at most 64 functions, a glossy lobe at most
 // kMaxGlossyTerms terms (16 values per vertex with the diffuse one).
@@ -151,6 +155,7 @@ class BrfGpuPass {
     std::size_t pairs_evaluated = 0;  ///< Live (not culled) pairs, as BrfResult counts them.
     std::size_t pairs_culled = 0;
     std::size_t pairs_reused = 0;           ///< Live pairs whose Phi was kept (relative pose unchanged).
+    std::size_t pair_slots = 0;             ///< Pairs in reach holding a Phi slot (culled ones included).
     std::size_t static_sources_reused = 0;  ///< Sources whose static-receiver Phi was kept.
     /// Static receivers inside a moved source's field that see none of it past the world
     /// (set_static_receivers' world), so get none of its bounce; counted per source.
@@ -228,6 +233,11 @@ class BrfGpuPass {
   /// The first bounce's weights and the culled pairs on the CPU, as brf_interreflect.
   void fit_first_and_cull(std::span<const BrfGpuInstance> instances, std::span<const std::vector<glm::vec3>> incoming,
                           float cull_threshold, float influence_scale, FrameData& frame) const;
+  /// Phi slots for this frame's pairs in reach: when they changed, a new packed layout, the
+  /// kept pairs' Phi copied over (through a spare buffer). Errors: slots above the SSBO limit.
+  engine::Status layout_pairs(std::size_t instance_count, const FrameData& frame);
+  /// The slot of pair key source x n + receiver (it must be in reach).
+  PairSlot& pair_slot(std::uint64_t key);
   /// Instance table, live sources per receiver, Phi jobs of moved pairs; updates pairs_, stats_.
   void plan_pairs(std::span<const BrfGpuInstance> instances, FrameData& frame);
   /// Uploads the incoming light, instance table, first weights and live lists; clears indirect_.
@@ -286,12 +296,18 @@ class BrfGpuPass {
   std::vector<std::uint32_t> vertex_offsets_;  ///< Per instance, plus the total.
   std::vector<std::uint32_t> value_offsets_;   ///< Per instance (K x V values each), plus the total.
   std::vector<std::uint32_t> weight_offsets_;
-  std::vector<PairSlot> pairs_;  ///< [source * n + receiver].
+  /// The pairs in each other's reach (brf_pair_influence), sorted by key source x n +
+  /// receiver, and their Phi slots (packed in key order in phi_): memory follows the pairs in
+  /// reach, not n^2. A pair culled by its bound keeps its slot; one that leaves reach loses it.
+  std::vector<std::uint64_t> pair_keys_;
+  std::vector<PairSlot> pairs_;
+  std::size_t phi_floats_ = 0;  ///< Floats of phi_ the slots use.
   std::vector<StaticSlot> static_slots_;
   std::vector<engine::GlBuffer> outputs_;  ///< Per instance: vec4 per vertex.
   std::size_t output_bytes_ = 0;
   Buffer occluders_;  ///< This frame's Phi jobs' occluder records.
   Buffer instance_table_, incoming_, gathered_, indirect_, weights_, phi_, live_, jobs_, groups_;
+  Buffer phi_spare_;  ///< layout_pairs()'s copy target, released after the swap.
   Buffer static_occlusion_;  ///< Per static receiver, the objects' occlusion of its baked light.
   Buffer static_indices_, static_visibility_, static_phi_, static_phi_spare_, static_touched_, static_entries_, static_out_;
   std::uint32_t static_touched_count_ = 0;
