@@ -643,3 +643,62 @@ TEST(BrfGpuPass, PairsOutsideTheInfluenceAreSkippedAsByTheTwin) {
   EXPECT_EQ(pass.stats().pairs_evaluated, 12u);
   EXPECT_LT(vertices_error(pass, cpu(instances, incoming, unlimited)), kTolerance);
 }
+
+// The Phi slots follow the pairs in reach (brf_pair_influence), not n^2: the row of four
+// holds 6 slots; moving the last object away drops its 2 and keeps the others' Phi (reused,
+// copied into the packed layout), coming back brings them again, and every frame matches the
+// twin.
+TEST(BrfGpuPass, PhiSlotsFollowThePairsInReach) {
+  auto ctx = headless_or_fail();
+  gi::BrfGpuPass pass = make_pass();
+  std::vector<gi::BrfGpuInstance> instances;
+  for (int i = 0; i < 4; ++i)
+    instances.push_back({static_cast<std::uint32_t>(i % 2),
+                         pose({3.0f * static_cast<float>(i), 0.0f, 0.1f * static_cast<float>(i)},
+                              0.3f * static_cast<float>(i), {0, 1, 0}),
+                         {0.8f, 0.6f, 0.4f}});
+  const gi::BrfUpdateSettings settings{.bounces = 2, .cull_threshold = 0.0f};
+  auto check = [&](std::size_t slots, std::size_t reused) {
+    const auto incoming = incoming_light(instances, {4.5f, 2.0f, 0.5f}, 20.0f);
+    ASSERT_TRUE(pass.run(instances, incoming, settings).ok());
+    EXPECT_EQ(pass.stats().pair_slots, slots);
+    EXPECT_EQ(pass.stats().pairs_evaluated, slots);
+    EXPECT_EQ(pass.stats().pairs_reused, reused);
+    EXPECT_LT(vertices_error(pass, cpu(instances, incoming, settings)), kTolerance);
+  };
+  check(6, 0);
+  const glm::mat4 home = instances[3].object_to_world;
+  instances[3].object_to_world = pose({40.0f, 0.0f, 0.0f}, 0.0f, {0, 1, 0});
+  check(4, 4);  // 0-1, 1-0, 1-2, 2-1 kept
+  instances[3].object_to_world = home;
+  check(6, 4);  // 2-3 and 3-2 evaluated again
+  check(6, 6);
+}
+
+// 240 cubes 3 m apart on a grid: each reaches its 8 neighbours at most, so the slots of the
+// pairs in reach fit a buffer limit that all n (n - 1) ordered pairs' Phi would exceed 20
+// times over (the cube's pair: its vertices x 8 functions as floats).
+TEST(BrfGpuPass, ManyInstancesFitBecauseOnlyPairsInReachHoldPhi) {
+  auto ctx = headless_or_fail();
+  const std::size_t n = 240;
+  const std::size_t pair_bytes = models().cube.positions.size() * 8 * sizeof(float);
+  const std::size_t limit = pair_bytes * n * (n - 1) / 20;
+  gi::BrfGpuPass pass = make_pass({.max_buffer_bytes = limit});
+  std::vector<gi::BrfGpuInstance> instances;
+  for (std::size_t i = 0; i < n; ++i)
+    instances.push_back({0, pose({3.0f * static_cast<float>(i % 16), 0.0f, 3.0f * static_cast<float>(i / 16)}, 0.1f * static_cast<float>(i), {0, 1, 0}),
+                         {0.8f, 0.6f, 0.4f}});
+  const auto incoming = incoming_light(instances, {20.0f, 3.0f, 20.0f}, 400.0f);
+  const gi::BrfUpdateSettings settings{.bounces = 1, .cull_threshold = 0.0f, .occlusion = false};
+  const auto status = pass.run(instances, incoming, settings);
+  ASSERT_TRUE(status.ok()) << status.error().to_string();
+  EXPECT_GT(pass.stats().pair_slots, n);
+  EXPECT_LE(pass.stats().pair_slots, 8 * n);
+  EXPECT_LT(pass.stats().pair_slots * pair_bytes, limit);
+  // With the influence limit off every ordered pair needs a slot: above the limit, an error
+  // that leaves the last frame's results in place.
+  const auto before = pass.read_back_vertices(17);
+  EXPECT_FALSE(pass.run(instances, incoming, {.bounces = 1, .cull_threshold = 0.0f, .influence_scale = 0.0f}).ok());
+  EXPECT_EQ(pass.read_back_vertices(17), before);
+  EXPECT_TRUE(all_finite(before));
+}
