@@ -16,7 +16,7 @@ struct BrfModel {
   uint vertex_count;
   uint psi_offset;       // first float of Psi (N x vertex_count, basis-major) in the psi buffer
   uint ainv_offset;      // first float of A^-1 (N x N, row-major)
-  uint field_offset;     // first float of the field in its field buffer
+  uint field_offset;     // first float of the field in its field buffer (a multiple of 4)
   uint field_buffer;     // which field buffer (one dispatch per buffer)
   uint terms;            // K: 1 + glossy terms; the field has K x N channels (k x N + i)
   vec4 box_lo;           // xyz: the object's bounding box (object space), brf_object_box
@@ -136,7 +136,8 @@ float brf_sphere_radius(BrfModel m, uint s) {
 }
 
 // The 8 samples around object-space point p, as in BasisRadianceField::sample: first float
-// of each sample's [term][basis][coefficient] block (relative to the field) and its weight
+// of each sample's [term][basis][coefficient] block (relative to the field; on the GPU each
+// channel's coefficients are padded to a multiple of 4, brf_padded) and its weight
 // (trilinear weight x falloff x (r_s / r)^2 between spheres). Returns how many of them carry
 // weight: 8 between two spheres, 4 inside the innermost or beyond the outermost sphere (one
 // shell: samples 4-7 have weight 0, so callers loop over the first `taps` only, which lets
@@ -173,7 +174,7 @@ uint brf_field_corners(BrfModel m, vec3 p, out uint base[8], out float weight[8]
   const int u0 = int(floor(fu)), v0 = int(floor(fv));
   const int u1 = u0 + 1, v1 = v0 + 1;
   const float tu = fu - float(u0), tv = fv - float(v0);
-  const uint per_point = m.terms * m.basis_count * m.sh_bands * m.sh_bands;
+  const uint per_point = m.terms * m.basis_count * brf_padded(m.sh_bands * m.sh_bands);
   const bool between = r > inner && r < outer && m.spheres > 1u;
   const uint cs[8] = uint[8](s0, s0, s0, s0, s1, s1, s1, s1);
   const int cu[8] = int[8](u0, u1, u0, u1, u0, u1, u0, u1);

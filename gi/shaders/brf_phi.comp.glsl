@@ -54,8 +54,12 @@ layout(std430, binding = 2) readonly buffer StaticPoints { vec4 static_points[];
 layout(std430, binding = 3) readonly buffer StaticIndices { uint static_indices[]; };
 layout(std430, binding = 4) readonly buffer Jobs { PhiJob jobs[]; };
 layout(std430, binding = 5) readonly buffer Groups { uvec2 groups[]; };  // (job, first point)
-layout(std430, binding = 6) readonly buffer Field { float field[]; };
+// Each channel's SH coefficients padded to vec4s (3 for 3 bands, 4 for 4; brf_gpu_pass.cpp's
+// gpu_field): llvmpipe (Mesa 22) runs each SSBO load as a loop over the SIMD lanes, so one
+// vec4 load costs about what one float load does.
+layout(std430, binding = 6) readonly buffer Field { vec4 field[]; };
 layout(std430, binding = 7) writeonly buffer Phi { float phi[]; };
+layout(std430, binding = 7) writeonly buffer Phi4 { vec4 phi4[]; };  // the same buffer, rows are C4 floats
 // sh_rotation_tables(): 26 directions (vec4 each, 104 floats), the pinv of bands 1..3
 // (3, 5, 7 rows x 26, row-major), then the glossy models' lobe SH and vertex frames.
 layout(std430, binding = 8) readonly buffer ShData { float sh_data[]; };
@@ -174,14 +178,14 @@ void main() {
   const uint row0 = job.phi_offset + k * rows * c4;
   const uint side = brf_horizon(m, p, n);
   if (side == 0u) {  // the source is behind the tangent plane: no light
-    for (uint i = 0u; i < rows * c4; ++i) phi[row0 + i] = 0.0;
+    for (uint i = 0u; i < rows * c4; i += 4u) phi4[(row0 + i) / 4u] = vec4(0.0);
     return;
   }
   // What the point sees of the source past the objects in the pair's way (1 without any).
   const float vis = contact_visibility(m, p, n) *
                     (job.occluder_count == 0u ? 1.0 : occluded_visibility(m, p, n, job.occluder_offset, job.occluder_count));
   if (vis == 0.0) {
-    for (uint i = 0u; i < rows * c4; ++i) phi[row0 + i] = 0.0;
+    for (uint i = 0u; i < rows * c4; i += 4u) phi4[(row0 + i) / 4u] = vec4(0.0);
     return;
   }
   float lobe[16];
@@ -192,28 +196,34 @@ void main() {
   uint base[8];
   float weight[8];
   const uint taps = brf_field_corners(m, p, base, weight);
-  const uint cc = m.sh_bands * m.sh_bands;
-  for (uint r = 0u; r < rows; ++r)
-    for (uint i = nc; i < c4; ++i) phi[row0 + r * c4 + i] = 0.0;
+  const uint cc = m.sh_bands * m.sh_bands, cq = brf_padded(cc) / 4u;  // vec4s per channel
 
 #ifndef BRF_GLOSSY_RECEIVER
   {  // a diffuse receiver or static point: the irradiance row only
     const float scale = (u_kind == 1u ? static_visibility[job.point_offset + k] : 1.0) * vis;
-    // The unclamped cosine in front is band 1 only: coefficients 1-3 (the others are 0, so
-    // skipping them changes no sum). Loops with per-invocation bounds rather than `continue`:
-    // llvmpipe leaves a loop once every lane of the SIMD group is done, where a skipped
-    // iteration would still run masked. The mesh's vertices come face by face, so a group's
-    // lanes mostly share the side and the tap count.
-    const uint q0 = side == 1u ? 1u : 0u, q1 = side == 1u ? 4u : cc;
-    for (uint i = 0u; i < nc; ++i) {
-      float sum = 0.0;
-      for (uint c = 0u; c < taps; ++c) {
-        const uint at = m.field_offset + base[c] + i * cc;
-        float d = 0.0;
-        for (uint q = q0; q < q1; ++q) d += field[at + q] * lobe[q];
-        sum += weight[c] * d;
+    // The unclamped cosine in front is band 1 only: the first vec4 (its coefficient 0 is 0,
+    // the others are 0, so skipping them changes no sum). Loops with per-invocation bounds
+    // rather than `continue`: llvmpipe leaves a loop once every lane of the SIMD group is
+    // done, where a skipped iteration would still run masked. The mesh's vertices come face
+    // by face, so a group's lanes mostly share the side and the tap count. Phi is written four
+    // channels at a time (the row's pads get 0).
+    const uint q1 = side == 1u ? 1u : cq;
+    const vec4 l0 = vec4(lobe[0], lobe[1], lobe[2], lobe[3]), l1 = vec4(lobe[4], lobe[5], lobe[6], lobe[7]),
+               l2 = vec4(lobe[8], lobe[9], lobe[10], lobe[11]), l3 = vec4(lobe[12], lobe[13], lobe[14], lobe[15]);
+    for (uint i4 = 0u; i4 < c4; i4 += 4u) {
+      vec4 out4 = vec4(0.0);
+      for (uint j = 0u; j < 4u; ++j) {
+        const uint i = i4 + j;
+        float sum = 0.0;
+        for (uint c = 0u; c < (i < nc ? taps : 0u); ++c) {
+          const uint at = (m.field_offset + base[c]) / 4u + i * cq;
+          float d = 0.0;
+          for (uint q = 0u; q < q1; ++q) d += dot(field[at + q], q == 0u ? l0 : q == 1u ? l1 : q == 2u ? l2 : l3);
+          sum += weight[c] * d;
+        }
+        out4[j] = sum * scale;
       }
-      phi[row0 + i] = sum * scale;
+      phi4[(row0 + i4) / 4u] = out4;
     }
     return;
   }
@@ -253,14 +263,17 @@ void main() {
       }
     }
   }
+  for (uint r = 0u; r < rows; ++r)
+    for (uint i = nc; i < c4; ++i) phi[row0 + r * c4 + i] = 0.0;
   // Per channel, the sample interpolated as BasisRadianceField::sample does, dotted with every row's lobe.
   for (uint i = 0u; i < nc; ++i) {
-    float coeffs[16];
-    for (uint q = 0u; q < cc; ++q) coeffs[q] = 0.0;
+    vec4 coeffs4[4] = vec4[4](vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0));
     for (uint c = 0u; c < taps; ++c) {
-      const uint at = m.field_offset + base[c] + i * cc;
-      for (uint q = 0u; q < cc; ++q) coeffs[q] += weight[c] * field[at + q];
+      const uint at = (m.field_offset + base[c]) / 4u + i * cq;
+      for (uint q = 0u; q < cq; ++q) coeffs4[q] += weight[c] * field[at + q];
     }
+    float coeffs[16];
+    for (uint q = 0u; q < 16u; ++q) coeffs[q] = coeffs4[q / 4u][q % 4u];
     for (uint r = 0u; r < rows; ++r) {
       float d = 0.0;
       for (uint q = 0u; q < cc; ++q) d += coeffs[q] * lobes[r * 16u + q];

@@ -85,6 +85,24 @@ std::vector<glm::vec3> read_back_vec4s(std::uint32_t buffer, std::size_t count) 
 
 std::uint32_t padded(std::uint32_t basis_count) { return (basis_count + 3u) & ~3u; }
 
+/// The field as the GPU holds it: each channel's coefficients padded to a multiple of 4
+/// floats (9 -> 12 for 3 bands), so brf_phi.comp.glsl reads them as vec4s. llvmpipe (Mesa 22)
+/// runs every SSBO load as a loop over the SIMD lanes, so a vec4 costs about what one float
+/// does: 3 loads per (sample, channel) instead of 9, 1 for the unclamped cosine's band 1.
+std::size_t gpu_field_floats(const BasisRadianceField& f) {
+  const std::size_t cc = static_cast<std::size_t>(f.coefficient_count());
+  return f.coefficients.size() / cc * padded(static_cast<std::uint32_t>(cc));
+}
+std::size_t gpu_field_bytes(const BasisRadianceField& f) { return gpu_field_floats(f) * sizeof(float); }
+std::vector<float> gpu_field(const BasisRadianceField& f) {
+  const std::size_t cc = static_cast<std::size_t>(f.coefficient_count()), cc4 = padded(static_cast<std::uint32_t>(cc));
+  std::vector<float> out(gpu_field_floats(f), 0.0f);
+  for (std::size_t c = 0; c < f.coefficients.size() / cc; ++c)
+    std::copy_n(f.coefficients.begin() + static_cast<std::ptrdiff_t>(c * cc), cc,
+                out.begin() + static_cast<std::ptrdiff_t>(c * cc4));
+  return out;
+}
+
 engine::Result<engine::ShaderProgram> build(const char* file) {
   return engine::ShaderProgramBuilder(gi_shader_files()).stage(engine::ShaderStage::Compute, file).build();
 }
@@ -167,8 +185,8 @@ engine::Status check_model(const BrfGpuModel& model, std::size_t m, std::size_t 
   if (f.coefficients.size() != points * channels * static_cast<std::size_t>(f.coefficient_count()))
     return error(which + "field holds " + std::to_string(f.coefficients.size()) + " floats, expected " +
                  std::to_string(points * channels * static_cast<std::size_t>(f.coefficient_count())));
-  if (f.bytes() > limit)
-    return error(which + "field of " + std::to_string(f.bytes()) + " bytes is above the SSBO limit of " +
+  if (gpu_field_bytes(f) > limit)
+    return error(which + "field of " + std::to_string(gpu_field_bytes(f)) + " bytes (channels padded to vec4s) is above the SSBO limit of " +
                  std::to_string(limit));
   for (std::size_t j = 0; j < nv; ++j)
     if (!engine::all_finite(mesh.positions[j]) || !engine::all_finite(mesh.normals[j]))
@@ -263,11 +281,11 @@ void BrfGpuPass::add_model(const BrfGpuModel& model, std::size_t limit, ModelDat
   g.psi_offset = u32(data.psi.size());
   g.ainv_offset = u32(data.a_inverse.size());
   std::vector<std::size_t>& groups = data.field_group_bytes;
-  if (groups.empty() || groups.back() + f.bytes() > limit) groups.push_back(0);
+  if (groups.empty() || groups.back() + gpu_field_bytes(f) > limit) groups.push_back(0);
   g.field_buffer = u32(groups.size() - 1);
   g.terms = u32(static_cast<std::size_t>(f.terms));
   g.field_offset = u32(groups.back() / sizeof(float));
-  groups.back() += f.bytes();
+  groups.back() += gpu_field_bytes(f);
   data.table.push_back(g);
   for (std::size_t j = 0; j < model.mesh->positions.size(); ++j) {
     data.vertices.emplace_back(model.mesh->positions[j], 1.0f);
@@ -321,7 +339,7 @@ void BrfGpuPass::upload_models(std::span<const BrfGpuModel> models, const ModelD
     const BasisRadianceField& f = *models[m].field;
     glNamedBufferSubData(fields_[data.table[m].field_buffer].id(),
                          static_cast<GLintptr>(data.table[m].field_offset * sizeof(float)),
-                         static_cast<GLsizeiptr>(f.bytes()), f.coefficients.data());
+                         static_cast<GLsizeiptr>(gpu_field_bytes(f)), gpu_field(f).data());
   }
   if (fields_.empty()) fields_.push_back(engine::GlBuffer::create(16, nullptr, GL_DYNAMIC_STORAGE_BIT));
   static_out_.reserve(16);
