@@ -54,10 +54,12 @@ layout(std430, binding = 2) readonly buffer StaticPoints { vec4 static_points[];
 layout(std430, binding = 3) readonly buffer StaticIndices { uint static_indices[]; };
 layout(std430, binding = 4) readonly buffer Jobs { PhiJob jobs[]; };
 layout(std430, binding = 5) readonly buffer Groups { uvec2 groups[]; };  // (job, first point)
-// Each channel's SH coefficients padded to vec4s (3 for 3 bands, 4 for 4; brf_gpu_pass.cpp's
-// gpu_field): llvmpipe (Mesa 22) runs each SSBO load as a loop over the SIMD lanes, so one
-// vec4 load costs about what one float load does.
-layout(std430, binding = 6) readonly buffer Field { vec4 field[]; };
+// The field: each channel's SH coefficients padded to vec4s (3 for 3 bands, 4 for 4;
+// brf_gpu_pass.cpp's gpu_field), read through a GL_RGBA32F buffer texture on unit 0:
+// llvmpipe (Mesa 22) runs each SSBO load as a scalar loop over the SIMD lanes, a texel fetch
+// as one vector gather.
+layout(binding = 0) uniform samplerBuffer u_field;
+vec4 field_at(uint i) { return texelFetch(u_field, int(i)); }
 layout(std430, binding = 7) writeonly buffer Phi { float phi[]; };
 layout(std430, binding = 7) writeonly buffer Phi4 { vec4 phi4[]; };  // the same buffer, rows are C4 floats
 // sh_rotation_tables(): 26 directions (vec4 each, 104 floats), the pinv of bands 1..3
@@ -218,7 +220,7 @@ void main() {
         for (uint c = 0u; c < (i < nc ? taps : 0u); ++c) {
           const uint at = (m.field_offset + base[c]) / 4u + i * cq;
           float d = 0.0;
-          for (uint q = 0u; q < q1; ++q) d += dot(field[at + q], q == 0u ? l0 : q == 1u ? l1 : q == 2u ? l2 : l3);
+          for (uint q = 0u; q < q1; ++q) d += dot(field_at(at + q), q == 0u ? l0 : q == 1u ? l1 : q == 2u ? l2 : l3);
           sum += weight[c] * d;
         }
         out4[j] = sum * scale;
@@ -270,7 +272,7 @@ void main() {
     vec4 coeffs4[4] = vec4[4](vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0));
     for (uint c = 0u; c < taps; ++c) {
       const uint at = (m.field_offset + base[c]) / 4u + i * cq;
-      for (uint q = 0u; q < cq; ++q) coeffs4[q] += weight[c] * field[at + q];
+      for (uint q = 0u; q < cq; ++q) coeffs4[q] += weight[c] * field_at(at + q);
     }
     float coeffs[16];
     for (uint q = 0u; q < 16u; ++q) coeffs[q] = coeffs4[q / 4u][q % 4u];

@@ -20,6 +20,7 @@ constexpr const char* kWhere = "BRF GPU pass";
 constexpr std::size_t kSsboLimitBytes = std::size_t{128} << 20;  // DESIGN.md §4 (llvmpipe)
 constexpr std::uint32_t kGroupSize = 64;                         // local_size_x of every brf_*.comp.glsl
 constexpr std::uint32_t kMaxGroupsPerDimension = 65535;
+constexpr GLuint kFieldTextureUnit = 0;  // u_field in brf_phi.comp.glsl
 constexpr int kMaxBasis = 64;  // kMaxChannels = 64 x 16 in brf_fit.comp.glsl
 // sh_data_ layout (ShData in brf_phi.comp.glsl): 26 directions as vec4s, then the pinv of
 // bands 1..3, then the glossy models' lobe SH and vertex frames.
@@ -227,6 +228,8 @@ struct BrfGpuPass::ModelData {
 engine::Result<BrfGpuPass> BrfGpuPass::create(std::span<const BrfGpuModel> models, const BrfGpuPassOptions& options) {
   // Check the data before acquiring anything.
   std::size_t limit = std::min(kSsboLimitBytes, gl_limit(GL_MAX_SHADER_STORAGE_BLOCK_SIZE));
+  // The fields are read through RGBA32F buffer textures too (field_textures_).
+  limit = std::min(limit, gl_limit(GL_MAX_TEXTURE_BUFFER_SIZE) * 16);
   if (options.max_buffer_bytes > 0) limit = std::min(limit, options.max_buffer_bytes);
   if (!(options.pose_tolerance >= 0.0f)) return error("pose tolerance must be >= 0");
   for (std::size_t m = 0; m < models.size(); ++m)
@@ -342,6 +345,10 @@ void BrfGpuPass::upload_models(std::span<const BrfGpuModel> models, const ModelD
                          static_cast<GLsizeiptr>(gpu_field_bytes(f)), gpu_field(f).data());
   }
   if (fields_.empty()) fields_.push_back(engine::GlBuffer::create(16, nullptr, GL_DYNAMIC_STORAGE_BIT));
+  for (const engine::GlBuffer& b : fields_) {
+    field_textures_.push_back(engine::GlTexture::create(GL_TEXTURE_BUFFER));
+    glTextureBuffer(field_textures_.back().id(), GL_RGBA32F, b.id());
+  }
   static_out_.reserve(16);
   static_points_.reserve(16);
 }
@@ -452,7 +459,7 @@ void BrfGpuPass::dispatch_phi(std::span<const BrfPhiJob> jobs, bool static_kind)
     for (std::size_t b = 0; b < nf; ++b) {
       const auto [first, count] = ranges[v * nf + b];
       if (count == 0) continue;
-      bind(6, fields_[b].id());
+      glBindTextureUnit(kFieldTextureUnit, field_textures_[b].id());
       glProgramUniform1ui(id, glGetUniformLocation(id, "u_first_group"), first);
       glProgramUniform1ui(id, glGetUniformLocation(id, "u_group_count"), count);
       dispatch_groups(count);

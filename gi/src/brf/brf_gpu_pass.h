@@ -282,6 +282,9 @@ class BrfGpuPass {
   /// SH rotation tables, then the glossy models' lobe SH and object-space vertex frames.
   engine::GlBuffer sh_data_;
   std::vector<engine::GlBuffer> fields_;
+  /// Per field buffer, a GL_RGBA32F buffer texture over it: brf_phi.comp.glsl reads the field
+  /// through texelFetch (llvmpipe gathers texels as vectors; its SSBO loads loop over the lanes).
+  std::vector<engine::GlTexture> field_textures_;
   std::size_t model_bytes_ = 0;
 
   // Static receivers.
