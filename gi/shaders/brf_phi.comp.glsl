@@ -48,11 +48,15 @@ struct BrfOccluderRecord {
   vec4 hi;
 };
 
-layout(std430, binding = 0) readonly buffer Models { BrfModel models[]; };
-layout(std430, binding = 1) readonly buffer ModelVertices { vec4 model_vertices[]; };  // position, normal per vertex
+// Read-only per-dispatch data through buffer textures too (texel gathers, not lane loops):
+// unit 1 the model table (6 uvec4 per BrfModel), 2 the model vertices (position, normal per
+// vertex), 3 the jobs (15 uvec4 per PhiJob), 4 the occluder records (6 uvec4 each).
+layout(binding = 1) uniform usamplerBuffer u_models;
+layout(binding = 2) uniform samplerBuffer u_model_vertices;
+layout(binding = 3) uniform usamplerBuffer u_jobs;
+layout(binding = 4) uniform usamplerBuffer u_occluders;
 layout(std430, binding = 2) readonly buffer StaticPoints { vec4 static_points[]; };    // position, normal per receiver
 layout(std430, binding = 3) readonly buffer StaticIndices { uint static_indices[]; };
-layout(std430, binding = 4) readonly buffer Jobs { PhiJob jobs[]; };
 layout(std430, binding = 5) readonly buffer Groups { uvec2 groups[]; };  // (job, first point)
 // The field: each channel's SH coefficients padded to vec4s (3 for 3 bands, 4 for 4;
 // brf_gpu_pass.cpp's gpu_field), read through a GL_RGBA32F buffer texture on unit 0:
@@ -68,7 +72,57 @@ layout(std430, binding = 8) readonly buffer ShData { float sh_data[]; };
 // u_kind 1: per static_indices entry, the fraction of the source that receiver sees past the
 // static world (brf_static_visibility); the row is scaled by it.
 layout(std430, binding = 9) readonly buffer StaticVisibility { float static_visibility[]; };
-layout(std430, binding = 10) readonly buffer Occluders { BrfOccluderRecord occluders[]; };
+
+vec4 texel_f(usamplerBuffer t, uint i) { return uintBitsToFloat(texelFetch(t, int(i))); }
+mat4 texel_mat4(usamplerBuffer t, uint i) {
+  return mat4(texel_f(t, i), texel_f(t, i + 1u), texel_f(t, i + 2u), texel_f(t, i + 3u));
+}
+
+BrfModel load_model(uint index) {  // BrfModel in brf_common.glsl, std430
+  const uint at = 6u * index;
+  BrfModel m;
+  m.centre_inner = texel_f(u_models, at);
+  const uvec4 a = texelFetch(u_models, int(at + 1u)), b = texelFetch(u_models, int(at + 2u)),
+              c = texelFetch(u_models, int(at + 3u));
+  m.outer_radius = uintBitsToFloat(a.x);
+  m.spheres = a.y;
+  m.face_resolution = a.z;
+  m.sh_bands = a.w;
+  m.basis_count = b.x;
+  m.vertex_offset = b.y;
+  m.vertex_count = b.z;
+  m.psi_offset = b.w;
+  m.ainv_offset = c.x;
+  m.field_offset = c.y;
+  m.field_buffer = c.z;
+  m.terms = c.w;
+  m.box_lo = texel_f(u_models, at + 4u);
+  m.box_hi = texel_f(u_models, at + 5u);
+  return m;
+}
+
+PhiJob load_job(uint index) {  // PhiJob above, std430
+  const uint at = 15u * index;
+  PhiJob j;
+  j.to_source = texel_mat4(u_jobs, at);
+  j.normal_to_source = texel_mat4(u_jobs, at + 4u);
+  const uvec4 a = texelFetch(u_jobs, int(at + 8u)), b = texelFetch(u_jobs, int(at + 13u)),
+              c = texelFetch(u_jobs, int(at + 14u));
+  j.source_model = a.x;
+  j.point_offset = a.y;
+  j.point_count = a.z;
+  j.phi_offset = a.w;
+  j.frame_to_source = texel_mat4(u_jobs, at + 9u);
+  j.rows = b.x;
+  j.frame_offset = b.y;
+  j.lobe_offset = b.z;
+  j.pad0 = b.w;
+  j.occluder_offset = c.x;
+  j.occluder_count = c.y;
+  j.pad1 = c.z;
+  j.pad2 = c.w;
+  return j;
+}
 
 uniform uint u_first_group;
 uniform uint u_group_count;
@@ -81,17 +135,19 @@ const uint kMaxRows = 16u;  // 1 + kMaxGlossyTerms
 // brf_segment_clear (brf_visibility.cpp): the segment a -> b misses every box of the job's occluders.
 bool segment_clear(vec3 a, vec3 b, uint first, uint count) {
   for (uint o = first; o < first + count; ++o) {
-    const vec3 p = (occluders[o].to_occluder * vec4(a, 1.0)).xyz;
-    const vec3 d = (occluders[o].to_occluder * vec4(b, 1.0)).xyz - p;
+    const mat4 to_occluder = texel_mat4(u_occluders, 6u * o);
+    const vec3 lo = texel_f(u_occluders, 6u * o + 4u).xyz, hi = texel_f(u_occluders, 6u * o + 5u).xyz;
+    const vec3 p = (to_occluder * vec4(a, 1.0)).xyz;
+    const vec3 d = (to_occluder * vec4(b, 1.0)).xyz - p;
     float t0 = 0.0, t1 = 1.0;
     bool miss = false;
     for (int k = 0; k < 3 && !miss; ++k) {
       if (abs(d[k]) < 1e-12) {
-        miss = p[k] < occluders[o].lo[k] || p[k] > occluders[o].hi[k];
+        miss = p[k] < lo[k] || p[k] > hi[k];
         continue;
       }
       const float inv = 1.0 / d[k];
-      float ta = (occluders[o].lo[k] - p[k]) * inv, tb = (occluders[o].hi[k] - p[k]) * inv;
+      float ta = (lo[k] - p[k]) * inv, tb = (hi[k] - p[k]) * inv;
       if (ta > tb) {
         const float t = ta;
         ta = tb;
@@ -158,14 +214,14 @@ void main() {
   if (group >= u_group_count) return;
   const uvec2 g = groups[u_first_group + group];
   const uint k = g.y + gl_LocalInvocationIndex;
-  if (k >= jobs[g.x].point_count) return;
-  const PhiJob job = jobs[g.x];
+  const PhiJob job = load_job(g.x);
+  if (k >= job.point_count) return;
 
   vec3 p_in, n_in;
   if (u_kind == 0u) {
     const uint v = job.point_offset + k;
-    p_in = model_vertices[2u * v].xyz;
-    n_in = model_vertices[2u * v + 1u].xyz;
+    p_in = texelFetch(u_model_vertices, int(2u * v)).xyz;
+    n_in = texelFetch(u_model_vertices, int(2u * v + 1u)).xyz;
   } else {
     const uint t = static_indices[job.point_offset + k];
     p_in = static_points[2u * t].xyz;
@@ -174,7 +230,7 @@ void main() {
   const vec3 p = (job.to_source * vec4(p_in, 1.0)).xyz;
   const vec3 n = normalize(mat3(job.normal_to_source) * n_in);
 
-  const BrfModel m = models[job.source_model];
+  const BrfModel m = load_model(job.source_model);
   const uint nc = m.basis_count * m.terms, c4 = brf_padded(nc);
   const uint rows = job.rows;
   const uint row0 = job.phi_offset + k * rows * c4;

@@ -20,7 +20,10 @@ constexpr const char* kWhere = "BRF GPU pass";
 constexpr std::size_t kSsboLimitBytes = std::size_t{128} << 20;  // DESIGN.md §4 (llvmpipe)
 constexpr std::uint32_t kGroupSize = 64;                         // local_size_x of every brf_*.comp.glsl
 constexpr std::uint32_t kMaxGroupsPerDimension = 65535;
-constexpr GLuint kFieldTextureUnit = 0;  // u_field in brf_phi.comp.glsl
+// Texture units of brf_phi.comp.glsl's buffer textures (u_field, u_models, u_model_vertices,
+// u_jobs, u_occluders).
+constexpr GLuint kFieldTextureUnit = 0, kModelTextureUnit = 1, kVertexTextureUnit = 2, kJobTextureUnit = 3,
+                 kOccluderTextureUnit = 4;
 constexpr int kMaxBasis = 64;  // kMaxChannels = 64 x 16 in brf_fit.comp.glsl
 // sh_data_ layout (ShData in brf_phi.comp.glsl): 26 directions as vec4s, then the pinv of
 // bands 1..3, then the glossy models' lobe SH and vertex frames.
@@ -349,6 +352,12 @@ void BrfGpuPass::upload_models(std::span<const BrfGpuModel> models, const ModelD
     field_textures_.push_back(engine::GlTexture::create(GL_TEXTURE_BUFFER));
     glTextureBuffer(field_textures_.back().id(), GL_RGBA32F, b.id());
   }
+  model_texture_ = engine::GlTexture::create(GL_TEXTURE_BUFFER);
+  glTextureBuffer(model_texture_.id(), GL_RGBA32UI, model_table_.id());
+  vertex_texture_ = engine::GlTexture::create(GL_TEXTURE_BUFFER);
+  glTextureBuffer(vertex_texture_.id(), GL_RGBA32F, model_vertices_.id());
+  job_texture_ = engine::GlTexture::create(GL_TEXTURE_BUFFER);
+  occluder_texture_ = engine::GlTexture::create(GL_TEXTURE_BUFFER);
   static_out_.reserve(16);
   static_points_.reserve(16);
 }
@@ -441,16 +450,19 @@ void BrfGpuPass::dispatch_phi(std::span<const BrfPhiJob> jobs, bool static_kind)
   jobs_.upload(jobs.data(), jobs.size() * sizeof(BrfPhiJob));
   groups_.upload(groups.data(), groups.size() * sizeof(glm::uvec2));
 
-  bind(0, model_table_.id());
-  bind(1, model_vertices_.id());
+  if (occluders_.buffer.empty()) occluders_.reserve(16);
+  glTextureBuffer(job_texture_.id(), GL_RGBA32UI, jobs_.buffer.id());
+  glTextureBuffer(occluder_texture_.id(), GL_RGBA32UI, occluders_.buffer.id());
+  glBindTextureUnit(kModelTextureUnit, model_texture_.id());
+  glBindTextureUnit(kVertexTextureUnit, vertex_texture_.id());
+  glBindTextureUnit(kJobTextureUnit, job_texture_.id());
+  glBindTextureUnit(kOccluderTextureUnit, occluder_texture_.id());
   bind(2, static_points_.buffer.id());
   bind(3, static_indices_.buffer.empty() ? static_points_.buffer.id() : static_indices_.buffer.id());
-  bind(4, jobs_.buffer.id());
   bind(5, groups_.buffer.id());
   bind(7, static_kind ? static_phi_.buffer.id() : phi_.buffer.id());
   bind(8, sh_data_.id());
   bind(9, static_visibility_.buffer.empty() ? static_points_.buffer.id() : static_visibility_.buffer.id());
-  bind(10, occluders_.buffer.empty() ? static_points_.buffer.id() : occluders_.buffer.id());
   for (std::size_t v = 0; v < 2; ++v) {
     const engine::ShaderProgram& program = v == 0 ? programs_.phi : programs_.phi_glossy;
     const GLuint id = program.id();

@@ -45,7 +45,7 @@
 // kMaxGlossyTerms terms (16 values per vertex with the diffuse one).
 //
 // GL state: create(), run(), set_static_receivers() and the read-backs need the creating
-// context current; they change the bound program and shader-storage bindings 0-10.
+// context current; they change the bound program and shader-storage bindings 0-10 and texture units 0-4.
 
 #include <engine/gpu/gl_objects.h>
 #include <engine/gpu/shader_program.h>
@@ -285,6 +285,9 @@ class BrfGpuPass {
   /// Per field buffer, a GL_RGBA32F buffer texture over it: brf_phi.comp.glsl reads the field
   /// through texelFetch (llvmpipe gathers texels as vectors; its SSBO loads loop over the lanes).
   std::vector<engine::GlTexture> field_textures_;
+  /// Buffer textures over the model table, the model vertices (both at create()), the Phi jobs
+  /// and their occluder records (attached at each dispatch): brf_phi.comp.glsl's read-only data.
+  engine::GlTexture model_texture_, vertex_texture_, job_texture_, occluder_texture_;
   std::size_t model_bytes_ = 0;
 
   // Static receivers.
