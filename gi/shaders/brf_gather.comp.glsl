@@ -12,12 +12,15 @@
 
 layout(local_size_x = 64) in;
 
-layout(std430, binding = 0) readonly buffer Instances { BrfInstance instances[]; };
-layout(std430, binding = 1) readonly buffer Models { BrfModel models[]; };
-// Per live (source, receiver) pair: (source's first weight vec4, first Phi vec4 of the pair, C4 / 4, source).
-layout(std430, binding = 2) readonly buffer LiveSources { uvec4 live_sources[]; };
-layout(std430, binding = 3) readonly buffer Weights { vec4 weights[]; };          // rgb per channel, pads 0
-layout(std430, binding = 4) readonly buffer Phi { vec4 phi[]; };                  // rows of C4 floats, pads 0
+// The read-only inputs are buffer textures: llvmpipe (Mesa 22) runs each SSBO load as a loop
+// over the SIMD lanes, a texel fetch is one gather.
+// Unit 0: the instance table, 4 uvec4 per BrfInstance (texel 2: model, vertex_offset,
+// vertex_count, weight_offset; 3: live_first, live_count, value_offset, terms).
+layout(binding = 0) uniform usamplerBuffer u_instances;
+// Unit 1: per live (source, receiver) pair: (source's first weight vec4, first Phi vec4 of the pair, C4 / 4, source).
+layout(binding = 1) uniform usamplerBuffer u_live_sources;
+layout(binding = 2) uniform samplerBuffer u_weights;  // rgb per channel, pads 0
+layout(binding = 3) uniform samplerBuffer u_phi;      // rows of C4 floats, pads 0
 layout(std430, binding = 5) writeonly buffer Gathered { vec4 gathered[]; };
 layout(std430, binding = 6) buffer Indirect { vec4 indirect[]; };
 
@@ -34,29 +37,31 @@ void main() {
   uint lo = 0u, hi = u_instance_count - 1u;
   while (lo < hi) {
     const uint mid = (lo + hi + 1u) / 2u;
-    if (instances[mid].vertex_offset <= gv) lo = mid; else hi = mid - 1u;
+    if (texelFetch(u_instances, int(4u * mid + 2u)).y <= gv) lo = mid; else hi = mid - 1u;
   }
-  const BrfInstance inst = instances[lo];
-  const uint j = gv - inst.vertex_offset;
-  const uint rows = inst.terms;
+  const uvec4 ia = texelFetch(u_instances, int(4u * lo + 2u)), ib = texelFetch(u_instances, int(4u * lo + 3u));
+  const uint vertex_offset = ia.y, vertex_count = ia.z, live_first = ib.x, live_count = ib.y, value_offset = ib.z;
+  const uint j = gv - vertex_offset;
+  const uint rows = ib.w;
   vec3 e[kMaxRows];
   for (uint r = 0u; r < rows; ++r) e[r] = vec3(0.0);
-  for (uint l = 0u; l < inst.live_count; ++l) {
-    const uvec4 src = live_sources[inst.live_first + l];
+  for (uint l = 0u; l < live_count; ++l) {
+    const uvec4 src = texelFetch(u_live_sources, int(live_first + l));
     const uint q4 = src.z;
     for (uint r = 0u; r < rows; ++r) {
       const uint at = src.y + (j * rows + r) * q4;
       vec3 pair = vec3(0.0);
       for (uint q = 0u; q < q4; ++q) {
-        const vec4 p = phi[at + q];
-        const uint w = src.x + 4u * q;
-        pair += p.x * weights[w].xyz + p.y * weights[w + 1u].xyz + p.z * weights[w + 2u].xyz + p.w * weights[w + 3u].xyz;
+        const vec4 p = texelFetch(u_phi, int(at + q));
+        const int w = int(src.x + 4u * q);
+        pair += p.x * texelFetch(u_weights, w).xyz + p.y * texelFetch(u_weights, w + 1).xyz +
+                p.z * texelFetch(u_weights, w + 2).xyz + p.w * texelFetch(u_weights, w + 3).xyz;
       }
       e[r] += r == 0u ? max(pair, vec3(0.0)) : pair;  // SH ringing must not make the irradiance negative
     }
   }
   for (uint r = 0u; r < rows; ++r) {
-    const uint at = inst.value_offset + r * inst.vertex_count + j;
+    const uint at = value_offset + r * vertex_count + j;
     gathered[at] = vec4(e[r], 0.0);
     indirect[at] += vec4(e[r], 0.0);
   }

@@ -357,6 +357,7 @@ void BrfGpuPass::upload_models(std::span<const BrfGpuModel> models, const ModelD
   vertex_texture_ = engine::GlTexture::create(GL_TEXTURE_BUFFER);
   glTextureBuffer(vertex_texture_.id(), GL_RGBA32F, model_vertices_.id());
   job_texture_ = engine::GlTexture::create(GL_TEXTURE_BUFFER);
+  for (engine::GlTexture& t : gather_textures_) t = engine::GlTexture::create(GL_TEXTURE_BUFFER);
   occluder_texture_ = engine::GlTexture::create(GL_TEXTURE_BUFFER);
   static_out_.reserve(16);
   static_points_.reserve(16);
@@ -939,13 +940,16 @@ void BrfGpuPass::dispatch_gather(std::size_t instance_count) {
   programs_.gather.use();
   glProgramUniform1ui(id, glGetUniformLocation(id, "u_instance_count"), u32(instance_count));
   glProgramUniform1ui(id, glGetUniformLocation(id, "u_vertex_total"), vertex_total);
-  bind(0, instance_table_.buffer.id());
-  bind(1, model_table_.id());
-  bind(2, live_.buffer.id());
-  bind(3, weights_.buffer.id());
-  bind(4, phi_.buffer.id());
+  // Inputs through buffer textures (units 0-3; their buffers may have been re-created).
+  const std::pair<const Buffer*, GLenum> inputs[4] = {
+      {&instance_table_, GL_RGBA32UI}, {&live_, GL_RGBA32UI}, {&weights_, GL_RGBA32F}, {&phi_, GL_RGBA32F}};
+  for (GLuint u = 0; u < 4; ++u) {
+    glTextureBuffer(gather_textures_[u].id(), inputs[u].second, inputs[u].first->buffer.id());
+    glBindTextureUnit(u, gather_textures_[u].id());
+  }
   bind(5, gathered_.buffer.id());
   bind(6, indirect_.buffer.id());
+  glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);  // Phi and weights were written as storage
   dispatch_groups((vertex_total + kGroupSize - 1) / kGroupSize);
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
 }

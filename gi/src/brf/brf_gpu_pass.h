@@ -288,6 +288,8 @@ class BrfGpuPass {
   /// Buffer textures over the model table, the model vertices (both at create()), the Phi jobs
   /// and their occluder records (attached at each dispatch): brf_phi.comp.glsl's read-only data.
   engine::GlTexture model_texture_, vertex_texture_, job_texture_, occluder_texture_;
+  /// brf_gather.comp.glsl's inputs (instance table, live sources, weights, Phi), attached at each dispatch.
+  engine::GlTexture gather_textures_[4];
   std::size_t model_bytes_ = 0;
 
   // Static receivers.
