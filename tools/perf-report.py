@@ -105,17 +105,21 @@ def main():
     # BRF.
     lines.append("### BRF: all crates moving, default culling (1e-3), influence limit off (before) and on (`brf_bench`)")
     lines.append("")
-    lines.append("| crates | all pairs | pairs evaluated (off → on) | GPU ms off | GPU ms on |")
-    lines.append("|---|---|---|---|---|")
+    lines.append("| crates | all pairs | pairs evaluated (off → on) | GPU ms off | GPU ms on | process CPU ms on | Phi slots / GPU MB on |")
+    lines.append("|---|---|---|---|---|---|---|")
     series = {}
     for name, e in brf.items():
         m = re.match(r"BM_BrfGpuInfluence/(\d+)/(\d)", name)
         if m:
             series.setdefault(int(m.group(2)), {})[int(m.group(1))] = e
-    for n in sorted(series.get(0, {})):
-        off, on = series[0].get(n), series.get(1, {}).get(n)
-        lines.append(f"| {n} | {int(off['all_pairs'])} | {int(off['pairs_evaluated'])} → "
-                     f"{int(on['pairs_evaluated']) if on else '—'} | {fmt(ms(off))} | {fmt(ms(on)) if on else '—'} |")
+    for n in sorted(set(series.get(0, {})) | set(series.get(1, {}))):
+        off, on = series.get(0, {}).get(n), series.get(1, {}).get(n)
+        any_ = off or on
+        slots = f"{int(on['pair_slots'])} / {fmt(on['gpu_MB'])}" if on and 'pair_slots' in on else '—'
+        lines.append(f"| {n} | {int(any_['all_pairs'])} | {int(off['pairs_evaluated']) if off else '—'} → "
+                     f"{int(on['pairs_evaluated']) if on else '—'} | {fmt(ms(off)) if off else '—'} | "
+                     f"{fmt(ms(on)) if on else '—'} | {fmt(on['process_cpu_ms']) if on and 'process_cpu_ms' in on else '—'} | "
+                     f"{slots} |")
     g = next((e for n, e in brf.items() if n.startswith("BM_BrfGatherCpu")), None)
     if g:
         lines.append("")
