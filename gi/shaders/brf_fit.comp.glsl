@@ -13,11 +13,14 @@ layout(local_size_x = 64) in;
 
 layout(std430, binding = 0) readonly buffer Instances { BrfInstance instances[]; };
 layout(std430, binding = 1) readonly buffer Models { BrfModel models[]; };
-layout(std430, binding = 2) readonly buffer Psi { float psi[]; };
-layout(std430, binding = 3) readonly buffer AInverse { float a_inverse[]; };
-layout(std430, binding = 4) readonly buffer Incoming { vec4 incoming[]; };
-layout(std430, binding = 5) readonly buffer Gathered { vec4 gathered[]; };
-layout(std430, binding = 6) readonly buffer Indirect { vec4 indirect[]; };
+// The arrays read in the loops are buffer textures (llvmpipe, Mesa 22: a texel fetch is one
+// gather, an SSBO load a loop over the SIMD lanes): unit 0 Psi, 1 A^-1 (R32F), 2 incoming,
+// 3 gathered, 4 indirect (RGBA32F).
+layout(binding = 0) uniform samplerBuffer u_psi;
+layout(binding = 1) uniform samplerBuffer u_a_inverse;
+layout(binding = 2) uniform samplerBuffer u_incoming;
+layout(binding = 3) uniform samplerBuffer u_gathered;
+layout(binding = 4) uniform samplerBuffer u_indirect;
 layout(std430, binding = 7) writeonly buffer Weights { vec4 weights[]; };
 
 uniform uint u_mode;
@@ -37,8 +40,9 @@ void main() {
     vec3 b = vec3(0.0);
     for (uint j = 0u; j < nv; ++j) {
       const uint gv = first + j;
-      const vec3 e = u_mode == 0u ? gathered[gv].xyz : incoming[gv].xyz + indirect[gv].xyz;
-      b += psi[psi_row + j] * (reflectance * e);
+      const vec3 e = u_mode == 0u ? texelFetch(u_gathered, int(gv)).xyz
+                                  : texelFetch(u_incoming, int(gv)).xyz + texelFetch(u_indirect, int(gv)).xyz;
+      b += texelFetch(u_psi, int(psi_row + j)).x * (reflectance * e);
     }
     s_b[ch] = b;
   }
@@ -46,7 +50,7 @@ void main() {
   for (uint ch = gl_LocalInvocationIndex; ch < nc; ch += gl_WorkGroupSize.x) {
     const uint term = ch / nb, r = ch - term * nb;
     vec3 w = vec3(0.0);
-    for (uint q = 0u; q < nb; ++q) w += a_inverse[m.ainv_offset + r * nb + q] * s_b[term * nb + q];
+    for (uint q = 0u; q < nb; ++q) w += texelFetch(u_a_inverse, int(m.ainv_offset + r * nb + q)).x * s_b[term * nb + q];
     weights[inst.weight_offset + ch] = vec4(w, 0.0);
   }
 }

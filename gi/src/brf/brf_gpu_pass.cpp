@@ -358,6 +358,7 @@ void BrfGpuPass::upload_models(std::span<const BrfGpuModel> models, const ModelD
   glTextureBuffer(vertex_texture_.id(), GL_RGBA32F, model_vertices_.id());
   job_texture_ = engine::GlTexture::create(GL_TEXTURE_BUFFER);
   for (engine::GlTexture& t : gather_textures_) t = engine::GlTexture::create(GL_TEXTURE_BUFFER);
+  for (engine::GlTexture& t : fit_textures_) t = engine::GlTexture::create(GL_TEXTURE_BUFFER);
   occluder_texture_ = engine::GlTexture::create(GL_TEXTURE_BUFFER);
   static_out_.reserve(16);
   static_points_.reserve(16);
@@ -924,12 +925,18 @@ void BrfGpuPass::dispatch_fit(std::uint32_t mode, std::size_t instance_count) {
   glProgramUniform1ui(id, glGetUniformLocation(id, "u_mode"), mode);
   bind(0, instance_table_.buffer.id());
   bind(1, model_table_.id());
-  bind(2, psi_.id());
-  bind(3, a_inverse_.id());
-  bind(4, incoming_.buffer.id());
-  bind(5, gathered_.buffer.id());
-  bind(6, indirect_.buffer.id());
   bind(7, weights_.buffer.id());
+  // The looped-over inputs through buffer textures (units 0-4; the per-frame buffers may have been re-created).
+  const std::pair<GLuint, GLenum> inputs[5] = {{psi_.id(), GL_R32F},
+                                               {a_inverse_.id(), GL_R32F},
+                                               {incoming_.buffer.id(), GL_RGBA32F},
+                                               {gathered_.buffer.id(), GL_RGBA32F},
+                                               {indirect_.buffer.id(), GL_RGBA32F}};
+  for (GLuint u = 0; u < 5; ++u) {
+    glTextureBuffer(fit_textures_[u].id(), inputs[u].second, inputs[u].first);
+    glBindTextureUnit(u, fit_textures_[u].id());
+  }
+  glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);  // gathered and indirect were written as storage
   glDispatchCompute(u32(instance_count), 1, 1);
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
 }

@@ -290,6 +290,8 @@ class BrfGpuPass {
   engine::GlTexture model_texture_, vertex_texture_, job_texture_, occluder_texture_;
   /// brf_gather.comp.glsl's inputs (instance table, live sources, weights, Phi), attached at each dispatch.
   engine::GlTexture gather_textures_[4];
+  /// brf_fit.comp.glsl's inputs (Psi, A^-1, incoming, gathered, indirect), attached at each dispatch.
+  engine::GlTexture fit_textures_[5];
   std::size_t model_bytes_ = 0;
 
   // Static receivers.
