@@ -68,7 +68,7 @@ def main():
     lines.append("")
 
     # PRM light change.
-    lc = next(iter(relight.values()), None)
+    lc = next((e for n, e in relight.items() if n.startswith("BM_PrmLightChange")), None)
     lines.append("### PRM: one light change on the demo level (preview bake)")
     lines.append("")
     lines.append("| | CPU ms | GPU ms | total ms | atlas re-bake ms | re-bake / change | target |")
@@ -78,7 +78,8 @@ def main():
         c = lc
         lines.append(f"| after (`prm_relight_bench`) | {fmt(c['cpu_ms'])} | {fmt(c['gpu_ms'])} | {fmt(c['total_ms'])} | "
                      f"{fmt(c['atlas_rebake_ms'])} | {fmt(c['vs_rebake'])} | "
-                     f"{'met' if c['vs_rebake'] >= 1000 and c['total_ms'] <= 0.9 else 'not met'} |")
+                     f"≤ 0.9 ms {'met' if c['total_ms'] <= 0.9 else 'not met'}, "
+                     f"≥ 1000× {'met' if c['vs_rebake'] >= 1000 else 'not met'} |")
         lines.append("")
         lines.append(f"{int(c['texels'])} pane texels, {int(c['entries'])} entry points, {int(c['clusters'])} clusters "
                      f"lit; the pane sum with no cluster (its fixed part: texel list, every texel written) "

@@ -3,9 +3,14 @@
 // are CPU timings; compare them as ratios). The yardstick is measured in the same loop,
 // interleaved with the pane sum (one of each per iteration, so machine load hits both
 // alike): a plain compute kernel streaming the same bytes (the K half-float panes, T x K x 6
-// bytes) as vec4 loads into a vec4 buffer of the same size (read + write). Counters:
+// bytes) as vec4 loads into a vec4 buffer of the same size (read + write), in two forms timed
+// alike: through SSBOs, and through a buffer texture read with texelFetch and an image buffer
+// written with imageStore (llvmpipe runs an SSBO load as a loop over the SIMD lanes, a texel
+// fetch as one gather: the pane sum reads its panes the second way, so the yardstick must
+// too). The faster of the two is the device's streaming bandwidth. Counters:
 //   pane_GB/s     pane bytes read per second by the pane sum (median iteration);
-//   stream_GB/s   the same bytes read per second by the yardstick (median iteration);
+//   stream_GB/s   the same bytes read per second by the faster yardstick (median iteration);
+//   ssbo_stream_GB/s, texture_stream_GB/s  each yardstick's own figure;
 //   vs_stream     pane_GB/s / stream_GB/s: the share of the device's streaming bandwidth
 //                 (issue 23 target >= 0.5);
 //   Mtexel_clusters/s  pane texel x cluster products per second.
@@ -81,14 +86,30 @@ void main() {
 }
 )";
 
+// The same stream through a buffer texture (read) and an image buffer (write).
+constexpr const char* kTextureStreamShader = R"(#version 450 core
+layout(local_size_x = 64) in;
+layout(binding = 0) uniform samplerBuffer u_src;
+layout(binding = 1, rgba32f) uniform writeonly imageBuffer u_dst;
+uniform uint u_count;
+uniform float u_scale;
+void main() {
+  const uint i = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * 64u + gl_LocalInvocationIndex;
+  if (i < u_count) imageStore(u_dst, int(i), texelFetch(u_src, int(i)) * u_scale);
+}
+)";
+
 struct StreamKernel {
   engine::ShaderProgram program;
   engine::GlBuffer src, dst;
+  GLuint src_texture = 0, dst_texture = 0;  // the texture form only
+  bool textures = false;
   std::uint32_t count = 0;  // vec4s
   int count_location = -1, scale_location = -1;
 
-  explicit StreamKernel(std::size_t bytes) {
-    const engine::ShaderFile file{"stream_yardstick.comp.glsl", "gi/benchmarks/prm_gpu_bench.cpp", kStreamShader};
+  StreamKernel(std::size_t bytes, bool through_textures) : textures(through_textures) {
+    const engine::ShaderFile file{textures ? "texture_stream_yardstick.comp.glsl" : "stream_yardstick.comp.glsl",
+                                  "gi/benchmarks/prm_gpu_bench.cpp", textures ? kTextureStreamShader : kStreamShader};
     auto built = engine::ShaderProgramBuilder(std::span(&file, 1)).stage(engine::ShaderStage::Compute, file.name).build();
     if (!built) {
       std::fprintf(stderr, "%s\n", built.error().to_string().c_str());
@@ -101,19 +122,36 @@ struct StreamKernel {
     for (float& v : data) v = rng.next_float();
     src = engine::GlBuffer::create(data.size() * sizeof(float), data.data());
     dst = engine::GlBuffer::create(data.size() * sizeof(float), nullptr);
+    if (textures) {
+      glCreateTextures(GL_TEXTURE_BUFFER, 1, &src_texture);
+      glTextureBuffer(src_texture, GL_RGBA32F, src.id());
+      glCreateTextures(GL_TEXTURE_BUFFER, 1, &dst_texture);
+      glTextureBuffer(dst_texture, GL_RGBA32F, dst.id());
+    }
     count_location = glGetUniformLocation(program.id(), "u_count");
     scale_location = glGetUniformLocation(program.id(), "u_scale");
+  }
+  StreamKernel(const StreamKernel&) = delete;
+  StreamKernel& operator=(const StreamKernel&) = delete;
+  ~StreamKernel() {
+    if (src_texture) glDeleteTextures(1, &src_texture);
+    if (dst_texture) glDeleteTextures(1, &dst_texture);
   }
   void run() const {
     program.use();
     glProgramUniform1ui(program.id(), count_location, count);
     glProgramUniform1f(program.id(), scale_location, 0.5f);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, src.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, dst.id());
+    if (textures) {
+      glBindTextureUnit(0, src_texture);
+      glBindImageTexture(1, dst_texture, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    } else {
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, src.id());
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, dst.id());
+    }
     const std::uint32_t groups = (count + 63) / 64;
     const std::uint32_t gx = std::min<std::uint32_t>(groups, 65535);
     glDispatchCompute(gx, (groups + gx - 1) / gx, 1);
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    glMemoryBarrier(textures ? GL_SHADER_IMAGE_ACCESS_BARRIER_BIT : GL_SHADER_STORAGE_BARRIER_BIT);
   }
 };
 
@@ -128,15 +166,20 @@ void BM_PrmGpuSum(benchmark::State& state) {
   const auto k = static_cast<int>(state.range(1));
   gi::PrmGpuPass& pass = pass_for(texels);
   const double pane_bytes = double(texels) * double(k) * 6.0;
-  const StreamKernel stream(static_cast<std::size_t>(pane_bytes));
+  const StreamKernel stream(static_cast<std::size_t>(pane_bytes), false);
+  const StreamKernel texture_stream(static_cast<std::size_t>(pane_bytes), true);
   std::vector<gi::ClusterWeight> selected;
   for (int i = 0; i < k; ++i)
     selected.push_back({static_cast<std::uint32_t>(i * (kClusters / k)), glm::vec3(0.5f, 0.25f, 1.0f)});
   (void)pass.run(selected);  // warm-up: first-dispatch shader compilation in llvmpipe
   stream.run();
+  texture_stream.run();
   glFinish();
-  std::vector<double> sum_s, stream_s;
+  std::vector<double> sum_s, stream_s, texture_stream_s;
   for (auto _ : state) {
+    const auto tt = Clock::now();
+    texture_stream.run();
+    glFinish();
     const auto t0 = Clock::now();
     stream.run();
     glFinish();
@@ -144,11 +187,15 @@ void BM_PrmGpuSum(benchmark::State& state) {
     if (!pass.run(selected)) state.SkipWithError("PrmGpuPass::run failed");
     glFinish();
     const auto t2 = Clock::now();
+    texture_stream_s.push_back(std::chrono::duration<double>(t0 - tt).count());
     stream_s.push_back(std::chrono::duration<double>(t1 - t0).count());
     sum_s.push_back(std::chrono::duration<double>(t2 - t1).count());
     state.SetIterationTime(sum_s.back());
   }
-  const double sum_median = median(sum_s), stream_median = median(stream_s);
+  const double sum_median = median(sum_s), ssbo_median = median(stream_s), texture_median = median(texture_stream_s);
+  const double stream_median = std::min(ssbo_median, texture_median);
+  state.counters["ssbo_stream_GB/s"] = pane_bytes * 1e-9 / ssbo_median;
+  state.counters["texture_stream_GB/s"] = pane_bytes * 1e-9 / texture_median;
   state.counters["Mtexel_clusters/s"] = double(texels) * double(k) * 1e-6 / sum_median;
   state.counters["pane_GB/s"] = pane_bytes * 1e-9 / sum_median;
   state.counters["stream_GB/s"] = pane_bytes * 1e-9 / stream_median;
