@@ -1,4 +1,5 @@
 #include <engine/light_reach.h>
+#include <engine/segment_box.h>
 
 #include <algorithm>
 #include <cmath>
@@ -6,24 +7,6 @@
 namespace engine {
 
 namespace {
-
-// Slab test: does the segment p + t d, t in [0, 1], touch the box?
-bool segment_hits_box(const glm::vec3& p, const glm::vec3& d, const glm::vec3& lo, const glm::vec3& hi) {
-  float t0 = 0.0f, t1 = 1.0f;
-  for (int a = 0; a < 3; ++a) {
-    if (std::abs(d[a]) < 1e-12f) {
-      if (p[a] < lo[a] || p[a] > hi[a]) return false;
-      continue;
-    }
-    const float inv = 1.0f / d[a];
-    float ta = (lo[a] - p[a]) * inv, tb = (hi[a] - p[a]) * inv;
-    if (ta > tb) std::swap(ta, tb);
-    t0 = std::max(t0, ta);
-    t1 = std::min(t1, tb);
-    if (t0 > t1) return false;
-  }
-  return true;
-}
 
 // Moeller-Trumbore, both faces; t in units of |d| (d not normalized).
 bool segment_hits_triangle(const glm::vec3& p, const glm::vec3& d, const ReachTriangle& tri, float t_min, float t_max) {
@@ -53,7 +36,7 @@ bool segment_blocked(const std::vector<ReachOccluder>& occluders, const glm::vec
   const float t_min = end_margin_m / len;
   const float t_max = 1.0f - t_min;
   for (const ReachOccluder& o : occluders) {
-    if (!segment_hits_box(p, d, o.min, o.max)) continue;
+    if (!segment_meets_box(p, d, 1.0f, o.min, o.max)) continue;
     for (const ReachTriangle& tri : o.triangles)
       if (segment_hits_triangle(p, d, tri, t_min, t_max)) return true;
   }

@@ -1,6 +1,7 @@
 #include "antiradiance/antiradiance_direct_light.h"
 
 #include <engine/check.h>
+#include <engine/segment_box.h>
 
 #include <algorithm>
 #include <limits>
@@ -102,28 +103,6 @@ std::vector<glm::vec3> AntiradianceDirectLight::irradiance(const ElementHierarch
   return last_;
 }
 
-namespace {
-
-// Whether the segment p + t d, t in [0, t_max], meets the box (slab test; t_max may be infinite).
-bool segment_meets_box(const glm::vec3& p, const glm::vec3& d, float t_max, const glm::vec3& lo, const glm::vec3& hi) {
-  float t0 = 0.0f, t1 = t_max;
-  for (int a = 0; a < 3; ++a) {
-    if (d[a] == 0.0f) {
-      if (p[a] < lo[a] || p[a] > hi[a]) return false;
-      continue;
-    }
-    const float inv = 1.0f / d[a];
-    float ta = (lo[a] - p[a]) * inv, tb = (hi[a] - p[a]) * inv;
-    if (ta > tb) std::swap(ta, tb);
-    t0 = std::max(t0, ta);
-    t1 = std::min(t1, tb);
-    if (t0 > t1) return false;
-  }
-  return true;
-}
-
-}  // namespace
-
 const std::vector<glm::vec3>& AntiradianceDirectLight::update(const ElementHierarchy& h) {
   if (last_.size() != h.leaf_count()) {
     irradiance(h);
@@ -149,7 +128,7 @@ const std::vector<glm::vec3>& AntiradianceDirectLight::update(const ElementHiera
         const glm::vec3 d = directional ? -em.direction : em.position - p;
         const float t_max = directional ? std::numeric_limits<float>::infinity() : 1.0f;
         for (const Box& b : swept_)
-          if (segment_meets_box(p, d, t_max, b.lo, b.hi)) {
+          if (engine::segment_meets_box(p, d, t_max, b.lo, b.hi)) {
             todo[l] = 1;
             break;
           }
