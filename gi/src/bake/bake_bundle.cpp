@@ -23,6 +23,7 @@
 #include "brf/brf_io.h"
 #include "brf/brf_mesh.h"
 #include "bundle/geometry_hash.h"
+#include "bundle/shard_set.h"
 #include "bundle/manifest.h"
 #include "core/thread_pool.h"
 #include "dlm/dlm.h"
@@ -561,18 +562,12 @@ engine::Result<BakeReport> bake_shard(const BakeInput& input, const fs::path& bu
 engine::Result<MergedParts> read_shards(const BakeInput& input, const fs::path& bundle_dir, const BakeOptions& options,
                                         const std::vector<std::string>& methods, const BakeHost& host) {
   const fs::path dir = shard_directory(bundle_dir);
-  std::error_code ec;
-  std::vector<fs::path> files;
-  for (const auto& e : fs::directory_iterator(dir, ec))
-    if (e.path().extension() == ".gishard") files.push_back(e.path());
-  if (ec) return engine::Error{dir.string(), "", "cannot list the shard directory: " + ec.message()};
-  std::sort(files.begin(), files.end());
-  if (files.empty()) return engine::Error{dir.string(), "", "no shard file (*.gishard) to merge"};
+  auto files = list_shard_files(dir, ".gishard");
+  if (!files) return files.error();
   const ShardFile expected = shard_header(input, options, methods, 0, options.shard_count);
   std::uint32_t count = options.shard_count;
-  std::vector<std::optional<ShardFile>> shards;
-  std::vector<fs::path> where;
-  for (const fs::path& path : files) {
+  ShardSet<ShardFile> set;
+  for (const fs::path& path : *files) {
     auto file = read_shard_file(path);
     if (!file) return file.error();
     const auto foreign = [&](const std::string& what) {
@@ -596,19 +591,15 @@ engine::Result<MergedParts> read_shards(const BakeInput& input, const fs::path& 
         file->prm.has_value() != has_method(methods, "prm") ||
         file->antiradiance.has_value() != has_method(methods, "antiradiance"))
       return foreign("its methods differ from this merge's");
-    if (shards.empty()) shards.resize(count), where.resize(count);
-    const std::uint32_t i = file->index;
-    if (shards[i])
-      return engine::Error{path.string(), "", "duplicate shard " + std::to_string(i) + " of " + std::to_string(count) +
-                                                  " (also in " + where[i].string() + ")"};
-    shards[i] = std::move(file).value();
-    where[i] = path;
+    const std::uint32_t index = file->index;
+    if (auto ok = set.place(path, index, count, std::move(file).value()); !ok) return ok.error();
   }
+  if (auto ok = set.complete(count, [&](std::uint32_t i) { return dir / shard_file_name(i, count); }); !ok)
+    return ok.error();
+  auto& shards = set.shards;
+  const auto& where = set.where;
   MergedParts merged;
   for (std::uint32_t i = 0; i < count; ++i) {
-    if (!shards[i])
-      return engine::Error{(dir / shard_file_name(i, count)).string(), "",
-                           "shard " + std::to_string(i) + " of " + std::to_string(count) + " is missing"};
     if (shards[i]->atlas) merged.atlas.push_back(std::move(*shards[i]->atlas));
     if (shards[i]->prm) merged.prm.push_back(std::move(*shards[i]->prm));
     if (shards[i]->antiradiance) {

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "bundle/geometry_hash.h"
+#include "bundle/shard_set.h"
 #include "core/work_shard.h"
 #include "io/blob_file.h"
 #include "io/content_hash.h"
@@ -365,19 +366,13 @@ engine::Result<ReferenceOutputs> merge_reference_shards(const BakeInput& input, 
                                                         const fs::path& shard_dir, std::uint32_t count) {
   if (auto ok = check_job(job); !ok) return ok.error();
   if (auto ok = validate_bake_input(input); !ok) return ok.error();
-  std::error_code ec;
-  std::vector<fs::path> files;
-  for (const auto& e : fs::directory_iterator(shard_dir, ec))
-    if (e.path().extension() == kExtension) files.push_back(e.path());
-  if (ec) return engine::Error{shard_dir.string(), "", "cannot list the shard directory: " + ec.message()};
-  std::sort(files.begin(), files.end());
-  if (files.empty()) return engine::Error{shard_dir.string(), "", "no shard file (*.girefshard) to merge"};
+  auto files = list_shard_files(shard_dir, kExtension);
+  if (!files) return files.error();
 
   const std::string scene_hash = reference_scene_hash(input);
   const std::string settings_hash = job_settings_hash(job);
-  std::vector<std::optional<ShardFile>> shards;
-  std::vector<fs::path> where;
-  for (const fs::path& path : files) {
+  ShardSet<ShardFile> set;
+  for (const fs::path& path : *files) {
     auto file = read_shard(path);
     if (!file) return file.error();
     const auto foreign = [&](const std::string& what) {
@@ -396,18 +391,14 @@ engine::Result<ReferenceOutputs> merge_reference_shards(const BakeInput& input, 
                      std::to_string(job.settings.seed) + ")");
     if (file->image.has_value() != job.image.has_value() || file->atlas.has_value() != job.atlas.has_value())
       return foreign("its parts (image, atlas) differ from this merge's");
-    if (shards.empty()) shards.resize(count), where.resize(count);
-    const std::uint32_t i = file->index;
-    if (shards[i])
-      return engine::Error{path.string(), "", "duplicate shard " + std::to_string(i) + " of " + std::to_string(count) +
-                                                  " (also in " + where[i].string() + ")"};
-    shards[i] = std::move(file).value();
-    where[i] = path;
+    const std::uint32_t index = file->index;
+    if (auto ok = set.place(path, index, count, std::move(file).value()); !ok) return ok.error();
   }
-  for (std::uint32_t i = 0; i < count; ++i)
-    if (!shards[i])
-      return engine::Error{(shard_dir / reference_shard_file_name(i, count)).string(), "",
-                           "shard " + std::to_string(i) + " of " + std::to_string(count) + " is missing"};
+  if (auto ok = set.complete(count, [&](std::uint32_t i) { return shard_dir / reference_shard_file_name(i, count); });
+      !ok)
+    return ok.error();
+  const auto& shards = set.shards;
+  const auto& where = set.where;
 
   ReferenceOutputs out;
   if (job.image) {
