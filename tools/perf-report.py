@@ -52,6 +52,38 @@ def fmt(v, digits=3):
     return f"{v:.{digits}g}"
 
 
+FRAME_TARGETS = {"960x540": 15.0, "640x360": 30.0}
+
+
+def medians(values):
+    return " / ".join(fmt(v) for v in values) if values else "—"
+
+
+def load_frame(out_dir, size):
+    """The demo's headless summary for one size (tools/perf-report.sh writes frame_WxH.txt):
+    frames/s, the pass medians, CPU seconds. None when the run was skipped; an error naming the
+    file when it ran but the summary is not there (a failed run, or the summary's format moved)."""
+    path = os.path.join(out_dir, f"frame_{size}.txt")
+    if not os.path.exists(path):
+        return None
+    text = open(path).read()
+    fps = re.search(r"gi_demo: (\d+) frames in ([\d.]+) s \(([\d.]+) frames/s\)", text)
+    cpu = re.search(r"process CPU s: ([\d.]+) user ([\d.]+) sys", text)
+    if not fps or not cpu:
+        sys.exit(f"perf-report: {path}: no gi_demo summary in it (did the run fail?):\n{text[-2000:]}")
+
+    def median(label):
+        """The pass's median ms; a pass split over several labels (the shadow maps' view count
+        moves with the flashlight) gives each median, joined."""
+        found = re.findall(r"\n\s*" + re.escape(label) + r"[^\n]*?median\s+([\d.]+)", text)
+        return [float(v) for v in found]
+
+    frames = int(fps.group(1))
+    return {"size": size, "frames": frames, "fps": frames / float(fps.group(2)),
+            "forward_median_ms": median("forward + indirect"), "shadow_median_ms": median("shadow maps"),
+            "tonemap_median_ms": median("tonemap"), "cpu_s": float(cpu.group(1)) + float(cpu.group(2))}
+
+
 def main():
     out_dir, doc, png = sys.argv[1], sys.argv[2], sys.argv[3]
     prm, ctx = load(os.path.join(out_dir, "prm_gpu_bench.json"))
@@ -128,6 +160,26 @@ def main():
                      f"{fmt(g['gather_GB/s'])} GB/s against memcpy {fmt(g['memcpy_GB/s'])} GB/s of the same bytes: "
                      f"**{fmt(g['vs_memcpy'], 2)}** (target ≥ 0.5).")
     lines.append("")
+    # The frame.
+    frames = [f for f in (load_frame(out_dir, size) for size in FRAME_TARGETS) if f]
+    if frames:
+        with open(os.path.join(out_dir, "frame.json"), "w") as f:
+            json.dump(frames, f, indent=1)
+        lines.append("### The demo level's frame (`gi_demo --headless --frames 60`, preview bundle, all GI on)")
+        lines.append("")
+        lines.append("| size | frames/s | forward + indirect median ms | shadow maps median ms | tonemap median ms "
+                     "| process CPU s / frame | target |")
+        lines.append("|---|---|---|---|---|---|---|")
+        for f in frames:
+            t = FRAME_TARGETS[f["size"]]
+            lines.append(f"| {f['size']} | **{f['fps']:.1f}** | {medians(f['forward_median_ms'])} | "
+                         f"{medians(f['shadow_median_ms'])} | {medians(f['tonemap_median_ms'])} | "
+                         f"{fmt(f['cpu_s'] / f['frames'], 2)} | ≥ {t:g} frames/s "
+                         f"{'met' if f['fps'] >= t else 'not met'} |")
+        lines.append("")
+        lines.append("The profile and what limits it: [performance-frame.md](performance-frame.md).")
+        lines.append("")
+
     lines.append("![cost against object count and atlas texels](images/performance.png)")
     lines.append("")
     lines.append(END)
