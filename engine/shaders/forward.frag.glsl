@@ -23,6 +23,11 @@
 #ifndef AREA_SOFT_SHADOWS
 #define AREA_SOFT_SHADOWS 1
 #endif
+// 1: area lights' visibility from the half-resolution pass (area_shadow.frag.glsl, upsampled
+// per pixel into u_area_visibility, channel GpuLight::shadow_params.z); 0: shadow_area here.
+#ifndef AREA_SHADOW_HALF
+#define AREA_SHADOW_HALF 0
+#endif
 // 0: the scene has no sky (radiance and gradient all zero): its term is zero and left out.
 #ifndef SKY_TERM
 #define SKY_TERM 1
@@ -75,6 +80,10 @@ layout(binding = 3) uniform sampler2D u_irradiance_atlas;
 layout(binding = 6) uniform sampler2D u_glossy_radiance;
 layout(binding = 7) uniform isampler2D u_directional_index;
 
+#if AREA_SHADOW_HALF
+layout(binding = 13) uniform sampler2D u_area_visibility;
+#endif
+
 layout(location = 0) out vec4 o_radiance;
 
 void main() {
@@ -114,7 +123,9 @@ void main() {
     const int i = POINT_LIGHTS + SPOT_LIGHTS + DIRECTIONAL_LIGHTS + k;
     to_light = normalize(lights[i].position_type.xyz - s.position);
     radiance += area_light_radiance(lights[i], s) *
-#if AREA_SOFT_SHADOWS
+#if AREA_SHADOW_HALF
+                texelFetch(u_area_visibility, ivec2(gl_FragCoord.xy), 0)[int(lights[i].shadow_params.z)];
+#elif AREA_SOFT_SHADOWS
                 shadow_area(lights[i], s.position, s.normal, to_light);
 #else
                 shadow_2d(lights[i], s.position, s.normal, to_light, 2.0);

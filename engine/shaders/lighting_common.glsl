@@ -23,7 +23,7 @@ struct GpuLight {
   vec4 area_half_y;       // xyz: half of the rectangle along the light's Y axis (m)
   mat4 shadow_view_proj;  // world -> clip of the 2-D shadow map
   vec4 shadow_eye;        // xyz: shadow camera position (m); w: far distance that maps to depth 1 (m)
-  vec4 shadow_params;     // x: 0 ortho / 1 distance; y: texel footprint (m, or m per m of distance); zw: unused
+  vec4 shadow_params;     // x: 0 ortho / 1 distance; y: texel footprint (m, or m per m of distance); z: area lights: index among them; w: unused
 };
 
 layout(std430, binding = 0) readonly buffer Lights { GpuLight lights[]; };

@@ -101,6 +101,7 @@ int main(int argc, char** argv) {
   RunOptions o;
   std::string area_shadows = "soft";
   std::string light_reach = "on";
+  std::string area_shadow_res = "full";
   CLI::App app{"gi_demo: the playable demo level of the GI module"};
   app.add_option("--scene", o.scene, "glTF scene to play (default: assets/demo_level.gltf)");
   app.add_flag("--headless", o.headless, "Run without a window (EGL surfaceless), driven by --script or --replay");
@@ -117,6 +118,10 @@ int main(int argc, char** argv) {
                  "on: static lights shade only where static geometry lets them reach (default); off: every light "
                  "on every pixel (engine::RenderSettings::light_reach_culling)")
       ->check(CLI::IsMember({"on", "off"}));
+  app.add_option("--area-shadow-res", area_shadow_res,
+                 "full: area lights' soft shadows per pixel (default); half: at half resolution, upsampled on "
+                 "each pixel's own surface (engine::RenderSettings::area_shadow_res)")
+      ->check(CLI::IsMember({"full", "half"}));
   app.add_option("--every", o.every, "Headless: write every K-th frame")->check(CLI::PositiveNumber);
   app.add_flag("--exr", o.exr, "Headless: also write DIR/frame_NNNN.exr (linear HDR)");
   app.add_flag("--no-render", o.no_render, "Headless: simulate only (no GPU), e.g. to record sessions");
@@ -138,6 +143,7 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   o.area_soft_shadows = area_shadows == "soft";
   o.light_reach_culling = light_reach == "on";
+  o.area_shadow_res = area_shadow_res == "half" ? engine::AreaShadowRes::Half : engine::AreaShadowRes::Full;
   o.size_given = w->count() > 0 || h->count() > 0;
   if (o.script.empty()) o.script = std::string(script_name(default_script(o.scene)));
   if (!script_from_name(o.script)) {

@@ -137,7 +137,7 @@ int main(int argc, char** argv) {
   app.add_option("--session", session_path, "Recorded session (.girec)")->required()->check(CLI::ExistingFile);
   app.add_option("--bundle", bundles,
                  "NAME=DIR of a bake bundle, or 'none' for the stand-in (repeatable); NAME=DIR,area-shadows=centre "
-                 "shadows area lights from their centre only (default soft); NAME=DIR,light-reach=off[,area-shadows=...] "
+                 "shadows area lights from their centre only (default soft); NAME=DIR,light-reach=off[,area-shadows=...][,area-shadow-res=half] "
                  "shades every light on every pixel (default on)")
       ->required();
   app.add_option("--frames", frames_text, "Comma-separated frames compared with the path tracer");
@@ -222,6 +222,17 @@ int main(int argc, char** argv) {
     const std::size_t eq = spec.find('=');
     row.name = eq == std::string::npos ? spec : spec.substr(0, eq);
     row.bundle = eq == std::string::npos ? "" : spec.substr(eq + 1);
+    // ",area-shadow-res=half" (RenderSettings::area_shadow_res), last.
+    engine::AreaShadowRes area_shadow_res = engine::AreaShadowRes::Full;
+    if (const std::size_t opt = row.bundle.find(",area-shadow-res="); opt != std::string::npos) {
+      const std::string value = row.bundle.substr(opt + 17);
+      if (value != "full" && value != "half") {
+        std::cerr << "gi-replay-quality: area-shadow-res must be full or half, not '" << value << "'\n";
+        return 2;
+      }
+      area_shadow_res = value == "half" ? engine::AreaShadowRes::Half : engine::AreaShadowRes::Full;
+      row.bundle = row.bundle.substr(0, opt);
+    }
     // Renderer choices after the bundle: ",area-shadows=centre" (RenderSettings::area_soft_shadows off).
     bool area_soft_shadows = true;
     if (const std::size_t opt = row.bundle.find(",area-shadows="); opt != std::string::npos) {
@@ -263,6 +274,7 @@ int main(int argc, char** argv) {
         sim->scene().assets,
         engine::RenderSettings{.width = width, .height = height, .exposure = game_demo::kDemoExposure,
                                .area_soft_shadows = area_soft_shadows,
+                               .area_shadow_res = area_shadow_res,
                                .light_reach_culling = light_reach});
     if (!renderer) {
       std::cerr << "gi-replay-quality: " << renderer.error().to_string() << '\n';

@@ -102,6 +102,7 @@ int run_windowed(const RunOptions& o, RunState& state) {
                                .height = o.height,
                                .exposure = o.exposure,
                                .area_soft_shadows = o.area_soft_shadows,
+                               .area_shadow_res = o.area_shadow_res,
                                .light_reach_culling = o.light_reach_culling,
                                .warn = [](const std::string& line) { std::cerr << "gi_demo: " << line << '\n'; }});
   if (!r) {

@@ -32,6 +32,9 @@
 
 namespace engine {
 
+/// Where area lights' soft shadows are computed (RenderSettings::area_shadow_res).
+enum class AreaShadowRes : std::uint8_t { Full, Half };
+
 /// G toggles the split screen: left half direct light only, right half direct + indirect.
 enum class SplitView : std::uint8_t { Off, DirectLeftFullRight };
 
@@ -63,6 +66,15 @@ struct RenderSettings {
   /// rectangle's centre (a 3x3 grid of bilinear compare taps, cheaper, hard-edged and dark
   /// where the centre is hidden but part of the rectangle is not).
   bool area_soft_shadows = true;
+  /// Soft area shadows (area_soft_shadows) per pixel (Full), or at half resolution (Half):
+  /// a pass over the scene at half the width and height computes each area light's
+  /// visibility (at most 4 area lights; more: Full) and each full-resolution pixel takes the
+  /// bilinear mean of the 4 nearest half-resolution texels that lie on its own surface
+  /// (tangent plane within 2 cm + 1% of the camera distance, normals within ~25 degrees);
+  /// a pixel none of them matches (geometry edges) is computed at full resolution. The light
+  /// reach masks then keep 7 lights (the stencil's top bit flags those pixels).
+  /// docs/performance-frame.md has the cost and the error.
+  AreaShadowRes area_shadow_res = AreaShadowRes::Full;
   /// Static lights shade only where static geometry lets them reach (engine/light_reach.h):
   /// a voxel grid of light masks built from the static shadow casters when they or the
   /// static lights change, written to the stencil by the depth pre-pass; each pixel is

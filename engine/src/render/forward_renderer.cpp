@@ -46,7 +46,12 @@ enum TextureUnit : GLuint {
   kGlossyUnit = 6,
   kDirectionalIndexUnit = 7,
   kShadowDepthUnit = 12,  // the 2-D shadow maps again, raw depth (shadow_common.glsl's sun disc)
+  kAreaVisibilityUnit = 13,  // area_shadow.frag.glsl: half-resolution visibility; forward: full-resolution
+  kAreaPlaneUnit = 14,       // area_shadow.frag.glsl: half-resolution tangent planes
 };
+// The stencil's top bit: pixels whose area-light visibility the half-resolution pass could
+// not lend (area_shadow.frag.glsl); the light-reach masks use the 7 bits below it then.
+constexpr GLuint kAreaFallbackBit = 0x80;
 constexpr GLuint kLightsBinding = 0;
 constexpr GLuint kVertexIrradianceBinding = 1;
 constexpr GLuint kDirectionalRadianceBinding = 2;  // directional_radiance.glsl
@@ -89,9 +94,10 @@ Result<ShaderProgram> build(const char* vertex, const char* fragment) {
 }
 
 // Point, spot, directional and area light counts, then area specular samples per side,
-// whether area lights are soft-shadowed (RenderSettings::area_soft_shadows) and whether the
-// scene has a sky term (0: its radiance and gradient are zero, the shader leaves it out).
-using LightCounts = std::array<int, 7>;
+// whether area lights are soft-shadowed (RenderSettings::area_soft_shadows), whether the
+// scene has a sky term (0: its radiance and gradient are zero, the shader leaves it out) and
+// whether area lights' visibility comes from the half-resolution pass (area_shadow_res).
+using LightCounts = std::array<int, 8>;
 
 // The forward program for one combination of light counts (see forward.frag.glsl).
 Result<ShaderProgram> build_forward(const LightCounts& n) {
@@ -105,6 +111,17 @@ Result<ShaderProgram> build_forward(const LightCounts& n) {
       .define("AREA_SPECULAR_SIDE " + std::to_string(n[4]))
       .define("AREA_SOFT_SHADOWS " + std::to_string(n[5]))
       .define("SKY_TERM " + std::to_string(n[6]))
+      .define("AREA_SHADOW_HALF " + std::to_string(n[7]))
+      .build();
+}
+
+// One pass of the half-resolution area shadows (area_shadow.frag.glsl) for `area_lights` lights.
+Result<ShaderProgram> build_area_shadow(int pass, int area_lights) {
+  return ShaderProgramBuilder(engine_shader_files())
+      .stage(ShaderStage::Vertex, "forward.vert.glsl")
+      .stage(ShaderStage::Fragment, "area_shadow.frag.glsl")
+      .define("AREA_SHADOW_PASS " + std::to_string(pass))
+      .define("AREA_LIGHTS " + std::to_string(area_lights))
       .build();
 }
 
@@ -150,7 +167,7 @@ class ForwardRenderer final : public Renderer {
         albedo_table_(upload_gltf_albedo_table()),
         no_directional_index_(no_directional_index()),
         shadow_depth_sampler_(raw_depth_sampler()) {
-    forward_variants_.emplace(LightCounts{0, 0, 0, 0, 3, 1, 1}, std::move(forward));
+    forward_variants_.emplace(LightCounts{0, 0, 0, 0, 3, 1, 1, 0}, std::move(forward));
     ensure_targets();
   }
 
@@ -176,6 +193,9 @@ class ForwardRenderer final : public Renderer {
   void forward_pass(const Registry& registry, Entity camera, const std::vector<DrawItem>& items,
                     const std::vector<LightGroup>& groups);
   const ShaderProgram& forward_program(const LightCounts& counts);
+  const ShaderProgram& area_shadow_program(int pass, int area_lights);
+  void area_shadow_passes(const glm::mat4& view_proj, const glm::vec3& camera_position, const std::vector<DrawItem>& items);
+  void draw_geometry(const std::vector<DrawItem>& items, bool double_sided_uniform);
   void depth_prepass(const glm::mat4& view_proj, const std::vector<DrawItem>& items, bool reach);
   std::vector<LightGroup> light_groups(const Registry& registry, const std::vector<DrawItem>& items,
                                        const render::LightList& lights);
@@ -186,6 +206,18 @@ class ForwardRenderer final : public Renderer {
   RenderSettings settings_;
   GpuScene scene_;
   std::map<LightCounts, ShaderProgram> forward_variants_;
+  std::map<std::pair<int, int>, ShaderProgram> area_shadow_programs_;  // (pass, area lights)
+  // Half-resolution area shadows (RenderSettings::area_shadow_res): this frame's area lights
+  // (empty: full-resolution lookups), their buffer, the half-resolution targets and the
+  // full-resolution visibility the forward pass reads.
+  std::vector<render::GpuLight> area_lights_;
+  GlBuffer area_lights_buffer_ = GlBuffer::create();
+  GlTexture half_depth_;
+  GlTexture half_visibility_;
+  GlTexture half_plane_;
+  GlTexture area_visibility_;
+  GlFramebuffer half_fbo_;
+  GlFramebuffer visibility_fbo_;
   ShaderProgram depth_only_;
   ShaderProgram depth_reach_;
   ReachState reach_;
@@ -212,6 +244,16 @@ class ForwardRenderer final : public Renderer {
   IndirectLightProvider* provider_ = nullptr;
   std::vector<PassTiming> timings_;
 };
+
+const ShaderProgram& ForwardRenderer::area_shadow_program(int pass, int area_lights) {
+  const std::pair<int, int> key(pass, area_lights);
+  auto it = area_shadow_programs_.find(key);
+  if (it != area_shadow_programs_.end()) return it->second;
+  Result<ShaderProgram> p = build_area_shadow(pass, area_lights);
+  if (!p) std::fprintf(stderr, "%s\n", p.error().to_string().c_str());
+  GI_EXPECTS(p.ok(), "area shadow shader must compile");
+  return area_shadow_programs_.emplace(key, std::move(p.value())).first->second;
+}
 
 const ShaderProgram& ForwardRenderer::forward_program(const LightCounts& counts) {
   auto it = forward_variants_.find(counts);
@@ -241,6 +283,28 @@ void ForwardRenderer::ensure_targets() {
   ldr_fbo_ = GlFramebuffer::create();
   glNamedFramebufferTexture(ldr_fbo_.id(), GL_COLOR_ATTACHMENT0, ldr_.id(), 0);
   GI_EXPECTS(hdr_fbo_.complete() && ldr_fbo_.complete(), "render targets must be complete");
+  // Half-resolution area shadows (area_shadow.frag.glsl): made with the other targets, used
+  // only when RenderSettings::area_shadow_res is Half.
+  const int half_w = (width_ + 1) / 2;
+  const int half_h = (height_ + 1) / 2;
+  half_depth_ = GlTexture::create_2d(GL_DEPTH_COMPONENT32F, half_w, half_h);
+  half_visibility_ = GlTexture::create_2d(GL_RGBA16F, half_w, half_h);
+  half_plane_ = GlTexture::create_2d(GL_RGBA32F, half_w, half_h);
+  area_visibility_ = GlTexture::create_2d(GL_RGBA16F, width_, height_);
+  for (GLuint t : {half_visibility_.id(), half_plane_.id(), area_visibility_.id()}) {
+    glTextureParameteri(t, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTextureParameteri(t, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  }
+  half_fbo_ = GlFramebuffer::create();
+  glNamedFramebufferTexture(half_fbo_.id(), GL_COLOR_ATTACHMENT0, half_visibility_.id(), 0);
+  glNamedFramebufferTexture(half_fbo_.id(), GL_COLOR_ATTACHMENT1, half_plane_.id(), 0);
+  glNamedFramebufferTexture(half_fbo_.id(), GL_DEPTH_ATTACHMENT, half_depth_.id(), 0);
+  const GLenum half_buffers[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+  glNamedFramebufferDrawBuffers(half_fbo_.id(), 2, half_buffers);
+  visibility_fbo_ = GlFramebuffer::create();
+  glNamedFramebufferTexture(visibility_fbo_.id(), GL_COLOR_ATTACHMENT0, area_visibility_.id(), 0);
+  glNamedFramebufferTexture(visibility_fbo_.id(), GL_DEPTH_STENCIL_ATTACHMENT, depth_.id(), 0);
+  GI_EXPECTS(half_fbo_.complete() && visibility_fbo_.complete(), "area shadow targets must be complete");
 }
 
 std::vector<DrawItem> ForwardRenderer::draw_items(const Registry& registry,
@@ -297,6 +361,16 @@ void ForwardRenderer::render(const Registry& registry, Entity camera) {
   shadow_maps_rendered_ = shadow_maps_.render(lights.shadow_views, items, scene_, shadow_);
   timings_.push_back({"shadow maps (" + std::to_string(lights.shadow_views.size()) + " views)", timer.lap_ms()});
 
+  // Half-resolution area shadows: every area light of the frame (each its visibility channel,
+  // GpuLight::shadow_params.z), when they are soft-shadowed, at most 4 and one has a map.
+  area_lights_.clear();
+  if (settings_.area_shadow_res == AreaShadowRes::Half && settings_.area_soft_shadows) {
+    for (const render::GpuLight& g : lights.lights)
+      if (static_cast<int>(g.position_type.w) == static_cast<int>(render::GpuLightType::Area)) area_lights_.push_back(g);
+    const bool any_map = std::any_of(area_lights_.begin(), area_lights_.end(),
+                                     [](const render::GpuLight& g) { return g.cone.z >= 0.0f; });
+    if (area_lights_.size() > 4 || !any_map) area_lights_.clear();
+  }
   std::vector<LightGroup> groups = light_groups(registry, items, lights);
   light_groups_ = static_cast<int>(groups.size());
   {  // Every group's lights, one after the other (each at an SSBO offset alignment).
@@ -332,9 +406,11 @@ std::vector<LightGroup> ForwardRenderer::light_groups(const Registry& registry, 
   // mask is cullable[i].
   std::vector<int> cullable;
   int n_static = 0;
+  // With half-resolution area shadows the stencil's top bit flags their fallback pixels.
+  const std::size_t max_cullable = LightReachGrid::kMaxLights - (area_lights_.empty() ? 0 : 1);
   if (settings_.light_reach_culling)
     for (int pass = 0; pass < 2; ++pass) {
-      for (std::size_t i = 0; i < lights.lights.size() && cullable.size() < LightReachGrid::kMaxLights; ++i) {
+      for (std::size_t i = 0; i < lights.lights.size() && cullable.size() < max_cullable; ++i) {
         const render::GpuLight& g = lights.lights[i];
         const Light* l = registry.try_get<Light>(lights.entities[i]);
         const bool shadowed = g.cone.z >= 0.0f || g.cone.w >= 0.0f;
@@ -514,6 +590,13 @@ void ForwardRenderer::forward_pass(const Registry& registry, Entity camera, cons
   glBindVertexArray(scene_.vertex_array());
   const bool reach = !groups.empty() && groups.front().mask >= 0;
   depth_prepass(view_proj, items, reach);
+  if (!area_lights_.empty()) {
+    area_shadow_passes(view_proj, camera_position, items);
+    glBindFramebuffer(GL_FRAMEBUFFER, hdr_fbo_.id());
+    glViewport(0, 0, width_, height_);
+    glBindVertexArray(scene_.vertex_array());
+    glBindTextureUnit(kAreaVisibilityUnit, area_visibility_.id());
+  }
   // Shade only the visible surface of each pixel (llvmpipe pays per shaded fragment).
   glDepthFunc(GL_EQUAL);
   glDepthMask(GL_FALSE);
@@ -548,12 +631,12 @@ void ForwardRenderer::forward_pass(const Registry& registry, Entity camera, cons
   const bool has_sky = glm::any(glm::notEqual(settings_.sky_radiance, zero)) || glm::any(glm::notEqual(sky.horizon, zero)) ||
                        glm::any(glm::notEqual(sky.zenith, zero)) || glm::any(glm::notEqual(sky.ground, zero));
   for (const LightGroup& group : groups) {
-    if (reach) glStencilFunc(GL_EQUAL, group.mask, 0xFF);
+    if (reach) glStencilFunc(GL_EQUAL, group.mask, area_lights_.empty() ? 0xFF : 0xFF & ~kAreaFallbackBit);
     glBindBufferRange(GL_SHADER_STORAGE_BUFFER, kLightsBinding, lights_buffer_.id(), group.offset,
                       static_cast<GLsizeiptr>(std::max<std::size_t>(1, group.lights.size()) * sizeof(render::GpuLight)));
     const LightCounts counts{group.count_by_type[0], group.count_by_type[1], group.count_by_type[2],
                              group.count_by_type[3], std::clamp(settings_.area_specular_samples_per_side, 1, 4),
-                             settings_.area_soft_shadows ? 1 : 0, has_sky ? 1 : 0};
+                             settings_.area_soft_shadows ? 1 : 0, has_sky ? 1 : 0, area_lights_.empty() ? 0 : 1};
     // Rough dielectrics draw with the one-specular-point variant of area lights (rough_dielectric),
     // the other materials with RenderSettings::area_specular_samples_per_side: two passes over the
     // items, each with its program, when that makes a difference.
@@ -660,6 +743,94 @@ void ForwardRenderer::forward_pass(const Registry& registry, Entity camera, cons
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }
 
+// Every item's primitives with the pre-pass's culling (double-sided materials both faces);
+// with `double_sided_uniform`, location 26 says which (area_shadow.frag.glsl flips the normal).
+void ForwardRenderer::draw_geometry(const std::vector<DrawItem>& items, bool double_sided_uniform) {
+  for (const DrawItem& item : items) {
+    glUniformMatrix4fv(0, 1, GL_FALSE, glm::value_ptr(item.model));
+    if (double_sided_uniform) {
+      const glm::mat4 normal_matrix(glm::transpose(glm::inverse(glm::mat3(item.model))));
+      glUniformMatrix4fv(4, 1, GL_FALSE, glm::value_ptr(normal_matrix));
+      glUniform1i(12, item.mesh->first_vertex);
+    }
+    for (const render::GpuPrimitive& p : item.mesh->primitives) {
+      const bool two = scene_.material(item.material_override >= 0 ? item.material_override : p.material).double_sided;
+      if (two)
+        glDisable(GL_CULL_FACE);
+      else
+        glEnable(GL_CULL_FACE);
+      if (double_sided_uniform) glUniform1i(26, two ? 1 : 0);
+      glDrawElementsBaseVertex(GL_TRIANGLES, static_cast<GLsizei>(p.index_count), GL_UNSIGNED_INT,
+                               reinterpret_cast<const void*>(static_cast<std::uintptr_t>(p.first_index) * 4u),
+                               p.base_vertex);
+    }
+  }
+}
+
+// The area lights' soft-shadow visibility at half resolution, upsampled where the surface
+// matches and computed at full resolution where it does not (area_shadow.frag.glsl), into
+// area_visibility_ for the forward pass. Needs the full-resolution depth pre-pass done.
+void ForwardRenderer::area_shadow_passes(const glm::mat4& view_proj, const glm::vec3& camera_position,
+                                         const std::vector<DrawItem>& items) {
+  const int n = static_cast<int>(area_lights_.size());
+  glNamedBufferData(area_lights_buffer_.id(), static_cast<GLsizeiptr>(area_lights_.size() * sizeof(render::GpuLight)),
+                    area_lights_.data(), GL_STREAM_DRAW);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kLightsBinding, area_lights_buffer_.id());
+  glBindTextureUnit(kShadowMapsUnit, shadow_maps_.maps_2d());
+  glBindTextureUnit(kPointShadowMapsUnit, shadow_maps_.cube_maps());
+  glBindTextureUnit(kShadowDepthUnit, shadow_maps_.maps_2d());
+  glBindSampler(kShadowDepthUnit, shadow_depth_sampler_.id());
+  const auto common_uniforms = [&](const ShaderProgram& program) {
+    program.use();
+    glUniformMatrix4fv(8, 1, GL_FALSE, glm::value_ptr(view_proj));
+    glUniform3fv(16, 1, glm::value_ptr(camera_position));
+    glUniform1i(13, 0);  // forward.vert.glsl: no vertex irradiance, no lobes
+    glUniform1i(40, 0);
+  };
+  // 1. Half resolution: depth, then each surface's visibility and tangent plane.
+  const int half_w = (width_ + 1) / 2;
+  const int half_h = (height_ + 1) / 2;
+  glBindFramebuffer(GL_FRAMEBUFFER, half_fbo_.id());
+  glViewport(0, 0, half_w, half_h);
+  const float one = 1.0f;
+  const float unlit[4] = {1.0f, 1.0f, 1.0f, 1.0f};
+  const float no_plane[4] = {0.0f, 0.0f, 0.0f, 0.0f};  // a zero normal matches no pixel
+  glClearNamedFramebufferfv(half_fbo_.id(), GL_DEPTH, 0, &one);
+  glClearNamedFramebufferfv(half_fbo_.id(), GL_COLOR, 0, unlit);
+  glClearNamedFramebufferfv(half_fbo_.id(), GL_COLOR, 1, no_plane);
+  glDepthFunc(GL_LESS);
+  glDepthMask(GL_TRUE);
+  glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+  depth_only_.use();
+  glUniformMatrix4fv(8, 1, GL_FALSE, glm::value_ptr(view_proj));
+  draw_geometry(items, false);
+  glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  glDepthFunc(GL_EQUAL);
+  glDepthMask(GL_FALSE);
+  common_uniforms(area_shadow_program(0, n));
+  draw_geometry(items, true);
+  // 2. Full resolution on the pre-pass's depth: upsample, flagging the pixels no half-resolution
+  // texel of their own surface covers in the stencil's top bit (the reach masks keep theirs).
+  glBindFramebuffer(GL_FRAMEBUFFER, visibility_fbo_.id());
+  glViewport(0, 0, width_, height_);
+  glBindTextureUnit(kAreaVisibilityUnit, half_visibility_.id());
+  glBindTextureUnit(kAreaPlaneUnit, half_plane_.id());
+  glEnable(GL_STENCIL_TEST);
+  glStencilMask(kAreaFallbackBit);
+  glStencilFunc(GL_ALWAYS, 0, 0xFF);
+  glStencilOp(GL_KEEP, GL_KEEP, GL_REPLACE);
+  common_uniforms(area_shadow_program(1, n));
+  draw_geometry(items, true);
+  // 3. The flagged pixels at full resolution (the stencil rejects the others before shading).
+  glStencilMask(0);
+  glStencilFunc(GL_EQUAL, static_cast<GLint>(kAreaFallbackBit), kAreaFallbackBit);
+  glStencilOp(GL_KEEP, GL_KEEP, GL_KEEP);
+  common_uniforms(area_shadow_program(2, n));
+  draw_geometry(items, true);
+  glDisable(GL_STENCIL_TEST);
+  glStencilMask(0xFF);
+}
+
 void ForwardRenderer::depth_prepass(const glm::mat4& view_proj, const std::vector<DrawItem>& items, bool reach) {
   glDepthFunc(GL_LESS);
   glDepthMask(GL_TRUE);
@@ -744,7 +915,7 @@ Result<std::unique_ptr<Renderer>> Renderer::create(const SceneAsset& assets, con
   GI_EXPECTS(settings.width > 0 && settings.height > 0, "RenderSettings width and height must be positive");
   if (glGetString(GL_VERSION) == nullptr)
     return Error{assets.source, "renderer", "no current OpenGL context (create an engine::GpuContext first)"};
-  auto forward = build_forward(LightCounts{0, 0, 0, 0, 3, 1, 1});
+  auto forward = build_forward(LightCounts{0, 0, 0, 0, 3, 1, 1, 0});
   if (!forward) return forward.error();
   auto depth = build("shadow.vert.glsl", "depth_only.frag.glsl");
   if (!depth) return depth.error();

@@ -149,7 +149,11 @@ LightList collect_lights(const Registry& registry, const SceneBounds& bounds, co
   std::stable_sort(collected.begin(), collected.end(), [](const auto& a, const auto& b) {
     return a.first.position_type.w < b.first.position_type.w;
   });
-  for (const auto& [g, e] : collected) {
+  int area_index = 0;
+  for (auto& [g, e] : collected) {
+    // An area light's channel in the half-resolution visibility (area_shadow.frag.glsl): its
+    // order among the frame's area lights.
+    if (static_cast<int>(g.position_type.w) == static_cast<int>(GpuLightType::Area)) g.shadow_params.z = static_cast<float>(area_index++);
     out.lights.push_back(g);
     out.entities.push_back(e);
   }
