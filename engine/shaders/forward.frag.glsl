@@ -115,7 +115,7 @@ void main() {
     const int i = POINT_LIGHTS + SPOT_LIGHTS + k;
     radiance += directional_light_radiance(lights[i], s, to_light) *
                 (lights[i].radiant.w > 0.0 ? shadow_2d_disc(lights[i], s.position, s.normal, to_light)  // the sun's disc
-                                           : shadow_2d(lights[i], s.position, s.normal, to_light, 1.0));
+                                           : shadow_2d(lights[i], s.position, s.normal, to_light, 1.0, false));
   }
 #endif
 #if AREA_LIGHTS > 0
@@ -128,7 +128,7 @@ void main() {
 #elif AREA_SOFT_SHADOWS
                 shadow_area(lights[i], s.position, s.normal, to_light);
 #else
-                shadow_2d(lights[i], s.position, s.normal, to_light, 2.0);
+                shadow_2d(lights[i], s.position, s.normal, to_light, 2.0, true);
 #endif
   }
 #endif

@@ -18,12 +18,12 @@ struct GpuLight {
   vec4 position_type;     // xyz: world position (m); w: LIGHT_* type
   vec4 direction_range;   // xyz: unit emission direction (the light's -Z); w: range (m), 0 = unlimited
   vec4 radiant;           // rgb: colour x intensity (W/sr, W/m^2 or W/(m^2 sr) by type)
-  vec4 cone;              // x: cos(outer), y: cos(inner), z: 2-D shadow layer or -1, w: shadow cube or -1
+  vec4 cone;              // x: cos(outer), y: cos(inner), z: 2-D shadow layer or -1, w: shadow cube or -1 (point; area: the grazing band)
   vec4 area_half_x;       // xyz: half of the rectangle along the light's X axis (m)
   vec4 area_half_y;       // xyz: half of the rectangle along the light's Y axis (m)
   mat4 shadow_view_proj;  // world -> clip of the 2-D shadow map
   vec4 shadow_eye;        // xyz: shadow camera position (m); w: far distance that maps to depth 1 (m)
-  vec4 shadow_params;     // x: 0 ortho / 1 distance; y: texel footprint (m, or m per m of distance); z: area lights: index among them; w: unused
+  vec4 shadow_params;     // x: 0 ortho / 1 distance; y: texel footprint (m, or m per m of distance); z: area lights: index among them; w: area lights: texel footprint of the cube map (cone.w) beyond the 2-D map
 };
 
 layout(std430, binding = 0) readonly buffer Lights { GpuLight lights[]; };

@@ -18,9 +18,26 @@ float slope_tangent(vec3 n, vec3 to_light) {
   return min(sqrt(1.0 - n_dot_l * n_dot_l) / n_dot_l, 8.0);
 }
 
+// Beyond an area light's 2-D map, which covers 150 degrees around its normal: the grazing band
+// its rectangle still lights (75-90 degrees off the normal, e.g. through a wall's far side
+// at a grazing angle). There the shadow comes from the cube map of the rectangle's centre
+// (GpuLight::cone.w, one bilinear compare tap: a hard shadow from the centre, where the
+// emitted light is at most cos 75 = 26% of the normal's). Without a cube (more area lights
+// than ShadowCapacity::max_area_cubes): unshadowed, as before.
+float shadow_area_grazing(GpuLight light, vec3 p, vec3 n, vec3 to_light) {
+  int cube = int(light.cone.w);
+  if (cube < 0) return 1.0;
+  vec3 eye = light.shadow_eye.xyz;
+  float texel = light.shadow_params.w * length(p - eye);
+  vec3 d = p + n * texel - eye;
+  float bias = texel * (1.0 + slope_tangent(n, to_light));
+  return texture(u_point_shadow_maps, vec4(d, float(cube)), (length(d) - bias) / light.shadow_eye.w);
+}
+
 // A 3x3 grid of bilinear compare taps `spacing` texels apart (1: 4x4 texel footprint,
-// 2: 6x6, the softened area-light kernel). `spacing` is passed as a literal.
-float shadow_2d(GpuLight light, vec3 p, vec3 n, vec3 to_light, float spacing) {
+// 2: 6x6, the softened area-light kernel). `spacing` and `area` (an area light: beyond the
+// map, its grazing band's cube) are passed as literals.
+float shadow_2d(GpuLight light, vec3 p, vec3 n, vec3 to_light, float spacing, bool area) {
   int layer = int(light.cone.z);
   if (layer < 0) return 1.0;
   bool ortho = light.shadow_params.x < 0.5;
@@ -31,9 +48,11 @@ float shadow_2d(GpuLight light, vec3 p, vec3 n, vec3 to_light, float spacing) {
   float texel = ortho ? light.shadow_params.y : light.shadow_params.y * dist;
   vec3 po = p + n * texel;
   vec4 clip = light.shadow_view_proj * vec4(po, 1.0);
-  if (clip.w <= 0.0) return 1.0;
+  // Beyond the map: an area light's grazing band (its centre-shadowed variant), else unshadowed.
+  float beyond = area ? shadow_area_grazing(light, p, n, to_light) : 1.0;
+  if (clip.w <= 0.0) return beyond;
   vec2 uv = clip.xy / clip.w * 0.5 + 0.5;
-  if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)))) return 1.0;
+  if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)))) return beyond;
   float d = ortho ? dot(po - eye, axis) : length(po - eye);
   float bias = texel * (1.0 + spacing * slope_tangent(n, to_light));
   float ref = (d - bias) / far_m;
@@ -187,9 +206,9 @@ float shadow_area(GpuLight light, vec3 p, vec3 n, vec3 to_light) {
   float texel = light.shadow_params.y * length(p - eye);
   vec3 po = p + n * texel;
   vec4 clip = light.shadow_view_proj * vec4(po, 1.0);
-  if (clip.w <= 0.0) return 1.0;
+  if (clip.w <= 0.0) return shadow_area_grazing(light, p, n, to_light);
   vec2 uv = clip.xy / clip.w * 0.5 + 0.5;
-  if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)))) return 1.0;
+  if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)))) return shadow_area_grazing(light, p, n, to_light);
   vec3 rel = po - eye;
   float d = length(rel);
   float bias = texel * (1.0 + slope_tangent(n, to_light));

@@ -59,6 +59,25 @@ LightList collect_lights(const Registry& registry, const SceneBounds& bounds, co
                          std::vector<std::pair<Entity, const char*>>* skipped) {
   LightList out;
   std::vector<std::pair<GpuLight, Entity>> collected;
+  // Six 90 degree faces from `position` into the next slice of the cube-map array.
+  const auto add_cube = [&](const glm::vec3& position, float far_m) {
+    const float near_m = std::max(0.01f, far_m * 1e-4f);
+    const glm::mat4 proj = glm::perspective(glm::radians(90.0f), 1.0f, near_m, far_m);
+    // GL cube-map face order and orientation (+X, -X, +Y, -Y, +Z, -Z).
+    const glm::vec3 face_dir[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    const glm::vec3 face_up[6] = {{0, -1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}, {0, -1, 0}, {0, -1, 0}};
+    for (int f = 0; f < 6; ++f) {
+      ShadowView v;
+      v.view_proj = proj * glm::lookAt(position, position + face_dir[f], face_up[f]);
+      v.eye = position;
+      v.far_m = far_m;
+      v.cube = true;
+      v.layer = out.cubes * 6 + f;
+      out.shadow_views.push_back(v);
+    }
+    return out.cubes++;
+  };
+  int point_cubes = 0, area_cubes = 0;
   registry.view<Light, WorldTransform>().each([&](Entity e, const Light& light, const WorldTransform& wt) {
     if (!light.enabled) return;
     if (const char* why = unusable_light(light, wt.matrix)) {
@@ -90,23 +109,10 @@ LightList collect_lights(const Registry& registry, const SceneBounds& bounds, co
     }
 
     const bool shadowed = light.cast_shadows && !bounds.empty;
-    if (shadowed && light.type == LightType::Point && out.cubes < capacity.max_cubes) {
+    if (shadowed && light.type == LightType::Point && point_cubes < capacity.max_cubes) {
       const float far_m = (light.range_m > 0.0f ? light.range_m : farthest_corner(position, bounds)) * 1.01f;
-      const float near_m = std::max(0.01f, far_m * 1e-4f);
-      const glm::mat4 proj = glm::perspective(glm::radians(90.0f), 1.0f, near_m, far_m);
-      // GL cube-map face order and orientation (+X, -X, +Y, -Y, +Z, -Z).
-      const glm::vec3 face_dir[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
-      const glm::vec3 face_up[6] = {{0, -1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}, {0, -1, 0}, {0, -1, 0}};
-      for (int f = 0; f < 6; ++f) {
-        ShadowView v;
-        v.view_proj = proj * glm::lookAt(position, position + face_dir[f], face_up[f]);
-        v.eye = position;
-        v.far_m = far_m;
-        v.cube = true;
-        v.layer = out.cubes * 6 + f;
-        out.shadow_views.push_back(v);
-      }
-      g.cone.w = static_cast<float>(out.cubes++);
+      ++point_cubes;
+      g.cone.w = static_cast<float>(add_cube(position, far_m));
       g.shadow_eye = glm::vec4(position, far_m);
       g.shadow_params = glm::vec4(1.0f, 2.0f / static_cast<float>(capacity.cube_size), 0.0f, 0.0f);
     } else if (shadowed && light.type != LightType::Point && out.layers_2d < capacity.max_2d_layers) {
@@ -141,6 +147,14 @@ LightList collect_lights(const Registry& registry, const SceneBounds& bounds, co
       g.shadow_view_proj = v.view_proj;
       g.shadow_eye = glm::vec4(v.eye, v.far_m);
       g.shadow_params = glm::vec4(v.ortho ? 0.0f : 1.0f, texel, 0.0f, 0.0f);
+      // The 2-D map covers kAreaShadowFov; the rectangle lights its whole front half-space.
+      // Beyond the map (the grazing band, 75-90 degrees off its normal) the shadow is looked up
+      // in a cube map from the rectangle's centre (shadow_common.glsl's shadow_area_grazing).
+      if (light.type == LightType::Area && area_cubes < capacity.max_area_cubes) {
+        ++area_cubes;
+        g.cone.w = static_cast<float>(add_cube(position, v.far_m));
+        g.shadow_params.w = 2.0f / static_cast<float>(capacity.cube_size);
+      }
     }
     collected.emplace_back(g, e);
   });

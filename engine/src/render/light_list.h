@@ -2,7 +2,8 @@
 // Turns the registry's enabled lights into GpuLight records and plans their shadow maps:
 // directional (orthographic, fitted to the scene bounds), spot (perspective, the cone),
 // area (perspective with a 150 degree field of view from the rectangle's centre; the shader
-// soft-shadows it over the rectangle, shadow_common.glsl's shadow_area),
+// soft-shadows it over the rectangle, shadow_common.glsl's shadow_area; beyond it, a cube
+// map from the centre for the grazing band),
 // point (a cube-map-array slice, six 90 degree faces).
 
 #include <array>
@@ -21,6 +22,9 @@ struct ShadowCapacity {
   int cube_size = 512;     ///< Texels per side of a cube face.
   int max_2d_layers = 8;   ///< Directional, spot and area lights with shadows beyond this are unshadowed.
   int max_cubes = 4;       ///< Point lights with shadows beyond this are unshadowed.
+  /// Area lights with a cube map for the grazing band beyond their 2-D map (more: unshadowed
+  /// there). In the same cube-map array, after or between the point lights' cubes.
+  int max_area_cubes = 4;
 };
 
 struct LightList {
