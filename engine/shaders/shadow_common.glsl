@@ -64,23 +64,38 @@ float shadow_2d(GpuLight light, vec3 p, vec3 n, vec3 to_light, float spacing, bo
   return sum / 9.0;
 }
 
+// Where a receiver p (normal n) falls in a light's perspective 2-D map (spot and area lights):
+// p offset along n by one texel at its distance, in the map's clip space and uv. False when
+// it falls outside the map or behind the eye.
+struct MapLookup {
+  vec3 eye;     // the map's eye (m)
+  float far_m;  // the distance that maps to depth 1 (m)
+  float texel;  // one texel's footprint at p (m)
+  vec3 po;      // p offset along its normal by one texel
+  vec4 clip;    // po in the map's clip space
+  vec2 uv;
+};
+bool perspective_lookup(GpuLight light, vec3 p, vec3 n, out MapLookup m) {
+  m.eye = light.shadow_eye.xyz;
+  m.far_m = light.shadow_eye.w;
+  m.texel = light.shadow_params.y * length(p - m.eye);
+  m.po = p + n * m.texel;
+  m.clip = light.shadow_view_proj * vec4(m.po, 1.0);
+  if (m.clip.w <= 0.0) return false;
+  m.uv = m.clip.xy / m.clip.w * 0.5 + 0.5;
+  return !(any(lessThan(m.uv, vec2(0.0))) || any(greaterThan(m.uv, vec2(1.0))));
+}
+
 // A spot light's 2-D map: one bilinear compare tap. The spot is a point source, its shadow
 // hard: the bilinear weights anti-alias the edge (shadow_2d's 3 x 3 grid widened it to 4 x 4
 // texels for 9 lookups on every pixel the flashlight covers).
 float shadow_2d_point(GpuLight light, vec3 p, vec3 n, vec3 to_light) {
   int layer = int(light.cone.z);
   if (layer < 0) return 1.0;
-  vec3 eye = light.shadow_eye.xyz;
-  float far_m = light.shadow_eye.w;
-  float dist = length(p - eye);
-  float texel = light.shadow_params.y * dist;
-  vec3 po = p + n * texel;
-  vec4 clip = light.shadow_view_proj * vec4(po, 1.0);
-  if (clip.w <= 0.0) return 1.0;
-  vec2 uv = clip.xy / clip.w * 0.5 + 0.5;
-  if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)))) return 1.0;
-  float bias = texel * (1.0 + slope_tangent(n, to_light));
-  return texture(u_shadow_maps, vec4(uv, float(layer), (length(po - eye) - bias) / far_m));
+  MapLookup m;
+  if (!perspective_lookup(light, p, n, m)) return 1.0;
+  float bias = m.texel * (1.0 + slope_tangent(n, to_light));
+  return texture(u_shadow_maps, vec4(m.uv, float(layer), (length(m.po - m.eye) - bias) / m.far_m));
 }
 
 float shadow_cube(GpuLight light, vec3 p, vec3 n, vec3 to_light) {
@@ -201,15 +216,12 @@ const float kAreaFilterTexels = 32.0;
 float shadow_area(GpuLight light, vec3 p, vec3 n, vec3 to_light) {
   int layer = int(light.cone.z);
   if (layer < 0) return 1.0;
-  vec3 eye = light.shadow_eye.xyz;
-  float far_m = light.shadow_eye.w;
-  float texel = light.shadow_params.y * length(p - eye);
-  vec3 po = p + n * texel;
-  vec4 clip = light.shadow_view_proj * vec4(po, 1.0);
-  if (clip.w <= 0.0) return shadow_area_grazing(light, p, n, to_light);
-  vec2 uv = clip.xy / clip.w * 0.5 + 0.5;
-  if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)))) return shadow_area_grazing(light, p, n, to_light);
-  vec3 rel = po - eye;
+  MapLookup m;
+  if (!perspective_lookup(light, p, n, m)) return shadow_area_grazing(light, p, n, to_light);
+  float far_m = m.far_m, texel = m.texel;
+  vec4 clip = m.clip;
+  vec2 uv = m.uv;
+  vec3 rel = m.po - m.eye;
   float d = length(rel);
   float bias = texel * (1.0 + slope_tangent(n, to_light));
   vec2 size = vec2(textureSize(u_shadow_maps, 0).xy);
