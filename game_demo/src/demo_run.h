@@ -30,7 +30,7 @@ struct RunOptions {
   bool area_soft_shadows = true;   ///< --area-shadows soft|centre (engine::RenderSettings::area_soft_shadows).
   bool light_reach_culling = true;  ///< --light-reach on|off (engine::RenderSettings::light_reach_culling).
   /// --area-shadow-res full|half (engine::RenderSettings::area_shadow_res).
-  engine::AreaShadowRes area_shadow_res = engine::AreaShadowRes::Full;
+  engine::AreaShadowRes area_shadow_res = engine::AreaShadowRes::Half;
   bool size_given = false;
   std::uint64_t every = 1;
   bool exr = false;

@@ -101,7 +101,7 @@ int main(int argc, char** argv) {
   RunOptions o;
   std::string area_shadows = "soft";
   std::string light_reach = "on";
-  std::string area_shadow_res = "full";
+  std::string area_shadow_res = "half";
   CLI::App app{"gi_demo: the playable demo level of the GI module"};
   app.add_option("--scene", o.scene, "glTF scene to play (default: assets/demo_level.gltf)");
   app.add_flag("--headless", o.headless, "Run without a window (EGL surfaceless), driven by --script or --replay");
@@ -119,8 +119,8 @@ int main(int argc, char** argv) {
                  "on every pixel (engine::RenderSettings::light_reach_culling)")
       ->check(CLI::IsMember({"on", "off"}));
   app.add_option("--area-shadow-res", area_shadow_res,
-                 "full: area lights' soft shadows per pixel (default); half: at half resolution, upsampled on "
-                 "each pixel's own surface (engine::RenderSettings::area_shadow_res)")
+                 "half: area lights' soft shadows at half resolution, upsampled on each pixel's own surface "
+                 "(default); full: per pixel (engine::RenderSettings::area_shadow_res)")
       ->check(CLI::IsMember({"full", "half"}));
   app.add_option("--every", o.every, "Headless: write every K-th frame")->check(CLI::PositiveNumber);
   app.add_flag("--exr", o.exr, "Headless: also write DIR/frame_NNNN.exr (linear HDR)");

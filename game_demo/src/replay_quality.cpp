@@ -137,7 +137,7 @@ int main(int argc, char** argv) {
   app.add_option("--session", session_path, "Recorded session (.girec)")->required()->check(CLI::ExistingFile);
   app.add_option("--bundle", bundles,
                  "NAME=DIR of a bake bundle, or 'none' for the stand-in (repeatable); NAME=DIR,area-shadows=centre "
-                 "shadows area lights from their centre only (default soft); NAME=DIR,light-reach=off[,area-shadows=...][,area-shadow-res=half] "
+                 "shadows area lights from their centre only (default soft); NAME=DIR,light-reach=off[,area-shadows=...][,area-shadow-res=full|half] "
                  "shades every light on every pixel (default on)")
       ->required();
   app.add_option("--frames", frames_text, "Comma-separated frames compared with the path tracer");
@@ -222,8 +222,8 @@ int main(int argc, char** argv) {
     const std::size_t eq = spec.find('=');
     row.name = eq == std::string::npos ? spec : spec.substr(0, eq);
     row.bundle = eq == std::string::npos ? "" : spec.substr(eq + 1);
-    // ",area-shadow-res=half" (RenderSettings::area_shadow_res), last.
-    engine::AreaShadowRes area_shadow_res = engine::AreaShadowRes::Full;
+    // ",area-shadow-res=full|half" (RenderSettings::area_shadow_res, default half), last.
+    engine::AreaShadowRes area_shadow_res = engine::AreaShadowRes::Half;
     if (const std::size_t opt = row.bundle.find(",area-shadow-res="); opt != std::string::npos) {
       const std::string value = row.bundle.substr(opt + 17);
       if (value != "full" && value != "half") {

@@ -73,8 +73,9 @@ struct RenderSettings {
   /// (tangent plane within 2 cm + 1% of the camera distance, normals within ~25 degrees);
   /// a pixel none of them matches (geometry edges) is computed at full resolution. The light
   /// reach masks then keep 7 lights (the stencil's top bit flags those pixels).
-  /// docs/performance-frame.md has the cost and the error.
-  AreaShadowRes area_shadow_res = AreaShadowRes::Full;
+  /// docs/performance-frame.md has the cost (-10 to -21% of the demo level's frame CPU) and
+  /// the error (none measurable against the path tracer: docs/replay_quality.md).
+  AreaShadowRes area_shadow_res = AreaShadowRes::Half;
   /// Static lights shade only where static geometry lets them reach (engine/light_reach.h):
   /// a voxel grid of light masks built from the static shadow casters when they or the
   /// static lights change, written to the stencil by the depth pre-pass; each pixel is
