@@ -10,7 +10,9 @@
 // polygon formula) times the diffuse lobe's Fresnel weight averaged over n x n stratified
 // points, specular those points weighted by cos_l dA / d^2.
 // Shadows: cube maps (point), orthographic fitted to the scene bounds (directional),
-// perspective (spot; area from the rectangle's centre with 150 degrees and a wider kernel).
+// perspective (spot; area from the rectangle's centre with 150 degrees, soft over the
+// rectangle by PCSS at half resolution by default, and beyond the 150 degrees a cube map from
+// the centre for the grazing band).
 //   auto ctx = engine::GpuContext::create_headless();              // engine/gpu/context.h
 //   auto r = engine::Renderer::create(scene.assets, {.width = 640, .height = 360});
 //   r.value()->render(scene.registry, engine::find_camera(scene.registry));
