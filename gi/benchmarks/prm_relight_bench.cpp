@@ -105,10 +105,57 @@ double median(std::vector<double> v) {
   return v.empty() ? 0.0 : v[v.size() / 2];
 }
 
+// Per-texel error of the atlas summed from `test` panes against the one from `ref` panes, over
+// the 8 poses' K-sums (sum_panes, the GPU pass's CPU twin): over the lit texels (largest
+// channel in `ref` above 1e-6 of the pose's brightest texel: below it half floats flush pane
+// values to zero), a texel's error is max over channels |test - ref| / its largest channel.
+struct AtlasError {
+  double max = 0.0, p95 = 0.0;
+  double rel_rmse = 0.0;   // sqrt(sum |test - ref|^2 / sum |ref|^2) over the lit texels and channels
+  double total = 0.0;      // |sum test - sum ref| / sum ref (all channels)
+};
+AtlasError atlas_error(const gi::Prm& test, const gi::Prm& ref, const std::vector<std::vector<gi::ClusterWeight>>& picks) {
+  std::vector<double> rel;
+  double d2 = 0.0, r2 = 0.0, st = 0.0, sr = 0.0;
+  for (const auto& picked : picks) {
+    const std::vector<glm::vec3> a = gi::sum_panes(test, picked), b = gi::sum_panes(ref, picked);
+    float brightest = 0.0f;
+    for (const glm::vec3& v : b) brightest = std::max({brightest, v.x, v.y, v.z});
+    for (std::size_t t = 0; t < a.size(); ++t) {
+      const float top = std::max({b[t].x, b[t].y, b[t].z});
+      if (!(top > 1e-6f * brightest)) continue;
+      const glm::vec3 e = glm::abs(a[t] - b[t]);
+      rel.push_back(static_cast<double>(std::max({e.x, e.y, e.z}) / top));
+      d2 += static_cast<double>(glm::dot(e, e));
+      r2 += static_cast<double>(glm::dot(b[t], b[t]));
+      st += static_cast<double>(a[t].x + a[t].y + a[t].z);
+      sr += static_cast<double>(b[t].x + b[t].y + b[t].z);
+    }
+  }
+  AtlasError out;
+  if (rel.empty()) return out;
+  std::sort(rel.begin(), rel.end());
+  out.max = rel.back();
+  out.p95 = rel[rel.size() * 95 / 100];
+  out.rel_rmse = std::sqrt(d2 / r2);
+  out.total = std::abs(st - sr) / sr;
+  return out;
+}
+
+gi::Prm with_panes(const gi::Prm& prm, gi::PrmPaneEncoding encoding) {
+  gi::Prm out = prm;
+  out.panes = or_exit(gi::decoded_panes(prm, encoding));
+  return out;
+}
+
+// Argument: the pane encoding (0 half floats, 1 RGB9E5). Extra counters: the K-sum atlas's
+// error under this encoding against half floats (err_vs_half_*) and against the float panes
+// (err_vs_float_*), per texel (max, p95), rel RMSE and total, over the 8 poses.
 void BM_PrmLightChange(benchmark::State& state) {
   const DemoLevel& d = demo_level();
   (void)bench::gl_context();
-  gi::PrmGpuPass pass = or_exit(gi::PrmGpuPass::create(d.prm));
+  const auto encoding = static_cast<gi::PrmPaneEncoding>(state.range(0));
+  gi::PrmGpuPass pass = or_exit(gi::PrmGpuPass::create(d.prm, {.encoding = encoding}));
   constexpr int kActive = 32;  // GISystemSettings::prm_active_clusters
 
   // The yardstick: the light atlas re-baked (preview), once, in this run.
@@ -130,6 +177,7 @@ void BM_PrmLightChange(benchmark::State& state) {
   std::vector<double> cpu, gpu, cpu_time, gpu_time;
   std::size_t frame = 0, clusters = 0;
   std::vector<gi::ClusterWeight> last_picked;
+  std::vector<std::vector<gi::ClusterWeight>> picks;  // one per pose
   for (auto _ : state) {
     const double c0 = process_cpu_ms();
     const auto t0 = Clock::now();
@@ -150,6 +198,7 @@ void BM_PrmLightChange(benchmark::State& state) {
     gpu.push_back(std::chrono::duration<double, std::milli>(t2 - t1).count());
     clusters = picked.size();
     last_picked = picked;
+    if (picks.size() < poses.size()) picks.push_back(picked);
   }
   // The pane sum's fixed part: no cluster selected (the texel list read, every texel written).
   std::vector<double> empty, empty_time;
@@ -162,6 +211,21 @@ void BM_PrmLightChange(benchmark::State& state) {
     empty_time.push_back(process_cpu_ms() - c0);
   }
   state.counters["gpu_k0_ms"] = median(empty);
+  state.counters["pane_mb"] = static_cast<double>(pass.pane_bytes()) / 1e6;
+  {
+    const gi::Prm mine = with_panes(d.prm, encoding);
+    const gi::Prm half = with_panes(d.prm, gi::PrmPaneEncoding::Half);
+    const AtlasError vs_half = atlas_error(mine, half, picks);
+    const AtlasError vs_float = atlas_error(mine, d.prm, picks);
+    state.counters["err_vs_half_max"] = vs_half.max;
+    state.counters["err_vs_half_p95"] = vs_half.p95;
+    state.counters["err_vs_half_rmse"] = vs_half.rel_rmse;
+    state.counters["err_vs_half_total"] = vs_half.total;
+    state.counters["err_vs_float_max"] = vs_float.max;
+    state.counters["err_vs_float_p95"] = vs_float.p95;
+    state.counters["err_vs_float_rmse"] = vs_float.rel_rmse;
+    state.counters["err_vs_float_total"] = vs_float.total;
+  }
   state.counters["gpu_k0_cpu_time_ms"] = median(empty_time);
   // Process CPU time (all threads) of each part: steadier than wall time under load.
   state.counters["cpu_cpu_time_ms"] = median(cpu_time);
@@ -209,7 +273,13 @@ void BM_PrmLightChange(benchmark::State& state) {
     state.counters["picked_nonzero_blocks"] = picked_total ? double(picked_nonzero) / double(picked_total) : 0.0;
   }
 }
-BENCHMARK(BM_PrmLightChange)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
+BENCHMARK(BM_PrmLightChange)
+    ->ArgName("rgb9e5")
+    ->Arg(0)
+    ->Arg(1)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MinTime(2.0);
 
 // The CPU part's two ray sets alone, on the same poses: the flux check (64^2 directions from
 // the lamp, closest hits) and the entry points' shadow rays with their kernels (no flux check).

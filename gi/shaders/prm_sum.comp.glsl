@@ -50,6 +50,17 @@ const uint kBlock = 8u;  // elements per invocation
 
 ivec2 coord_of(uint texel) { return ivec2(int(texel & 0xffffu), int(texel >> 16)); }
 
+#ifdef PRM_PANES_RGB9E5
+// One shared-exponent element: R, G, B 9-bit mantissas in bits 0-8, 9-17, 18-26, the
+// exponent e in bits 27-31, value = mantissa x 2^(e - 24). The 2^-24 is folded into the
+// weight (prm_gpu_pass.cpp), so this builds 2^e from its bits: integer ops and three
+// int-to-float conversions.
+vec3 rgb9e5(uint w) {
+  const float scale = uintBitsToFloat((w >> 27) + 127u << 23);
+  return vec3(float(w & 511u), float(w >> 9 & 511u), float(w >> 18 & 511u)) * scale;
+}
+#endif
+
 void main() {
   const uint group = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
   const uint block = group * gl_WorkGroupSize.x + gl_LocalInvocationIndex;
@@ -74,6 +85,19 @@ void main() {
   for (uint k = 0u; k < u_weight_count; ++k) {
     const uvec4 wk = texelFetch(weights, int(u_first_weight + k));
     const vec3 weight = uintBitsToFloat(wk.xyz);
+#ifdef PRM_PANES_RGB9E5
+    const uint at = wk.w + 2u * block;  // 8 words: one RGB9E5 element each
+    const uvec4 a = texelFetch(pane_blocks, int(at));
+    const uvec4 b = texelFetch(pane_blocks, int(at + 1u));
+    sum[0] += weight * rgb9e5(a.x);
+    sum[1] += weight * rgb9e5(a.y);
+    sum[2] += weight * rgb9e5(a.z);
+    sum[3] += weight * rgb9e5(a.w);
+    sum[4] += weight * rgb9e5(b.x);
+    sum[5] += weight * rgb9e5(b.y);
+    sum[6] += weight * rgb9e5(b.z);
+    sum[7] += weight * rgb9e5(b.w);
+#else
     const uint at = wk.w + 3u * block;  // 24 halves: R0 G0 B0 R1 ... B7
     const uvec4 a = texelFetch(pane_blocks, int(at));
     const uvec4 b = texelFetch(pane_blocks, int(at + 1u));
@@ -89,6 +113,7 @@ void main() {
     sum[5] += weight * vec3(h7.y, h8.x, h8.y);
     sum[6] += weight * vec3(h9.x, h9.y, h10.x);
     sum[7] += weight * vec3(h10.y, h11.x, h11.y);
+#endif
   }
   for (uint e = 0u; e < kBlock; ++e)
     if (e < count) imageStore(out_image, coord_of(texel[e]), vec4(sum[e], 1.0));

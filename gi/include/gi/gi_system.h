@@ -45,6 +45,9 @@ namespace gi {
 
 struct GISystemSettings {
   int prm_active_clusters = 32;      ///< PRM: panes summed per update (the heaviest K; 0: all).
+  /// PRM: panes in GPU memory as RGB9E5 (4 bytes a texel) instead of half floats (6), a third
+  /// fewer bytes per light change; <= 2e-3 of a texel's largest channel (docs/prm.md).
+  bool prm_shared_exponent_panes = true;
   int brf_bounces = 3;               ///< BRF: bounces between dynamic objects.
   float brf_cull_threshold = 1e-3f;  ///< BRF: skip object pairs below this share of the largest (§5.4).
   float probe_spacing_m = 1.0f;      ///< BRF: spacing of the world-light probes for dynamic objects.

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <string>
 
 #include <glm/gtc/packing.hpp>
@@ -18,7 +19,7 @@ namespace {
 constexpr const char* kWhere = "PRM GPU pass";
 constexpr std::size_t kSsboLimitBytes = std::size_t{128} << 20;  // DESIGN.md §4 (llvmpipe): per buffer
 constexpr std::uint32_t kGroupSize = 64;  // local_size_x of prm_sum.comp.glsl
-constexpr std::size_t kBlock = 8;         // elements an invocation sums (three uvec4s of halves per pane)
+constexpr std::size_t kBlock = 8;         // elements an invocation sums (per pane three uvec4s of halves or two of RGB9E5)
 constexpr std::uint32_t kMaxGroupsPerDimension = 65535;
 
 /// The weight of one selected cluster as prm_sum.comp.glsl reads it (std430 PaneWeight).
@@ -33,28 +34,94 @@ enum class SumMode : std::uint32_t { Zero = 0, Base = 1, Accumulate = 2 };
 
 engine::Error error(std::string message) { return engine::Error{"", kWhere, std::move(message)}; }
 
-/// Words of one packed pane: 3 halves per element, two per word, whole blocks of eight
-/// elements (12 words, three uvec4s: the shader reads a block's three even for a short last
-/// block), so every pane starts on a 16-byte boundary.
-std::size_t pane_stride_words(std::size_t elements) { return 12 * ((elements + kBlock - 1) / kBlock); }
+/// Words of one packed block of eight elements: 24 halves in three uvec4s, or eight RGB9E5
+/// words in two. The shader reads a block's uvec4s whole, even for a short last block.
+std::size_t block_words(PrmPaneEncoding encoding) { return encoding == PrmPaneEncoding::Half ? 12 : 8; }
+
+/// Words of one packed pane: whole blocks, so every pane starts on a 16-byte boundary.
+std::size_t pane_stride_words(std::size_t elements, PrmPaneEncoding encoding) {
+  return block_words(encoding) * ((elements + kBlock - 1) / kBlock);
+}
 
 /// The power of two exponent s such that the pane's largest |value| x 2^s lies in
-/// [2^14, 2^15): the top of the half range without overflow. 0 for an all-zero pane.
-int pane_scale_exponent(std::span<const float> pane) {
+/// [2^14, 2^15): the top of the half range without overflow (and below RGB9E5's largest
+/// value, 65408). 0 for an all-zero pane. Capped so the inverse scale (times RGB9E5's 2^-24)
+/// stays a normal float.
+int pane_scale_exponent(std::span<const float> pane, PrmPaneEncoding encoding) {
   float largest = 0.0f;
   for (float v : pane) largest = std::max(largest, std::abs(v));
   if (largest == 0.0f) return 0;
   int e = 0;
   (void)std::frexp(largest, &e);  // largest = m 2^e, m in [0.5, 1)
-  return std::min(15 - e, 126);   // keep the inverse scale 2^-s a normal float
+  return std::min(15 - e, encoding == PrmPaneEncoding::Half ? 126 : 126 - 24);
+}
+
+// RGB9E5 as GL's EXT_texture_shared_exponent defines it (N = 9 mantissa bits, bias B = 15),
+// but decoded as mantissa x 2^(e - 24) (prm_sum.comp.glsl folds the 2^-24 into the weight).
+constexpr int kMantissaBits = 9;
+constexpr int kExponentBias = 15;
+constexpr int kMantissaShift = kExponentBias + kMantissaBits;  // 24
+
+/// Encodes non-negative r, g, b below 2^15 (the pane scale puts them there).
+std::uint32_t encode_rgb9e5(float r, float g, float b) {
+  const float largest = std::max({r, g, b});
+  if (!(largest > 0.0f)) return 0u;
+  int e = 0;
+  (void)std::frexp(largest, &e);  // floor(log2(largest)) = e - 1
+  int shared = std::max(-kExponentBias - 1, e - 1) + 1 + kExponentBias;
+  const auto quantize = [](float v, int exponent) {
+    return static_cast<std::uint32_t>(std::floor(std::ldexp(static_cast<double>(v), kMantissaShift - exponent) + 0.5));
+  };
+  if (quantize(largest, shared) == (1u << kMantissaBits)) ++shared;  // rounded up to the next power of two
+  shared = std::min(shared, 31);
+  const std::uint32_t limit = (1u << kMantissaBits) - 1u;
+  return std::min(quantize(r, shared), limit) | std::min(quantize(g, shared), limit) << 9 |
+         std::min(quantize(b, shared), limit) << 18 | static_cast<std::uint32_t>(shared) << 27;
+}
+
+glm::vec3 decode_rgb9e5(std::uint32_t w) {
+  const float scale = std::ldexp(1.0f, static_cast<int>(w >> 27) - kMantissaShift);
+  return glm::vec3(static_cast<float>(w & 511u), static_cast<float>(w >> 9 & 511u), static_cast<float>(w >> 18 & 511u)) *
+         scale;
 }
 
 /// Packs `pane` (3 floats per element) scaled by 2^exponent into `words` (zeroed, stride long).
-void pack_pane(std::span<const float> pane, int exponent, std::span<std::uint32_t> words) {
-  for (std::size_t h = 0; h < pane.size(); ++h) {
-    const std::uint32_t half = glm::packHalf1x16(std::ldexp(pane[h], exponent));
-    words[h / 2] |= half << (16 * (h & 1));
+void pack_pane(std::span<const float> pane, int exponent, PrmPaneEncoding encoding, std::span<std::uint32_t> words) {
+  if (encoding == PrmPaneEncoding::Half) {
+    for (std::size_t h = 0; h < pane.size(); ++h) {
+      const std::uint32_t half = glm::packHalf1x16(std::ldexp(pane[h], exponent));
+      words[h / 2] |= half << (16 * (h & 1));
+    }
+    return;
   }
+  for (std::size_t i = 0; i < pane.size() / 3; ++i)
+    words[i] = encode_rgb9e5(std::ldexp(pane[3 * i], exponent), std::ldexp(pane[3 * i + 1], exponent),
+                             std::ldexp(pane[3 * i + 2], exponent));
+}
+
+/// The values `pack_pane` stored, unscaled again: what the shader sums.
+void unpack_pane(std::span<const std::uint32_t> words, int exponent, PrmPaneEncoding encoding, std::span<float> pane) {
+  if (encoding == PrmPaneEncoding::Half) {
+    for (std::size_t h = 0; h < pane.size(); ++h)
+      pane[h] = std::ldexp(glm::unpackHalf1x16(static_cast<std::uint16_t>(words[h / 2] >> (16 * (h & 1)))), -exponent);
+    return;
+  }
+  for (std::size_t i = 0; i < pane.size() / 3; ++i) {
+    const glm::vec3 v = decode_rgb9e5(words[i]);
+    for (int ch = 0; ch < 3; ++ch) pane[3 * i + static_cast<std::size_t>(ch)] = std::ldexp(v[ch], -exponent);
+  }
+}
+
+/// Error naming the first pane value the encoding cannot hold, if any.
+std::optional<engine::Error> check_pane_values(const Prm& prm, PrmPaneEncoding encoding) {
+  const std::size_t elements = std::max<std::size_t>(prm.texels.size(), 1);
+  for (std::size_t f = 0; f < prm.panes.size(); ++f) {
+    const bool finite = std::isfinite(prm.panes[f]);
+    if (finite && (encoding == PrmPaneEncoding::Half || prm.panes[f] >= 0.0f)) continue;
+    return error("pane " + std::to_string(f / 3 / elements) + " element " + std::to_string(f / 3 % elements) +
+                 (finite ? " is negative (the shared-exponent encoding holds only values >= 0)" : " is not finite"));
+  }
+  return std::nullopt;
 }
 
 std::size_t gl_limit(GLenum name) {
@@ -88,10 +155,7 @@ engine::Result<PrmGpuPass> PrmGpuPass::create(const Prm& prm, const PrmGpuPassOp
   if (prm.panes.size() / 3 / std::max<std::size_t>(elements, 1) != clusters || prm.panes.size() != clusters * elements * 3)
     return error("panes hold " + std::to_string(prm.panes.size()) + " floats, expected " + std::to_string(clusters) +
                  " clusters x " + std::to_string(elements) + " texels x 3");
-  for (std::size_t f = 0; f < prm.panes.size(); ++f)
-    if (!std::isfinite(prm.panes[f]))
-      return error("pane " + std::to_string(f / 3 / elements) + " element " + std::to_string(f / 3 % elements) +
-                   " is not finite");
+  if (auto bad = check_pane_values(prm, options.encoding)) return *bad;
 
   // Every input is read through an RGBA32UI buffer texture: at most GL_MAX_TEXTURE_BUFFER_SIZE
   // texels of 16 bytes each.
@@ -101,7 +165,7 @@ engine::Result<PrmGpuPass> PrmGpuPass::create(const Prm& prm, const PrmGpuPassOp
   if (texel_bytes > buffer_limit)
     return error(std::to_string(elements) + " pane texels need " + std::to_string(texel_bytes) +
                  " bytes, above the buffer limit of " + std::to_string(buffer_limit));
-  const std::size_t stride = pane_stride_words(elements);
+  const std::size_t stride = pane_stride_words(elements, options.encoding);
   const std::size_t pane_bytes = stride * sizeof(std::uint32_t);
   if (pane_bytes > buffer_limit)
     return error("one pane of " + std::to_string(elements) + " texels needs " + std::to_string(pane_bytes) +
@@ -111,12 +175,14 @@ engine::Result<PrmGpuPass> PrmGpuPass::create(const Prm& prm, const PrmGpuPassOp
   pass.width_ = prm.width;
   pass.height_ = prm.height;
   pass.element_count_ = static_cast<std::uint32_t>(elements);
+  pass.decode_scale_ = options.encoding == PrmPaneEncoding::Half ? 1.0f : std::ldexp(1.0f, -kMantissaShift);
   pass.max_groups_x_ = options.max_groups_x > 0 ? std::min(options.max_groups_x, kMaxGroupsPerDimension)
                                                 : kMaxGroupsPerDimension;
 
-  auto program = engine::ShaderProgramBuilder(gi_shader_files())
-                     .stage(engine::ShaderStage::Compute, "prm_sum.comp.glsl")
-                     .build();
+  engine::ShaderProgramBuilder builder(gi_shader_files());
+  builder.stage(engine::ShaderStage::Compute, "prm_sum.comp.glsl");
+  if (options.encoding == PrmPaneEncoding::SharedExponent) builder.define("PRM_PANES_RGB9E5 1");
+  auto program = builder.build();
   if (!program) return program.error();
   pass.program_ = std::move(program).value();
   const GLuint id = pass.program_.id();
@@ -132,9 +198,9 @@ engine::Result<PrmGpuPass> PrmGpuPass::create(const Prm& prm, const PrmGpuPassOp
     words.assign(count * stride, 0u);
     for (std::size_t c = first; c < first + count; ++c) {
       const std::span<const float> pane(prm.panes.data() + c * elements * 3, elements * 3);
-      const int exponent = pane_scale_exponent(pane);
+      const int exponent = pane_scale_exponent(pane, options.encoding);
       const std::size_t offset = (c - first) * stride;
-      pack_pane(pane, exponent, std::span<std::uint32_t>(words).subspan(offset, stride));
+      pack_pane(pane, exponent, options.encoding, std::span<std::uint32_t>(words).subspan(offset, stride));
       pass.panes_[c] = {static_cast<std::uint32_t>(pass.pane_buffers_.size()), static_cast<std::uint32_t>(offset),
                         std::ldexp(1.0f, -exponent)};
     }
@@ -198,7 +264,7 @@ engine::Status PrmGpuPass::run(std::span<const ClusterWeight> selected) {
     for (const ClusterWeight& w : selected) {
       const PaneLocation& p = panes_[w.cluster];
       if (p.buffer != b) continue;
-      const glm::vec3 scaled = w.weight * p.inverse_scale;
+      const glm::vec3 scaled = w.weight * (p.inverse_scale * decode_scale_);
       weights.push_back({scaled.x, scaled.y, scaled.z, p.word_offset / 4});
     }
     ranges[b].second = static_cast<std::uint32_t>(weights.size()) - ranges[b].first;
@@ -265,6 +331,28 @@ std::vector<glm::vec3> PrmGpuPass::read_back() const {
   glGetTextureImage(output_.id(), 0, GL_RGB, GL_FLOAT, static_cast<GLsizei>(atlas.size() * sizeof(glm::vec3)),
                     atlas.data());
   return atlas;
+}
+
+engine::Result<std::vector<float>> decoded_panes(const Prm& prm, PrmPaneEncoding encoding) {
+  if (auto bad = check_pane_values(prm, encoding)) return *bad;
+  const std::size_t elements = prm.texels.size();
+  std::vector<float> out(prm.panes.size(), 0.0f);
+  if (elements == 0) return out;
+  std::vector<std::uint32_t> words(pane_stride_words(elements, encoding));
+  for (std::size_t first = 0; first + elements * 3 <= prm.panes.size(); first += elements * 3) {
+    const std::span<const float> pane(prm.panes.data() + first, elements * 3);
+    const int exponent = pane_scale_exponent(pane, encoding);
+    std::fill(words.begin(), words.end(), 0u);
+    pack_pane(pane, exponent, encoding, words);
+    unpack_pane(words, exponent, encoding, std::span<float>(out.data() + first, elements * 3));
+  }
+  return out;
+}
+
+std::size_t PrmGpuPass::pane_bytes() const {
+  std::size_t bytes = 0;
+  for (std::size_t b : pane_buffer_bytes_) bytes += b;
+  return bytes;
 }
 
 std::size_t PrmGpuPass::gpu_bytes() const {

@@ -33,7 +33,29 @@
 
 namespace gi {
 
+/// How PrmGpuPass holds the panes in GPU memory. Encoded at upload from the float panes (the
+/// bundle's files are unchanged); both start from a per-pane power-of-two scale folded into
+/// the weights. decoded_panes() gives the values the pass sums, for its CPU twin.
+enum class PrmPaneEncoding : std::uint8_t {
+  /// Three half floats per element (6 bytes): each value within 2^-11 (~4.9e-4) of itself.
+  Half,
+  /// RGB9E5 (4 bytes, a third fewer bytes to stream per light change): three 9-bit
+  /// mantissas sharing the largest channel's exponent in one 32-bit word, decoded with
+  /// integer ops. Each channel within 2^-9 x (1 + 2^-9) (~2e-3) of the element's largest
+  /// channel (half a mantissa step; the largest has 256-511 steps). Pane values must not be
+  /// negative.
+  SharedExponent,
+};
+
+/// The panes as PrmGpuPass sums them under `encoding`: prm.panes (same layout) encoded and
+/// decoded, each pane through its power-of-two scale. gi::sum_panes over a Prm holding these
+/// panes is the pass's CPU twin up to float summation order. Error: a non-finite value, or a
+/// negative one under SharedExponent.
+engine::Result<std::vector<float>> decoded_panes(const Prm& prm, PrmPaneEncoding encoding);
+
 struct PrmGpuPassOptions {
+  /// Pane encoding in GPU memory (docs/prm.md "Pane encoding" measures both on the demo level).
+  PrmPaneEncoding encoding = PrmPaneEncoding::Half;
   /// Largest pane buffer (bytes) read as one buffer texture; panes are split over several
   /// buffers (whole panes each) above it. 0: the driver's GL_MAX_TEXTURE_BUFFER_SIZE x 16
   /// bytes, at most 128 MiB. Tests set it small to exercise the split.
@@ -85,6 +107,8 @@ class PrmGpuPass {
   int height() const { return height_; }
   /// Pane buffers the panes were split over (1 unless they exceed the buffer limit).
   std::size_t pane_buffer_count() const { return pane_buffers_.size(); }
+  /// Bytes the panes occupy in GPU memory (all buffers, padding included).
+  std::size_t pane_bytes() const;
 
  private:
   /// Where one cluster's pane lives: its buffer, its first word and its packing scale.
@@ -118,6 +142,7 @@ class PrmGpuPass {
   int height_ = 0;
   std::uint32_t element_count_ = 0;
   std::uint32_t max_groups_x_ = 65535;
+  float decode_scale_ = 1.0f;  ///< Folded into every weight: 2^-24 for RGB9E5 mantissas, 1 for halves.
 };
 
 }  // namespace gi

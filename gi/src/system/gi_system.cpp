@@ -308,7 +308,9 @@ engine::Result<std::unique_ptr<GISystem>> GISystem::load(const std::filesystem::
 
   if (prm) {
     auto p = PrmLighting::from_bake(std::move(*prm), atlas ? &*atlas : nullptr, scene,
-                                    {.active_clusters = settings.prm_active_clusters, .log = settings.log});
+                                    {.active_clusters = settings.prm_active_clusters,
+                                     .log = settings.log,
+                                     .shared_exponent_panes = settings.prm_shared_exponent_panes});
     if (!p) return p.error();
     impl->prm = std::move(p).value();
   } else if (atlas) {

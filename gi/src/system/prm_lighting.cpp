@@ -119,7 +119,8 @@ const engine::IndirectLightFrame& PrmLighting::frame() {
   ++m.stats.frames;
   if (!m.stats.disabled.empty()) return m.frame;
   if (!m.pass) {
-    auto pass = PrmGpuPass::create(m.prm);
+    auto pass = PrmGpuPass::create(m.prm, {.encoding = m.settings.shared_exponent_panes ? PrmPaneEncoding::SharedExponent
+                                                                                      : PrmPaneEncoding::Half});
     if (!pass) {
       // No GL resources: leave the frame empty (the renderer falls back to its stand-in).
       m.disable(pass.error().to_string());

@@ -35,6 +35,10 @@ struct LightAtlasBake;
 struct PrmLightingSettings {
   int active_clusters = 32;  ///< K: panes summed per update (the heaviest); 0: all.
   LogCallback log;           ///< Told when the GPU pass cannot run (the PRM turns off).
+  /// Panes in GPU memory as RGB9E5 (4 bytes per element) instead of half floats (6): a third
+  /// fewer bytes per light change, at <= 2e-3 of a texel's largest channel per pane value
+  /// (docs/prm.md "Pane encoding").
+  bool shared_exponent_panes = true;
 };
 
 class PrmLighting final : public engine::IndirectLightProvider {

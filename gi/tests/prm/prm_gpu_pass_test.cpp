@@ -335,4 +335,100 @@ TEST(PrmGpuPass, MovesOwnership) {
   EXPECT_LE(worst_error_ratio(moved.read_back(), cpu_sum(prm, selected)), 1.0);
 }
 
+// The shared-exponent encoding (RGB9E5, 4 bytes per element): its CPU twin is gi::sum_panes
+// over decoded_panes, so the GPU sum must equal the CPU sum of the decoded panes up to float
+// summation order; the decoded panes lie within 2^-9 (1 + 2^-9) of each element's largest
+// channel of the float panes.
+gi::Prm with_decoded_panes(const gi::Prm& prm, gi::PrmPaneEncoding encoding) {
+  gi::Prm out = prm;
+  auto panes = gi::decoded_panes(prm, encoding);
+  EXPECT_TRUE(panes.ok()) << panes.error().to_string();
+  if (panes) out.panes = std::move(panes).value();
+  return out;
+}
+
+TEST(PrmGpuPass, SharedExponentPanesStayWithinTheirBound) {
+  for (const auto& [lo, hi] : {std::pair{1e-3f, 1e2f}, std::pair{1e4f, 1e7f}, std::pair{1e-9f, 1e-6f}}) {
+    const gi::Prm prm = synthetic_prm(37, 23, 4, lo, hi, 31);
+    const gi::Prm q = with_decoded_panes(prm, gi::PrmPaneEncoding::SharedExponent);
+    ASSERT_EQ(q.panes.size(), prm.panes.size());
+    double worst = 0.0;
+    std::size_t changed = 0;
+    for (std::size_t e = 0; e < prm.panes.size() / 3; ++e) {
+      const float* v = &prm.panes[3 * e];
+      const float top = std::max({v[0], v[1], v[2]});
+      for (int ch = 0; ch < 3; ++ch) {
+        const double err = std::abs(double(q.panes[3 * e + ch]) - double(v[ch]));
+        worst = std::max(worst, err / double(top));
+        changed += q.panes[3 * e + ch] != v[ch];
+      }
+    }
+    std::printf("values in [%g, %g]: max |decoded - float| / element's largest channel %.3g\n", double(lo), double(hi), worst);
+    EXPECT_LE(worst, std::ldexp(1.0, -9) * (1.0 + std::ldexp(1.0, -9)));
+    EXPECT_GT(changed, prm.panes.size() / 2);  // it does round: not a copy of the float panes
+  }
+  // Halves decode within 2^-11 of each value.
+  const gi::Prm prm = synthetic_prm(37, 23, 4);
+  const gi::Prm h = with_decoded_panes(prm, gi::PrmPaneEncoding::Half);
+  for (std::size_t f = 0; f < prm.panes.size(); ++f)
+    ASSERT_LE(std::abs(h.panes[f] - prm.panes[f]), std::ldexp(1.0f, -11) * prm.panes[f]) << f;
+}
+
+TEST(PrmGpuPass, SharedExponentMatchesItsCpuTwin) {
+  auto ctx = headless_or_fail();
+  for (const auto& [lo, hi] : {std::pair{1e-3f, 1e2f}, std::pair{1e4f, 1e7f}, std::pair{1e-9f, 1e-6f}}) {
+    const gi::Prm prm = synthetic_prm(37, 23, 20, lo, hi, 41);
+    auto pass = gi::PrmGpuPass::create(prm, {.encoding = gi::PrmPaneEncoding::SharedExponent});
+    ASSERT_TRUE(pass.ok()) << pass.error().to_string();
+    EXPECT_EQ(pass->pane_bytes(), 20 * ((prm.texels.size() + 7) / 8) * 32);  // 4 bytes per element
+    const gi::Prm twin = with_decoded_panes(prm, gi::PrmPaneEncoding::SharedExponent);
+    std::vector<glm::vec3> base(static_cast<std::size_t>(37 * 23), glm::vec3(0.5f, 0.25f, 2.0f) * hi);
+    for (int k : {1, 7, 20}) {
+      const auto selected = pick(20, k, static_cast<std::uint64_t>(k) + 3);
+      ASSERT_TRUE(pass->run(selected).ok());
+      const Reference ref = cpu_sum(twin, selected);
+      const auto gpu = pass->read_back();
+      for (std::size_t t = 0; t < gpu.size(); ++t)
+        for (int ch = 0; ch < 3; ++ch)
+          ASSERT_NEAR(gpu[t][ch], ref.value[t][ch], 1e-5 * ref.magnitude[t][ch]) << "K = " << k << ", texel " << t;
+      ASSERT_TRUE(pass->set_base(base).ok());
+      ASSERT_TRUE(pass->run(selected).ok());
+      const Reference with_base = cpu_sum(twin, selected, base);
+      const auto gpu_base = pass->read_back();
+      for (std::size_t t = 0; t < gpu.size(); ++t)
+        for (int ch = 0; ch < 3; ++ch)
+          ASSERT_NEAR(gpu_base[t][ch], with_base.value[t][ch],
+                      1e-5 * (with_base.magnitude[t][ch] + std::abs(with_base.value[t][ch])))
+              << "K = " << k << ", base, texel " << t;
+      ASSERT_TRUE(pass->set_base({}).ok());
+    }
+  }
+}
+
+TEST(PrmGpuPass, SharedExponentRejectsNegativePaneValues) {
+  auto ctx = headless_or_fail();
+  gi::Prm prm = synthetic_prm(37, 23, 4);
+  prm.panes[3 * prm.texels.size() + 5] = -1.0f;  // pane 1, element 1, G
+  EXPECT_TRUE(gi::PrmGpuPass::create(prm).ok()) << "halves hold negative values";
+  auto pass = gi::PrmGpuPass::create(prm, {.encoding = gi::PrmPaneEncoding::SharedExponent});
+  ASSERT_FALSE(pass.ok());
+  EXPECT_NE(pass.error().message.find("pane 1 element 1 is negative"), std::string::npos) << pass.error().to_string();
+  EXPECT_FALSE(gi::decoded_panes(prm, gi::PrmPaneEncoding::SharedExponent).ok());
+}
+
+TEST(PrmGpuPass, HalfPanesMatchTheirCpuTwinUpToSummationOrder) {
+  auto ctx = headless_or_fail();
+  const gi::Prm prm = synthetic_prm(37, 23, 20);
+  auto pass = gi::PrmGpuPass::create(prm);
+  ASSERT_TRUE(pass.ok()) << pass.error().to_string();
+  EXPECT_EQ(pass->pane_bytes(), 20 * ((prm.texels.size() + 7) / 8) * 48);  // 6 bytes per element
+  const gi::Prm twin = with_decoded_panes(prm, gi::PrmPaneEncoding::Half);
+  const auto selected = pick(20, 20, 9);
+  ASSERT_TRUE(pass->run(selected).ok());
+  const Reference ref = cpu_sum(twin, selected);
+  const auto gpu = pass->read_back();
+  for (std::size_t t = 0; t < gpu.size(); ++t)
+    for (int ch = 0; ch < 3; ++ch) ASSERT_NEAR(gpu[t][ch], ref.value[t][ch], 1e-5 * ref.magnitude[t][ch]) << t;
+}
+
 }  // namespace
