@@ -39,6 +39,7 @@
 
 #include "bench_gl.h"
 
+#include "core/thread_pool.h"
 #include "light_atlas/light_atlas.h"
 #include "prm/prm.h"
 #include "prm/prm_gpu_pass.h"
@@ -148,13 +149,16 @@ gi::Prm with_panes(const gi::Prm& prm, gi::PrmPaneEncoding encoding) {
   return out;
 }
 
-// Argument: the pane encoding (0 half floats, 1 RGB9E5). Extra counters: the K-sum atlas's
+// Arguments: the pane encoding (0 half floats, 1 RGB9E5) and the threads tracing the flux
+// check (1: the calling thread; PrmLighting uses the hardware's). Extra counters: the K-sum atlas's
 // error under this encoding against half floats (err_vs_half_*) and against the float panes
 // (err_vs_float_*), per texel (max, p95), rel RMSE and total, over the 8 poses.
 void BM_PrmLightChange(benchmark::State& state) {
   const DemoLevel& d = demo_level();
   (void)bench::gl_context();
   const auto encoding = static_cast<gi::PrmPaneEncoding>(state.range(0));
+  std::unique_ptr<gi::ThreadPool> pool;
+  if (state.range(1) > 1) pool = std::make_unique<gi::ThreadPool>(static_cast<unsigned>(state.range(1)));
   gi::PrmGpuPass pass = or_exit(gi::PrmGpuPass::create(d.prm, {.encoding = encoding}));
   constexpr int kActive = 32;  // GISystemSettings::prm_active_clusters
 
@@ -184,7 +188,7 @@ void BM_PrmLightChange(benchmark::State& state) {
     const gi::ReferenceLight ref = gi::reference_light(d.lamp, poses[frame++ % poses.size()]);
     const std::vector<gi::PointEmitter> emitters =
         gi::light_point_emitters(std::span<const gi::ReferenceLight>(&ref, 1), 16, d.prm.settings.seed);
-    const std::vector<glm::vec3> entry = gi::entry_irradiance(d.prm, emitters, *d.caster);
+    const std::vector<glm::vec3> entry = gi::entry_irradiance(d.prm, emitters, *d.caster, pool.get());
     const std::vector<gi::ClusterWeight> picked = gi::select_clusters(gi::cluster_weights(d.prm, entry), kActive);
     const auto t1 = Clock::now();
     const double c1 = process_cpu_ms();
@@ -274,9 +278,10 @@ void BM_PrmLightChange(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_PrmLightChange)
-    ->ArgName("rgb9e5")
-    ->Arg(0)
-    ->Arg(1)
+    ->ArgNames({"rgb9e5", "threads"})
+    ->Args({0, 1})
+    ->Args({1, 1})
+    ->Args({1, 2})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->MinTime(2.0);
@@ -292,16 +297,19 @@ std::vector<gi::PointEmitter> lamp_emitters(const DemoLevel& d, int pose) {
   return gi::light_point_emitters(std::span<const gi::ReferenceLight>(&ref, 1), 16, d.prm.settings.seed);
 }
 
+// Argument: threads tracing the rays (1: the calling thread).
 void BM_PrmFluxCheck(benchmark::State& state) {
   const DemoLevel& d = demo_level();
+  std::unique_ptr<gi::ThreadPool> pool;
+  if (state.range(0) > 1) pool = std::make_unique<gi::ThreadPool>(static_cast<unsigned>(state.range(0)));
   int pose = 0;
   for (auto _ : state) {
     const std::vector<gi::PointEmitter> e = lamp_emitters(d, pose++);
     std::vector<gi::LitDirection> hits;
-    benchmark::DoNotOptimize(gi::punctual_lit_solid_angle(e[0], *d.caster, 64, &hits));
+    benchmark::DoNotOptimize(gi::punctual_lit_solid_angle(e[0], *d.caster, 64, &hits, pool.get()));
   }
 }
-BENCHMARK(BM_PrmFluxCheck)->Unit(benchmark::kMicrosecond)->UseRealTime()->MinTime(1.0);
+BENCHMARK(BM_PrmFluxCheck)->ArgName("threads")->Arg(1)->Arg(2)->Unit(benchmark::kMicrosecond)->UseRealTime()->MinTime(1.0);
 
 void BM_PrmEntryShadowRays(benchmark::State& state) {
   const DemoLevel& d = demo_level();

@@ -33,7 +33,8 @@ void deposit_hits(const Prm& prm, const PointEmitter& light, const std::vector<L
 
 }  // namespace
 
-std::vector<glm::vec3> entry_irradiance(const Prm& prm, std::span<const PointEmitter> lights, const RayCaster& caster) {
+std::vector<glm::vec3> entry_irradiance(const Prm& prm, std::span<const PointEmitter> lights, const RayCaster& caster,
+                                        ThreadPool* pool) {
   std::vector<glm::vec3> out(prm.entries.size(), glm::vec3(0.0f));
   std::vector<glm::vec3> one(prm.entries.size());
   for (const PointEmitter& l : lights) {
@@ -52,7 +53,7 @@ std::vector<glm::vec3> entry_irradiance(const Prm& prm, std::span<const PointEmi
       // what the light sends onto the scene (point_emitters.h). A light touching a surface
       // puts its flux between the entry points: then the traced hits are deposited instead.
       std::vector<LitDirection> hits;
-      const double traced = static_cast<double>(luminance(l.radiant)) * punctual_lit_solid_angle(l, caster, kFluxSide, &hits);
+      const double traced = static_cast<double>(luminance(l.radiant)) * punctual_lit_solid_angle(l, caster, kFluxSide, &hits, pool);
       if (sampled > 0.25 * traced) {
         const auto scale = static_cast<float>(std::clamp(traced / sampled, 0.25, 4.0));
         for (glm::vec3& v : one) v *= scale;

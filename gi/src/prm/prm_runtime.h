@@ -19,14 +19,18 @@
 
 namespace gi {
 
+class ThreadPool;
+
 /// Irradiance (W/m^2, RGB) at every entry point from `lights` with shadow rays (eq. 4: the
 /// emission x visibility x cos / (d^2 + A/pi) form, A the entry point's area, so a light
 /// touching a surface stays bounded; point lights are I cos / (d^2 + A/pi)). A punctual
 /// light's weights are rescaled to the flux it sends onto the scene (64^2 traced
 /// directions); when the entry points see less than a quarter of it (a light touching a
 /// surface lights only millimetres), the traced hits are deposited on their nearest entry
-/// points instead.
-std::vector<glm::vec3> entry_irradiance(const Prm& prm, std::span<const PointEmitter> lights, const RayCaster& caster);
+/// points instead. `pool` (optional) traces the flux check's rays over its threads: the
+/// same result bit for bit.
+std::vector<glm::vec3> entry_irradiance(const Prm& prm, std::span<const PointEmitter> lights, const RayCaster& caster,
+                                        ThreadPool* pool = nullptr);
 
 /// Weight of every cluster: the mean irradiance of its members (§5.1).
 std::vector<glm::vec3> cluster_weights(const Prm& prm, std::span<const glm::vec3> entry_irradiance);

@@ -3,11 +3,14 @@
 #include <GL/glcorearb.h>
 #include <engine/runtime_limits.h>
 
+#include <algorithm>
 #include <chrono>
 #include <optional>
+#include <thread>
 #include <unordered_map>
 
 #include "bundle/light_signature.h"
+#include "core/thread_pool.h"
 #include "bundle/manifest.h"
 #include "light_atlas/light_atlas.h"
 #include "light_atlas/light_atlas_io.h"
@@ -27,6 +30,7 @@ struct PrmLighting::Impl {
   Prm prm;
   std::vector<glm::vec3> base;  ///< Static-light atlas (empty: none).
   std::unique_ptr<RayCaster> caster;
+  std::unique_ptr<ThreadPool> pool;  ///< Traces the flux checks (settings.threads).
   PrmLightingSettings settings;
   std::optional<PrmGpuPass> pass;
   bool fresh = false;
@@ -76,7 +80,7 @@ struct PrmLighting::Impl {
           const ReferenceLight ref = reference_light(l, wt.matrix);
           const std::vector<PointEmitter> emitters =
               light_point_emitters(std::span<const ReferenceLight>(&ref, 1), 16, prm.settings.seed);
-          c.entry = entry_irradiance(prm, emitters, *caster);
+          c.entry = entry_irradiance(prm, emitters, *caster, pool.get());
         });
     for (auto it = lights.begin(); it != lights.end();) {
       if (!it->second.seen) {
@@ -111,6 +115,8 @@ engine::Result<std::unique_ptr<PrmLighting>> PrmLighting::from_bake(Prm prm, con
   if (base) impl->base = base->irradiance;
   impl->caster = std::move(caster).value();
   impl->settings = settings;
+  const unsigned threads = settings.threads > 0 ? settings.threads : std::min(4u, std::max(1u, std::thread::hardware_concurrency()));
+  if (threads > 1) impl->pool = std::make_unique<ThreadPool>(threads);
   return std::unique_ptr<PrmLighting>(new PrmLighting(std::move(impl)));
 }
 

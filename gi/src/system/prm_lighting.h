@@ -39,6 +39,11 @@ struct PrmLightingSettings {
   /// fewer bytes per light change, at <= 2e-3 of a texel's largest channel per pane value
   /// (docs/prm.md "Pane encoding").
   bool shared_exponent_panes = true;
+  /// Threads tracing a moving light's flux check (4096 rays, ~0.12 ms of the update's CPU
+  /// part) on an update; 0: the hardware's (at most 4). The result does not depend on it.
+  /// Default 1 (the calling thread): two threads pay only where a core is idle; with the
+  /// cores busy they were slower (prm_relight_bench BM_PrmFluxCheck/threads:2, docs/performance.md).
+  unsigned threads = 1;
 };
 
 class PrmLighting final : public engine::IndirectLightProvider {

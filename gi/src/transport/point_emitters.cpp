@@ -8,6 +8,7 @@
 #include <numbers>
 
 #include "core/random.h"
+#include "core/thread_pool.h"
 #include "raytrace/light_falloff.h"
 #include "raytrace/ray_offset.h"
 
@@ -173,7 +174,7 @@ const std::vector<glm::vec3>& sphere_directions(int side) {
 }  // namespace
 
 double punctual_lit_solid_angle(const PointEmitter& e, const RayCaster& caster, int side,
-                                std::vector<LitDirection>* hits) {
+                                std::vector<LitDirection>* hits, ThreadPool* pool) {
   const float per_direction = 4.0f * kPi / static_cast<float>(side * side);
   // The directions inside the spot cone (all for a point light), traced as one stream: all
   // leave one point, so the caster may trace them as packets.
@@ -189,7 +190,18 @@ double punctual_lit_solid_angle(const PointEmitter& e, const RayCaster& caster, 
     weights.push_back(weight);
   }
   std::vector<Hit> found(rays.size());
-  caster.intersect_many(rays, found);
+  if (pool != nullptr && pool->size() > 1) {
+    // Chunks of 64 packets: each hit lands in its own slot, so any split gives the same sum.
+    constexpr std::size_t kChunk = 1024;
+    const std::span<const Ray> all(rays);
+    const std::span<Hit> out(found);
+    pool->parallel_for((rays.size() + kChunk - 1) / kChunk, [&](std::size_t c) {
+      const std::size_t first = c * kChunk, n = std::min(kChunk, rays.size() - first);
+      caster.intersect_many(all.subspan(first, n), out.subspan(first, n));
+    });
+  } else {
+    caster.intersect_many(rays, found);
+  }
   double sum = 0.0;
   for (std::size_t i = 0; i < rays.size(); ++i) {
     const Hit& h = found[i];

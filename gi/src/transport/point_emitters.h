@@ -25,6 +25,8 @@
 
 namespace gi {
 
+class ThreadPool;
+
 struct PointEmitter {
   enum class Kind : std::uint8_t { Punctual, Directional, Lambertian };
   Kind kind = Kind::Punctual;
@@ -73,14 +75,15 @@ bool emitter_visible(const RayCaster& caster, const PointEmitter& e, const glm::
 /// and range window: 4 pi / N x the sum over N = side^2 stratified directions of cone x
 /// window x hit (front faces only: the back of a one-sided surface receives nothing).
 /// I x this is the flux the light sends onto the scene. `hits` (optional)
-/// receives every hit point with the solid angle it stands for (weighted).
+/// receives every hit point with the solid angle it stands for (weighted). `pool` (optional)
+/// traces the rays in chunks over its threads; the result is the same bit for bit.
 struct LitDirection {
   glm::vec3 point;
   glm::vec3 normal;  ///< Unit geometric normal (front side, facing the light).
   float solid_angle_sr;
 };
 double punctual_lit_solid_angle(const PointEmitter& e, const RayCaster& caster, int side,
-                                std::vector<LitDirection>* hits = nullptr);
+                                std::vector<LitDirection>* hits = nullptr, ThreadPool* pool = nullptr);
 
 /// True when the segment between two surface points (each with its unit normal, on the
 /// side facing the other) is free.

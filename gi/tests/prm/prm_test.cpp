@@ -9,9 +9,11 @@
 #include <cmath>
 #include <cstdio>
 
+#include "core/thread_pool.h"
 #include "prm/entry_clusters.h"
 #include "prm/prm_runtime.h"
 #include "raytrace/atlas_reference.h"
+#include "transport/point_emitters.h"
 #include "transport/static_scene.h"
 #include "uv/atlas_input.h"
 
@@ -121,6 +123,43 @@ TEST(PrmChamber, BitIdenticalForAnyThreadCount) {
 // A light touching a wall, inside the pedestal, outside the chamber, and a million times
 // brighter: finite, non-negative, and the indirect power never exceeds what the light's
 // power can give: Phi rho / (1 - rho) with the brightest albedo.
+// The flux check's rays traced over a thread pool (PrmLighting's update): the same entry
+// irradiance bit for bit as on the calling thread, including the case where the traced hits
+// are deposited (a spot 1 mm from a wall, facing it).
+TEST(PrmRuntime, EntryIrradianceIsTheSameOverAThreadPool) {
+  engine::Scene scene = chamber();
+  gi::PrmSettings ps;
+  ps.texels_per_metre = 2.0f;
+  ps.entry_points = 256;
+  ps.clusters = 16;
+  auto prm = gi::bake_prm(gi::bake_input_from(scene), ps);
+  ASSERT_TRUE(prm) << prm.error().to_string();
+  auto caster = gi::make_static_caster(gi::bake_input_from(scene));
+  ASSERT_TRUE(caster);
+  gi::ThreadPool two(2), three(3);
+  for (const auto& [position, direction] : {std::pair{glm::vec3(0.0f, 2.5f, 0.0f), glm::vec3(0.2f, -1.0f, 0.1f)},
+                                            std::pair{glm::vec3(1.6f, 0.3f, 1.6f), glm::vec3(-1.0f, 0.2f, -1.0f)},
+                                            std::pair{glm::vec3(1.999f, 1.5f, 0.0f), glm::vec3(1.0f, 0.0f, 0.0f)}}) {
+    place_spot(scene, position, direction);
+    const auto lights = gi::scene_lights(scene.registry, gi::BakeLights::Moving);
+    const auto emitters = gi::light_point_emitters(lights, 16, prm->settings.seed);
+    const std::vector<glm::vec3> alone = gi::entry_irradiance(*prm, emitters, **caster);
+    double sum = 0.0;
+    for (const glm::vec3& e : alone) sum += static_cast<double>(e.x + e.y + e.z);
+    EXPECT_GT(sum, 0.0);
+    EXPECT_EQ(gi::entry_irradiance(*prm, emitters, **caster, &two), alone);
+    EXPECT_EQ(gi::entry_irradiance(*prm, emitters, **caster, &three), alone);
+    std::vector<gi::LitDirection> a, b;
+    EXPECT_EQ(gi::punctual_lit_solid_angle(emitters[0], **caster, 64, &a),
+              gi::punctual_lit_solid_angle(emitters[0], **caster, 64, &b, &two));
+    ASSERT_EQ(a.size(), b.size());
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      EXPECT_EQ(a[i].point, b[i].point);
+      EXPECT_EQ(a[i].solid_angle_sr, b[i].solid_angle_sr);
+    }
+  }
+}
+
 TEST(PrmStability, HardLightPlacementsStayBoundedAndFinite) {
   engine::Scene scene = chamber();
   const gi::Prm prm = small_prm(scene);
