@@ -6,10 +6,13 @@
 // width cost llvmpipe a scalar loop per invocation). Work groups on a 2-D grid when one row
 // would exceed 65535.
 //
-// Pane storage (prm_gpu_pass.cpp writes it): each pane is a run of half floats, three per
-// element (R, G, B) packed tightly, two halves per uint (low half first), read as uvec4s:
-// eight elements (24 halves) fill three uvec4s exactly. One invocation sums one such block
-// of eight elements: per cluster three 16-byte texel fetches (llvmpipe gathers SSBO loads
+// Pane storage (prm_gpu_pass.cpp writes it), one of two encodings:
+// - PRM_PANES_RGB9E5 defined (the default): one 32-bit word per element (three 9-bit
+//   mantissas, one shared exponent); eight elements fill two uvec4s, a third fewer bytes.
+// - otherwise half floats, three per element (R, G, B) packed tightly, two halves per uint
+//   (low half first): eight elements (24 halves) fill three uvec4s exactly.
+// One invocation sums one block of eight elements: per cluster two or three 16-byte texel
+// fetches (llvmpipe gathers SSBO loads
 // lane by lane and component by component, so bytes per load set the speed: the 4-byte
 // loads of one element pair per invocation streamed a fifth of what a plain vec4 copy does,
 // gi/benchmarks/prm_gpu_bench; buffer-texture fetches run as straight-line vector code and

@@ -1,13 +1,15 @@
 #pragma once
 // The PRM runtime sum on the GPU (Szécsi et al. 2006, §5.2): the weighted sum of the
 // selected clusters' panes, written into an RGBA32F irradiance atlas texture, the GPU twin
-// of gi::sum_panes (prm_runtime.h). Panes are uploaded once, as half floats; a run uploads
-// only the K weights and dispatches one compute pass (gi/shaders/prm_sum.comp.glsl).
+// of gi::sum_panes (prm_runtime.h). Panes are uploaded once, as half floats or RGB9E5
+// (PrmPaneEncoding); a run uploads only the K weights and dispatches one compute pass
+// (gi/shaders/prm_sum.comp.glsl).
 //   auto pass = gi::PrmGpuPass::create(prm).value();            // a GL context is current
 //   if (auto s = pass.run(gi::select_clusters(weights, 32)); !s) { /* s.error() */ }
 //   // pass.texture(): irradiance (W/m^2) per atlas texel, 0 outside the panes' texels
 //
-// Precision: pane values are stored as half floats after a per-pane power-of-two scale
+// Precision (PrmPaneEncoding::SharedExponent: see there; its CPU twin sums decoded_panes()):
+// half-float pane values are stored after a per-pane power-of-two scale
 // (exact, folded into the weight), so each pane value carries a relative rounding error of
 // at most 2^-11 (~4.9e-4) whatever its magnitude, down to 2^-29 of its pane's largest value
 // (smaller values are absolute errors below 2^-40 of it). Sums, weights and the atlas are
