@@ -111,6 +111,8 @@ def main():
         label = "RGB9E5 panes (default)" if "rgb9e5:1" in name else "half-float panes"
         if threads and threads.group(1) != "1":
             label += f", flux check on {threads.group(1)} threads"
+        if "base:1" in name:
+            label += ", light atlas as base (the demo's case)"
         return label
 
     changes.sort(key=lambda ne: (("rgb9e5:1" in ne[0]), ne[0]))
