@@ -33,6 +33,10 @@
 #include "bench_gl.h"
 #include <glm/gtc/matrix_transform.hpp>
 
+#include <engine/gltf.h>
+#include <gi/bake_input.h>
+
+#include "brf/brf_bake.h"
 #include "brf/brf_gpu_pass.h"
 #include "brf/brf_mesh.h"
 #include "brf/brf_runtime.h"
@@ -183,6 +187,130 @@ void BM_BrfGpu(benchmark::State& state) {
   state.counters["gpu_MB"] = static_cast<double>(pass->gpu_bytes()) / 1e6;
 }
 BENCHMARK(BM_BrfGpu)->ArgsProduct({{1, 5, 10, 30}, {0, 1}, {0, 1}})->Unit(benchmark::kMillisecond);
+
+// The level of detail for distant pairs (BrfUpdateSettings::lod_distance, brf_lod.h): every
+// crate moving, no bound culling, as BM_BrfGpu/n/1/0 with lod_distance = the second arg / 10
+// (0: off, the exact evaluation). Counter pairs_lod: the far pairs interpolated.
+void BM_BrfGpuLod(benchmark::State& state) {
+  (void)bench::gl_context();
+  const Shared& s = shared();
+  const int n = static_cast<int>(state.range(0));
+  const float lod = static_cast<float>(state.range(1)) / 10.0f;
+  const gi::BrfGpuModel model{&s.mesh, &s.basis, &s.field};
+  auto pass = gi::BrfGpuPass::create(std::span(&model, 1));
+  if (!pass) {
+    state.SkipWithError(pass.error().to_string().c_str());
+    return;
+  }
+  const gi::PointEmitter light = grid_light(n);
+  std::vector<gi::BrfGpuInstance> poses[2];
+  for (int k = 0; k < 2; ++k)
+    for (const gi::BrfObject& o : crates(n, 0.02f * static_cast<float>(k)))
+      poses[k].push_back({0, o.object_to_world, o.albedo});
+  const auto incoming = gi::brf_direct_light(crates(n), std::span<const gi::PointEmitter>(&light, 1), nullptr);
+  const gi::BrfUpdateSettings settings{.bounces = 3, .cull_threshold = 0.0f, .lod_distance = lod};
+  if (!pass->run(poses[1], incoming, settings)) state.SkipWithError("run failed");
+  glFinish();
+  std::size_t frame = 0;
+  const double cpu0 = process_cpu_ms();
+  for (auto _ : state) {
+    const auto status = pass->run(poses[frame % 2], incoming, settings);
+    glFinish();
+    if (!status) state.SkipWithError(status.error().to_string().c_str());
+    ++frame;
+  }
+  state.counters["process_cpu_ms"] = (process_cpu_ms() - cpu0) / static_cast<double>(std::max<std::size_t>(frame, 1));
+  state.counters["pairs_evaluated"] = static_cast<double>(pass->stats().pairs_evaluated);
+  state.counters["pairs_lod"] = static_cast<double>(pass->stats().pairs_lod);
+}
+BENCHMARK(BM_BrfGpuLod)->ArgsProduct({{30}, {0, 20, 30, 50}})->Unit(benchmark::kMillisecond);
+
+// The level of detail's error, per vertex, against the exact evaluation (the CPU twin, 3
+// bounces, no bound culling, occlusion on): scene 0 the 30 crates of BM_BrfGpuLod (lit by
+// grid_light), scene 1 the crates room's dynamic objects (assets/crates_room.gltf, BRF baked at
+// the preview preset, a point light 1.5 m above their centre); lod_distance = the second arg /
+// 10. Counters: max_rel and p95_rel, the largest and 95th-percentile relative error of a
+// vertex's interreflected irradiance (|E_lod - E| / max(|E|, 1% of the mean |E|), RGB
+// lengths), pairs_lod of pairs_evaluated; the time is the CPU twin with the level of detail.
+struct RoomObjects {
+  std::vector<gi::BrfMeshBake> bakes;
+  std::vector<gi::BrfSource> sources;
+  std::vector<gi::BrfObject> objects;
+};
+
+const RoomObjects& crates_room() {
+  static const RoomObjects room = [] {
+    RoomObjects r;
+    auto asset = engine::load_gltf(GI_SOURCE_DIR "/assets/crates_room.gltf");
+    if (!asset) return r;
+    const engine::Scene scene = engine::instantiate(std::move(asset).value());
+    const gi::BakeInput input = gi::bake_input_from(scene);
+    auto sources = gi::dynamic_brf_meshes(input);
+    if (!sources) return r;
+    r.sources = std::move(sources).value();
+    const gi::BrfSettings settings = gi::brf_preset("preview").value();
+    for (const gi::BrfSource& src : r.sources) r.bakes.push_back(gi::bake_brf_mesh(src, settings).value());
+    for (std::size_t m = 0; m < r.sources.size(); ++m)
+      for (std::uint32_t i : r.sources[m].instances)
+        r.objects.push_back({&r.sources[m].mesh, &r.bakes[m].basis, &r.bakes[m].field, input.instances[i].object_to_world,
+                             gi::brf_source_albedo(input, r.sources[m]),
+                             r.bakes[m].glossy ? &*r.bakes[m].glossy : nullptr, r.sources[m].specular});
+    return r;
+  }();
+  return room;
+}
+
+std::pair<double, double> lod_vertex_errors(const gi::BrfResult& lod, const gi::BrfResult& exact) {
+  double mean = 0.0;
+  std::size_t count = 0;
+  for (const auto& v : exact.indirect)
+    for (const glm::vec3& e : v) {
+      mean += glm::length(glm::dvec3(e));
+      ++count;
+    }
+  mean /= static_cast<double>(std::max<std::size_t>(count, 1));
+  std::vector<double> rel;
+  for (std::size_t o = 0; o < exact.indirect.size(); ++o)
+    for (std::size_t j = 0; j < exact.indirect[o].size(); ++j)
+      rel.push_back(glm::length(glm::dvec3(lod.indirect[o][j]) - glm::dvec3(exact.indirect[o][j])) /
+                    std::max(glm::length(glm::dvec3(exact.indirect[o][j])), 0.01 * mean));
+  if (rel.empty()) return {0.0, 0.0};
+  std::sort(rel.begin(), rel.end());
+  return {rel.back(), rel[static_cast<std::size_t>(0.95 * static_cast<double>(rel.size() - 1))]};
+}
+
+void BM_BrfLodError(benchmark::State& state) {
+  const bool room = state.range(0) != 0;
+  const float lod = static_cast<float>(state.range(1)) / 10.0f;
+  std::vector<gi::BrfObject> objects;
+  gi::PointEmitter light = grid_light(30);
+  if (room) {
+    objects = crates_room().objects;
+    if (objects.empty()) {
+      state.SkipWithError("crates room: no dynamic objects loaded");
+      return;
+    }
+    glm::vec3 centre(0.0f);
+    for (const gi::BrfObject& o : objects) centre += glm::vec3(o.object_to_world[3]);
+    light.position = centre / static_cast<float>(objects.size()) + glm::vec3(0.0f, 1.5f, 0.0f);
+    light.radiant = glm::vec3(10.0f);
+  } else {
+    objects = crates(30);
+  }
+  const auto incoming = gi::brf_direct_light(objects, std::span<const gi::PointEmitter>(&light, 1), nullptr);
+  const gi::BrfResult exact = gi::brf_interreflect(objects, incoming, {.bounces = 3, .cull_threshold = 0.0f});
+  gi::BrfResult r;
+  for (auto _ : state) {
+    r = gi::brf_interreflect(objects, incoming, {.bounces = 3, .cull_threshold = 0.0f, .lod_distance = lod});
+    benchmark::DoNotOptimize(r.indirect.data());
+  }
+  const auto [max_rel, p95] = lod_vertex_errors(r, exact);
+  state.counters["max_rel"] = max_rel;
+  state.counters["p95_rel"] = p95;
+  state.counters["pairs_lod"] = static_cast<double>(r.pairs_lod);
+  state.counters["pairs_evaluated"] = static_cast<double>(r.pairs_evaluated);
+}
+BENCHMARK(BM_BrfLodError)->ArgsProduct({{0, 1}, {0, 20, 30, 50}})->Unit(benchmark::kMillisecond);
 
 // Occlusion between the crates (BrfUpdateSettings::occlusion, brf_visibility.h) on and off in
 // the same run: crates, moving, occlusion; no culling. On, a pair's Phi also depends on the

@@ -33,11 +33,13 @@ struct PhiJob {
   uint rows;              // receiver terms K_r (1: diffuse receiver or static point)
   uint frame_offset;      // glossy receiver: first float of its vertex frames (t, b, n per vertex) in sh_data
   uint lobe_offset;       // glossy receiver: first float of its lobe SH (16 per glossy term) in sh_data
-  uint pad0;
+  uint lod_points;        // level of detail (brf_lod.h; diffuse receivers): 0, or kind 0: 1 + the receiver's
+                          // first representative point in u_lod (point k is the vertex u_lod[lod_points - 1 + k].x,
+                          // its row the field part only, at phi_offset + k C4); kind 2: 1 + its first vertex entry
   uint occluder_offset;   // first record in occluders (kind 0): boxes of objects in the pair's way
   uint occluder_count;
-  uint pad1;
-  uint pad2;
+  uint lod_rows;          // kind 2: first vec4 of the representative points' rows (u_lod_rows)
+  uint pad;
 };
 
 // A dynamic object's box standing between a pair (brf_pair_occluders): to_occluder maps the
@@ -55,6 +57,11 @@ layout(binding = 1) uniform usamplerBuffer u_models;
 layout(binding = 2) uniform samplerBuffer u_model_vertices;
 layout(binding = 3) uniform usamplerBuffer u_jobs;
 layout(binding = 4) uniform usamplerBuffer u_occluders;
+// Unit 5: the level-of-detail tables (brf_gpu_pass.cpp ModelData::lod_table): representative
+// vertices (uvec4(vertex, 0, 0, 0)), per vertex uvec4(points a, b, c, 0), uvec4(weight bits, 0).
+// Unit 6: Phi as vec4s, for kind 2's reads of the representative rows (written by kind 0).
+layout(binding = 5) uniform usamplerBuffer u_lod;
+layout(binding = 6) uniform samplerBuffer u_lod_rows;
 layout(std430, binding = 2) readonly buffer StaticPoints { vec4 static_points[]; };    // position, normal per receiver
 layout(std430, binding = 3) readonly buffer StaticIndices { uint static_indices[]; };
 layout(std430, binding = 5) readonly buffer Groups { uvec2 groups[]; };  // (job, first point)
@@ -116,17 +123,19 @@ PhiJob load_job(uint index) {  // PhiJob above, std430
   j.rows = b.x;
   j.frame_offset = b.y;
   j.lobe_offset = b.z;
-  j.pad0 = b.w;
+  j.lod_points = b.w;
   j.occluder_offset = c.x;
   j.occluder_count = c.y;
-  j.pad1 = c.z;
-  j.pad2 = c.w;
+  j.lod_rows = c.z;
+  j.pad = c.w;
   return j;
 }
 
 uniform uint u_first_group;
 uniform uint u_group_count;
-uniform uint u_kind;  // 0: instance vertices, 1: static receivers
+// 0: instance vertices, 1: static receivers, 2: instance vertices of a far pair, their rows
+// interpolated from the representative points' (level of detail, brf_lod.h)
+uniform uint u_kind;
 
 const uint kDirections = 26u;
 const uint kPinvOffset[4] = uint[4](0u, 104u, 182u, 312u);
@@ -213,12 +222,16 @@ void main() {
   const uint group = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
   if (group >= u_group_count) return;
   const uvec2 g = groups[u_first_group + group];
-  const uint k = g.y + gl_LocalInvocationIndex;
   const PhiJob job = load_job(g.x);
-  if (k >= job.point_count) return;
+  if (g.y + gl_LocalInvocationIndex >= job.point_count) return;
+  // The receiver vertex (kind 0) or static entry: with the level of detail, a representative
+  // vertex (its row is written where the vertex's is; brf_lod_expand.comp.glsl fills the others).
+  const bool points = u_kind == 0u && job.lod_points != 0u;  // representative points (field part only)
+  const uint k = points ? texelFetch(u_lod, int(job.lod_points - 1u + g.y + gl_LocalInvocationIndex)).x
+                        : g.y + gl_LocalInvocationIndex;
 
   vec3 p_in, n_in;
-  if (u_kind == 0u) {
+  if (u_kind != 1u) {  // instance vertices (kinds 0 and 2)
     const uint v = job.point_offset + k;
     p_in = texelFetch(u_model_vertices, int(2u * v)).xyz;
     n_in = texelFetch(u_model_vertices, int(2u * v + 1u)).xyz;
@@ -233,17 +246,33 @@ void main() {
   const BrfModel m = load_model(job.source_model);
   const uint nc = m.basis_count * m.terms, c4 = brf_padded(nc);
   const uint rows = job.rows;
-  const uint row0 = job.phi_offset + k * rows * c4;
+  const uint row0 = job.phi_offset + (points ? g.y + gl_LocalInvocationIndex : k) * rows * c4;
   const uint side = brf_horizon(m, p, n);
   if (side == 0u) {  // the source is behind the tangent plane: no light
     for (uint i = 0u; i < rows * c4; i += 4u) phi4[(row0 + i) / 4u] = vec4(0.0);
     return;
   }
   // What the point sees of the source past the objects in the pair's way (1 without any).
-  const float vis = contact_visibility(m, p, n) *
-                    (job.occluder_count == 0u ? 1.0 : occluded_visibility(m, p, n, job.occluder_offset, job.occluder_count));
+  // (Representative points: none; the vertices they are interpolated to apply their own.)
+  const float vis = points ? 1.0
+                           : contact_visibility(m, p, n) *
+                                 (job.occluder_count == 0u ? 1.0
+                                                           : occluded_visibility(m, p, n, job.occluder_offset, job.occluder_count));
   if (vis == 0.0) {
     for (uint i = 0u; i < rows * c4; i += 4u) phi4[(row0 + i) / 4u] = vec4(0.0);
+    return;
+  }
+  if (u_kind == 2u) {  // brf_lod_interpolate: ((w0 a + w1 b) + w2 c) x vis
+    const uint e = job.lod_points - 1u + 2u * k;
+    const uvec4 from = texelFetch(u_lod, int(e));
+    const vec3 w = uintBitsToFloat(texelFetch(u_lod, int(e + 1u)).xyz);
+    const uint q4 = c4 / 4u;
+    for (uint q = 0u; q < q4; ++q) {
+      const vec4 a = texelFetch(u_lod_rows, int(job.lod_rows + from.x * q4 + q));
+      const vec4 b = texelFetch(u_lod_rows, int(job.lod_rows + from.y * q4 + q));
+      const vec4 c = texelFetch(u_lod_rows, int(job.lod_rows + from.z * q4 + q));
+      phi4[row0 / 4u + q] = ((w.x * a + w.y * b) + w.z * c) * vis;
+    }
     return;
   }
   float lobe[16];

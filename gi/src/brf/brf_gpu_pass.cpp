@@ -9,6 +9,7 @@
 #include <string>
 #include <utility>
 
+#include "brf/brf_lod.h"
 #include "brf/brf_visibility.h"
 #include "gpu/gi_shaders.h"
 
@@ -23,7 +24,7 @@ constexpr std::uint32_t kMaxGroupsPerDimension = 65535;
 // Texture units of brf_phi.comp.glsl's buffer textures (u_field, u_models, u_model_vertices,
 // u_jobs, u_occluders).
 constexpr GLuint kFieldTextureUnit = 0, kModelTextureUnit = 1, kVertexTextureUnit = 2, kJobTextureUnit = 3,
-                 kOccluderTextureUnit = 4;
+                 kOccluderTextureUnit = 4, kLodTextureUnit = 5, kLodRowsTextureUnit = 6;
 constexpr int kMaxBasis = 64;  // kMaxChannels = 64 x 16 in brf_fit.comp.glsl
 // sh_data_ layout (ShData in brf_phi.comp.glsl): 26 directions as vec4s, then the pinv of
 // bands 1..3, then the glossy models' lobe SH and vertex frames.
@@ -121,8 +122,13 @@ struct BrfPhiJob {
   glm::mat4 normal_to_source{1.0f};
   std::uint32_t source_model = 0, point_offset = 0, point_count = 0, phi_offset = 0;
   glm::mat4 frame_to_source{1.0f};  // glossy receiver: its object space's rotation into the source's
-  std::uint32_t rows = 1, frame_offset = 0, lobe_offset = 0, pad0 = 0;
-  std::uint32_t occluder_offset = 0, occluder_count = 0, pad1 = 0, pad2 = 0;  // into the occluder records
+  std::uint32_t rows = 1, frame_offset = 0, lobe_offset = 0;
+  // Level of detail (brf_lod.h): 0, or 1 + the receiver's first representative point (kind 0)
+  // / first vertex entry (kind 2) in the lod table
+  std::uint32_t lod_points = 0;
+  std::uint32_t occluder_offset = 0, occluder_count = 0;  // into the occluder records
+  std::uint32_t lod_rows = 0;  // kind 2: first vec4 of the representative points' rows in phi_
+  std::uint32_t pad = 0;
 };
 static_assert(sizeof(BrfPhiJob) == 240, "must match PhiJob in brf_phi.comp.glsl (std430)");
 
@@ -226,6 +232,10 @@ struct BrfGpuPass::ModelData {
   std::vector<float> psi, a_inverse;
   std::vector<std::size_t> field_group_bytes;  ///< Fields grouped into buffers under the limit.
   std::vector<float> sh_data;                  ///< SH rotation tables first (kPinvOffset), then per glossy model.
+  /// Level-of-detail tables (brf_lod.h): per model its representative vertices (uvec4(vertex,
+  /// 0, 0, 0) each), then per vertex uvec4(from a, b, c (indices into the points), 0) and
+  /// uvec4(weight bits, 0).
+  std::vector<glm::uvec4> lod_table;
 };
 
 engine::Result<BrfGpuPass> BrfGpuPass::create(std::span<const BrfGpuModel> models, const BrfGpuPassOptions& options) {
@@ -321,6 +331,19 @@ void BrfGpuPass::add_model(const BrfGpuModel& model, std::size_t limit, ModelDat
       for (int c = 0; c < 3; ++c) sh_data.insert(sh_data.end(), {frame[c].x, frame[c].y, frame[c].z});
     }
   }
+  if (model.glossy == nullptr) {  // glossy receivers are evaluated in full
+    const BrfLodPoints lod = brf_lod_points(*model.mesh);
+    if (!lod.empty()) {
+      info.lod_point_offset = u32(data.lod_table.size());
+      info.lod_point_count = u32(lod.points.size());
+      for (std::uint32_t p : lod.points) data.lod_table.emplace_back(p, 0u, 0u, 0u);
+      info.lod_entry_offset = u32(data.lod_table.size());
+      for (std::size_t j = 0; j < lod.from.size(); ++j) {
+        data.lod_table.emplace_back(lod.from[j], 0u);
+        data.lod_table.emplace_back(glm::floatBitsToUint(lod.weights[j]), 0u);
+      }
+    }
+  }
   models_.push_back(info);
 }
 
@@ -337,6 +360,7 @@ void BrfGpuPass::upload_models(std::span<const BrfGpuModel> models, const ModelD
   psi_ = upload_once(data.psi);
   a_inverse_ = upload_once(data.a_inverse);
   sh_data_ = upload_once(data.sh_data);
+  lod_table_ = upload_once(data.lod_table);
   for (std::size_t bytes : data.field_group_bytes) {
     fields_.push_back(engine::GlBuffer::create(std::max<std::size_t>(bytes, 16), nullptr, GL_DYNAMIC_STORAGE_BIT));
     model_bytes_ += std::max<std::size_t>(bytes, 16);
@@ -360,6 +384,9 @@ void BrfGpuPass::upload_models(std::span<const BrfGpuModel> models, const ModelD
   for (engine::GlTexture& t : gather_textures_) t = engine::GlTexture::create(GL_TEXTURE_BUFFER);
   for (engine::GlTexture& t : fit_textures_) t = engine::GlTexture::create(GL_TEXTURE_BUFFER);
   occluder_texture_ = engine::GlTexture::create(GL_TEXTURE_BUFFER);
+  lod_texture_ = engine::GlTexture::create(GL_TEXTURE_BUFFER);
+  glTextureBuffer(lod_texture_.id(), GL_RGBA32UI, lod_table_.id());
+  lod_rows_texture_ = engine::GlTexture::create(GL_TEXTURE_BUFFER);
   static_out_.reserve(16);
   static_points_.reserve(16);
 }
@@ -432,7 +459,8 @@ engine::Status BrfGpuPass::reset_layout(std::span<const BrfGpuInstance> instance
   return {};
 }
 
-void BrfGpuPass::dispatch_phi(std::span<const BrfPhiJob> jobs, bool static_kind) {
+void BrfGpuPass::dispatch_phi(std::span<const BrfPhiJob> jobs, std::uint32_t kind) {
+  const bool static_kind = kind == 1;
   if (jobs.empty()) return;
   // Work groups sorted by program (one-row jobs, glossy receivers) and the source's field
   // buffer: one dispatch per (program, buffer).
@@ -459,6 +487,11 @@ void BrfGpuPass::dispatch_phi(std::span<const BrfPhiJob> jobs, bool static_kind)
   glBindTextureUnit(kVertexTextureUnit, vertex_texture_.id());
   glBindTextureUnit(kJobTextureUnit, job_texture_.id());
   glBindTextureUnit(kOccluderTextureUnit, occluder_texture_.id());
+  glBindTextureUnit(kLodTextureUnit, lod_texture_.id());
+  glTextureBuffer(lod_rows_texture_.id(), GL_RGBA32F, phi_.buffer.id());
+  glBindTextureUnit(kLodRowsTextureUnit, lod_rows_texture_.id());
+  if (kind == 2)  // the representative rows were written as storage by the previous dispatch
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
   bind(2, static_points_.buffer.id());
   bind(3, static_indices_.buffer.empty() ? static_points_.buffer.id() : static_indices_.buffer.id());
   bind(5, groups_.buffer.id());
@@ -469,7 +502,7 @@ void BrfGpuPass::dispatch_phi(std::span<const BrfPhiJob> jobs, bool static_kind)
     const engine::ShaderProgram& program = v == 0 ? programs_.phi : programs_.phi_glossy;
     const GLuint id = program.id();
     program.use();
-    glProgramUniform1ui(id, glGetUniformLocation(id, "u_kind"), static_kind ? 1u : 0u);
+    glProgramUniform1ui(id, glGetUniformLocation(id, "u_kind"), kind);
     for (std::size_t b = 0; b < nf; ++b) {
       const auto [first, count] = ranges[v * nf + b];
       if (count == 0) continue;
@@ -614,7 +647,7 @@ void BrfGpuPass::relayout_static_phi(std::span<const BrfGpuInstance> instances, 
   std::swap(static_phi_, static_phi_spare_);
   static_indices_.upload(indices.data(), indices.size() * sizeof(std::uint32_t));
   static_visibility_.upload(vis.data(), vis.size() * sizeof(float));
-  dispatch_phi(jobs, true);
+  dispatch_phi(jobs, 1);
 }
 
 void BrfGpuPass::upload_static_lists(std::span<const BrfGpuInstance> instances) {
@@ -662,7 +695,9 @@ struct BrfGpuPass::FrameData {
   std::vector<glm::uvec4> live;  ///< (source's first weight vec4, first Phi vec4, C4 / 4, source)
   std::vector<BrfPhiJob> jobs;
   std::vector<GpuOccluder> occluders;  ///< The jobs' occluder records.
+  std::vector<BrfPhiJob> lod_jobs;     ///< Kind 2: the level-of-detail pairs' rows from their points'.
   bool occlusion = true;               ///< BrfUpdateSettings::occlusion.
+  float lod_distance = 0.0f;           ///< BrfUpdateSettings::lod_distance.
 };
 
 engine::Status BrfGpuPass::run(std::span<const BrfGpuInstance> instances,
@@ -688,11 +723,13 @@ engine::Status BrfGpuPass::run(std::span<const BrfGpuInstance> instances,
 
   FrameData frame;
   frame.occlusion = settings.occlusion;
+  frame.lod_distance = settings.lod_distance;
   fit_first_and_cull(instances, incoming, settings.cull_threshold, settings.influence_scale, frame);
   if (auto s = layout_pairs(n, frame); !s) return s;
   plan_pairs(instances, frame);
   occluders_.upload(frame.occluders.data(), frame.occluders.size() * sizeof(GpuOccluder));
-  dispatch_phi(frame.jobs, false);
+  dispatch_phi(frame.jobs, 0);
+  dispatch_phi(frame.lod_jobs, 2);
   upload_frame(incoming, frame);
   for (int bounce = 0; bounce < settings.bounces; ++bounce) {
     if (bounce > 0) dispatch_fit(0, n);
@@ -765,7 +802,8 @@ void BrfGpuPass::fit_first_and_cull(std::span<const BrfGpuInstance> instances,
 
 engine::Status BrfGpuPass::layout_pairs(std::size_t instance_count, const FrameData& frame) {
   stats_.pair_slots = frame.in_reach.size();
-  if (frame.in_reach == pair_keys_) return {};
+  const bool lod = frame.lod_distance > 0.0f && std::isfinite(frame.lod_distance);
+  if (frame.in_reach == pair_keys_ && lod == layout_lod_) return {};
   // New packed layout in key order; kept pairs keep their state and Phi (copied below).
   const std::size_t n = instance_count;
   std::vector<PairSlot> slots(frame.in_reach.size());
@@ -793,6 +831,14 @@ engine::Status BrfGpuPass::layout_pairs(std::size_t instance_count, const FrameD
     slots[k].phi_offset = u32(floats);
     floats += size;
   }
+  // With the level of detail on, scratch after the slots for the representative points' rows
+  // of receivers with a table (used only in the frames where the pair is far and moved).
+  for (std::size_t k = 0; lod && k < frame.in_reach.size(); ++k) {
+    const std::size_t s = frame.in_reach[k] / n, r = frame.in_reach[k] % n;
+    const ModelInfo& mr = models_[layout_models_[r]];
+    slots[k].lod_rows = u32(floats);
+    floats += static_cast<std::size_t>(mr.lod_point_count) * padded(models_[layout_models_[s]].channels());
+  }
   if (floats * sizeof(float) > max_buffer_bytes_)
     return error(std::to_string(frame.in_reach.size()) + " pairs in reach need " +
                  std::to_string(floats * sizeof(float)) + " bytes of pair Phi, above the SSBO limit of " +
@@ -809,6 +855,7 @@ engine::Status BrfGpuPass::layout_pairs(std::size_t instance_count, const FrameD
     phi_spare_ = Buffer{};
   }
   pair_keys_ = frame.in_reach;
+  layout_lod_ = lod;
   pairs_ = std::move(slots);
   phi_floats_ = floats;
   return {};
@@ -826,12 +873,16 @@ void BrfGpuPass::plan_pairs(std::span<const BrfGpuInstance> instances, FrameData
   frame.table.assign(n, GpuInstance{});
   std::vector<glm::mat4> to_source(n);
   std::vector<glm::mat3> pure_to_source(n);  // uniform scale removed, as brf_basis_irradiance
-  std::vector<BrfSphere> spheres(n);
+  std::vector<BrfSphere> spheres(n), inner(n);
   for (std::size_t s = 0; s < n; ++s) {
     to_source[s] = glm::inverse(instances[s].object_to_world);
     const glm::mat3 rot = glm::mat3(to_source[s]);
     pure_to_source[s] = rot / glm::length(rot[0]);
     spheres[s] = brf_bounding_sphere(brf_object_box(*models_[instances[s].model].mesh), instances[s].object_to_world);
+    // The innermost field sphere in world space, as brf_interreflect places it (brf_pair_far).
+    const glm::mat4& m = instances[s].object_to_world;
+    const BasisRadianceField& f = *models_[instances[s].model].field;
+    inner[s] = {glm::vec3(m * glm::vec4(f.centre, 1.0f)), f.inner_radius * glm::length(glm::vec3(m[0]))};
   }
   std::vector<std::uint32_t> ids;
   std::vector<glm::mat4> poses;
@@ -873,7 +924,10 @@ void BrfGpuPass::plan_pairs(std::span<const BrfGpuInstance> instances, FrameData
       bool same_occluders = slot.occluders == ids;
       for (std::size_t k = 0; same_occluders && k < ids.size(); ++k)
         same_occluders = same_pose(slot.occluder_poses[k], poses[k], pose_tolerance_);
-      if (slot.valid && same_pose(slot.pose, relative, pose_tolerance_) && same_occluders) {
+      // Level of detail (brf_lod.h): diffuse receivers with a table, far from the source.
+      const bool lod = mr.lod_point_count > 0 && brf_pair_far(spheres[r], inner[s], frame.lod_distance);
+      if (lod) ++stats_.pairs_lod;
+      if (slot.valid && same_pose(slot.pose, relative, pose_tolerance_) && same_occluders && slot.lod == lod) {
         ++stats_.pairs_reused;
         continue;
       }
@@ -896,9 +950,22 @@ void BrfGpuPass::plan_pairs(std::span<const BrfGpuInstance> instances, FrameData
         const BrfBox box = brf_object_box(*models_[instances[ids[k]].model].mesh);
         frame.occluders.push_back({poses[k], glm::vec4(box.lo, 0.0f), glm::vec4(box.hi, 0.0f)});
       }
+      if (lod) {
+        // Kind 2 (after the kind-0 dispatch): every vertex's own side and visibility, its row
+        // interpolated from the representative points' rows, which this kind-0 job writes
+        // (field part only) into the slot's scratch.
+        BrfPhiJob rows = job;
+        rows.lod_points = 1u + mr.lod_entry_offset;
+        rows.lod_rows = slot.lod_rows / 4;
+        frame.lod_jobs.push_back(rows);
+        job.lod_points = 1u + mr.lod_point_offset;
+        job.point_count = mr.lod_point_count;
+        job.phi_offset = slot.lod_rows;
+      }
       frame.jobs.push_back(job);
       slot.valid = true;
       slot.pose = relative;
+      slot.lod = lod;
       slot.occluders = ids;
       slot.occluder_poses = poses;
     }

@@ -45,7 +45,7 @@
 // kMaxGlossyTerms terms (16 values per vertex with the diffuse one).
 //
 // GL state: create(), run(), set_static_receivers() and the read-backs need the creating
-// context current; they change the bound program and shader-storage bindings 0-10 and texture units 0-4.
+// context current; they change the bound program and shader-storage bindings 0-10 and texture units 0-6.
 
 #include <engine/gpu/gl_objects.h>
 #include <engine/gpu/shader_program.h>
@@ -155,6 +155,7 @@ class BrfGpuPass {
     std::size_t pairs_evaluated = 0;  ///< Live (not culled) pairs, as BrfResult counts them.
     std::size_t pairs_culled = 0;
     std::size_t pairs_reused = 0;           ///< Live pairs whose Phi was kept (relative pose unchanged).
+    std::size_t pairs_lod = 0;  ///< Live pairs whose Phi uses the level of detail (BrfUpdateSettings::lod_distance).
     std::size_t pair_slots = 0;             ///< Pairs in reach holding a Phi slot (culled ones included).
     std::size_t static_sources_reused = 0;  ///< Sources whose static-receiver Phi was kept.
     /// Static receivers inside a moved source's field that see none of it past the world
@@ -191,6 +192,9 @@ class BrfGpuPass {
     const BrfMesh* mesh = nullptr;    ///< For pair culling (BrfObject).
     const BasisRadianceField* field = nullptr;
     const BrdfSeparation* glossy = nullptr;
+    /// Level of detail (brf_lod.h): its representative vertices (lod_point_count uvec4s from
+    /// lod_point_offset in lod_table_) and per vertex 2 uvec4s from lod_entry_offset; 0 points: none.
+    std::uint32_t lod_point_offset = 0, lod_point_count = 0, lod_entry_offset = 0;
     std::uint32_t channels() const { return terms * basis_count; }
   };
   /// One ordered (source, receiver) pair's cached Phi.
@@ -198,6 +202,10 @@ class BrfGpuPass {
     std::uint32_t phi_offset = 0;  ///< First float in phi_.
     bool valid = false;            ///< Phi holds the basis irradiance at `pose`.
     glm::mat4 pose{1.0f};          ///< inverse(M_source) x M_receiver when computed.
+    bool lod = false;              ///< Computed with the level of detail (brf_lod.h).
+    /// Receivers with a level-of-detail table: first float in phi_ of the representative
+    /// points' rows (scratch for one frame, after the slots).
+    std::uint32_t lod_rows = 0;
     std::vector<std::uint32_t> occluders;  ///< Instances in the way (brf_pair_occluders) when computed.
     std::vector<glm::mat4> occluder_poses;  ///< inverse(M_occluder) x M_source of each.
   };
@@ -269,8 +277,10 @@ class BrfGpuPass {
                            std::size_t total_floats);
   /// Per touched static receiver, its sources in instance order (static_touched_, static_entries_).
   void upload_static_lists(std::span<const BrfGpuInstance> instances);
-  /// Evaluates `jobs` (one dispatch per field buffer) into phi_ or, for static_kind, static_phi_.
-  void dispatch_phi(std::span<const BrfPhiJob> jobs, bool static_kind);
+  /// Evaluates `jobs` (one dispatch per field buffer) into phi_ or, for kind 1 (static
+  /// receivers), static_phi_;
+  /// kind 2: the level-of-detail pairs' rows from their representative points' (brf_lod.h).
+  void dispatch_phi(std::span<const BrfPhiJob> jobs, std::uint32_t kind);
 
   Programs programs_;
   std::vector<ModelInfo> models_;
@@ -288,6 +298,10 @@ class BrfGpuPass {
   /// Buffer textures over the model table, the model vertices (both at create()), the Phi jobs
   /// and their occluder records (attached at each dispatch): brf_phi.comp.glsl's read-only data.
   engine::GlTexture model_texture_, vertex_texture_, job_texture_, occluder_texture_;
+  /// Level-of-detail tables of every model (ModelInfo::lod_*), uvec4s, and a buffer texture
+  /// over them (brf_phi's u_lod); a buffer texture over phi_ (u_lod_rows: the representative rows).
+  engine::GlBuffer lod_table_;
+  engine::GlTexture lod_texture_, lod_rows_texture_;
   /// brf_gather.comp.glsl's inputs (instance table, live sources, weights, Phi), attached at each dispatch.
   engine::GlTexture gather_textures_[4];
   /// brf_fit.comp.glsl's inputs (Psi, A^-1, incoming, gathered, indirect), attached at each dispatch.
@@ -311,7 +325,8 @@ class BrfGpuPass {
   /// reach, not n^2. A pair culled by its bound keeps its slot; one that leaves reach loses it.
   std::vector<std::uint64_t> pair_keys_;
   std::vector<PairSlot> pairs_;
-  std::size_t phi_floats_ = 0;  ///< Floats of phi_ the slots use.
+  std::size_t phi_floats_ = 0;  ///< Floats of phi_ the slots use (and the level of detail's scratch).
+  bool layout_lod_ = false;     ///< The layout has the level of detail's scratch (PairSlot::lod_rows).
   std::vector<StaticSlot> static_slots_;
   std::vector<engine::GlBuffer> outputs_;  ///< Per instance: vec4 per vertex.
   std::size_t output_bytes_ = 0;

@@ -7,6 +7,7 @@
 #include <limits>
 #include <numbers>
 
+#include "brf/brf_lod.h"
 #include "brf/brf_visibility.h"
 #include "brf/spherical_harmonics.h"
 #include "raytrace/embree_ray_caster.h"
@@ -71,7 +72,7 @@ BrfHorizon brf_horizon(const BrfBox& box, const glm::vec3& p, const glm::vec3& n
 void brf_basis_irradiance(const BrfObject& source, std::span<const glm::vec3> positions,
                           std::span<const glm::vec3> normals, std::vector<float>& out,
                           const BrdfSeparation* receiver_glossy, std::span<const glm::mat3> frames,
-                          std::span<const BrfOccluder> occluders) {
+                          std::span<const BrfOccluder> occluders, const BrfLodPoints* lod) {
   const BasisRadianceField& f = *source.field;
   const auto cc = static_cast<std::size_t>(f.coefficient_count());
   const auto channels = static_cast<std::size_t>(f.channel_count());
@@ -92,6 +93,24 @@ void brf_basis_irradiance(const BrfObject& source, std::span<const glm::vec3> po
   const BrfBox box = brf_object_box(*source.mesh);
   const auto targets = brf_visibility_targets(box);
   std::array<float, kMaxShCoefficients> rotated{};
+  // With a level-of-detail table (diffuse receivers only): the field part of the rows (field
+  // . lobe, no visibility) at the representative points first, interpolated below.
+  const bool reduced = lod != nullptr && !lod->empty() && kr == 1 && lod->from.size() == positions.size();
+  std::vector<float> point_rows;
+  if (reduced) {
+    point_rows.assign(lod->points.size() * channels, 0.0f);
+    for (std::size_t i = 0; i < lod->points.size(); ++i) {
+      const std::size_t j = lod->points[i];
+      const glm::vec3 p = glm::vec3(to_source * glm::vec4(positions[j], 1.0f));
+      const glm::vec3 n = glm::normalize(rot * normals[j]);
+      const BrfHorizon side = brf_horizon(box, p, n);
+      if (side == BrfHorizon::Behind) continue;
+      f.sample(p, coeffs);
+      const auto lobe = side == BrfHorizon::InFront ? sh_cosine(n) : sh_clamped_cosine(n, f.sh_bands);
+      for (std::size_t c = 0; c < channels; ++c)
+        point_rows[i * channels + c] = sh_dot(std::span<const float>(coeffs).subspan(c * cc), lobe, cc);
+    }
+  }
   for (std::size_t j = 0; j < positions.size(); ++j) {
     const glm::vec3 p = glm::vec3(to_source * glm::vec4(positions[j], 1.0f));
     const glm::vec3 n = glm::normalize(rot * normals[j]);
@@ -105,6 +124,10 @@ void brf_basis_irradiance(const BrfObject& source, std::span<const glm::vec3> po
                                            return brf_segment_clear(a, b, occluders);
                                          }));
     if (v == 0.0f) continue;
+    if (reduced) {  // this vertex's own side and visibility, the field part interpolated
+      brf_lod_interpolate(*lod, j, point_rows, channels, v, out.data() + j * channels);
+      continue;
+    }
     f.sample(p, coeffs);
     const auto lobe = side == BrfHorizon::InFront ? sh_cosine(n) : sh_clamped_cosine(n, f.sh_bands);
     float* row = out.data() + j * kr * channels;
@@ -351,6 +374,27 @@ BrfResult brf_interreflect(std::span<const BrfObject> objects, std::span<const s
   }
   std::vector<std::vector<float>> phi(n * n);
   std::vector<BrfOccluder> occluders;
+  // Level of detail (brf_lod.h): one table per distinct diffuse receiver mesh, the sources'
+  // innermost field spheres in world space.
+  std::vector<const BrfLodPoints*> lod(n, nullptr);
+  std::vector<std::pair<const BrfMesh*, BrfLodPoints>> lod_tables;
+  std::vector<BrfSphere> inner(n);
+  const bool lod_on = settings.lod_distance > 0.0f && std::isfinite(settings.lod_distance);
+  if (lod_on) {
+    lod_tables.reserve(n);
+    for (std::size_t o = 0; o < n; ++o) {
+      const BrfObject& obj = objects[o];
+      inner[o] = {glm::vec3(obj.object_to_world * glm::vec4(obj.field->centre, 1.0f)),
+                  obj.field->inner_radius * glm::length(glm::vec3(obj.object_to_world[0]))};
+      if (obj.glossy != nullptr) continue;
+      auto it = std::find_if(lod_tables.begin(), lod_tables.end(), [&](const auto& t) { return t.first == obj.mesh; });
+      if (it == lod_tables.end()) {
+        lod_tables.emplace_back(obj.mesh, brf_lod_points(*obj.mesh));
+        it = lod_tables.end() - 1;
+      }
+      if (!it->second.empty()) lod[o] = &it->second;
+    }
+  }
   for (std::size_t s = 0; s < n; ++s)
     for (std::size_t r = 0; r < n; ++r) {
       if (s == r) continue;
@@ -363,8 +407,11 @@ BrfResult brf_interreflect(std::span<const BrfObject> objects, std::span<const s
       if (settings.occlusion)
         for (std::uint32_t o : brf_pair_occluders(spheres, s, r))
           occluders.push_back({boxes[o], glm::inverse(objects[o].object_to_world) * objects[s].object_to_world});
+      const BrfLodPoints* pair_lod =
+          lod[r] != nullptr && brf_pair_far(spheres[r], inner[s], settings.lod_distance) ? lod[r] : nullptr;
+      if (pair_lod != nullptr) ++out.pairs_lod;
       brf_basis_irradiance(objects[s], wv[r].positions, wv[r].normals, phi[s * n + r], objects[r].glossy, wv[r].frames,
-                           occluders);
+                           occluders, pair_lod);
     }
 
   for (int bounce = 0; bounce < settings.bounces; ++bounce) {

@@ -49,6 +49,7 @@
 namespace gi {
 
 class RayCaster;
+struct BrfLodPoints;  // brf_lod.h
 
 struct BrfObject {
   const BrfMesh* mesh = nullptr;
@@ -79,6 +80,12 @@ struct BrfUpdateSettings {
   /// touches grow with the objects' neighbours, not with n^2. 0 (or below, or not finite):
   /// no limit, every pair is a candidate.
   float influence_scale = 1.0f;
+  /// Level of detail for distant pairs (brf_lod.h): a pair whose receiver lies at least this
+  /// x the source's innermost field sphere from the source's field centre (brf_pair_far) gets
+  /// Phi in full only at the receiver's representative vertices (brf_lod_points), interpolated
+  /// to the others. Diffuse receivers only. 0 (or below, or not finite): off, every vertex
+  /// exact. Default chosen by the per-vertex error table in docs/brf.md.
+  float lod_distance = 0.0f;
 };
 
 /// Points of the static world that take the objects' bounce (world space, unit normals).
@@ -103,6 +110,7 @@ struct BrfResult {
   std::vector<float> static_occlusion;
   std::size_t pairs_evaluated = 0;
   std::size_t pairs_culled = 0;
+  std::size_t pairs_lod = 0;  ///< Evaluated pairs that used the level of detail (brf_lod.h).
 };
 
 /// Per-vertex world-space positions and unit normals of an object; for a glossy object also
@@ -146,10 +154,12 @@ BrfHorizon brf_horizon(const BrfBox& box, const glm::vec3& p, const glm::vec3& n
 /// With `occluders` (boxes of other objects, to_occluder from the source's object space), each
 /// point's rows are scaled by the fraction of the source it sees past them
 /// (brf_box_visibility, brf_visibility.h; the V of eq. 12-13 taken out of the integral).
+/// With `lod` (a diffuse receiver's table, brf_lod.h, for its positions), only its
+/// representative points are evaluated and the other rows interpolated (brf_lod_expand).
 void brf_basis_irradiance(const BrfObject& source, std::span<const glm::vec3> positions,
                           std::span<const glm::vec3> normals, std::vector<float>& out,
                           const BrdfSeparation* receiver_glossy = nullptr, std::span<const glm::mat3> frames = {},
-                          std::span<const BrfOccluder> occluders = {});
+                          std::span<const BrfOccluder> occluders = {}, const BrfLodPoints* lod = nullptr);
 
 /// One bounce of one pair (step c): out[k x V + j] += sum_c w[rgb][c] x phi[(j K_r + k) C + c]
 /// (clamped at 0 for k = 0), phi as brf_basis_irradiance writes it (C = `channels`, K_r =
