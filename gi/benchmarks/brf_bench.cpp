@@ -190,12 +190,14 @@ BENCHMARK(BM_BrfGpu)->ArgsProduct({{1, 5, 10, 30}, {0, 1}, {0, 1}})->Unit(benchm
 
 // The level of detail for distant pairs (BrfUpdateSettings::lod_distance, brf_lod.h): every
 // crate moving, no bound culling, as BM_BrfGpu/n/1/0 with lod_distance = the second arg / 10
-// (0: off, the exact evaluation). Counter pairs_lod: the far pairs interpolated.
+// (0: off, the exact evaluation); third arg 1: shared visibility (lod_shared_visibility).
+// Counter pairs_lod: the far pairs interpolated.
 void BM_BrfGpuLod(benchmark::State& state) {
   (void)bench::gl_context();
   const Shared& s = shared();
   const int n = static_cast<int>(state.range(0));
   const float lod = static_cast<float>(state.range(1)) / 10.0f;
+  const bool shared = state.range(2) != 0;
   const gi::BrfGpuModel model{&s.mesh, &s.basis, &s.field};
   auto pass = gi::BrfGpuPass::create(std::span(&model, 1));
   if (!pass) {
@@ -208,7 +210,8 @@ void BM_BrfGpuLod(benchmark::State& state) {
     for (const gi::BrfObject& o : crates(n, 0.02f * static_cast<float>(k)))
       poses[k].push_back({0, o.object_to_world, o.albedo});
   const auto incoming = gi::brf_direct_light(crates(n), std::span<const gi::PointEmitter>(&light, 1), nullptr);
-  const gi::BrfUpdateSettings settings{.bounces = 3, .cull_threshold = 0.0f, .lod_distance = lod};
+  const gi::BrfUpdateSettings settings{
+      .bounces = 3, .cull_threshold = 0.0f, .lod_distance = lod, .lod_shared_visibility = shared};
   if (!pass->run(poses[1], incoming, settings)) state.SkipWithError("run failed");
   glFinish();
   std::size_t frame = 0;
@@ -223,7 +226,7 @@ void BM_BrfGpuLod(benchmark::State& state) {
   state.counters["pairs_evaluated"] = static_cast<double>(pass->stats().pairs_evaluated);
   state.counters["pairs_lod"] = static_cast<double>(pass->stats().pairs_lod);
 }
-BENCHMARK(BM_BrfGpuLod)->ArgsProduct({{30}, {0, 20, 30, 50}})->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_BrfGpuLod)->ArgsProduct({{30}, {0, 20, 30, 50}, {0, 1}})->Unit(benchmark::kMillisecond);
 
 // The level of detail's error, per vertex, against the exact evaluation (the CPU twin, 3
 // bounces, no bound culling, occlusion on): scene 0 the 30 crates of BM_BrfGpuLod (lit by
@@ -232,6 +235,7 @@ BENCHMARK(BM_BrfGpuLod)->ArgsProduct({{30}, {0, 20, 30, 50}})->Unit(benchmark::k
 // 10. Counters: max_rel and p95_rel, the largest and 95th-percentile relative error of a
 // vertex's interreflected irradiance (|E_lod - E| / max(|E|, 1% of the mean |E|), RGB
 // lengths), pairs_lod of pairs_evaluated; the time is the CPU twin with the level of detail.
+// Third arg 1: shared visibility.
 struct RoomObjects {
   std::vector<gi::BrfMeshBake> bakes;
   std::vector<gi::BrfSource> sources;
@@ -282,6 +286,7 @@ std::pair<double, double> lod_vertex_errors(const gi::BrfResult& lod, const gi::
 void BM_BrfLodError(benchmark::State& state) {
   const bool room = state.range(0) != 0;
   const float lod = static_cast<float>(state.range(1)) / 10.0f;
+  const bool shared = state.range(2) != 0;
   std::vector<gi::BrfObject> objects;
   gi::PointEmitter light = grid_light(30);
   if (room) {
@@ -298,10 +303,12 @@ void BM_BrfLodError(benchmark::State& state) {
     objects = crates(30);
   }
   const auto incoming = gi::brf_direct_light(objects, std::span<const gi::PointEmitter>(&light, 1), nullptr);
-  const gi::BrfResult exact = gi::brf_interreflect(objects, incoming, {.bounces = 3, .cull_threshold = 0.0f});
+  const gi::BrfResult exact =
+      gi::brf_interreflect(objects, incoming, {.bounces = 3, .cull_threshold = 0.0f, .lod_distance = 0.0f});
   gi::BrfResult r;
   for (auto _ : state) {
-    r = gi::brf_interreflect(objects, incoming, {.bounces = 3, .cull_threshold = 0.0f, .lod_distance = lod});
+    r = gi::brf_interreflect(objects, incoming,
+                             {.bounces = 3, .cull_threshold = 0.0f, .lod_distance = lod, .lod_shared_visibility = shared});
     benchmark::DoNotOptimize(r.indirect.data());
   }
   const auto [max_rel, p95] = lod_vertex_errors(r, exact);
@@ -310,7 +317,7 @@ void BM_BrfLodError(benchmark::State& state) {
   state.counters["pairs_lod"] = static_cast<double>(r.pairs_lod);
   state.counters["pairs_evaluated"] = static_cast<double>(r.pairs_evaluated);
 }
-BENCHMARK(BM_BrfLodError)->ArgsProduct({{0, 1}, {0, 20, 30, 50}})->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_BrfLodError)->ArgsProduct({{0, 1}, {0, 20, 30, 50}, {0, 1}})->Unit(benchmark::kMillisecond);
 
 // Occlusion between the crates (BrfUpdateSettings::occlusion, brf_visibility.h) on and off in
 // the same run: crates, moving, occlusion; no culling. On, a pair's Phi also depends on the

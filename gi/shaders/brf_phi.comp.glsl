@@ -39,7 +39,9 @@ struct PhiJob {
   uint occluder_offset;   // first record in occluders (kind 0): boxes of objects in the pair's way
   uint occluder_count;
   uint lod_rows;          // kind 2: first vec4 of the representative points' rows (u_lod_rows)
-  uint pad;
+  uint lod_shared;        // 1: shared visibility (BrfUpdateSettings::lod_shared_visibility): the points'
+                          // rows carry their visibility, kind 2 interpolates whole rows (kind 2: frame_offset
+                          // holds the vec4s per row)
 };
 
 // A dynamic object's box standing between a pair (brf_pair_occluders): to_occluder maps the
@@ -127,14 +129,14 @@ PhiJob load_job(uint index) {  // PhiJob above, std430
   j.occluder_offset = c.x;
   j.occluder_count = c.y;
   j.lod_rows = c.z;
-  j.pad = c.w;
+  j.lod_shared = c.w;
   return j;
 }
 
 uniform uint u_first_group;
 uniform uint u_group_count;
-// 0: instance vertices, 1: static receivers, 2: instance vertices of a far pair, their rows
-// interpolated from the representative points' (level of detail, brf_lod.h)
+// 0: instance vertices, 1: static receivers, 2 (the BRF_LOD_ROWS variant): instance vertices of
+// a far pair, their rows interpolated from the representative points' (level of detail, brf_lod.h)
 uniform uint u_kind;
 
 const uint kDirections = 26u;
@@ -218,20 +220,66 @@ float contact_visibility(BrfModel m, vec3 p, vec3 n) {
   return t0 >= gap ? 1.0 : t0 / gap;
 }
 
+#ifdef BRF_LOD_ROWS
+// Kind 2 (level of detail, brf_lod.h), its own program variant so that it reads only what it
+// needs (llvmpipe pays per texel fetch and invocation): a far pair's row of vertex k is
+// brf_lod_interpolate of its representative points' rows (written by a kind-0 job into the
+// slot's scratch), scaled by the vertex's own horizon and visibility (brf_basis_irradiance's),
+// or, with shared visibility (lod_shared != 0), as it is.
 void main() {
   const uint group = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
   if (group >= u_group_count) return;
   const uvec2 g = groups[u_first_group + group];
+  const uint at = 15u * g.x;  // PhiJob
+  const uvec4 a = texelFetch(u_jobs, int(at + 8u));  // source_model, point_offset, point_count, phi_offset
+  const uint k = g.y + gl_LocalInvocationIndex;
+  if (k >= a.z) return;
+  const uvec4 b = texelFetch(u_jobs, int(at + 13u));  // rows, frame_offset (here: vec4s per row), lobe_offset, lod_points
+  const uvec4 c = texelFetch(u_jobs, int(at + 14u));  // occluder_offset, occluder_count, lod_rows, lod_shared
+  const uint q4 = b.y, e = b.w - 1u + 2u * k, out0 = a.w / 4u + k * q4;
+  float vis = 1.0;
+  if (c.w == 0u) {
+    const mat4 to_source = texel_mat4(u_jobs, at);
+    const mat3 normal_to_source = mat3(texel_mat4(u_jobs, at + 4u));
+    const uint v = a.y + k;
+    const vec3 p = (to_source * vec4(texelFetch(u_model_vertices, int(2u * v)).xyz, 1.0)).xyz;
+    const vec3 n = normalize(normal_to_source * texelFetch(u_model_vertices, int(2u * v + 1u)).xyz);
+    BrfModel m;
+    m.box_lo = texel_f(u_models, 6u * a.x + 4u);
+    m.box_hi = texel_f(u_models, 6u * a.x + 5u);
+    vis = brf_horizon(m, p, n) == 0u ? 0.0
+                                     : contact_visibility(m, p, n) * (c.y == 0u ? 1.0 : occluded_visibility(m, p, n, c.x, c.y));
+  }
+  if (vis == 0.0) {
+    for (uint q = 0u; q < q4; ++q) phi4[out0 + q] = vec4(0.0);
+    return;
+  }
+  const uvec4 from = texelFetch(u_lod, int(e));
+  const vec3 w = uintBitsToFloat(texelFetch(u_lod, int(e + 1u)).xyz);
+  for (uint q = 0u; q < q4; ++q) {
+    const vec4 ra = texelFetch(u_lod_rows, int(c.z + from.x * q4 + q));
+    const vec4 rb = texelFetch(u_lod_rows, int(c.z + from.y * q4 + q));
+    const vec4 rc = texelFetch(u_lod_rows, int(c.z + from.z * q4 + q));
+    phi4[out0 + q] = ((w.x * ra + w.y * rb) + w.z * rc) * vis;
+  }
+}
+#else
+void main() {
+  const uint group = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
+  if (group >= u_group_count) return;
+  const uvec2 g = groups[u_first_group + group];
+  // Lanes past the job's last point leave before loading the rest of the job.
+  if (g.y + gl_LocalInvocationIndex >= texelFetch(u_jobs, int(15u * g.x + 8u)).z) return;
   const PhiJob job = load_job(g.x);
-  if (g.y + gl_LocalInvocationIndex >= job.point_count) return;
   // The receiver vertex (kind 0) or static entry: with the level of detail, a representative
   // vertex (its row is written where the vertex's is; brf_lod_expand.comp.glsl fills the others).
-  const bool points = u_kind == 0u && job.lod_points != 0u;  // representative points (field part only)
+  // Representative points (level of detail): the field part only, or with shared visibility the whole row.
+  const bool points = u_kind == 0u && job.lod_points != 0u;
   const uint k = points ? texelFetch(u_lod, int(job.lod_points - 1u + g.y + gl_LocalInvocationIndex)).x
                         : g.y + gl_LocalInvocationIndex;
 
   vec3 p_in, n_in;
-  if (u_kind != 1u) {  // instance vertices (kinds 0 and 2)
+  if (u_kind == 0u) {
     const uint v = job.point_offset + k;
     p_in = texelFetch(u_model_vertices, int(2u * v)).xyz;
     n_in = texelFetch(u_model_vertices, int(2u * v + 1u)).xyz;
@@ -254,25 +302,12 @@ void main() {
   }
   // What the point sees of the source past the objects in the pair's way (1 without any).
   // (Representative points: none; the vertices they are interpolated to apply their own.)
-  const float vis = points ? 1.0
+  const float vis = (points && job.lod_shared == 0u) ? 1.0
                            : contact_visibility(m, p, n) *
                                  (job.occluder_count == 0u ? 1.0
                                                            : occluded_visibility(m, p, n, job.occluder_offset, job.occluder_count));
   if (vis == 0.0) {
     for (uint i = 0u; i < rows * c4; i += 4u) phi4[(row0 + i) / 4u] = vec4(0.0);
-    return;
-  }
-  if (u_kind == 2u) {  // brf_lod_interpolate: ((w0 a + w1 b) + w2 c) x vis
-    const uint e = job.lod_points - 1u + 2u * k;
-    const uvec4 from = texelFetch(u_lod, int(e));
-    const vec3 w = uintBitsToFloat(texelFetch(u_lod, int(e + 1u)).xyz);
-    const uint q4 = c4 / 4u;
-    for (uint q = 0u; q < q4; ++q) {
-      const vec4 a = texelFetch(u_lod_rows, int(job.lod_rows + from.x * q4 + q));
-      const vec4 b = texelFetch(u_lod_rows, int(job.lod_rows + from.y * q4 + q));
-      const vec4 c = texelFetch(u_lod_rows, int(job.lod_rows + from.z * q4 + q));
-      phi4[row0 / 4u + q] = ((w.x * a + w.y * b) + w.z * c) * vis;
-    }
     return;
   }
   float lobe[16];
@@ -369,3 +404,4 @@ void main() {
   }
 #endif
 }
+#endif  // BRF_LOD_ROWS

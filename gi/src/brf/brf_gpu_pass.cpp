@@ -128,7 +128,7 @@ struct BrfPhiJob {
   std::uint32_t lod_points = 0;
   std::uint32_t occluder_offset = 0, occluder_count = 0;  // into the occluder records
   std::uint32_t lod_rows = 0;  // kind 2: first vec4 of the representative points' rows in phi_
-  std::uint32_t pad = 0;
+  std::uint32_t lod_shared = 0;  // BrfUpdateSettings::lod_shared_visibility (0 / 1)
 };
 static_assert(sizeof(BrfPhiJob) == 240, "must match PhiJob in brf_phi.comp.glsl (std430)");
 
@@ -277,6 +277,12 @@ engine::Status BrfGpuPass::build_programs() {
                    .build();
   if (!built) return built.error();
   programs_.phi_glossy = std::move(built).value();
+  auto lod = engine::ShaderProgramBuilder(gi_shader_files())
+                 .define("BRF_LOD_ROWS 1")
+                 .stage(engine::ShaderStage::Compute, "brf_phi.comp.glsl")
+                 .build();
+  if (!lod) return lod.error();
+  programs_.phi_lod = std::move(lod).value();
   return {};
 }
 
@@ -499,7 +505,7 @@ void BrfGpuPass::dispatch_phi(std::span<const BrfPhiJob> jobs, std::uint32_t kin
   bind(8, sh_data_.id());
   bind(9, static_visibility_.buffer.empty() ? static_points_.buffer.id() : static_visibility_.buffer.id());
   for (std::size_t v = 0; v < 2; ++v) {
-    const engine::ShaderProgram& program = v == 0 ? programs_.phi : programs_.phi_glossy;
+    const engine::ShaderProgram& program = kind == 2 ? programs_.phi_lod : v == 0 ? programs_.phi : programs_.phi_glossy;
     const GLuint id = program.id();
     program.use();
     glProgramUniform1ui(id, glGetUniformLocation(id, "u_kind"), kind);
@@ -698,6 +704,7 @@ struct BrfGpuPass::FrameData {
   std::vector<BrfPhiJob> lod_jobs;     ///< Kind 2: the level-of-detail pairs' rows from their points'.
   bool occlusion = true;               ///< BrfUpdateSettings::occlusion.
   float lod_distance = 0.0f;           ///< BrfUpdateSettings::lod_distance.
+  bool lod_shared = false;             ///< BrfUpdateSettings::lod_shared_visibility.
 };
 
 engine::Status BrfGpuPass::run(std::span<const BrfGpuInstance> instances,
@@ -724,6 +731,7 @@ engine::Status BrfGpuPass::run(std::span<const BrfGpuInstance> instances,
   FrameData frame;
   frame.occlusion = settings.occlusion;
   frame.lod_distance = settings.lod_distance;
+  frame.lod_shared = settings.lod_shared_visibility;
   fit_first_and_cull(instances, incoming, settings.cull_threshold, settings.influence_scale, frame);
   if (auto s = layout_pairs(n, frame); !s) return s;
   plan_pairs(instances, frame);
@@ -925,8 +933,9 @@ void BrfGpuPass::plan_pairs(std::span<const BrfGpuInstance> instances, FrameData
       for (std::size_t k = 0; same_occluders && k < ids.size(); ++k)
         same_occluders = same_pose(slot.occluder_poses[k], poses[k], pose_tolerance_);
       // Level of detail (brf_lod.h): diffuse receivers with a table, far from the source.
-      const bool lod = mr.lod_point_count > 0 && brf_pair_far(spheres[r], inner[s], frame.lod_distance);
-      if (lod) ++stats_.pairs_lod;
+      const bool far = mr.lod_point_count > 0 && brf_pair_far(spheres[r], inner[s], frame.lod_distance);
+      const std::uint8_t lod = far ? (frame.lod_shared ? 2 : 1) : 0;
+      if (far) ++stats_.pairs_lod;
       if (slot.valid && same_pose(slot.pose, relative, pose_tolerance_) && same_occluders && slot.lod == lod) {
         ++stats_.pairs_reused;
         continue;
@@ -950,11 +959,13 @@ void BrfGpuPass::plan_pairs(std::span<const BrfGpuInstance> instances, FrameData
         const BrfBox box = brf_object_box(*models_[instances[ids[k]].model].mesh);
         frame.occluders.push_back({poses[k], glm::vec4(box.lo, 0.0f), glm::vec4(box.hi, 0.0f)});
       }
-      if (lod) {
+      if (far) {
+        job.lod_shared = frame.lod_shared ? 1u : 0u;
         // Kind 2 (after the kind-0 dispatch): every vertex's own side and visibility, its row
         // interpolated from the representative points' rows, which this kind-0 job writes
         // (field part only) into the slot's scratch.
         BrfPhiJob rows = job;
+        rows.frame_offset = padded(models_[instances[s].model].channels()) / 4;  // vec4s per row
         rows.lod_points = 1u + mr.lod_entry_offset;
         rows.lod_rows = slot.lod_rows / 4;
         frame.lod_jobs.push_back(rows);

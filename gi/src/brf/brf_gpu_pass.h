@@ -202,7 +202,7 @@ class BrfGpuPass {
     std::uint32_t phi_offset = 0;  ///< First float in phi_.
     bool valid = false;            ///< Phi holds the basis irradiance at `pose`.
     glm::mat4 pose{1.0f};          ///< inverse(M_source) x M_receiver when computed.
-    bool lod = false;              ///< Computed with the level of detail (brf_lod.h).
+    std::uint8_t lod = 0;          ///< Computed with the level of detail (brf_lod.h): 1, 2 with shared visibility.
     /// Receivers with a level-of-detail table: first float in phi_ of the representative
     /// points' rows (scratch for one frame, after the slots).
     std::uint32_t lod_rows = 0;
@@ -221,6 +221,7 @@ class BrfGpuPass {
   };
   struct Programs {
     engine::ShaderProgram phi, phi_glossy, fit, gather, static_gather;  ///< phi_glossy: jobs of K_r > 1 rows
+    engine::ShaderProgram phi_lod;  ///< brf_phi's BRF_LOD_ROWS variant: kind 2 (level of detail)
   };
 
   struct ModelData;  ///< create()'s model tables on the CPU before upload (brf_gpu_pass.cpp).

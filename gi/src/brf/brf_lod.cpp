@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace gi {
 
@@ -90,28 +91,76 @@ BrfLodPoints brf_lod_points(const BrfMesh& mesh) {
     const float d01 = glm::dot(e0, e1), d11 = glm::dot(e1, e1);
     const float denom = d00 * d11 - d01 * d01;
     const bool plane = denom > 1e-6f * d00 * d11 && c != a && c != b;
-    const std::uint32_t reps[3] = {a, b, plane ? c : a};
+    // In the group's plane: a lattice of G x G nodes over its extent, each taken by the member
+    // nearest to it (G = 3 for groups of 18 members or more, 2 from 8, else the triangle a b c).
+    // The lattice's axes along a-c (a rectangle's edge: a and b are opposite corners).
+    const glm::vec3 eu = plane ? glm::normalize(e1) : e0;
+    const glm::vec3 ev = plane ? glm::normalize(e0 - glm::dot(e0, eu) * eu) : e0;
+    auto uv = [&](std::uint32_t m) { return glm::vec2(glm::dot(pos[m] - pos[a], eu), glm::dot(pos[m] - pos[a], ev)); };
+    std::vector<std::uint32_t> reps;
+    const int lattice = !plane ? 0 : members.size() >= 64 ? 3 : members.size() >= 8 ? 2 : 0;
+    glm::vec2 lo2(0.0f), hi2(0.0f);
+    for (std::uint32_t m : members) {
+      lo2 = glm::min(lo2, uv(m));
+      hi2 = glm::max(hi2, uv(m));
+    }
+    for (int i = 0; i < lattice; ++i)
+      for (int k = 0; k < lattice; ++k) {
+        const glm::vec2 node = lo2 + (hi2 - lo2) * glm::vec2(static_cast<float>(i), static_cast<float>(k)) /
+                                         static_cast<float>(lattice - 1);
+        std::uint32_t best_m = members[0];
+        float best_d = std::numeric_limits<float>::max();
+        for (std::uint32_t m : members) {
+          const glm::vec2 d = uv(m) - node;
+          if (glm::dot(d, d) < best_d) {
+            best_d = glm::dot(d, d);
+            best_m = m;
+          }
+        }
+        if (std::find(reps.begin(), reps.end(), best_m) == reps.end()) reps.push_back(best_m);
+      }
+    if (reps.size() < 3) reps = plane ? std::vector<std::uint32_t>{a, b, c} : std::vector<std::uint32_t>{a, b};
     for (std::uint32_t r : reps) {
-      if (is_point[r] != 0) continue;
       lod.points.push_back(r);
       is_point[r] = 1;
     }
+    const float area = std::max((hi2.x - lo2.x) * (hi2.y - lo2.y), 1e-12f);
     for (std::uint32_t m : members) {
-      lod.from[m] = glm::uvec3(reps[0], reps[1], reps[2]);
       if (is_point[m] != 0) {
         lod.from[m] = glm::uvec3(m);
         lod.weights[m] = glm::vec3(1.0f, 0.0f, 0.0f);
         continue;
       }
-      const glm::vec3 d = pos[m] - pos[a];
-      const float d20 = glm::dot(d, e0), d21 = glm::dot(d, e1);
-      if (plane) {
-        const float v = (d11 * d20 - d01 * d21) / denom, w = (d00 * d21 - d01 * d20) / denom;
-        lod.weights[m] = glm::vec3(1.0f - v - w, v, w);
-      } else {
-        const float t = d00 > 0.0f ? d20 / d00 : 0.0f;
+      if (reps.size() == 2) {  // a line
+        const float t = d00 > 0.0f ? glm::dot(pos[m] - pos[a], e0) / d00 : 0.0f;
+        lod.from[m] = glm::uvec3(reps[0], reps[1], reps[0]);
         lod.weights[m] = glm::vec3(1.0f - t, t, 0.0f);
+        continue;
       }
+      // The smallest triangle of representative points holding the member (barycentric
+      // weights >= 0), else the one it lies least outside of.
+      const glm::vec2 x = uv(m);
+      float best_area = std::numeric_limits<float>::max(), best_outside = -std::numeric_limits<float>::max();
+      bool inside_found = false;
+      for (std::size_t i = 0; i < reps.size(); ++i)
+        for (std::size_t j = i + 1; j < reps.size(); ++j)
+          for (std::size_t k = j + 1; k < reps.size(); ++k) {
+            const glm::vec2 p0 = uv(reps[i]), p1 = uv(reps[j]), p2 = uv(reps[k]);
+            const float det = (p1.x - p0.x) * (p2.y - p0.y) - (p2.x - p0.x) * (p1.y - p0.y);
+            if (std::fabs(det) <= 1e-4f * area) continue;
+            const float w1 = ((x.x - p0.x) * (p2.y - p0.y) - (p2.x - p0.x) * (x.y - p0.y)) / det;
+            const float w2 = ((p1.x - p0.x) * (x.y - p0.y) - (x.x - p0.x) * (p1.y - p0.y)) / det;
+            const glm::vec3 w(1.0f - w1 - w2, w1, w2);
+            const float least = std::min({w.x, w.y, w.z});
+            const bool inside = least >= -1e-5f;
+            if (inside ? (!inside_found || std::fabs(det) < best_area) : (!inside_found && least > best_outside)) {
+              inside_found = inside_found || inside;
+              best_area = std::fabs(det);
+              best_outside = least;
+              lod.from[m] = glm::uvec3(reps[i], reps[j], reps[k]);
+              lod.weights[m] = w;
+            }
+          }
     }
   }
   std::sort(lod.points.begin(), lod.points.end());

@@ -10,11 +10,13 @@
 //   - the vertices are grouped by plane (greedy: normal cos >= kBrfLodNormalCos to the group's
 //     first vertex's, and within kBrfLodPlaneTolerance x the mesh's bounding radius of its
 //     plane): the lobe is then the same over a group and the source on the same side of it;
-//   - per group, 3 representative vertices spanning it (farthest from the centroid, farthest
-//     from that, farthest from the line through both; 2 when the group is a line, all of it
-//     when it has at most 3), and every vertex of the group takes the barycentric
-//     coordinates of its projection onto their plane (exact for Phi linear over the group;
-//     coordinates may be negative for vertices outside the triangle).
+//   - per group, representative vertices on a lattice over its extent in its plane (the member
+//     nearest to each of 3 x 3 nodes for groups of 64 members or more, 2 x 2 from 8; else 3
+//     spanning it: farthest from the centroid, farthest from that, farthest from the line
+//     through both; 2 when the group is a line, all of it when it has at most 3); every other
+//     vertex takes the barycentric coordinates of the smallest triangle of them holding it
+//     (exact for a field part linear over the triangle; no extrapolation inside the lattice).
+//     A crate face of 5 x 5 vertices: its 4 corners, 24 points for the crate of 150 vertices.
 // A mesh of smooth normals (many groups) gets no table (points empty): its pairs stay exact.
 // Only diffuse receivers (one Phi row per vertex) use it; glossy receivers are evaluated in full.
 //   gi::BrfLodPoints lod = gi::brf_lod_points(mesh);

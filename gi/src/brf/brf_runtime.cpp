@@ -72,7 +72,8 @@ BrfHorizon brf_horizon(const BrfBox& box, const glm::vec3& p, const glm::vec3& n
 void brf_basis_irradiance(const BrfObject& source, std::span<const glm::vec3> positions,
                           std::span<const glm::vec3> normals, std::vector<float>& out,
                           const BrdfSeparation* receiver_glossy, std::span<const glm::mat3> frames,
-                          std::span<const BrfOccluder> occluders, const BrfLodPoints* lod) {
+                          std::span<const BrfOccluder> occluders, const BrfLodPoints* lod,
+                          bool lod_shared_visibility) {
   const BasisRadianceField& f = *source.field;
   const auto cc = static_cast<std::size_t>(f.coefficient_count());
   const auto channels = static_cast<std::size_t>(f.channel_count());
@@ -105,10 +106,24 @@ void brf_basis_irradiance(const BrfObject& source, std::span<const glm::vec3> po
       const glm::vec3 n = glm::normalize(rot * normals[j]);
       const BrfHorizon side = brf_horizon(box, p, n);
       if (side == BrfHorizon::Behind) continue;
+      // Shared visibility: the point's row as the full evaluation has it, visibility included.
+      const float v = !lod_shared_visibility ? 1.0f
+                      : brf_contact_visibility(box, p, n) *
+                            (occluders.empty() ? 1.0f
+                                               : brf_weighted_visibility(p, n, targets, [&](std::size_t, const glm::vec3& a,
+                                                                                            const glm::vec3& b) {
+                                                   return brf_segment_clear(a, b, occluders);
+                                                 }));
+      if (v == 0.0f) continue;
       f.sample(p, coeffs);
       const auto lobe = side == BrfHorizon::InFront ? sh_cosine(n) : sh_clamped_cosine(n, f.sh_bands);
       for (std::size_t c = 0; c < channels; ++c)
-        point_rows[i * channels + c] = sh_dot(std::span<const float>(coeffs).subspan(c * cc), lobe, cc);
+        point_rows[i * channels + c] = sh_dot(std::span<const float>(coeffs).subspan(c * cc), lobe, cc) * v;
+    }
+    if (lod_shared_visibility) {  // every vertex's row from the points' rows as they are
+      for (std::size_t j = 0; j < positions.size(); ++j)
+        brf_lod_interpolate(*lod, j, point_rows, channels, 1.0f, out.data() + j * channels);
+      return;
     }
   }
   for (std::size_t j = 0; j < positions.size(); ++j) {
@@ -411,7 +426,7 @@ BrfResult brf_interreflect(std::span<const BrfObject> objects, std::span<const s
           lod[r] != nullptr && brf_pair_far(spheres[r], inner[s], settings.lod_distance) ? lod[r] : nullptr;
       if (pair_lod != nullptr) ++out.pairs_lod;
       brf_basis_irradiance(objects[s], wv[r].positions, wv[r].normals, phi[s * n + r], objects[r].glossy, wv[r].frames,
-                           occluders, pair_lod);
+                           occluders, pair_lod, settings.lod_shared_visibility);
     }
 
   for (int bounce = 0; bounce < settings.bounces; ++bounce) {

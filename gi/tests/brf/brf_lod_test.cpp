@@ -87,11 +87,11 @@ std::pair<double, double> vertex_errors(const gi::BrfResult& lod, const gi::BrfR
   return {rel.back(), rel[static_cast<std::size_t>(0.95 * static_cast<double>(rel.size() - 1))]};
 }
 
-TEST(BrfLodPoints, CrateFacesGetThreePointsThatReproduceLinearFunctions) {
+TEST(BrfLodPoints, CrateFacesGetALatticeOfPointsThatReproducesLinearFunctions) {
   const gi::BrfMesh& mesh = crate().mesh;
   const gi::BrfLodPoints lod = gi::brf_lod_points(mesh);
   ASSERT_EQ(lod.from.size(), mesh.positions.size());
-  EXPECT_EQ(lod.points.size(), 18u);  // 6 faces x 3
+  EXPECT_EQ(lod.points.size(), 24u);  // 6 faces x 2 x 2 (their corners)
   EXPECT_TRUE(std::is_sorted(lod.points.begin(), lod.points.end()));
   const glm::vec3 a(0.3f, -1.2f, 0.7f);
   auto f = [&](const glm::vec3& p) { return glm::dot(a, p) + 0.4f; };
@@ -109,6 +109,7 @@ TEST(BrfLodPoints, CrateFacesGetThreePointsThatReproduceLinearFunctions) {
       EXPECT_NEAR(glm::dot(mesh.normals[j], mesh.positions[r[k]] - mesh.positions[j]), 0.0f, 1e-5f);
     }
     EXPECT_NEAR(w.x + w.y + w.z, 1.0f, 1e-5f);
+    EXPECT_GE(std::min({w.x, w.y, w.z}), -1e-5f) << "vertex " << j << " is interpolated, not extrapolated";
     const float interpolated = w.x * f(mesh.positions[r.x]) + w.y * f(mesh.positions[r.y]) + w.z * f(mesh.positions[r.z]);
     EXPECT_NEAR(interpolated, f(mesh.positions[j]), 1e-5f) << "vertex " << j;
   }
@@ -141,7 +142,7 @@ TEST(BrfLodPoints, PairsAreFarBeyondTheMultipleOfTheInnerSphere) {
 TEST(BrfLod, OffIsBitIdenticalAndNearPairsAreUnchanged) {
   const std::vector<gi::BrfObject> objects = grid(3);
   const auto in = incoming(objects, {1.2f, 2.5f, 1.0f});
-  const gi::BrfResult off = gi::brf_interreflect(objects, in, {.cull_threshold = 0.0f});
+  const gi::BrfResult off = gi::brf_interreflect(objects, in, {.cull_threshold = 0.0f, .lod_distance = 0.0f});
   EXPECT_EQ(off.pairs_lod, 0u);
   // Off by every spelling, and on with no pair far enough: the same bits.
   for (float lod : {0.0f, -1.0f, std::numeric_limits<float>::infinity(), 1e6f}) {
@@ -152,7 +153,7 @@ TEST(BrfLod, OffIsBitIdenticalAndNearPairsAreUnchanged) {
   // Two neighbours (1.8 inner radii apart) at lod_distance 2: near, exact.
   const std::vector<gi::BrfObject> two(objects.begin(), objects.begin() + 2);
   const std::vector<std::vector<glm::vec3>> in_two(in.begin(), in.begin() + 2);
-  const gi::BrfResult exact = gi::brf_interreflect(two, in_two, {.cull_threshold = 0.0f});
+  const gi::BrfResult exact = gi::brf_interreflect(two, in_two, {.cull_threshold = 0.0f, .lod_distance = 0.0f});
   const gi::BrfResult near = gi::brf_interreflect(two, in_two, {.cull_threshold = 0.0f, .lod_distance = 2.0f});
   EXPECT_EQ(near.pairs_lod, 0u);
   EXPECT_EQ(near.indirect, exact.indirect);
@@ -175,7 +176,7 @@ TEST(BrfLod, FarPairsEvaluateTheRepresentativePointsExactlyAndStayWithinTheBound
 
   // The whole frame: per-vertex error against the exact evaluation, by threshold.
   const auto in = incoming(objects, {1.2f, 2.5f, 1.0f});
-  const gi::BrfResult exact = gi::brf_interreflect(objects, in, {.cull_threshold = 0.0f});
+  const gi::BrfResult exact = gi::brf_interreflect(objects, in, {.cull_threshold = 0.0f, .lod_distance = 0.0f});
   for (float lod_distance : {3.0f, 5.0f}) {
     const gi::BrfResult r = gi::brf_interreflect(objects, in, {.cull_threshold = 0.0f, .lod_distance = lod_distance});
     const auto [max_rel, p95] = vertex_errors(r, exact);
@@ -183,9 +184,18 @@ TEST(BrfLod, FarPairsEvaluateTheRepresentativePointsExactlyAndStayWithinTheBound
                 double(lod_distance), r.pairs_lod, r.pairs_evaluated, max_rel, p95);
     EXPECT_GT(r.pairs_lod, 0u);
     EXPECT_LT(r.pairs_lod, r.pairs_evaluated);  // the neighbours stay exact
-    EXPECT_LT(max_rel, 0.05) << lod_distance;  // measured 0.020 at both
-    EXPECT_LT(p95, 0.01) << lod_distance;      // measured 0.005
+    EXPECT_LT(max_rel, 0.05) << lod_distance;  // measured 0.013 at both
+    EXPECT_LT(p95, 0.01) << lod_distance;      // measured 0.004
   }
+  // Shared visibility: whole rows interpolated (a face partly hidden by the middle crate gets
+  // its corners' mix): looser.
+  const gi::BrfResult shared =
+      gi::brf_interreflect(objects, in, {.cull_threshold = 0.0f, .lod_distance = 5.0f, .lod_shared_visibility = true});
+  const auto [max_shared, p95_shared] = vertex_errors(shared, exact);
+  std::printf("lod_distance 5.0, shared visibility: vertex rel error max %.4f, p95 %.4f\n", max_shared, p95_shared);
+  EXPECT_EQ(shared.pairs_lod, 20u);
+  EXPECT_LT(max_shared, 0.3);  // measured 0.10, p95 0.033
+  EXPECT_LT(p95_shared, 0.1);
 }
 
 engine::GpuContext headless_or_fail() {
@@ -231,9 +241,10 @@ TEST(BrfLod, GpuPassMatchesItsTwinWithTheLevelOfDetail) {
     for (const auto& o : r.indirect) v.insert(v.end(), o.begin(), o.end());
     return v;
   };
-  for (float cull : {0.0f, 1e-3f}) {
-    const gi::BrfUpdateSettings off{.bounces = 3, .cull_threshold = cull};
-    const gi::BrfUpdateSettings on{.bounces = 3, .cull_threshold = cull, .lod_distance = 2.0f};
+  for (const auto& [cull, shared] : {std::pair{0.0f, false}, std::pair{1e-3f, false}, std::pair{1e-3f, true}}) {
+    const gi::BrfUpdateSettings off{.bounces = 3, .cull_threshold = cull, .lod_distance = 0.0f};
+    const gi::BrfUpdateSettings on{
+        .bounces = 3, .cull_threshold = cull, .lod_distance = 2.0f, .lod_shared_visibility = shared};
     ASSERT_TRUE(pass.run(instances, in, off).ok());
     const std::vector<glm::vec3> gpu_off = all();
     EXPECT_EQ(pass.stats().pairs_lod, 0u);
@@ -243,8 +254,8 @@ TEST(BrfLod, GpuPassMatchesItsTwinWithTheLevelOfDetail) {
     const gi::BrfResult ref = gi::brf_interreflect(objects, in, on);
     const std::vector<glm::vec3> gpu_on = all();
     const double e = relative_rmse(gpu_on, flat(ref));
-    std::printf("cull %g: lod on, GPU vs CPU rel RMSE %.2e, %zu far pairs of %zu; lod on vs off %.2e\n", double(cull),
-                e, pass.stats().pairs_lod, pass.stats().pairs_evaluated, relative_rmse(gpu_on, gpu_off));
+    std::printf("cull %g, shared visibility %d: lod on, GPU vs CPU rel RMSE %.2e, %zu far pairs of %zu; lod on vs off %.2e\n", double(cull),
+                int(shared), e, pass.stats().pairs_lod, pass.stats().pairs_evaluated, relative_rmse(gpu_on, gpu_off));
     EXPECT_LT(e, 1e-3);
     EXPECT_GT(ref.pairs_lod, 0u);
     EXPECT_EQ(pass.stats().pairs_lod, ref.pairs_lod);
