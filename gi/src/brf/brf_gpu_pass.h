@@ -25,7 +25,12 @@
 //     does not move), the fit of each source's total light (all terms) and
 //     brf_static_gather.comp.glsl.
 // Pair culling is brf_pair_culling on the CPU with the same first weights as the CPU twin, so
-// both evaluate the same pairs.
+// both evaluate the same pairs. Far pairs may use the level of detail (brf_lod.h,
+// BrfUpdateSettings::lod_distance): Phi at the receiver's representative points (a kind-0 job
+// into scratch after the slots), then brf_phi's BRF_LOD_ROWS variant (kind 2) for every vertex.
+// Sources: brf_gpu_pass.cpp (create(), model tables and uploads, static receivers, outputs),
+// brf_gpu_frame.cpp (run(): the frame's CPU side, the Phi slot table, the dispatches),
+// brf_gpu_pass_detail.h (what both share).
 //   auto pass = gi::BrfGpuPass::create(models).value();          // a GL context is current
 //   pass.run(instances, incoming, {.bounces = 3});               // then bind pass.vertex_buffer(i)
 //
