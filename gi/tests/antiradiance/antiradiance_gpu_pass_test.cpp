@@ -13,17 +13,11 @@
 #include "antiradiance/antiradiance_gpu_pass.h"
 #include "antiradiance/antiradiance_region.h"
 #include "antiradiance_scenes.h"
+#include "gl_context.h"
 
 namespace {
 
-engine::GpuContext headless_or_fail() {
-  auto ctx = engine::GpuContext::create_headless();
-  if (!ctx) {
-    ADD_FAILURE() << "headless GL context creation failed: " << ctx.error().to_string();
-    std::abort();
-  }
-  return std::move(ctx).value();
-}
+using gltest::headless_or_fail;
 
 float largest(const std::vector<glm::vec3>& v) {
   float m = 0.0f;

@@ -19,19 +19,13 @@
 #include "brf/brdf_separation.h"
 #include "brf/brf_runtime.h"
 #include "brf_scenes.h"
+#include "gl_context.h"
 
 namespace {
 
 constexpr double kTolerance = 1e-3;
 
-engine::GpuContext headless_or_fail() {
-  auto ctx = engine::GpuContext::create_headless();
-  if (!ctx) {
-    ADD_FAILURE() << "headless GL context creation failed: " << ctx.error().to_string();
-    std::abort();
-  }
-  return std::move(ctx).value();
-}
+using gltest::headless_or_fail;
 
 gi::BrfMesh box(glm::vec3 half, int n) { return brftest::box(half, n); }
 

@@ -20,6 +20,7 @@
 #include "raytrace/reference_render.h"
 #include "reference_scenes.h"
 #include "transport/point_emitters.h"
+#include "gl_context.h"
 
 namespace {
 
@@ -116,14 +117,7 @@ TEST(BrfOcclusion, TheThirdCrateGetsOnlyWhatPassesTheSecond) {
   EXPECT_LT(std::abs(w3 - t3), 0.5 * std::abs(o3 - t3));
 }
 
-engine::GpuContext headless_or_fail() {
-  auto ctx = engine::GpuContext::create_headless();
-  if (!ctx) {
-    ADD_FAILURE() << "headless GL context creation failed: " << ctx.error().to_string();
-    std::abort();
-  }
-  return std::move(ctx).value();
-}
+using gltest::headless_or_fail;
 
 double rel_rmse(std::span<const glm::vec3> a, std::span<const glm::vec3> b) {
   double err = 0.0, norm = 0.0;

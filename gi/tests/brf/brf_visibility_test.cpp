@@ -22,17 +22,11 @@
 #include "raytrace/reference_render.h"
 #include "reference_scenes.h"
 #include "transport/point_emitters.h"
+#include "gl_context.h"
 
 namespace {
 
-engine::GpuContext headless_or_fail() {
-  auto ctx = engine::GpuContext::create_headless();
-  if (!ctx) {
-    ADD_FAILURE() << "headless GL context creation failed: " << ctx.error().to_string();
-    std::abort();
-  }
-  return std::move(ctx).value();
-}
+using gltest::headless_or_fail;
 
 struct Crate {
   gi::BrfMesh mesh = brftest::box({0.3f, 0.3f, 0.3f}, 3);

@@ -17,20 +17,14 @@
 #include "prm/prm.h"
 #include "prm/prm_gpu_pass.h"
 #include "prm/prm_runtime.h"
+#include "gl_context.h"
 
 namespace {
 
 constexpr double kRelativeTolerance = 1e-3;
 constexpr double kAbsoluteTolerance = 1e-6;
 
-engine::GpuContext headless_or_fail() {
-  auto ctx = engine::GpuContext::create_headless();
-  if (!ctx) {
-    ADD_FAILURE() << "headless GL context creation failed: " << ctx.error().to_string();
-    std::abort();
-  }
-  return std::move(ctx).value();
-}
+using gltest::headless_or_fail;
 
 // A hand-made PRM: a pseudo-random ascending two-thirds of the atlas texels, pane values
 // log-uniform in [min_value, max_value] per channel.
