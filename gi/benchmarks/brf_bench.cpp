@@ -149,13 +149,12 @@ void BM_BrfInterreflectCpuGlossy(benchmark::State& state) {
 }
 BENCHMARK(BM_BrfInterreflectCpuGlossy)->Arg(1)->Arg(5)->Arg(10)->Arg(30)->Unit(benchmark::kMillisecond);
 
-
-void BM_BrfGpu(benchmark::State& state) {
+// The GPU pass over n crates, timed per run() with glFinish: moving alternates two poses a few
+// degrees apart (every Phi re-evaluated), still repeats one (every Phi reused). Counters: the
+// process's CPU ms per run (llvmpipe's threads included) and the pass's stats.
+void run_gpu_pass(benchmark::State& state, int n, bool moving, const gi::BrfUpdateSettings& settings) {
   (void)bench::gl_context();
   const Shared& s = shared();
-  const int n = static_cast<int>(state.range(0));
-  const bool moving = state.range(1) != 0;
-  const bool cull = state.range(2) != 0;
   const gi::BrfGpuModel model{&s.mesh, &s.basis, &s.field};
   auto pass = gi::BrfGpuPass::create(std::span(&model, 1));
   if (!pass) {
@@ -163,13 +162,11 @@ void BM_BrfGpu(benchmark::State& state) {
     return;
   }
   const gi::PointEmitter light = grid_light(n);
-  // Two poses a few degrees apart; moving runs alternate between them.
   std::vector<gi::BrfGpuInstance> poses[2];
   for (int k = 0; k < 2; ++k)
     for (const gi::BrfObject& o : crates(n, 0.02f * static_cast<float>(k)))
       poses[k].push_back({0, o.object_to_world, o.albedo});
   const auto incoming = gi::brf_direct_light(crates(n), std::span<const gi::PointEmitter>(&light, 1), nullptr);
-  const gi::BrfUpdateSettings settings{.bounces = 3, .cull_threshold = cull ? 1e-2f : 0.0f};
   if (!pass->run(poses[1], incoming, settings)) state.SkipWithError("run failed");
   glFinish();
   std::size_t frame = 0;
@@ -183,8 +180,16 @@ void BM_BrfGpu(benchmark::State& state) {
   state.counters["process_cpu_ms"] = (process_cpu_ms() - cpu0) / static_cast<double>(std::max<std::size_t>(frame, 1));
   state.counters["pairs_evaluated"] = static_cast<double>(pass->stats().pairs_evaluated);
   state.counters["pairs_reused"] = static_cast<double>(pass->stats().pairs_reused);
+  state.counters["pairs_lod"] = static_cast<double>(pass->stats().pairs_lod);
   state.counters["run_cpu_ms"] = pass->stats().cpu_ms;
   state.counters["gpu_MB"] = static_cast<double>(pass->gpu_bytes()) / 1e6;
+}
+
+// n crates, moving or still, bound culling on or off; the default settings otherwise (the
+// level of detail included).
+void BM_BrfGpu(benchmark::State& state) {
+  run_gpu_pass(state, static_cast<int>(state.range(0)), state.range(1) != 0,
+               {.bounces = 3, .cull_threshold = state.range(2) != 0 ? 1e-2f : 0.0f});
 }
 BENCHMARK(BM_BrfGpu)->ArgsProduct({{1, 5, 10, 30}, {0, 1}, {0, 1}})->Unit(benchmark::kMillisecond);
 
@@ -193,38 +198,11 @@ BENCHMARK(BM_BrfGpu)->ArgsProduct({{1, 5, 10, 30}, {0, 1}, {0, 1}})->Unit(benchm
 // (0: off, the exact evaluation); third arg 1: shared visibility (lod_shared_visibility).
 // Counter pairs_lod: the far pairs interpolated.
 void BM_BrfGpuLod(benchmark::State& state) {
-  (void)bench::gl_context();
-  const Shared& s = shared();
-  const int n = static_cast<int>(state.range(0));
-  const float lod = static_cast<float>(state.range(1)) / 10.0f;
-  const bool shared = state.range(2) != 0;
-  const gi::BrfGpuModel model{&s.mesh, &s.basis, &s.field};
-  auto pass = gi::BrfGpuPass::create(std::span(&model, 1));
-  if (!pass) {
-    state.SkipWithError(pass.error().to_string().c_str());
-    return;
-  }
-  const gi::PointEmitter light = grid_light(n);
-  std::vector<gi::BrfGpuInstance> poses[2];
-  for (int k = 0; k < 2; ++k)
-    for (const gi::BrfObject& o : crates(n, 0.02f * static_cast<float>(k)))
-      poses[k].push_back({0, o.object_to_world, o.albedo});
-  const auto incoming = gi::brf_direct_light(crates(n), std::span<const gi::PointEmitter>(&light, 1), nullptr);
-  const gi::BrfUpdateSettings settings{
-      .bounces = 3, .cull_threshold = 0.0f, .lod_distance = lod, .lod_shared_visibility = shared};
-  if (!pass->run(poses[1], incoming, settings)) state.SkipWithError("run failed");
-  glFinish();
-  std::size_t frame = 0;
-  const double cpu0 = process_cpu_ms();
-  for (auto _ : state) {
-    const auto status = pass->run(poses[frame % 2], incoming, settings);
-    glFinish();
-    if (!status) state.SkipWithError(status.error().to_string().c_str());
-    ++frame;
-  }
-  state.counters["process_cpu_ms"] = (process_cpu_ms() - cpu0) / static_cast<double>(std::max<std::size_t>(frame, 1));
-  state.counters["pairs_evaluated"] = static_cast<double>(pass->stats().pairs_evaluated);
-  state.counters["pairs_lod"] = static_cast<double>(pass->stats().pairs_lod);
+  run_gpu_pass(state, static_cast<int>(state.range(0)), true,
+               {.bounces = 3,
+                .cull_threshold = 0.0f,
+                .lod_distance = static_cast<float>(state.range(1)) / 10.0f,
+                .lod_shared_visibility = state.range(2) != 0});
 }
 BENCHMARK(BM_BrfGpuLod)->ArgsProduct({{30}, {0, 20, 30, 50}, {0, 1}})->Unit(benchmark::kMillisecond);
 
@@ -264,25 +242,6 @@ const RoomObjects& crates_room() {
   return room;
 }
 
-std::pair<double, double> lod_vertex_errors(const gi::BrfResult& lod, const gi::BrfResult& exact) {
-  double mean = 0.0;
-  std::size_t count = 0;
-  for (const auto& v : exact.indirect)
-    for (const glm::vec3& e : v) {
-      mean += glm::length(glm::dvec3(e));
-      ++count;
-    }
-  mean /= static_cast<double>(std::max<std::size_t>(count, 1));
-  std::vector<double> rel;
-  for (std::size_t o = 0; o < exact.indirect.size(); ++o)
-    for (std::size_t j = 0; j < exact.indirect[o].size(); ++j)
-      rel.push_back(glm::length(glm::dvec3(lod.indirect[o][j]) - glm::dvec3(exact.indirect[o][j])) /
-                    std::max(glm::length(glm::dvec3(exact.indirect[o][j])), 0.01 * mean));
-  if (rel.empty()) return {0.0, 0.0};
-  std::sort(rel.begin(), rel.end());
-  return {rel.back(), rel[static_cast<std::size_t>(0.95 * static_cast<double>(rel.size() - 1))]};
-}
-
 void BM_BrfLodError(benchmark::State& state) {
   const bool room = state.range(0) != 0;
   const float lod = static_cast<float>(state.range(1)) / 10.0f;
@@ -311,7 +270,7 @@ void BM_BrfLodError(benchmark::State& state) {
                              {.bounces = 3, .cull_threshold = 0.0f, .lod_distance = lod, .lod_shared_visibility = shared});
     benchmark::DoNotOptimize(r.indirect.data());
   }
-  const auto [max_rel, p95] = lod_vertex_errors(r, exact);
+  const auto [max_rel, p95] = gi::brf_vertex_error(r, exact);
   state.counters["max_rel"] = max_rel;
   state.counters["p95_rel"] = p95;
   state.counters["pairs_lod"] = static_cast<double>(r.pairs_lod);

@@ -1,4 +1,5 @@
 #include "brf/brf_lod.h"
+#include "brf/brf_runtime.h"
 
 #include <algorithm>
 #include <cmath>
@@ -183,6 +184,27 @@ void brf_lod_interpolate(const BrfLodPoints& lod, std::size_t j, std::span<const
   const float* c = rows.data() + lod.from[j].z * row_floats;
   const glm::vec3 w = lod.weights[j];
   for (std::size_t k = 0; k < row_floats; ++k) out[k] = ((w.x * a[k] + w.y * b[k]) + w.z * c[k]) * scale;
+}
+
+BrfVertexError brf_vertex_error(const BrfResult& approx, const BrfResult& exact) {
+  double mean = 0.0;
+  std::size_t count = 0;
+  for (const auto& v : exact.indirect)
+    for (const glm::vec3& e : v) {
+      mean += glm::length(glm::dvec3(e));
+      ++count;
+    }
+  mean /= static_cast<double>(std::max<std::size_t>(count, 1));
+  std::vector<double> rel;
+  rel.reserve(count);
+  for (std::size_t o = 0; o < exact.indirect.size(); ++o)
+    for (std::size_t j = 0; j < exact.indirect[o].size(); ++j) {
+      const double d = glm::length(glm::dvec3(approx.indirect[o][j]) - glm::dvec3(exact.indirect[o][j]));
+      rel.push_back(d / std::max(glm::length(glm::dvec3(exact.indirect[o][j])), 0.01 * mean));
+    }
+  if (rel.empty()) return {};
+  std::sort(rel.begin(), rel.end());
+  return {rel.back(), rel[static_cast<std::size_t>(0.95 * static_cast<double>(rel.size() - 1))]};
 }
 
 }  // namespace gi

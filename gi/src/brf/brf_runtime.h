@@ -212,6 +212,17 @@ std::vector<std::vector<glm::vec3>> brf_direct_light(std::span<const BrfObject> 
 BrfResult brf_interreflect(std::span<const BrfObject> objects, std::span<const std::vector<glm::vec3>> incoming,
                            const BrfUpdateSettings& settings, const BrfStaticReceivers& receivers = {});
 
+/// How far an approximate interreflection (the level of detail, brf_lod.h) is from the exact
+/// one, per vertex: each vertex's relative error of its interreflected irradiance (`indirect`,
+/// RGB length), the denominator floored at 1% of the mean exact vertex irradiance (vertices
+/// facing away from every neighbour get almost nothing). The largest and the 95th percentile;
+/// docs/brf.md's level-of-detail table and its tests measure with it. Same shapes required.
+struct BrfVertexError {
+  double max = 0.0;
+  double p95 = 0.0;
+};
+BrfVertexError brf_vertex_error(const BrfResult& approx, const BrfResult& exact);
+
 /// Direct light (objects only, no world) then brf_interreflect; `direct` is filled.
 /// Preconditions: every object's mesh, basis and field belong together; lights are point or
 /// spot emitters (PointEmitter::Kind::Punctual) in world space.

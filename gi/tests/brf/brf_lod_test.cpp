@@ -19,6 +19,7 @@
 #include "brf/brf_gpu_pass.h"
 #include "brf/brf_runtime.h"
 #include "brf_scenes.h"
+#include "gl_context.h"
 
 namespace {
 
@@ -63,28 +64,6 @@ std::vector<std::vector<glm::vec3>> incoming(std::span<const gi::BrfObject> obje
     }
   }
   return in;
-}
-
-// Per-vertex relative error of the irradiance (RGB length) against the exact result, with
-// the denominator floored at 1% of the mean exact irradiance (vertices facing away from every
-// neighbour get almost nothing): (max, 95th percentile).
-std::pair<double, double> vertex_errors(const gi::BrfResult& lod, const gi::BrfResult& exact) {
-  double mean = 0.0;
-  std::size_t count = 0;
-  for (const auto& v : exact.indirect)
-    for (const glm::vec3& e : v) {
-      mean += glm::length(glm::dvec3(e));
-      ++count;
-    }
-  mean /= static_cast<double>(std::max<std::size_t>(count, 1));
-  std::vector<double> rel;
-  for (std::size_t o = 0; o < exact.indirect.size(); ++o)
-    for (std::size_t j = 0; j < exact.indirect[o].size(); ++j) {
-      const double d = glm::length(glm::dvec3(lod.indirect[o][j]) - glm::dvec3(exact.indirect[o][j]));
-      rel.push_back(d / std::max(glm::length(glm::dvec3(exact.indirect[o][j])), 0.01 * mean));
-    }
-  std::sort(rel.begin(), rel.end());
-  return {rel.back(), rel[static_cast<std::size_t>(0.95 * static_cast<double>(rel.size() - 1))]};
 }
 
 TEST(BrfLodPoints, CrateFacesGetALatticeOfPointsThatReproducesLinearFunctions) {
@@ -179,7 +158,7 @@ TEST(BrfLod, FarPairsEvaluateTheRepresentativePointsExactlyAndStayWithinTheBound
   const gi::BrfResult exact = gi::brf_interreflect(objects, in, {.cull_threshold = 0.0f, .lod_distance = 0.0f});
   for (float lod_distance : {3.0f, 5.0f}) {
     const gi::BrfResult r = gi::brf_interreflect(objects, in, {.cull_threshold = 0.0f, .lod_distance = lod_distance});
-    const auto [max_rel, p95] = vertex_errors(r, exact);
+    const auto [max_rel, p95] = gi::brf_vertex_error(r, exact);
     std::printf("lod_distance %.1f: %zu of %zu pairs far, vertex rel error max %.4f, p95 %.4f\n",
                 double(lod_distance), r.pairs_lod, r.pairs_evaluated, max_rel, p95);
     EXPECT_GT(r.pairs_lod, 0u);
@@ -191,21 +170,14 @@ TEST(BrfLod, FarPairsEvaluateTheRepresentativePointsExactlyAndStayWithinTheBound
   // its corners' mix): looser.
   const gi::BrfResult shared =
       gi::brf_interreflect(objects, in, {.cull_threshold = 0.0f, .lod_distance = 5.0f, .lod_shared_visibility = true});
-  const auto [max_shared, p95_shared] = vertex_errors(shared, exact);
+  const auto [max_shared, p95_shared] = gi::brf_vertex_error(shared, exact);
   std::printf("lod_distance 5.0, shared visibility: vertex rel error max %.4f, p95 %.4f\n", max_shared, p95_shared);
   EXPECT_EQ(shared.pairs_lod, 20u);
   EXPECT_LT(max_shared, 0.3);  // measured 0.10, p95 0.033
   EXPECT_LT(p95_shared, 0.1);
 }
 
-engine::GpuContext headless_or_fail() {
-  auto ctx = engine::GpuContext::create_headless();
-  if (!ctx) {
-    ADD_FAILURE() << "headless GL context creation failed: " << ctx.error().to_string();
-    std::abort();
-  }
-  return std::move(ctx).value();
-}
+using gltest::headless_or_fail;
 
 double relative_rmse(std::span<const glm::vec3> a, std::span<const glm::vec3> b) {
   double err = 0.0, norm = 0.0;
