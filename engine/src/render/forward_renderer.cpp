@@ -1,8 +1,9 @@
 // engine::Renderer: shadow maps, a forward linear-HDR pass (RGBA16F + depth), then
-// exposure, ACES-fitted tonemap and sRGB encoding into an RGBA8 target.
-#include <engine/renderer.h>
+// exposure, ACES-fitted tonemap and sRGB encoding into an RGBA8 target. The class is declared
+// in render/forward_renderer.h; its light reach and half-resolution area shadows live in
+// forward_reach.cpp and forward_area_shadow.cpp.
+#include "render/forward_renderer.h"
 
-#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <cstring>
@@ -28,41 +29,8 @@
 #include "render/light_list.h"
 #include "render/shadow_maps.h"
 
-namespace engine {
+namespace engine::render {
 
-namespace {
-
-using render::DrawItem;
-using render::GpuScene;
-
-// Texture units and SSBO bindings shared with forward.frag.glsl / shadow_common.glsl.
-enum TextureUnit : GLuint {
-  kBaseColorUnit = 0,
-  kMetallicRoughnessUnit = 1,
-  kEmissiveUnit = 2,
-  kIrradianceAtlasUnit = 3,
-  kShadowMapsUnit = 4,
-  kPointShadowMapsUnit = 5,
-  kGlossyUnit = 6,
-  kDirectionalIndexUnit = 7,
-  kShadowDepthUnit = 12,  // the 2-D shadow maps again, raw depth (shadow_common.glsl's sun disc)
-  kAreaVisibilityUnit = 13,  // area_shadow.frag.glsl: half-resolution visibility; forward: full-resolution
-  kAreaPlaneUnit = 14,       // area_shadow.frag.glsl: half-resolution tangent planes
-};
-// The stencil's top bit: pixels whose area-light visibility the half-resolution pass could
-// not lend (area_shadow.frag.glsl); the light-reach masks use the 7 bits below it then.
-constexpr GLuint kAreaFallbackBit = 0x80;
-constexpr GLuint kLightsBinding = 0;
-constexpr GLuint kVertexIrradianceBinding = 1;
-constexpr GLuint kDirectionalRadianceBinding = 2;  // directional_radiance.glsl
-constexpr GLuint kDirectionalDirectionBinding = 3;
-constexpr GLuint kLobeCoefficientsBinding = 6;  // forward.vert.glsl: IndirectLightFrame::vertex_radiance_lobes
-constexpr GLuint kLobeTableBinding = 7;
-constexpr GLuint kReachUnit = 0;  // depth_reach.frag.glsl (the pre-pass binds no material texture)
-constexpr float kReachVoxelM = 0.5f;  // light reach grid spacing (engine/light_reach.h)
-
-// Nearest, clamped, no depth comparison: the 2-D shadow maps read as depths (the blocker
-// search of a directional light with a disc, shadow_common.glsl).
 GlSampler raw_depth_sampler() {
   GlSampler s = GlSampler::create();
   glSamplerParameteri(s.id(), GL_TEXTURE_COMPARE_MODE, GL_NONE);
@@ -73,8 +41,6 @@ GlSampler raw_depth_sampler() {
   return s;
 }
 
-// A 1x1 R32I texture holding -1 ("no element"): what the directional index sampler reads
-// when the provider has no directional radiance.
 GlTexture no_directional_index() {
   GlTexture t = GlTexture::create_2d(GL_R32I, 1, 1);
   const GLint none = -1;
@@ -84,6 +50,8 @@ GlTexture no_directional_index() {
   return t;
 }
 
+namespace {
+
 enum IndirectMode : int { kIndirectNone = 0, kIndirectAmbient = 1, kIndirectAtlas = 2, kIndirectVertex = 3 };
 
 Result<ShaderProgram> build(const char* vertex, const char* fragment) {
@@ -92,12 +60,6 @@ Result<ShaderProgram> build(const char* vertex, const char* fragment) {
       .stage(ShaderStage::Fragment, fragment)
       .build();
 }
-
-// Point, spot, directional and area light counts, then area specular samples per side,
-// whether area lights are soft-shadowed (RenderSettings::area_soft_shadows), whether the
-// scene has a sky term (0: its radiance and gradient are zero, the shader leaves it out) and
-// whether area lights' visibility comes from the half-resolution pass (area_shadow_res).
-using LightCounts = std::array<int, 8>;
 
 // The forward program for one combination of light counts (see forward.frag.glsl).
 Result<ShaderProgram> build_forward(const LightCounts& n) {
@@ -115,145 +77,16 @@ Result<ShaderProgram> build_forward(const LightCounts& n) {
       .build();
 }
 
-// One pass of the half-resolution area shadows (area_shadow.frag.glsl) for `area_lights` lights.
-Result<ShaderProgram> build_area_shadow(int pass, int area_lights) {
-  return ShaderProgramBuilder(engine_shader_files())
-      .stage(ShaderStage::Vertex, "forward.vert.glsl")
-      .stage(ShaderStage::Fragment, "area_shadow.frag.glsl")
-      .define("AREA_SHADOW_PASS " + std::to_string(pass))
-      .define("AREA_LIGHTS " + std::to_string(area_lights))
-      .build();
+// A dielectric whose roughness is at least kRoughForOnePoint everywhere (no roughness texture):
+// its GGX lobe is far wider than the spread of directions to an area light's points, so one
+// specular point per rectangle (the centre) gives its radiance within about 1% (1.02% worst
+// at roughness 0.9, RendererAreaLight.RoughDielectricsTakeOneSpecularPoint).
+constexpr float kRoughForOnePoint = 0.9f;
+bool rough_dielectric(const render::GpuMaterial& m, GLuint white_texture) {
+  return m.metallic == 0.0f && m.roughness >= kRoughForOnePoint && m.metallic_roughness_texture == white_texture;
 }
 
-// The lights one set of pixels is shaded with: those of one light-reach mask (the stencil
-// value the pre-pass wrote), as a range of the lights buffer.
-struct LightGroup {
-  int mask = -1;  ///< stencil value; -1: no stencil test (no reach grid)
-  std::vector<render::GpuLight> lights;  ///< sorted by type, like LightList::lights
-  std::array<int, 4> count_by_type{};
-  render::SceneBounds bounds;  ///< where the mask's voxels are; empty: everywhere
-  GLintptr offset = 0;         ///< into the lights buffer (bytes)
-};
-
-// The static shadow casters and static lights a reach grid was built from, and the grid.
-struct ReachState {
-  std::vector<float> light_key;  // the cullable static lights' entity ids and geometry
-  std::vector<float> moving_key;  // the cullable moving lights' entity ids and positions
-  std::vector<ReachOccluder> occluders;  // the static casters of the last static build
-  render::SceneBounds statics;           // the grid's extent: every static item
-  LightReachGrid static_grid;            // the static lights' bits
-  std::map<std::uint32_t, glm::mat4> static_models;  // static occluders at the build
-  std::set<std::uint32_t> moved;  // static entities seen moving: never occluders again
-  LightReachGrid grid;
-  std::vector<int> mask_bounds_index;  // per mask value: index into bounds, -1 none
-  std::vector<render::SceneBounds> bounds;
-  GlTexture texture;
-  int builds = 0;
-};
-
-class ForwardRenderer final : public Renderer {
- public:
-  ForwardRenderer(GpuScene scene, ShaderProgram forward, ShaderProgram depth, ShaderProgram depth_reach,
-                  ShaderProgram shadow, ShaderProgram tonemap, const RenderSettings& settings)
-      : settings_(settings),
-        scene_(std::move(scene)),
-        depth_only_(std::move(depth)),
-        depth_reach_(std::move(depth_reach)),
-
-        shadow_(std::move(shadow)),
-        tonemap_(std::move(tonemap)),
-        lights_buffer_(GlBuffer::create()),
-        empty_vao_(GlVertexArray::create()),
-        albedo_table_(upload_gltf_albedo_table()),
-        no_directional_index_(no_directional_index()),
-        shadow_depth_sampler_(raw_depth_sampler()) {
-    forward_variants_.emplace(LightCounts{0, 0, 0, 0, 3, 1, 1, 0}, std::move(forward));
-    ensure_targets();
-  }
-
-  void render(const Registry& registry, Entity camera) override;
-  ImageRgba8 read_ldr() const override;
-  ImageRgbaF read_hdr() const override;
-  void present(int window_width, int window_height) const override {
-    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
-    glBlitNamedFramebuffer(ldr_fbo_.id(), 0, 0, 0, width_, height_, 0, 0, window_width, window_height,
-                           GL_COLOR_BUFFER_BIT, GL_LINEAR);
-  }
-  void set_indirect_light(IndirectLightProvider* provider) override { provider_ = provider; }
-  RenderSettings& settings() override { return settings_; }
-  const std::vector<PassTiming>& last_timings() const override { return timings_; }
-  int last_shadow_maps_rendered() const override { return shadow_maps_rendered_; }
-  int last_skipped_entities() const override { return skipped_entities_; }
-  int last_light_groups() const override { return light_groups_; }
-
- private:
-  void ensure_targets();
-  std::vector<DrawItem> draw_items(const Registry& registry, std::vector<std::pair<Entity, const char*>>& skipped) const;
-  void report_skipped(const Registry& registry, const std::vector<std::pair<Entity, const char*>>& skipped);
-  void forward_pass(const Registry& registry, Entity camera, const std::vector<DrawItem>& items,
-                    const std::vector<LightGroup>& groups);
-  const ShaderProgram& forward_program(const LightCounts& counts);
-  const ShaderProgram& area_shadow_program(int pass, int area_lights);
-  void area_shadow_passes(const glm::mat4& view_proj, const glm::vec3& camera_position, const std::vector<DrawItem>& items);
-  void draw_geometry(const std::vector<DrawItem>& items, bool double_sided_uniform);
-  void depth_prepass(const glm::mat4& view_proj, const std::vector<DrawItem>& items, bool reach);
-  std::vector<LightGroup> light_groups(const Registry& registry, const std::vector<DrawItem>& items,
-                                       const render::LightList& lights);
-  void update_reach(const std::vector<DrawItem>& items, const render::LightList& lights, const std::vector<int>& cullable,
-                    int n_static);
-  void tonemap_pass();
-
-  RenderSettings settings_;
-  GpuScene scene_;
-  std::map<LightCounts, ShaderProgram> forward_variants_;
-  std::map<std::pair<int, int>, ShaderProgram> area_shadow_programs_;  // (pass, area lights)
-  // Half-resolution area shadows (RenderSettings::area_shadow_res): this frame's area lights
-  // (empty: full-resolution lookups), their buffer, the half-resolution targets and the
-  // full-resolution visibility the forward pass reads.
-  std::vector<render::GpuLight> area_lights_;
-  GlBuffer area_lights_buffer_ = GlBuffer::create();
-  GlTexture half_depth_;
-  GlTexture half_visibility_;
-  GlTexture half_plane_;
-  GlTexture area_visibility_;
-  GlFramebuffer half_fbo_;
-  GlFramebuffer visibility_fbo_;
-  ShaderProgram depth_only_;
-  ShaderProgram depth_reach_;
-  ReachState reach_;
-  ShaderProgram shadow_;
-  ShaderProgram tonemap_;
-  render::ShadowMaps shadow_maps_;
-  int shadow_maps_rendered_ = 0;
-  int skipped_entities_ = 0;
-  int light_groups_ = 1;
-  std::set<std::uint32_t> warned_;  // entity ids skipped and reported, while they stay unusable
-  glm::mat4 last_camera_world_{1.0f};
-  GlBuffer lights_buffer_;
-  GlVertexArray empty_vao_;
-  GlTexture albedo_table_;  // gltf_brdf.glsl's directional albedo table
-  GlTexture no_directional_index_;
-  GlSampler shadow_depth_sampler_;  // no depth compare: the sun disc's blocker search reads depths
-  GlTexture hdr_;
-  GlTexture depth_;
-  GlTexture ldr_;
-  GlFramebuffer hdr_fbo_;
-  GlFramebuffer ldr_fbo_;
-  int width_ = 0;
-  int height_ = 0;
-  IndirectLightProvider* provider_ = nullptr;
-  std::vector<PassTiming> timings_;
-};
-
-const ShaderProgram& ForwardRenderer::area_shadow_program(int pass, int area_lights) {
-  const std::pair<int, int> key(pass, area_lights);
-  auto it = area_shadow_programs_.find(key);
-  if (it != area_shadow_programs_.end()) return it->second;
-  Result<ShaderProgram> p = build_area_shadow(pass, area_lights);
-  if (!p) std::fprintf(stderr, "%s\n", p.error().to_string().c_str());
-  GI_EXPECTS(p.ok(), "area shadow shader must compile");
-  return area_shadow_programs_.emplace(key, std::move(p.value())).first->second;
-}
+}  // namespace
 
 const ShaderProgram& ForwardRenderer::forward_program(const LightCounts& counts) {
   auto it = forward_variants_.find(counts);
@@ -394,171 +227,6 @@ void ForwardRenderer::render(const Registry& registry, Entity camera) {
 
   tonemap_pass();
   timings_.push_back({"tonemap (exposure, ACES fitted, sRGB)", timer.lap_ms()});
-}
-
-std::vector<LightGroup> ForwardRenderer::light_groups(const Registry& registry, const std::vector<DrawItem>& items,
-                                                      const render::LightList& lights) {
-  // Culled by reach: static (not Light::moves), shadowed point, spot and area lights (an
-  // unshadowed light shines through walls in this renderer; a directional one reaches
-  // everything it is not shadowed from), then moving shadowed point lights (their reach is
-  // recomputed on every frame they move; a moving spot, the flashlight, lights what the
-  // camera sees and stays on). The first LightReachGrid::kMaxLights of them; bit i of a
-  // mask is cullable[i].
-  std::vector<int> cullable;
-  int n_static = 0;
-  // With half-resolution area shadows the stencil's top bit flags their fallback pixels.
-  const std::size_t max_cullable = LightReachGrid::kMaxLights - (area_lights_.empty() ? 0 : 1);
-  if (settings_.light_reach_culling)
-    for (int pass = 0; pass < 2; ++pass) {
-      for (std::size_t i = 0; i < lights.lights.size() && cullable.size() < max_cullable; ++i) {
-        const render::GpuLight& g = lights.lights[i];
-        const Light* l = registry.try_get<Light>(lights.entities[i]);
-        const bool shadowed = g.cone.z >= 0.0f || g.cone.w >= 0.0f;
-        if (l == nullptr || !shadowed || l->type == LightType::Directional) continue;
-        if (pass == 0 ? !l->moves : (l->moves && l->type == LightType::Point)) cullable.push_back(static_cast<int>(i));
-      }
-      if (pass == 0) n_static = static_cast<int>(cullable.size());
-    }
-  LightGroup everything;
-  everything.lights = lights.lights;
-  everything.count_by_type = lights.count_by_type;
-  if (cullable.empty()) return {everything};
-  update_reach(items, lights, cullable, n_static);
-  if (reach_.grid.empty()) return {everything};
-  std::vector<LightGroup> groups;
-  for (int mask = 0; mask < 256; ++mask) {
-    const int bi = reach_.mask_bounds_index[static_cast<std::size_t>(mask)];
-    if (bi < 0 && mask != reach_.grid.all) continue;
-    LightGroup g;
-    g.mask = mask;
-    // The all-lights mask also covers everything outside the grid: no bounds.
-    if (mask != reach_.grid.all) g.bounds = reach_.bounds[static_cast<std::size_t>(bi)];
-    for (std::size_t i = 0; i < lights.lights.size(); ++i) {
-      const auto it = std::find(cullable.begin(), cullable.end(), static_cast<int>(i));
-      if (it != cullable.end() && (mask & (1 << (it - cullable.begin()))) == 0) continue;
-      g.lights.push_back(lights.lights[i]);
-      ++g.count_by_type[static_cast<std::size_t>(lights.lights[i].position_type.w)];
-    }
-    groups.push_back(std::move(g));
-  }
-  return groups;
-}
-
-// Rebuilds the static lights' reach grid when they or the static shadow casters changed
-// since the last build. A static item seen at a new transform is never an occluder again
-// (a door that swings): the grid stays conservative while it moves, and is not rebuilt for
-// it every frame. The moving lights' bits are recomputed whenever one of them moved.
-void ForwardRenderer::update_reach(const std::vector<DrawItem>& items, const render::LightList& lights,
-                                   const std::vector<int>& cullable, int n_static) {
-  std::vector<float> key, moving_key;
-  std::vector<ReachLight> static_lights, moving_lights;
-  for (std::size_t c = 0; c < cullable.size(); ++c) {
-    const std::size_t i = static_cast<std::size_t>(cullable[c]);
-    const render::GpuLight& g = lights.lights[i];
-    ReachLight r;
-    r.position = glm::vec3(g.position_type);
-    r.direction = glm::vec3(g.direction_range);
-    if (static_cast<int>(g.position_type.w) == static_cast<int>(render::GpuLightType::Area)) {
-      r.half_x = glm::vec3(g.area_half_x);
-      r.half_y = glm::vec3(g.area_half_y);
-    }
-    const bool is_static = static_cast<int>(c) < n_static;
-    (is_static ? static_lights : moving_lights).push_back(r);
-    std::vector<float>& k = is_static ? key : moving_key;
-    k.push_back(static_cast<float>(lights.entities[i].id()));
-    for (const glm::vec3& v : {r.position, r.direction, r.half_x, r.half_y}) k.insert(k.end(), {v.x, v.y, v.z});
-  }
-  std::map<std::uint32_t, glm::mat4> models;
-  for (const DrawItem& item : items)
-    if (item.is_static && item.cast_shadows && !reach_.moved.contains(item.entity.id())) models[item.entity.id()] = item.model;
-  const bool built = reach_.builds > 0;
-  const bool static_changed = !built || key != reach_.light_key || models != reach_.static_models;
-  if (!static_changed && moving_key == reach_.moving_key) return;
-  if (static_changed) {
-    if (built)
-      for (const auto& [id, m] : models) {
-        const auto it = reach_.static_models.find(id);
-        if (it != reach_.static_models.end() && it->second != m) reach_.moved.insert(id);
-      }
-    for (std::uint32_t id : reach_.moved) models.erase(id);
-    reach_.occluders.clear();
-    reach_.statics = render::SceneBounds{};
-    render::SceneBounds& statics = reach_.statics;
-    for (const DrawItem& item : items) {
-      if (!item.is_static) continue;
-      statics.min = statics.empty ? item.bounds.min : glm::min(statics.min, item.bounds.min);
-      statics.max = statics.empty ? item.bounds.max : glm::max(statics.max, item.bounds.max);
-      statics.empty = false;
-      if (!models.contains(item.entity.id())) continue;
-      ReachOccluder o;
-      o.min = item.bounds.min;
-      o.max = item.bounds.max;
-      const std::vector<glm::vec3>& c = item.mesh->triangle_corners;
-      for (std::size_t t = 0; t + 2 < c.size(); t += 3)
-        o.triangles.push_back({glm::vec3(item.model * glm::vec4(c[t], 1.0f)),
-                               glm::vec3(item.model * glm::vec4(c[t + 1], 1.0f)),
-                               glm::vec3(item.model * glm::vec4(c[t + 2], 1.0f))});
-      reach_.occluders.push_back(std::move(o));
-    }
-    reach_.light_key = std::move(key);
-    reach_.static_models = std::move(models);
-    ++reach_.builds;
-    reach_.static_grid = statics.empty ? LightReachGrid{}
-                                       : build_light_reach_grid(reach_.occluders, static_lights, statics.min, statics.max,
-                                                                kReachVoxelM);
-  }
-  reach_.moving_key = std::move(moving_key);
-  LightReachGrid moving;
-  if (!moving_lights.empty() && !reach_.statics.empty)
-    moving = build_light_reach_grid(reach_.occluders, moving_lights, reach_.statics.min, reach_.statics.max, kReachVoxelM);
-  // Static bits low, moving bits above them (both grids span the same voxels).
-  const glm::ivec3 old_dims = reach_.grid.dims;
-  reach_.grid = !reach_.static_grid.empty() ? reach_.static_grid : moving;
-  if (!reach_.static_grid.empty() && !moving.empty() && moving.dims == reach_.grid.dims)
-    for (std::size_t v = 0; v < reach_.grid.masks.size(); ++v)
-      reach_.grid.masks[v] = static_cast<std::uint8_t>(reach_.grid.masks[v] | (moving.masks[v] << n_static));
-  reach_.grid.all = static_cast<std::uint8_t>((1u << cullable.size()) - 1u);
-  reach_.mask_bounds_index.assign(256, -1);
-  reach_.bounds.clear();
-  if (reach_.grid.empty()) return;
-  const LightReachGrid& g = reach_.grid;
-  for (int z = 0; z < g.dims.z; ++z)
-    for (int y = 0; y < g.dims.y; ++y)
-      for (int x = 0; x < g.dims.x; ++x) {
-        const std::uint8_t m = g.masks[static_cast<std::size_t>((z * g.dims.y + y) * g.dims.x + x)];
-        int& bi = reach_.mask_bounds_index[m];
-        if (bi < 0) {
-          bi = static_cast<int>(reach_.bounds.size());
-          reach_.bounds.emplace_back();
-        }
-        render::SceneBounds& b = reach_.bounds[static_cast<std::size_t>(bi)];
-        const glm::vec3 lo = g.origin + glm::vec3(x, y, z) * g.voxel_m;
-        const glm::vec3 hi = lo + glm::vec3(g.voxel_m);
-        b.min = b.empty ? lo : glm::min(b.min, lo);
-        b.max = b.empty ? hi : glm::max(b.max, hi);
-        b.empty = false;
-      }
-  if (reach_.texture.empty() || old_dims.x != g.dims.x || old_dims.y != g.dims.y || old_dims.z != g.dims.z) {
-    reach_.texture = GlTexture::create(GL_TEXTURE_3D);
-    glTextureStorage3D(reach_.texture.id(), 1, GL_R8UI, g.dims.x, g.dims.y, g.dims.z);
-    glTextureParameteri(reach_.texture.id(), GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    glTextureParameteri(reach_.texture.id(), GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-  }
-  GLint unpack = 4;
-  glGetIntegerv(GL_UNPACK_ALIGNMENT, &unpack);
-  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-  glTextureSubImage3D(reach_.texture.id(), 0, 0, 0, 0, g.dims.x, g.dims.y, g.dims.z, GL_RED_INTEGER, GL_UNSIGNED_BYTE,
-                      g.masks.data());
-  glPixelStorei(GL_UNPACK_ALIGNMENT, unpack);
-}
-
-// A dielectric whose roughness is at least kRoughForOnePoint everywhere (no roughness texture):
-// its GGX lobe is far wider than the spread of directions to an area light's points, so one
-// specular point per rectangle (the centre) gives its radiance within about 1% (1.02% worst
-// at roughness 0.9, RendererAreaLight.RoughDielectricsTakeOneSpecularPoint).
-constexpr float kRoughForOnePoint = 0.9f;
-bool rough_dielectric(const render::GpuMaterial& m, GLuint white_texture) {
-  return m.metallic == 0.0f && m.roughness >= kRoughForOnePoint && m.metallic_roughness_texture == white_texture;
 }
 
 void ForwardRenderer::forward_pass(const Registry& registry, Entity camera, const std::vector<DrawItem>& items,
@@ -743,94 +411,6 @@ void ForwardRenderer::forward_pass(const Registry& registry, Entity camera, cons
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }
 
-// Every item's primitives with the pre-pass's culling (double-sided materials both faces);
-// with `double_sided_uniform`, location 26 says which (area_shadow.frag.glsl flips the normal).
-void ForwardRenderer::draw_geometry(const std::vector<DrawItem>& items, bool double_sided_uniform) {
-  for (const DrawItem& item : items) {
-    glUniformMatrix4fv(0, 1, GL_FALSE, glm::value_ptr(item.model));
-    if (double_sided_uniform) {
-      const glm::mat4 normal_matrix(glm::transpose(glm::inverse(glm::mat3(item.model))));
-      glUniformMatrix4fv(4, 1, GL_FALSE, glm::value_ptr(normal_matrix));
-      glUniform1i(12, item.mesh->first_vertex);
-    }
-    for (const render::GpuPrimitive& p : item.mesh->primitives) {
-      const bool two = scene_.material(item.material_override >= 0 ? item.material_override : p.material).double_sided;
-      if (two)
-        glDisable(GL_CULL_FACE);
-      else
-        glEnable(GL_CULL_FACE);
-      if (double_sided_uniform) glUniform1i(26, two ? 1 : 0);
-      glDrawElementsBaseVertex(GL_TRIANGLES, static_cast<GLsizei>(p.index_count), GL_UNSIGNED_INT,
-                               reinterpret_cast<const void*>(static_cast<std::uintptr_t>(p.first_index) * 4u),
-                               p.base_vertex);
-    }
-  }
-}
-
-// The area lights' soft-shadow visibility at half resolution, upsampled where the surface
-// matches and computed at full resolution where it does not (area_shadow.frag.glsl), into
-// area_visibility_ for the forward pass. Needs the full-resolution depth pre-pass done.
-void ForwardRenderer::area_shadow_passes(const glm::mat4& view_proj, const glm::vec3& camera_position,
-                                         const std::vector<DrawItem>& items) {
-  const int n = static_cast<int>(area_lights_.size());
-  glNamedBufferData(area_lights_buffer_.id(), static_cast<GLsizeiptr>(area_lights_.size() * sizeof(render::GpuLight)),
-                    area_lights_.data(), GL_STREAM_DRAW);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kLightsBinding, area_lights_buffer_.id());
-  glBindTextureUnit(kShadowMapsUnit, shadow_maps_.maps_2d());
-  glBindTextureUnit(kPointShadowMapsUnit, shadow_maps_.cube_maps());
-  glBindTextureUnit(kShadowDepthUnit, shadow_maps_.maps_2d());
-  glBindSampler(kShadowDepthUnit, shadow_depth_sampler_.id());
-  const auto common_uniforms = [&](const ShaderProgram& program) {
-    program.use();
-    glUniformMatrix4fv(8, 1, GL_FALSE, glm::value_ptr(view_proj));
-    glUniform3fv(16, 1, glm::value_ptr(camera_position));
-    glUniform1i(13, 0);  // forward.vert.glsl: no vertex irradiance, no lobes
-    glUniform1i(40, 0);
-  };
-  // 1. Half resolution: depth, then each surface's visibility and tangent plane.
-  const int half_w = (width_ + 1) / 2;
-  const int half_h = (height_ + 1) / 2;
-  glBindFramebuffer(GL_FRAMEBUFFER, half_fbo_.id());
-  glViewport(0, 0, half_w, half_h);
-  const float one = 1.0f;
-  const float unlit[4] = {1.0f, 1.0f, 1.0f, 1.0f};
-  const float no_plane[4] = {0.0f, 0.0f, 0.0f, 0.0f};  // a zero normal matches no pixel
-  glClearNamedFramebufferfv(half_fbo_.id(), GL_DEPTH, 0, &one);
-  glClearNamedFramebufferfv(half_fbo_.id(), GL_COLOR, 0, unlit);
-  glClearNamedFramebufferfv(half_fbo_.id(), GL_COLOR, 1, no_plane);
-  glDepthFunc(GL_LESS);
-  glDepthMask(GL_TRUE);
-  glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
-  depth_only_.use();
-  glUniformMatrix4fv(8, 1, GL_FALSE, glm::value_ptr(view_proj));
-  draw_geometry(items, false);
-  glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-  glDepthFunc(GL_EQUAL);
-  glDepthMask(GL_FALSE);
-  common_uniforms(area_shadow_program(0, n));
-  draw_geometry(items, true);
-  // 2. Full resolution on the pre-pass's depth: upsample, flagging the pixels no half-resolution
-  // texel of their own surface covers in the stencil's top bit (the reach masks keep theirs).
-  glBindFramebuffer(GL_FRAMEBUFFER, visibility_fbo_.id());
-  glViewport(0, 0, width_, height_);
-  glBindTextureUnit(kAreaVisibilityUnit, half_visibility_.id());
-  glBindTextureUnit(kAreaPlaneUnit, half_plane_.id());
-  glEnable(GL_STENCIL_TEST);
-  glStencilMask(kAreaFallbackBit);
-  glStencilFunc(GL_ALWAYS, 0, 0xFF);
-  glStencilOp(GL_KEEP, GL_KEEP, GL_REPLACE);
-  common_uniforms(area_shadow_program(1, n));
-  draw_geometry(items, true);
-  // 3. The flagged pixels at full resolution (the stencil rejects the others before shading).
-  glStencilMask(0);
-  glStencilFunc(GL_EQUAL, static_cast<GLint>(kAreaFallbackBit), kAreaFallbackBit);
-  glStencilOp(GL_KEEP, GL_KEEP, GL_KEEP);
-  common_uniforms(area_shadow_program(2, n));
-  draw_geometry(items, true);
-  glDisable(GL_STENCIL_TEST);
-  glStencilMask(0xFF);
-}
-
 void ForwardRenderer::depth_prepass(const glm::mat4& view_proj, const std::vector<DrawItem>& items, bool reach) {
   glDepthFunc(GL_LESS);
   glDepthMask(GL_TRUE);
@@ -909,9 +489,12 @@ ImageRgbaF ForwardRenderer::read_hdr() const {
   return image;
 }
 
-}  // namespace
+}  // namespace engine::render
+
+namespace engine {
 
 Result<std::unique_ptr<Renderer>> Renderer::create(const SceneAsset& assets, const RenderSettings& settings) {
+  using namespace render;
   GI_EXPECTS(settings.width > 0 && settings.height > 0, "RenderSettings width and height must be positive");
   if (glGetString(GL_VERSION) == nullptr)
     return Error{assets.source, "renderer", "no current OpenGL context (create an engine::GpuContext first)"};
