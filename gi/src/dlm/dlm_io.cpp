@@ -9,6 +9,7 @@
 #include <span>
 #include <system_error>
 
+#include "core/half_scale.h"
 #include "bundle/bundle.h"
 #include "io/json_fields.h"
 #include "uv/atlas_input.h"
@@ -33,13 +34,6 @@ bool is_power_of_two(float s) {
   return std::isfinite(s) && s > 0.0f && std::frexp(s, &e) == 0.5f;
 }
 
-// 2^(e - 15) for a largest value m x 2^e: the largest maps into [2^14, 2^15).
-float layer_scale(float max_value) {
-  if (!(max_value > 0.0f)) return 1.0f;
-  int e = 0;
-  std::frexp(max_value, &e);
-  return std::ldexp(1.0f, e - 15);
-}
 
 std::uint16_t to_half(float v) { return glm::packHalf1x16(v); }
 float from_half(std::uint16_t h) { return glm::unpackHalf1x16(h); }
@@ -140,7 +134,7 @@ engine::Status write_dlm_file(const fs::path& path, const Dlm& dlm, const std::s
   for (std::size_t k = 0; k < scales.size(); ++k) {
     const auto first = dlm.radiance.begin() + static_cast<std::ptrdiff_t>(k * per_bin);
     const float max_value = per_bin == 0 ? 0.0f : *std::max_element(first, first + static_cast<std::ptrdiff_t>(per_bin));
-    scales[k] = layer_scale(max_value);
+    scales[k] = half_layer_scale(max_value);
     for (std::size_t j = k * per_bin; j < (k + 1) * per_bin; ++j) halves[j] = to_half(dlm.radiance[j] / scales[k]);
   }
   const DlmSettings& s = dlm.settings;

@@ -11,6 +11,7 @@
 #include <span>
 #include <system_error>
 
+#include "core/half_scale.h"
 #include "bundle/bundle.h"
 #include "io/json_fields.h"
 #include "io/zstd_stream.h"
@@ -84,13 +85,6 @@ std::string check_prm(const Prm& p) {
   return {};
 }
 
-// The power-of-two scale that maps a pane's largest value into [2^14, 2^15) (prm_io.h).
-float pane_scale(float max_value) {
-  if (!(max_value > 0.0f)) return 1.0f;
-  int e = 0;
-  std::frexp(max_value, &e);
-  return std::ldexp(1.0f, std::max(e - 15, -126));
-}
 
 bool is_power_of_two(float s) {
   int e = 0;
@@ -164,7 +158,7 @@ std::string encode_panes(const Prm& p, std::vector<float>& scales, std::vector<s
     const auto first = p.panes.begin() + static_cast<std::ptrdiff_t>(c * per_pane);
     const float max_value =
         per_pane == 0 ? 0.0f : *std::max_element(first, first + static_cast<std::ptrdiff_t>(per_pane));
-    const float scale = pane_scale(max_value);
+    const float scale = half_layer_scale(max_value);
     scales[c] = scale;
     for (std::size_t j = c * per_pane; j < (c + 1) * per_pane; ++j) {
       const std::uint16_t h = float_to_half(p.panes[j] / scale);

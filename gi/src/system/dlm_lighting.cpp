@@ -6,6 +6,8 @@
 #include <cmath>
 #include <glm/gtc/packing.hpp>
 
+#include "core/half_scale.h"
+
 namespace gi {
 
 engine::Result<std::unique_ptr<DlmLighting>> DlmLighting::from_bake(Dlm dlm, int width, int height) {
@@ -28,10 +30,7 @@ engine::Result<std::unique_ptr<DlmLighting>> DlmLighting::from_bake(Dlm dlm, int
   for (std::size_t k = 0; k < bins; ++k) {
     const float* first = dlm.radiance.data() + k * elements * 3;
     const float max_value = elements == 0 ? 0.0f : *std::max_element(first, first + elements * 3);
-    // A power of two putting the bin's largest value into [2^14, 2^15) (as dlm.bin stores it).
-    int e = 0;
-    std::frexp(max_value, &e);
-    const float scale = max_value > 0.0f ? std::ldexp(1.0f, e - 15) : 1.0f;
+    const float scale = half_layer_scale(max_value);  // as dlm.bin stores it
     l->directions_.emplace_back(dlm.directions[k], scale);
     for (std::size_t i = 0; i < elements; ++i) {
       const float* v = first + i * 3;

@@ -147,6 +147,25 @@ TEST(DlmIo, RoundTripKeepsStructureExactAndRadianceWithinTheHalfBound) {
   EXPECT_EQ(m->methods["dlm"]["memory"]["bytes_per_texel"].get<int>(), static_cast<int>(d.directions.size()) * 6);
 }
 
+// A bin whose largest value lies below 2^-126 x 2^15 (radiance ~1e-34): its scale used to be
+// 2^(e - 15) below the smallest normal float, ldexp gave 0, and the written file was refused
+// on reading ("the scale of bin k (0) is not a positive power of two"; found by the CI's fuzz
+// leg re-writing a file it had read, tests/fuzz/regressions/dlm/). The scale stops at 2^-126.
+TEST(DlmIo, ABinOfTinyValuesIsWrittenSoThatItReadsBack) {
+  gi::Dlm d = baked();
+  const std::size_t per_bin = d.texels.size() * 3;
+  ASSERT_GT(per_bin, 0u);
+  for (std::size_t j = 0; j < per_bin; ++j) d.radiance[j] = std::ldexp(static_cast<float>(j % 7), -143);
+  const fs::path dir = scratch_dir("tiny_bin");
+  const auto st = gi::save_dlm(dir, d, gi::bake_input_from(box()));
+  ASSERT_TRUE(st.ok()) << st.error().to_string();
+  auto back = gi::load_dlm(dir, gi::bake_input_from(box()));
+  ASSERT_TRUE(back.ok()) << back.error().to_string();
+  // At scale 2^-126 a half's finest step is 2^-24 x 2^-126 = 2^-150: the values (multiples of
+  // 2^-143) come back exactly.
+  for (std::size_t j = 0; j < per_bin; ++j) EXPECT_EQ(back->radiance[j], d.radiance[j]) << j;
+}
+
 TEST(DlmIo, StaleGeometryAndLightsAreRejected) {
   const fs::path dir = saved_bundle("stale");
   engine::SceneAsset moved = box();
