@@ -5,12 +5,19 @@
 
 #include <cstdint>
 #include <cstring>
+#include <limits>
 #include <random>
 #include <filesystem>
 #include <fstream>
 #include <string>
 #include <vector>
 
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wshadow"
+#pragma GCC diagnostic ignored "-Wnull-dereference"
+#include <draco/compression/encode.h>
+#include <draco/mesh/mesh.h>
+#pragma GCC diagnostic pop
 #include <nlohmann/json.hpp>
 
 #include <engine/gltf.h>
@@ -246,6 +253,59 @@ TEST(GltfErrors, CorruptDracoData) {
   expect_error(write("draco.gltf", d.dump()), {"KHR_draco_mesh_compression", "corrupt or truncated Draco data"});
   d["meshes"][0]["primitives"][0]["extensions"]["KHR_draco_mesh_compression"]["bufferView"] = 9;
   expect_error(write("draco_view.gltf", d.dump()), {"KHR_draco_mesh_compression", "out of range"});
+}
+
+/// A Draco mesh (one triangle) whose TEXCOORD_0 is stored as raw floats, `bad` at vertex 1.
+std::vector<std::uint8_t> draco_triangle_with_uv(float bad) {
+  draco::Mesh mesh;
+  mesh.set_num_points(3);
+  mesh.SetNumFaces(1);
+  mesh.SetFace(draco::FaceIndex(0), {draco::PointIndex(0), draco::PointIndex(1), draco::PointIndex(2)});
+  const auto add = [&mesh](draco::GeometryAttribute::Type type, int ncomp, const std::vector<float>& v) {
+    draco::GeometryAttribute ga;
+    ga.Init(type, nullptr, static_cast<std::uint8_t>(ncomp), draco::DT_FLOAT32, false,
+            static_cast<std::int64_t>(sizeof(float)) * ncomp, 0);
+    const int id = mesh.AddAttribute(ga, true, 3);
+    for (std::uint32_t i = 0; i < 3; ++i)
+      mesh.attribute(id)->SetAttributeValue(draco::AttributeValueIndex(i), v.data() + i * static_cast<std::uint32_t>(ncomp));
+    return id;
+  };
+  add(draco::GeometryAttribute::POSITION, 3, {0, 0, 0, 1, 0, 0, 0, 1, 0});
+  add(draco::GeometryAttribute::TEX_COORD, 2, {0, 0, bad, 0, 0, 1});
+  draco::Encoder encoder;  // no quantization: the floats are stored as they are
+  encoder.SetEncodingMethod(draco::MESH_SEQUENTIAL_ENCODING);
+  draco::EncoderBuffer buffer;
+  EXPECT_TRUE(encoder.EncodeMeshToBuffer(mesh, &buffer).ok());
+  return {reinterpret_cast<const std::uint8_t*>(buffer.data()),
+          reinterpret_cast<const std::uint8_t*>(buffer.data()) + buffer.size()};
+}
+
+// Found by fuzz_gltf's write-back check: a Draco attribute other than POSITION decoded to
+// NaN was loaded as it was, write_gltf wrote it into a plain accessor, and the loader then
+// refused its own output ("accessor 6: element 0 is not finite"). A Draco attribute is now
+// checked like an accessor.
+TEST(GltfErrors, DracoAttributeThatIsNotFinite) {
+  const auto doc_for = [](const std::vector<std::uint8_t>& compressed) {
+    json d = json::parse(R"({"asset": {"version": "2.0"},
+      "extensionsUsed": ["KHR_draco_mesh_compression"], "extensionsRequired": ["KHR_draco_mesh_compression"],
+      "accessors": [{"componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]},
+                    {"componentType": 5126, "count": 3, "type": "VEC2"},
+                    {"componentType": 5123, "count": 3, "type": "SCALAR"}],
+      "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 1}, "indices": 2,
+        "extensions": {"KHR_draco_mesh_compression": {"bufferView": 0, "attributes": {"POSITION": 0, "TEXCOORD_0": 1}}}}]}],
+      "nodes": [{"mesh": 0}], "scenes": [{"nodes": [0]}], "scene": 0})");
+    d["bufferViews"] = json::array({{{"buffer", 0}, {"byteOffset", 0}, {"byteLength", compressed.size()}}});
+    d["buffers"] = json::array(
+        {{{"byteLength", compressed.size()}, {"uri", "data:application/octet-stream;base64," + base64(compressed)}}});
+    return d.dump();
+  };
+  auto fine = engine::load_gltf(write("fine.gltf", doc_for(draco_triangle_with_uv(1.0f))));
+  ASSERT_TRUE(fine.ok()) << fine.error().to_string();
+  ASSERT_EQ(fine->meshes.at(0).primitives.at(0).uv0.size(), 3u);
+  expect_error(write("nan.gltf", doc_for(draco_triangle_with_uv(std::numeric_limits<float>::quiet_NaN()))),
+               {"KHR_draco_mesh_compression", "TEXCOORD_0", "element 1", "not finite"});
+  expect_error(write("inf.gltf", doc_for(draco_triangle_with_uv(std::numeric_limits<float>::infinity()))),
+               {"TEXCOORD_0", "element 1", "not finite"});
 }
 
 TEST(GltfErrors, AbsurdCountsHitTheLimits) {

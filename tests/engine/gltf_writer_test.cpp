@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <string>
 
 #include <glm/gtc/constants.hpp>
@@ -271,6 +272,31 @@ TEST(GltfWriter, MeshWithoutPrimitivesIsLeftOutAndItsNodesKeepNoMesh) {
     ASSERT_NE(it, loaded->nodes.end()) << before.name;
     EXPECT_EQ(it->mesh, before.mesh >= 0 ? before.mesh - 1 : -1) << before.name;
   }
+}
+
+TEST(GltfWriter, RefusesANonFiniteNormalOrTextureCoordinate) {
+  // The loader refuses such a file, so the writer must not write one (it checked positions only).
+  const auto refused = [](engine::SceneAsset scene, const char* what) {
+    const fs::path path = temp_dir("non_finite") / "scene.glb";
+    fs::remove(path);
+    const engine::Status st = engine::write_gltf(scene, path, {.binary = true});
+    ASSERT_FALSE(st) << what;
+    EXPECT_NE(st.error().to_string().find(what), std::string::npos) << st.error().to_string();
+    EXPECT_FALSE(fs::exists(path)) << "nothing half-written";
+  };
+  const engine::SceneAsset scene = feature_scene();
+  const auto has_both = [](const engine::Mesh& m) {
+    return !m.primitives.empty() && !m.primitives[0].normals.empty() && !m.primitives[0].uv0.empty();
+  };
+  const auto it = std::find_if(scene.meshes.begin(), scene.meshes.end(), has_both);
+  ASSERT_NE(it, scene.meshes.end());
+  const auto mesh = static_cast<std::size_t>(it - scene.meshes.begin());
+  engine::SceneAsset bad_normal = scene;
+  bad_normal.meshes[mesh].primitives[0].normals[0].y = std::numeric_limits<float>::quiet_NaN();
+  refused(bad_normal, "normal is NaN or infinite");
+  engine::SceneAsset bad_uv = scene;
+  bad_uv.meshes[mesh].primitives[0].uv0[0].x = std::numeric_limits<float>::infinity();
+  refused(bad_uv, "texture coordinate is NaN or infinite");
 }
 
 TEST(GltfWriter, WritesPhotometricUnitsAndEmissiveStrength) {

@@ -4,6 +4,8 @@
 
 #include "gltf/gltf_load_internal.h"
 
+#include <cmath>
+
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wshadow"
 #pragma GCC diagnostic ignored "-Wnull-dereference"
@@ -79,7 +81,15 @@ Result<DracoPrimitive> decode_draco(const Context& ctx, const ParsedFile& file, 
           !attribute->ConvertValue<float>(value_index, static_cast<std::int8_t>(ncomp), tmp)) {
         return ctx.error(where, "attribute '" + semantic + "' cannot be decoded");
       }
-      for (int c = 0; c < ncomp; ++c) values[i.value() * static_cast<std::size_t>(ncomp) + static_cast<std::size_t>(c)] = tmp[c];
+      for (int c = 0; c < ncomp; ++c) {
+        // Checked like an accessor's elements (gltf_load_accessors.cpp): raw Draco floats
+        // carry any bit pattern, and a NaN here would reach the renderer and the bakers.
+        if (!std::isfinite(tmp[c])) {
+          return ctx.error(where, "attribute '" + semantic + "' element " + std::to_string(i.value()) +
+                                      " is not finite (NaN or Inf)");
+        }
+        values[i.value() * static_cast<std::size_t>(ncomp) + static_cast<std::size_t>(c)] = tmp[c];
+      }
     }
     out.components[semantic] = ncomp;
     out.attributes[semantic] = std::move(values);

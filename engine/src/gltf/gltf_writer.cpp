@@ -174,6 +174,11 @@ class GltfBuilder {
       if (i >= n) return error(where, "index " + std::to_string(i) + " out of range");
     for (const glm::vec3& v : p.positions)
       if (!engine::all_finite(v)) return error(where, "position is NaN or infinite");
+    for (const glm::vec3& v : p.normals)
+      if (!engine::all_finite(v)) return error(where, "normal is NaN or infinite");
+    for (const std::vector<glm::vec2>* uvs : {&p.uv0, &p.uv1})
+      for (const glm::vec2& v : *uvs)
+        if (!engine::all_finite(v)) return error(where, "texture coordinate is NaN or infinite");
     if (p.material >= static_cast<int>(scene_.materials.size())) return error(where, "material index out of range");
     return {};
   }
