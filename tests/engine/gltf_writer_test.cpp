@@ -274,6 +274,20 @@ TEST(GltfWriter, MeshWithoutPrimitivesIsLeftOutAndItsNodesKeepNoMesh) {
   }
 }
 
+TEST(GltfWriter, ABareNodeIsWrittenAsAnEmptyObject) {
+  // Found by fuzz_gltf: a node with no name, an identity transform and nothing attached was
+  // written as null, and the loader refused the file ("nodes 0: must be an object").
+  engine::SceneAsset scene = feature_scene();
+  scene.nodes.push_back(engine::Node{});
+  const fs::path path = temp_dir("bare_node") / "scene.gltf";
+  const engine::Status st = engine::write_gltf(scene, path);
+  ASSERT_TRUE(st) << st.error().to_string();
+  EXPECT_EQ(read_bytes(path).find("null"), std::string::npos);
+  auto loaded = engine::load_gltf(path);
+  ASSERT_TRUE(loaded) << loaded.error().to_string();
+  EXPECT_EQ(loaded->nodes.size(), scene.nodes.size());
+}
+
 TEST(GltfWriter, RefusesANonFiniteNormalOrTextureCoordinate) {
   // The loader refuses such a file, so the writer must not write one (it checked positions only).
   const auto refused = [](engine::SceneAsset scene, const char* what) {

@@ -386,7 +386,7 @@ class GltfBuilder {
     for (int i = 0; i < count; ++i) {
       const Node& n = scene_.nodes[static_cast<std::size_t>(i)];
       const std::string where = "nodes[" + std::to_string(i) + "]";
-      json j;
+      json j = json::object();  // a bare node (no name, identity, nothing attached) is {}, not null
       if (!n.name.empty()) j["name"] = n.name;
       if (!engine::all_finite(n.translation) || !engine::all_finite(n.scale) || !std::isfinite(n.rotation.w) ||
           !engine::all_finite(glm::vec3(n.rotation.x, n.rotation.y, n.rotation.z)))
