@@ -32,10 +32,15 @@ if [[ "${FRAME:-1}" != 0 ]]; then
   bundle=out/demo_level.gibake
   [[ -f "$bundle/manifest.json" ]] || "$build/tools/gi-bake/gi-bake" --scene assets/demo_level.gltf \
       --preset preview --out "$bundle" > /dev/null
-  for size in 960x540 640x360; do
-    log="$out/frame_$size.txt"
+  # "_flat": the same frame with --shading flat, the yardstick (every surface its base colour,
+  # everything else as usual). 96x54: shading costs next to nothing, so its frame is the part
+  # that does not scale with pixels.
+  for run in 960x540 960x540_flat 640x360 640x360_flat 96x54; do
+    size=${run%_flat}
+    shading=full; [[ $run == *_flat ]] && shading=flat
+    log="$out/frame_$run.txt"
     { TIMEFORMAT="process CPU s: %U user %S sys"; time "$build/game_demo/gi_demo" --headless --frames 60 \
-        --width "${size%x*}" --height "${size#*x}" --gi-bundle "$bundle" ; } > "$log" 2>&1
+        --width "${size%x*}" --height "${size#*x}" --shading "$shading" --gi-bundle "$bundle" ; } > "$log" 2>&1
   done
 fi
 { echo "end $(date -u +%FT%TZ) $(cut -d' ' -f1-3 /proc/loadavg)"; } >> "$out/load.txt"

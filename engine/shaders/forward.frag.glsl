@@ -32,6 +32,10 @@
 #ifndef SKY_TERM
 #define SKY_TERM 1
 #endif
+// 1: the frame's yardstick (RenderSettings::flat_shading): the base colour, unlit.
+#ifndef FLAT_SHADING
+#define FLAT_SHADING 0
+#endif
 
 #include "lighting_common.glsl"
 #include "shadow_common.glsl"
@@ -88,6 +92,10 @@ layout(location = 0) out vec4 o_radiance;
 
 void main() {
   vec4 base = u_base_color * texture(u_base_color_texture, v_uv0);
+#if FLAT_SHADING
+  o_radiance = vec4(base.rgb, 1.0);
+  return;
+#endif
   vec4 mr = texture(u_metallic_roughness_texture, v_uv0);
 
   Surface s;

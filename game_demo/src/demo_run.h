@@ -29,6 +29,7 @@ struct RunOptions {
   float exposure = kDemoExposure;  ///< Linear scale before tonemapping.
   bool area_soft_shadows = true;   ///< --area-shadows soft|centre (engine::RenderSettings::area_soft_shadows).
   bool light_reach_culling = true;  ///< --light-reach on|off (engine::RenderSettings::light_reach_culling).
+  bool flat_shading = false;        ///< --shading full|flat (engine::RenderSettings::flat_shading: a yardstick).
   /// --area-shadow-res full|half (engine::RenderSettings::area_shadow_res).
   engine::AreaShadowRes area_shadow_res = engine::AreaShadowRes::Half;
   bool size_given = false;

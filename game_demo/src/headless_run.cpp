@@ -67,6 +67,7 @@ int run_headless(const RunOptions& o, RunState& state) {
                                .area_soft_shadows = o.area_soft_shadows,
                                .area_shadow_res = o.area_shadow_res,
                                .light_reach_culling = o.light_reach_culling,
+                               .flat_shading = o.flat_shading,
                                .warn = [](const std::string& line) { std::cerr << "gi_demo: " << line << '\n'; }});
     if (!r) {
       std::cerr << "gi_demo: " << r.error().to_string() << '\n';

@@ -102,6 +102,7 @@ int main(int argc, char** argv) {
   std::string area_shadows = "soft";
   std::string light_reach = "on";
   std::string area_shadow_res = "half";
+  std::string shading = "full";
   CLI::App app{"gi_demo: the playable demo level of the GI module"};
   app.add_option("--scene", o.scene, "glTF scene to play (default: assets/demo_level.gltf)");
   app.add_flag("--headless", o.headless, "Run without a window (EGL surfaceless), driven by --script or --replay");
@@ -122,6 +123,10 @@ int main(int argc, char** argv) {
                  "half: area lights' soft shadows at half resolution, upsampled on each pixel's own surface "
                  "(default); full: per pixel (engine::RenderSettings::area_shadow_res)")
       ->check(CLI::IsMember({"full", "half"}));
+  app.add_option("--shading", shading,
+                 "full: the frame as players see it (default); flat: measurement only, every surface its base colour "
+                 "unlit with everything else as usual, the cost floor of any shading (engine::RenderSettings::flat_shading)")
+      ->check(CLI::IsMember({"full", "flat"}));
   app.add_option("--every", o.every, "Headless: write every K-th frame")->check(CLI::PositiveNumber);
   app.add_flag("--exr", o.exr, "Headless: also write DIR/frame_NNNN.exr (linear HDR)");
   app.add_flag("--no-render", o.no_render, "Headless: simulate only (no GPU), e.g. to record sessions");
@@ -143,6 +148,7 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   o.area_soft_shadows = area_shadows == "soft";
   o.light_reach_culling = light_reach == "on";
+  o.flat_shading = shading == "flat";
   o.area_shadow_res = area_shadow_res == "half" ? engine::AreaShadowRes::Half : engine::AreaShadowRes::Full;
   o.size_given = w->count() > 0 || h->count() > 0;
   if (o.script.empty()) o.script = std::string(script_name(default_script(o.scene)));

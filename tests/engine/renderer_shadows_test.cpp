@@ -59,6 +59,27 @@ TEST(RendererShadows, PointLightCubeMapShadow) {
   expect_shadow(s.render(engine::Light{.type = engine::LightType::Point, .intensity = 10.0f}), s.cam);
 }
 
+// RenderSettings::flat_shading, the frame's yardstick for tools/perf-report.sh: every surface
+// shows its base colour unlit, in and beside the shadow, and the full frame comes back after.
+TEST(RendererShadows, FlatShadingYardstickWritesTheBaseColourUnlit) {
+  engine::GpuContext ctx = headless_context();
+  OccluderScene s;
+  add_light(s.reg, engine::Light{.type = engine::LightType::Point, .intensity = 10.0f}, {-1.5f, 2.0f, 0.0f}, {0, 0, 0});
+  engine::Entity camera = s.cam.add_to(s.reg);
+  auto r = make_renderer(s.assets, s.cam.size, kAmbient);
+  ASSERT_NE(r, nullptr);
+  const glm::ivec2 in_shadow = s.cam.pixel_of({0.0f, 0.0f, 0.0f}), beside = s.cam.pixel_of({0.0f, 0.0f, 0.8f});
+  r->settings().flat_shading = true;
+  r->render(s.reg, camera);
+  engine::ImageRgbaF img = r->read_hdr();
+  EXPECT_NEAR(red(img, in_shadow), kAlbedo, 1e-4f);
+  EXPECT_NEAR(red(img, beside), kAlbedo, 1e-4f);
+  r->settings().flat_shading = false;
+  r->render(s.reg, camera);
+  img = r->read_hdr();
+  expect_shadow(img, s.cam);
+}
+
 TEST(RendererShadows, SpotLightShadow) {
   engine::GpuContext ctx = headless_context();
   OccluderScene s;
@@ -228,7 +249,9 @@ TEST(RendererIndirect, AtlasForStaticAndVertexBufferForDynamicMeshes) {
     const float albedo = engine::gltf_directional_albedo(engine::gltf_brdf(glm::vec3(kAlbedo), 0.0f, 1.0f), cos_v).sum().x;
     EXPECT_NEAR(red(img, cam.pixel_of({-1.2f, 0, 0})), albedo / kPi * atlas_e, 0.01f * albedo / kPi * atlas_e);
     EXPECT_NEAR(red(img, cam.pixel_of({1.2f, 0, 0})), albedo / kPi * 4.0f, 0.01f * albedo / kPi * 4.0f);
-    EXPECT_NE(r->last_timings()[1].name.find("test constant"), std::string::npos);
+    ASSERT_EQ(r->last_timings().size(), 4u);
+    EXPECT_NE(r->last_timings()[1].name.find("indirect light update (test constant"), std::string::npos);
+    EXPECT_NE(r->last_timings()[2].name.find("forward + indirect (test constant"), std::string::npos);
     EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
   }
   glDeleteTextures(1, &atlas);

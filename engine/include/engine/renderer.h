@@ -84,6 +84,12 @@ struct RenderSettings {
   /// shaded once with the lights of its mask. Lights that move (Light::moves), directional
   /// and unshadowed lights are shaded everywhere. Off: every light on every pixel.
   bool light_reach_culling = true;
+  /// Measurement only, the frame's yardstick: the forward pass writes each surface's base
+  /// colour unlit (one texture read), and no area-shadow pass runs; everything else (the
+  /// indirect provider's update, the shadow maps, the depth pre-pass, the tonemap) runs as
+  /// usual. Its frame time is what any shading costs at least at this size on this device
+  /// (tools/perf-report.sh runs it beside the full frame; docs/performance-frame.md).
+  bool flat_shading = false;
   /// The scene's sky (SceneAsset::environment.sky_radiance, W/(m^2 sr); Renderer::create
   /// copies it from the assets). Drawn as direct light: an ambient term without sky
   /// visibility, E = pi x radiance reflected as uniformly arriving light is, on both halves
@@ -154,8 +160,9 @@ class Renderer {
   virtual void set_indirect_light(IndirectLightProvider* provider) = 0;
   virtual RenderSettings& settings() = 0;
   /// Timings of the passes of the last render(), in execution order: "shadow maps (N views)",
-  /// "forward + constant ambient (stand-in)" or "forward + indirect (<provider label>)"
-  /// (includes the depth pre-pass), "tonemap (...)".
+  /// with an IndirectLightProvider "indirect light update (<provider label>)" (its frame():
+  /// the GI's per-frame GPU and CPU work), then "forward + constant ambient (stand-in)" or
+  /// "forward + indirect (<provider label>)" (includes the depth pre-pass), "tonemap (...)".
   virtual const std::vector<PassTiming>& last_timings() const = 0;
   /// Shadow-map views (2-D maps and cube faces) the last render() drew. A view is kept while
   /// neither its light nor a caster that can reach it (not wholly outside its clip volume)

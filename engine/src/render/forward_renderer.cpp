@@ -74,6 +74,7 @@ Result<ShaderProgram> build_forward(const LightCounts& n) {
       .define("AREA_SOFT_SHADOWS " + std::to_string(n[5]))
       .define("SKY_TERM " + std::to_string(n[6]))
       .define("AREA_SHADOW_HALF " + std::to_string(n[7]))
+      .define("FLAT_SHADING " + std::to_string(n[8]))
       .build();
 }
 
@@ -197,7 +198,7 @@ void ForwardRenderer::render(const Registry& registry, Entity camera) {
   // Half-resolution area shadows: every area light of the frame (each its visibility channel,
   // GpuLight::shadow_params.z), when they are soft-shadowed, at most 4 and one has a map.
   area_lights_.clear();
-  if (settings_.area_shadow_res == AreaShadowRes::Half && settings_.area_soft_shadows) {
+  if (settings_.area_shadow_res == AreaShadowRes::Half && settings_.area_soft_shadows && !settings_.flat_shading) {
     for (const render::GpuLight& g : lights.lights)
       if (static_cast<int>(g.position_type.w) == static_cast<int>(render::GpuLightType::Area)) area_lights_.push_back(g);
     const bool any_map = std::any_of(area_lights_.begin(), area_lights_.end(),
@@ -220,7 +221,14 @@ void ForwardRenderer::render(const Registry& registry, Entity camera) {
     }
     glNamedBufferData(lights_buffer_.id(), static_cast<GLsizeiptr>(bytes.size()), bytes.data(), GL_STREAM_DRAW);
   }
-  forward_pass(registry, camera, items, groups);
+  // The provider's per-frame work (its GPU passes and their CPU side) is its own pass, so
+  // the summary and the overlay show what the GI costs apart from drawing with it.
+  const IndirectLightFrame* indirect = nullptr;
+  if (provider_) {
+    indirect = &provider_->frame();
+    timings_.push_back({std::string("indirect light update (") + provider_->label() + ")", timer.lap_ms()});
+  }
+  forward_pass(registry, camera, items, groups, indirect);
   timings_.push_back({provider_ ? std::string("forward + indirect (") + provider_->label() + ")"
                                 : std::string("forward + constant ambient (stand-in)"),
                       timer.lap_ms()});
@@ -230,7 +238,7 @@ void ForwardRenderer::render(const Registry& registry, Entity camera) {
 }
 
 void ForwardRenderer::forward_pass(const Registry& registry, Entity camera, const std::vector<DrawItem>& items,
-                                   const std::vector<LightGroup>& groups) {
+                                   const std::vector<LightGroup>& groups, const IndirectLightFrame* indirect) {
   const Camera& cam = registry.get<Camera>(camera);
   const glm::mat4& camera_now = registry.get<WorldTransform>(camera).matrix;
   if (unusable_world_matrix(camera_now) == nullptr) last_camera_world_ = camera_now;
@@ -240,7 +248,6 @@ void ForwardRenderer::forward_pass(const Registry& registry, Entity camera, cons
       glm::perspective(cam.yfov_rad, aspect, cam.znear_m, cam.zfar_m) * glm::inverse(camera_world);
   const glm::vec3 camera_position(camera_world[3]);
 
-  const IndirectLightFrame* indirect = provider_ ? &provider_->frame() : nullptr;
 
   glBindFramebuffer(GL_FRAMEBUFFER, hdr_fbo_.id());
   glViewport(0, 0, width_, height_);
@@ -304,7 +311,8 @@ void ForwardRenderer::forward_pass(const Registry& registry, Entity camera, cons
                       static_cast<GLsizeiptr>(std::max<std::size_t>(1, group.lights.size()) * sizeof(render::GpuLight)));
     const LightCounts counts{group.count_by_type[0], group.count_by_type[1], group.count_by_type[2],
                              group.count_by_type[3], std::clamp(settings_.area_specular_samples_per_side, 1, 4),
-                             settings_.area_soft_shadows ? 1 : 0, has_sky ? 1 : 0, area_lights_.empty() ? 0 : 1};
+                             settings_.area_soft_shadows ? 1 : 0, has_sky ? 1 : 0, area_lights_.empty() ? 0 : 1,
+                             settings_.flat_shading ? 1 : 0};
     // Rough dielectrics draw with the one-specular-point variant of area lights (rough_dielectric),
     // the other materials with RenderSettings::area_specular_samples_per_side: two passes over the
     // items, each with its program, when that makes a difference.

@@ -67,7 +67,7 @@ GlTexture no_directional_index();
 // whether area lights are soft-shadowed (RenderSettings::area_soft_shadows), whether the
 // scene has a sky term (0: its radiance and gradient are zero, the shader leaves it out) and
 // whether area lights' visibility comes from the half-resolution pass (area_shadow_res).
-using LightCounts = std::array<int, 8>;
+using LightCounts = std::array<int, 9>;  // ..., [8] FLAT_SHADING (RenderSettings::flat_shading)
 
 // The lights one set of pixels is shaded with: those of one light-reach mask (the stencil
 // value the pre-pass wrote), as a range of the lights buffer.
@@ -111,7 +111,7 @@ class ForwardRenderer final : public Renderer {
         albedo_table_(upload_gltf_albedo_table()),
         no_directional_index_(no_directional_index()),
         shadow_depth_sampler_(raw_depth_sampler()) {
-    forward_variants_.emplace(LightCounts{0, 0, 0, 0, 3, 1, 1, 0}, std::move(forward));
+    forward_variants_.emplace(LightCounts{0, 0, 0, 0, 3, 1, 1, 0, 0}, std::move(forward));
     ensure_targets();
   }
 
@@ -135,7 +135,7 @@ class ForwardRenderer final : public Renderer {
   std::vector<DrawItem> draw_items(const Registry& registry, std::vector<std::pair<Entity, const char*>>& skipped) const;
   void report_skipped(const Registry& registry, const std::vector<std::pair<Entity, const char*>>& skipped);
   void forward_pass(const Registry& registry, Entity camera, const std::vector<DrawItem>& items,
-                    const std::vector<LightGroup>& groups);
+                    const std::vector<LightGroup>& groups, const IndirectLightFrame* indirect);
   const ShaderProgram& forward_program(const LightCounts& counts);
   const ShaderProgram& area_shadow_program(int pass, int area_lights);
   void area_shadow_passes(const glm::mat4& view_proj, const glm::vec3& camera_position, const std::vector<DrawItem>& items);
