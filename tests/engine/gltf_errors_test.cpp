@@ -102,6 +102,27 @@ TEST(GltfErrors, ValidBaselineLoads) {
   EXPECT_EQ(r->meshes.at(0).primitives.at(0).indices.size(), 3u);
 }
 
+// Found by fuzz_gltf: two indices made no triangle, and the primitive was kept with empty
+// indices, which engine::Primitive reads as non-indexed: write_gltf then refused the scene
+// ("non-indexed vertex count is not a multiple of 3"). Such a primitive is now skipped like
+// points and lines, and the scene writes and loads back.
+TEST(GltfErrors, IndicesThatMakeNoTriangleLeaveThePrimitiveOut) {
+  for (const std::vector<std::uint16_t>& indices : {std::vector<std::uint16_t>{0, 1}, std::vector<std::uint16_t>{0}}) {
+    json d = valid_doc(indices);
+    d["accessors"][1]["count"] = indices.size();
+    auto r = engine::load_gltf(write("two.gltf", d.dump()));
+    ASSERT_TRUE(r.ok()) << r.error().to_string();
+    ASSERT_EQ(r->meshes.size(), 1u);
+    EXPECT_TRUE(r->meshes[0].primitives.empty());
+    const fs::path again = dir() / "again.glb";
+    const engine::Status st = engine::write_gltf(*r, again, {.binary = true});
+    ASSERT_TRUE(st) << st.error().to_string();
+    auto back = engine::load_gltf(again);
+    ASSERT_TRUE(back.ok()) << back.error().to_string();
+    EXPECT_EQ(back->nodes.size(), r->nodes.size());
+  }
+}
+
 TEST(GltfErrors, NonExistentPathEmptyFileAndDirectory) {
   expect_error(dir() / "missing.gltf", {"does not exist"});
   expect_error(write("empty.gltf", ""), {"empty file"});

@@ -212,6 +212,13 @@ Result<std::optional<Primitive>> convert_primitive(const Context& ctx, const Par
   } else {
     out.indices = to_triangle_list(indices, prim.mode);
   }
+  if (out.indices.empty()) {
+    // Fewer than 3 indices (or a strip or fan of fewer than 3 vertices): no triangle to draw,
+    // skipped like points and lines. Kept, it would read as a non-indexed primitive
+    // (engine::Primitive: empty indices) whose vertices make no whole triangles.
+    std::fprintf(stderr, "warning: %s: %s: no whole triangle, primitive skipped\n", ctx.file.c_str(), where.c_str());
+    return std::optional<Primitive>{};
+  }
   if (out.normals.empty()) out.normals = compute_smooth_normals(out.positions, out.indices);
   return std::optional<Primitive>{std::move(out)};
 }
