@@ -311,6 +311,57 @@ TEST(RendererShadows, MapsAreReRenderedOnlyWhenTheirLightOrACasterMoves) {
   EXPECT_TRUE(same_pixels(r->read_hdr(), first));
 }
 
+// A light that stays while a dynamic caster moves keeps its static casters' depth in a cache:
+// the views are then a copy plus the dynamic caster alone, and every frame must equal what a
+// fresh renderer (drawing every caster) draws; a static caster moving too invalidates it.
+TEST(RendererShadows, StaticDepthCacheDrawsWhatDrawingEveryCasterDraws) {
+  engine::GpuContext ctx = headless_context();
+  OccluderScene s;
+  add_light(s.reg, engine::Light{.type = engine::LightType::Spot, .intensity = 10.0f, .outer_cone_rad = 0.7f},
+            {-1.5f, 2.0f, 0.0f}, {0.0f, 0.0f, 0.0f});
+  add_light(s.reg, engine::Light{.type = engine::LightType::Point, .intensity = 5.0f}, {1.5f, 2.0f, 0.5f},
+            {0.0f, 0.0f, 0.0f});
+  const auto at = [](glm::vec3 p) { return glm::translate(glm::mat4(1.0f), p); };
+  const engine::Entity crate = add_mesh(s.reg, 1, at({0.5f, 0.9f, 0.6f}), /*is_static=*/false);
+  engine::Entity box{};
+  s.reg.view<engine::MeshRenderer>().each([&](engine::Entity e, const engine::MeshRenderer& mr) {
+    if (mr.mesh == 1 && e != crate) box = e;
+  });
+  ASSERT_FALSE(box.is_null());
+  const engine::Entity camera = s.cam.add_to(s.reg);
+  auto r = make_renderer(s.assets, s.cam.size, kAmbient);
+  ASSERT_TRUE(r);
+  const auto matches_fresh = [&](const char* what) {
+    const engine::ImageRgbaF img = r->read_hdr();
+    auto fresh = make_renderer(s.assets, s.cam.size, kAmbient);
+    ASSERT_TRUE(fresh);
+    fresh->render(s.reg, camera);
+    EXPECT_TRUE(same_pixels(img, fresh->read_hdr())) << what;
+  };
+  r->render(s.reg, camera);
+  EXPECT_EQ(r->last_shadow_maps_over_static_depth(), 0);
+  const engine::ImageRgbaF first = r->read_hdr();
+
+  s.reg.write<engine::WorldTransform>(crate).matrix = at({0.2f, 0.9f, 0.9f});
+  r->render(s.reg, camera);  // the lights' static depth is cached now
+  EXPECT_EQ(r->last_shadow_maps_over_static_depth(), 0);
+  EXPECT_FALSE(same_pixels(r->read_hdr(), first)) << "the crate's shadow moved";
+  matches_fresh("first move (static depth drawn into the cache)");
+
+  s.reg.write<engine::WorldTransform>(crate).matrix = at({-0.2f, 0.7f, 0.8f});
+  r->render(s.reg, camera);
+  const int cached = r->last_shadow_maps_over_static_depth();
+  EXPECT_GT(cached, 0);
+  EXPECT_LE(cached, r->last_shadow_maps_rendered());  // a view the crate just entered fills its cache now
+  matches_fresh("second move (from the cache)");
+
+  s.reg.write<engine::WorldTransform>(box).matrix = at({-0.5f, 1.1f, -0.2f});
+  s.reg.write<engine::WorldTransform>(crate).matrix = at({0.3f, 0.8f, 0.4f});
+  r->render(s.reg, camera);
+  EXPECT_LT(r->last_shadow_maps_over_static_depth(), r->last_shadow_maps_rendered());
+  matches_fresh("a static caster moved too (the cache is redrawn)");
+}
+
 }  // namespace
 
 namespace {

@@ -168,6 +168,9 @@ class Renderer {
   /// neither its light nor a caster that can reach it (not wholly outside its clip volume)
   /// moved: static lights over static casters are drawn once.
   virtual int last_shadow_maps_rendered() const = 0;
+  /// Of those, the views of lights that did not move whose dynamic casters did: drawn as a
+  /// copy of their static casters' cached depth plus the dynamic casters alone.
+  virtual int last_shadow_maps_over_static_depth() const = 0;
   /// Light and mesh entities the last render() left out as unusable (see RenderSettings::warn).
   /// A camera whose transform is unusable is replaced by its last usable one.
   virtual int last_skipped_entities() const = 0;

@@ -127,6 +127,7 @@ class ForwardRenderer final : public Renderer {
   RenderSettings& settings() override { return settings_; }
   const std::vector<PassTiming>& last_timings() const override { return timings_; }
   int last_shadow_maps_rendered() const override { return shadow_maps_rendered_; }
+  int last_shadow_maps_over_static_depth() const override { return shadow_maps_.last_cached_views(); }
   int last_skipped_entities() const override { return skipped_entities_; }
   int last_light_groups() const override { return light_groups_; }
 

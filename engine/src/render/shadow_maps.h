@@ -22,12 +22,17 @@ class ShadowMaps {
   /// those whose bounds come within the view's far distance of its eye; every caster for
   /// orthographic ones). A layer whose view and reaching casters (mesh and transform) are
   /// what they were when it was last rendered is kept: static lights over static casters
-  /// render once. Returns the number of views rendered.
+  /// render once. A layer of a light that did not move whose dynamic casters did keeps its
+  /// static casters' depth in a second texture: it is copied back and only the dynamic
+  /// casters are drawn (the same texels as drawing every caster). Returns the number of
+  /// views rendered.
   int render(const std::vector<ShadowView>& views, const std::vector<DrawItem>& items, const GpuScene& scene,
              const ShaderProgram& program);
 
   std::uint32_t maps_2d() const { return maps_2d_.id(); }
   std::uint32_t cube_maps() const { return cube_maps_.id(); }
+  /// Of the last render()'s views, those drawn over their cached static depth.
+  int last_cached_views() const { return cached_views_; }
 
  private:
   /// What a layer holds: the view and its casters as last rendered.
@@ -37,9 +42,15 @@ class ShadowMaps {
     bool operator==(const LayerContent& o) const;
   };
   std::vector<LayerContent> content_2d_, content_cube_;  ///< Per 2-D layer / cube layer (cube * 6 + face).
+  /// The static depth cache: per layer, the view and static casters its texel hold.
+  std::vector<LayerContent> static_content_2d_, static_content_cube_;
+  void ensure_static_cache();
 
   GlTexture maps_2d_;
   GlTexture cube_maps_;
+  GlTexture static_2d_;    ///< Same size as maps_2d_, made on first use.
+  GlTexture static_cube_;  ///< Same size as cube_maps_, made on first use.
+  int cached_views_ = 0;
   GlFramebuffer framebuffer_;
   int map_size_ = 0;
   int layers_2d_ = 0;
