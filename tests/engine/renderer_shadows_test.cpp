@@ -266,6 +266,14 @@ bool same_pixels(const engine::ImageRgbaF& a, const engine::ImageRgbaF& b) {
   return a.width == b.width && a.height == b.height && a.pixels == b.pixels;
 }
 
+// The two lights of the shadow-map caching tests: a spot (a 2-D map) and a point light (6 cube faces).
+void add_spot_and_point(engine::Registry& reg) {
+  add_light(reg, engine::Light{.type = engine::LightType::Spot, .intensity = 10.0f, .outer_cone_rad = 0.7f},
+            {-1.5f, 2.0f, 0.0f}, {0.0f, 0.0f, 0.0f});
+  add_light(reg, engine::Light{.type = engine::LightType::Point, .intensity = 5.0f}, {1.5f, 2.0f, 0.5f},
+            {0.0f, 0.0f, 0.0f});
+}
+
 // Shadow maps are kept while neither their light nor a caster that can reach them moved:
 // a second frame re-renders none and draws the same pixels; moving the box re-renders the
 // views it can reach and draws what a fresh renderer draws; moving it back restores the
@@ -273,10 +281,7 @@ bool same_pixels(const engine::ImageRgbaF& a, const engine::ImageRgbaF& b) {
 TEST(RendererShadows, MapsAreReRenderedOnlyWhenTheirLightOrACasterMoves) {
   engine::GpuContext ctx = headless_context();
   OccluderScene s;
-  add_light(s.reg, engine::Light{.type = engine::LightType::Spot, .intensity = 10.0f, .outer_cone_rad = 0.7f},
-            {-1.5f, 2.0f, 0.0f}, {0.0f, 0.0f, 0.0f});
-  add_light(s.reg, engine::Light{.type = engine::LightType::Point, .intensity = 5.0f}, {1.5f, 2.0f, 0.5f},
-            {0.0f, 0.0f, 0.0f});
+  add_spot_and_point(s.reg);
   const engine::Entity camera = s.cam.add_to(s.reg);
   auto r = make_renderer(s.assets, s.cam.size, kAmbient);
   ASSERT_TRUE(r);
@@ -317,10 +322,7 @@ TEST(RendererShadows, MapsAreReRenderedOnlyWhenTheirLightOrACasterMoves) {
 TEST(RendererShadows, StaticDepthCacheDrawsWhatDrawingEveryCasterDraws) {
   engine::GpuContext ctx = headless_context();
   OccluderScene s;
-  add_light(s.reg, engine::Light{.type = engine::LightType::Spot, .intensity = 10.0f, .outer_cone_rad = 0.7f},
-            {-1.5f, 2.0f, 0.0f}, {0.0f, 0.0f, 0.0f});
-  add_light(s.reg, engine::Light{.type = engine::LightType::Point, .intensity = 5.0f}, {1.5f, 2.0f, 0.5f},
-            {0.0f, 0.0f, 0.0f});
+  add_spot_and_point(s.reg);
   const auto at = [](glm::vec3 p) { return glm::translate(glm::mat4(1.0f), p); };
   const engine::Entity crate = add_mesh(s.reg, 1, at({0.5f, 0.9f, 0.6f}), /*is_static=*/false);
   engine::Entity box{};
