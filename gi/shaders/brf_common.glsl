@@ -26,7 +26,8 @@ struct BrfModel {
 // One placed instance this frame.
 struct BrfInstance {
   vec4 albedo;           // rgb diffuse albedo
-  vec4 specular;         // rgb glossy colour (glossy models)
+  vec3 specular;         // rgb glossy colour (glossy models)
+  uint gather_first;     // brf_gather.comp.glsl: its first invocation (4 vertices each)
   uint model;
   uint vertex_offset;    // first vertex of the instance (the gather's invocation index)
   uint vertex_count;     // V

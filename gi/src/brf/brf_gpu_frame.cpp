@@ -282,7 +282,8 @@ void BrfGpuPass::plan_pairs(std::span<const BrfGpuInstance> instances, FrameData
     const ModelInfo& mr = models_[instances[r].model];
     GpuInstance& g = frame.table[r];
     g.albedo = glm::vec4(instances[r].albedo, 0.0f);
-    g.specular = glm::vec4(instances[r].specular, 0.0f);
+    g.specular = instances[r].specular;
+    g.gather_first = gather_offsets_[r];
     g.model = instances[r].model;
     g.vertex_offset = vertex_offsets_[r];
     g.vertex_count = mr.vertex_count;
@@ -404,11 +405,11 @@ void BrfGpuPass::dispatch_fit(std::uint32_t mode, std::size_t instance_count) {
 }
 
 void BrfGpuPass::dispatch_gather(std::size_t instance_count) {
-  const std::uint32_t vertex_total = vertex_offsets_[instance_count];
+  const std::uint32_t invocations = gather_offsets_[instance_count];
   const GLuint id = programs_.gather.id();
   programs_.gather.use();
   glProgramUniform1ui(id, glGetUniformLocation(id, "u_instance_count"), u32(instance_count));
-  glProgramUniform1ui(id, glGetUniformLocation(id, "u_vertex_total"), vertex_total);
+  glProgramUniform1ui(id, glGetUniformLocation(id, "u_invocation_total"), invocations);
   // Inputs through buffer textures (units 0-3; their buffers may have been re-created).
   const std::pair<const Buffer*, GLenum> inputs[4] = {
       {&instance_table_, GL_RGBA32UI}, {&live_, GL_RGBA32UI}, {&weights_, GL_RGBA32F}, {&phi_, GL_RGBA32F}};
@@ -419,7 +420,7 @@ void BrfGpuPass::dispatch_gather(std::size_t instance_count) {
   bind(5, gathered_.buffer.id());
   bind(6, indirect_.buffer.id());
   glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);  // Phi and weights were written as storage
-  dispatch_groups((vertex_total + kGroupSize - 1) / kGroupSize);
+  dispatch_groups((invocations + kGroupSize - 1) / kGroupSize);
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
 }
 

@@ -307,10 +307,12 @@ engine::Status BrfGpuPass::set_static_receivers(std::span<const glm::vec3> posit
 
 engine::Status BrfGpuPass::reset_layout(std::span<const BrfGpuInstance> instances) {
   const std::size_t n = instances.size();
-  std::vector<std::uint32_t> vertex_offsets(n + 1, 0), value_offsets(n + 1, 0), weight_offsets(n + 1, 0);
+  std::vector<std::uint32_t> vertex_offsets(n + 1, 0), value_offsets(n + 1, 0), weight_offsets(n + 1, 0),
+      gather_offsets(n + 1, 0);
   for (std::size_t i = 0; i < n; ++i) {
     const ModelInfo& m = models_[instances[i].model];
     vertex_offsets[i + 1] = vertex_offsets[i] + m.vertex_count;
+    gather_offsets[i + 1] = gather_offsets[i] + (m.vertex_count + kGatherVertices - 1) / kGatherVertices;
     value_offsets[i + 1] = value_offsets[i] + m.terms * m.vertex_count;
     weight_offsets[i + 1] = weight_offsets[i] + padded(m.channels());  // rgb vec4 per channel
   }
@@ -320,6 +322,7 @@ engine::Status BrfGpuPass::reset_layout(std::span<const BrfGpuInstance> instance
   layout_models_.resize(n);
   for (std::size_t i = 0; i < n; ++i) layout_models_[i] = instances[i].model;
   vertex_offsets_ = std::move(vertex_offsets);
+  gather_offsets_ = std::move(gather_offsets);
   value_offsets_ = std::move(value_offsets);
   weight_offsets_ = std::move(weight_offsets);
   pair_keys_.clear();  // the Phi slots follow the pairs in reach (layout_pairs)

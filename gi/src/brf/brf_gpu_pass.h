@@ -324,6 +324,7 @@ class BrfGpuPass {
   // Per layout (instance count and models).
   std::vector<std::uint32_t> layout_models_;
   std::vector<std::uint32_t> vertex_offsets_;  ///< Per instance, plus the total.
+  std::vector<std::uint32_t> gather_offsets_;  ///< Per instance its first brf_gather invocation, plus the total.
   std::vector<std::uint32_t> value_offsets_;   ///< Per instance (K x V values each), plus the total.
   std::vector<std::uint32_t> weight_offsets_;
   /// The pairs in each other's reach (brf_pair_influence), sorted by key source x n +

@@ -50,7 +50,9 @@ static_assert(sizeof(GpuModel) == 96, "must match BrfModel in brf_common.glsl (s
 
 /// BrfInstance in brf_common.glsl (std430).
 struct GpuInstance {
-  glm::vec4 albedo{0.0f}, specular{0.0f};
+  glm::vec4 albedo{0.0f};
+  glm::vec3 specular{0.0f};
+  std::uint32_t gather_first = 0;  ///< brf_gather.comp.glsl: the instance's first invocation (kGatherVertices each).
   std::uint32_t model = 0, vertex_offset = 0, vertex_count = 0, weight_offset = 0;
   std::uint32_t live_first = 0, live_count = 0, value_offset = 0, terms = 1;
 };
@@ -80,6 +82,9 @@ inline void dispatch_groups(std::uint32_t groups) {
   const std::uint32_t gx = std::min(groups, kMaxGroupsPerDimension);
   glDispatchCompute(gx, (groups + gx - 1) / gx, 1);
 }
+
+/// Vertices per brf_gather.comp.glsl invocation (its kGatherVertices): the weights fetched once serve them all.
+constexpr std::uint32_t kGatherVertices = 4;
 
 inline std::uint32_t u32(std::size_t v) { return static_cast<std::uint32_t>(v); }
 
