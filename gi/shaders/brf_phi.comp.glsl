@@ -143,52 +143,64 @@ const uint kDirections = 26u;
 const uint kPinvOffset[4] = uint[4](0u, 104u, 182u, 312u);
 const uint kMaxRows = 16u;  // 1 + kMaxGlossyTerms
 
-// brf_segment_clear (brf_visibility.cpp): the segment a -> b misses every box of the job's occluders.
-bool segment_clear(vec3 a, vec3 b, uint first, uint count) {
-  for (uint o = first; o < first + count; ++o) {
-    const mat4 to_occluder = texel_mat4(u_occluders, 6u * o);
-    const vec3 lo = texel_f(u_occluders, 6u * o + 4u).xyz, hi = texel_f(u_occluders, 6u * o + 5u).xyz;
-    const vec3 p = (to_occluder * vec4(a, 1.0)).xyz;
-    const vec3 d = (to_occluder * vec4(b, 1.0)).xyz - p;
-    float t0 = 0.0, t1 = 1.0;
-    bool miss = false;
-    for (int k = 0; k < 3 && !miss; ++k) {
-      if (abs(d[k]) < 1e-12) {
-        miss = p[k] < lo[k] || p[k] > hi[k];
-        continue;
-      }
-      const float inv = 1.0 / d[k];
-      float ta = (lo[k] - p[k]) * inv, tb = (hi[k] - p[k]) * inv;
-      if (ta > tb) {
-        const float t = ta;
-        ta = tb;
-        tb = t;
-      }
-      t0 = max(t0, ta);
-      t1 = min(t1, tb);
-      miss = t0 > t1;
-    }
-    if (!miss) return false;
-  }
-  return true;
+// Target i of brf_visibility_targets (brf_visibility.h): the source box's centre c (i = 0)
+// or a corner pulled to 0.7 (c +- h).
+vec3 visibility_target(vec3 c, vec3 h, int i) {
+  return i == 0 ? c
+                : c + vec3((((i - 1) & 1) != 0) ? h.x : -h.x, (((i - 1) & 2) != 0) ? h.y : -h.y,
+                           (((i - 1) & 4) != 0) ? h.z : -h.z);
 }
 
 // brf_weighted_visibility over brf_visibility_targets (brf_visibility.h): the cosine-weighted
-// fraction of the source's 9 target points (box centre, corners pulled to 0.7) that p sees.
+// fraction of the source's 9 target points (box centre, corners pulled to 0.7) that p sees,
+// a segment p -> target seen when it misses every box of the job's occluders (brf_segment_clear,
+// brf_visibility.cpp). Occluders outer, targets inner: each occluder record is read and p
+// mapped into its box once (not once per target; on llvmpipe the texel reads were the cost),
+// the segment tests and the sums are the per-target ones bit for bit.
 float occluded_visibility(BrfModel m, vec3 p, vec3 n, uint first, uint count) {
   const vec3 c = 0.5 * (m.box_lo.xyz + m.box_hi.xyz), h = 0.7 * 0.5 * (m.box_hi.xyz - m.box_lo.xyz);
+  uint wanted = 0u;  // targets in front of p
+  for (int i = 0; i < 9; ++i) {
+    const vec3 d = visibility_target(c, h, i) - p;
+    const float len = length(d);
+    if (len > 0.0 && !(dot(n, d) / len <= 0.0)) wanted |= 1u << uint(i);
+  }
+  uint blocked = 0u;
+  for (uint o = first; o < first + count; ++o) {
+    const mat4 to_occluder = texel_mat4(u_occluders, 6u * o);
+    const vec3 lo = texel_f(u_occluders, 6u * o + 4u).xyz, hi = texel_f(u_occluders, 6u * o + 5u).xyz;
+    const vec3 po = (to_occluder * vec4(p, 1.0)).xyz;
+    for (int i = 0; i < 9; ++i) {
+      if ((wanted & ~blocked & (1u << uint(i))) == 0u) continue;
+      const vec3 d = (to_occluder * vec4(visibility_target(c, h, i), 1.0)).xyz - po;
+      float t0 = 0.0, t1 = 1.0;
+      bool miss = false;
+      for (int k = 0; k < 3 && !miss; ++k) {
+        if (abs(d[k]) < 1e-12) {
+          miss = po[k] < lo[k] || po[k] > hi[k];
+          continue;
+        }
+        const float inv = 1.0 / d[k];
+        float ta = (lo[k] - po[k]) * inv, tb = (hi[k] - po[k]) * inv;
+        if (ta > tb) {
+          const float t = ta;
+          ta = tb;
+          tb = t;
+        }
+        t0 = max(t0, ta);
+        t1 = min(t1, tb);
+        miss = t0 > t1;
+      }
+      if (!miss) blocked |= 1u << uint(i);
+    }
+  }
   float all = 0.0, seen = 0.0;
   for (int i = 0; i < 9; ++i) {
-    const vec3 t = i == 0 ? c
-                          : c + vec3((((i - 1) & 1) != 0) ? h.x : -h.x, (((i - 1) & 2) != 0) ? h.y : -h.y,
-                                     (((i - 1) & 4) != 0) ? h.z : -h.z);
-    const vec3 d = t - p;
-    const float len = length(d);
-    if (!(len > 0.0)) continue;
-    const float cs = dot(n, d) / len;
-    if (cs <= 0.0) continue;
+    if ((wanted & (1u << uint(i))) == 0u) continue;
+    const vec3 d = visibility_target(c, h, i) - p;
+    const float cs = dot(n, d) / length(d);
     all += cs;
-    if (segment_clear(p, t, first, count)) seen += cs;
+    if ((blocked & (1u << uint(i))) == 0u) seen += cs;
   }
   return all > 0.0 ? seen / all : 0.0;
 }

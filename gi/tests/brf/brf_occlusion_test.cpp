@@ -166,6 +166,47 @@ TEST(BrfOcclusion, GpuPassMatchesItsTwinAndReevaluatesWhenAnOccluderMoves) {
   EXPECT_EQ(pass.stats().pairs_reused, 6u);
 }
 
+// The GPU's occluder loop runs occluders outer and the 9 lines of sight inner, a line hidden
+// once by any occluder: four crates in a row, the two middle ones small, one low and one high
+// and off the axis, so each hides a different part of the outer crates from each other
+// (brf_pair_occluders gives both). The twin matches with the level of detail off (the outer
+// pairs evaluated per vertex) and on at d = 2 (their rows interpolated, the visibility per vertex).
+TEST(BrfOcclusion, TwoOccludersEachHidingPartMatchTheTwin) {
+  auto ctx = headless_or_fail();
+  const CrateModel& m = model();
+  auto pass = gi::BrfGpuPass::create(std::vector<gi::BrfGpuModel>{{&m.mesh, &m.basis, &m.field}}).value();
+  const glm::mat4 poses[4] = {
+      glm::translate(glm::mat4(1.0f), {-1.6f, 0.0f, 0.0f}),
+      glm::scale(glm::translate(glm::mat4(1.0f), {-0.55f, -0.14f, 0.1f}), glm::vec3(0.5f)),
+      glm::scale(glm::translate(glm::mat4(1.0f), {0.55f, 0.16f, -0.12f}), glm::vec3(0.5f)),
+      glm::translate(glm::mat4(1.0f), {1.6f, 0.0f, 0.0f})};
+  std::vector<gi::BrfObject> objects;
+  for (const glm::mat4& p : poses) objects.push_back({&m.mesh, &m.basis, &m.field, p, kWhite});
+  std::vector<gi::BrfSphere> spheres;
+  for (const gi::BrfObject& o : objects) spheres.push_back(gi::brf_bounding_sphere(gi::brf_object_box(*o.mesh), o.object_to_world));
+  ASSERT_EQ(gi::brf_pair_occluders(spheres, 0, 3), (std::vector<std::uint32_t>{1, 2}));
+  gi::PointEmitter light;
+  light.position = {0.0f, 2.0f, 0.6f};
+  light.radiant = glm::vec3(8.0f);
+  const auto direct = gi::brf_direct_light(objects, std::span(&light, 1), nullptr);
+  std::vector<gi::BrfGpuInstance> inst;
+  for (const gi::BrfObject& o : objects) inst.push_back({0, o.object_to_world, o.albedo});
+  for (const float lod : {0.0f, 2.0f}) {
+    const gi::BrfUpdateSettings settings{.bounces = 2, .cull_threshold = 0.0f, .lod_distance = lod};
+    const gi::BrfResult cpu = gi::brf_interreflect(objects, direct, settings);
+    gi::BrfUpdateSettings open = settings;
+    open.occlusion = false;
+    const gi::BrfResult unoccluded = gi::brf_interreflect(objects, direct, open);
+    EXPECT_NE(sum_x(cpu.indirect[3]), sum_x(unoccluded.indirect[3]));
+    ASSERT_TRUE(pass.run(inst, direct, settings).ok());
+    if (lod > 0.0f) {
+      EXPECT_GT(pass.stats().pairs_lod, 0u);
+    }
+    for (std::size_t i = 0; i < 4; ++i)
+      EXPECT_LT(rel_rmse(pass.read_back_vertices(i), cpu.indirect[i]), 1e-3) << "instance " << i << ", lod " << lod;
+  }
+}
+
 }  // namespace
 
 namespace {
