@@ -181,6 +181,7 @@ void run_gpu_pass(benchmark::State& state, int n, bool moving, const gi::BrfUpda
   state.counters["pairs_evaluated"] = static_cast<double>(pass->stats().pairs_evaluated);
   state.counters["pairs_reused"] = static_cast<double>(pass->stats().pairs_reused);
   state.counters["pairs_lod"] = static_cast<double>(pass->stats().pairs_lod);
+  state.counters["lod_points_packed"] = static_cast<double>(pass->stats().lod_points_packed);
   state.counters["run_cpu_ms"] = pass->stats().cpu_ms;
   state.counters["gpu_MB"] = static_cast<double>(pass->gpu_bytes()) / 1e6;
 }

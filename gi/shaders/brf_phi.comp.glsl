@@ -135,6 +135,9 @@ PhiJob load_job(uint index) {  // PhiJob above, std430
 
 uniform uint u_first_group;
 uniform uint u_group_count;
+// 1: the table has one entry (job, point) per invocation (kind 0's packed level-of-detail
+// points, BrfGpuPassOptions::pack_lod_points) and u_group_count counts invocations.
+uniform uint u_packed;
 // 0: instance vertices, 1: static receivers, 2 (the BRF_LOD_ROWS variant): instance vertices of
 // a far pair, their rows interpolated from the representative points' (level of detail, brf_lod.h)
 uniform uint u_kind;
@@ -278,17 +281,27 @@ void main() {
 #else
 void main() {
   const uint group = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
-  if (group >= u_group_count) return;
-  const uvec2 g = groups[u_first_group + group];
-  // Lanes past the job's last point leave before loading the rest of the job.
-  if (g.y + gl_LocalInvocationIndex >= texelFetch(u_jobs, int(15u * g.x + 8u)).z) return;
-  const PhiJob job = load_job(g.x);
+  uint job_index, point;  // the job and its point (vertex, static entry or representative point)
+  if (u_packed != 0u) {
+    const uint entry = group * gl_WorkGroupSize.x + gl_LocalInvocationIndex;
+    if (entry >= u_group_count) return;
+    const uvec2 e = groups[u_first_group + entry];
+    job_index = e.x;
+    point = e.y;
+  } else {
+    if (group >= u_group_count) return;
+    const uvec2 g = groups[u_first_group + group];
+    job_index = g.x;
+    point = g.y + gl_LocalInvocationIndex;
+    // Lanes past the job's last point leave before loading the rest of the job.
+    if (point >= texelFetch(u_jobs, int(15u * g.x + 8u)).z) return;
+  }
+  const PhiJob job = load_job(job_index);
   // The receiver vertex (kind 0) or static entry: with the level of detail, a representative
   // vertex (its row is written where the vertex's is; brf_lod_expand.comp.glsl fills the others).
   // Representative points (level of detail): the field part only, or with shared visibility the whole row.
   const bool points = u_kind == 0u && job.lod_points != 0u;
-  const uint k = points ? texelFetch(u_lod, int(job.lod_points - 1u + g.y + gl_LocalInvocationIndex)).x
-                        : g.y + gl_LocalInvocationIndex;
+  const uint k = points ? texelFetch(u_lod, int(job.lod_points - 1u + point)).x : point;
 
   vec3 p_in, n_in;
   if (u_kind == 0u) {
@@ -306,7 +319,7 @@ void main() {
   const BrfModel m = load_model(job.source_model);
   const uint nc = m.basis_count * m.terms, c4 = brf_padded(nc);
   const uint rows = job.rows;
-  const uint row0 = job.phi_offset + (points ? g.y + gl_LocalInvocationIndex : k) * rows * c4;
+  const uint row0 = job.phi_offset + point * rows * c4;
   const uint side = brf_horizon(m, p, n);
   if (side == 0u) {  // the source is behind the tangent plane: no light
     for (uint i = 0u; i < rows * c4; i += 4u) phi4[(row0 + i) / 4u] = vec4(0.0);

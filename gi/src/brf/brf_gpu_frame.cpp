@@ -23,19 +23,30 @@ void BrfGpuPass::dispatch_phi(std::span<const BrfPhiJob> jobs, std::uint32_t kin
   const bool static_kind = kind == 1;
   if (jobs.empty()) return;
   // Work groups sorted by program (one-row jobs, glossy receivers) and the source's field
-  // buffer: one dispatch per (program, buffer).
+  // buffer: one dispatch per (program, buffer). Class 2 (kind 0, pack_lod_points): the
+  // level-of-detail jobs' representative points, packed: one table entry (job, point) per
+  // invocation, so a work group serves several far pairs (a crate has 24 points: a work
+  // group per pair left 40 of its 64 invocations idle).
   std::vector<glm::uvec2> groups;
   const std::size_t nf = fields_.size();
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> ranges(2 * nf, {0u, 0u});
-  for (std::size_t v = 0; v < 2; ++v)
+  constexpr std::size_t kClasses = 3;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> ranges(kClasses * nf, {0u, 0u});
+  const bool pack = kind == 0 && pack_lod_points_;
+  for (std::size_t v = 0; v < kClasses; ++v)
     for (std::size_t b = 0; b < nf; ++b) {
       ranges[v * nf + b].first = u32(groups.size());
       for (std::size_t j = 0; j < jobs.size(); ++j) {
-        if (models_[jobs[j].source_model].field_buffer != b || (jobs[j].rows > 1) != (v == 1)) continue;
-        for (std::uint32_t first = 0; first < jobs[j].point_count; first += kGroupSize)
-          groups.emplace_back(u32(j), first);
+        const bool packed = pack && jobs[j].lod_points != 0 && jobs[j].rows == 1;
+        const std::size_t job_class = packed ? 2 : jobs[j].rows > 1 ? 1 : 0;
+        if (models_[jobs[j].source_model].field_buffer != b || job_class != v) continue;
+        if (packed)
+          for (std::uint32_t point = 0; point < jobs[j].point_count; ++point) groups.emplace_back(u32(j), point);
+        else
+          for (std::uint32_t first = 0; first < jobs[j].point_count; first += kGroupSize)
+            groups.emplace_back(u32(j), first);
       }
       ranges[v * nf + b].second = u32(groups.size()) - ranges[v * nf + b].first;
+      if (v == 2) stats_.lod_points_packed += ranges[v * nf + b].second;
     }
   jobs_.upload(jobs.data(), jobs.size() * sizeof(BrfPhiJob));
   groups_.upload(groups.data(), groups.size() * sizeof(glm::uvec2));
@@ -58,18 +69,19 @@ void BrfGpuPass::dispatch_phi(std::span<const BrfPhiJob> jobs, std::uint32_t kin
   bind(7, static_kind ? static_phi_.buffer.id() : phi_.buffer.id());
   bind(8, sh_data_.id());
   bind(9, static_visibility_.buffer.empty() ? static_points_.buffer.id() : static_visibility_.buffer.id());
-  for (std::size_t v = 0; v < 2; ++v) {
-    const engine::ShaderProgram& program = kind == 2 ? programs_.phi_lod : v == 0 ? programs_.phi : programs_.phi_glossy;
+  for (std::size_t v = 0; v < kClasses; ++v) {
+    const engine::ShaderProgram& program = kind == 2 ? programs_.phi_lod : v == 1 ? programs_.phi_glossy : programs_.phi;
     const GLuint id = program.id();
     program.use();
     glProgramUniform1ui(id, glGetUniformLocation(id, "u_kind"), kind);
+    if (kind != 2) glProgramUniform1ui(id, glGetUniformLocation(id, "u_packed"), v == 2 ? 1u : 0u);
     for (std::size_t b = 0; b < nf; ++b) {
       const auto [first, count] = ranges[v * nf + b];
       if (count == 0) continue;
       glBindTextureUnit(kFieldTextureUnit, field_textures_[b].id());
       glProgramUniform1ui(id, glGetUniformLocation(id, "u_first_group"), first);
-      glProgramUniform1ui(id, glGetUniformLocation(id, "u_group_count"), count);
-      dispatch_groups(count);
+      glProgramUniform1ui(id, glGetUniformLocation(id, "u_group_count"), count);  // packed: invocations
+      dispatch_groups(v == 2 ? (count + kGroupSize - 1) / kGroupSize : count);
     }
   }
 }

@@ -129,6 +129,7 @@ engine::Result<BrfGpuPass> BrfGpuPass::create(std::span<const BrfGpuModel> model
   BrfGpuPass pass;
   pass.max_buffer_bytes_ = limit;
   pass.pose_tolerance_ = options.pose_tolerance;
+  pass.pack_lod_points_ = options.pack_lod_points;
   if (auto s = pass.build_programs(); !s) return s.error();
 
   // Model tables, vertices, bases; fields grouped into buffers under the limit.

@@ -95,6 +95,11 @@ struct BrfGpuPassOptions {
   /// Two poses (relative source-receiver pose, or a source's world transform) are the same
   /// when no matrix element differs by more than this x (1 + |element|).
   float pose_tolerance = 1e-6f;
+  /// Level of detail (brf_lod.h): the far pairs' representative points (24 for a crate) of
+  /// several pairs packed into one work group, one invocation per point (a per-invocation
+  /// job table), rather than a 64-wide work group per pair. Off: the per-pair work groups (the
+  /// same results bit for bit; tests compare the two).
+  bool pack_lod_points = true;
 };
 
 /// Interreflection between rigid objects on the GPU. Move-only; owns its GL objects
@@ -162,6 +167,8 @@ class BrfGpuPass {
     std::size_t pairs_reused = 0;           ///< Live pairs whose Phi was kept (relative pose unchanged).
     std::size_t pairs_lod = 0;  ///< Live pairs whose Phi uses the level of detail (BrfUpdateSettings::lod_distance).
     std::size_t pair_slots = 0;             ///< Pairs in reach holding a Phi slot (culled ones included).
+    /// Far pairs' representative points evaluated packed (BrfGpuPassOptions::pack_lod_points).
+    std::size_t lod_points_packed = 0;
     std::size_t static_sources_reused = 0;  ///< Sources whose static-receiver Phi was kept.
     /// Static receivers inside a moved source's field that see none of it past the world
     /// (set_static_receivers' world), so get none of its bounce; counted per source.
@@ -292,6 +299,7 @@ class BrfGpuPass {
   std::vector<ModelInfo> models_;
   std::size_t max_buffer_bytes_ = 0;
   float pose_tolerance_ = 1e-6f;
+  bool pack_lod_points_ = true;  ///< BrfGpuPassOptions::pack_lod_points.
 
   // Uploaded once at create().
   engine::GlBuffer model_table_, model_vertices_, psi_, a_inverse_;

@@ -240,4 +240,51 @@ TEST(BrfLod, GpuPassMatchesItsTwinWithTheLevelOfDetail) {
   }
 }
 
+// Kind 0's far-pair representative points packed several pairs to a work group, one
+// invocation per point (BrfGpuPassOptions::pack_lod_points, the default), give the per-pair
+// work groups' results bit for bit: 4 x 4 crates (16 crates, 24 points each), d = 2, with
+// and without shared visibility, one model and two (the instances alternating).
+TEST(BrfLod, PackedRepresentativePointsGiveTheSameBitsAsOneWorkGroupPerPair) {
+  auto ctx = headless_or_fail();
+  const Crate& c = crate();
+  const gi::BrfGpuModel model{&c.mesh, &c.basis, &c.field};
+  const std::vector<gi::BrfGpuModel> models = {model, model};
+  const std::vector<gi::BrfObject> objects = grid(4);
+  const auto in = incoming(objects, {1.8f, 2.5f, 1.6f});
+  for (const std::size_t model_count : {std::size_t{1}, std::size_t{2}}) {
+    std::vector<gi::BrfGpuInstance> instances;
+    for (std::size_t i = 0; i < objects.size(); ++i)
+      instances.push_back({static_cast<std::uint32_t>(i % model_count), objects[i].object_to_world, objects[i].albedo});
+    std::vector<glm::vec3> result[2];
+    for (const bool shared : {false, true}) {
+      std::size_t far = 0;
+      for (int packed = 0; packed < 2; ++packed) {
+        gi::BrfGpuPassOptions options;
+        options.pack_lod_points = packed != 0;
+        auto created = gi::BrfGpuPass::create(std::span(models.data(), model_count), options);
+        ASSERT_TRUE(created.ok()) << created.error().to_string();
+        gi::BrfGpuPass pass = std::move(created).value();
+        const gi::BrfUpdateSettings on{.bounces = 3, .cull_threshold = 0.0f, .lod_distance = 2.0f, .lod_shared_visibility = shared};
+        const auto status = pass.run(instances, in, on);
+        ASSERT_TRUE(status.ok()) << status.error().to_string();
+        result[packed].clear();
+        for (std::size_t i = 0; i < instances.size(); ++i) {
+          const auto r = pass.read_back_vertices(i);
+          result[packed].insert(result[packed].end(), r.begin(), r.end());
+        }
+        far = pass.stats().pairs_lod;
+        if (packed != 0)
+          EXPECT_EQ(pass.stats().lod_points_packed, far * 24u) << "24 points per crate, packed";
+        else
+          EXPECT_EQ(pass.stats().lod_points_packed, 0u);
+      }
+      EXPECT_GT(far, 20u);
+      ASSERT_EQ(result[0].size(), result[1].size());
+      std::size_t differ = 0;
+      for (std::size_t k = 0; k < result[0].size(); ++k) differ += result[0][k] != result[1][k] ? 1 : 0;
+      EXPECT_EQ(differ, 0u) << model_count << " model(s), shared visibility " << shared;
+    }
+  }
+}
+
 }  // namespace
