@@ -282,7 +282,7 @@ void BrfGpuPass::plan_pairs(std::span<const BrfGpuInstance> instances, FrameData
     to_source[s] = glm::inverse(instances[s].object_to_world);
     const glm::mat3 rot = glm::mat3(to_source[s]);
     pure_to_source[s] = rot / glm::length(rot[0]);
-    spheres[s] = brf_bounding_sphere(brf_object_box(*models_[instances[s].model].mesh), instances[s].object_to_world);
+    spheres[s] = brf_bounding_sphere(models_[instances[s].model].box, instances[s].object_to_world);
     // The innermost field sphere in world space, as brf_interreflect places it (brf_pair_far).
     const glm::mat4& m = instances[s].object_to_world;
     const BasisRadianceField& f = *models_[instances[s].model].field;
@@ -353,7 +353,7 @@ void BrfGpuPass::plan_pairs(std::span<const BrfGpuInstance> instances, FrameData
       job.occluder_offset = u32(frame.occluders.size());
       job.occluder_count = u32(ids.size());
       for (std::size_t k = 0; k < ids.size(); ++k) {
-        const BrfBox box = brf_object_box(*models_[instances[ids[k]].model].mesh);
+        const BrfBox& box = models_[instances[ids[k]].model].box;
         frame.occluders.push_back({poses[k], glm::vec4(box.lo, 0.0f), glm::vec4(box.hi, 0.0f)});
       }
       if (far) {

@@ -202,6 +202,7 @@ void BrfGpuPass::add_model(const BrfGpuModel& model, std::size_t limit, ModelDat
   info.field_buffer = g.field_buffer;
   info.outer_radius = f.outer_radius;
   info.field_centre = f.centre;
+  info.box = box;
   info.basis = model.basis;
   info.mesh = model.mesh;
   info.field = model.field;

@@ -200,6 +200,7 @@ class BrfGpuPass {
     std::uint32_t field_buffer = 0;
     float outer_radius = 0.0f;
     glm::vec3 field_centre{0.0f};
+    BrfBox box;                       ///< brf_object_box of the mesh (once, not per pair and frame).
     const BrfBasis* basis = nullptr;  ///< For the CPU first fit.
     const BrfMesh* mesh = nullptr;    ///< For pair culling (BrfObject).
     const BasisRadianceField* field = nullptr;
