@@ -195,6 +195,14 @@ def main():
         lines.append(f"CPU twin's bounce loop (`brf_gather`, 30 crates, {fmt(g['phi_MB'])} MB of Phi): "
                      f"{fmt(g['gather_GB/s'])} GB/s against memcpy {fmt(g['memcpy_GB/s'])} GB/s of the same bytes: "
                      f"**{fmt(g['vs_memcpy'], 2)}** (target ≥ 0.5).")
+    # Issue 23's BRF target at the defaults (no bound culling, lod_distance 5), and the fixed part.
+    moving, still = brf.get("BM_BrfGpu/30/1/0"), brf.get("BM_BrfGpu/30/0/0")
+    if moving:
+        lines.append("")
+        lines.append(f"30 crates all moving at the default settings (`BM_BrfGpu/30/1/0`, no bound culling, "
+                     f"`lod_distance` 5): **{fmt(ms(moving))} ms** GPU wall, process CPU "
+                     f"{fmt(moving.get('process_cpu_ms'))} ms (target ≤ 20 ms); nothing moving (`BM_BrfGpu/30/0/0`): "
+                     f"{fmt(ms(still)) if still else '—'} ms.")
     lines.append("")
     # The frame.
     runs = [(size, v) for size in FRAME_TARGETS for v in ("", "_flat")] + [(FRAME_FIXED_SIZE, "")]

@@ -21,7 +21,7 @@ common=(--benchmark_repetitions="$reps" --benchmark_enable_random_interleaving=t
 { echo "start $(date -u +%FT%TZ) $(cut -d' ' -f1-3 /proc/loadavg) nproc $(nproc)"; } > "$out/load.txt"
 "$bench/prm_gpu_bench" "${common[@]}" --benchmark_out="$out/prm_gpu_bench.json" > /dev/null
 "$bench/prm_relight_bench" "${common[@]}" --benchmark_out="$out/prm_relight_bench.json" > /dev/null
-"$bench/brf_bench" "${common[@]}" --benchmark_filter='BM_BrfGpuInfluence|BM_BrfGatherCpu' \
+"$bench/brf_bench" "${common[@]}" --benchmark_filter='BM_BrfGpuInfluence|BM_BrfGatherCpu|BM_BrfGpu/30/[01]/0$' \
   --benchmark_out="$out/brf_bench.json" > /dev/null
 if [[ -n "${BEFORE:-}" && -x "$BEFORE/gi/benchmarks/prm_gpu_bench" ]]; then
   "$BEFORE/gi/benchmarks/prm_gpu_bench" "${common[@]}" --benchmark_out="$out/prm_gpu_bench_before.json" > /dev/null
