@@ -21,6 +21,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <map>
 #include <memory>
 #include <vector>
@@ -206,6 +207,39 @@ BENCHMARK(BM_PrmGpuSum)
     ->ArgsProduct({{64 << 10, 256 << 10}, {8, 16, 32, 128}})
     ->Unit(benchmark::kMillisecond)
     ->UseManualTime();
+
+// The pass's fixed part (no cluster: the texel list read, every pane texel written) against T:
+// what a dispatch costs by itself (T = 8: one invocation) and per texel. Counters: run_ms
+// (PrmGpuPass::run: the dispatch, synchronous on llvmpipe), finish_ms (the glFinish after it)
+// and cpu_time_ms (both in process CPU time, every thread), medians.
+void BM_PrmGpuFixed(benchmark::State& state) {
+  using Clock = std::chrono::steady_clock;
+  gi::PrmGpuPass& pass = pass_for(static_cast<std::size_t>(state.range(0)));
+  (void)pass.run({});
+  glFinish();
+  const auto process_cpu_ms = [] {
+    timespec ts{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) * 1e-6;
+  };
+  std::vector<double> run_ms, finish_ms, cpu_ms;
+  for (auto _ : state) {
+    const double c0 = process_cpu_ms();
+    const auto t0 = Clock::now();
+    if (!pass.run({})) state.SkipWithError("PrmGpuPass::run failed");
+    const auto t1 = Clock::now();
+    glFinish();
+    const auto t2 = Clock::now();
+    cpu_ms.push_back(process_cpu_ms() - c0);
+    run_ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
+    finish_ms.push_back(std::chrono::duration<double, std::milli>(t2 - t1).count());
+    state.SetIterationTime(std::chrono::duration<double>(t2 - t0).count());
+  }
+  state.counters["run_ms"] = median(run_ms);
+  state.counters["finish_ms"] = median(finish_ms);
+  state.counters["cpu_time_ms"] = median(cpu_ms);  // process CPU time (llvmpipe's threads too): steadier under load
+}
+BENCHMARK(BM_PrmGpuFixed)->ArgName("T")->Arg(8)->Arg(4096)->Arg(64 << 10)->Unit(benchmark::kMicrosecond)->UseManualTime();
 
 }  // namespace
 
