@@ -14,4 +14,8 @@ void RayCaster::occluded_many(std::span<const Ray> rays, std::span<std::uint8_t>
   for (std::size_t i = 0; i < rays.size(); ++i) out[i] = occluded(rays[i]) ? 1 : 0;
 }
 
+void RayCaster::occluded_coherent(std::span<const Ray> rays, std::span<std::uint8_t> out) const {
+  occluded_many(rays, out);
+}
+
 }  // namespace gi

@@ -24,6 +24,9 @@ class RayCaster {
   virtual void intersect_many(std::span<const Ray> rays, std::span<Hit> hits) const;
   /// Occlusion of many rays; out[i] = occluded(rays[i]).
   virtual void occluded_many(std::span<const Ray> rays, std::span<std::uint8_t> out) const;
+  /// occluded_many for rays that run close together (e.g. shadow rays towards one light):
+  /// implementations may trace them in packets. out[i] = occluded(rays[i]), the same answers.
+  virtual void occluded_coherent(std::span<const Ray> rays, std::span<std::uint8_t> out) const;
   /// Moves a dynamic instance; takes effect at the next commit().
   virtual void set_instance_transform(std::uint32_t instance, const glm::mat4& object_to_world) = 0;
   /// Rebuilds what changed since the last commit (only the top level for moved instances).

@@ -218,22 +218,36 @@ double punctual_lit_solid_angle(const PointEmitter& e, const RayCaster& caster, 
   return static_cast<double>(per_direction) * sum;
 }
 
-bool segment_visible(const RayCaster& caster, const glm::vec3& a, const glm::vec3& na, const glm::vec3& b,
-                     const glm::vec3& nb) {
+namespace {
+
+Ray segment_ray(const glm::vec3& a, const glm::vec3& na, const glm::vec3& b, const glm::vec3& nb) {
   const glm::vec3 o = offset_ray_origin(a, na);
   const glm::vec3 t = offset_ray_origin(b, nb);
-  return !caster.occluded(Ray{o, 0.0f, t - o, 1.0f});
+  return Ray{o, 0.0f, t - o, 1.0f};
 }
 
-bool emitter_visible(const RayCaster& caster, const PointEmitter& e, const glm::vec3& p, const glm::vec3& n) {
-  const glm::vec3 o = offset_ray_origin(p, n);
+}  // namespace
+
+bool segment_visible(const RayCaster& caster, const glm::vec3& a, const glm::vec3& na, const glm::vec3& b,
+                     const glm::vec3& nb) {
+  return !caster.occluded(segment_ray(a, na, b, nb));
+}
+
+Ray emitter_shadow_ray(const PointEmitter& e, const glm::vec3& p, const glm::vec3& n) {
   switch (e.kind) {
-    case PointEmitter::Kind::Directional: return !caster.occluded(Ray{o, 0.0f, -e.direction});
-    case PointEmitter::Kind::Punctual: return !caster.occluded(Ray{o, 0.0f, e.position - o, 1.0f});
+    case PointEmitter::Kind::Directional: return Ray{offset_ray_origin(p, n), 0.0f, -e.direction};
+    case PointEmitter::Kind::Punctual: {
+      const glm::vec3 o = offset_ray_origin(p, n);
+      return Ray{o, 0.0f, e.position - o, 1.0f};
+    }
     case PointEmitter::Kind::Lambertian: break;
   }
   const glm::vec3 ne = glm::dot(e.direction, p - e.position) >= 0.0f ? e.direction : -e.direction;
-  return segment_visible(caster, p, n, e.position, ne);
+  return segment_ray(p, n, e.position, ne);
+}
+
+bool emitter_visible(const RayCaster& caster, const PointEmitter& e, const glm::vec3& p, const glm::vec3& n) {
+  return !caster.occluded(emitter_shadow_ray(e, p, n));
 }
 
 }  // namespace gi

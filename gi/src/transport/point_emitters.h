@@ -71,6 +71,10 @@ float lambertian_kernel(const glm::vec3& q, const glm::vec3& nq, float emitter_a
 /// Surface end points are moved off their surfaces (ray_offset.h) so neither self-shadows.
 bool emitter_visible(const RayCaster& caster, const PointEmitter& e, const glm::vec3& p, const glm::vec3& n);
 
+/// The shadow ray emitter_visible traces: emitter_visible(c, e, p, n) == !c.occluded(emitter_shadow_ray(e, p, n)).
+/// For tracing many at once (RayCaster::occluded_coherent).
+Ray emitter_shadow_ray(const PointEmitter& e, const glm::vec3& p, const glm::vec3& n);
+
 /// Solid angle (sr) of static geometry lit by punctual emitter e, weighted by its spot cone
 /// and range window: 4 pi / N x the sum over N = side^2 stratified directions of cone x
 /// window x hit (front faces only: the back of a one-sided surface receives nothing).

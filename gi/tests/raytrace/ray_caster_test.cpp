@@ -124,6 +124,43 @@ TEST(EmbreeRayCaster, StreamQueriesMatchSingleRays) {
   EXPECT_GT(fan_hit_count, 100);  // the fan must hit the cubes, not only miss them
 }
 
+TEST(EmbreeRayCaster, CoherentOcclusionMatchesSingleRays) {
+  const gi::RtSceneData data = scattered_cubes(20, 3);
+  auto rc = gi::make_embree_ray_caster(data);
+  ASSERT_TRUE(rc);
+  // Shadow rays towards one light (PRM entry points: a segment from each point to the light,
+  // t_max 1) and rays in random directions; 1013 of each, so the last packet is partial.
+  const glm::vec3 light(0.3f, 0.2f, -0.1f);
+  gi::Pcg32 rng(11, 12);
+  std::vector<gi::Ray> rays;
+  for (int i = 0; i < 1013; ++i) {
+    const glm::vec3 p(rng.next_float() * 12 - 6, rng.next_float() * 12 - 6, rng.next_float() * 12 - 6);
+    rays.push_back(gi::Ray{p, 0.0f, light - p, 1.0f});
+  }
+  for (int i = 0; i < 1013; ++i) rays.push_back(random_ray(rng));
+  for (const std::size_t n : {rays.size(), std::size_t{1013}, std::size_t{16}, std::size_t{5}, std::size_t{0}}) {
+    const std::span<const gi::Ray> some(rays.data(), n);
+    std::vector<std::uint8_t> coherent(n, 7), many(n, 7);
+    (*rc)->occluded_coherent(some, coherent);
+    (*rc)->occluded_many(some, many);
+    std::size_t blocked = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      ASSERT_EQ(coherent[i], (*rc)->occluded(some[i]) ? 1 : 0) << "ray " << i << " of " << n;
+      ASSERT_EQ(coherent[i], many[i]) << "ray " << i << " of " << n;
+      blocked += coherent[i];
+    }
+    if (n >= 1013) {
+      EXPECT_GT(blocked, n / 10) << "the rays must be blocked often, not only pass";
+      EXPECT_LT(blocked, n - n / 10) << "the rays must pass often, not only be blocked";
+    }
+  }
+  // The interface's default (a caster without packets) answers the same.
+  gi::BruteForceRayCaster brute(data);
+  std::vector<std::uint8_t> coherent(rays.size());
+  brute.occluded_coherent(rays, coherent);
+  for (std::size_t i = 0; i < rays.size(); ++i) ASSERT_EQ(coherent[i], brute.occluded(rays[i]) ? 1 : 0) << i;
+}
+
 TEST(EmbreeRayCaster, MovingDynamicInstanceUpdatesHits) {
   gi::RtSceneData data;
   data.geometries.push_back(unit_cube());
