@@ -14,7 +14,9 @@
 // panes' blocks of 8 elements holding any non-zero value), picked_nonzero_blocks (the same
 // over the last change's clusters), picked_zero_runs64 (share of those clusters' runs of 64
 // elements, one 8-lane SIMD group of 8-element blocks on llvmpipe, that are all zero: all a
-// zero-block skip could drop there); cpu_cpu_time_ms, gpu_cpu_time_ms,
+// zero-block skip could drop there), unlit_runs64 / unlit_runs512 (share of the runs of 64 /
+// 512 elements that no cluster of two consecutive poses' picks lights: what a change could
+// leave unwritten, exactly; 0 on the demo level); cpu_cpu_time_ms, gpu_cpu_time_ms,
 // gpu_k0_cpu_time_ms: the same parts in process CPU time (all threads, llvmpipe's included),
 // steadier than wall time when other jobs share the cores. BM_PrmFluxCheck and
 // BM_PrmEntryShadowRays time the CPU part's two ray sets alone.
@@ -276,6 +278,21 @@ void BM_PrmLightChange(benchmark::State& state) {
         zero_runs += !any;
       }
     state.counters["picked_zero_runs64"] = runs ? double(zero_runs) / double(runs) : 0.0;
+    // Runs of 64 / 512 elements (one SIMD group / one work group) that no cluster of two
+    // consecutive poses' picks lights: the texels a change could leave unwritten, exactly.
+    for (const std::size_t run : {std::size_t{64}, std::size_t{512}}) {
+      std::size_t unchanged = 0, all = 0;
+      for (std::size_t p = 1; p < picks.size(); ++p)
+        for (std::size_t first = 0; first < n; first += run, ++all) {
+          bool any = false;
+          for (const auto* picked : {&picks[p - 1], &picks[p]})
+            for (const gi::ClusterWeight& w : *picked)
+              for (std::size_t i = first; i < std::min(n, first + run) && !any; ++i)
+                for (int ch = 0; ch < 3; ++ch) any |= d.prm.panes[(std::size_t(w.cluster) * n + i) * 3 + ch] != 0.0f;
+          unchanged += !any;
+        }
+      state.counters["unlit_runs" + std::to_string(run)] = all ? double(unchanged) / double(all) : 0.0;
+    }
     state.counters["picked_nonzero_blocks"] = picked_total ? double(picked_nonzero) / double(picked_total) : 0.0;
   }
 }
