@@ -90,7 +90,8 @@ int run_headless(const RunOptions& o, RunState& state) {
   Summary step_ms, render_ms, write_ms, total_ms;
   std::map<std::string, Summary> systems, passes;
   std::vector<std::string> system_order, pass_order;
-  std::uint64_t shadow_views_drawn = 0, shadow_views_cached = 0, rendered_frames = 0, light_groups = 0;
+  std::uint64_t shadow_views_drawn = 0, shadow_views_cached = 0, shadow_views_unseen = 0, rendered_frames = 0,
+                light_groups = 0;
   const auto run_t0 = Clock::now();
   for (std::uint64_t i = 0; i < frames; ++i) {
     const auto t0 = Clock::now();
@@ -119,6 +120,7 @@ int run_headless(const RunOptions& o, RunState& state) {
       }
       shadow_views_drawn += static_cast<std::uint64_t>(renderer->last_shadow_maps_rendered());
       shadow_views_cached += static_cast<std::uint64_t>(renderer->last_shadow_maps_over_static_depth());
+      shadow_views_unseen += static_cast<std::uint64_t>(renderer->last_shadow_maps_unseen());
       light_groups += static_cast<std::uint64_t>(renderer->last_light_groups());
       ++rendered_frames;
       if (written) {
@@ -151,9 +153,11 @@ int run_headless(const RunOptions& o, RunState& state) {
   for (const auto& n : pass_order) passes[n].print(n.c_str());
   if (rendered_frames > 0)
     std::printf("  shadow-map views drawn per frame: %.2f (the others kept: their light and casters did not move), "
-                "%.2f of them over their static casters' cached depth (only dynamic casters moved)\n",
+                "%.2f of them over their static casters' cached depth (only dynamic casters moved); %.2f changed "
+                "but left undrawn (the camera cannot see into them)\n",
                 static_cast<double>(shadow_views_drawn) / static_cast<double>(rendered_frames),
-                static_cast<double>(shadow_views_cached) / static_cast<double>(rendered_frames));
+                static_cast<double>(shadow_views_cached) / static_cast<double>(rendered_frames),
+                static_cast<double>(shadow_views_unseen) / static_cast<double>(rendered_frames));
   if (rendered_frames > 0)
     std::printf("  light sets per frame: %.2f (pixels shaded with only the lights that can reach them; 1: every light "
                 "everywhere)\n",

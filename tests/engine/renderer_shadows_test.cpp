@@ -287,7 +287,9 @@ TEST(RendererShadows, MapsAreReRenderedOnlyWhenTheirLightOrACasterMoves) {
   ASSERT_TRUE(r);
   r->render(s.reg, camera);
   EXPECT_EQ(r->last_timings().front().name, "shadow maps (7 views)");
-  EXPECT_EQ(r->last_shadow_maps_rendered(), 7);
+  // The camera looks down from above the lights: cube faces it cannot see into wait.
+  EXPECT_EQ(r->last_shadow_maps_rendered() + r->last_shadow_maps_unseen(), 7);
+  EXPECT_GT(r->last_shadow_maps_rendered(), 0);
   const engine::ImageRgbaF first = r->read_hdr();
   r->render(s.reg, camera);
   EXPECT_EQ(r->last_shadow_maps_rendered(), 0);
@@ -314,6 +316,40 @@ TEST(RendererShadows, MapsAreReRenderedOnlyWhenTheirLightOrACasterMoves) {
   s.reg.write<engine::WorldTransform>(box).matrix = original;
   r->render(s.reg, camera);
   EXPECT_TRUE(same_pixels(r->read_hdr(), first));
+}
+
+// A view that changed but that the camera cannot see into is not drawn; when the camera turns
+// to it, it is drawn before use: each frame equals a fresh renderer's, which draws every view
+// the camera can see from scratch. The point light moves every frame (its faces always change).
+TEST(RendererShadows, UnseenViewsAreDrawnWhenTheCameraTurnsToThem) {
+  engine::GpuContext ctx = headless_context();
+  OccluderScene s;
+  const engine::Entity lamp =
+      add_light(s.reg, engine::Light{.type = engine::LightType::Point, .intensity = 5.0f}, {1.5f, 2.0f, 0.5f}, {0, 0, 0});
+  const engine::Entity camera = s.cam.add_to(s.reg);
+  auto r = make_renderer(s.assets, s.cam.size, kAmbient);
+  ASSERT_TRUE(r);
+  const auto matches_fresh = [&](const char* what) {
+    const engine::ImageRgbaF img = r->read_hdr();
+    auto fresh = make_renderer(s.assets, s.cam.size, kAmbient);
+    ASSERT_TRUE(fresh);
+    fresh->render(s.reg, camera);
+    EXPECT_TRUE(same_pixels(img, fresh->read_hdr())) << what;
+  };
+  // Looking straight down at the floor from 3 m: the faces above the light are out of view.
+  r->render(s.reg, camera);
+  EXPECT_GT(r->last_shadow_maps_unseen(), 0);
+  EXPECT_EQ(r->last_shadow_maps_rendered() + r->last_shadow_maps_unseen(), 6);
+  s.reg.write<engine::WorldTransform>(lamp).matrix = looking_at({1.2f, 2.1f, 0.3f}, {0, 0, 0});
+  r->render(s.reg, camera);
+  const int unseen = r->last_shadow_maps_unseen();
+  EXPECT_GT(unseen, 0);
+  matches_fresh("looking down");
+  // Turned to look up past the light and the box: the faces left undrawn are drawn now.
+  s.reg.write<engine::WorldTransform>(camera).matrix = looking_at({-2.0f, 0.5f, -1.0f}, {1.2f, 3.0f, 0.3f});
+  r->render(s.reg, camera);
+  EXPECT_LT(r->last_shadow_maps_unseen(), unseen);
+  matches_fresh("turned up");
 }
 
 // A light that stays while a dynamic caster moves keeps its static casters' depth in a cache:

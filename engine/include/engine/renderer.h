@@ -171,6 +171,9 @@ class Renderer {
   /// Of those, the views of lights that did not move whose dynamic casters did: drawn as a
   /// copy of their static casters' cached depth plus the dynamic casters alone.
   virtual int last_shadow_maps_over_static_depth() const = 0;
+  /// Views that changed but were not drawn: the camera cannot see into their volume, so no
+  /// pixel looks them up (drawn on the first frame it can).
+  virtual int last_shadow_maps_unseen() const = 0;
   /// Light and mesh entities the last render() left out as unusable (see RenderSettings::warn).
   /// A camera whose transform is unusable is replaced by its last usable one.
   virtual int last_skipped_entities() const = 0;

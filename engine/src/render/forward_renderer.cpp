@@ -192,7 +192,8 @@ void ForwardRenderer::render(const Registry& registry, Entity camera) {
   const render::LightList lights = render::collect_lights(registry, render::scene_bounds(items), capacity, &skipped);
   report_skipped(registry, skipped);
   shadow_maps_.reserve(capacity.map_size, lights.layers_2d, capacity.cube_size, lights.cubes);
-  shadow_maps_rendered_ = shadow_maps_.render(lights.shadow_views, items, scene_, shadow_);
+  const CameraView view = camera_view(registry, camera);
+  shadow_maps_rendered_ = shadow_maps_.render(lights.shadow_views, items, scene_, shadow_, view.view_proj);
   timings_.push_back({"shadow maps (" + std::to_string(lights.shadow_views.size()) + " views)", timer.lap_ms()});
 
   // Half-resolution area shadows: every area light of the frame (each its visibility channel,
@@ -228,7 +229,7 @@ void ForwardRenderer::render(const Registry& registry, Entity camera) {
     indirect = &provider_->frame();
     timings_.push_back({std::string("indirect light update (") + provider_->label() + ")", timer.lap_ms()});
   }
-  forward_pass(registry, camera, items, groups, indirect);
+  forward_pass(view, items, groups, indirect);
   timings_.push_back({provider_ ? std::string("forward + indirect (") + provider_->label() + ")"
                                 : std::string("forward + constant ambient (stand-in)"),
                       timer.lap_ms()});
@@ -237,16 +238,20 @@ void ForwardRenderer::render(const Registry& registry, Entity camera) {
   timings_.push_back({"tonemap (exposure, ACES fitted, sRGB)", timer.lap_ms()});
 }
 
-void ForwardRenderer::forward_pass(const Registry& registry, Entity camera, const std::vector<DrawItem>& items,
-                                   const std::vector<LightGroup>& groups, const IndirectLightFrame* indirect) {
+ForwardRenderer::CameraView ForwardRenderer::camera_view(const Registry& registry, Entity camera) {
   const Camera& cam = registry.get<Camera>(camera);
   const glm::mat4& camera_now = registry.get<WorldTransform>(camera).matrix;
   if (unusable_world_matrix(camera_now) == nullptr) last_camera_world_ = camera_now;
   const glm::mat4& camera_world = last_camera_world_;
   const float aspect = cam.aspect > 0.0f ? cam.aspect : static_cast<float>(width_) / static_cast<float>(height_);
-  const glm::mat4 view_proj =
-      glm::perspective(cam.yfov_rad, aspect, cam.znear_m, cam.zfar_m) * glm::inverse(camera_world);
-  const glm::vec3 camera_position(camera_world[3]);
+  return {glm::perspective(cam.yfov_rad, aspect, cam.znear_m, cam.zfar_m) * glm::inverse(camera_world),
+          glm::vec3(camera_world[3])};
+}
+
+void ForwardRenderer::forward_pass(const CameraView& view, const std::vector<DrawItem>& items,
+                                   const std::vector<LightGroup>& groups, const IndirectLightFrame* indirect) {
+  const glm::mat4& view_proj = view.view_proj;
+  const glm::vec3& camera_position = view.position;
 
 
   glBindFramebuffer(GL_FRAMEBUFFER, hdr_fbo_.id());

@@ -128,6 +128,7 @@ class ForwardRenderer final : public Renderer {
   const std::vector<PassTiming>& last_timings() const override { return timings_; }
   int last_shadow_maps_rendered() const override { return shadow_maps_rendered_; }
   int last_shadow_maps_over_static_depth() const override { return shadow_maps_.last_cached_views(); }
+  int last_shadow_maps_unseen() const override { return shadow_maps_.last_unseen_views(); }
   int last_skipped_entities() const override { return skipped_entities_; }
   int last_light_groups() const override { return light_groups_; }
 
@@ -135,8 +136,15 @@ class ForwardRenderer final : public Renderer {
   void ensure_targets();
   std::vector<DrawItem> draw_items(const Registry& registry, std::vector<std::pair<Entity, const char*>>& skipped) const;
   void report_skipped(const Registry& registry, const std::vector<std::pair<Entity, const char*>>& skipped);
-  void forward_pass(const Registry& registry, Entity camera, const std::vector<DrawItem>& items,
-                    const std::vector<LightGroup>& groups, const IndirectLightFrame* indirect);
+  /// The camera's view-projection and position this frame (an unusable world matrix keeps
+  /// the last usable one).
+  struct CameraView {
+    glm::mat4 view_proj{1.0f};
+    glm::vec3 position{0.0f};
+  };
+  CameraView camera_view(const Registry& registry, Entity camera);
+  void forward_pass(const CameraView& view, const std::vector<DrawItem>& items, const std::vector<LightGroup>& groups,
+                    const IndirectLightFrame* indirect);
   const ShaderProgram& forward_program(const LightCounts& counts);
   const ShaderProgram& area_shadow_program(int pass, int area_lights);
   void area_shadow_passes(const glm::mat4& view_proj, const glm::vec3& camera_position, const std::vector<DrawItem>& items);

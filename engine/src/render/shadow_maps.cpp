@@ -1,6 +1,8 @@
 #include "render/shadow_maps.h"
 
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <utility>
 
 #include <GL/glcorearb.h>
@@ -51,6 +53,36 @@ void ShadowMaps::reserve(int map_size, int layers_2d, int cube_size, int cubes) 
 
 namespace {
 
+/// The 6 planes (a, b, c, d: inside where a x + b y + c z + d >= 0) of a view-projection's clip volume.
+std::array<glm::vec4, 6> clip_planes(const glm::mat4& m) {
+  const glm::vec4 r0(m[0][0], m[1][0], m[2][0], m[3][0]), r1(m[0][1], m[1][1], m[2][1], m[3][1]),
+      r2(m[0][2], m[1][2], m[2][2], m[3][2]), r3(m[0][3], m[1][3], m[2][3], m[3][3]);
+  return {r3 + r0, r3 - r0, r3 + r1, r3 - r1, r3 + r2, r3 - r2};
+}
+
+/// False when a perspective shadow view's volume, widened by a quarter of its half-width on
+/// each side (filter taps and a cube map's seamless filtering reach past a face's edge),
+/// lies wholly outside one of the camera's clip planes: no pixel the camera sees can look
+/// it up. Its corners: the eye (the near plane's corners, as close as it) and the far plane's.
+bool may_be_seen(const glm::mat4& view_proj, const std::array<glm::vec4, 6>& camera_planes) {
+  const glm::mat4 to_world = glm::inverse(view_proj);
+  glm::vec3 corners[8];
+  int n = 0;
+  for (const float z : {-1.0f, 1.0f})
+    for (const float x : {-1.25f, 1.25f})
+      for (const float y : {-1.25f, 1.25f}) {
+        const glm::vec4 w = to_world * glm::vec4(x, y, z, 1.0f);
+        if (!(std::abs(w.w) > 0.0f)) return true;
+        corners[n++] = glm::vec3(w) / w.w;
+      }
+  for (const glm::vec4& p : camera_planes) {
+    bool all_outside = true;
+    for (const glm::vec3& c : corners) all_outside = all_outside && glm::dot(glm::vec3(p), c) + p.w < 0.0f;
+    if (all_outside) return false;
+  }
+  return true;
+}
+
 bool same_view(const ShadowView& a, const ShadowView& b) {
   return a.view_proj == b.view_proj && a.eye == b.eye && a.axis == b.axis && a.far_m == b.far_m &&
          a.ortho == b.ortho && a.cube == b.cube && a.layer == b.layer;
@@ -63,7 +95,7 @@ bool ShadowMaps::LayerContent::operator==(const LayerContent& o) const {
 }
 
 int ShadowMaps::render(const std::vector<ShadowView>& views, const std::vector<DrawItem>& items,
-                       const GpuScene& scene, const ShaderProgram& program) {
+                       const GpuScene& scene, const ShaderProgram& program, const glm::mat4& camera_view_proj) {
   // Each view's content first: the casters whose world bounds are not wholly outside one
   // of its clip planes (they would be clipped whole, so culling them changes no texel),
   // split into static (StaticTag) and dynamic ones for the static depth cache below.
@@ -74,10 +106,7 @@ int ShadowMaps::render(const std::vector<ShadowView>& views, const std::vector<D
     const ShadowView& v = views[k];
     wanted[k].view = v;
     wanted_static[k].view = v;
-    const glm::mat4& m = v.view_proj;
-    const glm::vec4 r0(m[0][0], m[1][0], m[2][0], m[3][0]), r1(m[0][1], m[1][1], m[2][1], m[3][1]),
-        r2(m[0][2], m[1][2], m[2][2], m[3][2]), r3(m[0][3], m[1][3], m[2][3], m[3][3]);
-    const glm::vec4 planes[6] = {r3 + r0, r3 - r0, r3 + r1, r3 - r1, r3 + r2, r3 - r2};
+    const std::array<glm::vec4, 6> planes = clip_planes(v.view_proj);
     for (const DrawItem& item : items) {
       if (!item.cast_shadows) continue;
       const glm::vec3& lo = item.bounds.min;
@@ -97,10 +126,19 @@ int ShadowMaps::render(const std::vector<ShadowView>& views, const std::vector<D
     }
   }
   std::vector<std::size_t> stale;
+  const std::array<glm::vec4, 6> camera_planes = clip_planes(camera_view_proj);
+  unseen_views_ = 0;
   for (std::size_t k = 0; k < views.size(); ++k) {
     std::vector<LayerContent>& held = views[k].cube ? content_cube_ : content_2d_;
     const auto slot = static_cast<std::size_t>(views[k].layer);
     if (slot < held.size() && held[slot] == wanted[k]) continue;
+    // Only pixels the camera sees look a map up, so a stale view whose volume lies wholly
+    // outside the camera's is left as it is: its record still says what its texels hold, so
+    // it is drawn on the first frame the camera can see into it.
+    if (!views[k].ortho && !may_be_seen(views[k].view_proj, camera_planes)) {
+      ++unseen_views_;
+      continue;
+    }
     stale.push_back(k);
   }
   cached_views_ = 0;

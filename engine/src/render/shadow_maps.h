@@ -26,13 +26,17 @@ class ShadowMaps {
   /// static casters' depth in a second texture: it is copied back and only the dynamic
   /// casters are drawn (the same texels as drawing every caster). Returns the number of
   /// views rendered.
+  /// A view that would be drawn but whose volume the camera (`camera_view_proj`) cannot see
+  /// into is not drawn and is drawn when it can (last_unseen_views()).
   int render(const std::vector<ShadowView>& views, const std::vector<DrawItem>& items, const GpuScene& scene,
-             const ShaderProgram& program);
+             const ShaderProgram& program, const glm::mat4& camera_view_proj);
 
   std::uint32_t maps_2d() const { return maps_2d_.id(); }
   std::uint32_t cube_maps() const { return cube_maps_.id(); }
   /// Of the last render()'s views, those drawn over their cached static depth.
   int last_cached_views() const { return cached_views_; }
+  /// Of the last render()'s views that changed, those left undrawn: the camera cannot see into them.
+  int last_unseen_views() const { return unseen_views_; }
 
  private:
   /// What a layer holds: the view and its casters as last rendered.
@@ -51,6 +55,7 @@ class ShadowMaps {
   GlTexture static_2d_;    ///< Same size as maps_2d_, made on first use.
   GlTexture static_cube_;  ///< Same size as cube_maps_, made on first use.
   int cached_views_ = 0;
+  int unseen_views_ = 0;
   GlFramebuffer framebuffer_;
   int map_size_ = 0;
   int layers_2d_ = 0;
