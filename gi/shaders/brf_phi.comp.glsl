@@ -154,6 +154,14 @@ vec3 visibility_target(vec3 c, vec3 h, int i) {
                            (((i - 1) & 4) != 0) ? h.z : -h.z);
 }
 
+// One axis of a ray-box slab test: narrows [t0, t1] to where p + t d lies within [lo, hi]
+// along it (inv = 1 / d, |d| >= 1e-12); the order of the two crossings as the CPU twin swaps them.
+void clip_to_slab(float lo, float hi, float p, float inv, inout float t0, inout float t1) {
+  const float ta = (lo - p) * inv, tb = (hi - p) * inv;
+  t0 = max(t0, min(ta, tb));
+  t1 = min(t1, max(ta, tb));
+}
+
 // brf_weighted_visibility over brf_visibility_targets (brf_visibility.h): the cosine-weighted
 // fraction of the source's 9 target points (box centre, corners pulled to 0.7) that p sees,
 // a segment p -> target seen when it misses every box of the job's occluders (brf_segment_clear,
@@ -183,15 +191,7 @@ float occluded_visibility(BrfModel m, vec3 p, vec3 n, uint first, uint count) {
           miss = po[k] < lo[k] || po[k] > hi[k];
           continue;
         }
-        const float inv = 1.0 / d[k];
-        float ta = (lo[k] - po[k]) * inv, tb = (hi[k] - po[k]) * inv;
-        if (ta > tb) {
-          const float t = ta;
-          ta = tb;
-          tb = t;
-        }
-        t0 = max(t0, ta);
-        t1 = min(t1, tb);
+        clip_to_slab(lo[k], hi[k], po[k], 1.0 / d[k], t0, t1);
         miss = t0 > t1;
       }
       if (!miss) blocked |= 1u << uint(i);
@@ -220,15 +220,7 @@ float contact_visibility(BrfModel m, vec3 p, vec3 n) {
       if (p[k] < m.box_lo[k] || p[k] > m.box_hi[k]) return 1.0;
       continue;
     }
-    const float inv = 1.0 / n[k];
-    float ta = (m.box_lo[k] - p[k]) * inv, tb = (m.box_hi[k] - p[k]) * inv;
-    if (ta > tb) {
-      const float t = ta;
-      ta = tb;
-      tb = t;
-    }
-    t0 = max(t0, ta);
-    t1 = min(t1, tb);
+    clip_to_slab(m.box_lo[k], m.box_hi[k], p[k], 1.0 / n[k], t0, t1);
   }
   if (t0 > t1 || t1 < 0.0) return 1.0;
   if (t0 <= 0.0) return 0.0;

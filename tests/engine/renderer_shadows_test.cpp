@@ -266,6 +266,16 @@ bool same_pixels(const engine::ImageRgbaF& a, const engine::ImageRgbaF& b) {
   return a.width == b.width && a.height == b.height && a.pixels == b.pixels;
 }
 
+// The last frame of `r` equals what a fresh renderer draws of the same registry: every
+// shadow view drawn from scratch.
+void expect_same_as_fresh(engine::Renderer& r, OccluderScene& s, engine::Entity camera, const char* what) {
+  const engine::ImageRgbaF img = r.read_hdr();
+  auto fresh = make_renderer(s.assets, s.cam.size, kAmbient);
+  ASSERT_TRUE(fresh);
+  fresh->render(s.reg, camera);
+  EXPECT_TRUE(same_pixels(img, fresh->read_hdr())) << what;
+}
+
 // The two lights of the shadow-map caching tests: a spot (a 2-D map) and a point light (6 cube faces).
 void add_spot_and_point(engine::Registry& reg) {
   add_light(reg, engine::Light{.type = engine::LightType::Spot, .intensity = 10.0f, .outer_cone_rad = 0.7f},
@@ -329,13 +339,7 @@ TEST(RendererShadows, UnseenViewsAreDrawnWhenTheCameraTurnsToThem) {
   const engine::Entity camera = s.cam.add_to(s.reg);
   auto r = make_renderer(s.assets, s.cam.size, kAmbient);
   ASSERT_TRUE(r);
-  const auto matches_fresh = [&](const char* what) {
-    const engine::ImageRgbaF img = r->read_hdr();
-    auto fresh = make_renderer(s.assets, s.cam.size, kAmbient);
-    ASSERT_TRUE(fresh);
-    fresh->render(s.reg, camera);
-    EXPECT_TRUE(same_pixels(img, fresh->read_hdr())) << what;
-  };
+  const auto matches_fresh = [&](const char* what) { expect_same_as_fresh(*r, s, camera, what); };
   // Looking straight down at the floor from 3 m: the faces above the light are out of view.
   r->render(s.reg, camera);
   EXPECT_GT(r->last_shadow_maps_unseen(), 0);
@@ -369,13 +373,7 @@ TEST(RendererShadows, StaticDepthCacheDrawsWhatDrawingEveryCasterDraws) {
   const engine::Entity camera = s.cam.add_to(s.reg);
   auto r = make_renderer(s.assets, s.cam.size, kAmbient);
   ASSERT_TRUE(r);
-  const auto matches_fresh = [&](const char* what) {
-    const engine::ImageRgbaF img = r->read_hdr();
-    auto fresh = make_renderer(s.assets, s.cam.size, kAmbient);
-    ASSERT_TRUE(fresh);
-    fresh->render(s.reg, camera);
-    EXPECT_TRUE(same_pixels(img, fresh->read_hdr())) << what;
-  };
+  const auto matches_fresh = [&](const char* what) { expect_same_as_fresh(*r, s, camera, what); };
   r->render(s.reg, camera);
   EXPECT_EQ(r->last_shadow_maps_over_static_depth(), 0);
   const engine::ImageRgbaF first = r->read_hdr();

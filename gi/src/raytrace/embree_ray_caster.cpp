@@ -137,6 +137,22 @@ class EmbreeRayCaster final : public RayCaster {
     return r.tfar < 0.0f;
   }
 
+  /// Lane j of a 16-ray packet (intersect_many, occluded_coherent), its id j.
+  static void set_lane(RTCRay16& packet, std::size_t j, const RTCRay& r) {
+    packet.org_x[j] = r.org_x;
+    packet.org_y[j] = r.org_y;
+    packet.org_z[j] = r.org_z;
+    packet.tnear[j] = r.tnear;
+    packet.dir_x[j] = r.dir_x;
+    packet.dir_y[j] = r.dir_y;
+    packet.dir_z[j] = r.dir_z;
+    packet.time[j] = r.time;
+    packet.tfar[j] = r.tfar;
+    packet.mask[j] = r.mask;
+    packet.id[j] = static_cast<unsigned>(j);
+    packet.flags[j] = r.flags;
+  }
+
   // Packets of 16 (Embree's widest; it splits them on narrower machines): a stream whose
   // rays share an origin or run side by side traverses the tree once per packet. The same
   // watertight triangle test as rtcIntersect1, so the hits are the same.
@@ -152,19 +168,7 @@ class EmbreeRayCaster final : public RayCaster {
       const std::size_t n = std::min(kWidth, rays.size() - first);
       for (std::size_t j = 0; j < kWidth; ++j) {
         valid[j] = j < n ? -1 : 0;
-        const RTCRayHit rh = to_embree(rays[first + std::min(j, n - 1)]);
-        packet.ray.org_x[j] = rh.ray.org_x;
-        packet.ray.org_y[j] = rh.ray.org_y;
-        packet.ray.org_z[j] = rh.ray.org_z;
-        packet.ray.tnear[j] = rh.ray.tnear;
-        packet.ray.dir_x[j] = rh.ray.dir_x;
-        packet.ray.dir_y[j] = rh.ray.dir_y;
-        packet.ray.dir_z[j] = rh.ray.dir_z;
-        packet.ray.time[j] = rh.ray.time;
-        packet.ray.tfar[j] = rh.ray.tfar;
-        packet.ray.mask[j] = rh.ray.mask;
-        packet.ray.id[j] = static_cast<unsigned>(j);
-        packet.ray.flags[j] = rh.ray.flags;
+        set_lane(packet.ray, j, to_embree(rays[first + std::min(j, n - 1)]).ray);
         packet.hit.geomID[j] = RTC_INVALID_GEOMETRY_ID;
         packet.hit.instID[0][j] = RTC_INVALID_GEOMETRY_ID;
       }
@@ -207,19 +211,7 @@ class EmbreeRayCaster final : public RayCaster {
       const std::size_t n = std::min(kWidth, rays.size() - first);
       for (std::size_t j = 0; j < kWidth; ++j) {
         valid[j] = j < n ? -1 : 0;
-        const RTCRay r = to_embree(rays[first + std::min(j, n - 1)]).ray;
-        packet.org_x[j] = r.org_x;
-        packet.org_y[j] = r.org_y;
-        packet.org_z[j] = r.org_z;
-        packet.tnear[j] = r.tnear;
-        packet.dir_x[j] = r.dir_x;
-        packet.dir_y[j] = r.dir_y;
-        packet.dir_z[j] = r.dir_z;
-        packet.time[j] = r.time;
-        packet.tfar[j] = r.tfar;
-        packet.mask[j] = r.mask;
-        packet.id[j] = static_cast<unsigned>(j);
-        packet.flags[j] = r.flags;
+        set_lane(packet, j, to_embree(rays[first + std::min(j, n - 1)]).ray);
       }
       rtcOccluded16(valid, top_.h, &ctx, &packet);
       for (std::size_t j = 0; j < n; ++j) out[first + j] = packet.tfar[j] < 0.0f ? 1 : 0;
