@@ -43,7 +43,7 @@ struct RunOptions {
   bool verbose = false;
   bool only_written = false;  ///< Headless: render only the frames written to --out.
   std::string gi_bundle;      ///< Bake bundle (scene.gibake/) whose light atlas lights the scene; empty: stand-in.
-  std::vector<float> sky;     ///< --sky R,G,B: the scene's sky radiance (empty: the scene's own).
+  std::string sky;            ///< --sky: the sky replacing the scene's (engine::parse_sky_text; empty: the scene's own).
 };
 
 /// Everything a run needs after start-up checks: the simulation, and the session being

@@ -4,6 +4,7 @@
 //   gi_demo --headless --script push_crates --frames 600 --record s.girec --no-render
 //   gi_demo --headless --replay tests/sessions/push_crates.girec
 //   gi_demo --gi-bundle out/demo_level.gibake        light the static world with its bake (light atlas, PRM)
+#include <engine/sky.h>
 #include <gi/gi_system.h>
 
 #include <CLI/CLI.hpp>
@@ -140,10 +141,12 @@ int main(int argc, char** argv) {
                "Headless: render only the frames --out/--every write (fast golden and approval runs)");
   app.add_option("--gi-bundle", o.gi_bundle,
                  "Light the static world with the light atlas of this bake bundle (scene.gibake/)");
-  app.add_option("--sky", o.sky, "R,G,B: light the scene with a uniform sky of this radiance, W/(m^2 sr) (as gi-bake --sky)")
-      ->delimiter(',')
-      ->expected(3)
-      ->check(CLI::NonNegativeNumber);
+  app.add_option("--sky", o.sky,
+                 "Replace the scene's sky, as gi-bake --sky: R,G,B a uniform sky, or "
+                 "'zenith:R,G,B;horizon:R,G,B;ground:R,G,B' a gradient (W/(m^2 sr); docs/scene-format.md)")
+      ->check([](const std::string& text) {
+        return engine::parse_sky_text(text) ? std::string() : std::string("--sky wants ") + engine::kSkyTextUsage;
+      });
   app.add_flag("--verbose", o.verbose, "Headless: print the script's waypoints and the player's position each second");
   CLI11_PARSE(app, argc, argv);
   o.area_soft_shadows = area_shadows == "soft";
@@ -209,8 +212,11 @@ int main(int argc, char** argv) {
       state.record = std::move(s);
     }
   }
-  if (o.sky.size() == 3)  // before the renderer and the GI system read the scene
-    state.sim->scene().assets.environment.sky_radiance = glm::vec3(o.sky[0], o.sky[1], o.sky[2]);
+  if (!o.sky.empty()) {  // before the renderer and the GI system read the scene
+    const engine::SkyText sky = engine::parse_sky_text(o.sky).value();  // checked by the option
+    state.sim->scene().assets.environment.sky_radiance = sky.uniform;
+    state.sim->scene().assets.environment.sky_gradient = sky.gradient;
+  }
   const int status = o.headless ? run_headless(o, state) : run_windowed(o, state);
   if (!state.finish_recording(o.record_file)) return 1;
   if (state.replay && status == 0) {

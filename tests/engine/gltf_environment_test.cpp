@@ -202,3 +202,23 @@ TEST(GltfEnvironment, GradientSkyIrradianceFormulasMatchNumericIntegration) {
     EXPECT_NEAR(static_cast<double>(engine::sky_irradiance(uniform, g, {0, 1, 0})[c]), static_cast<double>(up[c]), 1e-4);
   }
 }
+
+// The command-line form of the sky (gi-bake, gi-reference and gi_demo --sky): either form
+// replaces the whole sky; anything malformed is refused.
+TEST(GltfEnvironment, SkyTextParsesBothFormsAndRefusesMalformedOnes) {
+  const auto uniform = engine::parse_sky_text("0.5,0.25,1");
+  ASSERT_TRUE(uniform);
+  EXPECT_EQ(uniform->uniform, glm::vec3(0.5f, 0.25f, 1.0f));
+  EXPECT_TRUE(uniform->gradient.empty());
+  const auto gradient = engine::parse_sky_text("ground:0.1,0.09,0.08;zenith:0.15,0.3,0.8;horizon:0.6,0.7,0.85");
+  ASSERT_TRUE(gradient);
+  EXPECT_EQ(gradient->uniform, glm::vec3(0.0f));
+  EXPECT_EQ(gradient->gradient.zenith, glm::vec3(0.15f, 0.3f, 0.8f));
+  EXPECT_EQ(gradient->gradient.horizon, glm::vec3(0.6f, 0.7f, 0.85f));
+  EXPECT_EQ(gradient->gradient.ground, glm::vec3(0.1f, 0.09f, 0.08f));
+  for (const char* bad : {"", "1,1", "1,1,1,1", "1,,1", "1,-1,1", "nan,1,1", "inf,1,1", "1,1,x", "zenith:1,1,1",
+                          "zenith:1,1,1;horizon:1,1,1", "zenith:1,1,1;horizon:1,1,1;ground:1,1,1;zenith:1,1,1",
+                          "zenith:1,1,1;horizon:1,1,1;sky:1,1,1", "zenith:1,1,1;horizon:1,1,1;ground:1,1",
+                          "zenith:1,1,1;horizon:1,1,1;ground:1,1,1;", "1,1,1;zenith:1,1,1"})
+    EXPECT_FALSE(engine::parse_sky_text(bad)) << "'" << bad << "'";
+}

@@ -40,13 +40,8 @@ std::optional<int> parse(CLI::App& app, std::string_view tool, int argc, char** 
 
 /// SIGINT and SIGTERM set the flag interrupted() reads (and restore the default action, so
 /// a second signal ends the process).
-/// `--sky R,G,B`: three finite radiances >= 0 (W/(m^2 sr)), else nothing.
-std::optional<glm::vec3> parse_sky(const std::string& text);
-
-/// `--sky` in either form, replacing the scene's sky (docs/scene-format.md):
-///   "R,G,B"                                        a uniform sky (parse_sky);
-///   "zenith:R,G,B;horizon:R,G,B;ground:R,G,B"      a gradient over the elevation (engine/sky.h),
-/// the three keys in any order, each once. False (env untouched) when malformed.
+/// `--sky` in either form (engine::parse_sky_text), replacing the scene's whole sky
+/// (docs/scene-format.md). False (env untouched) when malformed.
 bool set_sky(engine::Environment& env, const std::string& text);
 inline constexpr const char* kSkyUsage =
     "--sky wants R,G,B or 'zenith:R,G,B;horizon:R,G,B;ground:R,G,B': finite radiances >= 0";

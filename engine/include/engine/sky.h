@@ -11,6 +11,8 @@
 //   glm::vec3 l = engine::sky_radiance(uniform, g, glm::normalize(dir));
 
 #include <cmath>
+#include <optional>
+#include <string_view>
 
 #include <glm/glm.hpp>
 
@@ -72,5 +74,19 @@ inline glm::vec3 sky_irradiance(const glm::vec3& uniform, const SkyGradient& gra
   return pi * (uniform + gradient.horizon) + (gradient.zenith - gradient.horizon) * sky_kink_irradiance(t) +
          (gradient.ground - gradient.horizon) * sky_kink_irradiance(pi - t);
 }
+
+/// A sky as the command-line tools take it (`--sky` of gi-bake, gi-reference and gi_demo;
+/// docs/scene-format.md): "R,G,B" a uniform sky, or "zenith:R,G,B;horizon:R,G,B;ground:R,G,B"
+/// a gradient (the three keys in any order, each once); finite radiances >= 0, W/(m^2 sr).
+/// Either form replaces a scene's whole sky: the uniform form has no gradient, the gradient
+/// form no uniform part.
+struct SkyText {
+  glm::vec3 uniform{0.0f};
+  SkyGradient gradient;
+};
+/// Parses `text`; nullopt when it is malformed.
+std::optional<SkyText> parse_sky_text(std::string_view text);
+inline constexpr const char* kSkyTextUsage =
+    "R,G,B or 'zenith:R,G,B;horizon:R,G,B;ground:R,G,B': finite radiances >= 0, W/(m^2 sr)";
 
 }  // namespace engine
