@@ -76,6 +76,14 @@ layout(location = 61) uniform vec3 u_sky_gradient[3];
 // an ambient cube, +X +Y +Z faces and -X -Y -Z faces.
 layout(location = 64) uniform vec3 u_sky_visibility_pos;
 layout(location = 65) uniform vec3 u_sky_visibility_neg;
+// What this item's baked irradiance (u_indirect_mode 2) holds besides indirect light
+// (IndirectLightFrame::atlas_holds_*), so it is not drawn twice: bit 0 the sky's direct light
+// (no sky term here), bit 1 the direct light of the lights that do not move (GpuLight::flags.x:
+// those lights add nothing here).
+layout(location = 66) uniform int u_baked_direct;
+
+// 1 for a light drawn live on this item, 0 for one whose direct light its bake holds.
+float live(GpuLight light) { return (u_baked_direct & 2) != 0 ? 1.0 - light.flags.x : 1.0; }
 
 layout(binding = 0) uniform sampler2D u_base_color_texture;
 layout(binding = 1) uniform sampler2D u_metallic_roughness_texture;
@@ -110,18 +118,20 @@ void main() {
   vec3 to_light;
 #if POINT_LIGHTS > 0
   for (int i = 0; i < POINT_LIGHTS; ++i)
-    radiance += point_light_radiance(lights[i], s, to_light) * shadow_cube(lights[i], s.position, s.normal, to_light);
+    radiance += live(lights[i]) * point_light_radiance(lights[i], s, to_light) *
+                shadow_cube(lights[i], s.position, s.normal, to_light);
 #endif
 #if SPOT_LIGHTS > 0
   for (int k = 0; k < SPOT_LIGHTS; ++k) {
     const int i = POINT_LIGHTS + k;
-    radiance += spot_light_radiance(lights[i], s, to_light) * shadow_2d_point(lights[i], s.position, s.normal, to_light);
+    radiance += live(lights[i]) * spot_light_radiance(lights[i], s, to_light) *
+                shadow_2d_point(lights[i], s.position, s.normal, to_light);
   }
 #endif
 #if DIRECTIONAL_LIGHTS > 0
   for (int k = 0; k < DIRECTIONAL_LIGHTS; ++k) {
     const int i = POINT_LIGHTS + SPOT_LIGHTS + k;
-    radiance += directional_light_radiance(lights[i], s, to_light) *
+    radiance += live(lights[i]) * directional_light_radiance(lights[i], s, to_light) *
                 (lights[i].radiant.w > 0.0 ? shadow_2d_disc(lights[i], s.position, s.normal, to_light)  // the sun's disc
                                            : shadow_2d(lights[i], s.position, s.normal, to_light, 1.0, false));
   }
@@ -130,7 +140,7 @@ void main() {
   for (int k = 0; k < AREA_LIGHTS; ++k) {
     const int i = POINT_LIGHTS + SPOT_LIGHTS + DIRECTIONAL_LIGHTS + k;
     to_light = normalize(lights[i].position_type.xyz - s.position);
-    radiance += area_light_radiance(lights[i], s) *
+    radiance += live(lights[i]) * area_light_radiance(lights[i], s) *
 #if AREA_SHADOW_HALF
                 texelFetch(u_area_visibility, ivec2(gl_FragCoord.xy), 0)[int(lights[i].shadow_params.z)];
 #elif AREA_SOFT_SHADOWS
@@ -145,19 +155,21 @@ void main() {
   // light is (E / pi x directional albedo). Both halves of a split view. A gradient adds its
   // irradiance at this normal, E / pi as a uniform radiance (engine::sky_irradiance:
   // E = pi horizon + (zenith - horizon) K(t) + (ground - horizon) K(pi - t), t = acos(n.y),
-  // K(t) = 2/3 ((pi - t) cos t + sin t)). Unshadowed on static surfaces; on a dynamic entity
-  // scaled by the provider's measured sky visibility.
+  // K(t) = 2/3 ((pi - t) cos t + sin t)). On a dynamic entity scaled by the provider's
+  // measured sky visibility; none where the item's bake holds the sky (shadowed by the level).
 #if SKY_TERM
-  float sky_t = acos(clamp(s.normal.y, -1.0, 1.0));
-  float sky_k_up = (2.0 / 3.0) * ((PI - sky_t) * cos(sky_t) + sin(sky_t));
-  float sky_k_down = (2.0 / 3.0) * (sky_t * cos(PI - sky_t) + sin(sky_t));
-  vec3 sky_l = u_sky_radiance + max(u_sky_gradient[0] + (u_sky_gradient[1] * sky_k_up + u_sky_gradient[2] * sky_k_down) / PI,
-                                    vec3(0.0));
-  vec3 n2 = s.normal * s.normal;
-  sky_l *= dot(n2, mix(u_sky_visibility_neg, u_sky_visibility_pos, step(vec3(0.0), s.normal)));
-  if (any(greaterThan(sky_l, vec3(0.0)))) {
-    GltfBrdfValue sky_albedo = gltf_directional_albedo(s.brdf, dot(s.normal, s.view));
-    radiance += sky_l * (sky_albedo.diffuse + sky_albedo.specular);
+  if ((u_baked_direct & 1) == 0) {
+    float sky_t = acos(clamp(s.normal.y, -1.0, 1.0));
+    float sky_k_up = (2.0 / 3.0) * ((PI - sky_t) * cos(sky_t) + sin(sky_t));
+    float sky_k_down = (2.0 / 3.0) * (sky_t * cos(PI - sky_t) + sin(sky_t));
+    vec3 sky_l = u_sky_radiance + max(u_sky_gradient[0] + (u_sky_gradient[1] * sky_k_up + u_sky_gradient[2] * sky_k_down) / PI,
+                                      vec3(0.0));
+    vec3 n2 = s.normal * s.normal;
+    sky_l *= dot(n2, mix(u_sky_visibility_neg, u_sky_visibility_pos, step(vec3(0.0), s.normal)));
+    if (any(greaterThan(sky_l, vec3(0.0)))) {
+      GltfBrdfValue sky_albedo = gltf_directional_albedo(s.brdf, dot(s.normal, s.view));
+      radiance += sky_l * (sky_albedo.diffuse + sky_albedo.specular);
+    }
   }
 #endif
 

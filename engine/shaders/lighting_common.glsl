@@ -13,7 +13,7 @@ const int LIGHT_SPOT = 1;
 const int LIGHT_DIRECTIONAL = 2;
 const int LIGHT_AREA = 3;
 
-// Mirrors engine/src/render/gpu_light.h (std430, 192 bytes).
+// Mirrors engine/src/render/gpu_light.h (std430, 208 bytes).
 struct GpuLight {
   vec4 position_type;     // xyz: world position (m); w: LIGHT_* type
   vec4 direction_range;   // xyz: unit emission direction (the light's -Z); w: range (m), 0 = unlimited
@@ -24,6 +24,7 @@ struct GpuLight {
   mat4 shadow_view_proj;  // world -> clip of the 2-D shadow map
   vec4 shadow_eye;        // xyz: shadow camera position (m); w: far distance that maps to depth 1 (m)
   vec4 shadow_params;     // x: 0 ortho / 1 distance; y: texel footprint (m, or m per m of distance); z: area lights: index among them; w: area lights: texel footprint of the cube map (cone.w) beyond the 2-D map
+  vec4 flags;             // x: 1 when the light does not move (Light::moves false): a bake may hold its direct light
 };
 
 layout(std430, binding = 0) readonly buffer Lights { GpuLight lights[]; };

@@ -1,6 +1,8 @@
 // The renderer's sky term (RenderSettings::sky_radiance / sky_gradient, docs/scene-format.md):
 // a gradient sky lights an upward plane with its analytic irradiance, and a provider's sky visibility (IndirectLightFrame::sky_visibility) darkens the sky
-// term of a dynamic entity and of nothing else.
+// term of a dynamic entity and of nothing else. A provider whose atlas holds the sky, or the
+// static lights' direct light (IndirectLightFrame::atlas_holds_*), replaces those terms on the
+// static surfaces that read it, and on nothing else: nothing is drawn twice.
 #define GL_GLEXT_PROTOTYPES 1
 #include <GL/glcorearb.h>
 #include <engine/gltf_brdf.h>
@@ -85,6 +87,80 @@ TEST(RendererSky, ProviderSkyVisibilityDarkensOnlyTheDynamicEntity) {
   const float open = 1.0f * s.albedo_at(1.2f);  // L x directional albedo
   EXPECT_NEAR(red(img, s.cam.pixel_of({-1.2f, 0, 0})), open, 0.01f * open) << "static: unoccluded";
   EXPECT_NEAR(red(img, s.cam.pixel_of({1.2f, 0, 0})), 0.25f * open, 0.01f * open) << "dynamic: its +Y visibility";
+  EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
+}
+
+// A provider whose irradiance atlas is one texel of irradiance `e` (W/m^2) read by every
+// static mesh (the planes have no TEXCOORD_1: all read texel 0).
+class UniformAtlas : public engine::IndirectLightProvider {
+ public:
+  explicit UniformAtlas(glm::vec3 e) {
+    glCreateTextures(GL_TEXTURE_2D, 1, &texture_);
+    glTextureStorage2D(texture_, 1, GL_RGBA32F, 1, 1);
+    const float texel[4] = {e.x, e.y, e.z, 1.0f};
+    glTextureSubImage2D(texture_, 0, 0, 0, 1, 1, GL_RGBA, GL_FLOAT, texel);
+    frame_.irradiance_atlas_texture = texture_;
+  }
+  ~UniformAtlas() override { glDeleteTextures(1, &texture_); }
+  UniformAtlas(const UniformAtlas&) = delete;
+  UniformAtlas& operator=(const UniformAtlas&) = delete;
+  const engine::IndirectLightFrame& frame() override { return frame_; }
+  const char* label() const override { return "test uniform atlas"; }
+  engine::IndirectLightFrame frame_;
+
+ private:
+  GLuint texture_ = 0;
+};
+
+TEST(RendererSky, AnAtlasThatHoldsTheSkyReplacesTheSkyTermOnStaticSurfacesOnly) {
+  engine::GpuContext ctx = headless_context();
+  TwoPlanes s;
+  s.assets.environment.sky_radiance = glm::vec3(1.0f);
+  auto r = make_renderer(s.assets, s.cam.size, 0.0f);
+  ASSERT_NE(r, nullptr);
+  const float baked = 0.8f;  // W/m^2: the sky's shadowed irradiance, as a bake would hold it
+  UniformAtlas atlas{glm::vec3(baked)};
+  r->set_indirect_light(&atlas);
+  const float open = 1.0f * s.albedo_at(1.2f);  // the sky term: L x directional albedo
+  const float from_atlas = baked / kPi * s.albedo_at(1.2f);
+  r->render(s.reg, s.camera);
+  engine::ImageRgbaF img = r->read_hdr();
+  EXPECT_NEAR(red(img, s.cam.pixel_of({-1.2f, 0, 0})), open + from_atlas, 0.01f * open) << "static, atlas of indirect light only";
+  atlas.frame_.atlas_holds_sky = true;
+  r->render(s.reg, s.camera);
+  img = r->read_hdr();
+  EXPECT_NEAR(red(img, s.cam.pixel_of({-1.2f, 0, 0})), from_atlas, 0.01f * from_atlas) << "static: the atlas's sky alone";
+  EXPECT_NEAR(red(img, s.cam.pixel_of({1.2f, 0, 0})), open, 0.01f * open) << "dynamic: reads no atlas, keeps the sky term";
+  EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
+}
+
+// A static light (moves false) and a moving one, 1 m above the two planes. With an atlas that
+// holds the static lights' direct light, a static plane is lit by the moving light alone (the
+// atlas, 0 here, stands for the rest); the dynamic plane by both, as without the flag.
+TEST(RendererSky, AnAtlasThatHoldsTheStaticLightsLeavesOnlyMovingLightsLiveOnStaticSurfaces) {
+  engine::GpuContext ctx = headless_context();
+  TwoPlanes s;
+  engine::Light fixed{.type = engine::LightType::Point, .intensity = 2.0f, .cast_shadows = false};
+  engine::Light moving{.type = engine::LightType::Point, .intensity = 1.0f, .moves = true, .cast_shadows = false};
+  const engine::Entity fixed_light = add_light(s.reg, fixed, {0.0f, 1.0f, 0.3f}, {0.0f, 0.0f, 0.3f});
+  add_light(s.reg, moving, {0.0f, 1.0f, -0.3f}, {0.0f, 0.0f, -0.3f});
+  auto r = make_renderer(s.assets, s.cam.size, 0.0f);
+  ASSERT_NE(r, nullptr);
+  UniformAtlas atlas{glm::vec3(0.0f)};
+  r->set_indirect_light(&atlas);
+  const glm::ivec2 on_static = s.cam.pixel_of({-1.2f, 0, 0}), on_dynamic = s.cam.pixel_of({1.2f, 0, 0});
+  r->render(s.reg, s.camera);
+  const engine::ImageRgbaF both = r->read_hdr();
+  s.reg.write<engine::Light>(fixed_light).enabled = false;
+  r->render(s.reg, s.camera);
+  const engine::ImageRgbaF moving_only = r->read_hdr();
+  s.reg.write<engine::Light>(fixed_light).enabled = true;
+  atlas.frame_.atlas_holds_static_lights = true;
+  r->render(s.reg, s.camera);
+  const engine::ImageRgbaF held = r->read_hdr();
+  ASSERT_GT(red(both, on_static), 1.5f * red(moving_only, on_static)) << "the static light must matter";
+  EXPECT_NEAR(red(held, on_static), red(moving_only, on_static), 1e-5f) << "static: the moving light alone";
+  EXPECT_NEAR(red(held, on_dynamic), red(both, on_dynamic), 1e-5f) << "dynamic: both lights live";
   EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
 }
 

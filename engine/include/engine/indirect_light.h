@@ -18,6 +18,16 @@ struct IndirectLightFrame {
   /// TEXCOORD_1 of static meshes. Shading reflects it as uniformly arriving light:
   /// E/pi x the BRDF's directional albedo (engine/gltf_brdf.h).
   std::uint32_t irradiance_atlas_texture = 0;
+  /// What the irradiance atlas holds besides indirect light, so that nothing is drawn twice
+  /// on the static surfaces that read it (docs/scene-format.md, "What is baked and what is
+  /// drawn live"):
+  ///   atlas_holds_sky            the sky's direct light, shadowed by the static world: the
+  ///                              renderer adds no sky term (RenderSettings::sky_radiance) there;
+  ///   atlas_holds_static_lights  the direct light of every light that does not move
+  ///                              (Light::moves false): those lights add nothing there.
+  /// Dynamic meshes keep the sky term (scaled by sky_visibility) and every light.
+  bool atlas_holds_sky = false;
+  bool atlas_holds_static_lights = false;
   /// Per-vertex indirect irradiance of a dynamic mesh entity: an SSBO of vec4 (W/m^2 in
   /// xyz), one per vertex of the entity's mesh, primitives concatenated in order.
   /// Returns 0 when the entity has none.
@@ -68,8 +78,8 @@ struct IndirectLightFrame {
   int directional_bin_count = 0;
   int directional_element_count = 0;
 
-  /// Optional sky occlusion of a dynamic mesh entity (the sky is drawn as unshadowed ambient
-  /// light, RenderSettings::sky_radiance): the share (0..1) of the sky's unoccluded
+  /// Optional sky occlusion of a dynamic mesh entity (the renderer draws the sky on dynamic
+  /// meshes as ambient light, RenderSettings::sky_radiance): the share (0..1) of the sky's unoccluded
   /// irradiance a surface facing +X, -X, +Y, -Y, +Z, -Z gets at the entity, an ambient cube
   /// the provider measured. The renderer scales the entity's sky term by it, blended by the
   /// normal's squared components. False: not provided (unoccluded).

@@ -91,11 +91,12 @@ struct RenderSettings {
   /// (tools/perf-report.sh runs it beside the full frame; docs/performance-frame.md).
   bool flat_shading = false;
   /// The scene's sky (SceneAsset::environment.sky_radiance, W/(m^2 sr); Renderer::create
-  /// copies it from the assets). Drawn as direct light: an ambient term without sky
-  /// visibility, E = pi x radiance reflected as uniformly arriving light is, on both halves
-  /// of a split view. Its shadowed share and its bounces come from the indirect provider
-  /// (a light atlas baked with the sky). Pixels no geometry covers show it (the background).
-  /// docs/scene-format.md.
+  /// copies it from the assets). Pixels no geometry covers show it (the background). On
+  /// surfaces whose baked irradiance holds the sky (IndirectLightFrame::atlas_holds_sky: the
+  /// static world under a GI bundle) it comes from the bake, shadowed by the level, and is
+  /// not drawn again; elsewhere it is drawn as direct light, an ambient term E = pi x
+  /// radiance reflected as uniformly arriving light is, scaled on dynamic meshes by the
+  /// provider's sky visibility (unoccluded without one). docs/scene-format.md.
   glm::vec3 sky_radiance{0.0f};
   /// The sky's gradient over the elevation, added to sky_radiance (engine/sky.h;
   /// SceneAsset::environment.sky_gradient, copied by Renderer::create). Its ambient term is

@@ -371,6 +371,10 @@ void ForwardRenderer::forward_pass(const CameraView& view, const std::vector<Dra
           glUniform3f(64, axes[0], axes[2], axes[4]);
           glUniform3f(65, axes[1], axes[3], axes[5]);
         }
+        // What the atlas this item reads holds besides indirect light (not drawn again here).
+        const bool baked = mode == kIndirectAtlas;
+        glUniform1i(66, (baked && indirect->atlas_holds_sky ? 1 : 0) |
+                            (baked && indirect->atlas_holds_static_lights ? 2 : 0));
         if (vertex_buffer != 0) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kVertexIrradianceBinding, vertex_buffer);
         // Per-vertex view-dependent indirect light (IndirectLightFrame::vertex_radiance_lobes).
         IndirectLightFrame::VertexRadianceLobes lobes;

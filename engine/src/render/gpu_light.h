@@ -17,7 +17,8 @@ struct GpuLight {
   glm::mat4 shadow_view_proj{1.0f};  ///< world -> clip of the 2-D shadow map
   glm::vec4 shadow_eye{0.0f, 0.0f, 0.0f, 1.0f};  ///< shadow eye (m), w far (m)
   glm::vec4 shadow_params{0.0f};     ///< x 0 ortho / 1 distance, y texel footprint, z area: index among area lights, w area: texel footprint of its grazing-band cube map
+  glm::vec4 flags{0.0f};             ///< x 1: the light does not move (Light::moves false), so a bake may hold its direct light
 };
-static_assert(sizeof(GpuLight) == 192, "GpuLight must match the std430 layout of lighting_common.glsl");
+static_assert(sizeof(GpuLight) == 208, "GpuLight must match the std430 layout of lighting_common.glsl");
 
 }  // namespace engine::render

@@ -93,6 +93,7 @@ LightList collect_lights(const Registry& registry, const SceneBounds& bounds, co
     g.position_type = glm::vec4(position, 0.0f);
     g.direction_range = glm::vec4(dir, light.range_m);
     g.radiant = glm::vec4(light.color * light.intensity, 0.0f);
+    g.flags.x = light.moves ? 0.0f : 1.0f;
     if (light.type == LightType::Directional && light.angular_radius_rad > 0.0f)  // the sun's disc
       g.radiant.w = std::tan(std::min(light.angular_radius_rad, 0.7853982f));
     g.cone = glm::vec4(std::cos(light.outer_cone_rad), std::cos(std::min(light.inner_cone_rad, light.outer_cone_rad)),
