@@ -67,7 +67,9 @@ int main(int argc, char** argv) {
   app.add_option("--dlm-directions", o.dlm_directions, "Override the DLM's direction count")
       ->check(CLI::Range(8, 256));
   app.add_option("--dlm-photons", o.dlm_photons, "Override the DLM's photon paths")->check(CLI::PositiveNumber);
-  app.add_flag("--include-direct", o.include_direct, "Store direct + indirect irradiance (default: indirect only)");
+  app.add_flag("--include-direct", o.include_direct,
+               "Bake the static lights' direct light into the atlas too (the renderer then draws none of theirs on "
+               "the static world); without it the atlas holds the indirect light and the sky's shadowed direct light");
   app.add_option("--threads", o.threads, "Worker threads (0: all); the result does not depend on it");
   app.add_option("--seed", o.seed, "Random seed");
   // Distributed bakes (docs/distributed-bake.md).

@@ -42,7 +42,12 @@ struct BakeOptions {
   int brf_spheres = 0;                     ///< BRF: field spheres.
   int dlm_directions = 0;                  ///< DLM: directions in the global set (8..256).
   std::uint64_t dlm_photons = 0;           ///< DLM: photon paths.
-  bool include_direct = false;             ///< Light atlas: store direct + indirect (default: indirect only).
+  /// Light atlas: also hold the static lights' direct light (the renderer then draws none
+  /// of theirs on the static world). Without it the atlas holds the indirect light and the
+  /// direct light the renderer does not draw: the sky's, shadowed by the level, and that of
+  /// emissive surfaces no light stands for (docs/scene-format.md, "What is baked and what is
+  /// drawn live").
+  bool include_direct = false;
   std::vector<std::string> moving_lights;  ///< Lights (by name) the game moves although not flagged (PlanOptions).
   unsigned threads = 0;                    ///< Worker threads; 0: all hardware threads. Does not change the result.
   std::uint64_t seed = 1;

@@ -14,7 +14,7 @@ namespace gi {
 namespace {
 
 constexpr BlobMagic kShardMagic{"GISHARD1"};
-constexpr std::uint32_t kShardVersion = 1;
+constexpr std::uint32_t kShardVersion = 2;  // 2: the light atlas's baked_direct
 constexpr std::uint8_t kHasAtlas = 1, kHasPrm = 2, kHasAntiradiance = 4;
 
 bool ascending(const std::vector<std::uint32_t>& v) {
@@ -42,6 +42,7 @@ engine::Status write_shard_file(const std::filesystem::path& path, const ShardFi
     w.put_array(a.texels);
     w.put_array(a.indirect);
     w.put_array(a.direct);
+    w.put_array(a.baked_direct);
     w.put_array(a.hidden);
     w.put(a.shared_rays);
     w.put(a.own_rays);
@@ -80,8 +81,8 @@ engine::Result<ShardFile> read_shard_file(const std::filesystem::path& path) {
   complete = complete && r.get(parts);
   if (complete && (parts & kHasAtlas)) {
     LightAtlasShardPart a;
-    complete = r.get_array(a.texels) && r.get_array(a.indirect) && r.get_array(a.direct) && r.get_array(a.hidden) &&
-               r.get(a.shared_rays) && r.get(a.own_rays);
+    complete = r.get_array(a.texels) && r.get_array(a.indirect) && r.get_array(a.direct) &&
+               r.get_array(a.baked_direct) && r.get_array(a.hidden) && r.get(a.shared_rays) && r.get(a.own_rays);
     f.atlas = std::move(a);
   }
   if (complete && (parts & kHasPrm)) {
@@ -110,10 +111,12 @@ engine::Result<ShardFile> read_shard_file(const std::filesystem::path& path) {
   if (f.atlas) {
     const LightAtlasShardPart& a = *f.atlas;
     const std::size_t n = a.texels.size();
-    if (a.indirect.size() != n || a.direct.size() != n || a.hidden.size() != n || !ascending(a.texels))
+    if (a.indirect.size() != n || a.direct.size() != n || a.baked_direct.size() != n || a.hidden.size() != n ||
+        !ascending(a.texels))
       return engine::Error{path.string(), "light atlas", "texel arrays differ in size or are not ascending"};
     for (std::size_t k = 0; k < n; ++k)
-      if (!engine::all_finite(a.indirect[k]) || !engine::all_finite(a.direct[k]) || a.hidden[k] > 1)
+      if (!engine::all_finite(a.indirect[k]) || !engine::all_finite(a.direct[k]) ||
+          !engine::all_finite(a.baked_direct[k]) || a.hidden[k] > 1)
         return engine::Error{path.string(), "light atlas", "texel " + std::to_string(a.texels[k]) + " is not finite"};
   }
   if (f.prm) {

@@ -138,6 +138,10 @@ engine::Result<VplPowers> light_vpls(const BakeScene& b, const VplSet& vpls, con
 
 int dilation_rings(const AtlasLayout& layout) { return std::max(4, layout.padding_texels); }
 
+// Sky rays per texel of the VPL final shooting's baked direct light (the gather presets
+// count the sky on their own solve and gather rays instead).
+constexpr int kVplSkyRays = 64;
+
 }  // namespace
 
 namespace {
@@ -166,6 +170,7 @@ engine::Result<TexelGatherResult> assemble_parts(const AtlasTexels& texels,
   TexelGatherResult out;
   out.indirect.assign(n, glm::vec3(0.0f));
   out.direct.assign(n, glm::vec3(0.0f));
+  out.baked_direct.assign(n, glm::vec3(0.0f));
   out.hidden.assign(n, 0);
   const auto count = static_cast<std::uint32_t>(parts.size());
   for (std::uint32_t i = 0; i < count; ++i) {
@@ -175,12 +180,13 @@ engine::Result<TexelGatherResult> assemble_parts(const AtlasTexels& texels,
     for (std::size_t w = 0; w < work.size(); ++w)
       if (shard.owns(w)) expected.push_back(work[w]);
     if (p.texels != expected || p.indirect.size() != expected.size() || p.direct.size() != expected.size() ||
-        p.hidden.size() != expected.size())
+        p.baked_direct.size() != expected.size() || p.hidden.size() != expected.size())
       return engine::Error{.message = "light-atlas shard " + std::to_string(i) + " of " + std::to_string(count) +
                                       ": its texels are not that shard's texels of this scene's atlas"};
     for (std::size_t k = 0; k < expected.size(); ++k) {
       out.indirect[expected[k]] = p.indirect[k];
       out.direct[expected[k]] = p.direct[k];
+      out.baked_direct[expected[k]] = p.baked_direct[k];
       out.hidden[expected[k]] = p.hidden[k];
     }
     out.own_rays += p.own_rays;
@@ -241,6 +247,7 @@ engine::Result<LightAtlasBake> bake_light_atlas_run(const BakeInput& input, cons
       p.texels.push_back(i);
       p.indirect.push_back(gathered->indirect[i]);
       p.direct.push_back(gathered->direct[i]);
+      p.baked_direct.push_back(gathered->baked_direct[i]);
       p.hidden.push_back(gathered->hidden[i]);
     }
     p.shared_rays = gathered->shared_rays;
@@ -283,7 +290,8 @@ engine::Result<LightAtlasBake> bake_light_atlas_run(const BakeInput& input, cons
     // area-weighted mean of the total irradiance at their sample points' texels, instead of
     // a VPL solution of their own (steps 2-3 cost more than the gather at 1000+ VPLs).
     std::vector<glm::vec3> total(out.irradiance.size());
-    for (std::size_t t = 0; t < total.size(); ++t) total[t] = out.irradiance[t] + gathered->direct[t];
+    for (std::size_t t = 0; t < total.size(); ++t)
+      total[t] = out.irradiance[t] + gathered->direct[t] + gathered->baked_direct[t];
     const std::vector<glm::vec3> at_samples =
         irradiance_at_points(b.texels, total, out.layout.texels_per_metre, out.vpls.sample_position,
                              out.vpls.sample_normal);
@@ -297,8 +305,12 @@ engine::Result<LightAtlasBake> bake_light_atlas_run(const BakeInput& input, cons
       }
       if (area > 0.0) out.vpl_power[j] = out.vpls.albedo[j] * out.vpls.area_m2[j] * glm::vec3(sum / area);
     }
-    if (settings.include_direct)
-      for (std::size_t t = 0; t < out.irradiance.size(); ++t) out.irradiance[t] += gathered->direct[t];
+    // The atlas holds what the renderer does not draw (the sky, unlit emitters), and with
+    // include_direct the static lights' direct light too.
+    for (std::size_t t = 0; t < out.irradiance.size(); ++t) {
+      out.irradiance[t] += gathered->baked_direct[t];
+      if (settings.include_direct) out.irradiance[t] += gathered->direct[t];
+    }
     out.stats.final_seconds = seconds_since(t0) - gathered->direct_seconds;
   } else {
     auto powers = light_vpls(b, out.vpls, settings, pool, &out.stats);
@@ -319,11 +331,19 @@ engine::Result<LightAtlasBake> bake_light_atlas_run(const BakeInput& input, cons
     if (!final_result) return final_result.error();
     out.irradiance = std::move(final_result->irradiance);
     rays += final_result->rays;
-    if (settings.include_direct) {
-      const float texel_area = 1.0f / (out.layout.texels_per_metre * out.layout.texels_per_metre);
-      const std::vector<glm::vec3> direct =
-          direct_into_atlas(b.emitters, b.texels, texel_area, *b.caster, pool, &rays);
-      for (std::size_t t = 0; t < direct.size(); ++t) out.irradiance[t] += direct[t];
+    // The direct light the renderer does not draw (the sky's, and that of emitters no light
+    // stands for), and with include_direct every emitter's.
+    std::vector<PointEmitter> unlit;
+    for (const PointEmitter& e : b.emitters)
+      if (!e.drawn_live) unlit.push_back(e);
+    const float texel_area = 1.0f / (out.layout.texels_per_metre * out.layout.texels_per_metre);
+    const std::vector<glm::vec3> direct =
+        direct_into_atlas(settings.include_direct ? b.emitters : unlit, b.texels, texel_area, *b.caster, pool, &rays);
+    for (std::size_t t = 0; t < direct.size(); ++t) out.irradiance[t] += direct[t];
+    if (engine::sky_lit(b.scene.sky_radiance, b.scene.sky_gradient)) {
+      auto sky = sky_direct_light(b, out.layout, kVplSkyRays, settings.seed, pool);
+      if (!sky) return sky.error();
+      for (std::size_t t = 0; t < direct.size(); ++t) out.irradiance[t] += (*sky)[t];
     }
     out.stats.final_seconds = seconds_since(t0);
   }

@@ -46,7 +46,11 @@ struct LightAtlasSettings {
   /// the largest power after direct lighting (paper §3.3's threshold).
   float unshot_threshold = 1e-4f;
   int area_light_samples = 64;  ///< Point samples per area light or emissive triangle (>= 1).
-  bool include_direct = false;  ///< Add direct irradiance to the atlas (default: indirect only).
+  /// The atlas always holds the indirect light and the direct light the renderer does not
+  /// draw (the sky's, shadowed by the level, and emitters no light stands for); true adds
+  /// the static lights' direct light too (the renderer then draws none of theirs on the
+  /// static surfaces that read the atlas).
+  bool include_direct = false;
   /// How step 4 fills the texels. VplShooting: the paper's final shooting (texels x VPLs
   /// shadow rays). TexelGather: a final gather from every texel (texel_gather.h; `gather`
   /// holds its knobs, its seed and progress are this struct's); the VPL solution of steps
@@ -90,8 +94,11 @@ struct LightAtlasBake {
   int width = 0;
   int height = 0;
   /// Irradiance per texel (W/m^2, linear RGB), texel (x, y) at y * width + x, dilated into
-  /// the chart gutters so bilinear reads inside a chart never see empty texels. Indirect
-  /// only unless settings.include_direct.
+  /// the chart gutters so bilinear reads inside a chart never see empty texels: the
+  /// indirect light plus the direct light the renderer does not draw (the sky, shadowed by
+  /// the static world; emissive surfaces no light stands for), plus the static lights'
+  /// direct light when settings.include_direct (docs/scene-format.md, "What is baked and
+  /// what is drawn live").
   std::vector<glm::vec3> irradiance;
   std::vector<std::uint8_t> valid;  ///< Texels a triangle covers.
   LightAtlasSettings settings;
@@ -114,7 +121,8 @@ engine::Result<LightAtlasBake> bake_light_atlas(const BakeInput& input, const Li
 struct LightAtlasShardPart {
   std::vector<std::uint32_t> texels;   ///< Atlas texel indices, ascending.
   std::vector<glm::vec3> indirect;     ///< Per texel of `texels`: steps 2-3's irradiance.
-  std::vector<glm::vec3> direct;       ///< Per texel of `texels`: step 1 (sky included).
+  std::vector<glm::vec3> direct;       ///< Per texel of `texels`: TexelGatherResult::direct.
+  std::vector<glm::vec3> baked_direct; ///< Per texel of `texels`: TexelGatherResult::baked_direct (unfiltered).
   std::vector<std::uint8_t> hidden;    ///< Per texel of `texels`.
   std::uint64_t shared_rays = 0;       ///< Rays of steps 1-2 (the same in every shard).
   std::uint64_t own_rays = 0;          ///< Rays of step 3 for `texels`.
@@ -139,7 +147,8 @@ struct LightAtlasUpdateStats {
 /// Recomputes the VPL solution under the input's current lights, then re-shoots into the
 /// atlas only the differences E_new - E_old of VPLs whose change exceeds
 /// `relative_threshold` x the largest new VPL power. Threshold 0 reproduces a full re-bake
-/// up to float rounding.
+/// up to float rounding. The direct light the atlas holds of the sky and of unlit emitters
+/// is left as baked: an update is for the static lights' settings, not the sky's.
 engine::Result<LightAtlasUpdateStats> update_light_atlas(const BakeInput& input, LightAtlasBake& previous,
                                                          float relative_threshold);
 

@@ -29,6 +29,10 @@ json settings_json(const LightAtlasSettings& s) {
               {"seed", s.seed}};
 }
 
+// What direct light the atlas holds (light_atlas.h, LightAtlasBake::irradiance): "unlit" the
+// sky's and that of emitters no light stands for; "all" every static source's.
+std::string direct_light_name(const LightAtlasSettings& s) { return s.include_direct ? "all" : "unlit"; }
+
 json stats_json(const LightAtlasStats& s) {
   return json{{"vpls", s.vpls},
               {"sample_points", s.sample_points},
@@ -51,7 +55,7 @@ LightAtlasStats read_stats(JsonFields& f) {
 
 // What the manifest entry says about the files and the layout.
 struct EntryInfo {
-  std::string exr_file, exr_checksum, vpls_file, vpls_checksum, lights_hash;
+  std::string exr_file, exr_checksum, vpls_file, vpls_checksum, lights_hash, direct_light;
   float requested_texels_per_metre = 0.0f;
   float texels_per_metre = 0.0f;
   int padding_texels = 0;
@@ -68,6 +72,8 @@ engine::Result<EntryInfo> read_entry(const fs::path& manifest_file, const json& 
   e.vpls_file = f.get<std::string>("files.vpls.file");
   e.vpls_checksum = f.get<std::string>("files.vpls.xxh3_64");
   e.lights_hash = f.get<std::string>("lights_hash");
+  // Absent in bundles baked before the atlas held the sky (load_light_atlas says so).
+  if (entry.is_object() && entry.contains("direct_light")) e.direct_light = f.get<std::string>("direct_light");
   e.requested_texels_per_metre = f.get<float>("layout.requested_texels_per_metre");
   e.texels_per_metre = f.get<float>("layout.texels_per_metre");
   e.padding_texels = f.get<int>("layout.padding_texels");
@@ -149,6 +155,7 @@ engine::Status save_light_atlas(const fs::path& bundle_dir, const LightAtlasBake
                     {{"irradiance", {{"file", kLightAtlasExrFile}, {"xxh3_64", *exr_sum}}},
                      {"vpls", {{"file", kLightAtlasVplsFile}, {"xxh3_64", *vpls_sum}}}}},
                    {"lights_hash", static_lights_hash(input)},
+                   {"direct_light", direct_light_name(bake.settings)},
                    {"settings", settings_json(bake.settings)},
                    {"layout",
                     {{"requested_texels_per_metre", bake.layout.requested_texels_per_metre},
@@ -174,6 +181,11 @@ engine::Result<LightAtlasBake> load_light_atlas(const fs::path& bundle_dir, cons
                              entry->lights_hash + ", but the scene's static lights hash to " + lights +
                              " (a static light was edited; re-bake, or update it with gi::update_light_atlas)"};
 
+  if (entry->direct_light.empty())
+    return engine::Error{manifest_file.string(), "methods.light_atlas.direct_light",
+                         "the light atlas in " + bundle_dir.string() +
+                             " was baked before the atlas held the sky's direct light (the renderer drew the sky "
+                             "unshadowed then); re-bake"};
   const fs::path vpls_path = bundle_dir / entry->vpls_file;
   const fs::path exr_path = bundle_dir / entry->exr_file;
   if (engine::Status s = check_file_checksum(vpls_path, entry->vpls_checksum); !s) return s.error();
@@ -206,6 +218,10 @@ engine::Result<LightAtlasBake> load_light_atlas(const fs::path& bundle_dir, cons
   bake.height = bake.layout.height;
   if (engine::Status s = read_atlas_exr(exr_path, bake); !s) return s.error();
   bake.settings = vpl_file->settings;
+  if (entry->direct_light != direct_light_name(bake.settings))
+    return engine::Error{manifest_file.string(), "methods.light_atlas.direct_light",
+                         "\"" + entry->direct_light + "\" does not match the bake's settings (\"" +
+                             direct_light_name(bake.settings) + "\")"};
   bake.stats = entry->stats;
   bake.vpls = std::move(vpl_file->vpls);
   bake.vpl_power = std::move(vpl_file->vpl_power);

@@ -10,6 +10,10 @@
 //   manifest.json          methods.light_atlas = {
 //     "files":    { "irradiance": {"file": "light_atlas.exr", "xxh3_64": "<hex>"},
 //                   "vpls":       {"file": "light_atlas_vpls.bin", "xxh3_64": "<hex>"} },
+//     "direct_light": "unlit" (the atlas holds, besides indirect light, the direct light the
+//                     renderer does not draw: the sky's and that of emitters no light stands
+//                     for) or "all" (settings.include_direct: every static source's);
+//                     a bundle without it predates the baked sky and does not load,
 //     "settings": { LightAtlasSettings' scalar fields but threads },
 //     "layout":   { "requested_texels_per_metre", "texels_per_metre", "padding_texels", "width", "height" },
 //     "stats":    { LightAtlasStats' counts (timings: bake_stats.json) } }

@@ -1,6 +1,7 @@
 #include "light_atlas/texel_gather.h"
 
 #include <engine/gltf_brdf.h>
+#include <engine/sky.h>
 
 #include <algorithm>
 #include <chrono>
@@ -148,9 +149,14 @@ std::uint32_t landing(const StaticBakeScene& b, const AtlasLayout& layout, const
   return t.redirect[static_cast<std::size_t>(y) * static_cast<std::size_t>(t.width) + static_cast<std::size_t>(x)];
 }
 
-// Step 1 at one texel: every static light and the emissive triangles, light sampling only.
-glm::vec3 direct_at(const StaticBakeScene& b, const glm::vec3& p, const glm::vec3& n, const glm::vec3& face, int samples,
-                    Pcg32& rng, std::uint64_t* rays) {
+// Step 1 at one texel, light sampling only: `live`, every static light and the emissive
+// triangles that stand for an area light (the renderer draws those lights); `unlit`, the
+// emissive triangles no light stands for (the renderer draws no light of theirs).
+struct DirectAt {
+  glm::vec3 live{0.0f}, unlit{0.0f};
+};
+DirectAt direct_at(const StaticBakeScene& b, const glm::vec3& p, const glm::vec3& n, const glm::vec3& face, int samples,
+                   Pcg32& rng, std::uint64_t* rays) {
   const glm::vec3 origin = offset_ray_origin(p, face);
   glm::dvec3 sum(0.0);
   const auto inv = 1.0 / static_cast<double>(samples);
@@ -215,7 +221,8 @@ glm::vec3 direct_at(const StaticBakeScene& b, const glm::vec3& p, const glm::vec
     sum += glm::dvec3(l.radiant * (atten * cos_r));
   }
   const EmitterTable& em = b.index.emitters;
-  if (em.triangle.empty()) return glm::vec3(sum);
+  if (em.triangle.empty()) return {glm::vec3(sum), glm::vec3(0.0f)};
+  glm::dvec3 unlit(0.0);
   const float shift_y = rng.next_float();  // drawn first: see random.h
   const glm::vec2 shift(rng.next_float(), shift_y);
   const float pick_shift = rng.next_float();
@@ -223,9 +230,10 @@ glm::vec3 direct_at(const StaticBakeScene& b, const glm::vec3& p, const glm::vec
     float u_pick = (static_cast<float>(s) + pick_shift) / static_cast<float>(samples);
     u_pick = std::min(u_pick, 0x1.fffffep-1f);
     const auto k = static_cast<std::size_t>(std::lower_bound(em.cdf.begin(), em.cdf.end(), u_pick) - em.cdf.begin());
-    const ShadingTriangle& tri = b.index.triangles[em.triangle[std::min(k, em.triangle.size() - 1)]];
+    const std::size_t pick = std::min(k, em.triangle.size() - 1);
+    const ShadingTriangle& tri = b.index.triangles[em.triangle[pick]];
     const ReferenceMaterial& mat = b.scene.materials[tri.material];
-    const float prob = em.probability[std::min(k, em.triangle.size() - 1)];
+    const float prob = em.probability[pick];
     const glm::vec2 u = hammersley(static_cast<std::uint32_t>(s), static_cast<std::uint32_t>(samples), shift);
     const float su = std::sqrt(u.x);
     const glm::vec3 q = tri.p0 + su * (1.0f - u.y) * tri.e1 + su * u.y * tri.e2;
@@ -239,9 +247,9 @@ glm::vec3 direct_at(const StaticBakeScene& b, const glm::vec3& p, const glm::vec
     if (cos_l <= 0.0f || cos_r <= 0.0f || glm::dot(wi, face) <= 0.0f) continue;
     ++*rays;
     if (b.caster->occluded(Ray{origin, 0.0f, q - origin, 0.9999f})) continue;
-    sum += glm::dvec3(mat.emission * (cos_r * cos_l * tri.area_m2 / (prob * d2))) * inv;
+    (em.stands_for_light[pick] != 0 ? sum : unlit) += glm::dvec3(mat.emission * (cos_r * cos_l * tri.area_m2 / (prob * d2))) * inv;
   }
-  return glm::vec3(sum);
+  return {glm::vec3(sum), glm::vec3(unlit)};
 }
 
 glm::vec3 bilinear(const std::vector<glm::vec3>& img, int w, int h, glm::vec2 uv) {
@@ -349,6 +357,137 @@ std::vector<glm::vec3> filter_world(const AtlasTexels& tx, const TexelTable& t, 
 
 }  // namespace
 
+namespace {
+
+// The sky's radiance along a ray that escapes in direction wi (engine/sky.h).
+glm::vec3 sky_along(const StaticBakeScene& b, const glm::vec3& wi) {
+  return engine::sky_radiance(b.scene.sky_radiance, b.scene.sky_gradient, wi);
+}
+
+// What steps 2-3 hand each other.
+struct KeptRays {
+  std::size_t per_texel = 0;
+  std::vector<std::uint32_t> land;   // work item w's ray r lands at land[w * per_texel + r]
+  std::vector<glm::vec3> sky;        // per atlas texel: the sky's direct irradiance from the kept rays
+  std::vector<std::uint8_t> hidden;  // per atlas texel
+};
+
+// Step 2's casting: `solve_rays` stratified cosine rays per texel, each kept as the texel it
+// lands on. The rays that escape see the sky: with cosine sampling E = pi / N x the sum of
+// the sky's radiance over the escaping rays (the sky's direct light, shadowed by the level).
+bool cast_kept_rays(const StaticBakeScene& b, const AtlasLayout& layout, const TexelTable& t,
+                    const TexelGatherSettings& s, ThreadPool& pool, const ProgressCallback& progress,
+                    std::vector<std::uint64_t>& rays_of, KeptRays& k) {
+  const AtlasTexels& tx = b.texels;
+  const std::size_t ns = static_cast<std::size_t>(s.solve_rays);
+  k.per_texel = ns;
+  k.land.assign(t.work.size() * ns, kDark);
+  k.sky.assign(tx.valid.size(), glm::vec3(0.0f));
+  k.hidden.assign(tx.valid.size(), 0);
+  return pool.parallel_for_with_progress(t.work.size(), progress, [&](std::size_t w) {
+    const std::uint32_t i = t.work[w];
+    Pcg32 rng = Pcg32::for_item(s.seed, stream_id(i, kSolveStream));
+    const float shift_y = rng.next_float();  // drawn first: see random.h
+    const glm::vec2 shift(rng.next_float(), shift_y);
+    const glm::vec3 origin = offset_ray_origin(tx.position[i], t.face[i]);
+    std::size_t back = 0;
+    glm::vec3 sky_seen(0.0f);
+    for (std::size_t r = 0; r < ns; ++r) {
+      const glm::vec2 u = hammersley(static_cast<std::uint32_t>(r), static_cast<std::uint32_t>(ns), shift);
+      const glm::vec3 wi = sample_cosine_hemisphere(tx.normal[i], u.x, u.y);
+      if (glm::dot(wi, t.face[i]) <= 0.0f) continue;  // below the surface: dark
+      ++rays_of[w];
+      const std::uint32_t land = landing(b, layout, t, Ray{origin, 0.0f, wi}, nullptr);
+      k.land[w * ns + r] = land;
+      if (land == kSky) sky_seen += sky_along(b, wi);
+      back += land == kBack;
+    }
+    k.hidden[i] = static_cast<float>(back) > kHiddenBackFraction * static_cast<float>(ns) ? 1 : 0;
+    k.sky[i] = kPi * sky_seen / static_cast<float>(ns);
+  });
+}
+
+// Step 2's iteration: E_i+1 = T(E_d + E_i) over the kept rays until a bounce adds less than
+// 1e-4 of the total. `emitted` is the direct light every texel reflects (E_d). Returns the
+// iterations run.
+int solve_kept_rays(const TexelTable& t, const KeptRays& k, const std::vector<glm::vec3>& emitted, int bounces,
+                    ThreadPool& pool, std::vector<glm::vec3>& e) {
+  const std::size_t n = e.size(), ns = k.per_texel;
+  std::vector<glm::vec3> reflected(n, glm::vec3(0.0f)), next(n, glm::vec3(0.0f));
+  int iterations = 0;
+  for (int it = 0; it < bounces; ++it) {
+    for (std::uint32_t i : t.work) reflected[i] = t.albedo[i] * (emitted[i] + e[i]);
+    pool.parallel_for(
+        t.work.size(),
+        [&](std::size_t w) {
+          glm::dvec3 sum(0.0);
+          for (std::size_t r = 0; r < ns; ++r) {
+            const std::uint32_t land = k.land[w * ns + r];
+            if (land < kBack) sum += glm::dvec3(reflected[land]);
+          }
+          next[t.work[w]] = glm::vec3(sum / static_cast<double>(ns));
+        },
+        256);
+    double added = 0.0, total = 0.0;
+    for (std::uint32_t i : t.work) {
+      added += static_cast<double>(max_abs(next[i] - e[i]));
+      total += static_cast<double>(max_abs(next[i]));
+    }
+    std::swap(e, next);
+    iterations = it + 1;
+    if (!(added > 1e-4 * total)) break;
+  }
+  return iterations;
+}
+
+// Step 3 for the texels `mine` (work items): `gather_rays` fresh stratified rays read
+// `reflected` (rho (E_d + E), dilated) bilinearly where they land, and the sky where they
+// escape. Each estimate is averaged with step 2's (in e and k.sky), weighted by ray counts.
+// Texels not in `mine` get 0 in both.
+bool final_gather(const StaticBakeScene& b, const AtlasLayout& layout, const TexelTable& t,
+                  const TexelGatherSettings& s, ThreadPool& pool, const ProgressCallback& progress,
+                  const std::vector<std::size_t>& mine, const std::vector<glm::vec3>& reflected, const KeptRays& k,
+                  std::vector<glm::vec3>& e, std::vector<glm::vec3>& sky, std::vector<std::uint64_t>& rays_of) {
+  const AtlasTexels& tx = b.texels;
+  const auto nf = static_cast<std::size_t>(s.gather_rays);
+  const double w_solve = static_cast<double>(k.per_texel) / static_cast<double>(k.per_texel + nf);
+  std::vector<glm::vec3> gathered(e.size(), glm::vec3(0.0f));
+  sky.assign(e.size(), glm::vec3(0.0f));
+  const bool done = pool.parallel_for_with_progress(mine.size(), progress, [&](std::size_t m) {
+    const std::size_t w = mine[m];
+    const std::uint32_t i = t.work[w];
+    Pcg32 rng = Pcg32::for_item(s.seed, stream_id(i, kGatherStream));
+    const float shift_y = rng.next_float();  // drawn first: see random.h
+    const glm::vec2 shift(rng.next_float(), shift_y);
+    const glm::vec3 origin = offset_ray_origin(tx.position[i], t.face[i]);
+    glm::dvec3 sum(0.0), sky_seen(0.0);
+    for (std::size_t r = 0; r < nf; ++r) {
+      const glm::vec2 u = hammersley(static_cast<std::uint32_t>(r), static_cast<std::uint32_t>(nf), shift);
+      const glm::vec3 wi = sample_cosine_hemisphere(tx.normal[i], u.x, u.y);
+      if (glm::dot(wi, t.face[i]) <= 0.0f) continue;
+      ++rays_of[w];
+      glm::vec2 uv;
+      const std::uint32_t land = landing(b, layout, t, Ray{origin, 0.0f, wi}, &uv);
+      if (land < kBack) sum += glm::dvec3(bilinear(reflected, t.width, t.height, uv));
+      if (land == kSky) sky_seen += glm::dvec3(sky_along(b, wi));
+    }
+    const glm::dvec3 mean = sum / static_cast<double>(nf), sky_mean = sky_seen / static_cast<double>(nf);
+    gathered[i] = glm::vec3(w_solve * glm::dvec3(e[i]) + (1.0 - w_solve) * mean);
+    sky[i] = glm::vec3(w_solve * glm::dvec3(k.sky[i]) + (1.0 - w_solve) * static_cast<double>(kPi) * sky_mean);
+  });
+  e = std::move(gathered);
+  return done;
+}
+
+// Step 4 on both filtered fields (indirect and the baked direct light).
+void filter_result(const AtlasTexels& tx, const TexelTable& t, float radius_m, float texel_m, ThreadPool& pool,
+                   TexelGatherResult& out) {
+  out.indirect = filter_world(tx, t, out.indirect, out.hidden, radius_m, texel_m, pool);
+  out.baked_direct = filter_world(tx, t, out.baked_direct, out.hidden, radius_m, texel_m, pool);
+}
+
+}  // namespace
+
 engine::Result<TexelGatherResult> gather_atlas(const StaticBakeScene& b, const AtlasLayout& layout,
                                                const TexelGatherSettings& s, ThreadPool& pool) {
   if (auto ok = validate(s); !ok) return ok.error();
@@ -363,6 +502,7 @@ engine::Result<TexelGatherResult> gather_atlas(const StaticBakeScene& b, const A
   };
   TexelGatherResult out;
   out.direct.assign(n, glm::vec3(0.0f));
+  out.baked_direct.assign(n, glm::vec3(0.0f));
   out.indirect.assign(n, glm::vec3(0.0f));
   std::vector<std::uint64_t> rays_of(work, 0);
 
@@ -371,70 +511,22 @@ engine::Result<TexelGatherResult> gather_atlas(const StaticBakeScene& b, const A
   if (!pool.parallel_for_with_progress(work, phase(0.0, 0.15), [&](std::size_t w) {
         const std::uint32_t i = t.work[w];
         Pcg32 rng = Pcg32::for_item(s.seed, stream_id(i, kDirectStream));
-        out.direct[i] = direct_at(b, tx.position[i], tx.normal[i], t.face[i], s.direct_samples, rng, &rays_of[w]);
+        const DirectAt d = direct_at(b, tx.position[i], tx.normal[i], t.face[i], s.direct_samples, rng, &rays_of[w]);
+        out.direct[i] = d.live;
+        out.baked_direct[i] = d.unlit;
       }))
     return engine::cancelled_error("light-atlas gather");
   out.direct_seconds = seconds_since(t0);
 
-  // Step 2: cast and keep.
+  // Step 2. Every texel reflects the direct light of the lights, of the emitters and of the sky.
   t0 = Clock::now();
-  const auto ns = static_cast<std::size_t>(s.solve_rays);
-  std::vector<std::uint32_t> kept(work * ns, kDark);
-  const glm::vec3 sky = b.scene.sky_radiance;
-  const engine::SkyGradient& sky_gradient = b.scene.sky_gradient;  // engine/sky.h: by the escaping direction
-  std::vector<std::uint8_t> hidden(n, 0);
-  if (!pool.parallel_for_with_progress(work, phase(0.15, 0.45), [&](std::size_t w) {
-        const std::uint32_t i = t.work[w];
-        Pcg32 rng = Pcg32::for_item(s.seed, stream_id(i, kSolveStream));
-        const float shift_y = rng.next_float();  // drawn first: see random.h
-        const glm::vec2 shift(rng.next_float(), shift_y);
-        const glm::vec3 origin = offset_ray_origin(tx.position[i], t.face[i]);
-        std::size_t escaped = 0, back = 0;
-        glm::vec3 gradient_seen(0.0f);  // sum over escaped rays of the sky gradient's radiance
-        for (std::size_t r = 0; r < ns; ++r) {
-          const glm::vec2 u = hammersley(static_cast<std::uint32_t>(r), static_cast<std::uint32_t>(ns), shift);
-          const glm::vec3 wi = sample_cosine_hemisphere(tx.normal[i], u.x, u.y);
-          if (glm::dot(wi, t.face[i]) <= 0.0f) continue;  // below the surface: dark
-          ++rays_of[w];
-          const std::uint32_t land = landing(b, layout, t, Ray{origin, 0.0f, wi}, nullptr);
-          kept[w * ns + r] = land;
-          escaped += land == kSky;
-          if (land == kSky && !sky_gradient.empty())
-            gradient_seen += engine::sky_radiance(glm::vec3(0.0f), sky_gradient, wi);
-          back += land == kBack;
-        }
-        hidden[i] = static_cast<float>(back) > kHiddenBackFraction * static_cast<float>(ns) ? 1 : 0;
-        // Sky seen directly is direct light; cosine sampling: E = pi L x fraction escaping.
-        out.direct[i] += kPi * sky * (static_cast<float>(escaped) / static_cast<float>(ns));
-        out.direct[i] += kPi * gradient_seen / static_cast<float>(ns);
-      }))
+  KeptRays kept;
+  if (!cast_kept_rays(b, layout, t, s, pool, phase(0.15, 0.45), rays_of, kept))
     return engine::cancelled_error("light-atlas gather");
-
-  // Step 2: iterate. B = rho (E_d + E) per texel, the light a texel sends on (pi L).
-  std::vector<glm::vec3> reflected(n, glm::vec3(0.0f)), next(n, glm::vec3(0.0f));
+  std::vector<glm::vec3> emitted(n, glm::vec3(0.0f));
+  for (std::uint32_t i : t.work) emitted[i] = out.direct[i] + out.baked_direct[i] + kept.sky[i];
   std::vector<glm::vec3>& e = out.indirect;
-  for (int it = 0; it < s.bounces; ++it) {
-    for (std::uint32_t i : t.work) reflected[i] = t.albedo[i] * (out.direct[i] + e[i]);
-    pool.parallel_for(
-        work,
-        [&](std::size_t w) {
-          glm::dvec3 sum(0.0);
-          for (std::size_t r = 0; r < ns; ++r) {
-            const std::uint32_t land = kept[w * ns + r];
-            if (land < kBack) sum += glm::dvec3(reflected[land]);
-          }
-          next[t.work[w]] = glm::vec3(sum / static_cast<double>(ns));
-        },
-        256);
-    double added = 0.0, total = 0.0;
-    for (std::uint32_t i : t.work) {
-      added += static_cast<double>(max_abs(next[i] - e[i]));
-      total += static_cast<double>(max_abs(next[i]));
-    }
-    std::swap(e, next);
-    out.iterations = it + 1;
-    if (!(added > 1e-4 * total)) break;
-  }
+  out.iterations = solve_kept_rays(t, kept, emitted, s.bounces, pool, e);
   out.solve_seconds = seconds_since(t0);
   if (s.progress && !s.progress(0.5)) return engine::cancelled_error("light-atlas gather");
 
@@ -442,57 +534,51 @@ engine::Result<TexelGatherResult> gather_atlas(const StaticBakeScene& b, const A
   t0 = Clock::now();
   const float texel_m = layout.texels_per_metre > 0.0f ? 1.0f / layout.texels_per_metre : 0.0f;
   const bool filtering = s.filter_radius_texels > 0.0f && texel_m > 0.0f;
+  const float radius_m = s.filter_radius_texels * texel_m;
+  std::vector<glm::vec3> sky = kept.sky;
   if (s.gather_rays > 0) {
     // The gather reads the solve's light filtered too: its noise would otherwise come back
     // as blotches a few texels wide (a bright texel lights its neighbours' rays).
-    const std::vector<glm::vec3> source =
-        filtering ? filter_world(tx, t, e, hidden, s.filter_radius_texels * texel_m, texel_m, pool) : e;
-    for (std::uint32_t i : t.work) reflected[i] = t.albedo[i] * (out.direct[i] + source[i]);
+    const std::vector<glm::vec3> source = filtering ? filter_world(tx, t, e, kept.hidden, radius_m, texel_m, pool) : e;
+    std::vector<glm::vec3> reflected(n, glm::vec3(0.0f));
+    for (std::uint32_t i : t.work) reflected[i] = t.albedo[i] * (emitted[i] + source[i]);
     dilate<glm::vec3>(reflected, t.width, t.height, tx.valid, std::max(3, layout.padding_texels));
-    const auto nf = static_cast<std::size_t>(s.gather_rays);
-    const double w_solve = static_cast<double>(ns) / static_cast<double>(ns + nf);
-    std::vector<glm::vec3> gathered(n, glm::vec3(0.0f));
-    const std::vector<std::size_t> mine = s.shard.items(work);  // all of them in a whole bake
     std::vector<std::uint64_t> gather_rays_of(work, 0);
-    if (!pool.parallel_for_with_progress(mine.size(), phase(0.5, 0.95), [&](std::size_t m) {
-          const std::size_t w = mine[m];
-          const std::uint32_t i = t.work[w];
-          Pcg32 rng = Pcg32::for_item(s.seed, stream_id(i, kGatherStream));
-          const float shift_y = rng.next_float();  // drawn first: see random.h
-          const glm::vec2 shift(rng.next_float(), shift_y);
-          const glm::vec3 origin = offset_ray_origin(tx.position[i], t.face[i]);
-          glm::dvec3 sum(0.0);
-          for (std::size_t r = 0; r < nf; ++r) {
-            const glm::vec2 u = hammersley(static_cast<std::uint32_t>(r), static_cast<std::uint32_t>(nf), shift);
-            const glm::vec3 wi = sample_cosine_hemisphere(tx.normal[i], u.x, u.y);
-            if (glm::dot(wi, t.face[i]) <= 0.0f) continue;
-            ++gather_rays_of[w];
-            glm::vec2 uv;
-            const std::uint32_t land = landing(b, layout, t, Ray{origin, 0.0f, wi}, &uv);
-            if (land < kBack) sum += glm::dvec3(bilinear(reflected, t.width, t.height, uv));
-          }
-          const glm::dvec3 mean = sum / static_cast<double>(nf);
-          gathered[i] = glm::vec3(w_solve * glm::dvec3(e[i]) + (1.0 - w_solve) * mean);
-        }))
+    if (!final_gather(b, layout, t, s, pool, phase(0.5, 0.95), s.shard.items(work), reflected, kept, e, sky,
+                      gather_rays_of))
       return engine::cancelled_error("light-atlas gather");
-    e = std::move(gathered);
     for (std::uint64_t r : gather_rays_of) out.own_rays += r;
   } else if (!s.shard.whole()) {
     for (std::size_t w = 0; w < work; ++w)
-      if (!s.shard.owns(w)) e[t.work[w]] = glm::vec3(0.0f);
+      if (!s.shard.owns(w)) e[t.work[w]] = sky[t.work[w]] = glm::vec3(0.0f);
   }
+  for (std::uint32_t i : t.work) out.baked_direct[i] += sky[i];
   out.gather_seconds = seconds_since(t0);
   for (std::uint64_t r : rays_of) out.shared_rays += r;
   out.rays = out.shared_rays + out.own_rays;
-  out.hidden = std::move(hidden);
+  out.hidden = std::move(kept.hidden);
 
   // Step 4 (a shard leaves it to the merge).
   if (s.part_only) return out;
   t0 = Clock::now();
-  if (filtering) out.indirect = filter_world(tx, t, e, out.hidden, s.filter_radius_texels * texel_m, texel_m, pool);
+  if (filtering) filter_result(tx, t, radius_m, texel_m, pool, out);
   out.filter_seconds = seconds_since(t0);
   if (s.progress && !s.progress(1.0)) return engine::cancelled_error("light-atlas gather");
   return out;
+}
+
+engine::Result<std::vector<glm::vec3>> sky_direct_light(const StaticBakeScene& b, const AtlasLayout& layout,
+                                                        int rays, std::uint64_t seed, ThreadPool& pool) {
+  if (rays < 1) return engine::invalid_request("the sky's direct light: rays must be >= 1");
+  auto table = texel_table(b, layout);
+  if (!table) return table.error();
+  std::vector<std::uint64_t> rays_of(table->work.size(), 0);
+  TexelGatherSettings s;
+  s.solve_rays = rays;
+  s.seed = seed;
+  KeptRays kept;
+  cast_kept_rays(b, layout, *table, s, pool, {}, rays_of, kept);
+  return std::move(kept.sky);
 }
 
 // The same filter call as gather_atlas's step 4, for a result merged from shards.
@@ -503,10 +589,10 @@ engine::Status filter_gathered(const StaticBakeScene& b, const AtlasLayout& layo
   if (s.filter_radius_texels > 0.0f && texel_m > 0.0f) {
     auto table = texel_table(b, layout);
     if (!table) return table.error();
-    if (out.indirect.size() != b.texels.valid.size() || out.hidden.size() != b.texels.valid.size())
+    if (out.indirect.size() != b.texels.valid.size() || out.baked_direct.size() != b.texels.valid.size() ||
+        out.hidden.size() != b.texels.valid.size())
       return engine::Error{.message = "texel gather: the result to filter does not match the atlas"};
-    out.indirect = filter_world(b.texels, *table, out.indirect, out.hidden, s.filter_radius_texels * texel_m, texel_m,
-                                pool);
+    filter_result(b.texels, *table, s.filter_radius_texels * texel_m, texel_m, pool, out);
   }
   out.filter_seconds = seconds_since(t0);
   return {};

@@ -9,7 +9,7 @@
 // Steps:
 //   1. Direct irradiance E_d at every texel: punctual lights with one shadow ray, area
 //      lights and emissive triangles with `direct_samples` stratified samples (light
-//      sampling, unbiased), the sky from the misses of step 2.
+//      sampling, unbiased); the sky from the rays of steps 2 and 3 that escape.
 //   2. Kept-ray solve: `solve_rays` cosine-distributed, stratified rays per texel; the texel
 //      each ray lands on is kept, so every bounce after the first costs a lookup, not a ray.
 //      Jacobi iteration E_i+1 = T(E_d + E_i), T the kept rays' mean of the reflected
@@ -23,6 +23,10 @@
 //      across chart borders, Gaussian-weighted.
 // Surfaces reflect as diffuse with the glTF BRDF's hemispherical albedo (as the VPLs do).
 // Back faces of one-sided surfaces are black; rays that escape see the sky (direct light).
+// The direct light comes out in two parts: what the renderer draws live (the static lights,
+// and the emissive triangles that stand for an area light), and what only the bake has
+// (the sky, shadowed by the level, and emissive surfaces no light stands for: `baked_direct`,
+// which the atlas always holds; docs/scene-format.md, "What is baked and what is drawn live").
 // Deterministic for any thread count: every texel's random numbers come from (seed, texel).
 
 #include <engine/result.h>
@@ -58,7 +62,13 @@ struct TexelGatherSettings {
 
 struct TexelGatherResult {
   std::vector<glm::vec3> indirect;  ///< Per texel, W/m^2 (0 on empty texels, not dilated).
-  std::vector<glm::vec3> direct;    ///< Per texel, W/m^2 (step 1, sky included).
+  /// Per texel, W/m^2: step 1's direct light of the static lights and of the emissive
+  /// triangles that stand for an area light (the light the renderer draws live).
+  std::vector<glm::vec3> direct;
+  /// Per texel, W/m^2: the direct light the renderer does not draw: the sky's (from the
+  /// escaping rays of steps 2-3, weighted as `indirect`) and that of emissive triangles no
+  /// light stands for (step 1). Filtered in step 4 as `indirect` is.
+  std::vector<glm::vec3> baked_direct;
   std::uint64_t rays = 0;
   std::uint64_t shared_rays = 0;  ///< Of `rays`: steps 1-2 (every texel, in every shard).
   std::uint64_t own_rays = 0;     ///< Of `rays`: step 3 for the shard's texels.
@@ -73,10 +83,17 @@ engine::Result<TexelGatherResult> gather_atlas(const StaticBakeScene& scene, con
                                                const TexelGatherSettings& settings, ThreadPool& pool);
 
 /// Step 4 on a result whose steps 1-3 ran (merged from shards): the world-space filter of
-/// `result.indirect` when settings.filter_radius_texels > 0: the same filter, on the same
-/// values, as a whole bake's gather_atlas ends with.
+/// `result.indirect` and `result.baked_direct` when settings.filter_radius_texels > 0: the
+/// same filter, on the same values, as a whole bake's gather_atlas ends with.
 engine::Status filter_gathered(const StaticBakeScene& scene, const AtlasLayout& layout,
                                const TexelGatherSettings& settings, ThreadPool& pool, TexelGatherResult& result);
+
+/// The sky's direct irradiance (W/m^2) at every valid texel, shadowed by the static world,
+/// from `rays` stratified cosine rays per texel (those that escape bring the sky of their
+/// direction), unfiltered: for a bake that does not gather (the VPL final shooting). Errors:
+/// rays < 1, a layout that is not the one `scene.texels` were rasterized from.
+engine::Result<std::vector<glm::vec3>> sky_direct_light(const StaticBakeScene& scene, const AtlasLayout& layout,
+                                                        int rays, std::uint64_t seed, ThreadPool& pool);
 
 /// Irradiance at surface points read from a texel field: each point takes the nearest
 /// valid texel within two texels whose normal faces its own (within 60 degrees); 0 where

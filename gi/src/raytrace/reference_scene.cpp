@@ -50,6 +50,10 @@ void index_emitters(const ReferenceScene& scene, ReferenceSceneIndex& index, boo
       if (skip || !(lum > 0.0f) || !(tri.area_m2 > 0.0f)) continue;
       tri.emitter = static_cast<std::int32_t>(index.emitters.triangle.size());
       index.emitters.triangle.push_back(t);
+      bool proxy = false;
+      for (const ReferenceLight& l : scene.lights)
+        proxy = proxy || (l.type == ReferenceLight::Type::Area && is_proxy_of(tri, l));
+      index.emitters.stands_for_light.push_back(proxy ? 1 : 0);
       power.push_back(static_cast<double>(lum) * static_cast<double>(tri.area_m2) * (mat.double_sided ? 2.0 : 1.0));
     }
   }

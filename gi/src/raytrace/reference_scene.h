@@ -72,6 +72,10 @@ struct EmitterTable {
   std::vector<std::uint32_t> triangle;  ///< Index into ReferenceSceneIndex::triangles.
   std::vector<float> probability;       ///< Probability of picking each emitter.
   std::vector<float> cdf;               ///< Inclusive running sum of probability; back() == 1.
+  /// Per emitter: 1 when the triangle is the emissive proxy of an area light (the renderer
+  /// draws that light live), 0 when no light stands for it (its light on other surfaces
+  /// exists only in the bakes: docs/scene-format.md, "What is baked and what is drawn live").
+  std::vector<std::uint8_t> stands_for_light;
 };
 
 /// The snapshot flattened for shading: triangle index = instance_first[instance] + primitive.

@@ -318,6 +318,10 @@ engine::Result<std::unique_ptr<GISystem>> GISystem::load(const std::filesystem::
     if (!a) return a.error();
     impl->atlas = std::move(a).value();
   }
+  // The atlas (alone or under the PRM's panes) holds the sky's direct light, and every static
+  // light's with include_direct: the renderer draws neither again on the static world.
+  impl->frame.atlas_holds_sky = atlas.has_value();
+  impl->frame.atlas_holds_static_lights = atlas.has_value() && atlas->settings.include_direct;
   impl->registry = &scene.registry;
   impl->log = settings.log;
   impl->relabel();

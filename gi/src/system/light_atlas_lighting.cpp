@@ -24,8 +24,11 @@ std::vector<float> rgba_of(const LightAtlasBake& bake) {
 
 }  // namespace
 
-LightAtlasLighting::LightAtlasLighting(int width, int height, std::vector<float> rgba)
-    : width_(width), height_(height), rgba_(std::move(rgba)) {}
+LightAtlasLighting::LightAtlasLighting(int width, int height, std::vector<float> rgba, bool holds_static_lights)
+    : width_(width), height_(height), rgba_(std::move(rgba)) {
+  frame_.atlas_holds_sky = true;  // light_atlas.h: LightAtlasBake::irradiance
+  frame_.atlas_holds_static_lights = holds_static_lights;
+}
 
 LightAtlasLighting::~LightAtlasLighting() = default;
 
@@ -42,13 +45,13 @@ engine::Result<std::unique_ptr<LightAtlasLighting>> LightAtlasLighting::from_bak
   auto with_uv1 = with_atlas_uv1(asset, bake.layout);
   if (!with_uv1) return with_uv1.error();
   asset = std::move(with_uv1).value();
-  return std::unique_ptr<LightAtlasLighting>(new LightAtlasLighting(bake.width, bake.height, rgba_of(bake)));
+  return std::unique_ptr<LightAtlasLighting>(new LightAtlasLighting(bake.width, bake.height, rgba_of(bake), bake.settings.include_direct));
 }
 
 engine::Result<std::unique_ptr<LightAtlasLighting>> LightAtlasLighting::from_bake(const LightAtlasBake& bake,
                                                                                   engine::Scene& scene) {
   if (engine::Status s = apply_atlas_uv1(scene, bake.layout); !s) return s.error();
-  return std::unique_ptr<LightAtlasLighting>(new LightAtlasLighting(bake.width, bake.height, rgba_of(bake)));
+  return std::unique_ptr<LightAtlasLighting>(new LightAtlasLighting(bake.width, bake.height, rgba_of(bake), bake.settings.include_direct));
 }
 
 const engine::IndirectLightFrame& LightAtlasLighting::frame() {

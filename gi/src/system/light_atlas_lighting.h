@@ -41,7 +41,8 @@ class LightAtlasLighting final : public engine::IndirectLightProvider {
   ~LightAtlasLighting() override;
 
   /// The atlas texture (RGBA32F: RGB irradiance in W/m^2, A = 1 on texels a triangle
-  /// covers; linear filtering, clamped to the edge), uploaded on the first call.
+  /// covers; linear filtering, clamped to the edge), uploaded on the first call; it holds the
+  /// sky's direct light, and the static lights' with include_direct (atlas_holds_*).
   const engine::IndirectLightFrame& frame() override;
   /// "light atlas".
   const char* label() const override { return "light atlas"; }
@@ -50,7 +51,7 @@ class LightAtlasLighting final : public engine::IndirectLightProvider {
   int atlas_height() const { return height_; }
 
  private:
-  LightAtlasLighting(int width, int height, std::vector<float> rgba);
+  LightAtlasLighting(int width, int height, std::vector<float> rgba, bool holds_static_lights);
 
   int width_ = 0;
   int height_ = 0;

@@ -108,6 +108,7 @@ std::vector<PointEmitter> point_emitters(const ReferenceScene& scene, const Refe
         p.radiant = kPi * m.emission * tri.area_m2 / strata;
         p.area_m2 = tri.area_m2 / strata;
         p.two_sided = m.double_sided;
+        p.drawn_live = tri.emitter >= 0 && index.emitters.stands_for_light[static_cast<std::size_t>(tri.emitter)] != 0;
         out.push_back(p);
       });
     }

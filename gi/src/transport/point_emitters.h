@@ -38,6 +38,10 @@ struct PointEmitter {
   float area_m2 = 0.0f;  ///< Lambertian: the area the point stands for.
   bool spot = false;
   bool two_sided = false;  ///< Lambertian: emits from both sides.
+  /// False for the points of an emissive triangle no light stands for: the renderer draws
+  /// no light of it, so a bake holds its direct light (the static lights' and their proxies'
+  /// points are true: drawn live).
+  bool drawn_live = true;
   float range_m = 0.0f;
   float cos_outer = -1.0f;
   float cos_inner = 1.0f;
