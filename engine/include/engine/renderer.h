@@ -23,6 +23,7 @@
 #include <vector>
 
 #include <engine/entity.h>
+#include <engine/exposure.h>
 #include <engine/image.h>
 #include <functional>
 #include <string>
@@ -43,10 +44,19 @@ enum class SplitView : std::uint8_t { Off, DirectLeftFullRight };
 struct RenderSettings {
   int width = 960;
   int height = 540;
-  /// Linear scale applied before tonemapping (exposure = 1 / (1.2 * 2^EV100) style factor).
+  /// Linear scale applied before tonemapping in ExposureMode::FixedLinear (the default).
   /// LDR = sRGB_encode(ACES_fitted(hdr x exposure)), ACES fitted = Narkowicz 2015:
   /// x (2.51 x + 0.03) / (x (2.43 x + 0.59) + 0.14) per channel, clamped to [0, 1].
   float exposure = 1.0f;
+  /// How the exposure is chosen (engine/exposure.h, docs/exposure.md): `exposure` as given,
+  /// `ev100` through the camera model, or automatic (metered on the GPU from each frame and
+  /// adapted over render()'s time step).
+  ExposureMode exposure_mode = ExposureMode::FixedLinear;
+  /// ExposureMode::FixedEv100: the camera's exposure value at ISO 100; the radiance is scaled
+  /// by 683 / (1.2 x 2^ev100) (15: the sunny-16 rule).
+  float ev100 = 15.0f;
+  /// ExposureMode::Automatic: compensation, clamp, metering percentiles, adaptation rates.
+  AutoExposure auto_exposure;
   /// Texels per side of 2-D shadow maps (directional, spot, area); point-light cube faces
   /// use half of it. At most 8 2-D maps and 4 cube maps per frame; further lights are unshadowed.
   int shadow_map_size = 1024;
@@ -128,8 +138,14 @@ class Renderer {
 
   /// Draws the registry's MeshRenderer entities lit by its Light entities, seen from
   /// `camera` (an entity with Camera and WorldTransform), into the offscreen HDR target;
-  /// then tonemaps into the LDR target (and, in a window, the default framebuffer).
-  virtual void render(const Registry& registry, Entity camera) = 0;
+  /// then exposes and tonemaps into the LDR target (and, in a window, the default framebuffer).
+  /// `dt_s`: the seconds of game time since the previous render() (>= 0; several fixed
+  /// steps when the game steps more often than it draws), which drives automatic exposure's
+  /// adaptation. No clock is read, so a replayed or headless run renders the same frames.
+  virtual void render(const Registry& registry, Entity camera, double dt_s) = 0;
+  /// render(registry, camera, kDefaultFrameDtS): one 60 Hz step since the last frame.
+  void render(const Registry& registry, Entity camera) { render(registry, camera, kDefaultFrameDtS); }
+  static constexpr double kDefaultFrameDtS = 1.0 / 60.0;
 
   /// The tonemapped frame (sRGB, rows top to bottom).
   virtual ImageRgba8 read_ldr() const = 0;
@@ -163,7 +179,8 @@ class Renderer {
   /// Timings of the passes of the last render(), in execution order: "shadow maps (N views)",
   /// with an IndirectLightProvider "indirect light update (<provider label>)" (its frame():
   /// the GI's per-frame GPU and CPU work), then "forward + constant ambient (stand-in)" or
-  /// "forward + indirect (<provider label>)" (includes the depth pre-pass), "tonemap (...)".
+  /// "forward + indirect (<provider label>)" (includes the depth pre-pass), with automatic
+  /// exposure "auto exposure (histogram, adapt)", then "tonemap (...)".
   virtual const std::vector<PassTiming>& last_timings() const = 0;
   /// Shadow-map views (2-D maps and cube faces) the last render() drew. A view is kept while
   /// neither its light nor a caster that can reach it (not wholly outside its clip volume)
@@ -178,6 +195,13 @@ class Renderer {
   /// Light and mesh entities the last render() left out as unusable (see RenderSettings::warn).
   /// A camera whose transform is unusable is replaced by its last usable one.
   virtual int last_skipped_entities() const = 0;
+  /// The exposure the last render() applied. Automatic: read back from the GPU (waits for
+  /// the frame; for stats, overlays and tests, not needed to draw); fixed modes: no read-back.
+  virtual ExposureReading read_exposure() const = 0;
+  /// Automatic exposure starts over: the next render() sets the exposure to its frame's
+  /// metered target instead of adapting toward it (a cut, a teleport, a new level). The first
+  /// automatic frame, and the first after a frame with a fixed mode, do so too.
+  virtual void reset_exposure() = 0;
   /// Light sets the last render() shaded pixels with (RenderSettings::light_reach_culling):
   /// one per light-reach mask in the scene's grid, each drawn over the pixels of its mask;
   /// 1 when every pixel got every light.

@@ -5,6 +5,7 @@
 #include "render/forward_renderer.h"
 
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <map>
@@ -177,7 +178,8 @@ void ForwardRenderer::report_skipped(const Registry& registry, const std::vector
   warned_ = std::move(now);
 }
 
-void ForwardRenderer::render(const Registry& registry, Entity camera) {
+void ForwardRenderer::render(const Registry& registry, Entity camera, double dt_s) {
+  GI_EXPECTS(std::isfinite(dt_s) && dt_s >= 0.0, "render()'s time step must be finite and not negative");
   GI_EXPECTS(registry.valid(camera) && registry.has<Camera>(camera) && registry.has<WorldTransform>(camera),
              "render() needs a camera entity with Camera and WorldTransform");
   ensure_targets();
@@ -233,6 +235,17 @@ void ForwardRenderer::render(const Registry& registry, Entity camera) {
   timings_.push_back({provider_ ? std::string("forward + indirect (") + provider_->label() + ")"
                                 : std::string("forward + constant ambient (stand-in)"),
                       timer.lap_ms()});
+
+  // Automatic exposure: metered and adapted on the GPU, read by the tonemap (docs/exposure.md).
+  exposure_metered_ = settings_.exposure_mode == ExposureMode::Automatic;
+  if (exposure_metered_) {
+    exposure_meter_.run(hdr_.id(), width_, height_, dt_s, exposure_snap_, settings_.auto_exposure);
+    exposure_snap_ = false;
+    timings_.push_back({"auto exposure (histogram, adapt)", timer.lap_ms()});
+  } else {
+    applied_exposure_ = fixed_exposure();
+    exposure_snap_ = true;  // switching to automatic starts from the metered target
+  }
 
   tonemap_pass();
   timings_.push_back({"tonemap (exposure, ACES fitted, sRGB)", timer.lap_ms()});
@@ -469,11 +482,35 @@ void ForwardRenderer::tonemap_pass() {
   glDisable(GL_DEPTH_TEST);
   glDisable(GL_CULL_FACE);
   tonemap_.use();
-  glUniform1f(0, settings_.exposure);
+  glUniform1f(0, exposure_metered_ ? 1.0f : applied_exposure_);
+  glUniform1i(1, exposure_metered_ ? 1 : 0);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kExposureStateBinding, exposure_meter_.state_buffer());
   glBindTextureUnit(0, hdr_.id());
   glBindVertexArray(empty_vao_.id());
   glDrawArrays(GL_TRIANGLES, 0, 3);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
+}
+
+float ForwardRenderer::fixed_exposure() const {
+  return settings_.exposure_mode == ExposureMode::FixedEv100 ? exposure_of_ev100(settings_.ev100) : settings_.exposure;
+}
+
+ExposureReading ForwardRenderer::read_exposure() const {
+  ExposureReading r;
+  if (!exposure_metered_) {
+    r.exposure = applied_exposure_;
+    r.ev100 = r.exposure > 0.0f ? ev100_of_exposure(r.exposure) : 0.0f;
+    r.target_ev100 = r.ev100;
+    return r;
+  }
+  const GpuExposureState s = exposure_meter_.read();
+  r.exposure = s.exposure;
+  r.ev100 = s.ev100;
+  r.target_ev100 = s.target_ev100;
+  r.mean_log2_luminance = s.mean_log2_luminance;
+  r.metered_pixels = s.metered_pixels;
+  r.metered = true;
+  return r;
 }
 
 ImageRgba8 ForwardRenderer::read_ldr() const {
@@ -523,18 +560,21 @@ Result<std::unique_ptr<Renderer>> Renderer::create(const SceneAsset& assets, con
   if (!depth_reach) return depth_reach.error();
   auto shadow = build("shadow.vert.glsl", "shadow.frag.glsl");
   if (!shadow) return shadow.error();
-  auto tonemap = build("fullscreen.vert.glsl", "tonemap.frag.glsl");
+  ShaderProgramBuilder tonemap_builder(engine_shader_files());
+  tonemap_builder.stage(ShaderStage::Vertex, "fullscreen.vert.glsl").stage(ShaderStage::Fragment, "tonemap.frag.glsl");
+  auto tonemap = define_exposure_constants(tonemap_builder).build();
   if (!tonemap) return tonemap.error();
+  auto exposure_meter = ExposureMeter::create();
+  if (!exposure_meter) return exposure_meter.error();
   auto scene = GpuScene::upload(assets);
   if (!scene) return scene.error();
   glEnable(GL_TEXTURE_CUBE_MAP_SEAMLESS);
   RenderSettings with_sky = settings;
   with_sky.sky_radiance = assets.environment.sky_radiance;
   with_sky.sky_gradient = assets.environment.sky_gradient;
-  return std::unique_ptr<Renderer>(std::make_unique<ForwardRenderer>(std::move(scene.value()), std::move(forward.value()),
-                                                                     std::move(depth.value()), std::move(depth_reach.value()),
-                                                                     std::move(shadow.value()),
-                                                                     std::move(tonemap.value()), with_sky));
+  return std::unique_ptr<Renderer>(std::make_unique<ForwardRenderer>(
+      std::move(scene.value()), std::move(forward.value()), std::move(depth.value()), std::move(depth_reach.value()),
+      std::move(shadow.value()), std::move(tonemap.value()), std::move(exposure_meter.value()), with_sky));
 }
 
 }  // namespace engine

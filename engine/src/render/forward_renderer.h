@@ -22,6 +22,7 @@
 #include <engine/gpu/gltf_brdf_texture.h>
 #include <engine/gpu/shader_program.h>
 
+#include "render/exposure_meter.h"
 #include "render/frame_data.h"
 #include "render/gpu_scene.h"
 #include "render/light_list.h"
@@ -98,7 +99,8 @@ struct ReachState {
 class ForwardRenderer final : public Renderer {
  public:
   ForwardRenderer(GpuScene scene, ShaderProgram forward, ShaderProgram depth, ShaderProgram depth_reach,
-                  ShaderProgram shadow, ShaderProgram tonemap, const RenderSettings& settings)
+                  ShaderProgram shadow, ShaderProgram tonemap, ExposureMeter exposure_meter,
+                  const RenderSettings& settings)
       : settings_(settings),
         scene_(std::move(scene)),
         depth_only_(std::move(depth)),
@@ -106,6 +108,7 @@ class ForwardRenderer final : public Renderer {
 
         shadow_(std::move(shadow)),
         tonemap_(std::move(tonemap)),
+        exposure_meter_(std::move(exposure_meter)),
         lights_buffer_(GlBuffer::create()),
         empty_vao_(GlVertexArray::create()),
         albedo_table_(upload_gltf_albedo_table()),
@@ -115,7 +118,8 @@ class ForwardRenderer final : public Renderer {
     ensure_targets();
   }
 
-  void render(const Registry& registry, Entity camera) override;
+  using Renderer::render;
+  void render(const Registry& registry, Entity camera, double dt_s) override;
   ImageRgba8 read_ldr() const override;
   ImageRgbaF read_hdr() const override;
   void present(int window_width, int window_height) const override {
@@ -131,6 +135,8 @@ class ForwardRenderer final : public Renderer {
   int last_shadow_maps_unseen() const override { return shadow_maps_.last_unseen_views(); }
   int last_skipped_entities() const override { return skipped_entities_; }
   int last_light_groups() const override { return light_groups_; }
+  ExposureReading read_exposure() const override;
+  void reset_exposure() override { exposure_snap_ = true; }
 
  private:
   void ensure_targets();
@@ -155,6 +161,8 @@ class ForwardRenderer final : public Renderer {
   void update_reach(const std::vector<DrawItem>& items, const render::LightList& lights, const std::vector<int>& cullable,
                     int n_static);
   void tonemap_pass();
+  /// The exposure of a fixed mode (FixedLinear, FixedEv100).
+  float fixed_exposure() const;
 
   RenderSettings settings_;
   GpuScene scene_;
@@ -176,6 +184,10 @@ class ForwardRenderer final : public Renderer {
   ReachState reach_;
   ShaderProgram shadow_;
   ShaderProgram tonemap_;
+  ExposureMeter exposure_meter_;
+  bool exposure_snap_ = true;      ///< The next automatic frame snaps to its target.
+  bool exposure_metered_ = false;  ///< The last frame's exposure came from exposure_meter_.
+  float applied_exposure_ = 1.0f;  ///< Otherwise, the fixed exposure it was shown with.
   render::ShadowMaps shadow_maps_;
   int shadow_maps_rendered_ = 0;
   int skipped_entities_ = 0;
