@@ -1,6 +1,10 @@
 #include <engine/scene.h>
 
+#include <algorithm>
+#include <numeric>
 #include <unordered_map>
+#include <utility>
+#include <vector>
 
 namespace engine {
 
@@ -10,7 +14,17 @@ Scene instantiate(SceneAsset assets) {
   Registry& reg = scene.registry;
   const std::vector<Node>& nodes = scene.assets.nodes;
   scene.node_entities.resize(nodes.size());
-  for (std::size_t i = 0; i < nodes.size(); ++i) scene.node_entities[i] = reg.create();
+  // Entities in the file's node order (nodes not from a file after those, in their order),
+  // so the camera of the lowest entity index is the file's first (find_camera).
+  std::vector<std::size_t> creation(nodes.size());
+  std::iota(creation.begin(), creation.end(), std::size_t{0});
+  const auto file_order = [&](std::size_t i) {
+    const bool from_file = nodes[i].file_index >= 0;
+    return std::pair(!from_file, from_file ? static_cast<std::size_t>(nodes[i].file_index) : i);
+  };
+  std::stable_sort(creation.begin(), creation.end(),
+                   [&](std::size_t a, std::size_t b) { return file_order(a) < file_order(b); });
+  for (std::size_t i : creation) scene.node_entities[i] = reg.create();
   for (std::size_t i = 0; i < nodes.size(); ++i) {
     const Node& n = nodes[i];
     const Entity e = scene.node_entities[i];
@@ -79,8 +93,10 @@ void update_world_transforms(Registry& reg) {
 }
 
 Entity find_camera(const Registry& registry) {
-  const auto cams = registry.entities_with<Camera>();
-  return cams.empty() ? kNullEntity : cams.front();
+  Entity first;
+  for (Entity e : registry.entities_with<Camera>())
+    if (!first || e.index < first.index) first = e;
+  return first;
 }
 
 Entity find_by_name(const Registry& registry, std::string_view name) {

@@ -16,7 +16,9 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <nlohmann/json.hpp>
 
+#include <engine/components.h>
 #include <engine/gltf.h>
+#include <engine/scene.h>
 
 namespace {
 
@@ -157,6 +159,32 @@ TEST(GltfLoader, NodesComeParentsFirstWithReindexedParents) {
   EXPECT_EQ(s.nodes[2].parent, 1);
   EXPECT_EQ(s.nodes[3].parent, -1);
   EXPECT_EQ(s.nodes[2].mesh, 0);
+}
+
+// engine::find_camera on an instantiated file: the camera node first in the file's "nodes"
+// array, not the first the loader stores (parents first: "inner" under "group" comes before
+// "front" there).
+TEST(GltfLoader, FindCameraPicksTheFirstCameraInTheFilesNodeOrder) {
+  GltfBuilder b = triangle_file();
+  b.doc["cameras"] = json::parse(R"([{"type": "perspective", "perspective": {"yfov": 0.5, "znear": 0.1}},
+                                     {"type": "perspective", "perspective": {"yfov": 0.7, "znear": 0.1}}])");
+  b.doc["nodes"] = json::parse(R"([
+    {"name": "group", "children": [3]},
+    {"name": "model", "mesh": 0},
+    {"name": "front", "camera": 1},
+    {"name": "inner", "camera": 0}])");
+  b.doc["scenes"] = json::parse(R"([{"nodes": [0, 1, 2]}])");
+  engine::SceneAsset a = load(write_text("cameras.gltf", b.gltf()));
+  ASSERT_EQ(a.nodes.size(), 4u);
+  EXPECT_EQ(a.nodes[1].name, "inner");
+  EXPECT_EQ(a.nodes[1].file_index, 3);
+  EXPECT_EQ(a.nodes[3].name, "front");
+  EXPECT_EQ(a.nodes[3].file_index, 2);
+  const engine::Scene scene = engine::instantiate(std::move(a));
+  const engine::Entity first = engine::find_camera(scene.registry);
+  ASSERT_TRUE(first);
+  EXPECT_EQ(scene.registry.get<engine::Name>(first).value, "front");
+  EXPECT_EQ(first, scene.node_entities[3]);
 }
 
 TEST(GltfLoader, WithoutScenesAllRootsLoad) {

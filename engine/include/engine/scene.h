@@ -17,7 +17,7 @@ struct Scene {
   std::vector<Entity> node_entities;
 };
 
-/// Creates one entity per node with Name, Transform (parented as in the file) and
+/// Creates one entity per node (in Node::file_index order) with Name, Transform (parented as in the file) and
 /// WorldTransform, plus MeshRenderer, Light and Camera where the node has them. Mesh nodes
 /// are tagged DynamicTag when their gi mobility is Dynamic, StaticTag otherwise; dynamic
 /// mesh nodes also get a RigidBody. World transforms are computed before returning.
@@ -28,7 +28,8 @@ Scene instantiate(SceneAsset assets);
 /// WorldTransform only when its value differs, so changed<WorldTransform>() means "moved".
 void update_world_transforms(Registry& registry);
 
-/// The first entity with a Camera, or null.
+/// The entity with a Camera of the lowest index, or null: in an instantiated glTF scene, the
+/// camera node that comes first in the file's "nodes" array (Node::file_index).
 Entity find_camera(const Registry& registry);
 
 /// The first entity whose Name equals `name`, or null.

@@ -87,6 +87,10 @@ struct Node {
   int light = -1;   ///< Index into SceneAsset::lights.
   int camera = -1;  ///< Index into SceneAsset::cameras.
   NodeGiFlags gi;
+  /// Its index in the glTF file's "nodes" array; -1 when it does not come from a file (a
+  /// scene built in code, the sun's node). Nodes are stored parents first, so this order
+  /// can differ from theirs; engine::instantiate creates entities in it.
+  int file_index = -1;
 };
 
 struct NamedLight {

@@ -217,6 +217,7 @@ Status convert_nodes(const Context& ctx, const ParsedFile& file, const std::vect
     FileNode& fn = nodes[static_cast<std::size_t>(index)];
     Node node = fn.node;
     node.parent = out_parent;
+    node.file_index = index;
     const bool moves = fn.gi.light_moves.value_or(false);
     if (fn.punctual_light >= 0) {
       node.light = fn.punctual_light;
