@@ -31,8 +31,9 @@ enum class ExposureMode : std::uint8_t {
 };
 
 /// Automatic exposure's metering, clamp, compensation and adaptation
-/// (RenderSettings::auto_exposure). Metering: the frame's pixels whose photometric luminance
-/// is at least 2^kMeteredLog2LuminanceMin cd/m^2 (darker ones, such as a background without
+/// (RenderSettings::auto_exposure). Metering: the frame's pixels on every
+/// kMeteredPixelStride-th column and row from the bottom-left corner (a quarter of them)
+/// whose photometric luminance is at least 2^kMeteredLog2LuminanceMin cd/m^2 (darker ones, such as a background without
 /// a sky, are not metered; brighter than 2^kMeteredLog2LuminanceMax count as that) are ranked
 /// by luminance; the mean log2 luminance of those ranked between low_percentile and
 /// high_percentile (fractions of the metered pixels) is log2 of the frame's log-average
@@ -78,6 +79,10 @@ struct ExposureReading {
 inline constexpr float kSaturationScale = 1.2f;
 /// Reflected-light meter: EV100 = log2(L_avg x 100 / 12.5) = log2(L_avg) + kMeterEvOffset.
 inline constexpr float kMeterEvOffset = 3.0f;
+/// Metering looks at every second pixel of every second row (GL's pixel (0, 0) first): a
+/// quarter of the frame, which keeps the pass at about a third of the tonemap's cost on
+/// llvmpipe (docs/exposure.md) and changes the log-average of any frame by little.
+inline constexpr int kMeteredPixelStride = 2;
 /// Metered luminance range, cd/m^2: 2^-10 (below starlight) to 2^22 (well above the engine's sun).
 inline constexpr float kMeteredLog2LuminanceMin = -10.0f;
 inline constexpr float kMeteredLog2LuminanceMax = 22.0f;

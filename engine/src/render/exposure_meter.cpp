@@ -57,7 +57,8 @@ ShaderProgramBuilder& define_exposure_constants(ShaderProgramBuilder& b) {
       .define("METER_EV_OFFSET " + std::to_string(kMeterEvOffset))
       .define("LUMENS_PER_WATT " + std::to_string(units::kLumensPerWatt))
       .define("SATURATION_SCALE " + std::to_string(kSaturationScale))
-      .define("PIXELS_PER_SIDE " + std::to_string(kMeterPixelsPerSide));
+      .define("PIXELS_PER_SIDE " + std::to_string(kMeterPixelsPerSide))
+      .define("METER_STRIDE " + std::to_string(kMeteredPixelStride));
 }
 
 Result<ExposureMeter> ExposureMeter::create() {
@@ -85,7 +86,7 @@ void ExposureMeter::run(std::uint32_t hdr, int width, int height, double dt_s, b
   histogram_.use();
   glBindTextureUnit(0, hdr);
   glUniform2i(0, width, height);
-  constexpr int tile = 16 * kMeterPixelsPerSide;
+  constexpr int tile = 16 * kMeterPixelsPerSide * kMeteredPixelStride;
   glDispatchCompute(static_cast<GLuint>((width + tile - 1) / tile), static_cast<GLuint>((height + tile - 1) / tile), 1);
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
 

@@ -24,8 +24,9 @@ inline constexpr std::uint32_t kExposureHistogramBinding = 5;
 /// below 2^32 / 15 = 286 M pixels, far beyond the largest target).
 inline constexpr int kMeterBins = 256;
 inline constexpr int kMeterSubBinSteps = 16;
-/// Each invocation of the histogram pass meters PIXELS_PER_SIDE^2 pixels, so a work group
-/// covers a 64 x 64 tile (8192^2 pixels: 128 x 128 groups, far below the 65535 limit).
+/// Each invocation of the histogram pass meters PIXELS_PER_SIDE^2 pixels, every
+/// kMeteredPixelStride-th of every kMeteredPixelStride-th row, so a work group covers a
+/// 128 x 128 tile (8192^2 pixels: 64 x 64 groups, far below the 65535 limit).
 inline constexpr int kMeterPixelsPerSide = 4;
 
 /// C++ mirror of exposure_common.glsl's ExposureState (std430).
