@@ -2,17 +2,22 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <limits>
+#include <string>
 
 #include <glm/gtc/quaternion.hpp>
+#include <glm/gtx/matrix_decompose.hpp>
 
 #include <engine/components.h>
+#include <engine/finite.h>
 
 namespace game_demo {
 
 namespace {
 
 constexpr float kMaxPitchRad = 1.45f;
+constexpr float kModelRadiusM = 2.5f;  // framing_view: a smaller bounding sphere is a model, not a level
 
 glm::quat rotation_of(float yaw_rad, float pitch_rad) {
   return glm::angleAxis(yaw_rad, glm::vec3(0, 1, 0)) * glm::angleAxis(pitch_rad, glm::vec3(1, 0, 0));
@@ -66,6 +71,18 @@ Aabb mesh_world_bounds(const engine::Scene& scene, engine::Entity e) {
   return box;
 }
 
+// Flying: along the view (pitch included), sideways on the horizontal and along world +Y,
+// at the scene's fly speed, through everything.
+void fly(engine::Registry& reg, const engine::FrameTime& time, const GameplayContext& ctx, float fwd, float side,
+         const glm::vec3& view, const glm::vec3& right) {
+  const float vertical = (ctx.input.held(Key::Up) ? 1.0f : 0.0f) - (ctx.input.held(Key::Down) ? 1.0f : 0.0f);
+  const glm::vec3 direction = view * fwd + right * side + glm::vec3(0.0f, vertical, 0.0f);
+  if (direction == glm::vec3(0.0f)) return;
+  const float speed = reg.get<PlayerController>(ctx.camera).fly_speed_m_s;
+  const glm::vec3 step = glm::normalize(direction) * (speed * static_cast<float>(time.dt_s));
+  if (engine::all_finite(step)) reg.write<engine::Transform>(ctx.camera).position += step;
+}
+
 void player_controller(engine::Registry& reg, const engine::FrameTime& time, GameplayContext& ctx) {
   if (!ctx.camera || !reg.has<PlayerController>(ctx.camera)) return;
   const InputFrame& in = ctx.input;
@@ -83,12 +100,16 @@ void player_controller(engine::Registry& reg, const engine::FrameTime& time, Gam
     reg.write<engine::Transform>(ctx.camera).rotation = rotation_of(yaw, pitch);
   }
 
-  // Walking: horizontal, one axis at a time so the player slides along walls.
   const float fwd = (in.held(Key::W) ? 1.0f : 0.0f) - (in.held(Key::S) ? 1.0f : 0.0f);
   const float side = (in.held(Key::D) ? 1.0f : 0.0f) - (in.held(Key::A) ? 1.0f : 0.0f);
-  if (fwd == 0.0f && side == 0.0f) return;
   const glm::vec3 forward = forward_of_yaw(yaw);
   const glm::vec3 right(-forward.z, 0.0f, forward.x);
+  if (ctx.tuning.locomotion == Locomotion::Fly) {
+    fly(reg, time, ctx, fwd, side, rotation_of(yaw, pitch) * glm::vec3(0.0f, 0.0f, -1.0f), right);
+    return;
+  }
+  // Walking: horizontal, one axis at a time so the player slides along walls.
+  if (fwd == 0.0f && side == 0.0f) return;
   const glm::vec3 step = glm::normalize(forward * fwd + right * side) *
                          (pc.walk_speed_m_s * static_cast<float>(time.dt_s));
   glm::vec3 eye = reg.get<engine::Transform>(ctx.camera).position;
@@ -201,12 +222,47 @@ Aabb crate_box(const engine::Registry& reg, engine::Entity crate, float skin_m) 
   return {center - glm::max(half, glm::vec3(0.0f)), center + glm::max(half, glm::vec3(0.0f))};
 }
 
+Locomotion default_locomotion(std::string_view scene_as_given) {
+  if (scene_as_given.empty()) return Locomotion::Walk;  // gi_demo's default scene: the demo level
+  const std::string file = std::filesystem::path(scene_as_given).filename().string();
+  return file.starts_with("demo_level.") ? Locomotion::Walk : Locomotion::Fly;
+}
+
+engine::Transform framing_view(const glm::vec3& min, const glm::vec3& max, engine::Camera& camera) {
+  const glm::vec3 centre = 0.5f * (min + max);
+  const float radius = 0.5f * glm::length(max - min);
+  engine::Transform t;
+  t.position = centre;
+  if (!(radius > 0.0f) || !std::isfinite(radius)) return t;
+  if (radius < kModelRadiusM) {  // a model: from the front, its sphere filling 1/1.6 of the view
+    t.position = centre + glm::vec3(0.0f, 0.0f, 1.6f * radius / std::tan(0.5f * camera.yfov_rad));
+    camera.znear_m = std::min(camera.znear_m, 0.1f * radius);
+    return t;
+  }
+  // A level: from above a diagonal, the whole bounding sphere within the vertical field of view.
+  const glm::vec3 from_centre = glm::normalize(glm::vec3(1.0f, 1.0f, 1.0f));
+  const float distance = radius / std::sin(0.5f * camera.yfov_rad);
+  t.position = centre + from_centre * distance;
+  const glm::vec3 f = -from_centre;
+  t.rotation = rotation_of(std::atan2(-f.x, -f.z), std::asin(f.y));
+  camera.znear_m = 0.005f * radius;
+  camera.zfar_m = 4.0f * (distance + radius);
+  return t;
+}
+
 GameplayContext prepare_scene(engine::Scene& scene, const GameplayTuning& tuning) {
   engine::Registry& reg = scene.registry;
   engine::update_world_transforms(reg);
   GameplayContext ctx;
   ctx.tuning = tuning;
   ctx.collision = CollisionWorld::build(scene);
+  Aabb bounds{glm::vec3(std::numeric_limits<float>::max()), glm::vec3(std::numeric_limits<float>::lowest())};
+  for (engine::Entity e : reg.entities_with<engine::MeshRenderer>()) {
+    const Aabb b = mesh_world_bounds(scene, e);
+    if (b.empty()) continue;
+    bounds.min = glm::min(bounds.min, b.min);
+    bounds.max = glm::max(bounds.max, b.max);
+  }
 
   // Camera and player.
   ctx.camera = engine::find_by_name(reg, "camera");
@@ -214,25 +270,28 @@ GameplayContext prepare_scene(engine::Scene& scene, const GameplayTuning& tuning
   if (!ctx.camera) {
     ctx.camera = reg.create();
     reg.emplace<engine::Name>(ctx.camera, engine::Name{"camera"});
-    const Aabb& b = ctx.collision.level_bounds();
-    engine::Transform t;
     engine::Camera camera;
-    if (!b.empty()) t.position = glm::vec3(b.center().x, b.min.y + 1.6f, b.center().z);
-    // A single object rather than a level (a model as artists ship it, no camera): framed
-    // from +Z, its bounding sphere filling the view.
-    const float radius = b.empty() ? 0.0f : 0.5f * glm::length(b.max - b.min);
-    if (radius > 0.0f && radius < 2.5f) {
-      t.position = b.center() + glm::vec3(0.0f, 0.0f, 1.6f * radius / std::tan(0.5f * camera.yfov_rad));
-      camera.znear_m = std::min(camera.znear_m, 0.1f * radius);
-    }
-    reg.emplace<engine::Transform>(ctx.camera, t);
+    reg.emplace<engine::Transform>(ctx.camera,
+                                   bounds.empty() ? engine::Transform{} : framing_view(bounds.min, bounds.max, camera));
     reg.emplace<engine::Camera>(ctx.camera, camera);
+  } else if (const engine::Transform& t = reg.get<engine::Transform>(ctx.camera); t.parent) {
+    // The player moves the camera in world space: a camera under a parent node starts at
+    // its world pose, parented to nothing.
+    glm::vec3 scale, skew;
+    glm::vec4 perspective;
+    engine::Transform world;
+    glm::decompose(reg.get<engine::WorldTransform>(ctx.camera).matrix, scale, world.rotation, world.position, skew,
+                   perspective);
+    world.rotation = glm::normalize(world.rotation);
+    reg.write<engine::Transform>(ctx.camera) = world;
+    engine::update_world_transforms(reg);
   }
   const glm::quat q = reg.get<engine::Transform>(ctx.camera).rotation;
   const glm::vec3 f = q * glm::vec3(0, 0, -1);
   PlayerController pc;
   pc.yaw_rad = std::atan2(-f.x, -f.z);
   pc.pitch_rad = std::asin(std::clamp(f.y, -1.0f, 1.0f));
+  pc.fly_speed_m_s = bounds.empty() ? pc.walk_speed_m_s : glm::length(bounds.max - bounds.min) / tuning.fly_crossing_s;
   reg.emplace<PlayerController>(ctx.camera, pc);
 
   // Flashlight.

@@ -53,7 +53,9 @@ engine::Result<Simulation> simulation_for_session(const Session& session, const 
   engine::Result<engine::Scene> scene = load_scene(scene_path);
   if (!scene) return scene.error();
   return Simulation(std::move(scene).value(),
-                    SimulationSettings{.fixed_dt_s = session.header.fixed_dt_s, .seed = session.header.seed});
+                    SimulationSettings{.fixed_dt_s = session.header.fixed_dt_s,
+                                       .seed = session.header.seed,
+                                       .tuning = {.locomotion = default_locomotion(session.header.scene_path)}});
 }
 
 ReplayOutcome replay_inputs(Simulation& sim, const Session& session, const ReplayFrameCallback& after_step) {

@@ -1,8 +1,11 @@
 // Gameplay systems on a room built in code (demo/test_room.h): walking, mouse look,
-// walls, the flashlight toggle, pushing crates, and change tracking.
+// walls, the flashlight toggle, pushing crates, change tracking, flying and the starting view.
+#include <algorithm>
 #include <cmath>
 
 #include <gtest/gtest.h>
+
+#include <glm/gtc/quaternion.hpp>
 
 #include <engine/components.h>
 
@@ -245,3 +248,107 @@ TEST(Flashlight, ATapBetweenTwoPollsTogglesItOnce) {
 }
 
 }  // namespace
+
+namespace {
+
+game_demo::SimulationSettings flying() {
+  game_demo::SimulationSettings s;
+  s.tuning.locomotion = game_demo::Locomotion::Fly;
+  return s;
+}
+
+// The room's meshes span x -5.2..5.2, y -0.2..3.2, z -3.2..3.2 (demo/test_room.h).
+const float kRoomDiagonalM = std::sqrt(10.4f * 10.4f + 3.4f * 3.4f + 6.4f * 6.4f);
+
+}  // namespace
+
+TEST(Locomotion, WalkOnTheDemoLevelFlyElsewhere) {
+  EXPECT_EQ(game_demo::default_locomotion(""), game_demo::Locomotion::Walk);
+  EXPECT_EQ(game_demo::default_locomotion("assets/demo_level.gltf"), game_demo::Locomotion::Walk);
+  EXPECT_EQ(game_demo::default_locomotion("/x/demo_level.draco.glb"), game_demo::Locomotion::Walk);
+  EXPECT_EQ(game_demo::default_locomotion("../shared/external-assets/dabrovic-sponza/sponza.gltf"),
+            game_demo::Locomotion::Fly);
+  EXPECT_EQ(game_demo::SimulationSettings{}.tuning.locomotion, game_demo::Locomotion::Walk);
+}
+
+// Flying: W along the view with its pitch, Up/Down along +Y, through walls, at the scene's
+// diagonal / fly_crossing_s (10 s).
+TEST(PlayerController, FlyingFollowsThePitchedViewThroughWallsAtTheScenesSpeed) {
+  game_demo::Simulation sim(demo_test::make_room({}), flying());
+  const float speed = kRoomDiagonalM / 10.0f;
+  EXPECT_NEAR(sim.registry().get<game_demo::PlayerController>(sim.context().camera).fly_speed_m_s, speed, 1e-4f);
+  InputFrame look_up;
+  look_up.mouse_dy_px = -0.5f / 0.0025f;  // the mouse forward: 0.5 rad up
+  sim.step(look_up);
+  const glm::vec3 start = eye_of(sim);
+  for (int i = 0; i < 60; ++i) sim.step(keys({Key::W}));
+  const glm::vec3 moved = eye_of(sim) - start;
+  EXPECT_NEAR(glm::length(moved), speed, 1e-3f) << "one second at the fly speed";
+  EXPECT_NEAR(moved.y, speed * std::sin(0.5f), 1e-3f);
+  EXPECT_NEAR(moved.z, -speed * std::cos(0.5f), 1e-3f);
+  for (int i = 0; i < 60; ++i) sim.step(keys({Key::Down}));
+  EXPECT_NEAR(eye_of(sim).y, start.y + moved.y - speed, 1e-3f);
+  for (int i = 0; i < 60; ++i) sim.step(keys({Key::Up}));
+  EXPECT_NEAR(eye_of(sim).y, start.y + moved.y, 1e-3f);
+  for (int i = 0; i < 10 * 60; ++i) sim.step(keys({Key::A}));  // 12.7 m to the left: out through the west wall
+  EXPECT_LT(eye_of(sim).x, -5.2f);
+
+  // Walking on the same room: no height change, stopped by the wall.
+  game_demo::Simulation walk(demo_test::make_room({}));
+  walk.step(look_up);
+  for (int i = 0; i < 10 * 60; ++i) walk.step(keys({Key::A}));
+  EXPECT_GT(eye_of(walk).x, -5.0f);
+  EXPECT_FLOAT_EQ(eye_of(walk).y, 1.6f);
+}
+
+// A level without a camera (the room's meshes, no camera node) is framed from above a
+// diagonal: every corner of its bounds in view, the camera outside them, zfar beyond them.
+TEST(PrepareScene, ALevelWithoutACameraIsFramedFromAboveADiagonal) {
+  engine::Scene room = demo_test::make_room({});
+  engine::SceneAsset a = room.assets;
+  a.nodes.erase(std::remove_if(a.nodes.begin(), a.nodes.end(), [](const engine::Node& n) { return n.camera >= 0; }),
+                a.nodes.end());
+  a.cameras.clear();
+  game_demo::Simulation sim(engine::instantiate(std::move(a)), flying());
+  const engine::Entity camera = sim.context().camera;
+  const engine::Transform& t = sim.registry().get<engine::Transform>(camera);
+  const engine::Camera& cam = sim.registry().get<engine::Camera>(camera);
+  const glm::vec3 centre(0.0f, 1.5f, 0.0f);
+  const glm::vec3 forward = t.rotation * glm::vec3(0.0f, 0.0f, -1.0f);
+  EXPECT_GT(glm::dot(glm::normalize(centre - t.position), forward), 0.9999f) << "looking at the centre";
+  EXPECT_GT(t.position.y, 3.2f) << "from above";
+  EXPECT_GT(t.position.x, 5.2f);
+  EXPECT_GT(t.position.z, 3.2f);
+  for (int i = 0; i < 8; ++i) {
+    const glm::vec3 corner((i & 1) ? 5.2f : -5.2f, (i & 2) ? 3.2f : -0.2f, (i & 4) ? 3.2f : -3.2f);
+    const glm::vec3 to = corner - t.position;
+    const float angle = std::acos(glm::dot(glm::normalize(to), forward));
+    EXPECT_LT(angle, 0.5f * cam.yfov_rad) << "corner " << i << " in the vertical field of view";
+    EXPECT_LT(glm::length(to), cam.zfar_m);
+    EXPECT_GT(glm::length(to), cam.znear_m);
+  }
+  EXPECT_NEAR(cam.znear_m, 0.005f * 0.5f * kRoomDiagonalM, 1e-5f);
+}
+
+// A camera under a transformed parent starts at its world pose, then moves in world space.
+TEST(PrepareScene, ACameraUnderAParentStartsAtItsWorldPose) {
+  engine::Scene room = demo_test::make_room({});
+  engine::SceneAsset a = room.assets;
+  engine::Node rig;
+  rig.name = "rig";
+  rig.translation = {1.0f, 0.5f, 0.0f};
+  rig.rotation = glm::angleAxis(0.5f, glm::vec3(0.0f, 1.0f, 0.0f));
+  a.nodes.push_back(rig);
+  for (engine::Node& n : a.nodes)
+    if (n.camera >= 0) n.parent = static_cast<int>(a.nodes.size() - 1);
+  std::rotate(a.nodes.begin(), a.nodes.end() - 1, a.nodes.end());  // parents first
+  for (engine::Node& n : a.nodes) n.parent = n.parent >= 0 ? 0 : -1;
+  engine::Scene scene = engine::instantiate(std::move(a));
+  const engine::Entity cam_entity = engine::find_camera(scene.registry);
+  const glm::mat4 world = scene.registry.get<engine::WorldTransform>(cam_entity).matrix;
+  game_demo::Simulation sim(std::move(scene), flying());
+  const engine::Transform& t = sim.registry().get<engine::Transform>(sim.context().camera);
+  EXPECT_FALSE(t.parent);
+  EXPECT_NEAR(glm::length(t.position - glm::vec3(world[3])), 0.0f, 1e-5f);
+  EXPECT_NEAR(std::abs(glm::dot(t.rotation, glm::quat_cast(glm::mat3(world)))), 1.0f, 1e-5f);
+}

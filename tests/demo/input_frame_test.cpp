@@ -41,7 +41,7 @@ TEST(InputFrame, RejectsShortBuffersAndUnknownKeys) {
   std::vector<std::byte> bytes;
   game_demo::append_input_frame(bytes, {.keys = 1});
   EXPECT_FALSE(game_demo::read_input_frame(std::span(bytes).first(11)).has_value());
-  bytes[1] = std::byte{0x01};  // bit 8: no such key (bit 7 is O)
+  bytes[1] = std::byte{0x04};  // bit 10: no such key (bit 9 is Down)
   EXPECT_FALSE(game_demo::read_input_frame(bytes).has_value());
 }
 

@@ -12,19 +12,22 @@
 
 namespace game_demo {
 
-/// The keys the demo reacts to. Movement keys act while held; F, E, G and O act on the step
-/// where they go from released to held (edge-triggered in the gameplay systems).
+/// The keys the demo reacts to. Movement keys (W, A, S, D, Up, Down) act while held; F, E, G
+/// and O act on the step where they go from released to held (edge-triggered in the
+/// gameplay systems).
 enum class Key : std::uint8_t {
-  W = 0,  ///< forward
-  A = 1,  ///< strafe left
-  S = 2,  ///< backward
-  D = 3,  ///< strafe right
-  F = 4,  ///< toggle the flashlight
-  E = 5,  ///< push the crate in front of the camera
-  G = 6,  ///< toggle the split screen (direct only | full)
-  O = 7,  ///< close / open the corridor door (a deforming node: antiradiance relights it)
+  W = 0,     ///< forward
+  A = 1,     ///< strafe left
+  S = 2,     ///< backward
+  D = 3,     ///< strafe right
+  F = 4,     ///< toggle the flashlight
+  E = 5,     ///< push the crate in front of the camera
+  G = 6,     ///< toggle the split screen (direct only | full)
+  O = 7,     ///< close / open the corridor door (a deforming node: antiradiance relights it)
+  Up = 8,    ///< fly up (Locomotion::Fly; the window maps Space)
+  Down = 9,  ///< fly down (Locomotion::Fly; the window maps C)
 };
-inline constexpr int kKeyCount = 8;
+inline constexpr int kKeyCount = 10;
 
 /// The bit of `k` in InputFrame::keys.
 constexpr std::uint32_t key_bit(Key k) { return 1u << static_cast<std::uint32_t>(k); }
