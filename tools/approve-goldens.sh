@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Regenerates the golden images of tests/golden/ by replaying the committed sessions
 # headlessly, exactly as tests/demo/golden_test.cpp does (session, frame and size from
-# tests/golden/goldens.txt). Review the new images before committing them.
+# tests/golden/goldens.txt; the fixed exposure game_demo::kDemoExposure, 0.3, not gi_demo's
+# automatic default). Review the new images before committing them.
 #   tools/approve-goldens.sh [BUILD_DIR]        # default BUILD_DIR: build
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -20,7 +21,7 @@ while read -r session frame width height lighting; do
                                            --out "$bundle" >/dev/null
     gi=(--gi-bundle "$bundle") suffix="_gi"
   fi
-  "$demo" --headless --replay "tests/sessions/$session.girec" --frames $((frame + 1)) --width "$width" \
+  "$demo" --headless --replay "tests/sessions/$session.girec" --exposure 0.3 --frames $((frame + 1)) --width "$width" \
           --height "$height" --out "$tmp/$session$suffix" --every "$frame" --only-written-frames "${gi[@]}" >/dev/null
   out=$(printf "tests/golden/%s_f%04d%s.png" "$session" "$frame" "$suffix")
   cp "$(printf "%s/%s%s/frame_%04d.png" "$tmp" "$session" "$suffix" "$frame")" "$out"

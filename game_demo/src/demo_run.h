@@ -26,7 +26,12 @@ struct RunOptions {
   std::string out_dir;          ///< Headless frame folder (empty: no images written).
   int width = 960;
   int height = 540;
-  float exposure = kDemoExposure;  ///< Linear scale before tonemapping.
+  /// Exposure (engine/exposure.h, docs/exposure.md): automatic unless --exposure (a fixed
+  /// linear scale, as the goldens render with kDemoExposure) or --ev100 fixes it.
+  engine::ExposureMode exposure_mode = engine::ExposureMode::Automatic;
+  float exposure = kDemoExposure;         ///< --exposure: linear scale before tonemapping.
+  float ev100 = 15.0f;                    ///< --ev100: a camera's exposure value at ISO 100.
+  float exposure_compensation_ev = 0.0f;  ///< --exposure-compensation: automatic exposure's bias, EV.
   bool area_soft_shadows = true;   ///< --area-shadows soft|centre (engine::RenderSettings::area_soft_shadows).
   bool light_reach_culling = true;  ///< --light-reach on|off (engine::RenderSettings::light_reach_culling).
   bool flat_shading = false;        ///< --shading full|flat (engine::RenderSettings::flat_shading: a yardstick).
@@ -59,6 +64,24 @@ struct RunState {
   bool step(const InputFrame& input);
   /// Writes the recording, if any; prints and returns false on failure.
   bool finish_recording(const std::string& path) const;
+};
+
+/// The renderer's settings for a run (size, exposure, shadows, light reach, shading).
+engine::RenderSettings render_settings(const RunOptions& options);
+
+/// One line for the overlay and the headless summary: the exposure of the last frame
+/// ("automatic, EV100 12.31 (target 12.40) ..."; reads it back from the GPU when automatic).
+std::string describe_exposure(const RunOptions& options, const engine::Renderer& renderer);
+
+/// The game time since the previous render, for automatic exposure's adaptation: the
+/// steps run since then x the fixed step (0 when none ran; the first frame snaps anyway).
+struct RenderClock {
+  std::uint64_t last_rendered_step = 0;
+  double dt_s(const Simulation& sim) {
+    const double dt = static_cast<double>(sim.frame() - last_rendered_step) * sim.settings().fixed_dt_s;
+    last_rendered_step = sim.frame();
+    return dt;
+  }
 };
 
 /// Maps the simulation's split flag to the renderer's setting.

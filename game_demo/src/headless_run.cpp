@@ -59,16 +59,7 @@ int run_headless(const RunOptions& o, RunState& state) {
     }
     gpu.emplace(std::move(ctx).value());
     if (!load_indirect_light(o, sim, indirect)) return 1;  // before the renderer: it adds TEXCOORD_1
-    auto r = engine::Renderer::create(
-        sim.scene().assets,
-        engine::RenderSettings{.width = o.width,
-                               .height = o.height,
-                               .exposure = o.exposure,
-                               .area_soft_shadows = o.area_soft_shadows,
-                               .area_shadow_res = o.area_shadow_res,
-                               .light_reach_culling = o.light_reach_culling,
-                               .flat_shading = o.flat_shading,
-                               .warn = [](const std::string& line) { std::cerr << "gi_demo: " << line << '\n'; }});
+    auto r = engine::Renderer::create(sim.scene().assets, render_settings(o));
     if (!r) {
       std::cerr << "gi_demo: " << r.error().to_string() << '\n';
       return 1;
@@ -92,6 +83,7 @@ int run_headless(const RunOptions& o, RunState& state) {
   std::vector<std::string> system_order, pass_order;
   std::uint64_t shadow_views_drawn = 0, shadow_views_cached = 0, shadow_views_unseen = 0, rendered_frames = 0,
                 light_groups = 0;
+  RenderClock render_clock;
   const auto run_t0 = Clock::now();
   for (std::uint64_t i = 0; i < frames; ++i) {
     const auto t0 = Clock::now();
@@ -112,7 +104,7 @@ int run_headless(const RunOptions& o, RunState& state) {
     if (renderer && (written || !o.only_written)) {
       const auto t1 = Clock::now();
       renderer->settings().split = split_of(sim);
-      renderer->render(sim.registry(), sim.context().camera);
+      renderer->render(sim.registry(), sim.context().camera, render_clock.dt_s(sim));
       render_ms.add(ms_since(t1));
       for (const auto& p : renderer->last_timings()) {
         if (!passes.contains(p.name)) pass_order.push_back(p.name);
@@ -162,6 +154,7 @@ int run_headless(const RunOptions& o, RunState& state) {
     std::printf("  light sets per frame: %.2f (pixels shaded with only the lights that can reach them; 1: every light "
                 "everywhere)\n",
                 static_cast<double>(light_groups) / static_cast<double>(rendered_frames));
+  if (rendered_frames > 0) std::printf("  %s at the last frame\n", describe_exposure(o, *renderer).c_str());
   for (const std::string& line : gi_status_lines(indirect.get())) std::printf("%s\n", line.c_str());
   std::printf("final state checksum 0x%016llx after frame %llu\n", static_cast<unsigned long long>(sim.checksum()),
               static_cast<unsigned long long>(sim.frame()));

@@ -1,9 +1,11 @@
 // gi_demo: the playable demo level. See `gi_demo --help`.
 //   gi_demo                                   window: WASD + mouse, F flashlight, E push, G split, Esc quits
+//   gi_demo --scene any.gltf                  its first camera or a framing view; flies: WASD, mouse, Space/C
 //   gi_demo --headless --frames 120 --out /tmp/frames
 //   gi_demo --headless --script push_crates --frames 600 --record s.girec --no-render
 //   gi_demo --headless --replay tests/sessions/push_crates.girec
 //   gi_demo --gi-bundle out/demo_level.gibake        light the static world with its bake (light atlas, PRM)
+//   gi_demo --exposure 0.3 | --ev100 15             fixed exposure instead of automatic (docs/exposure.md)
 #include <engine/sky.h>
 #include <gi/gi_system.h>
 
@@ -53,6 +55,36 @@ bool load_indirect_light(const RunOptions& o, Simulation& sim, std::unique_ptr<g
   }
   system = std::move(loaded).value();
   return true;
+}
+
+engine::RenderSettings render_settings(const RunOptions& o) {
+  engine::RenderSettings s{.width = o.width,
+                           .height = o.height,
+                           .exposure = o.exposure,
+                           .exposure_mode = o.exposure_mode,
+                           .ev100 = o.ev100,
+                           .area_soft_shadows = o.area_soft_shadows,
+                           .area_shadow_res = o.area_shadow_res,
+                           .light_reach_culling = o.light_reach_culling,
+                           .flat_shading = o.flat_shading,
+                           .warn = [](const std::string& line) { std::cerr << "gi_demo: " << line << '\n'; }};
+  s.auto_exposure.compensation_ev = o.exposure_compensation_ev;
+  return s;
+}
+
+std::string describe_exposure(const RunOptions& o, const engine::Renderer& renderer) {
+  const engine::ExposureReading e = renderer.read_exposure();
+  char line[160];
+  if (e.metered)
+    std::snprintf(line, sizeof line, "exposure: automatic, EV100 %.2f (target %.2f, compensation %+.1f EV), x%.4g",
+                  double{e.ev100}, double{e.target_ev100}, double{o.exposure_compensation_ev}, double{e.exposure});
+  else if (o.exposure_mode == engine::ExposureMode::FixedEv100)
+    std::snprintf(line, sizeof line, "exposure: fixed EV100 %.2f (--ev100), x%.4g", double{e.ev100},
+                  double{e.exposure});
+  else
+    std::snprintf(line, sizeof line, "exposure: fixed x%.4g (--exposure; EV100 %.2f)", double{e.exposure},
+                  double{e.ev100});
+  return line;
 }
 
 std::string describe_indirect_light(const RunOptions& o, const gi::GISystem* system) {
@@ -111,8 +143,18 @@ int main(int argc, char** argv) {
   app.add_option("--out", o.out_dir, "Headless: write DIR/frame_NNNN.png (tonemapped)");
   auto* w = app.add_option("--width", o.width, "Render width in pixels")->check(CLI::Range(16, 8192));
   auto* h = app.add_option("--height", o.height, "Render height in pixels")->check(CLI::Range(16, 8192));
-  app.add_option("--exposure", o.exposure, "Linear exposure before tonemapping (default 0.3)")
-      ->check(CLI::PositiveNumber);
+  auto* exposure = app.add_option("--exposure", o.exposure,
+                                  "Fixed linear exposure before tonemapping, e.g. 0.3 (the demo level's look, as "
+                                  "its goldens); default: automatic (docs/exposure.md)")
+                       ->check(CLI::PositiveNumber);
+  auto* ev100 = app.add_option("--ev100", o.ev100,
+                               "Fixed exposure of a camera at this EV100: radiance x 683 / (1.2 x 2^EV100) "
+                               "(15: the sunny-16 rule)")
+                    ->excludes(exposure);
+  app.add_option("--exposure-compensation", o.exposure_compensation_ev,
+                 "Automatic exposure: EV added after metering (+1: twice as bright)")
+      ->excludes(exposure)
+      ->excludes(ev100);
   app.add_option("--area-shadows", area_shadows,
                  "soft: area lights soft-shadowed over their rectangle (default); centre: from their centre only (cheaper)")
       ->check(CLI::IsMember({"soft", "centre"}));
@@ -154,6 +196,9 @@ int main(int argc, char** argv) {
   o.flat_shading = shading == "flat";
   o.area_shadow_res = area_shadow_res == "half" ? engine::AreaShadowRes::Half : engine::AreaShadowRes::Full;
   o.size_given = w->count() > 0 || h->count() > 0;
+  o.exposure_mode = exposure->count() > 0 ? engine::ExposureMode::FixedLinear
+                    : ev100->count() > 0  ? engine::ExposureMode::FixedEv100
+                                          : engine::ExposureMode::Automatic;
   if (o.script.empty()) o.script = std::string(script_name(default_script(o.scene)));
   if (!script_from_name(o.script)) {
     std::cerr << "gi_demo: unknown --script \"" << o.script << "\"\n";
@@ -195,7 +240,9 @@ int main(int argc, char** argv) {
       std::cerr << "gi_demo: " << scene.error().to_string() << '\n';
       return 1;
     }
-    state.sim = std::make_unique<Simulation>(std::move(scene).value(), SimulationSettings{.seed = o.seed});
+    state.sim = std::make_unique<Simulation>(
+        std::move(scene).value(),
+        SimulationSettings{.seed = o.seed, .tuning = {.locomotion = default_locomotion(as_given)}});
     if (!o.record_file.empty()) {
       auto hash = hash_scene_file(path);
       if (!hash) {

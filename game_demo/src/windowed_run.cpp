@@ -27,9 +27,10 @@ namespace {
 
 constexpr int kMaxStepsPerFrame = 8;  // beyond this the simulation slows down instead of spiralling
 
-constexpr std::pair<int, Key> kKeyMap[] = {{GLFW_KEY_W, Key::W}, {GLFW_KEY_A, Key::A}, {GLFW_KEY_S, Key::S},
-                                           {GLFW_KEY_D, Key::D}, {GLFW_KEY_F, Key::F}, {GLFW_KEY_E, Key::E},
-                                           {GLFW_KEY_G, Key::G}, {GLFW_KEY_O, Key::O}};
+constexpr std::pair<int, Key> kKeyMap[] = {{GLFW_KEY_W, Key::W},   {GLFW_KEY_A, Key::A}, {GLFW_KEY_S, Key::S},
+                                           {GLFW_KEY_D, Key::D},   {GLFW_KEY_F, Key::F}, {GLFW_KEY_E, Key::E},
+                                           {GLFW_KEY_G, Key::G},   {GLFW_KEY_O, Key::O}, {GLFW_KEY_SPACE, Key::Up},
+                                           {GLFW_KEY_C, Key::Down}};
 
 // Presses between two polls (GLFW queues key events; a tap is over before the next frame at
 // 2-3 frames/s). One window, so one latch.
@@ -70,6 +71,10 @@ void draw_overlay(const RunOptions& o, const RunState& state, const engine::Rend
   const engine::Light* torch = sim.registry().try_get<engine::Light>(sim.context().flashlight);
   ImGui::Text("flashlight (F): %s   split (G): %s", torch && torch->enabled ? "on" : "off",
               sim.context().split_view ? "direct | full" : "off");
+  if (sim.context().tuning.locomotion == Locomotion::Fly)
+    ImGui::Text("flying: WASD along the view, mouse look, Space up, C down; %.3g m/s",
+                double{sim.registry().get<PlayerController>(sim.context().camera).fly_speed_m_s});
+  ImGui::TextUnformatted(describe_exposure(o, renderer).c_str());
   if (state.replay)
     ImGui::Text("replaying %s: %llu / %zu", o.replay_file.c_str(), static_cast<unsigned long long>(sim.frame()),
                 state.replay->frames.size());
@@ -96,16 +101,7 @@ int run_windowed(const RunOptions& o, RunState& state) {
   std::unique_ptr<gi::GISystem> indirect;  // destroyed before the context
   if (!load_indirect_light(o, sim, indirect)) return 1;    // before the renderer: it adds TEXCOORD_1
   const std::string indirect_text = describe_indirect_light(o, indirect.get());
-  auto r = engine::Renderer::create(
-        sim.scene().assets,
-        engine::RenderSettings{.width = o.width,
-                               .height = o.height,
-                               .exposure = o.exposure,
-                               .area_soft_shadows = o.area_soft_shadows,
-                               .area_shadow_res = o.area_shadow_res,
-                               .light_reach_culling = o.light_reach_culling,
-                               .flat_shading = o.flat_shading,
-                               .warn = [](const std::string& line) { std::cerr << "gi_demo: " << line << '\n'; }});
+  auto r = engine::Renderer::create(sim.scene().assets, render_settings(o));
   if (!r) {
     std::cerr << "gi_demo: " << r.error().to_string() << '\n';
     return 1;
@@ -133,6 +129,7 @@ int run_windowed(const RunOptions& o, RunState& state) {
   double fps_window_start = last;
   int fps_window_frames = 0;
   int status = 0;
+  RenderClock render_clock;
   while (!glfwWindowShouldClose(window)) {
     glfwPollEvents();
     if (glfwGetKey(window, GLFW_KEY_ESCAPE) == GLFW_PRESS) break;
@@ -179,7 +176,7 @@ int run_windowed(const RunOptions& o, RunState& state) {
     int fb_w = 0, fb_h = 0;
     glfwGetFramebufferSize(window, &fb_w, &fb_h);
     renderer->settings().split = split_of(sim);
-    renderer->render(sim.registry(), sim.context().camera);
+    renderer->render(sim.registry(), sim.context().camera, render_clock.dt_s(sim));
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     glViewport(0, 0, fb_w, fb_h);
     renderer->present(fb_w, fb_h);

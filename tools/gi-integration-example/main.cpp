@@ -62,9 +62,12 @@ int main(int argc, char** argv) {
   }
   std::cout << (*gi)->label() << '\n' << (*gi)->describe();
 
-  // 5. The renderer, with the GI system as its indirect light.
-  auto renderer =
-      engine::Renderer::create(scene.assets, engine::RenderSettings{.width = 640, .height = 360, .exposure = 0.5f});
+  // 5. The renderer, with the GI system as its indirect light and automatic exposure
+  //    (metered from each frame on the GPU, docs/exposure.md; ExposureMode::FixedLinear or
+  //    FixedEv100 fix it).
+  auto renderer = engine::Renderer::create(
+      scene.assets,
+      engine::RenderSettings{.width = 640, .height = 360, .exposure_mode = engine::ExposureMode::Automatic});
   if (!renderer) {
     std::cerr << renderer.error().to_string() << '\n';
     return 1;
@@ -82,7 +85,7 @@ int main(int argc, char** argv) {
       scene.registry.write<engine::Transform>(crate).position += glm::vec3(-0.065f, 0.0f, 0.09f);
       engine::update_world_transforms(scene.registry);
     }
-    (*renderer)->render(scene.registry, camera);
+    (*renderer)->render(scene.registry, camera, 1.0 / 60.0);  // the game's time step drives the exposure's adaptation
     if (frame % 20 == 19) {
       char name[64];
       std::snprintf(name, sizeof name, "frame_%02d.png", frame);
@@ -92,6 +95,7 @@ int main(int argc, char** argv) {
       }
     }
   }
+  std::printf("exposure: automatic, EV100 %.2f at the last frame\n", double{(*renderer)->read_exposure().ev100});
   const gi::GISystem::Stats& st = (*gi)->stats();
   std::printf(
       "%llu frames: %llu with nothing to recompute, %llu BRF updates (%llu with motion), %llu atlas composites\n",
