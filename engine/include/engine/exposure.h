@@ -44,7 +44,7 @@ struct AutoExposure {
   /// Brightness added after metering, in EV: +1 shows the frame twice as bright.
   float compensation_ev = 0.0f;
   /// The metered EV100 is clamped to [min_ev100, max_ev100] (before the compensation):
-  /// -4 is a landscape under a full moon, so a room with its lights off stays dark instead
+  /// -4 is about a landscape under a full moon, so a room with its lights off stays dark instead
   /// of being pulled up to a noisy grey; 21 is one EV above the engine's 700 W/m^2 sun on a
   /// white surface (20.1), so the sun's own disc or a specular glint cannot push it further.
   float min_ev100 = -4.0f;
