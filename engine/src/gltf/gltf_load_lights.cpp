@@ -2,6 +2,7 @@
 // KHR_lights_punctual lights are converted from photometric glTF units to the engine's
 // radiometric ones (engine/units.h); the "gi" extras schema is in docs/scene-format.md.
 
+#include <engine/sun.h>
 #include <engine/units.h>
 
 #include <algorithm>
@@ -256,27 +257,12 @@ Status parse_scene_environment(const Context& ctx, const Json& scene_json, const
     auto radius = number_member(ctx, *sun, "angular_radius_deg", 0.27, swhere);
     if (!radius) return radius.error();
     if (!(*radius >= 0.0 && *radius <= 45.0)) return ctx.error(swhere, "'angular_radius_deg' must lie in [0, 45]");
-    // A directional light shines along its node's local -Z: rotate -Z onto `direction`.
-    const glm::vec3 to = glm::normalize(*d);
-    const glm::vec3 from(0.0f, 0.0f, -1.0f);
-    glm::quat q = glm::dot(from, to) < -0.999999f ? glm::angleAxis(static_cast<float>(std::numbers::pi), glm::vec3(1, 0, 0))
-                                                  : glm::rotation(from, to);
-    NamedLight light;
-    light.name = "sun";
-    light.light.type = LightType::Directional;
-    const float peak = std::max({e->x, e->y, e->z});
-    light.light.intensity = peak;  // W/m^2 on a surface facing the sun
-    light.light.color = peak > 0.0f ? *e / peak : glm::vec3(1.0f);
-    light.light.angular_radius_rad = static_cast<float>(*radius * std::numbers::pi / 180.0);  // the disc
-    Node node;
-    node.name = "sun";
-    node.rotation = glm::normalize(q);
-    node.light = static_cast<int>(scene.lights.size());
-    scene.environment.sun_light = node.light;
-    scene.environment.sun_node = static_cast<int>(scene.nodes.size());
-    scene.environment.sun_angular_radius_rad = static_cast<float>(*radius * std::numbers::pi / 180.0);
-    scene.lights.push_back(std::move(light));
-    scene.nodes.push_back(std::move(node));
+    // Appended after the file's nodes (scene extras are read last): the sun's node comes last.
+    scene.environment.sun_light = -1;
+    scene.environment.sun_node = -1;
+    set_sun(scene, {.direction = *d,
+                    .irradiance = *e,
+                    .angular_radius_rad = static_cast<float>(*radius * std::numbers::pi / 180.0)});
   }
   return {};
 }
