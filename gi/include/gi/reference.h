@@ -60,6 +60,24 @@ engine::Result<engine::ImageRgbaF> render_reference_image(const BakeInput& input
 engine::Result<engine::ImageRgbaF> render_reference_image(const engine::Scene& scene, engine::Entity camera, int width,
                                                           int height, const ReferenceSettings& settings);
 
+/// What the camera rays through the pixel centres hit first: the reference's geometry AOV,
+/// to tell pixels apart by the place they show (world regions) and the background from the
+/// level. Rows top to bottom, pixel (x, y) at y * width + x.
+struct FirstHitImage {
+  int width = 0;
+  int height = 0;
+  std::vector<glm::vec3> position_m;  ///< World-space point hit, metres; 0 where nothing is hit.
+  std::vector<glm::vec3> normal;      ///< Unit normal of the triangle hit, facing the camera; 0 where none.
+  std::vector<std::uint8_t> hit;      ///< 1: a surface; 0: the ray escapes (the sky, the background).
+};
+
+/// The first hits of the very rays render_reference_image traces with jitter_pixels = false
+/// (one through each pixel's centre), the same geometry and camera conventions. `threads` as
+/// in ReferenceSettings (the result does not depend on it). Errors: bad sizes or field of
+/// view, malformed geometry.
+engine::Result<FirstHitImage> reference_first_hits(const BakeInput& input, const ReferenceCamera& camera, int width,
+                                                   int height, unsigned threads = 0);
+
 /// A receiver of irradiance: a point on a surface and the unit normal of its lit side.
 struct SurfacePoint {
   glm::vec3 position_m{0.0f};

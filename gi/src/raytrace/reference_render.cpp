@@ -53,24 +53,51 @@ PathTracerSettings tracer_settings(const ReferenceSettings& s) {
   return t;
 }
 
+engine::Status check_camera(const PinholeCamera& camera) {
+  if (camera.width < 1 || camera.height < 1 || camera.width > 16384 || camera.height > 16384)
+    return settings_error("image size must be in [1, 16384]^2, got " + std::to_string(camera.width) + "x" +
+                          std::to_string(camera.height));
+  if (!(camera.yfov_rad > 0.0f && camera.yfov_rad < 3.1f)) return settings_error("camera yfov must be in (0, 3.1) rad");
+  return {};
+}
+
+// The camera rays of a pinhole image: one place, so the first-hit image and the radiance
+// image trace the very same rays through the pixel centres.
+struct PixelRays {
+  explicit PixelRays(const PinholeCamera& camera)
+      : eye(camera.camera_to_world[3]),
+        rot(camera.camera_to_world),
+        tan_half(std::tan(0.5f * camera.yfov_rad)),
+        aspect(camera.aspect > 0.0f ? camera.aspect
+                                    : static_cast<float>(camera.width) / static_cast<float>(camera.height)),
+        width(camera.width),
+        height(camera.height) {}
+
+  /// Unit direction through (x + jx, y + jy) in pixels, rows top to bottom.
+  glm::vec3 direction(int x, int y, float jx, float jy) const {
+    const float ndc_x = 2.0f * (static_cast<float>(x) + jx) / static_cast<float>(width) - 1.0f;
+    const float ndc_y = 1.0f - 2.0f * (static_cast<float>(y) + jy) / static_cast<float>(height);
+    return glm::normalize(rot * glm::vec3(ndc_x * tan_half * aspect, ndc_y * tan_half, -1.0f));
+  }
+
+  glm::vec3 eye;
+  glm::mat3 rot;
+  float tan_half;
+  float aspect;
+  int width;
+  int height;
+};
+
 }  // namespace
 
 engine::Result<engine::ImageRgbaF> render_reference(const ReferenceScene& scene, const PinholeCamera& camera,
                                                     const ReferenceSettings& settings, const WorkShard& shard) {
   if (auto ok = check_settings(settings); !ok) return ok.error();
-  if (camera.width < 1 || camera.height < 1 || camera.width > 16384 || camera.height > 16384)
-    return settings_error("image size must be in [1, 16384]^2, got " + std::to_string(camera.width) + "x" +
-                          std::to_string(camera.height));
-  if (!(camera.yfov_rad > 0.0f && camera.yfov_rad < 3.1f)) return settings_error("camera yfov must be in (0, 3.1) rad");
+  if (auto ok = check_camera(camera); !ok) return ok.error();
   auto prepared = prepare(scene);
   if (!prepared) return prepared.error();
   const PathTracer tracer(scene, prepared->index, *prepared->caster, tracer_settings(settings));
-
-  const float tan_half = std::tan(0.5f * camera.yfov_rad);
-  const float aspect =
-      camera.aspect > 0.0f ? camera.aspect : static_cast<float>(camera.width) / static_cast<float>(camera.height);
-  const glm::vec3 eye(camera.camera_to_world[3]);
-  const glm::mat3 rot(camera.camera_to_world);
+  const PixelRays rays(camera);
 
   engine::ImageRgbaF image;
   image.width = camera.width;
@@ -93,16 +120,44 @@ engine::Result<engine::ImageRgbaF> render_reference(const ReferenceScene& scene,
         for (int s = 0; s < settings.samples_per_pixel; ++s) {
           const float jx = settings.jitter_pixels ? rng.next_float() : 0.5f;
           const float jy = settings.jitter_pixels ? rng.next_float() : 0.5f;
-          const float ndc_x = 2.0f * (static_cast<float>(x) + jx) / static_cast<float>(camera.width) - 1.0f;
-          const float ndc_y = 1.0f - 2.0f * (static_cast<float>(y) + jy) / static_cast<float>(camera.height);
-          const glm::vec3 dir = glm::normalize(rot * glm::vec3(ndc_x * tan_half * aspect, ndc_y * tan_half, -1.0f));
-          sum += glm::dvec3(finite_or_zero(tracer.radiance(Ray{eye, 0.0f, dir}, rng)));
+          sum += glm::dvec3(finite_or_zero(tracer.radiance(Ray{rays.eye, 0.0f, rays.direction(x, y, jx, jy)}, rng)));
         }
         const glm::dvec3 mean = sum / static_cast<double>(settings.samples_per_pixel);
         for (int c = 0; c < 3; ++c) image.pixels[4 * i + static_cast<std::size_t>(c)] = static_cast<float>(mean[c]);
       });
   if (!completed) return engine::cancelled_error("reference render");
   return image;
+}
+
+engine::Result<FirstHitImage> first_hits(const ReferenceScene& scene, const PinholeCamera& camera, unsigned threads) {
+  if (auto ok = check_camera(camera); !ok) return ok.error();
+  auto prepared = prepare(scene);
+  if (!prepared) return prepared.error();
+  const PixelRays rays(camera);
+  FirstHitImage out;
+  out.width = camera.width;
+  out.height = camera.height;
+  const std::size_t count = static_cast<std::size_t>(camera.width) * static_cast<std::size_t>(camera.height);
+  out.position_m.assign(count, glm::vec3(0.0f));
+  out.normal.assign(count, glm::vec3(0.0f));
+  out.hit.assign(count, 0);
+  ThreadPool pool(threads);
+  pool.parallel_for(
+      count,
+      [&](std::size_t i) {
+        const int x = static_cast<int>(i % static_cast<std::size_t>(camera.width));
+        const int y = static_cast<int>(i / static_cast<std::size_t>(camera.width));
+        const glm::vec3 dir = rays.direction(x, y, 0.5f, 0.5f);
+        const Hit hit = prepared->caster->intersect(Ray{rays.eye, 0.0f, dir});
+        if (!hit.valid()) return;
+        const ShadingTriangle& tri =
+            prepared->index.triangles[prepared->index.instance_first[hit.instance] + hit.primitive];
+        out.position_m[i] = tri.p0 + hit.barycentric.x * tri.e1 + hit.barycentric.y * tri.e2;
+        out.normal[i] = glm::dot(tri.face_normal, dir) > 0.0f ? -tri.face_normal : tri.face_normal;
+        out.hit[i] = 1;
+      },
+      256);
+  return out;
 }
 
 engine::Result<IrradianceEstimate> estimate_irradiance(const ReferenceScene& scene,
@@ -173,6 +228,18 @@ engine::Result<engine::ImageRgbaF> render_reference_image(const BakeInput& input
   pc.width = width;
   pc.height = height;
   return render_reference(reference_scene_from(input), pc, settings);
+}
+
+engine::Result<FirstHitImage> reference_first_hits(const BakeInput& input, const ReferenceCamera& camera, int width,
+                                                   int height, unsigned threads) {
+  if (auto ok = validate_bake_input(input); !ok) return ok.error();
+  PinholeCamera pc;
+  pc.camera_to_world = camera.camera_to_world;
+  pc.yfov_rad = camera.yfov_rad;
+  pc.aspect = camera.aspect;
+  pc.width = width;
+  pc.height = height;
+  return first_hits(reference_scene_from(input), pc, threads);
 }
 
 engine::Result<IrradianceEstimate> reference_irradiance(const BakeInput& input, std::span<const SurfacePoint> points,

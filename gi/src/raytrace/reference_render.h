@@ -33,6 +33,11 @@ struct PinholeCamera {
 engine::Result<engine::ImageRgbaF> render_reference(const ReferenceScene& scene, const PinholeCamera& camera,
                                                     const ReferenceSettings& settings, const WorkShard& shard = {});
 
+/// What the camera rays through the pixel centres (render_reference with jitter_pixels
+/// false traces the same rays) hit first.
+engine::Result<FirstHitImage> first_hits(const ReferenceScene& scene, const PinholeCamera& camera,
+                                         unsigned threads = 0);
+
 /// `shard`: only the points of the shard's blocks of 64 are estimated (the others stay 0).
 engine::Result<IrradianceEstimate> estimate_irradiance(const ReferenceScene& scene, std::span<const SurfacePoint> points,
                                                        const ReferenceSettings& settings, const WorkShard& shard = {});
