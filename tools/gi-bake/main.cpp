@@ -3,6 +3,7 @@
 //   gi-bake --plan assets/demo_level.gltf --preset preview    # print the effect plan, bake nothing
 //   gi-bake --scene level.gltf --preset medium --export-uv1 out/level_uv1.gltf   # the lightmap UVs
 //   gi-bake --scene Avocado.glb --sky 0.8,0.9,1.0 --out out/avocado.gibake      # lit by a uniform sky
+//   gi-bake --scene level.gltf --sun 'direction:0.3,-1,0.2;irradiance:700,650,600'  # and a sun
 //   gi-bake --scene level.gltf --out out/level.gibake --shard 3/8   # one shard of a distributed bake
 //   gi-bake --scene level.gltf --out out/level.gibake --merge       # the bundle from all 8 shards
 // Without --methods it bakes what gi::plan (gi/plan.h) calls for and says what it skips;
@@ -22,6 +23,7 @@
 #include <vector>
 
 #include "console_progress.h"
+#include "sun_option.h"
 #include "tool_main.h"
 
 namespace {
@@ -40,7 +42,7 @@ std::vector<std::string> split(const std::string& list) {
 
 int main(int argc, char** argv) {
   CLI::App app{"Bakes a scene's GI data into a bake bundle (manifest.json + one file per method)"};
-  std::string scene_path, positional_scene, out_dir, methods, export_uv1, sky;
+  std::string scene_path, positional_scene, out_dir, methods, export_uv1, sky, sun;
   bool plan_only = false;
   gi::BakeOptions o;
   app.add_option("--scene", scene_path, "glTF/GLB scene")->check(CLI::ExistingFile);
@@ -53,6 +55,9 @@ int main(int argc, char** argv) {
                  "R,G,B: a uniform sky of this radiance, W/(m^2 sr), or 'zenith:R,G,B;horizon:R,G,B;ground:R,G,B' "
                  "a gradient over the elevation, for scenes that carry none (replaces the scene's gi.sky; "
                  "docs/scene-format.md)");
+  app.add_option("--sun", sun,
+                 "'direction:dx,dy,dz;irradiance:R,G,B[;angular_radius_deg:D]': a sun replacing the scene's gi.sun "
+                 "(docs/scene-format.md)");
   app.add_option("--out", out_dir, "Bundle directory (default: out/<scene>.gibake)");
   app.add_option("--methods", methods,
                  "Comma-separated methods to bake: atlas, prm, dlm, brf, antiradiance (default: what the plan calls for)");
@@ -101,6 +106,8 @@ int main(int argc, char** argv) {
     if (!tools::set_sky(asset->environment, sky))
       return tools::fail(kTool, std::string(tools::kSkyUsage) + ", got '" + sky + "'", tools::kExitUsage);
   }
+  if (!sun.empty() && !tools::set_sun(*asset, sun))
+    return tools::fail(kTool, std::string(tools::kSunUsage) + ", got '" + sun + "'", tools::kExitUsage);
   if (!export_uv1.empty()) {
     auto uv = gi::with_light_atlas_uv1(*asset, {.preset = o.preset, .texels_per_metre = o.texels_per_metre});
     if (!uv) return tools::fail(kTool, uv.error());
