@@ -1,0 +1,245 @@
+// gi-frame-truth: a scene's frame with its GI against the path tracer's truth of the same
+// state, per world region the pixels show and over the frame (gi/frame_truth.h). Lights the
+// scene in memory (sun, sky; optionally without its own lights and textures), bakes it at
+// each --preset (gi::bake_bundle) and/or takes --bundle NAME=DIR, renders one truth per view
+// and compares every bake's frame with it; writes each view's images (truth, regions, and per
+// bake the frame and the luminance ratio) and the table (Markdown, CSV). docs/real_level.md.
+//   gi-frame-truth --scene ../shared/external-assets/dabrovic-sponza/sponza.gltf --untextured
+//       --sky 'zenith:10,16,30;horizon:28,30,34;ground:6,6,6'
+//       --sun 'direction:0.25,-1,0.15;irradiance:700,650,600' --camera courtyard=-10,1.7,-2,8,4,4.5,60
+//       --region courtyard:-11.6,-1,-3.18,11.6,4.75,3.18 --preset preview --preset medium
+//       --width 240 --height 135 --spp 512 --out out/level --md out/level/table.md
+// Without --camera, the scene's first glTF camera. Progress on stderr, the table and the
+// costs on stdout. Exit codes: tools/common/tool_main.h.
+#include <engine/gltf.h>
+#include <engine/gpu/context.h>
+#include <engine/scene.h>
+#include <gi/bake.h>
+#include <gi/frame_truth.h>
+#include <sys/resource.h>
+
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "console_progress.h"
+#include "frame_truth_output.h"
+#include "sun_option.h"
+#include "tool_main.h"
+#include "view_options.h"
+
+namespace {
+
+constexpr const char* kTool = "gi-frame-truth";
+namespace fs = std::filesystem;
+using frame_truth_tool::RunInfo;
+
+/// Peak resident memory of this process so far, MB (getrusage: ru_maxrss is in KiB on Linux).
+double peak_rss_mb() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return static_cast<double>(usage.ru_maxrss) / 1024.0;
+}
+
+/// The scene's first glTF camera as a FrameCamera (its world position, looking along -Z).
+std::optional<gi::FrameCamera> scene_camera(const engine::SceneAsset& asset) {
+  const engine::Scene scene = engine::instantiate(asset);
+  const engine::Entity e = engine::find_camera(scene.registry);
+  if (e.is_null()) return std::nullopt;
+  const glm::mat4& m = scene.registry.get<engine::WorldTransform>(e).matrix;
+  const glm::vec3 position(m[3]);
+  const glm::vec3 forward = -glm::normalize(glm::vec3(m[2]));
+  return gi::FrameCamera{.name = "scene",
+                         .position_m = position,
+                         .target_m = position + forward,
+                         .yfov_rad = scene.registry.get<engine::Camera>(e).yfov_rad};
+}
+
+/// Removes every light and emission the scene carries (a Cornell box without its lamp).
+void drop_lights(engine::SceneAsset& a) {
+  for (engine::Node& n : a.nodes) n.light = -1;
+  a.lights.clear();
+  a.environment.sun_light = a.environment.sun_node = -1;
+  for (engine::Material& m : a.materials) m.emissive = glm::vec3(0.0f);
+}
+
+bool append(const std::string& path, const std::string& header, const std::string& rows) {
+  const bool fresh = !fs::exists(path) || fs::file_size(path) == 0;
+  std::ofstream out(path, std::ios::app);
+  out << (fresh ? header : "") << rows;
+  return static_cast<bool>(out);
+}
+
+/// A GI to compare: its name in the table and its bundle.
+struct NamedBundle {
+  std::string name;
+  std::string dir;
+};
+
+/// Bakes `asset` at each preset into <out>/<label>_<preset>.gibake; appends a summary line
+/// (wall time, the process's peak RSS so far) per bake.
+engine::Result<std::vector<NamedBundle>> bake_presets(const engine::SceneAsset& asset,
+                                                      const std::vector<std::string>& presets, const std::string& out,
+                                                      const std::string& label, unsigned threads,
+                                                      tools::ConsoleProgress& bar, std::string& summary) {
+  std::vector<NamedBundle> out_bundles;
+  const gi::BakeInput input = gi::bake_input_from(asset);
+  for (const std::string& preset : presets) {
+    const std::string dir = (fs::path(out) / (label + "_" + preset + ".gibake")).string();
+    const auto t0 = std::chrono::steady_clock::now();
+    auto baked =
+        gi::bake_bundle(input, dir, {.preset = preset, .threads = threads}, {.progress = bar.stages(), .log = {}});
+    bar.finish();
+    if (!baked) return baked.error();
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    char line[256];
+    std::snprintf(line, sizeof line, "%s: bake %s: %.1f s wall; peak RSS of the process so far %.0f MB\n",
+                  label.c_str(), preset.c_str(), seconds, peak_rss_mb());
+    summary += line;
+    out_bundles.push_back({preset, dir});
+  }
+  return out_bundles;
+}
+
+std::string cost_lines(const std::string& label, const std::string& gi, const gi::FrameTruthReport& r,
+                       const std::string& gi_label) {
+  char line[512];
+  std::snprintf(line, sizeof line,
+                "%s, %s, %s: frame %.1f ms (first %.1f ms) with %s; truth %.1f s; %zu background, %zu non-finite "
+                "pixels\n",
+                label.c_str(), gi.c_str(), r.camera.c_str(), r.cost.frame_ms, r.cost.first_frame_ms, gi_label.c_str(),
+                r.truth_seconds, r.background_pixels, r.nonfinite_pixels);
+  std::string out = line;
+  for (const engine::PassTiming& p : r.cost.frame) {
+    std::snprintf(line, sizeof line, "    %s: %.2f ms\n", p.name.c_str(), p.ms);
+    out += line;
+  }
+  return out;
+}
+
+}  // namespace
+
+// Long for the order it keeps in one place: options, the scene lit in memory, the bakes, then
+// per view one truth compared with every bake, and the outputs.
+int main(int argc, char** argv) {
+  CLI::App app{"A scene's frame with its GI against the path tracer's truth, per world region and over the frame"};
+  std::string scene_path, sky, sun, out_dir, md_path, csv_path, label;
+  std::vector<std::string> camera_texts, region_texts, bundle_texts, presets;
+  bool untextured = false, no_lights = false;
+  float exposure = 0.0f;
+  gi::FrameTruthSettings settings;
+  app.add_option("--scene", scene_path, "glTF/GLB scene")->required()->check(CLI::ExistingFile);
+  app.add_flag("--untextured", untextured,
+               "Drop the materials' textures in memory (the bakers and the path tracer do not read them yet)");
+  app.add_flag("--no-lights", no_lights, "Drop the scene's own lights and emission (before --sun)");
+  app.add_option("--sky", sky, "R,G,B or 'zenith:R,G,B;horizon:R,G,B;ground:R,G,B', as gi-bake --sky");
+  app.add_option("--sun", sun,
+                 "'direction:dx,dy,dz;irradiance:R,G,B[;angular_radius_deg:D]': a sun replacing the scene's (as "
+                 "gi-bake --sun)");
+  app.add_option("--camera", camera_texts,
+                 "NAME=px,py,pz,tx,ty,tz[,yfov_deg]: a view from p looking at t (repeatable; default: the scene's "
+                 "first camera)");
+  app.add_option("--region", region_texts,
+                 "NAME:minx,miny,minz,maxx,maxy,maxz: a world box (repeatable; the first that holds a pixel's first "
+                 "hit wins; the rest is 'other')");
+  app.add_option("--bundle", bundle_texts,
+                 "[NAME=]DIR: an existing bake bundle of this scene as lit here (repeatable)");
+  app.add_option("--preset", presets, "Bake at this preset and compare (repeatable; default preview without --bundle)");
+  app.add_option("--width", settings.width, "Image width")->check(CLI::Range(8, 4096));
+  app.add_option("--height", settings.height, "Image height")->check(CLI::Range(8, 4096));
+  app.add_option("--spp", settings.samples_per_pixel, "The truth's samples per pixel (two halves)")
+      ->check(CLI::Range(2, 1 << 20));
+  app.add_option("--seed", settings.seed, "The truth's seed (its halves: seed, seed + 1)");
+  app.add_option("--threads", settings.threads, "Path tracer and bake threads (0: all)");
+  app.add_option("--exposure", exposure, "Exposure of the PNGs (0: per view, from the truth's mean)");
+  app.add_option("--out", out_dir, "Folder for the bundles baked here and each view's images")->required();
+  app.add_option("--label", label, "The run's name in the table and image names (default: the scene's stem)");
+  app.add_option("--md", md_path, "Markdown file to append the table to (header when new)");
+  app.add_option("--csv", csv_path, "CSV file to append the rows to (header when new)");
+  if (auto rc = tools::parse(app, kTool, argc, argv)) return *rc;
+
+  if (label.empty()) label = fs::path(scene_path).stem().string();
+  std::vector<gi::FrameCamera> cameras;
+  for (const std::string& t : camera_texts) {
+    const auto c = frame_truth_tool::parse_camera(t);
+    if (!c) return tools::fail(kTool, "--camera wants NAME=px,py,pz,tx,ty,tz[,yfov_deg], got '" + t + "'", 2);
+    cameras.push_back(*c);
+  }
+  for (const std::string& t : region_texts) {
+    const auto r = frame_truth_tool::parse_region(t);
+    if (!r) return tools::fail(kTool, "--region wants NAME:minx,miny,minz,maxx,maxy,maxz, got '" + t + "'", 2);
+    settings.regions.push_back(*r);
+  }
+  std::vector<NamedBundle> gis;
+  for (const std::string& t : bundle_texts) {
+    const std::size_t eq = t.find('=');
+    const std::string dir = eq == std::string::npos ? t : t.substr(eq + 1);
+    gis.push_back({eq == std::string::npos ? fs::path(dir).stem().string() : t.substr(0, eq), dir});
+  }
+  if (gis.empty() && presets.empty()) presets.push_back("preview");
+
+  auto loaded = engine::load_gltf(scene_path);
+  if (!loaded) return tools::fail(kTool, loaded.error());
+  engine::SceneAsset asset = std::move(loaded).value();
+  if (untextured) asset = gi::without_textures(std::move(asset));
+  if (no_lights) drop_lights(asset);
+  if (!sky.empty() && !tools::set_sky(asset.environment, sky))
+    return tools::fail(kTool, std::string(tools::kSkyUsage) + ", got '" + sky + "'", tools::kExitUsage);
+  if (!sun.empty() && !tools::set_sun(asset, sun))
+    return tools::fail(kTool, std::string(tools::kSunUsage) + ", got '" + sun + "'", tools::kExitUsage);
+  if (cameras.empty()) {
+    const auto c = scene_camera(asset);
+    if (!c) return tools::fail(kTool, scene_path + " has no camera: give --camera", tools::kExitUsage);
+    cameras.push_back(*c);
+  }
+
+  tools::install_interrupt_handler();
+  tools::ConsoleProgress bar;
+  std::string summary;
+  auto baked = bake_presets(asset, presets, out_dir, label, settings.threads, bar, summary);
+  if (!baked) return tools::fail(kTool, baked.error());
+  gis.insert(gis.end(), baked->begin(), baked->end());
+
+  auto gpu = engine::GpuContext::create_headless();
+  if (!gpu) return tools::fail(kTool, gpu.error());
+  std::vector<std::unique_ptr<gi::FrameTruthBench>> benches;
+  for (const NamedBundle& g : gis) {
+    auto bench = gi::FrameTruthBench::create(asset, g.dir, settings);
+    if (!bench) return tools::fail(kTool, bench.error());
+    benches.push_back(std::move(bench).value());
+  }
+  std::string md, csv;
+  for (const gi::FrameCamera& camera : cameras) {
+    auto truth = benches.front()->render_truth(camera, bar.stages());
+    bar.finish();
+    if (!truth) return tools::fail(kTool, truth.error());
+    const std::string stem = label + "_" + camera.name;
+    if (auto ok = frame_truth_tool::write_truth_images(out_dir, stem, *truth, exposure); !ok)
+      return tools::fail(kTool, ok.error());
+    for (std::size_t g = 0; g < gis.size(); ++g) {
+      auto report = benches[g]->compare(*truth);
+      if (!report) return tools::fail(kTool, report.error());
+      if (auto ok = frame_truth_tool::write_frame_images(out_dir, stem + "_" + gis[g].name, *report, *truth, exposure);
+          !ok)
+        return tools::fail(kTool, ok.error());
+      const RunInfo run{.label = label,
+                        .gi = gis[g].name,
+                        .width = settings.width,
+                        .height = settings.height,
+                        .samples_per_pixel = truth->samples_per_pixel};
+      md += frame_truth_tool::markdown_rows(run, *report);
+      csv += frame_truth_tool::csv_rows(run, *report);
+      summary += cost_lines(label, gis[g].name, *report, benches[g]->gi_label());
+    }
+  }
+  std::fputs((frame_truth_tool::markdown_header() + md + "\n" + summary).c_str(), stdout);
+  if (!md_path.empty() && !append(md_path, frame_truth_tool::markdown_header(), md))
+    return tools::fail(kTool, "cannot write " + md_path, tools::kExitFailure);
+  if (!csv_path.empty() && !append(csv_path, frame_truth_tool::csv_header(), csv))
+    return tools::fail(kTool, "cannot write " + csv_path, tools::kExitFailure);
+  return tools::kExitOk;
+}
