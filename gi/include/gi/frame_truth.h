@@ -99,9 +99,11 @@ struct RegionAccuracy {
 
 /// What one measured frame cost the renderer (engine::Renderer::last_timings).
 struct FrameCost {
-  std::vector<engine::PassTiming> first_frame;  ///< The first frame drawn (GI upload, shadow maps).
-  std::vector<engine::PassTiming> frame;        ///< The measured frame after the warm-up.
-  double first_frame_ms = 0.0;                  ///< Sums of the passes.
+  /// The first frame drawn from the view (on a bench's first view it also compiles the
+  /// shaders, uploads the GI data and draws the shadow maps).
+  std::vector<engine::PassTiming> first_frame;
+  std::vector<engine::PassTiming> frame;  ///< The measured frame after the warm-up.
+  double first_frame_ms = 0.0;            ///< Sums of the passes.
   double frame_ms = 0.0;
 };
 
