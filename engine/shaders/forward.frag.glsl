@@ -133,7 +133,7 @@ void main() {
     const int i = POINT_LIGHTS + SPOT_LIGHTS + k;
     radiance += live(lights[i]) * directional_light_radiance(lights[i], s, to_light) *
                 (lights[i].radiant.w > 0.0 ? shadow_2d_disc(lights[i], s.position, s.normal, to_light)  // the sun's disc
-                                           : shadow_2d(lights[i], s.position, s.normal, to_light, 1.0, false));
+                                           : shadow_2d_sun(lights[i], s.position, s.normal, to_light));
   }
 #endif
 #if AREA_LIGHTS > 0

@@ -12,6 +12,9 @@
 layout(binding = 4) uniform sampler2DArrayShadow u_shadow_maps;
 layout(binding = 5) uniform samplerCubeArrayShadow u_point_shadow_maps;
 layout(binding = 12) uniform sampler2DArray u_shadow_depths;  // the same 2-D maps, raw depths
+// Directional lights' maps: an array of its own, larger (each covers the whole level).
+layout(binding = 10) uniform sampler2DArrayShadow u_sun_shadow_maps;
+layout(binding = 11) uniform sampler2DArray u_sun_shadow_depths;  // the same, raw depths
 
 float slope_tangent(vec3 n, vec3 to_light) {
   float n_dot_l = clamp(dot(n, to_light), 0.05, 1.0);
@@ -37,7 +40,7 @@ float shadow_area_grazing(GpuLight light, vec3 p, vec3 n, vec3 to_light) {
 // A 3x3 grid of bilinear compare taps `spacing` texels apart (1: 4x4 texel footprint,
 // 2: 6x6, the softened area-light kernel). `spacing` and `area` (an area light: beyond the
 // map, its grazing band's cube) are passed as literals.
-float shadow_2d(GpuLight light, vec3 p, vec3 n, vec3 to_light, float spacing, bool area) {
+float shadow_2d_in(sampler2DArrayShadow maps, GpuLight light, vec3 p, vec3 n, vec3 to_light, float spacing, bool area) {
   int layer = int(light.cone.z);
   if (layer < 0) return 1.0;
   bool ortho = light.shadow_params.x < 0.5;
@@ -56,12 +59,20 @@ float shadow_2d(GpuLight light, vec3 p, vec3 n, vec3 to_light, float spacing, bo
   float d = ortho ? dot(po - eye, axis) : length(po - eye);
   float bias = texel * (1.0 + spacing * slope_tangent(n, to_light));
   float ref = (d - bias) / far_m;
-  vec2 texel_uv = 1.0 / vec2(textureSize(u_shadow_maps, 0).xy);
+  vec2 texel_uv = 1.0 / vec2(textureSize(maps, 0).xy);
   float sum = 0.0;
   for (int y = -1; y <= 1; ++y)
     for (int x = -1; x <= 1; ++x)
-      sum += texture(u_shadow_maps, vec4(uv + vec2(x, y) * spacing * texel_uv, float(layer), ref));
+      sum += texture(maps, vec4(uv + vec2(x, y) * spacing * texel_uv, float(layer), ref));
   return sum / 9.0;
+}
+// Spot and area lights' maps.
+float shadow_2d(GpuLight light, vec3 p, vec3 n, vec3 to_light, float spacing, bool area) {
+  return shadow_2d_in(u_shadow_maps, light, p, n, to_light, spacing, area);
+}
+// A directional light without a disc (a point sun): its own array, the 4 x 4 texel footprint.
+float shadow_2d_sun(GpuLight light, vec3 p, vec3 n, vec3 to_light) {
+  return shadow_2d_in(u_sun_shadow_maps, light, p, n, to_light, 1.0, false);
 }
 
 // Where a receiver p (normal n) falls in a light's perspective 2-D map (spot and area lights):
@@ -140,8 +151,10 @@ const vec2 kDisc24[24] = vec2[24](
 // uniformly over a disc of radius b tan r (kDisc24) average the visibility of the sun's
 // disc: their fraction behind an edge follows the disc's area, so the 10-90% width of the
 // edge is the disc's 1.37 b tan r (a square grid of taps spread it over 2 b tan r).
-// Ortho maps only (directional lights).
-const float kSunMaxTexels = 48.0;
+// Ortho maps only (directional lights). The search and the taps reach at most 192 texels
+// (a 5 degree disc 1 m behind its blocker on a 4 m scene at 4096 texels: 87): the tap count
+// is fixed, so the cap only bounds how sparse the taps get on a huge penumbra.
+const float kSunMaxTexels = 192.0;
 float shadow_2d_disc(GpuLight light, vec3 p, vec3 n, vec3 to_light) {
   int layer = int(light.cone.z);
   if (layer < 0) return 1.0;
@@ -157,11 +170,11 @@ float shadow_2d_disc(GpuLight light, vec3 p, vec3 n, vec3 to_light) {
   float d = dot(po - eye, axis);
   float bias = texel * (1.0 + slope_tangent(n, to_light));
   float ref = (d - bias) / far_m;
-  vec2 texel_uv = 1.0 / vec2(textureSize(u_shadow_maps, 0).xy);
+  vec2 texel_uv = 1.0 / vec2(textureSize(u_sun_shadow_maps, 0).xy);
   float search = clamp(d * tan_r / texel, 1.0, kSunMaxTexels);  // texels
   float blockers = 0.0, blocker_depth = 0.0;
   for (int i = 0; i < 16; ++i) {
-    float z = texture(u_shadow_depths, vec3(uv + kDisc16[i] * search * texel_uv, float(layer))).r;
+    float z = texture(u_sun_shadow_depths, vec3(uv + kDisc16[i] * search * texel_uv, float(layer))).r;
     if (z < ref) {
       blockers += 1.0;
       blocker_depth += z;
@@ -171,7 +184,7 @@ float shadow_2d_disc(GpuLight light, vec3 p, vec3 n, vec3 to_light) {
   float b = max(d - blocker_depth / blockers * far_m, 0.0);  // receiver - blocker, metres
   float radius = clamp(b * tan_r / texel, 1.0, kSunMaxTexels);  // penumbra half-width, texels
   float sum = 0.0;
-  for (int i = 0; i < 24; ++i) sum += texture(u_shadow_maps, vec4(uv + kDisc24[i] * radius * texel_uv, float(layer), ref));
+  for (int i = 0; i < 24; ++i) sum += texture(u_sun_shadow_maps, vec4(uv + kDisc24[i] * radius * texel_uv, float(layer), ref));
   return sum / 24.0;
 }
 

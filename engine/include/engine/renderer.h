@@ -57,9 +57,16 @@ struct RenderSettings {
   float ev100 = 15.0f;
   /// ExposureMode::Automatic: compensation, clamp, metering percentiles, adaptation rates.
   AutoExposure auto_exposure;
-  /// Texels per side of 2-D shadow maps (directional, spot, area); point-light cube faces
-  /// use half of it. At most 8 2-D maps and 4 cube maps per frame; further lights are unshadowed.
+  /// Texels per side of 2-D shadow maps (spot, area); point-light cube faces use half of
+  /// it. At most 8 2-D maps and 4 cube maps per frame; further lights are unshadowed.
   int shadow_map_size = 1024;
+  /// Texels per side of a directional light's shadow map (the sun's), an array of its own:
+  /// it covers the whole level (fitted to the scene bounds as the light sees them), so it
+  /// needs more texels than a spot light's cone. 4096: 1 cm texels over a 40 m level,
+  /// 64 MB (32-bit depth; twice that while dynamic casters move under a still sun, the
+  /// static depth cache). At most 2 directional lights are shadowed. docs/real_level.md
+  /// measured it on Dabrovic Sponza (the facades lit at grazing angles need it).
+  int sun_shadow_map_size = 4096;
   /// Radiance of the constant ambient stand-in used when no IndirectLightProvider is set,
   /// W/(m^2 sr) per channel; it is labelled "constant ambient (stand-in)" in timings.
   float stand_in_ambient = 0.02f;

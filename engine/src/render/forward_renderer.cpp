@@ -191,9 +191,11 @@ void ForwardRenderer::render(const Registry& registry, Entity camera, double dt_
   render::ShadowCapacity capacity;
   capacity.map_size = std::max(16, settings_.shadow_map_size);
   capacity.cube_size = std::max(16, settings_.shadow_map_size / 2);
+  capacity.sun_size = std::max(16, settings_.sun_shadow_map_size);
   const render::LightList lights = render::collect_lights(registry, render::scene_bounds(items), capacity, &skipped);
   report_skipped(registry, skipped);
-  shadow_maps_.reserve(capacity.map_size, lights.layers_2d, capacity.cube_size, lights.cubes);
+  shadow_maps_.reserve(capacity.map_size, lights.layers_2d, capacity.sun_size, lights.sun_layers, capacity.cube_size,
+                       lights.cubes);
   const CameraView view = camera_view(registry, camera);
   shadow_maps_rendered_ = shadow_maps_.render(lights.shadow_views, items, scene_, shadow_, view.view_proj);
   timings_.push_back({"shadow maps (" + std::to_string(lights.shadow_views.size()) + " views)", timer.lap_ms()});
@@ -303,6 +305,9 @@ void ForwardRenderer::forward_pass(const CameraView& view, const std::vector<Dra
   glBindTextureUnit(kPointShadowMapsUnit, shadow_maps_.cube_maps());
   glBindTextureUnit(kShadowDepthUnit, shadow_maps_.maps_2d());
   glBindSampler(kShadowDepthUnit, shadow_depth_sampler_.id());
+  glBindTextureUnit(kSunShadowMapsUnit, shadow_maps_.sun_maps());
+  glBindTextureUnit(kSunShadowDepthUnit, shadow_maps_.sun_maps());
+  glBindSampler(kSunShadowDepthUnit, shadow_depth_sampler_.id());
   const GLuint atlas = indirect ? indirect->irradiance_atlas_texture : 0;
   const GLuint glossy = indirect ? indirect->glossy_radiance_texture : 0;
   glBindTextureUnit(kIrradianceAtlasUnit, atlas != 0 ? atlas : scene_.white_texture());

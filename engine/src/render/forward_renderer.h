@@ -40,6 +40,8 @@ enum TextureUnit : GLuint {
   kPointShadowMapsUnit = 5,
   kGlossyUnit = 6,
   kDirectionalIndexUnit = 7,
+  kSunShadowMapsUnit = 10,   // directional lights' own 2-D maps (shadow_common.glsl)
+  kSunShadowDepthUnit = 11,  // the same, raw depth (the sun disc's blocker search)
   kShadowDepthUnit = 12,  // the 2-D shadow maps again, raw depth (shadow_common.glsl's sun disc)
   kAreaVisibilityUnit = 13,  // area_shadow.frag.glsl: half-resolution visibility; forward: full-resolution
   kAreaPlaneUnit = 14,       // area_shadow.frag.glsl: half-resolution tangent planes

@@ -42,6 +42,9 @@ struct ShadowView {
   float far_m = 1.0f;
   bool ortho = false;
   bool cube = false;  ///< Layer of the point-light cube-map array (cube * 6 + face) vs 2-D array.
+  /// Layer of the directional lights' own 2-D array (ShadowCapacity::sun_size) vs the spot
+  /// and area lights' array.
+  bool sun = false;
   int layer = 0;
 };
 

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -116,38 +117,60 @@ LightList collect_lights(const Registry& registry, const SceneBounds& bounds, co
       g.cone.w = static_cast<float>(add_cube(position, far_m));
       g.shadow_eye = glm::vec4(position, far_m);
       g.shadow_params = glm::vec4(1.0f, 2.0f / static_cast<float>(capacity.cube_size), 0.0f, 0.0f);
-    } else if (shadowed && light.type != LightType::Point && out.layers_2d < capacity.max_2d_layers) {
+    } else if (shadowed && light.type == LightType::Directional && out.sun_layers < capacity.max_sun_layers) {
+      // Orthographic along the light, its window fitted to the scene bounds' corners as the
+      // light sees them (a level longer than it is wide gets its texels along its length),
+      // the depth range to the bounding sphere.
+      ShadowView v;
+      v.axis = dir;
+      v.sun = true;
+      v.ortho = true;
+      v.layer = out.sun_layers;
+      const glm::vec3 centre = 0.5f * (bounds.min + bounds.max);
+      const float radius = std::max(0.5f * glm::length(bounds.max - bounds.min), 1e-3f) * 1.01f;
+      v.eye = centre - dir * radius;
+      v.far_m = 2.0f * radius;
+      const glm::mat4 view = glm::lookAt(v.eye, centre, any_perpendicular_up(dir));
+      glm::vec2 lo(std::numeric_limits<float>::max()), hi(std::numeric_limits<float>::lowest());
+      for (int i = 0; i < 8; ++i) {
+        const glm::vec3 c((i & 1) ? bounds.max.x : bounds.min.x, (i & 2) ? bounds.max.y : bounds.min.y,
+                          (i & 4) ? bounds.max.z : bounds.min.z);
+        const glm::vec2 q(view * glm::vec4(c, 1.0f));
+        lo = glm::min(lo, q);
+        hi = glm::max(hi, q);
+      }
+      const glm::vec2 margin = glm::max(0.005f * (hi - lo), glm::vec2(1e-3f));
+      lo -= margin;
+      hi += margin;
+      v.view_proj = glm::ortho(lo.x, hi.x, lo.y, hi.y, 0.0f, v.far_m) * view;
+      out.shadow_views.push_back(v);
+      g.cone.z = static_cast<float>(out.sun_layers++);
+      g.shadow_view_proj = v.view_proj;
+      g.shadow_eye = glm::vec4(v.eye, v.far_m);
+      // The larger of the two texel sides: what the normal offset and the bias must clear.
+      const glm::vec2 texel = (hi - lo) / static_cast<float>(capacity.sun_size);
+      g.shadow_params = glm::vec4(0.0f, std::max(texel.x, texel.y), 0.0f, 0.0f);
+    } else if (shadowed && light.type != LightType::Point && light.type != LightType::Directional &&
+               out.layers_2d < capacity.max_2d_layers) {
       ShadowView v;
       v.axis = dir;
       v.layer = out.layers_2d;
-      float texel = 0.0f;
-      if (light.type == LightType::Directional) {
-        const glm::vec3 centre = 0.5f * (bounds.min + bounds.max);
-        const float radius = std::max(0.5f * glm::length(bounds.max - bounds.min), 1e-3f) * 1.01f;
-        v.eye = centre - dir * radius;
-        v.far_m = 2.0f * radius;
-        v.ortho = true;
-        v.view_proj = glm::ortho(-radius, radius, -radius, radius, 0.0f, v.far_m) *
-                      glm::lookAt(v.eye, centre, any_perpendicular_up(dir));
-        texel = 2.0f * radius / static_cast<float>(capacity.map_size);
-      } else {
-        const float fov = light.type == LightType::Spot
-                              ? std::min(2.0f * light.outer_cone_rad + glm::radians(4.0f), glm::radians(170.0f))
-                              : kAreaShadowFov;
-        const float reach = light.type == LightType::Spot && light.range_m > 0.0f ? light.range_m
-                                                                                   : farthest_corner(position, bounds);
-        v.eye = position;
-        v.far_m = reach * 1.01f;
-        const float near_m = std::max(0.01f, v.far_m * 1e-4f);
-        v.view_proj = glm::perspective(fov, 1.0f, near_m, v.far_m) *
-                      glm::lookAt(position, position + dir, any_perpendicular_up(dir));
-        texel = 2.0f * std::tan(0.5f * fov) / static_cast<float>(capacity.map_size);
-      }
+      const float fov = light.type == LightType::Spot
+                            ? std::min(2.0f * light.outer_cone_rad + glm::radians(4.0f), glm::radians(170.0f))
+                            : kAreaShadowFov;
+      const float reach = light.type == LightType::Spot && light.range_m > 0.0f ? light.range_m
+                                                                                 : farthest_corner(position, bounds);
+      v.eye = position;
+      v.far_m = reach * 1.01f;
+      const float near_m = std::max(0.01f, v.far_m * 1e-4f);
+      v.view_proj = glm::perspective(fov, 1.0f, near_m, v.far_m) *
+                    glm::lookAt(position, position + dir, any_perpendicular_up(dir));
+      const float texel = 2.0f * std::tan(0.5f * fov) / static_cast<float>(capacity.map_size);
       out.shadow_views.push_back(v);
       g.cone.z = static_cast<float>(out.layers_2d++);
       g.shadow_view_proj = v.view_proj;
       g.shadow_eye = glm::vec4(v.eye, v.far_m);
-      g.shadow_params = glm::vec4(v.ortho ? 0.0f : 1.0f, texel, 0.0f, 0.0f);
+      g.shadow_params = glm::vec4(1.0f, texel, 0.0f, 0.0f);
       // The 2-D map covers kAreaShadowFov; the rectangle lights its whole front half-space.
       // Beyond the map (the grazing band, 75-90 degrees off its normal) the shadow is looked up
       // in a cube map from the rectangle's centre (shadow_common.glsl's shadow_area_grazing).

@@ -23,27 +23,24 @@ void set_compare_sampling(std::uint32_t texture) {
 
 }  // namespace
 
-void ShadowMaps::reserve(int map_size, int layers_2d, int cube_size, int cubes) {
-  layers_2d = std::max(layers_2d, 1);
-  cubes = std::max(cubes, 1);
-  if (maps_2d_.empty() || map_size != map_size_ || layers_2d > layers_2d_) {
-    maps_2d_ = GlTexture::create_2d_array(GL_DEPTH_COMPONENT32F, map_size, map_size, layers_2d);
-    set_compare_sampling(maps_2d_.id());
-    map_size_ = map_size;
-    layers_2d_ = layers_2d;
-    content_2d_.clear();  // new, empty textures
-    static_2d_ = GlTexture{};  // the static depth cache follows the maps' size (ensure_static_cache)
-    static_content_2d_.clear();
-  }
-  if (cube_maps_.empty() || cube_size != cube_size_ || cubes > cubes_) {
-    cube_maps_ = GlTexture::create_cube_array(GL_DEPTH_COMPONENT32F, cube_size, cubes);
-    set_compare_sampling(cube_maps_.id());
-    cube_size_ = cube_size;
-    cubes_ = cubes;
-    content_cube_.clear();
-    static_cube_ = GlTexture{};
-    static_content_cube_.clear();
-  }
+void ShadowMaps::reserve_array(Kind kind, int size, int layers) {
+  MapArray& a = maps_[kind];
+  layers = std::max(layers, 1);
+  if (!a.texture.empty() && size == a.size && layers <= a.layers) return;
+  a.texture = kind == kCubeMaps ? GlTexture::create_cube_array(GL_DEPTH_COMPONENT32F, size, layers)
+                                : GlTexture::create_2d_array(GL_DEPTH_COMPONENT32F, size, size, layers);
+  set_compare_sampling(a.texture.id());
+  a.size = size;
+  a.layers = layers;
+  a.content.clear();          // new, empty textures
+  a.static_cache = GlTexture{};  // the static depth cache follows the maps' size (ensure_static_cache)
+  a.static_content.clear();
+}
+
+void ShadowMaps::reserve(int map_size, int layers_2d, int sun_size, int sun_layers, int cube_size, int cubes) {
+  reserve_array(kMaps2d, map_size, layers_2d);
+  reserve_array(kSunMaps, sun_size, sun_layers);
+  reserve_array(kCubeMaps, cube_size, cubes);
   if (framebuffer_.empty()) {
     framebuffer_ = GlFramebuffer::create();
     glNamedFramebufferDrawBuffer(framebuffer_.id(), GL_NONE);
@@ -85,7 +82,7 @@ bool may_be_seen(const glm::mat4& view_proj, const std::array<glm::vec4, 6>& cam
 
 bool same_view(const ShadowView& a, const ShadowView& b) {
   return a.view_proj == b.view_proj && a.eye == b.eye && a.axis == b.axis && a.far_m == b.far_m &&
-         a.ortho == b.ortho && a.cube == b.cube && a.layer == b.layer;
+         a.ortho == b.ortho && a.cube == b.cube && a.sun == b.sun && a.layer == b.layer;
 }
 
 }  // namespace
@@ -129,7 +126,7 @@ int ShadowMaps::render(const std::vector<ShadowView>& views, const std::vector<D
   const std::array<glm::vec4, 6> camera_planes = clip_planes(camera_view_proj);
   unseen_views_ = 0;
   for (std::size_t k = 0; k < views.size(); ++k) {
-    std::vector<LayerContent>& held = views[k].cube ? content_cube_ : content_2d_;
+    const std::vector<LayerContent>& held = maps_[kind_of(views[k])].content;
     const auto slot = static_cast<std::size_t>(views[k].layer);
     if (slot < held.size() && held[slot] == wanted[k]) continue;
     // Only pixels the camera sees look a map up, so a stale view whose volume lies wholly
@@ -163,8 +160,10 @@ int ShadowMaps::render(const std::vector<ShadowView>& views, const std::vector<D
   const float one = 1.0f;
   for (std::size_t k : stale) {
     const ShadowView& v = views[k];
-    const int size = v.cube ? cube_size_ : map_size_;
-    std::vector<LayerContent>& held = v.cube ? content_cube_ : content_2d_;
+    const Kind kind = kind_of(v);
+    MapArray& maps = maps_[kind];
+    const int size = maps.size;
+    std::vector<LayerContent>& held = maps.content;
     const auto slot = static_cast<std::size_t>(v.layer);
     glViewport(0, 0, size, size);
     glUniformMatrix4fv(8, 1, GL_FALSE, glm::value_ptr(v.view_proj));
@@ -172,7 +171,7 @@ int ShadowMaps::render(const std::vector<ShadowView>& views, const std::vector<D
     glUniform1f(17, v.far_m);
     glUniform1i(18, v.ortho ? 1 : 0);
     glUniform3fv(19, 1, glm::value_ptr(v.axis));
-    const std::uint32_t target = v.cube ? cube_maps_.id() : maps_2d_.id();
+    const std::uint32_t target = maps.texture.id();
     // A light that did not move, whose dynamic casters did: its static casters' depth is kept
     // in a second texture, copied back, and only the dynamic casters are drawn over it. The
     // depth test keeps the nearest of both, so the layer holds exactly what drawing every
@@ -180,9 +179,9 @@ int ShadowMaps::render(const std::vector<ShadowView>& views, const std::vector<D
     // stale every frame.
     const bool light_still = slot < held.size() && same_view(held[slot].view, v);
     if (light_still && !dynamic[k].empty() && !wanted_static[k].casters.empty()) {
-      ensure_static_cache();
-      std::vector<LayerContent>& cached = v.cube ? static_content_cube_ : static_content_2d_;
-      const std::uint32_t cache = v.cube ? static_cube_.id() : static_2d_.id();
+      ensure_static_cache(kind);
+      std::vector<LayerContent>& cached = maps.static_content;
+      const std::uint32_t cache = maps.static_cache.id();
       if (!(slot < cached.size() && cached[slot] == wanted_static[k])) {
         glNamedFramebufferTextureLayer(framebuffer_.id(), GL_DEPTH_ATTACHMENT, cache, 0, v.layer);
         glClearNamedFramebufferfv(framebuffer_.id(), GL_DEPTH, 0, &one);
@@ -192,8 +191,8 @@ int ShadowMaps::render(const std::vector<ShadowView>& views, const std::vector<D
       } else {
         ++cached_views_;
       }
-      const GLenum kind = v.cube ? GL_TEXTURE_CUBE_MAP_ARRAY : GL_TEXTURE_2D_ARRAY;
-      glCopyImageSubData(cache, kind, 0, 0, 0, v.layer, target, kind, 0, 0, 0, v.layer, size, size, 1);
+      const GLenum gl_kind = v.cube ? GL_TEXTURE_CUBE_MAP_ARRAY : GL_TEXTURE_2D_ARRAY;
+      glCopyImageSubData(cache, gl_kind, 0, 0, 0, v.layer, target, gl_kind, 0, 0, 0, v.layer, size, size, 1);
       glNamedFramebufferTextureLayer(framebuffer_.id(), GL_DEPTH_ATTACHMENT, target, 0, v.layer);
       draw(dynamic[k]);
     } else {
@@ -208,15 +207,12 @@ int ShadowMaps::render(const std::vector<ShadowView>& views, const std::vector<D
   return static_cast<int>(stale.size());
 }
 
-void ShadowMaps::ensure_static_cache() {
-  if (static_2d_.empty()) {
-    static_2d_ = GlTexture::create_2d_array(GL_DEPTH_COMPONENT32F, map_size_, map_size_, layers_2d_);
-    static_content_2d_.clear();
-  }
-  if (static_cube_.empty()) {
-    static_cube_ = GlTexture::create_cube_array(GL_DEPTH_COMPONENT32F, cube_size_, cubes_);
-    static_content_cube_.clear();
-  }
+void ShadowMaps::ensure_static_cache(Kind kind) {
+  MapArray& a = maps_[kind];
+  if (!a.static_cache.empty()) return;
+  a.static_cache = kind == kCubeMaps ? GlTexture::create_cube_array(GL_DEPTH_COMPONENT32F, a.size, a.layers)
+                                     : GlTexture::create_2d_array(GL_DEPTH_COMPONENT32F, a.size, a.size, a.layers);
+  a.static_content.clear();
 }
 
 }  // namespace engine::render

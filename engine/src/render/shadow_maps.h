@@ -1,7 +1,8 @@
 #pragma once
 // Depth textures of the shadow-casting lights and the pass that fills them: a 2-D array
-// (directional, spot, area lights) and a cube-map array (point lights), both compared in
-// the shader (sampler*Shadow) against linear depth.
+// (spot, area lights), a 2-D array of its own size for directional lights (each covers the
+// whole level) and a cube-map array (point lights), all compared in the shader
+// (sampler*Shadow) against linear depth.
 
 #include <vector>
 
@@ -15,9 +16,10 @@ namespace engine::render {
 
 class ShadowMaps {
  public:
-  /// Makes room for `layers_2d` maps of map_size^2 and `cubes` cube maps of cube_size^2
-  /// per face (at least one of each so the samplers are always complete).
-  void reserve(int map_size, int layers_2d, int cube_size, int cubes);
+  /// Makes room for `layers_2d` maps of map_size^2, `sun_layers` maps of sun_size^2 and
+  /// `cubes` cube maps of cube_size^2 per face (at least one of each so the samplers are
+  /// always complete).
+  void reserve(int map_size, int layers_2d, int sun_size, int sun_layers, int cube_size, int cubes);
   /// Renders into each view's layer the casters that can reach it (for perspective views,
   /// those whose bounds come within the view's far distance of its eye; every caster for
   /// orthographic ones). A layer whose view and reaching casters (mesh and transform) are
@@ -31,8 +33,9 @@ class ShadowMaps {
   int render(const std::vector<ShadowView>& views, const std::vector<DrawItem>& items, const GpuScene& scene,
              const ShaderProgram& program, const glm::mat4& camera_view_proj);
 
-  std::uint32_t maps_2d() const { return maps_2d_.id(); }
-  std::uint32_t cube_maps() const { return cube_maps_.id(); }
+  std::uint32_t maps_2d() const { return maps_[kMaps2d].texture.id(); }
+  std::uint32_t sun_maps() const { return maps_[kSunMaps].texture.id(); }
+  std::uint32_t cube_maps() const { return maps_[kCubeMaps].texture.id(); }
   /// Of the last render()'s views, those drawn over their cached static depth.
   int last_cached_views() const { return cached_views_; }
   /// Of the last render()'s views that changed, those left undrawn: the camera cannot see into them.
@@ -45,22 +48,24 @@ class ShadowMaps {
     std::vector<std::pair<const GpuMesh*, glm::mat4>> casters;
     bool operator==(const LayerContent& o) const;
   };
-  std::vector<LayerContent> content_2d_, content_cube_;  ///< Per 2-D layer / cube layer (cube * 6 + face).
-  /// The static depth cache: per layer, the view and static casters its texel hold.
-  std::vector<LayerContent> static_content_2d_, static_content_cube_;
-  void ensure_static_cache();
+  /// One texture array and what its layers hold.
+  struct MapArray {
+    GlTexture texture;
+    GlTexture static_cache;  ///< The static depth cache: same size, made on first use.
+    std::vector<LayerContent> content;         ///< Per layer (a cube array: cube * 6 + face).
+    std::vector<LayerContent> static_content;  ///< Per layer: the view and static casters the cache holds.
+    int size = 0;
+    int layers = 0;  ///< Layers of a 2-D array; cubes of a cube array.
+  };
+  enum Kind : int { kMaps2d = 0, kSunMaps = 1, kCubeMaps = 2 };
+  static Kind kind_of(const ShadowView& v) { return v.cube ? kCubeMaps : v.sun ? kSunMaps : kMaps2d; }
+  void reserve_array(Kind kind, int size, int layers);
+  void ensure_static_cache(Kind kind);
 
-  GlTexture maps_2d_;
-  GlTexture cube_maps_;
-  GlTexture static_2d_;    ///< Same size as maps_2d_, made on first use.
-  GlTexture static_cube_;  ///< Same size as cube_maps_, made on first use.
+  MapArray maps_[3];
   int cached_views_ = 0;
   int unseen_views_ = 0;
   GlFramebuffer framebuffer_;
-  int map_size_ = 0;
-  int layers_2d_ = 0;
-  int cube_size_ = 0;
-  int cubes_ = 0;
 };
 
 }  // namespace engine::render
