@@ -109,10 +109,11 @@ std::string cost_lines(const std::string& label, const std::string& gi, const gi
                        const std::string& gi_label) {
   char line[512];
   std::snprintf(line, sizeof line,
-                "%s, %s, %s: frame %.1f ms (first %.1f ms) with %s; truth %.1f s; %zu background, %zu non-finite "
-                "pixels\n",
-                label.c_str(), gi.c_str(), r.camera.c_str(), r.cost.frame_ms, r.cost.first_frame_ms, gi_label.c_str(),
-                r.truth_seconds, r.background_pixels, r.nonfinite_pixels);
+                "%s, %s, %s, %dx%d: frame %.1f ms (median; %.1f-%.1f; first %.1f ms) with %s; truth %.1f s; %zu "
+                "background, %zu non-finite pixels\n",
+                label.c_str(), gi.c_str(), r.camera.c_str(), r.frame.width, r.frame.height, r.cost.frame_ms,
+                r.cost.frame_ms_min, r.cost.frame_ms_max, r.cost.first_frame_ms, gi_label.c_str(), r.truth_seconds,
+                r.background_pixels, r.nonfinite_pixels);
   std::string out = line;
   for (const engine::PassTiming& p : r.cost.frame) {
     std::snprintf(line, sizeof line, "    %s: %.2f ms\n", p.name.c_str(), p.ms);

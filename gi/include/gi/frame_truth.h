@@ -68,9 +68,12 @@ struct FrameTruthSettings {
   /// The renderer's fixed exposure (RenderSettings::exposure): only its LDR frame depends on
   /// it, the compared HDR frame does not.
   float exposure = 1.0f;
-  /// Frames drawn before the measured one (the first uploads the GI data and draws the
+  /// Frames drawn before the timed ones (the first uploads the GI data and draws the
   /// shadow maps; a still scene's later frames are its steady cost).
   int warmup_frames = 2;
+  /// Frames timed after the warm-up (>= 1): the cost is the median one's, so that a busy
+  /// machine's odd frame does not make it. The compared frame is the last (all are the same).
+  int timed_frames = 5;
   /// Checked in order, the first that holds the hit wins; at most 250.
   std::vector<WorldRegion> regions;
   /// How far off the surface (along its normal, towards the camera) a pixel's hit is
@@ -102,9 +105,11 @@ struct FrameCost {
   /// The first frame drawn from the view (on a bench's first view it also compiles the
   /// shaders, uploads the GI data and draws the shadow maps).
   std::vector<engine::PassTiming> first_frame;
-  std::vector<engine::PassTiming> frame;  ///< The measured frame after the warm-up.
+  std::vector<engine::PassTiming> frame;  ///< The median of the timed frames (by their sum).
   double first_frame_ms = 0.0;            ///< Sums of the passes.
   double frame_ms = 0.0;
+  double frame_ms_min = 0.0;  ///< The fastest and slowest timed frames' sums.
+  double frame_ms_max = 0.0;
 };
 
 /// Region index of a background pixel in FrameTruth::region_of_pixel.
