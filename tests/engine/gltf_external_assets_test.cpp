@@ -161,10 +161,10 @@ TEST(GltfExternalAssets, AvocadoDracoWithTextures) {
   EXPECT_EQ(p.normals.size(), p.positions.size());
   ASSERT_EQ(s.materials.size(), 1u);
   const auto& m = s.materials[0];
-  ASSERT_GE(m.base_color_texture, 0);
-  ASSERT_GE(m.normal_texture, 0);
-  ASSERT_GE(m.metallic_roughness_texture, 0);
-  const auto& img = s.images.at(static_cast<std::size_t>(m.base_color_texture));
+  ASSERT_GE(m.base_color_texture.image, 0);
+  ASSERT_GE(m.normal_texture.image, 0);
+  ASSERT_GE(m.metallic_roughness_texture.image, 0);
+  const auto& img = s.images.at(static_cast<std::size_t>(m.base_color_texture.image));
   EXPECT_GT(img.width, 0);
   EXPECT_EQ(img.rgba8.size(), static_cast<std::size_t>(img.width) * static_cast<std::size_t>(img.height) * 4u);
   for (const auto& uv : p.uv0) {
@@ -174,7 +174,7 @@ TEST(GltfExternalAssets, AvocadoDracoWithTextures) {
   const auto lazy = load_ok(assets() / "Avocado/glTF-Draco/Avocado.gltf", {.load_images = false});
   ASSERT_EQ(lazy.images.size(), s.images.size());
   EXPECT_TRUE(lazy.images.at(0).rgba8.empty());
-  EXPECT_EQ(lazy.materials.at(0).base_color_texture, m.base_color_texture);
+  EXPECT_EQ(lazy.materials.at(0).base_color_texture.image, m.base_color_texture.image);
 }
 
 TEST(GltfExternalAssets, LightsPunctualLampConvertsCandela) {

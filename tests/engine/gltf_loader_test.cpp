@@ -393,9 +393,9 @@ TEST(GltfLoader, MaterialsAndImages) {
   EXPECT_FLOAT_EQ(m.roughness, 0.7f);
   EXPECT_EQ(m.emissive, glm::vec3(4.0f, 2.0f, 0.0f));  // factor x strength
   EXPECT_TRUE(m.double_sided);
-  EXPECT_EQ(m.base_color_texture, 0);
-  EXPECT_EQ(m.normal_texture, 0);
-  EXPECT_EQ(m.emissive_texture, -1);
+  EXPECT_EQ(m.base_color_texture.image, 0);
+  EXPECT_EQ(m.normal_texture.image, 0);
+  EXPECT_EQ(m.emissive_texture.image, -1);
   EXPECT_EQ(s.meshes.at(0).primitives.at(0).material, 0);
   ASSERT_EQ(s.images.size(), 1u);
   const auto& img = s.images[0];
@@ -407,7 +407,7 @@ TEST(GltfLoader, MaterialsAndImages) {
   const auto lazy = load(path, {.load_images = false});
   ASSERT_EQ(lazy.images.size(), 1u);
   EXPECT_TRUE(lazy.images[0].rgba8.empty());
-  EXPECT_EQ(lazy.materials.at(0).base_color_texture, 0);
+  EXPECT_EQ(lazy.materials.at(0).base_color_texture.image, 0);
 }
 
 TEST(GltfLoader, PunctualLightsAndCamerasInEngineUnits) {

@@ -58,7 +58,7 @@ engine::SceneAsset feature_scene() {
   plain.base_color = {0.7f, 0.5f, 0.3f, 1.0f};
   plain.roughness = 0.15f;
   plain.double_sided = true;
-  plain.base_color_texture = 0;
+  plain.base_color_texture.image = 0;
   plain.specular_factor = 0.25f;                     // KHR_materials_specular
   plain.specular_color_factor = {2.0f, 1.0f, 0.5f};  // above 1 is allowed (the BRDF clamps F0)
   engine::Material glow;
@@ -166,7 +166,7 @@ void expect_round_trip(const engine::SceneAsset& in, const engine::SceneAsset& o
     EXPECT_FLOAT_EQ(b.roughness, a.roughness);
     expect_vec_near(b.emissive, a.emissive, 1e-5f * (1.0f + a.emissive.x), a.name + " emissive");
     EXPECT_EQ(b.double_sided, a.double_sided);
-    EXPECT_EQ(b.base_color_texture, a.base_color_texture);
+    EXPECT_EQ(b.base_color_texture.image, a.base_color_texture.image);
     EXPECT_FLOAT_EQ(b.specular_factor, a.specular_factor) << a.name;
     for (int c = 0; c < 3; ++c) EXPECT_FLOAT_EQ(b.specular_color_factor[c], a.specular_color_factor[c]) << a.name;
   }

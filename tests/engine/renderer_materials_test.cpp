@@ -43,7 +43,7 @@ TEST(RendererMaterials, BaseColorTextureIsDecodedFromSrgb) {
   s.assets.images.push_back(solid_image(188, 188, 188));
   engine::Material m = diffuse_material(1.0f);
   m.base_color = glm::vec4(0.8f, 0.8f, 0.8f, 1.0f);
-  m.base_color_texture = 0;
+  m.base_color_texture.image = 0;
   const engine::ImageRgbaF img = s.render(m, true);
   const float albedo = 0.8f * srgb_to_linear(188.0f / 255.0f);  // ~0.40
   const int c = s.cam.size / 2;
@@ -57,7 +57,7 @@ TEST(RendererMaterials, MetallicRoughnessTextureUsesBlueAndGreen) {
   // G = roughness 0.5 (x factor 1), B = metallic 1 (x factor 1): a rough metal of base 0.9.
   s.assets.images.push_back(solid_image(0, 128, 255));
   engine::Material m = diffuse_material(0.9f, 1.0f, 1.0f);
-  m.metallic_roughness_texture = 0;
+  m.metallic_roughness_texture.image = 0;
   const engine::ImageRgbaF img = s.render(m, true);
   const int c = s.cam.size / 2;
   const float roughness = 128.0f / 255.0f;
@@ -118,7 +118,7 @@ TEST(RendererCreate, MalformedMeshIsAnErrorNotACrash) {
 
   engine::SceneAsset bad_image;
   bad_image.materials.push_back(diffuse_material(0.5f));
-  bad_image.materials[0].base_color_texture = 3;  // no images
+  bad_image.materials[0].base_color_texture.image = 3;  // no images
   bad_image.meshes.push_back(plane_mesh(1.0f, 0));
   auto r2 = engine::Renderer::create(bad_image, settings);
   ASSERT_FALSE(r2.ok());

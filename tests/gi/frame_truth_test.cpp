@@ -85,15 +85,15 @@ TEST(FrameTruth, WithoutTexturesKeepsTheFactorsAndDropsEveryTexture) {
   engine::SceneAsset a;
   engine::Material m;
   m.base_color = {0.5f, 0.4f, 0.3f, 1.0f};
-  m.base_color_texture = 0;
-  m.metallic_roughness_texture = 1;
-  m.emissive_texture = 2;
-  m.normal_texture = 3;
+  m.base_color_texture.image = 0;
+  m.metallic_roughness_texture.image = 1;
+  m.emissive_texture.image = 2;
+  m.normal_texture.image = 3;
   a.materials.push_back(m);
   const engine::SceneAsset b = gi::without_textures(a);
   EXPECT_EQ(b.materials[0].base_color, m.base_color);
-  EXPECT_EQ(b.materials[0].base_color_texture, -1);
-  EXPECT_EQ(b.materials[0].metallic_roughness_texture, -1);
-  EXPECT_EQ(b.materials[0].emissive_texture, -1);
-  EXPECT_EQ(b.materials[0].normal_texture, -1);
+  EXPECT_EQ(b.materials[0].base_color_texture.image, -1);
+  EXPECT_EQ(b.materials[0].metallic_roughness_texture.image, -1);
+  EXPECT_EQ(b.materials[0].emissive_texture.image, -1);
+  EXPECT_EQ(b.materials[0].normal_texture.image, -1);
 }

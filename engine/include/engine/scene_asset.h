@@ -5,6 +5,7 @@
 //   engine::Result<engine::SceneAsset> a = engine::load_gltf("assets/cornell_box.gltf");
 //   engine::Scene scene = engine::instantiate(std::move(a.value()));
 
+#include <cmath>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -27,8 +28,49 @@ struct Image {
   std::vector<std::uint8_t> rgba8;
 };
 
-/// Metallic-roughness material. Colours are linear; textures index SceneAsset::images
-/// (-1: none). Base colour and emissive textures are sRGB-encoded, the others linear.
+/// How a texture's texels are addressed outside [0, 1] (glTF sampler wrapS / wrapT).
+enum class TextureWrap : std::uint8_t { Repeat, ClampToEdge, MirroredRepeat };
+
+/// glTF sampler: wrap modes and filters. glTF leaves an absent filter to the implementation;
+/// the loader then picks linear with mipmaps (the default here).
+struct TextureSampler {
+  TextureWrap wrap_s = TextureWrap::Repeat;
+  TextureWrap wrap_t = TextureWrap::Repeat;
+  bool mag_linear = true;  ///< magFilter LINEAR (false: NEAREST).
+  bool min_linear = true;  ///< minFilter LINEAR* (false: NEAREST*).
+  bool mipmaps = true;     ///< minFilter *_MIPMAP_* (or absent): sample a mip level for the footprint.
+};
+
+/// KHR_texture_transform: uv' = translate(offset) x rotate(rotation) x scale(scale) x uv.
+struct TextureTransform {
+  glm::vec2 offset{0.0f};
+  float rotation_rad = 0.0f;  ///< Counter-clockwise in UV space, as the extension defines it.
+  glm::vec2 scale{1.0f};
+};
+
+/// A material's texture: the image, the vertex UV set it reads (TEXCOORD_n), the sampler
+/// and the optional KHR_texture_transform.
+struct TextureRef {
+  int image = -1;    ///< Index into SceneAsset::images; -1: no texture.
+  int texcoord = 0;  ///< TEXCOORD_n: 0 (Primitive::uv0) or 1 (Primitive::uv1).
+  TextureSampler sampler;
+  TextureTransform transform;
+  bool present() const { return image >= 0; }
+};
+
+/// The UV a texture is sampled at after its KHR_texture_transform.
+inline glm::vec2 transformed_uv(const TextureTransform& t, glm::vec2 uv) {
+  const float c = std::cos(t.rotation_rad);
+  const float s = std::sin(t.rotation_rad);
+  const glm::vec2 scaled = uv * t.scale;
+  return glm::vec2(c * scaled.x + s * scaled.y, -s * scaled.x + c * scaled.y) + t.offset;
+}
+
+/// glTF alphaMode: OPAQUE ignores alpha, MASK cuts out below alpha_cutoff, BLEND blends.
+enum class AlphaMode : std::uint8_t { Opaque, Mask, Blend };
+
+/// Metallic-roughness material. Colours are linear; base colour and emissive textures are
+/// sRGB-encoded, the others linear. Alpha is base_color.a x the base colour texture's alpha.
 struct Material {
   std::string name;
   glm::vec4 base_color{1.0f};
@@ -40,10 +82,13 @@ struct Material {
   /// Lambertian) and the colour its F0 (0.04) is multiplied by. Metals ignore both.
   float specular_factor = 1.0f;
   glm::vec3 specular_color_factor{1.0f};
-  int base_color_texture = -1;
-  int metallic_roughness_texture = -1;
-  int normal_texture = -1;
-  int emissive_texture = -1;
+  TextureRef base_color_texture;          ///< RGB x base_color.rgb, A x base_color.a (sRGB).
+  TextureRef metallic_roughness_texture;  ///< G x roughness, B x metallic (linear).
+  TextureRef normal_texture;              ///< Tangent-space normal (linear), scaled by normal_scale.
+  TextureRef emissive_texture;            ///< RGB x emissive (sRGB).
+  float normal_scale = 1.0f;              ///< normalTexture.scale.
+  AlphaMode alpha_mode = AlphaMode::Opaque;
+  float alpha_cutoff = 0.5f;  ///< MASK: texels with alpha below it are cut out.
   bool double_sided = false;
 };
 

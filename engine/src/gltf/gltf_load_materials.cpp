@@ -189,22 +189,24 @@ Result<std::vector<Material>> convert_materials(const Context& ctx, const Parsed
       }
     }
     struct Slot {
-      int texture;
-      int* target;
+      int index;
+      int texcoord;
+      TextureRef* target;
       const char* name;
     };
-    const Slot slots[] = {{pbr.baseColorTexture.index, &m.base_color_texture, "baseColorTexture"},
-                          {pbr.metallicRoughnessTexture.index, &m.metallic_roughness_texture, "metallicRoughnessTexture"},
-                          {src.normalTexture.index, &m.normal_texture, "normalTexture"},
-                          {src.emissiveTexture.index, &m.emissive_texture, "emissiveTexture"}};
+    const Slot slots[] = {{pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord, &m.base_color_texture, "baseColorTexture"},
+                          {pbr.metallicRoughnessTexture.index, pbr.metallicRoughnessTexture.texCoord, &m.metallic_roughness_texture, "metallicRoughnessTexture"},
+                          {src.normalTexture.index, src.normalTexture.texCoord, &m.normal_texture, "normalTexture"},
+                          {src.emissiveTexture.index, src.emissiveTexture.texCoord, &m.emissive_texture, "emissiveTexture"}};
     // The engine does not use occlusion, but a dangling reference is still a broken file.
     if (src.occlusionTexture.index >= 0 && static_cast<std::size_t>(src.occlusionTexture.index) >= file.model.textures.size()) {
       return ctx.error(where + " occlusionTexture", "texture " + std::to_string(src.occlusionTexture.index) + " is out of range");
     }
     for (const Slot& slot : slots) {
-      auto image = texture_image(ctx, file, slot.texture, where + " " + slot.name);
+      auto image = texture_image(ctx, file, slot.index, where + " " + slot.name);
       if (!image) return image.error();
-      *slot.target = *image;
+      slot.target->image = *image;
+      slot.target->texcoord = slot.texcoord;
     }
     out.push_back(std::move(m));
   }

@@ -134,13 +134,13 @@ class GltfBuilder {
       json pbr = {{"baseColorFactor", vec(m.base_color)},
                   {"metallicFactor", num(m.metallic)},
                   {"roughnessFactor", num(m.roughness)}};
-      if (m.base_color_texture >= 0) pbr["baseColorTexture"] = {{"index", m.base_color_texture}};
-      if (m.metallic_roughness_texture >= 0)
-        pbr["metallicRoughnessTexture"] = {{"index", m.metallic_roughness_texture}};
+      if (m.base_color_texture.present()) pbr["baseColorTexture"] = {{"index", m.base_color_texture.image}};
+      if (m.metallic_roughness_texture.present())
+        pbr["metallicRoughnessTexture"] = {{"index", m.metallic_roughness_texture.image}};
       json j = {{"pbrMetallicRoughness", std::move(pbr)}};
       if (!m.name.empty()) j["name"] = m.name;
-      if (m.normal_texture >= 0) j["normalTexture"] = {{"index", m.normal_texture}};
-      if (m.emissive_texture >= 0) j["emissiveTexture"] = {{"index", m.emissive_texture}};
+      if (m.normal_texture.present()) j["normalTexture"] = {{"index", m.normal_texture.image}};
+      if (m.emissive_texture.present()) j["emissiveTexture"] = {{"index", m.emissive_texture.image}};
       const float peak = std::max({m.emissive.x, m.emissive.y, m.emissive.z});
       if (peak > 1.0f) {
         // glTF clamps emissiveFactor to [0,1]; the rest goes into the strength.

@@ -151,11 +151,11 @@ Result<GpuScene> GpuScene::upload(const SceneAsset& assets) {
     gm.specular_factor = src.specular_factor;
     gm.specular_color_factor = src.specular_color_factor;
     gm.double_sided = src.double_sided;
-    auto base = texture(src.base_color_texture, true, i, "baseColorTexture");
+    auto base = texture(src.base_color_texture.image, true, i, "baseColorTexture");
     if (!base) return base.error();
-    auto mr = texture(src.metallic_roughness_texture, false, i, "metallicRoughnessTexture");
+    auto mr = texture(src.metallic_roughness_texture.image, false, i, "metallicRoughnessTexture");
     if (!mr) return mr.error();
-    auto emissive = texture(src.emissive_texture, true, i, "emissiveTexture");
+    auto emissive = texture(src.emissive_texture.image, true, i, "emissiveTexture");
     if (!emissive) return emissive.error();
     gm.base_color_texture = base.value();
     gm.metallic_roughness_texture = mr.value();

@@ -253,10 +253,10 @@ engine::Result<FrameTruthReport> FrameTruthBench::compare(const FrameCamera& cam
 
 engine::SceneAsset without_textures(engine::SceneAsset asset) {
   for (engine::Material& m : asset.materials) {
-    m.base_color_texture = -1;
-    m.metallic_roughness_texture = -1;
-    m.emissive_texture = -1;
-    m.normal_texture = -1;
+    m.base_color_texture = {};
+    m.metallic_roughness_texture = {};
+    m.emissive_texture = {};
+    m.normal_texture = {};
   }
   return asset;
 }

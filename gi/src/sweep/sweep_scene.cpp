@@ -53,10 +53,10 @@ void add_asset(ContentHash& h, const engine::SceneAsset& a) {
     add_vec(h, m.emissive);
     h.add_value(m.specular_factor);
     add_vec(h, m.specular_color_factor);
-    h.add_value(m.base_color_texture);
-    h.add_value(m.metallic_roughness_texture);
-    h.add_value(m.normal_texture);
-    h.add_value(m.emissive_texture);
+    h.add_value(m.base_color_texture.image);
+    h.add_value(m.metallic_roughness_texture.image);
+    h.add_value(m.normal_texture.image);
+    h.add_value(m.emissive_texture.image);
     h.add_value(m.double_sided);
   }
   h.add_value(static_cast<std::uint64_t>(a.images.size()));
