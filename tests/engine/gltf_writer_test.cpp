@@ -1,18 +1,17 @@
 // engine::write_gltf: round trips through engine::load_gltf (.gltf and .glb), byte
 // determinism, all-or-nothing output, Draco within quantization and bad-input errors.
+#include <engine/gltf.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <glm/gtc/constants.hpp>
 #include <iterator>
 #include <limits>
+#include <nlohmann/json.hpp>
 #include <string>
-
-#include <glm/gtc/constants.hpp>
-
-#include <engine/gltf.h>
 
 namespace {
 
@@ -69,7 +68,31 @@ engine::SceneAsset feature_scene() {
   engine::Material dim;
   dim.name = "dim";
   dim.emissive = {0.5f, 0.25f, 0.0f};
-  s.materials = {plain, glow, dim};
+  // Issue 33: a cut-out leaf with a clamped, nearest-filtered base colour on TEXCOORD_1 under
+  // a KHR_texture_transform, a scaled normal map sharing the image but not the sampler, and
+  // a blended pane reusing the first sampler (one sampler per distinct TextureSampler).
+  engine::Material leaf;
+  leaf.name = "leaf";
+  leaf.base_color_texture = {.image = 1, .texcoord = 1};
+  leaf.base_color_texture.sampler = {.wrap_s = engine::TextureWrap::ClampToEdge,
+                                     .wrap_t = engine::TextureWrap::MirroredRepeat,
+                                     .mag_linear = false,
+                                     .min_linear = false,
+                                     .mipmaps = false};
+  leaf.base_color_texture.transform = {.offset = {0.25f, -0.5f}, .rotation_rad = 0.3f, .scale = {2.0f, 0.5f}};
+  leaf.normal_texture = {.image = 1};
+  leaf.normal_scale = 0.5f;
+  leaf.alpha_mode = engine::AlphaMode::Mask;
+  leaf.alpha_cutoff = 0.3f;
+  leaf.double_sided = true;
+  engine::Material pane;
+  pane.name = "pane";
+  pane.base_color = {0.9f, 0.95f, 1.0f, 0.4f};
+  pane.alpha_mode = engine::AlphaMode::Blend;
+  pane.emissive_texture = leaf.base_color_texture;
+  pane.emissive_texture.transform = {};
+  pane.emissive = {0.1f, 0.1f, 0.1f};
+  s.materials = {plain, glow, dim, leaf, pane};
 
   engine::Image img;
   img.name = "checker";
@@ -78,6 +101,12 @@ engine::SceneAsset feature_scene() {
   for (int i = 0; i < img.width * img.height; ++i)
     img.rgba8.insert(img.rgba8.end(), {static_cast<std::uint8_t>(30 * i), static_cast<std::uint8_t>(255 - 20 * i), 7, 255});
   s.images.push_back(img);
+  engine::Image mask;  // alpha 0 or 255 in a 2x2 checker
+  mask.name = "mask";
+  mask.width = 2;
+  mask.height = 2;
+  mask.rgba8 = {40, 160, 30, 255, 40, 160, 30, 0, 40, 160, 30, 0, 40, 160, 30, 255};
+  s.images.push_back(mask);
 
   engine::Mesh m;
   m.name = "ground";
@@ -166,7 +195,13 @@ void expect_round_trip(const engine::SceneAsset& in, const engine::SceneAsset& o
     EXPECT_FLOAT_EQ(b.roughness, a.roughness);
     expect_vec_near(b.emissive, a.emissive, 1e-5f * (1.0f + a.emissive.x), a.name + " emissive");
     EXPECT_EQ(b.double_sided, a.double_sided);
-    EXPECT_EQ(b.base_color_texture.image, a.base_color_texture.image);
+    for (const auto& [ta, tb] :
+         {std::pair{&a.base_color_texture, &b.base_color_texture},
+          std::pair{&a.metallic_roughness_texture, &b.metallic_roughness_texture},
+          std::pair{&a.normal_texture, &b.normal_texture}, std::pair{&a.emissive_texture, &b.emissive_texture}}) {
+      EXPECT_EQ(tb->image, ta->image) << a.name;
+      EXPECT_EQ(tb->texcoord, ta->texcoord) << a.name;
+    }
     EXPECT_FLOAT_EQ(b.specular_factor, a.specular_factor) << a.name;
     for (int c = 0; c < 3; ++c) EXPECT_FLOAT_EQ(b.specular_color_factor[c], a.specular_color_factor[c]) << a.name;
   }
@@ -240,6 +275,101 @@ TEST(GltfWriter, RoundTripsEveryFeatureThroughGlb) {
   auto loaded = engine::load_gltf(path);
   ASSERT_TRUE(loaded) << loaded.error().to_string();
   expect_round_trip(scene, *loaded);
+}
+
+// Issue 33's material data beyond image and texCoord: samplers, KHR_texture_transform,
+// alphaMode / alphaCutoff and normalTexture.scale.
+void expect_texture_state_round_trip(const engine::SceneAsset& in, const engine::SceneAsset& out) {
+  ASSERT_EQ(out.materials.size(), in.materials.size());
+  for (std::size_t i = 0; i < in.materials.size(); ++i) {
+    const engine::Material& a = in.materials[i];
+    const engine::Material& b = out.materials[i];
+    EXPECT_EQ(b.alpha_mode, a.alpha_mode) << a.name;
+    EXPECT_FLOAT_EQ(b.alpha_cutoff, a.alpha_cutoff) << a.name;
+    EXPECT_FLOAT_EQ(b.normal_scale, a.normal_scale) << a.name;
+    for (const auto& [ta, tb] :
+         {std::pair{&a.base_color_texture, &b.base_color_texture},
+          std::pair{&a.metallic_roughness_texture, &b.metallic_roughness_texture},
+          std::pair{&a.normal_texture, &b.normal_texture}, std::pair{&a.emissive_texture, &b.emissive_texture}}) {
+      if (!ta->present()) continue;
+      EXPECT_EQ(tb->sampler.wrap_s, ta->sampler.wrap_s) << a.name;
+      EXPECT_EQ(tb->sampler.wrap_t, ta->sampler.wrap_t) << a.name;
+      EXPECT_EQ(tb->sampler.mag_linear, ta->sampler.mag_linear) << a.name;
+      EXPECT_EQ(tb->sampler.min_linear, ta->sampler.min_linear) << a.name;
+      EXPECT_EQ(tb->sampler.mipmaps, ta->sampler.mipmaps) << a.name;
+      EXPECT_FLOAT_EQ(tb->transform.offset.x, ta->transform.offset.x) << a.name;
+      EXPECT_FLOAT_EQ(tb->transform.offset.y, ta->transform.offset.y) << a.name;
+      EXPECT_FLOAT_EQ(tb->transform.rotation_rad, ta->transform.rotation_rad) << a.name;
+      EXPECT_FLOAT_EQ(tb->transform.scale.x, ta->transform.scale.x) << a.name;
+      EXPECT_FLOAT_EQ(tb->transform.scale.y, ta->transform.scale.y) << a.name;
+    }
+  }
+}
+
+// Disabled until the loader reads samplers, KHR_texture_transform and alpha (issue 33's
+// loader step, in parallel on another branch): the base loader sets only image and texCoord.
+// Enable it when that work is merged; WritesSamplersTransformsAndAlphaAsGltfDefines checks
+// the written JSON meanwhile.
+TEST(GltfWriter, DISABLED_RoundTripsSamplersTransformsAndAlpha) {
+  const engine::SceneAsset scene = feature_scene();
+  for (const char* name : {"scene.gltf", "scene.glb"}) {
+    const fs::path path = temp_dir("texture_state") / name;
+    const engine::Status st = engine::write_gltf(scene, path);
+    ASSERT_TRUE(st) << st.error().to_string();
+    auto loaded = engine::load_gltf(path);
+    ASSERT_TRUE(loaded) << loaded.error().to_string();
+    expect_texture_state_round_trip(scene, *loaded);
+  }
+}
+
+TEST(GltfWriter, WritesSamplersTransformsAndAlphaAsGltfDefines) {
+  const fs::path path = temp_dir("texture_json") / "scene.gltf";
+  ASSERT_TRUE(engine::write_gltf(feature_scene(), path));
+  const nlohmann::json doc = nlohmann::json::parse(read_bytes(path));
+  // Two distinct samplers (the default and the leaf's), three (image, sampler) textures.
+  const nlohmann::json samplers = nlohmann::json::parse(R"([
+    {"magFilter": 9729, "minFilter": 9987, "wrapS": 10497, "wrapT": 10497},
+    {"magFilter": 9728, "minFilter": 9728, "wrapS": 33071, "wrapT": 33648}])");
+  EXPECT_EQ(doc.at("samplers"), samplers);
+  const nlohmann::json textures = nlohmann::json::parse(R"([
+    {"sampler": 0, "source": 0}, {"sampler": 1, "source": 1}, {"sampler": 0, "source": 1}])");
+  EXPECT_EQ(doc.at("textures"), textures);
+  const nlohmann::json& mats = doc.at("materials");
+  ASSERT_EQ(mats.size(), 5u);
+  // plain: defaults are left out (no alphaMode, no texCoord, no transform).
+  EXPECT_FALSE(mats[0].contains("alphaMode"));
+  EXPECT_FALSE(mats[0].contains("alphaCutoff"));
+  EXPECT_EQ(mats[0].at("pbrMetallicRoughness").at("baseColorTexture"), nlohmann::json({{"index", 0}}));
+  // leaf: MASK with its cutoff, TEXCOORD_1 and the transform, normal scale.
+  const nlohmann::json& leaf = mats[3];
+  EXPECT_EQ(leaf.at("alphaMode"), "MASK");
+  EXPECT_DOUBLE_EQ(leaf.at("alphaCutoff").get<double>(), 0.3);
+  const nlohmann::json& base = leaf.at("pbrMetallicRoughness").at("baseColorTexture");
+  EXPECT_EQ(base.at("index"), 1);
+  EXPECT_EQ(base.at("texCoord"), 1);
+  const nlohmann::json transform =
+      nlohmann::json::parse(R"({"offset": [0.25, -0.5], "rotation": 0.3, "scale": [2.0, 0.5]})");
+  EXPECT_EQ(base.at("extensions").at("KHR_texture_transform"), transform);
+  EXPECT_EQ(leaf.at("normalTexture"), nlohmann::json::parse(R"({"index": 2, "scale": 0.5})"));
+  // pane: BLEND without a cutoff (glTF ignores it outside MASK); its emissive texture has
+  // the leaf's sampler and no transform.
+  EXPECT_EQ(mats[4].at("alphaMode"), "BLEND");
+  EXPECT_FALSE(mats[4].contains("alphaCutoff"));
+  EXPECT_EQ(mats[4].at("emissiveTexture"), nlohmann::json::parse(R"({"index": 1, "texCoord": 1})"));
+  const auto used = doc.at("extensionsUsed").get<std::vector<std::string>>();
+  EXPECT_NE(std::find(used.begin(), used.end(), "KHR_texture_transform"), used.end());
+  EXPECT_FALSE(doc.contains("extensionsRequired")) << "a viewer without the transform still draws the texture";
+}
+
+TEST(GltfWriter, RefusesATextureOfAMissingImage) {
+  engine::SceneAsset scene = feature_scene();
+  scene.materials[3].normal_texture.image = 7;
+  const fs::path path = temp_dir("missing_image") / "scene.gltf";
+  const engine::Status st = engine::write_gltf(scene, path);
+  ASSERT_FALSE(st);
+  EXPECT_EQ(st.error().location, "materials[3] normalTexture");
+  EXPECT_NE(st.error().message.find("image 7 is out of range"), std::string::npos) << st.error().to_string();
+  EXPECT_FALSE(fs::exists(path));
 }
 
 TEST(GltfWriter, MeshWithoutPrimitivesIsLeftOutAndItsNodesKeepNoMesh) {

@@ -1,7 +1,9 @@
 // engine::write_gltf: SceneAsset -> glTF 2.0 (.gltf + .bin, or .glb), optionally with
-// KHR_draco_mesh_compression. The JSON is built with nlohmann::json, whose objects keep
-// their keys sorted, and floats are written in their shortest round-trip form, so the
-// same input always gives the same bytes.
+// KHR_draco_mesh_compression. Images are embedded as PNG in the binary buffer; each
+// material's textures get a sampler (one per distinct engine::TextureSampler), their
+// TEXCOORD set and KHR_texture_transform when it is not the identity. The JSON is built
+// with nlohmann::json, whose objects keep their keys sorted, and floats are written in
+// their shortest round-trip form, so the same input always gives the same bytes.
 #include <engine/finite.h>
 #include <engine/gltf.h>
 #include <engine/units.h>
@@ -13,6 +15,7 @@
 #include <nlohmann/json.hpp>
 #include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "gltf/draco_encode.h"
@@ -69,7 +72,8 @@ class GltfBuilder {
   Status build() {
     doc_["asset"] = {{"version", "2.0"}, {"generator", "gi engine::write_gltf"}};
     if (auto s = write_images(); !s) return s;
-    write_materials();
+    if (auto s = write_materials(); !s) return s;
+    write_textures();
     if (auto s = write_meshes(); !s) return s;
     write_lights();
     write_cameras();
@@ -100,7 +104,6 @@ class GltfBuilder {
   Status write_images() {
     if (scene_.images.empty()) return {};
     json images = json::array();
-    json textures = json::array();
     for (std::size_t i = 0; i < scene_.images.size(); ++i) {
       const Image& img = scene_.images[i];
       const std::string where = "images[" + std::to_string(i) + "]";
@@ -120,27 +123,103 @@ class GltfBuilder {
         return error(where, "image has neither pixels nor a URI");
       }
       images.push_back(std::move(j));
-      textures.push_back({{"source", i}});
     }
     doc_["images"] = std::move(images);
-    doc_["textures"] = std::move(textures);
     return {};
   }
 
-  void write_materials() {
-    if (scene_.materials.empty()) return;
+  /// glTF sampler enums (§5.26): wrap modes and filters.
+  static int wrap_enum(TextureWrap w) {
+    switch (w) {
+      case TextureWrap::ClampToEdge:
+        return 33071;
+      case TextureWrap::MirroredRepeat:
+        return 33648;
+      case TextureWrap::Repeat:
+        break;
+    }
+    return 10497;
+  }
+  static json sampler_json(const TextureSampler& s) {
+    const int min_filter = s.mipmaps ? (s.min_linear ? 9987 : 9986)   // LINEAR_ / NEAREST_MIPMAP_LINEAR
+                                     : (s.min_linear ? 9729 : 9728);  // LINEAR / NEAREST
+    return {{"wrapS", wrap_enum(s.wrap_s)},
+            {"wrapT", wrap_enum(s.wrap_t)},
+            {"magFilter", s.mag_linear ? 9729 : 9728},
+            {"minFilter", min_filter}};
+  }
+  static bool same_sampler(const TextureSampler& a, const TextureSampler& b) {
+    return a.wrap_s == b.wrap_s && a.wrap_t == b.wrap_t && a.mag_linear == b.mag_linear &&
+           a.min_linear == b.min_linear && a.mipmaps == b.mipmaps;
+  }
+
+  /// The glTF texture (image + sampler) for `t`, added on first use: one sampler per
+  /// distinct TextureSampler, one texture per distinct (image, sampler) pair, in the order
+  /// the materials first use them.
+  int texture_index(const TextureRef& t) {
+    auto s = std::find_if(samplers_.begin(), samplers_.end(),
+                          [&](const TextureSampler& o) { return same_sampler(o, t.sampler); });
+    if (s == samplers_.end()) s = samplers_.insert(samplers_.end(), t.sampler);
+    const std::pair<int, int> key{t.image, static_cast<int>(s - samplers_.begin())};
+    auto k = std::find(textures_.begin(), textures_.end(), key);
+    if (k == textures_.end()) k = textures_.insert(textures_.end(), key);
+    return static_cast<int>(k - textures_.begin());
+  }
+
+  Status check_texture(const TextureRef& t, const std::string& where) const {
+    if (t.image >= static_cast<int>(scene_.images.size()))
+      return error(where, "image " + std::to_string(t.image) + " is out of range (" +
+                              std::to_string(scene_.images.size()) + " images)");
+    if (t.texcoord < 0) return error(where, "texcoord must be >= 0, got " + std::to_string(t.texcoord));
+    const TextureTransform& x = t.transform;
+    if (!engine::all_finite(x.offset) || !engine::all_finite(x.scale) || !std::isfinite(x.rotation_rad))
+      return error(where, "texture transform is NaN or infinite");
+    return {};
+  }
+
+  /// A textureInfo: index, texCoord (when not 0) and KHR_texture_transform (when not the identity).
+  json texture_info(const TextureRef& t) {
+    json j = {{"index", texture_index(t)}};
+    if (t.texcoord != 0) j["texCoord"] = t.texcoord;
+    const TextureTransform& x = t.transform;
+    json transform = json::object();
+    if (x.offset != glm::vec2(0.0f)) transform["offset"] = vec(x.offset);
+    if (x.rotation_rad != 0.0f) transform["rotation"] = num(x.rotation_rad);
+    if (x.scale != glm::vec2(1.0f)) transform["scale"] = vec(x.scale);
+    if (!transform.empty()) {
+      j["extensions"]["KHR_texture_transform"] = std::move(transform);
+      used_.insert("KHR_texture_transform");
+    }
+    return j;
+  }
+
+  Status write_materials() {
+    if (scene_.materials.empty()) return {};
     json materials = json::array();
-    for (const Material& m : scene_.materials) {
+    for (std::size_t i = 0; i < scene_.materials.size(); ++i) {
+      const Material& m = scene_.materials[i];
+      const std::string where = "materials[" + std::to_string(i) + "]";
+      for (const auto& [ref, name] :
+           {std::pair{&m.base_color_texture, "baseColorTexture"},
+            std::pair{&m.metallic_roughness_texture, "metallicRoughnessTexture"},
+            std::pair{&m.normal_texture, "normalTexture"}, std::pair{&m.emissive_texture, "emissiveTexture"}})
+        if (auto s = check_texture(*ref, where + " " + name); !s) return s;
+      if (!std::isfinite(m.alpha_cutoff) || m.alpha_cutoff < 0.0f)
+        return error(where, "alphaCutoff must be a finite number >= 0");
+      if (!std::isfinite(m.normal_scale)) return error(where, "normal texture scale is NaN or infinite");
       json pbr = {{"baseColorFactor", vec(m.base_color)},
                   {"metallicFactor", num(m.metallic)},
                   {"roughnessFactor", num(m.roughness)}};
-      if (m.base_color_texture.present()) pbr["baseColorTexture"] = {{"index", m.base_color_texture.image}};
+      if (m.base_color_texture.present()) pbr["baseColorTexture"] = texture_info(m.base_color_texture);
       if (m.metallic_roughness_texture.present())
-        pbr["metallicRoughnessTexture"] = {{"index", m.metallic_roughness_texture.image}};
+        pbr["metallicRoughnessTexture"] = texture_info(m.metallic_roughness_texture);
       json j = {{"pbrMetallicRoughness", std::move(pbr)}};
       if (!m.name.empty()) j["name"] = m.name;
-      if (m.normal_texture.present()) j["normalTexture"] = {{"index", m.normal_texture.image}};
-      if (m.emissive_texture.present()) j["emissiveTexture"] = {{"index", m.emissive_texture.image}};
+      if (m.normal_texture.present()) {
+        j["normalTexture"] = texture_info(m.normal_texture);
+        if (m.normal_scale != 1.0f) j["normalTexture"]["scale"] = num(m.normal_scale);
+      }
+      if (m.emissive_texture.present()) j["emissiveTexture"] = texture_info(m.emissive_texture);
       const float peak = std::max({m.emissive.x, m.emissive.y, m.emissive.z});
       if (peak > 1.0f) {
         // glTF clamps emissiveFactor to [0,1]; the rest goes into the strength.
@@ -155,10 +234,29 @@ class GltfBuilder {
                                                      {"specularColorFactor", vec(m.specular_color_factor)}};
         used_.insert("KHR_materials_specular");
       }
+      // Defaults (OPAQUE, cutoff 0.5) are left out; glTF ignores alphaCutoff unless MASK.
+      if (m.alpha_mode == AlphaMode::Mask) {
+        j["alphaMode"] = "MASK";
+        if (m.alpha_cutoff != 0.5f) j["alphaCutoff"] = num(m.alpha_cutoff);
+      } else if (m.alpha_mode == AlphaMode::Blend) {
+        j["alphaMode"] = "BLEND";
+      }
       if (m.double_sided) j["doubleSided"] = true;
       materials.push_back(std::move(j));
     }
     doc_["materials"] = std::move(materials);
+    return {};
+  }
+
+  /// The textures and samplers the materials use (texture_index collected them).
+  void write_textures() {
+    if (textures_.empty()) return;
+    json samplers = json::array();
+    for (const TextureSampler& s : samplers_) samplers.push_back(sampler_json(s));
+    json textures = json::array();
+    for (const auto& [image, sampler] : textures_) textures.push_back({{"source", image}, {"sampler", sampler}});
+    doc_["samplers"] = std::move(samplers);
+    doc_["textures"] = std::move(textures);
   }
 
   Status check_primitive(const Primitive& p, const std::string& where) const {
@@ -291,7 +389,7 @@ class GltfBuilder {
     khr_light_index_.assign(scene_.lights.size(), -1);
     for (std::size_t i = 0; i < scene_.lights.size(); ++i) {
       const Light& l = scene_.lights[i].light;
-      if (l.type == LightType::Area) continue;  // written as node extras
+      if (l.type == LightType::Area) continue;                                               // written as node extras
       if (sun_in_extras() && static_cast<int>(i) == scene_.environment.sun_light) continue;  // scene extras
       json j = {{"color", vec(l.color)}};
       if (!scene_.lights[i].name.empty()) j["name"] = scene_.lights[i].name;
@@ -433,7 +531,9 @@ class GltfBuilder {
   json accessors_ = json::array();
   BinaryChunk bin_;
   std::vector<int> khr_light_index_;
-  std::vector<int> mesh_index_;  ///< SceneAsset mesh -> written mesh, -1 when left out (no primitives).
+  std::vector<int> mesh_index_;                ///< SceneAsset mesh -> written mesh, -1 when left out (no primitives).
+  std::vector<TextureSampler> samplers_;       ///< Distinct samplers, in order of first use.
+  std::vector<std::pair<int, int>> textures_;  ///< (image, sampler) per glTF texture.
   std::set<std::string> used_;
   std::set<std::string> required_;
 };
