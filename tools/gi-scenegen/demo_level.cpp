@@ -1,5 +1,11 @@
 // The demo level: a hub lit by static lights, a crate room with pushable crates (dynamic),
 // a corridor with a glossy floor and a lamp room whose lamp swings (light_moves = true).
+// Textures (textures.h): the hub's west wall is red brick beside its light floor (the
+// corner light lights it: red bleeds onto the floor), a tartan rug lies in the hub, the
+// lamp room has a wooden plank floor, and a wire-mesh grille (alphaMode MASK) hangs under
+// the crate room's light, casting its cut-out shadow onto the floor. The rug and the grille
+// are horizontal (they never block walking: the collision keeps wall-like triangles only)
+// and added after the other nodes, which keep their indices.
 //
 // Top view (x right, z up):
 //   z [16.4, 22.4]  lamp room    x [0, 8]    (swinging lamp hangs from a pivot node)
@@ -12,6 +18,7 @@
 #include "rooms.h"
 #include "scene_builder.h"
 #include "scenes.h"
+#include "textures.h"
 
 namespace scenegen {
 
@@ -21,20 +28,23 @@ engine::SceneAsset demo_level() {
   const int hub_floor_mat = b.material("hub_tiles", {0.6f, 0.58f, 0.52f});
   const int crate_floor_mat = b.material("concrete", {0.5f, 0.5f, 0.5f});
   const int glossy = b.material("polished_floor", {0.45f, 0.42f, 0.4f}, 0.15f, 0.0f);
-  const int lamp_floor_mat = b.material("lamp_room_boards", {0.55f, 0.42f, 0.3f});
+  const int lamp_floor_mat = b.textured_material("lamp_room_boards", b.image(wood_planks_texture()));
   const int pillar_mat = b.material("pillar_white", {0.85f, 0.85f, 0.85f});
   const int wood = b.material("crate_wood", {0.62f, 0.45f, 0.28f});
   const int red = b.material("crate_red", {0.75f, 0.06f, 0.05f});
   const int shade_mat = b.material("lamp_shade", {0.3f, 0.3f, 0.32f}, 0.4f, 1.0f);
   const glm::vec3 panel_radiance(20.0f, 19.0f, 17.5f);
   const int panel_mat = b.material("ceiling_panel", {0.8f, 0.8f, 0.8f}, 1.0f, 0.0f, panel_radiance);
+  const int brick_mat = b.textured_material("brick", b.image(brick_texture()));
 
   const Opening hub_crate_door{3.4f, 4.6f, 0.0f, 2.2f};  // along z, in the walls x = 8 / 8.2
   const Opening north_door{3.2f, 4.8f, 0.0f, 2.4f};      // along x, in walls z = 8..8.2 and 16.2..16.4
 
   // Hub.
   MeshBuilder hub, hub_floor;
-  add_room(hub, hub_floor, {hub_floor_mat, wall, wall}, {0, 0, 0}, {8, 3.5f, 8}, {{}, {hub_crate_door}, {}, {north_door}});
+  RoomMaterials hub_mats{hub_floor_mat, wall, wall};
+  hub_mats.west = brick_mat;
+  add_room(hub, hub_floor, hub_mats, {0, 0, 0}, {8, 3.5f, 8}, {{}, {hub_crate_door}, {}, {north_door}});
   add_doorway_x(hub, hub_floor, {hub_floor_mat, wall, wall}, 8.0f, 8.2f, hub_crate_door);
   add_doorway_z(hub, hub_floor, {hub_floor_mat, wall, wall}, 8.0f, 8.2f, north_door);
   b.add_mesh_node("hub", hub, engine::Mobility::Static);
@@ -113,6 +123,24 @@ engine::SceneAsset demo_level() {
   const int door_node = b.add_mesh_node("corridor_door", door, engine::Mobility::Static, {3.2f, 0.0f, 8.2f},
                                         glm::angleAxis(glm::radians(-90.0f), glm::vec3(0, 1, 0)));
   b.asset().nodes[static_cast<std::size_t>(door_node)].gi.region = engine::GiRegion::Deforming;
+
+  // A 2 x 2 m tartan rug in the hub's south-east quarter, 4 mm above the floor (whole
+  // repeats of the 1 m texture, so its border follows the sett).
+  MeshBuilder rug;
+  rug.horizontal(b.textured_material("rug_tartan", b.image(tartan_fabric_texture())), 0.004f, 5.0f, 7.0f, 2.0f, 4.0f,
+                 1.0f);
+  b.add_mesh_node("hub_rug", rug, engine::Mobility::Static);
+  // A 0.6 m wire-mesh grille 0.5 m under the crate room's light (y 2.8, ceiling 3): its
+  // shadow covers ~3.4 m of the floor with 35 cm diamonds. Double-sided: seen from below,
+  // shadowing from above.
+  const int mesh_mat = b.textured_material("wire_mesh", b.image(wire_mesh_texture()), 0.5f);
+  engine::Material& wire = b.asset().materials[static_cast<std::size_t>(mesh_mat)];
+  wire.alpha_mode = engine::AlphaMode::Mask;
+  wire.alpha_cutoff = 0.5f;
+  wire.double_sided = true;
+  MeshBuilder grille;
+  grille.horizontal(mesh_mat, 2.3f, 10.9f, 11.5f, 3.7f, 4.3f, -1.0f);
+  b.add_mesh_node("crate_room_grille", grille, engine::Mobility::Static);
   return b.take();
 }
 

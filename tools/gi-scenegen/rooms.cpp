@@ -7,10 +7,11 @@ void add_room(MeshBuilder& walls, MeshBuilder& floor, RoomMaterials m, glm::vec3
               const RoomOpenings& o) {
   floor.horizontal(m.floor, lo.y, lo.x, hi.x, lo.z, hi.z, 1.0f);
   walls.horizontal(m.ceiling, hi.y, lo.x, hi.x, lo.z, hi.z, -1.0f);
-  walls.wall_x(m.walls, lo.x, lo.z, hi.z, lo.y, hi.y, 1.0f, o.west);
-  walls.wall_x(m.walls, hi.x, lo.z, hi.z, lo.y, hi.y, -1.0f, o.east);
-  walls.wall_z(m.walls, lo.z, lo.x, hi.x, lo.y, hi.y, 1.0f, o.south);
-  walls.wall_z(m.walls, hi.z, lo.x, hi.x, lo.y, hi.y, -1.0f, o.north);
+  const auto wall = [&](int own) { return own >= 0 ? own : m.walls; };
+  walls.wall_x(wall(m.west), lo.x, lo.z, hi.z, lo.y, hi.y, 1.0f, o.west);
+  walls.wall_x(wall(m.east), hi.x, lo.z, hi.z, lo.y, hi.y, -1.0f, o.east);
+  walls.wall_z(wall(m.south), lo.z, lo.x, hi.x, lo.y, hi.y, 1.0f, o.south);
+  walls.wall_z(wall(m.north), hi.z, lo.x, hi.x, lo.y, hi.y, -1.0f, o.north);
 }
 
 void add_doorway_x(MeshBuilder& walls, MeshBuilder& floor, RoomMaterials m, float x0, float x1, Opening o) {

@@ -16,8 +16,11 @@ struct RoomOpenings {
   std::vector<Opening> west, east, south, north;
 };
 
+/// Materials of a room's surfaces. `west` .. `north` give one wall a material of its own
+/// (-1: `walls`); doorway tunnels use `walls`.
 struct RoomMaterials {
   int floor, walls, ceiling;
+  int west = -1, east = -1, south = -1, north = -1;
 };
 
 /// Floor into `floor` and walls + ceiling into `walls`, all facing inside the box [min, max].

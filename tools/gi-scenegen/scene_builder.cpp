@@ -2,10 +2,20 @@
 #include "scene_builder.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include <glm/gtc/quaternion.hpp>
 
+#include <engine/check.h>
+
 namespace scenegen {
+
+glm::vec2 planar_uv(glm::vec3 p, glm::vec3 n) {
+  if (std::abs(n.y) >= 0.7f) return {p.x, p.z};  // floors and ceilings
+  // Walls: u to the right as seen from the front, v down (image rows run top to bottom).
+  const glm::vec3 right = glm::normalize(glm::vec3(n.z, 0.0f, -n.x));  // cross(+y, n)
+  return {glm::dot(p, right), -p.y};
+}
 
 void MeshBuilder::quad(int material, glm::vec3 p0, glm::vec3 p1, glm::vec3 p2, glm::vec3 p3, glm::vec3 facing_hint) {
   // Newell-style normal from the diagonals: robust for slightly non-planar quads.
@@ -17,12 +27,10 @@ void MeshBuilder::quad(int material, glm::vec3 p0, glm::vec3 p1, glm::vec3 p2, g
   engine::Primitive& prim = by_material_[material];
   prim.material = material;
   const auto base = static_cast<std::uint32_t>(prim.positions.size());
-  const glm::vec3 e1 = glm::normalize(p1 - p0);
-  const glm::vec3 e2 = glm::normalize(glm::cross(n, e1));
   for (const glm::vec3& p : {p0, p1, p2, p3}) {
     prim.positions.push_back(p);
     prim.normals.push_back(n);
-    prim.uv0.emplace_back(glm::dot(p - p0, e1), glm::dot(p - p0, e2));
+    prim.uv0.push_back(planar_uv(p, n));
   }
   for (std::uint32_t i : {0u, 1u, 2u, 0u, 2u, 3u}) prim.indices.push_back(base + i);
 }
@@ -37,8 +45,6 @@ void MeshBuilder::quad_grid(int material, glm::vec3 p0, glm::vec3 p1, glm::vec3 
   engine::Primitive& prim = by_material_[material];
   prim.material = material;
   const auto base = static_cast<std::uint32_t>(prim.positions.size());
-  const glm::vec3 e1 = glm::normalize(p1 - p0);
-  const glm::vec3 e2 = glm::normalize(glm::cross(nrm, e1));
   const auto fn = static_cast<float>(n);
   for (int j = 0; j <= n; ++j)
     for (int i = 0; i <= n; ++i) {
@@ -46,7 +52,7 @@ void MeshBuilder::quad_grid(int material, glm::vec3 p0, glm::vec3 p1, glm::vec3 
       const glm::vec3 p = (1.0f - v) * ((1.0f - u) * p0 + u * p1) + v * ((1.0f - u) * p3 + u * p2);
       prim.positions.push_back(p);
       prim.normals.push_back(nrm);
-      prim.uv0.emplace_back(glm::dot(p - p0, e1), glm::dot(p - p0, e2));
+      prim.uv0.push_back(planar_uv(p, nrm));
     }
   const auto at = [&](int i, int j) { return base + static_cast<std::uint32_t>(j * (n + 1) + i); };
   for (int j = 0; j < n; ++j)
@@ -154,6 +160,19 @@ int SceneBuilder::material(std::string name, glm::vec3 base_color, float roughne
   m.emissive = emissive_radiance;
   asset_.materials.push_back(std::move(m));
   return static_cast<int>(asset_.materials.size()) - 1;
+}
+
+int SceneBuilder::image(engine::Image image) {
+  asset_.images.push_back(std::move(image));
+  return static_cast<int>(asset_.images.size()) - 1;
+}
+
+int SceneBuilder::textured_material(std::string name, int image, float roughness, glm::vec3 tint) {
+  GI_EXPECTS(image >= 0 && image < static_cast<int>(asset_.images.size()), "textured_material needs an added image");
+  const int m = material(std::move(name), tint, roughness);
+  engine::Material& mat = asset_.materials[static_cast<std::size_t>(m)];
+  mat.base_color_texture.image = image;  // TEXCOORD_0, REPEAT, linear with mipmaps: the defaults
+  return m;
 }
 
 int SceneBuilder::add_mesh(const std::string& name, const MeshBuilder& mesh) {

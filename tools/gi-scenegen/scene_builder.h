@@ -1,6 +1,8 @@
 #pragma once
 // Helpers that build engine::SceneAsset content from quads, boxes and rooms, in metres,
-// y up. Every quad gets a flat normal and planar TEXCOORD_0 in metres along its edges.
+// y up. Every quad gets a flat normal and planar TEXCOORD_0 in metres (planar_uv), taken
+// from the mesh's coordinates so a texture runs on across neighbouring quads (the pieces
+// of a wall around a door) at 1 repeat per metre (textures.h).
 //   scenegen::SceneBuilder b;  int white = b.material("white", {0.7f, 0.7f, 0.7f});
 //   scenegen::MeshBuilder m;   m.box(white, {0, 0.5f, 0}, {0.5f, 0.5f, 0.5f});  b.add_mesh_node("crate", m);
 
@@ -16,6 +18,11 @@ namespace scenegen {
 struct Opening {
   float a0, a1, y0, y1;
 };
+
+/// TEXCOORD_0 of point `p` of a quad facing `n`, in metres: floors and ceilings (|n.y| >= 0.7)
+/// u = x, v = z; walls u along the wall to the right as seen from the front, v = -y (the
+/// image's top row up).
+glm::vec2 planar_uv(glm::vec3 p, glm::vec3 n);
 
 /// Collects triangles per material; build() turns them into one engine::Mesh.
 class MeshBuilder {
@@ -54,6 +61,11 @@ class SceneBuilder {
  public:
   int material(std::string name, glm::vec3 base_color, float roughness = 1.0f, float metallic = 0.0f,
                glm::vec3 emissive_radiance = glm::vec3(0.0f));
+  /// Adds an image for textures; returns its index.
+  int image(engine::Image image);
+  /// A material whose base colour is the sRGB image `image` (TEXCOORD_0, REPEAT, linear
+  /// filtering with mipmaps) times `tint` (linear; 1: the texture's own colours).
+  int textured_material(std::string name, int image, float roughness = 1.0f, glm::vec3 tint = glm::vec3(1.0f));
   /// A node drawing `mesh` (added as a new mesh named after the node).
   int add_mesh_node(const std::string& name, const MeshBuilder& mesh, engine::Mobility mobility,
                     glm::vec3 translation = glm::vec3(0.0f), glm::quat rotation = glm::quat(1, 0, 0, 0));
