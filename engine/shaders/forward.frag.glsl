@@ -40,11 +40,13 @@
 #include "lighting_common.glsl"
 #include "shadow_common.glsl"
 #include "directional_radiance.glsl"
+#include "material_common.glsl"
 
 in vec3 v_world;
 in vec3 v_normal;
 in vec2 v_uv0;
 in vec2 v_uv1;
+in vec4 v_tangent;
 in vec3 v_vertex_irradiance;
 // Per-vertex view-dependent indirect light (forward.vert.glsl, vertex_radiance_lobes): terms > 0: use v_lobe_radiance.
 in vec3 v_lobe_radiance;
@@ -91,6 +93,9 @@ layout(binding = 2) uniform sampler2D u_emissive_texture;
 layout(binding = 3) uniform sampler2D u_irradiance_atlas;
 layout(binding = 6) uniform sampler2D u_glossy_radiance;
 layout(binding = 7) uniform isampler2D u_directional_index;
+layout(binding = 15) uniform sampler2D u_normal_texture;
+layout(location = 72) uniform float u_normal_scale;
+layout(location = 82) uniform int u_normal_map;
 
 #if AREA_SHADOW_HALF
 layout(binding = 13) uniform sampler2D u_area_visibility;
@@ -98,22 +103,44 @@ layout(binding = 13) uniform sampler2D u_area_visibility;
 
 layout(location = 0) out vec4 o_radiance;
 
+// The shading normal: the vertex normal, or with a normal map (u_normal_map) the tangent-space
+// normal n_t = (2 tex - 1) x (scale, scale, 1) in the frame (T, B = w cross(N, T), N), T made
+// orthogonal to N (glTF 2.0 §3.9.3). Back faces of double-sided materials flip the frame.
+vec3 shading_normal() {
+  vec3 n = normalize(v_normal);
+  const bool flip = u_double_sided != 0 && !gl_FrontFacing;
+  if (u_normal_map != 0) {
+    vec3 t = v_tangent.xyz - n * dot(n, v_tangent.xyz);
+    if (dot(t, t) > 1e-12) {  // zero tangents (a material override's normal map): none
+      t = normalize(t);
+      const vec3 b = cross(n, t) * (v_tangent.w < 0.0 ? -1.0 : 1.0);
+      vec3 tn = texture(u_normal_texture, material_uv(2, v_uv0, v_uv1)).xyz * 2.0 - 1.0;
+      tn.xy *= u_normal_scale;
+      n = normalize(mat3(t, b, n) * tn);
+    }
+  }
+  return flip ? -n : n;
+}
+
 void main() {
-  vec4 base = u_base_color * texture(u_base_color_texture, v_uv0);
+  // MASK's cut-out texels never get here: the depth pre-pass discarded them (alpha_test), and
+  // this pass shades only where its depth equals the pre-pass's. A discard here would cost
+  // llvmpipe its early depth test on every material. OPAQUE ignores alpha; BLEND outputs it.
+  vec4 base = u_base_color * texture(u_base_color_texture, material_uv(0, v_uv0, v_uv1));
+  const float alpha = u_alpha_mode == 2 ? base.a : 1.0;
 #if FLAT_SHADING
-  o_radiance = vec4(base.rgb, 1.0);
+  o_radiance = vec4(base.rgb, alpha);
   return;
 #endif
-  vec4 mr = texture(u_metallic_roughness_texture, v_uv0);
+  vec4 mr = texture(u_metallic_roughness_texture, material_uv(1, v_uv0, v_uv1));
 
   Surface s;
   s.position = v_world;
-  s.normal = normalize(v_normal);
-  if (u_double_sided != 0 && !gl_FrontFacing) s.normal = -s.normal;
+  s.normal = shading_normal();
   s.view = normalize(u_camera_position - v_world);
   s.brdf = gltf_brdf(base.rgb, u_metallic * mr.b, u_roughness * mr.g, u_specular_factor, u_specular_color_factor);
 
-  vec3 radiance = u_emissive * texture(u_emissive_texture, v_uv0).rgb;
+  vec3 radiance = u_emissive * texture(u_emissive_texture, material_uv(3, v_uv0, v_uv1)).rgb;
   // #if guards: llvmpipe runs a loop body at least once (masked) even for zero iterations.
   vec3 to_light;
 #if POINT_LIGHTS > 0
@@ -200,5 +227,5 @@ void main() {
     }
     radiance += e / PI * albedo.diffuse + specular;
   }
-  o_radiance = vec4(radiance, 1.0);
+  o_radiance = vec4(radiance, alpha);
 }

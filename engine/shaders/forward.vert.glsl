@@ -1,11 +1,12 @@
 #version 450 core
-// Forward pass vertex stage: world position, normal, both UV sets and (for dynamic meshes
+// Forward pass vertex stage: world position, normal, tangent, both UV sets and (for dynamic meshes
 // with a provider buffer) the per-vertex indirect irradiance.
 
 layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec3 a_normal;
 layout(location = 2) in vec2 a_uv0;
 layout(location = 3) in vec2 a_uv1;
+layout(location = 4) in vec4 a_tangent;  // xyz tangent, w handedness (zero: no normal map)
 
 layout(location = 0) uniform mat4 u_model;
 layout(location = 4) uniform mat4 u_normal_matrix;
@@ -21,6 +22,7 @@ out vec3 v_world;
 out vec3 v_normal;
 out vec2 v_uv0;
 out vec2 v_uv1;
+out vec4 v_tangent;  // world-space tangent; w the handedness, mirrored with the model matrix
 out vec3 v_vertex_irradiance;
 
 // --- Per-vertex view-dependent indirect light (IndirectLightFrame::vertex_radiance_lobes) ---
@@ -77,6 +79,8 @@ void main() {
   v_normal = mat3(u_normal_matrix) * a_normal;
   v_uv0 = a_uv0;
   v_uv1 = a_uv1;
+  const mat3 linear = mat3(u_model);
+  v_tangent = vec4(linear * a_tangent.xyz, determinant(linear) < 0.0 ? -a_tangent.w : a_tangent.w);
   v_vertex_irradiance = u_use_vertex_irradiance != 0 ? vertex_irradiance[gl_VertexID - u_mesh_first_vertex].xyz : vec3(0.0);
   v_lobe_radiance = lobe_radiance(world.xyz);
   gl_Position = u_view_proj * world;

@@ -383,6 +383,8 @@ TEST(GltfLoader, MaterialsAndImages) {
     "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 4}},
     "doubleSided": true}])");
   b.doc["meshes"][0]["primitives"][0]["material"] = 0;
+  // The textures read TEXCOORD_0, which the primitive must have (else an error, issue 33).
+  b.doc["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_0"] = b.floats({0, 0, 1, 0, 0, 1}, "VEC2", 2);
   const fs::path path = write_text("mat.gltf", b.gltf());
   const auto s = load(path);
   ASSERT_EQ(s.materials.size(), 1u);

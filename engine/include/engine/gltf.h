@@ -19,6 +19,12 @@ struct GltfLoadLimits {
   std::size_t max_indices_per_primitive = 3u << 26;
   std::size_t max_nodes = 1u << 20;
   int max_image_dimension = 16384;
+  /// Pixels of one decoded image: 2^26 (64 M, 256 MiB as RGBA8). Checked from the image's
+  /// header before it is decoded; the error names the image and the file.
+  std::size_t max_image_pixels = std::size_t{1} << 26;
+  /// Bytes of all decoded images of the file together (RGBA8, 4 per pixel): 2 GiB. Checked
+  /// before each image is decoded.
+  std::size_t max_scene_image_bytes = std::size_t{2} << 30;
   /// Accessor elements (vertex attributes, indices) read in the whole file: 2^28 (268 M).
   /// With the per-primitive limits it bounds the loader's time and memory for any file.
   std::size_t max_scene_elements = std::size_t{1} << 28;
@@ -29,6 +35,10 @@ struct GltfLoadLimits {
 
 struct GltfLoadOptions {
   bool load_images = true;  ///< Decode textures (off: materials keep indices, images are empty).
+  /// Image URIs that leave the scene file's folder (an absolute path, or '..' components
+  /// that climb above it) are refused unless this is set: a downloaded scene must not read
+  /// arbitrary files of the machine. Symbolic links inside the folder are not followed up.
+  bool allow_uris_outside_folder = false;
   GltfLoadLimits limits{};
 };
 

@@ -42,6 +42,10 @@ struct TextureSampler {
 };
 
 /// KHR_texture_transform: uv' = translate(offset) x rotate(rotation) x scale(scale) x uv.
+/// The rotation matrix is [cos sin; -sin cos] acting on (u, v): with v pointing down the
+/// image (glTF's UV origin is the image's top-left corner) the UVs turn counter-clockwise
+/// as seen on the image, as the extension's README example checks (offset [0, 1], rotation
+/// pi/2, scale 0.5 samples the lower-left quadrant).
 struct TextureTransform {
   glm::vec2 offset{0.0f};
   float rotation_rad = 0.0f;  ///< Counter-clockwise in UV space, as the extension defines it.
@@ -92,11 +96,16 @@ struct Material {
   bool double_sided = false;
 };
 
-/// One triangle list. positions are required; normals, uv0 and uv1 are empty or have one
-/// entry per position. uv1 is the light-atlas parameterization (TEXCOORD_1) when present.
+/// One triangle list. positions are required; normals, tangents, uv0 and uv1 are empty or
+/// have one entry per position. uv1 is the light-atlas parameterization (TEXCOORD_1) when
+/// present.
 struct Primitive {
   std::vector<glm::vec3> positions;
   std::vector<glm::vec3> normals;
+  /// glTF TANGENT: xyz the unit tangent (direction of increasing u of the normal texture's
+  /// UV set), w = +1 or -1 the handedness: bitangent = w x cross(normal, tangent). Empty:
+  /// the renderer generates them where a normal texture needs them (engine/tangents.h).
+  std::vector<glm::vec4> tangents;
   std::vector<glm::vec2> uv0;
   std::vector<glm::vec2> uv1;
   std::vector<std::uint32_t> indices;

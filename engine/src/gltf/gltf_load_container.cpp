@@ -300,12 +300,63 @@ Result<BufferViews> check_buffer_views(const Context& ctx, const Json& doc,
   return out;
 }
 
-/// images: the buffer view in range and reading a buffer that has data.
+/// A URI reference's percent-encoded octets decoded (RFC 3986 §2.1), as a file path.
+std::string percent_decoded(const std::string& uri) {
+  std::string out;
+  for (std::size_t i = 0; i < uri.size(); ++i) {
+    const auto hex = [](char c) {
+      return c >= '0' && c <= '9' ? c - '0' : c >= 'a' && c <= 'f' ? c - 'a' + 10 : c >= 'A' && c <= 'F' ? c - 'A' + 10 : -1;
+    };
+    if (uri[i] == '%' && i + 2 < uri.size() && hex(uri[i + 1]) >= 0 && hex(uri[i + 2]) >= 0) {
+      out.push_back(static_cast<char>(hex(uri[i + 1]) * 16 + hex(uri[i + 2])));
+      i += 2;
+    } else {
+      out.push_back(uri[i]);
+    }
+  }
+  return out;
+}
+
+/// Why a relative-file URI would read outside the scene's folder, or empty: an absolute path
+/// (a leading '/' or '\\', a drive letter, a file: scheme) or '..' components that climb
+/// above the folder (checked lexically, after percent-decoding, with '\\' as a separator).
+std::string uri_leaves_folder(const std::string& uri) {
+  if (uri.rfind("data:", 0) == 0) return "";
+  const std::string path = percent_decoded(uri);
+  if (path.rfind("file:", 0) == 0) return "it is a file: URI (absolute)";
+  if (!path.empty() && (path[0] == '/' || path[0] == '\\')) return "it is an absolute path";
+  if (path.size() >= 2 && path[1] == ':') return "it is an absolute path (drive letter)";
+  int depth = 0;
+  std::size_t start = 0;
+  while (start <= path.size()) {
+    std::size_t end = path.find_first_of("/\\", start);
+    if (end == std::string::npos) end = path.size();
+    const std::string part = path.substr(start, end - start);
+    if (part == "..") {
+      if (--depth < 0) return "its '..' components climb above the scene's folder";
+    } else if (!part.empty() && part != ".") {
+      ++depth;
+    }
+    start = end + 1;
+  }
+  return "";
+}
+
+/// images: the buffer view in range, reading a buffer that has data, and a URI that stays in
+/// the scene's folder (GltfLoadOptions::allow_uris_outside_folder).
 Status check_images(const Context& ctx, const Json& doc, const BufferViews& views,
                     const std::vector<std::string>& buffer_problems) {
   if (const Json* images = find_member(doc, "images")) {
     for (std::size_t i = 0; i < images->size(); ++i) {
       const std::string where = "image " + std::to_string(i);
+      if (const Json* uri = find_member((*images)[i], "uri"); uri != nullptr && uri->is_string()) {
+        const std::string why = uri_leaves_folder(uri->get<std::string>());
+        if (!why.empty() && !ctx.options.allow_uris_outside_folder) {
+          return ctx.error(where + " '" + uri->get<std::string>() + "'",
+                           "refused: the URI leaves the scene's folder (" + why +
+                               "); set GltfLoadOptions::allow_uris_outside_folder to allow it");
+        }
+      }
       auto view = index_member(ctx, (*images)[i], "bufferView", -1, where);
       if (!view) return view.error();
       if (*view >= 0 && static_cast<std::size_t>(*view) >= views.count) {
@@ -603,6 +654,8 @@ Result<ParsedFile> parse_file(const Context& ctx, const fs::path& path) {
   ImageDecodeState& images = out.images;
   images.decode = ctx.options.load_images;
   images.max_dimension = ctx.options.limits.max_image_dimension;
+  images.max_pixels = ctx.options.limits.max_image_pixels;
+  images.max_total_bytes = ctx.options.limits.max_scene_image_bytes;
   const std::size_t image_count = array_size(out.doc, "images");
   images.failures.resize(image_count);
   images.delivered.resize(image_count, false);

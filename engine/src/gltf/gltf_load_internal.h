@@ -70,6 +70,9 @@ struct DracoRef {
 struct ImageDecodeState {
   bool decode = true;
   int max_dimension = 16384;
+  std::size_t max_pixels = std::size_t{1} << 26;            ///< GltfLoadLimits::max_image_pixels
+  std::size_t max_total_bytes = std::size_t{2} << 30;       ///< GltfLoadLimits::max_scene_image_bytes
+  std::size_t decoded_bytes = 0;                            ///< decoded so far (RGBA8)
   std::vector<std::string> failures;  ///< per image index: empty, or why it failed
   std::vector<bool> delivered;        ///< per image index: bytes were found
   std::vector<bool> used;             ///< per image index: a material's texture samples it (decoded only then)
@@ -122,6 +125,8 @@ std::vector<glm::vec3> compute_smooth_normals(const std::vector<glm::vec3>& posi
 // gltf_load_materials.cpp
 Result<std::vector<Image>> convert_images(const Context& ctx, const ParsedFile& file);
 Result<std::vector<Material>> convert_materials(const Context& ctx, const ParsedFile& file);
+/// Every primitive has the TEXCOORD set each texture of its material reads (TextureRef::texcoord).
+Status check_texcoord_sets(const Context& ctx, const SceneAsset& scene);
 bool decode_image_callback(tinygltf::Image* image, int image_idx, std::string* err, std::string* warn,
                            int req_width, int req_height, const unsigned char* bytes, int size,
                            void* user_data);

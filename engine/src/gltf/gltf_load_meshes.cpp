@@ -1,5 +1,5 @@
-// Mesh primitives of the glTF loader (glTF 2.0 §3.7.2): POSITION, NORMAL, TEXCOORD_0 and
-// TEXCOORD_1 as triangle lists. Strips and fans become lists, points and lines are skipped,
+// Mesh primitives of the glTF loader (glTF 2.0 §3.7.2): POSITION, NORMAL, TANGENT,
+// TEXCOORD_0 and TEXCOORD_1 as triangle lists. Strips and fans become lists, points and lines are skipped,
 // missing normals are computed, missing indices generated; morph targets and skins are
 // ignored (the base mesh loads).
 
@@ -29,6 +29,10 @@ bool attribute_layout_allowed(const std::string& semantic, const tinygltf::Acces
   }
   if (semantic == "NORMAL") {
     if (acc.type != TINYGLTF_TYPE_VEC3) return false;
+    return ct == kFloat || (quantized && (ct == kByte || ct == kShort) && acc.normalized);
+  }
+  if (semantic == "TANGENT") {
+    if (acc.type != TINYGLTF_TYPE_VEC4) return false;
     return ct == kFloat || (quantized && (ct == kByte || ct == kShort) && acc.normalized);
   }
   // TEXCOORD_n
@@ -149,8 +153,12 @@ Result<std::optional<Primitive>> convert_primitive(const Context& ctx, const Par
   if (!uv0) return uv0.error();
   auto uv1 = read_attribute(ctx, file, prim, dp, "TEXCOORD_1", 2, where);
   if (!uv1) return uv1.error();
-  const std::pair<const char*, const Attribute*> others[] = {
-      {"NORMAL", &normal.value()}, {"TEXCOORD_0", &uv0.value()}, {"TEXCOORD_1", &uv1.value()}};
+  auto tangent = read_attribute(ctx, file, prim, dp, "TANGENT", 4, where);
+  if (!tangent) return tangent.error();
+  const std::pair<const char*, const Attribute*> others[] = {{"NORMAL", &normal.value()},
+                                                             {"TEXCOORD_0", &uv0.value()},
+                                                             {"TEXCOORD_1", &uv1.value()},
+                                                             {"TANGENT", &tangent.value()}};
   for (const auto& [name, attr] : others) {
     const std::size_t count = attr->components == 0 ? 0 : attr->values.size() / static_cast<std::size_t>(attr->components);
     if (!attr->values.empty() && count != vertex_count) {
@@ -165,6 +173,21 @@ Result<std::optional<Primitive>> convert_primitive(const Context& ctx, const Par
   }
   out.uv0 = to_vectors<glm::vec2>(uv0->values);
   out.uv1 = to_vectors<glm::vec2>(uv1->values);
+  // TANGENT (§3.7.2.1): xyz unit, w the handedness +-1. Exporters write zero tangents where
+  // the UVs are degenerate; then the set is dropped with a warning and the renderer
+  // generates it (engine/tangents.h), as it does for a file without tangents.
+  out.tangents = to_vectors<glm::vec4>(tangent->values);
+  for (std::size_t i = 0; i < out.tangents.size(); ++i) {
+    glm::vec4& t = out.tangents[i];
+    const float len = glm::length(glm::vec3(t));
+    if (!std::isfinite(len) || len < 1e-6f || !std::isfinite(t.w) || t.w == 0.0f) {
+      std::fprintf(stderr, "warning: %s: %s: TANGENT %zu is degenerate, tangents are generated instead\n",
+                   ctx.file.c_str(), where.c_str(), i);
+      out.tangents.clear();
+      break;
+    }
+    t = glm::vec4(glm::vec3(t) / len, t.w > 0.0f ? 1.0f : -1.0f);
+  }
 
   std::vector<std::uint32_t> indices;
   const auto stored_indices = file.primitive_indices.find({mesh_index, prim_index});

@@ -28,6 +28,7 @@ Result<SceneAsset> load_gltf_unchecked(const gltf_load::Context& ctx, const std:
   auto meshes = gltf_load::convert_meshes(ctx, file);
   if (!meshes) return meshes.error();
   scene.meshes = std::move(meshes.value());
+  if (auto ok = gltf_load::check_texcoord_sets(ctx, scene); !ok) return ok.error();
   std::vector<int> camera_map;
   auto cameras = gltf_load::convert_cameras(ctx, file, camera_map);
   if (!cameras) return cameras.error();

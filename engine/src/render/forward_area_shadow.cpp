@@ -35,26 +35,42 @@ const ShaderProgram& ForwardRenderer::area_shadow_program(int pass, int area_lig
 
 // Every item's primitives with the pre-pass's culling (double-sided materials both faces);
 // with `double_sided_uniform`, location 26 says which (area_shadow.frag.glsl flips the normal).
-void ForwardRenderer::draw_geometry(const std::vector<DrawItem>& items, bool double_sided_uniform) {
-  for (const DrawItem& item : items) {
-    glUniformMatrix4fv(0, 1, GL_FALSE, glm::value_ptr(item.model));
-    if (double_sided_uniform) {
-      const glm::mat4 normal_matrix(glm::transpose(glm::inverse(glm::mat3(item.model))));
-      glUniformMatrix4fv(4, 1, GL_FALSE, glm::value_ptr(normal_matrix));
-      glUniform1i(12, item.mesh->first_vertex);
+// BLEND primitives are left out (they write no depth; they read the visibility of the surface
+// behind them). Without `double_sided_uniform` this is the half-resolution depth pass: MASK
+// primitives are drawn last with the alpha-tested depth program at `view_proj`.
+void ForwardRenderer::draw_geometry(const std::vector<DrawItem>& items, bool double_sided_uniform,
+                                    const glm::mat4& view_proj) {
+  const bool depth_pass = !double_sided_uniform;
+  for (const bool cut_out : {false, true}) {
+    if (cut_out) {
+      if (!depth_pass || !scene_.has_mask()) break;
+      alpha_test_program("depth_only.frag.glsl").use();
+      glUniformMatrix4fv(8, 1, GL_FALSE, glm::value_ptr(view_proj));
     }
-    for (const render::GpuPrimitive& p : item.mesh->primitives) {
-      const bool two = scene_.material(item.material_override >= 0 ? item.material_override : p.material).double_sided;
-      if (two)
-        glDisable(GL_CULL_FACE);
-      else
-        glEnable(GL_CULL_FACE);
-      if (double_sided_uniform) glUniform1i(26, two ? 1 : 0);
-      glDrawElementsBaseVertex(GL_TRIANGLES, static_cast<GLsizei>(p.index_count), GL_UNSIGNED_INT,
-                               reinterpret_cast<const void*>(static_cast<std::uintptr_t>(p.first_index) * 4u),
-                               p.base_vertex);
+    for (const DrawItem& item : items) {
+      glUniformMatrix4fv(0, 1, GL_FALSE, glm::value_ptr(item.model));
+      if (double_sided_uniform) {
+        const glm::mat4 normal_matrix(glm::transpose(glm::inverse(glm::mat3(item.model))));
+        glUniformMatrix4fv(4, 1, GL_FALSE, glm::value_ptr(normal_matrix));
+        glUniform1i(12, item.mesh->first_vertex);
+      }
+      for (const render::GpuPrimitive& p : item.mesh->primitives) {
+        const render::GpuMaterial& m = scene_.material(item.material_override >= 0 ? item.material_override : p.material);
+        if (m.alpha_mode == AlphaMode::Blend) continue;
+        if (depth_pass && (m.alpha_mode == AlphaMode::Mask) != cut_out) continue;
+        if (cut_out) render::bind_alpha_test(m, m.alpha_cutoff);
+        if (m.double_sided)
+          glDisable(GL_CULL_FACE);
+        else
+          glEnable(GL_CULL_FACE);
+        if (double_sided_uniform) glUniform1i(26, m.double_sided ? 1 : 0);
+        glDrawElementsBaseVertex(GL_TRIANGLES, static_cast<GLsizei>(p.index_count), GL_UNSIGNED_INT,
+                                 reinterpret_cast<const void*>(static_cast<std::uintptr_t>(p.first_index) * 4u),
+                                 p.base_vertex);
+      }
     }
   }
+  if (depth_pass) render::unbind_material_samplers();
 }
 
 // The area lights' soft-shadow visibility at half resolution, upsampled where the surface
@@ -93,12 +109,12 @@ void ForwardRenderer::area_shadow_passes(const glm::mat4& view_proj, const glm::
   glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
   depth_only_.use();
   glUniformMatrix4fv(8, 1, GL_FALSE, glm::value_ptr(view_proj));
-  draw_geometry(items, false);
+  draw_geometry(items, false, view_proj);
   glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
   glDepthFunc(GL_EQUAL);
   glDepthMask(GL_FALSE);
   common_uniforms(area_shadow_program(0, n));
-  draw_geometry(items, true);
+  draw_geometry(items, true, view_proj);
   // 2. Full resolution on the pre-pass's depth: upsample, flagging the pixels no half-resolution
   // texel of their own surface covers in the stencil's top bit (the reach masks keep theirs).
   glBindFramebuffer(GL_FRAMEBUFFER, visibility_fbo_.id());
@@ -110,13 +126,13 @@ void ForwardRenderer::area_shadow_passes(const glm::mat4& view_proj, const glm::
   glStencilFunc(GL_ALWAYS, 0, 0xFF);
   glStencilOp(GL_KEEP, GL_KEEP, GL_REPLACE);
   common_uniforms(area_shadow_program(1, n));
-  draw_geometry(items, true);
+  draw_geometry(items, true, view_proj);
   // 3. The flagged pixels at full resolution (the stencil rejects the others before shading).
   glStencilMask(0);
   glStencilFunc(GL_EQUAL, static_cast<GLint>(kAreaFallbackBit), kAreaFallbackBit);
   glStencilOp(GL_KEEP, GL_KEEP, GL_KEEP);
   common_uniforms(area_shadow_program(2, n));
-  draw_geometry(items, true);
+  draw_geometry(items, true, view_proj);
   glDisable(GL_STENCIL_TEST);
   glStencilMask(0xFF);
 }

@@ -105,11 +105,20 @@ void ForwardRenderer::update_reach(const std::vector<DrawItem>& items, const ren
       ReachOccluder o;
       o.min = item.bounds.min;
       o.max = item.bounds.max;
+      // Triangle corners in primitive order; MASK and BLEND primitives let light through
+      // their holes, so they occlude nothing here (the grid stays conservative).
       const std::vector<glm::vec3>& c = item.mesh->triangle_corners;
-      for (std::size_t t = 0; t + 2 < c.size(); t += 3)
-        o.triangles.push_back({glm::vec3(item.model * glm::vec4(c[t], 1.0f)),
-                               glm::vec3(item.model * glm::vec4(c[t + 1], 1.0f)),
-                               glm::vec3(item.model * glm::vec4(c[t + 2], 1.0f))});
+      std::size_t first = 0;
+      for (const render::GpuPrimitive& p : item.mesh->primitives) {
+        const std::size_t end = std::min(c.size(), first + p.index_count);
+        const bool opaque =
+            !scene_.material(item.material_override >= 0 ? item.material_override : p.material).cut_out();
+        for (std::size_t t = first; opaque && t + 2 < end; t += 3)
+          o.triangles.push_back({glm::vec3(item.model * glm::vec4(c[t], 1.0f)),
+                                 glm::vec3(item.model * glm::vec4(c[t + 1], 1.0f)),
+                                 glm::vec3(item.model * glm::vec4(c[t + 2], 1.0f))});
+        first = end;
+      }
       reach_.occluders.push_back(std::move(o));
     }
     reach_.light_key = std::move(key);

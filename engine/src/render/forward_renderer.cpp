@@ -4,6 +4,7 @@
 // forward_reach.cpp and forward_area_shadow.cpp.
 #include "render/forward_renderer.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -197,7 +198,9 @@ void ForwardRenderer::render(const Registry& registry, Entity camera, double dt_
   shadow_maps_.reserve(capacity.map_size, lights.layers_2d, capacity.sun_size, lights.sun_layers, capacity.cube_size,
                        lights.cubes);
   const CameraView view = camera_view(registry, camera);
-  shadow_maps_rendered_ = shadow_maps_.render(lights.shadow_views, items, scene_, shadow_, view.view_proj);
+  // The alpha-tested shadow program only for scenes with MASK or BLEND materials (made on first use).
+  const ShaderProgram* shadow_cut_out = scene_.has_cut_out() ? &alpha_test_program("shadow.frag.glsl") : nullptr;
+  shadow_maps_rendered_ = shadow_maps_.render(lights.shadow_views, items, scene_, shadow_, shadow_cut_out, view.view_proj);
   timings_.push_back({"shadow maps (" + std::to_string(lights.shadow_views.size()) + " views)", timer.lap_ms()});
 
   // Half-resolution area shadows: every area light of the frame (each its visibility channel,
@@ -328,8 +331,10 @@ void ForwardRenderer::forward_pass(const CameraView& view, const std::vector<Dra
   const glm::vec3 zero(0.0f);
   const bool has_sky = glm::any(glm::notEqual(settings_.sky_radiance, zero)) || glm::any(glm::notEqual(sky.horizon, zero)) ||
                        glm::any(glm::notEqual(sky.zenith, zero)) || glm::any(glm::notEqual(sky.ground, zero));
-  for (const LightGroup& group : groups) {
-    if (reach) glStencilFunc(GL_EQUAL, group.mask, area_lights_.empty() ? 0xFF : 0xFF & ~kAreaFallbackBit);
+  // One light group's pixels (its stencil mask), or with `blend` the BLEND primitives of
+  // `order` (back to front) over everything, without the stencil.
+  const auto shade = [&](const LightGroup& group, const std::vector<const DrawItem*>& order, bool blend) {
+    if (reach && !blend) glStencilFunc(GL_EQUAL, group.mask, area_lights_.empty() ? 0xFF : 0xFF & ~kAreaFallbackBit);
     glBindBufferRange(GL_SHADER_STORAGE_BUFFER, kLightsBinding, lights_buffer_.id(), group.offset,
                       static_cast<GLsizeiptr>(std::max<std::size_t>(1, group.lights.size()) * sizeof(render::GpuLight)));
     const LightCounts counts{group.count_by_type[0], group.count_by_type[1], group.count_by_type[2],
@@ -341,7 +346,8 @@ void ForwardRenderer::forward_pass(const CameraView& view, const std::vector<Dra
     // items, each with its program, when that makes a difference.
     LightCounts rough_counts = counts;
     rough_counts[4] = 1;
-    const bool split_rough = counts[3] > 0 && counts[4] > 1 && settings_.area_specular_one_point_on_rough;
+    // (Not for BLEND primitives: two passes would break their back-to-front order.)
+    const bool split_rough = !blend && counts[3] > 0 && counts[4] > 1 && settings_.area_specular_one_point_on_rough;
     for (int pass = 0; pass < (split_rough ? 2 : 1); ++pass) {
       const ShaderProgram& program = forward_program(pass == 0 ? counts : rough_counts);
       program.use();
@@ -358,14 +364,16 @@ void ForwardRenderer::forward_pass(const CameraView& view, const std::vector<Dra
         glUniform3fv(61, 3, glm::value_ptr(terms[0]));
       }
       glUniform1f(24, settings_.split == SplitView::DirectLeftFullRight ? 0.5f * static_cast<float>(width_) : -1.0f);
-      glUniform1i(25, glossy != 0 ? 1 : 0);
+      glUniform1i(25, glossy != 0 && !blend ? 1 : 0);  // the glossy texture is the opaque surface's
 
       const auto in_pass = [&](const DrawItem& item, const render::GpuPrimitive& p) {
-        if (!split_rough) return true;
         const render::GpuMaterial& m = scene_.material(item.material_override >= 0 ? item.material_override : p.material);
+        if ((m.alpha_mode == AlphaMode::Blend) != blend) return false;
+        if (!split_rough) return true;
         return rough_dielectric(m, scene_.white_texture()) == (pass == 1);
       };
-      for (const DrawItem& item : items) {
+      for (const DrawItem* drawn : order) {
+        const DrawItem& item = *drawn;
         const render::SceneBounds& gb = group.bounds;
         if (!gb.empty && (glm::any(glm::lessThan(item.bounds.max, gb.min)) || glm::any(glm::greaterThan(item.bounds.min, gb.max))))
           continue;  // none of this group's pixels can be on the item
@@ -431,13 +439,49 @@ void ForwardRenderer::forward_pass(const CameraView& view, const std::vector<Dra
           glBindTextureUnit(kBaseColorUnit, m.base_color_texture);
           glBindTextureUnit(kMetallicRoughnessUnit, m.metallic_roughness_texture);
           glBindTextureUnit(kEmissiveUnit, m.emissive_texture);
+          glBindTextureUnit(kNormalUnit, m.normal_texture != 0 ? m.normal_texture : scene_.white_texture());
+          glBindSampler(kBaseColorUnit, m.samplers[render::kBaseColorSlot]);
+          glBindSampler(kMetallicRoughnessUnit, m.samplers[render::kMetallicRoughnessSlot]);
+          glBindSampler(kEmissiveUnit, m.samplers[render::kEmissiveSlot]);
+          glBindSampler(kNormalUnit, m.samplers[render::kNormalSlot]);
+          render::set_material_texturing(m);
           glDrawElementsBaseVertex(GL_TRIANGLES, static_cast<GLsizei>(p.index_count), GL_UNSIGNED_INT,
                                    reinterpret_cast<const void*>(static_cast<std::uintptr_t>(p.first_index) * 4u),
                                    p.base_vertex);
         }
       }
     }
+  };
+  std::vector<const DrawItem*> in_order;
+  for (const DrawItem& item : items) in_order.push_back(&item);
+  for (const LightGroup& group : groups) shade(group, in_order, false);
+  // BLEND: after every opaque pixel, back to front by the item's centre, blended over what is
+  // there ("over": alpha x colour + (1 - alpha) x behind; the target's alpha is kept), tested
+  // against the pre-pass's depth but not writing it. Every pixel of a blended surface is lit
+  // by the group of all lights (the reach stencil holds the surface behind it).
+  std::vector<std::pair<float, const DrawItem*>> blended;
+  for (const DrawItem& item : items)
+    for (const render::GpuPrimitive& p : item.mesh->primitives)
+      if (scene_.material(item.material_override >= 0 ? item.material_override : p.material).alpha_mode ==
+          AlphaMode::Blend) {
+        const glm::vec3 centre = 0.5f * (item.bounds.min + item.bounds.max);
+        blended.emplace_back(glm::length(centre - camera_position), &item);
+        break;
+      }
+  if (!blended.empty()) {
+    std::stable_sort(blended.begin(), blended.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+    std::vector<const DrawItem*> back_to_front;
+    for (const auto& [distance, item] : blended) back_to_front.push_back(item);
+    const auto all = std::find_if(groups.begin(), groups.end(),
+                                  [&](const LightGroup& g) { return !reach || g.mask == reach_.grid.all; });
+    glDisable(GL_STENCIL_TEST);
+    glDepthFunc(GL_LESS);
+    glEnable(GL_BLEND);
+    glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ZERO, GL_ONE);
+    if (all != groups.end()) shade(*all, back_to_front, true);
+    glDisable(GL_BLEND);
   }
+  unbind_material_samplers();
   glDisable(GL_STENCIL_TEST);
   glStencilMask(0xFF);
   glDisable(GL_CULL_FACE);
@@ -446,37 +490,63 @@ void ForwardRenderer::forward_pass(const CameraView& view, const std::vector<Dra
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }
 
+// The depth-only fragment stage `fragment` with ALPHA_TEST 1 (shadow.vert.glsl's vertices).
+const ShaderProgram& ForwardRenderer::alpha_test_program(const char* fragment) {
+  auto it = alpha_test_programs_.find(fragment);
+  if (it != alpha_test_programs_.end()) return it->second;
+  Result<ShaderProgram> p = ShaderProgramBuilder(engine_shader_files())
+                                .stage(ShaderStage::Vertex, "shadow.vert.glsl")
+                                .stage(ShaderStage::Fragment, fragment)
+                                .define("ALPHA_TEST 1")
+                                .build();
+  if (!p) std::fprintf(stderr, "%s\n", p.error().to_string().c_str());
+  GI_EXPECTS(p.ok(), "alpha-tested depth shader must compile");
+  return alpha_test_programs_.emplace(fragment, std::move(p.value())).first->second;
+}
+
+// The pre-pass's depth (and reach stencil) of every opaque and MASK primitive: opaque ones
+// first, then the MASK ones with the alpha-tested variant of the same program (a discard costs
+// llvmpipe its early depth test, so only they pay it). BLEND primitives write no depth.
 void ForwardRenderer::depth_prepass(const glm::mat4& view_proj, const std::vector<DrawItem>& items, bool reach) {
   glDepthFunc(GL_LESS);
   glDepthMask(GL_TRUE);
   glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
   if (reach) {  // the nearest surface's reach mask into the stencil
-    depth_reach_.use();
     glEnable(GL_STENCIL_TEST);
     glStencilMask(0xFF);
     glStencilFunc(GL_ALWAYS, 0, 0xFF);
     glStencilOp(GL_KEEP, GL_KEEP, GL_REPLACE);
     glBindTextureUnit(kReachUnit, reach_.texture.id());
-    glUniform3fv(50, 1, glm::value_ptr(reach_.grid.origin));
-    glUniform1f(51, 1.0f / reach_.grid.voxel_m);
-    glUniform1i(52, reach_.grid.all);
-  } else {
-    depth_only_.use();
   }
-  glUniformMatrix4fv(8, 1, GL_FALSE, glm::value_ptr(view_proj));
-  for (const DrawItem& item : items) {
-    glUniformMatrix4fv(0, 1, GL_FALSE, glm::value_ptr(item.model));
-    for (const render::GpuPrimitive& p : item.mesh->primitives) {
-      // Same culling as the shading pass, so both passes see the same surfaces.
-      if (scene_.material(item.material_override >= 0 ? item.material_override : p.material).double_sided)
-        glDisable(GL_CULL_FACE);
-      else
-        glEnable(GL_CULL_FACE);
-      glDrawElementsBaseVertex(GL_TRIANGLES, static_cast<GLsizei>(p.index_count), GL_UNSIGNED_INT,
-                               reinterpret_cast<const void*>(static_cast<std::uintptr_t>(p.first_index) * 4u),
-                               p.base_vertex);
+  for (const bool cut_out : {false, true}) {
+    if (cut_out && !scene_.has_mask()) break;
+    const ShaderProgram& program = cut_out ? alpha_test_program(reach ? "depth_reach.frag.glsl" : "depth_only.frag.glsl")
+                                           : (reach ? depth_reach_ : depth_only_);
+    program.use();
+    glUniformMatrix4fv(8, 1, GL_FALSE, glm::value_ptr(view_proj));
+    if (reach) {
+      glUniform3fv(50, 1, glm::value_ptr(reach_.grid.origin));
+      glUniform1f(51, 1.0f / reach_.grid.voxel_m);
+      glUniform1i(52, reach_.grid.all);
+    }
+    for (const DrawItem& item : items) {
+      glUniformMatrix4fv(0, 1, GL_FALSE, glm::value_ptr(item.model));
+      for (const render::GpuPrimitive& p : item.mesh->primitives) {
+        const render::GpuMaterial& m = scene_.material(item.material_override >= 0 ? item.material_override : p.material);
+        if (m.alpha_mode == AlphaMode::Blend || (m.alpha_mode == AlphaMode::Mask) != cut_out) continue;
+        if (cut_out) render::bind_alpha_test(m, m.alpha_cutoff);
+        // Same culling as the shading pass, so both passes see the same surfaces.
+        if (m.double_sided)
+          glDisable(GL_CULL_FACE);
+        else
+          glEnable(GL_CULL_FACE);
+        glDrawElementsBaseVertex(GL_TRIANGLES, static_cast<GLsizei>(p.index_count), GL_UNSIGNED_INT,
+                                 reinterpret_cast<const void*>(static_cast<std::uintptr_t>(p.first_index) * 4u),
+                                 p.base_vertex);
+      }
     }
   }
+  render::unbind_material_samplers();
   glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
   glDisable(GL_STENCIL_TEST);
 }

@@ -40,12 +40,16 @@ enum TextureUnit : GLuint {
   kPointShadowMapsUnit = 5,
   kGlossyUnit = 6,
   kDirectionalIndexUnit = 7,
+  kNormalUnit = 15,  // forward.frag.glsl: the normal texture (render::kMaterialNormalUnit)
   kSunShadowMapsUnit = 10,   // directional lights' own 2-D maps (shadow_common.glsl)
   kSunShadowDepthUnit = 11,  // the same, raw depth (the sun disc's blocker search)
   kShadowDepthUnit = 12,  // the 2-D shadow maps again, raw depth (shadow_common.glsl's sun disc)
   kAreaVisibilityUnit = 13,  // area_shadow.frag.glsl: half-resolution visibility; forward: full-resolution
   kAreaPlaneUnit = 14,       // area_shadow.frag.glsl: half-resolution tangent planes
 };
+static_assert(kBaseColorUnit == render::kMaterialBaseColorUnit && kMetallicRoughnessUnit == render::kMaterialMetallicRoughnessUnit &&
+                  kEmissiveUnit == render::kMaterialEmissiveUnit && kNormalUnit == render::kMaterialNormalUnit,
+              "material texture units agree with gpu_scene.h");
 // The stencil's top bit: pixels whose area-light visibility the half-resolution pass could
 // not lend (area_shadow.frag.glsl); the light-reach masks use the 7 bits below it then.
 constexpr GLuint kAreaFallbackBit = 0x80;
@@ -55,7 +59,7 @@ constexpr GLuint kDirectionalRadianceBinding = 2;  // directional_radiance.glsl
 constexpr GLuint kDirectionalDirectionBinding = 3;
 constexpr GLuint kLobeCoefficientsBinding = 6;  // forward.vert.glsl: IndirectLightFrame::vertex_radiance_lobes
 constexpr GLuint kLobeTableBinding = 7;
-constexpr GLuint kReachUnit = 0;  // depth_reach.frag.glsl (the pre-pass binds no material texture)
+constexpr GLuint kReachUnit = 9;  // depth_reach.frag.glsl (unit 0: the alpha test's base colour)
 constexpr float kReachVoxelM = 0.5f;  // light reach grid spacing (engine/light_reach.h)
 
 // Nearest, clamped, no depth comparison: the 2-D shadow maps read as depths (the blocker
@@ -156,7 +160,9 @@ class ForwardRenderer final : public Renderer {
   const ShaderProgram& forward_program(const LightCounts& counts);
   const ShaderProgram& area_shadow_program(int pass, int area_lights);
   void area_shadow_passes(const glm::mat4& view_proj, const glm::vec3& camera_position, const std::vector<DrawItem>& items);
-  void draw_geometry(const std::vector<DrawItem>& items, bool double_sided_uniform);
+  void draw_geometry(const std::vector<DrawItem>& items, bool double_sided_uniform, const glm::mat4& view_proj);
+  /// A depth-only fragment stage built with ALPHA_TEST 1 (material_common.glsl), made on first use.
+  const ShaderProgram& alpha_test_program(const char* fragment);
   void depth_prepass(const glm::mat4& view_proj, const std::vector<DrawItem>& items, bool reach);
   std::vector<LightGroup> light_groups(const Registry& registry, const std::vector<DrawItem>& items,
                                        const render::LightList& lights);
@@ -185,6 +191,9 @@ class ForwardRenderer final : public Renderer {
   ShaderProgram depth_reach_;
   ReachState reach_;
   ShaderProgram shadow_;
+  // Fragment stage -> its ALPHA_TEST variant (material_common.glsl): shadow.frag.glsl for MASK
+  // and BLEND casters, depth_only / depth_reach.frag.glsl for MASK in the pre-passes.
+  std::map<std::string, ShaderProgram> alpha_test_programs_;
   ShaderProgram tonemap_;
   ExposureMeter exposure_meter_;
   bool exposure_snap_ = true;      ///< The next automatic frame snaps to its target.

@@ -6,8 +6,11 @@
 #include <limits>
 #include <map>
 #include <string>
+#include <tuple>
 
 #include <GL/glcorearb.h>
+
+#include <engine/tangents.h>
 
 namespace engine::render {
 
@@ -34,6 +37,30 @@ std::vector<glm::vec3> computed_normals(const Primitive& p, const std::vector<st
   return n;
 }
 
+// One GL sampler object's parameters for a glTF sampler. The default TextureSampler (repeat,
+// linear, mipmaps) equals what upload_image sets on the texture itself.
+GlSampler make_sampler(const TextureSampler& s) {
+  const auto wrap = [](TextureWrap w) -> GLint {
+    return w == TextureWrap::ClampToEdge ? GL_CLAMP_TO_EDGE : w == TextureWrap::MirroredRepeat ? GL_MIRRORED_REPEAT : GL_REPEAT;
+  };
+  GlSampler out = GlSampler::create();
+  glSamplerParameteri(out.id(), GL_TEXTURE_WRAP_S, wrap(s.wrap_s));
+  glSamplerParameteri(out.id(), GL_TEXTURE_WRAP_T, wrap(s.wrap_t));
+  glSamplerParameteri(out.id(), GL_TEXTURE_MAG_FILTER, s.mag_linear ? GL_LINEAR : GL_NEAREST);
+  const GLint min = s.mipmaps ? (s.min_linear ? GL_LINEAR_MIPMAP_LINEAR : GL_NEAREST_MIPMAP_LINEAR)
+                              : (s.min_linear ? GL_LINEAR : GL_NEAREST);
+  glSamplerParameteri(out.id(), GL_TEXTURE_MIN_FILTER, min);
+  return out;
+}
+
+// KHR_texture_transform as two rows of a 2x3 matrix (engine::transformed_uv's formula).
+void transform_rows(const TextureTransform& t, glm::vec4& row0, glm::vec4& row1) {
+  const float c = std::cos(t.rotation_rad);
+  const float s = std::sin(t.rotation_rad);
+  row0 = glm::vec4(c * t.scale.x, s * t.scale.y, t.offset.x, 0.0f);
+  row1 = glm::vec4(-s * t.scale.x, c * t.scale.y, t.offset.y, 0.0f);
+}
+
 GlTexture upload_image(const Image& image, bool srgb) {
   const int levels = 1 + static_cast<int>(std::floor(std::log2(std::max(image.width, image.height))));
   GlTexture t = GlTexture::create_2d(srgb ? GL_SRGB8_ALPHA8 : GL_RGBA8, image.width, image.height, levels);
@@ -41,6 +68,7 @@ GlTexture upload_image(const Image& image, bool srgb) {
   // Rows top to bottom as in the file: glTF's UV (0, 0) is the image's top-left corner,
   // which lands at texture coordinate (0, 0) this way.
   glTextureSubImage2D(t.id(), 0, 0, 0, image.width, image.height, GL_RGBA, GL_UNSIGNED_BYTE, image.rgba8.data());
+  // Every level is made: a texture's samplers (TextureSampler::mipmaps) may read them.
   glGenerateTextureMipmap(t.id());
   glTextureParameteri(t.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
   glTextureParameteri(t.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
@@ -50,6 +78,28 @@ GlTexture upload_image(const Image& image, bool srgb) {
 }
 
 }  // namespace
+
+void set_material_texturing(const GpuMaterial& m) {
+  glUniform1i(kAlphaModeLocation, static_cast<int>(m.alpha_mode));
+  glUniform1f(kAlphaCutoffLocation, m.alpha_cutoff);
+  glUniform1f(kNormalScaleLocation, m.normal_scale);
+  glUniform4iv(kTexcoordSetsLocation, 1, &m.texcoord_sets.x);
+  glUniform4fv(kUvTransformsLocation, 8, &m.uv_transforms[0].x);
+  glUniform1i(kNormalMapLocation, m.normal_texture != 0 ? 1 : 0);
+}
+
+void bind_alpha_test(const GpuMaterial& m, float cutoff) {
+  set_material_texturing(m);
+  glUniform1f(kAlphaCutoffLocation, cutoff);
+  glUniform1f(kBaseAlphaLocation, m.base_color.w);
+  glBindTextureUnit(kMaterialBaseColorUnit, m.base_color_texture);
+  glBindSampler(kMaterialBaseColorUnit, m.samplers[kBaseColorSlot]);
+}
+
+void unbind_material_samplers() {
+  for (GLuint unit : {kMaterialBaseColorUnit, kMaterialMetallicRoughnessUnit, kMaterialEmissiveUnit, kMaterialNormalUnit})
+    glBindSampler(unit, 0);
+}
 
 const GpuMaterial& GpuScene::material(int index) const {
   if (index < 0 || static_cast<std::size_t>(index) >= materials_.size()) return default_material_;
@@ -83,7 +133,21 @@ Result<GpuScene> GpuScene::upload(const SceneAsset& assets) {
       if (prim_indices.size() % 3 != 0) return primitive_error(assets, m, pi, "index count is not a multiple of 3");
       for (std::uint32_t i : prim_indices)
         if (i >= n) return primitive_error(assets, m, pi, "index " + std::to_string(i) + " out of range");
+      if (!p.tangents.empty() && p.tangents.size() != n)
+        return primitive_error(assets, m, pi, "tangents count differs from positions count");
       const std::vector<glm::vec3> normals = p.normals.empty() ? computed_normals(p, prim_indices) : p.normals;
+      // Tangents where the material has a normal map: the file's, else generated from the
+      // normal texture's UV set (engine/tangents.h). A material_override with a normal map on
+      // a mesh whose own material has none finds zero tangents and shades without it.
+      std::vector<glm::vec4> tangents;
+      const Material* mat = p.material >= 0 ? &assets.materials[static_cast<std::size_t>(p.material)] : nullptr;
+      if (mat != nullptr && mat->normal_texture.present()) {
+        const std::vector<glm::vec2>& uvs = mat->normal_texture.texcoord == 1 ? p.uv1 : p.uv0;
+        if (!p.tangents.empty())
+          tangents = p.tangents;
+        else if (uvs.size() == n)
+          tangents = generate_tangents(p.positions, normals, uvs, prim_indices);
+      }
       GpuPrimitive gp;
       gp.first_index = static_cast<std::uint32_t>(indices.size());
       gp.index_count = static_cast<std::uint32_t>(prim_indices.size());
@@ -91,7 +155,8 @@ Result<GpuScene> GpuScene::upload(const SceneAsset& assets) {
       gp.material = p.material;
       for (std::size_t i = 0; i < n; ++i) {
         vertices.push_back(GpuVertex{p.positions[i], normals[i], p.uv0.empty() ? glm::vec2(0.0f) : p.uv0[i],
-                                     p.uv1.empty() ? glm::vec2(0.0f) : p.uv1[i]});
+                                     p.uv1.empty() ? glm::vec2(0.0f) : p.uv1[i],
+                                     tangents.empty() ? glm::vec4(0.0f) : tangents[i]});
         gm.bounds_min = glm::min(gm.bounds_min, p.positions[i]);
         gm.bounds_max = glm::max(gm.bounds_max, p.positions[i]);
       }
@@ -110,10 +175,10 @@ Result<GpuScene> GpuScene::upload(const SceneAsset& assets) {
   const GLuint vao = scene.vao_.id();
   glVertexArrayVertexBuffer(vao, 0, scene.vertices_.id(), 0, sizeof(GpuVertex));
   glVertexArrayElementBuffer(vao, scene.indices_.id());
-  const GLuint offsets[4] = {offsetof(GpuVertex, position), offsetof(GpuVertex, normal), offsetof(GpuVertex, uv0),
-                             offsetof(GpuVertex, uv1)};
-  const GLint sizes[4] = {3, 3, 2, 2};
-  for (GLuint a = 0; a < 4; ++a) {
+  const GLuint offsets[5] = {offsetof(GpuVertex, position), offsetof(GpuVertex, normal), offsetof(GpuVertex, uv0),
+                             offsetof(GpuVertex, uv1), offsetof(GpuVertex, tangent)};
+  const GLint sizes[5] = {3, 3, 2, 2, 4};
+  for (GLuint a = 0; a < 5; ++a) {
     glEnableVertexArrayAttrib(vao, a);
     glVertexArrayAttribFormat(vao, a, sizes[a], GL_FLOAT, GL_FALSE, offsets[a]);
     glVertexArrayAttribBinding(vao, a, 0);
@@ -141,6 +206,15 @@ Result<GpuScene> GpuScene::upload(const SceneAsset& assets) {
     uploaded[{image, srgb}] = scene.textures_.back().id();
     return scene.textures_.back().id();
   };
+  std::map<std::tuple<TextureWrap, TextureWrap, bool, bool, bool>, std::uint32_t> samplers;
+  auto sampler = [&](const TextureRef& ref) -> std::uint32_t {
+    if (!ref.present()) return 0;
+    const TextureSampler& s = ref.sampler;
+    const auto key = std::make_tuple(s.wrap_s, s.wrap_t, s.mag_linear, s.min_linear, s.mipmaps);
+    if (auto it = samplers.find(key); it != samplers.end()) return it->second;
+    scene.samplers_.push_back(make_sampler(s));
+    return samplers[key] = scene.samplers_.back().id();
+  };
   for (std::size_t i = 0; i < assets.materials.size(); ++i) {
     const Material& src = assets.materials[i];
     GpuMaterial gm;
@@ -151,15 +225,35 @@ Result<GpuScene> GpuScene::upload(const SceneAsset& assets) {
     gm.specular_factor = src.specular_factor;
     gm.specular_color_factor = src.specular_color_factor;
     gm.double_sided = src.double_sided;
+    gm.alpha_mode = src.alpha_mode;
+    gm.alpha_cutoff = src.alpha_cutoff;
+    gm.normal_scale = src.normal_scale;
     auto base = texture(src.base_color_texture.image, true, i, "baseColorTexture");
     if (!base) return base.error();
     auto mr = texture(src.metallic_roughness_texture.image, false, i, "metallicRoughnessTexture");
     if (!mr) return mr.error();
     auto emissive = texture(src.emissive_texture.image, true, i, "emissiveTexture");
     if (!emissive) return emissive.error();
+    auto normal = texture(src.normal_texture.image, false, i, "normalTexture");
+    if (!normal) return normal.error();
     gm.base_color_texture = base.value();
     gm.metallic_roughness_texture = mr.value();
     gm.emissive_texture = emissive.value();
+    gm.normal_texture = src.normal_texture.present() ? normal.value() : 0;
+    const TextureRef* refs[4] = {&src.base_color_texture, &src.metallic_roughness_texture, &src.normal_texture,
+                                 &src.emissive_texture};
+    for (int slot = 0; slot < 4; ++slot) {
+      const TextureRef& ref = *refs[slot];
+      if (ref.texcoord != 0 && ref.texcoord != 1)
+        return Error{assets.source, "materials[" + std::to_string(i) + "]",
+                     "texture TEXCOORD_" + std::to_string(ref.texcoord) + " is not supported (0 or 1)"};
+      gm.samplers[static_cast<std::size_t>(slot)] = sampler(ref);
+      gm.texcoord_sets[slot] = ref.texcoord;
+      transform_rows(ref.transform, gm.uv_transforms[static_cast<std::size_t>(2 * slot)],
+                     gm.uv_transforms[static_cast<std::size_t>(2 * slot + 1)]);
+    }
+    scene.has_mask_ = scene.has_mask_ || gm.alpha_mode == AlphaMode::Mask;
+    scene.has_cut_out_ = scene.has_cut_out_ || gm.cut_out();
     scene.materials_.push_back(gm);
   }
   return scene;

@@ -2,6 +2,7 @@
 // The scene's meshes, materials and textures on the GPU: one interleaved vertex buffer and
 // one index buffer for every primitive of every mesh, plus per-material draw parameters.
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -13,14 +14,36 @@
 
 namespace engine::render {
 
-/// Vertex layout of the scene vertex buffer (locations 0..3 of forward/shadow shaders).
+/// Vertex layout of the scene vertex buffer (locations 0..4 of forward/shadow shaders).
 struct GpuVertex {
   glm::vec3 position;
   glm::vec3 normal;
   glm::vec2 uv0;
   glm::vec2 uv1;
+  /// Location 4: the normal map's tangent (Primitive::tangents, or engine::generate_tangents
+  /// from the normal texture's UV set); zero where the material has no normal texture.
+  glm::vec4 tangent;
 };
-static_assert(sizeof(GpuVertex) == 40, "GpuVertex is tightly packed");
+static_assert(sizeof(GpuVertex) == 56, "GpuVertex is tightly packed");
+
+/// Uniform locations of a material's texturing and alpha, shared by forward.frag.glsl and the
+/// alpha-tested depth passes (material_common.glsl).
+enum MaterialUniform : int {
+  kAlphaModeLocation = 70,     ///< int: 0 OPAQUE, 1 MASK, 2 BLEND
+  kAlphaCutoffLocation = 71,   ///< float: fragments with alpha below it are discarded (MASK)
+  kNormalScaleLocation = 72,   ///< float: normalTexture.scale
+  kTexcoordSetsLocation = 73,  ///< ivec4: each texture slot's TEXCOORD set (0 or 1)
+  kUvTransformsLocation = 74,  ///< vec4[8]: each slot's KHR_texture_transform, two rows of a 2x3 matrix
+  kNormalMapLocation = 82,     ///< int: 1 when the material has a normal texture
+  kBaseAlphaLocation = 83,     ///< float: baseColorFactor.a (alpha-tested depth passes)
+};
+
+/// Texture units of a material's textures (forward.frag.glsl, material_common.glsl).
+enum MaterialUnit : unsigned { kMaterialBaseColorUnit = 0, kMaterialMetallicRoughnessUnit = 1, kMaterialEmissiveUnit = 2,
+                               kMaterialNormalUnit = 15 };
+
+/// Texture slots of a material, in the order of GpuMaterial::texcoord_sets / uv_transforms.
+enum MaterialSlot : int { kBaseColorSlot = 0, kMetallicRoughnessSlot = 1, kNormalSlot = 2, kEmissiveSlot = 3 };
 
 struct GpuPrimitive {
   std::uint32_t first_index = 0;  ///< Offset into the index buffer (indices).
@@ -51,7 +74,33 @@ struct GpuMaterial {
   std::uint32_t base_color_texture = 0;  ///< GL names (0: the white default).
   std::uint32_t metallic_roughness_texture = 0;
   std::uint32_t emissive_texture = 0;
+  std::uint32_t normal_texture = 0;  ///< 0: no normal map (the vertex normal shades).
+  float normal_scale = 1.0f;
+  /// GL sampler objects per slot (MaterialSlot), made per distinct TextureSampler; 0 for an
+  /// absent texture (the white default's own parameters).
+  std::array<std::uint32_t, 4> samplers{};
+  glm::ivec4 texcoord_sets{0};  ///< Per slot: TEXCOORD_0 or TEXCOORD_1.
+  /// Per slot two rows (xyz) of KHR_texture_transform as a 2x3 matrix: uv' = (row0 . (uv, 1),
+  /// row1 . (uv, 1)). Identity rows by default, which give uv exactly.
+  std::array<glm::vec4, 8> uv_transforms{glm::vec4(1, 0, 0, 0), glm::vec4(0, 1, 0, 0), glm::vec4(1, 0, 0, 0),
+                                         glm::vec4(0, 1, 0, 0), glm::vec4(1, 0, 0, 0), glm::vec4(0, 1, 0, 0),
+                                         glm::vec4(1, 0, 0, 0), glm::vec4(0, 1, 0, 0)};
+  AlphaMode alpha_mode = AlphaMode::Opaque;
+  float alpha_cutoff = 0.5f;
+  /// Drawn with its alpha tested in the depth passes: MASK at its cutoff; BLEND casts
+  /// shadows as a cut-out at 0.5 (docs/scene-format.md).
+  bool cut_out() const { return alpha_mode != AlphaMode::Opaque; }
 };
+
+/// Sets `m`'s texturing uniforms (MaterialUniform: TEXCOORD sets, transforms, alpha mode and
+/// cutoff, normal scale) on the current program.
+void set_material_texturing(const GpuMaterial& m);
+/// For the alpha-tested depth passes (ALPHA_TEST in material_common.glsl): the texturing
+/// uniforms, base alpha and `cutoff`, and the base colour texture and its sampler on unit 0.
+void bind_alpha_test(const GpuMaterial& m, float cutoff);
+/// Unbinds the sampler objects set_material_texturing's callers bound (units 0, 1, 2, 15), so
+/// later passes sample their textures with the textures' own parameters.
+void unbind_material_samplers();
 
 class GpuScene {
  public:
@@ -63,6 +112,10 @@ class GpuScene {
   const GpuMaterial& material(int index) const;
   std::uint32_t vertex_array() const { return vao_.id(); }
   std::uint32_t white_texture() const { return white_.id(); }
+  /// Some material is MASK (the depth passes need their alpha-tested variants).
+  bool has_mask() const { return has_mask_; }
+  /// Some material is MASK or BLEND (the shadow maps need the alpha-tested variant).
+  bool has_cut_out() const { return has_cut_out_; }
 
  private:
   GlBuffer vertices_;
@@ -70,9 +123,12 @@ class GpuScene {
   GlVertexArray vao_;
   GlTexture white_;
   std::vector<GlTexture> textures_;
+  std::vector<GlSampler> samplers_;
   std::vector<GpuMesh> meshes_;
   std::vector<GpuMaterial> materials_;
   GpuMaterial default_material_;
+  bool has_mask_ = false;
+  bool has_cut_out_ = false;
 };
 
 }  // namespace engine::render

@@ -92,13 +92,14 @@ bool ShadowMaps::LayerContent::operator==(const LayerContent& o) const {
 }
 
 int ShadowMaps::render(const std::vector<ShadowView>& views, const std::vector<DrawItem>& items,
-                       const GpuScene& scene, const ShaderProgram& program, const glm::mat4& camera_view_proj) {
+                       const GpuScene& scene, const ShaderProgram& program, const ShaderProgram* cut_out_program,
+                       const glm::mat4& camera_view_proj) {
   // Each view's content first: the casters whose world bounds are not wholly outside one
   // of its clip planes (they would be clipped whole, so culling them changes no texel),
   // split into static (StaticTag) and dynamic ones for the static depth cache below.
   std::vector<LayerContent> wanted(views.size());
   std::vector<LayerContent> wanted_static(views.size());
-  std::vector<std::vector<std::pair<const GpuMesh*, glm::mat4>>> dynamic(views.size());
+  std::vector<std::vector<Caster>> dynamic(views.size());
   for (std::size_t k = 0; k < views.size(); ++k) {
     const ShadowView& v = views[k];
     wanted[k].view = v;
@@ -118,8 +119,9 @@ int ShadowMaps::render(const std::vector<ShadowView>& views, const std::vector<D
         }
       }
       if (outside) continue;
-      wanted[k].casters.emplace_back(item.mesh, item.model);
-      (item.is_static ? wanted_static[k].casters : dynamic[k]).emplace_back(item.mesh, item.model);
+      const Caster caster{item.mesh, item.model, item.material_override};
+      wanted[k].casters.push_back(caster);
+      (item.is_static ? wanted_static[k].casters : dynamic[k]).push_back(caster);
     }
   }
   std::vector<std::size_t> stale;
@@ -146,15 +148,41 @@ int ShadowMaps::render(const std::vector<ShadowView>& views, const std::vector<D
   glDepthMask(GL_TRUE);
   glDisable(GL_CULL_FACE);  // both faces cast: open meshes and single planes stay opaque
   glDisable(GL_BLEND);
-  program.use();
   glBindVertexArray(scene.vertex_array());
-  const auto draw = [](const std::vector<std::pair<const GpuMesh*, glm::mat4>>& casters) {
-    for (const auto& [mesh, model] : casters) {
-      glUniformMatrix4fv(0, 1, GL_FALSE, glm::value_ptr(model));
-      for (const GpuPrimitive& p : mesh->primitives)
-        glDrawElementsBaseVertex(GL_TRIANGLES, static_cast<GLsizei>(p.index_count), GL_UNSIGNED_INT,
-                                 reinterpret_cast<const void*>(static_cast<std::uintptr_t>(p.first_index) * 4u),
-                                 p.base_vertex);
+  const ShadowView* current = nullptr;
+  const auto set_view = [&](const ShadowView& v) {
+    glUniformMatrix4fv(8, 1, GL_FALSE, glm::value_ptr(v.view_proj));
+    glUniform3fv(16, 1, glm::value_ptr(v.eye));
+    glUniform1f(17, v.far_m);
+    glUniform1i(18, v.ortho ? 1 : 0);
+    glUniform3fv(19, 1, glm::value_ptr(v.axis));
+  };
+  // Opaque primitives with `program`, then the cut-out ones (MASK, BLEND) with the alpha test.
+  const auto draw = [&](const std::vector<Caster>& casters) {
+    for (const bool cut_out : {false, true}) {
+      if (cut_out && cut_out_program == nullptr) break;
+      const ShaderProgram& p = cut_out ? *cut_out_program : program;
+      bool used = false;
+      for (const Caster& c : casters) {
+        bool model_set = false;
+        for (const GpuPrimitive& prim : c.mesh->primitives) {
+          const GpuMaterial& m = scene.material(c.material_override >= 0 ? c.material_override : prim.material);
+          if (m.cut_out() != cut_out) continue;
+          if (!used) {
+            p.use();
+            set_view(*current);
+            used = true;
+          }
+          if (!model_set) {
+            glUniformMatrix4fv(0, 1, GL_FALSE, glm::value_ptr(c.model));
+            model_set = true;
+          }
+          if (cut_out) bind_alpha_test(m, m.alpha_mode == AlphaMode::Mask ? m.alpha_cutoff : 0.5f);
+          glDrawElementsBaseVertex(GL_TRIANGLES, static_cast<GLsizei>(prim.index_count), GL_UNSIGNED_INT,
+                                   reinterpret_cast<const void*>(static_cast<std::uintptr_t>(prim.first_index) * 4u),
+                                   prim.base_vertex);
+        }
+      }
     }
   };
   const float one = 1.0f;
@@ -166,11 +194,7 @@ int ShadowMaps::render(const std::vector<ShadowView>& views, const std::vector<D
     std::vector<LayerContent>& held = maps.content;
     const auto slot = static_cast<std::size_t>(v.layer);
     glViewport(0, 0, size, size);
-    glUniformMatrix4fv(8, 1, GL_FALSE, glm::value_ptr(v.view_proj));
-    glUniform3fv(16, 1, glm::value_ptr(v.eye));
-    glUniform1f(17, v.far_m);
-    glUniform1i(18, v.ortho ? 1 : 0);
-    glUniform3fv(19, 1, glm::value_ptr(v.axis));
+    current = &v;
     const std::uint32_t target = maps.texture.id();
     // A light that did not move, whose dynamic casters did: its static casters' depth is kept
     // in a second texture, copied back, and only the dynamic casters are drawn over it. The
@@ -203,6 +227,7 @@ int ShadowMaps::render(const std::vector<ShadowView>& views, const std::vector<D
     if (held.size() <= slot) held.resize(slot + 1);
     held[slot] = std::move(wanted[k]);
   }
+  unbind_material_samplers();
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   return static_cast<int>(stale.size());
 }

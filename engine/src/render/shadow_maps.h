@@ -30,8 +30,11 @@ class ShadowMaps {
   /// views rendered.
   /// A view that would be drawn but whose volume the camera (`camera_view_proj`) cannot see
   /// into is not drawn and is drawn when it can (last_unseen_views()).
+  /// Opaque primitives are drawn with `program`; MASK ones (at their cutoff) and BLEND ones
+  /// (a cut-out at 0.5) with `cut_out_program`, shadow.frag.glsl with ALPHA_TEST (needed only
+  /// when the scene has such materials, GpuScene::has_cut_out()).
   int render(const std::vector<ShadowView>& views, const std::vector<DrawItem>& items, const GpuScene& scene,
-             const ShaderProgram& program, const glm::mat4& camera_view_proj);
+             const ShaderProgram& program, const ShaderProgram* cut_out_program, const glm::mat4& camera_view_proj);
 
   std::uint32_t maps_2d() const { return maps_[kMaps2d].texture.id(); }
   std::uint32_t sun_maps() const { return maps_[kSunMaps].texture.id(); }
@@ -42,10 +45,19 @@ class ShadowMaps {
   int last_unseen_views() const { return unseen_views_; }
 
  private:
+  /// A caster as drawn: mesh, transform and material override (its alpha cuts the shadow).
+  struct Caster {
+    const GpuMesh* mesh = nullptr;
+    glm::mat4 model{1.0f};
+    std::int32_t material_override = -1;
+    bool operator==(const Caster& o) const {
+      return mesh == o.mesh && model == o.model && material_override == o.material_override;
+    }
+  };
   /// What a layer holds: the view and its casters as last rendered.
   struct LayerContent {
     ShadowView view;
-    std::vector<std::pair<const GpuMesh*, glm::mat4>> casters;
+    std::vector<Caster> casters;
     bool operator==(const LayerContent& o) const;
   };
   /// One texture array and what its layers hold.
