@@ -306,11 +306,8 @@ void expect_texture_state_round_trip(const engine::SceneAsset& in, const engine:
   }
 }
 
-// Disabled until the loader reads samplers, KHR_texture_transform and alpha (issue 33's
-// loader step, in parallel on another branch): the base loader sets only image and texCoord.
-// Enable it when that work is merged; WritesSamplersTransformsAndAlphaAsGltfDefines checks
-// the written JSON meanwhile.
-TEST(GltfWriter, DISABLED_RoundTripsSamplersTransformsAndAlpha) {
+// What the writer writes, the loader reads back: samplers, KHR_texture_transform, alpha.
+TEST(GltfWriter, RoundTripsSamplersTransformsAndAlpha) {
   const engine::SceneAsset scene = feature_scene();
   for (const char* name : {"scene.gltf", "scene.glb"}) {
     const fs::path path = temp_dir("texture_state") / name;

@@ -266,6 +266,9 @@ class GltfBuilder {
     if (!p.normals.empty() && p.normals.size() != n) return error(where, "normals count differs from positions count");
     if (!p.uv0.empty() && p.uv0.size() != n) return error(where, "uv0 count differs from positions count");
     if (!p.uv1.empty() && p.uv1.size() != n) return error(where, "uv1 count differs from positions count");
+    if (!p.tangents.empty() && p.tangents.size() != n) return error(where, "tangents count differs from positions count");
+    for (const glm::vec4& t : p.tangents)
+      if (!engine::all_finite(t)) return error(where, "tangent is NaN or infinite");
     if (p.indices.size() % 3 != 0) return error(where, "index count is not a multiple of 3");
     if (p.indices.empty() && n % 3 != 0) return error(where, "non-indexed vertex count is not a multiple of 3");
     for (std::uint32_t i : p.indices)
@@ -311,6 +314,7 @@ class GltfBuilder {
     if (!p.normals.empty()) attributes["NORMAL"] = add_attribute(p.normals, "VEC3");
     if (!p.uv0.empty()) attributes["TEXCOORD_0"] = add_attribute(p.uv0, "VEC2");
     if (!p.uv1.empty()) attributes["TEXCOORD_1"] = add_attribute(p.uv1, "VEC2");
+    if (!p.tangents.empty()) attributes["TANGENT"] = add_attribute(p.tangents, "VEC4");
     json j = {{"attributes", std::move(attributes)}, {"mode", 4}};
     if (!p.indices.empty()) j["indices"] = add_indices(p.indices, p.positions.size());
     return j;
