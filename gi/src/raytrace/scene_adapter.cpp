@@ -2,6 +2,8 @@
 
 #include <glm/glm.hpp>
 
+#include <cmath>
+
 namespace gi {
 
 namespace {
@@ -202,9 +204,9 @@ std::vector<glm::vec2> mesh_uvs(const BakeMesh& mesh, Field field) {
 
 }  // namespace
 
-ReferenceScene reference_scene_from(const BakeInput& input) {
-  ReferenceScene out;
-  out.geometry = rt_scene_from(input);
+namespace {
+
+void add_materials(const BakeInput& input, ReferenceScene& out) {
   TextureTable textures(input, out.textures);
   for (const BakeMaterial& m : input.materials) {
     ReferenceMaterial r = reference_material(m);
@@ -214,6 +216,48 @@ ReferenceScene reference_scene_from(const BakeInput& input) {
     out.materials.push_back(r);
   }
   out.materials.push_back(reference_material(BakeMaterial{}));  // primitives without a material
+}
+
+}  // namespace
+
+ReferenceScene material_scene_from(const BakeInput& input) {
+  ReferenceScene out;
+  add_materials(input, out);
+  return out;
+}
+
+ShadingTriangle lookup_triangle(const BakeInput& input, const BakeInstance& instance, const BakePrimitive& prim,
+                                std::size_t t, const glm::vec3 world[3]) {
+  ShadingTriangle tri;
+  const int m = material_of(input, prim, instance.material_override);
+  tri.material = m >= 0 ? static_cast<std::uint32_t>(m) : static_cast<std::uint32_t>(input.materials.size());
+  tri.p0 = world[0];
+  tri.e1 = world[1] - world[0];
+  tri.e2 = world[2] - world[0];
+  const glm::vec3 c = glm::cross(tri.e1, tri.e2);
+  tri.area_m2 = 0.5f * glm::length(c);
+  tri.face_normal = tri.area_m2 > 0.0f ? glm::normalize(c) : glm::vec3(0.0f, 1.0f, 0.0f);
+  tri.n0 = tri.n1 = tri.n2 = tri.face_normal;
+  for (int set = 0; set < 2; ++set) {
+    const std::vector<glm::vec2>& uv = set == 0 ? prim.uv0 : prim.uv1;
+    if (uv.size() != prim.positions.size()) continue;
+    glm::vec2* corner = set == 0 ? tri.uv0 : tri.uv1;
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t i = prim.indices[3 * t + static_cast<std::size_t>(k)];
+      corner[k] = i < uv.size() ? uv[i] : glm::vec2(0.0f);
+    }
+    const glm::vec2 a = corner[1] - corner[0], b = corner[2] - corner[0];
+    const float uv_area = 0.5f * std::fabs(a.x * b.y - a.y * b.x);
+    const float per_m = tri.area_m2 > 0.0f ? std::sqrt(uv_area / tri.area_m2) : 0.0f;
+    tri.uv_per_m[set] = std::isfinite(per_m) ? per_m : 0.0f;
+  }
+  return tri;
+}
+
+ReferenceScene reference_scene_from(const BakeInput& input) {
+  ReferenceScene out;
+  out.geometry = rt_scene_from(input);
+  add_materials(input, out);
 
   const std::size_t geometries = out.geometry.geometries.size();
   out.normals.resize(geometries);
