@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <set>
 #include <span>
 #include <utility>
@@ -97,6 +98,7 @@ engine::Result<BrfMesh> brf_mesh_from_input(const BakeInput& input, std::uint32_
   const BakeMesh& m = input.meshes[mesh_index];
   const std::string location = "mesh " + std::to_string(mesh_index) + " \"" + m.name + "\"";
   BrfMesh out;
+  std::optional<ReferenceScene> looks;  // the material lookup's data, built for the first textured primitive
   for (std::size_t pi = 0; pi < m.primitives.size(); ++pi) {
     const BakePrimitive& p = m.primitives[pi];
     const std::size_t n = p.positions.size();
@@ -140,7 +142,7 @@ engine::Result<BrfMesh> brf_mesh_from_input(const BakeInput& input, std::uint32_
     if (mat.textured()) {
       // Per vertex: the texture's mean around it, over the corner regions of the triangles
       // that share it (each the half of the triangle nearest the vertex), area-weighted.
-      const ReferenceScene looks = material_scene_from(input);
+      if (!looks) looks = material_scene_from(input);  // once per mesh: the mip chains
       BakeInstance at_origin;
       at_origin.material_override = material_override;
       std::vector<double> sum(n, 0.0), weight(n, 0.0);
@@ -153,7 +155,7 @@ engine::Result<BrfMesh> brf_mesh_from_input(const BakeInput& input, std::uint32_
           const glm::vec2 b = corner_bary[k];
           const glm::vec2 centre = b + 0.25f * (glm::vec2(1.0f / 3.0f) - b) * 2.0f;  // halfway to the centroid
           const glm::vec2 e1 = 0.5f * (corner_bary[(k + 1) % 3] - b), e2 = 0.5f * (corner_bary[(k + 2) % 3] - b);
-          const float r = std::clamp(luminance(footprint_albedo(looks, tri, centre, e1, e2)), 0.0f, 1.0f);
+          const float r = std::clamp(luminance(footprint_albedo(*looks, tri, centre, e1, e2)), 0.0f, 1.0f);
           const std::uint32_t v = p.indices[t + static_cast<std::size_t>(k)];
           sum[v] += static_cast<double>(r) * tri.area_m2;
           weight[v] += static_cast<double>(tri.area_m2);
