@@ -231,3 +231,33 @@ TEST(BakeApi, ParentChainsResolveOnceForAllNodes) {
   // A million float additions drift (measured 0.6%): the position is 1 m along x, roughly.
   EXPECT_NEAR(in.instances[2].object_to_world[3][0], 1e-6f * kDepth, 0.02f);
 }
+
+// A bundle remembers the textures it was baked with (issue 33): the level with one texel of
+// a base colour texture changed is another level, and the runtime refuses the bundle as stale.
+TEST(BakeApi, ABundleBakedWithOtherTexturesIsStale) {
+  auto loaded = engine::load_gltf(GI_SOURCE_DIR "/assets/demo_level.gltf");
+  ASSERT_TRUE(loaded) << loaded.error().to_string();
+  engine::SceneAsset asset = std::move(loaded).value();
+  engine::Image checker{.name = "checker", .uri = "", .width = 4, .height = 4, .rgba8 = {}};
+  for (int i = 0; i < 16; ++i) checker.rgba8.insert(checker.rgba8.end(), {200, 90, static_cast<std::uint8_t>(i * 16), 255});
+  asset.images.push_back(checker);
+  const int textured = asset.meshes[0].primitives[0].material;
+  ASSERT_GE(textured, 0);
+  asset.materials[static_cast<std::size_t>(textured)].base_color_texture.image = static_cast<int>(asset.images.size() - 1);
+  const gi::BakeInput input = gi::bake_input_from(asset);
+  ASSERT_TRUE(gi::validate_bake_input(input)) << gi::validate_bake_input(input).error().to_string();
+
+  const fs::path dir = fresh_dir("textured_demo_level.gibake");
+  auto report = gi::bake_bundle(input, dir, {.preset = "preview", .methods = {"atlas"}});
+  ASSERT_TRUE(report) << report.error().to_string();
+
+  engine::Scene same = engine::instantiate(engine::SceneAsset(asset));
+  auto accepted = gi::GISystem::load(dir, same);
+  EXPECT_TRUE(accepted) << "the textures it was baked with: " << (accepted ? "" : accepted.error().to_string());
+  engine::SceneAsset changed = asset;
+  changed.images.back().rgba8[5] ^= 0x40;  // one texel's green
+  engine::Scene other = engine::instantiate(std::move(changed));
+  auto refused = gi::GISystem::load(dir, other);
+  ASSERT_FALSE(refused) << "a bundle baked with other textures must be refused";
+  EXPECT_NE(refused.error().to_string().find("stale"), std::string::npos) << refused.error().to_string();
+}

@@ -1,6 +1,8 @@
 // Issue 32's acceptance on a real third-party level: the Dabrovic Sponza atrium (read from
 // GI_EXTERNAL_ASSETS_DIR, never copied; skipped with a message without it), untextured (the
-// bakers and the path tracer do not read textures yet), lit by a high sun into the courtyard
+// renderer, the bakers and the path tracer all see the factors alone, gi::without_textures;
+// the textured level's atlas against the textured path tracer is
+// gi/tests/light_atlas/textured_real_level_test.cpp), lit by a high sun into the courtyard
 // and a gradient sky, baked at the preview preset, seen from the courtyard floor along the
 // arcades: the renderer's frame against the path tracer's truth of the same state, per region
 // (open courtyard, ground-floor arcades, upper gallery) and over the frame

@@ -43,10 +43,13 @@ std::vector<std::string> split(const std::string& list) {
 int main(int argc, char** argv) {
   CLI::App app{"Bakes a scene's GI data into a bake bundle (manifest.json + one file per method)"};
   std::string scene_path, positional_scene, out_dir, methods, export_uv1, sky, sun;
-  bool plan_only = false;
+  bool plan_only = false, untextured = false;
   gi::BakeOptions o;
   app.add_option("--scene", scene_path, "glTF/GLB scene")->check(CLI::ExistingFile);
   app.add_option("scene", positional_scene, "glTF/GLB scene (instead of --scene)")->check(CLI::ExistingFile);
+  app.add_flag("--untextured", untextured,
+               "Bake the scene's materials without their textures and alpha (factors alone, gi::without_textures; "
+               "docs/materials-in-bakes.md)");
   app.add_flag("--plan", plan_only, "Print the effect plan with estimates for --preset and exit (docs/plan.md)");
   app.add_option("--export-uv1", export_uv1,
                  "Write the scene with the light-atlas UVs of --preset/--density as TEXCOORD_1 to this .gltf/.glb "
@@ -119,7 +122,8 @@ int main(int argc, char** argv) {
     if (out_dir.empty() && !plan_only) return tools::kExitOk;
   }
   const engine::Scene scene = engine::instantiate(std::move(asset).value());
-  const gi::BakeInput input = gi::bake_input_from(scene);
+  const gi::BakeInput input =
+      untextured ? gi::without_textures(gi::bake_input_from(scene)) : gi::bake_input_from(scene);
 
   if (plan_only) {
     std::fputs(gi::format_plan(gi::plan(input, {.preset = o.preset,

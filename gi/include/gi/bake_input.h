@@ -13,6 +13,7 @@
 #include <engine/components.h>
 #include <engine/result.h>
 #include <engine/scene.h>
+#include <engine/scene_asset.h>
 #include <engine/sky.h>
 
 #include <cstdint>
@@ -22,8 +23,26 @@
 
 namespace gi {
 
-/// glTF metallic-roughness factors, the parameters of the one BRDF (engine/gltf_brdf.h).
-/// Textures are not read by the bakers.
+/// A decoded image a material's texture reads: 8-bit RGBA, rows top to bottom (engine::Image).
+/// Base colour and emissive textures hold sRGB-encoded colour, the others linear data.
+struct BakeImage {
+  std::string name;
+  std::string uri;  ///< The file it came from (empty: embedded), for messages.
+  int width = 0;
+  int height = 0;
+  std::vector<std::uint8_t> rgba8;  ///< width x height x 4 bytes.
+};
+
+/// A material's texture: image (index into BakeInput::images; -1 none), TEXCOORD set
+/// (0: BakePrimitive::uv0, 1: uv1), sampler and KHR_texture_transform (engine/scene_asset.h).
+using BakeTexture = engine::TextureRef;
+
+/// glTF metallic-roughness material, the parameters of the one BRDF (engine/gltf_brdf.h),
+/// with its textures and alpha. Every baker and the path tracer read the textures through
+/// one material lookup (docs/materials-in-bakes.md): base colour (sRGB) x base_color,
+/// metallic-roughness (G roughness, B metallic, linear) x the factors, emissive (sRGB) x
+/// emission. The normal texture is carried but not read by the bakers (they fold surfaces
+/// into diffuse reflectors at the texel's normal).
 struct BakeMaterial {
   std::string name;
   glm::vec3 base_color{1.0f};      ///< Linear, in [0, 1].
@@ -33,6 +52,23 @@ struct BakeMaterial {
   glm::vec3 specular_color{1.0f};  ///< KHR_materials_specular specularColorFactor (>= 0).
   glm::vec3 emission{0.0f};        ///< Emitted radiance of the front face, W/(m^2 sr).
   bool double_sided = false;       ///< Back faces shade and emit like front faces.
+  float base_alpha = 1.0f;         ///< base colour alpha factor, in [0, 1] (x the texture's alpha).
+  BakeTexture base_color_texture;          ///< RGB x base_color, A x base_alpha (sRGB).
+  BakeTexture metallic_roughness_texture;  ///< G x roughness, B x metallic (linear).
+  BakeTexture emissive_texture;            ///< RGB x emission (sRGB).
+  BakeTexture normal_texture;              ///< Tangent-space normal (linear); not read by the bakers.
+  float normal_scale = 1.0f;
+  /// Opaque ignores alpha; Mask cuts out where alpha < alpha_cutoff; Blend is baked as a
+  /// cut-out at alpha 0.5 (a bake has no order to blend in; docs/materials-in-bakes.md).
+  engine::AlphaMode alpha_mode = engine::AlphaMode::Opaque;
+  float alpha_cutoff = 0.5f;  ///< Mask: alpha below it is cut out, in [0, 1].
+
+  /// True when any of the textures the bakers read is present.
+  bool textured() const {
+    return base_color_texture.present() || metallic_roughness_texture.present() || emissive_texture.present();
+  }
+  /// True when some of the surface may be cut out (Mask or Blend).
+  bool cuts_out() const { return alpha_mode != engine::AlphaMode::Opaque; }
 };
 
 /// A triangle list with one material.
@@ -40,6 +76,8 @@ struct BakePrimitive {
   std::vector<glm::vec3> positions;    ///< Object space, metres.
   std::vector<glm::vec3> normals;      ///< Empty (flat shading) or one unit normal per position.
   std::vector<std::uint32_t> indices;  ///< Three per triangle, into positions.
+  std::vector<glm::vec2> uv0;          ///< TEXCOORD_0: empty or one per position (material UVs).
+  std::vector<glm::vec2> uv1;          ///< TEXCOORD_1: empty or one per position.
   int material = -1;                   ///< Index into BakeInput::materials; -1: glTF's default material.
 };
 
@@ -94,6 +132,7 @@ struct BakeInput {
   std::string name;  ///< For messages and the bundle's manifest (e.g. the scene file's name).
   std::vector<BakeMesh> meshes;
   std::vector<BakeMaterial> materials;
+  std::vector<BakeImage> images;  ///< What the materials' textures index.
   std::vector<BakeInstance> instances;
   std::vector<BakeLight> lights;  ///< Switched-off ones included (skipped by the bakers).
   BakeEnvironment environment;
@@ -101,6 +140,10 @@ struct BakeInput {
 
 /// The material of primitive `p` of `instance` (its override, its own, or glTF's default).
 BakeMaterial bake_material(const BakeInput& input, const BakeInstance& instance, const BakePrimitive& p);
+
+/// `input` with its materials' textures and alpha dropped (factors alone, Opaque) and its
+/// images cleared: what the bakers saw before they read textures (gi-bake --untextured).
+BakeInput without_textures(BakeInput input);
 
 /// The live engine scene as plain data: one instance per entity with a MeshRenderer and a
 /// WorldTransform (in entity order, which is node order for engine::instantiate; id = the
@@ -121,8 +164,10 @@ BakeInput bake_input_from(const engine::SceneAsset& asset);
 glm::mat4 node_world_matrix(const engine::SceneAsset& asset, int node);
 
 /// Checks what the bakers rely on: mesh and material indices in range, three indices per
-/// triangle within range, normals empty or one per position, finite positions, normals,
-/// matrices and light values, factors in range. The error names the element ("mesh 3
+/// triangle within range, normals and UV sets empty or one per position, finite positions,
+/// normals, UVs, matrices and light values, factors in range; images of width x height x 4
+/// bytes; texture image indices in range and the UV set a texture reads present on every
+/// primitive that uses the material. The error names the element ("mesh 3
 /// 'crate' primitive 0: index 77 out of range (12 vertices)").
 engine::Status validate_bake_input(const BakeInput& input);
 

@@ -21,8 +21,9 @@
 // air the surface faces: the two faces of a thin wall then fall into the rooms they face):
 // the first region box that holds that point, else "other"; pixels whose ray escapes (the
 // sky) are background and compared nowhere.
-// Textures: the bakers and the path tracer do not read them yet; compare a scene whose
-// materials have none (without_textures) so both sides see the same materials.
+// Textures: the bakers and the path tracer read them (docs/materials-in-bakes.md); a bundle
+// baked --untextured is compared on the scene without_textures() gives, so both sides see
+// the same materials.
 
 #include <engine/image.h>
 #include <engine/renderer.h>
@@ -191,8 +192,9 @@ class FrameTruthBench {
 };
 
 /// `asset` with every material's base-colour, metallic-roughness, emissive and normal
-/// textures dropped (the factors stay): what the bakers and the path tracer see today, so
-/// the renderer sees the same materials.
+/// textures and its alpha mode dropped (the factors stay, Opaque): the scene a bake of
+/// gi::without_textures(BakeInput) (gi-bake --untextured) saw, so the renderer, the bakers
+/// and the path tracer see the same materials. The images stay (unused).
 engine::SceneAsset without_textures(engine::SceneAsset asset);
 
 /// The frame's luminance against the truth's per pixel, in false colour: log2 of the ratio

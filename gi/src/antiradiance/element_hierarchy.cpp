@@ -10,6 +10,7 @@
 
 #include <glm/gtc/constants.hpp>
 
+#include "raytrace/material_lookup.h"
 #include "raytrace/scene_adapter.h"
 
 namespace gi {
@@ -201,6 +202,10 @@ engine::Result<ElementHierarchy> build_element_hierarchy(const BakeInput& input,
   const int groups = 1 + static_cast<int>(h.deforming_instances.size());
   std::vector<std::vector<SourceTriangle>> by_group(static_cast<std::size_t>(groups));
   std::int32_t deforming_index = 0;
+  // Textured materials: each source triangle folds in its texture's mean (material_lookup.h).
+  const bool any_textured =
+      std::any_of(input.materials.begin(), input.materials.end(), [](const BakeMaterial& m) { return m.textured(); });
+  const ReferenceScene looks = any_textured ? material_scene_from(input) : ReferenceScene{};
   for (std::size_t i = 0; i < input.instances.size(); ++i) {
     const BakeInstance& inst = input.instances[i];
     std::int32_t group = 0;
@@ -227,6 +232,9 @@ engine::Result<ElementHierarchy> build_element_hierarchy(const BakeInput& input,
           if (glm::any(glm::lessThan(thi, lo)) || glm::any(glm::greaterThan(tlo, hi))) continue;
         }
         s.albedo = albedo;
+        if (mat.textured())
+          s.albedo = glm::clamp(triangle_albedo(looks, lookup_triangle(input, inst, prim, t / 3, s.p)), glm::vec3(0.0f),
+                                glm::vec3(1.0f));
         s.instance = static_cast<std::int32_t>(i);
         s.group = group;
         by_group[static_cast<std::size_t>(group)].push_back(s);

@@ -4,11 +4,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <set>
 #include <span>
 #include <utility>
 
 #include "io/content_hash.h"
+#include "raytrace/material_lookup.h"
 #include "raytrace/scene_adapter.h"
 #include "transport/vpl_set.h"
 
@@ -96,6 +98,7 @@ engine::Result<BrfMesh> brf_mesh_from_input(const BakeInput& input, std::uint32_
   const BakeMesh& m = input.meshes[mesh_index];
   const std::string location = "mesh " + std::to_string(mesh_index) + " \"" + m.name + "\"";
   BrfMesh out;
+  std::optional<ReferenceScene> looks;  // the material lookup's data, built for the first textured primitive
   for (std::size_t pi = 0; pi < m.primitives.size(); ++pi) {
     const BakePrimitive& p = m.primitives[pi];
     const std::size_t n = p.positions.size();
@@ -136,7 +139,33 @@ engine::Result<BrfMesh> brf_mesh_from_input(const BakeInput& input, std::uint32_
     if (!std::isfinite(rho)) return engine::Error{where, location, "the base colour is NaN or infinite"};
     out.positions.insert(out.positions.end(), p.positions.begin(), p.positions.end());
     out.normals.insert(out.normals.end(), normals.begin(), normals.end());
-    out.reflectance.insert(out.reflectance.end(), n, rho);
+    if (mat.textured()) {
+      // Per vertex: the texture's mean around it, over the corner regions of the triangles
+      // that share it (each the half of the triangle nearest the vertex), area-weighted.
+      if (!looks) looks = material_scene_from(input);  // once per mesh: the mip chains
+      BakeInstance at_origin;
+      at_origin.material_override = material_override;
+      std::vector<double> sum(n, 0.0), weight(n, 0.0);
+      for (std::size_t t = 0; t + 2 < p.indices.size(); t += 3) {
+        const glm::vec3 corners[3] = {p.positions[p.indices[t]], p.positions[p.indices[t + 1]],
+                                      p.positions[p.indices[t + 2]]};
+        const ShadingTriangle tri = lookup_triangle(input, at_origin, p, t / 3, corners);
+        const glm::vec2 corner_bary[3] = {{0.0f, 0.0f}, {1.0f, 0.0f}, {0.0f, 1.0f}};
+        for (int k = 0; k < 3; ++k) {
+          const glm::vec2 b = corner_bary[k];
+          const glm::vec2 centre = b + 0.25f * (glm::vec2(1.0f / 3.0f) - b) * 2.0f;  // halfway to the centroid
+          const glm::vec2 e1 = 0.5f * (corner_bary[(k + 1) % 3] - b), e2 = 0.5f * (corner_bary[(k + 2) % 3] - b);
+          const float r = std::clamp(luminance(footprint_albedo(*looks, tri, centre, e1, e2)), 0.0f, 1.0f);
+          const std::uint32_t v = p.indices[t + static_cast<std::size_t>(k)];
+          sum[v] += static_cast<double>(r) * tri.area_m2;
+          weight[v] += static_cast<double>(tri.area_m2);
+        }
+      }
+      for (std::size_t v = 0; v < n; ++v)
+        out.reflectance.push_back(weight[v] > 0.0 ? static_cast<float>(sum[v] / weight[v]) : rho);
+    } else {
+      out.reflectance.insert(out.reflectance.end(), n, rho);
+    }
     for (std::uint32_t i : p.indices) out.indices.push_back(base + i);
   }
   if (out.indices.empty()) return engine::Error{where, location, "the mesh has no triangle"};

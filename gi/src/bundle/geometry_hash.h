@@ -13,9 +13,12 @@ namespace gi {
 /// id, its world matrix, and per primitive its triangles as corners (the position and, when
 /// present, the normal of each index, in index order; an out-of-range index is hashed as
 /// its value) and the factors of the material it renders with (override, own or default:
-/// base colour, metallic, roughness, specular, specular colour, emission). Dynamic
-/// instances, lights, names and the file path do not enter; textures do not either (the
-/// bakers do not read them). Vertex order and splitting do not matter as long as the
+/// base colour, metallic, roughness, specular, specular colour, emission) and, for a
+/// textured or cut-out (Mask, Blend) material only, the textures the bakers read (each
+/// image's texels by their XXH3, UV set, wrap, mipmaps, transform), alpha mode, cutoff and
+/// alpha factor and the primitive's UV sets per corner: a bundle baked with other textures
+/// is stale. An untextured opaque material adds nothing more, so bundles of untextured
+/// scenes keep their hash. Dynamic instances, lights, names and the file path do not enter. Vertex order and splitting do not matter as long as the
 /// triangles stay the same, so a scene given its atlas uv1 (gi::with_atlas_uv1) hashes like
 /// the original.
 std::string scene_geometry_hash(const BakeInput& input);

@@ -1,5 +1,7 @@
 #include "dlm/dlm.h"
 
+#include "raytrace/material_lookup.h"
+
 #include <engine/directional_radiance.h>
 #include <engine/finite.h>
 
@@ -235,7 +237,9 @@ engine::Result<Dlm> bake_dlm(const BakeInput& input, const DlmSettings& settings
                  .first;
       }
       triangle_glossy[t] = it->second.first ? 1 : 0;
-      triangle_albedo[t] = it->second.second;
+      // Textured: the texture's mean over the triangle (the material lookup, material_lookup.h).
+      triangle_albedo[t] = s.scene.materials[m].textured() ? gi::triangle_albedo(s.scene, s.index.triangles[t])
+                                                            : it->second.second;
     }
   }
 

@@ -12,6 +12,7 @@
 
 #include "core/random.h"
 #include "raytrace/light_falloff.h"
+#include "raytrace/material_lookup.h"
 #include "raytrace/ray_offset.h"
 #include "raytrace/reference_brdf.h"
 #include "uv/atlas_dilation.h"
@@ -97,6 +98,13 @@ engine::Result<TexelTable> texel_table(const StaticBakeScene& b, const AtlasLayo
     const std::uint32_t mesh = static_cast<std::uint32_t>(tx.mesh[i]);
     const ShadingTriangle& tri =
         b.index.triangles[b.index.instance_first[b.static_instance[mesh]] + static_cast<std::uint32_t>(tx.triangle[i])];
+    if (b.scene.materials[tri.material].textured()) {
+      // The texture's mean over the texel's footprint (material_lookup.h), not one point.
+      const TexelFootprint f = texel_footprint(layout, tx.mesh[i], tx.triangle[i], i);
+      t.albedo[i] = footprint_albedo(b.scene, tri, f.centre, f.axis_u, f.axis_v);
+      t.face[i] = glm::dot(tri.face_normal, tx.normal[i]) < 0.0f ? -tri.face_normal : tri.face_normal;
+      continue;
+    }
     auto it = albedo_of.find(tri.material);
     if (it == albedo_of.end())
       it = albedo_of.emplace(tri.material, engine::gltf_hemispherical_albedo(b.scene.materials[tri.material].brdf).sum())
@@ -247,7 +255,8 @@ DirectAt direct_at(const StaticBakeScene& b, const glm::vec3& p, const glm::vec3
     if (cos_l <= 0.0f || cos_r <= 0.0f || glm::dot(wi, face) <= 0.0f) continue;
     ++*rays;
     if (b.caster->occluded(Ray{origin, 0.0f, q - origin, 0.9999f})) continue;
-    (em.stands_for_light[pick] != 0 ? sum : unlit) += glm::dvec3(mat.emission * (cos_r * cos_l * tri.area_m2 / (prob * d2))) * inv;
+    const glm::vec3 emission = emission_at(b.scene, tri, glm::vec2(su * (1.0f - u.y), su * u.y), 0.0f);
+    (em.stands_for_light[pick] != 0 ? sum : unlit) += glm::dvec3(emission * (cos_r * cos_l * tri.area_m2 / (prob * d2))) * inv;
   }
   return {glm::vec3(sum), glm::vec3(unlit)};
 }

@@ -1,5 +1,8 @@
 #include "prm/prm.h"
 
+#include "raytrace/material_lookup.h"
+#include "raytrace/path_tracer.h"
+
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -79,7 +82,12 @@ std::vector<PathNode> random_walks(const VplSet& entries, std::size_t k, const S
       const glm::vec3 ng = glm::normalize(hit.geometric_normal);
       if (glm::dot(ng, dir) >= 0.0f) break;  // the back of a one-sided surface absorbs
       const std::uint32_t tri = s.triangle_of(hit);
-      const glm::vec3 albedo = triangle_albedo[tri];
+      // Textured: the material lookup at the hit, for the ray cone of a bounce ray (the
+      // path tracer's bounce spread, path_tracer.h).
+      const ShadingTriangle& st = s.index.triangles[tri];
+      const glm::vec3 albedo = s.scene.materials[st.material].textured()
+                                   ? albedo_at(s.scene, st, hit.barycentric, hit.t * PathTracerSettings{}.bounce_spread_rad)
+                                   : triangle_albedo[tri];
       const float q = std::min(1.0f, max_component(albedo));
       if (!(u_rr < q)) break;
       position = s.index.triangles[tri].p0 + hit.barycentric.x * s.index.triangles[tri].e1 +
@@ -127,6 +135,10 @@ engine::Result<Prm> bake_prm_run(const BakeInput& input, const PrmSettings& sett
   std::vector<glm::vec3> triangle_albedo(s.index.triangles.size());
   for (std::size_t t = 0; t < triangle_albedo.size(); ++t) {
     const std::uint32_t m = s.index.triangles[t].material;
+    if (s.scene.materials[m].textured()) {  // the texture's mean over the triangle
+      triangle_albedo[t] = gi::triangle_albedo(s.scene, s.index.triangles[t]);
+      continue;
+    }
     auto it = material_albedo.find(m);
     if (it == material_albedo.end())
       it = material_albedo.emplace(m, engine::gltf_hemispherical_albedo(s.scene.materials[m].brdf).sum()).first;

@@ -44,6 +44,8 @@ Hit BruteForceRayCaster::intersect(const Ray& ray) const {
     if (v < 0.0f || u + v > 1.0f) continue;
     const float t = glm::dot(tri.e2, qv) * inv;
     if (t < ray.t_min || t > best.t) continue;
+    const RtGeometry& geo = data_.geometries[tri.geometry];
+    if (geo.cutout && geo.cutout->cut(geo.indices, tri.primitive, {u, v})) continue;  // alpha cut-out
     best.t = t;
     best.instance = tri.instance;
     best.geometry = tri.geometry;

@@ -55,6 +55,20 @@ struct SceneHandle {
   }
 };
 
+// Intersection and occlusion filter of a geometry with cut-outs (alpha MASK / BLEND): a hit
+// where the alpha is below the cutoff is rejected, so the ray goes on. Embree calls it for
+// single rays and for every lane of a packet alike (valid[i] == 0: no hit to judge).
+// `geometryUserPtr` is the RtGeometry.
+void cutout_filter(const RTCFilterFunctionNArguments* args) {
+  const auto* geo = static_cast<const RtGeometry*>(args->geometryUserPtr);
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] == 0) continue;
+    const std::uint32_t prim = RTCHitN_primID(args->hit, args->N, i);
+    const glm::vec2 bary(RTCHitN_u(args->hit, args->N, i), RTCHitN_v(args->hit, args->N, i));
+    if (geo->cutout->cut(geo->indices, prim, bary)) args->valid[i] = 0;
+  }
+}
+
 class EmbreeRayCaster final : public RayCaster {
  public:
   engine::Status build(const RtSceneData& data) {
@@ -246,6 +260,11 @@ class EmbreeRayCaster final : public RayCaster {
     auto* idx = static_cast<unsigned*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
                                                                3 * sizeof(unsigned), geo.indices.size() / 3));
     for (std::size_t i = 0; i < geo.indices.size(); ++i) idx[i] = geo.indices[i];
+    if (geo.cutout) {  // `geo` lives in data_, which outlives the Embree scene
+      rtcSetGeometryUserData(g, const_cast<RtGeometry*>(&geo));
+      rtcSetGeometryIntersectFilterFunction(g, cutout_filter);
+      rtcSetGeometryOccludedFilterFunction(g, cutout_filter);
+    }
     rtcCommitGeometry(g);
     const unsigned id = rtcAttachGeometry(scene, g);
     rtcReleaseGeometry(g);

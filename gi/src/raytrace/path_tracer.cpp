@@ -5,6 +5,7 @@
 #include <numbers>
 
 #include "raytrace/light_falloff.h"
+#include "raytrace/material_lookup.h"
 #include "raytrace/ray_offset.h"
 
 namespace gi {
@@ -101,6 +102,7 @@ glm::vec3 PathTracer::direct_light(const glm::vec3& origin, const glm::vec3& p, 
   const ShadingTriangle& t = index_.triangles[em.triangle[std::min(pick, em.triangle.size() - 1)]];
   const ReferenceMaterial& mat = scene_.materials[t.material];
   const float su = std::sqrt(u1);
+  const glm::vec2 bary(su * (1.0f - u2), su * u2);
   // Uniform on the triangle: p0 + sqrt(u1) (1 - u2) e1 + sqrt(u1) u2 e2.
   const glm::vec3 q = t.p0 + su * (1.0f - u2) * t.e1 + su * u2 * t.e2;
   const glm::vec3 to = q - p;
@@ -116,12 +118,14 @@ glm::vec3 PathTracer::direct_light(const glm::vec3& origin, const glm::vec3& p, 
   // Stop just short of the emitter so it does not occlude itself.
   if (caster_.occluded(Ray{origin, 0.0f, q - origin, 0.9999f})) return sum;
   const float weight = power_heuristic(pdf_light, brdf.pdf(wo, wi));
-  return sum + mat.emission * fcos * (weight / pdf_light);
+  return sum + emission_at(scene_, t, bary, 0.0f) * fcos * (weight / pdf_light);
 }
 
 PathTracer::Traced PathTracer::trace(Ray ray, float prev_pdf, int max_light_vertex, Pcg32& rng) const {
   Traced out;
   glm::vec3 beta(1.0f);
+  float spread = settings_.camera_spread_rad;  // ray cone: footprint width_m at the hit
+  float width_m = 0.0f;
   for (int k = 1; k <= settings_.max_vertices; ++k) {
     glm::vec3& sink = k == 1 ? out.emitted : out.reflected;
     const Hit hit = caster_.intersect(ray);
@@ -136,6 +140,7 @@ PathTracer::Traced PathTracer::trace(Ray ray, float prev_pdf, int max_light_vert
     const bool front = glm::dot(tri.face_normal, wo) > 0.0f;
     if (!front && !mat.double_sided) break;  // the back of a one-sided surface: opaque and black
     const glm::vec3 p = tri.p0 + hit.barycentric.x * tri.e1 + hit.barycentric.y * tri.e2;
+    width_m += hit.t * glm::length(ray.direction) * spread;
 
     if (tri.emitter >= 0 && k <= max_light_vertex) {
       float weight = 1.0f;
@@ -143,11 +148,11 @@ PathTracer::Traced PathTracer::trace(Ray ray, float prev_pdf, int max_light_vert
         const float cos_light = std::fabs(glm::dot(tri.face_normal, wo));
         weight = power_heuristic(prev_pdf, emitter_pdf(tri, hit.t * hit.t, cos_light));
       }
-      sink += beta * mat.emission * weight;
+      sink += beta * emission_at(scene_, tri, hit.barycentric, width_m) * weight;
     }
     if (k + 1 > max_light_vertex) break;
 
-    const ReferenceBrdf brdf = shading_brdf(scene_, tri, hit.barycentric, front);
+    const ReferenceBrdf brdf = shading_brdf(scene_, tri, hit.barycentric, front, width_m);
     const glm::vec3 facing = front ? tri.face_normal : -tri.face_normal;
     const glm::vec3 origin = offset_ray_origin(p, facing);
     out.reflected += beta * direct_light(origin, p, brdf, wo, rng);
@@ -167,6 +172,7 @@ PathTracer::Traced PathTracer::trace(Ray ray, float prev_pdf, int max_light_vert
       beta /= survive;
     }
     ray = Ray{origin, 0.0f, s.wi};
+    spread += settings_.bounce_spread_rad;
   }
   return out;
 }

@@ -21,6 +21,14 @@ struct PathTracerSettings {
   int max_bounces = -1;           ///< Indirect bounces; -1: unlimited; 0: direct only.
   int russian_roulette_start = 3; ///< Path vertex from which Russian roulette applies.
   int max_vertices = 1024;        ///< Safety stop (with albedo <= 0.95 the cut energy is < 1e-22).
+  /// Ray cones for texture lookups (material_lookup.h): a path's footprint at a hit is the
+  /// sum over its segments of length x spread, the spread starting at camera_spread_rad
+  /// (0: camera rays read the finest mip level; many samples per pixel average the texture)
+  /// and growing by bounce_spread_rad at every scattering. The default gives a footprint of
+  /// 0.2 m ten metres after a bounce: the texture is averaged over what one bounce ray's
+  /// sample stands for without blurring texture detail the lighting correlates with.
+  float camera_spread_rad = 0.0f;
+  float bounce_spread_rad = 0.02f;
 };
 
 class PathTracer {

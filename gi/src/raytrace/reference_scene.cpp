@@ -2,6 +2,8 @@
 
 #include <engine/finite.h>
 
+#include "raytrace/material_lookup.h"
+
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -46,7 +48,8 @@ void index_emitters(const ReferenceScene& scene, ReferenceSceneIndex& index, boo
       ShadingTriangle& tri = index.triangles[t];
       tri.emitter = -1;
       const ReferenceMaterial& mat = scene.materials[tri.material];
-      const float lum = luminance(mat.emission);
+      // Sampled by power: an emissive texture's mean over the triangle x the factor.
+      const float lum = luminance(mat.emissive_texture.present() ? triangle_emission(scene, tri) : mat.emission);
       if (skip || !(lum > 0.0f) || !(tri.area_m2 > 0.0f)) continue;
       tri.emitter = static_cast<std::int32_t>(index.emitters.triangle.size());
       index.emitters.triangle.push_back(t);
@@ -85,6 +88,17 @@ engine::Result<ReferenceSceneIndex> index_reference_scene(const ReferenceScene& 
       return scene_error("material " + std::to_string(m),
                          "non-finite value, alpha <= 0, or metallic / specular weight outside [0, 1]");
   }
+  for (const auto* uvs : {&scene.uv0, &scene.uv1})
+    if (!uvs->empty() && uvs->size() != g.geometries.size())
+      return scene_error("geometries", "UV sets given for " + std::to_string(uvs->size()) + " of " +
+                                           std::to_string(g.geometries.size()) + " geometries");
+  for (std::size_t m = 0; m < scene.materials.size(); ++m)
+    for (const MaterialTexture* t : {&scene.materials[m].base_color_texture,
+                                     &scene.materials[m].metallic_roughness_texture, &scene.materials[m].emissive_texture})
+      if (t->present() && (static_cast<std::size_t>(t->mips) >= scene.textures.size() ||
+                           scene.textures[static_cast<std::size_t>(t->mips)].levels.empty() || t->texcoord < 0 ||
+                           t->texcoord > 1))
+        return scene_error("material " + std::to_string(m), "texture index out of range or UV set not 0 or 1");
   for (std::size_t i = 0; i < scene.lights.size(); ++i) {
     const ReferenceLight& l = scene.lights[i];
     if (!engine::all_finite(l.position) || !engine::all_finite(l.direction) || !engine::all_finite(l.radiant) ||
@@ -105,6 +119,14 @@ engine::Result<ReferenceSceneIndex> index_reference_scene(const ReferenceScene& 
     if (!normals.empty() && normals.size() != geo.positions.size())
       return scene_error(where, "normal count differs from vertex count");
     if (mats.size() != tri_count) return scene_error(where, "material count differs from triangle count");
+    const std::vector<glm::vec2>* uv_sets[2] = {nullptr, nullptr};
+    for (int set = 0; set < 2; ++set) {
+      const auto& uvs = set == 0 ? scene.uv0 : scene.uv1;
+      if (uvs.empty() || uvs[in.geometry].empty()) continue;
+      if (uvs[in.geometry].size() != geo.positions.size())
+        return scene_error(where, "TEXCOORD_" + std::to_string(set) + " count differs from vertex count");
+      uv_sets[set] = &uvs[in.geometry];
+    }
     const glm::mat4& m = in.object_to_world;
     const glm::mat3 normal_matrix = glm::transpose(glm::inverse(glm::mat3(m)));
     const bool mirrored = glm::determinant(glm::mat3(m)) < 0.0f;  // glTF: front faces turn clockwise
@@ -144,6 +166,15 @@ engine::Result<ReferenceSceneIndex> index_reference_scene(const ReferenceScene& 
       tri.n1 = n[1];
       tri.n2 = n[2];
       tri.material = mats[t];
+      for (int set = 0; set < 2; ++set) {
+        if (!uv_sets[set]) continue;
+        glm::vec2* c = set == 0 ? tri.uv0 : tri.uv1;
+        for (int k = 0; k < 3; ++k) c[k] = (*uv_sets[set])[vi[k]];
+        const glm::vec2 a = c[1] - c[0], b = c[2] - c[0];
+        const float uv_area = 0.5f * std::fabs(a.x * b.y - a.y * b.x);
+        const float per_m = tri.area_m2 > 0.0f ? std::sqrt(uv_area / tri.area_m2) : 0.0f;
+        tri.uv_per_m[set] = std::isfinite(per_m) ? per_m : 0.0f;
+      }
       index.triangles.push_back(tri);
     }
   }
@@ -164,10 +195,10 @@ void keep_static_emitters(const ReferenceScene& scene, ReferenceSceneIndex& inde
   index_emitters(scene, index, /*static_only=*/true);
 }
 
-ReferenceBrdf shading_brdf(const ReferenceScene& scene, const ShadingTriangle& tri, glm::vec2 uv, bool front) {
-  const ReferenceMaterial& mat = scene.materials[tri.material];
+ReferenceBrdf shading_brdf(const ReferenceScene& scene, const ShadingTriangle& tri, glm::vec2 uv, bool front,
+                           float footprint_m) {
   ReferenceBrdf f;
-  f.material = mat.brdf;
+  f.material = material_brdf_at(scene, tri, uv, footprint_m);
   glm::vec3 n = (1.0f - uv.x - uv.y) * tri.n0 + uv.x * tri.n1 + uv.y * tri.n2;
   const float len = glm::length(n);
   n = len > 1e-8f ? n / len : tri.face_normal;

@@ -15,6 +15,7 @@
 #include <engine/result.h>
 #include <engine/sky.h>
 
+#include "raytrace/material_textures.h"
 #include "raytrace/reference_brdf.h"
 #include "raytrace/rt_scene_data.h"
 
@@ -22,9 +23,22 @@ namespace gi {
 
 struct ReferenceMaterial {
   /// glTF's BRDF (engine/gltf_brdf.h); engine::gltf_lambertian(albedo) for a pure Lambertian.
+  /// With textures: the BRDF of the factors alone; material_lookup.h multiplies them in.
   engine::GltfBrdf brdf = engine::gltf_brdf(glm::vec3(0.8f), 0.0f, 1.0f);
-  glm::vec3 emission{0.0f};        ///< Emitted radiance, W/(m^2 sr), from the front face.
+  glm::vec3 emission{0.0f};        ///< Emitted radiance, W/(m^2 sr), from the front face (x the emissive texture).
   bool double_sided = false;       ///< Back faces shade (and emit) like front faces.
+  /// The factors the textures multiply (glTF metallic-roughness), read only when a texture is present.
+  glm::vec3 base_color{0.8f};
+  float metallic = 0.0f;
+  float roughness = 1.0f;
+  float specular = 1.0f;
+  glm::vec3 specular_color{1.0f};
+  MaterialTexture base_color_texture;          ///< RGB x base_color (sRGB-decoded mips).
+  MaterialTexture metallic_roughness_texture;  ///< G x roughness, B x metallic (linear mips).
+  MaterialTexture emissive_texture;            ///< RGB x emission (sRGB-decoded mips).
+  bool textured() const {
+    return base_color_texture.present() || metallic_roughness_texture.present() || emissive_texture.present();
+  }
 };
 
 /// A light in engine units (engine/components.h), world space.
@@ -52,6 +66,10 @@ struct ReferenceScene {
   std::vector<std::vector<glm::vec3>> normals;               ///< [geometry][vertex], object space.
   std::vector<std::vector<std::uint32_t>> triangle_material; ///< [geometry][triangle] into materials.
   std::vector<ReferenceMaterial> materials;
+  /// [geometry][vertex] material UV sets TEXCOORD_0 / TEXCOORD_1; the outer vector may be
+  /// empty (no UVs anywhere) and an inner one empty (that geometry has none).
+  std::vector<std::vector<glm::vec2>> uv0, uv1;
+  std::vector<TextureMips> textures;  ///< What MaterialTexture::mips indexes.
   std::vector<ReferenceLight> lights;
   glm::vec3 sky_radiance{0.0f};  ///< Radiance of rays that escape, W/(m^2 sr) (a uniform sky).
   engine::SkyGradient sky_gradient;  ///< Added to it by the escaping direction's elevation (engine/sky.h).
@@ -65,6 +83,11 @@ struct ShadingTriangle {
   float area_m2 = 0.0f;
   std::uint32_t material = 0;
   std::int32_t emitter = -1;     ///< Index into ReferenceSceneIndex::emitters, or -1.
+  glm::vec2 uv0[3]{};            ///< TEXCOORD_0 at the corners (0 when absent).
+  glm::vec2 uv1[3]{};            ///< TEXCOORD_1 at the corners (0 when absent).
+  /// UV units per metre on the surface, per set: sqrt(UV area / area); a footprint of w
+  /// metres covers w x uv_per_m[set] in UV (the ray-cone mip choice, material_lookup.h).
+  float uv_per_m[2]{0.0f, 0.0f};
 };
 
 /// Emissive triangles, sampled in proportion to their power (area x luminance x sides).
@@ -107,7 +130,9 @@ engine::Result<ReferenceSceneIndex> index_reference_scene(const ReferenceScene& 
 void keep_static_emitters(const ReferenceScene& scene, ReferenceSceneIndex& index);
 
 /// The BRDF of a hit on triangle `tri` at barycentrics (u, v), seen from the side of wo.
-/// `front` says whether wo lies on the front side.
-ReferenceBrdf shading_brdf(const ReferenceScene& scene, const ShadingTriangle& tri, glm::vec2 uv, bool front);
+/// `front` says whether wo lies on the front side. The material's textures are read there
+/// (material_lookup.h) for a footprint of `footprint_m` metres (0: the finest mip level).
+ReferenceBrdf shading_brdf(const ReferenceScene& scene, const ShadingTriangle& tri, glm::vec2 uv, bool front,
+                           float footprint_m = 0.0f);
 
 }  // namespace gi

@@ -26,4 +26,15 @@ ReferenceLight reference_light(const engine::Light& light, const glm::mat4& worl
 /// A material's factors as a path-tracer material (glTF's BRDF).
 ReferenceMaterial reference_material(const BakeMaterial& material);
 
+/// What the material lookup (material_lookup.h) needs of `input` without its geometry: the
+/// materials as reference_scene_from makes them (index input.materials.size(): the default)
+/// and their textures' mip chains. For bakers that walk BakeInput's primitives themselves.
+ReferenceScene material_scene_from(const BakeInput& input);
+
+/// Triangle t (its three indices at prim.indices[3t]) of `prim` drawn by `instance` with
+/// world corners `world`, as a ShadingTriangle of material_scene_from(input): material,
+/// corners, area and UVs (for the lookups; no normals, no emitter).
+ShadingTriangle lookup_triangle(const BakeInput& input, const BakeInstance& instance, const BakePrimitive& prim,
+                                std::size_t t, const glm::vec3 world[3]);
+
 }  // namespace gi

@@ -2,6 +2,7 @@
 #include <gi/bake_input.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
@@ -22,15 +23,31 @@ BakeMaterial material_from(const engine::Material& m) {
   b.specular_color = m.specular_color_factor;
   b.emission = m.emissive;
   b.double_sided = m.double_sided;
+  b.base_alpha = m.base_color.w;
+  b.base_color_texture = m.base_color_texture;
+  b.metallic_roughness_texture = m.metallic_roughness_texture;
+  b.emissive_texture = m.emissive_texture;
+  b.normal_texture = m.normal_texture;
+  b.normal_scale = m.normal_scale;
+  b.alpha_mode = m.alpha_mode;
+  b.alpha_cutoff = m.alpha_cutoff;
   return b;
+}
+
+BakeImage image_from(const engine::Image& i) {
+  return {.name = i.name, .uri = i.uri, .width = i.width, .height = i.height, .rgba8 = i.rgba8};
 }
 
 BakeMesh mesh_from(const engine::Mesh& m) {
   BakeMesh b;
   b.name = m.name;
   for (const engine::Primitive& p : m.primitives)
-    b.primitives.push_back(
-        {.positions = p.positions, .normals = p.normals, .indices = p.indices, .material = p.material});
+    b.primitives.push_back({.positions = p.positions,
+                            .normals = p.normals,
+                            .indices = p.indices,
+                            .uv0 = p.uv0,
+                            .uv1 = p.uv1,
+                            .material = p.material});
   return b;
 }
 
@@ -116,6 +133,26 @@ engine::Error input_error(const std::string& location, const std::string& messag
   return engine::Error{"<bake input>", location, message};
 }
 
+// The textures of a material the bakers check, with their names for messages.
+std::array<std::pair<const char*, const BakeTexture*>, 4> material_textures(const BakeMaterial& m) {
+  return {{{"base colour", &m.base_color_texture},
+           {"metallic-roughness", &m.metallic_roughness_texture},
+           {"emissive", &m.emissive_texture},
+           {"normal", &m.normal_texture}}};
+}
+
+// What is wrong when material `m` reads a UV set primitive `p` lacks (empty: nothing).
+std::string missing_uv_set(const BakeMaterial& m, const BakePrimitive& p) {
+  for (const auto& [what, t] : material_textures(m)) {
+    if (!t->present() || t == &m.normal_texture) continue;
+    const std::vector<glm::vec2>& uv = t->texcoord == 1 ? p.uv1 : p.uv0;
+    if (uv.size() != p.positions.size() && !p.positions.empty())
+      return std::string("material '") + m.name + "' reads its " + what + " texture through TEXCOORD_" +
+             std::to_string(t->texcoord) + ", which the primitive lacks";
+  }
+  return {};
+}
+
 }  // namespace
 
 BakeMaterial bake_material(const BakeInput& input, const BakeInstance& instance, const BakePrimitive& p) {
@@ -123,6 +160,18 @@ BakeMaterial bake_material(const BakeInput& input, const BakeInstance& instance,
   if (m >= 0 && static_cast<std::size_t>(m) < input.materials.size())
     return input.materials[static_cast<std::size_t>(m)];
   return material_from(engine::Material{});
+}
+
+BakeInput without_textures(BakeInput input) {
+  for (BakeMaterial& m : input.materials) {
+    m.base_color_texture = {};
+    m.metallic_roughness_texture = {};
+    m.emissive_texture = {};
+    m.normal_texture = {};
+    m.alpha_mode = engine::AlphaMode::Opaque;
+  }
+  input.images.clear();
+  return input;
 }
 
 glm::mat4 node_world_matrix(const engine::SceneAsset& asset, int node) {
@@ -146,6 +195,7 @@ BakeInput bake_input_from(const engine::SceneAsset& asset) {
   in.environment.sky_gradient = asset.environment.sky_gradient;
   for (const engine::Mesh& m : asset.meshes) in.meshes.push_back(mesh_from(m));
   for (const engine::Material& m : asset.materials) in.materials.push_back(material_from(m));
+  for (const engine::Image& i : asset.images) in.images.push_back(image_from(i));
   const NodeChains chains = node_chains(asset);
   for (std::size_t ni = 0; ni < asset.nodes.size(); ++ni) {
     const engine::Node& node = asset.nodes[ni];
@@ -179,6 +229,7 @@ BakeInput bake_input_from(const engine::Scene& scene) {
   in.environment.sky_gradient = scene.assets.environment.sky_gradient;
   for (const engine::Mesh& m : scene.assets.meshes) in.meshes.push_back(mesh_from(m));
   for (const engine::Material& m : scene.assets.materials) in.materials.push_back(material_from(m));
+  for (const engine::Image& i : scene.assets.images) in.images.push_back(image_from(i));
 
   const NodeChains chains = node_chains(scene.assets);
   std::unordered_map<std::uint32_t, int> node_of;  // entity index -> node index
@@ -229,6 +280,30 @@ engine::Status validate_bake_input(const BakeInput& input) {
       return input_error(where,
                          "base colour, metallic, roughness and specular must be in [0, 1], specular colour and "
                          "emission >= 0");
+    if (!(m.base_alpha >= 0.0f && m.base_alpha <= 1.0f) || !(m.alpha_cutoff >= 0.0f && m.alpha_cutoff <= 1.0f))
+      return input_error(where, "base colour alpha and alpha cutoff must be in [0, 1]");
+    for (const auto& [what, t] : material_textures(m)) {
+      if (!t->present()) continue;
+      if (static_cast<std::size_t>(t->image) >= input.images.size())
+        return input_error(where, std::string(what) + " texture: image " + std::to_string(t->image) + " out of range (" +
+                                      std::to_string(input.images.size()) + " images)");
+      if (t->texcoord < 0 || t->texcoord > 1)
+        return input_error(where, std::string(what) + " texture: TEXCOORD_" + std::to_string(t->texcoord) +
+                                      " (the bakers read TEXCOORD_0 and TEXCOORD_1)");
+      if (!engine::all_finite(t->transform.offset) || !engine::all_finite(t->transform.scale) ||
+          !std::isfinite(t->transform.rotation_rad))
+        return input_error(where, std::string(what) + " texture: the transform is NaN or infinite");
+    }
+  }
+  for (std::size_t ii = 0; ii < input.images.size(); ++ii) {
+    const BakeImage& img = input.images[ii];
+    const std::string where = "image " + std::to_string(ii) + " '" + (img.uri.empty() ? img.name : img.uri) + "'";
+    if (img.width <= 0 || img.height <= 0 || img.width > 65536 || img.height > 65536)
+      return input_error(where, "size " + std::to_string(img.width) + " x " + std::to_string(img.height) +
+                                    " is outside 1..65536");
+    if (img.rgba8.size() != static_cast<std::size_t>(img.width) * static_cast<std::size_t>(img.height) * 4u)
+      return input_error(where, std::to_string(img.rgba8.size()) + " bytes for " + std::to_string(img.width) + " x " +
+                                    std::to_string(img.height) + " RGBA8 texels");
   }
   for (std::size_t mi = 0; mi < input.meshes.size(); ++mi) {
     const BakeMesh& mesh = input.meshes[mi];
@@ -250,6 +325,17 @@ engine::Status validate_bake_input(const BakeInput& input) {
       if (p.material >= static_cast<int>(input.materials.size()))
         return input_error(where, "material " + std::to_string(p.material) + " out of range (" +
                                       std::to_string(input.materials.size()) + " materials)");
+      for (const auto* uv : {&p.uv0, &p.uv1}) {
+        if (!uv->empty() && uv->size() != p.positions.size())
+          return input_error(where, std::to_string(uv->size()) + " TEXCOORD_" + (uv == &p.uv0 ? "0" : "1") +
+                                        " values for " + std::to_string(p.positions.size()) + " positions");
+        for (const glm::vec2& t : *uv)
+          if (!engine::all_finite(t)) return input_error(where, "a texture coordinate is NaN or infinite");
+      }
+      if (p.material >= 0)
+        if (const std::string missing = missing_uv_set(input.materials[static_cast<std::size_t>(p.material)], p);
+            !missing.empty())
+          return input_error(where, missing);
     }
   }
   for (std::size_t ii = 0; ii < input.instances.size(); ++ii) {

@@ -1,5 +1,7 @@
 #include "sweep/dlm_sweep.h"
 
+#include "raytrace/material_lookup.h"
+
 #include <engine/directional_radiance.h>
 #include <engine/scene.h>
 #include <gi/error_metrics.h>
@@ -59,7 +61,12 @@ engine::Result<GlossyTexels> glossy_texels(const SweepScene& scene, double densi
     const std::uint32_t inst = g.s.static_instance[static_cast<std::size_t>(tex.mesh[t])];
     const ShadingTriangle& tri =
         g.s.index.triangles[g.s.index.instance_first[inst] + static_cast<std::uint32_t>(tex.triangle[t])];
-    const engine::GltfBrdf& brdf = g.s.scene.materials[tri.material].brdf;
+    // Textured: the material's mean over the texel's footprint (material_lookup.h).
+    const engine::GltfBrdf brdf = [&] {
+      if (!g.s.scene.materials[tri.material].textured()) return g.s.scene.materials[tri.material].brdf;
+      const TexelFootprint f = texel_footprint(*layout, tex.mesh[t], tex.triangle[t], t);
+      return footprint_brdf(g.s.scene, tri, f.centre, f.axis_u, f.axis_v);
+    }();
     if (!(static_cast<double>(std::sqrt(brdf.alpha)) < roughness)) continue;
     if (!(glm::dot(tex.normal[t], g.eye - tex.position[t]) > 0.0f)) continue;
     g.glossy[t] = 1;

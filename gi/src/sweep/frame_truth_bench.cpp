@@ -257,6 +257,7 @@ engine::SceneAsset without_textures(engine::SceneAsset asset) {
     m.metallic_roughness_texture = {};
     m.emissive_texture = {};
     m.normal_texture = {};
+    m.alpha_mode = engine::AlphaMode::Opaque;  // as gi::without_textures(BakeInput)
   }
   return asset;
 }

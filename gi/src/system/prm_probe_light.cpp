@@ -3,11 +3,14 @@
 #include <engine/finite.h>
 #include <engine/gltf_brdf.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <string>
 #include <unordered_map>
 
 #include "prm/prm.h"
+#include "raytrace/material_lookup.h"
 #include "raytrace/ray.h"
 #include "raytrace/ray_caster.h"
 #include "system/prm_lighting.h"
@@ -34,7 +37,12 @@ std::vector<glm::vec3> prm_entry_albedo(const StaticBakeScene& statics, std::spa
       ++misses;
       continue;
     }
-    const std::uint32_t material = statics.index.triangles[statics.triangle_of(hit)].material;
+    const ShadingTriangle& tri = statics.index.triangles[statics.triangle_of(hit)];
+    const std::uint32_t material = tri.material;
+    if (statics.scene.materials[material].textured()) {  // the texture around the entry point
+      out[i] = albedo_at(statics.scene, tri, hit.barycentric, std::sqrt(std::max(e.area_m2, 0.0f)));
+      continue;
+    }
     auto it = of_material.find(material);
     if (it == of_material.end())
       it = of_material.emplace(material, engine::gltf_hemispherical_albedo(statics.scene.materials[material].brdf).sum())

@@ -1,5 +1,7 @@
 #include "transport/point_emitters.h"
 
+#include "raytrace/material_lookup.h"
+
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -105,7 +107,9 @@ std::vector<PointEmitter> point_emitters(const ReferenceScene& scene, const Refe
         p.kind = PointEmitter::Kind::Lambertian;
         p.position = tri.p0 + su * (1.0f - v) * tri.e1 + su * v * tri.e2;
         p.direction = tri.face_normal;
-        p.radiant = kPi * m.emission * tri.area_m2 / strata;
+        // The emissive texture at the point, read at the level of its stratum's size.
+        p.radiant = kPi * emission_at(scene, tri, glm::vec2(su * (1.0f - v), su * v), std::sqrt(tri.area_m2 / strata)) *
+                    tri.area_m2 / strata;
         p.area_m2 = tri.area_m2 / strata;
         p.two_sided = m.double_sided;
         p.drawn_live = tri.emitter >= 0 && index.emitters.stands_for_light[static_cast<std::size_t>(tri.emitter)] != 0;

@@ -54,7 +54,52 @@ engine::Result<StaticBakeScene> prepare_static_scene(const BakeInput& input, con
   auto texels = sample_atlas_texels(input, layout, placement, b.caster.get());
   if (!texels) return texels.error();
   b.texels = std::move(texels).value();
+  drop_cut_out_texels(b, layout);
   return b;
+}
+
+TexelFootprint texel_footprint(const AtlasLayout& layout, int mesh, int triangle, std::size_t texel) {
+  TexelFootprint f;
+  const AtlasMeshUv& mu = layout.meshes[static_cast<std::size_t>(mesh)];
+  const std::uint32_t* idx = &mu.indices[3u * static_cast<std::size_t>(triangle)];
+  const glm::vec2 a0 = mu.uv1[idx[0]], a1 = mu.uv1[idx[1]], a2 = mu.uv1[idx[2]];
+  const glm::mat2 m(a1 - a0, a2 - a0);  // barycentrics (u, v) -> atlas UV offset
+  const float det = glm::determinant(m);
+  const auto w = static_cast<float>(layout.width), h = static_cast<float>(layout.height);
+  const glm::vec2 centre((static_cast<float>(texel % static_cast<std::size_t>(layout.width)) + 0.5f) / w,
+                         (static_cast<float>(texel / static_cast<std::size_t>(layout.width)) + 0.5f) / h);
+  if (!(std::fabs(det) > 1e-20f) || !std::isfinite(det)) {
+    f.centre = glm::vec2(1.0f / 3.0f);
+    return f;
+  }
+  const glm::mat2 inv = glm::inverse(m);
+  f.centre = inv * (centre - a0);
+  f.axis_u = inv * glm::vec2(1.0f / w, 0.0f);
+  f.axis_v = inv * glm::vec2(0.0f, 1.0f / h);
+  return f;
+}
+
+void drop_cut_out_texels(StaticBakeScene& b, const AtlasLayout& layout) {
+  AtlasTexels& tx = b.texels;
+  for (std::size_t i = 0; i < tx.valid.size(); ++i) {
+    if (!tx.valid[i] || tx.mesh[i] < 0 || tx.triangle[i] < 0) continue;
+    const RtInstance& inst = b.scene.geometry.instances[b.static_instance[static_cast<std::size_t>(tx.mesh[i])]];
+    const RtGeometry& geo = b.scene.geometry.geometries[inst.geometry];
+    if (!geo.cutout) continue;
+    const auto tri = static_cast<std::uint32_t>(tx.triangle[i]);
+    if (tri >= geo.cutout->triangle_mask.size() || geo.cutout->triangle_mask[tri] < 0) continue;
+    // 4 x 4 points over the texel's footprint on its triangle: any one kept keeps the texel.
+    const TexelFootprint f = texel_footprint(layout, tx.mesh[i], tx.triangle[i], i);
+    bool kept = false;
+    for (int k = 0; k < 16 && !kept; ++k) {
+      glm::vec2 q = f.centre + ((static_cast<float>(k % 4) + 0.5f) / 4.0f - 0.5f) * f.axis_u +
+                    ((static_cast<float>(k / 4) + 0.5f) / 4.0f - 0.5f) * f.axis_v;
+      q = glm::max(q, glm::vec2(0.0f));
+      if (q.x + q.y > 1.0f) q /= q.x + q.y;
+      kept = !geo.cutout->cut(geo.indices, tri, q);
+    }
+    if (!kept) tx.valid[i] = 0;
+  }
 }
 
 }  // namespace gi

@@ -47,6 +47,20 @@ engine::Result<StaticBakeScene> prepare_static_scene(const BakeInput& input, con
                                                      BakeLights lights,
                                                      TexelPlacement placement = TexelPlacement::Raster);
 
+/// A light-atlas texel's footprint on its triangle in barycentrics (u, v): its centre and
+/// the offsets of one texel step along the atlas's x and y (the texel covers centre +-
+/// axis_u / 2 +- axis_v / 2). Degenerate atlas triangles give the centroid and zero axes.
+struct TexelFootprint {
+  glm::vec2 centre{0.0f};
+  glm::vec2 axis_u{0.0f};
+  glm::vec2 axis_v{0.0f};
+};
+TexelFootprint texel_footprint(const AtlasLayout& layout, int mesh, int triangle, std::size_t texel);
+
+/// Marks the texels wholly cut out (alpha MASK / BLEND, none of 4 x 4 points over the
+/// texel's footprint kept) as not valid: nothing there to light. prepare_static_scene runs it.
+void drop_cut_out_texels(StaticBakeScene& scene, const AtlasLayout& layout);
+
 /// A ray caster over the static mesh instances of `input` (what a runtime relighting of the
 /// static world shadows with). Errors: no static instance, invalid data.
 engine::Result<std::unique_ptr<RayCaster>> make_static_caster(const BakeInput& input);

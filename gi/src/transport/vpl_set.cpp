@@ -1,5 +1,7 @@
 #include "transport/vpl_set.h"
 
+#include "raytrace/material_lookup.h"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -73,6 +75,8 @@ struct Sample {
   glm::vec3 normal;
   glm::vec2 plane;  // chart coordinates, metres
   std::uint32_t material;
+  std::uint32_t triangle;  // index.triangles entry it lies on
+  glm::vec2 bary;          // its barycentrics there (the material lookup's point)
 };
 
 // Jittered grid of spacing h over the chart's rectangle: one candidate per cell, kept when it
@@ -92,7 +96,8 @@ std::vector<Sample> jittered_points(const Chart& chart, const ChartPlane& plane,
       glm::vec2 uv;
       if (!plane.locate(q, k, uv)) continue;
       const ShadingTriangle& tri = index.triangles[first_triangle + chart.triangles[k]];
-      out.push_back({tri.p0 + uv.x * tri.e1 + uv.y * tri.e2, tri.face_normal, q, tri.material});
+      out.push_back({tri.p0 + uv.x * tri.e1 + uv.y * tri.e2, tri.face_normal, q, tri.material,
+                     first_triangle + chart.triangles[k], uv});
     }
   }
   return out;
@@ -186,7 +191,13 @@ engine::Result<VplSet> distribute_vpls(const ReferenceScene& scene, const Refere
   const double h = std::sqrt(total_area / settings.vpl_count);                   // VPL spacing
   const double hs = h / std::sqrt(static_cast<double>(settings.samples_per_vpl));  // sample spacing
   std::unordered_map<std::uint32_t, glm::vec3> albedo_cache;
-  const auto albedo = [&](std::uint32_t m) {
+  // A sample's albedo: its material's, or with textures the material lookup's at its point
+  // for a footprint of the sample spacing (the samples of a patch together average the
+  // texture over the patch).
+  const auto albedo = [&](const Sample& sample) {
+    const std::uint32_t m = sample.material;
+    if (scene.materials[m].textured())
+      return albedo_at(scene, index.triangles[sample.triangle], sample.bary, static_cast<float>(hs));
     auto it = albedo_cache.find(m);
     if (it == albedo_cache.end()) it = albedo_cache.emplace(m, engine::gltf_hemispherical_albedo(scene.materials[m].brdf).sum()).first;
     return it->second;
@@ -209,7 +220,8 @@ engine::Result<VplSet> distribute_vpls(const ReferenceScene& scene, const Refere
         // area hs^2, so the expected area is kept (the chart's texels still receive light).
         if (static_cast<double>(rng.next_float()) >= chart.area_m2 / (hs * hs)) continue;
         const ShadingTriangle& tri = index.triangles[sm.first_triangle + chart.triangles.front()];
-        samples.push_back({tri.p0 + (tri.e1 + tri.e2) / 3.0f, tri.face_normal, {}, tri.material});
+        samples.push_back({tri.p0 + (tri.e1 + tri.e2) / 3.0f, tri.face_normal, {}, tri.material,
+                           sm.first_triangle + chart.triangles.front(), glm::vec2(1.0f / 3.0f)});
         sample_area = hs * hs;
       }
 
@@ -231,7 +243,7 @@ engine::Result<VplSet> distribute_vpls(const ReferenceScene& scene, const Refere
         for (std::uint32_t s : patch) {
           centroid += glm::dvec3(samples[s].position);
           normal += glm::dvec3(samples[s].normal);
-          rho += glm::dvec3(albedo(samples[s].material));
+          rho += glm::dvec3(albedo(samples[s]));
         }
         centroid /= static_cast<double>(patch.size());
         std::uint32_t nearest = patch.front();
