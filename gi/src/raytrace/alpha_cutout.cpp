@@ -33,15 +33,16 @@ float RtAlphaCutout::alpha(const std::vector<std::uint32_t>& indices, std::uint3
   const std::vector<glm::vec2>& uv = m.texcoord == 1 ? uv1 : uv0;
   const std::uint32_t* v = &indices[3u * triangle];
   if (v[0] >= uv.size() || v[1] >= uv.size() || v[2] >= uv.size()) return m.factor;
-  const glm::vec2 p = engine::transformed_uv(m.transform, (1.0f - b.x - b.y) * uv[v[0]] + b.x * uv[v[1]] + b.y * uv[v[2]]);
+  const glm::vec2 p =
+      engine::transformed_uv(m.transform, (1.0f - b.x - b.y) * uv[v[0]] + b.x * uv[v[1]] + b.y * uv[v[2]]);
   if (!m.sampler.mag_linear) {  // NEAREST: the texel the point lies in
     const float nx = std::floor(p.x * static_cast<float>(m.width)), ny = std::floor(p.y * static_cast<float>(m.height));
     if (!std::isfinite(nx) || !std::isfinite(ny)) return m.factor;
     const int x = wrap(static_cast<int>(std::clamp(nx, -1.0e9f, 1.0e9f)), m.width, m.sampler.wrap_s);
     const int y = wrap(static_cast<int>(std::clamp(ny, -1.0e9f, 1.0e9f)), m.height, m.sampler.wrap_t);
     return m.factor *
-           static_cast<float>(m.alpha[static_cast<std::size_t>(y) * static_cast<std::size_t>(m.width) +
-                                      static_cast<std::size_t>(x)]) /
+           static_cast<float>(
+               m.alpha[static_cast<std::size_t>(y) * static_cast<std::size_t>(m.width) + static_cast<std::size_t>(x)]) /
            255.0f;
   }
   const float fx = p.x * static_cast<float>(m.width) - 0.5f;
@@ -54,8 +55,8 @@ float RtAlphaCutout::alpha(const std::vector<std::uint32_t>& indices, std::uint3
   const auto at = [&](int x, int y) {
     x = wrap(x, m.width, m.sampler.wrap_s);
     y = wrap(y, m.height, m.sampler.wrap_t);
-    return static_cast<float>(m.alpha[static_cast<std::size_t>(y) * static_cast<std::size_t>(m.width) +
-                                      static_cast<std::size_t>(x)]) /
+    return static_cast<float>(
+               m.alpha[static_cast<std::size_t>(y) * static_cast<std::size_t>(m.width) + static_cast<std::size_t>(x)]) /
            255.0f;
   };
   const float a = (1.0f - ay) * ((1.0f - ax) * at(x0, y0) + ax * at(x0 + 1, y0)) +

@@ -40,8 +40,9 @@ engine::GltfBrdf material_brdf_at(const ReferenceScene& scene, const ShadingTria
                                   float footprint_m) {
   const ReferenceMaterial& m = scene.materials[tri.material];
   if (!m.base_color_texture.present() && !m.metallic_roughness_texture.present()) return m.brdf;
-  const glm::vec3 base =
-      m.base_color_texture.present() ? glm::vec3(read(scene, tri, m.base_color_texture, bary, footprint_m)) : glm::vec3(1.0f);
+  const glm::vec3 base = m.base_color_texture.present()
+                             ? glm::vec3(read(scene, tri, m.base_color_texture, bary, footprint_m))
+                             : glm::vec3(1.0f);
   glm::vec2 mr(1.0f);
   if (m.metallic_roughness_texture.present()) {
     const glm::vec4 t = read(scene, tri, m.metallic_roughness_texture, bary, footprint_m);
@@ -106,8 +107,8 @@ engine::GltfBrdf footprint_brdf(const ReferenceScene& scene, const ShadingTriang
   });
 }
 
-glm::vec3 footprint_albedo(const ReferenceScene& scene, const ShadingTriangle& tri, glm::vec2 centre,
-                           glm::vec2 axis_u, glm::vec2 axis_v) {
+glm::vec3 footprint_albedo(const ReferenceScene& scene, const ShadingTriangle& tri, glm::vec2 centre, glm::vec2 axis_u,
+                           glm::vec2 axis_v) {
   return engine::gltf_hemispherical_albedo(footprint_brdf(scene, tri, centre, axis_u, axis_v)).sum();
 }
 

@@ -13,9 +13,9 @@
 //   engine::GltfBrdf b = gi::material_brdf_at(scene, tri, bary, footprint_m);
 //   glm::vec3 rho = gi::footprint_albedo(scene, tri, centre, axis_u, axis_v);
 
-#include <glm/glm.hpp>
-
 #include <engine/gltf_brdf.h>
+
+#include <glm/glm.hpp>
 
 #include "raytrace/reference_scene.h"
 
@@ -36,8 +36,8 @@ engine::GltfBrdf footprint_brdf(const ReferenceScene& scene, const ShadingTriang
 
 /// Hemispherical albedo (both lobes, engine::gltf_hemispherical_albedo) of footprint_brdf:
 /// what a receiving element folds in as a diffuse reflector.
-glm::vec3 footprint_albedo(const ReferenceScene& scene, const ShadingTriangle& tri, glm::vec2 centre,
-                           glm::vec2 axis_u, glm::vec2 axis_v);
+glm::vec3 footprint_albedo(const ReferenceScene& scene, const ShadingTriangle& tri, glm::vec2 centre, glm::vec2 axis_u,
+                           glm::vec2 axis_v);
 
 /// footprint_albedo over the whole triangle.
 glm::vec3 triangle_albedo(const ReferenceScene& scene, const ShadingTriangle& tri);

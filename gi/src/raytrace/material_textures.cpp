@@ -60,8 +60,8 @@ glm::vec4 bilinear(const TextureMips::Level& l, const engine::TextureSampler& s,
   return (1.0f - ay) * ((1.0f - ax) * at(xa, ya) + ax * at(xb, ya)) + ay * ((1.0f - ax) * at(xa, yb) + ax * at(xb, yb));
 }
 
-// Level k+1 from level k: each texel the weighted mean of the texels of level k its box
-// covers (2 per axis, 3 with weights 1/2 1 1/2... normalized, on an odd axis).
+// Level k+1 from level k: each texel the overlap-weighted mean of the level-k texels its box
+// covers (build_texture_mips).
 TextureMips::Level half(const TextureMips::Level& src) {
   TextureMips::Level dst;
   dst.width = std::max(1, src.width / 2);
@@ -111,9 +111,10 @@ TextureMips::Level half(const TextureMips::Level& src) {
 float srgb_to_linear(std::uint8_t v) { return srgb_table()[v]; }
 
 TextureMips build_texture_mips(const BakeImage& image, bool srgb) {
-  GI_EXPECTS(image.width >= 1 && image.height >= 1 &&
-                 image.rgba8.size() == static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height) * 4u,
-             "a valid RGBA8 image (validate_bake_input checks it)");
+  GI_EXPECTS(
+      image.width >= 1 && image.height >= 1 &&
+          image.rgba8.size() == static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height) * 4u,
+      "a valid RGBA8 image (validate_bake_input checks it)");
   TextureMips mips;
   TextureMips::Level base;
   base.width = image.width;

@@ -7,13 +7,12 @@
 //   gi::TextureMips mips = gi::build_texture_mips(image, /*srgb=*/true);
 //   glm::vec4 rgba = gi::sample_texture(mips, sampler, uv, gi::mip_level(mips, uv_footprint));
 
-#include <cstdint>
-#include <vector>
-
-#include <glm/glm.hpp>
-
 #include <engine/scene_asset.h>
 #include <gi/bake_input.h>
+
+#include <cstdint>
+#include <glm/glm.hpp>
+#include <vector>
 
 namespace gi {
 
@@ -31,8 +30,9 @@ struct TextureMips {
 float srgb_to_linear(std::uint8_t v);
 
 /// Decodes `image` (RGB through srgb_to_linear when `srgb`; alpha always linear) and
-/// box-filters it down to 1 x 1 (each texel of level k+1 the mean of the 2 x 2 texels of
-/// level k it covers; an odd edge texel is shared by its neighbours' boxes with half weight).
+/// box-filters it down to 1 x 1: each texel of level k+1 is the mean of the texels of level
+/// k under its box (2 x 2 on even sizes; on an odd axis the box spans n / m source texels,
+/// each weighted by its overlap), so every level keeps the image's mean.
 /// Precondition: a valid image (width, height >= 1, width x height x 4 bytes).
 TextureMips build_texture_mips(const BakeImage& image, bool srgb);
 

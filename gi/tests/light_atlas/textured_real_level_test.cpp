@@ -5,11 +5,10 @@
 // and the colour of the light under the arcades, where it arrives after bouncing off the
 // textured stone (the sky alone lights the level: everything the atlas holds is the truth's
 // total, nothing is drawn live).
-#include <gtest/gtest.h>
-
 #include <engine/gltf.h>
 #include <gi/bake_input.h>
 #include <gi/reference.h>
+#include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
@@ -54,7 +53,8 @@ TEST(TexturedRealLevel, SponzaAtlasMatchesTheTexturedPathTracerOverallAndInColou
   ASSERT_TRUE(bake) << bake.error().to_string();
   // 32 paths per texel: the truth's noise per texel is large, its means over thousands of
   // texels are not (below 1%).
-  auto truth = gi::reference_atlas(input, s.texels_per_metre, {.samples_per_pixel = 32, .max_bounces = -1, .seed = 7, .threads = 2});
+  auto truth = gi::reference_atlas(input, s.texels_per_metre,
+                                   {.samples_per_pixel = 32, .max_bounces = -1, .seed = 7, .threads = 2});
   ASSERT_TRUE(truth) << truth.error().to_string();
   ASSERT_EQ(truth->width, bake->width);
   ASSERT_EQ(truth->height, bake->height);
@@ -96,15 +96,18 @@ TEST(TexturedRealLevel, SponzaAtlasMatchesTheTexturedPathTracerOverallAndInColou
   const double bounce_error = lum(baked_arcade - sky_arcade) / lum(truth_bounce_arcade) - 1.0;
   const double plain_bounce_error = lum(plain_arcade - sky_arcade) / lum(truth_bounce_arcade) - 1.0;
   const glm::dvec3 pb = chromaticity(plain_arcade - sky_arcade);
-  std::printf("Sponza textured, sky only, preview atlas (%dx%d, %zu texels, %.1f s) vs path tracer (32 spp):\n"
-              "  all texels bias %+.1f%%; arcades (%zu texels) bias %+.1f%%, chromaticity r %.4f/%.4f b %.4f/%.4f\n",
-              bake->width, bake->height, n_all, bake->stats.total_seconds, 100.0 * bias, n_arcade, 100.0 * arcade_bias,
-              cb.x, ct.x, cb.z, ct.z);
-  std::printf("  arcades' bounced light chromaticity r %.4f/%.4f b %.4f/%.4f (the sky's r %.4f b %.4f; bounce share %.0f%%)\n",
-              bb.x, bt.x, bb.z, bt.z, sky.x, sky.z, 100.0 * lum(truth_bounce_arcade) / lum(truth_arcade));
-  std::printf("  arcades' bounced light against the truth's: textured bake %+.1f%%, untextured bake %+.1f%% "
-              "(chromaticity r %.4f b %.4f)\n",
-              100.0 * bounce_error, 100.0 * plain_bounce_error, pb.x, pb.z);
+  std::printf(
+      "Sponza textured, sky only, preview atlas (%dx%d, %zu texels, %.1f s) vs path tracer (32 spp):\n"
+      "  all texels bias %+.1f%%; arcades (%zu texels) bias %+.1f%%, chromaticity r %.4f/%.4f b %.4f/%.4f\n",
+      bake->width, bake->height, n_all, bake->stats.total_seconds, 100.0 * bias, n_arcade, 100.0 * arcade_bias, cb.x,
+      ct.x, cb.z, ct.z);
+  std::printf(
+      "  arcades' bounced light chromaticity r %.4f/%.4f b %.4f/%.4f (the sky's r %.4f b %.4f; bounce share %.0f%%)\n",
+      bb.x, bt.x, bb.z, bt.z, sky.x, sky.z, 100.0 * lum(truth_bounce_arcade) / lum(truth_arcade));
+  std::printf(
+      "  arcades' bounced light against the truth's: textured bake %+.1f%%, untextured bake %+.1f%% "
+      "(chromaticity r %.4f b %.4f)\n",
+      100.0 * bounce_error, 100.0 * plain_bounce_error, pb.x, pb.z);
   // The preview preset's error budget on this level (docs/real_level.md: the untextured
   // level's frame within 5%); textures change the albedo, not how the bakers move light.
   EXPECT_LE(std::fabs(bias), 0.10) << "atlas mean against the truth";

@@ -2,13 +2,12 @@
 // through the one material lookup (material_lookup.h) and alpha MASK cuts holes in what
 // every ray caster hits. Against closed forms: a textured plate under a point light, a
 // furnace of textured walls, the shadow of a masked card.
+#include <gi/bake_input.h>
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <numbers>
 #include <vector>
-
-#include <gtest/gtest.h>
-
-#include <gi/bake_input.h>
 
 #include "core/random.h"
 #include "raytrace/brute_force_ray_caster.h"
@@ -77,7 +76,8 @@ TEST(TextureMips, BoxFilterAveragesInLinearSpace) {
   EXPECT_NEAR(mips.levels.back().texels[0].x, 0.5f, 1e-6f);
   EXPECT_NEAR(gi::srgb_to_linear(188), 0.5029f, 1e-3f);  // IEC 61966-2-1
   // An odd size keeps the mean too (a 3 x 3 -> 1 x 1 box).
-  const gi::BakeImage odd = image(3, 3, [](int x, int y) { return glm::u8vec4(x == 1 && y == 1 ? 255 : 0, 0, 0, 255); });
+  const gi::BakeImage odd =
+      image(3, 3, [](int x, int y) { return glm::u8vec4(x == 1 && y == 1 ? 255 : 0, 0, 0, 255); });
   EXPECT_NEAR(gi::build_texture_mips(odd, false).levels.back().texels[0].x, 1.0f / 9.0f, 1e-6f);
 }
 
@@ -86,7 +86,8 @@ TEST(TextureMips, BoxFilterAveragesInLinearSpace) {
 // (the plate cannot see itself; a delta light needs one shadow ray).
 TEST(TexturedPlate, RadianceIsTextureTimesAnalyticIrradiance) {
   gi::BakeInput in;
-  in.images.push_back(image(4, 4, [](int x, int y) { return glm::u8vec4(byte(x, y, 0), byte(x, y, 1), byte(x, y, 2), 255); }));
+  in.images.push_back(
+      image(4, 4, [](int x, int y) { return glm::u8vec4(byte(x, y, 0), byte(x, y, 1), byte(x, y, 2), 255); }));
   in.materials.push_back(lambertian_textured(0));
   in.meshes.push_back({"plate", {plate(0.0f, 2.0f, 0)}});
   in.instances.push_back({.name = "plate", .mesh = 0});
@@ -213,7 +214,8 @@ TEST(AlphaMask, CardCastsACutOutShadowOfItsOpaqueArea) {
         ASSERT_EQ(brute.occluded(rays[r]) ? 1 : 0, single[r]) << "ray " << r;
       }
     }
-    EXPECT_NEAR(static_cast<float>(shadowed) * cell * cell, expected, 0.02f * expected) << (nearest ? "nearest" : "linear");
+    EXPECT_NEAR(static_cast<float>(shadowed) * cell * cell, expected, 0.02f * expected)
+        << (nearest ? "nearest" : "linear");
 
     // The path tracer sees the same holes: direct irradiance 0 in the shadow, I h / d^3 elsewhere.
     const gi::PathTracer pt(scene, *index, **embree, {.max_bounces = 0});
