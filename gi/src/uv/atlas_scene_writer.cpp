@@ -68,6 +68,19 @@ engine::Result<engine::Mesh> mesh_with_uv1(const engine::SceneAsset& scene, cons
     copy_attribute(src.positions, prim.positions, sources[p]);
     copy_attribute(src.normals, prim.normals, sources[p]);
     copy_attribute(src.uv0, prim.uv0, sources[p]);
+    copy_attribute(src.tangents, prim.tangents, sources[p]);
+    // The atlas takes TEXCOORD_1: a material that reads its textures there would read the
+    // atlas's parameterization instead of the artist's (docs/scene-format.md).
+    if (src.material >= 0 && static_cast<std::size_t>(src.material) < scene.materials.size()) {
+      const engine::Material& m = scene.materials[static_cast<std::size_t>(src.material)];
+      for (const engine::TextureRef* t :
+           {&m.base_color_texture, &m.metallic_roughness_texture, &m.normal_texture, &m.emissive_texture})
+        if (t->present() && t->texcoord == 1)
+          return engine::Error{scene.source, "mesh '" + mesh.name + "' primitive " + std::to_string(p),
+                               "material '" + m.name +
+                                   "' reads a texture from TEXCOORD_1, which the light atlas replaces on static "
+                                   "meshes; move the texture to TEXCOORD_0 or make the node dynamic"};
+    }
     prim.uv1 = std::move(uv1[p]);
     for (std::uint32_t& i : prim.indices) {
       const std::uint32_t o = uv.indices[k++];

@@ -168,3 +168,37 @@ TEST(AtlasSceneWriter, SplitVerticesStayInTheirPrimitive) {
   for (std::size_t k = 0; k < c.indices.size(); ++k)
     EXPECT_EQ(c.positions[c.indices[k]], cube.positions[cube.indices[k]]);
 }
+
+// The atlas's TEXCOORD_1 replaces the file's on static meshes: tangents follow the split
+// vertices, and a material reading a texture from TEXCOORD_1 is refused by name.
+TEST(AtlasSceneWriter, TangentsFollowTheSplitVerticesAndTexcoord1TexturesAreRefused) {
+  engine::SceneAsset s;
+  engine::Primitive p = quad(glm::vec3(0.0f));
+  p.tangents.assign(4, glm::vec4(1, 0, 0, 1));
+  p.material = 0;
+  engine::Material m;
+  m.name = "decal";
+  m.base_color_texture.image = 0;
+  s.materials = {m};
+  s.images.resize(1);
+  s.meshes = {engine::Mesh{"wall", {p}}};
+  engine::Node n{"wall"};
+  n.mesh = 0;
+  s.nodes = {n};
+  const auto inputs = gi::atlas_inputs_from(gi::bake_input_from(s));
+  auto layout = gi::build_atlas_layout(inputs, {.texels_per_metre = 16.0f});
+  ASSERT_TRUE(layout.ok()) << layout.error().to_string();
+  auto out = gi::with_atlas_uv1(s, layout.value());
+  ASSERT_TRUE(out.ok()) << out.error().to_string();
+  const engine::Primitive& written = out->meshes[0].primitives[0];
+  EXPECT_EQ(written.tangents.size(), written.positions.size());
+
+  s.materials[0].base_color_texture.texcoord = 1;
+  s.meshes[0].primitives[0].uv1 = s.meshes[0].primitives[0].uv0;
+  auto refused = gi::with_atlas_uv1(s, layout.value());
+  ASSERT_FALSE(refused.ok());
+  const std::string message = refused.error().to_string();
+  EXPECT_NE(message.find("'wall'"), std::string::npos) << message;
+  EXPECT_NE(message.find("'decal'"), std::string::npos) << message;
+  EXPECT_NE(message.find("TEXCOORD_1"), std::string::npos) << message;
+}
