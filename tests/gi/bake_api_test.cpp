@@ -28,8 +28,12 @@ gi::BakeInput pipeline_input(const engine::SceneAsset& asset) {
   for (const engine::Mesh& m : asset.meshes) {
     gi::BakeMesh mesh{.name = m.name, .primitives = {}};
     for (const engine::Primitive& p : m.primitives)
-      mesh.primitives.push_back(
-          {.positions = p.positions, .normals = p.normals, .indices = p.indices, .material = p.material});
+      mesh.primitives.push_back({.positions = p.positions,
+                                 .normals = p.normals,
+                                 .indices = p.indices,
+                                 .uv0 = p.uv0,
+                                 .uv1 = p.uv1,
+                                 .material = p.material});
     in.meshes.push_back(std::move(mesh));
   }
   for (const engine::Material& m : asset.materials)
@@ -40,7 +44,18 @@ gi::BakeInput pipeline_input(const engine::SceneAsset& asset) {
                             .specular = m.specular_factor,
                             .specular_color = m.specular_color_factor,
                             .emission = m.emissive,
-                            .double_sided = m.double_sided});
+                            .double_sided = m.double_sided,
+                            .base_alpha = m.base_color.w,
+                            .base_color_texture = m.base_color_texture,
+                            .metallic_roughness_texture = m.metallic_roughness_texture,
+                            .emissive_texture = m.emissive_texture,
+                            .normal_texture = m.normal_texture,
+                            .normal_scale = m.normal_scale,
+                            .alpha_mode = m.alpha_mode,
+                            .alpha_cutoff = m.alpha_cutoff});
+  // The textures' decoded texels (the demo level's brick, wood, rug and grille).
+  for (const engine::Image& i : asset.images)
+    in.images.push_back({.name = i.name, .uri = i.uri, .width = i.width, .height = i.height, .rgba8 = i.rgba8});
   for (std::size_t i = 0; i < asset.nodes.size(); ++i) {
     const engine::Node& n = asset.nodes[i];
     const glm::mat4 world = gi::node_world_matrix(asset, static_cast<int>(i));

@@ -165,8 +165,8 @@ glm::mat4 node_world_matrix(const engine::SceneAsset& asset, int node);
 
 /// Checks what the bakers rely on: mesh and material indices in range, three indices per
 /// triangle within range, normals and UV sets empty or one per position, finite positions,
-/// normals, UVs, matrices and light values, factors in range; images of width x height x 4
-/// bytes; texture image indices in range and the UV set a texture reads present on every
+/// normals, UVs, matrices and light values, factors in range; every image a texture reads
+/// of width x height x 4 bytes (others may be empty: a loader need not decode them); texture image indices in range and the UV set a texture reads present on every
 /// primitive that uses the material. The error names the element ("mesh 3
 /// 'crate' primitive 0: index 77 out of range (12 vertices)").
 engine::Status validate_bake_input(const BakeInput& input);

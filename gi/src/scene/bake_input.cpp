@@ -295,7 +295,14 @@ engine::Status validate_bake_input(const BakeInput& input) {
         return input_error(where, std::string(what) + " texture: the transform is NaN or infinite");
     }
   }
+  // Only images a material's texture reads must hold texels: a loader need not decode the
+  // others (a glTF's images for extensions the engine does not read, e.g. transmission).
+  std::vector<bool> referenced(input.images.size(), false);
+  for (const BakeMaterial& m : input.materials)
+    for (const auto& [what, t] : material_textures(m))
+      if (t->present()) referenced[static_cast<std::size_t>(t->image)] = true;
   for (std::size_t ii = 0; ii < input.images.size(); ++ii) {
+    if (!referenced[ii]) continue;
     const BakeImage& img = input.images[ii];
     const std::string where = "image " + std::to_string(ii) + " '" + (img.uri.empty() ? img.name : img.uri) + "'";
     if (img.width <= 0 || img.height <= 0 || img.width > 65536 || img.height > 65536)
