@@ -1,30 +1,10 @@
 #include <algorithm>
 #include <cmath>
 
+#include "raytrace/material_textures.h"
 #include "raytrace/rt_scene_data.h"
 
 namespace gi {
-namespace {
-
-int wrap(int i, int n, engine::TextureWrap mode) {
-  switch (mode) {
-    case engine::TextureWrap::ClampToEdge:
-      return std::clamp(i, 0, n - 1);
-    case engine::TextureWrap::MirroredRepeat: {
-      const int period = 2 * n;
-      int m = i % period;
-      if (m < 0) m += period;
-      return m < n ? m : period - 1 - m;
-    }
-    case engine::TextureWrap::Repeat:
-    default: {
-      const int m = i % n;
-      return m < 0 ? m + n : m;
-    }
-  }
-}
-
-}  // namespace
 
 float RtAlphaCutout::alpha(const std::vector<std::uint32_t>& indices, std::uint32_t triangle, glm::vec2 b) const {
   if (triangle >= triangle_mask.size() || triangle_mask[triangle] < 0) return 1.0f;
@@ -38,8 +18,8 @@ float RtAlphaCutout::alpha(const std::vector<std::uint32_t>& indices, std::uint3
   if (!m.sampler.mag_linear) {  // NEAREST: the texel the point lies in
     const float nx = std::floor(p.x * static_cast<float>(m.width)), ny = std::floor(p.y * static_cast<float>(m.height));
     if (!std::isfinite(nx) || !std::isfinite(ny)) return m.factor;
-    const int x = wrap(static_cast<int>(std::clamp(nx, -1.0e9f, 1.0e9f)), m.width, m.sampler.wrap_s);
-    const int y = wrap(static_cast<int>(std::clamp(ny, -1.0e9f, 1.0e9f)), m.height, m.sampler.wrap_t);
+    const int x = wrap_texel(static_cast<int>(std::clamp(nx, -1.0e9f, 1.0e9f)), m.width, m.sampler.wrap_s);
+    const int y = wrap_texel(static_cast<int>(std::clamp(ny, -1.0e9f, 1.0e9f)), m.height, m.sampler.wrap_t);
     return m.factor *
            static_cast<float>(
                m.alpha[static_cast<std::size_t>(y) * static_cast<std::size_t>(m.width) + static_cast<std::size_t>(x)]) /
@@ -53,8 +33,8 @@ float RtAlphaCutout::alpha(const std::vector<std::uint32_t>& indices, std::uint3
   const int x0 = static_cast<int>(std::clamp(x0f, -1.0e9f, 1.0e9f));
   const int y0 = static_cast<int>(std::clamp(y0f, -1.0e9f, 1.0e9f));
   const auto at = [&](int x, int y) {
-    x = wrap(x, m.width, m.sampler.wrap_s);
-    y = wrap(y, m.height, m.sampler.wrap_t);
+    x = wrap_texel(x, m.width, m.sampler.wrap_s);
+    y = wrap_texel(y, m.height, m.sampler.wrap_t);
     return static_cast<float>(
                m.alpha[static_cast<std::size_t>(y) * static_cast<std::size_t>(m.width) + static_cast<std::size_t>(x)]) /
            255.0f;

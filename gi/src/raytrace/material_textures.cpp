@@ -23,25 +23,6 @@ const std::array<float, 256>& srgb_table() {
   return table;
 }
 
-// Texel coordinate i of an axis of n texels under a wrap mode.
-int wrap(int i, int n, engine::TextureWrap mode) {
-  switch (mode) {
-    case engine::TextureWrap::ClampToEdge:
-      return std::clamp(i, 0, n - 1);
-    case engine::TextureWrap::MirroredRepeat: {
-      const int period = 2 * n;
-      int m = i % period;
-      if (m < 0) m += period;
-      return m < n ? m : period - 1 - m;
-    }
-    case engine::TextureWrap::Repeat:
-    default: {
-      int m = i % n;
-      return m < 0 ? m + n : m;
-    }
-  }
-}
-
 // Bilinear lookup in one level (texel centres at half-integers, as GL samples).
 glm::vec4 bilinear(const TextureMips::Level& l, const engine::TextureSampler& s, glm::vec2 uv) {
   // Far-away UVs: keep the float arithmetic exact by wrapping the integer part first.
@@ -52,8 +33,8 @@ glm::vec4 bilinear(const TextureMips::Level& l, const engine::TextureSampler& s,
   const float ax = fx - x0f, ay = fy - y0f;
   const auto clamp_int = [](float f) { return static_cast<int>(std::clamp(f, -1.0e9f, 1.0e9f)); };
   const int x0 = clamp_int(x0f), y0 = clamp_int(y0f);
-  const int xa = wrap(x0, l.width, s.wrap_s), xb = wrap(x0 + 1, l.width, s.wrap_s);
-  const int ya = wrap(y0, l.height, s.wrap_t), yb = wrap(y0 + 1, l.height, s.wrap_t);
+  const int xa = wrap_texel(x0, l.width, s.wrap_s), xb = wrap_texel(x0 + 1, l.width, s.wrap_s);
+  const int ya = wrap_texel(y0, l.height, s.wrap_t), yb = wrap_texel(y0 + 1, l.height, s.wrap_t);
   const auto at = [&](int x, int y) {
     return l.texels[static_cast<std::size_t>(y) * static_cast<std::size_t>(l.width) + static_cast<std::size_t>(x)];
   };
@@ -107,6 +88,25 @@ TextureMips::Level half(const TextureMips::Level& src) {
 }
 
 }  // namespace
+
+int wrap_texel(int i, int n, engine::TextureWrap mode) {
+  switch (mode) {
+    case engine::TextureWrap::ClampToEdge:
+      return std::clamp(i, 0, n - 1);
+    case engine::TextureWrap::MirroredRepeat: {
+      const int period = 2 * n;
+      int m = i % period;
+      if (m < 0) m += period;
+      return m < n ? m : period - 1 - m;
+    }
+    case engine::TextureWrap::Repeat:
+    default: {
+      int m = i % n;
+      return m < 0 ? m + n : m;
+    }
+  }
+}
+
 
 float srgb_to_linear(std::uint8_t v) { return srgb_table()[v]; }
 

@@ -59,4 +59,7 @@ struct MaterialTexture {
 glm::vec4 sample_material_texture(const std::vector<TextureMips>& textures, const MaterialTexture& t, glm::vec2 uv,
                                   float uv_footprint);
 
+/// Texel coordinate i of an axis of n texels under a glTF wrap mode (also the alpha cut-outs').
+int wrap_texel(int i, int n, engine::TextureWrap mode);
+
 }  // namespace gi
