@@ -90,7 +90,8 @@ TEST(RendererAlpha, MaskCastsAShadowOnlyWhereAlphaIsAboveTheCutoff) {
   engine::GpuContext ctx = headless_context();
   ShadowScene s;
   const auto [left, right] = s.lit_fraction(s.render(engine::AlphaMode::Mask));
-  std::printf("MASK: lit fraction of the shadow's z < 0 half %.3f, z > 0 half %.3f\n", left, right);
+  std::printf("MASK: lit fraction of the shadow's z < 0 half %.3f, z > 0 half %.3f\n", static_cast<double>(left),
+              static_cast<double>(right));
   EXPECT_GT(left, 0.97f) << "the cut-out half lets the light through";
   EXPECT_LT(right, 0.03f) << "the opaque half casts its shadow";
 }
@@ -99,7 +100,8 @@ TEST(RendererAlpha, OpaqueIgnoresAlphaAndCastsTheWholeShadow) {
   engine::GpuContext ctx = headless_context();
   ShadowScene s;
   const auto [left, right] = s.lit_fraction(s.render(engine::AlphaMode::Opaque));
-  std::printf("OPAQUE: lit fraction of the shadow's z < 0 half %.3f, z > 0 half %.3f\n", left, right);
+  std::printf("OPAQUE: lit fraction of the shadow's z < 0 half %.3f, z > 0 half %.3f\n", static_cast<double>(left),
+              static_cast<double>(right));
   EXPECT_LT(left, 0.03f);
   EXPECT_LT(right, 0.03f);
 }
@@ -108,7 +110,8 @@ TEST(RendererAlpha, BlendCastsACutOutShadowAtOneHalf) {
   engine::GpuContext ctx = headless_context();
   ShadowScene s;
   const auto [left, right] = s.lit_fraction(s.render(engine::AlphaMode::Blend));
-  std::printf("BLEND: lit fraction of the shadow's z < 0 half %.3f, z > 0 half %.3f\n", left, right);
+  std::printf("BLEND: lit fraction of the shadow's z < 0 half %.3f, z > 0 half %.3f\n", static_cast<double>(left),
+              static_cast<double>(right));
   EXPECT_GT(left, 0.97f);
   EXPECT_LT(right, 0.03f);
 }
@@ -139,7 +142,8 @@ TEST(RendererAlpha, BlendAtOneHalfMixesWithWhatIsBehind) {
   const glm::ivec2 p = blend.cam.pixel_of(at);
   for (int c : {0, 1}) {
     const float expected = 0.5f * channel(quad, p, c) + 0.5f * channel(floor, p, c);
-    std::printf("BLEND 50%%: channel %d %.4f, 0.5 quad + 0.5 floor %.4f\n", c, channel(mixed, p, c), expected);
+    std::printf("BLEND 50%%: channel %d %.4f, 0.5 quad + 0.5 floor %.4f\n", c, static_cast<double>(channel(mixed, p, c)),
+                static_cast<double>(expected));
     EXPECT_NEAR(channel(mixed, p, c), expected, 0.02f * expected + 1e-4f) << "channel " << c;
   }
   EXPECT_GT(channel(floor, p, 1), 0.05f);  // the mix is not trivially one of the two
@@ -286,7 +290,8 @@ TEST(RendererNormalMap, TiltedNormalMapShadesWithTheTiltedNormal) {
                                reference_brdf_cos(0.5f, 0.0f, 1.0f, glm::vec3(0, 1, 0), v, l);
   ASSERT_GT(red(a, c, c), 0.0f);
   EXPECT_GT(expected_ratio, 1.3f);  // cos 0 / cos 45 for the diffuse part
-  std::printf("normal map: radiance ratio %.4f, reference %.4f\n", red(b, c, c) / red(a, c, c), expected_ratio);
+  std::printf("normal map: radiance ratio %.4f, reference %.4f\n", static_cast<double>(red(b, c, c) / red(a, c, c)),
+              static_cast<double>(expected_ratio));
   EXPECT_NEAR(red(b, c, c) / red(a, c, c), expected_ratio, 0.02f * expected_ratio);
 }
 

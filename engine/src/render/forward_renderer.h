@@ -47,8 +47,10 @@ enum TextureUnit : GLuint {
   kAreaVisibilityUnit = 13,  // area_shadow.frag.glsl: half-resolution visibility; forward: full-resolution
   kAreaPlaneUnit = 14,       // area_shadow.frag.glsl: half-resolution tangent planes
 };
-static_assert(kBaseColorUnit == render::kMaterialBaseColorUnit && kMetallicRoughnessUnit == render::kMaterialMetallicRoughnessUnit &&
-                  kEmissiveUnit == render::kMaterialEmissiveUnit && kNormalUnit == render::kMaterialNormalUnit,
+static_assert(int{kBaseColorUnit} == int{render::kMaterialBaseColorUnit} &&
+                  int{kMetallicRoughnessUnit} == int{render::kMaterialMetallicRoughnessUnit} &&
+                  int{kEmissiveUnit} == int{render::kMaterialEmissiveUnit} &&
+                  int{kNormalUnit} == int{render::kMaterialNormalUnit},
               "material texture units agree with gpu_scene.h");
 // The stencil's top bit: pixels whose area-light visibility the half-resolution pass could
 // not lend (area_shadow.frag.glsl); the light-reach masks use the 7 bits below it then.

@@ -157,7 +157,7 @@ engine::Result<BrfMesh> brf_mesh_from_input(const BakeInput& input, std::uint32_
           const glm::vec2 e1 = 0.5f * (corner_bary[(k + 1) % 3] - b), e2 = 0.5f * (corner_bary[(k + 2) % 3] - b);
           const float r = std::clamp(luminance(footprint_albedo(*looks, tri, centre, e1, e2)), 0.0f, 1.0f);
           const std::uint32_t v = p.indices[t + static_cast<std::size_t>(k)];
-          sum[v] += static_cast<double>(r) * tri.area_m2;
+          sum[v] += static_cast<double>(r) * static_cast<double>(tri.area_m2);
           weight[v] += static_cast<double>(tri.area_m2);
         }
       }

@@ -168,9 +168,9 @@ engine::Result<ReferenceSceneIndex> index_reference_scene(const ReferenceScene& 
       tri.material = mats[t];
       for (int set = 0; set < 2; ++set) {
         if (!uv_sets[set]) continue;
-        glm::vec2* c = set == 0 ? tri.uv0 : tri.uv1;
-        for (int k = 0; k < 3; ++k) c[k] = (*uv_sets[set])[vi[k]];
-        const glm::vec2 a = c[1] - c[0], b = c[2] - c[0];
+        glm::vec2* uv = set == 0 ? tri.uv0 : tri.uv1;
+        for (int k = 0; k < 3; ++k) uv[k] = (*uv_sets[set])[vi[k]];
+        const glm::vec2 a = uv[1] - uv[0], b = uv[2] - uv[0];
         const float uv_area = 0.5f * std::fabs(a.x * b.y - a.y * b.x);
         const float per_m = tri.area_m2 > 0.0f ? std::sqrt(uv_area / tri.area_m2) : 0.0f;
         tri.uv_per_m[set] = std::isfinite(per_m) ? per_m : 0.0f;
