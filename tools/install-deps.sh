@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs every build and test dependency of the project from Debian's packages.
 # Idempotent: packages already present are left alone; `apt-get update` runs once.
+# clang-format-14 checks the sources' layout (tools/check-format.sh, CI main leg).
 # clang, libclang-rt-14-dev (libFuzzer and clang's sanitizer runtimes, only recommended by
 # clang) and llvm (llvm-symbolizer for sanitizer stack traces) build the fuzz targets
 # (tools/fuzz.sh); the regular build stays GCC.
@@ -15,7 +16,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libeigen3-dev libzstd-dev libtinyexr-dev libcli11-dev libimgui-dev libtbb-dev libxxhash-dev
   xvfb xauth
-  clang libclang-rt-14-dev llvm
+  clang libclang-rt-14-dev llvm clang-format-14
   python3-matplotlib
   slurmctld slurmd slurm-client munge
 )

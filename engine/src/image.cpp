@@ -144,7 +144,8 @@ Result<ImageRgbaF> load_exr(const fs::path& path) {
   if (width < 1 || height < 1 || width > kMaxExrSide || height > kMaxExrSide || width * height > kMaxExrPixels)
     return fail("data window " + std::to_string(width) + " x " + std::to_string(height) + " outside 1.." +
                 std::to_string(kMaxExrSide) + " per side and " + std::to_string(kMaxExrPixels) + " pixels");
-  if (chunks < 0 || chunks > height) return fail("chunkCount " + std::to_string(chunks) + " for " + std::to_string(height) + " scanlines");
+  if (chunks < 0 || chunks > height)
+    return fail("chunkCount " + std::to_string(chunks) + " for " + std::to_string(height) + " scanlines");
 
   float* rgba = nullptr;
   int w = 0;

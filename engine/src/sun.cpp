@@ -3,9 +3,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <glm/gtc/quaternion.hpp>
 #include <glm/gtx/quaternion.hpp>
-#include <numbers>
 
 namespace engine {
 

@@ -20,10 +20,10 @@
 namespace game_demo {
 
 struct RunOptions {
-  std::string scene;            ///< As given (empty: the demo level).
+  std::string scene;  ///< As given (empty: the demo level).
   bool headless = false;
-  std::uint64_t frames = 0;     ///< 0: headless default 120 / replay length / windowed unlimited.
-  std::string out_dir;          ///< Headless frame folder (empty: no images written).
+  std::uint64_t frames = 0;  ///< 0: headless default 120 / replay length / windowed unlimited.
+  std::string out_dir;       ///< Headless frame folder (empty: no images written).
   int width = 960;
   int height = 540;
   /// Exposure (engine/exposure.h, docs/exposure.md): automatic unless --exposure (a fixed
@@ -32,9 +32,9 @@ struct RunOptions {
   float exposure = kDemoExposure;         ///< --exposure: linear scale before tonemapping.
   float ev100 = 15.0f;                    ///< --ev100: a camera's exposure value at ISO 100.
   float exposure_compensation_ev = 0.0f;  ///< --exposure-compensation: automatic exposure's bias, EV.
-  bool area_soft_shadows = true;   ///< --area-shadows soft|centre (engine::RenderSettings::area_soft_shadows).
-  bool light_reach_culling = true;  ///< --light-reach on|off (engine::RenderSettings::light_reach_culling).
-  bool flat_shading = false;        ///< --shading full|flat (engine::RenderSettings::flat_shading: a yardstick).
+  bool area_soft_shadows = true;          ///< --area-shadows soft|centre (engine::RenderSettings::area_soft_shadows).
+  bool light_reach_culling = true;        ///< --light-reach on|off (engine::RenderSettings::light_reach_culling).
+  bool flat_shading = false;              ///< --shading full|flat (engine::RenderSettings::flat_shading: a yardstick).
   /// --area-shadow-res full|half (engine::RenderSettings::area_shadow_res).
   engine::AreaShadowRes area_shadow_res = engine::AreaShadowRes::Half;
   bool size_given = false;
@@ -48,7 +48,7 @@ struct RunOptions {
   bool verbose = false;
   bool only_written = false;  ///< Headless: render only the frames written to --out.
   std::string gi_bundle;      ///< Bake bundle (scene.gibake/) whose light atlas lights the scene; empty: stand-in.
-  std::string sky;            ///< --sky: the sky replacing the scene's (engine::parse_sky_text; empty: the scene's own).
+  std::string sky;  ///< --sky: the sky replacing the scene's (engine::parse_sky_text; empty: the scene's own).
 };
 
 /// Everything a run needs after start-up checks: the simulation, and the session being

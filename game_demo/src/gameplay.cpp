@@ -110,8 +110,8 @@ void player_controller(engine::Registry& reg, const engine::FrameTime& time, Gam
   }
   // Walking: horizontal, one axis at a time so the player slides along walls.
   if (fwd == 0.0f && side == 0.0f) return;
-  const glm::vec3 step = glm::normalize(forward * fwd + right * side) *
-                         (pc.walk_speed_m_s * static_cast<float>(time.dt_s));
+  const glm::vec3 step =
+      glm::normalize(forward * fwd + right * side) * (pc.walk_speed_m_s * static_cast<float>(time.dt_s));
   glm::vec3 eye = reg.get<engine::Transform>(ctx.camera).position;
   const glm::vec3 start = eye;
   for (int axis : {0, 2}) {
@@ -168,14 +168,16 @@ void swing_lamp(engine::Registry& reg, const engine::FrameTime& time, const Game
   const double phase = 2.0 * 3.14159265358979 * time.time_s / double{ctx.tuning.lamp_period_s};
   const float angle = ctx.tuning.lamp_amplitude_rad * static_cast<float>(std::sin(phase));
   const glm::quat q = ctx.pivot_rest_rotation * glm::angleAxis(angle, glm::vec3(0, 0, 1));
-  if (q != reg.get<engine::Transform>(ctx.swinging_pivot).rotation) reg.write<engine::Transform>(ctx.swinging_pivot).rotation = q;
+  if (q != reg.get<engine::Transform>(ctx.swinging_pivot).rotation)
+    reg.write<engine::Transform>(ctx.swinging_pivot).rotation = q;
 }
 
 // A crate rests on something when a box a few centimetres below it meets a floor or
 // another crate it does not already overlap.
 bool supported(const engine::Registry& reg, engine::Entity crate, const Aabb& box, const GameplayContext& ctx) {
   const Aabb probe = box.shifted({0.0f, -ctx.tuning.support_probe_m, 0.0f});
-  return ctx.collision.blocks_vertical_move(box, probe) || crate_blocks(reg, crate, box, probe, ctx.tuning.collision_skin_m);
+  return ctx.collision.blocks_vertical_move(box, probe) ||
+         crate_blocks(reg, crate, box, probe, ctx.tuning.collision_skin_m);
 }
 
 void integrate_rigid_bodies(engine::Registry& reg, const engine::FrameTime& time, GameplayContext& ctx) {
@@ -354,7 +356,8 @@ void add_gameplay_systems(engine::SystemSchedule& schedule, GameplayContext& ctx
                [c](engine::Registry& r, const engine::FrameTime&) { push_crate(r, *c); });
   schedule.add(engine::Stage::Gameplay, "swinging_lamp",
                [c](engine::Registry& r, const engine::FrameTime& t) { swing_lamp(r, t, *c); });
-  schedule.add(engine::Stage::Gameplay, "door", [c](engine::Registry& r, const engine::FrameTime&) { toggle_door(r, *c); });
+  schedule.add(engine::Stage::Gameplay, "door",
+               [c](engine::Registry& r, const engine::FrameTime&) { toggle_door(r, *c); });
   schedule.add(engine::Stage::Physics, "rigid_bodies",
                [c](engine::Registry& r, const engine::FrameTime& t) { integrate_rigid_bodies(r, t, *c); });
   schedule.add(engine::Stage::Transform, "world_transforms",

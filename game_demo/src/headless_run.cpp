@@ -30,8 +30,11 @@ struct Summary {
     std::vector<double> v = values;
     std::sort(v.begin(), v.end());
     const double mean = std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
-    const auto pct = [&](double p) { return v[std::min(v.size() - 1, static_cast<std::size_t>(p * static_cast<double>(v.size())))]; };
-    std::printf("  %-22s mean %8.3f  median %8.3f  p95 %8.3f  max %8.3f ms\n", label, mean, pct(0.5), pct(0.95), v.back());
+    const auto pct = [&](double p) {
+      return v[std::min(v.size() - 1, static_cast<std::size_t>(p * static_cast<double>(v.size())))];
+    };
+    std::printf("  %-22s mean %8.3f  median %8.3f  p95 %8.3f  max %8.3f ms\n", label, mean, pct(0.5), pct(0.95),
+                v.back());
   }
 };
 
@@ -40,13 +43,16 @@ struct Summary {
 int run_headless(const RunOptions& o, RunState& state) {
   Simulation& sim = *state.sim;
   std::uint64_t frames = o.frames;
-  if (state.replay) frames = frames == 0 ? state.replay->frames.size() : std::min<std::uint64_t>(frames, state.replay->frames.size());
-  else if (frames == 0) frames = 120;
+  if (state.replay)
+    frames = frames == 0 ? state.replay->frames.size() : std::min<std::uint64_t>(frames, state.replay->frames.size());
+  else if (frames == 0)
+    frames = 120;
 
   std::optional<ScriptedPilot> pilot;
   if (!state.replay) pilot.emplace(sim, *script_from_name(o.script), frames);
   if (pilot && o.verbose)
-    for (const glm::vec3& p : pilot->waypoints()) std::printf("waypoint (%.2f, %.2f, %.2f)\n", double{p.x}, double{p.y}, double{p.z});
+    for (const glm::vec3& p : pilot->waypoints())
+      std::printf("waypoint (%.2f, %.2f, %.2f)\n", double{p.x}, double{p.y}, double{p.z});
 
   std::optional<engine::GpuContext> gpu;
   std::unique_ptr<gi::GISystem> indirect;  // destroyed before gpu
@@ -144,16 +150,18 @@ int run_headless(const RunOptions& o, RunState& state) {
   if (!pass_order.empty()) std::printf("render passes:\n");
   for (const auto& n : pass_order) passes[n].print(n.c_str());
   if (rendered_frames > 0)
-    std::printf("  shadow-map views drawn per frame: %.2f (the others kept: their light and casters did not move), "
-                "%.2f of them over their static casters' cached depth (only dynamic casters moved); %.2f changed "
-                "but left undrawn (the camera cannot see into them)\n",
-                static_cast<double>(shadow_views_drawn) / static_cast<double>(rendered_frames),
-                static_cast<double>(shadow_views_cached) / static_cast<double>(rendered_frames),
-                static_cast<double>(shadow_views_unseen) / static_cast<double>(rendered_frames));
+    std::printf(
+        "  shadow-map views drawn per frame: %.2f (the others kept: their light and casters did not move), "
+        "%.2f of them over their static casters' cached depth (only dynamic casters moved); %.2f changed "
+        "but left undrawn (the camera cannot see into them)\n",
+        static_cast<double>(shadow_views_drawn) / static_cast<double>(rendered_frames),
+        static_cast<double>(shadow_views_cached) / static_cast<double>(rendered_frames),
+        static_cast<double>(shadow_views_unseen) / static_cast<double>(rendered_frames));
   if (rendered_frames > 0)
-    std::printf("  light sets per frame: %.2f (pixels shaded with only the lights that can reach them; 1: every light "
-                "everywhere)\n",
-                static_cast<double>(light_groups) / static_cast<double>(rendered_frames));
+    std::printf(
+        "  light sets per frame: %.2f (pixels shaded with only the lights that can reach them; 1: every light "
+        "everywhere)\n",
+        static_cast<double>(light_groups) / static_cast<double>(rendered_frames));
   if (rendered_frames > 0) std::printf("  %s at the last frame\n", describe_exposure(o, *renderer).c_str());
   for (const std::string& line : gi_status_lines(indirect.get())) std::printf("%s\n", line.c_str());
   std::printf("final state checksum 0x%016llx after frame %llu\n", static_cast<unsigned long long>(sim.checksum()),

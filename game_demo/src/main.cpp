@@ -9,9 +9,9 @@
 #include <engine/sky.h>
 #include <gi/gi_system.h>
 
-#include <CLI/CLI.hpp>
 #include <cstdio>
 #include <iostream>
+#include <CLI/CLI.hpp>
 
 #include "demo_run.h"
 
@@ -155,8 +155,9 @@ int main(int argc, char** argv) {
                  "Automatic exposure: EV added after metering (+1: twice as bright)")
       ->excludes(exposure)
       ->excludes(ev100);
-  app.add_option("--area-shadows", area_shadows,
-                 "soft: area lights soft-shadowed over their rectangle (default); centre: from their centre only (cheaper)")
+  app.add_option(
+         "--area-shadows", area_shadows,
+         "soft: area lights soft-shadowed over their rectangle (default); centre: from their centre only (cheaper)")
       ->check(CLI::IsMember({"soft", "centre"}));
   app.add_option("--light-reach", light_reach,
                  "on: static lights shade only where static geometry lets them reach (default); off: every light "
@@ -166,9 +167,10 @@ int main(int argc, char** argv) {
                  "half: area lights' soft shadows at half resolution, upsampled on each pixel's own surface "
                  "(default); full: per pixel (engine::RenderSettings::area_shadow_res)")
       ->check(CLI::IsMember({"full", "half"}));
-  app.add_option("--shading", shading,
-                 "full: the frame as players see it (default); flat: measurement only, every surface its base colour "
-                 "unlit with everything else as usual, the cost floor of any shading (engine::RenderSettings::flat_shading)")
+  app.add_option(
+         "--shading", shading,
+         "full: the frame as players see it (default); flat: measurement only, every surface its base colour "
+         "unlit with everything else as usual, the cost floor of any shading (engine::RenderSettings::flat_shading)")
       ->check(CLI::IsMember({"full", "flat"}));
   app.add_option("--every", o.every, "Headless: write every K-th frame")->check(CLI::PositiveNumber);
   app.add_flag("--exr", o.exr, "Headless: also write DIR/frame_NNNN.exr (linear HDR)");

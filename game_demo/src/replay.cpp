@@ -43,13 +43,16 @@ engine::Result<Simulation> simulation_for_session(const Session& session, const 
       scene_override.empty() ? resolve_scene_path(session.header.scene_path) : scene_override;
   engine::Result<std::uint64_t> hash = hash_scene_file(scene_path);
   if (!hash)
-    return engine::Error{session_file, "header",
-                         "cannot read the recorded scene \"" + session.header.scene_path + "\": " + hash.error().to_string()};
+    return engine::Error{
+        session_file, "header",
+        "cannot read the recorded scene \"" + session.header.scene_path + "\": " + hash.error().to_string()};
   if (*hash != session.header.scene_hash)
     return engine::Error{session_file, "header",
-                         "scene \"" + scene_path.string() + "\" differs from the one this session was recorded on "
-                         "(scene hash " + hex(*hash) + ", recorded " + hex(session.header.scene_hash) +
-                         "); re-record the session (tools/record-sessions.sh for the committed ones)"};
+                         "scene \"" + scene_path.string() +
+                             "\" differs from the one this session was recorded on "
+                             "(scene hash " +
+                             hex(*hash) + ", recorded " + hex(session.header.scene_hash) +
+                             "); re-record the session (tools/record-sessions.sh for the committed ones)"};
   engine::Result<engine::Scene> scene = load_scene(scene_path);
   if (!scene) return scene.error();
   return Simulation(std::move(scene).value(),

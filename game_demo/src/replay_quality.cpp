@@ -19,6 +19,7 @@
 #define GL_GLEXT_PROTOTYPES 1
 #include <GL/glcorearb.h>
 #include <engine/gpu/context.h>
+#include <engine/image.h>
 #include <engine/renderer.h>
 #include <game_demo/replay.h>
 #include <game_demo/session_file.h>
@@ -27,9 +28,7 @@
 #include <gi/gi_system.h>
 #include <gi/reference.h>
 #include <gi/rgb_field.h>
-#include <engine/image.h>
 
-#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -39,6 +38,7 @@
 #include <map>
 #include <numeric>
 #include <sstream>
+#include <CLI/CLI.hpp>
 
 namespace {
 
@@ -91,7 +91,8 @@ bool save_frame(const std::string& dir, const std::string& name, std::uint64_t f
     const float srgb = v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
     png.pixels[i] = static_cast<std::uint8_t>(std::lround(255.0f * (std::isfinite(srgb) ? srgb : 0.0f)));
   }
-  for (const engine::Status& st : {engine::save_exr(base.string() + ".exr", image), engine::save_png(base.string() + ".png", png)})
+  for (const engine::Status& st :
+       {engine::save_exr(base.string() + ".exr", image), engine::save_png(base.string() + ".png", png)})
     if (!st) {
       std::cerr << "gi-replay-quality: " << st.error().to_string() << '\n';
       return false;
@@ -137,7 +138,8 @@ int main(int argc, char** argv) {
   app.add_option("--session", session_path, "Recorded session (.girec)")->required()->check(CLI::ExistingFile);
   app.add_option("--bundle", bundles,
                  "NAME=DIR of a bake bundle, or 'none' for the stand-in (repeatable); NAME=DIR,area-shadows=centre "
-                 "shadows area lights from their centre only (default soft); NAME=DIR,light-reach=off[,area-shadows=...][,area-shadow-res=full|half] "
+                 "shadows area lights from their centre only (default soft); "
+                 "NAME=DIR,light-reach=off[,area-shadows=...][,area-shadow-res=full|half] "
                  "shades every light on every pixel (default on)")
       ->required();
   app.add_option("--frames", frames_text, "Comma-separated frames compared with the path tracer");
@@ -193,7 +195,8 @@ int main(int argc, char** argv) {
         half[h] = std::move(image).value();
       }
       engine::ImageRgbaF image = half[0];
-      for (std::size_t i = 0; i < image.pixels.size(); ++i) image.pixels[i] = 0.5f * (half[0].pixels[i] + half[1].pixels[i]);
+      for (std::size_t i = 0; i < image.pixels.size(); ++i)
+        image.pixels[i] = 0.5f * (half[0].pixels[i] + half[1].pixels[i]);
       if (!save_frame(images_dir, "ref", f, image)) return 1;
       std::size_t bad = 0;
       gi::RgbField field = field_of(image, &bad);
@@ -270,12 +273,13 @@ int main(int argc, char** argv) {
       }
       gi = std::move(loaded).value();
     }
-    auto renderer = engine::Renderer::create(
-        sim->scene().assets,
-        engine::RenderSettings{.width = width, .height = height, .exposure = game_demo::kDemoExposure,
-                               .area_soft_shadows = area_soft_shadows,
-                               .area_shadow_res = area_shadow_res,
-                               .light_reach_culling = light_reach});
+    auto renderer =
+        engine::Renderer::create(sim->scene().assets, engine::RenderSettings{.width = width,
+                                                                             .height = height,
+                                                                             .exposure = game_demo::kDemoExposure,
+                                                                             .area_soft_shadows = area_soft_shadows,
+                                                                             .area_shadow_res = area_shadow_res,
+                                                                             .light_reach_culling = light_reach});
     if (!renderer) {
       std::cerr << "gi-replay-quality: " << renderer.error().to_string() << '\n';
       return 1;

@@ -23,7 +23,9 @@ float yaw_towards(const glm::vec3& from, const glm::vec3& to) {
   return std::atan2(-d.x, -d.z);
 }
 
-float horizontal_distance(const glm::vec3& a, const glm::vec3& b) { return glm::length(glm::vec2(a.x - b.x, a.z - b.z)); }
+float horizontal_distance(const glm::vec3& a, const glm::vec3& b) {
+  return glm::length(glm::vec2(a.x - b.x, a.z - b.z));
+}
 
 // Greedy nearest-neighbour order starting at `from`.
 std::vector<std::size_t> visiting_order(const glm::vec3& from, const std::vector<glm::vec3>& points) {
@@ -34,7 +36,8 @@ std::vector<std::size_t> visiting_order(const glm::vec3& from, const std::vector
     std::size_t best = 0;
     float best_d = std::numeric_limits<float>::max();
     for (std::size_t i = 0; i < points.size(); ++i)
-      if (!used[i] && horizontal_distance(at, points[i]) < best_d) best_d = horizontal_distance(at, points[i]), best = i;
+      if (!used[i] && horizontal_distance(at, points[i]) < best_d)
+        best_d = horizontal_distance(at, points[i]), best = i;
     used[best] = true;
     order.push_back(best);
     at = points[best];
@@ -59,13 +62,20 @@ Script default_script(std::string_view scene_as_given) {
 
 std::string_view script_name(Script s) {
   switch (s) {
-    case Script::Tour: return "tour";
-    case Script::WalkFlashlight: return "walk_flashlight";
-    case Script::PushCrates: return "push_crates";
-    case Script::SplitScreen: return "split_screen";
-    case Script::OpenDoor: return "open_door";
-    case Script::CrateToWall: return "crate_to_wall";
-    case Script::None: return "none";
+    case Script::Tour:
+      return "tour";
+    case Script::WalkFlashlight:
+      return "walk_flashlight";
+    case Script::PushCrates:
+      return "push_crates";
+    case Script::SplitScreen:
+      return "split_screen";
+    case Script::OpenDoor:
+      return "open_door";
+    case Script::CrateToWall:
+      return "crate_to_wall";
+    case Script::None:
+      return "none";
   }
   return "?";
 }
@@ -81,7 +91,8 @@ ScriptedPilot::ScriptedPilot(const Simulation& sim, Script script, std::uint64_t
   if (!level.empty()) {
     const double walls = static_cast<double>(std::max<std::size_t>(ctx.collision.wall_triangle_count(), 1));
     auto cells_at = [&](double c) {
-      return (static_cast<double>(level.max.x - level.min.x) / c + 1.0) * (static_cast<double>(level.max.z - level.min.z) / c + 1.0);
+      return (static_cast<double>(level.max.x - level.min.x) / c + 1.0) *
+             (static_cast<double>(level.max.z - level.min.z) / c + 1.0);
     };
     while (cells_at(double{cell_m_}) * walls > 2e8 || cells_at(double{cell_m_}) > 4e6) cell_m_ *= 2.0f;
     origin_ = glm::vec3(level.min.x, eye.y, level.min.z);
@@ -103,10 +114,12 @@ ScriptedPilot::ScriptedPilot(const Simulation& sim, Script script, std::uint64_t
         b.min = glm::min(b.min, w);
         b.max = glm::max(b.max, w);
       }
-    if (b.empty() || (b.max.x - b.min.x) * (b.max.z - b.min.z) < 6.0f || !(b.min.y < eye.y && b.max.y > eye.y)) continue;
+    if (b.empty() || (b.max.x - b.min.x) * (b.max.z - b.min.z) < 6.0f || !(b.min.y < eye.y && b.max.y > eye.y))
+      continue;
     glm::vec3 p = b.center();
     p.y = eye.y;
-    const bool near_other = std::any_of(rooms.begin(), rooms.end(), [&](const glm::vec3& r) { return horizontal_distance(r, p) < 2.0f; });
+    const bool near_other =
+        std::any_of(rooms.begin(), rooms.end(), [&](const glm::vec3& r) { return horizontal_distance(r, p) < 2.0f; });
     if (!near_other && nearest_walkable(p)) rooms.push_back(p);
   }
   // Fallback for levels without room meshes: the static lights.
@@ -116,7 +129,8 @@ ScriptedPilot::ScriptedPilot(const Simulation& sim, Script script, std::uint64_t
     if (had_rooms || l.moves || l.type == engine::LightType::Directional || e == ctx.flashlight) continue;
     glm::vec3 p = glm::vec3(reg.get<engine::WorldTransform>(e).matrix[3]);
     p.y = eye.y;
-    const bool near_other = std::any_of(rooms.begin(), rooms.end(), [&](const glm::vec3& r) { return horizontal_distance(r, p) < 2.0f; });
+    const bool near_other =
+        std::any_of(rooms.begin(), rooms.end(), [&](const glm::vec3& r) { return horizontal_distance(r, p) < 2.0f; });
     if (!near_other && nearest_walkable(p)) rooms.push_back(p);
   }
   std::vector<glm::vec3> crates;
@@ -223,7 +237,8 @@ void ScriptedPilot::next_crate_to_wall(const Simulation& sim, InputFrame& in) {
         path_ = find_path(eye, crate - wall_push_dir_ * 1.1f);
         path_index_ = 0;
       }
-      if (follow_path(eye, pc.yaw_rad, pc.look_rad_per_px, in) || wall_phase_frames_ > kGiveUpFrames) go(1, std::nullopt);
+      if (follow_path(eye, pc.yaw_rad, pc.look_rad_per_px, in) || wall_phase_frames_ > kGiveUpFrames)
+        go(1, std::nullopt);
       break;
     case 1:  // face along the push and push
       if (turn_to(push_yaw) < 0.03f) {
@@ -244,7 +259,8 @@ void ScriptedPilot::next_crate_to_wall(const Simulation& sim, InputFrame& in) {
       }
       break;
     case 3:  // the wall's other side
-      if (follow_path(eye, pc.yaw_rad, pc.look_rad_per_px, in) || wall_phase_frames_ > kGiveUpFrames) go(4, std::nullopt);
+      if (follow_path(eye, pc.yaw_rad, pc.look_rad_per_px, in) || wall_phase_frames_ > kGiveUpFrames)
+        go(4, std::nullopt);
       break;
     default: {  // look at the crate's place through the wall, down to the floor where it stands
       turn_to(yaw_towards(eye, crate));
@@ -267,7 +283,8 @@ void ScriptedPilot::mark_walkable(const Simulation& sim) {
     for (int x = 0; x < nx_; ++x) {
       const glm::vec3 p = cell_center({x, z});
       // A slightly fattened player box keeps the walk off the walls.
-      const Aabb box{p + pc.box_min_from_eye_m - glm::vec3(0.1f, 0, 0.1f), p + pc.box_max_from_eye_m + glm::vec3(0.1f, 0, 0.1f)};
+      const Aabb box{p + pc.box_min_from_eye_m - glm::vec3(0.1f, 0, 0.1f),
+                     p + pc.box_max_from_eye_m + glm::vec3(0.1f, 0, 0.1f)};
       bool ok = box.min.x >= level.min.x && box.max.x <= level.max.x && box.min.z >= level.min.z &&
                 box.max.z <= level.max.z && !ctx.collision.overlaps_wall(box);
       for (const Aabb& c : crates) ok = ok && !c.overlaps(box);
@@ -281,7 +298,8 @@ bool ScriptedPilot::walkable(int x, int z) const {
 }
 
 glm::vec3 ScriptedPilot::cell_center(Cell c) const {
-  return origin_ + glm::vec3((static_cast<float>(c.x) + 0.5f) * cell_m_, 0.0f, (static_cast<float>(c.z) + 0.5f) * cell_m_);
+  return origin_ +
+         glm::vec3((static_cast<float>(c.x) + 0.5f) * cell_m_, 0.0f, (static_cast<float>(c.z) + 0.5f) * cell_m_);
 }
 
 std::optional<ScriptedPilot::Cell> ScriptedPilot::nearest_walkable(const glm::vec3& p) const {
@@ -306,7 +324,9 @@ std::optional<ScriptedPilot::Cell> ScriptedPilot::nearest_walkable(const glm::ve
 std::vector<glm::vec3> ScriptedPilot::find_path(const glm::vec3& from, const glm::vec3& to) const {
   const std::optional<Cell> start = nearest_walkable(from), goal = nearest_walkable(to);
   if (!start || !goal) return {};
-  const auto index = [&](Cell c) { return static_cast<std::size_t>(c.z) * static_cast<std::size_t>(nx_) + static_cast<std::size_t>(c.x); };
+  const auto index = [&](Cell c) {
+    return static_cast<std::size_t>(c.z) * static_cast<std::size_t>(nx_) + static_cast<std::size_t>(c.x);
+  };
   std::vector<std::int32_t> came_from(free_.size(), -1);
   std::deque<Cell> queue{*start};
   came_from[index(*start)] = static_cast<std::int32_t>(index(*start));
@@ -317,7 +337,8 @@ std::vector<glm::vec3> ScriptedPilot::find_path(const glm::vec3& from, const glm
     for (int dz = -1; dz <= 1; ++dz)
       for (int dx = -1; dx <= 1; ++dx) {
         if ((dx == 0 && dz == 0) || !walkable(c.x + dx, c.z + dz)) continue;
-        if (dx != 0 && dz != 0 && (!walkable(c.x + dx, c.z) || !walkable(c.x, c.z + dz))) continue;  // no corner cutting
+        if (dx != 0 && dz != 0 && (!walkable(c.x + dx, c.z) || !walkable(c.x, c.z + dz)))
+          continue;  // no corner cutting
         const Cell n{c.x + dx, c.z + dz};
         if (came_from[index(n)] >= 0) continue;
         came_from[index(n)] = static_cast<std::int32_t>(index(c));
@@ -327,7 +348,8 @@ std::vector<glm::vec3> ScriptedPilot::find_path(const glm::vec3& from, const glm
   if (came_from[index(*goal)] < 0) return {};
   std::vector<glm::vec3> path;
   for (std::size_t i = index(*goal);; i = static_cast<std::size_t>(came_from[i])) {
-    path.push_back(cell_center({static_cast<int>(i % static_cast<std::size_t>(nx_)), static_cast<int>(i / static_cast<std::size_t>(nx_))}));
+    path.push_back(cell_center(
+        {static_cast<int>(i % static_cast<std::size_t>(nx_)), static_cast<int>(i / static_cast<std::size_t>(nx_))}));
     if (i == index(*start)) break;
   }
   std::reverse(path.begin(), path.end());

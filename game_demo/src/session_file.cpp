@@ -5,8 +5,8 @@
 #include <cmath>
 #include <fstream>
 #include <iterator>
-#include <nlohmann/json.hpp>
 #include <system_error>
+#include <nlohmann/json.hpp>
 
 namespace game_demo {
 

@@ -98,8 +98,8 @@ int run_windowed(const RunOptions& o, RunState& state) {
     return 1;
   }
   GLFWwindow* window = ctx->window();
-  std::unique_ptr<gi::GISystem> indirect;  // destroyed before the context
-  if (!load_indirect_light(o, sim, indirect)) return 1;    // before the renderer: it adds TEXCOORD_1
+  std::unique_ptr<gi::GISystem> indirect;                // destroyed before the context
+  if (!load_indirect_light(o, sim, indirect)) return 1;  // before the renderer: it adds TEXCOORD_1
   const std::string indirect_text = describe_indirect_light(o, indirect.get());
   auto r = engine::Renderer::create(sim.scene().assets, render_settings(o));
   if (!r) {

@@ -84,10 +84,18 @@ void BM_AntiradiancePassGpu(benchmark::State& state) {
   gpu.reset(c.region->direct());
   for (auto _ : state) {
     switch (state.range(0)) {
-      case 0: gpu.global(); break;
-      case 1: gpu.push(); break;
-      case 2: gpu.local(true, true); break;
-      default: gpu.pull(); break;
+      case 0:
+        gpu.global();
+        break;
+      case 1:
+        gpu.push();
+        break;
+      case 2:
+        gpu.local(true, true);
+        break;
+      default:
+        gpu.pull();
+        break;
     }
     glFinish();
   }

@@ -30,8 +30,8 @@
 #include <benchmark/benchmark.h>
 #include <engine/gpu/context.h>
 
-#include "bench_gl.h"
 #include <glm/gtc/matrix_transform.hpp>
+#include "bench_gl.h"
 
 #include <engine/gltf.h>
 #include <gi/bake_input.h>
@@ -115,7 +115,8 @@ void BM_BrfInterreflectCpu(benchmark::State& state) {
   const gi::PointEmitter light = grid_light(n);
   const auto incoming = gi::brf_direct_light(objects, std::span<const gi::PointEmitter>(&light, 1), nullptr);
   for (auto _ : state) {
-    const gi::BrfResult r = gi::brf_interreflect(objects, incoming, {.bounces = 3, .cull_threshold = cull ? 1e-2f : 0.0f});
+    const gi::BrfResult r =
+        gi::brf_interreflect(objects, incoming, {.bounces = 3, .cull_threshold = cull ? 1e-2f : 0.0f});
     benchmark::DoNotOptimize(r.indirect.data());
   }
 }
@@ -123,7 +124,8 @@ BENCHMARK(BM_BrfInterreflectCpu)->ArgsProduct({{1, 5, 10, 30}, {0, 1}})->Unit(be
 
 struct SharedGlossy {
   gi::BrfMesh mesh = crate(0.25f, 4);
-  gi::BrdfSeparation sep = gi::separate_glossy_brdf({.f0 = 0.9f, .alpha = 0.25f}, {.terms = 4, .resolution = 16}).value();
+  gi::BrdfSeparation sep =
+      gi::separate_glossy_brdf({.f0 = 0.9f, .alpha = 0.25f}, {.terms = 4, .resolution = 16}).value();
   gi::BrfBasis basis = gi::compute_pca_basis(mesh, {.lights = 256, .basis = 16}, &sep).value();
   gi::BasisRadianceField field = gi::compute_basis_radiance_field(mesh, basis, {}, &sep).value();
 };
@@ -235,8 +237,8 @@ const RoomObjects& crates_room() {
     for (const gi::BrfSource& src : r.sources) r.bakes.push_back(gi::bake_brf_mesh(src, settings).value());
     for (std::size_t m = 0; m < r.sources.size(); ++m)
       for (std::uint32_t i : r.sources[m].instances)
-        r.objects.push_back({&r.sources[m].mesh, &r.bakes[m].basis, &r.bakes[m].field, input.instances[i].object_to_world,
-                             gi::brf_source_albedo(input, r.sources[m]),
+        r.objects.push_back({&r.sources[m].mesh, &r.bakes[m].basis, &r.bakes[m].field,
+                             input.instances[i].object_to_world, gi::brf_source_albedo(input, r.sources[m]),
                              r.bakes[m].glossy ? &*r.bakes[m].glossy : nullptr, r.sources[m].specular});
     return r;
   }();
@@ -267,8 +269,9 @@ void BM_BrfLodError(benchmark::State& state) {
       gi::brf_interreflect(objects, incoming, {.bounces = 3, .cull_threshold = 0.0f, .lod_distance = 0.0f});
   gi::BrfResult r;
   for (auto _ : state) {
-    r = gi::brf_interreflect(objects, incoming,
-                             {.bounces = 3, .cull_threshold = 0.0f, .lod_distance = lod, .lod_shared_visibility = shared});
+    r = gi::brf_interreflect(
+        objects, incoming,
+        {.bounces = 3, .cull_threshold = 0.0f, .lod_distance = lod, .lod_shared_visibility = shared});
     benchmark::DoNotOptimize(r.indirect.data());
   }
   const auto [max_rel, p95] = gi::brf_vertex_error(r, exact);
@@ -380,7 +383,8 @@ void BM_BrfGatherCpu(benchmark::State& state) {
     }
   std::vector<std::array<std::vector<float>, 3>> w;
   for (const gi::BrfObject& o : objects)
-    w.push_back(gi::brf_fit_rgb(*o.basis, std::vector<glm::vec3>(o.mesh->positions.size(), glm::vec3(1.0f, 0.5f, 0.2f))));
+    w.push_back(
+        gi::brf_fit_rgb(*o.basis, std::vector<glm::vec3>(o.mesh->positions.size(), glm::vec3(1.0f, 0.5f, 0.2f))));
   const std::size_t channels = static_cast<std::size_t>(shared().field.channel_count());
   std::vector<glm::vec3> out(objects[0].mesh->positions.size());
   std::vector<float> copy(bytes / sizeof(float));
@@ -426,10 +430,12 @@ void BM_BrfGpuGlossy(benchmark::State& state) {
   }
   const gi::PointEmitter light = grid_light(n);
   std::vector<gi::BrfObject> objects = crates(n);
-  for (gi::BrfObject& o : objects) o.basis = &g.basis, o.field = &g.field, o.glossy = &g.sep, o.albedo = glm::vec3(0.0f);
+  for (gi::BrfObject& o : objects)
+    o.basis = &g.basis, o.field = &g.field, o.glossy = &g.sep, o.albedo = glm::vec3(0.0f);
   std::vector<gi::BrfGpuInstance> poses[2];
   for (int k = 0; k < 2; ++k)
-    for (const gi::BrfObject& o : crates(n, 0.02f * static_cast<float>(k))) poses[k].push_back({0, o.object_to_world, glm::vec3(0.0f)});
+    for (const gi::BrfObject& o : crates(n, 0.02f * static_cast<float>(k)))
+      poses[k].push_back({0, o.object_to_world, glm::vec3(0.0f)});
   const auto incoming = gi::brf_direct_light(objects, std::span<const gi::PointEmitter>(&light, 1), nullptr);
   const gi::BrfUpdateSettings settings{.bounces = 3, .cull_threshold = 0.0f};
   if (!pass->run(poses[1], incoming, settings)) state.SkipWithError("run failed");

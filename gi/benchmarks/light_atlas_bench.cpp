@@ -48,9 +48,8 @@ const Fixture& cornell(float density) {
     const gi::BakeInput& input = cornell_input();
     Fixture out;
     out.layout = gi::build_atlas_layout(gi::atlas_inputs_from(input), {.texels_per_metre = density}).value();
-    out.scene = gi::prepare_static_scene(input, out.layout, gi::BakeLights::Static,
-                                         gi::TexelPlacement::VisibleSurface)
-                    .value();
+    out.scene =
+        gi::prepare_static_scene(input, out.layout, gi::BakeLights::Static, gi::TexelPlacement::VisibleSurface).value();
     return out;
   }();
   return f;
@@ -80,8 +79,8 @@ void BM_GatherStages(benchmark::State& state) {
   state.counters["gather_s"] = last.gather_seconds;
   state.counters["filter_s"] = last.filter_seconds;
   state.counters["iterations"] = last.iterations;
-  state.counters["Mrays/s"] = benchmark::Counter(static_cast<double>(last.rays) * 1e-6 * state.iterations(),
-                                                 benchmark::Counter::kIsRate);
+  state.counters["Mrays/s"] =
+      benchmark::Counter(static_cast<double>(last.rays) * 1e-6 * state.iterations(), benchmark::Counter::kIsRate);
 }
 
 // The yardstick: cosine rays from every valid texel through the same caster, closest hit,

@@ -43,7 +43,6 @@ namespace {
 constexpr int kClusters = 128;  // the largest K benchmarked
 constexpr int kAtlasWidth = 1024;
 
-
 // T pane texels: every other texel of a 1024-wide atlas; 128 clusters of pane values in (0, 10).
 gi::Prm synthetic_prm(std::size_t texels) {
   gi::Prm prm;
@@ -111,7 +110,8 @@ struct StreamKernel {
   StreamKernel(std::size_t bytes, bool through_textures) : textures(through_textures) {
     const engine::ShaderFile file{textures ? "texture_stream_yardstick.comp.glsl" : "stream_yardstick.comp.glsl",
                                   "gi/benchmarks/prm_gpu_bench.cpp", textures ? kTextureStreamShader : kStreamShader};
-    auto built = engine::ShaderProgramBuilder(std::span(&file, 1)).stage(engine::ShaderStage::Compute, file.name).build();
+    auto built =
+        engine::ShaderProgramBuilder(std::span(&file, 1)).stage(engine::ShaderStage::Compute, file.name).build();
     if (!built) {
       std::fprintf(stderr, "%s\n", built.error().to_string().c_str());
       std::exit(1);
@@ -239,7 +239,13 @@ void BM_PrmGpuFixed(benchmark::State& state) {
   state.counters["finish_ms"] = median(finish_ms);
   state.counters["cpu_time_ms"] = median(cpu_ms);  // process CPU time (llvmpipe's threads too): steadier under load
 }
-BENCHMARK(BM_PrmGpuFixed)->ArgName("T")->Arg(8)->Arg(4096)->Arg(64 << 10)->Unit(benchmark::kMicrosecond)->UseManualTime();
+BENCHMARK(BM_PrmGpuFixed)
+    ->ArgName("T")
+    ->Arg(8)
+    ->Arg(4096)
+    ->Arg(64 << 10)
+    ->Unit(benchmark::kMicrosecond)
+    ->UseManualTime();
 
 }  // namespace
 

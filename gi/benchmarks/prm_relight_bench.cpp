@@ -34,11 +34,11 @@
 #include <vector>
 
 #include <benchmark/benchmark.h>
+#include <glm/gtc/matrix_transform.hpp>
 #include <engine/components.h>
 #include <engine/gltf.h>
 #include <engine/scene.h>
 #include <gi/bake_input.h>
-#include <glm/gtc/matrix_transform.hpp>
 
 #include "bench_gl.h"
 
@@ -75,7 +75,8 @@ struct DemoLevel {
 const DemoLevel& demo_level() {
   static const DemoLevel d = [] {
     DemoLevel out;
-    engine::Scene scene = engine::instantiate(or_exit(engine::load_gltf(std::string(GI_SOURCE_DIR) + "/assets/demo_level.gltf")));
+    engine::Scene scene =
+        engine::instantiate(or_exit(engine::load_gltf(std::string(GI_SOURCE_DIR) + "/assets/demo_level.gltf")));
     engine::update_world_transforms(scene.registry);
     bool found = false;
     scene.registry.view<engine::Light, engine::WorldTransform>().each(
@@ -115,10 +116,11 @@ double median(std::vector<double> v) {
 // values to zero), a texel's error is max over channels |test - ref| / its largest channel.
 struct AtlasError {
   double max = 0.0, p95 = 0.0;
-  double rel_rmse = 0.0;   // sqrt(sum |test - ref|^2 / sum |ref|^2) over the lit texels and channels
-  double total = 0.0;      // |sum test - sum ref| / sum ref (all channels)
+  double rel_rmse = 0.0;  // sqrt(sum |test - ref|^2 / sum |ref|^2) over the lit texels and channels
+  double total = 0.0;     // |sum test - sum ref| / sum ref (all channels)
 };
-AtlasError atlas_error(const gi::Prm& test, const gi::Prm& ref, const std::vector<std::vector<gi::ClusterWeight>>& picks) {
+AtlasError atlas_error(const gi::Prm& test, const gi::Prm& ref,
+                       const std::vector<std::vector<gi::ClusterWeight>>& picks) {
   std::vector<double> rel;
   double d2 = 0.0, r2 = 0.0, st = 0.0, sr = 0.0;
   for (const auto& picked : picks) {
@@ -329,7 +331,13 @@ void BM_PrmFluxCheck(benchmark::State& state) {
     benchmark::DoNotOptimize(gi::punctual_lit_solid_angle(e[0], *d.caster, 64, &hits, pool.get()));
   }
 }
-BENCHMARK(BM_PrmFluxCheck)->ArgName("threads")->Arg(1)->Arg(2)->Unit(benchmark::kMicrosecond)->UseRealTime()->MinTime(1.0);
+BENCHMARK(BM_PrmFluxCheck)
+    ->ArgName("threads")
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime()
+    ->MinTime(1.0);
 
 // Argument: 1 traces the shadow rays together in packets (RayCaster::occluded_coherent, what
 // entry_irradiance does), 0 one by one (emitter_visible). Both are checked to agree ray for ray
@@ -381,7 +389,13 @@ void BM_PrmEntryShadowRays(benchmark::State& state) {
   }
   state.counters["rays_checked"] = static_cast<double>(checked);
 }
-BENCHMARK(BM_PrmEntryShadowRays)->ArgName("packets")->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond)->UseRealTime()->MinTime(1.0);
+BENCHMARK(BM_PrmEntryShadowRays)
+    ->ArgName("packets")
+    ->Arg(0)
+    ->Arg(1)
+    ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime()
+    ->MinTime(1.0);
 
 }  // namespace
 

@@ -73,7 +73,8 @@ void BM_WrapperIntersect(benchmark::State& state) {
     for (const gi::Ray& r : f.rays) hits += f.caster->intersect(r).valid();
   }
   benchmark::DoNotOptimize(hits);
-  state.counters["rays/s"] = benchmark::Counter(double(state.iterations() * f.rays.size()), benchmark::Counter::kIsRate);
+  state.counters["rays/s"] =
+      benchmark::Counter(double(state.iterations() * f.rays.size()), benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_WrapperIntersect)->Unit(benchmark::kMillisecond);
 
@@ -84,7 +85,8 @@ void BM_WrapperIntersectStream(benchmark::State& state) {
     f.caster->intersect_many(f.rays, hits);
     benchmark::DoNotOptimize(hits.data());
   }
-  state.counters["rays/s"] = benchmark::Counter(double(state.iterations() * f.rays.size()), benchmark::Counter::kIsRate);
+  state.counters["rays/s"] =
+      benchmark::Counter(double(state.iterations() * f.rays.size()), benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_WrapperIntersectStream)->Unit(benchmark::kMillisecond);
 
@@ -112,7 +114,8 @@ void BM_RawEmbreeIntersect(benchmark::State& state) {
     }
   }
   benchmark::DoNotOptimize(hits);
-  state.counters["rays/s"] = benchmark::Counter(double(state.iterations() * f.rays.size()), benchmark::Counter::kIsRate);
+  state.counters["rays/s"] =
+      benchmark::Counter(double(state.iterations() * f.rays.size()), benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_RawEmbreeIntersect)->Unit(benchmark::kMillisecond);
 
@@ -122,7 +125,8 @@ void BM_WrapperOccluded(benchmark::State& state) {
   for (auto _ : state)
     for (const gi::Ray& r : f.rays) occ += f.caster->occluded(r);
   benchmark::DoNotOptimize(occ);
-  state.counters["rays/s"] = benchmark::Counter(double(state.iterations() * f.rays.size()), benchmark::Counter::kIsRate);
+  state.counters["rays/s"] =
+      benchmark::Counter(double(state.iterations() * f.rays.size()), benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_WrapperOccluded)->Unit(benchmark::kMillisecond);
 

@@ -15,8 +15,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     gi_fuzz::fail("write_manifest refused what read_manifest accepted: " + s.error().to_string());
   engine::Result<gi::Manifest> back = gi::read_manifest(gi_fuzz::scratch_dir());
   if (!back) gi_fuzz::fail("the re-written manifest does not read: " + back.error().to_string());
-  if (back->format_version != m->format_version || back->geometry_hash != m->geometry_hash ||
-      back->scene != m->scene || back->methods != m->methods || back->plan != m->plan)
+  if (back->format_version != m->format_version || back->geometry_hash != m->geometry_hash || back->scene != m->scene ||
+      back->methods != m->methods || back->plan != m->plan)
     gi_fuzz::fail("the re-written manifest reads back other fields");
   return 0;
 }

@@ -6,8 +6,8 @@
 
 #include <algorithm>
 #include <filesystem>
-#include <functional>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <regex>
 #include <set>
@@ -107,8 +107,8 @@ TEST(Architecture, FoldersIncludeOnlyFoldersOfTheTargetsTheyLink) {
     const std::set<std::string> allowed = reachable_targets(l, target);
     for (const std::string& inc : includes)
       EXPECT_TRUE(allowed.count(l.target_of_folder.at(inc)))
-          << "gi/src/" << folder << " (" << target << ") includes gi/src/" << inc << " ("
-          << l.target_of_folder.at(inc) << "), a target it does not link";
+          << "gi/src/" << folder << " (" << target << ") includes gi/src/" << inc << " (" << l.target_of_folder.at(inc)
+          << "), a target it does not link";
   }
 }
 

@@ -77,7 +77,8 @@ TEST(CommittedSessions, PushCratesMovesCrates) {
   auto sim = game_demo::simulation_for_session(*session, file.string());
   ASSERT_TRUE(sim) << sim.error().to_string();
   std::vector<glm::vec3> before;
-  for (engine::Entity c : game_demo::crates_of(sim->registry())) before.push_back(sim->registry().get<engine::Transform>(c).position);
+  for (engine::Entity c : game_demo::crates_of(sim->registry()))
+    before.push_back(sim->registry().get<engine::Transform>(c).position);
   (void)game_demo::replay_inputs(*sim, *session);
   int moved = 0;
   const auto crates = game_demo::crates_of(sim->registry());
@@ -99,11 +100,12 @@ TEST(CommittedSessions, PushCratesWallPutsTheRedCrateAgainstTheWallAndTheCameraB
   ASSERT_FALSE(red.is_null());
   (void)game_demo::replay_inputs(*sim, *session);
   const game_demo::Aabb box = game_demo::crate_box(sim->registry(), red, 0.0f);
-  EXPECT_NEAR(box.min.x, 8.2f, 0.05f);              // against the wall
+  EXPECT_NEAR(box.min.x, 8.2f, 0.05f);                // against the wall
   EXPECT_TRUE(box.max.z < 3.4f || box.min.z > 4.6f);  // beside the doorway (z 3.4..4.6), not in it
   const glm::vec3 eye = sim->registry().get<engine::Transform>(sim->context().camera).position;
   EXPECT_LT(eye.x, 7.9f);
-  const glm::vec3 view = game_demo::forward_of_yaw(sim->registry().get<game_demo::PlayerController>(sim->context().camera).yaw_rad);
+  const glm::vec3 view =
+      game_demo::forward_of_yaw(sim->registry().get<game_demo::PlayerController>(sim->context().camera).yaw_rad);
   glm::vec3 to_crate = box.center() - eye;
   to_crate.y = 0.0f;
   EXPECT_GT(glm::dot(glm::normalize(to_crate), view), 0.98f);

@@ -74,7 +74,7 @@ TEST(PlayerController, WallsKeepThePlayerInsideTheRoom) {
   // The player box reaches 0.25 m from the eye; the inner wall faces are at x = 5, z = -3.
   EXPECT_LE(eye.x, 5.0f - 0.25f + 1e-4f);
   EXPECT_GE(eye.z, -3.0f + 0.25f - 1e-4f);
-  EXPECT_GT(eye.x, 4.6f);   // it did get there, sliding along the walls
+  EXPECT_GT(eye.x, 4.6f);  // it did get there, sliding along the walls
   EXPECT_LT(eye.z, -2.6f);
 }
 
@@ -118,10 +118,10 @@ TEST(Push, ECratePushedForwardStopsAtTheWall) {
   for (int i = 0; i < 3 * 60; ++i) sim.step({});
   const glm::vec3 p = reg.get<engine::Transform>(crate).position;
   const glm::vec3 v = reg.get<engine::RigidBody>(crate).velocity_m_s;
-  EXPECT_LT(p.z, z0 - 0.4f);                           // moved forward
-  EXPECT_GE(p.z - 0.4f, -3.0f - 1e-3f);                // not into the wall
-  EXPECT_LT(p.z - 0.4f, -3.0f + 0.05f);                // but up against it
-  EXPECT_EQ(v, glm::vec3(0.0f));                       // and at rest
+  EXPECT_LT(p.z, z0 - 0.4f);             // moved forward
+  EXPECT_GE(p.z - 0.4f, -3.0f - 1e-3f);  // not into the wall
+  EXPECT_LT(p.z - 0.4f, -3.0f + 0.05f);  // but up against it
+  EXPECT_EQ(v, glm::vec3(0.0f));         // and at rest
   EXPECT_NEAR(p.x, 0.0f, 1e-6f);
 }
 
@@ -143,9 +143,9 @@ TEST(Push, ACrateStopsAgainstAnotherCrate) {
   for (int i = 0; i < 3 * 60; ++i) sim.step({});
   const float front = reg.get<engine::Transform>(crates[0]).position.z;
   const float back = reg.get<engine::Transform>(crates[1]).position.z;
-  EXPECT_FLOAT_EQ(back, -2.0f);                  // the far crate did not move
-  EXPECT_GE(front - back, 0.8f - 1e-4f);         // boxes never overlap
-  EXPECT_LT(front - back, 0.8f + 0.05f);         // and the pushed one went all the way
+  EXPECT_FLOAT_EQ(back, -2.0f);           // the far crate did not move
+  EXPECT_GE(front - back, 0.8f - 1e-4f);  // boxes never overlap
+  EXPECT_LT(front - back, 0.8f + 0.05f);  // and the pushed one went all the way
 }
 
 TEST(ChangeTracking, AStepWithoutInputWritesNoTransform) {
@@ -186,8 +186,8 @@ TEST(SplitScreen, GTogglesOnPress) {
 
 TEST(Schedule, GameplaySystemsRunInTheDocumentedOrder) {
   game_demo::Simulation sim(demo_test::make_room({}));
-  const std::vector<std::string> expected = {"player_controller", "flashlight", "split_screen",
-                                             "push", "swinging_lamp", "door", "rigid_bodies", "world_transforms"};
+  const std::vector<std::string> expected = {"player_controller", "flashlight", "split_screen", "push",
+                                             "swinging_lamp",     "door",       "rigid_bodies", "world_transforms"};
   EXPECT_EQ(sim.schedule().order(), expected);
 }
 
@@ -197,18 +197,17 @@ namespace {
 
 TEST(RigidBodies, UnsupportedCrateFallsToTheFloorAndStackedCrateRests) {
   // One crate floating 1 m up, one resting on another.
-  game_demo::Simulation sim(demo_test::make_room(
-      {{{3.0f, 1.4f, 0.0f}}, {{-3.0f, 0.4f, 0.0f}}, {{-3.0f, 1.2f, 0.0f}}}));
+  game_demo::Simulation sim(demo_test::make_room({{{3.0f, 1.4f, 0.0f}}, {{-3.0f, 0.4f, 0.0f}}, {{-3.0f, 1.2f, 0.0f}}}));
   const auto& reg = sim.registry();
   const auto crates = reg.entities_with<engine::DynamicTag>();
   ASSERT_EQ(crates.size(), 3u);
   sim.step({});
-  EXPECT_LT(reg.get<engine::RigidBody>(crates[0]).velocity_m_s.y, 0.0f);  // falling
+  EXPECT_LT(reg.get<engine::RigidBody>(crates[0]).velocity_m_s.y, 0.0f);           // falling
   EXPECT_EQ(reg.get<engine::RigidBody>(crates[2]).velocity_m_s, glm::vec3(0.0f));  // stacked: supported
   for (int i = 0; i < 2 * 60; ++i) sim.step({});
   const float bottom = reg.get<engine::Transform>(crates[0]).position.y - 0.4f;
   EXPECT_GE(bottom, -0.01f - 1e-4f);  // never more than the 1 cm collision skin into the floor
-  EXPECT_LT(bottom, 0.03f + 1e-4f); // landed within the support probe
+  EXPECT_LT(bottom, 0.03f + 1e-4f);   // landed within the support probe
   EXPECT_EQ(reg.get<engine::RigidBody>(crates[0]).velocity_m_s, glm::vec3(0.0f));
   EXPECT_FLOAT_EQ(reg.get<engine::Transform>(crates[2]).position.y, 1.2f);
   sim.step({});

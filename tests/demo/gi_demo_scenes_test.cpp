@@ -13,12 +13,12 @@
 // them are clipped (every channel at 250/255 or more). Automatic exposure gives 0.31-0.43
 // with under 1% clipped; gi_demo's old fixed exposure 0.3 fails every file (0.004-0.09), and
 // --exposure 100 fails MultiUVTest as white (44% clipped).
-#include <engine/gltf.h>
-#include <engine/image.h>
 #include <fcntl.h>
-#include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
+#include <gtest/gtest.h>
+#include <engine/gltf.h>
+#include <engine/image.h>
 
 #include <algorithm>
 #include <cstdio>

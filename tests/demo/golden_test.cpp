@@ -42,13 +42,16 @@ struct GoldenSpec {
 
   std::string name() const {
     char buf[128];
-    std::snprintf(buf, sizeof buf, "%s_f%04llu%s", session.c_str(), static_cast<unsigned long long>(frame), gi ? "_gi" : "");
+    std::snprintf(buf, sizeof buf, "%s_f%04llu%s", session.c_str(), static_cast<unsigned long long>(frame),
+                  gi ? "_gi" : "");
     return buf;
   }
 };
 
 // What DemoBundle.BakePreview (tests/CMakeLists.txt) writes: gi-bake --preset preview.
-std::filesystem::path demo_bundle() { return std::filesystem::path(GI_BINARY_DIR) / "test-bundles" / "demo_level.gibake"; }
+std::filesystem::path demo_bundle() {
+  return std::filesystem::path(GI_BINARY_DIR) / "test-bundles" / "demo_level.gibake";
+}
 
 std::vector<GoldenSpec> golden_specs() {
   std::ifstream in(std::filesystem::path(GI_SOURCE_DIR) / "tests" / "golden" / "goldens.txt");
@@ -83,7 +86,8 @@ ImageDiff compare(const engine::ImageRgba8& a, const engine::ImageRgba8& b) {
   for (std::size_t p = 0; p < n; ++p) {
     int worst = 0;
     for (int c = 0; c < 3; ++c) {
-      const int delta = std::abs(int{a.pixels[4 * p + static_cast<std::size_t>(c)]} - int{b.pixels[4 * p + static_cast<std::size_t>(c)]});
+      const int delta = std::abs(int{a.pixels[4 * p + static_cast<std::size_t>(c)]} -
+                                 int{b.pixels[4 * p + static_cast<std::size_t>(c)]});
       worst = std::max(worst, delta);
       sum += delta;
     }
@@ -97,7 +101,8 @@ ImageDiff compare(const engine::ImageRgba8& a, const engine::ImageRgba8& b) {
 }
 
 engine::ImageRgba8 render_replayed_frame(const GoldenSpec& g) {
-  const std::filesystem::path file = std::filesystem::path(GI_SOURCE_DIR) / "tests" / "sessions" / (g.session + ".girec");
+  const std::filesystem::path file =
+      std::filesystem::path(GI_SOURCE_DIR) / "tests" / "sessions" / (g.session + ".girec");
   auto session = game_demo::load_session(file);
   EXPECT_TRUE(session) << session.error().to_string();
   if (!session) return {};
@@ -123,7 +128,9 @@ engine::ImageRgba8 render_replayed_frame(const GoldenSpec& g) {
   }
   const game_demo::ReplayOutcome out = game_demo::replay_inputs(*sim, *session);
   EXPECT_FALSE(out.mismatch.has_value()) << game_demo::describe(*out.mismatch);
-  auto renderer = engine::Renderer::create(sim->scene().assets, engine::RenderSettings{.width = g.width, .height = g.height, .exposure = game_demo::kDemoExposure});
+  auto renderer = engine::Renderer::create(
+      sim->scene().assets,
+      engine::RenderSettings{.width = g.width, .height = g.height, .exposure = game_demo::kDemoExposure});
   EXPECT_TRUE(renderer) << renderer.error().to_string();
   if (!renderer) return {};
   (*renderer)->set_indirect_light(gi.get());
@@ -151,15 +158,16 @@ TEST(GoldenImages, ReplayedSessionFramesMatchTheGoldens) {
     const engine::ImageRgba8 actual = render_replayed_frame(g);
     ASSERT_EQ(actual.width, g.width);
     ASSERT_EQ(actual.height, g.height);
-    const std::filesystem::path golden_path = std::filesystem::path(GI_SOURCE_DIR) / "tests" / "golden" / (std::string(name) + ".png");
+    const std::filesystem::path golden_path =
+        std::filesystem::path(GI_SOURCE_DIR) / "tests" / "golden" / (std::string(name) + ".png");
     const std::filesystem::path failures = std::filesystem::path(GI_BINARY_DIR) / "golden_failures";
     const std::string approve = "tools/approve-goldens.sh " + std::filesystem::path(GI_BINARY_DIR).filename().string();
     auto golden = engine::load_png(golden_path);
     if (!golden) {
       std::filesystem::create_directories(failures);
       (void)engine::save_png(failures / (std::string(name) + "_actual.png"), actual);
-      ADD_FAILURE() << "missing golden " << golden_path << " (" << golden.error().to_string()
-                    << "); review " << (failures / (std::string(name) + "_actual.png")) << " and approve with: " << approve;
+      ADD_FAILURE() << "missing golden " << golden_path << " (" << golden.error().to_string() << "); review "
+                    << (failures / (std::string(name) + "_actual.png")) << " and approve with: " << approve;
       continue;
     }
     ASSERT_EQ(golden->width, actual.width);
@@ -171,8 +179,9 @@ TEST(GoldenImages, ReplayedSessionFramesMatchTheGoldens) {
       (void)engine::save_png(failures / (std::string(name) + "_actual.png"), actual);
       (void)engine::save_png(failures / (std::string(name) + "_diff.png"), d.diff);
     }
-    EXPECT_TRUE(ok) << name << ": " << 100.0 * d.fraction_differing << "% of pixels differ by > 8/255 (limit 0.5%), mean abs diff "
-                    << d.mean_abs << "/255 (limit 1/255); actual and diff images in " << failures
+    EXPECT_TRUE(ok) << name << ": " << 100.0 * d.fraction_differing
+                    << "% of pixels differ by > 8/255 (limit 0.5%), mean abs diff " << d.mean_abs
+                    << "/255 (limit 1/255); actual and diff images in " << failures
                     << "; if the change is intended, approve with: " << approve;
   }
 }
@@ -184,7 +193,8 @@ TEST(GoldenImages, ReplayedSessionFramesMatchTheGoldens) {
 // in the crate room's far corner instead: left of the doorway (the hub's wall and floor) the
 // two frames must be the same. Through the doorway the crate room may change.
 TEST(GoldenImages, NoBounceThroughTheCrateRoomsWall) {
-  const std::filesystem::path file = std::filesystem::path(GI_SOURCE_DIR) / "tests" / "sessions" / "push_crates_wall.girec";
+  const std::filesystem::path file =
+      std::filesystem::path(GI_SOURCE_DIR) / "tests" / "sessions" / "push_crates_wall.girec";
   auto session = game_demo::load_session(file);
   ASSERT_TRUE(session) << session.error().to_string();
   session->frames.resize(std::min<std::size_t>(session->frames.size(), 701));
@@ -197,7 +207,8 @@ TEST(GoldenImages, NoBounceThroughTheCrateRoomsWall) {
   const game_demo::ReplayOutcome out = game_demo::replay_inputs(*sim, *session);
   ASSERT_FALSE(out.mismatch.has_value()) << game_demo::describe(*out.mismatch);
   const int w = 320, h = 180;
-  auto renderer = engine::Renderer::create(sim->scene().assets, engine::RenderSettings{.width = w, .height = h, .exposure = game_demo::kDemoExposure});
+  auto renderer = engine::Renderer::create(
+      sim->scene().assets, engine::RenderSettings{.width = w, .height = h, .exposure = game_demo::kDemoExposure});
   ASSERT_TRUE(renderer) << renderer.error().to_string();
   (*renderer)->set_indirect_light(loaded->get());
   (*renderer)->render(sim->registry(), sim->context().camera);
@@ -214,7 +225,9 @@ TEST(GoldenImages, NoBounceThroughTheCrateRoomsWall) {
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < 200; ++x)
       for (int c = 0; c < 3; ++c) {
-        const std::size_t i = 4 * (static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)) + static_cast<std::size_t>(c);
+        const std::size_t i =
+            4 * (static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)) +
+            static_cast<std::size_t>(c);
         const double a = double{at_wall.pixels[i]}, b = double{away.pixels[i]};
         worst = std::max(worst, std::abs(a - b) / std::max(b, 1e-3));
         sum += b;

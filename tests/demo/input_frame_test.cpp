@@ -1,5 +1,5 @@
-#include <game_demo/input_frame.h>
 #include <gtest/gtest.h>
+#include <game_demo/input_frame.h>
 
 #include <bit>
 #include <cmath>

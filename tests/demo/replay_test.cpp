@@ -66,7 +66,8 @@ void write_all(const std::filesystem::path& p, const std::vector<std::uint8_t>& 
 TEST(Determinism, SameInputsGiveIdenticalChecksums) {
   const game_demo::Session a = record(150), b = record(150);
   ASSERT_EQ(a.frames.size(), b.frames.size());
-  for (std::size_t i = 0; i < a.frames.size(); ++i) ASSERT_EQ(a.frames[i].checksum, b.frames[i].checksum) << "frame " << i;
+  for (std::size_t i = 0; i < a.frames.size(); ++i)
+    ASSERT_EQ(a.frames[i].checksum, b.frames[i].checksum) << "frame " << i;
   // ...and the checksum does follow the state: every step of this script changes something.
   for (std::size_t i = 1; i < 40; ++i) EXPECT_NE(a.frames[i].checksum, a.frames[i - 1].checksum);
 }
@@ -213,17 +214,13 @@ TEST_F(SessionFileErrors, MissingFileAndEmptyFile) {
 
 TEST(SessionScene, ChangedSceneFileIsRejectedWithTheReRecordHint) {
   const auto dir = temp_dir();
-  {
-    std::ofstream(dir / "level.gltf") << R"({"asset":{"version":"2.0"}})";
-  }
+  { std::ofstream(dir / "level.gltf") << R"({"asset":{"version":"2.0"}})"; }
   game_demo::Session s = record(5);
   s.header.scene_path = (dir / "level.gltf").string();
   auto hash = game_demo::hash_scene_file(dir / "level.gltf");
   ASSERT_TRUE(hash);
   s.header.scene_hash = *hash;
-  {
-    std::ofstream(dir / "level.gltf") << R"({"asset":{"version":"2.0"},"nodes":[]})";
-  }
+  { std::ofstream(dir / "level.gltf") << R"({"asset":{"version":"2.0"},"nodes":[]})"; }
   auto sim = game_demo::simulation_for_session(s, "walk.girec");
   ASSERT_FALSE(sim);
   const std::string e = sim.error().to_string();

@@ -21,7 +21,8 @@ inline engine::Mesh box_mesh(const glm::vec3& half) {
   for (int i = 0; i < 8; ++i)
     p.positions.push_back({(i & 1) ? half.x : -half.x, (i & 2) ? half.y : -half.y, (i & 4) ? half.z : -half.z});
   // Two triangles per face: -x, +x, -y, +y, -z, +z.
-  const std::uint32_t faces[6][4] = {{0, 2, 6, 4}, {1, 5, 7, 3}, {0, 4, 5, 1}, {2, 3, 7, 6}, {0, 1, 3, 2}, {4, 6, 7, 5}};
+  const std::uint32_t faces[6][4] = {{0, 2, 6, 4}, {1, 5, 7, 3}, {0, 4, 5, 1},
+                                     {2, 3, 7, 6}, {0, 1, 3, 2}, {4, 6, 7, 5}};
   for (const auto& f : faces) p.indices.insert(p.indices.end(), {f[0], f[1], f[2], f[0], f[2], f[3]});
   engine::Mesh m;
   m.primitives.push_back(std::move(p));

@@ -8,10 +8,10 @@
 
 #include <cmath>
 #include <cstdio>
-#include <glm/gtc/packing.hpp>
 #include <numbers>
 #include <random>
 #include <vector>
+#include <glm/gtc/packing.hpp>
 
 #include <engine/directional_radiance.h>
 #include <engine/gltf_brdf.h>
@@ -94,7 +94,8 @@ TEST(DirectionalRadiance, GlslTwinAgreesWithTheCpp) {
         for (float cos_v : {1.0f, 0.7f, 0.3f, 0.05f})
           for (float phi : {0.0f, 2.0f})
             for (int e = 0; e < elements; ++e) {
-              glm::vec3 t = glm::normalize(glm::cross(n, std::fabs(n.x) > 0.9f ? glm::vec3(0, 0, 1) : glm::vec3(1, 0, 0)));
+              glm::vec3 t =
+                  glm::normalize(glm::cross(n, std::fabs(n.x) > 0.9f ? glm::vec3(0, 0, 1) : glm::vec3(1, 0, 0)));
               const glm::vec3 b = glm::cross(n, t);
               const float s = std::sqrt(1.0f - cos_v * cos_v);
               const glm::vec3 v = glm::normalize(cos_v * n + s * (std::cos(phi) * t + std::sin(phi) * b));
@@ -102,7 +103,8 @@ TEST(DirectionalRadiance, GlslTwinAgreesWithTheCpp) {
                                glm::vec4(v, static_cast<float>(e))});
             }
 
-  const engine::ShaderFile twin{"directional_twin.comp.glsl", "tests/engine/directional_radiance_test.cpp", kTwinShader};
+  const engine::ShaderFile twin{"directional_twin.comp.glsl", "tests/engine/directional_radiance_test.cpp",
+                                kTwinShader};
   auto program = engine::ShaderProgramBuilder(std::span<const engine::ShaderFile>(&twin, 1))
                      .add_files(engine::engine_shader_files())
                      .stage(engine::ShaderStage::Compute, "directional_twin.comp.glsl")
@@ -143,9 +145,9 @@ TEST(DirectionalRadiance, GlslTwinAgreesWithTheCpp) {
     nonzero += scale > 1e-6f;
     ASSERT_TRUE(std::isfinite(g.x) && std::isfinite(g.y) && std::isfinite(g.z)) << i;
     if (d > 1e-3f) {
-      ADD_FAILURE() << "case " << i << " (roughness " << c.n_roughness.w << ", cos_v " << glm::dot(glm::vec3(c.v), glm::vec3(c.n_roughness))
-                    << "): GPU (" << g.x << ", " << g.y << ", " << g.z << ") vs C++ (" << cpu.x << ", " << cpu.y << ", "
-                    << cpu.z << ")";
+      ADD_FAILURE() << "case " << i << " (roughness " << c.n_roughness.w << ", cos_v "
+                    << glm::dot(glm::vec3(c.v), glm::vec3(c.n_roughness)) << "): GPU (" << g.x << ", " << g.y << ", "
+                    << g.z << ") vs C++ (" << cpu.x << ", " << cpu.y << ", " << cpu.z << ")";
       break;
     }
   }

@@ -27,9 +27,9 @@ glm::vec3 direction(float theta_deg, float phi_deg) {
 
 // One evaluation: the material's factors, a frame and two directions (std430, 96 bytes).
 struct Case {
-  glm::vec4 base_metallic;     // rgb base colour, a metallic
-  glm::vec4 specular_color;    // rgb specularColorFactor, a specularFactor
-  glm::vec4 n_roughness;       // xyz normal, w roughness
+  glm::vec4 base_metallic;   // rgb base colour, a metallic
+  glm::vec4 specular_color;  // rgb specularColorFactor, a specularFactor
+  glm::vec4 n_roughness;     // xyz normal, w roughness
   glm::vec4 v;
   glm::vec4 l;
   glm::vec4 pad;
@@ -38,9 +38,9 @@ static_assert(sizeof(Case) == 96);
 
 // What the shader writes per case (std430, 64 bytes).
 struct Out {
-  glm::vec4 diffuse;           // xyz, w = gltf_diffuse_weight(v.h)
+  glm::vec4 diffuse;  // xyz, w = gltf_diffuse_weight(v.h)
   glm::vec4 specular;
-  glm::vec4 albedo_diffuse;    // gltf_directional_albedo at n.v
+  glm::vec4 albedo_diffuse;  // gltf_directional_albedo at n.v
   glm::vec4 albedo_specular;
 };
 static_assert(sizeof(Out) == 64);
@@ -128,8 +128,8 @@ TEST(GltfBrdf, GlslTwinAgreesWithTheCppOnAGridOfMaterialsAndAngles) {
     const engine::GltfBrdfValue f = engine::gltf_eval_cos(m, n, v, l);
     const engine::GltfBrdfValue a = engine::gltf_directional_albedo(m, glm::dot(n, v));
     const float w = engine::gltf_diffuse_weight(m, glm::dot(v, glm::normalize(v + l)));
-    const float e = std::max({rel_diff(glm::vec3(gpu[i].diffuse), f.diffuse), rel_diff(glm::vec3(gpu[i].specular), f.specular),
-                              std::fabs(gpu[i].diffuse.w - w)});
+    const float e = std::max({rel_diff(glm::vec3(gpu[i].diffuse), f.diffuse),
+                              rel_diff(glm::vec3(gpu[i].specular), f.specular), std::fabs(gpu[i].diffuse.w - w)});
     const float ea = std::max(rel_diff(glm::vec3(gpu[i].albedo_diffuse), a.diffuse),
                               rel_diff(glm::vec3(gpu[i].albedo_specular), a.specular));
     // Near-mirror lobes (roughness at the clamp) are ill-conditioned in float: D's peak
@@ -144,9 +144,10 @@ TEST(GltfBrdf, GlslTwinAgreesWithTheCppOnAGridOfMaterialsAndAngles) {
       break;
     }
   }
-  std::printf("%zu cases: worst relative difference GLSL vs C++: BRDF %.2e (roughness < 0.1: %.2e), directional albedo %.2e\n",
-              cases.size(), static_cast<double>(worst_eval), static_cast<double>(worst_eval_mirror),
-              static_cast<double>(worst_albedo));
+  std::printf(
+      "%zu cases: worst relative difference GLSL vs C++: BRDF %.2e (roughness < 0.1: %.2e), directional albedo %.2e\n",
+      cases.size(), static_cast<double>(worst_eval), static_cast<double>(worst_eval_mirror),
+      static_cast<double>(worst_albedo));
 }
 
 TEST(GltfBrdf, IsReciprocal) {

@@ -55,8 +55,7 @@ fs::path with_scene_gi(const std::string& name, const json& gi) {
 }  // namespace
 
 TEST(GltfEnvironment, SkyAndSunLoadTheSunAsADirectionalLightOnItsOwnNode) {
-  const fs::path path = with_scene_gi(
-      "sky_sun.gltf", json::parse(R"({"sky": {"radiance": [0.5, 0.6, 0.9]},
+  const fs::path path = with_scene_gi("sky_sun.gltf", json::parse(R"({"sky": {"radiance": [0.5, 0.6, 0.9]},
                                       "sun": {"direction": [0, -2, 0], "irradiance": [800, 700, 600],
                                               "angular_radius_deg": 0.5}})"));
   auto a = engine::load_gltf(path);
@@ -77,8 +76,7 @@ TEST(GltfEnvironment, SkyAndSunLoadTheSunAsADirectionalLightOnItsOwnNode) {
 }
 
 TEST(GltfEnvironment, WriterWritesSkyAndSunBackAsSceneExtras) {
-  auto a = engine::load_gltf(with_scene_gi(
-      "roundtrip_in.gltf", json::parse(R"({"sky": {"radiance": [1, 2, 3]},
+  auto a = engine::load_gltf(with_scene_gi("roundtrip_in.gltf", json::parse(R"({"sky": {"radiance": [1, 2, 3]},
                                            "sun": {"direction": [1, -1, 0], "irradiance": [5, 5, 5]}})")));
   ASSERT_TRUE(a) << a.error().to_string();
   const fs::path out = dir() / "roundtrip_out.glb";
@@ -144,7 +142,9 @@ TEST(GltfEnvironment, GradientSkyLoadsEvaluatesAndRoundTrips) {
   EXPECT_EQ(env.sky_gradient.zenith, glm::vec3(0.2f, 0.4f, 1.0f));
   EXPECT_EQ(env.sky_gradient.horizon, glm::vec3(0.8f, 0.9f, 1.0f));
   EXPECT_EQ(env.sky_gradient.ground, glm::vec3(0.1f, 0.1f, 0.05f));
-  const auto at = [&](glm::vec3 d) { return engine::sky_radiance(env.sky_radiance, env.sky_gradient, glm::normalize(d)); };
+  const auto at = [&](glm::vec3 d) {
+    return engine::sky_radiance(env.sky_radiance, env.sky_gradient, glm::normalize(d));
+  };
   const auto near = [](glm::vec3 p, glm::vec3 q) { return glm::length(p - q) < 1e-6f; };
   EXPECT_TRUE(near(at({0, 1, 0}), env.sky_gradient.zenith));
   EXPECT_TRUE(near(at({1, 0, 0}), env.sky_gradient.horizon));
@@ -163,7 +163,8 @@ TEST(GltfEnvironment, GradientSkyLoadsEvaluatesAndRoundTrips) {
 
   auto both = engine::load_gltf(with_scene_gi(
       "gradient_plus_uniform.gltf",
-      json::parse(R"({"sky": {"radiance": [1, 1, 1], "zenith": [1, 0, 0], "horizon": [0, 0, 0], "ground": [0, 0, 0]}})")));
+      json::parse(
+          R"({"sky": {"radiance": [1, 1, 1], "zenith": [1, 0, 0], "horizon": [0, 0, 0], "ground": [0, 0, 0]}})")));
   ASSERT_TRUE(both) << both.error().to_string();
   EXPECT_EQ(engine::sky_radiance(both->environment.sky_radiance, both->environment.sky_gradient, {0, 1, 0}),
             glm::vec3(2, 1, 1));
@@ -173,7 +174,8 @@ TEST(GltfEnvironment, GradientSkyLoadsEvaluatesAndRoundTrips) {
 // integration over the sphere.
 TEST(GltfEnvironment, GradientSkyIrradianceFormulasMatchNumericIntegration) {
   const glm::vec3 uniform(0.3f, 0.0f, 0.0f);
-  const engine::SkyGradient g{.zenith = {0.2f, 1.0f, 0.0f}, .horizon = {0.8f, 0.1f, 0.5f}, .ground = {0.1f, 0.6f, 2.0f}};
+  const engine::SkyGradient g{
+      .zenith = {0.2f, 1.0f, 0.0f}, .horizon = {0.8f, 0.1f, 0.5f}, .ground = {0.1f, 0.6f, 2.0f}};
   const int n = 400;  // midpoint rule over (theta, phi)
   const double pi = 3.141592653589793;
   const glm::dvec3 normals[] = {{0, 1, 0}, {0, -1, 0}, {1, 0, 0}, {0.6, 0.8, 0}, {0, -0.6, 0.8}};
@@ -199,7 +201,8 @@ TEST(GltfEnvironment, GradientSkyIrradianceFormulasMatchNumericIntegration) {
       const double e = static_cast<double>(engine::sky_irradiance(uniform, g, glm::vec3(normals[k]))[c]);
       EXPECT_NEAR(e, irradiance[k][c], 2e-3 * (1.0 + irradiance[k][c])) << "normal " << k << " channel " << c;
     }
-    EXPECT_NEAR(static_cast<double>(engine::sky_irradiance(uniform, g, {0, 1, 0})[c]), static_cast<double>(up[c]), 1e-4);
+    EXPECT_NEAR(static_cast<double>(engine::sky_irradiance(uniform, g, {0, 1, 0})[c]), static_cast<double>(up[c]),
+                1e-4);
   }
 }
 

@@ -5,10 +5,10 @@
 
 #include <cstdint>
 #include <cstring>
-#include <limits>
-#include <random>
 #include <filesystem>
 #include <fstream>
+#include <limits>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -61,7 +61,8 @@ json valid_doc(const std::vector<std::uint16_t>& indices = {0, 1, 2}) {
     "nodes": [{"mesh": 0}], "scenes": [{"nodes": [0]}], "scene": 0})");
   d["bufferViews"] = json::array({{{"buffer", 0}, {"byteOffset", 0}, {"byteLength", 36}},
                                   {{"buffer", 0}, {"byteOffset", 36}, {"byteLength", idx.size()}}});
-  d["buffers"] = json::array({{{"byteLength", bin.size()}, {"uri", "data:application/octet-stream;base64," + base64(bin)}}});
+  d["buffers"] =
+      json::array({{{"byteLength", bin.size()}, {"uri", "data:application/octet-stream;base64," + base64(bin)}}});
   return d;
 }
 
@@ -80,8 +81,8 @@ fs::path write(const std::string& name, const std::string& text) {
 
 fs::path write_bytes(const std::string& name, const std::vector<std::uint8_t>& bytes) {
   const fs::path p = dir() / name;
-  std::ofstream(p, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()),
-                                           static_cast<std::streamsize>(bytes.size()));
+  std::ofstream(p, std::ios::binary)
+      .write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
   return p;
 }
 
@@ -288,7 +289,8 @@ std::vector<std::uint8_t> draco_triangle_with_uv(float bad) {
             static_cast<std::int64_t>(sizeof(float)) * ncomp, 0);
     const int id = mesh.AddAttribute(ga, true, 3);
     for (std::uint32_t i = 0; i < 3; ++i)
-      mesh.attribute(id)->SetAttributeValue(draco::AttributeValueIndex(i), v.data() + i * static_cast<std::uint32_t>(ncomp));
+      mesh.attribute(id)->SetAttributeValue(draco::AttributeValueIndex(i),
+                                            v.data() + i * static_cast<std::uint32_t>(ncomp));
     return id;
   };
   add(draco::GeometryAttribute::POSITION, 3, {0, 0, 0, 1, 0, 0, 0, 1, 0});
@@ -344,12 +346,14 @@ TEST(GltfErrors, AbsurdCountsHitTheLimits) {
 TEST(GltfErrors, InvalidLights) {
   json d = valid_doc();
   d["extensionsUsed"] = json::array({"KHR_lights_punctual"});
-  d["extensions"] = json::parse(R"({"KHR_lights_punctual": {"lights": [{"type": "point"}, {"type": "point", "intensity": -1}]}})");
+  d["extensions"] =
+      json::parse(R"({"KHR_lights_punctual": {"lights": [{"type": "point"}, {"type": "point", "intensity": -1}]}})");
   expect_error(write("negative.gltf", d.dump()), {"light 1", "negative"});
   // Finite in the file, infinite as a float (the headless demo once wrote NaN/Inf frames).
   d["extensions"]["KHR_lights_punctual"]["lights"][1] = json::parse(R"({"type": "point", "intensity": 1e39})");
   expect_error(write("huge.gltf", d.dump()), {"light 1", "beyond any real light"});
-  d["extensions"]["KHR_lights_punctual"]["lights"][1] = json::parse(R"({"type": "spot", "spot": {"innerConeAngle": 0.6, "outerConeAngle": 0.3}})");
+  d["extensions"]["KHR_lights_punctual"]["lights"][1] =
+      json::parse(R"({"type": "spot", "spot": {"innerConeAngle": 0.6, "outerConeAngle": 0.3}})");
   expect_error(write("cone.gltf", d.dump()), {"light 1", "innerConeAngle"});
   d["extensions"]["KHR_lights_punctual"]["lights"][1] = json::parse(R"({"type": "sphere"})");
   expect_error(write("type.gltf", d.dump()), {"light 1", "unknown light type 'sphere'"});

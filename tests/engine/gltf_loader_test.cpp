@@ -59,7 +59,10 @@ struct GltfBuilder {
   }
   int accessor(int view_index, int component_type, int count, const char* type, int byte_offset = 0,
                bool normalized = false) {
-    json a = {{"bufferView", view_index}, {"componentType", component_type}, {"count", count}, {"type", type},
+    json a = {{"bufferView", view_index},
+              {"componentType", component_type},
+              {"count", count},
+              {"type", type},
               {"byteOffset", byte_offset}};
     if (normalized) a["normalized"] = true;
     doc["accessors"].push_back(a);
@@ -74,8 +77,8 @@ struct GltfBuilder {
   /// The .gltf text with the buffer as a base64 data URI.
   std::string gltf() const {
     json d = doc;
-    d["buffers"] = json::array({{{"byteLength", bin.size()},
-                                 {"uri", "data:application/octet-stream;base64," + base64(bin)}}});
+    d["buffers"] =
+        json::array({{{"byteLength", bin.size()}, {"uri", "data:application/octet-stream;base64," + base64(bin)}}});
     return d.dump(1);
   }
   /// The same content as a .glb (JSON chunk + BIN chunk).
@@ -118,8 +121,8 @@ fs::path write_text(const std::string& name, const std::string& text) {
 
 fs::path write_bytes(const std::string& name, const std::vector<std::uint8_t>& bytes) {
   const fs::path p = test_dir() / name;
-  std::ofstream(p, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()),
-                                           static_cast<std::streamsize>(bytes.size()));
+  std::ofstream(p, std::ios::binary)
+      .write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
   return p;
 }
 
@@ -218,8 +221,8 @@ TEST(GltfLoader, NodeMatrixIsDecomposedToTrs) {
   }
   EXPECT_NEAR(std::abs(glm::dot(n.rotation, r)), 1.0f, 1e-5f);  // q and -q are the same rotation
   // Recomposed, it gives the same matrix.
-  const glm::mat4 back =
-      glm::translate(glm::mat4(1.0f), n.translation) * glm::mat4_cast(n.rotation) * glm::scale(glm::mat4(1.0f), n.scale);
+  const glm::mat4 back = glm::translate(glm::mat4(1.0f), n.translation) * glm::mat4_cast(n.rotation) *
+                         glm::scale(glm::mat4(1.0f), n.scale);
   for (int c = 0; c < 4; ++c) {
     for (int row = 0; row < 4; ++row) EXPECT_NEAR(back[c][row], m[c][row], 1e-5f);
   }
@@ -228,7 +231,8 @@ TEST(GltfLoader, NodeMatrixIsDecomposedToTrs) {
 TEST(GltfLoader, TrsAndQuaternionOrderFollowGltf) {
   GltfBuilder b = triangle_file();
   // glTF rotation is [x, y, z, w]: 90 degrees about +Y.
-  b.doc["nodes"] = json::parse(R"([{"translation": [1, 2, 3], "rotation": [0, 0.70710678, 0, 0.70710678], "scale": [4, 5, 6]}])");
+  b.doc["nodes"] =
+      json::parse(R"([{"translation": [1, 2, 3], "rotation": [0, 0.70710678, 0, 0.70710678], "scale": [4, 5, 6]}])");
   const auto s = load(write_text("trs.gltf", b.gltf()));
   ASSERT_EQ(s.nodes.size(), 1u);
   EXPECT_EQ(s.nodes[0].translation, glm::vec3(1, 2, 3));
@@ -243,7 +247,8 @@ TEST(GltfLoader, MissingNormalsAreAreaWeightedSmoothNormals) {
   // small one in the XZ plane (cross product (0,1,0)).
   const int pos = b.floats({0, 0, 0, 2, 0, 0, 0, 2, 0, 0, 0, 1, 1, 0, 0}, "VEC3", 3);
   const int idx = b.indices({0, 1, 2, 0, 3, 4});
-  b.doc["meshes"] = json::array({{{"primitives", json::array({{{"attributes", {{"POSITION", pos}}}, {"indices", idx}}})}}});
+  b.doc["meshes"] =
+      json::array({{{"primitives", json::array({{{"attributes", {{"POSITION", pos}}}, {"indices", idx}}})}}});
   const auto s = load(write_text("n.gltf", b.gltf()));
   ASSERT_EQ(s.meshes.size(), 1u);
   const auto& p = s.meshes[0].primitives.at(0);
@@ -265,10 +270,11 @@ TEST(GltfLoader, Texcoord1IsLoadedWhenPresent) {
   const int pos = b.floats({0, 0, 0, 1, 0, 0, 0, 1, 0}, "VEC3", 3);
   const int uv0 = b.floats({0, 0, 1, 0, 0, 1}, "VEC2", 2);
   const int uv1 = b.floats({0.25f, 0.25f, 0.5f, 0.25f, 0.25f, 0.5f}, "VEC2", 2);
-  b.doc["meshes"] = json::array({{{"primitives", json::array({
-                                     {{"attributes", {{"POSITION", pos}, {"TEXCOORD_0", uv0}, {"TEXCOORD_1", uv1}}}},
-                                     {{"attributes", {{"POSITION", pos}, {"TEXCOORD_0", uv0}}}},
-                                 })}}});
+  b.doc["meshes"] =
+      json::array({{{"primitives", json::array({
+                                       {{"attributes", {{"POSITION", pos}, {"TEXCOORD_0", uv0}, {"TEXCOORD_1", uv1}}}},
+                                       {{"attributes", {{"POSITION", pos}, {"TEXCOORD_0", uv0}}}},
+                                   })}}});
   const auto s = load(write_text("uv.gltf", b.gltf()));
   ASSERT_EQ(s.meshes.at(0).primitives.size(), 2u);
   const auto& with = s.meshes[0].primitives[0];
@@ -286,9 +292,10 @@ TEST(GltfLoader, StripsAndFansBecomeConsistentlyWoundLists) {
   const int strip_pos = b.floats({0, 0, 0, 0, 1, 0, 1, 0, 0, 1, 1, 0, 2, 0, 0}, "VEC3", 3);
   // A fan around the origin, counter-clockwise seen from +Z.
   const int fan_pos = b.floats({0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0, -1, 1, 0}, "VEC3", 3);
-  b.doc["meshes"] = json::array({{{"primitives", json::array({{{"attributes", {{"POSITION", strip_pos}}}, {"mode", 5}},
-                                                             {{"attributes", {{"POSITION", fan_pos}}}, {"mode", 6}},
-                                                             {{"attributes", {{"POSITION", fan_pos}}}, {"mode", 1}}})}}});
+  b.doc["meshes"] =
+      json::array({{{"primitives", json::array({{{"attributes", {{"POSITION", strip_pos}}}, {"mode", 5}},
+                                                {{"attributes", {{"POSITION", fan_pos}}}, {"mode", 6}},
+                                                {{"attributes", {{"POSITION", fan_pos}}}, {"mode", 1}}})}}});
   const auto s = load(write_text("strip.gltf", b.gltf()));
   ASSERT_EQ(s.meshes.at(0).primitives.size(), 2u) << "the LINES primitive is skipped";
   const auto& strip = s.meshes[0].primitives[0];
@@ -323,8 +330,9 @@ TEST(GltfLoader, NormalizedStridedAndSparseAccessors) {
       {"count", 1},
       {"indices", {{"bufferView", sparse_indices}, {"componentType", 5123}}},
       {"values", {{"bufferView", sparse_values}}}};
-  b.doc["meshes"] = json::array(
-      {{{"primitives", json::array({{{"attributes", {{"POSITION", pos}, {"TEXCOORD_0", uv}, {"TEXCOORD_1", uv1}}}}})}}});
+  b.doc["meshes"] =
+      json::array({{{"primitives",
+                     json::array({{{"attributes", {{"POSITION", pos}, {"TEXCOORD_0", uv}, {"TEXCOORD_1", uv1}}}}})}}});
   const auto s = load(write_text("layout.gltf", b.gltf()));
   ASSERT_EQ(s.meshes.size(), 1u);
   const auto& p = s.meshes[0].primitives.at(0);
@@ -460,7 +468,8 @@ TEST(GltfLoader, PunctualLightsAndCamerasInEngineUnits) {
 
 TEST(GltfLoader, GiExtrasGiveMobilityMovingLightsAndAreaLights) {
   GltfBuilder b = triangle_file();
-  b.doc["extensions"] = json::parse(R"({"KHR_lights_punctual": {"lights": [{"type": "spot", "spot": {}}, {"type": "point"}]}})");
+  b.doc["extensions"] =
+      json::parse(R"({"KHR_lights_punctual": {"lights": [{"type": "spot", "spot": {}}, {"type": "point"}]}})");
   b.doc["nodes"] = json::parse(R"([
     {"name": "wall", "mesh": 0, "extras": {"gi": {"mobility": "static"}}},
     {"name": "crate", "mesh": 0, "extras": {"gi": {"mobility": "dynamic", "future_key": 3}, "other": 1}},
@@ -497,8 +506,10 @@ TEST(GltfLoader, GlbLoadsTheSameAsGltf) {
   const int idx = b.indices({0, 1, 2, 2, 1, 3});
   b.doc["meshes"] = json::array(
       {{{"name", "quad"},
-        {"primitives", json::array({{{"attributes", {{"POSITION", pos}, {"NORMAL", nrm}, {"TEXCOORD_1", uv1}}}, {"indices", idx}}})}}});
-  b.doc["nodes"] = json::parse(R"([{"name": "q", "mesh": 0, "translation": [1, 2, 3], "children": [1]}, {"name": "c"}])");
+        {"primitives", json::array({{{"attributes", {{"POSITION", pos}, {"NORMAL", nrm}, {"TEXCOORD_1", uv1}}},
+                                     {"indices", idx}}})}}});
+  b.doc["nodes"] =
+      json::parse(R"([{"name": "q", "mesh": 0, "translation": [1, 2, 3], "children": [1]}, {"name": "c"}])");
   const auto text = load(write_text("same.gltf", b.gltf()));
   // Saved with a .gltf extension on purpose: the loader decides by the magic.
   const auto binary = load(write_bytes("same_binary.gltf", b.glb()));

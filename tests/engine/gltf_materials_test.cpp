@@ -66,7 +66,8 @@ json textured_doc(bool uv1 = false) {
     "materials": [{"name": "leaf", "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}],
     "nodes": [{"mesh": 0}], "scenes": [{"nodes": [0]}], "scene": 0})");
   if (uv1) d["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_1"] = 1;
-  d["buffers"] = json::array({{{"byteLength", bin.size()}, {"uri", "data:application/octet-stream;base64," + base64(bin)}}});
+  d["buffers"] =
+      json::array({{{"byteLength", bin.size()}, {"uri", "data:application/octet-stream;base64," + base64(bin)}}});
   return d;
 }
 
@@ -251,8 +252,33 @@ TEST(GltfMaterials, ImagesOverTheSceneBudgetAreRefused) {
 TEST(GltfMaterials, TangentsAreLoaded) {
   json d = textured_doc();
   // textured_doc's positions (36 bytes) and uvs (24 bytes), then 3 tangents (48 bytes).
-  std::vector<float> data = {0, 0, 0, 1, 0, 0, 0, 1, 0, /* uv */ 0, 0, 1, 0, 0, 1,
-                             /* tangents */ 1, 0, 0, 1, 0, 2, 0, 1, 0, 0, 1, -1};
+  std::vector<float> data = {0,
+                             0,
+                             0,
+                             1,
+                             0,
+                             0,
+                             0,
+                             1,
+                             0,
+                             /* uv */ 0,
+                             0,
+                             1,
+                             0,
+                             0,
+                             1,
+                             /* tangents */ 1,
+                             0,
+                             0,
+                             1,
+                             0,
+                             2,
+                             0,
+                             1,
+                             0,
+                             0,
+                             1,
+                             -1};
   std::vector<std::uint8_t> bin(data.size() * 4);
   std::memcpy(bin.data(), data.data(), bin.size());
   d["buffers"][0] = {{"byteLength", bin.size()}, {"uri", "data:application/octet-stream;base64," + base64(bin)}};

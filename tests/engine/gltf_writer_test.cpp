@@ -1,17 +1,17 @@
 // engine::write_gltf: round trips through engine::load_gltf (.gltf and .glb), byte
 // determinism, all-or-nothing output, Draco within quantization and bad-input errors.
-#include <engine/gltf.h>
 #include <gtest/gtest.h>
+#include <engine/gltf.h>
 
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <glm/gtc/constants.hpp>
 #include <iterator>
 #include <limits>
-#include <nlohmann/json.hpp>
 #include <string>
+#include <glm/gtc/constants.hpp>
+#include <nlohmann/json.hpp>
 
 namespace {
 
@@ -99,7 +99,8 @@ engine::SceneAsset feature_scene() {
   img.width = 4;
   img.height = 2;
   for (int i = 0; i < img.width * img.height; ++i)
-    img.rgba8.insert(img.rgba8.end(), {static_cast<std::uint8_t>(30 * i), static_cast<std::uint8_t>(255 - 20 * i), 7, 255});
+    img.rgba8.insert(img.rgba8.end(),
+                     {static_cast<std::uint8_t>(30 * i), static_cast<std::uint8_t>(255 - 20 * i), 7, 255});
   s.images.push_back(img);
   engine::Image mask;  // alpha 0 or 255 in a 2x2 checker
   mask.name = "mask";
@@ -118,7 +119,8 @@ engine::SceneAsset feature_scene() {
   big.primitives.push_back(grid_primitive(260, 5.0f, false, 2));
   s.meshes.push_back(big);
 
-  engine::Light point{.type = engine::LightType::Point, .color = {1.0f, 0.9f, 0.8f}, .intensity = 12.0f, .range_m = 20.0f};
+  engine::Light point{
+      .type = engine::LightType::Point, .color = {1.0f, 0.9f, 0.8f}, .intensity = 12.0f, .range_m = 20.0f};
   engine::Light spot{.type = engine::LightType::Spot, .intensity = 3.0f};
   spot.inner_cone_rad = glm::radians(30.0f);
   spot.outer_cone_rad = glm::radians(40.0f);
@@ -237,7 +239,8 @@ void expect_round_trip(const engine::SceneAsset& in, const engine::SceneAsset& o
       const engine::Light& la = in.lights[static_cast<std::size_t>(a.light)].light;
       const engine::Light& lb = out.lights[static_cast<std::size_t>(b->light)].light;
       EXPECT_EQ(lb.type, la.type) << a.name;
-      expect_vec_near(lb.color * lb.intensity, la.color * la.intensity, 1e-5f * la.intensity, a.name + " color x intensity");
+      expect_vec_near(lb.color * lb.intensity, la.color * la.intensity, 1e-5f * la.intensity,
+                      a.name + " color x intensity");
       EXPECT_EQ(lb.moves, la.moves) << a.name;
       if (la.type == engine::LightType::Spot) {
         EXPECT_NEAR(lb.inner_cone_rad, la.inner_cone_rad, 1e-6f);
@@ -504,7 +507,10 @@ TEST(GltfWriter, RejectsInconsistentPrimitiveWithItsLocation) {
 // Quantization step of `bits` over the largest extent of the primitive's bounding box.
 float quantization_step(const std::vector<glm::vec3>& positions, int bits) {
   glm::vec3 lo(1e30f), hi(-1e30f);
-  for (const glm::vec3& p : positions) { lo = glm::min(lo, p); hi = glm::max(hi, p); }
+  for (const glm::vec3& p : positions) {
+    lo = glm::min(lo, p);
+    hi = glm::max(hi, p);
+  }
   const glm::vec3 ext = hi - lo;
   return std::max({ext.x, ext.y, ext.z}) / static_cast<float>((1 << bits) - 1);
 }
@@ -531,18 +537,24 @@ TEST(GltfWriter, DracoPrimitivesMatchTheirPlainTwinsWithinQuantization) {
       const float step = quantization_step(a.positions, options.draco_position_bits);
       if (a.positions.size() > 2000) continue;  // the big grid is checked by count only (O(n^2) match)
       for (std::size_t t = 0; t < b.indices.size(); t += 3) {
-        const glm::vec3 cb = (b.positions[b.indices[t]] + b.positions[b.indices[t + 1]] + b.positions[b.indices[t + 2]]) / 3.0f;
+        const glm::vec3 cb =
+            (b.positions[b.indices[t]] + b.positions[b.indices[t + 1]] + b.positions[b.indices[t + 2]]) / 3.0f;
         std::size_t best = 0;
         float best_d = 1e30f;
         for (std::size_t s = 0; s < a.indices.size(); s += 3) {
-          const glm::vec3 ca = (a.positions[a.indices[s]] + a.positions[a.indices[s + 1]] + a.positions[a.indices[s + 2]]) / 3.0f;
+          const glm::vec3 ca =
+              (a.positions[a.indices[s]] + a.positions[a.indices[s + 1]] + a.positions[a.indices[s + 2]]) / 3.0f;
           const float d = glm::length(ca - cb);
-          if (d < best_d) { best_d = d; best = s; }
+          if (d < best_d) {
+            best_d = d;
+            best = s;
+          }
         }
         for (int c = 0; c < 3; ++c) {
           const glm::vec3 pb = b.positions[b.indices[t + static_cast<std::size_t>(c)]];
           float nearest = 1e30f;
-          for (int e = 0; e < 3; ++e) nearest = std::min(nearest, glm::length(pb - a.positions[a.indices[best + static_cast<std::size_t>(e)]]));
+          for (int e = 0; e < 3; ++e)
+            nearest = std::min(nearest, glm::length(pb - a.positions[a.indices[best + static_cast<std::size_t>(e)]]));
           // Per component error <= step / 2, so the 3-D error <= step * sqrt(3) / 2 < step.
           EXPECT_LE(nearest, step) << "mesh " << m << " primitive " << k << " triangle " << t / 3;
         }

@@ -148,8 +148,9 @@ TEST(ShaderProgramBuilder, BuildsAndRunsEmbeddedEngineShaders) {
                 .build();
   ASSERT_TRUE(ok.ok()) << ok.error().to_string();
   EXPECT_FALSE(ok->empty());
-  for (auto [vs, fs] : {std::pair{"forward.vert.glsl", "forward.frag.glsl"}, std::pair{"shadow.vert.glsl", "shadow.frag.glsl"},
-                        std::pair{"fullscreen.vert.glsl", "tonemap.frag.glsl"}}) {
+  for (auto [vs, fs] :
+       {std::pair{"forward.vert.glsl", "forward.frag.glsl"}, std::pair{"shadow.vert.glsl", "shadow.frag.glsl"},
+        std::pair{"fullscreen.vert.glsl", "tonemap.frag.glsl"}}) {
     auto p = engine::ShaderProgramBuilder(engine::engine_shader_files())
                  .stage(engine::ShaderStage::Vertex, vs)
                  .stage(engine::ShaderStage::Fragment, fs)

@@ -57,7 +57,8 @@ TEST(ImageExr, WriteReadRoundTripWithinHalfPrecision) {
 TEST(ImageExr, FloatPixelsRoundTripBitExactly) {
   const fs::path dir = scratch_dir("exr_float");
   engine::ImageRgbaF img{7, 3, {}};
-  for (int i = 0; i < 7 * 3 * 4; ++i) img.pixels.push_back(1.0f / static_cast<float>(i + 3) + 1e5f * static_cast<float>(i % 3));
+  for (int i = 0; i < 7 * 3 * 4; ++i)
+    img.pixels.push_back(1.0f / static_cast<float>(i + 3) + 1e5f * static_cast<float>(i % 3));
   ASSERT_TRUE(engine::save_exr(dir / "a.exr", img, engine::ExrPixelType::Float).ok());
   auto back = engine::load_exr(dir / "a.exr");
   ASSERT_TRUE(back.ok()) << back.error().to_string();

@@ -32,10 +32,10 @@ engine::ReachOccluder wall_with_doorway() {
 
 TEST(LightReach, SegmentTestSeesThroughTheDoorwayOnly) {
   const std::vector<engine::ReachOccluder> occ{wall_with_doorway()};
-  EXPECT_FALSE(engine::segment_blocked(occ, {-2, 1, 0}, {2, 1, 0}, 1e-3f));     // through the doorway
-  EXPECT_TRUE(engine::segment_blocked(occ, {-2, 1, 2}, {2, 1, 2}, 1e-3f));      // through the wall
+  EXPECT_FALSE(engine::segment_blocked(occ, {-2, 1, 0}, {2, 1, 0}, 1e-3f));       // through the doorway
+  EXPECT_TRUE(engine::segment_blocked(occ, {-2, 1, 2}, {2, 1, 2}, 1e-3f));        // through the wall
   EXPECT_TRUE(engine::segment_blocked(occ, {-2, 2.5f, 0}, {2, 2.5f, 0}, 1e-3f));  // through the lintel
-  EXPECT_FALSE(engine::segment_blocked(occ, {-2, 1, 2}, {-1, 1, -2}, 1e-3f));  // beside it
+  EXPECT_FALSE(engine::segment_blocked(occ, {-2, 1, 2}, {-1, 1, -2}, 1e-3f));     // beside it
 }
 
 TEST(LightReach, ConservativeAtRandomPointsAndCullsBehindTheWall) {
@@ -76,7 +76,8 @@ TEST(LightReach, AreaLightsReachOnlyTheirEmittingSide) {
   area.direction = {0.0f, -1.0f, 0.0f};
   area.half_x = {0.5f, 0.0f, 0.0f};
   area.half_y = {0.0f, 0.0f, 0.5f};
-  const engine::LightReachGrid g = engine::build_light_reach_grid({}, {area}, glm::vec3(-3, 0, -3), glm::vec3(3, 6, 3), 0.5f);
+  const engine::LightReachGrid g =
+      engine::build_light_reach_grid({}, {area}, glm::vec3(-3, 0, -3), glm::vec3(3, 6, 3), 0.5f);
   EXPECT_EQ(g.at({1.0f, 0.5f, 1.0f}), 1);
   EXPECT_EQ(g.at({0.0f, 4.5f, 0.0f}), 0);
 }
@@ -108,8 +109,9 @@ TEST(RendererLightReach, SameImageWithAndWithoutCulling) {
   add_light(reg, engine::Light{.type = engine::LightType::Area, .intensity = 10.0f, .area_size_m = {1.0f, 1.0f}},
             {2.0f, 2.9f, -1.0f}, {2.0f, 0.0f, -1.0f});
   // A moving point light (its reach is recomputed when it moves), first in room B.
-  const engine::Entity lamp = add_light(
-      reg, engine::Light{.type = engine::LightType::Point, .intensity = 8.0f, .moves = true}, {2.5f, 1.5f, 2.5f}, {0, 0, 0});
+  const engine::Entity lamp =
+      add_light(reg, engine::Light{.type = engine::LightType::Point, .intensity = 8.0f, .moves = true},
+                {2.5f, 1.5f, 2.5f}, {0, 0, 0});
   const TestCamera cam{{0.0f, 9.0f, 0.5f}, {0.0f, 0.0f, 0.0f}, 0.9f, 128};
   const engine::Entity camera = cam.add_to(reg);
 

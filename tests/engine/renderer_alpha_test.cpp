@@ -31,8 +31,10 @@ engine::TextureSampler nearest(engine::TextureWrap wrap = engine::TextureWrap::C
 }
 
 float channel(const engine::ImageRgbaF& img, glm::ivec2 p, int c) {
-  return img.pixels[(static_cast<std::size_t>(p.y) * static_cast<std::size_t>(img.width) + static_cast<std::size_t>(p.x)) * 4 +
-                    static_cast<std::size_t>(c)];
+  return img
+      .pixels[(static_cast<std::size_t>(p.y) * static_cast<std::size_t>(img.width) + static_cast<std::size_t>(p.x)) *
+                  4 +
+              static_cast<std::size_t>(c)];
 }
 
 // --- Alpha: a 1 m quad at y = 2 over a floor, a point light at (-3, 4, 0): the quad's shadow
@@ -142,8 +144,8 @@ TEST(RendererAlpha, BlendAtOneHalfMixesWithWhatIsBehind) {
   const glm::ivec2 p = blend.cam.pixel_of(at);
   for (int c : {0, 1}) {
     const float expected = 0.5f * channel(quad, p, c) + 0.5f * channel(floor, p, c);
-    std::printf("BLEND 50%%: channel %d %.4f, 0.5 quad + 0.5 floor %.4f\n", c, static_cast<double>(channel(mixed, p, c)),
-                static_cast<double>(expected));
+    std::printf("BLEND 50%%: channel %d %.4f, 0.5 quad + 0.5 floor %.4f\n", c,
+                static_cast<double>(channel(mixed, p, c)), static_cast<double>(expected));
     EXPECT_NEAR(channel(mixed, p, c), expected, 0.02f * expected + 1e-4f) << "channel " << c;
   }
   EXPECT_GT(channel(floor, p, 1), 0.05f);  // the mix is not trivially one of the two

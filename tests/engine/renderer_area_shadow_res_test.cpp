@@ -94,9 +94,10 @@ TEST(RendererAreaShadowRes, HalfResolutionMatchesFullWithinTheNeighbourhood) {
   std::sort(diffs.begin(), diffs.end());
   const float p95 = diffs[diffs.size() * 95 / 100];
   const float max_diff = diffs.back();
-  std::printf("half vs full resolution area shadows: max %.4f, p95 %.5f of the peak; %d pixels beyond their "
-              "neighbourhood's range (worst %.4f)\n",
-              static_cast<double>(max_diff), static_cast<double>(p95), outside, static_cast<double>(worst_outside));
+  std::printf(
+      "half vs full resolution area shadows: max %.4f, p95 %.5f of the peak; %d pixels beyond their "
+      "neighbourhood's range (worst %.4f)\n",
+      static_cast<double>(max_diff), static_cast<double>(p95), outside, static_cast<double>(worst_outside));
   EXPECT_EQ(outside, 0) << "worst " << worst_outside << " of the peak beyond the 5x5 neighbourhood's range";
   EXPECT_LT(p95, 0.01f);
   // The largest difference is at the sharpest penumbrae (contact shadows); a shadow lent across

@@ -93,7 +93,8 @@ TEST(RendererSpotLight, LitInsideConeDarkOutside) {
   PlaneScene s;
   const float outer = 0.3f;
   add_light(s.reg,
-            engine::Light{.type = engine::LightType::Spot, .intensity = 10.0f, .inner_cone_rad = 0.2f, .outer_cone_rad = outer},
+            engine::Light{
+                .type = engine::LightType::Spot, .intensity = 10.0f, .inner_cone_rad = 0.2f, .outer_cone_rad = outer},
             {0, 2, 0}, {0, 0, 0});
   const engine::ImageRgbaF img = s.render();
   const int c = s.cam.size / 2;
@@ -140,11 +141,13 @@ TEST(RendererAreaLight, CentreIrradianceMatchesRectangleFormFactor) {
   const int n = 200;
   for (int j = 0; j < n; ++j)
     for (int i = 0; i < n; ++i) {
-      const glm::vec3 q((static_cast<float>(i) + 0.5f) / n * w - 0.5f * w, d, (static_cast<float>(j) + 0.5f) / n * h - 0.5f * h);
+      const glm::vec3 q((static_cast<float>(i) + 0.5f) / n * w - 0.5f * w, d,
+                        (static_cast<float>(j) + 0.5f) / n * h - 0.5f * h);
       const float d2 = glm::dot(q, q);
       const glm::vec3 l = q / std::sqrt(d2);
       const float dA = w * h / static_cast<float>(n * n);
-      spec += static_cast<double>(radiance * (reference_brdf_cos(kAlbedo, 0, 1, {0, 1, 0}, v, l) - kAlbedo / kPi * l.y) * l.y * dA / d2);
+      spec += static_cast<double>(
+          radiance * (reference_brdf_cos(kAlbedo, 0, 1, {0, 1, 0}, v, l) - kAlbedo / kPi * l.y) * l.y * dA / d2);
     }
   const float expected = kAlbedo / kPi * e + static_cast<float>(spec);
   // Diffuse: exact polygon integral; specular: 16 stratified points (spec is ~2% of the total).
@@ -214,7 +217,8 @@ TEST(RendererAreaLight, RoughDielectricsTakeOneSpecularPoint) {
     worst = std::max(worst, diff / nine.pixels[i]);
     largest = std::max(largest, diff);
   }
-  std::printf("rough dielectric, one area-specular point vs 3 x 3: worst %.4f%% of the pixel\n", 100.0 * static_cast<double>(worst));
+  std::printf("rough dielectric, one area-specular point vs 3 x 3: worst %.4f%% of the pixel\n",
+              100.0 * static_cast<double>(worst));
   EXPECT_GT(largest, 0.0f);
   EXPECT_LT(worst, 0.015f);
 }
@@ -226,7 +230,8 @@ TEST(RendererGgx, GlossyHighlightAtMirrorDirectionIsStrongerThanRough) {
   for (int k = 0; k < 2; ++k) {
     PlaneScene s(roughness[k]);
     s.cam = TestCamera{{1.0f, 2.0f, 0.0f}, {0.0f, 0.0f, 0.0f}};
-    add_light(s.reg, engine::Light{.type = engine::LightType::Point, .intensity = 10.0f}, {-1.0f, 2.0f, 0.0f}, {0, 0, 0});
+    add_light(s.reg, engine::Light{.type = engine::LightType::Point, .intensity = 10.0f}, {-1.0f, 2.0f, 0.0f},
+              {0, 0, 0});
     const engine::ImageRgbaF img = s.render();
     const int c = s.cam.size / 2;
     centre[k] = red(img, c, c);

@@ -72,7 +72,8 @@ TEST(RendererMaterials, EmissionIsAddedAsRadiance) {
   m.emissive = glm::vec3(2.0f, 1.0f, 0.5f);
   const engine::ImageRgbaF img = s.render(m, false);
   const int c = s.cam.size / 2;
-  const std::size_t i = (static_cast<std::size_t>(c) * static_cast<std::size_t>(img.width) + static_cast<std::size_t>(c)) * 4;
+  const std::size_t i =
+      (static_cast<std::size_t>(c) * static_cast<std::size_t>(img.width) + static_cast<std::size_t>(c)) * 4;
   EXPECT_NEAR(img.pixels[i + 0], 2.0f, 2e-3f);
   EXPECT_NEAR(img.pixels[i + 1], 1.0f, 1e-3f);
   EXPECT_NEAR(img.pixels[i + 2], 0.5f, 1e-3f);
@@ -95,7 +96,8 @@ TEST(RendererMaterials, SingleSidedBackFacesAreCulledDoubleSidedAreShaded) {
     ASSERT_NE(r, nullptr);
     r->render(reg, camera);
     const engine::ImageRgbaF img = r->read_hdr();
-    EXPECT_NEAR(red(img, cam.size / 2, cam.size / 2), double_sided ? 1.0f : 0.0f, 1e-3f) << "double_sided " << double_sided;
+    EXPECT_NEAR(red(img, cam.size / 2, cam.size / 2), double_sided ? 1.0f : 0.0f, 1e-3f)
+        << "double_sided " << double_sided;
   }
 }
 

@@ -83,7 +83,8 @@ TEST(RendererShadows, FlatShadingYardstickWritesTheBaseColourUnlit) {
 TEST(RendererShadows, SpotLightShadow) {
   engine::GpuContext ctx = headless_context();
   OccluderScene s;
-  expect_shadow(s.render(engine::Light{.type = engine::LightType::Spot, .intensity = 10.0f, .outer_cone_rad = 0.7f}), s.cam);
+  expect_shadow(s.render(engine::Light{.type = engine::LightType::Spot, .intensity = 10.0f, .outer_cone_rad = 0.7f}),
+                s.cam);
 }
 
 TEST(RendererShadows, DirectionalLightShadow) {
@@ -95,8 +96,9 @@ TEST(RendererShadows, DirectionalLightShadow) {
 TEST(RendererShadows, AreaLightShadow) {
   engine::GpuContext ctx = headless_context();
   OccluderScene s;
-  expect_shadow(s.render(engine::Light{.type = engine::LightType::Area, .intensity = 250.0f, .area_size_m = {0.2f, 0.2f}}),
-                s.cam);
+  expect_shadow(
+      s.render(engine::Light{.type = engine::LightType::Area, .intensity = 250.0f, .area_size_m = {0.2f, 0.2f}}),
+      s.cam);
 }
 
 TEST(RendererShadows, NoSelfShadowAcneOnLitPlane) {
@@ -109,8 +111,8 @@ TEST(RendererShadows, NoSelfShadowAcneOnLitPlane) {
     for (int x = 0; x < s.cam.size; x += 4) {
       const glm::vec3 p = s.cam.plane_point(x, y);
       if (p.x < 0.8f && std::abs(p.z) < 0.45f) continue;  // the box's shadow spans x in [-0.4, 0.62] m
-      const float expected = reference_point_light(kAlbedo, 1.0f, p, s.cam.eye, {-1.5f, 2.0f, 0.0f}, 10.0f) +
-                             kAlbedo * kAmbient;
+      const float expected =
+          reference_point_light(kAlbedo, 1.0f, p, s.cam.eye, {-1.5f, 2.0f, 0.0f}, 10.0f) + kAlbedo * kAmbient;
       EXPECT_NEAR(red(img, x, y), expected, 0.02f * expected) << "pixel " << x << "," << y;
       ++checked;
     }
@@ -193,7 +195,8 @@ TEST(RendererReadback, RowsRunTopToBottom) {
   const glm::ivec2 under = cam.pixel_of({0, 0, -1});
   EXPECT_LT(under.y, cam.size / 2);
   EXPECT_GT(red(hdr, cam.size / 2, 2), red(hdr, cam.size / 2, cam.size - 3));
-  const float expected = reference_point_light(kAlbedo, 1.0f, cam.plane_point(under.x, under.y), cam.eye, {0, 1, -1}, 10.0f);
+  const float expected =
+      reference_point_light(kAlbedo, 1.0f, cam.plane_point(under.x, under.y), cam.eye, {0, 1, -1}, 10.0f);
   EXPECT_NEAR(red(hdr, under), expected, 0.02f * expected);
 }
 
@@ -246,7 +249,8 @@ TEST(RendererIndirect, AtlasForStaticAndVertexBufferForDynamicMeshes) {
     // Irradiance without direction is reflected as uniform light: E / pi x the BRDF's
     // directional albedo at the view angle (both lobes).
     const float cos_v = 4.0f / std::sqrt(16.0f + 1.2f * 1.2f);
-    const float albedo = engine::gltf_directional_albedo(engine::gltf_brdf(glm::vec3(kAlbedo), 0.0f, 1.0f), cos_v).sum().x;
+    const float albedo =
+        engine::gltf_directional_albedo(engine::gltf_brdf(glm::vec3(kAlbedo), 0.0f, 1.0f), cos_v).sum().x;
     EXPECT_NEAR(red(img, cam.pixel_of({-1.2f, 0, 0})), albedo / kPi * atlas_e, 0.01f * albedo / kPi * atlas_e);
     EXPECT_NEAR(red(img, cam.pixel_of({1.2f, 0, 0})), albedo / kPi * 4.0f, 0.01f * albedo / kPi * 4.0f);
     ASSERT_EQ(r->last_timings().size(), 4u);
@@ -334,8 +338,8 @@ TEST(RendererShadows, MapsAreReRenderedOnlyWhenTheirLightOrACasterMoves) {
 TEST(RendererShadows, UnseenViewsAreDrawnWhenTheCameraTurnsToThem) {
   engine::GpuContext ctx = headless_context();
   OccluderScene s;
-  const engine::Entity lamp =
-      add_light(s.reg, engine::Light{.type = engine::LightType::Point, .intensity = 5.0f}, {1.5f, 2.0f, 0.5f}, {0, 0, 0});
+  const engine::Entity lamp = add_light(s.reg, engine::Light{.type = engine::LightType::Point, .intensity = 5.0f},
+                                        {1.5f, 2.0f, 0.5f}, {0, 0, 0});
   const engine::Entity camera = s.cam.add_to(s.reg);
   auto r = make_renderer(s.assets, s.cam.size, kAmbient);
   ASSERT_TRUE(r);
@@ -466,8 +470,9 @@ TEST(RendererShadows, AreaLightPenumbraFollowsTheLightsSize) {
   const double ramp = 0.6 * 1.0 / (2.0 - 1.0);
   const double soft = area_edge_width(true, 0.6f, 2.0f, 1.0f);
   const double hard = area_edge_width(false, 0.6f, 2.0f, 1.0f);
-  std::printf("area light 0.6 m, 10-90%% shadow edge: soft %.4f m, from the centre %.4f m (geometry 0.8 x %.3f = %.4f)\n",
-              soft, hard, ramp, 0.8 * ramp);
+  std::printf(
+      "area light 0.6 m, 10-90%% shadow edge: soft %.4f m, from the centre %.4f m (geometry 0.8 x %.3f = %.4f)\n", soft,
+      hard, ramp, 0.8 * ramp);
   EXPECT_NEAR(soft, 0.8 * ramp, 0.2 * 0.8 * ramp);
   EXPECT_LT(hard, 0.25 * soft);
 }

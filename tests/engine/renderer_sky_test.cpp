@@ -1,8 +1,8 @@
 // The renderer's sky term (RenderSettings::sky_radiance / sky_gradient, docs/scene-format.md):
-// a gradient sky lights an upward plane with its analytic irradiance, and a provider's sky visibility (IndirectLightFrame::sky_visibility) darkens the sky
-// term of a dynamic entity and of nothing else. A provider whose atlas holds the sky, or the
-// static lights' direct light (IndirectLightFrame::atlas_holds_*), replaces those terms on the
-// static surfaces that read it, and on nothing else: nothing is drawn twice.
+// a gradient sky lights an upward plane with its analytic irradiance, and a provider's sky visibility
+// (IndirectLightFrame::sky_visibility) darkens the sky term of a dynamic entity and of nothing else. A provider whose
+// atlas holds the sky, or the static lights' direct light (IndirectLightFrame::atlas_holds_*), replaces those terms on
+// the static surfaces that read it, and on nothing else: nothing is drawn twice.
 #define GL_GLEXT_PROTOTYPES 1
 #include <GL/glcorearb.h>
 #include <engine/gltf_brdf.h>
@@ -60,7 +60,8 @@ struct TwoPlanes {
 TEST(RendererSky, GradientSkyLightsAnUpwardPlaneWithItsIrradiance) {
   engine::GpuContext ctx = headless_context();
   TwoPlanes s;
-  s.assets.environment.sky_gradient = {.zenith = {2.0f, 1.0f, 1.0f}, .horizon = {0.5f, 1.0f, 1.0f}, .ground = {9.0f, 9.0f, 9.0f}};
+  s.assets.environment.sky_gradient = {
+      .zenith = {2.0f, 1.0f, 1.0f}, .horizon = {0.5f, 1.0f, 1.0f}, .ground = {9.0f, 9.0f, 9.0f}};
   auto r = make_renderer(s.assets, s.cam.size, 0.0f);
   ASSERT_NE(r, nullptr);
   EXPECT_EQ(r->settings().sky_gradient, s.assets.environment.sky_gradient);
@@ -125,12 +126,15 @@ TEST(RendererSky, AnAtlasThatHoldsTheSkyReplacesTheSkyTermOnStaticSurfacesOnly) 
   const float from_atlas = baked / kPi * s.albedo_at(1.2f);
   r->render(s.reg, s.camera);
   engine::ImageRgbaF img = r->read_hdr();
-  EXPECT_NEAR(red(img, s.cam.pixel_of({-1.2f, 0, 0})), open + from_atlas, 0.01f * open) << "static, atlas of indirect light only";
+  EXPECT_NEAR(red(img, s.cam.pixel_of({-1.2f, 0, 0})), open + from_atlas, 0.01f * open)
+      << "static, atlas of indirect light only";
   atlas.frame_.atlas_holds_sky = true;
   r->render(s.reg, s.camera);
   img = r->read_hdr();
-  EXPECT_NEAR(red(img, s.cam.pixel_of({-1.2f, 0, 0})), from_atlas, 0.01f * from_atlas) << "static: the atlas's sky alone";
-  EXPECT_NEAR(red(img, s.cam.pixel_of({1.2f, 0, 0})), open, 0.01f * open) << "dynamic: reads no atlas, keeps the sky term";
+  EXPECT_NEAR(red(img, s.cam.pixel_of({-1.2f, 0, 0})), from_atlas, 0.01f * from_atlas)
+      << "static: the atlas's sky alone";
+  EXPECT_NEAR(red(img, s.cam.pixel_of({1.2f, 0, 0})), open, 0.01f * open)
+      << "dynamic: reads no atlas, keeps the sky term";
   EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
 }
 
@@ -179,7 +183,8 @@ double edge_width(float angular_radius_rad) {
   plate.name = "plate";
   plate.primitives.emplace_back();
   plate.primitives[0].material = 0;
-  add_quad(plate.primitives[0], glm::vec3(-1.5f, 1.0f, 0.0f), glm::vec3(0, 0, 1.5f), glm::vec3(1.5f, 0, 0));  // faces up
+  add_quad(plate.primitives[0], glm::vec3(-1.5f, 1.0f, 0.0f), glm::vec3(0, 0, 1.5f),
+           glm::vec3(1.5f, 0, 0));  // faces up
   assets.meshes.push_back(plate);
   engine::Registry reg;
   add_mesh(reg, 0, glm::mat4(1.0f));
@@ -216,9 +221,10 @@ TEST(RendererSky, SunDiscWidensTheShadowEdge) {
   const float r = 5.0f * kPi / 180.0f;
   const double big_r = std::tan(static_cast<double>(r));  // h = 1 m
   const double soft = edge_width(r), hard = edge_width(0.0f);
-  std::printf("renderer shadow edge 10-90%%: sun radius 5 deg %.4f m (disc geometry 1.37 R = %.4f, a square box 1.6 R = %.4f); "
-              "point sun %.4f m\n",
-              soft, 1.374 * big_r, 1.6 * big_r, hard);
+  std::printf(
+      "renderer shadow edge 10-90%%: sun radius 5 deg %.4f m (disc geometry 1.37 R = %.4f, a square box 1.6 R = %.4f); "
+      "point sun %.4f m\n",
+      soft, 1.374 * big_r, 1.6 * big_r, hard);
   EXPECT_NEAR(soft, 1.374 * big_r, 0.15 * 1.374 * big_r);
   EXPECT_LT(hard, 0.5 * soft);
 }

@@ -63,12 +63,12 @@ inline engine::Mesh box_mesh(glm::vec3 half, int material) {
   engine::Primitive& p = m.primitives[0];
   p.material = material;
   const glm::vec3 x(half.x, 0, 0), y(0, half.y, 0), z(0, 0, half.z);
-  add_quad(p, y, z, x);    // +Y
-  add_quad(p, -y, x, z);   // -Y
-  add_quad(p, x, y, z);    // +X
-  add_quad(p, -x, z, y);   // -X
-  add_quad(p, z, x, y);    // +Z
-  add_quad(p, -z, y, x);   // -Z
+  add_quad(p, y, z, x);   // +Y
+  add_quad(p, -y, x, z);  // -Y
+  add_quad(p, x, y, z);   // +X
+  add_quad(p, -x, z, y);  // -X
+  add_quad(p, z, x, y);   // +Z
+  add_quad(p, -z, y, x);  // -Z
   return m;
 }
 
@@ -93,7 +93,8 @@ inline engine::Entity add_entity(engine::Registry& reg, const glm::mat4& world) 
   return e;
 }
 
-inline engine::Entity add_mesh(engine::Registry& reg, std::uint32_t mesh, const glm::mat4& world, bool is_static = true) {
+inline engine::Entity add_mesh(engine::Registry& reg, std::uint32_t mesh, const glm::mat4& world,
+                               bool is_static = true) {
   engine::Entity e = add_entity(reg, world);
   reg.emplace<engine::MeshRenderer>(e, engine::MeshRenderer{mesh, -1, true});
   if (is_static)
@@ -103,7 +104,8 @@ inline engine::Entity add_mesh(engine::Registry& reg, std::uint32_t mesh, const 
   return e;
 }
 
-inline engine::Entity add_light(engine::Registry& reg, const engine::Light& light, glm::vec3 position, glm::vec3 target) {
+inline engine::Entity add_light(engine::Registry& reg, const engine::Light& light, glm::vec3 position,
+                                glm::vec3 target) {
   engine::Entity e = add_entity(reg, looking_at(position, target));
   reg.emplace<engine::Light>(e, light);
   return e;
@@ -133,17 +135,20 @@ struct TestCamera {
   }
   /// The pixel whose centre is nearest to world point p.
   glm::ivec2 pixel_of(glm::vec3 p) const {
-    const glm::mat4 view = glm::lookAt(eye, target, std::abs(glm::normalize(target - eye).y) > 0.99f ? glm::vec3(0, 0, -1) : glm::vec3(0, 1, 0));
+    const glm::mat4 view = glm::lookAt(
+        eye, target, std::abs(glm::normalize(target - eye).y) > 0.99f ? glm::vec3(0, 0, -1) : glm::vec3(0, 1, 0));
     const glm::vec4 clip = glm::perspective(yfov, 1.0f, 0.05f, 100.0f) * view * glm::vec4(p, 1.0f);
     const glm::vec2 ndc = glm::vec2(clip) / clip.w;
     const float s = static_cast<float>(size);
-    return {static_cast<int>(std::floor((ndc.x * 0.5f + 0.5f) * s)), static_cast<int>(std::floor((0.5f - 0.5f * ndc.y) * s))};
+    return {static_cast<int>(std::floor((ndc.x * 0.5f + 0.5f) * s)),
+            static_cast<int>(std::floor((0.5f - 0.5f * ndc.y) * s))};
   }
 };
 
 /// Red channel of pixel (x, y) of an image with rows top to bottom.
 inline float red(const engine::ImageRgbaF& img, int x, int y) {
-  return img.pixels[(static_cast<std::size_t>(y) * static_cast<std::size_t>(img.width) + static_cast<std::size_t>(x)) * 4];
+  return img
+      .pixels[(static_cast<std::size_t>(y) * static_cast<std::size_t>(img.width) + static_cast<std::size_t>(x)) * 4];
 }
 inline float red(const engine::ImageRgbaF& img, glm::ivec2 p) { return red(img, p.x, p.y); }
 

@@ -1,15 +1,15 @@
 // engine::set_sun (engine/sun.h): the sun a tool or a test gives a scene in memory is the
 // very light and node the glTF loader makes from the scene's gi.sun, and a second sun
 // replaces the first.
+#include <gtest/gtest.h>
 #include <engine/gltf.h>
 #include <engine/sun.h>
-#include <gtest/gtest.h>
 
 #include <filesystem>
 #include <fstream>
+#include <numbers>
 #include <glm/gtc/quaternion.hpp>
 #include <nlohmann/json.hpp>
-#include <numbers>
 
 namespace {
 

@@ -9,6 +9,7 @@
 // normal build, with tests/fuzz/replay_main.cpp as a ctest that replays the target's seed
 // corpus and its regression inputs (tests/fuzz/corpus/<name>/, tests/fuzz/regressions/<name>/).
 
+#include <unistd.h>
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
@@ -18,7 +19,6 @@
 #include <string>
 #include <system_error>
 #include <utility>
-#include <unistd.h>
 
 namespace gi_fuzz {
 

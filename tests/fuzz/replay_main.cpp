@@ -43,8 +43,8 @@ int replay(const std::vector<fs::path>& files) {
     gi_fuzz::refused("the target set no verdict");
     LLVMFuzzerTestOneInput(reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size());
     const gi_fuzz::Verdict& v = gi_fuzz::last_verdict();
-    std::printf("%s (%zu bytes): %s%s\n", p.c_str(), bytes.size(), v.accepted ? "accepted" : "refused: ",
-                v.reason.c_str());
+    std::printf("%s (%zu bytes): %s%s\n", p.c_str(), bytes.size(),
+                v.accepted ? "accepted" : "refused: ", v.reason.c_str());
     std::fflush(stdout);
     if (!v.accepted) ++refused;
   }
@@ -56,13 +56,14 @@ int replay(const std::vector<fs::path>& files) {
 int main(int argc, char** argv) {
   fs::path seeds, regressions;
   for (int i = 1; i + 1 < argc; i += 2) {
-    if (std::strcmp(argv[i], "--seeds") == 0) seeds = argv[i + 1];
-    else if (std::strcmp(argv[i], "--regressions") == 0) regressions = argv[i + 1];
+    if (std::strcmp(argv[i], "--seeds") == 0)
+      seeds = argv[i + 1];
+    else if (std::strcmp(argv[i], "--regressions") == 0)
+      regressions = argv[i + 1];
   }
   const std::vector<fs::path> seed_files = files_of(seeds);
   if (seeds.empty() || seed_files.empty()) {
-    std::fprintf(stderr, "usage: %s --seeds DIR [--regressions DIR]; no seeds found in '%s'\n", argv[0],
-                 seeds.c_str());
+    std::fprintf(stderr, "usage: %s --seeds DIR [--regressions DIR]; no seeds found in '%s'\n", argv[0], seeds.c_str());
     return 1;
   }
   const int refused_seeds = replay(seed_files);

@@ -1,11 +1,11 @@
 // The public bake API (gi/bake.h) as a studio's pipeline uses it: a BakeInput filled by the
 // pipeline's own code from its own scene data — no engine::Scene, no registry — baked into
 // a bundle that the runtime then accepts for the level the game instantiates.
+#include <gtest/gtest.h>
 #include <engine/gltf.h>
 #include <engine/scene.h>
 #include <gi/bake.h>
 #include <gi/gi_system.h>
-#include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
@@ -254,11 +254,13 @@ TEST(BakeApi, ABundleBakedWithOtherTexturesIsStale) {
   ASSERT_TRUE(loaded) << loaded.error().to_string();
   engine::SceneAsset asset = std::move(loaded).value();
   engine::Image checker{.name = "checker", .uri = "", .width = 4, .height = 4, .rgba8 = {}};
-  for (int i = 0; i < 16; ++i) checker.rgba8.insert(checker.rgba8.end(), {200, 90, static_cast<std::uint8_t>(i * 16), 255});
+  for (int i = 0; i < 16; ++i)
+    checker.rgba8.insert(checker.rgba8.end(), {200, 90, static_cast<std::uint8_t>(i * 16), 255});
   asset.images.push_back(checker);
   const int textured = asset.meshes[0].primitives[0].material;
   ASSERT_GE(textured, 0);
-  asset.materials[static_cast<std::size_t>(textured)].base_color_texture.image = static_cast<int>(asset.images.size() - 1);
+  asset.materials[static_cast<std::size_t>(textured)].base_color_texture.image =
+      static_cast<int>(asset.images.size() - 1);
   const gi::BakeInput input = gi::bake_input_from(asset);
   ASSERT_TRUE(gi::validate_bake_input(input)) << gi::validate_bake_input(input).error().to_string();
 

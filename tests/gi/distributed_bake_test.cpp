@@ -3,10 +3,10 @@
 // gather and the PRM's panes into a shard file; merge_shards writes the bundle from them.
 // The merged bundle is byte-identical to a one-process bake for N = 1, 2 and 7, and a merge
 // refuses a missing, duplicated, damaged or foreign shard, naming it, without leaving a bundle.
+#include <gtest/gtest.h>
 #include <engine/gltf.h>
 #include <gi/bake.h>
 #include <gi/bake_input.h>
-#include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cstdio>

@@ -3,12 +3,12 @@
 // gi::merge_reference_shards assembles the job's outputs from them. The merged image and
 // atlas are bit-identical to a one-process run for N = 1, 2 and 7, and a merge refuses a
 // missing, duplicated, damaged or foreign shard, naming it.
+#include <gtest/gtest.h>
 #include <engine/gltf.h>
 #include <engine/scene.h>
 #include <gi/bake_input.h>
 #include <gi/reference.h>
 #include <gi/reference_shard.h>
-#include <gtest/gtest.h>
 
 #include <cstring>
 #include <filesystem>
@@ -68,12 +68,12 @@ class DistributedReference : public ::testing::Test {
     const engine::Camera& cam = scene.registry.get<engine::Camera>(camera);
     // A 24x20 image (480 pixels: 8 blocks, so of 7 shards one gets two) and the atlas at 20
     // texels/m (about a thousand texels), 2 samples each, 2 bounces: seconds in all.
-    job_.image = gi::ReferenceImageJob{
-        .camera = {.camera_to_world = scene.registry.get<engine::WorldTransform>(camera).matrix,
-                   .yfov_rad = cam.yfov_rad,
-                   .aspect = cam.aspect},
-        .width = 24,
-        .height = 20};
+    job_.image =
+        gi::ReferenceImageJob{.camera = {.camera_to_world = scene.registry.get<engine::WorldTransform>(camera).matrix,
+                                         .yfov_rad = cam.yfov_rad,
+                                         .aspect = cam.aspect},
+                              .width = 24,
+                              .height = 20};
     job_.atlas = gi::ReferenceAtlasJob{.texels_per_metre = 20.0f};
     job_.settings.samples_per_pixel = 2;
     job_.settings.max_bounces = 2;
@@ -208,7 +208,8 @@ TEST_F(DistributedReference, MergeRefusesForeignShardsNamingThem) {
   {
     shard_all(root_ / "n", 2, job_);
     shard_all(root_ / "n3", 3, job_);
-    fs::copy_file(root_ / "n3" / gi::reference_shard_file_name(2, 3), root_ / "n" / gi::reference_shard_file_name(2, 3));
+    fs::copy_file(root_ / "n3" / gi::reference_shard_file_name(2, 3),
+                  root_ / "n" / gi::reference_shard_file_name(2, 3));
     const std::string e = merge_error(root_ / "n");
     EXPECT_NE(e.find("foreign shard: shard 2 of 3, the merge is of 2"), std::string::npos) << e;
   }

@@ -1,9 +1,9 @@
 // The frame-vs-truth instrument (gi/frame_truth.h): the bench's pixels split into regions,
 // "other" and background and nothing else, its comparisons repeatable, its bad input refused.
+#include <gtest/gtest.h>
 #include <engine/gltf.h>
 #include <engine/gpu/context.h>
 #include <gi/frame_truth.h>
-#include <gtest/gtest.h>
 
 namespace {
 

@@ -1,12 +1,12 @@
 // gi::with_light_atlas_uv1 (gi/light_atlas_uv.h, gi-bake --export-uv1): the exported scene
 // carries exactly the TEXCOORD_1 the runtime gives the static meshes from a bundle baked
 // from the original scene, and laying out the exported file again gives the same atlas.
+#include <gtest/gtest.h>
 #include <engine/gltf.h>
 #include <engine/scene.h>
 #include <gi/bake.h>
 #include <gi/gi_system.h>
 #include <gi/light_atlas_uv.h>
-#include <gtest/gtest.h>
 
 #include <filesystem>
 

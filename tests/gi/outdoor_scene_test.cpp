@@ -2,6 +2,7 @@
 // gi.sky, or gi-bake --sky). The planner plans the light atlas for them, the bake lights it,
 // the runtime and the renderer draw it. The Avocado (Khronos sample, Draco-compressed) is
 // read from GI_EXTERNAL_ASSETS_DIR, never copied; the test skips with a message without it.
+#include <gtest/gtest.h>
 #include <engine/components.h>
 #include <engine/gltf.h>
 #include <engine/gpu/context.h>
@@ -10,7 +11,6 @@
 #include <gi/bake.h>
 #include <gi/gi_system.h>
 #include <gi/plan.h>
-#include <gtest/gtest.h>
 
 #include <cmath>
 #include <filesystem>
@@ -62,7 +62,8 @@ TEST(OutdoorScene, AvocadoUnderASkyIsBakedLoadedAndRenderedHeadless) {
       for (const glm::vec3& v : p.positions) lo = glm::min(lo, v), hi = glm::max(hi, v);
   const glm::vec3 centre = 0.5f * (lo + hi);
   const float radius = 0.5f * glm::length(hi - lo);
-  a.cameras.push_back({"camera", engine::Camera{.yfov_rad = 0.8f, .znear_m = radius * 0.05f, .zfar_m = radius * 20.0f}});
+  a.cameras.push_back(
+      {"camera", engine::Camera{.yfov_rad = 0.8f, .znear_m = radius * 0.05f, .zfar_m = radius * 20.0f}});
   engine::Node cam;
   cam.name = "camera";
   cam.camera = 0;
@@ -170,7 +171,8 @@ engine::ImageRgbaF cornell_frame_with_sky(bool include_direct) {
   auto loaded = engine::load_gltf(GI_SOURCE_DIR "/assets/cornell_box.gltf");
   EXPECT_TRUE(loaded) << loaded.error().to_string();
   engine::SceneAsset a = std::move(loaded).value();
-  a.environment.sky_gradient = {.zenith = {0.1f, 0.3f, 1.2f}, .horizon = {1.0f, 0.9f, 0.6f}, .ground = {0.3f, 0.2f, 0.1f}};
+  a.environment.sky_gradient = {
+      .zenith = {0.1f, 0.3f, 1.2f}, .horizon = {1.0f, 0.9f, 0.6f}, .ground = {0.3f, 0.2f, 0.1f}};
   const fs::path bundle = fs::path(GI_BINARY_DIR) / "test_output" / "outdoor_scene" /
                           (include_direct ? "cornell_sky_all.gibake" : "cornell_sky.gibake");
   fs::remove_all(bundle);
@@ -215,8 +217,9 @@ TEST(OutdoorScene, IncludeDirectCountsNothingTwice) {
       for (int y = by * kBlock; y < (by + 1) * kBlock; ++y)
         for (int x = bx * kBlock; x < (bx + 1) * kBlock; ++x)
           for (int c = 0; c < 3; ++c) {
-            const std::size_t i = 4 * (static_cast<std::size_t>(y) * static_cast<std::size_t>(live.width) +
-                                       static_cast<std::size_t>(x)) + static_cast<std::size_t>(c);
+            const std::size_t i =
+                4 * (static_cast<std::size_t>(y) * static_cast<std::size_t>(live.width) + static_cast<std::size_t>(x)) +
+                static_cast<std::size_t>(c);
             l += static_cast<double>(live.pixels[i]);
             b += static_cast<double>(baked.pixels[i]);
           }
@@ -224,9 +227,10 @@ TEST(OutdoorScene, IncludeDirectCountsNothingTwice) {
       sum_baked += b;
       if (l > 0.0) worst = std::max(worst, std::fabs(b / l - 1.0));
     }
-  std::printf("Cornell box with its lamp under a gradient sky: frame with --include-direct / default %.4f, worst "
-              "%d x %d block %.4f\n",
-              sum_baked / sum_live, kBlock, kBlock, worst);
+  std::printf(
+      "Cornell box with its lamp under a gradient sky: frame with --include-direct / default %.4f, worst "
+      "%d x %d block %.4f\n",
+      sum_baked / sum_live, kBlock, kBlock, worst);
   EXPECT_NEAR(sum_baked / sum_live, 1.0, 0.04);
   EXPECT_LT(worst, 0.25);
 }

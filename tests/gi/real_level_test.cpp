@@ -8,13 +8,13 @@
 // (open courtyard, ground-floor arcades, upper gallery) and over the frame
 // (gi/frame_truth.h). docs/real_level.md has the full table (both suns, two views, every
 // preset) made by tools/check-real-level.sh with the same scene, lights, views and regions.
+#include <gtest/gtest.h>
 #include <engine/gltf.h>
 #include <engine/gpu/context.h>
 #include <engine/image.h>
 #include <engine/sun.h>
 #include <gi/bake.h>
 #include <gi/frame_truth.h>
-#include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
@@ -191,8 +191,8 @@ TEST(RealLevel, ADynamicCrateInAnArcadeIsAsDarkAsTheArcade) {
                                            {.width = 128, .height = 96, .samples_per_pixel = 256, .regions = regions});
   ASSERT_TRUE(bench) << bench.error().to_string();
   // From inside the arcade, west of the crate, looking along the arcade at it.
-  auto report = (*bench)->compare({.name = "crate", .position_m = {-1.0f, 1.5f, 4.6f}, .target_m = crate,
-                                   .yfov_rad = 0.8f});
+  auto report =
+      (*bench)->compare({.name = "crate", .position_m = {-1.0f, 1.5f, 4.6f}, .target_m = crate, .yfov_rad = 0.8f});
   ASSERT_TRUE(report) << report.error().to_string();
   std::printf("Dabrovic Sponza, a dynamic crate in the north arcade, preview bake (%s), 128x96, 256 spp:\n",
               (*bench)->gi_label().c_str());

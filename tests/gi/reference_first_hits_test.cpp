@@ -1,8 +1,8 @@
 // gi::reference_first_hits (gi/reference.h): what the path tracer's rays through the pixel
 // centres hit first, for a quad in front of a pinhole camera, worked out by hand.
+#include <gtest/gtest.h>
 #include <gi/bake_input.h>
 #include <gi/reference.h>
-#include <gtest/gtest.h>
 
 namespace {
 

@@ -62,8 +62,10 @@ TEST(ReferenceVsRenderer, CornellBoxDirectLightMatchesPerPixel) {
   const double median = rel[rel.size() / 2];
   const double p80 = rel[rel.size() * 8 / 10];
   const double p90 = rel[rel.size() * 9 / 10];
-  std::printf("Cornell box direct light, renderer / path tracer: total %.4f, per-pixel difference: median %.4f, "
-              "80th percentile %.4f, 90th percentile %.4f\n", sum_raster / sum_traced, median, p80, p90);
+  std::printf(
+      "Cornell box direct light, renderer / path tracer: total %.4f, per-pixel difference: median %.4f, "
+      "80th percentile %.4f, 90th percentile %.4f\n",
+      sum_raster / sum_traced, median, p80, p90);
   EXPECT_NEAR(sum_raster / sum_traced, 1.0, 0.02);
   EXPECT_LT(median, 0.03);
   // The tail is the renderer's shadow map, not light units: its soft shadows are PCSS in one

@@ -59,7 +59,10 @@ TEST(SceneGenerator, CommittedAssetsAreUpToDate) {
 // Largest extent of the positions divided by the number of quantization steps.
 float quantization_step(const std::vector<glm::vec3>& positions, int bits) {
   glm::vec3 lo(1e30f), hi(-1e30f);
-  for (const glm::vec3& p : positions) { lo = glm::min(lo, p); hi = glm::max(hi, p); }
+  for (const glm::vec3& p : positions) {
+    lo = glm::min(lo, p);
+    hi = glm::max(hi, p);
+  }
   const glm::vec3 e = hi - lo;
   return std::max({e.x, e.y, e.z}) / static_cast<float>((1 << bits) - 1);
 }
@@ -134,15 +137,15 @@ TEST(SceneGenerator, ScenesCarryTheirGiFlags) {
     if (n.name.rfind("crate", 0) == 0 && n.gi.mobility == engine::Mobility::Dynamic) ++dynamic_crates;
   EXPECT_GE(dynamic_crates, 4);
   const engine::Node& red = node(crates, "crate_red");
-  const engine::Material& red_mat =
-      crates.materials[static_cast<std::size_t>(crates.meshes[static_cast<std::size_t>(red.mesh)].primitives[0].material)];
+  const engine::Material& red_mat = crates.materials[static_cast<std::size_t>(
+      crates.meshes[static_cast<std::size_t>(red.mesh)].primitives[0].material)];
   EXPECT_GT(red_mat.base_color.x, 5.0f * red_mat.base_color.y);
   EXPECT_EQ(node(crates, "statue").gi.mobility, engine::Mobility::Static);
 
   const engine::SceneAsset glossy = scenegen::glossy_room();
   const engine::Node& floor = node(glossy, "glossy_floor");
-  const engine::Material& fm =
-      glossy.materials[static_cast<std::size_t>(glossy.meshes[static_cast<std::size_t>(floor.mesh)].primitives[0].material)];
+  const engine::Material& fm = glossy.materials[static_cast<std::size_t>(
+      glossy.meshes[static_cast<std::size_t>(floor.mesh)].primitives[0].material)];
   EXPECT_FLOAT_EQ(fm.roughness, 0.15f);
   EXPECT_FLOAT_EQ(fm.metallic, 0.0f);
 

@@ -31,13 +31,17 @@ TEST(CornellBoxScene, UsesEveryMeasuredVertex) {
     EXPECT_TRUE(has_vertex(tris, "walls", v)) << v.x << " " << v.y << " " << v.z;
   for (const glm::vec3& v : {mm(130, 165, 65), mm(82, 165, 225), mm(240, 165, 272), mm(290, 165, 114), mm(130, 0, 65)})
     EXPECT_TRUE(has_vertex(tris, "short_block", v)) << v.x << " " << v.y << " " << v.z;
-  for (const glm::vec3& v : {mm(423, 330, 247), mm(265, 330, 296), mm(314, 330, 456), mm(472, 330, 406), mm(472, 0, 406)})
+  for (const glm::vec3& v :
+       {mm(423, 330, 247), mm(265, 330, 296), mm(314, 330, 456), mm(472, 330, 406), mm(472, 0, 406)})
     EXPECT_TRUE(has_vertex(tris, "tall_block", v)) << v.x << " " << v.y << " " << v.z;
   // Bounds of the box: x 0..556, y 0..548.8, z 0..559.2 mm.
   glm::vec3 lo(1e9f), hi(-1e9f);
   for (const auto& t : tris)
     if (t.node == "walls")
-      for (const glm::vec3& p : {t.a, t.b, t.c}) { lo = glm::min(lo, p); hi = glm::max(hi, p); }
+      for (const glm::vec3& p : {t.a, t.b, t.c}) {
+        lo = glm::min(lo, p);
+        hi = glm::max(hi, p);
+      }
   EXPECT_NEAR(lo.x, 0.0f, kTol);
   EXPECT_NEAR(hi.x, 0.556f, kTol);
   EXPECT_NEAR(hi.y, 0.5488f, kTol);
@@ -114,7 +118,8 @@ TEST(CornellBoxScene, LightAndCameraMatchTheMeasurements) {
   }
   EXPECT_EQ(quad_tris, 2);
   const engine::Node& qn = s.nodes[static_cast<std::size_t>(scenegen_test::find_node(s, "light_quad"))];
-  const engine::Material& qm = s.materials[static_cast<std::size_t>(s.meshes[static_cast<std::size_t>(qn.mesh)].primitives[0].material)];
+  const engine::Material& qm =
+      s.materials[static_cast<std::size_t>(s.meshes[static_cast<std::size_t>(qn.mesh)].primitives[0].material)];
   EXPECT_NEAR(qm.emissive.x, 18.387f, 1e-4f);
 
   const int cam = scenegen_test::find_node(s, "camera");

@@ -23,7 +23,8 @@ bool visible(const SurfacePoint& x, const SurfacePoint& y, const std::vector<Wor
                       [&](const WorldTriangle& t) { return scenegen_test::segment_hits(x.p, y.p, t); });
 }
 
-std::vector<SurfacePoint> samples(const std::vector<WorldTriangle>& tris, float spacing, bool (*keep)(const std::string&)) {
+std::vector<SurfacePoint> samples(const std::vector<WorldTriangle>& tris, float spacing,
+                                  bool (*keep)(const std::string&)) {
   std::vector<SurfacePoint> out;
   for (const WorldTriangle& t : tris) {
     if (!keep(t.node)) continue;
@@ -63,9 +64,15 @@ TEST(CorridorScene, CorridorFloorSeesNeitherTheLampNorAnythingTheLampLights) {
   int sees_lamp = 0, sees_lit = 0;
   for (const SurfacePoint& f : corridor_floor) {
     for (const SurfacePoint& l : lamp)
-      if (visible(f, l, occluders)) { ++sees_lamp; break; }
+      if (visible(f, l, occluders)) {
+        ++sees_lamp;
+        break;
+      }
     for (const SurfacePoint& s : lit)
-      if (visible(f, s, occluders)) { ++sees_lit; break; }
+      if (visible(f, s, occluders)) {
+        ++sees_lit;
+        break;
+      }
   }
   EXPECT_EQ(sees_lamp, 0) << "corridor floor points with a direct path to the lamp";
   EXPECT_EQ(sees_lit, 0) << "corridor floor points with a one-bounce path from the lamp";
@@ -80,7 +87,8 @@ namespace {
 // [4.4, 5.4]) up to the 1 cm gaps at the jambs, whatever angle it was authored at.
 TEST(CorridorScene, DoorIsADeformingRegionHingedAtItsOrigin) {
   const engine::SceneAsset scene = scenegen::corridor();
-  const auto door = std::find_if(scene.nodes.begin(), scene.nodes.end(), [](const engine::Node& n) { return n.name == "door"; });
+  const auto door =
+      std::find_if(scene.nodes.begin(), scene.nodes.end(), [](const engine::Node& n) { return n.name == "door"; });
   ASSERT_NE(door, scene.nodes.end());
   EXPECT_EQ(door->gi.region, engine::GiRegion::Deforming);
   EXPECT_EQ(door->translation, glm::vec3(6.0f, 0.0f, 5.4f));

@@ -18,13 +18,15 @@ namespace scenegen_test {
 inline glm::mat4 local_matrix(const engine::Node& n) {
   glm::mat4 m(1.0f);
   m[3] = glm::vec4(n.translation, 1.0f);
-  return m * glm::mat4_cast(n.rotation) * glm::mat4(glm::vec4(n.scale.x, 0, 0, 0), glm::vec4(0, n.scale.y, 0, 0),
-                                                    glm::vec4(0, 0, n.scale.z, 0), glm::vec4(0, 0, 0, 1));
+  return m * glm::mat4_cast(n.rotation) *
+         glm::mat4(glm::vec4(n.scale.x, 0, 0, 0), glm::vec4(0, n.scale.y, 0, 0), glm::vec4(0, 0, n.scale.z, 0),
+                   glm::vec4(0, 0, 0, 1));
 }
 
 inline glm::mat4 world_matrix(const engine::SceneAsset& s, int node) {
   glm::mat4 m(1.0f);
-  for (int i = node; i >= 0; i = s.nodes[static_cast<std::size_t>(i)].parent) m = local_matrix(s.nodes[static_cast<std::size_t>(i)]) * m;
+  for (int i = node; i >= 0; i = s.nodes[static_cast<std::size_t>(i)].parent)
+    m = local_matrix(s.nodes[static_cast<std::size_t>(i)]) * m;
   return m;
 }
 

@@ -2,14 +2,14 @@
 // 2 / 130, Ctrl-C cancels cleanly; and the one progress bar's text. The tools run as real
 // processes, as a user or a build script runs them.
 #include <fcntl.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+#include <gtest/gtest.h>
 #include <engine/gltf.h>
 #include <engine/scene.h>
 #include <gi/gi_system.h>
 #include <gi/version.h>
-#include <gtest/gtest.h>
-#include <signal.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <chrono>
 #include <filesystem>
@@ -196,17 +196,18 @@ TEST(GiBake, SkyMakesASceneWithoutLightsBakeable) {
 
   const fs::path out = fs::path(GI_BINARY_DIR) / "test_output" / "tools_test" / "avocado_sky.gibake";
   fs::remove_all(out);
-  const ToolRun bake = run(GI_BAKE_EXE, {"--scene", avocado.string(), "--preset", "preview", "--sky", "0.8,0.9,1.0",
-                                         "--out", out.string()});
+  const ToolRun bake = run(
+      GI_BAKE_EXE, {"--scene", avocado.string(), "--preset", "preview", "--sky", "0.8,0.9,1.0", "--out", out.string()});
   EXPECT_EQ(bake.exit_code, 0) << bake.output;
   EXPECT_NE(bake.output.find("gi-bake: atlas:"), std::string::npos) << bake.output;
   EXPECT_TRUE(fs::exists(out / "manifest.json")) << bake.output;
 }
 
 TEST(GiBake, BadSkyIsAUsageError) {
-  for (const char* sky : {"1,2", "1,-1,1", "a,b,c", "1,1,1,1", "zenith:1,1,1;horizon:1,1,1",
-                          "zenith:1,1,1;horizon:1,1,1;ground:1,1", "zenith:1,1,1;horizon:1,1,1;ground:1,1,1;ground:1,1,1",
-                          "zenith:1,1,1;horizon:1,1,1;sun:1,1,1", "zenith:1,1,1;horizon:1,1,1;ground:-1,1,1"}) {
+  for (const char* sky :
+       {"1,2", "1,-1,1", "a,b,c", "1,1,1,1", "zenith:1,1,1;horizon:1,1,1", "zenith:1,1,1;horizon:1,1,1;ground:1,1",
+        "zenith:1,1,1;horizon:1,1,1;ground:1,1,1;ground:1,1,1", "zenith:1,1,1;horizon:1,1,1;sun:1,1,1",
+        "zenith:1,1,1;horizon:1,1,1;ground:-1,1,1"}) {
     const ToolRun r = run(GI_BAKE_EXE, {"--plan", GI_SOURCE_DIR "/assets/cornell_box.gltf", "--sky", sky});
     EXPECT_EQ(r.exit_code, 2) << sky << "\n" << r.output;
     EXPECT_NE(r.output.find("--sky"), std::string::npos) << sky << "\n" << r.output;
@@ -287,9 +288,9 @@ TEST(GiBake, AKilledRebakeLeavesTheOldBundleOrTheNewOneNeverAMix) {
   fs::create_directories(root);
   const fs::path dir = root / "cornell.gibake";
   const std::string scene = GI_SOURCE_DIR "/assets/cornell_box.gltf";
-  const std::vector<std::string> old_bake{"--scene", scene,         "--preset", "preview", "--methods",
+  const std::vector<std::string> old_bake{"--scene",   scene,       "--preset", "preview", "--methods",
                                           "atlas,prm", "--threads", "2",        "--out",   dir.string()};
-  const std::vector<std::string> new_bake{"--scene", scene,         "--preset", "medium", "--methods",
+  const std::vector<std::string> new_bake{"--scene",   scene,       "--preset", "medium", "--methods",
                                           "atlas,prm", "--threads", "2",        "--out",  dir.string()};
   // The new bundle, baked once without interruption (to know its bytes), then the old one.
   ASSERT_EQ(run(GI_BAKE_EXE, new_bake).exit_code, 0);
@@ -305,12 +306,12 @@ TEST(GiBake, AKilledRebakeLeavesTheOldBundleOrTheNewOneNeverAMix) {
     double seconds;
   };
   const KillPoint points[] = {
-      {"", 0.01},                      // while starting: lock, staging copy
-      {"light atlas of", 30.0},        // the atlas baking
-      {"PRM of", 30.0},                // the atlas written into staging, the PRM baking
-      {"time: walks", 30.0},           // the PRM being saved
-      {"", 1.5},                       // wherever the clock says
-      {"gi-bake: atlas:", 30.0},       // after the exchange, while reporting
+      {"", 0.01},                 // while starting: lock, staging copy
+      {"light atlas of", 30.0},   // the atlas baking
+      {"PRM of", 30.0},           // the atlas written into staging, the PRM baking
+      {"time: walks", 30.0},      // the PRM being saved
+      {"", 1.5},                  // wherever the clock says
+      {"gi-bake: atlas:", 30.0},  // after the exchange, while reporting
   };
   int saw_old = 0, saw_new = 0;
   for (const KillPoint& p : points) {
@@ -347,8 +348,9 @@ TEST(GiBake, ShardAndMergeGiveTheOneProcessBundle) {
   std::error_code ec;
   fs::remove_all(root, ec);
   fs::create_directories(root);
-  const std::vector<std::string> common{"--scene", GI_SOURCE_DIR "/assets/cornell_box.gltf", "--preset", "preview",
-                                        "--methods", "atlas,prm", "--density", "12"};
+  const std::vector<std::string> common{
+      "--scene", GI_SOURCE_DIR "/assets/cornell_box.gltf", "--preset", "preview", "--methods", "atlas,prm", "--density",
+      "12"};
   const auto with = [&](const fs::path& out, std::vector<std::string> extra) {
     std::vector<std::string> a = common;
     a.push_back("--out");
@@ -393,16 +395,16 @@ TEST(GiReference, ShardAndMergeGiveTheOneProcessFiles) {
   fs::remove_all(root, ec);
   fs::create_directories(root);
   const auto with = [&](const std::string& name, std::vector<std::string> extra) {
-    std::vector<std::string> a{"--scene",  GI_SOURCE_DIR "/assets/cornell_box.gltf",
-                               "--spp",    "2",
-                               "--bounces", "2",
-                               "--seed",   "4",
-                               "--width",  "20",
-                               "--height", "16",
+    std::vector<std::string> a{"--scene",         GI_SOURCE_DIR "/assets/cornell_box.gltf",
+                               "--spp",           "2",
+                               "--bounces",       "2",
+                               "--seed",          "4",
+                               "--width",         "20",
+                               "--height",        "16",
                                "--atlas-density", "10",
-                               "--out",    (root / (name + ".exr")).string(),
-                               "--png",    (root / (name + ".png")).string(),
-                               "--atlas-out", (root / (name + "_atlas")).string()};
+                               "--out",           (root / (name + ".exr")).string(),
+                               "--png",           (root / (name + ".png")).string(),
+                               "--atlas-out",     (root / (name + "_atlas")).string()};
     a.insert(a.end(), extra.begin(), extra.end());
     return a;
   };
@@ -433,8 +435,8 @@ TEST(GiReference, ShardAndMergeGiveTheOneProcessFiles) {
     std::ifstream in(p, std::ios::binary);
     return std::string((std::istreambuf_iterator<char>(in)), {});
   };
-  for (const std::string file : {".exr", ".png", "_atlas/atlas_direct.exr", "_atlas/atlas_indirect.exr",
-                                 "_atlas/atlas_total.exr"}) {
+  for (const std::string file :
+       {".exr", ".png", "_atlas/atlas_direct.exr", "_atlas/atlas_indirect.exr", "_atlas/atlas_total.exr"}) {
     const std::string a = bytes(root / ("whole" + file)), b = bytes(root / ("sharded" + file));
     EXPECT_FALSE(a.empty()) << file;
     EXPECT_TRUE(a == b) << file << " differs between the merged and the one-process reference";

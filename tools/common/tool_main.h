@@ -10,14 +10,14 @@
 //   tools::install_interrupt_handler();
 //   if (!result) return tools::fail("gi-bake", result.error());
 
+#include <glm/vec3.hpp>
 #include <engine/result.h>
 #include <engine/scene_asset.h>
-#include <glm/vec3.hpp>
 
-#include <CLI/CLI.hpp>
 #include <optional>
 #include <string>
 #include <string_view>
+#include <CLI/CLI.hpp>
 
 namespace tools {
 

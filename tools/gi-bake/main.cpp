@@ -13,7 +13,6 @@
 #include <gi/bake.h>
 #include <gi/light_atlas_uv.h>
 
-#include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -21,6 +20,7 @@
 #include <sstream>
 #include <string>
 #include <vector>
+#include <CLI/CLI.hpp>
 
 #include "console_progress.h"
 #include "sun_option.h"
@@ -62,8 +62,9 @@ int main(int argc, char** argv) {
                  "'direction:dx,dy,dz;irradiance:R,G,B[;angular_radius_deg:D]': a sun replacing the scene's gi.sun "
                  "(docs/scene-format.md)");
   app.add_option("--out", out_dir, "Bundle directory (default: out/<scene>.gibake)");
-  app.add_option("--methods", methods,
-                 "Comma-separated methods to bake: atlas, prm, dlm, brf, antiradiance (default: what the plan calls for)");
+  app.add_option(
+      "--methods", methods,
+      "Comma-separated methods to bake: atlas, prm, dlm, brf, antiradiance (default: what the plan calls for)");
   app.add_option("--preset", o.preset, "Quality preset: preview, medium, high (docs/sweeps/README.md)");
   app.add_option("--vpls", o.vpls, "Override the preset's VPL count")->check(CLI::PositiveNumber);
   app.add_option("--bounces", o.bounces, "Override the preset's indirect bounces")->check(CLI::Range(1, 64));
@@ -72,8 +73,7 @@ int main(int argc, char** argv) {
   app.add_option("--samples", o.samples_per_vpl, "Override the sample points per VPL")->check(CLI::Range(1, 1024));
   app.add_option("--brf-basis", o.brf_basis, "Override the preset's BRF basis functions N")->check(CLI::Range(1, 1024));
   app.add_option("--brf-spheres", o.brf_spheres, "Override the preset's BRF field spheres")->check(CLI::Range(1, 256));
-  app.add_option("--dlm-directions", o.dlm_directions, "Override the DLM's direction count")
-      ->check(CLI::Range(8, 256));
+  app.add_option("--dlm-directions", o.dlm_directions, "Override the DLM's direction count")->check(CLI::Range(8, 256));
   app.add_option("--dlm-photons", o.dlm_photons, "Override the DLM's photon paths")->check(CLI::PositiveNumber);
   app.add_flag("--include-direct", o.include_direct,
                "Bake the static lights' direct light into the atlas too (the renderer then draws none of theirs on "

@@ -11,20 +11,20 @@
 //       --width 240 --height 135 --spp 512 --out out/level --md out/level/table.md
 // Without --camera, the scene's first glTF camera. Progress on stderr, the table and the
 // costs on stdout. Exit codes: tools/common/tool_main.h.
+#include <sys/resource.h>
 #include <engine/gltf.h>
 #include <engine/gpu/context.h>
 #include <engine/scene.h>
 #include <gi/bake.h>
 #include <gi/frame_truth.h>
-#include <sys/resource.h>
 
-#include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
 #include <vector>
+#include <CLI/CLI.hpp>
 
 #include "console_progress.h"
 #include "frame_truth_output.h"

@@ -7,10 +7,10 @@
 
 #include <gi/frame_truth.h>
 
-#include <glm/glm.hpp>
 #include <optional>
 #include <string>
 #include <vector>
+#include <glm/glm.hpp>
 
 namespace frame_truth_tool {
 

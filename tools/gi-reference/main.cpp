@@ -15,7 +15,6 @@
 #include <gi/reference.h>
 #include <gi/reference_shard.h>
 
-#include <CLI/CLI.hpp>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -23,6 +22,7 @@
 #include <filesystem>
 #include <iostream>
 #include <string>
+#include <CLI/CLI.hpp>
 
 #include "console_progress.h"
 #include "tool_main.h"
@@ -151,11 +151,12 @@ int main(int argc, char** argv) {
       return tools::fail(kTool, scene_path + ": no camera" + (camera_name.empty() ? "" : " named " + camera_name),
                          tools::kExitUsage);
     const engine::Camera& cam = scene.registry.get<engine::Camera>(camera);
-    job.image = gi::ReferenceImageJob{.camera = {.camera_to_world = scene.registry.get<engine::WorldTransform>(camera).matrix,
-                                                 .yfov_rad = cam.yfov_rad,
-                                                 .aspect = cam.aspect},
-                                      .width = width,
-                                      .height = height};
+    job.image =
+        gi::ReferenceImageJob{.camera = {.camera_to_world = scene.registry.get<engine::WorldTransform>(camera).matrix,
+                                         .yfov_rad = cam.yfov_rad,
+                                         .aspect = cam.aspect},
+                              .width = width,
+                              .height = height};
   }
   if (!atlas_out.empty()) job.atlas = gi::ReferenceAtlasJob{.texels_per_metre = atlas_density};
   const gi::BakeInput input = gi::bake_input_from(scene);

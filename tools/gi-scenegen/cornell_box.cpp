@@ -26,10 +26,10 @@ engine::SceneAsset cornell_box() {
   auto wall = [&](int m, glm::vec3 a, glm::vec3 bb, glm::vec3 c, glm::vec3 d) {
     walls.quad(m, a, bb, c, d, inside - 0.25f * (a + bb + c + d));
   };
-  wall(white, mm(552.8, 0, 0), mm(0, 0, 0), mm(0, 0, 559.2), mm(549.6, 0, 559.2));                  // floor
+  wall(white, mm(552.8, 0, 0), mm(0, 0, 0), mm(0, 0, 559.2), mm(549.6, 0, 559.2));                // floor
   wall(white, mm(556, 548.8, 0), mm(556, 548.8, 559.2), mm(0, 548.8, 559.2), mm(0, 548.8, 0));    // ceiling
   wall(white, mm(549.6, 0, 559.2), mm(0, 0, 559.2), mm(0, 548.8, 559.2), mm(556, 548.8, 559.2));  // back
-  wall(green, mm(0, 0, 559.2), mm(0, 0, 0), mm(0, 548.8, 0), mm(0, 548.8, 559.2));                  // left
+  wall(green, mm(0, 0, 559.2), mm(0, 0, 0), mm(0, 548.8, 0), mm(0, 548.8, 559.2));                // left
   wall(red, mm(552.8, 0, 0), mm(549.6, 0, 559.2), mm(556, 548.8, 559.2), mm(556, 548.8, 0));      // right
   b.add_mesh_node("walls", walls, engine::Mobility::Static);
 

@@ -39,7 +39,8 @@ engine::SceneAsset corridor() {
 
   // The room, with both openings in its east wall, and the two tunnels through that wall.
   MeshBuilder room, room_floor;
-  add_room(room, room_floor, mats, {0, 0, 0}, {kRoomSize, kHeight, kRoomSize}, {{}, {alcove_opening, door_opening}, {}, {}});
+  add_room(room, room_floor, mats, {0, 0, 0}, {kRoomSize, kHeight, kRoomSize},
+           {{}, {alcove_opening, door_opening}, {}, {}});
   add_doorway_x(room, room_floor, mats, kRoomSize, kAnnexX, alcove_opening);
   add_doorway_x(room, room_floor, mats, kRoomSize, kAnnexX, door_opening);
   b.add_mesh_node("room", room, engine::Mobility::Static);

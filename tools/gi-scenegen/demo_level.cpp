@@ -91,7 +91,8 @@ engine::SceneAsset demo_level() {
 
   // Glossy corridor.
   MeshBuilder corridor, corridor_floor;
-  add_room(corridor, corridor_floor, {glossy, wall, wall}, {3, 0, 8.2f}, {5, 3, 16.2f}, {{}, {}, {north_door}, {north_door}});
+  add_room(corridor, corridor_floor, {glossy, wall, wall}, {3, 0, 8.2f}, {5, 3, 16.2f},
+           {{}, {}, {north_door}, {north_door}});
   add_doorway_z(corridor, corridor_floor, {glossy, wall, wall}, 16.2f, 16.4f, north_door);
   b.add_mesh_node("corridor", corridor, engine::Mobility::Static);
   b.add_mesh_node("corridor_floor", corridor_floor, engine::Mobility::Static);
@@ -100,7 +101,8 @@ engine::SceneAsset demo_level() {
   // Lamp room with the swinging lamp: a dynamic pivot under the ceiling, a shade and a
   // moving point light 1.2 m below it.
   MeshBuilder lamp_room, lamp_floor;
-  add_room(lamp_room, lamp_floor, {lamp_floor_mat, wall, wall}, {0, 0, 16.4f}, {8, 3.5f, 22.4f}, {{}, {}, {north_door}, {}});
+  add_room(lamp_room, lamp_floor, {lamp_floor_mat, wall, wall}, {0, 0, 16.4f}, {8, 3.5f, 22.4f},
+           {{}, {}, {north_door}, {}});
   b.add_mesh_node("lamp_room", lamp_room, engine::Mobility::Static);
   b.add_mesh_node("lamp_room_floor", lamp_floor, engine::Mobility::Static);
   const int pivot = b.add_group_node("lamp_pivot", {4.0f, 3.5f, 19.4f}, engine::Mobility::Dynamic);

@@ -75,8 +75,8 @@ void MeshBuilder::tessellated_box(int material, glm::vec3 c, glm::vec3 h, int n)
 }
 
 void MeshBuilder::box(int material, glm::vec3 c, glm::vec3 h, bool inward) {
-  const glm::vec3 top[4] = {c + glm::vec3(-h.x, h.y, -h.z), c + glm::vec3(h.x, h.y, -h.z),
-                            c + glm::vec3(h.x, h.y, h.z), c + glm::vec3(-h.x, h.y, h.z)};
+  const glm::vec3 top[4] = {c + glm::vec3(-h.x, h.y, -h.z), c + glm::vec3(h.x, h.y, -h.z), c + glm::vec3(h.x, h.y, h.z),
+                            c + glm::vec3(-h.x, h.y, h.z)};
   if (!inward) {
     prism(material, top, c.y - h.y);
     return;
@@ -185,8 +185,8 @@ int SceneBuilder::add_mesh_node(const std::string& name, const MeshBuilder& mesh
   return add_instance_node(name, add_mesh(name, mesh), mobility, translation, rotation);
 }
 
-int SceneBuilder::add_instance_node(const std::string& name, int mesh, engine::Mobility mobility,
-                                    glm::vec3 translation, glm::quat rotation) {
+int SceneBuilder::add_instance_node(const std::string& name, int mesh, engine::Mobility mobility, glm::vec3 translation,
+                                    glm::quat rotation) {
   engine::Node n;
   n.name = name;
   n.mesh = mesh;

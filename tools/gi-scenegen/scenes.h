@@ -36,9 +36,9 @@ engine::Status write_all_scenes(const std::filesystem::path& dir);
 
 /// Geometry facts of the corridor scene, shared with its tests.
 namespace corridor_layout {
-inline constexpr float kRoomSize = 6.0f;       ///< Room interior x, z in [0, 6].
-inline constexpr float kWall = 0.2f;           ///< Wall thickness between room and annex.
-inline constexpr float kHeight = 3.0f;         ///< Ceiling height of room and corridor.
+inline constexpr float kRoomSize = 6.0f;             ///< Room interior x, z in [0, 6].
+inline constexpr float kWall = 0.2f;                 ///< Wall thickness between room and annex.
+inline constexpr float kHeight = 3.0f;               ///< Ceiling height of room and corridor.
 inline constexpr float kAnnexX = kRoomSize + kWall;  ///< Alcove and corridor start at x = 6.2.
 }  // namespace corridor_layout
 

@@ -15,7 +15,6 @@
 #include <gi/bake.h>
 #include <gi/gi_system.h>
 
-#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -25,6 +24,7 @@
 #include <iostream>
 #include <string>
 #include <vector>
+#include <CLI/CLI.hpp>
 
 namespace {
 
@@ -101,8 +101,9 @@ int main(int argc, char** argv) {
     engine::Node n;
     n.name = l.name;
     n.light = static_cast<int>(asset->lights.size()) - 1;
-    n.translation = lo + (hi - lo) * glm::vec3((static_cast<float>(i % 4) + 0.5f) / 4.0f, 0.0f,
-                                               (static_cast<float>(i / 4) + 0.5f) / 4.0f) +
+    n.translation = lo +
+                    (hi - lo) * glm::vec3((static_cast<float>(i % 4) + 0.5f) / 4.0f, 0.0f,
+                                          (static_cast<float>(i / 4) + 0.5f) / 4.0f) +
                     glm::vec3(0.0f, 2.5f, 0.0f);
     n.gi.mobility = engine::Mobility::Dynamic;
     asset->nodes.push_back(n);
@@ -130,9 +131,10 @@ int main(int argc, char** argv) {
     return 1;
   }
   auto renderer = engine::Renderer::create(
-      scene.assets, engine::RenderSettings{.width = width, .height = height, .exposure = 0.3f, .warn = [](const std::string& s) {
-                                             std::cerr << "gi-stress: " << s << '\n';
-                                           }});
+      scene.assets,
+      engine::RenderSettings{.width = width, .height = height, .exposure = 0.3f, .warn = [](const std::string& s) {
+                               std::cerr << "gi-stress: " << s << '\n';
+                             }});
   if (!renderer) {
     std::cerr << "gi-stress: " << renderer.error().to_string() << '\n';
     return 1;
@@ -144,7 +146,8 @@ int main(int argc, char** argv) {
   std::vector<Mover> movers;
   for (int i = 0; i < crates; ++i) {
     const engine::Entity e = engine::find_by_name(scene.registry, "stress_crate_" + std::to_string(i));
-    movers.push_back({e, scene.registry.get<engine::Transform>(e).position, 0.15f, 0.9f, 0.37f * static_cast<float>(i)});
+    movers.push_back(
+        {e, scene.registry.get<engine::Transform>(e).position, 0.15f, 0.9f, 0.37f * static_cast<float>(i)});
   }
   for (int i = 0; i < lights; ++i) {
     const engine::Entity e = engine::find_by_name(scene.registry, "stress_light_" + std::to_string(i));
@@ -167,15 +170,17 @@ int main(int argc, char** argv) {
     for (float v : (*renderer)->read_hdr().pixels) non_finite += !std::isfinite(v);
     if (f + 1 == warmup) baseline = rss_mb();
     if (f + 1 > warmup) peak_growth = std::max(peak_growth, rss_mb() - baseline);
-    if ((f + 1) % std::max(1, frames / 10) == 0) std::printf("gi-stress: frame %d, resident %.1f MB\n", f + 1, rss_mb());
+    if ((f + 1) % std::max(1, frames / 10) == 0)
+      std::printf("gi-stress: frame %d, resident %.1f MB\n", f + 1, rss_mb());
   }
   const double end = rss_mb();
   const gi::GISystem::Stats& st = (*gi)->stats();
   std::printf("gi-stress: resident %.1f MB after %d warm-up frames, %.1f MB at the end, largest growth %.1f MB\n",
               baseline, warmup, end, peak_growth);
-  std::printf("gi-stress: %zu non-finite HDR values over %d frames; %.1f ms a frame; %llu BRF updates, %llu PRM updates\n",
-              non_finite, frames, total_ms / frames, static_cast<unsigned long long>(st.brf_updates),
-              static_cast<unsigned long long>(st.prm_updates));
+  std::printf(
+      "gi-stress: %zu non-finite HDR values over %d frames; %.1f ms a frame; %llu BRF updates, %llu PRM updates\n",
+      non_finite, frames, total_ms / frames, static_cast<unsigned long long>(st.brf_updates),
+      static_cast<unsigned long long>(st.prm_updates));
   for (const std::string& off : st.disabled) std::printf("gi-stress: turned off: %s\n", off.c_str());
   gi->reset();
   const bool ok = non_finite == 0 && (frames <= warmup || peak_growth <= max_growth_mb);

@@ -6,10 +6,10 @@
 //   gi-sweep --method pathtracer --scene assets/cornell_box.gltf --knob spp=1,4,16 --out out/sweeps
 #include <gi/sweep.h>
 
-#include <CLI/CLI.hpp>
 #include <cstdio>
 #include <string>
 #include <vector>
+#include <CLI/CLI.hpp>
 
 #include "console_progress.h"
 #include "plot_command.h"

@@ -10,11 +10,11 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
-#include <glm/glm.hpp>
 #include <span>
 #include <string>
 #include <type_traits>
 #include <vector>
+#include <glm/glm.hpp>
 
 namespace engine {
 

@@ -15,7 +15,7 @@ namespace engine::detail {
 }  // namespace engine::detail
 
 /// GI_EXPECTS(cond, "what the caller must guarantee"): aborts with the message when cond is false.
-#define GI_EXPECTS(cond, message)                                              \
-  do {                                                                         \
+#define GI_EXPECTS(cond, message)                                                    \
+  do {                                                                               \
     if (!(cond)) ::engine::detail::check_failed(#cond, message, __FILE__, __LINE__); \
   } while (false)

@@ -14,8 +14,8 @@ namespace engine {
 
 /// Limits that protect the loader from absurd inputs; exceeding one is a data error.
 struct GltfLoadLimits {
-  std::size_t max_file_bytes = std::size_t{2} << 30;      ///< 2 GiB
-  std::size_t max_vertices_per_primitive = 1u << 26;      ///< 67 M
+  std::size_t max_file_bytes = std::size_t{2} << 30;  ///< 2 GiB
+  std::size_t max_vertices_per_primitive = 1u << 26;  ///< 67 M
   std::size_t max_indices_per_primitive = 3u << 26;
   std::size_t max_nodes = 1u << 20;
   int max_image_dimension = 16384;
@@ -48,8 +48,8 @@ struct GltfLoadOptions {
 Result<SceneAsset> load_gltf(const std::filesystem::path& path, const GltfLoadOptions& options = {});
 
 struct GltfWriteOptions {
-  bool binary = false;        ///< .glb (one file) instead of .gltf + .bin.
-  bool draco = false;         ///< Compress meshes with KHR_draco_mesh_compression.
+  bool binary = false;  ///< .glb (one file) instead of .gltf + .bin.
+  bool draco = false;   ///< Compress meshes with KHR_draco_mesh_compression.
   int draco_position_bits = 14;
   int draco_normal_bits = 10;
   int draco_texcoord_bits = 12;

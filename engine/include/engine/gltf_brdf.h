@@ -32,10 +32,10 @@ inline constexpr float kGltfDielectricF0 = 0.04f;
 
 /// The BRDF's parameters at one shading point (material factors times texture values).
 struct GltfBrdf {
-  glm::vec3 base_color{1.0f};      ///< Linear base colour.
-  float metallic = 0.0f;           ///< In [0, 1].
-  float alpha = 1.0f;              ///< GGX alpha = clamped roughness^2.
-  float specular_weight = 1.0f;    ///< KHR_materials_specular specularFactor: 0 = pure Lambertian dielectric.
+  glm::vec3 base_color{1.0f};    ///< Linear base colour.
+  float metallic = 0.0f;         ///< In [0, 1].
+  float alpha = 1.0f;            ///< GGX alpha = clamped roughness^2.
+  float specular_weight = 1.0f;  ///< KHR_materials_specular specularFactor: 0 = pure Lambertian dielectric.
   glm::vec3 dielectric_f0{kGltfDielectricF0};  ///< min(0.04 x specularColorFactor, 1).
 };
 

@@ -49,9 +49,9 @@ struct LightReachGrid {
   static constexpr int kMaxLights = 8;
   glm::vec3 origin{0.0f};  ///< World position of voxel (0, 0, 0)'s minimum corner (m).
   float voxel_m = 0.5f;
-  glm::ivec3 dims{0};      ///< Voxels per axis; 0: no grid (every point gets every light).
+  glm::ivec3 dims{0};               ///< Voxels per axis; 0: no grid (every point gets every light).
   std::vector<std::uint8_t> masks;  ///< x fastest, then y, then z.
-  std::uint8_t all = 0;    ///< The mask with every light's bit (outside the grid).
+  std::uint8_t all = 0;             ///< The mask with every light's bit (outside the grid).
 
   bool empty() const { return masks.empty(); }
   /// The mask of the voxel holding p; `all` outside the grid.
@@ -60,8 +60,9 @@ struct LightReachGrid {
 
 /// At most LightReachGrid::kMaxLights lights (bit i = lights[i]). The grid covers
 /// [min, max] padded by one voxel.
-LightReachGrid build_light_reach_grid(const std::vector<ReachOccluder>& occluders, const std::vector<ReachLight>& lights,
-                                      const glm::vec3& min, const glm::vec3& max, float voxel_m);
+LightReachGrid build_light_reach_grid(const std::vector<ReachOccluder>& occluders,
+                                      const std::vector<ReachLight>& lights, const glm::vec3& min, const glm::vec3& max,
+                                      float voxel_m);
 
 /// Whether the segment from p to q (ends excluded by `end_margin_m`) crosses a triangle.
 bool segment_blocked(const std::vector<ReachOccluder>& occluders, const glm::vec3& p, const glm::vec3& q,

@@ -22,11 +22,11 @@
 #include <string>
 #include <vector>
 
+#include <functional>
+#include <string>
 #include <engine/entity.h>
 #include <engine/exposure.h>
 #include <engine/image.h>
-#include <functional>
-#include <string>
 
 #include <engine/indirect_light.h>
 #include <engine/registry.h>

@@ -17,8 +17,8 @@
 
 namespace engine {
 
-inline constexpr float kMaxWorldCoordinate = 1e6f;   ///< Metres from the origin.
-inline constexpr float kMinAxisScale = 1e-6f;        ///< Length of a transform's axis.
+inline constexpr float kMaxWorldCoordinate = 1e6f;  ///< Metres from the origin.
+inline constexpr float kMinAxisScale = 1e-6f;       ///< Length of a transform's axis.
 inline constexpr float kMaxAxisScale = 1e6f;
 inline constexpr float kMaxRuntimeLightValue = 1e15f;  ///< Intensity, and colour x intensity.
 

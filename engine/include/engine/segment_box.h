@@ -4,8 +4,8 @@
 //   if (engine::segment_meets_box(origin, to - origin, 1.0f, box_lo, box_hi)) { ...test its triangles... }
 
 #include <algorithm>
-#include <glm/glm.hpp>
 #include <utility>
+#include <glm/glm.hpp>
 
 namespace engine {
 

@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <bit>
-#include <cstdint>
 #include <cmath>
+#include <cstdint>
 #include <map>
 #include <mutex>
 #include <numbers>
@@ -205,7 +205,8 @@ GltfBrdfValue gltf_hemispherical_albedo(const GltfBrdf& m) {
   const std::uint32_t key = std::bit_cast<std::uint32_t>(m.alpha);
   {
     const std::lock_guard lock(mutex);
-    if (auto it = integrals_of_alpha.find(key); it != integrals_of_alpha.end()) return albedo_from_integrals(m, it->second);
+    if (auto it = integrals_of_alpha.find(key); it != integrals_of_alpha.end())
+      return albedo_from_integrals(m, it->second);
   }
   constexpr int kCos = 48;
   glm::dvec3 sum(0.0);

@@ -43,8 +43,8 @@ int add_float_attribute(draco::Mesh& mesh, draco::GeometryAttribute::Type type, 
 
 }  // namespace
 
-bool encode_draco_primitive(const Primitive& primitive, const DracoQuantization& bits,
-                            DracoPrimitive& out, std::string& error) {
+bool encode_draco_primitive(const Primitive& primitive, const DracoQuantization& bits, DracoPrimitive& out,
+                            std::string& error) {
   const std::size_t n = primitive.positions.size();
   draco::Mesh mesh;
   mesh.set_num_points(static_cast<draco::PointIndex::ValueType>(n));

@@ -30,15 +30,15 @@ struct DracoPrimitive {
   int normal_id = -1;
   int uv0_id = -1;
   int uv1_id = -1;
-  std::size_t vertex_count = 0;     ///< Decoded point count (accessor count).
-  std::size_t index_count = 0;      ///< Decoded faces x 3.
-  glm::vec3 position_min{0.0f};     ///< Bounds of the decoded positions.
+  std::size_t vertex_count = 0;  ///< Decoded point count (accessor count).
+  std::size_t index_count = 0;   ///< Decoded faces x 3.
+  glm::vec3 position_min{0.0f};  ///< Bounds of the decoded positions.
   glm::vec3 position_max{0.0f};
 };
 
 /// Encodes `primitive` (edgebreaker, quantized). Returns false with `error` set when Draco
 /// rejects it. Non-indexed primitives are encoded as sequential triangles.
-bool encode_draco_primitive(const Primitive& primitive, const DracoQuantization& bits,
-                            DracoPrimitive& out, std::string& error);
+bool encode_draco_primitive(const Primitive& primitive, const DracoQuantization& bits, DracoPrimitive& out,
+                            std::string& error);
 
 }  // namespace engine::gltf

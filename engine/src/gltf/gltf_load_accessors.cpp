@@ -14,12 +14,16 @@ namespace {
 std::size_t component_size(int component_type) {
   switch (component_type) {
     case TINYGLTF_COMPONENT_TYPE_BYTE:
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return 1;
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+      return 1;
     case TINYGLTF_COMPONENT_TYPE_SHORT:
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return 2;
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT:
+      return 2;
     case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
-    case TINYGLTF_COMPONENT_TYPE_FLOAT: return 4;
-    default: return 0;
+    case TINYGLTF_COMPONENT_TYPE_FLOAT:
+      return 4;
+    default:
+      return 0;
   }
 }
 
@@ -31,7 +35,8 @@ double read_component(const std::uint8_t* p, int component_type, bool normalized
       std::memcpy(&v, p, 1);
       return normalized ? std::max(v / 127.0, -1.0) : v;
     }
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return normalized ? p[0] / 255.0 : p[0];
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+      return normalized ? p[0] / 255.0 : p[0];
     case TINYGLTF_COMPONENT_TYPE_SHORT: {
       std::int16_t v;
       std::memcpy(&v, p, 2);
@@ -52,7 +57,8 @@ double read_component(const std::uint8_t* p, int component_type, bool normalized
       std::memcpy(&v, p, 4);
       return static_cast<double>(v);
     }
-    default: return 0.0;
+    default:
+      return 0.0;
   }
 }
 
@@ -76,8 +82,8 @@ Result<ByteRange> locate(const Context& ctx, const ParsedFile& file, int view, s
   }
   const std::size_t buffer_index = static_cast<std::size_t>(bv.buffer);
   if (buffer_index < file.buffer_problems.size() && !file.buffer_problems[buffer_index].empty()) {
-    return ctx.error(where, "reads buffer " + std::to_string(bv.buffer) + ", which has no data: " +
-                                file.buffer_problems[buffer_index]);
+    return ctx.error(where, "reads buffer " + std::to_string(bv.buffer) +
+                                ", which has no data: " + file.buffer_problems[buffer_index]);
   }
   const std::vector<unsigned char>& buffer = model.buffers[buffer_index].data;
   if (bv.byteOffset > buffer.size() || bv.byteLength > buffer.size() - bv.byteOffset) {
@@ -113,14 +119,22 @@ Result<ByteRange> locate(const Context& ctx, const ParsedFile& file, int view, s
 
 int component_count(int type) {
   switch (type) {
-    case TINYGLTF_TYPE_SCALAR: return 1;
-    case TINYGLTF_TYPE_VEC2: return 2;
-    case TINYGLTF_TYPE_VEC3: return 3;
-    case TINYGLTF_TYPE_VEC4: return 4;
-    case TINYGLTF_TYPE_MAT2: return 4;
-    case TINYGLTF_TYPE_MAT3: return 9;
-    case TINYGLTF_TYPE_MAT4: return 16;
-    default: return 0;
+    case TINYGLTF_TYPE_SCALAR:
+      return 1;
+    case TINYGLTF_TYPE_VEC2:
+      return 2;
+    case TINYGLTF_TYPE_VEC3:
+      return 3;
+    case TINYGLTF_TYPE_VEC4:
+      return 4;
+    case TINYGLTF_TYPE_MAT2:
+      return 4;
+    case TINYGLTF_TYPE_MAT3:
+      return 9;
+    case TINYGLTF_TYPE_MAT4:
+      return 16;
+    default:
+      return 0;
   }
 }
 
@@ -145,7 +159,8 @@ Result<std::vector<double>> read_accessor(const Context& ctx, const ParsedFile& 
   }
   if (acc.count < 1) return ctx.error(where, "count must be >= 1");
   if (acc.count > max_count) {
-    return ctx.error(where, "count " + std::to_string(acc.count) + " exceeds the limit of " + std::to_string(max_count));
+    return ctx.error(where,
+                     "count " + std::to_string(acc.count) + " exceeds the limit of " + std::to_string(max_count));
   }
   const std::size_t n = static_cast<std::size_t>(ncomp);
   const std::size_t element_size = csize * n;
@@ -170,7 +185,8 @@ Result<std::vector<double>> read_accessor(const Context& ctx, const ParsedFile& 
     values.resize(acc.count * n);
     for (std::size_t i = 0; i < acc.count; ++i) {
       const std::uint8_t* e = range->data + i * range->stride;
-      for (std::size_t c = 0; c < n; ++c) values[i * n + c] = read_component(e + c * csize, acc.componentType, acc.normalized);
+      for (std::size_t c = 0; c < n; ++c)
+        values[i * n + c] = read_component(e + c * csize, acc.componentType, acc.normalized);
     }
   } else {
     values.assign(acc.count * n, 0.0);  // §3.6.2.3: no bufferView means zeros
@@ -206,7 +222,8 @@ Result<std::vector<double>> read_accessor(const Context& ctx, const ParsedFile& 
       previous = target;
       const std::size_t t = static_cast<std::size_t>(target);
       for (std::size_t c = 0; c < n; ++c) {
-        values[t * n + c] = read_component(vrange->data + k * element_size + c * csize, acc.componentType, acc.normalized);
+        values[t * n + c] =
+            read_component(vrange->data + k * element_size + c * csize, acc.componentType, acc.normalized);
       }
     }
   }

@@ -28,7 +28,8 @@ Result<DracoPrimitive> decode_draco(const Context& ctx, const ParsedFile& file, 
   }
   const std::size_t buffer_index = static_cast<std::size_t>(view.buffer);
   if (buffer_index < file.buffer_problems.size() && !file.buffer_problems[buffer_index].empty()) {
-    return ctx.error(where, "buffer " + std::to_string(view.buffer) + " has no data: " + file.buffer_problems[buffer_index]);
+    return ctx.error(where,
+                     "buffer " + std::to_string(view.buffer) + " has no data: " + file.buffer_problems[buffer_index]);
   }
   const std::vector<unsigned char>& buffer = model.buffers[buffer_index].data;
   if (view.byteOffset > buffer.size() || view.byteLength > buffer.size() - view.byteOffset) {

@@ -70,18 +70,18 @@ struct DracoRef {
 struct ImageDecodeState {
   bool decode = true;
   int max_dimension = 16384;
-  std::size_t max_pixels = std::size_t{1} << 26;            ///< GltfLoadLimits::max_image_pixels
-  std::size_t max_total_bytes = std::size_t{2} << 30;       ///< GltfLoadLimits::max_scene_image_bytes
-  std::size_t decoded_bytes = 0;                            ///< decoded so far (RGBA8)
-  std::vector<std::string> failures;  ///< per image index: empty, or why it failed
-  std::vector<bool> delivered;        ///< per image index: bytes were found
-  std::vector<bool> used;             ///< per image index: a material's texture samples it (decoded only then)
+  std::size_t max_pixels = std::size_t{1} << 26;       ///< GltfLoadLimits::max_image_pixels
+  std::size_t max_total_bytes = std::size_t{2} << 30;  ///< GltfLoadLimits::max_scene_image_bytes
+  std::size_t decoded_bytes = 0;                       ///< decoded so far (RGBA8)
+  std::vector<std::string> failures;                   ///< per image index: empty, or why it failed
+  std::vector<bool> delivered;                         ///< per image index: bytes were found
+  std::vector<bool> used;  ///< per image index: a material's texture samples it (decoded only then)
 };
 
 struct ParsedFile {
   Json doc;
   tinygltf::Model model;
-  std::map<std::pair<int, int>, DracoRef> draco;   ///< (mesh, primitive) -> Draco data
+  std::map<std::pair<int, int>, DracoRef> draco;  ///< (mesh, primitive) -> Draco data
   /// (mesh, primitive) -> indices accessor. Removed from what tinygltf sees, because it
   /// rejects valid index accessors without a buffer view (Draco, all-zero indices).
   std::map<std::pair<int, int>, int> primitive_indices;
@@ -91,7 +91,7 @@ struct ParsedFile {
   /// Per accessor: why it cannot be read (unknown type...), or empty. An error only when used.
   std::vector<std::string> accessor_problems;
   ImageDecodeState images;
-  bool mesh_quantization = false;                  ///< KHR_mesh_quantization is used
+  bool mesh_quantization = false;  ///< KHR_mesh_quantization is used
 };
 
 // gltf_load_container.cpp: file checks, GLB chunks, JSON pre-validation, tinygltf, images.
@@ -101,8 +101,7 @@ Result<ParsedFile> parse_file(const Context& ctx, const std::filesystem::path& p
 /// Reads accessor `index` as doubles, `count * components` of them, normalized integers
 /// converted as glTF 2.0 §3.11 says, sparse substitution applied (§3.6.2.3).
 /// `max_count` bounds the element count.
-Result<std::vector<double>> read_accessor(const Context& ctx, const ParsedFile& file, int index,
-                                          std::size_t max_count);
+Result<std::vector<double>> read_accessor(const Context& ctx, const ParsedFile& file, int index, std::size_t max_count);
 /// Number of components of an accessor type (SCALAR 1 ... MAT4 16), 0 if unknown.
 int component_count(int type);
 
@@ -127,9 +126,8 @@ Result<std::vector<Image>> convert_images(const Context& ctx, const ParsedFile& 
 Result<std::vector<Material>> convert_materials(const Context& ctx, const ParsedFile& file);
 /// Every primitive has the TEXCOORD set each texture of its material reads (TextureRef::texcoord).
 Status check_texcoord_sets(const Context& ctx, const SceneAsset& scene);
-bool decode_image_callback(tinygltf::Image* image, int image_idx, std::string* err, std::string* warn,
-                           int req_width, int req_height, const unsigned char* bytes, int size,
-                           void* user_data);
+bool decode_image_callback(tinygltf::Image* image, int image_idx, std::string* err, std::string* warn, int req_width,
+                           int req_height, const unsigned char* bytes, int size, void* user_data);
 
 // gltf_load_lights.cpp
 /// The file's KHR_lights_punctual lights, converted to engine units.
@@ -154,8 +152,7 @@ Status parse_scene_environment(const Context& ctx, const Json& scene_json, const
 // gltf_load_nodes.cpp
 /// Fills scene.nodes (parents first) and appends area lights to scene.lights.
 /// `camera_map` maps file camera indices to scene.cameras (-1: skipped).
-Status convert_nodes(const Context& ctx, const ParsedFile& file, const std::vector<int>& camera_map,
-                     SceneAsset& scene);
+Status convert_nodes(const Context& ctx, const ParsedFile& file, const std::vector<int>& camera_map, SceneAsset& scene);
 
 // JSON helpers (gltf_load_container.cpp).
 /// The member `key` of `object` if `object` is an object holding it, else nullptr.

@@ -34,8 +34,8 @@ bool decode_image_callback(tinygltf::Image* image, int image_idx, std::string* /
     return true;
   }
   if (w <= 0 || h <= 0 || w > state->max_dimension || h > state->max_dimension) {
-    state->failures[idx] = "image of " + std::to_string(w) + "x" + std::to_string(h) +
-                           " pixels exceeds the limit of " + std::to_string(state->max_dimension);
+    state->failures[idx] = "image of " + std::to_string(w) + "x" + std::to_string(h) + " pixels exceeds the limit of " +
+                           std::to_string(state->max_dimension);
     return true;
   }
   // Budgets from the header, before a byte is decoded (GltfLoadLimits).
@@ -123,7 +123,8 @@ Result<int> texture_image(const Context& ctx, const ParsedFile& file, int textur
   }
   const int source = model.textures[static_cast<std::size_t>(texture)].source;
   if (source >= 0 && static_cast<std::size_t>(source) >= model.images.size()) {
-    return ctx.error("texture " + std::to_string(texture), "source image " + std::to_string(source) + " is out of range");
+    return ctx.error("texture " + std::to_string(texture),
+                     "source image " + std::to_string(source) + " is out of range");
   }
   if (auto ok = image_status(ctx, file, source); !ok) return ok.error();
   return source;
@@ -150,7 +151,8 @@ Status read_specular_extension(const Context& ctx, const Json* exts, const std::
   m.specular_factor = *weight;
   const Json* color = find_member(*ext, "specularColorFactor");
   if (color == nullptr) return {};
-  if (!color->is_array() || color->size() != 3) return ctx.error(at, "specularColorFactor must be an array of 3 numbers");
+  if (!color->is_array() || color->size() != 3)
+    return ctx.error(at, "specularColorFactor must be an array of 3 numbers");
   for (std::size_t c = 0; c < 3; ++c) {
     const Json& v = (*color)[c];
     if (!v.is_number() || !std::isfinite(v.get<double>()) || v.get<double>() < 0.0 || v.get<double>() > 1e6) {
@@ -323,8 +325,8 @@ Result<std::vector<Material>> convert_materials(const Context& ctx, const Parsed
       // KHR_materials_emissive_strength: emissiveStrength >= 0 multiplies emissiveFactor.
       const Json* strength_ext = exts != nullptr ? find_member(*exts, "KHR_materials_emissive_strength") : nullptr;
       if (strength_ext != nullptr) {
-        auto strength = number_member(ctx, *strength_ext, "emissiveStrength", 1.0,
-                                      where + " KHR_materials_emissive_strength");
+        auto strength =
+            number_member(ctx, *strength_ext, "emissiveStrength", 1.0, where + " KHR_materials_emissive_strength");
         if (!strength) return strength.error();
         // Finite as a double can overflow as a float once it multiplies emissiveFactor.
         if (!std::isfinite(*strength) || *strength < 0.0 || *strength > 1e15) {
@@ -356,12 +358,15 @@ Result<std::vector<Material>> convert_materials(const Context& ctx, const Parsed
         {src.emissiveTexture.index, src.emissiveTexture.texCoord, info(json_material, "emissiveTexture"),
          &m.emissive_texture, "emissiveTexture"}};
     // The engine does not use occlusion, but a dangling reference is still a broken file.
-    if (src.occlusionTexture.index >= 0 && static_cast<std::size_t>(src.occlusionTexture.index) >= file.model.textures.size()) {
-      return ctx.error(where + " occlusionTexture", "texture " + std::to_string(src.occlusionTexture.index) + " is out of range");
+    if (src.occlusionTexture.index >= 0 &&
+        static_cast<std::size_t>(src.occlusionTexture.index) >= file.model.textures.size()) {
+      return ctx.error(where + " occlusionTexture",
+                       "texture " + std::to_string(src.occlusionTexture.index) + " is out of range");
     }
     const std::string named = where + (src.name.empty() ? "" : " '" + src.name + "'");
     for (const Slot& slot : slots) {
-      if (auto ok = read_texture_ref(ctx, file, slot.index, slot.texcoord, slot.info, named + " " + slot.name, *slot.target);
+      if (auto ok =
+              read_texture_ref(ctx, file, slot.index, slot.texcoord, slot.info, named + " " + slot.name, *slot.target);
           !ok)
         return ok.error();
     }
@@ -388,10 +393,11 @@ Status check_texcoord_sets(const Context& ctx, const SceneAsset& scene) {
       const Primitive& p = mesh.primitives[pi];
       if (p.material < 0 || static_cast<std::size_t>(p.material) >= scene.materials.size()) continue;
       const Material& m = scene.materials[static_cast<std::size_t>(p.material)];
-      const std::pair<const TextureRef*, const char*> slots[] = {{&m.base_color_texture, "baseColorTexture"},
-                                                                 {&m.metallic_roughness_texture, "metallicRoughnessTexture"},
-                                                                 {&m.normal_texture, "normalTexture"},
-                                                                 {&m.emissive_texture, "emissiveTexture"}};
+      const std::pair<const TextureRef*, const char*> slots[] = {
+          {&m.base_color_texture, "baseColorTexture"},
+          {&m.metallic_roughness_texture, "metallicRoughnessTexture"},
+          {&m.normal_texture, "normalTexture"},
+          {&m.emissive_texture, "emissiveTexture"}};
       for (const auto& [ref, name] : slots) {
         if (!ref->present()) continue;
         const bool has = ref->texcoord == 0 ? !p.uv0.empty() : !p.uv1.empty();

@@ -139,7 +139,8 @@ Result<std::optional<Primitive>> convert_primitive(const Context& ctx, const Par
   if (position->values.empty()) {
     // §3.7.2.1 lets POSITION be absent (an extension may provide the geometry): nothing
     // the engine can draw, so the primitive is skipped like points and lines.
-    std::fprintf(stderr, "warning: %s: %s: no POSITION attribute, primitive skipped\n", ctx.file.c_str(), where.c_str());
+    std::fprintf(stderr, "warning: %s: %s: no POSITION attribute, primitive skipped\n", ctx.file.c_str(),
+                 where.c_str());
     return std::optional<Primitive>{};
   }
   Primitive out;
@@ -160,7 +161,8 @@ Result<std::optional<Primitive>> convert_primitive(const Context& ctx, const Par
                                                              {"TEXCOORD_1", &uv1.value()},
                                                              {"TANGENT", &tangent.value()}};
   for (const auto& [name, attr] : others) {
-    const std::size_t count = attr->components == 0 ? 0 : attr->values.size() / static_cast<std::size_t>(attr->components);
+    const std::size_t count =
+        attr->components == 0 ? 0 : attr->values.size() / static_cast<std::size_t>(attr->components);
     if (!attr->values.empty() && count != vertex_count) {
       return ctx.error(where, std::string(name) + " has " + std::to_string(count) + " elements, POSITION has " +
                                   std::to_string(vertex_count));
@@ -206,7 +208,8 @@ Result<std::optional<Primitive>> convert_primitive(const Context& ctx, const Par
     // §3.7.2.1: indices are SCALAR unsigned byte/short/int, not normalized.
     if (acc.type != TINYGLTF_TYPE_SCALAR || acc.normalized ||
         (acc.componentType != kUByte && acc.componentType != kUShort && acc.componentType != kUInt)) {
-      return ctx.error("accessor " + std::to_string(indices_accessor), "is not a valid index accessor (SCALAR unsigned integer)");
+      return ctx.error("accessor " + std::to_string(indices_accessor),
+                       "is not a valid index accessor (SCALAR unsigned integer)");
     }
     auto values = read_accessor(ctx, file, indices_accessor, ctx.options.limits.max_indices_per_primitive);
     if (!values) return values.error();

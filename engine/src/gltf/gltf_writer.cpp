@@ -12,11 +12,11 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
-#include <nlohmann/json.hpp>
 #include <set>
 #include <string>
 #include <utility>
 #include <vector>
+#include <nlohmann/json.hpp>
 
 #include "gltf/draco_encode.h"
 #include "gltf/gltf_file_output.h"
@@ -266,7 +266,8 @@ class GltfBuilder {
     if (!p.normals.empty() && p.normals.size() != n) return error(where, "normals count differs from positions count");
     if (!p.uv0.empty() && p.uv0.size() != n) return error(where, "uv0 count differs from positions count");
     if (!p.uv1.empty() && p.uv1.size() != n) return error(where, "uv1 count differs from positions count");
-    if (!p.tangents.empty() && p.tangents.size() != n) return error(where, "tangents count differs from positions count");
+    if (!p.tangents.empty() && p.tangents.size() != n)
+      return error(where, "tangents count differs from positions count");
     for (const glm::vec4& t : p.tangents)
       if (!engine::all_finite(t)) return error(where, "tangent is NaN or infinite");
     if (p.indices.size() % 3 != 0) return error(where, "index count is not a multiple of 3");

@@ -26,7 +26,8 @@ bool debug_requested() {
 void GLAPIENTRY print_debug_message(GLenum source, GLenum type, GLuint id, GLenum severity, GLsizei /*length*/,
                                     const GLchar* message, const void* /*user*/) {
   if (severity == GL_DEBUG_SEVERITY_NOTIFICATION) return;
-  std::fprintf(stderr, "GL debug [source 0x%x type 0x%x id %u severity 0x%x]: %s\n", source, type, id, severity, message);
+  std::fprintf(stderr, "GL debug [source 0x%x type 0x%x id %u severity 0x%x]: %s\n", source, type, id, severity,
+               message);
 }
 
 void install_debug_output() {
@@ -98,10 +99,14 @@ Result<GpuContext> GpuContext::create_headless() {
     if (--g_egl_users == 0) eglTerminate(display);
     return Error{"", "EGL", egl_error_text("eglBindAPI(EGL_OPENGL_API)")};
   }
-  const EGLint context_attributes[] = {EGL_CONTEXT_MAJOR_VERSION, 4,
-                                       EGL_CONTEXT_MINOR_VERSION, 5,
-                                       EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
-                                       EGL_CONTEXT_OPENGL_DEBUG, debug_requested() ? EGL_TRUE : EGL_FALSE,
+  const EGLint context_attributes[] = {EGL_CONTEXT_MAJOR_VERSION,
+                                       4,
+                                       EGL_CONTEXT_MINOR_VERSION,
+                                       5,
+                                       EGL_CONTEXT_OPENGL_PROFILE_MASK,
+                                       EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
+                                       EGL_CONTEXT_OPENGL_DEBUG,
+                                       debug_requested() ? EGL_TRUE : EGL_FALSE,
                                        EGL_NONE};
   // Surfaceless contexts need no config (EGL_KHR_no_config_context).
   EGLContext context = eglCreateContext(display, EGL_NO_CONFIG_KHR, EGL_NO_CONTEXT, context_attributes);
@@ -139,8 +144,9 @@ Result<GpuContext> GpuContext::create_window(const std::string& title, int width
     const char* description = nullptr;
     glfwGetError(&description);
     if (--g_glfw_users == 0) glfwTerminate();
-    return Error{"", "GLFW", std::string("glfwCreateWindow (OpenGL 4.5 core) failed: ") +
-                                 (description ? description : "unknown error")};
+    return Error{
+        "", "GLFW",
+        std::string("glfwCreateWindow (OpenGL 4.5 core) failed: ") + (description ? description : "unknown error")};
   }
   glfwMakeContextCurrent(state->window);
   glfwSwapInterval(0);

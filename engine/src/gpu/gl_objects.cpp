@@ -8,15 +8,33 @@ void delete_gl_object(GlObjectKind kind, std::uint32_t id) {
   if (id == 0) return;
   const GLuint name = id;
   switch (kind) {
-    case GlObjectKind::Buffer: glDeleteBuffers(1, &name); break;
-    case GlObjectKind::Texture: glDeleteTextures(1, &name); break;
-    case GlObjectKind::Framebuffer: glDeleteFramebuffers(1, &name); break;
-    case GlObjectKind::Renderbuffer: glDeleteRenderbuffers(1, &name); break;
-    case GlObjectKind::VertexArray: glDeleteVertexArrays(1, &name); break;
-    case GlObjectKind::Query: glDeleteQueries(1, &name); break;
-    case GlObjectKind::Program: glDeleteProgram(name); break;
-    case GlObjectKind::Shader: glDeleteShader(name); break;
-    case GlObjectKind::Sampler: glDeleteSamplers(1, &name); break;
+    case GlObjectKind::Buffer:
+      glDeleteBuffers(1, &name);
+      break;
+    case GlObjectKind::Texture:
+      glDeleteTextures(1, &name);
+      break;
+    case GlObjectKind::Framebuffer:
+      glDeleteFramebuffers(1, &name);
+      break;
+    case GlObjectKind::Renderbuffer:
+      glDeleteRenderbuffers(1, &name);
+      break;
+    case GlObjectKind::VertexArray:
+      glDeleteVertexArrays(1, &name);
+      break;
+    case GlObjectKind::Query:
+      glDeleteQueries(1, &name);
+      break;
+    case GlObjectKind::Program:
+      glDeleteProgram(name);
+      break;
+    case GlObjectKind::Shader:
+      glDeleteShader(name);
+      break;
+    case GlObjectKind::Sampler:
+      glDeleteSamplers(1, &name);
+      break;
   }
 }
 

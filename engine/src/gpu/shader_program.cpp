@@ -13,10 +13,14 @@ namespace {
 
 GLenum gl_stage(ShaderStage s) {
   switch (s) {
-    case ShaderStage::Vertex: return GL_VERTEX_SHADER;
-    case ShaderStage::Geometry: return GL_GEOMETRY_SHADER;
-    case ShaderStage::Fragment: return GL_FRAGMENT_SHADER;
-    case ShaderStage::Compute: return GL_COMPUTE_SHADER;
+    case ShaderStage::Vertex:
+      return GL_VERTEX_SHADER;
+    case ShaderStage::Geometry:
+      return GL_GEOMETRY_SHADER;
+    case ShaderStage::Fragment:
+      return GL_FRAGMENT_SHADER;
+    case ShaderStage::Compute:
+      return GL_COMPUTE_SHADER;
   }
   return GL_VERTEX_SHADER;
 }

@@ -55,7 +55,8 @@ void ForwardRenderer::draw_geometry(const std::vector<DrawItem>& items, bool dou
         glUniform1i(12, item.mesh->first_vertex);
       }
       for (const render::GpuPrimitive& p : item.mesh->primitives) {
-        const render::GpuMaterial& m = scene_.material(item.material_override >= 0 ? item.material_override : p.material);
+        const render::GpuMaterial& m =
+            scene_.material(item.material_override >= 0 ? item.material_override : p.material);
         if (m.alpha_mode == AlphaMode::Blend) continue;
         if (depth_pass && (m.alpha_mode == AlphaMode::Mask) != cut_out) continue;
         if (cut_out) render::bind_alpha_test(m, m.alpha_cutoff);

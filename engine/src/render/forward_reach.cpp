@@ -82,7 +82,8 @@ void ForwardRenderer::update_reach(const std::vector<DrawItem>& items, const ren
   }
   std::map<std::uint32_t, glm::mat4> models;
   for (const DrawItem& item : items)
-    if (item.is_static && item.cast_shadows && !reach_.moved.contains(item.entity.id())) models[item.entity.id()] = item.model;
+    if (item.is_static && item.cast_shadows && !reach_.moved.contains(item.entity.id()))
+      models[item.entity.id()] = item.model;
   const bool built = reach_.builds > 0;
   const bool static_changed = !built || key != reach_.light_key || models != reach_.static_models;
   if (!static_changed && moving_key == reach_.moving_key) return;
@@ -124,14 +125,15 @@ void ForwardRenderer::update_reach(const std::vector<DrawItem>& items, const ren
     reach_.light_key = std::move(key);
     reach_.static_models = std::move(models);
     ++reach_.builds;
-    reach_.static_grid = statics.empty ? LightReachGrid{}
-                                       : build_light_reach_grid(reach_.occluders, static_lights, statics.min, statics.max,
-                                                                kReachVoxelM);
+    reach_.static_grid =
+        statics.empty ? LightReachGrid{}
+                      : build_light_reach_grid(reach_.occluders, static_lights, statics.min, statics.max, kReachVoxelM);
   }
   reach_.moving_key = std::move(moving_key);
   LightReachGrid moving;
   if (!moving_lights.empty() && !reach_.statics.empty)
-    moving = build_light_reach_grid(reach_.occluders, moving_lights, reach_.statics.min, reach_.statics.max, kReachVoxelM);
+    moving =
+        build_light_reach_grid(reach_.occluders, moving_lights, reach_.statics.min, reach_.statics.max, kReachVoxelM);
   // Static bits low, moving bits above them (both grids span the same voxels).
   const glm::ivec3 old_dims = reach_.grid.dims;
   reach_.grid = !reach_.static_grid.empty() ? reach_.static_grid : moving;

@@ -11,20 +11,20 @@
 #include <cstring>
 #include <map>
 #include <set>
-#include <utility>
 #include <string>
+#include <utility>
 
 #include <GL/glcorearb.h>
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/type_ptr.hpp>
 
 #include <engine/components.h>
-#include <engine/light_reach.h>
-#include <engine/runtime_limits.h>
 #include <engine/gpu/gl_objects.h>
 #include <engine/gpu/gltf_brdf_texture.h>
 #include <engine/gpu/gpu_timer.h>
 #include <engine/gpu/shader_program.h>
+#include <engine/light_reach.h>
+#include <engine/runtime_limits.h>
 
 #include "render/frame_data.h"
 #include "render/gpu_scene.h"
@@ -166,7 +166,8 @@ std::vector<DrawItem> ForwardRenderer::draw_items(const Registry& registry,
 }
 
 // One warning per entity when it starts being skipped; forgotten when it is usable again.
-void ForwardRenderer::report_skipped(const Registry& registry, const std::vector<std::pair<Entity, const char*>>& skipped) {
+void ForwardRenderer::report_skipped(const Registry& registry,
+                                     const std::vector<std::pair<Entity, const char*>>& skipped) {
   skipped_entities_ = static_cast<int>(skipped.size());
   std::set<std::uint32_t> now;
   for (const auto& [e, why] : skipped) {
@@ -200,7 +201,8 @@ void ForwardRenderer::render(const Registry& registry, Entity camera, double dt_
   const CameraView view = camera_view(registry, camera);
   // The alpha-tested shadow program only for scenes with MASK or BLEND materials (made on first use).
   const ShaderProgram* shadow_cut_out = scene_.has_cut_out() ? &alpha_test_program("shadow.frag.glsl") : nullptr;
-  shadow_maps_rendered_ = shadow_maps_.render(lights.shadow_views, items, scene_, shadow_, shadow_cut_out, view.view_proj);
+  shadow_maps_rendered_ =
+      shadow_maps_.render(lights.shadow_views, items, scene_, shadow_, shadow_cut_out, view.view_proj);
   timings_.push_back({"shadow maps (" + std::to_string(lights.shadow_views.size()) + " views)", timer.lap_ms()});
 
   // Half-resolution area shadows: every area light of the frame (each its visibility channel,
@@ -208,7 +210,8 @@ void ForwardRenderer::render(const Registry& registry, Entity camera, double dt_
   area_lights_.clear();
   if (settings_.area_shadow_res == AreaShadowRes::Half && settings_.area_soft_shadows && !settings_.flat_shading) {
     for (const render::GpuLight& g : lights.lights)
-      if (static_cast<int>(g.position_type.w) == static_cast<int>(render::GpuLightType::Area)) area_lights_.push_back(g);
+      if (static_cast<int>(g.position_type.w) == static_cast<int>(render::GpuLightType::Area))
+        area_lights_.push_back(g);
     const bool any_map = std::any_of(area_lights_.begin(), area_lights_.end(),
                                      [](const render::GpuLight& g) { return g.cone.z >= 0.0f; });
     if (area_lights_.size() > 4 || !any_map) area_lights_.clear();
@@ -225,7 +228,8 @@ void ForwardRenderer::render(const Registry& registry, Entity camera, double dt_
       g.offset = static_cast<GLintptr>(at);
       const std::size_t n = std::max<std::size_t>(1, g.lights.size()) * sizeof(render::GpuLight);
       bytes.resize(at + n, 0);
-      if (!g.lights.empty()) std::memcpy(bytes.data() + at, g.lights.data(), g.lights.size() * sizeof(render::GpuLight));
+      if (!g.lights.empty())
+        std::memcpy(bytes.data() + at, g.lights.data(), g.lights.size() * sizeof(render::GpuLight));
     }
     glNamedBufferData(lights_buffer_.id(), static_cast<GLsizeiptr>(bytes.size()), bytes.data(), GL_STREAM_DRAW);
   }
@@ -270,7 +274,6 @@ void ForwardRenderer::forward_pass(const CameraView& view, const std::vector<Dra
                                    const std::vector<LightGroup>& groups, const IndirectLightFrame* indirect) {
   const glm::mat4& view_proj = view.view_proj;
   const glm::vec3& camera_position = view.position;
-
 
   glBindFramebuffer(GL_FRAMEBUFFER, hdr_fbo_.id());
   glViewport(0, 0, width_, height_);
@@ -329,17 +332,24 @@ void ForwardRenderer::forward_pass(const CameraView& view, const std::vector<Dra
 
   const SkyGradient& sky = settings_.sky_gradient;
   const glm::vec3 zero(0.0f);
-  const bool has_sky = glm::any(glm::notEqual(settings_.sky_radiance, zero)) || glm::any(glm::notEqual(sky.horizon, zero)) ||
-                       glm::any(glm::notEqual(sky.zenith, zero)) || glm::any(glm::notEqual(sky.ground, zero));
+  const bool has_sky = glm::any(glm::notEqual(settings_.sky_radiance, zero)) ||
+                       glm::any(glm::notEqual(sky.horizon, zero)) || glm::any(glm::notEqual(sky.zenith, zero)) ||
+                       glm::any(glm::notEqual(sky.ground, zero));
   // One light group's pixels (its stencil mask), or with `blend` the BLEND primitives of
   // `order` (back to front) over everything, without the stencil.
   const auto shade = [&](const LightGroup& group, const std::vector<const DrawItem*>& order, bool blend) {
     if (reach && !blend) glStencilFunc(GL_EQUAL, group.mask, area_lights_.empty() ? 0xFF : 0xFF & ~kAreaFallbackBit);
-    glBindBufferRange(GL_SHADER_STORAGE_BUFFER, kLightsBinding, lights_buffer_.id(), group.offset,
-                      static_cast<GLsizeiptr>(std::max<std::size_t>(1, group.lights.size()) * sizeof(render::GpuLight)));
-    const LightCounts counts{group.count_by_type[0], group.count_by_type[1], group.count_by_type[2],
-                             group.count_by_type[3], std::clamp(settings_.area_specular_samples_per_side, 1, 4),
-                             settings_.area_soft_shadows ? 1 : 0, has_sky ? 1 : 0, area_lights_.empty() ? 0 : 1,
+    glBindBufferRange(
+        GL_SHADER_STORAGE_BUFFER, kLightsBinding, lights_buffer_.id(), group.offset,
+        static_cast<GLsizeiptr>(std::max<std::size_t>(1, group.lights.size()) * sizeof(render::GpuLight)));
+    const LightCounts counts{group.count_by_type[0],
+                             group.count_by_type[1],
+                             group.count_by_type[2],
+                             group.count_by_type[3],
+                             std::clamp(settings_.area_specular_samples_per_side, 1, 4),
+                             settings_.area_soft_shadows ? 1 : 0,
+                             has_sky ? 1 : 0,
+                             area_lights_.empty() ? 0 : 1,
                              settings_.flat_shading ? 1 : 0};
     // Rough dielectrics draw with the one-specular-point variant of area lights (rough_dielectric),
     // the other materials with RenderSettings::area_specular_samples_per_side: two passes over the
@@ -367,7 +377,8 @@ void ForwardRenderer::forward_pass(const CameraView& view, const std::vector<Dra
       glUniform1i(25, glossy != 0 && !blend ? 1 : 0);  // the glossy texture is the opaque surface's
 
       const auto in_pass = [&](const DrawItem& item, const render::GpuPrimitive& p) {
-        const render::GpuMaterial& m = scene_.material(item.material_override >= 0 ? item.material_override : p.material);
+        const render::GpuMaterial& m =
+            scene_.material(item.material_override >= 0 ? item.material_override : p.material);
         if ((m.alpha_mode == AlphaMode::Blend) != blend) return false;
         if (!split_rough) return true;
         return rough_dielectric(m, scene_.white_texture()) == (pass == 1);
@@ -375,7 +386,8 @@ void ForwardRenderer::forward_pass(const CameraView& view, const std::vector<Dra
       for (const DrawItem* drawn : order) {
         const DrawItem& item = *drawn;
         const render::SceneBounds& gb = group.bounds;
-        if (!gb.empty && (glm::any(glm::lessThan(item.bounds.max, gb.min)) || glm::any(glm::greaterThan(item.bounds.min, gb.max))))
+        if (!gb.empty &&
+            (glm::any(glm::lessThan(item.bounds.max, gb.min)) || glm::any(glm::greaterThan(item.bounds.min, gb.max))))
           continue;  // none of this group's pixels can be on the item
         if (std::none_of(item.mesh->primitives.begin(), item.mesh->primitives.end(),
                          [&](const render::GpuPrimitive& p) { return in_pass(item, p); }))
@@ -399,8 +411,8 @@ void ForwardRenderer::forward_pass(const CameraView& view, const std::vector<Dra
         }
         // What the atlas this item reads holds besides indirect light (not drawn again here).
         const bool baked = mode == kIndirectAtlas;
-        glUniform1i(66, (baked && indirect->atlas_holds_sky ? 1 : 0) |
-                            (baked && indirect->atlas_holds_static_lights ? 2 : 0));
+        glUniform1i(
+            66, (baked && indirect->atlas_holds_sky ? 1 : 0) | (baked && indirect->atlas_holds_static_lights ? 2 : 0));
         if (vertex_buffer != 0) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kVertexIrradianceBinding, vertex_buffer);
         // Per-vertex view-dependent indirect light (IndirectLightFrame::vertex_radiance_lobes).
         IndirectLightFrame::VertexRadianceLobes lobes;
@@ -520,8 +532,9 @@ void ForwardRenderer::depth_prepass(const glm::mat4& view_proj, const std::vecto
   }
   for (const bool cut_out : {false, true}) {
     if (cut_out && !scene_.has_mask()) break;
-    const ShaderProgram& program = cut_out ? alpha_test_program(reach ? "depth_reach.frag.glsl" : "depth_only.frag.glsl")
-                                           : (reach ? depth_reach_ : depth_only_);
+    const ShaderProgram& program = cut_out
+                                       ? alpha_test_program(reach ? "depth_reach.frag.glsl" : "depth_only.frag.glsl")
+                                       : (reach ? depth_reach_ : depth_only_);
     program.use();
     glUniformMatrix4fv(8, 1, GL_FALSE, glm::value_ptr(view_proj));
     if (reach) {
@@ -532,7 +545,8 @@ void ForwardRenderer::depth_prepass(const glm::mat4& view_proj, const std::vecto
     for (const DrawItem& item : items) {
       glUniformMatrix4fv(0, 1, GL_FALSE, glm::value_ptr(item.model));
       for (const render::GpuPrimitive& p : item.mesh->primitives) {
-        const render::GpuMaterial& m = scene_.material(item.material_override >= 0 ? item.material_override : p.material);
+        const render::GpuMaterial& m =
+            scene_.material(item.material_override >= 0 ? item.material_override : p.material);
         if (m.alpha_mode == AlphaMode::Blend || (m.alpha_mode == AlphaMode::Mask) != cut_out) continue;
         if (cut_out) render::bind_alpha_test(m, m.alpha_cutoff);
         // Same culling as the shading pass, so both passes see the same surfaces.

@@ -17,10 +17,10 @@
 #include <glm/glm.hpp>
 
 #include <engine/components.h>
-#include <engine/light_reach.h>
 #include <engine/gpu/gl_objects.h>
 #include <engine/gpu/gltf_brdf_texture.h>
 #include <engine/gpu/shader_program.h>
+#include <engine/light_reach.h>
 
 #include "render/exposure_meter.h"
 #include "render/frame_data.h"
@@ -40,10 +40,10 @@ enum TextureUnit : GLuint {
   kPointShadowMapsUnit = 5,
   kGlossyUnit = 6,
   kDirectionalIndexUnit = 7,
-  kNormalUnit = 15,  // forward.frag.glsl: the normal texture (render::kMaterialNormalUnit)
+  kNormalUnit = 15,          // forward.frag.glsl: the normal texture (render::kMaterialNormalUnit)
   kSunShadowMapsUnit = 10,   // directional lights' own 2-D maps (shadow_common.glsl)
   kSunShadowDepthUnit = 11,  // the same, raw depth (the sun disc's blocker search)
-  kShadowDepthUnit = 12,  // the 2-D shadow maps again, raw depth (shadow_common.glsl's sun disc)
+  kShadowDepthUnit = 12,     // the 2-D shadow maps again, raw depth (shadow_common.glsl's sun disc)
   kAreaVisibilityUnit = 13,  // area_shadow.frag.glsl: half-resolution visibility; forward: full-resolution
   kAreaPlaneUnit = 14,       // area_shadow.frag.glsl: half-resolution tangent planes
 };
@@ -61,7 +61,7 @@ constexpr GLuint kDirectionalRadianceBinding = 2;  // directional_radiance.glsl
 constexpr GLuint kDirectionalDirectionBinding = 3;
 constexpr GLuint kLobeCoefficientsBinding = 6;  // forward.vert.glsl: IndirectLightFrame::vertex_radiance_lobes
 constexpr GLuint kLobeTableBinding = 7;
-constexpr GLuint kReachUnit = 9;  // depth_reach.frag.glsl (unit 0: the alpha test's base colour)
+constexpr GLuint kReachUnit = 9;      // depth_reach.frag.glsl (unit 0: the alpha test's base colour)
 constexpr float kReachVoxelM = 0.5f;  // light reach grid spacing (engine/light_reach.h)
 
 // Nearest, clamped, no depth comparison: the 2-D shadow maps read as depths (the blocker
@@ -81,7 +81,7 @@ using LightCounts = std::array<int, 9>;  // ..., [8] FLAT_SHADING (RenderSetting
 // The lights one set of pixels is shaded with: those of one light-reach mask (the stencil
 // value the pre-pass wrote), as a range of the lights buffer.
 struct LightGroup {
-  int mask = -1;  ///< stencil value; -1: no stencil test (no reach grid)
+  int mask = -1;                         ///< stencil value; -1: no stencil test (no reach grid)
   std::vector<render::GpuLight> lights;  ///< sorted by type, like LightList::lights
   std::array<int, 4> count_by_type{};
   render::SceneBounds bounds;  ///< where the mask's voxels are; empty: everywhere
@@ -90,13 +90,13 @@ struct LightGroup {
 
 // The static shadow casters and static lights a reach grid was built from, and the grid.
 struct ReachState {
-  std::vector<float> light_key;  // the cullable static lights' entity ids and geometry
-  std::vector<float> moving_key;  // the cullable moving lights' entity ids and positions
-  std::vector<ReachOccluder> occluders;  // the static casters of the last static build
-  render::SceneBounds statics;           // the grid's extent: every static item
-  LightReachGrid static_grid;            // the static lights' bits
+  std::vector<float> light_key;                      // the cullable static lights' entity ids and geometry
+  std::vector<float> moving_key;                     // the cullable moving lights' entity ids and positions
+  std::vector<ReachOccluder> occluders;              // the static casters of the last static build
+  render::SceneBounds statics;                       // the grid's extent: every static item
+  LightReachGrid static_grid;                        // the static lights' bits
   std::map<std::uint32_t, glm::mat4> static_models;  // static occluders at the build
-  std::set<std::uint32_t> moved;  // static entities seen moving: never occluders again
+  std::set<std::uint32_t> moved;                     // static entities seen moving: never occluders again
   LightReachGrid grid;
   std::vector<int> mask_bounds_index;  // per mask value: index into bounds, -1 none
   std::vector<render::SceneBounds> bounds;
@@ -148,7 +148,8 @@ class ForwardRenderer final : public Renderer {
 
  private:
   void ensure_targets();
-  std::vector<DrawItem> draw_items(const Registry& registry, std::vector<std::pair<Entity, const char*>>& skipped) const;
+  std::vector<DrawItem> draw_items(const Registry& registry,
+                                   std::vector<std::pair<Entity, const char*>>& skipped) const;
   void report_skipped(const Registry& registry, const std::vector<std::pair<Entity, const char*>>& skipped);
   /// The camera's view-projection and position this frame (an unusable world matrix keeps
   /// the last usable one).
@@ -161,15 +162,16 @@ class ForwardRenderer final : public Renderer {
                     const IndirectLightFrame* indirect);
   const ShaderProgram& forward_program(const LightCounts& counts);
   const ShaderProgram& area_shadow_program(int pass, int area_lights);
-  void area_shadow_passes(const glm::mat4& view_proj, const glm::vec3& camera_position, const std::vector<DrawItem>& items);
+  void area_shadow_passes(const glm::mat4& view_proj, const glm::vec3& camera_position,
+                          const std::vector<DrawItem>& items);
   void draw_geometry(const std::vector<DrawItem>& items, bool double_sided_uniform, const glm::mat4& view_proj);
   /// A depth-only fragment stage built with ALPHA_TEST 1 (material_common.glsl), made on first use.
   const ShaderProgram& alpha_test_program(const char* fragment);
   void depth_prepass(const glm::mat4& view_proj, const std::vector<DrawItem>& items, bool reach);
   std::vector<LightGroup> light_groups(const Registry& registry, const std::vector<DrawItem>& items,
                                        const render::LightList& lights);
-  void update_reach(const std::vector<DrawItem>& items, const render::LightList& lights, const std::vector<int>& cullable,
-                    int n_static);
+  void update_reach(const std::vector<DrawItem>& items, const render::LightList& lights,
+                    const std::vector<int>& cullable, int n_static);
   void tonemap_pass();
   /// The exposure of a fixed mode (FixedLinear, FixedEv100).
   float fixed_exposure() const;

@@ -41,7 +41,9 @@ std::vector<glm::vec3> computed_normals(const Primitive& p, const std::vector<st
 // linear, mipmaps) equals what upload_image sets on the texture itself.
 GlSampler make_sampler(const TextureSampler& s) {
   const auto wrap = [](TextureWrap w) -> GLint {
-    return w == TextureWrap::ClampToEdge ? GL_CLAMP_TO_EDGE : w == TextureWrap::MirroredRepeat ? GL_MIRRORED_REPEAT : GL_REPEAT;
+    return w == TextureWrap::ClampToEdge      ? GL_CLAMP_TO_EDGE
+           : w == TextureWrap::MirroredRepeat ? GL_MIRRORED_REPEAT
+                                              : GL_REPEAT;
   };
   GlSampler out = GlSampler::create();
   glSamplerParameteri(out.id(), GL_TEXTURE_WRAP_S, wrap(s.wrap_s));
@@ -97,7 +99,8 @@ void bind_alpha_test(const GpuMaterial& m, float cutoff) {
 }
 
 void unbind_material_samplers() {
-  for (GLuint unit : {kMaterialBaseColorUnit, kMaterialMetallicRoughnessUnit, kMaterialEmissiveUnit, kMaterialNormalUnit})
+  for (GLuint unit :
+       {kMaterialBaseColorUnit, kMaterialMetallicRoughnessUnit, kMaterialEmissiveUnit, kMaterialNormalUnit})
     glBindSampler(unit, 0);
 }
 
@@ -121,8 +124,10 @@ Result<GpuScene> GpuScene::upload(const SceneAsset& assets) {
       const std::size_t n = p.positions.size();
       if (!p.normals.empty() && p.normals.size() != n)
         return primitive_error(assets, m, pi, "normals count differs from positions count");
-      if (!p.uv0.empty() && p.uv0.size() != n) return primitive_error(assets, m, pi, "uv0 count differs from positions count");
-      if (!p.uv1.empty() && p.uv1.size() != n) return primitive_error(assets, m, pi, "uv1 count differs from positions count");
+      if (!p.uv0.empty() && p.uv0.size() != n)
+        return primitive_error(assets, m, pi, "uv0 count differs from positions count");
+      if (!p.uv1.empty() && p.uv1.size() != n)
+        return primitive_error(assets, m, pi, "uv1 count differs from positions count");
       if (p.material >= 0 && static_cast<std::size_t>(p.material) >= assets.materials.size())
         return primitive_error(assets, m, pi, "material index " + std::to_string(p.material) + " out of range");
       std::vector<std::uint32_t> prim_indices = p.indices;

@@ -39,8 +39,12 @@ enum MaterialUniform : int {
 };
 
 /// Texture units of a material's textures (forward.frag.glsl, material_common.glsl).
-enum MaterialUnit : unsigned { kMaterialBaseColorUnit = 0, kMaterialMetallicRoughnessUnit = 1, kMaterialEmissiveUnit = 2,
-                               kMaterialNormalUnit = 15 };
+enum MaterialUnit : unsigned {
+  kMaterialBaseColorUnit = 0,
+  kMaterialMetallicRoughnessUnit = 1,
+  kMaterialEmissiveUnit = 2,
+  kMaterialNormalUnit = 15
+};
 
 /// Texture slots of a material, in the order of GpuMaterial::texcoord_sets / uv_transforms.
 enum MaterialSlot : int { kBaseColorSlot = 0, kMetallicRoughnessSlot = 1, kNormalSlot = 2, kEmissiveSlot = 3 };
@@ -48,7 +52,7 @@ enum MaterialSlot : int { kBaseColorSlot = 0, kMetallicRoughnessSlot = 1, kNorma
 struct GpuPrimitive {
   std::uint32_t first_index = 0;  ///< Offset into the index buffer (indices).
   std::uint32_t index_count = 0;
-  std::int32_t base_vertex = 0;   ///< Scene vertex of the primitive's vertex 0.
+  std::int32_t base_vertex = 0;  ///< Scene vertex of the primitive's vertex 0.
   int material = -1;
 };
 

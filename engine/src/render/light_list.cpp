@@ -100,9 +100,15 @@ LightList collect_lights(const Registry& registry, const SceneBounds& bounds, co
     g.cone = glm::vec4(std::cos(light.outer_cone_rad), std::cos(std::min(light.inner_cone_rad, light.outer_cone_rad)),
                        -1.0f, -1.0f);
     switch (light.type) {
-      case LightType::Point: g.position_type.w = static_cast<float>(GpuLightType::Point); break;
-      case LightType::Spot: g.position_type.w = static_cast<float>(GpuLightType::Spot); break;
-      case LightType::Directional: g.position_type.w = static_cast<float>(GpuLightType::Directional); break;
+      case LightType::Point:
+        g.position_type.w = static_cast<float>(GpuLightType::Point);
+        break;
+      case LightType::Spot:
+        g.position_type.w = static_cast<float>(GpuLightType::Spot);
+        break;
+      case LightType::Directional:
+        g.position_type.w = static_cast<float>(GpuLightType::Directional);
+        break;
       case LightType::Area:
         g.position_type.w = static_cast<float>(GpuLightType::Area);
         g.area_half_x = glm::vec4(axis_x * (0.5f * light.area_size_m.x), 0.0f);
@@ -158,8 +164,8 @@ LightList collect_lights(const Registry& registry, const SceneBounds& bounds, co
       const float fov = light.type == LightType::Spot
                             ? std::min(2.0f * light.outer_cone_rad + glm::radians(4.0f), glm::radians(170.0f))
                             : kAreaShadowFov;
-      const float reach = light.type == LightType::Spot && light.range_m > 0.0f ? light.range_m
-                                                                                 : farthest_corner(position, bounds);
+      const float reach =
+          light.type == LightType::Spot && light.range_m > 0.0f ? light.range_m : farthest_corner(position, bounds);
       v.eye = position;
       v.far_m = reach * 1.01f;
       const float near_m = std::max(0.01f, v.far_m * 1e-4f);
@@ -184,14 +190,14 @@ LightList collect_lights(const Registry& registry, const SceneBounds& bounds, co
   });
   // Sorted by type (point, spot, directional, area): the forward shader loops over each
   // type with a compile-time count.
-  std::stable_sort(collected.begin(), collected.end(), [](const auto& a, const auto& b) {
-    return a.first.position_type.w < b.first.position_type.w;
-  });
+  std::stable_sort(collected.begin(), collected.end(),
+                   [](const auto& a, const auto& b) { return a.first.position_type.w < b.first.position_type.w; });
   int area_index = 0;
   for (auto& [g, e] : collected) {
     // An area light's channel in the half-resolution visibility (area_shadow.frag.glsl): its
     // order among the frame's area lights.
-    if (static_cast<int>(g.position_type.w) == static_cast<int>(GpuLightType::Area)) g.shadow_params.z = static_cast<float>(area_index++);
+    if (static_cast<int>(g.position_type.w) == static_cast<int>(GpuLightType::Area))
+      g.shadow_params.z = static_cast<float>(area_index++);
     out.lights.push_back(g);
     out.entities.push_back(e);
   }

@@ -46,13 +46,15 @@ bool segment_blocked(const std::vector<ReachOccluder>& occluders, const glm::vec
 std::uint8_t LightReachGrid::at(const glm::vec3& p) const {
   if (masks.empty()) return all;
   const glm::vec3 f = (p - origin) / voxel_m;
-  const glm::ivec3 i(static_cast<int>(std::floor(f.x)), static_cast<int>(std::floor(f.y)), static_cast<int>(std::floor(f.z)));
+  const glm::ivec3 i(static_cast<int>(std::floor(f.x)), static_cast<int>(std::floor(f.y)),
+                     static_cast<int>(std::floor(f.z)));
   if (i.x < 0 || i.y < 0 || i.z < 0 || i.x >= dims.x || i.y >= dims.y || i.z >= dims.z) return all;
   return masks[static_cast<std::size_t>((i.z * dims.y + i.y) * dims.x + i.x)];
 }
 
-LightReachGrid build_light_reach_grid(const std::vector<ReachOccluder>& occluders, const std::vector<ReachLight>& lights,
-                                      const glm::vec3& min, const glm::vec3& max, float voxel_m) {
+LightReachGrid build_light_reach_grid(const std::vector<ReachOccluder>& occluders,
+                                      const std::vector<ReachLight>& lights, const glm::vec3& min, const glm::vec3& max,
+                                      float voxel_m) {
   LightReachGrid g;
   g.voxel_m = voxel_m;
   const int n_lights = std::min(static_cast<int>(lights.size()), LightReachGrid::kMaxLights);
@@ -88,9 +90,8 @@ LightReachGrid build_light_reach_grid(const std::vector<ReachOccluder>& occluder
   // Lattice points (the voxels' corners).
   const glm::ivec3 pts = g.dims + 1;
   const auto point_index = [&](int x, int y, int z) { return static_cast<std::size_t>((z * pts.y + y) * pts.x + x); };
-  std::vector<std::uint8_t> seen(static_cast<std::size_t>(pts.x) * static_cast<std::size_t>(pts.y) *
-                                     static_cast<std::size_t>(pts.z),
-                                 0);
+  std::vector<std::uint8_t> seen(
+      static_cast<std::size_t>(pts.x) * static_cast<std::size_t>(pts.y) * static_cast<std::size_t>(pts.z), 0);
   constexpr float kEndMargin = 5e-3f;  // the area light's emissive quad sits 0.1 mm in front of it
   for (int z = 0; z < pts.z; ++z)
     for (int y = 0; y < pts.y; ++y)
@@ -109,15 +110,18 @@ LightReachGrid build_light_reach_grid(const std::vector<ReachOccluder>& occluder
       }
 
   // Voxel = union of its corners, then dilated by one voxel.
-  const std::size_t n = static_cast<std::size_t>(g.dims.x) * static_cast<std::size_t>(g.dims.y) *
-                        static_cast<std::size_t>(g.dims.z);
+  const std::size_t n =
+      static_cast<std::size_t>(g.dims.x) * static_cast<std::size_t>(g.dims.y) * static_cast<std::size_t>(g.dims.z);
   std::vector<std::uint8_t> corners(n, 0);
-  const auto voxel_index = [&](int x, int y, int z) { return static_cast<std::size_t>((z * g.dims.y + y) * g.dims.x + x); };
+  const auto voxel_index = [&](int x, int y, int z) {
+    return static_cast<std::size_t>((z * g.dims.y + y) * g.dims.x + x);
+  };
   for (int z = 0; z < g.dims.z; ++z)
     for (int y = 0; y < g.dims.y; ++y)
       for (int x = 0; x < g.dims.x; ++x) {
         std::uint8_t m = 0;
-        for (int c = 0; c < 8; ++c) m = static_cast<std::uint8_t>(m | seen[point_index(x + (c & 1), y + ((c >> 1) & 1), z + (c >> 2))]);
+        for (int c = 0; c < 8; ++c)
+          m = static_cast<std::uint8_t>(m | seen[point_index(x + (c & 1), y + ((c >> 1) & 1), z + (c >> 2))]);
         corners[voxel_index(x, y, z)] = m;
       }
   g.masks.assign(n, 0);

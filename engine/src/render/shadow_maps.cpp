@@ -32,7 +32,7 @@ void ShadowMaps::reserve_array(Kind kind, int size, int layers) {
   set_compare_sampling(a.texture.id());
   a.size = size;
   a.layers = layers;
-  a.content.clear();          // new, empty textures
+  a.content.clear();             // new, empty textures
   a.static_cache = GlTexture{};  // the static depth cache follows the maps' size (ensure_static_cache)
   a.static_content.clear();
 }
@@ -81,8 +81,8 @@ bool may_be_seen(const glm::mat4& view_proj, const std::array<glm::vec4, 6>& cam
 }
 
 bool same_view(const ShadowView& a, const ShadowView& b) {
-  return a.view_proj == b.view_proj && a.eye == b.eye && a.axis == b.axis && a.far_m == b.far_m &&
-         a.ortho == b.ortho && a.cube == b.cube && a.sun == b.sun && a.layer == b.layer;
+  return a.view_proj == b.view_proj && a.eye == b.eye && a.axis == b.axis && a.far_m == b.far_m && a.ortho == b.ortho &&
+         a.cube == b.cube && a.sun == b.sun && a.layer == b.layer;
 }
 
 }  // namespace
@@ -91,8 +91,8 @@ bool ShadowMaps::LayerContent::operator==(const LayerContent& o) const {
   return same_view(view, o.view) && casters == o.casters;
 }
 
-int ShadowMaps::render(const std::vector<ShadowView>& views, const std::vector<DrawItem>& items,
-                       const GpuScene& scene, const ShaderProgram& program, const ShaderProgram* cut_out_program,
+int ShadowMaps::render(const std::vector<ShadowView>& views, const std::vector<DrawItem>& items, const GpuScene& scene,
+                       const ShaderProgram& program, const ShaderProgram* cut_out_program,
                        const glm::mat4& camera_view_proj) {
   // Each view's content first: the casters whose world bounds are not wholly outside one
   // of its clip planes (they would be clipped whole, so culling them changes no texel),

@@ -63,7 +63,7 @@ class ShadowMaps {
   /// One texture array and what its layers hold.
   struct MapArray {
     GlTexture texture;
-    GlTexture static_cache;  ///< The static depth cache: same size, made on first use.
+    GlTexture static_cache;                    ///< The static depth cache: same size, made on first use.
     std::vector<LayerContent> content;         ///< Per layer (a cube array: cube * 6 + face).
     std::vector<LayerContent> static_content;  ///< Per layer: the view and static casters the cache holds.
     int size = 0;

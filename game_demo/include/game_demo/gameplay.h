@@ -53,16 +53,16 @@ struct CrateShape {
 
 /// Gameplay tuning constants.
 struct GameplayTuning {
-  float push_reach_m = 2.0f;          ///< Farthest crate surface the push reaches.
-  float push_cone_cos = 0.5f;         ///< Crate centre within 60 degrees of the view direction.
-  float push_impulse_n_s = 3.0f;      ///< Impulse along the horizontal view direction.
-  float crate_damping = 0.9f;         ///< Fraction of crate velocity lost per second.
-  float rest_speed_m_s = 0.05f;       ///< Below this a crate stops exactly.
-  float gravity_m_s2 = 9.81f;         ///< Unsupported crates fall.
-  float support_probe_m = 0.03f;      ///< How far below a crate support is looked for.
-  float lamp_period_s = 3.2f;         ///< Swing period of the pivot named "lamp_pivot".
-  float lamp_amplitude_rad = 0.35f;   ///< Swing amplitude about the pivot's local Z.
-  float collision_skin_m = 0.01f;     ///< Crate boxes are shrunk vertically by this (resting contact).
+  float push_reach_m = 2.0f;                 ///< Farthest crate surface the push reaches.
+  float push_cone_cos = 0.5f;                ///< Crate centre within 60 degrees of the view direction.
+  float push_impulse_n_s = 3.0f;             ///< Impulse along the horizontal view direction.
+  float crate_damping = 0.9f;                ///< Fraction of crate velocity lost per second.
+  float rest_speed_m_s = 0.05f;              ///< Below this a crate stops exactly.
+  float gravity_m_s2 = 9.81f;                ///< Unsupported crates fall.
+  float support_probe_m = 0.03f;             ///< How far below a crate support is looked for.
+  float lamp_period_s = 3.2f;                ///< Swing period of the pivot named "lamp_pivot".
+  float lamp_amplitude_rad = 0.35f;          ///< Swing amplitude about the pivot's local Z.
+  float collision_skin_m = 0.01f;            ///< Crate boxes are shrunk vertically by this (resting contact).
   Locomotion locomotion = Locomotion::Walk;  ///< default_locomotion() of the scene in gi_demo.
   /// Locomotion::Fly: seconds to fly the diagonal of the scene's bounds, whatever its size
   /// (Dabrovic Sponza's bounds, 45 m across: 4.5 m/s).
@@ -74,16 +74,16 @@ struct GameplayTuning {
 struct GameplayContext {
   engine::Entity camera;
   engine::Entity flashlight;
-  engine::Entity swinging_pivot;     ///< "lamp_pivot" when the scene has one, else null.
+  engine::Entity swinging_pivot;  ///< "lamp_pivot" when the scene has one, else null.
   glm::quat pivot_rest_rotation{1.0f, 0.0f, 0.0f, 0.0f};
   CollisionWorld collision;
   GameplayTuning tuning;
-  InputFrame input;                  ///< This step's input (set before each run).
-  std::uint32_t previous_keys = 0;   ///< Last step's held keys.
-  bool split_view = false;           ///< Toggled by G; the renderer reads it.
-  engine::Entity door;               ///< "corridor_door" when the scene has one, else null.
+  InputFrame input;                                      ///< This step's input (set before each run).
+  std::uint32_t previous_keys = 0;                       ///< Last step's held keys.
+  bool split_view = false;                               ///< Toggled by G; the renderer reads it.
+  engine::Entity door;                                   ///< "corridor_door" when the scene has one, else null.
   glm::quat door_open_rotation{1.0f, 0.0f, 0.0f, 0.0f};  ///< Its authored (open) rotation; closed is identity.
-  bool door_closed = false;          ///< Toggled by O.
+  bool door_closed = false;                              ///< Toggled by O.
 
   bool pressed(Key k) const { return input.held(k) && (previous_keys & key_bit(k)) == 0; }
 };

@@ -40,7 +40,8 @@ class ScriptedPilot {
  public:
   /// Plans on the simulation's current state: a walkability grid (0.25 m cells) from the
   /// collision world at the camera's height, waypoints at the centres of large static
-  /// meshes spanning eye height (rooms; the static lights when there are none) and crates. `frames` is the budget the timed key presses scale to.
+  /// meshes spanning eye height (rooms; the static lights when there are none) and crates. `frames` is the budget the
+  /// timed key presses scale to.
   ScriptedPilot(const Simulation& sim, Script script, std::uint64_t frames);
 
   /// The input for the next step of `sim`.

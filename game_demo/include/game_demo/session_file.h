@@ -39,7 +39,7 @@ struct SessionHeader {
   std::string scene_path;        ///< The scene as given on the command line when recording.
   std::uint64_t scene_hash = 0;  ///< hash_scene_file() of that scene when recording.
   std::uint64_t seed = 0;
-  std::uint32_t width = 960;     ///< Render size of the recording, pixels.
+  std::uint32_t width = 960;  ///< Render size of the recording, pixels.
   std::uint32_t height = 540;
   double fixed_dt_s = 1.0 / 60.0;
 };

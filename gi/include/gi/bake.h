@@ -32,16 +32,16 @@ namespace gi {
 
 /// What to bake and at what quality. Overrides of the preset are used when positive.
 struct BakeOptions {
-  std::string preset = "medium";           ///< preview | medium | high (docs/sweeps/README.md).
-  std::vector<std::string> methods;        ///< Method keys to bake; empty: what gi::plan calls for.
-  float texels_per_metre = 0.0f;           ///< Atlas density (atlas and PRM).
-  int vpls = 0;                            ///< Light atlas: VPL count.
-  int bounces = 0;                         ///< Light atlas: indirect bounces.
-  int samples_per_vpl = 0;                 ///< Light atlas: sample points per VPL.
-  int brf_basis = 0;                       ///< BRF: basis functions N.
-  int brf_spheres = 0;                     ///< BRF: field spheres.
-  int dlm_directions = 0;                  ///< DLM: directions in the global set (8..256).
-  std::uint64_t dlm_photons = 0;           ///< DLM: photon paths.
+  std::string preset = "medium";     ///< preview | medium | high (docs/sweeps/README.md).
+  std::vector<std::string> methods;  ///< Method keys to bake; empty: what gi::plan calls for.
+  float texels_per_metre = 0.0f;     ///< Atlas density (atlas and PRM).
+  int vpls = 0;                      ///< Light atlas: VPL count.
+  int bounces = 0;                   ///< Light atlas: indirect bounces.
+  int samples_per_vpl = 0;           ///< Light atlas: sample points per VPL.
+  int brf_basis = 0;                 ///< BRF: basis functions N.
+  int brf_spheres = 0;               ///< BRF: field spheres.
+  int dlm_directions = 0;            ///< DLM: directions in the global set (8..256).
+  std::uint64_t dlm_photons = 0;     ///< DLM: photon paths.
   /// Light atlas: also hold the static lights' direct light (the renderer then draws none
   /// of theirs on the static world). Without it the atlas holds the indirect light and the
   /// direct light the renderer does not draw: the sky's, shadowed by the level, and that of

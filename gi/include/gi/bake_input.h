@@ -17,9 +17,9 @@
 #include <engine/sky.h>
 
 #include <cstdint>
-#include <glm/glm.hpp>
 #include <string>
 #include <vector>
+#include <glm/glm.hpp>
 
 namespace gi {
 
@@ -45,14 +45,14 @@ using BakeTexture = engine::TextureRef;
 /// into diffuse reflectors at the texel's normal).
 struct BakeMaterial {
   std::string name;
-  glm::vec3 base_color{1.0f};      ///< Linear, in [0, 1].
-  float metallic = 0.0f;           ///< In [0, 1].
-  float roughness = 1.0f;          ///< Perceptual roughness in [0, 1].
-  float specular = 1.0f;           ///< KHR_materials_specular specularFactor in [0, 1].
-  glm::vec3 specular_color{1.0f};  ///< KHR_materials_specular specularColorFactor (>= 0).
-  glm::vec3 emission{0.0f};        ///< Emitted radiance of the front face, W/(m^2 sr).
-  bool double_sided = false;       ///< Back faces shade and emit like front faces.
-  float base_alpha = 1.0f;         ///< base colour alpha factor, in [0, 1] (x the texture's alpha).
+  glm::vec3 base_color{1.0f};              ///< Linear, in [0, 1].
+  float metallic = 0.0f;                   ///< In [0, 1].
+  float roughness = 1.0f;                  ///< Perceptual roughness in [0, 1].
+  float specular = 1.0f;                   ///< KHR_materials_specular specularFactor in [0, 1].
+  glm::vec3 specular_color{1.0f};          ///< KHR_materials_specular specularColorFactor (>= 0).
+  glm::vec3 emission{0.0f};                ///< Emitted radiance of the front face, W/(m^2 sr).
+  bool double_sided = false;               ///< Back faces shade and emit like front faces.
+  float base_alpha = 1.0f;                 ///< base colour alpha factor, in [0, 1] (x the texture's alpha).
   BakeTexture base_color_texture;          ///< RGB x base_color, A x base_alpha (sRGB).
   BakeTexture metallic_roughness_texture;  ///< G x roughness, B x metallic (linear).
   BakeTexture emissive_texture;            ///< RGB x emission (sRGB).
@@ -166,8 +166,8 @@ glm::mat4 node_world_matrix(const engine::SceneAsset& asset, int node);
 /// Checks what the bakers rely on: mesh and material indices in range, three indices per
 /// triangle within range, normals and UV sets empty or one per position, finite positions,
 /// normals, UVs, matrices and light values, factors in range; every image a texture reads
-/// of width x height x 4 bytes (others may be empty: a loader need not decode them); texture image indices in range and the UV set a texture reads present on every
-/// primitive that uses the material. The error names the element ("mesh 3
+/// of width x height x 4 bytes (others may be empty: a loader need not decode them); texture image indices in range and
+/// the UV set a texture reads present on every primitive that uses the material. The error names the element ("mesh 3
 /// 'crate' primitive 0: index 77 out of range (12 vertices)").
 engine::Status validate_bake_input(const BakeInput& input);
 

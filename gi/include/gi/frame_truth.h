@@ -34,10 +34,10 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
-#include <glm/glm.hpp>
 #include <memory>
 #include <string>
 #include <vector>
+#include <glm/glm.hpp>
 
 namespace gi {
 

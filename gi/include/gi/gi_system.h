@@ -44,7 +44,7 @@
 namespace gi {
 
 struct GISystemSettings {
-  int prm_active_clusters = 32;      ///< PRM: panes summed per update (the heaviest K; 0: all).
+  int prm_active_clusters = 32;  ///< PRM: panes summed per update (the heaviest K; 0: all).
   /// PRM: panes in GPU memory as RGB9E5 (4 bytes a texel) instead of half floats (6), a third
   /// fewer bytes per light change; <= 2e-3 of a texel's largest channel (docs/prm.md).
   bool prm_shared_exponent_panes = true;
@@ -88,11 +88,11 @@ class GISystem final : public engine::IndirectLightProvider {
     double last_brf_gpu_ms = 0.0;         ///< Interreflection pass (glFinish-timed).
     std::size_t dynamic_objects = 0;
     std::size_t dynamic_vertices = 0;
-    std::size_t brf_field_bytes = 0;  ///< Basis + fields of all dynamic meshes (CPU copy).
-    std::size_t load_probe_ms = 0;    ///< Probe grid computed at load.
-    std::size_t dlm_texels = 0;       ///< Directional light maps: stored texels (glossy + gutter); 0: none.
-    std::size_t dlm_gpu_bytes = 0;    ///< ... their radiance, directions and index texture on the GPU.
-    std::uint64_t antiradiance_updates = 0;          ///< Frames on which a deforming node moved and was solved.
+    std::size_t brf_field_bytes = 0;         ///< Basis + fields of all dynamic meshes (CPU copy).
+    std::size_t load_probe_ms = 0;           ///< Probe grid computed at load.
+    std::size_t dlm_texels = 0;              ///< Directional light maps: stored texels (glossy + gutter); 0: none.
+    std::size_t dlm_gpu_bytes = 0;           ///< ... their radiance, directions and index texture on the GPU.
+    std::uint64_t antiradiance_updates = 0;  ///< Frames on which a deforming node moved and was solved.
     std::size_t antiradiance_relinked_elements = 0;  ///< Last such frame: elements whose links were rebuilt.
     double last_antiradiance_ms = 0.0;               ///< Relink + direct light + GPU iteration (glFinish-timed).
     /// Light and dynamic-object entities left out of the last frame's GI because their world

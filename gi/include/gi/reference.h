@@ -21,9 +21,9 @@
 #include <gi/progress.h>
 
 #include <cstdint>
-#include <glm/glm.hpp>
 #include <span>
 #include <vector>
+#include <glm/glm.hpp>
 
 namespace gi {
 

@@ -6,9 +6,9 @@
 
 #include <cstddef>
 #include <cstdint>
-#include <glm/glm.hpp>
 #include <span>
 #include <vector>
+#include <glm/glm.hpp>
 
 namespace gi {
 

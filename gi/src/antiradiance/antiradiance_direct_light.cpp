@@ -76,19 +76,20 @@ void AntiradianceDirectLight::set_instance_transform(std::uint32_t instance, con
 
 void AntiradianceDirectLight::compute(const ElementHierarchy& h, const std::vector<char>& todo,
                                       std::vector<glm::vec3>& out) const {
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, h.leaf_count(), 16), [&](const tbb::blocked_range<std::size_t>& r) {
-    for (std::size_t l = r.begin(); l != r.end(); ++l) {
-      if (!todo.empty() && !todo[l]) continue;
-      const ElementNode& e = h.nodes[static_cast<std::size_t>(h.leaves[l])];
-      glm::vec3 sum(0.0f);
-      for (const PointEmitter& em : emitters_) {
-        const glm::vec3 v = emitter_irradiance(em, e.center, e.normal, e.area_m2);
-        if (v == glm::vec3(0.0f)) continue;
-        if (emitter_visible(*caster_, em, e.center, e.normal)) sum += v;
-      }
-      out[l] = sum;
-    }
-  });
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, h.leaf_count(), 16),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t l = r.begin(); l != r.end(); ++l) {
+                        if (!todo.empty() && !todo[l]) continue;
+                        const ElementNode& e = h.nodes[static_cast<std::size_t>(h.leaves[l])];
+                        glm::vec3 sum(0.0f);
+                        for (const PointEmitter& em : emitters_) {
+                          const glm::vec3 v = emitter_irradiance(em, e.center, e.normal, e.area_m2);
+                          if (v == glm::vec3(0.0f)) continue;
+                          if (emitter_visible(*caster_, em, e.center, e.normal)) sum += v;
+                        }
+                        out[l] = sum;
+                      }
+                    });
 }
 
 std::vector<glm::vec3> AntiradianceDirectLight::irradiance(const ElementHierarchy& h) {
@@ -113,29 +114,31 @@ const std::vector<glm::vec3>& AntiradianceDirectLight::update(const ElementHiera
     dirty_ = false;
   }
   std::vector<char> todo(h.leaf_count(), 0);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, h.leaf_count(), 64), [&](const tbb::blocked_range<std::size_t>& r) {
-    for (std::size_t l = r.begin(); l != r.end(); ++l) {
-      const auto node = static_cast<std::size_t>(h.leaves[l]);
-      const std::int32_t inst = h.node_instance[node];
-      if (inst >= 0 && static_cast<std::size_t>(inst) < deforming_.size() && deforming_[static_cast<std::size_t>(inst)]) {
-        todo[l] = 1;
-        continue;
-      }
-      if (swept_.empty()) continue;
-      const glm::vec3 p = h.nodes[node].center;
-      for (const PointEmitter& em : emitters_) {
-        const bool directional = em.kind == PointEmitter::Kind::Directional;
-        const glm::vec3 d = directional ? -em.direction : em.position - p;
-        const float t_max = directional ? std::numeric_limits<float>::infinity() : 1.0f;
-        for (const Box& b : swept_)
-          if (engine::segment_meets_box(p, d, t_max, b.lo, b.hi)) {
-            todo[l] = 1;
-            break;
-          }
-        if (todo[l]) break;
-      }
-    }
-  });
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, h.leaf_count(), 64),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t l = r.begin(); l != r.end(); ++l) {
+                        const auto node = static_cast<std::size_t>(h.leaves[l]);
+                        const std::int32_t inst = h.node_instance[node];
+                        if (inst >= 0 && static_cast<std::size_t>(inst) < deforming_.size() &&
+                            deforming_[static_cast<std::size_t>(inst)]) {
+                          todo[l] = 1;
+                          continue;
+                        }
+                        if (swept_.empty()) continue;
+                        const glm::vec3 p = h.nodes[node].center;
+                        for (const PointEmitter& em : emitters_) {
+                          const bool directional = em.kind == PointEmitter::Kind::Directional;
+                          const glm::vec3 d = directional ? -em.direction : em.position - p;
+                          const float t_max = directional ? std::numeric_limits<float>::infinity() : 1.0f;
+                          for (const Box& b : swept_)
+                            if (engine::segment_meets_box(p, d, t_max, b.lo, b.hi)) {
+                              todo[l] = 1;
+                              break;
+                            }
+                          if (todo[l]) break;
+                        }
+                      }
+                    });
   last_recomputed_ = static_cast<std::size_t>(std::count(todo.begin(), todo.end(), 1));
   compute(h, todo, last_);
   swept_.clear();

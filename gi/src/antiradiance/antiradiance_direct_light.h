@@ -59,9 +59,9 @@ class AntiradianceDirectLight {
   std::vector<PointEmitter> emitters_;
   std::unique_ptr<RayCaster> caster_;
   std::vector<char> deforming_;
-  std::vector<Box> object_bounds_;     ///< Per BakeInput instance (deforming ones only meaningful).
-  std::vector<glm::mat4> transform_;   ///< Per BakeInput instance: its current transform.
-  std::vector<Box> swept_;             ///< Moved instances' bounds, before and after, since the last update.
+  std::vector<Box> object_bounds_;    ///< Per BakeInput instance (deforming ones only meaningful).
+  std::vector<glm::mat4> transform_;  ///< Per BakeInput instance: its current transform.
+  std::vector<Box> swept_;            ///< Moved instances' bounds, before and after, since the last update.
   std::vector<glm::vec3> last_;
   std::size_t last_recomputed_ = 0;
   bool dirty_ = false;

@@ -47,8 +47,10 @@ engine::GlBuffer buffer(std::size_t bytes, const void* data) {
   engine::GlBuffer b = engine::GlBuffer::create();
   const std::size_t size = std::max<std::size_t>(bytes, 16);
   glNamedBufferData(b.id(), static_cast<GLsizeiptr>(size), nullptr, GL_DYNAMIC_DRAW);
-  if (data != nullptr && bytes > 0) glNamedBufferSubData(b.id(), 0, static_cast<GLsizeiptr>(bytes), data);
-  else glClearNamedBufferData(b.id(), GL_R32F, GL_RED, GL_FLOAT, nullptr);
+  if (data != nullptr && bytes > 0)
+    glNamedBufferSubData(b.id(), 0, static_cast<GLsizeiptr>(bytes), data);
+  else
+    glClearNamedBufferData(b.id(), GL_R32F, GL_RED, GL_FLOAT, nullptr);
   return b;
 }
 
@@ -73,10 +75,10 @@ engine::Result<AntiradianceGpuPass> AntiradianceGpuPass::create(const ElementHie
   pass.m_ = static_cast<std::uint32_t>(m);
   pass.nodes_ = static_cast<std::uint32_t>(h.nodes.size());
   pass.leaves_ = static_cast<std::uint32_t>(h.leaf_count());
-  for (auto [program, name] : {std::pair{&pass.global_, "antiradiance_global.comp.glsl"},
-                               std::pair{&pass.push_, "antiradiance_push.comp.glsl"},
-                               std::pair{&pass.local_, "antiradiance_local.comp.glsl"},
-                               std::pair{&pass.pull_, "antiradiance_pull.comp.glsl"}}) {
+  for (auto [program, name] :
+       {std::pair{&pass.global_, "antiradiance_global.comp.glsl"},
+        std::pair{&pass.push_, "antiradiance_push.comp.glsl"}, std::pair{&pass.local_, "antiradiance_local.comp.glsl"},
+        std::pair{&pass.pull_, "antiradiance_pull.comp.glsl"}}) {
     auto p = compile(name);
     if (!p) return p.error();
     *program = std::move(p).value();
@@ -116,7 +118,8 @@ engine::Result<AntiradianceGpuPass> AntiradianceGpuPass::create(const ElementHie
 }
 
 engine::Status AntiradianceGpuPass::set_links(const LinkMesh& links) {
-  GI_EXPECTS(links.offsets.size() == static_cast<std::size_t>(nodes_) + 1, "set_links: offsets must match the hierarchy");
+  GI_EXPECTS(links.offsets.size() == static_cast<std::size_t>(nodes_) + 1,
+             "set_links: offsets must match the hierarchy");
   if (links.links.size() * sizeof(GpuLink) > ssbo_limit())
     return error(std::to_string(links.links.size()) + " links exceed the SSBO limit");
   std::vector<GpuLink> data(links.links.size());
@@ -204,7 +207,8 @@ LocalPassSums AntiradianceGpuPass::local(bool radiance, bool antiradiance) {
   glProgramUniform1ui(local_.id(), glGetUniformLocation(local_.id(), "u_antiradiance"), antiradiance ? 1u : 0u);
   dispatch(local_, leaves_);
   std::vector<glm::vec2> partial(leaves_);
-  glGetNamedBufferSubData(residual_.id(), 0, static_cast<GLsizeiptr>(partial.size() * sizeof(glm::vec2)), partial.data());
+  glGetNamedBufferSubData(residual_.id(), 0, static_cast<GLsizeiptr>(partial.size() * sizeof(glm::vec2)),
+                          partial.data());
   LocalPassSums sums;
   for (const glm::vec2& p : partial) {
     sums.change += static_cast<double>(p.x);

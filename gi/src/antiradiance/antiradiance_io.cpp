@@ -98,7 +98,8 @@ std::string check_bake(const AntiradianceBake& b) {
   if (h.node_instance.size() != n || h.object_center.size() != n || h.object_normal.size() != n ||
       h.object_radius.size() != n || h.object_area.size() != n)
     return "per-element arrays differ in size from the " + std::to_string(n) + " elements";
-  if (h.group_transform.size() != h.deforming_instances.size() || h.group_root.size() != h.deforming_instances.size() + 1)
+  if (h.group_transform.size() != h.deforming_instances.size() ||
+      h.group_root.size() != h.deforming_instances.size() + 1)
     return "group arrays do not match the " + std::to_string(h.deforming_instances.size()) + " deforming instances";
   for (std::int32_t r : h.group_root)
     if (r != -1 && !in_nodes(r)) return "a group root is out of range";
@@ -115,10 +116,11 @@ std::string check_bake(const AntiradianceBake& b) {
     if ((e.parent != -1 && !in_nodes(e.parent)) || e.child_count < 0 || e.first_child < 0 ||
         static_cast<std::size_t>(e.first_child) + static_cast<std::size_t>(e.child_count) > h.children.size() ||
         e.leaf_begin < 0 || e.leaf_end < e.leaf_begin || static_cast<std::size_t>(e.leaf_end) > h.leaves.size() ||
-        e.end <= static_cast<std::int32_t>(i) || static_cast<std::size_t>(e.end) > n ||
-        e.group < -1 || e.group > static_cast<std::int32_t>(h.deforming_instances.size()))
+        e.end <= static_cast<std::int32_t>(i) || static_cast<std::size_t>(e.end) > n || e.group < -1 ||
+        e.group > static_cast<std::int32_t>(h.deforming_instances.size()))
       return "element " + std::to_string(i) + " has an index out of range";
-    if (i > 0 && e.parent >= static_cast<std::int32_t>(i)) return "element " + std::to_string(i) + " follows its parent";
+    if (i > 0 && e.parent >= static_cast<std::int32_t>(i))
+      return "element " + std::to_string(i) + " follows its parent";
   }
   const std::int32_t bins = s.bins_per_side * s.bins_per_side;
   for (std::size_t k = 0; k < b.static_links.links.size(); ++k) {
@@ -126,7 +128,8 @@ std::string check_bake(const AntiradianceBake& b) {
     if (!in_nodes(l.receiver) || !in_nodes(l.sender) || l.bin < 0 || l.bin >= bins || !std::isfinite(l.form_factor) ||
         l.form_factor < 0.0f)
       return "static link " + std::to_string(k) + " is out of range";
-    if (h.nodes[static_cast<std::size_t>(l.receiver)].group != 0 || h.nodes[static_cast<std::size_t>(l.sender)].group != 0)
+    if (h.nodes[static_cast<std::size_t>(l.receiver)].group != 0 ||
+        h.nodes[static_cast<std::size_t>(l.sender)].group != 0)
       return "static link " + std::to_string(k) + " has an end in a deforming group";
     if (k > 0) {
       const Link& p = b.static_links.links[k - 1];
@@ -134,7 +137,9 @@ std::string check_bake(const AntiradianceBake& b) {
         return "static links are not sorted by receiver and bin";
     }
   }
-  if (b.baseline.size() != h.leaves.size()) return "the baseline has " + std::to_string(b.baseline.size()) + " values for " + std::to_string(h.leaves.size()) + " leaves";
+  if (b.baseline.size() != h.leaves.size())
+    return "the baseline has " + std::to_string(b.baseline.size()) + " values for " + std::to_string(h.leaves.size()) +
+           " leaves";
   for (const glm::vec3& v : b.baseline)
     if (!finite3(v)) return "the baseline holds a NaN or infinite value";
   return {};
@@ -167,9 +172,11 @@ std::vector<std::uint8_t> link_planes(const std::vector<Link>& links) {
   for (std::size_t k = 0; k < n; ++k) {
     const Link& l = links[k];
     const bool same_run = k > 0 && links[k - 1].receiver == l.receiver && links[k - 1].bin == l.bin;
-    const std::uint32_t step = static_cast<std::uint32_t>(l.receiver) - (k > 0 ? static_cast<std::uint32_t>(links[k - 1].receiver) : 0u);
+    const std::uint32_t step =
+        static_cast<std::uint32_t>(l.receiver) - (k > 0 ? static_cast<std::uint32_t>(links[k - 1].receiver) : 0u);
     const std::uint16_t b = static_cast<std::uint16_t>(l.bin);
-    const std::uint32_t sc = static_cast<std::uint32_t>(l.sender) - (same_run ? static_cast<std::uint32_t>(links[k - 1].sender) : 0u);
+    const std::uint32_t sc =
+        static_cast<std::uint32_t>(l.sender) - (same_run ? static_cast<std::uint32_t>(links[k - 1].sender) : 0u);
     std::uint32_t bits = 0;
     std::memcpy(&bits, &l.form_factor, 4);
     std::memcpy(receiver + 4 * k, &step, 4);
@@ -204,12 +211,17 @@ std::vector<Link> links_from_planes(const std::vector<std::uint8_t>& planes, std
 }
 
 json settings_json(const AntiradianceSettings& s) {
-  return json{{"bins_per_side", s.bins_per_side},         {"patch_size_m", s.patch_size_m},
-              {"exchange_radius_m", s.exchange_radius_m}, {"oracle_scale", s.oracle_scale},
-              {"iterations", s.iterations},               {"antiradiance_steps", s.antiradiance_steps},
+  return json{{"bins_per_side", s.bins_per_side},
+              {"patch_size_m", s.patch_size_m},
+              {"exchange_radius_m", s.exchange_radius_m},
+              {"oracle_scale", s.oracle_scale},
+              {"iterations", s.iterations},
+              {"antiradiance_steps", s.antiradiance_steps},
               {"scheme", s.scheme == AntiradianceScheme::Symmetric ? "symmetric" : "asymmetric"},
-              {"residual_tolerance", s.residual_tolerance}, {"growth_limit", s.growth_limit},
-              {"area_light_samples", s.area_light_samples}, {"seed", s.seed}};
+              {"residual_tolerance", s.residual_tolerance},
+              {"growth_limit", s.growth_limit},
+              {"area_light_samples", s.area_light_samples},
+              {"seed", s.seed}};
 }
 
 }  // namespace
@@ -314,8 +326,8 @@ engine::Status save_antiradiance(const fs::path& bundle_dir, const AntiradianceB
                    {"static_links", bake.static_links.links.size()},
                    {"deforming_instances", bake.hierarchy.deforming_instances},
                    {"memory", {{"file_bytes", static_cast<std::uint64_t>(bytes)}}}};
-  return update_manifest_method(bundle_dir, geometry_hash, fs::path(input.name).filename().string(), kAntiradianceMethod,
-                                entry);
+  return update_manifest_method(bundle_dir, geometry_hash, fs::path(input.name).filename().string(),
+                                kAntiradianceMethod, entry);
 }
 
 engine::Result<AntiradianceBake> load_antiradiance(const fs::path& bundle_dir, const BakeInput& input) {
@@ -330,13 +342,15 @@ engine::Result<AntiradianceBake> load_antiradiance(const fs::path& bundle_dir, c
     file = &(*entry)["files"]["elements"];
   if (file == nullptr || !file->is_object() || !file->contains("file") || !(*file)["file"].is_string() ||
       !file->contains("xxh3_64") || !(*file)["xxh3_64"].is_string())
-    return engine::Error{manifest_file.string(), where, "missing or malformed (needs \"file\" and \"xxh3_64\" strings)"};
+    return engine::Error{manifest_file.string(), where,
+                         "missing or malformed (needs \"file\" and \"xxh3_64\" strings)"};
   const fs::path path = bundle_dir / (*file)["file"].get<std::string>();
   if (engine::Status st = check_file_checksum(path, (*file)["xxh3_64"].get<std::string>()); !st) return st.error();
   auto f = read_antiradiance(path);
   if (!f) return f.error();
   if (f->geometry_hash != manifest->geometry_hash)
-    return file_error(path, "", "belongs to geometry " + f->geometry_hash + ", the manifest to " + manifest->geometry_hash);
+    return file_error(path, "",
+                      "belongs to geometry " + f->geometry_hash + ", the manifest to " + manifest->geometry_hash);
   return std::move(f->bake);
 }
 

@@ -21,7 +21,8 @@ void nodes_by_level(const ElementHierarchy& h, std::vector<std::int32_t>& nodes,
   for (std::size_t i = 1; i < offsets.size(); ++i) offsets[i] += offsets[i - 1];
   nodes.assign(h.nodes.size(), 0);
   std::vector<std::uint32_t> fill(offsets.begin(), offsets.end() - 1);
-  for (std::size_t n = 0; n < h.nodes.size(); ++n) nodes[fill[static_cast<std::size_t>(depth[n])]++] = static_cast<std::int32_t>(n);
+  for (std::size_t n = 0; n < h.nodes.size(); ++n)
+    nodes[fill[static_cast<std::size_t>(depth[n])]++] = static_cast<std::int32_t>(n);
 }
 
 CpuAntiradiancePasses::CpuAntiradiancePasses(const ElementHierarchy& h, const DirectionalBins& bins,

@@ -47,8 +47,10 @@ void check_energy(const AntiradiancePasses& passes, const ElementHierarchy& h, s
   }
   report.indirect_flux = flux;
   report.flux_bound = indirect_flux_bound(h, direct);
-  if (!std::isfinite(flux)) report.output_scale = 0.0f;
-  else if (flux > report.flux_bound) report.output_scale = static_cast<float>(report.flux_bound / flux);
+  if (!std::isfinite(flux))
+    report.output_scale = 0.0f;
+  else if (flux > report.flux_bound)
+    report.output_scale = static_cast<float>(report.flux_bound / flux);
 }
 
 }  // namespace

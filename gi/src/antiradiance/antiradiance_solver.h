@@ -32,14 +32,14 @@ namespace gi {
 
 struct AntiradianceSolveReport {
   AntiradianceScheme scheme = AntiradianceScheme::Symmetric;  ///< The scheme that produced the result.
-  bool fell_back = false;                ///< The symmetric iteration grew and was replaced.
-  int iterations = 0;                    ///< Iterations (radiance steps) of the final scheme.
-  int passes = 0;                        ///< Global passes run in all (including a discarded symmetric run).
-  std::vector<double> residuals;         ///< Relative residual after each iteration of the final scheme.
-  std::vector<double> changes;           ///< Absolute residual sum |Delta I_ex| (W/sr) of the symmetric run, fallen back or not.
-  bool diverged = false;                 ///< The asymmetric scheme grew too and was stopped.
-  double indirect_flux = 0.0;            ///< sum over leaves of area x |E| (W, first channel summed over RGB).
-  double flux_bound = 0.0;               ///< The energy bound it was checked against (W).
+  bool fell_back = false;                                     ///< The symmetric iteration grew and was replaced.
+  int iterations = 0;                                         ///< Iterations (radiance steps) of the final scheme.
+  int passes = 0;                 ///< Global passes run in all (including a discarded symmetric run).
+  std::vector<double> residuals;  ///< Relative residual after each iteration of the final scheme.
+  std::vector<double> changes;  ///< Absolute residual sum |Delta I_ex| (W/sr) of the symmetric run, fallen back or not.
+  bool diverged = false;        ///< The asymmetric scheme grew too and was stopped.
+  double indirect_flux = 0.0;   ///< sum over leaves of area x |E| (W, first channel summed over RGB).
+  double flux_bound = 0.0;      ///< The energy bound it was checked against (W).
   /// Multiply passes.irradiance() by this: 1, or what brings the flux down to the bound
   /// (0 when the result was not finite).
   float output_scale = 1.0f;

@@ -9,7 +9,8 @@
 
 namespace gi {
 
-std::vector<AntiradianceTexelBlend> antiradiance_texel_blends(const ElementHierarchy& h, const BakeInput& input, const AtlasLayout& layout) {
+std::vector<AntiradianceTexelBlend> antiradiance_texel_blends(const ElementHierarchy& h, const BakeInput& input,
+                                                              const AtlasLayout& layout) {
   const std::vector<AtlasInputMesh> inputs = atlas_inputs_from(input);
   const AtlasTexels texels = rasterize_atlas(layout, inputs);
   std::vector<std::int32_t> static_instance;  // atlas input mesh -> BakeInput instance
@@ -23,7 +24,8 @@ std::vector<AntiradianceTexelBlend> antiradiance_texel_blends(const ElementHiera
   }
   std::vector<AntiradianceTexelBlend> out;
   for (std::size_t t = 0; t < texels.valid.size(); ++t) {
-    if (texels.valid[t] == 0 || texels.mesh[t] < 0 || static_cast<std::size_t>(texels.mesh[t]) >= static_instance.size())
+    if (texels.valid[t] == 0 || texels.mesh[t] < 0 ||
+        static_cast<std::size_t>(texels.mesh[t]) >= static_instance.size())
       continue;
     const auto inst = static_cast<std::size_t>(static_instance[static_cast<std::size_t>(texels.mesh[t])]);
     const std::vector<std::int32_t>& candidates = leaves_of[inst];
@@ -45,8 +47,8 @@ std::vector<AntiradianceTexelBlend> antiradiance_texel_blends(const ElementHiera
     float total = 0.0f;
     for (int k = 0; k < 4; ++k) {
       if (best[static_cast<std::size_t>(k)].second < 0) continue;
-      const ElementNode& n =
-          h.nodes[static_cast<std::size_t>(h.leaves[static_cast<std::size_t>(best[static_cast<std::size_t>(k)].second)])];
+      const ElementNode& n = h.nodes[static_cast<std::size_t>(
+          h.leaves[static_cast<std::size_t>(best[static_cast<std::size_t>(k)].second)])];
       const float w = 1.0f / (best[static_cast<std::size_t>(k)].first + 0.25f * n.radius_m * n.radius_m);
       b.leaves[k] = best[static_cast<std::size_t>(k)].second;
       b.weights[k] = w;
@@ -62,7 +64,8 @@ glm::vec3 blend_leaves(const AntiradianceTexelBlend& b, std::span<const glm::vec
   glm::vec3 e(0.0f);
   for (int k = 0; k < 4; ++k) {
     const int l = b.leaves[k];
-    if (l >= 0 && static_cast<std::size_t>(l) < per_leaf.size()) e += b.weights[k] * per_leaf[static_cast<std::size_t>(l)];
+    if (l >= 0 && static_cast<std::size_t>(l) < per_leaf.size())
+      e += b.weights[k] * per_leaf[static_cast<std::size_t>(l)];
   }
   return e;
 }

@@ -52,8 +52,8 @@ DirectionalBins::DirectionalBins(int cells_per_side) : n_(cells_per_side) {
       const glm::dvec3 p00(octahedral_direction(uv0)), p10(octahedral_direction(uv0 + glm::vec2(h, 0.0f)));
       const glm::dvec3 p01(octahedral_direction(uv0 + glm::vec2(0.0f, h))),
           p11(octahedral_direction(uv0 + glm::vec2(h, h)));
-      const double area = 0.5 * glm::length(glm::cross(p10 - p00, p11 - p00)) +
-                          0.5 * glm::length(glm::cross(p11 - p00, p01 - p00));
+      const double area =
+          0.5 * glm::length(glm::cross(p10 - p00, p11 - p00)) + 0.5 * glm::length(glm::cross(p11 - p00, p01 - p00));
       const std::size_t j = static_cast<std::size_t>((y / kSub) * n_ + x / kSub);
       omega[j] += area;
       mean[j] += area * glm::dvec3(a);

@@ -18,8 +18,8 @@ namespace gi {
 namespace {
 
 struct SourceTriangle {
-  glm::vec3 p[3];      // world
-  glm::vec3 q[3];      // object space (deforming groups) or world (static)
+  glm::vec3 p[3];  // world
+  glm::vec3 q[3];  // object space (deforming groups) or world (static)
   glm::vec3 albedo;
   std::int32_t instance;
   std::int32_t group;
@@ -170,7 +170,9 @@ void refit_clusters(ElementHierarchy& h, std::int32_t begin, std::int32_t end, b
   }
 }
 
-engine::Error build_error(std::string message) { return engine::Error{"", "antiradiance elements", std::move(message)}; }
+engine::Error build_error(std::string message) {
+  return engine::Error{"", "antiradiance elements", std::move(message)};
+}
 
 }  // namespace
 
@@ -190,7 +192,9 @@ engine::Result<ElementHierarchy> build_element_hierarchy(const BakeInput& input,
     h.group_transform.push_back(inst.object_to_world);
     float reach = 0.0f;
     for (const BakePrimitive& p : input.meshes[inst.mesh].primitives)
-      for (const glm::vec3& v : p.positions) reach = std::max(reach, glm::length(glm::vec3(inst.object_to_world * glm::vec4(v, 1.0f)) - glm::vec3(inst.object_to_world[3])));
+      for (const glm::vec3& v : p.positions)
+        reach = std::max(reach, glm::length(glm::vec3(inst.object_to_world * glm::vec4(v, 1.0f)) -
+                                            glm::vec3(inst.object_to_world[3])));
     const glm::vec3 origin(inst.object_to_world[3]);
     lo = glm::min(lo, origin - glm::vec3(reach));
     hi = glm::max(hi, origin + glm::vec3(reach));
@@ -209,8 +213,10 @@ engine::Result<ElementHierarchy> build_element_hierarchy(const BakeInput& input,
   for (std::size_t i = 0; i < input.instances.size(); ++i) {
     const BakeInstance& inst = input.instances[i];
     std::int32_t group = 0;
-    if (inst.deforming) group = ++deforming_index;
-    else if (inst.mobility != BakeMobility::Static) continue;
+    if (inst.deforming)
+      group = ++deforming_index;
+    else if (inst.mobility != BakeMobility::Static)
+      continue;
     const glm::mat4& m = inst.object_to_world;
     for (const BakePrimitive& prim : input.meshes[inst.mesh].primitives) {
       const BakeMaterial mat = bake_material(input, inst, prim);
@@ -243,7 +249,8 @@ engine::Result<ElementHierarchy> build_element_hierarchy(const BakeInput& input,
   }
   for (int g = 1; g < groups; ++g)
     if (by_group[static_cast<std::size_t>(g)].empty())
-      return build_error("deforming instance '" + input.instances[h.deforming_instances[static_cast<std::size_t>(g - 1)]].name +
+      return build_error("deforming instance '" +
+                         input.instances[h.deforming_instances[static_cast<std::size_t>(g - 1)]].name +
                          "' has no triangle");
 
   Builder b{h, settings.patch_size_m};
@@ -283,7 +290,8 @@ void ElementHierarchy::set_group_transform(int group, const glm::mat4& m) {
   group_transform[static_cast<std::size_t>(group - 1)] = m;
   const std::int32_t r = group_root[static_cast<std::size_t>(group)];
   const glm::mat3 normal_matrix = glm::transpose(glm::inverse(glm::mat3(m)));
-  const float scale = std::max({glm::length(glm::vec3(m[0])), glm::length(glm::vec3(m[1])), glm::length(glm::vec3(m[2]))});
+  const float scale =
+      std::max({glm::length(glm::vec3(m[0])), glm::length(glm::vec3(m[1])), glm::length(glm::vec3(m[2]))});
   for (std::int32_t i = r; i < nodes[static_cast<std::size_t>(r)].end; ++i) {
     const auto k = static_cast<std::size_t>(i);
     ElementNode& n = nodes[k];

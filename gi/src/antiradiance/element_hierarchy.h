@@ -32,15 +32,16 @@ struct ElementNode {
   std::int32_t child_count = 0;
   std::int32_t leaf_begin = 0;  ///< Leaves below: [leaf_begin, leaf_end) in leaf order.
   std::int32_t leaf_end = 0;
-  std::int32_t group = 0;       ///< 0: static surfaces; g >= 1: deforming instance g - 1.
-  std::int32_t end = 0;         ///< One past the last node of this subtree (depth-first).
+  std::int32_t group = 0;  ///< 0: static surfaces; g >= 1: deforming instance g - 1.
+  std::int32_t end = 0;    ///< One past the last node of this subtree (depth-first).
 };
 
 struct ElementHierarchy {
-  std::vector<ElementNode> nodes;        ///< Depth-first pre-order; node 0 is the root.
-  std::vector<std::int32_t> children;    ///< Child node indices, referenced by first_child/child_count.
-  std::vector<std::int32_t> leaves;      ///< Leaf order -> node index (subtrees are contiguous).
-  std::vector<std::int32_t> group_root;  ///< Node index of each group's subtree (group 0: static; may be -1 when empty).
+  std::vector<ElementNode> nodes;      ///< Depth-first pre-order; node 0 is the root.
+  std::vector<std::int32_t> children;  ///< Child node indices, referenced by first_child/child_count.
+  std::vector<std::int32_t> leaves;    ///< Leaf order -> node index (subtrees are contiguous).
+  std::vector<std::int32_t>
+      group_root;  ///< Node index of each group's subtree (group 0: static; may be -1 when empty).
   /// BakeInput instance index of each deforming group (group g -> deforming_instances[g - 1]).
   std::vector<std::uint32_t> deforming_instances;
   /// Per node: BakeInput instance it came from (clusters: -1 unless inside a deforming group).

@@ -17,10 +17,10 @@ struct DiscPoint {
   float x, y;
 };
 constexpr DiscPoint kDisc[kSamples] = {
-    {0.0f, 0.0f},          {0.5f, 0.0f},           {0.1545f, 0.4755f},    {-0.4045f, 0.2939f},
-    {-0.4045f, -0.2939f},  {0.1545f, -0.4755f},    {0.8084f, 0.2627f},    {0.5f, 0.6877f},
-    {0.0f, 0.85f},         {-0.5f, 0.6877f},       {-0.8084f, 0.2627f},   {-0.8084f, -0.2627f},
-    {-0.5f, -0.6877f},     {0.0f, -0.85f},         {0.5f, -0.6877f},      {0.8084f, -0.2627f}};
+    {0.0f, 0.0f},         {0.5f, 0.0f},        {0.1545f, 0.4755f},  {-0.4045f, 0.2939f},
+    {-0.4045f, -0.2939f}, {0.1545f, -0.4755f}, {0.8084f, 0.2627f},  {0.5f, 0.6877f},
+    {0.0f, 0.85f},        {-0.5f, 0.6877f},    {-0.8084f, 0.2627f}, {-0.8084f, -0.2627f},
+    {-0.5f, -0.6877f},    {0.0f, -0.85f},      {0.5f, -0.6877f},    {0.8084f, -0.2627f}};
 
 struct Linker {
   const ElementHierarchy& h;
@@ -66,12 +66,13 @@ struct Linker {
     if (behind(rn, sn)) return;
     const glm::vec3 d = rn.center - sn.center;
     const float d2 = glm::dot(d, d);
-    const glm::vec3 axis = d2 > 0.0f ? d / std::sqrt(d2) : (rn.normal != glm::vec3(0.0f) ? -rn.normal : glm::vec3(0, 0, 1));
+    const glm::vec3 axis =
+        d2 > 0.0f ? d / std::sqrt(d2) : (rn.normal != glm::vec3(0.0f) ? -rn.normal : glm::vec3(0, 0, 1));
     const bool surface = sn.normal != glm::vec3(0.0f);
     const glm::vec3 disc_normal = surface ? sn.normal : axis;
     const float disc_radius = surface ? std::sqrt(sn.area_m2 / glm::pi<float>()) : sn.radius_m;
     const glm::vec3 t = glm::normalize(std::abs(disc_normal.x) < 0.9f ? glm::cross(disc_normal, glm::vec3(1, 0, 0))
-                                                                       : glm::cross(disc_normal, glm::vec3(0, 1, 0)));
+                                                                      : glm::cross(disc_normal, glm::vec3(0, 1, 0)));
     const glm::vec3 bt = glm::cross(disc_normal, t);
     const float sep = std::sqrt(d2);
     const bool overlap = sep < rn.radius_m + sn.radius_m;
@@ -191,7 +192,8 @@ engine::Result<LinkMesh> merge_link_shards(const ElementHierarchy& h, const std:
       const Link& l = p[k];
       if (l.receiver < 0 || static_cast<std::size_t>(l.receiver) >= nodes || l.sender < 0 ||
           static_cast<std::size_t>(l.sender) >= nodes || !shard.owns(static_cast<std::size_t>(l.receiver)))
-        return error(i, "link " + std::to_string(k) + " has a receiver that is not the shard's or an element out of range");
+        return error(
+            i, "link " + std::to_string(k) + " has a receiver that is not the shard's or an element out of range");
       if (k > 0 && !link_less(p[k - 1], l)) return error(i, "its links are not sorted");
     }
     total += p.size();
@@ -215,7 +217,8 @@ engine::Result<LinkMesh> merge_link_shards(const ElementHierarchy& h, const std:
 LinkMesh static_links(const ElementHierarchy& h, const LinkMesh& mesh) {
   LinkMesh out;
   for (const Link& l : mesh.links)
-    if (h.nodes[static_cast<std::size_t>(l.receiver)].group == 0 && h.nodes[static_cast<std::size_t>(l.sender)].group == 0)
+    if (h.nodes[static_cast<std::size_t>(l.receiver)].group == 0 &&
+        h.nodes[static_cast<std::size_t>(l.sender)].group == 0)
       out.links.push_back(l);
   // A LinkMesh's links are sorted (a total order), so the filtered ones are too: the sort
   // (most of this function's time on 3 M links) only runs for a mesh that is not.

@@ -39,8 +39,8 @@ namespace gi {
 struct Link {
   std::int32_t receiver = 0;
   std::int32_t sender = 0;
-  std::int32_t bin = 0;       ///< Bin of the direction sender -> receiver (same global bins at both ends).
-  float form_factor = 0.0f;   ///< 1 / (d^2_regularized omega_bin), 1/(m^2 sr).
+  std::int32_t bin = 0;      ///< Bin of the direction sender -> receiver (same global bins at both ends).
+  float form_factor = 0.0f;  ///< 1 / (d^2_regularized omega_bin), 1/(m^2 sr).
 };
 
 /// Links sorted by (receiver, bin, sender): receiver r's links are [offsets[r], offsets[r+1]),

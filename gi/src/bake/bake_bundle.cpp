@@ -1,8 +1,8 @@
 // gi::bake_bundle: plan, bake each method, write the bundle (gi/bake.h).
 #include <fcntl.h>
-#include <gi/bake.h>
 #include <sys/file.h>
 #include <unistd.h>
+#include <gi/bake.h>
 
 #include <algorithm>
 #include <cerrno>
@@ -23,8 +23,8 @@
 #include "brf/brf_io.h"
 #include "brf/brf_mesh.h"
 #include "bundle/geometry_hash.h"
-#include "bundle/shard_set.h"
 #include "bundle/manifest.h"
+#include "bundle/shard_set.h"
 #include "core/thread_pool.h"
 #include "dlm/dlm.h"
 #include "dlm/dlm_io.h"
@@ -252,18 +252,19 @@ engine::Status bake_dlm_method(const BakeInput& input, const fs::path& dir, cons
   settings->threads = o.threads;
   settings->seed = o.seed;
   settings->progress = stage.progress();
-  stage.log(format("directional light maps of %s, preset %s: %d directions, %llu photons, splat radius %g texels, "
-                   "%g texels/m, roughness < %g",
-                   scene_file_name(input).c_str(), o.preset.c_str(), settings->directions,
-                   static_cast<unsigned long long>(settings->photons), double{settings->splat_radius_texels},
-                   double{settings->texels_per_metre}, double{settings->glossy_roughness}));
+  stage.log(
+      format("directional light maps of %s, preset %s: %d directions, %llu photons, splat radius %g texels, "
+             "%g texels/m, roughness < %g",
+             scene_file_name(input).c_str(), o.preset.c_str(), settings->directions,
+             static_cast<unsigned long long>(settings->photons), double{settings->splat_radius_texels},
+             double{settings->texels_per_metre}, double{settings->glossy_roughness}));
   auto dlm = bake_dlm(input, *settings);
   if (!dlm) return dlm.error();
   const DlmStats& st = dlm->stats;
   stage.log(format("  %zu glossy texels, %zu stored (%.2f MB as halves, %zu B per texel); %llu deposits, %.1f M rays",
-                   st.glossy_texels, dlm->texel_count(),
-                   static_cast<double>(dlm->radiance.size()) * 2.0 / 1e6, dlm->directions.size() * 6,
-                   static_cast<unsigned long long>(st.deposits), static_cast<double>(st.rays) * 1e-6));
+                   st.glossy_texels, dlm->texel_count(), static_cast<double>(dlm->radiance.size()) * 2.0 / 1e6,
+                   dlm->directions.size() * 6, static_cast<unsigned long long>(st.deposits),
+                   static_cast<double>(st.rays) * 1e-6));
   stage.log(format("  time: photons %.2f s; total %.2f s", st.trace_seconds, st.total_seconds));
   timings = {{"trace_seconds", st.trace_seconds}, {"total_seconds", st.total_seconds}};
   return save_dlm(dir, *dlm, input);
@@ -435,8 +436,8 @@ engine::Result<std::vector<std::string>> methods_to_bake(const BakeInput& input,
   }
   for (const std::string& key : methods)
     if (std::find(bakeable.begin(), bakeable.end(), key) == bakeable.end())
-      return engine::invalid_request("method '" + key +
-                                     "' is not available in this build (available: atlas, prm, dlm, brf, antiradiance)");
+      return engine::invalid_request(
+          "method '" + key + "' is not available in this build (available: atlas, prm, dlm, brf, antiradiance)");
 
   // The sky in a PRM bake (docs/prm.md "The sky"): the sky is a static source, so its light
   // lives in the light atlas the PRM provider composes with (the atlas's final gather
@@ -608,8 +609,7 @@ engine::Result<MergedParts> read_shards(const BakeInput& input, const fs::path& 
       merged.antiradiance.push_back(std::move(links).value());
     }
   }
-  if (host.log)
-    host.log(LogLevel::Info, format("merging %u shards from %s", count, dir.string().c_str()));
+  if (host.log) host.log(LogLevel::Info, format("merging %u shards from %s", count, dir.string().c_str()));
   return merged;
 }
 
@@ -671,8 +671,9 @@ engine::Result<BakeReport> bake_bundle(const BakeInput& input, const fs::path& b
     engine::Status done = key == "atlas" ? bake_atlas(input, dir, options, {host, "light atlas"}, timings, parts)
                           : key == "prm" ? bake_prm_method(input, dir, options, {host, "PRM"}, timings, parts)
                           : key == "dlm" ? bake_dlm_method(input, dir, options, {host, "DLM"}, timings)
-                          : key == "antiradiance" ? bake_antiradiance_method(input, dir, options, {host, "antiradiance"}, timings, parts)
-                                         : bake_brf_method(input, dir, options, host, timings);
+                          : key == "antiradiance"
+                              ? bake_antiradiance_method(input, dir, options, {host, "antiradiance"}, timings, parts)
+                              : bake_brf_method(input, dir, options, host, timings);
     if (!done) return done.error();
     report.baked.push_back({key, seconds_since(start), method_bytes(dir, manifest_key(key))});
     method_stats[manifest_key(key)] = {{"seconds", report.baked.back().seconds}, {"stages", timings}};

@@ -104,7 +104,8 @@ engine::Result<ShardFile> read_shard_file(const std::filesystem::path& path) {
   const std::string location = "payload byte " + std::to_string(r.offset());
   if (!complete) return engine::Error{path.string(), location, "truncated payload"};
   if (r.remaining() != 0) return engine::Error{path.string(), location, "unexpected data after the last field"};
-  if (parts > (kHasAtlas | kHasPrm | kHasAntiradiance)) return engine::Error{path.string(), "parts", "unknown part flags"};
+  if (parts > (kHasAtlas | kHasPrm | kHasAntiradiance))
+    return engine::Error{path.string(), "parts", "unknown part flags"};
   if (f.count == 0 || f.index >= f.count)
     return engine::Error{path.string(), "shard",
                          "shard " + std::to_string(f.index) + " of " + std::to_string(f.count) + " does not exist"};

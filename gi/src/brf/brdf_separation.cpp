@@ -146,8 +146,10 @@ engine::Result<BrdfSeparation> separate_glossy_brdf(const GlossyLobe& lobe, cons
   Eigen::MatrixXd m(cells, cells);  // rows: w_out, columns: w_in
   for (int o = 0; o < cells; ++o)
     for (int i = 0; i < cells; ++i)
-      m(o, i) = static_cast<double>(glossy_lobe_brdf(lobe, dirs[static_cast<std::size_t>(i)], dirs[static_cast<std::size_t>(o)])) *
-                root_omega(o) * root_omega(i) * static_cast<double>(dirs[static_cast<std::size_t>(i)].z * dirs[static_cast<std::size_t>(o)].z);
+      m(o, i) = static_cast<double>(
+                    glossy_lobe_brdf(lobe, dirs[static_cast<std::size_t>(i)], dirs[static_cast<std::size_t>(o)])) *
+                root_omega(o) * root_omega(i) *
+                static_cast<double>(dirs[static_cast<std::size_t>(i)].z * dirs[static_cast<std::size_t>(o)].z);
   const Eigen::BDCSVD<Eigen::MatrixXd> svd(m, Eigen::ComputeThinU | Eigen::ComputeThinV);
   const Eigen::VectorXd& sigma = svd.singularValues();
 
@@ -156,7 +158,9 @@ engine::Result<BrdfSeparation> separate_glossy_brdf(const GlossyLobe& lobe, cons
   out.resolution = res;
   for (Eigen::Index i = 0; i < sigma.size(); ++i) out.singular_values.push_back(static_cast<float>(sigma(i)));
   int terms = std::min(settings.terms, static_cast<int>(sigma.size()));
-  while (terms < sigma.size() && terms < kMaxGlossyTerms && sigma(terms) > 0.0 && sigma(terms) >= 0.995 * sigma(terms - 1)) ++terms;
+  while (terms < sigma.size() && terms < kMaxGlossyTerms && sigma(terms) > 0.0 &&
+         sigma(terms) >= 0.995 * sigma(terms - 1))
+    ++terms;
   out.terms = terms;
   double tail = 0.0, all = 0.0;
   for (Eigen::Index i = 0; i < sigma.size(); ++i) {
@@ -173,8 +177,10 @@ engine::Result<BrdfSeparation> separate_glossy_brdf(const GlossyLobe& lobe, cons
     const double sign = svd.matrixV().col(k).sum() < 0.0 ? -1.0 : 1.0;
     for (int c = 0; c < cells; ++c) {
       const double cosine = static_cast<double>(dirs[static_cast<std::size_t>(c)].z);
-      out.g[static_cast<std::size_t>(k * cells + c)] = static_cast<float>(sign * s * svd.matrixV()(c, k) / (root_omega(c) * cosine));
-      out.h[static_cast<std::size_t>(k * cells + c)] = static_cast<float>(sign * s * svd.matrixU()(c, k) / (root_omega(c) * cosine));
+      out.g[static_cast<std::size_t>(k * cells + c)] =
+          static_cast<float>(sign * s * svd.matrixV()(c, k) / (root_omega(c) * cosine));
+      out.h[static_cast<std::size_t>(k * cells + c)] =
+          static_cast<float>(sign * s * svd.matrixU()(c, k) / (root_omega(c) * cosine));
     }
   }
 
@@ -192,7 +198,8 @@ engine::Result<BrdfSeparation> separate_glossy_brdf(const GlossyLobe& lobe, cons
       for (int k = 0; k < terms; ++k) {
         const double gw = static_cast<double>(out.g_at(k, w)) * static_cast<double>(w.z) * omega;
         for (int c = 0; c < kMaxShCoefficients; ++c)
-          acc[static_cast<std::size_t>(k * kMaxShCoefficients + c)] += gw * static_cast<double>(y[static_cast<std::size_t>(c)]);
+          acc[static_cast<std::size_t>(k * kMaxShCoefficients + c)] +=
+              gw * static_cast<double>(y[static_cast<std::size_t>(c)]);
       }
     }
   out.lobe_sh.assign(acc.begin(), acc.end());

@@ -40,8 +40,8 @@ namespace gi {
 inline constexpr int kMaxGlossyTerms = 15;
 
 struct GlossyLobe {
-  float f0 = 0.04f;    ///< Specular reflectance at normal incidence (a scalar: the shape).
-  float alpha = 0.25f; ///< GGX alpha = roughness^2.
+  float f0 = 0.04f;     ///< Specular reflectance at normal incidence (a scalar: the shape).
+  float alpha = 0.25f;  ///< GGX alpha = roughness^2.
 };
 
 struct BrdfSeparationSettings {
@@ -53,8 +53,8 @@ struct BrdfSeparation {
   GlossyLobe lobe;
   int terms = 0;
   int resolution = 0;
-  std::vector<float> g, h;          ///< [k * R * R + cell], cells row-major over (v, u).
-  std::vector<float> lobe_sh;       ///< [k * 16 + c]: SH of g_k(w) max(0, w.z), local frame.
+  std::vector<float> g, h;             ///< [k * R * R + cell], cells row-major over (v, u).
+  std::vector<float> lobe_sh;          ///< [k * 16 + c]: SH of g_k(w) max(0, w.z), local frame.
   std::vector<float> singular_values;  ///< All of them, descending.
   float relative_error = 0.0f;
 
@@ -69,7 +69,8 @@ struct BrdfSeparation {
   /// screen. Scales are clamped to [1/4, 4]; cells whose separated albedo is <= 0 keep h.
   std::vector<float> albedo_corrected_h() const;
   std::span<const float> lobe_coefficients(int k) const {
-    return std::span<const float>(lobe_sh).subspan(static_cast<std::size_t>(k) * kMaxShCoefficients, kMaxShCoefficients);
+    return std::span<const float>(lobe_sh).subspan(static_cast<std::size_t>(k) * kMaxShCoefficients,
+                                                   kMaxShCoefficients);
   }
 };
 

@@ -70,7 +70,9 @@ void BrfGpuPass::dispatch_phi(std::span<const BrfPhiJob> jobs, std::uint32_t kin
   bind(8, sh_data_.id());
   bind(9, static_visibility_.buffer.empty() ? static_points_.buffer.id() : static_visibility_.buffer.id());
   for (std::size_t v = 0; v < kClasses; ++v) {
-    const engine::ShaderProgram& program = kind == 2 ? programs_.phi_lod : v == 1 ? programs_.phi_glossy : programs_.phi;
+    const engine::ShaderProgram& program = kind == 2 ? programs_.phi_lod
+                                           : v == 1  ? programs_.phi_glossy
+                                                     : programs_.phi;
     const GLuint id = program.id();
     program.use();
     glProgramUniform1ui(id, glGetUniformLocation(id, "u_kind"), kind);
@@ -86,12 +88,11 @@ void BrfGpuPass::dispatch_phi(std::span<const BrfPhiJob> jobs, std::uint32_t kin
   }
 }
 
-
 /// run()'s CPU-side frame: the first weights, the culled pairs, the instance table, the live
 /// sources per receiver and the Phi jobs of the pairs that moved.
 struct BrfGpuPass::FrameData {
-  std::vector<glm::vec4> weights;    ///< First bounce's weights, rgb vec4 per channel; pads stay 0.
-  std::vector<std::uint8_t> culled;  ///< [source * n + receiver], as brf_pair_culling.
+  std::vector<glm::vec4> weights;       ///< First bounce's weights, rgb vec4 per channel; pads stay 0.
+  std::vector<std::uint8_t> culled;     ///< [source * n + receiver], as brf_pair_culling.
   std::vector<std::uint64_t> in_reach;  ///< Keys source x n + receiver of the pairs in reach, sorted.
   std::vector<GpuInstance> table;
   std::vector<glm::uvec4> live;  ///< (source's first weight vec4, first Phi vec4, C4 / 4, source)

@@ -9,9 +9,9 @@
 #include <string>
 #include <utility>
 
+#include "brf/brf_gpu_pass_detail.h"
 #include "brf/brf_lod.h"
 #include "brf/brf_visibility.h"
-#include "brf/brf_gpu_pass_detail.h"
 #include "gpu/gi_shaders.h"
 
 namespace gi {
@@ -74,8 +74,8 @@ engine::Status check_model(const BrfGpuModel& model, std::size_t m, std::size_t 
     return error(which + "field holds " + std::to_string(f.coefficients.size()) + " floats, expected " +
                  std::to_string(points * channels * static_cast<std::size_t>(f.coefficient_count())));
   if (gpu_field_bytes(f) > limit)
-    return error(which + "field of " + std::to_string(gpu_field_bytes(f)) + " bytes (channels padded to vec4s) is above the SSBO limit of " +
-                 std::to_string(limit));
+    return error(which + "field of " + std::to_string(gpu_field_bytes(f)) +
+                 " bytes (channels padded to vec4s) is above the SSBO limit of " + std::to_string(limit));
   for (std::size_t j = 0; j < nv; ++j)
     if (!engine::all_finite(mesh.positions[j]) || !engine::all_finite(mesh.normals[j]))
       return error(which + "non-finite vertex " + std::to_string(j));
@@ -582,7 +582,8 @@ std::size_t BrfGpuPass::gpu_bytes() const {
   std::size_t bytes = model_bytes_ + output_bytes_;
   for (const Buffer* b :
        {&static_points_, &instance_table_, &incoming_, &gathered_, &indirect_, &weights_, &phi_, &live_, &jobs_,
-        &groups_, &occluders_, &static_occlusion_, &static_indices_, &static_visibility_, &static_phi_, &static_phi_spare_, &static_touched_, &static_entries_, &static_out_})
+        &groups_, &occluders_, &static_occlusion_, &static_indices_, &static_visibility_, &static_phi_,
+        &static_phi_spare_, &static_touched_, &static_entries_, &static_out_})
     bytes += b->bytes;
   return bytes;
 }

@@ -58,9 +58,9 @@
 
 #include <cstddef>
 #include <cstdint>
-#include <glm/glm.hpp>
 #include <span>
 #include <vector>
+#include <glm/glm.hpp>
 
 #include "brf/brf_runtime.h"
 
@@ -164,9 +164,9 @@ class BrfGpuPass {
   struct Stats {
     std::size_t pairs_evaluated = 0;  ///< Live (not culled) pairs, as BrfResult counts them.
     std::size_t pairs_culled = 0;
-    std::size_t pairs_reused = 0;           ///< Live pairs whose Phi was kept (relative pose unchanged).
-    std::size_t pairs_lod = 0;  ///< Live pairs whose Phi uses the level of detail (BrfUpdateSettings::lod_distance).
-    std::size_t pair_slots = 0;             ///< Pairs in reach holding a Phi slot (culled ones included).
+    std::size_t pairs_reused = 0;  ///< Live pairs whose Phi was kept (relative pose unchanged).
+    std::size_t pairs_lod = 0;     ///< Live pairs whose Phi uses the level of detail (BrfUpdateSettings::lod_distance).
+    std::size_t pair_slots = 0;    ///< Pairs in reach holding a Phi slot (culled ones included).
     /// Far pairs' representative points evaluated packed (BrfGpuPassOptions::pack_lod_points).
     std::size_t lod_points_packed = 0;
     std::size_t static_sources_reused = 0;  ///< Sources whose static-receiver Phi was kept.
@@ -174,7 +174,7 @@ class BrfGpuPass {
     /// (set_static_receivers' world), so get none of its bounce; counted per source.
     std::size_t static_receivers_hidden = 0;
     double static_visibility_ms = 0.0;  ///< CPU time of their visibility rays.
-    double cpu_ms = 0.0;                    ///< Wall time of the last run() on the CPU.
+    double cpu_ms = 0.0;                ///< Wall time of the last run() on the CPU.
   };
   const Stats& stats() const { return stats_; }
   /// GPU memory held by the pass (bytes): models, per-frame buffers, Phi caches.
@@ -219,7 +219,7 @@ class BrfGpuPass {
     /// Receivers with a level-of-detail table: first float in phi_ of the representative
     /// points' rows (scratch for one frame, after the slots).
     std::uint32_t lod_rows = 0;
-    std::vector<std::uint32_t> occluders;  ///< Instances in the way (brf_pair_occluders) when computed.
+    std::vector<std::uint32_t> occluders;   ///< Instances in the way (brf_pair_occluders) when computed.
     std::vector<glm::mat4> occluder_poses;  ///< inverse(M_occluder) x M_source of each.
   };
   /// One source's static-receiver Phi.
@@ -348,9 +348,10 @@ class BrfGpuPass {
   std::size_t output_bytes_ = 0;
   Buffer occluders_;  ///< This frame's Phi jobs' occluder records.
   Buffer instance_table_, incoming_, gathered_, indirect_, weights_, phi_, live_, jobs_, groups_;
-  Buffer phi_spare_;  ///< layout_pairs()'s copy target, released after the swap.
+  Buffer phi_spare_;         ///< layout_pairs()'s copy target, released after the swap.
   Buffer static_occlusion_;  ///< Per static receiver, the objects' occlusion of its baked light.
-  Buffer static_indices_, static_visibility_, static_phi_, static_phi_spare_, static_touched_, static_entries_, static_out_;
+  Buffer static_indices_, static_visibility_, static_phi_, static_phi_spare_, static_touched_, static_entries_,
+      static_out_;
   std::uint32_t static_touched_count_ = 0;
 
   Stats stats_;

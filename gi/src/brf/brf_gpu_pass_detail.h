@@ -12,9 +12,9 @@
 #include <utility>
 #include <vector>
 
+#include <glm/glm.hpp>
 #include <engine/gpu/shader_program.h>
 #include <engine/result.h>
-#include <glm/glm.hpp>
 
 #include "brf/radiance_field.h"
 #include "gpu/gi_shaders.h"
@@ -138,7 +138,7 @@ struct BrfPhiJob {
   // / first vertex entry (kind 2) in the lod table
   std::uint32_t lod_points = 0;
   std::uint32_t occluder_offset = 0, occluder_count = 0;  // into the occluder records
-  std::uint32_t lod_rows = 0;  // kind 2: first vec4 of the representative points' rows in phi_
+  std::uint32_t lod_rows = 0;    // kind 2: first vec4 of the representative points' rows in phi_
   std::uint32_t lod_shared = 0;  // BrfUpdateSettings::lod_shared_visibility (0 / 1)
 };
 static_assert(sizeof(BrfPhiJob) == 240, "must match PhiJob in brf_phi.comp.glsl (std430)");

@@ -5,9 +5,9 @@
 
 #include <cmath>
 #include <cstring>
-#include <nlohmann/json.hpp>
 #include <set>
 #include <system_error>
+#include <nlohmann/json.hpp>
 
 #include "bundle/bundle.h"
 #include "io/json_fields.h"

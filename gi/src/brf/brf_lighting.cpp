@@ -3,9 +3,9 @@
 #include <GL/glcorearb.h>
 #include <engine/components.h>
 #include <engine/finite.h>
-#include <engine/runtime_limits.h>
 #include <engine/gpu/gl_objects.h>
 #include <engine/gpu/shader_program.h>
+#include <engine/runtime_limits.h>
 
 #include <chrono>
 #include <cstdio>
@@ -96,7 +96,8 @@ struct BrfLighting::Impl {
     composite_count = glGetUniformLocation(composite_program.id(), "u_count");
     composite_width = glGetUniformLocation(composite_program.id(), "u_atlas_width");
     if (!world.receiver_texels.empty()) {
-      if (auto s = pass->set_static_receivers(world.receiver_positions, world.receiver_normals, world.caster.get()); !s) {
+      if (auto s = pass->set_static_receivers(world.receiver_positions, world.receiver_normals, world.caster.get());
+          !s) {
         return disable(s.error().to_string());
       }
       receiver_texels =
@@ -304,8 +305,7 @@ bool BrfLighting::set_moving_world_light(std::span<const std::array<glm::vec3, 9
   if (!m.world.probes || radiance_sh.size() != m.world.probes->probe_count()) return false;
   if (m.static_probe_sh.empty()) m.static_probe_sh = m.world.probes->radiance_sh;
   for (std::size_t k = 0; k < radiance_sh.size(); ++k)
-    for (std::size_t j = 0; j < 9; ++j)
-      m.world.probes->radiance_sh[k][j] = m.static_probe_sh[k][j] + radiance_sh[k][j];
+    for (std::size_t j = 0; j < 9; ++j) m.world.probes->radiance_sh[k][j] = m.static_probe_sh[k][j] + radiance_sh[k][j];
   m.world_light_changed = true;
   return true;
 }

@@ -26,12 +26,12 @@
 #include <gi/log.h>
 
 #include <cstdint>
-#include <glm/glm.hpp>
 #include <memory>
 #include <optional>
 #include <span>
 #include <string>
 #include <vector>
+#include <glm/glm.hpp>
 
 #include "brf/brf_runtime.h"
 #include "brf/pca_basis.h"
@@ -118,14 +118,15 @@ class BrfLighting {
     std::uint64_t updates = 0;        ///< update() calls that computed something.
     std::uint64_t skipped = 0;        ///< update() calls on which nothing had changed.
     std::uint64_t objects_moved = 0;  ///< Updates with at least one moved object.
-    std::uint64_t world_light_changes = 0;  ///< Updates that re-gathered every object's world light (set_moving_world_light).
+    std::uint64_t world_light_changes =
+        0;                            ///< Updates that re-gathered every object's world light (set_moving_world_light).
     std::size_t pairs_evaluated = 0;  ///< Last update (GPU pass stats).
     std::size_t pairs_culled = 0;
     std::size_t pairs_reused = 0;
-    std::size_t static_hidden = 0;       ///< Last update: atlas texels in a moved object's field that do not see it.
-    double last_visibility_ms = 0.0;     ///< Last update: their rays against the static world (in last_gpu_ms).
-    double last_cpu_ms = 0.0;  ///< Direct light, probes, fits.
-    double last_gpu_ms = 0.0;  ///< GPU pass + vertex sums (glFinish-timed).
+    std::size_t static_hidden = 0;    ///< Last update: atlas texels in a moved object's field that do not see it.
+    double last_visibility_ms = 0.0;  ///< Last update: their rays against the static world (in last_gpu_ms).
+    double last_cpu_ms = 0.0;         ///< Direct light, probes, fits.
+    double last_gpu_ms = 0.0;         ///< GPU pass + vertex sums (glFinish-timed).
     std::size_t instances = 0;
     std::size_t vertices = 0;
     std::size_t static_receivers = 0;

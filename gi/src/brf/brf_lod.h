@@ -34,7 +34,7 @@
 
 namespace gi {
 
-inline constexpr float kBrfLodNormalCos = 0.98f;        ///< Normals within ~11 degrees share a group.
+inline constexpr float kBrfLodNormalCos = 0.98f;       ///< Normals within ~11 degrees share a group.
 inline constexpr float kBrfLodPlaneTolerance = 0.01f;  ///< Plane offset, x the bounding radius.
 
 struct BrfLodPoints {

@@ -72,8 +72,7 @@ BrfHorizon brf_horizon(const BrfBox& box, const glm::vec3& p, const glm::vec3& n
 void brf_basis_irradiance(const BrfObject& source, std::span<const glm::vec3> positions,
                           std::span<const glm::vec3> normals, std::vector<float>& out,
                           const BrdfSeparation* receiver_glossy, std::span<const glm::mat3> frames,
-                          std::span<const BrfOccluder> occluders, const BrfLodPoints* lod,
-                          bool lod_shared_visibility) {
+                          std::span<const BrfOccluder> occluders, const BrfLodPoints* lod, bool lod_shared_visibility) {
   const BasisRadianceField& f = *source.field;
   const auto cc = static_cast<std::size_t>(f.coefficient_count());
   const auto channels = static_cast<std::size_t>(f.channel_count());
@@ -107,13 +106,15 @@ void brf_basis_irradiance(const BrfObject& source, std::span<const glm::vec3> po
       const BrfHorizon side = brf_horizon(box, p, n);
       if (side == BrfHorizon::Behind) continue;
       // Shared visibility: the point's row as the full evaluation has it, visibility included.
-      const float v = !lod_shared_visibility ? 1.0f
-                      : brf_contact_visibility(box, p, n) *
-                            (occluders.empty() ? 1.0f
-                                               : brf_weighted_visibility(p, n, targets, [&](std::size_t, const glm::vec3& a,
-                                                                                            const glm::vec3& b) {
-                                                   return brf_segment_clear(a, b, occluders);
-                                                 }));
+      const float v =
+          !lod_shared_visibility
+              ? 1.0f
+              : brf_contact_visibility(box, p, n) *
+                    (occluders.empty() ? 1.0f
+                                       : brf_weighted_visibility(
+                                             p, n, targets, [&](std::size_t, const glm::vec3& a, const glm::vec3& b) {
+                                               return brf_segment_clear(a, b, occluders);
+                                             }));
       if (v == 0.0f) continue;
       f.sample(p, coeffs);
       const auto lobe = side == BrfHorizon::InFront ? sh_cosine(n) : sh_clamped_cosine(n, f.sh_bands);
@@ -134,10 +135,10 @@ void brf_basis_irradiance(const BrfObject& source, std::span<const glm::vec3> po
     // What the point sees of the source past the other objects (the GPU's brf_phi twin).
     const float v = brf_contact_visibility(box, p, n) *
                     (occluders.empty() ? 1.0f
-                                       : brf_weighted_visibility(p, n, targets, [&](std::size_t, const glm::vec3& a,
-                                                                                    const glm::vec3& b) {
-                                           return brf_segment_clear(a, b, occluders);
-                                         }));
+                                       : brf_weighted_visibility(
+                                             p, n, targets, [&](std::size_t, const glm::vec3& a, const glm::vec3& b) {
+                                               return brf_segment_clear(a, b, occluders);
+                                             }));
     if (v == 0.0f) continue;
     if (reduced) {  // this vertex's own side and visibility, the field part interpolated
       brf_lod_interpolate(*lod, j, point_rows, channels, v, out.data() + j * channels);
@@ -146,7 +147,8 @@ void brf_basis_irradiance(const BrfObject& source, std::span<const glm::vec3> po
     f.sample(p, coeffs);
     const auto lobe = side == BrfHorizon::InFront ? sh_cosine(n) : sh_clamped_cosine(n, f.sh_bands);
     float* row = out.data() + j * kr * channels;
-    for (std::size_t c = 0; c < channels; ++c) row[c] = sh_dot(std::span<const float>(coeffs).subspan(c * cc), lobe, cc);
+    for (std::size_t c = 0; c < channels; ++c)
+      row[c] = sh_dot(std::span<const float>(coeffs).subspan(c * cc), lobe, cc);
     if (kr > 1) {
       const ShRotation to_source_frame(pure * frames[j]);
       for (std::size_t k = 1; k < kr; ++k) {
@@ -229,8 +231,8 @@ std::vector<std::uint8_t> brf_pair_influence(std::span<const BrfObject> objects,
 }
 
 std::vector<std::uint8_t> brf_pair_culling(std::span<const BrfObject> objects,
-                                           std::span<const std::array<std::vector<float>, 3>> weights,
-                                           float threshold, float influence_scale) {
+                                           std::span<const std::array<std::vector<float>, 3>> weights, float threshold,
+                                           float influence_scale) {
   const std::size_t n = objects.size();
   std::vector<std::uint8_t> outside = brf_pair_influence(objects, influence_scale);
   if (threshold <= 0.0f) return outside;
@@ -258,9 +260,10 @@ std::vector<std::uint8_t> brf_pair_culling(std::span<const BrfObject> objects,
       for (std::size_t c = 0; c < 3; ++c) {
         float e = 0.0f;
         for (int i = 0; i < f.channel_count(); ++i)
-          e += std::fabs(weights[s][c][static_cast<std::size_t>(i)] *
-                         sh_dot(std::span<const float>(coeffs).subspan(static_cast<std::size_t>(i * f.coefficient_count())),
-                                lobe, static_cast<std::size_t>(f.coefficient_count())));
+          e += std::fabs(
+              weights[s][c][static_cast<std::size_t>(i)] *
+              sh_dot(std::span<const float>(coeffs).subspan(static_cast<std::size_t>(i * f.coefficient_count())), lobe,
+                     static_cast<std::size_t>(f.coefficient_count())));
         b = std::max(b, e);
       }
       bound[s * n + r] = b;
@@ -299,7 +302,8 @@ std::vector<std::vector<glm::vec3>> brf_direct_light(std::span<const BrfObject> 
         if (glossy == nullptr) continue;
         // E_k = g_k(w_light) E (eq. 8 for a point light), w_light in the vertex's frame.
         const glm::vec3 w = glm::transpose(v.frames[j]) * glm::normalize(l.position - v.positions[j]);
-        for (int k = 1; k <= glossy->terms; ++k) direct[o][static_cast<std::size_t>(k) * nv + j] += glossy->g_at(k - 1, w) * e;
+        for (int k = 1; k <= glossy->terms; ++k)
+          direct[o][static_cast<std::size_t>(k) * nv + j] += glossy->g_at(k - 1, w) * e;
       }
   }
   return direct;
@@ -378,7 +382,8 @@ BrfResult brf_interreflect(std::span<const BrfObject> objects, std::span<const s
   }
   std::vector<std::array<std::vector<float>, 3>> w(n);
   for (std::size_t s = 0; s < n; ++s) w[s] = brf_fit_rgb(*objects[s].basis, light[s]);
-  const std::vector<std::uint8_t> culled = brf_pair_culling(objects, w, settings.cull_threshold, settings.influence_scale);
+  const std::vector<std::uint8_t> culled =
+      brf_pair_culling(objects, w, settings.cull_threshold, settings.influence_scale);
 
   // Basis irradiance of every live pair, once per frame, seen past the objects in between.
   std::vector<BrfBox> boxes(n);
@@ -437,7 +442,8 @@ BrfResult brf_interreflect(std::span<const BrfObject> objects, std::span<const s
     for (std::size_t s = 0; s < n; ++s)
       for (std::size_t r = 0; r < n; ++r)
         if (s != r && culled[s * n + r] == 0)
-          brf_gather(phi[s * n + r], static_cast<std::size_t>(objects[s].field->channel_count()), terms[r], w[s], gathered[r]);
+          brf_gather(phi[s * n + r], static_cast<std::size_t>(objects[s].field->channel_count()), terms[r], w[s],
+                     gathered[r]);
     for (std::size_t r = 0; r < n; ++r) {
       reflect(objects[r], gathered[r], light[r]);
       for (std::size_t j = 0; j < gathered[r].size(); ++j) {

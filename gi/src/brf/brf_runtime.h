@@ -19,8 +19,8 @@
 //         albedo x (incoming + interreflected), times the fraction of the source they see
 //         past the static world when BrfStaticReceivers::world is given.
 // Pairs whose bound contribution I_c (§5.4) — the first bounce's irradiance at the
-// receiver's centre, facing the source, summed over the channels in absolute value — is below `cull_threshold` x the largest pair's are
-// skipped for the whole frame (brf_pair_culling).
+// receiver's centre, facing the source, summed over the channels in absolute value — is below `cull_threshold` x the
+// largest pair's are skipped for the whole frame (brf_pair_culling).
 //   std::vector<gi::BrfObject> objects{{&mesh, &basis, &field, transform, albedo}};
 //   gi::BrfResult r = gi::update_brf(objects, lights, {.bounces = 3});
 //   // r.indirect[object][vertex]: interreflected irradiance (W/m^2, RGB)
@@ -59,7 +59,7 @@ struct BrfObject {
   glm::vec3 albedo{0.8f};           ///< Diffuse albedo.
   /// The separated glossy lobe (nullptr: diffuse). The basis and field were baked with it.
   const BrdfSeparation* glossy = nullptr;
-  glm::vec3 specular{1.0f};         ///< Glossy colour: f0 (RGB) / glossy->lobe.f0.
+  glm::vec3 specular{1.0f};  ///< Glossy colour: f0 (RGB) / glossy->lobe.f0.
 
   int terms() const { return field->terms; }
 };
@@ -189,8 +189,8 @@ glm::vec3 brf_outgoing_radiance(const BrfObject& object, const BrfWorldVertices&
 /// `influence_scale`), whose bounds are not evaluated (the largest is over the pairs inside).
 /// threshold <= 0: no bound is evaluated, only the influence culls.
 std::vector<std::uint8_t> brf_pair_culling(std::span<const BrfObject> objects,
-                                           std::span<const std::array<std::vector<float>, 3>> weights,
-                                           float threshold, float influence_scale = 0.0f);
+                                           std::span<const std::array<std::vector<float>, 3>> weights, float threshold,
+                                           float influence_scale = 0.0f);
 
 /// The pairs outside each other's influence (BrfUpdateSettings::influence_scale):
 /// outside[s * n + r] != 0 when receiver r's bounding sphere (brf_bounding_sphere) lies wholly
@@ -207,8 +207,8 @@ std::vector<std::vector<glm::vec3>> brf_direct_light(std::span<const BrfObject> 
                                                      std::span<const PointEmitter> lights, const RayCaster* world);
 
 /// Steps 2a-2d from `incoming[object][k x V + vertex]`, the light arriving from outside the
-/// objects (a diffuse object: its irradiance only). `direct` is left empty. Preconditions: sizes match the meshes; receiver spans
-/// have equal sizes.
+/// objects (a diffuse object: its irradiance only). `direct` is left empty. Preconditions: sizes match the meshes;
+/// receiver spans have equal sizes.
 BrfResult brf_interreflect(std::span<const BrfObject> objects, std::span<const std::vector<glm::vec3>> incoming,
                            const BrfUpdateSettings& settings, const BrfStaticReceivers& receivers = {});
 

@@ -37,21 +37,22 @@ void brf_static_visibility(const RayCaster& world, std::span<const glm::vec3> ta
   world.occluded_many(rays, blocked);
   std::size_t next = 0;
   for (std::size_t j = 0; j < positions.size(); ++j)
-    out[j] = brf_weighted_visibility(positions[j], normals[j], targets,
-                                     [&](std::size_t, const glm::vec3&, const glm::vec3&) { return blocked[next++] == 0; });
+    out[j] =
+        brf_weighted_visibility(positions[j], normals[j], targets,
+                                [&](std::size_t, const glm::vec3&, const glm::vec3&) { return blocked[next++] == 0; });
 }
 
-float brf_box_form_factor(const BrfBox& box, const glm::mat4& object_to_world, const glm::vec3& p,
-                          const glm::vec3& n) {
+float brf_box_form_factor(const BrfBox& box, const glm::mat4& object_to_world, const glm::vec3& p, const glm::vec3& n) {
   const glm::vec3 local = glm::vec3(glm::inverse(object_to_world) * glm::vec4(p, 1.0f));
   if (glm::all(glm::greaterThan(local, box.lo)) && glm::all(glm::lessThan(local, box.hi))) return 1.0f;
   // Faces as corner indices (bit 0: x, 1: y, 2: z high) with the axis and side they face.
-  static constexpr int kFaces[6][4] = {{0, 2, 6, 4}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 3, 7, 6}, {0, 1, 3, 2}, {4, 5, 7, 6}};
+  static constexpr int kFaces[6][4] = {{0, 2, 6, 4}, {1, 3, 7, 5}, {0, 1, 5, 4},
+                                       {2, 3, 7, 6}, {0, 1, 3, 2}, {4, 5, 7, 6}};
   std::array<glm::vec3, 8> corner;
   for (int k = 0; k < 8; ++k)
-    corner[static_cast<std::size_t>(k)] = glm::vec3(
-        object_to_world * glm::vec4((k & 1) != 0 ? box.hi.x : box.lo.x, (k & 2) != 0 ? box.hi.y : box.lo.y,
-                                    (k & 4) != 0 ? box.hi.z : box.lo.z, 1.0f));
+    corner[static_cast<std::size_t>(k)] =
+        glm::vec3(object_to_world * glm::vec4((k & 1) != 0 ? box.hi.x : box.lo.x, (k & 2) != 0 ? box.hi.y : box.lo.y,
+                                              (k & 4) != 0 ? box.hi.z : box.lo.z, 1.0f));
   float total = 0.0f;
   for (int f = 0; f < 6; ++f) {
     const int axis = f / 2;
@@ -98,7 +99,7 @@ float brf_contact_visibility(const BrfBox& box, const glm::vec3& p, const glm::v
     t1 = std::min(t1, tb);
   }
   if (t0 > t1 || t1 < 0.0f) return 1.0f;  // the normal misses the box (or it lies behind)
-  if (t0 <= 0.0f) return 0.0f;             // inside the box
+  if (t0 <= 0.0f) return 0.0f;            // inside the box
   return t0 >= gap ? 1.0f : t0 / gap;
 }
 

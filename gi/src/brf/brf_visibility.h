@@ -57,8 +57,7 @@ bool brf_segment_clear(const glm::vec3& a, const glm::vec3& b, std::span<const B
 /// out[j] = the fraction of `targets` receiver j sees past `occluders` (cosine-weighted as
 /// above; the segment test brf_segment_clear). Preconditions: sizes equal.
 void brf_box_visibility(std::span<const BrfOccluder> occluders, std::span<const glm::vec3> targets,
-                        std::span<const glm::vec3> positions, std::span<const glm::vec3> normals,
-                        std::span<float> out);
+                        std::span<const glm::vec3> positions, std::span<const glm::vec3> normals, std::span<float> out);
 
 /// The form factor (cosine-weighted solid angle / pi) of an object's box (object space, placed
 /// by `object_to_world`) seen from world point p with unit normal n: the share of p's

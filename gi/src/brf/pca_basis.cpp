@@ -2,10 +2,10 @@
 
 #include <engine/finite.h>
 
-#include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <Eigen/Dense>
 
 #include "brf/brdf_separation.h"
 #include "raytrace/embree_ray_caster.h"

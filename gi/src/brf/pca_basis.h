@@ -38,10 +38,10 @@ struct BrfMesh {
 };
 
 struct PcaBasisSettings {
-  int lights = 256;                ///< N_light point lights around the bounding sphere.
-  int basis = 16;                  ///< N, the mean included.
-  float light_radius_scale = 1.5f; ///< Lights at this x the bounding radius (1: on the sphere).
-  float rank_tolerance = 1e-5f;    ///< Relative singular value below which components are dropped.
+  int lights = 256;                 ///< N_light point lights around the bounding sphere.
+  int basis = 16;                   ///< N, the mean included.
+  float light_radius_scale = 1.5f;  ///< Lights at this x the bounding radius (1: on the sphere).
+  float rank_tolerance = 1e-5f;     ///< Relative singular value below which components are dropped.
   /// Largest condition number of A kept by the pseudo-inverse: the runtime fits in single
   /// precision (GPU), where a condition of c loses about c x 6e-8 relative accuracy.
   double max_condition = 1e5;
@@ -49,13 +49,13 @@ struct PcaBasisSettings {
 
 struct BrfBasis {
   std::size_t vertex_count = 0;
-  int terms = 1;                    ///< Distributions per vertex it was trained on: 1 + glossy terms.
-  int basis_count = 0;              ///< N actually kept (<= requested).
-  std::vector<float> psi;           ///< Psi_i(x_j) at psi[i * vertex_count + j]; Psi_0 is the normalized mean.
-  std::vector<float> a_inverse;     ///< N x N, row-major: the (pseudo-)inverse of A.
+  int terms = 1;                       ///< Distributions per vertex it was trained on: 1 + glossy terms.
+  int basis_count = 0;                 ///< N actually kept (<= requested).
+  std::vector<float> psi;              ///< Psi_i(x_j) at psi[i * vertex_count + j]; Psi_0 is the normalized mean.
+  std::vector<float> a_inverse;        ///< N x N, row-major: the (pseudo-)inverse of A.
   std::vector<float> singular_values;  ///< Of the centred training matrix, descending.
-  double condition = 1.0;           ///< Of A, over the eigenvalues kept.
-  glm::vec3 centre{0.0f};           ///< Bounding sphere of the object.
+  double condition = 1.0;              ///< Of A, over the eigenvalues kept.
+  glm::vec3 centre{0.0f};              ///< Bounding sphere of the object.
   float radius = 0.0f;
 
   /// Least-squares weights of `values` (one per vertex): A^-1 b.

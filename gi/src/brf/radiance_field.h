@@ -15,9 +15,9 @@
 #include <gi/progress.h>
 
 #include <cstdint>
-#include <glm/glm.hpp>
 #include <span>
 #include <vector>
+#include <glm/glm.hpp>
 
 #include "brf/pca_basis.h"
 

@@ -72,8 +72,9 @@ struct BandFrames {
       const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
       const double phi = golden * n + 0.3;
       const double x = r * std::cos(phi), y = r * std::sin(phi);
-      dirs.push_back(glm::normalize(glm::vec3(static_cast<float>(x), static_cast<float>(y * std::cos(0.4) - z * std::sin(0.4)),
-                                              static_cast<float>(y * std::sin(0.4) + z * std::cos(0.4)))));
+      dirs.push_back(
+          glm::normalize(glm::vec3(static_cast<float>(x), static_cast<float>(y * std::cos(0.4) - z * std::sin(0.4)),
+                                   static_cast<float>(y * std::sin(0.4) + z * std::cos(0.4)))));
     }
     for (int l = 1; l < kMaxShBands; ++l) {
       const int count = 2 * l + 1;

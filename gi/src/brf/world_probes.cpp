@@ -188,7 +188,8 @@ engine::Result<WorldProbeTransfer> bake_world_probe_transfer(const RayCaster& st
           const float cos_v = glm::dot(normal[i], w_out);
           if (cos_v <= 0.0f) continue;
           const glm::vec3 start = offset_ray_origin(position[i], normal[i]);
-          if (static_world.occluded(Ray{.origin = start, .t_min = 0.0f, .direction = p - start, .t_max = 1.0f})) continue;
+          if (static_world.occluded(Ray{.origin = start, .t_min = 0.0f, .direction = p - start, .t_max = 1.0f}))
+            continue;
           const float kernel = cos_v / (std::numbers::pi_v<float> * d2 + area_m2[i]);
           const auto y_lm = sh_basis(-w_out);
           std::array<float, 9> c{};
@@ -216,7 +217,8 @@ engine::Result<std::vector<std::array<glm::vec3, 9>>> reproject_world_probes(con
                                     std::to_string(transfer.emitter_count) + " emitters"};
   for (std::size_t i = 0; i < power.size(); ++i)
     if (!engine::all_finite(power[i]))
-      return engine::Error{.message = "world probe reprojection: emitter " + std::to_string(i) + " has a non-finite power"};
+      return engine::Error{.message =
+                               "world probe reprojection: emitter " + std::to_string(i) + " has a non-finite power"};
   const std::size_t count = transfer.first.empty() ? 0 : transfer.first.size() - 1;
   std::vector<std::array<glm::vec3, 9>> sh(count);
   for (std::size_t k = 0; k < count; ++k) {

@@ -37,13 +37,13 @@ namespace gi {
 class RayCaster;
 
 struct WorldProbeSettings {
-  float spacing_m = 1.0f;     ///< Grid spacing.
-  int max_probes = 65536;     ///< The spacing grows until the grid fits.
-  unsigned threads = 0;       ///< 0: all hardware threads. The result does not depend on it.
+  float spacing_m = 1.0f;  ///< Grid spacing.
+  int max_probes = 65536;  ///< The spacing grows until the grid fits.
+  unsigned threads = 0;    ///< 0: all hardware threads. The result does not depend on it.
 };
 
 struct WorldProbeGrid {
-  glm::vec3 origin{0.0f};    ///< Probe (0, 0, 0).
+  glm::vec3 origin{0.0f};  ///< Probe (0, 0, 0).
   float spacing = 1.0f;
   glm::ivec3 dims{0};
   /// Per probe (x fastest, then y, then z): 9 SH coefficients per channel, radiance_sh[p][k].
@@ -73,12 +73,13 @@ engine::Result<WorldProbeGrid> bake_world_probes(const RayCaster& static_world, 
 //   auto t = gi::bake_world_probe_transfer(*caster, grid, pos, nrm, area).value();
 //   auto sh = gi::reproject_world_probes(t, power).value();   // per probe, add to grid.radiance_sh
 struct WorldProbeTransfer {
-  std::vector<std::uint32_t> first;                ///< probe_count + 1: probe p's entries [first[p], first[p + 1]).
-  std::vector<std::uint32_t> emitter;              ///< Per entry: the emitter it sees.
+  std::vector<std::uint32_t> first;               ///< probe_count + 1: probe p's entries [first[p], first[p + 1]).
+  std::vector<std::uint32_t> emitter;             ///< Per entry: the emitter it sees.
   std::vector<std::array<float, 9>> coefficient;  ///< Per entry: cos / (pi d^2 + A) x Y_j(probe -> emitter).
   std::size_t emitter_count = 0;
   std::size_t bytes() const {
-    return first.size() * sizeof(first[0]) + emitter.size() * sizeof(emitter[0]) + coefficient.size() * sizeof(coefficient[0]);
+    return first.size() * sizeof(first[0]) + emitter.size() * sizeof(emitter[0]) +
+           coefficient.size() * sizeof(coefficient[0]);
   }
 };
 

@@ -11,9 +11,9 @@
 
 #include <string_view>
 
-#include "io/blob_file.h"
 #include "bundle/geometry_hash.h"
 #include "bundle/manifest.h"
+#include "io/blob_file.h"
 
 namespace gi {
 

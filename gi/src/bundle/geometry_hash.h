@@ -18,9 +18,9 @@ namespace gi {
 /// image's texels by their XXH3, UV set, wrap, mipmaps, transform), alpha mode, cutoff and
 /// alpha factor and the primitive's UV sets per corner: a bundle baked with other textures
 /// is stale. An untextured opaque material adds nothing more, so bundles of untextured
-/// scenes keep their hash. Dynamic instances, lights, names and the file path do not enter. Vertex order and splitting do not matter as long as the
-/// triangles stay the same, so a scene given its atlas uv1 (gi::with_atlas_uv1) hashes like
-/// the original.
+/// scenes keep their hash. Dynamic instances, lights, names and the file path do not enter. Vertex order and splitting
+/// do not matter as long as the triangles stay the same, so a scene given its atlas uv1 (gi::with_atlas_uv1) hashes
+/// like the original.
 std::string scene_geometry_hash(const BakeInput& input);
 
 /// 16 hex digits over the lights a static bake (the light atlas) depends on: for every

@@ -12,8 +12,8 @@
 #include <gi/bake_input.h>
 
 #include <filesystem>
-#include <nlohmann/json.hpp>
 #include <string>
+#include <nlohmann/json.hpp>
 
 namespace gi {
 

@@ -30,8 +30,7 @@ inline engine::Result<std::vector<std::filesystem::path>> list_shard_files(const
     if (e.path().extension() == extension) files.push_back(e.path());
   if (ec) return engine::Error{dir.string(), "", "cannot list the shard directory: " + ec.message()};
   std::sort(files.begin(), files.end());
-  if (files.empty())
-    return engine::Error{dir.string(), "", "no shard file (*" + std::string(extension) + ") to merge"};
+  if (files.empty()) return engine::Error{dir.string(), "", "no shard file (*" + std::string(extension) + ") to merge"};
   return files;
 }
 
@@ -46,8 +45,9 @@ struct ShardSet {
   engine::Status place(const std::filesystem::path& path, std::uint32_t index, std::uint32_t count, File file) {
     if (shards.empty()) shards.resize(count), where.resize(count);
     if (shards[index])
-      return engine::Error{path.string(), "", "duplicate shard " + std::to_string(index) + " of " +
-                                                  std::to_string(count) + " (also in " + where[index].string() + ")"};
+      return engine::Error{path.string(), "",
+                           "duplicate shard " + std::to_string(index) + " of " + std::to_string(count) + " (also in " +
+                               where[index].string() + ")"};
     shards[index] = std::move(file);
     where[index] = path;
     return {};

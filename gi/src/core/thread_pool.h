@@ -7,8 +7,8 @@
 //   pool.parallel_for(n, [&](std::size_t i) { out[i] = shade(i); });
 // An exception thrown by fn reaches the caller of parallel_for (the other items stop).
 
-#include <gi/progress.h>
 #include <oneapi/tbb/task_arena.h>
+#include <gi/progress.h>
 
 #include <cstddef>
 #include <functional>

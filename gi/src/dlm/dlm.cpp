@@ -7,10 +7,10 @@
 
 #include <algorithm>
 #include <array>
-#include <limits>
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <map>
 #include <numbers>
 
@@ -61,8 +61,8 @@ glm::vec3 fibonacci_direction(int i, int n) {
   const double z = 1.0 - (2.0 * i + 1.0) / n;
   const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
   const double phi = golden * i;
-  return glm::normalize(glm::vec3(static_cast<float>(r * std::cos(phi)), static_cast<float>(r * std::sin(phi)),
-                                  static_cast<float>(z)));
+  return glm::normalize(
+      glm::vec3(static_cast<float>(r * std::cos(phi)), static_cast<float>(r * std::sin(phi)), static_cast<float>(z)));
 }
 
 // A photon source: a point emitter with its total power (W, RGB) and how it is sampled.
@@ -136,8 +136,12 @@ std::vector<Source> photon_sources(const std::vector<PointEmitter>& emitters, co
         s.power = e.radiant * (2.0f * kPi * (1.0f - cos_max));
         break;
       }
-      case PointEmitter::Kind::Directional: s.power = e.radiant * (kPi * bounds.radius * bounds.radius); break;
-      case PointEmitter::Kind::Lambertian: s.power = e.radiant * (e.two_sided ? 2.0f : 1.0f); break;
+      case PointEmitter::Kind::Directional:
+        s.power = e.radiant * (kPi * bounds.radius * bounds.radius);
+        break;
+      case PointEmitter::Kind::Lambertian:
+        s.power = e.radiant * (e.two_sided ? 2.0f : 1.0f);
+        break;
     }
     if (luminance(s.power) > 0.0f && engine::all_finite(s.power)) out.push_back(s);
   }
@@ -187,7 +191,8 @@ std::vector<float> dlm_bin_cosine_weights(std::span<const glm::vec3> directions,
 
 engine::Result<DlmSettings> dlm_preset(std::string_view name) {
   auto density = atlas_density_preset(name);
-  if (!density) return engine::invalid_request("unknown DLM preset '" + std::string(name) + "' (preview, medium, high)");
+  if (!density)
+    return engine::invalid_request("unknown DLM preset '" + std::string(name) + "' (preview, medium, high)");
   DlmSettings s;
   s.texels_per_metre = *density;
   // The photons a texel-bin receives fall with the density squared: the counts keep roughly
@@ -238,8 +243,8 @@ engine::Result<Dlm> bake_dlm(const BakeInput& input, const DlmSettings& settings
       }
       triangle_glossy[t] = it->second.first ? 1 : 0;
       // Textured: the texture's mean over the triangle (the material lookup, material_lookup.h).
-      triangle_albedo[t] = s.scene.materials[m].textured() ? gi::triangle_albedo(s.scene, s.index.triangles[t])
-                                                            : it->second.second;
+      triangle_albedo[t] =
+          s.scene.materials[m].textured() ? gi::triangle_albedo(s.scene, s.index.triangles[t]) : it->second.second;
     }
   }
 
@@ -344,8 +349,10 @@ engine::Result<Dlm> bake_dlm(const BakeInput& input, const DlmSettings& settings
                                     (0.5 * std::fabs(static_cast<double>(det)) * kSub * kSub);
       const auto chart = static_cast<std::int32_t>(mesh.triangle_chart[prim]);
       const glm::vec2 lo = glm::min(a, glm::min(b, d)), hi = glm::max(a, glm::max(b, d));
-      const auto m0 = static_cast<int>(std::floor((lo.x + 0.5f) * kSub)), m1 = static_cast<int>(std::ceil((hi.x + 0.5f) * kSub));
-      const auto n0 = static_cast<int>(std::floor((lo.y + 0.5f) * kSub)), n1 = static_cast<int>(std::ceil((hi.y + 0.5f) * kSub));
+      const auto m0 = static_cast<int>(std::floor((lo.x + 0.5f) * kSub)),
+                 m1 = static_cast<int>(std::ceil((hi.x + 0.5f) * kSub));
+      const auto n0 = static_cast<int>(std::floor((lo.y + 0.5f) * kSub)),
+                 n1 = static_cast<int>(std::ceil((hi.y + 0.5f) * kSub));
       for (int ny = n0; ny <= n1; ++ny)
         for (int mx = m0; mx <= m1; ++mx) {
           // Shifted off the sub-grid's centres so that no point lies exactly on an edge two
@@ -370,8 +377,8 @@ engine::Result<Dlm> bake_dlm(const BakeInput& input, const DlmSettings& settings
     const std::size_t first = out.size();
     for_kernel(texel_point(c, prim, bc), static_cast<std::int32_t>(dlm.layout.meshes[c].triangle_chart[prim]),
                [&](std::size_t t, float w) {
-                 out.push_back({static_cast<std::uint32_t>(element[t]),
-                                dlm_bin(dlm.directions, tex.normal[t], w_in), w * power});
+                 out.push_back(
+                     {static_cast<std::uint32_t>(element[t]), dlm_bin(dlm.directions, tex.normal[t], w_in), w * power});
                });
     return out.size() > first;
   };

@@ -33,26 +33,26 @@
 #include <gi/progress.h>
 
 #include <cstdint>
-#include <glm/glm.hpp>
 #include <span>
 #include <string_view>
 #include <vector>
+#include <glm/glm.hpp>
 
 #include "uv/atlas_layout.h"
 
 namespace gi {
 
 struct DlmSettings {
-  float texels_per_metre = 16.0f;  ///< Atlas density; the layout is the light atlas's (same preset, same uv1).
-  int directions = 32;             ///< N = |Omega|, 8..256.
+  float texels_per_metre = 16.0f;     ///< Atlas density; the layout is the light atlas's (same preset, same uv1).
+  int directions = 32;                ///< N = |Omega|, 8..256.
   std::uint64_t photons = 1'000'000;  ///< Photon paths shot from the lights.
   float splat_radius_texels = 1.5f;   ///< Tent kernel radius (the paper's pyramidal splats are 1.5 texels wide).
   float glossy_roughness = 0.35f;     ///< Texels of materials with roughness below this get maps (PlanOptions).
   int max_bounces = 16;               ///< Safety stop of a photon path (Russian roulette ends it first).
   int area_light_samples = 16;        ///< Point emitters per area light or emissive triangle.
   std::uint64_t seed = 1;
-  unsigned threads = 0;               ///< 0: all hardware threads. The result does not depend on it.
-  ProgressCallback progress;          ///< Fraction done; false cancels.
+  unsigned threads = 0;       ///< 0: all hardware threads. The result does not depend on it.
+  ProgressCallback progress;  ///< Fraction done; false cancels.
 };
 
 struct DlmStats {

@@ -4,13 +4,13 @@
 
 #include <algorithm>
 #include <cmath>
-#include <glm/gtc/packing.hpp>
-#include <nlohmann/json.hpp>
 #include <span>
 #include <system_error>
+#include <glm/gtc/packing.hpp>
+#include <nlohmann/json.hpp>
 
-#include "core/half_scale.h"
 #include "bundle/bundle.h"
+#include "core/half_scale.h"
 #include "io/json_fields.h"
 #include "uv/atlas_input.h"
 
@@ -33,7 +33,6 @@ bool is_power_of_two(float s) {
   int e = 0;
   return std::isfinite(s) && s > 0.0f && std::frexp(s, &e) == 0.5f;
 }
-
 
 std::uint16_t to_half(float v) { return glm::packHalf1x16(v); }
 float from_half(std::uint16_t h) { return glm::unpackHalf1x16(h); }
@@ -133,7 +132,8 @@ engine::Status write_dlm_file(const fs::path& path, const Dlm& dlm, const std::s
   std::vector<std::uint16_t> halves(dlm.radiance.size());
   for (std::size_t k = 0; k < scales.size(); ++k) {
     const auto first = dlm.radiance.begin() + static_cast<std::ptrdiff_t>(k * per_bin);
-    const float max_value = per_bin == 0 ? 0.0f : *std::max_element(first, first + static_cast<std::ptrdiff_t>(per_bin));
+    const float max_value =
+        per_bin == 0 ? 0.0f : *std::max_element(first, first + static_cast<std::ptrdiff_t>(per_bin));
     scales[k] = half_layer_scale(max_value);
     for (std::size_t j = k * per_bin; j < (k + 1) * per_bin; ++j) halves[j] = to_half(dlm.radiance[j] / scales[k]);
   }
@@ -188,9 +188,9 @@ engine::Result<DlmFile> read_dlm_file(const fs::path& path) {
                       str(scales.size()) + " scales for " + str(d.directions.size()) + " directions");
   for (std::size_t k = 0; k < scales.size(); ++k)
     if (!is_power_of_two(scales[k]))
-      return file_error(path, "bin_scale",
-                        "the scale of bin " + str(k) + " (" + std::to_string(scales[k]) +
-                            ") is not a positive power of two");
+      return file_error(
+          path, "bin_scale",
+          "the scale of bin " + str(k) + " (" + std::to_string(scales[k]) + ") is not a positive power of two");
   if (halves.size() != d.directions.size() * d.texels.size() * 3)
     return file_error(path, "radiance_half",
                       str(halves.size()) + " values, " + str(d.directions.size()) + " directions x " +
@@ -264,8 +264,8 @@ engine::Result<Dlm> load_dlm(const fs::path& bundle_dir, const BakeInput& input)
   auto file = read_dlm_file(path);
   if (!file) return file.error();
   if (file->geometry_hash != manifest->geometry_hash)
-    return file_error(path, "", "belongs to geometry " + file->geometry_hash + ", the manifest to " +
-                                    manifest->geometry_hash);
+    return file_error(path, "",
+                      "belongs to geometry " + file->geometry_hash + ", the manifest to " + manifest->geometry_hash);
   Dlm& dlm = file->dlm;
   const std::string prefix = std::string("methods.") + kDlmMethod;
   if (entry->directions != dlm.directions.size() || entry->texels != dlm.texels.size() || entry->width != dlm.width ||

@@ -10,10 +10,10 @@
 
 #include <cstdint>
 #include <limits>
-#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <type_traits>
+#include <nlohmann/json.hpp>
 
 namespace gi {
 

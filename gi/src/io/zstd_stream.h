@@ -7,8 +7,8 @@
 //   if (!planes) return planes.error();
 // Header-only: the readers that use it link zstd (gi_core does not).
 
-#include <engine/result.h>
 #include <zstd.h>
+#include <engine/result.h>
 
 #include <cstdint>
 #include <filesystem>
@@ -57,11 +57,14 @@ inline engine::Result<std::vector<std::uint8_t>> read_zstd_stream(const std::fil
     return error("the zstd frame holds " + std::to_string(content) + " bytes, the file's counts need " +
                  std::to_string(expected));
   const std::size_t frame_bytes = ZSTD_findFrameCompressedSize(frame.data(), frame.size());
-  if (ZSTD_isError(frame_bytes) != 0 || frame_bytes != frame.size()) return error("not exactly one zstd frame (corrupt)");
-  if (content / 131072 > frame.size() / 4 + 1) return error("the zstd frame is too small for the size it claims (corrupt)");
+  if (ZSTD_isError(frame_bytes) != 0 || frame_bytes != frame.size())
+    return error("not exactly one zstd frame (corrupt)");
+  if (content / 131072 > frame.size() / 4 + 1)
+    return error("the zstd frame is too small for the size it claims (corrupt)");
   std::vector<std::uint8_t> out(static_cast<std::size_t>(content));
   const std::size_t unpacked = ZSTD_decompress(out.data(), out.size(), frame.data(), frame.size());
-  if (ZSTD_isError(unpacked) != 0) return error(std::string("zstd decompression failed: ") + ZSTD_getErrorName(unpacked));
+  if (ZSTD_isError(unpacked) != 0)
+    return error(std::string("zstd decompression failed: ") + ZSTD_getErrorName(unpacked));
   if (unpacked != out.size())
     return error("decompressed " + std::to_string(unpacked) + " bytes, " + std::to_string(out.size()) + " expected");
   return out;

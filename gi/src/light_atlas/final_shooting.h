@@ -18,9 +18,9 @@
 #include <gi/progress.h>
 
 #include "core/thread_pool.h"
+#include "raytrace/ray_caster.h"
 #include "transport/point_emitters.h"
 #include "transport/vpl_set.h"
-#include "raytrace/ray_caster.h"
 #include "uv/atlas_rasterizer.h"
 
 namespace gi {

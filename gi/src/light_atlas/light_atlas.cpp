@@ -292,9 +292,8 @@ engine::Result<LightAtlasBake> bake_light_atlas_run(const BakeInput& input, cons
     std::vector<glm::vec3> total(out.irradiance.size());
     for (std::size_t t = 0; t < total.size(); ++t)
       total[t] = out.irradiance[t] + gathered->direct[t] + gathered->baked_direct[t];
-    const std::vector<glm::vec3> at_samples =
-        irradiance_at_points(b.texels, total, out.layout.texels_per_metre, out.vpls.sample_position,
-                             out.vpls.sample_normal);
+    const std::vector<glm::vec3> at_samples = irradiance_at_points(b.texels, total, out.layout.texels_per_metre,
+                                                                   out.vpls.sample_position, out.vpls.sample_normal);
     out.vpl_power.assign(out.vpls.size(), glm::vec3(0.0f));
     for (std::size_t j = 0; j < out.vpls.size(); ++j) {
       glm::dvec3 sum(0.0);

@@ -23,11 +23,11 @@
 #include <gi/progress.h>
 
 #include <cstdint>
-#include <glm/glm.hpp>
 #include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
+#include <glm/glm.hpp>
 
 #include "light_atlas/texel_gather.h"
 #include "transport/vpl_set.h"
@@ -119,13 +119,13 @@ engine::Result<LightAtlasBake> bake_light_atlas(const BakeInput& input, const Li
 /// texels. The layout, the texels, steps 1-2 and the VPLs are repeated bit for bit by every
 /// shard and by the merge instead of being shipped (measured in docs/distributed-bake.md).
 struct LightAtlasShardPart {
-  std::vector<std::uint32_t> texels;   ///< Atlas texel indices, ascending.
-  std::vector<glm::vec3> indirect;     ///< Per texel of `texels`: steps 2-3's irradiance.
-  std::vector<glm::vec3> direct;       ///< Per texel of `texels`: TexelGatherResult::direct.
-  std::vector<glm::vec3> baked_direct; ///< Per texel of `texels`: TexelGatherResult::baked_direct (unfiltered).
-  std::vector<std::uint8_t> hidden;    ///< Per texel of `texels`.
-  std::uint64_t shared_rays = 0;       ///< Rays of steps 1-2 (the same in every shard).
-  std::uint64_t own_rays = 0;          ///< Rays of step 3 for `texels`.
+  std::vector<std::uint32_t> texels;    ///< Atlas texel indices, ascending.
+  std::vector<glm::vec3> indirect;      ///< Per texel of `texels`: steps 2-3's irradiance.
+  std::vector<glm::vec3> direct;        ///< Per texel of `texels`: TexelGatherResult::direct.
+  std::vector<glm::vec3> baked_direct;  ///< Per texel of `texels`: TexelGatherResult::baked_direct (unfiltered).
+  std::vector<std::uint8_t> hidden;     ///< Per texel of `texels`.
+  std::uint64_t shared_rays = 0;        ///< Rays of steps 1-2 (the same in every shard).
+  std::uint64_t own_rays = 0;           ///< Rays of step 3 for `texels`.
 };
 
 /// Shard `shard` of bake_light_atlas(input, settings) (a TexelGather final pass; the VPL

@@ -3,8 +3,8 @@
 #include <engine/image.h>
 
 #include <cmath>
-#include <nlohmann/json.hpp>
 #include <system_error>
+#include <nlohmann/json.hpp>
 
 #include "bundle/bundle.h"
 #include "io/json_fields.h"
@@ -19,14 +19,10 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 
 json settings_json(const LightAtlasSettings& s) {
-  return json{{"texels_per_metre", s.texels_per_metre},
-              {"vpl_count", s.vpl_count},
-              {"samples_per_vpl", s.samples_per_vpl},
-              {"bounces", s.bounces},
-              {"unshot_threshold", s.unshot_threshold},
-              {"area_light_samples", s.area_light_samples},
-              {"include_direct", s.include_direct},
-              {"seed", s.seed}};
+  return json{{"texels_per_metre", s.texels_per_metre}, {"vpl_count", s.vpl_count},
+              {"samples_per_vpl", s.samples_per_vpl},   {"bounces", s.bounces},
+              {"unshot_threshold", s.unshot_threshold}, {"area_light_samples", s.area_light_samples},
+              {"include_direct", s.include_direct},     {"seed", s.seed}};
 }
 
 // What direct light the atlas holds (light_atlas.h, LightAtlasBake::irradiance): "unlit" the
@@ -34,12 +30,8 @@ json settings_json(const LightAtlasSettings& s) {
 std::string direct_light_name(const LightAtlasSettings& s) { return s.include_direct ? "all" : "unlit"; }
 
 json stats_json(const LightAtlasStats& s) {
-  return json{{"vpls", s.vpls},
-              {"sample_points", s.sample_points},
-              {"light_points", s.light_points},
-              {"shots", s.shots},
-              {"valid_texels", s.valid_texels},
-              {"rays", s.rays}};
+  return json{{"vpls", s.vpls},   {"sample_points", s.sample_points}, {"light_points", s.light_points},
+              {"shots", s.shots}, {"valid_texels", s.valid_texels},   {"rays", s.rays}};
 }
 
 LightAtlasStats read_stats(JsonFields& f) {

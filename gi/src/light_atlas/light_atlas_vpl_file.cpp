@@ -89,10 +89,10 @@ engine::Result<LightAtlasVplFile> read_light_atlas_vpls(const std::filesystem::p
   std::uint64_t seed = 0;
   const bool complete = r.get_string(f.geometry_hash) && r.get(s.texels_per_metre) && r.get(vpl_count) &&
                         r.get(samples_per_vpl) && r.get(bounces) && r.get(s.unshot_threshold) &&
-                        r.get(area_light_samples) && r.get(include_direct) && r.get(seed) &&
-                        r.get_array(v.position) && r.get_array(v.normal) && r.get_array(v.albedo) &&
-                        r.get_array(v.area_m2) && r.get_array(v.sample_first) && r.get_array(v.sample_position) &&
-                        r.get_array(v.sample_normal) && r.get_array(v.sample_area_m2) && r.get_array(f.vpl_power);
+                        r.get(area_light_samples) && r.get(include_direct) && r.get(seed) && r.get_array(v.position) &&
+                        r.get_array(v.normal) && r.get_array(v.albedo) && r.get_array(v.area_m2) &&
+                        r.get_array(v.sample_first) && r.get_array(v.sample_position) && r.get_array(v.sample_normal) &&
+                        r.get_array(v.sample_area_m2) && r.get_array(f.vpl_power);
   const std::string location = "payload byte " + std::to_string(r.offset());
   if (!complete) return engine::Error{path.string(), location, "truncated payload"};
   if (r.remaining() != 0) return engine::Error{path.string(), location, "unexpected data after the last field"};

@@ -67,9 +67,9 @@ engine::Status validate(const TexelGatherSettings& s) {
 // What the gather knows of every texel of the atlas.
 struct TexelTable {
   int width = 0, height = 0;
-  std::vector<std::uint32_t> work;  // valid texels in index order
-  std::vector<glm::vec3> albedo;    // per atlas texel: hemispherical albedo of its material
-  std::vector<glm::vec3> face;      // per atlas texel: unit geometric normal on the shading side
+  std::vector<std::uint32_t> work;      // valid texels in index order
+  std::vector<glm::vec3> albedo;        // per atlas texel: hemispherical albedo of its material
+  std::vector<glm::vec3> face;          // per atlas texel: unit geometric normal on the shading side
   std::vector<std::uint32_t> redirect;  // per atlas texel: itself when valid, else a valid neighbour or kDark
 };
 
@@ -107,8 +107,9 @@ engine::Result<TexelTable> texel_table(const StaticBakeScene& b, const AtlasLayo
     }
     auto it = albedo_of.find(tri.material);
     if (it == albedo_of.end())
-      it = albedo_of.emplace(tri.material, engine::gltf_hemispherical_albedo(b.scene.materials[tri.material].brdf).sum())
-               .first;
+      it =
+          albedo_of.emplace(tri.material, engine::gltf_hemispherical_albedo(b.scene.materials[tri.material].brdf).sum())
+              .first;
     t.albedo[i] = it->second;
     t.face[i] = glm::dot(tri.face_normal, tx.normal[i]) < 0.0f ? -tri.face_normal : tri.face_normal;
   }
@@ -256,7 +257,8 @@ DirectAt direct_at(const StaticBakeScene& b, const glm::vec3& p, const glm::vec3
     ++*rays;
     if (b.caster->occluded(Ray{origin, 0.0f, q - origin, 0.9999f})) continue;
     const glm::vec3 emission = emission_at(b.scene, tri, glm::vec2(su * (1.0f - u.y), su * u.y), 0.0f);
-    (em.stands_for_light[pick] != 0 ? sum : unlit) += glm::dvec3(emission * (cos_r * cos_l * tri.area_m2 / (prob * d2))) * inv;
+    (em.stands_for_light[pick] != 0 ? sum : unlit) +=
+        glm::dvec3(emission * (cos_r * cos_l * tri.area_m2 / (prob * d2))) * inv;
   }
   return {glm::vec3(sum), glm::vec3(unlit)};
 }
@@ -576,8 +578,8 @@ engine::Result<TexelGatherResult> gather_atlas(const StaticBakeScene& b, const A
   return out;
 }
 
-engine::Result<std::vector<glm::vec3>> sky_direct_light(const StaticBakeScene& b, const AtlasLayout& layout,
-                                                        int rays, std::uint64_t seed, ThreadPool& pool) {
+engine::Result<std::vector<glm::vec3>> sky_direct_light(const StaticBakeScene& b, const AtlasLayout& layout, int rays,
+                                                        std::uint64_t seed, ThreadPool& pool) {
   if (rays < 1) return engine::invalid_request("the sky's direct light: rays must be >= 1");
   auto table = texel_table(b, layout);
   if (!table) return table.error();
@@ -606,7 +608,6 @@ engine::Status filter_gathered(const StaticBakeScene& b, const AtlasLayout& layo
   out.filter_seconds = seconds_since(t0);
   return {};
 }
-
 
 std::vector<glm::vec3> irradiance_at_points(const AtlasTexels& texels, const std::vector<glm::vec3>& irradiance,
                                             float texels_per_metre, std::span<const glm::vec3> points,

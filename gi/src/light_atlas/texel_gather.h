@@ -34,8 +34,8 @@
 
 #include <cstdint>
 #include <span>
-#include <glm/glm.hpp>
 #include <vector>
+#include <glm/glm.hpp>
 
 #include "core/thread_pool.h"
 #include "core/work_shard.h"
@@ -45,13 +45,13 @@
 namespace gi {
 
 struct TexelGatherSettings {
-  int direct_samples = 16;           ///< Samples per texel on each area light and on the emitters (>= 1).
-  int solve_rays = 64;               ///< Kept rays per texel, iterated for all bounces (>= 1).
-  int gather_rays = 128;             ///< Fresh final-gather rays per texel (0: the solve alone).
-  int bounces = 64;                  ///< Most iterations of the kept-ray solve (indirect bounces).
-  float filter_radius_texels = 0.0f; ///< World-space filter radius in texels (0: none).
+  int direct_samples = 16;            ///< Samples per texel on each area light and on the emitters (>= 1).
+  int solve_rays = 64;                ///< Kept rays per texel, iterated for all bounces (>= 1).
+  int gather_rays = 128;              ///< Fresh final-gather rays per texel (0: the solve alone).
+  int bounces = 64;                   ///< Most iterations of the kept-ray solve (indirect bounces).
+  float filter_radius_texels = 0.0f;  ///< World-space filter radius in texels (0: none).
   std::uint64_t seed = 1;
-  ProgressCallback progress;         ///< Fraction done in [0, 1]; return false to cancel.
+  ProgressCallback progress;  ///< Fraction done in [0, 1]; return false to cancel.
   /// A distributed bake's shard (docs/distributed-bake.md): steps 1-2 run for every texel
   /// (every shard repeats them, bit for bit), step 3 only for the shard's texel blocks
   /// (the others stay 0), and with `part_only` step 4 not at all (filter_gathered runs it
@@ -70,10 +70,10 @@ struct TexelGatherResult {
   /// light stands for (step 1). Filtered in step 4 as `indirect` is.
   std::vector<glm::vec3> baked_direct;
   std::uint64_t rays = 0;
-  std::uint64_t shared_rays = 0;  ///< Of `rays`: steps 1-2 (every texel, in every shard).
-  std::uint64_t own_rays = 0;     ///< Of `rays`: step 3 for the shard's texels.
+  std::uint64_t shared_rays = 0;     ///< Of `rays`: steps 1-2 (every texel, in every shard).
+  std::uint64_t own_rays = 0;        ///< Of `rays`: step 3 for the shard's texels.
   std::vector<std::uint8_t> hidden;  ///< Per texel: seen from behind geometry; the filter skips it.
-  int iterations = 0;  ///< Bounces the solve ran.
+  int iterations = 0;                ///< Bounces the solve ran.
   double direct_seconds = 0.0, solve_seconds = 0.0, gather_seconds = 0.0, filter_seconds = 0.0;
 };
 

@@ -85,7 +85,7 @@ std::pair<float, std::string> min_roughness(const BakeInput& input, const BakeIn
 struct PlanFacts {
   std::vector<std::string> static_lights, moving_lights, moving_why;
   std::vector<std::string> static_meshes, emissive_meshes, glossy, glossy_why, deforming;
-  std::vector<std::size_t> glossy_instances;  // indices into BakeInput::instances
+  std::vector<std::size_t> glossy_instances;                          // indices into BakeInput::instances
   std::map<std::uint32_t, std::vector<std::string>> dynamic_by_mesh;  // mesh -> instances
   LightPointCount points;
   StaticSurfaceCensus census;
@@ -194,7 +194,8 @@ void plan_light_atlas(const PlanFacts& f, const std::optional<PlanPresets>& p, P
   if (f.static_lights.empty() && f.emissive_meshes.empty()) {
     atlas.reason = "the sky lights " + meshes + " (" + area + ")";
   } else if (f.static_lights.empty()) {
-    atlas.reason = emitting + (f.emissive_meshes.size() == 1 ? " lights " : " light ") + meshes + " (" + area + sky + ")";
+    atlas.reason =
+        emitting + (f.emissive_meshes.size() == 1 ? " lights " : " light ") + meshes + " (" + area + sky + ")";
   } else {
     atlas.reason = plural(f.static_lights.size(), "static light", "static lights") +
                    (f.static_lights.size() == 1 ? " lights " : " light ") + meshes + " (" + area +
@@ -204,15 +205,15 @@ void plan_light_atlas(const PlanFacts& f, const std::optional<PlanPresets>& p, P
   if (!p) return;
   const BakeWork w = light_atlas_work(f.census, p->atlas, f.points);
   const AtlasTexelEstimate t = atlas_texels(f.census, p->atlas.texels_per_metre);
-  atlas.estimate = {w.bake_seconds, w.runtime_bytes, static_cast<std::uint64_t>(t.lit_texels),
-                    fixed(f.census.area_m2, 1) + " m^2 x " + fixed(p->atlas.texels_per_metre, 0) +
-                        "^2 texels/m^2 -> ~" + std::to_string(static_cast<long long>(t.lit_texels)) +
-                        " texels (atlas " + std::to_string(t.width) + "x" + std::to_string(t.height) + ") x " +
-                        (p->atlas.final_pass == LightAtlasSettings::FinalPass::TexelGather
-                             ? std::to_string(p->atlas.gather.solve_rays) + " kept + " +
-                                   std::to_string(p->atlas.gather.gather_rays) + " gather rays"
-                             : std::to_string(p->atlas.vpl_count) + " VPLs, " + std::to_string(p->atlas.bounces) +
-                                   " bounces")};
+  atlas.estimate = {
+      w.bake_seconds, w.runtime_bytes, static_cast<std::uint64_t>(t.lit_texels),
+      fixed(f.census.area_m2, 1) + " m^2 x " + fixed(p->atlas.texels_per_metre, 0) + "^2 texels/m^2 -> ~" +
+          std::to_string(static_cast<long long>(t.lit_texels)) + " texels (atlas " + std::to_string(t.width) + "x" +
+          std::to_string(t.height) + ") x " +
+          (p->atlas.final_pass == LightAtlasSettings::FinalPass::TexelGather
+               ? std::to_string(p->atlas.gather.solve_rays) + " kept + " + std::to_string(p->atlas.gather.gather_rays) +
+                     " gather rays"
+               : std::to_string(p->atlas.vpl_count) + " VPLs, " + std::to_string(p->atlas.bounces) + " bounces")};
 }
 
 // PRM: moving lights over static geometry.
@@ -263,12 +264,12 @@ void plan_dlm(const BakeInput& input, const PlanFacts& f, const PlanOptions& opt
   for (std::size_t i : f.glossy_instances) glossy_only.instances.push_back(input.instances[i]);
   const StaticSurfaceCensus glossy = census_static_surfaces(glossy_only);
   double texels = 0.0, per_texel = 0.0;
-  const BakeWork w = dlm_work(glossy, f.census.albedo, atlas_texels(f.census, p->dlm.texels_per_metre), p->dlm,
-                              &texels, &per_texel);
+  const BakeWork w =
+      dlm_work(glossy, f.census.albedo, atlas_texels(f.census, p->dlm.texels_per_metre), p->dlm, &texels, &per_texel);
   dlm.estimate = {w.bake_seconds, w.runtime_bytes, static_cast<std::uint64_t>(texels),
                   fixed(glossy.area_m2, 1) + " m^2 glossy -> ~" + std::to_string(static_cast<long long>(texels)) +
-                      " texels x " + std::to_string(p->dlm.directions) + " directions x 8 B = " +
-                      format_bytes(static_cast<std::uint64_t>(per_texel)) + " per texel; " +
+                      " texels x " + std::to_string(p->dlm.directions) +
+                      " directions x 8 B = " + format_bytes(static_cast<std::uint64_t>(per_texel)) + " per texel; " +
                       std::to_string(p->dlm.photons) + " photons"};
 }
 

@@ -177,8 +177,8 @@ BakeWork dlm_work(const StaticSurfaceCensus& glossy, double albedo, const AtlasT
   const double texels = t.lit_texels + (t.pane_texels - t.lit_texels) / (2.0 * kPaneRings);
   if (stored_texels) *stored_texels = texels;
   if (bytes_per_texel) *bytes_per_texel = per_texel;
-  w.runtime_bytes = static_cast<std::uint64_t>(texels * per_texel +
-                                               4.0 * static_cast<double>(atlas.width) * atlas.height);
+  w.runtime_bytes =
+      static_cast<std::uint64_t>(texels * per_texel + 4.0 * static_cast<double>(atlas.width) * atlas.height);
   return w;
 }
 

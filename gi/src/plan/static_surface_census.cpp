@@ -2,9 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <glm/glm.hpp>
 #include <numeric>
 #include <unordered_map>
+#include <glm/glm.hpp>
 
 namespace gi {
 

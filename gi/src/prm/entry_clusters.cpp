@@ -12,20 +12,26 @@ using Point6 = std::array<float, 6>;
 
 float distance2(const Point6& a, const Point6& b) {
   float d = 0.0f;
-  for (int i = 0; i < 6; ++i) d += (a[static_cast<std::size_t>(i)] - b[static_cast<std::size_t>(i)]) *
-                                   (a[static_cast<std::size_t>(i)] - b[static_cast<std::size_t>(i)]);
+  for (int i = 0; i < 6; ++i)
+    d += (a[static_cast<std::size_t>(i)] - b[static_cast<std::size_t>(i)]) *
+         (a[static_cast<std::size_t>(i)] - b[static_cast<std::size_t>(i)]);
   return d;
 }
 
 }  // namespace
 
-std::vector<std::uint32_t> cluster_entry_points(std::span<const glm::vec3> positions, std::span<const glm::vec3> normals,
-                                                int clusters, float normal_scale_m, int kmeans_iterations) {
+std::vector<std::uint32_t> cluster_entry_points(std::span<const glm::vec3> positions,
+                                                std::span<const glm::vec3> normals, int clusters, float normal_scale_m,
+                                                int kmeans_iterations) {
   const std::size_t n = positions.size();
   std::vector<Point6> pts(n);
   for (std::size_t i = 0; i < n; ++i)
-    pts[i] = {positions[i].x, positions[i].y, positions[i].z, normals[i].x * normal_scale_m,
-              normals[i].y * normal_scale_m, normals[i].z * normal_scale_m};
+    pts[i] = {positions[i].x,
+              positions[i].y,
+              positions[i].z,
+              normals[i].x * normal_scale_m,
+              normals[i].y * normal_scale_m,
+              normals[i].z * normal_scale_m};
 
   // Median-split kd-tree: leaves are index lists; split the largest until there are enough.
   std::vector<std::vector<std::uint32_t>> leaves(1);
@@ -42,7 +48,8 @@ std::vector<std::uint32_t> cluster_entry_points(std::span<const glm::vec3> posit
     float widest = -1.0f;
     for (int a = 0; a < 6; ++a) {
       float lo = std::numeric_limits<float>::infinity(), hi = -lo;
-      for (std::uint32_t i : leaf) lo = std::min(lo, pts[i][static_cast<std::size_t>(a)]), hi = std::max(hi, pts[i][static_cast<std::size_t>(a)]);
+      for (std::uint32_t i : leaf)
+        lo = std::min(lo, pts[i][static_cast<std::size_t>(a)]), hi = std::max(hi, pts[i][static_cast<std::size_t>(a)]);
       if (hi - lo > widest) widest = hi - lo, axis = a;
     }
     const auto ax = static_cast<std::size_t>(axis);

@@ -17,7 +17,8 @@ namespace gi {
 /// scaled by `normal_scale_m` (metres per unit of normal difference). Deterministic: the
 /// leaf with most members is split next (ties: lowest index), along its widest dimension,
 /// at the median (ties by index). Preconditions: positions.size() == normals.size(), clusters >= 1.
-std::vector<std::uint32_t> cluster_entry_points(std::span<const glm::vec3> positions, std::span<const glm::vec3> normals,
-                                                int clusters, float normal_scale_m, int kmeans_iterations = 0);
+std::vector<std::uint32_t> cluster_entry_points(std::span<const glm::vec3> positions,
+                                                std::span<const glm::vec3> normals, int clusters, float normal_scale_m,
+                                                int kmeans_iterations = 0);
 
 }  // namespace gi

@@ -85,9 +85,10 @@ std::vector<PathNode> random_walks(const VplSet& entries, std::size_t k, const S
       // Textured: the material lookup at the hit, for the ray cone of a bounce ray (the
       // path tracer's bounce spread, path_tracer.h).
       const ShadingTriangle& st = s.index.triangles[tri];
-      const glm::vec3 albedo = s.scene.materials[st.material].textured()
-                                   ? albedo_at(s.scene, st, hit.barycentric, hit.t * PathTracerSettings{}.bounce_spread_rad)
-                                   : triangle_albedo[tri];
+      const glm::vec3 albedo =
+          s.scene.materials[st.material].textured()
+              ? albedo_at(s.scene, st, hit.barycentric, hit.t * PathTracerSettings{}.bounce_spread_rad)
+              : triangle_albedo[tri];
       const float q = std::min(1.0f, max_component(albedo));
       if (!(u_rr < q)) break;
       position = s.index.triangles[tri].p0 + hit.barycentric.x * s.index.triangles[tri].e1 +

@@ -16,9 +16,9 @@
 #include <gi/progress.h>
 
 #include <cstdint>
-#include <glm/glm.hpp>
 #include <string_view>
 #include <vector>
+#include <glm/glm.hpp>
 
 #include "core/work_shard.h"
 #include "uv/atlas_layout.h"

@@ -18,8 +18,8 @@ namespace {
 
 constexpr const char* kWhere = "PRM GPU pass";
 constexpr std::size_t kSsboLimitBytes = std::size_t{128} << 20;  // DESIGN.md §4 (llvmpipe): per buffer
-constexpr std::uint32_t kGroupSize = 64;  // local_size_x of prm_sum.comp.glsl
-constexpr std::size_t kBlock = 8;         // elements an invocation sums (per pane three uvec4s of halves or two of RGB9E5)
+constexpr std::uint32_t kGroupSize = 64;                         // local_size_x of prm_sum.comp.glsl
+constexpr std::size_t kBlock = 8;  // elements an invocation sums (per pane three uvec4s of halves or two of RGB9E5)
 constexpr std::uint32_t kMaxGroupsPerDimension = 65535;
 
 /// The weight of one selected cluster as prm_sum.comp.glsl reads it (std430 PaneWeight).
@@ -81,7 +81,8 @@ std::uint32_t encode_rgb9e5(float r, float g, float b) {
 
 glm::vec3 decode_rgb9e5(std::uint32_t w) {
   const float scale = std::ldexp(1.0f, static_cast<int>(w >> 27) - kMantissaShift);
-  return glm::vec3(static_cast<float>(w & 511u), static_cast<float>(w >> 9 & 511u), static_cast<float>(w >> 18 & 511u)) *
+  return glm::vec3(static_cast<float>(w & 511u), static_cast<float>(w >> 9 & 511u),
+                   static_cast<float>(w >> 18 & 511u)) *
          scale;
 }
 
@@ -152,7 +153,8 @@ engine::Result<PrmGpuPass> PrmGpuPass::create(const Prm& prm, const PrmGpuPassOp
   }
   if (prm.cluster_count < 0) return error("negative cluster count");
   const auto clusters = static_cast<std::size_t>(prm.cluster_count);
-  if (prm.panes.size() / 3 / std::max<std::size_t>(elements, 1) != clusters || prm.panes.size() != clusters * elements * 3)
+  if (prm.panes.size() / 3 / std::max<std::size_t>(elements, 1) != clusters ||
+      prm.panes.size() != clusters * elements * 3)
     return error("panes hold " + std::to_string(prm.panes.size()) + " floats, expected " + std::to_string(clusters) +
                  " clusters x " + std::to_string(elements) + " texels x 3");
   if (auto bad = check_pane_values(prm, options.encoding)) return *bad;
@@ -176,8 +178,8 @@ engine::Result<PrmGpuPass> PrmGpuPass::create(const Prm& prm, const PrmGpuPassOp
   pass.height_ = prm.height;
   pass.element_count_ = static_cast<std::uint32_t>(elements);
   pass.decode_scale_ = options.encoding == PrmPaneEncoding::Half ? 1.0f : std::ldexp(1.0f, -kMantissaShift);
-  pass.max_groups_x_ = options.max_groups_x > 0 ? std::min(options.max_groups_x, kMaxGroupsPerDimension)
-                                                : kMaxGroupsPerDimension;
+  pass.max_groups_x_ =
+      options.max_groups_x > 0 ? std::min(options.max_groups_x, kMaxGroupsPerDimension) : kMaxGroupsPerDimension;
 
   engine::ShaderProgramBuilder builder(gi_shader_files());
   builder.stage(engine::ShaderStage::Compute, "prm_sum.comp.glsl");
@@ -225,7 +227,8 @@ engine::Result<PrmGpuPass> PrmGpuPass::create(const Prm& prm, const PrmGpuPassOp
     const auto w = static_cast<std::uint32_t>(prm.width);
     t = (t % w) | ((t / w) << 16);
   }
-  texels.resize(std::max<std::size_t>((elements + kBlock - 1) / kBlock * kBlock, kBlock), 0u);  // whole blocks; never empty
+  texels.resize(std::max<std::size_t>((elements + kBlock - 1) / kBlock * kBlock, kBlock),
+                0u);  // whole blocks; never empty
   pass.texels_ = engine::GlBuffer::create(texels.size() * sizeof(std::uint32_t), texels.data());
   pass.texels_texture_ = engine::GlTexture::create(GL_TEXTURE_BUFFER);
   glTextureBuffer(pass.texels_texture_.id(), GL_RGBA32UI, pass.texels_.id());
@@ -240,8 +243,8 @@ engine::Result<PrmGpuPass> PrmGpuPass::create(const Prm& prm, const PrmGpuPassOp
   glTextureParameteri(pass.output_.id(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
   glTextureParameteri(pass.output_.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
   if (glGetError() == GL_OUT_OF_MEMORY)
-    return error("out of GPU memory uploading " + std::to_string(clusters) + " panes of " +
-                 std::to_string(elements) + " texels");
+    return error("out of GPU memory uploading " + std::to_string(clusters) + " panes of " + std::to_string(elements) +
+                 " texels");
   return pass;
 }
 
@@ -357,8 +360,9 @@ std::size_t PrmGpuPass::pane_bytes() const {
 
 std::size_t PrmGpuPass::gpu_bytes() const {
   const std::size_t atlas_bytes = static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_) * 16;
-  std::size_t bytes = std::max<std::size_t>((element_count_ + kBlock - 1) / kBlock * kBlock, kBlock) * sizeof(std::uint32_t) +
-                      weights_bytes_;
+  std::size_t bytes =
+      std::max<std::size_t>((element_count_ + kBlock - 1) / kBlock * kBlock, kBlock) * sizeof(std::uint32_t) +
+      weights_bytes_;
   for (std::size_t b : pane_buffer_bytes_) bytes += b;
   if (!output_.empty()) bytes += atlas_bytes;
   if (!base_.empty()) bytes += atlas_bytes;

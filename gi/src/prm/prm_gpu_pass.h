@@ -137,7 +137,7 @@ class PrmGpuPass {
   engine::GlTexture texels_texture_;   ///< texels_ as an RGBA32UI buffer texture.
   engine::GlTexture weights_texture_;  ///< weights_ as an RGBA32UI buffer texture.
   std::size_t max_weights_ = 0;        ///< Weights one run can upload (the buffer limit).
-  std::size_t weights_bytes_ = 0;  ///< Size of the last weight upload.
+  std::size_t weights_bytes_ = 0;      ///< Size of the last weight upload.
   engine::GlTexture output_;
   engine::GlTexture base_;
   int width_ = 0;

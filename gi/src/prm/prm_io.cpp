@@ -7,12 +7,12 @@
 #include <bit>
 #include <cmath>
 #include <limits>
-#include <nlohmann/json.hpp>
 #include <span>
 #include <system_error>
+#include <nlohmann/json.hpp>
 
-#include "core/half_scale.h"
 #include "bundle/bundle.h"
+#include "core/half_scale.h"
 #include "io/json_fields.h"
 #include "io/zstd_stream.h"
 #include "uv/atlas_input.h"
@@ -85,7 +85,6 @@ std::string check_prm(const Prm& p) {
   return {};
 }
 
-
 bool is_power_of_two(float s) {
   int e = 0;
   return std::isfinite(s) && s > 0.0f && std::frexp(s, &e) == 0.5f;
@@ -105,11 +104,7 @@ json settings_json(const PrmSettings& s) {
               {"seed", s.seed}};
 }
 
-json stats_json(const PrmStats& s) {
-  return json{{"paths", s.paths},
-              {"path_nodes", s.path_nodes},
-              {"rays", s.rays}};
-}
+json stats_json(const PrmStats& s) { return json{{"paths", s.paths}, {"path_nodes", s.path_nodes}, {"rays", s.rays}}; }
 
 // What the manifest entry says about the file, the layout and the sizes.
 struct EntryInfo {
@@ -220,7 +215,8 @@ engine::Status write_prm_panes(const fs::path& path, const Prm& prm, const std::
     return file_error(path, "", "cannot save the PRM: " + problem);
 
   auto packed = write_zstd_stream(
-      path, std::span<const std::uint8_t>(reinterpret_cast<const std::uint8_t*>(planes.data()), planes.size()), kZstdLevel);
+      path, std::span<const std::uint8_t>(reinterpret_cast<const std::uint8_t*>(planes.data()), planes.size()),
+      kZstdLevel);
   if (!packed) return packed.error();
   const std::vector<std::uint8_t>& frame = *packed;
 
@@ -274,10 +270,10 @@ engine::Result<PrmPaneFile> read_prm_panes(const fs::path& path) {
   std::vector<std::uint8_t> frame;
   const bool complete = r.get_string(f.geometry_hash) && r.get(s.texels_per_metre) && r.get(entry_points) &&
                         r.get(clusters) && r.get(s.splitting) && r.get(max_path_nodes) && r.get(kmeans) &&
-                        r.get(seed) && r.get(width) && r.get(height) && r.get(cluster_count) &&
-                        r.get_array(p.texels) && r.get_array(position) && r.get_array(normal) && r.get_array(area) &&
-                        r.get_array(cluster) && r.get_array(p.cluster_size) && r.get_array(scales) &&
-                        r.get(pane_half_bytes) && r.get_array(frame);
+                        r.get(seed) && r.get(width) && r.get(height) && r.get(cluster_count) && r.get_array(p.texels) &&
+                        r.get_array(position) && r.get_array(normal) && r.get_array(area) && r.get_array(cluster) &&
+                        r.get_array(p.cluster_size) && r.get_array(scales) && r.get(pane_half_bytes) &&
+                        r.get_array(frame);
   const std::string location = "payload byte " + std::to_string(r.offset());
   if (!complete) return file_error(path, location, "truncated payload");
   if (r.remaining() != 0) return file_error(path, location, "unexpected data after the last field");

@@ -69,7 +69,8 @@ std::vector<glm::vec3> entry_irradiance(const Prm& prm, std::span<const PointEmi
       // what the light sends onto the scene (point_emitters.h). A light touching a surface
       // puts its flux between the entry points: then the traced hits are deposited instead.
       std::vector<LitDirection> hits;
-      const double traced = static_cast<double>(luminance(l.radiant)) * punctual_lit_solid_angle(l, caster, kFluxSide, &hits, pool);
+      const double traced =
+          static_cast<double>(luminance(l.radiant)) * punctual_lit_solid_angle(l, caster, kFluxSide, &hits, pool);
       if (sampled > 0.25 * traced) {
         const auto scale = static_cast<float>(std::clamp(traced / sampled, 0.25, 4.0));
         for (glm::vec3& v : one) v *= scale;
@@ -112,7 +113,8 @@ std::vector<ClusterWeight> relight_clusters(const Prm& prm, std::span<const Refe
 }
 
 std::vector<glm::vec3> sum_panes(const Prm& prm, std::span<const ClusterWeight> selected) {
-  std::vector<glm::vec3> out(static_cast<std::size_t>(prm.width) * static_cast<std::size_t>(prm.height), glm::vec3(0.0f));
+  std::vector<glm::vec3> out(static_cast<std::size_t>(prm.width) * static_cast<std::size_t>(prm.height),
+                             glm::vec3(0.0f));
   const std::size_t n = prm.pane_size();
   for (const ClusterWeight& cw : selected) {
     const float* pane = prm.panes.data() + static_cast<std::size_t>(cw.cluster) * n * 3;

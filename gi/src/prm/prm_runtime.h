@@ -13,9 +13,9 @@
 
 #include <glm/glm.hpp>
 
-#include "transport/point_emitters.h"
 #include "prm/prm.h"
 #include "raytrace/ray_caster.h"
+#include "transport/point_emitters.h"
 
 namespace gi {
 

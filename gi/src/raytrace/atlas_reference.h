@@ -11,8 +11,8 @@
 #include <gi/reference.h>
 
 #include <cstdint>
-#include <glm/glm.hpp>
 #include <vector>
+#include <glm/glm.hpp>
 
 #include "uv/atlas_rasterizer.h"
 
@@ -25,7 +25,7 @@ struct AtlasIrradiance {
   std::vector<glm::vec3> direct;
   std::vector<glm::vec3> indirect;
   std::vector<glm::vec3> total;
-  std::vector<std::uint8_t> valid;  ///< Texels a triangle covers (the others hold dilated values or 0).
+  std::vector<std::uint8_t> valid;           ///< Texels a triangle covers (the others hold dilated values or 0).
   std::vector<glm::vec3> indirect_variance;  ///< Sampling variance of `indirect` (0 off the valid texels).
 };
 

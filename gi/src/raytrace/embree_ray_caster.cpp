@@ -123,9 +123,11 @@ class EmbreeRayCaster final : public RayCaster {
         // gather's time on the demo level went there).
         std::vector<glm::vec3>& normals = static_normals_.emplace_back();
         normals.resize(geo.indices.size() / 3);
-        for (std::size_t t = 0; t < normals.size(); ++t) normals[t] = world_normal(inst, geo, static_cast<std::uint32_t>(t));
+        for (std::size_t t = 0; t < normals.size(); ++t)
+          normals[t] = world_normal(inst, geo, static_cast<std::uint32_t>(t));
       }
-      static_normal_of_.push_back(inst.dynamic ? kNoStaticNormals : static_cast<std::uint32_t>(static_normals_.size() - 1));
+      static_normal_of_.push_back(inst.dynamic ? kNoStaticNormals
+                                               : static_cast<std::uint32_t>(static_normals_.size() - 1));
       GI_EXPECTS(id == i, "Embree geometry ids follow instance order");
     }
     rtcCommitScene(top_.h);
@@ -303,7 +305,8 @@ class EmbreeRayCaster final : public RayCaster {
     // The geometric normal from the world-space triangle (independent of Embree's
     // instance-space conventions).
     const std::uint32_t s = static_normal_of_[inst];
-    h.geometric_normal = s != kNoStaticNormals ? static_normals_[s][h.primitive] : world_normal(instance, geo, h.primitive);
+    h.geometric_normal =
+        s != kNoStaticNormals ? static_normals_[s][h.primitive] : world_normal(instance, geo, h.primitive);
     return h;
   }
 
@@ -317,7 +320,7 @@ class EmbreeRayCaster final : public RayCaster {
 
   static constexpr std::uint32_t kNoStaticNormals = 0xffffffffu;
   std::vector<std::vector<glm::vec3>> static_normals_;  ///< Per static instance (in instance order).
-  std::vector<std::uint32_t> static_normal_of_;         ///< Per instance: index into static_normals_, or kNoStaticNormals.
+  std::vector<std::uint32_t> static_normal_of_;  ///< Per instance: index into static_normals_, or kNoStaticNormals.
 
   RtSceneData data_;
   std::string embree_message_;  // declared before the device, which may call back until released

@@ -107,7 +107,6 @@ int wrap_texel(int i, int n, engine::TextureWrap mode) {
   }
 }
 
-
 float srgb_to_linear(std::uint8_t v) { return srgb_table()[v]; }
 
 TextureMips build_texture_mips(const BakeImage& image, bool srgb) {

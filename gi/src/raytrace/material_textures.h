@@ -11,8 +11,8 @@
 #include <gi/bake_input.h>
 
 #include <cstdint>
-#include <glm/glm.hpp>
 #include <vector>
+#include <glm/glm.hpp>
 
 namespace gi {
 

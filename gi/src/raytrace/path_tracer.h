@@ -18,9 +18,9 @@
 namespace gi {
 
 struct PathTracerSettings {
-  int max_bounces = -1;           ///< Indirect bounces; -1: unlimited; 0: direct only.
-  int russian_roulette_start = 3; ///< Path vertex from which Russian roulette applies.
-  int max_vertices = 1024;        ///< Safety stop (with albedo <= 0.95 the cut energy is < 1e-22).
+  int max_bounces = -1;            ///< Indirect bounces; -1: unlimited; 0: direct only.
+  int russian_roulette_start = 3;  ///< Path vertex from which Russian roulette applies.
+  int max_vertices = 1024;         ///< Safety stop (with albedo <= 0.95 the cut energy is < 1e-22).
   /// Ray cones for texture lookups (material_lookup.h): a path's footprint at a hit is the
   /// sum over its segments of length x spread, the spread starting at camera_spread_rad
   /// (0: camera rays read the finest mip level; many samples per pixel average the texture)

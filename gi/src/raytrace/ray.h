@@ -19,11 +19,11 @@ inline constexpr std::uint32_t kNoHit = 0xffffffffu;
 
 struct Hit {
   float t = std::numeric_limits<float>::infinity();
-  std::uint32_t geometry = kNoHit;  ///< Index into RtSceneData::geometries.
-  std::uint32_t instance = kNoHit;  ///< Index into RtSceneData::instances.
-  std::uint32_t primitive = kNoHit; ///< Triangle index within the geometry.
-  glm::vec2 barycentric{0.0f};      ///< (u, v): p = (1-u-v) p0 + u p1 + v p2.
-  glm::vec3 geometric_normal{0.0f}; ///< Unnormalized, world space, from the triangle winding.
+  std::uint32_t geometry = kNoHit;   ///< Index into RtSceneData::geometries.
+  std::uint32_t instance = kNoHit;   ///< Index into RtSceneData::instances.
+  std::uint32_t primitive = kNoHit;  ///< Triangle index within the geometry.
+  glm::vec2 barycentric{0.0f};       ///< (u, v): p = (1-u-v) p0 + u p1 + v p2.
+  glm::vec3 geometric_normal{0.0f};  ///< Unnormalized, world space, from the triangle winding.
 
   bool valid() const { return geometry != kNoHit; }
 };

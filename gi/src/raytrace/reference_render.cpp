@@ -104,27 +104,27 @@ engine::Result<engine::ImageRgbaF> render_reference(const ReferenceScene& scene,
   image.height = camera.height;
   image.pixels.assign(static_cast<std::size_t>(camera.width) * static_cast<std::size_t>(camera.height) * 4, 1.0f);
   // A whole image needs no item list (16384^2 pixels would be 2 GB of indices).
-  const std::vector<std::size_t> items = shard.whole() ? std::vector<std::size_t>{} : shard.items(image.pixels.size() / 4);
+  const std::vector<std::size_t> items =
+      shard.whole() ? std::vector<std::size_t>{} : shard.items(image.pixels.size() / 4);
   const std::size_t count = shard.whole() ? image.pixels.size() / 4 : items.size();
   if (!shard.whole())
     for (std::size_t i = 0; i < image.pixels.size(); ++i)
       if (i % 4 != 3) image.pixels[i] = 0.0f;
   ThreadPool pool(settings.threads);
-  const bool completed =
-      pool.parallel_for_with_progress(count, settings.progress, [&](std::size_t k) {
-        const std::size_t i = shard.whole() ? k : items[k];
-        const int x = static_cast<int>(i % static_cast<std::size_t>(camera.width));
-        const int y = static_cast<int>(i / static_cast<std::size_t>(camera.width));
-        Pcg32 rng = Pcg32::for_item(settings.seed, i);
-        glm::dvec3 sum(0.0);
-        for (int s = 0; s < settings.samples_per_pixel; ++s) {
-          const float jx = settings.jitter_pixels ? rng.next_float() : 0.5f;
-          const float jy = settings.jitter_pixels ? rng.next_float() : 0.5f;
-          sum += glm::dvec3(finite_or_zero(tracer.radiance(Ray{rays.eye, 0.0f, rays.direction(x, y, jx, jy)}, rng)));
-        }
-        const glm::dvec3 mean = sum / static_cast<double>(settings.samples_per_pixel);
-        for (int c = 0; c < 3; ++c) image.pixels[4 * i + static_cast<std::size_t>(c)] = static_cast<float>(mean[c]);
-      });
+  const bool completed = pool.parallel_for_with_progress(count, settings.progress, [&](std::size_t k) {
+    const std::size_t i = shard.whole() ? k : items[k];
+    const int x = static_cast<int>(i % static_cast<std::size_t>(camera.width));
+    const int y = static_cast<int>(i / static_cast<std::size_t>(camera.width));
+    Pcg32 rng = Pcg32::for_item(settings.seed, i);
+    glm::dvec3 sum(0.0);
+    for (int s = 0; s < settings.samples_per_pixel; ++s) {
+      const float jx = settings.jitter_pixels ? rng.next_float() : 0.5f;
+      const float jy = settings.jitter_pixels ? rng.next_float() : 0.5f;
+      sum += glm::dvec3(finite_or_zero(tracer.radiance(Ray{rays.eye, 0.0f, rays.direction(x, y, jx, jy)}, rng)));
+    }
+    const glm::dvec3 mean = sum / static_cast<double>(settings.samples_per_pixel);
+    for (int c = 0; c < 3; ++c) image.pixels[4 * i + static_cast<std::size_t>(c)] = static_cast<float>(mean[c]);
+  });
   if (!completed) return engine::cancelled_error("reference render");
   return image;
 }

@@ -39,7 +39,8 @@ engine::Result<FirstHitImage> first_hits(const ReferenceScene& scene, const Pinh
                                          unsigned threads = 0);
 
 /// `shard`: only the points of the shard's blocks of 64 are estimated (the others stay 0).
-engine::Result<IrradianceEstimate> estimate_irradiance(const ReferenceScene& scene, std::span<const SurfacePoint> points,
+engine::Result<IrradianceEstimate> estimate_irradiance(const ReferenceScene& scene,
+                                                       std::span<const SurfacePoint> points,
                                                        const ReferenceSettings& settings, const WorkShard& shard = {});
 
 }  // namespace gi

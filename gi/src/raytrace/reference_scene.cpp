@@ -93,11 +93,12 @@ engine::Result<ReferenceSceneIndex> index_reference_scene(const ReferenceScene& 
       return scene_error("geometries", "UV sets given for " + std::to_string(uvs->size()) + " of " +
                                            std::to_string(g.geometries.size()) + " geometries");
   for (std::size_t m = 0; m < scene.materials.size(); ++m)
-    for (const MaterialTexture* t : {&scene.materials[m].base_color_texture,
-                                     &scene.materials[m].metallic_roughness_texture, &scene.materials[m].emissive_texture})
-      if (t->present() && (static_cast<std::size_t>(t->mips) >= scene.textures.size() ||
-                           scene.textures[static_cast<std::size_t>(t->mips)].levels.empty() || t->texcoord < 0 ||
-                           t->texcoord > 1))
+    for (const MaterialTexture* t :
+         {&scene.materials[m].base_color_texture, &scene.materials[m].metallic_roughness_texture,
+          &scene.materials[m].emissive_texture})
+      if (t->present() &&
+          (static_cast<std::size_t>(t->mips) >= scene.textures.size() ||
+           scene.textures[static_cast<std::size_t>(t->mips)].levels.empty() || t->texcoord < 0 || t->texcoord > 1))
         return scene_error("material " + std::to_string(m), "texture index out of range or UV set not 0 or 1");
   for (std::size_t i = 0; i < scene.lights.size(); ++i) {
     const ReferenceLight& l = scene.lights[i];

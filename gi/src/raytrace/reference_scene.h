@@ -25,8 +25,8 @@ struct ReferenceMaterial {
   /// glTF's BRDF (engine/gltf_brdf.h); engine::gltf_lambertian(albedo) for a pure Lambertian.
   /// With textures: the BRDF of the factors alone; material_lookup.h multiplies them in.
   engine::GltfBrdf brdf = engine::gltf_brdf(glm::vec3(0.8f), 0.0f, 1.0f);
-  glm::vec3 emission{0.0f};        ///< Emitted radiance, W/(m^2 sr), from the front face (x the emissive texture).
-  bool double_sided = false;       ///< Back faces shade (and emit) like front faces.
+  glm::vec3 emission{0.0f};   ///< Emitted radiance, W/(m^2 sr), from the front face (x the emissive texture).
+  bool double_sided = false;  ///< Back faces shade (and emit) like front faces.
   /// The factors the textures multiply (glTF metallic-roughness), read only when a texture is present.
   glm::vec3 base_color{0.8f};
   float metallic = 0.0f;
@@ -49,9 +49,9 @@ struct ReferenceLight {
   glm::vec3 direction{0.0f, -1.0f, 0.0f};  ///< Unit emission direction (the light's -Z).
   glm::vec3 half_x{0.5f, 0.0f, 0.0f};      ///< Area: half the rectangle along its X axis (m).
   glm::vec3 half_y{0.0f, 0.0f, 0.5f};      ///< Area: half the rectangle along its Y axis (m).
-  glm::vec3 radiant{1.0f};  ///< W/sr (point, spot), W/m^2 (directional), W/(m^2 sr) (area).
-  float range_m = 0.0f;     ///< glTF range window; 0: unlimited.
-  float cos_outer = 0.0f;   ///< Spot cone.
+  glm::vec3 radiant{1.0f};                 ///< W/sr (point, spot), W/m^2 (directional), W/(m^2 sr) (area).
+  float range_m = 0.0f;                    ///< glTF range window; 0: unlimited.
+  float cos_outer = 0.0f;                  ///< Spot cone.
   float cos_inner = 1.0f;
   /// Directional: cos of the angular radius of the source's disc (engine::Light::
   /// angular_radius_rad); 1: a single direction. Light arrives uniformly from the cone
@@ -63,28 +63,28 @@ struct ReferenceLight {
 /// (normals per vertex may be empty: flat shading); per triangle a material index.
 struct ReferenceScene {
   RtSceneData geometry;
-  std::vector<std::vector<glm::vec3>> normals;               ///< [geometry][vertex], object space.
-  std::vector<std::vector<std::uint32_t>> triangle_material; ///< [geometry][triangle] into materials.
+  std::vector<std::vector<glm::vec3>> normals;                ///< [geometry][vertex], object space.
+  std::vector<std::vector<std::uint32_t>> triangle_material;  ///< [geometry][triangle] into materials.
   std::vector<ReferenceMaterial> materials;
   /// [geometry][vertex] material UV sets TEXCOORD_0 / TEXCOORD_1; the outer vector may be
   /// empty (no UVs anywhere) and an inner one empty (that geometry has none).
   std::vector<std::vector<glm::vec2>> uv0, uv1;
   std::vector<TextureMips> textures;  ///< What MaterialTexture::mips indexes.
   std::vector<ReferenceLight> lights;
-  glm::vec3 sky_radiance{0.0f};  ///< Radiance of rays that escape, W/(m^2 sr) (a uniform sky).
+  glm::vec3 sky_radiance{0.0f};      ///< Radiance of rays that escape, W/(m^2 sr) (a uniform sky).
   engine::SkyGradient sky_gradient;  ///< Added to it by the escaping direction's elevation (engine/sky.h).
 };
 
 /// One world-space triangle with what shading needs.
 struct ShadingTriangle {
-  glm::vec3 p0, e1, e2;          ///< p = p0 + u e1 + v e2.
-  glm::vec3 n0, n1, n2;          ///< Unit world-space vertex normals (the face normal when flat).
-  glm::vec3 face_normal;         ///< Unit, from the winding (front side).
+  glm::vec3 p0, e1, e2;   ///< p = p0 + u e1 + v e2.
+  glm::vec3 n0, n1, n2;   ///< Unit world-space vertex normals (the face normal when flat).
+  glm::vec3 face_normal;  ///< Unit, from the winding (front side).
   float area_m2 = 0.0f;
   std::uint32_t material = 0;
-  std::int32_t emitter = -1;     ///< Index into ReferenceSceneIndex::emitters, or -1.
-  glm::vec2 uv0[3]{};            ///< TEXCOORD_0 at the corners (0 when absent).
-  glm::vec2 uv1[3]{};            ///< TEXCOORD_1 at the corners (0 when absent).
+  std::int32_t emitter = -1;  ///< Index into ReferenceSceneIndex::emitters, or -1.
+  glm::vec2 uv0[3]{};         ///< TEXCOORD_0 at the corners (0 when absent).
+  glm::vec2 uv1[3]{};         ///< TEXCOORD_1 at the corners (0 when absent).
   /// UV units per metre on the surface, per set: sqrt(UV area / area); a footprint of w
   /// metres covers w x uv_per_m[set] in UV (the ray-cone mip choice, material_lookup.h).
   float uv_per_m[2]{0.0f, 0.0f};
@@ -114,10 +114,12 @@ struct ReferenceSceneIndex {
 };
 
 /// The triangles [first, end) of `instance` in ReferenceSceneIndex::triangles.
-inline std::pair<std::uint32_t, std::uint32_t> instance_triangles(const ReferenceSceneIndex& index, std::size_t instance) {
+inline std::pair<std::uint32_t, std::uint32_t> instance_triangles(const ReferenceSceneIndex& index,
+                                                                  std::size_t instance) {
   const std::uint32_t first = index.instance_first[instance];
-  const std::uint32_t end = instance + 1 < index.instance_first.size() ? index.instance_first[instance + 1]
-                                                                        : static_cast<std::uint32_t>(index.triangles.size());
+  const std::uint32_t end = instance + 1 < index.instance_first.size()
+                                ? index.instance_first[instance + 1]
+                                : static_cast<std::uint32_t>(index.triangles.size());
   return {first, end};
 }
 

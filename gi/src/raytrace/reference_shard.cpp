@@ -151,8 +151,8 @@ std::string job_settings_hash(const ReferenceJob& job) {
 
 engine::Status check_job(const ReferenceJob& job) {
   if (!job.image && !job.atlas) return engine::invalid_request("reference job: neither an image nor an atlas");
-  if (job.image && (job.image->width < 1 || job.image->height < 1 || job.image->width > 16384 ||
-                    job.image->height > 16384))
+  if (job.image &&
+      (job.image->width < 1 || job.image->height < 1 || job.image->width > 16384 || job.image->height > 16384))
     return engine::invalid_request("reference job: image size must be in [1, 16384]^2");
   if (job.atlas && !(job.atlas->texels_per_metre > 0.0f && std::isfinite(job.atlas->texels_per_metre)))
     return engine::invalid_request("reference job: atlas texels per metre must be > 0");
@@ -267,7 +267,8 @@ engine::Result<ShardFile> read_shard(const fs::path& path) {
   if (f.count == 0 || f.index >= f.count)
     return engine::Error{path.string(), "shard",
                          "shard " + std::to_string(f.index) + " of " + std::to_string(f.count) + " does not exist"};
-  if (f.image && (f.image->rgb.size() != f.image->pixels.size() || !ascending(f.image->pixels) || !finite(f.image->rgb)))
+  if (f.image &&
+      (f.image->rgb.size() != f.image->pixels.size() || !ascending(f.image->pixels) || !finite(f.image->rgb)))
     return engine::Error{path.string(), "image", "pixel arrays differ in size, are not ascending or not finite"};
   if (f.atlas) {
     const AtlasPart& a = *f.atlas;
@@ -415,7 +416,8 @@ engine::Result<ReferenceOutputs> merge_reference_shards(const BakeInput& input, 
                                  ": its pixels are not that shard's blocks of this " + std::to_string(w) + "x" +
                                  std::to_string(h) + " image"};
       for (std::size_t k = 0; k < p.pixels.size(); ++k)
-        for (int c = 0; c < 3; ++c) image.pixels[4 * std::size_t{p.pixels[k]} + static_cast<std::size_t>(c)] = p.rgb[k][c];
+        for (int c = 0; c < 3; ++c)
+          image.pixels[4 * std::size_t{p.pixels[k]} + static_cast<std::size_t>(c)] = p.rgb[k][c];
     }
     out.image = std::move(image);
   }

@@ -96,8 +96,8 @@ RtSceneData rt_scene_from(const BakeInput& input) {
         data.geometries.push_back(std::move(copy));
       }
     }
-    data.instances.push_back(
-        RtInstance{geometry, inst.object_to_world, inst.mobility == BakeMobility::Dynamic, static_cast<std::uint64_t>(inst.id)});
+    data.instances.push_back(RtInstance{geometry, inst.object_to_world, inst.mobility == BakeMobility::Dynamic,
+                                        static_cast<std::uint64_t>(inst.id)});
   }
   return data;
 }

@@ -4,10 +4,10 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <glm/gtc/matrix_transform.hpp>
-#include <glm/gtc/quaternion.hpp>
 #include <string>
 #include <unordered_map>
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/quaternion.hpp>
 
 namespace gi {
 
@@ -285,8 +285,8 @@ engine::Status validate_bake_input(const BakeInput& input) {
     for (const auto& [what, t] : material_textures(m)) {
       if (!t->present()) continue;
       if (static_cast<std::size_t>(t->image) >= input.images.size())
-        return input_error(where, std::string(what) + " texture: image " + std::to_string(t->image) + " out of range (" +
-                                      std::to_string(input.images.size()) + " images)");
+        return input_error(where, std::string(what) + " texture: image " + std::to_string(t->image) +
+                                      " out of range (" + std::to_string(input.images.size()) + " images)");
       if (t->texcoord < 0 || t->texcoord > 1)
         return input_error(where, std::string(what) + " texture: TEXCOORD_" + std::to_string(t->texcoord) +
                                       " (the bakers read TEXCOORD_0 and TEXCOORD_1)");
@@ -306,8 +306,8 @@ engine::Status validate_bake_input(const BakeInput& input) {
     const BakeImage& img = input.images[ii];
     const std::string where = "image " + std::to_string(ii) + " '" + (img.uri.empty() ? img.name : img.uri) + "'";
     if (img.width <= 0 || img.height <= 0 || img.width > 65536 || img.height > 65536)
-      return input_error(where, "size " + std::to_string(img.width) + " x " + std::to_string(img.height) +
-                                    " is outside 1..65536");
+      return input_error(
+          where, "size " + std::to_string(img.width) + " x " + std::to_string(img.height) + " is outside 1..65536");
     if (img.rgba8.size() != static_cast<std::size_t>(img.width) * static_cast<std::size_t>(img.height) * 4u)
       return input_error(where, std::to_string(img.rgba8.size()) + " bytes for " + std::to_string(img.width) + " x " +
                                     std::to_string(img.height) + " RGBA8 texels");

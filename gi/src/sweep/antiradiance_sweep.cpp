@@ -94,7 +94,8 @@ engine::Result<DoorSetup> door_setup(const SweepScene& scene, double density, do
     if (d.input.instances[i].mobility == BakeMobility::Static) static_instance.push_back(static_cast<std::int32_t>(i));
   d.mask.assign(d.texels.valid.size(), 0);
   for (std::size_t t = 0; t < d.texels.valid.size(); ++t) {
-    if (!d.texels.valid[t] || d.texels.mesh[t] < 0 || static_cast<std::size_t>(d.texels.mesh[t]) >= static_instance.size())
+    if (!d.texels.valid[t] || d.texels.mesh[t] < 0 ||
+        static_cast<std::size_t>(d.texels.mesh[t]) >= static_instance.size())
       continue;
     const auto inst = static_cast<std::size_t>(static_instance[static_cast<std::size_t>(d.texels.mesh[t])]);
     if (d.input.instances[inst].deforming) continue;
@@ -153,7 +154,8 @@ glm::vec3 ref_at(const RgbField& f, std::size_t i) { return {f.rgb[3 * i], f.rgb
 }  // namespace
 
 void register_antiradiance_sweep(SweepRegistry& registry) {
-  registry.add_reference_provider({.kind = "atlas_indirect_irradiance_door", .version = "pt-1", .compute = door_reference});
+  registry.add_reference_provider(
+      {.kind = "atlas_indirect_irradiance_door", .version = "pt-1", .compute = door_reference});
 
   SweepMethod m;
   m.name = "antiradiance";
@@ -233,7 +235,8 @@ void register_antiradiance_sweep(SweepRegistry& registry) {
     s.patch_size_m = static_cast<float>(ctx.knobs.real("patch"));
     s.bins_per_side = static_cast<int>(ctx.knobs.integer("bins"));
     s.iterations = static_cast<int>(ctx.knobs.integer("iterations"));
-    s.scheme = ctx.knobs.text("scheme") == "asymmetric" ? AntiradianceScheme::Asymmetric : AntiradianceScheme::Symmetric;
+    s.scheme =
+        ctx.knobs.text("scheme") == "asymmetric" ? AntiradianceScheme::Asymmetric : AntiradianceScheme::Symmetric;
     s.oracle_scale = static_cast<float>(ctx.knobs.real("oracle"));
     s.seed = ctx.seed;
 
@@ -245,9 +248,9 @@ void register_antiradiance_sweep(SweepRegistry& registry) {
     if (ctx.progress && !ctx.progress(0.3)) return engine::cancelled_error("antiradiance run");
     // What the bundle stores: antiradiance.bin as gi-bake writes it.
     {
-      const std::filesystem::path file = std::filesystem::temp_directory_path() /
-                                         ("gi-sweep-antiradiance-" + std::to_string(ctx.seed) + "-" +
-                                          std::to_string(reinterpret_cast<std::uintptr_t>(&out)) + ".bin");
+      const std::filesystem::path file =
+          std::filesystem::temp_directory_path() / ("gi-sweep-antiradiance-" + std::to_string(ctx.seed) + "-" +
+                                                    std::to_string(reinterpret_cast<std::uintptr_t>(&out)) + ".bin");
       if (engine::Status st = write_antiradiance(file, *bake, "sweep"); !st) return st.error();
       std::error_code ec;
       out.costs.bytes = static_cast<std::uint64_t>(std::filesystem::file_size(file, ec));
@@ -255,7 +258,8 @@ void register_antiradiance_sweep(SweepRegistry& registry) {
     }
     auto region = AntiradianceRegion::create(d->input, std::move(bake).value());
     if (!region) return region.error();
-    const std::vector<AntiradianceTexelBlend> blends = antiradiance_texel_blends(region->hierarchy(), d->input, d->layout);
+    const std::vector<AntiradianceTexelBlend> blends =
+        antiradiance_texel_blends(region->hierarchy(), d->input, d->layout);
 
     // Each door move on the CPU twin: relink + direct light (update(false)), then the solve.
     std::vector<glm::vec3> values(n * kPoses, glm::vec3(0.0f));
@@ -316,14 +320,17 @@ void register_antiradiance_sweep(SweepRegistry& registry) {
     }
     const double moves = static_cast<double>(kPoses - 1);
     out.costs.frame_ms = (move_ms + solve_ms) / moves;
-    out.field = RgbField::from_texels(d->texels.width, d->texels.height * static_cast<int>(kPoses), values, std::move(valid));
+    out.field =
+        RgbField::from_texels(d->texels.width, d->texels.height * static_cast<int>(kPoses), values, std::move(valid));
 
     // What changing nothing scores (the baked atlas left as it is) on the same texels.
     RgbField nothing = out.field;
     for (std::size_t k = 1; k < kPoses; ++k)
       for (std::size_t t = 0; t < n; ++t)
         if (d->mask[t])
-          for (int c = 0; c < 3; ++c) nothing.rgb[3 * (k * n + t) + static_cast<std::size_t>(c)] = ctx.reference.rgb[3 * t + static_cast<std::size_t>(c)];
+          for (int c = 0; c < 3; ++c)
+            nothing.rgb[3 * (k * n + t) + static_cast<std::size_t>(c)] =
+                ctx.reference.rgb[3 * t + static_cast<std::size_t>(c)];
 
     double gpu_ms = nan, gpu_bytes = nan, gpu_cpu_diff = nan;
     if (ctx.knobs.text("gpu") == "on") {
@@ -331,25 +338,26 @@ void register_antiradiance_sweep(SweepRegistry& registry) {
         gl->make_current();
         auto gpu = AntiradianceGpuPass::create(region->hierarchy(), region->bins(), region->links());
         if (gpu) {
-        // The runtime's door move (AntiradianceLighting::update): relink + direct light on
-        // the CPU, link upload, the iteration, the result read back; back to the first swing.
-        region->set_instance_transform(d->door, d->pose(kSwings[0]));
-        const auto t0 = Clock::now();
-        region->update(false);
-        if (engine::Status st = gpu->set_links(region->links()); !st) return st.error();
-        const AntiradianceSolveReport rep = run_antiradiance(*gpu, region->direct(), region->settings(), region->hierarchy());
-        std::vector<glm::vec3> e = gpu->irradiance();
-        glFinish();
-        gpu_ms = ms_since(t0);
-        gpu_bytes = static_cast<double>(gpu->gpu_bytes());
-        region->update(true);
-        const std::vector<glm::vec3> cpu = region->irradiance();
-        double diff = 0.0, scale = 0.0;
-        for (std::size_t l = 0; l < e.size() && l < cpu.size(); ++l) {
-          diff = std::max(diff, static_cast<double>(glm::length(rep.output_scale * e[l] - cpu[l])));
-          scale = std::max(scale, static_cast<double>(glm::length(cpu[l])));
-        }
-        gpu_cpu_diff = scale > 0.0 ? diff / scale : 0.0;
+          // The runtime's door move (AntiradianceLighting::update): relink + direct light on
+          // the CPU, link upload, the iteration, the result read back; back to the first swing.
+          region->set_instance_transform(d->door, d->pose(kSwings[0]));
+          const auto t0 = Clock::now();
+          region->update(false);
+          if (engine::Status st = gpu->set_links(region->links()); !st) return st.error();
+          const AntiradianceSolveReport rep =
+              run_antiradiance(*gpu, region->direct(), region->settings(), region->hierarchy());
+          std::vector<glm::vec3> e = gpu->irradiance();
+          glFinish();
+          gpu_ms = ms_since(t0);
+          gpu_bytes = static_cast<double>(gpu->gpu_bytes());
+          region->update(true);
+          const std::vector<glm::vec3> cpu = region->irradiance();
+          double diff = 0.0, scale = 0.0;
+          for (std::size_t l = 0; l < e.size() && l < cpu.size(); ++l) {
+            diff = std::max(diff, static_cast<double>(glm::length(rep.output_scale * e[l] - cpu[l])));
+            scale = std::max(scale, static_cast<double>(glm::length(cpu[l])));
+          }
+          gpu_cpu_diff = scale > 0.0 ? diff / scale : 0.0;
         }  // else: above the SSBO limit (or no compute shaders): the GPU columns stay empty
       }
     }
@@ -358,17 +366,16 @@ void register_antiradiance_sweep(SweepRegistry& registry) {
                   {"change_correlation", var_o > 0.0 && var_r > 0.0 ? cov / std::sqrt(var_o * var_r) : nan},
                   {"change_fit_scale", soo > 0.0 ? sor / soo : nan}};
     out.extras.insert(out.extras.end(), per_angle.begin(), per_angle.end());
-    out.extras.insert(out.extras.end(),
-                      {{"cpu_move_ms", move_ms / moves},
-                       {"cpu_solve_ms", solve_ms / moves},
-                       {"gpu_frame_ms", gpu_ms},
-                       {"gpu_bytes", gpu_bytes},
-                       {"gpu_cpu_rel_diff", gpu_cpu_diff},
-                       {"elements", static_cast<double>(region->hierarchy().nodes.size())},
-                       {"leaves", static_cast<double>(region->hierarchy().leaf_count())},
-                       {"links", static_cast<double>(region->links().links.size())},
-                       {"compared_texels", static_cast<double>(d->compared)},
-                       {"level", level}});
+    out.extras.insert(out.extras.end(), {{"cpu_move_ms", move_ms / moves},
+                                         {"cpu_solve_ms", solve_ms / moves},
+                                         {"gpu_frame_ms", gpu_ms},
+                                         {"gpu_bytes", gpu_bytes},
+                                         {"gpu_cpu_rel_diff", gpu_cpu_diff},
+                                         {"elements", static_cast<double>(region->hierarchy().nodes.size())},
+                                         {"leaves", static_cast<double>(region->hierarchy().leaf_count())},
+                                         {"links", static_cast<double>(region->links().links.size())},
+                                         {"compared_texels", static_cast<double>(d->compared)},
+                                         {"level", level}});
     return out;
   };
   registry.add_method(std::move(m));

@@ -180,7 +180,8 @@ void register_brf_sweep(SweepRegistry& registry) {
        .default_grid = {"apart"},
        .choices = {"apart", "all"}},
       {.name = "occlusion",
-       .description = "occlusion between the objects (BrfUpdateSettings::occlusion; the contact factor stays on): on or off",
+       .description =
+           "occlusion between the objects (BrfUpdateSettings::occlusion; the contact factor stays on): on or off",
        .kind = KnobKind::Choice,
        .default_grid = {"on"},
        .choices = {"on", "off"}},
@@ -265,11 +266,10 @@ void register_brf_sweep(SweepRegistry& registry) {
     for (ReferenceLight& l : bake_lights(input, BakeLights::Moving)) lights.push_back(l);
     const std::vector<PointEmitter> emitters = light_point_emitters(lights, 64, ctx.seed);
     const auto t1 = std::chrono::steady_clock::now();
-    const BrfResult r =
-        update_brf(brf, emitters,
-                   {.bounces = static_cast<int>(ctx.knobs.integer("bounces")),
-                    .cull_threshold = 0.0f,
-                    .occlusion = ctx.knobs.text("occlusion") == "on"});
+    const BrfResult r = update_brf(brf, emitters,
+                                   {.bounces = static_cast<int>(ctx.knobs.integer("bounces")),
+                                    .cull_threshold = 0.0f,
+                                    .occlusion = ctx.knobs.text("occlusion") == "on"});
     const double frame_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t1).count();
     std::vector<glm::vec3> values;  // the irradiance: each object's first block
     for (std::size_t i = 0; i < r.indirect.size(); ++i)

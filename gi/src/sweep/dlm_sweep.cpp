@@ -51,8 +51,8 @@ engine::Result<GlossyTexels> glossy_texels(const SweepScene& scene, double densi
   if (!layout) return layout.error();
   auto prepared = prepare_static_scene(input, *layout, BakeLights::Static);
   if (!prepared) return prepared.error();
-  GlossyTexels g{std::move(prepared).value(), glm::vec3(live.registry.get<engine::WorldTransform>(camera).matrix[3]),
-                 {}, {}};
+  GlossyTexels g{
+      std::move(prepared).value(), glm::vec3(live.registry.get<engine::WorldTransform>(camera).matrix[3]), {}, {}};
   const AtlasTexels& tex = g.s.texels;
   g.glossy.assign(tex.valid.size(), 0);
   g.brdf.resize(tex.valid.size());
@@ -196,8 +196,8 @@ void register_dlm_sweep(SweepRegistry& registry) {
       const std::vector<float> c = dlm_bin_cosine_weights(dlm->directions, tex.normal[t]);
       glm::vec3 e(0.0f);
       for (std::size_t k = 0; k < l.size(); ++k) e += c[k] * l[k];
-      atlas_values[t] = e / 3.14159265f *
-                        engine::gltf_directional_albedo(g->brdf[t], glm::dot(tex.normal[t], v)).specular;
+      atlas_values[t] =
+          e / 3.14159265f * engine::gltf_directional_albedo(g->brdf[t], glm::dot(tex.normal[t], v)).specular;
       mask[t] = 1;
     }
     MethodOutput out;

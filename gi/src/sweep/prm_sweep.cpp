@@ -5,10 +5,10 @@
 #include <gi/reference.h>
 
 #include <chrono>
-#include <glm/gtc/quaternion.hpp>
 #include <limits>
 #include <string>
 #include <vector>
+#include <glm/gtc/quaternion.hpp>
 
 #include "prm/prm.h"
 #include "prm/prm_runtime.h"
@@ -115,8 +115,9 @@ void register_prm_sweep(SweepRegistry& registry) {
          rs.threads = job.threads;
          rs.progress = job.progress;
          const std::string world = job.request.param("world");
-         auto truth = reference_atlas_irradiance(reference_world(bake_input_from(*scene), world.empty() ? "all" : world),
-                                                 rasterize_atlas(*layout, inputs), rs);
+         auto truth =
+             reference_atlas_irradiance(reference_world(bake_input_from(*scene), world.empty() ? "all" : world),
+                                        rasterize_atlas(*layout, inputs), rs);
          if (!truth) return truth.error();
          return RgbField::from_texels(truth->width, truth->height, truth->indirect, truth->valid);
        }});

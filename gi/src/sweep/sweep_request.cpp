@@ -54,9 +54,7 @@ std::string file_stem_safe(std::string s) {
 
 // The gi-sweep command line that makes `r` (paths as given, so relative to where it ran).
 std::string sweep_command(const SweepRequest& r) {
-  auto arg = [](const std::string& s) {
-    return s.find_first_of(" \t'\"$\\") == std::string::npos ? s : "'" + s + "'";
-  };
+  auto arg = [](const std::string& s) { return s.find_first_of(" \t'\"$\\") == std::string::npos ? s : "'" + s + "'"; };
   std::string c = "gi-sweep --method " + arg(r.method) + " --scene " + arg(r.scene.generic_string());
   for (const std::string& k : r.knobs) c += " --knob " + arg(k);
   c += " --out " + arg(r.out_dir.generic_string());
@@ -150,10 +148,10 @@ engine::Result<SweepReport> run_sweep(const SweepRequest& request, const SweepHo
   SweepReport report;
   report.csv = std::filesystem::path(stem).concat(".csv");
   report.markdown = std::filesystem::path(stem).concat(".md");
-  const SweepSummary summary = summarize_sweep(
-      result->rows, {.cost = request.frame_cost ? SweepCost::FrameMs : SweepCost::BakeSeconds,
-                     .targets = targets,
-                     .command = sweep_command(request)});
+  const SweepSummary summary =
+      summarize_sweep(result->rows, {.cost = request.frame_cost ? SweepCost::FrameMs : SweepCost::BakeSeconds,
+                                     .targets = targets,
+                                     .command = sweep_command(request)});
   if (engine::Status s = write_file_atomically(report.csv, sweep_csv(result->rows)); !s) return s.error();
   if (engine::Status s = write_file_atomically(report.markdown, sweep_summary_markdown(result->rows, summary)); !s)
     return s.error();

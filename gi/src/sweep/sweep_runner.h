@@ -37,9 +37,10 @@ struct SweepRow {
   std::string method;
   std::string scene;
   KnobSetting knobs;
-  ErrorReport error;          ///< Against the reference (NaN metrics when the run failed).
-  RunCosts costs;             ///< As the method reported them.
-  std::vector<std::pair<std::string, double>> extras;  ///< MethodOutput::extras, as the method reported them (+ the harness's, above).
+  ErrorReport error;  ///< Against the reference (NaN metrics when the run failed).
+  RunCosts costs;     ///< As the method reported them.
+  std::vector<std::pair<std::string, double>>
+      extras;                 ///< MethodOutput::extras, as the method reported them (+ the harness's, above).
   double wall_seconds = 0.0;  ///< Wall time of the run call, measured by the harness.
   std::string reference_key;  ///< The full reference cache key.
   std::string status = "ok";  ///< "ok", or why the run has no valid metrics.

@@ -105,8 +105,7 @@ std::string sweep_summary_markdown(std::span<const SweepRow> rows, const SweepSu
 
   md += "## Runs\n\n|";
   for (const std::string& k : knobs) md += " " + md_cell(k) + " |";
-  md +=
-      " rel RMSE | max rel | PSNR dB | fit s | fit rel RMSE | bake s | frame ms | bytes | front | preset | status |";
+  md += " rel RMSE | max rel | PSNR dB | fit s | fit rel RMSE | bake s | frame ms | bytes | front | preset | status |";
   for (const std::string& e : extras) md += " " + md_cell(e) + " |";
   md += "\n|";
   for (std::size_t i = 0; i < knobs.size() + 11 + extras.size(); ++i) md += "---|";
@@ -124,28 +123,28 @@ std::string sweep_summary_markdown(std::span<const SweepRow> rows, const SweepSu
   }
 
   const std::string error_name = truth ? "truth_rel_rmse" : "rel RMSE";
-  md += "\n## Pareto front\n\nRuns no other run beats on both " + error_name + " and " + cost_name(summary.options.cost) +
-        " (failed runs excluded), cheapest first:\n\n";
+  md += "\n## Pareto front\n\nRuns no other run beats on both " + error_name + " and " +
+        cost_name(summary.options.cost) + " (failed runs excluded), cheapest first:\n\n";
   if (summary.front.empty()) md += "(empty: no run produced a valid error and cost)\n";
   for (std::size_t i : summary.front) {
-    md += "- " + (rows[i].knobs.label().empty() ? std::string("(no knobs)") : rows[i].knobs.label()) + ": " + error_name + " " +
-          fixed(summary.points[i].error, 4) + ", " + fixed(summary.points[i].cost, 4) + " " +
+    md += "- " + (rows[i].knobs.label().empty() ? std::string("(no knobs)") : rows[i].knobs.label()) + ": " +
+          error_name + " " + fixed(summary.points[i].error, 4) + ", " + fixed(summary.points[i].cost, 4) + " " +
           (summary.options.cost == SweepCost::BakeSeconds ? "s" : "ms") + "\n";
   }
 
   const PresetTargets& t = summary.options.targets;
-  md +=
-      "\n## Suggested presets\n\nRule: each preset is the cheapest Pareto-front run whose " + error_name + " is at or "
-      "below its target (preview " +
-      format_number(t.preview) + ", medium " + format_number(t.medium) + ", high " + format_number(t.high) +
-      "); when no front run reaches a target, the most accurate front run is suggested and "
-      "marked \"target not met\".\n\n";
+  md += "\n## Suggested presets\n\nRule: each preset is the cheapest Pareto-front run whose " + error_name +
+        " is at or "
+        "below its target (preview " +
+        format_number(t.preview) + ", medium " + format_number(t.medium) + ", high " + format_number(t.high) +
+        "); when no front run reaches a target, the most accurate front run is suggested and "
+        "marked \"target not met\".\n\n";
   if (summary.presets.empty()) md += "(none: the front is empty)\n";
   for (const PresetChoice& p : summary.presets) {
     const SweepRow& r = rows[p.index];
-    md += "- **" + p.name + "**: " + (r.knobs.label().empty() ? std::string("(no knobs)") : r.knobs.label()) +
-          " (" + error_name + " " + fixed(summary.points[p.index].error, 4) + ", " + fixed(summary.points[p.index].cost, 4) + " " +
-          (summary.options.cost == SweepCost::BakeSeconds ? "s" : "ms") + ")" +
+    md += "- **" + p.name + "**: " + (r.knobs.label().empty() ? std::string("(no knobs)") : r.knobs.label()) + " (" +
+          error_name + " " + fixed(summary.points[p.index].error, 4) + ", " + fixed(summary.points[p.index].cost, 4) +
+          " " + (summary.options.cost == SweepCost::BakeSeconds ? "s" : "ms") + ")" +
           (p.target_met ? "" : " -- target " + format_number(p.target) + " not met") + "\n";
   }
   return md;

@@ -32,7 +32,8 @@ engine::Result<std::unique_ptr<AntiradianceLighting>> AntiradianceLighting::crea
   std::unique_ptr<AntiradianceLighting> a(new AntiradianceLighting());
   a->region_ = std::make_unique<AntiradianceRegion>(std::move(region).value());
   a->registry_ = &registry;
-  for (std::uint32_t i : a->region_->hierarchy().deforming_instances) a->deforming_.emplace_back(i, input.instances[i].entity);
+  for (std::uint32_t i : a->region_->hierarchy().deforming_instances)
+    a->deforming_.emplace_back(i, input.instances[i].entity);
   std::vector<TexelBlend> blends = antiradiance_texel_blends(a->region_->hierarchy(), input, layout);
   a->blend_count_ = static_cast<std::uint32_t>(blends.size());
   a->width_ = layout.width;
@@ -62,14 +63,16 @@ bool AntiradianceLighting::ensure_gpu() {
   program_ = std::move(program).value();
   gpu_.emplace(std::move(gpu).value());
   blends_ = engine::GlBuffer::create();
-  glNamedBufferData(blends_.id(), static_cast<GLsizeiptr>(std::max<std::size_t>(blends_host_.size(), 1) * sizeof(TexelBlend)),
+  glNamedBufferData(blends_.id(),
+                    static_cast<GLsizeiptr>(std::max<std::size_t>(blends_host_.size(), 1) * sizeof(TexelBlend)),
                     nullptr, GL_STATIC_DRAW);
   if (!blends_host_.empty())
     glNamedBufferSubData(blends_.id(), 0, static_cast<GLsizeiptr>(blends_host_.size() * sizeof(TexelBlend)),
                          blends_host_.data());
   delta_ = engine::GlBuffer::create();
-  glNamedBufferData(delta_.id(), static_cast<GLsizeiptr>(std::max<std::size_t>(region_->hierarchy().leaf_count(), 1) * 16),
-                    nullptr, GL_DYNAMIC_DRAW);
+  glNamedBufferData(delta_.id(),
+                    static_cast<GLsizeiptr>(std::max<std::size_t>(region_->hierarchy().leaf_count(), 1) * 16), nullptr,
+                    GL_DYNAMIC_DRAW);
   glClearNamedBufferData(delta_.id(), GL_R32F, GL_RED, GL_FLOAT, nullptr);  // baked pose: no change
   return true;
 }
@@ -112,7 +115,8 @@ bool AntiradianceLighting::update() {
 }
 
 void AntiradianceLighting::composite(std::uint32_t base_texture, std::uint32_t out_texture) {
-  glCopyImageSubData(base_texture, GL_TEXTURE_2D, 0, 0, 0, 0, out_texture, GL_TEXTURE_2D, 0, 0, 0, 0, width_, height_, 1);
+  glCopyImageSubData(base_texture, GL_TEXTURE_2D, 0, 0, 0, 0, out_texture, GL_TEXTURE_2D, 0, 0, 0, 0, width_, height_,
+                     1);
   if (!ensure_gpu() || blend_count_ == 0) return;
   glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
   program_.use();

@@ -31,13 +31,13 @@ class AntiradianceLighting {
   /// One covered atlas texel: its leaves and blend weights (antiradiance_texel_blend.h).
   using TexelBlendHost = AntiradianceTexelBlend;
   struct Stats {
-    std::uint64_t updates = 0;            ///< Frames on which a deforming instance moved.
-    std::size_t relinked_elements = 0;    ///< Last update: elements whose links were rebuilt.
-    std::size_t links = 0;                ///< Links after it.
-    std::size_t elements = 0;             ///< Elements of the region.
-    std::size_t covered_texels = 0;       ///< Atlas texels the region's change reaches.
-    double last_ms = 0.0;                 ///< Last update: relink + direct light + GPU iteration (glFinish-timed).
-    bool fell_back = false;               ///< Last update: the symmetric iteration grew.
+    std::uint64_t updates = 0;          ///< Frames on which a deforming instance moved.
+    std::size_t relinked_elements = 0;  ///< Last update: elements whose links were rebuilt.
+    std::size_t links = 0;              ///< Links after it.
+    std::size_t elements = 0;           ///< Elements of the region.
+    std::size_t covered_texels = 0;     ///< Atlas texels the region's change reaches.
+    double last_ms = 0.0;               ///< Last update: relink + direct light + GPU iteration (glFinish-timed).
+    bool fell_back = false;             ///< Last update: the symmetric iteration grew.
   };
 
   /// Errors: the bake does not fit `input` (AntiradianceRegion::create).

@@ -38,9 +38,9 @@ class DlmLighting {
   DlmLighting() = default;
   int width_ = 0, height_ = 0, bins_ = 0;
   std::size_t elements_ = 0;
-  std::vector<std::int32_t> index_;     ///< Released after the upload.
-  std::vector<glm::uvec2> packed_;      ///< Released after the upload.
-  std::vector<glm::vec4> directions_;   ///< Direction and scale per bin.
+  std::vector<std::int32_t> index_;    ///< Released after the upload.
+  std::vector<glm::uvec2> packed_;     ///< Released after the upload.
+  std::vector<glm::vec4> directions_;  ///< Direction and scale per bin.
   engine::GlTexture index_texture_;
   engine::GlBuffer radiance_buffer_;
   engine::GlBuffer direction_buffer_;

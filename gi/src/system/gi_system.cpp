@@ -22,8 +22,8 @@
 #include "light_atlas/light_atlas_io.h"
 #include "prm/prm.h"
 #include "prm/prm_io.h"
-#include "system/dlm_lighting.h"
 #include "system/antiradiance_lighting.h"
+#include "system/dlm_lighting.h"
 #include "system/light_atlas_lighting.h"
 #include "system/prm_lighting.h"
 #include "system/prm_probe_light.h"
@@ -54,7 +54,7 @@ struct GISystem::Impl {
   std::unique_ptr<PrmLighting> prm;
   std::unique_ptr<BrfLighting> brf;
   std::unique_ptr<PrmProbeLight> prm_probe;  // the moving lights' first bounce in the BRF world probes
-  std::unique_ptr<DlmLighting> dlm;  // directional light maps of the glossy static surfaces
+  std::unique_ptr<DlmLighting> dlm;          // directional light maps of the glossy static surfaces
   std::unique_ptr<AntiradianceLighting> anti;
   std::unique_ptr<SkyVisibility> sky;  // dynamic entities' sky occlusion, when the scene has a sky
   engine::GlTexture anti_out;
@@ -82,8 +82,8 @@ struct GISystem::Impl {
       now.insert(e.id());
       if (warned.contains(e.id()) || !log) return;
       const auto* name = registry->try_get<engine::Name>(e);
-      log(LogLevel::Warning, std::string("GI: ") + what + " '" + (name ? name->value : "entity " + std::to_string(e.id())) +
-                                 "' skipped: " + why);
+      log(LogLevel::Warning, std::string("GI: ") + what + " '" +
+                                 (name ? name->value : "entity " + std::to_string(e.id())) + "' skipped: " + why);
     };
     registry->view<engine::Light, engine::WorldTransform>().each(
         [&](engine::Entity e, const engine::Light& l, const engine::WorldTransform& wt) {
@@ -287,7 +287,8 @@ engine::Result<std::unique_ptr<GISystem>> GISystem::load(const std::filesystem::
     if (impl->prm_probe)
       text << "BRF world probes: + moving lights' first bounce from the PRM's entry points ("
            << impl->prm_probe->stats().transfer_entries << " probe-entry links, "
-           << static_cast<double>(impl->prm_probe->stats().transfer_bytes) / 1e6 << " MB), re-projected when a moving light changes\n";
+           << static_cast<double>(impl->prm_probe->stats().transfer_bytes) / 1e6
+           << " MB), re-projected when a moving light changes\n";
   }
 
   // Antiradiance: the deforming region's change, added into the atlas of the same layout.
@@ -360,7 +361,8 @@ const engine::IndirectLightFrame& GISystem::frame() {
     }
     // The moving lights' first bounce in the BRF world probes, re-projected only when the PRM's
     // entry irradiance changed.
-    if (m.prm_probe && m.brf && m.prm_probe->update(*m.prm) && m.brf->set_moving_world_light(m.prm_probe->radiance_sh())) {
+    if (m.prm_probe && m.brf && m.prm_probe->update(*m.prm) &&
+        m.brf->set_moving_world_light(m.prm_probe->radiance_sh())) {
       ++m.stats.prm_probe_updates;
       m.stats.last_prm_probe_ms = m.prm_probe->stats().last_ms;
     }

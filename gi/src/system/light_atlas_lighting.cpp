@@ -45,13 +45,15 @@ engine::Result<std::unique_ptr<LightAtlasLighting>> LightAtlasLighting::from_bak
   auto with_uv1 = with_atlas_uv1(asset, bake.layout);
   if (!with_uv1) return with_uv1.error();
   asset = std::move(with_uv1).value();
-  return std::unique_ptr<LightAtlasLighting>(new LightAtlasLighting(bake.width, bake.height, rgba_of(bake), bake.settings.include_direct));
+  return std::unique_ptr<LightAtlasLighting>(
+      new LightAtlasLighting(bake.width, bake.height, rgba_of(bake), bake.settings.include_direct));
 }
 
 engine::Result<std::unique_ptr<LightAtlasLighting>> LightAtlasLighting::from_bake(const LightAtlasBake& bake,
                                                                                   engine::Scene& scene) {
   if (engine::Status s = apply_atlas_uv1(scene, bake.layout); !s) return s.error();
-  return std::unique_ptr<LightAtlasLighting>(new LightAtlasLighting(bake.width, bake.height, rgba_of(bake), bake.settings.include_direct));
+  return std::unique_ptr<LightAtlasLighting>(
+      new LightAtlasLighting(bake.width, bake.height, rgba_of(bake), bake.settings.include_direct));
 }
 
 const engine::IndirectLightFrame& LightAtlasLighting::frame() {

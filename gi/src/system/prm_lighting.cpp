@@ -10,8 +10,8 @@
 #include <unordered_map>
 
 #include "bundle/light_signature.h"
-#include "core/thread_pool.h"
 #include "bundle/manifest.h"
+#include "core/thread_pool.h"
 #include "light_atlas/light_atlas.h"
 #include "light_atlas/light_atlas_io.h"
 #include "prm/prm.h"
@@ -115,7 +115,8 @@ engine::Result<std::unique_ptr<PrmLighting>> PrmLighting::from_bake(Prm prm, con
   if (base) impl->base = base->irradiance;
   impl->caster = std::move(caster).value();
   impl->settings = settings;
-  const unsigned threads = settings.threads > 0 ? settings.threads : std::min(4u, std::max(1u, std::thread::hardware_concurrency()));
+  const unsigned threads =
+      settings.threads > 0 ? settings.threads : std::min(4u, std::max(1u, std::thread::hardware_concurrency()));
   if (threads > 1) impl->pool = std::make_unique<ThreadPool>(threads);
   return std::unique_ptr<PrmLighting>(new PrmLighting(std::move(impl)));
 }
@@ -125,8 +126,9 @@ const engine::IndirectLightFrame& PrmLighting::frame() {
   ++m.stats.frames;
   if (!m.stats.disabled.empty()) return m.frame;
   if (!m.pass) {
-    auto pass = PrmGpuPass::create(m.prm, {.encoding = m.settings.shared_exponent_panes ? PrmPaneEncoding::SharedExponent
-                                                                                      : PrmPaneEncoding::Half});
+    auto pass = PrmGpuPass::create(
+        m.prm,
+        {.encoding = m.settings.shared_exponent_panes ? PrmPaneEncoding::SharedExponent : PrmPaneEncoding::Half});
     if (!pass) {
       // No GL resources: leave the frame empty (the renderer falls back to its stand-in).
       m.disable(pass.error().to_string());

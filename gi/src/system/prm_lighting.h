@@ -21,10 +21,10 @@
 #include <gi/log.h>
 
 #include <cstdint>
-#include <glm/glm.hpp>
 #include <memory>
 #include <span>
 #include <vector>
+#include <glm/glm.hpp>
 
 namespace gi {
 

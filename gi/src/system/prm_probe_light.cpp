@@ -45,8 +45,9 @@ std::vector<glm::vec3> prm_entry_albedo(const StaticBakeScene& statics, std::spa
     }
     auto it = of_material.find(material);
     if (it == of_material.end())
-      it = of_material.emplace(material, engine::gltf_hemispherical_albedo(statics.scene.materials[material].brdf).sum())
-               .first;
+      it =
+          of_material.emplace(material, engine::gltf_hemispherical_albedo(statics.scene.materials[material].brdf).sum())
+              .first;
     out[i] = it->second;
   }
   if (missed != nullptr) *missed = misses;
@@ -57,9 +58,9 @@ engine::Result<PrmProbeLight> PrmProbeLight::create(const RayCaster& static_worl
                                                     std::span<const PrmEntryPoint> entries,
                                                     std::vector<glm::vec3> albedo, unsigned threads) {
   if (albedo.size() != entries.size())
-    return engine::Error{.location = "PRM world probes",
-                         .message = std::to_string(albedo.size()) + " albedos for " + std::to_string(entries.size()) +
-                                    " entry points"};
+    return engine::Error{
+        .location = "PRM world probes",
+        .message = std::to_string(albedo.size()) + " albedos for " + std::to_string(entries.size()) + " entry points"};
   std::vector<glm::vec3> position, normal;
   std::vector<float> area;
   position.reserve(entries.size());

@@ -9,16 +9,16 @@
 // BrfLighting adds to the static probes. A frame where no moving light changed does nothing.
 // The moving lights' second and later bounces off the world are left out.
 // Internal to GISystem.
-//   auto light = gi::PrmProbeLight::create(*caster, grid, prm.entries, gi::prm_entry_albedo(statics, prm.entries)).value();
-//   if (light.update(prm_lighting)) brf.set_moving_world_light(light.radiance_sh());
+//   auto light = gi::PrmProbeLight::create(*caster, grid, prm.entries, gi::prm_entry_albedo(statics,
+//   prm.entries)).value(); if (light.update(prm_lighting)) brf.set_moving_world_light(light.radiance_sh());
 
 #include <engine/result.h>
 
 #include <array>
 #include <cstdint>
-#include <glm/glm.hpp>
 #include <span>
 #include <vector>
+#include <glm/glm.hpp>
 
 #include "brf/world_probes.h"
 
@@ -54,7 +54,7 @@ class PrmProbeLight {
 
   struct Stats {
     std::uint64_t reprojections = 0;
-    double last_ms = 0.0;            ///< Last re-projection (CPU).
+    double last_ms = 0.0;  ///< Last re-projection (CPU).
     std::size_t transfer_bytes = 0;
     std::size_t transfer_entries = 0;  ///< (probe, visible entry point) pairs.
   };

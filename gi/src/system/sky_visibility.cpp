@@ -63,7 +63,8 @@ std::array<float, 6> SkyVisibility::measure(const glm::vec3& point) const {
     }
   }
   std::array<float, 6> v{};
-  for (int a = 0; a < 6; ++a) v[static_cast<std::size_t>(a)] = all[a] > 0.0 ? static_cast<float>(seen[a] / all[a]) : 1.0f;
+  for (int a = 0; a < 6; ++a)
+    v[static_cast<std::size_t>(a)] = all[a] > 0.0 ? static_cast<float>(seen[a] / all[a]) : 1.0f;
   return v;
 }
 

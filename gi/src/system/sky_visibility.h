@@ -52,7 +52,7 @@ class SkyVisibility {
   const engine::Registry* registry_ = nullptr;
   std::unique_ptr<RayCaster> caster_;
   std::vector<glm::vec3> directions_;
-  std::vector<float> sky_weight_;  ///< Luminance of the sky's radiance of each direction.
+  std::vector<float> sky_weight_;                             ///< Luminance of the sky's radiance of each direction.
   std::vector<std::pair<glm::vec3, glm::vec3>> mesh_bounds_;  ///< Object-space box per asset mesh.
   struct Entry {
     glm::mat4 matrix{0.0f};

@@ -48,7 +48,9 @@ std::vector<PointEmitter> light_point_emitters(std::span<const ReferenceLight> l
     e.radiant = l.radiant;
     e.range_m = l.range_m;
     switch (l.type) {
-      case ReferenceLight::Type::Point: out.push_back(e); break;
+      case ReferenceLight::Type::Point:
+        out.push_back(e);
+        break;
       case ReferenceLight::Type::Spot:
         e.spot = true;
         e.cos_outer = l.cos_outer;
@@ -69,7 +71,8 @@ std::vector<PointEmitter> light_point_emitters(std::span<const ReferenceLight> l
           // 1 mm in front of the light's plane: a panel drawn for the light (its emissive
           // proxy, just in front of the plane so the light is not inside it) must not shadow
           // the light's own points.
-          p.position = l.position + (2.0f * u - 1.0f) * l.half_x + (2.0f * v - 1.0f) * l.half_y + kAreaSampleLift * l.direction;
+          p.position =
+              l.position + (2.0f * u - 1.0f) * l.half_x + (2.0f * v - 1.0f) * l.half_y + kAreaSampleLift * l.direction;
           p.direction = l.direction;
           p.radiant = kPi * l.radiant * area / strata;
           p.area_m2 = area / strata;
@@ -135,10 +138,12 @@ float lambertian_kernel(const glm::vec3& q, const glm::vec3& nq, float emitter_a
 
 glm::vec3 emitter_irradiance(const PointEmitter& e, const glm::vec3& p, const glm::vec3& n, float receiver_area_m2) {
   switch (e.kind) {
-    case PointEmitter::Kind::Directional: return e.radiant * std::max(0.0f, -glm::dot(n, e.direction));
+    case PointEmitter::Kind::Directional:
+      return e.radiant * std::max(0.0f, -glm::dot(n, e.direction));
     case PointEmitter::Kind::Lambertian:
       return e.radiant * lambertian_kernel(e.position, e.direction, e.area_m2, e.two_sided, p, n, receiver_area_m2);
-    case PointEmitter::Kind::Punctual: break;
+    case PointEmitter::Kind::Punctual:
+      break;
   }
   const glm::vec3 to = e.position - p;
   const float d2 = glm::dot(to, to);
@@ -240,12 +245,14 @@ bool segment_visible(const RayCaster& caster, const glm::vec3& a, const glm::vec
 
 Ray emitter_shadow_ray(const PointEmitter& e, const glm::vec3& p, const glm::vec3& n) {
   switch (e.kind) {
-    case PointEmitter::Kind::Directional: return Ray{offset_ray_origin(p, n), 0.0f, -e.direction};
+    case PointEmitter::Kind::Directional:
+      return Ray{offset_ray_origin(p, n), 0.0f, -e.direction};
     case PointEmitter::Kind::Punctual: {
       const glm::vec3 o = offset_ray_origin(p, n);
       return Ray{o, 0.0f, e.position - o, 1.0f};
     }
-    case PointEmitter::Kind::Lambertian: break;
+    case PointEmitter::Kind::Lambertian:
+      break;
   }
   const glm::vec3 ne = glm::dot(e.direction, p - e.position) >= 0.0f ? e.direction : -e.direction;
   return segment_ray(p, n, e.position, ne);

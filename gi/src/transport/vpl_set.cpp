@@ -161,7 +161,8 @@ engine::Result<VplSet> distribute_vpls(const ReferenceScene& scene, const Refere
   if (settings.vpl_count < 1 || settings.vpl_count > 10'000'000)
     return engine::Error{.message = "VPL count " + std::to_string(settings.vpl_count) + " is outside 1..10^7"};
   if (settings.samples_per_vpl < 1 || settings.samples_per_vpl > 1024)
-    return engine::Error{.message = "samples per VPL " + std::to_string(settings.samples_per_vpl) + " is outside 1..1024"};
+    return engine::Error{.message =
+                             "samples per VPL " + std::to_string(settings.samples_per_vpl) + " is outside 1..1024"};
 
   // Static instances as atlas-input meshes (three vertices per triangle; charting welds them).
   struct StaticMesh {
@@ -188,7 +189,7 @@ engine::Result<VplSet> distribute_vpls(const ReferenceScene& scene, const Refere
   if (!(total_area > 0.0) || !std::isfinite(total_area))
     return engine::Error{.message = "the scene has no static surface area to place VPLs on"};
 
-  const double h = std::sqrt(total_area / settings.vpl_count);                   // VPL spacing
+  const double h = std::sqrt(total_area / settings.vpl_count);                     // VPL spacing
   const double hs = h / std::sqrt(static_cast<double>(settings.samples_per_vpl));  // sample spacing
   std::unordered_map<std::uint32_t, glm::vec3> albedo_cache;
   // A sample's albedo: its material's, or with textures the material lookup's at its point
@@ -199,7 +200,8 @@ engine::Result<VplSet> distribute_vpls(const ReferenceScene& scene, const Refere
     if (scene.materials[m].textured())
       return albedo_at(scene, index.triangles[sample.triangle], sample.bary, static_cast<float>(hs));
     auto it = albedo_cache.find(m);
-    if (it == albedo_cache.end()) it = albedo_cache.emplace(m, engine::gltf_hemispherical_albedo(scene.materials[m].brdf).sum()).first;
+    if (it == albedo_cache.end())
+      it = albedo_cache.emplace(m, engine::gltf_hemispherical_albedo(scene.materials[m].brdf).sum()).first;
     return it->second;
   };
 
@@ -220,16 +222,21 @@ engine::Result<VplSet> distribute_vpls(const ReferenceScene& scene, const Refere
         // area hs^2, so the expected area is kept (the chart's texels still receive light).
         if (static_cast<double>(rng.next_float()) >= chart.area_m2 / (hs * hs)) continue;
         const ShadingTriangle& tri = index.triangles[sm.first_triangle + chart.triangles.front()];
-        samples.push_back({tri.p0 + (tri.e1 + tri.e2) / 3.0f, tri.face_normal, {}, tri.material,
-                           sm.first_triangle + chart.triangles.front(), glm::vec2(1.0f / 3.0f)});
+        samples.push_back({tri.p0 + (tri.e1 + tri.e2) / 3.0f,
+                           tri.face_normal,
+                           {},
+                           tri.material,
+                           sm.first_triangle + chart.triangles.front(),
+                           glm::vec2(1.0f / 3.0f)});
         sample_area = hs * hs;
       }
 
       // One sample per VPL: every sample is its own VPL (a second grid of the same spacing
       // would leave about a third of its seeds without a sample).
-      std::vector<Sample> seeds = settings.samples_per_vpl == 1
-                                      ? samples
-                                      : jittered_points(chart, plane, index, sm.first_triangle, static_cast<float>(h), rng);
+      std::vector<Sample> seeds =
+          settings.samples_per_vpl == 1
+              ? samples
+              : jittered_points(chart, plane, index, sm.first_triangle, static_cast<float>(h), rng);
       if (seeds.empty()) seeds.push_back(samples[samples.size() / 2]);
 
       // Voronoi patches: every sample joins its nearest seed (in the chart's plane).

@@ -15,8 +15,8 @@
 
 #include <engine/result.h>
 
-#include "transport/point_emitters.h"
 #include "raytrace/reference_scene.h"
+#include "transport/point_emitters.h"
 
 namespace gi {
 
@@ -28,10 +28,10 @@ struct VplDistributionSettings {
 
 /// Structure of arrays; sample points of VPL j are [sample_first[j], sample_first[j + 1]).
 struct VplSet {
-  std::vector<glm::vec3> position;       ///< On the surface, metres.
-  std::vector<glm::vec3> normal;         ///< Unit, front side of the patch.
-  std::vector<glm::vec3> albedo;         ///< Hemispherical reflectance of the patch's material (RGB).
-  std::vector<float> area_m2;            ///< Patch area A_j.
+  std::vector<glm::vec3> position;          ///< On the surface, metres.
+  std::vector<glm::vec3> normal;            ///< Unit, front side of the patch.
+  std::vector<glm::vec3> albedo;            ///< Hemispherical reflectance of the patch's material (RGB).
+  std::vector<float> area_m2;               ///< Patch area A_j.
   std::vector<std::uint32_t> sample_first;  ///< size() + 1 entries.
   std::vector<glm::vec3> sample_position;   ///< Sample points S_jk, metres.
   std::vector<glm::vec3> sample_normal;     ///< Unit geometric normal at S_jk.

@@ -13,9 +13,9 @@
 #include <gi/progress.h>
 
 #include "core/thread_pool.h"
+#include "raytrace/ray_caster.h"
 #include "transport/point_emitters.h"
 #include "transport/vpl_set.h"
-#include "raytrace/ray_caster.h"
 
 namespace gi {
 
@@ -29,12 +29,12 @@ std::vector<glm::vec3> direct_to_vpls(const VplSet& vpls, const std::vector<Poin
                                       const RayCaster& caster, ThreadPool& pool, std::uint64_t* rays = nullptr);
 
 struct PropagationSettings {
-  int bounces = 5;                 ///< 1: no shooting; b: b - 1 generations.
-  float unshot_threshold = 1e-4f;  ///< Relative to the largest VPL power after direct light.
+  int bounces = 5;                                       ///< 1: no shooting; b: b - 1 generations.
+  float unshot_threshold = 1e-4f;                        ///< Relative to the largest VPL power after direct light.
   std::size_t row_cache_bytes = std::size_t{512} << 20;  ///< Form-factor rows kept for later generations.
-  int reach_rays = 256;            ///< Cosine rays per shooter estimating how much of its light hits the scene.
+  int reach_rays = 256;  ///< Cosine rays per shooter estimating how much of its light hits the scene.
   std::uint64_t seed = 1;
-  ProgressCallback progress;       ///< Fraction of the shots of the current generation.
+  ProgressCallback progress;  ///< Fraction of the shots of the current generation.
 };
 
 struct VplSolution {

@@ -12,9 +12,9 @@
 // the gutter (useful for mipmaps).
 
 #include <cstdint>
-#include <glm/glm.hpp>
 #include <span>
 #include <vector>
+#include <glm/glm.hpp>
 
 namespace gi {
 

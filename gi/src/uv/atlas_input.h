@@ -8,10 +8,10 @@
 #include <gi/bake_input.h>
 
 #include <cstdint>
-#include <glm/glm.hpp>
 #include <span>
 #include <string>
 #include <vector>
+#include <glm/glm.hpp>
 
 namespace gi {
 

@@ -21,9 +21,9 @@
 #include <engine/result.h>
 
 #include <cstdint>
-#include <glm/glm.hpp>
 #include <span>
 #include <vector>
+#include <glm/glm.hpp>
 
 #include "uv/atlas_input.h"
 

@@ -20,9 +20,9 @@
 //   sample there. An isolated tiny or degenerate triangle always owns a sample.
 
 #include <cstdint>
-#include <glm/glm.hpp>
 #include <span>
 #include <vector>
+#include <glm/glm.hpp>
 
 #include "uv/atlas_input.h"
 #include "uv/atlas_layout.h"

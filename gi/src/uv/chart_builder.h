@@ -5,8 +5,8 @@
 //   glm::vec2 m = charts[0].project_m(mesh.positions[i]);  // metres from the chart's corner
 
 #include <cstdint>
-#include <glm/glm.hpp>
 #include <vector>
+#include <glm/glm.hpp>
 
 #include "uv/atlas_input.h"
 

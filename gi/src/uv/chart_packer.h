@@ -4,10 +4,10 @@
 //   std::optional<gi::ShelfPacking> p = gi::pack_growing(sizes, 2, 4096);
 //   glm::ivec2 corner = p->origins[0];  // min texel of footprint 0
 
-#include <glm/glm.hpp>
 #include <optional>
 #include <span>
 #include <vector>
+#include <glm/glm.hpp>
 
 namespace gi {
 

@@ -2,8 +2,8 @@
 // per roughness and view angle, from the engine (engine/gltf_brdf.h, its tabulated
 // integrals) and from this test's own quadrature of the specification's formulas
 // (analytic_support.h). docs/analytic_truth.md "Furnace table" shows the printed table.
-#include <engine/gltf_brdf.h>
 #include <gtest/gtest.h>
+#include <engine/gltf_brdf.h>
 
 #include <cstdio>
 

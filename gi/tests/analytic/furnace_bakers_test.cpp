@@ -13,8 +13,8 @@
 // A box, not a sphere: the charts of a tessellated sphere are one triangle each at test atlas
 // sizes, and for a uniformly emitting enclosure the prediction above does not depend on the
 // shape (docs/analytic_truth.md).
-#include <engine/gltf_brdf.h>
 #include <gtest/gtest.h>
+#include <engine/gltf_brdf.h>
 
 #include <cstdio>
 

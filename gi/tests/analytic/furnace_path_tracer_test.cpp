@@ -7,8 +7,8 @@
 // and a_max Le). a(theta) comes from the test's own quadrature (analytic_support.h), not from
 // the engine. With a white dielectric a > 1 at grazing angles (fresnel_mix): the series has
 // no limit, so only finite bounce counts are checked.
-#include <engine/gltf_brdf.h>
 #include <gtest/gtest.h>
+#include <engine/gltf_brdf.h>
 
 #include <cstdio>
 

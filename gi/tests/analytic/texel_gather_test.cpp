@@ -66,8 +66,9 @@ TEST(TexelGather, ClosedBoxEdgeAndCornerTexelsMatchThePathTracer) {
     sum += static_cast<double>(bake->irradiance[t].y), ++n;
   }
   const double expected = 4.0 * kPi * double{kIntensity} * double{kRho} / ((1.0 - double{kRho}) * 24.0);
-  std::printf("closed box, gather 64 kept + 256 rays vs path tracer (4096 spp) per texel; texel mean / closed form %.4f\n",
-              sum / static_cast<double>(n) / expected);
+  std::printf(
+      "closed box, gather 64 kept + 256 rays vs path tracer (4096 spp) per texel; texel mean / closed form %.4f\n",
+      sum / static_cast<double>(n) / expected);
   interior.print("interior texels");
   edge.print("texels within one texel of an edge");
   EXPECT_GT(edge.n, 100u);
@@ -100,8 +101,8 @@ gi::BakeInput room_with_box_and_thin_wall() {
   analytic::add_static(in, std::move(box), analytic::lambert(0.7f), "box");
   // Thin wall: x in [0.6, 0.62], z in [-1.0, 1.0], height 1.4, closed on top.
   const float x0 = 0.6f, x1 = 0.62f, h = 1.4f;
-  analytic::add_quad(wall, {x0, f, -1.0f}, {0, 0, 2.0f}, {0, h, 0});   // faces -x
-  analytic::add_quad(wall, {x1, f, -1.0f}, {0, h, 0}, {0, 0, 2.0f});   // faces +x
+  analytic::add_quad(wall, {x0, f, -1.0f}, {0, 0, 2.0f}, {0, h, 0});            // faces -x
+  analytic::add_quad(wall, {x1, f, -1.0f}, {0, h, 0}, {0, 0, 2.0f});            // faces +x
   analytic::add_quad(wall, {x0, f + h, -1.0f}, {0, 0, 2.0f}, {x1 - x0, 0, 0});  // top, +y
   analytic::add_quad(wall, {x0, f, -1.0f}, {x1 - x0, 0, 0}, {0, h, 0});         // end z-, -z
   analytic::add_quad(wall, {x0, f, 1.0f}, {0, h, 0}, {x1 - x0, 0, 0});          // end z+, +z
@@ -208,7 +209,8 @@ TEST(TexelGather, FlatWallSplitIntoTwoChartsHasNoJumpAtTheSeam) {
   for (std::size_t l : left) {
     std::size_t best = right.front();
     for (std::size_t r : right)
-      if (std::fabs(texels.position[r].y - texels.position[l].y) < std::fabs(texels.position[best].y - texels.position[l].y))
+      if (std::fabs(texels.position[r].y - texels.position[l].y) <
+          std::fabs(texels.position[best].y - texels.position[l].y))
         best = r;
     if (std::fabs(texels.position[best].y - texels.position[l].y) > 0.5f * texel) continue;
     const double baked_jump = static_cast<double>(bake->irradiance[best].y - bake->irradiance[l].y);

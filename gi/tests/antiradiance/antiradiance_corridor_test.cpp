@@ -79,10 +79,11 @@ TEST(AntiradianceCorridor, DoorSwingChangeErrorIsBoundedAgainstThePathTracer) {
     const Means m = measure(degrees, s, 256);
     for (int z = 0; z < kZones; ++z)
       std::printf("door %3.0f deg, %s: antiradiance %.4f (change %+.4f), path tracer %.4f (change %+.4f) W/m^2\n",
-                  double(degrees), z == kNearDoor ? "room near the door" : "corridor", m.ours[z], m.ours[z] - baked.ours[z],
-                  m.ref[z], m.ref[z] - baked.ref[z]);
+                  double(degrees), z == kNearDoor ? "room near the door" : "corridor", m.ours[z],
+                  m.ours[z] - baked.ours[z], m.ref[z], m.ref[z] - baked.ref[z]);
     const double near_error = (m.ours[kNearDoor] - baked.ours[kNearDoor]) - (m.ref[kNearDoor] - baked.ref[kNearDoor]);
-    const double corridor_error = (m.ours[kCorridor] - baked.ours[kCorridor]) - (m.ref[kCorridor] - baked.ref[kCorridor]);
+    const double corridor_error =
+        (m.ours[kCorridor] - baked.ours[kCorridor]) - (m.ref[kCorridor] - baked.ref[kCorridor]);
     EXPECT_LE(std::abs(near_error), 0.15 * m.ref[kNearDoor]) << degrees;
     EXPECT_LE(std::abs(corridor_error), 0.01) << degrees;
   }

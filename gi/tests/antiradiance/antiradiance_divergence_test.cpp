@@ -17,7 +17,8 @@ gi::BakeInput stack(int plates, float albedo, float spacing) {
   gi::BakeInput in;
   for (int i = 0; i < plates; ++i) {
     const float x = spacing * static_cast<float>(i + 1);
-    artest::add_mesh(in, "plate" + std::to_string(i), artest::solid_box({x, -1, -1}, {x + 0.02f, 1, 1}), glm::vec3(albedo), i == 0);
+    artest::add_mesh(in, "plate" + std::to_string(i), artest::solid_box({x, -1, -1}, {x + 0.02f, 1, 1}),
+                     glm::vec3(albedo), i == 0);
   }
   // A closed room around them (inward), so light keeps bouncing.
   gi::BakePrimitive room;

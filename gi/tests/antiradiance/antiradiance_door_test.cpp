@@ -22,7 +22,7 @@ gi::AntiradianceSettings door_settings() {
 }
 
 struct Solved {
-  glm::vec3 receiver{0.0f};        // mean indirect irradiance on the receiver (W/m^2)
+  glm::vec3 receiver{0.0f};  // mean indirect irradiance on the receiver (W/m^2)
   gi::AntiradianceSolveReport report;
 };
 
@@ -127,7 +127,8 @@ TEST(AntiradianceDoor, LightInsideTheRegionStaysFiniteAndBoundedByTheEmittedFlux
     indirect_flux += static_cast<double>(n.area_m2 * std::abs(e[l].x));
   }
   const double emitted = 4.0 * 3.14159265358979;
-  std::printf("light inside: direct flux %.4f W, indirect %.4f W of %.3f W emitted\n", direct_flux, indirect_flux, emitted);
+  std::printf("light inside: direct flux %.4f W, indirect %.4f W of %.3f W emitted\n", direct_flux, indirect_flux,
+              emitted);
   EXPECT_LE(direct_flux, emitted);
   EXPECT_LE(indirect_flux, emitted);
   EXPECT_TRUE(finite(artest::instance_mean(h, scene.input, scene.receiver, e)));

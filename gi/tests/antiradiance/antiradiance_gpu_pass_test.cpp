@@ -3,8 +3,8 @@
 // agree to float rounding. Tolerance per entry: 1e-4 x (the table's largest |value|) + 1e-7
 // (fused multiply-adds and the order of the three-term local sums may differ by an ulp per
 // operation; the largest chain is one link list of a few thousand terms).
-#include <engine/gpu/context.h>
 #include <gtest/gtest.h>
+#include <engine/gpu/context.h>
 
 #include <algorithm>
 #include <cmath>
@@ -32,7 +32,8 @@ void expect_close(const std::vector<glm::vec3>& cpu, const std::vector<glm::vec3
   for (std::size_t i = 0; i < cpu.size(); ++i)
     for (int c = 0; c < 3; ++c)
       if (!(std::abs(cpu[i][c] - gpu[i][c]) <= tol)) {
-        if (bad++ < 5) ADD_FAILURE() << what << " entry " << i << " channel " << c << ": cpu " << cpu[i][c] << " gpu " << gpu[i][c];
+        if (bad++ < 5)
+          ADD_FAILURE() << what << " entry " << i << " channel " << c << ": cpu " << cpu[i][c] << " gpu " << gpu[i][c];
       }
   EXPECT_EQ(bad, 0u) << what;
 }

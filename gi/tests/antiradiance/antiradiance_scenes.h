@@ -67,12 +67,12 @@ inline std::uint32_t add_mesh(gi::BakeInput& in, const std::string& name, gi::Ba
 inline gi::BakePrimitive solid_box(glm::vec3 lo, glm::vec3 hi) {
   gi::BakePrimitive p;
   const glm::vec3 d = hi - lo;
-  add_quad(p, lo, {0, d.y, 0}, {d.x, 0, 0});                       // z = lo, -z
-  add_quad(p, {lo.x, lo.y, hi.z}, {d.x, 0, 0}, {0, d.y, 0});      // z = hi, +z
-  add_quad(p, lo, {0, 0, d.z}, {0, d.y, 0});                       // x = lo, -x
-  add_quad(p, {hi.x, lo.y, lo.z}, {0, d.y, 0}, {0, 0, d.z});      // x = hi, +x
-  add_quad(p, lo, {d.x, 0, 0}, {0, 0, d.z});                       // y = lo, -y
-  add_quad(p, {lo.x, hi.y, lo.z}, {0, 0, d.z}, {d.x, 0, 0});      // y = hi, +y
+  add_quad(p, lo, {0, d.y, 0}, {d.x, 0, 0});                  // z = lo, -z
+  add_quad(p, {lo.x, lo.y, hi.z}, {d.x, 0, 0}, {0, d.y, 0});  // z = hi, +z
+  add_quad(p, lo, {0, 0, d.z}, {0, d.y, 0});                  // x = lo, -x
+  add_quad(p, {hi.x, lo.y, lo.z}, {0, d.y, 0}, {0, 0, d.z});  // x = hi, +x
+  add_quad(p, lo, {d.x, 0, 0}, {0, 0, d.z});                  // y = lo, -y
+  add_quad(p, {lo.x, hi.y, lo.z}, {0, 0, d.z}, {d.x, 0, 0});  // y = hi, +y
   return p;
 }
 
@@ -125,8 +125,8 @@ inline DoorScene door_scene(float degrees, float wall_thickness = 0.2f, float ga
   add_mesh(s.input, "wall", wall, glm::vec3(0.5f), false);
   const float t = std::min(0.04f, wall_thickness);
   // Door in its hinge frame: x in [0, t], z in [gap, 1 - gap] (closed: rotation 0).
-  s.door = add_mesh(s.input, "door", solid_box({0, -0.5f + gap, gap}, {t, 0.5f - gap, 1.0f - gap}), glm::vec3(0.6f), true,
-                    hinge_matrix(degrees));
+  s.door = add_mesh(s.input, "door", solid_box({0, -0.5f + gap, gap}, {t, 0.5f - gap, 1.0f - gap}), glm::vec3(0.6f),
+                    true, hinge_matrix(degrees));
   gi::BakePrimitive r;
   add_quad(r, {2.2f, -0.5f, -0.5f}, {0, 0, 1}, {0, 1, 0});
   s.receiver = add_mesh(s.input, "receiver", r, glm::vec3(0.5f), false);

@@ -79,7 +79,8 @@ TEST_F(AntiradianceShard, BakeFromLinkShardsIsTheWholeBake) {
   ASSERT_TRUE(merged.ok()) << merged.error().to_string();
   EXPECT_TRUE(same_links(merged->static_links, whole->static_links));
   ASSERT_EQ(merged->baseline.size(), whole->baseline.size());
-  EXPECT_EQ(std::memcmp(merged->baseline.data(), whole->baseline.data(), whole->baseline.size() * sizeof(glm::vec3)), 0);
+  EXPECT_EQ(std::memcmp(merged->baseline.data(), whole->baseline.data(), whole->baseline.size() * sizeof(glm::vec3)),
+            0);
 }
 
 TEST_F(AntiradianceShard, MergeRefusesPartsThatAreNotTheirShards) {

@@ -2,8 +2,8 @@
 // separable approximation of the GGX lobe, and glossy objects against the path tracer.
 #include <cmath>
 #include <cstdio>
-#include <numbers>
 #include <limits>
+#include <numbers>
 #include <random>
 
 #include <unistd.h>
@@ -20,11 +20,11 @@
 #include "brf/brf_runtime.h"
 #include "brf/spherical_harmonics.h"
 #include "brf_scenes.h"
-#include "transport/point_emitters.h"
 #include "raytrace/embree_ray_caster.h"
 #include "raytrace/reference_brdf.h"
 #include "raytrace/reference_render.h"
 #include "reference_scenes.h"
+#include "transport/point_emitters.h"
 
 namespace {
 
@@ -71,15 +71,18 @@ TEST(BrfShRotation, TurnsTheClampedCosineOntoTheRotatedNormal) {
 TEST(BrfGlossySeparation, ErrorFallsWithTermsAndTheTableReproducesTheLobe) {
   float previous = 1.0f;
   for (int k : {1, 2, 4, 8, 15}) {
-    const gi::BrdfSeparation s = gi::separate_glossy_brdf({.f0 = 0.9f, .alpha = 0.5f}, {.terms = k, .resolution = 16}).value();
-    std::printf("alpha 0.5: K asked %2d -> %2d terms, weighted L2 error %.3f\n", k, s.terms, static_cast<double>(s.relative_error));
+    const gi::BrdfSeparation s =
+        gi::separate_glossy_brdf({.f0 = 0.9f, .alpha = 0.5f}, {.terms = k, .resolution = 16}).value();
+    std::printf("alpha 0.5: K asked %2d -> %2d terms, weighted L2 error %.3f\n", k, s.terms,
+                static_cast<double>(s.relative_error));
     EXPECT_GE(s.terms, k);
     EXPECT_LE(s.relative_error, previous);
     previous = s.relative_error;
   }
   EXPECT_LT(previous, 0.35f);
   // The reported error is the table's: evaluating g and h reproduces the lobe to about it.
-  const gi::BrdfSeparation s = gi::separate_glossy_brdf({.f0 = 0.9f, .alpha = 0.8f}, {.terms = 15, .resolution = 16}).value();
+  const gi::BrdfSeparation s =
+      gi::separate_glossy_brdf({.f0 = 0.9f, .alpha = 0.8f}, {.terms = 15, .resolution = 16}).value();
   std::mt19937 rng(3);
   double err = 0.0, norm = 0.0;
   for (int i = 0; i < 4000; ++i) {
@@ -91,8 +94,8 @@ TEST(BrfGlossySeparation, ErrorFallsWithTermsAndTheTableReproducesTheLobe) {
     err += (ours - truth) * (ours - truth);
     norm += truth * truth;
   }
-  std::printf("alpha 0.8, %d terms: table error %.3f at random directions (SVD's %.3f)\n", s.terms, std::sqrt(err / norm),
-              static_cast<double>(s.relative_error));
+  std::printf("alpha 0.8, %d terms: table error %.3f at random directions (SVD's %.3f)\n", s.terms,
+              std::sqrt(err / norm), static_cast<double>(s.relative_error));
   EXPECT_LT(std::sqrt(err / norm), 2.0 * static_cast<double>(s.relative_error) + 0.05);
 }
 
@@ -111,8 +114,8 @@ struct Baked {
   gi::BasisRadianceField field;
   Baked(gi::BrfMesh m, const gi::BrdfSeparation* glossy) : mesh(std::move(m)) {
     basis = gi::compute_pca_basis(mesh, {.lights = 256, .basis = 24}, glossy).value();
-    field = gi::compute_basis_radiance_field(mesh, basis, {.spheres = 12, .face_resolution = 12, .sh_bands = 3, .directions = 512},
-                                             glossy)
+    field = gi::compute_basis_radiance_field(
+                mesh, basis, {.spheres = 12, .face_resolution = 12, .sh_bands = 3, .directions = 512}, glossy)
                 .value();
   }
 };
@@ -145,7 +148,8 @@ TEST(BrfGlossy, GlossySourceLightsItsNeighbourAsThePathTracerDoes) {
   const glm::mat4 m_source(1.0f);
   const glm::mat4 m_receiver = glm::translate(glm::mat4(1.0f), {0.75f, 0.0f, 0.0f});
   const gi::PointEmitter light = point_light({-1.0f, 0.9f, 0.0f}, 4.0f);
-  const gi::BrfMesh source_mesh = brftest::box({0.3f, 0.3f, 0.3f}, 6), receiver_mesh = brftest::box({0.2f, 0.8f, 0.4f}, 6);
+  const gi::BrfMesh source_mesh = brftest::box({0.3f, 0.3f, 0.3f}, 6),
+                    receiver_mesh = brftest::box({0.2f, 0.8f, 0.4f}, 6);
   const Baked receiver(receiver_mesh, nullptr), diffuse_source(source_mesh, nullptr);
 
   gi::ReferenceScene ref;
@@ -179,13 +183,15 @@ TEST(BrfGlossy, GlossySourceLightsItsNeighbourAsThePathTracerDoes) {
   const double albedo = static_cast<double>(engine::gltf_hemispherical_albedo(metal.brdf).specular.x);
   const double none = run(diffuse_source, nullptr, source_diffuse);
   const double stand_in = run(diffuse_source, nullptr, source_diffuse + glm::vec3(static_cast<float>(albedo)));
-  std::printf("receiver rel RMSE: glossy lobe left out %.3f, diffuse stand-in (albedo +%.2f) %.3f\n", none, albedo, stand_in);
+  std::printf("receiver rel RMSE: glossy lobe left out %.3f, diffuse stand-in (albedo +%.2f) %.3f\n", none, albedo,
+              stand_in);
   double k1 = 0.0, k4 = 0.0;
   for (int k : {1, 4}) {
     const gi::BrdfSeparation sep = gi::separate_glossy_brdf(lobe, {.terms = k, .resolution = 32}).value();
     const Baked source(source_mesh, &sep);
     const double e = run(source, &sep, source_diffuse);
-    std::printf("receiver rel RMSE: %d glossy terms (BRDF error %.2f) %.3f\n", sep.terms, static_cast<double>(sep.relative_error), e);
+    std::printf("receiver rel RMSE: %d glossy terms (BRDF error %.2f) %.3f\n", sep.terms,
+                static_cast<double>(sep.relative_error), e);
     (k == 1 ? k1 : k4) = e;
   }
   EXPECT_LT(k4, 0.6 * k1);
@@ -202,9 +208,11 @@ TEST(BrfGlossy, GlossyReceiverReflectsTowardTheViewerLikeTheExactLobe) {
   const glm::vec3 red(0.8f, 0.1f, 0.1f), receiver_diffuse(0.1f);
   const glm::mat4 m_source = glm::translate(glm::mat4(1.0f), {-0.45f, 0.0f, 0.0f});
   // Turned, so the receiver's frames are not the world's.
-  const glm::mat4 m_receiver = glm::rotate(glm::translate(glm::mat4(1.0f), {0.4f, 0.1f, 0.05f}), 0.3f, glm::vec3(0, 1, 0));
+  const glm::mat4 m_receiver =
+      glm::rotate(glm::translate(glm::mat4(1.0f), {0.4f, 0.1f, 0.05f}), 0.3f, glm::vec3(0, 1, 0));
   const gi::PointEmitter light = point_light({-1.2f, 1.0f, 0.6f}, 4.0f);
-  const Baked source(brftest::box({0.3f, 0.3f, 0.3f}, 6), nullptr), receiver(brftest::box({0.25f, 0.4f, 0.25f}, 6), &sep);
+  const Baked source(brftest::box({0.3f, 0.3f, 0.3f}, 6), nullptr),
+      receiver(brftest::box({0.25f, 0.4f, 0.25f}, 6), &sep);
   gi::BrfObject objects[] = {{&source.mesh, &source.basis, &source.field, m_source, red},
                              {&receiver.mesh, &receiver.basis, &receiver.field, m_receiver, receiver_diffuse}};
   objects[1].glossy = &sep;
@@ -221,7 +229,8 @@ TEST(BrfGlossy, GlossyReceiverReflectsTowardTheViewerLikeTheExactLobe) {
   std::vector<glm::vec3> ours, truth, diffuse_only;
   constexpr int kRays = 4096;
   for (std::size_t j = 0; j < v.positions.size(); ++j) {
-    if (glm::dot(v.normals[j], view) <= 0.1f || glm::dot(v.normals[j], glm::vec3(-1, 0, 0)) < 0.5f) continue;  // facing the red box
+    if (glm::dot(v.normals[j], view) <= 0.1f || glm::dot(v.normals[j], glm::vec3(-1, 0, 0)) < 0.5f)
+      continue;  // facing the red box
     const glm::mat3 to_local = glm::transpose(v.frames[j]);
     const glm::vec3 wo = to_local * view;
     glm::dvec3 sum(0.0);
@@ -246,8 +255,10 @@ TEST(BrfGlossy, GlossyReceiverReflectsTowardTheViewerLikeTheExactLobe) {
   }
   ASSERT_GT(truth.size(), 20u);
   const double err = rel_rmse(ours, truth), err_diffuse = rel_rmse(diffuse_only, truth);
-  std::printf("glossy receiver, %zu vertices: rel RMSE of the radiance toward the viewer %.3f (%d terms), %.3f with the diffuse part only\n",
-              truth.size(), err, sep.terms, err_diffuse);
+  std::printf(
+      "glossy receiver, %zu vertices: rel RMSE of the radiance toward the viewer %.3f (%d terms), %.3f with the "
+      "diffuse part only\n",
+      truth.size(), err, sep.terms, err_diffuse);
   EXPECT_LT(err, 0.5 * err_diffuse);
   EXPECT_LT(err, 0.3);
 }
@@ -255,11 +266,13 @@ TEST(BrfGlossy, GlossyReceiverReflectsTowardTheViewerLikeTheExactLobe) {
 // Turning both glossy objects and the light together changes no term: the tangent frames
 // come from object-space normals and turn with the objects.
 TEST(BrfGlossy, RotatingEverythingTogetherChangesNoTerm) {
-  const gi::BrdfSeparation sep = gi::separate_glossy_brdf({.f0 = 0.9f, .alpha = 0.5f}, {.terms = 4, .resolution = 16}).value();
+  const gi::BrdfSeparation sep =
+      gi::separate_glossy_brdf({.f0 = 0.9f, .alpha = 0.5f}, {.terms = 4, .resolution = 16}).value();
   gi::BrfMesh a_mesh = brftest::box({0.3f, 0.3f, 0.3f}, 4), b_mesh = brftest::box({0.25f, 0.4f, 0.25f}, 4);
   const auto bake = [&](const gi::BrfMesh& m, gi::BrfBasis& basis, gi::BasisRadianceField& field) {
     basis = gi::compute_pca_basis(m, {.lights = 128, .basis = 12}, &sep).value();
-    field = gi::compute_basis_radiance_field(m, basis, {.spheres = 6, .face_resolution = 6, .directions = 128}, &sep).value();
+    field = gi::compute_basis_radiance_field(m, basis, {.spheres = 6, .face_resolution = 6, .directions = 128}, &sep)
+                .value();
   };
   gi::BrfBasis a_basis, b_basis;
   gi::BasisRadianceField a_field, b_field;
@@ -267,7 +280,8 @@ TEST(BrfGlossy, RotatingEverythingTogetherChangesNoTerm) {
   bake(b_mesh, b_basis, b_field);
   const auto run = [&](const glm::mat4& world) {
     gi::BrfObject objects[] = {
-        {&a_mesh, &a_basis, &a_field, world * glm::translate(glm::mat4(1.0f), {-0.45f, 0.0f, 0.0f}), glm::vec3(0.3f, 0.05f, 0.05f)},
+        {&a_mesh, &a_basis, &a_field, world * glm::translate(glm::mat4(1.0f), {-0.45f, 0.0f, 0.0f}),
+         glm::vec3(0.3f, 0.05f, 0.05f)},
         {&b_mesh, &b_basis, &b_field, world * glm::translate(glm::mat4(1.0f), {0.4f, 0.1f, 0.05f}), glm::vec3(0.2f)}};
     objects[0].glossy = objects[1].glossy = &sep;
     const gi::PointEmitter light = point_light(glm::vec3(world * glm::vec4(-1.2f, 1.0f, 0.6f, 1.0f)), 4.0f);

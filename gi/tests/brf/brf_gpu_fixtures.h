@@ -9,9 +9,9 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <glm/gtc/matrix_transform.hpp>
 #include <span>
 #include <vector>
+#include <glm/gtc/matrix_transform.hpp>
 
 #include "brf/brf_gpu_pass.h"
 #include "brf/brf_runtime.h"
@@ -63,8 +63,8 @@ inline std::vector<gi::BrfGpuInstance> three_objects(float third_distance = 0.7f
 }
 
 // Light arriving at each vertex from a point light (unshadowed) plus a constant sky term.
-inline std::vector<std::vector<glm::vec3>> incoming_light(std::span<const gi::BrfGpuInstance> instances, glm::vec3 light,
-                                                   float strength = 4.0f) {
+inline std::vector<std::vector<glm::vec3>> incoming_light(std::span<const gi::BrfGpuInstance> instances,
+                                                          glm::vec3 light, float strength = 4.0f) {
   std::vector<std::vector<glm::vec3>> in;
   for (const gi::BrfGpuInstance& i : instances) {
     const gi::BrfWorldVertices v = gi::brf_world_vertices(models().object(i));
@@ -102,8 +102,9 @@ inline StaticPoints static_points() {
   return s;
 }
 
-inline gi::BrfResult cpu(std::span<const gi::BrfGpuInstance> instances, std::span<const std::vector<glm::vec3>> incoming,
-                  const gi::BrfUpdateSettings& settings, const StaticPoints* receivers = nullptr) {
+inline gi::BrfResult cpu(std::span<const gi::BrfGpuInstance> instances,
+                         std::span<const std::vector<glm::vec3>> incoming, const gi::BrfUpdateSettings& settings,
+                         const StaticPoints* receivers = nullptr) {
   std::vector<gi::BrfObject> objects;
   for (const auto& i : instances) objects.push_back(models().object(i));
   gi::BrfStaticReceivers r;

@@ -19,7 +19,8 @@ using gltest::headless_or_fail;
 // Glossy scenes: model 0 the diffuse cube, 1 a glossy cube (GGX f0 0.9, alpha 0.5, 4+ terms,
 // 4 SH bands), 2 a glossy slab (3 bands) sharing the lobe.
 struct GlossyModels {
-  gi::BrdfSeparation sep = gi::separate_glossy_brdf({.f0 = 0.9f, .alpha = 0.5f}, {.terms = 4, .resolution = 16}).value();
+  gi::BrdfSeparation sep =
+      gi::separate_glossy_brdf({.f0 = 0.9f, .alpha = 0.5f}, {.terms = 4, .resolution = 16}).value();
   gi::BrfMesh cube = box({0.3f, 0.3f, 0.3f}, 3);
   gi::BrfMesh slab = box({0.2f, 0.4f, 0.25f}, 3);
   gi::BrfBasis cube_basis = gi::compute_pca_basis(cube, {.lights = 64, .basis = 6}, &sep).value();
@@ -34,7 +35,8 @@ struct GlossyModels {
           .value();
   std::vector<gi::BrfGpuModel> gpu() const {
     const Models& d = models();
-    return {{&d.cube, &d.cube_basis, &d.cube_field}, {&cube, &cube_basis, &cube_field, &sep},
+    return {{&d.cube, &d.cube_basis, &d.cube_field},
+            {&cube, &cube_basis, &cube_field, &sep},
             {&slab, &slab_basis, &slab_field, &sep}};
   }
   gi::BrfObject object(const gi::BrfGpuInstance& i) const {
@@ -79,8 +81,9 @@ std::vector<std::vector<glm::vec3>> glossy_incoming(std::span<const gi::BrfGpuIn
   return in;
 }
 
-gi::BrfResult glossy_cpu(std::span<const gi::BrfGpuInstance> instances, std::span<const std::vector<glm::vec3>> incoming,
-                         const gi::BrfUpdateSettings& settings, const StaticPoints* receivers = nullptr) {
+gi::BrfResult glossy_cpu(std::span<const gi::BrfGpuInstance> instances,
+                         std::span<const std::vector<glm::vec3>> incoming, const gi::BrfUpdateSettings& settings,
+                         const StaticPoints* receivers = nullptr) {
   std::vector<gi::BrfObject> objects;
   for (const auto& i : instances) objects.push_back(glossy_models().object(i));
   gi::BrfStaticReceivers r;
@@ -203,7 +206,8 @@ TEST(BrfGpuPass, GlossyModelsAndLightMustMatch) {
   auto ctx = headless_or_fail();
   const GlossyModels& g = glossy_models();
   // A glossy field without its lobe, a lobe with another number of terms, a lobe on a diffuse field.
-  const gi::BrdfSeparation other = gi::separate_glossy_brdf({.f0 = 0.9f, .alpha = 0.5f}, {.terms = 1, .resolution = 8}).value();
+  const gi::BrdfSeparation other =
+      gi::separate_glossy_brdf({.f0 = 0.9f, .alpha = 0.5f}, {.terms = 1, .resolution = 8}).value();
   ASSERT_NE(other.terms, g.sep.terms);
   const Models& d = models();
   for (const gi::BrfGpuModel& bad : {gi::BrfGpuModel{&g.cube, &g.cube_basis, &g.cube_field},

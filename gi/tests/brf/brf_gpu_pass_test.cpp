@@ -6,15 +6,15 @@
 // the shared scenes and measures: brf_gpu_fixtures.h.
 #include "brf/brf_gpu_pass.h"
 
-#include <engine/gpu/context.h>
 #include <gtest/gtest.h>
+#include <engine/gpu/context.h>
 
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <glm/gtc/matrix_transform.hpp>
 #include <limits>
 #include <vector>
+#include <glm/gtc/matrix_transform.hpp>
 
 #include "brf/brf_runtime.h"
 #include "brf_gpu_fixtures.h"
@@ -141,7 +141,8 @@ TEST(BrfGpuPass, GatherCoversVertexCountsThatAreNoMultipleOfFour) {
   for (std::size_t i = 0; i < instances.size(); ++i) {
     const auto v = pass.read_back_vertices(i);
     ASSERT_EQ(v.size(), ref.indirect[i].size());
-    const std::span<const glm::vec3> tail_gpu(v.end() - 4, v.end()), tail_cpu(ref.indirect[i].end() - 4, ref.indirect[i].end());
+    const std::span<const glm::vec3> tail_gpu(v.end() - 4, v.end()),
+        tail_cpu(ref.indirect[i].end() - 4, ref.indirect[i].end());
     EXPECT_LT(relative_rmse(tail_gpu, tail_cpu), kTolerance) << "instance " << i << "'s last 4 vertices";
   }
 }
@@ -333,7 +334,6 @@ TEST(BrfGpuPass, BadInputReturnsErrors) {
   EXPECT_LT(vertices_error(pass, cpu(instances, incoming, settings)), kTolerance);
 }
 
-
 }  // namespace
 
 // Four objects in a row 3 m apart: each source's influence (its outermost field sphere,
@@ -345,7 +345,9 @@ TEST(BrfGpuPass, PairsOutsideTheInfluenceAreSkippedAsByTheTwin) {
   gi::BrfGpuPass pass = make_pass();
   std::vector<gi::BrfGpuInstance> instances;
   for (int i = 0; i < 4; ++i)
-    instances.push_back({static_cast<std::uint32_t>(i % 2), pose({3.0f * static_cast<float>(i), 0.0f, 0.1f * static_cast<float>(i)}, 0.3f * static_cast<float>(i), {0, 1, 0}),
+    instances.push_back({static_cast<std::uint32_t>(i % 2),
+                         pose({3.0f * static_cast<float>(i), 0.0f, 0.1f * static_cast<float>(i)},
+                              0.3f * static_cast<float>(i), {0, 1, 0}),
                          {0.8f, 0.6f, 0.4f}});
   const auto incoming = incoming_light(instances, {4.5f, 2.0f, 0.5f}, 20.0f);
   for (float cull : {0.0f, 1e-3f}) {
@@ -403,7 +405,9 @@ TEST(BrfGpuPass, ManyInstancesFitBecauseOnlyPairsInReachHoldPhi) {
   gi::BrfGpuPass pass = make_pass({.max_buffer_bytes = limit});
   std::vector<gi::BrfGpuInstance> instances;
   for (std::size_t i = 0; i < n; ++i)
-    instances.push_back({0, pose({3.0f * static_cast<float>(i % 16), 0.0f, 3.0f * static_cast<float>(i / 16)}, 0.1f * static_cast<float>(i), {0, 1, 0}),
+    instances.push_back({0,
+                         pose({3.0f * static_cast<float>(i % 16), 0.0f, 3.0f * static_cast<float>(i / 16)},
+                              0.1f * static_cast<float>(i), {0, 1, 0}),
                          {0.8f, 0.6f, 0.4f}});
   const auto incoming = incoming_light(instances, {20.0f, 3.0f, 20.0f}, 400.0f);
   const gi::BrfUpdateSettings settings{.bounces = 1, .cull_threshold = 0.0f, .occlusion = false};

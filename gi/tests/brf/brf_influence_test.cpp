@@ -6,8 +6,8 @@
 #include <array>
 #include <cmath>
 #include <limits>
-#include <glm/gtc/matrix_transform.hpp>
 #include <vector>
+#include <glm/gtc/matrix_transform.hpp>
 
 #include "brf/brf_runtime.h"
 #include "brf/brf_visibility.h"
@@ -22,11 +22,13 @@ struct Models {
   gi::BrfBasis cube_basis = gi::compute_pca_basis(cube, {.lights = 32, .basis = 4}).value();
   gi::BrfBasis slab_basis = gi::compute_pca_basis(slab, {.lights = 32, .basis = 4}).value();
   gi::BasisRadianceField cube_field =
-      gi::compute_basis_radiance_field(cube, cube_basis, {.spheres = 3, .face_resolution = 3, .sh_bands = 3, .directions = 32})
+      gi::compute_basis_radiance_field(cube, cube_basis,
+                                       {.spheres = 3, .face_resolution = 3, .sh_bands = 3, .directions = 32})
           .value();
   gi::BasisRadianceField slab_field =
-      gi::compute_basis_radiance_field(slab, slab_basis,
-                                       {.spheres = 3, .face_resolution = 3, .sh_bands = 3, .outer_radius_scale = 3.0f, .directions = 32})
+      gi::compute_basis_radiance_field(
+          slab, slab_basis,
+          {.spheres = 3, .face_resolution = 3, .sh_bands = 3, .outer_radius_scale = 3.0f, .directions = 32})
           .value();
 };
 
@@ -61,9 +63,11 @@ std::vector<std::uint8_t> brute_force(std::span<const gi::BrfObject> objects, fl
   for (std::size_t s = 0; s < n; ++s)
     for (std::size_t r = 0; r < n; ++r) {
       if (s == r) continue;
-      const gi::BrfSphere rs = gi::brf_bounding_sphere(gi::brf_object_box(*objects[r].mesh), objects[r].object_to_world);
+      const gi::BrfSphere rs =
+          gi::brf_bounding_sphere(gi::brf_object_box(*objects[r].mesh), objects[r].object_to_world);
       const glm::vec3 c = glm::vec3(objects[s].object_to_world * glm::vec4(objects[s].field->centre, 1.0f));
-      const float reach = objects[s].field->outer_radius * glm::length(glm::vec3(objects[s].object_to_world[0])) * scale;
+      const float reach =
+          objects[s].field->outer_radius * glm::length(glm::vec3(objects[s].object_to_world[0])) * scale;
       if (glm::length(rs.centre - c) < reach + rs.radius) outside[s * n + r] = 0;
     }
   return outside;

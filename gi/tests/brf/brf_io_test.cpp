@@ -3,9 +3,9 @@
 // rejected with messages naming the file.
 #include "brf/brf_io.h"
 
+#include <gtest/gtest.h>
 #include <engine/gltf.h>
 #include <engine/gltf_brdf.h>
-#include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstring>
@@ -15,8 +15,8 @@
 #include <string>
 #include <vector>
 
-#include "bundle/bundle.h"
 #include <engine/byte_stream.h>
+#include "bundle/bundle.h"
 #include "raytrace/scene_adapter.h"
 
 namespace {

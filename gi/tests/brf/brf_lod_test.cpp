@@ -4,17 +4,17 @@
 // with the level of detail on matches its twin (llvmpipe through EGL; fails, never skips).
 #include "brf/brf_lod.h"
 
-#include <engine/gpu/context.h>
 #include <gtest/gtest.h>
+#include <engine/gpu/context.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <glm/gtc/matrix_transform.hpp>
 #include <limits>
 #include <numbers>
 #include <vector>
+#include <glm/gtc/matrix_transform.hpp>
 
 #include "brf/brf_gpu_pass.h"
 #include "brf/brf_runtime.h"
@@ -27,9 +27,9 @@ namespace {
 struct Crate {
   gi::BrfMesh mesh = brftest::box(glm::vec3(0.25f), 4);
   gi::BrfBasis basis = gi::compute_pca_basis(mesh, {.lights = 64, .basis = 8}).value();
-  gi::BasisRadianceField field =
-      gi::compute_basis_radiance_field(mesh, basis, {.spheres = 6, .face_resolution = 6, .sh_bands = 3, .directions = 64})
-          .value();
+  gi::BasisRadianceField field = gi::compute_basis_radiance_field(
+                                     mesh, basis, {.spheres = 6, .face_resolution = 6, .sh_bands = 3, .directions = 64})
+                                     .value();
 };
 
 const Crate& crate() {
@@ -89,7 +89,8 @@ TEST(BrfLodPoints, CrateFacesGetALatticeOfPointsThatReproducesLinearFunctions) {
     }
     EXPECT_NEAR(w.x + w.y + w.z, 1.0f, 1e-5f);
     EXPECT_GE(std::min({w.x, w.y, w.z}), -1e-5f) << "vertex " << j << " is interpolated, not extrapolated";
-    const float interpolated = w.x * f(mesh.positions[r.x]) + w.y * f(mesh.positions[r.y]) + w.z * f(mesh.positions[r.z]);
+    const float interpolated =
+        w.x * f(mesh.positions[r.x]) + w.y * f(mesh.positions[r.y]) + w.z * f(mesh.positions[r.z]);
     EXPECT_NEAR(interpolated, f(mesh.positions[j]), 1e-5f) << "vertex " << j;
   }
 }
@@ -159,12 +160,12 @@ TEST(BrfLod, FarPairsEvaluateTheRepresentativePointsExactlyAndStayWithinTheBound
   for (float lod_distance : {3.0f, 5.0f}) {
     const gi::BrfResult r = gi::brf_interreflect(objects, in, {.cull_threshold = 0.0f, .lod_distance = lod_distance});
     const auto [max_rel, p95] = gi::brf_vertex_error(r, exact);
-    std::printf("lod_distance %.1f: %zu of %zu pairs far, vertex rel error max %.4f, p95 %.4f\n",
-                double(lod_distance), r.pairs_lod, r.pairs_evaluated, max_rel, p95);
+    std::printf("lod_distance %.1f: %zu of %zu pairs far, vertex rel error max %.4f, p95 %.4f\n", double(lod_distance),
+                r.pairs_lod, r.pairs_evaluated, max_rel, p95);
     EXPECT_GT(r.pairs_lod, 0u);
     EXPECT_LT(r.pairs_lod, r.pairs_evaluated);  // the neighbours stay exact
-    EXPECT_LT(max_rel, 0.05) << lod_distance;  // measured 0.013 at both
-    EXPECT_LT(p95, 0.01) << lod_distance;      // measured 0.004
+    EXPECT_LT(max_rel, 0.05) << lod_distance;   // measured 0.013 at both
+    EXPECT_LT(p95, 0.01) << lod_distance;       // measured 0.004
   }
   // Shared visibility: whole rows interpolated (a face partly hidden by the middle crate gets
   // its corners' mix): looser.
@@ -226,8 +227,10 @@ TEST(BrfLod, GpuPassMatchesItsTwinWithTheLevelOfDetail) {
     const gi::BrfResult ref = gi::brf_interreflect(objects, in, on);
     const std::vector<glm::vec3> gpu_on = all();
     const double e = relative_rmse(gpu_on, flat(ref));
-    std::printf("cull %g, shared visibility %d: lod on, GPU vs CPU rel RMSE %.2e, %zu far pairs of %zu; lod on vs off %.2e\n", double(cull),
-                int(shared), e, pass.stats().pairs_lod, pass.stats().pairs_evaluated, relative_rmse(gpu_on, gpu_off));
+    std::printf(
+        "cull %g, shared visibility %d: lod on, GPU vs CPU rel RMSE %.2e, %zu far pairs of %zu; lod on vs off %.2e\n",
+        double(cull), int(shared), e, pass.stats().pairs_lod, pass.stats().pairs_evaluated,
+        relative_rmse(gpu_on, gpu_off));
     EXPECT_LT(e, 1e-3);
     EXPECT_GT(ref.pairs_lod, 0u);
     EXPECT_EQ(pass.stats().pairs_lod, ref.pairs_lod);
@@ -264,7 +267,8 @@ TEST(BrfLod, PackedRepresentativePointsGiveTheSameBitsAsOneWorkGroupPerPair) {
         auto created = gi::BrfGpuPass::create(std::span(models.data(), model_count), options);
         ASSERT_TRUE(created.ok()) << created.error().to_string();
         gi::BrfGpuPass pass = std::move(created).value();
-        const gi::BrfUpdateSettings on{.bounces = 3, .cull_threshold = 0.0f, .lod_distance = 2.0f, .lod_shared_visibility = shared};
+        const gi::BrfUpdateSettings on{
+            .bounces = 3, .cull_threshold = 0.0f, .lod_distance = 2.0f, .lod_shared_visibility = shared};
         const auto status = pass.run(instances, in, on);
         ASSERT_TRUE(status.ok()) << status.error().to_string();
         result[packed].clear();

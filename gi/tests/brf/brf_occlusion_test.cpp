@@ -4,23 +4,23 @@
 // the third crate gets about what the path tracer says passes beside the second. The GPU
 // pass does the same box tests (brf_phi.comp.glsl) and matches its CPU twin; moving the
 // middle crate re-evaluates the outer pair's Phi although that pair's relative pose holds.
-#include <engine/gpu/context.h>
 #include <gtest/gtest.h>
+#include <engine/gpu/context.h>
 
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <glm/gtc/matrix_transform.hpp>
 #include <vector>
+#include <glm/gtc/matrix_transform.hpp>
 
 #include "brf/brf_gpu_pass.h"
 #include "brf/brf_runtime.h"
 #include "brf/brf_visibility.h"
 #include "brf_scenes.h"
+#include "gl_context.h"
 #include "raytrace/reference_render.h"
 #include "reference_scenes.h"
 #include "transport/point_emitters.h"
-#include "gl_context.h"
 
 namespace {
 
@@ -28,7 +28,8 @@ struct CrateModel {
   gi::BrfMesh mesh = brftest::box({0.3f, 0.3f, 0.3f}, 4);
   gi::BrfBasis basis = gi::compute_pca_basis(mesh, {.lights = 256, .basis = 16}).value();
   gi::BasisRadianceField field =
-      gi::compute_basis_radiance_field(mesh, basis, {.spheres = 8, .face_resolution = 8, .sh_bands = 3, .directions = 256})
+      gi::compute_basis_radiance_field(mesh, basis,
+                                       {.spheres = 8, .face_resolution = 8, .sh_bands = 3, .directions = 256})
           .value();
 };
 
@@ -40,10 +41,9 @@ const CrateModel& model() {
 const glm::vec3 kWhite(0.8f);
 // In a row along x on one floor plane (y = -0.3), the middle one scaled to 0.6 (36 cm): part
 // of the first crate's light passes over it onto the third.
-const glm::mat4 kPoses[3] = {
-    glm::translate(glm::mat4(1.0f), {-1.0f, 0.0f, 0.0f}),
-    glm::scale(glm::translate(glm::mat4(1.0f), {0.0f, -0.12f, 0.0f}), glm::vec3(0.6f)),
-    glm::translate(glm::mat4(1.0f), {1.0f, 0.0f, 0.0f})};
+const glm::mat4 kPoses[3] = {glm::translate(glm::mat4(1.0f), {-1.0f, 0.0f, 0.0f}),
+                             glm::scale(glm::translate(glm::mat4(1.0f), {0.0f, -0.12f, 0.0f}), glm::vec3(0.6f)),
+                             glm::translate(glm::mat4(1.0f), {1.0f, 0.0f, 0.0f})};
 
 // A narrow spot above the gap between the first two crates, aimed at the first crate's face
 // toward the second: it lights the first crate only.
@@ -106,8 +106,8 @@ TEST(BrfOcclusion, TheThirdCrateGetsOnlyWhatPassesTheSecond) {
   const double w2 = sum_x(with.indirect[1]), w3 = sum_x(with.indirect[2]);
   const double o2 = sum_x(without.indirect[1]), o3 = sum_x(without.indirect[2]);
   std::printf("second crate: path tracer %.4f, occlusion %.4f, none %.4f\n", t2, w2, o2);
-  std::printf("third crate:  path tracer %.4f, occlusion %.4f, none %.4f (sums of red irradiance over vertices)\n",
-              t3, w3, o3);
+  std::printf("third crate:  path tracer %.4f, occlusion %.4f, none %.4f (sums of red irradiance over vertices)\n", t3,
+              w3, o3);
   // The second crate sees the first directly: occlusion changes little there.
   EXPECT_NEAR(w2 / t2, 1.0, 0.25);
   // Without occlusion the third crate is lit through the second: 1.85x the path tracer.
@@ -153,8 +153,8 @@ TEST(BrfOcclusion, GpuPassMatchesItsTwinAndReevaluatesWhenAnOccluderMoves) {
     if (poses == &lifted) {
       // Every pair's Phi again: the middle crate's pairs moved, the outer pairs' occluder did.
       EXPECT_EQ(pass.stats().pairs_reused, 0u);
-      const gi::BrfResult row = gi::brf_interreflect(crates(kPoses), gi::brf_direct_light(crates(kPoses), emitters, nullptr),
-                                                     settings);
+      const gi::BrfResult row =
+          gi::brf_interreflect(crates(kPoses), gi::brf_direct_light(crates(kPoses), emitters, nullptr), settings);
       EXPECT_NE(sum_x(cpu.indirect[2]), sum_x(row.indirect[2]));
     }
   }
@@ -175,15 +175,15 @@ TEST(BrfOcclusion, TwoOccludersEachHidingPartMatchTheTwin) {
   auto ctx = headless_or_fail();
   const CrateModel& m = model();
   auto pass = gi::BrfGpuPass::create(std::vector<gi::BrfGpuModel>{{&m.mesh, &m.basis, &m.field}}).value();
-  const glm::mat4 poses[4] = {
-      glm::translate(glm::mat4(1.0f), {-1.6f, 0.0f, 0.0f}),
-      glm::scale(glm::translate(glm::mat4(1.0f), {-0.55f, -0.14f, 0.1f}), glm::vec3(0.5f)),
-      glm::scale(glm::translate(glm::mat4(1.0f), {0.55f, 0.16f, -0.12f}), glm::vec3(0.5f)),
-      glm::translate(glm::mat4(1.0f), {1.6f, 0.0f, 0.0f})};
+  const glm::mat4 poses[4] = {glm::translate(glm::mat4(1.0f), {-1.6f, 0.0f, 0.0f}),
+                              glm::scale(glm::translate(glm::mat4(1.0f), {-0.55f, -0.14f, 0.1f}), glm::vec3(0.5f)),
+                              glm::scale(glm::translate(glm::mat4(1.0f), {0.55f, 0.16f, -0.12f}), glm::vec3(0.5f)),
+                              glm::translate(glm::mat4(1.0f), {1.6f, 0.0f, 0.0f})};
   std::vector<gi::BrfObject> objects;
   for (const glm::mat4& p : poses) objects.push_back({&m.mesh, &m.basis, &m.field, p, kWhite});
   std::vector<gi::BrfSphere> spheres;
-  for (const gi::BrfObject& o : objects) spheres.push_back(gi::brf_bounding_sphere(gi::brf_object_box(*o.mesh), o.object_to_world));
+  for (const gi::BrfObject& o : objects)
+    spheres.push_back(gi::brf_bounding_sphere(gi::brf_object_box(*o.mesh), o.object_to_world));
   ASSERT_EQ(gi::brf_pair_occluders(spheres, 0, 3), (std::vector<std::uint32_t>{1, 2}));
   gi::PointEmitter light;
   light.position = {0.0f, 2.0f, 0.6f};
@@ -306,9 +306,10 @@ TEST(BrfOcclusion, StackedCratesContactFacesAgainstThePathTracer) {
     (contact ? contact_ours : rest_ours) += ours;
     (contact ? contact_truth : rest_truth) += t;
   }
-  std::printf("stacked crates, sums of indirect irradiance (red): contact faces %.4f vs path tracer %.4f (%.2fx); "
-              "other vertices %.4f vs %.4f\n",
-              contact_ours, contact_truth, contact_ours / contact_truth, rest_ours, rest_truth);
+  std::printf(
+      "stacked crates, sums of indirect irradiance (red): contact faces %.4f vs path tracer %.4f (%.2fx); "
+      "other vertices %.4f vs %.4f\n",
+      contact_ours, contact_truth, contact_ours / contact_truth, rest_ours, rest_truth);
   // 5.9x before the contact factor (brf_contact_visibility), 2.6x with it.
   EXPECT_LT(contact_ours, 3.5 * contact_truth);
   EXPECT_GT(contact_ours, 0.5 * contact_truth);
@@ -384,9 +385,10 @@ TEST(BrfOcclusion, AlignedStackContactFacesOnTheCpuTwinAndTheGpu) {
     sum[1] += static_cast<double>(gpu[o][j].x);
     sum[2] += static_cast<double>(truth.indirect[k].x);
   }
-  std::printf("aligned stack, red indirect summed: contact faces CPU %.5f, GPU %.5f, path tracer %.5f; "
-              "elsewhere CPU %.5f, GPU %.5f, path tracer %.5f\n",
-              contact[0], contact[1], contact[2], rest[0], rest[1], rest[2]);
+  std::printf(
+      "aligned stack, red indirect summed: contact faces CPU %.5f, GPU %.5f, path tracer %.5f; "
+      "elsewhere CPU %.5f, GPU %.5f, path tracer %.5f\n",
+      contact[0], contact[1], contact[2], rest[0], rest[1], rest[2]);
   for (int i = 0; i < 2; ++i) {
     EXPECT_LT(contact[i], 3.0 * contact[2] + 1e-3) << (i == 0 ? "CPU" : "GPU");
     EXPECT_LT(contact[i], 0.01 * rest[i]) << (i == 0 ? "CPU" : "GPU");

@@ -28,7 +28,8 @@ gi::BrfMesh sphere(float r, int rings, int segments) {
   const auto at = [&](int i, int j) { return static_cast<std::uint32_t>(i * (segments + 1) + j); };
   for (int i = 0; i < rings; ++i)
     for (int j = 0; j < segments; ++j)
-      m.indices.insert(m.indices.end(), {at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+      m.indices.insert(m.indices.end(),
+                       {at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j), at(i + 1, j + 1), at(i, j + 1)});
   return m;
 }
 
@@ -44,7 +45,8 @@ gi::BrfMesh plate(float s, int n) {
   const auto at = [&](int i, int j) { return static_cast<std::uint32_t>(i * (n + 1) + j); };
   for (int i = 0; i < n; ++i)
     for (int j = 0; j < n; ++j)
-      m.indices.insert(m.indices.end(), {at(i, j), at(i, j + 1), at(i + 1, j + 1), at(i, j), at(i + 1, j + 1), at(i + 1, j)});
+      m.indices.insert(m.indices.end(),
+                       {at(i, j), at(i, j + 1), at(i + 1, j + 1), at(i, j), at(i + 1, j + 1), at(i + 1, j)});
   return m;
 }
 

@@ -10,8 +10,8 @@
 #include "brf/pca_basis.h"
 #include "brf/radiance_field.h"
 #include "brf/spherical_harmonics.h"
-#include "raytrace/embree_ray_caster.h"
 #include "brf_scenes.h"
+#include "raytrace/embree_ray_caster.h"
 
 namespace {
 
@@ -29,13 +29,15 @@ double integrated_irradiance(const gi::BrfMesh& mesh, const std::vector<float>& 
   double e = 0.0;
   for (int i = 0; i < count; ++i) {
     const double z = 1.0 - (2.0 * i + 1.0) / count, r = std::sqrt(std::max(0.0, 1.0 - z * z));
-    const glm::vec3 w(static_cast<float>(r * std::cos(golden * i)), static_cast<float>(r * std::sin(golden * i)), static_cast<float>(z));
+    const glm::vec3 w(static_cast<float>(r * std::cos(golden * i)), static_cast<float>(r * std::sin(golden * i)),
+                      static_cast<float>(z));
     const float c = glm::dot(n, w);
     if (c <= 0.0f) continue;
     const gi::Hit h = caster->intersect(gi::Ray{p, 0.0f, w});
     if (!h.valid() || glm::dot(h.geometric_normal, w) >= 0.0f) continue;
     const std::uint32_t* t = mesh.indices.data() + 3 * static_cast<std::size_t>(h.primitive);
-    const float radiosity = (1.0f - h.barycentric.x - h.barycentric.y) * b[t[0]] + h.barycentric.x * b[t[1]] + h.barycentric.y * b[t[2]];
+    const float radiosity =
+        (1.0f - h.barycentric.x - h.barycentric.y) * b[t[0]] + h.barycentric.x * b[t[1]] + h.barycentric.y * b[t[2]];
     e += static_cast<double>(radiosity / std::numbers::pi_v<float> * c);
   }
   return e * 4.0 * std::numbers::pi / count;
@@ -47,9 +49,10 @@ double field_irradiance(const gi::BasisRadianceField& f, const std::vector<float
   const auto lobe = gi::sh_clamped_cosine(n, f.sh_bands);
   double e = 0.0;
   for (int i = 0; i < f.basis_count; ++i)
-    e += static_cast<double>(w[static_cast<std::size_t>(i)] *
-                             gi::sh_dot(std::span<const float>(c).subspan(static_cast<std::size_t>(i * f.coefficient_count())), lobe,
-                                        static_cast<std::size_t>(f.coefficient_count())));
+    e += static_cast<double>(
+        w[static_cast<std::size_t>(i)] *
+        gi::sh_dot(std::span<const float>(c).subspan(static_cast<std::size_t>(i * f.coefficient_count())), lobe,
+                   static_cast<std::size_t>(f.coefficient_count())));
   return e;
 }
 
@@ -61,7 +64,9 @@ TEST(BrfRadianceField, IrradianceFromTheFieldMatchesDirectIntegration) {
   const gi::BrfMesh mesh = box({0.4f, 0.25f, 0.3f}, 4);
   const gi::BrfBasis basis = gi::compute_pca_basis(mesh, {.lights = 128, .basis = 16}).value();
   const gi::BasisRadianceField field =
-      gi::compute_basis_radiance_field(mesh, basis, {.spheres = 8, .face_resolution = 16, .sh_bands = 3, .directions = 256}).value();
+      gi::compute_basis_radiance_field(mesh, basis,
+                                       {.spheres = 8, .face_resolution = 16, .sh_bands = 3, .directions = 256})
+          .value();
   std::printf("field: %d spheres x %d points, %d basis functions, %zu bytes\n", field.spheres,
               6 * field.face_resolution * field.face_resolution, field.basis_count, field.bytes());
   // The object lit by a light above and to the side; the receivers see its lit faces.
@@ -77,8 +82,8 @@ TEST(BrfRadianceField, IrradianceFromTheFieldMatchesDirectIntegration) {
     const glm::vec3 n = glm::normalize(-p);  // facing the object
     const double truth = integrated_irradiance(mesh, radiosity, p, n);
     const double ours = field_irradiance(field, w, p, n);
-    std::printf("receiver at %.1f R: field %.5f, integrated %.5f (ratio %.3f)\n", double{glm::length(p) / basis.radius}, ours,
-                truth, ours / truth);
+    std::printf("receiver at %.1f R: field %.5f, integrated %.5f (ratio %.3f)\n", double{glm::length(p) / basis.radius},
+                ours, truth, ours / truth);
     EXPECT_NEAR(ours / truth, 1.0, 0.15);
   }
 }
@@ -89,7 +94,8 @@ TEST(BrfRadianceField, InsideTheInnermostSphereAndFarAwayStayFinite) {
   const gi::BasisRadianceField field =
       gi::compute_basis_radiance_field(mesh, basis, {.spheres = 4, .face_resolution = 4, .directions = 256}).value();
   std::vector<float> w(static_cast<std::size_t>(basis.basis_count), 1.0f);
-  for (glm::vec3 p : {glm::vec3(0.1f, 0.0f, 0.0f), glm::vec3(0.0f), glm::vec3(0.6f, 0.0f, 0.0f), glm::vec3(1e6f, 0.0f, 0.0f)}) {
+  for (glm::vec3 p :
+       {glm::vec3(0.1f, 0.0f, 0.0f), glm::vec3(0.0f), glm::vec3(0.6f, 0.0f, 0.0f), glm::vec3(1e6f, 0.0f, 0.0f)}) {
     const double e = field_irradiance(field, w, p, {-1.0f, 0.0f, 0.0f});
     EXPECT_TRUE(std::isfinite(e)) << p.x;
   }
@@ -106,7 +112,8 @@ struct LitBox {
   gi::BrfMesh mesh = box({0.3f, 0.3f, 0.3f}, 6);
   gi::BrfBasis basis = gi::compute_pca_basis(mesh, {.lights = 128, .basis = 16}).value();
   gi::BasisRadianceField field =
-      gi::compute_basis_radiance_field(mesh, basis, {.spheres = 8, .face_resolution = 8, .sh_bands = 3, .directions = 256})
+      gi::compute_basis_radiance_field(mesh, basis,
+                                       {.spheres = 8, .face_resolution = 8, .sh_bands = 3, .directions = 256})
           .value();
   std::vector<float> w, radiosity;
   LitBox() {

@@ -10,9 +10,9 @@
 #include <gtest/gtest.h>
 
 #include "brf/brf_runtime.h"
+#include "brf_scenes.h"
 #include "raytrace/reference_render.h"
 #include "reference_scenes.h"
-#include "brf_scenes.h"
 
 namespace {
 
@@ -98,8 +98,9 @@ TEST(BrfRuntime, RotatingEverythingTogetherChangesNothing) {
   const glm::mat4 m_receiver = glm::translate(glm::mat4(1.0f), {0.4f, 0.1f, 0.05f});
   const glm::vec3 light_p(-1.2f, 1.0f, 0.6f);
   const auto run = [&](const glm::mat4& world) {
-    const gi::BrfObject objects[] = {{&s.source, &s.source_basis, &s.source_field, world * m_source, glm::vec3(0.8f, 0.1f, 0.1f)},
-                                     {&s.receiver, &s.receiver_basis, &s.receiver_field, world * m_receiver, glm::vec3(0.8f)}};
+    const gi::BrfObject objects[] = {
+        {&s.source, &s.source_basis, &s.source_field, world * m_source, glm::vec3(0.8f, 0.1f, 0.1f)},
+        {&s.receiver, &s.receiver_basis, &s.receiver_field, world * m_receiver, glm::vec3(0.8f)}};
     const gi::PointEmitter light = point_light(glm::vec3(world * glm::vec4(light_p, 1.0f)), 4.0f);
     return gi::update_brf(objects, std::span<const gi::PointEmitter>(&light, 1), {.bounces = 3});
   };
@@ -125,7 +126,8 @@ TEST(BrfRuntime, OverlappingTouchingAndScaledObjectsStayFiniteAndBounded) {
     const gi::BrfObject objects[] = {
         {&s.source, &s.source_basis, &s.source_field, scaled * glm::translate(glm::mat4(1.0f), {-0.45f, 0.0f, 0.0f}),
          glm::vec3(0.8f, 0.1f, 0.1f)},
-        {&s.receiver, &s.receiver_basis, &s.receiver_field, scaled * glm::translate(glm::mat4(1.0f), receiver_at), glm::vec3(0.8f)}};
+        {&s.receiver, &s.receiver_basis, &s.receiver_field, scaled * glm::translate(glm::mat4(1.0f), receiver_at),
+         glm::vec3(0.8f)}};
     // Intensity x scale^2 keeps the irradiance of the scaled scene the same.
     const gi::PointEmitter light = point_light(scale * light_p, 4.0f * scale * scale);
     return gi::update_brf(objects, std::span<const gi::PointEmitter>(&light, 1), {.bounces = 3});
@@ -146,7 +148,7 @@ TEST(BrfRuntime, OverlappingTouchingAndScaledObjectsStayFiniteAndBounded) {
     EXPECT_LE(indirect, 4.0f * direct) << what;
   };
   check(run({-0.3f, 0.05f, 0.0f}, 1.0f), "overlapping");  // centres 0.15 m apart: each inside the other
-  check(run({0.1f, 0.0f, 0.0f}, 1.0f), "touching");  // receiver x in [-0.15, 0.35], source x in [-0.75, -0.15]
+  check(run({0.1f, 0.0f, 0.0f}, 1.0f), "touching");       // receiver x in [-0.15, 0.35], source x in [-0.75, -0.15]
   const gi::BrfResult metre = run({0.4f, 0.1f, 0.05f}, 1.0f);
   for (float scale : {0.01f, 100.0f}) {
     const gi::BrfResult r = run({0.4f, 0.1f, 0.05f}, scale);

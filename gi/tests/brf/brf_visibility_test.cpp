@@ -5,24 +5,24 @@
 // test can fail); receivers on the crate's side of the wall keep every bit of the bounce.
 #include "brf/brf_visibility.h"
 
-#include <engine/gpu/context.h>
 #include <gtest/gtest.h>
+#include <engine/gpu/context.h>
 
 #include <cmath>
 #include <cstdio>
-#include <numbers>
 #include <cstdlib>
-#include <glm/gtc/matrix_transform.hpp>
+#include <numbers>
 #include <vector>
+#include <glm/gtc/matrix_transform.hpp>
 
 #include "brf/brf_gpu_pass.h"
 #include "brf/brf_runtime.h"
 #include "brf_scenes.h"
+#include "gl_context.h"
 #include "raytrace/embree_ray_caster.h"
 #include "raytrace/reference_render.h"
 #include "reference_scenes.h"
 #include "transport/point_emitters.h"
-#include "gl_context.h"
 
 namespace {
 
@@ -31,9 +31,9 @@ using gltest::headless_or_fail;
 struct Crate {
   gi::BrfMesh mesh = brftest::box({0.3f, 0.3f, 0.3f}, 3);
   gi::BrfBasis basis = gi::compute_pca_basis(mesh, {.lights = 64, .basis = 8}).value();
-  gi::BasisRadianceField field =
-      gi::compute_basis_radiance_field(mesh, basis, {.spheres = 6, .face_resolution = 6, .sh_bands = 3, .directions = 64})
-          .value();
+  gi::BasisRadianceField field = gi::compute_basis_radiance_field(
+                                     mesh, basis, {.spheres = 6, .face_resolution = 6, .sh_bands = 3, .directions = 64})
+                                     .value();
 };
 
 const Crate& crate() {
@@ -101,10 +101,10 @@ TEST(BrfVisibility, TargetsAndSegmentsFollowTheBox) {
   for (std::size_t i = 1; i < t.size(); ++i)
     EXPECT_NEAR(glm::length(glm::abs(t[i]) - gi::kBrfCornerPull * glm::vec3(1.0f, 2.0f, 3.0f)), 0.0f, 1e-6f);
   const gi::BrfOccluder o{box, glm::inverse(glm::translate(glm::mat4(1.0f), {5.0f, 0.0f, 0.0f}))};
-  EXPECT_FALSE(gi::brf_segment_clear({0, 0, 0}, {10, 0, 0}, std::span(&o, 1)));   // straight through
-  EXPECT_TRUE(gi::brf_segment_clear({0, 0, 0}, {3.9f, 0, 0}, std::span(&o, 1)));  // stops short
+  EXPECT_FALSE(gi::brf_segment_clear({0, 0, 0}, {10, 0, 0}, std::span(&o, 1)));       // straight through
+  EXPECT_TRUE(gi::brf_segment_clear({0, 0, 0}, {3.9f, 0, 0}, std::span(&o, 1)));      // stops short
   EXPECT_TRUE(gi::brf_segment_clear({0, 2.1f, 0}, {10, 2.1f, 0}, std::span(&o, 1)));  // passes above
-  EXPECT_FALSE(gi::brf_segment_clear({5, 0, 0}, {5, 0, 0}, std::span(&o, 1)));     // a point inside
+  EXPECT_FALSE(gi::brf_segment_clear({5, 0, 0}, {5, 0, 0}, std::span(&o, 1)));        // a point inside
 }
 
 TEST(BrfVisibility, NoBounceThroughAWallOnTheCpuTwinAndTheGpu) {
@@ -192,7 +192,8 @@ TEST(BrfVisibility, BoxFormFactorMatchesKnownCases) {
   EXPECT_EQ(gi::brf_box_form_factor(box, glm::translate(glm::mat4(1.0f), {0.0f, -2.0f, 0.0f}), {0, 0, 0}, up), 0.0f);
   EXPECT_EQ(gi::brf_box_form_factor(box, glm::mat4(1.0f), {0.1f, 0.2f, 0.0f}, up), 1.0f);
   // Beside the box on its floor: a share between the two.
-  const float side = gi::brf_box_form_factor(box, glm::translate(glm::mat4(1.0f), {0.0f, 0.5f, 0.0f}), {0.6f, 0, 0}, up);
+  const float side =
+      gi::brf_box_form_factor(box, glm::translate(glm::mat4(1.0f), {0.0f, 0.5f, 0.0f}), {0.6f, 0, 0}, up);
   EXPECT_GT(side, 0.05f);
   EXPECT_LT(side, 0.5f);
 }
@@ -240,8 +241,8 @@ TEST(BrfVisibility, TheFloorBesideACrateIsDarkerAsThePathTracerSays) {
     incoming[0].push_back(crate_light.direct[j] + crate_light.indirect[j]);
 
   const gi::BrfUpdateSettings settings{.bounces = 1, .cull_threshold = 0.0f};
-  const gi::BrfResult b = gi::brf_interreflect(std::span(&object, 1), incoming, settings,
-                                               {r.positions, r.normals, world.get()});
+  const gi::BrfResult b =
+      gi::brf_interreflect(std::span(&object, 1), incoming, settings, {r.positions, r.normals, world.get()});
   double err_occluded = 0.0, err_plain = 0.0, norm = 0.0, darker = 0.0;
   for (std::size_t t = 0; t < r.positions.size(); ++t) {
     const glm::dvec3 base(truth_without.indirect[t]), ref(truth_with.indirect[t]), bounce(b.static_irradiance[t]);
@@ -252,9 +253,10 @@ TEST(BrfVisibility, TheFloorBesideACrateIsDarkerAsThePathTracerSays) {
     norm += glm::dot(ref, ref);
     darker = std::max(darker, static_cast<double>(b.static_occlusion[t]));
   }
-  std::printf("floor beside a crate, rel RMSE vs the path tracer: baked x (1 - occlusion) + bounce %.3f, "
-              "baked + bounce %.3f (largest occlusion %.3f)\n",
-              std::sqrt(err_occluded / norm), std::sqrt(err_plain / norm), darker);
+  std::printf(
+      "floor beside a crate, rel RMSE vs the path tracer: baked x (1 - occlusion) + bounce %.3f, "
+      "baked + bounce %.3f (largest occlusion %.3f)\n",
+      std::sqrt(err_occluded / norm), std::sqrt(err_plain / norm), darker);
   EXPECT_GT(darker, 0.1);
   EXPECT_LT(std::sqrt(err_occluded / norm), 0.2);  // 0.149 measured (docs/brf.md)
   EXPECT_LT(err_occluded, 0.5 * err_plain);

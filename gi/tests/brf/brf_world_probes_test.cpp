@@ -1,8 +1,8 @@
 // The static world as a light source for dynamic objects (gi/src/brf/world_probes.h):
 // probe irradiance from the light atlas's VPLs against the path tracer's indirect
 // irradiance at free points of a closed box, and probes inside walls not leaking.
-#include <engine/scene.h>
 #include <gtest/gtest.h>
+#include <engine/scene.h>
 
 #include <cmath>
 #include <cstdio>
@@ -69,8 +69,10 @@ TEST(BrfWorldProbes, ProbesSitInsideTheRoomAndOutsideOnesAreInvalid) {
   for (std::uint8_t v : b.probes.valid) EXPECT_EQ(v, 1);
   // Near a wall (between the outer probes and the wall) the light stays that of the room,
   // against the path tracer.
-  std::vector<gi::SurfacePoint> points = {{{0.0f, 0.0f, 0.0f}, {0, 1, 0}}, {{0.95f, 0.0f, 0.0f}, {0, 1, 0}},
-                                          {{0.95f, 0.0f, 0.0f}, {-1, 0, 0}}, {{0.2f, -0.95f, 0.3f}, {0, 0, 1}}};
+  std::vector<gi::SurfacePoint> points = {{{0.0f, 0.0f, 0.0f}, {0, 1, 0}},
+                                          {{0.95f, 0.0f, 0.0f}, {0, 1, 0}},
+                                          {{0.95f, 0.0f, 0.0f}, {-1, 0, 0}},
+                                          {{0.2f, -0.95f, 0.3f}, {0, 0, 1}}};
   gi::ReferenceSettings rs;
   rs.samples_per_pixel = 4096;
   const auto truth =
@@ -126,8 +128,8 @@ TEST(BrfWorldProbes, TransferReprojectsWhatBakingWithThePowersGives) {
       gi::bake_world_probe_transfer(*caster, b.probes, v.position, v.normal, v.area_m2).value();
   std::size_t valid = 0;
   for (std::uint8_t f : b.probes.valid) valid += f;
-  std::printf("transfer: %zu probes (%zu valid), %zu VPLs, %zu entries, %.2f MB\n", b.probes.probe_count(), valid, v.size(),
-              t.emitter.size(), static_cast<double>(t.bytes()) / 1e6);
+  std::printf("transfer: %zu probes (%zu valid), %zu VPLs, %zu entries, %.2f MB\n", b.probes.probe_count(), valid,
+              v.size(), t.emitter.size(), static_cast<double>(t.bytes()) / 1e6);
   const auto check = [&](const std::vector<glm::vec3>& power, const gi::WorldProbeGrid& baked) {
     const auto sh = gi::reproject_world_probes(t, power).value();
     ASSERT_EQ(sh.size(), baked.probe_count());
@@ -143,7 +145,8 @@ TEST(BrfWorldProbes, TransferReprojectsWhatBakingWithThePowersGives) {
   };
   check(b.atlas.vpl_power, b.probes);
   std::vector<glm::vec3> relit(v.size(), glm::vec3(0.0f));
-  for (std::size_t i = 0; i < v.size(); i += 7) relit[i] = glm::vec3(3.0f, 1.0f, 0.5f) * (1.0f + static_cast<float>(i % 5));
+  for (std::size_t i = 0; i < v.size(); i += 7)
+    relit[i] = glm::vec3(3.0f, 1.0f, 0.5f) * (1.0f + static_cast<float>(i % 5));
   check(relit, gi::bake_world_probes(*caster, v, relit, {.spacing_m = 0.5f}).value());
   EXPECT_FALSE(gi::reproject_world_probes(t, std::vector<glm::vec3>(v.size() + 1)).ok());
   std::vector<glm::vec3> nan_power(v.size(), glm::vec3(0.0f));
@@ -242,14 +245,14 @@ TEST(BrfWorldProbes, TheSkysBounceOffTheFloorReachesThem) {
   ASSERT_TRUE(probes) << probes.error().to_string();
   glm::dvec3 power(0.0);
   for (const glm::vec3& v : atlas->vpl_power) power += glm::dvec3(v);
-  std::printf("%zu VPLs, total power %.2f W; probe grid %d x %d x %d from (%.2f %.2f %.2f)\n", atlas->vpls.size(), power.y,
-              probes->dims.x, probes->dims.y, probes->dims.z, double{probes->origin.x}, double{probes->origin.y},
-              double{probes->origin.z});
+  std::printf("%zu VPLs, total power %.2f W; probe grid %d x %d x %d from (%.2f %.2f %.2f)\n", atlas->vpls.size(),
+              power.y, probes->dims.x, probes->dims.y, probes->dims.z, double{probes->origin.x},
+              double{probes->origin.y}, double{probes->origin.z});
   const glm::vec3 down = probes->irradiance({0.3f, 1.0f, 0.2f}, {0, -1, 0});
   const glm::vec3 up = probes->irradiance({0.3f, 1.0f, 0.2f}, {0, 1, 0});
   const float expected = 3.14159265f * 0.5f * 0.98f;
-  std::printf("1 m over the floor under the sky: E facing down %.3f (expected ~%.3f), facing up %.3f\n",
-              double{down.y}, double{expected}, double{up.y});
+  std::printf("1 m over the floor under the sky: E facing down %.3f (expected ~%.3f), facing up %.3f\n", double{down.y},
+              double{expected}, double{up.y});
   EXPECT_GT(down.y, 0.7f * expected);
   EXPECT_LT(down.y, 1.3f * expected);
   EXPECT_LT(up.y, 0.15f * expected);

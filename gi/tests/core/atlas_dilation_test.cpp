@@ -3,8 +3,8 @@
 // triangle edges and vertices (the chart seams) of every scene.
 #include "uv/atlas_dilation.h"
 
-#include <engine/gltf.h>
 #include <gtest/gtest.h>
+#include <engine/gltf.h>
 
 #include <algorithm>
 #include <cmath>

@@ -3,8 +3,8 @@
 // degenerate triangles, density reduction and build timings.
 #include "uv/atlas_layout.h"
 
-#include <engine/gltf.h>
 #include <gtest/gtest.h>
+#include <engine/gltf.h>
 
 #include <algorithm>
 #include <chrono>

@@ -2,8 +2,8 @@
 // unit normals, the ownership rule and guaranteed samples for tiny triangles.
 #include "uv/atlas_rasterizer.h"
 
-#include <engine/gltf.h>
 #include <gtest/gtest.h>
+#include <engine/gltf.h>
 
 #include <cmath>
 #include <vector>

@@ -2,8 +2,8 @@
 // of the Cornell box, and meshes shared by several nodes.
 #include "uv/atlas_scene_writer.h"
 
-#include <engine/gltf.h>
 #include <gtest/gtest.h>
+#include <engine/gltf.h>
 
 #include <cmath>
 #include <filesystem>

@@ -1,8 +1,8 @@
 // The bake bundle's building blocks: the checksummed blob container (round trip, every
 // corruption rejected with the file named), atomic writes that leave nothing behind on
 // failure, manifest.json, and the scene geometry hash that detects stale bundles.
-#include <engine/gltf.h>
 #include <gtest/gtest.h>
+#include <engine/gltf.h>
 
 #include <cmath>
 #include <cstddef>

@@ -1,7 +1,7 @@
 // Error metrics against hand-computed values (gi/src/metrics/error_metrics.h).
+#include <gtest/gtest.h>
 #include <engine/display_transform.h>
 #include <gi/error_metrics.h>
-#include <gtest/gtest.h>
 
 #include <cmath>
 #include <limits>

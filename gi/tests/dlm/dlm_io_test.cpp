@@ -2,9 +2,9 @@
 // half-float bound), stale bundles, and damaged or inconsistent files rejected naming the file.
 #include "dlm/dlm_io.h"
 
+#include <gtest/gtest.h>
 #include <engine/byte_stream.h>
 #include <engine/scene_asset.h>
-#include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstring>

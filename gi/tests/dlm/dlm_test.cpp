@@ -3,9 +3,9 @@
 // hard cases, and the reflected specular radiance against the reference path tracer.
 #include "dlm/dlm.h"
 
+#include <gtest/gtest.h>
 #include <engine/directional_radiance.h>
 #include <engine/scene_asset.h>
-#include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
@@ -48,9 +48,8 @@ engine::SceneAsset glossy_box(const BoxOptions& o) {
                                          .base_color = glm::vec4(glm::vec3(o.wall_albedo), 1.0f),
                                          .roughness = 1.0f,
                                          .specular_factor = o.lambert_walls ? 0.0f : 1.0f});
-  a.materials.push_back(engine::Material{.name = "polished",
-                                         .base_color = glm::vec4(glm::vec3(0.5f), 1.0f),
-                                         .roughness = o.floor_roughness});
+  a.materials.push_back(engine::Material{
+      .name = "polished", .base_color = glm::vec4(glm::vec3(0.5f), 1.0f), .roughness = o.floor_roughness});
   const float s = o.size, h = 0.5f * s;
   engine::Mesh walls;
   walls.name = "walls";
@@ -132,10 +131,8 @@ TEST(DlmDirections, BinIsTheNearestUsableDirection) {
 TEST(DlmBake, FurnaceBinsHoldTheIndirectRadiance) {
   engine::SceneAsset a;
   const glm::vec3 le(0.5f);
-  a.materials.push_back(engine::Material{.name = "glossy_emitter",
-                                         .base_color = glm::vec4(glm::vec3(0.6f), 1.0f),
-                                         .roughness = 0.2f,
-                                         .emissive = le});
+  a.materials.push_back(engine::Material{
+      .name = "glossy_emitter", .base_color = glm::vec4(glm::vec3(0.6f), 1.0f), .roughness = 0.2f, .emissive = le});
   engine::Mesh m;
   m.name = "box";
   engine::Primitive p;
@@ -156,8 +153,7 @@ TEST(DlmBake, FurnaceBinsHoldTheIndirectRadiance) {
   st.area_light_samples = 4;
   auto dlm = gi::bake_dlm(input, st);
   ASSERT_TRUE(dlm) << dlm.error().to_string();
-  const float albedo =
-      engine::gltf_hemispherical_albedo(engine::gltf_brdf(glm::vec3(0.6f), 0.0f, 0.2f)).sum().y;
+  const float albedo = engine::gltf_hemispherical_albedo(engine::gltf_brdf(glm::vec3(0.6f), 0.0f, 0.2f)).sum().y;
   const float expected = le.y * albedo / (1.0f - albedo);
   ASSERT_GT(dlm->texels.size(), 0u);
   // Mean over (texel, usable bin) of the glossy texels, and the mean of each bin.
@@ -181,8 +177,8 @@ TEST(DlmBake, FurnaceBinsHoldTheIndirectRadiance) {
     }
   }
   const double mean = sum / static_cast<double>(count);
-  std::printf("furnace: expected %.4f, mean %.4f over %zu texel-bins, %llu deposits\n", static_cast<double>(expected), mean, count,
-              static_cast<unsigned long long>(dlm->stats.deposits));
+  std::printf("furnace: expected %.4f, mean %.4f over %zu texel-bins, %llu deposits\n", static_cast<double>(expected),
+              mean, count, static_cast<unsigned long long>(dlm->stats.deposits));
   EXPECT_NEAR(mean, static_cast<double>(expected), 0.03 * static_cast<double>(expected));
   for (std::size_t k = 0; k < bin_sum.size(); ++k)
     if (bin_count[k] > 0) {

@@ -1,9 +1,9 @@
 // The light-atlas baker against the reference path tracer's per-texel indirect irradiance:
 // the measured Cornell box and the corridor whose light needs several bounces.
+#include <gtest/gtest.h>
 #include <engine/gltf.h>
 #include <engine/scene.h>
 #include <gi/error_metrics.h>
-#include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
@@ -54,9 +54,10 @@ TEST(LightAtlasCornell, HighPresetMatchesReference) {
       gi::RgbField::from_texels(truth.width, truth.height, truth.indirect, truth.valid, truth.indirect_variance);
   const gi::ErrorReport e =
       gi::compare_rgb(gi::RgbField::from_texels(bake->width, bake->height, bake->irradiance, bake->valid), ref);
-  std::printf("Cornell box, high preset: rel RMSE %.4f (reference noise %.4f, against the truth %.4f; scale fit %.4f), "
-              "bake %.2f s\n",
-              e.rel_rmse, e.reference_noise, e.truth_rel_rmse, e.fit_scale, bake->stats.total_seconds);
+  std::printf(
+      "Cornell box, high preset: rel RMSE %.4f (reference noise %.4f, against the truth %.4f; scale fit %.4f), "
+      "bake %.2f s\n",
+      e.rel_rmse, e.reference_noise, e.truth_rel_rmse, e.fit_scale, bake->stats.total_seconds);
   EXPECT_LT(e.rel_rmse, 0.035);
   EXPECT_LT(e.truth_rel_rmse, 0.018);
   EXPECT_NEAR(e.fit_scale, 1.0, 0.02);

@@ -2,8 +2,8 @@
 // light atlas bakes the static world's light, so it must not count that glow at the object's
 // authored pose. The same quad made static lights the floor below it, which the test also
 // checks, so the test fails if emissive geometry stops being baked at all.
-#include <engine/scene_asset.h>
 #include <gtest/gtest.h>
+#include <engine/scene_asset.h>
 
 #include <cstdio>
 
@@ -66,7 +66,8 @@ double mean_floor_irradiance(engine::Mobility quad_mobility) {
 TEST(LightAtlasEmitters, ADynamicObjectsGlowIsNotBakedIntoTheStaticWorld) {
   const double with_static = mean_floor_irradiance(engine::Mobility::Static);
   const double with_dynamic = mean_floor_irradiance(engine::Mobility::Dynamic);
-  std::printf("floor under a glowing quad: mean E %.4f (quad static), %.6f (quad dynamic)\n", with_static, with_dynamic);
+  std::printf("floor under a glowing quad: mean E %.4f (quad static), %.6f (quad dynamic)\n", with_static,
+              with_dynamic);
   // A 1 x 1 m Lambertian emitter of radiance 1 at 0.5 m: E under its centre is about 1.7, the
   // floor's mean (most of it outside the quad's footprint) well above 0.1.
   EXPECT_GT(with_static, 0.1);

@@ -1,6 +1,6 @@
 // The light-atlas baker's energy bookkeeping in a closed box: the multi-bounce series.
-#include <engine/scene.h>
 #include <gtest/gtest.h>
+#include <engine/scene.h>
 
 #include <cstdio>
 #include <numbers>

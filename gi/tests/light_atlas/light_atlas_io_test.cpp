@@ -2,9 +2,9 @@
 // bundles and damaged files rejected with messages naming the file.
 #include "light_atlas/light_atlas_io.h"
 
+#include <gtest/gtest.h>
 #include <engine/gltf.h>
 #include <engine/image.h>
-#include <gtest/gtest.h>
 
 #include <cstdio>
 #include <cstring>

@@ -4,10 +4,10 @@
 // paths return the sky radiance. The atlas holds the sky's direct light by default (the
 // renderer draws no sky on the static world then), shadowed by the level: what the path
 // tracer gets, less the direct light of the lights the renderer draws.
+#include <gtest/gtest.h>
 #include <engine/gltf.h>
 #include <engine/sky.h>
 #include <gi/error_metrics.h>
-#include <gtest/gtest.h>
 
 #include <glm/gtc/quaternion.hpp>
 
@@ -61,7 +61,8 @@ gi::BakeInput open_floor(const glm::vec3& uniform, const engine::SkyGradient& gr
 // estimate it per texel.
 TEST(LightAtlasSky, FloorUnderAGradientSkyGetsTheAnalyticIrradiance) {
   const glm::vec3 uniform(0.1f, 0.0f, 0.0f);
-  const engine::SkyGradient g{.zenith = {0.2f, 0.4f, 1.0f}, .horizon = {1.0f, 0.9f, 0.7f}, .ground = {3.0f, 3.0f, 3.0f}};
+  const engine::SkyGradient g{
+      .zenith = {0.2f, 0.4f, 1.0f}, .horizon = {1.0f, 0.9f, 0.7f}, .ground = {3.0f, 3.0f, 3.0f}};
   gi::LightAtlasSettings s = gi::light_atlas_preset("medium").value();
   s.texels_per_metre = 4.0f;  // the default: the atlas holds the sky's direct light
   auto bake = gi::bake_light_atlas(open_floor(uniform, g), s);
@@ -77,10 +78,10 @@ TEST(LightAtlasSky, FloorUnderAGradientSkyGetsTheAnalyticIrradiance) {
   }
   ASSERT_GT(n, 100u);
   mean /= static_cast<double>(n);
-  std::printf("floor under a gradient sky: %zu texels, mean E (%.4f %.4f %.4f), analytic (%.4f %.4f %.4f), worst texel "
-              "off by (%.4f %.4f %.4f)\n",
-              n, mean.x, mean.y, mean.z, double{expected.x}, double{expected.y}, double{expected.z}, worst.x, worst.y,
-              worst.z);
+  std::printf(
+      "floor under a gradient sky: %zu texels, mean E (%.4f %.4f %.4f), analytic (%.4f %.4f %.4f), worst texel "
+      "off by (%.4f %.4f %.4f)\n",
+      n, mean.x, mean.y, mean.z, double{expected.x}, double{expected.y}, double{expected.z}, worst.x, worst.y, worst.z);
   for (int c = 0; c < 3; ++c) {
     EXPECT_NEAR(mean[c], static_cast<double>(expected[c]), 0.005 * static_cast<double>(expected[c])) << "channel " << c;
     EXPECT_LT(worst[c], 0.03) << "channel " << c;
@@ -108,7 +109,8 @@ TEST(LightAtlasSky, BakeUnderTheSkyMatchesThePathTracer) {
   ASSERT_TRUE(truth) << truth.error().to_string();
 
   double lit = 0.0;
-  for (std::size_t t = 0; t < truth->total.size(); ++t) lit += truth->valid[t] ? static_cast<double>(truth->total[t].y) : 0.0;
+  for (std::size_t t = 0; t < truth->total.size(); ++t)
+    lit += truth->valid[t] ? static_cast<double>(truth->total[t].y) : 0.0;
   ASSERT_GT(lit, 0.0) << "the sky reaches nothing in the reference";
   const gi::ErrorReport e =
       gi::compare_rgb(gi::RgbField::from_texels(bake->width, bake->height, bake->irradiance, bake->valid),
@@ -130,7 +132,8 @@ TEST(LightAtlasSky, BakeUnderAGradientSkyMatchesThePathTracer) {
   for (engine::Node& n : a.nodes) n.light = -1;
   a.lights.clear();
   for (engine::Material& m : a.materials) m.emissive = glm::vec3(0.0f);
-  a.environment.sky_gradient = {.zenith = {0.1f, 0.3f, 1.2f}, .horizon = {1.0f, 0.9f, 0.6f}, .ground = {0.3f, 0.2f, 0.1f}};
+  a.environment.sky_gradient = {
+      .zenith = {0.1f, 0.3f, 1.2f}, .horizon = {1.0f, 0.9f, 0.6f}, .ground = {0.3f, 0.2f, 0.1f}};
   const gi::BakeInput input = gi::bake_input_from(a);
   gi::LightAtlasSettings s = gi::light_atlas_preset("medium").value();
   s.texels_per_metre = 64.0f;  // the default: the atlas holds the sky's direct light
@@ -166,7 +169,8 @@ TEST(LightAtlasSky, TheAtlasHoldsTheSkysDirectLightAndNotTheSuns) {
   for (engine::Node& n : a.nodes) n.light = -1;
   a.lights.clear();
   for (engine::Material& m : a.materials) m.emissive = glm::vec3(0.0f);
-  a.environment.sky_gradient = {.zenith = {0.1f, 0.3f, 1.2f}, .horizon = {1.0f, 0.9f, 0.6f}, .ground = {0.3f, 0.2f, 0.1f}};
+  a.environment.sky_gradient = {
+      .zenith = {0.1f, 0.3f, 1.2f}, .horizon = {1.0f, 0.9f, 0.6f}, .ground = {0.3f, 0.2f, 0.1f}};
   engine::Light sun{.type = engine::LightType::Directional, .color = {1.0f, 0.9f, 0.8f}, .intensity = 20.0f};
   a.lights.push_back({"sun", sun});
   engine::Node sun_node;
@@ -220,10 +224,11 @@ TEST(LightAtlasSky, TheAtlasHoldsTheSkysDirectLightAndNotTheSuns) {
   std::vector<glm::vec3> added(bake->irradiance.size());
   for (std::size_t t = 0; t < added.size(); ++t) added[t] = with_sun->irradiance[t] - bake->irradiance[t];
   const gi::ErrorReport d = gi::compare_rgb(field(added, bake->valid), field(sun_truth, truth->valid));
-  std::printf("Cornell box, sun + gradient sky, medium at 32 texels/m: the atlas against the truth less the sun's "
-              "direct light: rel RMSE %.4f (scale fit %.4f); the sun's share of the truth %.3f; include_direct adds "
-              "the sun's direct light: rel RMSE %.4f (scale fit %.4f)\n",
-              e.rel_rmse, e.fit_scale, sun_share / total, d.rel_rmse, d.fit_scale);
+  std::printf(
+      "Cornell box, sun + gradient sky, medium at 32 texels/m: the atlas against the truth less the sun's "
+      "direct light: rel RMSE %.4f (scale fit %.4f); the sun's share of the truth %.3f; include_direct adds "
+      "the sun's direct light: rel RMSE %.4f (scale fit %.4f)\n",
+      e.rel_rmse, e.fit_scale, sun_share / total, d.rel_rmse, d.fit_scale);
   // Measured 0.105 (scale fit 1.022): the sun's bright patch lighting the box by a bounce is
   // the gather's hard case (the sky alone: 0.04); include_direct adds the sun's direct light
   // exactly as the path tracer's direct-only run has it (0.0000: one shadow ray per texel,

@@ -1,7 +1,7 @@
 // The light-atlas baker on hard cases: albedo close to 1, a light touching a wall, tiny and
 // huge scenes, thread-count independence, lights that move, and the incremental update.
-#include <engine/scene.h>
 #include <gtest/gtest.h>
+#include <engine/scene.h>
 
 #include <algorithm>
 #include <cmath>

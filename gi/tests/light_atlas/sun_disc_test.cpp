@@ -6,9 +6,9 @@
 // (x, h), so the lit fraction is the share of that disc beyond the edge,
 //   f(x) = 1 - (acos(x/R) - (x/R) sqrt(1 - (x/R)^2)) / pi  for |x| < R,
 // 0 below -R and 1 above R: a penumbra 2 h tan r wide. Black surfaces: nothing bounces.
+#include <gtest/gtest.h>
 #include <engine/scene_asset.h>
 #include <gi/reference.h>
-#include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
@@ -45,9 +45,12 @@ gi::BakeInput plate_over_floor(float angular_radius_rad) {
   engine::Material black;
   black.base_color = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
   a.materials.push_back(black);
-  a.meshes.push_back({.name = "floor", .primitives = {quad({-0.5f, 0, -0.25f}, {-0.5f, 0, 0.25f}, {0.5f, 0, 0.25f}, {0.5f, 0, -0.25f}, {0, 1, 0})}});
+  a.meshes.push_back(
+      {.name = "floor",
+       .primitives = {quad({-0.5f, 0, -0.25f}, {-0.5f, 0, 0.25f}, {0.5f, 0, 0.25f}, {0.5f, 0, -0.25f}, {0, 1, 0})}});
   a.meshes.push_back({.name = "plate",
-                      .primitives = {quad({-1, kHeight, -0.6f}, {-1, kHeight, 0.6f}, {0, kHeight, 0.6f}, {0, kHeight, -0.6f}, {0, 1, 0})}});
+                      .primitives = {quad({-1, kHeight, -0.6f}, {-1, kHeight, 0.6f}, {0, kHeight, 0.6f},
+                                          {0, kHeight, -0.6f}, {0, 1, 0})}});
   for (int m = 0; m < 2; ++m) {
     engine::Node n;
     n.name = a.meshes[static_cast<std::size_t>(m)].name;
@@ -117,9 +120,10 @@ TEST(SunDisc, PathTracerPenumbraMatchesTheDiscGeometry) {
     EXPECT_EQ(e->indirect[i], glm::vec3(0.0f));
   }
   const double width = crossing(curve, 0.9) - crossing(curve, 0.1), expected = analytic_width_10_90(big_r);
-  std::printf("path tracer, sun radius 5 deg at h = 1 m: penumbra 10-90%% %.4f m (analytic %.4f, full 2 h tan r = "
-              "%.4f), worst point off by %.3f\n",
-              width, expected, 2.0 * big_r, worst);
+  std::printf(
+      "path tracer, sun radius 5 deg at h = 1 m: penumbra 10-90%% %.4f m (analytic %.4f, full 2 h tan r = "
+      "%.4f), worst point off by %.3f\n",
+      width, expected, 2.0 * big_r, worst);
   EXPECT_LT(worst, 0.05);
   EXPECT_NEAR(width, expected, 0.1 * expected);
 }
@@ -153,13 +157,16 @@ TEST(SunDisc, LightAtlasPenumbraMatchesTheDiscGeometry) {
     return crossing(curve, 0.9) - crossing(curve, 0.1);
   };
   const float r = 5.0f * static_cast<float>(kPi) / 180.0f;
-  const double big_r = static_cast<double>(kHeight) * std::tan(static_cast<double>(r)), expected = analytic_width_10_90(big_r);
+  const double big_r = static_cast<double>(kHeight) * std::tan(static_cast<double>(r)),
+               expected = analytic_width_10_90(big_r);
   double worst = 0.0, unused = 0.0;
   const double width = measure(r, &worst);
   const double hard = measure(0.0f, &unused);
-  std::printf("light atlas (medium, 16 direct samples, 64 texels/m), sun radius 5 deg at h = 1 m: penumbra 10-90%% %.4f m (analytic %.4f), "
-              "worst texel off by %.3f; a point sun: %.4f m\n",
-              width, expected, worst, hard);
+  std::printf(
+      "light atlas (medium, 16 direct samples, 64 texels/m), sun radius 5 deg at h = 1 m: penumbra 10-90%% %.4f m "
+      "(analytic %.4f), "
+      "worst texel off by %.3f; a point sun: %.4f m\n",
+      width, expected, worst, hard);
   EXPECT_NEAR(width, expected, 0.15 * expected);
   EXPECT_LT(worst, 0.2);  // 16 stratified directions per texel; measured 0.11 (high preset) and 0.15 (this)
   EXPECT_LT(hard, 0.25 * expected) << "a sun without a disc casts a hard edge";

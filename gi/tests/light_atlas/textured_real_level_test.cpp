@@ -5,10 +5,10 @@
 // and the colour of the light under the arcades, where it arrives after bouncing off the
 // textured stone (the sky alone lights the level: everything the atlas holds is the truth's
 // total, nothing is drawn live).
+#include <gtest/gtest.h>
 #include <engine/gltf.h>
 #include <gi/bake_input.h>
 #include <gi/reference.h>
-#include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>

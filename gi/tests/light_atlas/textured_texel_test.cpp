@@ -1,8 +1,8 @@
 // A light-atlas texel on a textured surface folds in the texture's mean over its footprint
 // (material_lookup.h), not the colour at its sample point; texels an alpha MASK cuts out
 // wholly are not lit (issue 33, docs/materials-in-bakes.md).
-#include <gi/bake_input.h>
 #include <gtest/gtest.h>
+#include <gi/bake_input.h>
 
 #include "raytrace/material_lookup.h"
 #include "transport/static_scene.h"

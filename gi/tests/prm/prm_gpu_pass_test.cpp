@@ -4,8 +4,8 @@
 // kRelativeTolerance x sum_k |weight_k| |pane_k[i]| (per channel) + kAbsoluteTolerance of the
 // reference: half rounding is at most 2^-11 (~4.9e-4) of each pane value, float
 // accumulation adds ~1e-7 per term.
-#include <engine/gpu/context.h>
 #include <gtest/gtest.h>
+#include <engine/gpu/context.h>
 
 #include <algorithm>
 #include <cmath>
@@ -14,10 +14,10 @@
 #include <vector>
 
 #include "core/random.h"
+#include "gl_context.h"
 #include "prm/prm.h"
 #include "prm/prm_gpu_pass.h"
 #include "prm/prm_runtime.h"
-#include "gl_context.h"
 
 namespace {
 
@@ -357,7 +357,8 @@ TEST(PrmGpuPass, SharedExponentPanesStayWithinTheirBound) {
         changed += q.panes[3 * e + ch] != v[ch];
       }
     }
-    std::printf("values in [%g, %g]: max |decoded - float| / element's largest channel %.3g\n", double(lo), double(hi), worst);
+    std::printf("values in [%g, %g]: max |decoded - float| / element's largest channel %.3g\n", double(lo), double(hi),
+                worst);
     EXPECT_LE(worst, std::ldexp(1.0, -9) * (1.0 + std::ldexp(1.0, -9)));
     EXPECT_GT(changed, prm.panes.size() / 2);  // it does round: not a copy of the float panes
   }

@@ -3,9 +3,9 @@
 // pays, stale bundles and damaged files rejected with messages naming the file.
 #include "prm/prm_io.h"
 
-#include <engine/gltf.h>
-#include <gtest/gtest.h>
 #include <zstd.h>
+#include <gtest/gtest.h>
+#include <engine/gltf.h>
 
 #include <algorithm>
 #include <cmath>
@@ -17,8 +17,8 @@
 #include <random>
 #include <string>
 
-#include "bundle/bundle.h"
 #include <engine/byte_stream.h>
+#include "bundle/bundle.h"
 #include "io/content_hash.h"
 #include "uv/atlas_input.h"
 

@@ -1,10 +1,10 @@
 // PRM (Szécsi 2006) on the spot chamber against the reference path tracer, and its hard cases.
 #include "prm/prm.h"
 
+#include <gtest/gtest.h>
 #include <engine/gltf.h>
 #include <engine/scene.h>
 #include <gi/error_metrics.h>
-#include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>

@@ -4,8 +4,8 @@
 // on frames whose headers claim sizes their bytes do not hold.
 #include "io/zstd_stream.h"
 
-#include <gtest/gtest.h>
 #include <zstd.h>
+#include <gtest/gtest.h>
 
 #include <cstdint>
 #include <numeric>
@@ -50,8 +50,7 @@ TEST(ZstdStream, AFrameClaimingMoreThanTheCapIsRefusedBeforeAnythingIsAllocated)
     const std::string message = result.error().to_string();
     EXPECT_NE(message.find("forged.bin"), std::string::npos) << message;
     EXPECT_NE(message.find("panes"), std::string::npos) << message;
-    EXPECT_NE(message.find("above the " + std::to_string(gi::kMaxDecompressedBytes) + "-byte limit"),
-              std::string::npos)
+    EXPECT_NE(message.find("above the " + std::to_string(gi::kMaxDecompressedBytes) + "-byte limit"), std::string::npos)
         << message;
   }
 }

@@ -37,8 +37,8 @@ gi::RtSceneData scattered_cubes(int count, std::uint64_t seed) {
   data.geometries.push_back(unit_cube());
   for (int i = 0; i < count; ++i) {
     gi::Pcg32 rng = gi::Pcg32::for_item(seed, static_cast<std::uint64_t>(i));
-    glm::mat4 m = glm::translate(glm::mat4(1.0f), glm::vec3(rng.next_float() * 8 - 4, rng.next_float() * 8 - 4,
-                                                            rng.next_float() * 8 - 4));
+    glm::mat4 m = glm::translate(
+        glm::mat4(1.0f), glm::vec3(rng.next_float() * 8 - 4, rng.next_float() * 8 - 4, rng.next_float() * 8 - 4));
     m = glm::rotate(m, rng.next_float() * 6.28f, glm::normalize(glm::vec3(1, rng.next_float(), 0.3f)));
     m = glm::scale(m, glm::vec3(0.3f + rng.next_float()));
     data.instances.push_back(gi::RtInstance{0, m, i % 3 == 0, static_cast<std::uint64_t>(i)});

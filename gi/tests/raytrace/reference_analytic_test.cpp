@@ -111,11 +111,14 @@ TEST(ReferenceSpotLight, ConeFalloffMatchesTheRenderer) {
   l.cos_outer = std::cos(0.5f);
   s.lights.push_back(l);
   const float r_inner = 2.0f * std::tan(0.25f), r_mid = 2.0f * std::tan(0.4f), r_out = 2.0f * std::tan(0.6f);
-  const std::vector<gi::SurfacePoint> pts = {{{r_inner, 0, 0}, {0, 1, 0}}, {{0, 0, r_mid}, {0, 1, 0}},
-                                             {{-r_out, 0, 0}, {0, 1, 0}}};
+  const std::vector<gi::SurfacePoint> pts = {
+      {{r_inner, 0, 0}, {0, 1, 0}}, {{0, 0, r_mid}, {0, 1, 0}}, {{-r_out, 0, 0}, {0, 1, 0}}};
   auto e = gi::estimate_irradiance(s, pts, settings(1));
   ASSERT_TRUE(e);
-  const auto point_e = [](float r) { const float d = std::sqrt(4.0f + r * r); return 8.0f * 2.0f / (d * d * d); };
+  const auto point_e = [](float r) {
+    const float d = std::sqrt(4.0f + r * r);
+    return 8.0f * 2.0f / (d * d * d);
+  };
   EXPECT_NEAR(e->direct[0].x, point_e(r_inner), 1e-4f);
   const float t = (std::cos(0.4f) - l.cos_outer) / (l.cos_inner - l.cos_outer);
   EXPECT_NEAR(e->direct[1].x, point_e(r_mid) * t * t * (3 - 2 * t), 1e-4f);
@@ -167,7 +170,8 @@ TEST(ReferenceSky, LambertianPlaneUnderGradientSky) {
   ASSERT_TRUE(e);
   for (int c = 0; c < 3; ++c) {
     double mean = 0.0;
-    for (std::size_t i = 0; i < pts.size(); ++i) mean += static_cast<double>(e->direct[i][c]) / static_cast<double>(pts.size());
+    for (std::size_t i = 0; i < pts.size(); ++i)
+      mean += static_cast<double>(e->direct[i][c]) / static_cast<double>(pts.size());
     EXPECT_NEAR(mean, static_cast<double>(expected[c]), 0.005 * static_cast<double>(expected[c])) << "channel " << c;
   }
   for (std::size_t i = 0; i < pts.size(); ++i) EXPECT_EQ(e->indirect[i], glm::vec3(0.0f));

@@ -1,9 +1,9 @@
 // The reference path tracer on the measured Cornell box (assets/cornell_box.gltf): energy
 // balance, determinism across thread counts, and its errors.
+#include <gtest/gtest.h>
 #include <engine/gltf.h>
 #include <engine/scene.h>
 #include <gi/reference.h>
-#include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>

@@ -2,8 +2,8 @@
 // through the one material lookup (material_lookup.h) and alpha MASK cuts holes in what
 // every ray caster hits. Against closed forms: a textured plate under a point light, a
 // furnace of textured walls, the shadow of a masked card.
-#include <gi/bake_input.h>
 #include <gtest/gtest.h>
+#include <gi/bake_input.h>
 
 #include <cmath>
 #include <numbers>

@@ -4,8 +4,8 @@
 // context is a failure that names why.
 //   TEST(X, Y) { auto ctx = gltest::headless_or_fail(); ... }
 
-#include <engine/gpu/context.h>
 #include <gtest/gtest.h>
+#include <engine/gpu/context.h>
 
 #include <cstdlib>
 #include <utility>

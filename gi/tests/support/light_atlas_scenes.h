@@ -20,12 +20,12 @@ inline void add_quad(engine::Primitive& p, glm::vec3 c, glm::vec3 u, glm::vec3 v
 inline engine::Primitive inward_cube(float s) {
   engine::Primitive p;
   const float h = 0.5f * s;
-  add_quad(p, {-h, -h, -h}, {0, 0, s}, {s, 0, 0});   // floor, +y
-  add_quad(p, {-h, h, -h}, {s, 0, 0}, {0, 0, s});    // ceiling, -y
-  add_quad(p, {-h, -h, -h}, {s, 0, 0}, {0, s, 0});   // z = -h, +z
-  add_quad(p, {-h, -h, h}, {0, s, 0}, {s, 0, 0});    // z = +h, -z
-  add_quad(p, {-h, -h, -h}, {0, s, 0}, {0, 0, s});   // x = -h, +x
-  add_quad(p, {h, -h, -h}, {0, 0, s}, {0, s, 0});    // x = +h, -x
+  add_quad(p, {-h, -h, -h}, {0, 0, s}, {s, 0, 0});  // floor, +y
+  add_quad(p, {-h, h, -h}, {s, 0, 0}, {0, 0, s});   // ceiling, -y
+  add_quad(p, {-h, -h, -h}, {s, 0, 0}, {0, s, 0});  // z = -h, +z
+  add_quad(p, {-h, -h, h}, {0, s, 0}, {s, 0, 0});   // z = +h, -z
+  add_quad(p, {-h, -h, -h}, {0, s, 0}, {0, 0, s});  // x = -h, +x
+  add_quad(p, {h, -h, -h}, {0, 0, s}, {0, s, 0});   // x = +h, -x
   return p;
 }
 

@@ -2,11 +2,11 @@
 // Pareto front and presets, CSV round trips, the reference cache's integrity checks and
 // atomic writes. The method and the reference provider here are synthetic and exist in
 // this test only.
+#include <unistd.h>
+#include <gtest/gtest.h>
 #include <engine/scene.h>
 #include <gi/bake_input.h>
 #include <gi/sweep.h>
-#include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
@@ -634,10 +634,11 @@ TEST(AntiradianceSweep, CorridorDoorSwingRunIsMeasured) {
     ADD_FAILURE() << "no extra " << name;
     return std::numeric_limits<double>::quiet_NaN();
   };
-  std::printf("antiradiance on the corridor: rel RMSE %.4f (changing nothing %.4f), correlation %.3f; %.0f ms per door "
-              "move (CPU), %.0f ms (GPU), %.1f MB file, %.1f MB GPU\n",
-              row.error.rel_rmse, extra("nothing_rel_rmse"), extra("change_correlation"), row.costs.frame_ms,
-              extra("gpu_frame_ms"), static_cast<double>(row.costs.bytes) / 1e6, extra("gpu_bytes") / 1e6);
+  std::printf(
+      "antiradiance on the corridor: rel RMSE %.4f (changing nothing %.4f), correlation %.3f; %.0f ms per door "
+      "move (CPU), %.0f ms (GPU), %.1f MB file, %.1f MB GPU\n",
+      row.error.rel_rmse, extra("nothing_rel_rmse"), extra("change_correlation"), row.costs.frame_ms,
+      extra("gpu_frame_ms"), static_cast<double>(row.costs.bytes) / 1e6, extra("gpu_bytes") / 1e6);
   EXPECT_TRUE(std::isfinite(row.error.rel_rmse));
   EXPECT_GT(row.costs.frame_ms, 0.0);
   EXPECT_GT(row.costs.bytes, 1000u);

@@ -2,15 +2,15 @@
 // light atlas + antiradiance; the atlas handed to the renderer is the baked one until the
 // door moves, changes on the frame it moves, and nothing is recomputed on frames it does not.
 #define GL_GLEXT_PROTOTYPES 1
+#include <unistd.h>
 #include <GL/glcorearb.h>
+#include <gtest/gtest.h>
 #include <engine/components.h>
 #include <engine/gltf.h>
 #include <engine/gpu/context.h>
 #include <engine/scene.h>
 #include <gi/bake.h>
 #include <gi/gi_system.h>
-#include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
@@ -34,7 +34,8 @@ engine::Scene corridor() {
 TEST(AntiradianceLighting, TheCorridorDoorChangesTheAtlasOnlyOnFramesItMoves) {
   auto ctx = engine::GpuContext::create_headless();
   ASSERT_TRUE(ctx) << "no headless GL context: " << ctx.error().to_string();
-  const fs::path dir = fs::temp_directory_path() / ("gi_antiradiance_lighting_" + std::to_string(::getpid()) + ".gibake");
+  const fs::path dir =
+      fs::temp_directory_path() / ("gi_antiradiance_lighting_" + std::to_string(::getpid()) + ".gibake");
   fs::remove_all(dir);
   engine::Scene scene = corridor();
   gi::BakeOptions options;

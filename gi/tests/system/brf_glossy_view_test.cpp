@@ -4,7 +4,9 @@
 // against the reference path tracer's indirect light at the same points seen from the same
 // eyes. llvmpipe through EGL; never skipped.
 #define GL_GLEXT_PROTOTYPES 1
+#include <unistd.h>
 #include <GL/glcorearb.h>
+#include <gtest/gtest.h>
 #include <engine/components.h>
 #include <engine/gltf.h>
 #include <engine/gpu/context.h>
@@ -12,18 +14,16 @@
 #include <engine/renderer.h>
 #include <engine/scene.h>
 #include <gi/gi_system.h>
-#include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
-#include <glm/gtc/matrix_transform.hpp>
-#include <glm/gtc/quaternion.hpp>
 #include <optional>
 #include <string>
 #include <vector>
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/quaternion.hpp>
 
 #include "brf/brdf_separation.h"
 #include "brf/brf_bake.h"
@@ -71,7 +71,9 @@ void place_camera(engine::Scene& scene, const glm::vec3& eye, const glm::vec3& t
 struct WithoutLobes final : engine::IndirectLightProvider {
   struct Frame final : engine::IndirectLightFrame {
     const engine::IndirectLightFrame* inner = nullptr;
-    std::uint32_t vertex_irradiance_buffer(engine::Entity e) const override { return inner->vertex_irradiance_buffer(e); }
+    std::uint32_t vertex_irradiance_buffer(engine::Entity e) const override {
+      return inner->vertex_irradiance_buffer(e);
+    }
   };
   engine::IndirectLightProvider* gi = nullptr;
   Frame frame_;
@@ -85,7 +87,8 @@ struct WithoutLobes final : engine::IndirectLightProvider {
 };
 
 glm::vec3 pixel(const engine::ImageRgbaF& img, int x, int y) {
-  const std::size_t i = 4 * (static_cast<std::size_t>(y) * static_cast<std::size_t>(img.width) + static_cast<std::size_t>(x));
+  const std::size_t i =
+      4 * (static_cast<std::size_t>(y) * static_cast<std::size_t>(img.width) + static_cast<std::size_t>(x));
   return {img.pixels[i], img.pixels[i + 1], img.pixels[i + 2]};
 }
 
@@ -96,7 +99,7 @@ struct View {
 
 struct ViewResult {
   glm::dvec3 drawn{0.0}, without_lobes{0.0}, reference{0.0};  // sums over the face's points
-  double rel_rmse = 0.0;                                       // drawn vs reference, per point
+  double rel_rmse = 0.0;                                      // drawn vs reference, per point
 };
 
 TEST(BrfGlossyView, TheMetalCratesViewDependentBounceIsDrawnAsThePathTracerSeesIt) {
@@ -176,9 +179,10 @@ TEST(BrfGlossyView, TheMetalCratesViewDependentBounceIsDrawnAsThePathTracerSeesI
     }
     e /= 4096.0;
     const glm::dvec3 at(mesh.positions[centre]), brf(v[centre]);
-    std::printf("metal face centre (vertex %zu at %.2f %.2f %.2f): indirect irradiance BRF (%.3f, %.3f, %.3f), path "
-                "tracer (%.3f, %.3f, %.3f) W/m^2\n",
-                centre, at.x, at.y, at.z, brf.x, brf.y, brf.z, e.x, e.y, e.z);
+    std::printf(
+        "metal face centre (vertex %zu at %.2f %.2f %.2f): indirect irradiance BRF (%.3f, %.3f, %.3f), path "
+        "tracer (%.3f, %.3f, %.3f) W/m^2\n",
+        centre, at.x, at.y, at.z, brf.x, brf.y, brf.z, e.x, e.y, e.z);
   }
 
   // Two eyes at the face's height: 49 degrees off its normal away from the wall (the mirror
@@ -196,7 +200,8 @@ TEST(BrfGlossyView, TheMetalCratesViewDependentBounceIsDrawnAsThePathTracerSeesI
     r.render(scene.registry, engine::find_camera(scene.registry));
     const engine::ImageRgbaF drawn_img = r.read_hdr();
     if (const char* out = std::getenv("GI_TEST_IMAGE_DIR")) {
-      (void)engine::save_png(std::string(out) + "/brf_glossy_view_" + std::to_string(results.size()) + ".png", r.read_ldr());
+      (void)engine::save_png(std::string(out) + "/brf_glossy_view_" + std::to_string(results.size()) + ".png",
+                             r.read_ldr());
     }
     r.set_indirect_light(&without);
     r.render(scene.registry, engine::find_camera(scene.registry));
@@ -210,7 +215,8 @@ TEST(BrfGlossyView, TheMetalCratesViewDependentBounceIsDrawnAsThePathTracerSeesI
     // not turned: its frame is brf_tangent_frame of the object-space normal).
     {
       const glm::vec3 at = kCratePosition + mesh.positions[centre];
-      const glm::vec3 local = glm::transpose(gi::brf_tangent_frame(mesh.normals[centre])) * glm::normalize(view.eye - at);
+      const glm::vec3 local =
+          glm::transpose(gi::brf_tangent_frame(mesh.normals[centre])) * glm::normalize(view.eye - at);
       glm::vec3 expected(0.0f);
       for (int k = 0; k < lobes.terms; ++k)
         expected += glm::vec3(terms[static_cast<std::size_t>(k + 1) * nv + centre]) * separation->h_at(k, local);
@@ -242,8 +248,7 @@ TEST(BrfGlossyView, TheMetalCratesViewDependentBounceIsDrawnAsThePathTracerSeesI
         const float py = 1.0f - 2.0f * (static_cast<float>(y) + 0.5f) / kHeight;
         const glm::mat4 cam_to_world = glm::inverse(glm::lookAt(view.eye, face_centre, glm::vec3(0.0f, 1.0f, 0.0f)));
         const float th = std::tan(0.5f * cam.yfov_rad);
-        const glm::vec3 ray_dir =
-            glm::normalize(glm::mat3(cam_to_world) * glm::vec3(px * th * aspect, py * th, -1.0f));
+        const glm::vec3 ray_dir = glm::normalize(glm::mat3(cam_to_world) * glm::vec3(px * th * aspect, py * th, -1.0f));
         glm::dvec3 indirect(0.0);
         for (int s = 0; s < kSamples; ++s) {
           gi::Pcg32 rng = gi::Pcg32::for_item(7, static_cast<std::uint64_t>(points * kSamples + s));
@@ -265,10 +270,11 @@ TEST(BrfGlossyView, TheMetalCratesViewDependentBounceIsDrawnAsThePathTracerSeesI
         ++points;
       }
     res.rel_rmse = std::sqrt(err2 / std::max(ref2, 1e-30));
-    std::printf("%s: indirect radiance summed over %d points of the metal face (W/(m^2 sr)): path tracer (%.4f, %.4f, "
-                "%.4f), drawn with lobes (%.4f, %.4f, %.4f), without (%.4f, %.4f, %.4f); per-point rel RMSE %.3f\n",
-                view.name, points, res.reference.x, res.reference.y, res.reference.z, res.drawn.x, res.drawn.y,
-                res.drawn.z, res.without_lobes.x, res.without_lobes.y, res.without_lobes.z, res.rel_rmse);
+    std::printf(
+        "%s: indirect radiance summed over %d points of the metal face (W/(m^2 sr)): path tracer (%.4f, %.4f, "
+        "%.4f), drawn with lobes (%.4f, %.4f, %.4f), without (%.4f, %.4f, %.4f); per-point rel RMSE %.3f\n",
+        view.name, points, res.reference.x, res.reference.y, res.reference.z, res.drawn.x, res.drawn.y, res.drawn.z,
+        res.without_lobes.x, res.without_lobes.y, res.without_lobes.z, res.rel_rmse);
     results.push_back(res);
   }
   const auto sum = [](const glm::dvec3& v) { return v.x + v.y + v.z; };

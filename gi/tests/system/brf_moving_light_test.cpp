@@ -4,21 +4,21 @@
 // floor through the probes (the PRM's entry points as first-bounce emitters), compared with
 // the path tracer; the probes are re-projected only on frames where a moving light changed.
 #define GL_GLEXT_PROTOTYPES 1
+#include <unistd.h>
 #include <GL/glcorearb.h>
+#include <gtest/gtest.h>
 #include <engine/components.h>
 #include <engine/gltf.h>
 #include <engine/gpu/context.h>
 #include <engine/scene.h>
 #include <gi/gi_system.h>
 #include <gi/reference.h>
-#include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <glm/gtc/quaternion.hpp>
 #include <string>
+#include <glm/gtc/quaternion.hpp>
 
 #include "brf/brf_bake.h"
 #include "brf/brf_io.h"
@@ -172,9 +172,10 @@ TEST(BrfMovingLight, ACrateBesideTheMovingLampGetsItsBounceOffTheFloor) {
   const double o = sum_x(ours), t1 = sum_x(one.indirect), ta = sum_x(all.indirect);
   double direct = 0.0;
   for (const glm::vec3& d : one.direct) direct += static_cast<double>(d.x);
-  std::printf("crate_2's face toward the lamp's patch, the lamp's indirect light (red, summed over %zu vertices): "
-              "ours %.4f, path tracer one bounce %.4f (%.2fx), all bounces %.4f (%.2fx); its direct light %.4f\n",
-              ours.size(), o, t1, o / t1, ta, o / ta, direct);
+  std::printf(
+      "crate_2's face toward the lamp's patch, the lamp's indirect light (red, summed over %zu vertices): "
+      "ours %.4f, path tracer one bounce %.4f (%.2fx), all bounces %.4f (%.2fx); its direct light %.4f\n",
+      ours.size(), o, t1, o / t1, ta, o / ta, direct);
   EXPECT_LT(direct, 0.01 * t1) << "the lamp must not light the crate directly";
   EXPECT_GT(t1, 0.0);
   for (const glm::vec3& e : ours) EXPECT_GE(e.x, -1e-4f);
@@ -192,7 +193,8 @@ TEST(BrfMovingLight, ACrateBesideTheMovingLampGetsItsBounceOffTheFloor) {
   const std::vector<glm::vec3> moved = read_face(gi, crate, face);
   EXPECT_EQ(gi.stats().prm_probe_updates, 3u);
   EXPECT_LT(sum_x(moved) - sum_x(off), 0.7 * o);
-  std::printf("lamp 2 m farther: %.4f; re-projection %.3f ms\n", sum_x(moved) - sum_x(off), gi.stats().last_prm_probe_ms);
+  std::printf("lamp 2 m farther: %.4f; re-projection %.3f ms\n", sum_x(moved) - sum_x(off),
+              gi.stats().last_prm_probe_ms);
 }
 
 // The entry points' albedo (prm_entry_albedo): every entry point of the spot chamber finds the

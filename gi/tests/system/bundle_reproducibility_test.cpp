@@ -3,10 +3,10 @@
 // atlas EXR + VPLs, PRM panes, directional light maps, basis radiance fields, antiradiance),
 // the manifest included. Only bake_stats.json differs, and it says how (threads, timings).
 // The world probes GISystem builds from the atlas at load time are compared too.
+#include <gtest/gtest.h>
 #include <engine/gltf.h>
 #include <gi/bake.h>
 #include <gi/bake_input.h>
-#include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cstring>
@@ -14,9 +14,9 @@
 #include <fstream>
 #include <iterator>
 #include <map>
-#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
+#include <nlohmann/json.hpp>
 
 #include "brf/world_probes.h"
 #include "light_atlas/light_atlas_io.h"
@@ -113,9 +113,9 @@ TEST(BundleReproducibility, OneAndTwoThreadsGiveByteIdenticalFilesAndWorldProbes
   ASSERT_TRUE(p1.ok() && p2.ok());
   ASSERT_GT(p1->probe_count(), 0u);
   ASSERT_EQ(p1->radiance_sh.size(), p2->radiance_sh.size());
-  EXPECT_EQ(std::memcmp(p1->radiance_sh.data(), p2->radiance_sh.data(),
-                        p1->radiance_sh.size() * sizeof(p1->radiance_sh[0])),
-            0);
+  EXPECT_EQ(
+      std::memcmp(p1->radiance_sh.data(), p2->radiance_sh.data(), p1->radiance_sh.size() * sizeof(p1->radiance_sh[0])),
+      0);
   EXPECT_EQ(p1->valid, p2->valid);
 }
 

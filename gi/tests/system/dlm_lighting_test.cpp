@@ -5,6 +5,8 @@
 // point, normal, view and material.
 #include "system/dlm_lighting.h"
 
+#include <unistd.h>
+#include <gtest/gtest.h>
 #include <engine/directional_radiance.h>
 #include <engine/gltf.h>
 #include <engine/gpu/context.h>
@@ -12,16 +14,14 @@
 #include <engine/scene.h>
 #include <gi/bake.h>
 #include <gi/gi_system.h>
-#include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <glm/gtc/matrix_transform.hpp>
 #include <limits>
 #include <optional>
+#include <glm/gtc/matrix_transform.hpp>
 
 #include "dlm/dlm.h"
 #include "light_atlas/light_atlas.h"
@@ -205,9 +205,9 @@ TEST(DlmLighting, DirectionalBinsMatchTheCppTwinAtPixels) {
   const engine::Camera& cam = f->scene.registry.get<engine::Camera>(camera);
   const glm::mat4 world = f->scene.registry.get<engine::WorldTransform>(camera).matrix;
   const glm::dvec3 eye(world[3]);
-  const glm::dmat4 inv(glm::inverse(glm::perspective(cam.yfov_rad, cam.aspect > 0.0f ? cam.aspect : 1.0f, cam.znear_m,
-                                                     cam.zfar_m) *
-                                    glm::inverse(world)));
+  const glm::dmat4 inv(
+      glm::inverse(glm::perspective(cam.yfov_rad, cam.aspect > 0.0f ? cam.aspect : 1.0f, cam.znear_m, cam.zfar_m) *
+                   glm::inverse(world)));
   int checked = 0, on_boundary = 0;
   double worst = 0.0;
   for (int py = 4; py < kSize; py += 7) {
@@ -249,7 +249,8 @@ TEST(DlmLighting, DirectionalBinsMatchTheCppTwinAtPixels) {
       // A lobe sample lying on the boundary between two bins switches bins under the
       // rasterizer's interpolation error of v (checked at 6e-3): such pixels are counted, not compared.
       bool boundary = false;
-      const glm::vec3 tu = glm::normalize(glm::cross(n, std::fabs(n.x) > 0.9f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0)));
+      const glm::vec3 tu =
+          glm::normalize(glm::cross(n, std::fabs(n.x) > 0.9f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0)));
       const glm::vec3 tv = glm::cross(n, tu);
       for (const glm::vec3 dv : {6e-3f * tu, -6e-3f * tu, 6e-3f * tv, -6e-3f * tv}) {
         const glm::vec3 e2 = engine::directional_specular(brdf, n, glm::normalize(v + dv), dirs, stored);
@@ -274,9 +275,10 @@ TEST(DlmLighting, DirectionalBinsMatchTheCppTwinAtPixels) {
       ++checked;
     }
   }
-  std::printf("directional bins: %d pixels checked (%d on a bin boundary skipped), worst relative difference GPU vs "
-              "C++ %.3g\n",
-              checked, on_boundary, worst);
+  std::printf(
+      "directional bins: %d pixels checked (%d on a bin boundary skipped), worst relative difference GPU vs "
+      "C++ %.3g\n",
+      checked, on_boundary, worst);
   EXPECT_GT(checked, 50);
   EXPECT_LT(on_boundary, checked / 5);
 }

@@ -2,14 +2,14 @@
 // from one bundle; the red crate's bounce turns the white statue pink, and each frame
 // recomputes only what changed (counters).
 #define GL_GLEXT_PROTOTYPES 1
+#include <unistd.h>
 #include <GL/glcorearb.h>
+#include <gtest/gtest.h>
 #include <engine/components.h>
 #include <engine/gltf.h>
 #include <engine/gpu/context.h>
 #include <engine/scene.h>
 #include <gi/gi_system.h>
-#include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
@@ -163,9 +163,9 @@ TEST(GISystem, TheRedCrateTurnsTheStatuePink) {
   // The change is the crate's red bounce minus the world light it blocks (BrfResult::static_occlusion):
   // 10 cm in front of the plinth it blocks more than its unlit side sends, so the plinth gets
   // darker, and redder.
-  EXPECT_GT(near.x - near.y, 0.1);                                     // red light
-  EXPECT_GT(near.x - near.y, 5.0 * std::max(far.x - far.y, 1e-6));   // from the crate that came close
-  EXPECT_LT(near.y, far.y);                                            // and it blocks the world's light
+  EXPECT_GT(near.x - near.y, 0.1);                                  // red light
+  EXPECT_GT(near.x - near.y, 5.0 * std::max(far.x - far.y, 1e-6));  // from the crate that came close
+  EXPECT_LT(near.y, far.y);                                         // and it blocks the world's light
 }
 
 TEST(GISystem, ABundleOfOtherMeshesIsRejectedAsStale) {

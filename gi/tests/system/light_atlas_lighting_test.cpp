@@ -3,20 +3,20 @@
 // stand-in of radiance a, and an atlas lit on one chart lights exactly that chart's pixels.
 #include "system/light_atlas_lighting.h"
 
+#include <gtest/gtest.h>
 #include <engine/gltf.h>
 #include <engine/gpu/context.h>
 #include <engine/renderer.h>
 #include <engine/scene.h>
-#include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <glm/gtc/matrix_transform.hpp>
 #include <limits>
 #include <optional>
 #include <string>
 #include <vector>
+#include <glm/gtc/matrix_transform.hpp>
 
 #include "bundle/geometry_hash.h"
 #include "light_atlas/light_atlas.h"

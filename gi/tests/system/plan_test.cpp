@@ -1,9 +1,9 @@
 // gi::plan on the project's scenes (DESIGN.md §3 "Effects on demand", docs/plan.md): which
 // methods each scene calls for and why, the JSON form, the manifest's "plan" section, and
 // the cost model against the bakes it was calibrated on.
+#include <gtest/gtest.h>
 #include <engine/gltf.h>
 #include <gi/plan.h>
-#include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cstdio>

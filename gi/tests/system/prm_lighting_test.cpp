@@ -4,10 +4,10 @@
 #include "system/prm_lighting.h"
 
 #include <GL/glcorearb.h>
+#include <gtest/gtest.h>
 #include <engine/gltf.h>
 #include <engine/gpu/context.h>
 #include <engine/scene.h>
-#include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>

@@ -6,12 +6,12 @@
 // world then, docs/scene-format.md).
 #define GL_GLEXT_PROTOTYPES 1
 #include <GL/glcorearb.h>
+#include <gtest/gtest.h>
 #include <engine/gltf.h>
 #include <engine/gpu/context.h>
 #include <engine/scene.h>
 #include <gi/bake.h>
 #include <gi/error_metrics.h>
-#include <gtest/gtest.h>
 
 #include <unistd.h>
 
@@ -110,12 +110,13 @@ TEST(PrmSky, APrmBakeOfASkyLitSceneCarriesTheSkyInItsAtlasAndMatchesThePathTrace
   const gi::ErrorReport sky_part =
       gi::compare_rgb(gi::RgbField::from_texels(w, h, atlas->irradiance, texels.valid), sky);
   const gi::ErrorReport lamp_part = gi::compare_rgb(gi::RgbField::from_texels(w, h, prm_only, texels.valid), lamp);
-  std::printf("sky-lit Cornell box + moving lamp, medium preset at 32 texels/m, indirect + the sky's direct "
-              "irradiance, rel RMSE (scale fit):\n"
-              "  light atlas + PRM vs sky + lamp %.4f (%.4f); PRM without the atlas vs sky + lamp %.4f (%.4f)\n"
-              "  its parts: atlas vs the sky alone %.4f (%.4f), PRM vs the lamp alone %.4f (%.4f)\n",
-              with_sky.rel_rmse, with_sky.fit_scale, prm_alone.rel_rmse, prm_alone.fit_scale, sky_part.rel_rmse,
-              sky_part.fit_scale, lamp_part.rel_rmse, lamp_part.fit_scale);
+  std::printf(
+      "sky-lit Cornell box + moving lamp, medium preset at 32 texels/m, indirect + the sky's direct "
+      "irradiance, rel RMSE (scale fit):\n"
+      "  light atlas + PRM vs sky + lamp %.4f (%.4f); PRM without the atlas vs sky + lamp %.4f (%.4f)\n"
+      "  its parts: atlas vs the sky alone %.4f (%.4f), PRM vs the lamp alone %.4f (%.4f)\n",
+      with_sky.rel_rmse, with_sky.fit_scale, prm_alone.rel_rmse, prm_alone.fit_scale, sky_part.rel_rmse,
+      sky_part.fit_scale, lamp_part.rel_rmse, lamp_part.fit_scale);
   // Measured: 0.150 (scale 1.047); the parts 0.180 (sky, atlas) and 0.221 (lamp, PRM; the
   // spot chamber's medium-preset class, docs/prm.md); the PRM alone 0.617 (scale 2.19).
   EXPECT_LT(with_sky.rel_rmse, 0.2);

@@ -4,7 +4,9 @@
 // stays finite — the PRM's atlas, the BRF's per-vertex light, the rendered HDR frame. When
 // the values are good again the frame is what it was. Real GL on llvmpipe (never skipped).
 #define GL_GLEXT_PROTOTYPES 1
+#include <unistd.h>
 #include <GL/glcorearb.h>
+#include <gtest/gtest.h>
 #include <engine/components.h>
 #include <engine/gltf.h>
 #include <engine/gpu/context.h>
@@ -12,8 +14,6 @@
 #include <engine/scene.h>
 #include <gi/bake.h>
 #include <gi/gi_system.h>
-#include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>

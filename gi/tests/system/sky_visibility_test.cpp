@@ -4,13 +4,13 @@
 // GISystem hands it to the renderer for a sky-lit scene.
 #include "system/sky_visibility.h"
 
+#include <unistd.h>
+#include <gtest/gtest.h>
 #include <engine/components.h>
 #include <engine/gpu/context.h>
 #include <engine/scene.h>
 #include <gi/bake.h>
 #include <gi/gi_system.h>
-#include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <cstdio>
 #include <filesystem>
@@ -93,7 +93,8 @@ TEST(SkyVisibility, GiSystemProvidesItForASkyLitScene) {
   const std::filesystem::path dir =
       std::filesystem::temp_directory_path() / ("gi_sky_visibility_" + std::to_string(::getpid()) + ".gibake");
   std::filesystem::remove_all(dir);
-  auto baked = gi::bake_bundle(gi::bake_input_from(scene), dir, {.preset = "preview", .methods = {"atlas"}, .texels_per_metre = 1.0f});
+  auto baked = gi::bake_bundle(gi::bake_input_from(scene), dir,
+                               {.preset = "preview", .methods = {"atlas"}, .texels_per_metre = 1.0f});
   ASSERT_TRUE(baked) << baked.error().to_string();
   auto gpu = engine::GpuContext::create_headless();
   ASSERT_TRUE(gpu) << gpu.error().to_string();

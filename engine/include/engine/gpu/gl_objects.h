@@ -10,7 +10,17 @@
 namespace engine {
 
 /// How a GL object name is released (one function per GL object kind).
-enum class GlObjectKind : std::uint8_t { Buffer, Texture, Framebuffer, Renderbuffer, VertexArray, Query, Program, Shader, Sampler };
+enum class GlObjectKind : std::uint8_t {
+  Buffer,
+  Texture,
+  Framebuffer,
+  Renderbuffer,
+  VertexArray,
+  Query,
+  Program,
+  Shader,
+  Sampler
+};
 
 /// Deletes `id` of the given kind (glDeleteBuffers, glDeleteProgram...). 0 is ignored.
 void delete_gl_object(GlObjectKind kind, std::uint32_t id);

@@ -5,7 +5,8 @@
 // as an engine::Error {file = "path/of/the/included.glsl", location = "line 12", ...} whose
 // to_string() reads "path: line 12: message".
 //   auto p = engine::ShaderProgramBuilder(engine::engine_shader_files())
-//                .stage(engine::ShaderStage::Vertex, "forward.vert.glsl").stage(engine::ShaderStage::Fragment, "forward.frag.glsl").build();
+//                .stage(engine::ShaderStage::Vertex, "forward.vert.glsl").stage(engine::ShaderStage::Fragment,
+//                "forward.frag.glsl").build();
 
 #include <span>
 #include <string>
