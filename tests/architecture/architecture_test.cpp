@@ -3,6 +3,7 @@
 // folder include graph has no cycle, engine never includes gi, and nothing outside gi/
 // includes gi/src: tools, the demo and the top-level tests use the public headers.
 #include <gtest/gtest.h>
+#include <gi/methods.h>
 
 #include <algorithm>
 #include <filesystem>
@@ -161,6 +162,30 @@ TEST(Architecture, NothingOutsideGiIncludesGiSrcAndEngineNeverIncludesGi) {
           EXPECT_FALSE(std::regex_search(line, gi_public)) << rel << " (engine) includes gi: " << line;
       }
     }
+  }
+}
+
+// GISystem composes the methods through the method table only (gi/src/system/method_table.h,
+// issue 34): gi_system.cpp includes no method's folder and no method's adapter, and every
+// method of gi/methods.h has its adapter, system/<key>_method.cpp, whose loader the table
+// names. A sixth method is its adapter file and one row; GISystem does not change.
+TEST(Architecture, GiSystemKnowsNoMethodOnlyTheTable) {
+  const fs::path system = kGiSrc / "system" / "gi_system.cpp";
+  const std::set<std::string> folders = included_folders(system);
+  for (const gi::MethodDescriptor& m : gi::kMethods)
+    EXPECT_FALSE(folders.count(std::string(m.key))) << "gi_system.cpp includes gi/src/" << m.key << "/...";
+  for (const char* f : {"prm", "brf", "dlm"}) EXPECT_FALSE(folders.count(f)) << "gi_system.cpp includes gi/src/" << f;
+  static const std::regex adapter(R"re(^\s*#\s*include\s*"system/[a-z_0-9]+_(lighting|method|probe_light)\.h")re");
+  std::ifstream in(system);
+  for (std::string line; std::getline(in, line);)
+    EXPECT_FALSE(std::regex_search(line, adapter)) << "gi_system.cpp includes a method's adapter: " << line;
+  std::ifstream table_in(kGiSrc / "system" / "method_table.cpp");
+  const std::string table((std::istreambuf_iterator<char>(table_in)), std::istreambuf_iterator<char>());
+  for (const gi::MethodDescriptor& m : gi::kMethods) {
+    const std::string key(m.key);
+    EXPECT_TRUE(fs::exists(kGiSrc / "system" / (key + "_method.cpp"))) << "no adapter system/" << key << "_method.cpp";
+    EXPECT_NE(table.find("&load_" + key + "_method"), std::string::npos)
+        << "method_table.cpp does not name load_" << key << "_method";
   }
 }
 

@@ -72,6 +72,8 @@ class GISystem final : public engine::IndirectLightProvider {
   const char* label() const override;
 
   struct Stats {
+    double load_ms = 0.0;         ///< GISystem::load: the bundle read and checked, CPU-side setup (no GL).
+    double first_frame_ms = 0.0;  ///< The first frame(): GPU uploads and first composites (glFinish-timed).
     std::uint64_t frames = 0;
     std::uint64_t idle_frames = 0;        ///< Frames on which nothing was recomputed.
     std::uint64_t prm_updates = 0;        ///< Frames on which a moving light re-summed the PRM.

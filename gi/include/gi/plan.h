@@ -21,6 +21,7 @@
 #include <engine/result.h>
 #include <engine/scene.h>
 #include <gi/bake_input.h>
+#include <gi/methods.h>
 
 #include <cstdint>
 #include <optional>
@@ -29,10 +30,6 @@
 #include <vector>
 
 namespace gi {
-
-/// The five methods of DESIGN.md §1, in that order.
-enum class EffectMethod : std::uint8_t { LightAtlas, Prm, DirectionalLightMaps, Antiradiance, BasisRadianceFields };
-inline constexpr int kEffectMethodCount = 5;
 
 /// The method's key as gi-bake --methods and the manifest spell it: "atlas", "prm", "dlm",
 /// "antiradiance", "brf".

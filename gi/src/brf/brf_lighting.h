@@ -64,7 +64,7 @@ struct BrfInstanceBinding {
 struct BrfWorldLink {
   /// The static world: shadows for the objects' direct light, and what hides an object from
   /// the static receivers (brf_static_visibility: no bounce through walls).
-  std::unique_ptr<RayCaster> caster;
+  std::shared_ptr<const RayCaster> caster;
   std::optional<WorldProbeGrid> probes;  ///< The world's light onto the objects.
   /// Static receivers: atlas texels (index y * width + x) with their world points and normals.
   std::vector<std::uint32_t> receiver_texels;

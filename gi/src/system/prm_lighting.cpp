@@ -28,9 +28,9 @@ namespace gi {
 struct PrmLighting::Impl {
   const engine::Registry* registry = nullptr;
   Prm prm;
-  std::vector<glm::vec3> base;  ///< Static-light atlas (empty: none).
-  std::unique_ptr<RayCaster> caster;
-  std::unique_ptr<ThreadPool> pool;  ///< Traces the flux checks (settings.threads).
+  std::vector<glm::vec3> base;              ///< Static-light atlas (empty: none).
+  std::shared_ptr<const RayCaster> caster;  ///< The static world (shared with the other methods).
+  std::unique_ptr<ThreadPool> pool;         ///< Traces the flux checks (settings.threads).
   PrmLightingSettings settings;
   std::optional<PrmGpuPass> pass;
   bool fresh = false;
@@ -98,22 +98,25 @@ PrmLighting::PrmLighting(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 PrmLighting::~PrmLighting() = default;
 
 engine::Result<std::unique_ptr<PrmLighting>> PrmLighting::from_bake(Prm prm, const LightAtlasBake* base,
-                                                                    engine::Scene& scene,
-                                                                    PrmLightingSettings settings) {
+                                                                    engine::Scene& scene, PrmLightingSettings settings,
+                                                                    std::shared_ptr<const RayCaster> static_world) {
   if (base && (base->width != prm.width || base->height != prm.height ||
                base->layout.texels_per_metre != prm.layout.texels_per_metre))
     return engine::Error{scene.assets.source, "PRM",
                          "the light atlas (" + std::to_string(base->width) + "x" + std::to_string(base->height) +
                              ") and the PRM (" + std::to_string(prm.width) + "x" + std::to_string(prm.height) +
                              ") were baked at different layouts; bake both at one density"};
-  auto caster = make_static_caster(bake_input_from(scene));
-  if (!caster) return caster.error();
+  if (!static_world) {
+    auto caster = make_static_caster(bake_input_from(scene));
+    if (!caster) return caster.error();
+    static_world = std::move(caster).value();
+  }
   if (engine::Status s = apply_atlas_uv1(scene, prm.layout); !s) return s.error();
   auto impl = std::make_unique<Impl>();
   impl->registry = &scene.registry;
   impl->prm = std::move(prm);
   if (base) impl->base = base->irradiance;
-  impl->caster = std::move(caster).value();
+  impl->caster = std::move(static_world);
   impl->settings = settings;
   const unsigned threads =
       settings.threads > 0 ? settings.threads : std::min(4u, std::max(1u, std::thread::hardware_concurrency()));
@@ -169,6 +172,8 @@ const char* PrmLighting::label() const { return impl_->base.empty() ? "PRM" : "l
 const PrmLighting::Stats& PrmLighting::stats() const { return impl_->stats; }
 
 std::span<const PrmEntryPoint> PrmLighting::entry_points() const { return impl_->prm.entries; }
+
+const AtlasLayout& PrmLighting::layout() const { return impl_->prm.layout; }
 
 std::vector<glm::vec3> PrmLighting::moving_entry_irradiance() const {
   std::vector<glm::vec3> sum(impl_->prm.entries.size(), glm::vec3(0.0f));

@@ -31,6 +31,8 @@ namespace gi {
 struct Prm;
 struct PrmEntryPoint;
 struct LightAtlasBake;
+struct AtlasLayout;
+class RayCaster;
 
 struct PrmLightingSettings {
   int active_clusters = 32;  ///< K: panes summed per update (the heaviest); 0: all.
@@ -49,9 +51,9 @@ struct PrmLightingSettings {
 class PrmLighting final : public engine::IndirectLightProvider {
  public:
   /// From bakes in memory (base may be null). Same layout required.
-  static engine::Result<std::unique_ptr<PrmLighting>> from_bake(Prm prm, const LightAtlasBake* base,
-                                                                engine::Scene& scene,
-                                                                PrmLightingSettings settings = {});
+  static engine::Result<std::unique_ptr<PrmLighting>> from_bake(
+      Prm prm, const LightAtlasBake* base, engine::Scene& scene, PrmLightingSettings settings = {},
+      std::shared_ptr<const RayCaster> static_world = nullptr);
 
   PrmLighting(const PrmLighting&) = delete;
   PrmLighting& operator=(const PrmLighting&) = delete;
@@ -78,6 +80,8 @@ class PrmLighting final : public engine::IndirectLightProvider {
   // the moving lights' first bounce off the static world as emitters.
   /// The PRM's entry points (where moving lights first hit the static world).
   std::span<const PrmEntryPoint> entry_points() const;
+  /// The atlas layout the panes are drawn at (the static meshes' TEXCOORD_1).
+  const AtlasLayout& layout() const;
   /// Per entry point, the moving lights' irradiance (W/m^2) as of the last update (the cached
   /// per-light values summed); zeros before the first frame.
   std::vector<glm::vec3> moving_entry_irradiance() const;

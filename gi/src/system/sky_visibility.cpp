@@ -20,12 +20,16 @@ float luminance(const glm::vec3& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0
 
 }  // namespace
 
-engine::Result<std::unique_ptr<SkyVisibility>> SkyVisibility::create(const engine::Scene& scene) {
-  auto caster = make_static_caster(bake_input_from(scene));
-  if (!caster) return caster.error();
+engine::Result<std::unique_ptr<SkyVisibility>> SkyVisibility::create(const engine::Scene& scene,
+                                                                     std::shared_ptr<const RayCaster> static_world) {
+  if (!static_world) {
+    auto caster = make_static_caster(bake_input_from(scene));
+    if (!caster) return caster.error();
+    static_world = std::move(caster).value();
+  }
   std::unique_ptr<SkyVisibility> out(new SkyVisibility());
   out->registry_ = &scene.registry;
-  out->caster_ = std::move(caster).value();
+  out->caster_ = std::move(static_world);
   const engine::Environment& env = scene.assets.environment;
   // Spherical Fibonacci directions: equal solid angle each.
   const float golden = std::numbers::pi_v<float> * (3.0f - std::sqrt(5.0f));

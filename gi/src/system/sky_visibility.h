@@ -36,7 +36,10 @@ class SkyVisibility {
 
   /// For the dynamic mesh entities of `scene` (MeshRenderer without StaticTag), against its
   /// static instances, under its sky (scene.assets.environment).
-  static engine::Result<std::unique_ptr<SkyVisibility>> create(const engine::Scene& scene);
+  /// `static_world`: the static world's ray caster when the caller has one (GISystem shares
+  /// one between its methods); built from `scene` otherwise.
+  static engine::Result<std::unique_ptr<SkyVisibility>> create(const engine::Scene& scene,
+                                                               std::shared_ptr<const RayCaster> static_world = nullptr);
 
   /// Re-measures the scene's entities that moved (or appeared); returns how many were measured.
   std::size_t update();
@@ -50,7 +53,7 @@ class SkyVisibility {
  private:
   SkyVisibility() = default;
   const engine::Registry* registry_ = nullptr;
-  std::unique_ptr<RayCaster> caster_;
+  std::shared_ptr<const RayCaster> caster_;
   std::vector<glm::vec3> directions_;
   std::vector<float> sky_weight_;                             ///< Luminance of the sky's radiance of each direction.
   std::vector<std::pair<glm::vec3, glm::vec3>> mesh_bounds_;  ///< Object-space box per asset mesh.

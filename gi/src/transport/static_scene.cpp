@@ -38,7 +38,8 @@ engine::Result<std::unique_ptr<RayCaster>> make_static_caster(const BakeInput& i
 }
 
 engine::Result<StaticBakeScene> prepare_static_scene(const BakeInput& input, const AtlasLayout& layout,
-                                                     BakeLights lights, TexelPlacement placement) {
+                                                     BakeLights lights, TexelPlacement placement,
+                                                     std::shared_ptr<const RayCaster> static_world) {
   StaticBakeScene b;
   b.scene = reference_scene_from(input);
   b.scene.lights = bake_lights(input, lights);
@@ -48,9 +49,13 @@ engine::Result<StaticBakeScene> prepare_static_scene(const BakeInput& input, con
   keep_static_emitters(b.scene, b.index);  // a dynamic object's glow moves with it: not the static bake's light
   const RtSceneData statics = static_instances(b.scene.geometry, &b.static_instance);
   if (statics.instances.empty()) return engine::Error{.message = "the scene has no static mesh to bake"};
-  auto caster = make_embree_ray_caster(statics);
-  if (!caster) return caster.error();
-  b.caster = std::move(caster).value();
+  if (static_world) {
+    b.caster = std::move(static_world);
+  } else {
+    auto caster = make_embree_ray_caster(statics);
+    if (!caster) return caster.error();
+    b.caster = std::move(caster).value();
+  }
   auto texels = sample_atlas_texels(input, layout, placement, b.caster.get());
   if (!texels) return texels.error();
   b.texels = std::move(texels).value();

@@ -30,7 +30,7 @@ enum class BakeLights : std::uint8_t {
 struct StaticBakeScene {
   ReferenceScene scene;
   ReferenceSceneIndex index;
-  std::unique_ptr<RayCaster> caster;  ///< Static instances only.
+  std::shared_ptr<const RayCaster> caster;  ///< Static instances only.
   /// Caster instance -> snapshot instance (scene.geometry.instances index).
   std::vector<std::uint32_t> static_instance;
   AtlasTexels texels;  ///< The layout's texels.
@@ -42,10 +42,13 @@ struct StaticBakeScene {
 };
 
 /// Errors: invalid scene data (non-finite values...), no static mesh instance.
-/// `placement`: where the texels' samples lie (gi/reference.h).
+/// `placement`: where the texels' samples lie (gi/reference.h). `static_world`: a caster the
+/// caller already built over the same static instances (make_static_caster of `input`),
+/// shared instead of building a second one.
 engine::Result<StaticBakeScene> prepare_static_scene(const BakeInput& input, const AtlasLayout& layout,
                                                      BakeLights lights,
-                                                     TexelPlacement placement = TexelPlacement::Raster);
+                                                     TexelPlacement placement = TexelPlacement::Raster,
+                                                     std::shared_ptr<const RayCaster> static_world = nullptr);
 
 /// A light-atlas texel's footprint on its triangle in barycentrics (u, v): its centre and
 /// the offsets of one texel step along the atlas's x and y (the texel covers centre +-
