@@ -2,8 +2,9 @@
 // and decompressing them, measured in the same run (issue 34: load <= 2x the yardstick, the
 // GPU upload of the first frame reported apart).
 //   ./build/gi/benchmarks/gi_load_bench --benchmark_counters_tabular=true
-//   GI_LOAD_BENCH_SCENE=../shared/external-assets/dabrovic-sponza/sponza.gltf \
-//   GI_LOAD_BENCH_BUNDLE=/tmp/sponza_preview.gibake ./build/gi/benchmarks/gi_load_bench
+//   GI_LOAD_BENCH_SCENE=../shared/external-assets/dabrovic-sponza/sponza.gltf
+//     GI_LOAD_BENCH_BUNDLE=/tmp/sponza_preview.gibake ./build/gi/benchmarks/gi_load_bench
+//   (the two variables on one command line)
 // Without GI_LOAD_BENCH_SCENE the demo level (assets/demo_level.gltf) is baked at preview into
 // a temporary directory first (every method its plan asks for) and loaded from there.
 // Benchmarks:
