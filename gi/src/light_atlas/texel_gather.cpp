@@ -74,6 +74,7 @@ struct TexelTable {
 };
 
 engine::Result<TexelTable> texel_table(const StaticBakeScene& b, const AtlasLayout& layout) {
+  // Long: the layout checks, the per-texel albedo and face tables and the gutter redirects of one table.
   const AtlasTexels& tx = b.texels;
   if (tx.width != layout.width || tx.height != layout.height || layout.meshes.size() != b.static_instance.size())
     return engine::Error{.message = "texel gather: the atlas layout does not match the bake scene"};
