@@ -1,7 +1,8 @@
 // The architecture, checked: gi/src folders include only the folders of the targets they
 // link (gi/CMakeLists.txt writes the targets' folders and links to GI_LAYERS_FILE), the
 // folder include graph has no cycle, engine never includes gi, and nothing outside gi/
-// includes gi/src: tools, the demo and the top-level tests use the public headers.
+// includes gi/src: tools, the demo and the top-level tests use the public headers, and
+// the methods read their bundle files through the one reader path (bundle/bundle_reader.h).
 #include <gtest/gtest.h>
 #include <gi/methods.h>
 
@@ -190,3 +191,38 @@ TEST(Architecture, GiSystemKnowsNoMethodOnlyTheTable) {
 }
 
 }  // namespace
+
+// One reader path: a method (a target that links gi_transport: gi_light_atlas, gi_prm, ...)
+// never reads manifest.json or checks a bundle file's checksum itself. It opens its entry
+// through gi::BundleReader (gi/src/bundle/bundle_reader.h), which makes the manifest,
+// geometry, file-name and checksum checks once, with one error text for every method. The
+// rule: no source in a method's folder calls read_manifest, read_current_manifest,
+// manifest_method or check_file_checksum (writers may still call update_manifest_method).
+TEST(Architecture, MethodsReadTheirBundleFilesThroughTheBundleReader) {
+  const Layers l = read_layers();
+  std::set<std::string> method_targets;
+  for (const auto& [target, linked] : l.links)
+    if (linked.count("gi_transport")) method_targets.insert(target);
+  ASSERT_GE(method_targets.size(), 5u) << "the layers file lists fewer method targets than the five methods";
+  static const std::regex bundle_access(
+      R"re(\b(read_manifest|read_current_manifest|manifest_method|check_file_checksum)\s*\()re");
+  std::size_t files_checked = 0;
+  for (const auto& [folder, target] : l.target_of_folder) {
+    if (!method_targets.count(target) || !fs::exists(kGiSrc / folder)) continue;
+    for (const auto& e : fs::recursive_directory_iterator(kGiSrc / folder)) {
+      if (!e.is_regular_file() || !is_source(e.path())) continue;
+      ++files_checked;
+      std::ifstream in(e.path());
+      int line_number = 0;
+      for (std::string line; std::getline(in, line);) {
+        ++line_number;
+        const std::string code = line.substr(0, line.find("//"));
+        std::smatch m;
+        EXPECT_FALSE(std::regex_search(code, m, bundle_access))
+            << "gi/src/" << folder << "/" << e.path().filename().string() << ":" << line_number << " calls " << m[1]
+            << ": a method reads its bundle entry through gi::BundleReader (bundle/bundle_reader.h)";
+      }
+    }
+  }
+  EXPECT_GT(files_checked, 0u);
+}

@@ -6,6 +6,7 @@
 #include <cstring>
 #include <type_traits>
 
+#include "bundle/bundle_reader.h"
 #include "bundle/geometry_hash.h"
 #include "bundle/manifest.h"
 #include "io/zstd_stream.h"
@@ -331,26 +332,13 @@ engine::Status save_antiradiance(const fs::path& bundle_dir, const AntiradianceB
 }
 
 engine::Result<AntiradianceBake> load_antiradiance(const fs::path& bundle_dir, const BakeInput& input) {
-  auto manifest = read_current_manifest(bundle_dir, input, "re-bake the antiradiance region");
-  if (!manifest) return manifest.error();
-  const fs::path manifest_file = bundle_dir / kManifestFileName;
-  auto entry = manifest_method(bundle_dir, *manifest, kAntiradianceMethod);
-  if (!entry) return entry.error();
-  const std::string where = std::string("methods.") + kAntiradianceMethod + ".files.elements";
-  const json* file = nullptr;
-  if (entry->contains("files") && (*entry)["files"].is_object() && (*entry)["files"].contains("elements"))
-    file = &(*entry)["files"]["elements"];
-  if (file == nullptr || !file->is_object() || !file->contains("file") || !(*file)["file"].is_string() ||
-      !file->contains("xxh3_64") || !(*file)["xxh3_64"].is_string())
-    return engine::Error{manifest_file.string(), where,
-                         "missing or malformed (needs \"file\" and \"xxh3_64\" strings)"};
-  const fs::path path = bundle_dir / (*file)["file"].get<std::string>();
-  if (engine::Status st = check_file_checksum(path, (*file)["xxh3_64"].get<std::string>()); !st) return st.error();
-  auto f = read_antiradiance(path);
+  auto bundle = BundleReader::open(bundle_dir, kAntiradianceMethod, input, "re-bake the antiradiance region");
+  if (!bundle) return bundle.error();
+  auto path = bundle->file("elements");
+  if (!path) return path.error();
+  auto f = read_antiradiance(*path);
   if (!f) return f.error();
-  if (f->geometry_hash != manifest->geometry_hash)
-    return file_error(path, "",
-                      "belongs to geometry " + f->geometry_hash + ", the manifest to " + manifest->geometry_hash);
+  if (engine::Status st = bundle->check_geometry(*path, f->geometry_hash); !st) return st.error();
   return std::move(f->bake);
 }
 

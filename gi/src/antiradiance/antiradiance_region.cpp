@@ -3,12 +3,13 @@
 #include <algorithm>
 #include <chrono>
 
+#include "core/stopwatch.h"
+
 namespace gi {
 
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
 engine::Status check_bins(const AntiradianceSettings& settings) {
   if (settings.bins_per_side < 1 || settings.bins_per_side > 64)

@@ -3,15 +3,9 @@
 #include <chrono>
 #include <utility>
 
+#include "core/stopwatch.h"
+
 namespace gi {
-
-namespace {
-
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
-}  // namespace
 
 engine::Result<BrfSettings> brf_preset(std::string_view name) {
   BrfSettings s;

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bundle/bundle.h"
+#include "bundle/bundle_reader.h"
 #include "io/json_fields.h"
 #include "io/zstd_stream.h"
 
@@ -345,43 +346,32 @@ engine::Status save_brf(const fs::path& bundle_dir, const BrfBake& bake, const B
 }
 
 engine::Result<BrfBake> load_brf(const fs::path& bundle_dir, std::span<const BrfSource> sources) {
-  auto manifest = read_manifest(bundle_dir);
-  if (!manifest) return manifest.error();
-  const fs::path manifest_file = bundle_dir / kManifestFileName;
-  auto entry = manifest_method(bundle_dir, *manifest, kBrfMethod);
-  if (!entry) return entry.error();
-  const std::string prefix = std::string("methods.") + kBrfMethod;
-  JsonFields fields(*entry, manifest_file.string(), prefix);
+  // Each mesh's file carries its mesh's hash, checked below: no whole-scene geometry check.
+  auto bundle = BundleReader::open_any_geometry(bundle_dir, kBrfMethod);
+  if (!bundle) return bundle.error();
+  JsonFields fields = bundle->fields();
   BrfBake out;
   out.settings = read_settings(fields);
   if (fields.error()) return *fields.error();
 
   for (const BrfSource& source : sources) {
-    const std::string key = "files." + source.name;
-    if (!entry->contains("files") || !(*entry)["files"].is_object() || !(*entry)["files"].contains(source.name))
-      return engine::Error{
-          manifest_file.string(), prefix + "." + key,
-          "no basis radiance field for the scene's dynamic mesh \"" + source.name + "\" (re-bake with --methods brf)"};
-    const std::string file_name = fields.get<std::string>(key + ".file");
-    const std::string checksum = fields.get<std::string>(key + ".xxh3_64");
-    if (fields.error()) return *fields.error();
-    if (!is_bundle_file_name(file_name))
-      return engine::Error{manifest_file.string(), prefix + "." + key + ".file",
-                           "\"" + file_name + "\" is not a file name inside the bundle"};
-    const fs::path path = bundle_dir / file_name;
-    if (engine::Status s = check_file_checksum(path, checksum); !s) return s.error();
-    auto mesh = read_brf_mesh(path);
+    if (!bundle->has_file(source.name))
+      return bundle->entry_error("files." + source.name, "no basis radiance field for the scene's dynamic mesh \"" +
+                                                             source.name + "\" (re-bake with --methods brf)");
+    auto path = bundle->file(source.name);
+    if (!path) return path.error();
+    auto mesh = read_brf_mesh(*path);
     if (!mesh) return mesh.error();
     if (mesh->name != source.name)
-      return file_error(path, "name",
+      return file_error(*path, "name",
                         "holds mesh \"" + mesh->name + "\", the manifest lists it for \"" + source.name + "\"");
     if (mesh->mesh_hash != source.mesh_hash)
-      return file_error(path, "mesh_hash",
+      return file_error(*path, "mesh_hash",
                         "stale basis radiance field: baked from mesh hash " + mesh->mesh_hash + ", but mesh \"" +
                             source.name + "\" of the scene hashes to " + source.mesh_hash +
                             " (re-bake with --methods brf)");
     if (mesh->basis.vertex_count != source.mesh.positions.size())
-      return file_error(path, "vertex_count",
+      return file_error(*path, "vertex_count",
                         "the basis has " + str(mesh->basis.vertex_count) + " vertices, mesh \"" + source.name + "\" " +
                             str(source.mesh.positions.size()));
     out.meshes.push_back(std::move(mesh).value());

@@ -9,6 +9,7 @@
 #include <span>
 #include <utility>
 
+#include "core/color.h"
 #include "io/content_hash.h"
 #include "raytrace/material_lookup.h"
 #include "raytrace/scene_adapter.h"
@@ -17,8 +18,6 @@
 namespace gi {
 
 namespace {
-
-float luminance(const glm::vec3& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 
 // A file-name fragment from a mesh name: [A-Za-z0-9_-] kept, anything else '_'.
 std::string name_fragment(const std::string& name, std::uint32_t mesh_index) {

@@ -1,5 +1,7 @@
 #include "dlm/dlm.h"
 
+#include "core/color.h"
+#include "core/stopwatch.h"
 #include "raytrace/material_lookup.h"
 
 #include <engine/directional_radiance.h>
@@ -29,7 +31,6 @@ namespace gi {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 constexpr float kPi = std::numbers::pi_v<float>;
 // Photons per batch (a batch is traced by one thread, its deposits merged in photon order)
@@ -52,8 +53,6 @@ engine::Status validate(const DlmSettings& s) {
   if (s.area_light_samples < 1 || s.area_light_samples > 65536) return bad("area_light_samples must be in 1..65536");
   return {};
 }
-
-float max_component(const glm::vec3& v) { return std::max(v.x, std::max(v.y, v.z)); }
 
 // Spherical Fibonacci lattice point i of n.
 glm::vec3 fibonacci_direction(int i, int n) {

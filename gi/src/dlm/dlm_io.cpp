@@ -10,9 +10,9 @@
 #include <nlohmann/json.hpp>
 
 #include "bundle/bundle.h"
+#include "bundle/bundle_reader.h"
 #include "core/half_scale.h"
 #include "io/json_fields.h"
-#include "uv/atlas_input.h"
 
 namespace gi {
 
@@ -84,29 +84,19 @@ json stats_json(const DlmStats& s) {
               {"glossy_texels", s.glossy_texels}};
 }
 
+// What the manifest entry says beyond its file: the lights, the layout and the sizes.
 struct EntryInfo {
-  std::string file, checksum, lights_hash;
-  float requested_texels_per_metre = 0.0f;
-  float texels_per_metre = 0.0f;
-  int padding_texels = 0;
-  int width = 0;
-  int height = 0;
+  std::string lights_hash;
+  BakedAtlasLayout layout;
   std::size_t directions = 0, texels = 0;
   DlmStats stats;
 };
 
-engine::Result<EntryInfo> read_entry(const fs::path& manifest_file, const json& entry) {
-  const std::string prefix = std::string("methods.") + kDlmMethod;
-  JsonFields f(entry, manifest_file.string(), prefix);
+engine::Result<EntryInfo> read_entry(const BundleReader& bundle) {
+  JsonFields f = bundle.fields();
   EntryInfo e;
-  e.file = f.get<std::string>("files.maps.file");
-  e.checksum = f.get<std::string>("files.maps.xxh3_64");
   e.lights_hash = f.get<std::string>("lights_hash");
-  e.requested_texels_per_metre = f.get<float>("layout.requested_texels_per_metre");
-  e.texels_per_metre = f.get<float>("layout.texels_per_metre");
-  e.padding_texels = f.get<int>("layout.padding_texels");
-  e.width = f.get<int>("layout.width");
-  e.height = f.get<int>("layout.height");
+  e.layout = read_baked_atlas_layout(f);
   e.directions = f.get<std::size_t>("directions");
   e.texels = f.get<std::size_t>("texels");
   e.stats.photons = f.get<std::uint64_t>("stats.photons");
@@ -116,9 +106,6 @@ engine::Result<EntryInfo> read_entry(const fs::path& manifest_file, const json& 
   e.stats.emitted_watts = f.get<double>("stats.emitted_watts");
   e.stats.glossy_texels = f.get<std::size_t>("stats.glossy_texels");
   if (f.error()) return *f.error();
-  if (!is_bundle_file_name(e.file))
-    return engine::Error{manifest_file.string(), prefix + ".files.maps.file",
-                         "\"" + e.file + "\" is not a file name inside the bundle"};
   return e;
 }
 
@@ -230,12 +217,7 @@ engine::Status save_dlm(const fs::path& bundle_dir, const Dlm& dlm, const BakeIn
       {"files", {{"maps", {{"file", kDlmFile}, {"xxh3_64", *sum}}}}},
       {"lights_hash", static_lights_hash(input)},
       {"settings", settings_json(dlm.settings)},
-      {"layout",
-       {{"requested_texels_per_metre", dlm.layout.requested_texels_per_metre},
-        {"texels_per_metre", dlm.layout.texels_per_metre},
-        {"padding_texels", dlm.layout.padding_texels},
-        {"width", dlm.layout.width},
-        {"height", dlm.layout.height}}},
+      {"layout", baked_atlas_layout_json(dlm.layout)},
       {"directions", n},
       {"texels", dlm.texels.size()},
       {"stats", stats_json(dlm.stats)},
@@ -248,47 +230,28 @@ engine::Status save_dlm(const fs::path& bundle_dir, const Dlm& dlm, const BakeIn
 }
 
 engine::Result<Dlm> load_dlm(const fs::path& bundle_dir, const BakeInput& input) {
-  auto manifest = read_current_manifest(bundle_dir, input, "re-bake the directional light maps");
-  if (!manifest) return manifest.error();
-  const fs::path manifest_file = bundle_dir / kManifestFileName;
-  auto entry_json = manifest_method(bundle_dir, *manifest, kDlmMethod);
-  if (!entry_json) return entry_json.error();
-  auto entry = read_entry(manifest_file, *entry_json);
+  auto bundle = BundleReader::open(bundle_dir, kDlmMethod, input, "re-bake the directional light maps");
+  if (!bundle) return bundle.error();
+  auto entry = read_entry(*bundle);
   if (!entry) return entry.error();
-  if (const std::string lights = static_lights_hash(input); entry->lights_hash != lights)
-    return engine::Error{manifest_file.string(), "methods.dlm.lights_hash",
-                         "stale directional light maps in " + bundle_dir.string() + ": baked under static lights " +
-                             entry->lights_hash + ", but the scene's static lights hash to " + lights + " (re-bake)"};
-  const fs::path path = bundle_dir / entry->file;
-  if (engine::Status st = check_file_checksum(path, entry->checksum); !st) return st.error();
-  auto file = read_dlm_file(path);
+  if (engine::Status st = bundle->check_lights(entry->lights_hash, input, "directional light maps", "re-bake"); !st)
+    return st.error();
+  auto path = bundle->file("maps");
+  if (!path) return path.error();
+  auto file = read_dlm_file(*path);
   if (!file) return file.error();
-  if (file->geometry_hash != manifest->geometry_hash)
-    return file_error(path, "",
-                      "belongs to geometry " + file->geometry_hash + ", the manifest to " + manifest->geometry_hash);
+  if (engine::Status st = bundle->check_geometry(*path, file->geometry_hash); !st) return st.error();
   Dlm& dlm = file->dlm;
-  const std::string prefix = std::string("methods.") + kDlmMethod;
-  if (entry->directions != dlm.directions.size() || entry->texels != dlm.texels.size() || entry->width != dlm.width ||
-      entry->height != dlm.height)
-    return engine::Error{manifest_file.string(), prefix,
-                         "the manifest describes " + str(entry->directions) + " directions, " + str(entry->texels) +
-                             " texels, " + std::to_string(entry->width) + "x" + std::to_string(entry->height) + "; " +
-                             path.string() + " holds " + str(dlm.directions.size()) + ", " + str(dlm.texels.size()) +
-                             ", " + std::to_string(dlm.width) + "x" + std::to_string(dlm.height)};
-  auto layout = build_atlas_layout(
-      atlas_inputs_from(input),
-      AtlasSettings{.texels_per_metre = entry->requested_texels_per_metre, .padding_texels = entry->padding_texels});
-  if (!layout) {
-    engine::Error e = layout.error();
-    e.message = "cannot rebuild the DLM atlas layout of " + manifest_file.string() + ": " + e.message;
-    return e;
-  }
-  if (layout->width != entry->width || layout->height != entry->height ||
-      layout->texels_per_metre != entry->texels_per_metre)
-    return engine::Error{manifest_file.string(), prefix + ".layout",
-                         "the rebuilt layout (" + std::to_string(layout->width) + "x" + std::to_string(layout->height) +
-                             ") differs from the baked one (" + std::to_string(entry->width) + "x" +
-                             std::to_string(entry->height) + "); the atlas code changed since the bake (re-bake)"};
+  const BakedAtlasLayout& l = entry->layout;
+  if (entry->directions != dlm.directions.size() || entry->texels != dlm.texels.size() || l.width != dlm.width ||
+      l.height != dlm.height)
+    return bundle->entry_error("", "the manifest describes " + str(entry->directions) + " directions, " +
+                                       str(entry->texels) + " texels, " + std::to_string(l.width) + "x" +
+                                       std::to_string(l.height) + "; " + path->string() + " holds " +
+                                       str(dlm.directions.size()) + ", " + str(dlm.texels.size()) + ", " +
+                                       std::to_string(dlm.width) + "x" + std::to_string(dlm.height));
+  auto layout = bundle->atlas_layout(input, l, "DLM atlas layout");
+  if (!layout) return layout.error();
   dlm.layout = std::move(layout).value();
   dlm.stats = entry->stats;
   return std::move(file->dlm);

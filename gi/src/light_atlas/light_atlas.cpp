@@ -8,7 +8,9 @@
 #include <cmath>
 #include <span>
 
+#include "core/color.h"
 #include "core/random.h"
+#include "core/stopwatch.h"
 #include "light_atlas/final_shooting.h"
 #include "raytrace/ray_offset.h"
 #include "raytrace/reference_brdf.h"
@@ -23,7 +25,6 @@ namespace gi {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 engine::Status validate(const LightAtlasSettings& s) {
   const auto bad = [](std::string what) { return engine::invalid_request("light-atlas settings: " + what); };
@@ -393,7 +394,7 @@ engine::Result<LightAtlasUpdateStats> update_light_atlas(const BakeInput& input,
   auto powers = light_vpls(b, previous.vpls, settings, pool, nullptr);
   if (!powers) return powers.error();
   float largest = 0.0f;
-  for (const glm::vec3& e : powers->power) largest = std::max(largest, std::max(e.x, std::max(e.y, e.z)));
+  for (const glm::vec3& e : powers->power) largest = std::max(largest, max_component(e));
   std::vector<std::uint32_t> shooters;
   std::vector<glm::vec3> delta;
   for (std::uint32_t i = 0; i < previous.vpls.size(); ++i) {

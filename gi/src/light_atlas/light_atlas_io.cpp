@@ -7,9 +7,9 @@
 #include <nlohmann/json.hpp>
 
 #include "bundle/bundle.h"
+#include "bundle/bundle_reader.h"
 #include "io/json_fields.h"
 #include "light_atlas/light_atlas_vpl_file.h"
-#include "uv/atlas_input.h"
 
 namespace gi {
 
@@ -45,38 +45,23 @@ LightAtlasStats read_stats(JsonFields& f) {
   return s;
 }
 
-// What the manifest entry says about the files and the layout.
+// What the manifest entry says beyond its files: the lights, the direct light, the layout.
 struct EntryInfo {
-  std::string exr_file, exr_checksum, vpls_file, vpls_checksum, lights_hash, direct_light;
-  float requested_texels_per_metre = 0.0f;
-  float texels_per_metre = 0.0f;
-  int padding_texels = 0;
-  int width = 0;
-  int height = 0;
+  std::string lights_hash, direct_light;
+  BakedAtlasLayout layout;
   LightAtlasStats stats;
 };
 
-engine::Result<EntryInfo> read_entry(const fs::path& manifest_file, const json& entry) {
-  JsonFields f(entry, manifest_file.string(), std::string("methods.") + kLightAtlasMethod);
+engine::Result<EntryInfo> read_entry(const BundleReader& bundle) {
+  JsonFields f = bundle.fields();
   EntryInfo e;
-  e.exr_file = f.get<std::string>("files.irradiance.file");
-  e.exr_checksum = f.get<std::string>("files.irradiance.xxh3_64");
-  e.vpls_file = f.get<std::string>("files.vpls.file");
-  e.vpls_checksum = f.get<std::string>("files.vpls.xxh3_64");
   e.lights_hash = f.get<std::string>("lights_hash");
   // Absent in bundles baked before the atlas held the sky (load_light_atlas says so).
-  if (entry.is_object() && entry.contains("direct_light")) e.direct_light = f.get<std::string>("direct_light");
-  e.requested_texels_per_metre = f.get<float>("layout.requested_texels_per_metre");
-  e.texels_per_metre = f.get<float>("layout.texels_per_metre");
-  e.padding_texels = f.get<int>("layout.padding_texels");
-  e.width = f.get<int>("layout.width");
-  e.height = f.get<int>("layout.height");
+  if (bundle.entry().is_object() && bundle.entry().contains("direct_light"))
+    e.direct_light = f.get<std::string>("direct_light");
+  e.layout = read_baked_atlas_layout(f);
   e.stats = read_stats(f);
   if (f.error()) return *f.error();
-  for (const std::string* name : {&e.exr_file, &e.vpls_file})
-    if (!is_bundle_file_name(*name))
-      return engine::Error{manifest_file.string(), "methods.light_atlas.files",
-                           "\"" + *name + "\" is not a file name inside the bundle"};
   return e;
 }
 
@@ -149,71 +134,45 @@ engine::Status save_light_atlas(const fs::path& bundle_dir, const LightAtlasBake
                    {"lights_hash", static_lights_hash(input)},
                    {"direct_light", direct_light_name(bake.settings)},
                    {"settings", settings_json(bake.settings)},
-                   {"layout",
-                    {{"requested_texels_per_metre", bake.layout.requested_texels_per_metre},
-                     {"texels_per_metre", bake.layout.texels_per_metre},
-                     {"padding_texels", bake.layout.padding_texels},
-                     {"width", bake.layout.width},
-                     {"height", bake.layout.height}}},
+                   {"layout", baked_atlas_layout_json(bake.layout)},
                    {"stats", stats_json(bake.stats)}};
   return update_manifest_method(bundle_dir, geometry_hash, scene_name, kLightAtlasMethod, entry);
 }
 
 engine::Result<LightAtlasBake> load_light_atlas(const fs::path& bundle_dir, const BakeInput& input) {
-  auto manifest = read_current_manifest(bundle_dir, input, "re-bake");
-  if (!manifest) return manifest.error();
-  const fs::path manifest_file = bundle_dir / kManifestFileName;
-  auto entry_json = manifest_method(bundle_dir, *manifest, kLightAtlasMethod);
-  if (!entry_json) return entry_json.error();
-  auto entry = read_entry(manifest_file, *entry_json);
+  auto bundle = BundleReader::open(bundle_dir, kLightAtlasMethod, input, "re-bake");
+  if (!bundle) return bundle.error();
+  auto entry = read_entry(*bundle);
   if (!entry) return entry.error();
-  if (const std::string lights = static_lights_hash(input); entry->lights_hash != lights)
-    return engine::Error{manifest_file.string(), "methods.light_atlas.lights_hash",
-                         "stale light atlas in " + bundle_dir.string() + ": baked under static lights " +
-                             entry->lights_hash + ", but the scene's static lights hash to " + lights +
-                             " (a static light was edited; re-bake, or update it with gi::update_light_atlas)"};
-
+  if (engine::Status s =
+          bundle->check_lights(entry->lights_hash, input, "light atlas",
+                               "a static light was edited; re-bake, or update it with gi::update_light_atlas");
+      !s)
+    return s.error();
   if (entry->direct_light.empty())
-    return engine::Error{manifest_file.string(), "methods.light_atlas.direct_light",
-                         "the light atlas in " + bundle_dir.string() +
-                             " was baked before the atlas held the sky's direct light (the renderer drew the sky "
-                             "unshadowed then); re-bake"};
-  const fs::path vpls_path = bundle_dir / entry->vpls_file;
-  const fs::path exr_path = bundle_dir / entry->exr_file;
-  if (engine::Status s = check_file_checksum(vpls_path, entry->vpls_checksum); !s) return s.error();
-  if (engine::Status s = check_file_checksum(exr_path, entry->exr_checksum); !s) return s.error();
-  auto vpl_file = read_light_atlas_vpls(vpls_path);
+    return bundle->entry_error("direct_light", "the light atlas in " + bundle_dir.string() +
+                                                   " was baked before the atlas held the sky's direct light (the "
+                                                   "renderer drew the sky unshadowed then); re-bake");
+  auto vpls_path = bundle->file("vpls");
+  if (!vpls_path) return vpls_path.error();
+  auto exr_path = bundle->file("irradiance");
+  if (!exr_path) return exr_path.error();
+  auto vpl_file = read_light_atlas_vpls(*vpls_path);
   if (!vpl_file) return vpl_file.error();
-  if (vpl_file->geometry_hash != manifest->geometry_hash)
-    return engine::Error{
-        vpls_path.string(), "",
-        "belongs to geometry " + vpl_file->geometry_hash + ", the manifest to " + manifest->geometry_hash};
-
-  auto layout = build_atlas_layout(
-      atlas_inputs_from(input),
-      AtlasSettings{.texels_per_metre = entry->requested_texels_per_metre, .padding_texels = entry->padding_texels});
-  if (!layout) {
-    engine::Error e = layout.error();
-    e.message = "cannot rebuild the light atlas layout of " + manifest_file.string() + ": " + e.message;
-    return e;
-  }
-  if (layout->width != entry->width || layout->height != entry->height ||
-      layout->texels_per_metre != entry->texels_per_metre)
-    return engine::Error{manifest_file.string(), "methods.light_atlas.layout",
-                         "the rebuilt layout (" + std::to_string(layout->width) + "x" + std::to_string(layout->height) +
-                             ") differs from the baked one (" + std::to_string(entry->width) + "x" +
-                             std::to_string(entry->height) + "); the atlas code changed since the bake (re-bake)"};
+  if (engine::Status s = bundle->check_geometry(*vpls_path, vpl_file->geometry_hash); !s) return s.error();
+  auto layout = bundle->atlas_layout(input, entry->layout, "light atlas layout");
+  if (!layout) return layout.error();
 
   LightAtlasBake bake;
   bake.layout = std::move(layout).value();
   bake.width = bake.layout.width;
   bake.height = bake.layout.height;
-  if (engine::Status s = read_atlas_exr(exr_path, bake); !s) return s.error();
+  if (engine::Status s = read_atlas_exr(*exr_path, bake); !s) return s.error();
   bake.settings = vpl_file->settings;
   if (entry->direct_light != direct_light_name(bake.settings))
-    return engine::Error{manifest_file.string(), "methods.light_atlas.direct_light",
-                         "\"" + entry->direct_light + "\" does not match the bake's settings (\"" +
-                             direct_light_name(bake.settings) + "\")"};
+    return bundle->entry_error("direct_light", "\"" + entry->direct_light +
+                                                   "\" does not match the bake's settings (\"" +
+                                                   direct_light_name(bake.settings) + "\")");
   bake.stats = entry->stats;
   bake.vpls = std::move(vpl_file->vpls);
   bake.vpl_power = std::move(vpl_file->vpl_power);

@@ -11,6 +11,7 @@
 #include <unordered_map>
 
 #include "core/random.h"
+#include "core/stopwatch.h"
 #include "raytrace/light_falloff.h"
 #include "raytrace/material_lookup.h"
 #include "raytrace/ray_offset.h"
@@ -21,7 +22,6 @@ namespace gi {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 constexpr float kPi = std::numbers::pi_v<float>;
 constexpr std::uint32_t kDark = 0xffffffffu;  // a ray into the surface, or nothing to read
@@ -74,6 +74,7 @@ struct TexelTable {
 };
 
 engine::Result<TexelTable> texel_table(const StaticBakeScene& b, const AtlasLayout& layout) {
+  // Long: the layout checks, the per-texel albedo and face tables and the gutter redirects of one table.
   const AtlasTexels& tx = b.texels;
   if (tx.width != layout.width || tx.height != layout.height || layout.meshes.size() != b.static_instance.size())
     return engine::Error{.message = "texel gather: the atlas layout does not match the bake scene"};

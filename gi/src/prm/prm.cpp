@@ -1,5 +1,7 @@
 #include "prm/prm.h"
 
+#include "core/color.h"
+#include "core/stopwatch.h"
 #include "raytrace/material_lookup.h"
 #include "raytrace/path_tracer.h"
 
@@ -25,7 +27,6 @@ namespace gi {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 engine::Status validate(const PrmSettings& s) {
   const auto bad = [](std::string what) { return engine::invalid_request("PRM settings: " + what); };
@@ -47,8 +48,6 @@ struct PathNode {
   glm::vec3 normal;
   glm::vec3 power;
 };
-
-float max_component(const glm::vec3& v) { return std::max(v.x, std::max(v.y, v.z)); }
 
 // The random walks of one entry point (§4.1): N_s x a(y_1) paths, each carrying
 // albedo x area / (N_s a) so that every path has the same weight; cosine sampling from the

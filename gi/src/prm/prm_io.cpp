@@ -12,10 +12,10 @@
 #include <nlohmann/json.hpp>
 
 #include "bundle/bundle.h"
+#include "bundle/bundle_reader.h"
 #include "core/half_scale.h"
 #include "io/json_fields.h"
 #include "io/zstd_stream.h"
-#include "uv/atlas_input.h"
 
 namespace gi {
 
@@ -106,29 +106,17 @@ json settings_json(const PrmSettings& s) {
 
 json stats_json(const PrmStats& s) { return json{{"paths", s.paths}, {"path_nodes", s.path_nodes}, {"rays", s.rays}}; }
 
-// What the manifest entry says about the file, the layout and the sizes.
+// What the manifest entry says beyond its file: the layout and the sizes.
 struct EntryInfo {
-  std::string panes_file, panes_checksum;
-  float requested_texels_per_metre = 0.0f;
-  float texels_per_metre = 0.0f;
-  int padding_texels = 0;
-  int width = 0;
-  int height = 0;
+  BakedAtlasLayout layout;
   std::size_t entry_points = 0, clusters = 0, pane_texels = 0;
   PrmStats stats;
 };
 
-engine::Result<EntryInfo> read_entry(const fs::path& manifest_file, const json& entry) {
-  const std::string prefix = std::string("methods.") + kPrmMethod;
-  JsonFields f(entry, manifest_file.string(), prefix);
+engine::Result<EntryInfo> read_entry(const BundleReader& bundle) {
+  JsonFields f = bundle.fields();
   EntryInfo e;
-  e.panes_file = f.get<std::string>("files.panes.file");
-  e.panes_checksum = f.get<std::string>("files.panes.xxh3_64");
-  e.requested_texels_per_metre = f.get<float>("layout.requested_texels_per_metre");
-  e.texels_per_metre = f.get<float>("layout.texels_per_metre");
-  e.padding_texels = f.get<int>("layout.padding_texels");
-  e.width = f.get<int>("layout.width");
-  e.height = f.get<int>("layout.height");
+  e.layout = read_baked_atlas_layout(f);
   e.entry_points = f.get<std::size_t>("entry_points");
   e.clusters = f.get<std::size_t>("clusters");
   e.pane_texels = f.get<std::size_t>("pane_texels");
@@ -136,9 +124,6 @@ engine::Result<EntryInfo> read_entry(const fs::path& manifest_file, const json& 
   e.stats.path_nodes = f.get<std::size_t>("stats.path_nodes");
   e.stats.rays = f.get<std::uint64_t>("stats.rays");
   if (f.error()) return *f.error();
-  if (!is_bundle_file_name(e.panes_file))
-    return engine::Error{manifest_file.string(), prefix + ".files.panes.file",
-                         "\"" + e.panes_file + "\" is not a file name inside the bundle"};
   return e;
 }
 
@@ -255,6 +240,7 @@ engine::Status write_prm_panes(const fs::path& path, const Prm& prm, const std::
 }
 
 engine::Result<PrmPaneFile> read_prm_panes(const fs::path& path) {
+  // Long: the fields in file order, each count checked before the next array is sized from it.
   auto payload = read_blob(path, kPrmPanesMagic, kPrmPanesVersion);
   if (!payload) return payload.error();
   engine::ByteReader r(payload.value());
@@ -356,12 +342,7 @@ engine::Status save_prm(const fs::path& bundle_dir, const Prm& prm, const BakeIn
 
   const json entry{{"files", {{"panes", {{"file", kPrmPanesFile}, {"xxh3_64", *sum}}}}},
                    {"settings", settings_json(prm.settings)},
-                   {"layout",
-                    {{"requested_texels_per_metre", prm.layout.requested_texels_per_metre},
-                     {"texels_per_metre", prm.layout.texels_per_metre},
-                     {"padding_texels", prm.layout.padding_texels},
-                     {"width", prm.layout.width},
-                     {"height", prm.layout.height}}},
+                   {"layout", baked_atlas_layout_json(prm.layout)},
                    {"entry_points", prm.entries.size()},
                    {"clusters", prm.cluster_count},
                    {"pane_texels", prm.texels.size()},
@@ -373,47 +354,27 @@ engine::Status save_prm(const fs::path& bundle_dir, const Prm& prm, const BakeIn
 }
 
 engine::Result<Prm> load_prm(const fs::path& bundle_dir, const BakeInput& input) {
-  auto manifest = read_current_manifest(bundle_dir, input, "re-bake the PRM");
-  if (!manifest) return manifest.error();
-  const fs::path manifest_file = bundle_dir / kManifestFileName;
-  auto entry_json = manifest_method(bundle_dir, *manifest, kPrmMethod);
-  if (!entry_json) return entry_json.error();
-  auto entry = read_entry(manifest_file, *entry_json);
+  auto bundle = BundleReader::open(bundle_dir, kPrmMethod, input, "re-bake the PRM");
+  if (!bundle) return bundle.error();
+  auto entry = read_entry(*bundle);
   if (!entry) return entry.error();
-
-  const fs::path panes_path = bundle_dir / entry->panes_file;
-  if (engine::Status s = check_file_checksum(panes_path, entry->panes_checksum); !s) return s.error();
-  auto file = read_prm_panes(panes_path);
+  auto panes_path = bundle->file("panes");
+  if (!panes_path) return panes_path.error();
+  auto file = read_prm_panes(*panes_path);
   if (!file) return file.error();
-  if (file->geometry_hash != manifest->geometry_hash)
-    return file_error(panes_path, "",
-                      "belongs to geometry " + file->geometry_hash + ", the manifest to " + manifest->geometry_hash);
+  if (engine::Status s = bundle->check_geometry(*panes_path, file->geometry_hash); !s) return s.error();
   Prm& prm = file->prm;
-  const std::string prefix = std::string("methods.") + kPrmMethod;
+  const BakedAtlasLayout& l = entry->layout;
   if (entry->entry_points != prm.entries.size() || entry->clusters != static_cast<std::size_t>(prm.cluster_count) ||
-      entry->pane_texels != prm.texels.size() || entry->width != prm.width || entry->height != prm.height)
-    return engine::Error{manifest_file.string(), prefix,
-                         "the manifest describes " + str(entry->entry_points) + " entry points, " +
-                             str(entry->clusters) + " clusters, " + str(entry->pane_texels) + " pane texels, " +
-                             std::to_string(entry->width) + "x" + std::to_string(entry->height) + "; " +
-                             panes_path.string() + " holds " + str(prm.entries.size()) + ", " +
-                             std::to_string(prm.cluster_count) + ", " + str(prm.texels.size()) + ", " +
-                             std::to_string(prm.width) + "x" + std::to_string(prm.height)};
-
-  auto layout = build_atlas_layout(
-      atlas_inputs_from(input),
-      AtlasSettings{.texels_per_metre = entry->requested_texels_per_metre, .padding_texels = entry->padding_texels});
-  if (!layout) {
-    engine::Error e = layout.error();
-    e.message = "cannot rebuild the PRM atlas layout of " + manifest_file.string() + ": " + e.message;
-    return e;
-  }
-  if (layout->width != entry->width || layout->height != entry->height ||
-      layout->texels_per_metre != entry->texels_per_metre)
-    return engine::Error{manifest_file.string(), prefix + ".layout",
-                         "the rebuilt layout (" + std::to_string(layout->width) + "x" + std::to_string(layout->height) +
-                             ") differs from the baked one (" + std::to_string(entry->width) + "x" +
-                             std::to_string(entry->height) + "); the atlas code changed since the bake (re-bake)"};
+      entry->pane_texels != prm.texels.size() || l.width != prm.width || l.height != prm.height)
+    return bundle->entry_error("", "the manifest describes " + str(entry->entry_points) + " entry points, " +
+                                       str(entry->clusters) + " clusters, " + str(entry->pane_texels) +
+                                       " pane texels, " + std::to_string(l.width) + "x" + std::to_string(l.height) +
+                                       "; " + panes_path->string() + " holds " + str(prm.entries.size()) + ", " +
+                                       std::to_string(prm.cluster_count) + ", " + str(prm.texels.size()) + ", " +
+                                       std::to_string(prm.width) + "x" + std::to_string(prm.height));
+  auto layout = bundle->atlas_layout(input, l, "PRM atlas layout");
+  if (!layout) return layout.error();
   prm.layout = std::move(layout).value();
   prm.stats = entry->stats;
   return std::move(file->prm);

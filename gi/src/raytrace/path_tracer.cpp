@@ -4,6 +4,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "core/color.h"
 #include "raytrace/light_falloff.h"
 #include "raytrace/material_lookup.h"
 #include "raytrace/ray_offset.h"
@@ -24,8 +25,6 @@ float power_heuristic(float a, float b) {
 float spot_factor(const ReferenceLight& l, const glm::vec3& to_light) {
   return spot_cone(l.direction, l.cos_outer, l.cos_inner, to_light);
 }
-
-float max_component(const glm::vec3& v) { return std::max(v.x, std::max(v.y, v.z)); }
 
 }  // namespace
 

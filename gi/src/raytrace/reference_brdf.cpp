@@ -4,12 +4,12 @@
 #include <cmath>
 #include <numbers>
 
+#include "core/color.h"
+
 namespace gi {
 namespace {
 
 constexpr float kPi = std::numbers::pi_v<float>;
-
-float luminance(const glm::vec3& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 
 // Smith masking G1 of the view direction (the normalization of the visible-normal density).
 float smith_g1(float n_dot_v, float alpha) {

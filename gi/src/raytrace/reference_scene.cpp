@@ -2,6 +2,7 @@
 
 #include <engine/finite.h>
 
+#include "core/color.h"
 #include "raytrace/material_lookup.h"
 
 #include <algorithm>
@@ -10,8 +11,6 @@
 
 namespace gi {
 namespace {
-
-float luminance(const glm::vec3& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 
 engine::Error scene_error(std::string location, std::string message) {
   return engine::Error{"<reference scene>", std::move(location), std::move(message)};

@@ -12,6 +12,7 @@
 
 #include "brf/brf_mesh.h"
 #include "brf/brf_runtime.h"
+#include "core/stopwatch.h"
 #include "raytrace/reference_render.h"
 #include "raytrace/scene_adapter.h"
 #include "transport/point_emitters.h"
@@ -257,7 +258,7 @@ void register_brf_sweep(SweepRegistry& registry) {
       if (!ctx.progress(0.9 * static_cast<double>(s + 1) / static_cast<double>(objects->sources.size())))
         return engine::cancelled_error("BRF sweep run");
     }
-    const double bake_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const double bake_s = seconds_since(t0);
     std::vector<BrfObject> brf;
     for (const Objects::Instance& in : objects->instances)
       brf.push_back({&objects->sources[in.source].mesh, &bases[in.source], &fields[in.source], in.transform, in.albedo,

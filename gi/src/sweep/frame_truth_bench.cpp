@@ -14,6 +14,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
 
+#include "core/stopwatch.h"
 #include "sweep/region_accuracy.h"
 
 namespace gi {
@@ -199,7 +200,7 @@ engine::Result<FrameTruth> FrameTruthBench::render_truth(const FrameCamera& came
     if (hits->hit[i])
       truth.region_of_pixel[i] =
           region_of(truth.regions, hits->position_m[i] + s.settings.region_probe_m * hits->normal[i]);
-  truth.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  truth.seconds = seconds_since(t0);
   return truth;
 }
 

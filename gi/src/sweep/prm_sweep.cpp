@@ -10,6 +10,7 @@
 #include <vector>
 #include <glm/gtc/quaternion.hpp>
 
+#include "core/color.h"
 #include "prm/prm.h"
 #include "prm/prm_runtime.h"
 #include "raytrace/atlas_reference.h"
@@ -224,9 +225,7 @@ void register_prm_sweep(SweepRegistry& registry) {
     // error a runtime that rescaled to the full energy would have (the runtime does not).
     const auto all = relight_clusters(*prm, lights, **caster, 0);
     const std::vector<glm::vec3> full = sum_panes(*prm, all);
-    auto lum = [](const glm::vec3& c) {
-      return 0.2126 * static_cast<double>(c.x) + 0.7152 * static_cast<double>(c.y) + 0.0722 * static_cast<double>(c.z);
-    };
+    auto lum = [](const glm::vec3& c) { return luminance(double{c.x}, double{c.y}, double{c.z}); };
     double kept = 0.0, total = 0.0;
     for (std::size_t i = 0; i < atlas.size(); ++i) {
       if (!ctx.reference.is_valid(i)) continue;

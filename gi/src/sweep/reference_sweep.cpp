@@ -6,6 +6,7 @@
 #include <chrono>
 #include <string>
 
+#include "core/stopwatch.h"
 #include "raytrace/atlas_reference.h"
 #include "uv/atlas_input.h"
 #include "uv/atlas_layout.h"
@@ -129,7 +130,7 @@ void register_reference_sweep(SweepRegistry& registry) {
     if (!field) return field.error();
     MethodOutput out;
     out.field = std::move(field.value());
-    out.costs.bake_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    out.costs.bake_seconds = seconds_since(start);
     out.costs.bytes = out.field.rgb.size() * sizeof(float);
     return out;
   };

@@ -12,10 +12,9 @@
 #include <string>
 #include <vector>
 
-namespace gi {
+#include "core/color.h"
 
-/// Rec. 709 luminance of linear RGB.
-inline double luminance(double r, double g, double b) { return 0.2126 * r + 0.7152 * g + 0.0722 * b; }
+namespace gi {
 
 /// The accuracy of `frame` (RGBA, the renderer's) against `truth` (RGBA, the mean of two
 /// halves) over the pixels whose `mask` is nonzero; `truth_variance` holds 3 values (R, G,

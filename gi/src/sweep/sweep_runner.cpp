@@ -5,6 +5,7 @@
 #include <limits>
 #include <map>
 
+#include "core/stopwatch.h"
 #include "sweep/reference_cache.h"
 
 namespace gi {
@@ -80,7 +81,7 @@ engine::Result<SweepResult> run_sweep(const SweepRegistry& registry, const Sweep
     const auto start = std::chrono::steady_clock::now();
     engine::Result<MethodOutput> out = method.run(RunContext{scene, row.knobs, requests[request_of_run[run]], ref.field,
                                                              options.seed, options.threads, unit_progress});
-    row.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    row.wall_seconds = seconds_since(start);
     if (cancelled) break;  // a cancelled run's output is not a measurement
     const double nan = std::numeric_limits<double>::quiet_NaN();
     row.error.rel_rmse = row.error.max_rel = row.error.psnr_db = nan;

@@ -7,6 +7,7 @@
 #include <limits>
 #include <numbers>
 
+#include "core/color.h"
 #include "raytrace/ray.h"
 #include "transport/static_scene.h"
 
@@ -15,8 +16,6 @@ namespace gi {
 namespace {
 
 const glm::vec3 kAxes[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
-
-float luminance(const glm::vec3& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 
 }  // namespace
 

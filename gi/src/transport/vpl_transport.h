@@ -12,6 +12,7 @@
 #include <engine/result.h>
 #include <gi/progress.h>
 
+#include "core/color.h"
 #include "core/thread_pool.h"
 #include "raytrace/ray_caster.h"
 #include "transport/point_emitters.h"
@@ -59,8 +60,5 @@ struct VplSolution {
 /// shot updates the receivers in parallel, shots in queue order. Errors: cancelled.
 engine::Result<VplSolution> propagate(const VplSet& vpls, const std::vector<glm::vec3>& direct, const RayCaster& caster,
                                       ThreadPool& pool, const PropagationSettings& settings);
-
-/// Luminance weights used for priorities (Rec. 709).
-inline float luminance(const glm::vec3& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 
 }  // namespace gi

@@ -1,0 +1,109 @@
+#include "bundle/bundle_reader.h"
+
+#include <utility>
+
+#include "bundle/bundle.h"
+#include "uv/atlas_input.h"
+
+namespace gi {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+BakedAtlasLayout read_baked_atlas_layout(JsonFields& f) {
+  BakedAtlasLayout l;
+  l.requested_texels_per_metre = f.get<float>("layout.requested_texels_per_metre");
+  l.texels_per_metre = f.get<float>("layout.texels_per_metre");
+  l.padding_texels = f.get<int>("layout.padding_texels");
+  l.width = f.get<int>("layout.width");
+  l.height = f.get<int>("layout.height");
+  return l;
+}
+
+json baked_atlas_layout_json(const AtlasLayout& layout) {
+  return json{{"requested_texels_per_metre", layout.requested_texels_per_metre},
+              {"texels_per_metre", layout.texels_per_metre},
+              {"padding_texels", layout.padding_texels},
+              {"width", layout.width},
+              {"height", layout.height}};
+}
+
+BundleReader::BundleReader(fs::path dir, Manifest manifest, json entry, const std::string& method)
+    : dir_(std::move(dir)),
+      manifest_file_(dir_ / kManifestFileName),
+      manifest_(std::move(manifest)),
+      entry_(std::move(entry)),
+      prefix_("methods." + method) {}
+
+engine::Result<BundleReader> BundleReader::open(const fs::path& bundle_dir, const std::string& method,
+                                                const BakeInput& input, const std::string& rebake) {
+  auto manifest = read_current_manifest(bundle_dir, input, rebake);
+  if (!manifest) return manifest.error();
+  auto entry = manifest_method(bundle_dir, *manifest, method);
+  if (!entry) return entry.error();
+  return BundleReader(bundle_dir, std::move(manifest).value(), std::move(entry).value(), method);
+}
+
+engine::Result<BundleReader> BundleReader::open_any_geometry(const fs::path& bundle_dir, const std::string& method) {
+  auto manifest = read_manifest(bundle_dir);
+  if (!manifest) return manifest.error();
+  auto entry = manifest_method(bundle_dir, *manifest, method);
+  if (!entry) return entry.error();
+  return BundleReader(bundle_dir, std::move(manifest).value(), std::move(entry).value(), method);
+}
+
+engine::Error BundleReader::entry_error(const std::string& key, std::string message) const {
+  return engine::Error{manifest_file_.string(), key.empty() ? prefix_ : prefix_ + "." + key, std::move(message)};
+}
+
+bool BundleReader::has_file(const std::string& key) const {
+  return entry_.is_object() && entry_.contains("files") && entry_["files"].is_object() && entry_["files"].contains(key);
+}
+
+engine::Result<fs::path> BundleReader::file(const std::string& key) const {
+  JsonFields f = fields();
+  const std::string name = f.get<std::string>("files." + key + ".file");
+  const std::string checksum = f.get<std::string>("files." + key + ".xxh3_64");
+  if (f.error()) return *f.error();
+  if (!is_bundle_file_name(name))
+    return entry_error("files." + key + ".file", "\"" + name + "\" is not a file name inside the bundle");
+  const fs::path path = dir_ / name;
+  if (engine::Status s = check_file_checksum(path, checksum); !s) return s.error();
+  return path;
+}
+
+engine::Status BundleReader::check_geometry(const fs::path& file, const std::string& geometry_hash) const {
+  if (geometry_hash == manifest_.geometry_hash) return {};
+  return engine::Error{file.string(), "",
+                       "belongs to geometry " + geometry_hash + ", the manifest to " + manifest_.geometry_hash};
+}
+
+engine::Status BundleReader::check_lights(const std::string& baked_lights_hash, const BakeInput& input,
+                                          const std::string& what, const std::string& advice) const {
+  const std::string lights = static_lights_hash(input);
+  if (baked_lights_hash == lights) return {};
+  return entry_error("lights_hash", "stale " + what + " in " + dir_.string() + ": baked under static lights " +
+                                        baked_lights_hash + ", but the scene's static lights hash to " + lights + " (" +
+                                        advice + ")");
+}
+
+engine::Result<AtlasLayout> BundleReader::atlas_layout(const BakeInput& input, const BakedAtlasLayout& baked,
+                                                       const std::string& what) const {
+  auto layout = build_atlas_layout(
+      atlas_inputs_from(input),
+      AtlasSettings{.texels_per_metre = baked.requested_texels_per_metre, .padding_texels = baked.padding_texels});
+  if (!layout) {
+    engine::Error e = layout.error();
+    e.message = "cannot rebuild the " + what + " of " + manifest_file_.string() + ": " + e.message;
+    return e;
+  }
+  if (layout->width != baked.width || layout->height != baked.height ||
+      layout->texels_per_metre != baked.texels_per_metre)
+    return entry_error("layout", "the rebuilt layout (" + std::to_string(layout->width) + "x" +
+                                     std::to_string(layout->height) + ") differs from the baked one (" +
+                                     std::to_string(baked.width) + "x" + std::to_string(baked.height) +
+                                     "); the atlas code changed since the bake (re-bake)");
+  return layout;
+}
+
+}  // namespace gi
