@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <glm/gtc/type_ptr.hpp>
 #include <engine/check.h>
+#include <engine/log.h>
 
 namespace engine::render {
 
@@ -26,7 +27,7 @@ const LocatedProgram<AreaShadowUniforms>& ForwardRenderer::area_shadow_program(i
   auto it = area_shadow_programs_.find(key);
   if (it != area_shadow_programs_.end()) return it->second;
   Result<LocatedProgram<AreaShadowUniforms>> p = build_area_shadow(pass, area_lights);
-  if (!p) std::fprintf(stderr, "%s\n", p.error().to_string().c_str());
+  if (!p) log_message(LogLevel::Error, p.error().to_string());
   GI_EXPECTS(p.ok(), "area shadow shader must compile");
   return area_shadow_programs_.emplace(key, std::move(p.value())).first->second;
 }

@@ -24,6 +24,7 @@
 #include <engine/gpu/gpu_timer.h>
 #include <engine/gpu/shader_program.h>
 #include <engine/light_reach.h>
+#include <engine/log.h>
 #include <engine/runtime_limits.h>
 
 #include "render/frame_data.h"
@@ -93,7 +94,7 @@ const LocatedProgram<ForwardUniforms>& ForwardRenderer::forward_program(const Li
   if (it != forward_variants_.end()) return it->second;
   Result<LocatedProgram<ForwardUniforms>> p = build_forward(counts);
   // The variant without lights compiled in create(); a failure here is a shader bug.
-  if (!p) std::fprintf(stderr, "%s\n", p.error().to_string().c_str());
+  if (!p) log_message(LogLevel::Error, p.error().to_string());
   GI_EXPECTS(p.ok(), "forward shader variant must compile");
   return forward_variants_.emplace(counts, std::move(p.value())).first->second;
 }
@@ -512,7 +513,7 @@ const LocatedProgram<DepthUniforms>& ForwardRenderer::alpha_test_program(const c
   b.define("ALPHA_TEST 1");
   Result<LocatedProgram<DepthUniforms>> p = link_program<DepthUniforms>(
       std::move(b), {{ShaderStage::Vertex, "shadow.vert.glsl"}, {ShaderStage::Fragment, fragment}});
-  if (!p) std::fprintf(stderr, "%s\n", p.error().to_string().c_str());
+  if (!p) log_message(LogLevel::Error, p.error().to_string());
   GI_EXPECTS(p.ok(), "alpha-tested depth shader must compile");
   return alpha_test_programs_.emplace(fragment, std::move(p.value())).first->second;
 }
