@@ -25,7 +25,7 @@
 
 in vec3 v_world;
 in vec3 v_normal;
-layout(location = 26) uniform int u_double_sided;
+uniform int u_double_sided;
 // Area lights at the start of the Lights buffer (1..4), a compile-time count as in forward.frag.glsl.
 #ifndef AREA_LIGHTS
 #define AREA_LIGHTS 1
@@ -57,7 +57,7 @@ vec4 visibility(vec3 p, vec3 n) {
 const float kPlaneTolerance = 0.02;
 const float kPlaneSlope = 0.01;
 const float kNormalCos = 0.9;
-layout(location = 16) uniform vec3 u_camera_position;
+uniform vec3 u_camera_position;
 
 void main() {
   vec3 n = surface_normal();

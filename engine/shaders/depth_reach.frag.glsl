@@ -7,9 +7,9 @@
 #include "material_common.glsl"
 in vec3 v_world;
 layout(binding = 9) uniform usampler3D u_reach;
-layout(location = 50) uniform vec3 u_reach_origin;
-layout(location = 51) uniform float u_reach_inv_voxel;
-layout(location = 52) uniform int u_reach_all;  // outside the grid: every light
+uniform vec3 u_reach_origin;
+uniform float u_reach_inv_voxel;
+uniform int u_reach_all;  // outside the grid: every light
 
 void main() {
   alpha_test();

@@ -8,12 +8,12 @@
 #include "exposure_common.glsl"
 
 layout(local_size_x = 1) in;
-layout(location = 0) uniform float u_dt_s;
-layout(location = 1) uniform int u_snap;
-layout(location = 2) uniform vec2 u_percentiles;  // low, high (fractions of the metered pixels)
-layout(location = 3) uniform vec2 u_ev100_range;  // min, max of the metered EV100
-layout(location = 4) uniform float u_compensation_ev;
-layout(location = 5) uniform vec2 u_rates_per_s;  // scene got brighter, scene got darker
+uniform float u_dt_s;
+uniform int u_snap;
+uniform vec2 u_percentiles;  // low, high (fractions of the metered pixels)
+uniform vec2 u_ev100_range;  // min, max of the metered EV100
+uniform float u_compensation_ev;
+uniform vec2 u_rates_per_s;  // scene got brighter, scene got darker
 
 void main() {
   uint total = 0u;

@@ -14,7 +14,7 @@
 
 layout(local_size_x = 16, local_size_y = 16) in;  // 256 invocations: one per bin when merging
 layout(binding = 0) uniform sampler2D u_hdr;
-layout(location = 0) uniform ivec2 u_size;
+uniform ivec2 u_size;
 
 shared uint s_bins[METER_BINS];  // count << 16 | sum of sub-bin steps
 

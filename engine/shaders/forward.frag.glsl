@@ -50,39 +50,39 @@ in vec4 v_tangent;
 in vec3 v_vertex_irradiance;
 // Per-vertex view-dependent indirect light (forward.vert.glsl, vertex_radiance_lobes): terms > 0: use v_lobe_radiance.
 in vec3 v_lobe_radiance;
-layout(location = 40) uniform int u_lobe_terms;
+uniform int u_lobe_terms;
 
-layout(location = 16) uniform vec3 u_camera_position;
-layout(location = 18) uniform vec4 u_base_color;
-layout(location = 19) uniform float u_metallic;
-layout(location = 20) uniform float u_roughness;
-layout(location = 21) uniform vec3 u_emissive;
+uniform vec3 u_camera_position;
+uniform vec4 u_base_color;
+uniform float u_metallic;
+uniform float u_roughness;
+uniform vec3 u_emissive;
 // 0: none, 1: constant ambient stand-in, 2: irradiance atlas at TEXCOORD_1, 3: per-vertex irradiance.
-layout(location = 22) uniform int u_indirect_mode;
-layout(location = 23) uniform float u_ambient_radiance;
+uniform int u_indirect_mode;
+uniform float u_ambient_radiance;
 // Pixels with x < u_split_x get direct light only (SplitView::DirectLeftFullRight); -1: off.
-layout(location = 24) uniform float u_split_x;
-layout(location = 25) uniform int u_use_glossy;
-layout(location = 26) uniform int u_double_sided;
-layout(location = 27) uniform float u_specular_factor;       // KHR_materials_specular
-layout(location = 28) uniform vec3 u_specular_color_factor;  // KHR_materials_specular
+uniform float u_split_x;
+uniform int u_use_glossy;
+uniform int u_double_sided;
+uniform float u_specular_factor;       // KHR_materials_specular
+uniform vec3 u_specular_color_factor;  // KHR_materials_specular
 // Directional radiance of static surfaces (engine/indirect_light.h): bins and elements, 0: none.
-layout(location = 29) uniform int u_directional_bins;
-layout(location = 30) uniform int u_directional_elements;
+uniform int u_directional_bins;
+uniform int u_directional_elements;
 // The scene's sky (RenderSettings::sky_radiance), W/(m^2 sr): unshadowed ambient direct light.
-layout(location = 31) uniform vec3 u_sky_radiance;
+uniform vec3 u_sky_radiance;
 // The sky's gradient (RenderSettings::sky_gradient, engine/sky.h): horizon, zenith - horizon,
 // ground - horizon.
-layout(location = 61) uniform vec3 u_sky_gradient[3];
+uniform vec3 u_sky_gradient[3];
 // The sky's visibility on this item (IndirectLightFrame::sky_visibility; 1 = unoccluded):
 // an ambient cube, +X +Y +Z faces and -X -Y -Z faces.
-layout(location = 64) uniform vec3 u_sky_visibility_pos;
-layout(location = 65) uniform vec3 u_sky_visibility_neg;
+uniform vec3 u_sky_visibility_pos;
+uniform vec3 u_sky_visibility_neg;
 // What this item's baked irradiance (u_indirect_mode 2) holds besides indirect light
 // (IndirectLightFrame::atlas_holds_*), so it is not drawn twice: bit 0 the sky's direct light
 // (no sky term here), bit 1 the direct light of the lights that do not move (GpuLight::flags.x:
 // those lights add nothing here).
-layout(location = 66) uniform int u_baked_direct;
+uniform int u_baked_direct;
 
 // 1 for a light drawn live on this item, 0 for one whose direct light its bake holds.
 float live(GpuLight light) { return (u_baked_direct & 2) != 0 ? 1.0 - light.flags.x : 1.0; }
@@ -94,8 +94,8 @@ layout(binding = 3) uniform sampler2D u_irradiance_atlas;
 layout(binding = 6) uniform sampler2D u_glossy_radiance;
 layout(binding = 7) uniform isampler2D u_directional_index;
 layout(binding = 15) uniform sampler2D u_normal_texture;
-layout(location = 72) uniform float u_normal_scale;
-layout(location = 82) uniform int u_normal_map;
+uniform float u_normal_scale;
+uniform int u_normal_map;
 
 #if AREA_SHADOW_HALF
 layout(binding = 13) uniform sampler2D u_area_visibility;

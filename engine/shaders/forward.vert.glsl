@@ -8,13 +8,13 @@ layout(location = 2) in vec2 a_uv0;
 layout(location = 3) in vec2 a_uv1;
 layout(location = 4) in vec4 a_tangent;  // xyz tangent, w handedness (zero: no normal map)
 
-layout(location = 0) uniform mat4 u_model;
-layout(location = 4) uniform mat4 u_normal_matrix;
-layout(location = 8) uniform mat4 u_view_proj;
+uniform mat4 u_model;
+uniform mat4 u_normal_matrix;
+uniform mat4 u_view_proj;
 // Vertex of the whole-scene vertex buffer where this entity's mesh starts: gl_VertexID -
 // u_mesh_first_vertex indexes the mesh's primitives concatenated in order.
-layout(location = 12) uniform int u_mesh_first_vertex;
-layout(location = 13) uniform int u_use_vertex_irradiance;
+uniform int u_mesh_first_vertex;
+uniform int u_use_vertex_irradiance;
 
 layout(std430, binding = 1) readonly buffer VertexIrradiance { vec4 vertex_irradiance[]; };
 
@@ -27,11 +27,11 @@ out vec3 v_vertex_irradiance;
 
 // --- Per-vertex view-dependent indirect light (IndirectLightFrame::vertex_radiance_lobes) ---
 // L_spec toward the camera = sum_k c_k,j h_k(view in the vertex's frame); 0 terms: none.
-layout(location = 16) uniform vec3 u_camera_position;
-layout(location = 40) uniform int u_lobe_terms;
-layout(location = 41) uniform int u_lobe_resolution;
-layout(location = 42) uniform int u_lobe_first;
-layout(location = 43) uniform int u_lobe_stride;
+uniform vec3 u_camera_position;
+uniform int u_lobe_terms;
+uniform int u_lobe_resolution;
+uniform int u_lobe_first;
+uniform int u_lobe_stride;
 layout(std430, binding = 6) readonly buffer LobeCoefficients { vec4 lobe_coefficients[]; };
 layout(std430, binding = 7) readonly buffer LobeTable { float lobe_table[]; };
 out vec3 v_lobe_radiance;

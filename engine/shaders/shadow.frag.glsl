@@ -4,10 +4,10 @@
 // ALPHA_TEST 1: cut-out casters (MASK and BLEND materials) discard their transparent texels.
 #include "material_common.glsl"
 in vec3 v_world;
-layout(location = 16) uniform vec3 u_eye;
-layout(location = 17) uniform float u_far_m;
-layout(location = 18) uniform int u_ortho;
-layout(location = 19) uniform vec3 u_axis;
+uniform vec3 u_eye;
+uniform float u_far_m;
+uniform int u_ortho;
+uniform vec3 u_axis;
 void main() {
   alpha_test();
   float d = u_ortho != 0 ? dot(v_world - u_eye, u_axis) : length(v_world - u_eye);

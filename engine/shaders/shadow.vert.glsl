@@ -4,8 +4,8 @@
 layout(location = 0) in vec3 a_position;
 layout(location = 2) in vec2 a_uv0;
 layout(location = 3) in vec2 a_uv1;
-layout(location = 0) uniform mat4 u_model;
-layout(location = 8) uniform mat4 u_view_proj;
+uniform mat4 u_model;
+uniform mat4 u_view_proj;
 out vec3 v_world;
 out vec2 v_uv0;
 out vec2 v_uv1;

@@ -8,8 +8,8 @@
 #define EXPOSURE_STATE_BINDING 4  // render/exposure_meter.h's kExposureStateBinding defines it
 #endif
 layout(binding = 0) uniform sampler2D u_hdr;
-layout(location = 0) uniform float u_exposure;
-layout(location = 1) uniform int u_metered;
+uniform float u_exposure;
+uniform int u_metered;
 layout(std430, binding = EXPOSURE_STATE_BINDING) readonly buffer ExposureState { float state_exposure; };
 layout(location = 0) out vec4 o_color;
 

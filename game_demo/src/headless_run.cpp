@@ -14,6 +14,7 @@
 #include <engine/image.h>
 
 #include "demo_run.h"
+#include "tool_main.h"
 
 namespace game_demo {
 
@@ -92,9 +93,10 @@ int run_headless(const RunOptions& o, RunState& state) {
   RenderClock render_clock;
   const auto run_t0 = Clock::now();
   for (std::uint64_t i = 0; i < frames; ++i) {
+    if (tools::interrupted()) return tools::kExitCancelled;  // Ctrl-C: the frames written so far stay whole
     const auto t0 = Clock::now();
     const InputFrame input = state.replay ? state.replay->frames[i].input : pilot->next(sim);
-    if (!state.step(input)) return 3;
+    if (!state.step(input)) return tools::kExitFailure;
     step_ms.add(ms_since(t0));
     if (o.verbose && i % 60 == 0) {
       const glm::vec3 eye = sim.registry().get<engine::Transform>(sim.context().camera).position;

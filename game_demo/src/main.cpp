@@ -14,6 +14,7 @@
 #include <CLI/CLI.hpp>
 
 #include "demo_run.h"
+#include "tool_main.h"
 
 namespace game_demo {
 
@@ -192,7 +193,9 @@ int main(int argc, char** argv) {
         return engine::parse_sky_text(text) ? std::string() : std::string("--sky wants ") + engine::kSkyTextUsage;
       });
   app.add_flag("--verbose", o.verbose, "Headless: print the script's waypoints and the player's position each second");
-  CLI11_PARSE(app, argc, argv);
+  // The tools' host contract (tools/common/tool_main.h): --version, exit 0 done, 1 failed,
+  // 2 bad usage, 130 Ctrl-C (the recording is then not written).
+  if (const std::optional<int> rc = tools::parse(app, "gi_demo", argc, argv)) return *rc;
   o.area_soft_shadows = area_shadows == "soft";
   o.light_reach_culling = light_reach == "on";
   o.flat_shading = shading == "flat";
@@ -203,16 +206,13 @@ int main(int argc, char** argv) {
                                           : engine::ExposureMode::Automatic;
   if (o.script.empty()) o.script = std::string(script_name(default_script(o.scene)));
   if (!script_from_name(o.script)) {
-    std::cerr << "gi_demo: unknown --script \"" << o.script << "\"\n";
-    return 2;
+    return tools::fail("gi_demo", "unknown --script \"" + o.script + "\"", tools::kExitUsage);
   }
   if (o.no_render && !o.out_dir.empty()) {
-    std::cerr << "gi_demo: --no-render cannot write frames (--out)\n";
-    return 2;
+    return tools::fail("gi_demo", "--no-render cannot write frames (--out)", tools::kExitUsage);
   }
   if (o.no_render && !o.gi_bundle.empty()) {
-    std::cerr << "gi_demo: --no-render does not light anything (--gi-bundle)\n";
-    return 2;
+    return tools::fail("gi_demo", "--no-render does not light anything (--gi-bundle)", tools::kExitUsage);
   }
 
   RunState state;
@@ -266,8 +266,11 @@ int main(int argc, char** argv) {
     state.sim->scene().assets.environment.sky_radiance = sky.uniform;
     state.sim->scene().assets.environment.sky_gradient = sky.gradient;
   }
+  tools::install_interrupt_handler();
   const int status = o.headless ? run_headless(o, state) : run_windowed(o, state);
-  if (!state.finish_recording(o.record_file)) return 1;
+  if (status == tools::kExitCancelled)  // no half-played session recorded
+    return tools::fail("gi_demo", "cancelled (Ctrl-C), nothing recorded", tools::kExitCancelled);
+  if (!state.finish_recording(o.record_file)) return tools::kExitFailure;
   if (state.replay && status == 0) {
     const std::uint64_t played = state.sim->frame();
     if (played < state.replay->frames.size()) {
@@ -277,5 +280,5 @@ int main(int argc, char** argv) {
       std::cout << "replay OK: " << played << " frames, all checksums match\n";
     }
   }
-  return state.mismatches > 0 ? 3 : status;
+  return state.mismatches > 0 ? tools::kExitFailure : status;
 }

@@ -30,6 +30,7 @@
 #include <gi/rgb_field.h>
 
 #include <algorithm>
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -40,7 +41,11 @@
 #include <sstream>
 #include <CLI/CLI.hpp>
 
+#include "tool_main.h"
+
 namespace {
+
+constexpr const char* kTool = "gi-replay-quality";
 
 // Non-finite pixels are masked out (and counted): one NaN would make the whole frame's error NaN.
 gi::RgbField field_of(const engine::ImageRgbaF& image, std::size_t* non_finite = nullptr) {
@@ -148,11 +153,22 @@ int main(int argc, char** argv) {
   app.add_option("--spp", spp, "Path-tracer samples per pixel of the reference frames")->check(CLI::PositiveNumber);
   app.add_option("--out", out_path, "Markdown table to write (also printed)");
   app.add_option("--images", images_dir, "Directory for the compared frames as EXR (reference and each row)");
-  CLI11_PARSE(app, argc, argv);
+  // The tools' host contract (tools/common/tool_main.h): --version, exit 0 done, 1 failed,
+  // 2 bad usage, 130 Ctrl-C (stops at the next frame or reference sample pass; --out unwritten).
+  if (const std::optional<int> rc = tools::parse(app, kTool, argc, argv)) return *rc;
+  tools::install_interrupt_handler();
 
   std::vector<std::uint64_t> picked;
   std::stringstream ss(frames_text);
-  for (std::string f; std::getline(ss, f, ',');) picked.push_back(std::stoull(f));
+  for (std::string f; std::getline(ss, f, ',');) {
+    std::uint64_t frame = 0;
+    const auto [end, ec] = std::from_chars(f.data(), f.data() + f.size(), frame);
+    if (ec != std::errc{} || end != f.data() + f.size())
+      return tools::fail(kTool, "--frames wants comma-separated frame numbers, not '" + frames_text + "'",
+                         tools::kExitUsage);
+    picked.push_back(frame);
+  }
+  if (picked.empty()) return tools::fail(kTool, "--frames names no frame", tools::kExitUsage);
   std::sort(picked.begin(), picked.end());
   auto session = game_demo::load_session(session_path);
   if (!session) {
@@ -187,11 +203,9 @@ int main(int argc, char** argv) {
         rs.samples_per_pixel = std::max(1, spp / 2);
         rs.seed = static_cast<std::uint64_t>(h + 1);
         rs.jitter_pixels = false;  // through the pixel centres, as the rasterizer samples: light, not aliasing
+        rs.progress = [](double) { return !tools::interrupted(); };
         auto image = gi::render_reference_image(sim->scene(), sim->context().camera, width, height, rs);
-        if (!image) {
-          std::cerr << "gi-replay-quality: " << image.error().to_string() << '\n';
-          return 1;
-        }
+        if (!image) return tools::fail(kTool, image.error());
         half[h] = std::move(image).value();
       }
       engine::ImageRgbaF image = half[0];
@@ -287,6 +301,7 @@ int main(int argc, char** argv) {
     (*renderer)->set_indirect_light(gi.get());
     std::vector<double> ms;
     for (std::uint64_t f = 0; f <= last; ++f) {
+      if (tools::interrupted()) return tools::kExitCancelled;
       sim->step(session->frames[f].input);
       const auto t0 = std::chrono::steady_clock::now();
       (*renderer)->render(sim->registry(), sim->context().camera);

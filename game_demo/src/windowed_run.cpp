@@ -20,6 +20,7 @@
 #include <engine/gpu/context.h>
 
 #include "demo_run.h"
+#include "tool_main.h"
 
 namespace game_demo {
 
@@ -131,6 +132,10 @@ int run_windowed(const RunOptions& o, RunState& state) {
   int status = 0;
   RenderClock render_clock;
   while (!glfwWindowShouldClose(window)) {
+    if (tools::interrupted()) {
+      status = tools::kExitCancelled;
+      break;
+    }
     glfwPollEvents();
     if (glfwGetKey(window, GLFW_KEY_ESCAPE) == GLFW_PRESS) break;
     const double now = glfwGetTime();
@@ -161,7 +166,7 @@ int run_windowed(const RunOptions& o, RunState& state) {
           break;
         }
         if (!state.step(state.replay->frames[sim.frame()].input)) {
-          status = 3;
+          status = tools::kExitFailure;
           done = true;
           break;
         }

@@ -2,6 +2,7 @@
 // KHR_lights_punctual lights are converted from photometric glTF units to the engine's
 // radiometric ones (engine/units.h); the "gi" extras schema is in docs/scene-format.md.
 
+#include <engine/log.h>
 #include <engine/sun.h>
 #include <engine/units.h>
 
@@ -131,8 +132,8 @@ Result<std::vector<NamedCamera>> convert_cameras(const Context& ctx, const Parse
     const tinygltf::Camera& src = file.model.cameras[i];
     const std::string where = "camera " + std::to_string(i);
     if (src.type == "orthographic") {
-      std::fprintf(stderr, "warning: %s: %s: orthographic camera skipped (the engine has perspective cameras only)\n",
-                   ctx.file.c_str(), where.c_str());
+      log_message(LogLevel::Warning,
+                  ctx.file + ": " + where + ": orthographic camera skipped (the engine has perspective cameras only)");
       continue;
     }
     if (src.type != "perspective") return ctx.error(where, "unknown camera type '" + src.type + "'");

@@ -10,6 +10,8 @@
 
 #include <stb_image.h>  // compiled in tinygltf_impl.cpp (STB_IMAGE_IMPLEMENTATION)
 
+#include <engine/log.h>
+
 #include "gltf/gltf_load_internal.h"
 
 namespace engine::gltf_load {
@@ -82,7 +84,7 @@ Result<std::vector<Image>> convert_images(const Context& ctx, const ParsedFile& 
     const bool used = i < file.images.used.size() && file.images.used[i];
     if (auto ok = image_status(ctx, file, static_cast<int>(i)); !ok && !used) {
       // Only images that materials use must load (checked there); others are reported.
-      std::fprintf(stderr, "warning: %s (unused by materials)\n", ok.error().to_string().c_str());
+      log_message(LogLevel::Warning, ok.error().to_string() + " (unused by materials)");
     }
     Image img;
     img.name = src.name;

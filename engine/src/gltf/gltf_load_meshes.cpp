@@ -7,6 +7,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include <engine/log.h>
+
 #include "gltf/gltf_load_internal.h"
 
 namespace engine::gltf_load {
@@ -139,8 +141,7 @@ Result<std::optional<Primitive>> convert_primitive(const Context& ctx, const Par
   if (position->values.empty()) {
     // §3.7.2.1 lets POSITION be absent (an extension may provide the geometry): nothing
     // the engine can draw, so the primitive is skipped like points and lines.
-    std::fprintf(stderr, "warning: %s: %s: no POSITION attribute, primitive skipped\n", ctx.file.c_str(),
-                 where.c_str());
+    log_message(LogLevel::Warning, ctx.file + ": " + where + ": no POSITION attribute, primitive skipped");
     return std::optional<Primitive>{};
   }
   Primitive out;
@@ -183,8 +184,8 @@ Result<std::optional<Primitive>> convert_primitive(const Context& ctx, const Par
     glm::vec4& t = out.tangents[i];
     const float len = glm::length(glm::vec3(t));
     if (!std::isfinite(len) || len < 1e-6f || !std::isfinite(t.w) || t.w == 0.0f) {
-      std::fprintf(stderr, "warning: %s: %s: TANGENT %zu is degenerate, tangents are generated instead\n",
-                   ctx.file.c_str(), where.c_str(), i);
+      log_message(LogLevel::Warning, ctx.file + ": " + where + ": TANGENT " + std::to_string(i) +
+                                         " is degenerate, tangents are generated instead");
       out.tangents.clear();
       break;
     }
@@ -230,8 +231,9 @@ Result<std::optional<Primitive>> convert_primitive(const Context& ctx, const Par
     if (indices.size() % 3 != 0) {
       // Not an error for the validator (MESH_PRIMITIVE_INCOMPATIBLE_MODE): the trailing
       // partial triangle cannot be drawn and is dropped.
-      std::fprintf(stderr, "warning: %s: %s: %zu indices do not make whole triangles, the last %zu dropped\n",
-                   ctx.file.c_str(), where.c_str(), indices.size(), indices.size() % 3);
+      log_message(LogLevel::Warning, ctx.file + ": " + where + ": " + std::to_string(indices.size()) +
+                                         " indices do not make whole triangles, the last " +
+                                         std::to_string(indices.size() % 3) + " dropped");
       indices.resize(indices.size() - indices.size() % 3);
     }
     out.indices = std::move(indices);
@@ -242,7 +244,7 @@ Result<std::optional<Primitive>> convert_primitive(const Context& ctx, const Par
     // Fewer than 3 indices (or a strip or fan of fewer than 3 vertices): no triangle to draw,
     // skipped like points and lines. Kept, it would read as a non-indexed primitive
     // (engine::Primitive: empty indices) whose vertices make no whole triangles.
-    std::fprintf(stderr, "warning: %s: %s: no whole triangle, primitive skipped\n", ctx.file.c_str(), where.c_str());
+    log_message(LogLevel::Warning, ctx.file + ": " + where + ": no whole triangle, primitive skipped");
     return std::optional<Primitive>{};
   }
   if (out.normals.empty()) out.normals = compute_smooth_normals(out.positions, out.indices);
@@ -292,7 +294,7 @@ Result<std::vector<Mesh>> convert_meshes(const Context& ctx, const ParsedFile& f
       auto prim = convert_primitive(ctx, file, static_cast<int>(m), static_cast<int>(p), src.primitives[p]);
       if (!prim && used[m]) return prim.error();
       if (!prim) {
-        std::fprintf(stderr, "warning: %s (mesh unused by any node, left empty)\n", prim.error().to_string().c_str());
+        log_message(LogLevel::Warning, prim.error().to_string() + " (mesh unused by any node, left empty)");
         mesh.primitives.clear();
         break;
       }

@@ -1,4 +1,5 @@
 #include <engine/gpu/context.h>
+#include <engine/log.h>
 
 #include <cstdio>
 #include <cstdlib>
@@ -26,8 +27,10 @@ bool debug_requested() {
 void GLAPIENTRY print_debug_message(GLenum source, GLenum type, GLuint id, GLenum severity, GLsizei /*length*/,
                                     const GLchar* message, const void* /*user*/) {
   if (severity == GL_DEBUG_SEVERITY_NOTIFICATION) return;
-  std::fprintf(stderr, "GL debug [source 0x%x type 0x%x id %u severity 0x%x]: %s\n", source, type, id, severity,
-               message);
+  char head[96];
+  std::snprintf(head, sizeof head, "GL debug [source 0x%x type 0x%x id %u severity 0x%x]: ", source, type, id,
+                severity);
+  log_message(type == GL_DEBUG_TYPE_ERROR ? LogLevel::Error : LogLevel::Warning, std::string(head) + message);
 }
 
 void install_debug_output() {

@@ -35,10 +35,10 @@ namespace engine::render {
 
 namespace {
 
-Result<ShaderProgram> build_pass(const char* file) {
+template <class Uniforms>
+Result<LocatedProgram<Uniforms>> build_pass(const char* file) {
   ShaderProgramBuilder b(engine_shader_files());
-  b.stage(ShaderStage::Compute, file);
-  return define_exposure_constants(b).build();
+  return link_program<Uniforms>(define_exposure_constants(b), {{ShaderStage::Compute, file}});
 }
 
 }  // namespace
@@ -62,9 +62,9 @@ ShaderProgramBuilder& define_exposure_constants(ShaderProgramBuilder& b) {
 }
 
 Result<ExposureMeter> ExposureMeter::create() {
-  auto histogram = build_pass("exposure_histogram.comp.glsl");
+  auto histogram = build_pass<ExposureHistogramUniforms>("exposure_histogram.comp.glsl");
   if (!histogram) return histogram.error();
-  auto adapt = build_pass("exposure_adapt.comp.glsl");
+  auto adapt = build_pass<ExposureAdaptUniforms>("exposure_adapt.comp.glsl");
   if (!adapt) return adapt.error();
   ExposureMeter m;
   m.histogram_ = std::move(histogram.value());
@@ -85,19 +85,20 @@ void ExposureMeter::run(std::uint32_t hdr, int width, int height, double dt_s, b
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
   histogram_.use();
   glBindTextureUnit(0, hdr);
-  glUniform2i(0, width, height);
+  glUniform2i(histogram_.uniforms.size, width, height);
   constexpr int tile = 16 * kMeterPixelsPerSide * kMeteredPixelStride;
   glDispatchCompute(static_cast<GLuint>((width + tile - 1) / tile), static_cast<GLuint>((height + tile - 1) / tile), 1);
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
 
   adapt_.use();
-  glUniform1f(0, static_cast<float>(dt_s));
-  glUniform1i(1, snap ? 1 : 0);
+  const ExposureAdaptUniforms& u = adapt_.uniforms;
+  glUniform1f(u.dt_s, static_cast<float>(dt_s));
+  glUniform1i(u.snap, snap ? 1 : 0);
   const float low = std::clamp(s.low_percentile, 0.0f, 1.0f);
-  glUniform2f(2, low, std::clamp(s.high_percentile, low, 1.0f));
-  glUniform2f(3, s.min_ev100, std::max(s.min_ev100, s.max_ev100));
-  glUniform1f(4, s.compensation_ev);
-  glUniform2f(5, std::max(0.0f, s.brighter_rate_per_s), std::max(0.0f, s.darker_rate_per_s));
+  glUniform2f(u.percentiles, low, std::clamp(s.high_percentile, low, 1.0f));
+  glUniform2f(u.ev100_range, s.min_ev100, std::max(s.min_ev100, s.max_ev100));
+  glUniform1f(u.compensation_ev, s.compensation_ev);
+  glUniform2f(u.rates_per_s, std::max(0.0f, s.brighter_rate_per_s), std::max(0.0f, s.darker_rate_per_s));
   glDispatchCompute(1, 1, 1);
   // The tonemap's fragment shader reads the state; the next frame's passes read both buffers.
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);

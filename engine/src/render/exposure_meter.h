@@ -9,7 +9,9 @@
 #include <engine/exposure.h>
 #include <engine/gpu/gl_objects.h>
 #include <engine/gpu/shader_program.h>
+
 #include <engine/result.h>
+#include "render/program_uniforms.h"
 
 #include <cstdint>
 
@@ -59,8 +61,8 @@ class ExposureMeter {
   GpuExposureState read() const;
 
  private:
-  ShaderProgram histogram_;
-  ShaderProgram adapt_;
+  LocatedProgram<ExposureHistogramUniforms> histogram_;
+  LocatedProgram<ExposureAdaptUniforms> adapt_;
   GlBuffer histogram_buffer_;
   GlBuffer state_;
 };

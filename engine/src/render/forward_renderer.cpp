@@ -24,6 +24,7 @@
 #include <engine/gpu/gpu_timer.h>
 #include <engine/gpu/shader_program.h>
 #include <engine/light_reach.h>
+#include <engine/log.h>
 #include <engine/runtime_limits.h>
 
 #include "render/frame_data.h"
@@ -56,19 +57,15 @@ namespace {
 
 enum IndirectMode : int { kIndirectNone = 0, kIndirectAmbient = 1, kIndirectAtlas = 2, kIndirectVertex = 3 };
 
-Result<ShaderProgram> build(const char* vertex, const char* fragment) {
-  return ShaderProgramBuilder(engine_shader_files())
-      .stage(ShaderStage::Vertex, vertex)
-      .stage(ShaderStage::Fragment, fragment)
-      .build();
+Result<LocatedProgram<DepthUniforms>> build_depth(const char* fragment) {
+  return link_program<DepthUniforms>(ShaderProgramBuilder(engine_shader_files()),
+                                     {{ShaderStage::Vertex, "shadow.vert.glsl"}, {ShaderStage::Fragment, fragment}});
 }
 
 // The forward program for one combination of light counts (see forward.frag.glsl).
-Result<ShaderProgram> build_forward(const LightCounts& n) {
-  return ShaderProgramBuilder(engine_shader_files())
-      .stage(ShaderStage::Vertex, "forward.vert.glsl")
-      .stage(ShaderStage::Fragment, "forward.frag.glsl")
-      .define("POINT_LIGHTS " + std::to_string(n[0]))
+Result<LocatedProgram<ForwardUniforms>> build_forward(const LightCounts& n) {
+  ShaderProgramBuilder b(engine_shader_files());
+  b.define("POINT_LIGHTS " + std::to_string(n[0]))
       .define("SPOT_LIGHTS " + std::to_string(n[1]))
       .define("DIRECTIONAL_LIGHTS " + std::to_string(n[2]))
       .define("AREA_LIGHTS " + std::to_string(n[3]))
@@ -76,8 +73,9 @@ Result<ShaderProgram> build_forward(const LightCounts& n) {
       .define("AREA_SOFT_SHADOWS " + std::to_string(n[5]))
       .define("SKY_TERM " + std::to_string(n[6]))
       .define("AREA_SHADOW_HALF " + std::to_string(n[7]))
-      .define("FLAT_SHADING " + std::to_string(n[8]))
-      .build();
+      .define("FLAT_SHADING " + std::to_string(n[8]));
+  return link_program<ForwardUniforms>(
+      std::move(b), {{ShaderStage::Vertex, "forward.vert.glsl"}, {ShaderStage::Fragment, "forward.frag.glsl"}});
 }
 
 // A dielectric whose roughness is at least kRoughForOnePoint everywhere (no roughness texture):
@@ -91,12 +89,12 @@ bool rough_dielectric(const render::GpuMaterial& m, GLuint white_texture) {
 
 }  // namespace
 
-const ShaderProgram& ForwardRenderer::forward_program(const LightCounts& counts) {
+const LocatedProgram<ForwardUniforms>& ForwardRenderer::forward_program(const LightCounts& counts) {
   auto it = forward_variants_.find(counts);
   if (it != forward_variants_.end()) return it->second;
-  Result<ShaderProgram> p = build_forward(counts);
+  Result<LocatedProgram<ForwardUniforms>> p = build_forward(counts);
   // The variant without lights compiled in create(); a failure here is a shader bug.
-  if (!p) std::fprintf(stderr, "%s\n", p.error().to_string().c_str());
+  if (!p) log_message(LogLevel::Error, p.error().to_string());
   GI_EXPECTS(p.ok(), "forward shader variant must compile");
   return forward_variants_.emplace(counts, std::move(p.value())).first->second;
 }
@@ -200,7 +198,8 @@ void ForwardRenderer::render(const Registry& registry, Entity camera, double dt_
                        lights.cubes);
   const CameraView view = camera_view(registry, camera);
   // The alpha-tested shadow program only for scenes with MASK or BLEND materials (made on first use).
-  const ShaderProgram* shadow_cut_out = scene_.has_cut_out() ? &alpha_test_program("shadow.frag.glsl") : nullptr;
+  const LocatedProgram<DepthUniforms>* shadow_cut_out =
+      scene_.has_cut_out() ? &alpha_test_program("shadow.frag.glsl") : nullptr;
   shadow_maps_rendered_ =
       shadow_maps_.render(lights.shadow_views, items, scene_, shadow_, shadow_cut_out, view.view_proj);
   timings_.push_back({"shadow maps (" + std::to_string(lights.shadow_views.size()) + " views)", timer.lap_ms()});
@@ -359,22 +358,24 @@ void ForwardRenderer::forward_pass(const CameraView& view, const std::vector<Dra
     // (Not for BLEND primitives: two passes would break their back-to-front order.)
     const bool split_rough = !blend && counts[3] > 0 && counts[4] > 1 && settings_.area_specular_one_point_on_rough;
     for (int pass = 0; pass < (split_rough ? 2 : 1); ++pass) {
-      const ShaderProgram& program = forward_program(pass == 0 ? counts : rough_counts);
+      const LocatedProgram<ForwardUniforms>& program = forward_program(pass == 0 ? counts : rough_counts);
+      const ForwardUniforms& u = program.uniforms;
       program.use();
-      glUniform1i(29, directional ? indirect->directional_bin_count : 0);
-      glUniform1i(30, directional ? indirect->directional_element_count : 0);
+      glUniform1i(u.directional_bins, directional ? indirect->directional_bin_count : 0);
+      glUniform1i(u.directional_elements, directional ? indirect->directional_element_count : 0);
 
-      glUniformMatrix4fv(8, 1, GL_FALSE, glm::value_ptr(view_proj));
-      glUniform3fv(16, 1, glm::value_ptr(camera_position));
-      glUniform1f(23, settings_.stand_in_ambient);
-      glUniform3fv(31, 1, glm::value_ptr(settings_.sky_radiance));
+      glUniformMatrix4fv(u.view_proj, 1, GL_FALSE, glm::value_ptr(view_proj));
+      glUniform3fv(u.camera_position, 1, glm::value_ptr(camera_position));
+      glUniform1f(u.ambient_radiance, settings_.stand_in_ambient);
+      glUniform3fv(u.sky_radiance, 1, glm::value_ptr(settings_.sky_radiance));
       {  // The sky's gradient (engine/sky.h): horizon, zenith - horizon, ground - horizon.
         const SkyGradient& g = settings_.sky_gradient;
         const glm::vec3 terms[3] = {g.horizon, g.zenith - g.horizon, g.ground - g.horizon};
-        glUniform3fv(61, 3, glm::value_ptr(terms[0]));
+        glUniform3fv(u.sky_gradient, 3, glm::value_ptr(terms[0]));
       }
-      glUniform1f(24, settings_.split == SplitView::DirectLeftFullRight ? 0.5f * static_cast<float>(width_) : -1.0f);
-      glUniform1i(25, glossy != 0 && !blend ? 1 : 0);  // the glossy texture is the opaque surface's
+      glUniform1f(u.split_x,
+                  settings_.split == SplitView::DirectLeftFullRight ? 0.5f * static_cast<float>(width_) : -1.0f);
+      glUniform1i(u.use_glossy, glossy != 0 && !blend ? 1 : 0);  // the glossy texture is the opaque surface's
 
       const auto in_pass = [&](const DrawItem& item, const render::GpuPrimitive& p) {
         const render::GpuMaterial& m =
@@ -406,13 +407,13 @@ void ForwardRenderer::forward_pass(const CameraView& view, const std::vector<Dra
         {  // The sky's occlusion on a dynamic entity, when the provider measured it (indirect_light.h).
           float axes[6] = {1.0f, 1.0f, 1.0f, 1.0f, 1.0f, 1.0f};
           if (indirect != nullptr && !item.is_static) (void)indirect->sky_visibility(item.entity, axes);
-          glUniform3f(64, axes[0], axes[2], axes[4]);
-          glUniform3f(65, axes[1], axes[3], axes[5]);
+          glUniform3f(u.sky_visibility_pos, axes[0], axes[2], axes[4]);
+          glUniform3f(u.sky_visibility_neg, axes[1], axes[3], axes[5]);
         }
         // What the atlas this item reads holds besides indirect light (not drawn again here).
         const bool baked = mode == kIndirectAtlas;
-        glUniform1i(
-            66, (baked && indirect->atlas_holds_sky ? 1 : 0) | (baked && indirect->atlas_holds_static_lights ? 2 : 0));
+        glUniform1i(u.baked_direct, (baked && indirect->atlas_holds_sky ? 1 : 0) |
+                                        (baked && indirect->atlas_holds_static_lights ? 2 : 0));
         if (vertex_buffer != 0) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kVertexIrradianceBinding, vertex_buffer);
         // Per-vertex view-dependent indirect light (IndirectLightFrame::vertex_radiance_lobes).
         IndirectLightFrame::VertexRadianceLobes lobes;
@@ -423,16 +424,16 @@ void ForwardRenderer::forward_pass(const CameraView& view, const std::vector<Dra
           glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kLobeCoefficientsBinding, lobes.coefficient_buffer);
           glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kLobeTableBinding, lobes.lobe_buffer);
         }
-        glUniform1i(40, use_lobes ? lobes.terms : 0);
-        glUniform1i(41, lobes.resolution);
-        glUniform1i(42, lobes.first);
-        glUniform1i(43, lobes.stride);
-        glUniform1i(12, item.mesh->first_vertex);
-        glUniform1i(13, vertex_buffer != 0 ? 1 : 0);
-        glUniform1i(22, mode);
-        glUniformMatrix4fv(0, 1, GL_FALSE, glm::value_ptr(item.model));
+        glUniform1i(u.lobe_terms, use_lobes ? lobes.terms : 0);
+        glUniform1i(u.lobe_resolution, lobes.resolution);
+        glUniform1i(u.lobe_first, lobes.first);
+        glUniform1i(u.lobe_stride, lobes.stride);
+        glUniform1i(u.mesh_first_vertex, item.mesh->first_vertex);
+        glUniform1i(u.use_vertex_irradiance, vertex_buffer != 0 ? 1 : 0);
+        glUniform1i(u.indirect_mode, mode);
+        glUniformMatrix4fv(u.model, 1, GL_FALSE, glm::value_ptr(item.model));
         const glm::mat4 normal_matrix(glm::transpose(glm::inverse(glm::mat3(item.model))));
-        glUniformMatrix4fv(4, 1, GL_FALSE, glm::value_ptr(normal_matrix));
+        glUniformMatrix4fv(u.normal_matrix, 1, GL_FALSE, glm::value_ptr(normal_matrix));
         for (const render::GpuPrimitive& p : item.mesh->primitives) {
           if (!in_pass(item, p)) continue;
           const render::GpuMaterial& m =
@@ -441,13 +442,13 @@ void ForwardRenderer::forward_pass(const CameraView& view, const std::vector<Dra
             glDisable(GL_CULL_FACE);
           else
             glEnable(GL_CULL_FACE);
-          glUniform4fv(18, 1, glm::value_ptr(m.base_color));
-          glUniform1f(19, m.metallic);
-          glUniform1f(20, m.roughness);
-          glUniform3fv(21, 1, glm::value_ptr(m.emissive));
-          glUniform1i(26, m.double_sided ? 1 : 0);
-          glUniform1f(27, m.specular_factor);
-          glUniform3fv(28, 1, glm::value_ptr(m.specular_color_factor));
+          glUniform4fv(u.base_color, 1, glm::value_ptr(m.base_color));
+          glUniform1f(u.metallic, m.metallic);
+          glUniform1f(u.roughness, m.roughness);
+          glUniform3fv(u.emissive, 1, glm::value_ptr(m.emissive));
+          glUniform1i(u.double_sided, m.double_sided ? 1 : 0);
+          glUniform1f(u.specular_factor, m.specular_factor);
+          glUniform3fv(u.specular_color_factor, 1, glm::value_ptr(m.specular_color_factor));
           glBindTextureUnit(kBaseColorUnit, m.base_color_texture);
           glBindTextureUnit(kMetallicRoughnessUnit, m.metallic_roughness_texture);
           glBindTextureUnit(kEmissiveUnit, m.emissive_texture);
@@ -456,7 +457,9 @@ void ForwardRenderer::forward_pass(const CameraView& view, const std::vector<Dra
           glBindSampler(kMetallicRoughnessUnit, m.samplers[render::kMetallicRoughnessSlot]);
           glBindSampler(kEmissiveUnit, m.samplers[render::kEmissiveSlot]);
           glBindSampler(kNormalUnit, m.samplers[render::kNormalSlot]);
-          render::set_material_texturing(m);
+          render::set_material_texturing(m, u.material);
+          glUniform1f(u.normal_scale, m.normal_scale);
+          glUniform1i(u.normal_map, m.normal_texture != 0 ? 1 : 0);
           glDrawElementsBaseVertex(GL_TRIANGLES, static_cast<GLsizei>(p.index_count), GL_UNSIGNED_INT,
                                    reinterpret_cast<const void*>(static_cast<std::uintptr_t>(p.first_index) * 4u),
                                    p.base_vertex);
@@ -503,15 +506,14 @@ void ForwardRenderer::forward_pass(const CameraView& view, const std::vector<Dra
 }
 
 // The depth-only fragment stage `fragment` with ALPHA_TEST 1 (shadow.vert.glsl's vertices).
-const ShaderProgram& ForwardRenderer::alpha_test_program(const char* fragment) {
+const LocatedProgram<DepthUniforms>& ForwardRenderer::alpha_test_program(const char* fragment) {
   auto it = alpha_test_programs_.find(fragment);
   if (it != alpha_test_programs_.end()) return it->second;
-  Result<ShaderProgram> p = ShaderProgramBuilder(engine_shader_files())
-                                .stage(ShaderStage::Vertex, "shadow.vert.glsl")
-                                .stage(ShaderStage::Fragment, fragment)
-                                .define("ALPHA_TEST 1")
-                                .build();
-  if (!p) std::fprintf(stderr, "%s\n", p.error().to_string().c_str());
+  ShaderProgramBuilder b(engine_shader_files());
+  b.define("ALPHA_TEST 1");
+  Result<LocatedProgram<DepthUniforms>> p = link_program<DepthUniforms>(
+      std::move(b), {{ShaderStage::Vertex, "shadow.vert.glsl"}, {ShaderStage::Fragment, fragment}});
+  if (!p) log_message(LogLevel::Error, p.error().to_string());
   GI_EXPECTS(p.ok(), "alpha-tested depth shader must compile");
   return alpha_test_programs_.emplace(fragment, std::move(p.value())).first->second;
 }
@@ -532,23 +534,24 @@ void ForwardRenderer::depth_prepass(const glm::mat4& view_proj, const std::vecto
   }
   for (const bool cut_out : {false, true}) {
     if (cut_out && !scene_.has_mask()) break;
-    const ShaderProgram& program = cut_out
-                                       ? alpha_test_program(reach ? "depth_reach.frag.glsl" : "depth_only.frag.glsl")
-                                       : (reach ? depth_reach_ : depth_only_);
+    const LocatedProgram<DepthUniforms>& program =
+        cut_out ? alpha_test_program(reach ? "depth_reach.frag.glsl" : "depth_only.frag.glsl")
+                : (reach ? depth_reach_ : depth_only_);
+    const DepthUniforms& u = program.uniforms;
     program.use();
-    glUniformMatrix4fv(8, 1, GL_FALSE, glm::value_ptr(view_proj));
+    glUniformMatrix4fv(u.view_proj, 1, GL_FALSE, glm::value_ptr(view_proj));
     if (reach) {
-      glUniform3fv(50, 1, glm::value_ptr(reach_.grid.origin));
-      glUniform1f(51, 1.0f / reach_.grid.voxel_m);
-      glUniform1i(52, reach_.grid.all);
+      glUniform3fv(u.reach_origin, 1, glm::value_ptr(reach_.grid.origin));
+      glUniform1f(u.reach_inv_voxel, 1.0f / reach_.grid.voxel_m);
+      glUniform1i(u.reach_all, reach_.grid.all);
     }
     for (const DrawItem& item : items) {
-      glUniformMatrix4fv(0, 1, GL_FALSE, glm::value_ptr(item.model));
+      glUniformMatrix4fv(u.model, 1, GL_FALSE, glm::value_ptr(item.model));
       for (const render::GpuPrimitive& p : item.mesh->primitives) {
         const render::GpuMaterial& m =
             scene_.material(item.material_override >= 0 ? item.material_override : p.material);
         if (m.alpha_mode == AlphaMode::Blend || (m.alpha_mode == AlphaMode::Mask) != cut_out) continue;
-        if (cut_out) render::bind_alpha_test(m, m.alpha_cutoff);
+        if (cut_out) render::bind_alpha_test(m, m.alpha_cutoff, u.material);
         // Same culling as the shading pass, so both passes see the same surfaces.
         if (m.double_sided)
           glDisable(GL_CULL_FACE);
@@ -571,8 +574,8 @@ void ForwardRenderer::tonemap_pass() {
   glDisable(GL_DEPTH_TEST);
   glDisable(GL_CULL_FACE);
   tonemap_.use();
-  glUniform1f(0, exposure_metered_ ? 1.0f : applied_exposure_);
-  glUniform1i(1, exposure_metered_ ? 1 : 0);
+  glUniform1f(tonemap_.uniforms.exposure, exposure_metered_ ? 1.0f : applied_exposure_);
+  glUniform1i(tonemap_.uniforms.metered, exposure_metered_ ? 1 : 0);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kExposureStateBinding, exposure_meter_.state_buffer());
   glBindTextureUnit(0, hdr_.id());
   glBindVertexArray(empty_vao_.id());
@@ -643,15 +646,16 @@ Result<std::unique_ptr<Renderer>> Renderer::create(const SceneAsset& assets, con
     return Error{assets.source, "renderer", "no current OpenGL context (create an engine::GpuContext first)"};
   auto forward = build_forward(LightCounts{0, 0, 0, 0, 3, 1, 1, 0});
   if (!forward) return forward.error();
-  auto depth = build("shadow.vert.glsl", "depth_only.frag.glsl");
+  auto depth = build_depth("depth_only.frag.glsl");
   if (!depth) return depth.error();
-  auto depth_reach = build("shadow.vert.glsl", "depth_reach.frag.glsl");
+  auto depth_reach = build_depth("depth_reach.frag.glsl");
   if (!depth_reach) return depth_reach.error();
-  auto shadow = build("shadow.vert.glsl", "shadow.frag.glsl");
+  auto shadow = build_depth("shadow.frag.glsl");
   if (!shadow) return shadow.error();
   ShaderProgramBuilder tonemap_builder(engine_shader_files());
-  tonemap_builder.stage(ShaderStage::Vertex, "fullscreen.vert.glsl").stage(ShaderStage::Fragment, "tonemap.frag.glsl");
-  auto tonemap = define_exposure_constants(tonemap_builder).build();
+  auto tonemap = link_program<TonemapUniforms>(
+      define_exposure_constants(tonemap_builder),
+      {{ShaderStage::Vertex, "fullscreen.vert.glsl"}, {ShaderStage::Fragment, "tonemap.frag.glsl"}});
   if (!tonemap) return tonemap.error();
   auto exposure_meter = ExposureMeter::create();
   if (!exposure_meter) return exposure_meter.error();

@@ -26,6 +26,7 @@
 #include "render/frame_data.h"
 #include "render/gpu_scene.h"
 #include "render/light_list.h"
+#include "render/program_uniforms.h"
 #include "render/shadow_maps.h"
 
 namespace engine::render {
@@ -106,9 +107,9 @@ struct ReachState {
 
 class ForwardRenderer final : public Renderer {
  public:
-  ForwardRenderer(GpuScene scene, ShaderProgram forward, ShaderProgram depth, ShaderProgram depth_reach,
-                  ShaderProgram shadow, ShaderProgram tonemap, ExposureMeter exposure_meter,
-                  const RenderSettings& settings)
+  ForwardRenderer(GpuScene scene, LocatedProgram<ForwardUniforms> forward, LocatedProgram<DepthUniforms> depth,
+                  LocatedProgram<DepthUniforms> depth_reach, LocatedProgram<DepthUniforms> shadow,
+                  LocatedProgram<TonemapUniforms> tonemap, ExposureMeter exposure_meter, const RenderSettings& settings)
       : settings_(settings),
         scene_(std::move(scene)),
         depth_only_(std::move(depth)),
@@ -160,13 +161,16 @@ class ForwardRenderer final : public Renderer {
   CameraView camera_view(const Registry& registry, Entity camera);
   void forward_pass(const CameraView& view, const std::vector<DrawItem>& items, const std::vector<LightGroup>& groups,
                     const IndirectLightFrame* indirect);
-  const ShaderProgram& forward_program(const LightCounts& counts);
-  const ShaderProgram& area_shadow_program(int pass, int area_lights);
+  const LocatedProgram<ForwardUniforms>& forward_program(const LightCounts& counts);
+  const LocatedProgram<AreaShadowUniforms>& area_shadow_program(int pass, int area_lights);
   void area_shadow_passes(const glm::mat4& view_proj, const glm::vec3& camera_position,
                           const std::vector<DrawItem>& items);
-  void draw_geometry(const std::vector<DrawItem>& items, bool double_sided_uniform, const glm::mat4& view_proj);
+  /// `shading` null: the half-resolution depth pass (depth_only_ current); otherwise the area
+  /// shadow program `shading` is current.
+  void draw_geometry(const std::vector<DrawItem>& items, const LocatedProgram<AreaShadowUniforms>* shading,
+                     const glm::mat4& view_proj);
   /// A depth-only fragment stage built with ALPHA_TEST 1 (material_common.glsl), made on first use.
-  const ShaderProgram& alpha_test_program(const char* fragment);
+  const LocatedProgram<DepthUniforms>& alpha_test_program(const char* fragment);
   void depth_prepass(const glm::mat4& view_proj, const std::vector<DrawItem>& items, bool reach);
   std::vector<LightGroup> light_groups(const Registry& registry, const std::vector<DrawItem>& items,
                                        const render::LightList& lights);
@@ -178,8 +182,8 @@ class ForwardRenderer final : public Renderer {
 
   RenderSettings settings_;
   GpuScene scene_;
-  std::map<LightCounts, ShaderProgram> forward_variants_;
-  std::map<std::pair<int, int>, ShaderProgram> area_shadow_programs_;  // (pass, area lights)
+  std::map<LightCounts, LocatedProgram<ForwardUniforms>> forward_variants_;
+  std::map<std::pair<int, int>, LocatedProgram<AreaShadowUniforms>> area_shadow_programs_;  // (pass, area lights)
   // Half-resolution area shadows (RenderSettings::area_shadow_res): this frame's area lights
   // (empty: full-resolution lookups), their buffer, the half-resolution targets and the
   // full-resolution visibility the forward pass reads.
@@ -191,14 +195,14 @@ class ForwardRenderer final : public Renderer {
   GlTexture area_visibility_;
   GlFramebuffer half_fbo_;
   GlFramebuffer visibility_fbo_;
-  ShaderProgram depth_only_;
-  ShaderProgram depth_reach_;
+  LocatedProgram<DepthUniforms> depth_only_;
+  LocatedProgram<DepthUniforms> depth_reach_;
   ReachState reach_;
-  ShaderProgram shadow_;
+  LocatedProgram<DepthUniforms> shadow_;
   // Fragment stage -> its ALPHA_TEST variant (material_common.glsl): shadow.frag.glsl for MASK
   // and BLEND casters, depth_only / depth_reach.frag.glsl for MASK in the pre-passes.
-  std::map<std::string, ShaderProgram> alpha_test_programs_;
-  ShaderProgram tonemap_;
+  std::map<std::string, LocatedProgram<DepthUniforms>> alpha_test_programs_;
+  LocatedProgram<TonemapUniforms> tonemap_;
   ExposureMeter exposure_meter_;
   bool exposure_snap_ = true;      ///< The next automatic frame snaps to its target.
   bool exposure_metered_ = false;  ///< The last frame's exposure came from exposure_meter_.

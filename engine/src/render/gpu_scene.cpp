@@ -12,6 +12,8 @@
 
 #include <engine/tangents.h>
 
+#include "render/program_uniforms.h"
+
 namespace engine::render {
 
 namespace {
@@ -81,19 +83,17 @@ GlTexture upload_image(const Image& image, bool srgb) {
 
 }  // namespace
 
-void set_material_texturing(const GpuMaterial& m) {
-  glUniform1i(kAlphaModeLocation, static_cast<int>(m.alpha_mode));
-  glUniform1f(kAlphaCutoffLocation, m.alpha_cutoff);
-  glUniform1f(kNormalScaleLocation, m.normal_scale);
-  glUniform4iv(kTexcoordSetsLocation, 1, &m.texcoord_sets.x);
-  glUniform4fv(kUvTransformsLocation, 8, &m.uv_transforms[0].x);
-  glUniform1i(kNormalMapLocation, m.normal_texture != 0 ? 1 : 0);
+void set_material_texturing(const GpuMaterial& m, const MaterialUniforms& at) {
+  glUniform1i(at.alpha_mode, static_cast<int>(m.alpha_mode));
+  glUniform1f(at.alpha_cutoff, m.alpha_cutoff);
+  glUniform4iv(at.texcoord_sets, 1, &m.texcoord_sets.x);
+  glUniform4fv(at.uv_transforms, 8, &m.uv_transforms[0].x);
 }
 
-void bind_alpha_test(const GpuMaterial& m, float cutoff) {
-  set_material_texturing(m);
-  glUniform1f(kAlphaCutoffLocation, cutoff);
-  glUniform1f(kBaseAlphaLocation, m.base_color.w);
+void bind_alpha_test(const GpuMaterial& m, float cutoff, const MaterialUniforms& at) {
+  set_material_texturing(m, at);
+  glUniform1f(at.alpha_cutoff, cutoff);
+  glUniform1f(at.base_alpha, m.base_color.w);
   glBindTextureUnit(kMaterialBaseColorUnit, m.base_color_texture);
   glBindSampler(kMaterialBaseColorUnit, m.samplers[kBaseColorSlot]);
 }

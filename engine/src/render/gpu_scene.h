@@ -14,6 +14,8 @@
 
 namespace engine::render {
 
+struct MaterialUniforms;  // render/program_uniforms.h
+
 /// Vertex layout of the scene vertex buffer (locations 0..4 of forward/shadow shaders).
 struct GpuVertex {
   glm::vec3 position;
@@ -25,18 +27,6 @@ struct GpuVertex {
   glm::vec4 tangent;
 };
 static_assert(sizeof(GpuVertex) == 56, "GpuVertex is tightly packed");
-
-/// Uniform locations of a material's texturing and alpha, shared by forward.frag.glsl and the
-/// alpha-tested depth passes (material_common.glsl).
-enum MaterialUniform : int {
-  kAlphaModeLocation = 70,     ///< int: 0 OPAQUE, 1 MASK, 2 BLEND
-  kAlphaCutoffLocation = 71,   ///< float: fragments with alpha below it are discarded (MASK)
-  kNormalScaleLocation = 72,   ///< float: normalTexture.scale
-  kTexcoordSetsLocation = 73,  ///< ivec4: each texture slot's TEXCOORD set (0 or 1)
-  kUvTransformsLocation = 74,  ///< vec4[8]: each slot's KHR_texture_transform, two rows of a 2x3 matrix
-  kNormalMapLocation = 82,     ///< int: 1 when the material has a normal texture
-  kBaseAlphaLocation = 83,     ///< float: baseColorFactor.a (alpha-tested depth passes)
-};
 
 /// Texture units of a material's textures (forward.frag.glsl, material_common.glsl).
 enum MaterialUnit : unsigned {
@@ -96,12 +86,12 @@ struct GpuMaterial {
   bool cut_out() const { return alpha_mode != AlphaMode::Opaque; }
 };
 
-/// Sets `m`'s texturing uniforms (MaterialUniform: TEXCOORD sets, transforms, alpha mode and
-/// cutoff, normal scale) on the current program.
-void set_material_texturing(const GpuMaterial& m);
+/// Sets `m`'s texturing uniforms (material_common.glsl: TEXCOORD sets, transforms, alpha mode
+/// and cutoff) on the current program, whose locations `at` holds.
+void set_material_texturing(const GpuMaterial& m, const MaterialUniforms& at);
 /// For the alpha-tested depth passes (ALPHA_TEST in material_common.glsl): the texturing
 /// uniforms, base alpha and `cutoff`, and the base colour texture and its sampler on unit 0.
-void bind_alpha_test(const GpuMaterial& m, float cutoff);
+void bind_alpha_test(const GpuMaterial& m, float cutoff, const MaterialUniforms& at);
 /// Unbinds the sampler objects set_material_texturing's callers bound (units 0, 1, 2, 15), so
 /// later passes sample their textures with the textures' own parameters.
 void unbind_material_samplers();

@@ -92,8 +92,8 @@ bool ShadowMaps::LayerContent::operator==(const LayerContent& o) const {
 }
 
 int ShadowMaps::render(const std::vector<ShadowView>& views, const std::vector<DrawItem>& items, const GpuScene& scene,
-                       const ShaderProgram& program, const ShaderProgram* cut_out_program,
-                       const glm::mat4& camera_view_proj) {
+                       const LocatedProgram<DepthUniforms>& program,
+                       const LocatedProgram<DepthUniforms>* cut_out_program, const glm::mat4& camera_view_proj) {
   // Each view's content first: the casters whose world bounds are not wholly outside one
   // of its clip planes (they would be clipped whole, so culling them changes no texel),
   // split into static (StaticTag) and dynamic ones for the static depth cache below.
@@ -150,18 +150,18 @@ int ShadowMaps::render(const std::vector<ShadowView>& views, const std::vector<D
   glDisable(GL_BLEND);
   glBindVertexArray(scene.vertex_array());
   const ShadowView* current = nullptr;
-  const auto set_view = [&](const ShadowView& v) {
-    glUniformMatrix4fv(8, 1, GL_FALSE, glm::value_ptr(v.view_proj));
-    glUniform3fv(16, 1, glm::value_ptr(v.eye));
-    glUniform1f(17, v.far_m);
-    glUniform1i(18, v.ortho ? 1 : 0);
-    glUniform3fv(19, 1, glm::value_ptr(v.axis));
+  const auto set_view = [&](const DepthUniforms& u, const ShadowView& v) {
+    glUniformMatrix4fv(u.view_proj, 1, GL_FALSE, glm::value_ptr(v.view_proj));
+    glUniform3fv(u.eye, 1, glm::value_ptr(v.eye));
+    glUniform1f(u.far_m, v.far_m);
+    glUniform1i(u.ortho, v.ortho ? 1 : 0);
+    glUniform3fv(u.axis, 1, glm::value_ptr(v.axis));
   };
   // Opaque primitives with `program`, then the cut-out ones (MASK, BLEND) with the alpha test.
   const auto draw = [&](const std::vector<Caster>& casters) {
     for (const bool cut_out : {false, true}) {
       if (cut_out && cut_out_program == nullptr) break;
-      const ShaderProgram& p = cut_out ? *cut_out_program : program;
+      const LocatedProgram<DepthUniforms>& p = cut_out ? *cut_out_program : program;
       bool used = false;
       for (const Caster& c : casters) {
         bool model_set = false;
@@ -170,14 +170,14 @@ int ShadowMaps::render(const std::vector<ShadowView>& views, const std::vector<D
           if (m.cut_out() != cut_out) continue;
           if (!used) {
             p.use();
-            set_view(*current);
+            set_view(p.uniforms, *current);
             used = true;
           }
           if (!model_set) {
-            glUniformMatrix4fv(0, 1, GL_FALSE, glm::value_ptr(c.model));
+            glUniformMatrix4fv(p.uniforms.model, 1, GL_FALSE, glm::value_ptr(c.model));
             model_set = true;
           }
-          if (cut_out) bind_alpha_test(m, m.alpha_mode == AlphaMode::Mask ? m.alpha_cutoff : 0.5f);
+          if (cut_out) bind_alpha_test(m, m.alpha_mode == AlphaMode::Mask ? m.alpha_cutoff : 0.5f, p.uniforms.material);
           glDrawElementsBaseVertex(GL_TRIANGLES, static_cast<GLsizei>(prim.index_count), GL_UNSIGNED_INT,
                                    reinterpret_cast<const void*>(static_cast<std::uintptr_t>(prim.first_index) * 4u),
                                    prim.base_vertex);

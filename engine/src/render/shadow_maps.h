@@ -9,6 +9,8 @@
 #include <engine/gpu/gl_objects.h>
 #include <engine/gpu/shader_program.h>
 
+#include "render/program_uniforms.h"
+
 #include "render/frame_data.h"
 #include "render/gpu_scene.h"
 
@@ -34,7 +36,8 @@ class ShadowMaps {
   /// (a cut-out at 0.5) with `cut_out_program`, shadow.frag.glsl with ALPHA_TEST (needed only
   /// when the scene has such materials, GpuScene::has_cut_out()).
   int render(const std::vector<ShadowView>& views, const std::vector<DrawItem>& items, const GpuScene& scene,
-             const ShaderProgram& program, const ShaderProgram* cut_out_program, const glm::mat4& camera_view_proj);
+             const LocatedProgram<DepthUniforms>& program, const LocatedProgram<DepthUniforms>* cut_out_program,
+             const glm::mat4& camera_view_proj);
 
   std::uint32_t maps_2d() const { return maps_[kMaps2d].texture.id(); }
   std::uint32_t sun_maps() const { return maps_[kSunMaps].texture.id(); }

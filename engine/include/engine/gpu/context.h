@@ -15,7 +15,7 @@ namespace engine {
 /// Owns a GL context (and its window, if any); the destructor releases everything. The
 /// context is current on the creating thread after create_*(). In debug builds (or with
 /// the environment variable GI_GL_DEBUG=1) the context is a debug context and GL debug
-/// messages are printed to stderr.
+/// messages go to the engine log (engine/log.h).
 class GpuContext {
  public:
   /// EGL with EGL_PLATFORM_SURFACELESS_MESA: no window system needed. The context has no
