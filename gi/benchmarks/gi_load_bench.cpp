@@ -23,8 +23,8 @@
 #include <gi/bake_input.h>
 #include <gi/gi_system.h>
 
-#include <benchmark/benchmark.h>
 #include <zstd.h>
+#include <benchmark/benchmark.h>
 
 #include <chrono>
 #include <cstdio>

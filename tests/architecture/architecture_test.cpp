@@ -190,70 +190,71 @@ TEST(Architecture, GiSystemKnowsNoMethodOnlyTheTable) {
     EXPECT_NE(table.find("&load_" + key + "_method"), std::string::npos)
         << "method_table.cpp does not name load_" << key << "_method";
   }
+}
 
-  // Where `text` calls glUniform* / glProgramUniform* with a literal integer location (the
-  // first argument, or the second after glProgramUniform's program), as "line N: call".
-  // Calls may span lines: the location can sit on the line after the '('.
-  std::vector<std::string> literal_uniform_locations(const std::string& text) {
-    static const std::regex call_re(R"re(\bgl(Program)?Uniform\w*\s*\()re");
-    static const std::regex literal_re(R"re(^\s*[0-9][0-9a-fA-FxXuU]*\s*$)re");
-    std::vector<std::string> found;
-    for (auto it = std::sregex_iterator(text.begin(), text.end(), call_re); it != std::sregex_iterator(); ++it) {
-      const std::size_t open = static_cast<std::size_t>(it->position() + it->length());
-      // The arguments up to the location's ',' or ')' at depth 0.
-      std::vector<std::string> args(1);
-      int depth = 0;
-      for (std::size_t i = open; i < text.size() && args.size() <= 2; ++i) {
-        const char c = text[i];
-        if (c == '(') ++depth;
-        if (c == ')' && depth-- == 0) break;
-        if (c == ',' && depth == 0) {
-          args.emplace_back();
-          continue;
-        }
-        args.back() += c;
+// Where `text` calls glUniform* / glProgramUniform* with a literal integer location (the
+// first argument, or the second after glProgramUniform's program), as "line N: call".
+// Calls may span lines: the location can sit on the line after the '('.
+std::vector<std::string> literal_uniform_locations(const std::string& text) {
+  static const std::regex call_re(R"re(\bgl(Program)?Uniform\w*\s*\()re");
+  static const std::regex literal_re(R"re(^\s*[0-9][0-9a-fA-FxXuU]*\s*$)re");
+  std::vector<std::string> found;
+  for (auto it = std::sregex_iterator(text.begin(), text.end(), call_re); it != std::sregex_iterator(); ++it) {
+    const std::size_t open = static_cast<std::size_t>(it->position() + it->length());
+    // The arguments up to the location's ',' or ')' at depth 0.
+    std::vector<std::string> args(1);
+    int depth = 0;
+    for (std::size_t i = open; i < text.size() && args.size() <= 2; ++i) {
+      const char c = text[i];
+      if (c == '(') ++depth;
+      if (c == ')' && depth-- == 0) break;
+      if (c == ',' && depth == 0) {
+        args.emplace_back();
+        continue;
       }
-      const std::size_t location_arg = (*it)[1].matched ? 1 : 0;
-      if (args.size() <= location_arg || !std::regex_match(args[location_arg], literal_re)) continue;
-      const auto line = 1 + std::count(text.begin(), text.begin() + it->position(), '\n');
-      found.push_back("line " + std::to_string(line) + ": " + it->str() + args[0] +
-                      (location_arg == 1 ? "," + args[1] : std::string()) + ", ...");
+      args.back() += c;
     }
-    return found;
+    const std::size_t location_arg = (*it)[1].matched ? 1 : 0;
+    if (args.size() <= location_arg || !std::regex_match(args[location_arg], literal_re)) continue;
+    const auto line = 1 + std::count(text.begin(), text.begin() + it->position(), '\n');
+    found.push_back("line " + std::to_string(line) + ": " + it->str() + args[0] +
+                    (location_arg == 1 ? "," + args[1] : std::string()) + ", ...");
   }
+  return found;
+}
 
-  TEST(Architecture, LiteralUniformLocationCheckCatchesTheOldPatterns) {
-    // The forms engine/src used before named locations (forward_renderer.cpp, exposure_meter.cpp).
-    EXPECT_EQ(literal_uniform_locations("glUniformMatrix4fv(8, 1, GL_FALSE, glm::value_ptr(view_proj));").size(), 1u);
-    EXPECT_EQ(literal_uniform_locations("  glUniform1i(\n            66, (baked ? 1 : 0) | 2);").size(), 1u);
-    EXPECT_EQ(literal_uniform_locations("glUniform2f(2, low, std::clamp(h, low, 1.0f));\nglUniform1f( 4 , c);").size(),
-              2u);
-    EXPECT_EQ(literal_uniform_locations("glProgramUniform1ui(program.id(), 3, items);").size(), 1u);
-    EXPECT_EQ(literal_uniform_locations("glProgramUniform1ui(id(f(1, 2)), 0x10u, items);").size(), 1u);
-    // What it must let through: named locations, looked-up ones, literal values.
-    EXPECT_TRUE(literal_uniform_locations("glUniform1i(u.lobe_terms, 0);").empty());
-    EXPECT_TRUE(literal_uniform_locations("glUniformMatrix4fv(at(\"u_model\"), 1, GL_FALSE, m);").empty());
-    EXPECT_TRUE(
-        literal_uniform_locations("glProgramUniform1ui(p.id(), glGetUniformLocation(p.id(), \"u_bins\"), 8);").empty());
-    EXPECT_TRUE(literal_uniform_locations("glUniformBlockBinding(program, 0, 1);").empty());
-  }
+TEST(Architecture, LiteralUniformLocationCheckCatchesTheOldPatterns) {
+  // The forms engine/src used before named locations (forward_renderer.cpp, exposure_meter.cpp).
+  EXPECT_EQ(literal_uniform_locations("glUniformMatrix4fv(8, 1, GL_FALSE, glm::value_ptr(view_proj));").size(), 1u);
+  EXPECT_EQ(literal_uniform_locations("  glUniform1i(\n            66, (baked ? 1 : 0) | 2);").size(), 1u);
+  EXPECT_EQ(literal_uniform_locations("glUniform2f(2, low, std::clamp(h, low, 1.0f));\nglUniform1f( 4 , c);").size(),
+            2u);
+  EXPECT_EQ(literal_uniform_locations("glProgramUniform1ui(program.id(), 3, items);").size(), 1u);
+  EXPECT_EQ(literal_uniform_locations("glProgramUniform1ui(id(f(1, 2)), 0x10u, items);").size(), 1u);
+  // What it must let through: named locations, looked-up ones, literal values.
+  EXPECT_TRUE(literal_uniform_locations("glUniform1i(u.lobe_terms, 0);").empty());
+  EXPECT_TRUE(literal_uniform_locations("glUniformMatrix4fv(at(\"u_model\"), 1, GL_FALSE, m);").empty());
+  EXPECT_TRUE(
+      literal_uniform_locations("glProgramUniform1ui(p.id(), glGetUniformLocation(p.id(), \"u_bins\"), 8);").empty());
+  EXPECT_TRUE(literal_uniform_locations("glUniformBlockBinding(program, 0, 1);").empty());
+}
 
-  TEST(Architecture, NoUniformIsSetByALiteralLocation) {
-    std::size_t files = 0;
-    for (const char* top : {"engine", "gi"}) {
-      for (const auto& e : fs::recursive_directory_iterator(fs::path(GI_SOURCE_DIR) / top)) {
-        if (!e.is_regular_file() || !is_source(e.path())) continue;
-        ++files;
-        std::ifstream in(e.path());
-        const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-        for (const std::string& call : literal_uniform_locations(text))
-          ADD_FAILURE() << fs::relative(e.path(), GI_SOURCE_DIR).string() << " " << call
-                        << ": a literal uniform location; use a uniform block or a location looked up by name once "
-                           "per link (engine/src/render/program_uniforms.h)";
-      }
+TEST(Architecture, NoUniformIsSetByALiteralLocation) {
+  std::size_t files = 0;
+  for (const char* top : {"engine", "gi"}) {
+    for (const auto& e : fs::recursive_directory_iterator(fs::path(GI_SOURCE_DIR) / top)) {
+      if (!e.is_regular_file() || !is_source(e.path())) continue;
+      ++files;
+      std::ifstream in(e.path());
+      const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+      for (const std::string& call : literal_uniform_locations(text))
+        ADD_FAILURE() << fs::relative(e.path(), GI_SOURCE_DIR).string() << " " << call
+                      << ": a literal uniform location; use a uniform block or a location looked up by name once "
+                         "per link (engine/src/render/program_uniforms.h)";
     }
-    EXPECT_GT(files, 100u) << "the scan found almost no sources under engine/ and gi/";
   }
+  EXPECT_GT(files, 100u) << "the scan found almost no sources under engine/ and gi/";
+}
 
 }  // namespace
 

@@ -129,8 +129,8 @@ engine::Result<std::unique_ptr<PrmProbeLight>> light_world_probes(MethodLoad& lo
   const float spacing = load.settings.probe_spacing_m;
   if (load.atlas_bake && world.caster) {
     const auto t0 = std::chrono::steady_clock::now();
-    auto probes = bake_world_probes(*world.caster, load.atlas_bake->vpls, load.atlas_bake->vpl_power,
-                                    {.spacing_m = spacing});
+    auto probes =
+        bake_world_probes(*world.caster, load.atlas_bake->vpls, load.atlas_bake->vpl_power, {.spacing_m = spacing});
     if (!probes) return probes.error();
     world.probes.emplace(std::move(probes).value());
     load.stats.load_probe_ms = static_cast<std::size_t>(ms_since(t0));
@@ -170,10 +170,10 @@ engine::Result<std::unique_ptr<MethodRuntime>> load_brf_method(MethodLoad& load)
   const std::size_t receivers = world.receiver_texels.size();
   const std::size_t probe_count = world.probes ? world.probes->probe_count() : 0;
   const GISystemSettings& settings = load.settings;
-  auto brf = BrfLighting::create(
-      std::move(models->models), std::move(models->bindings), load.scene.registry, std::move(world),
-      {.update = {.bounces = settings.brf_bounces, .cull_threshold = settings.brf_cull_threshold},
-       .log = settings.log});
+  auto brf =
+      BrfLighting::create(std::move(models->models), std::move(models->bindings), load.scene.registry, std::move(world),
+                          {.update = {.bounces = settings.brf_bounces, .cull_threshold = settings.brf_cull_threshold},
+                           .log = settings.log});
   if (!brf) return brf.error();
   const auto& st = brf.value()->stats();
   load.stats.dynamic_objects = st.instances;
@@ -181,8 +181,7 @@ engine::Result<std::unique_ptr<MethodRuntime>> load_brf_method(MethodLoad& load)
   load.stats.brf_field_bytes = st.field_bytes;
   load.text << "BRF: " << st.instances << " dynamic objects (" << st.vertices << " vertices, "
             << static_cast<double>(st.field_bytes) / 1e6 << " MB of basis + fields), " << settings.brf_bounces
-            << " bounces; world light from " << probe_count << " probes; bounce onto " << receivers
-            << " atlas texels";
+            << " bounces; world light from " << probe_count << " probes; bounce onto " << receivers << " atlas texels";
   if (!glossy.empty()) {
     load.text << "; glossy:";
     for (std::size_t i = 0; i < glossy.size(); ++i) load.text << (i ? ", " : " ") << glossy[i];

@@ -43,12 +43,12 @@ engine::Result<std::unique_ptr<MethodRuntime>> load_prm_method(MethodLoad& load)
             << ", relit when a moving light changes\n";
   auto caster = load.static_world();
   if (!caster) return caster.error();
-  auto lighting = PrmLighting::from_bake(std::move(p).value(), load.atlas_bake ? &*load.atlas_bake : nullptr,
-                                         load.scene,
-                                         {.active_clusters = load.settings.prm_active_clusters,
-                                          .log = load.settings.log,
-                                          .shared_exponent_panes = load.settings.prm_shared_exponent_panes},
-                                         std::move(caster).value());
+  auto lighting =
+      PrmLighting::from_bake(std::move(p).value(), load.atlas_bake ? &*load.atlas_bake : nullptr, load.scene,
+                             {.active_clusters = load.settings.prm_active_clusters,
+                              .log = load.settings.log,
+                              .shared_exponent_panes = load.settings.prm_shared_exponent_panes},
+                             std::move(caster).value());
   if (!lighting) return lighting.error();
   if (load.layout == nullptr) {
     load.layout = &lighting.value()->layout();
