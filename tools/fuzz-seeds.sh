@@ -40,13 +40,13 @@ json.dump(g, open(out + "cb_deform.gltf", "w"))
 PY
 cp assets/cornell_box.bin "$tmp/"
 
-"$bake" --scene assets/cornell_box.gltf --preset preview --methods atlas,prm --density 2 --vpls 16 --samples 2 \
+"$bake" --scene assets/cornell_box.gltf --preset preview --methods light_atlas,prm --density 2 --vpls 16 --samples 2 \
   --threads 1 --out "$tmp/atlas_prm.gibake" >/dev/null
 "$bake" --scene assets/crates_room.gltf --preset preview --methods brf --brf-basis 2 --brf-spheres 1 \
   --threads 1 --out "$tmp/brf.gibake" >/dev/null
 "$bake" --scene "$tmp/cb_deform.gltf" --preset preview --methods antiradiance,dlm --density 2 --dlm-directions 8 \
   --dlm-photons 2000 --threads 1 --out "$tmp/ar_dlm.gibake" >/dev/null
-"$bake" --scene assets/cornell_box.gltf --preset preview --methods atlas,dlm --density 3 --vpls 64 --dlm-directions 8 \
+"$bake" --scene assets/cornell_box.gltf --preset preview --methods light_atlas,dlm --density 3 --vpls 64 --dlm-directions 8 \
   --dlm-photons 2000 --threads 1 --out "$tmp/no_dlm_texels.gibake" >/dev/null
 
 rm -rf "$corpus"

@@ -102,10 +102,10 @@ TEST(BakeApi, BakesTheDemoLevelFromPlainDataAndTheRuntimeAcceptsIt) {
                                 return true;
                               },
                           .log = [&](gi::LogLevel, std::string_view) { ++log_lines; }};
-  auto report = gi::bake_bundle(input, dir, {.preset = "preview", .methods = {"atlas"}}, host);
+  auto report = gi::bake_bundle(input, dir, {.preset = "preview", .methods = {"light_atlas"}}, host);
   ASSERT_TRUE(report) << report.error().to_string();
   ASSERT_EQ(report->baked.size(), 1u);
-  EXPECT_EQ(report->baked[0].method, "atlas");
+  EXPECT_EQ(report->baked[0].method, "light_atlas");
   EXPECT_GT(report->baked[0].bytes, 0u);
   EXPECT_EQ(stages, std::vector<std::string>{"light atlas"});
   EXPECT_TRUE(monotonic);
@@ -125,7 +125,7 @@ TEST(BakeApi, ABakeCancelledByItsHostWritesNothing) {
   ASSERT_TRUE(asset) << asset.error().to_string();
   const fs::path dir = fresh_dir("cancelled.gibake");
   int calls = 0;
-  auto report = gi::bake_bundle(pipeline_input(*asset), dir, {.preset = "preview", .methods = {"atlas"}},
+  auto report = gi::bake_bundle(pipeline_input(*asset), dir, {.preset = "preview", .methods = {"light_atlas"}},
                                 {.progress = [&](std::string_view, double) { return ++calls < 3; }});
   ASSERT_FALSE(report);
   EXPECT_EQ(report.error().kind, engine::ErrorKind::Cancelled) << report.error().to_string();
@@ -140,7 +140,7 @@ TEST(BakeApi, ACancelledRebakeLeavesTheWorkingBundleIntact) {
   ASSERT_TRUE(asset) << asset.error().to_string();
   const gi::BakeInput input = pipeline_input(*asset);
   const fs::path dir = fresh_dir("rebaked.gibake");
-  ASSERT_TRUE(gi::bake_bundle(input, dir, {.preset = "preview", .methods = {"atlas"}}));
+  ASSERT_TRUE(gi::bake_bundle(input, dir, {.preset = "preview", .methods = {"light_atlas"}}));
   const auto snapshot = [&] {
     std::vector<std::pair<std::string, std::string>> files;
     for (const auto& e : fs::directory_iterator(dir)) {
@@ -153,7 +153,7 @@ TEST(BakeApi, ACancelledRebakeLeavesTheWorkingBundleIntact) {
   const auto before = snapshot();
   int calls = 0;
   auto report = gi::bake_bundle(
-      input, dir, {.preset = "medium", .methods = {"atlas", "prm"}},
+      input, dir, {.preset = "medium", .methods = {"light_atlas", "prm"}},
       {.progress = [&](std::string_view stage, double) { return stage == "light atlas" || ++calls < 5; }});
   ASSERT_FALSE(report);
   EXPECT_EQ(report.error().kind, engine::ErrorKind::Cancelled);
@@ -199,9 +199,9 @@ TEST(BakeApi, ASecondBakeOfTheSameBundleIsRefusedWhileOneRuns) {
   const fs::path dir = fresh_dir("locked.gibake");
   std::string second_error;
   auto first = gi::bake_bundle(
-      input, dir, {.preset = "preview", .methods = {"atlas"}}, {.progress = [&](std::string_view, double) {
+      input, dir, {.preset = "preview", .methods = {"light_atlas"}}, {.progress = [&](std::string_view, double) {
         if (second_error.empty()) {
-          auto second = gi::bake_bundle(input, dir, {.preset = "preview", .methods = {"atlas"}});
+          auto second = gi::bake_bundle(input, dir, {.preset = "preview", .methods = {"light_atlas"}});
           second_error = second ? "the second bake ran" : second.error().to_string();
         }
         return true;
@@ -209,7 +209,7 @@ TEST(BakeApi, ASecondBakeOfTheSameBundleIsRefusedWhileOneRuns) {
   ASSERT_TRUE(first) << first.error().to_string();
   EXPECT_NE(second_error.find("another bake of this bundle is running"), std::string::npos) << second_error;
   // Released with the first: a third bake runs.
-  EXPECT_TRUE(gi::bake_bundle(input, dir, {.preset = "preview", .methods = {"atlas"}}));
+  EXPECT_TRUE(gi::bake_bundle(input, dir, {.preset = "preview", .methods = {"light_atlas"}}));
 }
 
 // bake_input_from(asset) resolves every node's parent chain once: world matrices equal the
@@ -265,7 +265,7 @@ TEST(BakeApi, ABundleBakedWithOtherTexturesIsStale) {
   ASSERT_TRUE(gi::validate_bake_input(input)) << gi::validate_bake_input(input).error().to_string();
 
   const fs::path dir = fresh_dir("textured_demo_level.gibake");
-  auto report = gi::bake_bundle(input, dir, {.preset = "preview", .methods = {"atlas"}});
+  auto report = gi::bake_bundle(input, dir, {.preset = "preview", .methods = {"light_atlas"}});
   ASSERT_TRUE(report) << report.error().to_string();
 
   engine::Scene same = engine::instantiate(engine::SceneAsset(asset));

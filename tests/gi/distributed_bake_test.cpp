@@ -34,7 +34,7 @@ std::map<std::string, std::vector<char>> bundle_files(const fs::path& dir) {
 // The Cornell box's light atlas and PRM at the preview preset, at a density giving ~1000
 // texels (16 blocks of 64: seven shards all get work, some three blocks).
 gi::BakeOptions small_options() {
-  return {.preset = "preview", .methods = {"atlas", "prm"}, .texels_per_metre = 20.0f, .threads = 2, .seed = 5};
+  return {.preset = "preview", .methods = {"light_atlas", "prm"}, .texels_per_metre = 20.0f, .threads = 2, .seed = 5};
 }
 
 class DistributedBake : public ::testing::Test {
@@ -253,7 +253,7 @@ TEST_F(DistributedBake, AntiradianceMergedBundleIsByteIdenticalForOneTwoAndSeven
   const fs::path mixed = root_ / "mixed.gibake";
   bake_shards(mixed, 2, options);
   gi::BakeOptions atlas_only = small_options();
-  atlas_only.methods = {"atlas"};
+  atlas_only.methods = {"light_atlas"};
   atlas_only.seed = 5;
   atlas_only.shard_index = 1;
   atlas_only.shard_count = 2;

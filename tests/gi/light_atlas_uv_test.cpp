@@ -39,7 +39,8 @@ TEST(LightAtlasUv, ExportedFileHasTheUv1TheRuntimeGivesTheStaticMeshes) {
   // What the runtime does with a bundle baked from the original scene.
   const fs::path bundle = kOut / "crates_room.gibake";
   fs::remove_all(bundle);
-  auto baked = gi::bake_bundle(gi::bake_input_from(original), bundle, {.preset = "preview", .methods = {"atlas"}});
+  auto baked =
+      gi::bake_bundle(gi::bake_input_from(original), bundle, {.preset = "preview", .methods = {"light_atlas"}});
   ASSERT_TRUE(baked) << baked.error().to_string();
   engine::Scene runtime = engine::instantiate(original);
   auto system = gi::GISystem::load(bundle, runtime);

@@ -41,7 +41,7 @@ TEST(OutdoorScene, TheSkyAloneMakesThePlannerPlanTheLightAtlas) {
   const gi::PlannedEffect& atlas = lit.effect(gi::EffectMethod::LightAtlas);
   EXPECT_TRUE(atlas.enabled) << atlas.reason;
   EXPECT_NE(atlas.reason.find("the sky lights"), std::string::npos) << atlas.reason;
-  EXPECT_EQ(lit.methods_to_bake(), std::vector<std::string>{"atlas"});
+  EXPECT_EQ(lit.methods_to_bake(), std::vector<std::string>{"light_atlas"});
 }
 
 TEST(OutdoorScene, AvocadoUnderASkyIsBakedLoadedAndRenderedHeadless) {
@@ -75,7 +75,7 @@ TEST(OutdoorScene, AvocadoUnderASkyIsBakedLoadedAndRenderedHeadless) {
   auto baked = gi::bake_bundle(gi::bake_input_from(a), bundle, {.preset = "preview"});
   ASSERT_TRUE(baked) << baked.error().to_string();
   ASSERT_EQ(baked->baked.size(), 1u);
-  EXPECT_EQ(baked->baked[0].method, "atlas");
+  EXPECT_EQ(baked->baked[0].method, "light_atlas");
 
   engine::Scene scene = engine::instantiate(a);
   auto gpu = engine::GpuContext::create_headless();
@@ -128,7 +128,7 @@ TEST(OutdoorScene, KhronosLampWithItsOwnLightsIsBakedLoadedAndRenderedHeadless) 
   ASSERT_FALSE(a.lights.empty());
   const gi::EffectPlan p = gi::plan(gi::bake_input_from(a), {.preset = "preview"});
   ASSERT_TRUE(p.effect(gi::EffectMethod::LightAtlas).enabled) << p.effect(gi::EffectMethod::LightAtlas).reason;
-  EXPECT_EQ(p.methods_to_bake(), std::vector<std::string>{"atlas"});
+  EXPECT_EQ(p.methods_to_bake(), std::vector<std::string>{"light_atlas"});
   a.cameras.push_back({"camera", engine::Camera{}});
   engine::Node cam;
   cam.name = "camera";

@@ -163,8 +163,8 @@ TEST(Tools, CtrlCCancelsABakeAndLeavesNoBundle) {
   fs::remove_all(out);
   // The high preset takes tens of seconds; the interrupt comes as soon as the bar shows.
   const ToolRun r = run(GI_BAKE_EXE,
-                        {"--scene", GI_SOURCE_DIR "/assets/cornell_box.gltf", "--methods", "atlas", "--preset", "high",
-                         "--threads", "2", "--out", out.string()},
+                        {"--scene", GI_SOURCE_DIR "/assets/cornell_box.gltf", "--methods", "light_atlas", "--preset",
+                         "high", "--threads", "2", "--out", out.string()},
                         20.0, "light atlas [");
   EXPECT_EQ(r.exit_code, 130) << r.output;
   EXPECT_NE(r.output.find("cancel"), std::string::npos) << r.output;
@@ -192,14 +192,14 @@ TEST(GiBake, SkyMakesASceneWithoutLightsBakeable) {
   const ToolRun plan = run(GI_BAKE_EXE, {"--plan", avocado.string(), "--preset", "preview", "--sky", "1,1,1"});
   EXPECT_EQ(plan.exit_code, 0) << plan.output;
   EXPECT_NE(plan.output.find("the sky lights"), std::string::npos) << plan.output;
-  EXPECT_NE(plan.output.find("bake: atlas"), std::string::npos) << plan.output;
+  EXPECT_NE(plan.output.find("bake: light_atlas"), std::string::npos) << plan.output;
 
   const fs::path out = fs::path(GI_BINARY_DIR) / "test_output" / "tools_test" / "avocado_sky.gibake";
   fs::remove_all(out);
   const ToolRun bake = run(
       GI_BAKE_EXE, {"--scene", avocado.string(), "--preset", "preview", "--sky", "0.8,0.9,1.0", "--out", out.string()});
   EXPECT_EQ(bake.exit_code, 0) << bake.output;
-  EXPECT_NE(bake.output.find("gi-bake: atlas:"), std::string::npos) << bake.output;
+  EXPECT_NE(bake.output.find("gi-bake: light_atlas:"), std::string::npos) << bake.output;
   EXPECT_TRUE(fs::exists(out / "manifest.json")) << bake.output;
 }
 
@@ -288,10 +288,10 @@ TEST(GiBake, AKilledRebakeLeavesTheOldBundleOrTheNewOneNeverAMix) {
   fs::create_directories(root);
   const fs::path dir = root / "cornell.gibake";
   const std::string scene = GI_SOURCE_DIR "/assets/cornell_box.gltf";
-  const std::vector<std::string> old_bake{"--scene",   scene,       "--preset", "preview", "--methods",
-                                          "atlas,prm", "--threads", "2",        "--out",   dir.string()};
-  const std::vector<std::string> new_bake{"--scene",   scene,       "--preset", "medium", "--methods",
-                                          "atlas,prm", "--threads", "2",        "--out",  dir.string()};
+  const std::vector<std::string> old_bake{"--scene",         scene,       "--preset", "preview", "--methods",
+                                          "light_atlas,prm", "--threads", "2",        "--out",   dir.string()};
+  const std::vector<std::string> new_bake{"--scene",         scene,       "--preset", "medium", "--methods",
+                                          "light_atlas,prm", "--threads", "2",        "--out",  dir.string()};
   // The new bundle, baked once without interruption (to know its bytes), then the old one.
   ASSERT_EQ(run(GI_BAKE_EXE, new_bake).exit_code, 0);
   const auto new_files = bundle_bytes(dir);
@@ -348,9 +348,10 @@ TEST(GiBake, ShardAndMergeGiveTheOneProcessBundle) {
   std::error_code ec;
   fs::remove_all(root, ec);
   fs::create_directories(root);
-  const std::vector<std::string> common{
-      "--scene", GI_SOURCE_DIR "/assets/cornell_box.gltf", "--preset", "preview", "--methods", "atlas,prm", "--density",
-      "12"};
+  const std::vector<std::string> common{"--scene",   GI_SOURCE_DIR "/assets/cornell_box.gltf",
+                                        "--preset",  "preview",
+                                        "--methods", "light_atlas,prm",
+                                        "--density", "12"};
   const auto with = [&](const fs::path& out, std::vector<std::string> extra) {
     std::vector<std::string> a = common;
     a.push_back("--out");

@@ -1,5 +1,5 @@
 // gi-bake: bakes the GI data of a scene into a bake bundle (gi::bake_bundle, gi/bake.h).
-//   gi-bake --scene assets/cornell_box.gltf --methods atlas --preset high --out out/cornell_box.gibake
+//   gi-bake --scene assets/cornell_box.gltf --methods light_atlas --preset high --out out/cornell_box.gibake
 //   gi-bake --plan assets/demo_level.gltf --preset preview    # print the effect plan, bake nothing
 //   gi-bake --scene level.gltf --preset medium --export-uv1 out/level_uv1.gltf   # the lightmap UVs
 //   gi-bake --scene Avocado.glb --sky 0.8,0.9,1.0 --out out/avocado.gibake      # lit by a uniform sky
@@ -64,7 +64,7 @@ int main(int argc, char** argv) {
   app.add_option("--out", out_dir, "Bundle directory (default: out/<scene>.gibake)");
   app.add_option(
       "--methods", methods,
-      "Comma-separated methods to bake: atlas, prm, dlm, brf, antiradiance (default: what the plan calls for)");
+      "Comma-separated methods to bake: light_atlas, prm, dlm, brf, antiradiance (default: what the plan calls for)");
   app.add_option("--preset", o.preset, "Quality preset: preview, medium, high (docs/sweeps/README.md)");
   app.add_option("--vpls", o.vpls, "Override the preset's VPL count")->check(CLI::PositiveNumber);
   app.add_option("--bounces", o.bounces, "Override the preset's indirect bounces")->check(CLI::Range(1, 64));

@@ -118,7 +118,7 @@ say "Slurm up on $node ($cpus CPUs) in $(($(date +%s) - start_time)) s"
 
 # The bake both ways.
 scene=$repo/assets/cornell_box.gltf
-opts=(--preset preview --methods atlas,prm --density 10 --seed 3)
+opts=(--preset preview --methods light_atlas,prm --density 10 --seed 3)
 "$gi_bake" --scene "$scene" --out "$work/local.gibake" "${opts[@]}" > "$work/local-bake.log" 2>&1 ||
   die "the local bake failed"
 jobs=$(bash "$repo/tools/slurm/submit.sh" --shards "$shards" --gi-bake "$gi_bake" --scene "$scene" \

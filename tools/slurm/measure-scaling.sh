@@ -6,7 +6,7 @@
 # shared machine disturbs far less than wall time (the wall time of the whole run is
 # printed too). Prints a Markdown table; a node per shard would take max(shard) + merge.
 #   bash tools/slurm/measure-scaling.sh [BUILD_DIR] [SCENE] [PRESET] [SHARD COUNTS...]
-#   GI_BAKE_OPTS="--methods atlas,prm" bash tools/slurm/measure-scaling.sh   # more gi-bake options
+#   GI_BAKE_OPTS="--methods light_atlas,prm" bash tools/slurm/measure-scaling.sh   # more gi-bake options
 set -euo pipefail
 repo=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
 build=$(cd "${1:-$repo/build}" && pwd)

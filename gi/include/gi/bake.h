@@ -9,9 +9,9 @@
 //                                 {.progress = draw_bar, .log = print_line});
 //   if (!report) std::cerr << report.error().to_string() << '\n';   // kind: Invalid, Cancelled, Failure
 //
-// Methods (gi::effect_key): "atlas" (light atlas, static lights), "prm" (precomputed
+// Methods (gi::effect_key, gi/methods.h): "light_atlas" (light atlas, static lights), "prm" (precomputed
 // radiance maps, moving lights), "brf" (basis radiance fields, one per distinct dynamic
-// mesh), "dlm" (directional light maps of the glossy static surfaces, docs/dlm.md). "atlas",
+// mesh), "dlm" (directional light maps of the glossy static surfaces, docs/dlm.md). "light_atlas",
 // "prm" and "dlm" share one uv1 layout (the preset's atlas density). Methods the
 // plan calls for that this build cannot bake ("antiradiance") are reported as
 // skipped, never silently dropped. Byte-identical files for any thread count and run (but
@@ -82,7 +82,7 @@ inline constexpr const char* kBakeStatsFileName = "bake_stats.json";
 
 /// One method written into the bundle.
 struct BakedMethod {
-  std::string method;       ///< "atlas", "prm", "dlm" or "brf".
+  std::string method;       ///< Its key: "light_atlas", "prm", "dlm", "brf" or "antiradiance".
   double seconds = 0.0;     ///< Wall time of its bake and save.
   std::uint64_t bytes = 0;  ///< Size of the files it wrote.
 };

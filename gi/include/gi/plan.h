@@ -7,7 +7,7 @@
 //
 // Rules (docs/plan.md):
 //   - no light (no enabled light, no emissive static surface) -> nothing;
-//   - static lights (or emissive static surfaces) and static meshes -> light atlas ("atlas");
+//   - static lights (or emissive static surfaces) and static meshes -> light atlas ("light_atlas");
 //   - a light moves (Light::moves / glTF gi.light_moves, a light on or under a dynamic node,
 //     or named in PlanOptions::moving_lights) and static meshes -> PRM ("prm");
 //   - a static surface with roughness below PlanOptions::glossy_roughness -> directional
@@ -31,7 +31,7 @@
 
 namespace gi {
 
-/// The method's key as gi-bake --methods and the manifest spell it: "atlas", "prm", "dlm",
+/// The method's key (gi/methods.h) as gi-bake --methods and the manifest spell it: "light_atlas", "prm", "dlm",
 /// "antiradiance", "brf".
 std::string_view effect_key(EffectMethod method);
 /// The method whose key is `key`, or nullopt.

@@ -171,8 +171,8 @@ engine::Status bake_dlm_method(const BakeInput& input, const fs::path& dir, cons
   return save_dlm(dir, *dlm, input);
 }
 
-// The manifest's method entry name of a plan key.
-std::string manifest_key(const std::string& key) { return key == "atlas" ? "light_atlas" : key; }
+// A method's one key (gi/methods.h): gi-bake --methods, the plan, the manifest.
+std::string key_of(EffectMethod m) { return std::string(method_descriptor(m).key); }
 
 // The methods a bake bakes, in order: options.methods, or what the plan calls for and this
 // build can bake (the rest in report.skipped); a sky-lit PRM brings the atlas with it.
@@ -195,17 +195,20 @@ engine::Result<std::vector<std::string>> methods_to_bake(const BakeInput& input,
   }
   for (const std::string& key : methods)
     if (std::find(bakeable.begin(), bakeable.end(), key) == bakeable.end())
-      return engine::invalid_request(
-          "method '" + key + "' is not available in this build (available: atlas, prm, dlm, brf, antiradiance)");
+      return engine::invalid_request("method '" + key + "' is not available in this build (available: " + [&] {
+        std::string list;
+        for (const std::string& b : bakeable) list += (list.empty() ? "" : ", ") + b;
+        return list;
+      }() + ")");
 
   // The sky in a PRM bake (docs/prm.md "The sky"): the sky is a static source, so its light
   // lives in the light atlas the PRM provider composes with (the atlas's final gather
   // resolves it per texel, the PRM's entry points only per cluster and compete for the K
   // active panes). A PRM asked for alone on a sky-lit scene bakes that atlas too, first.
   if (engine::sky_lit(input.environment.sky_radiance, input.environment.sky_gradient) &&
-      std::find(methods.begin(), methods.end(), "prm") != methods.end() &&
-      std::find(methods.begin(), methods.end(), "atlas") == methods.end()) {
-    methods.insert(methods.begin(), "atlas");
+      std::find(methods.begin(), methods.end(), key_of(EffectMethod::Prm)) != methods.end() &&
+      std::find(methods.begin(), methods.end(), key_of(EffectMethod::LightAtlas)) == methods.end()) {
+    methods.insert(methods.begin(), key_of(EffectMethod::LightAtlas));
     if (host.log)
       host.log(LogLevel::Info, "baking the light atlas too: it carries the sky the PRM composes with (docs/prm.md)");
   }
@@ -214,7 +217,11 @@ engine::Result<std::vector<std::string>> methods_to_bake(const BakeInput& input,
 
 }  // namespace
 
-std::vector<std::string> bakeable_methods() { return {"atlas", "prm", "dlm", "brf", "antiradiance"}; }
+std::vector<std::string> bakeable_methods() {
+  // Every method, in the order a bake runs them (the PRM and antiradiance after the light atlas).
+  return {key_of(EffectMethod::LightAtlas), key_of(EffectMethod::Prm), key_of(EffectMethod::DirectionalLightMaps),
+          key_of(EffectMethod::BasisRadianceFields), key_of(EffectMethod::Antiradiance)};
+}
 
 engine::Result<BakeReport> bake_bundle(const BakeInput& input, const fs::path& bundle_dir, const BakeOptions& options,
                                        const BakeHost& host) {
@@ -253,15 +260,17 @@ engine::Result<BakeReport> bake_bundle(const BakeInput& input, const fs::path& b
     const auto start = Clock::now();
     Timings timings = nlohmann::json::object();
     const MergedParts* parts = merged ? &*merged : nullptr;
-    engine::Status done = key == "atlas" ? bake_atlas(input, dir, options, {host, "light atlas"}, timings, parts)
-                          : key == "prm" ? bake_prm_method(input, dir, options, {host, "PRM"}, timings, parts)
-                          : key == "dlm" ? bake_dlm_method(input, dir, options, {host, "DLM"}, timings)
-                          : key == "antiradiance"
-                              ? bake_antiradiance_method(input, dir, options, {host, "antiradiance"}, timings, parts)
-                              : bake_brf_method(input, dir, options, host, timings);
+    const EffectMethod m = *method_from_key(key);  // methods_to_bake checked every key
+    const std::string name(effect_name(m));
+    engine::Status done =
+        m == EffectMethod::LightAtlas             ? bake_atlas(input, dir, options, {host, name}, timings, parts)
+        : m == EffectMethod::Prm                  ? bake_prm_method(input, dir, options, {host, name}, timings, parts)
+        : m == EffectMethod::DirectionalLightMaps ? bake_dlm_method(input, dir, options, {host, name}, timings)
+        : m == EffectMethod::Antiradiance ? bake_antiradiance_method(input, dir, options, {host, name}, timings, parts)
+                                          : bake_brf_method(input, dir, options, host, timings);
     if (!done) return done.error();
-    report.baked.push_back({key, seconds_since(start), method_bytes(dir, manifest_key(key))});
-    method_stats[manifest_key(key)] = {{"seconds", report.baked.back().seconds}, {"stages", timings}};
+    report.baked.push_back({key, seconds_since(start), method_bytes(dir, key)});
+    method_stats[key] = {{"seconds", report.baked.back().seconds}, {"stages", timings}};
   }
   if (auto ok = update_manifest_plan(dir, scene_geometry_hash(input), scene_file_name(input),
                                      plan_to_json_value(report.plan));

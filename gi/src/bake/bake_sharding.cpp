@@ -1,5 +1,8 @@
 #include "bake/bake_sharding.h"
 
+#include <gi/methods.h>
+#include <gi/plan.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -23,8 +26,9 @@ namespace {
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
-bool has_method(const std::vector<std::string>& methods, const char* key) {
-  return std::find(methods.begin(), methods.end(), key) != methods.end();
+// Whether `methods` holds `m`'s key (gi/methods.h).
+bool has_key(const std::vector<std::string>& methods, EffectMethod m) {
+  return std::find(methods.begin(), methods.end(), method_descriptor(m).key) != methods.end();
 }
 
 ShardFile shard_header(const BakeInput& input, const BakeOptions& options, const std::vector<std::string>& methods,
@@ -50,7 +54,7 @@ engine::Status shard_atlas(const BakeInput& input, const BakeOptions& options, c
   if (!part) return part.error();
   stage.log(format_line("light atlas shard %u/%u: %zu texels gathered, %.2f s", shard.index, shard.count,
                         part->texels.size(), seconds_since(start)));
-  report.baked.push_back({"atlas", seconds_since(start), 0});
+  report.baked.push_back({std::string(effect_key(EffectMethod::LightAtlas)), seconds_since(start), 0});
   file.atlas = std::move(part).value();
   return {};
 }
@@ -65,7 +69,7 @@ engine::Status shard_prm(const BakeInput& input, const BakeOptions& options, con
   if (!part) return part.error();
   stage.log(format_line("PRM shard %u/%u: %zu texels x %d clusters, %.2f s", shard.index, shard.count,
                         part->texels.size(), part->cluster_count, seconds_since(start)));
-  report.baked.push_back({"prm", seconds_since(start), 0});
+  report.baked.push_back({std::string(effect_key(EffectMethod::Prm)), seconds_since(start), 0});
   file.prm = std::move(part).value();
   return {};
 }
@@ -81,7 +85,7 @@ engine::Status shard_antiradiance(const BakeInput& input, const fs::path& bundle
   if (!frame) return frame.error();
   stage.log(format_line("antiradiance shard %u/%u: links of %zu elements, %zu links, %.2f s", shard.index, shard.count,
                         links->relinked_elements, links->links.size(), seconds_since(start)));
-  report.baked.push_back({"antiradiance", seconds_since(start), 0});
+  report.baked.push_back({std::string(effect_key(EffectMethod::Antiradiance)), seconds_since(start), 0});
   file.antiradiance = AntiradianceShardPart{.links = links->links.size(), .frame = std::move(frame).value()};
   return {};
 }
@@ -106,9 +110,9 @@ engine::Status check_shard(const fs::path& path, const ShardFile& file, const Sh
     return foreign("baked with other settings (settings hash " + file.settings_hash + " seed " +
                    std::to_string(file.seed) + ", this merge's " + expected.settings_hash + " seed " +
                    std::to_string(expected.seed) + ")");
-  if (file.methods != expected.methods || file.atlas.has_value() != has_method(methods, "atlas") ||
-      file.prm.has_value() != has_method(methods, "prm") ||
-      file.antiradiance.has_value() != has_method(methods, "antiradiance"))
+  if (file.methods != expected.methods || file.atlas.has_value() != has_key(methods, EffectMethod::LightAtlas) ||
+      file.prm.has_value() != has_key(methods, EffectMethod::Prm) ||
+      file.antiradiance.has_value() != has_key(methods, EffectMethod::Antiradiance))
     return foreign("its methods differ from this merge's");
   return {};
 }
@@ -137,14 +141,15 @@ engine::Result<BakeReport> bake_shard(const BakeInput& input, const fs::path& bu
   ShardFile file = shard_header(input, options, methods, index, count);
   const WorkShard shard{.index = index, .count = count};
   const BakeStage log{host, "shard"};
-  if (has_method(methods, "atlas"))
+  if (has_key(methods, EffectMethod::LightAtlas))
     if (auto ok = shard_atlas(input, options, host, shard, file, report); !ok) return ok.error();
-  if (has_method(methods, "prm"))
+  if (has_key(methods, EffectMethod::Prm))
     if (auto ok = shard_prm(input, options, host, shard, file, report); !ok) return ok.error();
-  if (has_method(methods, "antiradiance"))
+  if (has_key(methods, EffectMethod::Antiradiance))
     if (auto ok = shard_antiradiance(input, bundle_dir, options, host, shard, file, report); !ok) return ok.error();
   for (const std::string& m : methods)
-    if (m != "atlas" && m != "prm" && m != "antiradiance")
+    if (const auto k = method_from_key(m);
+        k != EffectMethod::LightAtlas && k != EffectMethod::Prm && k != EffectMethod::Antiradiance)
       log.log(m + ": not sharded, baked by the merge (docs/distributed-bake.md)");
   const fs::path dir = shard_directory(bundle_dir);
   std::error_code ec;

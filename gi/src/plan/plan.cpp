@@ -16,7 +16,6 @@ namespace gi {
 
 namespace {
 
-constexpr std::string_view kKeys[kEffectMethodCount] = {"atlas", "prm", "dlm", "antiradiance", "brf"};
 // What this build can bake (gi-bake --methods): every method.
 constexpr bool kAvailable[kEffectMethodCount] = {true, true, true, true, true};
 
@@ -352,13 +351,9 @@ std::string estimate_line(double seconds, std::uint64_t bytes) {
 
 }  // namespace
 
-std::string_view effect_key(EffectMethod method) { return kKeys[static_cast<int>(method)]; }
+std::string_view effect_key(EffectMethod method) { return method_descriptor(method).key; }
 
-std::optional<EffectMethod> effect_from_key(std::string_view key) {
-  for (int i = 0; i < kEffectMethodCount; ++i)
-    if (kKeys[i] == key) return static_cast<EffectMethod>(i);
-  return std::nullopt;
-}
+std::optional<EffectMethod> effect_from_key(std::string_view key) { return method_from_key(key); }
 
 const PlannedEffect& EffectPlan::effect(EffectMethod method) const {
   for (const PlannedEffect& e : effects)

@@ -73,7 +73,8 @@ engine::Result<EffectPlan> plan_from_json_value(const nlohmann::json& json, cons
     e.estimate.work_units = ef.get<std::uint64_t>("estimate.work_units");
     e.estimate.basis = ef.get<std::string>("estimate.basis");
     if (ef.error()) return *ef.error();
-    const auto method = effect_from_key(key);
+    // "atlas": the light atlas's key in plans stored before the one-name rule (issue 34).
+    const auto method = key == "atlas" ? std::optional(EffectMethod::LightAtlas) : effect_from_key(key);
     if (!method) return engine::Error{file, where + ".method", "unknown method '" + key + "'"};
     e.method = *method;
     if (!ej.contains("targets")) return engine::Error{file, where + ".targets", "missing field"};

@@ -1,5 +1,7 @@
 #include "plan/static_surface_census.h"
 
+#include "core/color.h"
+
 #include <algorithm>
 #include <cmath>
 #include <numeric>
@@ -99,8 +101,6 @@ void add_instance_charts(const std::vector<Triangle>& tris, std::vector<ChartExt
   }
 }
 
-double luminance(const glm::vec3& c) { return 0.2126 * double{c.x} + 0.7152 * double{c.y} + 0.0722 * double{c.z}; }
-
 }  // namespace
 
 StaticSurfaceCensus census_static_surfaces(const BakeInput& input) {
@@ -129,7 +129,7 @@ StaticSurfaceCensus census_static_surfaces(const BakeInput& input) {
         for (int a = 0; a < 3; ++a) key = mix(key, cell(t.normal[a], 1.0 / kNormalCells));
         t.plane = mix(key, cell(glm::dot(t.normal, t.p[0]), kOffsetCell_m));
         census.area_m2 += t.area;
-        albedo_area += luminance(base) * t.area;
+        albedo_area += luminance(double{base.x}, double{base.y}, double{base.z}) * t.area;
         tris.push_back(t);
       }
     }

@@ -1,5 +1,7 @@
 #include "sweep/antiradiance_sweep.h"
 
+#include <gi/methods.h>
+
 #include <GL/glcorearb.h>
 
 #include <engine/gpu/context.h>
@@ -158,7 +160,7 @@ void register_antiradiance_sweep(SweepRegistry& registry) {
       {.kind = "atlas_indirect_irradiance_door", .version = "pt-1", .compute = door_reference});
 
   SweepMethod m;
-  m.name = "antiradiance";
+  m.name = method_descriptor(EffectMethod::Antiradiance).key;  // gi/methods.h
   m.description =
       "antiradiance (Dachsbacher 2007): element size x bins x iterations vs the path-traced change of indirect "
       "irradiance when the deforming node swings -50, -25, +50 degrees from its baked pose";

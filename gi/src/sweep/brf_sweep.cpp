@@ -1,5 +1,7 @@
 #include "sweep/brf_sweep.h"
 
+#include <gi/methods.h>
+
 #include <engine/components.h>
 #include <engine/scene.h>
 #include <gi/reference.h>
@@ -128,7 +130,7 @@ void register_brf_sweep(SweepRegistry& registry) {
        }});
 
   SweepMethod m;
-  m.name = "brf";
+  m.name = method_descriptor(EffectMethod::BasisRadianceFields).key;  // gi/methods.h
   m.description =
       "basis radiance fields (Iwasaki et al.): basis N x SH bands x spheres x face points x lights x bounces, dynamic "
       "objects' vertices";

@@ -1,5 +1,7 @@
 #include "sweep/dlm_sweep.h"
 
+#include <gi/methods.h>
+
 #include "raytrace/material_lookup.h"
 
 #include <engine/directional_radiance.h>
@@ -111,7 +113,7 @@ void register_dlm_sweep(SweepRegistry& registry) {
       {.kind = "atlas_glossy_specular", .version = "pt-1", .compute = glossy_specular_reference});
 
   SweepMethod m;
-  m.name = "dlm";
+  m.name = method_descriptor(EffectMethod::DirectionalLightMaps).key;  // gi/methods.h
   m.description =
       "directional light maps (Hey 2002): directions x photons x density vs the path-traced specular indirect "
       "radiance of the glossy texels towards camera 0";

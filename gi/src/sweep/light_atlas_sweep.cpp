@@ -1,5 +1,7 @@
 #include "sweep/light_atlas_sweep.h"
 
+#include <gi/methods.h>
+
 #include <engine/scene.h>
 
 #include <algorithm>
@@ -10,7 +12,7 @@ namespace gi {
 
 void register_light_atlas_sweep(SweepRegistry& registry) {
   SweepMethod m;
-  m.name = "light_atlas";
+  m.name = method_descriptor(EffectMethod::LightAtlas).key;  // gi/methods.h
   m.description =
       "light atlas (Schärfig 2016): VPL final shooting or texel final gather, VPLs x bounces x rays x texel density vs "
       "path-traced indirect irradiance";

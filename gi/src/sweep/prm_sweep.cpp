@@ -1,5 +1,7 @@
 #include "sweep/prm_sweep.h"
 
+#include <gi/methods.h>
+
 #include <engine/scene.h>
 #include <gi/error_metrics.h>
 #include <gi/reference.h>
@@ -124,7 +126,7 @@ void register_prm_sweep(SweepRegistry& registry) {
        }});
 
   SweepMethod m;
-  m.name = "prm";
+  m.name = method_descriptor(EffectMethod::Prm).key;  // gi/methods.h
   m.description =
       "precomputed radiance maps (Szécsi 2006): entry points x clusters x active K x density x splitting, moving light "
       "at several poses";

@@ -1,7 +1,7 @@
 #pragma once
 // What a GI method and a reference provider give the sweep harness: knobs, the reference a
 // run needs, and a run function returning linear output plus costs.
-//   gi::SweepMethod m{.name = "atlas", .knobs = {texel_density}, .reference_for = ..., .run = bake_and_sample};
+//   gi::SweepMethod m{.name = "light_atlas", .knobs = {texel_density}, .reference_for = ..., .run = bake_and_sample};
 //   registry.add_method(std::move(m));
 
 #include <engine/result.h>

@@ -2,7 +2,7 @@
 // The list of GI methods and reference providers the sweep harness knows. Each method
 // registers itself at start-up (see builtin_methods.h); the harness never names them.
 //   gi::SweepRegistry registry;
-//   gi::register_builtin_sweep_methods(registry);  const gi::SweepMethod* m = registry.find_method("atlas");
+//   gi::register_builtin_sweep_methods(registry);  const gi::SweepMethod* m = registry.find_method("light_atlas");
 
 #include <memory>
 #include <string_view>

@@ -40,7 +40,7 @@ TEST(AntiradianceLighting, TheCorridorDoorChangesTheAtlasOnlyOnFramesItMoves) {
   engine::Scene scene = corridor();
   gi::BakeOptions options;
   options.preset = "preview";
-  options.methods = {"atlas", "antiradiance"};
+  options.methods = {"light_atlas", "antiradiance"};
   auto baked = gi::bake_bundle(gi::bake_input_from(scene), dir, options);
   ASSERT_TRUE(baked) << baked.error().to_string();
 

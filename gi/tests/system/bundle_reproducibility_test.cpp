@@ -46,7 +46,7 @@ engine::Result<gi::BakeReport> bake(const gi::BakeInput& input, const fs::path& 
   fs::remove_all(dir, ec);
   return gi::bake_bundle(input, dir,
                          {.preset = "preview",
-                          .methods = {"atlas", "prm", "dlm", "brf", "antiradiance"},
+                          .methods = {"light_atlas", "prm", "dlm", "brf", "antiradiance"},
                           .texels_per_metre = 4.0f,
                           .brf_basis = 8,
                           .brf_spheres = 4,

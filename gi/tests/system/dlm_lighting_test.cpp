@@ -294,7 +294,7 @@ TEST(DlmLighting, GISystemLoadsTheGlossyRoomsMapsAndRefusesADamagedFile) {
   ASSERT_TRUE(asset) << asset.error().to_string();
   engine::Scene scene = engine::instantiate(std::move(asset).value());
   auto report = gi::bake_bundle(gi::bake_input_from(scene), dir,
-                                {.preset = "preview", .methods = {"atlas", "dlm"}, .dlm_photons = 100'000});
+                                {.preset = "preview", .methods = {"light_atlas", "dlm"}, .dlm_photons = 100'000});
   ASSERT_TRUE(report) << report.error().to_string();
   ASSERT_EQ(report->baked.size(), 2u);
   EXPECT_EQ(report->baked[1].method, "dlm");

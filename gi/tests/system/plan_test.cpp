@@ -53,14 +53,14 @@ TEST(Plan, CornellBoxGetsTheLightAtlasOnly) {
   for (EffectMethod m :
        {EffectMethod::DirectionalLightMaps, EffectMethod::Antiradiance, EffectMethod::BasisRadianceFields})
     EXPECT_FALSE(p.effect(m).enabled) << gi::effect_key(m);
-  EXPECT_EQ(p.methods_to_bake(), std::vector<std::string>{"atlas"});
+  EXPECT_EQ(p.methods_to_bake(), std::vector<std::string>{"light_atlas"});
   EXPECT_TRUE(p.warnings.empty());
 }
 
 TEST(Plan, SpotChamberNeedsPrmOnceItsSpotMoves) {
   engine::Scene scene = load("spot_chamber.gltf");
   // As authored the spot does not move: atlas only.
-  EXPECT_EQ(gi::plan(scene).methods_to_bake(), std::vector<std::string>{"atlas"});
+  EXPECT_EQ(gi::plan(scene).methods_to_bake(), std::vector<std::string>{"light_atlas"});
   // The game scripts it (as the PRM tests and sweeps move it), named in the options...
   gi::EffectPlan scripted = gi::plan(scene, {.moving_lights = {"spot"}});
   EXPECT_TRUE(scripted.effect(EffectMethod::Prm).enabled);
@@ -91,7 +91,7 @@ TEST(Plan, DemoLevelNeedsEveryBuiltMethodIncludingDirectionalLightMaps) {
   EXPECT_TRUE(dlm.available);
   EXPECT_EQ(dlm.targets, std::vector<std::string>{"corridor_floor"});
   EXPECT_EQ(sorted(p.effect(EffectMethod::BasisRadianceFields).targets), sorted({"crate", "crate_red", "lamp_shade"}));
-  EXPECT_EQ(p.methods_to_bake(), (std::vector<std::string>{"atlas", "prm", "dlm", "antiradiance", "brf"}));
+  EXPECT_EQ(p.methods_to_bake(), (std::vector<std::string>{"light_atlas", "prm", "dlm", "antiradiance", "brf"}));
   const std::string text = gi::format_plan(p);
   EXPECT_TRUE(contains(text, "dlm           ON")) << text;
   EXPECT_TRUE(contains(text, "B per texel")) << text;  // the memory per texel, before the bake
@@ -124,7 +124,7 @@ TEST(Plan, GlossyRoomCallsForDirectionalLightMaps) {
   EXPECT_TRUE(contains(dlm.reason, "roughness 0.15 < 0.35")) << dlm.reason;
   EXPECT_GT(dlm.estimate.bake_seconds, 0.0);
   EXPECT_GT(dlm.estimate.runtime_bytes, 0u);
-  EXPECT_EQ(p.methods_to_bake(), (std::vector<std::string>{"atlas", "dlm"}));
+  EXPECT_EQ(p.methods_to_bake(), (std::vector<std::string>{"light_atlas", "dlm"}));
   EXPECT_FALSE(contains(gi::format_plan(p), "NOT BUILT"));
   // A stricter threshold drops it, and the reason says so.
   const gi::EffectPlan strict = gi::plan(load("glossy_room.gltf"), {.glossy_roughness = 0.1f});
@@ -259,7 +259,7 @@ TEST(PlanJson, TheManifestKeepsThePlanBesideTheMethods) {
   EXPECT_TRUE(m->methods.contains("prm"));
   auto plan = gi::plan_from_json_value(m->plan, "manifest.json");
   ASSERT_TRUE(plan) << plan.error().to_string();
-  EXPECT_EQ(plan->methods_to_bake(), std::vector<std::string>{"atlas"});
+  EXPECT_EQ(plan->methods_to_bake(), std::vector<std::string>{"light_atlas"});
 }
 
 // The cost model against the gi-bake runs it was calibrated on (docs/plan.md: CPU seconds

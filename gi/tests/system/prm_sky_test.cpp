@@ -65,7 +65,7 @@ TEST(PrmSky, APrmBakeOfASkyLitSceneCarriesTheSkyInItsAtlasAndMatchesThePathTrace
   auto report = gi::bake_bundle(input, dir, {.preset = "medium", .methods = {"prm"}, .texels_per_metre = 32.0f});
   ASSERT_TRUE(report) << report.error().to_string();
   ASSERT_EQ(report->baked.size(), 2u);
-  EXPECT_EQ(report->baked[0].method, "atlas") << "the sky's light atlas, baked before the PRM";
+  EXPECT_EQ(report->baked[0].method, "light_atlas") << "the sky's light atlas, baked before the PRM";
   EXPECT_EQ(report->baked[1].method, "prm");
 
   auto atlas = gi::load_light_atlas(dir, input);

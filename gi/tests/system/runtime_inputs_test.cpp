@@ -61,8 +61,9 @@ TEST(RuntimeInputs, NanOrAbsurdLightsAndObjectsAreSkippedOnceAndEverythingStaysF
   fs::remove_all(dir);
   {
     engine::Scene scene = crates_room_with_a_moving_light();
-    auto baked = gi::bake_bundle(gi::bake_input_from(scene), dir,
-                                 {.preset = "preview", .methods = {"atlas", "prm", "brf"}, .texels_per_metre = 4.0f});
+    auto baked =
+        gi::bake_bundle(gi::bake_input_from(scene), dir,
+                        {.preset = "preview", .methods = {"light_atlas", "prm", "brf"}, .texels_per_metre = 4.0f});
     ASSERT_TRUE(baked) << baked.error().to_string();
   }
   engine::Scene scene = crates_room_with_a_moving_light();

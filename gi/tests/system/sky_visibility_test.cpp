@@ -94,7 +94,7 @@ TEST(SkyVisibility, GiSystemProvidesItForASkyLitScene) {
       std::filesystem::temp_directory_path() / ("gi_sky_visibility_" + std::to_string(::getpid()) + ".gibake");
   std::filesystem::remove_all(dir);
   auto baked = gi::bake_bundle(gi::bake_input_from(scene), dir,
-                               {.preset = "preview", .methods = {"atlas"}, .texels_per_metre = 1.0f});
+                               {.preset = "preview", .methods = {"light_atlas"}, .texels_per_metre = 1.0f});
   ASSERT_TRUE(baked) << baked.error().to_string();
   auto gpu = engine::GpuContext::create_headless();
   ASSERT_TRUE(gpu) << gpu.error().to_string();
