@@ -206,7 +206,9 @@ class ConstantIndirect : public engine::IndirectLightProvider {
   struct Frame : engine::IndirectLightFrame {
     engine::Entity dynamic;
     std::uint32_t buffer = 0;
-    std::uint32_t vertex_irradiance_buffer(engine::Entity e) const override { return e == dynamic ? buffer : 0; }
+    engine::SsboHandle<engine::VertexIrradiance> vertex_irradiance_buffer(engine::Entity e) const override {
+      return {e == dynamic ? buffer : 0};
+    }
   };
   const engine::IndirectLightFrame& frame() override { return frame_; }
   const char* label() const override { return "test constant"; }
@@ -237,7 +239,7 @@ TEST(RendererIndirect, AtlasForStaticAndVertexBufferForDynamicMeshes) {
   glNamedBufferStorage(buffer, sizeof vertex_e, vertex_e, 0);
 
   ConstantIndirect provider;
-  provider.frame_.irradiance_atlas_texture = atlas;
+  provider.frame_.irradiance_atlas_texture = {atlas};
   provider.frame_.dynamic = dyn;
   provider.frame_.buffer = buffer;
   {

@@ -100,7 +100,7 @@ class UniformAtlas : public engine::IndirectLightProvider {
     glTextureStorage2D(texture_, 1, GL_RGBA32F, 1, 1);
     const float texel[4] = {e.x, e.y, e.z, 1.0f};
     glTextureSubImage2D(texture_, 0, 0, 0, 1, 1, GL_RGBA, GL_FLOAT, texel);
-    frame_.irradiance_atlas_texture = texture_;
+    frame_.irradiance_atlas_texture = {texture_};
   }
   ~UniformAtlas() override { glDeleteTextures(1, &texture_); }
   UniformAtlas(const UniformAtlas&) = delete;

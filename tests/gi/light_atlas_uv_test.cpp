@@ -8,6 +8,7 @@
 #include <gi/gi_system.h>
 #include <gi/light_atlas_uv.h>
 
+#include <algorithm>
 #include <filesystem>
 
 namespace fs = std::filesystem;
@@ -46,23 +47,29 @@ TEST(LightAtlasUv, ExportedFileHasTheUv1TheRuntimeGivesTheStaticMeshes) {
   auto system = gi::GISystem::load(bundle, runtime);
   ASSERT_TRUE(system) << system.error().to_string();
 
-  ASSERT_EQ(exported.meshes.size(), runtime.assets.meshes.size());
+  // The runtime leaves the scene as it was and hands the renderer, per static node, its mesh
+  // with TEXCOORD_1 (GISystem::atlas_meshes): the exported file's mesh of that node.
+  const std::span<const engine::AtlasMesh> atlas = (*system)->atlas_meshes();
+  ASSERT_FALSE(atlas.empty());
   std::size_t with_uv1 = 0;
-  for (std::size_t m = 0; m < exported.meshes.size(); ++m) {
-    const auto& a = exported.meshes[m].primitives;
-    const auto& b = runtime.assets.meshes[m].primitives;
-    EXPECT_EQ(exported.meshes[m].name, runtime.assets.meshes[m].name);
-    ASSERT_EQ(a.size(), b.size());
+  for (const engine::AtlasMesh& am : atlas) {
+    const auto node_it = std::find(runtime.node_entities.begin(), runtime.node_entities.end(), am.entity);
+    ASSERT_NE(node_it, runtime.node_entities.end());
+    const auto n = static_cast<std::size_t>(node_it - runtime.node_entities.begin());
+    ASSERT_EQ(am.source_mesh, static_cast<std::uint32_t>(original.nodes[n].mesh));
+    ASSERT_GE(exported.nodes[n].mesh, 0) << exported.nodes[n].name;
+    const engine::Mesh& file_mesh = exported.meshes[static_cast<std::size_t>(exported.nodes[n].mesh)];
+    const auto& a = file_mesh.primitives;
+    const auto& b = am.mesh.primitives;
+    ASSERT_EQ(a.size(), b.size()) << file_mesh.name;
     for (std::size_t p = 0; p < a.size(); ++p) {
-      EXPECT_EQ(a[p].indices, b[p].indices) << exported.meshes[m].name;
-      ASSERT_EQ(a[p].uv1.size(), b[p].uv1.size()) << exported.meshes[m].name;
-      for (std::size_t v = 0; v < a[p].uv1.size(); ++v) ASSERT_EQ(a[p].uv1[v], b[p].uv1[v]) << exported.meshes[m].name;
+      EXPECT_EQ(a[p].indices, b[p].indices) << file_mesh.name;
+      ASSERT_EQ(a[p].uv1.size(), b[p].uv1.size()) << file_mesh.name;
+      for (std::size_t v = 0; v < a[p].uv1.size(); ++v) ASSERT_EQ(a[p].uv1[v], b[p].uv1[v]) << file_mesh.name;
       with_uv1 += a[p].uv1.empty() ? 0 : 1;
     }
   }
   EXPECT_GT(with_uv1, 0u);
-  // Nodes point at the same (possibly duplicated) meshes.
-  ASSERT_EQ(exported.nodes.size(), runtime.assets.nodes.size());
   for (std::size_t n = 0; n < exported.nodes.size(); ++n) {
     EXPECT_EQ(exported.nodes[n].mesh, uv->scene.nodes[n].mesh) << exported.nodes[n].name;
     if (exported.nodes[n].mesh >= 0 && exported.nodes[n].gi.mobility == engine::Mobility::Static) {

@@ -168,15 +168,17 @@ class Renderer {
   /// light is: radiance += E/pi x the BRDF's directional albedo at the view angle, per lobe
   /// (engine::gltf_directional_albedo), where E is
   ///  - for entities with StaticTag: texture(irradiance_atlas_texture, TEXCOORD_1).rgb
-  ///    (bilinear, as bound by the provider's sampler state);
-  ///  - for other entities: vertex_irradiance_buffer(entity)[k].xyz,
+  ///    (bilinear, as bound by the provider's sampler state), TEXCOORD_1 of the entity's
+  ///    atlas mesh when the provider hands one (IndirectLightProvider::atlas_meshes), else
+  ///    of the scene's mesh;
+  ///  - for other entities: vertex_irradiance_buffer(entity)[k].irradiance,
   ///    interpolated over the triangle, where k is the vertex's index within the entity's
   ///    mesh with the primitives concatenated in order (primitive p's vertex i has
   ///    k = i + sum of the vertex counts of primitives 0..p-1); the shader reads it as
   ///    gl_VertexID - (scene vertex where the mesh starts). The SSBO is bound at binding 1;
   ///  - for those entities, vertex_radiance_lobes(entity) (if terms > 0) replaces the specular
   ///    lobe's share by the lobes' radiance toward the camera, evaluated per vertex;
-  ///  - glossy_radiance_texture (if not 0, texelFetch at the pixel) replaces the specular
+  ///  - glossy_radiance_texture (if provided, texelFetch at the pixel) replaces the specular
   ///    lobe's share by its rgb in proportion to its alpha (coverage).
   /// Without a provider every entity gets E = pi x stand_in_ambient (the irradiance of a
   /// uniform sky of that radiance). With SplitView::DirectLeftFullRight

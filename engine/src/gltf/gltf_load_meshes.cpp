@@ -116,39 +116,11 @@ std::vector<std::uint32_t> to_triangle_list(const std::vector<std::uint32_t>& id
   return out;
 }
 
-Result<std::optional<Primitive>> convert_primitive(const Context& ctx, const ParsedFile& file, int mesh_index,
-                                                   int prim_index, const tinygltf::Primitive& prim) {
-  const std::string where = "mesh " + std::to_string(mesh_index) + " primitive " + std::to_string(prim_index);
-  // §3.7.2.1 modes: 0 points, 1 lines, 2 line loop, 3 line strip, 4 triangles, 5 strip, 6 fan.
-  if (prim.mode >= TINYGLTF_MODE_POINTS && prim.mode <= TINYGLTF_MODE_LINE_STRIP) return std::optional<Primitive>{};
-  if (prim.mode < TINYGLTF_MODE_TRIANGLES || prim.mode > TINYGLTF_MODE_TRIANGLE_FAN) {
-    return ctx.error(where, "invalid mode " + std::to_string(prim.mode));
-  }
-  if (prim.material >= 0 && static_cast<std::size_t>(prim.material) >= file.model.materials.size()) {
-    return ctx.error(where, "material " + std::to_string(prim.material) + " is out of range (" +
-                                std::to_string(file.model.materials.size()) + " materials)");
-  }
-  std::optional<DracoPrimitive> draco;
-  if (const auto it = file.draco.find({mesh_index, prim_index}); it != file.draco.end()) {
-    auto decoded = decode_draco(ctx, file, it->second, where);
-    if (!decoded) return decoded.error();
-    draco = std::move(decoded.value());
-  }
-  const DracoPrimitive* dp = draco ? &*draco : nullptr;
-
-  auto position = read_attribute(ctx, file, prim, dp, "POSITION", 3, where);
-  if (!position) return position.error();
-  if (position->values.empty()) {
-    // §3.7.2.1 lets POSITION be absent (an extension may provide the geometry): nothing
-    // the engine can draw, so the primitive is skipped like points and lines.
-    log_message(LogLevel::Warning, ctx.file + ": " + where + ": no POSITION attribute, primitive skipped");
-    return std::optional<Primitive>{};
-  }
-  Primitive out;
-  out.material = prim.material;
-  out.positions = to_vectors<glm::vec3>(position->values);
+// NORMAL, TEXCOORD_0, TEXCOORD_1 and TANGENT of a primitive whose positions `out` holds, each
+// absent or one per position; normals made unit, degenerate tangent sets dropped.
+Status read_vertex_attributes(const Context& ctx, const ParsedFile& file, const tinygltf::Primitive& prim,
+                              const DracoPrimitive* dp, const std::string& where, Primitive& out) {
   const std::size_t vertex_count = out.positions.size();
-
   auto normal = read_attribute(ctx, file, prim, dp, "NORMAL", 3, where);
   if (!normal) return normal.error();
   auto uv0 = read_attribute(ctx, file, prim, dp, "TEXCOORD_0", 2, where);
@@ -191,7 +163,14 @@ Result<std::optional<Primitive>> convert_primitive(const Context& ctx, const Par
     }
     t = glm::vec4(glm::vec3(t) / len, t.w > 0.0f ? 1.0f : -1.0f);
   }
+  return {};
+}
 
+// The primitive's indices as stored (Draco's, the indices accessor's, else 0..n-1), each
+// checked against the vertex count.
+Result<std::vector<std::uint32_t>> read_indices(const Context& ctx, const ParsedFile& file, int mesh_index,
+                                                int prim_index, const DracoPrimitive* dp, std::size_t vertex_count,
+                                                const std::string& where) {
   std::vector<std::uint32_t> indices;
   const auto stored_indices = file.primitive_indices.find({mesh_index, prim_index});
   const int indices_accessor = stored_indices != file.primitive_indices.end() ? stored_indices->second : -1;
@@ -227,19 +206,59 @@ Result<std::optional<Primitive>> convert_primitive(const Context& ctx, const Par
                                 " is >= the vertex count " + std::to_string(vertex_count));
     }
   }
-  if (prim.mode == TINYGLTF_MODE_TRIANGLES) {
-    if (indices.size() % 3 != 0) {
-      // Not an error for the validator (MESH_PRIMITIVE_INCOMPATIBLE_MODE): the trailing
-      // partial triangle cannot be drawn and is dropped.
-      log_message(LogLevel::Warning, ctx.file + ": " + where + ": " + std::to_string(indices.size()) +
-                                         " indices do not make whole triangles, the last " +
-                                         std::to_string(indices.size() % 3) + " dropped");
-      indices.resize(indices.size() - indices.size() % 3);
-    }
-    out.indices = std::move(indices);
-  } else {
-    out.indices = to_triangle_list(indices, prim.mode);
+  return indices;
+}
+
+// `indices` of a TRIANGLES, TRIANGLE_STRIP or TRIANGLE_FAN primitive as a triangle list.
+std::vector<std::uint32_t> triangle_list(const Context& ctx, const std::string& where,
+                                         std::vector<std::uint32_t> indices, int mode) {
+  if (mode != TINYGLTF_MODE_TRIANGLES) return to_triangle_list(indices, mode);
+  if (indices.size() % 3 != 0) {
+    // Not an error for the validator (MESH_PRIMITIVE_INCOMPATIBLE_MODE): the trailing
+    // partial triangle cannot be drawn and is dropped.
+    log_message(LogLevel::Warning, ctx.file + ": " + where + ": " + std::to_string(indices.size()) +
+                                       " indices do not make whole triangles, the last " +
+                                       std::to_string(indices.size() % 3) + " dropped");
+    indices.resize(indices.size() - indices.size() % 3);
   }
+  return indices;
+}
+
+Result<std::optional<Primitive>> convert_primitive(const Context& ctx, const ParsedFile& file, int mesh_index,
+                                                   int prim_index, const tinygltf::Primitive& prim) {
+  const std::string where = "mesh " + std::to_string(mesh_index) + " primitive " + std::to_string(prim_index);
+  // §3.7.2.1 modes: 0 points, 1 lines, 2 line loop, 3 line strip, 4 triangles, 5 strip, 6 fan.
+  if (prim.mode >= TINYGLTF_MODE_POINTS && prim.mode <= TINYGLTF_MODE_LINE_STRIP) return std::optional<Primitive>{};
+  if (prim.mode < TINYGLTF_MODE_TRIANGLES || prim.mode > TINYGLTF_MODE_TRIANGLE_FAN) {
+    return ctx.error(where, "invalid mode " + std::to_string(prim.mode));
+  }
+  if (prim.material >= 0 && static_cast<std::size_t>(prim.material) >= file.model.materials.size()) {
+    return ctx.error(where, "material " + std::to_string(prim.material) + " is out of range (" +
+                                std::to_string(file.model.materials.size()) + " materials)");
+  }
+  std::optional<DracoPrimitive> draco;
+  if (const auto it = file.draco.find({mesh_index, prim_index}); it != file.draco.end()) {
+    auto decoded = decode_draco(ctx, file, it->second, where);
+    if (!decoded) return decoded.error();
+    draco = std::move(decoded.value());
+  }
+  const DracoPrimitive* dp = draco ? &*draco : nullptr;
+
+  auto position = read_attribute(ctx, file, prim, dp, "POSITION", 3, where);
+  if (!position) return position.error();
+  if (position->values.empty()) {
+    // §3.7.2.1 lets POSITION be absent (an extension may provide the geometry): nothing
+    // the engine can draw, so the primitive is skipped like points and lines.
+    log_message(LogLevel::Warning, ctx.file + ": " + where + ": no POSITION attribute, primitive skipped");
+    return std::optional<Primitive>{};
+  }
+  Primitive out;
+  out.material = prim.material;
+  out.positions = to_vectors<glm::vec3>(position->values);
+  if (Status s = read_vertex_attributes(ctx, file, prim, dp, where, out); !s) return s.error();
+  auto indices = read_indices(ctx, file, mesh_index, prim_index, dp, out.positions.size(), where);
+  if (!indices) return indices.error();
+  out.indices = triangle_list(ctx, where, std::move(indices).value(), prim.mode);
   if (out.indices.empty()) {
     // Fewer than 3 indices (or a strip or fan of fewer than 3 vertices): no triangle to draw,
     // skipped like points and lines. Kept, it would read as a non-indexed primitive

@@ -56,14 +56,17 @@ std::vector<LightGroup> ForwardRenderer::light_groups(const Registry& registry, 
   return groups;
 }
 
-// Rebuilds the static lights' reach grid when they or the static shadow casters changed
-// since the last build. A static item seen at a new transform is never an occluder again
-// (a door that swings): the grid stays conservative while it moves, and is not rebuilt for
-// it every frame. The moving lights' bits are recomputed whenever one of them moved.
-void ForwardRenderer::update_reach(const std::vector<DrawItem>& items, const render::LightList& lights,
-                                   const std::vector<int>& cullable, int n_static) {
+namespace {
+
+// The cullable lights as the reach grid sees them, static and moving apart, and the keys that
+// tell whether either set changed (entity ids and geometry).
+struct ReachLights {
   std::vector<float> key, moving_key;
   std::vector<ReachLight> static_lights, moving_lights;
+};
+
+ReachLights reach_lights(const render::LightList& lights, const std::vector<int>& cullable, int n_static) {
+  ReachLights out;
   for (std::size_t c = 0; c < cullable.size(); ++c) {
     const std::size_t i = static_cast<std::size_t>(cullable[c]);
     const render::GpuLight& g = lights.lights[i];
@@ -75,75 +78,52 @@ void ForwardRenderer::update_reach(const std::vector<DrawItem>& items, const ren
       r.half_y = glm::vec3(g.area_half_y);
     }
     const bool is_static = static_cast<int>(c) < n_static;
-    (is_static ? static_lights : moving_lights).push_back(r);
-    std::vector<float>& k = is_static ? key : moving_key;
+    (is_static ? out.static_lights : out.moving_lights).push_back(r);
+    std::vector<float>& k = is_static ? out.key : out.moving_key;
     k.push_back(static_cast<float>(lights.entities[i].id()));
     for (const glm::vec3& v : {r.position, r.direction, r.half_x, r.half_y}) k.insert(k.end(), {v.x, v.y, v.z});
   }
-  std::map<std::uint32_t, glm::mat4> models;
-  for (const DrawItem& item : items)
-    if (item.is_static && item.cast_shadows && !reach_.moved.contains(item.entity.id()))
-      models[item.entity.id()] = item.model;
-  const bool built = reach_.builds > 0;
-  const bool static_changed = !built || key != reach_.light_key || models != reach_.static_models;
-  if (!static_changed && moving_key == reach_.moving_key) return;
-  if (static_changed) {
-    if (built)
-      for (const auto& [id, m] : models) {
-        const auto it = reach_.static_models.find(id);
-        if (it != reach_.static_models.end() && it->second != m) reach_.moved.insert(id);
-      }
-    for (std::uint32_t id : reach_.moved) models.erase(id);
-    reach_.occluders.clear();
-    reach_.statics = render::SceneBounds{};
-    render::SceneBounds& statics = reach_.statics;
-    for (const DrawItem& item : items) {
-      if (!item.is_static) continue;
-      statics.min = statics.empty ? item.bounds.min : glm::min(statics.min, item.bounds.min);
-      statics.max = statics.empty ? item.bounds.max : glm::max(statics.max, item.bounds.max);
-      statics.empty = false;
-      if (!models.contains(item.entity.id())) continue;
-      ReachOccluder o;
-      o.min = item.bounds.min;
-      o.max = item.bounds.max;
-      // Triangle corners in primitive order; MASK and BLEND primitives let light through
-      // their holes, so they occlude nothing here (the grid stays conservative).
-      const std::vector<glm::vec3>& c = item.mesh->triangle_corners;
-      std::size_t first = 0;
-      for (const render::GpuPrimitive& p : item.mesh->primitives) {
-        const std::size_t end = std::min(c.size(), first + p.index_count);
-        const bool opaque =
-            !scene_.material(item.material_override >= 0 ? item.material_override : p.material).cut_out();
-        for (std::size_t t = first; opaque && t + 2 < end; t += 3)
-          o.triangles.push_back({glm::vec3(item.model * glm::vec4(c[t], 1.0f)),
-                                 glm::vec3(item.model * glm::vec4(c[t + 1], 1.0f)),
-                                 glm::vec3(item.model * glm::vec4(c[t + 2], 1.0f))});
-        first = end;
-      }
-      reach_.occluders.push_back(std::move(o));
+  return out;
+}
+
+}  // namespace
+
+// The static items' extent and, of those in `models`, their opaque triangles as occluders.
+void ForwardRenderer::collect_reach_occluders(const std::vector<DrawItem>& items,
+                                              const std::map<std::uint32_t, glm::mat4>& models) {
+  reach_.occluders.clear();
+  reach_.statics = render::SceneBounds{};
+  render::SceneBounds& statics = reach_.statics;
+  for (const DrawItem& item : items) {
+    if (!item.is_static) continue;
+    statics.min = statics.empty ? item.bounds.min : glm::min(statics.min, item.bounds.min);
+    statics.max = statics.empty ? item.bounds.max : glm::max(statics.max, item.bounds.max);
+    statics.empty = false;
+    if (!models.contains(item.entity.id())) continue;
+    ReachOccluder o;
+    o.min = item.bounds.min;
+    o.max = item.bounds.max;
+    // Triangle corners in primitive order; MASK and BLEND primitives let light through
+    // their holes, so they occlude nothing here (the grid stays conservative).
+    const std::vector<glm::vec3>& c = item.mesh->triangle_corners;
+    std::size_t first = 0;
+    for (const render::GpuPrimitive& p : item.mesh->primitives) {
+      const std::size_t end = std::min(c.size(), first + p.index_count);
+      const bool opaque = !scene_.material(item.material_override >= 0 ? item.material_override : p.material).cut_out();
+      for (std::size_t t = first; opaque && t + 2 < end; t += 3)
+        o.triangles.push_back({glm::vec3(item.model * glm::vec4(c[t], 1.0f)),
+                               glm::vec3(item.model * glm::vec4(c[t + 1], 1.0f)),
+                               glm::vec3(item.model * glm::vec4(c[t + 2], 1.0f))});
+      first = end;
     }
-    reach_.light_key = std::move(key);
-    reach_.static_models = std::move(models);
-    ++reach_.builds;
-    reach_.static_grid =
-        statics.empty ? LightReachGrid{}
-                      : build_light_reach_grid(reach_.occluders, static_lights, statics.min, statics.max, kReachVoxelM);
+    reach_.occluders.push_back(std::move(o));
   }
-  reach_.moving_key = std::move(moving_key);
-  LightReachGrid moving;
-  if (!moving_lights.empty() && !reach_.statics.empty)
-    moving =
-        build_light_reach_grid(reach_.occluders, moving_lights, reach_.statics.min, reach_.statics.max, kReachVoxelM);
-  // Static bits low, moving bits above them (both grids span the same voxels).
-  const glm::ivec3 old_dims = reach_.grid.dims;
-  reach_.grid = !reach_.static_grid.empty() ? reach_.static_grid : moving;
-  if (!reach_.static_grid.empty() && !moving.empty() && moving.dims == reach_.grid.dims)
-    for (std::size_t v = 0; v < reach_.grid.masks.size(); ++v)
-      reach_.grid.masks[v] = static_cast<std::uint8_t>(reach_.grid.masks[v] | (moving.masks[v] << n_static));
-  reach_.grid.all = static_cast<std::uint8_t>((1u << cullable.size()) - 1u);
+}
+
+// Per mask value of the grid, the box of the voxels holding it (reach_.bounds).
+void ForwardRenderer::bound_reach_masks() {
   reach_.mask_bounds_index.assign(256, -1);
   reach_.bounds.clear();
-  if (reach_.grid.empty()) return;
   const LightReachGrid& g = reach_.grid;
   for (int z = 0; z < g.dims.z; ++z)
     for (int y = 0; y < g.dims.y; ++y)
@@ -161,6 +141,11 @@ void ForwardRenderer::update_reach(const std::vector<DrawItem>& items, const ren
         b.max = b.empty ? hi : glm::max(b.max, hi);
         b.empty = false;
       }
+}
+
+// The grid's masks into reach_.texture (remade when the grid's dimensions are not `old_dims`).
+void ForwardRenderer::upload_reach_masks(const glm::ivec3& old_dims) {
+  const LightReachGrid& g = reach_.grid;
   if (reach_.texture.empty() || old_dims.x != g.dims.x || old_dims.y != g.dims.y || old_dims.z != g.dims.z) {
     reach_.texture = GlTexture::create(GL_TEXTURE_3D);
     glTextureStorage3D(reach_.texture.id(), 1, GL_R8UI, g.dims.x, g.dims.y, g.dims.z);
@@ -173,6 +158,57 @@ void ForwardRenderer::update_reach(const std::vector<DrawItem>& items, const ren
   glTextureSubImage3D(reach_.texture.id(), 0, 0, 0, 0, g.dims.x, g.dims.y, g.dims.z, GL_RED_INTEGER, GL_UNSIGNED_BYTE,
                       g.masks.data());
   glPixelStorei(GL_UNPACK_ALIGNMENT, unpack);
+}
+
+// Rebuilds the static lights' reach grid when they or the static shadow casters changed
+// since the last build. A static item seen at a new transform is never an occluder again
+// (a door that swings): the grid stays conservative while it moves, and is not rebuilt for
+// it every frame. The moving lights' bits are recomputed whenever one of them moved.
+void ForwardRenderer::update_reach(const std::vector<DrawItem>& items, const render::LightList& lights,
+                                   const std::vector<int>& cullable, int n_static) {
+  ReachLights r = reach_lights(lights, cullable, n_static);
+  std::map<std::uint32_t, glm::mat4> models;
+  for (const DrawItem& item : items)
+    if (item.is_static && item.cast_shadows && !reach_.moved.contains(item.entity.id()))
+      models[item.entity.id()] = item.model;
+  const bool built = reach_.builds > 0;
+  const bool static_changed = !built || r.key != reach_.light_key || models != reach_.static_models;
+  if (!static_changed && r.moving_key == reach_.moving_key) return;
+  if (static_changed) {
+    if (built)
+      for (const auto& [id, m] : models) {
+        const auto it = reach_.static_models.find(id);
+        if (it != reach_.static_models.end() && it->second != m) reach_.moved.insert(id);
+      }
+    for (std::uint32_t id : reach_.moved) models.erase(id);
+    collect_reach_occluders(items, models);
+    reach_.light_key = std::move(r.key);
+    reach_.static_models = std::move(models);
+    ++reach_.builds;
+    const render::SceneBounds& statics = reach_.statics;
+    reach_.static_grid = statics.empty ? LightReachGrid{}
+                                       : build_light_reach_grid(reach_.occluders, r.static_lights, statics.min,
+                                                                statics.max, kReachVoxelM);
+  }
+  reach_.moving_key = std::move(r.moving_key);
+  LightReachGrid moving;
+  if (!r.moving_lights.empty() && !reach_.statics.empty)
+    moving =
+        build_light_reach_grid(reach_.occluders, r.moving_lights, reach_.statics.min, reach_.statics.max, kReachVoxelM);
+  // Static bits low, moving bits above them (both grids span the same voxels).
+  const glm::ivec3 old_dims = reach_.grid.dims;
+  reach_.grid = !reach_.static_grid.empty() ? reach_.static_grid : moving;
+  if (!reach_.static_grid.empty() && !moving.empty() && moving.dims == reach_.grid.dims)
+    for (std::size_t v = 0; v < reach_.grid.masks.size(); ++v)
+      reach_.grid.masks[v] = static_cast<std::uint8_t>(reach_.grid.masks[v] | (moving.masks[v] << n_static));
+  reach_.grid.all = static_cast<std::uint8_t>((1u << cullable.size()) - 1u);
+  if (reach_.grid.empty()) {
+    reach_.mask_bounds_index.assign(256, -1);
+    reach_.bounds.clear();
+    return;
+  }
+  bound_reach_masks();
+  upload_reach_masks(old_dims);
 }
 
 }  // namespace engine::render

@@ -10,6 +10,7 @@
 #include <map>
 #include <set>
 #include <string>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -149,6 +150,9 @@ class ForwardRenderer final : public Renderer {
 
  private:
   void ensure_targets();
+  /// Uploads the provider's atlas meshes (IndirectLightProvider::atlas_meshes) when they are
+  /// not the ones drawn already, so the renderer may be made before or after the provider.
+  void sync_atlas_meshes();
   std::vector<DrawItem> draw_items(const Registry& registry,
                                    std::vector<std::pair<Entity, const char*>>& skipped) const;
   void report_skipped(const Registry& registry, const std::vector<std::pair<Entity, const char*>>& skipped);
@@ -161,6 +165,26 @@ class ForwardRenderer final : public Renderer {
   CameraView camera_view(const Registry& registry, Entity camera);
   void forward_pass(const CameraView& view, const std::vector<DrawItem>& items, const std::vector<LightGroup>& groups,
                     const IndirectLightFrame* indirect);
+  /// What every light group's shading reads: the camera, the provider's frame and what of
+  /// it is bound, the reach stencil, whether the scene has a sky term.
+  struct ForwardInputs {
+    const CameraView* view = nullptr;
+    const IndirectLightFrame* indirect = nullptr;
+    GLuint atlas = 0;
+    GLuint glossy = 0;
+    bool directional = false;
+    bool reach = false;
+    bool has_sky = false;
+  };
+  void begin_forward_pass(const CameraView& view, const std::vector<DrawItem>& items, bool reach);
+  ForwardInputs bind_forward_inputs(const IndirectLightFrame* indirect);
+  void set_forward_frame_uniforms(const ForwardUniforms& u, const ForwardInputs& in, bool blend);
+  void set_item_indirect(const ForwardUniforms& u, const DrawItem& item, const ForwardInputs& in);
+  void draw_shaded_primitive(const ForwardUniforms& u, const GpuMaterial& m, const GpuPrimitive& p);
+  void shade_group(const ForwardInputs& in, const LightGroup& group, const std::vector<const DrawItem*>& order,
+                   bool blend);
+  void shade_blended(const ForwardInputs& in, const std::vector<DrawItem>& items,
+                     const std::vector<LightGroup>& groups);
   const LocatedProgram<ForwardUniforms>& forward_program(const LightCounts& counts);
   const LocatedProgram<AreaShadowUniforms>& area_shadow_program(int pass, int area_lights);
   void area_shadow_passes(const glm::mat4& view_proj, const glm::vec3& camera_position,
@@ -176,6 +200,9 @@ class ForwardRenderer final : public Renderer {
                                        const render::LightList& lights);
   void update_reach(const std::vector<DrawItem>& items, const render::LightList& lights,
                     const std::vector<int>& cullable, int n_static);
+  void collect_reach_occluders(const std::vector<DrawItem>& items, const std::map<std::uint32_t, glm::mat4>& models);
+  void bound_reach_masks();
+  void upload_reach_masks(const glm::ivec3& old_dims);
   void tonemap_pass();
   /// The exposure of a fixed mode (FixedLinear, FixedEv100).
   float fixed_exposure() const;
@@ -226,6 +253,14 @@ class ForwardRenderer final : public Renderer {
   int width_ = 0;
   int height_ = 0;
   IndirectLightProvider* provider_ = nullptr;
+  // The atlas meshes in scene_ (the provider's span they came from) and, per static entity,
+  // the SceneAsset mesh its atlas mesh replaces and that atlas mesh's index in scene_.
+  struct AtlasOverride {
+    std::uint32_t source_mesh = 0;
+    std::size_t gpu_mesh = 0;
+  };
+  std::span<const AtlasMesh> atlas_drawn_;
+  std::unordered_map<Entity, AtlasOverride> atlas_overrides_;
   std::vector<PassTiming> timings_;
 };
 

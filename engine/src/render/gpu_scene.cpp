@@ -18,10 +18,6 @@ namespace engine::render {
 
 namespace {
 
-Error primitive_error(const SceneAsset& assets, std::size_t mesh, std::size_t prim, const std::string& what) {
-  return Error{assets.source, "meshes[" + std::to_string(mesh) + "].primitives[" + std::to_string(prim) + "]", what};
-}
-
 // Area-weighted vertex normals for primitives that have none.
 std::vector<glm::vec3> computed_normals(const Primitive& p, const std::vector<std::uint32_t>& indices) {
   std::vector<glm::vec3> n(p.positions.size(), glm::vec3(0.0f));
@@ -109,77 +105,98 @@ const GpuMaterial& GpuScene::material(int index) const {
   return materials_[static_cast<std::size_t>(index)];
 }
 
-Result<GpuScene> GpuScene::upload(const SceneAsset& assets) {
-  GpuScene scene;
-  std::vector<GpuVertex> vertices;
-  std::vector<std::uint32_t> indices;
-  for (std::size_t m = 0; m < assets.meshes.size(); ++m) {
-    const Mesh& mesh = assets.meshes[m];
-    GpuMesh gm;
-    gm.first_vertex = static_cast<std::int32_t>(vertices.size());
-    gm.bounds_min = glm::vec3(std::numeric_limits<float>::max());
-    gm.bounds_max = glm::vec3(-std::numeric_limits<float>::max());
-    for (std::size_t pi = 0; pi < mesh.primitives.size(); ++pi) {
-      const Primitive& p = mesh.primitives[pi];
-      const std::size_t n = p.positions.size();
-      if (!p.normals.empty() && p.normals.size() != n)
-        return primitive_error(assets, m, pi, "normals count differs from positions count");
-      if (!p.uv0.empty() && p.uv0.size() != n)
-        return primitive_error(assets, m, pi, "uv0 count differs from positions count");
-      if (!p.uv1.empty() && p.uv1.size() != n)
-        return primitive_error(assets, m, pi, "uv1 count differs from positions count");
-      if (p.material >= 0 && static_cast<std::size_t>(p.material) >= assets.materials.size())
-        return primitive_error(assets, m, pi, "material index " + std::to_string(p.material) + " out of range");
-      std::vector<std::uint32_t> prim_indices = p.indices;
-      if (prim_indices.empty()) {
-        prim_indices.resize(n);
-        for (std::size_t i = 0; i < n; ++i) prim_indices[i] = static_cast<std::uint32_t>(i);
-      }
-      if (prim_indices.size() % 3 != 0) return primitive_error(assets, m, pi, "index count is not a multiple of 3");
-      for (std::uint32_t i : prim_indices)
-        if (i >= n) return primitive_error(assets, m, pi, "index " + std::to_string(i) + " out of range");
-      if (!p.tangents.empty() && p.tangents.size() != n)
-        return primitive_error(assets, m, pi, "tangents count differs from positions count");
-      const std::vector<glm::vec3> normals = p.normals.empty() ? computed_normals(p, prim_indices) : p.normals;
-      // Tangents where the material has a normal map: the file's, else generated from the
-      // normal texture's UV set (engine/tangents.h). A material_override with a normal map on
-      // a mesh whose own material has none finds zero tangents and shades without it.
-      std::vector<glm::vec4> tangents;
-      const Material* mat = p.material >= 0 ? &assets.materials[static_cast<std::size_t>(p.material)] : nullptr;
-      if (mat != nullptr && mat->normal_texture.present()) {
-        const std::vector<glm::vec2>& uvs = mat->normal_texture.texcoord == 1 ? p.uv1 : p.uv0;
-        if (!p.tangents.empty())
-          tangents = p.tangents;
-        else if (uvs.size() == n)
-          tangents = generate_tangents(p.positions, normals, uvs, prim_indices);
-      }
-      GpuPrimitive gp;
-      gp.first_index = static_cast<std::uint32_t>(indices.size());
-      gp.index_count = static_cast<std::uint32_t>(prim_indices.size());
-      gp.base_vertex = static_cast<std::int32_t>(vertices.size());
-      gp.material = p.material;
-      for (std::size_t i = 0; i < n; ++i) {
-        vertices.push_back(GpuVertex{p.positions[i], normals[i], p.uv0.empty() ? glm::vec2(0.0f) : p.uv0[i],
-                                     p.uv1.empty() ? glm::vec2(0.0f) : p.uv1[i],
-                                     tangents.empty() ? glm::vec4(0.0f) : tangents[i]});
-        gm.bounds_min = glm::min(gm.bounds_min, p.positions[i]);
-        gm.bounds_max = glm::max(gm.bounds_max, p.positions[i]);
-      }
-      indices.insert(indices.end(), prim_indices.begin(), prim_indices.end());
-      for (std::uint32_t i : prim_indices) gm.triangle_corners.push_back(p.positions[i]);
-      gm.primitives.push_back(gp);
-    }
-    gm.vertex_count = static_cast<std::uint32_t>(vertices.size()) - static_cast<std::uint32_t>(gm.first_vertex);
-    if (gm.vertex_count == 0) gm.bounds_min = gm.bounds_max = glm::vec3(0.0f);
-    scene.meshes_.push_back(std::move(gm));
-  }
+namespace {
 
-  scene.vertices_ = GlBuffer::create(vertices.size() * sizeof(GpuVertex), vertices.data());
-  scene.indices_ = GlBuffer::create(indices.size() * sizeof(std::uint32_t), indices.data());
-  scene.vao_ = GlVertexArray::create();
-  const GLuint vao = scene.vao_.id();
-  glVertexArrayVertexBuffer(vao, 0, scene.vertices_.id(), 0, sizeof(GpuVertex));
-  glVertexArrayElementBuffer(vao, scene.indices_.id());
+// Where a mesh's errors point: the file and the mesh's name in it.
+struct MeshSource {
+  const std::string& file;
+  std::string mesh;  ///< "meshes[3]", "atlas mesh of entity 12"
+};
+
+Error primitive_error(const MeshSource& at, std::size_t prim, const std::string& what) {
+  return Error{at.file, at.mesh + ".primitives[" + std::to_string(prim) + "]", what};
+}
+
+// A primitive's indices, checked against its vertices (0, 1, 2, ... when it has none).
+Result<std::vector<std::uint32_t>> checked_indices(const Primitive& p, const MeshSource& at, std::size_t pi,
+                                                   std::size_t material_count) {
+  const std::size_t n = p.positions.size();
+  if (!p.normals.empty() && p.normals.size() != n)
+    return primitive_error(at, pi, "normals count differs from positions count");
+  if (!p.uv0.empty() && p.uv0.size() != n) return primitive_error(at, pi, "uv0 count differs from positions count");
+  if (!p.uv1.empty() && p.uv1.size() != n) return primitive_error(at, pi, "uv1 count differs from positions count");
+  if (p.material >= 0 && static_cast<std::size_t>(p.material) >= material_count)
+    return primitive_error(at, pi, "material index " + std::to_string(p.material) + " out of range");
+  std::vector<std::uint32_t> prim_indices = p.indices;
+  if (prim_indices.empty()) {
+    prim_indices.resize(n);
+    for (std::size_t i = 0; i < n; ++i) prim_indices[i] = static_cast<std::uint32_t>(i);
+  }
+  if (prim_indices.size() % 3 != 0) return primitive_error(at, pi, "index count is not a multiple of 3");
+  for (std::uint32_t i : prim_indices)
+    if (i >= n) return primitive_error(at, pi, "index " + std::to_string(i) + " out of range");
+  if (!p.tangents.empty() && p.tangents.size() != n)
+    return primitive_error(at, pi, "tangents count differs from positions count");
+  return prim_indices;
+}
+
+// Tangents where the material has a normal map: the file's, else generated from the normal
+// texture's UV set (engine/tangents.h). A material_override with a normal map on a mesh whose
+// own material has none finds zero tangents and shades without it.
+std::vector<glm::vec4> primitive_tangents(const Primitive& p, const std::vector<glm::vec3>& normals,
+                                          const std::vector<std::uint32_t>& prim_indices,
+                                          const std::vector<int>& normal_texcoords) {
+  const int set = p.material >= 0 ? normal_texcoords[static_cast<std::size_t>(p.material)] : -1;
+  if (set < 0) return {};
+  if (!p.tangents.empty()) return p.tangents;
+  const std::vector<glm::vec2>& uvs = set == 1 ? p.uv1 : p.uv0;
+  if (uvs.size() != p.positions.size()) return {};
+  return generate_tangents(p.positions, normals, uvs, prim_indices);
+}
+
+}  // namespace
+
+Result<GpuMesh> GpuScene::append_mesh(const Mesh& mesh, const std::string& file, const std::string& name,
+                                      MeshGeometry& out) const {
+  const MeshSource at{file, name};
+  const auto vertex_at = [&] { return static_cast<std::int32_t>(out.first_vertex + out.vertices.size()); };
+  GpuMesh gm;
+  gm.first_vertex = vertex_at();
+  gm.bounds_min = glm::vec3(std::numeric_limits<float>::max());
+  gm.bounds_max = glm::vec3(-std::numeric_limits<float>::max());
+  for (std::size_t pi = 0; pi < mesh.primitives.size(); ++pi) {
+    const Primitive& p = mesh.primitives[pi];
+    auto checked = checked_indices(p, at, pi, normal_texcoords_.size());
+    if (!checked) return checked.error();
+    const std::vector<std::uint32_t>& prim_indices = checked.value();
+    const std::vector<glm::vec3> normals = p.normals.empty() ? computed_normals(p, prim_indices) : p.normals;
+    const std::vector<glm::vec4> tangents = primitive_tangents(p, normals, prim_indices, normal_texcoords_);
+    GpuPrimitive gp;
+    gp.first_index = static_cast<std::uint32_t>(out.first_index + out.indices.size());
+    gp.index_count = static_cast<std::uint32_t>(prim_indices.size());
+    gp.base_vertex = vertex_at();
+    gp.material = p.material;
+    for (std::size_t i = 0; i < p.positions.size(); ++i) {
+      out.vertices.push_back(GpuVertex{p.positions[i], normals[i], p.uv0.empty() ? glm::vec2(0.0f) : p.uv0[i],
+                                       p.uv1.empty() ? glm::vec2(0.0f) : p.uv1[i],
+                                       tangents.empty() ? glm::vec4(0.0f) : tangents[i]});
+      gm.bounds_min = glm::min(gm.bounds_min, p.positions[i]);
+      gm.bounds_max = glm::max(gm.bounds_max, p.positions[i]);
+    }
+    out.indices.insert(out.indices.end(), prim_indices.begin(), prim_indices.end());
+    for (std::uint32_t i : prim_indices) gm.triangle_corners.push_back(p.positions[i]);
+    gm.primitives.push_back(gp);
+  }
+  gm.vertex_count = static_cast<std::uint32_t>(vertex_at() - gm.first_vertex);
+  if (gm.vertex_count == 0) gm.bounds_min = gm.bounds_max = glm::vec3(0.0f);
+  return gm;
+}
+
+void GpuScene::bind_vertex_array() {
+  vao_ = GlVertexArray::create();
+  const GLuint vao = vao_.id();
+  glVertexArrayVertexBuffer(vao, 0, vertices_.id(), 0, sizeof(GpuVertex));
+  glVertexArrayElementBuffer(vao, indices_.id());
   const GLuint offsets[5] = {offsetof(GpuVertex, position), offsetof(GpuVertex, normal), offsetof(GpuVertex, uv0),
                              offsetof(GpuVertex, uv1), offsetof(GpuVertex, tangent)};
   const GLint sizes[5] = {3, 3, 2, 2, 4};
@@ -188,7 +205,60 @@ Result<GpuScene> GpuScene::upload(const SceneAsset& assets) {
     glVertexArrayAttribFormat(vao, a, sizes[a], GL_FLOAT, GL_FALSE, offsets[a]);
     glVertexArrayAttribBinding(vao, a, 0);
   }
+}
 
+Result<GpuScene> GpuScene::upload(const SceneAsset& assets) {
+  GpuScene scene;
+  for (const Material& m : assets.materials)
+    scene.normal_texcoords_.push_back(m.normal_texture.present() ? m.normal_texture.texcoord : -1);
+  MeshGeometry geometry;
+  for (std::size_t m = 0; m < assets.meshes.size(); ++m) {
+    auto gm = scene.append_mesh(assets.meshes[m], assets.source, "meshes[" + std::to_string(m) + "]", geometry);
+    if (!gm) return gm.error();
+    scene.meshes_.push_back(std::move(gm).value());
+  }
+  scene.scene_meshes_ = scene.meshes_.size();
+  scene.scene_vertices_ = geometry.vertices.size();
+  scene.scene_indices_ = geometry.indices.size();
+  // Copyable: set_atlas_meshes keeps the scene's part when it appends the atlas meshes.
+  scene.vertices_ = GlBuffer::create(geometry.vertices.size() * sizeof(GpuVertex), geometry.vertices.data());
+  scene.indices_ = GlBuffer::create(geometry.indices.size() * sizeof(std::uint32_t), geometry.indices.data());
+  scene.bind_vertex_array();
+  if (Status s = scene.upload_materials(assets); !s) return s.error();
+  return scene;
+}
+
+Status GpuScene::set_atlas_meshes(std::span<const AtlasMesh> atlas) {
+  MeshGeometry geometry{.first_vertex = scene_vertices_, .first_index = scene_indices_};
+  std::vector<GpuMesh> added;
+  for (const AtlasMesh& a : atlas) {
+    auto gm = append_mesh(a.mesh, "indirect light provider", "atlas mesh of entity " + std::to_string(a.entity.id()),
+                          geometry);
+    if (!gm) return gm.error();
+    added.push_back(std::move(gm).value());
+  }
+  // The scene's vertices and indices first (copied on the GPU), the atlas meshes' after them.
+  const auto grown = [](const GlBuffer& old, std::size_t kept, const void* more, std::size_t more_bytes) {
+    GlBuffer b = GlBuffer::create(kept + more_bytes, nullptr, GL_DYNAMIC_STORAGE_BIT);
+    if (kept > 0) glCopyNamedBufferSubData(old.id(), b.id(), 0, 0, static_cast<GLsizeiptr>(kept));
+    if (more_bytes > 0)
+      glNamedBufferSubData(b.id(), static_cast<GLintptr>(kept), static_cast<GLsizeiptr>(more_bytes), more);
+    return b;
+  };
+  vertices_ = grown(vertices_, scene_vertices_ * sizeof(GpuVertex), geometry.vertices.data(),
+                    geometry.vertices.size() * sizeof(GpuVertex));
+  indices_ = grown(indices_, scene_indices_ * sizeof(std::uint32_t), geometry.indices.data(),
+                   geometry.indices.size() * sizeof(std::uint32_t));
+  bind_vertex_array();
+  meshes_.resize(scene_meshes_);
+  for (GpuMesh& gm : added) meshes_.push_back(std::move(gm));
+  return {};
+}
+
+// One loop over the materials (over 60 lines): the texture and sampler caches it fills are
+// shared by every material, and each material's textures are checked where they are read.
+Status GpuScene::upload_materials(const SceneAsset& assets) {
+  GpuScene& scene = *this;
   const std::uint8_t white[4] = {255, 255, 255, 255};
   scene.white_ = GlTexture::create_2d(GL_RGBA8, 1, 1);
   glTextureSubImage2D(scene.white_.id(), 0, 0, 0, 1, 1, GL_RGBA, GL_UNSIGNED_BYTE, white);
@@ -261,7 +331,7 @@ Result<GpuScene> GpuScene::upload(const SceneAsset& assets) {
     scene.has_cut_out_ = scene.has_cut_out_ || gm.cut_out();
     scene.materials_.push_back(gm);
   }
-  return scene;
+  return {};
 }
 
 }  // namespace engine::render

@@ -3,12 +3,16 @@
 // one index buffer for every primitive of every mesh, plus per-material draw parameters.
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
+#include <span>
+#include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
 
 #include <engine/gpu/gl_objects.h>
+#include <engine/indirect_light.h>
 #include <engine/result.h>
 #include <engine/scene_asset.h>
 
@@ -100,6 +104,13 @@ class GpuScene {
  public:
   /// Uploads every primitive and material. Errors name the mesh/primitive that is malformed.
   static Result<GpuScene> upload(const SceneAsset& assets);
+  /// Replaces the meshes drawn in place of the scene's on static entities (an indirect-light
+  /// provider's atlas meshes, engine/indirect_light.h) by `atlas`: atlas[k] becomes
+  /// meshes()[scene_mesh_count() + k]. Invalidates pointers into meshes(). On error (a
+  /// malformed mesh, named) nothing changes.
+  Status set_atlas_meshes(std::span<const AtlasMesh> atlas);
+  /// The SceneAsset's meshes: meshes()[0, scene_mesh_count()).
+  std::size_t scene_mesh_count() const { return scene_meshes_; }
 
   const std::vector<GpuMesh>& meshes() const { return meshes_; }
   /// Material `index`, or the default (white, dielectric, roughness 1) for -1/out of range.
@@ -112,6 +123,22 @@ class GpuScene {
   bool has_cut_out() const { return has_cut_out_; }
 
  private:
+  // Vertices and indices of meshes being uploaded, after `first_vertex` / `first_index` of
+  // the buffers.
+  struct MeshGeometry {
+    std::size_t first_vertex = 0;
+    std::size_t first_index = 0;
+    std::vector<GpuVertex> vertices;
+    std::vector<std::uint32_t> indices;
+  };
+  /// `mesh`'s primitives appended to `out`, checked (errors at `file`, `name`).
+  Result<GpuMesh> append_mesh(const Mesh& mesh, const std::string& file, const std::string& name,
+                              MeshGeometry& out) const;
+  /// A vertex array over vertices_ and indices_ (GpuVertex's locations 0..4).
+  void bind_vertex_array();
+  /// Every material's textures, samplers and draw parameters.
+  Status upload_materials(const SceneAsset& assets);
+
   GlBuffer vertices_;
   GlBuffer indices_;
   GlVertexArray vao_;
@@ -123,6 +150,11 @@ class GpuScene {
   GpuMaterial default_material_;
   bool has_mask_ = false;
   bool has_cut_out_ = false;
+  /// Per material: the TEXCOORD set of its normal texture (tangents are made from it), -1: none.
+  std::vector<int> normal_texcoords_;
+  std::size_t scene_meshes_ = 0;    ///< Meshes of the SceneAsset (the atlas meshes follow).
+  std::size_t scene_vertices_ = 0;  ///< Their vertices and indices, at the buffers' start.
+  std::size_t scene_indices_ = 0;
 };
 
 }  // namespace engine::render

@@ -91,19 +91,16 @@ bool ShadowMaps::LayerContent::operator==(const LayerContent& o) const {
   return same_view(view, o.view) && casters == o.casters;
 }
 
-int ShadowMaps::render(const std::vector<ShadowView>& views, const std::vector<DrawItem>& items, const GpuScene& scene,
-                       const LocatedProgram<DepthUniforms>& program,
-                       const LocatedProgram<DepthUniforms>* cut_out_program, const glm::mat4& camera_view_proj) {
-  // Each view's content first: the casters whose world bounds are not wholly outside one
-  // of its clip planes (they would be clipped whole, so culling them changes no texel),
-  // split into static (StaticTag) and dynamic ones for the static depth cache below.
-  std::vector<LayerContent> wanted(views.size());
-  std::vector<LayerContent> wanted_static(views.size());
-  std::vector<std::vector<Caster>> dynamic(views.size());
+ShadowMaps::ViewContents ShadowMaps::contents_of(const std::vector<ShadowView>& views,
+                                                 const std::vector<DrawItem>& items) {
+  ViewContents c;
+  c.wanted.resize(views.size());
+  c.wanted_static.resize(views.size());
+  c.dynamic.resize(views.size());
   for (std::size_t k = 0; k < views.size(); ++k) {
     const ShadowView& v = views[k];
-    wanted[k].view = v;
-    wanted_static[k].view = v;
+    c.wanted[k].view = v;
+    c.wanted_static[k].view = v;
     const std::array<glm::vec4, 6> planes = clip_planes(v.view_proj);
     for (const DrawItem& item : items) {
       if (!item.cast_shadows) continue;
@@ -120,10 +117,16 @@ int ShadowMaps::render(const std::vector<ShadowView>& views, const std::vector<D
       }
       if (outside) continue;
       const Caster caster{item.mesh, item.model, item.material_override};
-      wanted[k].casters.push_back(caster);
-      (item.is_static ? wanted_static[k].casters : dynamic[k]).push_back(caster);
+      c.wanted[k].casters.push_back(caster);
+      (item.is_static ? c.wanted_static[k].casters : c.dynamic[k]).push_back(caster);
     }
   }
+  return c;
+}
+
+std::vector<std::size_t> ShadowMaps::stale_views(const std::vector<ShadowView>& views,
+                                                 const std::vector<LayerContent>& wanted,
+                                                 const glm::mat4& camera_view_proj) {
   std::vector<std::size_t> stale;
   const std::array<glm::vec4, 6> camera_planes = clip_planes(camera_view_proj);
   unseen_views_ = 0;
@@ -140,6 +143,93 @@ int ShadowMaps::render(const std::vector<ShadowView>& views, const std::vector<D
     }
     stale.push_back(k);
   }
+  return stale;
+}
+
+void ShadowMaps::draw_casters(const std::vector<Caster>& casters, const ShadowView& view, const Programs& programs) {
+  const auto set_view = [&](const DepthUniforms& u) {
+    glUniformMatrix4fv(u.view_proj, 1, GL_FALSE, glm::value_ptr(view.view_proj));
+    glUniform3fv(u.eye, 1, glm::value_ptr(view.eye));
+    glUniform1f(u.far_m, view.far_m);
+    glUniform1i(u.ortho, view.ortho ? 1 : 0);
+    glUniform3fv(u.axis, 1, glm::value_ptr(view.axis));
+  };
+  for (const bool cut_out : {false, true}) {
+    if (cut_out && programs.cut_out == nullptr) break;
+    const LocatedProgram<DepthUniforms>& p = cut_out ? *programs.cut_out : *programs.opaque;
+    bool used = false;
+    for (const Caster& c : casters) {
+      bool model_set = false;
+      for (const GpuPrimitive& prim : c.mesh->primitives) {
+        const GpuMaterial& m = programs.scene->material(c.material_override >= 0 ? c.material_override : prim.material);
+        if (m.cut_out() != cut_out) continue;
+        if (!used) {
+          p.use();
+          set_view(p.uniforms);
+          used = true;
+        }
+        if (!model_set) {
+          glUniformMatrix4fv(p.uniforms.model, 1, GL_FALSE, glm::value_ptr(c.model));
+          model_set = true;
+        }
+        if (cut_out) bind_alpha_test(m, m.alpha_mode == AlphaMode::Mask ? m.alpha_cutoff : 0.5f, p.uniforms.material);
+        glDrawElementsBaseVertex(GL_TRIANGLES, static_cast<GLsizei>(prim.index_count), GL_UNSIGNED_INT,
+                                 reinterpret_cast<const void*>(static_cast<std::uintptr_t>(prim.first_index) * 4u),
+                                 prim.base_vertex);
+      }
+    }
+  }
+}
+
+void ShadowMaps::render_layer(const ShadowView& v, std::size_t k, ViewContents& contents, const Programs& programs) {
+  const float one = 1.0f;
+  const Kind kind = kind_of(v);
+  MapArray& maps = maps_[kind];
+  const int size = maps.size;
+  std::vector<LayerContent>& held = maps.content;
+  const auto slot = static_cast<std::size_t>(v.layer);
+  glViewport(0, 0, size, size);
+  const std::uint32_t target = maps.texture.id();
+  // A light that did not move, whose dynamic casters did: its static casters' depth is kept
+  // in a second texture, copied back, and only the dynamic casters are drawn over it. The
+  // depth test keeps the nearest of both, so the layer holds exactly what drawing every
+  // caster gives. A moving light (its view changed) draws everything: a cache would be
+  // stale every frame.
+  const bool light_still = slot < held.size() && same_view(held[slot].view, v);
+  if (light_still && !contents.dynamic[k].empty() && !contents.wanted_static[k].casters.empty()) {
+    ensure_static_cache(kind);
+    std::vector<LayerContent>& cached = maps.static_content;
+    const std::uint32_t cache = maps.static_cache.id();
+    if (!(slot < cached.size() && cached[slot] == contents.wanted_static[k])) {
+      glNamedFramebufferTextureLayer(framebuffer_.id(), GL_DEPTH_ATTACHMENT, cache, 0, v.layer);
+      glClearNamedFramebufferfv(framebuffer_.id(), GL_DEPTH, 0, &one);
+      draw_casters(contents.wanted_static[k].casters, v, programs);
+      if (cached.size() <= slot) cached.resize(slot + 1);
+      cached[slot] = std::move(contents.wanted_static[k]);
+    } else {
+      ++cached_views_;
+    }
+    const GLenum gl_kind = v.cube ? GL_TEXTURE_CUBE_MAP_ARRAY : GL_TEXTURE_2D_ARRAY;
+    glCopyImageSubData(cache, gl_kind, 0, 0, 0, v.layer, target, gl_kind, 0, 0, 0, v.layer, size, size, 1);
+    glNamedFramebufferTextureLayer(framebuffer_.id(), GL_DEPTH_ATTACHMENT, target, 0, v.layer);
+    draw_casters(contents.dynamic[k], v, programs);
+  } else {
+    glNamedFramebufferTextureLayer(framebuffer_.id(), GL_DEPTH_ATTACHMENT, target, 0, v.layer);
+    glClearNamedFramebufferfv(framebuffer_.id(), GL_DEPTH, 0, &one);
+    draw_casters(contents.wanted[k].casters, v, programs);
+  }
+  if (held.size() <= slot) held.resize(slot + 1);
+  held[slot] = std::move(contents.wanted[k]);
+}
+
+int ShadowMaps::render(const std::vector<ShadowView>& views, const std::vector<DrawItem>& items, const GpuScene& scene,
+                       const LocatedProgram<DepthUniforms>& program,
+                       const LocatedProgram<DepthUniforms>* cut_out_program, const glm::mat4& camera_view_proj) {
+  // Each view's content first: the casters whose world bounds are not wholly outside one
+  // of its clip planes (they would be clipped whole, so culling them changes no texel),
+  // split into static (StaticTag) and dynamic ones for the static depth cache.
+  ViewContents contents = contents_of(views, items);
+  const std::vector<std::size_t> stale = stale_views(views, contents.wanted, camera_view_proj);
   cached_views_ = 0;
   if (stale.empty()) return 0;
   glBindFramebuffer(GL_FRAMEBUFFER, framebuffer_.id());
@@ -149,84 +239,8 @@ int ShadowMaps::render(const std::vector<ShadowView>& views, const std::vector<D
   glDisable(GL_CULL_FACE);  // both faces cast: open meshes and single planes stay opaque
   glDisable(GL_BLEND);
   glBindVertexArray(scene.vertex_array());
-  const ShadowView* current = nullptr;
-  const auto set_view = [&](const DepthUniforms& u, const ShadowView& v) {
-    glUniformMatrix4fv(u.view_proj, 1, GL_FALSE, glm::value_ptr(v.view_proj));
-    glUniform3fv(u.eye, 1, glm::value_ptr(v.eye));
-    glUniform1f(u.far_m, v.far_m);
-    glUniform1i(u.ortho, v.ortho ? 1 : 0);
-    glUniform3fv(u.axis, 1, glm::value_ptr(v.axis));
-  };
-  // Opaque primitives with `program`, then the cut-out ones (MASK, BLEND) with the alpha test.
-  const auto draw = [&](const std::vector<Caster>& casters) {
-    for (const bool cut_out : {false, true}) {
-      if (cut_out && cut_out_program == nullptr) break;
-      const LocatedProgram<DepthUniforms>& p = cut_out ? *cut_out_program : program;
-      bool used = false;
-      for (const Caster& c : casters) {
-        bool model_set = false;
-        for (const GpuPrimitive& prim : c.mesh->primitives) {
-          const GpuMaterial& m = scene.material(c.material_override >= 0 ? c.material_override : prim.material);
-          if (m.cut_out() != cut_out) continue;
-          if (!used) {
-            p.use();
-            set_view(p.uniforms, *current);
-            used = true;
-          }
-          if (!model_set) {
-            glUniformMatrix4fv(p.uniforms.model, 1, GL_FALSE, glm::value_ptr(c.model));
-            model_set = true;
-          }
-          if (cut_out) bind_alpha_test(m, m.alpha_mode == AlphaMode::Mask ? m.alpha_cutoff : 0.5f, p.uniforms.material);
-          glDrawElementsBaseVertex(GL_TRIANGLES, static_cast<GLsizei>(prim.index_count), GL_UNSIGNED_INT,
-                                   reinterpret_cast<const void*>(static_cast<std::uintptr_t>(prim.first_index) * 4u),
-                                   prim.base_vertex);
-        }
-      }
-    }
-  };
-  const float one = 1.0f;
-  for (std::size_t k : stale) {
-    const ShadowView& v = views[k];
-    const Kind kind = kind_of(v);
-    MapArray& maps = maps_[kind];
-    const int size = maps.size;
-    std::vector<LayerContent>& held = maps.content;
-    const auto slot = static_cast<std::size_t>(v.layer);
-    glViewport(0, 0, size, size);
-    current = &v;
-    const std::uint32_t target = maps.texture.id();
-    // A light that did not move, whose dynamic casters did: its static casters' depth is kept
-    // in a second texture, copied back, and only the dynamic casters are drawn over it. The
-    // depth test keeps the nearest of both, so the layer holds exactly what drawing every
-    // caster gives. A moving light (its view changed) draws everything: a cache would be
-    // stale every frame.
-    const bool light_still = slot < held.size() && same_view(held[slot].view, v);
-    if (light_still && !dynamic[k].empty() && !wanted_static[k].casters.empty()) {
-      ensure_static_cache(kind);
-      std::vector<LayerContent>& cached = maps.static_content;
-      const std::uint32_t cache = maps.static_cache.id();
-      if (!(slot < cached.size() && cached[slot] == wanted_static[k])) {
-        glNamedFramebufferTextureLayer(framebuffer_.id(), GL_DEPTH_ATTACHMENT, cache, 0, v.layer);
-        glClearNamedFramebufferfv(framebuffer_.id(), GL_DEPTH, 0, &one);
-        draw(wanted_static[k].casters);
-        if (cached.size() <= slot) cached.resize(slot + 1);
-        cached[slot] = std::move(wanted_static[k]);
-      } else {
-        ++cached_views_;
-      }
-      const GLenum gl_kind = v.cube ? GL_TEXTURE_CUBE_MAP_ARRAY : GL_TEXTURE_2D_ARRAY;
-      glCopyImageSubData(cache, gl_kind, 0, 0, 0, v.layer, target, gl_kind, 0, 0, 0, v.layer, size, size, 1);
-      glNamedFramebufferTextureLayer(framebuffer_.id(), GL_DEPTH_ATTACHMENT, target, 0, v.layer);
-      draw(dynamic[k]);
-    } else {
-      glNamedFramebufferTextureLayer(framebuffer_.id(), GL_DEPTH_ATTACHMENT, target, 0, v.layer);
-      glClearNamedFramebufferfv(framebuffer_.id(), GL_DEPTH, 0, &one);
-      draw(wanted[k].casters);
-    }
-    if (held.size() <= slot) held.resize(slot + 1);
-    held[slot] = std::move(wanted[k]);
-  }
+  const Programs programs{&scene, &program, cut_out_program};
+  for (std::size_t k : stale) render_layer(views[k], k, contents, programs);
   unbind_material_samplers();
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   return static_cast<int>(stale.size());

@@ -76,6 +76,27 @@ class ShadowMaps {
   static Kind kind_of(const ShadowView& v) { return v.cube ? kCubeMaps : v.sun ? kSunMaps : kMaps2d; }
   void reserve_array(Kind kind, int size, int layers);
   void ensure_static_cache(Kind kind);
+  /// Per view: every caster that can reach it, its static ones, its dynamic ones.
+  struct ViewContents {
+    std::vector<LayerContent> wanted;
+    std::vector<LayerContent> wanted_static;
+    std::vector<std::vector<Caster>> dynamic;
+  };
+  static ViewContents contents_of(const std::vector<ShadowView>& views, const std::vector<DrawItem>& items);
+  /// The views whose layer holds other content than `wanted` and that the camera can see into
+  /// (counts the others in unseen_views_).
+  std::vector<std::size_t> stale_views(const std::vector<ShadowView>& views, const std::vector<LayerContent>& wanted,
+                                       const glm::mat4& camera_view_proj);
+  /// The programs a layer is drawn with and the materials they read.
+  struct Programs {
+    const GpuScene* scene = nullptr;
+    const LocatedProgram<DepthUniforms>* opaque = nullptr;
+    const LocatedProgram<DepthUniforms>* cut_out = nullptr;  ///< MASK and BLEND; null: none in the scene.
+  };
+  /// `casters` into the bound layer from `view`: opaque primitives first, then the cut-out ones.
+  static void draw_casters(const std::vector<Caster>& casters, const ShadowView& view, const Programs& programs);
+  /// View `k` (`v`) into its layer, over its static depth cache when only dynamic casters changed.
+  void render_layer(const ShadowView& v, std::size_t k, ViewContents& contents, const Programs& programs);
 
   MapArray maps_[3];
   int cached_views_ = 0;

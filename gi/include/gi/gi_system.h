@@ -3,9 +3,9 @@
 // and hands the renderer the indirect light of every frame, recomputing only what changed.
 //
 //   engine::Scene scene = engine::instantiate(engine::load_gltf("level.gltf").value());
-//   auto gi = gi::GISystem::load("out/level.gibake", scene);   // before Renderer::create
+//   auto renderer = engine::Renderer::create(scene.assets, {}).value();  // before or after load
+//   auto gi = gi::GISystem::load("out/level.gibake", scene);
 //   if (!gi) { std::cerr << gi.error().to_string() << '\n'; return 1; }
-//   auto renderer = engine::Renderer::create(scene.assets, {}).value();
 //   renderer->set_indirect_light(gi.value().get());             // frame() runs once per drawn frame
 //   // ... game loop: simulate (move crates, lights), then renderer->render(...)
 //
@@ -25,8 +25,10 @@
 // A frame where nothing changed does no work (Stats counts it).
 //
 // Loading checks every file against the scene (a bundle baked from other geometry, or from
-// other meshes, is rejected naming the file and both hashes) and gives the static meshes
-// TEXCOORD_1, so create the renderer from the scene after load(). The scene's registry must
+// other meshes, is rejected naming the file and both hashes). It does not change the scene:
+// the static meshes with TEXCOORD_1 reach the renderer through atlas_meshes()
+// (engine/indirect_light.h), so the renderer may be created before or after load(). The
+// scene's registry must
 // outlive the system; GL objects are created on the first frame() (context current) and
 // deleted with the system: destroy it before the GL context.
 
@@ -38,6 +40,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -70,6 +73,9 @@ class GISystem final : public engine::IndirectLightProvider {
   const engine::IndirectLightFrame& frame() override;
   /// "light atlas", "light atlas + PRM", "light atlas + PRM + BRF + DLM", "... + antiradiance"
   const char* label() const override;
+  /// The static meshes with the atlas's TEXCOORD_1 (the light atlas's or the PRM's layout),
+  /// drawn by the renderer in place of the scene's; the scene itself is not changed.
+  std::span<const engine::AtlasMesh> atlas_meshes() const override;
 
   struct Stats {
     double load_ms = 0.0;         ///< GISystem::load: the bundle read and checked, CPU-side setup (no GL).

@@ -292,8 +292,8 @@ engine::IndirectLightFrame::VertexRadianceLobes BrfLighting::vertex_lobes(engine
   const BrfModelData& model = m.models[m.instances[it->second].model];
   if (!model.glossy || model.glossy->terms <= 0) return {};
   const int vertices = static_cast<int>(model.mesh.positions.size());
-  return {.coefficient_buffer = m.total[it->second].id(),
-          .lobe_buffer = m.lobe_tables[m.instances[it->second].model].id(),
+  return {.coefficient_buffer = {m.total[it->second].id()},
+          .lobe_buffer = {m.lobe_tables[m.instances[it->second].model].id()},
           .first = vertices,
           .stride = vertices,
           .terms = model.glossy->terms,

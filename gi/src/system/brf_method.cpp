@@ -58,7 +58,9 @@ class BrfMethod final : public MethodRuntime {
   }
   std::string label() const override { return "BRF"; }
   std::string disabled() const override { return brf_->stats().disabled; }
-  std::uint32_t vertex_irradiance_buffer(engine::Entity e) const override { return brf_->vertex_buffer(e); }
+  engine::SsboHandle<engine::VertexIrradiance> vertex_irradiance_buffer(engine::Entity e) const override {
+    return {brf_->vertex_buffer(e)};
+  }
   engine::IndirectLightFrame::VertexRadianceLobes vertex_radiance_lobes(engine::Entity e) const override {
     return brf_->vertex_lobes(e);
   }

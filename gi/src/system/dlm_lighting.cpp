@@ -62,9 +62,12 @@ void DlmLighting::fill(engine::IndirectLightFrame& frame) {
     index_ = {};
     packed_ = {};
   }
-  frame.directional_index_texture = index_texture_.id();
-  frame.directional_radiance_buffer = radiance_buffer_.id();
-  frame.directional_direction_buffer = direction_buffer_.id();
+  // packed_ and directions_ were uploaded as the elements the renderer reads.
+  static_assert(sizeof(glm::uvec2) == sizeof(engine::DirectionalRadiance), "one DirectionalRadiance per uvec2");
+  static_assert(sizeof(glm::vec4) == sizeof(engine::DirectionalBin), "one DirectionalBin per vec4");
+  frame.directional_index_texture = {index_texture_.id()};
+  frame.directional_radiance_buffer = {radiance_buffer_.id()};
+  frame.directional_direction_buffer = {direction_buffer_.id()};
   frame.directional_bin_count = bins_;
   frame.directional_element_count = static_cast<int>(elements_);
 }

@@ -20,10 +20,10 @@ namespace {
 // The frame handed to the renderer: the atlas texture plus what the methods give per entity.
 struct SystemFrame final : engine::IndirectLightFrame {
   const std::vector<std::unique_ptr<MethodRuntime>>* methods = nullptr;
-  std::uint32_t vertex_irradiance_buffer(engine::Entity e) const override {
+  engine::SsboHandle<engine::VertexIrradiance> vertex_irradiance_buffer(engine::Entity e) const override {
     for (const auto& m : *methods)
-      if (std::uint32_t b = m->vertex_irradiance_buffer(e)) return b;
-    return 0;
+      if (engine::SsboHandle<engine::VertexIrradiance> b = m->vertex_irradiance_buffer(e)) return b;
+    return {};
   }
   // A glossy dynamic object's view-dependent indirect light (BRF glossy terms).
   VertexRadianceLobes vertex_radiance_lobes(engine::Entity e) const override {
@@ -182,7 +182,7 @@ const engine::IndirectLightFrame& GISystem::frame() {
   FrameState state{.stats = m.stats, .frame = m.frame};
   for (const auto& method : m.methods) method->frame(state);
   m.note_turned_off();
-  m.frame.irradiance_atlas_texture = state.atlas_texture;
+  m.frame.irradiance_atlas_texture = {state.atlas_texture};
   if (m.sky) m.sky->update();
   if (!state.work) ++m.stats.idle_frames;
   if (m.stats.frames == 1) {
@@ -193,6 +193,11 @@ const engine::IndirectLightFrame& GISystem::frame() {
 }
 
 const char* GISystem::label() const { return impl_->label.c_str(); }
+std::span<const engine::AtlasMesh> GISystem::atlas_meshes() const {
+  for (const auto& m : impl_->methods)
+    if (std::span<const engine::AtlasMesh> a = m->atlas_meshes(); !a.empty()) return a;
+  return {};
+}
 const GISystem::Stats& GISystem::stats() const { return impl_->stats; }
 std::string GISystem::describe() const { return impl_->description; }
 

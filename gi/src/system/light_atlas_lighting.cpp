@@ -50,10 +50,13 @@ engine::Result<std::unique_ptr<LightAtlasLighting>> LightAtlasLighting::from_bak
 }
 
 engine::Result<std::unique_ptr<LightAtlasLighting>> LightAtlasLighting::from_bake(const LightAtlasBake& bake,
-                                                                                  engine::Scene& scene) {
-  if (engine::Status s = apply_atlas_uv1(scene, bake.layout); !s) return s.error();
-  return std::unique_ptr<LightAtlasLighting>(
+                                                                                  const engine::Scene& scene) {
+  auto meshes = atlas_meshes_of(scene, bake.layout);
+  if (!meshes) return meshes.error();
+  auto out = std::unique_ptr<LightAtlasLighting>(
       new LightAtlasLighting(bake.width, bake.height, rgba_of(bake), bake.settings.include_direct));
+  out->atlas_meshes_ = std::move(meshes).value();
+  return out;
 }
 
 const engine::IndirectLightFrame& LightAtlasLighting::frame() {
@@ -64,7 +67,7 @@ const engine::IndirectLightFrame& LightAtlasLighting::frame() {
     glTextureParameteri(texture.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
     glTextureParameteri(texture.id(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
     glTextureParameteri(texture.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-    frame_.irradiance_atlas_texture = texture.id();
+    frame_.irradiance_atlas_texture = {texture.id()};
     texture_ = std::move(texture);
     rgba_ = {};
   }

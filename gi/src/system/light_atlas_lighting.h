@@ -2,15 +2,14 @@
 // The runtime side of a baked light atlas (internal to GISystem, which loads bundles): an
 // engine::IndirectLightProvider that hands the renderer the atlas as a texture, which it
 // samples at TEXCOORD_1 of static meshes.
-//   auto gi = gi::LightAtlasLighting::from_bake(bake, scene).value();  // before Renderer::create
+//   auto gi = gi::LightAtlasLighting::from_bake(bake, scene).value();
 //   renderer->set_indirect_light(gi.get());
 //
-// Giving the scene the atlas parameterization as TEXCOORD_1 (gi::with_atlas_uv1: static
-// meshes get uv1, vertices on chart borders are split, a mesh shared by several static nodes
-// is duplicated) changes its assets, so create the renderer from the scene afterwards.
-// Dynamic meshes get no indirect light from this provider. The GL texture is created on
-// the first frame() (the GL context must be current then) and deleted with the provider:
-// destroy it before the GL context.
+// The scene is left as it is: the static meshes with the atlas parameterization as
+// TEXCOORD_1 (gi::atlas_meshes_of: vertices on chart borders split, one mesh per static
+// instance) go to the renderer through atlas_meshes(). Dynamic meshes get no indirect light from this provider. The GL
+// texture is created on the first frame() (the GL context must be current then) and deleted with the provider: destroy
+// it before the GL context.
 
 #include <engine/gpu/gl_objects.h>
 #include <engine/indirect_light.h>
@@ -20,6 +19,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <vector>
 
 namespace gi {
@@ -31,10 +31,10 @@ class LightAtlasLighting final : public engine::IndirectLightProvider {
   /// From a bake (its layout must come from atlas_inputs_from(bake_input_from(asset)));
   /// replaces `asset` with its uv1 copy. Error when the layout does not match the asset.
   static engine::Result<std::unique_ptr<LightAtlasLighting>> from_bake(LightAtlasBake bake, engine::SceneAsset& asset);
-  /// The same for a scene already instantiated: replaces `scene.assets` and points the
-  /// MeshRenderer of every node whose mesh was duplicated at its copy.
+  /// For a scene already instantiated, which stays unchanged: the static meshes with the
+  /// atlas's TEXCOORD_1 are handed to the renderer by atlas_meshes().
   static engine::Result<std::unique_ptr<LightAtlasLighting>> from_bake(const LightAtlasBake& bake,
-                                                                       engine::Scene& scene);
+                                                                       const engine::Scene& scene);
 
   LightAtlasLighting(const LightAtlasLighting&) = delete;
   LightAtlasLighting& operator=(const LightAtlasLighting&) = delete;
@@ -46,6 +46,9 @@ class LightAtlasLighting final : public engine::IndirectLightProvider {
   const engine::IndirectLightFrame& frame() override;
   /// "light atlas".
   const char* label() const override { return "light atlas"; }
+  /// The static meshes with the atlas's TEXCOORD_1 (empty from the SceneAsset overload,
+  /// whose asset holds them).
+  std::span<const engine::AtlasMesh> atlas_meshes() const override { return atlas_meshes_; }
 
   int atlas_width() const { return width_; }
   int atlas_height() const { return height_; }
@@ -58,6 +61,7 @@ class LightAtlasLighting final : public engine::IndirectLightProvider {
   std::vector<float> rgba_;  ///< Texels to upload; released after the upload.
   engine::GlTexture texture_;
   engine::IndirectLightFrame frame_;
+  std::vector<engine::AtlasMesh> atlas_meshes_;
 };
 
 }  // namespace gi

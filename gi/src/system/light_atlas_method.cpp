@@ -14,11 +14,12 @@ class LightAtlasMethod final : public MethodRuntime {
  public:
   explicit LightAtlasMethod(std::unique_ptr<LightAtlasLighting> lighting) : lighting_(std::move(lighting)) {}
   void frame(FrameState& state) override {
-    state.atlas_texture = lighting_->frame().irradiance_atlas_texture;
+    state.atlas_texture = lighting_->frame().irradiance_atlas_texture.gl_name;
     state.atlas_changed = !shown_;
     shown_ = true;
   }
   std::string label() const override { return lighting_->label(); }
+  std::span<const engine::AtlasMesh> atlas_meshes() const override { return lighting_->atlas_meshes(); }
 
  private:
   std::unique_ptr<LightAtlasLighting> lighting_;

@@ -21,6 +21,7 @@
 #include <filesystem>
 #include <memory>
 #include <optional>
+#include <span>
 #include <sstream>
 #include <string>
 
@@ -83,8 +84,11 @@ class MethodRuntime {
   /// it runs. A method that turned off keeps its frame() a no-op.
   virtual std::string disabled() const { return {}; }
   /// The dynamic objects' light, asked by the renderer through the frame (BRF).
-  virtual std::uint32_t vertex_irradiance_buffer(engine::Entity) const { return 0; }
+  virtual engine::SsboHandle<engine::VertexIrradiance> vertex_irradiance_buffer(engine::Entity) const { return {}; }
   virtual engine::IndirectLightFrame::VertexRadianceLobes vertex_radiance_lobes(engine::Entity) const { return {}; }
+  /// The static meshes with the atlas's TEXCOORD_1, for the renderer (the method that makes
+  /// the static world's atlas: the light atlas, or the PRM).
+  virtual std::span<const engine::AtlasMesh> atlas_meshes() const { return {}; }
 };
 
 /// The GL texture the methods that add into the atlas write to: RGBA32F, linear, clamped, of

@@ -27,6 +27,7 @@ namespace gi {
 
 struct PrmLighting::Impl {
   const engine::Registry* registry = nullptr;
+  std::vector<engine::AtlasMesh> atlas_meshes;  ///< The static meshes with TEXCOORD_1, for the renderer.
   Prm prm;
   std::vector<glm::vec3> base;              ///< Static-light atlas (empty: none).
   std::shared_ptr<const RayCaster> caster;  ///< The static world (shared with the other methods).
@@ -52,7 +53,7 @@ struct PrmLighting::Impl {
     stats.disabled = std::move(reason);
     prm.panes = {};
     pass.reset();
-    frame.irradiance_atlas_texture = 0;
+    frame.irradiance_atlas_texture = {};
     if (settings.log) settings.log(LogLevel::Warning, "PRM disabled: " + stats.disabled);
   }
 
@@ -98,7 +99,8 @@ PrmLighting::PrmLighting(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 PrmLighting::~PrmLighting() = default;
 
 engine::Result<std::unique_ptr<PrmLighting>> PrmLighting::from_bake(Prm prm, const LightAtlasBake* base,
-                                                                    engine::Scene& scene, PrmLightingSettings settings,
+                                                                    const engine::Scene& scene,
+                                                                    PrmLightingSettings settings,
                                                                     std::shared_ptr<const RayCaster> static_world) {
   if (base && (base->width != prm.width || base->height != prm.height ||
                base->layout.texels_per_metre != prm.layout.texels_per_metre))
@@ -111,8 +113,10 @@ engine::Result<std::unique_ptr<PrmLighting>> PrmLighting::from_bake(Prm prm, con
     if (!caster) return caster.error();
     static_world = std::move(caster).value();
   }
-  if (engine::Status s = apply_atlas_uv1(scene, prm.layout); !s) return s.error();
+  auto meshes = atlas_meshes_of(scene, prm.layout);
+  if (!meshes) return meshes.error();
   auto impl = std::make_unique<Impl>();
+  impl->atlas_meshes = std::move(meshes).value();
   impl->registry = &scene.registry;
   impl->prm = std::move(prm);
   if (base) impl->base = base->irradiance;
@@ -123,6 +127,8 @@ engine::Result<std::unique_ptr<PrmLighting>> PrmLighting::from_bake(Prm prm, con
   if (threads > 1) impl->pool = std::make_unique<ThreadPool>(threads);
   return std::unique_ptr<PrmLighting>(new PrmLighting(std::move(impl)));
 }
+
+std::span<const engine::AtlasMesh> PrmLighting::atlas_meshes() const { return impl_->atlas_meshes; }
 
 const engine::IndirectLightFrame& PrmLighting::frame() {
   Impl& m = *impl_;
@@ -139,7 +145,7 @@ const engine::IndirectLightFrame& PrmLighting::frame() {
     }
     m.pass.emplace(std::move(pass).value());
     if (!m.base.empty()) (void)m.pass->set_base(m.base);
-    m.frame.irradiance_atlas_texture = m.pass->texture();
+    m.frame.irradiance_atlas_texture = {m.pass->texture()};
     m.stats.gpu_bytes = m.pass->gpu_bytes();
   }
   using Clock = std::chrono::steady_clock;

@@ -8,10 +8,11 @@
 // heaviest clusters and re-sums their panes on the GPU. A frame where nothing moved does
 // nothing.
 // Internal to GISystem, which loads bundles.
-//   auto gi = gi::PrmLighting::from_bake(std::move(prm), &atlas, scene).value();  // before Renderer::create
+//   auto gi = gi::PrmLighting::from_bake(std::move(prm), &atlas, scene).value();
 //   renderer->set_indirect_light(gi.get());
 //
-// It gives the scene's static meshes TEXCOORD_1 (see LightAtlasLighting). The provider
+// It leaves the scene as it is and hands the renderer the static meshes with TEXCOORD_1
+// through atlas_meshes() (see LightAtlasLighting). The provider
 // reads lights from `scene.registry`, which must outlive it. GL objects are created on the
 // first frame() (the context must be current) and deleted with the provider.
 
@@ -52,7 +53,7 @@ class PrmLighting final : public engine::IndirectLightProvider {
  public:
   /// From bakes in memory (base may be null). Same layout required.
   static engine::Result<std::unique_ptr<PrmLighting>> from_bake(
-      Prm prm, const LightAtlasBake* base, engine::Scene& scene, PrmLightingSettings settings = {},
+      Prm prm, const LightAtlasBake* base, const engine::Scene& scene, PrmLightingSettings settings = {},
       std::shared_ptr<const RayCaster> static_world = nullptr);
 
   PrmLighting(const PrmLighting&) = delete;
@@ -62,6 +63,8 @@ class PrmLighting final : public engine::IndirectLightProvider {
   /// The irradiance atlas for this frame (re-summed only when a moving light changed).
   const engine::IndirectLightFrame& frame() override;
   const char* label() const override;
+  /// The static meshes with the PRM's atlas as TEXCOORD_1 (gi::atlas_meshes_of).
+  std::span<const engine::AtlasMesh> atlas_meshes() const override;
 
   struct Stats {
     std::uint64_t frames = 0;

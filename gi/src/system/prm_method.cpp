@@ -15,7 +15,7 @@ class PrmMethod final : public MethodRuntime {
  public:
   explicit PrmMethod(std::unique_ptr<PrmLighting> lighting) : lighting_(std::move(lighting)) {}
   void frame(FrameState& state) override {
-    state.atlas_texture = lighting_->frame().irradiance_atlas_texture;
+    state.atlas_texture = lighting_->frame().irradiance_atlas_texture.gl_name;
     state.moving_lights = lighting_.get();
     const PrmLighting::Stats& ps = lighting_->stats();
     if (ps.updates != seen_updates_) {
@@ -27,6 +27,7 @@ class PrmMethod final : public MethodRuntime {
     }
   }
   std::string label() const override { return lighting_->label(); }
+  std::span<const engine::AtlasMesh> atlas_meshes() const override { return lighting_->atlas_meshes(); }
   std::string disabled() const override { return lighting_->stats().disabled; }
 
  private:

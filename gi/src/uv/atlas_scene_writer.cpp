@@ -130,20 +130,29 @@ engine::Result<engine::SceneAsset> with_atlas_uv1(const engine::SceneAsset& scen
   return out;
 }
 
-engine::Status apply_atlas_uv1(engine::Scene& scene, const AtlasLayout& layout) {
-  auto with_uv1 = with_atlas_uv1(scene.assets, layout);
-  if (!with_uv1) return with_uv1.error();
-  const std::vector<engine::Node> before = scene.assets.nodes;
-  scene.assets = std::move(with_uv1).value();
-  // with_atlas_uv1 keeps the nodes and appends a mesh copy for a static node sharing its mesh.
-  for (std::size_t i = 0; i < before.size() && i < scene.node_entities.size(); ++i) {
-    const int mesh = scene.assets.nodes[i].mesh;
-    const engine::Entity e = scene.node_entities[i];
-    if (mesh == before[i].mesh || mesh < 0 || !scene.registry.valid(e)) continue;
-    if (scene.registry.has<engine::MeshRenderer>(e))
-      scene.registry.write<engine::MeshRenderer>(e).mesh = static_cast<std::uint32_t>(mesh);
+engine::Result<std::vector<engine::AtlasMesh>> atlas_meshes_of(const engine::Scene& scene, const AtlasLayout& layout) {
+  const engine::SceneAsset& assets = scene.assets;
+  std::vector<engine::AtlasMesh> out;
+  out.reserve(layout.meshes.size());
+  for (std::size_t i = 0; i < layout.meshes.size(); ++i) {
+    const AtlasMeshUv& uv = layout.meshes[i];
+    if (uv.id < 0 || static_cast<std::size_t>(uv.id) >= assets.nodes.size())
+      return mismatch(assets, i, "id " + std::to_string(uv.id) + " is not a node index");
+    const engine::Node& node = assets.nodes[static_cast<std::size_t>(uv.id)];
+    if (node.mesh < 0 || static_cast<std::size_t>(node.mesh) >= assets.meshes.size() ||
+        node.gi.mobility == engine::Mobility::Dynamic)
+      return mismatch(assets, i, "node " + std::to_string(uv.id) + " has no static mesh");
+    const auto m = static_cast<std::size_t>(node.mesh);
+    engine::Result<engine::Mesh> mesh = mesh_with_uv1(assets, assets.meshes[m], uv, i);
+    if (!mesh) return mesh.error();
+    // A node without a live entity draws nothing to give the atlas to.
+    const auto node_index = static_cast<std::size_t>(uv.id);
+    if (node_index >= scene.node_entities.size() || !scene.registry.valid(scene.node_entities[node_index])) continue;
+    out.push_back({.entity = scene.node_entities[node_index],
+                   .source_mesh = static_cast<std::uint32_t>(m),
+                   .mesh = std::move(mesh).value()});
   }
-  return {};
+  return out;
 }
 
 }  // namespace gi

@@ -1,11 +1,17 @@
 #pragma once
-// Writes an atlas layout back into scene data as TEXCOORD_1 (Primitive::uv1), so the light
-// atlas parameterization can be saved with engine::write_gltf and read by the renderer.
+// An atlas layout as TEXCOORD_1 (Primitive::uv1) of the static meshes: written into a copy
+// of scene data, so the light atlas parameterization can be saved with engine::write_gltf,
+// or handed to the renderer as atlas meshes (engine/indirect_light.h) beside a scene that
+// stays as the game made it.
 //   auto layout = gi::build_atlas_layout(gi::atlas_inputs_from(asset));
 //   engine::Result<engine::SceneAsset> with_uv1 = gi::with_atlas_uv1(asset, layout.value());
+//   auto meshes = gi::atlas_meshes_of(scene, layout.value());   // scene unchanged
 
+#include <engine/indirect_light.h>
 #include <engine/result.h>
 #include <engine/scene.h>
+
+#include <vector>
 #include <engine/scene_asset.h>
 
 #include "uv/atlas_layout.h"
@@ -25,9 +31,11 @@ namespace gi {
 /// Error when the layout does not match the scene (ids, vertex or triangle counts).
 engine::Result<engine::SceneAsset> with_atlas_uv1(const engine::SceneAsset& scene, const AtlasLayout& layout);
 
-/// The same for a scene already instantiated: replaces `scene.assets` with its uv1 copy and
-/// points the MeshRenderer of every node whose mesh was duplicated at its copy. On error
-/// the scene is unchanged.
-engine::Status apply_atlas_uv1(engine::Scene& scene, const AtlasLayout& layout);
+/// For a scene already instantiated, without changing it: per static mesh instance of the
+/// layout whose node has a live entity, that entity's mesh with the layout's uv1 (vertices
+/// split as above), to draw in place of the scene's mesh (engine::IndirectLightProvider::
+/// atlas_meshes). Each instance gets its own mesh, whether or not its mesh is shared.
+/// Error when the layout does not match the scene, as with_atlas_uv1.
+engine::Result<std::vector<engine::AtlasMesh>> atlas_meshes_of(const engine::Scene& scene, const AtlasLayout& layout);
 
 }  // namespace gi

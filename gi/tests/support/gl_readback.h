@@ -12,6 +12,8 @@
 
 #include <glm/glm.hpp>
 
+#include <engine/indirect_light.h>
+
 namespace gltest {
 
 /// RGB of level 0 of a w x h RGBA float texture, row-major.
@@ -21,6 +23,11 @@ inline std::vector<glm::vec3> read_texture(std::uint32_t texture, int w, int h) 
   std::vector<glm::vec3> out(rgba.size() / 4);
   for (std::size_t i = 0; i < out.size(); ++i) out[i] = {rgba[4 * i], rgba[4 * i + 1], rgba[4 * i + 2]};
   return out;
+}
+
+/// The same for a provider's texture.
+inline std::vector<glm::vec3> read_texture(engine::TextureHandle texture, int w, int h) {
+  return read_texture(texture.gl_name, w, h);
 }
 
 }  // namespace gltest

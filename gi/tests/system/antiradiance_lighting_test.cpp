@@ -51,7 +51,7 @@ TEST(AntiradianceLighting, TheCorridorDoorChangesTheAtlasOnlyOnFramesItMoves) {
   EXPECT_NE(gi.describe().find("antiradiance:"), std::string::npos) << gi.describe();
 
   GLint w = 0, h = 0;
-  const std::uint32_t t0 = gi.frame().irradiance_atlas_texture;
+  const std::uint32_t t0 = gi.frame().irradiance_atlas_texture.gl_name;
   ASSERT_NE(t0, 0u);
   glGetTextureLevelParameteriv(t0, 0, GL_TEXTURE_WIDTH, &w);
   glGetTextureLevelParameteriv(t0, 0, GL_TEXTURE_HEIGHT, &h);
@@ -65,7 +65,7 @@ TEST(AntiradianceLighting, TheCorridorDoorChangesTheAtlasOnlyOnFramesItMoves) {
   const engine::Entity door = engine::find_by_name(scene.registry, "door");
   scene.registry.write<engine::Transform>(door).rotation = glm::angleAxis(glm::radians(100.0f), glm::vec3(0, 1, 0));
   engine::update_world_transforms(scene.registry);
-  const std::uint32_t t1 = gi.frame().irradiance_atlas_texture;
+  const std::uint32_t t1 = gi.frame().irradiance_atlas_texture.gl_name;
   EXPECT_EQ(gi.stats().antiradiance_updates, 1u);
   EXPECT_GT(gi.stats().antiradiance_relinked_elements, 0u);
   EXPECT_GT(gi.stats().last_antiradiance_ms, 0.0);

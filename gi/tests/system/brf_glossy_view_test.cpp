@@ -71,7 +71,7 @@ void place_camera(engine::Scene& scene, const glm::vec3& eye, const glm::vec3& t
 struct WithoutLobes final : engine::IndirectLightProvider {
   struct Frame final : engine::IndirectLightFrame {
     const engine::IndirectLightFrame* inner = nullptr;
-    std::uint32_t vertex_irradiance_buffer(engine::Entity e) const override {
+    engine::SsboHandle<engine::VertexIrradiance> vertex_irradiance_buffer(engine::Entity e) const override {
       return inner->vertex_irradiance_buffer(e);
     }
   };
@@ -84,6 +84,7 @@ struct WithoutLobes final : engine::IndirectLightProvider {
     return frame_;
   }
   const char* label() const override { return "without lobes"; }
+  std::span<const engine::AtlasMesh> atlas_meshes() const override { return gi->atlas_meshes(); }
 };
 
 glm::vec3 pixel(const engine::ImageRgbaF& img, int x, int y) {
@@ -137,7 +138,7 @@ TEST(BrfGlossyView, TheMetalCratesViewDependentBounceIsDrawnAsThePathTracerSeesI
   (void)gi.frame();
   const engine::IndirectLightFrame::VertexRadianceLobes lobes = gi.frame().vertex_radiance_lobes(crate);
   ASSERT_GT(lobes.terms, 0);
-  EXPECT_NE(lobes.coefficient_buffer, 0u);
+  EXPECT_NE(lobes.coefficient_buffer.gl_name, 0u);
   EXPECT_EQ(gi.frame().vertex_radiance_lobes(engine::find_by_name(scene.registry, "crate_2")).terms, 0);
 
   auto renderer = engine::Renderer::create(scene.assets, {.width = kWidth, .height = kHeight});
@@ -166,11 +167,11 @@ TEST(BrfGlossyView, TheMetalCratesViewDependentBounceIsDrawnAsThePathTracerSeesI
       centre = j;
   const std::size_t nv = mesh.positions.size();
   std::vector<glm::vec4> terms(nv * static_cast<std::size_t>(1 + lobes.terms));
-  glGetNamedBufferSubData(lobes.coefficient_buffer, 0, static_cast<GLsizeiptr>(terms.size() * sizeof(glm::vec4)),
-                          terms.data());
+  glGetNamedBufferSubData(lobes.coefficient_buffer.gl_name, 0,
+                          static_cast<GLsizeiptr>(terms.size() * sizeof(glm::vec4)), terms.data());
   {
     std::vector<glm::vec4> v(mesh.positions.size() * 2);
-    glGetNamedBufferSubData(gi.frame().vertex_irradiance_buffer(crate), 0,
+    glGetNamedBufferSubData(gi.frame().vertex_irradiance_buffer(crate).gl_name, 0,
                             static_cast<GLsizeiptr>(v.size() * sizeof(glm::vec4)), v.data());
     glm::dvec3 e(0.0);
     for (int s = 0; s < 4096; ++s) {

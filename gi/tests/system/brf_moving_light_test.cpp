@@ -103,7 +103,7 @@ Face facing_side(engine::Scene& scene, engine::Entity crate) {
 }
 
 std::vector<glm::vec3> read_face(gi::GISystem& gi, engine::Entity crate, const Face& f) {
-  const std::uint32_t buffer = gi.frame().vertex_irradiance_buffer(crate);
+  const std::uint32_t buffer = gi.frame().vertex_irradiance_buffer(crate).gl_name;
   EXPECT_NE(buffer, 0u);
   GLint64 bytes = 0;
   glGetNamedBufferParameteri64v(buffer, GL_BUFFER_SIZE, &bytes);

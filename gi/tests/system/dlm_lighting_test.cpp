@@ -138,7 +138,7 @@ TEST(DlmLighting, UniformBinsGiveExactlyTheAtlasSpecularShare) {
   Combined plain(atlas->get(), nullptr), with(atlas->get(), dlm->get());
   const engine::ImageRgbaF a = f->render(&plain);
   const engine::ImageRgbaF b = f->render(&with);
-  ASSERT_NE(with.frame().directional_index_texture, 0u);
+  ASSERT_TRUE(with.frame().directional_index_texture);
   double max_rel = 0.0;
   for (std::size_t i = 0; i < a.pixels.size(); ++i) {
     if (i % 4 == 3) continue;
@@ -310,7 +310,7 @@ TEST(DlmLighting, GISystemLoadsTheGlossyRoomsMapsAndRefusesADamagedFile) {
     EXPECT_GT((*gi_system)->stats().dlm_texels, 0u);
     EXPECT_GT((*gi_system)->stats().dlm_gpu_bytes, 0u);
     const engine::IndirectLightFrame& frame = (*gi_system)->frame();
-    EXPECT_NE(frame.directional_index_texture, 0u);
+    EXPECT_TRUE(frame.directional_index_texture);
     EXPECT_EQ(frame.directional_bin_count, 32);
     EXPECT_EQ(static_cast<std::size_t>(frame.directional_element_count), (*gi_system)->stats().dlm_texels);
   }

@@ -8,6 +8,7 @@
 #include <engine/components.h>
 #include <engine/gltf.h>
 #include <engine/gpu/context.h>
+#include <engine/renderer.h>
 #include <engine/scene.h>
 #include <gi/gi_system.h>
 #include <gi/plan.h>
@@ -24,6 +25,7 @@
 #include "light_atlas/light_atlas.h"
 #include "light_atlas/light_atlas_io.h"
 #include "transport/static_scene.h"
+#include "uv/atlas_scene_writer.h"
 
 namespace {
 
@@ -121,9 +123,9 @@ TEST(GISystem, RecomputesOnlyWhatChanged) {
 
   // Per-vertex buffers for the crates only, finite and non-negative.
   const engine::Entity crate = engine::find_by_name(scene.registry, "crate_1");
-  const std::uint32_t buffer = gi.frame().vertex_irradiance_buffer(crate);
+  const std::uint32_t buffer = gi.frame().vertex_irradiance_buffer(crate).gl_name;
   ASSERT_NE(buffer, 0u);
-  EXPECT_EQ(gi.frame().vertex_irradiance_buffer(engine::find_by_name(scene.registry, "statue")), 0u);
+  EXPECT_FALSE(gi.frame().vertex_irradiance_buffer(engine::find_by_name(scene.registry, "statue")));
   GLint64 bytes = 0;
   glGetNamedBufferParameteri64v(buffer, GL_BUFFER_SIZE, &bytes);
   std::vector<glm::vec4> v(static_cast<std::size_t>(bytes) / sizeof(glm::vec4));
@@ -173,6 +175,106 @@ TEST(GISystem, TheRedCrateTurnsTheStatuePink) {
   EXPECT_GT(near.x - near.y, 0.1);                                  // red light
   EXPECT_GT(near.x - near.y, 5.0 * std::max(far.x - far.y, 1e-6));  // from the crate that came close
   EXPECT_LT(near.y, far.y);                                         // and it blocks the world's light
+}
+
+TEST(GISystem, LoadLeavesTheScenesAssetsUnchanged) {
+  engine::Scene scene = crates_room();
+  const engine::SceneAsset before = scene.assets;
+  std::vector<std::uint32_t> meshes_before;
+  for (engine::Entity e : scene.node_entities)
+    if (const auto* mr = scene.registry.try_get<engine::MeshRenderer>(e)) meshes_before.push_back(mr->mesh);
+  auto loaded = gi::GISystem::load(bundle().dir, scene);
+  ASSERT_TRUE(loaded) << loaded.error().to_string();
+
+  ASSERT_EQ(scene.assets.meshes.size(), before.meshes.size());
+  for (std::size_t m = 0; m < before.meshes.size(); ++m) {
+    ASSERT_EQ(scene.assets.meshes[m].primitives.size(), before.meshes[m].primitives.size());
+    for (std::size_t p = 0; p < before.meshes[m].primitives.size(); ++p) {
+      const engine::Primitive& now = scene.assets.meshes[m].primitives[p];
+      const engine::Primitive& was = before.meshes[m].primitives[p];
+      EXPECT_EQ(now.positions, was.positions) << "mesh " << m;
+      EXPECT_EQ(now.normals, was.normals) << "mesh " << m;
+      EXPECT_EQ(now.uv0, was.uv0) << "mesh " << m;
+      EXPECT_EQ(now.uv1, was.uv1) << "mesh " << m << ": no TEXCOORD_1 written into the game's scene";
+      EXPECT_EQ(now.indices, was.indices) << "mesh " << m;
+    }
+  }
+  ASSERT_EQ(scene.assets.nodes.size(), before.nodes.size());
+  for (std::size_t n = 0; n < before.nodes.size(); ++n) EXPECT_EQ(scene.assets.nodes[n].mesh, before.nodes[n].mesh);
+  std::vector<std::uint32_t> meshes_after;
+  for (engine::Entity e : scene.node_entities)
+    if (const auto* mr = scene.registry.try_get<engine::MeshRenderer>(e)) meshes_after.push_back(mr->mesh);
+  EXPECT_EQ(meshes_after, meshes_before);
+
+  // The atlas's TEXCOORD_1 goes to the renderer instead: one atlas mesh per static instance
+  // the layout holds, for that node's entity and mesh.
+  const std::span<const engine::AtlasMesh> atlas = (*loaded)->atlas_meshes();
+  ASSERT_EQ(atlas.size(), bundle().atlas.layout.meshes.size());
+  for (std::size_t i = 0; i < atlas.size(); ++i) {
+    const auto node = static_cast<std::size_t>(bundle().atlas.layout.meshes[i].id);
+    EXPECT_EQ(atlas[i].entity, scene.node_entities[node]);
+    EXPECT_EQ(atlas[i].source_mesh, static_cast<std::uint32_t>(before.nodes[node].mesh));
+    for (const engine::Primitive& p : atlas[i].mesh.primitives) EXPECT_EQ(p.uv1.size(), p.positions.size());
+  }
+}
+
+// The GI system's light without its atlas meshes: for a renderer made from a scene that
+// holds TEXCOORD_1 itself (how the GI was drawn when load wrote it into the scene).
+struct WithoutAtlasMeshes final : engine::IndirectLightProvider {
+  engine::IndirectLightProvider* gi = nullptr;
+  const engine::IndirectLightFrame& frame() override { return gi->frame(); }
+  const char* label() const override { return gi->label(); }
+};
+
+enum class Order { RendererFirst, LoadFirst, Uv1InTheScene };
+
+// The crates room drawn with the GI, the renderer made before or after GISystem::load, or
+// from the scene with the atlas's TEXCOORD_1 written into it.
+engine::ImageRgba8 crates_room_frame(Order order) {
+  engine::Scene scene = crates_room();
+  engine::RenderSettings settings;
+  settings.width = 96;
+  settings.height = 64;
+  std::unique_ptr<engine::Renderer> renderer;
+  if (order == Order::RendererFirst) renderer = engine::Renderer::create(scene.assets, settings).value();
+  auto loaded = gi::GISystem::load(bundle().dir, scene);
+  EXPECT_TRUE(loaded) << loaded.error().to_string();
+  if (!loaded) return {};
+  WithoutAtlasMeshes without;
+  without.gi = loaded->get();
+  if (order == Order::LoadFirst) renderer = engine::Renderer::create(scene.assets, settings).value();
+  if (order == Order::Uv1InTheScene) {
+    auto with_uv1 = gi::with_atlas_uv1(scene.assets, bundle().atlas.layout);
+    EXPECT_TRUE(with_uv1) << with_uv1.error().to_string();
+    if (!with_uv1) return {};
+    EXPECT_EQ(with_uv1->meshes.size(), scene.assets.meshes.size()) << "no static mesh shared by two nodes";
+    renderer = engine::Renderer::create(*with_uv1, settings).value();
+  }
+  renderer->set_indirect_light(order == Order::Uv1InTheScene ? static_cast<engine::IndirectLightProvider*>(&without)
+                                                             : loaded->get());
+  renderer->render(scene.registry, engine::find_camera(scene.registry));
+  return renderer->read_ldr();
+}
+
+TEST(GISystem, TheRendererMayBeCreatedBeforeOrAfterLoad) {
+  auto ctx = engine::GpuContext::create_headless();
+  ASSERT_TRUE(ctx) << "no headless GL context: " << ctx.error().to_string();
+  const engine::ImageRgba8 after = crates_room_frame(Order::LoadFirst);
+  const engine::ImageRgba8 before = crates_room_frame(Order::RendererFirst);
+  ASSERT_FALSE(after.pixels.empty());
+  EXPECT_EQ(before.width, after.width);
+  EXPECT_EQ(before.pixels, after.pixels) << "the same frame, whichever was made first";
+  // ... and the frame drawn when load wrote TEXCOORD_1 into the scene, to the bit.
+  EXPECT_EQ(crates_room_frame(Order::Uv1InTheScene).pixels, after.pixels);
+
+  // And the atlas reaches the static surfaces: without the GI the frame differs.
+  engine::Scene scene = crates_room();
+  engine::RenderSettings settings;
+  settings.width = 96;
+  settings.height = 64;
+  auto plain = engine::Renderer::create(scene.assets, settings).value();
+  plain->render(scene.registry, engine::find_camera(scene.registry));
+  EXPECT_NE(plain->read_ldr().pixels, after.pixels);
 }
 
 TEST(GISystem, ABundleOfOtherMeshesIsRejectedAsStale) {
@@ -227,7 +329,7 @@ TEST(GISystem, AMetalCrateBouncesAsAGlossyObject) {
   const engine::MeshRenderer& mr = scene.registry.get<engine::MeshRenderer>(crate_2);
   const gi::BrfMesh mesh = gi::brf_mesh_from_input(gi::bake_input_from(scene.assets), mr.mesh).value();
   const auto facing_light = [&] {
-    const std::uint32_t buffer = gi.frame().vertex_irradiance_buffer(crate_2);
+    const std::uint32_t buffer = gi.frame().vertex_irradiance_buffer(crate_2).gl_name;
     std::vector<glm::vec4> v(mesh.positions.size());
     glGetNamedBufferSubData(buffer, 0, static_cast<GLsizeiptr>(v.size() * sizeof(glm::vec4)), v.data());
     glm::dvec3 sum(0.0);

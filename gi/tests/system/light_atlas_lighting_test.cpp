@@ -152,7 +152,7 @@ TEST(LightAtlasLighting, ConstantAtlasMatchesTheConstantAmbientStandIn) {
 
   const engine::ImageRgbaF stand_in = f->render(nullptr, kAmbient);
   const engine::ImageRgbaF atlas = f->render(provider.get(), /*ignored*/ 0.0f);
-  ASSERT_NE(provider->frame().irradiance_atlas_texture, 0u);
+  ASSERT_TRUE(provider->frame().irradiance_atlas_texture);
   ASSERT_EQ(atlas.pixels.size(), stand_in.pixels.size());
   // Tolerance: 1e-3 relative + 1e-7 absolute per channel, one step of the renderer's RGBA16F
   // HDR target (11-bit mantissa). Bilinear reads of a constant texture return it exactly;
@@ -264,8 +264,8 @@ TEST(LightAtlasLighting, LoadsABundleAndGivesTheSceneUv1) {
   EXPECT_NE(stale.error().to_string().find("stale"), std::string::npos) << stale.error().to_string();
 }
 
-TEST(LightAtlasLighting, LoadIntoAnInstantiatedSceneFollowsDuplicatedMeshes) {
-  // Two static nodes share one quad mesh: with_atlas_uv1 gives the second its own copy.
+TEST(LightAtlasLighting, LoadIntoAnInstantiatedSceneLeavesItAndGivesEachInstanceAnAtlasMesh) {
+  // Two static nodes share one quad mesh: each gets its own atlas mesh, the scene keeps one.
   engine::SceneAsset asset;
   engine::Primitive quad;
   quad.positions = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
@@ -289,11 +289,20 @@ TEST(LightAtlasLighting, LoadIntoAnInstantiatedSceneFollowsDuplicatedMeshes) {
   ASSERT_TRUE(bake.ok()) << bake.error().to_string();
   auto provider = gi::LightAtlasLighting::from_bake(*bake, scene);
   ASSERT_TRUE(provider.ok()) << provider.error().to_string();
-  ASSERT_EQ(scene.assets.meshes.size(), 2u);
+  // The scene is left as the game made it: one mesh, both nodes on it, no TEXCOORD_1.
+  ASSERT_EQ(scene.assets.meshes.size(), 1u);
+  EXPECT_TRUE(scene.assets.meshes[0].primitives[0].uv1.empty());
+  for (std::size_t i = 0; i < 2; ++i)
+    EXPECT_EQ(scene.registry.get<engine::MeshRenderer>(scene.node_entities[i]).mesh, 0u) << "node " << i;
+  // Each instance gets its own atlas mesh, with its own region of the atlas.
+  const std::span<const engine::AtlasMesh> atlas = (*provider)->atlas_meshes();
+  ASSERT_EQ(atlas.size(), 2u);
   for (std::size_t i = 0; i < 2; ++i) {
-    const auto mesh = static_cast<std::uint32_t>(scene.assets.nodes[i].mesh);
-    EXPECT_EQ(scene.registry.get<engine::MeshRenderer>(scene.node_entities[i]).mesh, mesh) << "node " << i;
-    EXPECT_EQ(scene.assets.meshes[mesh].primitives[0].uv1.size(), 4u);
+    EXPECT_EQ(atlas[i].entity, scene.node_entities[i]) << "node " << i;
+    EXPECT_EQ(atlas[i].source_mesh, 0u);
+    ASSERT_EQ(atlas[i].mesh.primitives.size(), 1u);
+    EXPECT_EQ(atlas[i].mesh.primitives[0].uv1.size(), 4u);
+    EXPECT_EQ(atlas[i].mesh.primitives[0].positions, quad.positions);
   }
-  EXPECT_NE(scene.assets.nodes[0].mesh, scene.assets.nodes[1].mesh);
+  EXPECT_NE(atlas[0].mesh.primitives[0].uv1, atlas[1].mesh.primitives[0].uv1);
 }

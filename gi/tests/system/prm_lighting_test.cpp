@@ -62,7 +62,7 @@ TEST(PrmLighting, UpdatesOnlyWhenAMovingLightChangesAndMatchesTheCpuSum) {
     EXPECT_LT(worst, 1e-4);  // the same decoded panes: only the float summation order differs
   };
 
-  const std::uint32_t tex = gi.frame().irradiance_atlas_texture;
+  const std::uint32_t tex = gi.frame().irradiance_atlas_texture.gl_name;
   ASSERT_NE(tex, 0u);
   EXPECT_EQ(gi.stats().updates, 1u);
   const std::vector<glm::vec3> first = read_texture(tex, cpu_copy.width, cpu_copy.height);
@@ -122,7 +122,7 @@ TEST(PrmLighting, OnlyTheLightThatMovedIsRecomputed) {
 
   scene.registry.write<engine::Transform>(second).position = {0.5f, 1.0f, -0.4f};
   engine::update_world_transforms(scene.registry);
-  const std::uint32_t tex = gi.frame().irradiance_atlas_texture;
+  const std::uint32_t tex = gi.frame().irradiance_atlas_texture.gl_name;
   EXPECT_EQ(gi.stats().updates, 2u);
   EXPECT_EQ(gi.stats().last_lights_recomputed, 1u);
   EXPECT_EQ(gi.stats().last_lights_reused, 1u);

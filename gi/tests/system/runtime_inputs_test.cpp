@@ -92,13 +92,13 @@ TEST(RuntimeInputs, NanOrAbsurdLightsAndObjectsAreSkippedOnceAndEverythingStaysF
   const auto frame = [&] {
     gi.frame();
     (*renderer)->render(scene.registry, camera);
-    const std::uint32_t atlas = gi.frame().irradiance_atlas_texture;
+    const std::uint32_t atlas = gi.frame().irradiance_atlas_texture.gl_name;
     glGetTextureLevelParameteriv(atlas, 0, GL_TEXTURE_WIDTH, &atlas_w);
     glGetTextureLevelParameteriv(atlas, 0, GL_TEXTURE_HEIGHT, &atlas_h);
     return (*renderer)->read_hdr();
   };
   const auto crate_light = [&] {
-    const std::uint32_t buffer = gi.frame().vertex_irradiance_buffer(crate);
+    const std::uint32_t buffer = gi.frame().vertex_irradiance_buffer(crate).gl_name;
     GLint64 bytes = 0;
     glGetNamedBufferParameteri64v(buffer, GL_BUFFER_SIZE, &bytes);
     std::vector<glm::vec4> v(static_cast<std::size_t>(bytes) / sizeof(glm::vec4));
