@@ -92,9 +92,9 @@ inline engine::SplitView split_of(const Simulation& sim) {
 /// The indirect light of a run: with --gi-bundle, the GI system of the bundle (light atlas,
 /// PRM for the moving lights, basis radiance fields for the crates; gi::GISystem) loaded
 /// against the simulation's scene (which it leaves as it is: the atlas UVs reach the renderer
-/// through the provider's atlas meshes, so the renderer may come before or after); without it, nullptr (the renderer's constant-ambient stand-in). Prints the error and
-/// returns false when the bundle does not load (missing, damaged, or baked from other
-/// geometry). Call with the GL context current; destroy the system before the context.
+/// through the provider's atlas meshes, so the renderer may come before or after); without it, nullptr (the renderer's
+/// constant-ambient stand-in). Prints the error and returns false when the bundle does not load (missing, damaged, or
+/// baked from other geometry). Call with the GL context current; destroy the system before the context.
 bool load_indirect_light(const RunOptions& options, Simulation& sim, std::unique_ptr<gi::GISystem>& system);
 
 /// One line for stdout and the overlay: which indirect light is used.
