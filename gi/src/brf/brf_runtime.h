@@ -36,7 +36,9 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <span>
+#include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -51,6 +53,33 @@ namespace gi {
 class RayCaster;
 struct BrfLodPoints;  // brf_lod.h
 
+/// One rigid object's baked data, what the bake produces and the bundle holds with the mesh it
+/// was baked for: the mesh (object space), its PCA basis and the basis radiance field around
+/// it, and a glossy mesh's separated lobe (the basis and field were baked with it; none:
+/// diffuse). The CPU twin, the GPU pass (brf_gpu_pass.h) and BrfLighting all take it.
+///   gi::BrfModel crate{"crate", mesh, basis, field};
+///   auto pass = gi::BrfGpuPass::create(std::span(&crate, 1)).value();
+struct BrfModel {
+  std::string name;  ///< BrfSource::name; for messages.
+  BrfMesh mesh;
+  BrfBasis basis;
+  BasisRadianceField field;
+  std::optional<BrdfSeparation> glossy;
+  /// The glossy lobe or nullptr (diffuse).
+  const BrdfSeparation* glossy_lobe() const { return glossy ? &*glossy : nullptr; }
+};
+
+/// One placed object: the model it draws (an index into the caller's models) and its state
+/// this frame.
+struct BrfInstance {
+  std::uint32_t model = 0;
+  glm::mat4 object_to_world{1.0f};  ///< Rigid (rotation + translation; uniform scale allowed).
+  glm::vec3 albedo{0.8f};           ///< Diffuse albedo.
+  glm::vec3 specular{1.0f};         ///< Glossy colour: f0 (RGB) / glossy->lobe.f0; unused for a diffuse model.
+};
+
+/// An instance with its model's parts resolved, as the CPU twin's functions take it
+/// (brf_object() builds one; tests and tools may point at parts they hold themselves).
 struct BrfObject {
   const BrfMesh* mesh = nullptr;
   const BrfBasis* basis = nullptr;
@@ -63,6 +92,12 @@ struct BrfObject {
 
   int terms() const { return field->terms; }
 };
+
+/// `instance` of `model` as the CPU twin takes it (pointing into `model`).
+inline BrfObject brf_object(const BrfModel& model, const BrfInstance& instance) {
+  return {&model.mesh,     &model.basis,        &model.field,     instance.object_to_world,
+          instance.albedo, model.glossy_lobe(), instance.specular};
+}
 
 struct BrfUpdateSettings {
   int bounces = 3;
