@@ -237,9 +237,9 @@ const RoomObjects& crates_room() {
     for (const gi::BrfSource& src : r.sources) r.bakes.push_back(gi::bake_brf_mesh(src, settings).value());
     for (std::size_t m = 0; m < r.sources.size(); ++m)
       for (std::uint32_t i : r.sources[m].instances)
-        r.objects.push_back({&r.sources[m].mesh, &r.bakes[m].basis, &r.bakes[m].field,
+        r.objects.push_back({&r.sources[m].mesh, &r.bakes[m].model.basis, &r.bakes[m].model.field,
                              input.instances[i].object_to_world, gi::brf_source_albedo(input, r.sources[m]),
-                             r.bakes[m].glossy ? &*r.bakes[m].glossy : nullptr, r.sources[m].specular});
+                             r.bakes[m].model.glossy ? &*r.bakes[m].model.glossy : nullptr, r.sources[m].specular});
     return r;
   }();
   return room;

@@ -36,14 +36,13 @@
 
 #include <array>
 #include <cstdint>
-#include <optional>
 #include <span>
-#include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
 
 #include "brf/brdf_separation.h"
+#include "brf/brf_model.h"
 #include "brf/pca_basis.h"
 #include "brf/radiance_field.h"
 #include "transport/point_emitters.h"
@@ -52,22 +51,6 @@ namespace gi {
 
 class RayCaster;
 struct BrfLodPoints;  // brf_lod.h
-
-/// One rigid object's baked data, what the bake produces and the bundle holds with the mesh it
-/// was baked for: the mesh (object space), its PCA basis and the basis radiance field around
-/// it, and a glossy mesh's separated lobe (the basis and field were baked with it; none:
-/// diffuse). The CPU twin, the GPU pass (brf_gpu_pass.h) and BrfLighting all take it.
-///   gi::BrfModel crate{"crate", mesh, basis, field};
-///   auto pass = gi::BrfGpuPass::create(std::span(&crate, 1)).value();
-struct BrfModel {
-  std::string name;  ///< BrfSource::name; for messages.
-  BrfMesh mesh;
-  BrfBasis basis;
-  BasisRadianceField field;
-  std::optional<BrdfSeparation> glossy;
-  /// The glossy lobe or nullptr (diffuse).
-  const BrdfSeparation* glossy_lobe() const { return glossy ? &*glossy : nullptr; }
-};
 
 /// One placed object: the model it draws (an index into the caller's models) and its state
 /// this frame.

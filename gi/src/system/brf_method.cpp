@@ -84,16 +84,15 @@ engine::Result<BrfModels> read_models(const MethodLoad& load) {
   if (!loaded) return loaded.error();
   BrfModels out;
   for (std::size_t i = 0; i < sources->size(); ++i) {
-    BrfSource& src = (*sources)[i];
-    BrfMeshBake& b = loaded->meshes[i];
+    const BrfSource& src = (*sources)[i];
     const auto model = static_cast<std::uint32_t>(out.models.size());
     const glm::vec3 albedo = brf_source_albedo(load.input, src);
     for (std::uint32_t k : src.instances) {
       out.instances.push_back({.model = model, .albedo = albedo, .specular = src.specular});
       out.entities.push_back(load.input.instances[k].entity);
     }
-    if (b.glossy) out.glossy.push_back(src.name);
-    out.models.push_back({src.name, std::move(src.mesh), std::move(b.basis), std::move(b.field), std::move(b.glossy)});
+    if (loaded->meshes[i].model.glossy) out.glossy.push_back(src.name);
+    out.models.push_back(std::move(loaded->meshes[i].model));
   }
   return out;
 }
