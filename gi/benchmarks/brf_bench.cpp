@@ -157,14 +157,14 @@ BENCHMARK(BM_BrfInterreflectCpuGlossy)->Arg(1)->Arg(5)->Arg(10)->Arg(30)->Unit(b
 void run_gpu_pass(benchmark::State& state, int n, bool moving, const gi::BrfUpdateSettings& settings) {
   (void)bench::gl_context();
   const Shared& s = shared();
-  const gi::BrfGpuModel model{&s.mesh, &s.basis, &s.field};
+  const gi::BrfModel model{"", s.mesh, s.basis, s.field};
   auto pass = gi::BrfGpuPass::create(std::span(&model, 1));
   if (!pass) {
     state.SkipWithError(pass.error().to_string().c_str());
     return;
   }
   const gi::PointEmitter light = grid_light(n);
-  std::vector<gi::BrfGpuInstance> poses[2];
+  std::vector<gi::BrfInstance> poses[2];
   for (int k = 0; k < 2; ++k)
     for (const gi::BrfObject& o : crates(n, 0.02f * static_cast<float>(k)))
       poses[k].push_back({0, o.object_to_world, o.albedo});
@@ -237,9 +237,9 @@ const RoomObjects& crates_room() {
     for (const gi::BrfSource& src : r.sources) r.bakes.push_back(gi::bake_brf_mesh(src, settings).value());
     for (std::size_t m = 0; m < r.sources.size(); ++m)
       for (std::uint32_t i : r.sources[m].instances)
-        r.objects.push_back({&r.sources[m].mesh, &r.bakes[m].basis, &r.bakes[m].field,
+        r.objects.push_back({&r.sources[m].mesh, &r.bakes[m].model.basis, &r.bakes[m].model.field,
                              input.instances[i].object_to_world, gi::brf_source_albedo(input, r.sources[m]),
-                             r.bakes[m].glossy ? &*r.bakes[m].glossy : nullptr, r.sources[m].specular});
+                             r.bakes[m].model.glossy ? &*r.bakes[m].model.glossy : nullptr, r.sources[m].specular});
     return r;
   }();
   return room;
@@ -291,14 +291,14 @@ void BM_BrfGpuOcclusion(benchmark::State& state) {
   const Shared& s = shared();
   const int n = static_cast<int>(state.range(0));
   const bool moving = state.range(1) != 0;
-  const gi::BrfGpuModel model{&s.mesh, &s.basis, &s.field};
+  const gi::BrfModel model{"", s.mesh, s.basis, s.field};
   auto pass = gi::BrfGpuPass::create(std::span(&model, 1));
   if (!pass) {
     state.SkipWithError(pass.error().to_string().c_str());
     return;
   }
   const gi::PointEmitter light = grid_light(n);
-  std::vector<gi::BrfGpuInstance> poses[2];
+  std::vector<gi::BrfInstance> poses[2];
   for (int k = 0; k < 2; ++k)
     for (const gi::BrfObject& o : crates(n, 0.02f * static_cast<float>(k)))
       poses[k].push_back({0, o.object_to_world, o.albedo});
@@ -327,14 +327,14 @@ void BM_BrfGpuInfluence(benchmark::State& state) {
   (void)bench::gl_context();
   const Shared& s = shared();
   const int n = static_cast<int>(state.range(0));
-  const gi::BrfGpuModel model{&s.mesh, &s.basis, &s.field};
+  const gi::BrfModel model{"", s.mesh, s.basis, s.field};
   auto pass = gi::BrfGpuPass::create(std::span(&model, 1));
   if (!pass) {
     state.SkipWithError(pass.error().to_string().c_str());
     return;
   }
   const gi::PointEmitter light = grid_light(n);
-  std::vector<gi::BrfGpuInstance> poses[2];
+  std::vector<gi::BrfInstance> poses[2];
   for (int k = 0; k < 2; ++k)
     for (const gi::BrfObject& o : crates(n, 0.02f * static_cast<float>(k)))
       poses[k].push_back({0, o.object_to_world, o.albedo});
@@ -422,7 +422,7 @@ void BM_BrfGpuGlossy(benchmark::State& state) {
   (void)bench::gl_context();
   static const SharedGlossy g;
   const int n = static_cast<int>(state.range(0));
-  const gi::BrfGpuModel model{&g.mesh, &g.basis, &g.field, &g.sep};
+  const gi::BrfModel model{"", g.mesh, g.basis, g.field, g.sep};
   auto pass = gi::BrfGpuPass::create(std::span(&model, 1));
   if (!pass) {
     state.SkipWithError(pass.error().to_string().c_str());
@@ -432,7 +432,7 @@ void BM_BrfGpuGlossy(benchmark::State& state) {
   std::vector<gi::BrfObject> objects = crates(n);
   for (gi::BrfObject& o : objects)
     o.basis = &g.basis, o.field = &g.field, o.glossy = &g.sep, o.albedo = glm::vec3(0.0f);
-  std::vector<gi::BrfGpuInstance> poses[2];
+  std::vector<gi::BrfInstance> poses[2];
   for (int k = 0; k < 2; ++k)
     for (const gi::BrfObject& o : crates(n, 0.02f * static_cast<float>(k)))
       poses[k].push_back({0, o.object_to_world, glm::vec3(0.0f)});

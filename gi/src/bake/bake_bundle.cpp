@@ -136,13 +136,14 @@ engine::Status bake_brf_method(const BakeInput& input, const fs::path& dir, cons
     if (!mesh) return mesh.error();
     stage.log(
         format_line("  %-16s %6zu vertices, %zu instances, basis %d of %d kept, condition %.3g, field %.2f MB, %.2f s",
-                    s.name.c_str(), s.mesh.positions.size(), s.instances.size(), mesh->basis.basis_count, b.basis,
-                    mesh->basis.condition, static_cast<double>(mesh->field.bytes()) / 1e6,
+                    s.name.c_str(), s.mesh.positions.size(), s.instances.size(), mesh->model.basis.basis_count, b.basis,
+                    mesh->model.basis.condition, static_cast<double>(mesh->model.field.bytes()) / 1e6,
                     mesh->basis_seconds + mesh->field_seconds));
-    if (mesh->glossy)
+    if (mesh->model.glossy)
       stage.log(format_line("  %-16s glossy (GGX alpha %.3f, f0 %.2f): %d BRDF terms, weighted BRDF error %.2f", "",
-                            static_cast<double>(mesh->glossy->lobe.alpha), static_cast<double>(mesh->glossy->lobe.f0),
-                            mesh->glossy->terms, static_cast<double>(mesh->glossy->relative_error)));
+                            static_cast<double>(mesh->model.glossy->lobe.alpha),
+                            static_cast<double>(mesh->model.glossy->lobe.f0), mesh->model.glossy->terms,
+                            static_cast<double>(mesh->model.glossy->relative_error)));
     timings[s.name] = {{"basis_seconds", mesh->basis_seconds}, {"field_seconds", mesh->field_seconds}};
     bake.meshes.push_back(std::move(mesh).value());
   }

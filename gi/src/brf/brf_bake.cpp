@@ -35,7 +35,8 @@ engine::Result<BrfMeshBake> bake_brf_mesh(const BrfSource& source, const BrfSett
     return e;
   };
   BrfMeshBake out;
-  out.name = source.name;
+  BrfModel& model = out.model;
+  model.name = source.name;
   out.mesh_hash = source.mesh_hash;
   constexpr double kBasisShare = 0.1;
   if (progress && !progress(0.0)) return prefixed(engine::cancelled_error("basis radiance field bake"));
@@ -43,9 +44,9 @@ engine::Result<BrfMeshBake> bake_brf_mesh(const BrfSource& source, const BrfSett
   if (source.glossy) {
     auto sep = separate_glossy_brdf(*source.glossy, settings.glossy);
     if (!sep) return prefixed(sep.error());
-    out.glossy = std::move(sep).value();
+    model.glossy = std::move(sep).value();
   }
-  const BrdfSeparation* glossy = out.glossy ? &*out.glossy : nullptr;
+  const BrdfSeparation* glossy = model.glossy_lobe();
   auto basis = compute_pca_basis(source.mesh, settings.basis, glossy);
   if (!basis) return prefixed(basis.error());
   out.basis_seconds = seconds_since(start);
@@ -56,8 +57,9 @@ engine::Result<BrfMeshBake> bake_brf_mesh(const BrfSource& source, const BrfSett
   auto field = compute_basis_radiance_field(source.mesh, *basis, field_settings, glossy);
   if (!field) return prefixed(field.error());
   out.field_seconds = seconds_since(start);
-  out.basis = std::move(basis).value();
-  out.field = std::move(field).value();
+  model.mesh = source.mesh;
+  model.basis = std::move(basis).value();
+  model.field = std::move(field).value();
   return out;
 }
 

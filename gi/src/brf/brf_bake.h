@@ -20,6 +20,7 @@
 #include <string_view>
 
 #include "brf/brf_mesh.h"
+#include "brf/brf_model.h"
 #include "brf/pca_basis.h"
 #include "brf/radiance_field.h"
 
@@ -35,15 +36,12 @@ struct BrfSettings {
 /// "preview", "medium" or "high" (above); error naming the valid names otherwise.
 engine::Result<BrfSettings> brf_preset(std::string_view name);
 
-/// What a bake of one dynamic mesh gives (and a brf_<name>.bin file holds).
+/// What a bake of one dynamic mesh gives (and a brf_<name>.bin file holds, but the mesh).
 struct BrfMeshBake {
-  std::string name;       ///< BrfSource::name.
-  std::string mesh_hash;  ///< BrfSource::mesh_hash of the mesh baked.
-  BrfBasis basis;
-  BasisRadianceField field;
-  std::optional<BrdfSeparation> glossy;  ///< The separated lobe of a glossy mesh.
-  double basis_seconds = 0.0;            ///< Wall time of compute_pca_basis.
-  double field_seconds = 0.0;            ///< Wall time of compute_basis_radiance_field.
+  BrfModel model;              ///< name: BrfSource::name; mesh: the source's (empty as read_brf_mesh reads it).
+  std::string mesh_hash;       ///< BrfSource::mesh_hash of the mesh baked.
+  double basis_seconds = 0.0;  ///< Wall time of compute_pca_basis.
+  double field_seconds = 0.0;  ///< Wall time of compute_basis_radiance_field.
 };
 
 /// Bakes `source.mesh`: for a glossy source separate_glossy_brdf with settings.glossy, then

@@ -104,8 +104,8 @@ struct BrfGpuPass::FrameData {
   bool lod_shared = false;             ///< BrfUpdateSettings::lod_shared_visibility.
 };
 
-engine::Status BrfGpuPass::run(std::span<const BrfGpuInstance> instances,
-                               std::span<const std::vector<glm::vec3>> incoming, const BrfUpdateSettings& settings) {
+engine::Status BrfGpuPass::run(std::span<const BrfInstance> instances, std::span<const std::vector<glm::vec3>> incoming,
+                               const BrfUpdateSettings& settings) {
   GI_EXPECTS(!programs_.phi.empty(), "BrfGpuPass::run on an empty (default or moved-from) pass");
   const auto t0 = std::chrono::steady_clock::now();
   const std::size_t n = instances.size();
@@ -147,7 +147,7 @@ engine::Status BrfGpuPass::run(std::span<const BrfGpuInstance> instances,
   return {};
 }
 
-engine::Status BrfGpuPass::check_frame(std::span<const BrfGpuInstance> instances,
+engine::Status BrfGpuPass::check_frame(std::span<const BrfInstance> instances,
                                        std::span<const std::vector<glm::vec3>> incoming) const {
   const std::size_t n = instances.size();
   if (incoming.size() != n)
@@ -155,7 +155,7 @@ engine::Status BrfGpuPass::check_frame(std::span<const BrfGpuInstance> instances
                  " given");
   if (n >= (std::size_t{1} << 16)) return error("too many instances");
   for (std::size_t i = 0; i < n; ++i) {
-    const BrfGpuInstance& inst = instances[i];
+    const BrfInstance& inst = instances[i];
     const std::string which = "instance " + std::to_string(i) + ": ";
     if (inst.model >= models_.size())
       return error(which + "model " + std::to_string(inst.model) + " does not exist (" +
@@ -175,7 +175,7 @@ engine::Status BrfGpuPass::check_frame(std::span<const BrfGpuInstance> instances
   return {};
 }
 
-void BrfGpuPass::fit_first_and_cull(std::span<const BrfGpuInstance> instances,
+void BrfGpuPass::fit_first_and_cull(std::span<const BrfInstance> instances,
                                     std::span<const std::vector<glm::vec3>> incoming, float cull_threshold,
                                     float influence_scale, FrameData& frame) const {
   // First weights and pair culling on the CPU, exactly as brf_interreflect decides them.
@@ -186,12 +186,11 @@ void BrfGpuPass::fit_first_and_cull(std::span<const BrfGpuInstance> instances,
   frame.weights.assign(weight_offsets_[n], glm::vec4(0.0f));  // pads stay 0
   for (std::size_t i = 0; i < n; ++i) {
     const ModelInfo& m = models_[instances[i].model];
-    objects[i] = {
-        m.mesh, m.basis, m.field, instances[i].object_to_world, instances[i].albedo, m.glossy, instances[i].specular};
+    objects[i] = brf_object(*m.model, instances[i]);
     light.resize(incoming[i].size());  // reflect() of brf_runtime.cpp: albedo x E_0, specular x E_k
     for (std::size_t j = 0; j < light.size(); ++j)
       light[j] = (j < m.vertex_count ? instances[i].albedo : instances[i].specular) * incoming[i][j];
-    first_weights[i] = brf_fit_rgb(*m.basis, light);
+    first_weights[i] = brf_fit_rgb(m.model->basis, light);
     for (std::size_t k = 0; k < m.channels(); ++k)
       frame.weights[weight_offsets_[i] + k] =
           glm::vec4(first_weights[i][0][k], first_weights[i][1][k], first_weights[i][2][k], 0.0f);
@@ -272,22 +271,74 @@ BrfGpuPass::PairSlot& BrfGpuPass::pair_slot(std::uint64_t key) {
   return pairs_[static_cast<std::size_t>(it - pair_keys_.begin())];
 }
 
-void BrfGpuPass::plan_pairs(std::span<const BrfGpuInstance> instances, FrameData& frame) {
+namespace {
+
+/// Per instance, what plan_pairs derives from its pose.
+struct FramePoses {
+  std::vector<glm::mat4> to_source;       ///< inverse(M)
+  std::vector<glm::mat3> pure_to_source;  ///< its rotation, uniform scale removed, as brf_basis_irradiance
+  std::vector<BrfSphere> spheres;         ///< bounding spheres (world space)
+  std::vector<BrfSphere> inner;           ///< innermost field spheres (world space)
+};
+
+}  // namespace
+
+void BrfGpuPass::queue_phi_job(std::span<const BrfInstance> instances, std::size_t s, std::size_t r,
+                               const PairSlot& slot, const glm::mat4& relative, const glm::mat3& frame_to_source,
+                               std::span<const std::uint32_t> occluders, std::span<const glm::mat4> occluder_poses,
+                               bool far, FrameData& frame) const {
+  const ModelInfo& mr = models_[instances[r].model];
+  BrfPhiJob job;
+  job.to_source = relative;
+  job.normal_to_source = glm::mat4(glm::transpose(glm::inverse(glm::mat3(relative))));
+  job.source_model = instances[s].model;
+  job.point_offset = mr.first_vertex;  // receiver vertices in the model-vertex buffer
+  job.point_count = mr.vertex_count;
+  job.phi_offset = slot.phi_offset;
+  job.rows = mr.terms;
+  if (mr.model->glossy) {
+    job.frame_to_source = glm::mat4(frame_to_source);
+    job.frame_offset = mr.frame_offset;
+    job.lobe_offset = mr.lobe_offset;
+  }
+  job.occluder_offset = u32(frame.occluders.size());
+  job.occluder_count = u32(occluders.size());
+  for (std::size_t k = 0; k < occluders.size(); ++k) {
+    const BrfBox& box = models_[instances[occluders[k]].model].box;
+    frame.occluders.push_back({occluder_poses[k], glm::vec4(box.lo, 0.0f), glm::vec4(box.hi, 0.0f)});
+  }
+  if (far) {
+    job.lod_shared = frame.lod_shared ? 1u : 0u;
+    // Kind 2 (after the kind-0 dispatch): every vertex's own side and visibility, its row
+    // interpolated from the representative points' rows, which this kind-0 job writes
+    // (field part only) into the slot's scratch.
+    BrfPhiJob rows = job;
+    rows.frame_offset = padded(models_[instances[s].model].channels()) / 4;  // vec4s per row
+    rows.lod_points = 1u + mr.lod_entry_offset;
+    rows.lod_rows = slot.lod_rows / 4;
+    frame.lod_jobs.push_back(rows);
+    job.lod_points = 1u + mr.lod_point_offset;
+    job.point_count = mr.lod_point_count;
+    job.phi_offset = slot.lod_rows;
+  }
+  frame.jobs.push_back(job);
+}
+
+void BrfGpuPass::plan_pairs(std::span<const BrfInstance> instances, FrameData& frame) {
   // Pairs whose relative pose changed (or never computed): Phi jobs; live sources per receiver.
   const std::size_t n = instances.size();
   frame.table.assign(n, GpuInstance{});
-  std::vector<glm::mat4> to_source(n);
-  std::vector<glm::mat3> pure_to_source(n);  // uniform scale removed, as brf_basis_irradiance
-  std::vector<BrfSphere> spheres(n), inner(n);
+  FramePoses fp{std::vector<glm::mat4>(n), std::vector<glm::mat3>(n), std::vector<BrfSphere>(n),
+                std::vector<BrfSphere>(n)};
   for (std::size_t s = 0; s < n; ++s) {
-    to_source[s] = glm::inverse(instances[s].object_to_world);
-    const glm::mat3 rot = glm::mat3(to_source[s]);
-    pure_to_source[s] = rot / glm::length(rot[0]);
-    spheres[s] = brf_bounding_sphere(models_[instances[s].model].box, instances[s].object_to_world);
+    fp.to_source[s] = glm::inverse(instances[s].object_to_world);
+    const glm::mat3 rot = glm::mat3(fp.to_source[s]);
+    fp.pure_to_source[s] = rot / glm::length(rot[0]);
+    fp.spheres[s] = brf_bounding_sphere(models_[instances[s].model].box, instances[s].object_to_world);
     // The innermost field sphere in world space, as brf_interreflect places it (brf_pair_far).
     const glm::mat4& m = instances[s].object_to_world;
-    const BasisRadianceField& f = *models_[instances[s].model].field;
-    inner[s] = {glm::vec3(m * glm::vec4(f.centre, 1.0f)), f.inner_radius * glm::length(glm::vec3(m[0]))};
+    const BasisRadianceField& f = models_[instances[s].model].model->field;
+    fp.inner[s] = {glm::vec3(m * glm::vec4(f.centre, 1.0f)), f.inner_radius * glm::length(glm::vec3(m[0]))};
   }
   std::vector<std::uint32_t> ids;
   std::vector<glm::mat4> poses;
@@ -315,7 +366,7 @@ void BrfGpuPass::plan_pairs(std::span<const BrfGpuInstance> instances, FrameData
       }
       ++stats_.pairs_evaluated;
       PairSlot& slot = pair_slot(std::uint64_t{s} * n + r);
-      const glm::mat4 relative = to_source[s] * instances[r].object_to_world;
+      const glm::mat4 relative = fp.to_source[s] * instances[r].object_to_world;
       frame.live.emplace_back(weight_offsets_[s], slot.phi_offset / 4,
                               padded(models_[instances[s].model].channels()) / 4, u32(s));
       // The objects in the way and their poses relative to the source: the pair's Phi is
@@ -323,55 +374,22 @@ void BrfGpuPass::plan_pairs(std::span<const BrfGpuInstance> instances, FrameData
       ids.clear();
       poses.clear();
       if (frame.occlusion)
-        for (std::uint32_t o : brf_pair_occluders(spheres, s, r)) {
+        for (std::uint32_t o : brf_pair_occluders(fp.spheres, s, r)) {
           ids.push_back(o);
-          poses.push_back(to_source[o] * instances[s].object_to_world);
+          poses.push_back(fp.to_source[o] * instances[s].object_to_world);
         }
       bool same_occluders = slot.occluders == ids;
       for (std::size_t k = 0; same_occluders && k < ids.size(); ++k)
         same_occluders = same_pose(slot.occluder_poses[k], poses[k], pose_tolerance_);
       // Level of detail (brf_lod.h): diffuse receivers with a table, far from the source.
-      const bool far = mr.lod_point_count > 0 && brf_pair_far(spheres[r], inner[s], frame.lod_distance);
+      const bool far = mr.lod_point_count > 0 && brf_pair_far(fp.spheres[r], fp.inner[s], frame.lod_distance);
       const std::uint8_t lod = far ? (frame.lod_shared ? 2 : 1) : 0;
       if (far) ++stats_.pairs_lod;
       if (slot.valid && same_pose(slot.pose, relative, pose_tolerance_) && same_occluders && slot.lod == lod) {
         ++stats_.pairs_reused;
         continue;
       }
-      BrfPhiJob job;
-      job.to_source = relative;
-      job.normal_to_source = glm::mat4(glm::transpose(glm::inverse(glm::mat3(relative))));
-      job.source_model = instances[s].model;
-      job.point_offset = mr.first_vertex;  // receiver vertices in the model-vertex buffer
-      job.point_count = mr.vertex_count;
-      job.phi_offset = slot.phi_offset;
-      job.rows = mr.terms;
-      if (mr.glossy != nullptr) {
-        job.frame_to_source = glm::mat4(pure_to_source[s] * receiver_rot);
-        job.frame_offset = mr.frame_offset;
-        job.lobe_offset = mr.lobe_offset;
-      }
-      job.occluder_offset = u32(frame.occluders.size());
-      job.occluder_count = u32(ids.size());
-      for (std::size_t k = 0; k < ids.size(); ++k) {
-        const BrfBox& box = models_[instances[ids[k]].model].box;
-        frame.occluders.push_back({poses[k], glm::vec4(box.lo, 0.0f), glm::vec4(box.hi, 0.0f)});
-      }
-      if (far) {
-        job.lod_shared = frame.lod_shared ? 1u : 0u;
-        // Kind 2 (after the kind-0 dispatch): every vertex's own side and visibility, its row
-        // interpolated from the representative points' rows, which this kind-0 job writes
-        // (field part only) into the slot's scratch.
-        BrfPhiJob rows = job;
-        rows.frame_offset = padded(models_[instances[s].model].channels()) / 4;  // vec4s per row
-        rows.lod_points = 1u + mr.lod_entry_offset;
-        rows.lod_rows = slot.lod_rows / 4;
-        frame.lod_jobs.push_back(rows);
-        job.lod_points = 1u + mr.lod_point_offset;
-        job.point_count = mr.lod_point_count;
-        job.phi_offset = slot.lod_rows;
-      }
-      frame.jobs.push_back(job);
+      queue_phi_job(instances, s, r, slot, relative, fp.pure_to_source[s] * receiver_rot, ids, poses, far, frame);
       slot.valid = true;
       slot.pose = relative;
       slot.lod = lod;

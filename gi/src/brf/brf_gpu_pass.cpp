@@ -33,14 +33,12 @@ void BrfGpuPass::Buffer::upload(const void* data, std::size_t size) {
 
 namespace {
 
-/// create()'s checks of model m (pointers, sizes, glossy terms, field settings, limit, finite data).
-engine::Status check_model(const BrfGpuModel& model, std::size_t m, std::size_t limit) {
+/// create()'s checks of model m (sizes, glossy terms, field settings, limit, finite data).
+engine::Status check_model(const BrfModel& model, std::size_t m, std::size_t limit) {
   const std::string which = "model " + std::to_string(m) + ": ";
-  if (model.mesh == nullptr || model.basis == nullptr || model.field == nullptr)
-    return error(which + "mesh, basis and field must all be given");
-  const BrfMesh& mesh = *model.mesh;
-  const BrfBasis& basis = *model.basis;
-  const BasisRadianceField& f = *model.field;
+  const BrfMesh& mesh = model.mesh;
+  const BrfBasis& basis = model.basis;
+  const BasisRadianceField& f = model.field;
   const std::size_t nv = mesh.positions.size();
   if (mesh.normals.size() != nv || basis.vertex_count != nv)
     return error(which + "the mesh has " + std::to_string(nv) + " positions, " + std::to_string(mesh.normals.size()) +
@@ -52,9 +50,9 @@ engine::Status check_model(const BrfGpuModel& model, std::size_t m, std::size_t 
   if (basis.psi.size() != nb * nv || basis.a_inverse.size() != nb * nb)
     return error(which + "basis arrays do not match its size");
   if (f.basis_count != basis.basis_count) return error(which + "the field was computed for another basis");
-  if (model.glossy == nullptr && f.terms != 1)
+  if (!model.glossy && f.terms != 1)
     return error(which + "a glossy field (" + std::to_string(f.terms) + " BRDF terms) but no glossy lobe");
-  if (model.glossy != nullptr) {
+  if (model.glossy) {
     const BrdfSeparation& g = *model.glossy;
     if (g.terms < 1 || g.terms > kMaxGlossyTerms || f.terms != 1 + g.terms)
       return error(which + "the field has " + std::to_string(f.terms) + " BRDF terms, the glossy lobe " +
@@ -116,7 +114,7 @@ struct BrfGpuPass::ModelData {
   std::vector<glm::uvec4> lod_table;
 };
 
-engine::Result<BrfGpuPass> BrfGpuPass::create(std::span<const BrfGpuModel> models, const BrfGpuPassOptions& options) {
+engine::Result<BrfGpuPass> BrfGpuPass::create(std::span<const BrfModel> models, const BrfGpuPassOptions& options) {
   // Check the data before acquiring anything.
   std::size_t limit = std::min(kSsboLimitBytes, gl_limit(GL_MAX_SHADER_STORAGE_BLOCK_SIZE));
   // The fields are read through RGBA32F buffer textures too (field_textures_).
@@ -135,7 +133,7 @@ engine::Result<BrfGpuPass> BrfGpuPass::create(std::span<const BrfGpuModel> model
   // Model tables, vertices, bases; fields grouped into buffers under the limit.
   ModelData data;
   data.sh_data = sh_rotation_data();
-  for (const BrfGpuModel& model : models) pass.add_model(model, limit, data);
+  for (const BrfModel& model : models) pass.add_model(model, limit, data);
   pass.upload_models(models, data);
   if (glGetError() == GL_OUT_OF_MEMORY) return error("out of GPU memory uploading the models");
   return pass;
@@ -165,20 +163,20 @@ engine::Status BrfGpuPass::build_programs() {
   return {};
 }
 
-void BrfGpuPass::add_model(const BrfGpuModel& model, std::size_t limit, ModelData& data) {
-  const BasisRadianceField& f = *model.field;
+void BrfGpuPass::add_model(const BrfModel& model, std::size_t limit, ModelData& data) {
+  const BasisRadianceField& f = model.field;
   GpuModel g;
   g.centre_inner = glm::vec4(f.centre, f.inner_radius);
   g.outer_radius = f.outer_radius;
-  const BrfBox box = brf_object_box(*model.mesh);
+  const BrfBox box = brf_object_box(model.mesh);
   g.box_lo = glm::vec4(box.lo, 0.0f);
   g.box_hi = glm::vec4(box.hi, 0.0f);
   g.spheres = u32(static_cast<std::size_t>(f.spheres));
   g.face_resolution = u32(static_cast<std::size_t>(f.face_resolution));
   g.sh_bands = u32(static_cast<std::size_t>(f.sh_bands));
-  g.basis_count = u32(static_cast<std::size_t>(model.basis->basis_count));
+  g.basis_count = u32(static_cast<std::size_t>(model.basis.basis_count));
   g.vertex_offset = u32(data.vertices.size() / 2);
-  g.vertex_count = u32(model.mesh->positions.size());
+  g.vertex_count = u32(model.mesh.positions.size());
   g.psi_offset = u32(data.psi.size());
   g.ainv_offset = u32(data.a_inverse.size());
   std::vector<std::size_t>& groups = data.field_group_bytes;
@@ -188,12 +186,12 @@ void BrfGpuPass::add_model(const BrfGpuModel& model, std::size_t limit, ModelDat
   g.field_offset = u32(groups.back() / sizeof(float));
   groups.back() += gpu_field_bytes(f);
   data.table.push_back(g);
-  for (std::size_t j = 0; j < model.mesh->positions.size(); ++j) {
-    data.vertices.emplace_back(model.mesh->positions[j], 1.0f);
-    data.vertices.emplace_back(model.mesh->normals[j], 0.0f);
+  for (std::size_t j = 0; j < model.mesh.positions.size(); ++j) {
+    data.vertices.emplace_back(model.mesh.positions[j], 1.0f);
+    data.vertices.emplace_back(model.mesh.normals[j], 0.0f);
   }
-  data.psi.insert(data.psi.end(), model.basis->psi.begin(), model.basis->psi.end());
-  data.a_inverse.insert(data.a_inverse.end(), model.basis->a_inverse.begin(), model.basis->a_inverse.end());
+  data.psi.insert(data.psi.end(), model.basis.psi.begin(), model.basis.psi.end());
+  data.a_inverse.insert(data.a_inverse.end(), model.basis.a_inverse.begin(), model.basis.a_inverse.end());
   ModelInfo info;
   info.first_vertex = g.vertex_offset;
   info.vertex_count = g.vertex_count;
@@ -203,22 +201,19 @@ void BrfGpuPass::add_model(const BrfGpuModel& model, std::size_t limit, ModelDat
   info.outer_radius = f.outer_radius;
   info.field_centre = f.centre;
   info.box = box;
-  info.basis = model.basis;
-  info.mesh = model.mesh;
-  info.field = model.field;
-  info.glossy = model.glossy;
-  if (model.glossy != nullptr) {  // lobe SH (local frame), object-space tangent frames (columns t, b, n)
+  info.model = &model;
+  if (model.glossy) {  // lobe SH (local frame), object-space tangent frames (columns t, b, n)
     std::vector<float>& sh_data = data.sh_data;
     info.lobe_offset = u32(sh_data.size());
     sh_data.insert(sh_data.end(), model.glossy->lobe_sh.begin(), model.glossy->lobe_sh.end());
     info.frame_offset = u32(sh_data.size());
-    for (const glm::vec3& nrm : model.mesh->normals) {
+    for (const glm::vec3& nrm : model.mesh.normals) {
       const glm::mat3 frame = brf_tangent_frame(nrm);
       for (int c = 0; c < 3; ++c) sh_data.insert(sh_data.end(), {frame[c].x, frame[c].y, frame[c].z});
     }
   }
-  if (model.glossy == nullptr) {  // glossy receivers are evaluated in full
-    const BrfLodPoints lod = brf_lod_points(*model.mesh);
+  if (!model.glossy) {  // glossy receivers are evaluated in full
+    const BrfLodPoints lod = brf_lod_points(model.mesh);
     if (!lod.empty()) {
       info.lod_point_offset = u32(data.lod_table.size());
       info.lod_point_count = u32(lod.points.size());
@@ -233,7 +228,7 @@ void BrfGpuPass::add_model(const BrfGpuModel& model, std::size_t limit, ModelDat
   models_.push_back(info);
 }
 
-void BrfGpuPass::upload_models(std::span<const BrfGpuModel> models, const ModelData& data) {
+void BrfGpuPass::upload_models(std::span<const BrfModel> models, const ModelData& data) {
   const auto upload_once = [this](const auto& v) {
     using T = typename std::decay_t<decltype(v)>::value_type;
     std::vector<T> padded(v);
@@ -252,7 +247,7 @@ void BrfGpuPass::upload_models(std::span<const BrfGpuModel> models, const ModelD
     model_bytes_ += std::max<std::size_t>(bytes, 16);
   }
   for (std::size_t m = 0; m < models.size(); ++m) {
-    const BasisRadianceField& f = *models[m].field;
+    const BasisRadianceField& f = models[m].field;
     glNamedBufferSubData(fields_[data.table[m].field_buffer].id(),
                          static_cast<GLintptr>(data.table[m].field_offset * sizeof(float)),
                          static_cast<GLsizeiptr>(gpu_field_bytes(f)), gpu_field(f).data());
@@ -307,7 +302,7 @@ engine::Status BrfGpuPass::set_static_receivers(std::span<const glm::vec3> posit
   return {};
 }
 
-engine::Status BrfGpuPass::reset_layout(std::span<const BrfGpuInstance> instances) {
+engine::Status BrfGpuPass::reset_layout(std::span<const BrfInstance> instances) {
   const std::size_t n = instances.size();
   std::vector<std::uint32_t> vertex_offsets(n + 1, 0), value_offsets(n + 1, 0), weight_offsets(n + 1, 0),
       gather_offsets(n + 1, 0);
@@ -348,7 +343,7 @@ engine::Status BrfGpuPass::reset_layout(std::span<const BrfGpuInstance> instance
   return {};
 }
 
-engine::Status BrfGpuPass::update_static(std::span<const BrfGpuInstance> instances) {
+engine::Status BrfGpuPass::update_static(std::span<const BrfInstance> instances) {
   const std::vector<std::uint8_t> moved = static_sources_moved(instances);
   if (std::none_of(moved.begin(), moved.end(), [](std::uint8_t m) { return m != 0; })) return {};
   std::size_t total_floats = 0;
@@ -362,7 +357,7 @@ engine::Status BrfGpuPass::update_static(std::span<const BrfGpuInstance> instanc
   return {};
 }
 
-std::vector<std::uint8_t> BrfGpuPass::static_sources_moved(std::span<const BrfGpuInstance> instances) {
+std::vector<std::uint8_t> BrfGpuPass::static_sources_moved(std::span<const BrfInstance> instances) {
   const std::size_t n = instances.size();
   stats_.static_sources_reused = 0;
   std::vector<std::uint8_t> moved(n, 0);
@@ -378,7 +373,7 @@ std::vector<std::uint8_t> BrfGpuPass::static_sources_moved(std::span<const BrfGp
   return moved;
 }
 
-std::vector<std::vector<std::uint32_t>> BrfGpuPass::static_receivers_inside(std::span<const BrfGpuInstance> instances,
+std::vector<std::vector<std::uint32_t>> BrfGpuPass::static_receivers_inside(std::span<const BrfInstance> instances,
                                                                             std::span<const std::uint8_t> moved,
                                                                             std::vector<std::vector<float>>& visibility,
                                                                             std::size_t& total_floats) {
@@ -401,7 +396,7 @@ std::vector<std::vector<std::uint32_t>> BrfGpuPass::static_receivers_inside(std:
         const auto t0 = std::chrono::steady_clock::now();
         // What each receiver sees of the source past the static world; those that see
         // nothing are dropped (their Phi would be scaled to 0).
-        std::array<glm::vec3, kBrfVisibilityTargets> targets = brf_visibility_targets(brf_object_box(*model.mesh));
+        std::array<glm::vec3, kBrfVisibilityTargets> targets = brf_visibility_targets(model.box);
         for (glm::vec3& t : targets) t = glm::vec3(m * glm::vec4(t, 1.0f));
         pos.clear();
         nrm.clear();
@@ -431,7 +426,7 @@ std::vector<std::vector<std::uint32_t>> BrfGpuPass::static_receivers_inside(std:
   return inside;
 }
 
-void BrfGpuPass::relayout_static_phi(std::span<const BrfGpuInstance> instances, std::span<const std::uint8_t> moved,
+void BrfGpuPass::relayout_static_phi(std::span<const BrfInstance> instances, std::span<const std::uint8_t> moved,
                                      std::span<std::vector<std::uint32_t>> inside,
                                      std::span<std::vector<float>> visibility, std::size_t total_floats) {
   // New layout; unmoved sources' Phi is copied over, moved ones are evaluated.
@@ -457,7 +452,7 @@ void BrfGpuPass::relayout_static_phi(std::span<const BrfGpuInstance> instances, 
       slot.pose = instances[s].object_to_world;
       slot.receivers = std::move(inside[s]);
       slot.visibility = std::move(visibility[s]);
-      const BrfBox box = brf_object_box(*model.mesh);
+      const BrfBox box = model.box;
       slot.occlusion.resize(slot.receivers.size());
       for (std::size_t k = 0; k < slot.receivers.size(); ++k)
         slot.occlusion[k] = slot.visibility[k] * brf_box_form_factor(box, instances[s].object_to_world,
@@ -484,7 +479,7 @@ void BrfGpuPass::relayout_static_phi(std::span<const BrfGpuInstance> instances, 
   dispatch_phi(jobs, 1);
 }
 
-void BrfGpuPass::upload_static_lists(std::span<const BrfGpuInstance> instances) {
+void BrfGpuPass::upload_static_lists(std::span<const BrfInstance> instances) {
   // Per touched receiver, its sources in instance order.
   const std::size_t n = instances.size();
   std::vector<std::uint32_t> count(static_count_, 0);
@@ -519,7 +514,7 @@ void BrfGpuPass::upload_static_lists(std::span<const BrfGpuInstance> instances) 
   static_touched_count_ = u32(touched.size());
 }
 
-engine::Status BrfGpuPass::gather_static(std::span<const BrfGpuInstance> instances) {
+engine::Status BrfGpuPass::gather_static(std::span<const BrfInstance> instances) {
   if (auto s = update_static(instances); !s) return s;
   dispatch_fit(1, instances.size());
   glClearNamedBufferData(static_out_.buffer.id(), GL_R32F, GL_RED, GL_FLOAT, nullptr);

@@ -2,9 +2,8 @@
 // The basis-radiance-field interreflection on the GPU (Iwasaki et al. §5): the compute twin of
 // gi::brf_interreflect (brf_runtime.h). Models (mesh, PCA basis, field) are uploaded once; a
 // frame uploads the instances' transforms and albedos and the light arriving at their
-// vertices, and compute shaders do the rest. Glossy models (BrfGpuModel::glossy, as
-// BrfObject::glossy) carry K = 1 + glossy terms values per vertex ([k x V + j], brf_runtime.h),
-// have fields with K x N channels and get K Phi rows per vertex as receivers:
+// vertices, and compute shaders do the rest. Glossy models (BrfModel::glossy) carry K = 1 + glossy terms values per
+// vertex ([k x V + j], brf_runtime.h), have fields with K x N channels and get K Phi rows per vertex as receivers:
 //   - brf_phi.comp.glsl: the basis irradiance Phi of every (source, receiver) pair whose
 //     relative pose changed (or the pose of an object in its way, brf_pair_occluders: Phi is
 //     scaled per vertex by how much of the source it sees past their boxes, with
@@ -69,25 +68,6 @@ namespace gi {
 class RayCaster;
 struct BrfPhiJob;  // one batched Phi evaluation (brf_gpu_pass.cpp)
 
-/// One kind of rigid object: its mesh, basis and field belong together (not owned; read at
-/// create() only).
-struct BrfGpuModel {
-  const BrfMesh* mesh = nullptr;
-  const BrfBasis* basis = nullptr;
-  const BasisRadianceField* field = nullptr;
-  /// The separated glossy lobe the basis and field were baked with (nullptr: diffuse); the
-  /// field must have 1 + glossy->terms terms. Read at create() only.
-  const BrdfSeparation* glossy = nullptr;
-};
-
-/// One placed object this frame.
-struct BrfGpuInstance {
-  std::uint32_t model = 0;          ///< Index into create()'s models.
-  glm::mat4 object_to_world{1.0f};  ///< Rigid (rotation + translation; uniform scale allowed).
-  glm::vec3 albedo{0.8f};           ///< Diffuse albedo.
-  glm::vec3 specular{1.0f};         ///< Glossy colour (BrfObject::specular); unused for diffuse models.
-};
-
 struct BrfGpuPassOptions {
   /// Largest buffer bound as one SSBO (bytes). 0: GL_MAX_SHADER_STORAGE_BLOCK_SIZE, at most
   /// 128 MiB. Tests set it small to exercise field buffers split by model.
@@ -108,11 +88,12 @@ struct BrfGpuPassOptions {
 ///   pass.run(instances, incoming, settings);  // pass.vertex_buffer(i): vec4 per vertex
 class BrfGpuPass {
  public:
-  /// Compiles the shaders and uploads every model's vertices, basis and field. Errors: a null
-  /// pointer, mesh / basis / field that do not belong together, a field whose terms do not
-  /// match the model's glossy lobe (or a glossy field without one), non-finite data, a basis
-  /// of more than 64 functions, a field larger than the SSBO limit, shader build failure.
-  static engine::Result<BrfGpuPass> create(std::span<const BrfGpuModel> models, const BrfGpuPassOptions& options = {});
+  /// Compiles the shaders and uploads every model's vertices, basis and field. `models` are
+  /// not copied: they must outlive the pass (run() reads their mesh, basis and field for the
+  /// first fit and the pair culling). Errors: mesh / basis / field that do not belong together, a field whose terms do
+  /// not match the model's glossy lobe (or a glossy field without one), non-finite data, a basis of more than 64
+  /// functions, a field larger than the SSBO limit, shader build failure.
+  static engine::Result<BrfGpuPass> create(std::span<const BrfModel> models, const BrfGpuPassOptions& options = {});
 
   BrfGpuPass() = default;
   BrfGpuPass(BrfGpuPass&&) noexcept = default;
@@ -139,7 +120,7 @@ class BrfGpuPass {
   /// incoming sizes that do not match the instances' meshes, non-finite transforms, albedos
   /// or incoming light, Phi slots above the SSBO limit. Ends with a barrier for shader
   /// storage, vertex attribute and buffer reads.
-  engine::Status run(std::span<const BrfGpuInstance> instances, std::span<const std::vector<glm::vec3>> incoming,
+  engine::Status run(std::span<const BrfInstance> instances, std::span<const std::vector<glm::vec3>> incoming,
                      const BrfUpdateSettings& settings);
 
   /// GL buffer of instance i of the last run: vec4 per vertex, xyz = interreflected
@@ -201,10 +182,7 @@ class BrfGpuPass {
     float outer_radius = 0.0f;
     glm::vec3 field_centre{0.0f};
     BrfBox box;                       ///< brf_object_box of the mesh (once, not per pair and frame).
-    const BrfBasis* basis = nullptr;  ///< For the CPU first fit.
-    const BrfMesh* mesh = nullptr;    ///< For pair culling (BrfObject).
-    const BasisRadianceField* field = nullptr;
-    const BrdfSeparation* glossy = nullptr;
+    const BrfModel* model = nullptr;  ///< create()'s model: the CPU first fit and pair culling (BrfObject).
     /// Level of detail (brf_lod.h): its representative vertices (lod_point_count uvec4s from
     /// lod_point_offset in lod_table_) and per vertex 2 uvec4s from lod_entry_offset; 0 points: none.
     std::uint32_t lod_point_offset = 0, lod_point_count = 0, lod_entry_offset = 0;
@@ -244,16 +222,16 @@ class BrfGpuPass {
   /// Compiles the compute programs (phi, fit, gather, static gather, then glossy phi).
   engine::Status build_programs();
   /// Appends one checked model to the CPU tables (field grouped under `limit`) and to models_.
-  void add_model(const BrfGpuModel& model, std::size_t limit, ModelData& data);
+  void add_model(const BrfModel& model, std::size_t limit, ModelData& data);
   /// Uploads the tables once, the fields into their buffers; reserves the static buffers.
-  void upload_models(std::span<const BrfGpuModel> models, const ModelData& data);
+  void upload_models(std::span<const BrfModel> models, const ModelData& data);
 
   // run()'s stages, in order (reset_layout() when the instances' models changed).
   /// The frame's checks (sizes, model indices, finite and non-singular data); changes nothing.
-  engine::Status check_frame(std::span<const BrfGpuInstance> instances,
+  engine::Status check_frame(std::span<const BrfInstance> instances,
                              std::span<const std::vector<glm::vec3>> incoming) const;
   /// The first bounce's weights and the culled pairs on the CPU, as brf_interreflect.
-  void fit_first_and_cull(std::span<const BrfGpuInstance> instances, std::span<const std::vector<glm::vec3>> incoming,
+  void fit_first_and_cull(std::span<const BrfInstance> instances, std::span<const std::vector<glm::vec3>> incoming,
                           float cull_threshold, float influence_scale, FrameData& frame) const;
   /// Phi slots for this frame's pairs in reach: when they changed, a new packed layout, the
   /// kept pairs' Phi copied over (through a spare buffer). Errors: slots above the SSBO limit.
@@ -261,7 +239,13 @@ class BrfGpuPass {
   /// The slot of pair key source x n + receiver (it must be in reach).
   PairSlot& pair_slot(std::uint64_t key);
   /// Instance table, live sources per receiver, Phi jobs of moved pairs; updates pairs_, stats_.
-  void plan_pairs(std::span<const BrfGpuInstance> instances, FrameData& frame);
+  void plan_pairs(std::span<const BrfInstance> instances, FrameData& frame);
+  /// plan_pairs' Phi job of pair (s, r) at pose `relative` (its kind-2 job too when `far`),
+  /// with the boxes of `occluders` at `occluder_poses` (relative to the source).
+  void queue_phi_job(std::span<const BrfInstance> instances, std::size_t s, std::size_t r, const PairSlot& slot,
+                     const glm::mat4& relative, const glm::mat3& frame_to_source,
+                     std::span<const std::uint32_t> occluders, std::span<const glm::mat4> occluder_poses, bool far,
+                     FrameData& frame) const;
   /// Uploads the incoming light, instance table, first weights and live lists; clears indirect_.
   void upload_frame(std::span<const std::vector<glm::vec3>> incoming, const FrameData& frame);
   /// One brf_fit.comp.glsl dispatch over all instances (u_mode 0: last bounce, 1: incoming + indirect).
@@ -269,28 +253,28 @@ class BrfGpuPass {
   /// One bounce's brf_gather.comp.glsl dispatch over all instance vertices.
   void dispatch_gather(std::size_t instance_count);
   /// Static receivers: update_static(), the fit of all light, brf_static_gather.comp.glsl.
-  engine::Status gather_static(std::span<const BrfGpuInstance> instances);
+  engine::Status gather_static(std::span<const BrfInstance> instances);
   /// Copies each instance's terms from indirect_ into its vertex buffer; the final barriers.
   void copy_outputs(std::size_t instance_count);
 
-  engine::Status reset_layout(std::span<const BrfGpuInstance> instances);
+  engine::Status reset_layout(std::span<const BrfInstance> instances);
   /// Static receivers' Phi of the sources that moved, the per-receiver source lists.
-  engine::Status update_static(std::span<const BrfGpuInstance> instances);
+  engine::Status update_static(std::span<const BrfInstance> instances);
   // update_static()'s stages, in order.
   /// Per source, 1 when its static-receiver Phi must be evaluated again; counts the reused ones.
-  std::vector<std::uint8_t> static_sources_moved(std::span<const BrfGpuInstance> instances);
+  std::vector<std::uint8_t> static_sources_moved(std::span<const BrfInstance> instances);
   /// Per source, the static receivers in its outermost sphere that see it (kept for unmoved
   /// ones) and, in `visibility`, how much of it they see; adds their Phi floats.
-  std::vector<std::vector<std::uint32_t>> static_receivers_inside(std::span<const BrfGpuInstance> instances,
+  std::vector<std::vector<std::uint32_t>> static_receivers_inside(std::span<const BrfInstance> instances,
                                                                   std::span<const std::uint8_t> moved,
                                                                   std::vector<std::vector<float>>& visibility,
                                                                   std::size_t& total_floats);
   /// Static Phi in its new layout: unmoved sources' copied over, moved ones' evaluated.
-  void relayout_static_phi(std::span<const BrfGpuInstance> instances, std::span<const std::uint8_t> moved,
+  void relayout_static_phi(std::span<const BrfInstance> instances, std::span<const std::uint8_t> moved,
                            std::span<std::vector<std::uint32_t>> inside, std::span<std::vector<float>> visibility,
                            std::size_t total_floats);
   /// Per touched static receiver, its sources in instance order (static_touched_, static_entries_).
-  void upload_static_lists(std::span<const BrfGpuInstance> instances);
+  void upload_static_lists(std::span<const BrfInstance> instances);
   /// Evaluates `jobs` (one dispatch per field buffer) into phi_ or, for kind 1 (static
   /// receivers), static_phi_;
   /// kind 2: the level-of-detail pairs' rows from their representative points' (brf_lod.h).

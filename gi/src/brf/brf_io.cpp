@@ -81,10 +81,11 @@ std::string check_glossy(const BrdfSeparation& g) {
 }
 
 // Empty when the bake's parts fit together and hold finite values, else what is wrong.
-std::string check_bake(const BrfMeshBake& b) {
+std::string check_bake(const BrfMeshBake& bake) {
+  const BrfModel& b = bake.model;
   if (b.name.empty() || !is_bundle_file_name(brf_file_name(b.name)))
     return "mesh name \"" + b.name + "\" is not usable in a file name";
-  if (!is_hex16(b.mesh_hash)) return "mesh_hash \"" + b.mesh_hash + "\" is not 16 lowercase hex digits";
+  if (!is_hex16(bake.mesh_hash)) return "mesh_hash \"" + bake.mesh_hash + "\" is not 16 lowercase hex digits";
   const BrfBasis& s = b.basis;
   if (s.vertex_count < 1 || s.vertex_count > kMaxVertices)
     return "vertex_count " + str(s.vertex_count) + " is outside 1..2^31";
@@ -200,16 +201,17 @@ std::string brf_file_name(const std::string& mesh_name) { return "brf_" + mesh_n
 engine::Status write_brf_mesh(const fs::path& path, const BrfMeshBake& bake, std::uint64_t* compressed_bytes) {
   if (std::string problem = check_bake(bake); !problem.empty())
     return file_error(path, "", "cannot save the basis radiance field: " + problem);
-  const std::vector<std::uint8_t> planes = to_planes(bake.field.coefficients);
+  const BrfModel& model = bake.model;
+  const std::vector<std::uint8_t> planes = to_planes(model.field.coefficients);
   auto packed = write_zstd_stream(path, planes, kZstdLevel);
   if (!packed) return packed.error();
   const std::vector<std::uint8_t>& frame = *packed;
   if (compressed_bytes != nullptr) *compressed_bytes = frame.size();
 
-  const BrfBasis& b = bake.basis;
-  const BasisRadianceField& f = bake.field;
+  const BrfBasis& b = model.basis;
+  const BasisRadianceField& f = model.field;
   engine::ByteWriter w;
-  w.put_string(bake.name);
+  w.put_string(model.name);
   w.put_string(bake.mesh_hash);
   w.put(static_cast<std::uint64_t>(b.vertex_count));
   w.put(static_cast<std::int32_t>(b.basis_count));
@@ -230,9 +232,9 @@ engine::Status write_brf_mesh(const fs::path& path, const BrfMeshBake& bake, std
   w.put(f.outer_radius);
   w.put(static_cast<std::uint64_t>(planes.size()));
   w.put_array(frame);
-  w.put(static_cast<std::int32_t>(bake.glossy ? bake.glossy->terms : 0));
-  if (bake.glossy) {
-    const BrdfSeparation& g = *bake.glossy;
+  w.put(static_cast<std::int32_t>(model.glossy ? model.glossy->terms : 0));
+  if (model.glossy) {
+    const BrdfSeparation& g = *model.glossy;
     w.put(g.lobe.f0);
     w.put(g.lobe.alpha);
     w.put(static_cast<std::int32_t>(g.resolution));
@@ -250,20 +252,20 @@ engine::Result<BrfMeshBake> read_brf_mesh(const fs::path& path) {
   if (!payload) return payload.error();
   engine::ByteReader r(payload.value());
   BrfMeshBake out;
-  BrfBasis& b = out.basis;
-  BasisRadianceField& f = out.field;
+  BrfBasis& b = out.model.basis;
+  BasisRadianceField& f = out.model.field;
   std::uint64_t vertex_count = 0, coefficient_bytes = 0;
   std::int32_t basis_count = 0, basis_terms = 0, spheres = 0, res = 0, bands = 0, field_basis = 0, field_terms = 0,
                glossy_terms = 0;
   std::vector<std::uint8_t> frame;
-  bool complete = r.get_string(out.name) && r.get_string(out.mesh_hash) && r.get(vertex_count) && r.get(basis_count) &&
-                  r.get(b.condition) && r.get(b.centre) && r.get(b.radius) && r.get_array(b.psi) &&
-                  r.get_array(b.a_inverse) && r.get_array(b.singular_values) && r.get(basis_terms) && r.get(spheres) &&
-                  r.get(res) && r.get(bands) && r.get(field_basis) && r.get(field_terms) && r.get(f.centre) &&
-                  r.get(f.inner_radius) && r.get(f.outer_radius) && r.get(coefficient_bytes) && r.get_array(frame) &&
-                  r.get(glossy_terms);
+  bool complete = r.get_string(out.model.name) && r.get_string(out.mesh_hash) && r.get(vertex_count) &&
+                  r.get(basis_count) && r.get(b.condition) && r.get(b.centre) && r.get(b.radius) &&
+                  r.get_array(b.psi) && r.get_array(b.a_inverse) && r.get_array(b.singular_values) &&
+                  r.get(basis_terms) && r.get(spheres) && r.get(res) && r.get(bands) && r.get(field_basis) &&
+                  r.get(field_terms) && r.get(f.centre) && r.get(f.inner_radius) && r.get(f.outer_radius) &&
+                  r.get(coefficient_bytes) && r.get_array(frame) && r.get(glossy_terms);
   if (complete && glossy_terms != 0) {
-    BrdfSeparation& g = out.glossy.emplace();
+    BrdfSeparation& g = out.model.glossy.emplace();
     std::int32_t table = 0;
     complete = r.get(g.lobe.f0) && r.get(g.lobe.alpha) && r.get(table) && r.get(g.relative_error) && r.get_array(g.g) &&
                r.get_array(g.h) && r.get_array(g.lobe_sh) && r.get_array(g.singular_values);
@@ -309,11 +311,11 @@ engine::Status save_brf(const fs::path& bundle_dir, const BrfBake& bake, const B
   // Checked before the directory is made, so a bad bake leaves nothing behind.
   std::set<std::string> names;
   for (const BrfMeshBake& m : bake.meshes) {
-    const fs::path file = bundle_dir / brf_file_name(m.name);
+    const fs::path file = bundle_dir / brf_file_name(m.model.name);
     if (std::string problem = check_bake(m); !problem.empty())
       return file_error(file, "", "cannot save the basis radiance field: " + problem);
-    if (!names.insert(m.name).second)
-      return file_error(file, "", "cannot save the BRF bake: two meshes are named \"" + m.name + "\"");
+    if (!names.insert(m.model.name).second)
+      return file_error(file, "", "cannot save the BRF bake: two meshes are named \"" + m.model.name + "\"");
   }
   std::error_code ec;
   fs::create_directories(bundle_dir, ec);
@@ -321,7 +323,7 @@ engine::Status save_brf(const fs::path& bundle_dir, const BrfBake& bake, const B
 
   json files = json::object(), meshes = json::object();
   for (const BrfMeshBake& m : bake.meshes) {
-    const std::string name = brf_file_name(m.name);
+    const std::string name = brf_file_name(m.model.name);
     const fs::path file = bundle_dir / name;
     std::uint64_t compressed = 0;
     if (engine::Status s = write_brf_mesh(file, m, &compressed); !s) return s;
@@ -329,17 +331,19 @@ engine::Status save_brf(const fs::path& bundle_dir, const BrfBake& bake, const B
     if (!sum) return sum.error();
     const std::uintmax_t file_bytes = fs::file_size(file, ec);
     if (ec) return file_error(file, "", "cannot read the file size: " + ec.message());
-    files[m.name] = json{{"file", name}, {"xxh3_64", *sum}};
-    meshes[m.name] = json{{"mesh_hash", m.mesh_hash},
-                          {"vertices", m.basis.vertex_count},
-                          {"basis_requested", bake.settings.basis.basis},
-                          {"basis_kept", m.basis.basis_count},
-                          {"condition", m.basis.condition},
-                          {"glossy_terms", m.glossy ? m.glossy->terms : 0},
-                          {"glossy_brdf_error", m.glossy ? static_cast<double>(m.glossy->relative_error) : 0.0},
-                          {"field_bytes", static_cast<std::uint64_t>(m.field.bytes())},
-                          {"field_compressed_bytes", compressed},
-                          {"file_bytes", static_cast<std::uint64_t>(file_bytes)}};
+    const BrfModel& model = m.model;
+    files[model.name] = json{{"file", name}, {"xxh3_64", *sum}};
+    meshes[model.name] =
+        json{{"mesh_hash", m.mesh_hash},
+             {"vertices", model.basis.vertex_count},
+             {"basis_requested", bake.settings.basis.basis},
+             {"basis_kept", model.basis.basis_count},
+             {"condition", model.basis.condition},
+             {"glossy_terms", model.glossy ? model.glossy->terms : 0},
+             {"glossy_brdf_error", model.glossy ? static_cast<double>(model.glossy->relative_error) : 0.0},
+             {"field_bytes", static_cast<std::uint64_t>(model.field.bytes())},
+             {"field_compressed_bytes", compressed},
+             {"file_bytes", static_cast<std::uint64_t>(file_bytes)}};
   }
   const json entry{{"files", files}, {"settings", settings_json(bake.settings)}, {"meshes", meshes}};
   return update_manifest_method(bundle_dir, scene_geometry_hash(input), scene_name, kBrfMethod, entry);
@@ -362,18 +366,19 @@ engine::Result<BrfBake> load_brf(const fs::path& bundle_dir, std::span<const Brf
     if (!path) return path.error();
     auto mesh = read_brf_mesh(*path);
     if (!mesh) return mesh.error();
-    if (mesh->name != source.name)
+    if (mesh->model.name != source.name)
       return file_error(*path, "name",
-                        "holds mesh \"" + mesh->name + "\", the manifest lists it for \"" + source.name + "\"");
+                        "holds mesh \"" + mesh->model.name + "\", the manifest lists it for \"" + source.name + "\"");
     if (mesh->mesh_hash != source.mesh_hash)
       return file_error(*path, "mesh_hash",
                         "stale basis radiance field: baked from mesh hash " + mesh->mesh_hash + ", but mesh \"" +
                             source.name + "\" of the scene hashes to " + source.mesh_hash +
                             " (re-bake with --methods brf)");
-    if (mesh->basis.vertex_count != source.mesh.positions.size())
+    if (mesh->model.basis.vertex_count != source.mesh.positions.size())
       return file_error(*path, "vertex_count",
-                        "the basis has " + str(mesh->basis.vertex_count) + " vertices, mesh \"" + source.name + "\" " +
-                            str(source.mesh.positions.size()));
+                        "the basis has " + str(mesh->model.basis.vertex_count) + " vertices, mesh \"" + source.name +
+                            "\" " + str(source.mesh.positions.size()));
+    mesh->model.mesh = source.mesh;  // what the basis was baked on (its hash checked above)
     out.meshes.push_back(std::move(mesh).value());
   }
   return out;

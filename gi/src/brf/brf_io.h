@@ -88,7 +88,8 @@ engine::Status write_brf_mesh(const std::filesystem::path& path, const BrfMeshBa
 
 /// Reads and checks one brf_<name>.bin: the container (magic, version, size, checksum),
 /// complete fields, nothing after them, sizes in range and consistent, the zstd frame and
-/// its size, finite values. The timings are left 0 (they live in the manifest).
+/// its size, finite values. The timings are left 0 (they live in the manifest) and the
+/// model's mesh empty (the file does not hold it: load_brf fills it in).
 engine::Result<BrfMeshBake> read_brf_mesh(const std::filesystem::path& path);
 
 /// Writes every mesh's file into `bundle_dir` (created if needed), then the manifest's
@@ -100,7 +101,8 @@ engine::Status save_brf(const std::filesystem::path& bundle_dir, const BrfBake& 
 /// Loads the bake of each of `sources` (result meshes[i] belongs to sources[i]): its
 /// manifest entry, the file's checksum against the manifest, read_brf_mesh, then the mesh
 /// hash against sources[i].mesh_hash (a differing one is a stale bake: the message says
-/// "stale" and names both hashes) and the vertex count. Timings come from the manifest.
+/// "stale" and names both hashes) and the vertex count; each model's mesh is then
+/// sources[i].mesh, what it was baked on. Timings come from the manifest.
 /// Every error names the file and the problem.
 engine::Result<BrfBake> load_brf(const std::filesystem::path& bundle_dir, std::span<const BrfSource> sources);
 

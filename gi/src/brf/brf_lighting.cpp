@@ -40,8 +40,10 @@ std::uint64_t lights_signature(const engine::Registry& registry) {
 
 struct BrfLighting::Impl {
   const engine::Registry* registry = nullptr;
-  std::vector<BrfModelData> models;
-  std::vector<BrfInstanceBinding> instances;
+  std::vector<BrfModel> models;
+  // Per instance: its model, albedos and last usable world transform (all zero before the first).
+  std::vector<BrfInstance> instances;
+  std::vector<engine::Entity> entities;  // who draws each instance
   BrfWorldLink world;
   BrfLightingSettings settings;
   std::unordered_map<std::uint32_t, std::size_t> instance_of;  // entity id -> instance
@@ -58,7 +60,6 @@ struct BrfLighting::Impl {
   engine::GlBuffer receiver_texels;
   bool gpu_failed = false;
 
-  std::vector<glm::mat4> transforms;
   std::vector<std::vector<glm::vec3>> world_incoming;  // probe light per instance vertex
   std::uint64_t last_lights = 0;
   bool computed = false;
@@ -66,6 +67,15 @@ struct BrfLighting::Impl {
   std::vector<std::array<glm::vec3, 9>> static_probe_sh;
   bool world_light_changed = false;  // set_moving_world_light since the last update
   Stats stats;
+
+  // update()'s stages.
+  /// Takes the entities' usable world transforms: per instance 1 when it moved (every
+  /// instance on the first update). NaN or absurd transforms keep the last usable pose.
+  std::vector<std::uint8_t> take_transforms(bool& any_moved);
+  /// Re-reads instance i's world light (K x V values) from the probes and uploads it.
+  void read_world_light(std::size_t i, const BrfObject& object, std::size_t values);
+  /// Per vertex: world light + interreflected, into `total`.
+  void sum_vertices();
 
   /// Turns the fields off for good, telling the host why. Returns false.
   bool disable(std::string reason) {
@@ -75,9 +85,7 @@ struct BrfLighting::Impl {
   }
 
   bool create_gpu() {
-    std::vector<BrfGpuModel> gm;
-    for (const BrfModelData& m : models) gm.push_back({&m.mesh, &m.basis, &m.field, m.glossy ? &*m.glossy : nullptr});
-    auto p = BrfGpuPass::create(gm);
+    auto p = BrfGpuPass::create(models);
     auto sum = engine::ShaderProgramBuilder(gi_shader_files())
                    .stage(engine::ShaderStage::Compute, "brf_vertex_sum.comp.glsl")
                    .build();
@@ -103,7 +111,7 @@ struct BrfLighting::Impl {
       receiver_texels =
           engine::GlBuffer::create(world.receiver_texels.size() * sizeof(std::uint32_t), world.receiver_texels.data());
     }
-    for (const BrfModelData& model : models) {
+    for (const BrfModel& model : models) {
       if (!model.glossy) {
         lobe_tables.emplace_back();
         continue;
@@ -112,7 +120,7 @@ struct BrfLighting::Impl {
       const std::vector<float> h = model.glossy->albedo_corrected_h();
       lobe_tables.push_back(engine::GlBuffer::create(h.size() * sizeof(float), h.data(), 0));
     }
-    for (const BrfInstanceBinding& b : instances) {
+    for (const BrfInstance& b : instances) {
       const std::size_t terms = static_cast<std::size_t>(models[b.model].field.terms);
       const std::size_t bytes =
           std::max<std::size_t>(models[b.model].mesh.positions.size() * terms, 1) * sizeof(glm::vec4);
@@ -127,19 +135,24 @@ struct BrfLighting::Impl {
 BrfLighting::BrfLighting(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 BrfLighting::~BrfLighting() = default;
 
-engine::Result<std::unique_ptr<BrfLighting>> BrfLighting::create(std::vector<BrfModelData> models,
-                                                                 std::vector<BrfInstanceBinding> instances,
+engine::Result<std::unique_ptr<BrfLighting>> BrfLighting::create(std::vector<BrfModel> models,
+                                                                 std::vector<BrfInstance> instances,
+                                                                 std::vector<engine::Entity> entities,
                                                                  const engine::Registry& registry, BrfWorldLink world,
                                                                  BrfLightingSettings settings) {
-  for (const BrfModelData& m : models)
+  for (const BrfModel& m : models)
     if (m.basis.vertex_count != m.mesh.positions.size() || m.field.basis_count != m.basis.basis_count)
       return engine::Error{.location = "basis radiance fields",
                            .message = "model '" + m.name + "': mesh, basis and field do not belong together"};
-  for (const BrfInstanceBinding& b : instances)
-    if (b.model >= models.size())
+  if (entities.size() != instances.size())
+    return engine::Error{.location = "basis radiance fields",
+                         .message = std::to_string(instances.size()) + " instances but " +
+                                    std::to_string(entities.size()) + " entities"};
+  for (std::size_t i = 0; i < instances.size(); ++i)
+    if (instances[i].model >= models.size())
       return engine::Error{.location = "basis radiance fields",
-                           .message = "entity " + std::to_string(b.entity.id()) + " uses model " +
-                                      std::to_string(b.model) + " of " + std::to_string(models.size())};
+                           .message = "entity " + std::to_string(entities[i].id()) + " uses model " +
+                                      std::to_string(instances[i].model) + " of " + std::to_string(models.size())};
   if (world.receiver_positions.size() != world.receiver_texels.size() ||
       world.receiver_normals.size() != world.receiver_texels.size())
     return engine::Error{.location = "basis radiance fields", .message = "static receiver arrays of different sizes"};
@@ -147,19 +160,82 @@ engine::Result<std::unique_ptr<BrfLighting>> BrfLighting::create(std::vector<Brf
   impl->registry = &registry;
   impl->models = std::move(models);
   impl->instances = std::move(instances);
+  impl->entities = std::move(entities);
   impl->world = std::move(world);
   impl->settings = settings;
   for (std::size_t i = 0; i < impl->instances.size(); ++i) {
-    impl->instance_of[impl->instances[i].entity.id()] = i;
+    impl->instance_of[impl->entities[i].id()] = i;
+    impl->instances[i].object_to_world = glm::mat4(0.0f);
     impl->stats.vertices += impl->models[impl->instances[i].model].mesh.positions.size();
   }
-  for (const BrfModelData& m : impl->models)
+  for (const BrfModel& m : impl->models)
     impl->stats.field_bytes += m.field.bytes() + m.basis.psi.size() * sizeof(float);
   impl->stats.instances = impl->instances.size();
   impl->stats.static_receivers = impl->world.receiver_texels.size();
-  impl->transforms.assign(impl->instances.size(), glm::mat4(0.0f));
   impl->world_incoming.resize(impl->instances.size());
   return std::unique_ptr<BrfLighting>(new BrfLighting(std::move(impl)));
+}
+
+std::vector<std::uint8_t> BrfLighting::Impl::take_transforms(bool& any_moved) {
+  std::vector<std::uint8_t> moved(instances.size(), 0);
+  any_moved = false;
+  for (std::size_t i = 0; i < instances.size(); ++i) {
+    const auto* wt = registry->try_get<engine::WorldTransform>(entities[i]);
+    if (wt == nullptr || engine::unusable_world_matrix(wt->matrix)) continue;
+    if (!computed || wt->matrix != instances[i].object_to_world) {
+      instances[i].object_to_world = wt->matrix;
+      moved[i] = 1;
+      any_moved = true;
+    }
+  }
+  return moved;
+}
+
+void BrfLighting::Impl::read_world_light(std::size_t i, const BrfObject& object, std::size_t values) {
+  const BrfWorldVertices v = brf_world_vertices(object);
+  const std::size_t nv = v.positions.size();
+  world_incoming[i].assign(values, glm::vec3(0.0f));
+  if (world.probes)
+    for (std::size_t j = 0; j < nv; ++j) {
+      world_incoming[i][j] = world.probes->irradiance(v.positions[j], v.normals[j]);
+      const BrdfSeparation* glossy = object.glossy;
+      if (glossy == nullptr) continue;
+      // A glossy vertex's E_k: the probes' radiance against g_k cos, turned from the
+      // vertex's frame into the world's.
+      std::array<glm::vec3, 9> radiance;
+      if (!world.probes->radiance(v.positions[j], radiance)) continue;
+      const ShRotation to_world(v.frames[j]);
+      std::array<float, kMaxShCoefficients> lobe{};
+      for (int k = 1; k <= glossy->terms; ++k) {
+        to_world.apply(glossy->lobe_coefficients(k - 1), lobe, 3);
+        glm::vec3 e(0.0f);
+        for (std::size_t c = 0; c < 9; ++c) e += lobe[c] * radiance[c];
+        world_incoming[i][static_cast<std::size_t>(k) * nv + j] = e;
+      }
+    }
+  std::vector<glm::vec4> packed(std::max<std::size_t>(world_incoming[i].size(), 1), glm::vec4(0.0f));
+  for (std::size_t j = 0; j < world_incoming[i].size(); ++j) packed[j] = glm::vec4(world_incoming[i][j], 0.0f);
+  glNamedBufferSubData(world_light[i].id(), 0, static_cast<GLsizeiptr>(packed.size() * sizeof(glm::vec4)),
+                       packed.data());
+}
+
+void BrfLighting::Impl::sum_vertices() {
+  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+  sum_program.use();
+  for (std::size_t i = 0; i < instances.size(); ++i) {
+    const BrfModel& model = models[instances[i].model];
+    const auto vertices = static_cast<std::uint32_t>(model.mesh.positions.size());
+    const auto count = vertices * static_cast<std::uint32_t>(model.field.terms);
+    glProgramUniform1ui(sum_program.id(), sum_count, count);
+    glProgramUniform1ui(sum_program.id(), sum_first_glossy, vertices);
+    const glm::vec3 specular = instances[i].specular;
+    glProgramUniform3f(sum_program.id(), sum_specular, specular.x, specular.y, specular.z);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, world_light[i].id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, pass->vertex_buffer(i));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, total[i].id());
+    glDispatchCompute((count + kGroupSize - 1) / kGroupSize, 1, 1);
+  }
+  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_VERTEX_ATTRIB_ARRAY_BARRIER_BIT);
 }
 
 bool BrfLighting::update() {
@@ -171,19 +247,9 @@ bool BrfLighting::update() {
   }
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();
-  // What changed: object transforms (NaN or absurd ones keep the last usable pose; GISystem
-  // warns once) and lights.
-  std::vector<std::uint8_t> moved(m.instances.size(), 0);
+  // What changed: object transforms (GISystem warns once about unusable ones) and lights.
   bool any_moved = false;
-  for (std::size_t i = 0; i < m.instances.size(); ++i) {
-    const auto* wt = m.registry->try_get<engine::WorldTransform>(m.instances[i].entity);
-    if (wt == nullptr || engine::unusable_world_matrix(wt->matrix)) continue;
-    if (!m.computed || wt->matrix != m.transforms[i]) {
-      m.transforms[i] = wt->matrix;
-      moved[i] = 1;
-      any_moved = true;
-    }
-  }
+  const std::vector<std::uint8_t> moved = m.take_transforms(any_moved);
   const std::uint64_t lights = lights_signature(*m.registry);
   const bool world_changed = m.world_light_changed;
   m.world_light_changed = false;
@@ -194,13 +260,7 @@ bool BrfLighting::update() {
   m.last_lights = lights;
 
   std::vector<BrfObject> objects;
-  std::vector<BrfGpuInstance> gpu_instances;
-  for (std::size_t i = 0; i < m.instances.size(); ++i) {
-    const BrfModelData& model = m.models[m.instances[i].model];
-    objects.push_back({&model.mesh, &model.basis, &model.field, m.transforms[i], m.instances[i].albedo,
-                       model.glossy ? &*model.glossy : nullptr, m.instances[i].specular});
-    gpu_instances.push_back({m.instances[i].model, m.transforms[i], m.instances[i].albedo, m.instances[i].specular});
-  }
+  for (const BrfInstance& instance : m.instances) objects.push_back(brf_object(m.models[instance.model], instance));
   // Direct light from every enabled light (static and moving), shadowed by objects and world.
   std::vector<ReferenceLight> all = scene_lights(*m.registry, BakeLights::Static);
   for (ReferenceLight& l : scene_lights(*m.registry, BakeLights::Moving)) all.push_back(l);
@@ -209,57 +269,15 @@ bool BrfLighting::update() {
   // The static world's light, re-read from the probes where an object moved (everywhere when
   // the probes' light changed).
   for (std::size_t i = 0; i < objects.size(); ++i) {
-    if (moved[i] != 0 || world_changed) {
-      const BrfWorldVertices v = brf_world_vertices(objects[i]);
-      const std::size_t nv = v.positions.size();
-      m.world_incoming[i].assign(incoming[i].size(), glm::vec3(0.0f));
-      if (m.world.probes)
-        for (std::size_t j = 0; j < nv; ++j) {
-          m.world_incoming[i][j] = m.world.probes->irradiance(v.positions[j], v.normals[j]);
-          const BrdfSeparation* glossy = objects[i].glossy;
-          if (glossy == nullptr) continue;
-          // A glossy vertex's E_k: the probes' radiance against g_k cos, turned from the
-          // vertex's frame into the world's.
-          std::array<glm::vec3, 9> radiance;
-          if (!m.world.probes->radiance(v.positions[j], radiance)) continue;
-          const ShRotation to_world(v.frames[j]);
-          std::array<float, kMaxShCoefficients> lobe{};
-          for (int k = 1; k <= glossy->terms; ++k) {
-            to_world.apply(glossy->lobe_coefficients(k - 1), lobe, 3);
-            glm::vec3 e(0.0f);
-            for (std::size_t c = 0; c < 9; ++c) e += lobe[c] * radiance[c];
-            m.world_incoming[i][static_cast<std::size_t>(k) * nv + j] = e;
-          }
-        }
-      std::vector<glm::vec4> packed(std::max<std::size_t>(m.world_incoming[i].size(), 1), glm::vec4(0.0f));
-      for (std::size_t j = 0; j < m.world_incoming[i].size(); ++j) packed[j] = glm::vec4(m.world_incoming[i][j], 0.0f);
-      glNamedBufferSubData(m.world_light[i].id(), 0, static_cast<GLsizeiptr>(packed.size() * sizeof(glm::vec4)),
-                           packed.data());
-    }
+    if (moved[i] != 0 || world_changed) m.read_world_light(i, objects[i], incoming[i].size());
     for (std::size_t j = 0; j < incoming[i].size(); ++j) incoming[i][j] += m.world_incoming[i][j];
   }
   const auto t1 = Clock::now();
-  if (engine::Status s = m.pass->run(gpu_instances, incoming, m.settings.update); !s) {
+  if (engine::Status s = m.pass->run(m.instances, incoming, m.settings.update); !s) {
     m.gpu_failed = !m.disable("update failed: " + s.error().to_string());
     return false;
   }
-  // Per vertex: world light + interreflected.
-  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-  m.sum_program.use();
-  for (std::size_t i = 0; i < m.instances.size(); ++i) {
-    const BrfModelData& model = m.models[m.instances[i].model];
-    const auto vertices = static_cast<std::uint32_t>(model.mesh.positions.size());
-    const auto count = vertices * static_cast<std::uint32_t>(model.field.terms);
-    glProgramUniform1ui(m.sum_program.id(), m.sum_count, count);
-    glProgramUniform1ui(m.sum_program.id(), m.sum_first_glossy, vertices);
-    const glm::vec3 specular = m.instances[i].specular;
-    glProgramUniform3f(m.sum_program.id(), m.sum_specular, specular.x, specular.y, specular.z);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, m.world_light[i].id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, m.pass->vertex_buffer(i));
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, m.total[i].id());
-    glDispatchCompute((count + kGroupSize - 1) / kGroupSize, 1, 1);
-  }
-  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_VERTEX_ATTRIB_ARRAY_BARRIER_BIT);
+  m.sum_vertices();
   glFinish();
   const auto t2 = Clock::now();
   const auto& ps = m.pass->stats();
@@ -289,7 +307,7 @@ engine::IndirectLightFrame::VertexRadianceLobes BrfLighting::vertex_lobes(engine
   const Impl& m = *impl_;
   const auto it = m.instance_of.find(e.id());
   if (it == m.instance_of.end() || it->second >= m.total.size() || !m.computed) return {};
-  const BrfModelData& model = m.models[m.instances[it->second].model];
+  const BrfModel& model = m.models[m.instances[it->second].model];
   if (!model.glossy || model.glossy->terms <= 0) return {};
   const int vertices = static_cast<int>(model.mesh.positions.size());
   return {.coefficient_buffer = {m.total[it->second].id()},

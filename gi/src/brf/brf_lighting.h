@@ -15,9 +15,9 @@
 //   - per vertex: world light + interreflected light (brf_vertex_sum.comp.glsl).
 // composite_world() writes base atlas + bounce into the caller's atlas texture
 // (brf_world_composite.comp.glsl).
-//   auto brf = gi::BrfLighting::create(std::move(models), bindings, scene.registry, std::move(world), {}).value();
-//   if (brf->update()) brf->composite_world(base_texture, composite_texture, width, height);
-//   GLuint ssbo = brf->vertex_buffer(crate_entity);
+//   auto brf = gi::BrfLighting::create(std::move(models), instances, entities, scene.registry, std::move(world),
+//   {}).value(); if (brf->update()) brf->composite_world(base_texture, composite_texture, width, height); GLuint ssbo =
+//   brf->vertex_buffer(crate_entity);
 
 #include <engine/entity.h>
 #include <engine/indirect_light.h>
@@ -42,24 +42,6 @@ namespace gi {
 
 class RayCaster;
 
-/// One distinct dynamic mesh with its precomputed basis and field.
-struct BrfModelData {
-  std::string name;
-  BrfMesh mesh;
-  BrfBasis basis;
-  BasisRadianceField field;
-  std::optional<BrdfSeparation> glossy;  ///< A glossy mesh's separated lobe.
-};
-
-/// A dynamic entity drawn with model `model`, diffuse albedo `albedo` (and, for a glossy
-/// model, glossy colour `specular`, BrfObject::specular).
-struct BrfInstanceBinding {
-  engine::Entity entity;
-  std::uint32_t model = 0;
-  glm::vec3 albedo{0.8f};
-  glm::vec3 specular{1.0f};
-};
-
 /// The static world's part (every member optional).
 struct BrfWorldLink {
   /// The static world: shadows for the objects' direct light, and what hides an object from
@@ -82,10 +64,13 @@ struct BrfLightingSettings {
 
 class BrfLighting {
  public:
-  /// Errors: a binding's model out of range, models whose parts do not belong together,
+  /// instances[i] is drawn by dynamic entity entities[i]; its object_to_world is ignored (each
+  /// update() reads the entity's WorldTransform). Errors: an instance's model out of range,
+  /// models whose parts do not belong together, entities and instances of different counts,
   /// receiver arrays of different sizes.
-  static engine::Result<std::unique_ptr<BrfLighting>> create(std::vector<BrfModelData> models,
-                                                             std::vector<BrfInstanceBinding> instances,
+  static engine::Result<std::unique_ptr<BrfLighting>> create(std::vector<BrfModel> models,
+                                                             std::vector<BrfInstance> instances,
+                                                             std::vector<engine::Entity> entities,
                                                              const engine::Registry& registry, BrfWorldLink world,
                                                              BrfLightingSettings settings = {});
   BrfLighting(const BrfLighting&) = delete;

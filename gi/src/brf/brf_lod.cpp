@@ -25,12 +25,11 @@ std::uint32_t farthest(std::span<const std::uint32_t> members, const std::vector
   return best;
 }
 
-}  // namespace
-
-BrfLodPoints brf_lod_points(const BrfMesh& mesh) {
+/// Vertices of (nearly) one plane, in vertex order: a group per plane (normals within
+/// kBrfLodNormalCos, points within the tolerance of the first member's plane). Empty when there
+/// would be too many groups for a table to pay (3 x groups > V / 2).
+std::vector<std::vector<std::uint32_t>> plane_groups(const BrfMesh& mesh) {
   const std::size_t nv = mesh.positions.size();
-  BrfLodPoints lod;
-  // Groups of (nearly) one plane, in vertex order.
   glm::vec3 lo(0.0f), hi(0.0f);
   for (std::size_t j = 0; j < nv; ++j) {
     lo = j == 0 ? mesh.positions[j] : glm::min(lo, mesh.positions[j]);
@@ -49,121 +48,164 @@ BrfLodPoints brf_lod_points(const BrfMesh& mesh) {
       groups.emplace_back();
       group_normal.push_back(mesh.normals[j]);
       group_point.push_back(mesh.positions[j]);
-      if (3 * groups.size() > nv / 2) return lod;  // too many groups: no table
+      if (3 * groups.size() > nv / 2) return {};  // too many groups: no table
     }
     groups[g].push_back(static_cast<std::uint32_t>(j));
   }
-  // First as vertex indices (rep_of), then renumbered into `points`.
+  return groups;
+}
+
+/// A group's extreme members and in-plane axes: a farthest from the centroid, b farthest
+/// from a, c farthest from the line a-b; `plane` when a, b, c span a triangle. The axes run
+/// along a-c (a rectangle's edge: a and b are opposite corners) and across it.
+struct GroupFrame {
+  std::uint32_t a = 0, b = 0, c = 0;
+  glm::vec3 e0{0.0f};  ///< b - a
+  float d00 = 0.0f;    ///< |e0|^2
+  bool plane = false;
+  glm::vec3 eu{0.0f}, ev{0.0f};
+  /// Member m's coordinates in the group's plane.
+  glm::vec2 uv(const std::vector<glm::vec3>& pos, std::uint32_t m) const {
+    return glm::vec2(glm::dot(pos[m] - pos[a], eu), glm::dot(pos[m] - pos[a], ev));
+  }
+};
+
+GroupFrame group_frame(const std::vector<std::uint32_t>& members, const std::vector<glm::vec3>& pos) {
+  GroupFrame f;
+  glm::vec3 centroid(0.0f);
+  for (std::uint32_t m : members) centroid += pos[m];
+  centroid /= static_cast<float>(members.size());
+  f.a = farthest(members, pos, centroid);
+  f.b = farthest(members, pos, pos[f.a]);
+  f.e0 = pos[f.b] - pos[f.a];
+  f.d00 = glm::dot(f.e0, f.e0);
+  // The member farthest from the line a-b.
+  f.c = f.a;
+  float best = -1.0f;
+  for (std::uint32_t m : members) {
+    const glm::vec3 d = pos[m] - pos[f.a];
+    const float t = f.d00 > 0.0f ? glm::dot(d, f.e0) / f.d00 : 0.0f;
+    const glm::vec3 off = d - t * f.e0;
+    const float o2 = glm::dot(off, off);
+    if (o2 > best) {
+      best = o2;
+      f.c = m;
+    }
+  }
+  const glm::vec3 e1 = pos[f.c] - pos[f.a];
+  const float d01 = glm::dot(f.e0, e1), d11 = glm::dot(e1, e1);
+  const float denom = f.d00 * d11 - d01 * d01;
+  f.plane = denom > 1e-6f * f.d00 * d11 && f.c != f.a && f.c != f.b;
+  f.eu = f.plane ? glm::normalize(e1) : f.e0;
+  f.ev = f.plane ? glm::normalize(f.e0 - glm::dot(f.e0, f.eu) * f.eu) : f.e0;
+  return f;
+}
+
+/// A group's representative points: in its plane, a lattice of G x G nodes over its extent
+/// [lo2, hi2], each taken by the member nearest to it (G = 3 for groups of 64 members or
+/// more, 2 from 8), else the triangle a b c (the line a b off a plane).
+std::vector<std::uint32_t> lattice_points(const std::vector<std::uint32_t>& members, const std::vector<glm::vec3>& pos,
+                                          const GroupFrame& f, glm::vec2 lo2, glm::vec2 hi2) {
+  std::vector<std::uint32_t> reps;
+  const int lattice = !f.plane ? 0 : members.size() >= 64 ? 3 : members.size() >= 8 ? 2 : 0;
+  for (int i = 0; i < lattice; ++i)
+    for (int k = 0; k < lattice; ++k) {
+      const glm::vec2 node =
+          lo2 + (hi2 - lo2) * glm::vec2(static_cast<float>(i), static_cast<float>(k)) / static_cast<float>(lattice - 1);
+      std::uint32_t best_m = members[0];
+      float best_d = std::numeric_limits<float>::max();
+      for (std::uint32_t m : members) {
+        const glm::vec2 d = f.uv(pos, m) - node;
+        if (glm::dot(d, d) < best_d) {
+          best_d = glm::dot(d, d);
+          best_m = m;
+        }
+      }
+      if (std::find(reps.begin(), reps.end(), best_m) == reps.end()) reps.push_back(best_m);
+    }
+  if (reps.size() < 3)
+    reps = f.plane ? std::vector<std::uint32_t>{f.a, f.b, f.c} : std::vector<std::uint32_t>{f.a, f.b};
+  return reps;
+}
+
+/// Member m's entry in `lod` (vertex indices): from the smallest triangle of representative
+/// points holding it (barycentric weights >= 0), else the one it lies least outside of.
+void triangle_weights(std::uint32_t m, const std::vector<std::uint32_t>& reps, const std::vector<glm::vec3>& pos,
+                      const GroupFrame& f, float area, BrfLodPoints& lod) {
+  const glm::vec2 x = f.uv(pos, m);
+  float best_area = std::numeric_limits<float>::max(), best_outside = -std::numeric_limits<float>::max();
+  bool inside_found = false;
+  for (std::size_t i = 0; i < reps.size(); ++i)
+    for (std::size_t j = i + 1; j < reps.size(); ++j)
+      for (std::size_t k = j + 1; k < reps.size(); ++k) {
+        const glm::vec2 p0 = f.uv(pos, reps[i]), p1 = f.uv(pos, reps[j]), p2 = f.uv(pos, reps[k]);
+        const float det = (p1.x - p0.x) * (p2.y - p0.y) - (p2.x - p0.x) * (p1.y - p0.y);
+        if (std::fabs(det) <= 1e-4f * area) continue;
+        const float w1 = ((x.x - p0.x) * (p2.y - p0.y) - (p2.x - p0.x) * (x.y - p0.y)) / det;
+        const float w2 = ((p1.x - p0.x) * (x.y - p0.y) - (x.x - p0.x) * (p1.y - p0.y)) / det;
+        const glm::vec3 w(1.0f - w1 - w2, w1, w2);
+        const float least = std::min({w.x, w.y, w.z});
+        const bool inside = least >= -1e-5f;
+        if (inside ? (!inside_found || std::fabs(det) < best_area) : (!inside_found && least > best_outside)) {
+          inside_found = inside_found || inside;
+          best_area = std::fabs(det);
+          best_outside = least;
+          lod.from[m] = glm::uvec3(reps[i], reps[j], reps[k]);
+          lod.weights[m] = w;
+        }
+      }
+}
+
+/// One group's representative points into `lod` (vertex indices) and every member's entry.
+void add_group(const std::vector<std::uint32_t>& members, const std::vector<glm::vec3>& pos, BrfLodPoints& lod,
+               std::vector<std::uint8_t>& is_point) {
+  if (members.size() <= 3) {
+    for (std::uint32_t m : members) {
+      lod.points.push_back(m);
+      lod.from[m] = glm::uvec3(m);
+      lod.weights[m] = glm::vec3(1.0f, 0.0f, 0.0f);
+      is_point[m] = 1;
+    }
+    return;
+  }
+  const GroupFrame f = group_frame(members, pos);
+  glm::vec2 lo2(0.0f), hi2(0.0f);
+  for (std::uint32_t m : members) {
+    lo2 = glm::min(lo2, f.uv(pos, m));
+    hi2 = glm::max(hi2, f.uv(pos, m));
+  }
+  const std::vector<std::uint32_t> reps = lattice_points(members, pos, f, lo2, hi2);
+  for (std::uint32_t r : reps) {
+    lod.points.push_back(r);
+    is_point[r] = 1;
+  }
+  const float area = std::max((hi2.x - lo2.x) * (hi2.y - lo2.y), 1e-12f);
+  for (std::uint32_t m : members) {
+    if (is_point[m] != 0) {
+      lod.from[m] = glm::uvec3(m);
+      lod.weights[m] = glm::vec3(1.0f, 0.0f, 0.0f);
+    } else if (reps.size() == 2) {  // a line
+      const float t = f.d00 > 0.0f ? glm::dot(pos[m] - pos[f.a], f.e0) / f.d00 : 0.0f;
+      lod.from[m] = glm::uvec3(reps[0], reps[1], reps[0]);
+      lod.weights[m] = glm::vec3(1.0f - t, t, 0.0f);
+    } else {
+      triangle_weights(m, reps, pos, f, area, lod);
+    }
+  }
+}
+
+}  // namespace
+
+BrfLodPoints brf_lod_points(const BrfMesh& mesh) {
+  const std::size_t nv = mesh.positions.size();
+  BrfLodPoints lod;
+  const std::vector<std::vector<std::uint32_t>> groups = plane_groups(mesh);
+  if (groups.empty()) return lod;
+  // First as vertex indices, then renumbered into `points`.
   lod.from.assign(nv, glm::uvec3(0));
   lod.weights.assign(nv, glm::vec3(0.0f));
   std::vector<std::uint8_t> is_point(nv, 0);
-  const auto& pos = mesh.positions;
-  for (const std::vector<std::uint32_t>& members : groups) {
-    if (members.size() <= 3) {
-      for (std::uint32_t m : members) {
-        lod.points.push_back(m);
-        lod.from[m] = glm::uvec3(m);
-        lod.weights[m] = glm::vec3(1.0f, 0.0f, 0.0f);
-        is_point[m] = 1;
-      }
-      continue;
-    }
-    glm::vec3 centroid(0.0f);
-    for (std::uint32_t m : members) centroid += pos[m];
-    centroid /= static_cast<float>(members.size());
-    const std::uint32_t a = farthest(members, pos, centroid);
-    const std::uint32_t b = farthest(members, pos, pos[a]);
-    const glm::vec3 e0 = pos[b] - pos[a];
-    const float d00 = glm::dot(e0, e0);
-    // The member farthest from the line a-b.
-    std::uint32_t c = a;
-    float best = -1.0f;
-    for (std::uint32_t m : members) {
-      const glm::vec3 d = pos[m] - pos[a];
-      const float t = d00 > 0.0f ? glm::dot(d, e0) / d00 : 0.0f;
-      const glm::vec3 off = d - t * e0;
-      const float o2 = glm::dot(off, off);
-      if (o2 > best) {
-        best = o2;
-        c = m;
-      }
-    }
-    const glm::vec3 e1 = pos[c] - pos[a];
-    const float d01 = glm::dot(e0, e1), d11 = glm::dot(e1, e1);
-    const float denom = d00 * d11 - d01 * d01;
-    const bool plane = denom > 1e-6f * d00 * d11 && c != a && c != b;
-    // In the group's plane: a lattice of G x G nodes over its extent, each taken by the member
-    // nearest to it (G = 3 for groups of 18 members or more, 2 from 8, else the triangle a b c).
-    // The lattice's axes along a-c (a rectangle's edge: a and b are opposite corners).
-    const glm::vec3 eu = plane ? glm::normalize(e1) : e0;
-    const glm::vec3 ev = plane ? glm::normalize(e0 - glm::dot(e0, eu) * eu) : e0;
-    auto uv = [&](std::uint32_t m) { return glm::vec2(glm::dot(pos[m] - pos[a], eu), glm::dot(pos[m] - pos[a], ev)); };
-    std::vector<std::uint32_t> reps;
-    const int lattice = !plane ? 0 : members.size() >= 64 ? 3 : members.size() >= 8 ? 2 : 0;
-    glm::vec2 lo2(0.0f), hi2(0.0f);
-    for (std::uint32_t m : members) {
-      lo2 = glm::min(lo2, uv(m));
-      hi2 = glm::max(hi2, uv(m));
-    }
-    for (int i = 0; i < lattice; ++i)
-      for (int k = 0; k < lattice; ++k) {
-        const glm::vec2 node = lo2 + (hi2 - lo2) * glm::vec2(static_cast<float>(i), static_cast<float>(k)) /
-                                         static_cast<float>(lattice - 1);
-        std::uint32_t best_m = members[0];
-        float best_d = std::numeric_limits<float>::max();
-        for (std::uint32_t m : members) {
-          const glm::vec2 d = uv(m) - node;
-          if (glm::dot(d, d) < best_d) {
-            best_d = glm::dot(d, d);
-            best_m = m;
-          }
-        }
-        if (std::find(reps.begin(), reps.end(), best_m) == reps.end()) reps.push_back(best_m);
-      }
-    if (reps.size() < 3) reps = plane ? std::vector<std::uint32_t>{a, b, c} : std::vector<std::uint32_t>{a, b};
-    for (std::uint32_t r : reps) {
-      lod.points.push_back(r);
-      is_point[r] = 1;
-    }
-    const float area = std::max((hi2.x - lo2.x) * (hi2.y - lo2.y), 1e-12f);
-    for (std::uint32_t m : members) {
-      if (is_point[m] != 0) {
-        lod.from[m] = glm::uvec3(m);
-        lod.weights[m] = glm::vec3(1.0f, 0.0f, 0.0f);
-        continue;
-      }
-      if (reps.size() == 2) {  // a line
-        const float t = d00 > 0.0f ? glm::dot(pos[m] - pos[a], e0) / d00 : 0.0f;
-        lod.from[m] = glm::uvec3(reps[0], reps[1], reps[0]);
-        lod.weights[m] = glm::vec3(1.0f - t, t, 0.0f);
-        continue;
-      }
-      // The smallest triangle of representative points holding the member (barycentric
-      // weights >= 0), else the one it lies least outside of.
-      const glm::vec2 x = uv(m);
-      float best_area = std::numeric_limits<float>::max(), best_outside = -std::numeric_limits<float>::max();
-      bool inside_found = false;
-      for (std::size_t i = 0; i < reps.size(); ++i)
-        for (std::size_t j = i + 1; j < reps.size(); ++j)
-          for (std::size_t k = j + 1; k < reps.size(); ++k) {
-            const glm::vec2 p0 = uv(reps[i]), p1 = uv(reps[j]), p2 = uv(reps[k]);
-            const float det = (p1.x - p0.x) * (p2.y - p0.y) - (p2.x - p0.x) * (p1.y - p0.y);
-            if (std::fabs(det) <= 1e-4f * area) continue;
-            const float w1 = ((x.x - p0.x) * (p2.y - p0.y) - (p2.x - p0.x) * (x.y - p0.y)) / det;
-            const float w2 = ((p1.x - p0.x) * (x.y - p0.y) - (x.x - p0.x) * (p1.y - p0.y)) / det;
-            const glm::vec3 w(1.0f - w1 - w2, w1, w2);
-            const float least = std::min({w.x, w.y, w.z});
-            const bool inside = least >= -1e-5f;
-            if (inside ? (!inside_found || std::fabs(det) < best_area) : (!inside_found && least > best_outside)) {
-              inside_found = inside_found || inside;
-              best_area = std::fabs(det);
-              best_outside = least;
-              lod.from[m] = glm::uvec3(reps[i], reps[j], reps[k]);
-              lod.weights[m] = w;
-            }
-          }
-    }
-  }
+  for (const std::vector<std::uint32_t>& members : groups) add_group(members, mesh.positions, lod, is_point);
   std::sort(lod.points.begin(), lod.points.end());
   if (2 * lod.points.size() > nv) return BrfLodPoints{};
   std::vector<std::uint32_t> index(nv, 0);  // vertex -> position in points

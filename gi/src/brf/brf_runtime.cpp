@@ -356,6 +356,116 @@ void reflect(const BrfObject& object, std::span<const glm::vec3> in, std::span<g
   for (std::size_t i = 0; i < in.size(); ++i) out[i] = (i < nv ? object.albedo : object.specular) * in[i];
 }
 
+/// Level of detail (brf_lod.h): one table per distinct diffuse receiver mesh, the sources'
+/// innermost field spheres in world space.
+struct PairLod {
+  std::vector<std::pair<const BrfMesh*, BrfLodPoints>> tables;
+  std::vector<const BrfLodPoints*> of;  ///< Per object: its table, or nullptr (none, glossy, off).
+  std::vector<BrfSphere> inner;         ///< Per object: its innermost field sphere (world space).
+};
+
+PairLod pair_lod(std::span<const BrfObject> objects, const BrfUpdateSettings& settings) {
+  const std::size_t n = objects.size();
+  PairLod lod;
+  lod.of.assign(n, nullptr);
+  lod.inner.resize(n);
+  const bool lod_on = settings.lod_distance > 0.0f && std::isfinite(settings.lod_distance);
+  if (!lod_on) return lod;
+  lod.tables.reserve(n);  // `of` points into it
+  for (std::size_t o = 0; o < n; ++o) {
+    const BrfObject& obj = objects[o];
+    lod.inner[o] = {glm::vec3(obj.object_to_world * glm::vec4(obj.field->centre, 1.0f)),
+                    obj.field->inner_radius * glm::length(glm::vec3(obj.object_to_world[0]))};
+    if (obj.glossy != nullptr) continue;
+    auto it = std::find_if(lod.tables.begin(), lod.tables.end(), [&](const auto& t) { return t.first == obj.mesh; });
+    if (it == lod.tables.end()) {
+      lod.tables.emplace_back(obj.mesh, brf_lod_points(*obj.mesh));
+      it = lod.tables.end() - 1;
+    }
+    if (!it->second.empty()) lod.of[o] = &it->second;
+  }
+  return lod;
+}
+
+/// Basis irradiance of every live pair ([s * n + r]), once per frame, seen past the objects
+/// in between; counts the pairs into `out`.
+std::vector<std::vector<float>> pair_phi(std::span<const BrfObject> objects, std::span<const BrfWorldVertices> wv,
+                                         std::span<const std::uint8_t> culled, const BrfUpdateSettings& settings,
+                                         BrfResult& out) {
+  const std::size_t n = objects.size();
+  std::vector<BrfBox> boxes(n);
+  std::vector<BrfSphere> spheres(n);
+  for (std::size_t o = 0; o < n; ++o) {
+    boxes[o] = brf_object_box(*objects[o].mesh);
+    spheres[o] = brf_bounding_sphere(boxes[o], objects[o].object_to_world);
+  }
+  std::vector<std::vector<float>> phi(n * n);
+  std::vector<BrfOccluder> occluders;
+  const PairLod lod = pair_lod(objects, settings);
+  for (std::size_t s = 0; s < n; ++s)
+    for (std::size_t r = 0; r < n; ++r) {
+      if (s == r) continue;
+      if (culled[s * n + r] != 0) {
+        ++out.pairs_culled;
+        continue;
+      }
+      ++out.pairs_evaluated;
+      occluders.clear();
+      if (settings.occlusion)
+        for (std::uint32_t o : brf_pair_occluders(spheres, s, r))
+          occluders.push_back({boxes[o], glm::inverse(objects[o].object_to_world) * objects[s].object_to_world});
+      const BrfLodPoints* pair_lod =
+          lod.of[r] != nullptr && brf_pair_far(spheres[r], lod.inner[s], settings.lod_distance) ? lod.of[r] : nullptr;
+      if (pair_lod != nullptr) ++out.pairs_lod;
+      brf_basis_irradiance(objects[s], wv[r].positions, wv[r].normals, phi[s * n + r], objects[r].glossy, wv[r].frames,
+                           occluders, pair_lod, settings.lod_shared_visibility);
+    }
+  return phi;
+}
+
+/// Step 2d: the static receivers get every object's total radiosity inside its field.
+void receive_static(std::span<const BrfObject> objects, std::span<const std::vector<glm::vec3>> total,
+                    const BrfStaticReceivers& receivers, BrfResult& out) {
+  std::vector<glm::vec3> pos, nrm;
+  std::vector<std::size_t> index;
+  std::vector<float> phi_static;
+  std::vector<glm::vec3> e;
+  std::vector<float> visibility;
+  for (std::size_t s = 0; s < objects.size(); ++s) {
+    const BasisRadianceField& f = *objects[s].field;
+    const glm::vec3 centre = glm::vec3(objects[s].object_to_world * glm::vec4(f.centre, 1.0f));
+    const float scale = glm::length(glm::vec3(objects[s].object_to_world[0]));
+    const float reach = f.outer_radius * scale;
+    pos.clear();
+    nrm.clear();
+    index.clear();
+    for (std::size_t t = 0; t < receivers.positions.size(); ++t)
+      if (glm::length(receivers.positions[t] - centre) <= reach) {
+        pos.push_back(receivers.positions[t]);
+        nrm.push_back(receivers.normals[t]);
+        index.push_back(t);
+      }
+    if (index.empty()) continue;
+    visibility.assign(index.size(), 1.0f);
+    if (receivers.world != nullptr) {
+      std::array<glm::vec3, kBrfVisibilityTargets> targets = brf_visibility_targets(brf_object_box(*objects[s].mesh));
+      for (glm::vec3& t : targets) t = glm::vec3(objects[s].object_to_world * glm::vec4(t, 1.0f));
+      brf_static_visibility(*receivers.world, targets, pos, nrm, visibility);
+    }
+    brf_basis_irradiance(objects[s], pos, nrm, phi_static);
+    const auto wt = brf_fit_rgb(*objects[s].basis, total[s]);
+    e.assign(index.size(), glm::vec3(0.0f));
+    brf_gather(phi_static, static_cast<std::size_t>(f.channel_count()), 1, wt, e);
+    const BrfBox box = brf_object_box(*objects[s].mesh);
+    for (std::size_t k = 0; k < index.size(); ++k)
+      if (visibility[k] > 0.0f) {
+        out.static_irradiance[index[k]] += visibility[k] * e[k];
+        out.static_occlusion[index[k]] +=
+            visibility[k] * brf_box_form_factor(box, objects[s].object_to_world, pos[k], nrm[k]);
+      }
+  }
+}
+
 }  // namespace
 
 BrfResult brf_interreflect(std::span<const BrfObject> objects, std::span<const std::vector<glm::vec3>> incoming,
@@ -384,55 +494,7 @@ BrfResult brf_interreflect(std::span<const BrfObject> objects, std::span<const s
   for (std::size_t s = 0; s < n; ++s) w[s] = brf_fit_rgb(*objects[s].basis, light[s]);
   const std::vector<std::uint8_t> culled =
       brf_pair_culling(objects, w, settings.cull_threshold, settings.influence_scale);
-
-  // Basis irradiance of every live pair, once per frame, seen past the objects in between.
-  std::vector<BrfBox> boxes(n);
-  std::vector<BrfSphere> spheres(n);
-  for (std::size_t o = 0; o < n; ++o) {
-    boxes[o] = brf_object_box(*objects[o].mesh);
-    spheres[o] = brf_bounding_sphere(boxes[o], objects[o].object_to_world);
-  }
-  std::vector<std::vector<float>> phi(n * n);
-  std::vector<BrfOccluder> occluders;
-  // Level of detail (brf_lod.h): one table per distinct diffuse receiver mesh, the sources'
-  // innermost field spheres in world space.
-  std::vector<const BrfLodPoints*> lod(n, nullptr);
-  std::vector<std::pair<const BrfMesh*, BrfLodPoints>> lod_tables;
-  std::vector<BrfSphere> inner(n);
-  const bool lod_on = settings.lod_distance > 0.0f && std::isfinite(settings.lod_distance);
-  if (lod_on) {
-    lod_tables.reserve(n);
-    for (std::size_t o = 0; o < n; ++o) {
-      const BrfObject& obj = objects[o];
-      inner[o] = {glm::vec3(obj.object_to_world * glm::vec4(obj.field->centre, 1.0f)),
-                  obj.field->inner_radius * glm::length(glm::vec3(obj.object_to_world[0]))};
-      if (obj.glossy != nullptr) continue;
-      auto it = std::find_if(lod_tables.begin(), lod_tables.end(), [&](const auto& t) { return t.first == obj.mesh; });
-      if (it == lod_tables.end()) {
-        lod_tables.emplace_back(obj.mesh, brf_lod_points(*obj.mesh));
-        it = lod_tables.end() - 1;
-      }
-      if (!it->second.empty()) lod[o] = &it->second;
-    }
-  }
-  for (std::size_t s = 0; s < n; ++s)
-    for (std::size_t r = 0; r < n; ++r) {
-      if (s == r) continue;
-      if (culled[s * n + r] != 0) {
-        ++out.pairs_culled;
-        continue;
-      }
-      ++out.pairs_evaluated;
-      occluders.clear();
-      if (settings.occlusion)
-        for (std::uint32_t o : brf_pair_occluders(spheres, s, r))
-          occluders.push_back({boxes[o], glm::inverse(objects[o].object_to_world) * objects[s].object_to_world});
-      const BrfLodPoints* pair_lod =
-          lod[r] != nullptr && brf_pair_far(spheres[r], inner[s], settings.lod_distance) ? lod[r] : nullptr;
-      if (pair_lod != nullptr) ++out.pairs_lod;
-      brf_basis_irradiance(objects[s], wv[r].positions, wv[r].normals, phi[s * n + r], objects[r].glossy, wv[r].frames,
-                           occluders, pair_lod, settings.lod_shared_visibility);
-    }
+  const std::vector<std::vector<float>> phi = pair_phi(objects, wv, culled, settings, out);
 
   for (int bounce = 0; bounce < settings.bounces; ++bounce) {
     if (bounce > 0)
@@ -453,47 +515,7 @@ BrfResult brf_interreflect(std::span<const BrfObject> objects, std::span<const s
     }
   }
 
-  // The static world receives every object's total radiosity inside its field.
-  if (!receivers.positions.empty()) {
-    std::vector<glm::vec3> pos, nrm;
-    std::vector<std::size_t> index;
-    std::vector<float> phi_static;
-    std::vector<glm::vec3> e;
-    std::vector<float> visibility;
-    for (std::size_t s = 0; s < n; ++s) {
-      const BasisRadianceField& f = *objects[s].field;
-      const glm::vec3 centre = glm::vec3(objects[s].object_to_world * glm::vec4(f.centre, 1.0f));
-      const float scale = glm::length(glm::vec3(objects[s].object_to_world[0]));
-      const float reach = f.outer_radius * scale;
-      pos.clear();
-      nrm.clear();
-      index.clear();
-      for (std::size_t t = 0; t < receivers.positions.size(); ++t)
-        if (glm::length(receivers.positions[t] - centre) <= reach) {
-          pos.push_back(receivers.positions[t]);
-          nrm.push_back(receivers.normals[t]);
-          index.push_back(t);
-        }
-      if (index.empty()) continue;
-      visibility.assign(index.size(), 1.0f);
-      if (receivers.world != nullptr) {
-        std::array<glm::vec3, kBrfVisibilityTargets> targets = brf_visibility_targets(brf_object_box(*objects[s].mesh));
-        for (glm::vec3& t : targets) t = glm::vec3(objects[s].object_to_world * glm::vec4(t, 1.0f));
-        brf_static_visibility(*receivers.world, targets, pos, nrm, visibility);
-      }
-      brf_basis_irradiance(objects[s], pos, nrm, phi_static);
-      const auto wt = brf_fit_rgb(*objects[s].basis, total[s]);
-      e.assign(index.size(), glm::vec3(0.0f));
-      brf_gather(phi_static, static_cast<std::size_t>(f.channel_count()), 1, wt, e);
-      const BrfBox box = brf_object_box(*objects[s].mesh);
-      for (std::size_t k = 0; k < index.size(); ++k)
-        if (visibility[k] > 0.0f) {
-          out.static_irradiance[index[k]] += visibility[k] * e[k];
-          out.static_occlusion[index[k]] +=
-              visibility[k] * brf_box_form_factor(box, objects[s].object_to_world, pos[k], nrm[k]);
-        }
-    }
-  }
+  if (!receivers.positions.empty()) receive_static(objects, total, receivers, out);
   for (float& o : out.static_occlusion) o = std::min(o, 1.0f);
   return out;
 }

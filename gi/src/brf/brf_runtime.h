@@ -42,6 +42,7 @@
 #include <glm/glm.hpp>
 
 #include "brf/brdf_separation.h"
+#include "brf/brf_model.h"
 #include "brf/pca_basis.h"
 #include "brf/radiance_field.h"
 #include "transport/point_emitters.h"
@@ -51,6 +52,17 @@ namespace gi {
 class RayCaster;
 struct BrfLodPoints;  // brf_lod.h
 
+/// One placed object: the model it draws (an index into the caller's models) and its state
+/// this frame.
+struct BrfInstance {
+  std::uint32_t model = 0;
+  glm::mat4 object_to_world{1.0f};  ///< Rigid (rotation + translation; uniform scale allowed).
+  glm::vec3 albedo{0.8f};           ///< Diffuse albedo.
+  glm::vec3 specular{1.0f};         ///< Glossy colour: f0 (RGB) / glossy->lobe.f0; unused for a diffuse model.
+};
+
+/// An instance with its model's parts resolved, as the CPU twin's functions take it
+/// (brf_object() builds one; tests and tools may point at parts they hold themselves).
 struct BrfObject {
   const BrfMesh* mesh = nullptr;
   const BrfBasis* basis = nullptr;
@@ -63,6 +75,12 @@ struct BrfObject {
 
   int terms() const { return field->terms; }
 };
+
+/// `instance` of `model` as the CPU twin takes it (pointing into `model`).
+inline BrfObject brf_object(const BrfModel& model, const BrfInstance& instance) {
+  return {&model.mesh,     &model.basis,        &model.field,     instance.object_to_world,
+          instance.albedo, model.glossy_lobe(), instance.specular};
+}
 
 struct BrfUpdateSettings {
   int bounces = 3;

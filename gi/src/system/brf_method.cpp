@@ -74,9 +74,10 @@ class BrfMethod final : public MethodRuntime {
 
 // The dynamic meshes' models and their instances, from the bundle's fields.
 struct BrfModels {
-  std::vector<BrfModelData> models;
-  std::vector<BrfInstanceBinding> bindings;
-  std::vector<std::string> glossy;  ///< Meshes whose lobe the fields hold in separable terms.
+  std::vector<BrfModel> models;
+  std::vector<BrfInstance> instances;
+  std::vector<engine::Entity> entities;  ///< Who draws each instance.
+  std::vector<std::string> glossy;       ///< Meshes whose lobe the fields hold in separable terms.
 };
 engine::Result<BrfModels> read_models(const MethodLoad& load) {
   auto sources = dynamic_brf_meshes(load.input);
@@ -85,14 +86,15 @@ engine::Result<BrfModels> read_models(const MethodLoad& load) {
   if (!loaded) return loaded.error();
   BrfModels out;
   for (std::size_t i = 0; i < sources->size(); ++i) {
-    BrfSource& src = (*sources)[i];
-    BrfMeshBake& b = loaded->meshes[i];
+    const BrfSource& src = (*sources)[i];
     const auto model = static_cast<std::uint32_t>(out.models.size());
     const glm::vec3 albedo = brf_source_albedo(load.input, src);
-    for (std::uint32_t k : src.instances)
-      out.bindings.push_back({load.input.instances[k].entity, model, albedo, src.specular});
-    if (b.glossy) out.glossy.push_back(src.name);
-    out.models.push_back({src.name, std::move(src.mesh), std::move(b.basis), std::move(b.field), std::move(b.glossy)});
+    for (std::uint32_t k : src.instances) {
+      out.instances.push_back({.model = model, .albedo = albedo, .specular = src.specular});
+      out.entities.push_back(load.input.instances[k].entity);
+    }
+    if (loaded->meshes[i].model.glossy) out.glossy.push_back(src.name);
+    out.models.push_back(std::move(loaded->meshes[i].model));
   }
   return out;
 }
@@ -173,7 +175,8 @@ engine::Result<std::unique_ptr<MethodRuntime>> load_brf_method(MethodLoad& load)
   const std::size_t probe_count = world.probes ? world.probes->probe_count() : 0;
   const GISystemSettings& settings = load.settings;
   auto brf =
-      BrfLighting::create(std::move(models->models), std::move(models->bindings), load.scene.registry, std::move(world),
+      BrfLighting::create(std::move(models->models), std::move(models->instances), std::move(models->entities),
+                          load.scene.registry, std::move(world),
                           {.update = {.bounces = settings.brf_bounces, .cull_threshold = settings.brf_cull_threshold},
                            .log = settings.log});
   if (!brf) return brf.error();

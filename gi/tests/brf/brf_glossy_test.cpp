@@ -309,31 +309,31 @@ TEST(BrfGlossy, BakeFileKeepsTheSeparationAndRejectsDamage) {
   settings.field.spheres = 4;
   settings.field.face_resolution = 4;
   const gi::BrfMeshBake bake = gi::bake_brf_mesh(source, settings).value();
-  ASSERT_TRUE(bake.glossy.has_value());
-  EXPECT_GE(bake.glossy->terms, 4);
-  EXPECT_EQ(bake.field.terms, bake.glossy->terms + 1);
+  ASSERT_TRUE(bake.model.glossy.has_value());
+  EXPECT_GE(bake.model.glossy->terms, 4);
+  EXPECT_EQ(bake.model.field.terms, bake.model.glossy->terms + 1);
   const std::filesystem::path dir =
       std::filesystem::path(GI_BINARY_DIR) / "test_output" / ("brf_glossy_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   const std::filesystem::path file = dir / "brf_shade.bin";
   ASSERT_TRUE(gi::write_brf_mesh(file, bake).ok());
   const gi::BrfMeshBake back = gi::read_brf_mesh(file).value();
-  ASSERT_TRUE(back.glossy.has_value());
-  EXPECT_EQ(back.glossy->terms, bake.glossy->terms);
-  EXPECT_EQ(back.glossy->g, bake.glossy->g);
-  EXPECT_EQ(back.glossy->h, bake.glossy->h);
-  EXPECT_EQ(back.glossy->lobe_sh, bake.glossy->lobe_sh);
-  EXPECT_EQ(back.field.coefficients, bake.field.coefficients);
-  EXPECT_EQ(back.basis.terms, bake.basis.terms);
+  ASSERT_TRUE(back.model.glossy.has_value());
+  EXPECT_EQ(back.model.glossy->terms, bake.model.glossy->terms);
+  EXPECT_EQ(back.model.glossy->g, bake.model.glossy->g);
+  EXPECT_EQ(back.model.glossy->h, bake.model.glossy->h);
+  EXPECT_EQ(back.model.glossy->lobe_sh, bake.model.glossy->lobe_sh);
+  EXPECT_EQ(back.model.field.coefficients, bake.model.field.coefficients);
+  EXPECT_EQ(back.model.basis.terms, bake.model.basis.terms);
 
   gi::BrfMeshBake bad = bake;
-  bad.glossy->h[3] = std::numeric_limits<float>::quiet_NaN();
+  bad.model.glossy->h[3] = std::numeric_limits<float>::quiet_NaN();
   const auto written = gi::write_brf_mesh(dir / "brf_bad.bin", bad);
   ASSERT_FALSE(written.ok());
   EXPECT_NE(written.error().message.find("glossy separation value"), std::string::npos) << written.error().to_string();
   EXPECT_FALSE(std::filesystem::exists(dir / "brf_bad.bin"));
   bad = bake;
-  bad.glossy.reset();  // a field of 1 + K terms without its separation
+  bad.model.glossy.reset();  // a field of 1 + K terms without its separation
   const auto mismatch = gi::write_brf_mesh(dir / "brf_bad.bin", bad);
   ASSERT_FALSE(mismatch.ok());
   EXPECT_NE(mismatch.error().message.find("BRDF terms disagree"), std::string::npos) << mismatch.error().to_string();

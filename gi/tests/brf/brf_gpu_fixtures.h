@@ -38,10 +38,10 @@ struct Models {
       gi::compute_basis_radiance_field(slab, slab_basis,
                                        {.spheres = 5, .face_resolution = 5, .sh_bands = 4, .directions = 64})
           .value();
-  std::vector<gi::BrfGpuModel> gpu() const {
-    return {{&cube, &cube_basis, &cube_field}, {&slab, &slab_basis, &slab_field}};
-  }
-  gi::BrfObject object(const gi::BrfGpuInstance& i) const {
+  // The pass reads its models every run: they live as long as the fixture.
+  std::vector<gi::BrfModel> gpu_models = {{"", cube, cube_basis, cube_field}, {"", slab, slab_basis, slab_field}};
+  const std::vector<gi::BrfModel>& gpu() const { return gpu_models; }
+  gi::BrfObject object(const gi::BrfInstance& i) const {
     return i.model == 0 ? gi::BrfObject{&cube, &cube_basis, &cube_field, i.object_to_world, i.albedo}
                         : gi::BrfObject{&slab, &slab_basis, &slab_field, i.object_to_world, i.albedo};
   }
@@ -56,17 +56,17 @@ inline glm::mat4 pose(glm::vec3 t, float angle, glm::vec3 axis, float scale = 1.
   return glm::scale(glm::rotate(glm::translate(glm::mat4(1.0f), t), angle, glm::normalize(axis)), glm::vec3(scale));
 }
 
-inline std::vector<gi::BrfGpuInstance> three_objects(float third_distance = 0.7f) {
+inline std::vector<gi::BrfInstance> three_objects(float third_distance = 0.7f) {
   return {{0, pose({-0.5f, 0.0f, 0.0f}, 0.4f, {0, 1, 0}), {0.8f, 0.2f, 0.1f}},
           {1, pose({0.45f, 0.1f, 0.05f}, 0.3f, {1, 1, 0}, 1.1f), {0.7f, 0.7f, 0.7f}},
           {0, pose({0.0f, 0.1f, third_distance}, -0.6f, {0, 1, 1}, 0.8f), {0.2f, 0.5f, 0.8f}}};
 }
 
 // Light arriving at each vertex from a point light (unshadowed) plus a constant sky term.
-inline std::vector<std::vector<glm::vec3>> incoming_light(std::span<const gi::BrfGpuInstance> instances,
-                                                          glm::vec3 light, float strength = 4.0f) {
+inline std::vector<std::vector<glm::vec3>> incoming_light(std::span<const gi::BrfInstance> instances, glm::vec3 light,
+                                                          float strength = 4.0f) {
   std::vector<std::vector<glm::vec3>> in;
-  for (const gi::BrfGpuInstance& i : instances) {
+  for (const gi::BrfInstance& i : instances) {
     const gi::BrfWorldVertices v = gi::brf_world_vertices(models().object(i));
     auto& e = in.emplace_back();
     for (std::size_t j = 0; j < v.positions.size(); ++j) {
@@ -102,9 +102,8 @@ inline StaticPoints static_points() {
   return s;
 }
 
-inline gi::BrfResult cpu(std::span<const gi::BrfGpuInstance> instances,
-                         std::span<const std::vector<glm::vec3>> incoming, const gi::BrfUpdateSettings& settings,
-                         const StaticPoints* receivers = nullptr) {
+inline gi::BrfResult cpu(std::span<const gi::BrfInstance> instances, std::span<const std::vector<glm::vec3>> incoming,
+                         const gi::BrfUpdateSettings& settings, const StaticPoints* receivers = nullptr) {
   std::vector<gi::BrfObject> objects;
   for (const auto& i : instances) objects.push_back(models().object(i));
   gi::BrfStaticReceivers r;

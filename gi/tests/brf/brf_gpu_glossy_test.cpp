@@ -33,13 +33,12 @@ struct GlossyModels {
       gi::compute_basis_radiance_field(slab, slab_basis,
                                        {.spheres = 4, .face_resolution = 5, .sh_bands = 3, .directions = 64}, &sep)
           .value();
-  std::vector<gi::BrfGpuModel> gpu() const {
-    const Models& d = models();
-    return {{&d.cube, &d.cube_basis, &d.cube_field},
-            {&cube, &cube_basis, &cube_field, &sep},
-            {&slab, &slab_basis, &slab_field, &sep}};
-  }
-  gi::BrfObject object(const gi::BrfGpuInstance& i) const {
+  // The pass reads its models every run: they live as long as the fixture.
+  std::vector<gi::BrfModel> gpu_models = {{"", models().cube, models().cube_basis, models().cube_field},
+                                          {"", cube, cube_basis, cube_field, sep},
+                                          {"", slab, slab_basis, slab_field, sep}};
+  const std::vector<gi::BrfModel>& gpu() const { return gpu_models; }
+  gi::BrfObject object(const gi::BrfInstance& i) const {
     const Models& d = models();
     if (i.model == 0) return {&d.cube, &d.cube_basis, &d.cube_field, i.object_to_world, i.albedo};
     if (i.model == 1) return {&cube, &cube_basis, &cube_field, i.object_to_world, i.albedo, &sep, i.specular};
@@ -52,7 +51,7 @@ const GlossyModels& glossy_models() {
   return m;
 }
 
-std::vector<gi::BrfGpuInstance> glossy_objects(float third_distance = 0.7f) {
+std::vector<gi::BrfInstance> glossy_objects(float third_distance = 0.7f) {
   return {{1, pose({-0.5f, 0.0f, 0.0f}, 0.4f, {0, 1, 0}), {0.3f, 0.2f, 0.1f}, {0.9f, 0.8f, 0.6f}},
           {2, pose({0.45f, 0.1f, 0.05f}, 0.3f, {1, 1, 0}, 1.1f), {0.2f, 0.3f, 0.3f}, {0.7f, 0.9f, 1.0f}},
           {0, pose({0.0f, 0.1f, third_distance}, -0.6f, {0, 1, 1}, 0.8f), {0.2f, 0.5f, 0.8f}}};
@@ -60,9 +59,9 @@ std::vector<gi::BrfGpuInstance> glossy_objects(float third_distance = 0.7f) {
 
 // The light of incoming_light, and for glossy objects E_k = g_k(w_light) x the point light's
 // irradiance (as brf_direct_light), [k x V + j].
-std::vector<std::vector<glm::vec3>> glossy_incoming(std::span<const gi::BrfGpuInstance> instances, glm::vec3 light) {
+std::vector<std::vector<glm::vec3>> glossy_incoming(std::span<const gi::BrfInstance> instances, glm::vec3 light) {
   std::vector<std::vector<glm::vec3>> in;
-  for (const gi::BrfGpuInstance& i : instances) {
+  for (const gi::BrfInstance& i : instances) {
     const gi::BrfObject object = glossy_models().object(i);
     const gi::BrfWorldVertices v = gi::brf_world_vertices(object);
     const std::size_t nv = v.positions.size();
@@ -81,9 +80,8 @@ std::vector<std::vector<glm::vec3>> glossy_incoming(std::span<const gi::BrfGpuIn
   return in;
 }
 
-gi::BrfResult glossy_cpu(std::span<const gi::BrfGpuInstance> instances,
-                         std::span<const std::vector<glm::vec3>> incoming, const gi::BrfUpdateSettings& settings,
-                         const StaticPoints* receivers = nullptr) {
+gi::BrfResult glossy_cpu(std::span<const gi::BrfInstance> instances, std::span<const std::vector<glm::vec3>> incoming,
+                         const gi::BrfUpdateSettings& settings, const StaticPoints* receivers = nullptr) {
   std::vector<gi::BrfObject> objects;
   for (const auto& i : instances) objects.push_back(glossy_models().object(i));
   gi::BrfStaticReceivers r;
@@ -92,7 +90,7 @@ gi::BrfResult glossy_cpu(std::span<const gi::BrfGpuInstance> instances,
 }
 
 // Relative RMSE over every term of every instance; `glossy_only`: the terms k >= 1 only.
-double terms_error(const gi::BrfGpuPass& pass, std::span<const gi::BrfGpuInstance> instances, const gi::BrfResult& ref,
+double terms_error(const gi::BrfGpuPass& pass, std::span<const gi::BrfInstance> instances, const gi::BrfResult& ref,
                    bool glossy_only = false) {
   std::vector<glm::vec3> a, b;
   for (std::size_t i = 0; i < ref.indirect.size(); ++i) {
@@ -210,10 +208,10 @@ TEST(BrfGpuPass, GlossyModelsAndLightMustMatch) {
       gi::separate_glossy_brdf({.f0 = 0.9f, .alpha = 0.5f}, {.terms = 1, .resolution = 8}).value();
   ASSERT_NE(other.terms, g.sep.terms);
   const Models& d = models();
-  for (const gi::BrfGpuModel& bad : {gi::BrfGpuModel{&g.cube, &g.cube_basis, &g.cube_field},
-                                     gi::BrfGpuModel{&g.cube, &g.cube_basis, &g.cube_field, &other},
-                                     gi::BrfGpuModel{&d.cube, &d.cube_basis, &d.cube_field, &g.sep}}) {
-    const gi::BrfGpuModel list[2] = {{&d.slab, &d.slab_basis, &d.slab_field}, bad};
+  for (const gi::BrfModel& bad : {gi::BrfModel{"", g.cube, g.cube_basis, g.cube_field},
+                                  gi::BrfModel{"", g.cube, g.cube_basis, g.cube_field, other},
+                                  gi::BrfModel{"", d.cube, d.cube_basis, d.cube_field, g.sep}}) {
+    const gi::BrfModel list[2] = {{"", d.slab, d.slab_basis, d.slab_field}, bad};
     auto pass = gi::BrfGpuPass::create(list);
     ASSERT_FALSE(pass.ok());
     EXPECT_NE(pass.error().message.find("model 1"), std::string::npos) << pass.error().to_string();

@@ -106,21 +106,20 @@ TEST(BrfGpuPass, GatherCoversVertexCountsThatAreNoMultipleOfFour) {
   ASSERT_EQ(ms[0].mesh.positions.size() % 4, 3u);
   ASSERT_EQ(ms[1].mesh.positions.size() % 4, 1u);
   ASSERT_EQ(ms[2].mesh.positions.size() % 4, 2u);
-  std::vector<gi::BrfGpuModel> gpu_models;
-  for (const Model& m : ms) gpu_models.push_back({&m.mesh, &m.basis, &m.field});
+  std::vector<gi::BrfModel> gpu_models;
+  for (const Model& m : ms) gpu_models.push_back({"", m.mesh, m.basis, m.field});
   auto created = gi::BrfGpuPass::create(gpu_models);
   ASSERT_TRUE(static_cast<bool>(created)) << created.error().to_string();
   gi::BrfGpuPass& pass = *created;
-  const std::vector<gi::BrfGpuInstance> instances = {
-      {0, pose({-0.5f, 0.0f, 0.0f}, 0.4f, {0, 1, 0}), {0.8f, 0.2f, 0.1f}},
-      {1, pose({0.4f, 0.1f, 0.05f}, 0.3f, {1, 1, 0}), {0.7f, 0.7f, 0.7f}},
-      {2, pose({0.0f, 0.1f, 0.6f}, -0.6f, {0, 1, 1}), {0.2f, 0.5f, 0.8f}},
-      {1, pose({0.0f, -0.6f, 0.0f}, 0.2f, {1, 0, 0}), {0.6f, 0.6f, 0.3f}},
-      {0, pose({-0.1f, 0.6f, -0.4f}, 1.0f, {0, 0, 1}), {0.5f, 0.8f, 0.5f}}};
+  const std::vector<gi::BrfInstance> instances = {{0, pose({-0.5f, 0.0f, 0.0f}, 0.4f, {0, 1, 0}), {0.8f, 0.2f, 0.1f}},
+                                                  {1, pose({0.4f, 0.1f, 0.05f}, 0.3f, {1, 1, 0}), {0.7f, 0.7f, 0.7f}},
+                                                  {2, pose({0.0f, 0.1f, 0.6f}, -0.6f, {0, 1, 1}), {0.2f, 0.5f, 0.8f}},
+                                                  {1, pose({0.0f, -0.6f, 0.0f}, 0.2f, {1, 0, 0}), {0.6f, 0.6f, 0.3f}},
+                                                  {0, pose({-0.1f, 0.6f, -0.4f}, 1.0f, {0, 0, 1}), {0.5f, 0.8f, 0.5f}}};
   std::vector<gi::BrfObject> objects;
   std::vector<std::vector<glm::vec3>> incoming;
   const glm::vec3 light(-1.0f, 1.5f, 0.8f);
-  for (const gi::BrfGpuInstance& i : instances) {
+  for (const gi::BrfInstance& i : instances) {
     const Model& m = ms[i.model];
     objects.push_back({&m.mesh, &m.basis, &m.field, i.object_to_world, i.albedo});
     const gi::BrfWorldVertices v = gi::brf_world_vertices(objects.back());
@@ -239,9 +238,9 @@ TEST(BrfGpuPass, OverlapsAndPointsInsideTheInnermostSphereStayFinite) {
   gi::BrfGpuPass pass = make_pass();
   // Two objects sharing a centre (every vertex inside the other's innermost sphere), a third
   // overlapping them; static receivers at a field centre and inside the innermost sphere.
-  const std::vector<gi::BrfGpuInstance> instances = {{0, pose({0.0f, 0.0f, 0.0f}, 0.0f, {0, 1, 0}), glm::vec3(0.8f)},
-                                                     {1, pose({0.0f, 0.0f, 0.0f}, 0.7f, {0, 1, 0}), glm::vec3(0.6f)},
-                                                     {0, pose({0.2f, 0.1f, 0.0f}, 0.3f, {1, 0, 0}), glm::vec3(0.5f)}};
+  const std::vector<gi::BrfInstance> instances = {{0, pose({0.0f, 0.0f, 0.0f}, 0.0f, {0, 1, 0}), glm::vec3(0.8f)},
+                                                  {1, pose({0.0f, 0.0f, 0.0f}, 0.7f, {0, 1, 0}), glm::vec3(0.6f)},
+                                                  {0, pose({0.2f, 0.1f, 0.0f}, 0.3f, {1, 0, 0}), glm::vec3(0.5f)}};
   const StaticPoints points{{glm::vec3(0.0f), glm::vec3(0.05f, 0.02f, 0.0f), glm::vec3(0.2f, 0.1f, 0.0f)},
                             {glm::vec3(0, 1, 0), glm::vec3(1, 0, 0), glm::vec3(0, 0, 1)}};
   ASSERT_TRUE(pass.set_static_receivers(points.positions, points.normals).ok());
@@ -264,7 +263,7 @@ TEST(BrfGpuPass, OverlapsAndPointsInsideTheInnermostSphereStayFinite) {
 TEST(BrfGpuPass, TheLightChangesSmoothlyAcrossFaceSeamsAsOnTheCpu) {
   auto ctx = headless_or_fail();
   gi::BrfGpuPass pass = make_pass();
-  const std::vector<gi::BrfGpuInstance> instances = {{0, pose({0.0f, 0.0f, 0.0f}, 0.0f, {0, 1, 0}), glm::vec3(0.8f)}};
+  const std::vector<gi::BrfInstance> instances = {{0, pose({0.0f, 0.0f, 0.0f}, 0.0f, {0, 1, 0}), glm::vec3(0.8f)}};
   const float r = 2.5f * models().cube_basis.radius;
   StaticPoints points;
   for (int k = 0; k <= 80; ++k) {
@@ -323,10 +322,10 @@ TEST(BrfGpuPass, BadInputReturnsErrors) {
   const glm::vec3 nrm[1] = {glm::vec3(0, 1, 0)};
   EXPECT_FALSE(pass.set_static_receivers(p, nrm).ok());
 
-  gi::BrfGpuModel broken = models().gpu()[0];
-  broken.field = nullptr;
+  gi::BrfModel broken = models().gpu()[0];
+  broken.basis.psi.pop_back();
   EXPECT_FALSE(gi::BrfGpuPass::create(std::span(&broken, 1)).ok());
-  gi::BrfGpuModel mismatched{&models().cube, &models().cube_basis, &models().slab_field};  // 8 vs 6 functions
+  gi::BrfModel mismatched{"", models().cube, models().cube_basis, models().slab_field};  // 8 vs 6 functions
   EXPECT_FALSE(gi::BrfGpuPass::create(std::span(&mismatched, 1)).ok());
 
   // Still usable after the errors.
@@ -343,7 +342,7 @@ TEST(BrfGpuPass, BadInputReturnsErrors) {
 TEST(BrfGpuPass, PairsOutsideTheInfluenceAreSkippedAsByTheTwin) {
   auto ctx = headless_or_fail();
   gi::BrfGpuPass pass = make_pass();
-  std::vector<gi::BrfGpuInstance> instances;
+  std::vector<gi::BrfInstance> instances;
   for (int i = 0; i < 4; ++i)
     instances.push_back({static_cast<std::uint32_t>(i % 2),
                          pose({3.0f * static_cast<float>(i), 0.0f, 0.1f * static_cast<float>(i)},
@@ -370,7 +369,7 @@ TEST(BrfGpuPass, PairsOutsideTheInfluenceAreSkippedAsByTheTwin) {
 TEST(BrfGpuPass, PhiSlotsFollowThePairsInReach) {
   auto ctx = headless_or_fail();
   gi::BrfGpuPass pass = make_pass();
-  std::vector<gi::BrfGpuInstance> instances;
+  std::vector<gi::BrfInstance> instances;
   for (int i = 0; i < 4; ++i)
     instances.push_back({static_cast<std::uint32_t>(i % 2),
                          pose({3.0f * static_cast<float>(i), 0.0f, 0.1f * static_cast<float>(i)},
@@ -403,7 +402,7 @@ TEST(BrfGpuPass, ManyInstancesFitBecauseOnlyPairsInReachHoldPhi) {
   const std::size_t pair_bytes = models().cube.positions.size() * 8 * sizeof(float);
   const std::size_t limit = pair_bytes * n * (n - 1) / 20;
   gi::BrfGpuPass pass = make_pass({.max_buffer_bytes = limit});
-  std::vector<gi::BrfGpuInstance> instances;
+  std::vector<gi::BrfInstance> instances;
   for (std::size_t i = 0; i < n; ++i)
     instances.push_back({0,
                          pose({3.0f * static_cast<float>(i % 16), 0.0f, 3.0f * static_cast<float>(i / 16)},

@@ -105,7 +105,7 @@ struct Offsets {
 };
 Offsets offsets_of(const gi::BrfMeshBake& b) {
   Offsets o{};
-  o.vertex_count = 8 + b.name.size() + 8 + b.mesh_hash.size();
+  o.vertex_count = 8 + b.model.name.size() + 8 + b.mesh_hash.size();
   o.basis_count = o.vertex_count + 8;
   o.condition = o.basis_count + 4;
   o.psi_count = o.condition + 8 + 12 + 4;
@@ -197,24 +197,27 @@ TEST(BrfIo, RoundTripIsBitExact) {
   for (std::size_t i = 0; i < a.meshes.size(); ++i) {
     const gi::BrfMeshBake& x = a.meshes[i];
     const gi::BrfMeshBake& y = loaded->meshes[i];
-    EXPECT_EQ(y.name, x.name);
+    EXPECT_EQ(y.model.name, x.model.name);
+    EXPECT_FALSE(y.model.mesh.positions.empty());  // load_brf fills in the scene's mesh, as the bake had it
+    EXPECT_TRUE(same_bits(y.model.mesh.positions, x.model.mesh.positions));
+    EXPECT_TRUE(same_bits(y.model.mesh.normals, x.model.mesh.normals));
     EXPECT_EQ(y.mesh_hash, x.mesh_hash);
-    EXPECT_EQ(y.basis.vertex_count, x.basis.vertex_count);
-    EXPECT_EQ(y.basis.basis_count, x.basis.basis_count);
-    EXPECT_TRUE(same_bits(y.basis.psi, x.basis.psi));
-    EXPECT_TRUE(same_bits(y.basis.a_inverse, x.basis.a_inverse));
-    EXPECT_TRUE(same_bits(y.basis.singular_values, x.basis.singular_values));
-    EXPECT_EQ(std::memcmp(&y.basis.condition, &x.basis.condition, sizeof(double)), 0);
-    EXPECT_TRUE(same_bits(y.basis.centre, x.basis.centre));
-    EXPECT_EQ(std::memcmp(&y.basis.radius, &x.basis.radius, sizeof(float)), 0);
-    EXPECT_EQ(y.field.spheres, x.field.spheres);
-    EXPECT_EQ(y.field.face_resolution, x.field.face_resolution);
-    EXPECT_EQ(y.field.sh_bands, x.field.sh_bands);
-    EXPECT_EQ(y.field.basis_count, x.field.basis_count);
-    EXPECT_TRUE(same_bits(y.field.centre, x.field.centre));
-    EXPECT_EQ(std::memcmp(&y.field.inner_radius, &x.field.inner_radius, sizeof(float)), 0);
-    EXPECT_EQ(std::memcmp(&y.field.outer_radius, &x.field.outer_radius, sizeof(float)), 0);
-    EXPECT_TRUE(same_bits(y.field.coefficients, x.field.coefficients));
+    EXPECT_EQ(y.model.basis.vertex_count, x.model.basis.vertex_count);
+    EXPECT_EQ(y.model.basis.basis_count, x.model.basis.basis_count);
+    EXPECT_TRUE(same_bits(y.model.basis.psi, x.model.basis.psi));
+    EXPECT_TRUE(same_bits(y.model.basis.a_inverse, x.model.basis.a_inverse));
+    EXPECT_TRUE(same_bits(y.model.basis.singular_values, x.model.basis.singular_values));
+    EXPECT_EQ(std::memcmp(&y.model.basis.condition, &x.model.basis.condition, sizeof(double)), 0);
+    EXPECT_TRUE(same_bits(y.model.basis.centre, x.model.basis.centre));
+    EXPECT_EQ(std::memcmp(&y.model.basis.radius, &x.model.basis.radius, sizeof(float)), 0);
+    EXPECT_EQ(y.model.field.spheres, x.model.field.spheres);
+    EXPECT_EQ(y.model.field.face_resolution, x.model.field.face_resolution);
+    EXPECT_EQ(y.model.field.sh_bands, x.model.field.sh_bands);
+    EXPECT_EQ(y.model.field.basis_count, x.model.field.basis_count);
+    EXPECT_TRUE(same_bits(y.model.field.centre, x.model.field.centre));
+    EXPECT_EQ(std::memcmp(&y.model.field.inner_radius, &x.model.field.inner_radius, sizeof(float)), 0);
+    EXPECT_EQ(std::memcmp(&y.model.field.outer_radius, &x.model.field.outer_radius, sizeof(float)), 0);
+    EXPECT_TRUE(same_bits(y.model.field.coefficients, x.model.field.coefficients));
     EXPECT_EQ(y.basis_seconds, 0.0) << "timings are in bake_stats.json, not in the bundle's files";
     EXPECT_EQ(y.field_seconds, 0.0);
   }
@@ -231,15 +234,15 @@ TEST(BrfIo, ManifestDescribesEveryMeshAndKeepsOtherMethods) {
   EXPECT_TRUE(m->methods.contains("prm"));
   const nlohmann::json& e = m->methods["brf"];
   for (const gi::BrfMeshBake& b : baked().meshes) {
-    EXPECT_EQ(e["files"][b.name]["file"], gi::brf_file_name(b.name));
-    EXPECT_EQ(e["files"][b.name]["xxh3_64"], gi::file_checksum(dir / gi::brf_file_name(b.name)).value());
-    const nlohmann::json& s = e["meshes"][b.name];
-    EXPECT_EQ(s["vertices"], b.basis.vertex_count);
-    EXPECT_EQ(s["basis_kept"], b.basis.basis_count);
-    EXPECT_EQ(s["field_bytes"], b.field.bytes());
-    EXPECT_EQ(s["file_bytes"], fs::file_size(dir / gi::brf_file_name(b.name)));
+    EXPECT_EQ(e["files"][b.model.name]["file"], gi::brf_file_name(b.model.name));
+    EXPECT_EQ(e["files"][b.model.name]["xxh3_64"], gi::file_checksum(dir / gi::brf_file_name(b.model.name)).value());
+    const nlohmann::json& s = e["meshes"][b.model.name];
+    EXPECT_EQ(s["vertices"], b.model.basis.vertex_count);
+    EXPECT_EQ(s["basis_kept"], b.model.basis.basis_count);
+    EXPECT_EQ(s["field_bytes"], b.model.field.bytes());
+    EXPECT_EQ(s["file_bytes"], fs::file_size(dir / gi::brf_file_name(b.model.name)));
     // The float planes compress.
-    EXPECT_LT(s["field_compressed_bytes"].get<std::uint64_t>(), b.field.bytes());
+    EXPECT_LT(s["field_compressed_bytes"].get<std::uint64_t>(), b.model.field.bytes());
   }
   EXPECT_EQ(e["settings"]["field"]["spheres"], 3);
 }
@@ -335,7 +338,7 @@ TEST(BrfIo, InconsistentPayloadsAreRejected) {
   EXPECT_NE(read_error(file).find("condition"), std::string::npos);
 
   p = original;
-  poke(p, o.basis_count, static_cast<std::int32_t>(b.basis.basis_count + 1));
+  poke(p, o.basis_count, static_cast<std::int32_t>(b.model.basis.basis_count + 1));
   put_payload(file, p);
   EXPECT_NE(read_error(file).find("psi has"), std::string::npos);
 
@@ -345,21 +348,21 @@ TEST(BrfIo, InconsistentPayloadsAreRejected) {
   EXPECT_NE(read_error(file).find("vertex_count"), std::string::npos);
 
   // The field header: spheres (after psi, a_inverse, singular_values and the basis's terms).
-  const std::size_t a_inv = o.psi_data + b.basis.psi.size() * 4;
-  const std::size_t sv = a_inv + 8 + b.basis.a_inverse.size() * 4;
-  const std::size_t spheres = sv + 8 + b.basis.singular_values.size() * 4 + 4;
+  const std::size_t a_inv = o.psi_data + b.model.basis.psi.size() * 4;
+  const std::size_t sv = a_inv + 8 + b.model.basis.a_inverse.size() * 4;
+  const std::size_t spheres = sv + 8 + b.model.basis.singular_values.size() * 4 + 4;
   p = original;
   poke(p, spheres, std::int32_t{100000});
   put_payload(file, p);
   EXPECT_NE(read_error(file).find("field settings out of range"), std::string::npos);
   p = original;
-  poke(p, spheres, std::int32_t{b.field.spheres + 1});
+  poke(p, spheres, std::int32_t{b.model.field.spheres + 1});
   put_payload(file, p);
   EXPECT_NE(read_error(file).find("coefficient bytes"), std::string::npos);
   // coefficient_bytes and the frame's own size disagree.
   const std::size_t coefficient_bytes = spheres + 20 + 12 + 8;
   p = original;
-  poke(p, coefficient_bytes, static_cast<std::uint64_t>(b.field.bytes() + 4));
+  poke(p, coefficient_bytes, static_cast<std::uint64_t>(b.model.field.bytes() + 4));
   put_payload(file, p);
   EXPECT_FALSE(gi::read_brf_mesh(file).ok());
 
@@ -370,20 +373,20 @@ TEST(BrfIo, InconsistentPayloadsAreRejected) {
 TEST(BrfIo, InvalidBakeRefusesToSaveAndWritesNothing) {
   const fs::path dir = scratch_dir("invalid");
   gi::BrfBake bad = baked();
-  bad.meshes[0].field.coefficients[7] = std::numeric_limits<float>::infinity();
+  bad.meshes[0].model.field.coefficients[7] = std::numeric_limits<float>::infinity();
   auto s = gi::save_brf(dir, bad, gi::bake_input_from(crates_room().assets));
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.error().to_string().find("brf_crate_red.bin"), std::string::npos) << s.error().to_string();
   EXPECT_FALSE(fs::exists(dir));
 
   bad = baked();
-  bad.meshes[1].basis.a_inverse.pop_back();
+  bad.meshes[1].model.basis.a_inverse.pop_back();
   s = gi::save_brf(dir, bad, gi::bake_input_from(crates_room().assets));
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.error().to_string().find("a_inverse"), std::string::npos);
 
   bad = baked();
-  bad.meshes[1].name = bad.meshes[0].name;
+  bad.meshes[1].model.name = bad.meshes[0].model.name;
   EXPECT_FALSE(gi::save_brf(dir, bad, gi::bake_input_from(crates_room().assets)).ok());
   EXPECT_FALSE(fs::exists(dir));
 }

@@ -193,12 +193,12 @@ double relative_rmse(std::span<const glm::vec3> a, std::span<const glm::vec3> b)
 TEST(BrfLod, GpuPassMatchesItsTwinWithTheLevelOfDetail) {
   auto ctx = headless_or_fail();
   const Crate& c = crate();
-  const gi::BrfGpuModel model{&c.mesh, &c.basis, &c.field};
+  const gi::BrfModel model{"", c.mesh, c.basis, c.field};
   auto created = gi::BrfGpuPass::create(std::span(&model, 1));
   ASSERT_TRUE(created.ok()) << created.error().to_string();
   gi::BrfGpuPass pass = std::move(created).value();
   const std::vector<gi::BrfObject> objects = grid(3);
-  std::vector<gi::BrfGpuInstance> instances;
+  std::vector<gi::BrfInstance> instances;
   for (const gi::BrfObject& o : objects) instances.push_back({0, o.object_to_world, o.albedo});
   const auto in = incoming(objects, {1.2f, 2.5f, 1.0f});
   auto all = [&] {
@@ -250,12 +250,12 @@ TEST(BrfLod, GpuPassMatchesItsTwinWithTheLevelOfDetail) {
 TEST(BrfLod, PackedRepresentativePointsGiveTheSameBitsAsOneWorkGroupPerPair) {
   auto ctx = headless_or_fail();
   const Crate& c = crate();
-  const gi::BrfGpuModel model{&c.mesh, &c.basis, &c.field};
-  const std::vector<gi::BrfGpuModel> models = {model, model};
+  const gi::BrfModel model{"", c.mesh, c.basis, c.field};
+  const std::vector<gi::BrfModel> models = {model, model};
   const std::vector<gi::BrfObject> objects = grid(4);
   const auto in = incoming(objects, {1.8f, 2.5f, 1.6f});
   for (const std::size_t model_count : {std::size_t{1}, std::size_t{2}}) {
-    std::vector<gi::BrfGpuInstance> instances;
+    std::vector<gi::BrfInstance> instances;
     for (std::size_t i = 0; i < objects.size(); ++i)
       instances.push_back({static_cast<std::uint32_t>(i % model_count), objects[i].object_to_world, objects[i].albedo});
     std::vector<glm::vec3> result[2];

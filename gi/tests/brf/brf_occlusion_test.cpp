@@ -132,7 +132,8 @@ double rel_rmse(std::span<const glm::vec3> a, std::span<const glm::vec3> b) {
 TEST(BrfOcclusion, GpuPassMatchesItsTwinAndReevaluatesWhenAnOccluderMoves) {
   auto ctx = headless_or_fail();
   const CrateModel& m = model();
-  auto pass = gi::BrfGpuPass::create(std::vector<gi::BrfGpuModel>{{&m.mesh, &m.basis, &m.field}}).value();
+  const std::vector<gi::BrfModel> brf_models{{"", m.mesh, m.basis, m.field}};  // outlives the pass
+  auto pass = gi::BrfGpuPass::create(brf_models).value();
   const gi::ReferenceLight light = spot();
   const std::vector<gi::PointEmitter> emitters = gi::light_point_emitters(std::span(&light, 1), 1, 1);
   const gi::BrfUpdateSettings settings{.bounces = 3, .cull_threshold = 0.0f};
@@ -143,7 +144,7 @@ TEST(BrfOcclusion, GpuPassMatchesItsTwinAndReevaluatesWhenAnOccluderMoves) {
     const std::vector<gi::BrfObject> objects = crates(*poses);
     const auto direct = gi::brf_direct_light(objects, emitters, nullptr);
     const gi::BrfResult cpu = gi::brf_interreflect(objects, direct, settings);
-    std::vector<gi::BrfGpuInstance> inst;
+    std::vector<gi::BrfInstance> inst;
     for (const gi::BrfObject& o : objects) inst.push_back({0, o.object_to_world, o.albedo});
     ASSERT_TRUE(pass.run(inst, direct, settings).ok());
     for (std::size_t i = 0; i < 3; ++i) {
@@ -160,7 +161,7 @@ TEST(BrfOcclusion, GpuPassMatchesItsTwinAndReevaluatesWhenAnOccluderMoves) {
   }
   // A frame where nothing moved reuses every pair.
   const std::vector<gi::BrfObject> objects = crates(lifted);
-  std::vector<gi::BrfGpuInstance> inst;
+  std::vector<gi::BrfInstance> inst;
   for (const gi::BrfObject& o : objects) inst.push_back({0, o.object_to_world, o.albedo});
   ASSERT_TRUE(pass.run(inst, gi::brf_direct_light(objects, emitters, nullptr), settings).ok());
   EXPECT_EQ(pass.stats().pairs_reused, 6u);
@@ -174,7 +175,8 @@ TEST(BrfOcclusion, GpuPassMatchesItsTwinAndReevaluatesWhenAnOccluderMoves) {
 TEST(BrfOcclusion, TwoOccludersEachHidingPartMatchTheTwin) {
   auto ctx = headless_or_fail();
   const CrateModel& m = model();
-  auto pass = gi::BrfGpuPass::create(std::vector<gi::BrfGpuModel>{{&m.mesh, &m.basis, &m.field}}).value();
+  const std::vector<gi::BrfModel> brf_models{{"", m.mesh, m.basis, m.field}};  // outlives the pass
+  auto pass = gi::BrfGpuPass::create(brf_models).value();
   const glm::mat4 poses[4] = {glm::translate(glm::mat4(1.0f), {-1.6f, 0.0f, 0.0f}),
                               glm::scale(glm::translate(glm::mat4(1.0f), {-0.55f, -0.14f, 0.1f}), glm::vec3(0.5f)),
                               glm::scale(glm::translate(glm::mat4(1.0f), {0.55f, 0.16f, -0.12f}), glm::vec3(0.5f)),
@@ -189,7 +191,7 @@ TEST(BrfOcclusion, TwoOccludersEachHidingPartMatchTheTwin) {
   light.position = {0.0f, 2.0f, 0.6f};
   light.radiant = glm::vec3(8.0f);
   const auto direct = gi::brf_direct_light(objects, std::span(&light, 1), nullptr);
-  std::vector<gi::BrfGpuInstance> inst;
+  std::vector<gi::BrfInstance> inst;
   for (const gi::BrfObject& o : objects) inst.push_back({0, o.object_to_world, o.albedo});
   for (const float lod : {0.0f, 2.0f}) {
     const gi::BrfUpdateSettings settings{.bounces = 2, .cull_threshold = 0.0f, .lod_distance = lod};
@@ -218,7 +220,8 @@ namespace {
 TEST(BrfOcclusion, ContactAndInterpenetrationStayFiniteAndBounded) {
   auto ctx = headless_or_fail();
   const CrateModel& m = model();
-  auto pass = gi::BrfGpuPass::create(std::vector<gi::BrfGpuModel>{{&m.mesh, &m.basis, &m.field}}).value();
+  const std::vector<gi::BrfModel> brf_models{{"", m.mesh, m.basis, m.field}};  // outlives the pass
+  auto pass = gi::BrfGpuPass::create(brf_models).value();
   const auto at = [](glm::vec3 t, float scale = 1.0f) {
     return glm::scale(glm::translate(glm::mat4(1.0f), t), glm::vec3(scale));
   };
@@ -242,7 +245,7 @@ TEST(BrfOcclusion, ContactAndInterpenetrationStayFiniteAndBounded) {
     const std::vector<gi::BrfObject> objects = crates(c.poses);
     const auto direct = gi::brf_direct_light(objects, emitters, nullptr);
     const gi::BrfResult cpu = gi::brf_interreflect(objects, direct, settings);
-    std::vector<gi::BrfGpuInstance> inst;
+    std::vector<gi::BrfInstance> inst;
     for (const gi::BrfObject& o : objects) inst.push_back({0, o.object_to_world, o.albedo});
     ASSERT_TRUE(pass.run(inst, direct, settings).ok()) << c.name;
     float brightest = 0.0f;
@@ -347,8 +350,9 @@ TEST(BrfOcclusion, AlignedStackContactFacesOnTheCpuTwinAndTheGpu) {
   const auto direct = gi::brf_direct_light(objects, emitters, nullptr);
   const gi::BrfUpdateSettings settings{.bounces = 3, .cull_threshold = 0.0f};
   const gi::BrfResult r = gi::brf_interreflect(objects, direct, settings);
-  auto pass = gi::BrfGpuPass::create(std::vector<gi::BrfGpuModel>{{&m.mesh, &m.basis, &m.field}}).value();
-  std::vector<gi::BrfGpuInstance> inst;
+  const std::vector<gi::BrfModel> brf_models{{"", m.mesh, m.basis, m.field}};  // outlives the pass
+  auto pass = gi::BrfGpuPass::create(brf_models).value();
+  std::vector<gi::BrfInstance> inst;
   for (const gi::BrfObject& o : objects) inst.push_back({0, o.object_to_world, o.albedo});
   ASSERT_TRUE(pass.run(inst, direct, settings).ok());
   std::vector<std::vector<glm::vec3>> gpu;

@@ -140,9 +140,10 @@ TEST(BrfVisibility, NoBounceThroughAWallOnTheCpuTwinAndTheGpu) {
   EXPECT_GT(near, 1e-3f);
 
   // The GPU pass: the same zeros, the same near light (float32 twin, rel. RMSE < 1e-3).
-  auto pass = gi::BrfGpuPass::create(std::vector<gi::BrfGpuModel>{{&c.mesh, &c.basis, &c.field}}).value();
+  const std::vector<gi::BrfModel> brf_models{{"", c.mesh, c.basis, c.field}};  // outlives the pass
+  auto pass = gi::BrfGpuPass::create(brf_models).value();
   ASSERT_TRUE(pass.set_static_receivers(r.positions, r.normals, wall.get()).ok());
-  const gi::BrfGpuInstance inst{0, kCratePose, kRed};
+  const gi::BrfInstance inst{0, kCratePose, kRed};
   ASSERT_TRUE(pass.run(std::span(&inst, 1), incoming, settings).ok());
   const std::vector<glm::vec3> gpu = pass.read_back_static();
   ASSERT_EQ(gpu.size(), r.positions.size());
@@ -261,9 +262,10 @@ TEST(BrfVisibility, TheFloorBesideACrateIsDarkerAsThePathTracerSays) {
   EXPECT_LT(std::sqrt(err_occluded / norm), 0.2);  // 0.149 measured (docs/brf.md)
   EXPECT_LT(err_occluded, 0.5 * err_plain);
 
-  auto pass = gi::BrfGpuPass::create(std::vector<gi::BrfGpuModel>{{&c.mesh, &c.basis, &c.field}}).value();
+  const std::vector<gi::BrfModel> brf_models{{"", c.mesh, c.basis, c.field}};  // outlives the pass
+  auto pass = gi::BrfGpuPass::create(brf_models).value();
   ASSERT_TRUE(pass.set_static_receivers(r.positions, r.normals, world.get()).ok());
-  const gi::BrfGpuInstance inst{0, pose, glm::vec3(0.6f)};
+  const gi::BrfInstance inst{0, pose, glm::vec3(0.6f)};
   ASSERT_TRUE(pass.run(std::span(&inst, 1), incoming, settings).ok());
   const std::vector<float> gpu = pass.read_back_static_occlusion();
   ASSERT_EQ(gpu.size(), b.static_occlusion.size());

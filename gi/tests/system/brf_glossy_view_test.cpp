@@ -122,9 +122,9 @@ TEST(BrfGlossyView, TheMetalCratesViewDependentBounceIsDrawnAsThePathTracerSeesI
     const std::vector<gi::BrfSource> sources = gi::dynamic_brf_meshes(gi::bake_input_from(scene)).value();
     for (const gi::BrfSource& src : sources) {
       brf.meshes.push_back(gi::bake_brf_mesh(src, brf.settings).value());
-      EXPECT_EQ(brf.meshes.back().glossy.has_value(), src.name == "crate_red") << src.name;
+      EXPECT_EQ(brf.meshes.back().model.glossy.has_value(), src.name == "crate_red") << src.name;
       if (src.name == "crate_red") {
-        separation = brf.meshes.back().glossy;
+        separation = brf.meshes.back().model.glossy;
         separation->h = separation->albedo_corrected_h();  // the table the renderer draws with
       }
     }

@@ -311,7 +311,7 @@ TEST(GISystem, AMetalCrateBouncesAsAGlossyObject) {
   brf.settings = gi::brf_preset("preview").value();
   for (const gi::BrfSource& src : sources) {
     brf.meshes.push_back(gi::bake_brf_mesh(src, brf.settings).value());
-    EXPECT_EQ(brf.meshes.back().glossy.has_value(), src.name == "crate_red") << src.name;
+    EXPECT_EQ(brf.meshes.back().model.glossy.has_value(), src.name == "crate_red") << src.name;
   }
   ASSERT_TRUE(gi::save_brf(dir, brf, gi::bake_input_from(scene.assets)));
 
