@@ -266,8 +266,8 @@ void vpl_power_from_atlas(const BakeScene& b, const TexelGatherResult& gathered,
 
 // The texel final gather (texel_gather.h), or the merge of the shards' gathers, into
 // out.irradiance and out.vpl_power; adds its rays to `rays`.
-engine::Status final_gather(const BakeScene& b, const LightAtlasSettings& settings, const ShardRun& run,
-                            ThreadPool& pool, LightAtlasBake& out, std::uint64_t& rays) {
+engine::Status texel_gather_pass(const BakeScene& b, const LightAtlasSettings& settings, const ShardRun& run,
+                                 ThreadPool& pool, LightAtlasBake& out, std::uint64_t& rays) {
   const auto t0 = Clock::now();
   TexelGatherSettings g = settings.gather;
   g.seed = settings.seed;
@@ -295,8 +295,8 @@ engine::Status final_gather(const BakeScene& b, const LightAtlasSettings& settin
 
 // The VPL final shooting: the VPLs lit, then shot into the atlas, with the direct light the
 // renderer does not draw; into out.irradiance and out.vpl_power; adds its rays to `rays`.
-engine::Status final_shooting(const BakeScene& b, const LightAtlasSettings& settings, ThreadPool& pool,
-                              LightAtlasBake& out, std::uint64_t& rays) {
+engine::Status vpl_shooting_pass(const BakeScene& b, const LightAtlasSettings& settings, ThreadPool& pool,
+                                 LightAtlasBake& out, std::uint64_t& rays) {
   auto powers = light_vpls(b, out.vpls, settings, pool, &out.stats);
   if (!powers) return powers.error();
   out.vpl_power = powers->power;
@@ -370,8 +370,8 @@ engine::Result<LightAtlasBake> bake_light_atlas_run(const BakeInput& input, cons
 
   std::uint64_t rays = 0;
   const engine::Status finished = settings.final_pass == LightAtlasSettings::FinalPass::TexelGather
-                                      ? final_gather(b, settings, run, pool, out, rays)
-                                      : final_shooting(b, settings, pool, out, rays);
+                                      ? texel_gather_pass(b, settings, run, pool, out, rays)
+                                      : vpl_shooting_pass(b, settings, pool, out, rays);
   if (!finished) return finished.error();
   out.valid = b.texels.valid;
   dilate<glm::vec3>(out.irradiance, out.width, out.height, out.valid, dilation_rings(out.layout));
