@@ -252,6 +252,68 @@ engine::Transform framing_view(const glm::vec3& min, const glm::vec3& max, engin
   return t;
 }
 
+namespace {
+
+// The player's camera: the one named "camera", else the first, else a new one framing the
+// scene; unparented (the player moves it in world space), with its PlayerController.
+engine::Entity prepare_player(engine::Scene& scene, const Aabb& bounds, const GameplayTuning& tuning) {
+  engine::Registry& reg = scene.registry;
+  engine::Entity player = engine::find_by_name(reg, "camera");
+  if (!player || !reg.has<engine::Camera>(player)) player = engine::find_camera(reg);
+  if (!player) {
+    player = reg.create();
+    reg.emplace<engine::Name>(player, engine::Name{"camera"});
+    engine::Camera camera;
+    reg.emplace<engine::Transform>(player,
+                                   bounds.empty() ? engine::Transform{} : framing_view(bounds.min, bounds.max, camera));
+    reg.emplace<engine::Camera>(player, camera);
+  } else if (const engine::Transform& t = reg.get<engine::Transform>(player); t.parent) {
+    // The player moves the camera in world space: a camera under a parent node starts at
+    // its world pose, parented to nothing.
+    glm::vec3 scale, skew;
+    glm::vec4 perspective;
+    engine::Transform world;
+    glm::decompose(reg.get<engine::WorldTransform>(player).matrix, scale, world.rotation, world.position, skew,
+                   perspective);
+    world.rotation = glm::normalize(world.rotation);
+    reg.write<engine::Transform>(player) = world;
+    engine::update_world_transforms(reg);
+  }
+  const glm::quat q = reg.get<engine::Transform>(player).rotation;
+  const glm::vec3 f = q * glm::vec3(0, 0, -1);
+  PlayerController pc;
+  pc.yaw_rad = std::atan2(-f.x, -f.z);
+  pc.pitch_rad = std::asin(std::clamp(f.y, -1.0f, 1.0f));
+  pc.fly_speed_m_s = bounds.empty() ? pc.walk_speed_m_s : glm::length(bounds.max - bounds.min) / tuning.fly_crossing_s;
+  reg.emplace<PlayerController>(player, pc);
+  return player;
+}
+
+// The flashlight: the scene's light named "flashlight" (made to move), else a new spot
+// under the camera, off.
+engine::Entity prepare_flashlight(engine::Registry& reg, engine::Entity camera) {
+  engine::Entity light = engine::find_by_name(reg, "flashlight");
+  if (!light || !reg.has<engine::Light>(light)) {
+    light = reg.create();
+    reg.emplace<engine::Name>(light, engine::Name{"flashlight"});
+    reg.emplace<engine::Transform>(light, engine::Transform{.position = {0.15f, -0.15f, 0.0f}, .parent = camera});
+    reg.emplace<engine::Light>(light, engine::Light{.type = engine::LightType::Spot,
+                                                    .color = {1.0f, 0.93f, 0.82f},
+                                                    .intensity = 4.0f,
+                                                    .range_m = 20.0f,
+                                                    .inner_cone_rad = 0.22f,
+                                                    .outer_cone_rad = 0.42f,
+                                                    .moves = true,
+                                                    .cast_shadows = true,
+                                                    .enabled = false});
+  } else if (!reg.get<engine::Light>(light).moves) {
+    reg.write<engine::Light>(light).moves = true;
+  }
+  return light;
+}
+
+}  // namespace
+
 GameplayContext prepare_scene(engine::Scene& scene, const GameplayTuning& tuning) {
   engine::Registry& reg = scene.registry;
   engine::update_world_transforms(reg);
@@ -266,55 +328,8 @@ GameplayContext prepare_scene(engine::Scene& scene, const GameplayTuning& tuning
     bounds.max = glm::max(bounds.max, b.max);
   }
 
-  // Camera and player.
-  ctx.camera = engine::find_by_name(reg, "camera");
-  if (!ctx.camera || !reg.has<engine::Camera>(ctx.camera)) ctx.camera = engine::find_camera(reg);
-  if (!ctx.camera) {
-    ctx.camera = reg.create();
-    reg.emplace<engine::Name>(ctx.camera, engine::Name{"camera"});
-    engine::Camera camera;
-    reg.emplace<engine::Transform>(ctx.camera,
-                                   bounds.empty() ? engine::Transform{} : framing_view(bounds.min, bounds.max, camera));
-    reg.emplace<engine::Camera>(ctx.camera, camera);
-  } else if (const engine::Transform& t = reg.get<engine::Transform>(ctx.camera); t.parent) {
-    // The player moves the camera in world space: a camera under a parent node starts at
-    // its world pose, parented to nothing.
-    glm::vec3 scale, skew;
-    glm::vec4 perspective;
-    engine::Transform world;
-    glm::decompose(reg.get<engine::WorldTransform>(ctx.camera).matrix, scale, world.rotation, world.position, skew,
-                   perspective);
-    world.rotation = glm::normalize(world.rotation);
-    reg.write<engine::Transform>(ctx.camera) = world;
-    engine::update_world_transforms(reg);
-  }
-  const glm::quat q = reg.get<engine::Transform>(ctx.camera).rotation;
-  const glm::vec3 f = q * glm::vec3(0, 0, -1);
-  PlayerController pc;
-  pc.yaw_rad = std::atan2(-f.x, -f.z);
-  pc.pitch_rad = std::asin(std::clamp(f.y, -1.0f, 1.0f));
-  pc.fly_speed_m_s = bounds.empty() ? pc.walk_speed_m_s : glm::length(bounds.max - bounds.min) / tuning.fly_crossing_s;
-  reg.emplace<PlayerController>(ctx.camera, pc);
-
-  // Flashlight.
-  ctx.flashlight = engine::find_by_name(reg, "flashlight");
-  if (!ctx.flashlight || !reg.has<engine::Light>(ctx.flashlight)) {
-    ctx.flashlight = reg.create();
-    reg.emplace<engine::Name>(ctx.flashlight, engine::Name{"flashlight"});
-    reg.emplace<engine::Transform>(ctx.flashlight,
-                                   engine::Transform{.position = {0.15f, -0.15f, 0.0f}, .parent = ctx.camera});
-    reg.emplace<engine::Light>(ctx.flashlight, engine::Light{.type = engine::LightType::Spot,
-                                                             .color = {1.0f, 0.93f, 0.82f},
-                                                             .intensity = 4.0f,
-                                                             .range_m = 20.0f,
-                                                             .inner_cone_rad = 0.22f,
-                                                             .outer_cone_rad = 0.42f,
-                                                             .moves = true,
-                                                             .cast_shadows = true,
-                                                             .enabled = false});
-  } else if (!reg.get<engine::Light>(ctx.flashlight).moves) {
-    reg.write<engine::Light>(ctx.flashlight).moves = true;
-  }
+  ctx.camera = prepare_player(scene, bounds, tuning);
+  ctx.flashlight = prepare_flashlight(reg, ctx.camera);
 
   // The swinging lamp's pivot (demo level), if the scene has one.
   ctx.swinging_pivot = engine::find_by_name(reg, "lamp_pivot");

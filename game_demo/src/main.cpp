@@ -130,49 +130,57 @@ std::vector<std::string> gi_status_lines(const gi::GISystem* system) {
 
 }  // namespace game_demo
 
-int main(int argc, char** argv) {
-  using namespace game_demo;
-  RunOptions o;
+namespace {
+
+using namespace game_demo;
+
+// The renderer's choices as the command line spells them, and the options whose presence counts.
+struct RenderChoices {
   std::string area_shadows = "soft";
   std::string light_reach = "on";
   std::string area_shadow_res = "half";
   std::string shading = "full";
-  CLI::App app{"gi_demo: the playable demo level of the GI module"};
-  app.add_option("--scene", o.scene, "glTF scene to play (default: assets/demo_level.gltf)");
-  app.add_flag("--headless", o.headless, "Run without a window (EGL surfaceless), driven by --script or --replay");
-  app.add_option("--frames", o.frames, "Fixed steps to run (headless default 120; replay: the session length)");
-  app.add_option("--out", o.out_dir, "Headless: write DIR/frame_NNNN.png (tonemapped)");
-  auto* w = app.add_option("--width", o.width, "Render width in pixels")->check(CLI::Range(16, 8192));
-  auto* h = app.add_option("--height", o.height, "Render height in pixels")->check(CLI::Range(16, 8192));
-  auto* exposure = app.add_option("--exposure", o.exposure,
-                                  "Fixed linear exposure before tonemapping, e.g. 0.3 (the demo level's look, as "
-                                  "its goldens); default: automatic (docs/exposure.md)")
-                       ->check(CLI::PositiveNumber);
-  auto* ev100 = app.add_option("--ev100", o.ev100,
-                               "Fixed exposure of a camera at this EV100: radiance x 683 / (1.2 x 2^EV100) "
-                               "(15: the sunny-16 rule)")
-                    ->excludes(exposure);
+  CLI::Option* width = nullptr;
+  CLI::Option* height = nullptr;
+  CLI::Option* exposure = nullptr;
+  CLI::Option* ev100 = nullptr;
+};
+
+void add_render_options(CLI::App& app, RunOptions& o, RenderChoices& c) {
+  c.width = app.add_option("--width", o.width, "Render width in pixels")->check(CLI::Range(16, 8192));
+  c.height = app.add_option("--height", o.height, "Render height in pixels")->check(CLI::Range(16, 8192));
+  c.exposure = app.add_option("--exposure", o.exposure,
+                              "Fixed linear exposure before tonemapping, e.g. 0.3 (the demo level's look, as "
+                              "its goldens); default: automatic (docs/exposure.md)")
+                   ->check(CLI::PositiveNumber);
+  c.ev100 = app.add_option("--ev100", o.ev100,
+                           "Fixed exposure of a camera at this EV100: radiance x 683 / (1.2 x 2^EV100) "
+                           "(15: the sunny-16 rule)")
+                ->excludes(c.exposure);
   app.add_option("--exposure-compensation", o.exposure_compensation_ev,
                  "Automatic exposure: EV added after metering (+1: twice as bright)")
-      ->excludes(exposure)
-      ->excludes(ev100);
+      ->excludes(c.exposure)
+      ->excludes(c.ev100);
   app.add_option(
-         "--area-shadows", area_shadows,
+         "--area-shadows", c.area_shadows,
          "soft: area lights soft-shadowed over their rectangle (default); centre: from their centre only (cheaper)")
       ->check(CLI::IsMember({"soft", "centre"}));
-  app.add_option("--light-reach", light_reach,
+  app.add_option("--light-reach", c.light_reach,
                  "on: static lights shade only where static geometry lets them reach (default); off: every light "
                  "on every pixel (engine::RenderSettings::light_reach_culling)")
       ->check(CLI::IsMember({"on", "off"}));
-  app.add_option("--area-shadow-res", area_shadow_res,
+  app.add_option("--area-shadow-res", c.area_shadow_res,
                  "half: area lights' soft shadows at half resolution, upsampled on each pixel's own surface "
                  "(default); full: per pixel (engine::RenderSettings::area_shadow_res)")
       ->check(CLI::IsMember({"full", "half"}));
   app.add_option(
-         "--shading", shading,
+         "--shading", c.shading,
          "full: the frame as players see it (default); flat: measurement only, every surface its base colour "
          "unlit with everything else as usual, the cost floor of any shading (engine::RenderSettings::flat_shading)")
       ->check(CLI::IsMember({"full", "flat"}));
+}
+
+void add_session_options(CLI::App& app, RunOptions& o) {
   app.add_option("--every", o.every, "Headless: write every K-th frame")->check(CLI::PositiveNumber);
   app.add_flag("--exr", o.exr, "Headless: also write DIR/frame_NNNN.exr (linear HDR)");
   app.add_flag("--no-render", o.no_render, "Headless: simulate only (no GPU), e.g. to record sessions");
@@ -193,17 +201,19 @@ int main(int argc, char** argv) {
         return engine::parse_sky_text(text) ? std::string() : std::string("--sky wants ") + engine::kSkyTextUsage;
       });
   app.add_flag("--verbose", o.verbose, "Headless: print the script's waypoints and the player's position each second");
-  // The tools' host contract (tools/common/tool_main.h): --version, exit 0 done, 1 failed,
-  // 2 bad usage, 130 Ctrl-C (the recording is then not written).
-  if (const std::optional<int> rc = tools::parse(app, "gi_demo", argc, argv)) return *rc;
-  o.area_soft_shadows = area_shadows == "soft";
-  o.light_reach_culling = light_reach == "on";
-  o.flat_shading = shading == "flat";
-  o.area_shadow_res = area_shadow_res == "half" ? engine::AreaShadowRes::Half : engine::AreaShadowRes::Full;
-  o.size_given = w->count() > 0 || h->count() > 0;
-  o.exposure_mode = exposure->count() > 0 ? engine::ExposureMode::FixedLinear
-                    : ev100->count() > 0  ? engine::ExposureMode::FixedEv100
-                                          : engine::ExposureMode::Automatic;
+}
+
+// Turns the parsed choices into the run's options and checks those that exclude each other;
+// the exit code when they do.
+std::optional<int> settle_options(const RenderChoices& c, RunOptions& o) {
+  o.area_soft_shadows = c.area_shadows == "soft";
+  o.light_reach_culling = c.light_reach == "on";
+  o.flat_shading = c.shading == "flat";
+  o.area_shadow_res = c.area_shadow_res == "half" ? engine::AreaShadowRes::Half : engine::AreaShadowRes::Full;
+  o.size_given = c.width->count() > 0 || c.height->count() > 0;
+  o.exposure_mode = c.exposure->count() > 0 ? engine::ExposureMode::FixedLinear
+                    : c.ev100->count() > 0  ? engine::ExposureMode::FixedEv100
+                                            : engine::ExposureMode::Automatic;
   if (o.script.empty()) o.script = std::string(script_name(default_script(o.scene)));
   if (!script_from_name(o.script)) {
     return tools::fail("gi_demo", "unknown --script \"" + o.script + "\"", tools::kExitUsage);
@@ -214,53 +224,81 @@ int main(int argc, char** argv) {
   if (o.no_render && !o.gi_bundle.empty()) {
     return tools::fail("gi_demo", "--no-render does not light anything (--gi-bundle)", tools::kExitUsage);
   }
+  return std::nullopt;
+}
+
+// The simulation of a replayed session (its size unless --width/--height); false after saying why not.
+bool open_replay(RunOptions& o, RunState& state) {
+  auto session = load_session(o.replay_file);
+  if (!session) {
+    std::cerr << "gi_demo: " << session.error().to_string() << '\n';
+    return false;
+  }
+  auto sim = simulation_for_session(*session, o.replay_file,
+                                    o.scene.empty() ? std::filesystem::path() : resolve_scene_path(o.scene));
+  if (!sim) {
+    std::cerr << "gi_demo: " << sim.error().to_string() << '\n';
+    return false;
+  }
+  if (!o.size_given) {
+    o.width = static_cast<int>(session->header.width);
+    o.height = static_cast<int>(session->header.height);
+  }
+  state.sim = std::make_unique<Simulation>(std::move(sim).value());
+  state.replay = std::move(session).value();
+  return true;
+}
+
+// The simulation of a new session on the scene, with its recording's header when --record;
+// false after saying why not.
+bool open_new_session(const RunOptions& o, RunState& state) {
+  const std::string as_given = o.scene.empty() ? std::string("assets/demo_level.gltf") : o.scene;
+  const std::filesystem::path path = o.scene.empty() ? default_scene_path() : resolve_scene_path(o.scene);
+  auto scene = load_scene(path);
+  if (!scene) {
+    std::cerr << "gi_demo: " << scene.error().to_string() << '\n';
+    return false;
+  }
+  state.sim = std::make_unique<Simulation>(
+      std::move(scene).value(),
+      SimulationSettings{.seed = o.seed, .tuning = {.locomotion = default_locomotion(as_given)}});
+  if (!o.record_file.empty()) {
+    auto hash = hash_scene_file(path);
+    if (!hash) {
+      std::cerr << "gi_demo: " << hash.error().to_string() << '\n';
+      return false;
+    }
+    Session s;
+    s.header = SessionHeader{.scene_path = as_given,
+                             .scene_hash = *hash,
+                             .seed = o.seed,
+                             .width = static_cast<std::uint32_t>(o.width),
+                             .height = static_cast<std::uint32_t>(o.height),
+                             .fixed_dt_s = state.sim->settings().fixed_dt_s};
+    state.record = std::move(s);
+  }
+  return true;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  RunOptions o;
+  RenderChoices choices;
+  CLI::App app{"gi_demo: the playable demo level of the GI module"};
+  app.add_option("--scene", o.scene, "glTF scene to play (default: assets/demo_level.gltf)");
+  app.add_flag("--headless", o.headless, "Run without a window (EGL surfaceless), driven by --script or --replay");
+  app.add_option("--frames", o.frames, "Fixed steps to run (headless default 120; replay: the session length)");
+  app.add_option("--out", o.out_dir, "Headless: write DIR/frame_NNNN.png (tonemapped)");
+  add_render_options(app, o, choices);
+  add_session_options(app, o);
+  // The tools' host contract (tools/common/tool_main.h): --version, exit 0 done, 1 failed,
+  // 2 bad usage, 130 Ctrl-C (the recording is then not written).
+  if (const std::optional<int> rc = tools::parse(app, "gi_demo", argc, argv)) return *rc;
+  if (const std::optional<int> rc = settle_options(choices, o)) return *rc;
 
   RunState state;
-  if (!o.replay_file.empty()) {
-    auto session = load_session(o.replay_file);
-    if (!session) {
-      std::cerr << "gi_demo: " << session.error().to_string() << '\n';
-      return 1;
-    }
-    auto sim = simulation_for_session(*session, o.replay_file,
-                                      o.scene.empty() ? std::filesystem::path() : resolve_scene_path(o.scene));
-    if (!sim) {
-      std::cerr << "gi_demo: " << sim.error().to_string() << '\n';
-      return 1;
-    }
-    if (!o.size_given) {
-      o.width = static_cast<int>(session->header.width);
-      o.height = static_cast<int>(session->header.height);
-    }
-    state.sim = std::make_unique<Simulation>(std::move(sim).value());
-    state.replay = std::move(session).value();
-  } else {
-    const std::string as_given = o.scene.empty() ? std::string("assets/demo_level.gltf") : o.scene;
-    const std::filesystem::path path = o.scene.empty() ? default_scene_path() : resolve_scene_path(o.scene);
-    auto scene = load_scene(path);
-    if (!scene) {
-      std::cerr << "gi_demo: " << scene.error().to_string() << '\n';
-      return 1;
-    }
-    state.sim = std::make_unique<Simulation>(
-        std::move(scene).value(),
-        SimulationSettings{.seed = o.seed, .tuning = {.locomotion = default_locomotion(as_given)}});
-    if (!o.record_file.empty()) {
-      auto hash = hash_scene_file(path);
-      if (!hash) {
-        std::cerr << "gi_demo: " << hash.error().to_string() << '\n';
-        return 1;
-      }
-      Session s;
-      s.header = SessionHeader{.scene_path = as_given,
-                               .scene_hash = *hash,
-                               .seed = o.seed,
-                               .width = static_cast<std::uint32_t>(o.width),
-                               .height = static_cast<std::uint32_t>(o.height),
-                               .fixed_dt_s = state.sim->settings().fixed_dt_s};
-      state.record = std::move(s);
-    }
-  }
+  if (!(o.replay_file.empty() ? open_new_session(o, state) : open_replay(o, state))) return 1;
   if (!o.sky.empty()) {  // before the renderer and the GI system read the scene
     const engine::SkyText sky = engine::parse_sky_text(o.sky).value();  // checked by the option
     state.sim->scene().assets.environment.sky_radiance = sky.uniform;

@@ -83,25 +83,37 @@ std::string_view script_name(Script s) {
 ScriptedPilot::ScriptedPilot(const Simulation& sim, Script script, std::uint64_t frames)
     : script_(script), budget_(frames) {
   const engine::Registry& reg = sim.registry();
-  const GameplayContext& ctx = sim.context();
-  const glm::vec3 eye = reg.get<engine::Transform>(ctx.camera).position;
-
-  // Walkability grid over the level bounds at eye height.
-  const Aabb& level = ctx.collision.level_bounds();
-  if (!level.empty()) {
-    const double walls = static_cast<double>(std::max<std::size_t>(ctx.collision.wall_triangle_count(), 1));
-    auto cells_at = [&](double c) {
-      return (static_cast<double>(level.max.x - level.min.x) / c + 1.0) *
-             (static_cast<double>(level.max.z - level.min.z) / c + 1.0);
-    };
-    while (cells_at(double{cell_m_}) * walls > 2e8 || cells_at(double{cell_m_}) > 4e6) cell_m_ *= 2.0f;
-    origin_ = glm::vec3(level.min.x, eye.y, level.min.z);
-    nx_ = static_cast<int>(std::ceil((level.max.x - level.min.x) / cell_m_)) + 1;
-    nz_ = static_cast<int>(std::ceil((level.max.z - level.min.z) / cell_m_)) + 1;
-    mark_walkable(sim);
-  }
-
+  const glm::vec3 eye = reg.get<engine::Transform>(sim.context().camera).position;
+  build_grid(sim, eye);
   // Waypoints: the centres of large static meshes at eye height (rooms), then crates.
+  const std::vector<glm::vec3> rooms = room_points(sim, eye);
+  std::vector<glm::vec3> crates;
+  for (engine::Entity c : crates_of(reg)) {
+    glm::vec3 p = crate_box(reg, c, 0.0f).center();
+    p.y = eye.y;
+    crates.push_back(p);
+  }
+  plan_script(reg, eye, rooms, crates);
+}
+
+void ScriptedPilot::build_grid(const Simulation& sim, const glm::vec3& eye) {
+  const GameplayContext& ctx = sim.context();
+  const Aabb& level = ctx.collision.level_bounds();
+  if (level.empty()) return;
+  const double walls = static_cast<double>(std::max<std::size_t>(ctx.collision.wall_triangle_count(), 1));
+  auto cells_at = [&](double c) {
+    return (static_cast<double>(level.max.x - level.min.x) / c + 1.0) *
+           (static_cast<double>(level.max.z - level.min.z) / c + 1.0);
+  };
+  while (cells_at(double{cell_m_}) * walls > 2e8 || cells_at(double{cell_m_}) > 4e6) cell_m_ *= 2.0f;
+  origin_ = glm::vec3(level.min.x, eye.y, level.min.z);
+  nx_ = static_cast<int>(std::ceil((level.max.x - level.min.x) / cell_m_)) + 1;
+  nz_ = static_cast<int>(std::ceil((level.max.z - level.min.z) / cell_m_)) + 1;
+  mark_walkable(sim);
+}
+
+std::vector<glm::vec3> ScriptedPilot::room_points(const Simulation& sim, const glm::vec3& eye) const {
+  const engine::Registry& reg = sim.registry();
   std::vector<glm::vec3> rooms;
   for (engine::Entity e : reg.view<engine::MeshRenderer, engine::StaticTag, engine::WorldTransform>().entities()) {
     const std::uint32_t mesh = reg.get<engine::MeshRenderer>(e).mesh;
@@ -126,19 +138,18 @@ ScriptedPilot::ScriptedPilot(const Simulation& sim, Script script, std::uint64_t
   const bool had_rooms = !rooms.empty();
   for (engine::Entity e : reg.view<engine::Light, engine::WorldTransform>().entities()) {
     const engine::Light& l = reg.get<engine::Light>(e);
-    if (had_rooms || l.moves || l.type == engine::LightType::Directional || e == ctx.flashlight) continue;
+    if (had_rooms || l.moves || l.type == engine::LightType::Directional || e == sim.context().flashlight) continue;
     glm::vec3 p = glm::vec3(reg.get<engine::WorldTransform>(e).matrix[3]);
     p.y = eye.y;
     const bool near_other =
         std::any_of(rooms.begin(), rooms.end(), [&](const glm::vec3& r) { return horizontal_distance(r, p) < 2.0f; });
     if (!near_other && nearest_walkable(p)) rooms.push_back(p);
   }
-  std::vector<glm::vec3> crates;
-  for (engine::Entity c : crates_of(reg)) {
-    glm::vec3 p = crate_box(reg, c, 0.0f).center();
-    p.y = eye.y;
-    crates.push_back(p);
-  }
+  return rooms;
+}
+
+void ScriptedPilot::plan_script(const engine::Registry& reg, const glm::vec3& eye, const std::vector<glm::vec3>& rooms,
+                                const std::vector<glm::vec3>& crates) {
   auto add = [&](const std::vector<glm::vec3>& pts, bool is_crate, std::size_t limit) {
     const glm::vec3 from = waypoints_.empty() ? eye : waypoints_.back();
     for (std::size_t i : visiting_order(from, pts)) {
@@ -208,6 +219,8 @@ bool ScriptedPilot::follow_path(const glm::vec3& eye, float yaw_rad, float look_
 // it less than 5 cm or more than 15 degrees off the push (a wall stopped it or it slid along
 // one), at most six times; then walk to 2.8 m past the crate
 // along the push (the wall's other side) and look back and down at the crate through the wall.
+// Long because it is one state machine: its five phases share the eye, the crate and the
+// turn_to/go helpers over them, and read best as one switch.
 void ScriptedPilot::next_crate_to_wall(const Simulation& sim, InputFrame& in) {
   const engine::Registry& reg = sim.registry();
   if (!wall_crate_) return;

@@ -89,6 +89,83 @@ void draw_overlay(const RunOptions& o, const RunState& state, const engine::Rend
   ImGui::End();
 }
 
+void open_imgui(GLFWwindow* window) {
+  glfwSetInputMode(window, GLFW_CURSOR, GLFW_CURSOR_DISABLED);
+  if (glfwRawMouseMotionSupported()) glfwSetInputMode(window, GLFW_RAW_MOUSE_MOTION, GLFW_TRUE);
+  IMGUI_CHECKVERSION();
+  ImGui::CreateContext();
+  ImGui::GetIO().IniFilename = nullptr;
+  glfwSetKeyCallback(window, on_key);  // before ImGui's backend, which chains to it
+  ImGui_ImplGlfw_InitForOpenGL(window, true);
+  ImGui_ImplOpenGL3_Init("#version 450");
+}
+
+// The wall clock of the window's frames: the last frame's time and the frames per second over
+// the last half second or more (frames counted / wall time): an average of per-frame rates
+// started from the first, nearly empty frame read 150 at 3.
+struct FrameClock {
+  double last = 0.0, fps = 0.0, frame_ms = 0.0, window_start = 0.0;
+  int window_frames = 0;
+
+  explicit FrameClock(double now) : last(now), window_start(now) {}
+  // Advances to `now`; returns the seconds since the last frame.
+  double tick(double now) {
+    frame_ms = (now - last) * 1000.0;
+    ++window_frames;
+    if (now - window_start >= 0.5) {
+      fps = window_frames / (now - window_start);
+      window_start = now;
+      window_frames = 0;
+    }
+    const double elapsed = now - last;
+    last = now;
+    return elapsed;
+  }
+};
+
+// The fixed steps the accumulated time holds, from the replay or the live input; true when
+// the run is done (the replay or --frames ran out, or a replayed checksum diverged: *status).
+bool step_fixed(const RunOptions& o, RunState& state, InputFrame live, double dt, double& accumulator, int& status) {
+  Simulation& sim = *state.sim;
+  bool done = false;
+  while (accumulator >= dt) {
+    accumulator -= dt;
+    if (state.replay) {
+      if (sim.frame() >= state.replay->frames.size()) return true;
+      if (!state.step(state.replay->frames[sim.frame()].input)) {
+        status = tools::kExitFailure;
+        return true;
+      }
+    } else {
+      state.step(live);
+      g_latch.stepped();
+      live.mouse_dx_px = live.mouse_dy_px = 0.0f;  // the mouse moved once, not once per step
+    }
+    if (o.frames > 0 && sim.frame() >= o.frames) done = true;
+  }
+  return done;
+}
+
+// Renders the frame to the window's framebuffer with the overlay on top (not yet swapped).
+void present_frame(const RunOptions& o, const RunState& state, GLFWwindow* window, engine::Renderer& renderer,
+                   RenderClock& render_clock, const std::string& indirect_text, const gi::GISystem* indirect,
+                   const FrameClock& clock) {
+  const Simulation& sim = *state.sim;
+  int fb_w = 0, fb_h = 0;
+  glfwGetFramebufferSize(window, &fb_w, &fb_h);
+  renderer.settings().split = split_of(sim);
+  renderer.render(sim.registry(), sim.context().camera, render_clock.dt_s(sim));
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  glViewport(0, 0, fb_w, fb_h);
+  renderer.present(fb_w, fb_h);
+  ImGui_ImplOpenGL3_NewFrame();
+  ImGui_ImplGlfw_NewFrame();
+  ImGui::NewFrame();
+  draw_overlay(o, state, renderer, indirect_text, indirect, clock.frame_ms, clock.fps);
+  ImGui::Render();
+  ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+}
+
 }  // namespace
 
 int run_windowed(const RunOptions& o, RunState& state) {
@@ -111,24 +188,13 @@ int run_windowed(const RunOptions& o, RunState& state) {
   renderer->set_indirect_light(indirect.get());
   std::cout << "gi_demo: window " << o.width << "x" << o.height << " on " << ctx->description() << '\n';
   std::cout << "gi_demo: indirect light: " << indirect_text << '\n';
-
-  glfwSetInputMode(window, GLFW_CURSOR, GLFW_CURSOR_DISABLED);
-  if (glfwRawMouseMotionSupported()) glfwSetInputMode(window, GLFW_RAW_MOUSE_MOTION, GLFW_TRUE);
-  IMGUI_CHECKVERSION();
-  ImGui::CreateContext();
-  ImGui::GetIO().IniFilename = nullptr;
-  glfwSetKeyCallback(window, on_key);  // before ImGui's backend, which chains to it
-  ImGui_ImplGlfw_InitForOpenGL(window, true);
-  ImGui_ImplOpenGL3_Init("#version 450");
+  open_imgui(window);
 
   const double dt = sim.settings().fixed_dt_s;
   double cursor_x = 0, cursor_y = 0;
   glfwGetCursorPos(window, &cursor_x, &cursor_y);
-  double last = glfwGetTime(), accumulator = 0.0, fps = 0.0, frame_ms = 0.0;
-  // Frames per second over the last half second or more (frames counted / wall time): an
-  // average of per-frame rates started from the first, nearly empty frame read 150 at 3.
-  double fps_window_start = last;
-  int fps_window_frames = 0;
+  FrameClock clock(glfwGetTime());
+  double accumulator = 0.0;
   int status = 0;
   RenderClock render_clock;
   while (!glfwWindowShouldClose(window)) {
@@ -138,16 +204,7 @@ int run_windowed(const RunOptions& o, RunState& state) {
     }
     glfwPollEvents();
     if (glfwGetKey(window, GLFW_KEY_ESCAPE) == GLFW_PRESS) break;
-    const double now = glfwGetTime();
-    frame_ms = (now - last) * 1000.0;
-    ++fps_window_frames;
-    if (now - fps_window_start >= 0.5) {
-      fps = fps_window_frames / (now - fps_window_start);
-      fps_window_start = now;
-      fps_window_frames = 0;
-    }
-    accumulator = std::min(accumulator + (now - last), kMaxStepsPerFrame * dt);
-    last = now;
+    accumulator = std::min(accumulator + clock.tick(glfwGetTime()), kMaxStepsPerFrame * dt);
 
     double x = 0, y = 0;
     glfwGetCursorPos(window, &x, &y);
@@ -156,41 +213,9 @@ int run_windowed(const RunOptions& o, RunState& state) {
     live.mouse_dy_px = static_cast<float>(y - cursor_y);
     cursor_x = x;
     cursor_y = y;
+    const bool done = step_fixed(o, state, live, dt, accumulator, status);
 
-    bool done = false;
-    while (accumulator >= dt) {
-      accumulator -= dt;
-      if (state.replay) {
-        if (sim.frame() >= state.replay->frames.size()) {
-          done = true;
-          break;
-        }
-        if (!state.step(state.replay->frames[sim.frame()].input)) {
-          status = tools::kExitFailure;
-          done = true;
-          break;
-        }
-      } else {
-        state.step(live);
-        g_latch.stepped();
-        live.mouse_dx_px = live.mouse_dy_px = 0.0f;  // the mouse moved once, not once per step
-      }
-      if (o.frames > 0 && sim.frame() >= o.frames) done = true;
-    }
-
-    int fb_w = 0, fb_h = 0;
-    glfwGetFramebufferSize(window, &fb_w, &fb_h);
-    renderer->settings().split = split_of(sim);
-    renderer->render(sim.registry(), sim.context().camera, render_clock.dt_s(sim));
-    glBindFramebuffer(GL_FRAMEBUFFER, 0);
-    glViewport(0, 0, fb_w, fb_h);
-    renderer->present(fb_w, fb_h);
-    ImGui_ImplOpenGL3_NewFrame();
-    ImGui_ImplGlfw_NewFrame();
-    ImGui::NewFrame();
-    draw_overlay(o, state, *renderer, indirect_text, indirect.get(), frame_ms, fps);
-    ImGui::Render();
-    ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+    present_frame(o, state, window, *renderer, render_clock, indirect_text, indirect.get(), clock);
     ctx->swap();
     if (done) break;
   }

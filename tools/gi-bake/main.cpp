@@ -38,32 +38,35 @@ std::vector<std::string> split(const std::string& list) {
   return out;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  CLI::App app{"Bakes a scene's GI data into a bake bundle (manifest.json + one file per method)"};
-  std::string scene_path, positional_scene, out_dir, methods, export_uv1, sky, sun;
+// The command line beside gi::BakeOptions.
+struct ToolOptions {
+  std::string scene_path, positional_scene, out_dir, methods, export_uv1, sky, sun, shard;
   bool plan_only = false, untextured = false;
-  gi::BakeOptions o;
-  app.add_option("--scene", scene_path, "glTF/GLB scene")->check(CLI::ExistingFile);
-  app.add_option("scene", positional_scene, "glTF/GLB scene (instead of --scene)")->check(CLI::ExistingFile);
-  app.add_flag("--untextured", untextured,
+};
+
+void add_scene_options(CLI::App& app, ToolOptions& t) {
+  app.add_option("--scene", t.scene_path, "glTF/GLB scene")->check(CLI::ExistingFile);
+  app.add_option("scene", t.positional_scene, "glTF/GLB scene (instead of --scene)")->check(CLI::ExistingFile);
+  app.add_flag("--untextured", t.untextured,
                "Bake the scene's materials without their textures and alpha (factors alone, gi::without_textures; "
                "docs/materials-in-bakes.md)");
-  app.add_flag("--plan", plan_only, "Print the effect plan with estimates for --preset and exit (docs/plan.md)");
-  app.add_option("--export-uv1", export_uv1,
+  app.add_flag("--plan", t.plan_only, "Print the effect plan with estimates for --preset and exit (docs/plan.md)");
+  app.add_option("--export-uv1", t.export_uv1,
                  "Write the scene with the light-atlas UVs of --preset/--density as TEXCOORD_1 to this .gltf/.glb "
                  "(bakes nothing unless --out is given too)");
-  app.add_option("--sky", sky,
+  app.add_option("--sky", t.sky,
                  "R,G,B: a uniform sky of this radiance, W/(m^2 sr), or 'zenith:R,G,B;horizon:R,G,B;ground:R,G,B' "
                  "a gradient over the elevation, for scenes that carry none (replaces the scene's gi.sky; "
                  "docs/scene-format.md)");
-  app.add_option("--sun", sun,
+  app.add_option("--sun", t.sun,
                  "'direction:dx,dy,dz;irradiance:R,G,B[;angular_radius_deg:D]': a sun replacing the scene's gi.sun "
                  "(docs/scene-format.md)");
-  app.add_option("--out", out_dir, "Bundle directory (default: out/<scene>.gibake)");
+  app.add_option("--out", t.out_dir, "Bundle directory (default: out/<scene>.gibake)");
+}
+
+void add_bake_options(CLI::App& app, ToolOptions& t, gi::BakeOptions& o) {
   app.add_option(
-      "--methods", methods,
+      "--methods", t.methods,
       "Comma-separated methods to bake: light_atlas, prm, dlm, brf, antiradiance (default: what the plan calls for)");
   app.add_option("--preset", o.preset, "Quality preset: preview, medium, high (docs/sweeps/README.md)");
   app.add_option("--vpls", o.vpls, "Override the preset's VPL count")->check(CLI::PositiveNumber);
@@ -81,63 +84,42 @@ int main(int argc, char** argv) {
   app.add_option("--threads", o.threads, "Worker threads (0: all); the result does not depend on it");
   app.add_option("--seed", o.seed, "Random seed");
   // Distributed bakes (docs/distributed-bake.md).
-  std::string shard;
-  app.add_option("--shard", shard,
+  app.add_option("--shard", t.shard,
                  "I/N: bake only shard I (0-based) of N of the light atlas and PRM into <out>.shards/ "
                  "(docs/distributed-bake.md)");
   app.add_flag("--merge", o.merge_shards,
                "Write the bundle from the shards in <out>.shards/ (every one of 0..N-1 once, of this scene and "
                "options), baking the other methods here");
-  if (auto rc = tools::parse(app, kTool, argc, argv)) return *rc;
-  if (!shard.empty()) {
-    unsigned index = 0, count = 0;
-    char tail = 0;
-    if (o.merge_shards || std::sscanf(shard.c_str(), "%u/%u%c", &index, &count, &tail) != 2 || count == 0 ||
-        index >= count || count > 65536)
-      return tools::fail(kTool, "--shard takes I/N with 0 <= I < N <= 65536 and no --merge, got '" + shard + "'",
-                         tools::kExitUsage);
-    o.shard_index = index;
-    o.shard_count = count;
-  }
-  if (scene_path.empty()) scene_path = positional_scene;
-  if (scene_path.empty()) return tools::fail(kTool, "no scene (--scene FILE or FILE)", tools::kExitUsage);
-  o.methods = split(methods);
+}
 
-  auto asset = engine::load_gltf(scene_path);
-  if (!asset) return tools::fail(kTool, asset.error());
-  if (!sky.empty()) {
-    if (!tools::set_sky(asset->environment, sky))
-      return tools::fail(kTool, std::string(tools::kSkyUsage) + ", got '" + sky + "'", tools::kExitUsage);
-  }
-  if (!sun.empty() && !tools::set_sun(*asset, sun))
-    return tools::fail(kTool, std::string(tools::kSunUsage) + ", got '" + sun + "'", tools::kExitUsage);
-  if (!export_uv1.empty()) {
-    auto uv = gi::with_light_atlas_uv1(*asset, {.preset = o.preset, .texels_per_metre = o.texels_per_metre});
-    if (!uv) return tools::fail(kTool, uv.error());
-    const bool glb = std::filesystem::path(export_uv1).extension() == ".glb";
-    if (auto written = engine::write_gltf(uv->scene, export_uv1, {.binary = glb}); !written)
-      return tools::fail(kTool, written.error());
-    std::printf("%s: wrote %s: TEXCOORD_1 of the static meshes, %zu charts in a %dx%d atlas at %g texels/m\n", kTool,
-                export_uv1.c_str(), uv->charts, uv->width, uv->height, double{uv->texels_per_metre});
-    if (out_dir.empty() && !plan_only) return tools::kExitOk;
-  }
-  const engine::Scene scene = engine::instantiate(std::move(asset).value());
-  const gi::BakeInput input =
-      untextured ? gi::without_textures(gi::bake_input_from(scene)) : gi::bake_input_from(scene);
+// --shard I/N into the options; the exit code when it is malformed.
+std::optional<int> parse_shard(const std::string& shard, gi::BakeOptions& o) {
+  if (shard.empty()) return std::nullopt;
+  unsigned index = 0, count = 0;
+  char tail = 0;
+  if (o.merge_shards || std::sscanf(shard.c_str(), "%u/%u%c", &index, &count, &tail) != 2 || count == 0 ||
+      index >= count || count > 65536)
+    return tools::fail(kTool, "--shard takes I/N with 0 <= I < N <= 65536 and no --merge, got '" + shard + "'",
+                       tools::kExitUsage);
+  o.shard_index = index;
+  o.shard_count = count;
+  return std::nullopt;
+}
 
-  if (plan_only) {
-    std::fputs(gi::format_plan(gi::plan(input, {.preset = o.preset,
-                                                .texels_per_metre = o.texels_per_metre,
-                                                .vpls = o.vpls,
-                                                .samples_per_vpl = o.samples_per_vpl,
-                                                .bounces = o.bounces}))
-                   .c_str(),
-               stdout);
-    return tools::kExitOk;
-  }
-  if (out_dir.empty())
-    out_dir = (std::filesystem::path("out") / (std::filesystem::path(scene_path).stem().string() + ".gibake")).string();
+// Writes the scene with the light-atlas UVs as TEXCOORD_1 (--export-uv1); the exit code on failure.
+std::optional<int> export_uv1(const engine::SceneAsset& asset, const ToolOptions& t, const gi::BakeOptions& o) {
+  auto uv = gi::with_light_atlas_uv1(asset, {.preset = o.preset, .texels_per_metre = o.texels_per_metre});
+  if (!uv) return tools::fail(kTool, uv.error());
+  const bool glb = std::filesystem::path(t.export_uv1).extension() == ".glb";
+  if (auto written = engine::write_gltf(uv->scene, t.export_uv1, {.binary = glb}); !written)
+    return tools::fail(kTool, written.error());
+  std::printf("%s: wrote %s: TEXCOORD_1 of the static meshes, %zu charts in a %dx%d atlas at %g texels/m\n", kTool,
+              t.export_uv1.c_str(), uv->charts, uv->width, uv->height, double{uv->texels_per_metre});
+  return std::nullopt;
+}
 
+// Bakes the bundle with a progress bar and the bake's log on the console, and reports what it wrote.
+int bake(const gi::BakeInput& input, const std::string& out_dir, const gi::BakeOptions& o) {
   tools::install_interrupt_handler();
   tools::ConsoleProgress bar;
   const gi::BakeHost host{.progress = bar.stages(), .log = [&](gi::LogLevel level, std::string_view line) {
@@ -163,4 +145,50 @@ int main(int argc, char** argv) {
     std::printf("%s: %s: %.2f s, %.1f MB\n", kTool, m.method.c_str(), m.seconds, static_cast<double>(m.bytes) / 1e6);
   std::printf("%s: wrote %s\n", kTool, out_dir.c_str());
   return tools::kExitOk;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Bakes a scene's GI data into a bake bundle (manifest.json + one file per method)"};
+  ToolOptions t;
+  gi::BakeOptions o;
+  add_scene_options(app, t);
+  add_bake_options(app, t, o);
+  if (auto rc = tools::parse(app, kTool, argc, argv)) return *rc;
+  if (auto rc = parse_shard(t.shard, o)) return *rc;
+  if (t.scene_path.empty()) t.scene_path = t.positional_scene;
+  if (t.scene_path.empty()) return tools::fail(kTool, "no scene (--scene FILE or FILE)", tools::kExitUsage);
+  o.methods = split(t.methods);
+
+  auto asset = engine::load_gltf(t.scene_path);
+  if (!asset) return tools::fail(kTool, asset.error());
+  if (!t.sky.empty()) {
+    if (!tools::set_sky(asset->environment, t.sky))
+      return tools::fail(kTool, std::string(tools::kSkyUsage) + ", got '" + t.sky + "'", tools::kExitUsage);
+  }
+  if (!t.sun.empty() && !tools::set_sun(*asset, t.sun))
+    return tools::fail(kTool, std::string(tools::kSunUsage) + ", got '" + t.sun + "'", tools::kExitUsage);
+  if (!t.export_uv1.empty()) {
+    if (auto rc = export_uv1(*asset, t, o)) return *rc;
+    if (t.out_dir.empty() && !t.plan_only) return tools::kExitOk;
+  }
+  const engine::Scene scene = engine::instantiate(std::move(asset).value());
+  const gi::BakeInput input =
+      t.untextured ? gi::without_textures(gi::bake_input_from(scene)) : gi::bake_input_from(scene);
+
+  if (t.plan_only) {
+    std::fputs(gi::format_plan(gi::plan(input, {.preset = o.preset,
+                                                .texels_per_metre = o.texels_per_metre,
+                                                .vpls = o.vpls,
+                                                .samples_per_vpl = o.samples_per_vpl,
+                                                .bounces = o.bounces}))
+                   .c_str(),
+               stdout);
+    return tools::kExitOk;
+  }
+  if (t.out_dir.empty())
+    t.out_dir =
+        (std::filesystem::path("out") / (std::filesystem::path(t.scene_path).stem().string() + ".gibake")).string();
+  return bake(input, t.out_dir, o);
 }

@@ -122,86 +122,145 @@ std::string cost_lines(const std::string& label, const std::string& gi, const gi
   return out;
 }
 
-}  // namespace
-
-// Long for the order it keeps in one place: options, the scene lit in memory, the bakes, then
-// per view one truth compared with every bake, and the outputs.
-int main(int argc, char** argv) {
-  CLI::App app{"A scene's frame with its GI against the path tracer's truth, per world region and over the frame"};
+struct Options {
   std::string scene_path, sky, sun, out_dir, md_path, csv_path, label;
   std::vector<std::string> camera_texts, region_texts, bundle_texts, presets;
   bool untextured = false, no_lights = false;
   float exposure = 0.0f;
   gi::FrameTruthSettings settings;
-  app.add_option("--scene", scene_path, "glTF/GLB scene")->required()->check(CLI::ExistingFile);
-  app.add_flag("--untextured", untextured,
+};
+
+void add_options(CLI::App& app, Options& o) {
+  app.add_option("--scene", o.scene_path, "glTF/GLB scene")->required()->check(CLI::ExistingFile);
+  app.add_flag("--untextured", o.untextured,
                "Drop the materials' textures in memory (the bakers and the path tracer do not read them yet)");
-  app.add_flag("--no-lights", no_lights, "Drop the scene's own lights and emission (before --sun)");
-  app.add_option("--sky", sky, "R,G,B or 'zenith:R,G,B;horizon:R,G,B;ground:R,G,B', as gi-bake --sky");
-  app.add_option("--sun", sun,
+  app.add_flag("--no-lights", o.no_lights, "Drop the scene's own lights and emission (before --sun)");
+  app.add_option("--sky", o.sky, "R,G,B or 'zenith:R,G,B;horizon:R,G,B;ground:R,G,B', as gi-bake --sky");
+  app.add_option("--sun", o.sun,
                  "'direction:dx,dy,dz;irradiance:R,G,B[;angular_radius_deg:D]': a sun replacing the scene's (as "
                  "gi-bake --sun)");
-  app.add_option("--camera", camera_texts,
+  app.add_option("--camera", o.camera_texts,
                  "NAME=px,py,pz,tx,ty,tz[,yfov_deg]: a view from p looking at t (repeatable; default: the scene's "
                  "first camera)");
-  app.add_option("--region", region_texts,
+  app.add_option("--region", o.region_texts,
                  "NAME:minx,miny,minz,maxx,maxy,maxz: a world box (repeatable; the first that holds a pixel's first "
                  "hit wins; the rest is 'other')");
-  app.add_option("--bundle", bundle_texts,
+  app.add_option("--bundle", o.bundle_texts,
                  "[NAME=]DIR: an existing bake bundle of this scene as lit here (repeatable)");
-  app.add_option("--preset", presets, "Bake at this preset and compare (repeatable; default preview without --bundle)");
-  app.add_option("--width", settings.width, "Image width")->check(CLI::Range(8, 4096));
-  app.add_option("--height", settings.height, "Image height")->check(CLI::Range(8, 4096));
-  app.add_option("--spp", settings.samples_per_pixel, "The truth's samples per pixel (two halves)")
+  app.add_option("--preset", o.presets,
+                 "Bake at this preset and compare (repeatable; default preview without --bundle)");
+  app.add_option("--width", o.settings.width, "Image width")->check(CLI::Range(8, 4096));
+  app.add_option("--height", o.settings.height, "Image height")->check(CLI::Range(8, 4096));
+  app.add_option("--spp", o.settings.samples_per_pixel, "The truth's samples per pixel (two halves)")
       ->check(CLI::Range(2, 1 << 20));
-  app.add_option("--seed", settings.seed, "The truth's seed (its halves: seed, seed + 1)");
-  app.add_option("--threads", settings.threads, "Path tracer and bake threads (0: all)");
-  app.add_option("--exposure", exposure, "Exposure of the PNGs (0: per view, from the truth's mean)");
-  app.add_option("--out", out_dir, "Folder for the bundles baked here and each view's images")->required();
-  app.add_option("--label", label, "The run's name in the table and image names (default: the scene's stem)");
-  app.add_option("--md", md_path, "Markdown file to append the table to (header when new)");
-  app.add_option("--csv", csv_path, "CSV file to append the rows to (header when new)");
-  if (auto rc = tools::parse(app, kTool, argc, argv)) return *rc;
+  app.add_option("--seed", o.settings.seed, "The truth's seed (its halves: seed, seed + 1)");
+  app.add_option("--threads", o.settings.threads, "Path tracer and bake threads (0: all)");
+  app.add_option("--exposure", o.exposure, "Exposure of the PNGs (0: per view, from the truth's mean)");
+  app.add_option("--out", o.out_dir, "Folder for the bundles baked here and each view's images")->required();
+  app.add_option("--label", o.label, "The run's name in the table and image names (default: the scene's stem)");
+  app.add_option("--md", o.md_path, "Markdown file to append the table to (header when new)");
+  app.add_option("--csv", o.csv_path, "CSV file to append the rows to (header when new)");
+}
 
-  if (label.empty()) label = fs::path(scene_path).stem().string();
-  std::vector<gi::FrameCamera> cameras;
-  for (const std::string& t : camera_texts) {
+// The views, regions and bundles of the command line (preview baked when none is named); the
+// exit code when one is malformed.
+std::optional<int> parse_views(Options& o, std::vector<gi::FrameCamera>& cameras, std::vector<NamedBundle>& gis) {
+  if (o.label.empty()) o.label = fs::path(o.scene_path).stem().string();
+  for (const std::string& t : o.camera_texts) {
     const auto c = frame_truth_tool::parse_camera(t);
     if (!c) return tools::fail(kTool, "--camera wants NAME=px,py,pz,tx,ty,tz[,yfov_deg], got '" + t + "'", 2);
     cameras.push_back(*c);
   }
-  for (const std::string& t : region_texts) {
+  for (const std::string& t : o.region_texts) {
     const auto r = frame_truth_tool::parse_region(t);
     if (!r) return tools::fail(kTool, "--region wants NAME:minx,miny,minz,maxx,maxy,maxz, got '" + t + "'", 2);
-    settings.regions.push_back(*r);
+    o.settings.regions.push_back(*r);
   }
-  std::vector<NamedBundle> gis;
-  for (const std::string& t : bundle_texts) {
+  for (const std::string& t : o.bundle_texts) {
     const std::size_t eq = t.find('=');
     const std::string dir = eq == std::string::npos ? t : t.substr(eq + 1);
     gis.push_back({eq == std::string::npos ? fs::path(dir).stem().string() : t.substr(0, eq), dir});
   }
-  if (gis.empty() && presets.empty()) presets.push_back("preview");
+  if (gis.empty() && o.presets.empty()) o.presets.push_back("preview");
+  return std::nullopt;
+}
 
-  auto loaded = engine::load_gltf(scene_path);
+// The scene as lit here (textures, lights, sky and sun as the options say), with its first
+// camera when no --camera was given; the exit code on failure.
+std::optional<int> lit_scene(const Options& o, engine::SceneAsset& asset, std::vector<gi::FrameCamera>& cameras) {
+  auto loaded = engine::load_gltf(o.scene_path);
   if (!loaded) return tools::fail(kTool, loaded.error());
-  engine::SceneAsset asset = std::move(loaded).value();
-  if (untextured) asset = gi::without_textures(std::move(asset));
-  if (no_lights) drop_lights(asset);
-  if (!sky.empty() && !tools::set_sky(asset.environment, sky))
-    return tools::fail(kTool, std::string(tools::kSkyUsage) + ", got '" + sky + "'", tools::kExitUsage);
-  if (!sun.empty() && !tools::set_sun(asset, sun))
-    return tools::fail(kTool, std::string(tools::kSunUsage) + ", got '" + sun + "'", tools::kExitUsage);
+  asset = std::move(loaded).value();
+  if (o.untextured) asset = gi::without_textures(std::move(asset));
+  if (o.no_lights) drop_lights(asset);
+  if (!o.sky.empty() && !tools::set_sky(asset.environment, o.sky))
+    return tools::fail(kTool, std::string(tools::kSkyUsage) + ", got '" + o.sky + "'", tools::kExitUsage);
+  if (!o.sun.empty() && !tools::set_sun(asset, o.sun))
+    return tools::fail(kTool, std::string(tools::kSunUsage) + ", got '" + o.sun + "'", tools::kExitUsage);
   if (cameras.empty()) {
     const auto c = scene_camera(asset);
-    if (!c) return tools::fail(kTool, scene_path + " has no camera: give --camera", tools::kExitUsage);
+    if (!c) return tools::fail(kTool, o.scene_path + " has no camera: give --camera", tools::kExitUsage);
     cameras.push_back(*c);
   }
+  return std::nullopt;
+}
+
+// The table's rows of every view and bundle, and their images.
+struct Tables {
+  std::string md, csv;
+};
+
+// Per view one truth, compared with every bundle's frame; the exit code on failure.
+std::optional<int> compare_views(const Options& o, const std::vector<gi::FrameCamera>& cameras,
+                                 const std::vector<NamedBundle>& gis,
+                                 const std::vector<std::unique_ptr<gi::FrameTruthBench>>& benches,
+                                 tools::ConsoleProgress& bar, Tables& tables, std::string& summary) {
+  for (const gi::FrameCamera& camera : cameras) {
+    auto truth = benches.front()->render_truth(camera, bar.stages());
+    bar.finish();
+    if (!truth) return tools::fail(kTool, truth.error());
+    const std::string stem = o.label + "_" + camera.name;
+    if (auto ok = frame_truth_tool::write_truth_images(o.out_dir, stem, *truth, o.exposure); !ok)
+      return tools::fail(kTool, ok.error());
+    for (std::size_t g = 0; g < gis.size(); ++g) {
+      auto report = benches[g]->compare(*truth);
+      if (!report) return tools::fail(kTool, report.error());
+      if (auto ok =
+              frame_truth_tool::write_frame_images(o.out_dir, stem + "_" + gis[g].name, *report, *truth, o.exposure);
+          !ok)
+        return tools::fail(kTool, ok.error());
+      const RunInfo run{.label = o.label,
+                        .gi = gis[g].name,
+                        .width = o.settings.width,
+                        .height = o.settings.height,
+                        .samples_per_pixel = truth->samples_per_pixel};
+      tables.md += frame_truth_tool::markdown_rows(run, *report);
+      tables.csv += frame_truth_tool::csv_rows(run, *report);
+      summary += cost_lines(o.label, gis[g].name, *report, benches[g]->gi_label());
+    }
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+// The order in one place: options, the scene lit in memory, the bakes, then per view one
+// truth compared with every bake, and the outputs.
+int main(int argc, char** argv) {
+  CLI::App app{"A scene's frame with its GI against the path tracer's truth, per world region and over the frame"};
+  Options o;
+  add_options(app, o);
+  if (auto rc = tools::parse(app, kTool, argc, argv)) return *rc;
+  std::vector<gi::FrameCamera> cameras;
+  std::vector<NamedBundle> gis;
+  if (auto rc = parse_views(o, cameras, gis)) return *rc;
+  engine::SceneAsset asset;
+  if (auto rc = lit_scene(o, asset, cameras)) return *rc;
 
   tools::install_interrupt_handler();
   tools::ConsoleProgress bar;
   std::string summary;
-  auto baked = bake_presets(asset, presets, out_dir, label, settings.threads, bar, summary);
+  auto baked = bake_presets(asset, o.presets, o.out_dir, o.label, o.settings.threads, bar, summary);
   if (!baked) return tools::fail(kTool, baked.error());
   gis.insert(gis.end(), baked->begin(), baked->end());
 
@@ -209,38 +268,16 @@ int main(int argc, char** argv) {
   if (!gpu) return tools::fail(kTool, gpu.error());
   std::vector<std::unique_ptr<gi::FrameTruthBench>> benches;
   for (const NamedBundle& g : gis) {
-    auto bench = gi::FrameTruthBench::create(asset, g.dir, settings);
+    auto bench = gi::FrameTruthBench::create(asset, g.dir, o.settings);
     if (!bench) return tools::fail(kTool, bench.error());
     benches.push_back(std::move(bench).value());
   }
-  std::string md, csv;
-  for (const gi::FrameCamera& camera : cameras) {
-    auto truth = benches.front()->render_truth(camera, bar.stages());
-    bar.finish();
-    if (!truth) return tools::fail(kTool, truth.error());
-    const std::string stem = label + "_" + camera.name;
-    if (auto ok = frame_truth_tool::write_truth_images(out_dir, stem, *truth, exposure); !ok)
-      return tools::fail(kTool, ok.error());
-    for (std::size_t g = 0; g < gis.size(); ++g) {
-      auto report = benches[g]->compare(*truth);
-      if (!report) return tools::fail(kTool, report.error());
-      if (auto ok = frame_truth_tool::write_frame_images(out_dir, stem + "_" + gis[g].name, *report, *truth, exposure);
-          !ok)
-        return tools::fail(kTool, ok.error());
-      const RunInfo run{.label = label,
-                        .gi = gis[g].name,
-                        .width = settings.width,
-                        .height = settings.height,
-                        .samples_per_pixel = truth->samples_per_pixel};
-      md += frame_truth_tool::markdown_rows(run, *report);
-      csv += frame_truth_tool::csv_rows(run, *report);
-      summary += cost_lines(label, gis[g].name, *report, benches[g]->gi_label());
-    }
-  }
-  std::fputs((frame_truth_tool::markdown_header() + md + "\n" + summary).c_str(), stdout);
-  if (!md_path.empty() && !append(md_path, frame_truth_tool::markdown_header(), md))
-    return tools::fail(kTool, "cannot write " + md_path, tools::kExitFailure);
-  if (!csv_path.empty() && !append(csv_path, frame_truth_tool::csv_header(), csv))
-    return tools::fail(kTool, "cannot write " + csv_path, tools::kExitFailure);
+  Tables tables;
+  if (auto rc = compare_views(o, cameras, gis, benches, bar, tables, summary)) return *rc;
+  std::fputs((frame_truth_tool::markdown_header() + tables.md + "\n" + summary).c_str(), stdout);
+  if (!o.md_path.empty() && !append(o.md_path, frame_truth_tool::markdown_header(), tables.md))
+    return tools::fail(kTool, "cannot write " + o.md_path, tools::kExitFailure);
+  if (!o.csv_path.empty() && !append(o.csv_path, frame_truth_tool::csv_header(), tables.csv))
+    return tools::fail(kTool, "cannot write " + o.csv_path, tools::kExitFailure);
   return tools::kExitOk;
 }

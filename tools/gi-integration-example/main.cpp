@@ -18,6 +18,9 @@
 #include <filesystem>
 #include <iostream>
 
+// Long because it is docs/integration.md's six numbered steps as one program, read top to
+// bottom beside that page; split into functions, the example would hide the order a game
+// must keep (the GI system before the renderer, reset before the GL context goes).
 int main(int argc, char** argv) {
   if (argc != 4) {
     std::cerr << "usage: gi-integration-example SCENE.gltf BUNDLE.gibake OUT_DIR\n";

@@ -68,135 +68,106 @@ engine::Status save_atomically(const std::filesystem::path& path, Save save) {
   return {};
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  CLI::App app{"Reference path tracer: camera images and light-atlas ground truth"};
+struct Options {
   std::string scene_path, out_path, png_path, atlas_out, camera_name, sky;
   int width = 256, height = 256, spp = 64, bounces = -1;
   unsigned threads = 0;
   std::uint64_t seed = 1;
   float exposure = 1.0f, atlas_density = 0.0f;
-  app.add_option("--scene", scene_path, "glTF scene (.gltf/.glb)")->required();
-  app.add_option("--camera", camera_name, "camera node name (default: the first camera)");
-  app.add_option("--width", width, "image width")->check(CLI::Range(1, 16384));
-  app.add_option("--height", height, "image height")->check(CLI::Range(1, 16384));
-  app.add_option("--spp", spp, "samples per pixel (or per atlas texel)")->check(CLI::Range(1, 1 << 20));
-  app.add_option("--bounces", bounces, "indirect bounces (-1: unlimited, 0: direct only)")->check(CLI::Range(-1, 1000));
-  app.add_option("--threads", threads, "worker threads (0: all); the result does not depend on it");
-  app.add_option("--seed", seed, "random seed");
-  app.add_option("--out", out_path, "linear OpenEXR of the camera image");
-  app.add_option("--png", png_path, "tonemapped PNG of the camera image (the renderer's display transform)");
-  app.add_option("--exposure", exposure, "exposure for --png");
-  app.add_option("--atlas-density", atlas_density, "light-atlas texels per metre (enables the atlas output)");
-  app.add_option("--sky", sky,
-                 "R,G,B (uniform) or 'zenith:R,G,B;horizon:R,G,B;ground:R,G,B' (gradient): a sky replacing the "
-                 "scene's gi.sky (as gi-bake --sky)");
-  app.add_option("--atlas-out", atlas_out, "folder for atlas_direct.exr, atlas_indirect.exr, atlas_total.exr");
-  // Distributed references (docs/distributed-bake.md).
   std::string shard, shard_dir;
   bool merge = false;
-  app.add_option("--shard", shard,
+  std::uint32_t shard_index = 0, shard_count = 0;  // from --shard
+};
+
+void add_options(CLI::App& app, Options& o) {
+  app.add_option("--scene", o.scene_path, "glTF scene (.gltf/.glb)")->required();
+  app.add_option("--camera", o.camera_name, "camera node name (default: the first camera)");
+  app.add_option("--width", o.width, "image width")->check(CLI::Range(1, 16384));
+  app.add_option("--height", o.height, "image height")->check(CLI::Range(1, 16384));
+  app.add_option("--spp", o.spp, "samples per pixel (or per atlas texel)")->check(CLI::Range(1, 1 << 20));
+  app.add_option("--bounces", o.bounces, "indirect bounces (-1: unlimited, 0: direct only)")
+      ->check(CLI::Range(-1, 1000));
+  app.add_option("--threads", o.threads, "worker threads (0: all); the result does not depend on it");
+  app.add_option("--seed", o.seed, "random seed");
+  app.add_option("--out", o.out_path, "linear OpenEXR of the camera image");
+  app.add_option("--png", o.png_path, "tonemapped PNG of the camera image (the renderer's display transform)");
+  app.add_option("--exposure", o.exposure, "exposure for --png");
+  app.add_option("--atlas-density", o.atlas_density, "light-atlas texels per metre (enables the atlas output)");
+  app.add_option("--sky", o.sky,
+                 "R,G,B (uniform) or 'zenith:R,G,B;horizon:R,G,B;ground:R,G,B' (gradient): a sky replacing the "
+                 "scene's gi.sky (as gi-bake --sky)");
+  app.add_option("--atlas-out", o.atlas_out, "folder for atlas_direct.exr, atlas_indirect.exr, atlas_total.exr");
+  // Distributed references (docs/distributed-bake.md).
+  app.add_option("--shard", o.shard,
                  "I/N: compute only shard I (0-based) of N (blocks of 64 pixels / atlas texels) into the shard "
                  "directory; no image or atlas is written");
-  app.add_flag("--merge", merge, "write the outputs from the N shard files in the shard directory");
-  app.add_option("--shard-dir", shard_dir,
+  app.add_flag("--merge", o.merge, "write the outputs from the N shard files in the shard directory");
+  app.add_option("--shard-dir", o.shard_dir,
                  "shard directory (default: <atlas-out>.shards, else <out>.shards, else <png>.shards)");
-  if (auto rc = tools::parse(app, kTool, argc, argv)) return *rc;
-  std::uint32_t shard_index = 0, shard_count = 0;
-  if (!shard.empty()) {
+}
+
+// Checks the options that depend on each other and fills the shard index, count and
+// directory; the exit code when they are wrong.
+std::optional<int> check_options(Options& o) {
+  if (!o.shard.empty()) {
     unsigned index = 0, count = 0;
     char tail = 0;
-    if (merge || std::sscanf(shard.c_str(), "%u/%u%c", &index, &count, &tail) != 2 || count == 0 || index >= count ||
-        count > 65536)
-      return tools::fail(kTool, "--shard takes I/N with 0 <= I < N <= 65536 and no --merge, got '" + shard + "'",
+    if (o.merge || std::sscanf(o.shard.c_str(), "%u/%u%c", &index, &count, &tail) != 2 || count == 0 ||
+        index >= count || count > 65536)
+      return tools::fail(kTool, "--shard takes I/N with 0 <= I < N <= 65536 and no --merge, got '" + o.shard + "'",
                          tools::kExitUsage);
-    shard_index = index;
-    shard_count = count;
+    o.shard_index = index;
+    o.shard_count = count;
   }
-  if (out_path.empty() && png_path.empty() && atlas_out.empty())
+  if (o.out_path.empty() && o.png_path.empty() && o.atlas_out.empty())
     return tools::fail(kTool, "nothing to do: give --out, --png or --atlas-out", tools::kExitUsage);
-  if (!atlas_out.empty() && !(atlas_density > 0.0f))
+  if (!o.atlas_out.empty() && !(o.atlas_density > 0.0f))
     return tools::fail(kTool, "--atlas-out needs --atlas-density > 0", tools::kExitUsage);
-  if (shard_dir.empty()) {
-    std::filesystem::path main_output = !atlas_out.empty() ? atlas_out : !out_path.empty() ? out_path : png_path;
+  if (o.shard_dir.empty()) {
+    std::filesystem::path main_output = !o.atlas_out.empty()  ? o.atlas_out
+                                        : !o.out_path.empty() ? o.out_path
+                                                              : o.png_path;
     if (!main_output.has_filename()) main_output = main_output.parent_path();  // "out/truth/"
-    shard_dir = main_output.string() + ".shards";
+    o.shard_dir = main_output.string() + ".shards";
   }
-  const bool distributed = shard_count > 0 || merge;
+  return std::nullopt;
+}
 
-  auto asset = engine::load_gltf(scene_path);
-  if (!asset) return tools::fail(kTool, asset.error());
-  if (!sky.empty()) {
-    if (!tools::set_sky(asset->environment, sky))
-      return tools::fail(kTool, std::string(tools::kSkyUsage) + ", got '" + sky + "'", tools::kExitUsage);
-  }
-  engine::Scene scene = engine::instantiate(std::move(asset).value());
-  tools::install_interrupt_handler();
-  tools::ConsoleProgress bar;
+// The camera image's job: the named camera, else the first; the exit code when there is none.
+std::optional<int> set_image_job(const Options& o, const engine::Scene& scene, gi::ReferenceJob& job) {
+  const engine::Entity camera =
+      o.camera_name.empty() ? engine::find_camera(scene.registry) : engine::find_by_name(scene.registry, o.camera_name);
+  if (camera.is_null() || !scene.registry.has<engine::Camera>(camera) ||
+      !scene.registry.has<engine::WorldTransform>(camera))
+    return tools::fail(kTool, o.scene_path + ": no camera" + (o.camera_name.empty() ? "" : " named " + o.camera_name),
+                       tools::kExitUsage);
+  const engine::Camera& cam = scene.registry.get<engine::Camera>(camera);
+  job.image =
+      gi::ReferenceImageJob{.camera = {.camera_to_world = scene.registry.get<engine::WorldTransform>(camera).matrix,
+                                       .yfov_rad = cam.yfov_rad,
+                                       .aspect = cam.aspect},
+                            .width = o.width,
+                            .height = o.height};
+  return std::nullopt;
+}
 
-  gi::ReferenceSettings settings;
-  settings.samples_per_pixel = spp;
-  settings.max_bounces = bounces;
-  settings.threads = threads;
-  settings.seed = seed;
-
-  gi::ReferenceJob job;
-  job.settings = settings;
-  if (!out_path.empty() || !png_path.empty()) {
-    const engine::Entity camera =
-        camera_name.empty() ? engine::find_camera(scene.registry) : engine::find_by_name(scene.registry, camera_name);
-    if (camera.is_null() || !scene.registry.has<engine::Camera>(camera) ||
-        !scene.registry.has<engine::WorldTransform>(camera))
-      return tools::fail(kTool, scene_path + ": no camera" + (camera_name.empty() ? "" : " named " + camera_name),
-                         tools::kExitUsage);
-    const engine::Camera& cam = scene.registry.get<engine::Camera>(camera);
-    job.image =
-        gi::ReferenceImageJob{.camera = {.camera_to_world = scene.registry.get<engine::WorldTransform>(camera).matrix,
-                                         .yfov_rad = cam.yfov_rad,
-                                         .aspect = cam.aspect},
-                              .width = width,
-                              .height = height};
-  }
-  if (!atlas_out.empty()) job.atlas = gi::ReferenceAtlasJob{.texels_per_metre = atlas_density};
-  const gi::BakeInput input = gi::bake_input_from(scene);
-
-  // Shard I of N: its blocks into the shard directory, nothing else written.
-  if (shard_count > 0) {
-    const auto start = Clock::now();
-    job.settings.progress = bar.stage("shard");
-    auto path = gi::reference_shard(input, job, shard_index, shard_count, shard_dir);
-    bar.finish();
-    if (!path) return tools::fail(kTool, path.error());
-    std::printf("shard %u/%u at %d spp in %.2f s: %s\n", shard_index, shard_count, spp, seconds_since(start),
-                path->string().c_str());
-    return tools::kExitOk;
-  }
-
-  // Everything is computed (or merged and checked) before any file is written.
-  gi::ReferenceOutputs outputs;
-  if (merge) {
-    job.settings.progress = bar.stage("merge");
-    auto merged = gi::merge_reference_shards(input, job, shard_dir);
-    bar.finish();
-    if (!merged) return tools::fail(kTool, merged.error());
-    outputs = std::move(merged).value();
-    std::printf("merged the shards in %s\n", shard_dir.c_str());
-  }
-  if (job.image && !distributed) {
-    gi::ReferenceJob part{.image = job.image, .atlas = {}, .settings = settings};
+// Renders the camera image and the atlas truth the job asks for in this process (not sharded).
+std::optional<int> render_locally(const Options& o, const gi::BakeInput& input, const gi::ReferenceJob& job,
+                                  tools::ConsoleProgress& bar, gi::ReferenceOutputs& outputs) {
+  if (job.image) {
+    gi::ReferenceJob part{.image = job.image, .atlas = {}, .settings = job.settings};
     part.settings.progress = bar.stage("render");
     const auto start = Clock::now();
     auto image = gi::render_reference_job(input, part);
     bar.finish();
     if (!image) return tools::fail(kTool, image.error());
     const double secs = seconds_since(start);
-    std::printf("rendered %dx%d at %d spp in %.2f s (%.3f Mpaths/s)\n", width, height, spp, secs,
-                static_cast<double>(width) * height * spp / secs * 1e-6);
+    std::printf("rendered %dx%d at %d spp in %.2f s (%.3f Mpaths/s)\n", o.width, o.height, o.spp, secs,
+                static_cast<double>(o.width) * o.height * o.spp / secs * 1e-6);
     outputs.image = std::move(image->image);
   }
-  if (job.atlas && !distributed) {
-    gi::ReferenceJob part{.image = {}, .atlas = job.atlas, .settings = settings};
+  if (job.atlas) {
+    gi::ReferenceJob part{.image = {}, .atlas = job.atlas, .settings = job.settings};
     part.settings.progress = bar.stage("atlas");
     const auto start = Clock::now();
     auto truth = gi::render_reference_job(input, part);
@@ -205,41 +176,106 @@ int main(int argc, char** argv) {
     std::size_t valid = 0;
     for (std::uint8_t v : truth->atlas->valid) valid += v;
     std::printf("atlas %dx%d at %.1f texels/m (%zu valid texels) at %d spp in %.2f s\n", truth->atlas->width,
-                truth->atlas->height, static_cast<double>(truth->atlas->texels_per_metre), valid, spp,
+                truth->atlas->height, static_cast<double>(truth->atlas->texels_per_metre), valid, o.spp,
                 seconds_since(start));
     outputs.atlas = std::move(truth->atlas);
   }
+  return std::nullopt;
+}
 
+// Writes the outputs computed: the EXR and PNG of the image, the three atlas EXRs.
+std::optional<int> write_outputs(const Options& o, const gi::ReferenceOutputs& outputs) {
   if (outputs.image) {
     const engine::ImageRgbaF& image = *outputs.image;
-    if (!out_path.empty())
-      if (auto ok = save_atomically(out_path, [&](const auto& p) { return engine::save_exr(p, image); }); !ok)
+    if (!o.out_path.empty())
+      if (auto ok = save_atomically(o.out_path, [&](const auto& p) { return engine::save_exr(p, image); }); !ok)
         return tools::fail(kTool, ok.error());
-    if (!png_path.empty()) {
+    if (!o.png_path.empty()) {
       engine::ImageRgba8 ldr{image.width, image.height, std::vector<std::uint8_t>(image.pixels.size())};
       for (std::size_t i = 0; i < image.pixels.size(); ++i)
         ldr.pixels[i] = i % 4 == 3
                             ? 255
                             : static_cast<std::uint8_t>(std::lround(
-                                  255.0 * engine::display_tonemap(static_cast<double>(image.pixels[i]), exposure)));
-      if (auto ok = save_atomically(png_path, [&](const auto& p) { return engine::save_png(p, ldr); }); !ok)
+                                  255.0 * engine::display_tonemap(static_cast<double>(image.pixels[i]), o.exposure)));
+      if (auto ok = save_atomically(o.png_path, [&](const auto& p) { return engine::save_png(p, ldr); }); !ok)
         return tools::fail(kTool, ok.error());
     }
   }
   if (outputs.atlas) {
     const gi::AtlasReference& truth = *outputs.atlas;
     std::error_code ec;
-    std::filesystem::create_directories(atlas_out, ec);
-    if (ec) return tools::fail(kTool, atlas_out + ": cannot create folder: " + ec.message(), tools::kExitFailure);
+    std::filesystem::create_directories(o.atlas_out, ec);
+    if (ec) return tools::fail(kTool, o.atlas_out + ": cannot create folder: " + ec.message(), tools::kExitFailure);
     const std::pair<const char*, const std::vector<glm::vec3>*> files[] = {{"atlas_direct.exr", &truth.direct},
                                                                            {"atlas_indirect.exr", &truth.indirect},
                                                                            {"atlas_total.exr", &truth.total}};
     for (const auto& [name, values] : files) {
-      const auto path = std::filesystem::path(atlas_out) / name;
+      const auto path = std::filesystem::path(o.atlas_out) / name;
       const engine::ImageRgbaF img = rgb_image(truth.width, truth.height, *values, truth.valid);
       if (auto ok = save_atomically(path, [&](const auto& p) { return engine::save_exr(p, img); }); !ok)
         return tools::fail(kTool, ok.error());
     }
   }
+  return std::nullopt;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Reference path tracer: camera images and light-atlas ground truth"};
+  Options o;
+  add_options(app, o);
+  if (auto rc = tools::parse(app, kTool, argc, argv)) return *rc;
+  if (auto rc = check_options(o)) return *rc;
+  const bool distributed = o.shard_count > 0 || o.merge;
+
+  auto asset = engine::load_gltf(o.scene_path);
+  if (!asset) return tools::fail(kTool, asset.error());
+  if (!o.sky.empty()) {
+    if (!tools::set_sky(asset->environment, o.sky))
+      return tools::fail(kTool, std::string(tools::kSkyUsage) + ", got '" + o.sky + "'", tools::kExitUsage);
+  }
+  engine::Scene scene = engine::instantiate(std::move(asset).value());
+  tools::install_interrupt_handler();
+  tools::ConsoleProgress bar;
+
+  gi::ReferenceSettings settings;
+  settings.samples_per_pixel = o.spp;
+  settings.max_bounces = o.bounces;
+  settings.threads = o.threads;
+  settings.seed = o.seed;
+
+  gi::ReferenceJob job;
+  job.settings = settings;
+  if (!o.out_path.empty() || !o.png_path.empty())
+    if (auto rc = set_image_job(o, scene, job)) return *rc;
+  if (!o.atlas_out.empty()) job.atlas = gi::ReferenceAtlasJob{.texels_per_metre = o.atlas_density};
+  const gi::BakeInput input = gi::bake_input_from(scene);
+
+  // Shard I of N: its blocks into the shard directory, nothing else written.
+  if (o.shard_count > 0) {
+    const auto start = Clock::now();
+    job.settings.progress = bar.stage("shard");
+    auto path = gi::reference_shard(input, job, o.shard_index, o.shard_count, o.shard_dir);
+    bar.finish();
+    if (!path) return tools::fail(kTool, path.error());
+    std::printf("shard %u/%u at %d spp in %.2f s: %s\n", o.shard_index, o.shard_count, o.spp, seconds_since(start),
+                path->string().c_str());
+    return tools::kExitOk;
+  }
+
+  // Everything is computed (or merged and checked) before any file is written.
+  gi::ReferenceOutputs outputs;
+  if (o.merge) {
+    job.settings.progress = bar.stage("merge");
+    auto merged = gi::merge_reference_shards(input, job, o.shard_dir);
+    bar.finish();
+    if (!merged) return tools::fail(kTool, merged.error());
+    outputs = std::move(merged).value();
+    std::printf("merged the shards in %s\n", o.shard_dir.c_str());
+  }
+  if (!distributed)
+    if (auto rc = render_locally(o, input, job, bar, outputs)) return *rc;
+  if (auto rc = write_outputs(o, outputs)) return *rc;
   return tools::kExitOk;
 }

@@ -24,6 +24,28 @@
 
 namespace scenegen {
 
+namespace {
+
+// The L-shaped corridor: leg 1 leaves the door along +x, leg 2 turns the corner along -z.
+void add_l_corridor(SceneBuilder& b, int floor_mat, int wall, const Opening& door_opening) {
+  using namespace corridor_layout;
+  MeshBuilder corridor_walls, corridor_floor;
+  corridor_floor.horizontal(floor_mat, 0.0f, kAnnexX, 9.2f, 4.2f, 5.6f, 1.0f);
+  corridor_floor.horizontal(floor_mat, 0.0f, 7.8f, 9.2f, -3.0f, 4.2f, 1.0f);
+  corridor_walls.horizontal(wall, kHeight, kAnnexX, 9.2f, 4.2f, 5.6f, -1.0f);
+  corridor_walls.horizontal(wall, kHeight, 7.8f, 9.2f, -3.0f, 4.2f, -1.0f);
+  corridor_walls.wall_x(wall, kAnnexX, 4.2f, 5.6f, 0.0f, kHeight, 1.0f, {door_opening});
+  corridor_walls.wall_z(wall, 5.6f, kAnnexX, 9.2f, 0.0f, kHeight, -1.0f);
+  corridor_walls.wall_x(wall, 9.2f, -3.0f, 5.6f, 0.0f, kHeight, -1.0f);
+  corridor_walls.wall_z(wall, -3.0f, 7.8f, 9.2f, 0.0f, kHeight, 1.0f);
+  corridor_walls.wall_x(wall, 7.8f, -3.0f, 4.2f, 0.0f, kHeight, 1.0f);
+  corridor_walls.wall_z(wall, 4.2f, kAnnexX, 7.8f, 0.0f, kHeight, 1.0f);
+  b.add_mesh_node("corridor_walls", corridor_walls, engine::Mobility::Static);
+  b.add_mesh_node("corridor_floor", corridor_floor, engine::Mobility::Static);
+}
+
+}  // namespace
+
 engine::SceneAsset corridor() {
   using namespace corridor_layout;
   SceneBuilder b;
@@ -52,20 +74,7 @@ engine::SceneAsset corridor() {
   b.add_mesh_node("alcove", alcove, engine::Mobility::Static);
   b.add_mesh_node("alcove_floor", alcove_floor, engine::Mobility::Static);
 
-  // The L-shaped corridor: leg 1 leaves the door along +x, leg 2 turns the corner along -z.
-  MeshBuilder corridor_walls, corridor_floor;
-  corridor_floor.horizontal(floor_mat, 0.0f, kAnnexX, 9.2f, 4.2f, 5.6f, 1.0f);
-  corridor_floor.horizontal(floor_mat, 0.0f, 7.8f, 9.2f, -3.0f, 4.2f, 1.0f);
-  corridor_walls.horizontal(wall, kHeight, kAnnexX, 9.2f, 4.2f, 5.6f, -1.0f);
-  corridor_walls.horizontal(wall, kHeight, 7.8f, 9.2f, -3.0f, 4.2f, -1.0f);
-  corridor_walls.wall_x(wall, kAnnexX, 4.2f, 5.6f, 0.0f, kHeight, 1.0f, {door_opening});
-  corridor_walls.wall_z(wall, 5.6f, kAnnexX, 9.2f, 0.0f, kHeight, -1.0f);
-  corridor_walls.wall_x(wall, 9.2f, -3.0f, 5.6f, 0.0f, kHeight, -1.0f);
-  corridor_walls.wall_z(wall, -3.0f, 7.8f, 9.2f, 0.0f, kHeight, 1.0f);
-  corridor_walls.wall_x(wall, 7.8f, -3.0f, 4.2f, 0.0f, kHeight, 1.0f);
-  corridor_walls.wall_z(wall, 4.2f, kAnnexX, 7.8f, 0.0f, kHeight, 1.0f);
-  b.add_mesh_node("corridor_walls", corridor_walls, engine::Mobility::Static);
-  b.add_mesh_node("corridor_floor", corridor_floor, engine::Mobility::Static);
+  add_l_corridor(b, floor_mat, wall, door_opening);
 
   // The door, left ajar: hinged at the room side of the doorway (x = 6, z = 5.4), swung
   // 50 degrees into the room. The node's origin is the hinge and its local +y the hinge

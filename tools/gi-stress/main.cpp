@@ -42,54 +42,41 @@ struct Mover {
   float radius, speed, phase;
 };
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  CLI::App app{"Stress run: many moving crates and lights through GISystem and the renderer, headless"};
+struct Options {
   std::string scene_path = "assets/demo_level.gltf", bundle;
   int crates = 200, lights = 16, frames = 1000, width = 320, height = 180, warmup = 50;
   double max_growth_mb = 64.0;
-  app.add_option("--scene", scene_path, "glTF scene (default assets/demo_level.gltf)");
-  app.add_option("--bundle", bundle, "Its bake bundle (baked at the preview preset when missing)")->required();
-  app.add_option("--crates", crates, "Extra dynamic crates (copies of the scene's first dynamic mesh)")
-      ->check(CLI::Range(0, 4096));
-  app.add_option("--lights", lights, "Extra moving point lights")->check(CLI::Range(0, 256));
-  app.add_option("--frames", frames, "Frames to run")->check(CLI::Range(1, 1000000));
-  app.add_option("--warmup", warmup, "Frames before the memory baseline")->check(CLI::Range(1, 1000000));
-  app.add_option("--width", width)->check(CLI::Range(16, 4096));
-  app.add_option("--height", height)->check(CLI::Range(16, 4096));
-  app.add_option("--max-growth-mb", max_growth_mb, "Largest resident growth after warm-up that passes (MB)");
-  CLI11_PARSE(app, argc, argv);
+};
 
-  auto asset = engine::load_gltf(scene_path);
-  if (!asset) {
-    std::cerr << "gi-stress: " << asset.error().to_string() << '\n';
-    return 1;
-  }
-  // The crates: copies of the first dynamic mesh node, on a grid over the static world's
-  // floor area; the lights: point lights 2.5 m up, each circling its own centre.
+// The lo and hi corners of the grid the crates and lights stand on: the demo level's rooms and corridor.
+constexpr glm::vec3 kGridLo{1.0f, 0.0f, 1.0f}, kGridHi{14.0f, 0.0f, 19.0f};
+
+// The crates: copies of the first dynamic mesh node, on a grid over the static world's
+// floor area; the lights: point lights 2.5 m up, each circling its own centre. False (after
+// saying why) when the scene has no dynamic mesh to copy.
+bool add_crates_and_lights(const Options& o, engine::SceneAsset& asset) {
   int crate_mesh = -1;
-  for (const engine::Node& n : asset->nodes)
+  for (const engine::Node& n : asset.nodes)
     if (n.mesh >= 0 && n.gi.mobility == engine::Mobility::Dynamic) {
       crate_mesh = n.mesh;
       break;
     }
-  if (crate_mesh < 0 && crates > 0) {
-    std::cerr << "gi-stress: " << scene_path << " has no dynamic mesh to copy\n";
-    return 1;
+  if (crate_mesh < 0 && o.crates > 0) {
+    std::cerr << "gi-stress: " << o.scene_path << " has no dynamic mesh to copy\n";
+    return false;
   }
-  const int side = std::max(1, static_cast<int>(std::ceil(std::sqrt(static_cast<double>(std::max(crates, 1))))));
-  const glm::vec3 lo{1.0f, 0.0f, 1.0f}, hi{14.0f, 0.0f, 19.0f};  // the demo level's rooms and corridor
-  for (int i = 0; i < crates; ++i) {
+  const int side = std::max(1, static_cast<int>(std::ceil(std::sqrt(static_cast<double>(std::max(o.crates, 1))))));
+  const glm::vec3 lo = kGridLo, hi = kGridHi;
+  for (int i = 0; i < o.crates; ++i) {
     engine::Node n;
     n.name = "stress_crate_" + std::to_string(i);
     n.mesh = crate_mesh;
     n.translation = lo + (hi - lo) * glm::vec3(static_cast<float>(i % side) / static_cast<float>(side), 0.0f,
                                                static_cast<float>(i / side) / static_cast<float>(side));
     n.gi.mobility = engine::Mobility::Dynamic;
-    asset->nodes.push_back(n);
+    asset.nodes.push_back(n);
   }
-  for (int i = 0; i < lights; ++i) {
+  for (int i = 0; i < o.lights; ++i) {
     engine::NamedLight l;
     l.name = "stress_light_" + std::to_string(i);
     l.light.type = engine::LightType::Point;
@@ -97,17 +84,111 @@ int main(int argc, char** argv) {
     l.light.color = glm::vec3(1.0f, 0.9f, 0.8f);
     l.light.moves = true;
     l.light.range_m = 6.0f;
-    asset->lights.push_back(l);
+    asset.lights.push_back(l);
     engine::Node n;
     n.name = l.name;
-    n.light = static_cast<int>(asset->lights.size()) - 1;
+    n.light = static_cast<int>(asset.lights.size()) - 1;
     n.translation = lo +
                     (hi - lo) * glm::vec3((static_cast<float>(i % 4) + 0.5f) / 4.0f, 0.0f,
                                           (static_cast<float>(i / 4) + 0.5f) / 4.0f) +
                     glm::vec3(0.0f, 2.5f, 0.0f);
     n.gi.mobility = engine::Mobility::Dynamic;
-    asset->nodes.push_back(n);
+    asset.nodes.push_back(n);
   }
+  return true;
+}
+
+std::vector<Mover> movers_of(const Options& o, const engine::Scene& scene) {
+  std::vector<Mover> movers;
+  for (int i = 0; i < o.crates; ++i) {
+    const engine::Entity e = engine::find_by_name(scene.registry, "stress_crate_" + std::to_string(i));
+    movers.push_back(
+        {e, scene.registry.get<engine::Transform>(e).position, 0.15f, 0.9f, 0.37f * static_cast<float>(i)});
+  }
+  for (int i = 0; i < o.lights; ++i) {
+    const engine::Entity e = engine::find_by_name(scene.registry, "stress_light_" + std::to_string(i));
+    movers.push_back({e, scene.registry.get<engine::Transform>(e).position, 1.5f, 0.5f, 1.1f * static_cast<float>(i)});
+  }
+  return movers;
+}
+
+// What the frames measured.
+struct Totals {
+  std::size_t non_finite = 0;
+  double baseline = 0.0, peak_growth = 0.0, total_ms = 0.0;
+};
+
+// Moves every mover along its circle, renders and reads back each frame, and follows the resident memory.
+Totals run_frames(const Options& o, engine::Scene& scene, engine::Renderer& renderer) {
+  const std::vector<Mover> movers = movers_of(o, scene);
+  const engine::Entity camera = engine::find_camera(scene.registry);
+  Totals r;
+  for (int f = 0; f < o.frames; ++f) {
+    const float t = static_cast<float>(f) / 30.0f;
+    for (const Mover& m : movers) {
+      const float a = m.speed * t + m.phase;
+      scene.registry.write<engine::Transform>(m.entity).position =
+          m.centre + glm::vec3(m.radius * std::cos(a), 0.0f, m.radius * std::sin(a));
+    }
+    engine::update_world_transforms(scene.registry);
+    const auto t0 = std::chrono::steady_clock::now();
+    renderer.render(scene.registry, camera);
+    r.total_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    for (float v : renderer.read_hdr().pixels) r.non_finite += !std::isfinite(v);
+    if (f + 1 == o.warmup) r.baseline = rss_mb();
+    if (f + 1 > o.warmup) r.peak_growth = std::max(r.peak_growth, rss_mb() - r.baseline);
+    if ((f + 1) % std::max(1, o.frames / 10) == 0)
+      std::printf("gi-stress: frame %d, resident %.1f MB\n", f + 1, rss_mb());
+  }
+  return r;
+}
+
+// Bakes the bundle at the preview preset when it does not exist; false after saying why not.
+bool bake_if_missing(const Options& o, const engine::Scene& scene, const gi::LogCallback& log) {
+  if (std::filesystem::exists(o.bundle)) return true;
+  auto report = gi::bake_bundle(gi::bake_input_from(scene), o.bundle, {.preset = "preview"}, {.log = log});
+  if (!report) {
+    std::cerr << "gi-stress: " << report.error().to_string() << '\n';
+    return false;
+  }
+  return true;
+}
+
+// Prints the memory, the frames' checks and times and what the GI turned off.
+void print_totals(const Options& o, const Totals& r, const gi::GISystem::Stats& st) {
+  const double end = rss_mb();
+  std::printf("gi-stress: resident %.1f MB after %d warm-up frames, %.1f MB at the end, largest growth %.1f MB\n",
+              r.baseline, o.warmup, end, r.peak_growth);
+  std::printf(
+      "gi-stress: %zu non-finite HDR values over %d frames; %.1f ms a frame; %llu BRF updates, %llu PRM updates\n",
+      r.non_finite, o.frames, r.total_ms / o.frames, static_cast<unsigned long long>(st.brf_updates),
+      static_cast<unsigned long long>(st.prm_updates));
+  for (const std::string& off : st.disabled) std::printf("gi-stress: turned off: %s\n", off.c_str());
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Stress run: many moving crates and lights through GISystem and the renderer, headless"};
+  Options o;
+  app.add_option("--scene", o.scene_path, "glTF scene (default assets/demo_level.gltf)");
+  app.add_option("--bundle", o.bundle, "Its bake bundle (baked at the preview preset when missing)")->required();
+  app.add_option("--crates", o.crates, "Extra dynamic crates (copies of the scene's first dynamic mesh)")
+      ->check(CLI::Range(0, 4096));
+  app.add_option("--lights", o.lights, "Extra moving point lights")->check(CLI::Range(0, 256));
+  app.add_option("--frames", o.frames, "Frames to run")->check(CLI::Range(1, 1000000));
+  app.add_option("--warmup", o.warmup, "Frames before the memory baseline")->check(CLI::Range(1, 1000000));
+  app.add_option("--width", o.width)->check(CLI::Range(16, 4096));
+  app.add_option("--height", o.height)->check(CLI::Range(16, 4096));
+  app.add_option("--max-growth-mb", o.max_growth_mb, "Largest resident growth after warm-up that passes (MB)");
+  CLI11_PARSE(app, argc, argv);
+
+  auto asset = engine::load_gltf(o.scene_path);
+  if (!asset) {
+    std::cerr << "gi-stress: " << asset.error().to_string() << '\n';
+    return 1;
+  }
+  if (!add_crates_and_lights(o, *asset)) return 1;
   engine::Scene scene = engine::instantiate(std::move(asset).value());
 
   auto gpu = engine::GpuContext::create_headless();
@@ -118,21 +199,15 @@ int main(int argc, char** argv) {
   const auto log = [](gi::LogLevel level, std::string_view line) {
     std::cerr << "gi-stress: " << gi::log_level_name(level) << ": " << line << '\n';
   };
-  if (!std::filesystem::exists(bundle)) {
-    auto report = gi::bake_bundle(gi::bake_input_from(scene), bundle, {.preset = "preview"}, {.log = log});
-    if (!report) {
-      std::cerr << "gi-stress: " << report.error().to_string() << '\n';
-      return 1;
-    }
-  }
-  auto gi = gi::GISystem::load(bundle, scene, {.log = log});
+  if (!bake_if_missing(o, scene, log)) return 1;
+  auto gi = gi::GISystem::load(o.bundle, scene, {.log = log});
   if (!gi) {
     std::cerr << "gi-stress: " << gi.error().to_string() << '\n';
     return 1;
   }
   auto renderer = engine::Renderer::create(
       scene.assets,
-      engine::RenderSettings{.width = width, .height = height, .exposure = 0.3f, .warn = [](const std::string& s) {
+      engine::RenderSettings{.width = o.width, .height = o.height, .exposure = 0.3f, .warn = [](const std::string& s) {
                                std::cerr << "gi-stress: " << s << '\n';
                              }});
   if (!renderer) {
@@ -140,50 +215,13 @@ int main(int argc, char** argv) {
     return 1;
   }
   (*renderer)->set_indirect_light(gi->get());
-  std::printf("gi-stress: %s, +%d crates, +%d moving lights, %d frames at %dx%d\n%s\n%s", scene_path.c_str(), crates,
-              lights, frames, width, height, (*gi)->label(), (*gi)->describe().c_str());
+  std::printf("gi-stress: %s, +%d crates, +%d moving lights, %d frames at %dx%d\n%s\n%s", o.scene_path.c_str(),
+              o.crates, o.lights, o.frames, o.width, o.height, (*gi)->label(), (*gi)->describe().c_str());
 
-  std::vector<Mover> movers;
-  for (int i = 0; i < crates; ++i) {
-    const engine::Entity e = engine::find_by_name(scene.registry, "stress_crate_" + std::to_string(i));
-    movers.push_back(
-        {e, scene.registry.get<engine::Transform>(e).position, 0.15f, 0.9f, 0.37f * static_cast<float>(i)});
-  }
-  for (int i = 0; i < lights; ++i) {
-    const engine::Entity e = engine::find_by_name(scene.registry, "stress_light_" + std::to_string(i));
-    movers.push_back({e, scene.registry.get<engine::Transform>(e).position, 1.5f, 0.5f, 1.1f * static_cast<float>(i)});
-  }
-  const engine::Entity camera = engine::find_camera(scene.registry);
-  std::size_t non_finite = 0;
-  double baseline = 0.0, peak_growth = 0.0, total_ms = 0.0;
-  for (int f = 0; f < frames; ++f) {
-    const float t = static_cast<float>(f) / 30.0f;
-    for (const Mover& m : movers) {
-      const float a = m.speed * t + m.phase;
-      scene.registry.write<engine::Transform>(m.entity).position =
-          m.centre + glm::vec3(m.radius * std::cos(a), 0.0f, m.radius * std::sin(a));
-    }
-    engine::update_world_transforms(scene.registry);
-    const auto t0 = std::chrono::steady_clock::now();
-    (*renderer)->render(scene.registry, camera);
-    total_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-    for (float v : (*renderer)->read_hdr().pixels) non_finite += !std::isfinite(v);
-    if (f + 1 == warmup) baseline = rss_mb();
-    if (f + 1 > warmup) peak_growth = std::max(peak_growth, rss_mb() - baseline);
-    if ((f + 1) % std::max(1, frames / 10) == 0)
-      std::printf("gi-stress: frame %d, resident %.1f MB\n", f + 1, rss_mb());
-  }
-  const double end = rss_mb();
-  const gi::GISystem::Stats& st = (*gi)->stats();
-  std::printf("gi-stress: resident %.1f MB after %d warm-up frames, %.1f MB at the end, largest growth %.1f MB\n",
-              baseline, warmup, end, peak_growth);
-  std::printf(
-      "gi-stress: %zu non-finite HDR values over %d frames; %.1f ms a frame; %llu BRF updates, %llu PRM updates\n",
-      non_finite, frames, total_ms / frames, static_cast<unsigned long long>(st.brf_updates),
-      static_cast<unsigned long long>(st.prm_updates));
-  for (const std::string& off : st.disabled) std::printf("gi-stress: turned off: %s\n", off.c_str());
+  const Totals r = run_frames(o, scene, **renderer);
+  print_totals(o, r, (*gi)->stats());
   gi->reset();
-  const bool ok = non_finite == 0 && (frames <= warmup || peak_growth <= max_growth_mb);
+  const bool ok = r.non_finite == 0 && (o.frames <= o.warmup || r.peak_growth <= o.max_growth_mb);
   std::printf("gi-stress: %s\n", ok ? "PASS" : "FAIL");
   return ok ? 0 : 1;
 }

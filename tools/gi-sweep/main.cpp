@@ -33,6 +33,41 @@ void print_list() {
   std::printf("\n");
 }
 
+// Runs the sweep with a progress bar and reports the files, the failures and the plots.
+int run_and_report(const gi::SweepRequest& request, bool no_plot) {
+  tools::install_interrupt_handler();
+  tools::ConsoleProgress bar;
+  const gi::SweepHost host{
+      .progress =
+          [&](const gi::SweepStatus& s) {
+            char detail[64];
+            std::snprintf(detail, sizeof detail, "%zu/%zu", s.units_done, s.units_total);
+            return bar.update("sweep", s.fraction(), std::string(detail) + "  " + s.current);
+          },
+      .log =
+          [&](gi::LogLevel level, std::string_view line) {
+            bar.finish();
+            std::fprintf(stderr, "%s: %s%.*s\n", kTool,
+                         level == gi::LogLevel::Info ? "" : "warning: ", static_cast<int>(line.size()), line.data());
+          }};
+  auto report = gi::run_sweep(request, host);
+  bar.finish();
+  if (!report) return tools::fail(kTool, report.error());
+  for (const std::string& f : report->failures) std::fprintf(stderr, "%s: run %s\n", kTool, f.c_str());
+  std::fprintf(stderr, "%s: wrote %s and %s (%zu run(s), %zu failed; references: %zu computed, %zu from cache)\n",
+               kTool, report->csv.c_str(), report->markdown.c_str(), report->runs, report->failures.size(),
+               report->references_computed, report->references_from_cache);
+  std::fprintf(stderr, "%s\n",
+               (no_plot ? "plots: skipped; to plot, run:\n  " + gi_sweep::plot_command(report->csv, request.frame_cost)
+                        : gi_sweep::plot_sweep_csv(report->csv, request.frame_cost))
+                   .c_str());
+  if (report->cancelled) {
+    std::fprintf(stderr, "%s: interrupted; the files hold the runs completed so far\n", kTool);
+    return tools::kExitCancelled;
+  }
+  return tools::kExitOk;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -70,35 +105,5 @@ int main(int argc, char** argv) {
   if (!presets.empty())
     for (int i = 0; i < 3; ++i) request.preset_targets[i] = presets[static_cast<std::size_t>(i)];
 
-  tools::install_interrupt_handler();
-  tools::ConsoleProgress bar;
-  const gi::SweepHost host{
-      .progress =
-          [&](const gi::SweepStatus& s) {
-            char detail[64];
-            std::snprintf(detail, sizeof detail, "%zu/%zu", s.units_done, s.units_total);
-            return bar.update("sweep", s.fraction(), std::string(detail) + "  " + s.current);
-          },
-      .log =
-          [&](gi::LogLevel level, std::string_view line) {
-            bar.finish();
-            std::fprintf(stderr, "%s: %s%.*s\n", kTool,
-                         level == gi::LogLevel::Info ? "" : "warning: ", static_cast<int>(line.size()), line.data());
-          }};
-  auto report = gi::run_sweep(request, host);
-  bar.finish();
-  if (!report) return tools::fail(kTool, report.error());
-  for (const std::string& f : report->failures) std::fprintf(stderr, "%s: run %s\n", kTool, f.c_str());
-  std::fprintf(stderr, "%s: wrote %s and %s (%zu run(s), %zu failed; references: %zu computed, %zu from cache)\n",
-               kTool, report->csv.c_str(), report->markdown.c_str(), report->runs, report->failures.size(),
-               report->references_computed, report->references_from_cache);
-  std::fprintf(stderr, "%s\n",
-               (no_plot ? "plots: skipped; to plot, run:\n  " + gi_sweep::plot_command(report->csv, request.frame_cost)
-                        : gi_sweep::plot_sweep_csv(report->csv, request.frame_cost))
-                   .c_str());
-  if (report->cancelled) {
-    std::fprintf(stderr, "%s: interrupted; the files hold the runs completed so far\n", kTool);
-    return tools::kExitCancelled;
-  }
-  return tools::kExitOk;
+  return run_and_report(request, no_plot);
 }

@@ -57,6 +57,15 @@ class ScriptedPilot {
   /// Marks the grid's cells where the (fattened) player box meets no wall and no crate, at
   /// the crates' current places.
   void mark_walkable(const Simulation& sim);
+  /// The walkability grid over the level bounds at eye height, its cells coarsened until the
+  /// walkability test stays cheap.
+  void build_grid(const Simulation& sim, const glm::vec3& eye);
+  /// The centres of large static meshes at eye height (rooms), else of the static lights,
+  /// each reachable and 2 m or more from the others.
+  std::vector<glm::vec3> room_points(const Simulation& sim, const glm::vec3& eye) const;
+  /// The script's waypoints among the rooms and crates, and its key presses.
+  void plan_script(const engine::Registry& reg, const glm::vec3& eye, const std::vector<glm::vec3>& rooms,
+                   const std::vector<glm::vec3>& crates);
   bool walkable(int x, int z) const;
   std::optional<Cell> nearest_walkable(const glm::vec3& p) const;
   glm::vec3 cell_center(Cell c) const;

@@ -174,17 +174,12 @@ engine::Error build_error(std::string message) {
   return engine::Error{"", "antiradiance elements", std::move(message)};
 }
 
-}  // namespace
-
-engine::Result<ElementHierarchy> build_element_hierarchy(const BakeInput& input, const AntiradianceSettings& settings) {
-  if (engine::Status st = validate_bake_input(input); !st) return st.error();
-  if (!(settings.patch_size_m > 0.0f) || !std::isfinite(settings.patch_size_m))
-    return build_error("patch_size_m must be positive");
-  if (!(settings.exchange_radius_m >= 0.0f)) return build_error("exchange_radius_m must not be negative");
-
-  ElementHierarchy h;
-  // The deforming region's swept bounds.
-  glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+// The deforming instances into h (their indices and transforms), with the bounds they sweep
+// about their origins widened by the exchange radius.
+void find_deforming(const BakeInput& input, const AntiradianceSettings& settings, ElementHierarchy& h, glm::vec3& lo,
+                    glm::vec3& hi) {
+  lo = glm::vec3(std::numeric_limits<float>::max());
+  hi = glm::vec3(-std::numeric_limits<float>::max());
   for (std::size_t i = 0; i < input.instances.size(); ++i) {
     const BakeInstance& inst = input.instances[i];
     if (!inst.deforming) continue;
@@ -199,14 +194,17 @@ engine::Result<ElementHierarchy> build_element_hierarchy(const BakeInput& input,
     lo = glm::min(lo, origin - glm::vec3(reach));
     hi = glm::max(hi, origin + glm::vec3(reach));
   }
-  if (h.deforming_instances.empty()) return build_error("no instance is flagged deforming");
   lo -= glm::vec3(settings.exchange_radius_m);
   hi += glm::vec3(settings.exchange_radius_m);
+}
 
-  const int groups = 1 + static_cast<int>(h.deforming_instances.size());
+// The source triangles per group (0: the static ones within lo..hi; g >= 1: deforming
+// instance g - 1's, with their object-space corners). Textured materials: each source
+// triangle folds in its texture's mean (material_lookup.h).
+std::vector<std::vector<SourceTriangle>> source_triangles(const BakeInput& input, int groups, const glm::vec3& lo,
+                                                          const glm::vec3& hi) {
   std::vector<std::vector<SourceTriangle>> by_group(static_cast<std::size_t>(groups));
   std::int32_t deforming_index = 0;
-  // Textured materials: each source triangle folds in its texture's mean (material_lookup.h).
   const bool any_textured =
       std::any_of(input.materials.begin(), input.materials.end(), [](const BakeMaterial& m) { return m.textured(); });
   const ReferenceScene looks = any_textured ? material_scene_from(input) : ReferenceScene{};
@@ -247,13 +245,14 @@ engine::Result<ElementHierarchy> build_element_hierarchy(const BakeInput& input,
       }
     }
   }
-  for (int g = 1; g < groups; ++g)
-    if (by_group[static_cast<std::size_t>(g)].empty())
-      return build_error("deforming instance '" +
-                         input.instances[h.deforming_instances[static_cast<std::size_t>(g - 1)]].name +
-                         "' has no triangle");
+  return by_group;
+}
 
-  Builder b{h, settings.patch_size_m};
+// The tree over the groups' clusters under one root, refit; the deforming groups' clusters
+// refit once in object space too.
+void assemble_tree(ElementHierarchy& h, std::vector<std::vector<SourceTriangle>>& by_group, float patch_size_m) {
+  const int groups = static_cast<int>(by_group.size());
+  Builder b{h, patch_size_m};
   const std::int32_t root = b.new_node(-1, -1, -1);
   std::vector<std::int32_t> kids;
   h.group_root.assign(static_cast<std::size_t>(groups), -1);
@@ -282,6 +281,30 @@ engine::Result<ElementHierarchy> build_element_hierarchy(const BakeInput& input,
     std::copy(saved.begin(), saved.end(), h.nodes.begin() + r);
   }
   h.nodes[0].group = -1;
+}
+
+}  // namespace
+
+engine::Result<ElementHierarchy> build_element_hierarchy(const BakeInput& input, const AntiradianceSettings& settings) {
+  if (engine::Status st = validate_bake_input(input); !st) return st.error();
+  if (!(settings.patch_size_m > 0.0f) || !std::isfinite(settings.patch_size_m))
+    return build_error("patch_size_m must be positive");
+  if (!(settings.exchange_radius_m >= 0.0f)) return build_error("exchange_radius_m must not be negative");
+
+  ElementHierarchy h;
+  // The deforming region's swept bounds.
+  glm::vec3 lo, hi;
+  find_deforming(input, settings, h, lo, hi);
+  if (h.deforming_instances.empty()) return build_error("no instance is flagged deforming");
+
+  const int groups = 1 + static_cast<int>(h.deforming_instances.size());
+  std::vector<std::vector<SourceTriangle>> by_group = source_triangles(input, groups, lo, hi);
+  for (int g = 1; g < groups; ++g)
+    if (by_group[static_cast<std::size_t>(g)].empty())
+      return build_error("deforming instance '" +
+                         input.instances[h.deforming_instances[static_cast<std::size_t>(g - 1)]].name +
+                         "' has no triangle");
+  assemble_tree(h, by_group, settings.patch_size_m);
   return h;
 }
 

@@ -206,113 +206,121 @@ engine::Result<DlmSettings> dlm_preset(std::string_view name) {
   return s;
 }
 
-engine::Result<Dlm> bake_dlm(const BakeInput& input, const DlmSettings& settings) {
-  if (auto ok = validate(settings); !ok) return ok.error();
-  if (auto ok = validate_bake_input(input); !ok) return ok.error();
-  const auto t_start = Clock::now();
-  auto layout = static_world_layout(input, settings.texels_per_metre);
-  if (!layout) return layout.error();
-  auto prepared = prepare_static_scene(input, *layout, BakeLights::Static);
-  if (!prepared) return prepared.error();
-  const StaticBakeScene& s = *prepared;
-  const AtlasTexels& tex = s.texels;
+namespace {
 
-  Dlm dlm;
-  dlm.settings = settings;
-  dlm.layout = std::move(layout).value();
-  dlm.width = dlm.layout.width;
-  dlm.height = dlm.layout.height;
-  dlm.directions = dlm_directions(settings.directions);
-  const std::size_t n_bins = dlm.directions.size();
+// Per triangle of the snapshot: glossy (rougher than the settings' limit or not) and the
+// folded albedo of its material.
+struct TriangleMaterials {
+  std::vector<std::uint8_t> glossy;
+  std::vector<glm::vec3> albedo;
+};
 
-  // Per triangle of the snapshot: glossy? and the folded albedo of its material.
-  std::vector<std::uint8_t> triangle_glossy(s.index.triangles.size(), 0);
-  std::vector<glm::vec3> triangle_albedo(s.index.triangles.size());
-  {
-    std::map<std::uint32_t, std::pair<bool, glm::vec3>> by_material;
-    for (std::size_t t = 0; t < s.index.triangles.size(); ++t) {
-      const std::uint32_t m = s.index.triangles[t].material;
-      auto it = by_material.find(m);
-      if (it == by_material.end()) {
-        const engine::GltfBrdf& brdf = s.scene.materials[m].brdf;
-        it = by_material
-                 .emplace(m, std::make_pair(std::sqrt(brdf.alpha) < settings.glossy_roughness,
-                                            engine::gltf_hemispherical_albedo(brdf).sum()))
-                 .first;
-      }
-      triangle_glossy[t] = it->second.first ? 1 : 0;
-      // Textured: the texture's mean over the triangle (the material lookup, material_lookup.h).
-      triangle_albedo[t] =
-          s.scene.materials[m].textured() ? gi::triangle_albedo(s.scene, s.index.triangles[t]) : it->second.second;
+TriangleMaterials triangle_materials(const StaticBakeScene& s, const DlmSettings& settings) {
+  TriangleMaterials out;
+  out.glossy.assign(s.index.triangles.size(), 0);
+  out.albedo.resize(s.index.triangles.size());
+  std::map<std::uint32_t, std::pair<bool, glm::vec3>> by_material;
+  for (std::size_t t = 0; t < s.index.triangles.size(); ++t) {
+    const std::uint32_t m = s.index.triangles[t].material;
+    auto it = by_material.find(m);
+    if (it == by_material.end()) {
+      const engine::GltfBrdf& brdf = s.scene.materials[m].brdf;
+      it = by_material
+               .emplace(m, std::make_pair(std::sqrt(brdf.alpha) < settings.glossy_roughness,
+                                          engine::gltf_hemispherical_albedo(brdf).sum()))
+               .first;
     }
+    out.glossy[t] = it->second.first ? 1 : 0;
+    // Textured: the texture's mean over the triangle (the material lookup, material_lookup.h).
+    out.albedo[t] =
+        s.scene.materials[m].textured() ? gi::triangle_albedo(s.scene, s.index.triangles[t]) : it->second.second;
   }
+  return out;
+}
 
-  // Glossy texels and their element index.
+// The glossy texels of the atlas: a mask, each one's element index (-1 elsewhere) and the
+// list of them in texel order.
+struct GlossyTexels {
+  std::vector<std::uint8_t> mask;
+  std::vector<std::int32_t> element;
+  std::vector<std::uint32_t> texels;
+};
+
+GlossyTexels glossy_texels_of(const StaticBakeScene& s, const std::vector<std::uint8_t>& triangle_glossy) {
+  const AtlasTexels& tex = s.texels;
   const std::size_t n_texels = tex.valid.size();
-  std::vector<std::uint8_t> glossy(n_texels, 0);
-  std::vector<std::int32_t> element(n_texels, -1);
-  std::vector<std::uint32_t> glossy_texels;
+  GlossyTexels g;
+  g.mask.assign(n_texels, 0);
+  g.element.assign(n_texels, -1);
   for (std::size_t t = 0; t < n_texels; ++t) {
     if (!tex.valid[t] || tex.mesh[t] < 0) continue;
     const std::uint32_t inst = s.static_instance[static_cast<std::size_t>(tex.mesh[t])];
     const std::uint32_t tri = s.index.instance_first[inst] + static_cast<std::uint32_t>(tex.triangle[t]);
     if (!triangle_glossy[tri]) continue;
-    glossy[t] = 1;
-    element[t] = static_cast<std::int32_t>(glossy_texels.size());
-    glossy_texels.push_back(static_cast<std::uint32_t>(t));
+    g.mask[t] = 1;
+    g.element[t] = static_cast<std::int32_t>(g.texels.size());
+    g.texels.push_back(static_cast<std::uint32_t>(t));
   }
-  dlm.stats.glossy_texels = glossy_texels.size();
-  if (glossy_texels.empty()) {
-    dlm.stats.total_seconds = seconds_since(t_start);
-    return dlm;
-  }
+  return g;
+}
 
-  // C_k(n) per glossy texel, shared by texels of equal normals.
+// C_k(n) per glossy texel, shared by texels of equal normals: the weights and each texel's slot.
+struct CosineWeights {
+  std::vector<std::vector<float>> weights;
+  std::vector<std::uint32_t> texel_slot;
+};
+
+CosineWeights cosine_weights_of(const AtlasTexels& tex, const std::vector<std::uint32_t>& glossy_texels,
+                                std::span<const glm::vec3> directions) {
   std::map<std::array<float, 3>, std::uint32_t> normal_slot;
-  std::vector<std::vector<float>> cosine_weights;
-  std::vector<std::uint32_t> texel_slot(glossy_texels.size());
+  CosineWeights out;
+  out.texel_slot.resize(glossy_texels.size());
   for (std::size_t i = 0; i < glossy_texels.size(); ++i) {
     const glm::vec3 n = tex.normal[glossy_texels[i]];
     const std::array<float, 3> key{n.x, n.y, n.z};
     auto it = normal_slot.find(key);
     if (it == normal_slot.end()) {
-      it = normal_slot.emplace(key, static_cast<std::uint32_t>(cosine_weights.size())).first;
-      cosine_weights.push_back(dlm_bin_cosine_weights(dlm.directions, n));
+      it = normal_slot.emplace(key, static_cast<std::uint32_t>(out.weights.size())).first;
+      out.weights.push_back(dlm_bin_cosine_weights(directions, n));
     }
-    texel_slot[i] = it->second;
+    out.texel_slot[i] = it->second;
   }
+  return out;
+}
 
-  // Photon sources.
+// The sphere around every triangle of the snapshot (directional photons start outside it).
+SceneBounds scene_bounds(const std::vector<ShadingTriangle>& triangles) {
   SceneBounds bounds;
-  {
-    glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
-    for (const ShadingTriangle& t : s.index.triangles)
-      for (const glm::vec3& p : {t.p0, t.p0 + t.e1, t.p0 + t.e2}) lo = glm::min(lo, p), hi = glm::max(hi, p);
-    bounds.centre = 0.5f * (lo + hi);
-    bounds.radius = std::max(0.5f * glm::length(hi - lo), 1e-3f);
-  }
-  const std::vector<Source> sources =
-      photon_sources(point_emitters(s.scene, s.index, settings.area_light_samples, settings.seed), bounds);
-  std::vector<double> cdf;
-  double total = 0.0;
-  for (const Source& src : sources) cdf.push_back(total += static_cast<double>(luminance(src.power)));
-  dlm.stats.emitted_watts = total;
+  glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+  for (const ShadingTriangle& t : triangles)
+    for (const glm::vec3& p : {t.p0, t.p0 + t.e1, t.p0 + t.e2}) lo = glm::min(lo, p), hi = glm::max(hi, p);
+  bounds.centre = 0.5f * (lo + hi);
+  bounds.radius = std::max(0.5f * glm::length(hi - lo), 1e-3f);
+  return bounds;
+}
 
-  const float radius = settings.splat_radius_texels;
-  const int W = dlm.width, H = dlm.height;
-  const auto kernel = [radius](float dx, float dy) {
+// The tent kernel of the photon splats over the atlas's glossy texels.
+struct SplatKernel {
+  const Dlm& dlm;
+  const AtlasTexels& tex;
+  const GlossyTexels& glossy;
+  float radius;
+  int W, H;
+
+  float weight(float dx, float dy) const {
     return std::max(0.0f, 1.0f - std::fabs(dx) / radius) * std::max(0.0f, 1.0f - std::fabs(dy) / radius);
-  };
+  }
   // Texel-space position of barycentrics `bc` on triangle `prim` of atlas mesh `c` (texel
   // centres at integers).
-  const auto texel_point = [&](std::uint32_t c, std::uint32_t prim, glm::vec2 bc) {
+  glm::vec2 texel_point(std::uint32_t c, std::uint32_t prim, glm::vec2 bc) const {
     const AtlasMeshUv& mesh = dlm.layout.meshes[c];
     const glm::vec2 uv = (1.0f - bc.x - bc.y) * mesh.uv1[mesh.indices[3 * prim]] +
                          bc.x * mesh.uv1[mesh.indices[3 * prim + 1]] + bc.y * mesh.uv1[mesh.indices[3 * prim + 2]];
     return glm::vec2(uv.x * static_cast<float>(W) - 0.5f, uv.y * static_cast<float>(H) - 0.5f);
-  };
+  }
   // Calls fn(texel, weight) for the glossy texels of `chart` the kernel at texel-space point q reaches.
-  const auto for_kernel = [&](glm::vec2 q, std::int32_t chart, auto&& fn) {
+  template <class Fn>
+  void for_kernel(glm::vec2 q, std::int32_t chart, Fn&& fn) const {
     const int x0 = std::max(0, static_cast<int>(std::ceil(q.x - radius))),
               x1 = std::min(W - 1, static_cast<int>(std::floor(q.x + radius)));
     const int y0 = std::max(0, static_cast<int>(std::ceil(q.y - radius))),
@@ -320,27 +328,44 @@ engine::Result<Dlm> bake_dlm(const BakeInput& input, const DlmSettings& settings
     for (int y = y0; y <= y1; ++y)
       for (int x = x0; x <= x1; ++x) {
         const std::size_t t = tex.index(x, y);
-        if (!glossy[t] || tex.chart[t] != chart) continue;
-        const float w = kernel(static_cast<float>(x) - q.x, static_cast<float>(y) - q.y);
+        if (!glossy.mask[t] || tex.chart[t] != chart) continue;
+        const float w = weight(static_cast<float>(x) - q.x, static_cast<float>(y) - q.y);
         if (w > 0.0f) fn(t, w);
       }
-  };
+  }
+  // Splats a photon arriving along -`w_in` at barycentrics `bc` of triangle `prim` of caster
+  // instance `c` (= atlas mesh c) into the glossy texels of its chart: K x power, divided by
+  // the normalizer once everything is summed.
+  bool splat(std::uint32_t c, std::uint32_t prim, glm::vec2 bc, const glm::vec3& w_in, const glm::vec3& power,
+             std::vector<Deposit>& out) const {
+    const std::size_t first = out.size();
+    for_kernel(texel_point(c, prim, bc), static_cast<std::int32_t>(dlm.layout.meshes[c].triangle_chart[prim]),
+               [&](std::size_t t, float w) {
+                 out.push_back({static_cast<std::uint32_t>(glossy.element[t]),
+                                dlm_bin(dlm.directions, tex.normal[t], w_in), w * power});
+               });
+    return out.size() > first;
+  }
+};
 
-  // Kernel density estimation: E_t = sum_i Phi_i K(x_i - x_t) / integral of K(x - x_t) dA
-  // over the glossy surface of t's chart. The normalizer is integrated over every glossy
-  // triangle with kSub x kSub points per texel (each standing for its share of the
-  // triangle's world area), so texels at chart borders (partly covered, or covered only
-  // conservatively) estimate the same density as inner ones.
+// Kernel density estimation: E_t = sum_i Phi_i K(x_i - x_t) / integral of K(x - x_t) dA
+// over the glossy surface of t's chart. The normalizer is integrated over every glossy
+// triangle with kSub x kSub points per texel (each standing for its share of the
+// triangle's world area), so texels at chart borders (partly covered, or covered only
+// conservatively) estimate the same density as inner ones.
+std::vector<double> kernel_normalizers(const StaticBakeScene& s, const SplatKernel& kernel,
+                                       const std::vector<std::uint8_t>& triangle_glossy) {
   constexpr int kSub = 4;
-  std::vector<double> normalizer(glossy_texels.size(), 0.0);
+  const Dlm& dlm = kernel.dlm;
+  std::vector<double> normalizer(kernel.glossy.texels.size(), 0.0);
   for (std::uint32_t c = 0; c < dlm.layout.meshes.size(); ++c) {
     const AtlasMeshUv& mesh = dlm.layout.meshes[c];
     const std::uint32_t first = s.index.instance_first[s.static_instance[c]];
     for (std::uint32_t prim = 0; prim < mesh.indices.size() / 3; ++prim) {
       const std::uint32_t tri = first + prim;
       if (!triangle_glossy[tri]) continue;
-      const glm::vec2 a = texel_point(c, prim, {0.0f, 0.0f}), b = texel_point(c, prim, {1.0f, 0.0f}),
-                      d = texel_point(c, prim, {0.0f, 1.0f});
+      const glm::vec2 a = kernel.texel_point(c, prim, {0.0f, 0.0f}), b = kernel.texel_point(c, prim, {1.0f, 0.0f}),
+                      d = kernel.texel_point(c, prim, {0.0f, 1.0f});
       const glm::vec2 e1 = b - a, e2 = d - a;
       const float det = e1.x * e2.y - e1.y * e2.x;
       if (!(std::fabs(det) > 1e-12f)) continue;
@@ -361,85 +386,101 @@ engine::Result<Dlm> bake_dlm(const BakeInput& input, const DlmSettings& settings
           const glm::vec2 r = q - a;
           const float u = (r.x * e2.y - r.y * e2.x) / det, v = (e1.x * r.y - e1.y * r.x) / det;
           if (u < 0.0f || v < 0.0f || u + v > 1.0f) continue;
-          for_kernel(q, chart, [&](std::size_t t, float w) {
-            normalizer[static_cast<std::size_t>(element[t])] += static_cast<double>(w) * area_per_point;
+          kernel.for_kernel(q, chart, [&](std::size_t t, float w) {
+            normalizer[static_cast<std::size_t>(kernel.glossy.element[t])] += static_cast<double>(w) * area_per_point;
           });
         }
     }
   }
+  return normalizer;
+}
 
-  // Splats a photon arriving along -`w_in` at barycentrics `bc` of triangle `prim` of caster
-  // instance `c` (= atlas mesh c) into the glossy texels of its chart: K x power, divided by
-  // the normalizer once everything is summed.
-  const auto splat = [&](std::uint32_t c, std::uint32_t prim, glm::vec2 bc, const glm::vec3& w_in,
-                         const glm::vec3& power, std::vector<Deposit>& out) -> bool {
-    const std::size_t first = out.size();
-    for_kernel(texel_point(c, prim, bc), static_cast<std::int32_t>(dlm.layout.meshes[c].triangle_chart[prim]),
-               [&](std::size_t t, float w) {
-                 out.push_back(
-                     {static_cast<std::uint32_t>(element[t]), dlm_bin(dlm.directions, tex.normal[t], w_in), w * power});
-               });
-    return out.size() > first;
-  };
+// The photon sources with the cumulative luminance of their powers (for picking one).
+struct SourcePicker {
+  std::vector<Source> sources;
+  std::vector<double> cdf;
+  double total = 0.0;
+};
 
-  struct BatchResult {
-    std::vector<Deposit> deposits;
-    std::uint64_t rays = 0, hits = 0, lost = 0;
-  };
-  const auto trace_batch = [&](std::uint64_t batch, BatchResult& r) {
-    const std::uint64_t begin = batch * kBatchPhotons, end = std::min(settings.photons, begin + kBatchPhotons);
-    const float share = static_cast<float>(total / static_cast<double>(settings.photons));
-    for (std::uint64_t i = begin; i < end; ++i) {
-      Pcg32 rng = Pcg32::for_item(settings.seed, i);
-      const double u = static_cast<double>(rng.next_float()) * total;
-      const auto pick = static_cast<std::size_t>(std::upper_bound(cdf.begin(), cdf.end(), u) - cdf.begin());
-      const Source& src = sources[std::min(pick, sources.size() - 1)];
-      // Power / pick probability / photons: the source's RGB power over its luminance x share.
-      Photon p = emit(src, bounds, share / luminance(src.power), rng);
-      for (int bounce = 0; bounce < settings.max_bounces; ++bounce) {
-        const float u1 = rng.next_float(), u2 = rng.next_float(), u_rr = rng.next_float();
-        ++r.rays;
-        const Hit hit = s.caster->intersect(Ray{p.origin, 0.0f, p.direction});
-        if (!hit.valid()) break;
-        glm::vec3 ng = glm::normalize(hit.geometric_normal);
-        const std::uint32_t tri = s.triangle_of(hit);
-        const ShadingTriangle& st = s.index.triangles[tri];
-        const bool front = glm::dot(ng, p.direction) < 0.0f;
-        if (!front) {
-          if (!s.scene.materials[st.material].double_sided) break;
-          ng = -ng;
-        }
-        if (bounce == 0 && p.range_m > 0.0f) p.power *= range_window(hit.t, p.range_m);
-        if (bounce >= 1 && front && triangle_glossy[tri]) {
-          ++r.hits;
-          if (!splat(hit.instance, hit.primitive, hit.barycentric, -p.direction, p.power, r.deposits)) ++r.lost;
-        }
-        const glm::vec3 albedo = triangle_albedo[tri];
-        const float q = std::min(1.0f, max_component(albedo));
-        if (!(u_rr < q)) break;
-        p.power *= albedo / q;
-        const glm::vec3 position = st.p0 + hit.barycentric.x * st.e1 + hit.barycentric.y * st.e2;
-        p.origin = offset_ray_origin(position, ng);
-        p.direction = sample_cosine_hemisphere(ng, u1, u2);
+SourcePicker source_picker(std::vector<Source> sources) {
+  SourcePicker out;
+  out.sources = std::move(sources);
+  for (const Source& src : out.sources) out.cdf.push_back(out.total += static_cast<double>(luminance(src.power)));
+  return out;
+}
+
+struct BatchResult {
+  std::vector<Deposit> deposits;
+  std::uint64_t rays = 0, hits = 0, lost = 0;
+};
+
+// Traces the photons of batch `batch` through the scene, splatting every hit on a glossy
+// front face after the first bounce; Russian roulette on the folded albedo ends a path.
+void trace_batch(const StaticBakeScene& s, const DlmSettings& settings, const TriangleMaterials& materials,
+                 const SourcePicker& picker, const SceneBounds& bounds, const SplatKernel& kernel, std::uint64_t batch,
+                 BatchResult& r) {
+  const std::uint64_t begin = batch * kBatchPhotons, end = std::min(settings.photons, begin + kBatchPhotons);
+  const double total = picker.total;
+  const float share = static_cast<float>(total / static_cast<double>(settings.photons));
+  for (std::uint64_t i = begin; i < end; ++i) {
+    Pcg32 rng = Pcg32::for_item(settings.seed, i);
+    const double u = static_cast<double>(rng.next_float()) * total;
+    const auto pick =
+        static_cast<std::size_t>(std::upper_bound(picker.cdf.begin(), picker.cdf.end(), u) - picker.cdf.begin());
+    const Source& src = picker.sources[std::min(pick, picker.sources.size() - 1)];
+    // Power / pick probability / photons: the source's RGB power over its luminance x share.
+    Photon p = emit(src, bounds, share / luminance(src.power), rng);
+    for (int bounce = 0; bounce < settings.max_bounces; ++bounce) {
+      const float u1 = rng.next_float(), u2 = rng.next_float(), u_rr = rng.next_float();
+      ++r.rays;
+      const Hit hit = s.caster->intersect(Ray{p.origin, 0.0f, p.direction});
+      if (!hit.valid()) break;
+      glm::vec3 ng = glm::normalize(hit.geometric_normal);
+      const std::uint32_t tri = s.triangle_of(hit);
+      const ShadingTriangle& st = s.index.triangles[tri];
+      const bool front = glm::dot(ng, p.direction) < 0.0f;
+      if (!front) {
+        if (!s.scene.materials[st.material].double_sided) break;
+        ng = -ng;
       }
+      if (bounce == 0 && p.range_m > 0.0f) p.power *= range_window(hit.t, p.range_m);
+      if (bounce >= 1 && front && materials.glossy[tri]) {
+        ++r.hits;
+        if (!kernel.splat(hit.instance, hit.primitive, hit.barycentric, -p.direction, p.power, r.deposits)) ++r.lost;
+      }
+      const glm::vec3 albedo = materials.albedo[tri];
+      const float q = std::min(1.0f, max_component(albedo));
+      if (!(u_rr < q)) break;
+      p.power *= albedo / q;
+      const glm::vec3 position = st.p0 + hit.barycentric.x * st.e1 + hit.barycentric.y * st.e2;
+      p.origin = offset_ray_origin(position, ng);
+      p.direction = sample_cosine_hemisphere(ng, u1, u2);
     }
-  };
+  }
+}
 
-  // Trace in rounds of batches; deposits summed in photon order (batch order, then within).
-  const auto t_trace = Clock::now();
-  std::vector<double> irradiance(n_bins * glossy_texels.size() * 3, 0.0);  // [bin][element][ch]
+// Traces the photons in rounds of batches, their deposits summed in photon order (batch
+// order, then within) into the irradiance per [bin][element][channel]; counts into `stats`.
+engine::Result<std::vector<double>> trace_photons(const StaticBakeScene& s, const DlmSettings& settings,
+                                                  const TriangleMaterials& materials, const SourcePicker& picker,
+                                                  const SceneBounds& bounds, const SplatKernel& kernel,
+                                                  DlmStats& stats) {
+  const std::size_t n_elements = kernel.glossy.texels.size();
+  std::vector<double> irradiance(kernel.dlm.directions.size() * n_elements * 3, 0.0);  // [bin][element][ch]
   ThreadPool pool(settings.threads);
-  const std::uint64_t batches = sources.empty() ? 0 : (settings.photons + kBatchPhotons - 1) / kBatchPhotons;
+  const std::uint64_t batches = picker.sources.empty() ? 0 : (settings.photons + kBatchPhotons - 1) / kBatchPhotons;
   for (std::uint64_t round = 0; round < batches; round += kRoundBatches) {
     const std::uint64_t count = std::min(kRoundBatches, batches - round);
     std::vector<BatchResult> results(count);
-    pool.parallel_for(count, [&](std::size_t b) { trace_batch(round + b, results[b]); });
+    pool.parallel_for(count, [&](std::size_t b) {
+      trace_batch(s, settings, materials, picker, bounds, kernel, round + b, results[b]);
+    });
     for (const BatchResult& r : results) {
-      dlm.stats.rays += r.rays;
-      dlm.stats.deposits += r.hits;
-      dlm.stats.lost_deposits += r.lost;
+      stats.rays += r.rays;
+      stats.deposits += r.hits;
+      stats.lost_deposits += r.lost;
       for (const Deposit& d : r.deposits) {
-        double* e = &irradiance[(d.bin * glossy_texels.size() + d.element) * 3];
+        double* e = &irradiance[(d.bin * n_elements + d.element) * 3];
         e[0] += static_cast<double>(d.irradiance.x), e[1] += static_cast<double>(d.irradiance.y),
             e[2] += static_cast<double>(d.irradiance.z);
       }
@@ -448,32 +489,83 @@ engine::Result<Dlm> bake_dlm(const BakeInput& input, const DlmSettings& settings
         !settings.progress(0.95 * static_cast<double>(round + count) / static_cast<double>(batches)))
       return engine::cancelled_error("DLM bake");
   }
-  dlm.stats.photons = sources.empty() ? 0 : settings.photons;
-  dlm.stats.trace_seconds = seconds_since(t_trace);
+  return irradiance;
+}
 
-  // Mean radiance per bin, then every bin's map dilated into the gutter next to its chart
-  // (only texels no chart covers: another chart's texels keep their own data or none).
+// Mean radiance per bin, then every bin's map dilated into the gutter next to its chart
+// (only texels no chart covers: another chart's texels keep their own data or none).
+void resolve_bins(const AtlasTexels& tex, const GlossyTexels& glossy, const CosineWeights& cosine,
+                  const std::vector<double>& normalizer, const std::vector<double>& irradiance, Dlm& dlm) {
+  const std::size_t n_bins = dlm.directions.size(), n_texels = tex.valid.size();
+  const std::vector<std::uint32_t>& glossy_texels = glossy.texels;
   const int rings = std::max(1, dlm.layout.padding_texels / 2);
   std::vector<glm::vec3> image(n_texels);
   std::vector<std::uint8_t> filled;
   for (std::size_t k = 0; k < n_bins; ++k) {
     std::fill(image.begin(), image.end(), glm::vec3(0.0f));
     for (std::size_t i = 0; i < glossy_texels.size(); ++i) {
-      const float c = cosine_weights[texel_slot[i]][k];
+      const float c = cosine.weights[cosine.texel_slot[i]][k];
       if (!(c > 0.0f)) continue;
       if (!(normalizer[i] > 0.0)) continue;
       const double* e = &irradiance[(k * glossy_texels.size() + i) * 3];
       image[glossy_texels[i]] = glm::vec3(glm::dvec3(e[0], e[1], e[2]) / (static_cast<double>(c) * normalizer[i]));
     }
-    filled = dilate<glm::vec3>(image, W, H, glossy, rings);
+    filled = dilate<glm::vec3>(image, dlm.width, dlm.height, glossy.mask, rings);
     if (k == 0) {  // the grown mask depends on the glossy texels only: the same for every bin
       for (std::size_t t = 0; t < n_texels; ++t)
-        if (glossy[t] || (filled[t] && !tex.valid[t])) dlm.texels.push_back(static_cast<std::uint32_t>(t));
+        if (glossy.mask[t] || (filled[t] && !tex.valid[t])) dlm.texels.push_back(static_cast<std::uint32_t>(t));
       dlm.radiance.resize(n_bins * dlm.texels.size() * 3);
     }
     for (std::size_t i = 0; i < dlm.texels.size(); ++i)
       std::memcpy(&dlm.radiance[(k * dlm.texels.size() + i) * 3], &image[dlm.texels[i]], sizeof(glm::vec3));
   }
+}
+
+}  // namespace
+
+engine::Result<Dlm> bake_dlm(const BakeInput& input, const DlmSettings& settings) {
+  if (auto ok = validate(settings); !ok) return ok.error();
+  if (auto ok = validate_bake_input(input); !ok) return ok.error();
+  const auto t_start = Clock::now();
+  auto layout = static_world_layout(input, settings.texels_per_metre);
+  if (!layout) return layout.error();
+  auto prepared = prepare_static_scene(input, *layout, BakeLights::Static);
+  if (!prepared) return prepared.error();
+  const StaticBakeScene& s = *prepared;
+  const AtlasTexels& tex = s.texels;
+
+  Dlm dlm;
+  dlm.settings = settings;
+  dlm.layout = std::move(layout).value();
+  dlm.width = dlm.layout.width;
+  dlm.height = dlm.layout.height;
+  dlm.directions = dlm_directions(settings.directions);
+
+  const TriangleMaterials materials = triangle_materials(s, settings);
+  const GlossyTexels glossy = glossy_texels_of(s, materials.glossy);
+  const std::vector<std::uint32_t>& glossy_texels = glossy.texels;
+  dlm.stats.glossy_texels = glossy_texels.size();
+  if (glossy_texels.empty()) {
+    dlm.stats.total_seconds = seconds_since(t_start);
+    return dlm;
+  }
+  const CosineWeights cosine = cosine_weights_of(tex, glossy_texels, dlm.directions);
+
+  const SceneBounds bounds = scene_bounds(s.index.triangles);
+  const SourcePicker picker = source_picker(
+      photon_sources(point_emitters(s.scene, s.index, settings.area_light_samples, settings.seed), bounds));
+  dlm.stats.emitted_watts = picker.total;
+
+  const SplatKernel kernel{dlm, tex, glossy, settings.splat_radius_texels, dlm.width, dlm.height};
+  const std::vector<double> normalizer = kernel_normalizers(s, kernel, materials.glossy);
+
+  const auto t_trace = Clock::now();
+  auto irradiance = trace_photons(s, settings, materials, picker, bounds, kernel, dlm.stats);
+  if (!irradiance) return irradiance.error();
+  dlm.stats.photons = picker.sources.empty() ? 0 : settings.photons;
+  dlm.stats.trace_seconds = seconds_since(t_trace);
+
+  resolve_bins(tex, glossy, cosine, normalizer, *irradiance, dlm);
   if (settings.progress && !settings.progress(1.0)) return engine::cancelled_error("DLM bake");
   dlm.stats.total_seconds = seconds_since(t_start);
   return dlm;

@@ -217,6 +217,122 @@ engine::Result<LightAtlasShardPart> bake_light_atlas_shard(const BakeInput& inpu
 
 namespace {
 
+// One shard: steps 1-3 of the gather, step 3 for its texel blocks, into *run.part.
+engine::Status gather_shard_part(const BakeScene& b, const AtlasLayout& layout, const LightAtlasSettings& settings,
+                                 const ShardRun& run, ThreadPool& pool) {
+  TexelGatherSettings g = settings.gather;
+  g.seed = settings.seed;
+  g.progress = settings.progress;
+  g.shard = run.shard;
+  g.part_only = true;
+  auto gathered = gather_atlas(b, layout, g, pool);
+  if (!gathered) return gathered.error();
+  const std::vector<std::uint32_t> work = gather_work(b.texels);
+  LightAtlasShardPart& p = *run.part;
+  for (std::size_t w = 0; w < work.size(); ++w) {
+    if (!run.shard.owns(w)) continue;
+    const std::uint32_t i = work[w];
+    p.texels.push_back(i);
+    p.indirect.push_back(gathered->indirect[i]);
+    p.direct.push_back(gathered->direct[i]);
+    p.baked_direct.push_back(gathered->baked_direct[i]);
+    p.hidden.push_back(gathered->hidden[i]);
+  }
+  p.shared_rays = gathered->shared_rays;
+  p.own_rays = gathered->own_rays;
+  return {};
+}
+
+// The VPLs (what BRF's world probes read) take their light from the gathered atlas: the
+// area-weighted mean of the total irradiance at their sample points' texels, instead of
+// a VPL solution of their own (steps 2-3 cost more than the gather at 1000+ VPLs).
+void vpl_power_from_atlas(const BakeScene& b, const TexelGatherResult& gathered, LightAtlasBake& out) {
+  std::vector<glm::vec3> total(out.irradiance.size());
+  for (std::size_t t = 0; t < total.size(); ++t)
+    total[t] = out.irradiance[t] + gathered.direct[t] + gathered.baked_direct[t];
+  const std::vector<glm::vec3> at_samples = irradiance_at_points(b.texels, total, out.layout.texels_per_metre,
+                                                                 out.vpls.sample_position, out.vpls.sample_normal);
+  out.vpl_power.assign(out.vpls.size(), glm::vec3(0.0f));
+  for (std::size_t j = 0; j < out.vpls.size(); ++j) {
+    glm::dvec3 sum(0.0);
+    double area = 0.0;
+    for (std::uint32_t k = out.vpls.sample_first[j]; k < out.vpls.sample_first[j + 1]; ++k) {
+      sum += glm::dvec3(at_samples[k]) * static_cast<double>(out.vpls.sample_area_m2[k]);
+      area += static_cast<double>(out.vpls.sample_area_m2[k]);
+    }
+    if (area > 0.0) out.vpl_power[j] = out.vpls.albedo[j] * out.vpls.area_m2[j] * glm::vec3(sum / area);
+  }
+}
+
+// The texel final gather (texel_gather.h), or the merge of the shards' gathers, into
+// out.irradiance and out.vpl_power; adds its rays to `rays`.
+engine::Status texel_gather_pass(const BakeScene& b, const LightAtlasSettings& settings, const ShardRun& run,
+                                 ThreadPool& pool, LightAtlasBake& out, std::uint64_t& rays) {
+  const auto t0 = Clock::now();
+  TexelGatherSettings g = settings.gather;
+  g.seed = settings.seed;
+  g.progress = sub_progress(settings.progress, Phase{kDirectPhase.begin, kFinalPhase.end});
+  auto gathered = run.parts ? assemble_parts(b.texels, *run.parts) : gather_atlas(b, out.layout, g, pool);
+  if (!gathered) return gathered.error();
+  if (run.parts) {  // the merge: the whole bake's last gather step on the shards' texels
+    if (auto ok = filter_gathered(b, out.layout, g, pool, *gathered); !ok) return ok.error();
+    if (g.progress && !g.progress(1.0)) return engine::cancelled_error("light-atlas merge");
+  }
+  out.stats.direct_seconds = gathered->direct_seconds;
+  out.irradiance = std::move(gathered->indirect);
+  rays += gathered->rays;
+  out.stats.gather_iterations = gathered->iterations;
+  vpl_power_from_atlas(b, *gathered, out);
+  // The atlas holds what the renderer does not draw (the sky, unlit emitters), and with
+  // include_direct the static lights' direct light too.
+  for (std::size_t t = 0; t < out.irradiance.size(); ++t) {
+    out.irradiance[t] += gathered->baked_direct[t];
+    if (settings.include_direct) out.irradiance[t] += gathered->direct[t];
+  }
+  out.stats.final_seconds = seconds_since(t0) - gathered->direct_seconds;
+  return {};
+}
+
+// The VPL final shooting: the VPLs lit, then shot into the atlas, with the direct light the
+// renderer does not draw; into out.irradiance and out.vpl_power; adds its rays to `rays`.
+engine::Status vpl_shooting_pass(const BakeScene& b, const LightAtlasSettings& settings, ThreadPool& pool,
+                                 LightAtlasBake& out, std::uint64_t& rays) {
+  auto powers = light_vpls(b, out.vpls, settings, pool, &out.stats);
+  if (!powers) return powers.error();
+  out.vpl_power = powers->power;
+  out.stats.shots = powers->shots;
+  rays += powers->rays;
+  const auto t0 = Clock::now();
+  std::vector<std::uint32_t> shooters;
+  std::vector<glm::vec3> shot;
+  for (std::uint32_t i = 0; i < out.vpls.size(); ++i)
+    if (out.vpl_power[i] != glm::vec3(0.0f)) shooters.push_back(i), shot.push_back(out.vpl_power[i]);
+  // Texels are point samples of irradiance (as the reference's): no receiver area; the
+  // emitter's sample areas alone bound the near field.
+  auto final_result =
+      shoot_into_atlas(out.vpls, shooters, shot, b.texels, 0.0f, *b.caster, pool,
+                       {.seed = settings.seed, .progress = sub_progress(settings.progress, kFinalPhase)});
+  if (!final_result) return final_result.error();
+  out.irradiance = std::move(final_result->irradiance);
+  rays += final_result->rays;
+  // The direct light the renderer does not draw (the sky's, and that of emitters no light
+  // stands for), and with include_direct every emitter's.
+  std::vector<PointEmitter> unlit;
+  for (const PointEmitter& e : b.emitters)
+    if (!e.drawn_live) unlit.push_back(e);
+  const float texel_area = 1.0f / (out.layout.texels_per_metre * out.layout.texels_per_metre);
+  const std::vector<glm::vec3> direct =
+      direct_into_atlas(settings.include_direct ? b.emitters : unlit, b.texels, texel_area, *b.caster, pool, &rays);
+  for (std::size_t t = 0; t < direct.size(); ++t) out.irradiance[t] += direct[t];
+  if (engine::sky_lit(b.scene.sky_radiance, b.scene.sky_gradient)) {
+    auto sky = sky_direct_light(b, out.layout, kVplSkyRays, settings.seed, pool);
+    if (!sky) return sky.error();
+    for (std::size_t t = 0; t < direct.size(); ++t) out.irradiance[t] += (*sky)[t];
+  }
+  out.stats.final_seconds = seconds_since(t0);
+  return {};
+}
+
 engine::Result<LightAtlasBake> bake_light_atlas_run(const BakeInput& input, const LightAtlasSettings& settings,
                                                     const ShardRun& run) {
   if (auto ok = validate(settings); !ok) return ok.error();
@@ -232,27 +348,8 @@ engine::Result<LightAtlasBake> bake_light_atlas_run(const BakeInput& input, cons
   if (!prepared) return prepared.error();
   const BakeScene& b = *prepared;
 
-  if (run.part) {  // one shard: steps 1-3 of the gather, step 3 for its texel blocks
-    TexelGatherSettings g = settings.gather;
-    g.seed = settings.seed;
-    g.progress = settings.progress;
-    g.shard = run.shard;
-    g.part_only = true;
-    auto gathered = gather_atlas(b, *layout, g, pool);
-    if (!gathered) return gathered.error();
-    const std::vector<std::uint32_t> work = gather_work(b.texels);
-    LightAtlasShardPart& p = *run.part;
-    for (std::size_t w = 0; w < work.size(); ++w) {
-      if (!run.shard.owns(w)) continue;
-      const std::uint32_t i = work[w];
-      p.texels.push_back(i);
-      p.indirect.push_back(gathered->indirect[i]);
-      p.direct.push_back(gathered->direct[i]);
-      p.baked_direct.push_back(gathered->baked_direct[i]);
-      p.hidden.push_back(gathered->hidden[i]);
-    }
-    p.shared_rays = gathered->shared_rays;
-    p.own_rays = gathered->own_rays;
+  if (run.part) {
+    if (auto ok = gather_shard_part(b, *layout, settings, run, pool); !ok) return ok.error();
     return LightAtlasBake{};
   }
 
@@ -272,81 +369,10 @@ engine::Result<LightAtlasBake> bake_light_atlas_run(const BakeInput& input, cons
   out.stats.vpl_seconds = seconds_since(t0);
 
   std::uint64_t rays = 0;
-  if (settings.final_pass == LightAtlasSettings::FinalPass::TexelGather) {
-    t0 = Clock::now();
-    TexelGatherSettings g = settings.gather;
-    g.seed = settings.seed;
-    g.progress = sub_progress(settings.progress, Phase{kDirectPhase.begin, kFinalPhase.end});
-    auto gathered = run.parts ? assemble_parts(b.texels, *run.parts) : gather_atlas(b, out.layout, g, pool);
-    if (!gathered) return gathered.error();
-    if (run.parts) {  // the merge: the whole bake's last gather step on the shards' texels
-      if (auto ok = filter_gathered(b, out.layout, g, pool, *gathered); !ok) return ok.error();
-      if (g.progress && !g.progress(1.0)) return engine::cancelled_error("light-atlas merge");
-    }
-    out.stats.direct_seconds = gathered->direct_seconds;
-    out.irradiance = std::move(gathered->indirect);
-    rays += gathered->rays;
-    out.stats.gather_iterations = gathered->iterations;
-    // The VPLs (what BRF's world probes read) take their light from the gathered atlas: the
-    // area-weighted mean of the total irradiance at their sample points' texels, instead of
-    // a VPL solution of their own (steps 2-3 cost more than the gather at 1000+ VPLs).
-    std::vector<glm::vec3> total(out.irradiance.size());
-    for (std::size_t t = 0; t < total.size(); ++t)
-      total[t] = out.irradiance[t] + gathered->direct[t] + gathered->baked_direct[t];
-    const std::vector<glm::vec3> at_samples = irradiance_at_points(b.texels, total, out.layout.texels_per_metre,
-                                                                   out.vpls.sample_position, out.vpls.sample_normal);
-    out.vpl_power.assign(out.vpls.size(), glm::vec3(0.0f));
-    for (std::size_t j = 0; j < out.vpls.size(); ++j) {
-      glm::dvec3 sum(0.0);
-      double area = 0.0;
-      for (std::uint32_t k = out.vpls.sample_first[j]; k < out.vpls.sample_first[j + 1]; ++k) {
-        sum += glm::dvec3(at_samples[k]) * static_cast<double>(out.vpls.sample_area_m2[k]);
-        area += static_cast<double>(out.vpls.sample_area_m2[k]);
-      }
-      if (area > 0.0) out.vpl_power[j] = out.vpls.albedo[j] * out.vpls.area_m2[j] * glm::vec3(sum / area);
-    }
-    // The atlas holds what the renderer does not draw (the sky, unlit emitters), and with
-    // include_direct the static lights' direct light too.
-    for (std::size_t t = 0; t < out.irradiance.size(); ++t) {
-      out.irradiance[t] += gathered->baked_direct[t];
-      if (settings.include_direct) out.irradiance[t] += gathered->direct[t];
-    }
-    out.stats.final_seconds = seconds_since(t0) - gathered->direct_seconds;
-  } else {
-    auto powers = light_vpls(b, out.vpls, settings, pool, &out.stats);
-    if (!powers) return powers.error();
-    out.vpl_power = powers->power;
-    out.stats.shots = powers->shots;
-    rays += powers->rays;
-    t0 = Clock::now();
-    std::vector<std::uint32_t> shooters;
-    std::vector<glm::vec3> shot;
-    for (std::uint32_t i = 0; i < out.vpls.size(); ++i)
-      if (out.vpl_power[i] != glm::vec3(0.0f)) shooters.push_back(i), shot.push_back(out.vpl_power[i]);
-    // Texels are point samples of irradiance (as the reference's): no receiver area; the
-    // emitter's sample areas alone bound the near field.
-    auto final_result =
-        shoot_into_atlas(out.vpls, shooters, shot, b.texels, 0.0f, *b.caster, pool,
-                         {.seed = settings.seed, .progress = sub_progress(settings.progress, kFinalPhase)});
-    if (!final_result) return final_result.error();
-    out.irradiance = std::move(final_result->irradiance);
-    rays += final_result->rays;
-    // The direct light the renderer does not draw (the sky's, and that of emitters no light
-    // stands for), and with include_direct every emitter's.
-    std::vector<PointEmitter> unlit;
-    for (const PointEmitter& e : b.emitters)
-      if (!e.drawn_live) unlit.push_back(e);
-    const float texel_area = 1.0f / (out.layout.texels_per_metre * out.layout.texels_per_metre);
-    const std::vector<glm::vec3> direct =
-        direct_into_atlas(settings.include_direct ? b.emitters : unlit, b.texels, texel_area, *b.caster, pool, &rays);
-    for (std::size_t t = 0; t < direct.size(); ++t) out.irradiance[t] += direct[t];
-    if (engine::sky_lit(b.scene.sky_radiance, b.scene.sky_gradient)) {
-      auto sky = sky_direct_light(b, out.layout, kVplSkyRays, settings.seed, pool);
-      if (!sky) return sky.error();
-      for (std::size_t t = 0; t < direct.size(); ++t) out.irradiance[t] += (*sky)[t];
-    }
-    out.stats.final_seconds = seconds_since(t0);
-  }
+  const engine::Status finished = settings.final_pass == LightAtlasSettings::FinalPass::TexelGather
+                                      ? texel_gather_pass(b, settings, run, pool, out, rays)
+                                      : vpl_shooting_pass(b, settings, pool, out, rays);
+  if (!finished) return finished.error();
   out.valid = b.texels.valid;
   dilate<glm::vec3>(out.irradiance, out.width, out.height, out.valid, dilation_rings(out.layout));
 

@@ -74,7 +74,8 @@ struct TexelTable {
 };
 
 engine::Result<TexelTable> texel_table(const StaticBakeScene& b, const AtlasLayout& layout) {
-  // Long: the layout checks, the per-texel albedo and face tables and the gutter redirects of one table.
+  // Long because it fills one table in one pass over the texels: the layout checks, the
+  // per-texel albedo and face, then the gutter redirects that read what that pass wrote.
   const AtlasTexels& tx = b.texels;
   if (tx.width != layout.width || tx.height != layout.height || layout.meshes.size() != b.static_instance.size())
     return engine::Error{.message = "texel gather: the atlas layout does not match the bake scene"};
@@ -165,102 +166,129 @@ std::uint32_t landing(const StaticBakeScene& b, const AtlasLayout& layout, const
 struct DirectAt {
   glm::vec3 live{0.0f}, unlit{0.0f};
 };
-DirectAt direct_at(const StaticBakeScene& b, const glm::vec3& p, const glm::vec3& n, const glm::vec3& face, int samples,
-                   Pcg32& rng, std::uint64_t* rays) {
-  const glm::vec3 origin = offset_ray_origin(p, face);
-  glm::dvec3 sum(0.0);
-  const auto inv = 1.0 / static_cast<double>(samples);
-  for (std::size_t i = 0; i < b.scene.lights.size(); ++i) {
-    const ReferenceLight& l = b.scene.lights[i];
-    if (l.type == ReferenceLight::Type::Area) {
-      if (b.index.light_has_proxy[i]) continue;  // its emissive geometry stands for it below
-      const float area = 4.0f * glm::length(l.half_x) * glm::length(l.half_y);
-      const float shift_y = rng.next_float();  // drawn first: see random.h
-      const glm::vec2 shift(rng.next_float(), shift_y);
-      for (int s = 0; s < samples; ++s) {
-        const glm::vec2 u = hammersley(static_cast<std::uint32_t>(s), static_cast<std::uint32_t>(samples), shift);
-        const glm::vec3 q = l.position + (2.0f * u.x - 1.0f) * l.half_x + (2.0f * u.y - 1.0f) * l.half_y;
-        const glm::vec3 to = q - p;
-        const float d2 = glm::dot(to, to);
-        if (!(d2 > 0.0f)) continue;
-        const glm::vec3 wi = to / std::sqrt(d2);
-        const float cos_l = -glm::dot(wi, l.direction), cos_r = glm::dot(wi, n);
-        if (cos_l <= 0.0f || cos_r <= 0.0f || glm::dot(wi, face) <= 0.0f) continue;
-        ++*rays;
-        if (b.caster->occluded(Ray{origin, 0.0f, q - origin, 1.0f})) continue;
-        sum += glm::dvec3(l.radiant * (cos_r * cos_l * area / d2)) * inv;
-      }
-      continue;
-    }
-    if (l.type == ReferenceLight::Type::Directional && l.cos_disc < 1.0f) {
-      // A disc (the sun's angular radius): `samples` stratified directions uniform over its
-      // cone, each carrying radiant / samples; soft shadows (docs/scene-format.md).
-      const float shift_y = rng.next_float();  // drawn first: see random.h
-      const glm::vec2 shift(rng.next_float(), shift_y);
-      for (int s = 0; s < samples; ++s) {
-        const glm::vec2 u = hammersley(static_cast<std::uint32_t>(s), static_cast<std::uint32_t>(samples), shift);
-        const glm::vec3 wi = sample_cone(-l.direction, l.cos_disc, u.x, u.y);
-        const float cos_r = glm::dot(wi, n);
-        if (cos_r <= 0.0f || glm::dot(wi, face) <= 0.0f) continue;
-        ++*rays;
-        if (b.caster->occluded(Ray{origin, 0.0f, wi, std::numeric_limits<float>::infinity()})) continue;
-        sum += glm::dvec3(l.radiant * cos_r) * inv;
-      }
-      continue;
-    }
-    glm::vec3 wi;
-    float atten = 1.0f, t_max = 1.0f;
-    glm::vec3 dir;
-    if (l.type == ReferenceLight::Type::Directional) {
-      wi = -l.direction;
-      dir = wi;
-      t_max = std::numeric_limits<float>::infinity();
-    } else {
-      const glm::vec3 to = l.position - p;
-      const float d2 = std::max(glm::dot(to, to), 1e-12f);
-      const float d = std::sqrt(d2);
-      wi = to / d;
-      atten = range_window(d, l.range_m) / d2;
-      if (l.type == ReferenceLight::Type::Spot) atten *= spot_cone(l.direction, l.cos_outer, l.cos_inner, wi);
-      dir = l.position - origin;
-    }
-    const float cos_r = glm::dot(wi, n);
-    if (atten <= 0.0f || cos_r <= 0.0f || glm::dot(wi, face) <= 0.0f) continue;
-    ++*rays;
-    if (b.caster->occluded(Ray{origin, 0.0f, dir, t_max})) continue;
-    sum += glm::dvec3(l.radiant * (atten * cos_r));
+// The light sampling of one texel: its point, normals and ray origin, the samples per light
+// (each weighing inv = 1 / samples) and the shadow rays counted.
+struct TexelLighting {
+  const StaticBakeScene& b;
+  glm::vec3 p, n, face, origin;
+  int samples;
+  double inv;
+  std::uint64_t* rays;
+};
+
+// An area light without emissive geometry: `samples` stratified points over its rectangle.
+void sample_area_light(const TexelLighting& t, const ReferenceLight& l, Pcg32& rng, glm::dvec3& sum) {
+  const float area = 4.0f * glm::length(l.half_x) * glm::length(l.half_y);
+  const float shift_y = rng.next_float();  // drawn first: see random.h
+  const glm::vec2 shift(rng.next_float(), shift_y);
+  for (int s = 0; s < t.samples; ++s) {
+    const glm::vec2 u = hammersley(static_cast<std::uint32_t>(s), static_cast<std::uint32_t>(t.samples), shift);
+    const glm::vec3 q = l.position + (2.0f * u.x - 1.0f) * l.half_x + (2.0f * u.y - 1.0f) * l.half_y;
+    const glm::vec3 to = q - t.p;
+    const float d2 = glm::dot(to, to);
+    if (!(d2 > 0.0f)) continue;
+    const glm::vec3 wi = to / std::sqrt(d2);
+    const float cos_l = -glm::dot(wi, l.direction), cos_r = glm::dot(wi, t.n);
+    if (cos_l <= 0.0f || cos_r <= 0.0f || glm::dot(wi, t.face) <= 0.0f) continue;
+    ++*t.rays;
+    if (t.b.caster->occluded(Ray{t.origin, 0.0f, q - t.origin, 1.0f})) continue;
+    sum += glm::dvec3(l.radiant * (cos_r * cos_l * area / d2)) * t.inv;
   }
+}
+
+// A disc (the sun's angular radius): `samples` stratified directions uniform over its
+// cone, each carrying radiant / samples; soft shadows (docs/scene-format.md).
+void sample_sun_disc(const TexelLighting& t, const ReferenceLight& l, Pcg32& rng, glm::dvec3& sum) {
+  const float shift_y = rng.next_float();  // drawn first: see random.h
+  const glm::vec2 shift(rng.next_float(), shift_y);
+  for (int s = 0; s < t.samples; ++s) {
+    const glm::vec2 u = hammersley(static_cast<std::uint32_t>(s), static_cast<std::uint32_t>(t.samples), shift);
+    const glm::vec3 wi = sample_cone(-l.direction, l.cos_disc, u.x, u.y);
+    const float cos_r = glm::dot(wi, t.n);
+    if (cos_r <= 0.0f || glm::dot(wi, t.face) <= 0.0f) continue;
+    ++*t.rays;
+    if (t.b.caster->occluded(Ray{t.origin, 0.0f, wi, std::numeric_limits<float>::infinity()})) continue;
+    sum += glm::dvec3(l.radiant * cos_r) * t.inv;
+  }
+}
+
+// A point, spot or sharp directional light: one shadow ray.
+void sample_point_light(const TexelLighting& t, const ReferenceLight& l, glm::dvec3& sum) {
+  glm::vec3 wi;
+  float atten = 1.0f, t_max = 1.0f;
+  glm::vec3 dir;
+  if (l.type == ReferenceLight::Type::Directional) {
+    wi = -l.direction;
+    dir = wi;
+    t_max = std::numeric_limits<float>::infinity();
+  } else {
+    const glm::vec3 to = l.position - t.p;
+    const float d2 = std::max(glm::dot(to, to), 1e-12f);
+    const float d = std::sqrt(d2);
+    wi = to / d;
+    atten = range_window(d, l.range_m) / d2;
+    if (l.type == ReferenceLight::Type::Spot) atten *= spot_cone(l.direction, l.cos_outer, l.cos_inner, wi);
+    dir = l.position - t.origin;
+  }
+  const float cos_r = glm::dot(wi, t.n);
+  if (atten <= 0.0f || cos_r <= 0.0f || glm::dot(wi, t.face) <= 0.0f) return;
+  ++*t.rays;
+  if (t.b.caster->occluded(Ray{t.origin, 0.0f, dir, t_max})) return;
+  sum += glm::dvec3(l.radiant * (atten * cos_r));
+}
+
+// The emissive triangles: `samples` stratified picks by power, each a stratified point; into
+// `sum` for those that stand for a light, `unlit` for the others.
+void sample_emitters(const TexelLighting& t, Pcg32& rng, glm::dvec3& sum, glm::dvec3& unlit) {
+  const StaticBakeScene& b = t.b;
   const EmitterTable& em = b.index.emitters;
-  if (em.triangle.empty()) return {glm::vec3(sum), glm::vec3(0.0f)};
-  glm::dvec3 unlit(0.0);
   const float shift_y = rng.next_float();  // drawn first: see random.h
   const glm::vec2 shift(rng.next_float(), shift_y);
   const float pick_shift = rng.next_float();
-  for (int s = 0; s < samples; ++s) {
-    float u_pick = (static_cast<float>(s) + pick_shift) / static_cast<float>(samples);
+  for (int s = 0; s < t.samples; ++s) {
+    float u_pick = (static_cast<float>(s) + pick_shift) / static_cast<float>(t.samples);
     u_pick = std::min(u_pick, 0x1.fffffep-1f);
     const auto k = static_cast<std::size_t>(std::lower_bound(em.cdf.begin(), em.cdf.end(), u_pick) - em.cdf.begin());
     const std::size_t pick = std::min(k, em.triangle.size() - 1);
     const ShadingTriangle& tri = b.index.triangles[em.triangle[pick]];
     const ReferenceMaterial& mat = b.scene.materials[tri.material];
     const float prob = em.probability[pick];
-    const glm::vec2 u = hammersley(static_cast<std::uint32_t>(s), static_cast<std::uint32_t>(samples), shift);
+    const glm::vec2 u = hammersley(static_cast<std::uint32_t>(s), static_cast<std::uint32_t>(t.samples), shift);
     const float su = std::sqrt(u.x);
     const glm::vec3 q = tri.p0 + su * (1.0f - u.y) * tri.e1 + su * u.y * tri.e2;
-    const glm::vec3 to = q - p;
+    const glm::vec3 to = q - t.p;
     const float d2 = glm::dot(to, to);
     if (!(d2 > 0.0f) || !(prob > 0.0f)) continue;
     const glm::vec3 wi = to / std::sqrt(d2);
     float cos_l = -glm::dot(wi, tri.face_normal);
     if (mat.double_sided) cos_l = std::fabs(cos_l);
-    const float cos_r = glm::dot(wi, n);
-    if (cos_l <= 0.0f || cos_r <= 0.0f || glm::dot(wi, face) <= 0.0f) continue;
-    ++*rays;
-    if (b.caster->occluded(Ray{origin, 0.0f, q - origin, 0.9999f})) continue;
+    const float cos_r = glm::dot(wi, t.n);
+    if (cos_l <= 0.0f || cos_r <= 0.0f || glm::dot(wi, t.face) <= 0.0f) continue;
+    ++*t.rays;
+    if (b.caster->occluded(Ray{t.origin, 0.0f, q - t.origin, 0.9999f})) continue;
     const glm::vec3 emission = emission_at(b.scene, tri, glm::vec2(su * (1.0f - u.y), su * u.y), 0.0f);
     (em.stands_for_light[pick] != 0 ? sum : unlit) +=
-        glm::dvec3(emission * (cos_r * cos_l * tri.area_m2 / (prob * d2))) * inv;
+        glm::dvec3(emission * (cos_r * cos_l * tri.area_m2 / (prob * d2))) * t.inv;
   }
+}
+
+DirectAt direct_at(const StaticBakeScene& b, const glm::vec3& p, const glm::vec3& n, const glm::vec3& face, int samples,
+                   Pcg32& rng, std::uint64_t* rays) {
+  const TexelLighting t{b, p, n, face, offset_ray_origin(p, face), samples, 1.0 / static_cast<double>(samples), rays};
+  glm::dvec3 sum(0.0);
+  for (std::size_t i = 0; i < b.scene.lights.size(); ++i) {
+    const ReferenceLight& l = b.scene.lights[i];
+    if (l.type == ReferenceLight::Type::Area) {
+      if (!b.index.light_has_proxy[i]) sample_area_light(t, l, rng, sum);  // else its emissive geometry stands for it
+    } else if (l.type == ReferenceLight::Type::Directional && l.cos_disc < 1.0f) {
+      sample_sun_disc(t, l, rng, sum);
+    } else {
+      sample_point_light(t, l, sum);
+    }
+  }
+  if (b.index.emitters.triangle.empty()) return {glm::vec3(sum), glm::vec3(0.0f)};
+  glm::dvec3 unlit(0.0);
+  sample_emitters(t, rng, sum, unlit);
   return {glm::vec3(sum), glm::vec3(unlit)};
 }
 
@@ -500,6 +528,9 @@ void filter_result(const AtlasTexels& tx, const TexelTable& t, float radius_m, f
 
 }  // namespace
 
+// Long because it is texel_gather.h's four steps in order, each a call of its own, timed and
+// sharing the texel table, the kept rays and the progress phases; split further, those would
+// travel between the steps as parameters without making any step easier to read.
 engine::Result<TexelGatherResult> gather_atlas(const StaticBakeScene& b, const AtlasLayout& layout,
                                                const TexelGatherSettings& s, ThreadPool& pool) {
   if (auto ok = validate(s); !ok) return ok.error();

@@ -18,27 +18,13 @@ float distance2(const Point6& a, const Point6& b) {
   return d;
 }
 
-}  // namespace
-
-std::vector<std::uint32_t> cluster_entry_points(std::span<const glm::vec3> positions,
-                                                std::span<const glm::vec3> normals, int clusters, float normal_scale_m,
-                                                int kmeans_iterations) {
-  const std::size_t n = positions.size();
-  std::vector<Point6> pts(n);
-  for (std::size_t i = 0; i < n; ++i)
-    pts[i] = {positions[i].x,
-              positions[i].y,
-              positions[i].z,
-              normals[i].x * normal_scale_m,
-              normals[i].y * normal_scale_m,
-              normals[i].z * normal_scale_m};
-
-  // Median-split kd-tree: leaves are index lists; split the largest until there are enough.
+// Median-split kd-tree: leaves are index lists; split the largest until there are enough.
+std::vector<std::vector<std::uint32_t>> kd_leaves(const std::vector<Point6>& pts, int clusters) {
   std::vector<std::vector<std::uint32_t>> leaves(1);
-  leaves[0].resize(n);
+  leaves[0].resize(pts.size());
   std::iota(leaves[0].begin(), leaves[0].end(), 0u);
   const auto target = static_cast<std::size_t>(std::max(1, clusters));
-  while (leaves.size() < std::min(target, n)) {
+  while (leaves.size() < std::min(target, pts.size())) {
     std::size_t big = 0;
     for (std::size_t l = 1; l < leaves.size(); ++l)
       if (leaves[l].size() > leaves[big].size()) big = l;
@@ -63,14 +49,16 @@ std::vector<std::uint32_t> cluster_entry_points(std::span<const glm::vec3> posit
     std::sort(upper.begin(), upper.end());
     leaves.push_back(std::move(upper));
   }
-  std::vector<std::uint32_t> out(n, 0);
-  for (std::size_t l = 0; l < leaves.size(); ++l)
-    for (std::uint32_t i : leaves[l]) out[i] = static_cast<std::uint32_t>(l);
+  return leaves;
+}
 
-  // Optional Lloyd steps from the kd-tree's centroids (empty clusters keep their centroid).
+// Optional Lloyd steps from the kd-tree's centroids (empty clusters keep their centroid).
+void lloyd_steps(const std::vector<Point6>& pts, std::size_t cluster_count, int kmeans_iterations,
+                 std::vector<std::uint32_t>& out) {
+  const std::size_t n = pts.size();
   for (int it = 0; it < kmeans_iterations; ++it) {
-    std::vector<Point6> centre(leaves.size(), Point6{});
-    std::vector<std::size_t> count(leaves.size(), 0);
+    std::vector<Point6> centre(cluster_count, Point6{});
+    std::vector<std::size_t> count(cluster_count, 0);
     for (std::size_t i = 0; i < n; ++i) {
       for (std::size_t a = 0; a < 6; ++a) centre[out[i]][a] += pts[i][a];
       ++count[out[i]];
@@ -92,6 +80,29 @@ std::vector<std::uint32_t> cluster_entry_points(std::span<const glm::vec3> posit
     }
     if (!changed) break;
   }
+}
+
+}  // namespace
+
+std::vector<std::uint32_t> cluster_entry_points(std::span<const glm::vec3> positions,
+                                                std::span<const glm::vec3> normals, int clusters, float normal_scale_m,
+                                                int kmeans_iterations) {
+  const std::size_t n = positions.size();
+  std::vector<Point6> pts(n);
+  for (std::size_t i = 0; i < n; ++i)
+    pts[i] = {positions[i].x,
+              positions[i].y,
+              positions[i].z,
+              normals[i].x * normal_scale_m,
+              normals[i].y * normal_scale_m,
+              normals[i].z * normal_scale_m};
+
+  const std::vector<std::vector<std::uint32_t>> leaves = kd_leaves(pts, clusters);
+  std::vector<std::uint32_t> out(n, 0);
+  for (std::size_t l = 0; l < leaves.size(); ++l)
+    for (std::uint32_t i : leaves[l]) out[i] = static_cast<std::uint32_t>(l);
+
+  lloyd_steps(pts, leaves.size(), kmeans_iterations, out);
   return out;
 }
 

@@ -108,6 +108,176 @@ struct PrmRun {
   const std::vector<PrmShardPart>* parts = nullptr;
 };
 
+// The folded albedo of every triangle of the snapshot (a textured one's: the texture's mean
+// over the triangle).
+std::vector<glm::vec3> triangle_albedos(const StaticBakeScene& s) {
+  std::unordered_map<std::uint32_t, glm::vec3> material_albedo;
+  std::vector<glm::vec3> triangle_albedo(s.index.triangles.size());
+  for (std::size_t t = 0; t < triangle_albedo.size(); ++t) {
+    const std::uint32_t m = s.index.triangles[t].material;
+    if (s.scene.materials[m].textured()) {  // the texture's mean over the triangle
+      triangle_albedo[t] = gi::triangle_albedo(s.scene, s.index.triangles[t]);
+      continue;
+    }
+    auto it = material_albedo.find(m);
+    if (it == material_albedo.end())
+      it = material_albedo.emplace(m, engine::gltf_hemispherical_albedo(s.scene.materials[m].brdf).sum()).first;
+    triangle_albedo[t] = it->second;
+  }
+  return triangle_albedo;
+}
+
+// Clusters the entry points into prm.entries, cluster_count and cluster_size: the normal
+// counts like a tenth of the scene's size.
+void cluster_entries(const VplSet& entries, const StaticBakeScene& s, const PrmSettings& settings, Prm& prm) {
+  const auto cluster_of =
+      cluster_entry_points(entries.position, entries.normal, settings.clusters,
+                           0.1f * std::max(s.index.scene_radius_m, 1e-6f), settings.kmeans ? 10 : 0);
+  prm.cluster_count = 0;
+  for (std::uint32_t c : cluster_of) prm.cluster_count = std::max(prm.cluster_count, static_cast<int>(c) + 1);
+  prm.cluster_size.assign(static_cast<std::size_t>(prm.cluster_count), 0);
+  for (std::size_t k = 0; k < entries.size(); ++k) {
+    prm.entries.push_back({entries.position[k], entries.normal[k], entries.area_m2[k], cluster_of[k]});
+    ++prm.cluster_size[cluster_of[k]];
+  }
+}
+
+// The merge: the shards' items in place of the walks and shadow rays, written into `full`
+// ([cluster][texel]) after checking each part is its shard's of this atlas.
+engine::Status merge_shard_parts(const std::vector<PrmShardPart>& parts, const std::vector<std::uint32_t>& valid,
+                                 std::size_t n_texels, Prm& prm, std::vector<glm::vec3>& full) {
+  const auto clusters = static_cast<std::size_t>(prm.cluster_count);
+  const auto count = static_cast<std::uint32_t>(parts.size());
+  for (std::uint32_t i = 0; i < count; ++i) {
+    const PrmShardPart& p = parts[i];
+    const WorkShard shard{.index = i, .count = count};
+    std::vector<std::uint32_t> expected;
+    for (std::size_t w = 0; w < valid.size(); ++w)
+      if (shard.owns(w)) expected.push_back(valid[w]);
+    if (p.texels != expected || p.cluster_count != prm.cluster_count ||
+        p.values.size() != expected.size() * clusters * 3)
+      return engine::Error{.message = "PRM shard " + std::to_string(i) + " of " + std::to_string(count) +
+                                      ": its texels or clusters are not that shard's of this scene's atlas"};
+    for (std::size_t k = 0; k < expected.size(); ++k)
+      for (std::size_t c = 0; c < clusters; ++c)
+        full[c * n_texels + expected[k]] =
+            glm::vec3(p.values[(k * clusters + c) * 3], p.values[(k * clusters + c) * 3 + 1],
+                      p.values[(k * clusters + c) * 3 + 2]);
+    prm.stats.rays += p.pane_rays;
+  }
+  if (count > 0) {
+    const PrmShardPart& first = parts.front();
+    prm.stats.rays += first.walk_rays;
+    prm.stats.paths = first.paths;
+    prm.stats.path_nodes = first.path_nodes;
+  }
+  return {};
+}
+
+// Random walks, per entry point in parallel (each from its own stream), counted into prm.stats.
+std::vector<std::vector<PathNode>> walk_entries(const VplSet& entries, const StaticBakeScene& s,
+                                                const std::vector<glm::vec3>& triangle_albedo,
+                                                const PrmSettings& settings, ThreadPool& pool, Prm& prm) {
+  const std::size_t n_entries = entries.size();
+  std::vector<std::vector<PathNode>> walks(n_entries);
+  std::vector<std::uint64_t> walk_rays(n_entries, 0);
+  std::vector<std::size_t> walk_paths(n_entries, 0);
+  pool.parallel_for(n_entries, [&](std::size_t k) {
+    walks[k] = random_walks(entries, k, s, triangle_albedo, settings, walk_rays[k], walk_paths[k]);
+  });
+  for (std::size_t k = 0; k < n_entries; ++k) {
+    prm.stats.rays += walk_rays[k];
+    prm.stats.paths += walk_paths[k];
+    prm.stats.path_nodes += walks[k].size();
+  }
+  return walks;
+}
+
+// Items (eq. 3): every virtual light connected to every reference point it sees, summed
+// per (cluster, texel) into `full`, for the valid texels `mine` indexes. Parallel over texels;
+// each texel visits the nodes in a fixed order, so the sums do not depend on the thread count.
+// The near field is regularized by the entry point's area (cos cos / (pi d^2 + A),
+// point_emitters.h). Returns the shadow rays traced.
+engine::Result<std::uint64_t> gather_items(const StaticBakeScene& s, const PrmSettings& settings, const Prm& prm,
+                                           const std::vector<std::vector<PathNode>>& walks,
+                                           const std::vector<std::uint32_t>& valid,
+                                           const std::vector<std::size_t>& mine, ThreadPool& pool,
+                                           std::vector<glm::vec3>& full) {
+  const AtlasTexels& tex = s.texels;
+  const auto clusters = static_cast<std::size_t>(prm.cluster_count);
+  const std::size_t n_entries = walks.size();
+  std::atomic<std::uint64_t> rays{0};
+  const std::size_t batches = std::clamp<std::size_t>(mine.size() / 64, 1, 100);
+  for (std::size_t b = 0; b < batches; ++b) {
+    const std::size_t begin = mine.size() * b / batches, end = mine.size() * (b + 1) / batches;
+    pool.parallel_for(
+        end - begin,
+        [&](std::size_t w) {
+          const std::uint32_t t = valid[mine[begin + w]];
+          const glm::vec3 p = tex.position[t], n = tex.normal[t];
+          std::vector<glm::dvec3> sum(clusters, glm::dvec3(0.0));
+          std::uint64_t local = 0;
+          for (std::size_t k = 0; k < n_entries; ++k) {
+            const float area = prm.entries[k].area_m2 / settings.splitting;
+            glm::dvec3 item(0.0);
+            for (const PathNode& v : walks[k]) {
+              const float f = lambertian_kernel(v.position, v.normal, area, false, p, n, 0.0f);
+              if (f <= 0.0f) continue;
+              ++local;
+              if (segment_visible(*s.caster, p, n, v.position, v.normal))
+                item += glm::dvec3(v.power) * static_cast<double>(f);
+            }
+            sum[prm.entries[k].cluster] += item;
+          }
+          for (std::size_t c = 0; c < clusters; ++c) full[c * tex.valid.size() + t] = glm::vec3(sum[c]);
+          rays += local;
+        },
+        4);
+    if (settings.progress && !settings.progress(0.05 + 0.9 * static_cast<double>(b + 1) / static_cast<double>(batches)))
+      return engine::cancelled_error("PRM bake");
+  }
+  return rays.load();
+}
+
+// A shard's part: its texels' items, with the walk counts every shard shares.
+void fill_shard_part(const Prm& prm, std::uint64_t pane_rays, const std::vector<std::uint32_t>& valid,
+                     const std::vector<std::size_t>& mine, const std::vector<glm::vec3>& full, std::size_t n_texels,
+                     PrmShardPart& p) {
+  const auto clusters = static_cast<std::size_t>(prm.cluster_count);
+  p.cluster_count = prm.cluster_count;
+  p.paths = prm.stats.paths;
+  p.path_nodes = prm.stats.path_nodes;
+  p.walk_rays = prm.stats.rays;
+  p.pane_rays = pane_rays;
+  p.texels.reserve(mine.size());
+  p.values.reserve(mine.size() * clusters * 3);
+  for (std::size_t w : mine) {
+    const std::uint32_t t = valid[w];
+    p.texels.push_back(t);
+    for (std::size_t c = 0; c < clusters; ++c)
+      for (int ch = 0; ch < 3; ++ch) p.values.push_back(full[c * n_texels + t][ch]);
+  }
+}
+
+// Dilation is linear: dilate every pane like the light atlas, keep the filled texels.
+void dilate_panes(const AtlasTexels& tex, std::vector<glm::vec3>& full, Prm& prm) {
+  const auto clusters = static_cast<std::size_t>(prm.cluster_count);
+  const int rings = std::max(4, prm.layout.padding_texels);
+  std::vector<std::uint8_t> filled;
+  for (std::size_t c = 0; c < clusters; ++c)
+    filled = dilate<glm::vec3>(std::span<glm::vec3>(full.data() + c * tex.valid.size(), tex.valid.size()), prm.width,
+                               prm.height, tex.valid, rings);
+  if (clusters == 0) filled = tex.valid;
+  for (std::size_t t = 0; t < filled.size(); ++t)
+    if (filled[t]) prm.texels.push_back(static_cast<std::uint32_t>(t));
+  prm.panes.resize(clusters * prm.texels.size() * 3);
+  for (std::size_t c = 0; c < clusters; ++c)
+    for (std::size_t i = 0; i < prm.texels.size(); ++i)
+      for (int ch = 0; ch < 3; ++ch)
+        prm.panes[(c * prm.texels.size() + i) * 3 + static_cast<std::size_t>(ch)] =
+            full[c * tex.valid.size() + prm.texels[i]][ch];
+}
+
 engine::Result<Prm> bake_prm_run(const BakeInput& input, const PrmSettings& settings, const PrmRun& run) {
   if (auto ok = validate(settings); !ok) return ok.error();
   if (auto ok = validate_bake_input(input); !ok) return ok.error();
@@ -130,32 +300,8 @@ engine::Result<Prm> bake_prm_run(const BakeInput& input, const PrmSettings& sett
   auto entries = distribute_vpls(s.scene, s.index,
                                  {.vpl_count = settings.entry_points, .samples_per_vpl = 1, .seed = settings.seed});
   if (!entries) return entries.error();
-  const std::size_t n_entries = entries->size();
-  std::unordered_map<std::uint32_t, glm::vec3> material_albedo;
-  std::vector<glm::vec3> triangle_albedo(s.index.triangles.size());
-  for (std::size_t t = 0; t < triangle_albedo.size(); ++t) {
-    const std::uint32_t m = s.index.triangles[t].material;
-    if (s.scene.materials[m].textured()) {  // the texture's mean over the triangle
-      triangle_albedo[t] = gi::triangle_albedo(s.scene, s.index.triangles[t]);
-      continue;
-    }
-    auto it = material_albedo.find(m);
-    if (it == material_albedo.end())
-      it = material_albedo.emplace(m, engine::gltf_hemispherical_albedo(s.scene.materials[m].brdf).sum()).first;
-    triangle_albedo[t] = it->second;
-  }
-
-  // Clusters: the normal counts like a tenth of the scene's size.
-  const auto cluster_of =
-      cluster_entry_points(entries->position, entries->normal, settings.clusters,
-                           0.1f * std::max(s.index.scene_radius_m, 1e-6f), settings.kmeans ? 10 : 0);
-  prm.cluster_count = 0;
-  for (std::uint32_t c : cluster_of) prm.cluster_count = std::max(prm.cluster_count, static_cast<int>(c) + 1);
-  prm.cluster_size.assign(static_cast<std::size_t>(prm.cluster_count), 0);
-  for (std::size_t k = 0; k < n_entries; ++k) {
-    prm.entries.push_back({entries->position[k], entries->normal[k], entries->area_m2[k], cluster_of[k]});
-    ++prm.cluster_size[cluster_of[k]];
-  }
+  const std::vector<glm::vec3> triangle_albedo = triangle_albedos(s);
+  cluster_entries(*entries, s, settings, prm);
 
   const AtlasTexels& tex = s.texels;
   std::vector<std::uint32_t> valid;
@@ -164,120 +310,25 @@ engine::Result<Prm> bake_prm_run(const BakeInput& input, const PrmSettings& sett
   const auto clusters = static_cast<std::size_t>(prm.cluster_count);
   std::vector<glm::vec3> full(clusters * tex.valid.size(), glm::vec3(0.0f));  // [cluster][texel]
   auto t0 = Clock::now();
-  if (run.parts) {  // the merge: the shards' items in place of the walks and shadow rays
-    const auto count = static_cast<std::uint32_t>(run.parts->size());
-    for (std::uint32_t i = 0; i < count; ++i) {
-      const PrmShardPart& p = (*run.parts)[i];
-      const WorkShard shard{.index = i, .count = count};
-      std::vector<std::uint32_t> expected;
-      for (std::size_t w = 0; w < valid.size(); ++w)
-        if (shard.owns(w)) expected.push_back(valid[w]);
-      if (p.texels != expected || p.cluster_count != prm.cluster_count ||
-          p.values.size() != expected.size() * clusters * 3)
-        return engine::Error{.message = "PRM shard " + std::to_string(i) + " of " + std::to_string(count) +
-                                        ": its texels or clusters are not that shard's of this scene's atlas"};
-      for (std::size_t k = 0; k < expected.size(); ++k)
-        for (std::size_t c = 0; c < clusters; ++c)
-          full[c * tex.valid.size() + expected[k]] =
-              glm::vec3(p.values[(k * clusters + c) * 3], p.values[(k * clusters + c) * 3 + 1],
-                        p.values[(k * clusters + c) * 3 + 2]);
-      prm.stats.rays += p.pane_rays;
-    }
-    if (count > 0) {
-      const PrmShardPart& first = run.parts->front();
-      prm.stats.rays += first.walk_rays;
-      prm.stats.paths = first.paths;
-      prm.stats.path_nodes = first.path_nodes;
-    }
+  if (run.parts) {
+    if (engine::Status st = merge_shard_parts(*run.parts, valid, tex.valid.size(), prm, full); !st) return st.error();
     if (settings.progress && !settings.progress(0.95)) return engine::cancelled_error("PRM merge");
   } else {
-    // Random walks, per entry point in parallel (each from its own stream).
-    std::vector<std::vector<PathNode>> walks(n_entries);
-    std::vector<std::uint64_t> walk_rays(n_entries, 0);
-    std::vector<std::size_t> walk_paths(n_entries, 0);
-    pool.parallel_for(n_entries, [&](std::size_t k) {
-      walks[k] = random_walks(*entries, k, s, triangle_albedo, settings, walk_rays[k], walk_paths[k]);
-    });
-    for (std::size_t k = 0; k < n_entries; ++k) {
-      prm.stats.rays += walk_rays[k];
-      prm.stats.paths += walk_paths[k];
-      prm.stats.path_nodes += walks[k].size();
-    }
+    const std::vector<std::vector<PathNode>> walks = walk_entries(*entries, s, triangle_albedo, settings, pool, prm);
     prm.stats.walk_seconds = seconds_since(t0);
     if (settings.progress && !settings.progress(0.05)) return engine::cancelled_error("PRM bake");
-
-    // Items (eq. 3): every virtual light connected to every reference point it sees, summed
-    // per (cluster, texel). Parallel over texels; each texel visits the nodes in a fixed
-    // order, so the sums do not depend on the thread count. The near field is regularized by
-    // the entry point's area (cos cos / (pi d^2 + A), point_emitters.h).
     t0 = Clock::now();
     const std::vector<std::size_t> mine = run.shard.items(valid.size());  // all of them in a whole bake
-    std::atomic<std::uint64_t> rays{0};
-    const std::size_t batches = std::clamp<std::size_t>(mine.size() / 64, 1, 100);
-    for (std::size_t b = 0; b < batches; ++b) {
-      const std::size_t begin = mine.size() * b / batches, end = mine.size() * (b + 1) / batches;
-      pool.parallel_for(
-          end - begin,
-          [&](std::size_t w) {
-            const std::uint32_t t = valid[mine[begin + w]];
-            const glm::vec3 p = tex.position[t], n = tex.normal[t];
-            std::vector<glm::dvec3> sum(clusters, glm::dvec3(0.0));
-            std::uint64_t local = 0;
-            for (std::size_t k = 0; k < n_entries; ++k) {
-              const float area = prm.entries[k].area_m2 / settings.splitting;
-              glm::dvec3 item(0.0);
-              for (const PathNode& v : walks[k]) {
-                const float f = lambertian_kernel(v.position, v.normal, area, false, p, n, 0.0f);
-                if (f <= 0.0f) continue;
-                ++local;
-                if (segment_visible(*s.caster, p, n, v.position, v.normal))
-                  item += glm::dvec3(v.power) * static_cast<double>(f);
-              }
-              sum[prm.entries[k].cluster] += item;
-            }
-            for (std::size_t c = 0; c < clusters; ++c) full[c * tex.valid.size() + t] = glm::vec3(sum[c]);
-            rays += local;
-          },
-          4);
-      if (settings.progress &&
-          !settings.progress(0.05 + 0.9 * static_cast<double>(b + 1) / static_cast<double>(batches)))
-        return engine::cancelled_error("PRM bake");
-    }
+    auto rays = gather_items(s, settings, prm, walks, valid, mine, pool, full);
+    if (!rays) return rays.error();
     if (run.part) {
-      PrmShardPart& p = *run.part;
-      p.cluster_count = prm.cluster_count;
-      p.paths = prm.stats.paths;
-      p.path_nodes = prm.stats.path_nodes;
-      p.walk_rays = prm.stats.rays;
-      p.pane_rays = rays.load();
-      p.texels.reserve(mine.size());
-      p.values.reserve(mine.size() * clusters * 3);
-      for (std::size_t w : mine) {
-        const std::uint32_t t = valid[w];
-        p.texels.push_back(t);
-        for (std::size_t c = 0; c < clusters; ++c)
-          for (int ch = 0; ch < 3; ++ch) p.values.push_back(full[c * tex.valid.size() + t][ch]);
-      }
+      fill_shard_part(prm, *rays, valid, mine, full, tex.valid.size(), *run.part);
       return Prm{};
     }
-    prm.stats.rays += rays.load();
+    prm.stats.rays += *rays;
   }
 
-  // Dilation is linear: dilate every pane like the light atlas, keep the filled texels.
-  const int rings = std::max(4, prm.layout.padding_texels);
-  std::vector<std::uint8_t> filled;
-  for (std::size_t c = 0; c < clusters; ++c)
-    filled = dilate<glm::vec3>(std::span<glm::vec3>(full.data() + c * tex.valid.size(), tex.valid.size()), prm.width,
-                               prm.height, tex.valid, rings);
-  if (clusters == 0) filled = tex.valid;
-  for (std::size_t t = 0; t < filled.size(); ++t)
-    if (filled[t]) prm.texels.push_back(static_cast<std::uint32_t>(t));
-  prm.panes.resize(clusters * prm.texels.size() * 3);
-  for (std::size_t c = 0; c < clusters; ++c)
-    for (std::size_t i = 0; i < prm.texels.size(); ++i)
-      for (int ch = 0; ch < 3; ++ch)
-        prm.panes[(c * prm.texels.size() + i) * 3 + static_cast<std::size_t>(ch)] =
-            full[c * tex.valid.size() + prm.texels[i]][ch];
+  dilate_panes(tex, full, prm);
   prm.stats.pane_seconds = seconds_since(t0);
   prm.stats.total_seconds = seconds_since(t_start);
   return prm;

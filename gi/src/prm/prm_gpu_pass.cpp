@@ -131,10 +131,8 @@ std::size_t gl_limit(GLenum name) {
   return value > 0 ? static_cast<std::size_t>(value) : 0;
 }
 
-}  // namespace
-
-engine::Result<PrmGpuPass> PrmGpuPass::create(const Prm& prm, const PrmGpuPassOptions& options) {
-  // Check the data before acquiring anything.
+// The bake's atlas, texels and panes checked before anything is acquired.
+std::optional<engine::Error> check_prm(const Prm& prm, PrmPaneEncoding encoding) {
   if (prm.width <= 0 || prm.height <= 0)
     return error("atlas size " + std::to_string(prm.width) + "x" + std::to_string(prm.height) + " is empty");
   const std::size_t atlas_texels = static_cast<std::size_t>(prm.width) * static_cast<std::size_t>(prm.height);
@@ -157,21 +155,36 @@ engine::Result<PrmGpuPass> PrmGpuPass::create(const Prm& prm, const PrmGpuPassOp
       prm.panes.size() != clusters * elements * 3)
     return error("panes hold " + std::to_string(prm.panes.size()) + " floats, expected " + std::to_string(clusters) +
                  " clusters x " + std::to_string(elements) + " texels x 3");
-  if (auto bad = check_pane_values(prm, options.encoding)) return *bad;
+  return check_pane_values(prm, encoding);
+}
 
-  // Every input is read through an RGBA32UI buffer texture: at most GL_MAX_TEXTURE_BUFFER_SIZE
-  // texels of 16 bytes each.
+// Every input is read through an RGBA32UI buffer texture: at most GL_MAX_TEXTURE_BUFFER_SIZE
+// texels of 16 bytes each. The limit per buffer, or the error when the texels or one pane
+// exceed it.
+engine::Result<std::size_t> buffer_limit_for(const Prm& prm, const PrmGpuPassOptions& options) {
+  const std::size_t elements = prm.texels.size();
   std::size_t buffer_limit = std::min(kSsboLimitBytes, gl_limit(GL_MAX_TEXTURE_BUFFER_SIZE) * 16);
   if (options.max_buffer_bytes > 0) buffer_limit = std::min(buffer_limit, options.max_buffer_bytes);
   const std::size_t texel_bytes = (elements + kBlock - 1) / kBlock * kBlock * sizeof(std::uint32_t);
   if (texel_bytes > buffer_limit)
     return error(std::to_string(elements) + " pane texels need " + std::to_string(texel_bytes) +
                  " bytes, above the buffer limit of " + std::to_string(buffer_limit));
-  const std::size_t stride = pane_stride_words(elements, options.encoding);
-  const std::size_t pane_bytes = stride * sizeof(std::uint32_t);
+  const std::size_t pane_bytes = pane_stride_words(elements, options.encoding) * sizeof(std::uint32_t);
   if (pane_bytes > buffer_limit)
     return error("one pane of " + std::to_string(elements) + " texels needs " + std::to_string(pane_bytes) +
                  " bytes, above the buffer limit of " + std::to_string(buffer_limit));
+  return buffer_limit;
+}
+
+}  // namespace
+
+engine::Result<PrmGpuPass> PrmGpuPass::create(const Prm& prm, const PrmGpuPassOptions& options) {
+  // Check the data before acquiring anything.
+  if (auto bad = check_prm(prm, options.encoding)) return *bad;
+  auto buffer_limit = buffer_limit_for(prm, options);
+  if (!buffer_limit) return buffer_limit.error();
+  const std::size_t elements = prm.texels.size();
+  const auto clusters = static_cast<std::size_t>(prm.cluster_count);
 
   PrmGpuPass pass;
   pass.width_ = prm.width;
@@ -191,36 +204,53 @@ engine::Result<PrmGpuPass> PrmGpuPass::create(const Prm& prm, const PrmGpuPassOp
   pass.uniforms_ = {glGetUniformLocation(id, "u_element_count"), glGetUniformLocation(id, "u_first_weight"),
                     glGetUniformLocation(id, "u_weight_count"), glGetUniformLocation(id, "u_mode")};
 
+  pass.upload_panes(prm, options.encoding, *buffer_limit);
+  pass.upload_texels(prm, *buffer_limit);
+  pass.create_output();
+  if (glGetError() == GL_OUT_OF_MEMORY)
+    return error("out of GPU memory uploading " + std::to_string(clusters) + " panes of " + std::to_string(elements) +
+                 " texels");
+  return pass;
+}
+
+void PrmGpuPass::upload_panes(const Prm& prm, PrmPaneEncoding encoding, std::size_t buffer_limit) {
+  const std::size_t elements = prm.texels.size();
+  const auto clusters = static_cast<std::size_t>(prm.cluster_count);
+  const std::size_t stride = pane_stride_words(elements, encoding);
+  const std::size_t pane_bytes = stride * sizeof(std::uint32_t);
   // Whole panes per buffer, as many as fit under the limit.
   const std::size_t panes_per_buffer = std::max<std::size_t>(1, buffer_limit / std::max<std::size_t>(pane_bytes, 1));
-  pass.panes_.resize(clusters);
+  panes_.resize(clusters);
   std::vector<std::uint32_t> words;
   for (std::size_t first = 0; first < clusters; first += panes_per_buffer) {
     const std::size_t count = std::min(panes_per_buffer, clusters - first);
     words.assign(count * stride, 0u);
     for (std::size_t c = first; c < first + count; ++c) {
       const std::span<const float> pane(prm.panes.data() + c * elements * 3, elements * 3);
-      const int exponent = pane_scale_exponent(pane, options.encoding);
+      const int exponent = pane_scale_exponent(pane, encoding);
       const std::size_t offset = (c - first) * stride;
-      pack_pane(pane, exponent, options.encoding, std::span<std::uint32_t>(words).subspan(offset, stride));
-      pass.panes_[c] = {static_cast<std::uint32_t>(pass.pane_buffers_.size()), static_cast<std::uint32_t>(offset),
-                        std::ldexp(1.0f, -exponent)};
+      pack_pane(pane, exponent, encoding, std::span<std::uint32_t>(words).subspan(offset, stride));
+      panes_[c] = {static_cast<std::uint32_t>(pane_buffers_.size()), static_cast<std::uint32_t>(offset),
+                   std::ldexp(1.0f, -exponent)};
     }
     const std::size_t bytes = std::max<std::size_t>(words.size() * sizeof(std::uint32_t), 16);
     words.resize(bytes / sizeof(std::uint32_t), 0u);
-    pass.pane_buffers_.push_back(engine::GlBuffer::create(bytes, words.data()));
-    pass.pane_buffer_bytes_.push_back(bytes);
-    pass.pane_textures_.push_back(engine::GlTexture::create(GL_TEXTURE_BUFFER));
-    glTextureBuffer(pass.pane_textures_.back().id(), GL_RGBA32UI, pass.pane_buffers_.back().id());
+    pane_buffers_.push_back(engine::GlBuffer::create(bytes, words.data()));
+    pane_buffer_bytes_.push_back(bytes);
+    pane_textures_.push_back(engine::GlTexture::create(GL_TEXTURE_BUFFER));
+    glTextureBuffer(pane_textures_.back().id(), GL_RGBA32UI, pane_buffers_.back().id());
   }
-  if (pass.pane_buffers_.empty()) {  // no clusters: a stub so binding 1 always holds a buffer
+  if (pane_buffers_.empty()) {  // no clusters: a stub so binding 1 always holds a buffer
     const std::uint32_t zeros[4] = {};
-    pass.pane_buffers_.push_back(engine::GlBuffer::create(sizeof(zeros), zeros));
-    pass.pane_buffer_bytes_.push_back(sizeof(zeros));
-    pass.pane_textures_.push_back(engine::GlTexture::create(GL_TEXTURE_BUFFER));
-    glTextureBuffer(pass.pane_textures_.back().id(), GL_RGBA32UI, pass.pane_buffers_.back().id());
+    pane_buffers_.push_back(engine::GlBuffer::create(sizeof(zeros), zeros));
+    pane_buffer_bytes_.push_back(sizeof(zeros));
+    pane_textures_.push_back(engine::GlTexture::create(GL_TEXTURE_BUFFER));
+    glTextureBuffer(pane_textures_.back().id(), GL_RGBA32UI, pane_buffers_.back().id());
   }
+}
 
+void PrmGpuPass::upload_texels(const Prm& prm, std::size_t buffer_limit) {
+  const std::size_t elements = prm.texels.size();
   // The shader reads texel coordinates packed x | y << 16 (no division per lane).
   std::vector<std::uint32_t> texels(prm.texels);
   for (std::uint32_t& t : texels) {
@@ -229,23 +259,21 @@ engine::Result<PrmGpuPass> PrmGpuPass::create(const Prm& prm, const PrmGpuPassOp
   }
   texels.resize(std::max<std::size_t>((elements + kBlock - 1) / kBlock * kBlock, kBlock),
                 0u);  // whole blocks; never empty
-  pass.texels_ = engine::GlBuffer::create(texels.size() * sizeof(std::uint32_t), texels.data());
-  pass.texels_texture_ = engine::GlTexture::create(GL_TEXTURE_BUFFER);
-  glTextureBuffer(pass.texels_texture_.id(), GL_RGBA32UI, pass.texels_.id());
-  pass.weights_ = engine::GlBuffer::create();
-  pass.weights_texture_ = engine::GlTexture::create(GL_TEXTURE_BUFFER);
-  pass.max_weights_ = buffer_limit / sizeof(GpuPaneWeight);
+  texels_ = engine::GlBuffer::create(texels.size() * sizeof(std::uint32_t), texels.data());
+  texels_texture_ = engine::GlTexture::create(GL_TEXTURE_BUFFER);
+  glTextureBuffer(texels_texture_.id(), GL_RGBA32UI, texels_.id());
+  weights_ = engine::GlBuffer::create();
+  weights_texture_ = engine::GlTexture::create(GL_TEXTURE_BUFFER);
+  max_weights_ = buffer_limit / sizeof(GpuPaneWeight);
+}
 
-  pass.output_ = engine::GlTexture::create_2d(GL_RGBA32F, prm.width, prm.height);
-  glClearTexImage(pass.output_.id(), 0, GL_RGBA, GL_FLOAT, nullptr);
-  glTextureParameteri(pass.output_.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-  glTextureParameteri(pass.output_.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-  glTextureParameteri(pass.output_.id(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-  glTextureParameteri(pass.output_.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-  if (glGetError() == GL_OUT_OF_MEMORY)
-    return error("out of GPU memory uploading " + std::to_string(clusters) + " panes of " + std::to_string(elements) +
-                 " texels");
-  return pass;
+void PrmGpuPass::create_output() {
+  output_ = engine::GlTexture::create_2d(GL_RGBA32F, width_, height_);
+  glClearTexImage(output_.id(), 0, GL_RGBA, GL_FLOAT, nullptr);
+  glTextureParameteri(output_.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTextureParameteri(output_.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTextureParameteri(output_.id(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTextureParameteri(output_.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
 }
 
 engine::Status PrmGpuPass::run(std::span<const ClusterWeight> selected) {
@@ -258,24 +286,7 @@ engine::Status PrmGpuPass::run(std::span<const ClusterWeight> selected) {
   if (selected.size() > max_weights_)
     return error(std::to_string(selected.size()) + " selected clusters, above the weight buffer's limit of " +
                  std::to_string(max_weights_));
-  // Weights grouped by pane buffer: one dispatch per buffer that holds a selected pane.
-  std::vector<GpuPaneWeight> weights;
-  weights.reserve(std::max<std::size_t>(selected.size(), 1));
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> ranges(pane_buffers_.size(), {0u, 0u});  // first, count
-  for (std::uint32_t b = 0; b < pane_buffers_.size(); ++b) {
-    ranges[b].first = static_cast<std::uint32_t>(weights.size());
-    for (const ClusterWeight& w : selected) {
-      const PaneLocation& p = panes_[w.cluster];
-      if (p.buffer != b) continue;
-      const glm::vec3 scaled = w.weight * (p.inverse_scale * decode_scale_);
-      weights.push_back({scaled.x, scaled.y, scaled.z, p.word_offset / 4});
-    }
-    ranges[b].second = static_cast<std::uint32_t>(weights.size()) - ranges[b].first;
-  }
-  if (weights.empty()) weights.emplace_back();  // GL buffers cannot be empty
-  weights_bytes_ = weights.size() * sizeof(GpuPaneWeight);
-  glNamedBufferData(weights_.id(), static_cast<GLsizeiptr>(weights_bytes_), weights.data(), GL_STREAM_DRAW);
-  glTextureBuffer(weights_texture_.id(), GL_RGBA32UI, weights_.id());
+  const std::vector<std::pair<std::uint32_t, std::uint32_t>> ranges = upload_weights(selected);
   if (element_count_ == 0) return {};
 
   program_.use();
@@ -309,6 +320,29 @@ engine::Status PrmGpuPass::run(std::span<const ClusterWeight> selected) {
   glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT |
                   GL_FRAMEBUFFER_BARRIER_BIT | GL_PIXEL_BUFFER_BARRIER_BIT);
   return {};
+}
+
+std::vector<std::pair<std::uint32_t, std::uint32_t>> PrmGpuPass::upload_weights(
+    std::span<const ClusterWeight> selected) {
+  // Weights grouped by pane buffer: one dispatch per buffer that holds a selected pane.
+  std::vector<GpuPaneWeight> weights;
+  weights.reserve(std::max<std::size_t>(selected.size(), 1));
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> ranges(pane_buffers_.size(), {0u, 0u});  // first, count
+  for (std::uint32_t b = 0; b < pane_buffers_.size(); ++b) {
+    ranges[b].first = static_cast<std::uint32_t>(weights.size());
+    for (const ClusterWeight& w : selected) {
+      const PaneLocation& p = panes_[w.cluster];
+      if (p.buffer != b) continue;
+      const glm::vec3 scaled = w.weight * (p.inverse_scale * decode_scale_);
+      weights.push_back({scaled.x, scaled.y, scaled.z, p.word_offset / 4});
+    }
+    ranges[b].second = static_cast<std::uint32_t>(weights.size()) - ranges[b].first;
+  }
+  if (weights.empty()) weights.emplace_back();  // GL buffers cannot be empty
+  weights_bytes_ = weights.size() * sizeof(GpuPaneWeight);
+  glNamedBufferData(weights_.id(), static_cast<GLsizeiptr>(weights_bytes_), weights.data(), GL_STREAM_DRAW);
+  glTextureBuffer(weights_texture_.id(), GL_RGBA32UI, weights_.id());
+  return ranges;
 }
 
 engine::Status PrmGpuPass::set_base(std::span<const glm::vec3> base_atlas) {

@@ -22,6 +22,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -113,6 +114,17 @@ class PrmGpuPass {
   std::size_t pane_bytes() const;
 
  private:
+  /// Packs the panes into buffers of whole panes under `buffer_limit` bytes each, with their
+  /// buffer textures and each pane's location.
+  void upload_panes(const Prm& prm, PrmPaneEncoding encoding, std::size_t buffer_limit);
+  /// The texel coordinates, packed for the shader, and the empty weights buffer.
+  void upload_texels(const Prm& prm, std::size_t buffer_limit);
+  /// The cleared, bilinear RGBA32F output texture.
+  void create_output();
+  /// Uploads the selected clusters' weights grouped by pane buffer; per buffer the first
+  /// weight and the count of its group.
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> upload_weights(std::span<const ClusterWeight> selected);
+
   /// Where one cluster's pane lives: its buffer, its first word and its packing scale.
   struct PaneLocation {
     std::uint32_t buffer = 0;

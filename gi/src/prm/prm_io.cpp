@@ -240,7 +240,8 @@ engine::Status write_prm_panes(const fs::path& path, const Prm& prm, const std::
 }
 
 engine::Result<PrmPaneFile> read_prm_panes(const fs::path& path) {
-  // Long: the fields in file order, each count checked before the next array is sized from it.
+  // Long because it reads the fields in file order, each count checked before the next array
+  // is sized from it; split, the checks would be parted from the reads they guard.
   auto payload = read_blob(path, kPrmPanesMagic, kPrmPanesVersion);
   if (!payload) return payload.error();
   engine::ByteReader r(payload.value());

@@ -69,28 +69,34 @@ void cutout_filter(const RTCFilterFunctionNArguments* args) {
   }
 }
 
+// The scene's indices, positions, instance geometries and transforms checked before Embree sees them.
+engine::Status check_scene_data(const RtSceneData& data) {
+  for (std::size_t g = 0; g < data.geometries.size(); ++g) {
+    const RtGeometry& geo = data.geometries[g];
+    const std::string where = "geometry " + std::to_string(g);
+    if (geo.indices.size() % 3 != 0) return engine::Error{"", where, "index count is not a multiple of 3"};
+    for (std::uint32_t i : geo.indices)
+      if (i >= geo.positions.size()) return engine::Error{"", where, "index " + std::to_string(i) + " out of range"};
+    for (const glm::vec3& p : geo.positions)
+      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+        return engine::Error{"", where, "non-finite vertex position"};
+  }
+  for (std::size_t i = 0; i < data.instances.size(); ++i) {
+    if (data.instances[i].geometry >= data.geometries.size())
+      return engine::Error{"", "instance " + std::to_string(i), "geometry index out of range"};
+    if (!engine::all_finite(data.instances[i].object_to_world))
+      return engine::Error{"", "instance " + std::to_string(i), "non-finite transform"};
+  }
+  return {};
+}
+
 class EmbreeRayCaster final : public RayCaster {
  public:
   engine::Status build(const RtSceneData& data) {
     data_ = data;
     static_normals_.clear();
     static_normal_of_.clear();
-    for (std::size_t g = 0; g < data_.geometries.size(); ++g) {
-      const RtGeometry& geo = data_.geometries[g];
-      const std::string where = "geometry " + std::to_string(g);
-      if (geo.indices.size() % 3 != 0) return engine::Error{"", where, "index count is not a multiple of 3"};
-      for (std::uint32_t i : geo.indices)
-        if (i >= geo.positions.size()) return engine::Error{"", where, "index " + std::to_string(i) + " out of range"};
-      for (const glm::vec3& p : geo.positions)
-        if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
-          return engine::Error{"", where, "non-finite vertex position"};
-    }
-    for (std::size_t i = 0; i < data_.instances.size(); ++i) {
-      if (data_.instances[i].geometry >= data_.geometries.size())
-        return engine::Error{"", "instance " + std::to_string(i), "geometry index out of range"};
-      if (!engine::all_finite(data_.instances[i].object_to_world))
-        return engine::Error{"", "instance " + std::to_string(i), "non-finite transform"};
-    }
+    if (auto ok = check_scene_data(data_); !ok) return ok;
 
     device_ = DeviceHandle(rtcNewDevice(nullptr));
     if (!device_.h) return engine::Error{"", "embree", "rtcNewDevice failed"};

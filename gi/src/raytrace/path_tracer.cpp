@@ -92,11 +92,18 @@ glm::vec3 PathTracer::direct_light(const glm::vec3& origin, const glm::vec3& p, 
     }
   }
 
-  const EmitterTable& em = index_.emitters;
   const float u_pick = rng.next_float();
   const float u1 = rng.next_float();
   const float u2 = rng.next_float();
-  if (em.triangle.empty()) return sum;
+  if (const std::optional<glm::vec3> e = emitter_light(origin, p, brdf, wo, u_pick, u1, u2)) return sum + *e;
+  return sum;
+}
+
+std::optional<glm::vec3> PathTracer::emitter_light(const glm::vec3& origin, const glm::vec3& p,
+                                                   const ReferenceBrdf& brdf, const glm::vec3& wo, float u_pick,
+                                                   float u1, float u2) const {
+  const EmitterTable& em = index_.emitters;
+  if (em.triangle.empty()) return std::nullopt;
   const auto pick = static_cast<std::size_t>(std::lower_bound(em.cdf.begin(), em.cdf.end(), u_pick) - em.cdf.begin());
   const ShadingTriangle& t = index_.triangles[em.triangle[std::min(pick, em.triangle.size() - 1)]];
   const ReferenceMaterial& mat = scene_.materials[t.material];
@@ -106,18 +113,18 @@ glm::vec3 PathTracer::direct_light(const glm::vec3& origin, const glm::vec3& p, 
   const glm::vec3 q = t.p0 + su * (1.0f - u2) * t.e1 + su * u2 * t.e2;
   const glm::vec3 to = q - p;
   const float d2 = glm::dot(to, to);
-  if (!(d2 > 0.0f)) return sum;
+  if (!(d2 > 0.0f)) return std::nullopt;
   const glm::vec3 wi = to / std::sqrt(d2);
   float cos_light = -glm::dot(wi, t.face_normal);
   if (mat.double_sided) cos_light = std::fabs(cos_light);
   const float pdf_light = emitter_pdf(t, d2, cos_light);
-  if (!(pdf_light > 0.0f) || !std::isfinite(pdf_light)) return sum;
+  if (!(pdf_light > 0.0f) || !std::isfinite(pdf_light)) return std::nullopt;
   const glm::vec3 fcos = brdf.eval_cos(wo, wi);
-  if (fcos == glm::vec3(0.0f)) return sum;
+  if (fcos == glm::vec3(0.0f)) return std::nullopt;
   // Stop just short of the emitter so it does not occlude itself.
-  if (caster_.occluded(Ray{origin, 0.0f, q - origin, 0.9999f})) return sum;
+  if (caster_.occluded(Ray{origin, 0.0f, q - origin, 0.9999f})) return std::nullopt;
   const float weight = power_heuristic(pdf_light, brdf.pdf(wo, wi));
-  return sum + emission_at(scene_, t, bary, 0.0f) * fcos * (weight / pdf_light);
+  return emission_at(scene_, t, bary, 0.0f) * fcos * (weight / pdf_light);
 }
 
 PathTracer::Traced PathTracer::trace(Ray ray, float prev_pdf, int max_light_vertex, Pcg32& rng) const {

@@ -6,6 +6,7 @@
 //   glm::vec3 L = pt.radiance(camera_ray, rng);
 
 #include <limits>
+#include <optional>
 
 #include <glm/glm.hpp>
 
@@ -63,6 +64,10 @@ class PathTracer {
   /// Next-event estimation at a surface point: every analytic light plus one emitter.
   glm::vec3 direct_light(const glm::vec3& origin, const glm::vec3& p, const ReferenceBrdf& brdf, const glm::vec3& wo,
                          Pcg32& rng) const;
+  /// direct_light()'s emitter sample: the emitter triangle picked by u_pick and its point at
+  /// (u1, u2), MIS-weighted; nullopt when it adds nothing.
+  std::optional<glm::vec3> emitter_light(const glm::vec3& origin, const glm::vec3& p, const ReferenceBrdf& brdf,
+                                         const glm::vec3& wo, float u_pick, float u1, float u2) const;
   /// Solid-angle density with which direct_light() samples a point on emitter triangle t.
   float emitter_pdf(const ShadingTriangle& t, float distance2, float cos_light) const;
 

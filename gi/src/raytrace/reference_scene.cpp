@@ -70,9 +70,8 @@ void index_emitters(const ReferenceScene& scene, ReferenceSceneIndex& index, boo
   if (!index.emitters.cdf.empty()) index.emitters.cdf.back() = 1.0f;
 }
 
-}  // namespace
-
-engine::Result<ReferenceSceneIndex> index_reference_scene(const ReferenceScene& scene) {
+// The scene's materials, UV sets, textures and lights checked before indexing.
+engine::Status check_scene(const ReferenceScene& scene) {
   const RtSceneData& g = scene.geometry;
   if (scene.normals.size() != g.geometries.size() || scene.triangle_material.size() != g.geometries.size())
     return scene_error("geometries", "normals/materials given for " + std::to_string(scene.normals.size()) + "/" +
@@ -105,79 +104,109 @@ engine::Result<ReferenceSceneIndex> index_reference_scene(const ReferenceScene& 
         !engine::all_finite(l.half_x) || !engine::all_finite(l.half_y))
       return scene_error("light " + std::to_string(i), "non-finite position, direction, size or intensity");
   }
+  return {};
+}
 
+// What one instance's triangles share: its vertex normals and UV sets (null: none), its
+// transform's normal matrix and whether it mirrors.
+struct InstanceFrame {
+  const std::vector<glm::vec3>& normals;
+  const std::vector<glm::vec2>* uv_sets[2];
+  glm::mat3 normal_matrix;
+  bool mirrored;
+};
+
+// The world-space triangle of vertices vi (positions p) with its face and vertex normals,
+// material and UVs with their density.
+ShadingTriangle shading_triangle(const glm::vec3 (&p)[3], const std::uint32_t (&vi)[3], const InstanceFrame& f,
+                                 std::uint32_t material) {
+  ShadingTriangle tri;
+  tri.p0 = p[0];
+  tri.e1 = p[1] - p[0];
+  tri.e2 = p[2] - p[0];
+  const glm::vec3 c = glm::cross(tri.e1, tri.e2);
+  const float len = glm::length(c);
+  tri.area_m2 = 0.5f * len;
+  tri.face_normal = len > 0.0f ? c / len : glm::vec3(0.0f, 1.0f, 0.0f);
+  if (f.mirrored) tri.face_normal = -tri.face_normal;
+  glm::vec3 n[3];
+  for (int k = 0; k < 3; ++k) {
+    n[k] = f.normals.empty() ? tri.face_normal : f.normal_matrix * f.normals[vi[k]];
+    const float nl = glm::length(n[k]);
+    n[k] = (nl > 0.0f && std::isfinite(nl)) ? n[k] / nl : tri.face_normal;
+  }
+  tri.n0 = n[0];
+  tri.n1 = n[1];
+  tri.n2 = n[2];
+  tri.material = material;
+  for (int set = 0; set < 2; ++set) {
+    if (!f.uv_sets[set]) continue;
+    glm::vec2* uv = set == 0 ? tri.uv0 : tri.uv1;
+    for (int k = 0; k < 3; ++k) uv[k] = (*f.uv_sets[set])[vi[k]];
+    const glm::vec2 a = uv[1] - uv[0], b = uv[2] - uv[0];
+    const float uv_area = 0.5f * std::fabs(a.x * b.y - a.y * b.x);
+    const float per_m = tri.area_m2 > 0.0f ? std::sqrt(uv_area / tri.area_m2) : 0.0f;
+    tri.uv_per_m[set] = std::isfinite(per_m) ? per_m : 0.0f;
+  }
+  return tri;
+}
+
+// Appends instance `inst`'s triangles to the index (checked), growing the bounds lo..hi.
+engine::Status index_instance(const ReferenceScene& scene, std::size_t inst, ReferenceSceneIndex& index, glm::vec3& lo,
+                              glm::vec3& hi) {
+  const RtSceneData& g = scene.geometry;
+  const RtInstance& in = g.instances[inst];
+  const std::string where = "instance " + std::to_string(inst);
+  if (in.geometry >= g.geometries.size()) return scene_error(where, "geometry index out of range");
+  const RtGeometry& geo = g.geometries[in.geometry];
+  const auto& mats = scene.triangle_material[in.geometry];
+  const std::size_t tri_count = geo.indices.size() / 3;
+  const glm::mat4& m = in.object_to_world;
+  InstanceFrame frame{scene.normals[in.geometry],
+                      {nullptr, nullptr},
+                      glm::transpose(glm::inverse(glm::mat3(m))),
+                      glm::determinant(glm::mat3(m)) < 0.0f};  // glTF: front faces turn clockwise
+  if (!frame.normals.empty() && frame.normals.size() != geo.positions.size())
+    return scene_error(where, "normal count differs from vertex count");
+  if (mats.size() != tri_count) return scene_error(where, "material count differs from triangle count");
+  for (int set = 0; set < 2; ++set) {
+    const auto& uvs = set == 0 ? scene.uv0 : scene.uv1;
+    if (uvs.empty() || uvs[in.geometry].empty()) continue;
+    if (uvs[in.geometry].size() != geo.positions.size())
+      return scene_error(where, "TEXCOORD_" + std::to_string(set) + " count differs from vertex count");
+    frame.uv_sets[set] = &uvs[in.geometry];
+  }
+  index.instance_first.push_back(static_cast<std::uint32_t>(index.triangles.size()));
+  for (std::size_t t = 0; t < tri_count; ++t) {
+    std::uint32_t vi[3];
+    for (int k = 0; k < 3; ++k) {
+      vi[k] = geo.indices[3 * t + static_cast<std::size_t>(k)];
+      if (vi[k] >= geo.positions.size())
+        return scene_error(where, "triangle " + std::to_string(t) + ": index out of range");
+    }
+    if (mats[t] >= scene.materials.size())
+      return scene_error(where, "triangle " + std::to_string(t) + ": material index out of range");
+    glm::vec3 p[3];
+    for (int k = 0; k < 3; ++k) {
+      p[k] = glm::vec3(m * glm::vec4(geo.positions[vi[k]], 1.0f));
+      if (!engine::all_finite(p[k]))
+        return scene_error(where, "triangle " + std::to_string(t) + ": non-finite position");
+      lo = glm::min(lo, p[k]);
+      hi = glm::max(hi, p[k]);
+    }
+    index.triangles.push_back(shading_triangle(p, vi, frame, mats[t]));
+  }
+  return {};
+}
+
+}  // namespace
+
+engine::Result<ReferenceSceneIndex> index_reference_scene(const ReferenceScene& scene) {
+  if (engine::Status ok = check_scene(scene); !ok) return ok.error();
   ReferenceSceneIndex index;
   glm::vec3 lo(INFINITY), hi(-INFINITY);
-  for (std::size_t inst = 0; inst < g.instances.size(); ++inst) {
-    const RtInstance& in = g.instances[inst];
-    const std::string where = "instance " + std::to_string(inst);
-    if (in.geometry >= g.geometries.size()) return scene_error(where, "geometry index out of range");
-    const RtGeometry& geo = g.geometries[in.geometry];
-    const auto& normals = scene.normals[in.geometry];
-    const auto& mats = scene.triangle_material[in.geometry];
-    const std::size_t tri_count = geo.indices.size() / 3;
-    if (!normals.empty() && normals.size() != geo.positions.size())
-      return scene_error(where, "normal count differs from vertex count");
-    if (mats.size() != tri_count) return scene_error(where, "material count differs from triangle count");
-    const std::vector<glm::vec2>* uv_sets[2] = {nullptr, nullptr};
-    for (int set = 0; set < 2; ++set) {
-      const auto& uvs = set == 0 ? scene.uv0 : scene.uv1;
-      if (uvs.empty() || uvs[in.geometry].empty()) continue;
-      if (uvs[in.geometry].size() != geo.positions.size())
-        return scene_error(where, "TEXCOORD_" + std::to_string(set) + " count differs from vertex count");
-      uv_sets[set] = &uvs[in.geometry];
-    }
-    const glm::mat4& m = in.object_to_world;
-    const glm::mat3 normal_matrix = glm::transpose(glm::inverse(glm::mat3(m)));
-    const bool mirrored = glm::determinant(glm::mat3(m)) < 0.0f;  // glTF: front faces turn clockwise
-    index.instance_first.push_back(static_cast<std::uint32_t>(index.triangles.size()));
-    for (std::size_t t = 0; t < tri_count; ++t) {
-      std::uint32_t vi[3];
-      for (int k = 0; k < 3; ++k) {
-        vi[k] = geo.indices[3 * t + static_cast<std::size_t>(k)];
-        if (vi[k] >= geo.positions.size())
-          return scene_error(where, "triangle " + std::to_string(t) + ": index out of range");
-      }
-      if (mats[t] >= scene.materials.size())
-        return scene_error(where, "triangle " + std::to_string(t) + ": material index out of range");
-      glm::vec3 p[3], n[3];
-      for (int k = 0; k < 3; ++k) {
-        p[k] = glm::vec3(m * glm::vec4(geo.positions[vi[k]], 1.0f));
-        if (!engine::all_finite(p[k]))
-          return scene_error(where, "triangle " + std::to_string(t) + ": non-finite position");
-        lo = glm::min(lo, p[k]);
-        hi = glm::max(hi, p[k]);
-      }
-      ShadingTriangle tri;
-      tri.p0 = p[0];
-      tri.e1 = p[1] - p[0];
-      tri.e2 = p[2] - p[0];
-      const glm::vec3 c = glm::cross(tri.e1, tri.e2);
-      const float len = glm::length(c);
-      tri.area_m2 = 0.5f * len;
-      tri.face_normal = len > 0.0f ? c / len : glm::vec3(0.0f, 1.0f, 0.0f);
-      if (mirrored) tri.face_normal = -tri.face_normal;
-      for (int k = 0; k < 3; ++k) {
-        n[k] = normals.empty() ? tri.face_normal : normal_matrix * normals[vi[k]];
-        const float nl = glm::length(n[k]);
-        n[k] = (nl > 0.0f && std::isfinite(nl)) ? n[k] / nl : tri.face_normal;
-      }
-      tri.n0 = n[0];
-      tri.n1 = n[1];
-      tri.n2 = n[2];
-      tri.material = mats[t];
-      for (int set = 0; set < 2; ++set) {
-        if (!uv_sets[set]) continue;
-        glm::vec2* uv = set == 0 ? tri.uv0 : tri.uv1;
-        for (int k = 0; k < 3; ++k) uv[k] = (*uv_sets[set])[vi[k]];
-        const glm::vec2 a = uv[1] - uv[0], b = uv[2] - uv[0];
-        const float uv_area = 0.5f * std::fabs(a.x * b.y - a.y * b.x);
-        const float per_m = tri.area_m2 > 0.0f ? std::sqrt(uv_area / tri.area_m2) : 0.0f;
-        tri.uv_per_m[set] = std::isfinite(per_m) ? per_m : 0.0f;
-      }
-      index.triangles.push_back(tri);
-    }
-  }
+  for (std::size_t inst = 0; inst < scene.geometry.instances.size(); ++inst)
+    if (engine::Status ok = index_instance(scene, inst, index, lo, hi); !ok) return ok.error();
   index.scene_radius_m = index.triangles.empty() ? 1.0f : 0.5f * glm::length(hi - lo);
 
   index.light_has_proxy.assign(scene.lights.size(), false);

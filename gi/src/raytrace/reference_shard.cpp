@@ -363,6 +363,64 @@ engine::Result<fs::path> reference_shard(const BakeInput& input, const Reference
   return path;
 }
 
+namespace {
+
+// The camera image from every shard's pixels, each checked to be its shard's blocks.
+engine::Result<engine::ImageRgbaF> merge_image(const ReferenceJob& job, const ShardSet<ShardFile>& set,
+                                               std::uint32_t count) {
+  const auto& shards = set.shards;
+  const auto& where = set.where;
+  const std::size_t w = static_cast<std::size_t>(job.image->width), h = static_cast<std::size_t>(job.image->height);
+  engine::ImageRgbaF image;
+  image.width = job.image->width;
+  image.height = job.image->height;
+  image.pixels.assign(w * h * 4, 1.0f);
+  for (std::uint32_t i = 0; i < count; ++i) {
+    const ImagePart& p = *shards[i]->image;
+    if (p.width != job.image->width || p.height != job.image->height || p.pixels != shard_items(i, count, w * h))
+      return engine::Error{where[i].string(), "image",
+                           "image shard " + std::to_string(i) + " of " + std::to_string(count) +
+                               ": its pixels are not that shard's blocks of this " + std::to_string(w) + "x" +
+                               std::to_string(h) + " image"};
+    for (std::size_t k = 0; k < p.pixels.size(); ++k)
+      for (int c = 0; c < 3; ++c)
+        image.pixels[4 * std::size_t{p.pixels[k]} + static_cast<std::size_t>(c)] = p.rgb[k][c];
+  }
+  return image;
+}
+
+// The atlas truth from every shard's texels, each checked to be its shard's blocks.
+engine::Result<AtlasReference> merge_atlas(const BakeInput& input, const ReferenceJob& job,
+                                           const ShardSet<ShardFile>& set, std::uint32_t count) {
+  const auto& shards = set.shards;
+  const auto& where = set.where;
+  auto setup = atlas_setup(input, *job.atlas);
+  if (!setup) return setup.error();
+  const std::size_t n = setup->points.size();
+  IrradianceEstimate e;
+  e.direct.assign(n, glm::vec3(0.0f));
+  e.indirect.assign(n, glm::vec3(0.0f));
+  e.indirect_variance.assign(n, glm::vec3(0.0f));
+  for (std::uint32_t i = 0; i < count; ++i) {
+    const AtlasPart& a = *shards[i]->atlas;
+    if (a.width != setup->texels.width || a.height != setup->texels.height || a.points != n ||
+        a.texels_per_metre != setup->texels_per_metre || a.indices != shard_items(i, count, n))
+      return engine::Error{where[i].string(), "atlas",
+                           "atlas shard " + std::to_string(i) + " of " + std::to_string(count) +
+                               ": its texels are not that shard's blocks of this scene's " +
+                               std::to_string(setup->texels.width) + "x" + std::to_string(setup->texels.height) +
+                               " atlas (" + std::to_string(n) + " valid texels)"};
+    for (std::size_t k = 0; k < a.indices.size(); ++k) {
+      e.direct[a.indices[k]] = a.direct[k];
+      e.indirect[a.indices[k]] = a.indirect[k];
+      e.indirect_variance[a.indices[k]] = a.variance[k];
+    }
+  }
+  return to_reference(*setup, assemble_atlas_irradiance(setup->texels, e));
+}
+
+}  // namespace
+
 engine::Result<ReferenceOutputs> merge_reference_shards(const BakeInput& input, const ReferenceJob& job,
                                                         const fs::path& shard_dir, std::uint32_t count) {
   if (auto ok = check_job(job); !ok) return ok.error();
@@ -398,53 +456,16 @@ engine::Result<ReferenceOutputs> merge_reference_shards(const BakeInput& input, 
   if (auto ok = set.complete(count, [&](std::uint32_t i) { return shard_dir / reference_shard_file_name(i, count); });
       !ok)
     return ok.error();
-  const auto& shards = set.shards;
-  const auto& where = set.where;
-
   ReferenceOutputs out;
   if (job.image) {
-    const std::size_t w = static_cast<std::size_t>(job.image->width), h = static_cast<std::size_t>(job.image->height);
-    engine::ImageRgbaF image;
-    image.width = job.image->width;
-    image.height = job.image->height;
-    image.pixels.assign(w * h * 4, 1.0f);
-    for (std::uint32_t i = 0; i < count; ++i) {
-      const ImagePart& p = *shards[i]->image;
-      if (p.width != job.image->width || p.height != job.image->height || p.pixels != shard_items(i, count, w * h))
-        return engine::Error{where[i].string(), "image",
-                             "image shard " + std::to_string(i) + " of " + std::to_string(count) +
-                                 ": its pixels are not that shard's blocks of this " + std::to_string(w) + "x" +
-                                 std::to_string(h) + " image"};
-      for (std::size_t k = 0; k < p.pixels.size(); ++k)
-        for (int c = 0; c < 3; ++c)
-          image.pixels[4 * std::size_t{p.pixels[k]} + static_cast<std::size_t>(c)] = p.rgb[k][c];
-    }
-    out.image = std::move(image);
+    auto image = merge_image(job, set, count);
+    if (!image) return image.error();
+    out.image = std::move(image).value();
   }
   if (job.atlas) {
-    auto setup = atlas_setup(input, *job.atlas);
-    if (!setup) return setup.error();
-    const std::size_t n = setup->points.size();
-    IrradianceEstimate e;
-    e.direct.assign(n, glm::vec3(0.0f));
-    e.indirect.assign(n, glm::vec3(0.0f));
-    e.indirect_variance.assign(n, glm::vec3(0.0f));
-    for (std::uint32_t i = 0; i < count; ++i) {
-      const AtlasPart& a = *shards[i]->atlas;
-      if (a.width != setup->texels.width || a.height != setup->texels.height || a.points != n ||
-          a.texels_per_metre != setup->texels_per_metre || a.indices != shard_items(i, count, n))
-        return engine::Error{where[i].string(), "atlas",
-                             "atlas shard " + std::to_string(i) + " of " + std::to_string(count) +
-                                 ": its texels are not that shard's blocks of this scene's " +
-                                 std::to_string(setup->texels.width) + "x" + std::to_string(setup->texels.height) +
-                                 " atlas (" + std::to_string(n) + " valid texels)"};
-      for (std::size_t k = 0; k < a.indices.size(); ++k) {
-        e.direct[a.indices[k]] = a.direct[k];
-        e.indirect[a.indices[k]] = a.indirect[k];
-        e.indirect_variance[a.indices[k]] = a.variance[k];
-      }
-    }
-    out.atlas = to_reference(*setup, assemble_atlas_irradiance(setup->texels, e));
+    auto atlas = merge_atlas(input, job, set, count);
+    if (!atlas) return atlas.error();
+    out.atlas = std::move(atlas).value();
   }
   return out;
 }

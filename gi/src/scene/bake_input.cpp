@@ -265,7 +265,9 @@ BakeInput bake_input_from(const engine::Scene& scene) {
   return in;
 }
 
-engine::Status validate_bake_input(const BakeInput& input) {
+namespace {
+
+engine::Status check_materials(const BakeInput& input) {
   for (std::size_t mi = 0; mi < input.materials.size(); ++mi) {
     const BakeMaterial& m = input.materials[mi];
     const std::string where = "material " + std::to_string(mi) + " '" + m.name + "'";
@@ -295,6 +297,10 @@ engine::Status validate_bake_input(const BakeInput& input) {
         return input_error(where, std::string(what) + " texture: the transform is NaN or infinite");
     }
   }
+  return {};
+}
+
+engine::Status check_images(const BakeInput& input) {
   // Only images a material's texture reads must hold texels: a loader need not decode the
   // others (a glTF's images for extensions the engine does not read, e.g. transmission).
   std::vector<bool> referenced(input.images.size(), false);
@@ -312,39 +318,51 @@ engine::Status validate_bake_input(const BakeInput& input) {
       return input_error(where, std::to_string(img.rgba8.size()) + " bytes for " + std::to_string(img.width) + " x " +
                                     std::to_string(img.height) + " RGBA8 texels");
   }
+  return {};
+}
+
+engine::Status check_primitive(const BakeInput& input, const BakePrimitive& p, const std::string& where) {
+  if (p.indices.size() % 3 != 0) return input_error(where, "the index count is not a multiple of 3");
+  if (!p.normals.empty() && p.normals.size() != p.positions.size())
+    return input_error(
+        where, std::to_string(p.normals.size()) + " normals for " + std::to_string(p.positions.size()) + " positions");
+  for (std::uint32_t i : p.indices)
+    if (i >= p.positions.size())
+      return input_error(
+          where, "index " + std::to_string(i) + " out of range (" + std::to_string(p.positions.size()) + " vertices)");
+  for (const glm::vec3& v : p.positions)
+    if (!engine::all_finite(v)) return input_error(where, "a position is NaN or infinite");
+  for (const glm::vec3& v : p.normals)
+    if (!engine::all_finite(v)) return input_error(where, "a normal is NaN or infinite");
+  if (p.material >= static_cast<int>(input.materials.size()))
+    return input_error(where, "material " + std::to_string(p.material) + " out of range (" +
+                                  std::to_string(input.materials.size()) + " materials)");
+  for (const auto* uv : {&p.uv0, &p.uv1}) {
+    if (!uv->empty() && uv->size() != p.positions.size())
+      return input_error(where, std::to_string(uv->size()) + " TEXCOORD_" + (uv == &p.uv0 ? "0" : "1") +
+                                    " values for " + std::to_string(p.positions.size()) + " positions");
+    for (const glm::vec2& t : *uv)
+      if (!engine::all_finite(t)) return input_error(where, "a texture coordinate is NaN or infinite");
+  }
+  if (p.material >= 0)
+    if (const std::string missing = missing_uv_set(input.materials[static_cast<std::size_t>(p.material)], p);
+        !missing.empty())
+      return input_error(where, missing);
+  return {};
+}
+
+engine::Status check_meshes(const BakeInput& input) {
   for (std::size_t mi = 0; mi < input.meshes.size(); ++mi) {
     const BakeMesh& mesh = input.meshes[mi];
     for (std::size_t pi = 0; pi < mesh.primitives.size(); ++pi) {
-      const BakePrimitive& p = mesh.primitives[pi];
       const std::string where = "mesh " + std::to_string(mi) + " '" + mesh.name + "' primitive " + std::to_string(pi);
-      if (p.indices.size() % 3 != 0) return input_error(where, "the index count is not a multiple of 3");
-      if (!p.normals.empty() && p.normals.size() != p.positions.size())
-        return input_error(where, std::to_string(p.normals.size()) + " normals for " +
-                                      std::to_string(p.positions.size()) + " positions");
-      for (std::uint32_t i : p.indices)
-        if (i >= p.positions.size())
-          return input_error(where, "index " + std::to_string(i) + " out of range (" +
-                                        std::to_string(p.positions.size()) + " vertices)");
-      for (const glm::vec3& v : p.positions)
-        if (!engine::all_finite(v)) return input_error(where, "a position is NaN or infinite");
-      for (const glm::vec3& v : p.normals)
-        if (!engine::all_finite(v)) return input_error(where, "a normal is NaN or infinite");
-      if (p.material >= static_cast<int>(input.materials.size()))
-        return input_error(where, "material " + std::to_string(p.material) + " out of range (" +
-                                      std::to_string(input.materials.size()) + " materials)");
-      for (const auto* uv : {&p.uv0, &p.uv1}) {
-        if (!uv->empty() && uv->size() != p.positions.size())
-          return input_error(where, std::to_string(uv->size()) + " TEXCOORD_" + (uv == &p.uv0 ? "0" : "1") +
-                                        " values for " + std::to_string(p.positions.size()) + " positions");
-        for (const glm::vec2& t : *uv)
-          if (!engine::all_finite(t)) return input_error(where, "a texture coordinate is NaN or infinite");
-      }
-      if (p.material >= 0)
-        if (const std::string missing = missing_uv_set(input.materials[static_cast<std::size_t>(p.material)], p);
-            !missing.empty())
-          return input_error(where, missing);
+      if (auto ok = check_primitive(input, mesh.primitives[pi], where); !ok) return ok;
     }
   }
+  return {};
+}
+
+engine::Status check_instances(const BakeInput& input) {
   for (std::size_t ii = 0; ii < input.instances.size(); ++ii) {
     const BakeInstance& inst = input.instances[ii];
     const std::string where = "instance " + std::to_string(ii) + " '" + inst.name + "'";
@@ -357,6 +375,10 @@ engine::Status validate_bake_input(const BakeInput& input) {
     const float det = glm::determinant(glm::mat3(inst.object_to_world));
     if (!std::isfinite(det) || std::fabs(det) < 1e-18f) return input_error(where, "the transform is not invertible");
   }
+  return {};
+}
+
+engine::Status check_lights_and_environment(const BakeInput& input) {
   for (std::size_t li = 0; li < input.lights.size(); ++li) {
     const BakeLight& l = input.lights[li];
     const std::string where = "light " + std::to_string(li) + " '" + l.name + "'";
@@ -375,6 +397,15 @@ engine::Status validate_bake_input(const BakeInput& input) {
                              input.environment.sky_gradient.ground})
     if (!engine::all_finite(g) || glm::any(glm::lessThan(g, glm::vec3(0.0f))))
       return input_error("environment", "the sky gradient's zenith, horizon and ground must be finite and >= 0");
+  return {};
+}
+
+}  // namespace
+
+engine::Status validate_bake_input(const BakeInput& input) {
+  for (engine::Status (*check)(const BakeInput&) :
+       {check_materials, check_images, check_meshes, check_instances, check_lights_and_environment})
+    if (auto ok = check(input); !ok) return ok;
   return {};
 }
 

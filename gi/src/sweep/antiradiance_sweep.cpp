@@ -153,18 +153,8 @@ const engine::GpuContext* gl_context() {
 
 glm::vec3 ref_at(const RgbField& f, std::size_t i) { return {f.rgb[3 * i], f.rgb[3 * i + 1], f.rgb[3 * i + 2]}; }
 
-}  // namespace
-
-void register_antiradiance_sweep(SweepRegistry& registry) {
-  registry.add_reference_provider(
-      {.kind = "atlas_indirect_irradiance_door", .version = "pt-1", .compute = door_reference});
-
-  SweepMethod m;
-  m.name = method_descriptor(EffectMethod::Antiradiance).key;  // gi/methods.h
-  m.description =
-      "antiradiance (Dachsbacher 2007): element size x bins x iterations vs the path-traced change of indirect "
-      "irradiance when the deforming node swings -50, -25, +50 degrees from its baked pose";
-  m.knobs = {
+std::vector<KnobSpec> antiradiance_knobs() {
+  return {
       {.name = "patch",
        .description = "leaf element size: longest triangle-piece edge, metres (sets the hierarchy's depth)",
        .kind = KnobKind::Real,
@@ -218,168 +208,235 @@ void register_antiradiance_sweep(SweepRegistry& registry) {
        .min_value = 1,
        .max_value = 1 << 20},
   };
-  m.reference_for = [](const SweepScene&, const KnobSetting& k) {
-    ReferenceRequest r;
-    r.kind = "atlas_indirect_irradiance_door";
-    r.params = {{"texels_per_m", k.text("density")},
-                {"radius", k.text("radius")},
-                {"spp", std::to_string(k.integer("ref_spp"))},
-                {"swings", kSwingsKey}};
-    return r;
-  };
-  m.run = [](const RunContext& ctx) -> engine::Result<MethodOutput> {
-    auto d = door_setup(ctx.scene, ctx.knobs.real("density"), ctx.knobs.real("radius"));
-    if (!d) return d.error();
-    const std::size_t n = d->texels.valid.size();
-    if (ctx.reference.width != d->texels.width || ctx.reference.height != d->texels.height * static_cast<int>(kPoses))
-      return engine::Error{.message = "the atlas size differs from the reference's"};
-    AntiradianceSettings s;
-    s.patch_size_m = static_cast<float>(ctx.knobs.real("patch"));
-    s.bins_per_side = static_cast<int>(ctx.knobs.integer("bins"));
-    s.iterations = static_cast<int>(ctx.knobs.integer("iterations"));
-    s.scheme =
-        ctx.knobs.text("scheme") == "asymmetric" ? AntiradianceScheme::Asymmetric : AntiradianceScheme::Symmetric;
-    s.oracle_scale = static_cast<float>(ctx.knobs.real("oracle"));
-    s.seed = ctx.seed;
+}
 
-    const auto t_bake = Clock::now();
-    auto bake = bake_antiradiance(d->input, s);
-    if (!bake) return bake.error();
-    MethodOutput out;
-    out.costs.bake_seconds = ms_since(t_bake) / 1000.0;
-    if (ctx.progress && !ctx.progress(0.3)) return engine::cancelled_error("antiradiance run");
-    // What the bundle stores: antiradiance.bin as gi-bake writes it.
-    {
-      const std::filesystem::path file =
-          std::filesystem::temp_directory_path() / ("gi-sweep-antiradiance-" + std::to_string(ctx.seed) + "-" +
-                                                    std::to_string(reinterpret_cast<std::uintptr_t>(&out)) + ".bin");
-      if (engine::Status st = write_antiradiance(file, *bake, "sweep"); !st) return st.error();
-      std::error_code ec;
-      out.costs.bytes = static_cast<std::uint64_t>(std::filesystem::file_size(file, ec));
-      std::filesystem::remove(file, ec);
+ReferenceRequest door_reference_request(const SweepScene&, const KnobSetting& k) {
+  ReferenceRequest r;
+  r.kind = "atlas_indirect_irradiance_door";
+  r.params = {{"texels_per_m", k.text("density")},
+              {"radius", k.text("radius")},
+              {"spp", std::to_string(k.integer("ref_spp"))},
+              {"swings", kSwingsKey}};
+  return r;
+}
+
+AntiradianceSettings antiradiance_settings(const RunContext& ctx) {
+  AntiradianceSettings s;
+  s.patch_size_m = static_cast<float>(ctx.knobs.real("patch"));
+  s.bins_per_side = static_cast<int>(ctx.knobs.integer("bins"));
+  s.iterations = static_cast<int>(ctx.knobs.integer("iterations"));
+  s.scheme = ctx.knobs.text("scheme") == "asymmetric" ? AntiradianceScheme::Asymmetric : AntiradianceScheme::Symmetric;
+  s.oracle_scale = static_cast<float>(ctx.knobs.real("oracle"));
+  s.seed = ctx.seed;
+  return s;
+}
+
+// What the bundle stores: the size of antiradiance.bin as gi-bake writes it (`unique` names
+// the temporary file apart from concurrent runs').
+engine::Result<std::uint64_t> stored_bytes(const AntiradianceBake& bake, std::uint64_t seed, const void* unique) {
+  const std::filesystem::path file =
+      std::filesystem::temp_directory_path() / ("gi-sweep-antiradiance-" + std::to_string(seed) + "-" +
+                                                std::to_string(reinterpret_cast<std::uintptr_t>(unique)) + ".bin");
+  if (engine::Status st = write_antiradiance(file, bake, "sweep"); !st) return st.error();
+  std::error_code ec;
+  const auto bytes = static_cast<std::uint64_t>(std::filesystem::file_size(file, ec));
+  std::filesystem::remove(file, ec);
+  return bytes;
+}
+
+// The door moves on the CPU twin scored against the reference's changes: the field of every
+// pose, the timings, and the change statistics (correlation sums and per-angle errors).
+struct DoorMoveScores {
+  std::vector<glm::vec3> values;
+  std::vector<std::uint8_t> valid;
+  double move_ms = 0.0, solve_ms = 0.0;
+  double so = 0.0, sr = 0.0, soo = 0.0, srr = 0.0, sor = 0.0, samples = 0.0;  // change correlation
+  double level = 0.0;  // mean |E_ref(baked)| per channel over the compared texels
+  std::vector<std::pair<std::string, double>> per_angle;
+};
+
+// Each door move on the CPU twin: relink + direct light (update(false)), then the solve.
+engine::Result<DoorMoveScores> score_door_moves(const RunContext& ctx, const DoorSetup& d, AntiradianceRegion& region,
+                                                const std::vector<AntiradianceTexelBlend>& blends) {
+  const std::size_t n = d.texels.valid.size();
+  DoorMoveScores s;
+  s.values.assign(n * kPoses, glm::vec3(0.0f));
+  s.valid.assign(n * kPoses, 0);
+  for (std::size_t t = 0; t < n; ++t)
+    if (d.mask[t]) {
+      const glm::vec3 e = ref_at(ctx.reference, t);
+      s.level += static_cast<double>(e.x + e.y + e.z);
     }
-    auto region = AntiradianceRegion::create(d->input, std::move(bake).value());
-    if (!region) return region.error();
-    const std::vector<AntiradianceTexelBlend> blends =
-        antiradiance_texel_blends(region->hierarchy(), d->input, d->layout);
+  s.level /= 3.0 * static_cast<double>(d.compared);
+  const double level = s.level;
+  for (std::size_t k = 1; k < kPoses; ++k) {
+    region.set_instance_transform(d.door, d.pose(kSwings[k - 1]));
+    const auto t0 = Clock::now();
+    region.update(false);
+    s.move_ms += ms_since(t0);
+    const auto t1 = Clock::now();
+    const AntiradianceSolveReport rep = region.update(true);  // nothing moved since: the solve only
+    s.solve_ms += ms_since(t1);
+    (void)rep;
+    const std::vector<glm::vec3> delta = region.delta(region.irradiance());
+    std::vector<glm::vec3> dt(n, glm::vec3(0.0f));
+    for (const AntiradianceTexelBlend& b : blends) dt[b.texel] = blend_leaves(b, delta);
+    double err2 = 0.0, change2 = 0.0, mean_o = 0.0, mean_r = 0.0;
+    for (std::size_t t = 0; t < n; ++t) {
+      if (!d.mask[t]) continue;
+      const glm::vec3 base = ref_at(ctx.reference, t);
+      s.values[k * n + t] = base + dt[t];
+      s.valid[k * n + t] = 1;
+      const glm::vec3 e = dt[t] - (ref_at(ctx.reference, k * n + t) - base);
+      err2 += static_cast<double>(glm::dot(e, e));
+      const glm::vec3 c = ref_at(ctx.reference, k * n + t) - base;
+      change2 += static_cast<double>(glm::dot(c, c));
+      for (int ch = 0; ch < 3; ++ch) {
+        const double o = static_cast<double>(dt[t][ch]), r = static_cast<double>(c[ch]);
+        mean_o += o, mean_r += r;
+        s.so += o, s.sr += r, s.soo += o * o, s.srr += r * r, s.sor += o * r, s.samples += 1.0;
+      }
+    }
+    const double nrmse = std::sqrt(err2 / (3.0 * static_cast<double>(d.compared))) / level;
+    const int swing = static_cast<int>(kSwings[k - 1]);
+    const std::string name = std::string(swing < 0 ? "m" : "p") + std::to_string(std::abs(swing));
+    s.per_angle.emplace_back("change_nrmse_swing_" + name, nrmse);
+    // What leaving the baked atlas unchanged scores by the same measure: the true change.
+    s.per_angle.emplace_back("nothing_nrmse_swing_" + name,
+                             std::sqrt(change2 / (3.0 * static_cast<double>(d.compared))) / level);
+    // The mean over the compared texels (zone averages, as the corridor test compares them):
+    // the true mean change and the error of the method's, both / level.
+    const double count = 3.0 * static_cast<double>(d.compared);
+    s.per_angle.emplace_back("true_mean_change_swing_" + name, mean_r / count / level);
+    s.per_angle.emplace_back("mean_change_error_swing_" + name, (mean_o - mean_r) / count / level);
+    if (ctx.progress && !ctx.progress(0.3 + 0.5 * static_cast<double>(k) / static_cast<double>(kPoses - 1)))
+      return engine::cancelled_error("antiradiance run");
+  }
+  return s;
+}
 
-    // Each door move on the CPU twin: relink + direct light (update(false)), then the solve.
-    std::vector<glm::vec3> values(n * kPoses, glm::vec3(0.0f));
-    std::vector<std::uint8_t> valid(n * kPoses, 0);
-    const double nan = std::numeric_limits<double>::quiet_NaN();
-    double move_ms = 0.0, solve_ms = 0.0;
-    double so = 0.0, sr = 0.0, soo = 0.0, srr = 0.0, sor = 0.0, samples = 0.0;  // change correlation
-    double level = 0.0;  // mean |E_ref(baked)| per channel over the compared texels
+// The GPU's door move: its time, its buffers' bytes and its largest difference from the CPU
+// twin (relative to the largest CPU irradiance). NaN each when no GPU pass can be made.
+struct GpuDoorMove {
+  double ms = std::numeric_limits<double>::quiet_NaN();
+  double bytes = std::numeric_limits<double>::quiet_NaN();
+  double cpu_diff = std::numeric_limits<double>::quiet_NaN();
+};
+
+engine::Result<GpuDoorMove> time_gpu_door_move(const DoorSetup& d, AntiradianceRegion& region) {
+  GpuDoorMove g;
+  const engine::GpuContext* gl = gl_context();
+  if (!gl) return g;
+  gl->make_current();
+  auto gpu = AntiradianceGpuPass::create(region.hierarchy(), region.bins(), region.links());
+  if (!gpu) return g;  // above the SSBO limit (or no compute shaders): the GPU columns stay empty
+  // The runtime's door move (AntiradianceLighting::update): relink + direct light on
+  // the CPU, link upload, the iteration, the result read back; back to the first swing.
+  region.set_instance_transform(d.door, d.pose(kSwings[0]));
+  const auto t0 = Clock::now();
+  region.update(false);
+  if (engine::Status st = gpu->set_links(region.links()); !st) return st.error();
+  const AntiradianceSolveReport rep = run_antiradiance(*gpu, region.direct(), region.settings(), region.hierarchy());
+  std::vector<glm::vec3> e = gpu->irradiance();
+  glFinish();
+  g.ms = ms_since(t0);
+  g.bytes = static_cast<double>(gpu->gpu_bytes());
+  region.update(true);
+  const std::vector<glm::vec3> cpu = region.irradiance();
+  double diff = 0.0, scale = 0.0;
+  for (std::size_t l = 0; l < e.size() && l < cpu.size(); ++l) {
+    diff = std::max(diff, static_cast<double>(glm::length(rep.output_scale * e[l] - cpu[l])));
+    scale = std::max(scale, static_cast<double>(glm::length(cpu[l])));
+  }
+  g.cpu_diff = scale > 0.0 ? diff / scale : 0.0;
+  return g;
+}
+
+// What changing nothing scores (the baked atlas left as it is) on the same texels: the
+// field with every moved pose's compared texels set back to the reference's baked pose.
+RgbField nothing_changed(const RgbField& field, const RgbField& reference, const DoorSetup& d) {
+  const std::size_t n = d.texels.valid.size();
+  RgbField nothing = field;
+  for (std::size_t k = 1; k < kPoses; ++k)
     for (std::size_t t = 0; t < n; ++t)
-      if (d->mask[t]) {
-        const glm::vec3 e = ref_at(ctx.reference, t);
-        level += static_cast<double>(e.x + e.y + e.z);
-      }
-    level /= 3.0 * static_cast<double>(d->compared);
-    std::vector<std::pair<std::string, double>> per_angle;
-    for (std::size_t k = 1; k < kPoses; ++k) {
-      region->set_instance_transform(d->door, d->pose(kSwings[k - 1]));
-      const auto t0 = Clock::now();
-      region->update(false);
-      move_ms += ms_since(t0);
-      const auto t1 = Clock::now();
-      const AntiradianceSolveReport rep = region->update(true);  // nothing moved since: the solve only
-      solve_ms += ms_since(t1);
-      (void)rep;
-      const std::vector<glm::vec3> delta = region->delta(region->irradiance());
-      std::vector<glm::vec3> dt(n, glm::vec3(0.0f));
-      for (const AntiradianceTexelBlend& b : blends) dt[b.texel] = blend_leaves(b, delta);
-      double err2 = 0.0, change2 = 0.0, mean_o = 0.0, mean_r = 0.0;
-      for (std::size_t t = 0; t < n; ++t) {
-        if (!d->mask[t]) continue;
-        const glm::vec3 base = ref_at(ctx.reference, t);
-        values[k * n + t] = base + dt[t];
-        valid[k * n + t] = 1;
-        const glm::vec3 e = dt[t] - (ref_at(ctx.reference, k * n + t) - base);
-        err2 += static_cast<double>(glm::dot(e, e));
-        const glm::vec3 c = ref_at(ctx.reference, k * n + t) - base;
-        change2 += static_cast<double>(glm::dot(c, c));
-        for (int ch = 0; ch < 3; ++ch) {
-          const double o = static_cast<double>(dt[t][ch]), r = static_cast<double>(c[ch]);
-          mean_o += o, mean_r += r;
-          so += o, sr += r, soo += o * o, srr += r * r, sor += o * r, samples += 1.0;
-        }
-      }
-      const double nrmse = std::sqrt(err2 / (3.0 * static_cast<double>(d->compared))) / level;
-      const int swing = static_cast<int>(kSwings[k - 1]);
-      const std::string name = std::string(swing < 0 ? "m" : "p") + std::to_string(std::abs(swing));
-      per_angle.emplace_back("change_nrmse_swing_" + name, nrmse);
-      // What leaving the baked atlas unchanged scores by the same measure: the true change.
-      per_angle.emplace_back("nothing_nrmse_swing_" + name,
-                             std::sqrt(change2 / (3.0 * static_cast<double>(d->compared))) / level);
-      // The mean over the compared texels (zone averages, as the corridor test compares them):
-      // the true mean change and the error of the method's, both / level.
-      const double count = 3.0 * static_cast<double>(d->compared);
-      per_angle.emplace_back("true_mean_change_swing_" + name, mean_r / count / level);
-      per_angle.emplace_back("mean_change_error_swing_" + name, (mean_o - mean_r) / count / level);
-      if (ctx.progress && !ctx.progress(0.3 + 0.5 * static_cast<double>(k) / static_cast<double>(kPoses - 1)))
-        return engine::cancelled_error("antiradiance run");
-    }
-    const double moves = static_cast<double>(kPoses - 1);
-    out.costs.frame_ms = (move_ms + solve_ms) / moves;
-    out.field =
-        RgbField::from_texels(d->texels.width, d->texels.height * static_cast<int>(kPoses), values, std::move(valid));
+      if (d.mask[t])
+        for (int c = 0; c < 3; ++c)
+          nothing.rgb[3 * (k * n + t) + static_cast<std::size_t>(c)] =
+              reference.rgb[3 * t + static_cast<std::size_t>(c)];
+  return nothing;
+}
 
-    // What changing nothing scores (the baked atlas left as it is) on the same texels.
-    RgbField nothing = out.field;
-    for (std::size_t k = 1; k < kPoses; ++k)
-      for (std::size_t t = 0; t < n; ++t)
-        if (d->mask[t])
-          for (int c = 0; c < 3; ++c)
-            nothing.rgb[3 * (k * n + t) + static_cast<std::size_t>(c)] =
-                ctx.reference.rgb[3 * t + static_cast<std::size_t>(c)];
+engine::Result<MethodOutput> run_door_moves(const RunContext& ctx) {
+  auto d = door_setup(ctx.scene, ctx.knobs.real("density"), ctx.knobs.real("radius"));
+  if (!d) return d.error();
+  if (ctx.reference.width != d->texels.width || ctx.reference.height != d->texels.height * static_cast<int>(kPoses))
+    return engine::Error{.message = "the atlas size differs from the reference's"};
+  const AntiradianceSettings s = antiradiance_settings(ctx);
 
-    double gpu_ms = nan, gpu_bytes = nan, gpu_cpu_diff = nan;
-    if (ctx.knobs.text("gpu") == "on") {
-      if (const engine::GpuContext* gl = gl_context()) {
-        gl->make_current();
-        auto gpu = AntiradianceGpuPass::create(region->hierarchy(), region->bins(), region->links());
-        if (gpu) {
-          // The runtime's door move (AntiradianceLighting::update): relink + direct light on
-          // the CPU, link upload, the iteration, the result read back; back to the first swing.
-          region->set_instance_transform(d->door, d->pose(kSwings[0]));
-          const auto t0 = Clock::now();
-          region->update(false);
-          if (engine::Status st = gpu->set_links(region->links()); !st) return st.error();
-          const AntiradianceSolveReport rep =
-              run_antiradiance(*gpu, region->direct(), region->settings(), region->hierarchy());
-          std::vector<glm::vec3> e = gpu->irradiance();
-          glFinish();
-          gpu_ms = ms_since(t0);
-          gpu_bytes = static_cast<double>(gpu->gpu_bytes());
-          region->update(true);
-          const std::vector<glm::vec3> cpu = region->irradiance();
-          double diff = 0.0, scale = 0.0;
-          for (std::size_t l = 0; l < e.size() && l < cpu.size(); ++l) {
-            diff = std::max(diff, static_cast<double>(glm::length(rep.output_scale * e[l] - cpu[l])));
-            scale = std::max(scale, static_cast<double>(glm::length(cpu[l])));
-          }
-          gpu_cpu_diff = scale > 0.0 ? diff / scale : 0.0;
-        }  // else: above the SSBO limit (or no compute shaders): the GPU columns stay empty
-      }
-    }
-    const double cov = sor - so * sr / samples, var_o = soo - so * so / samples, var_r = srr - sr * sr / samples;
-    out.extras = {{"nothing_rel_rmse", compare_rgb(nothing, ctx.reference).rel_rmse},
-                  {"change_correlation", var_o > 0.0 && var_r > 0.0 ? cov / std::sqrt(var_o * var_r) : nan},
-                  {"change_fit_scale", soo > 0.0 ? sor / soo : nan}};
-    out.extras.insert(out.extras.end(), per_angle.begin(), per_angle.end());
-    out.extras.insert(out.extras.end(), {{"cpu_move_ms", move_ms / moves},
-                                         {"cpu_solve_ms", solve_ms / moves},
-                                         {"gpu_frame_ms", gpu_ms},
-                                         {"gpu_bytes", gpu_bytes},
-                                         {"gpu_cpu_rel_diff", gpu_cpu_diff},
-                                         {"elements", static_cast<double>(region->hierarchy().nodes.size())},
-                                         {"leaves", static_cast<double>(region->hierarchy().leaf_count())},
-                                         {"links", static_cast<double>(region->links().links.size())},
-                                         {"compared_texels", static_cast<double>(d->compared)},
-                                         {"level", level}});
-    return out;
-  };
+  const auto t_bake = Clock::now();
+  auto bake = bake_antiradiance(d->input, s);
+  if (!bake) return bake.error();
+  MethodOutput out;
+  out.costs.bake_seconds = ms_since(t_bake) / 1000.0;
+  if (ctx.progress && !ctx.progress(0.3)) return engine::cancelled_error("antiradiance run");
+  auto bytes = stored_bytes(*bake, ctx.seed, &out);
+  if (!bytes) return bytes.error();
+  out.costs.bytes = *bytes;
+  auto region = AntiradianceRegion::create(d->input, std::move(bake).value());
+  if (!region) return region.error();
+  const std::vector<AntiradianceTexelBlend> blends =
+      antiradiance_texel_blends(region->hierarchy(), d->input, d->layout);
+
+  auto scores = score_door_moves(ctx, *d, *region, blends);
+  if (!scores) return scores.error();
+  DoorMoveScores& sc = *scores;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double moves = static_cast<double>(kPoses - 1);
+  out.costs.frame_ms = (sc.move_ms + sc.solve_ms) / moves;
+  out.field = RgbField::from_texels(d->texels.width, d->texels.height * static_cast<int>(kPoses), sc.values,
+                                    std::move(sc.valid));
+
+  GpuDoorMove gpu;
+  if (ctx.knobs.text("gpu") == "on") {
+    auto timed = time_gpu_door_move(*d, *region);
+    if (!timed) return timed.error();
+    gpu = *timed;
+  }
+  const double samples = sc.samples;
+  const double cov = sc.sor - sc.so * sc.sr / samples, var_o = sc.soo - sc.so * sc.so / samples,
+               var_r = sc.srr - sc.sr * sc.sr / samples;
+  out.extras = {
+      {"nothing_rel_rmse", compare_rgb(nothing_changed(out.field, ctx.reference, *d), ctx.reference).rel_rmse},
+      {"change_correlation", var_o > 0.0 && var_r > 0.0 ? cov / std::sqrt(var_o * var_r) : nan},
+      {"change_fit_scale", sc.soo > 0.0 ? sc.sor / sc.soo : nan}};
+  out.extras.insert(out.extras.end(), sc.per_angle.begin(), sc.per_angle.end());
+  out.extras.insert(out.extras.end(), {{"cpu_move_ms", sc.move_ms / moves},
+                                       {"cpu_solve_ms", sc.solve_ms / moves},
+                                       {"gpu_frame_ms", gpu.ms},
+                                       {"gpu_bytes", gpu.bytes},
+                                       {"gpu_cpu_rel_diff", gpu.cpu_diff},
+                                       {"elements", static_cast<double>(region->hierarchy().nodes.size())},
+                                       {"leaves", static_cast<double>(region->hierarchy().leaf_count())},
+                                       {"links", static_cast<double>(region->links().links.size())},
+                                       {"compared_texels", static_cast<double>(d->compared)},
+                                       {"level", sc.level}});
+  return out;
+}
+
+}  // namespace
+
+void register_antiradiance_sweep(SweepRegistry& registry) {
+  registry.add_reference_provider(
+      {.kind = "atlas_indirect_irradiance_door", .version = "pt-1", .compute = door_reference});
+
+  SweepMethod m;
+  m.name = method_descriptor(EffectMethod::Antiradiance).key;  // gi/methods.h
+  m.description =
+      "antiradiance (Dachsbacher 2007): element size x bins x iterations vs the path-traced change of indirect "
+      "irradiance when the deforming node swings -50, -25, +50 degrees from its baked pose";
+  m.knobs = antiradiance_knobs();
+  m.reference_for = door_reference_request;
+  m.run = run_door_moves;
   registry.add_method(std::move(m));
 }
 

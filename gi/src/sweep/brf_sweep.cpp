@@ -105,36 +105,27 @@ std::vector<SurfacePoint> vertex_points(const Objects& o) {
   return points;
 }
 
-}  // namespace
+engine::Result<RgbField> brf_vertex_reference(const ReferenceJob& job) {
+  const engine::Scene scene =
+      objects_only(job.scene.asset, job.request.param("objects") == "apart", job.request.param("metal"));
+  const BakeInput input = bake_input_from(scene);
+  auto objects = scene_objects(input);
+  if (!objects) return objects.error();
+  const std::vector<SurfacePoint> points = vertex_points(*objects);
+  ReferenceSettings rs;
+  rs.samples_per_pixel = std::stoi(job.request.param("spp"));
+  rs.seed = kReferenceSeed;
+  rs.threads = job.threads;
+  rs.progress = job.progress;
+  auto truth = estimate_irradiance(reference_scene_from(input), points, rs);
+  if (!truth) return truth.error();
+  const std::vector<std::uint8_t> valid(points.size(), 1);
+  return RgbField::from_texels(static_cast<int>(points.size()), 1, truth->indirect, valid);
+}
 
-void register_brf_sweep(SweepRegistry& registry) {
-  registry.add_reference_provider(
-      {.kind = "brf_vertex_indirect",
-       .version = "pt-1",
-       .compute = [](const ReferenceJob& job) -> engine::Result<RgbField> {
-         const engine::Scene scene =
-             objects_only(job.scene.asset, job.request.param("objects") == "apart", job.request.param("metal"));
-         const BakeInput input = bake_input_from(scene);
-         auto objects = scene_objects(input);
-         if (!objects) return objects.error();
-         const std::vector<SurfacePoint> points = vertex_points(*objects);
-         ReferenceSettings rs;
-         rs.samples_per_pixel = std::stoi(job.request.param("spp"));
-         rs.seed = kReferenceSeed;
-         rs.threads = job.threads;
-         rs.progress = job.progress;
-         auto truth = estimate_irradiance(reference_scene_from(input), points, rs);
-         if (!truth) return truth.error();
-         const std::vector<std::uint8_t> valid(points.size(), 1);
-         return RgbField::from_texels(static_cast<int>(points.size()), 1, truth->indirect, valid);
-       }});
-
-  SweepMethod m;
-  m.name = method_descriptor(EffectMethod::BasisRadianceFields).key;  // gi/methods.h
-  m.description =
-      "basis radiance fields (Iwasaki et al.): basis N x SH bands x spheres x face points x lights x bounces, dynamic "
-      "objects' vertices";
-  m.knobs = {
+// Long because it is one table, one entry per knob with its grid and range, read as a list.
+std::vector<KnobSpec> brf_knobs() {
+  return {
       {.name = "basis",
        .description = "PCA basis functions N (mean included)",
        .kind = KnobKind::Integer,
@@ -212,81 +203,114 @@ void register_brf_sweep(SweepRegistry& registry) {
        .min_value = 4,
        .max_value = 64},
   };
-  m.reference_for = [](const SweepScene&, const KnobSetting& k) {
-    ReferenceRequest r;
-    r.kind = "brf_vertex_indirect";
-    r.params.emplace_back("spp", std::to_string(k.integer("ref_spp")));
-    r.params.emplace_back("objects", k.text("objects"));
-    r.params.emplace_back("metal", k.text("metal"));
-    return r;
-  };
-  m.run = [](const RunContext& ctx) -> engine::Result<MethodOutput> {
-    const engine::Scene scene =
-        objects_only(ctx.scene.asset, ctx.knobs.text("objects") == "apart", ctx.knobs.text("metal"));
-    const BakeInput input = bake_input_from(scene);
-    auto objects = scene_objects(input);
-    if (!objects) return objects.error();
-    const auto t0 = std::chrono::steady_clock::now();
-    std::vector<BrfBasis> bases;
-    std::vector<BasisRadianceField> fields;
-    std::vector<std::optional<BrdfSeparation>> glossy(objects->sources.size());
-    std::uint64_t bytes = 0;
-    for (std::size_t s = 0; s < objects->sources.size(); ++s) {
-      const BrfMesh& mesh = objects->sources[s].mesh;
-      if (objects->sources[s].glossy) {
-        auto sep = separate_glossy_brdf(*objects->sources[s].glossy,
-                                        {.terms = static_cast<int>(ctx.knobs.integer("glossy_terms")),
-                                         .resolution = static_cast<int>(ctx.knobs.integer("brdf_res"))});
-        if (!sep) return sep.error();
-        glossy[s] = std::move(sep).value();
-      }
-      const BrdfSeparation* g = glossy[s] ? &*glossy[s] : nullptr;
-      auto basis = compute_pca_basis(mesh,
-                                     {.lights = static_cast<int>(ctx.knobs.integer("lights")),
-                                      .basis = static_cast<int>(ctx.knobs.integer("basis"))},
-                                     g);
-      if (!basis) return basis.error();
-      auto field = compute_basis_radiance_field(mesh, *basis,
-                                                {.spheres = static_cast<int>(ctx.knobs.integer("spheres")),
-                                                 .face_resolution = static_cast<int>(ctx.knobs.integer("face_res")),
-                                                 .sh_bands = static_cast<int>(ctx.knobs.integer("bands")),
-                                                 .directions = static_cast<int>(ctx.knobs.integer("directions")),
-                                                 .threads = ctx.threads},
-                                                g);
-      if (!field) return field.error();
-      bytes += field->bytes() + basis->psi.size() * sizeof(float);
-      bases.push_back(std::move(basis).value());
-      fields.push_back(std::move(field).value());
-      if (!ctx.progress(0.9 * static_cast<double>(s + 1) / static_cast<double>(objects->sources.size())))
-        return engine::cancelled_error("BRF sweep run");
+}
+
+ReferenceRequest brf_reference_request(const SweepScene&, const KnobSetting& k) {
+  ReferenceRequest r;
+  r.kind = "brf_vertex_indirect";
+  r.params.emplace_back("spp", std::to_string(k.integer("ref_spp")));
+  r.params.emplace_back("objects", k.text("objects"));
+  r.params.emplace_back("metal", k.text("metal"));
+  return r;
+}
+
+// Each source object's bake: its glossy BRDF separation (glossy materials only), PCA basis
+// and basis radiance field, with the bytes the fields and bases take.
+struct BakedSources {
+  std::vector<BrfBasis> bases;
+  std::vector<BasisRadianceField> fields;
+  std::vector<std::optional<BrdfSeparation>> glossy;
+  std::uint64_t bytes = 0;
+};
+
+engine::Result<BakedSources> bake_sources(const RunContext& ctx, const Objects& objects) {
+  BakedSources b;
+  b.glossy.resize(objects.sources.size());
+  for (std::size_t s = 0; s < objects.sources.size(); ++s) {
+    const BrfMesh& mesh = objects.sources[s].mesh;
+    if (objects.sources[s].glossy) {
+      auto sep = separate_glossy_brdf(*objects.sources[s].glossy,
+                                      {.terms = static_cast<int>(ctx.knobs.integer("glossy_terms")),
+                                       .resolution = static_cast<int>(ctx.knobs.integer("brdf_res"))});
+      if (!sep) return sep.error();
+      b.glossy[s] = std::move(sep).value();
     }
-    const double bake_s = seconds_since(t0);
-    std::vector<BrfObject> brf;
-    for (const Objects::Instance& in : objects->instances)
-      brf.push_back({&objects->sources[in.source].mesh, &bases[in.source], &fields[in.source], in.transform, in.albedo,
-                     glossy[in.source] ? &*glossy[in.source] : nullptr, in.specular});
-    std::vector<ReferenceLight> lights = bake_lights(input, BakeLights::Static);
-    for (ReferenceLight& l : bake_lights(input, BakeLights::Moving)) lights.push_back(l);
-    const std::vector<PointEmitter> emitters = light_point_emitters(lights, 64, ctx.seed);
-    const auto t1 = std::chrono::steady_clock::now();
-    const BrfResult r = update_brf(brf, emitters,
-                                   {.bounces = static_cast<int>(ctx.knobs.integer("bounces")),
-                                    .cull_threshold = 0.0f,
-                                    .occlusion = ctx.knobs.text("occlusion") == "on"});
-    const double frame_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t1).count();
-    std::vector<glm::vec3> values;  // the irradiance: each object's first block
-    for (std::size_t i = 0; i < r.indirect.size(); ++i)
-      values.insert(values.end(), r.indirect[i].begin(),
-                    r.indirect[i].begin() + static_cast<std::ptrdiff_t>(brf[i].mesh->positions.size()));
-    if (static_cast<int>(values.size()) != ctx.reference.width)
-      return engine::Error{.message = "vertex count differs from the reference's"};
-    MethodOutput out;
-    out.field = RgbField::from_texels(ctx.reference.width, 1, values, ctx.reference.valid);
-    out.costs.bake_seconds = bake_s;
-    out.costs.frame_ms = frame_ms;
-    out.costs.bytes = bytes;
-    return out;
-  };
+    const BrdfSeparation* g = b.glossy[s] ? &*b.glossy[s] : nullptr;
+    auto basis = compute_pca_basis(mesh,
+                                   {.lights = static_cast<int>(ctx.knobs.integer("lights")),
+                                    .basis = static_cast<int>(ctx.knobs.integer("basis"))},
+                                   g);
+    if (!basis) return basis.error();
+    auto field = compute_basis_radiance_field(mesh, *basis,
+                                              {.spheres = static_cast<int>(ctx.knobs.integer("spheres")),
+                                               .face_resolution = static_cast<int>(ctx.knobs.integer("face_res")),
+                                               .sh_bands = static_cast<int>(ctx.knobs.integer("bands")),
+                                               .directions = static_cast<int>(ctx.knobs.integer("directions")),
+                                               .threads = ctx.threads},
+                                              g);
+    if (!field) return field.error();
+    b.bytes += field->bytes() + basis->psi.size() * sizeof(float);
+    b.bases.push_back(std::move(basis).value());
+    b.fields.push_back(std::move(field).value());
+    if (!ctx.progress(0.9 * static_cast<double>(s + 1) / static_cast<double>(objects.sources.size())))
+      return engine::cancelled_error("BRF sweep run");
+  }
+  return b;
+}
+
+engine::Result<MethodOutput> run_brf(const RunContext& ctx) {
+  const engine::Scene scene =
+      objects_only(ctx.scene.asset, ctx.knobs.text("objects") == "apart", ctx.knobs.text("metal"));
+  const BakeInput input = bake_input_from(scene);
+  auto objects = scene_objects(input);
+  if (!objects) return objects.error();
+  const auto t0 = std::chrono::steady_clock::now();
+  auto baked = bake_sources(ctx, *objects);
+  if (!baked) return baked.error();
+  const std::vector<BrfBasis>& bases = baked->bases;
+  const std::vector<BasisRadianceField>& fields = baked->fields;
+  const std::vector<std::optional<BrdfSeparation>>& glossy = baked->glossy;
+  const double bake_s = seconds_since(t0);
+  std::vector<BrfObject> brf;
+  for (const Objects::Instance& in : objects->instances)
+    brf.push_back({&objects->sources[in.source].mesh, &bases[in.source], &fields[in.source], in.transform, in.albedo,
+                   glossy[in.source] ? &*glossy[in.source] : nullptr, in.specular});
+  std::vector<ReferenceLight> lights = bake_lights(input, BakeLights::Static);
+  for (ReferenceLight& l : bake_lights(input, BakeLights::Moving)) lights.push_back(l);
+  const std::vector<PointEmitter> emitters = light_point_emitters(lights, 64, ctx.seed);
+  const auto t1 = std::chrono::steady_clock::now();
+  const BrfResult r = update_brf(brf, emitters,
+                                 {.bounces = static_cast<int>(ctx.knobs.integer("bounces")),
+                                  .cull_threshold = 0.0f,
+                                  .occlusion = ctx.knobs.text("occlusion") == "on"});
+  const double frame_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t1).count();
+  std::vector<glm::vec3> values;  // the irradiance: each object's first block
+  for (std::size_t i = 0; i < r.indirect.size(); ++i)
+    values.insert(values.end(), r.indirect[i].begin(),
+                  r.indirect[i].begin() + static_cast<std::ptrdiff_t>(brf[i].mesh->positions.size()));
+  if (static_cast<int>(values.size()) != ctx.reference.width)
+    return engine::Error{.message = "vertex count differs from the reference's"};
+  MethodOutput out;
+  out.field = RgbField::from_texels(ctx.reference.width, 1, values, ctx.reference.valid);
+  out.costs.bake_seconds = bake_s;
+  out.costs.frame_ms = frame_ms;
+  out.costs.bytes = baked->bytes;
+  return out;
+}
+
+}  // namespace
+
+void register_brf_sweep(SweepRegistry& registry) {
+  registry.add_reference_provider({.kind = "brf_vertex_indirect", .version = "pt-1", .compute = brf_vertex_reference});
+
+  SweepMethod m;
+  m.name = method_descriptor(EffectMethod::BasisRadianceFields).key;  // gi/methods.h
+  m.description =
+      "basis radiance fields (Iwasaki et al.): basis N x SH bands x spheres x face points x lights x bounces, dynamic "
+      "objects' vertices";
+  m.knobs = brf_knobs();
+  m.reference_for = brf_reference_request;
+  m.run = run_brf;
   registry.add_method(std::move(m));
 }
 

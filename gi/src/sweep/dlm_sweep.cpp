@@ -106,18 +106,8 @@ engine::Result<RgbField> glossy_specular_reference(const ReferenceJob& job) {
   return RgbField::from_texels(tex.width, tex.height, out, g->glossy);
 }
 
-}  // namespace
-
-void register_dlm_sweep(SweepRegistry& registry) {
-  registry.add_reference_provider(
-      {.kind = "atlas_glossy_specular", .version = "pt-1", .compute = glossy_specular_reference});
-
-  SweepMethod m;
-  m.name = method_descriptor(EffectMethod::DirectionalLightMaps).key;  // gi/methods.h
-  m.description =
-      "directional light maps (Hey 2002): directions x photons x density vs the path-traced specular indirect "
-      "radiance of the glossy texels towards camera 0";
-  m.knobs = {
+std::vector<KnobSpec> dlm_knobs() {
+  return {
       {.name = "directions",
        .description = "directions in the global set Omega",
        .kind = KnobKind::Integer,
@@ -149,71 +139,87 @@ void register_dlm_sweep(SweepRegistry& registry) {
        .min_value = 1,
        .max_value = 1 << 20},
   };
-  m.reference_for = [](const SweepScene&, const KnobSetting& k) {
-    ReferenceRequest r;
-    r.kind = "atlas_glossy_specular";
-    char density[32];
-    std::snprintf(density, sizeof density, "%g", k.real("density"));
-    r.params = {{"texels_per_m", density},
-                {"spp", std::to_string(k.integer("ref_spp"))},
-                {"roughness", "0.35"},
-                {"camera", "0"}};
-    return r;
-  };
-  m.run = [](const RunContext& ctx) -> engine::Result<MethodOutput> {
-    DlmSettings s;
-    s.directions = static_cast<int>(ctx.knobs.integer("directions"));
-    s.photons = static_cast<std::uint64_t>(ctx.knobs.integer("kphotons")) * 1000u;
-    s.texels_per_metre = static_cast<float>(ctx.knobs.real("density"));
-    s.splat_radius_texels = static_cast<float>(ctx.knobs.real("splat"));
-    s.glossy_roughness = 0.35f;
-    s.seed = ctx.seed;
-    s.threads = ctx.threads;
-    s.progress = ctx.progress;
-    const engine::Scene scene = engine::instantiate(ctx.scene.asset);
-    auto dlm = bake_dlm(bake_input_from(scene), s);
-    if (!dlm) return dlm.error();
-    if (dlm->width != ctx.reference.width || dlm->height != ctx.reference.height)
-      return engine::Error{.message = "the maps' atlas size differs from the reference's"};
-    auto g = glossy_texels(ctx.scene, ctx.knobs.real("density"), 0.35, nullptr);
-    if (!g) return g.error();
-    // The renderer's evaluation (engine::directional_specular) at every stored glossy texel.
-    const AtlasTexels& tex = g->s.texels;
-    std::vector<glm::vec3> values(tex.valid.size(), glm::vec3(0.0f));
-    // The direction-less alternative on the same texels: the maps' own irradiance
-    // E = sum_k L_k C_k reflected as E / pi x the specular albedo (what the renderer draws
-    // without DLM from a perfect atlas): the "atlas_rel_rmse" extra.
-    std::vector<glm::vec3> atlas_values(tex.valid.size(), glm::vec3(0.0f));
-    std::vector<std::uint8_t> mask(tex.valid.size(), 0);
-    std::vector<glm::vec3> l(dlm->directions.size());
-    for (std::size_t i = 0; i < dlm->texels.size(); ++i) {
-      const std::uint32_t t = dlm->texels[i];
-      if (!g->glossy[t]) continue;
-      for (std::size_t k = 0; k < l.size(); ++k) {
-        const float* v = &dlm->radiance[(k * dlm->texels.size() + i) * 3];
-        l[k] = glm::vec3(v[0], v[1], v[2]);
-      }
-      const glm::vec3 v = glm::normalize(g->eye - tex.position[t]);
-      values[t] = engine::directional_specular(g->brdf[t], tex.normal[t], v, dlm->directions, l);
-      const std::vector<float> c = dlm_bin_cosine_weights(dlm->directions, tex.normal[t]);
-      glm::vec3 e(0.0f);
-      for (std::size_t k = 0; k < l.size(); ++k) e += c[k] * l[k];
-      atlas_values[t] =
-          e / 3.14159265f * engine::gltf_directional_albedo(g->brdf[t], glm::dot(tex.normal[t], v)).specular;
-      mask[t] = 1;
+}
+
+ReferenceRequest dlm_reference_request(const SweepScene&, const KnobSetting& k) {
+  ReferenceRequest r;
+  r.kind = "atlas_glossy_specular";
+  char density[32];
+  std::snprintf(density, sizeof density, "%g", k.real("density"));
+  r.params = {
+      {"texels_per_m", density}, {"spp", std::to_string(k.integer("ref_spp"))}, {"roughness", "0.35"}, {"camera", "0"}};
+  return r;
+}
+
+engine::Result<MethodOutput> run_dlm(const RunContext& ctx) {
+  DlmSettings s;
+  s.directions = static_cast<int>(ctx.knobs.integer("directions"));
+  s.photons = static_cast<std::uint64_t>(ctx.knobs.integer("kphotons")) * 1000u;
+  s.texels_per_metre = static_cast<float>(ctx.knobs.real("density"));
+  s.splat_radius_texels = static_cast<float>(ctx.knobs.real("splat"));
+  s.glossy_roughness = 0.35f;
+  s.seed = ctx.seed;
+  s.threads = ctx.threads;
+  s.progress = ctx.progress;
+  const engine::Scene scene = engine::instantiate(ctx.scene.asset);
+  auto dlm = bake_dlm(bake_input_from(scene), s);
+  if (!dlm) return dlm.error();
+  if (dlm->width != ctx.reference.width || dlm->height != ctx.reference.height)
+    return engine::Error{.message = "the maps' atlas size differs from the reference's"};
+  auto g = glossy_texels(ctx.scene, ctx.knobs.real("density"), 0.35, nullptr);
+  if (!g) return g.error();
+  // The renderer's evaluation (engine::directional_specular) at every stored glossy texel.
+  const AtlasTexels& tex = g->s.texels;
+  std::vector<glm::vec3> values(tex.valid.size(), glm::vec3(0.0f));
+  // The direction-less alternative on the same texels: the maps' own irradiance
+  // E = sum_k L_k C_k reflected as E / pi x the specular albedo (what the renderer draws
+  // without DLM from a perfect atlas): the "atlas_rel_rmse" extra.
+  std::vector<glm::vec3> atlas_values(tex.valid.size(), glm::vec3(0.0f));
+  std::vector<std::uint8_t> mask(tex.valid.size(), 0);
+  std::vector<glm::vec3> l(dlm->directions.size());
+  for (std::size_t i = 0; i < dlm->texels.size(); ++i) {
+    const std::uint32_t t = dlm->texels[i];
+    if (!g->glossy[t]) continue;
+    for (std::size_t k = 0; k < l.size(); ++k) {
+      const float* v = &dlm->radiance[(k * dlm->texels.size() + i) * 3];
+      l[k] = glm::vec3(v[0], v[1], v[2]);
     }
-    MethodOutput out;
-    const RgbField atlas_field = RgbField::from_texels(tex.width, tex.height, atlas_values, mask);
-    out.field = RgbField::from_texels(tex.width, tex.height, values, std::move(mask));
-    out.costs.bake_seconds = dlm->stats.total_seconds;
-    // What the runtime uploads: texels x directions x 8 B + the R32I index map.
-    out.costs.bytes = static_cast<std::uint64_t>(dlm->texels.size()) * dlm->directions.size() * 8u +
-                      static_cast<std::uint64_t>(dlm->width) * static_cast<std::uint64_t>(dlm->height) * 4u;
-    out.extras = {{"atlas_rel_rmse", relative_rmse(atlas_field, ctx.reference)},
-                  {"glossy_texels", static_cast<double>(dlm->stats.glossy_texels)},
-                  {"deposits", static_cast<double>(dlm->stats.deposits)}};
-    return out;
-  };
+    const glm::vec3 v = glm::normalize(g->eye - tex.position[t]);
+    values[t] = engine::directional_specular(g->brdf[t], tex.normal[t], v, dlm->directions, l);
+    const std::vector<float> c = dlm_bin_cosine_weights(dlm->directions, tex.normal[t]);
+    glm::vec3 e(0.0f);
+    for (std::size_t k = 0; k < l.size(); ++k) e += c[k] * l[k];
+    atlas_values[t] =
+        e / 3.14159265f * engine::gltf_directional_albedo(g->brdf[t], glm::dot(tex.normal[t], v)).specular;
+    mask[t] = 1;
+  }
+  MethodOutput out;
+  const RgbField atlas_field = RgbField::from_texels(tex.width, tex.height, atlas_values, mask);
+  out.field = RgbField::from_texels(tex.width, tex.height, values, std::move(mask));
+  out.costs.bake_seconds = dlm->stats.total_seconds;
+  // What the runtime uploads: texels x directions x 8 B + the R32I index map.
+  out.costs.bytes = static_cast<std::uint64_t>(dlm->texels.size()) * dlm->directions.size() * 8u +
+                    static_cast<std::uint64_t>(dlm->width) * static_cast<std::uint64_t>(dlm->height) * 4u;
+  out.extras = {{"atlas_rel_rmse", relative_rmse(atlas_field, ctx.reference)},
+                {"glossy_texels", static_cast<double>(dlm->stats.glossy_texels)},
+                {"deposits", static_cast<double>(dlm->stats.deposits)}};
+  return out;
+}
+
+}  // namespace
+
+void register_dlm_sweep(SweepRegistry& registry) {
+  registry.add_reference_provider(
+      {.kind = "atlas_glossy_specular", .version = "pt-1", .compute = glossy_specular_reference});
+
+  SweepMethod m;
+  m.name = method_descriptor(EffectMethod::DirectionalLightMaps).key;  // gi/methods.h
+  m.description =
+      "directional light maps (Hey 2002): directions x photons x density vs the path-traced specular indirect "
+      "radiance of the glossy texels towards camera 0";
+  m.knobs = dlm_knobs();
+  m.reference_for = dlm_reference_request;
+  m.run = run_dlm;
   registry.add_method(std::move(m));
 }
 

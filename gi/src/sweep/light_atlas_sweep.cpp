@@ -10,13 +10,11 @@
 
 namespace gi {
 
-void register_light_atlas_sweep(SweepRegistry& registry) {
-  SweepMethod m;
-  m.name = method_descriptor(EffectMethod::LightAtlas).key;  // gi/methods.h
-  m.description =
-      "light atlas (Schärfig 2016): VPL final shooting or texel final gather, VPLs x bounces x rays x texel density vs "
-      "path-traced indirect irradiance";
-  m.knobs = {
+namespace {
+
+// Long because it is one table, one entry per knob with its grid and range, read as a list.
+std::vector<KnobSpec> light_atlas_knobs() {
+  return {
       {.name = "vpls",
        .description = "target VPL count",
        .kind = KnobKind::Integer,
@@ -77,40 +75,55 @@ void register_light_atlas_sweep(SweepRegistry& registry) {
        .min_value = 1,
        .max_value = 1 << 20},
   };
-  m.reference_for = [](const SweepScene&, const KnobSetting& k) {
-    return ReferenceRequest::atlas_indirect_irradiance(
-        k.real("density"), static_cast<int>(k.integer("ref_spp")),
-        k.text("final") == "gather" ? TexelPlacement::VisibleSurface : TexelPlacement::Raster);
-  };
-  m.run = [](const RunContext& ctx) -> engine::Result<MethodOutput> {
-    LightAtlasSettings s;
-    s.vpl_count = static_cast<int>(ctx.knobs.integer("vpls"));
-    s.bounces = static_cast<int>(ctx.knobs.integer("bounces"));
-    s.texels_per_metre = static_cast<float>(ctx.knobs.real("density"));
-    s.samples_per_vpl = static_cast<int>(ctx.knobs.integer("samples"));
-    if (ctx.knobs.text("final") == "gather") {
-      s.final_pass = LightAtlasSettings::FinalPass::TexelGather;
-      s.gather.gather_rays = static_cast<int>(ctx.knobs.integer("rays"));
-      s.gather.solve_rays = static_cast<int>(ctx.knobs.integer("solve_rays"));
-      s.gather.direct_samples = static_cast<int>(ctx.knobs.integer("direct_samples"));
-      s.gather.filter_radius_texels = static_cast<float>(ctx.knobs.real("filter"));
-      s.gather.bounces = std::max(s.bounces, 1);
-    }
-    s.seed = ctx.seed;
-    s.threads = ctx.threads;
-    s.progress = ctx.progress;
-    const engine::Scene scene = engine::instantiate(ctx.scene.asset);
-    auto bake = bake_light_atlas(bake_input_from(scene), s);
-    if (!bake) return bake.error();
-    if (bake->width != ctx.reference.width || bake->height != ctx.reference.height)
-      return engine::Error{.message = "the bake's atlas size differs from the reference's"};
-    MethodOutput out;
-    out.field = RgbField::from_texels(bake->width, bake->height, bake->irradiance, bake->valid);
-    out.costs.bake_seconds = bake->stats.total_seconds;
-    // What a game ships: the atlas as RGBA16F.
-    out.costs.bytes = static_cast<std::uint64_t>(bake->width) * static_cast<std::uint64_t>(bake->height) * 8u;
-    return out;
-  };
+}
+
+ReferenceRequest light_atlas_reference_request(const SweepScene&, const KnobSetting& k) {
+  return ReferenceRequest::atlas_indirect_irradiance(
+      k.real("density"), static_cast<int>(k.integer("ref_spp")),
+      k.text("final") == "gather" ? TexelPlacement::VisibleSurface : TexelPlacement::Raster);
+}
+
+engine::Result<MethodOutput> run_light_atlas(const RunContext& ctx) {
+  LightAtlasSettings s;
+  s.vpl_count = static_cast<int>(ctx.knobs.integer("vpls"));
+  s.bounces = static_cast<int>(ctx.knobs.integer("bounces"));
+  s.texels_per_metre = static_cast<float>(ctx.knobs.real("density"));
+  s.samples_per_vpl = static_cast<int>(ctx.knobs.integer("samples"));
+  if (ctx.knobs.text("final") == "gather") {
+    s.final_pass = LightAtlasSettings::FinalPass::TexelGather;
+    s.gather.gather_rays = static_cast<int>(ctx.knobs.integer("rays"));
+    s.gather.solve_rays = static_cast<int>(ctx.knobs.integer("solve_rays"));
+    s.gather.direct_samples = static_cast<int>(ctx.knobs.integer("direct_samples"));
+    s.gather.filter_radius_texels = static_cast<float>(ctx.knobs.real("filter"));
+    s.gather.bounces = std::max(s.bounces, 1);
+  }
+  s.seed = ctx.seed;
+  s.threads = ctx.threads;
+  s.progress = ctx.progress;
+  const engine::Scene scene = engine::instantiate(ctx.scene.asset);
+  auto bake = bake_light_atlas(bake_input_from(scene), s);
+  if (!bake) return bake.error();
+  if (bake->width != ctx.reference.width || bake->height != ctx.reference.height)
+    return engine::Error{.message = "the bake's atlas size differs from the reference's"};
+  MethodOutput out;
+  out.field = RgbField::from_texels(bake->width, bake->height, bake->irradiance, bake->valid);
+  out.costs.bake_seconds = bake->stats.total_seconds;
+  // What a game ships: the atlas as RGBA16F.
+  out.costs.bytes = static_cast<std::uint64_t>(bake->width) * static_cast<std::uint64_t>(bake->height) * 8u;
+  return out;
+}
+
+}  // namespace
+
+void register_light_atlas_sweep(SweepRegistry& registry) {
+  SweepMethod m;
+  m.name = method_descriptor(EffectMethod::LightAtlas).key;  // gi/methods.h
+  m.description =
+      "light atlas (Schärfig 2016): VPL final shooting or texel final gather, VPLs x bounces x rays x texel density vs "
+      "path-traced indirect irradiance";
+  m.knobs = light_atlas_knobs();
+  m.reference_for = light_atlas_reference_request;
+  m.run = run_light_atlas;
   registry.add_method(std::move(m));
 }
 

@@ -97,40 +97,27 @@ BakeInput reference_world(BakeInput input, const std::string& world) {
   return input;
 }
 
-}  // namespace
+engine::Result<RgbField> prm_reference(const ReferenceJob& job) {
+  const std::string swing = job.request.param("swing");
+  auto scene = posed_scene(job.scene.asset, job.request.param("pose"), swing.empty() ? 0.0 : std::stod(swing));
+  if (!scene) return scene.error();
+  const auto inputs = atlas_inputs_from(bake_input_from(job.scene.asset));
+  auto layout = build_atlas_layout(inputs, {.texels_per_metre = std::stof(job.request.param("texels_per_m"))});
+  if (!layout) return layout.error();
+  ReferenceSettings rs;
+  rs.samples_per_pixel = std::stoi(job.request.param("spp"));
+  rs.seed = kReferenceSeed;
+  rs.threads = job.threads;
+  rs.progress = job.progress;
+  const std::string world = job.request.param("world");
+  auto truth = reference_atlas_irradiance(reference_world(bake_input_from(*scene), world.empty() ? "all" : world),
+                                          rasterize_atlas(*layout, inputs), rs);
+  if (!truth) return truth.error();
+  return RgbField::from_texels(truth->width, truth->height, truth->indirect, truth->valid);
+}
 
-void register_prm_sweep(SweepRegistry& registry) {
-  registry.add_reference_provider(
-      {.kind = "atlas_indirect_irradiance_posed",
-       // pt-3: emissive materials are dark too (pt-2 kept them, so a scene with an emissive
-       // surface, such as the demo level's ceiling panel, had its light in the reference).
-       .version = "pt-3",
-       .compute = [](const ReferenceJob& job) -> engine::Result<RgbField> {
-         const std::string swing = job.request.param("swing");
-         auto scene = posed_scene(job.scene.asset, job.request.param("pose"), swing.empty() ? 0.0 : std::stod(swing));
-         if (!scene) return scene.error();
-         const auto inputs = atlas_inputs_from(bake_input_from(job.scene.asset));
-         auto layout = build_atlas_layout(inputs, {.texels_per_metre = std::stof(job.request.param("texels_per_m"))});
-         if (!layout) return layout.error();
-         ReferenceSettings rs;
-         rs.samples_per_pixel = std::stoi(job.request.param("spp"));
-         rs.seed = kReferenceSeed;
-         rs.threads = job.threads;
-         rs.progress = job.progress;
-         const std::string world = job.request.param("world");
-         auto truth =
-             reference_atlas_irradiance(reference_world(bake_input_from(*scene), world.empty() ? "all" : world),
-                                        rasterize_atlas(*layout, inputs), rs);
-         if (!truth) return truth.error();
-         return RgbField::from_texels(truth->width, truth->height, truth->indirect, truth->valid);
-       }});
-
-  SweepMethod m;
-  m.name = method_descriptor(EffectMethod::Prm).key;  // gi/methods.h
-  m.description =
-      "precomputed radiance maps (Szécsi 2006): entry points x clusters x active K x density x splitting, moving light "
-      "at several poses";
-  m.knobs = {
+std::vector<KnobSpec> prm_knobs() {
+  return {
       {.name = "entries",
        .description = "entry points",
        .kind = KnobKind::Integer,
@@ -184,66 +171,86 @@ void register_prm_sweep(SweepRegistry& registry) {
        .min_value = 1,
        .max_value = 1 << 20},
   };
-  m.reference_for = [](const SweepScene&, const KnobSetting& k) {
-    ReferenceRequest r =
-        ReferenceRequest::atlas_indirect_irradiance(k.real("density"), static_cast<int>(k.integer("ref_spp")));
-    r.kind = "atlas_indirect_irradiance_posed";
-    r.params.emplace_back("pose", k.text("pose"));
-    // Only a swung light names its swing, so unswung references keep their cache keys.
-    if (k.real("swing") != 0.0) r.params.emplace_back("swing", k.text("swing"));
-    if (k.text("world") != "all") r.params.emplace_back("world", k.text("world"));
-    return r;
-  };
-  m.run = [](const RunContext& ctx) -> engine::Result<MethodOutput> {
-    auto scene = posed_scene(ctx.scene.asset, ctx.knobs.text("pose"), ctx.knobs.real("swing"));
-    if (!scene) return scene.error();
-    PrmSettings s;
-    s.texels_per_metre = static_cast<float>(ctx.knobs.real("density"));
-    s.entry_points = static_cast<int>(ctx.knobs.integer("entries"));
-    s.clusters = static_cast<int>(ctx.knobs.integer("clusters"));
-    s.splitting = static_cast<float>(ctx.knobs.real("splitting"));
-    s.seed = ctx.seed;
-    s.threads = ctx.threads;
-    s.progress = ctx.progress;
-    const BakeInput input = bake_input_from(*scene);
-    auto prm = bake_prm(input, s);
-    if (!prm) return prm.error();
-    if (prm->width != ctx.reference.width || prm->height != ctx.reference.height)
-      return engine::Error{.message = "the PRM's atlas size differs from the reference's"};
-    auto caster = make_static_caster(input);
-    if (!caster) return caster.error();
-    // Per-frame cost of a light change on the CPU: weights, selection and the pane sum.
-    const auto t0 = std::chrono::steady_clock::now();
-    const auto lights = bake_lights(input, BakeLights::Moving);
-    const auto picked = relight_clusters(*prm, lights, **caster, static_cast<int>(ctx.knobs.integer("active")));
-    const std::vector<glm::vec3> atlas = sum_panes(*prm, picked);
-    const double frame_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-    MethodOutput out;
-    out.field = RgbField::from_texels(prm->width, prm->height, atlas, ctx.reference.valid);
-    // What the K heaviest clusters leave out (not timed): the same relight with every lit
-    // cluster. dropped_energy = 1 - sum lum(K sum) / sum lum(all-cluster sum) over the valid
-    // texels (texels have one area at one density, so this is the share of reflected power the
-    // K-sum drops); rescaled_rel_rmse: the K-sum scaled by the inverse of the share kept, the
-    // error a runtime that rescaled to the full energy would have (the runtime does not).
-    const auto all = relight_clusters(*prm, lights, **caster, 0);
-    const std::vector<glm::vec3> full = sum_panes(*prm, all);
-    auto lum = [](const glm::vec3& c) { return luminance(double{c.x}, double{c.y}, double{c.z}); };
-    double kept = 0.0, total = 0.0;
-    for (std::size_t i = 0; i < atlas.size(); ++i) {
-      if (!ctx.reference.is_valid(i)) continue;
-      kept += lum(atlas[i]);
-      total += lum(full[i]);
-    }
-    const double nan = std::numeric_limits<double>::quiet_NaN();
-    out.extras = {{"clusters_lit", static_cast<double>(all.size())},
-                  {"clusters_summed", static_cast<double>(picked.size())},
-                  {"dropped_energy", total > 0.0 ? 1.0 - kept / total : nan},
-                  {"rescaled_rel_rmse", kept > 0.0 ? relative_rmse(out.field, ctx.reference, total / kept) : nan}};
-    out.costs.bake_seconds = prm->stats.total_seconds;
-    out.costs.frame_ms = frame_ms;
-    out.costs.bytes = static_cast<std::uint64_t>(prm->cluster_count) * prm->pane_size() * 3u * 2u;  // half-float panes
-    return out;
-  };
+}
+
+ReferenceRequest prm_reference_request(const SweepScene&, const KnobSetting& k) {
+  ReferenceRequest r =
+      ReferenceRequest::atlas_indirect_irradiance(k.real("density"), static_cast<int>(k.integer("ref_spp")));
+  r.kind = "atlas_indirect_irradiance_posed";
+  r.params.emplace_back("pose", k.text("pose"));
+  // Only a swung light names its swing, so unswung references keep their cache keys.
+  if (k.real("swing") != 0.0) r.params.emplace_back("swing", k.text("swing"));
+  if (k.text("world") != "all") r.params.emplace_back("world", k.text("world"));
+  return r;
+}
+
+engine::Result<MethodOutput> run_prm(const RunContext& ctx) {
+  auto scene = posed_scene(ctx.scene.asset, ctx.knobs.text("pose"), ctx.knobs.real("swing"));
+  if (!scene) return scene.error();
+  PrmSettings s;
+  s.texels_per_metre = static_cast<float>(ctx.knobs.real("density"));
+  s.entry_points = static_cast<int>(ctx.knobs.integer("entries"));
+  s.clusters = static_cast<int>(ctx.knobs.integer("clusters"));
+  s.splitting = static_cast<float>(ctx.knobs.real("splitting"));
+  s.seed = ctx.seed;
+  s.threads = ctx.threads;
+  s.progress = ctx.progress;
+  const BakeInput input = bake_input_from(*scene);
+  auto prm = bake_prm(input, s);
+  if (!prm) return prm.error();
+  if (prm->width != ctx.reference.width || prm->height != ctx.reference.height)
+    return engine::Error{.message = "the PRM's atlas size differs from the reference's"};
+  auto caster = make_static_caster(input);
+  if (!caster) return caster.error();
+  // Per-frame cost of a light change on the CPU: weights, selection and the pane sum.
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto lights = bake_lights(input, BakeLights::Moving);
+  const auto picked = relight_clusters(*prm, lights, **caster, static_cast<int>(ctx.knobs.integer("active")));
+  const std::vector<glm::vec3> atlas = sum_panes(*prm, picked);
+  const double frame_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  MethodOutput out;
+  out.field = RgbField::from_texels(prm->width, prm->height, atlas, ctx.reference.valid);
+  // What the K heaviest clusters leave out (not timed): the same relight with every lit
+  // cluster. dropped_energy = 1 - sum lum(K sum) / sum lum(all-cluster sum) over the valid
+  // texels (texels have one area at one density, so this is the share of reflected power the
+  // K-sum drops); rescaled_rel_rmse: the K-sum scaled by the inverse of the share kept, the
+  // error a runtime that rescaled to the full energy would have (the runtime does not).
+  const auto all = relight_clusters(*prm, lights, **caster, 0);
+  const std::vector<glm::vec3> full = sum_panes(*prm, all);
+  auto lum = [](const glm::vec3& c) { return luminance(double{c.x}, double{c.y}, double{c.z}); };
+  double kept = 0.0, total = 0.0;
+  for (std::size_t i = 0; i < atlas.size(); ++i) {
+    if (!ctx.reference.is_valid(i)) continue;
+    kept += lum(atlas[i]);
+    total += lum(full[i]);
+  }
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  out.extras = {{"clusters_lit", static_cast<double>(all.size())},
+                {"clusters_summed", static_cast<double>(picked.size())},
+                {"dropped_energy", total > 0.0 ? 1.0 - kept / total : nan},
+                {"rescaled_rel_rmse", kept > 0.0 ? relative_rmse(out.field, ctx.reference, total / kept) : nan}};
+  out.costs.bake_seconds = prm->stats.total_seconds;
+  out.costs.frame_ms = frame_ms;
+  out.costs.bytes = static_cast<std::uint64_t>(prm->cluster_count) * prm->pane_size() * 3u * 2u;  // half-float panes
+  return out;
+}
+
+}  // namespace
+
+void register_prm_sweep(SweepRegistry& registry) {
+  // pt-3: emissive materials are dark too (pt-2 kept them, so a scene with an emissive
+  // surface, such as the demo level's ceiling panel, had its light in the reference).
+  registry.add_reference_provider(
+      {.kind = "atlas_indirect_irradiance_posed", .version = "pt-3", .compute = prm_reference});
+
+  SweepMethod m;
+  m.name = method_descriptor(EffectMethod::Prm).key;  // gi/methods.h
+  m.description =
+      "precomputed radiance maps (Szécsi 2006): entry points x clusters x active K x density x splitting, moving light "
+      "at several poses";
+  m.knobs = prm_knobs();
+  m.reference_for = prm_reference_request;
+  m.run = run_prm;
   registry.add_method(std::move(m));
 }
 

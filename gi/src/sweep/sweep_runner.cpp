@@ -20,8 +20,50 @@ std::string layout_problem(const RgbField& out, const RgbField& ref) {
   return {};
 }
 
+// The reference each run needs, each distinct one once: `requests` in first-use order and
+// the index of every run's.
+void distinct_requests(const SweepMethod& method, const SweepScene& scene, std::span<const KnobSetting> settings,
+                       std::vector<ReferenceRequest>& requests, std::vector<std::size_t>& request_of_run) {
+  std::map<std::string, std::size_t> request_index;  // request key -> index into requests
+  for (const KnobSetting& s : settings) {
+    ReferenceRequest r = method.reference_for(scene, s);
+    auto [it, inserted] = request_index.emplace(r.key(), requests.size());
+    if (inserted) requests.push_back(std::move(r));
+    request_of_run.push_back(it->second);
+  }
+}
+
+// A run's costs, extras and errors against its reference into its row (NaN errors and a
+// status when the run failed or its field does not match the reference's layout).
+void score_row(const engine::Result<MethodOutput>& out, const ReferenceFetch& ref, const SweepOptions& options,
+               SweepRow& row) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  row.error.rel_rmse = row.error.max_rel = row.error.psnr_db = nan;
+  row.error.fit_scale = row.error.fit_rel_rmse = row.error.fit_max_rel = row.error.fit_psnr_db = nan;
+  if (!out) {
+    row.status = "run failed: " + out.error().to_string();
+  } else {
+    row.costs = out->costs;
+    row.extras = out->extras;
+    if (std::string p = layout_problem(out->field, ref.field); !p.empty()) {
+      row.status = p;
+    } else {
+      row.error = compare_rgb(out->field, ref.field, options.metrics);
+      if (!row.error.ok()) row.status = row.error.problem;
+      // A reference that knows its own noise: the error against the truth (error_metrics.h).
+      if (row.error.ok() && std::isfinite(row.error.reference_noise)) {
+        row.extras.emplace_back(std::string(kReferenceNoiseExtra), row.error.reference_noise);
+        if (std::isfinite(row.error.truth_rel_rmse))
+          row.extras.emplace_back(std::string(kTruthErrorExtra), row.error.truth_rel_rmse);
+      }
+    }
+  }
+}
+
 }  // namespace
 
+// Long because its two loops (the references, then the runs) drive one progress state and one
+// cancel flag through the same report callback; apart, those would be passed back and forth.
 engine::Result<SweepResult> run_sweep(const SweepRegistry& registry, const SweepMethod& method, const SweepScene& scene,
                                       std::span<const KnobSetting> settings, const SweepOptions& options,
                                       const SweepProgressFn& progress, const SweepLogFn& log) {
@@ -30,14 +72,8 @@ engine::Result<SweepResult> run_sweep(const SweepRegistry& registry, const Sweep
 
   // Requests first: the number of distinct references is part of the work total.
   std::vector<ReferenceRequest> requests;
-  std::map<std::string, std::size_t> request_index;  // request key -> index into requests
   std::vector<std::size_t> request_of_run;
-  for (const KnobSetting& s : settings) {
-    ReferenceRequest r = method.reference_for(scene, s);
-    auto [it, inserted] = request_index.emplace(r.key(), requests.size());
-    if (inserted) requests.push_back(std::move(r));
-    request_of_run.push_back(it->second);
-  }
+  distinct_requests(method, scene, settings, requests, request_of_run);
   for (const ReferenceRequest& r : requests) {
     if (registry.find_provider(r.kind) == nullptr) {
       return engine::Error{"method " + method.name, r.key(),
@@ -83,27 +119,7 @@ engine::Result<SweepResult> run_sweep(const SweepRegistry& registry, const Sweep
                                                              options.seed, options.threads, unit_progress});
     row.wall_seconds = seconds_since(start);
     if (cancelled) break;  // a cancelled run's output is not a measurement
-    const double nan = std::numeric_limits<double>::quiet_NaN();
-    row.error.rel_rmse = row.error.max_rel = row.error.psnr_db = nan;
-    row.error.fit_scale = row.error.fit_rel_rmse = row.error.fit_max_rel = row.error.fit_psnr_db = nan;
-    if (!out) {
-      row.status = "run failed: " + out.error().to_string();
-    } else {
-      row.costs = out->costs;
-      row.extras = out->extras;
-      if (std::string p = layout_problem(out->field, ref.field); !p.empty()) {
-        row.status = p;
-      } else {
-        row.error = compare_rgb(out->field, ref.field, options.metrics);
-        if (!row.error.ok()) row.status = row.error.problem;
-        // A reference that knows its own noise: the error against the truth (error_metrics.h).
-        if (row.error.ok() && std::isfinite(row.error.reference_noise)) {
-          row.extras.emplace_back(std::string(kReferenceNoiseExtra), row.error.reference_noise);
-          if (std::isfinite(row.error.truth_rel_rmse))
-            row.extras.emplace_back(std::string(kTruthErrorExtra), row.error.truth_rel_rmse);
-        }
-      }
-    }
+    score_row(out, ref, options, row);
     result.rows.push_back(std::move(row));
     ++state.units_done;
     state.current_fraction = 0.0;

@@ -30,7 +30,8 @@ void add_vecs(ContentHash& h, const std::vector<V>& vs) {
   for (const V& v : vs) add_vec(h, v);
 }
 
-void add_asset(ContentHash& h, const engine::SceneAsset& a) {
+// The meshes and materials, in the hash's order.
+void add_geometry(ContentHash& h, const engine::SceneAsset& a) {
   h.add_value(static_cast<std::uint64_t>(a.meshes.size()));
   for (const engine::Mesh& m : a.meshes) {
     h.add_string(m.name);
@@ -59,6 +60,10 @@ void add_asset(ContentHash& h, const engine::SceneAsset& a) {
     h.add_value(m.emissive_texture.image);
     h.add_value(m.double_sided);
   }
+}
+
+// The images and lights, in the hash's order.
+void add_images_and_lights(ContentHash& h, const engine::SceneAsset& a) {
   h.add_value(static_cast<std::uint64_t>(a.images.size()));
   for (const engine::Image& im : a.images) {
     h.add_value(im.width);
@@ -81,6 +86,10 @@ void add_asset(ContentHash& h, const engine::SceneAsset& a) {
     h.add_value(l.enabled);
     if (l.angular_radius_rad > 0.0f) h.add_value(l.angular_radius_rad);  // only then: older keys stay valid
   }
+}
+
+// The cameras, nodes and sky, in the hash's order.
+void add_cameras_nodes_and_sky(ContentHash& h, const engine::SceneAsset& a) {
   h.add_value(static_cast<std::uint64_t>(a.cameras.size()));
   for (const engine::NamedCamera& c : a.cameras) {
     h.add_string(c.name);
@@ -114,6 +123,12 @@ void add_asset(ContentHash& h, const engine::SceneAsset& a) {
     add_vec(h, env.sky_gradient.horizon);
     add_vec(h, env.sky_gradient.ground);
   }
+}
+
+void add_asset(ContentHash& h, const engine::SceneAsset& a) {
+  add_geometry(h, a);
+  add_images_and_lights(h, a);
+  add_cameras_nodes_and_sky(h, a);
 }
 
 }  // namespace

@@ -56,7 +56,42 @@ SweepSummary summarize_sweep(std::span<const SweepRow> rows, const SweepSummaryO
   return s;
 }
 
-std::string sweep_summary_markdown(std::span<const SweepRow> rows, const SweepSummary& summary) {
+namespace {
+
+// True when a run carries its error against the noise-free truth (the reference has its variance).
+bool has_truth_error(std::span<const SweepRow> rows) {
+  return std::any_of(rows.begin(), rows.end(), [](const SweepRow& r) {
+    return std::any_of(r.extras.begin(), r.extras.end(), [](const auto& e) { return e.first == kTruthErrorExtra; });
+  });
+}
+
+// The title, how to regenerate, the reference and what the columns measure.
+std::string summary_intro(std::span<const SweepRow> rows, const SweepSummary& summary, bool truth) {
+  std::string md;
+  const std::string method = rows.empty() ? std::string("(none)") : rows.front().method;
+  const std::string scene = rows.empty() ? std::string("(none)") : rows.front().scene;
+  md += "# Sweep: " + md_cell(method) + " on " + md_cell(scene) + "\n\n";
+  if (!summary.options.command.empty())
+    md += "Regenerate (from the repository root; `gi-sweep` is `build/tools/gi-sweep/gi-sweep`):\n\n```sh\n" +
+          summary.options.command + "\n```\n\n";
+  if (!rows.empty()) md += "Reference: `" + rows.front().reference_key + "`\n\n";
+  md +=
+      "Error: relative RMSE of linear values, sqrt(sum (a-r)^2 / sum r^2) over valid elements and the three "
+      "channels summed; max rel: max |a-r| / max(|r|, 0.01 mean |r|) per element (RGB norms); PSNR of the "
+      "tonemapped images (dB); fit: after the least-squares scale s. Trade-off cost: " +
+      cost_name(summary.options.cost) + ".\n\n";
+  if (truth)
+    md +=
+        "The reference carries its own sampling variance v per element: ref_noise = sqrt(sum v / sum r^2) is its "
+        "relative RMSE from the truth, and truth_rel_rmse = sqrt(max(0, sum (a-r)^2 - sum v) / (sum r^2 - sum v)) "
+        "the error against the noise-free truth (both sums unbiased when the method's noise is independent of the "
+        "reference's). The front and the presets use truth_rel_rmse.\n\n";
+
+  return md;
+}
+
+// "## Runs": one row per run, its knobs, errors, costs, front and preset marks and extras.
+std::string runs_table(std::span<const SweepRow> rows, const SweepSummary& summary) {
   std::vector<std::string> knobs;
   for (const SweepRow& r : rows)
     for (const auto& e : r.knobs.entries())
@@ -81,28 +116,6 @@ std::string sweep_summary_markdown(std::span<const SweepRow> rows, const SweepSu
   };
 
   std::string md;
-  const std::string method = rows.empty() ? std::string("(none)") : rows.front().method;
-  const std::string scene = rows.empty() ? std::string("(none)") : rows.front().scene;
-  md += "# Sweep: " + md_cell(method) + " on " + md_cell(scene) + "\n\n";
-  if (!summary.options.command.empty())
-    md += "Regenerate (from the repository root; `gi-sweep` is `build/tools/gi-sweep/gi-sweep`):\n\n```sh\n" +
-          summary.options.command + "\n```\n\n";
-  if (!rows.empty()) md += "Reference: `" + rows.front().reference_key + "`\n\n";
-  md +=
-      "Error: relative RMSE of linear values, sqrt(sum (a-r)^2 / sum r^2) over valid elements and the three "
-      "channels summed; max rel: max |a-r| / max(|r|, 0.01 mean |r|) per element (RGB norms); PSNR of the "
-      "tonemapped images (dB); fit: after the least-squares scale s. Trade-off cost: " +
-      cost_name(summary.options.cost) + ".\n\n";
-  const bool truth = std::any_of(rows.begin(), rows.end(), [](const SweepRow& r) {
-    return std::any_of(r.extras.begin(), r.extras.end(), [](const auto& e) { return e.first == kTruthErrorExtra; });
-  });
-  if (truth)
-    md +=
-        "The reference carries its own sampling variance v per element: ref_noise = sqrt(sum v / sum r^2) is its "
-        "relative RMSE from the truth, and truth_rel_rmse = sqrt(max(0, sum (a-r)^2 - sum v) / (sum r^2 - sum v)) "
-        "the error against the noise-free truth (both sums unbiased when the method's noise is independent of the "
-        "reference's). The front and the presets use truth_rel_rmse.\n\n";
-
   md += "## Runs\n\n|";
   for (const std::string& k : knobs) md += " " + md_cell(k) + " |";
   md += " rel RMSE | max rel | PSNR dB | fit s | fit rel RMSE | bake s | frame ms | bytes | front | preset | status |";
@@ -122,6 +135,12 @@ std::string sweep_summary_markdown(std::span<const SweepRow> rows, const SweepSu
     md += "\n";
   }
 
+  return md;
+}
+
+// "## Pareto front" and "## Suggested presets".
+std::string front_and_presets(std::span<const SweepRow> rows, const SweepSummary& summary, bool truth) {
+  std::string md;
   const std::string error_name = truth ? "truth_rel_rmse" : "rel RMSE";
   md += "\n## Pareto front\n\nRuns no other run beats on both " + error_name + " and " +
         cost_name(summary.options.cost) + " (failed runs excluded), cheapest first:\n\n";
@@ -148,6 +167,13 @@ std::string sweep_summary_markdown(std::span<const SweepRow> rows, const SweepSu
           (p.target_met ? "" : " -- target " + format_number(p.target) + " not met") + "\n";
   }
   return md;
+}
+
+}  // namespace
+
+std::string sweep_summary_markdown(std::span<const SweepRow> rows, const SweepSummary& summary) {
+  const bool truth = has_truth_error(rows);
+  return summary_intro(rows, summary, truth) + runs_table(rows, summary) + front_and_presets(rows, summary, truth);
 }
 
 }  // namespace gi

@@ -154,23 +154,16 @@ class SeedGrid {
   std::vector<std::vector<std::uint32_t>> buckets_;
 };
 
-}  // namespace
+// A static instance as an atlas-input mesh (three vertices per triangle; charting welds them).
+struct StaticMesh {
+  AtlasInputMesh mesh;
+  std::uint32_t first_triangle = 0;
+};
 
-engine::Result<VplSet> distribute_vpls(const ReferenceScene& scene, const ReferenceSceneIndex& index,
-                                       const VplDistributionSettings& settings) {
-  if (settings.vpl_count < 1 || settings.vpl_count > 10'000'000)
-    return engine::Error{.message = "VPL count " + std::to_string(settings.vpl_count) + " is outside 1..10^7"};
-  if (settings.samples_per_vpl < 1 || settings.samples_per_vpl > 1024)
-    return engine::Error{.message =
-                             "samples per VPL " + std::to_string(settings.samples_per_vpl) + " is outside 1..1024"};
-
-  // Static instances as atlas-input meshes (three vertices per triangle; charting welds them).
-  struct StaticMesh {
-    AtlasInputMesh mesh;
-    std::uint32_t first_triangle = 0;
-  };
+// The static instances as meshes, and their total area (m^2) in *total_area.
+std::vector<StaticMesh> static_meshes(const ReferenceScene& scene, const ReferenceSceneIndex& index,
+                                      double& total_area) {
   std::vector<StaticMesh> meshes;
-  double total_area = 0.0;
   const auto& instances = scene.geometry.instances;
   for (std::size_t k = 0; k < instances.size(); ++k) {
     if (instances[k].dynamic) continue;
@@ -186,24 +179,116 @@ engine::Result<VplSet> distribute_vpls(const ReferenceScene& scene, const Refere
     }
     if (!m.mesh.indices.empty()) meshes.push_back(std::move(m));
   }
+  return meshes;
+}
+
+// A sample's albedo: its material's, or with textures the material lookup's at its point
+// for a footprint of the sample spacing (the samples of a patch together average the
+// texture over the patch).
+class SampleAlbedo {
+ public:
+  SampleAlbedo(const ReferenceScene& scene, const ReferenceSceneIndex& index, double sample_spacing)
+      : scene_(scene), index_(index), hs_(sample_spacing) {}
+  glm::vec3 operator()(const Sample& sample) {
+    const std::uint32_t m = sample.material;
+    if (scene_.materials[m].textured())
+      return albedo_at(scene_, index_.triangles[sample.triangle], sample.bary, static_cast<float>(hs_));
+    auto it = cache_.find(m);
+    if (it == cache_.end())
+      it = cache_.emplace(m, engine::gltf_hemispherical_albedo(scene_.materials[m].brdf).sum()).first;
+    return it->second;
+  }
+
+ private:
+  const ReferenceScene& scene_;
+  const ReferenceSceneIndex& index_;
+  double hs_;
+  std::unordered_map<std::uint32_t, glm::vec3> cache_;
+};
+
+// One VPL per Voronoi patch: every sample joins its nearest seed (in the chart's plane);
+// one Lloyd step then puts the VPL at the patch sample nearest the patch's centroid.
+void add_patch_vpls(const std::vector<Sample>& samples, const std::vector<Sample>& seeds, double h, double sample_area,
+                    SampleAlbedo& albedo, VplSet& out) {
+  const SeedGrid grid(seeds, static_cast<float>(h));
+  std::vector<std::vector<std::uint32_t>> members(seeds.size());
+  for (std::uint32_t s = 0; s < samples.size(); ++s) members[grid.nearest(samples[s].plane)].push_back(s);
+  for (const auto& patch : members) {
+    if (patch.empty()) continue;
+    glm::dvec3 centroid(0.0), normal(0.0), rho(0.0);
+    for (std::uint32_t s : patch) {
+      centroid += glm::dvec3(samples[s].position);
+      normal += glm::dvec3(samples[s].normal);
+      rho += glm::dvec3(albedo(samples[s]));
+    }
+    centroid /= static_cast<double>(patch.size());
+    std::uint32_t nearest = patch.front();
+    double nearest_d = std::numeric_limits<double>::infinity();
+    for (std::uint32_t s : patch) {
+      const glm::dvec3 d = glm::dvec3(samples[s].position) - centroid;
+      if (glm::dot(d, d) < nearest_d) nearest_d = glm::dot(d, d), nearest = s;
+    }
+    out.position.push_back(samples[nearest].position);
+    out.normal.push_back(glm::length(normal) > 0.0 ? glm::vec3(glm::normalize(normal)) : samples[nearest].normal);
+    out.albedo.push_back(glm::vec3(rho / static_cast<double>(patch.size())));
+    out.area_m2.push_back(static_cast<float>(sample_area * static_cast<double>(patch.size())));
+    for (std::uint32_t s : patch) {
+      out.sample_position.push_back(samples[s].position);
+      out.sample_normal.push_back(samples[s].normal);
+      out.sample_area_m2.push_back(static_cast<float>(sample_area));
+    }
+    out.sample_first.push_back(static_cast<std::uint32_t>(out.sample_position.size()));
+  }
+}
+
+// The VPLs of one chart: jittered samples of spacing hs, seeds of spacing h, their patches.
+void add_chart_vpls(const Chart& chart, const StaticMesh& sm, const ReferenceSceneIndex& index,
+                    const VplDistributionSettings& settings, double h, double hs, Pcg32& rng, SampleAlbedo& albedo,
+                    VplSet& out) {
+  const ChartPlane plane(chart, index, sm.first_triangle);
+  std::vector<Sample> samples = jittered_points(chart, plane, index, sm.first_triangle, static_cast<float>(hs), rng);
+  double sample_area = samples.empty() ? 0.0 : chart.area_m2 / static_cast<double>(samples.size());
+  if (samples.empty()) {
+    // A chart smaller than a sample cell: one sample with probability area / hs^2 and
+    // area hs^2, so the expected area is kept (the chart's texels still receive light).
+    if (static_cast<double>(rng.next_float()) >= chart.area_m2 / (hs * hs)) return;
+    const ShadingTriangle& tri = index.triangles[sm.first_triangle + chart.triangles.front()];
+    samples.push_back({tri.p0 + (tri.e1 + tri.e2) / 3.0f,
+                       tri.face_normal,
+                       {},
+                       tri.material,
+                       sm.first_triangle + chart.triangles.front(),
+                       glm::vec2(1.0f / 3.0f)});
+    sample_area = hs * hs;
+  }
+
+  // One sample per VPL: every sample is its own VPL (a second grid of the same spacing
+  // would leave about a third of its seeds without a sample).
+  std::vector<Sample> seeds = settings.samples_per_vpl == 1
+                                  ? samples
+                                  : jittered_points(chart, plane, index, sm.first_triangle, static_cast<float>(h), rng);
+  if (seeds.empty()) seeds.push_back(samples[samples.size() / 2]);
+  add_patch_vpls(samples, seeds, h, sample_area, albedo, out);
+}
+
+}  // namespace
+
+engine::Result<VplSet> distribute_vpls(const ReferenceScene& scene, const ReferenceSceneIndex& index,
+                                       const VplDistributionSettings& settings) {
+  if (settings.vpl_count < 1 || settings.vpl_count > 10'000'000)
+    return engine::Error{.message = "VPL count " + std::to_string(settings.vpl_count) + " is outside 1..10^7"};
+  if (settings.samples_per_vpl < 1 || settings.samples_per_vpl > 1024)
+    return engine::Error{.message =
+                             "samples per VPL " + std::to_string(settings.samples_per_vpl) + " is outside 1..1024"};
+
+  double total_area = 0.0;
+  const std::vector<StaticMesh> meshes = static_meshes(scene, index, total_area);
   if (!(total_area > 0.0) || !std::isfinite(total_area))
     return engine::Error{.message = "the scene has no static surface area to place VPLs on"};
 
   const double h = std::sqrt(total_area / settings.vpl_count);                     // VPL spacing
   const double hs = h / std::sqrt(static_cast<double>(settings.samples_per_vpl));  // sample spacing
-  std::unordered_map<std::uint32_t, glm::vec3> albedo_cache;
-  // A sample's albedo: its material's, or with textures the material lookup's at its point
-  // for a footprint of the sample spacing (the samples of a patch together average the
-  // texture over the patch).
-  const auto albedo = [&](const Sample& sample) {
-    const std::uint32_t m = sample.material;
-    if (scene.materials[m].textured())
-      return albedo_at(scene, index.triangles[sample.triangle], sample.bary, static_cast<float>(hs));
-    auto it = albedo_cache.find(m);
-    if (it == albedo_cache.end())
-      it = albedo_cache.emplace(m, engine::gltf_hemispherical_albedo(scene.materials[m].brdf).sum()).first;
-    return it->second;
-  };
+  SampleAlbedo albedo(scene, index, hs);
 
   VplSet out;
   out.sample_first.push_back(0);
@@ -213,63 +298,7 @@ engine::Result<VplSet> distribute_vpls(const ReferenceScene& scene, const Refere
     for (const Chart& chart : build_charts(sm.mesh, static_cast<std::uint32_t>(mi), ChartingSettings{})) {
       Pcg32 rng = Pcg32::for_item(settings.seed, chart_id++);
       if (!(chart.area_m2 > 0.0)) continue;
-      const ChartPlane plane(chart, index, sm.first_triangle);
-      std::vector<Sample> samples =
-          jittered_points(chart, plane, index, sm.first_triangle, static_cast<float>(hs), rng);
-      double sample_area = samples.empty() ? 0.0 : chart.area_m2 / static_cast<double>(samples.size());
-      if (samples.empty()) {
-        // A chart smaller than a sample cell: one sample with probability area / hs^2 and
-        // area hs^2, so the expected area is kept (the chart's texels still receive light).
-        if (static_cast<double>(rng.next_float()) >= chart.area_m2 / (hs * hs)) continue;
-        const ShadingTriangle& tri = index.triangles[sm.first_triangle + chart.triangles.front()];
-        samples.push_back({tri.p0 + (tri.e1 + tri.e2) / 3.0f,
-                           tri.face_normal,
-                           {},
-                           tri.material,
-                           sm.first_triangle + chart.triangles.front(),
-                           glm::vec2(1.0f / 3.0f)});
-        sample_area = hs * hs;
-      }
-
-      // One sample per VPL: every sample is its own VPL (a second grid of the same spacing
-      // would leave about a third of its seeds without a sample).
-      std::vector<Sample> seeds =
-          settings.samples_per_vpl == 1
-              ? samples
-              : jittered_points(chart, plane, index, sm.first_triangle, static_cast<float>(h), rng);
-      if (seeds.empty()) seeds.push_back(samples[samples.size() / 2]);
-
-      // Voronoi patches: every sample joins its nearest seed (in the chart's plane).
-      const SeedGrid grid(seeds, static_cast<float>(h));
-      std::vector<std::vector<std::uint32_t>> members(seeds.size());
-      for (std::uint32_t s = 0; s < samples.size(); ++s) members[grid.nearest(samples[s].plane)].push_back(s);
-      for (const auto& patch : members) {
-        if (patch.empty()) continue;
-        // One Lloyd step: the VPL sits at the patch sample nearest the patch's centroid.
-        glm::dvec3 centroid(0.0), normal(0.0), rho(0.0);
-        for (std::uint32_t s : patch) {
-          centroid += glm::dvec3(samples[s].position);
-          normal += glm::dvec3(samples[s].normal);
-          rho += glm::dvec3(albedo(samples[s]));
-        }
-        centroid /= static_cast<double>(patch.size());
-        std::uint32_t nearest = patch.front();
-        double nearest_d = std::numeric_limits<double>::infinity();
-        for (std::uint32_t s : patch) {
-          const glm::dvec3 d = glm::dvec3(samples[s].position) - centroid;
-          if (glm::dot(d, d) < nearest_d) nearest_d = glm::dot(d, d), nearest = s;
-        }
-        out.position.push_back(samples[nearest].position);
-        out.normal.push_back(glm::length(normal) > 0.0 ? glm::vec3(glm::normalize(normal)) : samples[nearest].normal);
-        out.albedo.push_back(glm::vec3(rho / static_cast<double>(patch.size())));
-        out.area_m2.push_back(static_cast<float>(sample_area * static_cast<double>(patch.size())));
-        for (std::uint32_t s : patch) {
-          out.sample_position.push_back(samples[s].position);
-          out.sample_normal.push_back(samples[s].normal);
-          out.sample_area_m2.push_back(static_cast<float>(sample_area));
-        }
-        out.sample_first.push_back(static_cast<std::uint32_t>(out.sample_position.size()));
-      }
+      add_chart_vpls(chart, sm, index, settings, h, hs, rng, albedo, out);
     }
   }
   if (out.size() == 0) return engine::Error{.message = "no VPL could be placed on the static surfaces"};
