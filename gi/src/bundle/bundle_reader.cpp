@@ -98,6 +98,12 @@ engine::Status BundleReader::check_lights(const std::string& baked_lights_hash, 
 
 namespace {
 
+// "32x16, 8 texels/m (requested 8), padding 2": a layout as the errors show it.
+std::string describe(int width, int height, float density, float requested, int padding) {
+  return std::to_string(width) + "x" + std::to_string(height) + ", " + std::to_string(density) +
+         " texels/m (requested " + std::to_string(requested) + "), padding " + std::to_string(padding);
+}
+
 // Empty when `layout` has one mesh per static instance of `input`, with its id and vertex
 // count (what the renderer pairs UV1 with), else what differs.
 std::string layout_scene_mismatch(const AtlasLayout& layout, const BakeInput& input) {
@@ -143,9 +149,13 @@ engine::Result<AtlasLayout> BundleReader::atlas_layout(const BakeInput& input, c
       layout.requested_texels_per_metre != baked.requested_texels_per_metre ||
       layout.padding_texels != baked.padding_texels)
     return engine::Error{path->string(), "",
-                         "the " + what + " (" + std::to_string(layout.width) + "x" + std::to_string(layout.height) +
-                             ") differs from the one the manifest describes (" + std::to_string(baked.width) + "x" +
-                             std::to_string(baked.height) + ") (re-bake)"};
+                         "the " + what + " (" +
+                             describe(layout.width, layout.height, layout.texels_per_metre,
+                                      layout.requested_texels_per_metre, layout.padding_texels) +
+                             ") differs from the one the manifest describes (" +
+                             describe(baked.width, baked.height, baked.texels_per_metre,
+                                      baked.requested_texels_per_metre, baked.padding_texels) +
+                             ") (re-bake)"};
   if (std::string problem = layout_scene_mismatch(layout, input); !problem.empty())
     return engine::Error{path->string(), "", "the " + what + " does not fit the scene: " + problem + " (re-bake)"};
   return std::move(read->layout);
