@@ -50,7 +50,7 @@ cp assets/cornell_box.bin "$tmp/"
   --dlm-photons 2000 --threads 1 --out "$tmp/no_dlm_texels.gibake" >/dev/null
 
 rm -rf "$corpus"
-mkdir -p "$corpus"/{gltf,exr,session,blob,manifest,light_atlas_vpls,prm_panes,brf_mesh,antiradiance,dlm}
+mkdir -p "$corpus"/{gltf,exr,session,blob,manifest,atlas_layout,light_atlas_vpls,prm_panes,brf_mesh,antiradiance,dlm}
 cp assets/crates_room.draco.glb assets/demo_level.draco.glb "$tmp/spot_chamber.glb" "$tmp/cornell_box_embedded.gltf" \
   "$corpus/gltf/"
 cp "$tmp/atlas_prm.gibake/light_atlas.exr" "$corpus/exr/"
@@ -61,6 +61,7 @@ cp "$tmp/atlas_prm.gibake/manifest.json" "$corpus/manifest/atlas_prm.json"
 cp "$tmp/brf.gibake/manifest.json" "$corpus/manifest/brf.json"
 cp "$tmp/ar_dlm.gibake/manifest.json" "$corpus/manifest/antiradiance_dlm.json"
 cp "$tmp/atlas_prm.gibake/light_atlas_vpls.bin" "$corpus/light_atlas_vpls/"
+cp "$tmp/atlas_prm.gibake/prm_layout.bin" "$tmp/ar_dlm.gibake/dlm_layout.bin" "$corpus/atlas_layout/"
 cp "$tmp/atlas_prm.gibake/prm_panes.bin" "$corpus/prm_panes/"
 cp "$tmp/brf.gibake/brf_crate.bin" "$corpus/brf_mesh/"
 cp "$tmp/ar_dlm.gibake/antiradiance.bin" "$corpus/antiradiance/"

@@ -146,6 +146,42 @@ std::string check_bake(const AntiradianceBake& b) {
   return {};
 }
 
+// Empty when b.at_baked_pose fits b's hierarchy (indices, bins, order, values), else what
+// is wrong.
+std::string check_at_pose(const AntiradianceBake& b) {
+  const AntiradianceBake::AtBakedPose& p = b.at_baked_pose;
+  const ElementHierarchy& h = b.hierarchy;
+  const std::size_t n = h.nodes.size();
+  const auto in_nodes = [n](std::int64_t i) { return i >= 0 && static_cast<std::size_t>(i) < n; };
+  const std::int32_t bins = b.settings.bins_per_side * b.settings.bins_per_side;
+  if (p.links.relinked_elements > n) return "more relinked elements than elements";
+  for (std::size_t k = 0; k < p.links.links.size(); ++k) {
+    const Link& l = p.links.links[k];
+    if (!in_nodes(l.receiver) || !in_nodes(l.sender) || l.bin < 0 || l.bin >= bins || !std::isfinite(l.form_factor) ||
+        l.form_factor < 0.0f)
+      return "posed link " + std::to_string(k) + " is out of range";
+    if (h.nodes[static_cast<std::size_t>(l.receiver)].group < 1 &&
+        h.nodes[static_cast<std::size_t>(l.sender)].group < 1)
+      return "posed link " + std::to_string(k) + " has no end in a deforming group";
+    if (k > 0) {
+      const Link& q = p.links.links[k - 1];
+      if (q.receiver > l.receiver ||
+          (q.receiver == l.receiver && (q.bin > l.bin || (q.bin == l.bin && q.sender >= l.sender))))
+        return "posed links are not sorted by receiver, bin and sender";
+    }
+  }
+  const std::size_t leaves = h.leaves.size();
+  for (std::size_t k = 0; k < p.blends.size(); ++k) {
+    const AntiradianceTexelBlend& t = p.blends[k];
+    if (k > 0 && t.texel <= p.blends[k - 1].texel) return "texel blends are not in increasing texel order";
+    for (int j = 0; j < 4; ++j)
+      if (t.leaves[j] < -1 || (t.leaves[j] >= 0 && static_cast<std::size_t>(t.leaves[j]) >= leaves) ||
+          !std::isfinite(t.weights[j]))
+        return "texel blend " + std::to_string(k) + " names a leaf out of range or a non-finite weight";
+  }
+  return {};
+}
+
 // CSR offsets of sorted links.
 void index_links(std::size_t nodes, LinkMesh& mesh) {
   mesh.offsets.assign(nodes + 1, 0u);
@@ -209,6 +245,31 @@ std::vector<Link> links_from_planes(const std::vector<std::uint8_t>& planes, std
     std::memcpy(&l.form_factor, &bits, 4);
   }
   return links;
+}
+
+// Bytes per texel blend in the stream: texel (u32), four leaves (i32), four weights (f32).
+constexpr std::size_t kBlendBytes = 4 + 16 + 16;
+
+std::vector<std::uint8_t> blend_records(const std::vector<AntiradianceTexelBlend>& blends) {
+  std::vector<std::uint8_t> out(blends.size() * kBlendBytes);
+  for (std::size_t k = 0; k < blends.size(); ++k) {
+    std::uint8_t* o = out.data() + k * kBlendBytes;
+    std::memcpy(o, &blends[k].texel, 4);
+    std::memcpy(o + 4, &blends[k].leaves, 16);
+    std::memcpy(o + 20, &blends[k].weights, 16);
+  }
+  return out;
+}
+
+std::vector<AntiradianceTexelBlend> blends_from_records(const std::vector<std::uint8_t>& records, std::size_t n) {
+  std::vector<AntiradianceTexelBlend> blends(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::uint8_t* o = records.data() + k * kBlendBytes;
+    std::memcpy(&blends[k].texel, o, 4);
+    std::memcpy(&blends[k].leaves, o + 4, 16);
+    std::memcpy(&blends[k].weights, o + 20, 16);
+  }
+  return blends;
 }
 
 json settings_json(const AntiradianceSettings& s) {
@@ -307,6 +368,58 @@ engine::Result<AntiradianceFile> read_antiradiance(const fs::path& path) {
   return f;
 }
 
+engine::Status write_antiradiance_at_pose(const fs::path& path, const AntiradianceBake& b,
+                                          const std::string& geometry_hash) {
+  if (std::string problem = check_bake(b); !problem.empty())
+    return file_error(path, "", "cannot save the antiradiance bake: " + problem);
+  if (!b.at_baked_pose.present)
+    return file_error(path, "", "cannot save what the bake did not prepare (at_baked_pose)");
+  if (std::string problem = check_at_pose(b); !problem.empty())
+    return file_error(path, "", "cannot save the antiradiance load data: " + problem);
+  const AntiradianceBake::AtBakedPose& p = b.at_baked_pose;
+  auto links = write_zstd_stream(path, link_planes(p.links.links), kZstdLevel);
+  if (!links) return links.error();
+  auto blends = write_zstd_stream(path, blend_records(p.blends), kZstdLevel);
+  if (!blends) return blends.error();
+  Writer w;
+  w.string(geometry_hash);
+  w.put(static_cast<std::uint64_t>(p.links.relinked_elements));
+  w.put(static_cast<std::uint64_t>(p.links.links.size()));
+  w.array(*links);
+  w.put(p.layout_fingerprint);
+  w.put(static_cast<std::uint64_t>(p.blends.size()));
+  w.array(*blends);
+  return write_blob(path, kAntiradianceAtPoseMagic, kAntiradianceAtPoseVersion, w.bytes);
+}
+
+engine::Result<AntiradianceAtPoseFile> read_antiradiance_at_pose(const fs::path& path) {
+  auto payload = read_blob(path, kAntiradianceAtPoseMagic, kAntiradianceAtPoseVersion);
+  if (!payload) return payload.error();
+  Reader r(*payload);
+  AntiradianceAtPoseFile f;
+  AntiradianceBake::AtBakedPose& p = f.at_baked_pose;
+  std::uint64_t relinked = 0, link_count = 0, blend_count = 0;
+  std::vector<std::uint8_t> link_frame, blend_frame;
+  const bool ok = r.string(f.geometry_hash) && r.get(relinked) && r.get(link_count) && r.array(link_frame) &&
+                  r.get(p.layout_fingerprint) && r.get(blend_count) && r.array(blend_frame);
+  if (!ok) return file_error(path, "", "truncated: a field or array runs past the end of the payload");
+  if (!r.done()) return file_error(path, "", "trailing bytes after the last array");
+  if (link_count > (std::uint64_t{1} << 40) / kLinkPlaneBytes)
+    return file_error(path, "posed_links", std::to_string(link_count) + " links is beyond any bake (corrupt)");
+  if (blend_count > (std::uint64_t{1} << 40) / kBlendBytes)
+    return file_error(path, "texel_blends", std::to_string(blend_count) + " blends is beyond any bake (corrupt)");
+  auto planes = read_zstd_stream(path, "posed_links", link_frame, link_count * kLinkPlaneBytes);
+  if (!planes) return planes.error();
+  auto records = read_zstd_stream(path, "texel_blends", blend_frame, blend_count * kBlendBytes);
+  if (!records) return records.error();
+  p.links.links = links_from_planes(*planes, static_cast<std::size_t>(link_count));
+  p.links.relinked_elements = static_cast<std::size_t>(relinked);
+  p.links.links_made = p.links.links.size();
+  p.blends = blends_from_records(*records, static_cast<std::size_t>(blend_count));
+  p.present = true;
+  return f;
+}
+
 engine::Status save_antiradiance(const fs::path& bundle_dir, const AntiradianceBake& bake, const BakeInput& input) {
   const fs::path file = bundle_dir / kAntiradianceFile;
   if (std::string problem = check_bake(bake); !problem.empty())
@@ -320,7 +433,15 @@ engine::Status save_antiradiance(const fs::path& bundle_dir, const AntiradianceB
   if (!sum) return sum.error();
   const std::uintmax_t bytes = fs::file_size(file, ec);
   if (ec) return file_error(file, "", "cannot read the file size: " + ec.message());
-  const json entry{{"files", {{"elements", {{"file", kAntiradianceFile}, {"xxh3_64", *sum}}}}},
+  json files{{"elements", {{"file", kAntiradianceFile}, {"xxh3_64", *sum}}}};
+  if (bake.at_baked_pose.present) {
+    const fs::path at_pose = bundle_dir / kAntiradianceAtPoseFile;
+    if (engine::Status st = write_antiradiance_at_pose(at_pose, bake, geometry_hash); !st) return st;
+    auto at_pose_sum = file_checksum(at_pose);
+    if (!at_pose_sum) return at_pose_sum.error();
+    files["at_pose"] = {{"file", kAntiradianceAtPoseFile}, {"xxh3_64", *at_pose_sum}};
+  }
+  const json entry{{"files", files},
                    {"settings", settings_json(bake.settings)},
                    {"elements", bake.hierarchy.nodes.size()},
                    {"leaves", bake.hierarchy.leaves.size()},
@@ -339,6 +460,17 @@ engine::Result<AntiradianceBake> load_antiradiance(const fs::path& bundle_dir, c
   auto f = read_antiradiance(*path);
   if (!f) return f.error();
   if (engine::Status st = bundle->check_geometry(*path, f->geometry_hash); !st) return st.error();
+  // What the bake computed for a load at its pose (absent: the load computes it).
+  if (bundle->has_file("at_pose")) {
+    auto at_pose_path = bundle->file("at_pose");
+    if (!at_pose_path) return at_pose_path.error();
+    auto at_pose = read_antiradiance_at_pose(*at_pose_path);
+    if (!at_pose) return at_pose.error();
+    if (engine::Status st = bundle->check_geometry(*at_pose_path, at_pose->geometry_hash); !st) return st.error();
+    f->bake.at_baked_pose = std::move(at_pose->at_baked_pose);
+    if (std::string problem = check_at_pose(f->bake); !problem.empty())
+      return file_error(*at_pose_path, "", problem + " (corrupt, or of another bake; re-bake)");
+  }
   return std::move(f->bake);
 }
 

@@ -7,8 +7,18 @@
 // Files (DESIGN.md §5, docs/bake-bundle.md):
 //   antiradiance.bin  the checksummed container of io/blob_file.h, magic "GIANTIRA", version 2
 //                     (version 1 stored the links as 16-byte records: 2.5-3x larger; re-bake).
+//   antiradiance_at_pose.bin  magic "GIANTPOS", version 1: what a load at the baked pose
+//                     would compute (AntiradianceBake::AtBakedPose), written by the bake so
+//                     the load reads it (absent: the load computes it). Payload:
+//       string geometry_hash; uint64 relinked_elements; uint64 link_count;
+//       array<uint8> link_frame   the posed links (posed_links), planes as below;
+//       uint64 layout_fingerprint (atlas_layout_fingerprint of the blends' atlas, 0: none);
+//       uint64 blend_count; array<uint8> blend_frame   one zstd frame of blend_count x 36
+//                     bytes: texel (uint32), four leaves (int32, -1: none), four weights
+//                     (float32), in increasing texel order
 //   manifest.json     methods.antiradiance = {
-//     "files":    { "elements": {"file": "antiradiance.bin", "xxh3_64": "<hex of the whole file>"} },
+//     "files":    { "elements": {"file": "antiradiance.bin", "xxh3_64": "<hex of the whole file>"},
+//                   "at_pose": {"file": "antiradiance_at_pose.bin", "xxh3_64": ...} },
 //     "settings": { AntiradianceSettings' fields }, "elements", "leaves", "static_links",
 //     "deforming_instances", "memory": { "file_bytes" } }
 // The bake depends on the geometry and the materials (element albedos) and on the static
@@ -55,6 +65,10 @@ inline constexpr const char* kAntiradianceMethod = "antiradiance";
 inline constexpr const char* kAntiradianceFile = "antiradiance.bin";
 inline constexpr BlobMagic kAntiradianceMagic{"GIANTIRA"};
 inline constexpr std::uint32_t kAntiradianceVersion = 2;
+/// What the bake computed for a load at its pose (AntiradianceBake::AtBakedPose).
+inline constexpr const char* kAntiradianceAtPoseFile = "antiradiance_at_pose.bin";
+inline constexpr BlobMagic kAntiradianceAtPoseMagic{"GIANTPOS"};
+inline constexpr std::uint32_t kAntiradianceAtPoseVersion = 1;
 
 /// What antiradiance.bin holds.
 struct AntiradianceFile {
@@ -68,6 +82,20 @@ engine::Status write_antiradiance(const std::filesystem::path& path, const Antir
                                   const std::string& geometry_hash);
 /// Reads and checks antiradiance.bin (container, complete fields, sizes, indices, values).
 engine::Result<AntiradianceFile> read_antiradiance(const std::filesystem::path& path);
+
+/// What antiradiance_at_pose.bin holds.
+struct AntiradianceAtPoseFile {
+  std::string geometry_hash;
+  AntiradianceBake::AtBakedPose at_baked_pose;
+};
+
+/// Writes bake.at_baked_pose to `path` atomically. Error (naming the file, writing nothing)
+/// when the bake has none or it does not fit the bake's hierarchy.
+engine::Status write_antiradiance_at_pose(const std::filesystem::path& path, const AntiradianceBake& bake,
+                                          const std::string& geometry_hash);
+/// Reads antiradiance_at_pose.bin (container, complete fields, zstd streams of the sizes the
+/// counts give). Its indices are checked against the bake by load_antiradiance.
+engine::Result<AntiradianceAtPoseFile> read_antiradiance_at_pose(const std::filesystem::path& path);
 
 /// Writes antiradiance.bin into `bundle_dir` (created if needed) and the manifest's
 /// "antiradiance" entry (other methods' entries kept when the geometry hash is the same).

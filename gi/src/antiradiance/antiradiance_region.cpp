@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 
+#include "bundle/atlas_layout_file.h"
 #include "core/stopwatch.h"
 
 namespace gi {
@@ -110,15 +111,22 @@ engine::Result<AntiradianceRegion> AntiradianceRegion::create(const BakeInput& i
   r.direct_light_ = std::make_unique<AntiradianceDirectLight>(std::move(direct).value());
   // Place the deforming groups where `input` has them and link them.
   std::vector<int> groups;
+  r.at_baked_pose_ = true;
   for (int g = 1; g < r.hierarchy_->group_count(); ++g) {
     const std::uint32_t i = r.hierarchy_->deforming_instances[static_cast<std::size_t>(g - 1)];
     // At the baked pose the elements keep their baked world values (bit for bit the
     // baseline's); elsewhere they are placed from object space.
-    if (r.hierarchy_->group_transform[static_cast<std::size_t>(g - 1)] != input.instances[i].object_to_world)
+    if (r.hierarchy_->group_transform[static_cast<std::size_t>(g - 1)] != input.instances[i].object_to_world) {
       r.hierarchy_->set_group_transform(g, input.instances[i].object_to_world);
+      r.at_baked_pose_ = false;
+    }
     groups.push_back(g);
   }
-  relink_moved(*r.hierarchy_, *r.bins_, r.settings_, groups, *r.links_);
+  // At the baked pose the bake's posed links are what relinking would make.
+  if (r.at_baked_pose_ && bake.at_baked_pose.present)
+    merge_posed_links(*r.hierarchy_, bake.at_baked_pose.links, *r.links_);
+  else
+    relink_moved(*r.hierarchy_, *r.bins_, r.settings_, groups, *r.links_);
   r.cpu_ = std::make_unique<CpuAntiradiancePasses>(*r.hierarchy_, *r.bins_, *r.links_);
   r.direct_ = r.direct_light_->irradiance(*r.hierarchy_);
   r.counters_ = {groups.size(), r.links_->relinked_elements, r.links_->links_made, r.links_->links.size()};
@@ -133,6 +141,7 @@ bool AntiradianceRegion::set_instance_transform(std::uint32_t instance, const gl
   if (hierarchy_->group_transform[static_cast<std::size_t>(group - 1)] == m) return false;
   hierarchy_->set_group_transform(group, m);
   direct_light_->set_instance_transform(instance, m);
+  at_baked_pose_ = false;
   if (std::find(moved_.begin(), moved_.end(), group) == moved_.end()) moved_.push_back(group);
   return true;
 }
@@ -159,6 +168,22 @@ AntiradianceSolveReport AntiradianceRegion::update(bool solve) {
   if (!solve) return {};
   last_ = run_antiradiance(*cpu_, direct_, settings_, *hierarchy_);
   return last_;
+}
+
+void prepare_antiradiance_load(AntiradianceBake& bake, const BakeInput& input, const AtlasLayout* layout) {
+  // The groups AntiradianceRegion::create relinks, at the pose the bake holds them.
+  std::vector<int> groups;
+  for (int g = 1; g < bake.hierarchy.group_count(); ++g) groups.push_back(g);
+  const DirectionalBins bins(bake.settings.bins_per_side);
+  AntiradianceBake::AtBakedPose& p = bake.at_baked_pose;
+  p.links = posed_links(bake.hierarchy, bins, bake.settings, groups);
+  p.blends.clear();
+  p.layout_fingerprint = 0;
+  if (layout != nullptr) {
+    p.blends = antiradiance_texel_blends(bake.hierarchy, input, *layout);
+    p.layout_fingerprint = atlas_layout_fingerprint(*layout);
+  }
+  p.present = true;
 }
 
 }  // namespace gi

@@ -30,6 +30,7 @@
 #include "antiradiance/antiradiance_passes.h"
 #include "antiradiance/antiradiance_settings.h"
 #include "antiradiance/antiradiance_solver.h"
+#include "antiradiance/antiradiance_texel_blend.h"
 #include "antiradiance/directional_bins.h"
 #include "antiradiance/element_hierarchy.h"
 #include "antiradiance/link_mesh.h"
@@ -50,7 +51,23 @@ struct AntiradianceBake {
   struct StageSeconds {
     double links = 0.0, static_links = 0.0, direct = 0.0, solve = 0.0;
   } seconds;
+  /// What a load with the deforming groups at their baked pose would compute, computed by
+  /// the bake (prepare_antiradiance_load) and stored (antiradiance_io.h) so the load only
+  /// reads it: the links with an end in a deforming group (posed_links) and the runtime
+  /// atlas's texel blends. Absent (present false): the load computes both.
+  struct AtBakedPose {
+    bool present = false;
+    LinkMesh links;                        ///< posed_links of every deforming group.
+    std::uint64_t layout_fingerprint = 0;  ///< atlas_layout_fingerprint of the layout `blends` cover (0: none).
+    std::vector<AntiradianceTexelBlend> blends;
+  } at_baked_pose;
 };
+
+/// Fills bake.at_baked_pose: the posed links of every deforming group at the baked pose and,
+/// when `layout` is given (the atlas the runtime composites into: the bundle's light atlas,
+/// else its PRM), its texel blends. Bit for bit what AntiradianceRegion::create and
+/// AntiradianceLighting would compute from the bake at that pose.
+void prepare_antiradiance_load(AntiradianceBake& bake, const BakeInput& input, const AtlasLayout* layout);
 
 /// Builds the elements, links the static ones and solves the baseline. Errors: see
 /// build_element_hierarchy and AntiradianceDirectLight::create; bins_per_side outside [1, 64].
@@ -110,6 +127,9 @@ class AntiradianceRegion {
   const LinkMesh& links() const { return *links_; }
   const AntiradianceSettings& settings() const { return settings_; }
   const AntiradianceUpdateCounters& counters() const { return counters_; }
+  /// True while every deforming group is at the pose it was baked at (since create, before
+  /// any move): the bake's AtBakedPose then holds what the region would compute.
+  bool at_baked_pose() const { return at_baked_pose_; }
 
  private:
   AntiradianceSettings settings_;
@@ -124,6 +144,7 @@ class AntiradianceRegion {
   std::vector<int> moved_;
   AntiradianceSolveReport last_;
   AntiradianceUpdateCounters counters_;
+  bool at_baked_pose_ = false;
 };
 
 }  // namespace gi

@@ -270,4 +270,22 @@ void relink_moved(const ElementHierarchy& h, const DirectionalBins& bins, const 
   index_links(h, mesh);
 }
 
+LinkMesh posed_links(const ElementHierarchy& h, const DirectionalBins& bins, const AntiradianceSettings& settings,
+                     const std::vector<int>& groups) {
+  LinkMesh mesh;
+  relink_moved(h, bins, settings, groups, mesh);
+  return mesh;
+}
+
+void merge_posed_links(const ElementHierarchy& h, const LinkMesh& posed, LinkMesh& mesh) {
+  // relink_moved's tail: the kept (static) links, then the new ones sorted, merged.
+  const std::size_t kept = mesh.links.size();
+  mesh.links.insert(mesh.links.end(), posed.links.begin(), posed.links.end());
+  std::inplace_merge(mesh.links.begin(), mesh.links.begin() + static_cast<std::ptrdiff_t>(kept), mesh.links.end(),
+                     link_less);
+  index_links(h, mesh);
+  mesh.relinked_elements = posed.relinked_elements;
+  mesh.links_made = posed.links.size();
+}
+
 }  // namespace gi

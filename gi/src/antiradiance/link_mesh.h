@@ -80,4 +80,15 @@ LinkMesh static_links(const ElementHierarchy& h, const LinkMesh& mesh);
 void relink_moved(const ElementHierarchy& h, const DirectionalBins& bins, const AntiradianceSettings& settings,
                   const std::vector<int>& moved, LinkMesh& mesh);
 
+/// The links relink_moved(h, bins, settings, groups, mesh) adds to a mesh of static links
+/// at the groups' current poses, sorted, with its counters: what a bake stores so that a
+/// load at the baked pose merges them (merge_posed_links) instead of relinking.
+LinkMesh posed_links(const ElementHierarchy& h, const DirectionalBins& bins, const AntiradianceSettings& settings,
+                     const std::vector<int>& groups);
+
+/// What relink_moved(h, bins, settings, groups, mesh) makes of `mesh` (static links only)
+/// when `posed` = posed_links(h, bins, settings, groups) at the same poses: the same links
+/// in the same order, offsets and counters, bit for bit, by a linear merge.
+void merge_posed_links(const ElementHierarchy& h, const LinkMesh& posed, LinkMesh& mesh);
+
 }  // namespace gi

@@ -19,6 +19,7 @@
 #include "brf/brf_bake.h"
 #include "brf/brf_io.h"
 #include "brf/brf_mesh.h"
+#include "bundle/bundle_reader.h"
 #include "bundle/geometry_hash.h"
 #include "bundle/manifest.h"
 #include "core/stopwatch.h"
@@ -87,6 +88,21 @@ engine::Status bake_prm_method(const BakeInput& input, const fs::path& dir, cons
   return save_prm(dir, *prm, input);
 }
 
+// The atlas the runtime composites antiradiance into (GISystem: the light atlas's layout,
+// else the PRM's) as the bundle in `dir` holds it; none when it holds neither.
+std::optional<AtlasLayout> runtime_atlas_layout(const fs::path& dir, const BakeInput& input) {
+  for (const char* method : {kLightAtlasMethod, kPrmMethod}) {
+    auto bundle = BundleReader::open(dir, method, input, "re-bake");
+    if (!bundle) continue;
+    JsonFields f = bundle->fields();
+    const BakedAtlasLayout baked = read_baked_atlas_layout(f);
+    if (f.error()) continue;
+    auto layout = bundle->atlas_layout(input, baked, "atlas layout");
+    if (layout) return std::move(layout).value();
+  }
+  return std::nullopt;
+}
+
 engine::Status bake_antiradiance_method(const BakeInput& input, const fs::path& dir, const BakeOptions& o,
                                         const BakeStage& stage, Timings& timings, const MergedParts* parts = nullptr) {
   const AntiradianceSettings s = antiradiance_settings(o);
@@ -105,6 +121,12 @@ engine::Status bake_antiradiance_method(const BakeInput& input, const fs::path& 
   timings["static_links_seconds"] = bake->seconds.static_links;
   timings["direct_seconds"] = bake->seconds.direct;
   timings["solve_seconds"] = bake->seconds.solve;
+  // What a load at the baked pose computes (the posed links, the texel blends of the atlas
+  // baked before it in this bundle), stored so the load reads it.
+  const auto at_pose_start = Clock::now();
+  const std::optional<AtlasLayout> layout = runtime_atlas_layout(dir, input);
+  prepare_antiradiance_load(*bake, input, layout ? &*layout : nullptr);
+  timings["at_pose_seconds"] = seconds_since(at_pose_start);
   const auto save_start = Clock::now();
   auto saved = save_antiradiance(dir, *bake, input);
   timings["save_seconds"] = seconds_since(save_start);

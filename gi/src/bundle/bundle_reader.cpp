@@ -2,8 +2,8 @@
 
 #include <utility>
 
+#include "bundle/atlas_layout_file.h"
 #include "bundle/bundle.h"
-#include "uv/atlas_input.h"
 
 namespace gi {
 
@@ -26,6 +26,15 @@ json baked_atlas_layout_json(const AtlasLayout& layout) {
               {"padding_texels", layout.padding_texels},
               {"width", layout.width},
               {"height", layout.height}};
+}
+
+engine::Result<json> write_bundle_atlas_layout(const fs::path& bundle_dir, const std::string& file_name,
+                                               const AtlasLayout& layout, const std::string& geometry_hash) {
+  const fs::path path = bundle_dir / file_name;
+  if (engine::Status s = write_atlas_layout_file(path, layout, geometry_hash); !s) return s.error();
+  auto sum = file_checksum(path);
+  if (!sum) return sum.error();
+  return json{{"file", file_name}, {"xxh3_64", *sum}};
 }
 
 BundleReader::BundleReader(fs::path dir, Manifest manifest, json entry, const std::string& method)
@@ -87,23 +96,69 @@ engine::Status BundleReader::check_lights(const std::string& baked_lights_hash, 
                                         advice + ")");
 }
 
+namespace {
+
+// "32x16, 8 texels/m (requested 8), padding 2": a layout as the errors show it.
+std::string describe(int width, int height, float density, float requested, int padding) {
+  return std::to_string(width) + "x" + std::to_string(height) + ", " + std::to_string(density) +
+         " texels/m (requested " + std::to_string(requested) + "), padding " + std::to_string(padding);
+}
+
+// Empty when `layout` has one mesh per static instance of `input`, with its id and vertex
+// count (what the renderer pairs UV1 with), else what differs.
+std::string layout_scene_mismatch(const AtlasLayout& layout, const BakeInput& input) {
+  std::size_t m = 0;
+  for (const BakeInstance& inst : input.instances) {
+    if (inst.mobility != BakeMobility::Static || inst.mesh >= input.meshes.size()) continue;
+    if (m >= layout.meshes.size())
+      return "it holds " + std::to_string(layout.meshes.size()) + " meshes, the scene has more static instances";
+    const AtlasMeshUv& mesh = layout.meshes[m];
+    std::size_t vertices = 0, indices = 0;
+    for (const BakePrimitive& prim : input.meshes[inst.mesh].primitives) {
+      vertices += prim.positions.size();
+      indices += prim.indices.size();
+    }
+    if (mesh.id != inst.id || mesh.indices.size() != indices)
+      return "mesh " + std::to_string(m) + " is not static instance " + std::to_string(inst.id) + "'s";
+    for (std::uint32_t v : mesh.source_vertex)
+      if (v >= vertices) return "mesh " + std::to_string(m) + " names a vertex beyond the instance's";
+    ++m;
+  }
+  if (m != layout.meshes.size())
+    return "it holds " + std::to_string(layout.meshes.size()) + " meshes for " + std::to_string(m) +
+           " static instances";
+  return {};
+}
+
+}  // namespace
+
 engine::Result<AtlasLayout> BundleReader::atlas_layout(const BakeInput& input, const BakedAtlasLayout& baked,
                                                        const std::string& what) const {
-  auto layout = build_atlas_layout(
-      atlas_inputs_from(input),
-      AtlasSettings{.texels_per_metre = baked.requested_texels_per_metre, .padding_texels = baked.padding_texels});
-  if (!layout) {
-    engine::Error e = layout.error();
-    e.message = "cannot rebuild the " + what + " of " + manifest_file_.string() + ": " + e.message;
-    return e;
-  }
-  if (layout->width != baked.width || layout->height != baked.height ||
-      layout->texels_per_metre != baked.texels_per_metre)
-    return entry_error("layout", "the rebuilt layout (" + std::to_string(layout->width) + "x" +
-                                     std::to_string(layout->height) + ") differs from the baked one (" +
-                                     std::to_string(baked.width) + "x" + std::to_string(baked.height) +
-                                     "); the atlas code changed since the bake (re-bake)");
-  return layout;
+  if (!has_file("layout"))
+    return entry_error("files.layout", "no " + what +
+                                           " file: the bundle was baked before bakes wrote their layouts "
+                                           "(re-bake)");
+  auto path = file("layout");
+  if (!path) return path.error();
+  auto read = read_atlas_layout_file(*path);
+  if (!read) return read.error();
+  if (engine::Status s = check_geometry(*path, read->geometry_hash); !s) return s.error();
+  AtlasLayout& layout = read->layout;
+  if (layout.width != baked.width || layout.height != baked.height ||
+      layout.texels_per_metre != baked.texels_per_metre ||
+      layout.requested_texels_per_metre != baked.requested_texels_per_metre ||
+      layout.padding_texels != baked.padding_texels)
+    return engine::Error{path->string(), "",
+                         "the " + what + " (" +
+                             describe(layout.width, layout.height, layout.texels_per_metre,
+                                      layout.requested_texels_per_metre, layout.padding_texels) +
+                             ") differs from the one the manifest describes (" +
+                             describe(baked.width, baked.height, baked.texels_per_metre,
+                                      baked.requested_texels_per_metre, baked.padding_texels) +
+                             ") (re-bake)"};
+  if (std::string problem = layout_scene_mismatch(layout, input); !problem.empty())
+    return engine::Error{path->string(), "", "the " + what + " does not fit the scene: " + problem + " (re-bake)"};
+  return std::move(read->layout);
 }
 
 }  // namespace gi

@@ -3,8 +3,9 @@
 // A BundleReader opens a method's entry in manifest.json (the manifest read, the bundle's
 // geometry checked against the scene, the entry present), hands out the files the entry
 // names once their names stay inside the bundle and their checksums match, checks a
-// payload's geometry hash and static-lights hash, and rebuilds the atlas layout the entry
-// describes. Its errors name the file and the problem, so the loaders' errors read alike.
+// payload's geometry hash and static-lights hash, and reads the atlas layout the bake wrote
+// (files.layout, bundle/atlas_layout_file.h). Its errors name the file and the problem, so the loaders' errors read
+// alike.
 //   auto bundle = gi::BundleReader::open(dir, gi::kDlmMethod, input, "re-bake the directional light maps");
 //   if (!bundle) return bundle.error();
 //   auto path = bundle->file("maps");  // files.maps.{file,xxh3_64}
@@ -23,7 +24,7 @@
 namespace gi {
 
 /// The atlas layout a method's entry records ("layout": requested and achieved density,
-/// padding, size): enough to rebuild it from the scene and to check the rebuild.
+/// padding, size): what the layout file (files.layout) must agree with.
 struct BakedAtlasLayout {
   float requested_texels_per_metre = 0.0f;
   float texels_per_metre = 0.0f;
@@ -37,6 +38,12 @@ BakedAtlasLayout read_baked_atlas_layout(JsonFields& f);
 
 /// The "layout" object a writer stores for `layout` (read back by read_baked_atlas_layout).
 nlohmann::json baked_atlas_layout_json(const AtlasLayout& layout);
+
+/// Writes DIR/<file_name> (write_atlas_layout_file) and returns its manifest entry
+/// {"file", "xxh3_64"}, which a writer stores as "files.layout".
+engine::Result<nlohmann::json> write_bundle_atlas_layout(const std::filesystem::path& bundle_dir,
+                                                         const std::string& file_name, const AtlasLayout& layout,
+                                                         const std::string& geometry_hash);
 
 class BundleReader {
  public:
@@ -75,7 +82,9 @@ class BundleReader {
   /// the static lights hash of `input`: "stale <what> in DIR: ... (<advice>)".
   engine::Status check_lights(const std::string& baked_lights_hash, const BakeInput& input, const std::string& what,
                               const std::string& advice) const;
-  /// The atlas layout of `input` rebuilt with the entry's settings, checked against `baked`.
+  /// The atlas layout the bake wrote (the entry's files.layout), checked: its checksum, its
+  /// geometry hash, its size and densities against `baked`, and one mesh per static instance
+  /// of `input` with that instance's id and vertex count. Nothing is rebuilt from geometry.
   /// `what` names the atlas in errors ("PRM atlas layout").
   engine::Result<AtlasLayout> atlas_layout(const BakeInput& input, const BakedAtlasLayout& baked,
                                            const std::string& what) const;

@@ -5,7 +5,7 @@
 //   auto m = gi::read_manifest("level.gibake");
 //   if (m && m->geometry_hash != gi::scene_geometry_hash(asset)) { /* stale */ }
 //
-//   { "format_version": 2, "geometry_hash": "0123456789abcdef", "scene": "level.gltf",
+//   { "format_version": 3, "geometry_hash": "0123456789abcdef", "scene": "level.gltf",
 //     "methods": { "light_atlas": { "files": {...}, "settings": {...}, ... } } }
 
 #include <engine/result.h>
@@ -17,8 +17,9 @@
 
 namespace gi {
 
-// 2: XXH3-64 checksums and hashes ("xxh3_64"); 1 (FNV-1a) is refused with "re-bake".
-inline constexpr int kManifestFormatVersion = 2;
+// 3: the atlas methods' layouts are bundle files (files.layout), read at load, not rebuilt;
+// 2: XXH3-64 checksums and hashes ("xxh3_64"); 1 (FNV-1a). Older versions are refused with "re-bake".
+inline constexpr int kManifestFormatVersion = 3;
 inline constexpr const char* kManifestFileName = "manifest.json";
 
 struct Manifest {

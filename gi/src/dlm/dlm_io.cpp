@@ -212,9 +212,11 @@ engine::Status save_dlm(const fs::path& bundle_dir, const Dlm& dlm, const BakeIn
   if (!sum) return sum.error();
   const std::uintmax_t file_bytes = fs::file_size(file, ec);
   if (ec) return file_error(file, "", "cannot read the file size: " + ec.message());
+  auto layout_file = write_bundle_atlas_layout(bundle_dir, kDlmLayoutFile, dlm.layout, geometry_hash);
+  if (!layout_file) return layout_file.error();
   const std::uint64_t n = dlm.directions.size();
   const json entry{
-      {"files", {{"maps", {{"file", kDlmFile}, {"xxh3_64", *sum}}}}},
+      {"files", {{"maps", {{"file", kDlmFile}, {"xxh3_64", *sum}}}, {"layout", *layout_file}}},
       {"lights_hash", static_lights_hash(input)},
       {"settings", settings_json(dlm.settings)},
       {"layout", baked_atlas_layout_json(dlm.layout)},

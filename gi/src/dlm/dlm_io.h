@@ -46,6 +46,8 @@ namespace gi {
 
 inline constexpr const char* kDlmMethod = "dlm";
 inline constexpr const char* kDlmFile = "dlm.bin";
+/// The DLM's atlas layout (bundle/atlas_layout_file.h), files.layout.
+inline constexpr const char* kDlmLayoutFile = "dlm_layout.bin";
 inline constexpr BlobMagic kDlmMagic{"GIDLMAPS"};
 inline constexpr std::uint32_t kDlmVersion = 1;
 inline constexpr double kDlmRelativeError = 1.0 / 2048.0;

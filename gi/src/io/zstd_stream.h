@@ -5,7 +5,7 @@
 //   auto frame = gi::write_zstd_stream(path, planes, 9);
 //   auto planes = gi::read_zstd_stream(path, "panes", frame, clusters * texels * 6);
 //   if (!planes) return planes.error();
-// Header-only: the readers that use it link zstd (gi_core does not).
+// Header-only: the targets that use it link zstd (gi_core for the atlas layout file).
 
 #include <zstd.h>
 #include <engine/result.h>

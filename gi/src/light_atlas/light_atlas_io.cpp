@@ -127,10 +127,13 @@ engine::Status save_light_atlas(const fs::path& bundle_dir, const LightAtlasBake
   if (!exr_sum) return exr_sum.error();
   auto vpls_sum = file_checksum(vpls);
   if (!vpls_sum) return vpls_sum.error();
+  auto layout_file = write_bundle_atlas_layout(bundle_dir, kLightAtlasLayoutFile, bake.layout, geometry_hash);
+  if (!layout_file) return layout_file.error();
 
   const json entry{{"files",
                     {{"irradiance", {{"file", kLightAtlasExrFile}, {"xxh3_64", *exr_sum}}},
-                     {"vpls", {{"file", kLightAtlasVplsFile}, {"xxh3_64", *vpls_sum}}}}},
+                     {"vpls", {{"file", kLightAtlasVplsFile}, {"xxh3_64", *vpls_sum}}},
+                     {"layout", *layout_file}}},
                    {"lights_hash", static_lights_hash(input)},
                    {"direct_light", direct_light_name(bake.settings)},
                    {"settings", settings_json(bake.settings)},

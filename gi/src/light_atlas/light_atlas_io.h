@@ -33,6 +33,8 @@ namespace gi {
 inline constexpr const char* kLightAtlasMethod = "light_atlas";
 inline constexpr const char* kLightAtlasExrFile = "light_atlas.exr";
 inline constexpr const char* kLightAtlasVplsFile = "light_atlas_vpls.bin";
+/// The atlas layout (bundle/atlas_layout_file.h), files.layout.
+inline constexpr const char* kLightAtlasLayoutFile = "light_atlas_layout.bin";
 
 /// Writes `bake` of `input` into `bundle_dir` (created if needed): the EXR, the VPL file,
 /// then the manifest's "light_atlas" entry with the input's static_lights_hash (other

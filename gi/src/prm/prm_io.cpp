@@ -340,8 +340,10 @@ engine::Status save_prm(const fs::path& bundle_dir, const Prm& prm, const BakeIn
   if (!sum) return sum.error();
   const std::uintmax_t file_bytes = fs::file_size(panes, ec);
   if (ec) return file_error(panes, "", "cannot read the file size: " + ec.message());
+  auto layout_file = write_bundle_atlas_layout(bundle_dir, kPrmLayoutFile, prm.layout, geometry_hash);
+  if (!layout_file) return layout_file.error();
 
-  const json entry{{"files", {{"panes", {{"file", kPrmPanesFile}, {"xxh3_64", *sum}}}}},
+  const json entry{{"files", {{"panes", {{"file", kPrmPanesFile}, {"xxh3_64", *sum}}}, {"layout", *layout_file}}},
                    {"settings", settings_json(prm.settings)},
                    {"layout", baked_atlas_layout_json(prm.layout)},
                    {"entry_points", prm.entries.size()},

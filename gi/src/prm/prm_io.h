@@ -58,6 +58,8 @@ namespace gi {
 
 inline constexpr const char* kPrmMethod = "prm";
 inline constexpr const char* kPrmPanesFile = "prm_panes.bin";
+/// The PRM's atlas layout (bundle/atlas_layout_file.h), files.layout.
+inline constexpr const char* kPrmLayoutFile = "prm_layout.bin";
 inline constexpr BlobMagic kPrmPanesMagic{"GIPRMPAN"};
 // 2: the thread count left out (a bundle does not depend on it; bake_stats.json says it).
 inline constexpr std::uint32_t kPrmPanesVersion = 2;

@@ -10,6 +10,7 @@
 #include <chrono>
 #include <limits>
 
+#include "bundle/atlas_layout_file.h"
 #include "gpu/gi_shaders.h"
 
 namespace gi {
@@ -21,12 +22,26 @@ static_assert(sizeof(TexelBlend) == 48, "must match TexelBlend in antiradiance_c
 
 constexpr std::uint32_t kGroupSize = 64;
 
+// Stored blends name texels inside `layout`, in increasing order (as computed).
+bool blends_fit(const std::vector<TexelBlend>& blends, const AtlasLayout& layout) {
+  const std::uint64_t texels = static_cast<std::uint64_t>(layout.width) * static_cast<std::uint64_t>(layout.height);
+  for (std::size_t k = 0; k < blends.size(); ++k)
+    if (blends[k].texel >= texels || (k > 0 && blends[k].texel <= blends[k - 1].texel)) return false;
+  return true;
+}
+
 }  // namespace
 
 engine::Result<std::unique_ptr<AntiradianceLighting>> AntiradianceLighting::create(AntiradianceBake bake,
                                                                                    const BakeInput& input,
                                                                                    const AtlasLayout& layout,
                                                                                    const engine::Registry& registry) {
+  // The bake's blends (read with it) serve when they cover this layout and the region sits
+  // at its baked pose: they are then what antiradiance_texel_blends computes here.
+  std::vector<TexelBlend> stored = std::move(bake.at_baked_pose.blends);
+  const bool stored_fit = bake.at_baked_pose.present && bake.at_baked_pose.layout_fingerprint != 0 &&
+                          bake.at_baked_pose.layout_fingerprint == atlas_layout_fingerprint(layout) &&
+                          blends_fit(stored, layout);
   auto region = AntiradianceRegion::create(input, std::move(bake));
   if (!region) return region.error();
   std::unique_ptr<AntiradianceLighting> a(new AntiradianceLighting());
@@ -34,7 +49,9 @@ engine::Result<std::unique_ptr<AntiradianceLighting>> AntiradianceLighting::crea
   a->registry_ = &registry;
   for (std::uint32_t i : a->region_->hierarchy().deforming_instances)
     a->deforming_.emplace_back(i, input.instances[i].entity);
-  std::vector<TexelBlend> blends = antiradiance_texel_blends(a->region_->hierarchy(), input, layout);
+  std::vector<TexelBlend> blends = stored_fit && a->region_->at_baked_pose()
+                                       ? std::move(stored)
+                                       : antiradiance_texel_blends(a->region_->hierarchy(), input, layout);
   a->blend_count_ = static_cast<std::uint32_t>(blends.size());
   a->width_ = layout.width;
   a->height_ = layout.height;

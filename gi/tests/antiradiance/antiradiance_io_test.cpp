@@ -5,12 +5,15 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <string>
 
 #include "antiradiance_scenes.h"
+#include "bundle/atlas_layout_file.h"
+#include "uv/atlas_layout.h"
 
 namespace {
 
@@ -143,3 +146,108 @@ TEST(AntiradianceIo, InconsistentBakesAreRefusedBeforeWritingAndForeignScenesOnL
 }
 
 }  // namespace
+
+namespace {
+
+bool same_links(const gi::LinkMesh& a, const gi::LinkMesh& b) {
+  if (a.links.size() != b.links.size() || a.offsets != b.offsets || a.relinked_elements != b.relinked_elements ||
+      a.links_made != b.links_made)
+    return false;
+  for (std::size_t k = 0; k < a.links.size(); ++k) {
+    const gi::Link &x = a.links[k], &y = b.links[k];
+    if (x.receiver != y.receiver || x.sender != y.sender || x.bin != y.bin ||
+        std::memcmp(&x.form_factor, &y.form_factor, 4) != 0)
+      return false;
+  }
+  return true;
+}
+
+bool same_blends(const std::vector<gi::AntiradianceTexelBlend>& a, const std::vector<gi::AntiradianceTexelBlend>& b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t k = 0; k < a.size(); ++k)
+    if (a[k].texel != b[k].texel || a[k].leaves != b[k].leaves ||
+        std::memcmp(&a[k].weights, &b[k].weights, sizeof(glm::vec4)) != 0)
+      return false;
+  return true;
+}
+
+}  // namespace
+
+// The bake stores what a load at its pose computed (the deforming groups' links, the atlas
+// texels' blends); read back, they are bit for bit what the load computes without them.
+TEST(AntiradianceIo, WhatTheBakePreparesIsWhatTheLoadComputes) {
+  const artest::DoorScene scene = artest::door_scene(30.0f);
+  auto bake = gi::bake_antiradiance(scene.input, small());
+  ASSERT_TRUE(bake) << bake.error().to_string();
+  auto layout = gi::static_world_layout(scene.input, 8.0f);
+  ASSERT_TRUE(layout) << layout.error().to_string();
+  gi::AntiradianceBake prepared = *bake;
+  gi::prepare_antiradiance_load(prepared, scene.input, &*layout);
+  EXPECT_FALSE(prepared.at_baked_pose.links.links.empty()) << "the door links to the room";
+  EXPECT_FALSE(prepared.at_baked_pose.blends.empty());
+  const fs::path dir = scratch_dir("at_pose");
+  ASSERT_TRUE(gi::save_antiradiance(dir, prepared, scene.input));
+  ASSERT_TRUE(fs::exists(dir / gi::kAntiradianceAtPoseFile));
+  auto loaded = gi::load_antiradiance(dir, scene.input);
+  ASSERT_TRUE(loaded) << loaded.error().to_string();
+  ASSERT_TRUE(loaded->at_baked_pose.present);
+  EXPECT_EQ(loaded->at_baked_pose.layout_fingerprint, gi::atlas_layout_fingerprint(*layout));
+  // The blends the load used to compute, from the loaded hierarchy.
+  EXPECT_TRUE(same_blends(loaded->at_baked_pose.blends,
+                          gi::antiradiance_texel_blends(loaded->hierarchy, scene.input, *layout)));
+  // The region from the stored links against the region relinked as before.
+  gi::AntiradianceBake without = *loaded;
+  without.at_baked_pose = {};
+  auto merged = gi::AntiradianceRegion::create(scene.input, std::move(loaded).value());
+  auto relinked = gi::AntiradianceRegion::create(scene.input, std::move(without));
+  ASSERT_TRUE(merged && relinked);
+  EXPECT_TRUE(merged->at_baked_pose());
+  EXPECT_TRUE(same_links(merged->links(), relinked->links()));
+  EXPECT_EQ(merged->counters().links, relinked->counters().links);
+  EXPECT_EQ(merged->counters().relinked_elements, relinked->counters().relinked_elements);
+  merged->update();
+  relinked->update();
+  EXPECT_EQ(merged->irradiance(), relinked->irradiance());
+}
+
+// Away from the baked pose the stored links do not apply: the region relinks.
+TEST(AntiradianceIo, AScenePosedElsewhereRelinksInsteadOfUsingTheStoredLinks) {
+  const artest::DoorScene baked = artest::door_scene(30.0f);
+  auto bake = gi::bake_antiradiance(baked.input, small());
+  ASSERT_TRUE(bake) << bake.error().to_string();
+  gi::prepare_antiradiance_load(*bake, baked.input, nullptr);
+  EXPECT_EQ(bake->at_baked_pose.layout_fingerprint, 0u);
+  const artest::DoorScene moved = artest::door_scene(60.0f);
+  gi::AntiradianceBake without = *bake;
+  without.at_baked_pose = {};
+  auto a = gi::AntiradianceRegion::create(moved.input, std::move(bake).value());
+  auto b = gi::AntiradianceRegion::create(moved.input, std::move(without));
+  ASSERT_TRUE(a && b);
+  EXPECT_FALSE(a->at_baked_pose());
+  EXPECT_TRUE(same_links(a->links(), b->links()));
+}
+
+TEST(AntiradianceIo, ADamagedOrTruncatedAtPoseFileIsRejectedByName) {
+  const artest::DoorScene scene = artest::door_scene(30.0f);
+  auto bake = gi::bake_antiradiance(scene.input, small());
+  ASSERT_TRUE(bake) << bake.error().to_string();
+  gi::prepare_antiradiance_load(*bake, scene.input, nullptr);
+  const fs::path dir = scratch_dir("at_pose_damaged");
+  ASSERT_TRUE(gi::save_antiradiance(dir, *bake, scene.input));
+  const fs::path file = dir / gi::kAntiradianceAtPoseFile;
+  const std::vector<char> good = read_all(file);
+  std::vector<char> truncated(good.begin(), good.end() - 5);
+  write_all(file, truncated);
+  auto r = gi::load_antiradiance(dir, scene.input);
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().file, file.string());
+  auto direct = gi::read_antiradiance_at_pose(file);
+  ASSERT_FALSE(direct);
+  EXPECT_TRUE(contains(direct.error().to_string(), "truncated")) << direct.error().to_string();
+  std::vector<char> flipped = good;
+  flipped[flipped.size() - 3] = static_cast<char>(flipped[flipped.size() - 3] ^ 1);
+  write_all(file, flipped);
+  auto c = gi::load_antiradiance(dir, scene.input);
+  ASSERT_FALSE(c);
+  EXPECT_TRUE(contains(c.error().to_string(), "checksum")) << c.error().to_string();
+}

@@ -195,19 +195,20 @@ TEST(BundleManifest, RejectsBadManifestsNamingTheFile) {
   auto none = gi::read_manifest(dir);
   ASSERT_FALSE(none.ok());
   EXPECT_EQ(none.error().file, file.string());
-  expect_error("{ \"format_version\": 2, ", "malformed JSON");
+  expect_error("{ \"format_version\": 3, ", "malformed JSON");
   expect_error("[1, 2]", "not a JSON object");
   // Version 1 bundles (FNV-1a checksums) and future ones are refused with what to do.
   expect_error(R"({"format_version": 1, "geometry_hash": "a", "scene": "s", "methods": {}})", "format_version 1");
   expect_error(R"({"format_version": 1, "geometry_hash": "a", "scene": "s", "methods": {}})", "re-bake");
-  expect_error(R"({"format_version": 3, "geometry_hash": "a", "scene": "s", "methods": {}})", "format_version 3");
-  expect_error(R"({"format_version": 4294967298, "geometry_hash": "a", "scene": "s", "methods": {}})",
-               "format_version 4294967298");  // 2^32 + 2 does not narrow to 2
-  expect_error(R"({"format_version": 2, "scene": "s", "methods": {}})", "geometry_hash: missing field");
-  expect_error(R"({"format_version": 2, "geometry_hash": "a", "scene": "s", "methods": []})", "methods");
+  expect_error(R"({"format_version": 2, "geometry_hash": "a", "scene": "s", "methods": {}})", "re-bake");
+  expect_error(R"({"format_version": 4, "geometry_hash": "a", "scene": "s", "methods": {}})", "format_version 4");
+  expect_error(R"({"format_version": 4294967299, "geometry_hash": "a", "scene": "s", "methods": {}})",
+               "format_version 4294967299");  // 2^32 + 3 does not narrow to 3
+  expect_error(R"({"format_version": 3, "scene": "s", "methods": {}})", "geometry_hash: missing field");
+  expect_error(R"({"format_version": 3, "geometry_hash": "a", "scene": "s", "methods": []})", "methods");
   expect_error(R"({"format_version": "1", "geometry_hash": "a", "scene": "s", "methods": {}})", "integer");
   // A crafted manifest nested 200,000 levels deep: refused, not a stack overflow.
-  expect_error(R"({"format_version": 2, "geometry_hash": "a", "scene": "s", "methods": {"x": )" +
+  expect_error(R"({"format_version": 3, "geometry_hash": "a", "scene": "s", "methods": {"x": )" +
                    std::string(200000, '[') + std::string(200000, ']') + "}}",
                "nested deeper than 64 levels");
 }

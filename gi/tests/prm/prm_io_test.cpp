@@ -447,7 +447,7 @@ TEST(PrmIo, MissingOrDamagedFilesAreRejected) {
     ASSERT_TRUE(m.ok());
     m->methods["prm"]["layout"]["requested_texels_per_metre"] = 6.0;
     ASSERT_TRUE(gi::write_manifest(dir, *m).ok());
-    expect_load_error(dir, "manifest.json", "rebuilt layout");
+    expect_load_error(dir, "prm_layout.bin", "differs from the one the manifest describes");
   }
   {
     const fs::path dir = saved_bundle("wrong_counts");

@@ -73,8 +73,9 @@ TEST(BundleReproducibility, OneAndTwoThreadsGiveByteIdenticalFilesAndWorldProbes
   for (const auto& [name, bytes] : fb) names_b.push_back(name);
   ASSERT_EQ(names_a, names_b);
   // Every method wrote its files (a method that silently wrote nothing would compare equal).
-  for (const char* expected : {"manifest.json", "light_atlas.exr", "light_atlas_vpls.bin", "prm_panes.bin", "dlm.bin",
-                               "antiradiance.bin", "brf_crate.bin", gi::kBakeStatsFileName})
+  for (const char* expected : {"manifest.json", "light_atlas.exr", "light_atlas_vpls.bin", "light_atlas_layout.bin",
+                               "prm_panes.bin", "prm_layout.bin", "dlm.bin", "dlm_layout.bin", "antiradiance.bin",
+                               "antiradiance_at_pose.bin", "brf_crate.bin", gi::kBakeStatsFileName})
     EXPECT_TRUE(fa.contains(expected)) << expected << " missing from the bundle";
   std::size_t compared = 0;
   for (const auto& [name, bytes] : fa) {
