@@ -48,23 +48,17 @@ std::vector<glm::ivec2> footprints(const std::vector<Chart>& charts, double dens
   return sizes;
 }
 
-}  // namespace
+// The packing of the charts and the density it was reached at: the largest chart must fit inside
+// the padded atlas; then lower the density until the packing fits (footprints carry a fixed
+// overhead, so shrink geometrically).
+struct DensityPacking {
+  ShelfPacking packing;
+  std::vector<glm::ivec2> sizes;
+  double density = 0.0;
+};
 
-engine::Result<AtlasLayout> build_atlas_layout(std::span<const AtlasInputMesh> inputs, const AtlasSettings& settings) {
-  if (engine::Status s = validate_settings(settings); !s) return s.error();
-  if (engine::Status s = validate_atlas_inputs(inputs); !s) return s.error();
-
-  const ChartingSettings charting{.max_angle_degrees = settings.chart_max_angle_degrees,
-                                  .weld_distance_m = settings.weld_distance_m,
-                                  .rotate_to_min_area = settings.rotate_charts};
-  std::vector<Chart> charts;
-  for (std::size_t i = 0; i < inputs.size(); ++i) {
-    std::vector<Chart> mc = build_charts(inputs[i], static_cast<std::uint32_t>(i), charting);
-    charts.insert(charts.end(), std::make_move_iterator(mc.begin()), std::make_move_iterator(mc.end()));
-  }
-
-  // The largest chart must fit inside the padded atlas; then lower the density until the
-  // packing fits (footprints carry a fixed overhead, so shrink geometrically).
+engine::Result<DensityPacking> pack_at_fitting_density(const std::vector<Chart>& charts,
+                                                       const AtlasSettings& settings) {
   const int pad = settings.padding_texels;
   const int usable = settings.max_atlas_size - 2 * pad;
   double density = settings.texels_per_metre;
@@ -92,10 +86,73 @@ engine::Result<AtlasLayout> build_atlas_layout(std::span<const AtlasInputMesh> i
                          std::to_string(charts.size()) + " charts do not fit a " +
                              std::to_string(settings.max_atlas_size) + " x " + std::to_string(settings.max_atlas_size) +
                              " atlas with padding " + std::to_string(pad) + " at any texel density"};
+  return DensityPacking{std::move(*packing), std::move(sizes), density};
+}
+
+// One mesh's UV1: one output vertex per (input vertex, chart) pair, uv from that chart's
+// projection at `density` into its placed rectangle. out.triangle_chart is already set.
+void assign_mesh_uv1(const AtlasInputMesh& in, const std::vector<Chart>& charts,
+                     const std::vector<AtlasChart>& placed_charts, double density, glm::dvec2 atlas_size,
+                     AtlasMeshUv& out) {
+  constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
+  const std::size_t n = in.positions.size();
+  out.source_vertex.resize(n);
+  for (std::size_t v = 0; v < n; ++v) out.source_vertex[v] = static_cast<std::uint32_t>(v);
+  out.uv1.assign(n, glm::vec2(0.0f));
+  out.indices.resize(in.indices.size());
+  std::vector<std::uint32_t> first_chart(n, kNone);
+  std::unordered_map<std::uint64_t, std::uint32_t> copies;  // (vertex << 32 | chart) -> output vertex
+  for (std::size_t k = 0; k < in.indices.size(); ++k) {
+    const std::uint32_t v = in.indices[k];
+    const std::uint32_t ci = out.triangle_chart[k / 3];
+    std::uint32_t ov;
+    if (first_chart[v] == kNone || first_chart[v] == ci) {
+      ov = v;
+    } else {
+      const std::uint64_t key = (std::uint64_t{v} << 32) | ci;
+      auto [it, inserted] = copies.try_emplace(key, static_cast<std::uint32_t>(out.source_vertex.size()));
+      ov = it->second;
+      if (inserted) {
+        out.source_vertex.push_back(v);
+        out.uv1.emplace_back(0.0f);
+      }
+    }
+    out.indices[k] = ov;
+    if (first_chart[v] == kNone) first_chart[v] = ci;
+    const Chart& c = charts[ci];
+    const AtlasChart& placed = placed_charts[ci];
+    const glm::dvec2 extent = glm::dvec2(c.size_m) * density;
+    const glm::dvec2 margin = (glm::dvec2(placed.size) - extent) * 0.5;
+    const glm::dvec2 texel = glm::dvec2(placed.origin) + margin + glm::dvec2(c.project_m(in.positions[v])) * density;
+    out.uv1[ov] = glm::vec2(glm::clamp(texel / atlas_size, 0.0, 1.0));
+  }
+}
+
+}  // namespace
+
+engine::Result<AtlasLayout> build_atlas_layout(std::span<const AtlasInputMesh> inputs, const AtlasSettings& settings) {
+  if (engine::Status s = validate_settings(settings); !s) return s.error();
+  if (engine::Status s = validate_atlas_inputs(inputs); !s) return s.error();
+
+  const ChartingSettings charting{.max_angle_degrees = settings.chart_max_angle_degrees,
+                                  .weld_distance_m = settings.weld_distance_m,
+                                  .rotate_to_min_area = settings.rotate_charts};
+  std::vector<Chart> charts;
+  for (std::size_t i = 0; i < inputs.size(); ++i) {
+    std::vector<Chart> mc = build_charts(inputs[i], static_cast<std::uint32_t>(i), charting);
+    charts.insert(charts.end(), std::make_move_iterator(mc.begin()), std::make_move_iterator(mc.end()));
+  }
+
+  engine::Result<DensityPacking> fitted = pack_at_fitting_density(charts, settings);
+  if (!fitted) return fitted.error();
+  const ShelfPacking& packing = fitted->packing;
+  const std::vector<glm::ivec2>& sizes = fitted->sizes;
+  const double density = fitted->density;
+  const int pad = settings.padding_texels;
 
   AtlasLayout layout;
-  layout.width = packing->width;
-  layout.height = packing->height;
+  layout.width = packing.width;
+  layout.height = packing.height;
   layout.texels_per_metre = static_cast<float>(density);
   if (layout.texels_per_metre > settings.texels_per_metre) layout.texels_per_metre = settings.texels_per_metre;
   layout.requested_texels_per_metre = settings.texels_per_metre;
@@ -112,7 +169,7 @@ engine::Result<AtlasLayout> build_atlas_layout(std::span<const AtlasInputMesh> i
     const Chart& c = charts[ci];
     AtlasChart out;
     out.mesh = c.mesh;
-    out.origin = packing->origins[ci];
+    out.origin = packing.origins[ci];
     out.size = sizes[ci];
     out.normal = c.normal;
     out.triangle_count = static_cast<std::uint32_t>(c.triangles.size());
@@ -122,42 +179,8 @@ engine::Result<AtlasLayout> build_atlas_layout(std::span<const AtlasInputMesh> i
   }
 
   // Per mesh: one output vertex per (input vertex, chart) pair, uv from that chart's projection.
-  constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
-  for (std::size_t mi = 0; mi < inputs.size(); ++mi) {
-    const AtlasInputMesh& in = inputs[mi];
-    AtlasMeshUv& out = layout.meshes[mi];
-    const std::size_t n = in.positions.size();
-    out.source_vertex.resize(n);
-    for (std::size_t v = 0; v < n; ++v) out.source_vertex[v] = static_cast<std::uint32_t>(v);
-    out.uv1.assign(n, glm::vec2(0.0f));
-    out.indices.resize(in.indices.size());
-    std::vector<std::uint32_t> first_chart(n, kNone);
-    std::unordered_map<std::uint64_t, std::uint32_t> copies;  // (vertex << 32 | chart) -> output vertex
-    for (std::size_t k = 0; k < in.indices.size(); ++k) {
-      const std::uint32_t v = in.indices[k];
-      const std::uint32_t ci = out.triangle_chart[k / 3];
-      std::uint32_t ov;
-      if (first_chart[v] == kNone || first_chart[v] == ci) {
-        ov = v;
-      } else {
-        const std::uint64_t key = (std::uint64_t{v} << 32) | ci;
-        auto [it, inserted] = copies.try_emplace(key, static_cast<std::uint32_t>(out.source_vertex.size()));
-        ov = it->second;
-        if (inserted) {
-          out.source_vertex.push_back(v);
-          out.uv1.emplace_back(0.0f);
-        }
-      }
-      out.indices[k] = ov;
-      if (first_chart[v] == kNone) first_chart[v] = ci;
-      const Chart& c = charts[ci];
-      const AtlasChart& placed = layout.charts[ci];
-      const glm::dvec2 extent = glm::dvec2(c.size_m) * density;
-      const glm::dvec2 margin = (glm::dvec2(placed.size) - extent) * 0.5;
-      const glm::dvec2 texel = glm::dvec2(placed.origin) + margin + glm::dvec2(c.project_m(in.positions[v])) * density;
-      out.uv1[ov] = glm::vec2(glm::clamp(texel / atlas_size, 0.0, 1.0));
-    }
-  }
+  for (std::size_t mi = 0; mi < inputs.size(); ++mi)
+    assign_mesh_uv1(inputs[mi], charts, layout.charts, density, atlas_size, layout.meshes[mi]);
   return layout;
 }
 
