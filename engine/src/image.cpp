@@ -102,6 +102,8 @@ Status save_exr(const fs::path& path, const ImageRgbaF& image, ExrPixelType type
   return commit_temporary(tmp, path);
 }
 
+// Long because it is one guarded sequence: read the bytes, judge version and header before
+// tinyexr sizes anything from them, then decode; the checks must sit right before the call they protect.
 Result<ImageRgbaF> load_exr(const fs::path& path) {
   const auto fail = [&](const std::string& message) { return Error{path.string(), "", "cannot read EXR: " + message}; };
   std::error_code ec;

@@ -43,6 +43,8 @@ int add_float_attribute(draco::Mesh& mesh, draco::GeometryAttribute::Type type, 
 
 }  // namespace
 
+// Long because it is one round trip: fill a draco::Mesh, encode it, decode the bytes again and
+// read the counts and bounds the accessors need from the decoded mesh, each step on the last one's result.
 bool encode_draco_primitive(const Primitive& primitive, const DracoQuantization& bits, DracoPrimitive& out,
                             std::string& error) {
   const std::size_t n = primitive.positions.size();

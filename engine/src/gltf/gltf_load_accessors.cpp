@@ -138,6 +138,8 @@ int component_count(int type) {
   }
 }
 
+// Long because it is the accessor's checks and reads in the spec's order (type, count, budgets,
+// dense data, sparse overrides, finiteness), each returning its own error at the same `where`.
 Result<std::vector<double>> read_accessor(const Context& ctx, const ParsedFile& file, int index,
                                           std::size_t max_count) {
   const tinygltf::Model& model = file.model;

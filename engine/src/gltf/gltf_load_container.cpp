@@ -608,6 +608,8 @@ Result<double> number_member(const Context& ctx, const Json& object, const char*
   return v->get<double>();
 }
 
+// Long because it is one sequence from bytes to the tinygltf model (container, byte order mark,
+// JSON, depth, prevalidation, image limits, file callbacks, parse), each step returning its own error.
 Result<ParsedFile> parse_file(const Context& ctx, const fs::path& path) {
   auto bytes = read_regular_file(ctx, path, "");
   if (!bytes) return bytes.error();

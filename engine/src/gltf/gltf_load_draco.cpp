@@ -15,6 +15,8 @@
 
 namespace engine::gltf_load {
 
+// Long because it is one sequence over one decoded mesh: bound the bufferView, decode, check the
+// limits, copy the faces, then each attribute, every step a check returning its own error.
 Result<DracoPrimitive> decode_draco(const Context& ctx, const ParsedFile& file, const DracoRef& ref,
                                     const std::string& location) {
   const tinygltf::Model& model = file.model;

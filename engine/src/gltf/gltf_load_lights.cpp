@@ -41,6 +41,8 @@ Result<glm::vec<N, float>> number_array(const Context& ctx, const Json& value, c
 }
 
 /// One KHR_lights_punctual light definition.
+// Long because it reads the light's members as KHR_lights_punctual lists them (type,
+// intensity, color, range, spot cone), each a check and its error: a flat list read against the spec.
 Result<NamedLight> convert_light(const Context& ctx, const Json& src, const std::string& where) {
   if (!src.is_object()) return ctx.error(where, "must be an object");
   NamedLight out;

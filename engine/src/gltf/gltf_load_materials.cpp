@@ -292,6 +292,8 @@ Result<AlphaMode> alpha_mode(const Context& ctx, const std::string& mode, const 
 
 }  // namespace
 
+// Long because it converts each material member by member in the spec's order (factors,
+// extensions, texture slots, normal scale, alpha), each a check with its error, in one loop.
 Result<std::vector<Material>> convert_materials(const Context& ctx, const ParsedFile& file) {
   std::vector<Material> out;
   const Json* json_materials = find_member(file.doc, "materials");

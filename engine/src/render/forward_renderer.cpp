@@ -201,6 +201,8 @@ void ForwardRenderer::report_skipped(const Registry& registry,
   warned_ = std::move(now);
 }
 
+// Long because it is the frame's passes in order (shadow maps, area lights, light groups,
+// indirect light, forward, exposure, tonemap), each timed by the one GpuTimer as it ends.
 void ForwardRenderer::render(const Registry& registry, Entity camera, double dt_s) {
   GI_EXPECTS(std::isfinite(dt_s) && dt_s >= 0.0, "render()'s time step must be finite and not negative");
   GI_EXPECTS(registry.valid(camera) && registry.has<Camera>(camera) && registry.has<WorldTransform>(camera),

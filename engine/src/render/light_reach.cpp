@@ -52,6 +52,8 @@ std::uint8_t LightReachGrid::at(const glm::vec3& p) const {
   return masks[static_cast<std::size_t>((i.z * dims.y + i.y) * dims.x + i.x)];
 }
 
+// Long because it is one build in three passes over one grid: the light samples, what
+// each lattice point sees of them, then each voxel as its corners' union dilated by one voxel.
 LightReachGrid build_light_reach_grid(const std::vector<ReachOccluder>& occluders,
                                       const std::vector<ReachLight>& lights, const glm::vec3& min, const glm::vec3& max,
                                       float voxel_m) {

@@ -55,6 +55,8 @@ void check_energy(const AntiradiancePasses& passes, const ElementHierarchy& h, s
 
 }  // namespace
 
+// Long because it is one solve with its fallback: the symmetric scheme until it converges or
+// diverges, then the asymmetric one from the same start, both filling the one report.
 AntiradianceSolveReport run_antiradiance(AntiradiancePasses& passes, std::span<const glm::vec3> direct,
                                          const AntiradianceSettings& settings, const ElementHierarchy& h) {
   AntiradianceSolveReport report;

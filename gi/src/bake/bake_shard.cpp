@@ -64,6 +64,8 @@ engine::Status write_shard_file(const std::filesystem::path& path, const ShardFi
   return write_blob(path, kShardMagic, kShardVersion, w.bytes());
 }
 
+// Long because it reads one shard in its file order (header, methods, then each part its
+// flags name) and then checks what was read; the reader and the part flags run through both halves.
 engine::Result<ShardFile> read_shard_file(const std::filesystem::path& path) {
   auto payload = read_blob(path, kShardMagic, kShardVersion);
   if (!payload) return payload.error();

@@ -129,6 +129,8 @@ float BrdfSeparation::eval(const glm::vec3& w_in, const glm::vec3& w_out) const 
   return s;
 }
 
+// Long because it is one separation: tabulate the lobe, take its SVD, choose the terms,
+// scale g and h, then project g on SH; each step reads the previous step's matrices and tables.
 engine::Result<BrdfSeparation> separate_glossy_brdf(const GlossyLobe& lobe, const BrdfSeparationSettings& settings) {
   if (!(lobe.alpha > 0.0f && lobe.alpha <= 1.0f) || !(lobe.f0 > 0.0f && lobe.f0 <= 1.0f))
     return engine::Error{.message = "glossy BRDF separation: alpha and f0 must lie in (0, 1]"};

@@ -19,6 +19,8 @@ namespace gi {
 
 using namespace brf_gpu_detail;
 
+// Long because it is one dispatch sequence: sort the jobs' work groups by (class,
+// field buffer), upload them, bind the buffers, then one dispatch per range the sort produced.
 void BrfGpuPass::dispatch_phi(std::span<const BrfPhiJob> jobs, std::uint32_t kind) {
   const bool static_kind = kind == 1;
   if (jobs.empty()) return;
@@ -324,6 +326,8 @@ void BrfGpuPass::queue_phi_job(std::span<const BrfInstance> instances, std::size
   frame.jobs.push_back(job);
 }
 
+// Long because it is one walk over the (source, receiver) pairs deciding whether each
+// pair's Phi is reused or queued; the frame's poses and the pair slot's state are read and set together.
 void BrfGpuPass::plan_pairs(std::span<const BrfInstance> instances, FrameData& frame) {
   // Pairs whose relative pose changed (or never computed): Phi jobs; live sources per receiver.
   const std::size_t n = instances.size();

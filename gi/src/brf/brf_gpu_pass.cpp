@@ -163,6 +163,8 @@ engine::Status BrfGpuPass::build_programs() {
   return {};
 }
 
+// Long because it appends one model to every GPU table at once (model entry, vertices,
+// basis, field group, glossy frames, LOD table), each offset taken from a table's size as it goes.
 void BrfGpuPass::add_model(const BrfModel& model, std::size_t limit, ModelData& data) {
   const BasisRadianceField& f = model.field;
   GpuModel g;

@@ -89,6 +89,8 @@ std::string brf_mesh_hash(const BrfMesh& mesh, const std::optional<GlossyLobe>& 
   return h.hex();
 }
 
+// Long because it is one pass per primitive: check it, complete its normals, fold its
+// material to a reflectance per vertex (area-weighted where textured) and append it, errors naming it.
 engine::Result<BrfMesh> brf_mesh_from_input(const BakeInput& input, std::uint32_t mesh_index,
                                             std::int32_t material_override) {
   const std::string where = input.name.empty() ? std::string("the scene") : input.name;

@@ -69,6 +69,8 @@ BrfHorizon brf_horizon(const BrfBox& box, const glm::vec3& p, const glm::vec3& n
   return BrfHorizon::Straddling;
 }
 
+// Long because it is the CPU twin of the GPU's brf_phi pass, kept in the shader's order
+// (LOD points, then per vertex: horizon, visibility, lobe, glossy terms) so the two read side by side.
 void brf_basis_irradiance(const BrfObject& source, std::span<const glm::vec3> positions,
                           std::span<const glm::vec3> normals, std::vector<float>& out,
                           const BrdfSeparation* receiver_glossy, std::span<const glm::mat3> frames,

@@ -69,6 +69,8 @@ float BasisRadianceField::sphere_radius(int s) const {
   return inner_radius * std::pow(outer_radius / inner_radius, static_cast<float>(s) / static_cast<float>(spheres - 1));
 }
 
+// Long because it is one trilinear lookup: the radial coordinate, the cube face
+// cell across seams, then the eight corners summed with their weights and 1/r^2 scale.
 void BasisRadianceField::sample(const glm::vec3& p, std::span<float> out) const {
   const auto per_point = static_cast<std::size_t>(channel_count() * coefficient_count());
   std::fill(out.begin(), out.begin() + static_cast<std::ptrdiff_t>(per_point), 0.0f);
@@ -137,6 +139,8 @@ void BasisRadianceField::sample(const glm::vec3& p, std::span<float> out) const 
   }
 }
 
+// Long because it is the checks, the field's shape, then one parallel loop whose
+// body (a sample point's rays and their SH projection) reads most of the locals set up before it.
 engine::Result<BasisRadianceField> compute_basis_radiance_field(const BrfMesh& mesh, const BrfBasis& basis,
                                                                 const RadianceFieldSettings& settings,
                                                                 const BrdfSeparation* glossy) {

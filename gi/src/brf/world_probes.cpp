@@ -55,6 +55,8 @@ glm::vec3 WorldProbeGrid::irradiance(const glm::vec3& p, const glm::vec3& n) con
   return glm::max(e, glm::vec3(0.0f));  // 3-band ringing must not make light negative
 }
 
+// Long because it is one bake: bound the VPLs, size and centre the grid, then one parallel
+// loop per probe (the inside test, the VPLs gathered into SH) that reads the grid set up before it.
 engine::Result<WorldProbeGrid> bake_world_probes(const RayCaster& static_world, const VplSet& vpls,
                                                  std::span<const glm::vec3> vpl_power,
                                                  const WorldProbeSettings& settings) {

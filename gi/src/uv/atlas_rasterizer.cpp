@@ -52,6 +52,8 @@ glm::vec3 shading_normal(const AtlasInputMesh& in, const std::uint32_t v[3], glm
 
 }  // namespace
 
+// Long because it is one scan conversion: per triangle, per texel of its box, the inside or
+// conservative sample and its write to every texel array; the ownership rule between triangles is this loop.
 AtlasTexels rasterize_atlas(const AtlasLayout& layout, std::span<const AtlasInputMesh> inputs, float inset_texels) {
   GI_EXPECTS(inputs.size() == layout.meshes.size(), "inputs are the meshes the layout was built from");
   AtlasTexels out;

@@ -20,6 +20,8 @@ void copy_attribute(const std::vector<T>& from, std::vector<T>& to, const std::v
 }
 
 // The mesh of one static instance rebuilt with the layout's split vertices and uv1.
+// Long because it is one rebuild: check the layout against the mesh, map the output vertices
+// to primitives, then rebuild each primitive with that map; the checks and the map feed the last loop.
 engine::Result<engine::Mesh> mesh_with_uv1(const engine::SceneAsset& scene, const engine::Mesh& mesh,
                                            const AtlasMeshUv& uv, std::size_t mesh_index) {
   std::size_t vertices = 0, indices = 0;

@@ -125,6 +125,8 @@ std::vector<glm::vec2> convex_hull(std::vector<glm::vec2> pts) {
 
 // Fills the chart's projection: normal, in-plane axes (rotated so the bounding rectangle has
 // minimal area: it has a side collinear with a hull edge, Freeman & Shapira 1975), rectangle.
+// Long because it is one projection: normal and axes, the points in the plane, the
+// minimal-area rotation, then the wider-than-tall turn; axes and points change together at each step.
 void project_chart(Chart& chart, const AtlasInputMesh& mesh, const std::vector<glm::vec3>& face_cross, bool rotate) {
   glm::dvec3 sum(0.0);
   double area = 0.0;
@@ -195,6 +197,8 @@ void project_chart(Chart& chart, const AtlasInputMesh& mesh, const std::vector<g
 
 }  // namespace
 
+// Long because it is one charting pipeline: face normals, welded-edge adjacency, flood fill by
+// angle, degenerate triangles' placement, then projection; each stage reads the previous one's arrays.
 std::vector<Chart> build_charts(const AtlasInputMesh& mesh, std::uint32_t mesh_index,
                                 const ChartingSettings& settings) {
   const std::size_t tri_count = mesh.indices.size() / 3;
