@@ -255,7 +255,7 @@ Status GpuScene::set_atlas_meshes(std::span<const AtlasMesh> atlas) {
   return {};
 }
 
-// One loop over the materials (over 60 lines): the texture and sampler caches it fills are
+// Long because it is one loop over the materials: the texture and sampler caches it fills are
 // shared by every material, and each material's textures are checked where they are read.
 Status GpuScene::upload_materials(const SceneAsset& assets) {
   GpuScene& scene = *this;
