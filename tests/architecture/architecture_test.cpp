@@ -192,6 +192,30 @@ TEST(Architecture, GiSystemKnowsNoMethodOnlyTheTable) {
   }
 }
 
+// The bake's twin of the rule above (issue 34): bake_bundle.cpp includes no method's folder
+// and names no baker; every method of gi/methods.h has its baker, bake/<key>_baker.cpp, and
+// its row in bake/method_bakers.cpp. A sixth method bakes through its baker file and a row.
+TEST(Architecture, BakeBundleKnowsNoMethodOnlyTheBakerTable) {
+  const fs::path bundle = kGiSrc / "bake" / "bake_bundle.cpp";
+  const std::set<std::string> folders = included_folders(bundle);
+  for (const gi::MethodDescriptor& m : gi::kMethods)
+    EXPECT_FALSE(folders.count(std::string(m.key))) << "bake_bundle.cpp includes gi/src/" << m.key << "/...";
+  for (const char* f : {"prm", "brf", "dlm", "light_atlas", "antiradiance"})
+    EXPECT_FALSE(folders.count(f)) << "bake_bundle.cpp includes gi/src/" << f;
+  std::ifstream bundle_in(bundle);
+  const std::string bundle_text((std::istreambuf_iterator<char>(bundle_in)), std::istreambuf_iterator<char>());
+  std::ifstream table_in(kGiSrc / "bake" / "method_bakers.cpp");
+  const std::string table((std::istreambuf_iterator<char>(table_in)), std::istreambuf_iterator<char>());
+  for (const gi::MethodDescriptor& m : gi::kMethods) {
+    const std::string key(m.key);
+    EXPECT_TRUE(fs::exists(kGiSrc / "bake" / (key + "_baker.cpp"))) << "no baker bake/" << key << "_baker.cpp";
+    EXPECT_NE(table.find("&bake_" + key + "_method"), std::string::npos)
+        << "method_bakers.cpp does not name bake_" << key << "_method";
+    EXPECT_EQ(bundle_text.find("bake_" + key + "_method"), std::string::npos)
+        << "bake_bundle.cpp calls bake_" << key << "_method itself, not through the table";
+  }
+}
+
 // Where `text` calls glUniform* / glProgramUniform* with a literal integer location (the
 // first argument, or the second after glProgramUniform's program), as "line N: call".
 // Calls may span lines: the location can sit on the line after the '('.
