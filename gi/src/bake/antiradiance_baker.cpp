@@ -1,13 +1,14 @@
-// Antiradiance's baker (bake/method_bakers.h): the region, its links (or the shards'), what a load at the baked pose computes, save.
+// Antiradiance's baker (bake/method_bakers.h): the region, its links (or the shards'), what a load at the baked pose
+// computes, save.
 #include <chrono>
 #include <string>
 
-#include "bake/bake_options.h"
-#include "bake/bake_stage.h"
-#include "bake/method_bakers.h"
 #include "antiradiance/antiradiance_io.h"
 #include "antiradiance/antiradiance_region.h"
+#include "bake/bake_options.h"
 #include "bake/bake_sharding.h"
+#include "bake/bake_stage.h"
+#include "bake/method_bakers.h"
 #include "bundle/bundle_reader.h"
 #include "core/stopwatch.h"
 #include "light_atlas/light_atlas_io.h"

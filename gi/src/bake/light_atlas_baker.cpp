@@ -3,9 +3,9 @@
 #include <string>
 
 #include "bake/bake_options.h"
+#include "bake/bake_sharding.h"
 #include "bake/bake_stage.h"
 #include "bake/method_bakers.h"
-#include "bake/bake_sharding.h"
 #include "light_atlas/light_atlas.h"
 #include "light_atlas/light_atlas_io.h"
 
@@ -33,10 +33,10 @@ engine::Status bake_light_atlas_method(const MethodBake& job) {
       st.vpl_seconds, st.direct_seconds, st.propagate_seconds, st.final_seconds, st.total_seconds,
       static_cast<double>(st.rays) * 1e-6));
   job.timings = {{"vpl_seconds", st.vpl_seconds},
-             {"direct_seconds", st.direct_seconds},
-             {"propagate_seconds", st.propagate_seconds},
-             {"final_seconds", st.final_seconds},
-             {"total_seconds", st.total_seconds}};
+                 {"direct_seconds", st.direct_seconds},
+                 {"propagate_seconds", st.propagate_seconds},
+                 {"final_seconds", st.final_seconds},
+                 {"total_seconds", st.total_seconds}};
   return save_light_atlas(job.dir, *bake, input);
 }
 

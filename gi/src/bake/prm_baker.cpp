@@ -3,9 +3,9 @@
 #include <string>
 
 #include "bake/bake_options.h"
+#include "bake/bake_sharding.h"
 #include "bake/bake_stage.h"
 #include "bake/method_bakers.h"
-#include "bake/bake_sharding.h"
 #include "prm/prm.h"
 #include "prm/prm_io.h"
 
@@ -30,7 +30,8 @@ engine::Status bake_prm_method(const MethodBake& job) {
                   static_cast<double>(prm->pane_size()) * prm->cluster_count * 6.0 / 1e6, st.paths, st.path_nodes));
   stage.log(format_line("  time: walks %.2f s, panes %.2f s; total %.2f s; %.1f M rays", st.walk_seconds,
                         st.pane_seconds, st.total_seconds, static_cast<double>(st.rays) * 1e-6));
-  job.timings = {{"walk_seconds", st.walk_seconds}, {"pane_seconds", st.pane_seconds}, {"total_seconds", st.total_seconds}};
+  job.timings = {
+      {"walk_seconds", st.walk_seconds}, {"pane_seconds", st.pane_seconds}, {"total_seconds", st.total_seconds}};
   return save_prm(job.dir, *prm, input);
 }
 

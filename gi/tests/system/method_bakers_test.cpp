@@ -24,8 +24,8 @@ TEST(MethodBakers, EveryMethodHasOneBakerAndTheAtlasMethodsComeBeforeAntiradianc
   const auto rows = gi::method_bakers();
   EXPECT_EQ(rows.size(), gi::kMethods.size());
   for (const gi::MethodDescriptor& d : gi::kMethods) {
-    EXPECT_EQ(std::count_if(rows.begin(), rows.end(), [&](const gi::MethodBakerEntry& e) { return e.method == d.method; }),
-              1)
+    EXPECT_EQ(
+        std::count_if(rows.begin(), rows.end(), [&](const gi::MethodBakerEntry& e) { return e.method == d.method; }), 1)
         << d.key;
     EXPECT_EQ(gi::method_baker(d.method).method, d.method) << d.key;
     EXPECT_NE(gi::method_baker(d.method).bake, nullptr) << d.key;
@@ -36,8 +36,7 @@ TEST(MethodBakers, EveryMethodHasOneBakerAndTheAtlasMethodsComeBeforeAntiradianc
 
 TEST(MethodBakers, BakeableMethodsAreTheTablesKeysInItsOrder) {
   std::vector<std::string> keys;
-  for (const gi::MethodBakerEntry& e : gi::method_bakers())
-    keys.emplace_back(gi::method_descriptor(e.method).key);
+  for (const gi::MethodBakerEntry& e : gi::method_bakers()) keys.emplace_back(gi::method_descriptor(e.method).key);
   EXPECT_EQ(gi::bakeable_methods(), keys);
 }
 
