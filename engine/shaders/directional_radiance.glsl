@@ -16,8 +16,17 @@
 
 const float DIRECTIONAL_MIN_COS = 0.1;
 
-layout(std430, binding = DIRECTIONAL_RADIANCE_BINDING) readonly buffer DirectionalRadiance { uvec2 dr_values[]; };
-layout(std430, binding = DIRECTIONAL_DIRECTION_BINDING) readonly buffer DirectionalDirections { vec4 dr_directions[]; };
+// Element layouts: engine/indirect_light.h's DirectionalRadiance and DirectionalBin (std430, asserted there).
+struct DirectionalRadianceElement {
+  uint red_green;  // packHalf2x16(r, g)
+  uint blue;       // packHalf2x16(b, 0)
+};
+struct DirectionalBin {
+  vec3 direction;
+  float scale;
+};
+layout(std430, binding = DIRECTIONAL_RADIANCE_BINDING) readonly buffer DirectionalRadiance { DirectionalRadianceElement dr_values[]; };
+layout(std430, binding = DIRECTIONAL_DIRECTION_BINDING) readonly buffer DirectionalDirections { DirectionalBin dr_directions[]; };
 
 float directional_bin_alpha(int bin_count) {
   float n = float(max(bin_count, 2));
@@ -26,8 +35,8 @@ float directional_bin_alpha(int bin_count) {
 }
 
 vec3 directional_bin_radiance(int bin, int element, int element_count) {
-  uvec2 p = dr_values[bin * element_count + element];
-  return vec3(unpackHalf2x16(p.x), unpackHalf2x16(p.y).x) * dr_directions[bin].w;
+  DirectionalRadianceElement p = dr_values[bin * element_count + element];
+  return vec3(unpackHalf2x16(p.red_green), unpackHalf2x16(p.blue).x) * dr_directions[bin].scale;
 }
 
 const int DIRECTIONAL_LOBE_SAMPLES = 8;
@@ -47,7 +56,7 @@ int directional_bin_of(vec3 n, vec3 l, int bin_count) {
   int best = -1;
   float best_dot = -2.0;
   for (int k = 0; k < bin_count; ++k) {
-    vec3 psi = dr_directions[k].xyz;
+    vec3 psi = dr_directions[k].direction;
     if (!(dot(n, psi) > DIRECTIONAL_MIN_COS)) continue;
     float d = dot(l, psi);
     if (d > best_dot) {

@@ -16,7 +16,12 @@ uniform mat4 u_view_proj;
 uniform int u_mesh_first_vertex;
 uniform int u_use_vertex_irradiance;
 
-layout(std430, binding = 1) readonly buffer VertexIrradiance { vec4 vertex_irradiance[]; };
+// Element layouts: engine/indirect_light.h's structs of the same names (std430, asserted there).
+struct VertexIrradianceElement {
+  vec3 irradiance;
+  float unused;
+};
+layout(std430, binding = 1) readonly buffer VertexIrradiance { VertexIrradianceElement vertex_irradiance[]; };
 
 out vec3 v_world;
 out vec3 v_normal;
@@ -32,8 +37,15 @@ uniform int u_lobe_terms;
 uniform int u_lobe_resolution;
 uniform int u_lobe_first;
 uniform int u_lobe_stride;
-layout(std430, binding = 6) readonly buffer LobeCoefficients { vec4 lobe_coefficients[]; };
-layout(std430, binding = 7) readonly buffer LobeTable { float lobe_table[]; };
+struct LobeCoefficient {
+  vec3 radiance;
+  float unused;
+};
+struct LobeCell {
+  float value;
+};
+layout(std430, binding = 6) readonly buffer LobeCoefficients { LobeCoefficient lobe_coefficients[]; };
+layout(std430, binding = 7) readonly buffer LobeTable { LobeCell lobe_table[]; };
 out vec3 v_lobe_radiance;
 
 float lobe_at(int k, int res, vec2 s) {
@@ -44,8 +56,8 @@ float lobe_at(int k, int res, vec2 s) {
   const int u1 = min(u0 + 1, res - 1), v1 = min(v0 + 1, res - 1);
   const float tu = fu - float(u0), tv = fv - float(v0);
   const int base = k * res * res;
-  return (1.0 - tv) * ((1.0 - tu) * lobe_table[base + v0 * res + u0] + tu * lobe_table[base + v0 * res + u1]) +
-         tv * ((1.0 - tu) * lobe_table[base + v1 * res + u0] + tu * lobe_table[base + v1 * res + u1]);
+  return (1.0 - tv) * ((1.0 - tu) * lobe_table[base + v0 * res + u0].value + tu * lobe_table[base + v0 * res + u1].value) +
+         tv * ((1.0 - tu) * lobe_table[base + v1 * res + u0].value + tu * lobe_table[base + v1 * res + u1].value);
 }
 
 vec3 lobe_radiance(vec3 world) {
@@ -65,7 +77,7 @@ vec3 lobe_radiance(vec3 world) {
   const int j = gl_VertexID - u_mesh_first_vertex;
   vec3 radiance = vec3(0.0);
   for (int k = 0; k < u_lobe_terms; ++k)
-    radiance += lobe_coefficients[u_lobe_first + k * u_lobe_stride + j].rgb * lobe_at(k, u_lobe_resolution, s);
+    radiance += lobe_coefficients[u_lobe_first + k * u_lobe_stride + j].radiance * lobe_at(k, u_lobe_resolution, s);
   return radiance;
 }
 // --- end per-vertex view-dependent indirect light ---
@@ -81,7 +93,7 @@ void main() {
   v_uv1 = a_uv1;
   const mat3 linear = mat3(u_model);
   v_tangent = vec4(linear * a_tangent.xyz, determinant(linear) < 0.0 ? -a_tangent.w : a_tangent.w);
-  v_vertex_irradiance = u_use_vertex_irradiance != 0 ? vertex_irradiance[gl_VertexID - u_mesh_first_vertex].xyz : vec3(0.0);
+  v_vertex_irradiance = u_use_vertex_irradiance != 0 ? vertex_irradiance[gl_VertexID - u_mesh_first_vertex].irradiance : vec3(0.0);
   v_lobe_radiance = lobe_radiance(world.xyz);
   gl_Position = u_view_proj * world;
 }

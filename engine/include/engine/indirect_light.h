@@ -40,9 +40,9 @@ struct SsboHandle {
   friend constexpr bool operator==(SsboHandle, SsboHandle) = default;
 };
 
-// The elements of the SSBOs a provider hands the renderer. The engine's shaders declare them
-// as arrays of GLSL vectors and scalars (gi's shaders write them); each struct here is one
-// array element, its layout asserted against std430.
+// The elements of the SSBOs a provider hands the renderer. The engine's shaders declare the
+// same structs (gi's shaders write them); each struct here is one array element, its layout
+// asserted against std430 and named after its GLSL twin.
 
 /// One vertex's indirect irradiance (IndirectLightFrame::vertex_irradiance_buffer).
 struct VertexIrradiance {
@@ -50,7 +50,7 @@ struct VertexIrradiance {
   float unused = 0.0f;
 };
 static_assert(sizeof(VertexIrradiance) == 16 && offsetof(VertexIrradiance, irradiance) == 0,
-              "must match vec4 vertex_irradiance[] of VertexIrradiance in forward.vert.glsl (std430)");
+              "must match struct VertexIrradianceElement in forward.vert.glsl (std430)");
 
 /// One coefficient c of a vertex's view-dependent lobes (VertexRadianceLobes::coefficient_buffer).
 struct LobeCoefficient {
@@ -58,14 +58,14 @@ struct LobeCoefficient {
   float unused = 0.0f;
 };
 static_assert(sizeof(LobeCoefficient) == 16 && offsetof(LobeCoefficient, radiance) == 0,
-              "must match vec4 lobe_coefficients[] of LobeCoefficients in forward.vert.glsl (std430)");
+              "must match struct LobeCoefficient in forward.vert.glsl (std430)");
 
 /// One cell of a lobe's octahedral map (VertexRadianceLobes::lobe_buffer).
 struct LobeCell {
   float value = 0.0f;  ///< h_k at the cell's centre.
 };
 static_assert(sizeof(LobeCell) == 4 && offsetof(LobeCell, value) == 0,
-              "must match float lobe_table[] of LobeTable in forward.vert.glsl (std430)");
+              "must match struct LobeCell in forward.vert.glsl (std430)");
 
 /// Mean incoming radiance of one (bin, element) of the directional radiance, as half floats
 /// over the bin's scale (IndirectLightFrame::directional_radiance_buffer).
@@ -75,7 +75,7 @@ struct DirectionalRadiance {
 };
 static_assert(sizeof(DirectionalRadiance) == 8 && offsetof(DirectionalRadiance, red_green) == 0 &&
                   offsetof(DirectionalRadiance, blue) == 4,
-              "must match uvec2 dr_values[] of DirectionalRadiance in directional_radiance.glsl (std430)");
+              "must match struct DirectionalRadianceElement in directional_radiance.glsl (std430)");
 
 /// One direction bin of the directional radiance (IndirectLightFrame::directional_direction_buffer).
 struct DirectionalBin {
@@ -84,7 +84,7 @@ struct DirectionalBin {
 };
 static_assert(sizeof(DirectionalBin) == 16 && offsetof(DirectionalBin, direction) == 0 &&
                   offsetof(DirectionalBin, scale) == 12,
-              "must match vec4 dr_directions[] of DirectionalDirections in directional_radiance.glsl (std430)");
+              "must match struct DirectionalBin in directional_radiance.glsl (std430)");
 
 /// What a provider hands the renderer for one frame. The handles' GL objects are owned by the
 /// provider and stay valid until its next update; an empty handle means "not provided".
