@@ -115,8 +115,7 @@ std::vector<std::pair<std::string, double>> split_truth_extras(const RgbField& t
   }
   const ErrorReport part = compare_rgb(total, dominated);
   return {{"indirect_dominated", part.ok() ? part.truth_rel_rmse : nan},
-          {"indirect_dominated_share",
-           compared ? static_cast<double>(selected) / static_cast<double>(compared) : nan},
+          {"indirect_dominated_share", compared ? static_cast<double>(selected) / static_cast<double>(compared) : nan},
           {"whole", whole.ok() ? whole.truth_rel_rmse : nan},
           {"whole_bias", sum_truth > 0.0 ? sum_total / sum_truth - 1.0 : nan}};
 }

@@ -42,8 +42,7 @@ RgbField mean_of_two_estimates(const RgbField& a, const RgbField& b);
 
 /// 1 for the valid texels of `truth` whose indirect (summed over R, G, B) is at least
 /// `share` of their total (> 0), else 0.
-std::vector<std::uint8_t> indirect_dominated_mask(const AtlasSplitTruth& truth,
-                                                  double share = kIndirectDominatedShare);
+std::vector<std::uint8_t> indirect_dominated_mask(const AtlasSplitTruth& truth, double share = kIndirectDominatedShare);
 
 /// The measures of `total` (the method's whole lightmap, same layout as the truth's halves)
 /// as (name, value) sweep extras:

@@ -24,8 +24,8 @@ TexelPlacement placement_of(const std::string& text) {
 // The path tracer's atlas of the scene's static world (what the light atlas bakes).
 engine::Result<AtlasReference> trace_atlas(const SweepScene& s, double texels_per_m, TexelPlacement placement,
                                            const ReferenceSettings& settings) {
-  return reference_atlas(static_world(bake_input_from(engine::instantiate(s.asset))),
-                         static_cast<float>(texels_per_m), settings, placement);
+  return reference_atlas(static_world(bake_input_from(engine::instantiate(s.asset))), static_cast<float>(texels_per_m),
+                         settings, placement);
 }
 
 RgbField indirect_field(const AtlasReference& a) {
@@ -35,8 +35,7 @@ RgbField total_field(const AtlasReference& a) { return RgbField::from_texels(a.w
 
 engine::Result<RgbField> compute_split_truth(const ReferenceJob& job) {
   const ReferenceRequest& r = job.request;
-  if (r.param("estimates") != "2")
-    return engine::Error{"<sweep>", r.key(), "a split truth is the mean of estimates=2"};
+  if (r.param("estimates") != "2") return engine::Error{"<sweep>", r.key(), "a split truth is the mean of estimates=2"};
   AtlasReference halves[2];
   for (int e = 0; e < 2; ++e) {
     ReferenceSettings settings;

@@ -3,8 +3,8 @@
 // indirect-dominated texels, and the two measures with the truth's noise removed.
 #include "sweep/atlas_split_truth.h"
 
-#include <engine/sun.h>
 #include <gtest/gtest.h>
+#include <engine/sun.h>
 
 #include <cmath>
 #include <string>
