@@ -17,6 +17,10 @@
 #include <string>
 #include <vector>
 
+namespace engine {
+struct SceneAsset;
+}
+
 namespace gi {
 
 /// One knob of a sweep method, as `--list` shows it.
@@ -51,6 +55,21 @@ struct SweepRequest {
   bool frame_cost = false;                       ///< Pareto front over per-frame ms instead of bake seconds.
   double preset_targets[3] = {0.2, 0.05, 0.01};  ///< Relative RMSE of preview, medium, high.
   double exposure = 1.0;                         ///< Before tonemapping, for PSNR.
+  /// Applied to the scene once loaded, before the method and its references see it (gi-sweep's
+  /// --sky and --sun, parsed as gi-bake parses them). The scene's fingerprint, and so every
+  /// reference cache key, covers what it changes. Empty: the scene as loaded.
+  std::function<void(engine::SceneAsset&)> edit_scene;
+  /// The command-line arguments that make edit_scene ("--sky '...' --sun '...'"), for the
+  /// command written at the top of the Markdown summary.
+  std::string edit_scene_args;
+  /// The scene without its textures (gi::without_textures, as gi-bake --untextured), after
+  /// edit_scene; in the fingerprint too.
+  bool untextured = false;
+  /// > 0: judge the runs against the method's split truth (indirect and total irradiance of
+  /// the light atlas's texels, two path-traced estimates of this many samples per texel);
+  /// the runs then also report the indirect-dominated and whole-lightmap errors. 0: the
+  /// method's usual reference.
+  int split_truth_spp = 0;
 };
 
 /// Where a sweep is: runs (and references) done of the total, the current one and how far it is.

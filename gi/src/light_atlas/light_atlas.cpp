@@ -289,6 +289,7 @@ engine::Status texel_gather_pass(const BakeScene& b, const LightAtlasSettings& s
     out.irradiance[t] += gathered->baked_direct[t];
     if (settings.include_direct) out.irradiance[t] += gathered->direct[t];
   }
+  out.live_direct = std::move(gathered->direct);
   out.stats.final_seconds = seconds_since(t0) - gathered->direct_seconds;
   return {};
 }

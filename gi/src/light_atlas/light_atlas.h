@@ -101,6 +101,11 @@ struct LightAtlasBake {
   /// what is drawn live").
   std::vector<glm::vec3> irradiance;
   std::vector<std::uint8_t> valid;  ///< Texels a triangle covers.
+  /// Per texel, W/m^2: the static lights' direct light the final gather computed (what
+  /// include_direct adds to `irradiance`, not dilated), so `irradiance` + it is the whole
+  /// lightmap of a bake without include_direct (the sweeps' truth comparison). Empty for the
+  /// VPL final shooting.
+  std::vector<glm::vec3> live_direct;
   LightAtlasSettings settings;
   LightAtlasStats stats;
   /// The VPL solution (positions, patches, powers), kept for incremental updates (§6.2).

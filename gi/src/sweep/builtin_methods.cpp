@@ -1,6 +1,7 @@
 #include "sweep/builtin_methods.h"
 
 #include "sweep/antiradiance_sweep.h"
+#include "sweep/atlas_truth_sweep.h"
 #include "sweep/brf_sweep.h"
 #include "sweep/dlm_sweep.h"
 #include "sweep/light_atlas_sweep.h"
@@ -14,6 +15,8 @@ void register_builtin_sweep_methods(SweepRegistry& registry) {
   // and its own spp / bounces curve ("pathtracer").
   register_reference_sweep(registry);
   register_light_atlas_sweep(registry);
+  // The light atlas's split truth and the path tracer baking the atlas ("pathtracer_atlas").
+  register_atlas_truth_sweep(registry);
   register_prm_sweep(registry);
   register_brf_sweep(registry);
   register_dlm_sweep(registry);

@@ -7,6 +7,7 @@
 #include <algorithm>
 
 #include "light_atlas/light_atlas.h"
+#include "sweep/atlas_split_truth.h"
 
 namespace gi {
 
@@ -77,10 +78,25 @@ std::vector<KnobSpec> light_atlas_knobs() {
   };
 }
 
+TexelPlacement placement_of(const KnobSetting& k) {
+  return k.text("final") == "gather" ? TexelPlacement::VisibleSurface : TexelPlacement::Raster;
+}
+
 ReferenceRequest light_atlas_reference_request(const SweepScene&, const KnobSetting& k) {
-  return ReferenceRequest::atlas_indirect_irradiance(
-      k.real("density"), static_cast<int>(k.integer("ref_spp")),
-      k.text("final") == "gather" ? TexelPlacement::VisibleSurface : TexelPlacement::Raster);
+  return ReferenceRequest::atlas_indirect_irradiance(k.real("density"), static_cast<int>(k.integer("ref_spp")),
+                                                     placement_of(k));
+}
+
+// The whole lightmap (what gi-bake --include-direct bakes: the atlas plus the static lights'
+// direct light) against the split truth, into the run's extras. The VPL final shooting keeps
+// no direct light: its extras stay empty.
+void add_split_truth_extras(const LightAtlasBake& bake, const RgbField& split_truth, MethodOutput& out) {
+  if (bake.live_direct.size() != bake.irradiance.size()) return;
+  std::vector<glm::vec3> whole = bake.irradiance;
+  if (!bake.settings.include_direct)
+    for (std::size_t t = 0; t < whole.size(); ++t) whole[t] += bake.live_direct[t];
+  out.extras = split_truth_extras(RgbField::from_texels(bake.width, bake.height, whole, bake.valid),
+                                  unstack_split_truth(split_truth));
 }
 
 engine::Result<MethodOutput> run_light_atlas(const RunContext& ctx) {
@@ -110,6 +126,7 @@ engine::Result<MethodOutput> run_light_atlas(const RunContext& ctx) {
   out.costs.bake_seconds = bake->stats.total_seconds;
   // What a game ships: the atlas as RGBA16F.
   out.costs.bytes = static_cast<std::uint64_t>(bake->width) * static_cast<std::uint64_t>(bake->height) * 8u;
+  if (ctx.split_truth != nullptr) add_split_truth_extras(*bake, *ctx.split_truth, out);
   return out;
 }
 
@@ -123,6 +140,9 @@ void register_light_atlas_sweep(SweepRegistry& registry) {
       "path-traced indirect irradiance";
   m.knobs = light_atlas_knobs();
   m.reference_for = light_atlas_reference_request;
+  m.split_truth_for = [](const SweepScene&, const KnobSetting& k, int spp) {
+    return ReferenceRequest::atlas_split_truth(k.real("density"), spp, placement_of(k));
+  };
   m.run = run_light_atlas;
   registry.add_method(std::move(m));
 }

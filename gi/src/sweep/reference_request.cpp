@@ -54,4 +54,12 @@ ReferenceRequest ReferenceRequest::atlas_indirect_irradiance(double texels_per_m
   return r;
 }
 
+ReferenceRequest ReferenceRequest::atlas_split_truth(double texels_per_m, int spp, TexelPlacement placement) {
+  return {"atlas_split_truth",
+          {{"texels_per_m", format_number(texels_per_m)},
+           {"spp", std::to_string(spp)},
+           {"estimates", "2"},
+           {"texels", placement == TexelPlacement::VisibleSurface ? "visible_surface" : "raster"}}};
+}
+
 }  // namespace gi

@@ -33,6 +33,10 @@ struct ReferenceRequest {
   /// `placement` enters the key only when it is VisibleSurface.
   static ReferenceRequest atlas_indirect_irradiance(double texels_per_m, int spp,
                                                     TexelPlacement placement = TexelPlacement::Raster);
+  /// The light atlas's split truth (atlas_split_truth.h: indirect and total irradiance
+  /// stacked) at the same texels: the mean of two path-traced estimates of `spp` samples per
+  /// texel each, with different seeds, and its noise from them.
+  static ReferenceRequest atlas_split_truth(double texels_per_m, int spp, TexelPlacement placement);
 };
 
 }  // namespace gi

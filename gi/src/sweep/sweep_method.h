@@ -51,6 +51,10 @@ struct RunContext {
   std::uint64_t seed = 1;
   unsigned threads = 0;        ///< 0: all hardware threads.
   const ProgressFn& progress;  ///< Call it; stop and return an Error when it returns false.
+  /// With SweepOptions::split_truth_spp: the stacked split truth (atlas_split_truth.h) whose
+  /// indirect half is `reference`; the run scores its whole lightmap against it into its
+  /// extras (split_truth_extras). Null otherwise.
+  const RgbField* split_truth = nullptr;
 };
 
 /// A GI method as the sweep harness sees it.
@@ -60,6 +64,11 @@ struct SweepMethod {
   std::vector<KnobSpec> knobs;
   /// The reference a run with these knobs is compared against.
   std::function<ReferenceRequest(const SweepScene&, const KnobSetting&)> reference_for;
+  /// Optional, for methods that bake a light atlas: the split truth (indirect and total, two
+  /// path-traced estimates of `spp` samples per texel with different seeds) a run with these
+  /// knobs is judged against when SweepOptions::split_truth_spp = spp > 0. It replaces
+  /// reference_for's reference: the runs' main error is against its indirect half.
+  std::function<ReferenceRequest(const SweepScene&, const KnobSetting&, int spp)> split_truth_for;
   /// Renders or bakes with the knobs. Errors fail this run only (reported in its row).
   std::function<engine::Result<MethodOutput>(const RunContext&)> run;
 };

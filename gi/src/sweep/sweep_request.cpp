@@ -1,5 +1,6 @@
 // The public face of the harness (gi/sweep.h): the shipped registry, a request run end to
 // end, its files written.
+#include <gi/frame_truth.h>
 #include <gi/sweep.h>
 
 #include <algorithm>
@@ -67,6 +68,9 @@ std::string sweep_command(const SweepRequest& r) {
     c += " --presets " + format_number(r.preset_targets[0]) + "," + format_number(r.preset_targets[1]) + "," +
          format_number(r.preset_targets[2]);
   if (r.exposure != defaults.exposure) c += " --exposure " + format_number(r.exposure);
+  if (!r.edit_scene_args.empty()) c += " " + r.edit_scene_args;
+  if (r.untextured) c += " --untextured";
+  if (r.split_truth_spp > 0) c += " --split-truth " + std::to_string(r.split_truth_spp);
   return c;
 }
 
@@ -74,6 +78,18 @@ engine::Error invalid(const engine::Error& e) {
   engine::Error out = e;
   out.kind = engine::ErrorKind::Invalid;
   return out;
+}
+
+// The request's scene with its edits (lighting, textures) applied and fingerprinted.
+engine::Result<SweepScene> load_edited_scene(const SweepRequest& request) {
+  auto scene = load_sweep_scene(request.scene);
+  if (!scene || (!request.edit_scene && !request.untextured)) return scene;
+  if (request.edit_scene) request.edit_scene(scene->asset);
+  if (request.untextured) scene->asset = without_textures(std::move(scene->asset));
+  auto hash = scene_fingerprint(scene->path, scene->asset);
+  if (!hash) return hash.error();
+  scene->content_hash = hash.value();
+  return scene;
 }
 
 }  // namespace
@@ -119,8 +135,9 @@ engine::Result<SweepReport> run_sweep(const SweepRequest& request, const SweepHo
   const PresetTargets targets{request.preset_targets[0], request.preset_targets[1], request.preset_targets[2]};
   for (double t : request.preset_targets)
     if (!(t > 0.0) || !std::isfinite(t)) return engine::invalid_request("preset targets must be finite and > 0");
-  auto scene = load_sweep_scene(request.scene);
+  auto scene = load_edited_scene(request);
   if (!scene) return scene.error();
+  if (request.split_truth_spp < 0) return engine::invalid_request("the split truth's samples must be >= 0");
   std::error_code ec;
   std::filesystem::create_directories(request.out_dir, ec);
   if (ec) return engine::Error{request.out_dir.string(), "", "cannot create the output folder: " + ec.message()};
@@ -133,6 +150,7 @@ engine::Result<SweepReport> run_sweep(const SweepRequest& request, const SweepHo
   options.cache_dir = request.cache_dir.empty() ? request.out_dir / "reference-cache" : request.cache_dir;
   options.threads = request.threads;
   options.seed = request.seed;
+  options.split_truth_spp = request.split_truth_spp;
   options.metrics.exposure = request.exposure;
   auto result = run_sweep(
       registry, *method, *scene, settings, options,

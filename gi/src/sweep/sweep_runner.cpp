@@ -6,6 +6,7 @@
 #include <map>
 
 #include "core/stopwatch.h"
+#include "sweep/atlas_split_truth.h"
 #include "sweep/reference_cache.h"
 
 namespace gi {
@@ -22,11 +23,14 @@ std::string layout_problem(const RgbField& out, const RgbField& ref) {
 
 // The reference each run needs, each distinct one once: `requests` in first-use order and
 // the index of every run's.
+// With a split truth (options.split_truth_spp > 0) that is the method's split_truth_for.
 void distinct_requests(const SweepMethod& method, const SweepScene& scene, std::span<const KnobSetting> settings,
-                       std::vector<ReferenceRequest>& requests, std::vector<std::size_t>& request_of_run) {
+                       int split_truth_spp, std::vector<ReferenceRequest>& requests,
+                       std::vector<std::size_t>& request_of_run) {
   std::map<std::string, std::size_t> request_index;  // request key -> index into requests
   for (const KnobSetting& s : settings) {
-    ReferenceRequest r = method.reference_for(scene, s);
+    ReferenceRequest r =
+        split_truth_spp > 0 ? method.split_truth_for(scene, s, split_truth_spp) : method.reference_for(scene, s);
     auto [it, inserted] = request_index.emplace(r.key(), requests.size());
     if (inserted) requests.push_back(std::move(r));
     request_of_run.push_back(it->second);
@@ -71,9 +75,11 @@ engine::Result<SweepResult> run_sweep(const SweepRegistry& registry, const Sweep
   const ReferenceCache cache(options.cache_dir);
 
   // Requests first: the number of distinct references is part of the work total.
+  if (options.split_truth_spp > 0 && !method.split_truth_for)
+    return engine::Error{"method " + method.name, "", "this method cannot be judged against a split truth"};
   std::vector<ReferenceRequest> requests;
   std::vector<std::size_t> request_of_run;
-  distinct_requests(method, scene, settings, requests, request_of_run);
+  distinct_requests(method, scene, settings, options.split_truth_spp, requests, request_of_run);
   for (const ReferenceRequest& r : requests) {
     if (registry.find_provider(r.kind) == nullptr) {
       return engine::Error{"method " + method.name, r.key(),
@@ -92,6 +98,7 @@ engine::Result<SweepResult> run_sweep(const SweepRegistry& registry, const Sweep
   const ProgressFn unit_progress = [&](double f) { return report(f); };
 
   std::vector<ReferenceFetch> references;
+  std::vector<RgbField> split_truths;  // with options.split_truth_spp, as references
   for (const ReferenceRequest& r : requests) {
     state.current = "reference " + r.key();
     if (!report(0.0)) break;
@@ -101,6 +108,10 @@ engine::Result<SweepResult> run_sweep(const SweepRegistry& registry, const Sweep
     if (!fetched) return fetched.error();
     if (!fetched->warning.empty() && log) log(fetched->warning);
     (fetched->from_cache ? result.references_from_cache : result.references_computed) += 1;
+    if (options.split_truth_spp > 0) {  // the runs' reference is its indirect half
+      split_truths.push_back(std::move(fetched->field));
+      fetched->field = unstack_split_truth(split_truths.back()).indirect;
+    }
     references.push_back(std::move(fetched.value()));
     ++state.units_done;
   }
@@ -115,8 +126,10 @@ engine::Result<SweepResult> run_sweep(const SweepRegistry& registry, const Sweep
     state.current = "run " + (row.knobs.label().empty() ? std::string("(no knobs)") : row.knobs.label());
     if (!report(0.0)) break;
     const auto start = std::chrono::steady_clock::now();
-    engine::Result<MethodOutput> out = method.run(RunContext{scene, row.knobs, requests[request_of_run[run]], ref.field,
-                                                             options.seed, options.threads, unit_progress});
+    const RgbField* split_truth = split_truths.empty() ? nullptr : &split_truths[request_of_run[run]];
+    engine::Result<MethodOutput> out =
+        method.run(RunContext{scene, row.knobs, requests[request_of_run[run]], ref.field, options.seed, options.threads,
+                              unit_progress, split_truth});
     row.wall_seconds = seconds_since(start);
     if (cancelled) break;  // a cancelled run's output is not a measurement
     score_row(out, ref, options, row);

@@ -29,6 +29,9 @@ struct SweepOptions {
   std::filesystem::path cache_dir;  ///< Reference cache; empty: references are not cached on disk.
   unsigned threads = 0;             ///< Passed to methods and providers; 0: all hardware threads.
   std::uint64_t seed = 1;           ///< Passed to methods.
+  /// > 0: judge the runs against SweepMethod::split_truth_for's truth at this many samples
+  /// per texel (each of its two estimates); the method must have one. 0: reference_for's.
+  int split_truth_spp = 0;
   MetricOptions metrics;
 };
 
