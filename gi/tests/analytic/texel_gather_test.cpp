@@ -243,6 +243,8 @@ TEST(TexelGather, BitIdenticalForAnyThreadCount) {
   EXPECT_GT(one->stats.gather_iterations, 3);
 }
 
+gi::BakeInput room_lit_through_a_skylight();  // below
+
 TEST(TexelGather, EmitterRaysAreBitIdenticalForAnyThreadCount) {
   const gi::BakeInput input = room_lit_through_a_skylight();
   gi::LightAtlasSettings s = gather_settings(3.0f, 16);
@@ -273,8 +275,6 @@ TEST(TexelGather, RejectsBadSettingsAndCancels) {
   ASSERT_FALSE(cancelled);
   EXPECT_NE(cancelled.error().message.find("cancel"), std::string::npos) << cancelled.error().message;
 }
-
-}  // namespace
 
 // Issue 35's structure in a small scene: a 6 x 3 x 6 m room closed but for a 0.8 m hole in
 // its ceiling, through which a sun lights a patch of 0.64 m^2 of the floor; the rest of the
@@ -375,3 +375,5 @@ TEST(TexelGather, EmitterSamplingFindsASmallSunlitPatchThatLightsTheRoom) {
   EXPECT_NEAR(m.mean_ratio, c.mean_ratio, 0.01);
   EXPECT_NEAR(mm.mean_ratio, 1.0, 0.01);
 }
+
+}  // namespace
