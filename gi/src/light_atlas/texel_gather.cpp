@@ -7,11 +7,13 @@
 #include <chrono>
 #include <cmath>
 #include <numbers>
+#include <optional>
 #include <span>
 #include <unordered_map>
 
 #include "core/random.h"
 #include "core/stopwatch.h"
+#include "light_atlas/texel_emitters.h"
 #include "raytrace/light_falloff.h"
 #include "raytrace/material_lookup.h"
 #include "raytrace/ray_offset.h"
@@ -31,8 +33,8 @@ constexpr std::uint32_t kBack = 0xfffffffdu;  // the back of a one-sided surface
 // filter neither reads nor smooths it.
 constexpr float kHiddenBackFraction = 0.1f;
 
-// Item ids of the three random streams of a texel.
-constexpr std::uint64_t kDirectStream = 0, kSolveStream = 1, kGatherStream = 2;
+// Item ids of the four random streams of a texel.
+constexpr std::uint64_t kDirectStream = 0, kSolveStream = 1, kGatherStream = 2, kEmitterStream = 3;
 std::uint64_t stream_id(std::uint64_t texel, std::uint64_t stream) { return texel * 4 + stream; }
 
 float radical_inverse(std::uint32_t i) {
@@ -58,6 +60,7 @@ engine::Status validate(const TexelGatherSettings& s) {
   if (s.direct_samples < 1 || s.direct_samples > 65536) return bad("direct_samples is outside 1..65536");
   if (s.solve_rays < 1 || s.solve_rays > 65536) return bad("solve_rays is outside 1..65536");
   if (s.gather_rays < 0 || s.gather_rays > 1 << 20) return bad("gather_rays is outside 0..2^20");
+  if (s.emitter_rays < 0 || s.emitter_rays > 1 << 20) return bad("emitter_rays is outside 0..2^20");
   if (s.bounces < 1 || s.bounces > 1024) return bad("bounces is outside 1..1024");
   if (!(s.filter_radius_texels >= 0.0f) || s.filter_radius_texels > 16.0f)
     return bad("filter_radius_texels is outside [0, 16]");
@@ -145,19 +148,39 @@ glm::vec2 hit_uv(const AtlasLayout& layout, const Hit& h) {
   return (1.0f - u - v) * mu.uv1[idx[0]] + u * mu.uv1[idx[1]] + v * mu.uv1[idx[2]];
 }
 
-// Where a ray from a texel ends: kSky, kDark, or the atlas texel it reads.
+// Where a ray from a texel ends: `texel`, kSky, kBack or the atlas texel it reads (a valid
+// texel, redirected from an empty one); on a surface also the atlas UV of the hit, the atlas
+// texel under it as it is (`pixel`, maybe empty), the distance and |cos| at the surface.
+struct Landing {
+  std::uint32_t texel = kSky;
+  glm::vec2 uv{0.0f};
+  std::uint32_t pixel = kDark;
+  float distance = 0.0f, cos_surface = 0.0f;
+};
+
+Landing land_ray(const StaticBakeScene& b, const AtlasLayout& layout, const TexelTable& t, const Ray& ray) {
+  const Hit h = b.caster->intersect(ray);
+  if (!h.valid()) return {};
+  const ShadingTriangle& tri = b.index.triangles[b.triangle_of(h)];
+  const float cos_surface = glm::dot(tri.face_normal, ray.direction);
+  if (!(cos_surface < 0.0f) && !b.scene.materials[tri.material].double_sided) return {.texel = kBack};
+  Landing l;
+  l.uv = hit_uv(layout, h);
+  const int x = std::clamp(static_cast<int>(l.uv.x * static_cast<float>(t.width)), 0, t.width - 1);
+  const int y = std::clamp(static_cast<int>(l.uv.y * static_cast<float>(t.height)), 0, t.height - 1);
+  l.pixel = static_cast<std::uint32_t>(static_cast<std::size_t>(y) * static_cast<std::size_t>(t.width) +
+                                       static_cast<std::size_t>(x));
+  l.texel = t.redirect[l.pixel];
+  l.distance = h.t;
+  l.cos_surface = std::fabs(cos_surface);
+  return l;
+}
+
 std::uint32_t landing(const StaticBakeScene& b, const AtlasLayout& layout, const TexelTable& t, const Ray& ray,
                       glm::vec2* uv) {
-  const Hit h = b.caster->intersect(ray);
-  if (!h.valid()) return kSky;
-  const ShadingTriangle& tri = b.index.triangles[b.triangle_of(h)];
-  const bool front = glm::dot(tri.face_normal, ray.direction) < 0.0f;
-  if (!front && !b.scene.materials[tri.material].double_sided) return kBack;
-  const glm::vec2 u = hit_uv(layout, h);
-  if (uv) *uv = u;
-  const int x = std::clamp(static_cast<int>(u.x * static_cast<float>(t.width)), 0, t.width - 1);
-  const int y = std::clamp(static_cast<int>(u.y * static_cast<float>(t.height)), 0, t.height - 1);
-  return t.redirect[static_cast<std::size_t>(y) * static_cast<std::size_t>(t.width) + static_cast<std::size_t>(x)];
+  const Landing l = land_ray(b, layout, t, ray);
+  if (uv && l.texel != kSky && l.texel != kBack) *uv = l.uv;
+  return l.texel;
 }
 
 // Step 1 at one texel, light sampling only: `live`, every static light and the emissive
@@ -480,40 +503,103 @@ int solve_kept_rays(const TexelTable& t, const KeptRays& k, const std::vector<gl
   return iterations;
 }
 
-// Step 3 for the texels `mine` (work items): `gather_rays` fresh stratified rays read
-// `reflected` (rho (E_d + E), dilated) bilinearly where they land, and the sky where they
-// escape. Each estimate is averaged with step 2's (in e and k.sky), weighted by ray counts.
-// Texels not in `mine` get 0 in both.
-bool final_gather(const StaticBakeScene& b, const AtlasLayout& layout, const TexelTable& t,
-                  const TexelGatherSettings& s, ThreadPool& pool, const ProgressCallback& progress,
-                  const std::vector<std::size_t>& mine, const std::vector<glm::vec3>& reflected, const KeptRays& k,
-                  std::vector<glm::vec3>& e, std::vector<glm::vec3>& sky, std::vector<std::uint64_t>& rays_of) {
+// The fresh rays of one texel in step 3: the cosine rays' and the emitter rays' estimate of
+// the irradiance that `reflected` sends (W/m^2), and the cosine rays' mean sky radiance.
+struct FreshGather {
+  glm::dvec3 irradiance{0.0}, sky{0.0};
+};
+
+// The fresh rays of texel i. Without emitters: the mean of `gather_rays` cosine rays. With
+// them: every ray, cosine or emitter-sampled, reading B at a surface point y brings
+// B cos_x / pi / (n_c p_c + n_e p_e), p_c = cos_x / pi and p_e the emitter sampling's
+// density at y in solid angle (area density x d^2 / cos_y): the balance heuristic, unbiased
+// wherever either technique reaches (docs/light_atlas.md, "Emitter-sampled final gather").
+FreshGather gather_texel(const StaticBakeScene& b, const AtlasLayout& layout, const TexelTable& t,
+                         const TexelGatherSettings& s, const std::vector<glm::vec3>& reflected,
+                         const TexelEmitters* emitters, std::uint32_t i, std::uint64_t& rays) {
   const AtlasTexels& tx = b.texels;
   const auto nf = static_cast<std::size_t>(s.gather_rays);
-  const double w_solve = static_cast<double>(k.per_texel) / static_cast<double>(k.per_texel + nf);
+  const auto ne = emitters ? static_cast<std::size_t>(s.emitter_rays) : std::size_t{0};
+  const glm::vec3 n = tx.normal[i], origin = offset_ray_origin(tx.position[i], t.face[i]);
+  const std::uint32_t group = emitters ? emitters->group_of(i) : 0;
+  const double nc = static_cast<double>(nf);
+  // n_e p_e pi / cos_x at a landing: what the emitter rays add to the cosine rays' n_c.
+  const auto emitter_count = [&](const Landing& l, float cos_x) {
+    if (l.pixel == kDark || !(l.cos_surface > 0.0f)) return 0.0;
+    const double d = static_cast<double>(l.distance);
+    const double pe =
+        static_cast<double>(emitters->area_pdf(group, l.pixel)) * d * d / static_cast<double>(l.cos_surface);
+    return static_cast<double>(ne) * pe * static_cast<double>(kPi) / static_cast<double>(cos_x);
+  };
+  FreshGather g;
+  if (nf > 0) {
+    Pcg32 rng = Pcg32::for_item(s.seed, stream_id(i, kGatherStream));
+    const float shift_y = rng.next_float();  // drawn first: see random.h
+    const glm::vec2 shift(rng.next_float(), shift_y);
+    for (std::size_t r = 0; r < nf; ++r) {
+      const glm::vec2 u = hammersley(static_cast<std::uint32_t>(r), static_cast<std::uint32_t>(nf), shift);
+      const glm::vec3 wi = sample_cosine_hemisphere(n, u.x, u.y);
+      if (glm::dot(wi, t.face[i]) <= 0.0f) continue;
+      ++rays;
+      const Landing l = land_ray(b, layout, t, Ray{origin, 0.0f, wi});
+      if (l.texel < kBack) {
+        const glm::dvec3 radiosity(bilinear(reflected, t.width, t.height, l.uv));
+        g.irradiance += ne == 0 ? radiosity : radiosity / (nc + emitter_count(l, glm::dot(n, wi)));
+      }
+      if (l.texel == kSky) g.sky += glm::dvec3(sky_along(b, wi));
+    }
+    g.sky /= nc;
+    if (ne == 0) g.irradiance /= nc;
+  }
+  if (ne == 0) return g;
+  Pcg32 rng = Pcg32::for_item(s.seed, stream_id(i, kEmitterStream));
+  const float shift_y = rng.next_float();  // drawn first: see random.h
+  const glm::vec2 shift(rng.next_float(), shift_y);
+  for (std::size_t r = 0; r < ne; ++r) {
+    const glm::vec2 u = hammersley(static_cast<std::uint32_t>(r), static_cast<std::uint32_t>(ne), shift);
+    const TexelEmitters::Sample e = emitters->sample(group, u.x, u.y, rng.next_float());
+    if (e.texel == TexelEmitters::Sample::kNone) continue;
+    const glm::vec3 to = e.point - origin;
+    const float d = glm::length(to);
+    if (!(d > 0.0f)) continue;
+    const glm::vec3 wi = to / d;
+    const float cos_x = glm::dot(n, wi);
+    if (cos_x <= 0.0f || glm::dot(wi, t.face[i]) <= 0.0f) continue;
+    ++rays;
+    const Landing l = land_ray(b, layout, t, Ray{origin, 0.0f, wi});
+    if (l.texel >= kBack || l.pixel != e.texel) continue;  // occluded, or off the surface
+    // B cos_x / pi / (n_c p_c + n_e p_e) = B / (n_c + n_e p_e pi / cos_x).
+    const double count = nc + emitter_count(l, cos_x);
+    if (count > 0.0) g.irradiance += glm::dvec3(bilinear(reflected, t.width, t.height, l.uv)) / count;
+  }
+  return g;
+}
+
+// Step 3 for the texels `mine` (work items): `gather_rays` fresh stratified rays (and
+// `emitter_rays` towards `emitters`) read `reflected` (rho (E_d + E), dilated) bilinearly
+// where they land, and the sky where they escape. Each estimate is averaged with step 2's
+// (in e and k.sky), weighted by ray counts. Texels not in `mine` get 0 in both.
+bool final_gather(const StaticBakeScene& b, const AtlasLayout& layout, const TexelTable& t,
+                  const TexelGatherSettings& s, ThreadPool& pool, const ProgressCallback& progress,
+                  const std::vector<std::size_t>& mine, const std::vector<glm::vec3>& reflected,
+                  const TexelEmitters* emitters, const KeptRays& k, std::vector<glm::vec3>& e,
+                  std::vector<glm::vec3>& sky, std::vector<std::uint64_t>& rays_of) {
+  const auto nf = static_cast<std::size_t>(s.gather_rays);
+  const auto ne = emitters ? static_cast<std::size_t>(s.emitter_rays) : std::size_t{0};
+  // Both estimate T(E_d + E): weighted by their rays (the sky by the cosine rays alone).
+  // With emitter rays the kept rays are left out: read at their landing texels without MIS
+  // weights (their hit points are not kept), they would bring back the cosine rays' noise
+  // (on the skylit room: 95th-percentile texel 0.36 with them, 0.23 without).
+  const double w_solve = ne > 0 ? 0.0 : static_cast<double>(k.per_texel) / static_cast<double>(k.per_texel + nf);
+  const double w_sky = static_cast<double>(k.per_texel) / static_cast<double>(k.per_texel + nf);
   std::vector<glm::vec3> gathered(e.size(), glm::vec3(0.0f));
   sky.assign(e.size(), glm::vec3(0.0f));
   const bool done = pool.parallel_for_with_progress(mine.size(), progress, [&](std::size_t m) {
     const std::size_t w = mine[m];
     const std::uint32_t i = t.work[w];
-    Pcg32 rng = Pcg32::for_item(s.seed, stream_id(i, kGatherStream));
-    const float shift_y = rng.next_float();  // drawn first: see random.h
-    const glm::vec2 shift(rng.next_float(), shift_y);
-    const glm::vec3 origin = offset_ray_origin(tx.position[i], t.face[i]);
-    glm::dvec3 sum(0.0), sky_seen(0.0);
-    for (std::size_t r = 0; r < nf; ++r) {
-      const glm::vec2 u = hammersley(static_cast<std::uint32_t>(r), static_cast<std::uint32_t>(nf), shift);
-      const glm::vec3 wi = sample_cosine_hemisphere(tx.normal[i], u.x, u.y);
-      if (glm::dot(wi, t.face[i]) <= 0.0f) continue;
-      ++rays_of[w];
-      glm::vec2 uv;
-      const std::uint32_t land = landing(b, layout, t, Ray{origin, 0.0f, wi}, &uv);
-      if (land < kBack) sum += glm::dvec3(bilinear(reflected, t.width, t.height, uv));
-      if (land == kSky) sky_seen += glm::dvec3(sky_along(b, wi));
-    }
-    const glm::dvec3 mean = sum / static_cast<double>(nf), sky_mean = sky_seen / static_cast<double>(nf);
-    gathered[i] = glm::vec3(w_solve * glm::dvec3(e[i]) + (1.0 - w_solve) * mean);
-    sky[i] = glm::vec3(w_solve * glm::dvec3(k.sky[i]) + (1.0 - w_solve) * static_cast<double>(kPi) * sky_mean);
+    const FreshGather g = gather_texel(b, layout, t, s, reflected, emitters, i, rays_of[w]);
+    gathered[i] = glm::vec3(w_solve * glm::dvec3(e[i]) + (1.0 - w_solve) * g.irradiance);
+    sky[i] = glm::vec3(w_sky * glm::dvec3(k.sky[i]) + (1.0 - w_sky) * static_cast<double>(kPi) * g.sky);
   });
   e = std::move(gathered);
   return done;
@@ -579,16 +665,18 @@ engine::Result<TexelGatherResult> gather_atlas(const StaticBakeScene& b, const A
   const bool filtering = s.filter_radius_texels > 0.0f && texel_m > 0.0f;
   const float radius_m = s.filter_radius_texels * texel_m;
   std::vector<glm::vec3> sky = kept.sky;
-  if (s.gather_rays > 0) {
+  if (s.gather_rays > 0 || s.emitter_rays > 0) {
     // The gather reads the solve's light filtered too: its noise would otherwise come back
     // as blotches a few texels wide (a bright texel lights its neighbours' rays).
     const std::vector<glm::vec3> source = filtering ? filter_world(tx, t, e, kept.hidden, radius_m, texel_m, pool) : e;
     std::vector<glm::vec3> reflected(n, glm::vec3(0.0f));
     for (std::uint32_t i : t.work) reflected[i] = t.albedo[i] * (emitted[i] + source[i]);
+    std::optional<TexelEmitters> emitters;
+    if (s.emitter_rays > 0) emitters.emplace(b, layout, t.work, t.face, reflected, layout.texels_per_metre, pool);
     dilate<glm::vec3>(reflected, t.width, t.height, tx.valid, std::max(3, layout.padding_texels));
     std::vector<std::uint64_t> gather_rays_of(work, 0);
-    if (!final_gather(b, layout, t, s, pool, phase(0.5, 0.95), s.shard.items(work), reflected, kept, e, sky,
-                      gather_rays_of))
+    if (!final_gather(b, layout, t, s, pool, phase(0.5, 0.95), s.shard.items(work), reflected,
+                      emitters ? &*emitters : nullptr, kept, e, sky, gather_rays_of))
       return engine::cancelled_error("light-atlas gather");
     for (std::uint64_t r : gather_rays_of) out.own_rays += r;
   } else if (!s.shard.whole()) {

@@ -17,7 +17,9 @@
 //      total or after `bounces` iterations.
 //   3. Final gather: `gather_rays` fresh stratified rays per texel read rho (E_d + E) of the
 //      dilated atlas bilinearly where they hit; the result is averaged with step 2's, each
-//      weighted by its ray count (both estimate the same T(E_d + E)).
+//      weighted by its ray count (both estimate the same T(E_d + E)). With `emitter_rays`,
+//      that many more rays go to points drawn on the bright texels (texel_emitters.h), and
+//      both kinds of fresh rays are weighted by the balance heuristic (unbiased).
 //   4. Optional edge-aware filter in world space: texels within `filter_radius_texels` on
 //      the same plane (normals within ~18 degrees, plane distance below half a texel),
 //      across chart borders, Gaussian-weighted.
@@ -45,9 +47,13 @@
 namespace gi {
 
 struct TexelGatherSettings {
-  int direct_samples = 16;            ///< Samples per texel on each area light and on the emitters (>= 1).
-  int solve_rays = 64;                ///< Kept rays per texel, iterated for all bounces (>= 1).
-  int gather_rays = 128;              ///< Fresh final-gather rays per texel (0: the solve alone).
+  int direct_samples = 16;  ///< Samples per texel on each area light and on the emitters (>= 1).
+  int solve_rays = 64;      ///< Kept rays per texel, iterated for all bounces (>= 1).
+  int gather_rays = 128;    ///< Fresh final-gather rays per texel (0: the solve alone).
+  /// Fresh emitter-sampled rays per texel in step 3 (0: none): aimed at points drawn on the
+  /// texels that reflect the most light towards this one (texel_emitters.h), combined with
+  /// the cosine rays by multiple importance sampling (balance heuristic).
+  int emitter_rays = 0;
   int bounces = 64;                   ///< Most iterations of the kept-ray solve (indirect bounces).
   float filter_radius_texels = 0.0f;  ///< World-space filter radius in texels (0: none).
   std::uint64_t seed = 1;

@@ -99,8 +99,8 @@ BakeWork light_atlas_work(const StaticSurfaceCensus& census, const LightAtlasSet
   BakeWork w;
   const AtlasTexelEstimate t = atlas_texels(census, s.texels_per_metre);
   if (s.final_pass == LightAtlasSettings::FinalPass::TexelGather) {
-    const double per_texel = s.gather.solve_rays + s.gather.gather_rays + lights.punctual + lights.directional +
-                             static_cast<double>(lights.sampled > 0 ? s.gather.direct_samples : 0);
+    const double per_texel = s.gather.solve_rays + s.gather.gather_rays + s.gather.emitter_rays + lights.punctual +
+                             lights.directional + static_cast<double>(lights.sampled > 0 ? s.gather.direct_samples : 0);
     w.rays = t.lit_texels * per_texel;
     w.units = w.rays;
     w.cpu_seconds = w.rays * kAtlasCpuPerGatherRay + kAtlasCpuOverhead;

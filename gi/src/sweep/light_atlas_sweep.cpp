@@ -51,6 +51,12 @@ std::vector<KnobSpec> light_atlas_knobs() {
        .default_grid = {"128"},
        .min_value = 0,
        .max_value = 1 << 20},
+      {.name = "emitter_rays",
+       .description = "gather: fresh rays per texel aimed at the bright texels, MIS with the cosine rays (0: none)",
+       .kind = KnobKind::Integer,
+       .default_grid = {"0"},
+       .min_value = 0,
+       .max_value = 1 << 20},
       {.name = "solve_rays",
        .description = "gather: kept rays per texel iterated for every bounce",
        .kind = KnobKind::Integer,
@@ -109,6 +115,7 @@ engine::Result<MethodOutput> run_light_atlas(const RunContext& ctx) {
     s.final_pass = LightAtlasSettings::FinalPass::TexelGather;
     s.gather.gather_rays = static_cast<int>(ctx.knobs.integer("rays"));
     s.gather.solve_rays = static_cast<int>(ctx.knobs.integer("solve_rays"));
+    s.gather.emitter_rays = static_cast<int>(ctx.knobs.integer("emitter_rays"));
     s.gather.direct_samples = static_cast<int>(ctx.knobs.integer("direct_samples"));
     s.gather.filter_radius_texels = static_cast<float>(ctx.knobs.real("filter"));
     s.gather.bounces = std::max(s.bounces, 1);

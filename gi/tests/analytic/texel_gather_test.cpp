@@ -243,6 +243,25 @@ TEST(TexelGather, BitIdenticalForAnyThreadCount) {
   EXPECT_GT(one->stats.gather_iterations, 3);
 }
 
+gi::BakeInput room_lit_through_a_skylight();  // below
+
+TEST(TexelGather, EmitterRaysAreBitIdenticalForAnyThreadCount) {
+  const gi::BakeInput input = room_lit_through_a_skylight();
+  gi::LightAtlasSettings s = gather_settings(3.0f, 16);
+  s.gather.solve_rays = 16;
+  s.gather.emitter_rays = 16;
+  s.gather.filter_radius_texels = 1.5f;
+  s.threads = 1;
+  auto one = gi::bake_light_atlas(input, s);
+  s.threads = 3;
+  auto three = gi::bake_light_atlas(input, s);
+  s.gather.emitter_rays = 0;
+  auto cosine = gi::bake_light_atlas(input, s);
+  ASSERT_TRUE(one && three && cosine);
+  EXPECT_TRUE(one->irradiance == three->irradiance);
+  EXPECT_FALSE(one->irradiance == cosine->irradiance);  // the emitter rays did run
+}
+
 TEST(TexelGather, RejectsBadSettingsAndCancels) {
   const gi::BakeInput input = room_with_box_and_thin_wall();
   gi::LightAtlasSettings s = gather_settings(4.0f, 32);
@@ -255,6 +274,106 @@ TEST(TexelGather, RejectsBadSettingsAndCancels) {
   auto cancelled = gi::bake_light_atlas(input, s);
   ASSERT_FALSE(cancelled);
   EXPECT_NE(cancelled.error().message.find("cancel"), std::string::npos) << cancelled.error().message;
+}
+
+// Issue 35's structure in a small scene: a 6 x 3 x 6 m room closed but for a 0.8 m hole in
+// its ceiling, through which a sun lights a patch of 0.64 m^2 of the floor; the rest of the
+// room gets that patch's light by bounces (Sponza's arcades off its courtyard floor). The
+// sky is black.
+gi::BakeInput room_lit_through_a_skylight() {
+  const gi::BakeMaterial wall = analytic::lambert(0.6f);
+  gi::BakePrimitive p;
+  const float w = 6.0f, h = 3.0f, lo = -3.0f;
+  analytic::add_quad(p, {lo, 0, lo}, {0, 0, w}, {w, 0, 0});   // floor, +y
+  analytic::add_quad(p, {lo, 0, lo}, {w, 0, 0}, {0, h, 0});   // z = -3, +z
+  analytic::add_quad(p, {lo, 0, -lo}, {0, h, 0}, {w, 0, 0});  // z = +3, -z
+  analytic::add_quad(p, {lo, 0, lo}, {0, h, 0}, {0, 0, w});   // x = -3, +x
+  analytic::add_quad(p, {-lo, 0, lo}, {0, 0, w}, {0, h, 0});  // x = +3, -x
+  // Ceiling (faces -y) around the hole x, z in [1.8, 2.6].
+  const float a = 1.8f, b = 2.6f;
+  analytic::add_quad(p, {lo, h, lo}, {w, 0, 0}, {0, 0, a - lo});     // z < 1.8
+  analytic::add_quad(p, {lo, h, b}, {w, 0, 0}, {0, 0, -lo - b});     // z > 2.6
+  analytic::add_quad(p, {lo, h, a}, {a - lo, 0, 0}, {0, 0, b - a});  // x < 1.8 beside the hole
+  analytic::add_quad(p, {b, h, a}, {-lo - b, 0, 0}, {0, 0, b - a});  // x > 2.6 beside the hole
+  gi::BakeInput in;
+  in.name = "room lit through a skylight";
+  analytic::add_static(in, std::move(p), wall, "room");
+  gi::BakeLight sun;
+  sun.name = "sun";
+  sun.light.type = engine::LightType::Directional;
+  sun.light.intensity = 700.0f;
+  // Light travels along the node's -Z: down through the hole, a little slanted.
+  sun.light_to_world =
+      glm::mat4_cast(glm::quatLookAt(glm::normalize(glm::vec3(-0.1f, -1.0f, -0.05f)), glm::vec3(0.0f, 0.0f, 1.0f)));
+  in.lights.push_back(sun);
+  return in;
+}
+
+// The emitter-sampled gather (texel_emitters.h) against the cosine gather at equal fresh
+// rays, per texel: against the path tracer (its noise removed) and against the gather's own
+// converged value (the same kept-ray solve read by 4096 cosine rays, so the same discretization of the
+// sunlit patch, without the path tracer's noise): lower error at the 95th percentile and
+// overall, and the same mean (unbiased).
+TEST(TexelGather, EmitterSamplingFindsASmallSunlitPatchThatLightsTheRoom) {
+  const gi::BakeInput input = room_lit_through_a_skylight();
+  // The same kept-ray solve (32 rays) as the runs below, read by 4096 fresh cosine rays.
+  gi::LightAtlasSettings s = gather_settings(6.0f, 4096);
+  s.gather.solve_rays = 32;
+  auto converged = gi::bake_light_atlas(input, s);
+  ASSERT_TRUE(converged) << converged.error().to_string();
+  const gi::AtlasTexels texels = visible_texels(input, converged->layout);
+  auto truth = gi::reference_atlas_irradiance(input, texels, reference(1024));
+  ASSERT_TRUE(truth) << truth.error().to_string();
+  const gi::RgbField ref =
+      gi::RgbField::from_texels(texels.width, texels.height, truth->indirect, texels.valid, truth->indirect_variance);
+  struct Score {
+    double truth_error, p95, rms, mean_ratio;
+  };
+  const auto score = [&](const gi::LightAtlasBake& bake, const char* what) {
+    std::vector<double> rel;
+    double sum = 0.0, sum_ref = 0.0, sq = 0.0;
+    for (std::size_t t = 0; t < texels.valid.size(); ++t) {
+      if (!texels.valid[t]) continue;
+      const double r = static_cast<double>(converged->irradiance[t].y), x = static_cast<double>(bake.irradiance[t].y);
+      rel.push_back(std::fabs(x - r) / r);
+      sq += rel.back() * rel.back();
+      sum += x, sum_ref += r;
+    }
+    std::sort(rel.begin(), rel.end());
+    const gi::ErrorReport e =
+        gi::compare_rgb(gi::RgbField::from_texels(texels.width, texels.height, bake.irradiance, texels.valid), ref);
+    const Score out{e.truth_rel_rmse, rel[rel.size() * 95 / 100], std::sqrt(sq / static_cast<double>(rel.size())),
+                    sum / sum_ref};
+    std::printf("  %-34s vs truth %.4f | vs converged: 95th pct %.4f rms %.4f mean ratio %.4f | rays %llu\n", what,
+                out.truth_error, out.p95, out.rms, out.mean_ratio, static_cast<unsigned long long>(bake.stats.rays));
+    return out;
+  };
+  std::printf("room lit through a skylight, 32 kept rays + fresh rays, vs path tracer (1024 spp, noise %.4f)\n",
+              gi::compare_rgb(ref, ref).reference_noise);
+  score(*converged, "converged: 32 kept + 4096 cosine");
+  s.gather.gather_rays = 128;
+  auto cosine = gi::bake_light_atlas(input, s);
+  ASSERT_TRUE(cosine);
+  const Score c = score(*cosine, "128 cosine rays");
+  s.gather.gather_rays = 64;
+  s.gather.emitter_rays = 64;
+  auto emitter = gi::bake_light_atlas(input, s);
+  ASSERT_TRUE(emitter);
+  const Score m = score(*emitter, "64 cosine + 64 emitter rays (MIS)");
+  s.gather.gather_rays = 1024;
+  s.gather.emitter_rays = 1024;
+  auto many = gi::bake_light_atlas(input, s);
+  ASSERT_TRUE(many);
+  const Score mm = score(*many, "1024 cosine + 1024 emitter rays");
+  // Measured against the converged gather: 95th percentile 0.67 -> 0.15, rms 0.31 -> 0.094,
+  // mean ratio 0.996 and 0.999 (1024 + 1024 rays: 1.0006); against the path tracer (noise
+  // removed) 0.235 -> 0.152, the converged gather's own 0.135 being the atlas's
+  // discretization of the patch's sharp edges.
+  EXPECT_LT(m.p95, 0.5 * c.p95);
+  EXPECT_LT(m.rms, 0.5 * c.rms);
+  EXPECT_LT(m.truth_error, 0.8 * c.truth_error);
+  EXPECT_NEAR(m.mean_ratio, c.mean_ratio, 0.01);
+  EXPECT_NEAR(mm.mean_ratio, 1.0, 0.01);
 }
 
 }  // namespace
