@@ -17,6 +17,7 @@
 #include <gi/frame_truth.h>
 #include <gi/reference.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -30,6 +31,8 @@
 #include "light_atlas/light_atlas.h"
 #include "light_atlas/texel_gather.h"
 #include "raytrace/atlas_reference.h"
+#include "raytrace/ray_offset.h"
+#include "raytrace/reference_brdf.h"
 #include "raytrace/texel_samples.h"
 #include "transport/static_scene.h"
 #include "uv/atlas_layout.h"
@@ -190,6 +193,65 @@ int main(int argc, char** argv) {
       const glm::ivec2 sz = layout->charts[static_cast<std::size_t>(tx.chart[i])].size;
       into(by_chart[sz.x * sz.y <= 16 ? 16 : sz.x * sz.y <= 64 ? 64 : sz.x * sz.y <= 256 ? 256 : 1 << 30]);
     }
+  // GI_BREAKDOWN_TEXEL=i: 16 rays from texel i, where they land and the texel the atlas reads there.
+  if (const char* probe = std::getenv("GI_BREAKDOWN_TEXEL")) {
+    const std::size_t i = std::strtoul(probe, nullptr, 10);
+    const gi::ShadingTriangle& own =
+        scene->index
+            .triangles[scene->index.instance_first[scene->static_instance[static_cast<std::size_t>(tx.mesh[i])]] +
+                       static_cast<std::uint32_t>(tx.triangle[i])];
+    const glm::vec3 face = glm::dot(own.face_normal, tx.normal[i]) < 0.0f ? -own.face_normal : own.face_normal;
+    const glm::vec3 origin = gi::offset_ray_origin(tx.position[i], face);
+    for (int r = 0; r < 16; ++r) {
+      const glm::vec3 wi = gi::sample_cosine_hemisphere(tx.normal[i], (static_cast<float>(r) + 0.5f) / 16.0f,
+                                                        std::fmod(0.618034f * static_cast<float>(r), 1.0f));
+      const gi::Hit h = scene->caster->intersect(gi::Ray{origin, 0.0f, wi});
+      if (!h.valid()) {
+        std::printf("ray %d: sky\n", r);
+        continue;
+      }
+      const gi::ShadingTriangle& tri = scene->index.triangles[scene->triangle_of(h)];
+      const glm::vec3 p = tri.p0 + h.barycentric.x * tri.e1 + h.barycentric.y * tri.e2;
+      const gi::AtlasMeshUv& mu = layout->meshes[h.instance];
+      const std::uint32_t* idx = &mu.indices[3u * h.primitive];
+      const glm::vec2 uv = (1.0f - h.barycentric.x - h.barycentric.y) * mu.uv1[idx[0]] +
+                           h.barycentric.x * mu.uv1[idx[1]] + h.barycentric.y * mu.uv1[idx[2]];
+      const std::size_t j = tx.index(std::min(static_cast<int>(uv.x * static_cast<float>(tx.width)), tx.width - 1),
+                                     std::min(static_cast<int>(uv.y * static_cast<float>(tx.height)), tx.height - 1));
+      std::printf("ray %d: t %.3f %s hit (%.3f %.3f %.3f) texel %zu valid %d at (%.3f %.3f %.3f) total %.1f\n", r,
+                  static_cast<double>(h.t), glm::dot(tri.face_normal, wi) < 0.0f ? "front" : "back",
+                  static_cast<double>(p.x), static_cast<double>(p.y), static_cast<double>(p.z), j, tx.valid[j],
+                  static_cast<double>(tx.position[j].x), static_cast<double>(tx.position[j].y),
+                  static_cast<double>(tx.position[j].z),
+                  static_cast<double>(gathered->direct[j].y + gathered->baked_direct[j].y + gathered->indirect[j].y));
+    }
+  }
+  // GI_BREAKDOWN_WORST=N: the N texels of the largest error, one line each.
+  if (const char* worst = std::getenv("GI_BREAKDOWN_WORST")) {
+    std::vector<std::pair<double, std::size_t>> err;
+    for (std::size_t i = 0; i < n; ++i)
+      if (tx.valid[i]) {
+        const double a =
+            static_cast<double>(gathered->direct[i].y + gathered->baked_direct[i].y + gathered->indirect[i].y);
+        const double r = 0.5 * static_cast<double>(rd[0][i].y + ri[0][i].y + rd[1][i].y + ri[1][i].y);
+        err.emplace_back(std::fabs(a - r), i);
+      }
+    std::sort(err.rbegin(), err.rend());
+    for (std::size_t k = 0; k < std::min<std::size_t>(err.size(), std::strtoul(worst, nullptr, 10)); ++k) {
+      const std::size_t i = err[k].second;
+      std::printf(
+          "texel %zu (%d, %d) chart %d hidden %d p (%.3f %.3f %.3f) n (%.3f %.3f %.3f): gather direct %.2f + %.2f "
+          "indirect %.2f; path tracer direct %.2f / %.2f indirect %.2f / %.2f\n",
+          i, static_cast<int>(i % static_cast<std::size_t>(tx.width)),
+          static_cast<int>(i / static_cast<std::size_t>(tx.width)), tx.chart[i], gathered->hidden[i],
+          static_cast<double>(tx.position[i].x), static_cast<double>(tx.position[i].y),
+          static_cast<double>(tx.position[i].z), static_cast<double>(tx.normal[i].x),
+          static_cast<double>(tx.normal[i].y), static_cast<double>(tx.normal[i].z),
+          static_cast<double>(gathered->direct[i].y), static_cast<double>(gathered->baked_direct[i].y),
+          static_cast<double>(gathered->indirect[i].y), static_cast<double>(rd[0][i].y),
+          static_cast<double>(rd[1][i].y), static_cast<double>(ri[0][i].y), static_cast<double>(ri[1][i].y));
+    }
+  }
   std::printf("%s at %.1f texels/m, preset %s, truth 2 x %d spp\n", argv[1], static_cast<double>(density),
               preset.c_str(), spp);
   std::printf(

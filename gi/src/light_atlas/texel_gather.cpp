@@ -30,6 +30,10 @@ constexpr std::uint32_t kBack = 0xfffffffdu;  // the back of a one-sided surface
 // A texel whose kept rays see back faces this often lies inside or under geometry; the
 // filter neither reads nor smooths it.
 constexpr float kHiddenBackFraction = 0.1f;
+// Two surfaces facing each other closer than this (in texels) enclose a gap no light enters
+// (a slab's underside 2 mm above the next one's top, in Dabrovic Sponza): a ray from one
+// that lands on the other reads dark, not the texel there, whose sample lies in the open.
+constexpr float kGapTexels = 0.05f;
 
 // Item ids of the three random streams of a texel.
 constexpr std::uint64_t kDirectStream = 0, kSolveStream = 1, kGatherStream = 2;
@@ -71,6 +75,7 @@ struct TexelTable {
   std::vector<glm::vec3> albedo;        // per atlas texel: hemispherical albedo of its material
   std::vector<glm::vec3> face;          // per atlas texel: unit geometric normal on the shading side
   std::vector<std::uint32_t> redirect;  // per atlas texel: itself when valid, else a valid neighbour or kDark
+  float gap_m = 0.0f;                   // kGapTexels in metres
 };
 
 engine::Result<TexelTable> texel_table(const StaticBakeScene& b, const AtlasLayout& layout) {
@@ -88,6 +93,7 @@ engine::Result<TexelTable> texel_table(const StaticBakeScene& b, const AtlasLayo
   TexelTable t;
   t.width = tx.width;
   t.height = tx.height;
+  t.gap_m = layout.texels_per_metre > 0.0f ? kGapTexels / layout.texels_per_metre : 0.0f;
   const std::size_t n = tx.valid.size();
   t.albedo.assign(n, glm::vec3(0.0f));
   t.face.assign(n, glm::vec3(0.0f));
@@ -145,14 +151,17 @@ glm::vec2 hit_uv(const AtlasLayout& layout, const Hit& h) {
   return (1.0f - u - v) * mu.uv1[idx[0]] + u * mu.uv1[idx[1]] + v * mu.uv1[idx[2]];
 }
 
-// Where a ray from a texel ends: kSky, kDark, or the atlas texel it reads.
+// Where a ray from a texel whose face is `from` ends: kSky, kBack (the back of a one-sided
+// surface, or a surface facing `from` across a gap of less than kGapTexels), or the atlas
+// texel it reads.
 std::uint32_t landing(const StaticBakeScene& b, const AtlasLayout& layout, const TexelTable& t, const Ray& ray,
-                      glm::vec2* uv) {
+                      const glm::vec3& from, glm::vec2* uv) {
   const Hit h = b.caster->intersect(ray);
   if (!h.valid()) return kSky;
   const ShadingTriangle& tri = b.index.triangles[b.triangle_of(h)];
   const bool front = glm::dot(tri.face_normal, ray.direction) < 0.0f;
   if (!front && !b.scene.materials[tri.material].double_sided) return kBack;
+  if (h.t < t.gap_m && std::fabs(glm::dot(tri.face_normal, from)) > 0.9f) return kBack;
   const glm::vec2 u = hit_uv(layout, h);
   if (uv) *uv = u;
   const int x = std::clamp(static_cast<int>(u.x * static_cast<float>(t.width)), 0, t.width - 1);
@@ -437,7 +446,7 @@ bool cast_kept_rays(const StaticBakeScene& b, const AtlasLayout& layout, const T
       const glm::vec3 wi = sample_cosine_hemisphere(tx.normal[i], u.x, u.y);
       if (glm::dot(wi, t.face[i]) <= 0.0f) continue;  // below the surface: dark
       ++rays_of[w];
-      const std::uint32_t land = landing(b, layout, t, Ray{origin, 0.0f, wi}, nullptr);
+      const std::uint32_t land = landing(b, layout, t, Ray{origin, 0.0f, wi}, t.face[i], nullptr);
       k.land[w * ns + r] = land;
       if (land == kSky) sky_seen += sky_along(b, wi);
       back += land == kBack;
@@ -507,7 +516,7 @@ bool final_gather(const StaticBakeScene& b, const AtlasLayout& layout, const Tex
       if (glm::dot(wi, t.face[i]) <= 0.0f) continue;
       ++rays_of[w];
       glm::vec2 uv;
-      const std::uint32_t land = landing(b, layout, t, Ray{origin, 0.0f, wi}, &uv);
+      const std::uint32_t land = landing(b, layout, t, Ray{origin, 0.0f, wi}, t.face[i], &uv);
       if (land < kBack) sum += glm::dvec3(bilinear(reflected, t.width, t.height, uv));
       if (land == kSky) sky_seen += glm::dvec3(sky_along(b, wi));
     }
