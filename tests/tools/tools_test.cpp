@@ -237,6 +237,23 @@ TEST(GiReference, SkyOptionIsParsedAsGiBakes) {
   EXPECT_TRUE(fs::exists(out));
 }
 
+// gi-reference --sun: the same parser as gi-bake's and gi-frame-truth's (tools/common), so the
+// truth of a sun-lit bake (issue 35's Sponza) is rendered from the same command line: a bad
+// sun is a usage error naming the option, a good one renders the atlas truth.
+TEST(GiReference, SunOptionIsParsedAsGiBakes) {
+  const ToolRun bad = run(GI_REFERENCE_EXE, {"--scene", GI_SOURCE_DIR "/assets/cornell_box.gltf", "--sun",
+                                             "direction:0,0,0;irradiance:1,1,1", "--out", "x.exr"});
+  EXPECT_EQ(bad.exit_code, 2) << bad.output;
+  EXPECT_NE(bad.output.find("--sun"), std::string::npos) << bad.output;
+  const fs::path out = fs::path(GI_BINARY_DIR) / "test_output" / "tools_test" / "reference_sun";
+  fs::remove_all(out);
+  const ToolRun ok = run(GI_REFERENCE_EXE, {"--scene", GI_SOURCE_DIR "/assets/cornell_box.gltf", "--sun",
+                                            "direction:0.2,-0.6,1;irradiance:50,50,50", "--atlas-density", "4", "--spp",
+                                            "2", "--threads", "2", "--atlas-out", out.string()});
+  EXPECT_EQ(ok.exit_code, 0) << ok.output;
+  EXPECT_TRUE(fs::exists(out / "atlas_direct.exr")) << ok.output;
+}
+
 // gi-bake --export-uv1: the scene with the light-atlas UVs as TEXCOORD_1, nothing baked
 // (tests/gi/light_atlas_uv_test.cpp checks they are the runtime's).
 TEST(GiBake, ExportUv1WritesTheSceneWithLightmapUvs) {

@@ -3,6 +3,8 @@
 //   gi-reference --scene assets/cornell_box.gltf --width 256 --height 256 --spp 256 --out cbox.exr
 //   gi-reference --scene assets/cornell_box.gltf --atlas-density 64 --spp 256 --atlas-out out/cbox_atlas
 //   gi-reference --scene Avocado.glb --sky 0.8,0.9,1.0 --width 256 --height 256 --out avocado.exr
+//   gi-reference --scene sponza.gltf --sun 'direction:0.25,-1,0.15;irradiance:700,650,600' --sky SKY
+//                --atlas-density 8 --spp 256 --atlas-out out/truth
 //   gi-reference --scene level.gltf --atlas-density 32 --spp 1024 --atlas-out out/truth --shard 3/8  # one shard
 //   gi-reference --scene level.gltf --atlas-density 32 --spp 1024 --atlas-out out/truth --merge      # the 8 merged
 // Sharded runs (docs/distributed-bake.md) split the pixels and atlas texels into blocks of 64;
@@ -25,6 +27,7 @@
 #include <CLI/CLI.hpp>
 
 #include "console_progress.h"
+#include "sun_option.h"
 #include "tool_main.h"
 
 namespace {
@@ -69,7 +72,7 @@ engine::Status save_atomically(const std::filesystem::path& path, Save save) {
 }
 
 struct Options {
-  std::string scene_path, out_path, png_path, atlas_out, camera_name, sky;
+  std::string scene_path, out_path, png_path, atlas_out, camera_name, sky, sun;
   int width = 256, height = 256, spp = 64, bounces = -1;
   unsigned threads = 0;
   std::uint64_t seed = 1;
@@ -96,6 +99,9 @@ void add_options(CLI::App& app, Options& o) {
   app.add_option("--sky", o.sky,
                  "R,G,B (uniform) or 'zenith:R,G,B;horizon:R,G,B;ground:R,G,B' (gradient): a sky replacing the "
                  "scene's gi.sky (as gi-bake --sky)");
+  app.add_option("--sun", o.sun,
+                 "'direction:dx,dy,dz;irradiance:R,G,B[;angular_radius_deg:D]': a sun replacing the scene's gi.sun "
+                 "(as gi-bake --sun)");
   app.add_option("--atlas-out", o.atlas_out, "folder for atlas_direct.exr, atlas_indirect.exr, atlas_total.exr");
   // Distributed references (docs/distributed-bake.md).
   app.add_option("--shard", o.shard,
@@ -235,6 +241,8 @@ int main(int argc, char** argv) {
     if (!tools::set_sky(asset->environment, o.sky))
       return tools::fail(kTool, std::string(tools::kSkyUsage) + ", got '" + o.sky + "'", tools::kExitUsage);
   }
+  if (!o.sun.empty() && !tools::set_sun(*asset, o.sun))
+    return tools::fail(kTool, std::string(tools::kSunUsage) + ", got '" + o.sun + "'", tools::kExitUsage);
   engine::Scene scene = engine::instantiate(std::move(asset).value());
   tools::install_interrupt_handler();
   tools::ConsoleProgress bar;

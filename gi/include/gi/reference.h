@@ -81,7 +81,12 @@ engine::Result<FirstHitImage> reference_first_hits(const BakeInput& input, const
 /// A receiver of irradiance: a point on a surface and the unit normal of its lit side.
 struct SurfacePoint {
   glm::vec3 position_m{0.0f};
-  glm::vec3 normal{0.0f, 1.0f, 0.0f};
+  glm::vec3 normal{0.0f, 1.0f, 0.0f};  ///< Shading normal: the cosine's axis.
+  /// Unit geometric normal of the surface under the point, on the lit side; zero: `normal`.
+  /// Light from below the surface's own plane does not reach the point (the light atlas's
+  /// gather does the same): a shading normal off the face no longer lets the point see the
+  /// front of its own surface (docs/light_atlas.md, "Direct and indirect light").
+  glm::vec3 face_normal{0.0f};
 };
 
 /// Irradiance, W/m^2 per RGB channel: `direct` arrives straight from lights and emissive

@@ -32,6 +32,10 @@ constexpr std::uint32_t kBack = 0xfffffffdu;  // the back of a one-sided surface
 // A texel whose kept rays see back faces this often lies inside or under geometry; the
 // filter neither reads nor smooths it.
 constexpr float kHiddenBackFraction = 0.1f;
+// Two surfaces facing each other closer than this (in texels) enclose a gap no light enters
+// (a slab's underside 2 mm above the next one's top, in Dabrovic Sponza): a ray from one
+// that lands on the other reads dark, not the texel there, whose sample lies in the open.
+constexpr float kGapTexels = 0.05f;
 
 // Item ids of the four random streams of a texel.
 constexpr std::uint64_t kDirectStream = 0, kSolveStream = 1, kGatherStream = 2, kEmitterStream = 3;
@@ -74,6 +78,7 @@ struct TexelTable {
   std::vector<glm::vec3> albedo;        // per atlas texel: hemispherical albedo of its material
   std::vector<glm::vec3> face;          // per atlas texel: unit geometric normal on the shading side
   std::vector<std::uint32_t> redirect;  // per atlas texel: itself when valid, else a valid neighbour or kDark
+  float gap_m = 0.0f;                   // kGapTexels in metres
 };
 
 engine::Result<TexelTable> texel_table(const StaticBakeScene& b, const AtlasLayout& layout) {
@@ -91,6 +96,7 @@ engine::Result<TexelTable> texel_table(const StaticBakeScene& b, const AtlasLayo
   TexelTable t;
   t.width = tx.width;
   t.height = tx.height;
+  t.gap_m = layout.texels_per_metre > 0.0f ? kGapTexels / layout.texels_per_metre : 0.0f;
   const std::size_t n = tx.valid.size();
   t.albedo.assign(n, glm::vec3(0.0f));
   t.face.assign(n, glm::vec3(0.0f));
@@ -148,9 +154,11 @@ glm::vec2 hit_uv(const AtlasLayout& layout, const Hit& h) {
   return (1.0f - u - v) * mu.uv1[idx[0]] + u * mu.uv1[idx[1]] + v * mu.uv1[idx[2]];
 }
 
-// Where a ray from a texel ends: `texel`, kSky, kBack or the atlas texel it reads (a valid
-// texel, redirected from an empty one); on a surface also the atlas UV of the hit, the atlas
-// texel under it as it is (`pixel`, maybe empty), the distance and |cos| at the surface.
+// Where a ray from a texel whose face is `from` ends: kSky, kBack (the back of a one-sided
+// surface, or a surface facing `from` across a gap of less than kGapTexels) or the atlas texel
+// it reads (a valid texel, redirected from an empty one); on a surface also the atlas UV of the
+// hit, the atlas texel under it as it is (`pixel`, maybe empty), the distance and |cos| at the
+// surface.
 struct Landing {
   std::uint32_t texel = kSky;
   glm::vec2 uv{0.0f};
@@ -158,12 +166,14 @@ struct Landing {
   float distance = 0.0f, cos_surface = 0.0f;
 };
 
-Landing land_ray(const StaticBakeScene& b, const AtlasLayout& layout, const TexelTable& t, const Ray& ray) {
+Landing land_ray(const StaticBakeScene& b, const AtlasLayout& layout, const TexelTable& t, const Ray& ray,
+                 const glm::vec3& from) {
   const Hit h = b.caster->intersect(ray);
   if (!h.valid()) return {};
   const ShadingTriangle& tri = b.index.triangles[b.triangle_of(h)];
   const float cos_surface = glm::dot(tri.face_normal, ray.direction);
   if (!(cos_surface < 0.0f) && !b.scene.materials[tri.material].double_sided) return {.texel = kBack};
+  if (h.t < t.gap_m && std::fabs(glm::dot(tri.face_normal, from)) > 0.9f) return {.texel = kBack};
   Landing l;
   l.uv = hit_uv(layout, h);
   const int x = std::clamp(static_cast<int>(l.uv.x * static_cast<float>(t.width)), 0, t.width - 1);
@@ -177,8 +187,8 @@ Landing land_ray(const StaticBakeScene& b, const AtlasLayout& layout, const Texe
 }
 
 std::uint32_t landing(const StaticBakeScene& b, const AtlasLayout& layout, const TexelTable& t, const Ray& ray,
-                      glm::vec2* uv) {
-  const Landing l = land_ray(b, layout, t, ray);
+                      const glm::vec3& from, glm::vec2* uv) {
+  const Landing l = land_ray(b, layout, t, ray, from);
   if (uv && l.texel != kSky && l.texel != kBack) *uv = l.uv;
   return l.texel;
 }
@@ -460,7 +470,7 @@ bool cast_kept_rays(const StaticBakeScene& b, const AtlasLayout& layout, const T
       const glm::vec3 wi = sample_cosine_hemisphere(tx.normal[i], u.x, u.y);
       if (glm::dot(wi, t.face[i]) <= 0.0f) continue;  // below the surface: dark
       ++rays_of[w];
-      const std::uint32_t land = landing(b, layout, t, Ray{origin, 0.0f, wi}, nullptr);
+      const std::uint32_t land = landing(b, layout, t, Ray{origin, 0.0f, wi}, t.face[i], nullptr);
       k.land[w * ns + r] = land;
       if (land == kSky) sky_seen += sky_along(b, wi);
       back += land == kBack;
@@ -541,7 +551,7 @@ FreshGather gather_texel(const StaticBakeScene& b, const AtlasLayout& layout, co
       const glm::vec3 wi = sample_cosine_hemisphere(n, u.x, u.y);
       if (glm::dot(wi, t.face[i]) <= 0.0f) continue;
       ++rays;
-      const Landing l = land_ray(b, layout, t, Ray{origin, 0.0f, wi});
+      const Landing l = land_ray(b, layout, t, Ray{origin, 0.0f, wi}, t.face[i]);
       if (l.texel < kBack) {
         const glm::dvec3 radiosity(bilinear(reflected, t.width, t.height, l.uv));
         g.irradiance += ne == 0 ? radiosity : radiosity / (nc + emitter_count(l, glm::dot(n, wi)));
@@ -566,7 +576,7 @@ FreshGather gather_texel(const StaticBakeScene& b, const AtlasLayout& layout, co
     const float cos_x = glm::dot(n, wi);
     if (cos_x <= 0.0f || glm::dot(wi, t.face[i]) <= 0.0f) continue;
     ++rays;
-    const Landing l = land_ray(b, layout, t, Ray{origin, 0.0f, wi});
+    const Landing l = land_ray(b, layout, t, Ray{origin, 0.0f, wi}, t.face[i]);
     if (l.texel >= kBack || l.pixel != e.texel) continue;  // occluded, or off the surface
     // B cos_x / pi / (n_c p_c + n_e p_e) = B / (n_c + n_e p_e pi / cos_x).
     const double count = nc + emitter_count(l, cos_x);

@@ -1,5 +1,6 @@
 #include "raytrace/atlas_reference.h"
 
+#include <cmath>
 #include <span>
 
 #include "raytrace/texel_samples.h"
@@ -9,10 +10,31 @@
 
 namespace gi {
 
-std::vector<SurfacePoint> atlas_sample_points(const AtlasTexels& texels) {
+namespace {
+
+// The unit geometric normal of texel i's triangle on its shading normal's side; zero when
+// the triangle is not among `inputs` or is degenerate.
+glm::vec3 texel_face(const std::vector<AtlasInputMesh>& inputs, const AtlasTexels& texels, std::size_t i) {
+  const auto mesh = static_cast<std::size_t>(texels.mesh[i]), tri = static_cast<std::size_t>(texels.triangle[i]);
+  if (texels.mesh[i] < 0 || texels.triangle[i] < 0 || mesh >= inputs.size() ||
+      3 * tri + 2 >= inputs[mesh].indices.size())
+    return glm::vec3(0.0f);
+  const AtlasInputMesh& m = inputs[mesh];
+  const glm::vec3 p0 = m.positions[m.indices[3 * tri]], p1 = m.positions[m.indices[3 * tri + 1]],
+                  p2 = m.positions[m.indices[3 * tri + 2]];
+  const glm::vec3 c = glm::cross(p1 - p0, p2 - p0);
+  const float len = glm::length(c);
+  if (!(len > 0.0f) || !std::isfinite(len)) return glm::vec3(0.0f);
+  return glm::dot(c, texels.normal[i]) < 0.0f ? -c / len : c / len;
+}
+
+}  // namespace
+
+std::vector<SurfacePoint> atlas_sample_points(const BakeInput& input, const AtlasTexels& texels) {
+  const std::vector<AtlasInputMesh> inputs = atlas_inputs_from(input);
   std::vector<SurfacePoint> points;
   for (std::size_t i = 0; i < texels.valid.size(); ++i)
-    if (texels.valid[i]) points.push_back({texels.position[i], texels.normal[i]});
+    if (texels.valid[i]) points.push_back({texels.position[i], texels.normal[i], texel_face(inputs, texels, i)});
   return points;
 }
 
@@ -43,7 +65,7 @@ AtlasIrradiance assemble_atlas_irradiance(const AtlasTexels& texels, const Irrad
 
 engine::Result<AtlasIrradiance> reference_atlas_irradiance(const BakeInput& input, const AtlasTexels& texels,
                                                            const ReferenceSettings& settings) {
-  const std::vector<SurfacePoint> points = atlas_sample_points(texels);
+  const std::vector<SurfacePoint> points = atlas_sample_points(input, texels);
   auto e = reference_irradiance(input, points, settings);
   if (!e) return e.error();
   return assemble_atlas_irradiance(texels, *e);

@@ -30,8 +30,10 @@ struct AtlasIrradiance {
 };
 
 /// The sample points of `texels`: its valid texels in index order (a texel's point index is
-/// its place among them, what its random stream and shard block are numbered by).
-std::vector<SurfacePoint> atlas_sample_points(const AtlasTexels& texels);
+/// its place among them, what its random stream and shard block are numbered by), each with
+/// the geometric normal of its triangle among the static instances of `input` (the ones
+/// `texels` were rasterized from) turned to its shading normal's side, as the gather takes it.
+std::vector<SurfacePoint> atlas_sample_points(const BakeInput& input, const AtlasTexels& texels);
 
 /// The atlas from the estimate at atlas_sample_points(texels): values put in place, dilated,
 /// total = direct + indirect. What reference_atlas_irradiance and a merge of shards both run.

@@ -194,7 +194,8 @@ glm::vec3 PathTracer::reflected_radiance(const Ray& ray, Pcg32& rng) const {
   return trace(ray, 0.0f, max_e, rng).reflected;
 }
 
-PathTracer::Irradiance PathTracer::irradiance(const glm::vec3& p, const glm::vec3& n, Pcg32& rng) const {
+PathTracer::Irradiance PathTracer::irradiance(const glm::vec3& p, const glm::vec3& n, Pcg32& rng,
+                                              const glm::vec3& face) const {
   // The receiver is a cosine lobe: "BRDF x cos" = cos, sampled with density cos / pi.
   ReferenceBrdf receiver;
   receiver.normal = n;
@@ -207,6 +208,9 @@ PathTracer::Irradiance PathTracer::irradiance(const glm::vec3& p, const glm::vec
   const glm::vec3 wi = sample_cosine_hemisphere(n, u1, u2);
   const float pdf = std::max(glm::dot(wi, n), 0.0f) / kPi;
   if (!(pdf > 0.0f)) return e;
+  // Below the surface's own plane (a shading normal off the face): the ray would see the
+  // front of the very surface it leaves, light the point cannot receive.
+  if (glm::dot(wi, face) < 0.0f) return e;
   const int max_e = settings_.max_bounces < 0 ? kUnlimited : settings_.max_bounces + 1;
   const Traced t = trace(Ray{origin, 0.0f, wi}, pdf, max_e, rng);
   e.direct += kPi * t.emitted;  // L cos / pdf = pi L

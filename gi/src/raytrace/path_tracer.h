@@ -50,8 +50,11 @@ class PathTracer {
     glm::vec3 direct{0.0f};
     glm::vec3 indirect{0.0f};
   };
-  /// One-sample irradiance estimate at `p` on the side of unit normal `n`.
-  Irradiance irradiance(const glm::vec3& p, const glm::vec3& n, Pcg32& rng) const;
+  /// One-sample irradiance estimate at `p` on the side of unit normal `n`. `face`: the unit
+  /// geometric normal of the surface under `p` (zero: none); light from below its plane is
+  /// dark, as for the light atlas's gather (the surface cannot see its own front).
+  Irradiance irradiance(const glm::vec3& p, const glm::vec3& n, Pcg32& rng,
+                        const glm::vec3& face = glm::vec3(0.0f)) const;
 
  private:
   struct Traced {

@@ -186,7 +186,8 @@ engine::Result<IrradianceEstimate> estimate_irradiance(const ReferenceScene& sce
     Pcg32 rng = Pcg32::for_item(settings.seed, i);
     glm::dvec3 direct(0.0), indirect(0.0), indirect2(0.0);
     for (int s = 0; s < settings.samples_per_pixel; ++s) {
-      const PathTracer::Irradiance e = tracer.irradiance(points[i].position_m, points[i].normal, rng);
+      const PathTracer::Irradiance e =
+          tracer.irradiance(points[i].position_m, points[i].normal, rng, points[i].face_normal);
       direct += glm::dvec3(finite_or_zero(e.direct));
       const glm::dvec3 ind(finite_or_zero(e.indirect));
       indirect += ind;

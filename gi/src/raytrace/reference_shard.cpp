@@ -182,7 +182,7 @@ engine::Result<AtlasSetup> atlas_setup(const BakeInput& input, const ReferenceAt
   auto texels = sample_atlas_texels(input, *layout, job.placement);
   if (!texels) return texels.error();
   AtlasSetup out{.texels_per_metre = layout->texels_per_metre, .texels = std::move(texels).value(), .points = {}};
-  out.points = atlas_sample_points(out.texels);
+  out.points = atlas_sample_points(input, out.texels);
   return out;
 }
 

@@ -1,0 +1,268 @@
+// Where a gathered light atlas differs from the path tracer on a level (issue 35, "the
+// floor on the whole lightmap"): the gather's parts (the sun's and the lights' direct light,
+// the sky's, the indirect) and the path tracer's (gi::reference_atlas_irradiance at the very
+// same texel samples) per texel, the error of the whole lightmap broken down by kind of texel
+// (near a sun shadow edge, on a chart border, hidden, shading normal off the face, per
+// material, per chart size). The truth is two path-traced atlases of different seeds: with
+// r = (r1 + r2) / 2, sum (a - r)^2 - sum (r1 - r2)^2 / 4 estimates sum (a - t)^2 without the
+// references' noise (of the direct light too, which their variance does not cover).
+// A diagnosis program, not a benchmark: it prints a table.
+//   light_atlas_breakdown SCENE.gltf [texels_per_metre=8] [spp=64] [preset=medium] [cache_dir=.]
+// The scene is baked untextured under docs/real_level.md's sun and gradient sky; the two
+// references are cached in cache_dir (keyed by density and spp; delete them after a change
+// of the path tracer or of the texel placement).
+#include <engine/gltf.h>
+#include <engine/sun.h>
+#include <gi/bake_input.h>
+#include <gi/frame_truth.h>
+#include <gi/reference.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "core/thread_pool.h"
+#include "light_atlas/light_atlas.h"
+#include "light_atlas/texel_gather.h"
+#include "raytrace/atlas_reference.h"
+#include "raytrace/ray_offset.h"
+#include "raytrace/reference_brdf.h"
+#include "raytrace/texel_samples.h"
+#include "transport/static_scene.h"
+#include "uv/atlas_layout.h"
+
+namespace {
+
+struct Sums {
+  double err2 = 0.0, noise2 = 0.0, ref2 = 0.0, diff = 0.0, ref = 0.0, diff_direct = 0.0, diff_indirect = 0.0;
+  std::size_t n = 0;
+  // The parts' differences (gather - mean of the references), summed over the channels.
+  void add_parts(const glm::dvec3& direct, const glm::dvec3& indirect) {
+    diff_direct += direct.x + direct.y + direct.z;
+    diff_indirect += indirect.x + indirect.y + indirect.z;
+  }
+  void add(const glm::dvec3& a, const glm::dvec3& r1, const glm::dvec3& r2) {
+    const glm::dvec3 r = 0.5 * (r1 + r2), d = a - r, nd = r1 - r2;
+    err2 += glm::dot(d, d);
+    noise2 += 0.25 * glm::dot(nd, nd);
+    ref2 += glm::dot(r, r);
+    diff += d.x + d.y + d.z;
+    ref += r.x + r.y + r.z;
+    ++n;
+  }
+  double truth_err2() const { return std::max(0.0, err2 - noise2); }
+};
+
+void row(const char* name, const Sums& s, double all_ref2) {
+  if (s.n == 0) return;
+  std::printf("| %s | %zu | %.4f | %+.4f | %+.4f | %+.4f | %.4f | %.4f |\n", name, s.n,
+              std::sqrt(s.truth_err2() / std::max(1e-30, s.ref2 - s.noise2)), s.diff / s.ref, s.diff_direct / s.ref,
+              s.diff_indirect / s.ref, std::sqrt(s.truth_err2() / all_ref2),
+              std::sqrt(s.noise2 / std::max(1e-30, s.ref2)));
+}
+
+bool load_cache(const std::filesystem::path& p, std::size_t n, std::vector<glm::vec3>& direct,
+                std::vector<glm::vec3>& indirect) {
+  std::ifstream f(p, std::ios::binary);
+  if (!f) return false;
+  direct.resize(n);
+  indirect.resize(n);
+  f.read(reinterpret_cast<char*>(direct.data()), static_cast<std::streamsize>(n * sizeof(glm::vec3)));
+  f.read(reinterpret_cast<char*>(indirect.data()), static_cast<std::streamsize>(n * sizeof(glm::vec3)));
+  return static_cast<bool>(f);
+}
+
+void save_cache(const std::filesystem::path& p, const std::vector<glm::vec3>& direct,
+                const std::vector<glm::vec3>& indirect) {
+  std::ofstream f(p, std::ios::binary);
+  f.write(reinterpret_cast<const char*>(direct.data()),
+          static_cast<std::streamsize>(direct.size() * sizeof(glm::vec3)));
+  f.write(reinterpret_cast<const char*>(indirect.data()),
+          static_cast<std::streamsize>(indirect.size() * sizeof(glm::vec3)));
+}
+
+}  // namespace
+
+// Long because it is one diagnosis read top to bottom: load, bake, references, the table.
+int main(int argc, char** argv) {
+  if (argc < 2) {
+    std::fprintf(stderr, "usage: %s SCENE.gltf [texels_per_metre] [spp] [preset] [cache_dir]\n", argv[0]);
+    return 2;
+  }
+  const float density = argc > 2 ? std::strtof(argv[2], nullptr) : 8.0f;
+  const int spp = argc > 3 ? std::atoi(argv[3]) : 64;
+  const std::string preset = argc > 4 ? argv[4] : "medium";
+  const std::filesystem::path cache = argc > 5 ? argv[5] : ".";
+  auto loaded = engine::load_gltf(argv[1]);
+  if (!loaded) return std::fprintf(stderr, "%s\n", loaded.error().to_string().c_str()), 1;
+  engine::SceneAsset asset = gi::without_textures(std::move(loaded).value());
+  asset.environment.sky_radiance = glm::vec3(0.0f);
+  asset.environment.sky_gradient = {.zenith = {10, 16, 30}, .horizon = {28, 30, 34}, .ground = {6, 6, 6}};
+  engine::set_sun(asset, {.direction = {0.25f, -1.0f, 0.15f},
+                          .irradiance = {700.0f, 650.0f, 600.0f},
+                          .angular_radius_rad = 0.27f * 3.14159265f / 180.0f});
+  const gi::BakeInput input = gi::bake_input_from(asset);
+
+  gi::LightAtlasSettings s = gi::light_atlas_preset(preset).value();
+  s.texels_per_metre = density;
+  auto layout = gi::static_world_layout(input, density);
+  if (!layout) return std::fprintf(stderr, "%s\n", layout.error().to_string().c_str()), 1;
+  auto scene = gi::prepare_static_scene(input, *layout, gi::BakeLights::Static, gi::texel_placement(s));
+  if (!scene) return std::fprintf(stderr, "%s\n", scene.error().to_string().c_str()), 1;
+  gi::ThreadPool pool(2);
+  gi::TexelGatherSettings g = s.gather;
+  g.seed = s.seed;
+  auto gathered = gi::gather_atlas(*scene, *layout, g, pool);
+  if (!gathered) return std::fprintf(stderr, "%s\n", gathered.error().to_string().c_str()), 1;
+  const gi::AtlasTexels& tx = scene->texels;
+  const std::size_t n = tx.valid.size();
+
+  std::vector<glm::vec3> rd[2], ri[2];
+  for (int k = 0; k < 2; ++k) {
+    const auto file = cache / ("breakdown_ref_" + std::to_string(static_cast<int>(density * 100)) + "_" +
+                               std::to_string(spp) + "_" + std::to_string(k) + ".bin");
+    if (load_cache(file, n, rd[k], ri[k])) continue;
+    auto truth = gi::reference_atlas_irradiance(
+        input, tx,
+        {.samples_per_pixel = spp, .max_bounces = -1, .seed = 1000u + static_cast<unsigned>(k), .threads = 2});
+    if (!truth) return std::fprintf(stderr, "%s\n", truth.error().to_string().c_str()), 1;
+    rd[k] = truth->direct;
+    ri[k] = truth->indirect;
+    save_cache(file, rd[k], ri[k]);
+  }
+
+  // The sun's unshadowed irradiance at each texel, to find its shadow edges.
+  const glm::vec3 to_sun = -glm::normalize(glm::vec3(0.25f, -1.0f, 0.15f));
+  std::vector<float> lit(n, -1.0f);  // fraction of the unshadowed sun the gather sees
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!tx.valid[i]) continue;
+    const float c = glm::dot(tx.normal[i], to_sun);
+    lit[i] = c > 0.05f ? gathered->direct[i].y / (650.0f * c) : -1.0f;
+  }
+  Sums all, total_direct, total_indirect;
+  std::map<std::string, Sums> by;
+  std::map<int, Sums> by_material, by_chart;
+  for (int y = 0; y < tx.height; ++y)
+    for (int x = 0; x < tx.width; ++x) {
+      const std::size_t i = tx.index(x, y);
+      if (!tx.valid[i]) continue;
+      const glm::dvec3 a_d(gathered->direct[i] + gathered->baked_direct[i]), a_i(gathered->indirect[i]);
+      const glm::dvec3 a = a_d + a_i;
+      const glm::dvec3 r1 = glm::dvec3(rd[0][i] + ri[0][i]), r2 = glm::dvec3(rd[1][i] + ri[1][i]);
+      const glm::dvec3 dd = a_d - 0.5 * glm::dvec3(rd[0][i] + rd[1][i]),
+                       di = a_i - 0.5 * glm::dvec3(ri[0][i] + ri[1][i]);
+      const auto into = [&](Sums& sums) {
+        sums.add(a, r1, r2);
+        sums.add_parts(dd, di);
+      };
+      into(all);
+      total_direct.add(a_d, glm::dvec3(rd[0][i]), glm::dvec3(rd[1][i]));
+      total_indirect.add(a_i, glm::dvec3(ri[0][i]), glm::dvec3(ri[1][i]));
+      bool border = false, edge = false;
+      for (int k = 0; k < 9; ++k) {
+        const int nx = x + k % 3 - 1, ny = y + k / 3 - 1;
+        if (nx < 0 || ny < 0 || nx >= tx.width || ny >= tx.height || !tx.valid[tx.index(nx, ny)] ||
+            tx.chart[tx.index(nx, ny)] != tx.chart[i]) {
+          border = true;
+          continue;
+        }
+        const float l = lit[tx.index(nx, ny)];
+        if (lit[i] >= 0.0f && l >= 0.0f && std::fabs(l - lit[i]) > 0.2f) edge = true;
+      }
+      const bool penumbra = lit[i] > 0.02f && lit[i] < 0.98f;
+      const std::string kind = gathered->hidden[i] ? "hidden (back faces)"
+                               : edge || penumbra  ? "sun shadow edge"
+                               : border            ? "chart border"
+                               : lit[i] >= 0.98f   ? "sunlit interior"
+                               : glm::length(gathered->baked_direct[i]) > 0.0f && glm::length(a_i) == 0.0
+                                   ? "sky only"
+                                   : "shade interior";
+      into(by[kind]);
+      const gi::ShadingTriangle& tri =
+          scene->index
+              .triangles[scene->index.instance_first[scene->static_instance[static_cast<std::size_t>(tx.mesh[i])]] +
+                         static_cast<std::uint32_t>(tx.triangle[i])];
+      into(by[glm::dot(tri.face_normal, tx.normal[i]) < 0.996f ? "normal > 5 deg off face" : "normal on face"]);
+      into(by_material[static_cast<int>(tri.material)]);
+      const glm::ivec2 sz = layout->charts[static_cast<std::size_t>(tx.chart[i])].size;
+      into(by_chart[sz.x * sz.y <= 16 ? 16 : sz.x * sz.y <= 64 ? 64 : sz.x * sz.y <= 256 ? 256 : 1 << 30]);
+    }
+  // GI_BREAKDOWN_TEXEL=i: 16 rays from texel i, where they land and the texel the atlas reads there.
+  if (const char* probe = std::getenv("GI_BREAKDOWN_TEXEL")) {
+    const std::size_t i = std::strtoul(probe, nullptr, 10);
+    const gi::ShadingTriangle& own =
+        scene->index
+            .triangles[scene->index.instance_first[scene->static_instance[static_cast<std::size_t>(tx.mesh[i])]] +
+                       static_cast<std::uint32_t>(tx.triangle[i])];
+    const glm::vec3 face = glm::dot(own.face_normal, tx.normal[i]) < 0.0f ? -own.face_normal : own.face_normal;
+    const glm::vec3 origin = gi::offset_ray_origin(tx.position[i], face);
+    for (int r = 0; r < 16; ++r) {
+      const glm::vec3 wi = gi::sample_cosine_hemisphere(tx.normal[i], (static_cast<float>(r) + 0.5f) / 16.0f,
+                                                        std::fmod(0.618034f * static_cast<float>(r), 1.0f));
+      const gi::Hit h = scene->caster->intersect(gi::Ray{origin, 0.0f, wi});
+      if (!h.valid()) {
+        std::printf("ray %d: sky\n", r);
+        continue;
+      }
+      const gi::ShadingTriangle& tri = scene->index.triangles[scene->triangle_of(h)];
+      const glm::vec3 p = tri.p0 + h.barycentric.x * tri.e1 + h.barycentric.y * tri.e2;
+      const gi::AtlasMeshUv& mu = layout->meshes[h.instance];
+      const std::uint32_t* idx = &mu.indices[3u * h.primitive];
+      const glm::vec2 uv = (1.0f - h.barycentric.x - h.barycentric.y) * mu.uv1[idx[0]] +
+                           h.barycentric.x * mu.uv1[idx[1]] + h.barycentric.y * mu.uv1[idx[2]];
+      const std::size_t j = tx.index(std::min(static_cast<int>(uv.x * static_cast<float>(tx.width)), tx.width - 1),
+                                     std::min(static_cast<int>(uv.y * static_cast<float>(tx.height)), tx.height - 1));
+      std::printf("ray %d: t %.3f %s hit (%.3f %.3f %.3f) texel %zu valid %d at (%.3f %.3f %.3f) total %.1f\n", r,
+                  static_cast<double>(h.t), glm::dot(tri.face_normal, wi) < 0.0f ? "front" : "back",
+                  static_cast<double>(p.x), static_cast<double>(p.y), static_cast<double>(p.z), j, tx.valid[j],
+                  static_cast<double>(tx.position[j].x), static_cast<double>(tx.position[j].y),
+                  static_cast<double>(tx.position[j].z),
+                  static_cast<double>(gathered->direct[j].y + gathered->baked_direct[j].y + gathered->indirect[j].y));
+    }
+  }
+  // GI_BREAKDOWN_WORST=N: the N texels of the largest error, one line each.
+  if (const char* worst = std::getenv("GI_BREAKDOWN_WORST")) {
+    std::vector<std::pair<double, std::size_t>> err;
+    for (std::size_t i = 0; i < n; ++i)
+      if (tx.valid[i]) {
+        const double a =
+            static_cast<double>(gathered->direct[i].y + gathered->baked_direct[i].y + gathered->indirect[i].y);
+        const double r = 0.5 * static_cast<double>(rd[0][i].y + ri[0][i].y + rd[1][i].y + ri[1][i].y);
+        err.emplace_back(std::fabs(a - r), i);
+      }
+    std::sort(err.rbegin(), err.rend());
+    for (std::size_t k = 0; k < std::min<std::size_t>(err.size(), std::strtoul(worst, nullptr, 10)); ++k) {
+      const std::size_t i = err[k].second;
+      std::printf(
+          "texel %zu (%d, %d) chart %d hidden %d p (%.3f %.3f %.3f) n (%.3f %.3f %.3f): gather direct %.2f + %.2f "
+          "indirect %.2f; path tracer direct %.2f / %.2f indirect %.2f / %.2f\n",
+          i, static_cast<int>(i % static_cast<std::size_t>(tx.width)),
+          static_cast<int>(i / static_cast<std::size_t>(tx.width)), tx.chart[i], gathered->hidden[i],
+          static_cast<double>(tx.position[i].x), static_cast<double>(tx.position[i].y),
+          static_cast<double>(tx.position[i].z), static_cast<double>(tx.normal[i].x),
+          static_cast<double>(tx.normal[i].y), static_cast<double>(tx.normal[i].z),
+          static_cast<double>(gathered->direct[i].y), static_cast<double>(gathered->baked_direct[i].y),
+          static_cast<double>(gathered->indirect[i].y), static_cast<double>(rd[0][i].y),
+          static_cast<double>(rd[1][i].y), static_cast<double>(ri[0][i].y), static_cast<double>(ri[1][i].y));
+    }
+  }
+  std::printf("%s at %.1f texels/m, preset %s, truth 2 x %d spp\n", argv[1], static_cast<double>(density),
+              preset.c_str(), spp);
+  std::printf(
+      "| texels | n | rel err vs truth | bias | of it direct | of it indirect | share of the whole error | ref noise "
+      "|\n|---|---|---|---|---|---|---|---|\n");
+  row("all (total)", all, all.ref2 - all.noise2);
+  row("direct part (sun + sky)", total_direct, all.ref2 - all.noise2);
+  row("indirect part", total_indirect, all.ref2 - all.noise2);
+  for (const auto& [k, v] : by) row(k.c_str(), v, all.ref2 - all.noise2);
+  for (const auto& [k, v] : by_chart)
+    row(("chart <= " + std::to_string(k) + " texels").c_str(), v, all.ref2 - all.noise2);
+  for (const auto& [k, v] : by_material) row(("material " + std::to_string(k)).c_str(), v, all.ref2 - all.noise2);
+  return 0;
+}
