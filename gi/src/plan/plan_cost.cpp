@@ -33,8 +33,18 @@ constexpr double kAtlasCpuPerDirectRay = 1.0e-7;  // s; cornell_box preview (128
 constexpr double kAtlasCpuOverhead = 0.05;        // s; layout, rasterization, files
 // Final gather (texel_gather.h): every lit texel casts its kept and fresh rays (closest hit)
 // and its direct-light shadow rays; the solve's iterations and the filter are lookups.
+// Rays per texel: TexelGatherSettings' kept (solve_rays) and fresh (gather_rays) rays, one
+// shadow ray per punctual or directional light, direct_samples per texel when area lights
+// are sampled (gather_rays_per_texel below; a new per-texel ray count of the gather belongs there).
 constexpr double kAtlasCpuPerGatherRay =
     2.3e-7;  // s; demo_level preview 7.9 M rays in 0.92 s wall, medium 59.6 M in 6.5 s (2 threads)
+// A ray costs more in a larger scene once its BVH no longer stays in cache: flat from the spot
+// chamber (24 triangles, 2.0e-7 s per ray at medium) to the demo level (~2300, 2.2e-7), then
+// +12% per doubling of the triangles: Dabrovic Sponza (66k triangles, 5 doublings above)
+// costs 1.6x per ray (its quiet bakes, 18.7 s preview and 64.5 s medium, against 11.6 s and
+// 40.5 s from the flat cost; docs/plan.md "Calibration").
+constexpr double kAtlasCacheTriangles = 2048.0;
+constexpr double kAtlasRayCostPerDoubling = 0.12;
 
 // PRM (gi/src/prm): every path node (virtual light) is connected to every pane texel facing
 // it by one shadow ray; nodes = E x N_s x a / (1 - a) for a mean albedo a.
@@ -70,6 +80,20 @@ constexpr double kDlmTexelBytesPerDirection = 8.0;
 
 double wall_seconds(double parallel_cpu, double serial_cpu) { return parallel_cpu / 2.0 + serial_cpu; }
 
+// The final gather's rays per lit texel (TexelGatherSettings' ray counts and the lights).
+double gather_rays_per_texel(const TexelGatherSettings& g, const LightPointCount& lights) {
+  // Emitter rays (opt-in, 0 in every preset) counted as one gather ray each: not calibrated
+  // (on loaded cores one cost 2-3 cosine rays on Sponza; docs/light_atlas.md).
+  return g.solve_rays + g.gather_rays + g.emitter_rays + lights.punctual + lights.directional +
+         static_cast<double>(lights.sampled > 0 ? g.direct_samples : 0);
+}
+
+// CPU seconds per gather ray in a scene of `triangles` (kAtlasCacheTriangles above).
+double gather_cpu_per_ray(std::size_t triangles) {
+  const double doublings = std::max(0.0, std::log2(static_cast<double>(triangles) / kAtlasCacheTriangles));
+  return kAtlasCpuPerGatherRay * (1.0 + kAtlasRayCostPerDoubling * doublings);
+}
+
 }  // namespace
 
 AtlasTexelEstimate atlas_texels(const StaticSurfaceCensus& census, float texels_per_metre) {
@@ -99,12 +123,11 @@ BakeWork light_atlas_work(const StaticSurfaceCensus& census, const LightAtlasSet
   BakeWork w;
   const AtlasTexelEstimate t = atlas_texels(census, s.texels_per_metre);
   if (s.final_pass == LightAtlasSettings::FinalPass::TexelGather) {
-    const double per_texel = s.gather.solve_rays + s.gather.gather_rays + s.gather.emitter_rays + lights.punctual +
-                             lights.directional + static_cast<double>(lights.sampled > 0 ? s.gather.direct_samples : 0);
-    w.rays = t.lit_texels * per_texel;
+    w.rays = t.lit_texels * gather_rays_per_texel(s.gather, lights);
     w.units = w.rays;
-    w.cpu_seconds = w.rays * kAtlasCpuPerGatherRay + kAtlasCpuOverhead;
-    w.bake_seconds = wall_seconds(w.rays * kAtlasCpuPerGatherRay, kAtlasCpuOverhead);
+    const double parallel = w.rays * gather_cpu_per_ray(census.triangles);
+    w.cpu_seconds = parallel + kAtlasCpuOverhead;
+    w.bake_seconds = wall_seconds(parallel, kAtlasCpuOverhead);
     w.runtime_bytes = static_cast<std::uint64_t>(static_cast<double>(t.width) * t.height * kAtlasTexelBytes);
     return w;
   }

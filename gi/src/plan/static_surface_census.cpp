@@ -129,6 +129,7 @@ StaticSurfaceCensus census_static_surfaces(const BakeInput& input) {
         for (int a = 0; a < 3; ++a) key = mix(key, cell(t.normal[a], 1.0 / kNormalCells));
         t.plane = mix(key, cell(glm::dot(t.normal, t.p[0]), kOffsetCell_m));
         census.area_m2 += t.area;
+        ++census.triangles;
         albedo_area += luminance(double{base.x}, double{base.y}, double{base.z}) * t.area;
         tris.push_back(t);
       }

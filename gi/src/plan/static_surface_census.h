@@ -22,7 +22,8 @@ struct ChartExtent {
 
 struct StaticSurfaceCensus {
   double area_m2 = 0.0;
-  double albedo = 0.0;  ///< Area-weighted mean luminance of the base colour factors.
+  double albedo = 0.0;        ///< Area-weighted mean luminance of the base colour factors.
+  std::size_t triangles = 0;  ///< Non-degenerate triangles (the bake's ray-tracing scene size).
   std::vector<ChartExtent> charts;
 };
 
