@@ -109,7 +109,8 @@ engine::Result<MethodOutput> run_pathtracer_atlas(const RunContext& ctx) {
 }  // namespace
 
 void register_atlas_truth_sweep(SweepRegistry& registry) {
-  registry.add_reference_provider({.kind = "atlas_split_truth", .version = "pt2-1", .compute = compute_split_truth});
+  // pt2-2: rays below a texel's face are dropped (reference_sweep.cpp, pt-3).
+  registry.add_reference_provider({.kind = "atlas_split_truth", .version = "pt2-2", .compute = compute_split_truth});
 
   SweepMethod m;
   m.name = "pathtracer_atlas";

@@ -86,8 +86,10 @@ void register_reference_sweep(SweepRegistry& registry) {
   registry.add_reference_provider({.kind = "camera_image", .version = "pt-1", .compute = [](const ReferenceJob& job) {
                                      return render_camera(job.scene, job.request, reference_settings(job));
                                    }});
+  // pt-3: a texel's rays below its triangle's face are dropped (the shading normal may lean off
+  // it; pt-2 counted the front of the texel's own surface as indirect light).
   registry.add_reference_provider(
-      {.kind = "atlas_indirect_irradiance", .version = "pt-2", .compute = [](const ReferenceJob& job) {
+      {.kind = "atlas_indirect_irradiance", .version = "pt-3", .compute = [](const ReferenceJob& job) {
          return atlas_indirect(job.scene, job.request, reference_settings(job));
        }});
 
