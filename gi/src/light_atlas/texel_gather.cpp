@@ -13,8 +13,11 @@
 
 #include "core/random.h"
 #include "core/stopwatch.h"
+#include "light_atlas/texel_cells.h"
+#include "light_atlas/texel_direct.h"
 #include "light_atlas/texel_emitters.h"
-#include "raytrace/light_falloff.h"
+#include "light_atlas/texel_filter.h"
+#include "light_atlas/texel_sampling.h"
 #include "raytrace/material_lookup.h"
 #include "raytrace/ray_offset.h"
 #include "raytrace/reference_brdf.h"
@@ -40,24 +43,6 @@ constexpr float kGapTexels = 0.05f;
 // Item ids of the four random streams of a texel.
 constexpr std::uint64_t kDirectStream = 0, kSolveStream = 1, kGatherStream = 2, kEmitterStream = 3;
 std::uint64_t stream_id(std::uint64_t texel, std::uint64_t stream) { return texel * 4 + stream; }
-
-float radical_inverse(std::uint32_t i) {
-  i = (i << 16u) | (i >> 16u);
-  i = ((i & 0x55555555u) << 1u) | ((i & 0xAAAAAAAAu) >> 1u);
-  i = ((i & 0x33333333u) << 2u) | ((i & 0xCCCCCCCCu) >> 2u);
-  i = ((i & 0x0F0F0F0Fu) << 4u) | ((i & 0xF0F0F0F0u) >> 4u);
-  i = ((i & 0x00FF00FFu) << 8u) | ((i & 0xFF00FF00u) >> 8u);
-  return static_cast<float>(i >> 8) * 0x1p-24f;
-}
-
-// Point i of an n-point Hammersley set, shifted on the torus (Cranley-Patterson rotation):
-// stratified in both dimensions for any n, decorrelated between texels by the shift.
-glm::vec2 hammersley(std::uint32_t i, std::uint32_t n, glm::vec2 shift) {
-  const glm::vec2 u((static_cast<float>(i) + 0.5f) / static_cast<float>(n), radical_inverse(i));
-  glm::vec2 s = u + shift;
-  s -= glm::floor(s);
-  return glm::min(s, glm::vec2(0x1.fffffep-1f));
-}
 
 engine::Status validate(const TexelGatherSettings& s) {
   const auto bad = [](const std::string& what) { return engine::invalid_request("texel gather settings: " + what); };
@@ -193,138 +178,6 @@ std::uint32_t landing(const StaticBakeScene& b, const AtlasLayout& layout, const
   return l.texel;
 }
 
-// Step 1 at one texel, light sampling only: `live`, every static light and the emissive
-// triangles that stand for an area light (the renderer draws those lights); `unlit`, the
-// emissive triangles no light stands for (the renderer draws no light of theirs).
-struct DirectAt {
-  glm::vec3 live{0.0f}, unlit{0.0f};
-};
-// The light sampling of one texel: its point, normals and ray origin, the samples per light
-// (each weighing inv = 1 / samples) and the shadow rays counted.
-struct TexelLighting {
-  const StaticBakeScene& b;
-  glm::vec3 p, n, face, origin;
-  int samples;
-  double inv;
-  std::uint64_t* rays;
-};
-
-// An area light without emissive geometry: `samples` stratified points over its rectangle.
-void sample_area_light(const TexelLighting& t, const ReferenceLight& l, Pcg32& rng, glm::dvec3& sum) {
-  const float area = 4.0f * glm::length(l.half_x) * glm::length(l.half_y);
-  const float shift_y = rng.next_float();  // drawn first: see random.h
-  const glm::vec2 shift(rng.next_float(), shift_y);
-  for (int s = 0; s < t.samples; ++s) {
-    const glm::vec2 u = hammersley(static_cast<std::uint32_t>(s), static_cast<std::uint32_t>(t.samples), shift);
-    const glm::vec3 q = l.position + (2.0f * u.x - 1.0f) * l.half_x + (2.0f * u.y - 1.0f) * l.half_y;
-    const glm::vec3 to = q - t.p;
-    const float d2 = glm::dot(to, to);
-    if (!(d2 > 0.0f)) continue;
-    const glm::vec3 wi = to / std::sqrt(d2);
-    const float cos_l = -glm::dot(wi, l.direction), cos_r = glm::dot(wi, t.n);
-    if (cos_l <= 0.0f || cos_r <= 0.0f || glm::dot(wi, t.face) <= 0.0f) continue;
-    ++*t.rays;
-    if (t.b.caster->occluded(Ray{t.origin, 0.0f, q - t.origin, 1.0f})) continue;
-    sum += glm::dvec3(l.radiant * (cos_r * cos_l * area / d2)) * t.inv;
-  }
-}
-
-// A disc (the sun's angular radius): `samples` stratified directions uniform over its
-// cone, each carrying radiant / samples; soft shadows (docs/scene-format.md).
-void sample_sun_disc(const TexelLighting& t, const ReferenceLight& l, Pcg32& rng, glm::dvec3& sum) {
-  const float shift_y = rng.next_float();  // drawn first: see random.h
-  const glm::vec2 shift(rng.next_float(), shift_y);
-  for (int s = 0; s < t.samples; ++s) {
-    const glm::vec2 u = hammersley(static_cast<std::uint32_t>(s), static_cast<std::uint32_t>(t.samples), shift);
-    const glm::vec3 wi = sample_cone(-l.direction, l.cos_disc, u.x, u.y);
-    const float cos_r = glm::dot(wi, t.n);
-    if (cos_r <= 0.0f || glm::dot(wi, t.face) <= 0.0f) continue;
-    ++*t.rays;
-    if (t.b.caster->occluded(Ray{t.origin, 0.0f, wi, std::numeric_limits<float>::infinity()})) continue;
-    sum += glm::dvec3(l.radiant * cos_r) * t.inv;
-  }
-}
-
-// A point, spot or sharp directional light: one shadow ray.
-void sample_point_light(const TexelLighting& t, const ReferenceLight& l, glm::dvec3& sum) {
-  glm::vec3 wi;
-  float atten = 1.0f, t_max = 1.0f;
-  glm::vec3 dir;
-  if (l.type == ReferenceLight::Type::Directional) {
-    wi = -l.direction;
-    dir = wi;
-    t_max = std::numeric_limits<float>::infinity();
-  } else {
-    const glm::vec3 to = l.position - t.p;
-    const float d2 = std::max(glm::dot(to, to), 1e-12f);
-    const float d = std::sqrt(d2);
-    wi = to / d;
-    atten = range_window(d, l.range_m) / d2;
-    if (l.type == ReferenceLight::Type::Spot) atten *= spot_cone(l.direction, l.cos_outer, l.cos_inner, wi);
-    dir = l.position - t.origin;
-  }
-  const float cos_r = glm::dot(wi, t.n);
-  if (atten <= 0.0f || cos_r <= 0.0f || glm::dot(wi, t.face) <= 0.0f) return;
-  ++*t.rays;
-  if (t.b.caster->occluded(Ray{t.origin, 0.0f, dir, t_max})) return;
-  sum += glm::dvec3(l.radiant * (atten * cos_r));
-}
-
-// The emissive triangles: `samples` stratified picks by power, each a stratified point; into
-// `sum` for those that stand for a light, `unlit` for the others.
-void sample_emitters(const TexelLighting& t, Pcg32& rng, glm::dvec3& sum, glm::dvec3& unlit) {
-  const StaticBakeScene& b = t.b;
-  const EmitterTable& em = b.index.emitters;
-  const float shift_y = rng.next_float();  // drawn first: see random.h
-  const glm::vec2 shift(rng.next_float(), shift_y);
-  const float pick_shift = rng.next_float();
-  for (int s = 0; s < t.samples; ++s) {
-    float u_pick = (static_cast<float>(s) + pick_shift) / static_cast<float>(t.samples);
-    u_pick = std::min(u_pick, 0x1.fffffep-1f);
-    const auto k = static_cast<std::size_t>(std::lower_bound(em.cdf.begin(), em.cdf.end(), u_pick) - em.cdf.begin());
-    const std::size_t pick = std::min(k, em.triangle.size() - 1);
-    const ShadingTriangle& tri = b.index.triangles[em.triangle[pick]];
-    const ReferenceMaterial& mat = b.scene.materials[tri.material];
-    const float prob = em.probability[pick];
-    const glm::vec2 u = hammersley(static_cast<std::uint32_t>(s), static_cast<std::uint32_t>(t.samples), shift);
-    const float su = std::sqrt(u.x);
-    const glm::vec3 q = tri.p0 + su * (1.0f - u.y) * tri.e1 + su * u.y * tri.e2;
-    const glm::vec3 to = q - t.p;
-    const float d2 = glm::dot(to, to);
-    if (!(d2 > 0.0f) || !(prob > 0.0f)) continue;
-    const glm::vec3 wi = to / std::sqrt(d2);
-    float cos_l = -glm::dot(wi, tri.face_normal);
-    if (mat.double_sided) cos_l = std::fabs(cos_l);
-    const float cos_r = glm::dot(wi, t.n);
-    if (cos_l <= 0.0f || cos_r <= 0.0f || glm::dot(wi, t.face) <= 0.0f) continue;
-    ++*t.rays;
-    if (b.caster->occluded(Ray{t.origin, 0.0f, q - t.origin, 0.9999f})) continue;
-    const glm::vec3 emission = emission_at(b.scene, tri, glm::vec2(su * (1.0f - u.y), su * u.y), 0.0f);
-    (em.stands_for_light[pick] != 0 ? sum : unlit) +=
-        glm::dvec3(emission * (cos_r * cos_l * tri.area_m2 / (prob * d2))) * t.inv;
-  }
-}
-
-DirectAt direct_at(const StaticBakeScene& b, const glm::vec3& p, const glm::vec3& n, const glm::vec3& face, int samples,
-                   Pcg32& rng, std::uint64_t* rays) {
-  const TexelLighting t{b, p, n, face, offset_ray_origin(p, face), samples, 1.0 / static_cast<double>(samples), rays};
-  glm::dvec3 sum(0.0);
-  for (std::size_t i = 0; i < b.scene.lights.size(); ++i) {
-    const ReferenceLight& l = b.scene.lights[i];
-    if (l.type == ReferenceLight::Type::Area) {
-      if (!b.index.light_has_proxy[i]) sample_area_light(t, l, rng, sum);  // else its emissive geometry stands for it
-    } else if (l.type == ReferenceLight::Type::Directional && l.cos_disc < 1.0f) {
-      sample_sun_disc(t, l, rng, sum);
-    } else {
-      sample_point_light(t, l, sum);
-    }
-  }
-  if (b.index.emitters.triangle.empty()) return {glm::vec3(sum), glm::vec3(0.0f)};
-  glm::dvec3 unlit(0.0);
-  sample_emitters(t, rng, sum, unlit);
-  return {glm::vec3(sum), glm::vec3(unlit)};
-}
-
 glm::vec3 bilinear(const std::vector<glm::vec3>& img, int w, int h, glm::vec2 uv) {
   const float fx = uv.x * static_cast<float>(w) - 0.5f, fy = uv.y * static_cast<float>(h) - 0.5f;
   const float x0f = std::floor(fx), y0f = std::floor(fy);
@@ -340,93 +193,6 @@ glm::vec3 bilinear(const std::vector<glm::vec3>& img, int w, int h, glm::vec2 uv
 }
 
 float max_abs(const glm::vec3& v) { return std::max(std::fabs(v.x), std::max(std::fabs(v.y), std::fabs(v.z))); }
-
-// Texels bucketed by their sample position into cubic cells (exact integer cells, sorted,
-// texels ascending within a cell): the world-space neighbourhoods of the filter and of point
-// lookups, visited in a fixed order (bit-identical for any thread count).
-class TexelCells {
- public:
-  TexelCells(const AtlasTexels& tx, std::span<const std::uint32_t> texels, float cell_m) : cell_(cell_m) {
-    for (std::uint32_t i : texels) entries_.push_back({cell_of(tx.position[i]), i});
-    std::sort(entries_.begin(), entries_.end(), [](const Entry& a, const Entry& b) {
-      return before(a.cell, b.cell) || (a.cell == b.cell && a.texel < b.texel);
-    });
-    for (std::size_t k = 0; k < entries_.size(); ++k)
-      if (k == 0 || entries_[k].cell != entries_[k - 1].cell) cells_.push_back(entries_[k].cell), first_.push_back(k);
-    first_.push_back(entries_.size());
-  }
-  std::size_t cell_count() const { return cells_.size(); }
-  /// Calls fn(texel) for every texel of cell k.
-  template <class Fn>
-  void for_cell(std::size_t k, Fn&& fn) const {
-    for (std::size_t m = first_[k]; m < first_[k + 1]; ++m) fn(entries_[m].texel);
-  }
-  /// Calls fn(texel) for every texel in the 27 cells around cell c (dz, dy, dx order).
-  template <class Fn>
-  void for_around(const glm::ivec3& c, Fn&& fn) const {
-    for (int dz = -1; dz <= 1; ++dz)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx) {
-          const glm::ivec3 cc = c + glm::ivec3(dx, dy, dz);
-          const auto it = std::lower_bound(cells_.begin(), cells_.end(), cc, before);
-          if (it != cells_.end() && *it == cc) for_cell(static_cast<std::size_t>(it - cells_.begin()), fn);
-        }
-  }
-  const glm::ivec3& cell(std::size_t k) const { return cells_[k]; }
-  glm::ivec3 cell_of(const glm::vec3& p) const { return glm::ivec3(glm::floor(p / cell_)); }
-
- private:
-  struct Entry {
-    glm::ivec3 cell;
-    std::uint32_t texel;
-  };
-  static bool before(const glm::ivec3& a, const glm::ivec3& b) {
-    return a.z != b.z ? a.z < b.z : a.y != b.y ? a.y < b.y : a.x < b.x;
-  }
-  float cell_;
-  std::vector<Entry> entries_;
-  std::vector<glm::ivec3> cells_;
-  std::vector<std::size_t> first_;  // cell k holds entries_[first_[k], first_[k + 1])
-};
-
-// Step 4: Gaussian over texels on the same plane within the radius, across chart borders.
-// Each cell (of the radius) gathers its 27 neighbour cells' texels once and filters all of
-// its own texels against them.
-std::vector<glm::vec3> filter_world(const AtlasTexels& tx, const TexelTable& t, const std::vector<glm::vec3>& e,
-                                    const std::vector<std::uint8_t>& hidden, float radius_m, float texel_m,
-                                    ThreadPool& pool) {
-  std::vector<std::uint32_t> visible;
-  for (std::uint32_t i : t.work)
-    if (!hidden[i]) visible.push_back(i);
-  const TexelCells cells(tx, visible, radius_m);
-  std::vector<glm::vec3> out = e;
-  const float r2 = radius_m * radius_m, plane = 0.5f * texel_m;
-  pool.parallel_for(
-      cells.cell_count(),
-      [&](std::size_t c) {
-        struct Candidate {
-          glm::vec3 position, normal, value;
-        };
-        std::vector<Candidate> near;
-        cells.for_around(cells.cell(c), [&](std::uint32_t j) { near.push_back({tx.position[j], tx.normal[j], e[j]}); });
-        cells.for_cell(c, [&](std::uint32_t i) {
-          const glm::vec3 p = tx.position[i], n = tx.normal[i];
-          glm::vec3 sum(0.0f);
-          float weight = 0.0f;
-          for (const Candidate& q : near) {
-            const glm::vec3 d = q.position - p;
-            const float d2 = glm::dot(d, d);
-            if (d2 > r2 || glm::dot(q.normal, n) < 0.95f || std::fabs(glm::dot(d, n)) > plane) continue;
-            const float w = std::exp(-2.0f * d2 / r2);
-            sum += q.value * w;
-            weight += w;
-          }
-          if (weight > 0.0f) out[i] = sum / weight;
-        });
-      },
-      4);
-  return out;
-}
 
 }  // namespace
 
@@ -618,8 +384,8 @@ bool final_gather(const StaticBakeScene& b, const AtlasLayout& layout, const Tex
 // Step 4 on both filtered fields (indirect and the baked direct light).
 void filter_result(const AtlasTexels& tx, const TexelTable& t, float radius_m, float texel_m, ThreadPool& pool,
                    TexelGatherResult& out) {
-  out.indirect = filter_world(tx, t, out.indirect, out.hidden, radius_m, texel_m, pool);
-  out.baked_direct = filter_world(tx, t, out.baked_direct, out.hidden, radius_m, texel_m, pool);
+  out.indirect = filter_world(tx, t.work, out.indirect, out.hidden, radius_m, texel_m, pool);
+  out.baked_direct = filter_world(tx, t.work, out.baked_direct, out.hidden, radius_m, texel_m, pool);
 }
 
 }  // namespace
@@ -678,7 +444,8 @@ engine::Result<TexelGatherResult> gather_atlas(const StaticBakeScene& b, const A
   if (s.gather_rays > 0 || s.emitter_rays > 0) {
     // The gather reads the solve's light filtered too: its noise would otherwise come back
     // as blotches a few texels wide (a bright texel lights its neighbours' rays).
-    const std::vector<glm::vec3> source = filtering ? filter_world(tx, t, e, kept.hidden, radius_m, texel_m, pool) : e;
+    const std::vector<glm::vec3> source =
+        filtering ? filter_world(tx, t.work, e, kept.hidden, radius_m, texel_m, pool) : e;
     std::vector<glm::vec3> reflected(n, glm::vec3(0.0f));
     for (std::uint32_t i : t.work) reflected[i] = t.albedo[i] * (emitted[i] + source[i]);
     std::optional<TexelEmitters> emitters;

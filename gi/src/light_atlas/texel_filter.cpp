@@ -1,0 +1,49 @@
+#include "light_atlas/texel_filter.h"
+
+#include <cmath>
+
+#include "light_atlas/texel_cells.h"
+
+namespace gi {
+
+// Step 4: Gaussian over texels on the same plane within the radius, across chart borders.
+// Each cell (of the radius) gathers its 27 neighbour cells' texels once and filters all of
+// its own texels against them.
+std::vector<glm::vec3> filter_world(const AtlasTexels& tx, std::span<const std::uint32_t> work,
+const std::vector<glm::vec3>& e,
+                                    const std::vector<std::uint8_t>& hidden, float radius_m, float texel_m,
+                                    ThreadPool& pool) {
+  std::vector<std::uint32_t> visible;
+  for (std::uint32_t i : work)
+    if (!hidden[i]) visible.push_back(i);
+  const TexelCells cells(tx, visible, radius_m);
+  std::vector<glm::vec3> out = e;
+  const float r2 = radius_m * radius_m, plane = 0.5f * texel_m;
+  pool.parallel_for(
+      cells.cell_count(),
+      [&](std::size_t c) {
+        struct Candidate {
+          glm::vec3 position, normal, value;
+        };
+        std::vector<Candidate> near;
+        cells.for_around(cells.cell(c), [&](std::uint32_t j) { near.push_back({tx.position[j], tx.normal[j], e[j]}); });
+        cells.for_cell(c, [&](std::uint32_t i) {
+          const glm::vec3 p = tx.position[i], n = tx.normal[i];
+          glm::vec3 sum(0.0f);
+          float weight = 0.0f;
+          for (const Candidate& q : near) {
+            const glm::vec3 d = q.position - p;
+            const float d2 = glm::dot(d, d);
+            if (d2 > r2 || glm::dot(q.normal, n) < 0.95f || std::fabs(glm::dot(d, n)) > plane) continue;
+            const float w = std::exp(-2.0f * d2 / r2);
+            sum += q.value * w;
+            weight += w;
+          }
+          if (weight > 0.0f) out[i] = sum / weight;
+        });
+      },
+      4);
+  return out;
+}
+
+}  // namespace gi
