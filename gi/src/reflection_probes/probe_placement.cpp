@@ -3,10 +3,13 @@
 #include <algorithm>
 #include <cmath>
 #include <optional>
+#include <vector>
 
 namespace gi {
 
 namespace {
+
+constexpr int kBundleSide = 5;  // rays per side of a bundle (odd: one ray through the centre)
 
 struct Reach {
   float distance = 0.0f;  ///< To the nearest hit of the bundle, or to the world's bounds.
@@ -30,18 +33,23 @@ Reach reach(const RayCaster& caster, const glm::vec3& p, int side, const glm::ve
   const glm::vec3 d = axis_direction(side);
   const int a = side / 2;
   const int ua = (a + 1) % 3, va = (a + 2) % 3;
+  const float bound = to_bounds(p, side, lo, hi);
   Reach r;
-  r.distance = to_bounds(p, side, lo, hi);
-  for (int j = -1; j <= 1; ++j)
-    for (int i = -1; i <= 1; ++i) {
+  std::vector<float> distances;
+  const int half = kBundleSide / 2;
+  for (int j = -half; j <= half; ++j)
+    for (int i = -half; i <= half; ++i) {
       glm::vec3 o = p;
-      o[ua] += static_cast<float>(i) * spread;
-      o[va] += static_cast<float>(j) * spread;
-      const Hit h = caster.intersect(Ray{o, 0.0f, d, r.distance});
-      if (!h.valid()) continue;
-      if (i == 0 && j == 0 && glm::dot(h.geometric_normal, d) > 0.0f) r.inside = true;
-      r.distance = std::min(r.distance, h.t);
+      o[ua] += static_cast<float>(i) * spread / static_cast<float>(std::max(half, 1));
+      o[va] += static_cast<float>(j) * spread / static_cast<float>(std::max(half, 1));
+      const Hit h = caster.intersect(Ray{o, 0.0f, d, bound});
+      if (i == 0 && j == 0 && h.valid() && glm::dot(h.geometric_normal, d) > 0.0f) r.inside = true;
+      distances.push_back(h.valid() ? std::min(h.t, bound) : bound);
     }
+  // The median: openings and obstacles that cover less than half the bundle do not count.
+  std::nth_element(distances.begin(), distances.begin() + static_cast<std::ptrdiff_t>(distances.size() / 2),
+                   distances.end());
+  r.distance = distances[distances.size() / 2];
   return r;
 }
 

@@ -6,10 +6,11 @@
 //
 // The rule: candidate points at the centres of a grid of cells of about cell_m over the
 // static world's bounds, visited in grid order (y, then z, then x). A candidate already
-// inside a placed probe's box is skipped. From the others, 6 bundles of 3 x 3 parallel
+// inside a placed probe's box is skipped. From the others, 6 bundles of 5 x 5 parallel
 // rays (spread +-spread_m across the ray) go along +-x, +-y, +-z; each side of the box is at
-// the nearest hit of its bundle, so an opening narrower than the bundle (a doorway) does not
-// open the box into the next room, while a wall closes it. A candidate whose centre rays hit
+// the median distance of its bundle, so an opening (a doorway) or an obstacle (a crate, a
+// column) that covers less than half the bundle neither opens the box into the next room nor
+// closes it in front of the wall. A candidate whose centre rays hit
 // a back face is inside solid geometry and places nothing; rays that escape stop at the
 // world's bounds (outdoors). The probe sits at its box's centre when that point is free,
 // else at the candidate. Boxes thinner than min_box_m are dropped.
@@ -24,7 +25,7 @@ namespace gi {
 
 struct ProbePlacementSettings {
   float cell_m = 4.0f;     ///< Candidate spacing: about a room's size (> 0).
-  float spread_m = 0.75f;  ///< Half-width of a ray bundle: openings narrower than 2 x this stay closed.
+  float spread_m = 1.0f;   ///< Half-width of a ray bundle: openings and obstacles under half of it do not count.
   float min_box_m = 0.5f;  ///< Smallest box side kept.
   int max_probes = 64;     ///< Placement stops at this many.
 };
