@@ -41,6 +41,7 @@
 #include "shadow_common.glsl"
 #include "directional_radiance.glsl"
 #include "material_common.glsl"
+#include "reflection_probes.glsl"
 
 in vec3 v_world;
 in vec3 v_normal;
@@ -221,6 +222,12 @@ void main() {
     }
     // A dynamic mesh's per-vertex radiance lobes replace the specular lobe's share (the diffuse keeps E).
     if (u_indirect_mode == 3 && u_lobe_terms > 0) specular = v_lobe_radiance;
+    // Reflection probes replace the specular share on sharp static surfaces and on dynamic
+    // meshes without their own lobes, where a probe's box holds the point (reflection_probes.glsl).
+    if (reads_probes(s, u_indirect_mode == 2, u_indirect_mode == 3 && u_lobe_terms == 0)) {
+      vec3 probe;
+      if (probe_specular(s, albedo.specular, probe)) specular = probe;
+    }
     if (u_use_glossy != 0) {
       vec4 glossy = texelFetch(u_glossy_radiance, ivec2(gl_FragCoord.xy), 0);
       specular = mix(specular, glossy.rgb, clamp(glossy.a, 0.0, 1.0));

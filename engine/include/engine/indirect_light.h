@@ -86,6 +86,17 @@ static_assert(sizeof(DirectionalBin) == 16 && offsetof(DirectionalBin, direction
                   offsetof(DirectionalBin, scale) == 12,
               "must match struct DirectionalBin in directional_radiance.glsl (std430)");
 
+/// One reflection probe (IndirectLightFrame::reflection_probe_buffer): where its cube map was
+/// captured and the axis-aligned box that stands for its room (parallax correction).
+struct ReflectionProbeBox {
+  glm::vec4 centre{0.0f};   ///< xyz: the capture point, world space (m); w: unused.
+  glm::vec4 box_min{0.0f};  ///< xyz: the box's low corner (m); w: unused.
+  glm::vec4 box_max{0.0f};  ///< xyz: the box's high corner (m); w: unused.
+};
+static_assert(sizeof(ReflectionProbeBox) == 48 && offsetof(ReflectionProbeBox, centre) == 0 &&
+                  offsetof(ReflectionProbeBox, box_min) == 16 && offsetof(ReflectionProbeBox, box_max) == 32,
+              "must match struct ReflectionProbeBox in reflection_probes.glsl (std430)");
+
 /// What a provider hands the renderer for one frame. The handles' GL objects are owned by the
 /// provider and stay valid until its next update; an empty handle means "not provided".
 struct IndirectLightFrame {
@@ -150,6 +161,23 @@ struct IndirectLightFrame {
   SsboHandle<DirectionalBin> directional_direction_buffer;
   int directional_bin_count = 0;
   int directional_element_count = 0;
+
+  /// Optional reflection probes (gi fills them from baked probes, docs/reflection_probes.md):
+  /// prefiltered cube maps of the static world's radiance, each with a box for parallax. On
+  /// static surfaces of roughness below reflection_probe_max_roughness and on dynamic meshes
+  /// without vertex_radiance_lobes, where the point lies in probes' boxes, the specular lobe's
+  /// share of the indirect light is replaced (not added to) by the probes' mean radiance along
+  /// the box-projected reflection direction, read at the mip of the roughness, times the
+  /// lobe's directional albedo (the split sum; engine/shaders/reflection_probes.glsl).
+  ///   reflection_probe_cubes   cube map array (RGBA16F), cube i = probe i, level m the
+  ///                            radiance (W/(m^2 sr)) prefiltered for roughness m / (levels - 1)
+  ///   reflection_probe_buffer  one ReflectionProbeBox per probe
+  /// Empty handles / 0 counts: none.
+  TextureHandle reflection_probe_cubes;
+  SsboHandle<ReflectionProbeBox> reflection_probe_buffer;
+  int reflection_probe_count = 0;
+  int reflection_probe_levels = 0;
+  float reflection_probe_max_roughness = 0.0f;
 
   /// Optional sky occlusion of a dynamic mesh entity (the renderer draws the sky on dynamic
   /// meshes as ambient light, RenderSettings::sky_radiance): the share (0..1) of the sky's unoccluded

@@ -356,6 +356,13 @@ ForwardRenderer::ForwardInputs ForwardRenderer::bind_forward_inputs(const Indire
     bind_ssbo(kDirectionalRadianceBinding, indirect->directional_radiance_buffer);
     bind_ssbo(kDirectionalDirectionBinding, indirect->directional_direction_buffer);
   }
+  // Reflection probes (IndirectLightFrame::reflection_probe_*), when provided.
+  in.probes = indirect != nullptr && indirect->reflection_probe_cubes && indirect->reflection_probe_buffer &&
+              indirect->reflection_probe_count > 0 && indirect->reflection_probe_levels > 0;
+  if (in.probes) {
+    glBindTextureUnit(kReflectionProbeUnit, indirect->reflection_probe_cubes.gl_name);
+    bind_ssbo(kReflectionProbeBinding, indirect->reflection_probe_buffer);
+  }
   const SkyGradient& sky = settings_.sky_gradient;
   const glm::vec3 zero(0.0f);
   in.has_sky = glm::any(glm::notEqual(settings_.sky_radiance, zero)) || glm::any(glm::notEqual(sky.horizon, zero)) ||
@@ -367,6 +374,9 @@ ForwardRenderer::ForwardInputs ForwardRenderer::bind_forward_inputs(const Indire
 void ForwardRenderer::set_forward_frame_uniforms(const ForwardUniforms& u, const ForwardInputs& in, bool blend) {
   glUniform1i(u.directional_bins, in.directional ? in.indirect->directional_bin_count : 0);
   glUniform1i(u.directional_elements, in.directional ? in.indirect->directional_element_count : 0);
+  glUniform1i(u.probe_count, in.probes ? in.indirect->reflection_probe_count : 0);
+  glUniform1i(u.probe_levels, in.probes ? in.indirect->reflection_probe_levels : 0);
+  glUniform1f(u.probe_max_roughness, in.probes ? in.indirect->reflection_probe_max_roughness : 0.0f);
   glUniformMatrix4fv(u.view_proj, 1, GL_FALSE, glm::value_ptr(in.view->view_proj));
   glUniform3fv(u.camera_position, 1, glm::value_ptr(in.view->position));
   glUniform1f(u.ambient_radiance, settings_.stand_in_ambient);

@@ -63,8 +63,10 @@ constexpr GLuint kDirectionalRadianceBinding = 2;  // directional_radiance.glsl
 constexpr GLuint kDirectionalDirectionBinding = 3;
 constexpr GLuint kLobeCoefficientsBinding = 6;  // forward.vert.glsl: IndirectLightFrame::vertex_radiance_lobes
 constexpr GLuint kLobeTableBinding = 7;
-constexpr GLuint kReachUnit = 9;      // depth_reach.frag.glsl (unit 0: the alpha test's base colour)
-constexpr float kReachVoxelM = 0.5f;  // light reach grid spacing (engine/light_reach.h)
+constexpr GLuint kReflectionProbeBinding = 8;  // reflection_probes.glsl: IndirectLightFrame::reflection_probe_buffer
+constexpr GLuint kReflectionProbeUnit = 16;    // reflection_probes.glsl: the probes' cube map array (8: the BRDF table)
+constexpr GLuint kReachUnit = 9;               // depth_reach.frag.glsl (unit 0: the alpha test's base colour)
+constexpr float kReachVoxelM = 0.5f;           // light reach grid spacing (engine/light_reach.h)
 
 // Nearest, clamped, no depth comparison: the 2-D shadow maps read as depths (the blocker
 // search of a directional light with a disc, shadow_common.glsl).
@@ -173,6 +175,7 @@ class ForwardRenderer final : public Renderer {
     GLuint atlas = 0;
     GLuint glossy = 0;
     bool directional = false;
+    bool probes = false;  ///< IndirectLightFrame::reflection_probe_* provided and bound.
     bool reach = false;
     bool has_sky = false;
   };

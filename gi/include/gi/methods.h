@@ -13,9 +13,16 @@
 
 namespace gi {
 
-/// The five methods of DESIGN.md §1, in that order.
-enum class EffectMethod : std::uint8_t { LightAtlas, Prm, DirectionalLightMaps, Antiradiance, BasisRadianceFields };
-inline constexpr int kEffectMethodCount = 5;
+/// The five methods of DESIGN.md §1, in that order, then the reflection probes.
+enum class EffectMethod : std::uint8_t {
+  LightAtlas,
+  Prm,
+  DirectionalLightMaps,
+  Antiradiance,
+  BasisRadianceFields,
+  ReflectionProbes
+};
+inline constexpr int kEffectMethodCount = 6;
 
 struct MethodDescriptor {
   EffectMethod method;
@@ -31,6 +38,7 @@ inline constexpr std::array<MethodDescriptor, kEffectMethodCount> kMethods{{
     {EffectMethod::DirectionalLightMaps, "dlm", "DLM", "docs/dlm.md"},
     {EffectMethod::Antiradiance, "antiradiance", "antiradiance", "docs/antiradiance.md"},
     {EffectMethod::BasisRadianceFields, "brf", "BRF", "docs/brf.md"},
+    {EffectMethod::ReflectionProbes, "reflection_probes", "reflection probes", "docs/reflection_probes.md"},
 }};
 
 constexpr const MethodDescriptor& method_descriptor(EffectMethod m) { return kMethods[static_cast<std::size_t>(m)]; }

@@ -15,6 +15,7 @@ constexpr std::array kBakers = {
     MethodBakerEntry{EffectMethod::DirectionalLightMaps, &bake_dlm_method},
     MethodBakerEntry{EffectMethod::BasisRadianceFields, &bake_brf_method},
     MethodBakerEntry{EffectMethod::Antiradiance, &bake_antiradiance_method},
+    MethodBakerEntry{EffectMethod::ReflectionProbes, &bake_reflection_probes_method},
 };
 
 }  // namespace

@@ -47,5 +47,6 @@ engine::Status bake_prm_method(const MethodBake& bake);
 engine::Status bake_dlm_method(const MethodBake& bake);
 engine::Status bake_brf_method(const MethodBake& bake);
 engine::Status bake_antiradiance_method(const MethodBake& bake);
+engine::Status bake_reflection_probes_method(const MethodBake& bake);
 
 }  // namespace gi

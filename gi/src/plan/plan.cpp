@@ -2,6 +2,7 @@
 #include <gi/plan.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <map>
 #include <optional>
@@ -17,7 +18,7 @@ namespace gi {
 namespace {
 
 // What this build can bake (gi-bake --methods): every method.
-constexpr bool kAvailable[kEffectMethodCount] = {true, true, true, true, true};
+constexpr bool kAvailable[kEffectMethodCount] = {true, true, true, true, true, true};
 
 std::string plural(std::size_t n, const char* one, const char* many) {
   return std::to_string(n) + " " + (n == 1 ? one : many);
@@ -272,6 +273,47 @@ void plan_dlm(const BakeInput& input, const PlanFacts& f, const PlanOptions& opt
                       std::to_string(p->dlm.photons) + " photons"};
 }
 
+// Reflection probes: static surfaces smoother than the directional light maps' bins can
+// carry (roughness < kReflectionProbeMaxRoughness), and the dynamic objects that then read
+// them too. The probe count is estimated as one per 80 m^2 of static surface (a 4 x 3 x 4 m
+// room's floor, ceiling and walls); the bake places them (docs/reflection_probes.md).
+void plan_reflection_probes(const BakeInput& input, const PlanFacts& f, const PlanOptions& options,
+                            const PlannedEffect& atlas, PlannedEffect& probes) {
+  const std::string threshold = fixed(kReflectionProbeMaxRoughness, 2);
+  std::vector<std::string> sharp, why;
+  for (std::size_t i = 0; i < input.instances.size(); ++i) {
+    const BakeInstance& inst = input.instances[i];
+    if (inst.mesh >= input.meshes.size() || inst.mobility == BakeMobility::Dynamic) continue;
+    const auto [roughness, material] = min_roughness(input, inst);
+    if (roughness >= kReflectionProbeMaxRoughness) continue;
+    sharp.push_back(instance_name(input, i));
+    why.push_back("'" + sharp.back() + "' (" + material + ") has roughness " + fixed(roughness, 2));
+  }
+  if (sharp.empty()) {
+    probes.reason = "no static surface has roughness < " + threshold + " -> no reflection probes";
+    return;
+  }
+  if (!atlas.enabled) {
+    probes.reason = "static surface " + list_names(why, 2) + " < " + threshold +
+                    ", but the probes capture the light atlas's light and there is none -> no reflection probes";
+    return;
+  }
+  probes.enabled = true;
+  probes.reason = "static surface " + list_names(why, 2) + " < " + threshold +
+                  " -> reflection probes (box-projected cube maps, also read by dynamic objects)";
+  probes.targets = sharp;
+  const auto preset = reflection_probe_preset(options.preset);
+  if (!preset) return;
+  const ReflectionProbeSettings& s = *preset;
+  const auto count = static_cast<std::size_t>(std::max(1.0, std::round(f.census.area_m2 / 80.0)));
+  const int light_points = f.points.punctual + f.points.directional + f.points.sampled * s.area_light_samples;
+  const BakeWork w = reflection_probes_work(count, s, light_points);
+  probes.estimate = {w.bake_seconds, w.runtime_bytes, static_cast<std::uint64_t>(w.units),
+                     "~" + std::to_string(count) + " probes (" + fixed(f.census.area_m2, 0) + " m^2 / 80 m^2) x 6 x " +
+                         std::to_string(s.resolution) + "^2 texels x " + std::to_string(s.supersample * s.supersample) +
+                         " rays; RGBA16F with mips"};
+}
+
 // Antiradiance: flagged deforming or opening regions.
 void plan_antiradiance(const BakeInput& input, const PlanFacts& f, const PlanOptions& options, bool known_preset,
                        PlannedEffect& anti) {
@@ -415,6 +457,8 @@ EffectPlan plan(const BakeInput& input, const PlanOptions& options) {
   plan_antiradiance(input, f, options, p.has_value(), out.effects[static_cast<int>(EffectMethod::Antiradiance)]);
   plan_brf(input, f, options, out.facts.dynamic_meshes,
            out.effects[static_cast<int>(EffectMethod::BasisRadianceFields)]);
+  plan_reflection_probes(input, f, options, out.effects[static_cast<int>(EffectMethod::LightAtlas)],
+                         out.effects[static_cast<int>(EffectMethod::ReflectionProbes)]);
   for (PlannedEffect& e : out.effects)
     if (!e.enabled || !e.available) e.estimate = {};
   return out;

@@ -207,6 +207,29 @@ BakeWork dlm_work(const StaticSurfaceCensus& glossy, double albedo, const AtlasT
 
 namespace {
 
+// Reflection probes (gi/src/reflection_probes): CPU seconds per capture ray (camera or shadow
+// ray, material lookup, atlas read) and per prefilter sample, from the glossy_room bake at
+// preview (docs/reflection_probes.md, "Costs").
+constexpr double kProbeCpuPerRay = 1.0e-6;
+constexpr double kProbeCpuPerPrefilterSample = 2.0e-8;
+
+}  // namespace
+
+BakeWork reflection_probes_work(std::size_t probes, const ReflectionProbeSettings& s, int light_points) {
+  BakeWork w;
+  const double texels = 6.0 * s.resolution * s.resolution * static_cast<double>(probes);
+  const double rays_per_texel = static_cast<double>(s.supersample * s.supersample) * (1.0 + light_points);
+  w.rays = texels * rays_per_texel;
+  w.units = texels;
+  const double parallel = w.rays * kProbeCpuPerRay + texels / 3.0 * s.prefilter_samples * kProbeCpuPerPrefilterSample;
+  w.cpu_seconds = parallel;
+  w.bake_seconds = wall_seconds(parallel, 0.0);
+  w.runtime_bytes = static_cast<std::uint64_t>(texels * 8.0 * 4.0 / 3.0 + 48.0 * static_cast<double>(probes));
+  return w;
+}
+
+namespace {
+
 // Antiradiance (gi/src/antiradiance; measured by gi-sweep on the corridor, docs/sweeps/
 // antiradiance_corridor.csv, 0.4-0.8 m elements x 36-121 bins, and gi-bake on the demo level).
 // Links per element and bin: 4.57 at 0.6-0.8 m on the corridor, 3.85 at 0.4 m, 3.77 on the

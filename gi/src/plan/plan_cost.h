@@ -16,6 +16,7 @@
 #include "light_atlas/light_atlas.h"
 #include "plan/static_surface_census.h"
 #include "prm/prm.h"
+#include "reflection_probes/reflection_probes.h"
 
 namespace gi {
 
@@ -69,5 +70,10 @@ BakeWork dlm_work(const StaticSurfaceCensus& glossy, double albedo, const AtlasT
 /// their (receiver, bin) runs. `links` out: the link estimate; `file_bytes` out: antiradiance.bin.
 BakeWork antiradiance_work(std::size_t elements, std::size_t leaves, const AntiradianceSettings& settings,
                            double* links = nullptr, double* file_bytes = nullptr);
+
+/// Reflection probes: `probes` cube maps of settings.resolution^2 x 6 texels, supersample^2
+/// rays per texel plus a shadow ray per static light point at each hit, then the prefilter.
+/// runtime_bytes: RGBA16F cube maps with their mips (x 4/3) and 48 B per probe's box.
+BakeWork reflection_probes_work(std::size_t probes, const ReflectionProbeSettings& settings, int light_points);
 
 }  // namespace gi

@@ -11,12 +11,13 @@
 namespace gi {
 
 std::span<const MethodRuntimeEntry> method_runtimes() {
-  static constexpr std::array<MethodRuntimeEntry, 5> kTable{{
+  static constexpr std::array<MethodRuntimeEntry, 6> kTable{{
       {EffectMethod::LightAtlas, &load_light_atlas_method, std::nullopt, true},
       {EffectMethod::Prm, &load_prm_method, EffectMethod::LightAtlas, true},
       {EffectMethod::BasisRadianceFields, &load_brf_method, std::nullopt, true},
       {EffectMethod::DirectionalLightMaps, &load_dlm_method, std::nullopt, true},
       {EffectMethod::Antiradiance, &load_antiradiance_method, std::nullopt, false},
+      {EffectMethod::ReflectionProbes, &load_reflection_probes_method, std::nullopt, false},
   }};
   return kTable;
 }

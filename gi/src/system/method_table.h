@@ -40,5 +40,6 @@ engine::Result<std::unique_ptr<MethodRuntime>> load_prm_method(MethodLoad& load)
 engine::Result<std::unique_ptr<MethodRuntime>> load_brf_method(MethodLoad& load);
 engine::Result<std::unique_ptr<MethodRuntime>> load_dlm_method(MethodLoad& load);
 engine::Result<std::unique_ptr<MethodRuntime>> load_antiradiance_method(MethodLoad& load);
+engine::Result<std::unique_ptr<MethodRuntime>> load_reflection_probes_method(MethodLoad& load);
 
 }  // namespace gi

@@ -39,7 +39,7 @@ std::vector<std::string> sorted(std::vector<std::string> v) {
 
 TEST(Plan, CornellBoxGetsTheLightAtlasOnly) {
   const gi::EffectPlan p = gi::plan(load("cornell_box.gltf"), {.preset = "preview"});
-  ASSERT_EQ(p.effects.size(), 5u);
+  ASSERT_EQ(p.effects.size(), 6u);
   const gi::PlannedEffect& atlas = p.effect(EffectMethod::LightAtlas);
   EXPECT_TRUE(atlas.enabled);
   EXPECT_TRUE(atlas.available);
@@ -92,12 +92,31 @@ TEST(Plan, DemoLevelNeedsEveryBuiltMethodIncludingDirectionalLightMaps) {
   EXPECT_TRUE(dlm.available);
   EXPECT_EQ(dlm.targets, std::vector<std::string>{"corridor_floor"});
   EXPECT_EQ(sorted(p.effect(EffectMethod::BasisRadianceFields).targets), sorted({"crate", "crate_red", "lamp_shade"}));
-  EXPECT_EQ(p.methods_to_bake(), (std::vector<std::string>{"light_atlas", "prm", "dlm", "antiradiance", "brf"}));
+  EXPECT_EQ(p.methods_to_bake(),
+            (std::vector<std::string>{"light_atlas", "prm", "dlm", "antiradiance", "brf", "reflection_probes"}));
   const std::string text = gi::format_plan(p);
   EXPECT_TRUE(contains(text, "dlm           ON")) << text;
   EXPECT_TRUE(contains(text, "B per texel")) << text;  // the memory per texel, before the bake
   EXPECT_FALSE(contains(text, "cannot bake dlm")) << text;
   std::fputs(text.c_str(), stdout);
+}
+
+// The glossy floor (roughness 0.15) is below the probes' limit 0.3: one probe of 32^2 faces
+// at the medium preset (the room's ~70 m^2 of surface), its memory 6 x 32^2 x 8 B x 4/3 + 48 B.
+TEST(Plan, GlossyRoomCallsForReflectionProbes) {
+  const gi::EffectPlan p = gi::plan(load("glossy_room.gltf"));
+  const gi::PlannedEffect& probes = p.effect(EffectMethod::ReflectionProbes);
+  EXPECT_TRUE(probes.enabled);
+  EXPECT_TRUE(probes.available);
+  EXPECT_EQ(probes.targets, std::vector<std::string>{"glossy_floor"});
+  EXPECT_TRUE(contains(probes.reason, "roughness 0.15 < 0.30")) << probes.reason;
+  EXPECT_GT(probes.estimate.bake_seconds, 0.0);
+  EXPECT_EQ(probes.estimate.runtime_bytes % 65584u, 0u) << probes.estimate.runtime_bytes;
+  // The Cornell box's surfaces are rough: no probes.
+  const gi::EffectPlan cornell = gi::plan(load("cornell_box.gltf"));
+  EXPECT_FALSE(cornell.effect(EffectMethod::ReflectionProbes).enabled);
+  EXPECT_TRUE(
+      contains(cornell.effect(EffectMethod::ReflectionProbes).reason, "no static surface has roughness < 0.30"));
 }
 
 TEST(Plan, CratesRoomGetsBasisRadianceFieldsForTheCrateMeshesOnly) {
@@ -125,7 +144,7 @@ TEST(Plan, GlossyRoomCallsForDirectionalLightMaps) {
   EXPECT_TRUE(contains(dlm.reason, "roughness 0.15 < 0.35")) << dlm.reason;
   EXPECT_GT(dlm.estimate.bake_seconds, 0.0);
   EXPECT_GT(dlm.estimate.runtime_bytes, 0u);
-  EXPECT_EQ(p.methods_to_bake(), (std::vector<std::string>{"light_atlas", "dlm"}));
+  EXPECT_EQ(p.methods_to_bake(), (std::vector<std::string>{"light_atlas", "dlm", "reflection_probes"}));
   EXPECT_FALSE(contains(gi::format_plan(p), "NOT BUILT"));
   // A stricter threshold drops it, and the reason says so.
   const gi::EffectPlan strict = gi::plan(load("glossy_room.gltf"), {.glossy_roughness = 0.1f});

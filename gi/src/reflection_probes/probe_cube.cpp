@@ -1,0 +1,234 @@
+#include "reflection_probes/probe_cube.h"
+
+#include <engine/gltf_brdf.h>
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <numbers>
+
+#include "core/thread_pool.h"
+
+namespace gi {
+
+namespace {
+
+constexpr float kPi = std::numbers::pi_v<float>;
+
+// Texel of face coordinate u in [-1, 1] on a face of size s.
+int texel_of(float u, int s) {
+  const int x = static_cast<int>(std::floor((u + 1.0f) * 0.5f * static_cast<float>(s)));
+  return std::clamp(x, 0, s - 1);
+}
+
+glm::vec3 lookup_level(const std::vector<glm::vec3>& texels, int s, const glm::vec3& d) {
+  const CubeCoordinate c = cube_coordinate(d);
+  return texels[cube_texel_index(c.face, texel_of(c.u, s), texel_of(c.v, s), s)];
+}
+
+// Level 0 and its 2 x 2 box averages down to one texel per face: what the prefilter's
+// samples read, each at the level matching its share of the sphere.
+std::vector<std::vector<glm::vec3>> box_chain(const ProbeCube& cube) {
+  std::vector<std::vector<glm::vec3>> chain{cube.levels[0]};
+  for (int s = cube.size / 2; s >= 1; s /= 2) {
+    const std::vector<glm::vec3>& fine = chain.back();
+    std::vector<glm::vec3> coarse(static_cast<std::size_t>(6 * s * s));
+    for (int f = 0; f < 6; ++f)
+      for (int y = 0; y < s; ++y)
+        for (int x = 0; x < s; ++x)
+          coarse[cube_texel_index(f, x, y, s)] = 0.25f * (fine[cube_texel_index(f, 2 * x, 2 * y, 2 * s)] +
+                                                          fine[cube_texel_index(f, 2 * x + 1, 2 * y, 2 * s)] +
+                                                          fine[cube_texel_index(f, 2 * x, 2 * y + 1, 2 * s)] +
+                                                          fine[cube_texel_index(f, 2 * x + 1, 2 * y + 1, 2 * s)]);
+    chain.push_back(std::move(coarse));
+  }
+  return chain;
+}
+
+// Van der Corput's radical inverse in base 2: the bits of i mirrored about the binary point.
+float radical_inverse(std::uint32_t i) {
+  i = (i << 16u) | (i >> 16u);
+  i = ((i & 0x55555555u) << 1u) | ((i & 0xAAAAAAAAu) >> 1u);
+  i = ((i & 0x33333333u) << 2u) | ((i & 0xCCCCCCCCu) >> 2u);
+  i = ((i & 0x0F0F0F0Fu) << 4u) | ((i & 0xF0F0F0F0u) >> 4u);
+  i = ((i & 0x00FF00FFu) << 8u) | ((i & 0xFF00FF00u) >> 8u);
+  return static_cast<float>(i) * 2.3283064365386963e-10f;
+}
+
+// Orthonormal t, b around unit n (Duff et al. 2017).
+void basis(const glm::vec3& n, glm::vec3& t, glm::vec3& b) {
+  const float sign = std::copysign(1.0f, n.z);
+  const float a = -1.0f / (sign + n.z);
+  const float c = n.x * n.y * a;
+  t = glm::vec3(1.0f + sign * n.x * n.x * a, sign * c, -sign * n.x);
+  b = glm::vec3(c, sign + n.y * n.y * a, -n.y);
+}
+
+struct LobeSample {
+  glm::vec3 tangent_h{0.0f};  ///< The half vector in the frame (t, b, n).
+  float lod = 0.0f;           ///< Chain level the sample reads (fractional).
+};
+
+// The GGX half vectors of one level's lobe and the chain level each reads; the same for
+// every texel (the lobe is rotated onto the texel's direction).
+std::vector<LobeSample> lobe_samples(float alpha, int samples, int size0, int chain_levels) {
+  std::vector<LobeSample> out;
+  const float texel_sr = 4.0f * kPi / (6.0f * static_cast<float>(size0 * size0));
+  for (int i = 0; i < samples; ++i) {
+    const float phi = 2.0f * kPi * (static_cast<float>(i) + 0.5f) / static_cast<float>(samples);
+    const float xi = radical_inverse(static_cast<std::uint32_t>(i));
+    const float cos_h = std::sqrt((1.0f - xi) / (1.0f + (alpha * alpha - 1.0f) * xi));
+    const float sin_h = std::sqrt(std::max(0.0f, 1.0f - cos_h * cos_h));
+    LobeSample s;
+    s.tangent_h = glm::vec3(sin_h * std::cos(phi), sin_h * std::sin(phi), cos_h);
+    // pdf of l = D(n.h) (n.h) / (4 v.h) = D / 4 with v = n.
+    const float pdf = engine::gltf_ggx_distribution(cos_h, alpha) * 0.25f;
+    const float sample_sr = 1.0f / (static_cast<float>(samples) * std::max(pdf, 1e-12f));
+    s.lod = std::clamp(0.5f * std::log2(sample_sr / texel_sr) + 1.0f, 0.0f, static_cast<float>(chain_levels - 1));
+    out.push_back(s);
+  }
+  return out;
+}
+
+glm::vec3 read_chain(const std::vector<std::vector<glm::vec3>>& chain, int size0, float lod, const glm::vec3& d) {
+  const int lo = static_cast<int>(std::floor(lod));
+  const int hi = std::min(lo + 1, static_cast<int>(chain.size()) - 1);
+  const float f = lod - static_cast<float>(lo);
+  const glm::vec3 a = lookup_level(chain[static_cast<std::size_t>(lo)], cube_level_size(size0, lo), d);
+  if (f <= 0.0f || hi == lo) return a;
+  return a + f * (lookup_level(chain[static_cast<std::size_t>(hi)], cube_level_size(size0, hi), d) - a);
+}
+
+}  // namespace
+
+int full_mip_count(int size) { return size < 1 ? 0 : std::bit_width(static_cast<unsigned>(size)); }
+
+ProbeCube make_probe_cube(int size, int levels) {
+  ProbeCube c;
+  c.size = size;
+  for (int m = 0; m < levels; ++m) {
+    const int s = cube_level_size(size, m);
+    c.levels.emplace_back(static_cast<std::size_t>(6 * s * s), glm::vec3(0.0f));
+  }
+  return c;
+}
+
+glm::vec3 cube_direction(int face, float u, float v) {
+  glm::vec3 d;
+  switch (face) {
+    case 0:
+      d = glm::vec3(1.0f, -v, -u);
+      break;
+    case 1:
+      d = glm::vec3(-1.0f, -v, u);
+      break;
+    case 2:
+      d = glm::vec3(u, 1.0f, v);
+      break;
+    case 3:
+      d = glm::vec3(u, -1.0f, -v);
+      break;
+    case 4:
+      d = glm::vec3(u, -v, 1.0f);
+      break;
+    default:
+      d = glm::vec3(-u, -v, -1.0f);
+      break;
+  }
+  return glm::normalize(d);
+}
+
+glm::vec3 cube_texel_direction(int face, int x, int y, int s) {
+  const auto fs = static_cast<float>(s);
+  return cube_direction(face, (2.0f * static_cast<float>(x) + 1.0f) / fs - 1.0f,
+                        (2.0f * static_cast<float>(y) + 1.0f) / fs - 1.0f);
+}
+
+CubeCoordinate cube_coordinate(const glm::vec3& d) {
+  const glm::vec3 a = glm::abs(d);
+  CubeCoordinate c;
+  float sc = 0.0f, tc = 0.0f, ma = 1.0f;
+  if (a.x >= a.y && a.x >= a.z) {
+    c.face = d.x > 0.0f ? 0 : 1;
+    ma = a.x;
+    sc = d.x > 0.0f ? -d.z : d.z;
+    tc = -d.y;
+  } else if (a.y >= a.z) {
+    c.face = d.y > 0.0f ? 2 : 3;
+    ma = a.y;
+    sc = d.x;
+    tc = d.y > 0.0f ? d.z : -d.z;
+  } else {
+    c.face = d.z > 0.0f ? 4 : 5;
+    ma = a.z;
+    sc = d.z > 0.0f ? d.x : -d.x;
+    tc = -d.y;
+  }
+  c.u = sc / ma;
+  c.v = tc / ma;
+  return c;
+}
+
+float cube_texel_solid_angle(int x, int y, int s) {
+  // Integral of the face's area element: A(u, v) = atan2(u v, sqrt(u^2 + v^2 + 1)).
+  const auto area = [](float u, float v) { return std::atan2(u * v, std::sqrt(u * u + v * v + 1.0f)); };
+  const auto fs = static_cast<float>(s);
+  const float u0 = 2.0f * static_cast<float>(x) / fs - 1.0f, u1 = 2.0f * static_cast<float>(x + 1) / fs - 1.0f;
+  const float v0 = 2.0f * static_cast<float>(y) / fs - 1.0f, v1 = 2.0f * static_cast<float>(y + 1) / fs - 1.0f;
+  return area(u0, v0) - area(u0, v1) - area(u1, v0) + area(u1, v1);
+}
+
+glm::vec3 cube_lookup(const ProbeCube& cube, int level, const glm::vec3& d) {
+  return lookup_level(cube.levels[static_cast<std::size_t>(level)], cube_level_size(cube.size, level), d);
+}
+
+glm::vec3 box_projected_direction(const glm::vec3& p, const glm::vec3& r, const glm::vec3& centre,
+                                  const glm::vec3& box_min, const glm::vec3& box_max) {
+  const glm::vec3 q = glm::clamp(p, box_min, box_max);
+  float t = std::numeric_limits<float>::infinity();
+  for (int a = 0; a < 3; ++a) {
+    if (r[a] > 0.0f) t = std::min(t, (box_max[a] - q[a]) / r[a]);
+    if (r[a] < 0.0f) t = std::min(t, (box_min[a] - q[a]) / r[a]);
+  }
+  const glm::vec3 d = q + t * r - centre;
+  const float len = glm::length(d);
+  return len > 1e-6f ? d / len : glm::normalize(r);
+}
+
+void prefilter_ggx(ProbeCube& cube, int samples, ThreadPool* pool) {
+  const int levels = static_cast<int>(cube.levels.size());
+  if (levels < 2 || samples < 1) return;
+  const std::vector<std::vector<glm::vec3>> chain = box_chain(cube);
+  for (int m = 1; m < levels; ++m) {
+    const float r = static_cast<float>(m) / static_cast<float>(levels - 1);
+    const std::vector<LobeSample> lobe =
+        lobe_samples(std::max(r * r, 1e-4f), samples, cube.size, static_cast<int>(chain.size()));
+    const int s = cube_level_size(cube.size, m);
+    std::vector<glm::vec3>& out = cube.levels[static_cast<std::size_t>(m)];
+    const auto texel = [&](std::size_t i) {
+      const int face = static_cast<int>(i) / (s * s), y = static_cast<int>(i) / s % s, x = static_cast<int>(i) % s;
+      const glm::vec3 n = cube_texel_direction(face, x, y, s);
+      glm::vec3 t, b;
+      basis(n, t, b);
+      glm::vec3 sum(0.0f);
+      float weight = 0.0f;
+      for (const LobeSample& ls : lobe) {
+        const glm::vec3 h = ls.tangent_h.x * t + ls.tangent_h.y * b + ls.tangent_h.z * n;
+        const glm::vec3 l = 2.0f * glm::dot(n, h) * h - n;
+        const float nl = glm::dot(n, l);
+        if (nl <= 0.0f) continue;
+        sum += nl * read_chain(chain, cube.size, ls.lod, l);
+        weight += nl;
+      }
+      out[i] = weight > 0.0f ? sum / weight : read_chain(chain, cube.size, 0.0f, n);
+    };
+    if (pool)
+      pool->parallel_for(out.size(), texel, 16);
+    else
+      for (std::size_t i = 0; i < out.size(); ++i) texel(i);
+  }
+}
+
+}  // namespace gi

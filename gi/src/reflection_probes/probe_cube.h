@@ -1,0 +1,79 @@
+#pragma once
+// A reflection probe's cube map on the CPU: texel <-> direction in OpenGL's cube-map
+// convention (so the levels upload to a GL cube map as they are), the box projection that
+// gives the probe parallax, and the GGX prefilter into mip levels (docs/reflection_probes.md).
+//   gi::ProbeCube cube = gi::make_probe_cube(32, 6);
+//   cube.levels[0][gi::cube_texel_index(face, x, y, 32)] = radiance(gi::cube_texel_direction(face, x, y, 32));
+//   gi::prefilter_ggx(cube, 128);   // levels 1.. from level 0: roughness m / (levels - 1)
+//
+// Faces in GL order +X, -X, +Y, -Y, +Z, -Z; texel (x, y) of a face of size s sits at
+// (s, t) = ((x + 0.5) / s, (y + 0.5) / s), row y upwards in t, as glTexImage's rows are.
+
+#include <cstddef>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+namespace gi {
+
+class ThreadPool;
+
+/// One probe's radiance (W/(m^2 sr), linear RGB) by direction, level m of size
+/// max(size >> m, 1) holding the prefiltered radiance for roughness m / (levels - 1).
+struct ProbeCube {
+  int size = 0;                                ///< Face size of level 0, texels.
+  std::vector<std::vector<glm::vec3>> levels;  ///< Per level: 6 faces x s x s, face-major, row-major.
+};
+
+/// An empty (black) cube: `levels` levels from `size` (a power of two; levels <= log2(size) + 1).
+ProbeCube make_probe_cube(int size, int levels);
+/// The largest useful level count for `size`: log2(size) + 1.
+int full_mip_count(int size);
+/// Face size of level `level`.
+inline int cube_level_size(int size, int level) { return size >> level > 0 ? size >> level : 1; }
+
+inline std::size_t cube_texel_index(int face, int x, int y, int s) {
+  return (static_cast<std::size_t>(face) * static_cast<std::size_t>(s) + static_cast<std::size_t>(y)) *
+             static_cast<std::size_t>(s) +
+         static_cast<std::size_t>(x);
+}
+
+/// The unit direction through face coordinates (u, v) in [-1, 1] (u = 2s - 1, v = 2t - 1).
+glm::vec3 cube_direction(int face, float u, float v);
+/// The unit direction through the centre of texel (x, y) of a face of size s.
+glm::vec3 cube_texel_direction(int face, int x, int y, int s);
+
+/// Where direction `d` (not zero) meets the cube: its face and (u, v) in [-1, 1].
+struct CubeCoordinate {
+  int face = 0;
+  float u = 0.0f, v = 0.0f;
+};
+CubeCoordinate cube_coordinate(const glm::vec3& d);
+
+/// Solid angle (sr) of texel (x, y) of a face of size s; the 6 s^2 texels sum to 4 pi.
+float cube_texel_solid_angle(int x, int y, int s);
+
+/// Level `level` read in direction d, nearest texel.
+glm::vec3 cube_lookup(const ProbeCube& cube, int level, const glm::vec3& d);
+
+/// Parallax correction (Lagarde and Zanuttini 2012, "Local image-based lighting with
+/// parallax-corrected cubemaps"): the direction from the probe's centre to where the ray from
+/// `p` along `r` (not zero) leaves the box [box_min, box_max] that stands for the room. `p`
+/// must lie in the box (the caller blends only probes whose box holds the point); a point
+/// outside is clamped onto it. The same formula as probe_direction() in the forward shader.
+glm::vec3 box_projected_direction(const glm::vec3& p, const glm::vec3& r, const glm::vec3& centre,
+                                  const glm::vec3& box_min, const glm::vec3& box_max);
+
+/// Fills levels 1.. of `cube` from level 0 with the split-sum's prefiltered radiance (Karis
+/// 2013, "Real shading in Unreal Engine 4"): level m is the GGX lobe of alpha = r^2, r = m /
+/// (levels - 1), around each texel's direction N with the view taken along N (n = v = r),
+///   L_m(N) = sum_i L(l_i) (N.l_i) / sum_i (N.l_i),   l_i = reflect(-N, h_i),
+/// h_i importance-sampled from D over `samples` points of a Hammersley set. Each sample reads
+/// a box-downsampled copy of level 0 at the level whose texels span the sample's share of
+/// the sphere (Colbert and Krivanek 2007, "GPU-based importance sampling"; + 1 level), so a
+/// few samples see all of level 0's light and no texel sparkles. The weights sum to one per
+/// texel: a constant map stays that constant at every level. Level 0 keeps the mirror image.
+/// `pool` (optional) runs the texels of a level in parallel; the result does not depend on it.
+void prefilter_ggx(ProbeCube& cube, int samples, ThreadPool* pool = nullptr);
+
+}  // namespace gi

@@ -1,0 +1,105 @@
+#include "reflection_probes/probe_placement.h"
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <vector>
+
+namespace gi {
+
+namespace {
+
+constexpr int kBundleSide = 5;  // rays per side of a bundle (odd: one ray through the centre)
+
+struct Reach {
+  float distance = 0.0f;  ///< To the nearest hit of the bundle, or to the world's bounds.
+  bool inside = false;    ///< The centre ray hit a back face: the point is inside geometry.
+};
+
+glm::vec3 axis_direction(int side) {
+  glm::vec3 d(0.0f);
+  d[side / 2] = side % 2 == 0 ? 1.0f : -1.0f;
+  return d;
+}
+
+// Distance from p along axis side (0: +x, 1: -x, 2: +y, ...) to the world's bound.
+float to_bounds(const glm::vec3& p, int side, const glm::vec3& lo, const glm::vec3& hi) {
+  const int a = side / 2;
+  return std::max(0.0f, side % 2 == 0 ? hi[a] - p[a] : p[a] - lo[a]);
+}
+
+Reach reach(const RayCaster& caster, const glm::vec3& p, int side, const glm::vec3& lo, const glm::vec3& hi,
+            float spread) {
+  const glm::vec3 d = axis_direction(side);
+  const int a = side / 2;
+  const int ua = (a + 1) % 3, va = (a + 2) % 3;
+  const float bound = to_bounds(p, side, lo, hi);
+  Reach r;
+  std::vector<float> distances;
+  const int half = kBundleSide / 2;
+  for (int j = -half; j <= half; ++j)
+    for (int i = -half; i <= half; ++i) {
+      glm::vec3 o = p;
+      o[ua] += static_cast<float>(i) * spread / static_cast<float>(std::max(half, 1));
+      o[va] += static_cast<float>(j) * spread / static_cast<float>(std::max(half, 1));
+      const Hit h = caster.intersect(Ray{o, 0.0f, d, bound});
+      if (i == 0 && j == 0 && h.valid() && glm::dot(h.geometric_normal, d) > 0.0f) r.inside = true;
+      distances.push_back(h.valid() ? std::min(h.t, bound) : bound);
+    }
+  // The median: openings and obstacles that cover less than half the bundle do not count.
+  std::nth_element(distances.begin(), distances.begin() + static_cast<std::ptrdiff_t>(distances.size() / 2),
+                   distances.end());
+  r.distance = distances[distances.size() / 2];
+  return r;
+}
+
+// The box around free point p, or nullopt when p is inside geometry.
+std::optional<ProbeVolume> measure(const RayCaster& caster, const glm::vec3& p, const glm::vec3& lo,
+                                   const glm::vec3& hi, float spread) {
+  ProbeVolume v;
+  v.centre = p;
+  v.box_min = p;
+  v.box_max = p;
+  for (int side = 0; side < 6; ++side) {
+    const Reach r = reach(caster, p, side, lo, hi, spread);
+    if (r.inside) return std::nullopt;
+    if (side % 2 == 0)
+      v.box_max[side / 2] = p[side / 2] + r.distance;
+    else
+      v.box_min[side / 2] = p[side / 2] - r.distance;
+  }
+  return v;
+}
+
+bool free_point(const RayCaster& caster, const glm::vec3& p, const glm::vec3& lo, const glm::vec3& hi) {
+  for (int side = 0; side < 6; ++side)
+    if (reach(caster, p, side, lo, hi, 0.0f).inside) return false;
+  return true;
+}
+
+}  // namespace
+
+std::vector<ProbeVolume> place_probes(const RayCaster& caster, const glm::vec3& world_min, const glm::vec3& world_max,
+                                      const ProbePlacementSettings& settings) {
+  std::vector<ProbeVolume> probes;
+  const glm::vec3 extent = glm::max(world_max - world_min, glm::vec3(0.0f));
+  glm::ivec3 n;
+  for (int a = 0; a < 3; ++a) n[a] = std::max(1, static_cast<int>(std::ceil(extent[a] / settings.cell_m)));
+  for (int y = 0; y < n.y; ++y)
+    for (int z = 0; z < n.z; ++z)
+      for (int x = 0; x < n.x; ++x) {
+        if (static_cast<int>(probes.size()) >= settings.max_probes) return probes;
+        const glm::vec3 p = world_min + (glm::vec3(x, y, z) + 0.5f) / glm::vec3(n) * extent;
+        if (std::any_of(probes.begin(), probes.end(), [&](const ProbeVolume& v) { return v.contains(p); })) continue;
+        auto v = measure(caster, p, world_min, world_max, settings.spread_m);
+        if (!v) continue;
+        const glm::vec3 size = v->box_max - v->box_min;
+        if (std::min({size.x, size.y, size.z}) < settings.min_box_m) continue;
+        const glm::vec3 mid = 0.5f * (v->box_min + v->box_max);
+        if (free_point(caster, mid, world_min, world_max)) v->centre = mid;
+        probes.push_back(*v);
+      }
+  return probes;
+}
+
+}  // namespace gi

@@ -1,0 +1,114 @@
+// The cube-map math of the reflection probes (reflection_probes/probe_cube.h): directions
+// and texels agree with OpenGL's cube-map convention, texel solid angles cover the sphere,
+// the box projection's parallax, and the GGX prefilter's mean conservation.
+#include "reflection_probes/probe_cube.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+namespace {
+
+TEST(ProbeCube, TexelDirectionsRoundTripThroughTheCubeCoordinate) {
+  const int s = 8;
+  for (int face = 0; face < 6; ++face)
+    for (int y = 0; y < s; ++y)
+      for (int x = 0; x < s; ++x) {
+        const glm::vec3 d = gi::cube_texel_direction(face, x, y, s);
+        const gi::CubeCoordinate c = gi::cube_coordinate(d);
+        EXPECT_EQ(c.face, face);
+        EXPECT_NEAR(c.u, (2.0f * static_cast<float>(x) + 1.0f) / s - 1.0f, 1e-5f);
+        EXPECT_NEAR(c.v, (2.0f * static_cast<float>(y) + 1.0f) / s - 1.0f, 1e-5f);
+      }
+}
+
+// OpenGL 4.6 §8.13, table 8.19: the major axis picks the face; e.g. +Y's t grows with +z.
+TEST(ProbeCube, FacesFollowOpenGlsTable) {
+  EXPECT_EQ(gi::cube_coordinate({1, 0.1f, 0.2f}).face, 0);
+  EXPECT_EQ(gi::cube_coordinate({-1, 0.1f, 0.2f}).face, 1);
+  EXPECT_EQ(gi::cube_coordinate({0.1f, 1, 0.2f}).face, 2);
+  EXPECT_EQ(gi::cube_coordinate({0.1f, -1, 0.2f}).face, 3);
+  EXPECT_EQ(gi::cube_coordinate({0.1f, 0.2f, 1}).face, 4);
+  EXPECT_EQ(gi::cube_coordinate({0.1f, 0.2f, -1}).face, 5);
+  const gi::CubeCoordinate px = gi::cube_coordinate({1.0f, -0.5f, -0.25f});  // sc = -rz, tc = -ry
+  EXPECT_FLOAT_EQ(px.u, 0.25f);
+  EXPECT_FLOAT_EQ(px.v, 0.5f);
+  const gi::CubeCoordinate py = gi::cube_coordinate({0.5f, 1.0f, 0.25f});  // sc = rx, tc = rz
+  EXPECT_FLOAT_EQ(py.u, 0.5f);
+  EXPECT_FLOAT_EQ(py.v, 0.25f);
+}
+
+TEST(ProbeCube, TexelSolidAnglesCoverTheSphere) {
+  const int s = 16;
+  double sum = 0.0;
+  for (int y = 0; y < s; ++y)
+    for (int x = 0; x < s; ++x) sum += 6.0 * static_cast<double>(gi::cube_texel_solid_angle(x, y, s));
+  EXPECT_NEAR(sum, 4.0 * std::numbers::pi, 1e-4);
+}
+
+TEST(ProbeCube, BoxProjectionFromTheCentreIsTheReflectionItself) {
+  const glm::vec3 r = glm::normalize(glm::vec3(0.3f, -0.5f, 0.8f));
+  const glm::vec3 d = gi::box_projected_direction({0, 0, 0}, r, {0, 0, 0}, {-2, -1, -3}, {2, 1, 3});
+  EXPECT_NEAR(glm::length(d - r), 0.0f, 1e-6f);
+}
+
+// A point 1 m right of the centre of a 4 m cube looking along +z: the ray leaves the box at
+// (1, 0, 2), which the probe at the centre sees along normalize(1, 0, 2), not along +z.
+TEST(ProbeCube, BoxProjectionAddsTheParallaxOfTheBox) {
+  const glm::vec3 d = gi::box_projected_direction({1, 0, 0}, {0, 0, 1}, {0, 0, 0}, {-2, -2, -2}, {2, 2, 2});
+  const glm::vec3 expected = glm::normalize(glm::vec3(1, 0, 2));
+  EXPECT_NEAR(glm::length(d - expected), 0.0f, 1e-6f);
+  // A probe off the box's centre: from (0, 0, -1) the exit point (1, 0, 2) lies along (1, 0, 3).
+  const glm::vec3 off = gi::box_projected_direction({1, 0, 0}, {0, 0, 1}, {0, 0, -1}, {-2, -2, -2}, {2, 2, 2});
+  EXPECT_NEAR(glm::length(off - glm::normalize(glm::vec3(1, 0, 3))), 0.0f, 1e-6f);
+  // From (0, 1, 0) up the diagonal (1, 1, 0): the ceiling y = 2 comes first, at (1, 2, 0).
+  const glm::vec3 diag =
+      gi::box_projected_direction({0, 1, 0}, glm::normalize(glm::vec3(1, 1, 0)), {0, 0, 0}, {-2, -2, -2}, {2, 2, 2});
+  EXPECT_NEAR(glm::length(diag - glm::normalize(glm::vec3(1, 2, 0))), 0.0f, 1e-6f);
+}
+
+TEST(ProbeCube, PrefilterKeepsAConstantMapConstantAtEveryLevel) {
+  gi::ProbeCube cube = gi::make_probe_cube(16, gi::full_mip_count(16));
+  ASSERT_EQ(cube.levels.size(), 5u);
+  for (glm::vec3& t : cube.levels[0]) t = glm::vec3(0.25f, 1.5f, 3.0f);
+  gi::prefilter_ggx(cube, 64);
+  for (std::size_t m = 0; m < cube.levels.size(); ++m) {
+    ASSERT_EQ(cube.levels[m].size(), static_cast<std::size_t>(6 * gi::cube_level_size(16, static_cast<int>(m)) *
+                                                              gi::cube_level_size(16, static_cast<int>(m))));
+    for (const glm::vec3& t : cube.levels[m]) {
+      EXPECT_NEAR(t.x, 0.25f, 1e-6f) << "level " << m;
+      EXPECT_NEAR(t.y, 1.5f, 1e-5f) << "level " << m;
+      EXPECT_NEAR(t.z, 3.0f, 1e-5f) << "level " << m;
+    }
+  }
+}
+
+// The prefilter conserves the map's mean: one bright face's light spreads over the sphere at
+// rough levels but its solid-angle-weighted mean stays within a few percent, and the
+// roughest level is nearly uniform.
+TEST(ProbeCube, PrefilterConservesTheMeanOfAVaryingMap) {
+  const int s = 16;
+  gi::ProbeCube cube = gi::make_probe_cube(s, gi::full_mip_count(s));
+  for (int y = 0; y < s; ++y)
+    for (int x = 0; x < s; ++x) cube.levels[0][gi::cube_texel_index(2, x, y, s)] = glm::vec3(6.0f);  // +Y bright
+  gi::prefilter_ggx(cube, 256);
+  const auto mean = [&](std::size_t m) {
+    const int sm = gi::cube_level_size(s, static_cast<int>(m));
+    double sum = 0.0;
+    for (int f = 0; f < 6; ++f)
+      for (int y = 0; y < sm; ++y)
+        for (int x = 0; x < sm; ++x)
+          sum += static_cast<double>(cube.levels[m][gi::cube_texel_index(f, x, y, sm)].x *
+                                     gi::cube_texel_solid_angle(x, y, sm));
+    return sum / (4.0 * std::numbers::pi);
+  };
+  const double base = mean(0);
+  EXPECT_NEAR(base, 1.0, 1e-4);  // one face of six
+  for (std::size_t m = 1; m < cube.levels.size(); ++m) EXPECT_NEAR(mean(m), base, 0.1 * base) << "level " << m;
+  // Mirror-like level 1 keeps the face bright and the opposite face dark.
+  EXPECT_GT(cube.levels[1][gi::cube_texel_index(2, 4, 4, 8)].x, 5.0f);
+  EXPECT_LT(cube.levels[1][gi::cube_texel_index(3, 4, 4, 8)].x, 0.01f);
+}
+
+}  // namespace
