@@ -253,7 +253,10 @@ void plan_dlm(const BakeInput& input, const PlanFacts& f, const PlanOptions& opt
     return;
   }
   dlm.enabled = true;
-  dlm.reason = "static surface " + list_names(f.glossy_why, 2) + " < " + threshold + " -> directional light maps";
+  // The maps hold the static lights' and emissive surfaces' indirect light only (gi/src/dlm/dlm.h).
+  dlm.reason = "static surface " + list_names(f.glossy_why, 2) + " < " + threshold +
+               " -> directional light maps (static lights only: moving lights and the sky are absent from them, "
+               "their indirect light stays direction-less in the atlas term)";
   dlm.targets = f.glossy;
   if (!p) return;
   // The glossy instances' own charts: the texels that get a map per direction.
