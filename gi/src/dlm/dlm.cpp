@@ -49,6 +49,8 @@ engine::Status validate(const DlmSettings& s) {
   if (!(s.splat_radius_texels >= 0.5f) || s.splat_radius_texels > 16.0f)
     return bad("splat_radius_texels must be in [0.5, 16]");
   if (!(s.glossy_roughness > 0.0f) || s.glossy_roughness > 1.0f) return bad("glossy_roughness must be in (0, 1]");
+  if (!(s.glossy_roughness_min >= 0.0f) || !(s.glossy_roughness_min < s.glossy_roughness))
+    return bad("glossy_roughness_min must be in [0, glossy_roughness)");
   if (s.max_bounces < 2 || s.max_bounces > 1024) return bad("max_bounces must be in 2..1024");
   if (s.area_light_samples < 1 || s.area_light_samples > 65536) return bad("area_light_samples must be in 1..65536");
   return {};
@@ -222,7 +224,8 @@ TriangleMaterials triangle_materials(const StaticBakeScene& s, const DlmSettings
     if (it == by_material.end()) {
       const engine::GltfBrdf& brdf = s.scene.materials[m].brdf;
       it = by_material
-               .emplace(m, std::make_pair(std::sqrt(brdf.alpha) < settings.glossy_roughness,
+               .emplace(m, std::make_pair(std::sqrt(brdf.alpha) < settings.glossy_roughness &&
+                                              std::sqrt(brdf.alpha) >= settings.glossy_roughness_min,
                                           engine::gltf_hemispherical_albedo(brdf).sum()))
                .first;
     }

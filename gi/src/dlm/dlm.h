@@ -25,8 +25,8 @@
 //      (engine/directional_radiance.h). A bin whose C_k is small cannot hold more than the
 //      photons' flux over C_k: finite, and bounded by the lights' flux (tested).
 //   4. Each bin's map is dilated like the light atlas into the chart gutters.
-// Glossy texels: those whose owning triangle's material has roughness < glossy_roughness
-// (the planner's rule, per triangle). Bit-identical for any thread count: photons are traced
+// Glossy texels: those whose owning triangle's material has roughness in [glossy_roughness_min,
+// glossy_roughness) (the planner's range, per triangle). Bit-identical for any thread count: photons are traced
 // in fixed batches whose deposits are summed in photon order.
 
 #include <engine/result.h>
@@ -48,7 +48,8 @@ struct DlmSettings {
   int directions = 32;                ///< N = |Omega|, 8..256.
   std::uint64_t photons = 1'000'000;  ///< Photon paths shot from the lights.
   float splat_radius_texels = 1.5f;   ///< Tent kernel radius (the paper's pyramidal splats are 1.5 texels wide).
-  float glossy_roughness = 0.35f;     ///< Texels of materials with roughness below this get maps (PlanOptions).
+  float glossy_roughness = 0.8f;      ///< Texels of materials with roughness below this get maps (PlanOptions)
+  float glossy_roughness_min = 0.0f;  ///< ... and at or above this (sharper ones are the reflection probes').
   int max_bounces = 16;               ///< Safety stop of a photon path (Russian roulette ends it first).
   int area_light_samples = 16;        ///< Point emitters per area light or emissive triangle.
   std::uint64_t seed = 1;

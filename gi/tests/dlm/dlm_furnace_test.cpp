@@ -46,10 +46,8 @@ const glm::vec3 kEmission(0.5f);
 // A closed 2 m cube facing inwards, every face the same glossy emitter.
 engine::SceneAsset furnace_room() {
   engine::SceneAsset a;
-  a.materials.push_back(engine::Material{.name = "glossy_emitter",
-                                         .base_color = glm::vec4(kBase, 1.0f),
-                                         .roughness = kRoughness,
-                                         .emissive = kEmission});
+  a.materials.push_back(engine::Material{
+      .name = "glossy_emitter", .base_color = glm::vec4(kBase, 1.0f), .roughness = kRoughness, .emissive = kEmission});
   engine::Mesh m;
   m.name = "room";
   engine::Primitive p;

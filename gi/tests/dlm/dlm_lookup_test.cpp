@@ -28,8 +28,8 @@ glm::vec3 fibonacci(int i, int n) {
   const double golden = std::numbers::pi * (3.0 - std::sqrt(5.0));
   const double z = 1.0 - (2.0 * i + 1.0) / n, r = std::sqrt(std::max(0.0, 1.0 - z * z)), phi = golden * i;
   // z along the normal (y), so that the dense set is not aligned with the bins' lattice axis.
-  return glm::normalize(glm::vec3(static_cast<float>(r * std::cos(phi)), static_cast<float>(z),
-                                  static_cast<float>(r * std::sin(phi))));
+  return glm::normalize(
+      glm::vec3(static_cast<float>(r * std::cos(phi)), static_cast<float>(z), static_cast<float>(r * std::sin(phi))));
 }
 
 const std::vector<glm::vec3>& hemisphere() {

@@ -212,17 +212,21 @@ TEST(DlmBake, OnlyTheGlossyFloorGetsMaps) {
   EXPECT_EQ(dlm->stats.glossy_texels, floor_texels);
 }
 
-// Hard case: roughness near the threshold: 0.34 gets maps, 0.36 does not (threshold 0.35).
-TEST(DlmHardCases, RoughnessNearTheThreshold) {
-  for (const float r : {0.34f, 0.36f}) {
+// Hard case: roughness near the ends of the range [0.1, 0.8): 0.09 and 0.81 get no maps,
+// 0.11 and 0.79 do.
+TEST(DlmHardCases, RoughnessNearTheRangesEnds) {
+  for (const float r : {0.09f, 0.11f, 0.79f, 0.81f}) {
     BoxOptions o;
     o.floor_roughness = r;
-    auto dlm = gi::bake_dlm(gi::bake_input_from(glossy_box(o)), test_settings(5'000));
+    gi::DlmSettings st = test_settings(5'000);
+    st.glossy_roughness_min = 0.1f;
+    st.glossy_roughness = 0.8f;
+    auto dlm = gi::bake_dlm(gi::bake_input_from(glossy_box(o)), st);
     ASSERT_TRUE(dlm) << dlm.error().to_string();
-    if (r < 0.35f)
-      EXPECT_GT(dlm->stats.glossy_texels, 0u);
+    if (r > 0.1f && r < 0.8f)
+      EXPECT_GT(dlm->stats.glossy_texels, 0u) << r;
     else
-      EXPECT_EQ(dlm->stats.glossy_texels, 0u);
+      EXPECT_EQ(dlm->stats.glossy_texels, 0u) << r;
   }
 }
 
