@@ -91,6 +91,19 @@ struct PlanFacts {
   bool sky = false;  // the environment's sky lights the scene (an outdoor scene)
 };
 
+// A static surface by its roughness: in the DLM range, or sharper (the reflection probes' range).
+void classify_glossy(PlanFacts& f, const PlanOptions& options, std::size_t i, const std::string& name, float roughness,
+                     const std::string& material) {
+  const std::string what = "'" + name + "' (" + material + ") ";
+  if (roughness < options.glossy_roughness_min) {
+    f.sharp_glossy.push_back(what + fixed(roughness, 2));
+  } else if (roughness < options.glossy_roughness) {
+    f.glossy.push_back(name);
+    f.glossy_instances.push_back(i);
+    f.glossy_why.push_back(what + "has roughness " + fixed(roughness, 2));
+  }
+}
+
 PlanFacts gather_facts(const BakeInput& input, const PlanOptions& options, EffectPlan& out) {
   PlanFacts f;
   SceneFacts& facts = out.facts;
@@ -138,13 +151,7 @@ PlanFacts gather_facts(const BakeInput& input, const PlanOptions& options, Effec
     f.static_meshes.push_back(name);
     if (emissive(input, inst)) f.emissive_meshes.push_back(name);
     const auto [roughness, material] = min_roughness(input, inst);
-    if (roughness < options.glossy_roughness_min) {
-      f.sharp_glossy.push_back("'" + name + "' (" + material + ") " + fixed(roughness, 2));
-    } else if (roughness < options.glossy_roughness) {
-      f.glossy.push_back(name);
-      f.glossy_instances.push_back(i);
-      f.glossy_why.push_back("'" + name + "' (" + material + ") has roughness " + fixed(roughness, 2));
-    }
+    classify_glossy(f, options, i, name, roughness, material);
   }
   facts.emissive_surfaces = static_cast<int>(f.emissive_meshes.size());
   f.points.sampled += 2 * facts.emissive_surfaces;  // emissive quads: two triangles each, typically
