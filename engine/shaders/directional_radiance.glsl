@@ -14,8 +14,6 @@
 #define DIRECTIONAL_DIRECTION_BINDING 3
 #endif
 
-const float DIRECTIONAL_MIN_COS = 0.1;
-
 // Element layouts: engine/indirect_light.h's DirectionalRadiance and DirectionalBin (std430, asserted there).
 struct DirectionalRadianceElement {
   uint red_green;  // packHalf2x16(r, g)
@@ -28,19 +26,28 @@ struct DirectionalBin {
 layout(std430, binding = DIRECTIONAL_RADIANCE_BINDING) readonly buffer DirectionalRadiance { DirectionalRadianceElement dr_values[]; };
 layout(std430, binding = DIRECTIONAL_DIRECTION_BINDING) readonly buffer DirectionalDirections { DirectionalBin dr_directions[]; };
 
-float directional_bin_alpha(int bin_count) {
-  float n = float(max(bin_count, 2));
-  float theta = acos(clamp(1.0 - 2.0 / n, -1.0, 1.0));
-  return tan(0.5 * theta);
-}
-
 vec3 directional_bin_radiance(int bin, int element, int element_count) {
   DirectionalRadianceElement p = dr_values[bin * element_count + element];
   return vec3(unpackHalf2x16(p.red_green), unpackHalf2x16(p.blue).x) * dr_directions[bin].scale;
 }
 
-const int DIRECTIONAL_LOBE_SAMPLES = 8;
-const float DIRECTIONAL_LOBE_WIDENING = 0.5;
+// A point's bilinear footprint over the maps' texels: up to four stored elements (-1: none)
+// and their weights (summing to 1 over the elements that exist). The lookup is linear in the
+// bins' radiance, so reading the bins blended is the blend of the four texels' lookups: no
+// texel blocks, as the light atlas's bilinear irradiance.
+struct DirectionalTexels {
+  ivec4 element;
+  vec4 weight;
+};
+
+vec3 directional_bin_radiance(int bin, DirectionalTexels t, int element_count) {
+  vec3 sum = vec3(0.0);
+  for (int i = 0; i < 4; ++i)
+    if (t.weight[i] > 0.0) sum += t.weight[i] * directional_bin_radiance(bin, t.element[i], element_count);
+  return sum;
+}
+
+const int DIRECTIONAL_LOBE_SAMPLES = 16;
 
 vec2 directional_lobe_sample_point(int j) {
   uint bits = uint(j);
@@ -52,13 +59,11 @@ vec2 directional_lobe_sample_point(int j) {
   return vec2((float(j) + 0.5) / float(DIRECTIONAL_LOBE_SAMPLES), float(bits) * 2.3283064365386963e-10);
 }
 
-int directional_bin_of(vec3 n, vec3 l, int bin_count) {
+int directional_bin_of(vec3 l, int bin_count) {
   int best = -1;
   float best_dot = -2.0;
   for (int k = 0; k < bin_count; ++k) {
-    vec3 psi = dr_directions[k].direction;
-    if (!(dot(n, psi) > DIRECTIONAL_MIN_COS)) continue;
-    float d = dot(l, psi);
+    float d = dot(l, dr_directions[k].direction);
     if (d > best_dot) {
       best_dot = d;
       best = k;
@@ -67,10 +72,9 @@ int directional_bin_of(vec3 n, vec3 l, int bin_count) {
   return best;
 }
 
-// L_spec of engine::directional_specular for stored element `element`.
-vec3 directional_specular(GltfBrdf m, vec3 n, vec3 v, int element, int bin_count, int element_count) {
-  float a_bin = DIRECTIONAL_LOBE_WIDENING * directional_bin_alpha(bin_count);
-  float a = sqrt(m.alpha * m.alpha + a_bin * a_bin);
+// L_spec of engine::directional_specular for the bins blended over the footprint `texels`.
+vec3 directional_specular(GltfBrdf m, vec3 n, vec3 v, DirectionalTexels texels, int bin_count, int element_count) {
+  float a = m.alpha;
   float n_dot_v = max(dot(n, v), 1e-4);
   vec3 t = abs(n.x) > 0.9 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0);
   t = normalize(t - n * dot(n, t));
@@ -78,10 +82,10 @@ vec3 directional_specular(GltfBrdf m, vec3 n, vec3 v, int element, int bin_count
   vec3 ve = vec3(dot(v, t), dot(v, b), n_dot_v);
   vec3 vh = normalize(vec3(a * ve.x, a * ve.y, ve.z));
   float lensq = vh.x * vh.x + vh.y * vh.y;
-  vec3 t1 = lensq > 0.0 ? vec3(-vh.y, vh.x, 0.0) * inversesqrt(lensq) : vec3(1.0, 0.0, 0.0);
+  vec3 t1 = lensq > 1e-7 ? vec3(-vh.y, vh.x, 0.0) * inversesqrt(lensq) : vec3(1.0, 0.0, 0.0);
   vec3 t2 = cross(vh, t1);
   float g1 = 2.0 * n_dot_v / (n_dot_v + sqrt(a * a + (1.0 - a * a) * n_dot_v * n_dot_v));
-  float sum_w = 0.0;
+  vec3 sum_w = vec3(0.0);
   vec3 sum = vec3(0.0);
   for (int j = 0; j < DIRECTIONAL_LOBE_SAMPLES; ++j) {
     vec2 u = directional_lobe_sample_point(j);
@@ -96,12 +100,43 @@ vec3 directional_specular(GltfBrdf m, vec3 n, vec3 v, int element, int bin_count
     vec3 l = 2.0 * dot(v, h) * h - v;
     float n_dot_l = dot(n, l);
     if (!(n_dot_l > 0.0)) continue;
-    int k = directional_bin_of(n, l, bin_count);
+    int k = directional_bin_of(l, bin_count);
     if (k < 0) continue;
-    float w = 4.0 * n_dot_l * n_dot_v * gltf_smith_visibility(n_dot_v, n_dot_l, a) / g1;
+    float fresnel_w = gltf_schlick_weight(dot(v, h));
+    vec3 fresnel = (1.0 - m.metallic) * m.specular_weight * (m.dielectric_f0 + (vec3(1.0) - m.dielectric_f0) * fresnel_w) +
+                   m.metallic * (m.base_color + (vec3(1.0) - m.base_color) * fresnel_w);
+    vec3 w = fresnel * (4.0 * n_dot_l * n_dot_v * gltf_smith_visibility(n_dot_v, n_dot_l, a) / g1);
     sum_w += w;
-    sum += w * directional_bin_radiance(k, element, element_count);
+    sum += w * directional_bin_radiance(k, texels, element_count);
   }
-  if (!(sum_w > 0.0)) return vec3(0.0);
-  return gltf_directional_albedo(m, dot(n, v)).specular * (sum / sum_w);
+  vec3 albedo = gltf_directional_albedo(m, dot(n, v)).specular;
+  return mix(vec3(0.0), albedo * sum / max(sum_w, vec3(1e-30)), greaterThan(sum_w, vec3(0.0)));
+}
+
+// L_spec for stored element `element` alone.
+vec3 directional_specular(GltfBrdf m, vec3 n, vec3 v, int element, int bin_count, int element_count) {
+  return directional_specular(m, n, v, DirectionalTexels(ivec4(element, -1, -1, -1), vec4(1.0, 0.0, 0.0, 0.0)), bin_count,
+                              element_count);
+}
+
+// The footprint of uv1 point `uv` over the index texture (texel centres at (i + 0.5) / size):
+// the four nearest texels with bilinear weights, those without maps dropped and the rest
+// renormalized. `nearest` is the element of the texel holding uv (-1: no maps there).
+DirectionalTexels directional_footprint(isampler2D index, vec2 uv, out int nearest) {
+  ivec2 size = textureSize(index, 0);
+  nearest = texelFetch(index, clamp(ivec2(floor(uv * vec2(size))), ivec2(0), size - 1), 0).r;
+  vec2 f = uv * vec2(size) - 0.5;
+  ivec2 base = ivec2(floor(f));
+  vec2 w = f - floor(f);
+  DirectionalTexels t;
+  float total = 0.0;
+  for (int i = 0; i < 4; ++i) {
+    ivec2 o = ivec2(i & 1, i >> 1);
+    t.element[i] = texelFetch(index, clamp(base + o, ivec2(0), size - 1), 0).r;
+    t.weight[i] = t.element[i] >= 0 ? (o.x == 1 ? w.x : 1.0 - w.x) * (o.y == 1 ? w.y : 1.0 - w.y) : 0.0;
+    total += t.weight[i];
+  }
+  t.weight = total > 0.0 ? t.weight / total : vec4(1.0, 0.0, 0.0, 0.0);
+  if (!(total > 0.0)) t.element = ivec4(nearest, -1, -1, -1);
+  return t;
 }

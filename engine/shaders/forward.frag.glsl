@@ -214,11 +214,11 @@ void main() {
     GltfBrdfValue albedo = gltf_directional_albedo(s.brdf, dot(s.normal, s.view));
     vec3 specular = e / PI * albedo.specular;
     if (u_indirect_mode == 2 && u_directional_bins > 0) {
-      ivec2 size = textureSize(u_directional_index, 0);
-      ivec2 texel = clamp(ivec2(floor(v_uv1 * vec2(size))), ivec2(0), size - 1);
-      int element = texelFetch(u_directional_index, texel, 0).r;
+      // Bilinear over the texels with maps (directional_footprint), where the texel under v_uv1 has them.
+      int element;
+      DirectionalTexels texels = directional_footprint(u_directional_index, v_uv1, element);
       if (element >= 0)
-        specular = directional_specular(s.brdf, s.normal, s.view, element, u_directional_bins, u_directional_elements);
+        specular = directional_specular(s.brdf, s.normal, s.view, texels, u_directional_bins, u_directional_elements);
     }
     // A dynamic mesh's per-vertex radiance lobes replace the specular lobe's share (the diffuse keeps E).
     if (u_indirect_mode == 3 && u_lobe_terms > 0) specular = v_lobe_radiance;

@@ -131,7 +131,7 @@ TEST(DirectionalRadiance, GlslTwinAgreesWithTheCpp) {
   ASSERT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
 
   float worst = 0.0f;
-  std::size_t nonzero = 0;
+  std::size_t nonzero = 0, on_boundary = 0;
   for (std::size_t i = 0; i < cases.size(); ++i) {
     const Case& c = cases[i];
     const engine::GltfBrdf m =
@@ -144,6 +144,19 @@ TEST(DirectionalRadiance, GlslTwinAgreesWithTheCpp) {
     worst = std::max(worst, d);
     nonzero += scale > 1e-6f;
     ASSERT_TRUE(std::isfinite(g.x) && std::isfinite(g.y) && std::isfinite(g.z)) << i;
+    // A lobe sample within float rounding of a boundary between two bins may fall on either
+    // side in the GPU's arithmetic: such cases (the C++ changes under a 1e-4 move of v) are
+    // counted, not compared.
+    bool boundary = false;
+    for (const glm::vec3 dv : {glm::vec3(1e-4f, 0, 0), glm::vec3(0, 0, 1e-4f), glm::vec3(0, 1e-4f, 0)}) {
+      const glm::vec3 moved = engine::directional_specular(m, glm::vec3(c.n_roughness),
+                                                           glm::normalize(glm::vec3(c.v) + dv), dirs, decoded[e]);
+      for (int ch = 0; ch < 3; ++ch) boundary = boundary || std::fabs(moved[ch] - cpu[ch]) > 1e-2f * scale;
+    }
+    if (boundary) {
+      ++on_boundary;
+      continue;
+    }
     if (d > 1e-3f) {
       ADD_FAILURE() << "case " << i << " (roughness " << c.n_roughness.w << ", cos_v "
                     << glm::dot(glm::vec3(c.v), glm::vec3(c.n_roughness)) << "): GPU (" << g.x << ", " << g.y << ", "
@@ -152,7 +165,9 @@ TEST(DirectionalRadiance, GlslTwinAgreesWithTheCpp) {
     }
   }
   EXPECT_GT(nonzero, cases.size() / 2);
-  std::printf("%zu cases: worst relative difference GLSL vs C++ %.2e\n", cases.size(), static_cast<double>(worst));
+  EXPECT_LT(on_boundary, cases.size() / 50);
+  std::printf("%zu cases (%zu on a bin boundary skipped): worst relative difference GLSL vs C++ %.2e\n", cases.size(),
+              on_boundary, static_cast<double>(worst));
 }
 
 }  // namespace

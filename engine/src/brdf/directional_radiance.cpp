@@ -5,12 +5,6 @@
 
 namespace engine {
 
-float directional_bin_alpha(int bin_count) {
-  const float n = static_cast<float>(std::max(bin_count, 2));
-  const float theta = std::acos(std::clamp(1.0f - 2.0f / n, -1.0f, 1.0f));
-  return std::tan(0.5f * theta);
-}
-
 glm::vec2 directional_lobe_sample_point(int j) {
   // Hammersley: (j + 1/2) / M and the radical inverse of j in base 2.
   std::uint32_t bits = static_cast<std::uint32_t>(j);
@@ -23,11 +17,10 @@ glm::vec2 directional_lobe_sample_point(int j) {
           static_cast<float>(bits) * 2.3283064365386963e-10f};
 }
 
-int directional_bin_of(std::span<const glm::vec3> directions, const glm::vec3& n, const glm::vec3& l) {
+int directional_bin_of(std::span<const glm::vec3> directions, const glm::vec3& l) {
   int best = -1;
   float best_dot = -2.0f;
   for (std::size_t k = 0; k < directions.size(); ++k) {
-    if (!(glm::dot(n, directions[k]) > kDirectionalMinCos)) continue;
     const float d = glm::dot(l, directions[k]);
     if (d > best_dot) best_dot = d, best = static_cast<int>(k);
   }
@@ -36,8 +29,7 @@ int directional_bin_of(std::span<const glm::vec3> directions, const glm::vec3& n
 
 glm::vec3 directional_specular(const GltfBrdf& m, const glm::vec3& n, const glm::vec3& v,
                                std::span<const glm::vec3> directions, std::span<const glm::vec3> radiance) {
-  const float a_bin = kDirectionalLobeWidening * directional_bin_alpha(static_cast<int>(directions.size()));
-  const float a = std::sqrt(m.alpha * m.alpha + a_bin * a_bin);
+  const float a = m.alpha;
   const float n_dot_v = std::max(glm::dot(n, v), 1e-4f);
   // The frame (t, b, n) and v in it.
   glm::vec3 t = std::fabs(n.x) > 0.9f ? glm::vec3(0.0f, 1.0f, 0.0f) : glm::vec3(1.0f, 0.0f, 0.0f);
@@ -46,13 +38,14 @@ glm::vec3 directional_specular(const GltfBrdf& m, const glm::vec3& n, const glm:
   const glm::vec3 ve(glm::dot(v, t), glm::dot(v, b), n_dot_v);
   // Heitz 2018, "Sampling the GGX Distribution of Visible Normals".
   const glm::vec3 vh = glm::normalize(glm::vec3(a * ve.x, a * ve.y, ve.z));
+  // Below 1e-7 (a view within 3e-4 rad of the normal) the tangent is float noise, and the
+  // samples' rotation about n would differ between the C++ and the GPU: fixed instead.
   const float lensq = vh.x * vh.x + vh.y * vh.y;
-  const glm::vec3 t1 = lensq > 0.0f ? glm::vec3(-vh.y, vh.x, 0.0f) / std::sqrt(lensq) : glm::vec3(1.0f, 0.0f, 0.0f);
+  const glm::vec3 t1 = lensq > 1e-7f ? glm::vec3(-vh.y, vh.x, 0.0f) / std::sqrt(lensq) : glm::vec3(1.0f, 0.0f, 0.0f);
   const glm::vec3 t2 = glm::cross(vh, t1);
   const float g1 = 2.0f * n_dot_v / (n_dot_v + std::sqrt(a * a + (1.0f - a * a) * n_dot_v * n_dot_v));
   const std::size_t count = std::min(directions.size(), radiance.size());
-  float sum_w = 0.0f;
-  glm::vec3 sum(0.0f);
+  glm::vec3 sum_w(0.0f), sum(0.0f);
   for (int j = 0; j < kDirectionalLobeSamples; ++j) {
     const glm::vec2 u = directional_lobe_sample_point(j);
     const float r = std::sqrt(u.x), phi = 6.28318530718f * u.y;
@@ -65,15 +58,22 @@ glm::vec3 directional_specular(const GltfBrdf& m, const glm::vec3& n, const glm:
     const glm::vec3 l = 2.0f * glm::dot(v, h) * h - v;
     const float n_dot_l = glm::dot(n, l);
     if (!(n_dot_l > 0.0f)) continue;
-    const int k = directional_bin_of(directions.first(count), n, l);
+    const int k = directional_bin_of(directions.first(count), l);
     if (k < 0) continue;
-    // f cos / pdf of the visible-normal sampling, without Fresnel: G2(v, l) / G1(v).
-    const float w = 4.0f * n_dot_l * n_dot_v * gltf_smith_visibility(n_dot_v, n_dot_l, a) / g1;
+    // f cos / pdf of the visible-normal sampling: F(v.h) G2(v, l) / G1(v), per channel.
+    const float fresnel_w = gltf_schlick_weight(glm::dot(v, h));
+    const glm::vec3 fresnel =
+        (1.0f - m.metallic) * m.specular_weight * (m.dielectric_f0 + (1.0f - m.dielectric_f0) * fresnel_w) +
+        m.metallic * (m.base_color + (1.0f - m.base_color) * fresnel_w);
+    const glm::vec3 w = fresnel * (4.0f * n_dot_l * n_dot_v * gltf_smith_visibility(n_dot_v, n_dot_l, a) / g1);
     sum_w += w;
     sum += w * radiance[static_cast<std::size_t>(k)];
   }
-  if (!(sum_w > 0.0f)) return glm::vec3(0.0f);
-  return gltf_directional_albedo(m, glm::dot(n, v)).specular * (sum / sum_w);
+  const glm::vec3 albedo = gltf_directional_albedo(m, glm::dot(n, v)).specular;
+  glm::vec3 out(0.0f);
+  for (int c = 0; c < 3; ++c)
+    if (sum_w[c] > 0.0f) out[c] = albedo[c] * sum[c] / sum_w[c];
+  return out;
 }
 
 }  // namespace engine

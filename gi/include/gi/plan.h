@@ -10,7 +10,7 @@
 //   - static lights (or emissive static surfaces) and static meshes -> light atlas ("light_atlas");
 //   - a light moves (Light::moves / glTF gi.light_moves, a light on or under a dynamic node,
 //     or named in PlanOptions::moving_lights) and static meshes -> PRM ("prm");
-//   - a static surface with roughness below PlanOptions::glossy_roughness -> directional
+//   - a static surface with roughness in [PlanOptions::glossy_roughness_min, glossy_roughness) -> directional
 //     light maps ("dlm");
 //   - nodes flagged gi.region "deforming" -> antiradiance ("antiradiance") for them;
 //   - dynamic mesh entities -> basis radiance fields ("brf") for their meshes only.
@@ -73,6 +73,7 @@ struct EffectPlan {
   std::string scene;   ///< SceneAsset::source (file), informative.
   std::string preset;  ///< The preset the estimates are for.
   float glossy_roughness = 0.0f;
+  float glossy_roughness_min = 0.0f;
   SceneFacts facts;
   std::vector<PlannedEffect> effects;  ///< kEffectMethodCount entries.
   std::vector<std::string> warnings;   ///< Facts a bake would treat differently from the plan.
@@ -84,10 +85,12 @@ struct EffectPlan {
 
 struct PlanOptions {
   std::string preset = "medium";  ///< preview | medium | high (the bakers' presets).
-  /// Static surfaces with a roughness factor below this get directional light maps. At 0.35
-  /// (GGX alpha = roughness^2 = 0.12) the reflection of a light or a lit wall is a recognizable
-  /// image that a diffuse atlas cannot carry; the project's glossy floors use 0.15.
-  float glossy_roughness = 0.35f;
+  /// Static surfaces with a roughness factor in [glossy_roughness_min, glossy_roughness) get
+  /// directional light maps: the range over which they beat the atlas's direction-less
+  /// specular term against the path tracer on glossy_room (docs/dlm.md, "The regime", measured
+  /// 0.1 .. 0.8). Sharper surfaces are the reflection probes' (their lobe is narrower than a bin).
+  float glossy_roughness = 0.8f;
+  float glossy_roughness_min = 0.1f;
   /// Lights (by name) the game moves or scripts although the file does not flag them.
   std::vector<std::string> moving_lights;
   /// Overrides of the preset, as gi-bake's --density / --vpls / --samples / --bounces (0: preset).

@@ -49,6 +49,8 @@ engine::Status validate(const DlmSettings& s) {
   if (!(s.splat_radius_texels >= 0.5f) || s.splat_radius_texels > 16.0f)
     return bad("splat_radius_texels must be in [0.5, 16]");
   if (!(s.glossy_roughness > 0.0f) || s.glossy_roughness > 1.0f) return bad("glossy_roughness must be in (0, 1]");
+  if (!(s.glossy_roughness_min >= 0.0f) || !(s.glossy_roughness_min < s.glossy_roughness))
+    return bad("glossy_roughness_min must be in [0, glossy_roughness)");
   if (s.max_bounces < 2 || s.max_bounces > 1024) return bad("max_bounces must be in 2..1024");
   if (s.area_light_samples < 1 || s.area_light_samples > 65536) return bad("area_light_samples must be in 1..65536");
   return {};
@@ -162,18 +164,14 @@ std::vector<glm::vec3> dlm_directions(int count) {
   return out;
 }
 
-std::uint32_t dlm_bin(std::span<const glm::vec3> directions, const glm::vec3& n, const glm::vec3& w) {
-  std::uint32_t best = 0, best_facing = 0;
-  float best_dot = -2.0f, best_n = -2.0f;
-  bool any = false;
+std::uint32_t dlm_bin(std::span<const glm::vec3> directions, const glm::vec3& w) {
+  std::uint32_t best = 0;
+  float best_dot = -2.0f;
   for (std::size_t k = 0; k < directions.size(); ++k) {
-    const float nk = glm::dot(n, directions[k]);
-    if (nk > best_n) best_n = nk, best_facing = static_cast<std::uint32_t>(k);
-    if (!(nk > engine::kDirectionalMinCos)) continue;
     const float d = glm::dot(w, directions[k]);
-    if (d > best_dot) best_dot = d, best = static_cast<std::uint32_t>(k), any = true;
+    if (d > best_dot) best_dot = d, best = static_cast<std::uint32_t>(k);
   }
-  return any ? best : best_facing;
+  return best;
 }
 
 std::vector<float> dlm_bin_cosine_weights(std::span<const glm::vec3> directions, const glm::vec3& n) {
@@ -183,7 +181,7 @@ std::vector<float> dlm_bin_cosine_weights(std::span<const glm::vec3> directions,
     const glm::vec3 w = fibonacci_direction(i, kQuadratureDirections);
     const float cos_w = glm::dot(n, w);
     if (!(cos_w > 0.0f)) continue;
-    c[dlm_bin(directions, n, w)] += static_cast<double>(cos_w) * dw;
+    c[dlm_bin(directions, w)] += static_cast<double>(cos_w) * dw;
   }
   return std::vector<float>(c.begin(), c.end());
 }
@@ -226,7 +224,8 @@ TriangleMaterials triangle_materials(const StaticBakeScene& s, const DlmSettings
     if (it == by_material.end()) {
       const engine::GltfBrdf& brdf = s.scene.materials[m].brdf;
       it = by_material
-               .emplace(m, std::make_pair(std::sqrt(brdf.alpha) < settings.glossy_roughness,
+               .emplace(m, std::make_pair(std::sqrt(brdf.alpha) < settings.glossy_roughness &&
+                                              std::sqrt(brdf.alpha) >= settings.glossy_roughness_min,
                                           engine::gltf_hemispherical_albedo(brdf).sum()))
                .first;
     }
@@ -339,11 +338,11 @@ struct SplatKernel {
   bool splat(std::uint32_t c, std::uint32_t prim, glm::vec2 bc, const glm::vec3& w_in, const glm::vec3& power,
              std::vector<Deposit>& out) const {
     const std::size_t first = out.size();
-    for_kernel(texel_point(c, prim, bc), static_cast<std::int32_t>(dlm.layout.meshes[c].triangle_chart[prim]),
-               [&](std::size_t t, float w) {
-                 out.push_back({static_cast<std::uint32_t>(glossy.element[t]),
-                                dlm_bin(dlm.directions, tex.normal[t], w_in), w * power});
-               });
+    for_kernel(
+        texel_point(c, prim, bc), static_cast<std::int32_t>(dlm.layout.meshes[c].triangle_chart[prim]),
+        [&](std::size_t t, float w) {
+          out.push_back({static_cast<std::uint32_t>(glossy.element[t]), dlm_bin(dlm.directions, w_in), w * power});
+        });
     return out.size() > first;
   }
 };

@@ -8,8 +8,9 @@
 //
 // Bake (paper §3.1, deviations in docs/dlm.md):
 //   1. Omega: N directions of a spherical Fibonacci lattice (near-uniform; the paper warps
-//      random points [Shi92]). Bin k = the directions nearest psi_k among the bins usable at
-//      the texel's normal n (n.psi_k > engine::kDirectionalMinCos: the paper's "front-facing").
+//      random points [Shi92]). Bin k = the directions nearest psi_k (the paper's rule). At a
+//      texel of normal n the bins whose cell reaches above the horizon hold light, also a psi
+//      just below it (its cell's sliver above): light at the horizon stays in bins at the horizon.
 //   2. Photons from the static lights and emissive static surfaces (transport/point_emitters),
 //      chosen in proportion to their power, each from its own random stream (seed, photon).
 //      A path bounces diffusely with the hemispherical albedo of the glTF BRDF (Russian
@@ -18,14 +19,14 @@
 //      power into the bin nearest its incoming direction, with a pyramidal (tent) kernel of
 //      `splat_radius_texels` over the texels of the hit's chart.
 //   3. The splatted irradiance of bin k, E_k (W/m^2 over the texel's area), becomes the bin's
-//      mean radiance L_k = E_k / C_k(n), C_k(n) = integral over the bin's usable directions
+//      mean radiance L_k = E_k / C_k(n), C_k(n) = integral over the bin's directions above the horizon
 //      of n.w dw (by quadrature over a fine Fibonacci set): uniform incoming radiance L gives
 //      L_k = L in every bin. So the renderer integrates the glTF lobe against L_k
 //      (engine/directional_radiance.h). A bin whose C_k is small cannot hold more than the
 //      photons' flux over C_k: finite, and bounded by the lights' flux (tested).
 //   4. Each bin's map is dilated like the light atlas into the chart gutters.
-// Glossy texels: those whose owning triangle's material has roughness < glossy_roughness
-// (the planner's rule, per triangle). Bit-identical for any thread count: photons are traced
+// Glossy texels: those whose owning triangle's material has roughness in [glossy_roughness_min,
+// glossy_roughness) (the planner's range, per triangle). Bit-identical for any thread count: photons are traced
 // in fixed batches whose deposits are summed in photon order.
 
 #include <engine/result.h>
@@ -47,7 +48,8 @@ struct DlmSettings {
   int directions = 32;                ///< N = |Omega|, 8..256.
   std::uint64_t photons = 1'000'000;  ///< Photon paths shot from the lights.
   float splat_radius_texels = 1.5f;   ///< Tent kernel radius (the paper's pyramidal splats are 1.5 texels wide).
-  float glossy_roughness = 0.35f;     ///< Texels of materials with roughness below this get maps (PlanOptions).
+  float glossy_roughness = 0.8f;      ///< Texels of materials with roughness below this get maps (PlanOptions)
+  float glossy_roughness_min = 0.0f;  ///< ... and at or above this (sharper ones are the reflection probes').
   int max_bounces = 16;               ///< Safety stop of a photon path (Russian roulette ends it first).
   int area_light_samples = 16;        ///< Point emitters per area light or emissive triangle.
   std::uint64_t seed = 1;
@@ -76,8 +78,8 @@ struct Dlm {
   /// and the gutter texels dilation filled next to them.
   std::vector<std::uint32_t> texels;
   /// Bin k, element i, channel ch at radiance[(k * texels.size() + i) * 3 + ch]: mean
-  /// incoming indirect radiance (W/(m^2 sr)) from the directions of bin k. Zero in bins not
-  /// usable at the texel's normal.
+  /// incoming indirect radiance (W/(m^2 sr)) from the directions of bin k. Zero in bins
+  /// whose cell lies wholly below the texel's horizon.
   std::vector<float> radiance;
   DlmSettings settings;
   DlmStats stats;
@@ -91,9 +93,9 @@ engine::Result<DlmSettings> dlm_preset(std::string_view name);
 /// The N directions of Omega (spherical Fibonacci lattice), deterministic.
 std::vector<glm::vec3> dlm_directions(int count);
 
-/// The bin of incoming direction `w` at normal `n`: the nearest direction with
-/// n.psi > kDirectionalMinCos, or the one with the largest n.psi when none is usable.
-std::uint32_t dlm_bin(std::span<const glm::vec3> directions, const glm::vec3& n, const glm::vec3& w);
+/// The bin of incoming direction `w`: the nearest direction psi_k (the paper's rule, at every
+/// normal; engine::directional_bin_of is the renderer's twin).
+std::uint32_t dlm_bin(std::span<const glm::vec3> directions, const glm::vec3& w);
 
 /// C_k(n) for every bin: integral over the hemisphere of n of n.w, split by dlm_bin(w)
 /// (4096-point Fibonacci quadrature). Sums to ~pi.

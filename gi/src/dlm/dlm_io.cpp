@@ -42,7 +42,8 @@ std::string check_dlm(const Dlm& d) {
   const DlmSettings& s = d.settings;
   if (!(s.texels_per_metre > 0.0f) || !std::isfinite(s.texels_per_metre) || s.directions < 8 || s.directions > 256 ||
       s.photons < 1 || !(s.splat_radius_texels > 0.0f) || !std::isfinite(s.splat_radius_texels) ||
-      !(s.glossy_roughness > 0.0f) || !(s.glossy_roughness <= 1.0f) || s.max_bounces < 1 || s.area_light_samples < 1)
+      !(s.glossy_roughness > 0.0f) || !(s.glossy_roughness <= 1.0f) || !(s.glossy_roughness_min >= 0.0f) ||
+      !(s.glossy_roughness_min < s.glossy_roughness) || s.max_bounces < 1 || s.area_light_samples < 1)
     return "settings out of range";
   if (d.width <= 0 || d.height <= 0 || d.width > kMaxAtlasSide || d.height > kMaxAtlasSide)
     return "atlas size " + std::to_string(d.width) + "x" + std::to_string(d.height) + " is outside 1..16384";
@@ -70,6 +71,7 @@ json settings_json(const DlmSettings& s) {
               {"photons", s.photons},
               {"splat_radius_texels", s.splat_radius_texels},
               {"glossy_roughness", s.glossy_roughness},
+              {"glossy_roughness_min", s.glossy_roughness_min},
               {"max_bounces", s.max_bounces},
               {"area_light_samples", s.area_light_samples},
               {"seed", s.seed}};
@@ -132,6 +134,7 @@ engine::Status write_dlm_file(const fs::path& path, const Dlm& dlm, const std::s
   w.put(static_cast<std::uint64_t>(s.photons));
   w.put(s.splat_radius_texels);
   w.put(s.glossy_roughness);
+  w.put(s.glossy_roughness_min);
   w.put(static_cast<std::int32_t>(s.max_bounces));
   w.put(static_cast<std::int32_t>(s.area_light_samples));
   w.put(static_cast<std::uint64_t>(s.seed));
@@ -157,9 +160,9 @@ engine::Result<DlmFile> read_dlm_file(const fs::path& path) {
   std::vector<std::uint16_t> halves;
   const bool complete = r.get_string(f.geometry_hash) && r.get(s.texels_per_metre) && r.get(directions) &&
                         r.get(photons) && r.get(s.splat_radius_texels) && r.get(s.glossy_roughness) &&
-                        r.get(max_bounces) && r.get(area_samples) && r.get(seed) && r.get(width) && r.get(height) &&
-                        r.get_array(d.directions) && r.get_array(d.texels) && r.get_array(scales) &&
-                        r.get_array(halves);
+                        r.get(s.glossy_roughness_min) && r.get(max_bounces) && r.get(area_samples) && r.get(seed) &&
+                        r.get(width) && r.get(height) && r.get_array(d.directions) && r.get_array(d.texels) &&
+                        r.get_array(scales) && r.get_array(halves);
   const std::string location = "payload byte " + std::to_string(r.offset());
   if (!complete) return file_error(path, location, "truncated payload");
   if (r.remaining() != 0) return file_error(path, location, "unexpected data after the last field");

@@ -84,13 +84,26 @@ std::pair<float, std::string> min_roughness(const BakeInput& input, const BakeIn
 // What the rules read, gathered once.
 struct PlanFacts {
   std::vector<std::string> static_lights, moving_lights, moving_why;
-  std::vector<std::string> static_meshes, emissive_meshes, glossy, glossy_why, deforming;
+  std::vector<std::string> static_meshes, emissive_meshes, glossy, glossy_why, sharp_glossy, deforming;
   std::vector<std::size_t> glossy_instances;                          // indices into BakeInput::instances
   std::map<std::uint32_t, std::vector<std::string>> dynamic_by_mesh;  // mesh -> instances
   LightPointCount points;
   StaticSurfaceCensus census;
   bool sky = false;  // the environment's sky lights the scene (an outdoor scene)
 };
+
+// A static surface by its roughness: in the DLM range, or sharper (the reflection probes' range).
+void classify_glossy(PlanFacts& f, const PlanOptions& options, std::size_t i, const std::string& name, float roughness,
+                     const std::string& material) {
+  const std::string what = "'" + name + "' (" + material + ") ";
+  if (roughness < options.glossy_roughness_min) {
+    f.sharp_glossy.push_back(what + fixed(roughness, 2));
+  } else if (roughness < options.glossy_roughness) {
+    f.glossy.push_back(name);
+    f.glossy_instances.push_back(i);
+    f.glossy_why.push_back(what + "has roughness " + fixed(roughness, 2));
+  }
+}
 
 PlanFacts gather_facts(const BakeInput& input, const PlanOptions& options, EffectPlan& out) {
   PlanFacts f;
@@ -139,11 +152,7 @@ PlanFacts gather_facts(const BakeInput& input, const PlanOptions& options, Effec
     f.static_meshes.push_back(name);
     if (emissive(input, inst)) f.emissive_meshes.push_back(name);
     const auto [roughness, material] = min_roughness(input, inst);
-    if (roughness < options.glossy_roughness) {
-      f.glossy.push_back(name);
-      f.glossy_instances.push_back(i);
-      f.glossy_why.push_back("'" + name + "' (" + material + ") has roughness " + fixed(roughness, 2));
-    }
+    classify_glossy(f, options, i, name, roughness, material);
   }
   facts.emissive_surfaces = static_cast<int>(f.emissive_meshes.size());
   f.points.sampled += 2 * facts.emissive_surfaces;  // emissive quads: two triangles each, typically
@@ -166,6 +175,7 @@ std::optional<PlanPresets> presets(const PlanOptions& options) {
   if (!atlas || !prm || !dlm) return std::nullopt;
   PlanPresets p{*atlas, *prm, *dlm};
   p.dlm.glossy_roughness = options.glossy_roughness;
+  p.dlm.glossy_roughness_min = options.glossy_roughness_min;
   if (options.texels_per_metre > 0.0f)
     p.atlas.texels_per_metre = p.prm.texels_per_metre = p.dlm.texels_per_metre = options.texels_per_metre;
   if (options.vpls > 0) p.atlas.vpl_count = options.vpls;
@@ -249,12 +259,21 @@ void plan_prm(const PlanFacts& f, const std::optional<PlanPresets>& p, PlannedEf
 void plan_dlm(const BakeInput& input, const PlanFacts& f, const PlanOptions& options,
               const std::optional<PlanPresets>& p, PlannedEffect& dlm) {
   const std::string threshold = fixed(options.glossy_roughness, 2);
+  const std::string range = "[" + fixed(options.glossy_roughness_min, 2) + ", " + threshold + ")";
+  // Sharper surfaces: the reflection probes' range (their lobe is narrower than a bin).
+  const std::string sharp = f.sharp_glossy.empty()
+                                ? std::string()
+                                : "; sharper than " + fixed(options.glossy_roughness_min, 2) +
+                                      " (reflection probes' range): " + list_names(f.sharp_glossy, 2);
   if (f.glossy.empty()) {
-    dlm.reason = "no static surface has roughness < " + threshold + " -> no directional maps";
+    dlm.reason = "no static surface has roughness in " + range + " -> no directional maps" + sharp;
     return;
   }
   dlm.enabled = true;
-  dlm.reason = "static surface " + list_names(f.glossy_why, 2) + " < " + threshold + " -> directional light maps";
+  // The maps hold the static lights' and emissive surfaces' indirect light only (gi/src/dlm/dlm.h).
+  dlm.reason = "static surface " + list_names(f.glossy_why, 2) + " in " + range + sharp +
+               " -> directional light maps (static lights only: moving lights and the sky are absent from them, "
+               "their indirect light stays direction-less in the atlas term)";
   dlm.targets = f.glossy;
   if (!p) return;
   // The glossy instances' own charts: the texels that get a map per direction.
@@ -431,6 +450,7 @@ EffectPlan plan(const BakeInput& input, const PlanOptions& options) {
   out.scene = input.name;
   out.preset = options.preset;
   out.glossy_roughness = options.glossy_roughness;
+  out.glossy_roughness_min = options.glossy_roughness_min;
   for (int i = 0; i < kEffectMethodCount; ++i) {
     PlannedEffect e;
     e.method = static_cast<EffectMethod>(i);

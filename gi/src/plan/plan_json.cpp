@@ -9,6 +9,7 @@ nlohmann::json plan_to_json_value(const EffectPlan& p) {
   j["scene"] = p.scene;
   j["preset"] = p.preset;
   j["glossy_roughness"] = p.glossy_roughness;
+  j["glossy_roughness_min"] = p.glossy_roughness_min;
   j["facts"] = {{"static_lights", p.facts.static_lights},     {"moving_lights", p.facts.moving_lights},
                 {"disabled_lights", p.facts.disabled_lights}, {"emissive_surfaces", p.facts.emissive_surfaces},
                 {"static_meshes", p.facts.static_meshes},     {"dynamic_meshes", p.facts.dynamic_meshes},
@@ -38,6 +39,7 @@ engine::Result<EffectPlan> plan_from_json_value(const nlohmann::json& json, cons
   p.scene = f.get<std::string>("scene");
   p.preset = f.get<std::string>("preset");
   p.glossy_roughness = f.get<float>("glossy_roughness");
+  p.glossy_roughness_min = f.get<float>("glossy_roughness_min");
   p.facts.static_lights = f.get<int>("facts.static_lights");
   p.facts.moving_lights = f.get<int>("facts.moving_lights");
   p.facts.disabled_lights = f.get<int>("facts.disabled_lights");

@@ -8,7 +8,9 @@
 #include <engine/scene.h>
 #include <gi/error_metrics.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "core/random.h"
@@ -39,9 +41,22 @@ struct GlossyTexels {
   std::vector<engine::GltfBrdf> brdf;
 };
 
-engine::Result<GlossyTexels> glossy_texels(const SweepScene& scene, double density, double roughness,
+// The scene with every glossy material (roughness below 0.35, the planner's old threshold)
+// set to `floor_roughness`: glossy_room's floor; the glossy threshold of the bake and the
+// reference then sits above it.
+constexpr double kGlossyOriginal = 0.35;
+engine::SceneAsset with_floor_roughness(const engine::SceneAsset& asset, double floor_roughness) {
+  engine::SceneAsset out = asset;
+  for (engine::Material& m : out.materials)
+    if (static_cast<double>(m.roughness) < kGlossyOriginal) m.roughness = static_cast<float>(floor_roughness);
+  return out;
+}
+double glossy_threshold(double floor_roughness) { return std::max(kGlossyOriginal, floor_roughness + 0.05); }
+
+engine::Result<GlossyTexels> glossy_texels(const SweepScene& scene, double density, double floor_roughness,
                                            const ReferenceRequest* request) {
-  const engine::Scene live = engine::instantiate(scene.asset);
+  const double roughness = glossy_threshold(floor_roughness);
+  const engine::Scene live = engine::instantiate(with_floor_roughness(scene.asset, floor_roughness));
   engine::Entity camera{};
   for (std::size_t n = 0; n < live.assets.nodes.size(); ++n)
     if (live.assets.nodes[n].camera == 0) camera = live.node_entities[n];
@@ -79,31 +94,36 @@ engine::Result<GlossyTexels> glossy_texels(const SweepScene& scene, double densi
 
 engine::Result<RgbField> glossy_specular_reference(const ReferenceJob& job) {
   const ReferenceRequest& r = job.request;
-  auto g = glossy_texels(job.scene, std::stod(r.param("texels_per_m")), std::stod(r.param("roughness")), &r);
+  auto g = glossy_texels(job.scene, std::stod(r.param("texels_per_m")), std::stod(r.param("floor_roughness")), &r);
   if (!g) return g.error();
   const int spp = std::stoi(r.param("spp"));
   const AtlasTexels& tex = g->s.texels;
   PathTracer pt(g->s.scene, g->s.index, *g->s.caster, {});
-  std::vector<glm::vec3> out(tex.valid.size(), glm::vec3(0.0f));
+  std::vector<glm::vec3> out(tex.valid.size(), glm::vec3(0.0f)), variance(tex.valid.size(), glm::vec3(0.0f));
   ThreadPool pool(job.threads);
   const bool done = pool.parallel_for_with_progress(tex.valid.size(), job.progress, [&](std::size_t t) {
     if (!g->glossy[t]) return;
     const glm::vec3 p = tex.position[t], n = tex.normal[t], v = glm::normalize(g->eye - p);
     const ReferenceBrdf f{.normal = n, .material = g->brdf[t]};
     Pcg32 rng = Pcg32::for_item(kReferenceSeed, t);
-    glm::dvec3 sum(0.0);
+    glm::dvec3 sum(0.0), sum2(0.0);
     for (int j = 0; j < spp; ++j) {
       const float ul = rng.next_float(), u1 = rng.next_float(), u2 = rng.next_float();
       BrdfSample s;
       if (!f.sample(v, ul, u1, u2, s) || !(s.pdf > 0.0f)) continue;
       const glm::vec3 spec = engine::gltf_eval_cos(g->brdf[t], n, v, s.wi).specular / s.pdf;
       if (spec == glm::vec3(0.0f)) continue;
-      sum += glm::dvec3(spec * pt.reflected_radiance(Ray{offset_ray_origin(p, n), 0.0f, s.wi}, rng));
+      const glm::dvec3 x(spec * pt.reflected_radiance(Ray{offset_ray_origin(p, n), 0.0f, s.wi}, rng));
+      sum += x, sum2 += x * x;
     }
-    out[t] = glm::vec3(sum / static_cast<double>(spp));
+    const glm::dvec3 mean = sum / static_cast<double>(spp);
+    out[t] = glm::vec3(mean);
+    // The sampling variance of the mean, so that compare_rgb removes the reference's noise.
+    variance[t] = glm::vec3(glm::max(sum2 / static_cast<double>(spp) - mean * mean, glm::dvec3(0.0)) /
+                            static_cast<double>(std::max(spp - 1, 1)));
   });
   if (!done) return engine::cancelled_error("glossy specular reference");
-  return RgbField::from_texels(tex.width, tex.height, out, g->glossy);
+  return RgbField::from_texels(tex.width, tex.height, out, g->glossy, variance);
 }
 
 std::vector<KnobSpec> dlm_knobs() {
@@ -132,6 +152,12 @@ std::vector<KnobSpec> dlm_knobs() {
        .default_grid = {"2"},
        .min_value = 0.5,
        .max_value = 16},
+      {.name = "roughness",
+       .description = "roughness of the glossy materials (those below 0.35 in the scene: glossy_room's floor)",
+       .kind = KnobKind::Real,
+       .default_grid = {"0.15"},
+       .min_value = 0.05,
+       .max_value = 0.9},
       {.name = "ref_spp",
        .description = "specular-lobe samples per texel of the path-traced reference",
        .kind = KnobKind::Integer,
@@ -146,9 +172,38 @@ ReferenceRequest dlm_reference_request(const SweepScene&, const KnobSetting& k) 
   r.kind = "atlas_glossy_specular";
   char density[32];
   std::snprintf(density, sizeof density, "%g", k.real("density"));
-  r.params = {
-      {"texels_per_m", density}, {"spp", std::to_string(k.integer("ref_spp"))}, {"roughness", "0.35"}, {"camera", "0"}};
+  char roughness[32];
+  std::snprintf(roughness, sizeof roughness, "%g", k.real("roughness"));
+  r.params = {{"texels_per_m", density},
+              {"spp", std::to_string(k.integer("ref_spp"))},
+              {"floor_roughness", roughness},
+              {"camera", "0"}};
   return r;
+}
+
+// Mean bias per band of cos(theta_v) (view angle to the texel's normal), DLM and the
+// direction-less atlas term: sum of the values / sum of the reference's - 1 over the band's
+// glossy texels (the reference's noise averages out in the sums).
+void add_view_band_bias(const GlossyTexels& g, const std::vector<glm::vec3>& dlm, const std::vector<glm::vec3>& atlas,
+                        const RgbField& reference, std::vector<std::pair<std::string, double>>& extras) {
+  constexpr double kBands[] = {0.1, 0.3, 0.6, 1.01};
+  for (int b = 0; b < 3; ++b) {
+    double sd = 0.0, sa = 0.0, sr = 0.0;
+    for (std::size_t t = 0; t < dlm.size(); ++t) {
+      if (!g.glossy[t] || !reference.is_valid(t)) continue;
+      const glm::vec3 v = glm::normalize(g.eye - g.s.texels.position[t]);
+      const double c = static_cast<double>(glm::dot(g.s.texels.normal[t], v));
+      if (c < kBands[b] || c >= kBands[b + 1]) continue;
+      sd += static_cast<double>(dlm[t].x + dlm[t].y + dlm[t].z);
+      sa += static_cast<double>(atlas[t].x + atlas[t].y + atlas[t].z);
+      sr += static_cast<double>(reference.rgb[3 * t] + reference.rgb[3 * t + 1] + reference.rgb[3 * t + 2]);
+    }
+    char name[48];
+    std::snprintf(name, sizeof name, "bias_cos%.1f_%.1f", kBands[b], std::min(kBands[b + 1], 1.0));
+    extras.emplace_back(name, sr > 0.0 ? sd / sr - 1.0 : std::nan(""));
+    std::snprintf(name, sizeof name, "atlas_bias_cos%.1f_%.1f", kBands[b], std::min(kBands[b + 1], 1.0));
+    extras.emplace_back(name, sr > 0.0 ? sa / sr - 1.0 : std::nan(""));
+  }
 }
 
 engine::Result<MethodOutput> run_dlm(const RunContext& ctx) {
@@ -157,16 +212,17 @@ engine::Result<MethodOutput> run_dlm(const RunContext& ctx) {
   s.photons = static_cast<std::uint64_t>(ctx.knobs.integer("kphotons")) * 1000u;
   s.texels_per_metre = static_cast<float>(ctx.knobs.real("density"));
   s.splat_radius_texels = static_cast<float>(ctx.knobs.real("splat"));
-  s.glossy_roughness = 0.35f;
+  const double floor_roughness = ctx.knobs.real("roughness");
+  s.glossy_roughness = static_cast<float>(glossy_threshold(floor_roughness));
   s.seed = ctx.seed;
   s.threads = ctx.threads;
   s.progress = ctx.progress;
-  const engine::Scene scene = engine::instantiate(ctx.scene.asset);
+  const engine::Scene scene = engine::instantiate(with_floor_roughness(ctx.scene.asset, floor_roughness));
   auto dlm = bake_dlm(bake_input_from(scene), s);
   if (!dlm) return dlm.error();
   if (dlm->width != ctx.reference.width || dlm->height != ctx.reference.height)
     return engine::Error{.message = "the maps' atlas size differs from the reference's"};
-  auto g = glossy_texels(ctx.scene, ctx.knobs.real("density"), 0.35, nullptr);
+  auto g = glossy_texels(ctx.scene, ctx.knobs.real("density"), floor_roughness, nullptr);
   if (!g) return g.error();
   // The renderer's evaluation (engine::directional_specular) at every stored glossy texel.
   const AtlasTexels& tex = g->s.texels;
@@ -201,8 +257,10 @@ engine::Result<MethodOutput> run_dlm(const RunContext& ctx) {
   out.costs.bytes = static_cast<std::uint64_t>(dlm->texels.size()) * dlm->directions.size() * 8u +
                     static_cast<std::uint64_t>(dlm->width) * static_cast<std::uint64_t>(dlm->height) * 4u;
   out.extras = {{"atlas_rel_rmse", relative_rmse(atlas_field, ctx.reference)},
+                {"atlas_truth_rel_rmse", compare_rgb(atlas_field, ctx.reference).truth_rel_rmse},
                 {"glossy_texels", static_cast<double>(dlm->stats.glossy_texels)},
                 {"deposits", static_cast<double>(dlm->stats.deposits)}};
+  add_view_band_bias(*g, values, atlas_values, ctx.reference, out.extras);
   return out;
 }
 
@@ -210,7 +268,7 @@ engine::Result<MethodOutput> run_dlm(const RunContext& ctx) {
 
 void register_dlm_sweep(SweepRegistry& registry) {
   registry.add_reference_provider(
-      {.kind = "atlas_glossy_specular", .version = "pt-1", .compute = glossy_specular_reference});
+      {.kind = "atlas_glossy_specular", .version = "pt-2", .compute = glossy_specular_reference});
 
   SweepMethod m;
   m.name = method_descriptor(EffectMethod::DirectionalLightMaps).key;  // gi/methods.h

@@ -117,8 +117,9 @@ std::optional<Fixture> make_fixture(engine::SceneAsset uv1_asset) {
   return f;
 }
 
-gi::AtlasLayout layout_of(const engine::SceneAsset& asset) {
-  auto layout = gi::build_atlas_layout(gi::atlas_inputs_from(gi::bake_input_from(asset)), {.texels_per_metre = 8.0f});
+gi::AtlasLayout layout_of(const engine::SceneAsset& asset, float texels_per_metre = 8.0f) {
+  auto layout =
+      gi::build_atlas_layout(gi::atlas_inputs_from(gi::bake_input_from(asset)), {.texels_per_metre = texels_per_metre});
   EXPECT_TRUE(layout.ok()) << layout.error().to_string();
   return std::move(layout).value();
 }
@@ -148,6 +149,60 @@ TEST(DlmLighting, UniformBinsGiveExactlyTheAtlasSpecularShare) {
     ASSERT_NEAR(y, x, 2e-3 * x + 1e-6) << "pixel " << i / 4 % kSize << ", " << i / 4 / kSize;
   }
   std::printf("uniform bins vs the atlas's specular share: max relative difference %.3g\n", max_rel);
+}
+
+// Maps whose texel columns alternate between two radiances (uniform over the bins): every
+// texel boundary is a one-texel step. Rendered relative to uniform maps (the specular ratio
+// pattern / uniform, the emission removed with a render of empty maps), neighbouring pixels
+// on one surface must not jump by the step: the bins are read bilinearly across texels, so a
+// step spreads over the pixels of a texel. Measured: nearest-texel reads 237 of 8244 pairs
+// jump by > 0.4 and no pixel lies between the two levels; bilinear reads 44 (at chart
+// borders, where a texel's neighbours are gutter texels) and 4898 blended pixels.
+TEST(DlmLighting, OneTexelStepGivesNoBlockEdge) {
+  const engine::SceneAsset original = glossy_cornell();
+  const gi::AtlasLayout layout = layout_of(original, 2.0f);
+  engine::SceneAsset asset = original;
+  auto atlas = gi::LightAtlasLighting::from_bake(uniform_atlas(layout, glm::vec3(0.0f)), asset);
+  ASSERT_TRUE(atlas) << atlas.error().to_string();
+  const auto maps_of = [&](auto radiance_of_texel) {
+    gi::Dlm d = every_texel_dlm(layout, [](glm::vec3) { return glm::vec3(0.0f); });
+    for (std::size_t k = 0; k < d.directions.size(); ++k)
+      for (std::size_t i = 0; i < d.texels.size(); ++i) {
+        const float l = radiance_of_texel(d.texels[i] % static_cast<std::uint32_t>(d.width));
+        for (int ch = 0; ch < 3; ++ch) d.radiance[(k * d.texels.size() + i) * 3 + ch] = l;
+      }
+    auto lighting = gi::DlmLighting::from_bake(std::move(d), layout.width, layout.height);
+    EXPECT_TRUE(lighting) << lighting.error().to_string();
+    return std::move(lighting).value();
+  };
+  auto empty = maps_of([](std::uint32_t) { return 0.0f; });
+  auto uniform = maps_of([](std::uint32_t) { return 1.0f; });
+  auto step = maps_of([](std::uint32_t x) { return x % 2 == 0 ? 0.2f : 1.0f; });
+  auto f = make_fixture(std::move(asset));
+  ASSERT_TRUE(f);
+  Combined c0(atlas->get(), empty.get()), c1(atlas->get(), uniform.get()), c2(atlas->get(), step.get());
+  const engine::ImageRgbaF i0 = f->render(&c0), i1 = f->render(&c1), i2 = f->render(&c2);
+  const auto ratio = [&](int x, int y, double* base) {
+    const std::size_t i = static_cast<std::size_t>(y * kSize + x) * 4 + 1;
+    *base = static_cast<double>(i1.pixels[i] - i0.pixels[i]);
+    return *base > 1e-4 ? static_cast<double>(i2.pixels[i] - i0.pixels[i]) / *base : -1.0;
+  };
+  int pairs = 0, jumps = 0, ramps = 0;
+  for (int y = 1; y + 1 < kSize; ++y)
+    for (int x = 1; x + 1 < kSize; ++x) {
+      double b0 = 0.0, b1 = 0.0;
+      const double r0 = ratio(x, y, &b0), r1 = ratio(x + 1, y, &b1);
+      // One surface: both lit by the maps, the uniform render continuous across the pair.
+      if (r0 < 0.0 || r1 < 0.0 || std::fabs(b1 - b0) > 0.05 * std::max(b0, b1)) continue;
+      ++pairs;
+      if (std::fabs(r1 - r0) > 0.4) ++jumps;
+      if (r0 > 0.3 && r0 < 0.9) ++ramps;  // between the two levels: blended
+    }
+  std::printf("one-texel steps: %d neighbour pairs on one surface, %d jump by > 0.4, %d pixels blended\n", pairs, jumps,
+              ramps);
+  EXPECT_GT(pairs, 1000);
+  EXPECT_LT(jumps, pairs / 100);
+  EXPECT_GT(ramps, pairs / 4);
 }
 
 // Möller-Trumbore; distance along the ray or +inf.

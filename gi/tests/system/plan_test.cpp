@@ -90,7 +90,8 @@ TEST(Plan, DemoLevelNeedsEveryBuiltMethodIncludingDirectionalLightMaps) {
   const gi::PlannedEffect& dlm = p.effect(EffectMethod::DirectionalLightMaps);
   EXPECT_TRUE(dlm.enabled);
   EXPECT_TRUE(dlm.available);
-  EXPECT_EQ(dlm.targets, std::vector<std::string>{"corridor_floor"});
+  // The floor (0.15) and the grille (0.5) are in the measured range [0.10, 0.80) (docs/dlm.md).
+  EXPECT_EQ(dlm.targets, (std::vector<std::string>{"corridor_floor", "crate_room_grille"}));
   EXPECT_EQ(sorted(p.effect(EffectMethod::BasisRadianceFields).targets), sorted({"crate", "crate_red", "lamp_shade"}));
   EXPECT_EQ(p.methods_to_bake(),
             (std::vector<std::string>{"light_atlas", "prm", "dlm", "antiradiance", "brf", "reflection_probes"}));
@@ -141,16 +142,19 @@ TEST(Plan, GlossyRoomCallsForDirectionalLightMaps) {
   EXPECT_TRUE(dlm.enabled);
   EXPECT_TRUE(dlm.available);
   EXPECT_EQ(dlm.targets, std::vector<std::string>{"glossy_floor"});
-  EXPECT_TRUE(contains(dlm.reason, "roughness 0.15 < 0.35")) << dlm.reason;
+  EXPECT_TRUE(contains(dlm.reason, "roughness 0.15 in [0.10, 0.80)")) << dlm.reason;
+  EXPECT_TRUE(contains(dlm.reason, "moving lights and the sky are absent")) << dlm.reason;
   EXPECT_GT(dlm.estimate.bake_seconds, 0.0);
   EXPECT_GT(dlm.estimate.runtime_bytes, 0u);
   EXPECT_EQ(p.methods_to_bake(), (std::vector<std::string>{"light_atlas", "dlm", "reflection_probes"}));
   EXPECT_FALSE(contains(gi::format_plan(p), "NOT BUILT"));
-  // A stricter threshold drops it, and the reason says so.
-  const gi::EffectPlan strict = gi::plan(load("glossy_room.gltf"), {.glossy_roughness = 0.1f});
+  // A range above the floor's roughness drops it, and the reason names it as the probes'.
+  const gi::EffectPlan strict =
+      gi::plan(load("glossy_room.gltf"), {.glossy_roughness = 0.8f, .glossy_roughness_min = 0.2f});
+  const std::string& why = strict.effect(EffectMethod::DirectionalLightMaps).reason;
   EXPECT_FALSE(strict.effect(EffectMethod::DirectionalLightMaps).enabled);
-  EXPECT_TRUE(
-      contains(strict.effect(EffectMethod::DirectionalLightMaps).reason, "no static surface has roughness < 0.10"));
+  EXPECT_TRUE(contains(why, "no static surface has roughness in [0.20, 0.80)")) << why;
+  EXPECT_TRUE(contains(why, "(reflection probes' range): 'glossy_floor'")) << why;
 }
 
 TEST(Plan, ASceneWithoutLightGetsNothing) {
