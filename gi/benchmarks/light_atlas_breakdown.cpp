@@ -11,6 +11,10 @@
 // The scene is baked untextured under docs/real_level.md's sun and gradient sky; the two
 // references are cached in cache_dir (keyed by density and spp; delete them after a change
 // of the path tracer or of the texel placement).
+// Environment: GI_BREAKDOWN_FILTER=r (filter radius, texels; 0 = the sweep's unfiltered
+// run), GI_BREAKDOWN_SEEDS=2 (a second gather: the gather-noise and floor columns),
+// GI_BREAKDOWN_WORST=N (the N worst texels), GI_BREAKDOWN_TEXEL=i,j (per texel: its normals
+// and face, 16 rays and what they read, the path tracer there at 0, 1 and all bounces).
 #include <engine/gltf.h>
 #include <engine/sun.h>
 #include <gi/bake_input.h>
@@ -26,6 +30,7 @@
 #include <fstream>
 #include <map>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -237,6 +242,17 @@ int main(int argc, char** argv) {
     const glm::vec3 face = glm::dot(own.face_normal, tx.normal[i]) < 0.0f ? -own.face_normal : own.face_normal;
     const glm::vec3 origin = gi::offset_ray_origin(tx.position[i], face);
     const gi::Hit sun_hit = scene->caster->intersect(gi::Ray{origin, 0.0f, to_sun});
+    // The path tracer at the texel's sample with 0, 1 and all bounces: where its light comes from.
+    for (const int bounces : {0, 1, -1}) {
+      const gi::SurfacePoint point{.position_m = tx.position[i], .normal = tx.normal[i], .face_normal = face};
+      auto pt = gi::reference_irradiance(input, std::span<const gi::SurfacePoint>(&point, 1),
+                                         {.samples_per_pixel = 256, .max_bounces = bounces, .seed = 9, .threads = 2});
+      if (pt)
+        std::printf(
+            "texel %zu: path tracer, %d bounces: direct %.1f indirect %.1f (triangle's own face_normal.y %.3f)\n", i,
+            bounces, static_cast<double>(pt->direct[0].y), static_cast<double>(pt->indirect[0].y),
+            static_cast<double>(own.face_normal.y));
+    }
     std::printf(
         "texel %zu: p (%.4f %.4f %.4f) normal (%.3f %.3f %.3f) face (%.3f %.3f %.3f) sun cos %.3f / face %.3f, "
         "towards the sun: %s t %.4f\n",
