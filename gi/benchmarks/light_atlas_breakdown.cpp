@@ -11,6 +11,10 @@
 // The scene is baked untextured under docs/real_level.md's sun and gradient sky; the two
 // references are cached in cache_dir (keyed by density and spp; delete them after a change
 // of the path tracer or of the texel placement).
+// Environment: GI_BREAKDOWN_FILTER=r (filter radius, texels; 0 = the sweep's unfiltered
+// run), GI_BREAKDOWN_SEEDS=2 (a second gather: the gather-noise and floor columns),
+// GI_BREAKDOWN_WORST=N (the N worst texels), GI_BREAKDOWN_TEXEL=i,j (per texel: its normals
+// and face, 16 rays and what they read, the path tracer there at 0, 1 and all bounces).
 #include <engine/gltf.h>
 #include <engine/sun.h>
 #include <gi/bake_input.h>
@@ -21,9 +25,12 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -41,7 +48,9 @@ namespace {
 
 struct Sums {
   double err2 = 0.0, noise2 = 0.0, ref2 = 0.0, diff = 0.0, ref = 0.0, diff_direct = 0.0, diff_indirect = 0.0;
+  double gather_noise2 = 0.0;  // sum |a - a'|^2 / 2 over a second gather of another seed: the gather's variance
   std::size_t n = 0;
+  void add_second(const glm::dvec3& a, const glm::dvec3& a2) { gather_noise2 += 0.5 * glm::dot(a - a2, a - a2); }
   // The parts' differences (gather - mean of the references), summed over the channels.
   void add_parts(const glm::dvec3& direct, const glm::dvec3& indirect) {
     diff_direct += direct.x + direct.y + direct.z;
@@ -57,14 +66,17 @@ struct Sums {
     ++n;
   }
   double truth_err2() const { return std::max(0.0, err2 - noise2); }
+  // What is left of the error without the gather's own noise (needs a second gather).
+  double floor_err2() const { return std::max(0.0, truth_err2() - gather_noise2); }
 };
 
 void row(const char* name, const Sums& s, double all_ref2) {
   if (s.n == 0) return;
-  std::printf("| %s | %zu | %.4f | %+.4f | %+.4f | %+.4f | %.4f | %.4f |\n", name, s.n,
-              std::sqrt(s.truth_err2() / std::max(1e-30, s.ref2 - s.noise2)), s.diff / s.ref, s.diff_direct / s.ref,
-              s.diff_indirect / s.ref, std::sqrt(s.truth_err2() / all_ref2),
-              std::sqrt(s.noise2 / std::max(1e-30, s.ref2)));
+  const double truth2 = std::max(1e-30, s.ref2 - s.noise2);
+  std::printf("| %s | %zu | %.4f | %+.4f | %+.4f | %+.4f | %.4f | %.4f | %.4f | %.4f |\n", name, s.n,
+              std::sqrt(s.truth_err2() / truth2), s.diff / s.ref, s.diff_direct / s.ref, s.diff_indirect / s.ref,
+              std::sqrt(s.truth_err2() / all_ref2), std::sqrt(s.noise2 / std::max(1e-30, s.ref2)),
+              std::sqrt(s.gather_noise2 / truth2), std::sqrt(s.floor_err2() / truth2));
 }
 
 bool load_cache(const std::filesystem::path& p, std::size_t n, std::vector<glm::vec3>& direct,
@@ -118,8 +130,19 @@ int main(int argc, char** argv) {
   gi::ThreadPool pool(2);
   gi::TexelGatherSettings g = s.gather;
   g.seed = s.seed;
+  // GI_BREAKDOWN_FILTER=r: another filter radius (texels) than the preset's; 0 is the sweep's unfiltered run.
+  if (const char* r = std::getenv("GI_BREAKDOWN_FILTER")) g.filter_radius_texels = std::strtof(r, nullptr);
   auto gathered = gi::gather_atlas(*scene, *layout, g, pool);
   if (!gathered) return std::fprintf(stderr, "%s\n", gathered.error().to_string().c_str()), 1;
+  // GI_BREAKDOWN_SEEDS=2: a second gather of another seed; the two differ by the gather's noise,
+  // so the "floor" column (error without that noise) is its bias and reconstruction error.
+  std::optional<gi::TexelGatherResult> second;
+  if (const char* seeds = std::getenv("GI_BREAKDOWN_SEEDS"); seeds && std::atoi(seeds) >= 2) {
+    g.seed = s.seed + 1;
+    auto again = gi::gather_atlas(*scene, *layout, g, pool);
+    if (!again) return std::fprintf(stderr, "%s\n", again.error().to_string().c_str()), 1;
+    second = std::move(again).value();
+  }
   const gi::AtlasTexels& tx = scene->texels;
   const std::size_t n = tx.valid.size();
 
@@ -148,6 +171,7 @@ int main(int argc, char** argv) {
   Sums all, total_direct, total_indirect;
   std::map<std::string, Sums> by;
   std::map<int, Sums> by_material, by_chart;
+  std::map<std::string, Sums> by_dominated;
   for (int y = 0; y < tx.height; ++y)
     for (int x = 0; x < tx.width; ++x) {
       const std::size_t i = tx.index(x, y);
@@ -157,9 +181,11 @@ int main(int argc, char** argv) {
       const glm::dvec3 r1 = glm::dvec3(rd[0][i] + ri[0][i]), r2 = glm::dvec3(rd[1][i] + ri[1][i]);
       const glm::dvec3 dd = a_d - 0.5 * glm::dvec3(rd[0][i] + rd[1][i]),
                        di = a_i - 0.5 * glm::dvec3(ri[0][i] + ri[1][i]);
+      const glm::dvec3 a2 = second ? glm::dvec3(second->direct[i] + second->baked_direct[i] + second->indirect[i]) : a;
       const auto into = [&](Sums& sums) {
         sums.add(a, r1, r2);
         sums.add_parts(dd, di);
+        sums.add_second(a, a2);
       };
       into(all);
       total_direct.add(a_d, glm::dvec3(rd[0][i]), glm::dvec3(rd[1][i]));
@@ -192,9 +218,22 @@ int main(int argc, char** argv) {
       into(by_material[static_cast<int>(tri.material)]);
       const glm::ivec2 sz = layout->charts[static_cast<std::size_t>(tx.chart[i])].size;
       into(by_chart[sz.x * sz.y <= 16 ? 16 : sz.x * sz.y <= 64 ? 64 : sz.x * sz.y <= 256 ? 256 : 1 << 30]);
+      // The measure: texels whose truth indirect is >= 80% of the truth total.
+      const glm::dvec3 ri_mean = 0.5 * glm::dvec3(ri[0][i] + ri[1][i]), r_mean = 0.5 * (r1 + r2);
+      if (ri_mean.x + ri_mean.y + ri_mean.z >= 0.8 * (r_mean.x + r_mean.y + r_mean.z)) {
+        const bool thin = std::min(sz.x, sz.y) <= 4;  // the footprint includes the 1-texel rims
+        into(by_dominated["all"]);
+        into(by_dominated[gathered->hidden[i] ? "hidden" : border ? "chart border" : "chart interior"]);
+        if (thin) into(by_dominated["thin chart (<= 4 texels across)"]);
+        into(by_dominated[sz.x * sz.y <= 64 ? "chart <= 64 texels" : "chart > 64 texels"]);
+        into(by_dominated[glm::dot(tri.face_normal, tx.normal[i]) < 0.996f ? "normal > 5 deg off face"
+                                                                           : "normal on face"]);
+      }
     }
   // GI_BREAKDOWN_TEXEL=i: 16 rays from texel i, where they land and the texel the atlas reads there.
-  if (const char* probe = std::getenv("GI_BREAKDOWN_TEXEL")) {
+  // Several texels: GI_BREAKDOWN_TEXEL=i,j,k. Also where a ray towards the sun's centre stops.
+  for (const char* probe = std::getenv("GI_BREAKDOWN_TEXEL"); probe && *probe;
+       probe = std::strchr(probe, ',') ? std::strchr(probe, ',') + 1 : nullptr) {
     const std::size_t i = std::strtoul(probe, nullptr, 10);
     const gi::ShadingTriangle& own =
         scene->index
@@ -202,6 +241,26 @@ int main(int argc, char** argv) {
                        static_cast<std::uint32_t>(tx.triangle[i])];
     const glm::vec3 face = glm::dot(own.face_normal, tx.normal[i]) < 0.0f ? -own.face_normal : own.face_normal;
     const glm::vec3 origin = gi::offset_ray_origin(tx.position[i], face);
+    const gi::Hit sun_hit = scene->caster->intersect(gi::Ray{origin, 0.0f, to_sun});
+    // The path tracer at the texel's sample with 0, 1 and all bounces: where its light comes from.
+    for (const int bounces : {0, 1, -1}) {
+      const gi::SurfacePoint point{.position_m = tx.position[i], .normal = tx.normal[i], .face_normal = face};
+      auto pt = gi::reference_irradiance(input, std::span<const gi::SurfacePoint>(&point, 1),
+                                         {.samples_per_pixel = 256, .max_bounces = bounces, .seed = 9, .threads = 2});
+      if (pt)
+        std::printf(
+            "texel %zu: path tracer, %d bounces: direct %.1f indirect %.1f (triangle's own face_normal.y %.3f)\n", i,
+            bounces, static_cast<double>(pt->direct[0].y), static_cast<double>(pt->indirect[0].y),
+            static_cast<double>(own.face_normal.y));
+    }
+    std::printf(
+        "texel %zu: p (%.4f %.4f %.4f) normal (%.3f %.3f %.3f) face (%.3f %.3f %.3f) sun cos %.3f / face %.3f, "
+        "towards the sun: %s t %.4f\n",
+        i, static_cast<double>(tx.position[i].x), static_cast<double>(tx.position[i].y),
+        static_cast<double>(tx.position[i].z), static_cast<double>(tx.normal[i].x), static_cast<double>(tx.normal[i].y),
+        static_cast<double>(tx.normal[i].z), static_cast<double>(face.x), static_cast<double>(face.y),
+        static_cast<double>(face.z), static_cast<double>(glm::dot(tx.normal[i], to_sun)),
+        static_cast<double>(glm::dot(face, to_sun)), sun_hit.valid() ? "hit" : "sky", static_cast<double>(sun_hit.t));
     for (int r = 0; r < 16; ++r) {
       const glm::vec3 wi = gi::sample_cosine_hemisphere(tx.normal[i], (static_cast<float>(r) + 0.5f) / 16.0f,
                                                         std::fmod(0.618034f * static_cast<float>(r), 1.0f));
@@ -256,7 +315,7 @@ int main(int argc, char** argv) {
               preset.c_str(), spp);
   std::printf(
       "| texels | n | rel err vs truth | bias | of it direct | of it indirect | share of the whole error | ref noise "
-      "|\n|---|---|---|---|---|---|---|---|\n");
+      "| gather noise | floor |\n|---|---|---|---|---|---|---|---|---|---|\n");
   row("all (total)", all, all.ref2 - all.noise2);
   row("direct part (sun + sky)", total_direct, all.ref2 - all.noise2);
   row("indirect part", total_indirect, all.ref2 - all.noise2);
@@ -264,5 +323,6 @@ int main(int argc, char** argv) {
   for (const auto& [k, v] : by_chart)
     row(("chart <= " + std::to_string(k) + " texels").c_str(), v, all.ref2 - all.noise2);
   for (const auto& [k, v] : by_material) row(("material " + std::to_string(k)).c_str(), v, all.ref2 - all.noise2);
+  for (const auto& [k, v] : by_dominated) row(("indirect-dominated: " + k).c_str(), v, all.ref2 - all.noise2);
   return 0;
 }

@@ -26,6 +26,11 @@ float spot_factor(const ReferenceLight& l, const glm::vec3& to_light) {
   return spot_cone(l.direction, l.cos_outer, l.cos_inner, to_light);
 }
 
+// Light from below a receiver's own plane is dark (a zero face: no such receiver).
+bool below_face(const glm::vec3& wi, const glm::vec3& face) {
+  return face != glm::vec3(0.0f) && glm::dot(wi, face) <= 0.0f;
+}
+
 }  // namespace
 
 PathTracer::PathTracer(const ReferenceScene& scene, const ReferenceSceneIndex& index, const RayCaster& caster,
@@ -38,7 +43,7 @@ float PathTracer::emitter_pdf(const ShadingTriangle& t, float distance2, float c
 }
 
 glm::vec3 PathTracer::direct_light(const glm::vec3& origin, const glm::vec3& p, const ReferenceBrdf& brdf,
-                                   const glm::vec3& wo, Pcg32& rng) const {
+                                   const glm::vec3& wo, Pcg32& rng, const glm::vec3& face) const {
   glm::vec3 sum(0.0f);
   for (std::size_t i = 0; i < scene_.lights.size(); ++i) {
     const ReferenceLight& l = scene_.lights[i];
@@ -50,7 +55,7 @@ glm::vec3 PathTracer::direct_light(const glm::vec3& origin, const glm::vec3& p, 
         const float d = std::sqrt(d2);
         const glm::vec3 wi = to / d;
         const glm::vec3 fcos = brdf.eval_cos(wo, wi);
-        if (fcos == glm::vec3(0.0f)) break;
+        if (fcos == glm::vec3(0.0f) || below_face(wi, face)) break;
         float atten = range_window(d, l.range_m) / d2;
         if (l.type == ReferenceLight::Type::Spot) atten *= spot_factor(l, wi);
         if (atten <= 0.0f) break;
@@ -65,7 +70,7 @@ glm::vec3 PathTracer::direct_light(const glm::vec3& origin, const glm::vec3& p, 
           wi = sample_cone(-l.direction, l.cos_disc, u, rng.next_float());
         }
         const glm::vec3 fcos = brdf.eval_cos(wo, wi);
-        if (fcos == glm::vec3(0.0f)) break;
+        if (fcos == glm::vec3(0.0f) || below_face(wi, face)) break;
         if (caster_.occluded(Ray{origin, 0.0f, wi})) break;
         sum += l.radiant * fcos;
         break;
@@ -83,7 +88,7 @@ glm::vec3 PathTracer::direct_light(const glm::vec3& origin, const glm::vec3& p, 
         const float cos_light = -glm::dot(wi, l.direction);
         if (cos_light <= 0.0f) break;
         const glm::vec3 fcos = brdf.eval_cos(wo, wi);
-        if (fcos == glm::vec3(0.0f)) break;
+        if (fcos == glm::vec3(0.0f) || below_face(wi, face)) break;
         if (caster_.occluded(Ray{origin, 0.0f, q - origin, 1.0f})) break;
         const float area = 4.0f * glm::length(l.half_x) * glm::length(l.half_y);
         sum += l.radiant * fcos * (cos_light * area / d2);
@@ -95,13 +100,13 @@ glm::vec3 PathTracer::direct_light(const glm::vec3& origin, const glm::vec3& p, 
   const float u_pick = rng.next_float();
   const float u1 = rng.next_float();
   const float u2 = rng.next_float();
-  if (const std::optional<glm::vec3> e = emitter_light(origin, p, brdf, wo, u_pick, u1, u2)) return sum + *e;
+  if (const std::optional<glm::vec3> e = emitter_light(origin, p, brdf, wo, u_pick, u1, u2, face)) return sum + *e;
   return sum;
 }
 
 std::optional<glm::vec3> PathTracer::emitter_light(const glm::vec3& origin, const glm::vec3& p,
                                                    const ReferenceBrdf& brdf, const glm::vec3& wo, float u_pick,
-                                                   float u1, float u2) const {
+                                                   float u1, float u2, const glm::vec3& face) const {
   const EmitterTable& em = index_.emitters;
   if (em.triangle.empty()) return std::nullopt;
   const auto pick = static_cast<std::size_t>(std::lower_bound(em.cdf.begin(), em.cdf.end(), u_pick) - em.cdf.begin());
@@ -121,6 +126,7 @@ std::optional<glm::vec3> PathTracer::emitter_light(const glm::vec3& origin, cons
   if (!(pdf_light > 0.0f) || !std::isfinite(pdf_light)) return std::nullopt;
   const glm::vec3 fcos = brdf.eval_cos(wo, wi);
   if (fcos == glm::vec3(0.0f)) return std::nullopt;
+  if (below_face(wi, face)) return std::nullopt;
   // Stop just short of the emitter so it does not occlude itself.
   if (caster_.occluded(Ray{origin, 0.0f, q - origin, 0.9999f})) return std::nullopt;
   const float weight = power_heuristic(pdf_light, brdf.pdf(wo, wi));
@@ -200,9 +206,10 @@ PathTracer::Irradiance PathTracer::irradiance(const glm::vec3& p, const glm::vec
   ReferenceBrdf receiver;
   receiver.normal = n;
   receiver.material = engine::gltf_lambertian(glm::vec3(kPi));
-  const glm::vec3 origin = offset_ray_origin(p, n);
+  // Off the surface along its face, as the gather's rays (light_atlas/texel_gather.cpp).
+  const glm::vec3 origin = offset_ray_origin(p, face != glm::vec3(0.0f) ? face : n);
   Irradiance e;
-  e.direct = direct_light(origin, p, receiver, n, rng);
+  e.direct = direct_light(origin, p, receiver, n, rng, face);
   const float u2 = rng.next_float();  // drawn first: see random.h
   const float u1 = rng.next_float();
   const glm::vec3 wi = sample_cosine_hemisphere(n, u1, u2);

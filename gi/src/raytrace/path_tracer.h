@@ -64,13 +64,15 @@ class PathTracer {
   /// Follows a path from `ray`. `prev_pdf` is the solid-angle density of the ray's direction
   /// (0: not BRDF-sampled, no MIS). Light may reach the path at vertices 1..max_light_vertex.
   Traced trace(Ray ray, float prev_pdf, int max_light_vertex, Pcg32& rng) const;
-  /// Next-event estimation at a surface point: every analytic light plus one emitter.
+  /// Next-event estimation at a surface point: every analytic light plus one emitter. A
+  /// nonzero `face` (a receiver's geometric normal) drops the light from below its plane.
   glm::vec3 direct_light(const glm::vec3& origin, const glm::vec3& p, const ReferenceBrdf& brdf, const glm::vec3& wo,
-                         Pcg32& rng) const;
+                         Pcg32& rng, const glm::vec3& face = glm::vec3(0.0f)) const;
   /// direct_light()'s emitter sample: the emitter triangle picked by u_pick and its point at
   /// (u1, u2), MIS-weighted; nullopt when it adds nothing.
   std::optional<glm::vec3> emitter_light(const glm::vec3& origin, const glm::vec3& p, const ReferenceBrdf& brdf,
-                                         const glm::vec3& wo, float u_pick, float u1, float u2) const;
+                                         const glm::vec3& wo, float u_pick, float u1, float u2,
+                                         const glm::vec3& face = glm::vec3(0.0f)) const;
   /// Solid-angle density with which direct_light() samples a point on emitter triangle t.
   float emitter_pdf(const ShadingTriangle& t, float distance2, float cos_light) const;
 

@@ -109,8 +109,9 @@ engine::Result<MethodOutput> run_pathtracer_atlas(const RunContext& ctx) {
 }  // namespace
 
 void register_atlas_truth_sweep(SweepRegistry& registry) {
-  // pt2-2: rays below a texel's face are dropped (reference_sweep.cpp, pt-3).
-  registry.add_reference_provider({.kind = "atlas_split_truth", .version = "pt2-2", .compute = compute_split_truth});
+  // pt2-2: rays below a texel's face are dropped (reference_sweep.cpp, pt-3); pt2-3: the
+  // lights' too (pt-4).
+  registry.add_reference_provider({.kind = "atlas_split_truth", .version = "pt2-3", .compute = compute_split_truth});
 
   SweepMethod m;
   m.name = "pathtracer_atlas";

@@ -240,8 +240,9 @@ engine::Result<MethodOutput> run_prm(const RunContext& ctx) {
 void register_prm_sweep(SweepRegistry& registry) {
   // pt-3: emissive materials are dark too (pt-2 kept them, so a scene with an emissive
   // surface, such as the demo level's ceiling panel, had its light in the reference).
+  // pt-4: a texel's lights from below its face are dark too (reference_sweep.cpp, pt-4).
   registry.add_reference_provider(
-      {.kind = "atlas_indirect_irradiance_posed", .version = "pt-3", .compute = prm_reference});
+      {.kind = "atlas_indirect_irradiance_posed", .version = "pt-4", .compute = prm_reference});
 
   SweepMethod m;
   m.name = method_descriptor(EffectMethod::Prm).key;  // gi/methods.h

@@ -88,8 +88,10 @@ void register_reference_sweep(SweepRegistry& registry) {
                                    }});
   // pt-3: a texel's rays below its triangle's face are dropped (the shading normal may lean off
   // it; pt-2 counted the front of the texel's own surface as indirect light).
+  // pt-4: and so is the sun's and the lights' light from below the face, and the rays leave
+  // along the face (the light atlas's direct_at; pt-3 lit a leaning texel by a sun behind it).
   registry.add_reference_provider(
-      {.kind = "atlas_indirect_irradiance", .version = "pt-3", .compute = [](const ReferenceJob& job) {
+      {.kind = "atlas_indirect_irradiance", .version = "pt-4", .compute = [](const ReferenceJob& job) {
          return atlas_indirect(job.scene, job.request, reference_settings(job));
        }});
 

@@ -26,7 +26,7 @@ namespace {
 // (an open box of two sides) under a gradient sky and a sun. The wall's shading normals lean
 // `lean_rad` up at its top and down at its foot (a smoothed surface: its texels' normals are
 // off its face), the floor's are flat.
-gi::BakeInput wall_and_floor_under_the_sky(float lean_rad) {
+gi::BakeInput wall_and_floor_under_the_sky(float lean_rad, glm::vec3 sun_direction = {-0.6f, -1.0f, 0.3f}) {
   engine::SceneAsset a;
   engine::Primitive floor, wall;
   floor.positions = {{-2, 0, -2}, {2, 0, -2}, {2, 0, 2}, {-2, 0, 2}};
@@ -50,7 +50,7 @@ gi::BakeInput wall_and_floor_under_the_sky(float lean_rad) {
     a.nodes.push_back(n);
   }
   a.environment.sky_gradient = {.zenith = {10, 16, 30}, .horizon = {28, 30, 34}, .ground = {6, 6, 6}};
-  engine::set_sun(a, {.direction = {-0.6f, -1.0f, 0.3f}, .irradiance = {700.0f, 650.0f, 600.0f}});
+  engine::set_sun(a, {.direction = sun_direction, .irradiance = {700.0f, 650.0f, 600.0f}});
   return gi::bake_input_from(a);
 }
 
@@ -63,7 +63,10 @@ struct Split {
   std::size_t texels = 0;
 };
 
-Split compare_split(const gi::BakeInput& input, bool horizontal_only = false) {
+// `facing`: the texels compared, all or the horizontal ones (|normal.y| above 0.9).
+enum class Facing { All, Horizontal };
+
+Split compare_split(const gi::BakeInput& input, Facing facing = Facing::All) {
   gi::LightAtlasSettings s = gi::light_atlas_preset("high").value();
   s.texels_per_metre = 4.0f;
   auto layout = gi::static_world_layout(input, s.texels_per_metre);
@@ -81,7 +84,7 @@ Split compare_split(const gi::BakeInput& input, bool horizontal_only = false) {
   Split out;
   double bias = 0.0, total = 0.0;
   const auto compared = [&](std::size_t t) {
-    return scene->texels.valid[t] && !(horizontal_only && std::fabs(scene->texels.normal[t].y) < 0.9f);
+    return scene->texels.valid[t] && !(facing == Facing::Horizontal && std::fabs(scene->texels.normal[t].y) < 0.9f);
   };
   for (std::size_t t = 0; t < scene->texels.valid.size(); ++t)
     if (compared(t)) total += static_cast<double>(truth->direct[t].y + truth->indirect[t].y), ++out.texels;
@@ -162,16 +165,39 @@ TEST(DirectIndirectSplit, GatherAndPathTracerSplitTheSameWayUnderASkyAndASun) {
   }
 }
 
+// Light from below a receiver's own face is dark for the sun too. The gather's direct_at
+// always dropped it; the path tracer's receiver dropped its rays below the face but its
+// next-event estimate of the sun did not. On a closed surface the surface itself shadows
+// such a sun; where it does not (Dabrovic Sponza's roof edges, texels whose normals lean 60
+// degrees off their face) the path tracer lit texels at 415 W/m^2 that the gather left at 3,
+// most of the direct part's 2.1% error on the whole lightmap. Here a receiver in the open
+// 2 m above the floor, its normal leaning 60 degrees up off a face towards +x, the sun 17
+// degrees behind that face: only the sky's light from above the face reaches it, less than
+// the same receiver gets with its face along its normal, by at least the sun's share.
+TEST(DirectIndirectSplit, TheSunBehindAReceiversFaceIsDark) {
+  const glm::vec3 to_sun = glm::normalize(glm::vec3(-0.3f, 0.95f, 0.0f));
+  const gi::BakeInput input = wall_and_floor_under_the_sky(0.0f, -to_sun);
+  const glm::vec3 n(0.5f, 0.8660254f, 0.0f);
+  const std::vector<gi::SurfacePoint> points = {{.position_m = {0, 2, 0}, .normal = n, .face_normal = {1, 0, 0}},
+                                                {.position_m = {0, 2, 0}, .normal = n, .face_normal = n}};
+  auto e = gi::reference_irradiance(input, points, {.samples_per_pixel = 1024, .max_bounces = 0, .seed = 5});
+  ASSERT_TRUE(e) << e.error().to_string();
+  const double sun = 650.0 * static_cast<double>(glm::dot(n, to_sun));
+  const double behind = static_cast<double>(e->direct[0].y), in_front = static_cast<double>(e->direct[1].y);
+  std::printf("direct behind the face %.1f, in front %.1f, the sun's share %.1f W/m^2\n", behind, in_front, sun);
+  EXPECT_GT(in_front - behind, 0.95 * sun);
+}
+
 // The slab's underside 2 mm above the sunlit floor: no light enters the gap, and the path
 // tracer finds its texels nearly dark (6 W/m^2). The gather's rays from them land on the
 // floor 2 mm away and used to read the floor's texel there, whose sample lies in the sun
 // when the texel straddles the slab's rim: measured at 4 texels/m, the worst texel's
 // indirect 15.7 times the mean total's 5% above the path tracer's. Surfaces facing each
 // other closer than kGapTexels now read dark: 0.15, on the floor beside the slab. The
-// horizontal texels only: the slab's sides, one texel tall, read the floor next to them
-// bilinearly across the rim (too dark, 30% below the path tracer's indirect), another cause.
+// horizontal texels only: the slab's sides, one texel tall, read 18% too dark on average,
+// another cause (docs/light_atlas.md, "Noise against floor, cause by cause").
 TEST(DirectIndirectSplit, AGapBetweenStackedSurfacesStaysDark) {
-  const Split s = compare_split(slab_over_a_floor(0.002f), true);
+  const Split s = compare_split(slab_over_a_floor(0.002f), Facing::Horizontal);
   std::printf(
       "slab 2 mm over a floor, %zu horizontal texels: worst direct %.4f, worst indirect beyond 4 sigma %.4f, "
       "indirect bias %+.4f\n",
