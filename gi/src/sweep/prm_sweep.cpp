@@ -8,11 +8,13 @@
 
 #include <chrono>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 #include <glm/gtc/quaternion.hpp>
 
 #include "core/color.h"
+#include "prm/pane_upsample.h"
 #include "prm/prm.h"
 #include "prm/prm_runtime.h"
 #include "raytrace/atlas_reference.h"
@@ -116,6 +118,7 @@ engine::Result<RgbField> prm_reference(const ReferenceJob& job) {
   return RgbField::from_texels(truth->width, truth->height, truth->indirect, truth->valid);
 }
 
+// Long because it is the method's knob table: one entry per knob, nothing to split.
 std::vector<KnobSpec> prm_knobs() {
   return {
       {.name = "entries",
@@ -141,6 +144,12 @@ std::vector<KnobSpec> prm_knobs() {
        .kind = KnobKind::Real,
        .default_grid = {"4"},
        .min_value = 0.01,
+       .max_value = 1e4},
+      {.name = "pane_density",
+       .description = "pane texels per metre, upsampled per chart to the atlas's `density` (0: the same)",
+       .kind = KnobKind::Real,
+       .default_grid = {"0"},
+       .min_value = 0,
        .max_value = 1e4},
       {.name = "splitting",
        .description = "paths per entry point per unit albedo (N_s)",
@@ -184,11 +193,26 @@ ReferenceRequest prm_reference_request(const SweepScene&, const KnobSetting& k) 
   return r;
 }
 
+// Coarse panes are read per chart at the atlas's texels (pane_upsample.h), after the sum:
+// the upsampling is linear, so summing upsampled panes gives the same atlas.
+// None when `density` is 0 (the panes are at the atlas's density).
+engine::Result<std::optional<PaneUpsampler>> atlas_upsampler(const BakeInput& input, const Prm& prm, double density) {
+  if (density <= 0.0) return std::optional<PaneUpsampler>();
+  const auto inputs = atlas_inputs_from(input);
+  auto fine = build_atlas_layout(inputs, {.texels_per_metre = static_cast<float>(density)});
+  if (!fine) return fine.error();
+  auto up = PaneUpsampler::build(prm.layout, prm.texels, *fine, rasterize_atlas(*fine, inputs));
+  if (!up) return up.error();
+  return std::optional<PaneUpsampler>(std::move(up).value());
+}
+
 engine::Result<MethodOutput> run_prm(const RunContext& ctx) {
   auto scene = posed_scene(ctx.scene.asset, ctx.knobs.text("pose"), ctx.knobs.real("swing"));
   if (!scene) return scene.error();
   PrmSettings s;
-  s.texels_per_metre = static_cast<float>(ctx.knobs.real("density"));
+  const double density = ctx.knobs.real("density"), pane_density = ctx.knobs.real("pane_density");
+  const bool coarse = pane_density > 0.0 && pane_density != density;
+  s.texels_per_metre = static_cast<float>(coarse ? pane_density : density);
   s.entry_points = static_cast<int>(ctx.knobs.integer("entries"));
   s.clusters = static_cast<int>(ctx.knobs.integer("clusters"));
   s.splitting = static_cast<float>(ctx.knobs.real("splitting"));
@@ -198,7 +222,11 @@ engine::Result<MethodOutput> run_prm(const RunContext& ctx) {
   const BakeInput input = bake_input_from(*scene);
   auto prm = bake_prm(input, s);
   if (!prm) return prm.error();
-  if (prm->width != ctx.reference.width || prm->height != ctx.reference.height)
+  auto upsampler = atlas_upsampler(input, *prm, coarse ? density : 0.0);
+  if (!upsampler) return upsampler.error();
+  const auto to_atlas = [&](std::vector<glm::vec3> image) { return *upsampler ? (*upsampler)->apply(image) : image; };
+  const int width = coarse ? ctx.reference.width : prm->width, height = coarse ? ctx.reference.height : prm->height;
+  if (width != ctx.reference.width || height != ctx.reference.height)
     return engine::Error{.message = "the PRM's atlas size differs from the reference's"};
   auto caster = make_static_caster(input);
   if (!caster) return caster.error();
@@ -206,17 +234,17 @@ engine::Result<MethodOutput> run_prm(const RunContext& ctx) {
   const auto t0 = std::chrono::steady_clock::now();
   const auto lights = bake_lights(input, BakeLights::Moving);
   const auto picked = relight_clusters(*prm, lights, **caster, static_cast<int>(ctx.knobs.integer("active")));
-  const std::vector<glm::vec3> atlas = sum_panes(*prm, picked);
+  const std::vector<glm::vec3> atlas = to_atlas(sum_panes(*prm, picked));
   const double frame_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   MethodOutput out;
-  out.field = RgbField::from_texels(prm->width, prm->height, atlas, ctx.reference.valid);
+  out.field = RgbField::from_texels(width, height, atlas, ctx.reference.valid);
   // What the K heaviest clusters leave out (not timed): the same relight with every lit
   // cluster. dropped_energy = 1 - sum lum(K sum) / sum lum(all-cluster sum) over the valid
   // texels (texels have one area at one density, so this is the share of reflected power the
   // K-sum drops); rescaled_rel_rmse: the K-sum scaled by the inverse of the share kept, the
   // error a runtime that rescaled to the full energy would have (the runtime does not).
   const auto all = relight_clusters(*prm, lights, **caster, 0);
-  const std::vector<glm::vec3> full = sum_panes(*prm, all);
+  const std::vector<glm::vec3> full = to_atlas(sum_panes(*prm, all));
   auto lum = [](const glm::vec3& c) { return luminance(double{c.x}, double{c.y}, double{c.z}); };
   double kept = 0.0, total = 0.0;
   for (std::size_t i = 0; i < atlas.size(); ++i) {
@@ -228,7 +256,8 @@ engine::Result<MethodOutput> run_prm(const RunContext& ctx) {
   out.extras = {{"clusters_lit", static_cast<double>(all.size())},
                 {"clusters_summed", static_cast<double>(picked.size())},
                 {"dropped_energy", total > 0.0 ? 1.0 - kept / total : nan},
-                {"rescaled_rel_rmse", kept > 0.0 ? relative_rmse(out.field, ctx.reference, total / kept) : nan}};
+                {"rescaled_rel_rmse", kept > 0.0 ? relative_rmse(out.field, ctx.reference, total / kept) : nan},
+                {"pane_texels", static_cast<double>(prm->pane_size())}};
   out.costs.bake_seconds = prm->stats.total_seconds;
   out.costs.frame_ms = frame_ms;
   out.costs.bytes = static_cast<std::uint64_t>(prm->cluster_count) * prm->pane_size() * 3u * 2u;  // half-float panes
