@@ -10,9 +10,8 @@ namespace gi {
 // Each cell (of the radius) gathers its 27 neighbour cells' texels once and filters all of
 // its own texels against them.
 std::vector<glm::vec3> filter_world(const AtlasTexels& tx, std::span<const std::uint32_t> work,
-const std::vector<glm::vec3>& e,
-                                    const std::vector<std::uint8_t>& hidden, float radius_m, float texel_m,
-                                    ThreadPool& pool) {
+                                    const std::vector<glm::vec3>& e, const std::vector<std::uint8_t>& hidden,
+                                    float radius_m, float texel_m, ThreadPool& pool) {
   std::vector<std::uint32_t> visible;
   for (std::uint32_t i : work)
     if (!hidden[i]) visible.push_back(i);
