@@ -307,6 +307,8 @@ double luminance_of(const glm::dvec3& c) { return luminance(c.x, c.y, c.z); }
 // B cos_x / pi / (n_c p_c + n_e p_e), p_c = cos_x / pi and p_e the emitter sampling's
 // density at y in solid angle (area density x d^2 / cos_y): the balance heuristic, unbiased
 // wherever either technique reaches (docs/light_atlas.md, "Emitter-sampled final gather").
+// Long because both kinds of rays share the MIS counts and one spread of their estimates
+// (the variance); split, the two loops would pass all of them back and forth.
 FreshGather gather_texel(const StaticBakeScene& b, const AtlasLayout& layout, const TexelTable& t,
                          const TexelGatherSettings& s, const std::vector<glm::vec3>& reflected,
                          const TexelEmitters* emitters, std::uint32_t i, std::uint64_t& rays) {
