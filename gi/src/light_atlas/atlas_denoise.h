@@ -19,10 +19,10 @@
 namespace gi {
 
 struct DenoiseSettings {
-  int passes = 4;             ///< A-trous passes; pass k's step is 2^k texels (0: no denoising).
+  int passes = 4;  ///< A-trous passes; pass k's step is 2^k texels (0: no denoising).
   /// Value weight exp(-(l_i - l_j)^2 / (2 value_sigma^2 var(l_i - l_j))).
   float value_sigma = 2.0f;
-  float normal_power = 64.0f; ///< Normal weight max(0, n_i . n_j)^normal_power.
+  float normal_power = 64.0f;  ///< Normal weight max(0, n_i . n_j)^normal_power.
 };
 
 /// Denoises the fields `fields` (each per atlas texel, W/m^2) together over the texels of

@@ -85,9 +85,9 @@ Synthetic synthetic_scene(std::uint32_t seed) {
 
 struct Errors {
   double smooth_before = 0.0, smooth_after = 0.0;  // rms relative error of the smooth floor texels
-  double edge_worst = 0.0;        // worst |column mean error| / kStep within 2 texels of the edge
-  double wall_foot_worst = 0.0;   // worst relative bias of the floor's row next to the wall
-  double edge_texel_rms = 0.0;    // rms relative error of the texels within 2 texels of the edge
+  double edge_worst = 0.0;                         // worst |column mean error| / kStep within 2 texels of the edge
+  double wall_foot_worst = 0.0;                    // worst relative bias of the floor's row next to the wall
+  double edge_texel_rms = 0.0;                     // rms relative error of the texels within 2 texels of the edge
 };
 
 Errors errors(const Synthetic& s, const std::vector<glm::vec3>& out) {
@@ -169,7 +169,8 @@ TEST(AtlasDenoise, PropagatedVarianceMatchesTheSpreadOfTheOutput) {
     const std::vector<glm::vec3> out = denoised(s, 3, 2, &variance);
     if (sum.empty()) sum.assign(out.size(), 0.0), squares.assign(out.size(), 0.0), estimated = variance;
     for (std::size_t i = 0; i < out.size(); ++i)
-      sum[i] += static_cast<double>(out[i].x), squares[i] += static_cast<double>(out[i].x) * static_cast<double>(out[i].x);
+      sum[i] += static_cast<double>(out[i].x),
+          squares[i] += static_cast<double>(out[i].x) * static_cast<double>(out[i].x);
   }
   const Synthetic s = synthetic_scene(1);
   double spread = 0.0, estimate = 0.0;

@@ -58,8 +58,8 @@ struct Prepared {
 Prepared prepare(float texels_per_metre) {
   Prepared p{.input = floor_and_wall(), .layout = {}, .scene = {}};
   p.layout = gi::static_world_layout(p.input, texels_per_metre).value();
-  p.scene = gi::prepare_static_scene(p.input, p.layout, gi::BakeLights::Static, gi::TexelPlacement::VisibleSurface)
-                .value();
+  p.scene =
+      gi::prepare_static_scene(p.input, p.layout, gi::BakeLights::Static, gi::TexelPlacement::VisibleSurface).value();
   return p;
 }
 
