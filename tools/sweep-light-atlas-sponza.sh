@@ -10,6 +10,8 @@
 #                                                     path tracer's time; cached in $CACHE)
 #   HIGH=0 bash tools/sweep-light-atlas-sponza.sh    (without the high preset's run)
 #   TABLE_ONLY=1 bash tools/sweep-light-atlas-sponza.sh   (speedup.md from the CSVs already there)
+#   DENOISE=0 / EMITTERS=0                           (without the guided denoiser's runs / the
+#                                                     emitter-sampled gather's runs)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 sweep=${GI_SWEEP:-build/tools/gi-sweep/gi-sweep}
@@ -28,6 +30,18 @@ run "$sweep" "${gather[@]}" --knob solve_rays=32 --knob rays=128 --knob filter=2
   "${common[@]}" --out "$out/gather"
 csvs=("$out/gather/light_atlas_sponza.csv")
 run "$sweep" --method pathtracer_atlas --knob density=8 --knob "spp=$pt_spp" "${common[@]}" --out "$out/pathtracer"
+if [[ ${DENOISE:-1} != 0 ]]; then  # the guided denoiser (docs/light_atlas.md), 4 passes, at two ray budgets
+  run "$sweep" "${gather[@]}" --knob solve_rays=32 --knob rays=128 --knob filter=0 --knob direct_samples=8 \
+    --knob denoise=0,4 "${common[@]}" --out "$out/denoise"
+  run "$sweep" "${gather[@]}" --knob solve_rays=64 --knob rays=256 --knob filter=0 --knob direct_samples=8 \
+    --knob denoise=0,4 "${common[@]}" --out "$out/denoise_64_256"
+  csvs+=("$out/denoise/light_atlas_sponza.csv" "$out/denoise_64_256/light_atlas_sponza.csv")
+fi
+if [[ ${EMITTERS:-1} != 0 ]]; then  # the emitter-sampled gather at about the cosine rays' time
+  run "$sweep" "${gather[@]}" --knob solve_rays=32 --knob rays=64 --knob emitter_rays=32 --knob filter=0 \
+    --knob direct_samples=8 --knob denoise=0 "${common[@]}" --out "$out/emitters"
+  csvs+=("$out/emitters/light_atlas_sponza.csv")
+fi
 if [[ ${HIGH:-1} != 0 ]]; then  # high: 128 kept + 1024 fresh rays, no filter
   run "$sweep" "${gather[@]}" --knob solve_rays=128 --knob rays=1024 --knob filter=0 --knob direct_samples=16 \
     "${common[@]}" --out "$out/high"

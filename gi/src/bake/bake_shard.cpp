@@ -14,7 +14,7 @@ namespace gi {
 namespace {
 
 constexpr BlobMagic kShardMagic{"GISHARD1"};
-constexpr std::uint32_t kShardVersion = 2;  // 2: the light atlas's baked_direct
+constexpr std::uint32_t kShardVersion = 3;  // 2: the light atlas's baked_direct; 3: its variance
 constexpr std::uint8_t kHasAtlas = 1, kHasPrm = 2, kHasAntiradiance = 4;
 
 bool ascending(const std::vector<std::uint32_t>& v) {
@@ -44,6 +44,7 @@ engine::Status write_shard_file(const std::filesystem::path& path, const ShardFi
     w.put_array(a.direct);
     w.put_array(a.baked_direct);
     w.put_array(a.hidden);
+    w.put_array(a.variance);
     w.put(a.shared_rays);
     w.put(a.own_rays);
   }
@@ -84,7 +85,8 @@ engine::Result<ShardFile> read_shard_file(const std::filesystem::path& path) {
   if (complete && (parts & kHasAtlas)) {
     LightAtlasShardPart a;
     complete = r.get_array(a.texels) && r.get_array(a.indirect) && r.get_array(a.direct) &&
-               r.get_array(a.baked_direct) && r.get_array(a.hidden) && r.get(a.shared_rays) && r.get(a.own_rays);
+               r.get_array(a.baked_direct) && r.get_array(a.hidden) && r.get_array(a.variance) &&
+               r.get(a.shared_rays) && r.get(a.own_rays);
     f.atlas = std::move(a);
   }
   if (complete && (parts & kHasPrm)) {
@@ -115,11 +117,12 @@ engine::Result<ShardFile> read_shard_file(const std::filesystem::path& path) {
     const LightAtlasShardPart& a = *f.atlas;
     const std::size_t n = a.texels.size();
     if (a.indirect.size() != n || a.direct.size() != n || a.baked_direct.size() != n || a.hidden.size() != n ||
-        !ascending(a.texels))
+        a.variance.size() != n || !ascending(a.texels))
       return engine::Error{path.string(), "light atlas", "texel arrays differ in size or are not ascending"};
     for (std::size_t k = 0; k < n; ++k)
       if (!engine::all_finite(a.indirect[k]) || !engine::all_finite(a.direct[k]) ||
-          !engine::all_finite(a.baked_direct[k]) || a.hidden[k] > 1)
+          !engine::all_finite(a.baked_direct[k]) || a.hidden[k] > 1 || !(a.variance[k] >= 0.0f) ||
+          !std::isfinite(a.variance[k]))
         return engine::Error{path.string(), "light atlas", "texel " + std::to_string(a.texels[k]) + " is not finite"};
   }
   if (f.prm) {

@@ -173,6 +173,7 @@ engine::Result<TexelGatherResult> assemble_parts(const AtlasTexels& texels,
   out.direct.assign(n, glm::vec3(0.0f));
   out.baked_direct.assign(n, glm::vec3(0.0f));
   out.hidden.assign(n, 0);
+  out.variance.assign(n, 0.0f);
   const auto count = static_cast<std::uint32_t>(parts.size());
   for (std::uint32_t i = 0; i < count; ++i) {
     const LightAtlasShardPart& p = parts[i];
@@ -181,7 +182,8 @@ engine::Result<TexelGatherResult> assemble_parts(const AtlasTexels& texels,
     for (std::size_t w = 0; w < work.size(); ++w)
       if (shard.owns(w)) expected.push_back(work[w]);
     if (p.texels != expected || p.indirect.size() != expected.size() || p.direct.size() != expected.size() ||
-        p.baked_direct.size() != expected.size() || p.hidden.size() != expected.size())
+        p.baked_direct.size() != expected.size() || p.hidden.size() != expected.size() ||
+        p.variance.size() != expected.size())
       return engine::Error{.message = "light-atlas shard " + std::to_string(i) + " of " + std::to_string(count) +
                                       ": its texels are not that shard's texels of this scene's atlas"};
     for (std::size_t k = 0; k < expected.size(); ++k) {
@@ -189,6 +191,7 @@ engine::Result<TexelGatherResult> assemble_parts(const AtlasTexels& texels,
       out.direct[expected[k]] = p.direct[k];
       out.baked_direct[expected[k]] = p.baked_direct[k];
       out.hidden[expected[k]] = p.hidden[k];
+      out.variance[expected[k]] = p.variance[k];
     }
     out.own_rays += p.own_rays;
   }
@@ -237,6 +240,7 @@ engine::Status gather_shard_part(const BakeScene& b, const AtlasLayout& layout, 
     p.direct.push_back(gathered->direct[i]);
     p.baked_direct.push_back(gathered->baked_direct[i]);
     p.hidden.push_back(gathered->hidden[i]);
+    p.variance.push_back(gathered->variance[i]);
   }
   p.shared_rays = gathered->shared_rays;
   p.own_rays = gathered->own_rays;

@@ -129,6 +129,7 @@ struct LightAtlasShardPart {
   std::vector<glm::vec3> direct;        ///< Per texel of `texels`: TexelGatherResult::direct.
   std::vector<glm::vec3> baked_direct;  ///< Per texel of `texels`: TexelGatherResult::baked_direct (unfiltered).
   std::vector<std::uint8_t> hidden;     ///< Per texel of `texels`.
+  std::vector<float> variance;          ///< Per texel of `texels`: TexelGatherResult::variance (the denoiser's guide).
   std::uint64_t shared_rays = 0;        ///< Rays of steps 1-2 (the same in every shard).
   std::uint64_t own_rays = 0;           ///< Rays of step 3 for `texels`.
 };

@@ -11,8 +11,10 @@
 #include <span>
 #include <unordered_map>
 
+#include "core/color.h"
 #include "core/random.h"
 #include "core/stopwatch.h"
+#include "light_atlas/atlas_denoise.h"
 #include "light_atlas/texel_cells.h"
 #include "light_atlas/texel_direct.h"
 #include "light_atlas/texel_emitters.h"
@@ -53,6 +55,8 @@ engine::Status validate(const TexelGatherSettings& s) {
   if (s.bounces < 1 || s.bounces > 1024) return bad("bounces is outside 1..1024");
   if (!(s.filter_radius_texels >= 0.0f) || s.filter_radius_texels > 16.0f)
     return bad("filter_radius_texels is outside [0, 16]");
+  if (s.denoise_passes < 0 || s.denoise_passes > 8) return bad("denoise_passes is outside 0..8");
+  if (!(s.denoise_sigma > 0.0f) || s.denoise_sigma > 1000.0f) return bad("denoise_sigma is outside (0, 1000]");
   return {};
 }
 
@@ -280,16 +284,31 @@ int solve_kept_rays(const TexelTable& t, const KeptRays& k, const std::vector<gl
 }
 
 // The fresh rays of one texel in step 3: the cosine rays' and the emitter rays' estimate of
-// the irradiance that `reflected` sends (W/m^2), and the cosine rays' mean sky radiance.
+// the irradiance that `reflected` sends (W/m^2), and the cosine rays' mean sky radiance; the
+// sample variance of one ray's estimate of the luminance of irradiance + pi sky (the mean's
+// variance is it over the rays).
 struct FreshGather {
   glm::dvec3 irradiance{0.0}, sky{0.0};
+  double ray_variance = 0.0;
 };
+
+// The variance bookkeeping of gather_texel: each of the n rays estimates the luminance of
+// irradiance + pi sky by itself as z (its share of the mean times n).
+struct RaySpread {
+  double sum = 0.0, squares = 0.0;
+  void add(double z) { sum += z, squares += z * z; }
+  double variance(double n) const { return n > 1.0 ? std::max(0.0, (squares - sum * sum / n) / (n - 1.0)) : 0.0; }
+};
+
+double luminance_of(const glm::dvec3& c) { return luminance(c.x, c.y, c.z); }
 
 // The fresh rays of texel i. Without emitters: the mean of `gather_rays` cosine rays. With
 // them: every ray, cosine or emitter-sampled, reading B at a surface point y brings
 // B cos_x / pi / (n_c p_c + n_e p_e), p_c = cos_x / pi and p_e the emitter sampling's
 // density at y in solid angle (area density x d^2 / cos_y): the balance heuristic, unbiased
 // wherever either technique reaches (docs/light_atlas.md, "Emitter-sampled final gather").
+// Long because both kinds of rays share the MIS counts and one spread of their estimates
+// (the variance); split, the two loops would pass all of them back and forth.
 FreshGather gather_texel(const StaticBakeScene& b, const AtlasLayout& layout, const TexelTable& t,
                          const TexelGatherSettings& s, const std::vector<glm::vec3>& reflected,
                          const TexelEmitters* emitters, std::uint32_t i, std::uint64_t& rays) {
@@ -298,7 +317,8 @@ FreshGather gather_texel(const StaticBakeScene& b, const AtlasLayout& layout, co
   const auto ne = emitters ? static_cast<std::size_t>(s.emitter_rays) : std::size_t{0};
   const glm::vec3 n = tx.normal[i], origin = offset_ray_origin(tx.position[i], t.face[i]);
   const std::uint32_t group = emitters ? emitters->group_of(i) : 0;
-  const double nc = static_cast<double>(nf);
+  const double nc = static_cast<double>(nf), n_all = nc + static_cast<double>(ne);
+  RaySpread spread;
   // n_e p_e pi / cos_x at a landing: what the emitter rays add to the cosine rays' n_c.
   const auto emitter_count = [&](const Landing& l, float cos_x) {
     if (l.pixel == kDark || !(l.cos_surface > 0.0f)) return 0.0;
@@ -318,15 +338,23 @@ FreshGather gather_texel(const StaticBakeScene& b, const AtlasLayout& layout, co
       if (glm::dot(wi, t.face[i]) <= 0.0f) continue;
       ++rays;
       const Landing l = land_ray(b, layout, t, Ray{origin, 0.0f, wi}, t.face[i]);
+      double z = 0.0;
       if (l.texel < kBack) {
         const glm::dvec3 radiosity(bilinear(reflected, t.width, t.height, l.uv));
-        g.irradiance += ne == 0 ? radiosity : radiosity / (nc + emitter_count(l, glm::dot(n, wi)));
+        const glm::dvec3 share = ne == 0 ? radiosity : radiosity / (nc + emitter_count(l, glm::dot(n, wi)));
+        g.irradiance += share;
+        z = (ne == 0 ? 1.0 : n_all) * luminance_of(share);
       }
-      if (l.texel == kSky) g.sky += glm::dvec3(sky_along(b, wi));
+      if (l.texel == kSky) {
+        g.sky += glm::dvec3(sky_along(b, wi));
+        z = n_all / nc * static_cast<double>(kPi) * static_cast<double>(luminance(sky_along(b, wi)));
+      }
+      spread.add(z);
     }
     g.sky /= nc;
     if (ne == 0) g.irradiance /= nc;
   }
+  g.ray_variance = spread.variance(n_all);
   if (ne == 0) return g;
   Pcg32 rng = Pcg32::for_item(s.seed, stream_id(i, kEmitterStream));
   const float shift_y = rng.next_float();  // drawn first: see random.h
@@ -346,8 +374,12 @@ FreshGather gather_texel(const StaticBakeScene& b, const AtlasLayout& layout, co
     if (l.texel >= kBack || l.pixel != e.texel) continue;  // occluded, or off the surface
     // B cos_x / pi / (n_c p_c + n_e p_e) = B / (n_c + n_e p_e pi / cos_x).
     const double count = nc + emitter_count(l, cos_x);
-    if (count > 0.0) g.irradiance += glm::dvec3(bilinear(reflected, t.width, t.height, l.uv)) / count;
+    if (!(count > 0.0)) continue;
+    const glm::dvec3 share = glm::dvec3(bilinear(reflected, t.width, t.height, l.uv)) / count;
+    g.irradiance += share;
+    spread.add(n_all * luminance_of(share));
   }
+  g.ray_variance = spread.variance(n_all);
   return g;
 }
 
@@ -359,7 +391,7 @@ bool final_gather(const StaticBakeScene& b, const AtlasLayout& layout, const Tex
                   const TexelGatherSettings& s, ThreadPool& pool, const ProgressCallback& progress,
                   const std::vector<std::size_t>& mine, const std::vector<glm::vec3>& reflected,
                   const TexelEmitters* emitters, const KeptRays& k, std::vector<glm::vec3>& e,
-                  std::vector<glm::vec3>& sky, std::vector<std::uint64_t>& rays_of) {
+                  std::vector<glm::vec3>& sky, std::vector<float>& variance, std::vector<std::uint64_t>& rays_of) {
   const auto nf = static_cast<std::size_t>(s.gather_rays);
   const auto ne = emitters ? static_cast<std::size_t>(s.emitter_rays) : std::size_t{0};
   // Both estimate T(E_d + E): weighted by their rays (the sky by the cosine rays alone).
@@ -368,6 +400,9 @@ bool final_gather(const StaticBakeScene& b, const AtlasLayout& layout, const Tex
   // (on the skylit room: 95th-percentile texel 0.36 with them, 0.23 without).
   const double w_solve = ne > 0 ? 0.0 : static_cast<double>(k.per_texel) / static_cast<double>(k.per_texel + nf);
   const double w_sky = static_cast<double>(k.per_texel) / static_cast<double>(k.per_texel + nf);
+  // The mean's variance: the kept rays spread as the cosine rays do, so with them it is the
+  // fresh rays' spread over all the rays.
+  const double rays = static_cast<double>(nf + ne + (ne > 0 ? 0 : k.per_texel));
   std::vector<glm::vec3> gathered(e.size(), glm::vec3(0.0f));
   sky.assign(e.size(), glm::vec3(0.0f));
   const bool done = pool.parallel_for_with_progress(mine.size(), progress, [&](std::size_t m) {
@@ -376,14 +411,23 @@ bool final_gather(const StaticBakeScene& b, const AtlasLayout& layout, const Tex
     const FreshGather g = gather_texel(b, layout, t, s, reflected, emitters, i, rays_of[w]);
     gathered[i] = glm::vec3(w_solve * glm::dvec3(e[i]) + (1.0 - w_solve) * g.irradiance);
     sky[i] = glm::vec3(w_sky * glm::dvec3(k.sky[i]) + (1.0 - w_sky) * static_cast<double>(kPi) * g.sky);
+    variance[i] = static_cast<float>(g.ray_variance / rays);
   });
   e = std::move(gathered);
   return done;
 }
 
-// Step 4 on both filtered fields (indirect and the baked direct light).
-void filter_result(const AtlasTexels& tx, const TexelTable& t, float radius_m, float texel_m, ThreadPool& pool,
-                   TexelGatherResult& out) {
+// Step 4 on both filtered fields (indirect and the baked direct light): the denoiser, then
+// the filter, as the settings ask.
+void filter_result(const AtlasTexels& tx, const TexelTable& t, const TexelGatherSettings& s, float texel_m,
+                   ThreadPool& pool, TexelGatherResult& out) {
+  if (s.denoise_passes > 0 && texel_m > 0.0f) {
+    std::vector<glm::vec3>* const fields[] = {&out.indirect, &out.baked_direct};
+    denoise_world(tx, t.work, out.hidden, texel_m, {.passes = s.denoise_passes, .value_sigma = s.denoise_sigma}, pool,
+                  out.variance, fields);
+  }
+  if (s.filter_radius_texels <= 0.0f || !(texel_m > 0.0f)) return;
+  const float radius_m = s.filter_radius_texels * texel_m;
   out.indirect = filter_world(tx, t.work, out.indirect, out.hidden, radius_m, texel_m, pool);
   out.baked_direct = filter_world(tx, t.work, out.baked_direct, out.hidden, radius_m, texel_m, pool);
 }
@@ -409,6 +453,7 @@ engine::Result<TexelGatherResult> gather_atlas(const StaticBakeScene& b, const A
   out.direct.assign(n, glm::vec3(0.0f));
   out.baked_direct.assign(n, glm::vec3(0.0f));
   out.indirect.assign(n, glm::vec3(0.0f));
+  out.variance.assign(n, 0.0f);
   std::vector<std::uint64_t> rays_of(work, 0);
 
   // Step 1.
@@ -453,7 +498,7 @@ engine::Result<TexelGatherResult> gather_atlas(const StaticBakeScene& b, const A
     dilate<glm::vec3>(reflected, t.width, t.height, tx.valid, std::max(3, layout.padding_texels));
     std::vector<std::uint64_t> gather_rays_of(work, 0);
     if (!final_gather(b, layout, t, s, pool, phase(0.5, 0.95), s.shard.items(work), reflected,
-                      emitters ? &*emitters : nullptr, kept, e, sky, gather_rays_of))
+                      emitters ? &*emitters : nullptr, kept, e, sky, out.variance, gather_rays_of))
       return engine::cancelled_error("light-atlas gather");
     for (std::uint64_t r : gather_rays_of) out.own_rays += r;
   } else if (!s.shard.whole()) {
@@ -469,7 +514,7 @@ engine::Result<TexelGatherResult> gather_atlas(const StaticBakeScene& b, const A
   // Step 4 (a shard leaves it to the merge).
   if (s.part_only) return out;
   t0 = Clock::now();
-  if (filtering) filter_result(tx, t, radius_m, texel_m, pool, out);
+  filter_result(tx, t, s, texel_m, pool, out);
   out.filter_seconds = seconds_since(t0);
   if (s.progress && !s.progress(1.0)) return engine::cancelled_error("light-atlas gather");
   return out;
@@ -494,13 +539,14 @@ engine::Status filter_gathered(const StaticBakeScene& b, const AtlasLayout& layo
                                ThreadPool& pool, TexelGatherResult& out) {
   const auto t0 = Clock::now();
   const float texel_m = layout.texels_per_metre > 0.0f ? 1.0f / layout.texels_per_metre : 0.0f;
-  if (s.filter_radius_texels > 0.0f && texel_m > 0.0f) {
+  if ((s.filter_radius_texels > 0.0f || s.denoise_passes > 0) && texel_m > 0.0f) {
     auto table = texel_table(b, layout);
     if (!table) return table.error();
-    if (out.indirect.size() != b.texels.valid.size() || out.baked_direct.size() != b.texels.valid.size() ||
-        out.hidden.size() != b.texels.valid.size())
+    const std::size_t n = b.texels.valid.size();
+    if (out.indirect.size() != n || out.baked_direct.size() != n || out.hidden.size() != n ||
+        (s.denoise_passes > 0 && out.variance.size() != n))
       return engine::Error{.message = "texel gather: the result to filter does not match the atlas"};
-    filter_result(b.texels, *table, s.filter_radius_texels * texel_m, texel_m, pool, out);
+    filter_result(b.texels, *table, s, texel_m, pool, out);
   }
   out.filter_seconds = seconds_since(t0);
   return {};

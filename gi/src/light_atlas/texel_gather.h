@@ -20,7 +20,9 @@
 //      weighted by its ray count (both estimate the same T(E_d + E)). With `emitter_rays`,
 //      that many more rays go to points drawn on the bright texels (texel_emitters.h), and
 //      both kinds of fresh rays are weighted by the balance heuristic (unbiased).
-//   4. Optional edge-aware filter in world space: texels within `filter_radius_texels` on
+//   4. Optional guided denoiser (`denoise_passes`, atlas_denoise.h: edge-avoiding a-trous
+//      guided by the normals, the planes and step 3's per-texel variance), then the
+//      optional edge-aware filter in world space: texels within `filter_radius_texels` on
 //      the same plane (normals within ~18 degrees, plane distance below half a texel),
 //      across chart borders, Gaussian-weighted.
 // Surfaces reflect as diffuse with the glTF BRDF's hemispherical albedo (as the VPLs do).
@@ -56,6 +58,10 @@ struct TexelGatherSettings {
   int emitter_rays = 0;
   int bounces = 64;                   ///< Most iterations of the kept-ray solve (indirect bounces).
   float filter_radius_texels = 0.0f;  ///< World-space filter radius in texels (0: none).
+  /// Step 4's guided denoiser (atlas_denoise.h): a-trous passes over `indirect` and
+  /// `baked_direct`, guided by normals, planes and the gather's per-texel variance (0: none).
+  int denoise_passes = 0;
+  float denoise_sigma = 2.0f;  ///< The denoiser's value weight, in standard deviations.
   std::uint64_t seed = 1;
   ProgressCallback progress;  ///< Fraction done in [0, 1]; return false to cancel.
   /// A distributed bake's shard (docs/distributed-bake.md): steps 1-2 run for every texel
@@ -79,7 +85,11 @@ struct TexelGatherResult {
   std::uint64_t shared_rays = 0;     ///< Of `rays`: steps 1-2 (every texel, in every shard).
   std::uint64_t own_rays = 0;        ///< Of `rays`: step 3 for the shard's texels.
   std::vector<std::uint8_t> hidden;  ///< Per texel: seen from behind geometry; the filter skips it.
-  int iterations = 0;                ///< Bounces the solve ran.
+  /// Per texel, (W/m^2)^2: the variance of the luminance of `indirect` + the sky's part of
+  /// `baked_direct` as steps 2-3 estimate them, from the spread of step 3's rays (0 without
+  /// fresh rays and on texels another shard gathers); after the denoiser, of its output.
+  std::vector<float> variance;
+  int iterations = 0;  ///< Bounces the solve ran.
   double direct_seconds = 0.0, solve_seconds = 0.0, gather_seconds = 0.0, filter_seconds = 0.0;
 };
 
@@ -88,9 +98,9 @@ struct TexelGatherResult {
 engine::Result<TexelGatherResult> gather_atlas(const StaticBakeScene& scene, const AtlasLayout& layout,
                                                const TexelGatherSettings& settings, ThreadPool& pool);
 
-/// Step 4 on a result whose steps 1-3 ran (merged from shards): the world-space filter of
-/// `result.indirect` and `result.baked_direct` when settings.filter_radius_texels > 0: the
-/// same filter, on the same values, as a whole bake's gather_atlas ends with.
+/// Step 4 on a result whose steps 1-3 ran (merged from shards): the denoiser and the
+/// world-space filter of `result.indirect` and `result.baked_direct` as the settings ask:
+/// the same step 4, on the same values, as a whole bake's gather_atlas ends with.
 engine::Status filter_gathered(const StaticBakeScene& scene, const AtlasLayout& layout,
                                const TexelGatherSettings& settings, ThreadPool& pool, TexelGatherResult& result);
 

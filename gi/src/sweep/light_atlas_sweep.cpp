@@ -75,6 +75,18 @@ std::vector<KnobSpec> light_atlas_knobs() {
        .default_grid = {"0"},
        .min_value = 0,
        .max_value = 16},
+      {.name = "denoise",
+       .description = "gather: guided a-trous denoiser passes (steps 1, 2, 4, ... texels; 0: none)",
+       .kind = KnobKind::Integer,
+       .default_grid = {"0"},
+       .min_value = 0,
+       .max_value = 8},
+      {.name = "denoise_sigma",
+       .description = "gather: the denoiser's value weight, in standard deviations of the difference",
+       .kind = KnobKind::Real,
+       .default_grid = {"2"},
+       .min_value = 0.01,
+       .max_value = 1000},
       {.name = "ref_spp",
        .description = "samples per texel of the path-traced reference",
        .kind = KnobKind::Integer,
@@ -118,6 +130,8 @@ engine::Result<MethodOutput> run_light_atlas(const RunContext& ctx) {
     s.gather.emitter_rays = static_cast<int>(ctx.knobs.integer("emitter_rays"));
     s.gather.direct_samples = static_cast<int>(ctx.knobs.integer("direct_samples"));
     s.gather.filter_radius_texels = static_cast<float>(ctx.knobs.real("filter"));
+    s.gather.denoise_passes = static_cast<int>(ctx.knobs.integer("denoise"));
+    s.gather.denoise_sigma = static_cast<float>(ctx.knobs.real("denoise_sigma"));
     s.gather.bounces = std::max(s.bounces, 1);
   }
   s.seed = ctx.seed;

@@ -1,0 +1,103 @@
+#include "light_atlas/atlas_denoise.h"
+
+#include <cmath>
+
+#include "core/color.h"
+#include "light_atlas/texel_cells.h"
+
+namespace gi {
+namespace {
+
+// The cubic B-spline kernel of the a-trous wavelet (1/16, 1/4, 3/8, 1/4, 1/16 on the
+// lattice), radial: r in units of the pass's step, support 2.
+float b3_spline(float r) {
+  if (r < 1.0f) return 2.0f / 3.0f - r * r + 0.5f * r * r * r;
+  if (r < 2.0f) return (2.0f - r) * (2.0f - r) * (2.0f - r) / 6.0f;
+  return 0.0f;
+}
+
+// What one pass reads: the fields, their summed luminance and its variance.
+struct PassInput {
+  std::span<const std::vector<glm::vec3>> fields;
+  const std::vector<float>& lum;
+  const std::vector<float>& variance;
+};
+
+// One a-trous pass with step `step_texels`: every texel of `visible` takes the weighted mean
+// of itself and of the lattice texels (atlas pixel coordinates multiples of the step) within
+// two steps, written to `out_fields` and `out_variance`.
+void atrous_pass(const AtlasTexels& tx, const std::vector<std::uint32_t>& visible, int step_texels, float texel_m,
+                 const DenoiseSettings& s, ThreadPool& pool, const PassInput& in,
+                 std::vector<std::vector<glm::vec3>>& out_fields, std::vector<float>& out_variance) {
+  const auto step = static_cast<std::uint32_t>(step_texels);
+  const auto width = static_cast<std::uint32_t>(tx.width);
+  std::vector<std::uint32_t> lattice;
+  for (std::uint32_t j : visible)
+    if ((j % width) % step == 0 && (j / width) % step == 0) lattice.push_back(j);
+  const float step_m = static_cast<float>(step_texels) * texel_m;
+  const TexelCells all(tx, visible, 2.0f * step_m), on_lattice(tx, lattice, 2.0f * step_m);
+  const float plane_m = 0.5f * texel_m, min_cos = std::pow(1e-4f, 1.0f / s.normal_power);
+  const std::size_t nf = in.fields.size();
+  pool.parallel_for(
+      all.cell_count(),
+      [&](std::size_t c) {
+        std::vector<std::uint32_t> near;
+        on_lattice.for_around(all.cell(c), [&](std::uint32_t j) { near.push_back(j); });
+        all.for_cell(c, [&](std::uint32_t i) {
+          const glm::vec3 p = tx.position[i], n = tx.normal[i];
+          const float li = in.lum[i], vi = in.variance[i];
+          const float self = b3_spline(0.0f);
+          float weight = self, var = self * self * vi;
+          glm::vec3 sum[2] = {self * in.fields[0][i], nf > 1 ? self * in.fields[1][i] : glm::vec3(0.0f)};
+          for (std::uint32_t j : near) {
+            if (j == i) continue;
+            const glm::vec3 d = tx.position[j] - p;
+            const float ks = b3_spline(std::sqrt(glm::dot(d, d)) / step_m);
+            const float cos_n = glm::dot(tx.normal[j], n);
+            if (ks <= 0.0f || cos_n < min_cos) continue;
+            const float off_plane = glm::dot(d, n) / plane_m;
+            // The difference in units of its standard deviation (a floor of 1e-3 of the
+            // values where both are exact).
+            const float dl = li - in.lum[j];
+            const float floor = 1e-3f * (std::fabs(li) + std::fabs(in.lum[j]));
+            const float z2 = dl * dl / (s.value_sigma * s.value_sigma * (vi + in.variance[j]) + floor * floor + 1e-30f);
+            const float w = ks * std::pow(cos_n, s.normal_power) * std::exp(-off_plane * off_plane - 0.5f * z2);
+            if (!(w > 0.0f)) continue;
+            weight += w;
+            var += w * w * in.variance[j];
+            for (std::size_t f = 0; f < nf; ++f) sum[f] += w * in.fields[f][j];
+          }
+          for (std::size_t f = 0; f < nf; ++f) out_fields[f][i] = sum[f] / weight;
+          out_variance[i] = var / (weight * weight);
+        });
+      },
+      4);
+}
+
+}  // namespace
+
+void denoise_world(const AtlasTexels& tx, std::span<const std::uint32_t> work, const std::vector<std::uint8_t>& hidden,
+                   float texel_m, const DenoiseSettings& s, ThreadPool& pool, std::vector<float>& variance,
+                   std::span<std::vector<glm::vec3>* const> fields) {
+  if (s.passes <= 0 || fields.empty() || !(texel_m > 0.0f)) return;
+  std::vector<std::uint32_t> visible;
+  for (std::uint32_t i : work)
+    if (!hidden[i]) visible.push_back(i);
+  std::vector<std::vector<glm::vec3>> cur, next;
+  for (std::size_t f = 0; f < fields.size() && f < 2; ++f) cur.push_back(*fields[f]);
+  next = cur;
+  std::vector<float> lum(variance.size(), 0.0f), next_variance = variance;
+  for (int pass = 0; pass < s.passes; ++pass) {
+    for (std::uint32_t i : visible) {
+      glm::vec3 total(0.0f);
+      for (const auto& f : cur) total += f[i];
+      lum[i] = luminance(total);
+    }
+    atrous_pass(tx, visible, 1 << pass, texel_m, s, pool, PassInput{cur, lum, variance}, next, next_variance);
+    std::swap(cur, next);
+    std::swap(variance, next_variance);
+  }
+  for (std::size_t f = 0; f < cur.size(); ++f) *fields[f] = std::move(cur[f]);
+}
+
+}  // namespace gi

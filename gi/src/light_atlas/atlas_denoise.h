@@ -1,0 +1,38 @@
+#pragma once
+// Step 4b of the texel gather (texel_gather.h): a guided denoiser of the gathered light in
+// world space, across chart borders. Edge-avoiding a-trous (Dammertz et al. 2010) with a
+// variance-guided value weight (SVGF, Schied et al. 2017): `passes` passes of a sparse
+// kernel whose step doubles each pass (1, 2, 4, ... texels); a neighbour's weight falls with
+// the angle between the normals, with its distance off the texel's plane, and with the
+// difference of the two values in units of the standard deviation of that difference, so an
+// edge the estimate resolves (a sun-bounce gradient, a shadow) stays and noise goes.
+//   gi::denoise_world(texels, work, hidden, variance, texel_m, {.passes = 4}, pool, {&indirect, &sky});
+
+#include <cstdint>
+#include <span>
+#include <vector>
+#include <glm/glm.hpp>
+
+#include "core/thread_pool.h"
+#include "transport/static_scene.h"
+
+namespace gi {
+
+struct DenoiseSettings {
+  int passes = 4;  ///< A-trous passes; pass k's step is 2^k texels (0: no denoising).
+  /// Value weight exp(-(l_i - l_j)^2 / (2 value_sigma^2 var(l_i - l_j))).
+  float value_sigma = 2.0f;
+  float normal_power = 64.0f;  ///< Normal weight max(0, n_i . n_j)^normal_power.
+};
+
+/// Denoises the fields `fields` (each per atlas texel, W/m^2) together over the texels of
+/// `work` that are not `hidden`, guided by the luminance of their sum, whose per-texel
+/// variance (of the estimate, (W/m^2)^2) is `variance`; `variance` is updated to the
+/// variance of the denoised sum as the passes propagate it. Hidden texels keep their values
+/// and are read by nobody. Texel i's atlas pixel (i % texels.width, i / texels.width) places
+/// it on the sparse lattice of each pass. Bit-identical for any thread count.
+void denoise_world(const AtlasTexels& texels, std::span<const std::uint32_t> work,
+                   const std::vector<std::uint8_t>& hidden, float texel_m, const DenoiseSettings& settings,
+                   ThreadPool& pool, std::vector<float>& variance, std::span<std::vector<glm::vec3>* const> fields);
+
+}  // namespace gi
