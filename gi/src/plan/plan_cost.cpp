@@ -36,6 +36,11 @@ constexpr double kAtlasCpuOverhead = 0.05;        // s; layout, rasterization, f
 // Rays per texel: TexelGatherSettings' kept (solve_rays) and fresh (gather_rays) rays, one
 // shadow ray per punctual or directional light, direct_samples per texel when area lights
 // are sampled (gather_rays_per_texel below; a new per-texel ray count of the gather belongs there).
+// The gather's fixed cost (layout, rasterization, the static scene, the VPLs for the runtime,
+// files), serial: the Cornell box's quiet bakes at its preset densities (228-2388 texels) take
+// 0.017 / 0.032 / 0.29 s against 0.004 / 0.013 / 0.28 s of rays (tools/plan-calibration.py,
+// 29 Nov 2026), so ~0.015 s; 0.05 s overestimated them 2-3x.
+constexpr double kGatherCpuOverhead = 0.015;
 constexpr double kAtlasCpuPerGatherRay =
     2.3e-7;  // s; demo_level preview 7.9 M rays in 0.92 s wall, medium 59.6 M in 6.5 s (2 threads)
 // A ray costs more in a larger scene once its BVH no longer stays in cache: flat from the spot
@@ -126,8 +131,8 @@ BakeWork light_atlas_work(const StaticSurfaceCensus& census, const LightAtlasSet
     w.rays = t.lit_texels * gather_rays_per_texel(s.gather, lights);
     w.units = w.rays;
     const double parallel = w.rays * gather_cpu_per_ray(census.triangles);
-    w.cpu_seconds = parallel + kAtlasCpuOverhead;
-    w.bake_seconds = wall_seconds(parallel, kAtlasCpuOverhead);
+    w.cpu_seconds = parallel + kGatherCpuOverhead;
+    w.bake_seconds = wall_seconds(parallel, kGatherCpuOverhead);
     w.runtime_bytes = static_cast<std::uint64_t>(static_cast<double>(t.width) * t.height * kAtlasTexelBytes);
     return w;
   }
