@@ -78,8 +78,8 @@ engine::Result<PaneUpsampler> PaneUpsampler::build(const AtlasLayout& coarse,
                             static_cast<double>(i / static_cast<std::size_t>(fine.width)) + 0.5);
     const glm::dvec2 q = map.c0 + map.a * (centre - map.f0) - 0.5;
     const auto inside = [&](int x, int y) {
-      return x >= box.origin.x && y >= box.origin.y && x < box.origin.x + box.size.x &&
-             y < box.origin.y + box.size.y && filled[static_cast<std::size_t>(y) * coarse.width + x];
+      return x >= box.origin.x && y >= box.origin.y && x < box.origin.x + box.size.x && y < box.origin.y + box.size.y &&
+             filled[static_cast<std::size_t>(y) * coarse.width + x];
     };
     const int x0 = static_cast<int>(std::floor(q.x)), y0 = static_cast<int>(std::floor(q.y));
     const double ax = q.x - x0, ay = q.y - y0;

@@ -88,7 +88,8 @@ TEST(PaneUpsample, ASmoothFieldIsReadBackAtTheFineTexels) {
   const auto field = [](const glm::vec3& p) { return 10.0f + 3.0f * p.x + 1.5f * p.z; };  // 10..19 on the floor
   std::vector<glm::vec3> coarse(l.coarse_texels.valid.size(), glm::vec3(0.0f));
   for (std::size_t t = 0; t < coarse.size(); ++t)
-    if (l.coarse_texels.valid[t] && l.coarse_texels.mesh[t] == 0) coarse[t] = glm::vec3(field(l.coarse_texels.position[t]));
+    if (l.coarse_texels.valid[t] && l.coarse_texels.mesh[t] == 0)
+      coarse[t] = glm::vec3(field(l.coarse_texels.position[t]));
   coarse = dilated(l, coarse);
   auto up = gi::PaneUpsampler::build(l.coarse, l.coarse_filled, l.fine, l.fine_texels);
   ASSERT_TRUE(up) << up.error().to_string();
