@@ -6,17 +6,12 @@
 #include <cstdint>
 #include <glm/glm.hpp>
 
+#include "core/bit_reverse.h"
+
 namespace gi {
 
 // Van der Corput in base 2: the bits of i mirrored about the binary point (24 bits kept).
-inline float radical_inverse(std::uint32_t i) {
-  i = (i << 16u) | (i >> 16u);
-  i = ((i & 0x55555555u) << 1u) | ((i & 0xAAAAAAAAu) >> 1u);
-  i = ((i & 0x33333333u) << 2u) | ((i & 0xCCCCCCCCu) >> 2u);
-  i = ((i & 0x0F0F0F0Fu) << 4u) | ((i & 0xF0F0F0F0u) >> 4u);
-  i = ((i & 0x00FF00FFu) << 8u) | ((i & 0xFF00FF00u) >> 8u);
-  return static_cast<float>(i >> 8) * 0x1p-24f;
-}
+inline float radical_inverse(std::uint32_t i) { return static_cast<float>(reverse_bits(i) >> 8) * 0x1p-24f; }
 
 // Point i of an n-point Hammersley set, shifted on the torus (Cranley-Patterson rotation):
 // stratified in both dimensions for any n, decorrelated between texels by the shift.

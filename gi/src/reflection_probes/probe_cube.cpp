@@ -9,7 +9,9 @@
 #include <limits>
 #include <numbers>
 
+#include "core/bit_reverse.h"
 #include "core/thread_pool.h"
+#include "raytrace/reference_brdf.h"
 
 namespace gi {
 
@@ -48,23 +50,7 @@ std::vector<std::vector<glm::vec3>> box_chain(const ProbeCube& cube) {
 }
 
 // Van der Corput's radical inverse in base 2: the bits of i mirrored about the binary point.
-float radical_inverse(std::uint32_t i) {
-  i = (i << 16u) | (i >> 16u);
-  i = ((i & 0x55555555u) << 1u) | ((i & 0xAAAAAAAAu) >> 1u);
-  i = ((i & 0x33333333u) << 2u) | ((i & 0xCCCCCCCCu) >> 2u);
-  i = ((i & 0x0F0F0F0Fu) << 4u) | ((i & 0xF0F0F0F0u) >> 4u);
-  i = ((i & 0x00FF00FFu) << 8u) | ((i & 0xFF00FF00u) >> 8u);
-  return static_cast<float>(i) * 2.3283064365386963e-10f;
-}
-
-// Orthonormal t, b around unit n (Duff et al. 2017).
-void basis(const glm::vec3& n, glm::vec3& t, glm::vec3& b) {
-  const float sign = std::copysign(1.0f, n.z);
-  const float a = -1.0f / (sign + n.z);
-  const float c = n.x * n.y * a;
-  t = glm::vec3(1.0f + sign * n.x * n.x * a, sign * c, -sign * n.x);
-  b = glm::vec3(c, sign + n.y * n.y * a, -n.y);
-}
+float radical_inverse(std::uint32_t i) { return static_cast<float>(reverse_bits(i)) * 2.3283064365386963e-10f; }
 
 struct LobeSample {
   glm::vec3 tangent_h{0.0f};  ///< The half vector in the frame (t, b, n).
@@ -211,7 +197,7 @@ void prefilter_ggx(ProbeCube& cube, int samples, ThreadPool* pool) {
       const int face = static_cast<int>(i) / (s * s), y = static_cast<int>(i) / s % s, x = static_cast<int>(i) % s;
       const glm::vec3 n = cube_texel_direction(face, x, y, s);
       glm::vec3 t, b;
-      basis(n, t, b);
+      orthonormal_basis(n, t, b);
       glm::vec3 sum(0.0f);
       float weight = 0.0f;
       for (const LobeSample& ls : lobe) {
