@@ -45,6 +45,8 @@ struct AntiradianceBake {
   ElementHierarchy hierarchy;
   LinkMesh static_links;
   std::vector<glm::vec3> baseline;  ///< Indirect irradiance per leaf with the region at its baked pose.
+  /// How the baseline's solve ended (iterations, residual, budget_exhausted); not stored in a bundle.
+  AntiradianceSolveReport baseline_report;
   /// What the bake's stages took (wall seconds; bake_stats.json, not the bundle's files):
   /// the links (or, in a merge of shards, putting the shards' links in place), the static
   /// links' filter, the direct light and the baseline solve.

@@ -17,7 +17,13 @@
 // flux sum_leaves a E cannot exceed what the direct light reflects, F_rd = sum a albedo
 // E_direct, times 1 / (1 - albedo_max) (every further bounce keeps at most albedo_max of
 // it); above that (or non-finite) the output is scaled down to the bound (output_scale).
-// A residual tolerance may end either scheme early.
+// The solve runs to the residual tolerance (settings.residual_tolerance: sum |Delta I_ex| /
+// sum |I_ex| of the last iteration, the change relative to the region's exitant energy),
+// within a budget of settings.iterations; a solve that used the whole budget without
+// reaching it says so (budget_exhausted), and the callers warn and flag it in their stats.
+// The bake's baseline and the runtime solve the same way, so both stop within the tolerance
+// of the same fixed point (a cold start from the direct light: at the baked pose the two
+// solves are the same computation and the change is exactly 0).
 //   gi::AntiradianceSolveReport r = gi::run_antiradiance(passes, direct, settings, bound);
 
 #include <span>
@@ -38,8 +44,13 @@ struct AntiradianceSolveReport {
   std::vector<double> residuals;  ///< Relative residual after each iteration of the final scheme.
   std::vector<double> changes;  ///< Absolute residual sum |Delta I_ex| (W/sr) of the symmetric run, fallen back or not.
   bool diverged = false;        ///< The asymmetric scheme grew too and was stopped.
-  double indirect_flux = 0.0;   ///< sum over leaves of area x |E| (W, first channel summed over RGB).
-  double flux_bound = 0.0;      ///< The energy bound it was checked against (W).
+  bool converged = false;       ///< The relative residual dropped below the tolerance.
+  /// The budget (settings.iterations) ran out before the tolerance was reached (and the
+  /// solve did not diverge); never with a tolerance of 0.
+  bool budget_exhausted = false;
+  double residual = 0.0;       ///< Relative residual of the last iteration (0: no iteration).
+  double indirect_flux = 0.0;  ///< sum over leaves of area x |E| (W, first channel summed over RGB).
+  double flux_bound = 0.0;     ///< The energy bound it was checked against (W).
   /// Multiply passes.irradiance() by this: 1, or what brings the flux down to the bound
   /// (0 when the result was not finite).
   float output_scale = 1.0f;
