@@ -117,6 +117,13 @@ class AntiradianceRegion {
     for (glm::vec3& v : e) v *= last_.output_scale;
     return e;
   }
+  /// The exitant intensities I_ex of the last CPU solve (nodes x bins RGB, W/sr; its energy
+  /// guard applied): what gather_at_points reads (antiradiance_texel_gather.h).
+  std::vector<glm::vec3> exitant() const {
+    std::vector<glm::vec3> i = cpu_->exitant();
+    for (glm::vec3& v : i) v *= last_.output_scale;
+    return i;
+  }
   /// The report of the last CPU solve.
   const AntiradianceSolveReport& last_report() const { return last_; }
   /// The baseline's indirect irradiance per leaf (the region at its baked pose).
