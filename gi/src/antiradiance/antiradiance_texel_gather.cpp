@@ -71,8 +71,7 @@ struct PointGather {
       const glm::vec3 to_node = n.center - p.position;
       if (glm::dot(p.normal, to_node) < -n.radius_m) continue;  // wholly behind the point's plane
       const float d2 = glm::dot(to_node, to_node);
-      const bool fine = d2 > n.radius_m * n.radius_m &&
-                        glm::pi<float>() * n.radius_m * n.radius_m <= threshold_sr * d2;
+      const bool fine = d2 > n.radius_m * n.radius_m && glm::pi<float>() * n.radius_m * n.radius_m <= threshold_sr * d2;
       if (fine) {
         e += whole(p, node, to_node, d2);
       } else if (n.child_count == 0) {
@@ -91,9 +90,10 @@ struct PointGather {
 std::vector<glm::vec3> gather_at_points(const ElementHierarchy& h, const DirectionalBins& bins,
                                         const AntiradianceSettings& settings, std::span<const glm::vec3> exitant,
                                         std::span<const GatherPoint> points) {
-  const PointGather g{h, bins, exitant,
-                      std::max(settings.oracle_scale, 1e-6f) * 4.0f * glm::pi<float>() / static_cast<float>(bins.count()),
-                      static_cast<std::size_t>(bins.count())};
+  const PointGather g{
+      h, bins, exitant,
+      std::max(settings.oracle_scale, 1e-6f) * 4.0f * glm::pi<float>() / static_cast<float>(bins.count()),
+      static_cast<std::size_t>(bins.count())};
   std::vector<glm::vec3> out(points.size(), glm::vec3(0.0f));
   if (h.nodes.empty() || exitant.size() < h.nodes.size() * g.m) return out;
   tbb::parallel_for(std::size_t{0}, points.size(), [&](std::size_t i) { out[i] = g.at(points[i]); });
