@@ -103,6 +103,10 @@ class GISystem final : public engine::IndirectLightProvider {
     std::uint64_t antiradiance_updates = 0;  ///< Frames on which a deforming node moved and was solved.
     std::size_t antiradiance_relinked_elements = 0;  ///< Last such frame: elements whose links were rebuilt.
     double last_antiradiance_ms = 0.0;               ///< Relink + direct light + GPU iteration (glFinish-timed).
+    int antiradiance_iterations = 0;                 ///< Last such frame: iterations of its solve.
+    double antiradiance_residual = 0.0;              ///< ... its final relative residual.
+    /// ... it ran out of its iteration budget before the residual tolerance (a warning was logged).
+    bool antiradiance_unconverged = false;
     /// Light and dynamic-object entities left out of the last frame's GI because their world
     /// transform or light values are unusable (NaN, infinite, absurd: engine/runtime_limits.h).
     /// A skipped light gives no light; a skipped object keeps its last usable pose. Each is

@@ -42,6 +42,7 @@ engine::Result<AntiradianceBake> solve_baseline(const BakeInput& input, const An
   bake.baseline = base.irradiance();
   for (glm::vec3& v : bake.baseline) v *= rep.output_scale;
   bake.seconds.solve = seconds_since(t);
+  bake.baseline_report = rep;
   return bake;
 }
 

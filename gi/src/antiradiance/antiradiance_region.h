@@ -45,6 +45,8 @@ struct AntiradianceBake {
   ElementHierarchy hierarchy;
   LinkMesh static_links;
   std::vector<glm::vec3> baseline;  ///< Indirect irradiance per leaf with the region at its baked pose.
+  /// How the baseline's solve ended (iterations, residual, budget_exhausted); not stored in a bundle.
+  AntiradianceSolveReport baseline_report;
   /// What the bake's stages took (wall seconds; bake_stats.json, not the bundle's files):
   /// the links (or, in a merge of shards, putting the shards' links in place), the static
   /// links' filter, the direct light and the baseline solve.
@@ -114,6 +116,13 @@ class AntiradianceRegion {
     std::vector<glm::vec3> e = cpu_->irradiance();
     for (glm::vec3& v : e) v *= last_.output_scale;
     return e;
+  }
+  /// The exitant intensities I_ex of the last CPU solve (nodes x bins RGB, W/sr; its energy
+  /// guard applied): what gather_at_points reads (antiradiance_texel_gather.h).
+  std::vector<glm::vec3> exitant() const {
+    std::vector<glm::vec3> i = cpu_->exitant();
+    for (glm::vec3& v : i) v *= last_.output_scale;
+    return i;
   }
   /// The report of the last CPU solve.
   const AntiradianceSolveReport& last_report() const { return last_; }

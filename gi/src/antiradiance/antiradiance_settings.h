@@ -1,7 +1,7 @@
 #pragma once
 // The quality knobs of the antiradiance solver (Dachsbacher et al. 2007), one struct so the
 // bake, the runtime and the sweep read the same names.
-//   gi::AntiradianceSettings s;  s.bins_per_side = 8;  s.iterations = 4;
+//   gi::AntiradianceSettings s;  s.bins_per_side = 8;  s.residual_tolerance = 1e-3;
 
 #include <cstdint>
 #include <string_view>
@@ -25,14 +25,17 @@ struct AntiradianceSettings {
   /// The oracle links two elements when each one's solid angle seen from the other is at
   /// most oracle_scale x the smallest bin solid angle (1: the paper's rule).
   float oracle_scale = 1.0f;
-  /// Iterations (global + push + local + pull each); asymmetric: radiance steps.
-  int iterations = 8;
+  /// The iteration budget (global + push + local + pull each; asymmetric: radiance steps):
+  /// the solve stops at the residual tolerance, at the latest after this many iterations
+  /// (then it reports budget_exhausted, antiradiance_solver.h).
+  int iterations = 64;
   /// Asymmetric: antiradiance steps (eq. 14) before each radiance step (eq. 13).
   int antiradiance_steps = 4;
   AntiradianceScheme scheme = AntiradianceScheme::Symmetric;
-  /// Stop early when the relative residual (sum |Delta I_ex| / sum |I_ex|) drops below it;
-  /// 0: always run `iterations`.
-  double residual_tolerance = 0.0;
+  /// Converged when the relative residual of an iteration (sum |Delta I_ex| / sum |I_ex|: the
+  /// change relative to the region's exitant energy) drops below it; 0: always run
+  /// `iterations` (a fixed, unconverged count).
+  double residual_tolerance = 1e-3;
   /// Symmetric: fall back to the asymmetric scheme (restarted from the direct light) when
   /// the residual grew this many iterations in a row, or the intensities exceed the bound.
   int growth_limit = 2;

@@ -70,4 +70,46 @@ glm::vec3 blend_leaves(const AntiradianceTexelBlend& b, std::span<const glm::vec
   return e;
 }
 
+namespace {
+
+int heaviest(const AntiradianceTexelBlend& b) {
+  int best = -1;
+  for (int k = 0; k < 4; ++k)
+    if (b.leaves[k] >= 0 && (best < 0 || b.weights[k] > b.weights[best])) best = k;
+  return best < 0 ? -1 : b.leaves[best];
+}
+
+bool used(const AntiradianceTexelBlend& b, std::span<const glm::vec3> per_texel, std::span<const std::uint8_t> use) {
+  return b.texel < per_texel.size() && b.texel < use.size() && use[b.texel] != 0;
+}
+
+}  // namespace
+
+std::vector<glm::vec3> project_through_leaves(std::span<const AntiradianceTexelBlend> blends,
+                                              std::span<const glm::vec3> per_texel, std::span<const std::uint8_t> use,
+                                              std::size_t leaf_count) {
+  std::vector<glm::dvec3> sum(leaf_count, glm::dvec3(0.0));
+  std::vector<double> count(leaf_count, 0.0);
+  for (const AntiradianceTexelBlend& b : blends) {
+    const int l = heaviest(b);
+    if (l < 0 || static_cast<std::size_t>(l) >= leaf_count || !used(b, per_texel, use)) continue;
+    sum[static_cast<std::size_t>(l)] += glm::dvec3(per_texel[b.texel]);
+    count[static_cast<std::size_t>(l)] += 1.0;
+  }
+  std::vector<glm::vec3> out(per_texel.size(), glm::vec3(0.0f));
+  for (const AntiradianceTexelBlend& b : blends) {
+    if (!used(b, per_texel, use)) continue;
+    glm::dvec3 e(0.0);
+    double w = 0.0;
+    for (int k = 0; k < 4; ++k) {
+      const int l = b.leaves[k];
+      if (l < 0 || static_cast<std::size_t>(l) >= leaf_count || count[static_cast<std::size_t>(l)] == 0.0) continue;
+      e += static_cast<double>(b.weights[k]) * sum[static_cast<std::size_t>(l)] / count[static_cast<std::size_t>(l)];
+      w += static_cast<double>(b.weights[k]);
+    }
+    if (w > 0.0) out[b.texel] = glm::vec3(e / w);
+  }
+  return out;
+}
+
 }  // namespace gi

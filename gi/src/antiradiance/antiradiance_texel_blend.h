@@ -36,4 +36,14 @@ std::vector<AntiradianceTexelBlend> antiradiance_texel_blends(const ElementHiera
 /// sum_k weights[k] x per_leaf[leaves[k]].
 glm::vec3 blend_leaves(const AntiradianceTexelBlend& b, std::span<const glm::vec3> per_leaf);
 
+/// The floor the per-leaf output sets whatever the solver computes: a per-texel field
+/// (indexed by atlas texel, like blends' texel) projected onto the leaves and blended back.
+/// Each leaf gets the mean of `per_texel` over the texels of `blends` with `use` set whose
+/// heaviest leaf it is (the leaf's area average, sampled at the texels); each such texel
+/// then the blend of those means over its leaves that got one (weights renormalized; 0 when
+/// none did). Returned per atlas texel (`per_texel.size()`), 0 at texels not used.
+std::vector<glm::vec3> project_through_leaves(std::span<const AntiradianceTexelBlend> blends,
+                                              std::span<const glm::vec3> per_texel, std::span<const std::uint8_t> use,
+                                              std::size_t leaf_count);
+
 }  // namespace gi

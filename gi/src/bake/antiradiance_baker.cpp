@@ -56,6 +56,13 @@ engine::Status bake_antiradiance_method(const MethodBake& job) {
                         scene_file_name(input).c_str(), o.preset.c_str(), bake->hierarchy.nodes.size(),
                         bake->hierarchy.leaf_count(), s.bins_per_side * s.bins_per_side,
                         bake->static_links.links.size(), seconds_since(start)));
+  const AntiradianceSolveReport& rep = bake->baseline_report;
+  stage.log(format_line("antiradiance baseline: %d iterations, residual %.2e (tolerance %.0e)%s", rep.iterations,
+                        rep.residual, s.residual_tolerance, rep.fell_back ? ", asymmetric fallback" : ""));
+  if (rep.budget_exhausted && job.host.log)
+    job.host.log(LogLevel::Warning, format_line("antiradiance baseline did not converge in %d iterations (residual "
+                                                "%.2e): the runtime's change carries that error",
+                                                rep.iterations, rep.residual));
   // links_seconds: linking (a merge: putting the shards' links in place).
   timings["links_seconds"] = bake->seconds.links;
   timings["static_links_seconds"] = bake->seconds.static_links;

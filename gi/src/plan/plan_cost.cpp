@@ -251,6 +251,9 @@ constexpr double kArGpuBytesPerLink = 9.8;
 // antiradiance.bin: 4.8 bytes per link (zstd planes, AntiradianceIo test) + 72 per element
 // and 12 per leaf.
 constexpr double kArFileBytesPerLink = 4.8;
+// Iterations of a solve to a residual tolerance (1e-3): 19 on the corridor at 0.8 m / 64 bins
+// (docs/antiradiance.md, issue 37); at most the budget.
+constexpr int kArConvergedIterations = 19;
 
 }  // namespace
 
@@ -262,7 +265,9 @@ BakeWork antiradiance_work(std::size_t elements, std::size_t leaves, const Antir
   const double k = kArLinksPerElementBin * m * n;
   w.units = k;
   // The baseline solve is ~20% of it at 8 iterations (cpu_solve_ms / bake_s in the sweep).
-  w.cpu_seconds = k * kArSecondsPerLink * (0.8 + 0.2 * std::max(1, s.iterations) / 8.0) + kArSecondsOverhead;
+  const int iterations = s.residual_tolerance > 0.0 ? std::min(std::max(1, s.iterations), kArConvergedIterations)
+                                                    : std::max(1, s.iterations);
+  w.cpu_seconds = k * kArSecondsPerLink * (0.8 + 0.2 * iterations / 8.0) + kArSecondsOverhead;
   w.bake_seconds = w.cpu_seconds;
   w.runtime_bytes = static_cast<std::uint64_t>(24.0 * m * (n + l) + kArGpuBytesPerLink * k);
   if (links) *links = k;

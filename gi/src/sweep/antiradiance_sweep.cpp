@@ -22,6 +22,7 @@
 #include "antiradiance/antiradiance_io.h"
 #include "antiradiance/antiradiance_region.h"
 #include "antiradiance/antiradiance_texel_blend.h"
+#include "antiradiance/antiradiance_texel_gather.h"
 #include "raytrace/atlas_reference.h"
 #include "uv/atlas_input.h"
 #include "uv/atlas_layout.h"
@@ -153,6 +154,7 @@ const engine::GpuContext* gl_context() {
 
 glm::vec3 ref_at(const RgbField& f, std::size_t i) { return {f.rgb[3 * i], f.rgb[3 * i + 1], f.rgb[3 * i + 2]}; }
 
+// Long because it is one table: every knob of the method with its grid.
 std::vector<KnobSpec> antiradiance_knobs() {
   return {
       {.name = "patch",
@@ -168,11 +170,17 @@ std::vector<KnobSpec> antiradiance_knobs() {
        .min_value = 1,
        .max_value = 64},
       {.name = "iterations",
-       .description = "iterations (global + push + local + pull each; asymmetric: radiance steps)",
+       .description = "iteration budget (global + push + local + pull each; asymmetric: radiance steps)",
        .kind = KnobKind::Integer,
-       .default_grid = {"2", "4", "8"},
+       .default_grid = {"64"},
        .min_value = 1,
        .max_value = 256},
+      {.name = "tolerance",
+       .description = "residual tolerance of the solve (sum |dI_ex| / sum |I_ex|); 0: run the whole budget",
+       .kind = KnobKind::Real,
+       .default_grid = {"0.001"},
+       .min_value = 0,
+       .max_value = 1},
       {.name = "scheme",
        .description = "iteration of the paper's 2.2 (asymmetric: 4 antiradiance steps per radiance step)",
        .kind = KnobKind::Choice,
@@ -184,6 +192,12 @@ std::vector<KnobSpec> antiradiance_knobs() {
        .default_grid = {"1"},
        .min_value = 0.01,
        .max_value = 100},
+      {.name = "output",
+       .description = "how the change reaches a texel: blend (the runtime's 4 nearest leaves) or gather (from the "
+                      "hierarchy at the texel, antiradiance_texel_gather.h)",
+       .kind = KnobKind::Choice,
+       .default_grid = {"blend"},
+       .choices = {"blend", "gather"}},
       {.name = "gpu",
        .description = "also time the door move with the GPU passes (compute shaders; headless GL)",
        .kind = KnobKind::Choice,
@@ -225,6 +239,7 @@ AntiradianceSettings antiradiance_settings(const RunContext& ctx) {
   s.patch_size_m = static_cast<float>(ctx.knobs.real("patch"));
   s.bins_per_side = static_cast<int>(ctx.knobs.integer("bins"));
   s.iterations = static_cast<int>(ctx.knobs.integer("iterations"));
+  s.residual_tolerance = ctx.knobs.real("tolerance");
   s.scheme = ctx.knobs.text("scheme") == "asymmetric" ? AntiradianceScheme::Asymmetric : AntiradianceScheme::Symmetric;
   s.oracle_scale = static_cast<float>(ctx.knobs.real("oracle"));
   s.seed = ctx.seed;
@@ -249,19 +264,78 @@ engine::Result<std::uint64_t> stored_bytes(const AntiradianceBake& bake, std::ui
 struct DoorMoveScores {
   std::vector<glm::vec3> values;
   std::vector<std::uint8_t> valid;
-  double move_ms = 0.0, solve_ms = 0.0;
+  // The projection floor: every pose's field with the true change passed through the leaves
+  // (project_through_leaves) in place of the method's.
+  std::vector<glm::vec3> floor_values;
+  double move_ms = 0.0, solve_ms = 0.0, output_ms = 0.0;  // output: the change at the texels (gather or blend)
+  double iterations = 0.0, residual = 0.0;  // mean iterations of the moves' solves, largest final residual
+  double unconverged = 0.0;                 // moves whose solve ran out of its budget
   double so = 0.0, sr = 0.0, soo = 0.0, srr = 0.0, sor = 0.0, samples = 0.0;  // change correlation
   double level = 0.0;  // mean |E_ref(baked)| per channel over the compared texels
   std::vector<std::pair<std::string, double>> per_angle;
+
+  void add_solve(const AntiradianceSolveReport& rep) {
+    iterations += static_cast<double>(rep.iterations) / static_cast<double>(kPoses - 1);
+    residual = std::max(residual, rep.residual);
+    unconverged += rep.budget_exhausted ? 1.0 : 0.0;
+  }
+  // Pose k's floor: the reference's true change through the leaves, on the baked pose's truth.
+  void add_floor(const RgbField& reference, const DoorSetup& d, const std::vector<AntiradianceTexelBlend>& blends,
+                 std::size_t leaves, std::size_t k) {
+    const std::size_t n = d.texels.valid.size();
+    std::vector<glm::vec3> true_change(n, glm::vec3(0.0f));
+    for (std::size_t t = 0; t < n; ++t)
+      if (d.mask[t]) true_change[t] = ref_at(reference, k * n + t) - ref_at(reference, t);
+    const std::vector<glm::vec3> floor = project_through_leaves(blends, true_change, d.mask, leaves);
+    for (std::size_t t = 0; t < n; ++t)
+      if (d.mask[t]) floor_values[k * n + t] = ref_at(reference, t) + floor[t];
+  }
+};
+
+// The change at the compared texels: blended from the leaves' delta (the runtime's), or
+// gathered at the texels from the solved hierarchy minus the same gather at the baked pose.
+struct TexelOutput {
+  bool gather = false;
+  std::vector<GatherPoint> points;
+  std::vector<std::size_t> texel;   // per point
+  std::vector<glm::vec3> baseline;  // gathered at the baked pose
+
+  // Solves the region at its (baked) pose and gathers there.
+  TexelOutput(const DoorSetup& d, AntiradianceRegion& region, bool gather_at_texels) : gather(gather_at_texels) {
+    if (!gather) return;
+    for (std::size_t t = 0; t < d.mask.size(); ++t)
+      if (d.mask[t]) {
+        points.push_back({d.texels.position[t], d.texels.normal[t]});
+        texel.push_back(t);
+      }
+    region.update(true);
+    baseline = gather_at_points(region.hierarchy(), region.bins(), region.settings(), region.exitant(), points);
+  }
+
+  std::vector<glm::vec3> change(const AntiradianceRegion& region, const std::vector<AntiradianceTexelBlend>& blends,
+                                std::size_t n) const {
+    std::vector<glm::vec3> dt(n, glm::vec3(0.0f));
+    if (!gather) {
+      const std::vector<glm::vec3> delta = region.delta(region.irradiance());
+      for (const AntiradianceTexelBlend& b : blends) dt[b.texel] = blend_leaves(b, delta);
+      return dt;
+    }
+    const std::vector<glm::vec3> e =
+        gather_at_points(region.hierarchy(), region.bins(), region.settings(), region.exitant(), points);
+    for (std::size_t i = 0; i < points.size(); ++i) dt[texel[i]] = e[i] - baseline[i];
+    return dt;
+  }
 };
 
 // Each door move on the CPU twin: relink + direct light (update(false)), then the solve.
 engine::Result<DoorMoveScores> score_door_moves(const RunContext& ctx, const DoorSetup& d, AntiradianceRegion& region,
-                                                const std::vector<AntiradianceTexelBlend>& blends) {
+                                                const std::vector<AntiradianceTexelBlend>& blends,
+                                                const TexelOutput& output) {
   const std::size_t n = d.texels.valid.size();
   DoorMoveScores s;
   s.values.assign(n * kPoses, glm::vec3(0.0f));
   s.valid.assign(n * kPoses, 0);
+  s.floor_values.assign(n * kPoses, glm::vec3(0.0f));
   for (std::size_t t = 0; t < n; ++t)
     if (d.mask[t]) {
       const glm::vec3 e = ref_at(ctx.reference, t);
@@ -277,10 +351,11 @@ engine::Result<DoorMoveScores> score_door_moves(const RunContext& ctx, const Doo
     const auto t1 = Clock::now();
     const AntiradianceSolveReport rep = region.update(true);  // nothing moved since: the solve only
     s.solve_ms += ms_since(t1);
-    (void)rep;
-    const std::vector<glm::vec3> delta = region.delta(region.irradiance());
-    std::vector<glm::vec3> dt(n, glm::vec3(0.0f));
-    for (const AntiradianceTexelBlend& b : blends) dt[b.texel] = blend_leaves(b, delta);
+    s.add_solve(rep);
+    const auto t2 = Clock::now();
+    const std::vector<glm::vec3> dt = output.change(region, blends, n);
+    s.output_ms += ms_since(t2);
+    s.add_floor(ctx.reference, d, blends, region.hierarchy().leaf_count(), k);
     double err2 = 0.0, change2 = 0.0, mean_o = 0.0, mean_r = 0.0;
     for (std::size_t t = 0; t < n; ++t) {
       if (!d.mask[t]) continue;
@@ -366,6 +441,41 @@ RgbField nothing_changed(const RgbField& field, const RgbField& reference, const
   return nothing;
 }
 
+// The run's extras: the change statistics, the floor, the solves, the costs and sizes.
+std::vector<std::pair<std::string, double>> door_move_extras(const RunContext& ctx, const DoorSetup& d,
+                                                             const AntiradianceRegion& region, const DoorMoveScores& sc,
+                                                             const GpuDoorMove& gpu, const RgbField& field,
+                                                             const RgbField& floor_field) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double moves = static_cast<double>(kPoses - 1);
+  const double samples = sc.samples;
+  const double cov = sc.sor - sc.so * sc.sr / samples, var_o = sc.soo - sc.so * sc.so / samples,
+               var_r = sc.srr - sc.sr * sc.sr / samples;
+  std::vector<std::pair<std::string, double>> extras = {
+      {"nothing_rel_rmse", compare_rgb(nothing_changed(field, ctx.reference, d), ctx.reference).rel_rmse},
+      {"change_correlation", var_o > 0.0 && var_r > 0.0 ? cov / std::sqrt(var_o * var_r) : nan},
+      {"change_fit_scale", sc.soo > 0.0 ? sc.sor / sc.soo : nan},
+      // The rel. RMSE of the true change passed through the leaves: what the per-leaf output
+      // cannot go below, whatever the solver (project_through_leaves).
+      {"projection_floor_rel_rmse", compare_rgb(floor_field, ctx.reference).rel_rmse},
+      {"solve_iterations", sc.iterations},
+      {"solve_residual_max", sc.residual},
+      {"solve_unconverged", sc.unconverged}};
+  extras.insert(extras.end(), sc.per_angle.begin(), sc.per_angle.end());
+  extras.insert(extras.end(), {{"cpu_move_ms", sc.move_ms / moves},
+                               {"cpu_solve_ms", sc.solve_ms / moves},
+                               {"cpu_output_ms", sc.output_ms / moves},
+                               {"gpu_frame_ms", gpu.ms},
+                               {"gpu_bytes", gpu.bytes},
+                               {"gpu_cpu_rel_diff", gpu.cpu_diff},
+                               {"elements", static_cast<double>(region.hierarchy().nodes.size())},
+                               {"leaves", static_cast<double>(region.hierarchy().leaf_count())},
+                               {"links", static_cast<double>(region.links().links.size())},
+                               {"compared_texels", static_cast<double>(d.compared)},
+                               {"level", sc.level}});
+  return extras;
+}
+
 engine::Result<MethodOutput> run_door_moves(const RunContext& ctx) {
   auto d = door_setup(ctx.scene, ctx.knobs.real("density"), ctx.knobs.real("radius"));
   if (!d) return d.error();
@@ -387,12 +497,14 @@ engine::Result<MethodOutput> run_door_moves(const RunContext& ctx) {
   const std::vector<AntiradianceTexelBlend> blends =
       antiradiance_texel_blends(region->hierarchy(), d->input, d->layout);
 
-  auto scores = score_door_moves(ctx, *d, *region, blends);
+  const TexelOutput output(*d, *region, ctx.knobs.text("output") == "gather");
+  auto scores = score_door_moves(ctx, *d, *region, blends, output);
   if (!scores) return scores.error();
   DoorMoveScores& sc = *scores;
-  const double nan = std::numeric_limits<double>::quiet_NaN();
   const double moves = static_cast<double>(kPoses - 1);
-  out.costs.frame_ms = (sc.move_ms + sc.solve_ms) / moves;
+  out.costs.frame_ms = (sc.move_ms + sc.solve_ms + (output.gather ? sc.output_ms : 0.0)) / moves;
+  const RgbField floor_field =
+      RgbField::from_texels(d->texels.width, d->texels.height * static_cast<int>(kPoses), sc.floor_values, sc.valid);
   out.field = RgbField::from_texels(d->texels.width, d->texels.height * static_cast<int>(kPoses), sc.values,
                                     std::move(sc.valid));
 
@@ -402,24 +514,7 @@ engine::Result<MethodOutput> run_door_moves(const RunContext& ctx) {
     if (!timed) return timed.error();
     gpu = *timed;
   }
-  const double samples = sc.samples;
-  const double cov = sc.sor - sc.so * sc.sr / samples, var_o = sc.soo - sc.so * sc.so / samples,
-               var_r = sc.srr - sc.sr * sc.sr / samples;
-  out.extras = {
-      {"nothing_rel_rmse", compare_rgb(nothing_changed(out.field, ctx.reference, *d), ctx.reference).rel_rmse},
-      {"change_correlation", var_o > 0.0 && var_r > 0.0 ? cov / std::sqrt(var_o * var_r) : nan},
-      {"change_fit_scale", sc.soo > 0.0 ? sc.sor / sc.soo : nan}};
-  out.extras.insert(out.extras.end(), sc.per_angle.begin(), sc.per_angle.end());
-  out.extras.insert(out.extras.end(), {{"cpu_move_ms", sc.move_ms / moves},
-                                       {"cpu_solve_ms", sc.solve_ms / moves},
-                                       {"gpu_frame_ms", gpu.ms},
-                                       {"gpu_bytes", gpu.bytes},
-                                       {"gpu_cpu_rel_diff", gpu.cpu_diff},
-                                       {"elements", static_cast<double>(region->hierarchy().nodes.size())},
-                                       {"leaves", static_cast<double>(region->hierarchy().leaf_count())},
-                                       {"links", static_cast<double>(region->links().links.size())},
-                                       {"compared_texels", static_cast<double>(d->compared)},
-                                       {"level", sc.level}});
+  out.extras = door_move_extras(ctx, *d, *region, sc, gpu, out.field, floor_field);
   return out;
 }
 

@@ -9,6 +9,7 @@
 #include <array>
 #include <chrono>
 #include <limits>
+#include <string>
 
 #include "bundle/atlas_layout_file.h"
 #include "gpu/gi_shaders.h"
@@ -35,7 +36,8 @@ bool blends_fit(const std::vector<TexelBlend>& blends, const AtlasLayout& layout
 engine::Result<std::unique_ptr<AntiradianceLighting>> AntiradianceLighting::create(AntiradianceBake bake,
                                                                                    const BakeInput& input,
                                                                                    const AtlasLayout& layout,
-                                                                                   const engine::Registry& registry) {
+                                                                                   const engine::Registry& registry,
+                                                                                   LogCallback log) {
   // The bake's blends (read with it) serve when they cover this layout and the region sits
   // at its baked pose: they are then what antiradiance_texel_blends computes here.
   std::vector<TexelBlend> stored = std::move(bake.at_baked_pose.blends);
@@ -47,6 +49,7 @@ engine::Result<std::unique_ptr<AntiradianceLighting>> AntiradianceLighting::crea
   std::unique_ptr<AntiradianceLighting> a(new AntiradianceLighting());
   a->region_ = std::make_unique<AntiradianceRegion>(std::move(region).value());
   a->registry_ = &registry;
+  a->log_ = std::move(log);
   for (std::uint32_t i : a->region_->hierarchy().deforming_instances)
     a->deforming_.emplace_back(i, input.instances[i].entity);
   std::vector<TexelBlend> blends = stored_fit && a->region_->at_baked_pose()
@@ -127,6 +130,17 @@ bool AntiradianceLighting::update() {
   stats_.relinked_elements = region_->counters().relinked_elements;
   stats_.links = region_->counters().links;
   stats_.fell_back = report.fell_back;
+  stats_.iterations = report.iterations;
+  stats_.residual = report.residual;
+  stats_.unconverged = report.budget_exhausted;
+  if (report.budget_exhausted) {
+    ++stats_.unconverged_updates;
+    if (log_)
+      log_(LogLevel::Warning, "antiradiance: the solve did not converge in " + std::to_string(report.iterations) +
+                                  " iterations (residual " + std::to_string(report.residual) + ", tolerance " +
+                                  std::to_string(region_->settings().residual_tolerance) +
+                                  "); the door's change shows the last iterate");
+  }
   stats_.last_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   return true;
 }

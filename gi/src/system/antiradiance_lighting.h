@@ -13,6 +13,7 @@
 #include <engine/registry.h>
 #include <engine/result.h>
 #include <gi/bake_input.h>
+#include <gi/log.h>
 
 #include <memory>
 #include <optional>
@@ -38,12 +39,20 @@ class AntiradianceLighting {
     std::size_t covered_texels = 0;     ///< Atlas texels the region's change reaches.
     double last_ms = 0.0;               ///< Last update: relink + direct light + GPU iteration (glFinish-timed).
     bool fell_back = false;             ///< Last update: the symmetric iteration grew.
+    int iterations = 0;                 ///< Last update: iterations of the solve.
+    double residual = 0.0;              ///< Last update: its final relative residual (sum |Delta I_ex| / sum |I_ex|).
+    /// Last update: the iteration budget ran out before the residual tolerance (logged as a
+    /// warning); the change shown is the last iterate's.
+    bool unconverged = false;
+    std::uint64_t unconverged_updates = 0;  ///< Updates that ended so.
   };
 
-  /// Errors: the bake does not fit `input` (AntiradianceRegion::create).
+  /// Errors: the bake does not fit `input` (AntiradianceRegion::create). `log` hears a
+  /// warning for every solve that ends without converging.
   static engine::Result<std::unique_ptr<AntiradianceLighting>> create(AntiradianceBake bake, const BakeInput& input,
                                                                       const AtlasLayout& layout,
-                                                                      const engine::Registry& registry);
+                                                                      const engine::Registry& registry,
+                                                                      LogCallback log = {});
 
   /// Reads the deforming entities' world transforms; when one changed, solves (GL context
   /// current). True when it did. Errors of the GPU pass disable the method (stats().disabled).
@@ -72,6 +81,7 @@ class AntiradianceLighting {
   int width_ = 0, height_ = 0;
   Stats stats_;
   std::string disabled_;
+  LogCallback log_;
 };
 
 }  // namespace gi

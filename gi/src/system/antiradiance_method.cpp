@@ -28,6 +28,9 @@ class AntiradianceMethod final : public MethodRuntime {
       ++state.stats.antiradiance_updates;
       state.stats.antiradiance_relinked_elements = lighting_->stats().relinked_elements;
       state.stats.last_antiradiance_ms = lighting_->stats().last_ms;
+      state.stats.antiradiance_iterations = lighting_->stats().iterations;
+      state.stats.antiradiance_residual = lighting_->stats().residual;
+      state.stats.antiradiance_unconverged = lighting_->stats().unconverged;
     }
   }
   std::string label() const override { return "antiradiance"; }
@@ -47,7 +50,8 @@ engine::Result<std::unique_ptr<MethodRuntime>> load_antiradiance_method(MethodLo
                          "antiradiance adds into the light atlas: the bundle needs a light atlas or a PRM too"};
   auto bake = load_antiradiance(load.bundle_dir, load.input);
   if (!bake) return bake.error();
-  auto anti = AntiradianceLighting::create(std::move(bake).value(), load.input, *load.layout, load.scene.registry);
+  auto anti = AntiradianceLighting::create(std::move(bake).value(), load.input, *load.layout, load.scene.registry,
+                                           load.settings.log);
   if (!anti) return anti.error();
   const auto& st = anti.value()->stats();
   load.text << "antiradiance: " << st.elements << " elements, " << st.links << " links, " << st.covered_texels

@@ -66,8 +66,11 @@ TEST(AntiradianceDivergence, SymmetricIterationThatGrowsFallsBackToTheConverging
   EXPECT_TRUE(r.report.fell_back);
   EXPECT_EQ(r.report.scheme, gi::AntiradianceScheme::Asymmetric);
   EXPECT_FALSE(r.report.diverged);
+  // The fallback converges to the tolerance (1e-3) inside the budget.
+  EXPECT_TRUE(r.report.converged);
+  EXPECT_FALSE(r.report.budget_exhausted);
   ASSERT_FALSE(r.report.residuals.empty());
-  EXPECT_LT(r.report.residuals.back(), 1e-4);
+  EXPECT_LT(r.report.residuals.back(), 1e-3);
   EXPECT_EQ(r.report.output_scale, 1.0f);
   EXPECT_TRUE(r.finite);
   EXPECT_GT(r.indirect_flux, 0.0);
