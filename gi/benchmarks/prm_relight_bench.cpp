@@ -252,12 +252,13 @@ void BM_PrmLightChange(benchmark::State& state) {
   state.counters["entries"] = static_cast<double>(d.prm.entries.size());
   {
     const std::size_t n = d.prm.texels.size();
+    const std::vector<float> panes = gi::dense_panes(d.prm);
     std::size_t nonzero = 0, total = 0;
     for (int c = 0; c < d.prm.cluster_count; ++c)
       for (std::size_t first = 0; first < n; first += 8, ++total) {
         bool any = false;
         for (std::size_t i = first; i < std::min(n, first + 8) && !any; ++i)
-          for (int ch = 0; ch < 3; ++ch) any |= d.prm.panes[(std::size_t(c) * n + i) * 3 + ch] != 0.0f;
+          for (int ch = 0; ch < 3; ++ch) any |= panes[(std::size_t(c) * n + i) * 3 + ch] != 0.0f;
         nonzero += any;
       }
     state.counters["nonzero_blocks"] = double(nonzero) / double(total);
@@ -267,7 +268,7 @@ void BM_PrmLightChange(benchmark::State& state) {
       for (std::size_t first = 0; first < n; first += 8, ++picked_total) {
         bool any = false;
         for (std::size_t i = first; i < std::min(n, first + 8) && !any; ++i)
-          for (int ch = 0; ch < 3; ++ch) any |= d.prm.panes[(std::size_t(w.cluster) * n + i) * 3 + ch] != 0.0f;
+          for (int ch = 0; ch < 3; ++ch) any |= panes[(std::size_t(w.cluster) * n + i) * 3 + ch] != 0.0f;
         picked_nonzero += any;
       }
     // Runs of 8 blocks (64 elements, one 8-lane SIMD group of llvmpipe) all zero: what the skip can drop.
@@ -276,7 +277,7 @@ void BM_PrmLightChange(benchmark::State& state) {
       for (std::size_t first = 0; first < n; first += 64, ++runs) {
         bool any = false;
         for (std::size_t i = first; i < std::min(n, first + 64) && !any; ++i)
-          for (int ch = 0; ch < 3; ++ch) any |= d.prm.panes[(std::size_t(w.cluster) * n + i) * 3 + ch] != 0.0f;
+          for (int ch = 0; ch < 3; ++ch) any |= panes[(std::size_t(w.cluster) * n + i) * 3 + ch] != 0.0f;
         zero_runs += !any;
       }
     state.counters["picked_zero_runs64"] = runs ? double(zero_runs) / double(runs) : 0.0;
@@ -290,7 +291,7 @@ void BM_PrmLightChange(benchmark::State& state) {
           for (const auto* picked : {&picks[p - 1], &picks[p]})
             for (const gi::ClusterWeight& w : *picked)
               for (std::size_t i = first; i < std::min(n, first + run) && !any; ++i)
-                for (int ch = 0; ch < 3; ++ch) any |= d.prm.panes[(std::size_t(w.cluster) * n + i) * 3 + ch] != 0.0f;
+                for (int ch = 0; ch < 3; ++ch) any |= panes[(std::size_t(w.cluster) * n + i) * 3 + ch] != 0.0f;
           unchanged += !any;
         }
       state.counters["unlit_runs" + std::to_string(run)] = all ? double(unchanged) / double(all) : 0.0;
