@@ -187,6 +187,32 @@ std::string encode_panes(const Prm& p, std::vector<float>& scales, std::vector<s
   return {};
 }
 
+// The stored values of `q`'s blocks (their sizes checked against pane_half_bytes) from the
+// zstd frame of scaled halves in two byte planes.
+engine::Status decode_pane_values(const fs::path& path, std::span<const std::uint8_t> frame,
+                                  std::uint64_t pane_half_bytes, const std::vector<float>& scales, PrmPanes& q) {
+  auto unpacked = read_zstd_stream(path, "panes", frame, pane_half_bytes);
+  if (!unpacked) return unpacked.error();
+  const std::vector<std::uint8_t>& planes = *unpacked;
+
+  const auto total = static_cast<std::size_t>(pane_half_bytes / 2);
+  q.values.resize(total);
+  std::size_t c = 0;
+  for (std::size_t b = 0; b < q.blocks.size(); ++b) {
+    while (q.cluster_first[c + 1] <= b) ++c;
+    const std::size_t first = q.block_value[b] * 3, last = first + q.tiles.size(q.blocks[b]) * 3;
+    for (std::size_t j = first; j < last; ++j) {
+      const auto h = static_cast<std::uint16_t>(planes[j] | (planes[total + j] << 8));
+      if ((h & 0x8000u) != 0 || (h & 0x7c00u) == 0x7c00u)
+        return file_error(path, "panes",
+                          "pane " + str(c) + " block " + str(b) + " value " + str(j / 3) + " channel " + str(j % 3) +
+                              " is negative, infinite or NaN (corrupt)");
+      q.values[j] = half_to_float(h) * scales[c];
+    }
+  }
+  return {};
+}
+
 }  // namespace
 
 std::uint16_t float_to_half(float v) {
@@ -366,25 +392,7 @@ engine::Result<PrmPaneFile> read_prm_panes(const fs::path& path) {
     return file_error(path, "pane_half_bytes",
                       "the file says " + std::to_string(pane_half_bytes) + " bytes of halves, its blocks hold " +
                           std::to_string(stored) + " elements x 3 x 2 = " + std::to_string(values * 2) + " expected");
-  auto unpacked = read_zstd_stream(path, "panes", frame, pane_half_bytes);
-  if (!unpacked) return unpacked.error();
-  const std::vector<std::uint8_t>& planes = *unpacked;
-
-  const std::size_t total = static_cast<std::size_t>(values);
-  q.values.resize(total);
-  std::size_t c = 0;
-  for (std::size_t b = 0; b < q.blocks.size(); ++b) {
-    while (q.cluster_first[c + 1] <= b) ++c;
-    const std::size_t first = q.block_value[b] * 3, last = first + q.tiles.size(q.blocks[b]) * 3;
-    for (std::size_t j = first; j < last; ++j) {
-      const auto h = static_cast<std::uint16_t>(planes[j] | (planes[total + j] << 8));
-      if ((h & 0x8000u) != 0 || (h & 0x7c00u) == 0x7c00u)
-        return file_error(path, "panes",
-                          "pane " + str(c) + " block " + str(b) + " value " + str(j / 3) + " channel " + str(j % 3) +
-                              " is negative, infinite or NaN (corrupt)");
-      q.values[j] = half_to_float(h) * scales[c];
-    }
-  }
+  if (engine::Status st = decode_pane_values(path, frame, pane_half_bytes, scales, q); !st) return st.error();
   if (std::string problem = check_prm(p); !problem.empty()) return file_error(path, "", problem);
   return f;
 }
