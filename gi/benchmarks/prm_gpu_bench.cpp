@@ -51,9 +51,10 @@ gi::Prm synthetic_prm(std::size_t texels) {
   prm.cluster_count = kClusters;
   prm.texels.resize(texels);
   for (std::size_t i = 0; i < texels; ++i) prm.texels[i] = static_cast<std::uint32_t>(2 * i);
-  prm.panes.resize(static_cast<std::size_t>(kClusters) * texels * 3);
+  std::vector<float> dense(static_cast<std::size_t>(kClusters) * texels * 3);
   gi::Pcg32 rng(5, 1);
-  for (float& v : prm.panes) v = 10.0f * rng.next_float();
+  for (float& v : dense) v = 10.0f * rng.next_float();
+  gi::set_dense_panes(prm, dense);
   return prm;
 }
 

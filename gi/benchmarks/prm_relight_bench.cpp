@@ -9,8 +9,10 @@
 // Counters (medians over the iterations): cpu_ms (emitters, entry irradiance, weights,
 // selection), gpu_ms (pane sum + glFinish; CPU time on llvmpipe), atlas_rebake_ms (one bake
 // before the loop), vs_rebake = atlas_rebake_ms / (cpu_ms + gpu_ms) (issue 23 target >= 1000),
-// clusters (selected), texels (pane elements), gpu_k0_ms (the pane sum with no cluster: its
-// fixed part, the texel list read and every texel written), nonzero_blocks (share of the
+// clusters (selected), texels (pane elements), gpu_k0_ms (the pane sum with no cluster after
+// one with none: its fixed part, nothing written since the panes are sparse), chunks_per_change
+// (blocks of eight slots a change wrote: the picked clusters' tiles and the last change's),
+// chunks_all_tiles (every tile's), pane_blocks_stored_share, nonzero_blocks (share of the
 // panes' blocks of 8 elements holding any non-zero value), picked_nonzero_blocks (the same
 // over the last change's clusters), picked_zero_runs64 (share of those clusters' runs of 64
 // elements, one 8-lane SIMD group of 8-element blocks on llvmpipe, that are all zero: all a
@@ -186,7 +188,7 @@ void BM_PrmLightChange(benchmark::State& state) {
   if (state.range(2) != 0 && !pass.set_base(atlas.irradiance)) state.SkipWithError("PrmGpuPass::set_base failed");
   (void)pass.run({});  // first-dispatch shader compilation in llvmpipe
   glFinish();
-  std::vector<double> cpu, gpu, cpu_time, gpu_time;
+  std::vector<double> cpu, gpu, cpu_time, gpu_time, chunks;
   std::size_t frame = 0, clusters = 0;
   std::vector<gi::ClusterWeight> last_picked;
   std::vector<std::vector<gi::ClusterWeight>> picks;  // one per pose
@@ -209,6 +211,7 @@ void BM_PrmLightChange(benchmark::State& state) {
     cpu.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
     gpu.push_back(std::chrono::duration<double, std::milli>(t2 - t1).count());
     clusters = picked.size();
+    chunks.push_back(static_cast<double>(pass.last_run_chunks()));
     last_picked = picked;
     if (picks.size() < poses.size()) picks.push_back(picked);
   }
@@ -223,6 +226,17 @@ void BM_PrmLightChange(benchmark::State& state) {
     empty_time.push_back(process_cpu_ms() - c0);
   }
   state.counters["gpu_k0_ms"] = median(empty);
+  // Sparse panes (issue 38): blocks of eight slots one change wrote (the picked clusters'
+  // tiles and the last change's), against every tile's, and the share of blocks stored.
+  {
+    std::size_t all_chunks = 0;
+    for (std::size_t k = 0; k < d.prm.panes.tiles.tiles(); ++k) all_chunks += (d.prm.panes.tiles.size(k) + 7) / 8;
+    state.counters["chunks_per_change"] = median(chunks);
+    state.counters["chunks_all_tiles"] = static_cast<double>(all_chunks);
+    state.counters["pane_blocks_stored_share"] =
+        static_cast<double>(d.prm.panes.blocks.size()) /
+        static_cast<double>(std::max<std::size_t>(1, d.prm.panes.tiles.tiles() * d.prm.panes.cluster_count()));
+  }
   state.counters["pane_mb"] = static_cast<double>(pass.pane_bytes()) / 1e6;
   {
     const gi::Prm mine = with_panes(d.prm, encoding);
@@ -252,12 +266,13 @@ void BM_PrmLightChange(benchmark::State& state) {
   state.counters["entries"] = static_cast<double>(d.prm.entries.size());
   {
     const std::size_t n = d.prm.texels.size();
+    const std::vector<float> panes = gi::dense_panes(d.prm);
     std::size_t nonzero = 0, total = 0;
     for (int c = 0; c < d.prm.cluster_count; ++c)
       for (std::size_t first = 0; first < n; first += 8, ++total) {
         bool any = false;
         for (std::size_t i = first; i < std::min(n, first + 8) && !any; ++i)
-          for (int ch = 0; ch < 3; ++ch) any |= d.prm.panes[(std::size_t(c) * n + i) * 3 + ch] != 0.0f;
+          for (int ch = 0; ch < 3; ++ch) any |= panes[(std::size_t(c) * n + i) * 3 + ch] != 0.0f;
         nonzero += any;
       }
     state.counters["nonzero_blocks"] = double(nonzero) / double(total);
@@ -267,7 +282,7 @@ void BM_PrmLightChange(benchmark::State& state) {
       for (std::size_t first = 0; first < n; first += 8, ++picked_total) {
         bool any = false;
         for (std::size_t i = first; i < std::min(n, first + 8) && !any; ++i)
-          for (int ch = 0; ch < 3; ++ch) any |= d.prm.panes[(std::size_t(w.cluster) * n + i) * 3 + ch] != 0.0f;
+          for (int ch = 0; ch < 3; ++ch) any |= panes[(std::size_t(w.cluster) * n + i) * 3 + ch] != 0.0f;
         picked_nonzero += any;
       }
     // Runs of 8 blocks (64 elements, one 8-lane SIMD group of llvmpipe) all zero: what the skip can drop.
@@ -276,7 +291,7 @@ void BM_PrmLightChange(benchmark::State& state) {
       for (std::size_t first = 0; first < n; first += 64, ++runs) {
         bool any = false;
         for (std::size_t i = first; i < std::min(n, first + 64) && !any; ++i)
-          for (int ch = 0; ch < 3; ++ch) any |= d.prm.panes[(std::size_t(w.cluster) * n + i) * 3 + ch] != 0.0f;
+          for (int ch = 0; ch < 3; ++ch) any |= panes[(std::size_t(w.cluster) * n + i) * 3 + ch] != 0.0f;
         zero_runs += !any;
       }
     state.counters["picked_zero_runs64"] = runs ? double(zero_runs) / double(runs) : 0.0;
@@ -290,7 +305,7 @@ void BM_PrmLightChange(benchmark::State& state) {
           for (const auto* picked : {&picks[p - 1], &picks[p]})
             for (const gi::ClusterWeight& w : *picked)
               for (std::size_t i = first; i < std::min(n, first + run) && !any; ++i)
-                for (int ch = 0; ch < 3; ++ch) any |= d.prm.panes[(std::size_t(w.cluster) * n + i) * 3 + ch] != 0.0f;
+                for (int ch = 0; ch < 3; ++ch) any |= panes[(std::size_t(w.cluster) * n + i) * 3 + ch] != 0.0f;
           unchanged += !any;
         }
       state.counters["unlit_runs" + std::to_string(run)] = all ? double(unchanged) / double(all) : 0.0;

@@ -1,17 +1,21 @@
 #version 450 core
-// PRM runtime sum (Szécsi et al. 2006, §5.2): for every pane element i,
-//   E(texels[i]) = [base(texels[i])] + sum over the selected clusters k of weight_k * pane_k[i]
+// PRM runtime sum (Szécsi et al. 2006, §5.2): for every pane element i of a touched tile,
+//   E(texels[i]) = [base(texels[i])] + sum over the selected clusters k storing a block on
+//                  that tile of weight_k * pane_k[i]
 // written into the irradiance atlas at texel (x, y) = (texels[i] & 0xffff, texels[i] >> 16)
 // (prm_gpu_pass.cpp packs each texel's coordinates once: a per-lane integer division by the
-// width cost llvmpipe a scalar loop per invocation). Work groups on a 2-D grid when one row
-// would exceed 65535.
+// width cost llvmpipe a scalar loop per invocation). Panes are sparse (prm_panes.h): a
+// cluster stores only the atlas tiles its light reaches, so a light change dispatches only
+// the chunks (eight slots) of the tiles its clusters light (and of the last change's tiles,
+// written back to the base). Texel slots are grouped by tile, each tile padded to whole
+// chunks with 0xffffffff (skipped). Work groups on a 2-D grid when one row would exceed 65535.
 //
 // Pane storage (prm_gpu_pass.cpp writes it), one of two encodings:
 // - PRM_PANES_RGB9E5 defined (the default): one 32-bit word per element (three 9-bit
 //   mantissas, one shared exponent); eight elements fill two uvec4s, a third fewer bytes.
 // - otherwise half floats, three per element (R, G, B) packed tightly, two halves per uint
 //   (low half first): eight elements (24 halves) fill three uvec4s exactly.
-// One invocation sums one block of eight elements: per cluster two or three 16-byte texel
+// One invocation sums one chunk of eight elements: per block two or three 16-byte texel
 // fetches (llvmpipe gathers SSBO loads
 // lane by lane and component by component, so bytes per load set the speed: the 4-byte
 // loads of one element pair per invocation streamed a fifth of what a plain vec4 copy does,
@@ -27,29 +31,31 @@
 
 layout(local_size_x = 64) in;
 
-// All three inputs are RGBA32UI buffer textures over the buffers prm_gpu_pass.cpp fills:
+// All four inputs are RGBA32UI buffer textures over the buffers prm_gpu_pass.cpp fills:
 // llvmpipe fetches texels with straight-line vector code, where an SSBO load runs a loop
 // over lanes and components.
-// Texel coordinates x | y << 16, four per texel, padded to whole blocks of 8.
+// Texel coordinates x | y << 16, four per texel, slots grouped by tile.
 layout(binding = 0) uniform usamplerBuffer texels;
 // The bound pane buffer's uvec4s.
 layout(binding = 1) uniform usamplerBuffer pane_blocks;
-// Per selected cluster: (RGB weight x its pane's inverse packing scale as float bits, first
-// uvec4 of its pane in the bound pane buffer).
+// Per selected block: (RGB weight x its pane's inverse packing scale as float bits, first
+// uvec4 of the block in the bound pane buffer).
 layout(binding = 2) uniform usamplerBuffer weights;
+// Per chunk to sum: (its slot / 8, first weight, weight count, chunk index within its tile).
+layout(binding = 3) uniform usamplerBuffer chunks;
 
 layout(rgba32f, binding = 0) uniform image2D out_image;
 layout(rgba32f, binding = 1) readonly uniform image2D base_image;
 
-uniform uint u_element_count;  // T: pane elements
-uniform uint u_first_weight;   // this dispatch sums weights[u_first_weight .. + u_weight_count)
-uniform uint u_weight_count;
-uniform uint u_mode;           // 0: start from zero, 1: start from base_image, 2: accumulate
+uniform uint u_first_chunk;  // this dispatch sums chunks[u_first_chunk .. + u_chunk_count)
+uniform uint u_chunk_count;
+uniform uint u_mode;  // 0: start from zero, 1: start from base_image, 2: accumulate
 
 const uint kModeZero = 0u;
 const uint kModeBase = 1u;
 const uint kModeAccumulate = 2u;
 const uint kBlock = 8u;  // elements per invocation
+const uint kNoTexel = 0xffffffffu;
 
 ivec2 coord_of(uint texel) { return ivec2(int(texel & 0xffffu), int(texel >> 16)); }
 
@@ -66,10 +72,10 @@ vec3 rgb9e5(uint w) {
 
 void main() {
   const uint group = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
-  const uint block = group * gl_WorkGroupSize.x + gl_LocalInvocationIndex;
-  const uint first = kBlock * block;
-  if (first >= u_element_count) return;
-  const uint count = min(kBlock, u_element_count - first);
+  const uint index = group * gl_WorkGroupSize.x + gl_LocalInvocationIndex;
+  if (index >= u_chunk_count) return;
+  const uvec4 chunk = texelFetch(chunks, int(u_first_chunk + index));
+  const uint block = chunk.x;
 
   uint texel[8];
   const uvec4 t0 = texelFetch(texels, int(2u * block));
@@ -80,16 +86,16 @@ void main() {
   vec3 sum[8];
   for (uint e = 0u; e < kBlock; ++e) {
     sum[e] = vec3(0.0);
-    if (e < count) {
+    if (texel[e] != kNoTexel) {
       if (u_mode == kModeBase) sum[e] = imageLoad(base_image, coord_of(texel[e])).xyz;
       else if (u_mode == kModeAccumulate) sum[e] = imageLoad(out_image, coord_of(texel[e])).xyz;
     }
   }
-  for (uint k = 0u; k < u_weight_count; ++k) {
-    const uvec4 wk = texelFetch(weights, int(u_first_weight + k));
+  for (uint k = 0u; k < chunk.z; ++k) {
+    const uvec4 wk = texelFetch(weights, int(chunk.y + k));
     const vec3 weight = uintBitsToFloat(wk.xyz);
 #ifdef PRM_PANES_RGB9E5
-    const uint at = wk.w + 2u * block;  // 8 words: one RGB9E5 element each
+    const uint at = wk.w + 2u * chunk.w;  // 8 words: one RGB9E5 element each
     const uvec4 a = texelFetch(pane_blocks, int(at));
     const uvec4 b = texelFetch(pane_blocks, int(at + 1u));
     sum[0] += weight * rgb9e5(a.x);
@@ -101,7 +107,7 @@ void main() {
     sum[6] += weight * rgb9e5(b.z);
     sum[7] += weight * rgb9e5(b.w);
 #else
-    const uint at = wk.w + 3u * block;  // 24 halves: R0 G0 B0 R1 ... B7
+    const uint at = wk.w + 3u * chunk.w;  // 24 halves: R0 G0 B0 R1 ... B7
     const uvec4 a = texelFetch(pane_blocks, int(at));
     const uvec4 b = texelFetch(pane_blocks, int(at + 1u));
     const uvec4 c = texelFetch(pane_blocks, int(at + 2u));
@@ -119,5 +125,5 @@ void main() {
 #endif
   }
   for (uint e = 0u; e < kBlock; ++e)
-    if (e < count) imageStore(out_image, coord_of(texel[e]), vec4(sum[e], 1.0));
+    if (texel[e] != kNoTexel) imageStore(out_image, coord_of(texel[e]), vec4(sum[e], 1.0));
 }

@@ -24,10 +24,13 @@ engine::Status bake_prm_method(const MethodBake& job) {
   auto prm = merged ? merge_prm(input, *settings, merged->prm) : bake_prm(input, *settings);
   if (!prm) return prm.error();
   const PrmStats& st = prm->stats;
-  stage.log(
-      format_line("  panes %dx%d, %zu texels each, %d clusters (%.1f MB as half floats); %zu paths, %zu virtual lights",
-                  prm->width, prm->height, prm->pane_size(), prm->cluster_count,
-                  static_cast<double>(prm->pane_size()) * prm->cluster_count * 6.0 / 1e6, st.paths, st.path_nodes));
+  stage.log(format_line(
+      "  panes %dx%d, %zu texels each, %d clusters; %zu blocks of %d^2 texels kept (threshold %g): %.1f MB as "
+      "half floats (dense %.1f MB); %zu paths, %zu virtual lights",
+      prm->width, prm->height, prm->pane_size(), prm->cluster_count, prm->panes.blocks.size(),
+      prm->panes.blocks_settings.tile_texels, double{prm->panes.blocks_settings.threshold},
+      static_cast<double>(prm->panes.stored_elements()) * 6.0 / 1e6,
+      static_cast<double>(prm->pane_size()) * prm->cluster_count * 6.0 / 1e6, st.paths, st.path_nodes));
   stage.log(format_line("  time: walks %.2f s, panes %.2f s; total %.2f s; %.1f M rays", st.walk_seconds,
                         st.pane_seconds, st.total_seconds, static_cast<double>(st.rays) * 1e-6));
   job.timings = {

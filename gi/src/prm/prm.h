@@ -21,6 +21,7 @@
 #include <glm/glm.hpp>
 
 #include "core/work_shard.h"
+#include "prm/prm_panes.h"
 #include "uv/atlas_layout.h"
 
 namespace gi {
@@ -34,6 +35,10 @@ struct PrmSettings {
   float splitting = 4.0f;
   int max_path_nodes = 64;  ///< Safety stop of a random walk (Russian roulette ends it first).
   bool kmeans = false;      ///< Refine the median-split kd-tree clusters with k-means (Lloyd) steps.
+  /// Panes are stored per atlas tile of this many texels per side, only the tiles where the
+  /// cluster's light exceeds `pane_threshold` x its pane's largest value (prm_panes.h).
+  int pane_tile_texels = 8;
+  float pane_threshold = 0.0f;  ///< 0: every tile holding light (the dense panes exactly).
   std::uint64_t seed = 1;
   unsigned threads = 0;
   ProgressCallback progress;
@@ -67,15 +72,26 @@ struct Prm {
   std::vector<PrmEntryPoint> entries;
   int cluster_count = 0;
   std::vector<std::uint32_t> cluster_size;  ///< Members per cluster.
-  /// Pane c, element i, channel ch at panes[(c * texels.size() + i) * 3 + ch]: the indirect
-  /// irradiance (W/m^2) at texel texels[i] when every entry point of cluster c receives unit
-  /// irradiance (the sum of the members' items S_k).
-  std::vector<float> panes;
+  /// Pane c at element i: the indirect irradiance (W/m^2) at texel texels[i] when every entry
+  /// point of cluster c receives unit irradiance (the sum of the members' items S_k), stored
+  /// only on the tiles the cluster lights (prm_panes.h; dense_panes(prm) gives them all).
+  PrmPanes panes;
   PrmSettings settings;
   PrmStats stats;
 
   std::size_t pane_size() const { return texels.size(); }
 };
+
+/// prm's panes dense: pane c, element i, channel ch at [(c * texels.size() + i) * 3 + ch].
+inline std::vector<float> dense_panes(const Prm& prm) {
+  return dense_panes(prm.panes, prm.texels.size(), prm.cluster_count);
+}
+
+/// Replaces prm's panes by `dense` (dense_panes' order) cut into prm.settings' blocks.
+inline void set_dense_panes(Prm& prm, std::span<const float> dense) {
+  prm.panes = sparse_panes(prm.texels, prm.width, prm.cluster_count, dense,
+                           {.tile_texels = prm.settings.pane_tile_texels, .threshold = prm.settings.pane_threshold});
+}
 
 /// What one shard of a distributed bake computed (docs/distributed-bake.md): the items of
 /// its texel blocks (WorkShard over the valid atlas texels in index order), every cluster's

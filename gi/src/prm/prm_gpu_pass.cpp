@@ -28,6 +28,14 @@ struct GpuPaneWeight {
   std::uint32_t pane_offset = 0;       // first uvec4 of the pane in its buffer
 };
 static_assert(sizeof(GpuPaneWeight) == 16, "must match PaneWeight in prm_sum.comp.glsl (std430)");
+
+/// One block of eight pane slots to sum: its first slot / 8, its weights
+/// weights[first .. first + count), and its index within its tile (the offset into each block).
+struct GpuChunk {
+  std::uint32_t chunk = 0, first_weight = 0, weight_count = 0, chunk_in_tile = 0;
+};
+static_assert(sizeof(GpuChunk) == 16, "one RGBA32UI texel of the chunk buffer texture");
+constexpr std::uint32_t kNoTexel = 0xffffffffu;  // a padding slot (prm_sum.comp.glsl skips it)
 static_assert(sizeof(glm::vec3) == 12, "set_base and read_back move glm::vec3 arrays as packed RGB floats");
 
 enum class SumMode : std::uint32_t { Zero = 0, Base = 1, Accumulate = 2 };
@@ -37,11 +45,6 @@ engine::Error error(std::string message) { return engine::Error{"", kWhere, std:
 /// Words of one packed block of eight elements: 24 halves in three uvec4s, or eight RGB9E5
 /// words in two. The shader reads a block's uvec4s whole, even for a short last block.
 std::size_t block_words(PrmPaneEncoding encoding) { return encoding == PrmPaneEncoding::Half ? 12 : 8; }
-
-/// Words of one packed pane: whole blocks, so every pane starts on a 16-byte boundary.
-std::size_t pane_stride_words(std::size_t elements, PrmPaneEncoding encoding) {
-  return block_words(encoding) * ((elements + kBlock - 1) / kBlock);
-}
 
 /// The power of two exponent s such that the pane's largest |value| x 2^s lies in
 /// [2^14, 2^15): the top of the half range without overflow (and below RGB9E5's largest
@@ -115,14 +118,34 @@ void unpack_pane(std::span<const std::uint32_t> words, int exponent, PrmPaneEnco
 
 /// Error naming the first pane value the encoding cannot hold, if any.
 std::optional<engine::Error> check_pane_values(const Prm& prm, PrmPaneEncoding encoding) {
-  const std::size_t elements = std::max<std::size_t>(prm.texels.size(), 1);
-  for (std::size_t f = 0; f < prm.panes.size(); ++f) {
-    const bool finite = std::isfinite(prm.panes[f]);
-    if (finite && (encoding == PrmPaneEncoding::Half || prm.panes[f] >= 0.0f)) continue;
-    return error("pane " + std::to_string(f / 3 / elements) + " element " + std::to_string(f / 3 % elements) +
+  const std::vector<float>& values = prm.panes.values;
+  for (std::size_t f = 0; f < values.size(); ++f) {
+    const bool finite = std::isfinite(values[f]);
+    if (finite && (encoding == PrmPaneEncoding::Half || values[f] >= 0.0f)) continue;
+    return error("stored pane value " + std::to_string(f / 3) +
                  (finite ? " is negative (the shared-exponent encoding holds only values >= 0)" : " is not finite"));
   }
   return std::nullopt;
+}
+
+/// Cluster c's stored values (contiguous: its blocks follow each other).
+std::span<const float> cluster_values(const PrmPanes& p, std::size_t c) {
+  const std::uint32_t b0 = p.cluster_first[c], b1 = p.cluster_first[c + 1];
+  if (b0 == b1) return {};
+  const std::size_t first = p.block_value[b0] * 3;
+  const std::size_t last = (p.block_value[b1 - 1] + p.tiles.size(p.blocks[b1 - 1])) * 3;
+  return std::span<const float>(p.values).subspan(first, last - first);
+}
+
+/// Pane slots of a tile on the GPU: its elements padded to whole blocks of eight.
+std::size_t tile_slots(const PrmTiles& tiles, std::size_t k) { return (tiles.size(k) + kBlock - 1) / kBlock * kBlock; }
+
+/// Words cluster c's blocks take in a pane buffer.
+std::size_t cluster_words(const PrmPanes& p, std::size_t c, PrmPaneEncoding encoding) {
+  std::size_t words = 0;
+  for (std::uint32_t b = p.cluster_first[c]; b < p.cluster_first[c + 1]; ++b)
+    words += tile_slots(p.tiles, p.blocks[b]) / kBlock * block_words(encoding);
+  return words;
 }
 
 std::size_t gl_limit(GLenum name) {
@@ -150,11 +173,21 @@ std::optional<engine::Error> check_prm(const Prm& prm, PrmPaneEncoding encoding)
       return error("texels are not strictly ascending at element " + std::to_string(i));
   }
   if (prm.cluster_count < 0) return error("negative cluster count");
-  const auto clusters = static_cast<std::size_t>(prm.cluster_count);
-  if (prm.panes.size() / 3 / std::max<std::size_t>(elements, 1) != clusters ||
-      prm.panes.size() != clusters * elements * 3)
-    return error("panes hold " + std::to_string(prm.panes.size()) + " floats, expected " + std::to_string(clusters) +
-                 " clusters x " + std::to_string(elements) + " texels x 3");
+  const PrmPanes& p = prm.panes;
+  if (p.cluster_count() != static_cast<std::size_t>(prm.cluster_count) || p.tiles.elements.size() != elements ||
+      p.block_value.size() != p.blocks.size())
+    return error("panes hold " + std::to_string(p.cluster_count()) + " clusters over " +
+                 std::to_string(p.tiles.elements.size()) + " texels, expected " + std::to_string(prm.cluster_count) +
+                 " x " + std::to_string(elements));
+  std::size_t stored = 0;
+  for (std::uint32_t k : p.blocks) {
+    if (k >= p.tiles.tiles())
+      return error("a stored block lies on tile " + std::to_string(k) + " of " + std::to_string(p.tiles.tiles()));
+    stored += p.tiles.size(k);
+  }
+  if (p.values.size() != stored * 3)
+    return error("panes hold " + std::to_string(p.values.size()) + " floats, their blocks " + std::to_string(stored) +
+                 " texels x 3");
   return check_pane_values(prm, encoding);
 }
 
@@ -165,14 +198,18 @@ engine::Result<std::size_t> buffer_limit_for(const Prm& prm, const PrmGpuPassOpt
   const std::size_t elements = prm.texels.size();
   std::size_t buffer_limit = std::min(kSsboLimitBytes, gl_limit(GL_MAX_TEXTURE_BUFFER_SIZE) * 16);
   if (options.max_buffer_bytes > 0) buffer_limit = std::min(buffer_limit, options.max_buffer_bytes);
-  const std::size_t texel_bytes = (elements + kBlock - 1) / kBlock * kBlock * sizeof(std::uint32_t);
+  std::size_t slots = 0;
+  for (std::size_t k = 0; k < prm.panes.tiles.tiles(); ++k) slots += tile_slots(prm.panes.tiles, k);
+  const std::size_t texel_bytes = slots * sizeof(std::uint32_t);
   if (texel_bytes > buffer_limit)
     return error(std::to_string(elements) + " pane texels need " + std::to_string(texel_bytes) +
                  " bytes, above the buffer limit of " + std::to_string(buffer_limit));
-  const std::size_t pane_bytes = pane_stride_words(elements, options.encoding) * sizeof(std::uint32_t);
-  if (pane_bytes > buffer_limit)
-    return error("one pane of " + std::to_string(elements) + " texels needs " + std::to_string(pane_bytes) +
-                 " bytes, above the buffer limit of " + std::to_string(buffer_limit));
+  for (std::size_t c = 0; c < prm.panes.cluster_count(); ++c) {
+    const std::size_t pane_bytes = cluster_words(prm.panes, c, options.encoding) * sizeof(std::uint32_t);
+    if (pane_bytes > buffer_limit)
+      return error("pane " + std::to_string(c) + " needs " + std::to_string(pane_bytes) +
+                   " bytes, above the buffer limit of " + std::to_string(buffer_limit));
+  }
   return buffer_limit;
 }
 
@@ -189,7 +226,6 @@ engine::Result<PrmGpuPass> PrmGpuPass::create(const Prm& prm, const PrmGpuPassOp
   PrmGpuPass pass;
   pass.width_ = prm.width;
   pass.height_ = prm.height;
-  pass.element_count_ = static_cast<std::uint32_t>(elements);
   pass.decode_scale_ = options.encoding == PrmPaneEncoding::Half ? 1.0f : std::ldexp(1.0f, -kMantissaShift);
   pass.max_groups_x_ =
       options.max_groups_x > 0 ? std::min(options.max_groups_x, kMaxGroupsPerDimension) : kMaxGroupsPerDimension;
@@ -201,8 +237,8 @@ engine::Result<PrmGpuPass> PrmGpuPass::create(const Prm& prm, const PrmGpuPassOp
   if (!program) return program.error();
   pass.program_ = std::move(program).value();
   const GLuint id = pass.program_.id();
-  pass.uniforms_ = {glGetUniformLocation(id, "u_element_count"), glGetUniformLocation(id, "u_first_weight"),
-                    glGetUniformLocation(id, "u_weight_count"), glGetUniformLocation(id, "u_mode")};
+  pass.uniforms_ = {glGetUniformLocation(id, "u_first_chunk"), glGetUniformLocation(id, "u_chunk_count"),
+                    glGetUniformLocation(id, "u_mode")};
 
   pass.upload_panes(prm, options.encoding, *buffer_limit);
   pass.upload_texels(prm, *buffer_limit);
@@ -214,57 +250,67 @@ engine::Result<PrmGpuPass> PrmGpuPass::create(const Prm& prm, const PrmGpuPassOp
 }
 
 void PrmGpuPass::upload_panes(const Prm& prm, PrmPaneEncoding encoding, std::size_t buffer_limit) {
-  const std::size_t elements = prm.texels.size();
+  const PrmPanes& p = prm.panes;
   const auto clusters = static_cast<std::size_t>(prm.cluster_count);
-  const std::size_t stride = pane_stride_words(elements, encoding);
-  const std::size_t pane_bytes = stride * sizeof(std::uint32_t);
-  // Whole panes per buffer, as many as fit under the limit.
-  const std::size_t panes_per_buffer = std::max<std::size_t>(1, buffer_limit / std::max<std::size_t>(pane_bytes, 1));
+  cluster_first_ = p.cluster_first;
+  blocks_ = p.blocks;
+  block_offset_.assign(p.blocks.size(), 0u);
   panes_.resize(clusters);
+  // Whole panes per buffer, as many as fit under the limit.
   std::vector<std::uint32_t> words;
-  for (std::size_t first = 0; first < clusters; first += panes_per_buffer) {
-    const std::size_t count = std::min(panes_per_buffer, clusters - first);
-    words.assign(count * stride, 0u);
-    for (std::size_t c = first; c < first + count; ++c) {
-      const std::span<const float> pane(prm.panes.data() + c * elements * 3, elements * 3);
-      const int exponent = pane_scale_exponent(pane, encoding);
-      const std::size_t offset = (c - first) * stride;
-      pack_pane(pane, exponent, encoding, std::span<std::uint32_t>(words).subspan(offset, stride));
-      panes_[c] = {static_cast<std::uint32_t>(pane_buffers_.size()), static_cast<std::uint32_t>(offset),
-                   std::ldexp(1.0f, -exponent)};
-    }
+  const auto flush = [&] {
     const std::size_t bytes = std::max<std::size_t>(words.size() * sizeof(std::uint32_t), 16);
     words.resize(bytes / sizeof(std::uint32_t), 0u);
     pane_buffers_.push_back(engine::GlBuffer::create(bytes, words.data()));
     pane_buffer_bytes_.push_back(bytes);
     pane_textures_.push_back(engine::GlTexture::create(GL_TEXTURE_BUFFER));
     glTextureBuffer(pane_textures_.back().id(), GL_RGBA32UI, pane_buffers_.back().id());
+    words.clear();
+  };
+  for (std::size_t c = 0; c < clusters; ++c) {
+    const std::size_t need = cluster_words(p, c, encoding);
+    if (!words.empty() && (words.size() + need) * sizeof(std::uint32_t) > buffer_limit) flush();
+    const int exponent = pane_scale_exponent(cluster_values(p, c), encoding);
+    panes_[c] = {static_cast<std::uint32_t>(pane_buffers_.size()), std::ldexp(1.0f, -exponent)};
+    for (std::uint32_t b = p.cluster_first[c]; b < p.cluster_first[c + 1]; ++b) {
+      const std::size_t n = p.tiles.size(p.blocks[b]);
+      const std::size_t stride = tile_slots(p.tiles, p.blocks[b]) / kBlock * block_words(encoding);
+      block_offset_[b] = static_cast<std::uint32_t>(words.size() / 4);
+      words.resize(words.size() + stride, 0u);
+      pack_pane(std::span<const float>(p.values).subspan(p.block_value[b] * 3, n * 3), exponent, encoding,
+                std::span<std::uint32_t>(words).last(stride));
+    }
   }
-  if (pane_buffers_.empty()) {  // no clusters: a stub so binding 1 always holds a buffer
-    const std::uint32_t zeros[4] = {};
-    pane_buffers_.push_back(engine::GlBuffer::create(sizeof(zeros), zeros));
-    pane_buffer_bytes_.push_back(sizeof(zeros));
-    pane_textures_.push_back(engine::GlTexture::create(GL_TEXTURE_BUFFER));
-    glTextureBuffer(pane_textures_.back().id(), GL_RGBA32UI, pane_buffers_.back().id());
-  }
+  if (!words.empty() || pane_buffers_.empty()) flush();  // never empty: binding 1 always holds a buffer
 }
 
 void PrmGpuPass::upload_texels(const Prm& prm, std::size_t buffer_limit) {
-  const std::size_t elements = prm.texels.size();
-  // The shader reads texel coordinates packed x | y << 16 (no division per lane).
-  std::vector<std::uint32_t> texels(prm.texels);
-  for (std::uint32_t& t : texels) {
-    const auto w = static_cast<std::uint32_t>(prm.width);
-    t = (t % w) | ((t / w) << 16);
+  // Slots tile by tile, each tile padded to whole blocks of eight (padding: kNoTexel). The
+  // shader reads texel coordinates packed x | y << 16 (no division per lane).
+  const PrmTiles& tiles = prm.panes.tiles;
+  const auto w = static_cast<std::uint32_t>(prm.width);
+  std::vector<std::uint32_t> texels;
+  tile_slot_.assign(1, 0u);
+  for (std::size_t k = 0; k < tiles.tiles(); ++k) {
+    for (std::uint32_t j = tiles.first[k]; j < tiles.first[k + 1]; ++j) {
+      const std::uint32_t t = prm.texels[tiles.elements[j]];
+      texels.push_back((t % w) | ((t / w) << 16));
+    }
+    texels.resize(tile_slot_.back() + tile_slots(tiles, k), kNoTexel);
+    tile_slot_.push_back(static_cast<std::uint32_t>(texels.size()));
   }
-  texels.resize(std::max<std::size_t>((elements + kBlock - 1) / kBlock * kBlock, kBlock),
-                0u);  // whole blocks; never empty
+  if (texels.empty()) texels.assign(kBlock, kNoTexel);  // never empty
+  texel_slots_ = texels.size();
   texels_ = engine::GlBuffer::create(texels.size() * sizeof(std::uint32_t), texels.data());
   texels_texture_ = engine::GlTexture::create(GL_TEXTURE_BUFFER);
   glTextureBuffer(texels_texture_.id(), GL_RGBA32UI, texels_.id());
   weights_ = engine::GlBuffer::create();
   weights_texture_ = engine::GlTexture::create(GL_TEXTURE_BUFFER);
+  chunks_ = engine::GlBuffer::create();
+  chunks_texture_ = engine::GlTexture::create(GL_TEXTURE_BUFFER);
   max_weights_ = buffer_limit / sizeof(GpuPaneWeight);
+  tile_mark_.assign(tiles.tiles(), -1);
+  write_all_ = true;
 }
 
 void PrmGpuPass::create_output() {
@@ -282,39 +328,34 @@ engine::Status PrmGpuPass::run(std::span<const ClusterWeight> selected) {
     if (w.cluster >= panes_.size())
       return error("selected cluster " + std::to_string(w.cluster) + " does not exist (" +
                    std::to_string(panes_.size()) + " clusters)");
-
-  if (selected.size() > max_weights_)
-    return error(std::to_string(selected.size()) + " selected clusters, above the weight buffer's limit of " +
+  std::size_t blocks = 0;
+  for (const ClusterWeight& w : selected) blocks += cluster_first_[w.cluster + 1] - cluster_first_[w.cluster];
+  if (blocks > max_weights_)
+    return error(std::to_string(blocks) + " selected pane blocks, above the weight buffer's limit of " +
                  std::to_string(max_weights_));
-  const std::vector<std::pair<std::uint32_t, std::uint32_t>> ranges = upload_weights(selected);
-  if (element_count_ == 0) return {};
+  const std::vector<Dispatch> dispatches = upload_work(selected);
+  last_chunks_ = 0;
+  for (const Dispatch& d : dispatches) last_chunks_ += d.chunk_count;
+  if (dispatches.empty()) return {};
 
   program_.use();
-  glProgramUniform1ui(program_.id(), uniforms_.element_count, element_count_);
   glBindTextureUnit(0, texels_texture_.id());
   glBindTextureUnit(2, weights_texture_.id());
+  glBindTextureUnit(3, chunks_texture_.id());
   glBindImageTexture(0, output_.id(), 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
   glBindImageTexture(1, base_.id(), 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
-
-  const auto blocks = static_cast<std::uint32_t>((element_count_ + kBlock - 1) / kBlock);
-  const std::uint32_t groups = (blocks + kGroupSize - 1) / kGroupSize;
-  const std::uint32_t groups_x = std::min(groups, max_groups_x_);
-  const std::uint32_t groups_y = (groups + groups_x - 1) / groups_x;
-
-  // One dispatch per buffer holding a selected pane; K = 0 still needs one to write the
-  // base (or zeros). The first writes, later ones accumulate.
-  std::vector<std::size_t> dispatches;
-  for (std::size_t b = 0; b < ranges.size(); ++b)
-    if (ranges[b].second > 0) dispatches.push_back(b);
-  if (dispatches.empty()) dispatches.push_back(0);
+  // One dispatch per pane buffer holding a selected block, over the touched tiles' blocks of
+  // eight slots; the first writes (from the base or zero), later ones accumulate.
   for (std::size_t d = 0; d < dispatches.size(); ++d) {
-    const std::size_t b = dispatches[d];
     if (d > 0) glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
     const SumMode mode = d > 0 ? SumMode::Accumulate : base_.empty() ? SumMode::Zero : SumMode::Base;
+    const std::uint32_t groups = (dispatches[d].chunk_count + kGroupSize - 1) / kGroupSize;
+    const std::uint32_t groups_x = std::min(groups, max_groups_x_);
+    const std::uint32_t groups_y = (groups + groups_x - 1) / groups_x;
     glProgramUniform1ui(program_.id(), uniforms_.mode, static_cast<GLuint>(mode));
-    glProgramUniform1ui(program_.id(), uniforms_.first_weight, ranges[b].first);
-    glProgramUniform1ui(program_.id(), uniforms_.weight_count, ranges[b].second);
-    glBindTextureUnit(1, pane_textures_[b].id());
+    glProgramUniform1ui(program_.id(), uniforms_.first_chunk, dispatches[d].first_chunk);
+    glProgramUniform1ui(program_.id(), uniforms_.chunk_count, dispatches[d].chunk_count);
+    glBindTextureUnit(1, pane_textures_[dispatches[d].buffer].id());
     glDispatchCompute(groups_x, groups_y, 1);
   }
   glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT |
@@ -322,33 +363,91 @@ engine::Status PrmGpuPass::run(std::span<const ClusterWeight> selected) {
   return {};
 }
 
-std::vector<std::pair<std::uint32_t, std::uint32_t>> PrmGpuPass::upload_weights(
-    std::span<const ClusterWeight> selected) {
-  // Weights grouped by pane buffer: one dispatch per buffer that holds a selected pane.
+std::vector<std::uint32_t> PrmGpuPass::touched_tiles(std::span<const ClusterWeight> selected) {
+  // This run's tiles and the last run's (they go back to the base); every tile after
+  // creation or a new base. Ascending, each once; tile_mark_ maps each to its position
+  // until upload_work resets it.
+  std::vector<std::uint32_t> tiles;
+  const auto add = [&](std::uint32_t k) {
+    if (tile_mark_[k] >= 0) return;
+    tile_mark_[k] = 0;
+    tiles.push_back(k);
+  };
+  if (write_all_) {
+    for (std::uint32_t k = 0; k < tile_mark_.size(); ++k) add(k);
+  } else {
+    for (std::uint32_t k : last_tiles_) add(k);
+    for (const ClusterWeight& w : selected)
+      for (std::uint32_t b = cluster_first_[w.cluster]; b < cluster_first_[w.cluster + 1]; ++b) add(blocks_[b]);
+  }
+  std::sort(tiles.begin(), tiles.end());
+  for (std::size_t i = 0; i < tiles.size(); ++i) tile_mark_[tiles[i]] = static_cast<std::int32_t>(i);
+  write_all_ = false;
+  return tiles;
+}
+
+// Long because the weights of one pane buffer are grouped per touched tile (a counting sort
+// that keeps the selection's order, the CPU twin's summation order) and its chunks listed
+// in the same pass; split, the counts would travel between functions.
+std::vector<PrmGpuPass::Dispatch> PrmGpuPass::upload_work(std::span<const ClusterWeight> selected) {
+  const std::vector<std::uint32_t> tiles = touched_tiles(selected);
   std::vector<GpuPaneWeight> weights;
-  weights.reserve(std::max<std::size_t>(selected.size(), 1));
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> ranges(pane_buffers_.size(), {0u, 0u});  // first, count
-  for (std::uint32_t b = 0; b < pane_buffers_.size(); ++b) {
-    ranges[b].first = static_cast<std::uint32_t>(weights.size());
+  std::vector<GpuChunk> chunks;
+  std::vector<Dispatch> dispatches;
+  std::vector<std::uint32_t> count(tiles.size() + 1);
+  for (std::uint32_t g = 0; g < pane_buffers_.size() && !tiles.empty(); ++g) {
+    std::fill(count.begin(), count.end(), 0u);
+    for (const ClusterWeight& w : selected)
+      if (panes_[w.cluster].buffer == g)
+        for (std::uint32_t b = cluster_first_[w.cluster]; b < cluster_first_[w.cluster + 1]; ++b)
+          ++count[static_cast<std::size_t>(tile_mark_[blocks_[b]]) + 1];
+    for (std::size_t i = 1; i < count.size(); ++i) count[i] += count[i - 1];
+    if (count.back() == 0 && !dispatches.empty()) continue;
+    const auto first_weight = static_cast<std::uint32_t>(weights.size());
+    weights.resize(weights.size() + count.back());
+    std::vector<std::uint32_t> at(count.begin(), count.end() - 1);
     for (const ClusterWeight& w : selected) {
       const PaneLocation& p = panes_[w.cluster];
-      if (p.buffer != b) continue;
+      if (p.buffer != g) continue;
       const glm::vec3 scaled = w.weight * (p.inverse_scale * decode_scale_);
-      weights.push_back({scaled.x, scaled.y, scaled.z, p.word_offset / 4});
+      for (std::uint32_t b = cluster_first_[w.cluster]; b < cluster_first_[w.cluster + 1]; ++b)
+        weights[first_weight + at[static_cast<std::size_t>(tile_mark_[blocks_[b]])]++] = {scaled.x, scaled.y, scaled.z,
+                                                                                          block_offset_[b]};
     }
-    ranges[b].second = static_cast<std::uint32_t>(weights.size()) - ranges[b].first;
+    // The first dispatch writes every touched tile (from the base or zero), later ones only
+    // the tiles they add to.
+    Dispatch d{g, static_cast<std::uint32_t>(chunks.size()), 0u};
+    for (std::size_t i = 0; i < tiles.size(); ++i) {
+      const std::uint32_t n = count[i + 1] - count[i];
+      if (n == 0 && !dispatches.empty()) continue;
+      const std::uint32_t slot = tile_slot_[tiles[i]], slots = tile_slot_[tiles[i] + 1] - slot;
+      for (std::uint32_t k = 0; k < slots / kBlock; ++k)
+        chunks.push_back({slot / static_cast<std::uint32_t>(kBlock) + k, first_weight + count[i], n, k});
+    }
+    d.chunk_count = static_cast<std::uint32_t>(chunks.size()) - d.first_chunk;
+    dispatches.push_back(d);
   }
+  for (std::uint32_t k : tiles) tile_mark_[k] = -1;
+  last_tiles_.clear();
+  for (const ClusterWeight& w : selected)
+    for (std::uint32_t b = cluster_first_[w.cluster]; b < cluster_first_[w.cluster + 1]; ++b)
+      last_tiles_.push_back(blocks_[b]);
   if (weights.empty()) weights.emplace_back();  // GL buffers cannot be empty
+  if (chunks.empty()) chunks.emplace_back();
   weights_bytes_ = weights.size() * sizeof(GpuPaneWeight);
+  chunks_bytes_ = chunks.size() * sizeof(GpuChunk);
   glNamedBufferData(weights_.id(), static_cast<GLsizeiptr>(weights_bytes_), weights.data(), GL_STREAM_DRAW);
   glTextureBuffer(weights_texture_.id(), GL_RGBA32UI, weights_.id());
-  return ranges;
+  glNamedBufferData(chunks_.id(), static_cast<GLsizeiptr>(chunks_bytes_), chunks.data(), GL_STREAM_DRAW);
+  glTextureBuffer(chunks_texture_.id(), GL_RGBA32UI, chunks_.id());
+  return dispatches;
 }
 
 engine::Status PrmGpuPass::set_base(std::span<const glm::vec3> base_atlas) {
   GI_EXPECTS(!output_.empty(), "PrmGpuPass::set_base on an empty (default or moved-from) pass");
   if (base_atlas.empty()) {
     base_.reset();
+    write_all_ = true;
     return {};
   }
   const std::size_t texels = static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_);
@@ -356,6 +455,7 @@ engine::Status PrmGpuPass::set_base(std::span<const glm::vec3> base_atlas) {
     return error("base atlas holds " + std::to_string(base_atlas.size()) + " texels, the PRM atlas " +
                  std::to_string(width_) + "x" + std::to_string(height_));
   if (base_.empty()) base_ = engine::GlTexture::create_2d(GL_RGBA32F, width_, height_);
+  write_all_ = true;  // the next run writes the new base at every pane texel
   glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
   glTextureSubImage2D(base_.id(), 0, 0, 0, width_, height_, GL_RGB, GL_FLOAT, base_atlas.data());
   return {};
@@ -370,18 +470,18 @@ std::vector<glm::vec3> PrmGpuPass::read_back() const {
   return atlas;
 }
 
-engine::Result<std::vector<float>> decoded_panes(const Prm& prm, PrmPaneEncoding encoding) {
+engine::Result<PrmPanes> decoded_panes(const Prm& prm, PrmPaneEncoding encoding) {
   if (auto bad = check_pane_values(prm, encoding)) return *bad;
-  const std::size_t elements = prm.texels.size();
-  std::vector<float> out(prm.panes.size(), 0.0f);
-  if (elements == 0) return out;
-  std::vector<std::uint32_t> words(pane_stride_words(elements, encoding));
-  for (std::size_t first = 0; first + elements * 3 <= prm.panes.size(); first += elements * 3) {
-    const std::span<const float> pane(prm.panes.data() + first, elements * 3);
+  PrmPanes out = prm.panes;
+  std::vector<std::uint32_t> words;
+  for (std::size_t c = 0; c < out.cluster_count(); ++c) {
+    const std::span<const float> pane = cluster_values(prm.panes, c);
+    if (pane.empty()) continue;
     const int exponent = pane_scale_exponent(pane, encoding);
-    std::fill(words.begin(), words.end(), 0u);
+    words.assign(pane.size(), 0u);  // at least the words pack_pane writes
     pack_pane(pane, exponent, encoding, words);
-    unpack_pane(words, exponent, encoding, std::span<float>(out.data() + first, elements * 3));
+    const auto first = static_cast<std::size_t>(pane.data() - prm.panes.values.data());
+    unpack_pane(words, exponent, encoding, std::span<float>(out.values).subspan(first, pane.size()));
   }
   return out;
 }
@@ -394,9 +494,7 @@ std::size_t PrmGpuPass::pane_bytes() const {
 
 std::size_t PrmGpuPass::gpu_bytes() const {
   const std::size_t atlas_bytes = static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_) * 16;
-  std::size_t bytes =
-      std::max<std::size_t>((element_count_ + kBlock - 1) / kBlock * kBlock, kBlock) * sizeof(std::uint32_t) +
-      weights_bytes_;
+  std::size_t bytes = texel_slots_ * sizeof(std::uint32_t) + weights_bytes_ + chunks_bytes_;
   for (std::size_t b : pane_buffer_bytes_) bytes += b;
   if (!output_.empty()) bytes += atlas_bytes;
   if (!base_.empty()) bytes += atlas_bytes;

@@ -50,11 +50,11 @@ enum class PrmPaneEncoding : std::uint8_t {
   SharedExponent,
 };
 
-/// The panes as PrmGpuPass sums them under `encoding`: prm.panes (same layout) encoded and
+/// The panes as PrmGpuPass sums them under `encoding`: prm.panes (same blocks) encoded and
 /// decoded, each pane through its power-of-two scale. gi::sum_panes over a Prm holding these
 /// panes is the pass's CPU twin up to float summation order. Error: a non-finite value, or a
 /// negative one under SharedExponent.
-engine::Result<std::vector<float>> decoded_panes(const Prm& prm, PrmPaneEncoding encoding);
+engine::Result<PrmPanes> decoded_panes(const Prm& prm, PrmPaneEncoding encoding);
 
 struct PrmGpuPassOptions {
   /// Pane encoding in GPU memory (docs/prm.md "Pane encoding" measures both on the demo level).
@@ -90,9 +90,11 @@ class PrmGpuPass {
 
   /// Writes base + sum over `selected` of weight x pane into every pane texel (texels outside
   /// the panes keep 0). Overwrites the previous run. K = 0 writes the base (or 0). A cluster
-  /// listed twice counts twice. Ends with a memory barrier for texture fetches, image access
-  /// and read-back. Errors: a cluster index >= cluster_count; more clusters than the weight
-  /// buffer texture holds (the buffer limit / 16 bytes).
+  /// listed twice counts twice. Only the tiles the selected clusters store blocks on, and
+  /// those of the previous run, are written (every tile after creation or set_base): the work
+  /// follows the lit blocks. Ends with a memory barrier for texture fetches, image access and
+  /// read-back. Errors: a cluster index >= cluster_count; more selected blocks than the
+  /// weight buffer texture holds (the buffer limit / 16 bytes).
   engine::Status run(std::span<const ClusterWeight> selected);
 
   /// A base irradiance atlas (width x height texels, row-major) added at the pane texels by
@@ -112,29 +114,36 @@ class PrmGpuPass {
   std::size_t pane_buffer_count() const { return pane_buffers_.size(); }
   /// Bytes the panes occupy in GPU memory (all buffers, padding included).
   std::size_t pane_bytes() const;
+  /// Blocks of eight pane slots the last run dispatched (over all its dispatches).
+  std::size_t last_run_chunks() const { return last_chunks_; }
 
  private:
-  /// Packs the panes into buffers of whole panes under `buffer_limit` bytes each, with their
-  /// buffer textures and each pane's location.
+  /// Packs each pane's blocks into buffers of whole panes under `buffer_limit` bytes each,
+  /// with their buffer textures and each block's location.
   void upload_panes(const Prm& prm, PrmPaneEncoding encoding, std::size_t buffer_limit);
-  /// The texel coordinates, packed for the shader, and the empty weights buffer.
+  /// The texel coordinates tile by tile (padded to blocks of eight), the empty weight and
+  /// chunk buffers.
   void upload_texels(const Prm& prm, std::size_t buffer_limit);
   /// The cleared, bilinear RGBA32F output texture.
   void create_output();
-  /// Uploads the selected clusters' weights grouped by pane buffer; per buffer the first
-  /// weight and the count of its group.
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> upload_weights(std::span<const ClusterWeight> selected);
+  /// One compute dispatch: the pane buffer it reads and its chunks.
+  struct Dispatch {
+    std::uint32_t buffer = 0, first_chunk = 0, chunk_count = 0;
+  };
+  /// The tiles this run writes, ascending (tile_mark_ holds their positions).
+  std::vector<std::uint32_t> touched_tiles(std::span<const ClusterWeight> selected);
+  /// Uploads the selected blocks' weights grouped per pane buffer and tile, and the chunks
+  /// each dispatch sums.
+  std::vector<Dispatch> upload_work(std::span<const ClusterWeight> selected);
 
-  /// Where one cluster's pane lives: its buffer, its first word and its packing scale.
+  /// Where one cluster's pane lives: its buffer and its packing scale.
   struct PaneLocation {
     std::uint32_t buffer = 0;
-    std::uint32_t word_offset = 0;
     float inverse_scale = 1.0f;
   };
   struct Uniforms {
-    int element_count = -1;
-    int first_weight = -1;
-    int weight_count = -1;
+    int first_chunk = -1;
+    int chunk_count = -1;
     int mode = -1;
   };
 
@@ -145,6 +154,18 @@ class PrmGpuPass {
   std::vector<std::size_t> pane_buffer_bytes_;
   std::vector<engine::GlTexture> pane_textures_;  ///< Each pane buffer as an RGBA32UI buffer texture.
   std::vector<PaneLocation> panes_;
+  std::vector<std::uint32_t> cluster_first_;  ///< PrmPanes::cluster_first.
+  std::vector<std::uint32_t> blocks_;         ///< PrmPanes::blocks: the tile of each stored block.
+  std::vector<std::uint32_t> block_offset_;   ///< First uvec4 of each stored block in its buffer.
+  std::vector<std::uint32_t> tile_slot_;      ///< tiles+1: first slot of each tile (a multiple of 8).
+  std::vector<std::int32_t> tile_mark_;       ///< Per tile: its position in a run's list, else -1.
+  std::vector<std::uint32_t> last_tiles_;     ///< Tiles the previous run added light to.
+  bool write_all_ = true;                     ///< The next run writes every tile (new base or output).
+  std::size_t texel_slots_ = 0;
+  std::size_t last_chunks_ = 0;
+  engine::GlBuffer chunks_;
+  engine::GlTexture chunks_texture_;  ///< chunks_ as an RGBA32UI buffer texture.
+  std::size_t chunks_bytes_ = 0;
   engine::GlBuffer weights_;
   engine::GlTexture texels_texture_;   ///< texels_ as an RGBA32UI buffer texture.
   engine::GlTexture weights_texture_;  ///< weights_ as an RGBA32UI buffer texture.
@@ -154,7 +175,6 @@ class PrmGpuPass {
   engine::GlTexture base_;
   int width_ = 0;
   int height_ = 0;
-  std::uint32_t element_count_ = 0;
   std::uint32_t max_groups_x_ = 65535;
   float decode_scale_ = 1.0f;  ///< Folded into every weight: 2^-24 for RGB9E5 mantissas, 1 for halves.
 };

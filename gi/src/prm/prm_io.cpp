@@ -32,6 +32,58 @@ constexpr int kMaxAtlasSide = 16384;
 
 std::string str(std::size_t v) { return std::to_string(v); }
 
+// Empty when the texels ascend inside the atlas.
+std::string check_texels(const Prm& p) {
+  const std::uint64_t atlas_texels = static_cast<std::uint64_t>(p.width) * static_cast<std::uint64_t>(p.height);
+  for (std::size_t i = 0; i < p.texels.size(); ++i) {
+    if (p.texels[i] >= atlas_texels)
+      return "texel " + str(i) + " (index " + str(p.texels[i]) + ") is outside the " + std::to_string(p.width) + "x" +
+             std::to_string(p.height) + " atlas";
+    if (i > 0 && p.texels[i] <= p.texels[i - 1]) return "texels are not strictly ascending at element " + str(i);
+  }
+  return {};
+}
+
+// Empty when the sparse panes fit the texels and clusters and hold valid values.
+std::string check_panes(const Prm& p) {
+  const PrmPanes& q = p.panes;
+  const auto clusters = static_cast<std::size_t>(p.cluster_count);
+  const PrmBlockSettings& b = q.blocks_settings;
+  if (b.tile_texels < 1 || b.tile_texels > 256 || !(b.threshold >= 0.0f) || b.threshold > 1.0f)
+    return "pane blocks: tile " + std::to_string(b.tile_texels) + " outside 1..256 or threshold " +
+           std::to_string(b.threshold) + " outside [0, 1]";
+  if (q.tiles.elements.size() != p.texels.size()) return "pane tiles do not cover the texels";
+  if (q.cluster_first.size() != clusters + 1 || q.cluster_first.front() != 0 ||
+      q.cluster_first.back() != q.blocks.size())
+    return "pane cluster_first has " + str(q.cluster_first.size()) + " entries for " + str(clusters) +
+           " clusters, or does not span the " + str(q.blocks.size()) + " blocks";
+  std::uint64_t elements = 0;
+  for (std::size_t c = 0; c < clusters; ++c) {
+    if (q.cluster_first[c] > q.cluster_first[c + 1]) return "pane cluster_first decreases at cluster " + str(c);
+    for (std::uint32_t k = q.cluster_first[c]; k < q.cluster_first[c + 1]; ++k) {
+      if (q.blocks[k] >= q.tiles.tiles())
+        return "pane " + str(c) + " block " + str(k) + " is tile " + str(q.blocks[k]) + ", there are " +
+               str(q.tiles.tiles());
+      if (k > q.cluster_first[c] && q.blocks[k] <= q.blocks[k - 1])
+        return "pane " + str(c) + " blocks are not strictly ascending at block " + str(k);
+      elements += q.tiles.size(q.blocks[k]);
+    }
+  }
+  if (q.values.size() != elements * 3 || q.block_value.size() != q.blocks.size())
+    return "panes hold " + str(q.values.size()) + " values, their blocks " + std::to_string(elements) +
+           " elements x 3 = " + std::to_string(elements * 3) + " expected";
+  for (std::size_t j = 0; j < q.values.size(); ++j) {
+    const float v = q.values[j];
+    if (!std::isfinite(v) || v < 0.0f)
+      return "stored pane value " + str(j / 3) + " channel " + str(j % 3) + " is " +
+             (std::isnan(v)       ? "NaN"
+              : !std::isfinite(v) ? "infinite"
+                                  : "negative (" + std::to_string(v) + ")") +
+             ": panes must be finite and non-negative";
+  }
+  return {};
+}
+
 // Empty when the Prm's arrays fit together and its values are valid, else what is wrong.
 std::string check_prm(const Prm& p) {
   const PrmSettings& s = p.settings;
@@ -46,13 +98,7 @@ std::string check_prm(const Prm& p) {
   const auto clusters = static_cast<std::size_t>(p.cluster_count);
   if (p.cluster_size.size() != clusters)
     return "cluster_size has " + str(p.cluster_size.size()) + " elements for " + str(clusters) + " clusters";
-  const std::uint64_t atlas_texels = static_cast<std::uint64_t>(p.width) * static_cast<std::uint64_t>(p.height);
-  for (std::size_t i = 0; i < p.texels.size(); ++i) {
-    if (p.texels[i] >= atlas_texels)
-      return "texel " + str(i) + " (index " + str(p.texels[i]) + ") is outside the " + std::to_string(p.width) + "x" +
-             std::to_string(p.height) + " atlas";
-    if (i > 0 && p.texels[i] <= p.texels[i - 1]) return "texels are not strictly ascending at element " + str(i);
-  }
+  if (std::string problem = check_texels(p); !problem.empty()) return problem;
   std::vector<std::uint32_t> members(clusters, 0);
   for (std::size_t k = 0; k < p.entries.size(); ++k) {
     const PrmEntryPoint& e = p.entries[k];
@@ -67,22 +113,7 @@ std::string check_prm(const Prm& p) {
     if (members[c] != p.cluster_size[c])
       return "cluster_size[" + str(c) + "] is " + str(p.cluster_size[c]) + " but " + str(members[c]) +
              " entry points are in that cluster";
-  const std::size_t n = p.texels.size();
-  if (p.panes.size() != clusters * n * 3)
-    return "panes has " + str(p.panes.size()) + " values, " + str(clusters) + " clusters x " + str(n) +
-           " texels x 3 = " + str(clusters * n * 3) + " expected";
-  for (std::size_t j = 0; j < p.panes.size(); ++j) {
-    const float v = p.panes[j];
-    if (!std::isfinite(v) || v < 0.0f) {
-      const std::size_t c = j / (3 * n), i = (j / 3) % n;
-      return "pane " + str(c) + " texel " + str(p.texels[i]) + " channel " + str(j % 3) + " is " +
-             (std::isnan(v)       ? "NaN"
-              : !std::isfinite(v) ? "infinite"
-                                  : "negative (" + std::to_string(v) + ")") +
-             ": panes must be finite and non-negative";
-    }
-  }
-  return {};
+  return check_panes(p);
 }
 
 bool is_power_of_two(float s) {
@@ -101,7 +132,9 @@ json settings_json(const PrmSettings& s) {
               {"splitting", s.splitting},
               {"max_path_nodes", s.max_path_nodes},
               {"kmeans", s.kmeans},
-              {"seed", s.seed}};
+              {"seed", s.seed},
+              {"pane_tile_texels", s.pane_tile_texels},
+              {"pane_threshold", s.pane_threshold}};
 }
 
 json stats_json(const PrmStats& s) { return json{{"paths", s.paths}, {"path_nodes", s.path_nodes}, {"rays", s.rays}}; }
@@ -130,22 +163,51 @@ engine::Result<EntryInfo> read_entry(const BundleReader& bundle) {
 // The panes as scaled halves in two byte planes (prm_io.h), plus each pane's scale.
 // Error text when a value does not survive (cannot happen for finite values below ~1e38).
 std::string encode_panes(const Prm& p, std::vector<float>& scales, std::vector<std::byte>& planes) {
-  const std::size_t per_pane = p.texels.size() * 3;
-  const std::size_t total = p.panes.size();
+  const PrmPanes& q = p.panes;
+  const std::size_t total = q.values.size();
   scales.assign(static_cast<std::size_t>(p.cluster_count), 1.0f);
   planes.assign(total * 2, std::byte{0});
   for (std::size_t c = 0; c < scales.size(); ++c) {
-    const auto first = p.panes.begin() + static_cast<std::ptrdiff_t>(c * per_pane);
+    const std::size_t first = q.cluster_first[c] < q.blocks.size() ? q.block_value[q.cluster_first[c]] * 3 : total;
+    const std::size_t last =
+        q.cluster_first[c + 1] < q.blocks.size() ? q.block_value[q.cluster_first[c + 1]] * 3 : total;
+    const auto begin = q.values.begin() + static_cast<std::ptrdiff_t>(first);
     const float max_value =
-        per_pane == 0 ? 0.0f : *std::max_element(first, first + static_cast<std::ptrdiff_t>(per_pane));
+        first == last ? 0.0f : *std::max_element(begin, begin + static_cast<std::ptrdiff_t>(last - first));
     const float scale = half_layer_scale(max_value);
     scales[c] = scale;
-    for (std::size_t j = c * per_pane; j < (c + 1) * per_pane; ++j) {
-      const std::uint16_t h = float_to_half(p.panes[j] / scale);
+    for (std::size_t j = first; j < last; ++j) {
+      const std::uint16_t h = float_to_half(q.values[j] / scale);
       if (!std::isfinite(half_to_float(h) * scale))
-        return "pane " + str(c) + " value " + std::to_string(p.panes[j]) + " is too large to store";
+        return "pane " + str(c) + " value " + std::to_string(q.values[j]) + " is too large to store";
       planes[j] = static_cast<std::byte>(h & 0xffu);
       planes[total + j] = static_cast<std::byte>(h >> 8);
+    }
+  }
+  return {};
+}
+
+// The stored values of `q`'s blocks (their sizes checked against pane_half_bytes) from the
+// zstd frame of scaled halves in two byte planes.
+engine::Status decode_pane_values(const fs::path& path, std::span<const std::uint8_t> frame,
+                                  std::uint64_t pane_half_bytes, const std::vector<float>& scales, PrmPanes& q) {
+  auto unpacked = read_zstd_stream(path, "panes", frame, pane_half_bytes);
+  if (!unpacked) return unpacked.error();
+  const std::vector<std::uint8_t>& planes = *unpacked;
+
+  const auto total = static_cast<std::size_t>(pane_half_bytes / 2);
+  q.values.resize(total);
+  std::size_t c = 0;
+  for (std::size_t b = 0; b < q.blocks.size(); ++b) {
+    while (q.cluster_first[c + 1] <= b) ++c;
+    const std::size_t first = q.block_value[b] * 3, last = first + q.tiles.size(q.blocks[b]) * 3;
+    for (std::size_t j = first; j < last; ++j) {
+      const auto h = static_cast<std::uint16_t>(planes[j] | (planes[total + j] << 8));
+      if ((h & 0x8000u) != 0 || (h & 0x7c00u) == 0x7c00u)
+        return file_error(path, "panes",
+                          "pane " + str(c) + " block " + str(b) + " value " + str(j / 3) + " channel " + str(j % 3) +
+                              " is negative, infinite or NaN (corrupt)");
+      q.values[j] = half_to_float(h) * scales[c];
     }
   }
   return {};
@@ -233,6 +295,10 @@ engine::Status write_prm_panes(const fs::path& path, const Prm& prm, const std::
   w.put_array(area);
   w.put_array(cluster);
   w.put_array(prm.cluster_size);
+  w.put(static_cast<std::int32_t>(prm.panes.blocks_settings.tile_texels));
+  w.put(prm.panes.blocks_settings.threshold);
+  w.put_array(prm.panes.cluster_first);
+  w.put_array(prm.panes.blocks);
   w.put_array(scales);
   w.put(static_cast<std::uint64_t>(planes.size()));
   w.put_array(std::span<const std::uint8_t>(frame));
@@ -249,6 +315,8 @@ engine::Result<PrmPaneFile> read_prm_panes(const fs::path& path) {
   Prm& p = f.prm;
   PrmSettings& s = p.settings;
   std::int32_t entry_points = 0, clusters = 0, max_path_nodes = 0, width = 0, height = 0, cluster_count = 0;
+  std::int32_t tile_texels = 0;
+  PrmPanes& q = p.panes;
   std::uint8_t kmeans = 0;
   std::uint64_t seed = 0, pane_half_bytes = 0;
   std::vector<glm::vec3> position, normal;
@@ -259,8 +327,9 @@ engine::Result<PrmPaneFile> read_prm_panes(const fs::path& path) {
                         r.get(clusters) && r.get(s.splitting) && r.get(max_path_nodes) && r.get(kmeans) &&
                         r.get(seed) && r.get(width) && r.get(height) && r.get(cluster_count) && r.get_array(p.texels) &&
                         r.get_array(position) && r.get_array(normal) && r.get_array(area) && r.get_array(cluster) &&
-                        r.get_array(p.cluster_size) && r.get_array(scales) && r.get(pane_half_bytes) &&
-                        r.get_array(frame);
+                        r.get_array(p.cluster_size) && r.get(tile_texels) && r.get(q.blocks_settings.threshold) &&
+                        r.get_array(q.cluster_first) && r.get_array(q.blocks) && r.get_array(scales) &&
+                        r.get(pane_half_bytes) && r.get_array(frame);
   const std::string location = "payload byte " + std::to_string(r.offset());
   if (!complete) return file_error(path, location, "truncated payload");
   if (r.remaining() != 0) return file_error(path, location, "unexpected data after the last field");
@@ -294,27 +363,36 @@ engine::Result<PrmPaneFile> read_prm_panes(const fs::path& path) {
       return file_error(
           path, "pane_scale",
           "the scale of pane " + str(c) + " (" + std::to_string(scales[c]) + ") is not a positive power of two");
-  const std::uint64_t values = static_cast<std::uint64_t>(cluster_count) * p.texels.size() * 3;
+  if (tile_texels < 1 || tile_texels > 256)
+    return file_error(path, "tile_texels", "tile_texels " + std::to_string(tile_texels) + " is outside 1..256");
+  if (width < 1 || width > kMaxAtlasSide)
+    return file_error(path, "width", "atlas width " + std::to_string(width) + " is outside 1..16384");
+  if (std::string problem = check_texels(p); !problem.empty()) return file_error(path, "texels", problem);
+  s.pane_tile_texels = q.blocks_settings.tile_texels = tile_texels;
+  s.pane_threshold = q.blocks_settings.threshold;
+  q.tiles = prm_tiles(p.texels, width, tile_texels);
+  if (q.cluster_first.size() != static_cast<std::size_t>(cluster_count) + 1 ||
+      q.cluster_first.back() != q.blocks.size())
+    return file_error(path, "blocks",
+                      "cluster_first has " + str(q.cluster_first.size()) + " entries for " +
+                          std::to_string(cluster_count) + " clusters or does not end at the " + str(q.blocks.size()) +
+                          " blocks");
+  for (std::size_t c = 0; c + 1 < q.cluster_first.size(); ++c)
+    if (q.cluster_first[c] > q.cluster_first[c + 1] || q.cluster_first.front() != 0)
+      return file_error(path, "blocks", "cluster_first decreases at cluster " + str(c) + " or does not start at 0");
+  std::uint64_t stored = 0;
+  for (std::uint32_t k : q.blocks) {
+    if (k >= q.tiles.tiles())
+      return file_error(path, "blocks", "block tile " + str(k) + " is outside the " + str(q.tiles.tiles()) + " tiles");
+    stored += q.tiles.size(k);
+  }
+  q.index_values();
+  const std::uint64_t values = stored * 3;
   if (pane_half_bytes != values * 2)
     return file_error(path, "pane_half_bytes",
-                      "the file says " + std::to_string(pane_half_bytes) + " bytes of halves, " +
-                          std::to_string(cluster_count) + " clusters x " + str(p.texels.size()) +
-                          " texels x 3 x 2 = " + std::to_string(values * 2) + " expected");
-  auto unpacked = read_zstd_stream(path, "panes", frame, pane_half_bytes);
-  if (!unpacked) return unpacked.error();
-  const std::vector<std::uint8_t>& planes = *unpacked;
-
-  const std::size_t total = static_cast<std::size_t>(values);
-  const std::size_t per_pane = p.texels.size() * 3;
-  p.panes.resize(total);
-  for (std::size_t j = 0; j < total; ++j) {
-    const auto h = static_cast<std::uint16_t>(planes[j] | (planes[total + j] << 8));
-    if ((h & 0x8000u) != 0 || (h & 0x7c00u) == 0x7c00u)
-      return file_error(path, "panes",
-                        "pane " + str(j / per_pane) + " texel " + str(p.texels[(j % per_pane) / 3]) + " channel " +
-                            str(j % 3) + " is negative, infinite or NaN (corrupt)");
-    p.panes[j] = half_to_float(h) * scales[j / per_pane];
-  }
+                      "the file says " + std::to_string(pane_half_bytes) + " bytes of halves, its blocks hold " +
+                          std::to_string(stored) + " elements x 3 x 2 = " + std::to_string(values * 2) + " expected");
+  if (engine::Status st = decode_pane_values(path, frame, pane_half_bytes, scales, q); !st) return st.error();
   if (std::string problem = check_prm(p); !problem.empty()) return file_error(path, "", problem);
   return f;
 }
@@ -351,7 +429,8 @@ engine::Status save_prm(const fs::path& bundle_dir, const Prm& prm, const BakeIn
                    {"pane_texels", prm.texels.size()},
                    {"stats", stats_json(prm.stats)},
                    {"memory",
-                    {{"pane_bytes_half", static_cast<std::uint64_t>(prm.panes.size()) * 2},
+                    {{"pane_bytes_half", static_cast<std::uint64_t>(prm.panes.values.size()) * 2},
+                     {"pane_blocks", prm.panes.blocks.size()},
                      {"file_bytes", static_cast<std::uint64_t>(file_bytes)}}}};
   return update_manifest_method(bundle_dir, geometry_hash, scene_name, kPrmMethod, entry);
 }

@@ -4,14 +4,16 @@
 //   auto prm = gi::load_prm("level.gibake", input);   // checks the geometry hash
 //
 // Files (DESIGN.md §5, docs/bake-bundle.md):
-//   prm_panes.bin   the checksummed container of bake/blob_file.h, magic "GIPRMPAN", version 2.
+//   prm_panes.bin   the checksummed container of bake/blob_file.h, magic "GIPRMPAN", version 3.
 //   manifest.json   methods.prm = {
 //     "files":        { "panes": {"file": "prm_panes.bin", "xxh3_64": "<hex of the whole file>"} },
-//     "settings":     { PrmSettings' scalar fields but threads and progress },
+//     "settings":     { PrmSettings' scalar fields but threads and progress (pane_tile_texels and
+//                       pane_threshold included) },
 //     "layout":       { "requested_texels_per_metre", "texels_per_metre", "padding_texels", "width", "height" },
 //     "entry_points", "clusters", "pane_texels",
 //     "stats":        { PrmStats' counts (timings: bake_stats.json) },
-//     "memory":       { "pane_bytes_half": clusters x pane_texels x 3 x 2 (the panes as GPU halves),
+//     "memory":       { "pane_bytes_half": stored block elements x 3 x 2 (the panes as GPU halves),
+//                       "pane_blocks": blocks stored over all clusters,
 //                       "file_bytes": size of prm_panes.bin } }
 // The PRM depends on the static geometry and materials only (entry points stand for any
 // light), so there is no lights hash: moving or editing lights never makes it stale.
@@ -28,13 +30,19 @@
 //   array<vec3> entry_position, array<vec3> entry_normal, array<float32> entry_area_m2,
 //   array<uint32> entry_cluster        the entry points (one element per entry in each)
 //   array<uint32> cluster_size         cluster_count elements, members per cluster
+//   int32 tile_texels, float32 threshold
+//                                      the blocks (prm_panes.h): tiles of tile_texels^2 atlas texels
+//   array<uint32> cluster_first        cluster_count + 1 elements: pane c's blocks are
+//                                      blocks[cluster_first[c] .. cluster_first[c + 1])
+//   array<uint32> blocks               tile index of each stored block (prm_tiles order), ascending per pane
 //   array<float32> pane_scale          cluster_count elements, power-of-two scale s_c per pane
-//   uint64 pane_half_bytes             cluster_count x texels x 3 x 2: the decompressed size
+//   uint64 pane_half_bytes             stored block elements x 3 x 2: the decompressed size
 //   array<uint8> panes_zstd            one zstd frame (content size and checksum recorded)
-// Nothing follows (trailing bytes are an error). The zstd frame decompresses to the panes
-// as IEEE binary16 values h = half(v / s_c) in Prm::panes' order (pane c, element i,
-// channel ch), split into two byte planes: every half's low byte, then every high byte
-// (smooth panes then give long runs in the high-byte plane, which zstd packs well).
+// Nothing follows (trailing bytes are an error). The zstd frame decompresses to the stored
+// values as IEEE binary16 values h = half(v / s_c) in PrmPanes::values' order (block by
+// block, a block's elements in tile order, channel ch), split into two byte planes: every
+// half's low byte, then every high byte (smooth panes then give long runs in the high-byte
+// plane, which zstd packs well).
 //
 // Precision. s_c = 2^(e - 15) where the pane's largest value is m x 2^e (m in [0.5, 1)), so
 // the largest value maps into [2^14, 2^15) — well inside the half range (65504), whatever
@@ -62,7 +70,8 @@ inline constexpr const char* kPrmPanesFile = "prm_panes.bin";
 inline constexpr const char* kPrmLayoutFile = "prm_layout.bin";
 inline constexpr BlobMagic kPrmPanesMagic{"GIPRMPAN"};
 // 2: the thread count left out (a bundle does not depend on it; bake_stats.json says it).
-inline constexpr std::uint32_t kPrmPanesVersion = 2;
+// 3: sparse panes, stored per atlas tile only where the cluster's light reaches (issue 38).
+inline constexpr std::uint32_t kPrmPanesVersion = 3;
 
 /// Relative and pane-relative bounds of the half-float pane storage (see above).
 inline constexpr double kPrmPaneRelativeError = 1.0 / 2048.0;               // 2^-11

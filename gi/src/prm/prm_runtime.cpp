@@ -115,11 +115,16 @@ std::vector<ClusterWeight> relight_clusters(const Prm& prm, std::span<const Refe
 std::vector<glm::vec3> sum_panes(const Prm& prm, std::span<const ClusterWeight> selected) {
   std::vector<glm::vec3> out(static_cast<std::size_t>(prm.width) * static_cast<std::size_t>(prm.height),
                              glm::vec3(0.0f));
-  const std::size_t n = prm.pane_size();
+  // Only the blocks each selected cluster stores: the work follows the lit tiles.
+  const PrmPanes& p = prm.panes;
   for (const ClusterWeight& cw : selected) {
-    const float* pane = prm.panes.data() + static_cast<std::size_t>(cw.cluster) * n * 3;
-    for (std::size_t i = 0; i < n; ++i)
-      out[prm.texels[i]] += cw.weight * glm::vec3(pane[3 * i], pane[3 * i + 1], pane[3 * i + 2]);
+    if (cw.cluster >= p.cluster_count()) continue;
+    for (std::uint32_t b = p.cluster_first[cw.cluster]; b < p.cluster_first[cw.cluster + 1]; ++b) {
+      const std::uint32_t* element = p.tiles.elements.data() + p.tiles.first[p.blocks[b]];
+      const float* v = p.values.data() + p.block_value[b] * 3;
+      for (std::uint32_t j = 0; j < p.tiles.size(p.blocks[b]); ++j)
+        out[prm.texels[element[j]]] += cw.weight * glm::vec3(v[3 * j], v[3 * j + 1], v[3 * j + 2]);
+    }
   }
   return out;
 }

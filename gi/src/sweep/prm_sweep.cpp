@@ -151,6 +151,18 @@ std::vector<KnobSpec> prm_knobs() {
        .default_grid = {"0"},
        .min_value = 0,
        .max_value = 1e4},
+      {.name = "pane_threshold",
+       .description = "pane blocks kept above this fraction of their cluster's peak (0: every lit block)",
+       .kind = KnobKind::Real,
+       .default_grid = {"0"},
+       .min_value = 0,
+       .max_value = 1},
+      {.name = "pane_tile",
+       .description = "pane block side in pane texels",
+       .kind = KnobKind::Integer,
+       .default_grid = {"8"},
+       .min_value = 1,
+       .max_value = 256},
       {.name = "splitting",
        .description = "paths per entry point per unit albedo (N_s)",
        .kind = KnobKind::Real,
@@ -206,19 +218,27 @@ engine::Result<std::optional<PaneUpsampler>> atlas_upsampler(const BakeInput& in
   return std::optional<PaneUpsampler>(std::move(up).value());
 }
 
-engine::Result<MethodOutput> run_prm(const RunContext& ctx) {
-  auto scene = posed_scene(ctx.scene.asset, ctx.knobs.text("pose"), ctx.knobs.real("swing"));
-  if (!scene) return scene.error();
+// The bake settings of one run, panes at `pane_density` texels per metre.
+PrmSettings prm_settings_of(const RunContext& ctx, double pane_density) {
   PrmSettings s;
-  const double density = ctx.knobs.real("density"), pane_density = ctx.knobs.real("pane_density");
-  const bool coarse = pane_density > 0.0 && pane_density != density;
-  s.texels_per_metre = static_cast<float>(coarse ? pane_density : density);
+  s.texels_per_metre = static_cast<float>(pane_density);
   s.entry_points = static_cast<int>(ctx.knobs.integer("entries"));
   s.clusters = static_cast<int>(ctx.knobs.integer("clusters"));
   s.splitting = static_cast<float>(ctx.knobs.real("splitting"));
+  s.pane_threshold = static_cast<float>(ctx.knobs.real("pane_threshold"));
+  s.pane_tile_texels = static_cast<int>(ctx.knobs.integer("pane_tile"));
   s.seed = ctx.seed;
   s.threads = ctx.threads;
   s.progress = ctx.progress;
+  return s;
+}
+
+engine::Result<MethodOutput> run_prm(const RunContext& ctx) {
+  auto scene = posed_scene(ctx.scene.asset, ctx.knobs.text("pose"), ctx.knobs.real("swing"));
+  if (!scene) return scene.error();
+  const double density = ctx.knobs.real("density"), pane_density = ctx.knobs.real("pane_density");
+  const bool coarse = pane_density > 0.0 && pane_density != density;
+  const PrmSettings s = prm_settings_of(ctx, coarse ? pane_density : density);
   const BakeInput input = bake_input_from(*scene);
   auto prm = bake_prm(input, s);
   if (!prm) return prm.error();
@@ -257,10 +277,14 @@ engine::Result<MethodOutput> run_prm(const RunContext& ctx) {
                 {"clusters_summed", static_cast<double>(picked.size())},
                 {"dropped_energy", total > 0.0 ? 1.0 - kept / total : nan},
                 {"rescaled_rel_rmse", kept > 0.0 ? relative_rmse(out.field, ctx.reference, total / kept) : nan},
-                {"pane_texels", static_cast<double>(prm->pane_size())}};
+                {"pane_texels", static_cast<double>(prm->pane_size())},
+                {"pane_blocks", static_cast<double>(prm->panes.blocks.size())},
+                {"pane_blocks_dense", static_cast<double>(prm->panes.tiles.tiles() * prm->panes.cluster_count())},
+                {"pane_elements_stored", static_cast<double>(prm->panes.stored_elements())}};
   out.costs.bake_seconds = prm->stats.total_seconds;
   out.costs.frame_ms = frame_ms;
-  out.costs.bytes = static_cast<std::uint64_t>(prm->cluster_count) * prm->pane_size() * 3u * 2u;  // half-float panes
+  out.costs.bytes =
+      static_cast<std::uint64_t>(prm->panes.stored_elements()) * 3u * 2u;  // half-float panes, kept blocks
   return out;
 }
 

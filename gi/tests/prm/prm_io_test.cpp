@@ -66,16 +66,16 @@ gi::Prm fake_prm(float texels_per_metre = 4.0f) {
                          0.01f + 0.003f * f, cluster_of[k]});
   }
   const std::size_t n = p.texels.size();
-  p.panes.resize(4 * n * 3);
+  std::vector<float> panes(4 * n * 3);
   for (std::size_t i = 0; i < n; ++i) {
     const double u = static_cast<double>(i) / static_cast<double>(n - 1);
     for (std::size_t ch = 0; ch < 3; ++ch) {
       const double shade = 1.0 + 0.25 * static_cast<double>(ch);
-      p.panes[(0 * n + i) * 3 + ch] = static_cast<float>(std::pow(10.0, -6.0 + 10.0 * u) / shade);
-      p.panes[(1 * n + i) * 3 + ch] =
+      panes[(0 * n + i) * 3 + ch] = static_cast<float>(std::pow(10.0, -6.0 + 10.0 * u) / shade);
+      panes[(1 * n + i) * 3 + ch] =
           i % 7 == 0 ? 0.0f : static_cast<float>(0.3 * shade * (1.0 + 0.5 * std::sin(0.05 * static_cast<double>(i))));
-      p.panes[(2 * n + i) * 3 + ch] = 0.0f;
-      p.panes[(3 * n + i) * 3 + ch] = static_cast<float>(2e5 * shade / 1.5 * (0.5 + 0.5 * u));
+      panes[(2 * n + i) * 3 + ch] = 0.0f;
+      panes[(3 * n + i) * 3 + ch] = static_cast<float>(2e5 * shade / 1.5 * (0.5 + 0.5 * u));
     }
   }
   p.settings = {.texels_per_metre = texels_per_metre,
@@ -92,6 +92,7 @@ gi::Prm fake_prm(float texels_per_metre = 4.0f) {
              .walk_seconds = 0.125,
              .pane_seconds = 1.0 / 3.0,
              .total_seconds = 4.2};
+  gi::set_dense_panes(p, panes);
   return p;
 }
 
@@ -162,11 +163,12 @@ struct PaneError {
 PaneError pane_error(const gi::Prm& a, const gi::Prm& b) {
   PaneError e;
   const std::size_t per_pane = a.texels.size() * 3;
+  const std::vector<float> ap = gi::dense_panes(a), bp = gi::dense_panes(b);
   for (std::size_t c = 0; c < static_cast<std::size_t>(a.cluster_count); ++c) {
-    const auto first = a.panes.begin() + static_cast<std::ptrdiff_t>(c * per_pane);
+    const auto first = ap.begin() + static_cast<std::ptrdiff_t>(c * per_pane);
     const double max_c = *std::max_element(first, first + static_cast<std::ptrdiff_t>(per_pane));
     for (std::size_t j = c * per_pane; j < (c + 1) * per_pane; ++j) {
-      const double v = a.panes[j], d = b.panes[j];
+      const double v = ap[j], d = bp[j];
       const double bound = gi::kPrmPaneRelativeError * v + gi::kPrmPaneAbsoluteErrorOfMax * max_c;
       if (bound > 0.0)
         e.worst_of_bound = std::max(e.worst_of_bound, std::abs(d - v) / bound);
@@ -223,13 +225,17 @@ TEST(PrmIo, RoundTripKeepsStructureExactAndPanesWithinTheHalfBound) {
     EXPECT_EQ(back->entries[k].area_m2, prm.entries[k].area_m2);
     EXPECT_EQ(back->entries[k].cluster, prm.entries[k].cluster);
   }
-  ASSERT_EQ(back->panes.size(), prm.panes.size());
-  for (std::size_t j = 0; j < prm.panes.size(); ++j)
-    if (prm.panes[j] == 0.0f) {
-      ASSERT_EQ(back->panes[j], 0.0f) << "zeros stay zero, element " << j;
+  EXPECT_EQ(back->panes.blocks, prm.panes.blocks);
+  EXPECT_EQ(back->panes.cluster_first, prm.panes.cluster_first);
+  EXPECT_EQ(back->panes.tiles, prm.panes.tiles);
+  const std::vector<float> before = gi::dense_panes(prm), after = gi::dense_panes(*back);
+  ASSERT_EQ(after.size(), before.size());
+  for (std::size_t j = 0; j < before.size(); ++j)
+    if (before[j] == 0.0f) {
+      ASSERT_EQ(after[j], 0.0f) << "zeros stay zero, element " << j;
     }
   const std::size_t n = prm.texels.size();
-  EXPECT_GT(back->panes[(3 * n + n - 1) * 3 + 2], 65504.0f) << "values beyond the half range survive";
+  EXPECT_GT(after[(3 * n + n - 1) * 3 + 2], 65504.0f) << "values beyond the half range survive";
   const PaneError e = pane_error(prm, *back);
   std::printf("half panes: worst error %.3f of the stated bound, max relative error %.3g (bound %.3g)\n",
               e.worst_of_bound, e.max_relative, gi::kPrmPaneRelativeError);
@@ -293,7 +299,9 @@ TEST(PrmIo, ManifestEntryDescribesTheBake) {
   EXPECT_FALSE(e["stats"].contains("walk_seconds"));
   EXPECT_FALSE(e["stats"].contains("total_seconds"));
   EXPECT_FALSE(e["settings"].contains("threads"));
-  EXPECT_EQ(e["memory"]["pane_bytes_half"], 4 * prm.texels.size() * 3 * 2);
+  // Pane 2 is all zeros: none of its blocks is stored.
+  EXPECT_EQ(e["memory"]["pane_bytes_half"], 3 * prm.texels.size() * 3 * 2);
+  EXPECT_EQ(e["memory"]["pane_blocks"], prm.panes.blocks.size());
   EXPECT_EQ(e["memory"]["file_bytes"], fs::file_size(dir / "prm_panes.bin"));
   EXPECT_FALSE(e.contains("lights_hash")) << "the PRM does not depend on the lights";
 }
@@ -321,22 +329,23 @@ TEST(PrmIo, CompressionShrinksSmoothPanes) {
     ++prm.cluster_size[k];
   }
   const std::size_t n = prm.texels.size();
-  prm.panes.assign(16 * n * 3, 0.0f);
+  std::vector<float> panes(16 * n * 3, 0.0f);
   for (std::size_t c = 0; c < 16; ++c)
     for (std::size_t i = 0; i < n; ++i) {
       const auto x = static_cast<double>(prm.texels[i] % static_cast<std::uint32_t>(prm.width));
       const auto y = static_cast<double>(prm.texels[i] / static_cast<std::uint32_t>(prm.width));
       const double dx = x - 2.0 * static_cast<double>(c), dy = y - 3.0 * static_cast<double>(c);
       for (std::size_t ch = 0; ch < 3; ++ch)
-        prm.panes[(c * n + i) * 3 + ch] =
+        panes[(c * n + i) * 3 + ch] =
             static_cast<float>((1.0 + 0.2 * static_cast<double>(ch)) * 50.0 / (10.0 + dx * dx + dy * dy));
     }
+  gi::set_dense_panes(prm, panes);
   const fs::path dir = saved_bundle("compression", prm);
   const std::uintmax_t file_bytes = fs::file_size(dir / "prm_panes.bin");
-  const std::size_t half_bytes = prm.panes.size() * 2;
+  const std::size_t half_bytes = prm.panes.values.size() * 2;
   std::printf("%zu panes x %zu texels: halves %zu bytes, file %ju bytes (ratio %.2f; float32 would be %zu bytes)\n",
               std::size_t{16}, n, half_bytes, file_bytes,
-              static_cast<double>(half_bytes) / static_cast<double>(file_bytes), prm.panes.size() * 4);
+              static_cast<double>(half_bytes) / static_cast<double>(file_bytes), prm.panes.values.size() * 4);
   EXPECT_LT(file_bytes, half_bytes);
   auto back = gi::load_prm(dir, gi::bake_input_from(cornell()));
   ASSERT_TRUE(back.ok()) << back.error().to_string();
@@ -345,9 +354,10 @@ TEST(PrmIo, CompressionShrinksSmoothPanes) {
   // The round-trip data set's ratio, for the record.
   const gi::Prm fake = fake_prm();
   const fs::path d2 = saved_bundle("compression_fake", fake);
-  std::printf("fake_prm: halves %zu bytes, file %ju bytes (ratio %.2f)\n", fake.panes.size() * 2,
-              fs::file_size(d2 / "prm_panes.bin"),
-              static_cast<double>(fake.panes.size() * 2) / static_cast<double>(fs::file_size(d2 / "prm_panes.bin")));
+  std::printf(
+      "fake_prm: halves %zu bytes, file %ju bytes (ratio %.2f)\n", fake.panes.values.size() * 2,
+      fs::file_size(d2 / "prm_panes.bin"),
+      static_cast<double>(fake.panes.values.size() * 2) / static_cast<double>(fs::file_size(d2 / "prm_panes.bin")));
 }
 
 TEST(PrmIo, StaleBundleIsRejectedWithBothHashes) {
@@ -410,7 +420,11 @@ TEST(PrmIo, MissingOrDamagedFilesAreRejected) {
     b[8] = std::byte{1};  // version 1 stored the thread count
     write_all(dir / "prm_panes.bin", b);
     resign(dir);
-    expect_load_error(dir, "prm_panes.bin", "unsupported version 1, this build reads 2");
+    expect_load_error(dir, "prm_panes.bin", "unsupported version 1, this build reads 3");
+    b[8] = std::byte{2};  // version 2 stored dense panes (before the blocks of issue 38)
+    write_all(dir / "prm_panes.bin", b);
+    resign(dir);
+    expect_load_error(dir, "prm_panes.bin", "unsupported version 2, this build reads 3");
   }
   {
     const fs::path dir = saved_bundle("no_manifest");
@@ -501,7 +515,7 @@ TEST(PrmIo, InconsistentPayloadsAreRejected) {
     const gi::Prm prm = fake_prm();
     const fs::path dir = saved_bundle("nan_half", prm);
     const auto p = payload_of(dir);
-    const std::size_t half_bytes = prm.panes.size() * 2;
+    const std::size_t half_bytes = prm.panes.values.size() * 2;
     // The frame is the last field (uint64 size, then the frame): find where it starts.
     std::size_t frame_size = 0;
     for (std::size_t start = p.size() - 8; start > 0; --start) {
@@ -520,7 +534,7 @@ TEST(PrmIo, InconsistentPayloadsAreRejected) {
     for (std::uint16_t bad : {std::uint16_t{0x7e00}, std::uint16_t{0x8400}}) {  // NaN, -2^-14
       std::vector<std::byte> edited = planes;
       edited[5] = static_cast<std::byte>(bad & 0xff);
-      edited[prm.panes.size() + 5] = static_cast<std::byte>(bad >> 8);
+      edited[prm.panes.values.size() + 5] = static_cast<std::byte>(bad >> 8);
       std::vector<std::byte> frame(ZSTD_compressBound(half_bytes));
       const std::size_t packed = ZSTD_compress(frame.data(), frame.size(), edited.data(), edited.size(), 3);
       ASSERT_EQ(ZSTD_isError(packed), 0u);
@@ -558,7 +572,8 @@ TEST(PrmIo, RandomByteFlipsNeverCrash) {
     auto r = gi::load_prm(dir, gi::bake_input_from(cornell()));
     if (r.ok()) {
       ++loaded;
-      EXPECT_EQ(r->panes.size(), static_cast<std::size_t>(r->cluster_count) * r->texels.size() * 3);
+      EXPECT_EQ(r->panes.cluster_count(), static_cast<std::size_t>(r->cluster_count));
+      EXPECT_EQ(r->panes.tiles.elements.size(), r->texels.size());
     } else {
       ++rejected;
       EXPECT_NE(r.error().to_string().find("prm_panes.bin"), std::string::npos) << r.error().to_string();
@@ -585,17 +600,17 @@ TEST(PrmIo, InvalidPrmRefusesToSaveAndWritesNothing) {
     EXPECT_TRUE(gi::load_prm(existing, gi::bake_input_from(cornell())).ok());
   };
   gi::Prm p = fake_prm();
-  p.panes[17] = std::numeric_limits<float>::quiet_NaN();
+  p.panes.values[17] = std::numeric_limits<float>::quiet_NaN();
   expect_refused(p, "NaN");
   p = fake_prm();
-  p.panes[4] = -1e-3f;
+  p.panes.values[4] = -1e-3f;
   expect_refused(p, "negative");
   p = fake_prm();
-  p.panes.back() = std::numeric_limits<float>::infinity();
+  p.panes.values.back() = std::numeric_limits<float>::infinity();
   expect_refused(p, "infinite");
   p = fake_prm();
-  p.panes.pop_back();
-  expect_refused(p, "panes has");
+  p.panes.values.pop_back();
+  expect_refused(p, "panes hold");
   p = fake_prm();
   std::swap(p.texels[3], p.texels[4]);
   expect_refused(p, "not strictly ascending");
