@@ -97,8 +97,8 @@ float depth_in_box(const ProbeVolume& v, const glm::vec3& p, const glm::vec3& n)
 // probes whose box (grown by the margin) holds p, each read along the box-projected
 // reflection direction at lod roughness x (levels - 1), averaged, times the specular albedo.
 // `depth`: the largest depth_in_box over those probes. False where no box holds p.
-bool probe_specular(const ReflectionProbeSet& set, const engine::GltfBrdf& brdf, const glm::vec3& p,
-                    const glm::vec3& n, const glm::vec3& v, glm::vec3& out, float& depth) {
+bool probe_specular(const ReflectionProbeSet& set, const engine::GltfBrdf& brdf, const glm::vec3& p, const glm::vec3& n,
+                    const glm::vec3& v, glm::vec3& out, float& depth) {
   const glm::vec3 r = glm::reflect(-v, n);
   glm::vec3 sum(0.0f);
   int count = 0;
@@ -203,16 +203,15 @@ engine::Result<MethodOutput> run_reflection_probes(const RunContext& ctx) {
   const auto count = [](const std::vector<std::uint8_t>& m) {
     return static_cast<double>(std::count(m.begin(), m.end(), std::uint8_t{1}));
   };
-  out.extras = {
-      {"volume_truth_rel_rmse", compare_rgb(restricted(out.field, inner), ctx.reference).truth_rel_rmse},
-      {"border_truth_rel_rmse", compare_rgb(restricted(out.field, edge), ctx.reference).truth_rel_rmse},
-      {"volume_texels", count(inner)},
-      {"border_texels", count(edge)},
-      {"uncovered_texels", static_cast<double>(uncovered)},
-      {"probes", static_cast<double>(set->probes.size())},
-      {"capture_seconds", set->stats.capture_seconds},
-      {"prefilter_seconds", set->stats.prefilter_seconds},
-      {"atlas_seconds", atlas_seconds}};
+  out.extras = {{"volume_truth_rel_rmse", compare_rgb(restricted(out.field, inner), ctx.reference).truth_rel_rmse},
+                {"border_truth_rel_rmse", compare_rgb(restricted(out.field, edge), ctx.reference).truth_rel_rmse},
+                {"volume_texels", count(inner)},
+                {"border_texels", count(edge)},
+                {"uncovered_texels", static_cast<double>(uncovered)},
+                {"probes", static_cast<double>(set->probes.size())},
+                {"capture_seconds", set->stats.capture_seconds},
+                {"prefilter_seconds", set->stats.prefilter_seconds},
+                {"atlas_seconds", atlas_seconds}};
   add_view_band_bias(*g, values, covered, ctx.reference, out.extras);
   return out;
 }
@@ -220,9 +219,10 @@ engine::Result<MethodOutput> run_reflection_probes(const RunContext& ctx) {
 }  // namespace
 
 void register_reflection_probes_sweep(SweepRegistry& registry) {
-  registry.add_reference_provider({.kind = "probe_glossy_specular", .version = "pt-1", .compute = [](const ReferenceJob& job) {
-                                     return glossy_specular_truth(job, LobeRadiance::Full);
-                                   }});
+  registry.add_reference_provider(
+      {.kind = "probe_glossy_specular", .version = "pt-1", .compute = [](const ReferenceJob& job) {
+         return glossy_specular_truth(job, LobeRadiance::Full);
+       }});
   SweepMethod m;
   m.name = method_descriptor(EffectMethod::ReflectionProbes).key;  // gi/methods.h
   m.description =
