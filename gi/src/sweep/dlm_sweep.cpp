@@ -59,6 +59,12 @@ std::vector<KnobSpec> dlm_knobs() {
        .default_grid = {"0.15"},
        .min_value = 0.05,
        .max_value = 0.9},
+      {.name = "placement",
+       .description = "where the texels are measured: raster (the default, its references' keys unchanged) or "
+                      "visible_surface (off the lines where walls begin, as the reflection probes are measured)",
+       .kind = KnobKind::Choice,
+       .default_grid = {"raster"},
+       .choices = {"raster", "visible_surface"}},
       {.name = "ref_spp",
        .description = "specular-lobe samples per texel of the path-traced reference",
        .kind = KnobKind::Integer,
@@ -79,6 +85,7 @@ ReferenceRequest dlm_reference_request(const SweepScene&, const KnobSetting& k) 
               {"spp", std::to_string(k.integer("ref_spp"))},
               {"floor_roughness", roughness},
               {"camera", "0"}};
+  if (k.text("placement") == "visible_surface") r.params.emplace_back("placement", "visible_surface");
   return r;
 }
 
@@ -123,7 +130,9 @@ engine::Result<MethodOutput> run_dlm(const RunContext& ctx) {
   if (!dlm) return dlm.error();
   if (dlm->width != ctx.reference.width || dlm->height != ctx.reference.height)
     return engine::Error{.message = "the maps' atlas size differs from the reference's"};
-  auto g = glossy_texels(ctx.scene, ctx.knobs.real("density"), floor_roughness, nullptr);
+  const TexelPlacement placement =
+      ctx.knobs.text("placement") == "visible_surface" ? TexelPlacement::VisibleSurface : TexelPlacement::Raster;
+  auto g = glossy_texels(ctx.scene, ctx.knobs.real("density"), floor_roughness, nullptr, placement);
   if (!g) return g.error();
   // The renderer's evaluation (engine::directional_specular) at every stored glossy texel.
   const AtlasTexels& tex = g->s.texels;
