@@ -87,7 +87,30 @@ glm::vec3 read_chain(const std::vector<std::vector<glm::vec3>>& chain, int size0
   return a + f * (lookup_level(chain[static_cast<std::size_t>(hi)], cube_level_size(size0, hi), d) - a);
 }
 
+// Level texels read bilinearly at face coordinate (u, v), edge texels clamped.
+glm::vec3 bilinear_level(const std::vector<glm::vec3>& texels, int s, const CubeCoordinate& c) {
+  const float fx = (c.u + 1.0f) * 0.5f * static_cast<float>(s) - 0.5f;
+  const float fy = (c.v + 1.0f) * 0.5f * static_cast<float>(s) - 0.5f;
+  const int x0 = static_cast<int>(std::floor(fx)), y0 = static_cast<int>(std::floor(fy));
+  const float tx = fx - static_cast<float>(x0), ty = fy - static_cast<float>(y0);
+  const auto at = [&](int x, int y) {
+    return texels[cube_texel_index(c.face, std::clamp(x, 0, s - 1), std::clamp(y, 0, s - 1), s)];
+  };
+  return glm::mix(glm::mix(at(x0, y0), at(x0 + 1, y0), tx), glm::mix(at(x0, y0 + 1), at(x0 + 1, y0 + 1), tx), ty);
+}
+
 }  // namespace
+
+glm::vec3 cube_lookup_trilinear(const ProbeCube& cube, float lod, const glm::vec3& d) {
+  const int top = static_cast<int>(cube.levels.size()) - 1;
+  const float l = std::clamp(lod, 0.0f, static_cast<float>(std::max(top, 0)));
+  const int lo = static_cast<int>(std::floor(l)), hi = std::min(lo + 1, top);
+  const CubeCoordinate c = cube_coordinate(d);
+  const glm::vec3 a = bilinear_level(cube.levels[static_cast<std::size_t>(lo)], cube_level_size(cube.size, lo), c);
+  if (hi == lo) return a;
+  const glm::vec3 b = bilinear_level(cube.levels[static_cast<std::size_t>(hi)], cube_level_size(cube.size, hi), c);
+  return glm::mix(a, b, l - static_cast<float>(lo));
+}
 
 int full_mip_count(int size) { return size < 1 ? 0 : std::bit_width(static_cast<unsigned>(size)); }
 

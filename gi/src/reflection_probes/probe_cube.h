@@ -56,6 +56,12 @@ float cube_texel_solid_angle(int x, int y, int s);
 /// Level `level` read in direction d, nearest texel.
 glm::vec3 cube_lookup(const ProbeCube& cube, int level, const glm::vec3& d);
 
+/// The cube read as the renderer's sampler reads it (textureLod with linear filtering):
+/// bilinear within the face at each of the two levels around `lod` (clamped to the levels
+/// held), linear between them. The GPU's seamless filtering blends across face edges; here
+/// the face's edge texels are clamped (a difference within half a texel of an edge).
+glm::vec3 cube_lookup_trilinear(const ProbeCube& cube, float lod, const glm::vec3& d);
+
 /// Parallax correction (Lagarde and Zanuttini 2012, "Local image-based lighting with
 /// parallax-corrected cubemaps"): the direction from the probe's centre to where the ray from
 /// `p` along `r` (not zero) leaves the box [box_min, box_max] that stands for the room. `p`

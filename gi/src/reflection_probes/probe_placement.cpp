@@ -83,22 +83,40 @@ std::vector<ProbeVolume> place_probes(const RayCaster& caster, const glm::vec3& 
                                       const ProbePlacementSettings& settings) {
   std::vector<ProbeVolume> probes;
   const glm::vec3 extent = glm::max(world_max - world_min, glm::vec3(0.0f));
-  glm::ivec3 n;
-  for (int a = 0; a < 3; ++a) n[a] = std::max(1, static_cast<int>(std::ceil(extent[a] / settings.cell_m)));
-  for (int y = 0; y < n.y; ++y)
-    for (int z = 0; z < n.z; ++z)
-      for (int x = 0; x < n.x; ++x) {
-        if (static_cast<int>(probes.size()) >= settings.max_probes) return probes;
-        const glm::vec3 p = world_min + (glm::vec3(x, y, z) + 0.5f) / glm::vec3(n) * extent;
-        if (std::any_of(probes.begin(), probes.end(), [&](const ProbeVolume& v) { return v.contains(p); })) continue;
-        auto v = measure(caster, p, world_min, world_max, settings.spread_m);
-        if (!v) continue;
-        const glm::vec3 size = v->box_max - v->box_min;
-        if (std::min({size.x, size.y, size.z}) < settings.min_box_m) continue;
-        const glm::vec3 mid = 0.5f * (v->box_min + v->box_max);
-        if (free_point(caster, mid, world_min, world_max)) v->centre = mid;
-        probes.push_back(*v);
-      }
+  // Two passes: cells of cell_m, then of cell_m / 2 for the space the first left without a
+  // box. One grid of room-sized cells can step over a room narrower than a cell (the demo
+  // level's 2 m corridor lies between two candidates 3.6 m apart and got no probe).
+  for (const float cell : {settings.cell_m, 0.5f * settings.cell_m}) {
+    glm::ivec3 n;
+    for (int a = 0; a < 3; ++a) n[a] = std::max(1, static_cast<int>(std::ceil(extent[a] / cell)));
+    for (int y = 0; y < n.y; ++y)
+      for (int z = 0; z < n.z; ++z)
+        for (int x = 0; x < n.x; ++x) {
+          if (static_cast<int>(probes.size()) >= settings.max_probes) return probes;
+          glm::vec3 p = world_min + (glm::vec3(x, y, z) + 0.5f) / glm::vec3(n) * extent;
+          const auto covered = [&](const glm::vec3& q) {
+            return std::any_of(probes.begin(), probes.end(), [&](const ProbeVolume& v) { return v.contains(q); });
+          };
+          if (covered(p)) continue;
+          if (cell < settings.cell_m) {
+            // A finer candidate can sit next to a wall or a floor, where the bundles' spread
+            // reaches past them (the corridor's first candidate, 0.9 m above its floor and
+            // 0.2 m from its doorway, measured the whole level): it moves first to the middle
+            // of what its centre rays see.
+            const auto centre_rays = measure(caster, p, world_min, world_max, 0.0f);
+            if (!centre_rays) continue;
+            p = 0.5f * (centre_rays->box_min + centre_rays->box_max);
+            if (covered(p)) continue;
+          }
+          auto v = measure(caster, p, world_min, world_max, settings.spread_m);
+          if (!v) continue;
+          const glm::vec3 size = v->box_max - v->box_min;
+          if (std::min({size.x, size.y, size.z}) < settings.min_box_m) continue;
+          const glm::vec3 mid = 0.5f * (v->box_min + v->box_max);
+          if (free_point(caster, mid, world_min, world_max)) v->centre = mid;
+          probes.push_back(*v);
+        }
+  }
   return probes;
 }
 

@@ -5,7 +5,9 @@
 //   auto probes = gi::place_probes(caster, world_min, world_max, {.cell_m = 4.0f});
 //
 // The rule: candidate points at the centres of a grid of cells of about cell_m over the
-// static world's bounds, visited in grid order (y, then z, then x). A candidate already
+// static world's bounds, visited in grid order (y, then z, then x), then those of a grid of
+// cell_m / 2 (a room narrower than a cell, a corridor, can lie between the first grid's
+// candidates). A candidate already
 // inside a placed probe's box is skipped. From the others, 6 bundles of 5 x 5 parallel
 // rays (spread +-spread_m across the ray) go along +-x, +-y, +-z; each side of the box is at
 // the median distance of its bundle, so an opening (a doorway) or an obstacle (a crate, a

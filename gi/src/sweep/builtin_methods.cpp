@@ -7,6 +7,7 @@
 #include "sweep/light_atlas_sweep.h"
 #include "sweep/prm_sweep.h"
 #include "sweep/reference_sweep.h"
+#include "sweep/reflection_probes_sweep.h"
 
 namespace gi {
 
@@ -21,6 +22,7 @@ void register_builtin_sweep_methods(SweepRegistry& registry) {
   register_brf_sweep(registry);
   register_dlm_sweep(registry);
   register_antiradiance_sweep(registry);
+  register_reflection_probes_sweep(registry);
   //
   // GI METHODS (light atlas, PRM, DLM, BRF, antiradiance) register here as they land, one
   // add_method per method, with every quality knob declared (DESIGN.md 3, "Accuracy and its

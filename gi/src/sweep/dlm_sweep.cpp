@@ -1,5 +1,7 @@
 #include "sweep/dlm_sweep.h"
 
+#include "sweep/glossy_texels.h"
+
 #include <gi/methods.h>
 
 #include "raytrace/material_lookup.h"
@@ -13,11 +15,7 @@
 #include <cstdio>
 #include <string>
 
-#include "core/random.h"
-#include "core/thread_pool.h"
 #include "dlm/dlm.h"
-#include "raytrace/path_tracer.h"
-#include "raytrace/ray_offset.h"
 #include "transport/static_scene.h"
 #include "uv/atlas_input.h"
 #include "uv/atlas_layout.h"
@@ -25,105 +23,8 @@
 namespace gi {
 namespace {
 
-// Other random streams than any bake's (see reference_sweep.cpp).
-constexpr std::uint64_t kReferenceSeed = 0x646c6d7265666572ULL;
-
-engine::Error request_error(const ReferenceRequest& r, const std::string& message) {
-  return engine::Error{"<sweep>", r.key(), message};
-}
-
-// The static scene at the layout of `density`, the camera 0 position, and per texel whether
-// its triangle is glossy (roughness below `roughness`, the bake's rule) and its BRDF.
-struct GlossyTexels {
-  StaticBakeScene s;
-  glm::vec3 eye{0.0f};
-  std::vector<std::uint8_t> glossy;  // per atlas texel: glossy and facing the camera
-  std::vector<engine::GltfBrdf> brdf;
-};
-
-// The scene with every glossy material (roughness below 0.35, the planner's old threshold)
-// set to `floor_roughness`: glossy_room's floor; the glossy threshold of the bake and the
-// reference then sits above it.
-constexpr double kGlossyOriginal = 0.35;
-engine::SceneAsset with_floor_roughness(const engine::SceneAsset& asset, double floor_roughness) {
-  engine::SceneAsset out = asset;
-  for (engine::Material& m : out.materials)
-    if (static_cast<double>(m.roughness) < kGlossyOriginal) m.roughness = static_cast<float>(floor_roughness);
-  return out;
-}
-double glossy_threshold(double floor_roughness) { return std::max(kGlossyOriginal, floor_roughness + 0.05); }
-
-engine::Result<GlossyTexels> glossy_texels(const SweepScene& scene, double density, double floor_roughness,
-                                           const ReferenceRequest* request) {
-  const double roughness = glossy_threshold(floor_roughness);
-  const engine::Scene live = engine::instantiate(with_floor_roughness(scene.asset, floor_roughness));
-  engine::Entity camera{};
-  for (std::size_t n = 0; n < live.assets.nodes.size(); ++n)
-    if (live.assets.nodes[n].camera == 0) camera = live.node_entities[n];
-  if (camera.is_null())
-    return request ? request_error(*request, "the scene has no camera 0")
-                   : engine::Error{.message = "the scene has no camera 0"};
-  const BakeInput input = bake_input_from(live);
-  auto layout = build_atlas_layout(atlas_inputs_from(input), {.texels_per_metre = static_cast<float>(density)});
-  if (!layout) return layout.error();
-  auto prepared = prepare_static_scene(input, *layout, BakeLights::Static);
-  if (!prepared) return prepared.error();
-  GlossyTexels g{
-      std::move(prepared).value(), glm::vec3(live.registry.get<engine::WorldTransform>(camera).matrix[3]), {}, {}};
-  const AtlasTexels& tex = g.s.texels;
-  g.glossy.assign(tex.valid.size(), 0);
-  g.brdf.resize(tex.valid.size());
-  for (std::size_t t = 0; t < tex.valid.size(); ++t) {
-    if (!tex.valid[t] || tex.mesh[t] < 0) continue;
-    const std::uint32_t inst = g.s.static_instance[static_cast<std::size_t>(tex.mesh[t])];
-    const ShadingTriangle& tri =
-        g.s.index.triangles[g.s.index.instance_first[inst] + static_cast<std::uint32_t>(tex.triangle[t])];
-    // Textured: the material's mean over the texel's footprint (material_lookup.h).
-    const engine::GltfBrdf brdf = [&] {
-      if (!g.s.scene.materials[tri.material].textured()) return g.s.scene.materials[tri.material].brdf;
-      const TexelFootprint f = texel_footprint(*layout, tex.mesh[t], tex.triangle[t], t);
-      return footprint_brdf(g.s.scene, tri, f.centre, f.axis_u, f.axis_v);
-    }();
-    if (!(static_cast<double>(std::sqrt(brdf.alpha)) < roughness)) continue;
-    if (!(glm::dot(tex.normal[t], g.eye - tex.position[t]) > 0.0f)) continue;
-    g.glossy[t] = 1;
-    g.brdf[t] = brdf;
-  }
-  return g;
-}
-
 engine::Result<RgbField> glossy_specular_reference(const ReferenceJob& job) {
-  const ReferenceRequest& r = job.request;
-  auto g = glossy_texels(job.scene, std::stod(r.param("texels_per_m")), std::stod(r.param("floor_roughness")), &r);
-  if (!g) return g.error();
-  const int spp = std::stoi(r.param("spp"));
-  const AtlasTexels& tex = g->s.texels;
-  PathTracer pt(g->s.scene, g->s.index, *g->s.caster, {});
-  std::vector<glm::vec3> out(tex.valid.size(), glm::vec3(0.0f)), variance(tex.valid.size(), glm::vec3(0.0f));
-  ThreadPool pool(job.threads);
-  const bool done = pool.parallel_for_with_progress(tex.valid.size(), job.progress, [&](std::size_t t) {
-    if (!g->glossy[t]) return;
-    const glm::vec3 p = tex.position[t], n = tex.normal[t], v = glm::normalize(g->eye - p);
-    const ReferenceBrdf f{.normal = n, .material = g->brdf[t]};
-    Pcg32 rng = Pcg32::for_item(kReferenceSeed, t);
-    glm::dvec3 sum(0.0), sum2(0.0);
-    for (int j = 0; j < spp; ++j) {
-      const float ul = rng.next_float(), u1 = rng.next_float(), u2 = rng.next_float();
-      BrdfSample s;
-      if (!f.sample(v, ul, u1, u2, s) || !(s.pdf > 0.0f)) continue;
-      const glm::vec3 spec = engine::gltf_eval_cos(g->brdf[t], n, v, s.wi).specular / s.pdf;
-      if (spec == glm::vec3(0.0f)) continue;
-      const glm::dvec3 x(spec * pt.reflected_radiance(Ray{offset_ray_origin(p, n), 0.0f, s.wi}, rng));
-      sum += x, sum2 += x * x;
-    }
-    const glm::dvec3 mean = sum / static_cast<double>(spp);
-    out[t] = glm::vec3(mean);
-    // The sampling variance of the mean, so that compare_rgb removes the reference's noise.
-    variance[t] = glm::vec3(glm::max(sum2 / static_cast<double>(spp) - mean * mean, glm::dvec3(0.0)) /
-                            static_cast<double>(std::max(spp - 1, 1)));
-  });
-  if (!done) return engine::cancelled_error("glossy specular reference");
-  return RgbField::from_texels(tex.width, tex.height, out, g->glossy, variance);
+  return glossy_specular_truth(job, LobeRadiance::Reflected);
 }
 
 std::vector<KnobSpec> dlm_knobs() {
@@ -158,6 +59,12 @@ std::vector<KnobSpec> dlm_knobs() {
        .default_grid = {"0.15"},
        .min_value = 0.05,
        .max_value = 0.9},
+      {.name = "placement",
+       .description = "where the texels are measured: raster (the default, its references' keys unchanged) or "
+                      "visible_surface (off the lines where walls begin, as the reflection probes are measured)",
+       .kind = KnobKind::Choice,
+       .default_grid = {"raster"},
+       .choices = {"raster", "visible_surface"}},
       {.name = "ref_spp",
        .description = "specular-lobe samples per texel of the path-traced reference",
        .kind = KnobKind::Integer,
@@ -178,6 +85,7 @@ ReferenceRequest dlm_reference_request(const SweepScene&, const KnobSetting& k) 
               {"spp", std::to_string(k.integer("ref_spp"))},
               {"floor_roughness", roughness},
               {"camera", "0"}};
+  if (k.text("placement") == "visible_surface") r.params.emplace_back("placement", "visible_surface");
   return r;
 }
 
@@ -222,7 +130,9 @@ engine::Result<MethodOutput> run_dlm(const RunContext& ctx) {
   if (!dlm) return dlm.error();
   if (dlm->width != ctx.reference.width || dlm->height != ctx.reference.height)
     return engine::Error{.message = "the maps' atlas size differs from the reference's"};
-  auto g = glossy_texels(ctx.scene, ctx.knobs.real("density"), floor_roughness, nullptr);
+  const TexelPlacement placement =
+      ctx.knobs.text("placement") == "visible_surface" ? TexelPlacement::VisibleSurface : TexelPlacement::Raster;
+  auto g = glossy_texels(ctx.scene, ctx.knobs.real("density"), floor_roughness, nullptr, placement);
   if (!g) return g.error();
   // The renderer's evaluation (engine::directional_specular) at every stored glossy texel.
   const AtlasTexels& tex = g->s.texels;

@@ -112,3 +112,22 @@ TEST(ProbeCube, PrefilterConservesTheMeanOfAVaryingMap) {
 }
 
 }  // namespace
+
+// The sweep's stand-in for the renderer's textureLod: at a texel's centre it is the texel,
+// half-way between two texels their mean, and between levels the linear blend.
+TEST(ProbeCube, TrilinearLookupReadsTexelCentresAndBlendsBetweenThem) {
+  gi::ProbeCube cube = gi::make_probe_cube(4, 3);
+  for (std::size_t i = 0; i < cube.levels[0].size(); ++i) cube.levels[0][i] = glm::vec3(static_cast<float>(i));
+  for (glm::vec3& t : cube.levels[1]) t = glm::vec3(100.0f);
+  const glm::vec3 centre = gi::cube_texel_direction(4, 1, 2, 4);  // face +Z, texel (1, 2)
+  EXPECT_FLOAT_EQ(gi::cube_lookup_trilinear(cube, 0.0f, centre).x, cube.levels[0][gi::cube_texel_index(4, 1, 2, 4)].x);
+  // u = 0 lies half-way between texels 1 and 2 of row 2.
+  const glm::vec3 between = gi::cube_direction(4, 0.0f, 0.25f);
+  EXPECT_FLOAT_EQ(
+      gi::cube_lookup_trilinear(cube, 0.0f, between).x,
+      0.5f * (cube.levels[0][gi::cube_texel_index(4, 1, 2, 4)].x + cube.levels[0][gi::cube_texel_index(4, 2, 2, 4)].x));
+  const float level0 = cube.levels[0][gi::cube_texel_index(4, 1, 2, 4)].x;
+  EXPECT_FLOAT_EQ(gi::cube_lookup_trilinear(cube, 0.25f, centre).x, 0.75f * level0 + 0.25f * 100.0f);
+  // Past the last level the last level is read.
+  EXPECT_FLOAT_EQ(gi::cube_lookup_trilinear(cube, 7.0f, centre).x, 0.0f);
+}

@@ -105,6 +105,28 @@ TEST(ReflectionProbePlacement, TwoRoomsGiveTwoProbesWhoseBoxesAreTheRooms) {
   }
 }
 
+// The demo level's plan: a hub, a 2 m wide corridor and a side room, the world 14.4 m wide,
+// so the 4 m grid's candidates (x = 1.6, 5.2, 8.8, 12.4) all miss the corridor (x in [3, 5]).
+// The half-size second pass gives it its own probe, whose box is the corridor.
+TEST(ReflectionProbePlacement, ANarrowCorridorBetweenTheGridsCandidatesGetsAProbe) {
+  gi::BakeInput in;
+  in.name = "hub and corridor";
+  in.materials.push_back(lambert(0.5f));
+  add_static(in, room({0, 0, 0}, {8.2f, 3, 8.2f}), "hub");
+  add_static(in, room({3, 0, 8.4f}, {5, 3, 16.4f}), "corridor");
+  add_static(in, room({8.4f, 0, 1}, {14.2f, 3, 7}), "side room");
+  auto caster = gi::make_embree_ray_caster(gi::rt_scene_from(in));
+  ASSERT_TRUE(caster) << caster.error().to_string();
+  const auto probes = gi::place_probes(**caster, {-0.2f, 0, -0.2f}, {14.2f, 3, 16.4f}, gi::ProbePlacementSettings{});
+  ASSERT_EQ(probes.size(), 3u);
+  const auto corridor = std::find_if(probes.begin(), probes.end(), [](const gi::ProbeVolume& v) {
+    return v.contains({4.0f, 1.5f, 12.0f});
+  });
+  ASSERT_NE(corridor, probes.end());
+  EXPECT_NEAR(glm::length(corridor->box_min - glm::vec3(3, 0, 8.4f)), 0.0f, 1e-3f);
+  EXPECT_NEAR(glm::length(corridor->box_max - glm::vec3(5, 3, 16.4f)), 0.0f, 1e-3f);
+}
+
 // A closed 3 m room of albedo 0.5 whose atlas holds the same irradiance E everywhere: every
 // surface sends E / pi x 0.5 (a Lambertian's directional albedo is its albedo), so the probe
 // sees that radiance in every direction, and each prefiltered level keeps it.
