@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <optional>
 #include <span>
@@ -147,13 +148,27 @@ glm::vec2 hit_uv(const AtlasLayout& layout, const Hit& h) {
 // surface, or a surface facing `from` across a gap of less than kGapTexels) or the atlas texel
 // it reads (a valid texel, redirected from an empty one); on a surface also the atlas UV of the
 // hit, the atlas texel under it as it is (`pixel`, maybe empty), the distance and |cos| at the
-// surface.
+// surface, and the hit itself (its triangle, barycentrics, the side the ray came from).
 struct Landing {
   std::uint32_t texel = kSky;
   glm::vec2 uv{0.0f};
   std::uint32_t pixel = kDark;
   float distance = 0.0f, cos_surface = 0.0f;
+  std::uint32_t triangle = 0;
+  glm::vec2 barycentric{0.0f};
+  glm::vec3 side{0.0f};  // the hit triangle's unit face normal turned towards the ray's origin
 };
+
+// A ray from a texel landed on a surface facing it closer than kGapTexels: the two enclose a
+// dark gap only if something covers the landing point. A texel's sample moved off its
+// triangle by relocate_texel_samples (raytrace/texel_samples.h) can float that close over a
+// surface in the open (Dabrovic Sponza's gallery floor 0.8 mm under such a sample sees the
+// sun). One ray from the landing point back out along its side, as long as the gap, decides.
+bool gap_is_covered(const StaticBakeScene& b, const TexelTable& t, const Ray& ray, const Hit& h,
+                    const glm::vec3& side) {
+  const glm::vec3 p = ray.origin + h.t * ray.direction;
+  return b.caster->occluded(Ray{offset_ray_origin(p, side), 0.0f, side, 2.0f * t.gap_m});
+}
 
 Landing land_ray(const StaticBakeScene& b, const AtlasLayout& layout, const TexelTable& t, const Ray& ray,
                  const glm::vec3& from) {
@@ -162,8 +177,13 @@ Landing land_ray(const StaticBakeScene& b, const AtlasLayout& layout, const Texe
   const ShadingTriangle& tri = b.index.triangles[b.triangle_of(h)];
   const float cos_surface = glm::dot(tri.face_normal, ray.direction);
   if (!(cos_surface < 0.0f) && !b.scene.materials[tri.material].double_sided) return {.texel = kBack};
-  if (h.t < t.gap_m && std::fabs(glm::dot(tri.face_normal, from)) > 0.9f) return {.texel = kBack};
+  const glm::vec3 side = cos_surface < 0.0f ? tri.face_normal : -tri.face_normal;
+  if (h.t < t.gap_m && std::fabs(glm::dot(tri.face_normal, from)) > 0.9f && gap_is_covered(b, t, ray, h, side))
+    return {.texel = kBack};
   Landing l;
+  l.triangle = b.triangle_of(h);
+  l.barycentric = h.barycentric;
+  l.side = side;
   l.uv = hit_uv(layout, h);
   const int x = std::clamp(static_cast<int>(l.uv.x * static_cast<float>(t.width)), 0, t.width - 1);
   const int y = std::clamp(static_cast<int>(l.uv.y * static_cast<float>(t.height)), 0, t.height - 1);
@@ -283,6 +303,54 @@ int solve_kept_rays(const TexelTable& t, const KeptRays& k, const std::vector<gl
   return iterations;
 }
 
+// What step 3's rays read, per atlas pixel (dilated): rho (E_d + E) of every texel, the same
+// without the lights' direct light, rho (sky + E), and where the lights' direct light changes
+// sharply (`sharp`: in the pixel's 3 x 3 neighbourhood the dimmest is under half the
+// brightest, a shadow edge crossing it).
+struct GatherSource {
+  std::vector<glm::vec3> reflected, without_lights;
+  std::vector<std::uint8_t> sharp;
+};
+
+// A texel holds the light at its one sample point. Where a shadow edge crosses it, the light
+// of another point of the texel can be anything between its neighbours': in a 5 cm slot
+// under a slab of Dabrovic Sponza, the floor's texel straddles the slot's mouth, its sample
+// lies in the sun, and rays from the slab's underside that land in the dark slot read that
+// sun (issue 35, "Noise against floor"). There the read takes the lights' direct light at the
+// landing point itself (one sample of each light, unbiased) and only the rest bilinearly.
+glm::dvec3 read_landing(const StaticBakeScene& b, const TexelTable& t, const GatherSource& src, const Landing& l,
+                        Pcg32& rng, std::uint64_t& rays) {
+  if (!src.sharp[l.pixel]) return glm::dvec3(bilinear(src.reflected, t.width, t.height, l.uv));
+  const ShadingTriangle& tri = b.index.triangles[l.triangle];
+  const float u = l.barycentric.x, v = l.barycentric.y;
+  const glm::vec3 p = tri.p0 + u * tri.e1 + v * tri.e2;
+  glm::vec3 n = (1.0f - u - v) * tri.n0 + u * tri.n1 + v * tri.n2;
+  n = glm::dot(n, n) > 0.0f ? glm::normalize(n) : l.side;
+  if (glm::dot(n, l.side) < 0.0f) n = -n;  // a double-sided surface seen from behind
+  const DirectAt d = direct_at(b, p, n, l.side, 1, rng, &rays);
+  return glm::dvec3(bilinear(src.without_lights, t.width, t.height, l.uv)) +
+         glm::dvec3(t.albedo[l.texel] * (d.live + d.unlit));
+}
+
+// Marks the pixels whose 3 x 3 neighbourhood of `lit` (rho E_d, dilated) holds a sharp change.
+std::vector<std::uint8_t> sharp_pixels(const std::vector<glm::vec3>& lit, int w, int h) {
+  std::vector<std::uint8_t> sharp(lit.size(), 0);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      float lo = std::numeric_limits<float>::infinity(), hi = 0.0f;
+      for (int k = 0; k < 9; ++k) {
+        const int nx = std::clamp(x + k % 3 - 1, 0, w - 1), ny = std::clamp(y + k / 3 - 1, 0, h - 1);
+        const glm::vec3& c =
+            lit[static_cast<std::size_t>(ny) * static_cast<std::size_t>(w) + static_cast<std::size_t>(nx)];
+        const float l = luminance(c.x, c.y, c.z);
+        lo = std::min(lo, l), hi = std::max(hi, l);
+      }
+      sharp[static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)] =
+          hi > 0.0f && lo < 0.5f * hi ? 1 : 0;
+    }
+  return sharp;
+}
+
 // The fresh rays of one texel in step 3: the cosine rays' and the emitter rays' estimate of
 // the irradiance that `reflected` sends (W/m^2), and the cosine rays' mean sky radiance; the
 // sample variance of one ray's estimate of the luminance of irradiance + pi sky (the mean's
@@ -310,8 +378,8 @@ double luminance_of(const glm::dvec3& c) { return luminance(c.x, c.y, c.z); }
 // Long because both kinds of rays share the MIS counts and one spread of their estimates
 // (the variance); split, the two loops would pass all of them back and forth.
 FreshGather gather_texel(const StaticBakeScene& b, const AtlasLayout& layout, const TexelTable& t,
-                         const TexelGatherSettings& s, const std::vector<glm::vec3>& reflected,
-                         const TexelEmitters* emitters, std::uint32_t i, std::uint64_t& rays) {
+                         const TexelGatherSettings& s, const GatherSource& src, const TexelEmitters* emitters,
+                         std::uint32_t i, std::uint64_t& rays) {
   const AtlasTexels& tx = b.texels;
   const auto nf = static_cast<std::size_t>(s.gather_rays);
   const auto ne = emitters ? static_cast<std::size_t>(s.emitter_rays) : std::size_t{0};
@@ -340,7 +408,7 @@ FreshGather gather_texel(const StaticBakeScene& b, const AtlasLayout& layout, co
       const Landing l = land_ray(b, layout, t, Ray{origin, 0.0f, wi}, t.face[i]);
       double z = 0.0;
       if (l.texel < kBack) {
-        const glm::dvec3 radiosity(bilinear(reflected, t.width, t.height, l.uv));
+        const glm::dvec3 radiosity = read_landing(b, t, src, l, rng, rays);
         const glm::dvec3 share = ne == 0 ? radiosity : radiosity / (nc + emitter_count(l, glm::dot(n, wi)));
         g.irradiance += share;
         z = (ne == 0 ? 1.0 : n_all) * luminance_of(share);
@@ -375,7 +443,7 @@ FreshGather gather_texel(const StaticBakeScene& b, const AtlasLayout& layout, co
     // B cos_x / pi / (n_c p_c + n_e p_e) = B / (n_c + n_e p_e pi / cos_x).
     const double count = nc + emitter_count(l, cos_x);
     if (!(count > 0.0)) continue;
-    const glm::dvec3 share = glm::dvec3(bilinear(reflected, t.width, t.height, l.uv)) / count;
+    const glm::dvec3 share = glm::dvec3(bilinear(src.reflected, t.width, t.height, l.uv)) / count;
     g.irradiance += share;
     spread.add(n_all * luminance_of(share));
   }
@@ -389,9 +457,9 @@ FreshGather gather_texel(const StaticBakeScene& b, const AtlasLayout& layout, co
 // (in e and k.sky), weighted by ray counts. Texels not in `mine` get 0 in both.
 bool final_gather(const StaticBakeScene& b, const AtlasLayout& layout, const TexelTable& t,
                   const TexelGatherSettings& s, ThreadPool& pool, const ProgressCallback& progress,
-                  const std::vector<std::size_t>& mine, const std::vector<glm::vec3>& reflected,
-                  const TexelEmitters* emitters, const KeptRays& k, std::vector<glm::vec3>& e,
-                  std::vector<glm::vec3>& sky, std::vector<float>& variance, std::vector<std::uint64_t>& rays_of) {
+                  const std::vector<std::size_t>& mine, const GatherSource& src, const TexelEmitters* emitters,
+                  const KeptRays& k, std::vector<glm::vec3>& e, std::vector<glm::vec3>& sky,
+                  std::vector<float>& variance, std::vector<std::uint64_t>& rays_of) {
   const auto nf = static_cast<std::size_t>(s.gather_rays);
   const auto ne = emitters ? static_cast<std::size_t>(s.emitter_rays) : std::size_t{0};
   // Both estimate T(E_d + E): weighted by their rays (the sky by the cosine rays alone).
@@ -408,7 +476,7 @@ bool final_gather(const StaticBakeScene& b, const AtlasLayout& layout, const Tex
   const bool done = pool.parallel_for_with_progress(mine.size(), progress, [&](std::size_t m) {
     const std::size_t w = mine[m];
     const std::uint32_t i = t.work[w];
-    const FreshGather g = gather_texel(b, layout, t, s, reflected, emitters, i, rays_of[w]);
+    const FreshGather g = gather_texel(b, layout, t, s, src, emitters, i, rays_of[w]);
     gathered[i] = glm::vec3(w_solve * glm::dvec3(e[i]) + (1.0 - w_solve) * g.irradiance);
     sky[i] = glm::vec3(w_sky * glm::dvec3(k.sky[i]) + (1.0 - w_sky) * static_cast<double>(kPi) * g.sky);
     variance[i] = static_cast<float>(g.ray_variance / rays);
@@ -491,13 +559,23 @@ engine::Result<TexelGatherResult> gather_atlas(const StaticBakeScene& b, const A
     // as blotches a few texels wide (a bright texel lights its neighbours' rays).
     const std::vector<glm::vec3> source =
         filtering ? filter_world(tx, t.work, e, kept.hidden, radius_m, texel_m, pool) : e;
-    std::vector<glm::vec3> reflected(n, glm::vec3(0.0f));
-    for (std::uint32_t i : t.work) reflected[i] = t.albedo[i] * (emitted[i] + source[i]);
+    GatherSource src;
+    src.reflected.assign(n, glm::vec3(0.0f));
+    src.without_lights.assign(n, glm::vec3(0.0f));
+    std::vector<glm::vec3> lit(n, glm::vec3(0.0f));
+    for (std::uint32_t i : t.work) {
+      src.reflected[i] = t.albedo[i] * (emitted[i] + source[i]);
+      src.without_lights[i] = t.albedo[i] * (kept.sky[i] + source[i]);
+      lit[i] = t.albedo[i] * (out.direct[i] + out.baked_direct[i]);
+    }
     std::optional<TexelEmitters> emitters;
-    if (s.emitter_rays > 0) emitters.emplace(b, layout, t.work, t.face, reflected, layout.texels_per_metre, pool);
-    dilate<glm::vec3>(reflected, t.width, t.height, tx.valid, std::max(3, layout.padding_texels));
+    if (s.emitter_rays > 0) emitters.emplace(b, layout, t.work, t.face, src.reflected, layout.texels_per_metre, pool);
+    const int rings = std::max(3, layout.padding_texels);
+    for (auto* field : {&src.reflected, &src.without_lights, &lit})
+      dilate<glm::vec3>(*field, t.width, t.height, tx.valid, rings);
+    src.sharp = sharp_pixels(lit, t.width, t.height);
     std::vector<std::uint64_t> gather_rays_of(work, 0);
-    if (!final_gather(b, layout, t, s, pool, phase(0.5, 0.95), s.shard.items(work), reflected,
+    if (!final_gather(b, layout, t, s, pool, phase(0.5, 0.95), s.shard.items(work), src,
                       emitters ? &*emitters : nullptr, kept, e, sky, out.variance, gather_rays_of))
       return engine::cancelled_error("light-atlas gather");
     for (std::uint64_t r : gather_rays_of) out.own_rays += r;
