@@ -42,6 +42,10 @@ constexpr float kHiddenBackFraction = 0.1f;
 // (a slab's underside 2 mm above the next one's top, in Dabrovic Sponza): a ray from one
 // that lands on the other reads dark, not the texel there, whose sample lies in the open.
 constexpr float kGapTexels = 0.05f;
+// A texel's sample this far off its triangle's plane was moved by relocate_texel_samples (at
+// least 0.01 texel off its surface): whether it sees a point where a ray lands on its texel
+// is checked (Landing::unseen_corners).
+constexpr float kOffPlaneTexels = 0.001f;
 
 // Item ids of the four random streams of a texel.
 constexpr std::uint64_t kDirectStream = 0, kSolveStream = 1, kGatherStream = 2, kEmitterStream = 3;
@@ -69,7 +73,22 @@ struct TexelTable {
   std::vector<glm::vec3> face;          // per atlas texel: unit geometric normal on the shading side
   std::vector<std::uint32_t> redirect;  // per atlas texel: itself when valid, else a valid neighbour or kDark
   float gap_m = 0.0f;                   // kGapTexels in metres
+  float plane_m = 0.0f;                 // kOffPlaneTexels in metres
+  std::vector<std::uint8_t> moved;      // per atlas texel: its sample lies off its triangle's plane
+  float near_m = 0.0f;                  // one texel in metres
 };
+
+// TexelTable::moved: the samples relocate_texel_samples moved off their triangle's plane.
+void mark_moved_samples(const StaticBakeScene& b, TexelTable& t) {
+  const AtlasTexels& tx = b.texels;
+  t.moved.assign(tx.valid.size(), 0);
+  for (std::uint32_t i : t.work) {
+    const std::uint32_t mesh = static_cast<std::uint32_t>(tx.mesh[i]);
+    const ShadingTriangle& tri =
+        b.index.triangles[b.index.instance_first[b.static_instance[mesh]] + static_cast<std::uint32_t>(tx.triangle[i])];
+    t.moved[i] = std::fabs(glm::dot(tx.position[i] - tri.p0, tri.face_normal)) > t.plane_m ? 1 : 0;
+  }
+}
 
 engine::Result<TexelTable> texel_table(const StaticBakeScene& b, const AtlasLayout& layout) {
   // Long because it fills one table in one pass over the texels: the layout checks, the
@@ -87,6 +106,8 @@ engine::Result<TexelTable> texel_table(const StaticBakeScene& b, const AtlasLayo
   t.width = tx.width;
   t.height = tx.height;
   t.gap_m = layout.texels_per_metre > 0.0f ? kGapTexels / layout.texels_per_metre : 0.0f;
+  t.plane_m = layout.texels_per_metre > 0.0f ? kOffPlaneTexels / layout.texels_per_metre : 0.0f;
+  t.near_m = layout.texels_per_metre > 0.0f ? 1.0f / layout.texels_per_metre : 0.0f;
   const std::size_t n = tx.valid.size();
   t.albedo.assign(n, glm::vec3(0.0f));
   t.face.assign(n, glm::vec3(0.0f));
@@ -134,6 +155,7 @@ engine::Result<TexelTable> texel_table(const StaticBakeScene& b, const AtlasLayo
     if (found.empty()) break;
     for (const auto& [i, r] : found) t.redirect[i] = r;
   }
+  mark_moved_samples(b, t);
   return t;
 }
 
@@ -157,7 +179,42 @@ struct Landing {
   std::uint32_t triangle = 0;
   glm::vec2 barycentric{0.0f};
   glm::vec3 side{0.0f};  // the hit triangle's unit face normal turned towards the ray's origin
+  // Bit k: the sample of the bilinear read's corner k does not see the landing point (its
+  // light is not the point's).
+  std::uint8_t unseen_corners = 0;
 };
+
+// The four atlas pixels of a bilinear read at uv (bilinear()'s), corner k = (x0 + k % 2, y0 + k / 2),
+// and its fractions.
+struct Footprint {
+  std::size_t pixel[4];
+  float ax, ay;
+};
+
+Footprint footprint_at(int w, int h, glm::vec2 uv) {
+  const float fx = uv.x * static_cast<float>(w) - 0.5f, fy = uv.y * static_cast<float>(h) - 0.5f;
+  const float x0f = std::floor(fx), y0f = std::floor(fy);
+  Footprint f{};
+  f.ax = fx - x0f, f.ay = fy - y0f;
+  for (int k = 0; k < 4; ++k) {
+    const int x = std::clamp(static_cast<int>(x0f) + k % 2, 0, w - 1),
+              y = std::clamp(static_cast<int>(y0f) + k / 2, 0, h - 1);
+    f.pixel[k] = static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
+  }
+  return f;
+}
+
+// Whether the sample of `texel` does not see the point p on a surface facing `side` where a
+// ray landed on that texel. Sponza's stacked slabs enclose pockets a few centimetres tall,
+// closed on every side (the path tracer finds no light at all in them), whose floor's texels
+// have their samples moved through the pocket's walls into the sun by relocate_texel_samples:
+// a ray landing inside the pocket read 760 W/m^2 there.
+bool sample_unseen(const StaticBakeScene& b, const TexelTable& t, const glm::vec3& p, const glm::vec3& side,
+                   std::uint32_t texel) {
+  const glm::vec3 q = b.texels.position[texel];
+  const glm::vec3 from = offset_ray_origin(p, side), to = offset_ray_origin(q, t.face[texel]);
+  return b.caster->occluded(Ray{from, 0.0f, to - from, 1.0f});
+}
 
 // A ray from a texel landed on a surface facing it closer than kGapTexels: the two enclose a
 // dark gap only if something covers the landing point. A texel's sample moved off its
@@ -168,6 +225,24 @@ bool gap_is_covered(const StaticBakeScene& b, const TexelTable& t, const Ray& ra
                     const glm::vec3& side) {
   const glm::vec3 p = ray.origin + h.t * ray.direction;
   return b.caster->occluded(Ray{offset_ray_origin(p, side), 0.0f, side, 2.0f * t.gap_m});
+}
+
+// Landing::unseen_corners at the landing point p, `distance` from the ray's
+// origin: each sample checked once, the moved ones always, all of them on a landing closer
+// than a texel (a pocket's floor whose texels' samples lie beyond its walls).
+void mark_unseen(const StaticBakeScene& b, const TexelTable& t, const glm::vec3& p, float distance, Landing& l) {
+  const Footprint f = footprint_at(t.width, t.height, l.uv);
+  const bool near = distance < t.near_m;
+  std::uint32_t checked[5] = {l.texel, kDark, kDark, kDark, kDark};
+  bool unseen[5] = {(near || t.moved[l.texel] != 0) && sample_unseen(b, t, p, l.side, l.texel)};
+  for (int k = 0; k < 4; ++k) {
+    const std::uint32_t j = t.redirect[f.pixel[k]];
+    if (j == kDark || !(near || t.moved[j])) continue;
+    int c = 0;
+    while (c <= k && checked[c] != j && checked[c] != kDark) ++c;
+    if (checked[c] != j) checked[c] = j, unseen[c] = sample_unseen(b, t, p, l.side, j);
+    if (unseen[c]) l.unseen_corners = static_cast<std::uint8_t>(l.unseen_corners | (1u << k));
+  }
 }
 
 Landing land_ray(const StaticBakeScene& b, const AtlasLayout& layout, const TexelTable& t, const Ray& ray,
@@ -190,6 +265,7 @@ Landing land_ray(const StaticBakeScene& b, const AtlasLayout& layout, const Texe
   l.pixel = static_cast<std::uint32_t>(static_cast<std::size_t>(y) * static_cast<std::size_t>(t.width) +
                                        static_cast<std::size_t>(x));
   l.texel = t.redirect[l.pixel];
+  if (l.texel != kDark) mark_unseen(b, t, ray.origin + h.t * ray.direction, h.t, l);
   l.distance = h.t;
   l.cos_surface = std::fabs(cos_surface);
   return l;
@@ -318,9 +394,29 @@ struct GatherSource {
 // lies in the sun, and rays from the slab's underside that land in the dark slot read that
 // sun (issue 35, "Noise against floor"). There the read takes the lights' direct light at the
 // landing point itself (one sample of each light, unbiased) and only the rest bilinearly.
+// Bilinear corners whose samples do not see the point (Landing::unseen_corners) are left out;
+// where none does, that direct light is all the read takes.
 glm::dvec3 read_landing(const StaticBakeScene& b, const TexelTable& t, const GatherSource& src, const Landing& l,
                         Pcg32& rng, std::uint64_t& rays) {
-  if (!src.sharp[l.pixel]) return glm::dvec3(bilinear(src.reflected, t.width, t.height, l.uv));
+  const bool sharp = src.sharp[l.pixel] != 0;
+  if (l.unseen_corners == 0 && !sharp) return glm::dvec3(bilinear(src.reflected, t.width, t.height, l.uv));
+  glm::dvec3 rest(0.0);
+  if (l.unseen_corners != 0) {
+    // The bilinear read without the corners whose samples do not see the point.
+    const Footprint f = footprint_at(t.width, t.height, l.uv);
+    const std::vector<glm::vec3>& img = sharp ? src.without_lights : src.reflected;
+    double weights = 0.0;
+    for (int k = 0; k < 4; ++k) {
+      if (l.unseen_corners & (1u << k)) continue;
+      const double wk = static_cast<double>((k % 2 ? f.ax : 1.0f - f.ax) * (k / 2 ? f.ay : 1.0f - f.ay));
+      rest += wk * glm::dvec3(img[f.pixel[k]]), weights += wk;
+    }
+    if (weights > 0.0) rest /= weights;
+    if (!sharp && weights > 0.0) return rest;
+    if (!(weights > 0.0)) rest = glm::dvec3(0.0);
+  } else {
+    rest = glm::dvec3(bilinear(src.without_lights, t.width, t.height, l.uv));
+  }
   const ShadingTriangle& tri = b.index.triangles[l.triangle];
   const float u = l.barycentric.x, v = l.barycentric.y;
   const glm::vec3 p = tri.p0 + u * tri.e1 + v * tri.e2;
@@ -328,8 +424,8 @@ glm::dvec3 read_landing(const StaticBakeScene& b, const TexelTable& t, const Gat
   n = glm::dot(n, n) > 0.0f ? glm::normalize(n) : l.side;
   if (glm::dot(n, l.side) < 0.0f) n = -n;  // a double-sided surface seen from behind
   const DirectAt d = direct_at(b, p, n, l.side, 1, rng, &rays);
-  return glm::dvec3(bilinear(src.without_lights, t.width, t.height, l.uv)) +
-         glm::dvec3(t.albedo[l.texel] * (d.live + d.unlit));
+  const glm::dvec3 lights(t.albedo[l.texel] * (d.live + d.unlit));
+  return rest + lights;
 }
 
 // Marks the pixels whose 3 x 3 neighbourhood of `lit` (rho E_d, dilated) holds a sharp change.
