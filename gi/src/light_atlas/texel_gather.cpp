@@ -539,7 +539,7 @@ FreshGather gather_texel(const StaticBakeScene& b, const AtlasLayout& layout, co
     // B cos_x / pi / (n_c p_c + n_e p_e) = B / (n_c + n_e p_e pi / cos_x).
     const double count = nc + emitter_count(l, cos_x);
     if (!(count > 0.0)) continue;
-    const glm::dvec3 share = glm::dvec3(bilinear(src.reflected, t.width, t.height, l.uv)) / count;
+    const glm::dvec3 share = read_landing(b, t, src, l, rng, rays) / count;  // as the cosine rays read
     g.irradiance += share;
     spread.add(n_all * luminance_of(share));
   }
