@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <optional>
 #include <span>
@@ -41,6 +42,10 @@ constexpr float kHiddenBackFraction = 0.1f;
 // (a slab's underside 2 mm above the next one's top, in Dabrovic Sponza): a ray from one
 // that lands on the other reads dark, not the texel there, whose sample lies in the open.
 constexpr float kGapTexels = 0.05f;
+// A texel's sample this far off its triangle's plane was moved by relocate_texel_samples (at
+// least 0.01 texel off its surface): whether it sees a point where a ray lands on its texel
+// is checked (Landing::unseen_corners).
+constexpr float kOffPlaneTexels = 0.001f;
 
 // Item ids of the four random streams of a texel.
 constexpr std::uint64_t kDirectStream = 0, kSolveStream = 1, kGatherStream = 2, kEmitterStream = 3;
@@ -68,7 +73,22 @@ struct TexelTable {
   std::vector<glm::vec3> face;          // per atlas texel: unit geometric normal on the shading side
   std::vector<std::uint32_t> redirect;  // per atlas texel: itself when valid, else a valid neighbour or kDark
   float gap_m = 0.0f;                   // kGapTexels in metres
+  float plane_m = 0.0f;                 // kOffPlaneTexels in metres
+  std::vector<std::uint8_t> moved;      // per atlas texel: its sample lies off its triangle's plane
+  float near_m = 0.0f;                  // one texel in metres
 };
+
+// TexelTable::moved: the samples relocate_texel_samples moved off their triangle's plane.
+void mark_moved_samples(const StaticBakeScene& b, TexelTable& t) {
+  const AtlasTexels& tx = b.texels;
+  t.moved.assign(tx.valid.size(), 0);
+  for (std::uint32_t i : t.work) {
+    const std::uint32_t mesh = static_cast<std::uint32_t>(tx.mesh[i]);
+    const ShadingTriangle& tri =
+        b.index.triangles[b.index.instance_first[b.static_instance[mesh]] + static_cast<std::uint32_t>(tx.triangle[i])];
+    t.moved[i] = std::fabs(glm::dot(tx.position[i] - tri.p0, tri.face_normal)) > t.plane_m ? 1 : 0;
+  }
+}
 
 engine::Result<TexelTable> texel_table(const StaticBakeScene& b, const AtlasLayout& layout) {
   // Long because it fills one table in one pass over the texels: the layout checks, the
@@ -86,6 +106,8 @@ engine::Result<TexelTable> texel_table(const StaticBakeScene& b, const AtlasLayo
   t.width = tx.width;
   t.height = tx.height;
   t.gap_m = layout.texels_per_metre > 0.0f ? kGapTexels / layout.texels_per_metre : 0.0f;
+  t.plane_m = layout.texels_per_metre > 0.0f ? kOffPlaneTexels / layout.texels_per_metre : 0.0f;
+  t.near_m = layout.texels_per_metre > 0.0f ? 1.0f / layout.texels_per_metre : 0.0f;
   const std::size_t n = tx.valid.size();
   t.albedo.assign(n, glm::vec3(0.0f));
   t.face.assign(n, glm::vec3(0.0f));
@@ -133,6 +155,7 @@ engine::Result<TexelTable> texel_table(const StaticBakeScene& b, const AtlasLayo
     if (found.empty()) break;
     for (const auto& [i, r] : found) t.redirect[i] = r;
   }
+  mark_moved_samples(b, t);
   return t;
 }
 
@@ -147,13 +170,80 @@ glm::vec2 hit_uv(const AtlasLayout& layout, const Hit& h) {
 // surface, or a surface facing `from` across a gap of less than kGapTexels) or the atlas texel
 // it reads (a valid texel, redirected from an empty one); on a surface also the atlas UV of the
 // hit, the atlas texel under it as it is (`pixel`, maybe empty), the distance and |cos| at the
-// surface.
+// surface, and the hit itself (its triangle, barycentrics, the side the ray came from).
 struct Landing {
   std::uint32_t texel = kSky;
   glm::vec2 uv{0.0f};
   std::uint32_t pixel = kDark;
   float distance = 0.0f, cos_surface = 0.0f;
+  std::uint32_t triangle = 0;
+  glm::vec2 barycentric{0.0f};
+  glm::vec3 side{0.0f};  // the hit triangle's unit face normal turned towards the ray's origin
+  // Bit k: the sample of the bilinear read's corner k does not see the landing point (its
+  // light is not the point's).
+  std::uint8_t unseen_corners = 0;
 };
+
+// The four atlas pixels of a bilinear read at uv (bilinear()'s), corner k = (x0 + k % 2, y0 + k / 2),
+// and its fractions.
+struct Footprint {
+  std::size_t pixel[4];
+  float ax, ay;
+};
+
+Footprint footprint_at(int w, int h, glm::vec2 uv) {
+  const float fx = uv.x * static_cast<float>(w) - 0.5f, fy = uv.y * static_cast<float>(h) - 0.5f;
+  const float x0f = std::floor(fx), y0f = std::floor(fy);
+  Footprint f{};
+  f.ax = fx - x0f, f.ay = fy - y0f;
+  for (int k = 0; k < 4; ++k) {
+    const int x = std::clamp(static_cast<int>(x0f) + k % 2, 0, w - 1),
+              y = std::clamp(static_cast<int>(y0f) + k / 2, 0, h - 1);
+    f.pixel[k] = static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
+  }
+  return f;
+}
+
+// Whether the sample of `texel` does not see the point p on a surface facing `side` where a
+// ray landed on that texel. Sponza's stacked slabs enclose pockets a few centimetres tall,
+// closed on every side (the path tracer finds no light at all in them), whose floor's texels
+// have their samples moved through the pocket's walls into the sun by relocate_texel_samples:
+// a ray landing inside the pocket read 760 W/m^2 there.
+bool sample_unseen(const StaticBakeScene& b, const TexelTable& t, const glm::vec3& p, const glm::vec3& side,
+                   std::uint32_t texel) {
+  const glm::vec3 q = b.texels.position[texel];
+  const glm::vec3 from = offset_ray_origin(p, side), to = offset_ray_origin(q, t.face[texel]);
+  return b.caster->occluded(Ray{from, 0.0f, to - from, 1.0f});
+}
+
+// A ray from a texel landed on a surface facing it closer than kGapTexels: the two enclose a
+// dark gap only if something covers the landing point. A texel's sample moved off its
+// triangle by relocate_texel_samples (raytrace/texel_samples.h) can float that close over a
+// surface in the open (Dabrovic Sponza's gallery floor 0.8 mm under such a sample sees the
+// sun). One ray from the landing point back out along its side, as long as the gap, decides.
+bool gap_is_covered(const StaticBakeScene& b, const TexelTable& t, const Ray& ray, const Hit& h,
+                    const glm::vec3& side) {
+  const glm::vec3 p = ray.origin + h.t * ray.direction;
+  return b.caster->occluded(Ray{offset_ray_origin(p, side), 0.0f, side, 2.0f * t.gap_m});
+}
+
+// Landing::unseen_corners at the landing point p, `distance` from the ray's
+// origin: each sample checked once, the moved ones always, all of them on a landing closer
+// than a texel (a pocket's floor whose texels' samples lie beyond its walls).
+void mark_unseen(const StaticBakeScene& b, const TexelTable& t, const glm::vec3& p, float distance, Landing& l) {
+  const Footprint f = footprint_at(t.width, t.height, l.uv);
+  const bool near = distance < t.near_m;
+  std::uint32_t checked[5] = {l.texel, kDark, kDark, kDark, kDark};
+  bool unseen[5] = {(near || t.moved[l.texel] != 0) && sample_unseen(b, t, p, l.side, l.texel)};
+  for (int k = 0; k < 4; ++k) {
+    const std::uint32_t j = t.redirect[f.pixel[k]];
+    if (j == kDark || !(near || t.moved[j])) continue;
+    int c = 0;
+    while (c <= k && checked[c] != j && checked[c] != kDark) ++c;
+    if (checked[c] != j) checked[c] = j, unseen[c] = sample_unseen(b, t, p, l.side, j);
+    if (unseen[c]) l.unseen_corners = static_cast<std::uint8_t>(l.unseen_corners | (1u << k));
+  }
+}
 
 Landing land_ray(const StaticBakeScene& b, const AtlasLayout& layout, const TexelTable& t, const Ray& ray,
                  const glm::vec3& from) {
@@ -162,14 +252,20 @@ Landing land_ray(const StaticBakeScene& b, const AtlasLayout& layout, const Texe
   const ShadingTriangle& tri = b.index.triangles[b.triangle_of(h)];
   const float cos_surface = glm::dot(tri.face_normal, ray.direction);
   if (!(cos_surface < 0.0f) && !b.scene.materials[tri.material].double_sided) return {.texel = kBack};
-  if (h.t < t.gap_m && std::fabs(glm::dot(tri.face_normal, from)) > 0.9f) return {.texel = kBack};
+  const glm::vec3 side = cos_surface < 0.0f ? tri.face_normal : -tri.face_normal;
+  if (h.t < t.gap_m && std::fabs(glm::dot(tri.face_normal, from)) > 0.9f && gap_is_covered(b, t, ray, h, side))
+    return {.texel = kBack};
   Landing l;
+  l.triangle = b.triangle_of(h);
+  l.barycentric = h.barycentric;
+  l.side = side;
   l.uv = hit_uv(layout, h);
   const int x = std::clamp(static_cast<int>(l.uv.x * static_cast<float>(t.width)), 0, t.width - 1);
   const int y = std::clamp(static_cast<int>(l.uv.y * static_cast<float>(t.height)), 0, t.height - 1);
   l.pixel = static_cast<std::uint32_t>(static_cast<std::size_t>(y) * static_cast<std::size_t>(t.width) +
                                        static_cast<std::size_t>(x));
   l.texel = t.redirect[l.pixel];
+  if (l.texel != kDark) mark_unseen(b, t, ray.origin + h.t * ray.direction, h.t, l);
   l.distance = h.t;
   l.cos_surface = std::fabs(cos_surface);
   return l;
@@ -283,6 +379,74 @@ int solve_kept_rays(const TexelTable& t, const KeptRays& k, const std::vector<gl
   return iterations;
 }
 
+// What step 3's rays read, per atlas pixel (dilated): rho (E_d + E) of every texel, the same
+// without the lights' direct light, rho (sky + E), and where the lights' direct light changes
+// sharply (`sharp`: in the pixel's 3 x 3 neighbourhood the dimmest is under half the
+// brightest, a shadow edge crossing it).
+struct GatherSource {
+  std::vector<glm::vec3> reflected, without_lights;
+  std::vector<std::uint8_t> sharp;
+};
+
+// A texel holds the light at its one sample point. Where a shadow edge crosses it, the light
+// of another point of the texel can be anything between its neighbours': in a 5 cm slot
+// under a slab of Dabrovic Sponza, the floor's texel straddles the slot's mouth, its sample
+// lies in the sun, and rays from the slab's underside that land in the dark slot read that
+// sun (issue 35, "Noise against floor"). There the read takes the lights' direct light at the
+// landing point itself (one sample of each light, unbiased) and only the rest bilinearly.
+// Bilinear corners whose samples do not see the point (Landing::unseen_corners) are left out;
+// where none does, that direct light is all the read takes.
+glm::dvec3 read_landing(const StaticBakeScene& b, const TexelTable& t, const GatherSource& src, const Landing& l,
+                        Pcg32& rng, std::uint64_t& rays) {
+  const bool sharp = src.sharp[l.pixel] != 0;
+  if (l.unseen_corners == 0 && !sharp) return glm::dvec3(bilinear(src.reflected, t.width, t.height, l.uv));
+  glm::dvec3 rest(0.0);
+  if (l.unseen_corners != 0) {
+    // The bilinear read without the corners whose samples do not see the point.
+    const Footprint f = footprint_at(t.width, t.height, l.uv);
+    const std::vector<glm::vec3>& img = sharp ? src.without_lights : src.reflected;
+    double weights = 0.0;
+    for (int k = 0; k < 4; ++k) {
+      if (l.unseen_corners & (1u << k)) continue;
+      const double wk = static_cast<double>((k % 2 ? f.ax : 1.0f - f.ax) * (k / 2 ? f.ay : 1.0f - f.ay));
+      rest += wk * glm::dvec3(img[f.pixel[k]]), weights += wk;
+    }
+    if (weights > 0.0) rest /= weights;
+    if (!sharp && weights > 0.0) return rest;
+    if (!(weights > 0.0)) rest = glm::dvec3(0.0);
+  } else {
+    rest = glm::dvec3(bilinear(src.without_lights, t.width, t.height, l.uv));
+  }
+  const ShadingTriangle& tri = b.index.triangles[l.triangle];
+  const float u = l.barycentric.x, v = l.barycentric.y;
+  const glm::vec3 p = tri.p0 + u * tri.e1 + v * tri.e2;
+  glm::vec3 n = (1.0f - u - v) * tri.n0 + u * tri.n1 + v * tri.n2;
+  n = glm::dot(n, n) > 0.0f ? glm::normalize(n) : l.side;
+  if (glm::dot(n, l.side) < 0.0f) n = -n;  // a double-sided surface seen from behind
+  const DirectAt d = direct_at(b, p, n, l.side, 1, rng, &rays);
+  const glm::dvec3 lights(t.albedo[l.texel] * (d.live + d.unlit));
+  return rest + lights;
+}
+
+// Marks the pixels whose 3 x 3 neighbourhood of `lit` (rho E_d, dilated) holds a sharp change.
+std::vector<std::uint8_t> sharp_pixels(const std::vector<glm::vec3>& lit, int w, int h) {
+  std::vector<std::uint8_t> sharp(lit.size(), 0);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      float lo = std::numeric_limits<float>::infinity(), hi = 0.0f;
+      for (int k = 0; k < 9; ++k) {
+        const int nx = std::clamp(x + k % 3 - 1, 0, w - 1), ny = std::clamp(y + k / 3 - 1, 0, h - 1);
+        const glm::vec3& c =
+            lit[static_cast<std::size_t>(ny) * static_cast<std::size_t>(w) + static_cast<std::size_t>(nx)];
+        const float l = luminance(c.x, c.y, c.z);
+        lo = std::min(lo, l), hi = std::max(hi, l);
+      }
+      sharp[static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)] =
+          hi > 0.0f && lo < 0.5f * hi ? 1 : 0;
+    }
+  return sharp;
+}
+
 // The fresh rays of one texel in step 3: the cosine rays' and the emitter rays' estimate of
 // the irradiance that `reflected` sends (W/m^2), and the cosine rays' mean sky radiance; the
 // sample variance of one ray's estimate of the luminance of irradiance + pi sky (the mean's
@@ -310,8 +474,8 @@ double luminance_of(const glm::dvec3& c) { return luminance(c.x, c.y, c.z); }
 // Long because both kinds of rays share the MIS counts and one spread of their estimates
 // (the variance); split, the two loops would pass all of them back and forth.
 FreshGather gather_texel(const StaticBakeScene& b, const AtlasLayout& layout, const TexelTable& t,
-                         const TexelGatherSettings& s, const std::vector<glm::vec3>& reflected,
-                         const TexelEmitters* emitters, std::uint32_t i, std::uint64_t& rays) {
+                         const TexelGatherSettings& s, const GatherSource& src, const TexelEmitters* emitters,
+                         std::uint32_t i, std::uint64_t& rays) {
   const AtlasTexels& tx = b.texels;
   const auto nf = static_cast<std::size_t>(s.gather_rays);
   const auto ne = emitters ? static_cast<std::size_t>(s.emitter_rays) : std::size_t{0};
@@ -340,7 +504,7 @@ FreshGather gather_texel(const StaticBakeScene& b, const AtlasLayout& layout, co
       const Landing l = land_ray(b, layout, t, Ray{origin, 0.0f, wi}, t.face[i]);
       double z = 0.0;
       if (l.texel < kBack) {
-        const glm::dvec3 radiosity(bilinear(reflected, t.width, t.height, l.uv));
+        const glm::dvec3 radiosity = read_landing(b, t, src, l, rng, rays);
         const glm::dvec3 share = ne == 0 ? radiosity : radiosity / (nc + emitter_count(l, glm::dot(n, wi)));
         g.irradiance += share;
         z = (ne == 0 ? 1.0 : n_all) * luminance_of(share);
@@ -375,7 +539,7 @@ FreshGather gather_texel(const StaticBakeScene& b, const AtlasLayout& layout, co
     // B cos_x / pi / (n_c p_c + n_e p_e) = B / (n_c + n_e p_e pi / cos_x).
     const double count = nc + emitter_count(l, cos_x);
     if (!(count > 0.0)) continue;
-    const glm::dvec3 share = glm::dvec3(bilinear(reflected, t.width, t.height, l.uv)) / count;
+    const glm::dvec3 share = read_landing(b, t, src, l, rng, rays) / count;  // as the cosine rays read
     g.irradiance += share;
     spread.add(n_all * luminance_of(share));
   }
@@ -389,9 +553,9 @@ FreshGather gather_texel(const StaticBakeScene& b, const AtlasLayout& layout, co
 // (in e and k.sky), weighted by ray counts. Texels not in `mine` get 0 in both.
 bool final_gather(const StaticBakeScene& b, const AtlasLayout& layout, const TexelTable& t,
                   const TexelGatherSettings& s, ThreadPool& pool, const ProgressCallback& progress,
-                  const std::vector<std::size_t>& mine, const std::vector<glm::vec3>& reflected,
-                  const TexelEmitters* emitters, const KeptRays& k, std::vector<glm::vec3>& e,
-                  std::vector<glm::vec3>& sky, std::vector<float>& variance, std::vector<std::uint64_t>& rays_of) {
+                  const std::vector<std::size_t>& mine, const GatherSource& src, const TexelEmitters* emitters,
+                  const KeptRays& k, std::vector<glm::vec3>& e, std::vector<glm::vec3>& sky,
+                  std::vector<float>& variance, std::vector<std::uint64_t>& rays_of) {
   const auto nf = static_cast<std::size_t>(s.gather_rays);
   const auto ne = emitters ? static_cast<std::size_t>(s.emitter_rays) : std::size_t{0};
   // Both estimate T(E_d + E): weighted by their rays (the sky by the cosine rays alone).
@@ -408,7 +572,7 @@ bool final_gather(const StaticBakeScene& b, const AtlasLayout& layout, const Tex
   const bool done = pool.parallel_for_with_progress(mine.size(), progress, [&](std::size_t m) {
     const std::size_t w = mine[m];
     const std::uint32_t i = t.work[w];
-    const FreshGather g = gather_texel(b, layout, t, s, reflected, emitters, i, rays_of[w]);
+    const FreshGather g = gather_texel(b, layout, t, s, src, emitters, i, rays_of[w]);
     gathered[i] = glm::vec3(w_solve * glm::dvec3(e[i]) + (1.0 - w_solve) * g.irradiance);
     sky[i] = glm::vec3(w_sky * glm::dvec3(k.sky[i]) + (1.0 - w_sky) * static_cast<double>(kPi) * g.sky);
     variance[i] = static_cast<float>(g.ray_variance / rays);
@@ -491,13 +655,23 @@ engine::Result<TexelGatherResult> gather_atlas(const StaticBakeScene& b, const A
     // as blotches a few texels wide (a bright texel lights its neighbours' rays).
     const std::vector<glm::vec3> source =
         filtering ? filter_world(tx, t.work, e, kept.hidden, radius_m, texel_m, pool) : e;
-    std::vector<glm::vec3> reflected(n, glm::vec3(0.0f));
-    for (std::uint32_t i : t.work) reflected[i] = t.albedo[i] * (emitted[i] + source[i]);
+    GatherSource src;
+    src.reflected.assign(n, glm::vec3(0.0f));
+    src.without_lights.assign(n, glm::vec3(0.0f));
+    std::vector<glm::vec3> lit(n, glm::vec3(0.0f));
+    for (std::uint32_t i : t.work) {
+      src.reflected[i] = t.albedo[i] * (emitted[i] + source[i]);
+      src.without_lights[i] = t.albedo[i] * (kept.sky[i] + source[i]);
+      lit[i] = t.albedo[i] * (out.direct[i] + out.baked_direct[i]);
+    }
     std::optional<TexelEmitters> emitters;
-    if (s.emitter_rays > 0) emitters.emplace(b, layout, t.work, t.face, reflected, layout.texels_per_metre, pool);
-    dilate<glm::vec3>(reflected, t.width, t.height, tx.valid, std::max(3, layout.padding_texels));
+    if (s.emitter_rays > 0) emitters.emplace(b, layout, t.work, t.face, src.reflected, layout.texels_per_metre, pool);
+    const int rings = std::max(3, layout.padding_texels);
+    for (auto* field : {&src.reflected, &src.without_lights, &lit})
+      dilate<glm::vec3>(*field, t.width, t.height, tx.valid, rings);
+    src.sharp = sharp_pixels(lit, t.width, t.height);
     std::vector<std::uint64_t> gather_rays_of(work, 0);
-    if (!final_gather(b, layout, t, s, pool, phase(0.5, 0.95), s.shard.items(work), reflected,
+    if (!final_gather(b, layout, t, s, pool, phase(0.5, 0.95), s.shard.items(work), src,
                       emitters ? &*emitters : nullptr, kept, e, sky, out.variance, gather_rays_of))
       return engine::cancelled_error("light-atlas gather");
     for (std::uint64_t r : gather_rays_of) out.own_rays += r;
