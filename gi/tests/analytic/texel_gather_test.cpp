@@ -365,14 +365,16 @@ TEST(TexelGather, EmitterSamplingFindsASmallSunlitPatchThatLightsTheRoom) {
   auto many = gi::bake_light_atlas(input, s);
   ASSERT_TRUE(many);
   const Score mm = score(*many, "1024 cosine + 1024 emitter rays");
-  // Measured against the converged gather: 95th percentile 0.67 -> 0.15, rms 0.31 -> 0.094,
-  // mean ratio 0.996 and 0.999 (1024 + 1024 rays: 1.0006); against the path tracer (noise
-  // removed) 0.235 -> 0.152, the converged gather's own 0.135 being the atlas's
-  // discretization of the patch's sharp edges.
+  // Measured against the converged gather: 95th percentile 0.70 -> 0.32, rms 0.34 -> 0.21,
+  // mean ratio 0.988 and 0.999 (1024 + 1024 rays: 1.0006); against the path tracer (noise
+  // removed) 0.232 -> 0.204, the converged gather's own 0.068. Until the reads across a
+  // shadow edge took the lights' direct light at the landing point (issue 35, third pass)
+  // the gains were larger (rms 0.31 -> 0.094, truth 0.235 -> 0.152) but the converged gather
+  // itself was 0.135 off: the cosine rays' blurred read of the patch's edges then cost more.
   EXPECT_LT(m.p95, 0.5 * c.p95);
-  EXPECT_LT(m.rms, 0.5 * c.rms);
-  EXPECT_LT(m.truth_error, 0.8 * c.truth_error);
-  EXPECT_NEAR(m.mean_ratio, c.mean_ratio, 0.01);
+  EXPECT_LT(m.rms, 0.7 * c.rms);
+  EXPECT_LT(m.truth_error, 0.95 * c.truth_error);
+  EXPECT_NEAR(m.mean_ratio, 1.0, 0.01);
   EXPECT_NEAR(mm.mean_ratio, 1.0, 0.01);
 }
 
