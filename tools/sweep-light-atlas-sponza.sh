@@ -29,12 +29,16 @@ run() { if [[ ${TABLE_ONLY:-0} == 0 ]]; then "$@"; fi; }
 run "$sweep" "${gather[@]}" --knob solve_rays=32 --knob rays=128 --knob filter=2.5,0 --knob direct_samples=8 \
   "${common[@]}" --out "$out/gather"
 csvs=("$out/gather/light_atlas_sponza.csv")
+# the presets preview / medium now: the guided denoiser, 2 passes, then a 1.5-texel filter
+run "$sweep" "${gather[@]}" --knob solve_rays=32 --knob rays=128 --knob filter=1.5 --knob denoise=2 \
+  --knob direct_samples=8 "${common[@]}" --out "$out/preset"
+csvs+=("$out/preset/light_atlas_sponza.csv")
 run "$sweep" --method pathtracer_atlas --knob density=8 --knob "spp=$pt_spp" "${common[@]}" --out "$out/pathtracer"
-if [[ ${DENOISE:-1} != 0 ]]; then  # the guided denoiser (docs/light_atlas.md), 4 passes, at two ray budgets
+if [[ ${DENOISE:-1} != 0 ]]; then  # the guided denoiser alone (docs/light_atlas.md), 2 passes, at two ray budgets
   run "$sweep" "${gather[@]}" --knob solve_rays=32 --knob rays=128 --knob filter=0 --knob direct_samples=8 \
-    --knob denoise=0,4 "${common[@]}" --out "$out/denoise"
+    --knob denoise=2 "${common[@]}" --out "$out/denoise"
   run "$sweep" "${gather[@]}" --knob solve_rays=64 --knob rays=256 --knob filter=0 --knob direct_samples=8 \
-    --knob denoise=0,4 "${common[@]}" --out "$out/denoise_64_256"
+    --knob denoise=0,2 "${common[@]}" --out "$out/denoise_64_256"
   csvs+=("$out/denoise/light_atlas_sponza.csv" "$out/denoise_64_256/light_atlas_sponza.csv")
 fi
 if [[ ${EMITTERS:-1} != 0 ]]; then  # the emitter-sampled gather at about the cosine rays' time
