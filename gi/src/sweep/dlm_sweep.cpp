@@ -178,7 +178,7 @@ engine::Result<MethodOutput> run_dlm(const RunContext& ctx) {
 
 void register_dlm_sweep(SweepRegistry& registry) {
   registry.add_reference_provider(
-      {.kind = "atlas_glossy_specular", .version = "pt-2", .compute = glossy_specular_reference});
+      {.kind = "atlas_glossy_specular", .version = "pt-3", .compute = glossy_specular_reference});
 
   SweepMethod m;
   m.name = method_descriptor(EffectMethod::DirectionalLightMaps).key;  // gi/methods.h

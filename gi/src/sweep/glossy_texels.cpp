@@ -86,7 +86,10 @@ engine::Result<RgbField> glossy_specular_truth(const ReferenceJob& job, LobeRadi
   if (!g) return g.error();
   const int spp = std::stoi(r.param("spp"));
   const AtlasTexels& tex = g->s.texels;
-  PathTracer pt(g->s.scene, g->s.index, *g->s.caster, {});
+  // The tracer indexes the scene's triangles by the caster's instance ids: the static
+  // world's caster numbers only its static instances (snapshot_id_caster, static_scene.h).
+  const std::unique_ptr<RayCaster> caster = snapshot_id_caster(g->s);
+  PathTracer pt(g->s.scene, g->s.index, *caster, {});
   std::vector<glm::vec3> out(tex.valid.size(), glm::vec3(0.0f)), variance(tex.valid.size(), glm::vec3(0.0f));
   ThreadPool pool(job.threads);
   const bool done = pool.parallel_for_with_progress(tex.valid.size(), job.progress, [&](std::size_t t) {

@@ -31,6 +31,41 @@ std::vector<ReferenceLight> bake_lights(const BakeInput& input, BakeLights light
   return kept;
 }
 
+namespace {
+
+class SnapshotIdCaster final : public RayCaster {
+ public:
+  explicit SnapshotIdCaster(const StaticBakeScene& s) : s_(s) {}
+  Hit intersect(const Ray& ray) const override { return mapped(s_.caster->intersect(ray)); }
+  bool occluded(const Ray& ray) const override { return s_.caster->occluded(ray); }
+  void intersect_many(std::span<const Ray> rays, std::span<Hit> hits) const override {
+    s_.caster->intersect_many(rays, hits);
+    for (Hit& h : hits) h = mapped(h);
+  }
+  void occluded_many(std::span<const Ray> rays, std::span<std::uint8_t> out) const override {
+    s_.caster->occluded_many(rays, out);
+  }
+  void occluded_coherent(std::span<const Ray> rays, std::span<std::uint8_t> out) const override {
+    s_.caster->occluded_coherent(rays, out);
+  }
+  // The casters of a StaticBakeScene are shared and const: nothing moves through this view.
+  void set_instance_transform(std::uint32_t, const glm::mat4&) override {}
+  void commit() override {}
+
+ private:
+  Hit mapped(Hit h) const {
+    if (h.valid()) h.instance = s_.static_instance[h.instance];
+    return h;
+  }
+  const StaticBakeScene& s_;
+};
+
+}  // namespace
+
+std::unique_ptr<RayCaster> snapshot_id_caster(const StaticBakeScene& s) {
+  return std::make_unique<SnapshotIdCaster>(s);
+}
+
 engine::Result<std::unique_ptr<RayCaster>> make_static_caster(const BakeInput& input) {
   const RtSceneData statics = static_instances(rt_scene_from(input), nullptr);
   if (statics.instances.empty()) return engine::Error{.message = "the scene has no static mesh"};

@@ -41,6 +41,14 @@ struct StaticBakeScene {
   }
 };
 
+/// `s.caster` with the snapshot's instance ids: every hit's `instance` becomes
+/// s.static_instance[hit.instance], so that s.index.instance_first[hit.instance] finds the
+/// triangle it landed on. PathTracer indexes its ReferenceSceneIndex by the caster's ids: built
+/// on a StaticBakeScene it needs this view (with s.caster itself, a scene whose dynamic
+/// instances come before static ones shades hits on the wrong triangles). `s` must outlive it;
+/// it moves nothing (set_instance_transform and commit do nothing).
+std::unique_ptr<RayCaster> snapshot_id_caster(const StaticBakeScene& s);
+
 /// Errors: invalid scene data (non-finite values...), no static mesh instance.
 /// `placement`: where the texels' samples lie (gi/reference.h). `static_world`: a caster the
 /// caller already built over the same static instances (make_static_caster of `input`),
