@@ -172,8 +172,13 @@ struct IndirectLightFrame {
   ///   reflection_probe_cubes   cube map array (RGBA16F), cube i = probe i, level m the
   ///                            radiance (W/(m^2 sr)) prefiltered for roughness m / (levels - 1)
   ///   reflection_probe_buffer  one ReflectionProbeBox per probe
+  ///   reflection_probe_distances  optional cube map array (R32F, one level), cube i = probe
+  ///                            i's distance (m) from its centre to the surface it captured per
+  ///                            direction: the parallax then follows the captured surfaces (a
+  ///                            distance-impostor search along the reflected ray), not the box
   /// Empty handles / 0 counts: none.
   TextureHandle reflection_probe_cubes;
+  TextureHandle reflection_probe_distances;
   SsboHandle<ReflectionProbeBox> reflection_probe_buffer;
   int reflection_probe_count = 0;
   int reflection_probe_levels = 0;

@@ -361,6 +361,8 @@ ForwardRenderer::ForwardInputs ForwardRenderer::bind_forward_inputs(const Indire
               indirect->reflection_probe_count > 0 && indirect->reflection_probe_levels > 0;
   if (in.probes) {
     glBindTextureUnit(kReflectionProbeUnit, indirect->reflection_probe_cubes.gl_name);
+    if (indirect->reflection_probe_distances)
+      glBindTextureUnit(kReflectionProbeDistanceUnit, indirect->reflection_probe_distances.gl_name);
     bind_ssbo(kReflectionProbeBinding, indirect->reflection_probe_buffer);
   }
   const SkyGradient& sky = settings_.sky_gradient;
@@ -376,6 +378,7 @@ void ForwardRenderer::set_forward_frame_uniforms(const ForwardUniforms& u, const
   glUniform1i(u.directional_elements, in.directional ? in.indirect->directional_element_count : 0);
   glUniform1i(u.probe_count, in.probes ? in.indirect->reflection_probe_count : 0);
   glUniform1i(u.probe_levels, in.probes ? in.indirect->reflection_probe_levels : 0);
+  glUniform1i(u.probe_has_distances, in.probes && in.indirect->reflection_probe_distances ? 1 : 0);
   glUniform1f(u.probe_max_roughness, in.probes ? in.indirect->reflection_probe_max_roughness : 0.0f);
   glUniformMatrix4fv(u.view_proj, 1, GL_FALSE, glm::value_ptr(in.view->view_proj));
   glUniform3fv(u.camera_position, 1, glm::value_ptr(in.view->position));

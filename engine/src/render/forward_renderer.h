@@ -65,8 +65,9 @@ constexpr GLuint kLobeCoefficientsBinding = 6;  // forward.vert.glsl: IndirectLi
 constexpr GLuint kLobeTableBinding = 7;
 constexpr GLuint kReflectionProbeBinding = 8;  // reflection_probes.glsl: IndirectLightFrame::reflection_probe_buffer
 constexpr GLuint kReflectionProbeUnit = 16;    // reflection_probes.glsl: the probes' cube map array (8: the BRDF table)
-constexpr GLuint kReachUnit = 9;               // depth_reach.frag.glsl (unit 0: the alpha test's base colour)
-constexpr float kReachVoxelM = 0.5f;           // light reach grid spacing (engine/light_reach.h)
+constexpr GLuint kReflectionProbeDistanceUnit = 17;  // reflection_probes.glsl: the probes' distance cubes
+constexpr GLuint kReachUnit = 9;                     // depth_reach.frag.glsl (unit 0: the alpha test's base colour)
+constexpr float kReachVoxelM = 0.5f;                 // light reach grid spacing (engine/light_reach.h)
 
 // Nearest, clamped, no depth comparison: the 2-D shadow maps read as depths (the blocker
 // search of a directional light with a disc, shadow_common.glsl).

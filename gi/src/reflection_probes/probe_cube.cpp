@@ -88,7 +88,8 @@ glm::vec3 read_chain(const std::vector<std::vector<glm::vec3>>& chain, int size0
 }
 
 // Level texels read bilinearly at face coordinate (u, v), edge texels clamped.
-glm::vec3 bilinear_level(const std::vector<glm::vec3>& texels, int s, const CubeCoordinate& c) {
+template <typename T>
+T bilinear_level(const std::vector<T>& texels, int s, const CubeCoordinate& c) {
   const float fx = (c.u + 1.0f) * 0.5f * static_cast<float>(s) - 0.5f;
   const float fy = (c.v + 1.0f) * 0.5f * static_cast<float>(s) - 0.5f;
   const int x0 = static_cast<int>(std::floor(fx)), y0 = static_cast<int>(std::floor(fy));
@@ -110,6 +111,52 @@ glm::vec3 cube_lookup_trilinear(const ProbeCube& cube, float lod, const glm::vec
   if (hi == lo) return a;
   const glm::vec3 b = bilinear_level(cube.levels[static_cast<std::size_t>(hi)], cube_level_size(cube.size, hi), c);
   return glm::mix(a, b, l - static_cast<float>(lo));
+}
+
+float cube_distance_bilinear(const ProbeCube& cube, const glm::vec3& d) {
+  if (cube.distance.empty()) return kProbeFarDistance;
+  return bilinear_level(cube.distance, cube.size, cube_coordinate(d));
+}
+
+glm::vec3 distance_corrected_direction(const ProbeCube& cube, const glm::vec3& p, const glm::vec3& r,
+                                       const glm::vec3& centre, const glm::vec3& box_min, const glm::vec3& box_max) {
+  const glm::vec3 boxed = box_projected_direction(p, r, centre, box_min, box_max);
+  if (cube.distance.empty()) return boxed;
+  const glm::vec3 x = p - centre;
+  const float scale = std::max(glm::length(x), kProbeMinSearchScaleM);
+  // g(t) = |x + t r| - distance(x + t r): negative in front of the surface the probe saw
+  // along that direction, positive behind it. The ray's points t = scale a / (1 - a), a in
+  // (0, 1), cover it to infinity with steps that grow with the distance.
+  const auto g = [&](float t) {
+    const glm::vec3 q = x + t * r;
+    return glm::length(q) - cube_distance_bilinear(cube, q);
+  };
+  float t_lo = 0.0f, g_lo = 0.0f;
+  bool in_front = false;
+  for (int k = 1; k <= kProbeSearchSteps; ++k) {
+    const float a = static_cast<float>(k) / static_cast<float>(kProbeSearchSteps + 1);
+    const float t = scale * a / (1.0f - a), gt = g(t);
+    if (gt < 0.0f) {
+      t_lo = t, g_lo = gt, in_front = true;
+      continue;
+    }
+    if (!in_front) continue;
+    // The ray passed behind the captured surface between t_lo and t: secant steps.
+    float t_hi = t, g_hi = gt;
+    for (int i = 0; i < kProbeSecantSteps; ++i) {
+      const float tm = t_lo + (t_hi - t_lo) * g_lo / (g_lo - g_hi), gm = g(tm);
+      if (gm < 0.0f)
+        t_lo = tm, g_lo = gm;
+      else
+        t_hi = tm, g_hi = gm;
+    }
+    const float tm = t_lo + (t_hi - t_lo) * g_lo / (g_lo - g_hi);
+    const glm::vec3 q = x + tm * r;
+    return glm::dot(q, q) > 1e-12f ? q : r;
+  }
+  // Never in front of the captured surface (the point is hidden from the probe's centre):
+  // the box's answer; never behind one: the ray leaves the scene, its direction at infinity.
+  return in_front ? r : boxed;
 }
 
 int full_mip_count(int size) { return size < 1 ? 0 : std::bit_width(static_cast<unsigned>(size)); }

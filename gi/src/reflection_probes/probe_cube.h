@@ -23,7 +23,18 @@ class ThreadPool;
 struct ProbeCube {
   int size = 0;                                ///< Face size of level 0, texels.
   std::vector<std::vector<glm::vec3>> levels;  ///< Per level: 6 faces x s x s, face-major, row-major.
+  /// Level 0's texels' distance (m) from the probe's centre to the surface its rays met
+  /// (their mean; kProbeFarDistance where all left the scene). Empty: box projection only.
+  std::vector<float> distance;
 };
+
+/// The distance stored where a capture's rays met nothing (the sky).
+inline constexpr float kProbeFarDistance = 1e4f;
+/// The distance-corrected lookup's search (distance_corrected_direction): linear steps along
+/// the ray, then secant steps; its distance scale's floor (m).
+inline constexpr int kProbeSearchSteps = 12;
+inline constexpr int kProbeSecantSteps = 3;
+inline constexpr float kProbeMinSearchScaleM = 0.05f;
 
 /// An empty (black) cube: `levels` levels from `size` (a power of two; levels <= log2(size) + 1).
 ProbeCube make_probe_cube(int size, int levels);
@@ -69,6 +80,22 @@ glm::vec3 cube_lookup_trilinear(const ProbeCube& cube, float lod, const glm::vec
 /// outside is clamped onto it. The same formula as probe_direction() in the forward shader.
 glm::vec3 box_projected_direction(const glm::vec3& p, const glm::vec3& r, const glm::vec3& centre,
                                   const glm::vec3& box_min, const glm::vec3& box_max);
+
+/// The distance cube read bilinearly in direction d (edge texels clamped, as
+/// cube_lookup_trilinear); kProbeFarDistance when the cube holds no distances.
+float cube_distance_bilinear(const ProbeCube& cube, const glm::vec3& d);
+
+/// Parallax from the capture's own distances (a localized cube map searched as a distance
+/// impostor: Szirmay-Kalos, Aszodi, Lazanyi and Premecz 2005, "Approximate ray-tracing on the
+/// GPU with distance impostors"): the direction from the probe's centre to where the ray from
+/// `p` along `r` meets the surface the probe saw, found by kProbeSearchSteps steps along the
+/// ray for the first point behind that surface and kProbeSecantSteps secant steps. Light beyond
+/// an opening of the box and objects inside it get their own depth, where a box puts both on
+/// its sides. Falls back to box_projected_direction when `p` itself is hidden from the centre
+/// or the cube has no distances, and to `r` when the ray leaves the scene. The same search as
+/// probe_direction() in the forward shader.
+glm::vec3 distance_corrected_direction(const ProbeCube& cube, const glm::vec3& p, const glm::vec3& r,
+                                       const glm::vec3& centre, const glm::vec3& box_min, const glm::vec3& box_max);
 
 /// Fills levels 1.. of `cube` from level 0 with the split-sum's prefiltered radiance (Karis
 /// 2013, "Real shading in Unreal Engine 4"): level m is the GGX lobe of alpha = r^2, r = m /

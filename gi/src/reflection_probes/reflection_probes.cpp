@@ -65,11 +65,14 @@ glm::vec3 live_direct(const CaptureScene& c, const glm::vec3& p, const glm::vec3
   return sum;
 }
 
-// Radiance arriving at `origin` along unit `d`: what the renderer draws where the ray lands.
-glm::vec3 capture_radiance(const CaptureScene& c, const glm::vec3& origin, const glm::vec3& d, std::uint32_t& rays) {
+// Radiance arriving at `origin` along unit `d`: what the renderer draws where the ray lands;
+// `distance` the distance to that surface (unchanged when the ray leaves the scene).
+glm::vec3 capture_radiance(const CaptureScene& c, const glm::vec3& origin, const glm::vec3& d, std::uint32_t& rays,
+                           float& distance) {
   ++rays;
   const Hit h = c.s.caster->intersect(Ray{origin, 0.0f, d});
   if (!h.valid()) return engine::sky_radiance(c.sky_uniform, c.sky_gradient, d);
+  distance = h.t;
   const ShadingTriangle& tri = c.s.index.triangles[c.s.triangle_of(h)];
   const bool front = glm::dot(d, tri.face_normal) < 0.0f;
   if (!front && !c.s.scene.materials[tri.material].double_sided) return glm::vec3(0.0f);
@@ -88,17 +91,21 @@ glm::vec3 capture_radiance(const CaptureScene& c, const glm::vec3& origin, const
   return l;
 }
 
-// Level 0 of one probe: the mean of supersample^2 stratified rays per texel.
+// Level 0 of one probe: the mean of supersample^2 stratified rays per texel; its distances:
+// the mean distance of the rays that met a surface (kProbeFarDistance when none did).
 void capture(const CaptureScene& c, const ProbeVolume& probe, int supersample, ProbeCube& cube, ThreadPool& pool,
              std::vector<std::uint32_t>& rays) {
   const int s = cube.size;
   std::vector<glm::vec3>& out = cube.levels[0];
   rays.assign(out.size(), 0);
+  cube.distance.assign(out.size(), kProbeFarDistance);
   pool.parallel_for(
       out.size(),
       [&](std::size_t i) {
         const int face = static_cast<int>(i) / (s * s), y = static_cast<int>(i) / s % s, x = static_cast<int>(i) % s;
         glm::vec3 sum(0.0f);
+        float distance_sum = 0.0f;
+        int hits = 0;
         for (int j = 0; j < supersample; ++j)
           for (int k = 0; k < supersample; ++k) {
             const float u = (static_cast<float>(x) + (static_cast<float>(k) + 0.5f) / static_cast<float>(supersample)) /
@@ -107,9 +114,12 @@ void capture(const CaptureScene& c, const ProbeVolume& probe, int supersample, P
             const float v = (static_cast<float>(y) + (static_cast<float>(j) + 0.5f) / static_cast<float>(supersample)) /
                                 static_cast<float>(s) * 2.0f -
                             1.0f;
-            sum += capture_radiance(c, probe.centre, cube_direction(face, u, v), rays[i]);
+            float distance = -1.0f;
+            sum += capture_radiance(c, probe.centre, cube_direction(face, u, v), rays[i], distance);
+            if (distance >= 0.0f) distance_sum += distance, ++hits;
           }
         out[i] = sum / static_cast<float>(supersample * supersample);
+        if (hits > 0) cube.distance[i] = distance_sum / static_cast<float>(hits);
       },
       16);
 }

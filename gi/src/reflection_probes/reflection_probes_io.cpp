@@ -47,6 +47,11 @@ std::string check_set(const ReflectionProbeSet& set) {
           return "probe " + std::to_string(i) + " level " + std::to_string(m) +
                  " has a negative, infinite or NaN radiance";
     }
+    if (c.distance.size() != c.levels[0].size())
+      return "probe " + std::to_string(i) + " has " + std::to_string(c.distance.size()) + " distances for " +
+             std::to_string(c.levels[0].size()) + " level-0 texels";
+    for (float d : c.distance)
+      if (!(d >= 0.0f && d <= kProbeFarDistance)) return "probe " + std::to_string(i) + " has a distance out of range";
   }
   return {};
 }
@@ -125,8 +130,10 @@ engine::Status write_reflection_probes_file(const fs::path& path, const Reflecti
     w.put(v.box_min);
     w.put(v.box_max);
   }
-  for (const ProbeCube& c : set.cubes)
+  for (const ProbeCube& c : set.cubes) {
     for (const std::vector<glm::vec3>& level : c.levels) w.put_array(level);
+    w.put_array(c.distance);
+  }
   return write_blob(path, kReflectionProbesMagic, kReflectionProbesVersion, w.bytes());
 }
 
@@ -150,6 +157,7 @@ engine::Result<ReflectionProbesFile> read_reflection_probes_file(const fs::path&
     c.size = set.settings.resolution;
     c.levels.resize(static_cast<std::size_t>(levels));
     for (std::vector<glm::vec3>& level : c.levels) complete = complete && r.get_array(level);
+    complete = complete && r.get_array(c.distance);
   }
   const std::string location = "payload byte " + std::to_string(r.offset());
   if (!complete) return file_error(path, location, "truncated payload");

@@ -4,9 +4,11 @@
 //   auto probes = gi::load_reflection_probes("level.gibake", input);   // stale / truncated: an error naming the file
 //
 // Files (DESIGN.md §5):
-//   reflection_probes.bin  blob "GIRPROBE" v1 (io/blob_file.h): the geometry hash, the
+//   reflection_probes.bin  blob "GIRPROBE" v2 (io/blob_file.h): the geometry hash, the
 //                          settings, per probe its centre and box (9 float32), then per probe
-//                          per level 6 x s x s RGB float32 (probe_cube.h's order).
+//                          per level 6 x s x s RGB float32 (probe_cube.h's order) and its
+//                          level 0's 6 x s x s distances (float32, ProbeCube::distance).
+//                          Version 1 (no distances) is refused: re-bake.
 //   manifest.json          methods.reflection_probes = {
 //     "files": { "probes": {"file": "reflection_probes.bin", "xxh3_64": "<hex>"} },
 //     "lights_hash", "settings", "probes", "resolution", "levels", "stats", "memory" }
@@ -24,7 +26,7 @@ namespace gi {
 
 inline constexpr const char* kReflectionProbesFile = "reflection_probes.bin";
 inline constexpr BlobMagic kReflectionProbesMagic{"GIRPROBE"};
-inline constexpr std::uint32_t kReflectionProbesVersion = 1;
+inline constexpr std::uint32_t kReflectionProbesVersion = 2;
 
 /// The file's content: the probes and the geometry hash they were baked for.
 struct ReflectionProbesFile {

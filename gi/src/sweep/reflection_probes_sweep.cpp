@@ -41,6 +41,11 @@ std::vector<KnobSpec> reflection_probes_knobs() {
        .default_grid = {"128"},
        .min_value = 1,
        .max_value = 65536},
+      {.name = "parallax",
+       .description = "parallax correction: the captured distances (distance-impostor search) or the box alone",
+       .kind = KnobKind::Choice,
+       .default_grid = {"distance"},
+       .choices = {"distance", "box"}},
       {.name = "atlas",
        .description = "light-atlas preset whose irradiance the captures read on the static surfaces",
        .kind = KnobKind::Choice,
@@ -94,11 +99,12 @@ float depth_in_box(const ProbeVolume& v, const glm::vec3& p, const glm::vec3& n)
 }
 
 // What the forward shader adds at the texel (reflection_probes.glsl, probe_specular): the
-// probes whose box (grown by the margin) holds p, each read along the box-projected
-// reflection direction at lod roughness x (levels - 1), averaged, times the specular albedo.
+// probes whose box (grown by the margin) holds p, each read along the reflection direction
+// corrected for parallax (by the captured distances, or the box alone when `box_only`) at lod
+// roughness x (levels - 1), averaged, times the specular albedo.
 // `depth`: the largest depth_in_box over those probes. False where no box holds p.
 bool probe_specular(const ReflectionProbeSet& set, const engine::GltfBrdf& brdf, const glm::vec3& p, const glm::vec3& n,
-                    const glm::vec3& v, glm::vec3& out, float& depth) {
+                    const glm::vec3& v, bool box_only, glm::vec3& out, float& depth) {
   const glm::vec3 r = glm::reflect(-v, n);
   glm::vec3 sum(0.0f);
   int count = 0;
@@ -109,7 +115,9 @@ bool probe_specular(const ReflectionProbeSet& set, const engine::GltfBrdf& brdf,
       continue;
     const ProbeCube& cube = set.cubes[i];
     const float lod = std::sqrt(brdf.alpha) * static_cast<float>(cube.levels.size() - 1);
-    sum += cube_lookup_trilinear(cube, lod, box_projected_direction(p, r, pv.centre, pv.box_min, pv.box_max));
+    const glm::vec3 d = box_only ? box_projected_direction(p, r, pv.centre, pv.box_min, pv.box_max)
+                                 : distance_corrected_direction(cube, p, r, pv.centre, pv.box_min, pv.box_max);
+    sum += cube_lookup_trilinear(cube, lod, d);
     depth = std::max(depth, depth_in_box(pv, p, n));
     ++count;
   }
@@ -183,11 +191,12 @@ engine::Result<MethodOutput> run_reflection_probes(const RunContext& ctx) {
   std::vector<glm::vec3> values(tex.valid.size(), glm::vec3(0.0f));
   std::vector<std::uint8_t> covered(tex.valid.size(), 0), inner(tex.valid.size(), 0), edge(tex.valid.size(), 0);
   std::size_t uncovered = 0;
+  const bool box_only = ctx.knobs.text("parallax") == "box";
   for (std::size_t t = 0; t < tex.valid.size(); ++t) {
     if (!g->glossy[t]) continue;
     float depth = 0.0f;
     const glm::vec3 v = glm::normalize(g->eye - tex.position[t]);
-    if (!probe_specular(*set, g->brdf[t], tex.position[t], tex.normal[t], v, values[t], depth)) {
+    if (!probe_specular(*set, g->brdf[t], tex.position[t], tex.normal[t], v, box_only, values[t], depth)) {
       ++uncovered;
       continue;
     }
@@ -197,9 +206,11 @@ engine::Result<MethodOutput> run_reflection_probes(const RunContext& ctx) {
   MethodOutput out;
   out.field = RgbField::from_texels(tex.width, tex.height, values, covered);
   out.costs.bake_seconds = set->stats.total_seconds;
-  // What the runtime uploads: RGBA16F cube maps with every level.
-  for (const ProbeCube& c : set->cubes)
+  // What the runtime uploads: RGBA16F cube maps with every level, and R32F distances.
+  for (const ProbeCube& c : set->cubes) {
     for (const std::vector<glm::vec3>& level : c.levels) out.costs.bytes += level.size() * 8u;
+    if (!box_only) out.costs.bytes += c.distance.size() * 4u;
+  }
   const auto count = [](const std::vector<std::uint8_t>& m) {
     return static_cast<double>(std::count(m.begin(), m.end(), std::uint8_t{1}));
   };
@@ -220,7 +231,7 @@ engine::Result<MethodOutput> run_reflection_probes(const RunContext& ctx) {
 
 void register_reflection_probes_sweep(SweepRegistry& registry) {
   registry.add_reference_provider(
-      {.kind = "probe_glossy_specular", .version = "pt-1", .compute = [](const ReferenceJob& job) {
+      {.kind = "probe_glossy_specular", .version = "pt-2", .compute = [](const ReferenceJob& job) {
          return glossy_specular_truth(job, LobeRadiance::Full);
        }});
   SweepMethod m;

@@ -22,6 +22,7 @@ class ReflectionProbesMethod final : public MethodRuntime {
     engine::IndirectLightFrame& f = state.frame;
     f.reflection_probe_cubes = engine::TextureHandle{cubes_.id()};
     f.reflection_probe_buffer = engine::SsboHandle<engine::ReflectionProbeBox>{boxes_.id()};
+    f.reflection_probe_distances = engine::TextureHandle{distances_.id()};
     f.reflection_probe_count = static_cast<int>(set_.probes.size());
     f.reflection_probe_levels = levels_;
     f.reflection_probe_max_roughness = set_.settings.max_roughness;
@@ -44,6 +45,13 @@ class ReflectionProbesMethod final : public MethodRuntime {
       }
     glTextureParameteri(cubes_.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
     glTextureParameteri(cubes_.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    // Each probe's distances (level 0's size, one level), read bilinearly by the parallax search.
+    distances_ = engine::GlTexture::create_cube_array(GL_R32F, size, count, 1);
+    for (int i = 0; i < count; ++i)
+      glTextureSubImage3D(distances_.id(), 0, 0, 0, 6 * i, size, size, 6, GL_RED, GL_FLOAT,
+                          set_.cubes[static_cast<std::size_t>(i)].distance.data());
+    glTextureParameteri(distances_.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTextureParameteri(distances_.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
     std::vector<engine::ReflectionProbeBox> boxes;
     for (const ProbeVolume& v : set_.probes)
       boxes.push_back({glm::vec4(v.centre, 0.0f), glm::vec4(v.box_min, 0.0f), glm::vec4(v.box_max, 0.0f)});
@@ -54,7 +62,7 @@ class ReflectionProbesMethod final : public MethodRuntime {
 
   ReflectionProbeSet set_;
   int levels_ = 0;
-  engine::GlTexture cubes_;
+  engine::GlTexture cubes_, distances_;
   engine::GlBuffer boxes_;
 };
 
@@ -64,11 +72,13 @@ engine::Result<std::unique_ptr<MethodRuntime>> load_reflection_probes_method(Met
   auto set = load_reflection_probes(load.bundle_dir, load.input);
   if (!set) return set.error();
   std::uint64_t bytes = 0;
-  for (const ProbeCube& c : set->cubes)
+  for (const ProbeCube& c : set->cubes) {
+    bytes += c.distance.size() * 4;
     for (const auto& level : c.levels) bytes += level.size() * 8;
+  }
   load.text << "reflection probes: " << set->probes.size() << " probes of " << set->settings.resolution << "^2 x 6 ("
             << static_cast<double>(bytes) / 1e6 << " MB on the GPU); roughness < " << set->settings.max_roughness
-            << " and dynamic objects, box-projected, per pixel\n";
+            << " and dynamic objects, parallax from the captured distances, per pixel\n";
   if (set->probes.empty()) return std::unique_ptr<MethodRuntime>();
   return std::unique_ptr<MethodRuntime>(new ReflectionProbesMethod(std::move(set).value()));
 }

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -130,4 +131,70 @@ TEST(ProbeCube, TrilinearLookupReadsTexelCentresAndBlendsBetweenThem) {
   EXPECT_FLOAT_EQ(gi::cube_lookup_trilinear(cube, 0.25f, centre).x, 0.75f * level0 + 0.25f * 100.0f);
   // Past the last level the last level is read.
   EXPECT_FLOAT_EQ(gi::cube_lookup_trilinear(cube, 7.0f, centre).x, 0.0f);
+}
+
+namespace {
+
+// A hall [-2, 5] x [0, 3] x [-2, 2] m seen from a probe at (0, 1.5, 0) whose box is only its
+// first part, x <= 2: the distance from o along unit d to the hall's walls.
+const glm::vec3 kHallMin(-2.0f, 0.0f, -2.0f), kHallMax(5.0f, 3.0f, 2.0f), kBoxMax(2.0f, 3.0f, 2.0f);
+const glm::vec3 kHallProbe(0.0f, 1.5f, 0.0f);
+float hall_distance(const glm::vec3& o, const glm::vec3& d) {
+  float t = 1e30f;
+  for (int a = 0; a < 3; ++a)
+    if (d[a] != 0.0f) t = std::min(t, ((d[a] > 0.0f ? kHallMax[a] : kHallMin[a]) - o[a]) / d[a]);
+  return t;
+}
+
+gi::ProbeCube hall_cube(int size) {
+  gi::ProbeCube cube = gi::make_probe_cube(size, 1);
+  cube.distance.resize(cube.levels[0].size());
+  for (int f = 0; f < 6; ++f)
+    for (int y = 0; y < size; ++y)
+      for (int x = 0; x < size; ++x)
+        cube.distance[gi::cube_texel_index(f, x, y, size)] =
+            hall_distance(kHallProbe, gi::cube_texel_direction(f, x, y, size));
+  return cube;
+}
+
+float degrees_between(const glm::vec3& a, const glm::vec3& b) {
+  return std::acos(std::clamp(glm::dot(glm::normalize(a), glm::normalize(b)), -1.0f, 1.0f)) * 180.0f /
+         std::numbers::pi_v<float>;
+}
+
+}  // namespace
+
+// Floor points seen from an eye in the hall: the search along the reflected ray finds the
+// direction, from the probe, of where that ray meets the hall (its far wall beyond the box,
+// its ceiling, its side walls) within a degree, where the box alone is off by up to tens of
+// degrees beyond the box's open side.
+TEST(ProbeCube, TheDistanceSearchFindsWhereTheReflectedRayMeetsTheCapturedHall) {
+  const gi::ProbeCube cube = hall_cube(64);
+  const glm::vec3 eye(-1.5f, 1.5f, 0.0f);
+  float worst = 0.0f, worst_box = 0.0f;
+  for (float x : {-1.5f, -1.0f, -0.2f, 0.5f, 0.8f, 1.0f, 1.5f, 1.9f})
+    for (float z : {0.0f, 0.7f, -1.5f}) {
+      const glm::vec3 p(x, 0.0f, z);
+      const glm::vec3 r = glm::reflect(glm::normalize(p - eye), glm::vec3(0.0f, 1.0f, 0.0f));
+      const glm::vec3 truth = p + hall_distance(p, r) * r - kHallProbe;
+      const glm::vec3 got = gi::distance_corrected_direction(cube, p, r, kHallProbe, kHallMin, kBoxMax);
+      worst = std::max(worst, degrees_between(got, truth));
+      worst_box =
+          std::max(worst_box, degrees_between(gi::box_projected_direction(p, r, kHallProbe, kHallMin, kBoxMax), truth));
+      EXPECT_LT(degrees_between(got, truth), 1.0f) << "floor point " << x << ", " << z;
+    }
+  EXPECT_GT(worst_box, 10.0f);  // what the search is for
+  EXPECT_LT(worst, 1.0f);
+}
+
+// A point the probe does not see (behind the surface it captured in that direction) gets the
+// box's answer; a cube without distances too.
+TEST(ProbeCube, APointHiddenFromTheProbeFallsBackToTheBox) {
+  gi::ProbeCube cube = gi::make_probe_cube(16, 1);
+  cube.distance.assign(cube.levels[0].size(), 0.5f);  // a 0.5 m sphere around the probe
+  const glm::vec3 p(1.0f, 0.2f, 0.3f), r = glm::normalize(glm::vec3(0.3f, 1.0f, -0.2f));
+  const glm::vec3 boxed = gi::box_projected_direction(p, r, kHallProbe, kHallMin, kBoxMax);
+  EXPECT_LT(degrees_between(gi::distance_corrected_direction(cube, p, r, kHallProbe, kHallMin, kBoxMax), boxed), 1e-3f);
+  cube.distance.clear();
+  EXPECT_LT(degrees_between(gi::distance_corrected_direction(cube, p, r, kHallProbe, kHallMin, kBoxMax), boxed), 1e-3f);
 }

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 
@@ -55,6 +56,7 @@ gi::ReflectionProbeSet small_set() {
         v += 0.01f;
         t = glm::vec3(v, 2.0f * v, 0.5f);
       }
+    for (std::size_t t = 0; t < c.levels[0].size(); ++t) c.distance.push_back(0.5f + 0.01f * static_cast<float>(t));
     set.cubes.push_back(std::move(c));
   }
   return set;
@@ -72,6 +74,7 @@ TEST(ReflectionProbesIo, RoundTripIsExact) {
     EXPECT_EQ(back->probes[i].centre, set.probes[i].centre);
     EXPECT_EQ(back->probes[i].box_max, set.probes[i].box_max);
     EXPECT_EQ(back->cubes[i].levels, set.cubes[i].levels);
+    EXPECT_EQ(back->cubes[i].distance, set.cubes[i].distance);
   }
   EXPECT_EQ(back->settings.resolution, 4);
 }
@@ -107,6 +110,33 @@ TEST(ReflectionProbesIo, StaleBundleIsRefused) {
   auto r = gi::load_reflection_probes(dir, in);
   ASSERT_FALSE(r);
   EXPECT_NE(r.error().to_string().find("manifest.json"), std::string::npos) << r.error().to_string();
+}
+
+// Version 1 files (before the captured distances) are refused, naming the file and asking for a re-bake.
+TEST(ReflectionProbesIo, AVersionOneFileIsRefusedNamingIt) {
+  const fs::path dir = scratch_dir("version_one");
+  fs::create_directories(dir);
+  const fs::path file = dir / gi::kReflectionProbesFile;
+  ASSERT_TRUE(gi::write_blob(file, gi::kReflectionProbesMagic, 1, std::vector<std::byte>(64)));
+  auto r = gi::read_reflection_probes_file(file);
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().file, file.string());
+  EXPECT_NE(r.error().to_string().find("unsupported version 1"), std::string::npos) << r.error().to_string();
+}
+
+// A distance out of range (negative, NaN) or a cube without its distances is not written.
+TEST(ReflectionProbesIo, MissingOrInvalidDistancesAreNotWritten) {
+  const fs::path dir = scratch_dir("distances");
+  fs::create_directories(dir);
+  gi::ReflectionProbeSet set = small_set();
+  set.cubes[1].distance[3] = std::nanf("");
+  auto st = gi::write_reflection_probes_file(dir / gi::kReflectionProbesFile, set, "hash");
+  ASSERT_FALSE(st);
+  EXPECT_NE(st.error().message.find("distance out of range"), std::string::npos) << st.error().message;
+  set.cubes[1].distance.clear();
+  st = gi::write_reflection_probes_file(dir / gi::kReflectionProbesFile, set, "hash");
+  ASSERT_FALSE(st);
+  EXPECT_NE(st.error().message.find("0 distances for"), std::string::npos) << st.error().message;
 }
 
 TEST(ReflectionProbesIo, InconsistentSetIsNotWritten) {
