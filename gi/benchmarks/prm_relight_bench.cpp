@@ -4,7 +4,10 @@
 // emitters, entry irradiance (shadow rays against the static world, flux check), cluster
 // weights, the K = 32 heaviest clusters, and the GPU pane sum with glFinish.
 // The yardstick, measured in the same run: re-baking the light atlas (preview) for the
-// change, which is what a light without the PRM would cost.
+// change, which is what a light without the PRM would cost. Argument `coarse`: 1 panes at
+// half the atlas's density, upsampled (the medium preset's ratio, issue 38), 0 the preview
+// preset's panes at the atlas's density, both in the same run; counters gpu_mb
+// (PrmGpuPass::gpu_bytes) and upsampler_build_ms (what a load adds to read coarse panes).
 //   ./build/gi/benchmarks/prm_relight_bench --benchmark_counters_tabular=true
 // Counters (medians over the iterations): cpu_ms (emitters, entry irradiance, weights,
 // selection), gpu_ms (pane sum + glFinish; CPU time on llvmpipe), atlas_rebake_ms (one bake
@@ -68,7 +71,9 @@ T or_exit(engine::Result<T> r) {
 
 struct DemoLevel {
   gi::BakeInput input;
-  gi::Prm prm;
+  gi::Prm prm;        // the preview preset with panes at half the atlas's density, upsampled (medium's ratio)
+  gi::Prm dense_prm;  // the preview preset: panes at the atlas's density (pane_texels_per_metre = 0)
+  double upsampler_build_ms = 0.0;  // prm_atlas_read (atlas rasterized, taps built): what a load adds
   std::unique_ptr<gi::RayCaster> caster;
   engine::Light lamp;
   glm::mat4 lamp_world{1.0f};
@@ -93,7 +98,18 @@ const DemoLevel& demo_level() {
       std::exit(1);
     }
     out.input = gi::bake_input_from(scene);
-    out.prm = or_exit(gi::bake_prm(out.input, or_exit(gi::prm_preset("preview"))));
+    const gi::PrmSettings preview = or_exit(gi::prm_preset("preview"));
+    gi::PrmSettings coarse = preview;
+    coarse.pane_texels_per_metre = 0.5f * preview.texels_per_metre;
+    out.prm = or_exit(gi::bake_prm(out.input, coarse));
+    gi::PrmSettings dense = preview;
+    dense.pane_texels_per_metre = 0.0f;
+    out.dense_prm = or_exit(gi::bake_prm(out.input, dense));
+    if (out.prm.atlas) {
+      const auto b0 = Clock::now();
+      benchmark::DoNotOptimize(or_exit(gi::prm_atlas_read(out.prm, out.prm.atlas->layout, out.input)));
+      out.upsampler_build_ms = std::chrono::duration<double, std::milli>(Clock::now() - b0).count();
+    }
     out.caster = or_exit(gi::make_static_caster(out.input));
     return out;
   }();
@@ -157,12 +173,21 @@ gi::Prm with_panes(const gi::Prm& prm, gi::PrmPaneEncoding encoding) {
 }
 
 // Arguments: the pane encoding (0 half floats, 1 RGB9E5), the threads tracing the flux check
-// (1: the calling thread, PrmLighting's default) and base (1: the re-baked light atlas set as
-// the pass's base, the demo's case). Extra counters: the K-sum atlas's
-// error under this encoding against half floats (err_vs_half_*) and against the float panes
+// (1: the calling thread, PrmLighting's default), base (1: the re-baked light atlas set as
+// the pass's base, the demo's case) and coarse (1: the preset's panes at half the atlas's
+// density, upsampled; 0: dense panes at the atlas's density, as before issue 38's coarse panes). Extra counters: the
+// K-sum atlas's error under this encoding against half floats (err_vs_half_*) and against the float panes
 // (err_vs_float_*), per texel (max, p95), rel RMSE and total, over the 8 poses.
 void BM_PrmLightChange(benchmark::State& state) {
-  const DemoLevel& d = demo_level();
+  const DemoLevel& level = demo_level();
+  const bool coarse = state.range(3) != 0;
+  struct {
+    const gi::BakeInput& input;
+    const gi::Prm& prm;
+    const std::unique_ptr<gi::RayCaster>& caster;
+    const engine::Light& lamp;
+    const glm::mat4& lamp_world;
+  } d{level.input, coarse ? level.prm : level.dense_prm, level.caster, level.lamp, level.lamp_world};
   (void)bench::gl_context();
   const auto encoding = static_cast<gi::PrmPaneEncoding>(state.range(0));
   std::unique_ptr<gi::ThreadPool> pool;
@@ -238,6 +263,8 @@ void BM_PrmLightChange(benchmark::State& state) {
         static_cast<double>(std::max<std::size_t>(1, d.prm.panes.tiles.tiles() * d.prm.panes.cluster_count()));
   }
   state.counters["pane_mb"] = static_cast<double>(pass.pane_bytes()) / 1e6;
+  state.counters["gpu_mb"] = static_cast<double>(pass.gpu_bytes()) / 1e6;
+  state.counters["upsampler_build_ms"] = coarse ? level.upsampler_build_ms : 0.0;
   {
     const gi::Prm mine = with_panes(d.prm, encoding);
     const gi::Prm half = with_panes(d.prm, gi::PrmPaneEncoding::Half);
@@ -262,7 +289,7 @@ void BM_PrmLightChange(benchmark::State& state) {
   state.counters["vs_rebake"] = rebake_ms / (cpu_ms + gpu_ms);
   state.counters["clusters"] = static_cast<double>(clusters);
   state.counters["texels"] = static_cast<double>(d.prm.texels.size());
-  state.counters["atlas_texels"] = static_cast<double>(d.prm.width) * static_cast<double>(d.prm.height);
+  state.counters["atlas_texels"] = static_cast<double>(d.prm.atlas_width()) * static_cast<double>(d.prm.atlas_height());
   state.counters["entries"] = static_cast<double>(d.prm.entries.size());
   {
     const std::size_t n = d.prm.texels.size();
@@ -314,11 +341,13 @@ void BM_PrmLightChange(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_PrmLightChange)
-    ->ArgNames({"rgb9e5", "threads", "base"})
-    ->Args({0, 1, 0})
-    ->Args({1, 1, 0})
-    ->Args({1, 2, 0})
-    ->Args({1, 1, 1})
+    ->ArgNames({"rgb9e5", "threads", "base", "coarse"})
+    ->Args({0, 1, 0, 1})
+    ->Args({1, 1, 0, 1})
+    ->Args({1, 2, 0, 1})
+    ->Args({1, 1, 1, 1})
+    ->Args({1, 1, 0, 0})
+    ->Args({1, 1, 1, 0})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->MinTime(2.0);

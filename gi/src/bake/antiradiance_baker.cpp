@@ -29,10 +29,12 @@ std::optional<AtlasLayout> runtime_atlas_layout(const fs::path& dir, const BakeI
   for (const char* method : {kLightAtlasMethod, kPrmMethod}) {
     auto bundle = BundleReader::open(dir, method, input, "re-bake");
     if (!bundle) continue;
+    // A PRM with coarse panes writes the atlas it is read at (files.atlas_layout), not its panes' layout.
+    const std::string key = bundle->entry().contains(kPrmAtlasLayoutKey) ? kPrmAtlasLayoutKey : "layout";
     JsonFields f = bundle->fields();
-    const BakedAtlasLayout baked = read_baked_atlas_layout(f);
+    const BakedAtlasLayout baked = read_baked_atlas_layout(f, key);
     if (f.error()) continue;
-    auto layout = bundle->atlas_layout(input, baked, "atlas layout");
+    auto layout = bundle->atlas_layout(input, baked, "atlas layout", key);
     if (layout) return std::move(layout).value();
   }
   return std::nullopt;

@@ -23,7 +23,7 @@ engine::Result<LightAtlasSettings> atlas_settings(const BakeOptions& o, const Ba
 engine::Result<PrmSettings> prm_settings(const BakeOptions& o, const BakeStage& stage) {
   auto settings = prm_preset(o.preset);
   if (!settings) return settings.error();
-  if (o.texels_per_metre > 0.0f) settings->texels_per_metre = o.texels_per_metre;
+  if (o.texels_per_metre > 0.0f) set_prm_atlas_density(*settings, o.texels_per_metre);
   settings->threads = o.threads;
   settings->seed = o.seed;
   settings->progress = stage.progress();

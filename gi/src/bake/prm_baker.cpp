@@ -18,9 +18,10 @@ engine::Status bake_prm_method(const MethodBake& job) {
   const MergedParts* merged = job.merged;
   auto settings = prm_settings(o, stage);
   if (!settings) return settings.error();
-  stage.log(format_line("PRM of %s, preset %s: %d entry points, %d clusters, splitting %g, %g texels/m",
+  stage.log(format_line("PRM of %s, preset %s: %d entry points, %d clusters, splitting %g, %g texels/m (panes at %g)",
                         scene_file_name(input).c_str(), o.preset.c_str(), settings->entry_points, settings->clusters,
-                        double{settings->splitting}, double{settings->texels_per_metre}));
+                        double{settings->splitting}, double{settings->texels_per_metre},
+                        double{pane_density(*settings)}));
   auto prm = merged ? merge_prm(input, *settings, merged->prm) : bake_prm(input, *settings);
   if (!prm) return prm.error();
   const PrmStats& st = prm->stats;

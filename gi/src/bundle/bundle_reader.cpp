@@ -10,13 +10,13 @@ namespace gi {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-BakedAtlasLayout read_baked_atlas_layout(JsonFields& f) {
+BakedAtlasLayout read_baked_atlas_layout(JsonFields& f, const std::string& key) {
   BakedAtlasLayout l;
-  l.requested_texels_per_metre = f.get<float>("layout.requested_texels_per_metre");
-  l.texels_per_metre = f.get<float>("layout.texels_per_metre");
-  l.padding_texels = f.get<int>("layout.padding_texels");
-  l.width = f.get<int>("layout.width");
-  l.height = f.get<int>("layout.height");
+  l.requested_texels_per_metre = f.get<float>(key + ".requested_texels_per_metre");
+  l.texels_per_metre = f.get<float>(key + ".texels_per_metre");
+  l.padding_texels = f.get<int>(key + ".padding_texels");
+  l.width = f.get<int>(key + ".width");
+  l.height = f.get<int>(key + ".height");
   return l;
 }
 
@@ -133,12 +133,12 @@ std::string layout_scene_mismatch(const AtlasLayout& layout, const BakeInput& in
 }  // namespace
 
 engine::Result<AtlasLayout> BundleReader::atlas_layout(const BakeInput& input, const BakedAtlasLayout& baked,
-                                                       const std::string& what) const {
-  if (!has_file("layout"))
-    return entry_error("files.layout", "no " + what +
+                                                       const std::string& what, const std::string& key) const {
+  if (!has_file(key))
+    return entry_error("files." + key, "no " + what +
                                            " file: the bundle was baked before bakes wrote their layouts "
                                            "(re-bake)");
-  auto path = file("layout");
+  auto path = file(key);
   if (!path) return path.error();
   auto read = read_atlas_layout_file(*path);
   if (!read) return read.error();

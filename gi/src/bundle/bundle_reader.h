@@ -33,8 +33,8 @@ struct BakedAtlasLayout {
   int height = 0;
 };
 
-/// Reads the entry's "layout" fields into `f`'s error state (check f.error() afterwards).
-BakedAtlasLayout read_baked_atlas_layout(JsonFields& f);
+/// Reads the entry's "layout" fields (or `key`'s) into `f`'s error state (check f.error() afterwards).
+BakedAtlasLayout read_baked_atlas_layout(JsonFields& f, const std::string& key = "layout");
 
 /// The "layout" object a writer stores for `layout` (read back by read_baked_atlas_layout).
 nlohmann::json baked_atlas_layout_json(const AtlasLayout& layout);
@@ -85,9 +85,10 @@ class BundleReader {
   /// The atlas layout the bake wrote (the entry's files.layout), checked: its checksum, its
   /// geometry hash, its size and densities against `baked`, and one mesh per static instance
   /// of `input` with that instance's id and vertex count. Nothing is rebuilt from geometry.
-  /// `what` names the atlas in errors ("PRM atlas layout").
+  /// `what` names the atlas in errors ("PRM atlas layout"); `key`: the files entry
+  /// (files.<key>) when an entry stores more than one layout.
   engine::Result<AtlasLayout> atlas_layout(const BakeInput& input, const BakedAtlasLayout& baked,
-                                           const std::string& what) const;
+                                           const std::string& what, const std::string& key = "layout") const;
 
  private:
   BundleReader(std::filesystem::path dir, Manifest manifest, nlohmann::json entry, const std::string& method);

@@ -176,8 +176,10 @@ std::optional<PlanPresets> presets(const PlanOptions& options) {
   PlanPresets p{*atlas, *prm, *dlm};
   p.dlm.glossy_roughness = options.glossy_roughness;
   p.dlm.glossy_roughness_min = options.glossy_roughness_min;
-  if (options.texels_per_metre > 0.0f)
-    p.atlas.texels_per_metre = p.prm.texels_per_metre = p.dlm.texels_per_metre = options.texels_per_metre;
+  if (options.texels_per_metre > 0.0f) {
+    p.atlas.texels_per_metre = p.dlm.texels_per_metre = options.texels_per_metre;
+    set_prm_atlas_density(p.prm, options.texels_per_metre);
+  }
   if (options.vpls > 0) p.atlas.vpl_count = options.vpls;
   if (options.samples_per_vpl > 0) p.atlas.samples_per_vpl = options.samples_per_vpl;
   if (options.bounces > 0) p.atlas.bounces = options.bounces;
@@ -246,13 +248,13 @@ void plan_prm(const PlanFacts& f, const std::optional<PlanPresets>& p, PlannedEf
   if (!p) return;
   double nodes = 0.0;
   const BakeWork w = prm_work(f.census, p->prm, &nodes);
-  const AtlasTexelEstimate t = atlas_texels(f.census, p->prm.texels_per_metre);
-  prm.estimate = {w.bake_seconds, w.runtime_bytes, static_cast<std::uint64_t>(nodes),
-                  std::to_string(p->prm.entry_points) + " entry points x N_s " + fixed(p->prm.splitting, 0) +
-                      " at albedo " + fixed(f.census.albedo, 2) + " -> ~" +
-                      std::to_string(static_cast<long long>(nodes)) + " path nodes x ~" +
-                      std::to_string(static_cast<long long>(t.pane_texels)) + " pane texels; " +
-                      std::to_string(p->prm.clusters) + " panes as half floats"};
+  const AtlasTexelEstimate t = atlas_texels(f.census, pane_density(p->prm));
+  prm.estimate = {
+      w.bake_seconds, w.runtime_bytes, static_cast<std::uint64_t>(nodes),
+      std::to_string(p->prm.entry_points) + " entry points x N_s " + fixed(p->prm.splitting, 0) + " at albedo " +
+          fixed(f.census.albedo, 2) + " -> ~" + std::to_string(static_cast<long long>(nodes)) + " path nodes x ~" +
+          std::to_string(static_cast<long long>(t.pane_texels)) + " pane texels; " + std::to_string(p->prm.clusters) +
+          " panes as half floats at " + fixed(pane_density(p->prm), 0) + " texels/m"};
 }
 
 // Directional light maps: glossy static surfaces.

@@ -76,6 +76,9 @@ constexpr double kBrfCpuPerMadd = 1.0e-9;
 // are half floats (6 bytes per texel and cluster) plus its own RGBA32F irradiance atlas.
 constexpr double kAtlasTexelBytes = 16.0;
 constexpr double kPaneTexelBytes = 6.0;
+// Coarse PRM panes (pane_upsample.h): per atlas texel its entry (8 bytes) and ~4 bilinear
+// taps of 8 bytes (fewer at chart borders, more in the gutter rings).
+constexpr double kUpsampleBytesPerTexel = 40.0;
 
 // Sparse PRM panes (gi/src/prm/prm_panes.h): the share of the dense panes' texels the kept
 // blocks hold at a pane_threshold, the largest measured (docs/prm.md "Sparse panes"): a
@@ -175,7 +178,10 @@ BakeWork light_atlas_work(const StaticSurfaceCensus& census, const LightAtlasSet
 
 BakeWork prm_work(const StaticSurfaceCensus& census, const PrmSettings& s, double* path_nodes) {
   BakeWork w;
-  const AtlasTexelEstimate t = atlas_texels(census, s.texels_per_metre);
+  // Panes (and the bake's shadow rays) at the panes' density; the irradiance atlas at the
+  // atlas's, plus, for coarse panes, the coarse sum's texture and the upsampler's taps.
+  const AtlasTexelEstimate t = atlas_texels(census, pane_density(s));
+  const AtlasTexelEstimate atlas = atlas_texels(census, s.texels_per_metre);
   const double a = std::clamp(census.albedo, 0.0, 0.95);
   const double nodes = kPrmNodesFudge * s.entry_points * static_cast<double>(s.splitting) * a / (1.0 - a);
   if (path_nodes) *path_nodes = nodes;
@@ -184,9 +190,12 @@ BakeWork prm_work(const StaticSurfaceCensus& census, const PrmSettings& s, doubl
   const double parallel = w.rays * kPrmCpuPerRay;
   w.cpu_seconds = parallel + kPrmCpuOverhead;
   w.bake_seconds = wall_seconds(parallel, kPrmCpuOverhead);
-  w.runtime_bytes = static_cast<std::uint64_t>(static_cast<double>(s.clusters) * t.pane_texels * kPaneTexelBytes *
-                                                   prm_stored_share(s.pane_threshold) +
-                                               static_cast<double>(t.width) * t.height * kAtlasTexelBytes);
+  const double upsampling = coarse_panes(s) ? static_cast<double>(t.width) * t.height * kAtlasTexelBytes +
+                                                  atlas.pane_texels * kUpsampleBytesPerTexel
+                                            : 0.0;
+  w.runtime_bytes = static_cast<std::uint64_t>(
+      static_cast<double>(s.clusters) * t.pane_texels * kPaneTexelBytes * prm_stored_share(s.pane_threshold) +
+      static_cast<double>(atlas.width) * atlas.height * kAtlasTexelBytes + upsampling);
   return w;
 }
 

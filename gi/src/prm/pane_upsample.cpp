@@ -58,7 +58,8 @@ engine::Result<std::vector<ChartMap>> chart_maps(const AtlasLayout& coarse, cons
 // nearest filled texel of the footprint when none does.
 engine::Result<PaneUpsampler> PaneUpsampler::build(const AtlasLayout& coarse,
                                                    std::span<const std::uint32_t> coarse_filled,
-                                                   const AtlasLayout& fine, const AtlasTexels& fine_texels) {
+                                                   const AtlasLayout& fine, const AtlasTexels& fine_texels,
+                                                   int gutter_rings) {
   auto maps = chart_maps(coarse, fine);
   if (!maps) return maps.error();
   if (fine_texels.width != fine.width || fine_texels.height != fine.height)
@@ -103,12 +104,60 @@ engine::Result<PaneUpsampler> PaneUpsampler::build(const AtlasLayout& coarse,
           if (inside(x, y) && d2 < nearest)
             nearest = d2, taps[0] = {static_cast<std::uint32_t>(y * coarse.width + x), 1.0f};
         }
-      if (nearest == std::numeric_limits<double>::infinity()) ++up.orphans_;
+      if (nearest == std::numeric_limits<double>::infinity())
+        ++up.orphans_;
+      else
+        n = 1;
     }
     up.fine_texel_.push_back(static_cast<std::uint32_t>(i));
-    up.taps_.push_back(taps);
+    up.taps_.insert(up.taps_.end(), taps.begin(), taps.begin() + n);
+    up.tap_first_.push_back(static_cast<std::uint32_t>(up.taps_.size()));
   }
+  up.add_gutter_rings(fine.width, fine.height, gutter_rings);
   return up;
+}
+
+// gi::dilate's rings on the taps (dilation is linear): a ring texel reads the mean of its
+// 8-neighbours filled before that ring, their taps merged per coarse texel.
+void PaneUpsampler::add_gutter_rings(int width, int height, int rings) {
+  std::vector<std::int32_t> entry(fine_size_, -1);  // fine texel -> its entry
+  for (std::size_t k = 0; k < fine_texel_.size(); ++k) entry[fine_texel_[k]] = static_cast<std::int32_t>(k);
+  std::vector<Tap> merged;
+  for (int ring = 0; ring < rings; ++ring) {
+    const std::size_t filled_before = fine_texel_.size();
+    const auto filled = [&](int x, int y) {
+      if (x < 0 || y < 0 || x >= width || y >= height) return false;
+      const std::int32_t k = entry[static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + x];
+      return k >= 0 && static_cast<std::size_t>(k) < filled_before;
+    };
+    for (int y = 0; y < height; ++y)
+      for (int x = 0; x < width; ++x) {
+        const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + x;
+        if (entry[i] >= 0) continue;
+        merged.clear();
+        int neighbours = 0;
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) {
+            if ((dx == 0 && dy == 0) || !filled(x + dx, y + dy)) continue;
+            ++neighbours;
+            const auto k = static_cast<std::size_t>(entry[static_cast<std::size_t>(y + dy) * width + (x + dx)]);
+            for (std::uint32_t t = tap_first_[k]; t < tap_first_[k + 1]; ++t) {
+              auto at =
+                  std::find_if(merged.begin(), merged.end(), [&](const Tap& m) { return m.coarse == taps_[t].coarse; });
+              if (at == merged.end())
+                merged.push_back({taps_[t].coarse, taps_[t].weight});
+              else
+                at->weight += taps_[t].weight;
+            }
+          }
+        if (neighbours == 0) continue;
+        for (Tap& m : merged) m.weight /= static_cast<float>(neighbours);
+        entry[i] = static_cast<std::int32_t>(fine_texel_.size());
+        fine_texel_.push_back(static_cast<std::uint32_t>(i));
+        taps_.insert(taps_.end(), merged.begin(), merged.end());
+        tap_first_.push_back(static_cast<std::uint32_t>(taps_.size()));
+      }
+  }
 }
 
 std::vector<glm::vec3> PaneUpsampler::apply(std::span<const glm::vec3> coarse_image) const {
@@ -116,7 +165,8 @@ std::vector<glm::vec3> PaneUpsampler::apply(std::span<const glm::vec3> coarse_im
   std::vector<glm::vec3> out(fine_size_, glm::vec3(0.0f));
   for (std::size_t k = 0; k < fine_texel_.size(); ++k) {
     glm::vec3 v(0.0f);
-    for (const Tap& t : taps_[k]) v += t.weight * coarse_image[t.coarse];
+    for (std::uint32_t t = tap_first_[k]; t < tap_first_[k + 1]; ++t)
+      v += taps_[t].weight * coarse_image[taps_[t].coarse];
     out[fine_texel_[k]] = v;
   }
   return out;

@@ -22,6 +22,7 @@
 #include "uv/atlas_density.h"
 #include "uv/atlas_dilation.h"
 #include "uv/atlas_input.h"
+#include "uv/atlas_rasterizer.h"
 
 namespace gi {
 namespace {
@@ -32,6 +33,9 @@ engine::Status validate(const PrmSettings& s) {
   const auto bad = [](std::string what) { return engine::invalid_request("PRM settings: " + what); };
   if (!(s.texels_per_metre > 0.0f) || s.texels_per_metre > kMaxTexelsPerMetre)
     return bad("texels_per_metre " + std::to_string(s.texels_per_metre) + " is outside (0, 10^4]");
+  if (!(s.pane_texels_per_metre >= 0.0f) || s.pane_texels_per_metre > s.texels_per_metre)
+    return bad("pane_texels_per_metre " + std::to_string(s.pane_texels_per_metre) +
+               " is outside [0, texels_per_metre] (0: the atlas's density)");
   if (s.entry_points < 1 || s.entry_points > 1'000'000)
     return bad("entry_points " + std::to_string(s.entry_points) + " is outside 1..10^6");
   if (s.clusters < 1 || s.clusters > 65536)
@@ -286,7 +290,7 @@ engine::Result<Prm> bake_prm_run(const BakeInput& input, const PrmSettings& sett
   if (auto ok = validate(settings); !ok) return ok.error();
   if (auto ok = validate_bake_input(input); !ok) return ok.error();
   const auto t_start = Clock::now();
-  auto layout = static_world_layout(input, settings.texels_per_metre);
+  auto layout = static_world_layout(input, pane_density(settings));
   if (!layout) return layout.error();
   auto prepared = prepare_static_scene(input, *layout, BakeLights::None);
   if (!prepared) return prepared.error();
@@ -333,6 +337,13 @@ engine::Result<Prm> bake_prm_run(const BakeInput& input, const PrmSettings& sett
   }
 
   dilate_panes(tex, full, prm);
+  if (coarse_panes(settings)) {
+    auto atlas = static_world_layout(input, settings.texels_per_metre);
+    if (!atlas) return atlas.error();
+    auto read = prm_atlas_read(prm, std::move(atlas).value(), input);
+    if (!read) return read.error();
+    prm.atlas = std::move(read).value();
+  }
   prm.stats.pane_seconds = seconds_since(t0);
   prm.stats.total_seconds = seconds_since(t_start);
   return prm;
@@ -360,6 +371,15 @@ engine::Result<Prm> merge_prm(const BakeInput& input, const PrmSettings& setting
   return bake_prm_run(input, settings, {.shard = {}, .part = nullptr, .parts = &parts});
 }
 
+engine::Result<PrmAtlasRead> prm_atlas_read(const Prm& prm, AtlasLayout atlas, const BakeInput& input) {
+  const AtlasTexels fine = rasterize_atlas(atlas, atlas_inputs_from(input));
+  // The atlas's gutter rings as the light atlas dilates its own (max(4, padding) rings).
+  auto up = PaneUpsampler::build(prm.layout, prm.texels, atlas, fine, std::max(4, atlas.padding_texels));
+  if (!up) return up.error();
+  return PrmAtlasRead{.layout = std::move(atlas),
+                      .upsampler = std::make_shared<const PaneUpsampler>(std::move(up).value())};
+}
+
 engine::Result<PrmSettings> prm_preset(std::string_view name) {
   auto density = atlas_density_preset(name);
   if (!density)
@@ -369,10 +389,16 @@ engine::Result<PrmSettings> prm_preset(std::string_view name) {
   // Blocks below 1% of their cluster's peak dropped: the demo level keeps 53% of its pane
   // texels at the same error against the path tracer (docs/prm.md "Sparse panes").
   s.pane_threshold = 0.01f;
+  // Medium: panes at half the atlas's density, 1.06-1.07x the dense panes' error on the demo
+  // level for a third of their memory and a quarter of the bake (docs/prm.md "Panes coarser
+  // than the atlas"). Preview keeps dense panes: its 16 clusters save less pane memory than
+  // the upsampling taps cost, and its relight got slower (prm_relight_bench, docs/prm.md).
+  // High keeps dense panes: not measured there yet.
   if (name == "preview") {
     s.entry_points = 512, s.clusters = 16, s.splitting = 2.0f;
   } else if (name == "medium") {
     s.entry_points = 1024, s.clusters = 64, s.splitting = 4.0f;
+    s.pane_texels_per_metre = 0.5f * s.texels_per_metre;
   } else {
     s.entry_points = 4096, s.clusters = 128, s.splitting = 4.0f;
   }

@@ -16,20 +16,28 @@
 #include <gi/progress.h>
 
 #include <cstdint>
+#include <memory>
+#include <optional>
 #include <string_view>
 #include <vector>
 #include <glm/glm.hpp>
 
 #include "core/work_shard.h"
+#include "prm/pane_upsample.h"
 #include "prm/prm_panes.h"
 #include "uv/atlas_layout.h"
 
 namespace gi {
 
 struct PrmSettings {
-  float texels_per_metre = 8.0f;  ///< Pane (atlas) density; the layout is the light atlas's.
-  int entry_points = 1024;        ///< N_e, stratified over the static surfaces by area.
-  int clusters = 64;              ///< Panes stored: entry points are clustered into this many.
+  float texels_per_metre = 8.0f;  ///< The light atlas's density: the layout the PRM's sum is read at.
+  /// The panes' own density (texels per metre), at most texels_per_metre; 0: the atlas's
+  /// (dense panes). Coarser panes are baked on their own layout of the same charts and read
+  /// at the atlas's texels by a PaneUpsampler after the sum (docs/prm.md "Panes coarser than
+  /// the atlas").
+  float pane_texels_per_metre = 0.0f;
+  int entry_points = 1024;  ///< N_e, stratified over the static surfaces by area.
+  int clusters = 64;        ///< Panes stored: entry points are clustered into this many.
   /// N_s: paths per entry point are N_s x albedo (eq. in §4.1), so every path carries the
   /// same power.
   float splitting = 4.0f;
@@ -61,14 +69,22 @@ struct PrmStats {
   double total_seconds = 0.0;
 };
 
-/// A baked PRM. Panes cover `texels`: every texel a triangle covers plus the gutter rings
-/// the light atlas dilates into (dilation is linear, so it is applied to each pane at bake
-/// time and the runtime sum needs none).
-struct Prm {
+/// The light atlas a PRM with coarse panes is read at: its layout and the chart-respecting
+/// bilinear read of the pane layout at its texels (pane_upsample.h).
+struct PrmAtlasRead {
   AtlasLayout layout;
-  int width = 0;
+  std::shared_ptr<const PaneUpsampler> upsampler;  ///< Shared: immutable, built once per bake or load.
+};
+
+/// A baked PRM. Panes cover `texels`: every texel a triangle covers plus the gutter rings
+/// the pane layout dilates into (dilation is linear, so it is applied to each pane at bake
+/// time and the runtime sum needs none). The pane layout is the light atlas's unless the
+/// panes are coarser (`atlas` set): then sums are upsampled to the atlas.
+struct Prm {
+  AtlasLayout layout;  ///< The panes' layout (the light atlas's when `atlas` is empty).
+  int width = 0;       ///< Of the pane layout.
   int height = 0;
-  std::vector<std::uint32_t> texels;  ///< Atlas texel index (y * width + x) of each pane element, ascending.
+  std::vector<std::uint32_t> texels;  ///< Pane texel index (y * width + x) of each pane element, ascending.
   std::vector<PrmEntryPoint> entries;
   int cluster_count = 0;
   std::vector<std::uint32_t> cluster_size;  ///< Members per cluster.
@@ -78,9 +94,32 @@ struct Prm {
   PrmPanes panes;
   PrmSettings settings;
   PrmStats stats;
+  /// Set when the panes are coarser than the light atlas (settings.pane_texels_per_metre).
+  std::optional<PrmAtlasRead> atlas;
 
   std::size_t pane_size() const { return texels.size(); }
+  /// The light atlas the runtime writes (the renderer's TEXCOORD_1): `layout` for dense panes.
+  const AtlasLayout& atlas_layout() const { return atlas ? atlas->layout : layout; }
+  int atlas_width() const { return atlas ? atlas->layout.width : width; }
+  int atlas_height() const { return atlas ? atlas->layout.height : height; }
 };
+
+/// The density the panes are baked at: settings.pane_texels_per_metre, or the atlas's when 0.
+inline float pane_density(const PrmSettings& s) {
+  return s.pane_texels_per_metre > 0.0f ? s.pane_texels_per_metre : s.texels_per_metre;
+}
+/// True when the panes are baked coarser than the atlas (a PaneUpsampler reads them).
+inline bool coarse_panes(const PrmSettings& s) { return pane_density(s) < s.texels_per_metre; }
+/// Sets the atlas density, keeping the panes' ratio to it (a preset's coarse panes stay as coarse).
+inline void set_prm_atlas_density(PrmSettings& s, float texels_per_metre) {
+  if (s.pane_texels_per_metre > 0.0f && s.texels_per_metre > 0.0f)
+    s.pane_texels_per_metre *= texels_per_metre / s.texels_per_metre;
+  s.texels_per_metre = texels_per_metre;
+}
+
+/// The upsampler from `prm`'s pane layout to `atlas` (the light atlas of the same static
+/// world), rasterizing `atlas` over `input`'s static meshes. Error: layouts of other charts.
+engine::Result<PrmAtlasRead> prm_atlas_read(const Prm& prm, AtlasLayout atlas, const BakeInput& input);
 
 /// prm's panes dense: pane c, element i, channel ch at [(c * texels.size() + i) * 3 + ch].
 inline std::vector<float> dense_panes(const Prm& prm) {

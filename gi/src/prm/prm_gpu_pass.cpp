@@ -3,6 +3,7 @@
 #include <GL/glcorearb.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -218,14 +219,31 @@ engine::Result<std::size_t> buffer_limit_for(const Prm& prm, const PrmGpuPassOpt
 engine::Result<PrmGpuPass> PrmGpuPass::create(const Prm& prm, const PrmGpuPassOptions& options) {
   // Check the data before acquiring anything.
   if (auto bad = check_prm(prm, options.encoding)) return *bad;
+  if (prm.atlas && !prm.atlas->upsampler) return error("coarse panes without their upsampler");
+  if (prm.atlas) {
+    const PaneUpsampler& up = *prm.atlas->upsampler;
+    const std::size_t max_texture = std::min<std::size_t>(gl_limit(GL_MAX_TEXTURE_SIZE), 65536);
+    if (up.coarse_size() != static_cast<std::size_t>(prm.width) * static_cast<std::size_t>(prm.height) ||
+        up.fine_size() != static_cast<std::size_t>(prm.atlas_width()) * static_cast<std::size_t>(prm.atlas_height()))
+      return error("the upsampler reads a " + std::to_string(up.coarse_size()) + "-texel layout into a " +
+                   std::to_string(up.fine_size()) + "-texel one, the PRM's are " + std::to_string(prm.width) + "x" +
+                   std::to_string(prm.height) + " and " + std::to_string(prm.atlas_width()) + "x" +
+                   std::to_string(prm.atlas_height()));
+    if (prm.atlas_width() <= 0 || prm.atlas_height() <= 0 ||
+        static_cast<std::size_t>(std::max(prm.atlas_width(), prm.atlas_height())) > max_texture)
+      return error("atlas size " + std::to_string(prm.atlas_width()) + "x" + std::to_string(prm.atlas_height()) +
+                   " is empty or exceeds GL_MAX_TEXTURE_SIZE " + std::to_string(max_texture) + " (or 65536)");
+  }
   auto buffer_limit = buffer_limit_for(prm, options);
   if (!buffer_limit) return buffer_limit.error();
   const std::size_t elements = prm.texels.size();
   const auto clusters = static_cast<std::size_t>(prm.cluster_count);
 
   PrmGpuPass pass;
-  pass.width_ = prm.width;
-  pass.height_ = prm.height;
+  pass.width_ = prm.atlas_width();
+  pass.height_ = prm.atlas_height();
+  pass.pane_width_ = prm.width;
+  pass.pane_height_ = prm.height;
   pass.decode_scale_ = options.encoding == PrmPaneEncoding::Half ? 1.0f : std::ldexp(1.0f, -kMantissaShift);
   pass.max_groups_x_ =
       options.max_groups_x > 0 ? std::min(options.max_groups_x, kMaxGroupsPerDimension) : kMaxGroupsPerDimension;
@@ -242,6 +260,8 @@ engine::Result<PrmGpuPass> PrmGpuPass::create(const Prm& prm, const PrmGpuPassOp
 
   pass.upload_panes(prm, options.encoding, *buffer_limit);
   pass.upload_texels(prm, *buffer_limit);
+  if (prm.atlas)
+    if (engine::Status s = pass.upload_upsampler(*prm.atlas->upsampler, prm.width); !s) return s.error();
   pass.create_output();
   if (glGetError() == GL_OUT_OF_MEMORY)
     return error("out of GPU memory uploading " + std::to_string(clusters) + " panes of " + std::to_string(elements) +
@@ -313,7 +333,51 @@ void PrmGpuPass::upload_texels(const Prm& prm, std::size_t buffer_limit) {
   write_all_ = true;
 }
 
+engine::Status PrmGpuPass::upload_upsampler(const PaneUpsampler& up, int coarse_width) {
+  engine::ShaderProgramBuilder builder(gi_shader_files());
+  builder.stage(engine::ShaderStage::Compute, "prm_upsample.comp.glsl");
+  auto program = builder.build();
+  if (!program) return program.error();
+  upsample_program_ = std::move(program).value();
+  upsample_count_location_ = glGetUniformLocation(upsample_program_.id(), "u_count");
+  upsample_has_base_location_ = glGetUniformLocation(upsample_program_.id(), "u_has_base");
+  const auto packed = [](std::uint32_t t, std::uint32_t w) { return (t % w) | ((t / w) << 16); };
+  const auto fw = static_cast<std::uint32_t>(width_), cw = static_cast<std::uint32_t>(coarse_width);
+  std::vector<glm::uvec2> texels, taps;
+  texels.reserve(up.fine_texels().size() + 1);
+  for (std::size_t k = 0; k < up.fine_texels().size(); ++k)
+    texels.emplace_back(packed(up.fine_texels()[k], fw), up.tap_first()[k]);
+  texels.emplace_back(0u, static_cast<std::uint32_t>(up.taps().size()));
+  taps.reserve(std::max<std::size_t>(up.taps().size(), 1));
+  for (const PaneUpsampler::Tap& t : up.taps())
+    taps.emplace_back(packed(t.coarse, cw), std::bit_cast<std::uint32_t>(t.weight));
+  if (taps.empty()) taps.emplace_back(0u, 0u);  // GL buffers cannot be empty
+  upsample_texels_ = engine::GlBuffer::create(texels.size() * sizeof(glm::uvec2), texels.data());
+  upsample_taps_ = engine::GlBuffer::create(taps.size() * sizeof(glm::uvec2), taps.data());
+  upsample_bytes_ = (texels.size() + taps.size()) * sizeof(glm::uvec2);
+  upsample_count_ = static_cast<std::uint32_t>(up.fine_texels().size());
+  return {};
+}
+
+void PrmGpuPass::run_upsample() {
+  upsample_program_.use();
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, upsample_texels_.id());
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, upsample_taps_.id());
+  glBindImageTexture(0, output_.id(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+  glBindImageTexture(1, base_.id(), 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
+  glBindImageTexture(2, coarse_.id(), 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
+  glProgramUniform1ui(upsample_program_.id(), upsample_count_location_, upsample_count_);
+  glProgramUniform1ui(upsample_program_.id(), upsample_has_base_location_, base_.empty() ? 0u : 1u);
+  const std::uint32_t groups = (upsample_count_ + kGroupSize - 1) / kGroupSize;
+  const std::uint32_t groups_x = std::min(groups, max_groups_x_);
+  glDispatchCompute(groups_x, (groups + groups_x - 1) / groups_x, 1);
+}
+
 void PrmGpuPass::create_output() {
+  if (upsample_count_ > 0) {
+    coarse_ = engine::GlTexture::create_2d(GL_RGBA32F, pane_width_, pane_height_);
+    glClearTexImage(coarse_.id(), 0, GL_RGBA, GL_FLOAT, nullptr);
+  }
   output_ = engine::GlTexture::create_2d(GL_RGBA32F, width_, height_);
   glClearTexImage(output_.id(), 0, GL_RGBA, GL_FLOAT, nullptr);
   glTextureParameteri(output_.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
@@ -342,13 +406,16 @@ engine::Status PrmGpuPass::run(std::span<const ClusterWeight> selected) {
   glBindTextureUnit(0, texels_texture_.id());
   glBindTextureUnit(2, weights_texture_.id());
   glBindTextureUnit(3, chunks_texture_.id());
-  glBindImageTexture(0, output_.id(), 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+  // Coarse panes: the sum goes to the pane layout's texture, from zero (the base is added
+  // at the atlas's texels by the upsampling pass).
+  const bool coarse = upsample_count_ > 0;
+  glBindImageTexture(0, coarse ? coarse_.id() : output_.id(), 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
   glBindImageTexture(1, base_.id(), 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
   // One dispatch per pane buffer holding a selected block, over the touched tiles' blocks of
   // eight slots; the first writes (from the base or zero), later ones accumulate.
   for (std::size_t d = 0; d < dispatches.size(); ++d) {
     if (d > 0) glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
-    const SumMode mode = d > 0 ? SumMode::Accumulate : base_.empty() ? SumMode::Zero : SumMode::Base;
+    const SumMode mode = d > 0 ? SumMode::Accumulate : base_.empty() || coarse ? SumMode::Zero : SumMode::Base;
     const std::uint32_t groups = (dispatches[d].chunk_count + kGroupSize - 1) / kGroupSize;
     const std::uint32_t groups_x = std::min(groups, max_groups_x_);
     const std::uint32_t groups_y = (groups + groups_x - 1) / groups_x;
@@ -357,6 +424,10 @@ engine::Status PrmGpuPass::run(std::span<const ClusterWeight> selected) {
     glProgramUniform1ui(program_.id(), uniforms_.chunk_count, dispatches[d].chunk_count);
     glBindTextureUnit(1, pane_textures_[dispatches[d].buffer].id());
     glDispatchCompute(groups_x, groups_y, 1);
+  }
+  if (coarse) {
+    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+    run_upsample();
   }
   glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT |
                   GL_FRAMEBUFFER_BARRIER_BIT | GL_PIXEL_BUFFER_BARRIER_BIT);
@@ -494,9 +565,10 @@ std::size_t PrmGpuPass::pane_bytes() const {
 
 std::size_t PrmGpuPass::gpu_bytes() const {
   const std::size_t atlas_bytes = static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_) * 16;
-  std::size_t bytes = texel_slots_ * sizeof(std::uint32_t) + weights_bytes_ + chunks_bytes_;
+  std::size_t bytes = texel_slots_ * sizeof(std::uint32_t) + weights_bytes_ + chunks_bytes_ + upsample_bytes_;
   for (std::size_t b : pane_buffer_bytes_) bytes += b;
   if (!output_.empty()) bytes += atlas_bytes;
+  if (!coarse_.empty()) bytes += static_cast<std::size_t>(pane_width_) * static_cast<std::size_t>(pane_height_) * 16;
   if (!base_.empty()) bytes += atlas_bytes;
   return bytes;
 }

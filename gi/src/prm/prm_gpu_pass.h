@@ -3,7 +3,9 @@
 // selected clusters' panes, written into an RGBA32F irradiance atlas texture, the GPU twin
 // of gi::sum_panes (prm_runtime.h). Panes are uploaded once, as half floats or RGB9E5
 // (PrmPaneEncoding); a run uploads only the K weights and dispatches one compute pass
-// (gi/shaders/prm_sum.comp.glsl).
+// (gi/shaders/prm_sum.comp.glsl). Panes coarser than the atlas (Prm::atlas) are summed into
+// a texture of the pane layout, then a second pass (gi/shaders/prm_upsample.comp.glsl)
+// applies the PaneUpsampler's taps (uploaded once, SSBOs) into the atlas texture.
 //   auto pass = gi::PrmGpuPass::create(prm).value();            // a GL context is current
 //   if (auto s = pass.run(gi::select_clusters(weights, 32)); !s) { /* s.error() */ }
 //   // pass.texture(): irradiance (W/m^2) per atlas texel, 0 outside the panes' texels
@@ -17,7 +19,8 @@
 // rounding.
 //
 // GL state: create(), run(), set_base() and read_back() need the creating context current
-// and change the bound program, texture units 0-2 (buffer textures) and image units 0-1.
+// and change the bound program, texture units 0-3 (buffer textures), image units 0-2 and
+// shader storage bindings 0-1.
 
 #include <cstddef>
 #include <cstdint>
@@ -75,7 +78,9 @@ struct PrmGpuPassOptions {
 class PrmGpuPass {
  public:
   /// Compiles the shader, uploads `prm`'s texels and all its panes and creates the
-  /// width x height RGBA32F output texture (linear filtering, clamped, all zero). Errors:
+  /// RGBA32F output texture at the light atlas's size (prm.atlas_width() x atlas_height(),
+  /// linear filtering, clamped, all zero); coarse panes add a texture of the pane layout
+  /// and the upsampler's taps. Errors:
   /// inconsistent sizes, texels not ascending or outside the atlas, non-finite pane values,
   /// one pane or the texel list larger than the buffer limit, atlas above the texture limit,
   /// shader build failure.
@@ -89,12 +94,12 @@ class PrmGpuPass {
   ~PrmGpuPass() = default;
 
   /// Writes base + sum over `selected` of weight x pane into every pane texel (texels outside
-  /// the panes keep 0). Overwrites the previous run. K = 0 writes the base (or 0). A cluster
-  /// listed twice counts twice. Only the tiles the selected clusters store blocks on, and
-  /// those of the previous run, are written (every tile after creation or set_base): the work
-  /// follows the lit blocks. Ends with a memory barrier for texture fetches, image access and
-  /// read-back. Errors: a cluster index >= cluster_count; more selected blocks than the
-  /// weight buffer texture holds (the buffer limit / 16 bytes).
+  /// the panes keep 0); coarse panes: base + that sum upsampled, at every texel the
+  /// upsampler lists (the atlas's valid texels and gutter rings). Overwrites the previous run. K = 0 writes the base
+  /// (or 0). A cluster listed twice counts twice. Only the tiles the selected clusters store blocks on, and those of
+  /// the previous run, are written (every tile after creation or set_base): the work follows the lit blocks. Ends with
+  /// a memory barrier for texture fetches, image access and read-back. Errors: a cluster index >= cluster_count; more
+  /// selected blocks than the weight buffer texture holds (the buffer limit / 16 bytes).
   engine::Status run(std::span<const ClusterWeight> selected);
 
   /// A base irradiance atlas (width x height texels, row-major) added at the pane texels by
@@ -116,6 +121,8 @@ class PrmGpuPass {
   std::size_t pane_bytes() const;
   /// Blocks of eight pane slots the last run dispatched (over all its dispatches).
   std::size_t last_run_chunks() const { return last_chunks_; }
+  /// True when the panes are coarser than the output atlas (a second, upsampling pass).
+  bool upsamples() const { return upsample_count_ > 0; }
 
  private:
   /// Packs each pane's blocks into buffers of whole panes under `buffer_limit` bytes each,
@@ -124,8 +131,12 @@ class PrmGpuPass {
   /// The texel coordinates tile by tile (padded to blocks of eight), the empty weight and
   /// chunk buffers.
   void upload_texels(const Prm& prm, std::size_t buffer_limit);
-  /// The cleared, bilinear RGBA32F output texture.
+  /// The cleared, bilinear RGBA32F output texture (and the coarse sum's, coarse panes).
   void create_output();
+  /// Coarse panes: the upsampler's texels and taps as SSBOs, and its program.
+  engine::Status upload_upsampler(const PaneUpsampler& up, int coarse_width);
+  /// Coarse panes: the upsampling dispatch from the coarse sum into the output.
+  void run_upsample();
   /// One compute dispatch: the pane buffer it reads and its chunks.
   struct Dispatch {
     std::uint32_t buffer = 0, first_chunk = 0, chunk_count = 0;
@@ -173,8 +184,18 @@ class PrmGpuPass {
   std::size_t weights_bytes_ = 0;      ///< Size of the last weight upload.
   engine::GlTexture output_;
   engine::GlTexture base_;
-  int width_ = 0;
+  int width_ = 0;  ///< Of the output (the light atlas).
   int height_ = 0;
+  int pane_width_ = 0;  ///< Of the pane layout (the sum pass's coordinates).
+  int pane_height_ = 0;
+  engine::GlTexture coarse_;  ///< Coarse panes: the K-sum at the pane layout (no base).
+  engine::ShaderProgram upsample_program_;
+  engine::GlBuffer upsample_texels_;  ///< Per fine texel (x | y << 16, first tap), plus the end.
+  engine::GlBuffer upsample_taps_;    ///< Per tap (coarse x | y << 16, weight bits).
+  std::size_t upsample_bytes_ = 0;
+  std::uint32_t upsample_count_ = 0;  ///< Fine texels written (0: dense panes, no upsampling).
+  int upsample_count_location_ = -1;
+  int upsample_has_base_location_ = -1;
   std::uint32_t max_groups_x_ = 65535;
   float decode_scale_ = 1.0f;  ///< Folded into every weight: 2^-24 for RGB9E5 mantissas, 1 for halves.
 };

@@ -7,6 +7,7 @@
 #include <bit>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <span>
 #include <system_error>
 #include <nlohmann/json.hpp>
@@ -88,9 +89,10 @@ std::string check_panes(const Prm& p) {
 std::string check_prm(const Prm& p) {
   const PrmSettings& s = p.settings;
   if (!(s.texels_per_metre > 0.0f) || !std::isfinite(s.texels_per_metre) || !(s.splitting > 0.0f) ||
-      !std::isfinite(s.splitting) || s.entry_points < 1 || s.clusters < 1 || s.max_path_nodes < 1)
+      !std::isfinite(s.splitting) || s.entry_points < 1 || s.clusters < 1 || s.max_path_nodes < 1 ||
+      !(s.pane_texels_per_metre >= 0.0f) || s.pane_texels_per_metre > s.texels_per_metre)
     return "settings out of range (texels_per_metre and splitting must be positive, entry_points, clusters and "
-           "max_path_nodes at least 1)";
+           "max_path_nodes at least 1, pane_texels_per_metre in [0, texels_per_metre])";
   if (p.width <= 0 || p.height <= 0 || p.width > kMaxAtlasSide || p.height > kMaxAtlasSide)
     return "atlas size " + std::to_string(p.width) + "x" + std::to_string(p.height) + " is outside 1..16384";
   if (p.cluster_count < 1 || p.cluster_count > kMaxClusters)
@@ -133,6 +135,7 @@ json settings_json(const PrmSettings& s) {
               {"max_path_nodes", s.max_path_nodes},
               {"kmeans", s.kmeans},
               {"seed", s.seed},
+              {"pane_texels_per_metre", s.pane_texels_per_metre},
               {"pane_tile_texels", s.pane_tile_texels},
               {"pane_threshold", s.pane_threshold}};
 }
@@ -142,6 +145,7 @@ json stats_json(const PrmStats& s) { return json{{"paths", s.paths}, {"path_node
 // What the manifest entry says beyond its file: the layout and the sizes.
 struct EntryInfo {
   BakedAtlasLayout layout;
+  std::optional<BakedAtlasLayout> atlas_layout;  ///< Coarse panes: the light atlas's they are read at.
   std::size_t entry_points = 0, clusters = 0, pane_texels = 0;
   PrmStats stats;
 };
@@ -150,6 +154,7 @@ engine::Result<EntryInfo> read_entry(const BundleReader& bundle) {
   JsonFields f = bundle.fields();
   EntryInfo e;
   e.layout = read_baked_atlas_layout(f);
+  if (bundle.entry().contains(kPrmAtlasLayoutKey)) e.atlas_layout = read_baked_atlas_layout(f, kPrmAtlasLayoutKey);
   e.entry_points = f.get<std::size_t>("entry_points");
   e.clusters = f.get<std::size_t>("clusters");
   e.pane_texels = f.get<std::size_t>("pane_texels");
@@ -280,6 +285,7 @@ engine::Status write_prm_panes(const fs::path& path, const Prm& prm, const std::
   engine::ByteWriter w;
   w.put_string(geometry_hash);
   w.put(s.texels_per_metre);
+  w.put(s.pane_texels_per_metre);
   w.put(static_cast<std::int32_t>(s.entry_points));
   w.put(static_cast<std::int32_t>(s.clusters));
   w.put(s.splitting);
@@ -323,13 +329,13 @@ engine::Result<PrmPaneFile> read_prm_panes(const fs::path& path) {
   std::vector<float> area, scales;
   std::vector<std::uint32_t> cluster;
   std::vector<std::uint8_t> frame;
-  const bool complete = r.get_string(f.geometry_hash) && r.get(s.texels_per_metre) && r.get(entry_points) &&
-                        r.get(clusters) && r.get(s.splitting) && r.get(max_path_nodes) && r.get(kmeans) &&
-                        r.get(seed) && r.get(width) && r.get(height) && r.get(cluster_count) && r.get_array(p.texels) &&
-                        r.get_array(position) && r.get_array(normal) && r.get_array(area) && r.get_array(cluster) &&
-                        r.get_array(p.cluster_size) && r.get(tile_texels) && r.get(q.blocks_settings.threshold) &&
-                        r.get_array(q.cluster_first) && r.get_array(q.blocks) && r.get_array(scales) &&
-                        r.get(pane_half_bytes) && r.get_array(frame);
+  const bool complete = r.get_string(f.geometry_hash) && r.get(s.texels_per_metre) && r.get(s.pane_texels_per_metre) &&
+                        r.get(entry_points) && r.get(clusters) && r.get(s.splitting) && r.get(max_path_nodes) &&
+                        r.get(kmeans) && r.get(seed) && r.get(width) && r.get(height) && r.get(cluster_count) &&
+                        r.get_array(p.texels) && r.get_array(position) && r.get_array(normal) && r.get_array(area) &&
+                        r.get_array(cluster) && r.get_array(p.cluster_size) && r.get(tile_texels) &&
+                        r.get(q.blocks_settings.threshold) && r.get_array(q.cluster_first) && r.get_array(q.blocks) &&
+                        r.get_array(scales) && r.get(pane_half_bytes) && r.get_array(frame);
   const std::string location = "payload byte " + std::to_string(r.offset());
   if (!complete) return file_error(path, location, "truncated payload");
   if (r.remaining() != 0) return file_error(path, location, "unexpected data after the last field");
@@ -421,17 +427,23 @@ engine::Status save_prm(const fs::path& bundle_dir, const Prm& prm, const BakeIn
   auto layout_file = write_bundle_atlas_layout(bundle_dir, kPrmLayoutFile, prm.layout, geometry_hash);
   if (!layout_file) return layout_file.error();
 
-  const json entry{{"files", {{"panes", {{"file", kPrmPanesFile}, {"xxh3_64", *sum}}}, {"layout", *layout_file}}},
-                   {"settings", settings_json(prm.settings)},
-                   {"layout", baked_atlas_layout_json(prm.layout)},
-                   {"entry_points", prm.entries.size()},
-                   {"clusters", prm.cluster_count},
-                   {"pane_texels", prm.texels.size()},
-                   {"stats", stats_json(prm.stats)},
-                   {"memory",
-                    {{"pane_bytes_half", static_cast<std::uint64_t>(prm.panes.values.size()) * 2},
-                     {"pane_blocks", prm.panes.blocks.size()},
-                     {"file_bytes", static_cast<std::uint64_t>(file_bytes)}}}};
+  json entry{{"files", {{"panes", {{"file", kPrmPanesFile}, {"xxh3_64", *sum}}}, {"layout", *layout_file}}},
+             {"settings", settings_json(prm.settings)},
+             {"layout", baked_atlas_layout_json(prm.layout)},
+             {"entry_points", prm.entries.size()},
+             {"clusters", prm.cluster_count},
+             {"pane_texels", prm.texels.size()},
+             {"stats", stats_json(prm.stats)},
+             {"memory",
+              {{"pane_bytes_half", static_cast<std::uint64_t>(prm.panes.values.size()) * 2},
+               {"pane_blocks", prm.panes.blocks.size()},
+               {"file_bytes", static_cast<std::uint64_t>(file_bytes)}}}};
+  if (prm.atlas) {
+    auto atlas_file = write_bundle_atlas_layout(bundle_dir, kPrmAtlasLayoutFile, prm.atlas->layout, geometry_hash);
+    if (!atlas_file) return atlas_file.error();
+    entry["files"][kPrmAtlasLayoutKey] = *atlas_file;
+    entry[kPrmAtlasLayoutKey] = baked_atlas_layout_json(prm.atlas->layout);
+  }
   return update_manifest_method(bundle_dir, geometry_hash, scene_name, kPrmMethod, entry);
 }
 
@@ -455,10 +467,24 @@ engine::Result<Prm> load_prm(const fs::path& bundle_dir, const BakeInput& input)
                                        "; " + panes_path->string() + " holds " + str(prm.entries.size()) + ", " +
                                        std::to_string(prm.cluster_count) + ", " + str(prm.texels.size()) + ", " +
                                        std::to_string(prm.width) + "x" + std::to_string(prm.height));
-  auto layout = bundle->atlas_layout(input, l, "PRM atlas layout");
+  auto layout = bundle->atlas_layout(input, l, "PRM pane layout");
   if (!layout) return layout.error();
   prm.layout = std::move(layout).value();
   prm.stats = entry->stats;
+  if (coarse_panes(prm.settings) != entry->atlas_layout.has_value())
+    return bundle->entry_error(kPrmAtlasLayoutKey,
+                               coarse_panes(prm.settings)
+                                   ? "the panes are coarser than the atlas but the entry has no atlas layout (re-bake)"
+                                   : "the entry has an atlas layout but the panes are at the atlas's density");
+  if (entry->atlas_layout) {
+    // Coarse panes: the light atlas's layout as baked, and the read of the panes at its
+    // texels built from the two layouts (rasterizing the atlas; docs/prm.md measures it).
+    auto atlas = bundle->atlas_layout(input, *entry->atlas_layout, "PRM light atlas layout", kPrmAtlasLayoutKey);
+    if (!atlas) return atlas.error();
+    auto read = prm_atlas_read(prm, std::move(atlas).value(), input);
+    if (!read) return bundle->entry_error(kPrmAtlasLayoutKey, read.error().message);
+    prm.atlas = std::move(read).value();
+  }
   return std::move(file->prm);
 }
 

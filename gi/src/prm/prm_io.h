@@ -6,10 +6,15 @@
 // Files (DESIGN.md §5, docs/bake-bundle.md):
 //   prm_panes.bin   the checksummed container of bake/blob_file.h, magic "GIPRMPAN", version 3.
 //   manifest.json   methods.prm = {
-//     "files":        { "panes": {"file": "prm_panes.bin", "xxh3_64": "<hex of the whole file>"} },
+//     "files":        { "panes": {"file": "prm_panes.bin", "xxh3_64": "<hex of the whole file>"},
+//                       "layout": the pane layout (prm_layout.bin),
+//                       "atlas_layout": coarse panes only, the light atlas's layout (prm_atlas_layout.bin) },
 //     "settings":     { PrmSettings' scalar fields but threads and progress (pane_tile_texels and
 //                       pane_threshold included) },
-//     "layout":       { "requested_texels_per_metre", "texels_per_metre", "padding_texels", "width", "height" },
+//     "layout":       { "requested_texels_per_metre", "texels_per_metre", "padding_texels", "width", "height" }
+//                       of the pane layout,
+//     "atlas_layout": the same of the light atlas's layout (coarse panes only: pane_texels_per_metre > 0
+//                       and below texels_per_metre; load builds the PaneUpsampler from the two layouts),
 //     "entry_points", "clusters", "pane_texels",
 //     "stats":        { PrmStats' counts (timings: bake_stats.json) },
 //     "memory":       { "pane_bytes_half": stored block elements x 3 x 2 (the panes as GPU halves),
@@ -21,7 +26,7 @@
 // prm_panes.bin payload (little-endian; "array" = uint64 count then the elements;
 // vec3 = 3 x float32):
 //   string        geometry_hash        uint64 length + chars: the scene the PRM belongs to
-//   float32 texels_per_metre, int32 entry_points, int32 clusters, float32 splitting,
+//   float32 texels_per_metre, float32 pane_texels_per_metre, int32 entry_points, int32 clusters, float32 splitting,
 //   int32 max_path_nodes, uint8 kmeans, uint64 seed
 //                                      PrmSettings' scalar fields (not threads: no file depends on them)
 //   int32 width, int32 height          atlas size (the layout is rebuilt from the scene)
@@ -68,10 +73,14 @@ inline constexpr const char* kPrmMethod = "prm";
 inline constexpr const char* kPrmPanesFile = "prm_panes.bin";
 /// The PRM's atlas layout (bundle/atlas_layout_file.h), files.layout.
 inline constexpr const char* kPrmLayoutFile = "prm_layout.bin";
+/// Coarse panes only: the light atlas's layout they are read at, files.atlas_layout.
+inline constexpr const char* kPrmAtlasLayoutFile = "prm_atlas_layout.bin";
+inline constexpr const char* kPrmAtlasLayoutKey = "atlas_layout";
 inline constexpr BlobMagic kPrmPanesMagic{"GIPRMPAN"};
 // 2: the thread count left out (a bundle does not depend on it; bake_stats.json says it).
 // 3: sparse panes, stored per atlas tile only where the cluster's light reaches (issue 38).
-inline constexpr std::uint32_t kPrmPanesVersion = 3;
+// 4: pane_texels_per_metre (panes coarser than the atlas, read through a PaneUpsampler).
+inline constexpr std::uint32_t kPrmPanesVersion = 4;
 
 /// Relative and pane-relative bounds of the half-float pane storage (see above).
 inline constexpr double kPrmPaneRelativeError = 1.0 / 2048.0;               // 2^-11

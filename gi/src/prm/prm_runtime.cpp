@@ -126,6 +126,8 @@ std::vector<glm::vec3> sum_panes(const Prm& prm, std::span<const ClusterWeight> 
         out[prm.texels[element[j]]] += cw.weight * glm::vec3(v[3 * j], v[3 * j + 1], v[3 * j + 2]);
     }
   }
+  // Coarse panes: the upsampling is linear, so the sum is read at the atlas once.
+  if (prm.atlas && prm.atlas->upsampler) return prm.atlas->upsampler->apply(out);
   return out;
 }
 

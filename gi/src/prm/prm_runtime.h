@@ -50,7 +50,9 @@ std::vector<ClusterWeight> relight_clusters(const Prm& prm, std::span<const Refe
                                             const RayCaster& caster, int k);
 
 /// sum over `selected` of weight x pane, written to an atlas of width x height texels (0
-/// outside the panes' texels). The CPU twin of PrmGpuPass::run.
+/// outside the panes' texels); with coarse panes (prm.atlas), that sum read at the light
+/// atlas's texels (atlas_width() x atlas_height(), 0 outside its valid texels) by the
+/// upsampler, once. The CPU twin of PrmGpuPass::run.
 std::vector<glm::vec3> sum_panes(const Prm& prm, std::span<const ClusterWeight> selected);
 
 }  // namespace gi

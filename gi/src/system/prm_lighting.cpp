@@ -102,18 +102,20 @@ engine::Result<std::unique_ptr<PrmLighting>> PrmLighting::from_bake(Prm prm, con
                                                                     const engine::Scene& scene,
                                                                     PrmLightingSettings settings,
                                                                     std::shared_ptr<const RayCaster> static_world) {
-  if (base && (base->width != prm.width || base->height != prm.height ||
-               base->layout.texels_per_metre != prm.layout.texels_per_metre))
+  // The PRM's atlas (its panes' layout, or the atlas coarse panes are read at) is the light atlas's.
+  if (base && (base->width != prm.atlas_width() || base->height != prm.atlas_height() ||
+               base->layout.texels_per_metre != prm.atlas_layout().texels_per_metre))
     return engine::Error{scene.assets.source, "PRM",
                          "the light atlas (" + std::to_string(base->width) + "x" + std::to_string(base->height) +
-                             ") and the PRM (" + std::to_string(prm.width) + "x" + std::to_string(prm.height) +
+                             ") and the PRM (" + std::to_string(prm.atlas_width()) + "x" +
+                             std::to_string(prm.atlas_height()) +
                              ") were baked at different layouts; bake both at one density"};
   if (!static_world) {
     auto caster = make_static_caster(bake_input_from(scene));
     if (!caster) return caster.error();
     static_world = std::move(caster).value();
   }
-  auto meshes = atlas_meshes_of(scene, prm.layout);
+  auto meshes = atlas_meshes_of(scene, prm.atlas_layout());
   if (!meshes) return meshes.error();
   auto impl = std::make_unique<Impl>();
   impl->atlas_meshes = std::move(meshes).value();
@@ -179,7 +181,7 @@ const PrmLighting::Stats& PrmLighting::stats() const { return impl_->stats; }
 
 std::span<const PrmEntryPoint> PrmLighting::entry_points() const { return impl_->prm.entries; }
 
-const AtlasLayout& PrmLighting::layout() const { return impl_->prm.layout; }
+const AtlasLayout& PrmLighting::layout() const { return impl_->prm.atlas_layout(); }
 
 std::vector<glm::vec3> PrmLighting::moving_entry_irradiance() const {
   std::vector<glm::vec3> sum(impl_->prm.entries.size(), glm::vec3(0.0f));

@@ -5,7 +5,9 @@
 // reference: half rounding is at most 2^-11 (~4.9e-4) of each pane value, float
 // accumulation adds ~1e-7 per term.
 #include <gtest/gtest.h>
+#include <engine/gltf.h>
 #include <engine/gpu/context.h>
+#include <gi/bake_input.h>
 
 #include <algorithm>
 #include <cmath>
@@ -18,6 +20,8 @@
 #include "prm/prm.h"
 #include "prm/prm_gpu_pass.h"
 #include "prm/prm_runtime.h"
+#include "uv/atlas_input.h"
+#include "uv/atlas_rasterizer.h"
 
 namespace {
 
@@ -523,4 +527,103 @@ TEST(PrmGpuPass, SparsePanesWriteOnlyTheLitTilesAndMatchTheCpuTwin) {
   const auto gpu = rgb9e5->read_back();
   for (std::size_t t = 0; t < gpu.size(); ++t)
     for (int ch = 0; ch < 3; ++ch) ASSERT_NEAR(gpu[t][ch], ref.value[t][ch], 1e-5 * ref.magnitude[t][ch]) << t;
+}
+
+namespace {
+
+// A PRM whose panes are coarser than its atlas (issue 38): the Cornell box's charts at 8
+// texels per metre for the panes, read at 16 (the atlas), six clusters of pseudo-random
+// values in [0.01, 1] over the coarse layout's valid texels.
+gi::Prm coarse_prm() {
+  auto asset = engine::load_gltf(GI_SOURCE_DIR "/assets/cornell_box.gltf");
+  EXPECT_TRUE(asset.ok()) << asset.error().to_string();
+  const gi::BakeInput input = gi::bake_input_from(asset.value());
+  const auto inputs = gi::atlas_inputs_from(input);
+  auto coarse = gi::build_atlas_layout(inputs, {.texels_per_metre = 8.0f});
+  auto fine = gi::build_atlas_layout(inputs, {.texels_per_metre = 16.0f});
+  EXPECT_TRUE(coarse.ok() && fine.ok());
+  gi::Prm prm;
+  prm.layout = std::move(coarse).value();
+  prm.width = prm.layout.width;
+  prm.height = prm.layout.height;
+  prm.settings.texels_per_metre = 16.0f;
+  prm.settings.pane_texels_per_metre = 8.0f;
+  const gi::AtlasTexels texels = gi::rasterize_atlas(prm.layout, inputs);
+  for (std::size_t t = 0; t < texels.valid.size(); ++t)
+    if (texels.valid[t]) prm.texels.push_back(static_cast<std::uint32_t>(t));
+  prm.cluster_count = 6;
+  prm.cluster_size.assign(6, 1);
+  std::vector<float> dense(6 * prm.texels.size() * 3);
+  for (std::size_t f = 0; f < dense.size(); ++f) dense[f] = 0.01f + 0.99f * gi::Pcg32::for_item(11, f).next_float();
+  gi::set_dense_panes(prm, dense);
+  auto read = gi::prm_atlas_read(prm, std::move(fine).value(), input);
+  EXPECT_TRUE(read.ok()) << read.error().to_string();
+  prm.atlas = std::move(read).value();
+  return prm;
+}
+
+// The CPU twin of a coarse pass: base at the texels the upsampler writes, plus the
+// upsampled K-sum (sum_panes).
+std::vector<glm::vec3> coarse_twin(const gi::Prm& prm, std::span<const gi::ClusterWeight> selected,
+                                   std::span<const glm::vec3> base) {
+  std::vector<glm::vec3> out = gi::sum_panes(prm, selected);
+  for (std::uint32_t t : prm.atlas->upsampler->fine_texels()) out[t] += base[t];
+  return out;
+}
+
+}  // namespace
+
+// Coarse panes: the pass sums at the pane layout, then upsamples with the PaneUpsampler's
+// taps into the atlas. Its output equals the CPU twin (sum_panes over the decoded panes, then
+// the same taps) up to float summation order, and the float panes' sum within half
+// precision; a later run with fewer clusters leaves no stale light; the base lies at every
+// texel the upsampler writes (valid texels and gutter rings), 0 elsewhere.
+TEST(PrmGpuPass, CoarsePanesAreUpsampledIntoTheAtlasLikeTheCpuTwin) {
+  auto ctx = headless_or_fail();
+  const gi::Prm prm = coarse_prm();
+  const auto fine_size = static_cast<std::size_t>(prm.atlas_width() * prm.atlas_height());
+  ASSERT_GE(fine_size, static_cast<std::size_t>(2 * prm.width * prm.height));
+  std::vector<glm::vec3> base(fine_size);
+  for (std::size_t t = 0; t < base.size(); ++t) base[t] = glm::vec3(0.25f, 0.5f, static_cast<float>(t % 5));
+  const std::vector<gi::ClusterWeight> a{{0, glm::vec3(1.0f, 0.5f, 2.0f)}, {3, glm::vec3(0.25f)}};
+  const std::vector<gi::ClusterWeight> b{{5, glm::vec3(3.0f, 1.0f, 0.5f)}};
+  for (const gi::PrmPaneEncoding encoding : {gi::PrmPaneEncoding::Half, gi::PrmPaneEncoding::SharedExponent}) {
+    SCOPED_TRACE(encoding == gi::PrmPaneEncoding::Half ? "half" : "rgb9e5");
+    auto pass = gi::PrmGpuPass::create(prm, {.encoding = encoding});
+    ASSERT_TRUE(pass.ok()) << pass.error().to_string();
+    EXPECT_TRUE(pass->upsamples());
+    EXPECT_EQ(pass->width(), prm.atlas_width());
+    EXPECT_EQ(pass->height(), prm.atlas_height());
+    ASSERT_TRUE(pass->set_base(base).ok());
+    const gi::Prm twin = with_decoded_panes(prm, encoding);
+    for (const auto* selected : {&a, &b, &a}) {
+      ASSERT_TRUE(pass->run(*selected).ok());
+      const std::vector<glm::vec3> gpu = pass->read_back();
+      const std::vector<glm::vec3> cpu = coarse_twin(twin, *selected, base);
+      const std::vector<glm::vec3> exact = coarse_twin(prm, *selected, base);
+      ASSERT_EQ(gpu.size(), cpu.size());
+      double worst_twin = 0.0, worst_float = 0.0;
+      for (std::size_t t = 0; t < gpu.size(); ++t) {
+        // RGB9E5 rounds each channel to a step of the element's largest: its error is
+        // relative to the texel's largest channel.
+        const float top = std::max({exact[t].x, exact[t].y, exact[t].z});
+        for (int ch = 0; ch < 3; ++ch) {
+          const double scale = encoding == gi::PrmPaneEncoding::Half ? double(exact[t][ch]) : double(top);
+          worst_twin = std::max(worst_twin, double(std::abs(gpu[t][ch] - cpu[t][ch])) / (double(cpu[t][ch]) + 1e-6));
+          worst_float = std::max(worst_float, double(std::abs(gpu[t][ch] - exact[t][ch])) / (scale + 1e-6));
+        }
+      }
+      std::printf("coarse panes, K = %zu: max relative |gpu - twin| %.3g, |gpu - float panes| %.3g\n", selected->size(),
+                  worst_twin, worst_float);
+      EXPECT_LE(worst_twin, 1e-5);
+      // Half floats: 2^-11 of each (non-negative) value; RGB9E5: 2e-3 of each element's largest
+      // channel, times the weights' spread over channels (up to 8 here).
+      EXPECT_LE(worst_float, encoding == gi::PrmPaneEncoding::Half ? kRelativeTolerance : 2e-2);
+    }
+    ASSERT_TRUE(pass->run({}).ok());
+    const std::vector<glm::vec3> back = pass->read_back();
+    std::vector<bool> written(fine_size, false);
+    for (std::uint32_t t : prm.atlas->upsampler->fine_texels()) written[t] = true;
+    for (std::size_t t = 0; t < back.size(); ++t) ASSERT_EQ(back[t], written[t] ? base[t] : glm::vec3(0.0f)) << t;
+  }
 }

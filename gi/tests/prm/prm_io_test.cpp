@@ -20,6 +20,7 @@
 #include <engine/byte_stream.h>
 #include "bundle/bundle.h"
 #include "io/content_hash.h"
+#include "prm/prm_runtime.h"
 #include "uv/atlas_input.h"
 
 namespace {
@@ -144,7 +145,7 @@ void put_payload(const fs::path& dir, const std::vector<std::byte>& payload) {
 }
 
 // Offsets of fixed fields in the payload (geometry hash string of 16 characters first).
-constexpr std::size_t kSettingsBytes = 4 + 4 + 4 + 4 + 4 + 1 + 8;  // no thread count (version 2)
+constexpr std::size_t kSettingsBytes = 4 + 4 + 4 + 4 + 4 + 4 + 1 + 8;  // pane density since version 4
 constexpr std::size_t kClusterCountOffset = 8 + 16 + kSettingsBytes + 4 + 4;
 constexpr std::size_t kTexelsOffset = kClusterCountOffset + 4;  // uint64 count, then the texels
 
@@ -263,6 +264,60 @@ TEST(PrmIo, RoundTripKeepsStructureExactAndPanesWithinTheHalfBound) {
   auto again = gi::load_prm(dir, gi::bake_input_from(cornell()));
   ASSERT_TRUE(again.ok());
   EXPECT_EQ(again->panes, back->panes);
+}
+
+// Panes coarser than the atlas (issue 38): the bundle keeps both layouts, and the load
+// rebuilds the same upsampler, so the atlas it sums is the saved PRM's within half precision.
+TEST(PrmIo, CoarsePanesKeepTheirAtlasLayoutAndUpsampler) {
+  gi::Prm prm = fake_prm(8.0f);
+  prm.settings.texels_per_metre = 16.0f;
+  prm.settings.pane_texels_per_metre = 8.0f;
+  const gi::BakeInput input = gi::bake_input_from(cornell());
+  auto fine = gi::build_atlas_layout(gi::atlas_inputs_from(input), {.texels_per_metre = 16.0f});
+  ASSERT_TRUE(fine.ok());
+  auto read = gi::prm_atlas_read(prm, std::move(fine).value(), input);
+  ASSERT_TRUE(read.ok()) << read.error().to_string();
+  prm.atlas = std::move(read).value();
+  ASSERT_GT(prm.atlas_width() * prm.atlas_height(), prm.width * prm.height);
+  const fs::path dir = saved_bundle("coarse", prm);
+  EXPECT_TRUE(fs::exists(dir / gi::kPrmAtlasLayoutFile));
+
+  auto back = gi::load_prm(dir, input);
+  ASSERT_TRUE(back.ok()) << back.error().to_string();
+  EXPECT_EQ(back->settings.pane_texels_per_metre, 8.0f);
+  EXPECT_EQ(back->width, prm.width);
+  EXPECT_EQ(back->layout.requested_texels_per_metre, 8.0f);
+  ASSERT_TRUE(back->atlas.has_value());
+  EXPECT_EQ(back->atlas_width(), prm.atlas_width());
+  EXPECT_EQ(back->atlas_height(), prm.atlas_height());
+  EXPECT_EQ(back->atlas_layout().requested_texels_per_metre, 16.0f);
+  const gi::PaneUpsampler &a = *prm.atlas->upsampler, &b = *back->atlas->upsampler;
+  EXPECT_TRUE(std::ranges::equal(a.fine_texels(), b.fine_texels()));
+  EXPECT_TRUE(std::ranges::equal(a.tap_first(), b.tap_first()));
+  ASSERT_EQ(a.taps().size(), b.taps().size());
+  for (std::size_t t = 0; t < a.taps().size(); ++t) {
+    EXPECT_EQ(a.taps()[t].coarse, b.taps()[t].coarse);
+    EXPECT_EQ(a.taps()[t].weight, b.taps()[t].weight);
+  }
+  // The atlas summed from both: pane 1 (values 0.2-0.5) at weight 1, read at the atlas.
+  const std::vector<gi::ClusterWeight> one{{1, glm::vec3(1.0f)}};
+  const std::vector<glm::vec3> before = gi::sum_panes(prm, one), after = gi::sum_panes(*back, one);
+  ASSERT_EQ(before.size(), static_cast<std::size_t>(prm.atlas_width() * prm.atlas_height()));
+  ASSERT_EQ(after.size(), before.size());
+  std::size_t lit = 0;
+  for (std::size_t t = 0; t < before.size(); ++t) {
+    lit += before[t].x > 0.0f;
+    for (int ch = 0; ch < 3; ++ch)
+      EXPECT_NEAR(after[t][ch], before[t][ch], (gi::kPrmPaneRelativeError + 1e-6) * double(before[t][ch]) + 1e-7) << t;
+  }
+  EXPECT_GT(lit, a.fine_texels().size() / 2) << "the coarse pane reaches the atlas's texels";
+
+  // An entry that lost its atlas layout is refused, naming the manifest.
+  auto m = gi::read_manifest(dir);
+  ASSERT_TRUE(m.ok());
+  m->methods["prm"].erase(gi::kPrmAtlasLayoutKey);
+  ASSERT_TRUE(gi::write_manifest(dir, *m).ok());
+  expect_load_error(dir, "manifest.json", "no atlas layout");
 }
 
 TEST(PrmIo, ManifestEntryDescribesTheBake) {
@@ -420,11 +475,15 @@ TEST(PrmIo, MissingOrDamagedFilesAreRejected) {
     b[8] = std::byte{1};  // version 1 stored the thread count
     write_all(dir / "prm_panes.bin", b);
     resign(dir);
-    expect_load_error(dir, "prm_panes.bin", "unsupported version 1, this build reads 3");
+    expect_load_error(dir, "prm_panes.bin", "unsupported version 1, this build reads 4");
     b[8] = std::byte{2};  // version 2 stored dense panes (before the blocks of issue 38)
     write_all(dir / "prm_panes.bin", b);
     resign(dir);
-    expect_load_error(dir, "prm_panes.bin", "unsupported version 2, this build reads 3");
+    expect_load_error(dir, "prm_panes.bin", "unsupported version 2, this build reads 4");
+    b[8] = std::byte{3};  // version 3 had no pane density (panes always at the atlas's)
+    write_all(dir / "prm_panes.bin", b);
+    resign(dir);
+    expect_load_error(dir, "prm_panes.bin", "unsupported version 3, this build reads 4");
   }
   {
     const fs::path dir = saved_bundle("no_manifest");

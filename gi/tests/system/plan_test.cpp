@@ -313,7 +313,9 @@ TEST(PlanCost, EstimatesAreWithinAFactorOfTwoOfTheCalibrationBakes) {
     const engine::Scene scene = load(r.scene);
     const gi::StaticSurfaceCensus census = gi::census_static_surfaces(gi::bake_input_from(scene));
     const gi::LightAtlasSettings as = gi::light_atlas_preset(r.preset).value();
-    const gi::PrmSettings ps = gi::prm_preset(r.preset).value();
+    // Measured with panes at the atlas's density (before the presets' coarse panes).
+    gi::PrmSettings ps = gi::prm_preset(r.preset).value();
+    ps.pane_texels_per_metre = 0.0f;
     const gi::AtlasTexelEstimate t = gi::atlas_texels(census, as.texels_per_metre);
     // The light points gi-bake reported: spot 1 (the spot); cornell 128 = the area light's
     // emissive proxy, 2 triangles x 64; demo 131 = 3 punctual lights + 2 x 64.

@@ -87,6 +87,53 @@ TEST(PrmLighting, UpdatesOnlyWhenAMovingLightChangesAndMatchesTheCpuSum) {
   for (const glm::vec3& e : read_texture(tex, cpu_copy.width, cpu_copy.height)) EXPECT_EQ(e, glm::vec3(0.0f));
 }
 
+// Panes coarser than the atlas (the presets' since issue 38): the provider's texture is at the
+// atlas's size, its meshes carry the atlas's uv1, and it equals the CPU twin (the decoded
+// panes summed, then upsampled) up to float summation order.
+TEST(PrmLighting, CoarsePanesAreReadAtTheAtlasLikeTheCpuSum) {
+  auto ctx = engine::GpuContext::create_headless();
+  ASSERT_TRUE(ctx) << "no headless GL context: " << ctx.error().to_string();
+  auto asset = engine::load_gltf(GI_SOURCE_DIR "/assets/spot_chamber.gltf");
+  ASSERT_TRUE(asset);
+  engine::Scene scene = engine::instantiate(std::move(asset.value()));
+  const engine::Entity spot = engine::find_by_name(scene.registry, "spot");
+  scene.registry.write<engine::Light>(spot).moves = true;
+
+  gi::PrmSettings ps;
+  ps.texels_per_metre = 4.0f;
+  ps.pane_texels_per_metre = 2.0f;
+  ps.entry_points = 512;
+  ps.clusters = 32;
+  gi::Prm prm = gi::bake_prm(gi::bake_input_from(scene), ps).value();
+  ASSERT_TRUE(prm.atlas.has_value());
+  gi::Prm cpu_copy = prm;
+  cpu_copy.panes = gi::decoded_panes(prm, gi::PrmPaneEncoding::SharedExponent).value();
+  auto provider = gi::PrmLighting::from_bake(std::move(prm), nullptr, scene, {.active_clusters = 16});
+  ASSERT_TRUE(provider) << provider.error().to_string();
+  gi::PrmLighting& gi = **provider;
+  EXPECT_EQ(gi.layout().width, cpu_copy.atlas_width());
+  EXPECT_EQ(gi.layout().requested_texels_per_metre, 4.0f);
+
+  const std::uint32_t tex = gi.frame().irradiance_atlas_texture.gl_name;
+  ASSERT_NE(tex, 0u);
+  auto caster = gi::make_static_caster(gi::bake_input_from(scene)).value();
+  const std::vector<glm::vec3> cpu = gi::sum_panes(
+      cpu_copy, gi::relight_clusters(cpu_copy, gi::scene_lights(scene.registry, gi::BakeLights::Moving), *caster, 16));
+  const std::vector<glm::vec3> gpu = read_texture(tex, cpu_copy.atlas_width(), cpu_copy.atlas_height());
+  ASSERT_EQ(gpu.size(), cpu.size());
+  double worst = 0.0, lit = 0.0;
+  for (std::size_t t = 0; t < cpu.size(); ++t) {
+    lit += cpu[t].x > 0.0f;
+    for (int c = 0; c < 3; ++c)
+      worst = std::max(worst, std::abs(static_cast<double>(gpu[t][c] - cpu[t][c])) /
+                                  (std::abs(static_cast<double>(cpu[t][c])) + 1e-6));
+  }
+  std::printf("coarse panes: GPU vs CPU max relative difference %.2e over %.0f lit atlas texels, %zu GPU bytes\n",
+              worst, lit, gi.stats().gpu_bytes);
+  EXPECT_GT(lit, 0.0);
+  EXPECT_LT(worst, 1e-4);
+}
+
 // Two moving lights: when one moves, only its entry irradiance is recomputed (the other's is
 // cached), and the atlas still equals the CPU relight of both.
 TEST(PrmLighting, OnlyTheLightThatMovedIsRecomputed) {
