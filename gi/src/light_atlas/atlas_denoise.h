@@ -5,7 +5,10 @@
 // kernel whose step doubles each pass (1, 2, 4, ... texels); a neighbour's weight falls with
 // the angle between the normals, with its distance off the texel's plane, and with the
 // difference of the two values in units of the standard deviation of that difference, so an
-// edge the estimate resolves (a sun-bounce gradient, a shadow) stays and noise goes.
+// edge the estimate resolves (a sun-bounce gradient, a shadow) stays and noise goes. Before
+// the passes, a texel far above its neighbours (a gather whose few rays hit a bright patch
+// the others missed) is clamped to their mean + `outlier_sigmas` of their spread: its own
+// variance, large, would otherwise let the passes spread it into a blotch.
 //   gi::denoise_world(texels, work, hidden, variance, texel_m, {.passes = 4}, pool, {&indirect, &sky});
 
 #include <cstdint>
@@ -23,6 +26,10 @@ struct DenoiseSettings {
   /// Value weight exp(-(l_i - l_j)^2 / (2 value_sigma^2 var(l_i - l_j))).
   float value_sigma = 2.0f;
   float normal_power = 64.0f;  ///< Normal weight max(0, n_i . n_j)^normal_power.
+  /// The clamp before the passes: a texel's luminance at most the mean + outlier_sigmas
+  /// standard deviations of its co-planar neighbours' within 2.5 texels, their brightest left
+  /// out (0: no clamp).
+  float outlier_sigmas = 3.0f;
 };
 
 /// Denoises the fields `fields` (each per atlas texel, W/m^2) together over the texels of
