@@ -295,6 +295,19 @@ TEST(AtlasDenoise, BitIdenticalForAnyThreadCount) {
   const std::vector<glm::vec3> one = denoised(s, 4, 1), three = denoised(s, 4, 3);
   EXPECT_EQ(one, three);
   EXPECT_NE(one, s.noisy);
+  // With the outlier clamp, which takes the synthetic scene's noisiest texels (15% noise).
+  const auto clamped = [&](unsigned threads) {
+    Synthetic c = s;
+    gi::ThreadPool pool(threads);
+    std::vector<glm::vec3> zero(c.noisy.size(), glm::vec3(0.0f));
+    std::vector<glm::vec3>* const fields[] = {&c.noisy, &zero};
+    gi::denoise_world(c.texels, c.work, c.hidden, kTexel, {.passes = 4, .outlier_sigmas = 3.0f}, pool, c.variance,
+                      fields);
+    return c.noisy;
+  };
+  const std::vector<glm::vec3> clamped_one = clamped(1);
+  EXPECT_EQ(clamped_one, clamped(3));
+  EXPECT_NE(clamped_one, one);
 }
 
 }  // namespace
