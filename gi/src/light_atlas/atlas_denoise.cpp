@@ -1,6 +1,8 @@
 #include "light_atlas/atlas_denoise.h"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "core/color.h"
 #include "light_atlas/texel_cells.h"
@@ -74,6 +76,52 @@ void atrous_pass(const AtlasTexels& tx, const std::vector<std::uint32_t>& visibl
       4);
 }
 
+// The clamp's neighbourhood: co-planar texels (normals within ~26 degrees, centres within
+// half a texel of the plane) within 2.5 texels, 20 on a flat wall; fewer than 5 (a sliver of
+// a chart alone in its plane): no clamp.
+constexpr float kClampRadiusTexels = 2.5f;
+constexpr float kClampMinCos = 0.9f;
+constexpr int kClampMinNeighbours = 5;
+
+// The clamp before the passes (DenoiseSettings::outlier_sigmas): per texel, the factor that
+// brings its luminance down to the mean + k standard deviations of its neighbours' (their
+// brightest left out, so that two outliers side by side do not shelter each other), 1 if it
+// is not above. A step the gather resolves keeps: a texel on its bright side has at least a
+// third of its neighbours as bright, whose spread then reaches it.
+std::vector<float> outlier_scale(const AtlasTexels& tx, const std::vector<std::uint32_t>& visible, float texel_m,
+                                 float k, ThreadPool& pool, const std::vector<float>& lum) {
+  const float radius_m = kClampRadiusTexels * texel_m, plane_m = 0.5f * texel_m;
+  const TexelCells cells(tx, visible, radius_m);
+  std::vector<float> scale(lum.size(), 1.0f);
+  pool.parallel_for(
+      cells.cell_count(),
+      [&](std::size_t c) {
+        std::vector<std::uint32_t> near;
+        cells.for_around(cells.cell(c), [&](std::uint32_t j) { near.push_back(j); });
+        cells.for_cell(c, [&](std::uint32_t i) {
+          const glm::vec3 p = tx.position[i], n = tx.normal[i];
+          double sum = 0.0, squares = 0.0, brightest = -std::numeric_limits<double>::infinity();
+          int count = 0;
+          for (std::uint32_t j : near) {
+            const glm::vec3 d = tx.position[j] - p;
+            if (j == i || glm::dot(d, d) > radius_m * radius_m || glm::dot(tx.normal[j], n) < kClampMinCos ||
+                std::fabs(glm::dot(d, n)) > plane_m)
+              continue;
+            const double l = lum[j];
+            sum += l, squares += l * l, brightest = std::max(brightest, l), ++count;
+          }
+          if (count < kClampMinNeighbours) return;
+          sum -= brightest, squares -= brightest * brightest, --count;
+          const double mean = sum / count;
+          const double spread = std::sqrt(std::max(0.0, (squares - sum * mean) / (count - 1)));
+          const double limit = std::max(0.0, mean + static_cast<double>(k) * spread), li = lum[i];
+          if (li > limit) scale[i] = static_cast<float>(limit / li);
+        });
+      },
+      4);
+  return scale;
+}
+
 }  // namespace
 
 void denoise_world(const AtlasTexels& tx, std::span<const std::uint32_t> work, const std::vector<std::uint8_t>& hidden,
@@ -87,12 +135,21 @@ void denoise_world(const AtlasTexels& tx, std::span<const std::uint32_t> work, c
   for (std::size_t f = 0; f < fields.size() && f < 2; ++f) cur.push_back(*fields[f]);
   next = cur;
   std::vector<float> lum(variance.size(), 0.0f), next_variance = variance;
-  for (int pass = 0; pass < s.passes; ++pass) {
+  const auto sum_luminance = [&] {
     for (std::uint32_t i : visible) {
       glm::vec3 total(0.0f);
       for (const auto& f : cur) total += f[i];
       lum[i] = luminance(total);
     }
+  };
+  if (s.outlier_sigmas > 0.0f) {
+    sum_luminance();
+    const std::vector<float> scale = outlier_scale(tx, visible, texel_m, s.outlier_sigmas, pool, lum);
+    for (std::uint32_t i : visible)
+      for (auto& f : cur) f[i] *= scale[i];
+  }
+  for (int pass = 0; pass < s.passes; ++pass) {
+    sum_luminance();
     atrous_pass(tx, visible, 1 << pass, texel_m, s, pool, PassInput{cur, lum, variance}, next, next_variance);
     std::swap(cur, next);
     std::swap(variance, next_variance);

@@ -6,6 +6,10 @@
 // the angle between the normals, with its distance off the texel's plane, and with the
 // difference of the two values in units of the standard deviation of that difference, so an
 // edge the estimate resolves (a sun-bounce gradient, a shadow) stays and noise goes.
+// Optionally (`outlier_sigmas`, off by default), before the passes, a texel far above its
+// neighbours (a gather whose few rays hit a bright patch the others missed) is clamped to
+// their mean + `outlier_sigmas` of their spread: its own variance, large, would otherwise
+// let the passes spread it into a blotch.
 //   gi::denoise_world(texels, work, hidden, variance, texel_m, {.passes = 4}, pool, {&indirect, &sky});
 
 #include <cstdint>
@@ -23,6 +27,11 @@ struct DenoiseSettings {
   /// Value weight exp(-(l_i - l_j)^2 / (2 value_sigma^2 var(l_i - l_j))).
   float value_sigma = 2.0f;
   float normal_power = 64.0f;  ///< Normal weight max(0, n_i . n_j)^normal_power.
+  /// The clamp before the passes: a texel's luminance at most the mean + outlier_sigmas
+  /// standard deviations of its co-planar neighbours' within 2.5 texels, their brightest left
+  /// out (0: no clamp). Off by default: at 3 it removes the crate room's blotches but costs
+  /// Dabrovic Sponza 1.5 points of its indirect-dominated error (docs/light_atlas.md).
+  float outlier_sigmas = 0.0f;
 };
 
 /// Denoises the fields `fields` (each per atlas texel, W/m^2) together over the texels of
