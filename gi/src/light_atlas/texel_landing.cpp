@@ -93,10 +93,10 @@ glm::vec3 bilinear(const std::vector<glm::vec3>& img, int w, int h, glm::vec2 uv
          ay * ((1.0f - ax) * at(x0, y0 + 1) + ax * at(x0 + 1, y0 + 1));
 }
 
-}  // namespace
-
-Landing land_ray(const StaticBakeScene& b, const AtlasLayout& layout, const TexelTable& t, const Ray& ray,
-                 const glm::vec3& from) {
+// land_ray; with `corners` false, Landing::unseen_corners stays 0 (its visibility rays are
+// cast only for the reads that use them).
+Landing land(const StaticBakeScene& b, const AtlasLayout& layout, const TexelTable& t, const Ray& ray,
+             const glm::vec3& from, bool corners) {
   const Hit h = b.caster->intersect(ray);
   if (!h.valid()) return {};
   const ShadingTriangle& tri = b.index.triangles[b.triangle_of(h)];
@@ -115,15 +115,23 @@ Landing land_ray(const StaticBakeScene& b, const AtlasLayout& layout, const Texe
   l.pixel = static_cast<std::uint32_t>(static_cast<std::size_t>(y) * static_cast<std::size_t>(t.width) +
                                        static_cast<std::size_t>(x));
   l.texel = t.redirect[l.pixel];
-  if (l.texel != kDark) mark_unseen(b, t, ray.origin + h.t * ray.direction, h.t, l);
+  if (corners && l.texel != kDark) mark_unseen(b, t, ray.origin + h.t * ray.direction, h.t, l);
   l.distance = h.t;
   l.cos_surface = std::fabs(cos_surface);
   return l;
 }
 
+}  // namespace
+
+Landing land_ray(const StaticBakeScene& b, const AtlasLayout& layout, const TexelTable& t, const Ray& ray,
+                 const glm::vec3& from) {
+  return land(b, layout, t, ray, from, true);
+}
+
 std::uint32_t landing(const StaticBakeScene& b, const AtlasLayout& layout, const TexelTable& t, const Ray& ray,
                       const glm::vec3& from, glm::vec2* uv) {
-  const Landing l = land_ray(b, layout, t, ray, from);
+  // The kept rays read the texel alone: no corner of a bilinear read to check.
+  const Landing l = land(b, layout, t, ray, from, false);
   if (uv && l.texel != kSky && l.texel != kBack) *uv = l.uv;
   return l.texel;
 }

@@ -43,7 +43,7 @@ Landing land_ray(const StaticBakeScene& b, const AtlasLayout& layout, const Texe
                  const glm::vec3& from);
 
 /// land_ray's texel alone (kSky, kBack, kDark or a texel), and its atlas UV in `uv` (if given)
-/// when it lands on a surface.
+/// when it lands on a surface; without the visibility rays of Landing::unseen_corners.
 std::uint32_t landing(const StaticBakeScene& b, const AtlasLayout& layout, const TexelTable& t, const Ray& ray,
                       const glm::vec3& from, glm::vec2* uv);
 
