@@ -12,23 +12,36 @@
 #   TABLE_ONLY=1 bash tools/sweep-light-atlas-sponza.sh   (speedup.md from the CSVs already there)
 #   DENOISE=0 / EMITTERS=0                           (without the guided denoiser's runs / the
 #                                                     emitter-sampled gather's runs)
+#   FILTERS=0                                        (without the 2.5-texel / unfiltered runs)
+#   TEXTURED=1 bash tools/sweep-light-atlas-sponza.sh   (the level with its textures, in the
+#       bakers, the path tracer and the truth alike: docs/sweeps/light_atlas_sponza_textured/;
+#       its own truth, cached apart from the untextured one). The preset row and the path
+#       tracer's alone: TEXTURED=1 FILTERS=0 DENOISE=0 EMITTERS=0 HIGH=0 TRUTH_SPP=256
 set -euo pipefail
 cd "$(dirname "$0")/.."
 sweep=${GI_SWEEP:-build/tools/gi-sweep/gi-sweep}
+textured=${TEXTURED:-0}
 out=docs/sweeps/light_atlas_sponza
+texture_flag=(--untextured)
+if [[ $textured != 0 ]]; then
+  out=docs/sweeps/light_atlas_sponza_textured
+  texture_flag=()
+fi
 cache=${CACHE:-build/reference-cache}
 scene=${GI_EXTERNAL_ASSETS_DIR:-../shared/external-assets}/dabrovic-sponza/sponza.gltf
 truth_spp=${TRUTH_SPP:-256}
 pt_spp=${PT_SPP:-16,64}
-lighting=(--untextured --sky 'zenith:10,16,30;horizon:28,30,34;ground:6,6,6'
+lighting=("${texture_flag[@]}" --sky 'zenith:10,16,30;horizon:28,30,34;ground:6,6,6'
   --sun 'direction:0.25,-1,0.15;irradiance:700,650,600' --split-truth "$truth_spp")
 common=(--scene "$scene" "${lighting[@]}" --cache "$cache" --threads 2)
 gather=(--method light_atlas --knob density=8 --knob final=gather --knob vpls=1000 --knob bounces=64)
 run() { if [[ ${TABLE_ONLY:-0} == 0 ]]; then "$@"; fi; }
-# preview / medium settings (32 kept + 128 fresh rays), with and without the 2.5-texel filter
-run "$sweep" "${gather[@]}" --knob solve_rays=32 --knob rays=128 --knob filter=2.5,0 --knob direct_samples=8 \
-  "${common[@]}" --out "$out/gather"
-csvs=("$out/gather/light_atlas_sponza.csv")
+csvs=()
+if [[ ${FILTERS:-1} != 0 ]]; then  # 32 kept + 128 fresh rays, with the 2.5-texel filter (the presets before) and without
+  run "$sweep" "${gather[@]}" --knob solve_rays=32 --knob rays=128 --knob filter=2.5,0 --knob direct_samples=8 \
+    "${common[@]}" --out "$out/gather"
+  csvs+=("$out/gather/light_atlas_sponza.csv")
+fi
 # the presets preview / medium now: the guided denoiser, 2 passes, then a 1.5-texel filter
 run "$sweep" "${gather[@]}" --knob solve_rays=32 --knob rays=128 --knob filter=1.5 --knob denoise=2 \
   --knob direct_samples=8 "${common[@]}" --out "$out/preset"
@@ -54,8 +67,10 @@ fi
 {
   echo "# The light atlas against the path tracer on Dabrovic Sponza (issue 35)"
   echo
-  echo "Regenerate: \`TRUTH_SPP=$truth_spp PT_SPP=$pt_spp HIGH=${HIGH:-1} bash tools/sweep-light-atlas-sponza.sh\`"
-  echo "(the sweeps' own commands are at the top of their .md files). Untextured, the sun"
+  echo "Regenerate: \`TEXTURED=$textured FILTERS=${FILTERS:-1} DENOISE=${DENOISE:-1} EMITTERS=${EMITTERS:-1}" \
+    "TRUTH_SPP=$truth_spp PT_SPP=$pt_spp HIGH=${HIGH:-1} bash tools/sweep-light-atlas-sponza.sh\`"
+  if [[ $textured != 0 ]]; then textures="With its textures"; else textures="Untextured"; fi
+  echo "(the sweeps' own commands are at the top of their .md files). $textures, the sun"
   echo "\`direction:0.25,-1,0.15;irradiance:700,650,600\` and the sky \`zenith:10,16,30;horizon:28,30,34;ground:6,6,6\`,"
   echo "8 texels/m; truth: two $truth_spp-spp path-traced atlases, their noise removed. Load average when the"
   echo "sweeps ended: $(cut -d' ' -f1-3 /proc/loadavg) on $(nproc) cores (seconds under load are inflated alike for both)."

@@ -1,16 +1,13 @@
 #include "light_atlas/texel_gather.h"
 
-#include <engine/gltf_brdf.h>
 #include <engine/sky.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <limits>
 #include <numbers>
 #include <optional>
 #include <span>
-#include <unordered_map>
 
 #include "core/color.h"
 #include "core/random.h"
@@ -20,8 +17,9 @@
 #include "light_atlas/texel_direct.h"
 #include "light_atlas/texel_emitters.h"
 #include "light_atlas/texel_filter.h"
+#include "light_atlas/texel_landing.h"
 #include "light_atlas/texel_sampling.h"
-#include "raytrace/material_lookup.h"
+#include "light_atlas/texel_table.h"
 #include "raytrace/ray_offset.h"
 #include "raytrace/reference_brdf.h"
 #include "uv/atlas_dilation.h"
@@ -32,20 +30,9 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 constexpr float kPi = std::numbers::pi_v<float>;
-constexpr std::uint32_t kDark = 0xffffffffu;  // a ray into the surface, or nothing to read
-constexpr std::uint32_t kSky = 0xfffffffeu;   // the ray escaped
-constexpr std::uint32_t kBack = 0xfffffffdu;  // the back of a one-sided surface (black)
 // A texel whose kept rays see back faces this often lies inside or under geometry; the
 // filter neither reads nor smooths it.
 constexpr float kHiddenBackFraction = 0.1f;
-// Two surfaces facing each other closer than this (in texels) enclose a gap no light enters
-// (a slab's underside 2 mm above the next one's top, in Dabrovic Sponza): a ray from one
-// that lands on the other reads dark, not the texel there, whose sample lies in the open.
-constexpr float kGapTexels = 0.05f;
-// A texel's sample this far off its triangle's plane was moved by relocate_texel_samples (at
-// least 0.01 texel off its surface): whether it sees a point where a ray lands on its texel
-// is checked (Landing::unseen_corners).
-constexpr float kOffPlaneTexels = 0.001f;
 
 // Item ids of the four random streams of a texel.
 constexpr std::uint64_t kDirectStream = 0, kSolveStream = 1, kGatherStream = 2, kEmitterStream = 3;
@@ -65,238 +52,7 @@ engine::Status validate(const TexelGatherSettings& s) {
   return {};
 }
 
-// What the gather knows of every texel of the atlas.
-struct TexelTable {
-  int width = 0, height = 0;
-  std::vector<std::uint32_t> work;      // valid texels in index order
-  std::vector<glm::vec3> albedo;        // per atlas texel: hemispherical albedo of its material
-  std::vector<glm::vec3> face;          // per atlas texel: unit geometric normal on the shading side
-  std::vector<std::uint32_t> redirect;  // per atlas texel: itself when valid, else a valid neighbour or kDark
-  float gap_m = 0.0f;                   // kGapTexels in metres
-  float plane_m = 0.0f;                 // kOffPlaneTexels in metres
-  std::vector<std::uint8_t> moved;      // per atlas texel: its sample lies off its triangle's plane
-  float near_m = 0.0f;                  // one texel in metres
-};
-
-// TexelTable::moved: the samples relocate_texel_samples moved off their triangle's plane.
-void mark_moved_samples(const StaticBakeScene& b, TexelTable& t) {
-  const AtlasTexels& tx = b.texels;
-  t.moved.assign(tx.valid.size(), 0);
-  for (std::uint32_t i : t.work) {
-    const std::uint32_t mesh = static_cast<std::uint32_t>(tx.mesh[i]);
-    const ShadingTriangle& tri =
-        b.index.triangles[b.index.instance_first[b.static_instance[mesh]] + static_cast<std::uint32_t>(tx.triangle[i])];
-    t.moved[i] = std::fabs(glm::dot(tx.position[i] - tri.p0, tri.face_normal)) > t.plane_m ? 1 : 0;
-  }
-}
-
-engine::Result<TexelTable> texel_table(const StaticBakeScene& b, const AtlasLayout& layout) {
-  // Long because it fills one table in one pass over the texels: the layout checks, the
-  // per-texel albedo and face, then the gutter redirects that read what that pass wrote.
-  const AtlasTexels& tx = b.texels;
-  if (tx.width != layout.width || tx.height != layout.height || layout.meshes.size() != b.static_instance.size())
-    return engine::Error{.message = "texel gather: the atlas layout does not match the bake scene"};
-  for (std::size_t m = 0; m < layout.meshes.size(); ++m) {
-    const auto [first, end] = instance_triangles(b.index, b.static_instance[m]);
-    if (layout.meshes[m].indices.size() != 3u * (end - first))
-      return engine::Error{.message = "texel gather: atlas mesh " + std::to_string(m) +
-                                      " has another triangle count than its static instance"};
-  }
-  TexelTable t;
-  t.width = tx.width;
-  t.height = tx.height;
-  t.gap_m = layout.texels_per_metre > 0.0f ? kGapTexels / layout.texels_per_metre : 0.0f;
-  t.plane_m = layout.texels_per_metre > 0.0f ? kOffPlaneTexels / layout.texels_per_metre : 0.0f;
-  t.near_m = layout.texels_per_metre > 0.0f ? 1.0f / layout.texels_per_metre : 0.0f;
-  const std::size_t n = tx.valid.size();
-  t.albedo.assign(n, glm::vec3(0.0f));
-  t.face.assign(n, glm::vec3(0.0f));
-  t.redirect.assign(n, kDark);
-  std::unordered_map<std::uint32_t, glm::vec3> albedo_of;
-  for (std::size_t i = 0; i < n; ++i) {
-    if (!tx.valid[i]) continue;
-    t.work.push_back(static_cast<std::uint32_t>(i));
-    t.redirect[i] = static_cast<std::uint32_t>(i);
-    const std::uint32_t mesh = static_cast<std::uint32_t>(tx.mesh[i]);
-    const ShadingTriangle& tri =
-        b.index.triangles[b.index.instance_first[b.static_instance[mesh]] + static_cast<std::uint32_t>(tx.triangle[i])];
-    if (b.scene.materials[tri.material].textured()) {
-      // The texture's mean over the texel's footprint (material_lookup.h), not one point.
-      const TexelFootprint f = texel_footprint(layout, tx.mesh[i], tx.triangle[i], i);
-      t.albedo[i] = footprint_albedo(b.scene, tri, f.centre, f.axis_u, f.axis_v);
-      t.face[i] = glm::dot(tri.face_normal, tx.normal[i]) < 0.0f ? -tri.face_normal : tri.face_normal;
-      continue;
-    }
-    auto it = albedo_of.find(tri.material);
-    if (it == albedo_of.end())
-      it =
-          albedo_of.emplace(tri.material, engine::gltf_hemispherical_albedo(b.scene.materials[tri.material].brdf).sum())
-              .first;
-    t.albedo[i] = it->second;
-    t.face[i] = glm::dot(tri.face_normal, tx.normal[i]) < 0.0f ? -tri.face_normal : tri.face_normal;
-  }
-  // Rays landing on an empty texel of a chart (its gutter, a sliver's corner) read the
-  // nearest valid one, found ring by ring in a fixed neighbour order.
-  for (int ring = 0; ring < std::max(3, layout.padding_texels); ++ring) {
-    std::vector<std::pair<std::size_t, std::uint32_t>> found;
-    for (int y = 0; y < t.height; ++y)
-      for (int x = 0; x < t.width; ++x) {
-        const std::size_t i = tx.index(x, y);
-        if (t.redirect[i] != kDark) continue;
-        for (int k = 0; k < 9; ++k) {
-          const int nx = x + k % 3 - 1, ny = y + k / 3 - 1;
-          if (nx < 0 || ny < 0 || nx >= t.width || ny >= t.height) continue;
-          const std::uint32_t r = t.redirect[tx.index(nx, ny)];
-          if (r == kDark) continue;
-          found.emplace_back(i, r);
-          break;
-        }
-      }
-    if (found.empty()) break;
-    for (const auto& [i, r] : found) t.redirect[i] = r;
-  }
-  mark_moved_samples(b, t);
-  return t;
-}
-
-glm::vec2 hit_uv(const AtlasLayout& layout, const Hit& h) {
-  const AtlasMeshUv& mu = layout.meshes[h.instance];
-  const std::uint32_t* idx = &mu.indices[3u * h.primitive];
-  const float u = h.barycentric.x, v = h.barycentric.y;
-  return (1.0f - u - v) * mu.uv1[idx[0]] + u * mu.uv1[idx[1]] + v * mu.uv1[idx[2]];
-}
-
-// Where a ray from a texel whose face is `from` ends: kSky, kBack (the back of a one-sided
-// surface, or a surface facing `from` across a gap of less than kGapTexels) or the atlas texel
-// it reads (a valid texel, redirected from an empty one); on a surface also the atlas UV of the
-// hit, the atlas texel under it as it is (`pixel`, maybe empty), the distance and |cos| at the
-// surface, and the hit itself (its triangle, barycentrics, the side the ray came from).
-struct Landing {
-  std::uint32_t texel = kSky;
-  glm::vec2 uv{0.0f};
-  std::uint32_t pixel = kDark;
-  float distance = 0.0f, cos_surface = 0.0f;
-  std::uint32_t triangle = 0;
-  glm::vec2 barycentric{0.0f};
-  glm::vec3 side{0.0f};  // the hit triangle's unit face normal turned towards the ray's origin
-  // Bit k: the sample of the bilinear read's corner k does not see the landing point (its
-  // light is not the point's).
-  std::uint8_t unseen_corners = 0;
-};
-
-// The four atlas pixels of a bilinear read at uv (bilinear()'s), corner k = (x0 + k % 2, y0 + k / 2),
-// and its fractions.
-struct Footprint {
-  std::size_t pixel[4];
-  float ax, ay;
-};
-
-Footprint footprint_at(int w, int h, glm::vec2 uv) {
-  const float fx = uv.x * static_cast<float>(w) - 0.5f, fy = uv.y * static_cast<float>(h) - 0.5f;
-  const float x0f = std::floor(fx), y0f = std::floor(fy);
-  Footprint f{};
-  f.ax = fx - x0f, f.ay = fy - y0f;
-  for (int k = 0; k < 4; ++k) {
-    const int x = std::clamp(static_cast<int>(x0f) + k % 2, 0, w - 1),
-              y = std::clamp(static_cast<int>(y0f) + k / 2, 0, h - 1);
-    f.pixel[k] = static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
-  }
-  return f;
-}
-
-// Whether the sample of `texel` does not see the point p on a surface facing `side` where a
-// ray landed on that texel. Sponza's stacked slabs enclose pockets a few centimetres tall,
-// closed on every side (the path tracer finds no light at all in them), whose floor's texels
-// have their samples moved through the pocket's walls into the sun by relocate_texel_samples:
-// a ray landing inside the pocket read 760 W/m^2 there.
-bool sample_unseen(const StaticBakeScene& b, const TexelTable& t, const glm::vec3& p, const glm::vec3& side,
-                   std::uint32_t texel) {
-  const glm::vec3 q = b.texels.position[texel];
-  const glm::vec3 from = offset_ray_origin(p, side), to = offset_ray_origin(q, t.face[texel]);
-  return b.caster->occluded(Ray{from, 0.0f, to - from, 1.0f});
-}
-
-// A ray from a texel landed on a surface facing it closer than kGapTexels: the two enclose a
-// dark gap only if something covers the landing point. A texel's sample moved off its
-// triangle by relocate_texel_samples (raytrace/texel_samples.h) can float that close over a
-// surface in the open (Dabrovic Sponza's gallery floor 0.8 mm under such a sample sees the
-// sun). One ray from the landing point back out along its side, as long as the gap, decides.
-bool gap_is_covered(const StaticBakeScene& b, const TexelTable& t, const Ray& ray, const Hit& h,
-                    const glm::vec3& side) {
-  const glm::vec3 p = ray.origin + h.t * ray.direction;
-  return b.caster->occluded(Ray{offset_ray_origin(p, side), 0.0f, side, 2.0f * t.gap_m});
-}
-
-// Landing::unseen_corners at the landing point p, `distance` from the ray's
-// origin: each sample checked once, the moved ones always, all of them on a landing closer
-// than a texel (a pocket's floor whose texels' samples lie beyond its walls).
-void mark_unseen(const StaticBakeScene& b, const TexelTable& t, const glm::vec3& p, float distance, Landing& l) {
-  const Footprint f = footprint_at(t.width, t.height, l.uv);
-  const bool near = distance < t.near_m;
-  std::uint32_t checked[5] = {l.texel, kDark, kDark, kDark, kDark};
-  bool unseen[5] = {(near || t.moved[l.texel] != 0) && sample_unseen(b, t, p, l.side, l.texel)};
-  for (int k = 0; k < 4; ++k) {
-    const std::uint32_t j = t.redirect[f.pixel[k]];
-    if (j == kDark || !(near || t.moved[j])) continue;
-    int c = 0;
-    while (c <= k && checked[c] != j && checked[c] != kDark) ++c;
-    if (checked[c] != j) checked[c] = j, unseen[c] = sample_unseen(b, t, p, l.side, j);
-    if (unseen[c]) l.unseen_corners = static_cast<std::uint8_t>(l.unseen_corners | (1u << k));
-  }
-}
-
-Landing land_ray(const StaticBakeScene& b, const AtlasLayout& layout, const TexelTable& t, const Ray& ray,
-                 const glm::vec3& from) {
-  const Hit h = b.caster->intersect(ray);
-  if (!h.valid()) return {};
-  const ShadingTriangle& tri = b.index.triangles[b.triangle_of(h)];
-  const float cos_surface = glm::dot(tri.face_normal, ray.direction);
-  if (!(cos_surface < 0.0f) && !b.scene.materials[tri.material].double_sided) return {.texel = kBack};
-  const glm::vec3 side = cos_surface < 0.0f ? tri.face_normal : -tri.face_normal;
-  if (h.t < t.gap_m && std::fabs(glm::dot(tri.face_normal, from)) > 0.9f && gap_is_covered(b, t, ray, h, side))
-    return {.texel = kBack};
-  Landing l;
-  l.triangle = b.triangle_of(h);
-  l.barycentric = h.barycentric;
-  l.side = side;
-  l.uv = hit_uv(layout, h);
-  const int x = std::clamp(static_cast<int>(l.uv.x * static_cast<float>(t.width)), 0, t.width - 1);
-  const int y = std::clamp(static_cast<int>(l.uv.y * static_cast<float>(t.height)), 0, t.height - 1);
-  l.pixel = static_cast<std::uint32_t>(static_cast<std::size_t>(y) * static_cast<std::size_t>(t.width) +
-                                       static_cast<std::size_t>(x));
-  l.texel = t.redirect[l.pixel];
-  if (l.texel != kDark) mark_unseen(b, t, ray.origin + h.t * ray.direction, h.t, l);
-  l.distance = h.t;
-  l.cos_surface = std::fabs(cos_surface);
-  return l;
-}
-
-std::uint32_t landing(const StaticBakeScene& b, const AtlasLayout& layout, const TexelTable& t, const Ray& ray,
-                      const glm::vec3& from, glm::vec2* uv) {
-  const Landing l = land_ray(b, layout, t, ray, from);
-  if (uv && l.texel != kSky && l.texel != kBack) *uv = l.uv;
-  return l.texel;
-}
-
-glm::vec3 bilinear(const std::vector<glm::vec3>& img, int w, int h, glm::vec2 uv) {
-  const float fx = uv.x * static_cast<float>(w) - 0.5f, fy = uv.y * static_cast<float>(h) - 0.5f;
-  const float x0f = std::floor(fx), y0f = std::floor(fy);
-  const float ax = fx - x0f, ay = fy - y0f;
-  const int x0 = static_cast<int>(x0f), y0 = static_cast<int>(y0f);
-  const auto at = [&](int x, int y) {
-    x = std::clamp(x, 0, w - 1);
-    y = std::clamp(y, 0, h - 1);
-    return img[static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)];
-  };
-  return (1.0f - ay) * ((1.0f - ax) * at(x0, y0) + ax * at(x0 + 1, y0)) +
-         ay * ((1.0f - ax) * at(x0, y0 + 1) + ax * at(x0 + 1, y0 + 1));
-}
-
 float max_abs(const glm::vec3& v) { return std::max(std::fabs(v.x), std::max(std::fabs(v.y), std::fabs(v.z))); }
-
-}  // namespace
-
-namespace {
 
 // The sky's radiance along a ray that escapes in direction wi (engine/sky.h).
 glm::vec3 sky_along(const StaticBakeScene& b, const glm::vec3& wi) {
@@ -377,74 +133,6 @@ int solve_kept_rays(const TexelTable& t, const KeptRays& k, const std::vector<gl
     if (!(added > 1e-4 * total)) break;
   }
   return iterations;
-}
-
-// What step 3's rays read, per atlas pixel (dilated): rho (E_d + E) of every texel, the same
-// without the lights' direct light, rho (sky + E), and where the lights' direct light changes
-// sharply (`sharp`: in the pixel's 3 x 3 neighbourhood the dimmest is under half the
-// brightest, a shadow edge crossing it).
-struct GatherSource {
-  std::vector<glm::vec3> reflected, without_lights;
-  std::vector<std::uint8_t> sharp;
-};
-
-// A texel holds the light at its one sample point. Where a shadow edge crosses it, the light
-// of another point of the texel can be anything between its neighbours': in a 5 cm slot
-// under a slab of Dabrovic Sponza, the floor's texel straddles the slot's mouth, its sample
-// lies in the sun, and rays from the slab's underside that land in the dark slot read that
-// sun (issue 35, "Noise against floor"). There the read takes the lights' direct light at the
-// landing point itself (one sample of each light, unbiased) and only the rest bilinearly.
-// Bilinear corners whose samples do not see the point (Landing::unseen_corners) are left out;
-// where none does, that direct light is all the read takes.
-glm::dvec3 read_landing(const StaticBakeScene& b, const TexelTable& t, const GatherSource& src, const Landing& l,
-                        Pcg32& rng, std::uint64_t& rays) {
-  const bool sharp = src.sharp[l.pixel] != 0;
-  if (l.unseen_corners == 0 && !sharp) return glm::dvec3(bilinear(src.reflected, t.width, t.height, l.uv));
-  glm::dvec3 rest(0.0);
-  if (l.unseen_corners != 0) {
-    // The bilinear read without the corners whose samples do not see the point.
-    const Footprint f = footprint_at(t.width, t.height, l.uv);
-    const std::vector<glm::vec3>& img = sharp ? src.without_lights : src.reflected;
-    double weights = 0.0;
-    for (int k = 0; k < 4; ++k) {
-      if (l.unseen_corners & (1u << k)) continue;
-      const double wk = static_cast<double>((k % 2 ? f.ax : 1.0f - f.ax) * (k / 2 ? f.ay : 1.0f - f.ay));
-      rest += wk * glm::dvec3(img[f.pixel[k]]), weights += wk;
-    }
-    if (weights > 0.0) rest /= weights;
-    if (!sharp && weights > 0.0) return rest;
-    if (!(weights > 0.0)) rest = glm::dvec3(0.0);
-  } else {
-    rest = glm::dvec3(bilinear(src.without_lights, t.width, t.height, l.uv));
-  }
-  const ShadingTriangle& tri = b.index.triangles[l.triangle];
-  const float u = l.barycentric.x, v = l.barycentric.y;
-  const glm::vec3 p = tri.p0 + u * tri.e1 + v * tri.e2;
-  glm::vec3 n = (1.0f - u - v) * tri.n0 + u * tri.n1 + v * tri.n2;
-  n = glm::dot(n, n) > 0.0f ? glm::normalize(n) : l.side;
-  if (glm::dot(n, l.side) < 0.0f) n = -n;  // a double-sided surface seen from behind
-  const DirectAt d = direct_at(b, p, n, l.side, 1, rng, &rays);
-  const glm::dvec3 lights(t.albedo[l.texel] * (d.live + d.unlit));
-  return rest + lights;
-}
-
-// Marks the pixels whose 3 x 3 neighbourhood of `lit` (rho E_d, dilated) holds a sharp change.
-std::vector<std::uint8_t> sharp_pixels(const std::vector<glm::vec3>& lit, int w, int h) {
-  std::vector<std::uint8_t> sharp(lit.size(), 0);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      float lo = std::numeric_limits<float>::infinity(), hi = 0.0f;
-      for (int k = 0; k < 9; ++k) {
-        const int nx = std::clamp(x + k % 3 - 1, 0, w - 1), ny = std::clamp(y + k / 3 - 1, 0, h - 1);
-        const glm::vec3& c =
-            lit[static_cast<std::size_t>(ny) * static_cast<std::size_t>(w) + static_cast<std::size_t>(nx)];
-        const float l = luminance(c.x, c.y, c.z);
-        lo = std::min(lo, l), hi = std::max(hi, l);
-      }
-      sharp[static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)] =
-          hi > 0.0f && lo < 0.5f * hi ? 1 : 0;
-    }
-  return sharp;
 }
 
 // The fresh rays of one texel in step 3: the cosine rays' and the emitter rays' estimate of

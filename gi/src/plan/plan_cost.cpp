@@ -51,6 +51,19 @@ constexpr double kAtlasCpuPerGatherRay =
 // 40.5 s from the flat cost; docs/plan.md "Calibration").
 constexpr double kAtlasCacheTriangles = 2048.0;
 constexpr double kAtlasRayCostPerDoubling = 0.12;
+// The landing reads' visibility rays (texel_landing.h; docs/light_atlas.md, "The hidden
+// texels, third pass"): a fresh ray that lands closer than a texel, or on a texel whose sample
+// was moved off its surface, checks whether each bilinear corner's sample sees the landing
+// point. Counted per fresh ray (gi-bake --preset preview, 29 Nov 2026): Dabrovic Sponza 0.56
+// (39.1 M for 69.3 M fresh rays, untextured, 8 texels/m), the Cornell box 0.83 (32 texels/m)
+// and 0.38 (128 texels/m), the demo level 0.26, the spot chamber 0.25. Short (a texel or two),
+// they cost nothing measurable in the small scenes (CPU s before / after them: Cornell box
+// 128 texels/m high 9.59 / 9.25, demo level preview 2.34 / 2.26, tools/plan-calibration.py)
+// but about a gather ray each in Sponza, whose quiet preview bake went from 18.7 s to 26-30 s
+// (docs/light_atlas.md; without the kept rays' 9.8 M, its CPU time fell by 3.7 s). Modelled as
+// gather-ray equivalents per fresh ray growing as the ray cost does, with the triangles'
+// doublings above kAtlasCacheTriangles: 0.11 each, Sponza's 5 doublings 0.56.
+constexpr double kVisibilityRaysPerFreshRayPerDoubling = 0.11;
 
 // PRM (gi/src/prm): every path node (virtual light) is connected to every pane texel facing
 // it by one shadow ray; nodes = E x N_s x a / (1 - a) for a mean albedo a.
@@ -109,18 +122,26 @@ constexpr double kDlmTexelBytesPerDirection = 8.0;
 
 double wall_seconds(double parallel_cpu, double serial_cpu) { return parallel_cpu / 2.0 + serial_cpu; }
 
-// The final gather's rays per lit texel (TexelGatherSettings' ray counts and the lights).
-double gather_rays_per_texel(const TexelGatherSettings& g, const LightPointCount& lights) {
+// Doublings of a scene's `triangles` above kAtlasCacheTriangles (0 below).
+double cache_doublings(std::size_t triangles) {
+  return std::max(0.0, std::log2(static_cast<double>(triangles) / kAtlasCacheTriangles));
+}
+
+// The final gather's rays per lit texel in a scene of `triangles`: TexelGatherSettings' ray
+// counts, the lights, and the landing reads' visibility rays of the fresh rays (in gather-ray
+// equivalents, kVisibilityRaysPerFreshRayPerDoubling).
+double gather_rays_per_texel(const TexelGatherSettings& g, const LightPointCount& lights, std::size_t triangles) {
   // Emitter rays (opt-in, 0 in every preset) counted as one gather ray each: not calibrated
   // (on loaded cores one cost 2-3 cosine rays on Sponza; docs/light_atlas.md).
-  return g.solve_rays + g.gather_rays + g.emitter_rays + lights.punctual + lights.directional +
+  const double fresh = g.gather_rays + g.emitter_rays;
+  const double visibility = kVisibilityRaysPerFreshRayPerDoubling * cache_doublings(triangles);
+  return g.solve_rays + fresh * (1.0 + visibility) + lights.punctual + lights.directional +
          static_cast<double>(lights.sampled > 0 ? g.direct_samples : 0);
 }
 
 // CPU seconds per gather ray in a scene of `triangles` (kAtlasCacheTriangles above).
 double gather_cpu_per_ray(std::size_t triangles) {
-  const double doublings = std::max(0.0, std::log2(static_cast<double>(triangles) / kAtlasCacheTriangles));
-  return kAtlasCpuPerGatherRay * (1.0 + kAtlasRayCostPerDoubling * doublings);
+  return kAtlasCpuPerGatherRay * (1.0 + kAtlasRayCostPerDoubling * cache_doublings(triangles));
 }
 
 }  // namespace
@@ -152,7 +173,7 @@ BakeWork light_atlas_work(const StaticSurfaceCensus& census, const LightAtlasSet
   BakeWork w;
   const AtlasTexelEstimate t = atlas_texels(census, s.texels_per_metre);
   if (s.final_pass == LightAtlasSettings::FinalPass::TexelGather) {
-    w.rays = t.lit_texels * gather_rays_per_texel(s.gather, lights);
+    w.rays = t.lit_texels * gather_rays_per_texel(s.gather, lights, census.triangles);
     w.units = w.rays;
     const double parallel = w.rays * gather_cpu_per_ray(census.triangles);
     w.cpu_seconds = parallel + kGatherCpuOverhead;

@@ -354,9 +354,12 @@ TEST(PlanCost, EstimatesAreWithinAFactorOfTwoOfTheCalibrationBakes) {
 //   /usr/bin/time -v gi-bake --scene sponza.gltf --untextured --methods light_atlas --preset <p>
 //     --sun 'direction:0.25,-1,0.15;irradiance:700,650,600'
 //     --sky 'zenith:10,16,30;horizon:28,30,34;ground:6,6,6'
-// quiet wall 18.7 s (preview) and 64.5 s (medium) from issue 35; CPU (user + sys) 43.3 s and
-// 178.6 s on the shared machine (load ~9, 2 cores; build of f0c4ca9), i.e. 21.6 s and 89.3 s
-// wall by the model's rule (CPU / 2 for the parallel gather); peak RSS 489 MB and 1067 MB
+// After the landing reads' visibility rays (the hidden texels' third pass, docs/light_atlas.md):
+// the preview's quiet wall 30.1 s (the presets' row of that section's Sponza table, quiet
+// cores); CPU (user + sys) 44.4 s and 186.4 s from tools/plan-calibration.py on the shared
+// machine (load 7.5-9.9, 2 cores; docs/plan-calibration.md), i.e. 22.2 s and 93.2 s wall by the
+// model's rule (CPU / 2 for the parallel gather). The medium's quiet wall was not measured
+// again (64.5 s before the third pass, issue 35). Peak RSS 489 MB and 1067 MB before it
 // (docs/plan.md "Costs of the bake on a real level").
 TEST(PlanCost, LightAtlasEstimateIsWithinOneAndAHalfOfTheBakeOnDabrovicSponza) {
   const fs::path file = fs::path(GI_EXTERNAL_ASSETS_DIR) / "dabrovic-sponza" / "sponza.gltf";
@@ -369,9 +372,9 @@ TEST(PlanCost, LightAtlasEstimateIsWithinOneAndAHalfOfTheBakeOnDabrovicSponza) {
   const gi::BakeInput input = gi::without_textures(gi::bake_input_from(asset));  // gi-bake --untextured
   struct Measured {
     const char* preset;
-    double quiet_wall_s, cpu_s;  // cpu_s 0: not measured
+    double quiet_wall_s, cpu_s;  // 0: not measured
   };
-  const Measured runs[] = {{"preview", 18.7, 43.3}, {"medium", 64.5, 178.6}};
+  const Measured runs[] = {{"preview", 30.1, 44.4}, {"medium", 0.0, 186.4}};
   const auto within = [](double estimate, double measured) {
     return estimate > measured / 1.5 && estimate < 1.5 * measured;
   };
@@ -382,7 +385,9 @@ TEST(PlanCost, LightAtlasEstimateIsWithinOneAndAHalfOfTheBakeOnDabrovicSponza) {
     const double wall = atlas.estimate.bake_seconds;
     std::printf("sponza %-8s light atlas: %s\n  wall %.1f s estimated / %.1f s quiet / %.1f s from CPU\n", r.preset,
                 atlas.estimate.basis.c_str(), wall, r.quiet_wall_s, r.cpu_s / 2.0);
-    EXPECT_TRUE(within(wall, r.quiet_wall_s)) << r.preset << ": " << wall << " s against " << r.quiet_wall_s;
+    if (r.quiet_wall_s > 0.0) {
+      EXPECT_TRUE(within(wall, r.quiet_wall_s)) << r.preset << ": " << wall << " s against " << r.quiet_wall_s;
+    }
     if (r.cpu_s > 0.0) {
       EXPECT_TRUE(within(wall, r.cpu_s / 2.0)) << r.preset << ": " << wall << " s";
     }

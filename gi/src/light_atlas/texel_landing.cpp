@@ -1,0 +1,189 @@
+#include "light_atlas/texel_landing.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "core/color.h"
+#include "light_atlas/texel_direct.h"
+#include "raytrace/ray_offset.h"
+
+namespace gi {
+namespace {
+
+glm::vec2 hit_uv(const AtlasLayout& layout, const Hit& h) {
+  const AtlasMeshUv& mu = layout.meshes[h.instance];
+  const std::uint32_t* idx = &mu.indices[3u * h.primitive];
+  const float u = h.barycentric.x, v = h.barycentric.y;
+  return (1.0f - u - v) * mu.uv1[idx[0]] + u * mu.uv1[idx[1]] + v * mu.uv1[idx[2]];
+}
+
+// The four atlas pixels of a bilinear read at uv (bilinear()'s), corner k = (x0 + k % 2, y0 + k / 2),
+// and its fractions.
+struct Footprint {
+  std::size_t pixel[4];
+  float ax, ay;
+};
+
+Footprint footprint_at(int w, int h, glm::vec2 uv) {
+  const float fx = uv.x * static_cast<float>(w) - 0.5f, fy = uv.y * static_cast<float>(h) - 0.5f;
+  const float x0f = std::floor(fx), y0f = std::floor(fy);
+  Footprint f{};
+  f.ax = fx - x0f, f.ay = fy - y0f;
+  for (int k = 0; k < 4; ++k) {
+    const int x = std::clamp(static_cast<int>(x0f) + k % 2, 0, w - 1),
+              y = std::clamp(static_cast<int>(y0f) + k / 2, 0, h - 1);
+    f.pixel[k] = static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
+  }
+  return f;
+}
+
+// Whether the sample of `texel` does not see the point p on a surface facing `side` where a
+// ray landed on that texel. Sponza's stacked slabs enclose pockets a few centimetres tall,
+// closed on every side (the path tracer finds no light at all in them), whose floor's texels
+// have their samples moved through the pocket's walls into the sun by relocate_texel_samples:
+// a ray landing inside the pocket read 760 W/m^2 there.
+bool sample_unseen(const StaticBakeScene& b, const TexelTable& t, const glm::vec3& p, const glm::vec3& side,
+                   std::uint32_t texel) {
+  const glm::vec3 q = b.texels.position[texel];
+  const glm::vec3 from = offset_ray_origin(p, side), to = offset_ray_origin(q, t.face[texel]);
+  return b.caster->occluded(Ray{from, 0.0f, to - from, 1.0f});
+}
+
+// A ray from a texel landed on a surface facing it closer than kGapTexels: the two enclose a
+// dark gap only if something covers the landing point. A texel's sample moved off its
+// triangle by relocate_texel_samples (raytrace/texel_samples.h) can float that close over a
+// surface in the open (Dabrovic Sponza's gallery floor 0.8 mm under such a sample sees the
+// sun). One ray from the landing point back out along its side, as long as the gap, decides.
+bool gap_is_covered(const StaticBakeScene& b, const TexelTable& t, const Ray& ray, const Hit& h,
+                    const glm::vec3& side) {
+  const glm::vec3 p = ray.origin + h.t * ray.direction;
+  return b.caster->occluded(Ray{offset_ray_origin(p, side), 0.0f, side, 2.0f * t.gap_m});
+}
+
+// Landing::unseen_corners at the landing point p, `distance` from the ray's
+// origin: each sample checked once, the moved ones always, all of them on a landing closer
+// than a texel (a pocket's floor whose texels' samples lie beyond its walls).
+void mark_unseen(const StaticBakeScene& b, const TexelTable& t, const glm::vec3& p, float distance, Landing& l) {
+  const Footprint f = footprint_at(t.width, t.height, l.uv);
+  const bool near = distance < t.near_m;
+  std::uint32_t checked[5] = {l.texel, kDark, kDark, kDark, kDark};
+  bool unseen[5] = {(near || t.moved[l.texel] != 0) && sample_unseen(b, t, p, l.side, l.texel)};
+  for (int k = 0; k < 4; ++k) {
+    const std::uint32_t j = t.redirect[f.pixel[k]];
+    if (j == kDark || !(near || t.moved[j])) continue;
+    int c = 0;
+    while (c <= k && checked[c] != j && checked[c] != kDark) ++c;
+    if (checked[c] != j) checked[c] = j, unseen[c] = sample_unseen(b, t, p, l.side, j);
+    if (unseen[c]) l.unseen_corners = static_cast<std::uint8_t>(l.unseen_corners | (1u << k));
+  }
+}
+
+glm::vec3 bilinear(const std::vector<glm::vec3>& img, int w, int h, glm::vec2 uv) {
+  const float fx = uv.x * static_cast<float>(w) - 0.5f, fy = uv.y * static_cast<float>(h) - 0.5f;
+  const float x0f = std::floor(fx), y0f = std::floor(fy);
+  const float ax = fx - x0f, ay = fy - y0f;
+  const int x0 = static_cast<int>(x0f), y0 = static_cast<int>(y0f);
+  const auto at = [&](int x, int y) {
+    x = std::clamp(x, 0, w - 1);
+    y = std::clamp(y, 0, h - 1);
+    return img[static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)];
+  };
+  return (1.0f - ay) * ((1.0f - ax) * at(x0, y0) + ax * at(x0 + 1, y0)) +
+         ay * ((1.0f - ax) * at(x0, y0 + 1) + ax * at(x0 + 1, y0 + 1));
+}
+
+// land_ray; with `corners` false, Landing::unseen_corners stays 0 (its visibility rays are
+// cast only for the reads that use them).
+Landing land(const StaticBakeScene& b, const AtlasLayout& layout, const TexelTable& t, const Ray& ray,
+             const glm::vec3& from, bool corners) {
+  const Hit h = b.caster->intersect(ray);
+  if (!h.valid()) return {};
+  const ShadingTriangle& tri = b.index.triangles[b.triangle_of(h)];
+  const float cos_surface = glm::dot(tri.face_normal, ray.direction);
+  if (!(cos_surface < 0.0f) && !b.scene.materials[tri.material].double_sided) return {.texel = kBack};
+  const glm::vec3 side = cos_surface < 0.0f ? tri.face_normal : -tri.face_normal;
+  if (h.t < t.gap_m && std::fabs(glm::dot(tri.face_normal, from)) > 0.9f && gap_is_covered(b, t, ray, h, side))
+    return {.texel = kBack};
+  Landing l;
+  l.triangle = b.triangle_of(h);
+  l.barycentric = h.barycentric;
+  l.side = side;
+  l.uv = hit_uv(layout, h);
+  const int x = std::clamp(static_cast<int>(l.uv.x * static_cast<float>(t.width)), 0, t.width - 1);
+  const int y = std::clamp(static_cast<int>(l.uv.y * static_cast<float>(t.height)), 0, t.height - 1);
+  l.pixel = static_cast<std::uint32_t>(static_cast<std::size_t>(y) * static_cast<std::size_t>(t.width) +
+                                       static_cast<std::size_t>(x));
+  l.texel = t.redirect[l.pixel];
+  if (corners && l.texel != kDark) mark_unseen(b, t, ray.origin + h.t * ray.direction, h.t, l);
+  l.distance = h.t;
+  l.cos_surface = std::fabs(cos_surface);
+  return l;
+}
+
+}  // namespace
+
+Landing land_ray(const StaticBakeScene& b, const AtlasLayout& layout, const TexelTable& t, const Ray& ray,
+                 const glm::vec3& from) {
+  return land(b, layout, t, ray, from, true);
+}
+
+std::uint32_t landing(const StaticBakeScene& b, const AtlasLayout& layout, const TexelTable& t, const Ray& ray,
+                      const glm::vec3& from, glm::vec2* uv) {
+  // The kept rays read the texel alone: no corner of a bilinear read to check.
+  const Landing l = land(b, layout, t, ray, from, false);
+  if (uv && l.texel != kSky && l.texel != kBack) *uv = l.uv;
+  return l.texel;
+}
+
+glm::dvec3 read_landing(const StaticBakeScene& b, const TexelTable& t, const GatherSource& src, const Landing& l,
+                        Pcg32& rng, std::uint64_t& rays) {
+  const bool sharp = src.sharp[l.pixel] != 0;
+  if (l.unseen_corners == 0 && !sharp) return glm::dvec3(bilinear(src.reflected, t.width, t.height, l.uv));
+  glm::dvec3 rest(0.0);
+  if (l.unseen_corners != 0) {
+    // The bilinear read without the corners whose samples do not see the point.
+    const Footprint f = footprint_at(t.width, t.height, l.uv);
+    const std::vector<glm::vec3>& img = sharp ? src.without_lights : src.reflected;
+    double weights = 0.0;
+    for (int k = 0; k < 4; ++k) {
+      if (l.unseen_corners & (1u << k)) continue;
+      const double wk = static_cast<double>((k % 2 ? f.ax : 1.0f - f.ax) * (k / 2 ? f.ay : 1.0f - f.ay));
+      rest += wk * glm::dvec3(img[f.pixel[k]]), weights += wk;
+    }
+    if (weights > 0.0) rest /= weights;
+    if (!sharp && weights > 0.0) return rest;
+    if (!(weights > 0.0)) rest = glm::dvec3(0.0);
+  } else {
+    rest = glm::dvec3(bilinear(src.without_lights, t.width, t.height, l.uv));
+  }
+  const ShadingTriangle& tri = b.index.triangles[l.triangle];
+  const float u = l.barycentric.x, v = l.barycentric.y;
+  const glm::vec3 p = tri.p0 + u * tri.e1 + v * tri.e2;
+  glm::vec3 n = (1.0f - u - v) * tri.n0 + u * tri.n1 + v * tri.n2;
+  n = glm::dot(n, n) > 0.0f ? glm::normalize(n) : l.side;
+  if (glm::dot(n, l.side) < 0.0f) n = -n;  // a double-sided surface seen from behind
+  const DirectAt d = direct_at(b, p, n, l.side, 1, rng, &rays);
+  const glm::dvec3 lights(t.albedo[l.texel] * (d.live + d.unlit));
+  return rest + lights;
+}
+
+std::vector<std::uint8_t> sharp_pixels(const std::vector<glm::vec3>& lit, int w, int h) {
+  std::vector<std::uint8_t> sharp(lit.size(), 0);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      float lo = std::numeric_limits<float>::infinity(), hi = 0.0f;
+      for (int k = 0; k < 9; ++k) {
+        const int nx = std::clamp(x + k % 3 - 1, 0, w - 1), ny = std::clamp(y + k / 3 - 1, 0, h - 1);
+        const glm::vec3& c =
+            lit[static_cast<std::size_t>(ny) * static_cast<std::size_t>(w) + static_cast<std::size_t>(nx)];
+        const float l = luminance(c.x, c.y, c.z);
+        lo = std::min(lo, l), hi = std::max(hi, l);
+      }
+      sharp[static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)] =
+          hi > 0.0f && lo < 0.5f * hi ? 1 : 0;
+    }
+  return sharp;
+}
+
+}  // namespace gi
