@@ -154,7 +154,7 @@ TEST(BakeApi, ACancelledRebakeLeavesTheWorkingBundleIntact) {
   int calls = 0;
   auto report = gi::bake_bundle(
       input, dir, {.preset = "medium", .methods = {"light_atlas", "prm"}},
-      {.progress = [&](std::string_view stage, double) { return stage == "light atlas" || ++calls < 5; }});
+      {.progress = [&](std::string_view stage, double) { return stage == "light atlas" || ++calls < 2; }});
   ASSERT_FALSE(report);
   EXPECT_EQ(report.error().kind, engine::ErrorKind::Cancelled);
   EXPECT_EQ(snapshot(), before) << "the atlas baked before the cancel did not replace the working one";

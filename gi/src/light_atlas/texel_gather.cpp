@@ -49,6 +49,8 @@ engine::Status validate(const TexelGatherSettings& s) {
     return bad("filter_radius_texels is outside [0, 16]");
   if (s.denoise_passes < 0 || s.denoise_passes > 8) return bad("denoise_passes is outside 0..8");
   if (!(s.denoise_sigma > 0.0f) || s.denoise_sigma > 1000.0f) return bad("denoise_sigma is outside (0, 1000]");
+  if (!(s.denoise_outlier_sigmas >= 0.0f) || s.denoise_outlier_sigmas > 1000.0f)
+    return bad("denoise_outlier_sigmas is outside [0, 1000]");
   return {};
 }
 
@@ -275,8 +277,10 @@ void filter_result(const AtlasTexels& tx, const TexelTable& t, const TexelGather
                    ThreadPool& pool, TexelGatherResult& out) {
   if (s.denoise_passes > 0 && texel_m > 0.0f) {
     std::vector<glm::vec3>* const fields[] = {&out.indirect, &out.baked_direct};
-    denoise_world(tx, t.work, out.hidden, texel_m, {.passes = s.denoise_passes, .value_sigma = s.denoise_sigma}, pool,
-                  out.variance, fields);
+    denoise_world(
+        tx, t.work, out.hidden, texel_m,
+        {.passes = s.denoise_passes, .value_sigma = s.denoise_sigma, .outlier_sigmas = s.denoise_outlier_sigmas}, pool,
+        out.variance, fields);
   }
   if (s.filter_radius_texels <= 0.0f || !(texel_m > 0.0f)) return;
   const float radius_m = s.filter_radius_texels * texel_m;

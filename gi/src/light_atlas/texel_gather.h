@@ -62,6 +62,9 @@ struct TexelGatherSettings {
   /// `baked_direct`, guided by normals, planes and the gather's per-texel variance (0: none).
   int denoise_passes = 0;
   float denoise_sigma = 2.0f;  ///< The denoiser's value weight, in standard deviations.
+  /// The denoiser's outlier clamp before its passes (DenoiseSettings::outlier_sigmas): a
+  /// texel at most its co-planar neighbours' mean + this many standard deviations (0: off).
+  float denoise_outlier_sigmas = 0.0f;
   std::uint64_t seed = 1;
   ProgressCallback progress;  ///< Fraction done in [0, 1]; return false to cancel.
   /// A distributed bake's shard (docs/distributed-bake.md): steps 1-2 run for every texel

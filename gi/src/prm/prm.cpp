@@ -286,6 +286,18 @@ void dilate_panes(const AtlasTexels& tex, std::vector<glm::vec3>& full, Prm& prm
   set_dense_panes(prm, dense);
 }
 
+// Panes coarser than the atlas: the light atlas's layout and the upsampler that reads the
+// panes at its texels (pane_upsample.h); nothing for panes at the atlas's density.
+engine::Status attach_atlas_read(const BakeInput& input, const PrmSettings& settings, Prm& prm) {
+  if (!coarse_panes(settings)) return {};
+  auto atlas = static_world_layout(input, settings.texels_per_metre);
+  if (!atlas) return atlas.error();
+  auto read = prm_atlas_read(prm, std::move(atlas).value(), input);
+  if (!read) return read.error();
+  prm.atlas = std::move(read).value();
+  return {};
+}
+
 engine::Result<Prm> bake_prm_run(const BakeInput& input, const PrmSettings& settings, const PrmRun& run) {
   if (auto ok = validate(settings); !ok) return ok.error();
   if (auto ok = validate_bake_input(input); !ok) return ok.error();
@@ -337,13 +349,7 @@ engine::Result<Prm> bake_prm_run(const BakeInput& input, const PrmSettings& sett
   }
 
   dilate_panes(tex, full, prm);
-  if (coarse_panes(settings)) {
-    auto atlas = static_world_layout(input, settings.texels_per_metre);
-    if (!atlas) return atlas.error();
-    auto read = prm_atlas_read(prm, std::move(atlas).value(), input);
-    if (!read) return read.error();
-    prm.atlas = std::move(read).value();
-  }
+  if (engine::Status st = attach_atlas_read(input, settings, prm); !st) return st.error();
   prm.stats.pane_seconds = seconds_since(t0);
   prm.stats.total_seconds = seconds_since(t_start);
   return prm;

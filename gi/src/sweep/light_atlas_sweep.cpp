@@ -87,6 +87,13 @@ std::vector<KnobSpec> light_atlas_knobs() {
        .default_grid = {"2"},
        .min_value = 0.01,
        .max_value = 1000},
+      {.name = "outlier",
+       .description =
+           "gather: the denoiser's outlier clamp, standard deviations above the co-planar neighbours' mean (0: off)",
+       .kind = KnobKind::Real,
+       .default_grid = {"0"},
+       .min_value = 0,
+       .max_value = 1000},
       {.name = "ref_spp",
        .description = "samples per texel of the path-traced reference",
        .kind = KnobKind::Integer,
@@ -132,6 +139,7 @@ engine::Result<MethodOutput> run_light_atlas(const RunContext& ctx) {
     s.gather.filter_radius_texels = static_cast<float>(ctx.knobs.real("filter"));
     s.gather.denoise_passes = static_cast<int>(ctx.knobs.integer("denoise"));
     s.gather.denoise_sigma = static_cast<float>(ctx.knobs.real("denoise_sigma"));
+    s.gather.denoise_outlier_sigmas = static_cast<float>(ctx.knobs.real("outlier"));
     s.gather.bounces = std::max(s.bounces, 1);
   }
   s.seed = ctx.seed;
