@@ -1,28 +1,34 @@
 #version 450 core
 // PRM panes coarser than the light atlas (docs/prm.md "Panes coarser than the atlas"): the
 // pane sum (prm_sum.comp.glsl) is written at the panes' layout, then this pass reads it at
-// every light-atlas texel the PaneUpsampler lists (gi/src/prm/pane_upsample.h):
-//   E(fine) = [base(fine)] + sum over its taps t of weight_t * coarse(t)
+// every light-atlas texel the PaneUpsampler lists (gi/src/prm/pane_upsample.h), in passes:
+//   u_mode 0 (reads): E(fine) = sum over the 2 x 2 coarse texels at its origin of weight * coarse
+//   u_mode 1 (one gutter ring): E(fine) = mean of its filled 8-neighbours' E (the neighbour mask)
+//   u_mode 2 / 3: E(fine) += base(fine) over the reads / the ring texels
 // Taps stay inside the texel's own chart (no light crosses between surfaces); the atlas's
-// gutter rings carry the mean of their filled neighbours' taps, as the light atlas is
-// dilated. The upsampling is linear, so one pass per light change follows the K-sum.
-// The taps are uploaded once (prm_gpu_pass.cpp); one invocation per fine texel. Work groups
-// on a 2-D grid when one row would exceed 65535.
+// gutter rings are filled as the light atlas is dilated, ring after ring. The upsampling is
+// linear, so one set of passes per light change follows the K-sum. The records are uploaded
+// once (prm_gpu_pass.cpp): 16 bytes per read, 8 per ring texel. One invocation per record;
+// work groups on a 2-D grid when one row would exceed 65535.
 
 layout(local_size_x = 64) in;
 
-// Per fine texel: (its coordinates x | y << 16, its first tap); one more entry ends the
-// last texel's taps (.y = the tap count).
-layout(std430, binding = 0) readonly buffer FineTexels { uvec2 fine_texels[]; };
-// Per tap: (coarse texel coordinates x | y << 16, weight as float bits).
-layout(std430, binding = 1) readonly buffer Taps { uvec2 taps[]; };
+// Per read: (fine x | y << 16, coarse origin (x + 1) | (y + 1) << 16, weights 0 | 1 << 16,
+// weights 2 | 3 << 16), weights as 16-bit fractions of 65535.
+layout(std430, binding = 0) readonly buffer Reads { uvec4 reads[]; };
+// Per ring texel: (fine x | y << 16, its neighbour mask).
+layout(std430, binding = 1) readonly buffer Rings { uvec2 rings[]; };
 
-layout(rgba32f, binding = 0) writeonly uniform image2D out_image;
+layout(rgba32f, binding = 0) uniform image2D out_image;
 layout(rgba32f, binding = 1) readonly uniform image2D base_image;
 layout(rgba32f, binding = 2) readonly uniform image2D coarse_image;
 
-uniform uint u_count;     // fine texels
-uniform uint u_has_base;  // 1: add base_image
+uniform uint u_first;  // first record
+uniform uint u_count;  // records of this dispatch
+uniform uint u_mode;   // 0 reads, 1 a ring, 2 base over reads, 3 base over rings
+
+const ivec2 kNeighbour[8] = ivec2[8](ivec2(-1, -1), ivec2(0, -1), ivec2(1, -1), ivec2(-1, 0), ivec2(1, 0),
+                                     ivec2(-1, 1), ivec2(0, 1), ivec2(1, 1));
 
 ivec2 coord_of(uint texel) { return ivec2(int(texel & 0xffffu), int(texel >> 16)); }
 
@@ -30,14 +36,29 @@ void main() {
   const uint group = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
   const uint k = group * gl_WorkGroupSize.x + gl_LocalInvocationIndex;
   if (k >= u_count) return;
-  const uvec2 texel = fine_texels[k];
-  const uint last = fine_texels[k + 1u].y;
-  const ivec2 at = coord_of(texel.x);
-  vec3 sum = vec3(0.0);
-  for (uint t = texel.y; t < last; ++t) {
-    const uvec2 tap = taps[t];
-    sum += uintBitsToFloat(tap.y) * imageLoad(coarse_image, coord_of(tap.x)).xyz;
+  const uint r = u_first + k;
+  if (u_mode == 0u) {
+    const uvec4 read = reads[r];
+    const ivec2 origin = coord_of(read.y) - ivec2(1);
+    const float w[4] = float[4](float(read.z & 0xffffu) / 65535.0, float(read.z >> 16) / 65535.0,
+                                float(read.w & 0xffffu) / 65535.0, float(read.w >> 16) / 65535.0);
+    vec3 sum = vec3(0.0);
+    for (int t = 0; t < 4; ++t)
+      if (w[t] > 0.0) sum += w[t] * imageLoad(coarse_image, origin + ivec2(t & 1, t >> 1)).xyz;
+    imageStore(out_image, coord_of(read.x), vec4(sum, 1.0));
+  } else if (u_mode == 1u) {
+    const uvec2 ring = rings[r];
+    const ivec2 at = coord_of(ring.x);
+    vec3 sum = vec3(0.0);
+    float n = 0.0;
+    for (int t = 0; t < 8; ++t)
+      if ((ring.y & (1u << uint(t))) != 0u) {
+        sum += imageLoad(out_image, at + kNeighbour[t]).xyz;
+        n += 1.0;
+      }
+    imageStore(out_image, at, vec4(sum / n, 1.0));
+  } else {
+    const ivec2 at = coord_of(u_mode == 2u ? reads[r].x : rings[r].x);
+    imageStore(out_image, at, vec4(imageLoad(out_image, at).xyz + imageLoad(base_image, at).xyz, 1.0));
   }
-  if (u_has_base != 0u) sum += imageLoad(base_image, at).xyz;
-  imageStore(out_image, at, vec4(sum, 1.0));
 }

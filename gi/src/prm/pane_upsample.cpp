@@ -53,7 +53,7 @@ engine::Result<std::vector<ChartMap>> chart_maps(const AtlasLayout& coarse, cons
 
 }  // namespace
 
-// Long because the taps of one fine texel are found in one pass: its chart's map, the four
+// Long because the read of one fine texel is found in one pass: its chart's map, the four
 // bilinear neighbours kept when they lie in the chart's footprint and hold values, and the
 // nearest filled texel of the footprint when none does.
 engine::Result<PaneUpsampler> PaneUpsampler::build(const AtlasLayout& coarse,
@@ -65,6 +65,8 @@ engine::Result<PaneUpsampler> PaneUpsampler::build(const AtlasLayout& coarse,
   if (fine_texels.width != fine.width || fine_texels.height != fine.height)
     return engine::Error{.message = "PRM pane upsampling: the atlas texels are not of the atlas layout"};
   PaneUpsampler up;
+  up.fine_width_ = fine.width;
+  up.coarse_width_ = coarse.width;
   up.fine_size_ = static_cast<std::size_t>(fine.width) * static_cast<std::size_t>(fine.height);
   up.coarse_size_ = static_cast<std::size_t>(coarse.width) * static_cast<std::size_t>(coarse.height);
   std::vector<std::uint8_t> filled(up.coarse_size_, 0);
@@ -84,90 +86,99 @@ engine::Result<PaneUpsampler> PaneUpsampler::build(const AtlasLayout& coarse,
     };
     const int x0 = static_cast<int>(std::floor(q.x)), y0 = static_cast<int>(std::floor(q.y));
     const double ax = q.x - x0, ay = q.y - y0;
-    std::array<Tap, 4> taps{};
+    Read read{.fine = static_cast<std::uint32_t>(i), .origin = {x0, y0}, .weight = {}};
+    std::array<double, 4> w{};
     double sum = 0.0;
-    int n = 0;
     for (int k = 0; k < 4; ++k) {
-      const int x = x0 + (k & 1), y = y0 + (k >> 1);
-      const double w = ((k & 1) ? ax : 1.0 - ax) * ((k >> 1) ? ay : 1.0 - ay);
-      if (!map.known || !inside(x, y) || !(w > 0.0)) continue;
-      taps[static_cast<std::size_t>(n++)] = {static_cast<std::uint32_t>(y * coarse.width + x), static_cast<float>(w)};
-      sum += w;
+      const double wk = ((k & 1) ? ax : 1.0 - ax) * ((k >> 1) ? ay : 1.0 - ay);
+      if (!map.known || !inside(x0 + (k & 1), y0 + (k >> 1)) || !(wk > 0.0)) continue;
+      w[static_cast<std::size_t>(k)] = wk;
+      sum += wk;
     }
-    if (n > 0) {
-      for (int k = 0; k < n; ++k) taps[static_cast<std::size_t>(k)].weight /= static_cast<float>(sum);
+    if (sum > 0.0) {
+      for (std::size_t k = 0; k < 4; ++k)
+        read.weight[k] = std::round(static_cast<float>(w[k] / sum) * kWeightSteps) / kWeightSteps;
     } else {
       double nearest = std::numeric_limits<double>::infinity();
       for (int y = box.origin.y; y < box.origin.y + box.size.y; ++y)
         for (int x = box.origin.x; x < box.origin.x + box.size.x; ++x) {
           const double d2 = (x - q.x) * (x - q.x) + (y - q.y) * (y - q.y);
-          if (inside(x, y) && d2 < nearest)
-            nearest = d2, taps[0] = {static_cast<std::uint32_t>(y * coarse.width + x), 1.0f};
+          if (inside(x, y) && d2 < nearest) nearest = d2, read.origin = {x, y};
         }
-      if (nearest == std::numeric_limits<double>::infinity())
+      if (nearest == std::numeric_limits<double>::infinity()) {
         ++up.orphans_;
-      else
-        n = 1;
+        read.origin = {x0, y0};
+      } else {
+        read.weight[0] = 1.0f;
+      }
     }
-    up.fine_texel_.push_back(static_cast<std::uint32_t>(i));
-    up.taps_.insert(up.taps_.end(), taps.begin(), taps.begin() + n);
-    up.tap_first_.push_back(static_cast<std::uint32_t>(up.taps_.size()));
+    up.reads_.push_back(read);
   }
-  up.add_gutter_rings(fine.width, fine.height, gutter_rings);
+  up.add_gutter_rings(fine.height, gutter_rings);
   return up;
 }
 
-// gi::dilate's rings on the taps (dilation is linear): a ring texel reads the mean of its
-// 8-neighbours filled before that ring, their taps merged per coarse texel.
-void PaneUpsampler::add_gutter_rings(int width, int height, int rings) {
-  std::vector<std::int32_t> entry(fine_size_, -1);  // fine texel -> its entry
-  for (std::size_t k = 0; k < fine_texel_.size(); ++k) entry[fine_texel_[k]] = static_cast<std::int32_t>(k);
-  std::vector<Tap> merged;
-  for (int ring = 0; ring < rings; ++ring) {
-    const std::size_t filled_before = fine_texel_.size();
+// gi::dilate's rings (dilation is linear): a ring texel reads the mean of its 8-neighbours
+// filled before that ring, applied ring by ring after the reads.
+void PaneUpsampler::add_gutter_rings(int height, int rings) {
+  const int width = fine_width_;
+  std::vector<std::int32_t> ring_of(fine_size_, -1);  // fine texel -> the ring that filled it (0: a read)
+  for (const Read& r : reads_) ring_of[r.fine] = 0;
+  for (int ring = 1; ring <= rings; ++ring) {
     const auto filled = [&](int x, int y) {
       if (x < 0 || y < 0 || x >= width || y >= height) return false;
-      const std::int32_t k = entry[static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + x];
-      return k >= 0 && static_cast<std::size_t>(k) < filled_before;
+      const std::int32_t r = ring_of[static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + x];
+      return r >= 0 && r < ring;
     };
     for (int y = 0; y < height; ++y)
       for (int x = 0; x < width; ++x) {
         const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + x;
-        if (entry[i] >= 0) continue;
-        merged.clear();
-        int neighbours = 0;
-        for (int dy = -1; dy <= 1; ++dy)
-          for (int dx = -1; dx <= 1; ++dx) {
-            if ((dx == 0 && dy == 0) || !filled(x + dx, y + dy)) continue;
-            ++neighbours;
-            const auto k = static_cast<std::size_t>(entry[static_cast<std::size_t>(y + dy) * width + (x + dx)]);
-            for (std::uint32_t t = tap_first_[k]; t < tap_first_[k + 1]; ++t) {
-              auto at =
-                  std::find_if(merged.begin(), merged.end(), [&](const Tap& m) { return m.coarse == taps_[t].coarse; });
-              if (at == merged.end())
-                merged.push_back({taps_[t].coarse, taps_[t].weight});
-              else
-                at->weight += taps_[t].weight;
-            }
-          }
-        if (neighbours == 0) continue;
-        for (Tap& m : merged) m.weight /= static_cast<float>(neighbours);
-        entry[i] = static_cast<std::int32_t>(fine_texel_.size());
-        fine_texel_.push_back(static_cast<std::uint32_t>(i));
-        taps_.insert(taps_.end(), merged.begin(), merged.end());
-        tap_first_.push_back(static_cast<std::uint32_t>(taps_.size()));
+        if (ring_of[i] >= 0) continue;
+        std::uint32_t mask = 0;
+        for (std::size_t k = 0; k < kNeighbour.size(); ++k)
+          if (filled(x + kNeighbour[k].x, y + kNeighbour[k].y)) mask |= 1u << k;
+        if (mask == 0) continue;
+        ring_of[i] = ring;
+        ring_texels_.push_back({static_cast<std::uint32_t>(i), mask});
       }
+    ring_first_.push_back(static_cast<std::uint32_t>(ring_texels_.size()));
   }
+}
+
+std::vector<std::uint32_t> PaneUpsampler::fine_texels() const {
+  std::vector<std::uint32_t> out;
+  out.reserve(reads_.size() + ring_texels_.size());
+  for (const Read& r : reads_) out.push_back(r.fine);
+  for (const RingTexel& r : ring_texels_) out.push_back(r.fine);
+  return out;
 }
 
 std::vector<glm::vec3> PaneUpsampler::apply(std::span<const glm::vec3> coarse_image) const {
   if (coarse_image.size() != coarse_size_) return {};
   std::vector<glm::vec3> out(fine_size_, glm::vec3(0.0f));
-  for (std::size_t k = 0; k < fine_texel_.size(); ++k) {
+  const auto coarse_at = [&](int x, int y) {
+    if (x < 0 || y < 0 || x >= coarse_width_) return glm::vec3(0.0f);
+    const std::size_t t = static_cast<std::size_t>(y) * static_cast<std::size_t>(coarse_width_) + x;
+    return t < coarse_size_ ? coarse_image[t] : glm::vec3(0.0f);
+  };
+  for (const Read& r : reads_) {
     glm::vec3 v(0.0f);
-    for (std::uint32_t t = tap_first_[k]; t < tap_first_[k + 1]; ++t)
-      v += taps_[t].weight * coarse_image[taps_[t].coarse];
-    out[fine_texel_[k]] = v;
+    for (int k = 0; k < 4; ++k)
+      if (r.weight[static_cast<std::size_t>(k)] > 0.0f)
+        v += r.weight[static_cast<std::size_t>(k)] * coarse_at(r.origin.x + (k & 1), r.origin.y + (k >> 1));
+    out[r.fine] = v;
+  }
+  const auto w = static_cast<std::size_t>(fine_width_);
+  for (const RingTexel& r : ring_texels_) {
+    glm::vec3 v(0.0f);
+    float n = 0.0f;
+    for (std::size_t k = 0; k < kNeighbour.size(); ++k)
+      if (r.neighbours & (1u << k)) {
+        const std::size_t x = r.fine % w, y = r.fine / w;
+        v += out[(y + static_cast<std::size_t>(kNeighbour[k].y)) * w + x + static_cast<std::size_t>(kNeighbour[k].x)];
+        n += 1.0f;
+      }
+    out[r.fine] = v / n;
   }
   return out;
 }

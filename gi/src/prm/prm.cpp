@@ -265,7 +265,21 @@ void fill_shard_part(const Prm& prm, std::uint64_t pane_rays, const std::vector<
   }
 }
 
-// Dilation is linear: dilate every pane like the light atlas, keep the filled texels.
+// Coarse panes: the texels the PaneUpsampler can read, those inside a chart's footprint (it
+// takes taps only there, pane_upsample.h). The dilation rings in the gutters between the
+// footprints are read by nobody: the upsampler fills the atlas's own rings.
+void keep_chart_footprints(const AtlasLayout& layout, std::vector<std::uint8_t>& filled) {
+  std::vector<std::uint8_t> in_chart(filled.size(), 0);
+  for (const AtlasChart& chart : layout.charts)
+    for (int y = chart.origin.y; y < chart.origin.y + chart.size.y; ++y)
+      for (int x = chart.origin.x; x < chart.origin.x + chart.size.x; ++x)
+        in_chart[static_cast<std::size_t>(y) * static_cast<std::size_t>(layout.width) + static_cast<std::size_t>(x)] =
+            1;
+  for (std::size_t t = 0; t < filled.size(); ++t) filled[t] = filled[t] && in_chart[t];
+}
+
+// Dilation is linear: dilate every pane like the light atlas, keep the filled texels (of
+// coarse panes, only those inside the charts' footprints: keep_chart_footprints).
 void dilate_panes(const AtlasTexels& tex, std::vector<glm::vec3>& full, Prm& prm) {
   const auto clusters = static_cast<std::size_t>(prm.cluster_count);
   const int rings = std::max(4, prm.layout.padding_texels);
@@ -274,6 +288,7 @@ void dilate_panes(const AtlasTexels& tex, std::vector<glm::vec3>& full, Prm& prm
     filled = dilate<glm::vec3>(std::span<glm::vec3>(full.data() + c * tex.valid.size(), tex.valid.size()), prm.width,
                                prm.height, tex.valid, rings);
   if (clusters == 0) filled = tex.valid;
+  if (coarse_panes(prm.settings)) keep_chart_footprints(prm.layout, filled);
   for (std::size_t t = 0; t < filled.size(); ++t)
     if (filled[t]) prm.texels.push_back(static_cast<std::uint32_t>(t));
   std::vector<float> dense(clusters * prm.texels.size() * 3);

@@ -339,38 +339,63 @@ engine::Status PrmGpuPass::upload_upsampler(const PaneUpsampler& up, int coarse_
   auto program = builder.build();
   if (!program) return program.error();
   upsample_program_ = std::move(program).value();
-  upsample_count_location_ = glGetUniformLocation(upsample_program_.id(), "u_count");
-  upsample_has_base_location_ = glGetUniformLocation(upsample_program_.id(), "u_has_base");
+  const GLuint id = upsample_program_.id();
+  upsample_uniforms_ = {glGetUniformLocation(id, "u_first"), glGetUniformLocation(id, "u_count"),
+                        glGetUniformLocation(id, "u_mode")};
   const auto packed = [](std::uint32_t t, std::uint32_t w) { return (t % w) | ((t / w) << 16); };
-  const auto fw = static_cast<std::uint32_t>(width_), cw = static_cast<std::uint32_t>(coarse_width);
-  std::vector<glm::uvec2> texels, taps;
-  texels.reserve(up.fine_texels().size() + 1);
-  for (std::size_t k = 0; k < up.fine_texels().size(); ++k)
-    texels.emplace_back(packed(up.fine_texels()[k], fw), up.tap_first()[k]);
-  texels.emplace_back(0u, static_cast<std::uint32_t>(up.taps().size()));
-  taps.reserve(std::max<std::size_t>(up.taps().size(), 1));
-  for (const PaneUpsampler::Tap& t : up.taps())
-    taps.emplace_back(packed(t.coarse, cw), std::bit_cast<std::uint32_t>(t.weight));
-  if (taps.empty()) taps.emplace_back(0u, 0u);  // GL buffers cannot be empty
-  upsample_texels_ = engine::GlBuffer::create(texels.size() * sizeof(glm::uvec2), texels.data());
-  upsample_taps_ = engine::GlBuffer::create(taps.size() * sizeof(glm::uvec2), taps.data());
-  upsample_bytes_ = (texels.size() + taps.size()) * sizeof(glm::uvec2);
-  upsample_count_ = static_cast<std::uint32_t>(up.fine_texels().size());
+  const auto fw = static_cast<std::uint32_t>(width_);
+  if (coarse_width != up.coarse_width()) return error("the upsampler reads another pane layout");
+  std::vector<glm::uvec4> reads;
+  reads.reserve(std::max<std::size_t>(up.reads().size(), 1));
+  const auto weight = [](float w) { return static_cast<std::uint32_t>(std::lround(w * PaneUpsampler::kWeightSteps)); };
+  for (const PaneUpsampler::Read& r : up.reads()) {
+    if (r.origin.x < -1 || r.origin.y < -1 || r.origin.x > 65534 || r.origin.y > 65534)
+      return error("an upsampling read's origin lies outside the pane layout");
+    const auto ox = static_cast<std::uint32_t>(r.origin.x + 1), oy = static_cast<std::uint32_t>(r.origin.y + 1);
+    reads.emplace_back(packed(r.fine, fw), ox | (oy << 16), weight(r.weight[0]) | (weight(r.weight[1]) << 16),
+                       weight(r.weight[2]) | (weight(r.weight[3]) << 16));
+  }
+  std::vector<glm::uvec2> rings;
+  rings.reserve(std::max<std::size_t>(up.ring_texels().size(), 1));
+  for (const PaneUpsampler::RingTexel& r : up.ring_texels()) rings.emplace_back(packed(r.fine, fw), r.neighbours);
+  upsample_reads_count_ = static_cast<std::uint32_t>(reads.size());
+  upsample_ring_first_.assign(up.ring_first().begin(), up.ring_first().end());
+  if (reads.empty()) reads.emplace_back(0u);  // GL buffers cannot be empty
+  if (rings.empty()) rings.emplace_back(0u);
+  upsample_reads_ = engine::GlBuffer::create(reads.size() * sizeof(glm::uvec4), reads.data());
+  upsample_rings_ = engine::GlBuffer::create(rings.size() * sizeof(glm::uvec2), rings.data());
+  upsample_bytes_ = reads.size() * sizeof(glm::uvec4) + rings.size() * sizeof(glm::uvec2);
+  upsample_count_ = static_cast<std::uint32_t>(up.reads().size() + up.ring_texels().size());
   return {};
 }
 
 void PrmGpuPass::run_upsample() {
   upsample_program_.use();
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, upsample_texels_.id());
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, upsample_taps_.id());
-  glBindImageTexture(0, output_.id(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, upsample_reads_.id());
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, upsample_rings_.id());
+  glBindImageTexture(0, output_.id(), 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
   glBindImageTexture(1, base_.id(), 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
   glBindImageTexture(2, coarse_.id(), 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
-  glProgramUniform1ui(upsample_program_.id(), upsample_count_location_, upsample_count_);
-  glProgramUniform1ui(upsample_program_.id(), upsample_has_base_location_, base_.empty() ? 0u : 1u);
-  const std::uint32_t groups = (upsample_count_ + kGroupSize - 1) / kGroupSize;
-  const std::uint32_t groups_x = std::min(groups, max_groups_x_);
-  glDispatchCompute(groups_x, (groups + groups_x - 1) / groups_x, 1);
+  const GLuint id = upsample_program_.id();
+  const auto dispatch = [&](UpsampleMode mode, std::uint32_t first, std::uint32_t count) {
+    if (count == 0) return;
+    glProgramUniform1ui(id, upsample_uniforms_.mode, static_cast<GLuint>(mode));
+    glProgramUniform1ui(id, upsample_uniforms_.first, first);
+    glProgramUniform1ui(id, upsample_uniforms_.count, count);
+    const std::uint32_t groups = (count + kGroupSize - 1) / kGroupSize;
+    const std::uint32_t groups_x = std::min(groups, max_groups_x_);
+    glDispatchCompute(groups_x, (groups + groups_x - 1) / groups_x, 1);
+    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+  };
+  // The reads, then the rings one after the other (each reads the ones before), then the
+  // base at every texel written (the rings take the mean of the panes' light alone).
+  dispatch(UpsampleMode::Reads, 0, upsample_reads_count_);
+  for (std::size_t r = 0; r + 1 < upsample_ring_first_.size(); ++r)
+    dispatch(UpsampleMode::Ring, upsample_ring_first_[r], upsample_ring_first_[r + 1] - upsample_ring_first_[r]);
+  if (!base_.empty()) {
+    dispatch(UpsampleMode::BaseOverReads, 0, upsample_reads_count_);
+    dispatch(UpsampleMode::BaseOverRings, 0, upsample_ring_first_.empty() ? 0u : upsample_ring_first_.back());
+  }
 }
 
 void PrmGpuPass::create_output() {
@@ -563,14 +588,19 @@ std::size_t PrmGpuPass::pane_bytes() const {
   return bytes;
 }
 
-std::size_t PrmGpuPass::gpu_bytes() const {
+std::size_t PrmGpuPass::gpu_bytes() const { return memory().total(); }
+
+PrmGpuPass::Memory PrmGpuPass::memory() const {
   const std::size_t atlas_bytes = static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_) * 16;
-  std::size_t bytes = texel_slots_ * sizeof(std::uint32_t) + weights_bytes_ + chunks_bytes_ + upsample_bytes_;
-  for (std::size_t b : pane_buffer_bytes_) bytes += b;
-  if (!output_.empty()) bytes += atlas_bytes;
-  if (!coarse_.empty()) bytes += static_cast<std::size_t>(pane_width_) * static_cast<std::size_t>(pane_height_) * 16;
-  if (!base_.empty()) bytes += atlas_bytes;
-  return bytes;
+  Memory m;
+  for (std::size_t b : pane_buffer_bytes_) m.panes += b;
+  m.texels = texel_slots_ * sizeof(std::uint32_t);
+  m.work = weights_bytes_ + chunks_bytes_;
+  m.upsample = upsample_bytes_;
+  if (!coarse_.empty()) m.coarse = static_cast<std::size_t>(pane_width_) * static_cast<std::size_t>(pane_height_) * 16;
+  if (!output_.empty()) m.output = atlas_bytes;
+  if (!base_.empty()) m.base = atlas_bytes;
+  return m;
 }
 
 }  // namespace gi

@@ -112,6 +112,18 @@ class PrmGpuPass {
   std::vector<glm::vec3> read_back() const;
   /// GPU memory held: texel list, pane buffers, weights, output and base textures (bytes).
   std::size_t gpu_bytes() const;
+  /// gpu_bytes() by part (bytes; docs/prm.md "What Sponza's medium PRM holds").
+  struct Memory {
+    std::size_t panes = 0;     ///< Pane buffers (encoded blocks, tiles padded to 8 slots).
+    std::size_t texels = 0;    ///< The slots' texel coordinates (4 bytes per slot).
+    std::size_t work = 0;      ///< The last run's weights and chunk list.
+    std::size_t upsample = 0;  ///< Coarse panes: the upsampler's fine texels and taps.
+    std::size_t coarse = 0;    ///< Coarse panes: the K-sum texture at the pane layout (RGBA32F).
+    std::size_t output = 0;    ///< The output atlas (RGBA32F).
+    std::size_t base = 0;      ///< The base atlas (RGBA32F), when set.
+    std::size_t total() const { return panes + texels + work + upsample + coarse + output + base; }
+  };
+  Memory memory() const;
 
   int width() const { return width_; }
   int height() const { return height_; }
@@ -190,12 +202,17 @@ class PrmGpuPass {
   int pane_height_ = 0;
   engine::GlTexture coarse_;  ///< Coarse panes: the K-sum at the pane layout (no base).
   engine::ShaderProgram upsample_program_;
-  engine::GlBuffer upsample_texels_;  ///< Per fine texel (x | y << 16, first tap), plus the end.
-  engine::GlBuffer upsample_taps_;    ///< Per tap (coarse x | y << 16, weight bits).
+  engine::GlBuffer upsample_reads_;  ///< Per read: fine texel, coarse origin, 4 16-bit weights.
+  engine::GlBuffer upsample_rings_;  ///< Per ring texel: fine texel, neighbour mask.
   std::size_t upsample_bytes_ = 0;
   std::uint32_t upsample_count_ = 0;  ///< Fine texels written (0: dense panes, no upsampling).
-  int upsample_count_location_ = -1;
-  int upsample_has_base_location_ = -1;
+  std::uint32_t upsample_reads_count_ = 0;
+  std::vector<std::uint32_t> upsample_ring_first_;  ///< PaneUpsampler::ring_first.
+  enum class UpsampleMode : std::uint32_t { Reads = 0, Ring = 1, BaseOverReads = 2, BaseOverRings = 3 };
+  struct UpsampleUniforms {
+    int first = -1, count = -1, mode = -1;
+  };
+  UpsampleUniforms upsample_uniforms_;
   std::uint32_t max_groups_x_ = 65535;
   float decode_scale_ = 1.0f;  ///< Folded into every weight: 2^-24 for RGB9E5 mantissas, 1 for halves.
 };

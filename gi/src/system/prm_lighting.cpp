@@ -149,6 +149,12 @@ const engine::IndirectLightFrame& PrmLighting::frame() {
     if (!m.base.empty()) (void)m.pass->set_base(m.base);
     m.frame.irradiance_atlas_texture = {m.pass->texture()};
     m.stats.gpu_bytes = m.pass->gpu_bytes();
+    // The GPU holds the panes and the upsampler's taps now; nothing here reads the CPU copy
+    // again (the weights need the entry points alone), and on Sponza's medium PRM the float
+    // panes are 3x their RGB9E5 upload (docs/prm.md "What Sponza's medium PRM holds").
+    m.prm.panes.values = {};
+    m.prm.panes.block_value = {};
+    if (m.prm.atlas) m.prm.atlas->upsampler.reset();
   }
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();

@@ -128,3 +128,64 @@ TEST(PaneUpsample, LayoutsOfOtherChartsAreRefusedByName) {
 }
 
 }  // namespace
+
+namespace {
+
+// The coarse texels inside the charts' footprints: what a coarse PRM's panes keep (prm.cpp).
+std::vector<std::uint32_t> in_footprints(const Layouts& l) {
+  std::vector<std::uint32_t> out;
+  for (std::uint32_t t : l.coarse_filled) {
+    const int x = static_cast<int>(t % static_cast<std::uint32_t>(l.coarse.width));
+    const int y = static_cast<int>(t / static_cast<std::uint32_t>(l.coarse.width));
+    for (const gi::AtlasChart& c : l.coarse.charts)
+      if (x >= c.origin.x && y >= c.origin.y && x < c.origin.x + c.size.x && y < c.origin.y + c.size.y) {
+        out.push_back(t);
+        break;
+      }
+  }
+  return out;
+}
+
+}  // namespace
+
+// Issue 38: the panes' gutter rings outside the footprints are read by no fine texel, so
+// coarse panes drop them; the reads and rings built from the footprint texels alone are the
+// same records and give the same atlas. The records are the compact GPU form: four 16-bit
+// weights on a 2 x 2 block summing to 1, and ring texels the mean of their filled neighbours.
+TEST(PaneUpsample, PanesReadOnlyInsideTheFootprintsAndAsFourWeightsAndRingMeans) {
+  const Layouts l = layouts(2.0f, 16.0f);
+  const std::vector<std::uint32_t> kept = in_footprints(l);
+  ASSERT_LT(kept.size(), l.coarse_filled.size()) << "the dilation rings reach past the footprints";
+  auto all = gi::PaneUpsampler::build(l.coarse, l.coarse_filled, l.fine, l.fine_texels, 4);
+  auto trimmed = gi::PaneUpsampler::build(l.coarse, kept, l.fine, l.fine_texels, 4);
+  ASSERT_TRUE(all && trimmed);
+  EXPECT_TRUE(*all == *trimmed);
+  std::vector<glm::vec3> coarse(l.coarse_texels.valid.size(), glm::vec3(0.0f));
+  for (std::size_t t = 0; t < coarse.size(); ++t)
+    if (l.coarse_texels.valid[t]) coarse[t] = glm::vec3(1.0f + 0.25f * static_cast<float>(t % 7), 2.0f, 0.5f);
+  coarse = dilated(l, coarse);
+  const std::vector<glm::vec3> fine = trimmed->apply(coarse);
+  for (const gi::PaneUpsampler::Read& r : trimmed->reads()) {
+    float sum = 0.0f;
+    for (float w : r.weight) {
+      EXPECT_EQ(w * gi::PaneUpsampler::kWeightSteps, std::round(w * gi::PaneUpsampler::kWeightSteps));
+      sum += w;
+    }
+    EXPECT_NEAR(sum, 1.0f, 4.0f / gi::PaneUpsampler::kWeightSteps);
+  }
+  ASSERT_EQ(trimmed->ring_first().size(), 5u);
+  ASSERT_GT(trimmed->ring_texels().size(), 0u);
+  const auto w = static_cast<std::size_t>(l.fine.width);
+  for (const gi::PaneUpsampler::RingTexel& r : trimmed->ring_texels()) {
+    glm::vec3 mean(0.0f);
+    int n = 0;
+    for (std::size_t k = 0; k < 8; ++k)
+      if (r.neighbours & (1u << k)) {
+        const auto d = gi::PaneUpsampler::kNeighbour[k];
+        mean += fine[(r.fine / w + static_cast<std::size_t>(d.y)) * w + r.fine % w + static_cast<std::size_t>(d.x)];
+        ++n;
+      }
+    ASSERT_GT(n, 0);
+    EXPECT_NEAR(fine[r.fine].x, mean.x / static_cast<float>(n), 1e-5f * mean.x) << r.fine;
+  }
+}

@@ -592,6 +592,10 @@ TEST(PrmGpuPass, CoarsePanesAreUpsampledIntoTheAtlasLikeTheCpuTwin) {
     auto pass = gi::PrmGpuPass::create(prm, {.encoding = encoding});
     ASSERT_TRUE(pass.ok()) << pass.error().to_string();
     EXPECT_TRUE(pass->upsamples());
+    // Issue 38's compact records: 16 bytes per read, 8 per ring texel; the parts add up.
+    EXPECT_EQ(pass->memory().upsample, prm.atlas->upsampler->gpu_bytes());
+    EXPECT_EQ(pass->memory().total(), pass->gpu_bytes());
+    EXPECT_EQ(pass->memory().output, fine_size * 16);
     EXPECT_EQ(pass->width(), prm.atlas_width());
     EXPECT_EQ(pass->height(), prm.atlas_height());
     ASSERT_TRUE(pass->set_base(base).ok());

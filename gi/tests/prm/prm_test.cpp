@@ -147,6 +147,23 @@ TEST(PrmCoarsePanes, ReadAtTheAtlasTheyLightLikeDensePanes) {
   EXPECT_EQ(coarse->atlas_height(), dense->height);
   EXPECT_LT(coarse->pane_size() * 2, dense->pane_size()) << "half the density: under half the pane texels";
   EXPECT_EQ(coarse->atlas->upsampler->orphans(), 0u);
+  // Issue 38: coarse panes keep only the texels inside the charts' footprints (the upsampler
+  // reads nothing else), every covered texel among them.
+  {
+    std::vector<std::uint8_t> in_chart(static_cast<std::size_t>(coarse->width) * coarse->height, 0);
+    for (const gi::AtlasChart& ch : coarse->layout.charts)
+      for (int y = ch.origin.y; y < ch.origin.y + ch.size.y; ++y)
+        for (int x = ch.origin.x; x < ch.origin.x + ch.size.x; ++x)
+          in_chart[static_cast<std::size_t>(y) * static_cast<std::size_t>(coarse->width) + x] = 1;
+    for (std::uint32_t t : coarse->texels) ASSERT_TRUE(in_chart[t]) << "pane texel " << t << " outside every footprint";
+    const gi::AtlasTexels covered =
+        gi::rasterize_atlas(coarse->layout, gi::atlas_inputs_from(gi::bake_input_from(scene.assets)));
+    std::size_t valid = 0;
+    for (std::uint8_t v : covered.valid) valid += v;
+    std::size_t kept_valid = 0;
+    for (std::uint32_t t : coarse->texels) kept_valid += covered.valid[t];
+    EXPECT_EQ(kept_valid, valid);
+  }
 
   place_spot(scene, {1.5f, 1.2f, -1.2f}, {-1, -0.3f, 0.5f});
   const std::vector<glm::vec3> d = relight(*dense, scene), c = relight(*coarse, scene);
