@@ -253,8 +253,10 @@ void plan_prm(const PlanFacts& f, const std::optional<PlanPresets>& p, PlannedEf
       w.bake_seconds, w.runtime_bytes, static_cast<std::uint64_t>(nodes),
       std::to_string(p->prm.entry_points) + " entry points x N_s " + fixed(p->prm.splitting, 0) + " at albedo " +
           fixed(f.census.albedo, 2) + " -> ~" + std::to_string(static_cast<long long>(nodes)) + " path nodes x ~" +
-          std::to_string(static_cast<long long>(t.pane_texels)) + " pane texels; " + std::to_string(p->prm.clusters) +
-          " panes as half floats at " + fixed(pane_density(p->prm), 0) + " texels/m"};
+          std::to_string(static_cast<long long>(coarse_panes(p->prm) ? t.footprint_texels : t.pane_texels)) +
+          " pane texels; " + std::to_string(p->prm.clusters) +
+          (coarse_panes(p->prm) ? " panes as RGB9E5 at " : " panes as half floats at ") +
+          fixed(pane_density(p->prm), 0) + " texels/m"};
 }
 
 // Directional light maps: glossy static surfaces.

@@ -89,9 +89,12 @@ constexpr double kBrfCpuPerMadd = 1.0e-9;
 // are half floats (6 bytes per texel and cluster) plus its own RGBA32F irradiance atlas.
 constexpr double kAtlasTexelBytes = 16.0;
 constexpr double kPaneTexelBytes = 6.0;
-// Coarse PRM panes (pane_upsample.h): per atlas texel its entry (8 bytes) and ~4 bilinear
-// taps of 8 bytes (fewer at chart borders, more in the gutter rings).
-constexpr double kUpsampleBytesPerTexel = 40.0;
+// Coarse PRM panes (pane_upsample.h, docs/prm.md "What Sponza's medium PRM holds"): the
+// panes keep the texels inside the charts' footprints only, uploaded as RGB9E5 (4 bytes), and
+// the upsampler holds 16 bytes per lit atlas texel and 8 per gutter-ring texel.
+constexpr double kCoarsePaneTexelBytes = 4.0;
+constexpr double kUpsampleBytesPerLitTexel = 16.0;
+constexpr double kUpsampleBytesPerRingTexel = 8.0;
 
 // Sparse PRM panes (gi/src/prm/prm_panes.h): the share of the dense panes' texels the kept
 // blocks hold at a pane_threshold, the largest measured (docs/prm.md "Sparse panes"): a
@@ -156,6 +159,7 @@ AtlasTexelEstimate atlas_texels(const StaticSurfaceCensus& census, float texels_
     out.lit_texels += fill * (w + 1.0) * (h + 1.0);
     out.pane_texels += fill * (w + 1.0 + 2.0 * kPaneRings) * (h + 1.0 + 2.0 * kPaneRings);
     footprints.emplace_back(static_cast<int>(std::ceil(w)) + 1, static_cast<int>(std::ceil(h)) + 1);
+    out.footprint_texels += static_cast<double>(footprints.back().x) * footprints.back().y;
   }
   if (!footprints.empty()) {
     // The packer itself (cheap): footprints too large for the biggest atlas get the maximum.
@@ -211,12 +215,19 @@ BakeWork prm_work(const StaticSurfaceCensus& census, const PrmSettings& s, doubl
   const double parallel = w.rays * kPrmCpuPerRay;
   w.cpu_seconds = parallel + kPrmCpuOverhead;
   w.bake_seconds = wall_seconds(parallel, kPrmCpuOverhead);
-  const double upsampling = coarse_panes(s) ? static_cast<double>(t.width) * t.height * kAtlasTexelBytes +
-                                                  atlas.pane_texels * kUpsampleBytesPerTexel
-                                            : 0.0;
+  const double output = static_cast<double>(atlas.width) * atlas.height * kAtlasTexelBytes;
+  const double share = prm_stored_share(s.pane_threshold);
+  if (!coarse_panes(s)) {
+    w.runtime_bytes =
+        static_cast<std::uint64_t>(static_cast<double>(s.clusters) * t.pane_texels * kPaneTexelBytes * share + output);
+    return w;
+  }
+  // Coarse: the panes at the footprints, the coarse sum's texture, the upsampler's records.
+  const double upsampling = static_cast<double>(t.width) * t.height * kAtlasTexelBytes +
+                            atlas.lit_texels * kUpsampleBytesPerLitTexel +
+                            (atlas.pane_texels - atlas.lit_texels) * kUpsampleBytesPerRingTexel;
   w.runtime_bytes = static_cast<std::uint64_t>(
-      static_cast<double>(s.clusters) * t.pane_texels * kPaneTexelBytes * prm_stored_share(s.pane_threshold) +
-      static_cast<double>(atlas.width) * atlas.height * kAtlasTexelBytes + upsampling);
+      static_cast<double>(s.clusters) * t.footprint_texels * kCoarsePaneTexelBytes * share + output + upsampling);
   return w;
 }
 

@@ -31,7 +31,9 @@ struct LightPointCount {
 struct AtlasTexelEstimate {
   double lit_texels = 0.0;   ///< Texels a triangle covers (the atlas's "texels lit").
   double pane_texels = 0.0;  ///< Lit texels plus the dilated gutter rings (PRM pane elements).
-  int width = 0;             ///< Packed atlas size (power of two, as gi's packer chooses).
+  /// Texels inside the charts' footprints: coarse PRM panes keep only these (docs/prm.md).
+  double footprint_texels = 0.0;
+  int width = 0;  ///< Packed atlas size (power of two, as gi's packer chooses).
   int height = 0;
 };
 AtlasTexelEstimate atlas_texels(const StaticSurfaceCensus& census, float texels_per_metre);
