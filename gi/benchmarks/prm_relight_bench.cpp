@@ -51,6 +51,7 @@
 #include "light_atlas/light_atlas.h"
 #include "prm/prm.h"
 #include "prm/prm_gpu_pass.h"
+#include "prm/prm_io.h"
 #include "prm/prm_runtime.h"
 #include "raytrace/scene_adapter.h"
 #include "transport/point_emitters.h"
@@ -351,6 +352,136 @@ BENCHMARK(BM_PrmLightChange)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->MinTime(2.0);
+
+// The upsampler's GPU bytes in the format before issue 38's compact reads (8 bytes per fine
+// texel and per tap, a ring texel's taps the union of its neighbours'), for the memory table.
+std::size_t old_format_upsample_bytes(const gi::PaneUpsampler& up) {
+  std::vector<std::vector<std::uint32_t>> taps(up.fine_size());
+  std::size_t count = 0;
+  const auto coarse_index = [&](int x, int y) { return static_cast<std::uint32_t>(y * up.coarse_width() + x); };
+  for (const gi::PaneUpsampler::Read& r : up.reads())
+    for (int k = 0; k < 4; ++k)
+      if (r.weight[static_cast<std::size_t>(k)] > 0.0f)
+        taps[r.fine].push_back(coarse_index(r.origin.x + (k & 1), r.origin.y + (k >> 1)));
+  const auto w = static_cast<std::size_t>(up.fine_width());
+  for (const gi::PaneUpsampler::RingTexel& r : up.ring_texels()) {
+    std::vector<std::uint32_t> merged;
+    for (std::size_t k = 0; k < 8; ++k)
+      if (r.neighbours & (1u << k)) {
+        const std::size_t n = (r.fine / w + static_cast<std::size_t>(gi::PaneUpsampler::kNeighbour[k].y)) * w +
+                              r.fine % w + static_cast<std::size_t>(gi::PaneUpsampler::kNeighbour[k].x);
+        merged.insert(merged.end(), taps[n].begin(), taps[n].end());
+      }
+    std::sort(merged.begin(), merged.end());
+    merged.erase(std::unique(merged.begin(), merged.end()), merged.end());
+    taps[r.fine] = std::move(merged);
+  }
+  for (const auto& t : taps) count += t.size();
+  return (up.reads().size() + up.ring_texels().size() + 1 + count) * 8;
+}
+
+// A baked bundle's PRM (issue 38: Dabrovic Sponza with a moving torch at the medium preset),
+// when GI_PRM_BENCH_SCENE (the glTF) and GI_PRM_BENCH_BUNDLE (its bundle, baked with
+// `gi-bake --methods prm`) are set; skipped otherwise. Loads the PRM as a game does (load_prm:
+// the upsampler rebuilt), uploads it as RGB9E5 and reports its memory by part (MB): the GPU
+// pass's (PrmGpuPass::memory) and the CPU copy PrmLighting keeps (float panes, upsampler
+// taps). Then one light change per iteration, the first moving light carried through 8 poses
+// (0.5 m steps along x about its authored place). With GI_PRM_BENCH_REBAKE=<preset>, the
+// yardstick: the light atlas of the same scene re-baked once with that light static.
+//   GI_PRM_BENCH_SCENE=sponza_torch.gltf GI_PRM_BENCH_BUNDLE=sponza.gibake
+//     ./build/gi/benchmarks/prm_relight_bench --benchmark_filter=BM_PrmBundle --benchmark_counters_tabular=true
+void BM_PrmBundle(benchmark::State& state) {
+  const char* scene_path = std::getenv("GI_PRM_BENCH_SCENE");
+  const char* bundle_path = std::getenv("GI_PRM_BENCH_BUNDLE");
+  if (!scene_path || !bundle_path) {
+    state.SkipWithError("set GI_PRM_BENCH_SCENE and GI_PRM_BENCH_BUNDLE");
+    return;
+  }
+  engine::Scene scene = engine::instantiate(or_exit(engine::load_gltf(scene_path)));
+  engine::update_world_transforms(scene.registry);
+  const gi::BakeInput input = gi::bake_input_from(scene);
+  const gi::BakeLight* light = nullptr;
+  for (const gi::BakeLight& l : input.lights)
+    if (l.light.moves && !light) light = &l;
+  if (!light) {
+    state.SkipWithError("the scene has no moving light");
+    return;
+  }
+  const auto l0 = Clock::now();
+  const gi::Prm prm = or_exit(gi::load_prm(bundle_path, input));
+  const double load_ms = std::chrono::duration<double, std::milli>(Clock::now() - l0).count();
+  const auto caster = or_exit(gi::make_static_caster(input));
+  (void)bench::gl_context();
+  gi::PrmGpuPass pass = or_exit(gi::PrmGpuPass::create(prm, {.encoding = gi::PrmPaneEncoding::SharedExponent}));
+  std::vector<glm::mat4> poses;
+  for (int i = 0; i < 8; ++i)
+    poses.push_back(glm::translate(glm::mat4(1.0f), glm::vec3(0.5f * static_cast<float>(i - 4), 0.0f, 0.0f)) *
+                    light->light_to_world);
+  (void)pass.run({});
+  glFinish();
+  std::vector<double> cpu, gpu, cpu_time, gpu_time;
+  std::size_t frame = 0, clusters = 0;
+  for (auto _ : state) {
+    const double c0 = process_cpu_ms();
+    const auto t0 = Clock::now();
+    const gi::ReferenceLight ref = gi::reference_light(light->light, poses[frame++ % poses.size()]);
+    const std::vector<gi::PointEmitter> emitters =
+        gi::light_point_emitters(std::span<const gi::ReferenceLight>(&ref, 1), 16, prm.settings.seed);
+    const std::vector<glm::vec3> entry = gi::entry_irradiance(prm, emitters, *caster, nullptr);
+    const std::vector<gi::ClusterWeight> picked = gi::select_clusters(gi::cluster_weights(prm, entry), 32);
+    const auto t1 = Clock::now();
+    const double c1 = process_cpu_ms();
+    if (!pass.run(picked)) state.SkipWithError("PrmGpuPass::run failed");
+    glFinish();
+    const auto t2 = Clock::now();
+    cpu_time.push_back(c1 - c0);
+    gpu_time.push_back(process_cpu_ms() - c1);
+    cpu.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
+    gpu.push_back(std::chrono::duration<double, std::milli>(t2 - t1).count());
+    clusters = picked.size();
+  }
+  const gi::PrmGpuPass::Memory m = pass.memory();
+  const auto mb = [](double bytes) { return bytes / 1e6; };
+  state.counters["gpu_mb"] = mb(static_cast<double>(m.total()));
+  state.counters["gpu_panes_mb"] = mb(static_cast<double>(m.panes));
+  state.counters["gpu_texels_mb"] = mb(static_cast<double>(m.texels));
+  state.counters["gpu_upsample_mb"] = mb(static_cast<double>(m.upsample));
+  state.counters["gpu_coarse_mb"] = mb(static_cast<double>(m.coarse));
+  state.counters["gpu_output_mb"] = mb(static_cast<double>(m.output));
+  state.counters["gpu_work_mb"] = mb(static_cast<double>(m.work));
+  state.counters["cpu_panes_mb"] = mb(static_cast<double>(prm.panes.values.size() * sizeof(float)));
+  if (prm.atlas) {
+    const gi::PaneUpsampler& up = *prm.atlas->upsampler;
+    state.counters["cpu_upsample_mb"] =
+        mb(static_cast<double>(up.reads().size() * sizeof(gi::PaneUpsampler::Read) +
+                               up.ring_texels().size() * sizeof(gi::PaneUpsampler::RingTexel)));
+    state.counters["upsample_old_format_mb"] = mb(static_cast<double>(old_format_upsample_bytes(up)));
+    state.counters["upsample_reads"] = static_cast<double>(up.reads().size());
+    state.counters["upsample_ring_texels"] = static_cast<double>(up.ring_texels().size());
+  }
+  state.counters["pane_texels"] = static_cast<double>(prm.texels.size());
+  state.counters["pane_layout_texels"] = static_cast<double>(prm.width) * static_cast<double>(prm.height);
+  state.counters["atlas_texels"] = static_cast<double>(prm.atlas_width()) * static_cast<double>(prm.atlas_height());
+  state.counters["stored_elements"] = static_cast<double>(prm.panes.stored_elements());
+  state.counters["pane_blocks"] = static_cast<double>(prm.panes.blocks.size());
+  state.counters["clusters"] = static_cast<double>(clusters);
+  state.counters["load_ms"] = load_ms;
+  state.counters["cpu_ms"] = median(cpu);
+  state.counters["gpu_ms"] = median(gpu);
+  state.counters["cpu_cpu_time_ms"] = median(cpu_time);
+  state.counters["gpu_cpu_time_ms"] = median(gpu_time);
+  if (const char* preset = std::getenv("GI_PRM_BENCH_REBAKE")) {
+    gi::BakeInput fixed = input;
+    for (gi::BakeLight& l : fixed.lights) l.light.moves = false;
+    const auto b0 = Clock::now();
+    const auto atlas = or_exit(gi::bake_light_atlas(fixed, or_exit(gi::light_atlas_preset(preset))));
+    const double rebake_ms = std::chrono::duration<double, std::milli>(Clock::now() - b0).count();
+    benchmark::DoNotOptimize(atlas.irradiance.data());
+    state.counters["atlas_rebake_ms"] = rebake_ms;
+    state.counters["vs_rebake"] = rebake_ms / (median(cpu) + median(gpu));
+  }
+}
+BENCHMARK(BM_PrmBundle)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(16);
 
 // The CPU part's two ray sets alone, on the same poses: the flux check (64^2 directions from
 // the lamp, closest hits) and the entry points' shadow rays with their kernels (no flux check).
