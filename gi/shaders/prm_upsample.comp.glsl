@@ -4,7 +4,7 @@
 // every light-atlas texel the PaneUpsampler lists (gi/src/prm/pane_upsample.h), in passes:
 //   u_mode 0 (reads): E(fine) = sum over the 2 x 2 coarse texels at its origin of weight * coarse
 //   u_mode 1 (one gutter ring): E(fine) = mean of its filled 8-neighbours' E (the neighbour mask)
-//   u_mode 2 / 3: E(fine) += base(fine) over the reads / the ring texels
+//   u_mode 2 (base): E(fine) += base(fine) over the reads, then the ring texels (u_reads of them)
 // Taps stay inside the texel's own chart (no light crosses between surfaces); the atlas's
 // gutter rings are filled as the light atlas is dilated, ring after ring. The upsampling is
 // linear, so one set of passes per light change follows the K-sum. The records are uploaded
@@ -25,7 +25,8 @@ layout(rgba32f, binding = 2) readonly uniform image2D coarse_image;
 
 uniform uint u_first;  // first record
 uniform uint u_count;  // records of this dispatch
-uniform uint u_mode;   // 0 reads, 1 a ring, 2 base over reads, 3 base over rings
+uniform uint u_mode;   // 0 reads, 1 a ring, 2 the base over the reads and the rings
+uniform uint u_reads;  // reads (u_mode 2: record k >= u_reads is ring texel k - u_reads)
 
 const ivec2 kNeighbour[8] = ivec2[8](ivec2(-1, -1), ivec2(0, -1), ivec2(1, -1), ivec2(-1, 0), ivec2(1, 0),
                                      ivec2(-1, 1), ivec2(0, 1), ivec2(1, 1));
@@ -58,7 +59,7 @@ void main() {
       }
     imageStore(out_image, at, vec4(sum / n, 1.0));
   } else {
-    const ivec2 at = coord_of(u_mode == 2u ? reads[r].x : rings[r].x);
+    const ivec2 at = coord_of(r < u_reads ? reads[r].x : rings[r - u_reads].x);
     imageStore(out_image, at, vec4(imageLoad(out_image, at).xyz + imageLoad(base_image, at).xyz, 1.0));
   }
 }

@@ -341,7 +341,7 @@ engine::Status PrmGpuPass::upload_upsampler(const PaneUpsampler& up, int coarse_
   upsample_program_ = std::move(program).value();
   const GLuint id = upsample_program_.id();
   upsample_uniforms_ = {glGetUniformLocation(id, "u_first"), glGetUniformLocation(id, "u_count"),
-                        glGetUniformLocation(id, "u_mode")};
+                        glGetUniformLocation(id, "u_mode"), glGetUniformLocation(id, "u_reads")};
   const auto packed = [](std::uint32_t t, std::uint32_t w) { return (t % w) | ((t / w) << 16); };
   const auto fw = static_cast<std::uint32_t>(width_);
   if (coarse_width != up.coarse_width()) return error("the upsampler reads another pane layout");
@@ -388,13 +388,14 @@ void PrmGpuPass::run_upsample() {
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
   };
   // The reads, then the rings one after the other (each reads the ones before), then the
-  // base at every texel written (the rings take the mean of the panes' light alone).
+  // base at every texel written in one dispatch (the rings take the mean of the panes' light
+  // alone). Each dispatch is a fixed cost on llvmpipe (docs/performance.md).
   dispatch(UpsampleMode::Reads, 0, upsample_reads_count_);
   for (std::size_t r = 0; r + 1 < upsample_ring_first_.size(); ++r)
     dispatch(UpsampleMode::Ring, upsample_ring_first_[r], upsample_ring_first_[r + 1] - upsample_ring_first_[r]);
   if (!base_.empty()) {
-    dispatch(UpsampleMode::BaseOverReads, 0, upsample_reads_count_);
-    dispatch(UpsampleMode::BaseOverRings, 0, upsample_ring_first_.empty() ? 0u : upsample_ring_first_.back());
+    glProgramUniform1ui(id, upsample_uniforms_.reads, upsample_reads_count_);
+    dispatch(UpsampleMode::Base, 0, upsample_count_);
   }
 }
 

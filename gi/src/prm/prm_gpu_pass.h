@@ -208,9 +208,9 @@ class PrmGpuPass {
   std::uint32_t upsample_count_ = 0;  ///< Fine texels written (0: dense panes, no upsampling).
   std::uint32_t upsample_reads_count_ = 0;
   std::vector<std::uint32_t> upsample_ring_first_;  ///< PaneUpsampler::ring_first.
-  enum class UpsampleMode : std::uint32_t { Reads = 0, Ring = 1, BaseOverReads = 2, BaseOverRings = 3 };
+  enum class UpsampleMode : std::uint32_t { Reads = 0, Ring = 1, Base = 2 };
   struct UpsampleUniforms {
-    int first = -1, count = -1, mode = -1;
+    int first = -1, count = -1, mode = -1, reads = -1;
   };
   UpsampleUniforms upsample_uniforms_;
   std::uint32_t max_groups_x_ = 65535;
