@@ -125,7 +125,7 @@ TEST(AntiradianceLinkOracle, IsMetByEveryLinkOnceLeafLinksAreSplit) {
     }
   }
   EXPECT_GT(met, 0u);
-  EXPECT_GT(split, 0u);  // the scene has near pairs of leaves that fail the oracle
+  EXPECT_GT(split, 0u);   // the scene has near pairs of leaves that fail the oracle
   EXPECT_GT(capped, 0u);  // and touching ones (the door's edges against its faces)
 }
 
