@@ -19,6 +19,18 @@ struct AntiradianceSettings {
   int bins_per_side = 8;
   /// Leaves are triangle pieces whose longest edge is at most this (metres).
   float patch_size_m = 0.5f;
+  /// Adaptive leaves (issue 37): pieces within near_radius_m of a deforming instance's swept
+  /// sphere (its origin, through its farthest vertex), and the deforming instances' own pieces,
+  /// are split until their longest edge is at most this (metres); 0: off (patch_size_m
+  /// everywhere). A bundle stores the hierarchy, so a load does not read it.
+  float near_patch_size_m = 0.0f;
+  /// How far from the swept sphere the leaves are near_patch_size_m (metres).
+  float near_radius_m = 1.0f;
+  /// Leaf-leaf links that fail the oracle (issue 37): each end is split virtually into up to
+  /// this many equal-area disc pieces, as many as the oracle asks for at the pair's distance,
+  /// each piece pair with its own distance and bin (link_mesh.h); 0: off (the two leaves are
+  /// linked regardless, as one disc). Not stored in a bundle: sweep-only until a preset uses it.
+  int leaf_link_pieces = 0;
   /// Static triangles within this distance of the deforming region's swept bounds exchange
   /// light with it (metres).
   float exchange_radius_m = 8.0f;

@@ -26,9 +26,33 @@ struct SourceTriangle {
   glm::vec3 centroid;
 };
 
+// The sphere a deforming instance's vertices stay in under any rotation about its origin.
+struct SweptSphere {
+  glm::vec3 center{0.0f};
+  float radius_m = 0.0f;
+};
+
+// Adaptive leaf sizes: near_patch within near_radius of a swept sphere (and on the deforming
+// instances themselves), patch elsewhere.
+struct LeafSizing {
+  float patch = 0.5f;
+  float near_patch = 0.0f;  // 0: off
+  float near_radius = 0.0f;
+  std::vector<SweptSphere> swept;
+
+  // The largest longest-edge of a piece with this bounding sphere in this group.
+  float limit(std::int32_t group, const glm::vec3& center, float radius) const {
+    if (!(near_patch > 0.0f) || near_patch >= patch) return patch;
+    if (group >= 1) return near_patch;
+    for (const SweptSphere& s : swept)
+      if (glm::length(center - s.center) - radius - s.radius_m <= near_radius) return near_patch;
+    return patch;
+  }
+};
+
 struct Builder {
   ElementHierarchy& h;
-  float patch_size;
+  const LeafSizing& sizing;
 
   std::int32_t new_node(std::int32_t parent, std::int32_t group, std::int32_t instance) {
     ElementNode n;
@@ -44,7 +68,7 @@ struct Builder {
   }
 
   // A triangle piece (world a,b,c; object oa,ob,oc): split at the longest edge's midpoint
-  // until that edge is at most patch_size. Children are recorded in a per-node list first
+  // until that edge is at most the sizing's limit there. Children are recorded in a per-node list first
   // (depth-first: a node's children are emitted after it, each with its whole subtree).
   std::int32_t emit_triangle(std::int32_t parent, const SourceTriangle& t, const glm::vec3 (&w)[3],
                              const glm::vec3 (&o)[3]) {
@@ -74,7 +98,7 @@ struct Builder {
         e = k;
       }
     }
-    if (longest <= patch_size) {
+    if (longest <= sizing.limit(t.group, cw, n.radius_m)) {
       n.leaf_begin = static_cast<std::int32_t>(h.leaves.size());
       h.leaves.push_back(id);
       n.leaf_end = n.leaf_begin + 1;
@@ -177,7 +201,7 @@ engine::Error build_error(std::string message) {
 // The deforming instances into h (their indices and transforms), with the bounds they sweep
 // about their origins widened by the exchange radius.
 void find_deforming(const BakeInput& input, const AntiradianceSettings& settings, ElementHierarchy& h, glm::vec3& lo,
-                    glm::vec3& hi) {
+                    glm::vec3& hi, std::vector<SweptSphere>& swept) {
   lo = glm::vec3(std::numeric_limits<float>::max());
   hi = glm::vec3(-std::numeric_limits<float>::max());
   for (std::size_t i = 0; i < input.instances.size(); ++i) {
@@ -191,6 +215,7 @@ void find_deforming(const BakeInput& input, const AntiradianceSettings& settings
         reach = std::max(reach, glm::length(glm::vec3(inst.object_to_world * glm::vec4(v, 1.0f)) -
                                             glm::vec3(inst.object_to_world[3])));
     const glm::vec3 origin(inst.object_to_world[3]);
+    swept.push_back({origin, reach});
     lo = glm::min(lo, origin - glm::vec3(reach));
     hi = glm::max(hi, origin + glm::vec3(reach));
   }
@@ -250,9 +275,9 @@ std::vector<std::vector<SourceTriangle>> source_triangles(const BakeInput& input
 
 // The tree over the groups' clusters under one root, refit; the deforming groups' clusters
 // refit once in object space too.
-void assemble_tree(ElementHierarchy& h, std::vector<std::vector<SourceTriangle>>& by_group, float patch_size_m) {
+void assemble_tree(ElementHierarchy& h, std::vector<std::vector<SourceTriangle>>& by_group, const LeafSizing& sizing) {
   const int groups = static_cast<int>(by_group.size());
-  Builder b{h, patch_size_m};
+  Builder b{h, sizing};
   const std::int32_t root = b.new_node(-1, -1, -1);
   std::vector<std::int32_t> kids;
   h.group_root.assign(static_cast<std::size_t>(groups), -1);
@@ -290,11 +315,15 @@ engine::Result<ElementHierarchy> build_element_hierarchy(const BakeInput& input,
   if (!(settings.patch_size_m > 0.0f) || !std::isfinite(settings.patch_size_m))
     return build_error("patch_size_m must be positive");
   if (!(settings.exchange_radius_m >= 0.0f)) return build_error("exchange_radius_m must not be negative");
+  if (!(settings.near_patch_size_m >= 0.0f) || !std::isfinite(settings.near_patch_size_m))
+    return build_error("near_patch_size_m must not be negative");
+  if (!(settings.near_radius_m >= 0.0f)) return build_error("near_radius_m must not be negative");
 
   ElementHierarchy h;
   // The deforming region's swept bounds.
   glm::vec3 lo, hi;
-  find_deforming(input, settings, h, lo, hi);
+  LeafSizing sizing{settings.patch_size_m, settings.near_patch_size_m, settings.near_radius_m, {}};
+  find_deforming(input, settings, h, lo, hi, sizing.swept);
   if (h.deforming_instances.empty()) return build_error("no instance is flagged deforming");
 
   const int groups = 1 + static_cast<int>(h.deforming_instances.size());
@@ -304,7 +333,7 @@ engine::Result<ElementHierarchy> build_element_hierarchy(const BakeInput& input,
       return build_error("deforming instance '" +
                          input.instances[h.deforming_instances[static_cast<std::size_t>(g - 1)]].name +
                          "' has no triangle");
-  assemble_tree(h, by_group, settings.patch_size_m);
+  assemble_tree(h, by_group, sizing);
   return h;
 }
 

@@ -2,7 +2,8 @@
 // The elements of an antiradiance solve (Dachsbacher et al. 2007, §3.1-3.2, §4.1): patches of
 // the deforming region's surfaces and of the static surfaces near it, in one hierarchy laid
 // out depth-first. Leaves are triangle pieces (a triangle halved at its longest edge until
-// the edge is at most patch_size_m); above a triangle's pieces, a median-split cluster tree
+// the edge is at most patch_size_m, or near_patch_size_m near the deforming instances:
+// adaptive leaves, issue 37); above a triangle's pieces, a median-split cluster tree
 // over triangles (no normal: "clustering ... we do not need a normal"). The root's children
 // are one subtree per group: group 0 is the static surfaces, group g >= 1 the deforming
 // instance deforming_instances[g - 1], so a moved instance is one contiguous node range.
@@ -65,8 +66,11 @@ struct ElementHierarchy {
 /// triangle of the Static, non-deforming instances whose bounds come within
 /// settings.exchange_radius_m of the deforming instances' swept bounds (a sphere around each
 /// instance origin through its farthest vertex: any rotation about the origin stays inside).
+/// Pieces of the deforming instances, and static pieces whose bounding sphere comes within
+/// settings.near_radius_m of a swept sphere, are split to settings.near_patch_size_m when that
+/// is set (> 0) and finer than patch_size_m.
 /// Degenerate triangles are skipped. Errors: no deforming instance, invalid input, no
-/// triangle, patch_size_m not positive.
+/// triangle, patch_size_m not positive, near_patch_size_m or near_radius_m negative.
 engine::Result<ElementHierarchy> build_element_hierarchy(const BakeInput& input, const AntiradianceSettings& settings);
 
 }  // namespace gi

@@ -22,6 +22,21 @@ constexpr DiscPoint kDisc[kSamples] = {
     {0.0f, 0.85f},        {-0.5f, 0.6877f},    {-0.8084f, 0.2627f}, {-0.8084f, -0.2627f},
     {-0.5f, -0.6877f},    {0.0f, -0.85f},      {0.5f, -0.6877f},    {0.8084f, -0.2627f}};
 
+// Point k of n equal-area points on the unit disc (a Fermat spiral: point k stands for the
+// ring between radii sqrt(k/n) and sqrt((k+1)/n), turned by the golden angle; deterministic).
+DiscPoint spiral_point(int k, int n) {
+  if (n == 1) return {0.0f, 0.0f};  // one piece: the centre
+  const float r = std::sqrt((static_cast<float>(k) + 0.5f) / static_cast<float>(n));
+  const float a = 2.39996323f * static_cast<float>(k);
+  return {r * std::cos(a), r * std::sin(a)};
+}
+
+// Two unit tangents of the plane with normal n.
+void tangents(const glm::vec3& n, glm::vec3& t, glm::vec3& bt) {
+  t = glm::normalize(std::abs(n.x) < 0.9f ? glm::cross(n, glm::vec3(1, 0, 0)) : glm::cross(n, glm::vec3(0, 1, 0)));
+  bt = glm::cross(n, t);
+}
+
 struct Linker {
   const ElementHierarchy& h;
   const DirectionalBins& bins;
@@ -29,6 +44,11 @@ struct Linker {
   std::vector<Link>& out;
   /// Distributed bakes: only links to receivers of this shard (whole: every link).
   WorkShard shard{};
+  /// Leaf-leaf links that fail the oracle: pieces per end at most (0: linked regardless).
+  int max_pieces = 0;
+  /// Per bin: the split link's form factor so far, and the bins touched (scratch).
+  std::vector<float> bin_sum{};
+  std::vector<std::int32_t> touched{};
 
   // Does the subtree of node a hold a receiver of the shard? (Subtrees are index ranges.)
   bool subtree_owned(std::int32_t a) const {
@@ -59,11 +79,23 @@ struct Linker {
   // its plane with its area for a surface element; facing the receiver with its bounding
   // radius for a cluster), each direction point -> receiver centre picks a bin; a bin gets
   // the share of samples that fell in it. One record per (receiver, sender, bin).
-  void directed(std::int32_t r, std::int32_t s) {
+  void directed(std::int32_t r, std::int32_t s, bool fine) {
     if (!shard.owns(static_cast<std::size_t>(r))) return;
     const ElementNode& rn = node(r);
     const ElementNode& sn = node(s);
     if (behind(rn, sn)) return;
+    if (!fine && max_pieces > 0) {
+      // Coplanar neighbours (one surface cut into leaves) exchange nothing: every piece pair
+      // lies in the receiver's plane. Skipped before the pieces, most of the touching pairs.
+      if (std::abs(glm::dot(rn.normal, sn.center - rn.center)) <= 1e-5f * (rn.radius_m + sn.radius_m) &&
+          glm::dot(rn.normal, sn.normal) >= 0.9999f)
+        return;
+      const LinkPieces p = link_pieces(rn, sn, threshold_sr, max_pieces);
+      if (p.sender > 1 || p.receiver > 1) {
+        split_directed(r, s, p);
+        return;
+      }
+    }
     const glm::vec3 d = rn.center - sn.center;
     const float d2 = glm::dot(d, d);
     const glm::vec3 axis =
@@ -93,9 +125,47 @@ struct Linker {
     }
   }
 
-  void link(std::int32_t a, std::int32_t b) {
-    directed(a, b);
-    directed(b, a);
+  // Directed leaf link r <- s split virtually (§3.1's refinement for a pair of leaves): both
+  // leaves as discs of their area in their planes, cut into p.sender / p.receiver equal-area
+  // pieces (spiral_point); each piece pair adds, in the bin of its own direction, its share
+  // of the sender's intensity (1 / p.sender, the leaf's I_ex spread evenly over its area)
+  // averaged over the receiver's pieces, at its own distance: F_b = sum 1 / (ps pr d^2 omega_b),
+  // d^2 regularized by both pieces' disc terms (bounded for touching leaves). Sender pieces
+  // behind a receiver piece's plane add nothing (the positive hemisphere, as `behind`).
+  void split_directed(std::int32_t r, std::int32_t s, const LinkPieces& p) {
+    const ElementNode& rn = node(r);
+    const ElementNode& sn = node(s);
+    bin_sum.assign(static_cast<std::size_t>(bins.count()), 0.0f);
+    touched.clear();
+    glm::vec3 st, sbt, rt, rbt;
+    tangents(sn.normal, st, sbt);
+    tangents(rn.normal, rt, rbt);
+    const float s_radius = std::sqrt(sn.area_m2 / glm::pi<float>());
+    const float r_radius = std::sqrt(rn.area_m2 / glm::pi<float>());
+    const float reg =
+        (sn.area_m2 / static_cast<float>(p.sender) + rn.area_m2 / static_cast<float>(p.receiver)) / glm::pi<float>();
+    const float weight = 1.0f / (static_cast<float>(p.sender) * static_cast<float>(p.receiver));
+    for (int j = 0; j < p.sender; ++j) {
+      const DiscPoint a = spiral_point(j, p.sender);
+      const glm::vec3 ps = sn.center + s_radius * (a.x * st + a.y * sbt);
+      for (int k = 0; k < p.receiver; ++k) {
+        const DiscPoint b = spiral_point(k, p.receiver);
+        const glm::vec3 pr = rn.center + r_radius * (b.x * rt + b.y * rbt);
+        const glm::vec3 dir = pr - ps;
+        const float d2 = glm::dot(dir, dir);
+        if (!(d2 > 0.0f) || glm::dot(rn.normal, dir) >= 0.0f) continue;  // behind the receiver piece
+        const int bin = bins.bin_of(dir / std::sqrt(d2));
+        if (bin_sum[static_cast<std::size_t>(bin)] == 0.0f) touched.push_back(bin);
+        bin_sum[static_cast<std::size_t>(bin)] += weight / ((d2 + reg) * bins.solid_angle(bin));
+      }
+    }
+    std::sort(touched.begin(), touched.end());
+    for (std::int32_t b : touched) out.push_back({r, s, b, bin_sum[static_cast<std::size_t>(b)]});
+  }
+
+  void link(std::int32_t a, std::int32_t b, bool fine) {
+    directed(a, b, fine);
+    directed(b, a, fine);
   }
 
   void refine(std::int32_t a, std::int32_t b) {
@@ -110,7 +180,7 @@ struct Linker {
     const float sb = glm::pi<float>() * bn.radius_m * bn.radius_m / std::max(d2, 1e-30f);
     const bool fine = d > an.radius_m + bn.radius_m && std::max(sa, sb) <= threshold_sr;
     if (fine || (a_leaf && b_leaf)) {
-      link(a, b);
+      link(a, b, fine);
       return;
     }
     const bool split_a = b_leaf || (!a_leaf && an.radius_m >= bn.radius_m);
@@ -151,15 +221,34 @@ void sort_and_index(const ElementHierarchy& h, LinkMesh& mesh) {
   index_links(h, mesh);
 }
 
-float threshold(const DirectionalBins& bins, const AntiradianceSettings& s) {
+}  // namespace
+
+float oracle_threshold_sr(const DirectionalBins& bins, const AntiradianceSettings& s) {
   return std::max(s.oracle_scale, 1e-6f) * 4.0f * glm::pi<float>() / static_cast<float>(bins.count());
 }
 
-}  // namespace
+bool meets_oracle(const ElementNode& a, const ElementNode& b, float threshold_sr) {
+  const float d2 = glm::dot(a.center - b.center, a.center - b.center);
+  const float d = std::sqrt(d2);
+  const float r = std::max(a.radius_m, b.radius_m);
+  return d > a.radius_m + b.radius_m && glm::pi<float>() * r * r / std::max(d2, 1e-30f) <= threshold_sr;
+}
+
+LinkPieces link_pieces(const ElementNode& receiver, const ElementNode& sender, float threshold_sr, int max_pieces) {
+  // A piece of n has radius radius_m / sqrt(n): its solid angle at the centres' distance is
+  // pi radius_m^2 / (n d^2); the oracle asks for at most threshold_sr, so n >= that / threshold.
+  const float d2 = glm::dot(receiver.center - sender.center, receiver.center - sender.center);
+  const auto pieces = [&](const ElementNode& e) {
+    const double need = glm::pi<double>() * static_cast<double>(e.radius_m) * static_cast<double>(e.radius_m) /
+                        (std::max(static_cast<double>(d2), 1e-30) * static_cast<double>(threshold_sr));
+    return static_cast<int>(std::clamp(std::ceil(need), 1.0, static_cast<double>(std::max(max_pieces, 1))));
+  };
+  return {pieces(sender), pieces(receiver)};
+}
 
 LinkMesh link_elements(const ElementHierarchy& h, const DirectionalBins& bins, const AntiradianceSettings& settings) {
   LinkMesh mesh;
-  Linker linker{h, bins, threshold(bins, settings), mesh.links};
+  Linker linker{h, bins, oracle_threshold_sr(bins, settings), mesh.links, {}, settings.leaf_link_pieces};
   linker.self(0);
   sort_and_index(h, mesh);
   mesh.relinked_elements = h.nodes.size();
@@ -170,7 +259,7 @@ LinkMesh link_elements(const ElementHierarchy& h, const DirectionalBins& bins, c
 LinkMesh link_elements_shard(const ElementHierarchy& h, const DirectionalBins& bins,
                              const AntiradianceSettings& settings, const WorkShard& shard) {
   LinkMesh mesh;
-  Linker linker{h, bins, threshold(bins, settings), mesh.links, shard};
+  Linker linker{h, bins, oracle_threshold_sr(bins, settings), mesh.links, shard, settings.leaf_link_pieces};
   linker.self(0);
   sort_and_index(h, mesh);
   mesh.relinked_elements = shard.items(h.nodes.size()).size();
@@ -246,7 +335,7 @@ void relink_moved(const ElementHierarchy& h, const DirectionalBins& bins, const 
   // factors but turns their directions, hence their bins); links between unmoved groups stay.
   std::erase_if(mesh.links, [&](const Link& l) { return group_moved(l.receiver) || group_moved(l.sender); });
   const std::size_t kept = mesh.links.size();
-  Linker linker{h, bins, threshold(bins, settings), mesh.links};
+  Linker linker{h, bins, oracle_threshold_sr(bins, settings), mesh.links, {}, settings.leaf_link_pieces};
   for (int a = 0; a < h.group_count(); ++a)
     for (int b = a + 1; b < h.group_count(); ++b) {
       if (!is_moved[static_cast<std::size_t>(a)] && !is_moved[static_cast<std::size_t>(b)]) continue;

@@ -4,7 +4,11 @@
 // Refinement starts from the root's self-link (always subdivided) and uses the paper's
 // oracle: a pair is linked when each element's bounding-sphere solid angle seen from the
 // other is at most oracle_scale x the smallest bin's solid angle (and the spheres do not
-// overlap); otherwise the larger element is subdivided; two leaves are linked regardless.
+// overlap); otherwise the larger element is subdivided; two leaves are linked regardless,
+// unless settings.leaf_link_pieces > 0 (issue 37): then a leaf pair that fails the oracle is
+// split virtually, each end into as many equal-area pieces as the oracle asks for at the
+// pair's distance (link_pieces, at most leaf_link_pieces), every piece pair with its own
+// distance and bin; the link keeps one record per (receiver, sender, bin).
 // No visibility anywhere: antiradiance stands for it.
 //
 // Form factor, eq. 17: F = 1 / (d^2 omega_bin), spread over the bins the sender covers as
@@ -53,6 +57,23 @@ struct LinkMesh {
   std::size_t relinked_elements = 0;
   std::size_t links_made = 0;
 };
+
+/// The oracle's threshold: oracle_scale x 4 pi / bins (sr).
+float oracle_threshold_sr(const DirectionalBins& bins, const AntiradianceSettings& settings);
+
+/// The paper's oracle for a pair: the spheres do not overlap and each one's solid angle seen
+/// from the other's centre (pi r^2 / d^2) is at most threshold_sr.
+bool meets_oracle(const ElementNode& a, const ElementNode& b, float threshold_sr);
+
+/// How many equal-area pieces each end of a leaf-leaf link is split into (1: not split).
+struct LinkPieces {
+  int sender = 1;
+  int receiver = 1;
+};
+/// The pieces a link receiver <- sender that fails the oracle is split into: per end the
+/// fewest n with pi radius_m^2 / (n d^2) <= threshold_sr (d: the centres' distance), at most
+/// max_pieces (>= 1).
+LinkPieces link_pieces(const ElementNode& receiver, const ElementNode& sender, float threshold_sr, int max_pieces);
 
 /// All links of the hierarchy (counters: every element, every link).
 LinkMesh link_elements(const ElementHierarchy& h, const DirectionalBins& bins, const AntiradianceSettings& settings);

@@ -192,6 +192,31 @@ std::vector<KnobSpec> antiradiance_knobs() {
        .default_grid = {"1"},
        .min_value = 0.01,
        .max_value = 100},
+      {.name = "near_patch",
+       .description = "adaptive leaves: leaf size within near_radius of the door's swept sphere and on the door, "
+                      "metres (0: off, patch everywhere)",
+       .kind = KnobKind::Real,
+       .default_grid = {"0"},
+       .min_value = 0,
+       .max_value = 10},
+      {.name = "near_radius",
+       .description = "adaptive leaves: how far from the door's swept sphere the leaves are near_patch, metres",
+       .kind = KnobKind::Real,
+       .default_grid = {"1"},
+       .min_value = 0,
+       .max_value = 100},
+      {.name = "pieces",
+       .description = "leaf-leaf links that fail the oracle: virtual pieces per end at most (0: linked regardless)",
+       .kind = KnobKind::Integer,
+       .default_grid = {"0"},
+       .min_value = 0,
+       .max_value = 4096},
+      {.name = "solve",
+       .description = "off: build the leaves only and score the projection floor (the true change through them) as "
+                      "the field",
+       .kind = KnobKind::Choice,
+       .default_grid = {"on"},
+       .choices = {"on", "off"}},
       {.name = "output",
        .description = "how the change reaches a texel: blend (the runtime's 4 nearest leaves) or gather (from the "
                       "hierarchy at the texel, antiradiance_texel_gather.h)",
@@ -242,6 +267,9 @@ AntiradianceSettings antiradiance_settings(const RunContext& ctx) {
   s.residual_tolerance = ctx.knobs.real("tolerance");
   s.scheme = ctx.knobs.text("scheme") == "asymmetric" ? AntiradianceScheme::Asymmetric : AntiradianceScheme::Symmetric;
   s.oracle_scale = static_cast<float>(ctx.knobs.real("oracle"));
+  s.near_patch_size_m = static_cast<float>(ctx.knobs.real("near_patch"));
+  s.near_radius_m = static_cast<float>(ctx.knobs.real("near_radius"));
+  s.leaf_link_pieces = static_cast<int>(ctx.knobs.integer("pieces"));
   s.seed = ctx.seed;
   return s;
 }
@@ -476,12 +504,40 @@ std::vector<std::pair<std::string, double>> door_move_extras(const RunContext& c
   return extras;
 }
 
+// `--knob solve=off`: the leaves only, the field their projection floor (no solve needed:
+// the true change passed through the leaves), with the leaf counts.
+engine::Result<MethodOutput> run_projection_floor(const RunContext& ctx, const DoorSetup& d,
+                                                  const AntiradianceSettings& s) {
+  const auto t0 = Clock::now();
+  auto h = build_element_hierarchy(d.input, s);
+  if (!h) return h.error();
+  const std::vector<AntiradianceTexelBlend> blends = antiradiance_texel_blends(*h, d.input, d.layout);
+  MethodOutput out;
+  out.costs.bake_seconds = ms_since(t0) / 1000.0;
+  const std::size_t n = d.texels.valid.size();
+  DoorMoveScores sc;
+  sc.floor_values.assign(n * kPoses, glm::vec3(0.0f));
+  std::vector<std::uint8_t> valid(n * kPoses, 0);
+  for (std::size_t k = 1; k < kPoses; ++k) {  // the moved poses, as score_door_moves compares them
+    for (std::size_t t = 0; t < n; ++t) valid[k * n + t] = d.mask[t];
+    sc.add_floor(ctx.reference, d, blends, h->leaf_count(), k);
+  }
+  out.field = RgbField::from_texels(d.texels.width, d.texels.height * static_cast<int>(kPoses), sc.floor_values,
+                                    std::move(valid));
+  out.extras = {{"projection_floor_rel_rmse", compare_rgb(out.field, ctx.reference).rel_rmse},
+                {"elements", static_cast<double>(h->nodes.size())},
+                {"leaves", static_cast<double>(h->leaf_count())},
+                {"compared_texels", static_cast<double>(d.compared)}};
+  return out;
+}
+
 engine::Result<MethodOutput> run_door_moves(const RunContext& ctx) {
   auto d = door_setup(ctx.scene, ctx.knobs.real("density"), ctx.knobs.real("radius"));
   if (!d) return d.error();
   if (ctx.reference.width != d->texels.width || ctx.reference.height != d->texels.height * static_cast<int>(kPoses))
     return engine::Error{.message = "the atlas size differs from the reference's"};
   const AntiradianceSettings s = antiradiance_settings(ctx);
+  if (ctx.knobs.text("solve") == "off") return run_projection_floor(ctx, *d, s);
 
   const auto t_bake = Clock::now();
   auto bake = bake_antiradiance(d->input, s);
