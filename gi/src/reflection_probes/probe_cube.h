@@ -105,7 +105,7 @@ glm::vec3 distance_corrected_direction(const ProbeCube& cube, const glm::vec3& p
 inline constexpr int kProbeMaxLobeSamples = 16;
 /// The lobe samples the runtime asks the forward pass for (IndirectLightFrame::
 /// reflection_probe_lobe_samples; 0: the split sum's single read; docs/reflection_probes.md).
-inline constexpr int kProbeLobeSamples = 8;
+inline constexpr int kProbeLobeSamples = 4;
 
 /// The specular lobe at the actual view read from a prefiltered probe by filtered importance
 /// sampling (Colbert and Krivanek 2007, "GPU-based importance sampling"): `samples` (1 ..

@@ -55,7 +55,7 @@ std::vector<KnobSpec> reflection_probes_knobs() {
       {.name = "lobe_samples",
        .description = "GGX samples per probe of the filtered-importance-sampled lookup (lobe=fis)",
        .kind = KnobKind::Integer,
-       .default_grid = {"8"},
+       .default_grid = {"4"},
        .min_value = 1,
        .max_value = kProbeMaxLobeSamples},
       {.name = "atlas",
