@@ -36,11 +36,14 @@ uniform int u_probe_count;
 uniform int u_probe_has_distances;  // 1: u_probe_distances holds each probe's level-0 distances
 uniform int u_probe_levels;
 uniform float u_probe_max_roughness;
+uniform int u_probe_lobe_samples;  // 0: the split sum's single read; 1..PROBE_MAX_LOBE_SAMPLES: probe_lobe
 
 // gi's probe_cube.h: kProbeSearchSteps, kProbeSecantSteps, kProbeMinSearchScaleM.
 const int PROBE_SEARCH_STEPS = 12;
 const int PROBE_SECANT_STEPS = 3;
 const float PROBE_MIN_SEARCH_SCALE_M = 0.05;
+// gi's probe_cube.h: kProbeMaxLobeSamples.
+const int PROBE_MAX_LOBE_SAMPLES = 16;
 
 // The direction from the probe's centre to where the ray from p along r leaves the box.
 vec3 probe_box_direction(vec3 p, vec3 r, ReflectionProbeBox probe) {
@@ -93,6 +96,56 @@ vec3 probe_direction(vec3 p, vec3 r, ReflectionProbeBox probe, int i) {
   return in_front ? r : boxed;
 }
 
+// The specular lobe at the view read from probe i by filtered importance sampling (gi's
+// probe_lobe_radiance, probe_cube.cpp, the same samples and weights): u_probe_lobe_samples half
+// vectors from GGX's visible normals at v (Hammersley points), each reflected direction
+// corrected for parallax and read at the level prefiltered for the sample's share of the lobe
+// (its solid angle 1 / (count pdf), narrowed across the reflection's plane by v.h); weighted by F G2 / G1 and normalized per channel (the caller multiplies by the
+// directional albedo, as with the split sum).
+vec3 probe_lobe(Surface s, ReflectionProbeBox probe, int i) {
+  int count = clamp(u_probe_lobe_samples, 1, PROBE_MAX_LOBE_SAMPLES);
+  float alpha = s.brdf.alpha, a2 = alpha * alpha;
+  vec3 n = s.normal, v = s.view;
+  float nv = max(dot(n, v), 1e-4);
+  vec3 t = v - nv * n;
+  if (dot(t, t) < 1e-8) t = cross(abs(n.z) < 0.999 ? vec3(0.0, 0.0, 1.0) : vec3(1.0, 0.0, 0.0), n);
+  t = normalize(t);
+  vec3 b = cross(n, t);
+  vec3 vh = normalize(vec3(alpha * dot(v, t), 0.0, nv));
+  float g1 = 2.0 * nv / (nv + sqrt(a2 + (1.0 - a2) * nv * nv));
+  float top_level = float(max(u_probe_levels - 1, 0));
+  float fn = float(count);
+  float dielectric = (1.0 - s.brdf.metallic) * s.brdf.specular_weight;
+  vec3 sum = vec3(0.0), weight = vec3(0.0);
+  for (int k = 0; k < PROBE_MAX_LOBE_SAMPLES; ++k) {
+    if (k >= count) break;
+    float phi = 2.0 * GLTF_PI * (float(k) + 0.5) / fn;
+    float u = float(bitfieldReverse(uint(k))) * 2.3283064365386963e-10 + 0.5 / fn;
+    float z = (1.0 - u) * (1.0 + vh.z) - vh.z;
+    float sin_t = sqrt(clamp(1.0 - z * z, 0.0, 1.0));
+    vec3 c = vec3(sin_t * cos(phi), sin_t * sin(phi), z) + vh;
+    vec3 hl = normalize(vec3(alpha * c.x, alpha * c.y, max(c.z, 0.0)));
+    vec3 h = hl.x * t + hl.y * b + hl.z * n;
+    float vdh = dot(v, h);
+    vec3 l = 2.0 * vdh * h - v;
+    float nl = dot(n, l);
+    if (!(nl > 0.0) || !(vdh > 0.0)) continue;
+    float pdf = g1 * gltf_ggx_distribution(clamp(hl.z, 0.0, 1.0), alpha) / (4.0 * nv);
+    float lod = sqrt(sqrt(vdh / (fn * max(pdf, 1e-12) * 4.0 * GLTF_PI))) * top_level;
+    float w = gltf_schlick_weight(vdh);
+    vec3 f = dielectric * (s.brdf.dielectric_f0 + (vec3(1.0) - s.brdf.dielectric_f0) * w) +
+             s.brdf.metallic * (s.brdf.base_color + (vec3(1.0) - s.brdf.base_color) * w);
+    vec3 wi = f * (gltf_smith_visibility(nv, nl, alpha) * nl);
+    sum += wi * textureLod(u_probe_cubes, vec4(probe_direction(s.position, l, probe, i), float(i)), lod).rgb;
+    weight += wi;
+  }
+  bvec3 some = greaterThan(weight, vec3(0.0));
+  if (all(some)) return sum / weight;
+  vec3 fallback = textureLod(u_probe_cubes, vec4(probe_direction(s.position, reflect(-v, n), probe, i), float(i)),
+                             sqrt(alpha) * top_level).rgb;
+  return mix(fallback, sum / max(weight, vec3(1e-30)), vec3(some));
+}
+
 // Whether this surface reads the probes: static ones that read the atlas (`atlas`) below the
 // roughness limit, dynamic ones (`dynamic`) at any roughness.
 bool reads_probes(Surface s, bool atlas, bool dynamic) {
@@ -111,7 +164,10 @@ bool probe_specular(Surface s, vec3 specular_albedo, out vec3 specular) {
     if (any(lessThan(s.position, probe.box_min.xyz - PROBE_BOX_MARGIN_M)) ||
         any(greaterThan(s.position, probe.box_max.xyz + PROBE_BOX_MARGIN_M)))
       continue;
-    sum += textureLod(u_probe_cubes, vec4(probe_direction(s.position, r, probe, i), float(i)), lod).rgb;
+    if (u_probe_lobe_samples > 0)
+      sum += probe_lobe(s, probe, i);
+    else
+      sum += textureLod(u_probe_cubes, vec4(probe_direction(s.position, r, probe, i), float(i)), lod).rgb;
     count += 1.0;
   }
   if (count == 0.0) return false;

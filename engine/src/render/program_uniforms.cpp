@@ -38,6 +38,7 @@ ForwardUniforms ForwardUniforms::locate(const UniformLookup& at) {
           .probe_levels = at.location("u_probe_levels"),
           .probe_max_roughness = at.location("u_probe_max_roughness"),
           .probe_has_distances = at.location("u_probe_has_distances"),
+          .probe_lobe_samples = at.location("u_probe_lobe_samples"),
           .sky_radiance = at.location("u_sky_radiance"),
           .sky_gradient = at.location("u_sky_gradient"),
           .sky_visibility_pos = at.location("u_sky_visibility_pos"),

@@ -253,6 +253,61 @@ glm::vec3 box_projected_direction(const glm::vec3& p, const glm::vec3& r, const 
   return len > 1e-6f ? d / len : glm::normalize(r);
 }
 
+glm::vec3 probe_lobe_radiance(const ProbeCube& cube, const engine::GltfBrdf& brdf, const glm::vec3& p,
+                              const glm::vec3& n, const glm::vec3& v, int samples, const glm::vec3& centre,
+                              const glm::vec3& box_min, const glm::vec3& box_max, bool box_only) {
+  const int count = std::clamp(samples, 1, kProbeMaxLobeSamples);
+  const float alpha = brdf.alpha, a2 = alpha * alpha;
+  const float nv = std::max(glm::dot(n, v), 1e-4f);
+  const auto corrected = [&](const glm::vec3& l) {
+    return box_only ? box_projected_direction(p, l, centre, box_min, box_max)
+                    : distance_corrected_direction(cube, p, l, centre, box_min, box_max);
+  };
+  // The frame (t, b, n) with v in the (t, n) plane; the shader builds the same one.
+  glm::vec3 t = v - nv * n;
+  if (glm::dot(t, t) < 1e-8f)
+    t = glm::cross(std::abs(n.z) < 0.999f ? glm::vec3(0.0f, 0.0f, 1.0f) : glm::vec3(1.0f, 0.0f, 0.0f), n);
+  t = glm::normalize(t);
+  const glm::vec3 b = glm::cross(n, t);
+  // The view stretched by alpha (the hemisphere configuration of the visible normals).
+  const glm::vec3 vh = glm::normalize(glm::vec3(alpha * glm::dot(v, t), 0.0f, nv));
+  const float g1 = 2.0f * nv / (nv + std::sqrt(a2 + (1.0f - a2) * nv * nv));
+  const float top_level = static_cast<float>(cube.levels.size() - 1);
+  const auto fn = static_cast<float>(count);
+  const glm::vec3 f_dielectric_scale = (1.0f - brdf.metallic) * brdf.specular_weight * glm::vec3(1.0f);
+  glm::vec3 sum(0.0f), weight(0.0f);
+  for (int i = 0; i < count; ++i) {
+    const float phi = 2.0f * kPi * (static_cast<float>(i) + 0.5f) / fn;
+    const float u = radical_inverse(static_cast<std::uint32_t>(i)) + 0.5f / fn;
+    const float z = (1.0f - u) * (1.0f + vh.z) - vh.z;
+    const float sin_t = std::sqrt(std::clamp(1.0f - z * z, 0.0f, 1.0f));
+    const glm::vec3 c = glm::vec3(sin_t * std::cos(phi), sin_t * std::sin(phi), z) + vh;
+    const glm::vec3 hl = glm::normalize(glm::vec3(alpha * c.x, alpha * c.y, std::max(c.z, 0.0f)));
+    const glm::vec3 h = hl.x * t + hl.y * b + hl.z * n;
+    const float vdh = glm::dot(v, h);
+    const glm::vec3 l = 2.0f * vdh * h - v;
+    const float nl = glm::dot(n, l);
+    if (!(nl > 0.0f) || !(vdh > 0.0f)) continue;
+    // pdf(l) = G1(v) D(h) / (4 n.v); the sample stands for 1 / (count pdf) sr of the sphere,
+    // a patch narrower across the reflection's plane than along it by v.h: the level read is
+    // the one prefiltered with the GGX lobe (solid angle about 4 pi alpha^2) of that width.
+    const float pdf = g1 * engine::gltf_ggx_distribution(std::clamp(hl.z, 0.0f, 1.0f), alpha) / (4.0f * nv);
+    const float alpha_m = std::sqrt(vdh / (fn * std::max(pdf, 1e-12f) * 4.0f * kPi));
+    const float lod = std::sqrt(alpha_m) * top_level;
+    const float w = engine::gltf_schlick_weight(vdh);
+    const glm::vec3 f = f_dielectric_scale * (brdf.dielectric_f0 + (1.0f - brdf.dielectric_f0) * w) +
+                        brdf.metallic * (brdf.base_color + (1.0f - brdf.base_color) * w);
+    // The BRDF-sample weight F G2 / G1 up to the factor the samples share (G1, 4 n.v).
+    const glm::vec3 wi = f * (engine::gltf_smith_visibility(nv, nl, alpha) * nl);
+    sum += wi * cube_lookup_trilinear(cube, lod, corrected(l));
+    weight += wi;
+  }
+  const glm::vec3 fallback = cube_lookup_trilinear(cube, std::sqrt(alpha) * top_level, corrected(glm::reflect(-v, n)));
+  glm::vec3 out;
+  for (int k = 0; k < 3; ++k) out[k] = weight[k] > 0.0f ? sum[k] / weight[k] : fallback[k];
+  return out;
+}
+
 void prefilter_ggx(ProbeCube& cube, int samples, ThreadPool* pool) {
   const int levels = static_cast<int>(cube.levels.size());
   if (levels < 2 || samples < 1) return;

@@ -14,6 +14,10 @@
 
 #include <glm/glm.hpp>
 
+namespace engine {
+struct GltfBrdf;
+}
+
 namespace gi {
 
 class ThreadPool;
@@ -96,6 +100,31 @@ float cube_distance_bilinear(const ProbeCube& cube, const glm::vec3& d);
 /// probe_direction() in the forward shader.
 glm::vec3 distance_corrected_direction(const ProbeCube& cube, const glm::vec3& p, const glm::vec3& r,
                                        const glm::vec3& centre, const glm::vec3& box_min, const glm::vec3& box_max);
+
+/// The most lobe samples probe_lobe_radiance takes (the shader's PROBE_MAX_LOBE_SAMPLES).
+inline constexpr int kProbeMaxLobeSamples = 16;
+/// The lobe samples the runtime asks the forward pass for (IndirectLightFrame::
+/// reflection_probe_lobe_samples; 0: the split sum's single read; docs/reflection_probes.md).
+inline constexpr int kProbeLobeSamples = 4;
+
+/// The specular lobe at the actual view read from a prefiltered probe by filtered importance
+/// sampling (Colbert and Krivanek 2007, "GPU-based importance sampling"): `samples` (1 ..
+/// kProbeMaxLobeSamples) half vectors h_i drawn from GGX's distribution of visible normals at
+/// v (Heitz 2018; the spherical-cap form of Dupuy and Benyoub 2023) at fixed Hammersley
+/// points, each reflected direction l_i parallax-corrected (the captured distances, or the
+/// box alone when `box_only`) and read trilinearly at the level prefiltered with the GGX lobe
+/// as wide as the sample's share of the lobe: solid angle 1 / (samples pdf(l_i)), narrowed
+/// across the reflection's plane by v.h, taken as 4 pi alpha_m^2 (lod = sqrt(alpha_m) x
+/// (levels - 1), the prefilter's roughness per level). Unlike the split sum's lobe (prefiltered
+/// around the reflection with n = v), these follow the lobe's stretch along the reflection's
+/// plane and its off-specular shift at grazing views. Returned: the samples' radiance
+/// weighted by the BRDF-sample weight F G2 / G1 (per channel), normalized by the weights' sum,
+/// so the caller multiplies by the specular lobe's directional albedo as with the split sum
+/// (the environment BRDF counted once; a constant cube returns that constant exactly). The
+/// same lookup as probe_lobe() in engine/shaders/reflection_probes.glsl.
+glm::vec3 probe_lobe_radiance(const ProbeCube& cube, const engine::GltfBrdf& brdf, const glm::vec3& p,
+                              const glm::vec3& n, const glm::vec3& v, int samples, const glm::vec3& centre,
+                              const glm::vec3& box_min, const glm::vec3& box_max, bool box_only);
 
 /// Fills levels 1.. of `cube` from level 0 with the split-sum's prefiltered radiance (Karis
 /// 2013, "Real shading in Unreal Engine 4"): level m is the GGX lobe of alpha = r^2, r = m /

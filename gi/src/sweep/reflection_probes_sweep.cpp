@@ -46,6 +46,18 @@ std::vector<KnobSpec> reflection_probes_knobs() {
        .kind = KnobKind::Choice,
        .default_grid = {"distance"},
        .choices = {"distance", "box"}},
+      {.name = "lobe",
+       .description = "the lookup's lobe: the split sum's (one read along the reflection, isotropic, n = v) or "
+                      "filtered importance sampling of the lobe at the view (probe_lobe_radiance)",
+       .kind = KnobKind::Choice,
+       .default_grid = {"fis"},
+       .choices = {"split_sum", "fis"}},
+      {.name = "lobe_samples",
+       .description = "GGX samples per probe of the filtered-importance-sampled lookup (lobe=fis)",
+       .kind = KnobKind::Integer,
+       .default_grid = {"4"},
+       .min_value = 1,
+       .max_value = kProbeMaxLobeSamples},
       {.name = "atlas",
        .description = "light-atlas preset whose irradiance the captures read on the static surfaces",
        .kind = KnobKind::Choice,
@@ -101,10 +113,11 @@ float depth_in_box(const ProbeVolume& v, const glm::vec3& p, const glm::vec3& n)
 // What the forward shader adds at the texel (reflection_probes.glsl, probe_specular): the
 // probes whose box (grown by the margin) holds p, each read along the reflection direction
 // corrected for parallax (by the captured distances, or the box alone when `box_only`) at lod
-// roughness x (levels - 1), averaged, times the specular albedo.
+// roughness x (levels - 1), or by the lobe's samples at the view when `lobe_samples` > 0
+// (probe_lobe_radiance), averaged, times the specular albedo.
 // `depth`: the largest depth_in_box over those probes. False where no box holds p.
 bool probe_specular(const ReflectionProbeSet& set, const engine::GltfBrdf& brdf, const glm::vec3& p, const glm::vec3& n,
-                    const glm::vec3& v, bool box_only, glm::vec3& out, float& depth) {
+                    const glm::vec3& v, bool box_only, int lobe_samples, glm::vec3& out, float& depth) {
   const glm::vec3 r = glm::reflect(-v, n);
   glm::vec3 sum(0.0f);
   int count = 0;
@@ -114,10 +127,14 @@ bool probe_specular(const ReflectionProbeSet& set, const engine::GltfBrdf& brdf,
     if (glm::any(glm::lessThan(p, pv.box_min - kBoxMarginM)) || glm::any(glm::greaterThan(p, pv.box_max + kBoxMarginM)))
       continue;
     const ProbeCube& cube = set.cubes[i];
-    const float lod = std::sqrt(brdf.alpha) * static_cast<float>(cube.levels.size() - 1);
-    const glm::vec3 d = box_only ? box_projected_direction(p, r, pv.centre, pv.box_min, pv.box_max)
-                                 : distance_corrected_direction(cube, p, r, pv.centre, pv.box_min, pv.box_max);
-    sum += cube_lookup_trilinear(cube, lod, d);
+    if (lobe_samples > 0) {
+      sum += probe_lobe_radiance(cube, brdf, p, n, v, lobe_samples, pv.centre, pv.box_min, pv.box_max, box_only);
+    } else {
+      const float lod = std::sqrt(brdf.alpha) * static_cast<float>(cube.levels.size() - 1);
+      const glm::vec3 d = box_only ? box_projected_direction(p, r, pv.centre, pv.box_min, pv.box_max)
+                                   : distance_corrected_direction(cube, p, r, pv.centre, pv.box_min, pv.box_max);
+      sum += cube_lookup_trilinear(cube, lod, d);
+    }
     depth = std::max(depth, depth_in_box(pv, p, n));
     ++count;
   }
@@ -192,11 +209,13 @@ engine::Result<MethodOutput> run_reflection_probes(const RunContext& ctx) {
   std::vector<std::uint8_t> covered(tex.valid.size(), 0), inner(tex.valid.size(), 0), edge(tex.valid.size(), 0);
   std::size_t uncovered = 0;
   const bool box_only = ctx.knobs.text("parallax") == "box";
+  const int lobe_samples = ctx.knobs.text("lobe") == "fis" ? static_cast<int>(ctx.knobs.integer("lobe_samples")) : 0;
   for (std::size_t t = 0; t < tex.valid.size(); ++t) {
     if (!g->glossy[t]) continue;
     float depth = 0.0f;
     const glm::vec3 v = glm::normalize(g->eye - tex.position[t]);
-    if (!probe_specular(*set, g->brdf[t], tex.position[t], tex.normal[t], v, box_only, values[t], depth)) {
+    if (!probe_specular(*set, g->brdf[t], tex.position[t], tex.normal[t], v, box_only, lobe_samples, values[t],
+                        depth)) {
       ++uncovered;
       continue;
     }

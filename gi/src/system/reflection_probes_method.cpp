@@ -26,6 +26,7 @@ class ReflectionProbesMethod final : public MethodRuntime {
     f.reflection_probe_count = static_cast<int>(set_.probes.size());
     f.reflection_probe_levels = levels_;
     f.reflection_probe_max_roughness = set_.settings.max_roughness;
+    f.reflection_probe_lobe_samples = kProbeLobeSamples;
   }
   std::string label() const override { return "reflection probes"; }
 
