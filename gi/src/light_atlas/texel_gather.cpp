@@ -51,6 +51,7 @@ engine::Status validate(const TexelGatherSettings& s) {
   if (!(s.denoise_sigma > 0.0f) || s.denoise_sigma > 1000.0f) return bad("denoise_sigma is outside (0, 1000]");
   if (!(s.denoise_outlier_sigmas >= 0.0f) || s.denoise_outlier_sigmas > 1000.0f)
     return bad("denoise_outlier_sigmas is outside [0, 1000]");
+  if (!(s.source_filter_radius_texels <= 16.0f)) return bad("source_filter_radius_texels is above 16 (or NaN)");
   return {};
 }
 
@@ -256,7 +257,7 @@ bool final_gather(const StaticBakeScene& b, const AtlasLayout& layout, const Tex
   const double w_sky = static_cast<double>(k.per_texel) / static_cast<double>(k.per_texel + nf);
   // The mean's variance: the kept rays spread as the cosine rays do, so with them it is the
   // fresh rays' spread over all the rays.
-  const double rays = static_cast<double>(nf + ne + (ne > 0 ? 0 : k.per_texel));
+  const double rays = static_cast<double>(nf + ne + (w_solve > 0.0 ? k.per_texel : 0));
   std::vector<glm::vec3> gathered(e.size(), glm::vec3(0.0f));
   sky.assign(e.size(), glm::vec3(0.0f));
   const bool done = pool.parallel_for_with_progress(mine.size(), progress, [&](std::size_t m) {
@@ -269,6 +270,46 @@ bool final_gather(const StaticBakeScene& b, const AtlasLayout& layout, const Tex
   });
   e = std::move(gathered);
   return done;
+}
+
+// Step 3: the final gather reads the kept-ray solve's light (filtered as the settings ask:
+// its noise would otherwise come back as blotches a few texels wide, a bright texel lighting
+// its neighbours' rays). `out.indirect` holds the solve on entry and the gather on return;
+// `sky` the sky's direct light, likewise.
+bool gather_step(const StaticBakeScene& b, const AtlasLayout& layout, const TexelTable& t, const TexelGatherSettings& s,
+                 ThreadPool& pool, const ProgressCallback& progress, const KeptRays& kept,
+                 const std::vector<glm::vec3>& emitted, TexelGatherResult& out, std::vector<glm::vec3>& sky) {
+  const AtlasTexels& tx = b.texels;
+  const std::size_t n = tx.valid.size(), work = t.work.size();
+  const float texel_m = layout.texels_per_metre > 0.0f ? 1.0f / layout.texels_per_metre : 0.0f;
+  const float source_radius =
+      s.source_filter_radius_texels < 0.0f ? s.filter_radius_texels : s.source_filter_radius_texels;
+  const bool filtering = source_radius > 0.0f && texel_m > 0.0f;
+  const float radius_m = source_radius * texel_m;
+  std::vector<glm::vec3>& e = out.indirect;
+  const std::vector<glm::vec3> source =
+      filtering ? filter_world(tx, t.work, e, kept.hidden, radius_m, texel_m, pool) : e;
+  GatherSource src;
+  src.reflected.assign(n, glm::vec3(0.0f));
+  src.without_lights.assign(n, glm::vec3(0.0f));
+  std::vector<glm::vec3> lit(n, glm::vec3(0.0f));
+  for (std::uint32_t i : t.work) {
+    src.reflected[i] = t.albedo[i] * (emitted[i] + source[i]);
+    src.without_lights[i] = t.albedo[i] * (kept.sky[i] + source[i]);
+    lit[i] = t.albedo[i] * (out.direct[i] + out.baked_direct[i]);
+  }
+  std::optional<TexelEmitters> emitters;
+  if (s.emitter_rays > 0) emitters.emplace(b, layout, t.work, t.face, src.reflected, layout.texels_per_metre, pool);
+  const int rings = std::max(3, layout.padding_texels);
+  for (auto* field : {&src.reflected, &src.without_lights, &lit})
+    dilate<glm::vec3>(*field, t.width, t.height, tx.valid, rings);
+  src.sharp = s.landing_direct_everywhere ? std::vector<std::uint8_t>(n, 1) : sharp_pixels(lit, t.width, t.height);
+  std::vector<std::uint64_t> gather_rays_of(work, 0);
+  if (!final_gather(b, layout, t, s, pool, progress, s.shard.items(work), src, emitters ? &*emitters : nullptr, kept, e,
+                    sky, out.variance, gather_rays_of))
+    return false;
+  for (std::uint64_t r : gather_rays_of) out.own_rays += r;
+  return true;
 }
 
 // Step 4 on both filtered fields (indirect and the baked direct light): the denoiser, then
@@ -338,35 +379,10 @@ engine::Result<TexelGatherResult> gather_atlas(const StaticBakeScene& b, const A
 
   // Step 3.
   t0 = Clock::now();
-  const float texel_m = layout.texels_per_metre > 0.0f ? 1.0f / layout.texels_per_metre : 0.0f;
-  const bool filtering = s.filter_radius_texels > 0.0f && texel_m > 0.0f;
-  const float radius_m = s.filter_radius_texels * texel_m;
   std::vector<glm::vec3> sky = kept.sky;
   if (s.gather_rays > 0 || s.emitter_rays > 0) {
-    // The gather reads the solve's light filtered too: its noise would otherwise come back
-    // as blotches a few texels wide (a bright texel lights its neighbours' rays).
-    const std::vector<glm::vec3> source =
-        filtering ? filter_world(tx, t.work, e, kept.hidden, radius_m, texel_m, pool) : e;
-    GatherSource src;
-    src.reflected.assign(n, glm::vec3(0.0f));
-    src.without_lights.assign(n, glm::vec3(0.0f));
-    std::vector<glm::vec3> lit(n, glm::vec3(0.0f));
-    for (std::uint32_t i : t.work) {
-      src.reflected[i] = t.albedo[i] * (emitted[i] + source[i]);
-      src.without_lights[i] = t.albedo[i] * (kept.sky[i] + source[i]);
-      lit[i] = t.albedo[i] * (out.direct[i] + out.baked_direct[i]);
-    }
-    std::optional<TexelEmitters> emitters;
-    if (s.emitter_rays > 0) emitters.emplace(b, layout, t.work, t.face, src.reflected, layout.texels_per_metre, pool);
-    const int rings = std::max(3, layout.padding_texels);
-    for (auto* field : {&src.reflected, &src.without_lights, &lit})
-      dilate<glm::vec3>(*field, t.width, t.height, tx.valid, rings);
-    src.sharp = sharp_pixels(lit, t.width, t.height);
-    std::vector<std::uint64_t> gather_rays_of(work, 0);
-    if (!final_gather(b, layout, t, s, pool, phase(0.5, 0.95), s.shard.items(work), src,
-                      emitters ? &*emitters : nullptr, kept, e, sky, out.variance, gather_rays_of))
+    if (!gather_step(b, layout, t, s, pool, phase(0.5, 0.95), kept, emitted, out, sky))
       return engine::cancelled_error("light-atlas gather");
-    for (std::uint64_t r : gather_rays_of) out.own_rays += r;
   } else if (!s.shard.whole()) {
     for (std::size_t w = 0; w < work; ++w)
       if (!s.shard.owns(w)) e[t.work[w]] = sky[t.work[w]] = glm::vec3(0.0f);
@@ -380,6 +396,7 @@ engine::Result<TexelGatherResult> gather_atlas(const StaticBakeScene& b, const A
   // Step 4 (a shard leaves it to the merge).
   if (s.part_only) return out;
   t0 = Clock::now();
+  const float texel_m = layout.texels_per_metre > 0.0f ? 1.0f / layout.texels_per_metre : 0.0f;
   filter_result(tx, t, s, texel_m, pool, out);
   out.filter_seconds = seconds_since(t0);
   if (s.progress && !s.progress(1.0)) return engine::cancelled_error("light-atlas gather");

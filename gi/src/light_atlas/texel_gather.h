@@ -65,6 +65,17 @@ struct TexelGatherSettings {
   /// The denoiser's outlier clamp before its passes (DenoiseSettings::outlier_sigmas): a
   /// texel at most its co-planar neighbours' mean + this many standard deviations (0: off).
   float denoise_outlier_sigmas = 0.0f;
+  /// Step 3's reads where a fresh ray lands: false (the default) takes the lights' direct
+  /// light at the landing point itself only across shadow edges (read_landing's `sharp`
+  /// pixels) and reads it from the texels elsewhere; true takes it at the point everywhere
+  /// (one shadow ray per light and landing), the texels then give only the sky and the
+  /// indirect light there.
+  bool landing_direct_everywhere = false;
+  /// World-space filter radius, in texels, of the light step 3's rays read (the kept-ray
+  /// solve's), apart from the output's; negative: `filter_radius_texels`. A noisy bright
+  /// texel in what the rays read lights every neighbour whose rays land on it: blotches a
+  /// few texels wide that no filter of the output's per-texel noise removes.
+  float source_filter_radius_texels = -1.0f;
   std::uint64_t seed = 1;
   ProgressCallback progress;  ///< Fraction done in [0, 1]; return false to cancel.
   /// A distributed bake's shard (docs/distributed-bake.md): steps 1-2 run for every texel

@@ -94,6 +94,18 @@ std::vector<KnobSpec> light_atlas_knobs() {
        .default_grid = {"0"},
        .min_value = 0,
        .max_value = 1000},
+      {.name = "landing_direct",
+       .description = "gather: the lights' direct light where a fresh ray lands, at the point across shadow edges "
+                      "only (edges) or everywhere",
+       .kind = KnobKind::Choice,
+       .default_grid = {"edges"},
+       .choices = {"edges", "everywhere"}},
+      {.name = "source_filter",
+       .description = "gather: world-space filter radius of the light the fresh rays read, texels (-1: filter's)",
+       .kind = KnobKind::Real,
+       .default_grid = {"-1"},
+       .min_value = -1,
+       .max_value = 16},
       {.name = "ref_spp",
        .description = "samples per texel of the path-traced reference",
        .kind = KnobKind::Integer,
@@ -140,6 +152,8 @@ engine::Result<MethodOutput> run_light_atlas(const RunContext& ctx) {
     s.gather.denoise_passes = static_cast<int>(ctx.knobs.integer("denoise"));
     s.gather.denoise_sigma = static_cast<float>(ctx.knobs.real("denoise_sigma"));
     s.gather.denoise_outlier_sigmas = static_cast<float>(ctx.knobs.real("outlier"));
+    s.gather.landing_direct_everywhere = ctx.knobs.text("landing_direct") == "everywhere";
+    s.gather.source_filter_radius_texels = static_cast<float>(ctx.knobs.real("source_filter"));
     s.gather.bounces = std::max(s.bounces, 1);
   }
   s.seed = ctx.seed;
