@@ -182,8 +182,8 @@ engine::Result<RgbField> prm_reference(const ReferenceJob& job) {
   const std::string world = job.request.param("world"), subset = job.request.param("texels");
   AtlasTexels texels = rasterize_atlas(*layout, inputs);
   if (!subset.empty()) keep_random_texels(texels, std::stoull(subset));
-  auto truth = reference_atlas_irradiance(reference_world(bake_input_from(*scene), world.empty() ? "all" : world),
-                                          texels, rs);
+  auto truth =
+      reference_atlas_irradiance(reference_world(bake_input_from(*scene), world.empty() ? "all" : world), texels, rs);
   if (!truth) return truth.error();
   // With its sampling variance, so that the sweep reports the error against the noise-free
   // truth (error_metrics.h) beside the error against this reference.
@@ -321,8 +321,8 @@ engine::Result<std::shared_ptr<const Prm>> bake_prm_shared(const RunContext& ctx
                                                            const PrmSettings& s) {
   static std::mutex mutex;
   static std::vector<std::pair<std::string, std::shared_ptr<const Prm>>> kept;
-  const std::string key = ctx.scene.content_hash + "|" + ctx.knobs.text("entries") + "|" + ctx.knobs.text("clusters") + "|" +
-                          ctx.knobs.text("splitting") + "|" + ctx.knobs.text("pane_threshold") + "|" +
+  const std::string key = ctx.scene.content_hash + "|" + ctx.knobs.text("entries") + "|" + ctx.knobs.text("clusters") +
+                          "|" + ctx.knobs.text("splitting") + "|" + ctx.knobs.text("pane_threshold") + "|" +
                           ctx.knobs.text("pane_tile") + "|" + std::to_string(s.texels_per_metre) + "|" +
                           std::to_string(s.seed);
   {
