@@ -316,21 +316,22 @@ PrmSettings prm_settings_of(const RunContext& ctx, double pane_density) {
 // The bake does not see the moving light (entry points and paths start on the static
 // surfaces; the light only weights them at run time), so runs that differ only in the pose or
 // swing share one bake: the last two bakes of the process are kept, keyed by the scene and
-// the settings (the costs report the bake's own time either way).
+// the settings (the costs report the bake's own time either way). `at_subset`: gathered only
+// at the reference's valid texels (bake_prm_at).
 engine::Result<std::shared_ptr<const Prm>> bake_prm_shared(const RunContext& ctx, const BakeInput& input,
-                                                           const PrmSettings& s) {
+                                                           const PrmSettings& s, bool at_subset) {
   static std::mutex mutex;
   static std::vector<std::pair<std::string, std::shared_ptr<const Prm>>> kept;
   const std::string key = ctx.scene.content_hash + "|" + ctx.knobs.text("entries") + "|" + ctx.knobs.text("clusters") +
                           "|" + ctx.knobs.text("splitting") + "|" + ctx.knobs.text("pane_threshold") + "|" +
                           ctx.knobs.text("pane_tile") + "|" + std::to_string(s.texels_per_metre) + "|" +
-                          std::to_string(s.seed);
+                          std::to_string(s.seed) + (at_subset ? "|subset" : "");
   {
     const std::lock_guard lock(mutex);
     for (const auto& [k, prm] : kept)
       if (k == key) return prm;
   }
-  auto prm = bake_prm(input, s);
+  auto prm = at_subset ? bake_prm_at(input, s, ctx.reference.valid) : bake_prm(input, s);
   if (!prm) return prm.error();
   auto shared = std::make_shared<const Prm>(std::move(prm).value());
   const std::lock_guard lock(mutex);
@@ -346,7 +347,10 @@ engine::Result<MethodOutput> run_prm(const RunContext& ctx) {
   const bool coarse = pane_density > 0.0 && pane_density != density;
   const PrmSettings s = prm_settings_of(ctx, coarse ? pane_density : density);
   const BakeInput input = bake_input_from(*scene);
-  auto baked = bake_prm_shared(ctx, input, s);
+  // Dense panes without a threshold, scored at a subset of texels (ref_texels): gathered at
+  // those texels only, which hold what a whole bake gives them (bake_prm_at).
+  const bool at_subset = !coarse && s.pane_threshold == 0.0f && ctx.knobs.integer("ref_texels") > 0;
+  auto baked = bake_prm_shared(ctx, input, s, at_subset);
   if (!baked) return baked.error();
   const std::shared_ptr<const Prm> prm = std::move(baked).value();
   auto upsampler = atlas_upsampler(input, *prm, coarse ? density : 0.0);
