@@ -112,6 +112,7 @@ struct PrmRun {
   WorkShard shard;
   PrmShardPart* part = nullptr;
   const std::vector<PrmShardPart>* parts = nullptr;
+  const std::vector<std::uint8_t>* only = nullptr;  ///< bake_prm_at's texel flags.
 };
 
 // The folded albedo of every triangle of the snapshot (a textured one's: the texture's mean
@@ -353,7 +354,8 @@ engine::Result<Prm> bake_prm_run(const BakeInput& input, const PrmSettings& sett
     prm.stats.walk_seconds = seconds_since(t0);
     if (settings.progress && !settings.progress(0.05)) return engine::cancelled_error("PRM bake");
     t0 = Clock::now();
-    const std::vector<std::size_t> mine = run.shard.items(valid.size());  // all of them in a whole bake
+    std::vector<std::size_t> mine = run.shard.items(valid.size());  // all of them in a whole bake
+    if (run.only) std::erase_if(mine, [&](std::size_t i) { return (*run.only)[valid[i]] == 0; });
     auto rays = gather_items(s, settings, prm, walks, valid, mine, pool, full);
     if (!rays) return rays.error();
     if (run.part) {
@@ -374,6 +376,17 @@ engine::Result<Prm> bake_prm_run(const BakeInput& input, const PrmSettings& sett
 
 engine::Result<Prm> bake_prm(const BakeInput& input, const PrmSettings& settings) {
   return bake_prm_run(input, settings, {});
+}
+
+engine::Result<Prm> bake_prm_at(const BakeInput& input, const PrmSettings& settings,
+                                const std::vector<std::uint8_t>& only) {
+  if (coarse_panes(settings) || settings.pane_threshold != 0.0f)
+    return engine::invalid_request("PRM at a texel subset: only dense panes without a threshold");
+  auto layout = static_world_layout(input, pane_density(settings));
+  if (!layout) return layout.error();
+  if (only.size() != static_cast<std::size_t>(layout->width) * static_cast<std::size_t>(layout->height))
+    return engine::invalid_request("PRM at a texel subset: one flag per texel of the atlas");
+  return bake_prm_run(input, settings, {.shard = {}, .part = nullptr, .parts = nullptr, .only = &only});
 }
 
 engine::Result<PrmShardPart> bake_prm_shard(const BakeInput& input, const PrmSettings& settings, WorkShard shard) {

@@ -162,4 +162,13 @@ engine::Result<PrmSettings> prm_preset(std::string_view name);
 /// of range, cancelled.
 engine::Result<Prm> bake_prm(const BakeInput& input, const PrmSettings& settings);
 
+/// bake_prm gathering only at the atlas texels flagged in `only` (one flag per texel of the
+/// atlas; the other texels stay 0 before dilation): what a sweep scoring a subset of texels
+/// needs on a level too large to bake dense panes whole. A texel's sum is its own (as in a
+/// sharded bake), so the flagged texels hold exactly what a whole bake gives them. Dense
+/// panes without a threshold only (a threshold compares blocks with the whole pane's peak).
+/// Errors: coarse panes or a threshold, flags of another size, those of bake_prm.
+engine::Result<Prm> bake_prm_at(const BakeInput& input, const PrmSettings& settings,
+                                const std::vector<std::uint8_t>& only);
+
 }  // namespace gi

@@ -7,9 +7,14 @@
 #include <gi/reference.h>
 
 #include <chrono>
+#include <cstdint>
 #include <limits>
+#include <map>
+#include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 #include <glm/gtc/quaternion.hpp>
 
@@ -28,6 +33,38 @@ namespace {
 
 constexpr std::uint64_t kReferenceSeed = 0x7072656665726e63ULL;
 
+// The axis-aligned bounds of the static surfaces, metres.
+std::pair<glm::vec3, glm::vec3> static_bounds(const engine::SceneAsset& asset) {
+  glm::vec3 lo(std::numeric_limits<float>::infinity()), hi(-lo);
+  for (const AtlasInputMesh& m : atlas_inputs_from(bake_input_from(asset)))
+    for (const glm::vec3& p : m.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
+  return {lo, hi};
+}
+
+}  // namespace
+
+engine::Result<glm::vec3> moved_light_position(const engine::SceneAsset& asset, const glm::vec3& authored,
+                                               const std::string& pose) {
+  if (pose == "along") {
+    const auto [lo, hi] = static_bounds(asset);
+    return authored + glm::vec3(0.3f * (hi.x - lo.x), 0.0f, 0.0f);
+  }
+  if (pose != "wall20") return engine::Error{.message = "unknown light pose '" + pose + "' (along, wall20)"};
+  auto caster = make_static_caster(bake_input_from(asset));
+  if (!caster) return caster.error();
+  Hit nearest;
+  glm::vec3 towards(0.0f);
+  for (const glm::vec3 d : {glm::vec3(1, 0, 0), glm::vec3(-1, 0, 0), glm::vec3(0, 0, 1), glm::vec3(0, 0, -1)}) {
+    const Hit h = (*caster)->intersect(Ray{.origin = authored, .direction = d});
+    if (h.valid() && h.t < nearest.t) nearest = h, towards = d;
+  }
+  if (!nearest.valid() || nearest.t <= 0.2f)
+    return engine::Error{.message = "pose wall20: no static surface more than 20 cm away horizontally"};
+  return authored + (nearest.t - 0.2f) * towards;
+}
+
+namespace {
+
 // The scene with only its moving light on (the first light flagged as moving, else the
 // first light; every other light off and every emissive material dark, since the PRM relights
 // only the moving light and emissive surfaces belong to the static-light atlas), flagged as
@@ -35,7 +72,9 @@ constexpr std::uint64_t kReferenceSeed = 0x7072656665726e63ULL;
 // way the demo's swinging lamp moves (gameplay.cpp swing_lamp): a light with a parent node
 // (a pivot) turns its parent, rest rotation x angleAxis(swing, local Z); a light without one
 // turns about the world Z axis through its own position (a spot's beam sweeps across the
-// room). Errors: no light, unknown pose.
+// room). Poses "along" and "wall20" start from the authored position (moved_light_position):
+// for levels where "corner" and "wall", placed in the static bounds, land inside walls or
+// outside the building (Sponza). Errors: no light, unknown pose.
 engine::Result<engine::Scene> posed_scene(engine::SceneAsset asset, const std::string& pose, double swing_deg = 0.0) {
   int chosen = -1;
   for (std::size_t n = 0; n < asset.nodes.size() && chosen < 0; ++n) {
@@ -54,12 +93,17 @@ engine::Result<engine::Scene> posed_scene(engine::SceneAsset asset, const std::s
   light.enabled = true;
   light.moves = true;
   if (pose != "authored") {
-    glm::vec3 lo(std::numeric_limits<float>::infinity()), hi(-lo);
-    for (const AtlasInputMesh& m : atlas_inputs_from(bake_input_from(asset)))
-      for (const glm::vec3& p : m.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
+    const auto [lo, hi] = static_bounds(asset);
     const glm::vec3 size = hi - lo, centre = 0.5f * (lo + hi);
     glm::vec3 position, direction;
-    if (pose == "corner") {
+    if (pose == "along" || pose == "wall20") {
+      if (node.parent >= 0)
+        return engine::Error{.message = "the moving light has a parent node; pose it in world space first"};
+      auto at = moved_light_position(asset, node.translation, pose);
+      if (!at) return at.error();
+      position = *at;
+      direction = glm::vec3(0.0f, -1.0f, 0.0f);
+    } else if (pose == "corner") {
       position = lo + glm::vec3(0.15f, 0.3f, 0.15f) * size;
       direction = glm::normalize(centre - position);
     } else if (pose == "wall") {
@@ -69,7 +113,7 @@ engine::Result<engine::Scene> posed_scene(engine::SceneAsset asset, const std::s
       position = glm::vec3(hi.x - 0.01f, centre.y, centre.z);
       direction = glm::vec3(0.0f, -1.0f, 0.0f);
     } else {
-      return engine::Error{.message = "unknown light pose '" + pose + "' (authored, corner, wall)"};
+      return engine::Error{.message = "unknown light pose '" + pose + "' (authored, corner, wall, along, wall20)"};
     }
     if (node.parent >= 0)
       return engine::Error{.message = "the moving light has a parent node; pose it in world space first"};
@@ -99,6 +143,30 @@ BakeInput reference_world(BakeInput input, const std::string& world) {
   return input;
 }
 
+// splitmix64: a fixed, portable stream (std::shuffle's draws differ between libraries).
+std::uint64_t splitmix64(std::uint64_t& state) {
+  std::uint64_t z = (state += 0x9e3779b97f4a7c15ULL);
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  return z ^ (z >> 31);
+}
+
+}  // namespace
+
+void keep_random_texels(AtlasTexels& texels, std::uint64_t count) {
+  std::vector<std::size_t> valid;
+  for (std::size_t i = 0; i < texels.valid.size(); ++i)
+    if (texels.valid[i] != 0) valid.push_back(i);
+  if (count >= valid.size()) return;
+  // The first `count` of a partial Fisher-Yates shuffle.
+  std::uint64_t state = kReferenceSeed;
+  for (std::size_t i = 0; i < count; ++i)
+    std::swap(valid[i], valid[i + static_cast<std::size_t>(splitmix64(state) % (valid.size() - i))]);
+  for (std::size_t i = count; i < valid.size(); ++i) texels.valid[valid[i]] = 0;
+}
+
+namespace {
+
 engine::Result<RgbField> prm_reference(const ReferenceJob& job) {
   const std::string swing = job.request.param("swing");
   auto scene = posed_scene(job.scene.asset, job.request.param("pose"), swing.empty() ? 0.0 : std::stod(swing));
@@ -111,11 +179,15 @@ engine::Result<RgbField> prm_reference(const ReferenceJob& job) {
   rs.seed = kReferenceSeed;
   rs.threads = job.threads;
   rs.progress = job.progress;
-  const std::string world = job.request.param("world");
-  auto truth = reference_atlas_irradiance(reference_world(bake_input_from(*scene), world.empty() ? "all" : world),
-                                          rasterize_atlas(*layout, inputs), rs);
+  const std::string world = job.request.param("world"), subset = job.request.param("texels");
+  AtlasTexels texels = rasterize_atlas(*layout, inputs);
+  if (!subset.empty()) keep_random_texels(texels, std::stoull(subset));
+  auto truth =
+      reference_atlas_irradiance(reference_world(bake_input_from(*scene), world.empty() ? "all" : world), texels, rs);
   if (!truth) return truth.error();
-  return RgbField::from_texels(truth->width, truth->height, truth->indirect, truth->valid);
+  // With its sampling variance, so that the sweep reports the error against the noise-free
+  // truth (error_metrics.h) beside the error against this reference.
+  return RgbField::from_texels(truth->width, truth->height, truth->indirect, truth->valid, truth->indirect_variance);
 }
 
 // Long because it is the method's knob table: one entry per knob, nothing to split.
@@ -173,7 +245,7 @@ std::vector<KnobSpec> prm_knobs() {
        .description = "moving light pose",
        .kind = KnobKind::Choice,
        .default_grid = {"authored", "corner", "wall"},
-       .choices = {"authored", "corner", "wall"}},
+       .choices = {"authored", "corner", "wall", "along", "wall20"}},
       {.name = "swing",
        .description = "then the light swung about Z by this many degrees (its pivot if it has a parent)",
        .kind = KnobKind::Real,
@@ -185,6 +257,13 @@ std::vector<KnobSpec> prm_knobs() {
        .kind = KnobKind::Choice,
        .default_grid = {"all"},
        .choices = {"all", "static"}},
+      {.name = "ref_texels",
+       .description = "texels the reference path-traces and the error is scored at: a fixed random subset of the "
+                      "valid texels (0: all)",
+       .kind = KnobKind::Integer,
+       .default_grid = {"0"},
+       .min_value = 0,
+       .max_value = 1e9},
       {.name = "ref_spp",
        .description = "samples per texel of the path-traced reference",
        .kind = KnobKind::Integer,
@@ -202,6 +281,7 @@ ReferenceRequest prm_reference_request(const SweepScene&, const KnobSetting& k) 
   // Only a swung light names its swing, so unswung references keep their cache keys.
   if (k.real("swing") != 0.0) r.params.emplace_back("swing", k.text("swing"));
   if (k.text("world") != "all") r.params.emplace_back("world", k.text("world"));
+  if (k.integer("ref_texels") > 0) r.params.emplace_back("texels", k.text("ref_texels"));
   return r;
 }
 
@@ -233,6 +313,33 @@ PrmSettings prm_settings_of(const RunContext& ctx, double pane_density) {
   return s;
 }
 
+// The bake does not see the moving light (entry points and paths start on the static
+// surfaces; the light only weights them at run time), so runs that differ only in the pose or
+// swing share one bake: the last two bakes of the process are kept, keyed by the scene and
+// the settings (the costs report the bake's own time either way). `at_subset`: gathered only
+// at the reference's valid texels (bake_prm_at).
+engine::Result<std::shared_ptr<const Prm>> bake_prm_shared(const RunContext& ctx, const BakeInput& input,
+                                                           const PrmSettings& s, bool at_subset) {
+  static std::mutex mutex;
+  static std::vector<std::pair<std::string, std::shared_ptr<const Prm>>> kept;
+  const std::string key = ctx.scene.content_hash + "|" + ctx.knobs.text("entries") + "|" + ctx.knobs.text("clusters") +
+                          "|" + ctx.knobs.text("splitting") + "|" + ctx.knobs.text("pane_threshold") + "|" +
+                          ctx.knobs.text("pane_tile") + "|" + std::to_string(s.texels_per_metre) + "|" +
+                          std::to_string(s.seed) + (at_subset ? "|subset" : "");
+  {
+    const std::lock_guard lock(mutex);
+    for (const auto& [k, prm] : kept)
+      if (k == key) return prm;
+  }
+  auto prm = at_subset ? bake_prm_at(input, s, ctx.reference.valid) : bake_prm(input, s);
+  if (!prm) return prm.error();
+  auto shared = std::make_shared<const Prm>(std::move(prm).value());
+  const std::lock_guard lock(mutex);
+  if (kept.size() >= 2) kept.erase(kept.begin());
+  kept.emplace_back(key, shared);
+  return shared;
+}
+
 engine::Result<MethodOutput> run_prm(const RunContext& ctx) {
   auto scene = posed_scene(ctx.scene.asset, ctx.knobs.text("pose"), ctx.knobs.real("swing"));
   if (!scene) return scene.error();
@@ -240,8 +347,12 @@ engine::Result<MethodOutput> run_prm(const RunContext& ctx) {
   const bool coarse = pane_density > 0.0 && pane_density != density;
   const PrmSettings s = prm_settings_of(ctx, coarse ? pane_density : density);
   const BakeInput input = bake_input_from(*scene);
-  auto prm = bake_prm(input, s);
-  if (!prm) return prm.error();
+  // Dense panes without a threshold, scored at a subset of texels (ref_texels): gathered at
+  // those texels only, which hold what a whole bake gives them (bake_prm_at).
+  const bool at_subset = !coarse && s.pane_threshold == 0.0f && ctx.knobs.integer("ref_texels") > 0;
+  auto baked = bake_prm_shared(ctx, input, s, at_subset);
+  if (!baked) return baked.error();
+  const std::shared_ptr<const Prm> prm = std::move(baked).value();
   auto upsampler = atlas_upsampler(input, *prm, coarse ? density : 0.0);
   if (!upsampler) return upsampler.error();
   const auto to_atlas = [&](std::vector<glm::vec3> image) { return *upsampler ? (*upsampler)->apply(image) : image; };
@@ -294,8 +405,9 @@ void register_prm_sweep(SweepRegistry& registry) {
   // pt-3: emissive materials are dark too (pt-2 kept them, so a scene with an emissive
   // surface, such as the demo level's ceiling panel, had its light in the reference).
   // pt-4: a texel's lights from below its face are dark too (reference_sweep.cpp, pt-4).
+  // pt-5: the field carries its sampling variance (the error against the noise-free truth).
   registry.add_reference_provider(
-      {.kind = "atlas_indirect_irradiance_posed", .version = "pt-4", .compute = prm_reference});
+      {.kind = "atlas_indirect_irradiance_posed", .version = "pt-5", .compute = prm_reference});
 
   SweepMethod m;
   m.name = method_descriptor(EffectMethod::Prm).key;  // gi/methods.h

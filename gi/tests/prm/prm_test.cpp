@@ -121,6 +121,44 @@ TEST(PrmChamber, BitIdenticalForAnyThreadCount) {
   EXPECT_EQ(one.texels, two.texels);
 }
 
+// bake_prm_at (the sweep's dense panes on a level too large to bake whole, issue 38): the
+// flagged texels hold exactly what the whole bake gives them (a texel's sum is its own), the
+// other covered texels stay dark; coarse panes or a threshold are refused.
+TEST(PrmChamber, BakedAtATexelSubsetEqualsTheWholeBakeThere) {
+  const engine::Scene scene = chamber();
+  const gi::Prm whole = small_prm(scene);
+  gi::PrmSettings ps = whole.settings;
+  const gi::BakeInput input = gi::bake_input_from(scene);
+  const gi::AtlasTexels covered = gi::rasterize_atlas(whole.layout, gi::atlas_inputs_from(input));
+  std::vector<std::uint8_t> only(covered.valid.size(), 0);
+  std::size_t n = 0, flagged = 0;
+  for (std::size_t t = 0; t < only.size(); ++t)
+    if (covered.valid[t] && n++ % 7 == 0) only[t] = 1, ++flagged;
+  ASSERT_GT(flagged, 20u);
+  auto part = gi::bake_prm_at(input, ps, only);
+  ASSERT_TRUE(part) << part.error().to_string();
+  const std::vector<glm::vec3> a = relight(whole, scene), b = relight(*part, scene);
+  ASSERT_EQ(a.size(), b.size());
+  std::size_t lit = 0;
+  for (std::size_t t = 0; t < only.size(); ++t) {
+    if (!covered.valid[t]) continue;
+    if (only[t]) {
+      ASSERT_EQ(a[t], b[t]) << "texel " << t;
+      lit += a[t].x > 0.0f ? 1u : 0u;
+    } else {
+      ASSERT_EQ(b[t], glm::vec3(0.0f)) << "texel " << t << " was not asked for";
+    }
+  }
+  EXPECT_GT(lit, flagged / 2);
+  gi::PrmSettings thresholded = ps;
+  thresholded.pane_threshold = 0.01f;
+  EXPECT_FALSE(gi::bake_prm_at(input, thresholded, only));
+  gi::PrmSettings coarse = ps;
+  coarse.pane_texels_per_metre = 1.0f;
+  EXPECT_FALSE(gi::bake_prm_at(input, coarse, only));
+  EXPECT_FALSE(gi::bake_prm_at(input, ps, std::vector<std::uint8_t>(3, 1)));
+}
+
 // Panes coarser than the atlas (issue 38): baked on their own layout, summed there and read
 // at the atlas's texels. Against dense panes at the atlas's density: the same light within
 // a few percent in total and at every wall (the bilinear read is a low-pass of a smooth
