@@ -21,6 +21,7 @@ namespace {
 // The shader's PROBE_BOX_MARGIN_M (engine/shaders/reflection_probes.glsl).
 constexpr float kBoxMarginM = 0.05f;
 
+// Long because it is one table, one entry per knob with its grid and range, read as a list.
 std::vector<KnobSpec> reflection_probes_knobs() {
   return {
       {.name = "resolution",
