@@ -64,6 +64,14 @@ constexpr double kAtlasRayCostPerDoubling = 0.12;
 // gather-ray equivalents per fresh ray growing as the ray cost does, with the triangles'
 // doublings above kAtlasCacheTriangles: 0.11 each, Sponza's 5 doublings 0.56.
 constexpr double kVisibilityRaysPerFreshRayPerDoubling = 0.11;
+// An emitter-sampled gather ray (TexelGatherSettings::emitter_rays, 32 in the preview and
+// medium presets since the eighth session) in fresh cosine rays: 1 + this per doubling of the
+// triangles above kAtlasCacheTriangles. Sponza's preview bake took 44.4 CPU s without them and
+// 77.3 s with 32 per texel (557k texels, 2 cores at load ~10): 3.6 cosine rays each at its 5
+// doublings (long rays across the level to its bright texels, a CDF over more clusters); the
+// demo level's preview atlas (~1 doubling) took 19 s with 96 + 32 rays and 21 s with 128 + 0
+// in one loaded run: about 1.
+constexpr double kEmitterRayCostPerDoubling = 0.52;
 
 // PRM (gi/src/prm): every path node (virtual light) is connected to every pane texel facing
 // it by one shadow ray; nodes = E x N_s x a / (1 - a) for a mean albedo a.
@@ -134,10 +142,9 @@ double cache_doublings(std::size_t triangles) {
 // counts, the lights, and the landing reads' visibility rays of the fresh rays (in gather-ray
 // equivalents, kVisibilityRaysPerFreshRayPerDoubling).
 double gather_rays_per_texel(const TexelGatherSettings& g, const LightPointCount& lights, std::size_t triangles) {
-  // Emitter rays (opt-in, 0 in every preset) counted as one gather ray each: not calibrated
-  // (on loaded cores one cost 2-3 cosine rays on Sponza; docs/light_atlas.md).
-  const double fresh = g.gather_rays + g.emitter_rays;
-  const double visibility = kVisibilityRaysPerFreshRayPerDoubling * cache_doublings(triangles);
+  const double doublings = cache_doublings(triangles);
+  const double fresh = g.gather_rays + (1.0 + kEmitterRayCostPerDoubling * doublings) * g.emitter_rays;
+  const double visibility = kVisibilityRaysPerFreshRayPerDoubling * doublings;
   return g.solve_rays + fresh * (1.0 + visibility) + lights.punctual + lights.directional +
          static_cast<double>(lights.sampled > 0 ? g.direct_samples : 0);
 }
