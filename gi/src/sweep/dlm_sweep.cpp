@@ -65,6 +65,12 @@ std::vector<KnobSpec> dlm_knobs() {
        .kind = KnobKind::Choice,
        .default_grid = {"raster"},
        .choices = {"raster", "visible_surface"}},
+      {.name = "view",
+       .description = "where the eye is: camera0 (the default, its references' keys unchanged) or above (1.7 m above "
+                      "the glossy texels' centroid: the view bands camera 0 does not see, e.g. the demo corridor's)",
+       .kind = KnobKind::Choice,
+       .default_grid = {"camera0"},
+       .choices = {"camera0", "above"}},
       {.name = "ref_spp",
        .description = "specular-lobe samples per texel of the path-traced reference",
        .kind = KnobKind::Integer,
@@ -86,6 +92,7 @@ ReferenceRequest dlm_reference_request(const SweepScene&, const KnobSetting& k) 
               {"floor_roughness", roughness},
               {"camera", "0"}};
   if (k.text("placement") == "visible_surface") r.params.emplace_back("placement", "visible_surface");
+  if (k.text("view") == "above") r.params.emplace_back("view", "above");
   return r;
 }
 
@@ -132,7 +139,8 @@ engine::Result<MethodOutput> run_dlm(const RunContext& ctx) {
     return engine::Error{.message = "the maps' atlas size differs from the reference's"};
   const TexelPlacement placement =
       ctx.knobs.text("placement") == "visible_surface" ? TexelPlacement::VisibleSurface : TexelPlacement::Raster;
-  auto g = glossy_texels(ctx.scene, ctx.knobs.real("density"), floor_roughness, nullptr, placement);
+  const GlossyView view = ctx.knobs.text("view") == "above" ? GlossyView::Above : GlossyView::Camera0;
+  auto g = glossy_texels(ctx.scene, ctx.knobs.real("density"), floor_roughness, nullptr, placement, view);
   if (!g) return g.error();
   // The renderer's evaluation (engine::directional_specular) at every stored glossy texel.
   const AtlasTexels& tex = g->s.texels;
