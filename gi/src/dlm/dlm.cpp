@@ -164,6 +164,28 @@ std::vector<glm::vec3> dlm_directions(int count) {
   return out;
 }
 
+std::vector<glm::vec3> dlm_hemisphere_directions(int count) {
+  std::vector<glm::vec3> out;
+  const double golden = std::numbers::pi * (3.0 - std::sqrt(5.0));
+  for (int i = 0; i < count; ++i) {
+    const double z = 1.0 - (i + 0.5) / count;  // uniform in z: equal areas on the hemisphere
+    const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
+    out.push_back(glm::normalize(glm::vec3(static_cast<float>(r * std::cos(golden * i)),
+                                           static_cast<float>(r * std::sin(golden * i)), static_cast<float>(z))));
+  }
+  return out;
+}
+
+std::vector<glm::vec3> dlm_texel_directions(const Dlm& dlm, const glm::vec3& n) {
+  if (!dlm.settings.tangent_frame_bins) return dlm.directions;
+  glm::vec3 t, b;
+  orthonormal_basis(n, t, b);
+  std::vector<glm::vec3> out;
+  out.reserve(dlm.directions.size());
+  for (const glm::vec3& d : dlm.directions) out.push_back(d.x * t + d.y * b + d.z * n);
+  return out;
+}
+
 std::uint32_t dlm_bin(std::span<const glm::vec3> directions, const glm::vec3& w) {
   std::uint32_t best = 0;
   float best_dot = -2.0f;
@@ -263,14 +285,16 @@ GlossyTexels glossy_texels_of(const StaticBakeScene& s, const std::vector<std::u
   return g;
 }
 
-// C_k(n) per glossy texel, shared by texels of equal normals: the weights and each texel's slot.
+// C_k(n) per glossy texel, shared by texels of equal normals: the weights, the bins'
+// directions in world space (dlm_texel_directions) and each texel's slot.
 struct CosineWeights {
   std::vector<std::vector<float>> weights;
+  std::vector<std::vector<glm::vec3>> directions;
   std::vector<std::uint32_t> texel_slot;
 };
 
 CosineWeights cosine_weights_of(const AtlasTexels& tex, const std::vector<std::uint32_t>& glossy_texels,
-                                std::span<const glm::vec3> directions) {
+                                const Dlm& dlm) {
   std::map<std::array<float, 3>, std::uint32_t> normal_slot;
   CosineWeights out;
   out.texel_slot.resize(glossy_texels.size());
@@ -280,7 +304,8 @@ CosineWeights cosine_weights_of(const AtlasTexels& tex, const std::vector<std::u
     auto it = normal_slot.find(key);
     if (it == normal_slot.end()) {
       it = normal_slot.emplace(key, static_cast<std::uint32_t>(out.weights.size())).first;
-      out.weights.push_back(dlm_bin_cosine_weights(directions, n));
+      out.directions.push_back(dlm_texel_directions(dlm, n));
+      out.weights.push_back(dlm_bin_cosine_weights(out.directions.back(), n));
     }
     out.texel_slot[i] = it->second;
   }
@@ -303,6 +328,7 @@ struct SplatKernel {
   const Dlm& dlm;
   const AtlasTexels& tex;
   const GlossyTexels& glossy;
+  const CosineWeights& cosine;  // each texel's bins' directions
   float radius;
   int W, H;
 
@@ -338,11 +364,11 @@ struct SplatKernel {
   bool splat(std::uint32_t c, std::uint32_t prim, glm::vec2 bc, const glm::vec3& w_in, const glm::vec3& power,
              std::vector<Deposit>& out) const {
     const std::size_t first = out.size();
-    for_kernel(
-        texel_point(c, prim, bc), static_cast<std::int32_t>(dlm.layout.meshes[c].triangle_chart[prim]),
-        [&](std::size_t t, float w) {
-          out.push_back({static_cast<std::uint32_t>(glossy.element[t]), dlm_bin(dlm.directions, w_in), w * power});
-        });
+    for_kernel(texel_point(c, prim, bc), static_cast<std::int32_t>(dlm.layout.meshes[c].triangle_chart[prim]),
+               [&](std::size_t t, float w) {
+                 const auto e = static_cast<std::uint32_t>(glossy.element[t]);
+                 out.push_back({e, dlm_bin(cosine.directions[cosine.texel_slot[e]], w_in), w * power});
+               });
     return out.size() > first;
   }
 };
@@ -538,7 +564,8 @@ engine::Result<Dlm> bake_dlm(const BakeInput& input, const DlmSettings& settings
   dlm.layout = std::move(layout).value();
   dlm.width = dlm.layout.width;
   dlm.height = dlm.layout.height;
-  dlm.directions = dlm_directions(settings.directions);
+  dlm.directions = settings.tangent_frame_bins ? dlm_hemisphere_directions(settings.directions)
+                                               : dlm_directions(settings.directions);
 
   const TriangleMaterials materials = triangle_materials(s, settings);
   const GlossyTexels glossy = glossy_texels_of(s, materials.glossy);
@@ -548,14 +575,14 @@ engine::Result<Dlm> bake_dlm(const BakeInput& input, const DlmSettings& settings
     dlm.stats.total_seconds = seconds_since(t_start);
     return dlm;
   }
-  const CosineWeights cosine = cosine_weights_of(tex, glossy_texels, dlm.directions);
+  const CosineWeights cosine = cosine_weights_of(tex, glossy_texels, dlm);
 
   const SceneBounds bounds = scene_bounds(s.index.triangles);
   const SourcePicker picker = source_picker(
       photon_sources(point_emitters(s.scene, s.index, settings.area_light_samples, settings.seed), bounds));
   dlm.stats.emitted_watts = picker.total;
 
-  const SplatKernel kernel{dlm, tex, glossy, settings.splat_radius_texels, dlm.width, dlm.height};
+  const SplatKernel kernel{dlm, tex, glossy, cosine, settings.splat_radius_texels, dlm.width, dlm.height};
   const std::vector<double> normalizer = kernel_normalizers(s, kernel, materials.glossy);
 
   const auto t_trace = Clock::now();

@@ -52,6 +52,11 @@ struct DlmSettings {
   float glossy_roughness_min = 0.0f;  ///< ... and at or above this (sharper ones are the reflection probes').
   int max_bounces = 16;               ///< Safety stop of a photon path (Russian roulette ends it first).
   int area_light_samples = 16;        ///< Point emitters per area light or emissive triangle.
+  /// Bins in each texel's tangent frame: `directions` on the hemisphere about the texel's
+  /// normal (dlm_hemisphere_directions) instead of one global set, so a texel gets all N cells
+  /// above its horizon (docs/dlm.md, "The corridor's grazing band"). Measurement only: the
+  /// renderer reads global bins, so the bundle writer refuses these maps.
+  bool tangent_frame_bins = false;
   std::uint64_t seed = 1;
   unsigned threads = 0;       ///< 0: all hardware threads. The result does not depend on it.
   ProgressCallback progress;  ///< Fraction done; false cancels.
@@ -73,7 +78,9 @@ struct Dlm {
   AtlasLayout layout;
   int width = 0;
   int height = 0;
-  std::vector<glm::vec3> directions;  ///< Omega: N unit vectors.
+  /// Omega: N unit vectors; with settings.tangent_frame_bins, N on the hemisphere z > 0 of a
+  /// texel's tangent frame (dlm_texel_directions turns them to a normal).
+  std::vector<glm::vec3> directions;
   /// Atlas texel index (y * width + x) of each stored element, ascending: the glossy texels
   /// and the gutter texels dilation filled next to them.
   std::vector<std::uint32_t> texels;
@@ -92,6 +99,13 @@ engine::Result<DlmSettings> dlm_preset(std::string_view name);
 
 /// The N directions of Omega (spherical Fibonacci lattice), deterministic.
 std::vector<glm::vec3> dlm_directions(int count);
+
+/// N directions on the hemisphere z > 0 (equal-area spherical Fibonacci), for tangent-frame bins.
+std::vector<glm::vec3> dlm_hemisphere_directions(int count);
+
+/// The bins' directions in world space at a texel of unit normal `n`: the global set, or
+/// with tangent-frame bins the hemisphere set turned to n (orthonormal_basis(n): x, y, n).
+std::vector<glm::vec3> dlm_texel_directions(const Dlm& dlm, const glm::vec3& n);
 
 /// The bin of incoming direction `w`: the nearest direction psi_k (the paper's rule, at every
 /// normal; engine::directional_bin_of is the renderer's twin).

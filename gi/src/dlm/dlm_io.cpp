@@ -40,6 +40,7 @@ float from_half(std::uint16_t h) { return glm::unpackHalf1x16(h); }
 // Empty when the Dlm's arrays fit together and its values are valid, else what is wrong.
 std::string check_dlm(const Dlm& d) {
   const DlmSettings& s = d.settings;
+  if (s.tangent_frame_bins) return "tangent-frame bins are for measurement only: the renderer reads global bins";
   if (!(s.texels_per_metre > 0.0f) || !std::isfinite(s.texels_per_metre) || s.directions < 8 || s.directions > 256 ||
       s.photons < 1 || !(s.splat_radius_texels > 0.0f) || !std::isfinite(s.splat_radius_texels) ||
       !(s.glossy_roughness > 0.0f) || !(s.glossy_roughness <= 1.0f) || !(s.glossy_roughness_min >= 0.0f) ||

@@ -65,6 +65,18 @@ std::vector<KnobSpec> dlm_knobs() {
        .kind = KnobKind::Choice,
        .default_grid = {"raster"},
        .choices = {"raster", "visible_surface"}},
+      {.name = "bins",
+       .description = "global (one set of directions, the renderer's) or tangent (per texel about its normal, "
+                      "measurement only: docs/dlm.md, 'The corridor's grazing band')",
+       .kind = KnobKind::Choice,
+       .default_grid = {"global"},
+       .choices = {"global", "tangent"}},
+      {.name = "view",
+       .description = "where the eye is: camera0 (the default, its references' keys unchanged) or above (1.7 m above "
+                      "the glossy texels' centroid: the view bands camera 0 does not see, e.g. the demo corridor's)",
+       .kind = KnobKind::Choice,
+       .default_grid = {"camera0"},
+       .choices = {"camera0", "above"}},
       {.name = "ref_spp",
        .description = "specular-lobe samples per texel of the path-traced reference",
        .kind = KnobKind::Integer,
@@ -86,6 +98,7 @@ ReferenceRequest dlm_reference_request(const SweepScene&, const KnobSetting& k) 
               {"floor_roughness", roughness},
               {"camera", "0"}};
   if (k.text("placement") == "visible_surface") r.params.emplace_back("placement", "visible_surface");
+  if (k.text("view") == "above") r.params.emplace_back("view", "above");
   return r;
 }
 
@@ -122,6 +135,7 @@ engine::Result<MethodOutput> run_dlm(const RunContext& ctx) {
   s.splat_radius_texels = static_cast<float>(ctx.knobs.real("splat"));
   const double floor_roughness = ctx.knobs.real("roughness");
   s.glossy_roughness = static_cast<float>(glossy_threshold(floor_roughness));
+  s.tangent_frame_bins = ctx.knobs.text("bins") == "tangent";
   s.seed = ctx.seed;
   s.threads = ctx.threads;
   s.progress = ctx.progress;
@@ -132,7 +146,8 @@ engine::Result<MethodOutput> run_dlm(const RunContext& ctx) {
     return engine::Error{.message = "the maps' atlas size differs from the reference's"};
   const TexelPlacement placement =
       ctx.knobs.text("placement") == "visible_surface" ? TexelPlacement::VisibleSurface : TexelPlacement::Raster;
-  auto g = glossy_texels(ctx.scene, ctx.knobs.real("density"), floor_roughness, nullptr, placement);
+  const GlossyView view = ctx.knobs.text("view") == "above" ? GlossyView::Above : GlossyView::Camera0;
+  auto g = glossy_texels(ctx.scene, ctx.knobs.real("density"), floor_roughness, nullptr, placement, view);
   if (!g) return g.error();
   // The renderer's evaluation (engine::directional_specular) at every stored glossy texel.
   const AtlasTexels& tex = g->s.texels;
@@ -151,8 +166,9 @@ engine::Result<MethodOutput> run_dlm(const RunContext& ctx) {
       l[k] = glm::vec3(v[0], v[1], v[2]);
     }
     const glm::vec3 v = glm::normalize(g->eye - tex.position[t]);
-    values[t] = engine::directional_specular(g->brdf[t], tex.normal[t], v, dlm->directions, l);
-    const std::vector<float> c = dlm_bin_cosine_weights(dlm->directions, tex.normal[t]);
+    const std::vector<glm::vec3> directions = dlm_texel_directions(*dlm, tex.normal[t]);
+    values[t] = engine::directional_specular(g->brdf[t], tex.normal[t], v, directions, l);
+    const std::vector<float> c = dlm_bin_cosine_weights(directions, tex.normal[t]);
     glm::vec3 e(0.0f);
     for (std::size_t k = 0; k < l.size(); ++k) e += c[k] * l[k];
     atlas_values[t] =

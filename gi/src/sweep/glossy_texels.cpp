@@ -39,7 +39,7 @@ engine::SceneAsset with_floor_roughness(const engine::SceneAsset& asset, double 
 double glossy_threshold(double floor_roughness) { return std::max(kGlossyOriginal, floor_roughness + 0.05); }
 
 engine::Result<GlossyTexels> glossy_texels(const SweepScene& scene, double density, double floor_roughness,
-                                           const ReferenceRequest* request, TexelPlacement placement) {
+                                           const ReferenceRequest* request, TexelPlacement placement, GlossyView view) {
   const double roughness = glossy_threshold(floor_roughness);
   const engine::Scene live = engine::instantiate(with_floor_roughness(scene.asset, floor_roughness));
   engine::Entity camera{};
@@ -58,6 +58,7 @@ engine::Result<GlossyTexels> glossy_texels(const SweepScene& scene, double densi
   const AtlasTexels& tex = g.s.texels;
   g.glossy.assign(tex.valid.size(), 0);
   g.brdf.resize(tex.valid.size());
+  std::vector<std::uint8_t> glossy_material(tex.valid.size(), 0);
   for (std::size_t t = 0; t < tex.valid.size(); ++t) {
     if (!tex.valid[t] || tex.mesh[t] < 0) continue;
     const std::uint32_t inst = g.s.static_instance[static_cast<std::size_t>(tex.mesh[t])];
@@ -70,10 +71,22 @@ engine::Result<GlossyTexels> glossy_texels(const SweepScene& scene, double densi
       return footprint_brdf(g.s.scene, tri, f.centre, f.axis_u, f.axis_v);
     }();
     if (!(static_cast<double>(std::sqrt(brdf.alpha)) < roughness)) continue;
-    if (!(glm::dot(tex.normal[t], g.eye - tex.position[t]) > 0.0f)) continue;
-    g.glossy[t] = 1;
+    glossy_material[t] = 1;
     g.brdf[t] = brdf;
   }
+  if (view == GlossyView::Above) {
+    glm::dvec3 centre(0.0), normal(0.0);
+    double count = 0.0;
+    for (std::size_t t = 0; t < tex.valid.size(); ++t) {
+      if (!glossy_material[t]) continue;
+      centre += glm::dvec3(tex.position[t]);
+      normal += glm::dvec3(tex.normal[t]);
+      count += 1.0;
+    }
+    if (count > 0.0 && glm::length(normal) > 0.0) g.eye = glm::vec3(centre / count + 1.7 * glm::normalize(normal));
+  }
+  for (std::size_t t = 0; t < tex.valid.size(); ++t)
+    g.glossy[t] = glossy_material[t] && glm::dot(tex.normal[t], g.eye - tex.position[t]) > 0.0f ? 1 : 0;
   return g;
 }
 
@@ -82,7 +95,7 @@ engine::Result<RgbField> glossy_specular_truth(const ReferenceJob& job, LobeRadi
   const TexelPlacement placement =
       r.param("placement") == "visible_surface" ? TexelPlacement::VisibleSurface : TexelPlacement::Raster;
   auto g = glossy_texels(job.scene, std::stod(r.param("texels_per_m")), std::stod(r.param("floor_roughness")), &r,
-                         placement);
+                         placement, r.param("view") == "above" ? GlossyView::Above : GlossyView::Camera0);
   if (!g) return g.error();
   const int spp = std::stoi(r.param("spp"));
   const AtlasTexels& tex = g->s.texels;

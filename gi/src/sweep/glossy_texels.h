@@ -36,6 +36,11 @@ engine::SceneAsset with_floor_roughness(const engine::SceneAsset& asset, double 
 /// The glossy threshold of the bake and the reference for that floor: above it, at least 0.35.
 double glossy_threshold(double floor_roughness);
 
+/// Where the eye is: camera 0, or 1.7 m above the glossy texels' centroid along their mean
+/// normal (a player standing on the glossy floor: the views from above that a camera far
+/// away does not have, e.g. the demo corridor's floor, which camera 0 sees only at grazing).
+enum class GlossyView { Camera0, Above };
+
 /// The glossy texels of `scene` (its floor at `floor_roughness`) at `density` texels/m that
 /// camera 0 sees, their samples placed as `placement` says (gi/reference.h): Raster puts the
 /// samples of a floor's border texels on the line where the walls begin, and lobe rays from
@@ -43,7 +48,8 @@ double glossy_threshold(double floor_roughness);
 /// `request`, when given, names the errors.
 engine::Result<GlossyTexels> glossy_texels(const SweepScene& scene, double density, double floor_roughness,
                                            const ReferenceRequest* request,
-                                           TexelPlacement placement = TexelPlacement::Raster);
+                                           TexelPlacement placement = TexelPlacement::Raster,
+                                           GlossyView view = GlossyView::Camera0);
 
 /// What reaches the texel along a sampled lobe direction.
 enum class LobeRadiance {
@@ -51,11 +57,12 @@ enum class LobeRadiance {
   Full,       ///< PathTracer::radiance: with them (what a reflection probe captures).
 };
 
-/// The path-traced specular radiance each glossy texel reflects towards camera 0: the glTF
+/// The path-traced specular radiance each glossy texel reflects towards the eye: the glTF
 /// specular lobe importance-sampled (`request` params "texels_per_m", "spp",
 /// "floor_roughness"; "placement" = "visible_surface" for TexelPlacement::VisibleSurface,
-/// else Raster), its per-texel sampling variance kept so that compare_rgb removes
-/// the reference's noise. Deterministic in the request (its own random streams).
+/// else Raster; "view" = "above" for GlossyView::Above, else camera 0), its per-texel
+/// sampling variance kept so that compare_rgb removes the reference's noise. Deterministic
+/// in the request (its own random streams).
 engine::Result<RgbField> glossy_specular_truth(const ReferenceJob& job, LobeRadiance what);
 
 }  // namespace gi

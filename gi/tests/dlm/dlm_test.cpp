@@ -2,6 +2,7 @@
 // bake's energy (a furnace with a known answer), determinism, which texels get maps, the
 // hard cases, and the reflected specular radiance against the reference path tracer.
 #include "dlm/dlm.h"
+#include "dlm/dlm_io.h"
 
 #include <gtest/gtest.h>
 #include <engine/directional_radiance.h>
@@ -11,6 +12,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <numbers>
 
 #include "raytrace/path_tracer.h"
@@ -18,6 +20,8 @@
 #include "transport/static_scene.h"
 #include "uv/atlas_input.h"
 #include "uv/atlas_rasterizer.h"
+
+namespace fs = std::filesystem;
 
 namespace {
 
@@ -124,9 +128,8 @@ TEST(DlmDirections, BinIsTheNearestDirection) {
 // A closed furnace of one glossy emissive material: every surface emits L_e and folds to
 // albedo a, so the light that arrives after at least one reflection is L_e a / (1 - a) from
 // every direction: every usable bin of every texel holds that radiance.
-TEST(DlmBake, FurnaceBinsHoldTheIndirectRadiance) {
+engine::SceneAsset glossy_furnace(const glm::vec3& le) {
   engine::SceneAsset a;
-  const glm::vec3 le(0.5f);
   a.materials.push_back(engine::Material{
       .name = "glossy_emitter", .base_color = glm::vec4(glm::vec3(0.6f), 1.0f), .roughness = 0.2f, .emissive = le});
   engine::Mesh m;
@@ -143,7 +146,12 @@ TEST(DlmBake, FurnaceBinsHoldTheIndirectRadiance) {
   m.primitives.push_back(std::move(p));
   a.meshes.push_back(std::move(m));
   a.nodes.push_back(engine::Node{.name = "box", .mesh = 0, .gi = {engine::Mobility::Static}});
-  const gi::BakeInput input = gi::bake_input_from(a);
+  return a;
+}
+
+TEST(DlmBake, FurnaceBinsHoldTheIndirectRadiance) {
+  const glm::vec3 le(0.5f);
+  const gi::BakeInput input = gi::bake_input_from(glossy_furnace(le));
   gi::DlmSettings st = test_settings(400'000);
   st.texels_per_metre = 2.0f;
   st.area_light_samples = 4;
@@ -179,6 +187,49 @@ TEST(DlmBake, FurnaceBinsHoldTheIndirectRadiance) {
                   0.15 * static_cast<double>(expected))
           << k;
     }
+}
+
+// Tangent-frame bins (docs/dlm.md, "The corridor's grazing band"): the same furnace, every
+// one of the N bins of every texel above its horizon, each holding L_e a / (1 - a). The
+// renderer reads global bins only, so the bundle writer refuses these maps.
+TEST(DlmBake, TangentFrameFurnaceBinsHoldTheIndirectRadiance) {
+  const glm::vec3 le(0.5f);
+  const gi::BakeInput input = gi::bake_input_from(glossy_furnace(le));
+  gi::DlmSettings st = test_settings(400'000);
+  st.texels_per_metre = 2.0f;
+  st.area_light_samples = 4;
+  st.directions = 64;
+  st.tangent_frame_bins = true;
+  auto dlm = gi::bake_dlm(input, st);
+  ASSERT_TRUE(dlm) << dlm.error().to_string();
+  const float albedo = engine::gltf_hemispherical_albedo(engine::gltf_brdf(glm::vec3(0.6f), 0.0f, 0.2f)).sum().y;
+  const double expected = static_cast<double>(le.y * albedo / (1.0f - albedo));
+  auto rast = gi::rasterize_atlas(dlm->layout, gi::atlas_inputs_from(input));
+  double sum = 0.0;
+  std::size_t count = 0;
+  std::vector<double> bin_sum(dlm->directions.size(), 0.0);
+  std::vector<std::size_t> bin_count(dlm->directions.size(), 0);
+  for (std::size_t i = 0; i < dlm->texels.size(); ++i) {
+    const std::uint32_t t = dlm->texels[i];
+    if (!rast.valid[t]) continue;
+    for (std::size_t k = 0; k < dlm->directions.size(); ++k) {
+      sum += static_cast<double>(at(*dlm, k, i).y), ++count;
+      bin_sum[k] += static_cast<double>(at(*dlm, k, i).y), ++bin_count[k];
+    }
+  }
+  ASSERT_GT(count, 0u);
+  const double mean = sum / static_cast<double>(count);
+  std::printf("tangent-frame furnace: expected %.4f, mean %.4f over %zu texel-bins\n", expected, mean, count);
+  EXPECT_NEAR(mean, expected, 0.03 * expected);
+  for (std::size_t k = 0; k < bin_sum.size(); ++k) {
+    ASSERT_GT(bin_count[k], 0u) << k;
+    EXPECT_NEAR(bin_sum[k] / static_cast<double>(bin_count[k]), expected, 0.15 * expected) << k;
+  }
+  const fs::path dir = fs::temp_directory_path() / "gi_dlm_tangent_frame_refused";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  EXPECT_FALSE(gi::save_dlm(dir, *dlm, input));
+  fs::remove_all(dir);
 }
 
 TEST(DlmBake, BitIdenticalForOneAndFourThreads) {
