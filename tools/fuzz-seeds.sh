@@ -1,15 +1,28 @@
 #!/usr/bin/env bash
 # Regenerates the fuzz seed corpus tests/fuzz/corpus/ (tests/fuzz/README.md) from the project's
-# assets and tiny bakes by the built gi-bake (GI_BAKE, or BUILD_DIR/tools/gi-bake/gi-bake, build/ by default): run it after a bundle
-# file format changes (the ctest Fuzz.<target>.ReplaysSeedsAndRegressions then refuses a seed).
+# assets and tiny bakes by the built gi-bake (GI_BAKE, or BUILD_DIR/tools/gi-bake/gi-bake, build/
+# by default): run it after a bundle file format changes (the ctest
+# Fuzz.<target>.ReplaysSeedsAndRegressions then refuses a seed). Usage:
+#   tools/fuzz-seeds.sh                                            # the whole corpus
+#   tools/fuzz-seeds.sh light_atlas_vpls manifest/atlas_prm.json   # only these targets' folders or seeds
+# Naming targets or seeds replaces only those, so a branch that changed one format re-makes its
+# own seeds without touching the others'.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$(pwd)
 bake=${GI_BAKE:-"$root/${BUILD_DIR:-build}/tools/gi-bake/gi-bake"}
 [ -x "$bake" ] || { echo "fuzz-seeds.sh: build gi-bake first ($bake)" >&2; exit 1; }
+targets=(gltf exr session blob manifest atlas_layout light_atlas_vpls prm_panes brf_mesh antiradiance dlm)
+for name in "$@"; do
+  [[ " ${targets[*]} " == *" ${name%%/*} "* ]] || {
+    echo "fuzz-seeds.sh: no target '${name%%/*}' (targets: ${targets[*]})" >&2
+    exit 2
+  }
+done
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 corpus="$root/tests/fuzz/corpus"
+out="$tmp/corpus"
 
 python3 - "$root/assets" "$tmp" <<'PY'
 import base64, json, struct, sys
@@ -44,27 +57,42 @@ cp assets/cornell_box.bin "$tmp/"
   --threads 1 --out "$tmp/atlas_prm.gibake" >/dev/null
 "$bake" --scene assets/crates_room.gltf --preset preview --methods brf --brf-basis 2 --brf-spheres 1 \
   --threads 1 --out "$tmp/brf.gibake" >/dev/null
-"$bake" --scene "$tmp/cb_deform.gltf" --preset preview --methods antiradiance,dlm --density 2 --dlm-directions 8 \
-  --dlm-photons 2000 --threads 1 --out "$tmp/ar_dlm.gibake" >/dev/null
+# From the scratch directory, so the manifest names the scene "cb_deform.gltf", not a path that changes every run.
+(cd "$tmp" && "$bake" --scene cb_deform.gltf --preset preview --methods antiradiance,dlm --density 2 --dlm-directions 8 \
+  --dlm-photons 2000 --threads 1 --out ar_dlm.gibake >/dev/null)
 "$bake" --scene assets/cornell_box.gltf --preset preview --methods light_atlas,dlm --density 3 --vpls 64 --dlm-directions 8 \
   --dlm-photons 2000 --threads 1 --out "$tmp/no_dlm_texels.gibake" >/dev/null
 
-rm -rf "$corpus"
-mkdir -p "$corpus"/{gltf,exr,session,blob,manifest,atlas_layout,light_atlas_vpls,prm_panes,brf_mesh,antiradiance,dlm}
+for t in "${targets[@]}"; do mkdir -p "$out/$t"; done
 cp assets/crates_room.draco.glb assets/demo_level.draco.glb "$tmp/spot_chamber.glb" "$tmp/cornell_box_embedded.gltf" \
-  "$corpus/gltf/"
-cp "$tmp/atlas_prm.gibake/light_atlas.exr" "$corpus/exr/"
-cp tests/sessions/open_door.girec "$corpus/session/"
-cp "$tmp/ar_dlm.gibake/dlm.bin" "$corpus/blob/dlm.bin"
-cp "$tmp/no_dlm_texels.gibake/dlm.bin" "$corpus/blob/dlm_empty.bin"
-cp "$tmp/atlas_prm.gibake/manifest.json" "$corpus/manifest/atlas_prm.json"
-cp "$tmp/brf.gibake/manifest.json" "$corpus/manifest/brf.json"
-cp "$tmp/ar_dlm.gibake/manifest.json" "$corpus/manifest/antiradiance_dlm.json"
-cp "$tmp/atlas_prm.gibake/light_atlas_vpls.bin" "$corpus/light_atlas_vpls/"
-cp "$tmp/atlas_prm.gibake/prm_layout.bin" "$tmp/ar_dlm.gibake/dlm_layout.bin" "$corpus/atlas_layout/"
-cp "$tmp/atlas_prm.gibake/prm_panes.bin" "$corpus/prm_panes/"
-cp "$tmp/brf.gibake/brf_crate.bin" "$corpus/brf_mesh/"
-cp "$tmp/ar_dlm.gibake/antiradiance.bin" "$corpus/antiradiance/"
-cp "$tmp/ar_dlm.gibake/dlm.bin" "$corpus/dlm/"
-cp "$tmp/no_dlm_texels.gibake/dlm.bin" "$corpus/dlm/dlm_no_texels.bin"
-echo "fuzz-seeds.sh: $(find "$corpus" -type f | wc -l) seeds, $(du -sh "$corpus" | cut -f1) in $corpus"
+  "$out/gltf/"
+cp "$tmp/atlas_prm.gibake/light_atlas.exr" "$out/exr/"
+cp tests/sessions/open_door.girec "$out/session/"
+cp "$tmp/ar_dlm.gibake/dlm.bin" "$out/blob/dlm.bin"
+cp "$tmp/no_dlm_texels.gibake/dlm.bin" "$out/blob/dlm_empty.bin"
+cp "$tmp/atlas_prm.gibake/manifest.json" "$out/manifest/atlas_prm.json"
+cp "$tmp/brf.gibake/manifest.json" "$out/manifest/brf.json"
+cp "$tmp/ar_dlm.gibake/manifest.json" "$out/manifest/antiradiance_dlm.json"
+cp "$tmp/atlas_prm.gibake/light_atlas_vpls.bin" "$out/light_atlas_vpls/"
+cp "$tmp/atlas_prm.gibake/prm_layout.bin" "$tmp/ar_dlm.gibake/dlm_layout.bin" "$out/atlas_layout/"
+cp "$tmp/atlas_prm.gibake/prm_panes.bin" "$out/prm_panes/"
+cp "$tmp/brf.gibake/brf_crate.bin" "$out/brf_mesh/"
+cp "$tmp/ar_dlm.gibake/antiradiance.bin" "$out/antiradiance/"
+cp "$tmp/ar_dlm.gibake/dlm.bin" "$out/dlm/"
+cp "$tmp/no_dlm_texels.gibake/dlm.bin" "$out/dlm/dlm_no_texels.bin"
+
+if [ $# -eq 0 ]; then
+  rm -rf "$corpus"
+  cp -r "$out" "$corpus"
+  echo "fuzz-seeds.sh: $(find "$corpus" -type f | wc -l) seeds, $(du -sh "$corpus" | cut -f1) in $corpus"
+  exit 0
+fi
+for name in "$@"; do
+  [ -e "$out/$name" ] || { echo "fuzz-seeds.sh: no seed '$name' (have: $(cd "$out" && find . -type f | sort | tr '\n' ' '))" >&2; exit 2; }
+done
+for name in "$@"; do
+  rm -rf "${corpus:?}/$name"
+  mkdir -p "$(dirname "$corpus/$name")"
+  cp -r "$out/$name" "$corpus/$name"
+  echo "fuzz-seeds.sh: re-made $name ($(find "$corpus/$name" -type f | wc -l) files)"
+done

@@ -22,7 +22,8 @@ void main() {
   const uint i = gl_LocalInvocationIndex;
   s_bins[i] = 0u;
   barrier();
-  const ivec2 block = (ivec2(gl_WorkGroupID.xy) * 16 + ivec2(gl_LocalInvocationID.xy)) * (PIXELS_PER_SIDE * METER_STRIDE);
+  const ivec2 block =
+      (ivec2(gl_WorkGroupID.xy) * 16 + ivec2(gl_LocalInvocationID.xy)) * (PIXELS_PER_SIDE * METER_STRIDE);
   const float top = float(METER_BINS) - 0.5 / float(SUB_BIN_STEPS);
   uint run_bin = 0u;
   uint run = 0u;  // pixels of the current run, packed as a bin word

@@ -86,7 +86,8 @@ GltfBrdfValue gltf_eval_cos(GltfBrdf m, vec3 n, vec3 v, vec3 l) {
   vec3 f_metal = m.base_color + (vec3(1.0) - m.base_color) * w;
   float lobe = gltf_ggx_distribution(n_dot_h, m.alpha) * gltf_smith_visibility(n_dot_v, n_dot_l, m.alpha);
   out_value.diffuse = (1.0 - m.metallic) * gltf_diffuse_weight(m, v_dot_h) * m.base_color * (n_dot_l / GLTF_PI);
-  out_value.specular = ((1.0 - m.metallic) * m.specular_weight * f_dielectric + m.metallic * f_metal) * (lobe * n_dot_l);
+  out_value.specular =
+      ((1.0 - m.metallic) * m.specular_weight * f_dielectric + m.metallic * f_metal) * (lobe * n_dot_l);
   return out_value;
 }
 
@@ -101,7 +102,8 @@ vec4 gltf_albedo_table_sample(float n_dot_v, float roughness) {
   int j0 = min(int(y), GLTF_ALBEDO_TABLE_SIZE - 2);
   float fx = x - float(i0);
   float fy = y - float(j0);
-  vec4 lo = mix(texelFetch(u_gltf_albedo_table, ivec2(i0, j0), 0), texelFetch(u_gltf_albedo_table, ivec2(i0 + 1, j0), 0), fx);
+  vec4 lo =
+      mix(texelFetch(u_gltf_albedo_table, ivec2(i0, j0), 0), texelFetch(u_gltf_albedo_table, ivec2(i0 + 1, j0), 0), fx);
   vec4 hi = mix(texelFetch(u_gltf_albedo_table, ivec2(i0, j0 + 1), 0),
                 texelFetch(u_gltf_albedo_table, ivec2(i0 + 1, j0 + 1), 0), fx);
   return mix(lo, hi, fy);
@@ -114,7 +116,8 @@ GltfBrdfValue gltf_directional_albedo(GltfBrdf m, float n_dot_v) {
   float f0m = gltf_max_component(m.dielectric_f0);
   GltfBrdfValue out_value;
   out_value.diffuse = (1.0 - m.metallic) * m.base_color * (1.0 - m.specular_weight * (f0m + (1.0 - f0m) * abp.z));
-  out_value.specular = (1.0 - m.metallic) * m.specular_weight * (m.dielectric_f0 * abp.x + (vec3(1.0) - m.dielectric_f0) * abp.y) +
-                       m.metallic * (m.base_color * abp.x + (vec3(1.0) - m.base_color) * abp.y);
+  out_value.specular =
+      (1.0 - m.metallic) * m.specular_weight * (m.dielectric_f0 * abp.x + (vec3(1.0) - m.dielectric_f0) * abp.y) +
+      m.metallic * (m.base_color * abp.x + (vec3(1.0) - m.base_color) * abp.y);
   return out_value;
 }

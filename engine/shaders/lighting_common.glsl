@@ -15,16 +15,19 @@ const int LIGHT_AREA = 3;
 
 // Mirrors engine/src/render/gpu_light.h (std430, 208 bytes).
 struct GpuLight {
-  vec4 position_type;     // xyz: world position (m); w: LIGHT_* type
-  vec4 direction_range;   // xyz: unit emission direction (the light's -Z); w: range (m), 0 = unlimited
-  vec4 radiant;           // rgb: colour x intensity (W/sr, W/m^2 or W/(m^2 sr) by type)
-  vec4 cone;              // x: cos(outer), y: cos(inner), z: 2-D shadow layer or -1, w: shadow cube or -1 (point; area: the grazing band)
+  vec4 position_type;    // xyz: world position (m); w: LIGHT_* type
+  vec4 direction_range;  // xyz: unit emission direction (the light's -Z); w: range (m), 0 = unlimited
+  vec4 radiant;          // rgb: colour x intensity (W/sr, W/m^2 or W/(m^2 sr) by type)
+  // x: cos(outer), y: cos(inner), z: 2-D shadow layer or -1, w: shadow cube or -1 (point; area: the grazing band)
+  vec4 cone;
   vec4 area_half_x;       // xyz: half of the rectangle along the light's X axis (m)
   vec4 area_half_y;       // xyz: half of the rectangle along the light's Y axis (m)
   mat4 shadow_view_proj;  // world -> clip of the 2-D shadow map
   vec4 shadow_eye;        // xyz: shadow camera position (m); w: far distance that maps to depth 1 (m)
-  vec4 shadow_params;     // x: 0 ortho / 1 distance; y: texel footprint (m, or m per m of distance); z: area lights: index among them; w: area lights: texel footprint of the cube map (cone.w) beyond the 2-D map
-  vec4 flags;             // x: 1 when the light does not move (Light::moves false): a bake may hold its direct light
+  // x: 0 ortho / 1 distance; y: texel footprint (m, or m per m of distance); z: area lights: index among them;
+  // w: area lights: texel footprint of the cube map (cone.w) beyond the 2-D map
+  vec4 shadow_params;
+  vec4 flags;  // x: 1 when the light does not move (Light::moves false): a bake may hold its direct light
 };
 
 layout(std430, binding = 0) readonly buffer Lights { GpuLight lights[]; };
@@ -130,8 +133,9 @@ vec3 area_light_radiance(GpuLight light, Surface s) {
   }
   // All sample points below the horizon while the clipped rectangle is not: the weight
   // towards the light's centre.
-  float diffuse_weight = weight_sum > 0.0 ? diffuse_weight_sum / weight_sum
-                                          : gltf_diffuse_weight(s.brdf, dot(s.view, normalize(normalize(rel) + s.view)));
+  float diffuse_weight = weight_sum > 0.0
+                             ? diffuse_weight_sum / weight_sum
+                             : gltf_diffuse_weight(s.brdf, dot(s.view, normalize(normalize(rel) + s.view)));
   vec3 diffuse = (1.0 - s.brdf.metallic) * s.brdf.base_color / PI * diffuse_weight * irradiance_per_radiance;
   return light.radiant.rgb * (diffuse + specular);
 }
@@ -159,5 +163,6 @@ vec3 spot_light_radiance(GpuLight light, Surface s, out vec3 to_light) {
   float cos_axis = dot(-to_light, light.direction_range.xyz);
   float cos_outer = light.cone.x;
   float cos_inner = light.cone.y;
-  return radiance * (cos_inner - cos_outer > 1e-5 ? smoothstep(cos_outer, cos_inner, cos_axis) : step(cos_outer, cos_axis));
+  return radiance *
+         (cos_inner - cos_outer > 1e-5 ? smoothstep(cos_outer, cos_inner, cos_axis) : step(cos_outer, cos_axis));
 }

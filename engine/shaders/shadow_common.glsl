@@ -62,8 +62,7 @@ float shadow_2d_in(sampler2DArrayShadow maps, GpuLight light, vec3 p, vec3 n, ve
   vec2 texel_uv = 1.0 / vec2(textureSize(maps, 0).xy);
   float sum = 0.0;
   for (int y = -1; y <= 1; ++y)
-    for (int x = -1; x <= 1; ++x)
-      sum += texture(maps, vec4(uv + vec2(x, y) * spacing * texel_uv, float(layer), ref));
+    for (int x = -1; x <= 1; ++x) sum += texture(maps, vec4(uv + vec2(x, y) * spacing * texel_uv, float(layer), ref));
   return sum / 9.0;
 }
 // Spot and area lights' maps.
@@ -131,17 +130,16 @@ float shadow_cube(GpuLight light, vec3 p, vec3 n, vec3 to_light) {
 // Points spread uniformly over the unit disc (Vogel's spiral, golden-angle steps): the
 // fraction of them behind a straight edge follows the fraction of the disc's area there,
 // so a filter over them has the penumbra profile of a disc-shaped light.
-const vec2 kDisc16[16] = vec2[16](
-    vec2(0.1768, 0.0000), vec2(-0.2258, 0.2068), vec2(0.0346, -0.3938), vec2(0.2846, 0.3712),
-    vec2(-0.5222, -0.0924), vec2(0.4947, -0.3147), vec2(-0.1655, 0.6155), vec2(-0.3156, -0.6076),
-    vec2(0.6846, 0.2500), vec2(-0.7123, 0.2940), vec2(0.3434, -0.7337), vec2(0.2537, 0.8089),
-    vec2(-0.7647, -0.4432), vec2(0.8971, -0.1972), vec2(-0.5475, 0.7788), vec2(-0.1265, -0.9761));
+const vec2 kDisc16[16] =
+    vec2[16](vec2(0.1768, 0.0000), vec2(-0.2258, 0.2068), vec2(0.0346, -0.3938), vec2(0.2846, 0.3712),
+             vec2(-0.5222, -0.0924), vec2(0.4947, -0.3147), vec2(-0.1655, 0.6155), vec2(-0.3156, -0.6076),
+             vec2(0.6846, 0.2500), vec2(-0.7123, 0.2940), vec2(0.3434, -0.7337), vec2(0.2537, 0.8089),
+             vec2(-0.7647, -0.4432), vec2(0.8971, -0.1972), vec2(-0.5475, 0.7788), vec2(-0.1265, -0.9761));
 const vec2 kDisc24[24] = vec2[24](
-    vec2(0.1443, 0.0000), vec2(-0.1843, 0.1689), vec2(0.0282, -0.3215), vec2(0.2324, 0.3031),
-    vec2(-0.4264, -0.0754), vec2(0.4039, -0.2569), vec2(-0.1351, 0.5026), vec2(-0.2577, -0.4961),
-    vec2(0.5590, 0.2041), vec2(-0.5816, 0.2401), vec2(0.2803, -0.5991), vec2(0.2072, 0.6605),
-    vec2(-0.6244, -0.3619), vec2(0.7325, -0.1610), vec2(-0.4470, 0.6359), vec2(-0.1033, -0.7970),
-    vec2(0.6340, 0.5343), vec2(-0.8532, 0.0353), vec2(0.6223, -0.6193), vec2(-0.0416, 0.9004),
+    vec2(0.1443, 0.0000), vec2(-0.1843, 0.1689), vec2(0.0282, -0.3215), vec2(0.2324, 0.3031), vec2(-0.4264, -0.0754),
+    vec2(0.4039, -0.2569), vec2(-0.1351, 0.5026), vec2(-0.2577, -0.4961), vec2(0.5590, 0.2041), vec2(-0.5816, 0.2401),
+    vec2(0.2803, -0.5991), vec2(0.2072, 0.6605), vec2(-0.6244, -0.3619), vec2(0.7325, -0.1610), vec2(-0.4470, 0.6359),
+    vec2(-0.1033, -0.7970), vec2(0.6340, 0.5343), vec2(-0.8532, 0.0353), vec2(0.6223, -0.6193), vec2(-0.0416, 0.9004),
     vec2(-0.5922, -0.7096), vec2(0.9380, 0.1262), vec2(-0.7948, 0.5530), vec2(0.2172, -0.9654));
 
 // A directional light with a disc (the sun; light.radiant.w = tan r, r its angular radius):
@@ -181,25 +179,26 @@ float shadow_2d_disc(GpuLight light, vec3 p, vec3 n, vec3 to_light) {
     }
   }
   if (blockers == 0.0) return 1.0;
-  float b = max(d - blocker_depth / blockers * far_m, 0.0);  // receiver - blocker, metres
+  float b = max(d - blocker_depth / blockers * far_m, 0.0);     // receiver - blocker, metres
   float radius = clamp(b * tan_r / texel, 1.0, kSunMaxTexels);  // penumbra half-width, texels
   float sum = 0.0;
-  for (int i = 0; i < 24; ++i) sum += texture(u_sun_shadow_maps, vec4(uv + kDisc24[i] * radius * texel_uv, float(layer), ref));
+  for (int i = 0; i < 24; ++i)
+    sum += texture(u_sun_shadow_maps, vec4(uv + kDisc24[i] * radius * texel_uv, float(layer), ref));
   return sum / 24.0;
 }
 
 // 12 points over the square [-1, 1]^2, one in each row and each column of a 12 x 12 grid
 // (a rank-1 lattice, row 5 i mod 12), so a penumbra along either axis of a rectangle gets 12
 // steps (a 4 x 3 grid would give 3 or 4), smoothed by each tap's bilinear compare.
-const vec2 kRect12[12] = vec2[12](
-    vec2(-0.9167, -0.9167), vec2(-0.7500, -0.0833), vec2(-0.5833, 0.7500), vec2(-0.4167, -0.4167),
-    vec2(-0.2500, 0.4167), vec2(-0.0833, -0.7500), vec2(0.0833, 0.0833), vec2(0.2500, 0.9167),
-    vec2(0.4167, -0.2500), vec2(0.5833, 0.5833), vec2(0.7500, -0.5833), vec2(0.9167, 0.2500));
+const vec2 kRect12[12] =
+    vec2[12](vec2(-0.9167, -0.9167), vec2(-0.7500, -0.0833), vec2(-0.5833, 0.7500), vec2(-0.4167, -0.4167),
+             vec2(-0.2500, 0.4167), vec2(-0.0833, -0.7500), vec2(0.0833, 0.0833), vec2(0.2500, 0.9167),
+             vec2(0.4167, -0.2500), vec2(0.5833, 0.5833), vec2(0.7500, -0.5833), vec2(0.9167, 0.2500));
 // Where the blocker search gathers 2 x 2 texels: the receiver's own texels, then two rotated
 // rings over the rectangle's disc (a ring alone misses a blocker smaller than its radius).
-const vec2 kSearch9[9] = vec2[9](vec2(0.0, 0.0), vec2(-0.15, -0.45), vec2(0.45, -0.15), vec2(0.15, 0.45),
-                                 vec2(-0.45, 0.15), vec2(-0.35, -1.05), vec2(1.05, -0.35), vec2(0.35, 1.05),
-                                 vec2(-1.05, 0.35));
+const vec2 kSearch9[9] =
+    vec2[9](vec2(0.0, 0.0), vec2(-0.15, -0.45), vec2(0.45, -0.15), vec2(0.15, 0.45), vec2(-0.45, 0.15),
+            vec2(-0.35, -1.05), vec2(1.05, -0.35), vec2(0.35, 1.05), vec2(-1.05, 0.35));
 
 // Rectangular area light, soft-shadowed over its rectangle (PCSS). The light's 2-D map is a
 // perspective distance map from the rectangle's centre c. The light's point

@@ -13,13 +13,9 @@ uniform int u_metered;
 layout(std430, binding = EXPOSURE_STATE_BINDING) readonly buffer ExposureState { float state_exposure; };
 layout(location = 0) out vec4 o_color;
 
-vec3 aces_narkowicz(vec3 x) {
-  return clamp(x * (2.51 * x + 0.03) / (x * (2.43 * x + 0.59) + 0.14), 0.0, 1.0);
-}
+vec3 aces_narkowicz(vec3 x) { return clamp(x * (2.51 * x + 0.03) / (x * (2.43 * x + 0.59) + 0.14), 0.0, 1.0); }
 
-vec3 srgb_encode(vec3 c) {
-  return mix(c * 12.92, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), c));
-}
+vec3 srgb_encode(vec3 c) { return mix(c * 12.92, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), c)); }
 
 void main() {
   vec3 hdr = texelFetch(u_hdr, ivec2(gl_FragCoord.xy), 0).rgb;

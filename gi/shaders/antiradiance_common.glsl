@@ -5,11 +5,10 @@
 
 layout(local_size_x = 64) in;
 
-uniform uint u_bins;    // m
-uniform uint u_items;   // invocations that do work in this dispatch
+uniform uint u_bins;   // m
+uniform uint u_items;  // invocations that do work in this dispatch
 
 uint item_index() {
   const uint group = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
   return group * gl_WorkGroupSize.x + gl_LocalInvocationIndex;
 }
-

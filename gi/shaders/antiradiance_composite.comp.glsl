@@ -9,11 +9,11 @@
 layout(local_size_x = 64) in;
 
 struct TexelBlend {
-  uint texel;     // y * width + x
+  uint texel;  // y * width + x
   uint pad0;
   uint pad1;
   uint pad2;
-  ivec4 leaves;   // -1: unused
+  ivec4 leaves;  // -1: unused
   vec4 weights;
 };
 

@@ -6,36 +6,36 @@
 
 // One uploaded model: its field's geometry and where its data lives.
 struct BrfModel {
-  vec4 centre_inner;     // xyz: field centre (object space), w: innermost sphere radius
-  float outer_radius;    // outermost sphere radius
+  vec4 centre_inner;   // xyz: field centre (object space), w: innermost sphere radius
+  float outer_radius;  // outermost sphere radius
   uint spheres;
   uint face_resolution;
-  uint sh_bands;         // 3 or 4
-  uint basis_count;      // N
-  uint vertex_offset;    // first vertex in the model-vertex buffer
+  uint sh_bands;       // 3 or 4
+  uint basis_count;    // N
+  uint vertex_offset;  // first vertex in the model-vertex buffer
   uint vertex_count;
-  uint psi_offset;       // first float of Psi (N x vertex_count, basis-major) in the psi buffer
-  uint ainv_offset;      // first float of A^-1 (N x N, row-major)
-  uint field_offset;     // first float of the field in its field buffer (a multiple of 4)
-  uint field_buffer;     // which field buffer (one dispatch per buffer)
-  uint terms;            // K: 1 + glossy terms; the field has K x N channels (k x N + i)
-  vec4 box_lo;           // xyz: the object's bounding box (object space), brf_object_box
+  uint psi_offset;    // first float of Psi (N x vertex_count, basis-major) in the psi buffer
+  uint ainv_offset;   // first float of A^-1 (N x N, row-major)
+  uint field_offset;  // first float of the field in its field buffer (a multiple of 4)
+  uint field_buffer;  // which field buffer (one dispatch per buffer)
+  uint terms;         // K: 1 + glossy terms; the field has K x N channels (k x N + i)
+  vec4 box_lo;        // xyz: the object's bounding box (object space), brf_object_box
   vec4 box_hi;
 };
 
 // One placed instance this frame.
 struct BrfInstance {
-  vec4 albedo;           // rgb diffuse albedo
-  vec3 specular;         // rgb glossy colour (glossy models)
-  uint gather_first;     // brf_gather.comp.glsl: its first invocation (4 vertices each)
+  vec4 albedo;        // rgb diffuse albedo
+  vec3 specular;      // rgb glossy colour (glossy models)
+  uint gather_first;  // brf_gather.comp.glsl: its first invocation (4 vertices each)
   uint model;
-  uint vertex_offset;    // first vertex of the instance (the gather's invocation index)
-  uint vertex_count;     // V
-  uint weight_offset;    // first vec4 of its weights: one rgb vec4 per channel (k x N + i), K x N padded to 4
-  uint live_first;       // its live sources in the live-source list
+  uint vertex_offset;  // first vertex of the instance (the gather's invocation index)
+  uint vertex_count;   // V
+  uint weight_offset;  // first vec4 of its weights: one rgb vec4 per channel (k x N + i), K x N padded to 4
+  uint live_first;     // its live sources in the live-source list
   uint live_count;
-  uint value_offset;     // first of its K x V per-vertex values ([k x V + j]) in the value buffers
-  uint terms;            // K
+  uint value_offset;  // first of its K x V per-vertex values ([k x V + j]) in the value buffers
+  uint terms;         // K
 };
 
 // Channels padded to a multiple of 4: Phi rows and weight runs are read as vec4s.

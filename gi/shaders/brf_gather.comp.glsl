@@ -44,8 +44,8 @@ void gather_rows(uint j0, uint last, uint rows, uint r, uint live_first, uint li
   for (uint l = 0u; l < live_count; ++l) {
     const uvec4 src = texelFetch(u_live_sources, int(live_first + l));
     const uint q4 = src.z, stride = rows * q4;
-    const uint a0 = src.y + (j0 * rows + r) * q4, a1 = src.y + (j1 * rows + r) * q4,
-               a2 = src.y + (j2 * rows + r) * q4, a3 = src.y + (j3 * rows + r) * q4;
+    const uint a0 = src.y + (j0 * rows + r) * q4, a1 = src.y + (j1 * rows + r) * q4, a2 = src.y + (j2 * rows + r) * q4,
+               a3 = src.y + (j3 * rows + r) * q4;
     vec3 p0 = vec3(0.0), p1 = vec3(0.0), p2 = vec3(0.0), p3 = vec3(0.0);
     for (uint q = 0u; q < q4; ++q) {
       const int w = int(src.x + 4u * q);
@@ -74,7 +74,10 @@ void main() {
   uint lo = 0u, hi = u_instance_count - 1u;
   while (lo < hi) {
     const uint mid = (lo + hi + 1u) / 2u;
-    if (texelFetch(u_instances, int(4u * mid + 1u)).w <= gi) lo = mid; else hi = mid - 1u;
+    if (texelFetch(u_instances, int(4u * mid + 1u)).w <= gi)
+      lo = mid;
+    else
+      hi = mid - 1u;
   }
   const uint first = texelFetch(u_instances, int(4u * lo + 1u)).w;
   const uvec4 ia = texelFetch(u_instances, int(4u * lo + 2u)), ib = texelFetch(u_instances, int(4u * lo + 3u));

@@ -26,22 +26,22 @@ struct PhiJob {
   mat4 to_source;         // point -> source object space
   mat4 normal_to_source;  // normal -> source object space (mat3 part; normalized after)
   uint source_model;
-  uint point_offset;      // kind 0: first model vertex; kind 1: first entry of static_indices
+  uint point_offset;  // kind 0: first model vertex; kind 1: first entry of static_indices
   uint point_count;
-  uint phi_offset;        // first float written
-  mat4 frame_to_source;   // glossy receiver: rotation (mat3 part) of its object space into the source's
-  uint rows;              // receiver terms K_r (1: diffuse receiver or static point)
-  uint frame_offset;      // glossy receiver: first float of its vertex frames (t, b, n per vertex) in sh_data
-  uint lobe_offset;       // glossy receiver: first float of its lobe SH (16 per glossy term) in sh_data
-  uint lod_points;        // level of detail (brf_lod.h; diffuse receivers): 0, or kind 0: 1 + the receiver's
-                          // first representative point in u_lod (point k is the vertex u_lod[lod_points - 1 + k].x,
-                          // its row the field part only, at phi_offset + k C4); kind 2: 1 + its first vertex entry
-  uint occluder_offset;   // first record in occluders (kind 0): boxes of objects in the pair's way
+  uint phi_offset;       // first float written
+  mat4 frame_to_source;  // glossy receiver: rotation (mat3 part) of its object space into the source's
+  uint rows;             // receiver terms K_r (1: diffuse receiver or static point)
+  uint frame_offset;     // glossy receiver: first float of its vertex frames (t, b, n per vertex) in sh_data
+  uint lobe_offset;      // glossy receiver: first float of its lobe SH (16 per glossy term) in sh_data
+  uint lod_points;       // level of detail (brf_lod.h; diffuse receivers): 0, or kind 0: 1 + the receiver's
+                         // first representative point in u_lod (point k is the vertex u_lod[lod_points - 1 + k].x,
+                         // its row the field part only, at phi_offset + k C4); kind 2: 1 + its first vertex entry
+  uint occluder_offset;  // first record in occluders (kind 0): boxes of objects in the pair's way
   uint occluder_count;
-  uint lod_rows;          // kind 2: first vec4 of the representative points' rows (u_lod_rows)
-  uint lod_shared;        // 1: shared visibility (BrfUpdateSettings::lod_shared_visibility): the points'
-                          // rows carry their visibility, kind 2 interpolates whole rows (kind 2: frame_offset
-                          // holds the vec4s per row)
+  uint lod_rows;    // kind 2: first vec4 of the representative points' rows (u_lod_rows)
+  uint lod_shared;  // 1: shared visibility (BrfUpdateSettings::lod_shared_visibility): the points'
+                    // rows carry their visibility, kind 2 interpolates whole rows (kind 2: frame_offset
+                    // holds the vec4s per row)
 };
 
 // A dynamic object's box standing between a pair (brf_pair_occluders): to_occluder maps the
@@ -64,7 +64,7 @@ layout(binding = 4) uniform usamplerBuffer u_occluders;
 // Unit 6: Phi as vec4s, for kind 2's reads of the representative rows (written by kind 0).
 layout(binding = 5) uniform usamplerBuffer u_lod;
 layout(binding = 6) uniform samplerBuffer u_lod_rows;
-layout(std430, binding = 2) readonly buffer StaticPoints { vec4 static_points[]; };    // position, normal per receiver
+layout(std430, binding = 2) readonly buffer StaticPoints { vec4 static_points[]; };  // position, normal per receiver
 layout(std430, binding = 3) readonly buffer StaticIndices { uint static_indices[]; };
 layout(std430, binding = 5) readonly buffer Groups { uvec2 groups[]; };  // (job, first point)
 // The field: each channel's SH coefficients padded to vec4s (3 for 3 bands, 4 for 4;
@@ -237,11 +237,12 @@ void main() {
   const uint group = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
   if (group >= u_group_count) return;
   const uvec2 g = groups[u_first_group + group];
-  const uint at = 15u * g.x;  // PhiJob
+  const uint at = 15u * g.x;                         // PhiJob
   const uvec4 a = texelFetch(u_jobs, int(at + 8u));  // source_model, point_offset, point_count, phi_offset
   const uint k = g.y + gl_LocalInvocationIndex;
   if (k >= a.z) return;
-  const uvec4 b = texelFetch(u_jobs, int(at + 13u));  // rows, frame_offset (here: vec4s per row), lobe_offset, lod_points
+  // rows, frame_offset (here: vec4s per row), lobe_offset, lod_points
+  const uvec4 b = texelFetch(u_jobs, int(at + 13u));
   const uvec4 c = texelFetch(u_jobs, int(at + 14u));  // occluder_offset, occluder_count, lod_rows, lod_shared
   const uint q4 = b.y, e = b.w - 1u + 2u * k, out0 = a.w / 4u + k * q4;
   float vis = 1.0;
@@ -254,8 +255,9 @@ void main() {
     BrfModel m;
     m.box_lo = texel_f(u_models, 6u * a.x + 4u);
     m.box_hi = texel_f(u_models, 6u * a.x + 5u);
-    vis = brf_horizon(m, p, n) == 0u ? 0.0
-                                     : contact_visibility(m, p, n) * (c.y == 0u ? 1.0 : occluded_visibility(m, p, n, c.x, c.y));
+    vis = brf_horizon(m, p, n) == 0u
+              ? 0.0
+              : contact_visibility(m, p, n) * (c.y == 0u ? 1.0 : occluded_visibility(m, p, n, c.x, c.y));
   }
   if (vis == 0.0) {
     for (uint q = 0u; q < q4; ++q) phi4[out0 + q] = vec4(0.0);
@@ -319,10 +321,12 @@ void main() {
   }
   // What the point sees of the source past the objects in the pair's way (1 without any).
   // (Representative points: none; the vertices they are interpolated to apply their own.)
-  const float vis = (points && job.lod_shared == 0u) ? 1.0
-                           : contact_visibility(m, p, n) *
-                                 (job.occluder_count == 0u ? 1.0
-                                                           : occluded_visibility(m, p, n, job.occluder_offset, job.occluder_count));
+  const float vis =
+      (points && job.lod_shared == 0u)
+          ? 1.0
+          : contact_visibility(m, p, n) * (job.occluder_count == 0u
+                                               ? 1.0
+                                               : occluded_visibility(m, p, n, job.occluder_offset, job.occluder_count));
   if (vis == 0.0) {
     for (uint i = 0u; i < rows * c4; i += 4u) phi4[(row0 + i) / 4u] = vec4(0.0);
     return;

@@ -10,8 +10,8 @@ layout(std430, binding = 0) readonly buffer World { vec4 world[]; };
 layout(std430, binding = 1) readonly buffer Interreflected { vec4 interreflected[]; };
 layout(std430, binding = 2) writeonly buffer Total { vec4 total[]; };
 
-uniform uint u_count;        // values: V x K
-uniform uint u_first_glossy; // V: from here on the glossy terms E_k, drawn x the glossy colour
+uniform uint u_count;         // values: V x K
+uniform uint u_first_glossy;  // V: from here on the glossy terms E_k, drawn x the glossy colour
 uniform vec3 u_specular;
 
 void main() {

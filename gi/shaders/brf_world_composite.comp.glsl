@@ -3,8 +3,8 @@
 // receiver): out_image already holds the static irradiance atlas (light atlas [+ PRM]);
 // every static receiver texel i keeps (1 - occlusion[i]) of it (the share of its incoming
 // light the objects block, BrfResult::static_occlusion) and adds the objects' irradiance
-// bounce[i].xyz, at atlas texel texels[i] (x = t % width, y = t / width). One invocation per receiver; each texel appears
-// once, so there are no write races.
+// bounce[i].xyz, at atlas texel texels[i] (x = t % width, y = t / width). One invocation per receiver; each texel
+// appears once, so there are no write races.
 
 layout(local_size_x = 64) in;
 

@@ -80,15 +80,23 @@ void main() {
   uint texel[8];
   const uvec4 t0 = texelFetch(texels, int(2u * block));
   const uvec4 t1 = texelFetch(texels, int(2u * block + 1u));
-  texel[0] = t0.x; texel[1] = t0.y; texel[2] = t0.z; texel[3] = t0.w;
-  texel[4] = t1.x; texel[5] = t1.y; texel[6] = t1.z; texel[7] = t1.w;
+  texel[0] = t0.x;
+  texel[1] = t0.y;
+  texel[2] = t0.z;
+  texel[3] = t0.w;
+  texel[4] = t1.x;
+  texel[5] = t1.y;
+  texel[6] = t1.z;
+  texel[7] = t1.w;
 
   vec3 sum[8];
   for (uint e = 0u; e < kBlock; ++e) {
     sum[e] = vec3(0.0);
     if (texel[e] != kNoTexel) {
-      if (u_mode == kModeBase) sum[e] = imageLoad(base_image, coord_of(texel[e])).xyz;
-      else if (u_mode == kModeAccumulate) sum[e] = imageLoad(out_image, coord_of(texel[e])).xyz;
+      if (u_mode == kModeBase)
+        sum[e] = imageLoad(base_image, coord_of(texel[e])).xyz;
+      else if (u_mode == kModeAccumulate)
+        sum[e] = imageLoad(out_image, coord_of(texel[e])).xyz;
     }
   }
   for (uint k = 0u; k < chunk.z; ++k) {

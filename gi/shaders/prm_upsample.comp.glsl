@@ -28,8 +28,8 @@ uniform uint u_count;  // records of this dispatch
 uniform uint u_mode;   // 0 reads, 1 a ring, 2 the base over the reads and the rings
 uniform uint u_reads;  // reads (u_mode 2: record k >= u_reads is ring texel k - u_reads)
 
-const ivec2 kNeighbour[8] = ivec2[8](ivec2(-1, -1), ivec2(0, -1), ivec2(1, -1), ivec2(-1, 0), ivec2(1, 0),
-                                     ivec2(-1, 1), ivec2(0, 1), ivec2(1, 1));
+const ivec2 kNeighbour[8] = ivec2[8](ivec2(-1, -1), ivec2(0, -1), ivec2(1, -1), ivec2(-1, 0), ivec2(1, 0), ivec2(-1, 1),
+                                     ivec2(0, 1), ivec2(1, 1));
 
 ivec2 coord_of(uint texel) { return ivec2(int(texel & 0xffffu), int(texel >> 16)); }
 

@@ -1,6 +1,6 @@
 // The PRM sweep's helpers for large levels (gi/src/sweep/prm_sweep.h): the fixed random
 // subset of texels a reference path-traces, the poses that start from the authored light,
-// and the reference key of a subset.
+// the reference key of a subset, and the swing and world knobs in it.
 #include <gtest/gtest.h>
 
 #include <cstddef>
@@ -12,8 +12,11 @@
 #include "sweep/builtin_methods.h"
 #include "sweep/knob_grid.h"
 #include "sweep/prm_sweep.h"
+#include "sweep_fixtures.h"
 
 namespace {
+
+using sweeptest::make_scene;
 
 gi::AtlasTexels texels_with_valid(const std::vector<std::uint8_t>& valid) {
   gi::AtlasTexels t;
@@ -79,6 +82,29 @@ TEST(PrmSweep, TexelSubsetNamesItselfInTheReferenceKeyOnlyWhenSet) {
   ASSERT_TRUE(grid2) << grid2.error().to_string();
   EXPECT_EQ(prm->reference_for(scene, grid2->settings()[0]).key(),
             "atlas_indirect_irradiance_posed(pose=along,spp=4096,texels_per_m=4)");
+}
+
+// The PRM's swing and world knobs name themselves in the reference key only when set, so the
+// references of unswung, all-instance runs keep the keys (and cache files) they had before.
+TEST(BuiltinSweepMethods, PrmSwingAndWorldKeepDefaultReferenceKeys) {
+  gi::SweepRegistry reg;
+  gi::register_builtin_sweep_methods(reg);
+  const gi::SweepMethod* prm = reg.find_method("prm");
+  ASSERT_NE(prm, nullptr);
+  const gi::SweepScene scene = make_scene();
+  const std::vector<std::string> plain = {"entries=256", "clusters=32", "pose=corner"};
+  auto grid = gi::make_knob_grid(*prm, plain);
+  ASSERT_TRUE(grid) << grid.error().to_string();
+  ASSERT_EQ(grid->settings().size(), 1u);
+  EXPECT_EQ(prm->reference_for(scene, grid->settings()[0]).key(),
+            "atlas_indirect_irradiance_posed(pose=corner,spp=4096,texels_per_m=4)");
+  const std::vector<std::string> swung = {"entries=256", "clusters=32", "pose=corner", "swing=-20", "world=static"};
+  auto grid2 = gi::make_knob_grid(*prm, swung);
+  ASSERT_TRUE(grid2) << grid2.error().to_string();
+  EXPECT_EQ(prm->reference_for(scene, grid2->settings()[0]).key(),
+            "atlas_indirect_irradiance_posed(pose=corner,spp=4096,swing=-20,texels_per_m=4,world=static)");
+  const std::vector<std::string> bad = {"world=some"};
+  EXPECT_FALSE(gi::make_knob_grid(*prm, bad));
 }
 
 }  // namespace

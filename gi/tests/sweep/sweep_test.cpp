@@ -1,8 +1,7 @@
 // The sweep harness (gi/src/sweep): knob grids, runs against a cached reference, the
 // Pareto front and presets, CSV round trips, the reference cache's integrity checks and
 // atomic writes. The method and the reference provider here are synthetic and exist in
-// this test only.
-#include <unistd.h>
+// this test only. The built-in methods' own runs are tested in <method>_sweep_test.cpp.
 #include <gtest/gtest.h>
 #include <engine/scene.h>
 #include <gi/bake_input.h>
@@ -17,7 +16,6 @@
 
 #include "io/atomic_file.h"
 #include "sweep/builtin_methods.h"
-#include "sweep/glossy_texels.h"
 #include "sweep/knob_grid.h"
 #include "sweep/pareto_front.h"
 #include "sweep/reference_cache.h"
@@ -25,28 +23,14 @@
 #include "sweep/sweep_csv.h"
 #include "sweep/sweep_runner.h"
 #include "sweep/sweep_summary.h"
+#include "sweep_fixtures.h"
 
 namespace fs = std::filesystem;
 
 namespace {
 
-/// A fresh directory under the build tree, removed at the end of the test.
-class TempDir {
- public:
-  explicit TempDir(const std::string& name)
-      : path_(fs::path(GI_BINARY_DIR) / "sweep_test_tmp" / (name + "-" + std::to_string(::getpid()))) {
-    fs::remove_all(path_);
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-};
+using sweeptest::make_scene;
+using sweeptest::TempDir;
 
 std::string read_bytes(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
@@ -56,17 +40,6 @@ std::string read_bytes(const fs::path& p) {
 void write_bytes(const fs::path& p, const std::string& bytes) {
   std::ofstream out(p, std::ios::binary | std::ios::trunc);
   out << bytes;
-}
-
-/// A scene built in memory: one light whose colour the tests change to change the content.
-gi::SweepScene make_scene(float light_red = 1.0f) {
-  gi::SweepScene s;
-  engine::NamedLight l;
-  l.name = "key";
-  l.light.color = {light_red, 1.0f, 1.0f};
-  s.asset.lights.push_back(l);
-  s.content_hash = gi::scene_fingerprint({}, s.asset).value();
-  return s;
 }
 
 /// The synthetic world of these tests: a provider that counts its calls, and a method whose
@@ -540,188 +513,6 @@ TEST(BuiltinSweepMethods, RegisterOnlyRealMethods) {
   gi::SweepRegistry reg;
   gi::register_builtin_sweep_methods(reg);
   for (const gi::SweepMethod& m : reg.methods()) EXPECT_TRUE(m.run) << m.name;
-}
-
-// The PRM's swing and world knobs name themselves in the reference key only when set, so the
-// references of unswung, all-instance runs keep the keys (and cache files) they had before.
-TEST(BuiltinSweepMethods, PrmSwingAndWorldKeepDefaultReferenceKeys) {
-  gi::SweepRegistry reg;
-  gi::register_builtin_sweep_methods(reg);
-  const gi::SweepMethod* prm = reg.find_method("prm");
-  ASSERT_NE(prm, nullptr);
-  const gi::SweepScene scene = make_scene();
-  const std::vector<std::string> plain = {"entries=256", "clusters=32", "pose=corner"};
-  auto grid = gi::make_knob_grid(*prm, plain);
-  ASSERT_TRUE(grid) << grid.error().to_string();
-  ASSERT_EQ(grid->settings().size(), 1u);
-  EXPECT_EQ(prm->reference_for(scene, grid->settings()[0]).key(),
-            "atlas_indirect_irradiance_posed(pose=corner,spp=4096,texels_per_m=4)");
-  const std::vector<std::string> swung = {"entries=256", "clusters=32", "pose=corner", "swing=-20", "world=static"};
-  auto grid2 = gi::make_knob_grid(*prm, swung);
-  ASSERT_TRUE(grid2) << grid2.error().to_string();
-  EXPECT_EQ(prm->reference_for(scene, grid2->settings()[0]).key(),
-            "atlas_indirect_irradiance_posed(pose=corner,spp=4096,swing=-20,texels_per_m=4,world=static)");
-  const std::vector<std::string> bad = {"world=some"};
-  EXPECT_FALSE(gi::make_knob_grid(*prm, bad));
-}
-
-}  // namespace
-
-namespace {
-
-// The dlm method end to end on the glossy room (a coarse reference, 128 lobe samples per
-// texel): every run valid, and the directional light maps beat the direction-less atlas term
-// (E/pi x specular albedo) on the specular indirect light they add (docs/dlm.md, measured
-// with 1024 samples: 0.46 against 0.66 at 32 directions x 1 M photons).
-TEST(DlmSweep, GlossyRoomBeatsTheDirectionlessAtlasTerm) {
-  TempDir dir("dlm");
-  gi::SweepRequest request;
-  request.method = "dlm";
-  request.scene = fs::path(GI_SOURCE_DIR) / "assets" / "glossy_room.gltf";
-  request.knobs = {"directions=32", "kphotons=300", "ref_spp=128"};
-  request.out_dir = dir.path();
-  auto report = gi::run_sweep(request);
-  ASSERT_TRUE(report) << report.error().to_string();
-  ASSERT_EQ(report->runs, 1u);
-  EXPECT_TRUE(report->failures.empty());
-  std::ifstream in(report->csv);
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  auto rows = gi::parse_sweep_csv(text, report->csv.string());
-  ASSERT_TRUE(rows) << rows.error().to_string();
-  ASSERT_EQ(rows->size(), 1u);
-  const gi::SweepRow& row = rows->front();
-  ASSERT_TRUE(row.ok()) << row.status;
-  double atlas = std::numeric_limits<double>::quiet_NaN();
-  for (const auto& [name, value] : row.extras)
-    if (name == "atlas_rel_rmse") atlas = value;
-  std::printf("dlm on the glossy room: rel RMSE %.3f, direction-less atlas term %.3f\n", row.error.rel_rmse, atlas);
-  EXPECT_TRUE(std::isfinite(row.error.rel_rmse));
-  EXPECT_LT(row.error.rel_rmse, 0.6);
-  EXPECT_LT(row.error.rel_rmse, 0.85 * atlas);
-}
-
-}  // namespace
-
-namespace {
-
-// The antiradiance method end to end on the corridor, coarse (0.8 m elements, 36 bins, 4
-// iterations, a 256-spp reference at 4 texels/m): the run is valid, its cost columns and
-// extras are filled, the GPU passes give the CPU twin's result, and the mean change it adds
-// over the compared texels (the zone average the corridor test compares) is within a fifth
-// of their mean indirect level of the path tracer's at every angle. Per texel it is not
-// (docs/antiradiance.md, "Accuracy and its cost": the per-texel change near the door is
-// barely correlated with the true one), which the test prints but cannot bound usefully.
-TEST(AntiradianceSweep, CorridorDoorSwingRunIsMeasured) {
-  TempDir dir("antiradiance");
-  gi::SweepRequest request;
-  request.method = "antiradiance";
-  request.scene = fs::path(GI_SOURCE_DIR) / "assets" / "corridor.gltf";
-  request.knobs = {"patch=0.8", "bins=6", "iterations=4", "density=4", "ref_spp=256"};
-  request.out_dir = dir.path();
-  auto report = gi::run_sweep(request);
-  ASSERT_TRUE(report) << report.error().to_string();
-  ASSERT_EQ(report->runs, 1u);
-  EXPECT_TRUE(report->failures.empty());
-  std::ifstream in(report->csv);
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  auto rows = gi::parse_sweep_csv(text, report->csv.string());
-  ASSERT_TRUE(rows) << rows.error().to_string();
-  ASSERT_EQ(rows->size(), 1u);
-  const gi::SweepRow& row = rows->front();
-  ASSERT_TRUE(row.ok()) << row.status;
-  auto extra = [&](const std::string& name) {
-    for (const auto& [n, v] : row.extras)
-      if (n == name) return v;
-    ADD_FAILURE() << "no extra " << name;
-    return std::numeric_limits<double>::quiet_NaN();
-  };
-  std::printf(
-      "antiradiance on the corridor: rel RMSE %.4f (changing nothing %.4f), correlation %.3f; %.0f ms per door "
-      "move (CPU), %.0f ms (GPU), %.1f MB file, %.1f MB GPU\n",
-      row.error.rel_rmse, extra("nothing_rel_rmse"), extra("change_correlation"), row.costs.frame_ms,
-      extra("gpu_frame_ms"), static_cast<double>(row.costs.bytes) / 1e6, extra("gpu_bytes") / 1e6);
-  EXPECT_TRUE(std::isfinite(row.error.rel_rmse));
-  EXPECT_GT(row.costs.frame_ms, 0.0);
-  EXPECT_GT(row.costs.bytes, 1000u);
-  EXPECT_GT(extra("gpu_bytes"), 0.0);
-  EXPECT_LT(extra("gpu_cpu_rel_diff"), 1e-3);
-  EXPECT_GT(extra("compared_texels"), 100.0);
-  // The floor the per-leaf output sets (the true change through the leaves) is measured, and
-  // is below changing nothing: the projection keeps some of the change.
-  std::printf("  projection floor %.4f, %.1f iterations per move, largest residual %.2e\n",
-              extra("projection_floor_rel_rmse"), extra("solve_iterations"), extra("solve_residual_max"));
-  EXPECT_LT(extra("projection_floor_rel_rmse"), extra("nothing_rel_rmse"));
-  EXPECT_GT(extra("solve_iterations"), 0.0);
-  // The door changes the light: the path tracer's change is not zero.
-  EXPECT_GT(extra("nothing_rel_rmse"), 0.0);
-  for (const char* swing : {"m50", "m25", "p50"}) {
-    const double truth = extra(std::string("true_mean_change_swing_") + swing);
-    const double error = extra(std::string("mean_change_error_swing_") + swing);
-    std::printf("  swing %s: true mean change %+.4f, error of the method's %+.4f (/ level)\n", swing, truth, error);
-    EXPECT_LT(std::abs(error), 0.2) << swing;
-  }
-}
-
-}  // namespace
-
-namespace {
-
-// The cause of the reflection probes' first border error (0.73 against the path tracer on the
-// glossy room): the floor's border texels had their raster samples on the line where the
-// walls begin, and the reference's lobe rays from there slipped behind the walls (a truth of
-// 0 under a lit probe). Placed where a camera sees the floor, no sample lies on a wall.
-TEST(GlossyTexels, VisibleSurfaceSamplesStayOffTheWalls) {
-  auto scene = gi::load_sweep_scene(fs::path(GI_SOURCE_DIR) / "assets" / "glossy_room.gltf");
-  ASSERT_TRUE(scene) << scene.error().to_string();
-  const auto on_a_wall = [](const gi::GlossyTexels& g) {  // the room's walls: x = +-4 m, z = +-2.5 m
-    int n = 0;
-    for (std::size_t t = 0; t < g.glossy.size(); ++t) {
-      const glm::vec3 p = g.s.texels.position[t];
-      if (g.glossy[t] && (std::abs(std::abs(p.x) - 4.0f) < 1e-3f || std::abs(std::abs(p.z) - 2.5f) < 1e-3f)) ++n;
-    }
-    return n;
-  };
-  auto raster = gi::glossy_texels(*scene, 8.0, 0.2, nullptr, gi::TexelPlacement::Raster);
-  auto visible = gi::glossy_texels(*scene, 8.0, 0.2, nullptr, gi::TexelPlacement::VisibleSurface);
-  ASSERT_TRUE(raster && visible);
-  EXPECT_GT(on_a_wall(*raster), 50);
-  EXPECT_EQ(on_a_wall(*visible), 0);
-}
-
-double extra(const gi::SweepRow& row, const std::string& name) {
-  for (const auto& [n, v] : row.extras)
-    if (n == name) return v;
-  return std::numeric_limits<double>::quiet_NaN();
-}
-
-// The reflection probes end to end on the glossy room at roughness 0.2 (32^2 faces, a coarse
-// 128-sample reference): inside the probe's box and at its borders the error against the path
-// tracer's noise-free truth stays under the targets with a margin for the coarse
-// reference (docs/reflection_probes.md, "Accuracy": 0.24 / 0.25 measured with 1024 samples).
-TEST(ReflectionProbesSweep, GlossyRoomReflectionsFollowThePathTracer) {
-  TempDir dir("reflection_probes");
-  gi::SweepRequest request;
-  request.method = "reflection_probes";
-  request.scene = fs::path(GI_SOURCE_DIR) / "assets" / "glossy_room.gltf";
-  request.knobs = {"resolution=32", "roughness=0.2", "ref_spp=128"};
-  request.out_dir = dir.path();
-  request.threads = 2;
-  auto report = gi::run_sweep(request);
-  ASSERT_TRUE(report) << report.error().to_string();
-  ASSERT_EQ(report->runs, 1u);
-  std::ifstream in(report->csv);
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  auto rows = gi::parse_sweep_csv(text, report->csv.string());
-  ASSERT_TRUE(rows) << rows.error().to_string();
-  ASSERT_EQ(rows->size(), 1u);
-  const gi::SweepRow& row = rows->front();
-  ASSERT_TRUE(row.ok()) << row.status;
-  const double volume = extra(row, "volume_truth_rel_rmse"), border = extra(row, "border_truth_rel_rmse");
-  std::printf("reflection probes on the glossy room: volume %.3f, border %.3f\n", volume, border);
-  EXPECT_LT(volume, 0.35);
-  EXPECT_LT(border, 0.4);
-  EXPECT_EQ(extra(row, "uncovered_texels"), 0.0);
-  EXPECT_LT(std::abs(extra(row, "bias_cos0.3_0.6")), 0.15);
 }
 
 }  // namespace
