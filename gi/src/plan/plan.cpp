@@ -224,7 +224,11 @@ void plan_light_atlas(const PlanFacts& f, const std::optional<PlanPresets>& p, P
           std::to_string(t.height) + ") x " +
           (p->atlas.final_pass == LightAtlasSettings::FinalPass::TexelGather
                ? std::to_string(p->atlas.gather.solve_rays) + " kept + " + std::to_string(p->atlas.gather.gather_rays) +
-                     " gather rays"
+                     " gather" +
+                     (p->atlas.gather.emitter_rays > 0
+                          ? " + " + std::to_string(p->atlas.gather.emitter_rays) + " emitter-sampled"
+                          : std::string()) +
+                     " rays"
                : std::to_string(p->atlas.vpl_count) + " VPLs, " + std::to_string(p->atlas.bounces) + " bounces")};
 }
 
