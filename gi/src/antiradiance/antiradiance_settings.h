@@ -14,6 +14,9 @@ enum class AntiradianceScheme : std::uint8_t {
   Asymmetric,  ///< Per radiance step (eq. 13), `antiradiance_steps` steps of eq. 14 with L frozen.
 };
 
+/// The most pieces per link end a bake may ask for (the sweep's grid and a file's check).
+inline constexpr int kMaxLeafLinkPieces = 4096;
+
 struct AntiradianceSettings {
   /// Octahedral cells per side: bins = n^2 (8: 64 bins; the paper uses 128, n = 11 or 12 comes closest).
   int bins_per_side = 8;
@@ -29,7 +32,8 @@ struct AntiradianceSettings {
   /// Leaf-leaf links that fail the oracle (issue 37): each end is split virtually into up to
   /// this many equal-area disc pieces, as many as the oracle asks for at the pair's distance,
   /// each piece pair with its own distance and bin (link_mesh.h); 0: off (the two leaves are
-  /// linked regardless, as one disc). Not stored in a bundle: sweep-only until a preset uses it.
+  /// linked regardless, as one disc). Stored in antiradiance.bin (version 3): a load relinks
+  /// the deforming elements with it.
   int leaf_link_pieces = 0;
   /// Static triangles within this distance of the deforming region's swept bounds exchange
   /// light with it (metres).
