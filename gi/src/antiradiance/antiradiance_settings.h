@@ -60,11 +60,18 @@ struct AntiradianceSettings {
   std::uint64_t seed = 1;
 };
 
-/// The leaf size gi-bake bakes a preset at: 0.8 / 0.6 / 0.4 m at preview / medium / high
-/// (docs/sweeps/antiradiance_corridor.md: the element size barely moves the error; bins and
-/// iterations do).
-inline float antiradiance_preset_patch_size(std::string_view preset) {
-  return preset == "high" ? 0.4f : preset == "medium" ? 0.6f : 0.8f;
+/// The settings gi-bake bakes a preset at (and the planner estimates; issue 37, measured by
+/// gi-sweep on the corridor, docs/antiradiance.md "Issue 37: the presets"): 0.8 m leaves at
+/// every preset (0.6 / 0.4 m were worse at every bin count and cost 2-4x), the leaf links
+/// split to meet the oracle (at most 64 pieces per end: better at the same cost), and
+/// 64 / 144 / 400 bins at preview / medium / high (the bins buy the accuracy, at 2.4x / 5x the
+/// preview's door move and file).
+inline AntiradianceSettings antiradiance_preset(std::string_view preset) {
+  AntiradianceSettings s;
+  s.patch_size_m = 0.8f;
+  s.leaf_link_pieces = 64;
+  s.bins_per_side = preset == "high" ? 20 : preset == "medium" ? 12 : 8;
+  return s;
 }
 
 }  // namespace gi
