@@ -64,13 +64,15 @@ struct AntiradianceSettings {
 /// gi-sweep on the corridor, docs/antiradiance.md "Issue 37: the presets"): 0.8 m leaves at
 /// every preset (0.6 / 0.4 m were worse at every bin count and cost 2-4x), the leaf links
 /// split to meet the oracle (at most 64 pieces per end: better at the same cost), and
-/// 64 / 144 / 400 bins at preview / medium / high (the bins buy the accuracy, at 2.4x / 5x the
-/// preview's door move and file).
+/// 64 / 144 / 324 bins at preview / medium / high (the bins buy the accuracy, at 2.4x / ~4x
+/// the preview's door move and file; 256 bins scored worse than 144 at the door's fourth angle,
+/// and 400 bins put the demo level's 17.3 M static links at 138 MB, above llvmpipe's 128 MiB
+/// SSBO limit for the GPU pass).
 inline AntiradianceSettings antiradiance_preset(std::string_view preset) {
   AntiradianceSettings s;
   s.patch_size_m = 0.8f;
   s.leaf_link_pieces = 64;
-  s.bins_per_side = preset == "high" ? 20 : preset == "medium" ? 12 : 8;
+  s.bins_per_side = preset == "high" ? 18 : preset == "medium" ? 12 : 8;
   return s;
 }
 
