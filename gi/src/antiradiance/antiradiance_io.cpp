@@ -86,9 +86,8 @@ class Reader {
 
 bool finite3(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
-// Empty when the bake's arrays fit together and its values are valid, else what is wrong.
-std::string check_bake(const AntiradianceBake& b) {
-  const AntiradianceSettings& s = b.settings;
+// Empty when the settings a load uses (bins, leaf size, relinking, scheme) are valid, else what is wrong.
+std::string check_settings(const AntiradianceSettings& s) {
   if (s.bins_per_side < 1 || s.bins_per_side > 64) return "bins_per_side outside 1..64";
   if (!(s.patch_size_m > 0.0f) || !std::isfinite(s.patch_size_m)) return "patch_size_m must be positive";
   if (!(s.near_patch_size_m >= 0.0f) || !std::isfinite(s.near_patch_size_m))
@@ -98,6 +97,12 @@ std::string check_bake(const AntiradianceBake& b) {
   if (s.leaf_link_pieces < 0 || s.leaf_link_pieces > kMaxLeafLinkPieces)
     return "leaf_link_pieces outside 0.." + std::to_string(kMaxLeafLinkPieces);
   if (s.scheme != AntiradianceScheme::Symmetric && s.scheme != AntiradianceScheme::Asymmetric) return "unknown scheme";
+  return {};
+}
+
+// Empty when the bake's arrays fit together and its values are valid, else what is wrong.
+std::string check_bake(const AntiradianceBake& b) {
+  if (std::string problem = check_settings(b.settings); !problem.empty()) return problem;
   const ElementHierarchy& h = b.hierarchy;
   const std::size_t n = h.nodes.size();
   const auto in_nodes = [n](std::int64_t i) { return i >= 0 && static_cast<std::size_t>(i) < n; };
@@ -129,7 +134,7 @@ std::string check_bake(const AntiradianceBake& b) {
     if (i > 0 && e.parent >= static_cast<std::int32_t>(i))
       return "element " + std::to_string(i) + " follows its parent";
   }
-  const std::int32_t bins = s.bins_per_side * s.bins_per_side;
+  const std::int32_t bins = b.settings.bins_per_side * b.settings.bins_per_side;
   for (std::size_t k = 0; k < b.static_links.links.size(); ++k) {
     const Link& l = b.static_links.links[k];
     if (!in_nodes(l.receiver) || !in_nodes(l.sender) || l.bin < 0 || l.bin >= bins || !std::isfinite(l.form_factor) ||
