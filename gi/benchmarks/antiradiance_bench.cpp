@@ -1,7 +1,10 @@
 // Per-frame cost of the antiradiance region of assets/corridor.gltf (the door) at the
 // preview bake settings (0.8 m elements, 64 bins): what a frame where the door moved costs,
 // phase by phase. llvmpipe timings are CPU timings (DESIGN.md §4); GPU phases end in glFinish.
-//   ./build/gi/benchmarks/antiradiance_bench
+// BM_DoorMoveAtPreset (issue 37): one door move at a gi-bake preset's settings, from the bake
+// as a load gets it, against re-baking the corridor's light atlas at the same preset in the
+// same run (what a door without antiradiance would cost).
+//   ./build/gi/benchmarks/antiradiance_bench --benchmark_counters_tabular=true
 #include <GL/glcorearb.h>
 #include <benchmark/benchmark.h>
 #include <engine/gltf.h>
@@ -9,12 +12,17 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <map>
+#include <string>
 #include <vector>
 
 #include "antiradiance/antiradiance_gpu_pass.h"
 #include "antiradiance/antiradiance_region.h"
 #include "antiradiance/antiradiance_solver.h"
 #include "bench_gl.h"
+#include "light_atlas/light_atlas.h"
 
 namespace {
 
@@ -153,6 +161,65 @@ void BM_AntiradianceDoorMoveCpu(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_AntiradianceDoorMoveCpu)->Arg(8)->Arg(4)->Arg(2)->Unit(benchmark::kMillisecond)->Iterations(3);
+
+const char* preset_name(std::int64_t arg) { return arg == 0 ? "preview" : arg == 1 ? "medium" : "high"; }
+
+// The corridor's light atlas re-baked at `preset` with the door shut (once per preset and
+// process, ms): the yardstick of a door move.
+double atlas_rebake_ms(const char* preset) {
+  static std::map<std::string, double> measured;
+  if (auto it = measured.find(preset); it != measured.end()) return it->second;
+  Corridor& c = corridor();
+  gi::BakeInput shut = c.input;
+  shut.instances[c.door_instance].object_to_world = door(0.0f);
+  auto settings = gi::light_atlas_preset(preset);
+  if (!settings) std::exit(1);
+  const auto t0 = std::chrono::steady_clock::now();
+  auto atlas = gi::bake_light_atlas(shut, *settings);
+  if (!atlas) {
+    std::fprintf(stderr, "%s\n", atlas.error().to_string().c_str());
+    std::exit(1);
+  }
+  benchmark::DoNotOptimize(atlas->irradiance.data());
+  return measured[preset] = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// One door move at a gi-bake preset (arg: 0 preview, 1 medium, 2 high; gi::antiradiance_preset):
+// the region made from the preset's bake as a load makes it, then per iteration the door to
+// the next of 0 / 25 / 100 degrees, relink + direct light + the solve to its tolerance on
+// the CPU twin (the sweep's cpu move + solve). Counters: door_move_ms (mean), atlas_rebake_ms,
+// vs_rebake = atlas_rebake_ms / door_move_ms, iterations (mean), links, leaves.
+void BM_DoorMoveAtPreset(benchmark::State& state) {
+  Corridor& c = corridor();
+  const char* preset = preset_name(state.range(0));
+  const double rebake_ms = atlas_rebake_ms(preset);
+  gi::AntiradianceSettings s = gi::antiradiance_preset(preset);
+  auto bake = gi::bake_antiradiance(c.input, s);
+  if (!bake) std::exit(1);
+  auto region = gi::AntiradianceRegion::create(c.input, std::move(bake).value());
+  if (!region) std::exit(1);
+  region->update();  // the baked pose's solve, as the first frame after a load
+  constexpr float kAngles[] = {0.0f, 25.0f, 100.0f};
+  std::size_t k = 0;
+  double total_ms = 0.0, iterations = 0.0;
+  for (auto _ : state) {
+    const auto t0 = std::chrono::steady_clock::now();
+    region->set_instance_transform(c.door_instance, door(kAngles[k++ % std::size(kAngles)]));
+    const gi::AntiradianceSolveReport rep = region->update();
+    benchmark::DoNotOptimize(region->irradiance().data());
+    total_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    iterations += rep.iterations;
+  }
+  const double moves = static_cast<double>(state.iterations());
+  state.counters["door_move_ms"] = total_ms / moves;
+  state.counters["atlas_rebake_ms"] = rebake_ms;
+  state.counters["vs_rebake"] = rebake_ms / (total_ms / moves);
+  state.counters["iterations"] = iterations / moves;
+  state.counters["links"] = static_cast<double>(region->links().links.size());
+  state.counters["leaves"] = static_cast<double>(region->hierarchy().leaf_count());
+  state.counters["bins"] = static_cast<double>(region->bins().count());
+}
+BENCHMARK(BM_DoorMoveAtPreset)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->Iterations(3);
 
 // The yardstick for ratios on shared cores: sorting 1.6 M random 16-byte records by
 // (receiver, bin, sender) -- the job a relink did in full before it merged (a fixed

@@ -86,12 +86,23 @@ class Reader {
 
 bool finite3(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
-// Empty when the bake's arrays fit together and its values are valid, else what is wrong.
-std::string check_bake(const AntiradianceBake& b) {
-  const AntiradianceSettings& s = b.settings;
+// Empty when the settings a load uses (bins, leaf size, relinking, scheme) are valid, else what is wrong.
+std::string check_settings(const AntiradianceSettings& s) {
   if (s.bins_per_side < 1 || s.bins_per_side > 64) return "bins_per_side outside 1..64";
   if (!(s.patch_size_m > 0.0f) || !std::isfinite(s.patch_size_m)) return "patch_size_m must be positive";
+  if (!(s.near_patch_size_m >= 0.0f) || !std::isfinite(s.near_patch_size_m))
+    return "near_patch_size_m must be finite and not negative";
+  if (!(s.near_radius_m >= 0.0f) || !std::isfinite(s.near_radius_m))
+    return "near_radius_m must be finite and not negative";
+  if (s.leaf_link_pieces < 0 || s.leaf_link_pieces > kMaxLeafLinkPieces)
+    return "leaf_link_pieces outside 0.." + std::to_string(kMaxLeafLinkPieces);
   if (s.scheme != AntiradianceScheme::Symmetric && s.scheme != AntiradianceScheme::Asymmetric) return "unknown scheme";
+  return {};
+}
+
+// Empty when the bake's arrays fit together and its values are valid, else what is wrong.
+std::string check_bake(const AntiradianceBake& b) {
+  if (std::string problem = check_settings(b.settings); !problem.empty()) return problem;
   const ElementHierarchy& h = b.hierarchy;
   const std::size_t n = h.nodes.size();
   const auto in_nodes = [n](std::int64_t i) { return i >= 0 && static_cast<std::size_t>(i) < n; };
@@ -123,7 +134,7 @@ std::string check_bake(const AntiradianceBake& b) {
     if (i > 0 && e.parent >= static_cast<std::int32_t>(i))
       return "element " + std::to_string(i) + " follows its parent";
   }
-  const std::int32_t bins = s.bins_per_side * s.bins_per_side;
+  const std::int32_t bins = b.settings.bins_per_side * b.settings.bins_per_side;
   for (std::size_t k = 0; k < b.static_links.links.size(); ++k) {
     const Link& l = b.static_links.links[k];
     if (!in_nodes(l.receiver) || !in_nodes(l.sender) || l.bin < 0 || l.bin >= bins || !std::isfinite(l.form_factor) ||
@@ -283,6 +294,9 @@ json settings_json(const AntiradianceSettings& s) {
               {"residual_tolerance", s.residual_tolerance},
               {"growth_limit", s.growth_limit},
               {"area_light_samples", s.area_light_samples},
+              {"near_patch_size_m", s.near_patch_size_m},
+              {"near_radius_m", s.near_radius_m},
+              {"leaf_link_pieces", s.leaf_link_pieces},
               {"seed", s.seed}};
 }
 
@@ -305,6 +319,9 @@ engine::Status write_antiradiance(const fs::path& path, const AntiradianceBake& 
   w.put(static_cast<std::int32_t>(s.growth_limit));
   w.put(static_cast<std::int32_t>(s.area_light_samples));
   w.put(static_cast<std::uint64_t>(s.seed));
+  w.put(s.near_patch_size_m);
+  w.put(s.near_radius_m);
+  w.put(static_cast<std::int32_t>(s.leaf_link_pieces));
   const ElementHierarchy& h = b.hierarchy;
   w.array(h.deforming_instances);
   w.array(h.group_transform);
@@ -334,16 +351,16 @@ engine::Result<AntiradianceFile> read_antiradiance(const fs::path& path) {
   AntiradianceFile f;
   AntiradianceSettings& s = f.bake.settings;
   ElementHierarchy& h = f.bake.hierarchy;
-  std::int32_t bins = 0, iterations = 0, steps = 0, growth = 0, samples = 0;
+  std::int32_t bins = 0, iterations = 0, steps = 0, growth = 0, samples = 0, pieces = 0;
   std::uint8_t scheme = 0;
   std::uint64_t seed = 0;
-  const bool ok = r.string(f.geometry_hash) && r.get(bins) && r.get(s.patch_size_m) && r.get(s.exchange_radius_m) &&
-                  r.get(s.oracle_scale) && r.get(iterations) && r.get(steps) && r.get(scheme) &&
-                  r.get(s.residual_tolerance) && r.get(growth) && r.get(samples) && r.get(seed) &&
-                  r.array(h.deforming_instances) && r.array(h.group_transform) && r.array(h.nodes) &&
-                  r.array(h.children) && r.array(h.leaves) && r.array(h.group_root) && r.array(h.node_instance) &&
-                  r.array(h.object_center) && r.array(h.object_normal) && r.array(h.object_radius) &&
-                  r.array(h.object_area);
+  const bool ok =
+      r.string(f.geometry_hash) && r.get(bins) && r.get(s.patch_size_m) && r.get(s.exchange_radius_m) &&
+      r.get(s.oracle_scale) && r.get(iterations) && r.get(steps) && r.get(scheme) && r.get(s.residual_tolerance) &&
+      r.get(growth) && r.get(samples) && r.get(seed) && r.get(s.near_patch_size_m) && r.get(s.near_radius_m) &&
+      r.get(pieces) && r.array(h.deforming_instances) && r.array(h.group_transform) && r.array(h.nodes) &&
+      r.array(h.children) && r.array(h.leaves) && r.array(h.group_root) && r.array(h.node_instance) &&
+      r.array(h.object_center) && r.array(h.object_normal) && r.array(h.object_radius) && r.array(h.object_area);
   std::uint64_t link_count = 0;
   std::vector<std::uint8_t> frame;
   if (!ok || !r.get(link_count) || !r.array(frame) || !r.array(f.bake.baseline))
@@ -362,6 +379,7 @@ engine::Result<AntiradianceFile> read_antiradiance(const fs::path& path) {
   s.growth_limit = growth;
   s.area_light_samples = samples;
   s.seed = seed;
+  s.leaf_link_pieces = pieces;
   if (std::string problem = check_bake(f.bake); !problem.empty()) return file_error(path, "", problem);
   index_links(h.nodes.size(), f.bake.static_links);
   f.bake.static_links.links_made = f.bake.static_links.links.size();

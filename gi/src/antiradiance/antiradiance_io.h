@@ -5,8 +5,10 @@
 //   auto bake = gi::load_antiradiance("level.gibake", input);   // checks the geometry hash
 //
 // Files (DESIGN.md §5, docs/bake-bundle.md):
-//   antiradiance.bin  the checksummed container of io/blob_file.h, magic "GIANTIRA", version 2
-//                     (version 1 stored the links as 16-byte records: 2.5-3x larger; re-bake).
+//   antiradiance.bin  the checksummed container of io/blob_file.h, magic "GIANTIRA", version 3
+//                     (version 2 lacked the refinement settings below, so a load relinked the
+//                     door without split leaf links; version 1 stored the links as 16-byte
+//                     records. Both are refused by name: re-bake).
 //   antiradiance_at_pose.bin  magic "GIANTPOS", version 1: what a load at the baked pose
 //                     would compute (AntiradianceBake::AtBakedPose), written by the bake so
 //                     the load reads it (absent: the load computes it). Payload:
@@ -30,7 +32,8 @@
 //   string   geometry_hash                 uint64 length + chars
 //   int32 bins_per_side, float32 patch_size_m, float32 exchange_radius_m, float32 oracle_scale,
 //   int32 iterations, int32 antiradiance_steps, uint8 scheme, float64 residual_tolerance,
-//   int32 growth_limit, int32 area_light_samples, uint64 seed      AntiradianceSettings
+//   int32 growth_limit, int32 area_light_samples, uint64 seed,
+//   float32 near_patch_size_m, float32 near_radius_m, int32 leaf_link_pieces  AntiradianceSettings
 //   array<uint32> deforming_instances      BakeInput instance of each deforming group
 //   array<mat4>   group_transform          the pose each group was baked at
 //   array<node>   nodes                    ElementNode, 18 x 4 bytes: center vec3, radius,
@@ -64,7 +67,7 @@ namespace gi {
 inline constexpr const char* kAntiradianceMethod = "antiradiance";
 inline constexpr const char* kAntiradianceFile = "antiradiance.bin";
 inline constexpr BlobMagic kAntiradianceMagic{"GIANTIRA"};
-inline constexpr std::uint32_t kAntiradianceVersion = 2;
+inline constexpr std::uint32_t kAntiradianceVersion = 3;
 /// What the bake computed for a load at its pose (AntiradianceBake::AtBakedPose).
 inline constexpr const char* kAntiradianceAtPoseFile = "antiradiance_at_pose.bin";
 inline constexpr BlobMagic kAntiradianceAtPoseMagic{"GIANTPOS"};

@@ -14,6 +14,9 @@ enum class AntiradianceScheme : std::uint8_t {
   Asymmetric,  ///< Per radiance step (eq. 13), `antiradiance_steps` steps of eq. 14 with L frozen.
 };
 
+/// The most pieces per link end a bake may ask for (the sweep's grid and a file's check).
+inline constexpr int kMaxLeafLinkPieces = 4096;
+
 struct AntiradianceSettings {
   /// Octahedral cells per side: bins = n^2 (8: 64 bins; the paper uses 128, n = 11 or 12 comes closest).
   int bins_per_side = 8;
@@ -29,7 +32,8 @@ struct AntiradianceSettings {
   /// Leaf-leaf links that fail the oracle (issue 37): each end is split virtually into up to
   /// this many equal-area disc pieces, as many as the oracle asks for at the pair's distance,
   /// each piece pair with its own distance and bin (link_mesh.h); 0: off (the two leaves are
-  /// linked regardless, as one disc). Not stored in a bundle: sweep-only until a preset uses it.
+  /// linked regardless, as one disc). Stored in antiradiance.bin (version 3): a load relinks
+  /// the deforming elements with it.
   int leaf_link_pieces = 0;
   /// Static triangles within this distance of the deforming region's swept bounds exchange
   /// light with it (metres).
@@ -56,11 +60,20 @@ struct AntiradianceSettings {
   std::uint64_t seed = 1;
 };
 
-/// The leaf size gi-bake bakes a preset at: 0.8 / 0.6 / 0.4 m at preview / medium / high
-/// (docs/sweeps/antiradiance_corridor.md: the element size barely moves the error; bins and
-/// iterations do).
-inline float antiradiance_preset_patch_size(std::string_view preset) {
-  return preset == "high" ? 0.4f : preset == "medium" ? 0.6f : 0.8f;
+/// The settings gi-bake bakes a preset at (and the planner estimates; issue 37, measured by
+/// gi-sweep on the corridor, docs/antiradiance.md "Issue 37: the presets"): 0.8 m leaves at
+/// every preset (0.6 / 0.4 m were worse at every bin count and cost 2-4x), the leaf links
+/// split to meet the oracle (at most 64 pieces per end: better at the same cost), and
+/// 64 / 144 / 324 bins at preview / medium / high (the bins buy the accuracy, at 2.4x / ~4x
+/// the preview's door move and file; 256 bins scored worse than 144 at the door's fourth angle,
+/// and 400 bins put the demo level's 17.3 M static links at 138 MB, above llvmpipe's 128 MiB
+/// SSBO limit for the GPU pass).
+inline AntiradianceSettings antiradiance_preset(std::string_view preset) {
+  AntiradianceSettings s;
+  s.patch_size_m = 0.8f;
+  s.leaf_link_pieces = 64;
+  s.bins_per_side = preset == "high" ? 18 : preset == "medium" ? 12 : 8;
+  return s;
 }
 
 }  // namespace gi

@@ -52,8 +52,7 @@ engine::Result<BrfSettings> brf_settings(const BakeOptions& o) {
 }
 
 AntiradianceSettings antiradiance_settings(const BakeOptions& o) {
-  AntiradianceSettings s;
-  s.patch_size_m = antiradiance_preset_patch_size(o.preset);
+  AntiradianceSettings s = antiradiance_preset(o.preset);
   s.seed = o.seed;
   return s;
 }

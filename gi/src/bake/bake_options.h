@@ -27,7 +27,8 @@ engine::Result<PrmSettings> prm_settings(const BakeOptions& o, const BakeStage& 
 engine::Result<DlmSettings> dlm_settings(const BakeOptions& o, const BakeStage& stage);
 /// The basis radiance fields' settings (preset, brf_basis, brf_spheres); progress is per mesh.
 engine::Result<BrfSettings> brf_settings(const BakeOptions& o);
-/// Antiradiance (docs/antiradiance.md): elements of 0.8 / 0.6 / 0.4 m at preview / medium / high.
+/// Antiradiance (docs/antiradiance.md): antiradiance_preset(preset) (0.8 m leaves, split leaf links,
+/// 64 / 144 / 324 bins at preview / medium / high).
 AntiradianceSettings antiradiance_settings(const BakeOptions& o);
 
 /// The hash of every option that changes a bake's files (not threads, not the shard fields):

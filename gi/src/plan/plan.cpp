@@ -355,8 +355,7 @@ void plan_antiradiance(const BakeInput& input, const PlanFacts& f, const PlanOpt
   if (!known_preset) return;
   // The elements as the bake builds them (cheap: triangle pieces and a cluster tree); the
   // links, the bake time and the GPU bytes from the cost model.
-  AntiradianceSettings s;
-  s.patch_size_m = antiradiance_preset_patch_size(options.preset);
+  const AntiradianceSettings s = antiradiance_preset(options.preset);
   auto h = build_element_hierarchy(input, s);
   if (!h) return;
   double links = 0.0, file = 0.0;

@@ -308,8 +308,13 @@ namespace {
 // Antiradiance (gi/src/antiradiance; measured by gi-sweep on the corridor, docs/sweeps/
 // antiradiance_corridor.csv, 0.4-0.8 m elements x 36-121 bins, and gi-bake on the demo level).
 // Links per element and bin: 4.57 at 0.6-0.8 m on the corridor, 3.85 at 0.4 m, 3.77 on the
-// demo level at preview (13259 elements, 3.2 M links).
+// demo level at preview (13259 elements, 3.2 M links), leaves linked regardless.
 constexpr double kArLinksPerElementBin = 4.2;
+// With the leaf links split (leaf_link_pieces > 0, the presets since issue 37) coplanar
+// neighbours are no longer linked: 3.80 at 64 bins and 3.90 at 144 on the corridor (0.8 m,
+// gi-sweep: 1.33 M / 3.07 M links of 5475 elements), 2.86 on the demo level at preview
+// (gi-bake: 2.44 M links of 13331 elements, 3.12 M unsplit).
+constexpr double kArSplitLinksPerElementBin = 3.3;
 // Bake wall seconds per link (linking + the baseline solve at 8 iterations + the direct
 // light), 2 threads shared: 0.55-0.65 us over the corridor grid (bake_s / links).
 constexpr double kArSecondsPerLink = 6.0e-7;
@@ -332,7 +337,7 @@ BakeWork antiradiance_work(std::size_t elements, std::size_t leaves, const Antir
   BakeWork w;
   const double m = static_cast<double>(s.bins_per_side) * s.bins_per_side;
   const double n = static_cast<double>(elements), l = static_cast<double>(leaves);
-  const double k = kArLinksPerElementBin * m * n;
+  const double k = (s.leaf_link_pieces > 0 ? kArSplitLinksPerElementBin : kArLinksPerElementBin) * m * n;
   w.units = k;
   // The baseline solve is ~20% of it at 8 iterations (cpu_solve_ms / bake_s in the sweep).
   const int iterations = s.residual_tolerance > 0.0 ? std::min(std::max(1, s.iterations), kArConvergedIterations)

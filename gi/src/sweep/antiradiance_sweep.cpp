@@ -36,10 +36,24 @@ namespace {
 constexpr std::uint64_t kReferenceSeed = 0x616e746972616469ULL;
 
 // Swings about the door's local Y from its authored (baked) pose, degrees. The corridor's
-// door is authored at 50 degrees open: 0 (shut), 25 and 100.
-constexpr float kSwings[] = {-50.0f, -25.0f, 50.0f};
-constexpr const char* kSwingsKey = "-50+-25+50";
-constexpr std::size_t kPoses = 1 + std::size(kSwings);
+// door is authored at 50 degrees open: the sweep's poses are 0 (shut), 25 and 100; the knob
+// `swings` scores other ones (issue 37's angle in no sweep: +25, the door at 75 degrees).
+constexpr float kSweepSwings[] = {-50.0f, -25.0f, 50.0f};
+constexpr const char* kSweepSwingsKey = "-50+-25+50";
+const std::vector<std::string> kSwingChoices = {kSweepSwingsKey, "+25", "+10"};
+
+// "-50+-25+50" -> {-50, -25, 50}; "+25" -> {25}.
+std::vector<float> parse_swings(const std::string& key) {
+  std::vector<float> out;
+  std::size_t at = 0;
+  while (at < key.size()) {
+    std::size_t end = key.find('+', at);
+    if (end == std::string::npos) end = key.size();
+    if (end > at) out.push_back(std::stof(key.substr(at, end - at)));
+    at = end + 1;
+  }
+  return out;
+}
 
 using Clock = std::chrono::steady_clock;
 double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
@@ -53,6 +67,10 @@ struct DoorSetup {
   AtlasTexels texels;
   std::vector<std::uint8_t> mask;  // per texel: compared
   std::size_t compared = 0;
+  std::vector<float> swings;  // the moved poses, degrees from the baked one
+
+  // The baked pose and every moved one.
+  std::size_t poses() const { return 1 + swings.size(); }
 
   glm::mat4 pose(float swing_deg) const {
     return authored * glm::rotate(glm::mat4(1.0f), glm::radians(swing_deg), glm::vec3(0.0f, 1.0f, 0.0f));
@@ -64,8 +82,10 @@ struct DoorSetup {
   }
 };
 
-engine::Result<DoorSetup> door_setup(const SweepScene& scene, double density, double radius) {
+engine::Result<DoorSetup> door_setup(const SweepScene& scene, double density, double radius,
+                                     const std::string& swings) {
   DoorSetup d;
+  d.swings = parse_swings(swings);
   d.input = bake_input_from(scene.asset);
   bool found = false;
   for (std::size_t i = 0; i < d.input.instances.size() && !found; ++i)
@@ -80,10 +100,11 @@ engine::Result<DoorSetup> door_setup(const SweepScene& scene, double density, do
   if (!layout) return layout.error();
   d.layout = std::move(layout).value();
   d.texels = rasterize_atlas(d.layout, inputs);
-  // The door's swept bounds over the baked pose and every swing.
+  // The door's swept bounds over the baked pose and the sweep's swings (whatever `swings`
+  // scores, so that every run compares the same texels).
   glm::vec3 lo(std::numeric_limits<float>::infinity()), hi(-lo);
   const BakeMesh& mesh = d.input.meshes[d.input.instances[d.door].mesh];
-  for (float swing : {0.0f, kSwings[0], kSwings[1], kSwings[2]}) {
+  for (float swing : {0.0f, kSweepSwings[0], kSweepSwings[1], kSweepSwings[2]}) {
     const glm::mat4 m = d.pose(swing);
     for (const BakePrimitive& p : mesh.primitives)
       for (const glm::vec3& v : p.positions) {
@@ -114,24 +135,26 @@ engine::Result<DoorSetup> door_setup(const SweepScene& scene, double density, do
 
 engine::Result<RgbField> door_reference(const ReferenceJob& job) {
   const ReferenceRequest& r = job.request;
-  if (r.param("swings") != kSwingsKey) return engine::Error{"<sweep>", r.key(), "unknown swings"};
-  auto d = door_setup(job.scene, std::stod(r.param("texels_per_m")), std::stod(r.param("radius")));
+  if (std::find(kSwingChoices.begin(), kSwingChoices.end(), r.param("swings")) == kSwingChoices.end())
+    return engine::Error{"<sweep>", r.key(), "unknown swings"};
+  auto d = door_setup(job.scene, std::stod(r.param("texels_per_m")), std::stod(r.param("radius")), r.param("swings"));
   if (!d) return engine::Error{"<sweep>", r.key(), d.error().message};
   AtlasTexels masked = d->texels;
   masked.valid = d->mask;
   const std::size_t n = masked.valid.size();
-  std::vector<glm::vec3> values(n * kPoses, glm::vec3(0.0f));
-  std::vector<std::uint8_t> valid(n * kPoses, 0);
-  for (std::size_t k = 0; k < kPoses; ++k) {
+  const std::size_t poses = d->poses();
+  std::vector<glm::vec3> values(n * poses, glm::vec3(0.0f));
+  std::vector<std::uint8_t> valid(n * poses, 0);
+  for (std::size_t k = 0; k < poses; ++k) {
     ReferenceSettings rs;
     rs.samples_per_pixel = std::stoi(r.param("spp"));
     rs.seed = kReferenceSeed;
     rs.threads = job.threads;
     const ProgressFn& outer = job.progress;
-    rs.progress = [&outer, k](double f) {
-      return !outer || outer((static_cast<double>(k) + f) / static_cast<double>(kPoses));
+    rs.progress = [&outer, k, poses](double f) {
+      return !outer || outer((static_cast<double>(k) + f) / static_cast<double>(poses));
     };
-    auto truth = reference_atlas_irradiance(d->posed(k == 0 ? 0.0f : kSwings[k - 1]), masked, rs);
+    auto truth = reference_atlas_irradiance(d->posed(k == 0 ? 0.0f : d->swings[k - 1]), masked, rs);
     if (!truth) return truth.error();
     for (std::size_t t = 0; t < n; ++t)
       if (d->mask[t]) {
@@ -139,7 +162,7 @@ engine::Result<RgbField> door_reference(const ReferenceJob& job) {
         valid[k * n + t] = 1;
       }
   }
-  return RgbField::from_texels(d->texels.width, d->texels.height * static_cast<int>(kPoses), values, std::move(valid));
+  return RgbField::from_texels(d->texels.width, d->texels.height * static_cast<int>(poses), values, std::move(valid));
 }
 
 // The shared headless GL context of the GPU timings (nullptr when none can be made).
@@ -240,6 +263,12 @@ std::vector<KnobSpec> antiradiance_knobs() {
        .default_grid = {"1"},
        .min_value = 0,
        .max_value = 1e4},
+      {.name = "swings",
+       .description = "the door's moves scored, degrees from its baked pose joined by '+' (the corridor's door is "
+                      "baked at 50: -50+-25+50 are 0, 25 and 100 degrees; +25 is 75, +10 is 60)",
+       .kind = KnobKind::Choice,
+       .default_grid = {kSweepSwingsKey},
+       .choices = kSwingChoices},
       {.name = "ref_spp",
        .description = "samples per texel and pose of the path-traced reference",
        .kind = KnobKind::Integer,
@@ -255,7 +284,7 @@ ReferenceRequest door_reference_request(const SweepScene&, const KnobSetting& k)
   r.params = {{"texels_per_m", k.text("density")},
               {"radius", k.text("radius")},
               {"spp", std::to_string(k.integer("ref_spp"))},
-              {"swings", kSwingsKey}};
+              {"swings", k.text("swings")}};
   return r;
 }
 
@@ -302,8 +331,8 @@ struct DoorMoveScores {
   double level = 0.0;  // mean |E_ref(baked)| per channel over the compared texels
   std::vector<std::pair<std::string, double>> per_angle;
 
-  void add_solve(const AntiradianceSolveReport& rep) {
-    iterations += static_cast<double>(rep.iterations) / static_cast<double>(kPoses - 1);
+  void add_solve(const AntiradianceSolveReport& rep, std::size_t moves) {
+    iterations += static_cast<double>(rep.iterations) / static_cast<double>(moves);
     residual = std::max(residual, rep.residual);
     unconverged += rep.budget_exhausted ? 1.0 : 0.0;
   }
@@ -361,9 +390,10 @@ engine::Result<DoorMoveScores> score_door_moves(const RunContext& ctx, const Doo
                                                 const TexelOutput& output) {
   const std::size_t n = d.texels.valid.size();
   DoorMoveScores s;
-  s.values.assign(n * kPoses, glm::vec3(0.0f));
-  s.valid.assign(n * kPoses, 0);
-  s.floor_values.assign(n * kPoses, glm::vec3(0.0f));
+  const std::size_t poses = d.poses();
+  s.values.assign(n * poses, glm::vec3(0.0f));
+  s.valid.assign(n * poses, 0);
+  s.floor_values.assign(n * poses, glm::vec3(0.0f));
   for (std::size_t t = 0; t < n; ++t)
     if (d.mask[t]) {
       const glm::vec3 e = ref_at(ctx.reference, t);
@@ -371,15 +401,15 @@ engine::Result<DoorMoveScores> score_door_moves(const RunContext& ctx, const Doo
     }
   s.level /= 3.0 * static_cast<double>(d.compared);
   const double level = s.level;
-  for (std::size_t k = 1; k < kPoses; ++k) {
-    region.set_instance_transform(d.door, d.pose(kSwings[k - 1]));
+  for (std::size_t k = 1; k < poses; ++k) {
+    region.set_instance_transform(d.door, d.pose(d.swings[k - 1]));
     const auto t0 = Clock::now();
     region.update(false);
     s.move_ms += ms_since(t0);
     const auto t1 = Clock::now();
     const AntiradianceSolveReport rep = region.update(true);  // nothing moved since: the solve only
     s.solve_ms += ms_since(t1);
-    s.add_solve(rep);
+    s.add_solve(rep, poses - 1);
     const auto t2 = Clock::now();
     const std::vector<glm::vec3> dt = output.change(region, blends, n);
     s.output_ms += ms_since(t2);
@@ -401,7 +431,7 @@ engine::Result<DoorMoveScores> score_door_moves(const RunContext& ctx, const Doo
       }
     }
     const double nrmse = std::sqrt(err2 / (3.0 * static_cast<double>(d.compared))) / level;
-    const int swing = static_cast<int>(kSwings[k - 1]);
+    const int swing = static_cast<int>(d.swings[k - 1]);
     const std::string name = std::string(swing < 0 ? "m" : "p") + std::to_string(std::abs(swing));
     s.per_angle.emplace_back("change_nrmse_swing_" + name, nrmse);
     // What leaving the baked atlas unchanged scores by the same measure: the true change.
@@ -412,7 +442,7 @@ engine::Result<DoorMoveScores> score_door_moves(const RunContext& ctx, const Doo
     const double count = 3.0 * static_cast<double>(d.compared);
     s.per_angle.emplace_back("true_mean_change_swing_" + name, mean_r / count / level);
     s.per_angle.emplace_back("mean_change_error_swing_" + name, (mean_o - mean_r) / count / level);
-    if (ctx.progress && !ctx.progress(0.3 + 0.5 * static_cast<double>(k) / static_cast<double>(kPoses - 1)))
+    if (ctx.progress && !ctx.progress(0.3 + 0.5 * static_cast<double>(k) / static_cast<double>(poses - 1)))
       return engine::cancelled_error("antiradiance run");
   }
   return s;
@@ -435,7 +465,7 @@ engine::Result<GpuDoorMove> time_gpu_door_move(const DoorSetup& d, AntiradianceR
   if (!gpu) return g;  // above the SSBO limit (or no compute shaders): the GPU columns stay empty
   // The runtime's door move (AntiradianceLighting::update): relink + direct light on
   // the CPU, link upload, the iteration, the result read back; back to the first swing.
-  region.set_instance_transform(d.door, d.pose(kSwings[0]));
+  region.set_instance_transform(d.door, d.pose(d.swings[0]));
   const auto t0 = Clock::now();
   region.update(false);
   if (engine::Status st = gpu->set_links(region.links()); !st) return st.error();
@@ -460,7 +490,7 @@ engine::Result<GpuDoorMove> time_gpu_door_move(const DoorSetup& d, AntiradianceR
 RgbField nothing_changed(const RgbField& field, const RgbField& reference, const DoorSetup& d) {
   const std::size_t n = d.texels.valid.size();
   RgbField nothing = field;
-  for (std::size_t k = 1; k < kPoses; ++k)
+  for (std::size_t k = 1; k < d.poses(); ++k)
     for (std::size_t t = 0; t < n; ++t)
       if (d.mask[t])
         for (int c = 0; c < 3; ++c)
@@ -475,7 +505,7 @@ std::vector<std::pair<std::string, double>> door_move_extras(const RunContext& c
                                                              const GpuDoorMove& gpu, const RgbField& field,
                                                              const RgbField& floor_field) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  const double moves = static_cast<double>(kPoses - 1);
+  const double moves = static_cast<double>(d.poses() - 1);
   const double samples = sc.samples;
   const double cov = sc.sor - sc.so * sc.sr / samples, var_o = sc.soo - sc.so * sc.so / samples,
                var_r = sc.srr - sc.sr * sc.sr / samples;
@@ -516,13 +546,13 @@ engine::Result<MethodOutput> run_projection_floor(const RunContext& ctx, const D
   out.costs.bake_seconds = ms_since(t0) / 1000.0;
   const std::size_t n = d.texels.valid.size();
   DoorMoveScores sc;
-  sc.floor_values.assign(n * kPoses, glm::vec3(0.0f));
-  std::vector<std::uint8_t> valid(n * kPoses, 0);
-  for (std::size_t k = 1; k < kPoses; ++k) {  // the moved poses, as score_door_moves compares them
+  sc.floor_values.assign(n * d.poses(), glm::vec3(0.0f));
+  std::vector<std::uint8_t> valid(n * d.poses(), 0);
+  for (std::size_t k = 1; k < d.poses(); ++k) {  // the moved poses, as score_door_moves compares them
     for (std::size_t t = 0; t < n; ++t) valid[k * n + t] = d.mask[t];
     sc.add_floor(ctx.reference, d, blends, h->leaf_count(), k);
   }
-  out.field = RgbField::from_texels(d.texels.width, d.texels.height * static_cast<int>(kPoses), sc.floor_values,
+  out.field = RgbField::from_texels(d.texels.width, d.texels.height * static_cast<int>(d.poses()), sc.floor_values,
                                     std::move(valid));
   out.extras = {{"projection_floor_rel_rmse", compare_rgb(out.field, ctx.reference).rel_rmse},
                 {"elements", static_cast<double>(h->nodes.size())},
@@ -532,9 +562,10 @@ engine::Result<MethodOutput> run_projection_floor(const RunContext& ctx, const D
 }
 
 engine::Result<MethodOutput> run_door_moves(const RunContext& ctx) {
-  auto d = door_setup(ctx.scene, ctx.knobs.real("density"), ctx.knobs.real("radius"));
+  auto d = door_setup(ctx.scene, ctx.knobs.real("density"), ctx.knobs.real("radius"), ctx.knobs.text("swings"));
   if (!d) return d.error();
-  if (ctx.reference.width != d->texels.width || ctx.reference.height != d->texels.height * static_cast<int>(kPoses))
+  const int poses = static_cast<int>(d->poses());
+  if (ctx.reference.width != d->texels.width || ctx.reference.height != d->texels.height * poses)
     return engine::Error{.message = "the atlas size differs from the reference's"};
   const AntiradianceSettings s = antiradiance_settings(ctx);
   if (ctx.knobs.text("solve") == "off") return run_projection_floor(ctx, *d, s);
@@ -557,12 +588,11 @@ engine::Result<MethodOutput> run_door_moves(const RunContext& ctx) {
   auto scores = score_door_moves(ctx, *d, *region, blends, output);
   if (!scores) return scores.error();
   DoorMoveScores& sc = *scores;
-  const double moves = static_cast<double>(kPoses - 1);
+  const double moves = static_cast<double>(poses - 1);
   out.costs.frame_ms = (sc.move_ms + sc.solve_ms + (output.gather ? sc.output_ms : 0.0)) / moves;
   const RgbField floor_field =
-      RgbField::from_texels(d->texels.width, d->texels.height * static_cast<int>(kPoses), sc.floor_values, sc.valid);
-  out.field = RgbField::from_texels(d->texels.width, d->texels.height * static_cast<int>(kPoses), sc.values,
-                                    std::move(sc.valid));
+      RgbField::from_texels(d->texels.width, d->texels.height * poses, sc.floor_values, sc.valid);
+  out.field = RgbField::from_texels(d->texels.width, d->texels.height * poses, sc.values, std::move(sc.valid));
 
   GpuDoorMove gpu;
   if (ctx.knobs.text("gpu") == "on") {

@@ -11,8 +11,11 @@
 #include <iterator>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 #include "antiradiance_scenes.h"
 #include "bundle/atlas_layout_file.h"
+#include "io/blob_file.h"
 #include "uv/atlas_layout.h"
 
 namespace {
@@ -250,4 +253,77 @@ TEST(AntiradianceIo, ADamagedOrTruncatedAtPoseFileIsRejectedByName) {
   auto c = gi::load_antiradiance(dir, scene.input);
   ASSERT_FALSE(c);
   EXPECT_TRUE(contains(c.error().to_string(), "checksum")) << c.error().to_string();
+}
+
+namespace {
+
+// Rewrites `file`'s container with another payload layout version (re-sealed, so only the
+// version is wrong) and the manifest's checksum of it, as an older gi-bake left the bundle.
+void reseal_with_version(const fs::path& dir, const fs::path& file, std::uint32_t version) {
+  auto payload = gi::read_blob(file, gi::kAntiradianceMagic, gi::kAntiradianceVersion);
+  ASSERT_TRUE(payload) << payload.error().to_string();
+  ASSERT_TRUE(gi::write_blob(file, gi::kAntiradianceMagic, version, *payload));
+  auto sum = gi::file_checksum(file);
+  ASSERT_TRUE(sum) << sum.error().to_string();
+  std::ifstream in(dir / "manifest.json");
+  nlohmann::json manifest = nlohmann::json::parse(in);
+  in.close();
+  manifest["methods"]["antiradiance"]["files"]["elements"]["xxh3_64"] = *sum;
+  std::ofstream(dir / "manifest.json", std::ios::trunc) << manifest.dump(2);
+}
+
+}  // namespace
+
+// Version 3 stores the refinement settings (issue 37): a load relinks the door with the
+// bake's split leaf links, not with the defaults (which would link the leaves regardless).
+TEST(AntiradianceIo, TheRefinementSettingsComeBackAndTheLoadRelinksWithThem) {
+  const artest::DoorScene baked = artest::door_scene(30.0f);
+  gi::AntiradianceSettings s = small();
+  s.leaf_link_pieces = 16;
+  s.near_patch_size_m = 0.3f;
+  s.near_radius_m = 0.4f;
+  auto bake = gi::bake_antiradiance(baked.input, s);
+  ASSERT_TRUE(bake) << bake.error().to_string();
+  const fs::path dir = scratch_dir("refinement");
+  ASSERT_TRUE(gi::save_antiradiance(dir, *bake, baked.input));
+  auto loaded = gi::load_antiradiance(dir, baked.input);
+  ASSERT_TRUE(loaded) << loaded.error().to_string();
+  EXPECT_EQ(loaded->settings.leaf_link_pieces, 16);
+  EXPECT_EQ(loaded->settings.near_patch_size_m, 0.3f);
+  EXPECT_EQ(loaded->settings.near_radius_m, 0.4f);
+  EXPECT_EQ(loaded->hierarchy.leaf_count(), bake->hierarchy.leaf_count());
+  // Posed elsewhere, the loaded region relinks the door as the fresh bake's region does,
+  // and not as a region with the links unsplit.
+  const artest::DoorScene moved = artest::door_scene(70.0f);
+  gi::AntiradianceBake unsplit = *bake;
+  unsplit.settings.leaf_link_pieces = 0;
+  auto fresh = gi::AntiradianceRegion::create(moved.input, std::move(bake).value());
+  auto from_file = gi::AntiradianceRegion::create(moved.input, std::move(loaded).value());
+  auto regardless = gi::AntiradianceRegion::create(moved.input, std::move(unsplit));
+  ASSERT_TRUE(fresh && from_file && regardless);
+  EXPECT_TRUE(same_links(fresh->links(), from_file->links()));
+  EXPECT_FALSE(same_links(fresh->links(), regardless->links())) << "the door's leaf links split or not alike";
+}
+
+// A bundle of the previous layout (no refinement settings) is refused by name, not misread.
+TEST(AntiradianceIo, AVersion2FileIsRefusedWithTheFilesName) {
+  const artest::DoorScene scene = artest::door_scene(30.0f);
+  auto bake = gi::bake_antiradiance(scene.input, small());
+  ASSERT_TRUE(bake) << bake.error().to_string();
+  const fs::path dir = scratch_dir("version2");
+  ASSERT_TRUE(gi::save_antiradiance(dir, *bake, scene.input));
+  const fs::path file = dir / gi::kAntiradianceFile;
+  reseal_with_version(dir, file, 2);
+  auto loaded = gi::load_antiradiance(dir, scene.input);
+  ASSERT_FALSE(loaded);
+  const std::string message = loaded.error().to_string();
+  EXPECT_EQ(loaded.error().file, file.string()) << message;
+  EXPECT_TRUE(contains(message, "version 2")) << message;
+  EXPECT_TRUE(contains(message, "re-bake")) << message;
+  // A file that claims a bad refinement setting (resealed payload) is refused by its checks.
+  gi::AntiradianceBake bad = *bake;
+  bad.settings.leaf_link_pieces = gi::kMaxLeafLinkPieces + 1;
+  auto st = gi::write_antiradiance(dir / "bad.bin", bad, "h");
+  ASSERT_FALSE(st);
+  EXPECT_TRUE(contains(st.error().to_string(), "leaf_link_pieces")) << st.error().to_string();
 }
