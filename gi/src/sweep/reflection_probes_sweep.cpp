@@ -10,7 +10,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <optional>
 #include <string>
 
 #include "core/random.h"
@@ -320,6 +319,26 @@ void dump_texels(const RunContext& ctx, const AtlasTexels& tex, const std::vecto
   std::fclose(f);
 }
 
+// With the knob `estimate` other than runtime: `values` at the covered texels replaced by the
+// diagnosis's estimate.
+engine::Status diagnose(const RunContext& ctx, const BakedProbes& baked, const BakeInput& input, const GlossyTexels& g,
+                        const std::vector<std::uint8_t>& covered, bool box_only, int lobe_samples,
+                        std::vector<glm::vec3>& values) {
+  const Estimate estimate = estimate_of(ctx.knobs.text("estimate"));
+  if (estimate == Estimate::Runtime) return {};
+  auto capturer = ProbeCapturer::make(input, baked.source(), baked.settings);
+  if (!capturer) return capturer.error();
+  const AtlasTexels& tex = g.s.texels;
+  ThreadPool pool(ctx.threads);
+  pool.parallel_for(tex.valid.size(), [&](std::size_t t) {
+    if (!covered[t]) return;
+    const glm::vec3 v = glm::normalize(g.eye - tex.position[t]);
+    values[t] = diagnosis_estimate(estimate, baked, *capturer, g.brdf[t], tex.position[t], tex.normal[t], v, t,
+                                   box_only, lobe_samples);
+  });
+  return {};
+}
+
 engine::Result<MethodOutput> run_reflection_probes(const RunContext& ctx) {
   const double roughness = ctx.knobs.real("roughness");
   const engine::Scene scene = engine::instantiate(with_floor_roughness(ctx.scene.asset, roughness));
@@ -327,13 +346,6 @@ engine::Result<MethodOutput> run_reflection_probes(const RunContext& ctx) {
   auto baked = bake_probes(ctx, input);
   if (!baked) return baked.error();
   const ReflectionProbeSet* set = &baked->set;
-  const Estimate estimate = estimate_of(ctx.knobs.text("estimate"));
-  std::optional<ProbeCapturer> capturer;
-  if (estimate != Estimate::Runtime) {
-    auto c = ProbeCapturer::make(input, baked->source(), baked->settings);
-    if (!c) return c.error();
-    capturer.emplace(std::move(c).value());
-  }
   // Samples where a camera sees the floor (not on the line where the walls begin): the
   // forward pass evaluates the probes at pixels, and the reference's lobe rays from a
   // border texel's raster sample slip behind the wall (a 0 truth under a lit probe).
@@ -360,15 +372,8 @@ engine::Result<MethodOutput> run_reflection_probes(const RunContext& ctx) {
     covered[t] = 1;
     (depth < border ? edge : inner)[t] = 1;
   }
-  if (estimate != Estimate::Runtime) {
-    ThreadPool pool(ctx.threads);
-    pool.parallel_for(tex.valid.size(), [&](std::size_t t) {
-      if (!covered[t]) return;
-      const glm::vec3 v = glm::normalize(g->eye - tex.position[t]);
-      values[t] = diagnosis_estimate(estimate, *baked, *capturer, g->brdf[t], tex.position[t], tex.normal[t], v, t,
-                                     box_only, lobe_samples);
-    });
-  }
+  if (auto diagnosed = diagnose(ctx, *baked, input, *g, covered, box_only, lobe_samples, values); !diagnosed)
+    return diagnosed.error();
   dump_texels(ctx, tex, values, inner, covered);
   MethodOutput out;
   out.field = RgbField::from_texels(tex.width, tex.height, values, covered);
