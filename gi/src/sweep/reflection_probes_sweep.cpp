@@ -57,7 +57,7 @@ std::vector<KnobSpec> reflection_probes_knobs() {
                       "filtered importance sampling of the lobe at the view (probe_lobe_radiance)",
        .kind = KnobKind::Choice,
        .default_grid = {"fis"},
-       .choices = {"split_sum", "fis"}},
+       .choices = {"split_sum", "fis", "fis_chain"}},
       {.name = "lobe_samples",
        .description = "GGX samples per probe of the filtered-importance-sampled lookup (lobe=fis)",
        .kind = KnobKind::Integer,
@@ -138,7 +138,8 @@ float depth_in_box(const ProbeVolume& v, const glm::vec3& p, const glm::vec3& n)
 // (probe_lobe_radiance), blended by probe_blend_weight (faded across segments), times the specular albedo.
 // `depth`: the largest depth_in_box over those probes. False where no box holds p.
 bool probe_specular(const ReflectionProbeSet& set, const engine::GltfBrdf& brdf, const glm::vec3& p, const glm::vec3& n,
-                    const glm::vec3& v, bool box_only, int lobe_samples, glm::vec3& out, float& depth) {
+                    const glm::vec3& v, bool box_only, int lobe_samples, const std::vector<ProbeCube>* chains,
+                    glm::vec3& out, float& depth) {
   const glm::vec3 r = glm::reflect(-v, n);
   glm::vec3 sum(0.0f);
   float weight = 0.0f;
@@ -149,7 +150,8 @@ bool probe_specular(const ReflectionProbeSet& set, const engine::GltfBrdf& brdf,
     if (!(w > 0.0f)) continue;
     const ProbeCube& cube = set.cubes[i];
     if (lobe_samples > 0) {
-      sum += w * probe_lobe_radiance(cube, brdf, p, n, v, lobe_samples, pv.centre, pv.box_min, pv.box_max, box_only);
+      sum += w * probe_lobe_radiance(cube, brdf, p, n, v, lobe_samples, pv.centre, pv.box_min, pv.box_max, box_only,
+                                     chains ? &(*chains)[i] : nullptr);
     } else {
       const float lod = std::sqrt(brdf.alpha) * static_cast<float>(cube.levels.size() - 1);
       const glm::vec3 d = box_only ? box_projected_direction(p, r, pv.centre, pv.box_min, pv.box_max)
@@ -339,6 +341,14 @@ engine::Status diagnose(const RunContext& ctx, const BakedProbes& baked, const B
   return {};
 }
 
+// With lobe=fis_chain: each probe's box-filtered chain, which the lobe's samples read; else none.
+std::vector<ProbeCube> lookup_chains(const RunContext& ctx, const ReflectionProbeSet& set) {
+  std::vector<ProbeCube> chains;
+  if (ctx.knobs.text("lobe") == "fis_chain")
+    for (const ProbeCube& c : set.cubes) chains.push_back(box_filtered_chain(c));
+  return chains;
+}
+
 engine::Result<MethodOutput> run_reflection_probes(const RunContext& ctx) {
   const double roughness = ctx.knobs.real("roughness");
   const engine::Scene scene = engine::instantiate(with_floor_roughness(ctx.scene.asset, roughness));
@@ -359,13 +369,15 @@ engine::Result<MethodOutput> run_reflection_probes(const RunContext& ctx) {
   std::vector<std::uint8_t> covered(tex.valid.size(), 0), inner(tex.valid.size(), 0), edge(tex.valid.size(), 0);
   std::size_t uncovered = 0;
   const bool box_only = ctx.knobs.text("parallax") == "box";
-  const int lobe_samples = ctx.knobs.text("lobe") == "fis" ? static_cast<int>(ctx.knobs.integer("lobe_samples")) : 0;
+  const int lobe_samples =
+      ctx.knobs.text("lobe") != "split_sum" ? static_cast<int>(ctx.knobs.integer("lobe_samples")) : 0;
+  const std::vector<ProbeCube> chains = lookup_chains(ctx, *set);
   for (std::size_t t = 0; t < tex.valid.size(); ++t) {
     if (!g->glossy[t]) continue;
     float depth = 0.0f;
     const glm::vec3 v = glm::normalize(g->eye - tex.position[t]);
-    if (!probe_specular(*set, g->brdf[t], tex.position[t], tex.normal[t], v, box_only, lobe_samples, values[t],
-                        depth)) {
+    if (!probe_specular(*set, g->brdf[t], tex.position[t], tex.normal[t], v, box_only, lobe_samples,
+                        chains.empty() ? nullptr : &chains, values[t], depth)) {
       ++uncovered;
       continue;
     }
