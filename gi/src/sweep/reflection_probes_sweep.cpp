@@ -356,9 +356,8 @@ engine::Result<MethodOutput> run_reflection_probes(const RunContext& ctx) {
   auto baked = bake_probes(ctx, input);
   if (!baked) return baked.error();
   const ReflectionProbeSet* set = &baked->set;
-  // Samples where a camera sees the floor (not on the line where the walls begin): the
-  // forward pass evaluates the probes at pixels, and the reference's lobe rays from a
-  // border texel's raster sample slip behind the wall (a 0 truth under a lit probe).
+  // Samples where a camera sees the floor, as the forward pass's pixels (a border texel's raster
+  // sample lies on the line where the walls begin, and the reference's rays slip behind them).
   auto g = glossy_texels(ctx.scene, ctx.knobs.real("density"), roughness, nullptr, TexelPlacement::VisibleSurface);
   if (!g) return g.error();
   const AtlasTexels& tex = g->s.texels;
