@@ -7,7 +7,8 @@
 // reflection direction corrected for parallax, by the capture's own distances when the probes
 // carry them (gi's distance_corrected_direction, probe_cube.h: a distance-impostor search
 // along the ray), else by the box (box_projected_direction), read at
-// mip roughness x (levels - 1); they are averaged with equal weights. The split sum multiplies
+// mip roughness x (levels - 1); they are blended by probe_weight (equal inside a room, faded
+// across the overlap of a corridor's segments). The split sum multiplies
 // that by the specular lobe's directional albedo (gltf_directional_albedo: Karis 2013's
 // environment BRDF). No probe holds the point: the caller keeps its specular.
 
@@ -22,6 +23,8 @@
 #endif
 
 const float PROBE_BOX_MARGIN_M = 0.05;
+// gi's probe_placement.h: kProbeFadeM (how far a corridor's segments reach into each other).
+const float PROBE_FADE_M = 0.5;
 
 // engine/indirect_light.h's ReflectionProbeBox (std430, asserted there).
 struct ReflectionProbeBox {
@@ -152,25 +155,37 @@ bool reads_probes(Surface s, bool atlas, bool dynamic) {
   return u_probe_count > 0 && (dynamic || (atlas && s.brdf.alpha < u_probe_max_roughness * u_probe_max_roughness));
 }
 
+// Probe i's weight at p in the blend (gi's probe_blend_weight, probe_placement.cpp): 0 outside
+// its box grown by the margin, else the product over the axes of clamp(depth / PROBE_FADE_M,
+// 1e-3, 1), depth the distance from the box's nearer side; the sides every box holding p shares cancel in the normalization,
+// and across two segments' overlap the weights fade linearly from one to the next.
+float probe_weight(vec3 p, ReflectionProbeBox probe) {
+  if (any(lessThan(p, probe.box_min.xyz - PROBE_BOX_MARGIN_M)) ||
+      any(greaterThan(p, probe.box_max.xyz + PROBE_BOX_MARGIN_M)))
+    return 0.0;
+  vec3 depth = min(p - probe.box_min.xyz, probe.box_max.xyz - p);
+  vec3 f = clamp(depth / PROBE_FADE_M, vec3(1e-3), vec3(1.0));
+  return f.x * f.y * f.z;
+}
+
 // The probes' specular at s, given the lobe's directional albedo; false where no box holds it.
 bool probe_specular(Surface s, vec3 specular_albedo, out vec3 specular) {
   specular = vec3(0.0);
   vec3 r = reflect(-s.view, s.normal);
   float lod = sqrt(s.brdf.alpha) * float(max(u_probe_levels - 1, 0));
   vec3 sum = vec3(0.0);
-  float count = 0.0;
+  float weight = 0.0;
   for (int i = 0; i < u_probe_count; ++i) {
     ReflectionProbeBox probe = rp_probes[i];
-    if (any(lessThan(s.position, probe.box_min.xyz - PROBE_BOX_MARGIN_M)) ||
-        any(greaterThan(s.position, probe.box_max.xyz + PROBE_BOX_MARGIN_M)))
-      continue;
+    float w = probe_weight(s.position, probe);
+    if (w <= 0.0) continue;
     if (u_probe_lobe_samples > 0)
-      sum += probe_lobe(s, probe, i);
+      sum += w * probe_lobe(s, probe, i);
     else
-      sum += textureLod(u_probe_cubes, vec4(probe_direction(s.position, r, probe, i), float(i)), lod).rgb;
-    count += 1.0;
+      sum += w * textureLod(u_probe_cubes, vec4(probe_direction(s.position, r, probe, i), float(i)), lod).rgb;
+    weight += w;
   }
-  if (count == 0.0) return false;
-  specular = sum / count * specular_albedo;
+  if (weight <= 0.0) return false;
+  specular = sum / weight * specular_albedo;
   return true;
 }

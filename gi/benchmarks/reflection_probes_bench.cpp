@@ -130,36 +130,23 @@ void time_forward(benchmark::State& state, Demo& d) {
   state.counters["lobe_samples"] = static_cast<double>(state.range(0));
 }
 
-void BM_ForwardPassDemoCamera0(benchmark::State& state) {
+// Camera 0's own placement.
+engine::Transform camera0_view(const engine::Transform& camera0) { return camera0; }
+
+// The forward pass from one view, the lobe samples state.range(0).
+void BM_ForwardPass(benchmark::State& state, engine::Transform (*view)(const engine::Transform&)) {
   Demo& d = demo();
-  place_camera(d, d.camera0);
+  place_camera(d, view(d.camera0));
   time_forward(state, d);
 }
 
-void BM_ForwardPassCorridorFloor(benchmark::State& state) {
-  Demo& d = demo();
-  place_camera(d, corridor_view(d.camera0));
-  time_forward(state, d);
-}
 // Interleaved yardstick: the split sum (0) first and last.
-BENCHMARK(BM_ForwardPassDemoCamera0)
-    ->Arg(0)
-    ->Arg(4)
-    ->Arg(8)
-    ->Arg(16)
-    ->Arg(0)
-    ->UseManualTime()
-    ->Unit(benchmark::kMillisecond)
-    ->MinTime(2.0);
-BENCHMARK(BM_ForwardPassCorridorFloor)
-    ->Arg(0)
-    ->Arg(4)
-    ->Arg(8)
-    ->Arg(16)
-    ->Arg(0)
-    ->UseManualTime()
-    ->Unit(benchmark::kMillisecond)
-    ->MinTime(2.0);
+void lobe_sample_counts(benchmark::internal::Benchmark* b) {
+  b->Arg(0)->Arg(4)->Arg(8)->Arg(16)->Arg(0)->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(2.0);
+}
+
+BENCHMARK_CAPTURE(BM_ForwardPass, DemoCamera0, camera0_view)->Apply(lobe_sample_counts);
+BENCHMARK_CAPTURE(BM_ForwardPass, CorridorFloor, corridor_view)->Apply(lobe_sample_counts);
 
 }  // namespace
 

@@ -5,148 +5,42 @@
 // opening of the box where the probe's captured distances put it, the probes'
 // specular replaces the atlas's specular share instead of adding to it, and rough floors
 // above the probes' roughness limit keep the atlas's.
-#define GL_GLEXT_PROTOTYPES 1
-#include <GL/glcorearb.h>
-
-#include <engine/gltf_brdf.h>
 #include <engine/image.h>
-#include <engine/indirect_light.h>
 
 #include <algorithm>
 #include <filesystem>
 #include <vector>
 
-#include "engine/renderer_test_scene.h"
+#include "engine/reflection_probe_test_scene.h"
 
 namespace {
 
 using namespace renderer_test;
+using namespace probe_test;
 
 constexpr float kWall = 10.0f;  // W/(m^2 sr): the bright +X wall
-const glm::vec3 kRoomMin(-2.0f, 0.0f, -2.0f);
-const glm::vec3 kRoomMax(2.0f, 3.0f, 2.0f);
-const glm::vec3 kProbe(0.0f, 1.5f, 0.0f);
 
-// The room seen from the probe: kWall where the ray from kProbe along d leaves the box through
-// x = 2, else black.
-float room_radiance(glm::vec3 d) {
-  float t = 1e30f;
-  int axis = 0;
-  for (int a = 0; a < 3; ++a) {
-    if (d[a] == 0.0f) continue;
-    const float ta = ((d[a] > 0.0f ? kRoomMax[a] : kRoomMin[a]) - kProbe[a]) / d[a];
-    if (ta < t) t = ta, axis = a;
-  }
-  return axis == 0 && d.x > 0.0f ? kWall : 0.0f;
-}
-
-// GL's cube-map face directions (OpenGL 4.6 table 8.19) for face coordinates u, v in [-1, 1].
-glm::vec3 face_direction(int face, float u, float v) {
-  switch (face) {
-    case 0:
-      return {1.0f, -v, -u};
-    case 1:
-      return {-1.0f, -v, u};
-    case 2:
-      return {u, 1.0f, v};
-    case 3:
-      return {u, -1.0f, -v};
-    case 4:
-      return {u, -v, 1.0f};
-    default:
-      return {-u, -v, -1.0f};
-  }
-}
-
-// A hall that runs on beyond the probe's box: its bright wall at x = kHallEnd, the box (and
-// the room's other walls) as above. What the probe at kProbe sees: radiance and distance.
-constexpr float kHallEnd = 5.0f;
-struct Seen {
-  float radiance = 0.0f, distance = 0.0f;
-};
-Seen hall_seen(glm::vec3 d) {
-  const glm::vec3 hi(kHallEnd, kRoomMax.y, kRoomMax.z);
-  float t = 1e30f;
-  int axis = 0;
-  for (int a = 0; a < 3; ++a) {
-    if (d[a] == 0.0f) continue;
-    const float ta = ((d[a] > 0.0f ? hi[a] : kRoomMin[a]) - kProbe[a]) / d[a];
-    if (ta < t) t = ta, axis = a;
-  }
-  return {axis == 0 && d.x > 0.0f ? kWall : 0.0f, t};
+// What the probe sees along d: kWall where the ray from kProbe leaves the room through x = 2
+// (or, `hall`, the hall through x = kHallEnd), else black; and how far that is.
+float room_radiance(glm::vec3 d, bool hall) {
+  const SideHit h = side_hit(d, hall ? kHallEnd : kRoomMax.x);
+  return h.axis == 0 && d.x > 0.0f ? kWall : 0.0f;
 }
 
 // A provider with an irradiance atlas of one texel `e` and one probe of the room above: every
 // level holds the room's unfiltered image (the floor's roughness 0.02 reads levels 0 and 1).
 // `hall`: the probe stands in the hall instead (its box still the room's) and carries its
 // captured distances when `distances`.
-class RoomProbe : public engine::IndirectLightProvider {
- public:
-  RoomProbe(float e, float max_roughness, bool hall = false, bool distances = false) {
-    glCreateTextures(GL_TEXTURE_2D, 1, &atlas_);
-    glTextureStorage2D(atlas_, 1, GL_RGBA32F, 1, 1);
-    const float texel[4] = {e, e, e, 1.0f};
-    glTextureSubImage2D(atlas_, 0, 0, 0, 1, 1, GL_RGBA, GL_FLOAT, texel);
-    const int size = 64, levels = 7;
-    glCreateTextures(GL_TEXTURE_CUBE_MAP_ARRAY, 1, &cubes_);
-    glTextureStorage3D(cubes_, levels, GL_RGBA16F, size, size, 6);
-    for (int m = 0; m < levels; ++m) {
-      const int s = size >> m;
-      std::vector<float> texels;
-      for (int f = 0; f < 6; ++f)
-        for (int y = 0; y < s; ++y)
-          for (int x = 0; x < s; ++x) {
-            const float u = (2.0f * static_cast<float>(x) + 1.0f) / static_cast<float>(s) - 1.0f;
-            const float v = (2.0f * static_cast<float>(y) + 1.0f) / static_cast<float>(s) - 1.0f;
-            const glm::vec3 d = glm::normalize(face_direction(f, u, v));
-            const float l = hall ? hall_seen(d).radiance : room_radiance(d);
-            texels.insert(texels.end(), {l, l, l});
-          }
-      glTextureSubImage3D(cubes_, m, 0, 0, 0, s, s, 6, GL_RGB, GL_FLOAT, texels.data());
-    }
-    glTextureParameteri(cubes_, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
-    glTextureParameteri(cubes_, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    if (distances) {
-      glCreateTextures(GL_TEXTURE_CUBE_MAP_ARRAY, 1, &distances_);
-      glTextureStorage3D(distances_, 1, GL_R32F, size, size, 6);
-      std::vector<float> texels;
-      for (int f = 0; f < 6; ++f)
-        for (int y = 0; y < size; ++y)
-          for (int x = 0; x < size; ++x) {
-            const float u = (2.0f * static_cast<float>(x) + 1.0f) / static_cast<float>(size) - 1.0f;
-            const float v = (2.0f * static_cast<float>(y) + 1.0f) / static_cast<float>(size) - 1.0f;
-            texels.push_back(hall_seen(glm::normalize(face_direction(f, u, v))).distance);
-          }
-      glTextureSubImage3D(distances_, 0, 0, 0, 0, size, size, 6, GL_RED, GL_FLOAT, texels.data());
-      glTextureParameteri(distances_, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-      glTextureParameteri(distances_, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-      frame_.reflection_probe_distances = {distances_};
-    }
-    const engine::ReflectionProbeBox box{glm::vec4(kProbe, 0.0f), glm::vec4(kRoomMin, 0.0f), glm::vec4(kRoomMax, 0.0f)};
-    glCreateBuffers(1, &boxes_);
-    glNamedBufferStorage(boxes_, sizeof box, &box, 0);
-    frame_.irradiance_atlas_texture = {atlas_};
-    frame_.reflection_probe_cubes = {cubes_};
-    frame_.reflection_probe_buffer = engine::SsboHandle<engine::ReflectionProbeBox>{boxes_};
-    frame_.reflection_probe_count = 1;
-    frame_.reflection_probe_levels = levels;
-    frame_.reflection_probe_max_roughness = max_roughness;
-  }
-  ~RoomProbe() override {
-    glDeleteTextures(1, &atlas_);
-    glDeleteTextures(1, &cubes_);
-    if (distances_ != 0) glDeleteTextures(1, &distances_);
-    glDeleteBuffers(1, &boxes_);
-  }
-  RoomProbe(const RoomProbe&) = delete;
-  RoomProbe& operator=(const RoomProbe&) = delete;
-  const engine::IndirectLightFrame& frame() override { return frame_; }
-  const char* label() const override { return "test room probe"; }
-  engine::IndirectLightFrame frame_;
-
- private:
-  GLuint atlas_ = 0, cubes_ = 0, distances_ = 0, boxes_ = 0;
-};
+ProbeProvider room_probe(float e, float max_roughness, bool hall = false, bool distances = false) {
+  const int size = 64, levels = 7;
+  std::vector<std::vector<glm::vec3>> texels;
+  for (int m = 0; m < levels; ++m)
+    texels.push_back(cube_level<glm::vec3>(size >> m, [&](glm::vec3 d) { return glm::vec3(room_radiance(d, hall)); }));
+  const std::vector<float> seen_distance =
+      cube_level<float>(size, [](glm::vec3 d) { return side_hit(d, kHallEnd).distance; });
+  return ProbeProvider(size, texels, distances ? &seen_distance : nullptr,
+                       {.atlas_irradiance = e, .max_roughness = max_roughness});
+}
 
 // The red radiance of the pixel that sees floor point p (a test failure when p is outside the frame).
 float seen(const engine::ImageRgbaF& img, const TestCamera& cam, glm::vec3 p) {
@@ -158,24 +52,9 @@ float seen(const engine::ImageRgbaF& img, const TestCamera& cam, glm::vec3 p) {
   return red(img, px);
 }
 
-struct GlossyFloor {
-  engine::SceneAsset assets;
-  engine::Registry reg;
-  TestCamera cam{{-1.5f, 1.5f, 0.0f}, {0.5f, 0.0f, 0.0f}, 1.2f, 97};
-  engine::Entity camera;
-  float roughness;
-
-  explicit GlossyFloor(float r) : roughness(r) {
-    assets.materials.push_back(diffuse_material(0.5f, r));
-    assets.meshes.push_back(plane_mesh(2.0f, 0));
-    add_mesh(reg, 0, glm::mat4(1.0f), /*is_static=*/true);
-    camera = cam.add_to(reg);
-  }
-  // The floor's directional albedo per lobe at floor point p seen from the camera.
-  engine::GltfBrdfValue albedo_at(glm::vec3 p) const {
-    const float cos_v = glm::normalize(cam.eye - p).y;
-    return engine::gltf_directional_albedo(engine::gltf_brdf(glm::vec3(0.5f), 0.0f, roughness), cos_v);
-  }
+// The camera over the floor's line z = 0, looking along +x.
+struct Floor : GlossyFloor {
+  explicit Floor(float r) : GlossyFloor(r, TestCamera{{-1.5f, 1.5f, 0.0f}, {0.5f, 0.0f, 0.0f}, 1.2f, 97}) {}
 };
 
 // On the floor's line z = 0 the view ray from the eye (-1.5, 1.5, 0) reflected at (x, 0, 0)
@@ -184,10 +63,10 @@ struct GlossyFloor {
 // (the reflection taken as infinitely far) would put that edge at x = 0.5.
 TEST(RendererReflectionProbes, TheBrightWallIsReflectedWhereTheMirrorGeometryPutsIt) {
   engine::GpuContext ctx = headless_context();
-  GlossyFloor s(0.02f);
+  Floor s(0.02f);
   auto r = make_renderer(s.assets, s.cam.size, 0.0f);
   ASSERT_NE(r, nullptr);
-  RoomProbe probe(0.0f, 0.3f);
+  ProbeProvider probe = room_probe(0.0f, 0.3f);
   r->set_indirect_light(&probe);
   r->render(s.reg, s.camera);
   const engine::ImageRgbaF img = r->read_hdr();
@@ -219,11 +98,11 @@ TEST(RendererReflectionProbes, TheBrightWallIsReflectedWhereTheMirrorGeometryPut
 // wall that way only for x > 1: a third of a metre of the reflection goes dark.
 TEST(RendererReflectionProbes, LightBeyondTheBoxsOpeningIsReflectedAtItsCapturedDistance) {
   engine::GpuContext ctx = headless_context();
-  GlossyFloor s(0.02f);
+  Floor s(0.02f);
   auto r = make_renderer(s.assets, s.cam.size, 0.0f);
   ASSERT_NE(r, nullptr);
   const auto render = [&](bool distances) {
-    RoomProbe probe(0.0f, 0.3f, /*hall=*/true, distances);
+    ProbeProvider probe = room_probe(0.0f, 0.3f, /*hall=*/true, distances);
     r->set_indirect_light(&probe);
     r->render(s.reg, s.camera);
     engine::ImageRgbaF img = r->read_hdr();
@@ -254,10 +133,10 @@ TEST(RendererReflectionProbes, ProbesReplaceTheAtlasSpecularOnlyBelowTheRoughnes
   const float e = 2.0f;
   const glm::vec3 dark(-0.6f, 0.0f, 0.0f), bright(1.0f, 0.0f, 0.0f);  // both in the frame
   {
-    GlossyFloor s(0.02f);
+    Floor s(0.02f);
     auto r = make_renderer(s.assets, s.cam.size, 0.0f);
     ASSERT_NE(r, nullptr);
-    RoomProbe probe(e, 0.3f);
+    ProbeProvider probe = room_probe(e, 0.3f);
     r->set_indirect_light(&probe);
     r->render(s.reg, s.camera);
     const engine::ImageRgbaF img = r->read_hdr();
@@ -267,10 +146,10 @@ TEST(RendererReflectionProbes, ProbesReplaceTheAtlasSpecularOnlyBelowTheRoughnes
     EXPECT_NEAR(seen(img, s.cam, bright), lit, 0.03f * lit);
   }
   {
-    GlossyFloor s(0.8f);
+    Floor s(0.8f);
     auto r = make_renderer(s.assets, s.cam.size, 0.0f);
     ASSERT_NE(r, nullptr);
-    RoomProbe probe(e, 0.3f);
+    ProbeProvider probe = room_probe(e, 0.3f);
     r->set_indirect_light(&probe);
     r->render(s.reg, s.camera);
     const engine::ImageRgbaF img = r->read_hdr();

@@ -159,6 +159,14 @@ glm::vec3 distance_corrected_direction(const ProbeCube& cube, const glm::vec3& p
   return in_front ? r : boxed;
 }
 
+ProbeCube box_filtered_chain(const ProbeCube& cube) {
+  ProbeCube out;
+  out.size = cube.size;
+  out.levels = box_chain(cube);
+  out.distance = cube.distance;
+  return out;
+}
+
 int full_mip_count(int size) { return size < 1 ? 0 : std::bit_width(static_cast<unsigned>(size)); }
 
 ProbeCube make_probe_cube(int size, int levels) {
@@ -255,7 +263,8 @@ glm::vec3 box_projected_direction(const glm::vec3& p, const glm::vec3& r, const 
 
 glm::vec3 probe_lobe_radiance(const ProbeCube& cube, const engine::GltfBrdf& brdf, const glm::vec3& p,
                               const glm::vec3& n, const glm::vec3& v, int samples, const glm::vec3& centre,
-                              const glm::vec3& box_min, const glm::vec3& box_max, bool box_only) {
+                              const glm::vec3& box_min, const glm::vec3& box_max, bool box_only,
+                              const ProbeCube* chain) {
   const int count = std::clamp(samples, 1, kProbeMaxLobeSamples);
   const float alpha = brdf.alpha, a2 = alpha * alpha;
   const float nv = std::max(glm::dot(n, v), 1e-4f);
@@ -293,13 +302,18 @@ glm::vec3 probe_lobe_radiance(const ProbeCube& cube, const engine::GltfBrdf& brd
     // the one prefiltered with the GGX lobe (solid angle about 4 pi alpha^2) of that width.
     const float pdf = g1 * engine::gltf_ggx_distribution(std::clamp(hl.z, 0.0f, 1.0f), alpha) / (4.0f * nv);
     const float alpha_m = std::sqrt(vdh / (fn * std::max(pdf, 1e-12f) * 4.0f * kPi));
-    const float lod = std::sqrt(alpha_m) * top_level;
+    float lod = std::sqrt(alpha_m) * top_level;
+    if (chain) {
+      const float texel_sr = 4.0f * kPi / (6.0f * static_cast<float>(chain->size * chain->size));
+      const float sample_sr = 1.0f / (fn * std::max(pdf, 1e-12f));
+      lod = std::max(0.5f * std::log2(sample_sr / texel_sr) + 1.0f, 0.0f);
+    }
     const float w = engine::gltf_schlick_weight(vdh);
     const glm::vec3 f = f_dielectric_scale * (brdf.dielectric_f0 + (1.0f - brdf.dielectric_f0) * w) +
                         brdf.metallic * (brdf.base_color + (1.0f - brdf.base_color) * w);
     // The BRDF-sample weight F G2 / G1 up to the factor the samples share (G1, 4 n.v).
     const glm::vec3 wi = f * (engine::gltf_smith_visibility(nv, nl, alpha) * nl);
-    sum += wi * cube_lookup_trilinear(cube, lod, corrected(l));
+    sum += wi * cube_lookup_trilinear(chain ? *chain : cube, lod, corrected(l));
     weight += wi;
   }
   const glm::vec3 fallback = cube_lookup_trilinear(cube, std::sqrt(alpha) * top_level, corrected(glm::reflect(-v, n)));

@@ -122,9 +122,17 @@ inline constexpr int kProbeLobeSamples = 4;
 /// so the caller multiplies by the specular lobe's directional albedo as with the split sum
 /// (the environment BRDF counted once; a constant cube returns that constant exactly). The
 /// same lookup as probe_lobe() in engine/shaders/reflection_probes.glsl.
+/// `chain` (optional, CPU only: the sweep's `lobe=fis_chain`, docs/reflection_probes.md): the
+/// samples read this box-filtered chain of level 0 (box_filtered_chain) instead, at the level
+/// whose texels span the sample's solid angle, + 1 (Colbert and Krivanek's own rule).
 glm::vec3 probe_lobe_radiance(const ProbeCube& cube, const engine::GltfBrdf& brdf, const glm::vec3& p,
                               const glm::vec3& n, const glm::vec3& v, int samples, const glm::vec3& centre,
-                              const glm::vec3& box_min, const glm::vec3& box_max, bool box_only);
+                              const glm::vec3& box_min, const glm::vec3& box_max, bool box_only,
+                              const ProbeCube* chain = nullptr);
+
+/// Level 0 of `cube` and its 2 x 2 box averages down to one texel per face, as a cube (what
+/// the prefilter's samples read; its distances are level 0's).
+ProbeCube box_filtered_chain(const ProbeCube& cube);
 
 /// Fills levels 1.. of `cube` from level 0 with the split-sum's prefiltered radiance (Karis
 /// 2013, "Real shading in Unreal Engine 4"): level m is the GGX lobe of alpha = r^2, r = m /

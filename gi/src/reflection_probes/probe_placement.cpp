@@ -77,6 +77,32 @@ bool free_point(const RayCaster& caster, const glm::vec3& p, const glm::vec3& lo
   return true;
 }
 
+// `v` as it is, or, when it is a corridor (its longer horizontal side more than `aspect`
+// times its shorter one), cut across its length into segments about as long as it is wide,
+// each a probe at its centre (when free) whose box reaches kProbeFadeM / 2 into the next.
+void add_probes(const RayCaster& caster, const ProbeVolume& v, float aspect, const glm::vec3& lo, const glm::vec3& hi,
+                std::vector<ProbeVolume>& probes) {
+  const glm::vec3 size = v.box_max - v.box_min;
+  const int along = size.x >= size.z ? 0 : 2;
+  const float length = size[along], width = size[2 - along];
+  if (!(aspect > 0.0f) || !(length > aspect * width)) {
+    probes.push_back(v);
+    return;
+  }
+  const int count = static_cast<int>(std::lround(length / width));
+  const float step = length / static_cast<float>(count);
+  for (int k = 0; k < count; ++k) {
+    ProbeVolume s = v;
+    s.box_min[along] = v.box_min[along] + static_cast<float>(k) * step - (k > 0 ? 0.5f * kProbeFadeM : 0.0f);
+    s.box_max[along] =
+        v.box_min[along] + static_cast<float>(k + 1) * step + (k + 1 < count ? 0.5f * kProbeFadeM : 0.0f);
+    glm::vec3 mid = v.centre;
+    mid[along] = v.box_min[along] + (static_cast<float>(k) + 0.5f) * step;
+    s.centre = free_point(caster, mid, lo, hi) ? mid : v.centre;
+    probes.push_back(s);
+  }
+}
+
 }  // namespace
 
 std::vector<ProbeVolume> place_probes(const RayCaster& caster, const glm::vec3& world_min, const glm::vec3& world_max,
@@ -114,10 +140,19 @@ std::vector<ProbeVolume> place_probes(const RayCaster& caster, const glm::vec3& 
           if (std::min({size.x, size.y, size.z}) < settings.min_box_m) continue;
           const glm::vec3 mid = 0.5f * (v->box_min + v->box_max);
           if (free_point(caster, mid, world_min, world_max)) v->centre = mid;
-          probes.push_back(*v);
+          add_probes(caster, *v, settings.corridor_aspect, world_min, world_max, probes);
+          if (static_cast<int>(probes.size()) > settings.max_probes)
+            probes.resize(static_cast<std::size_t>(settings.max_probes));
         }
   }
   return probes;
+}
+
+float probe_blend_weight(const ProbeVolume& v, const glm::vec3& p, float margin) {
+  if (glm::any(glm::lessThan(p, v.box_min - margin)) || glm::any(glm::greaterThan(p, v.box_max + margin))) return 0.0f;
+  const glm::vec3 depth = glm::min(p - v.box_min, v.box_max - p);
+  const glm::vec3 f = glm::clamp(depth / kProbeFadeM, glm::vec3(1e-3f), glm::vec3(1.0f));
+  return f.x * f.y * f.z;
 }
 
 }  // namespace gi

@@ -15,7 +15,10 @@
 // closes it in front of the wall. A candidate whose centre rays hit
 // a back face is inside solid geometry and places nothing; rays that escape stop at the
 // world's bounds (outdoors). The probe sits at its box's centre when that point is free,
-// else at the candidate. Boxes thinner than min_box_m are dropped.
+// else at the candidate. Boxes thinner than min_box_m are dropped. Optionally, a box much
+// longer than wide (corridor_aspect) becomes segments about as long as it is wide, each with its own probe
+// at its centre and its own box, reaching kProbeFadeM / 2 into its neighbours' so the
+// forward pass fades between them.
 
 #include <vector>
 
@@ -30,7 +33,18 @@ struct ProbePlacementSettings {
   float spread_m = 1.0f;   ///< Half-width of a ray bundle: openings and obstacles under half of it do not count.
   float min_box_m = 0.5f;  ///< Smallest box side kept.
   int max_probes = 64;     ///< Placement stops at this many.
+  /// When > 0, a box whose longer horizontal side is more than this times its shorter one (a
+  /// corridor) is cut across its length into segments about as long as it is wide, a probe
+  /// each, so no point of it lies far from a probe's centre. Off (0) by default: on the demo
+  /// corridor (2) the segments' level 0 is closer to the truth, but the lookup reads them
+  /// worse (docs/reflection_probes.md, "Where the corridor's error comes from"). Not stored in
+  /// the bundle (the boxes are).
+  float corridor_aspect = 0.0f;
 };
+
+/// How far (m) the segments of a cut box reach into their neighbours: the width over which
+/// the forward pass fades from one segment's probe to the next (the shader's PROBE_FADE_M).
+inline constexpr float kProbeFadeM = 0.5f;
 
 /// One probe: where its cube map is captured and the box that stands for its room.
 struct ProbeVolume {
@@ -45,5 +59,13 @@ struct ProbeVolume {
 /// The probes of the static world `caster` traces, whose geometry lies in [world_min, world_max].
 std::vector<ProbeVolume> place_probes(const RayCaster& caster, const glm::vec3& world_min, const glm::vec3& world_max,
                                       const ProbePlacementSettings& settings);
+
+/// The weight of probe `v` at point p in the forward pass's blend (the shader's probe_weight):
+/// 0 outside its box grown by `margin`, else the product over the axes of clamp(depth /
+/// kProbeFadeM, 1e-3, 1), depth p's distance from the box's nearer side along the axis
+/// (negative within the margin). The blend divides by the weights' sum, so the factors of the sides every box holding
+/// p shares (a room's floor and walls) cancel, and across the overlap of two segments the
+/// weights fade linearly from one probe to the next.
+float probe_blend_weight(const ProbeVolume& v, const glm::vec3& p, float margin);
 
 }  // namespace gi

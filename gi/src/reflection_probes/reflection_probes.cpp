@@ -93,35 +93,37 @@ glm::vec3 capture_radiance(const CaptureScene& c, const glm::vec3& origin, const
 
 // Level 0 of one probe: the mean of supersample^2 stratified rays per texel; its distances:
 // the mean distance of the rays that met a surface (kProbeFarDistance when none did).
-void capture(const CaptureScene& c, const ProbeVolume& probe, int supersample, ProbeCube& cube, ThreadPool& pool,
+// `pool` null: on the calling thread.
+void capture(const CaptureScene& c, const glm::vec3& centre, int supersample, ProbeCube& cube, ThreadPool* pool,
              std::vector<std::uint32_t>& rays) {
   const int s = cube.size;
   std::vector<glm::vec3>& out = cube.levels[0];
   rays.assign(out.size(), 0);
   cube.distance.assign(out.size(), kProbeFarDistance);
-  pool.parallel_for(
-      out.size(),
-      [&](std::size_t i) {
-        const int face = static_cast<int>(i) / (s * s), y = static_cast<int>(i) / s % s, x = static_cast<int>(i) % s;
-        glm::vec3 sum(0.0f);
-        float distance_sum = 0.0f;
-        int hits = 0;
-        for (int j = 0; j < supersample; ++j)
-          for (int k = 0; k < supersample; ++k) {
-            const float u = (static_cast<float>(x) + (static_cast<float>(k) + 0.5f) / static_cast<float>(supersample)) /
-                                static_cast<float>(s) * 2.0f -
-                            1.0f;
-            const float v = (static_cast<float>(y) + (static_cast<float>(j) + 0.5f) / static_cast<float>(supersample)) /
-                                static_cast<float>(s) * 2.0f -
-                            1.0f;
-            float distance = -1.0f;
-            sum += capture_radiance(c, probe.centre, cube_direction(face, u, v), rays[i], distance);
-            if (distance >= 0.0f) distance_sum += distance, ++hits;
-          }
-        out[i] = sum / static_cast<float>(supersample * supersample);
-        if (hits > 0) cube.distance[i] = distance_sum / static_cast<float>(hits);
-      },
-      16);
+  const auto texel = [&](std::size_t i) {
+    const int face = static_cast<int>(i) / (s * s), y = static_cast<int>(i) / s % s, x = static_cast<int>(i) % s;
+    glm::vec3 sum(0.0f);
+    float distance_sum = 0.0f;
+    int hits = 0;
+    for (int j = 0; j < supersample; ++j)
+      for (int k = 0; k < supersample; ++k) {
+        const float u = (static_cast<float>(x) + (static_cast<float>(k) + 0.5f) / static_cast<float>(supersample)) /
+                            static_cast<float>(s) * 2.0f -
+                        1.0f;
+        const float v = (static_cast<float>(y) + (static_cast<float>(j) + 0.5f) / static_cast<float>(supersample)) /
+                            static_cast<float>(s) * 2.0f -
+                        1.0f;
+        float distance = -1.0f;
+        sum += capture_radiance(c, centre, cube_direction(face, u, v), rays[i], distance);
+        if (distance >= 0.0f) distance_sum += distance, ++hits;
+      }
+    out[i] = sum / static_cast<float>(supersample * supersample);
+    if (hits > 0) cube.distance[i] = distance_sum / static_cast<float>(hits);
+  };
+  if (pool)
+    pool->parallel_for(out.size(), texel, 16);
+  else
+    for (std::size_t i = 0; i < out.size(); ++i) texel(i);
 }
 
 std::string check_atlas(const BakeInput& input, const ProbeAtlas& a) {
@@ -172,7 +174,7 @@ void bake_probe(const CaptureScene& c, ReflectionProbeSet& set, std::size_t i, T
   ProbeCube cube = make_probe_cube(st.resolution, full_mip_count(st.resolution));
   std::vector<std::uint32_t> rays;
   auto t0 = std::chrono::steady_clock::now();
-  capture(c, set.probes[i], st.supersample, cube, pool, rays);
+  capture(c, set.probes[i].centre, st.supersample, cube, &pool, rays);
   set.stats.capture_seconds += seconds_since(t0);
   set.stats.rays += std::accumulate(rays.begin(), rays.end(), std::uint64_t{0});
   t0 = std::chrono::steady_clock::now();
@@ -263,6 +265,48 @@ engine::Result<std::vector<std::size_t>> rebake_probes_touching(const BakeInput&
     redone.push_back(i);
   }
   return redone;
+}
+
+struct ProbeCapturer::Impl {
+  PreparedCapture prepared;
+  ReflectionProbeSettings settings;
+  ProbeAtlas atlas;
+  glm::vec3 sky_uniform{0.0f};
+  engine::SkyGradient sky_gradient;
+};
+
+ProbeCapturer::ProbeCapturer(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+ProbeCapturer::ProbeCapturer(ProbeCapturer&&) noexcept = default;
+ProbeCapturer& ProbeCapturer::operator=(ProbeCapturer&&) noexcept = default;
+ProbeCapturer::~ProbeCapturer() = default;
+
+engine::Result<ProbeCapturer> ProbeCapturer::make(const BakeInput& input, const ProbeAtlas& atlas,
+                                                  const ReflectionProbeSettings& settings) {
+  auto prepared = prepare_capture(input, atlas, settings);
+  if (!prepared) return prepared.error();
+  auto impl = std::make_unique<Impl>(Impl{std::move(prepared).value(), settings, atlas, input.environment.sky_radiance,
+                                          input.environment.sky_gradient});
+  return ProbeCapturer(std::move(impl));
+}
+
+ProbeCube ProbeCapturer::bake_at(const glm::vec3& centre) const {
+  const CaptureScene c{impl_->prepared.scene, impl_->atlas,
+                       impl_->prepared.live,  impl_->sky_uniform,
+                       impl_->sky_gradient,   2.0f / static_cast<float>(impl_->settings.resolution)};
+  ProbeCube cube = make_probe_cube(impl_->settings.resolution, full_mip_count(impl_->settings.resolution));
+  std::vector<std::uint32_t> rays;
+  capture(c, centre, impl_->settings.supersample, cube, nullptr, rays);
+  prefilter_ggx(cube, impl_->settings.prefilter_samples, nullptr);
+  return cube;
+}
+
+glm::vec3 ProbeCapturer::radiance(const glm::vec3& origin, const glm::vec3& d) const {
+  const CaptureScene c{impl_->prepared.scene, impl_->atlas,
+                       impl_->prepared.live,  impl_->sky_uniform,
+                       impl_->sky_gradient,   2.0f / static_cast<float>(impl_->settings.resolution)};
+  std::uint32_t rays = 0;
+  float distance = 0.0f;
+  return capture_radiance(c, origin, d, rays, distance);
 }
 
 }  // namespace gi

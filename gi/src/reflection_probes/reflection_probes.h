@@ -23,6 +23,7 @@
 #include <gi/bake_input.h>
 
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <string>
 #include <string_view>
@@ -94,5 +95,29 @@ engine::Result<ReflectionProbeSet> bake_reflection_probes(const BakeInput& input
 engine::Result<std::vector<std::size_t>> rebake_probes_touching(const BakeInput& input, const ProbeAtlas& atlas,
                                                                 ReflectionProbeSet& set, const glm::vec3& changed_min,
                                                                 const glm::vec3& changed_max);
+
+/// One prepared static world that captures probes anywhere: the oracle probes of the
+/// accuracy diagnosis (docs/reflection_probes.md, "Where the corridor's error comes from": a
+/// probe captured at the shaded point itself has no parallax error).
+class ProbeCapturer {
+ public:
+  /// Errors as bake_reflection_probes'.
+  static engine::Result<ProbeCapturer> make(const BakeInput& input, const ProbeAtlas& atlas,
+                                            const ReflectionProbeSettings& settings);
+  ProbeCapturer(ProbeCapturer&&) noexcept;
+  ProbeCapturer& operator=(ProbeCapturer&&) noexcept;
+  ~ProbeCapturer();
+
+  /// A probe centred at `centre`, captured and prefiltered as the bake's probes are (the
+  /// settings' resolution, supersample, prefilter samples); single-threaded.
+  [[nodiscard]] ProbeCube bake_at(const glm::vec3& centre) const;
+  /// What one capture ray from `origin` along unit `d` returns (the renderer's radiance where it lands).
+  [[nodiscard]] glm::vec3 radiance(const glm::vec3& origin, const glm::vec3& d) const;
+
+ private:
+  struct Impl;
+  explicit ProbeCapturer(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
 
 }  // namespace gi

@@ -9,9 +9,14 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <string>
 
+#include "core/random.h"
+#include "core/thread_pool.h"
 #include "light_atlas/light_atlas.h"
+#include "raytrace/ray_offset.h"
+#include "raytrace/reference_brdf.h"
 #include "reflection_probes/reflection_probes.h"
 #include "sweep/glossy_texels.h"
 
@@ -52,13 +57,28 @@ std::vector<KnobSpec> reflection_probes_knobs() {
                       "filtered importance sampling of the lobe at the view (probe_lobe_radiance)",
        .kind = KnobKind::Choice,
        .default_grid = {"fis"},
-       .choices = {"split_sum", "fis"}},
+       .choices = {"split_sum", "fis", "fis_chain"}},
       {.name = "lobe_samples",
        .description = "GGX samples per probe of the filtered-importance-sampled lookup (lobe=fis)",
        .kind = KnobKind::Integer,
        .default_grid = {"4"},
        .min_value = 1,
        .max_value = kProbeMaxLobeSamples},
+      {.name = "segments",
+       .description = "corridors cut into segments about as long as they are wide, a probe each (on: "
+                      "ProbePlacementSettings::corridor_aspect 2; off: one probe per box, the default)",
+       .kind = KnobKind::Choice,
+       .default_grid = {"off"},
+       .choices = {"on", "off"}},
+      {.name = "estimate",
+       .description = "what is scored (the diagnosis, docs/reflection_probes.md): runtime (the probes as the "
+                      "forward pass reads them); trace (the lobe through the capture's own radiance, traced from "
+                      "the texel: no probe); oracle_level0 / oracle (a probe captured at the texel itself, no "
+                      "parallax error: its level 0 under the exact lobe / read as the runtime reads); level0 "
+                      "(the placed probes' level 0 under the exact lobe, each sample parallax-corrected)",
+       .kind = KnobKind::Choice,
+       .default_grid = {"runtime"},
+       .choices = {"runtime", "trace", "oracle_level0", "oracle", "level0"}},
       {.name = "atlas",
        .description = "light-atlas preset whose irradiance the captures read on the static surfaces",
        .kind = KnobKind::Choice,
@@ -115,32 +135,34 @@ float depth_in_box(const ProbeVolume& v, const glm::vec3& p, const glm::vec3& n)
 // probes whose box (grown by the margin) holds p, each read along the reflection direction
 // corrected for parallax (by the captured distances, or the box alone when `box_only`) at lod
 // roughness x (levels - 1), or by the lobe's samples at the view when `lobe_samples` > 0
-// (probe_lobe_radiance), averaged, times the specular albedo.
+// (probe_lobe_radiance), blended by probe_blend_weight (faded across segments), times the specular albedo.
 // `depth`: the largest depth_in_box over those probes. False where no box holds p.
 bool probe_specular(const ReflectionProbeSet& set, const engine::GltfBrdf& brdf, const glm::vec3& p, const glm::vec3& n,
-                    const glm::vec3& v, bool box_only, int lobe_samples, glm::vec3& out, float& depth) {
+                    const glm::vec3& v, bool box_only, int lobe_samples, const std::vector<ProbeCube>* chains,
+                    glm::vec3& out, float& depth) {
   const glm::vec3 r = glm::reflect(-v, n);
   glm::vec3 sum(0.0f);
-  int count = 0;
+  float weight = 0.0f;
   depth = -1e30f;
   for (std::size_t i = 0; i < set.probes.size(); ++i) {
     const ProbeVolume& pv = set.probes[i];
-    if (glm::any(glm::lessThan(p, pv.box_min - kBoxMarginM)) || glm::any(glm::greaterThan(p, pv.box_max + kBoxMarginM)))
-      continue;
+    const float w = probe_blend_weight(pv, p, kBoxMarginM);
+    if (!(w > 0.0f)) continue;
     const ProbeCube& cube = set.cubes[i];
     if (lobe_samples > 0) {
-      sum += probe_lobe_radiance(cube, brdf, p, n, v, lobe_samples, pv.centre, pv.box_min, pv.box_max, box_only);
+      sum += w * probe_lobe_radiance(cube, brdf, p, n, v, lobe_samples, pv.centre, pv.box_min, pv.box_max, box_only,
+                                     chains ? &(*chains)[i] : nullptr);
     } else {
       const float lod = std::sqrt(brdf.alpha) * static_cast<float>(cube.levels.size() - 1);
       const glm::vec3 d = box_only ? box_projected_direction(p, r, pv.centre, pv.box_min, pv.box_max)
                                    : distance_corrected_direction(cube, p, r, pv.centre, pv.box_min, pv.box_max);
-      sum += cube_lookup_trilinear(cube, lod, d);
+      sum += w * cube_lookup_trilinear(cube, lod, d);
     }
     depth = std::max(depth, depth_in_box(pv, p, n));
-    ++count;
+    weight += w;
   }
-  if (count == 0) return false;
-  out = sum / static_cast<float>(count) * engine::gltf_directional_albedo(brdf, glm::dot(n, v)).specular;
+  if (!(weight > 0.0f)) return false;
+  out = sum / weight * engine::gltf_directional_albedo(brdf, glm::dot(n, v)).specular;
   return true;
 }
 
@@ -172,34 +194,170 @@ void add_view_band_bias(const GlossyTexels& g, const std::vector<glm::vec3>& val
   }
 }
 
-engine::Result<ReflectionProbeSet> bake_probes(const RunContext& ctx, const BakeInput& input, double& atlas_seconds) {
+// The light atlas the captures read and the probes baked from it.
+struct BakedProbes {
+  LightAtlasBake atlas;
+  ReflectionProbeSettings settings;
+  ReflectionProbeSet set;
+  [[nodiscard]] ProbeAtlas source() const {
+    return ProbeAtlas{&atlas.layout, atlas.width, atlas.height, atlas.irradiance, atlas.settings.include_direct};
+  }
+};
+
+engine::Result<BakedProbes> bake_probes(const RunContext& ctx, const BakeInput& input) {
   auto atlas_settings = light_atlas_preset(ctx.knobs.text("atlas"));
   if (!atlas_settings) return atlas_settings.error();
   atlas_settings->seed = ctx.seed;
   atlas_settings->threads = ctx.threads;
   auto atlas = bake_light_atlas(input, *atlas_settings);
   if (!atlas) return atlas.error();
-  atlas_seconds = atlas->stats.total_seconds;
-  ReflectionProbeSettings s;
+  BakedProbes b{std::move(atlas).value(), {}, {}};
+  ReflectionProbeSettings& s = b.settings;
   s.resolution = static_cast<int>(ctx.knobs.integer("resolution"));
   s.supersample = static_cast<int>(ctx.knobs.integer("supersample"));
   s.prefilter_samples = static_cast<int>(ctx.knobs.integer("prefilter"));
   s.seed = ctx.seed;
   s.threads = ctx.threads;
-  const ProbeAtlas source{&atlas->layout, atlas->width, atlas->height, atlas->irradiance,
-                          atlas->settings.include_direct};
-  return bake_reflection_probes(input, source, s);
+  if (ctx.knobs.text("segments") == "on") s.placement.corridor_aspect = 2.0f;
+  auto set = bake_reflection_probes(input, b.source(), s);
+  if (!set) return set.error();
+  b.set = std::move(set).value();
+  return b;
+}
+
+// Samples of the exact lobe per texel (the diagnosis's estimates): enough that their noise
+// (about 1/sqrt(N) of the reference's at its 1024 samples x 4) stays below the errors compared.
+constexpr int kExactLobeSamples = 4096;
+constexpr int kTracedLobeSamples = 1024;
+
+// The specular lobe's reflected radiance at a texel by Monte Carlo over the glTF BRDF as the
+// reference samples it (ReferenceBrdf, its specular share over the pdf), `incoming(l)` the
+// radiance arriving along l; the same random numbers for every estimate of the texel.
+template <typename Incoming>
+glm::vec3 exact_lobe(const engine::GltfBrdf& brdf, const glm::vec3& n, const glm::vec3& v, std::size_t texel,
+                     int samples, const Incoming& incoming) {
+  const ReferenceBrdf f{.normal = n, .material = brdf};
+  Pcg32 rng = Pcg32::for_item(0x70726f6265ull, texel);
+  glm::vec3 sum(0.0f);
+  for (int j = 0; j < samples; ++j) {
+    const float ul = rng.next_float(), u1 = rng.next_float(), u2 = rng.next_float();
+    BrdfSample bs;
+    if (!f.sample(v, ul, u1, u2, bs) || !(bs.pdf > 0.0f)) continue;
+    const glm::vec3 spec = engine::gltf_eval_cos(brdf, n, v, bs.wi).specular / bs.pdf;
+    if (spec != glm::vec3(0.0f)) sum += spec * incoming(bs.wi);
+  }
+  return sum / static_cast<float>(samples);
+}
+
+enum class Estimate { Runtime, Trace, OracleLevel0, Oracle, Level0 };
+
+Estimate estimate_of(const std::string& name) {
+  if (name == "trace") return Estimate::Trace;
+  if (name == "oracle_level0") return Estimate::OracleLevel0;
+  if (name == "oracle") return Estimate::Oracle;
+  if (name == "level0") return Estimate::Level0;
+  return Estimate::Runtime;
+}
+
+// The diagnosis's estimates at texel t (`estimate` not Runtime): see the knob `estimate`.
+glm::vec3 diagnosis_estimate(Estimate estimate, const BakedProbes& b, const ProbeCapturer& capturer,
+                             const engine::GltfBrdf& brdf, const glm::vec3& p, const glm::vec3& n, const glm::vec3& v,
+                             std::size_t t, bool box_only, int lobe_samples) {
+  const glm::vec3 origin = offset_ray_origin(p, n);
+  if (estimate == Estimate::Trace)
+    return exact_lobe(brdf, n, v, t, kTracedLobeSamples,
+                      [&](const glm::vec3& l) { return capturer.radiance(origin, l); });
+  if (estimate == Estimate::Level0) {
+    glm::vec3 sum(0.0f);
+    float weight = 0.0f;
+    for (std::size_t i = 0; i < b.set.probes.size(); ++i) {
+      const ProbeVolume& pv = b.set.probes[i];
+      const float w = probe_blend_weight(pv, p, kBoxMarginM);
+      if (!(w > 0.0f)) continue;
+      const ProbeCube& cube = b.set.cubes[i];
+      sum += w * exact_lobe(brdf, n, v, t, kExactLobeSamples, [&](const glm::vec3& l) {
+               const glm::vec3 d = box_only
+                                       ? box_projected_direction(p, l, pv.centre, pv.box_min, pv.box_max)
+                                       : distance_corrected_direction(cube, p, l, pv.centre, pv.box_min, pv.box_max);
+               return cube_lookup_trilinear(cube, 0.0f, d);
+             });
+      weight += w;
+    }
+    return weight > 0.0f ? sum / weight : glm::vec3(0.0f);
+  }
+  const ProbeCube cube = capturer.bake_at(origin);
+  if (estimate == Estimate::OracleLevel0)
+    return exact_lobe(brdf, n, v, t, kExactLobeSamples,
+                      [&](const glm::vec3& l) { return cube_lookup_trilinear(cube, 0.0f, l); });
+  // The runtime's lookup of a probe centred at the point: every direction reads as it leaves.
+  const glm::vec3 albedo = engine::gltf_directional_albedo(brdf, glm::dot(n, v)).specular;
+  if (lobe_samples > 0)
+    return probe_lobe_radiance(cube, brdf, origin, n, v, lobe_samples, origin, origin, origin, true) * albedo;
+  const float lod = std::sqrt(brdf.alpha) * static_cast<float>(cube.levels.size() - 1);
+  return cube_lookup_trilinear(cube, lod, glm::reflect(-v, n)) * albedo;
+}
+
+// With GI_PROBE_SWEEP_DUMP set to a file: one CSV row per scored texel appended to it (the
+// diagnosis's per-texel maps): the run's knobs, the texel's position, inside (1) or border
+// (0), the reference's and the estimate's radiance (RGB summed).
+void dump_texels(const RunContext& ctx, const AtlasTexels& tex, const std::vector<glm::vec3>& values,
+                 const std::vector<std::uint8_t>& inner, const std::vector<std::uint8_t>& covered) {
+  const char* path = std::getenv("GI_PROBE_SWEEP_DUMP");
+  if (!path || !*path) return;
+  std::FILE* f = std::fopen(path, "a");
+  if (!f) return;
+  const std::string label = ctx.knobs.text("estimate") + "," + ctx.knobs.text("lobe") + "," +
+                            std::to_string(ctx.knobs.integer("lobe_samples")) + "," +
+                            std::to_string(ctx.knobs.integer("resolution")) + "," +
+                            format_number(ctx.knobs.real("roughness"));
+  for (std::size_t t = 0; t < values.size(); ++t) {
+    if (!covered[t] || !ctx.reference.is_valid(t)) continue;
+    const glm::vec3& q = tex.position[t];
+    const float truth = ctx.reference.rgb[3 * t] + ctx.reference.rgb[3 * t + 1] + ctx.reference.rgb[3 * t + 2];
+    std::fprintf(f, "%s,%.3f,%.3f,%.3f,%d,%.6g,%.6g\n", label.c_str(), static_cast<double>(q.x),
+                 static_cast<double>(q.y), static_cast<double>(q.z), inner[t] ? 1 : 0, static_cast<double>(truth),
+                 static_cast<double>(values[t].x + values[t].y + values[t].z));
+  }
+  std::fclose(f);
+}
+
+// With the knob `estimate` other than runtime: `values` at the covered texels replaced by the
+// diagnosis's estimate.
+engine::Status diagnose(const RunContext& ctx, const BakedProbes& baked, const BakeInput& input, const GlossyTexels& g,
+                        const std::vector<std::uint8_t>& covered, bool box_only, int lobe_samples,
+                        std::vector<glm::vec3>& values) {
+  const Estimate estimate = estimate_of(ctx.knobs.text("estimate"));
+  if (estimate == Estimate::Runtime) return {};
+  auto capturer = ProbeCapturer::make(input, baked.source(), baked.settings);
+  if (!capturer) return capturer.error();
+  const AtlasTexels& tex = g.s.texels;
+  ThreadPool pool(ctx.threads);
+  pool.parallel_for(tex.valid.size(), [&](std::size_t t) {
+    if (!covered[t]) return;
+    const glm::vec3 v = glm::normalize(g.eye - tex.position[t]);
+    values[t] = diagnosis_estimate(estimate, baked, *capturer, g.brdf[t], tex.position[t], tex.normal[t], v, t,
+                                   box_only, lobe_samples);
+  });
+  return {};
+}
+
+// With lobe=fis_chain: each probe's box-filtered chain, which the lobe's samples read; else none.
+std::vector<ProbeCube> lookup_chains(const RunContext& ctx, const ReflectionProbeSet& set) {
+  std::vector<ProbeCube> chains;
+  if (ctx.knobs.text("lobe") == "fis_chain")
+    for (const ProbeCube& c : set.cubes) chains.push_back(box_filtered_chain(c));
+  return chains;
 }
 
 engine::Result<MethodOutput> run_reflection_probes(const RunContext& ctx) {
   const double roughness = ctx.knobs.real("roughness");
   const engine::Scene scene = engine::instantiate(with_floor_roughness(ctx.scene.asset, roughness));
-  double atlas_seconds = 0.0;
-  auto set = bake_probes(ctx, bake_input_from(scene), atlas_seconds);
-  if (!set) return set.error();
-  // Samples where a camera sees the floor (not on the line where the walls begin): the
-  // forward pass evaluates the probes at pixels, and the reference's lobe rays from a
-  // border texel's raster sample slip behind the wall (a 0 truth under a lit probe).
+  const BakeInput input = bake_input_from(scene);
+  auto baked = bake_probes(ctx, input);
+  if (!baked) return baked.error();
+  const ReflectionProbeSet* set = &baked->set;
+  // Samples where a camera sees the floor, as the forward pass's pixels (a border texel's raster
+  // sample lies on the line where the walls begin, and the reference's rays slip behind them).
   auto g = glossy_texels(ctx.scene, ctx.knobs.real("density"), roughness, nullptr, TexelPlacement::VisibleSurface);
   if (!g) return g.error();
   const AtlasTexels& tex = g->s.texels;
@@ -210,19 +368,24 @@ engine::Result<MethodOutput> run_reflection_probes(const RunContext& ctx) {
   std::vector<std::uint8_t> covered(tex.valid.size(), 0), inner(tex.valid.size(), 0), edge(tex.valid.size(), 0);
   std::size_t uncovered = 0;
   const bool box_only = ctx.knobs.text("parallax") == "box";
-  const int lobe_samples = ctx.knobs.text("lobe") == "fis" ? static_cast<int>(ctx.knobs.integer("lobe_samples")) : 0;
+  const int lobe_samples =
+      ctx.knobs.text("lobe") != "split_sum" ? static_cast<int>(ctx.knobs.integer("lobe_samples")) : 0;
+  const std::vector<ProbeCube> chains = lookup_chains(ctx, *set);
   for (std::size_t t = 0; t < tex.valid.size(); ++t) {
     if (!g->glossy[t]) continue;
     float depth = 0.0f;
     const glm::vec3 v = glm::normalize(g->eye - tex.position[t]);
-    if (!probe_specular(*set, g->brdf[t], tex.position[t], tex.normal[t], v, box_only, lobe_samples, values[t],
-                        depth)) {
+    if (!probe_specular(*set, g->brdf[t], tex.position[t], tex.normal[t], v, box_only, lobe_samples,
+                        chains.empty() ? nullptr : &chains, values[t], depth)) {
       ++uncovered;
       continue;
     }
     covered[t] = 1;
     (depth < border ? edge : inner)[t] = 1;
   }
+  if (auto diagnosed = diagnose(ctx, *baked, input, *g, covered, box_only, lobe_samples, values); !diagnosed)
+    return diagnosed.error();
+  dump_texels(ctx, tex, values, inner, covered);
   MethodOutput out;
   out.field = RgbField::from_texels(tex.width, tex.height, values, covered);
   out.costs.bake_seconds = set->stats.total_seconds;
@@ -242,7 +405,7 @@ engine::Result<MethodOutput> run_reflection_probes(const RunContext& ctx) {
                 {"probes", static_cast<double>(set->probes.size())},
                 {"capture_seconds", set->stats.capture_seconds},
                 {"prefilter_seconds", set->stats.prefilter_seconds},
-                {"atlas_seconds", atlas_seconds}};
+                {"atlas_seconds", baked->atlas.stats.total_seconds}};
   add_view_band_bias(*g, values, covered, ctx.reference, out.extras);
   return out;
 }

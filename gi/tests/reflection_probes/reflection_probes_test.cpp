@@ -127,6 +127,44 @@ TEST(ReflectionProbePlacement, ANarrowCorridorBetweenTheGridsCandidatesGetsAProb
   EXPECT_NEAR(glm::length(corridor->box_max - glm::vec3(5, 3, 16.4f)), 0.0f, 1e-3f);
 }
 
+// With corridor_aspect 2 the same corridor (8 m long, 2 m wide) becomes 4 segments of 2 m, a
+// probe at each one's centre, each box reaching kProbeFadeM / 2 into the next; the blend's
+// weights are equal on the plane between two segments and fade to (almost) nothing at the far
+// end of their overlap, and the sides all of them share (the floor) cancel.
+TEST(ReflectionProbePlacement, ACorridorCutIntoSegmentsFadesFromOneProbeToTheNext) {
+  gi::BakeInput in;
+  in.name = "hub and corridor";
+  in.materials.push_back(lambert(0.5f));
+  add_static(in, room({0, 0, 0}, {8.2f, 3, 8.2f}), "hub");
+  add_static(in, room({3, 0, 8.4f}, {5, 3, 16.4f}), "corridor");
+  auto caster = gi::make_embree_ray_caster(gi::rt_scene_from(in));
+  ASSERT_TRUE(caster) << caster.error().to_string();
+  gi::ProbePlacementSettings settings;
+  settings.corridor_aspect = 2.0f;
+  auto probes = gi::place_probes(**caster, {-0.2f, 0, -0.2f}, {8.4f, 3, 16.4f}, settings);
+  std::erase_if(probes, [](const gi::ProbeVolume& v) { return v.box_min.z < 8.0f; });  // the hub's
+  ASSERT_EQ(probes.size(), 4u);
+  std::sort(probes.begin(), probes.end(), [](const auto& p, const auto& q) { return p.centre.z < q.centre.z; });
+  const float half_fade = 0.5f * gi::kProbeFadeM;
+  for (int k = 0; k < 4; ++k) {
+    const gi::ProbeVolume& v = probes[static_cast<std::size_t>(k)];
+    const float z0 = 8.4f + 2.0f * static_cast<float>(k), z1 = z0 + 2.0f;
+    EXPECT_NEAR(glm::length(v.centre - glm::vec3(4.0f, 1.5f, z0 + 1.0f)), 0.0f, 1e-3f) << "segment " << k;
+    EXPECT_NEAR(v.box_min.z, k > 0 ? z0 - half_fade : z0, 1e-3f) << "segment " << k;
+    EXPECT_NEAR(v.box_max.z, k < 3 ? z1 + half_fade : z1, 1e-3f) << "segment " << k;
+    EXPECT_NEAR(v.box_min.x, 3.0f, 1e-3f);
+    EXPECT_NEAR(v.box_max.x, 5.0f, 1e-3f);
+  }
+  const auto ratio = [&](glm::vec3 p) {
+    return gi::probe_blend_weight(probes[2], p, 0.05f) / gi::probe_blend_weight(probes[1], p, 0.05f);
+  };
+  EXPECT_NEAR(ratio({4.0f, 0.0f, 12.4f}), 1.0f, 1e-4f);  // on the floor, between segments 1 and 2
+  EXPECT_NEAR(ratio({3.1f, 1.0f, 12.4f}), 1.0f, 1e-4f);  // near a wall
+  EXPECT_LT(ratio({4.0f, 0.0f, 12.4f - half_fade + 0.01f}), 0.05f);
+  EXPECT_GT(ratio({4.0f, 0.0f, 12.4f + half_fade - 0.01f}), 20.0f);
+  EXPECT_EQ(gi::probe_blend_weight(probes[2], {4.0f, 0.0f, 11.0f}, 0.05f), 0.0f);
+}
+
 // A closed 3 m room of albedo 0.5 whose atlas holds the same irradiance E everywhere: every
 // surface sends E / pi x 0.5 (a Lambertian's directional albedo is its albedo), so the probe
 // sees that radiance in every direction, and each prefiltered level keeps it.
@@ -194,6 +232,43 @@ TEST(ReflectionProbeBake, AChangeInOneRoomRebakesOnlyItsProbe) {
       set->stats.capture_seconds, set->stats.prefilter_seconds, static_cast<unsigned long long>(set->stats.rays),
       updated.stats.capture_seconds, updated.stats.prefilter_seconds,
       static_cast<unsigned long long>(updated.stats.rays));
+}
+
+// The diagnosis's oracle probes (ProbeCapturer, docs/reflection_probes.md, "Where the corridor's
+// error comes from"): a probe captured anywhere by the capturer is, at a placed probe's centre,
+// bit for bit the bake's, levels and distances; its single rays are what the capture averages
+// (the lamp's direct light where it reaches, the atlas's light everywhere).
+TEST(ReflectionProbeBake, TheCapturerAtAProbesCentreIsTheBakesProbe) {
+  gi::BakeInput in = two_rooms();
+  gi::BakeLight lamp;
+  lamp.name = "lamp";
+  lamp.light.type = engine::LightType::Point;
+  lamp.light.intensity = 20.0f;
+  lamp.light_to_world = glm::translate(glm::mat4(1.0f), glm::vec3(2, 2.5f, 2));
+  in.lights.push_back(lamp);
+  auto layout = gi::static_world_layout(in, 4.0f);
+  ASSERT_TRUE(layout);
+  const std::vector<glm::vec3> irradiance(static_cast<std::size_t>(layout->width * layout->height), glm::vec3(0.1f));
+  const gi::ProbeAtlas atlas{&*layout, layout->width, layout->height, irradiance, false};
+  gi::ReflectionProbeSettings s;
+  s.resolution = 16;
+  s.prefilter_samples = 32;
+  s.threads = 2;
+  auto set = gi::bake_reflection_probes(in, atlas, s);
+  ASSERT_TRUE(set) << set.error().to_string();
+  auto capturer = gi::ProbeCapturer::make(in, atlas, s);
+  ASSERT_TRUE(capturer) << capturer.error().to_string();
+  for (std::size_t i = 0; i < set->probes.size(); ++i) {
+    const gi::ProbeCube cube = capturer->bake_at(set->probes[i].centre);
+    EXPECT_EQ(cube.levels, set->cubes[i].levels) << "probe " << i;
+    EXPECT_EQ(cube.distance, set->cubes[i].distance) << "probe " << i;
+  }
+  // The floor below the lamp: the lamp's direct light (20 / 2.5^2 W/m^2) and the atlas's 0.1,
+  // times 0.5 / pi. The other room's ceiling, above the doorway's top, has the atlas's alone.
+  const glm::vec3 lit = capturer->radiance({2, 1, 2}, {0, -1, 0});
+  EXPECT_NEAR(lit.x, (20.0f / 6.25f + 0.1f) * 0.5f / std::numbers::pi_v<float>, 0.02f);
+  const glm::vec3 dark = capturer->radiance({6.2f, 1, 2}, {0, 1, 0});
+  EXPECT_NEAR(dark.x, 0.1f * 0.5f / std::numbers::pi_v<float>, 0.002f);
 }
 
 }  // namespace
