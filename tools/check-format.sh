@@ -27,31 +27,11 @@ cd "$(dirname "$0")/.."
 fmt=${CLANG_FORMAT:-clang-format-14}
 command -v "$fmt" >/dev/null || { echo "check-format: $fmt not found (apt install clang-format-14)" >&2; exit 2; }
 
-# Shaders that other branches were changing when the shaders joined the check (30 Nov 2026): the
-# whole-tree check and fix leave them alone until they are formatted (tools/check-format.sh --fix
-# FILE, after those branches are merged); then their lines here go. Named files are always checked.
-pending=(
-  engine/shaders/directional_radiance.glsl
-  engine/shaders/forward.frag.glsl
-  engine/shaders/forward.vert.glsl
-  engine/shaders/reflection_probes.glsl
-)
-
 if [ ${#named[@]} -gt 0 ]; then
   files=("${named[@]}")
 else
   files=()
-  while IFS= read -r f; do
-    for p in "${pending[@]}"; do [ "$f" = "$p" ] && continue 2; done
-    files+=("$f")
-  done < <(git ls-files '*.cpp' '*.h' '*.hpp' '*.glsl')
-  for p in "${pending[@]}"; do
-    if [ -f "$p" ] && "$fmt" "$p" | cmp -s - "$p"; then
-      echo "check-format: $p is pending but already clean: remove it from tools/check-format.sh's pending list" >&2
-    else
-      echo "check-format: $p left out (pending, see tools/check-format.sh)" >&2
-    fi
-  done
+  while IFS= read -r f; do files+=("$f"); done < <(git ls-files '*.cpp' '*.h' '*.hpp' '*.glsl')
 fi
 
 if [ $fix = 1 ]; then

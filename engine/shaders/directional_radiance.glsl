@@ -23,8 +23,12 @@ struct DirectionalBin {
   vec3 direction;
   float scale;
 };
-layout(std430, binding = DIRECTIONAL_RADIANCE_BINDING) readonly buffer DirectionalRadiance { DirectionalRadianceElement dr_values[]; };
-layout(std430, binding = DIRECTIONAL_DIRECTION_BINDING) readonly buffer DirectionalDirections { DirectionalBin dr_directions[]; };
+layout(std430, binding = DIRECTIONAL_RADIANCE_BINDING) readonly buffer DirectionalRadiance {
+  DirectionalRadianceElement dr_values[];
+};
+layout(std430, binding = DIRECTIONAL_DIRECTION_BINDING) readonly buffer DirectionalDirections {
+  DirectionalBin dr_directions[];
+};
 
 vec3 directional_bin_radiance(int bin, int element, int element_count) {
   DirectionalRadianceElement p = dr_values[bin * element_count + element];
@@ -103,8 +107,9 @@ vec3 directional_specular(GltfBrdf m, vec3 n, vec3 v, DirectionalTexels texels, 
     int k = directional_bin_of(l, bin_count);
     if (k < 0) continue;
     float fresnel_w = gltf_schlick_weight(dot(v, h));
-    vec3 fresnel = (1.0 - m.metallic) * m.specular_weight * (m.dielectric_f0 + (vec3(1.0) - m.dielectric_f0) * fresnel_w) +
-                   m.metallic * (m.base_color + (vec3(1.0) - m.base_color) * fresnel_w);
+    vec3 fresnel =
+        (1.0 - m.metallic) * m.specular_weight * (m.dielectric_f0 + (vec3(1.0) - m.dielectric_f0) * fresnel_w) +
+        m.metallic * (m.base_color + (vec3(1.0) - m.base_color) * fresnel_w);
     vec3 w = fresnel * (4.0 * n_dot_l * n_dot_v * gltf_smith_visibility(n_dot_v, n_dot_l, a) / g1);
     sum_w += w;
     sum += w * directional_bin_radiance(k, texels, element_count);
@@ -115,8 +120,8 @@ vec3 directional_specular(GltfBrdf m, vec3 n, vec3 v, DirectionalTexels texels, 
 
 // L_spec for stored element `element` alone.
 vec3 directional_specular(GltfBrdf m, vec3 n, vec3 v, int element, int bin_count, int element_count) {
-  return directional_specular(m, n, v, DirectionalTexels(ivec4(element, -1, -1, -1), vec4(1.0, 0.0, 0.0, 0.0)), bin_count,
-                              element_count);
+  return directional_specular(m, n, v, DirectionalTexels(ivec4(element, -1, -1, -1), vec4(1.0, 0.0, 0.0, 0.0)),
+                              bin_count, element_count);
 }
 
 // The footprint of uv1 point `uv` over the index texture (texel centres at (i + 0.5) / size):

@@ -159,9 +159,10 @@ void main() {
 #if DIRECTIONAL_LIGHTS > 0
   for (int k = 0; k < DIRECTIONAL_LIGHTS; ++k) {
     const int i = POINT_LIGHTS + SPOT_LIGHTS + k;
-    radiance += live(lights[i]) * directional_light_radiance(lights[i], s, to_light) *
-                (lights[i].radiant.w > 0.0 ? shadow_2d_disc(lights[i], s.position, s.normal, to_light)  // the sun's disc
-                                           : shadow_2d_sun(lights[i], s.position, s.normal, to_light));
+    radiance +=
+        live(lights[i]) * directional_light_radiance(lights[i], s, to_light) *
+        (lights[i].radiant.w > 0.0 ? shadow_2d_disc(lights[i], s.position, s.normal, to_light)  // the sun's disc
+                                   : shadow_2d_sun(lights[i], s.position, s.normal, to_light));
   }
 #endif
 #if AREA_LIGHTS > 0
@@ -190,8 +191,9 @@ void main() {
     float sky_t = acos(clamp(s.normal.y, -1.0, 1.0));
     float sky_k_up = (2.0 / 3.0) * ((PI - sky_t) * cos(sky_t) + sin(sky_t));
     float sky_k_down = (2.0 / 3.0) * (sky_t * cos(PI - sky_t) + sin(sky_t));
-    vec3 sky_l = u_sky_radiance + max(u_sky_gradient[0] + (u_sky_gradient[1] * sky_k_up + u_sky_gradient[2] * sky_k_down) / PI,
-                                      vec3(0.0));
+    vec3 sky_l =
+        u_sky_radiance +
+        max(u_sky_gradient[0] + (u_sky_gradient[1] * sky_k_up + u_sky_gradient[2] * sky_k_down) / PI, vec3(0.0));
     vec3 n2 = s.normal * s.normal;
     sky_l *= dot(n2, mix(u_sky_visibility_neg, u_sky_visibility_pos, step(vec3(0.0), s.normal)));
     if (any(greaterThan(sky_l, vec3(0.0)))) {

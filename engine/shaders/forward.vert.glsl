@@ -56,7 +56,8 @@ float lobe_at(int k, int res, vec2 s) {
   const int u1 = min(u0 + 1, res - 1), v1 = min(v0 + 1, res - 1);
   const float tu = fu - float(u0), tv = fv - float(v0);
   const int base = k * res * res;
-  return (1.0 - tv) * ((1.0 - tu) * lobe_table[base + v0 * res + u0].value + tu * lobe_table[base + v0 * res + u1].value) +
+  return (1.0 - tv) *
+             ((1.0 - tu) * lobe_table[base + v0 * res + u0].value + tu * lobe_table[base + v0 * res + u1].value) +
          tv * ((1.0 - tu) * lobe_table[base + v1 * res + u0].value + tu * lobe_table[base + v1 * res + u1].value);
 }
 
@@ -93,7 +94,8 @@ void main() {
   v_uv1 = a_uv1;
   const mat3 linear = mat3(u_model);
   v_tangent = vec4(linear * a_tangent.xyz, determinant(linear) < 0.0 ? -a_tangent.w : a_tangent.w);
-  v_vertex_irradiance = u_use_vertex_irradiance != 0 ? vertex_irradiance[gl_VertexID - u_mesh_first_vertex].irradiance : vec3(0.0);
+  v_vertex_irradiance =
+      u_use_vertex_irradiance != 0 ? vertex_irradiance[gl_VertexID - u_mesh_first_vertex].irradiance : vec3(0.0);
   v_lobe_radiance = lobe_radiance(world.xyz);
   gl_Position = u_view_proj * world;
 }

@@ -103,8 +103,8 @@ vec3 probe_direction(vec3 p, vec3 r, ReflectionProbeBox probe, int i) {
 // probe_lobe_radiance, probe_cube.cpp, the same samples and weights): u_probe_lobe_samples half
 // vectors from GGX's visible normals at v (Hammersley points), each reflected direction
 // corrected for parallax and read at the level prefiltered for the sample's share of the lobe
-// (its solid angle 1 / (count pdf), narrowed across the reflection's plane by v.h); weighted by F G2 / G1 and normalized per channel (the caller multiplies by the
-// directional albedo, as with the split sum).
+// (its solid angle 1 / (count pdf), narrowed across the reflection's plane by v.h); weighted by F G2 / G1 and
+// normalized per channel (the caller multiplies by the directional albedo, as with the split sum).
 vec3 probe_lobe(Surface s, ReflectionProbeBox probe, int i) {
   int count = clamp(u_probe_lobe_samples, 1, PROBE_MAX_LOBE_SAMPLES);
   float alpha = s.brdf.alpha, a2 = alpha * alpha;
@@ -145,7 +145,8 @@ vec3 probe_lobe(Surface s, ReflectionProbeBox probe, int i) {
   bvec3 some = greaterThan(weight, vec3(0.0));
   if (all(some)) return sum / weight;
   vec3 fallback = textureLod(u_probe_cubes, vec4(probe_direction(s.position, reflect(-v, n), probe, i), float(i)),
-                             sqrt(alpha) * top_level).rgb;
+                             sqrt(alpha) * top_level)
+                      .rgb;
   return mix(fallback, sum / max(weight, vec3(1e-30)), vec3(some));
 }
 
@@ -157,8 +158,8 @@ bool reads_probes(Surface s, bool atlas, bool dynamic) {
 
 // Probe i's weight at p in the blend (gi's probe_blend_weight, probe_placement.cpp): 0 outside
 // its box grown by the margin, else the product over the axes of clamp(depth / PROBE_FADE_M,
-// 1e-3, 1), depth the distance from the box's nearer side; the sides every box holding p shares cancel in the normalization,
-// and across two segments' overlap the weights fade linearly from one to the next.
+// 1e-3, 1), depth the distance from the box's nearer side; the sides every box holding p shares cancel in the
+// normalization, and across two segments' overlap the weights fade linearly from one to the next.
 float probe_weight(vec3 p, ReflectionProbeBox probe) {
   if (any(lessThan(p, probe.box_min.xyz - PROBE_BOX_MARGIN_M)) ||
       any(greaterThan(p, probe.box_max.xyz + PROBE_BOX_MARGIN_M)))
