@@ -127,18 +127,24 @@ void add_view_band_bias(const GlossyTexels& g, const std::vector<glm::vec3>& dlm
   }
 }
 
-engine::Result<MethodOutput> run_dlm(const RunContext& ctx) {
+// The bake's settings from the run's knobs.
+DlmSettings dlm_settings(const RunContext& ctx, double floor_roughness) {
   DlmSettings s;
   s.directions = static_cast<int>(ctx.knobs.integer("directions"));
   s.photons = static_cast<std::uint64_t>(ctx.knobs.integer("kphotons")) * 1000u;
   s.texels_per_metre = static_cast<float>(ctx.knobs.real("density"));
   s.splat_radius_texels = static_cast<float>(ctx.knobs.real("splat"));
-  const double floor_roughness = ctx.knobs.real("roughness");
   s.glossy_roughness = static_cast<float>(glossy_threshold(floor_roughness));
   s.tangent_frame_bins = ctx.knobs.text("bins") == "tangent";
   s.seed = ctx.seed;
   s.threads = ctx.threads;
   s.progress = ctx.progress;
+  return s;
+}
+
+engine::Result<MethodOutput> run_dlm(const RunContext& ctx) {
+  const double floor_roughness = ctx.knobs.real("roughness");
+  const DlmSettings s = dlm_settings(ctx, floor_roughness);
   const engine::Scene scene = engine::instantiate(with_floor_roughness(ctx.scene.asset, floor_roughness));
   auto dlm = bake_dlm(bake_input_from(scene), s);
   if (!dlm) return dlm.error();
