@@ -195,20 +195,35 @@ TEST(ReflectionProbeBake, UniformlyLitClosedRoomIsUniformAtEveryLevel) {
     }
 }
 
-// The two rooms lit by a lamp in room A: re-baking for a change inside room B redoes probe B
-// alone, bit for bit what a whole bake gives it, and leaves probe A untouched.
-TEST(ReflectionProbeBake, AChangeInOneRoomRebakesOnlyItsProbe) {
-  gi::BakeInput in = two_rooms();
+// The two rooms lit by a 20 W/sr lamp in room A, 2.5 m above its floor, and an atlas of
+// 0.1 W/m^2 everywhere at 4 texels/m (not holding the lamp's light).
+struct LitTwoRooms {
+  gi::BakeInput in;
+  gi::AtlasLayout layout;
+  std::vector<glm::vec3> irradiance;
+  gi::ProbeAtlas atlas() const { return {&layout, layout.width, layout.height, irradiance, false}; }
+};
+
+LitTwoRooms lit_two_rooms() {
+  LitTwoRooms r;
+  r.in = two_rooms();
   gi::BakeLight lamp;
   lamp.name = "lamp";
   lamp.light.type = engine::LightType::Point;
   lamp.light.intensity = 20.0f;
   lamp.light_to_world = glm::translate(glm::mat4(1.0f), glm::vec3(2, 2.5f, 2));
-  in.lights.push_back(lamp);
-  auto layout = gi::static_world_layout(in, 4.0f);
-  ASSERT_TRUE(layout);
-  const std::vector<glm::vec3> irradiance(static_cast<std::size_t>(layout->width * layout->height), glm::vec3(0.1f));
-  const gi::ProbeAtlas atlas{&*layout, layout->width, layout->height, irradiance, false};
+  r.in.lights.push_back(lamp);
+  r.layout = gi::static_world_layout(r.in, 4.0f).value();
+  r.irradiance.assign(static_cast<std::size_t>(r.layout.width * r.layout.height), glm::vec3(0.1f));
+  return r;
+}
+
+// The two rooms lit by a lamp in room A: re-baking for a change inside room B redoes probe B
+// alone, bit for bit what a whole bake gives it, and leaves probe A untouched.
+TEST(ReflectionProbeBake, AChangeInOneRoomRebakesOnlyItsProbe) {
+  const LitTwoRooms rooms = lit_two_rooms();
+  const gi::BakeInput& in = rooms.in;
+  const gi::ProbeAtlas atlas = rooms.atlas();
   gi::ReflectionProbeSettings s;
   s.resolution = 32;
   s.prefilter_samples = 64;
@@ -239,17 +254,9 @@ TEST(ReflectionProbeBake, AChangeInOneRoomRebakesOnlyItsProbe) {
 // bit for bit the bake's, levels and distances; its single rays are what the capture averages
 // (the lamp's direct light where it reaches, the atlas's light everywhere).
 TEST(ReflectionProbeBake, TheCapturerAtAProbesCentreIsTheBakesProbe) {
-  gi::BakeInput in = two_rooms();
-  gi::BakeLight lamp;
-  lamp.name = "lamp";
-  lamp.light.type = engine::LightType::Point;
-  lamp.light.intensity = 20.0f;
-  lamp.light_to_world = glm::translate(glm::mat4(1.0f), glm::vec3(2, 2.5f, 2));
-  in.lights.push_back(lamp);
-  auto layout = gi::static_world_layout(in, 4.0f);
-  ASSERT_TRUE(layout);
-  const std::vector<glm::vec3> irradiance(static_cast<std::size_t>(layout->width * layout->height), glm::vec3(0.1f));
-  const gi::ProbeAtlas atlas{&*layout, layout->width, layout->height, irradiance, false};
+  const LitTwoRooms rooms = lit_two_rooms();
+  const gi::BakeInput& in = rooms.in;
+  const gi::ProbeAtlas atlas = rooms.atlas();
   gi::ReflectionProbeSettings s;
   s.resolution = 16;
   s.prefilter_samples = 32;
