@@ -1,29 +1,23 @@
 // engine::Renderer: shadow maps, a forward linear-HDR pass (RGBA16F + depth), then
 // exposure, ACES-fitted tonemap and sRGB encoding into an RGBA8 target. The class is declared
-// in render/forward_renderer.h; its light reach and half-resolution area shadows live in
-// forward_reach.cpp and forward_area_shadow.cpp.
+// in render/forward_renderer.h with the map of its files; this one holds the frame (its
+// targets, what it draws, its passes in order) and Renderer::create.
 #include "render/forward_renderer.h"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
-#include <cstdio>
 #include <cstring>
-#include <map>
 #include <set>
 #include <string>
 #include <utility>
 
 #include <GL/glcorearb.h>
 #include <glm/gtc/matrix_transform.hpp>
-#include <glm/gtc/type_ptr.hpp>
 
 #include <engine/components.h>
 #include <engine/gpu/gl_objects.h>
-#include <engine/gpu/gltf_brdf_texture.h>
 #include <engine/gpu/gpu_timer.h>
 #include <engine/gpu/shader_program.h>
-#include <engine/light_reach.h>
 #include <engine/log.h>
 #include <engine/runtime_limits.h>
 
@@ -55,55 +49,12 @@ GlTexture no_directional_index() {
 
 namespace {
 
-enum IndirectMode : int { kIndirectNone = 0, kIndirectAmbient = 1, kIndirectAtlas = 2, kIndirectVertex = 3 };
-
 Result<LocatedProgram<DepthUniforms>> build_depth(const char* fragment) {
   return link_program<DepthUniforms>(ShaderProgramBuilder(engine_shader_files()),
                                      {{ShaderStage::Vertex, "shadow.vert.glsl"}, {ShaderStage::Fragment, fragment}});
 }
 
-// The forward program for one combination of light counts (see forward.frag.glsl).
-Result<LocatedProgram<ForwardUniforms>> build_forward(const LightCounts& n) {
-  ShaderProgramBuilder b(engine_shader_files());
-  b.define("POINT_LIGHTS " + std::to_string(n[0]))
-      .define("SPOT_LIGHTS " + std::to_string(n[1]))
-      .define("DIRECTIONAL_LIGHTS " + std::to_string(n[2]))
-      .define("AREA_LIGHTS " + std::to_string(n[3]))
-      .define("AREA_SPECULAR_SIDE " + std::to_string(n[4]))
-      .define("AREA_SOFT_SHADOWS " + std::to_string(n[5]))
-      .define("SKY_TERM " + std::to_string(n[6]))
-      .define("AREA_SHADOW_HALF " + std::to_string(n[7]))
-      .define("FLAT_SHADING " + std::to_string(n[8]));
-  return link_program<ForwardUniforms>(
-      std::move(b), {{ShaderStage::Vertex, "forward.vert.glsl"}, {ShaderStage::Fragment, "forward.frag.glsl"}});
-}
-
-// A dielectric whose roughness is at least kRoughForOnePoint everywhere (no roughness texture):
-// its GGX lobe is far wider than the spread of directions to an area light's points, so one
-// specular point per rectangle (the centre) gives its radiance within about 1% (1.02% worst
-// at roughness 0.9, RendererAreaLight.RoughDielectricsTakeOneSpecularPoint).
-constexpr float kRoughForOnePoint = 0.9f;
-bool rough_dielectric(const render::GpuMaterial& m, GLuint white_texture) {
-  return m.metallic == 0.0f && m.roughness >= kRoughForOnePoint && m.metallic_roughness_texture == white_texture;
-}
-
-// A provider's SSBO of `Element`s at `binding`, where the engine's shaders declare that element.
-template <class Element>
-void bind_ssbo(GLuint binding, SsboHandle<Element> buffer) {
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding, buffer.gl_name);
-}
-
 }  // namespace
-
-const LocatedProgram<ForwardUniforms>& ForwardRenderer::forward_program(const LightCounts& counts) {
-  auto it = forward_variants_.find(counts);
-  if (it != forward_variants_.end()) return it->second;
-  Result<LocatedProgram<ForwardUniforms>> p = build_forward(counts);
-  // The variant without lights compiled in create(); a failure here is a shader bug.
-  if (!p) log_message(LogLevel::Error, p.error().to_string());
-  GI_EXPECTS(p.ok(), "forward shader variant must compile");
-  return forward_variants_.emplace(counts, std::move(p.value())).first->second;
-}
 
 void ForwardRenderer::ensure_targets() {
   GI_EXPECTS(settings_.width > 0 && settings_.height > 0, "render size must be positive");
@@ -295,413 +246,6 @@ ForwardRenderer::CameraView ForwardRenderer::camera_view(const Registry& registr
           glm::vec3(camera_world[3])};
 }
 
-// The HDR target cleared to the sky, the depth pre-pass (and the reach stencil), the
-// half-resolution area shadows; then the state that shades only each pixel's visible surface.
-void ForwardRenderer::begin_forward_pass(const CameraView& view, const std::vector<DrawItem>& items, bool reach) {
-  glBindFramebuffer(GL_FRAMEBUFFER, hdr_fbo_.id());
-  glViewport(0, 0, width_, height_);
-  // Where no geometry is, the camera sees the sky (black without one), as the path tracer does.
-  // With a gradient, the horizon's radiance (what a level camera sees at the image's centre).
-  const glm::vec3 sky_bg = sky_radiance(settings_.sky_radiance, settings_.sky_gradient, glm::vec3(1.0f, 0.0f, 0.0f));
-  const float background[4] = {sky_bg.x, sky_bg.y, sky_bg.z, 1.0f};
-  const float far_depth = 1.0f;
-  glClearNamedFramebufferfv(hdr_fbo_.id(), GL_COLOR, 0, background);
-  glClearNamedFramebufferfi(hdr_fbo_.id(), GL_DEPTH_STENCIL, 0, far_depth, 0);
-  glEnable(GL_DEPTH_TEST);
-  glDisable(GL_BLEND);
-  glFrontFace(GL_CCW);
-  glCullFace(GL_BACK);
-  glBindVertexArray(scene_.vertex_array());
-  depth_prepass(view.view_proj, items, reach);
-  if (!area_lights_.empty()) {
-    area_shadow_passes(view.view_proj, view.position, items);
-    glBindFramebuffer(GL_FRAMEBUFFER, hdr_fbo_.id());
-    glViewport(0, 0, width_, height_);
-    glBindVertexArray(scene_.vertex_array());
-    glBindTextureUnit(kAreaVisibilityUnit, area_visibility_.id());
-  }
-  // Shade only the visible surface of each pixel (llvmpipe pays per shaded fragment).
-  glDepthFunc(GL_EQUAL);
-  glDepthMask(GL_FALSE);
-  if (reach) {  // ... with the lights of its reach mask (the stencil the pre-pass wrote)
-    glEnable(GL_STENCIL_TEST);
-    glStencilMask(0);
-    glStencilOp(GL_KEEP, GL_KEEP, GL_KEEP);
-  }
-}
-
-// The shadow maps, the provider's textures and buffers and the BRDF table on their units.
-ForwardRenderer::ForwardInputs ForwardRenderer::bind_forward_inputs(const IndirectLightFrame* indirect) {
-  glBindTextureUnit(kShadowMapsUnit, shadow_maps_.maps_2d());
-  glBindTextureUnit(kPointShadowMapsUnit, shadow_maps_.cube_maps());
-  glBindTextureUnit(kShadowDepthUnit, shadow_maps_.maps_2d());
-  glBindSampler(kShadowDepthUnit, shadow_depth_sampler_.id());
-  glBindTextureUnit(kSunShadowMapsUnit, shadow_maps_.sun_maps());
-  glBindTextureUnit(kSunShadowDepthUnit, shadow_maps_.sun_maps());
-  glBindSampler(kSunShadowDepthUnit, shadow_depth_sampler_.id());
-  ForwardInputs in;
-  in.indirect = indirect;
-  in.atlas = indirect ? indirect->irradiance_atlas_texture.gl_name : 0;
-  in.glossy = indirect ? indirect->glossy_radiance_texture.gl_name : 0;
-  glBindTextureUnit(kIrradianceAtlasUnit, in.atlas != 0 ? in.atlas : scene_.white_texture());
-  glBindTextureUnit(kGlossyUnit, in.glossy != 0 ? in.glossy : scene_.white_texture());
-  glBindTextureUnit(kGltfAlbedoTableUnit, albedo_table_.id());
-  // Directional radiance of static surfaces (IndirectLightFrame::directional_*), when provided.
-  in.directional = indirect != nullptr && indirect->directional_index_texture &&
-                   indirect->directional_radiance_buffer && indirect->directional_direction_buffer &&
-                   indirect->directional_bin_count > 0 && indirect->directional_element_count > 0;
-  glBindTextureUnit(kDirectionalIndexUnit,
-                    in.directional ? indirect->directional_index_texture.gl_name : no_directional_index_.id());
-  if (in.directional) {
-    bind_ssbo(kDirectionalRadianceBinding, indirect->directional_radiance_buffer);
-    bind_ssbo(kDirectionalDirectionBinding, indirect->directional_direction_buffer);
-  }
-  // Reflection probes (IndirectLightFrame::reflection_probe_*), when provided.
-  in.probes = indirect != nullptr && indirect->reflection_probe_cubes && indirect->reflection_probe_buffer &&
-              indirect->reflection_probe_count > 0 && indirect->reflection_probe_levels > 0;
-  if (in.probes) {
-    glBindTextureUnit(kReflectionProbeUnit, indirect->reflection_probe_cubes.gl_name);
-    if (indirect->reflection_probe_distances)
-      glBindTextureUnit(kReflectionProbeDistanceUnit, indirect->reflection_probe_distances.gl_name);
-    bind_ssbo(kReflectionProbeBinding, indirect->reflection_probe_buffer);
-  }
-  const SkyGradient& sky = settings_.sky_gradient;
-  const glm::vec3 zero(0.0f);
-  in.has_sky = glm::any(glm::notEqual(settings_.sky_radiance, zero)) || glm::any(glm::notEqual(sky.horizon, zero)) ||
-               glm::any(glm::notEqual(sky.zenith, zero)) || glm::any(glm::notEqual(sky.ground, zero));
-  return in;
-}
-
-// The uniforms every item of a forward program's pass shares.
-void ForwardRenderer::set_forward_frame_uniforms(const ForwardUniforms& u, const ForwardInputs& in, bool blend) {
-  glUniform1i(u.directional_bins, in.directional ? in.indirect->directional_bin_count : 0);
-  glUniform1i(u.directional_elements, in.directional ? in.indirect->directional_element_count : 0);
-  glUniform1i(u.probe_count, in.probes ? in.indirect->reflection_probe_count : 0);
-  glUniform1i(u.probe_levels, in.probes ? in.indirect->reflection_probe_levels : 0);
-  glUniform1i(u.probe_has_distances, in.probes && in.indirect->reflection_probe_distances ? 1 : 0);
-  glUniform1f(u.probe_max_roughness, in.probes ? in.indirect->reflection_probe_max_roughness : 0.0f);
-  glUniform1i(u.probe_lobe_samples, in.probes ? in.indirect->reflection_probe_lobe_samples : 0);
-  glUniformMatrix4fv(u.view_proj, 1, GL_FALSE, glm::value_ptr(in.view->view_proj));
-  glUniform3fv(u.camera_position, 1, glm::value_ptr(in.view->position));
-  glUniform1f(u.ambient_radiance, settings_.stand_in_ambient);
-  glUniform3fv(u.sky_radiance, 1, glm::value_ptr(settings_.sky_radiance));
-  {  // The sky's gradient (engine/sky.h): horizon, zenith - horizon, ground - horizon.
-    const SkyGradient& g = settings_.sky_gradient;
-    const glm::vec3 terms[3] = {g.horizon, g.zenith - g.horizon, g.ground - g.horizon};
-    glUniform3fv(u.sky_gradient, 3, glm::value_ptr(terms[0]));
-  }
-  glUniform1f(u.split_x, settings_.split == SplitView::DirectLeftFullRight ? 0.5f * static_cast<float>(width_) : -1.0f);
-  glUniform1i(u.use_glossy, in.glossy != 0 && !blend ? 1 : 0);  // the glossy texture is the opaque surface's
-}
-
-// Where `item`'s indirect light comes from (the atlas for static items, the provider's
-// per-vertex buffers for dynamic ones, the stand-in without a provider), its sky occlusion
-// and what its atlas holds besides indirect light; binds its buffers and sets the uniforms.
-void ForwardRenderer::set_item_indirect(const ForwardUniforms& u, const DrawItem& item, const ForwardInputs& in) {
-  const IndirectLightFrame* indirect = in.indirect;
-  int mode = kIndirectAmbient;
-  SsboHandle<VertexIrradiance> vertex_buffer;
-  if (indirect != nullptr) {
-    mode = kIndirectNone;
-    if (item.is_static && in.atlas != 0) {
-      mode = kIndirectAtlas;
-    } else if (!item.is_static) {
-      vertex_buffer = indirect->vertex_irradiance_buffer(item.entity);
-      if (vertex_buffer) mode = kIndirectVertex;
-    }
-  }
-  {  // The sky's occlusion on a dynamic entity, when the provider measured it (indirect_light.h).
-    float axes[6] = {1.0f, 1.0f, 1.0f, 1.0f, 1.0f, 1.0f};
-    if (indirect != nullptr && !item.is_static) (void)indirect->sky_visibility(item.entity, axes);
-    glUniform3f(u.sky_visibility_pos, axes[0], axes[2], axes[4]);
-    glUniform3f(u.sky_visibility_neg, axes[1], axes[3], axes[5]);
-  }
-  // What the atlas this item reads holds besides indirect light (not drawn again here).
-  const bool baked = mode == kIndirectAtlas;
-  glUniform1i(u.baked_direct,
-              (baked && indirect->atlas_holds_sky ? 1 : 0) | (baked && indirect->atlas_holds_static_lights ? 2 : 0));
-  if (vertex_buffer) bind_ssbo(kVertexIrradianceBinding, vertex_buffer);
-  // Per-vertex view-dependent indirect light (IndirectLightFrame::vertex_radiance_lobes).
-  IndirectLightFrame::VertexRadianceLobes lobes;
-  if (vertex_buffer) lobes = indirect->vertex_radiance_lobes(item.entity);
-  const bool use_lobes = lobes.terms > 0 && lobes.resolution > 0 && lobes.coefficient_buffer && lobes.lobe_buffer &&
-                         lobes.first >= 0 && lobes.stride >= 0;
-  if (use_lobes) {
-    bind_ssbo(kLobeCoefficientsBinding, lobes.coefficient_buffer);
-    bind_ssbo(kLobeTableBinding, lobes.lobe_buffer);
-  }
-  glUniform1i(u.lobe_terms, use_lobes ? lobes.terms : 0);
-  glUniform1i(u.lobe_resolution, lobes.resolution);
-  glUniform1i(u.lobe_first, lobes.first);
-  glUniform1i(u.lobe_stride, lobes.stride);
-  glUniform1i(u.mesh_first_vertex, item.mesh->first_vertex);
-  glUniform1i(u.use_vertex_irradiance, vertex_buffer ? 1 : 0);
-  glUniform1i(u.indirect_mode, mode);
-}
-
-// One primitive with its material (factors, textures, samplers, culling).
-void ForwardRenderer::draw_shaded_primitive(const ForwardUniforms& u, const GpuMaterial& m, const GpuPrimitive& p) {
-  if (m.double_sided)
-    glDisable(GL_CULL_FACE);
-  else
-    glEnable(GL_CULL_FACE);
-  glUniform4fv(u.base_color, 1, glm::value_ptr(m.base_color));
-  glUniform1f(u.metallic, m.metallic);
-  glUniform1f(u.roughness, m.roughness);
-  glUniform3fv(u.emissive, 1, glm::value_ptr(m.emissive));
-  glUniform1i(u.double_sided, m.double_sided ? 1 : 0);
-  glUniform1f(u.specular_factor, m.specular_factor);
-  glUniform3fv(u.specular_color_factor, 1, glm::value_ptr(m.specular_color_factor));
-  glBindTextureUnit(kBaseColorUnit, m.base_color_texture);
-  glBindTextureUnit(kMetallicRoughnessUnit, m.metallic_roughness_texture);
-  glBindTextureUnit(kEmissiveUnit, m.emissive_texture);
-  glBindTextureUnit(kNormalUnit, m.normal_texture != 0 ? m.normal_texture : scene_.white_texture());
-  glBindSampler(kBaseColorUnit, m.samplers[render::kBaseColorSlot]);
-  glBindSampler(kMetallicRoughnessUnit, m.samplers[render::kMetallicRoughnessSlot]);
-  glBindSampler(kEmissiveUnit, m.samplers[render::kEmissiveSlot]);
-  glBindSampler(kNormalUnit, m.samplers[render::kNormalSlot]);
-  render::set_material_texturing(m, u.material);
-  glUniform1f(u.normal_scale, m.normal_scale);
-  glUniform1i(u.normal_map, m.normal_texture != 0 ? 1 : 0);
-  glDrawElementsBaseVertex(GL_TRIANGLES, static_cast<GLsizei>(p.index_count), GL_UNSIGNED_INT,
-                           reinterpret_cast<const void*>(static_cast<std::uintptr_t>(p.first_index) * 4u),
-                           p.base_vertex);
-}
-
-// One light group's pixels (its stencil mask), or with `blend` the BLEND primitives of
-// `order` (back to front) over everything, without the stencil.
-void ForwardRenderer::shade_group(const ForwardInputs& in, const LightGroup& group,
-                                  const std::vector<const DrawItem*>& order, bool blend) {
-  if (in.reach && !blend) glStencilFunc(GL_EQUAL, group.mask, area_lights_.empty() ? 0xFF : 0xFF & ~kAreaFallbackBit);
-  glBindBufferRange(GL_SHADER_STORAGE_BUFFER, kLightsBinding, lights_buffer_.id(), group.offset,
-                    static_cast<GLsizeiptr>(std::max<std::size_t>(1, group.lights.size()) * sizeof(render::GpuLight)));
-  const LightCounts counts{group.count_by_type[0],
-                           group.count_by_type[1],
-                           group.count_by_type[2],
-                           group.count_by_type[3],
-                           std::clamp(settings_.area_specular_samples_per_side, 1, 4),
-                           settings_.area_soft_shadows ? 1 : 0,
-                           in.has_sky ? 1 : 0,
-                           area_lights_.empty() ? 0 : 1,
-                           settings_.flat_shading ? 1 : 0};
-  // Rough dielectrics draw with the one-specular-point variant of area lights (rough_dielectric),
-  // the other materials with RenderSettings::area_specular_samples_per_side: two passes over the
-  // items, each with its program, when that makes a difference.
-  LightCounts rough_counts = counts;
-  rough_counts[4] = 1;
-  // (Not for BLEND primitives: two passes would break their back-to-front order.)
-  const bool split_rough = !blend && counts[3] > 0 && counts[4] > 1 && settings_.area_specular_one_point_on_rough;
-  for (int pass = 0; pass < (split_rough ? 2 : 1); ++pass) {
-    const LocatedProgram<ForwardUniforms>& program = forward_program(pass == 0 ? counts : rough_counts);
-    const ForwardUniforms& u = program.uniforms;
-    program.use();
-    set_forward_frame_uniforms(u, in, blend);
-    const auto in_pass = [&](const DrawItem& item, const render::GpuPrimitive& p) {
-      const render::GpuMaterial& m = scene_.material(item.material_override >= 0 ? item.material_override : p.material);
-      if ((m.alpha_mode == AlphaMode::Blend) != blend) return false;
-      if (!split_rough) return true;
-      return rough_dielectric(m, scene_.white_texture()) == (pass == 1);
-    };
-    for (const DrawItem* drawn : order) {
-      const DrawItem& item = *drawn;
-      const render::SceneBounds& gb = group.bounds;
-      if (!gb.empty &&
-          (glm::any(glm::lessThan(item.bounds.max, gb.min)) || glm::any(glm::greaterThan(item.bounds.min, gb.max))))
-        continue;  // none of this group's pixels can be on the item
-      if (std::none_of(item.mesh->primitives.begin(), item.mesh->primitives.end(),
-                       [&](const render::GpuPrimitive& p) { return in_pass(item, p); }))
-        continue;
-      set_item_indirect(u, item, in);
-      glUniformMatrix4fv(u.model, 1, GL_FALSE, glm::value_ptr(item.model));
-      const glm::mat4 normal_matrix(glm::transpose(glm::inverse(glm::mat3(item.model))));
-      glUniformMatrix4fv(u.normal_matrix, 1, GL_FALSE, glm::value_ptr(normal_matrix));
-      for (const render::GpuPrimitive& p : item.mesh->primitives) {
-        if (!in_pass(item, p)) continue;
-        draw_shaded_primitive(u, scene_.material(item.material_override >= 0 ? item.material_override : p.material), p);
-      }
-    }
-  }
-}
-
-// BLEND: after every opaque pixel, back to front by the item's centre, blended over what is
-// there ("over": alpha x colour + (1 - alpha) x behind; the target's alpha is kept), tested
-// against the pre-pass's depth but not writing it. Every pixel of a blended surface is lit
-// by the group of all lights (the reach stencil holds the surface behind it).
-void ForwardRenderer::shade_blended(const ForwardInputs& in, const std::vector<DrawItem>& items,
-                                    const std::vector<LightGroup>& groups) {
-  std::vector<std::pair<float, const DrawItem*>> blended;
-  for (const DrawItem& item : items)
-    for (const render::GpuPrimitive& p : item.mesh->primitives)
-      if (scene_.material(item.material_override >= 0 ? item.material_override : p.material).alpha_mode ==
-          AlphaMode::Blend) {
-        const glm::vec3 centre = 0.5f * (item.bounds.min + item.bounds.max);
-        blended.emplace_back(glm::length(centre - in.view->position), &item);
-        break;
-      }
-  if (blended.empty()) return;
-  std::stable_sort(blended.begin(), blended.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
-  std::vector<const DrawItem*> back_to_front;
-  for (const auto& [distance, item] : blended) back_to_front.push_back(item);
-  const auto all = std::find_if(groups.begin(), groups.end(),
-                                [&](const LightGroup& g) { return !in.reach || g.mask == reach_.grid.all; });
-  glDisable(GL_STENCIL_TEST);
-  glDepthFunc(GL_LESS);
-  glEnable(GL_BLEND);
-  glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ZERO, GL_ONE);
-  if (all != groups.end()) shade_group(in, *all, back_to_front, true);
-  glDisable(GL_BLEND);
-}
-
-void ForwardRenderer::forward_pass(const CameraView& view, const std::vector<DrawItem>& items,
-                                   const std::vector<LightGroup>& groups, const IndirectLightFrame* indirect) {
-  const bool reach = !groups.empty() && groups.front().mask >= 0;
-  begin_forward_pass(view, items, reach);
-  ForwardInputs in = bind_forward_inputs(indirect);
-  in.view = &view;
-  in.reach = reach;
-  std::vector<const DrawItem*> in_order;
-  for (const DrawItem& item : items) in_order.push_back(&item);
-  for (const LightGroup& group : groups) shade_group(in, group, in_order, false);
-  shade_blended(in, items, groups);
-  unbind_material_samplers();
-  glDisable(GL_STENCIL_TEST);
-  glStencilMask(0xFF);
-  glDisable(GL_CULL_FACE);
-  glDepthFunc(GL_LESS);
-  glDepthMask(GL_TRUE);
-  glBindFramebuffer(GL_FRAMEBUFFER, 0);
-}
-
-// The depth-only fragment stage `fragment` with ALPHA_TEST 1 (shadow.vert.glsl's vertices).
-const LocatedProgram<DepthUniforms>& ForwardRenderer::alpha_test_program(const char* fragment) {
-  auto it = alpha_test_programs_.find(fragment);
-  if (it != alpha_test_programs_.end()) return it->second;
-  ShaderProgramBuilder b(engine_shader_files());
-  b.define("ALPHA_TEST 1");
-  Result<LocatedProgram<DepthUniforms>> p = link_program<DepthUniforms>(
-      std::move(b), {{ShaderStage::Vertex, "shadow.vert.glsl"}, {ShaderStage::Fragment, fragment}});
-  if (!p) log_message(LogLevel::Error, p.error().to_string());
-  GI_EXPECTS(p.ok(), "alpha-tested depth shader must compile");
-  return alpha_test_programs_.emplace(fragment, std::move(p.value())).first->second;
-}
-
-// The pre-pass's depth (and reach stencil) of every opaque and MASK primitive: opaque ones
-// first, then the MASK ones with the alpha-tested variant of the same program (a discard costs
-// llvmpipe its early depth test, so only they pay it). BLEND primitives write no depth.
-void ForwardRenderer::depth_prepass(const glm::mat4& view_proj, const std::vector<DrawItem>& items, bool reach) {
-  glDepthFunc(GL_LESS);
-  glDepthMask(GL_TRUE);
-  glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
-  if (reach) {  // the nearest surface's reach mask into the stencil
-    glEnable(GL_STENCIL_TEST);
-    glStencilMask(0xFF);
-    glStencilFunc(GL_ALWAYS, 0, 0xFF);
-    glStencilOp(GL_KEEP, GL_KEEP, GL_REPLACE);
-    glBindTextureUnit(kReachUnit, reach_.texture.id());
-  }
-  for (const bool cut_out : {false, true}) {
-    if (cut_out && !scene_.has_mask()) break;
-    const LocatedProgram<DepthUniforms>& program =
-        cut_out ? alpha_test_program(reach ? "depth_reach.frag.glsl" : "depth_only.frag.glsl")
-                : (reach ? depth_reach_ : depth_only_);
-    const DepthUniforms& u = program.uniforms;
-    program.use();
-    glUniformMatrix4fv(u.view_proj, 1, GL_FALSE, glm::value_ptr(view_proj));
-    if (reach) {
-      glUniform3fv(u.reach_origin, 1, glm::value_ptr(reach_.grid.origin));
-      glUniform1f(u.reach_inv_voxel, 1.0f / reach_.grid.voxel_m);
-      glUniform1i(u.reach_all, reach_.grid.all);
-    }
-    for (const DrawItem& item : items) {
-      glUniformMatrix4fv(u.model, 1, GL_FALSE, glm::value_ptr(item.model));
-      for (const render::GpuPrimitive& p : item.mesh->primitives) {
-        const render::GpuMaterial& m =
-            scene_.material(item.material_override >= 0 ? item.material_override : p.material);
-        if (m.alpha_mode == AlphaMode::Blend || (m.alpha_mode == AlphaMode::Mask) != cut_out) continue;
-        if (cut_out) render::bind_alpha_test(m, m.alpha_cutoff, u.material);
-        // Same culling as the shading pass, so both passes see the same surfaces.
-        if (m.double_sided)
-          glDisable(GL_CULL_FACE);
-        else
-          glEnable(GL_CULL_FACE);
-        glDrawElementsBaseVertex(GL_TRIANGLES, static_cast<GLsizei>(p.index_count), GL_UNSIGNED_INT,
-                                 reinterpret_cast<const void*>(static_cast<std::uintptr_t>(p.first_index) * 4u),
-                                 p.base_vertex);
-      }
-    }
-  }
-  render::unbind_material_samplers();
-  glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-  glDisable(GL_STENCIL_TEST);
-}
-
-void ForwardRenderer::tonemap_pass() {
-  glBindFramebuffer(GL_FRAMEBUFFER, ldr_fbo_.id());
-  glViewport(0, 0, width_, height_);
-  glDisable(GL_DEPTH_TEST);
-  glDisable(GL_CULL_FACE);
-  tonemap_.use();
-  glUniform1f(tonemap_.uniforms.exposure, exposure_metered_ ? 1.0f : applied_exposure_);
-  glUniform1i(tonemap_.uniforms.metered, exposure_metered_ ? 1 : 0);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kExposureStateBinding, exposure_meter_.state_buffer());
-  glBindTextureUnit(0, hdr_.id());
-  glBindVertexArray(empty_vao_.id());
-  glDrawArrays(GL_TRIANGLES, 0, 3);
-  glBindFramebuffer(GL_FRAMEBUFFER, 0);
-}
-
-float ForwardRenderer::fixed_exposure() const {
-  return settings_.exposure_mode == ExposureMode::FixedEv100 ? exposure_of_ev100(settings_.ev100) : settings_.exposure;
-}
-
-ExposureReading ForwardRenderer::read_exposure() const {
-  ExposureReading r;
-  if (!exposure_metered_) {
-    r.exposure = applied_exposure_;
-    r.ev100 = r.exposure > 0.0f ? ev100_of_exposure(r.exposure) : 0.0f;
-    r.target_ev100 = r.ev100;
-    return r;
-  }
-  const GpuExposureState s = exposure_meter_.read();
-  r.exposure = s.exposure;
-  r.ev100 = s.ev100;
-  r.target_ev100 = s.target_ev100;
-  r.mean_log2_luminance = s.mean_log2_luminance;
-  r.metered_pixels = s.metered_pixels;
-  r.metered = true;
-  return r;
-}
-
-ImageRgba8 ForwardRenderer::read_ldr() const {
-  ImageRgba8 image;
-  image.width = width_;
-  image.height = height_;
-  std::vector<std::uint8_t> raw(static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_) * 4);
-  glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  glGetTextureImage(ldr_.id(), 0, GL_RGBA, GL_UNSIGNED_BYTE, static_cast<GLsizei>(raw.size()), raw.data());
-  image.pixels.resize(raw.size());
-  const std::size_t row = static_cast<std::size_t>(width_) * 4;
-  for (int y = 0; y < height_; ++y)  // GL rows run bottom to top
-    std::copy_n(raw.begin() + static_cast<std::ptrdiff_t>(row * static_cast<std::size_t>(height_ - 1 - y)), row,
-                image.pixels.begin() + static_cast<std::ptrdiff_t>(row * static_cast<std::size_t>(y)));
-  return image;
-}
-
-ImageRgbaF ForwardRenderer::read_hdr() const {
-  ImageRgbaF image;
-  image.width = width_;
-  image.height = height_;
-  std::vector<float> raw(static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_) * 4);
-  glPixelStorei(GL_PACK_ALIGNMENT, 4);
-  glGetTextureImage(hdr_.id(), 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(raw.size() * sizeof(float)), raw.data());
-  image.pixels.resize(raw.size());
-  const std::size_t row = static_cast<std::size_t>(width_) * 4;
-  for (int y = 0; y < height_; ++y)
-    std::copy_n(raw.begin() + static_cast<std::ptrdiff_t>(row * static_cast<std::size_t>(height_ - 1 - y)), row,
-                image.pixels.begin() + static_cast<std::ptrdiff_t>(row * static_cast<std::size_t>(y)));
-  return image;
-}
-
 }  // namespace engine::render
 
 namespace engine {
@@ -711,7 +255,7 @@ Result<std::unique_ptr<Renderer>> Renderer::create(const SceneAsset& assets, con
   GI_EXPECTS(settings.width > 0 && settings.height > 0, "RenderSettings width and height must be positive");
   if (glGetString(GL_VERSION) == nullptr)
     return Error{assets.source, "renderer", "no current OpenGL context (create an engine::GpuContext first)"};
-  auto forward = build_forward(LightCounts{0, 0, 0, 0, 3, 1, 1, 0});
+  auto forward = build_forward_program(LightCounts{0, 0, 0, 0, 3, 1, 1, 0});
   if (!forward) return forward.error();
   auto depth = build_depth("depth_only.frag.glsl");
   if (!depth) return depth.error();

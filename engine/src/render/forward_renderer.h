@@ -1,9 +1,11 @@
 #pragma once
 // engine::render::ForwardRenderer (internal): the engine::Renderer that Renderer::create makes.
-// One class in three files: forward_renderer.cpp (the frame: shadow maps, depth pre-pass,
-// forward pass, tonemap, read-back), forward_reach.cpp (the light reach grid and the light
-// groups each stencil mask is shaded with) and forward_area_shadow.cpp (the area lights'
-// soft shadows at half resolution).
+// One class in seven files: forward_renderer.cpp (the frame: its targets, draw items, the passes
+// in order, Renderer::create), forward_prepass.cpp (what runs before shading: the clear, the
+// depth pre-pass and its reach stencil), forward_shading.cpp (the forward pass: program
+// variants, inputs, uniforms, drawing), forward_output.cpp (tonemap, exposure, read-back),
+// forward_reach.cpp (the light reach grid and the light groups each stencil mask is shaded
+// with) and forward_area_shadow.cpp (the area lights' soft shadows at half resolution).
 #include <engine/renderer.h>
 
 #include <array>
@@ -82,6 +84,9 @@ GlTexture no_directional_index();
 // scene has a sky term (0: its radiance and gradient are zero, the shader leaves it out) and
 // whether area lights' visibility comes from the half-resolution pass (area_shadow_res).
 using LightCounts = std::array<int, 9>;  // ..., [8] FLAT_SHADING (RenderSettings::flat_shading)
+
+// The forward program for one combination of light counts (forward.frag.glsl's defines).
+Result<LocatedProgram<ForwardUniforms>> build_forward_program(const LightCounts& counts);
 
 // The lights one set of pixels is shaded with: those of one light-reach mask (the stencil
 // value the pre-pass wrote), as a range of the lights buffer.
