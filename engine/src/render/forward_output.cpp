@@ -16,6 +16,21 @@
 
 namespace engine::render {
 
+namespace {
+
+// RGBA rows read back from GL (bottom to top) in an image's order (top to bottom).
+template <class Channel>
+std::vector<Channel> rows_top_down(const std::vector<Channel>& gl_rows, int width, int height) {
+  std::vector<Channel> out(gl_rows.size());
+  const std::size_t row = static_cast<std::size_t>(width) * 4;
+  for (int y = 0; y < height; ++y)
+    std::copy_n(gl_rows.begin() + static_cast<std::ptrdiff_t>(row * static_cast<std::size_t>(height - 1 - y)), row,
+                out.begin() + static_cast<std::ptrdiff_t>(row * static_cast<std::size_t>(y)));
+  return out;
+}
+
+}  // namespace
+
 void ForwardRenderer::tonemap_pass() {
   glBindFramebuffer(GL_FRAMEBUFFER, ldr_fbo_.id());
   glViewport(0, 0, width_, height_);
@@ -60,11 +75,7 @@ ImageRgba8 ForwardRenderer::read_ldr() const {
   std::vector<std::uint8_t> raw(static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_) * 4);
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
   glGetTextureImage(ldr_.id(), 0, GL_RGBA, GL_UNSIGNED_BYTE, static_cast<GLsizei>(raw.size()), raw.data());
-  image.pixels.resize(raw.size());
-  const std::size_t row = static_cast<std::size_t>(width_) * 4;
-  for (int y = 0; y < height_; ++y)  // GL rows run bottom to top
-    std::copy_n(raw.begin() + static_cast<std::ptrdiff_t>(row * static_cast<std::size_t>(height_ - 1 - y)), row,
-                image.pixels.begin() + static_cast<std::ptrdiff_t>(row * static_cast<std::size_t>(y)));
+  image.pixels = rows_top_down(raw, width_, height_);
   return image;
 }
 
@@ -75,11 +86,7 @@ ImageRgbaF ForwardRenderer::read_hdr() const {
   std::vector<float> raw(static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_) * 4);
   glPixelStorei(GL_PACK_ALIGNMENT, 4);
   glGetTextureImage(hdr_.id(), 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(raw.size() * sizeof(float)), raw.data());
-  image.pixels.resize(raw.size());
-  const std::size_t row = static_cast<std::size_t>(width_) * 4;
-  for (int y = 0; y < height_; ++y)
-    std::copy_n(raw.begin() + static_cast<std::ptrdiff_t>(row * static_cast<std::size_t>(height_ - 1 - y)), row,
-                image.pixels.begin() + static_cast<std::ptrdiff_t>(row * static_cast<std::size_t>(y)));
+  image.pixels = rows_top_down(raw, width_, height_);
   return image;
 }
 
