@@ -5,10 +5,18 @@
 # Fuzz.<target>.ReplaysSeedsAndRegressions then refuses a seed). Usage:
 #   tools/fuzz-seeds.sh                                            # the whole corpus
 #   tools/fuzz-seeds.sh light_atlas_vpls manifest/atlas_prm.json   # only these targets' folders or seeds
+#   tools/fuzz-seeds.sh --check [NAME...]                           # list stale seeds, change nothing
 # Naming targets or seeds replaces only those, so a branch that changed one format re-makes its
-# own seeds without touching the others'.
+# own seeds without touching the others'. --check makes the seeds in a scratch directory and
+# lists those that differ from the committed ones (a manifest's bake_seconds aside, which differ
+# every run); exit 1 when any does.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+check=0
+if [ "${1:-}" = "--check" ]; then
+  check=1
+  shift
+fi
 root=$(pwd)
 bake=${GI_BAKE:-"$root/${BUILD_DIR:-build}/tools/gi-bake/gi-bake"}
 [ -x "$bake" ] || { echo "fuzz-seeds.sh: build gi-bake first ($bake)" >&2; exit 1; }
@@ -81,6 +89,37 @@ cp "$tmp/ar_dlm.gibake/antiradiance.bin" "$out/antiradiance/"
 cp "$tmp/ar_dlm.gibake/dlm.bin" "$out/dlm/"
 cp "$tmp/no_dlm_texels.gibake/dlm.bin" "$out/dlm/dlm_no_texels.bin"
 
+if [ $check -eq 1 ]; then
+  stale=$(python3 - "$out" "$corpus" "$@" <<'PY'
+import json, os, sys
+out, corpus, names = sys.argv[1], sys.argv[2], sys.argv[3:]
+def untimed(x):  # a manifest without its bake times
+    if isinstance(x, dict):
+        return {k: untimed(v) for k, v in x.items() if k != "bake_seconds"}
+    return [untimed(v) for v in x] if isinstance(x, list) else x
+for root, _, files in sorted(os.walk(out)):
+    for f in sorted(files):
+        rel = os.path.relpath(os.path.join(root, f), out)
+        if names and not any(rel == n or rel.startswith(n.rstrip("/") + "/") for n in names):
+            continue
+        made = open(os.path.join(root, f), "rb").read()
+        path = os.path.join(corpus, rel)
+        committed = open(path, "rb").read() if os.path.exists(path) else None
+        same = committed == made
+        if not same and committed is not None and rel.endswith(".json"):
+            same = untimed(json.loads(committed)) == untimed(json.loads(made))
+        if not same:
+            print(rel if committed is not None else rel + " (missing)")
+PY
+  )
+  if [ -z "$stale" ]; then
+    echo "fuzz-seeds.sh: every seed checked is what the sources make now"
+    exit 0
+  fi
+  echo "fuzz-seeds.sh: stale seeds (re-make them with tools/fuzz-seeds.sh NAME...):"
+  echo "$stale"
+  exit 1
+fi
 if [ $# -eq 0 ]; then
   rm -rf "$corpus"
   cp -r "$out" "$corpus"
