@@ -9,7 +9,7 @@
 //
 // Top view (x right, z up):
 //   z [16.4, 22.4]  lamp room    x [0, 8]    (swinging lamp hangs from a pivot node)
-//   z [8.2, 16.2]   corridor     x [3, 5]    (glossy floor, roughness 0.15)
+//   z [8.2, 16.2]   corridor     x [3, 5]    (dark polished floor, roughness 0.15)
 //   z [0, 8]        hub          x [0, 8]    + crate room x [8.2, 14.2], z [1, 7] to the east
 // Walls between spaces are 0.2 m thick; doorways are 1.6 m (hub-corridor-lamp room) and
 // 1.2 m (hub-crate room) wide; the hub-corridor doorway has a door (deforming, key O).
@@ -36,7 +36,9 @@ DemoMaterials demo_materials(SceneBuilder& b) {
   m.wall = b.material("plaster", {0.7f, 0.7f, 0.7f});
   m.hub_floor_mat = b.material("hub_tiles", {0.6f, 0.58f, 0.52f});
   m.crate_floor_mat = b.material("concrete", {0.5f, 0.5f, 0.5f});
-  m.glossy = b.material("polished_floor", {0.45f, 0.42f, 0.4f}, 0.15f, 0.0f);
+  // Dark polished stone (issue 36's demo item): under a light grey albedo the diffuse term hid
+  // the 0.04-F0 reflection of the lit doorway and walls; at 0.08 the reflection reads (README).
+  m.glossy = b.material("polished_floor", {0.08f, 0.076f, 0.072f}, 0.15f, 0.0f);
   m.lamp_floor_mat = b.textured_material("lamp_room_boards", b.image(wood_planks_texture()));
   m.pillar_mat = b.material("pillar_white", {0.85f, 0.85f, 0.85f});
   m.wood = b.material("crate_wood", {0.62f, 0.45f, 0.28f});

@@ -86,11 +86,13 @@ struct EffectPlan {
 struct PlanOptions {
   std::string preset = "medium";  ///< preview | medium | high (the bakers' presets).
   /// Static surfaces with a roughness factor in [glossy_roughness_min, glossy_roughness) get
-  /// directional light maps: the range over which they beat the atlas's direction-less
-  /// specular term against the path tracer on glossy_room (docs/dlm.md, "The regime", measured
-  /// 0.1 .. 0.8). Sharper surfaces are the reflection probes' (their lobe is narrower than a bin).
+  /// directional light maps: each roughness goes to exactly one method (docs/plan.md, "Routing").
+  /// The top is where the maps stop beating the atlas's direction-less specular term against the
+  /// path tracer (docs/dlm.md, "The regime", measured to 0.8); sharper surfaces than the bottom,
+  /// the reflection probes' limit (kReflectionProbeMaxRoughness, 0.3), are the probes', which win
+  /// on the demo corridor from 0.1 to 0.3 and whose specular the renderer draws there anyway.
   float glossy_roughness = 0.8f;
-  float glossy_roughness_min = 0.1f;
+  float glossy_roughness_min = 0.3f;
   /// Lights (by name) the game moves or scripts although the file does not flag them.
   std::vector<std::string> moving_lights;
   /// Overrides of the preset, as gi-bake's --density / --vpls / --samples / --bounces (0: preset).

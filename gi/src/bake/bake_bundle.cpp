@@ -119,7 +119,7 @@ engine::Result<BakeReport> bake_bundle(const BakeInput& input, const fs::path& b
     Timings timings = nlohmann::json::object();
     const MergedParts* parts = merged ? &*merged : nullptr;
     const EffectMethod m = *method_from_key(key);  // methods_to_bake checked every key
-    engine::Status done = method_baker(m).bake(MethodBake{input, dir, options, host, parts, timings});
+    engine::Status done = method_baker(m).bake(MethodBake{input, dir, options, host, parts, timings, methods});
     if (!done) return done.error();
     report.baked.push_back({key, seconds_since(start), method_bytes(dir, key)});
     method_stats[key] = {{"seconds", report.baked.back().seconds}, {"stages", timings}};

@@ -11,6 +11,8 @@
 
 #include <filesystem>
 #include <span>
+#include <string>
+#include <vector>
 #include <nlohmann/json.hpp>
 
 #include "bake/bake_sharding.h"
@@ -28,6 +30,8 @@ struct MethodBake {
   const BakeHost& host;
   const MergedParts* merged;  ///< A distributed bake's merge: every shard's parts; else nullptr.
   Timings& timings;           ///< The baker's stages, filled for bake_stats.json.
+  /// Every method this bake bakes (keys): the DLM leaves the probes' surfaces to them when both are baked.
+  const std::vector<std::string>& methods;
 };
 
 struct MethodBakerEntry {

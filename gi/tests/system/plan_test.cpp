@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <engine/gltf.h>
 #include <engine/sun.h>
+#include <gi/bake.h>
 #include <gi/plan.h>
 
 #include <algorithm>
@@ -16,6 +17,7 @@
 #include "plan/plan_cost.h"
 #include "plan/plan_json.h"
 #include "plan/static_surface_census.h"
+#include "reflection_probes/reflection_probes.h"
 #include "uv/atlas_input.h"
 #include "uv/atlas_layout.h"
 
@@ -90,8 +92,8 @@ TEST(Plan, DemoLevelNeedsEveryBuiltMethodIncludingDirectionalLightMaps) {
   const gi::PlannedEffect& dlm = p.effect(EffectMethod::DirectionalLightMaps);
   EXPECT_TRUE(dlm.enabled);
   EXPECT_TRUE(dlm.available);
-  // The floor (0.15) and the grille (0.5) are in the measured range [0.10, 0.80) (docs/dlm.md).
-  EXPECT_EQ(dlm.targets, (std::vector<std::string>{"corridor_floor", "crate_room_grille"}));
+  // The grille (0.5) is in the maps' range [0.30, 0.80); the floor (0.15) is the probes' (docs/plan.md, "Routing").
+  EXPECT_EQ(dlm.targets, std::vector<std::string>{"crate_room_grille"});
   EXPECT_EQ(sorted(p.effect(EffectMethod::BasisRadianceFields).targets), sorted({"crate", "crate_red", "lamp_shade"}));
   EXPECT_EQ(p.methods_to_bake(),
             (std::vector<std::string>{"light_atlas", "prm", "dlm", "antiradiance", "brf", "reflection_probes"}));
@@ -136,25 +138,102 @@ TEST(Plan, CratesRoomGetsBasisRadianceFieldsForTheCrateMeshesOnly) {
   EXPECT_NEAR(static_cast<double>(brf.estimate.runtime_bytes), 2 * 5.97e6, 0.01 * 2 * 5.97e6);
 }
 
-TEST(Plan, GlossyRoomCallsForDirectionalLightMaps) {
+// The glossy room's floor (0.15) is the probes' alone by default; a range the caller widens
+// down to it gives it directional light maps, with their estimate.
+TEST(Plan, GlossyRoomsFloorGetsDirectionalLightMapsOnlyWhenTheRangeIsWidenedToIt) {
   const gi::EffectPlan p = gi::plan(load("glossy_room.gltf"));
   const gi::PlannedEffect& dlm = p.effect(EffectMethod::DirectionalLightMaps);
-  EXPECT_TRUE(dlm.enabled);
-  EXPECT_TRUE(dlm.available);
-  EXPECT_EQ(dlm.targets, std::vector<std::string>{"glossy_floor"});
-  EXPECT_TRUE(contains(dlm.reason, "roughness 0.15 in [0.10, 0.80)")) << dlm.reason;
-  EXPECT_TRUE(contains(dlm.reason, "moving lights and the sky are absent")) << dlm.reason;
-  EXPECT_GT(dlm.estimate.bake_seconds, 0.0);
-  EXPECT_GT(dlm.estimate.runtime_bytes, 0u);
-  EXPECT_EQ(p.methods_to_bake(), (std::vector<std::string>{"light_atlas", "dlm", "reflection_probes"}));
+  EXPECT_FALSE(dlm.enabled);
+  EXPECT_TRUE(contains(dlm.reason, "no static surface has roughness in [0.30, 0.80)")) << dlm.reason;
+  EXPECT_TRUE(contains(dlm.reason, "(reflection probes' range): 'glossy_floor'")) << dlm.reason;
+  EXPECT_EQ(p.methods_to_bake(), (std::vector<std::string>{"light_atlas", "reflection_probes"}));
   EXPECT_FALSE(contains(gi::format_plan(p), "NOT BUILT"));
-  // A range above the floor's roughness drops it, and the reason names it as the probes'.
-  const gi::EffectPlan strict =
-      gi::plan(load("glossy_room.gltf"), {.glossy_roughness = 0.8f, .glossy_roughness_min = 0.2f});
-  const std::string& why = strict.effect(EffectMethod::DirectionalLightMaps).reason;
-  EXPECT_FALSE(strict.effect(EffectMethod::DirectionalLightMaps).enabled);
-  EXPECT_TRUE(contains(why, "no static surface has roughness in [0.20, 0.80)")) << why;
-  EXPECT_TRUE(contains(why, "(reflection probes' range): 'glossy_floor'")) << why;
+  const gi::EffectPlan wide =
+      gi::plan(load("glossy_room.gltf"), {.glossy_roughness = 0.8f, .glossy_roughness_min = 0.1f});
+  const gi::PlannedEffect& maps = wide.effect(EffectMethod::DirectionalLightMaps);
+  EXPECT_TRUE(maps.enabled);
+  EXPECT_TRUE(maps.available);
+  EXPECT_EQ(maps.targets, std::vector<std::string>{"glossy_floor"});
+  EXPECT_TRUE(contains(maps.reason, "roughness 0.15 in [0.10, 0.80)")) << maps.reason;
+  EXPECT_TRUE(contains(maps.reason, "moving lights and the sky are absent")) << maps.reason;
+  EXPECT_GT(maps.estimate.bake_seconds, 0.0);
+  EXPECT_GT(maps.estimate.runtime_bytes, 0u);
+  EXPECT_EQ(wide.methods_to_bake(), (std::vector<std::string>{"light_atlas", "dlm", "reflection_probes"}));
+}
+
+// Issue 36's routing: with the default options every roughness below the maps' top goes to
+// exactly one method, the probes below their limit and the maps from it. The demo level's
+// corridor floor (0.15) gets probes and no maps, its grille (0.5) maps and no probe.
+TEST(Plan, EachRoughnessGoesToExactlyOneGlossyMethod) {
+  EXPECT_EQ(gi::PlanOptions{}.glossy_roughness_min, gi::kReflectionProbeMaxRoughness);
+  const gi::EffectPlan demo = gi::plan(load("demo_level.gltf"), {.preset = "preview"});
+  const auto& maps = demo.effect(EffectMethod::DirectionalLightMaps).targets;
+  const auto& probes = demo.effect(EffectMethod::ReflectionProbes).targets;
+  const auto has = [](const std::vector<std::string>& v, const char* name) {
+    return std::count(v.begin(), v.end(), name) == 1;
+  };
+  EXPECT_TRUE(has(probes, "corridor_floor"));
+  EXPECT_FALSE(has(maps, "corridor_floor"));
+  EXPECT_TRUE(has(maps, "crate_room_grille"));
+  EXPECT_FALSE(has(probes, "crate_room_grille"));
+
+  // One 1 m quad per roughness under a lamp, either side of each boundary.
+  const std::vector<float> roughness{0.02f, 0.1f, 0.15f, 0.29f, 0.3f, 0.5f, 0.79f, 0.8f, 1.0f};
+  engine::SceneAsset a;
+  a.lights.push_back({"lamp", engine::Light{}});
+  engine::Node lamp;
+  lamp.name = "lamp";
+  lamp.light = 0;
+  lamp.translation = {0.0f, 2.0f, 0.0f};
+  a.nodes.push_back(lamp);
+  for (std::size_t i = 0; i < roughness.size(); ++i) {
+    engine::Material m;
+    m.name = "m" + std::to_string(i);
+    m.roughness = roughness[i];
+    a.materials.push_back(m);
+    engine::Primitive prim;
+    const float x = static_cast<float>(i);
+    prim.positions = {{x, 0, 0}, {x + 1, 0, 0}, {x + 1, 0, 1}, {x, 0, 1}};
+    prim.indices = {0, 2, 1, 0, 3, 2};
+    prim.material = static_cast<int>(i);
+    a.meshes.push_back({"quad" + std::to_string(i), {prim}});
+    engine::Node node;
+    node.name = "r" + std::to_string(i);
+    node.mesh = static_cast<int>(i);
+    node.gi.mobility = engine::Mobility::Static;
+    a.nodes.push_back(node);
+  }
+  const gi::EffectPlan p = gi::plan(engine::instantiate(a), {.preset = "preview"});
+  const auto& dlm = p.effect(EffectMethod::DirectionalLightMaps).targets;
+  const auto& rp = p.effect(EffectMethod::ReflectionProbes).targets;
+  for (std::size_t i = 0; i < roughness.size(); ++i) {
+    const std::string name = "r" + std::to_string(i);
+    const bool to_probes = has(rp, name.c_str()), to_maps = has(dlm, name.c_str());
+    EXPECT_EQ(to_probes, roughness[i] < 0.3f) << "roughness " << roughness[i];
+    EXPECT_EQ(to_maps, roughness[i] >= 0.3f && roughness[i] < 0.8f) << "roughness " << roughness[i];
+    EXPECT_FALSE(to_probes && to_maps) << "roughness " << roughness[i];
+  }
+}
+
+// The bake follows the routing: baked beside the reflection probes, the maps leave the
+// glossy room's 0.15 floor to them (no texel), while alone they keep it (DlmLighting.*).
+TEST(Plan, MapsBakedBesideTheProbesLeaveTheProbesSurfacesOut) {
+  const fs::path dir = fs::path(GI_BINARY_DIR) / "test_output" / "plan_test" / "routed.gibake";
+  fs::remove_all(dir);
+  const gi::BakeInput input = gi::bake_input_from(load("glossy_room.gltf"));
+  for (const bool with_probes : {true, false}) {
+    std::vector<std::string> methods{"light_atlas", "dlm"};
+    if (with_probes) methods.push_back("reflection_probes");
+    auto report = gi::bake_bundle(input, dir, {.preset = "preview", .methods = methods, .dlm_photons = 20'000});
+    ASSERT_TRUE(report) << report.error().to_string();
+    auto m = gi::read_manifest(dir);
+    ASSERT_TRUE(m) << m.error().to_string();
+    const auto texels = m->methods["dlm"]["texels"].get<std::size_t>();
+    if (with_probes)
+      EXPECT_EQ(texels, 0u);
+    else
+      EXPECT_GT(texels, 100u);
+  }
 }
 
 TEST(Plan, ASceneWithoutLightGetsNothing) {
