@@ -61,7 +61,9 @@ class AntiradiancePasses {
   virtual std::vector<glm::vec3> irradiance() const = 0;
 };
 
-/// The CPU twin: plain loops over the tables, single-threaded, float sums in the shaders' order.
+/// The CPU twin: loops over the tables, float sums in the shaders' order. Each pass runs its
+/// items (receivers, nodes of a level, leaves) on TBB's threads, every item writing only its
+/// own entries: bit for bit the same tables for any thread count.
 class CpuAntiradiancePasses final : public AntiradiancePasses {
  public:
   /// Keeps references: the hierarchy, bins and links must outlive it (their sizes must not change).
@@ -84,6 +86,7 @@ class CpuAntiradiancePasses final : public AntiradiancePasses {
   std::vector<glm::vec3> i_ex_, l_in_, i_l_, i_a_, e_, direct_;
   std::vector<std::int32_t> by_level_;        ///< Nodes ordered by depth (root first).
   std::vector<std::uint32_t> level_offsets_;  ///< by_level_ range of each depth.
+  std::vector<glm::vec2> leaf_sums_;          ///< The local pass's (change, magnitude) per leaf.
 };
 
 }  // namespace gi
