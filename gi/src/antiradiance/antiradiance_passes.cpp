@@ -66,6 +66,12 @@ void CpuAntiradiancePasses::reset(std::span<const glm::vec3> direct) {
   pull();
 }
 
+void CpuAntiradiancePasses::warm_start(std::span<const glm::vec3> direct) {
+  GI_EXPECTS(direct.size() == h_.leaf_count(), "warm_start: one direct irradiance per leaf");
+  // The local pass reads the leaves' normals and areas from the hierarchy itself.
+  direct_.assign(direct.begin(), direct.end());
+}
+
 void CpuAntiradiancePasses::global() {
   const std::size_t m = static_cast<std::size_t>(m_);
   // One receiver's row per item (its links are contiguous): 16 rows a task at least.

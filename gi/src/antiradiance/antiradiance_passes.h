@@ -46,6 +46,11 @@ class AntiradiancePasses {
   /// irradiance, no antiradiance: "shadowing of the direct illumination is done by the
   /// shadow map", §3.3), I_A = 0, E = 0; pulls. `direct`: W/m^2 per leaf.
   virtual void reset(std::span<const glm::vec3> direct) = 0;
+  /// Starts from the tables of the last solve instead (a warm start: the solution of the
+  /// previous pose is the first iterate, so a door moved a little needs few iterations to the
+  /// same fixed point): takes the new direct light (W/m^2 per leaf) and the leaves' current
+  /// normals and areas, keeps I_ex, I_L, I_A and E. Precondition: reset() ran before.
+  virtual void warm_start(std::span<const glm::vec3> direct) = 0;
   /// Global pass (operator U, eq. 16): L_in[r][bin] = sum over r's links of F I_ex[s][bin].
   virtual void global() = 0;
   /// Push: level by level from the root's children down, L_in[n] += L_in[parent(n)].
@@ -69,6 +74,7 @@ class CpuAntiradiancePasses final : public AntiradiancePasses {
   /// Keeps references: the hierarchy, bins and links must outlive it (their sizes must not change).
   CpuAntiradiancePasses(const ElementHierarchy& h, const DirectionalBins& bins, const LinkMesh& links);
   void reset(std::span<const glm::vec3> direct) override;
+  void warm_start(std::span<const glm::vec3> direct) override;
   void global() override;
   void push() override;
   LocalPassSums local(bool radiance, bool antiradiance) override;

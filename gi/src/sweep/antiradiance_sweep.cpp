@@ -204,6 +204,13 @@ std::vector<KnobSpec> antiradiance_knobs() {
        .default_grid = {"0.001"},
        .min_value = 0,
        .max_value = 1},
+      {.name = "warm",
+       .description = "a door move's solve starts from the previous pose's solution, converged when its residual "
+                      "also dropped by this factor from its first iteration's (0: from the direct light)",
+       .kind = KnobKind::Real,
+       .default_grid = {"0.03"},
+       .min_value = 0,
+       .max_value = 1},
       {.name = "scheme",
        .description = "iteration of the paper's 2.2 (asymmetric: 4 antiradiance steps per radiance step)",
        .kind = KnobKind::Choice,
@@ -294,6 +301,8 @@ AntiradianceSettings antiradiance_settings(const RunContext& ctx) {
   s.bins_per_side = static_cast<int>(ctx.knobs.integer("bins"));
   s.iterations = static_cast<int>(ctx.knobs.integer("iterations"));
   s.residual_tolerance = ctx.knobs.real("tolerance");
+  s.warm_start = ctx.knobs.real("warm") > 0.0;
+  s.warm_tolerance = ctx.knobs.real("warm");
   s.scheme = ctx.knobs.text("scheme") == "asymmetric" ? AntiradianceScheme::Asymmetric : AntiradianceScheme::Symmetric;
   s.oracle_scale = static_cast<float>(ctx.knobs.real("oracle"));
   s.near_patch_size_m = static_cast<float>(ctx.knobs.real("near_patch"));
@@ -474,6 +483,7 @@ engine::Result<GpuDoorMove> time_gpu_door_move(const DoorSetup& d, AntiradianceR
   glFinish();
   g.ms = ms_since(t0);
   g.bytes = static_cast<double>(gpu->gpu_bytes());
+  region.discard_solution();  // the fresh GPU pass started from the direct light: so does the twin
   region.update(true);
   const std::vector<glm::vec3> cpu = region.irradiance();
   double diff = 0.0, scale = 0.0;
