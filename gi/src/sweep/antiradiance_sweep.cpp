@@ -177,8 +177,8 @@ const engine::GpuContext* gl_context() {
 
 glm::vec3 ref_at(const RgbField& f, std::size_t i) { return {f.rgb[3 * i], f.rgb[3 * i + 1], f.rgb[3 * i + 2]}; }
 
-// Long because it is one table: every knob of the method with its grid.
-std::vector<KnobSpec> antiradiance_knobs() {
+// Long because it is one table: every knob of the method's bake and solve with its grid.
+std::vector<KnobSpec> solve_knobs() {
   return {
       {.name = "patch",
        .description = "leaf element size: longest triangle-piece edge, metres (sets the hierarchy's depth)",
@@ -258,6 +258,12 @@ std::vector<KnobSpec> antiradiance_knobs() {
        .kind = KnobKind::Choice,
        .default_grid = {"on"},
        .choices = {"on", "off"}},
+  };
+}
+
+// The knobs of what is scored: where and at which door angles, against how many samples.
+std::vector<KnobSpec> scoring_knobs() {
+  return {
       {.name = "density",
        .description = "atlas texels per metre where the change is compared",
        .kind = KnobKind::Real,
@@ -283,6 +289,12 @@ std::vector<KnobSpec> antiradiance_knobs() {
        .min_value = 1,
        .max_value = 1 << 20},
   };
+}
+
+std::vector<KnobSpec> antiradiance_knobs() {
+  std::vector<KnobSpec> knobs = solve_knobs();
+  for (KnobSpec& k : scoring_knobs()) knobs.push_back(std::move(k));
+  return knobs;
 }
 
 ReferenceRequest door_reference_request(const SweepScene&, const KnobSetting& k) {
