@@ -11,6 +11,10 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include <time.h>
+#include <oneapi/tbb/global_control.h>
+#include <oneapi/tbb/info.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -184,42 +188,107 @@ double atlas_rebake_ms(const char* preset) {
   return measured[preset] = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// One door move at a gi-bake preset (arg: 0 preview, 1 medium, 2 high; gi::antiradiance_preset):
-// the region made from the preset's bake as a load makes it, then per iteration the door to
-// the next of 0 / 25 / 100 degrees, relink + direct light + the solve to its tolerance on
-// the CPU twin (the sweep's cpu move + solve). Counters: door_move_ms (mean), atlas_rebake_ms,
-// vs_rebake = atlas_rebake_ms / door_move_ms, iterations (mean), links, leaves.
-void BM_DoorMoveAtPreset(benchmark::State& state) {
+// CPU time of the whole process (every thread), ms.
+double process_cpu_ms() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return 1e3 * static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_nsec);
+}
+
+// The door's angle at move k (from the baked 50 degrees): jumps to 0 / 25 / 100 in turn, or
+// steps of 5 degrees between 0 and 100 and back, as a player opens and shuts a door (55, 60,
+// ..., 100, 95, ..., 0, 5, ...).
+float door_angle(bool small_steps, std::size_t k) {
+  constexpr float kJumps[] = {0.0f, 25.0f, 100.0f};
+  if (!small_steps) return kJumps[k % std::size(kJumps)];
+  const std::size_t phase = (10 + 1 + k) % 40;  // 50 degrees = 10 steps into a 40-step cycle
+  return 5.0f * static_cast<float>(phase <= 20 ? phase : 40 - phase);
+}
+
+// Door moves at a gi-bake preset, `small_steps` or not (door_angle). Args: preset (0 preview,
+// 1 medium, 2 high; gi::antiradiance_preset), warm (0: every solve from the direct light, as
+// before the warm start; 1: from the previous pose's solution), threads1 (0: TBB's default,
+// the machine's 2; 1: one thread for the passes and the direct light). The region is made
+// from the preset's bake as a load makes it and solved at the baked pose (a load's first
+// frame); per iteration the door moves, relink + direct light + the solve to its tolerance
+// on the CPU twin (the sweep's cpu move + solve). Counters: door_move_ms (wall, mean),
+// door_move_cpu_ms (every thread's CPU), relink_direct_cpu_ms (its relink + direct light
+// part), links_made (by the relink), max_move_ms, atlas_rebake_ms (the yardstick:
+// re-baking the corridor's light atlas at the same preset, door shut, once per process),
+// vs_rebake, iterations (mean), links, leaves.
+void door_moves(benchmark::State& state, bool small_steps) {
   Corridor& c = corridor();
   const char* preset = preset_name(state.range(0));
   const double rebake_ms = atlas_rebake_ms(preset);
   gi::AntiradianceSettings s = gi::antiradiance_preset(preset);
+  s.warm_start = state.range(1) != 0;
+  const auto threads = static_cast<std::size_t>(state.range(2) == 1 ? 1 : oneapi::tbb::info::default_concurrency());
+  oneapi::tbb::global_control limit(oneapi::tbb::global_control::max_allowed_parallelism, threads);
   auto bake = gi::bake_antiradiance(c.input, s);
   if (!bake) std::exit(1);
   auto region = gi::AntiradianceRegion::create(c.input, std::move(bake).value());
   if (!region) std::exit(1);
   region->update();  // the baked pose's solve, as the first frame after a load
-  constexpr float kAngles[] = {0.0f, 25.0f, 100.0f};
   std::size_t k = 0;
-  double total_ms = 0.0, iterations = 0.0;
+  double total_ms = 0.0, cpu_ms = 0.0, max_ms = 0.0, iterations = 0.0, move_cpu_ms = 0.0, links_made = 0.0;
   for (auto _ : state) {
     const auto t0 = std::chrono::steady_clock::now();
-    region->set_instance_transform(c.door_instance, door(kAngles[k++ % std::size(kAngles)]));
-    const gi::AntiradianceSolveReport rep = region->update();
+    const double c0 = process_cpu_ms();
+    region->set_instance_transform(c.door_instance, door(door_angle(small_steps, k++)));
+    region->update(false);  // relink + direct light
+    move_cpu_ms += process_cpu_ms() - c0;
+    links_made += static_cast<double>(region->counters().links_made);
+    const gi::AntiradianceSolveReport rep = region->update();  // nothing moved since: the solve
     benchmark::DoNotOptimize(region->irradiance().data());
-    total_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    cpu_ms += process_cpu_ms() - c0;
+    total_ms += ms;
+    max_ms = std::max(max_ms, ms);
     iterations += rep.iterations;
   }
   const double moves = static_cast<double>(state.iterations());
   state.counters["door_move_ms"] = total_ms / moves;
+  state.counters["door_move_cpu_ms"] = cpu_ms / moves;
+  state.counters["relink_direct_cpu_ms"] = move_cpu_ms / moves;
+  state.counters["links_made"] = links_made / moves;
+  state.counters["max_move_ms"] = max_ms;
   state.counters["atlas_rebake_ms"] = rebake_ms;
   state.counters["vs_rebake"] = rebake_ms / (total_ms / moves);
   state.counters["iterations"] = iterations / moves;
+  state.counters["threads"] = static_cast<double>(threads);
   state.counters["links"] = static_cast<double>(region->links().links.size());
   state.counters["leaves"] = static_cast<double>(region->hierarchy().leaf_count());
   state.counters["bins"] = static_cast<double>(region->bins().count());
 }
-BENCHMARK(BM_DoorMoveAtPreset)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->Iterations(3);
+
+// The door to 0 / 25 / 100 degrees in turn (3 moves, each angle once).
+void BM_DoorMoveAtPreset(benchmark::State& state) { door_moves(state, false); }
+BENCHMARK(BM_DoorMoveAtPreset)
+    ->ArgNames({"preset", "warm", "threads1"})
+    ->Args({0, 0, 1})
+    ->Args({0, 0, 0})
+    ->Args({0, 1, 0})
+    ->Args({1, 0, 1})
+    ->Args({1, 0, 0})
+    ->Args({1, 1, 0})
+    ->Args({2, 0, 0})
+    ->Args({2, 1, 0})
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(3);
+
+// The door opened from its baked 50 to 100 degrees, shut to 0 and opened to 50 again in
+// 5-degree steps (40 moves: a player at the door, a few degrees per frame; the last move is
+// back at the baked pose, where the change is 0 without a solve).
+void BM_DoorStepsAtPreset(benchmark::State& state) { door_moves(state, true); }
+BENCHMARK(BM_DoorStepsAtPreset)
+    ->ArgNames({"preset", "warm", "threads1"})
+    ->Args({0, 0, 0})
+    ->Args({0, 1, 0})
+    ->Args({1, 0, 0})
+    ->Args({1, 1, 0})
+    ->Args({2, 1, 0})
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(40);
 
 // The yardstick for ratios on shared cores: sorting 1.6 M random 16-byte records by
 // (receiver, bin, sender) -- the job a relink did in full before it merged (a fixed

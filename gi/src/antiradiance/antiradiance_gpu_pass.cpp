@@ -154,14 +154,24 @@ void AntiradianceGpuPass::dispatch(const engine::ShaderProgram& program, std::ui
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
 }
 
-void AntiradianceGpuPass::reset(std::span<const glm::vec3> direct) {
-  GI_EXPECTS(direct.size() == leaves_, "reset: one direct irradiance per leaf");
+void AntiradianceGpuPass::upload_leaves(std::span<const glm::vec3> direct) {
   std::vector<GpuLeaf> data(leaves_);
   for (std::size_t l = 0; l < leaves_; ++l) {
     const ElementNode& e = h_->nodes[static_cast<std::size_t>(h_->leaves[l])];
     data[l] = {glm::vec4(e.normal, e.area_m2), glm::vec4(e.albedo, 0.0f), glm::vec4(direct[l], 0.0f)};
   }
   glNamedBufferSubData(leaf_data_.id(), 0, static_cast<GLsizeiptr>(data.size() * sizeof(GpuLeaf)), data.data());
+}
+
+void AntiradianceGpuPass::warm_start(std::span<const glm::vec3> direct) {
+  GI_EXPECTS(direct.size() == leaves_, "warm_start: one direct irradiance per leaf");
+  upload_leaves(direct);  // the tables stay: the last solve's I_ex is the first iterate
+  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+}
+
+void AntiradianceGpuPass::reset(std::span<const glm::vec3> direct) {
+  GI_EXPECTS(direct.size() == leaves_, "reset: one direct irradiance per leaf");
+  upload_leaves(direct);
   // The local pass over zero incident light writes I_L from the direct light, I_A = 0, E = 0.
   for (const engine::GlBuffer* b : {&l_in_, &i_a_, &i_ex_})
     glClearNamedBufferData(b->id(), GL_R32F, GL_RED, GL_FLOAT, nullptr);

@@ -42,6 +42,7 @@ class AntiradianceGpuPass final : public AntiradiancePasses {
   engine::Status set_links(const LinkMesh& links);
 
   void reset(std::span<const glm::vec3> direct) override;
+  void warm_start(std::span<const glm::vec3> direct) override;
   void global() override;
   void push() override;
   LocalPassSums local(bool radiance, bool antiradiance) override;
@@ -57,6 +58,8 @@ class AntiradianceGpuPass final : public AntiradiancePasses {
   explicit AntiradianceGpuPass(const ElementHierarchy& h) : h_(&h) {}
   void dispatch(const engine::ShaderProgram& program, std::uint32_t items);
   void set_first(const engine::ShaderProgram& program, std::uint32_t first);
+  /// Uploads the leaves' normals, areas, albedos and `direct`.
+  void upload_leaves(std::span<const glm::vec3> direct);
 
   const ElementHierarchy* h_;
   std::uint32_t m_ = 0;

@@ -6,8 +6,25 @@
 #include <cmath>
 
 #include <glm/gtc/constants.hpp>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 namespace gi {
+
+namespace {
+
+// Calls fn(i) for i in [begin, end) on TBB's threads, `grain` items at least per task. Every
+// caller writes only item i's own entries, so the tables are bit for bit the same for any
+// thread count (the tests compare 1 and 4 threads).
+template <class Fn>
+void for_each_item(std::size_t begin, std::size_t end, std::size_t grain, const Fn& fn) {
+  if (begin >= end) return;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(begin, end, grain), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t i = r.begin(); i != r.end(); ++i) fn(i);
+  });
+}
+
+}  // namespace
 
 void nodes_by_level(const ElementHierarchy& h, std::vector<std::int32_t>& nodes, std::vector<std::uint32_t>& offsets) {
   std::vector<std::int32_t> depth(h.nodes.size(), 0);
@@ -36,6 +53,7 @@ CpuAntiradiancePasses::CpuAntiradiancePasses(const ElementHierarchy& h, const Di
   i_a_.assign(h.leaf_count() * m, glm::vec3(0.0f));
   e_.assign(h.leaf_count(), glm::vec3(0.0f));
   direct_.assign(h.leaf_count(), glm::vec3(0.0f));
+  leaf_sums_.assign(h.leaf_count(), glm::vec2(0.0f));
 }
 
 void CpuAntiradiancePasses::reset(std::span<const glm::vec3> direct) {
@@ -48,9 +66,16 @@ void CpuAntiradiancePasses::reset(std::span<const glm::vec3> direct) {
   pull();
 }
 
+void CpuAntiradiancePasses::warm_start(std::span<const glm::vec3> direct) {
+  GI_EXPECTS(direct.size() == h_.leaf_count(), "warm_start: one direct irradiance per leaf");
+  // The local pass reads the leaves' normals and areas from the hierarchy itself.
+  direct_.assign(direct.begin(), direct.end());
+}
+
 void CpuAntiradiancePasses::global() {
   const std::size_t m = static_cast<std::size_t>(m_);
-  for (std::size_t r = 0; r < h_.nodes.size(); ++r) {
+  // One receiver's row per item (its links are contiguous): 16 rows a task at least.
+  for_each_item(0, h_.nodes.size(), 16, [&](std::size_t r) {
     glm::vec3* row = &l_in_[r * m];
     std::fill(row, row + m, glm::vec3(0.0f));
     // Links of r sorted by (bin, sender): each bin's sum runs in link order from zero, as
@@ -60,23 +85,24 @@ void CpuAntiradiancePasses::global() {
       const auto b = static_cast<std::size_t>(l.bin);
       row[b] += l.form_factor * i_ex_[static_cast<std::size_t>(l.sender) * m + b];
     }
-  }
+  });
 }
 
 void CpuAntiradiancePasses::push() {
   const std::size_t m = static_cast<std::size_t>(m_);
+  // Level by level (a node reads its parent's finished row); the nodes of a level in parallel.
   for (std::size_t d = 1; d + 1 < level_offsets_.size(); ++d)
-    for (std::uint32_t i = level_offsets_[d]; i < level_offsets_[d + 1]; ++i) {
+    for_each_item(level_offsets_[d], level_offsets_[d + 1], 64, [&](std::size_t i) {
       const auto n = static_cast<std::size_t>(by_level_[i]);
       const auto p = static_cast<std::size_t>(h_.nodes[n].parent);
       for (std::size_t b = 0; b < m; ++b) l_in_[n * m + b] += l_in_[p * m + b];
-    }
+    });
 }
 
 LocalPassSums CpuAntiradiancePasses::local(bool radiance, bool antiradiance) {
   const std::size_t m = static_cast<std::size_t>(m_);
-  LocalPassSums sums;
-  for (std::size_t l = 0; l < h_.leaf_count(); ++l) {
+  // Each leaf on its own (its partial sums into leaf_sums_), then the sums in leaf order.
+  for_each_item(0, h_.leaf_count(), 16, [&](std::size_t l) {
     const std::size_t n = static_cast<std::size_t>(h_.leaves[l]);
     const ElementNode& e = h_.nodes[n];
     glm::vec3 irradiance(0.0f);
@@ -99,26 +125,31 @@ LocalPassSums CpuAntiradiancePasses::local(bool radiance, bool antiradiance) {
       magnitude += a.x + a.y + a.z;
       i_ex_[n * m + b] = ex;
     }
-    sums.change += static_cast<double>(change);
-    sums.magnitude += static_cast<double>(magnitude);
+    leaf_sums_[l] = {change, magnitude};
+  });
+  LocalPassSums sums;
+  for (const glm::vec2& s : leaf_sums_) {
+    sums.change += static_cast<double>(s.x);
+    sums.magnitude += static_cast<double>(s.y);
   }
   return sums;
 }
 
 void CpuAntiradiancePasses::pull() {
   const std::size_t m = static_cast<std::size_t>(m_);
+  // From the deepest level up (a node reads its children's finished rows); a level in parallel.
   for (std::size_t d = level_offsets_.size() - 1; d-- > 0;)
-    for (std::uint32_t i = level_offsets_[d]; i < level_offsets_[d + 1]; ++i) {
+    for_each_item(level_offsets_[d], level_offsets_[d + 1], 16, [&](std::size_t i) {
       const auto n = static_cast<std::size_t>(by_level_[i]);
       const ElementNode& e = h_.nodes[n];
-      if (e.child_count == 0) continue;
+      if (e.child_count == 0) return;
       for (std::size_t b = 0; b < m; ++b) {
         glm::vec3 sum(0.0f);
         for (std::int32_t c = 0; c < e.child_count; ++c)
           sum += i_ex_[static_cast<std::size_t>(h_.children[static_cast<std::size_t>(e.first_child + c)]) * m + b];
         i_ex_[n * m + b] = sum;
       }
-    }
+    });
 }
 
 }  // namespace gi

@@ -46,6 +46,11 @@ class AntiradiancePasses {
   /// irradiance, no antiradiance: "shadowing of the direct illumination is done by the
   /// shadow map", §3.3), I_A = 0, E = 0; pulls. `direct`: W/m^2 per leaf.
   virtual void reset(std::span<const glm::vec3> direct) = 0;
+  /// Starts from the tables of the last solve instead (a warm start: the solution of the
+  /// previous pose is the first iterate, so a door moved a little needs few iterations to the
+  /// same fixed point): takes the new direct light (W/m^2 per leaf) and the leaves' current
+  /// normals and areas, keeps I_ex, I_L, I_A and E. Precondition: reset() ran before.
+  virtual void warm_start(std::span<const glm::vec3> direct) = 0;
   /// Global pass (operator U, eq. 16): L_in[r][bin] = sum over r's links of F I_ex[s][bin].
   virtual void global() = 0;
   /// Push: level by level from the root's children down, L_in[n] += L_in[parent(n)].
@@ -61,12 +66,15 @@ class AntiradiancePasses {
   virtual std::vector<glm::vec3> irradiance() const = 0;
 };
 
-/// The CPU twin: plain loops over the tables, single-threaded, float sums in the shaders' order.
+/// The CPU twin: loops over the tables, float sums in the shaders' order. Each pass runs its
+/// items (receivers, nodes of a level, leaves) on TBB's threads, every item writing only its
+/// own entries: bit for bit the same tables for any thread count.
 class CpuAntiradiancePasses final : public AntiradiancePasses {
  public:
   /// Keeps references: the hierarchy, bins and links must outlive it (their sizes must not change).
   CpuAntiradiancePasses(const ElementHierarchy& h, const DirectionalBins& bins, const LinkMesh& links);
   void reset(std::span<const glm::vec3> direct) override;
+  void warm_start(std::span<const glm::vec3> direct) override;
   void global() override;
   void push() override;
   LocalPassSums local(bool radiance, bool antiradiance) override;
@@ -84,6 +92,7 @@ class CpuAntiradiancePasses final : public AntiradiancePasses {
   std::vector<glm::vec3> i_ex_, l_in_, i_l_, i_a_, e_, direct_;
   std::vector<std::int32_t> by_level_;        ///< Nodes ordered by depth (root first).
   std::vector<std::uint32_t> level_offsets_;  ///< by_level_ range of each depth.
+  std::vector<glm::vec2> leaf_sums_;          ///< The local pass's (change, magnitude) per leaf.
 };
 
 }  // namespace gi

@@ -110,6 +110,7 @@ engine::Result<AntiradianceRegion> AntiradianceRegion::create(const BakeInput& i
   r.baseline_ = std::move(bake.baseline);
   r.links_ = std::make_unique<LinkMesh>(std::move(bake.static_links));
   r.direct_light_ = std::make_unique<AntiradianceDirectLight>(std::move(direct).value());
+  r.baked_transform_ = r.hierarchy_->group_transform;
   // Place the deforming groups where `input` has them and link them.
   std::vector<int> groups;
   r.at_baked_pose_ = true;
@@ -167,9 +168,28 @@ AntiradianceSolveReport AntiradianceRegion::update(bool solve) {
   }
   counters_.links = links_->links.size();
   if (!solve) return {};
-  last_ = run_antiradiance(*cpu_, direct_, settings_, *hierarchy_);
+  if (solved_ && posed_as_baked()) {
+    // The baseline is this pose's solve; the tables keep the last pose's (the next warm start).
+    last_ = {};
+    last_.converged = true;
+    showing_baseline_ = true;
+    return last_;
+  }
+  const bool warm = settings_.warm_start && warm_startable_;
+  last_ = run_antiradiance(*cpu_, direct_, settings_, *hierarchy_,
+                           warm ? AntiradianceStart::Warm : AntiradianceStart::Cold);
+  solved_ = true;
+  // Only a converged solve's tables start the next one: the change is then the difference of
+  // two solves within the tolerance of their fixed points, like the cold-started baseline's. An
+  // unconverged one (a budget too small, or a fixed count: tolerance 0) would carry its
+  // iterations over, and the change would hold the difference of iteration counts; a diverged
+  // (or energy-clamped) one is no start either.
+  warm_startable_ = last_.converged && !last_.diverged && last_.output_scale == 1.0f;
+  showing_baseline_ = false;
   return last_;
 }
+
+bool AntiradianceRegion::posed_as_baked() const { return hierarchy_->group_transform == baked_transform_; }
 
 void prepare_antiradiance_load(AntiradianceBake& bake, const BakeInput& input, const AtlasLayout* layout) {
   // The groups AntiradianceRegion::create relinks, at the pose the bake holds them.

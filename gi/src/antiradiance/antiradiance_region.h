@@ -109,21 +109,33 @@ class AntiradianceRegion {
   bool set_instance_transform(std::uint32_t instance, const glm::mat4& object_to_world);
   /// Relinks what moved since the last update (nothing when nothing moved) and recomputes
   /// the direct light; then solves on the CPU unless `solve` is false (the GPU twin solves).
+  /// The first solve starts cold (from the direct light: at the baked pose bit for bit the
+  /// baseline's computation); later ones start from the last solve's tables when
+  /// settings().warm_start is set and that solve converged (to the tolerance, within the
+  /// budget, without diverging). With every deforming
+  /// group back at its baked transform (posed_as_baked) after a first solve, the solve is
+  /// skipped and irradiance() is the baseline: the change is exactly 0 there.
   AntiradianceSolveReport update(bool solve = true);
 
-  /// Indirect irradiance (W/m^2) per leaf of the last CPU solve (its energy guard applied).
+  /// Indirect irradiance (W/m^2) per leaf of the last CPU solve (its energy guard applied);
+  /// the baseline when that update found the region posed as baked.
   std::vector<glm::vec3> irradiance() const {
+    if (showing_baseline_) return baseline_;
     std::vector<glm::vec3> e = cpu_->irradiance();
     for (glm::vec3& v : e) v *= last_.output_scale;
     return e;
   }
   /// The exitant intensities I_ex of the last CPU solve (nodes x bins RGB, W/sr; its energy
-  /// guard applied): what gather_at_points reads (antiradiance_texel_gather.h).
+  /// guard applied): what gather_at_points reads (antiradiance_texel_gather.h). An update
+  /// that skipped the solve (posed as baked) leaves them as they were.
   std::vector<glm::vec3> exitant() const {
     std::vector<glm::vec3> i = cpu_->exitant();
     for (glm::vec3& v : i) v *= last_.output_scale;
     return i;
   }
+  /// The next solve starts from the direct light, as the first (what a GPU twin made afresh
+  /// does, for comparisons).
+  void discard_solution() { warm_startable_ = false; }
   /// The report of the last CPU solve.
   const AntiradianceSolveReport& last_report() const { return last_; }
   /// The baseline's indirect irradiance per leaf (the region at its baked pose).
@@ -139,6 +151,9 @@ class AntiradianceRegion {
   /// True while every deforming group is at the pose it was baked at (since create, before
   /// any move): the bake's AtBakedPose then holds what the region would compute.
   bool at_baked_pose() const { return at_baked_pose_; }
+  /// True while every deforming group's transform equals the one it was baked at (also after
+  /// moving away and back): the change there is 0 by definition.
+  bool posed_as_baked() const;
 
  private:
   AntiradianceSettings settings_;
@@ -150,10 +165,14 @@ class AntiradianceRegion {
   std::unique_ptr<CpuAntiradiancePasses> cpu_;
   std::vector<glm::vec3> direct_;
   std::vector<glm::vec3> baseline_;
+  std::vector<glm::mat4> baked_transform_;  ///< Per deforming group g: [g - 1], as baked.
   std::vector<int> moved_;
   AntiradianceSolveReport last_;
   AntiradianceUpdateCounters counters_;
   bool at_baked_pose_ = false;
+  bool solved_ = false;            ///< The CPU passes hold a solve.
+  bool warm_startable_ = false;    ///< ... one that converged (a warm start can use it).
+  bool showing_baseline_ = false;  ///< The last update found the region posed as baked.
 };
 
 }  // namespace gi

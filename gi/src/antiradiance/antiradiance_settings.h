@@ -52,6 +52,14 @@ struct AntiradianceSettings {
   /// change relative to the region's exitant energy) drops below it; 0: always run
   /// `iterations` (a fixed, unconverged count).
   double residual_tolerance = 1e-3;
+  /// A door move's solve starts from the previous pose's solution (runtime only, not stored
+  /// in a bundle: the bake's baseline always starts from the direct light); false: every
+  /// solve starts from the direct light, as before issue 37's warm start.
+  bool warm_start = true;
+  /// A warm-started solve is converged when, besides residual_tolerance, its residual sum has
+  /// dropped by this factor from its first iteration's (the door's change converged by about
+  /// that factor; antiradiance_solver.h).
+  double warm_tolerance = 0.03;
   /// Symmetric: fall back to the asymmetric scheme (restarted from the direct light) when
   /// the residual grew this many iterations in a row, or the intensities exceed the bound.
   int growth_limit = 2;

@@ -81,8 +81,17 @@ bool stalled(const std::vector<double>& changes) {
   return n > 2 * kStallWindow && changes[n - 1] > 0.5 * changes[n - 1 - kStallWindow];
 }
 
-bool converged(const AntiradianceSettings& settings, const LocalPassSums& s) {
-  return settings.residual_tolerance > 0.0 && relative(s) < settings.residual_tolerance;
+// Converged: the relative residual is below the tolerance. A warm start begins near the
+// fixed point everywhere except where the door changed the light, so that alone would stop it
+// while the change itself is still far from converged (its error shrinks by the iteration's
+// rate per step, the same as a cold start's remainder); it also needs the residual down by
+// warm_tolerance from its first iteration's (the change's error down by about that factor),
+// or the whole residual negligible (below tolerance x warm_tolerance).
+bool converged(const AntiradianceSettings& settings, const LocalPassSums& s, bool warm, double first_change) {
+  if (!(settings.residual_tolerance > 0.0 && relative(s) < settings.residual_tolerance)) return false;
+  if (!warm) return true;
+  return s.change <= settings.warm_tolerance * first_change ||
+         relative(s) < settings.residual_tolerance * settings.warm_tolerance;
 }
 
 // The symmetric scheme; false when it diverged (the report then holds its residual changes).
@@ -97,7 +106,7 @@ bool run_symmetric(AntiradiancePasses& passes, const AntiradianceSettings& setti
     report.changes.push_back(s.change);
     report.iterations = i + 1;
     if (watch.grew(s.change, i)) return false;
-    if (converged(settings, s)) {
+    if (converged(settings, s, report.warm, report.changes.front())) {
       report.converged = true;
       break;
     }
@@ -114,6 +123,7 @@ void run_asymmetric(AntiradiancePasses& passes, const AntiradianceSettings& sett
   report.scheme = AntiradianceScheme::Asymmetric;
   const int a_steps = std::max(settings.antiradiance_steps, 1);
   GrowthWatch watch{settings.growth_limit};
+  double first_change = 0.0;
   for (int i = 0; i < budget; ++i) {
     for (int j = 0; j < a_steps; ++j) {
       step(passes, false, true);
@@ -127,7 +137,8 @@ void run_asymmetric(AntiradiancePasses& passes, const AntiradianceSettings& sett
       report.diverged = true;
       break;
     }
-    if (converged(settings, s)) {
+    if (i == 0) first_change = s.change;
+    if (converged(settings, s, report.warm, first_change)) {
       report.converged = true;
       break;
     }
@@ -137,15 +148,21 @@ void run_asymmetric(AntiradiancePasses& passes, const AntiradianceSettings& sett
 }  // namespace
 
 AntiradianceSolveReport run_antiradiance(AntiradiancePasses& passes, std::span<const glm::vec3> direct,
-                                         const AntiradianceSettings& settings, const ElementHierarchy& h) {
+                                         const AntiradianceSettings& settings, const ElementHierarchy& h,
+                                         AntiradianceStart start) {
   AntiradianceSolveReport report;
   const int budget = std::max(settings.iterations, 0);
-  passes.reset(direct);
+  report.warm = start == AntiradianceStart::Warm;
+  if (report.warm)
+    passes.warm_start(direct);
+  else
+    passes.reset(direct);
   bool done = false;
   if (settings.scheme == AntiradianceScheme::Symmetric) {
     done = run_symmetric(passes, settings, budget, report);
     if (!done) {
       report.fell_back = true;
+      report.warm = false;
       report.residuals.clear();
       report.iterations = 0;
       passes.reset(direct);

@@ -29,6 +29,7 @@
 // same computation and the change is exactly 0).
 //   gi::AntiradianceSolveReport r = gi::run_antiradiance(passes, direct, settings, bound);
 
+#include <cstdint>
 #include <span>
 #include <vector>
 
@@ -41,6 +42,7 @@ namespace gi {
 
 struct AntiradianceSolveReport {
   AntiradianceScheme scheme = AntiradianceScheme::Symmetric;  ///< The scheme that produced the result.
+  bool warm = false;              ///< It started from the last solve's tables (and did not fall back).
   bool fell_back = false;         ///< The symmetric iteration grew (or stalled) and was replaced.
   bool stalled = false;           ///< ... because it stalled: 8 iterations did not halve its residual (after 16).
   int iterations = 0;             ///< Iterations (radiance steps) of the final scheme.
@@ -64,9 +66,18 @@ struct AntiradianceSolveReport {
 /// E_direct (RGB summed) / (1 - min(albedo_max, 0.999)).
 double indirect_flux_bound(const ElementHierarchy& h, std::span<const glm::vec3> direct);
 
+/// Where a solve starts.
+enum class AntiradianceStart : std::uint8_t {
+  Cold,  ///< From the direct light (passes.reset): the bake's baseline, a region's first solve.
+  Warm,  ///< From the passes' last solution (passes.warm_start): a door moved since.
+};
+
 /// Runs the schedule on `passes` from `direct` (W/m^2 per leaf); the result is
-/// passes.irradiance().
+/// passes.irradiance(). A warm start iterates from the passes' tables (precondition: they
+/// hold a solve of the same hierarchy and links' layout); a fallback after growth or a stall
+/// restarts cold, as a cold solve does.
 AntiradianceSolveReport run_antiradiance(AntiradiancePasses& passes, std::span<const glm::vec3> direct,
-                                         const AntiradianceSettings& settings, const ElementHierarchy& h);
+                                         const AntiradianceSettings& settings, const ElementHierarchy& h,
+                                         AntiradianceStart start = AntiradianceStart::Cold);
 
 }  // namespace gi

@@ -5,6 +5,8 @@
 #include <string>
 
 #include <glm/gtc/constants.hpp>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 namespace gi {
 
@@ -37,7 +39,9 @@ void tangents(const glm::vec3& n, glm::vec3& t, glm::vec3& bt) {
   bt = glm::cross(n, t);
 }
 
-struct Linker {
+// The links of one pair of elements (both ways), written to `out`: what refinement decided
+// to link. Scratch per maker, so one maker per thread.
+struct LinkMaker {
   const ElementHierarchy& h;
   const DirectionalBins& bins;
   float threshold_sr;
@@ -49,17 +53,8 @@ struct Linker {
   /// Per bin: the split link's form factor so far, and the bins touched (scratch).
   std::vector<float> bin_sum{};
   std::vector<std::int32_t> touched{};
-
-  // Does the subtree of node a hold a receiver of the shard? (Subtrees are index ranges.)
-  bool subtree_owned(std::int32_t a) const {
-    if (shard.whole()) return true;
-    const std::size_t lo = static_cast<std::size_t>(a), hi = static_cast<std::size_t>(node(a).end);
-    const std::size_t block = WorkShard::kBlockItems;
-    if (hi - lo >= block * shard.count) return true;
-    for (std::size_t b = lo / block; b * block < hi; ++b)
-      if (b % shard.count == shard.index) return true;
-    return false;
-  }
+  /// The pieces' points of a split link's two ends (scratch).
+  std::vector<glm::vec3> sender_points{}, receiver_points{};
 
   const ElementNode& node(std::int32_t i) const { return h.nodes[static_cast<std::size_t>(i)]; }
 
@@ -68,7 +63,7 @@ struct Linker {
   }
 
   // Receiver r, sender s wholly behind r's plane: nothing to receive.
-  bool behind(const ElementNode& r, const ElementNode& s) const {
+  static bool behind(const ElementNode& r, const ElementNode& s) {
     if (r.normal == glm::vec3(0.0f)) return false;
     return glm::dot(r.normal, s.center - r.center) < -s.radius_m;
   }
@@ -125,6 +120,18 @@ struct Linker {
     }
   }
 
+  // The n equal-area pieces' points of leaf `e` as a disc of its area in its plane.
+  static void piece_points(const ElementNode& e, int n, std::vector<glm::vec3>& points) {
+    glm::vec3 t, bt;
+    tangents(e.normal, t, bt);
+    const float radius = std::sqrt(e.area_m2 / glm::pi<float>());
+    points.resize(static_cast<std::size_t>(n));
+    for (int k = 0; k < n; ++k) {
+      const DiscPoint a = spiral_point(k, n);
+      points[static_cast<std::size_t>(k)] = e.center + radius * (a.x * t + a.y * bt);
+    }
+  }
+
   // Directed leaf link r <- s split virtually (§3.1's refinement for a pair of leaves): both
   // leaves as discs of their area in their planes, cut into p.sender / p.receiver equal-area
   // pieces (spiral_point); each piece pair adds, in the bin of its own direction, its share
@@ -137,20 +144,13 @@ struct Linker {
     const ElementNode& sn = node(s);
     bin_sum.assign(static_cast<std::size_t>(bins.count()), 0.0f);
     touched.clear();
-    glm::vec3 st, sbt, rt, rbt;
-    tangents(sn.normal, st, sbt);
-    tangents(rn.normal, rt, rbt);
-    const float s_radius = std::sqrt(sn.area_m2 / glm::pi<float>());
-    const float r_radius = std::sqrt(rn.area_m2 / glm::pi<float>());
+    piece_points(sn, p.sender, sender_points);
+    piece_points(rn, p.receiver, receiver_points);
     const float reg =
         (sn.area_m2 / static_cast<float>(p.sender) + rn.area_m2 / static_cast<float>(p.receiver)) / glm::pi<float>();
     const float weight = 1.0f / (static_cast<float>(p.sender) * static_cast<float>(p.receiver));
-    for (int j = 0; j < p.sender; ++j) {
-      const DiscPoint a = spiral_point(j, p.sender);
-      const glm::vec3 ps = sn.center + s_radius * (a.x * st + a.y * sbt);
-      for (int k = 0; k < p.receiver; ++k) {
-        const DiscPoint b = spiral_point(k, p.receiver);
-        const glm::vec3 pr = rn.center + r_radius * (b.x * rt + b.y * rbt);
+    for (const glm::vec3& ps : sender_points)
+      for (const glm::vec3& pr : receiver_points) {
         const glm::vec3 dir = pr - ps;
         const float d2 = glm::dot(dir, dir);
         if (!(d2 > 0.0f) || glm::dot(rn.normal, dir) >= 0.0f) continue;  // behind the receiver piece
@@ -158,7 +158,6 @@ struct Linker {
         if (bin_sum[static_cast<std::size_t>(bin)] == 0.0f) touched.push_back(bin);
         bin_sum[static_cast<std::size_t>(bin)] += weight / ((d2 + reg) * bins.solid_angle(bin));
       }
-    }
     std::sort(touched.begin(), touched.end());
     for (std::int32_t b : touched) out.push_back({r, s, b, bin_sum[static_cast<std::size_t>(b)]});
   }
@@ -167,12 +166,41 @@ struct Linker {
     directed(a, b, fine);
     directed(b, a, fine);
   }
+};
+
+// A pair refinement decided to link (both ways); fine: it meets the oracle.
+struct LinkPair {
+  std::int32_t a = 0, b = 0;
+  bool fine = false;
+};
+
+// The refinement (§3.2): which pairs of elements are linked, from the root's self-link or
+// from pairs of groups; collects them, LinkMaker makes their links (make_links).
+struct Refinement {
+  const ElementHierarchy& h;
+  float threshold_sr;
+  std::vector<LinkPair>& pairs;
+  /// Distributed bakes: pairs whose subtrees hold no receiver of the shard are not visited.
+  WorkShard shard{};
+
+  const ElementNode& node(std::int32_t i) const { return h.nodes[static_cast<std::size_t>(i)]; }
+
+  // Does the subtree of node a hold a receiver of the shard? (Subtrees are index ranges.)
+  bool subtree_owned(std::int32_t a) const {
+    if (shard.whole()) return true;
+    const std::size_t lo = static_cast<std::size_t>(a), hi = static_cast<std::size_t>(node(a).end);
+    const std::size_t block = WorkShard::kBlockItems;
+    if (hi - lo >= block * shard.count) return true;
+    for (std::size_t b = lo / block; b * block < hi; ++b)
+      if (b % shard.count == shard.index) return true;
+    return false;
+  }
 
   void refine(std::int32_t a, std::int32_t b) {
     if (!subtree_owned(a) && !subtree_owned(b)) return;  // no link of the shard below
     const ElementNode& an = node(a);
     const ElementNode& bn = node(b);
-    if (behind(an, bn) && behind(bn, an)) return;  // back to back: no exchange either way
+    if (LinkMaker::behind(an, bn) && LinkMaker::behind(bn, an)) return;  // back to back: no exchange either way
     const float d2 = glm::dot(an.center - bn.center, an.center - bn.center);
     const float d = std::sqrt(d2);
     const bool a_leaf = an.child_count == 0, b_leaf = bn.child_count == 0;
@@ -180,7 +208,7 @@ struct Linker {
     const float sb = glm::pi<float>() * bn.radius_m * bn.radius_m / std::max(d2, 1e-30f);
     const bool fine = d > an.radius_m + bn.radius_m && std::max(sa, sb) <= threshold_sr;
     if (fine || (a_leaf && b_leaf)) {
-      link(a, b, fine);
+      pairs.push_back({a, b, fine});
       return;
     }
     const bool split_a = b_leaf || (!a_leaf && an.radius_m >= bn.radius_m);
@@ -202,6 +230,26 @@ struct Linker {
     }
   }
 };
+
+// Appends the links of `pairs` to `out` (in pair order), the pairs' links made on TBB's
+// threads in chunks, each chunk into its own list: the same links as one thread makes.
+void make_links(const ElementHierarchy& h, const DirectionalBins& bins, float threshold_sr, const WorkShard& shard,
+                int max_pieces, const std::vector<LinkPair>& pairs, std::vector<Link>& out) {
+  constexpr std::size_t kChunk = 256;
+  const std::size_t chunks = (pairs.size() + kChunk - 1) / kChunk;
+  std::vector<std::vector<Link>> parts(chunks);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks, 1), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t c = r.begin(); c != r.end(); ++c) {
+      LinkMaker maker{h, bins, threshold_sr, parts[c], shard, max_pieces};
+      for (std::size_t i = c * kChunk; i < std::min(pairs.size(), (c + 1) * kChunk); ++i)
+        maker.link(pairs[i].a, pairs[i].b, pairs[i].fine);
+    }
+  });
+  std::size_t total = out.size();
+  for (const std::vector<Link>& part : parts) total += part.size();
+  out.reserve(total);
+  for (const std::vector<Link>& part : parts) out.insert(out.end(), part.begin(), part.end());
+}
 
 // (receiver, bin, sender): a total order, since refinement links a pair once and a pair's
 // links differ in their bins.
@@ -248,8 +296,10 @@ LinkPieces link_pieces(const ElementNode& receiver, const ElementNode& sender, f
 
 LinkMesh link_elements(const ElementHierarchy& h, const DirectionalBins& bins, const AntiradianceSettings& settings) {
   LinkMesh mesh;
-  Linker linker{h, bins, oracle_threshold_sr(bins, settings), mesh.links, {}, settings.leaf_link_pieces};
-  linker.self(0);
+  const float threshold = oracle_threshold_sr(bins, settings);
+  std::vector<LinkPair> pairs;
+  Refinement{h, threshold, pairs}.self(0);
+  make_links(h, bins, threshold, {}, settings.leaf_link_pieces, pairs, mesh.links);
   sort_and_index(h, mesh);
   mesh.relinked_elements = h.nodes.size();
   mesh.links_made = mesh.links.size();
@@ -259,8 +309,10 @@ LinkMesh link_elements(const ElementHierarchy& h, const DirectionalBins& bins, c
 LinkMesh link_elements_shard(const ElementHierarchy& h, const DirectionalBins& bins,
                              const AntiradianceSettings& settings, const WorkShard& shard) {
   LinkMesh mesh;
-  Linker linker{h, bins, oracle_threshold_sr(bins, settings), mesh.links, shard, settings.leaf_link_pieces};
-  linker.self(0);
+  const float threshold = oracle_threshold_sr(bins, settings);
+  std::vector<LinkPair> pairs;
+  Refinement{h, threshold, pairs, shard}.self(0);
+  make_links(h, bins, threshold, shard, settings.leaf_link_pieces, pairs, mesh.links);
   sort_and_index(h, mesh);
   mesh.relinked_elements = shard.items(h.nodes.size()).size();
   mesh.links_made = mesh.links.size();
@@ -335,16 +387,19 @@ void relink_moved(const ElementHierarchy& h, const DirectionalBins& bins, const 
   // factors but turns their directions, hence their bins); links between unmoved groups stay.
   std::erase_if(mesh.links, [&](const Link& l) { return group_moved(l.receiver) || group_moved(l.sender); });
   const std::size_t kept = mesh.links.size();
-  Linker linker{h, bins, oracle_threshold_sr(bins, settings), mesh.links, {}, settings.leaf_link_pieces};
+  const float threshold = oracle_threshold_sr(bins, settings);
+  std::vector<LinkPair> pairs;
+  Refinement refinement{h, threshold, pairs};
   for (int a = 0; a < h.group_count(); ++a)
     for (int b = a + 1; b < h.group_count(); ++b) {
       if (!is_moved[static_cast<std::size_t>(a)] && !is_moved[static_cast<std::size_t>(b)]) continue;
       const std::int32_t ra = h.group_root[static_cast<std::size_t>(a)], rb = h.group_root[static_cast<std::size_t>(b)];
       if (ra < 0 || rb < 0) continue;
-      linker.refine(ra, rb);
+      refinement.refine(ra, rb);
     }
   for (int g = 1; g < h.group_count(); ++g)
-    if (is_moved[static_cast<std::size_t>(g)]) linker.self(h.group_root[static_cast<std::size_t>(g)]);
+    if (is_moved[static_cast<std::size_t>(g)]) refinement.self(h.group_root[static_cast<std::size_t>(g)]);
+  make_links(h, bins, threshold, {}, settings.leaf_link_pieces, pairs, mesh.links);
   for (int g = 1; g < h.group_count(); ++g)
     if (is_moved[static_cast<std::size_t>(g)]) {
       const std::int32_t r = h.group_root[static_cast<std::size_t>(g)];

@@ -177,8 +177,8 @@ const engine::GpuContext* gl_context() {
 
 glm::vec3 ref_at(const RgbField& f, std::size_t i) { return {f.rgb[3 * i], f.rgb[3 * i + 1], f.rgb[3 * i + 2]}; }
 
-// Long because it is one table: every knob of the method with its grid.
-std::vector<KnobSpec> antiradiance_knobs() {
+// Long because it is one table: every knob of the method's bake and solve with its grid.
+std::vector<KnobSpec> solve_knobs() {
   return {
       {.name = "patch",
        .description = "leaf element size: longest triangle-piece edge, metres (sets the hierarchy's depth)",
@@ -202,6 +202,13 @@ std::vector<KnobSpec> antiradiance_knobs() {
        .description = "residual tolerance of the solve (sum |dI_ex| / sum |I_ex|); 0: run the whole budget",
        .kind = KnobKind::Real,
        .default_grid = {"0.001"},
+       .min_value = 0,
+       .max_value = 1},
+      {.name = "warm",
+       .description = "a door move's solve starts from the previous pose's solution, converged when its residual "
+                      "also dropped by this factor from its first iteration's (0: from the direct light)",
+       .kind = KnobKind::Real,
+       .default_grid = {"0.03"},
        .min_value = 0,
        .max_value = 1},
       {.name = "scheme",
@@ -251,6 +258,12 @@ std::vector<KnobSpec> antiradiance_knobs() {
        .kind = KnobKind::Choice,
        .default_grid = {"on"},
        .choices = {"on", "off"}},
+  };
+}
+
+// The knobs of what is scored: where and at which door angles, against how many samples.
+std::vector<KnobSpec> scoring_knobs() {
+  return {
       {.name = "density",
        .description = "atlas texels per metre where the change is compared",
        .kind = KnobKind::Real,
@@ -278,6 +291,12 @@ std::vector<KnobSpec> antiradiance_knobs() {
   };
 }
 
+std::vector<KnobSpec> antiradiance_knobs() {
+  std::vector<KnobSpec> knobs = solve_knobs();
+  for (KnobSpec& k : scoring_knobs()) knobs.push_back(std::move(k));
+  return knobs;
+}
+
 ReferenceRequest door_reference_request(const SweepScene&, const KnobSetting& k) {
   ReferenceRequest r;
   r.kind = "atlas_indirect_irradiance_door";
@@ -294,6 +313,8 @@ AntiradianceSettings antiradiance_settings(const RunContext& ctx) {
   s.bins_per_side = static_cast<int>(ctx.knobs.integer("bins"));
   s.iterations = static_cast<int>(ctx.knobs.integer("iterations"));
   s.residual_tolerance = ctx.knobs.real("tolerance");
+  s.warm_start = ctx.knobs.real("warm") > 0.0;
+  s.warm_tolerance = ctx.knobs.real("warm");
   s.scheme = ctx.knobs.text("scheme") == "asymmetric" ? AntiradianceScheme::Asymmetric : AntiradianceScheme::Symmetric;
   s.oracle_scale = static_cast<float>(ctx.knobs.real("oracle"));
   s.near_patch_size_m = static_cast<float>(ctx.knobs.real("near_patch"));
@@ -474,6 +495,7 @@ engine::Result<GpuDoorMove> time_gpu_door_move(const DoorSetup& d, AntiradianceR
   glFinish();
   g.ms = ms_since(t0);
   g.bytes = static_cast<double>(gpu->gpu_bytes());
+  region.discard_solution();  // the fresh GPU pass started from the direct light: so does the twin
   region.update(true);
   const std::vector<glm::vec3> cpu = region.irradiance();
   double diff = 0.0, scale = 0.0;

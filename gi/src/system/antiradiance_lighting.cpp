@@ -118,17 +118,37 @@ bool AntiradianceLighting::update() {
   if (!moved) return false;
   const auto t0 = std::chrono::steady_clock::now();
   region_->update(false);  // relink the moved groups, direct light at the elements
+  ++stats_.updates;
+  if (region_->posed_as_baked()) {
+    // Back at the baked pose: the change is 0 (the atlas holds this pose). No solve; the GPU
+    // tables keep the last pose's solution for the next warm start.
+    glClearNamedBufferData(delta_.id(), GL_R32F, GL_RED, GL_FLOAT, nullptr);
+    glFinish();
+    record(AntiradianceSolveReport{});
+    stats_.last_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    return true;
+  }
   if (engine::Status st = gpu_->set_links(region_->links()); !st) {
     disabled_ = st.error().to_string();
     return false;
   }
+  const bool warm = region_->settings().warm_start && gpu_warm_startable_;
   const AntiradianceSolveReport report =
-      run_antiradiance(*gpu_, region_->direct(), region_->settings(), region_->hierarchy());
+      run_antiradiance(*gpu_, region_->direct(), region_->settings(), region_->hierarchy(),
+                       warm ? AntiradianceStart::Warm : AntiradianceStart::Cold);
+  // As the CPU region: only a converged solve starts the next (AntiradianceRegion::update).
+  gpu_warm_startable_ = report.converged && !report.diverged && report.output_scale == 1.0f;
   upload_delta(gpu_->irradiance(), report.output_scale);
   glFinish();
-  ++stats_.updates;
+  record(report);
+  stats_.last_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  return true;
+}
+
+void AntiradianceLighting::record(const AntiradianceSolveReport& report) {
   stats_.relinked_elements = region_->counters().relinked_elements;
   stats_.links = region_->counters().links;
+  stats_.warm = report.warm;
   stats_.fell_back = report.fell_back;
   stats_.iterations = report.iterations;
   stats_.residual = report.residual;
@@ -141,8 +161,6 @@ bool AntiradianceLighting::update() {
                                   std::to_string(region_->settings().residual_tolerance) +
                                   "); the door's change shows the last iterate");
   }
-  stats_.last_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-  return true;
 }
 
 void AntiradianceLighting::composite(std::uint32_t base_texture, std::uint32_t out_texture) {

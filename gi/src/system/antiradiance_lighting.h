@@ -2,9 +2,9 @@
 // The runtime of an antiradiance region (docs/antiradiance.md) inside GISystem: watches
 // the deforming instances' entities, and on a frame where one moved relinks only its
 // elements, recomputes the direct light at the elements, runs the iteration on the GPU
-// (antiradiance_gpu_pass.h) and adds the change against the baked pose into the
-// irradiance atlas (antiradiance_composite.comp.glsl). A frame where nothing moved does
-// nothing; composite() re-adds the last change when the base atlas changed.
+// (antiradiance_gpu_pass.h; from the previous pose's solution after the first solve) and adds the change against the
+// baked pose into the irradiance atlas (antiradiance_composite.comp.glsl). A frame where nothing moved does nothing;
+// composite() re-adds the last change when the base atlas changed.
 //   auto a = gi::AntiradianceLighting::create(std::move(bake), input, layout, scene.registry).value();
 //   if (a->update()) { /* moved */ }  a->composite(base_texture, out_texture);
 
@@ -45,6 +45,9 @@ class AntiradianceLighting {
     /// warning); the change shown is the last iterate's.
     bool unconverged = false;
     std::uint64_t unconverged_updates = 0;  ///< Updates that ended so.
+    /// Last update: the solve started from the previous pose's solution (warm start), not
+    /// from the direct light. An update back at the baked pose solves nothing (iterations 0).
+    bool warm = false;
   };
 
   /// Errors: the bake does not fit `input` (AntiradianceRegion::create). `log` hears a
@@ -68,6 +71,8 @@ class AntiradianceLighting {
   AntiradianceLighting() = default;
   /// GL objects on first use (a context is current in frame()). False: disabled.
   bool ensure_gpu();
+  /// The last update's solve (and the relink's counters) into stats_; warns when unconverged.
+  void record(const AntiradianceSolveReport& report);
   /// Uploads delta = E(now) - baseline per leaf.
   void upload_delta(const std::vector<glm::vec3>& irradiance, float scale);
   std::vector<TexelBlendHost> blends_host_;
@@ -78,6 +83,7 @@ class AntiradianceLighting {
   engine::ShaderProgram program_;
   engine::GlBuffer blends_, delta_;
   std::uint32_t blend_count_ = 0;
+  bool gpu_warm_startable_ = false;  ///< The GPU tables hold a converged solve.
   int width_ = 0, height_ = 0;
   Stats stats_;
   std::string disabled_;

@@ -89,4 +89,37 @@ TEST(AntiradianceGpuPass, MatchesTheCpuTwinAfterTheDoorMovesAndIsRelinked) {
   EXPECT_GT(gpu->gpu_bytes(), 0u);
 }
 
+// A warm start (the runtime's door move after its first solve): both twins solved at one
+// pose, the door moved and relinked, both started from their own last tables; the GPU's
+// new leaf normals and direct light are uploaded without clearing the tables.
+TEST(AntiradianceGpuPass, WarmStartAfterTheDoorMovesMatchesTheCpuTwin) {
+  engine::GpuContext ctx = headless_or_fail();
+  gi::AntiradianceSettings s = settings(gi::AntiradianceScheme::Symmetric);
+  s.iterations = 64;  // converged, as a warm start needs
+  const artest::DoorScene scene = artest::door_scene(0.0f);
+  auto region = gi::AntiradianceRegion::create(scene.input, s);
+  ASSERT_TRUE(region);
+  gi::CpuAntiradiancePasses cpu(region->hierarchy(), region->bins(), region->links());
+  auto gpu = gi::AntiradianceGpuPass::create(region->hierarchy(), region->bins(), region->links());
+  ASSERT_TRUE(gpu) << gpu.error().to_string();
+  ASSERT_TRUE(gi::run_antiradiance(cpu, region->direct(), s, region->hierarchy()).converged);
+  ASSERT_TRUE(gi::run_antiradiance(*gpu, region->direct(), s, region->hierarchy()).converged);
+  ASSERT_TRUE(region->set_instance_transform(scene.door, artest::hinge_matrix(40.0f)));
+  region->update(false);
+  ASSERT_TRUE(gpu->set_links(region->links()));
+  const auto warm = gi::AntiradianceStart::Warm;
+  const gi::AntiradianceSolveReport rc = gi::run_antiradiance(cpu, region->direct(), s, region->hierarchy(), warm);
+  const gi::AntiradianceSolveReport rg = gi::run_antiradiance(*gpu, region->direct(), s, region->hierarchy(), warm);
+  EXPECT_TRUE(rc.warm && rg.warm);
+  EXPECT_EQ(rc.iterations, rg.iterations);
+  expect_close(cpu.irradiance(), gpu->irradiance(), "irradiance");
+  expect_close(cpu.exitant(), gpu->exitant(), "exitant intensity");
+  // The warm start reached the cold solve's fixed point at the new pose (within the tolerance).
+  gi::CpuAntiradiancePasses cold(region->hierarchy(), region->bins(), region->links());
+  gi::run_antiradiance(cold, region->direct(), s, region->hierarchy());
+  const std::vector<glm::vec3> a = cold.irradiance(), b = cpu.irradiance();
+  const float scale = largest(a);
+  for (std::size_t l = 0; l < a.size(); ++l) ASSERT_NEAR(a[l].x, b[l].x, 0.01f * scale) << l;
+}
+
 }  // namespace

@@ -100,6 +100,7 @@ class StallingPasses final : public gi::AntiradiancePasses {
     k_change_ = 1.0;
     calls_ = 0;
   }
+  void warm_start(std::span<const glm::vec3>) override {}
   void global() override {}
   void push() override {}
   gi::LocalPassSums local(bool radiance, bool antiradiance) override {
