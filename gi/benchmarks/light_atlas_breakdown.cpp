@@ -132,6 +132,11 @@ int main(int argc, char** argv) {
   g.seed = s.seed;
   // GI_BREAKDOWN_FILTER=r: another filter radius (texels) than the preset's; 0 is the sweep's unfiltered run.
   if (const char* r = std::getenv("GI_BREAKDOWN_FILTER")) g.filter_radius_texels = std::strtof(r, nullptr);
+  // GI_BREAKDOWN_NEAR=rays,texels: landings nearer than `texels` regather with `rays` rays.
+  if (const char* r = std::getenv("GI_BREAKDOWN_NEAR")) {
+    g.near_regather_rays = std::atoi(r);
+    if (const char* c = std::strchr(r, ',')) g.near_regather_texels = std::strtof(c + 1, nullptr);
+  }
   auto gathered = gi::gather_atlas(*scene, *layout, g, pool);
   if (!gathered) return std::fprintf(stderr, "%s\n", gathered.error().to_string().c_str()), 1;
   // GI_BREAKDOWN_SEEDS=2: a second gather of another seed; the two differ by the gather's noise,

@@ -52,6 +52,9 @@ engine::Status validate(const TexelGatherSettings& s) {
   if (!(s.denoise_outlier_sigmas >= 0.0f) || s.denoise_outlier_sigmas > 1000.0f)
     return bad("denoise_outlier_sigmas is outside [0, 1000]");
   if (!(s.source_filter_radius_texels <= 16.0f)) return bad("source_filter_radius_texels is above 16 (or NaN)");
+  if (s.near_regather_rays < 0 || s.near_regather_rays > 4096) return bad("near_regather_rays is outside 0..4096");
+  if (!(s.near_regather_texels >= 0.0f) || s.near_regather_texels > 64.0f)
+    return bad("near_regather_texels is outside [0, 64]");
   return {};
 }
 
@@ -304,6 +307,9 @@ bool gather_step(const StaticBakeScene& b, const AtlasLayout& layout, const Texe
   for (auto* field : {&src.reflected, &src.without_lights, &lit})
     dilate<glm::vec3>(*field, t.width, t.height, tx.valid, rings);
   src.sharp = s.landing_direct_everywhere ? std::vector<std::uint8_t>(n, 1) : sharp_pixels(lit, t.width, t.height);
+  src.layout = &layout;
+  src.near_rays = s.near_regather_rays;
+  src.near_m = s.near_regather_texels * texel_m;
   std::vector<std::uint64_t> gather_rays_of(work, 0);
   if (!final_gather(b, layout, t, s, pool, progress, s.shard.items(work), src, emitters ? &*emitters : nullptr, kept, e,
                     sky, out.variance, gather_rays_of))

@@ -76,6 +76,12 @@ struct TexelGatherSettings {
   /// texel in what the rays read lights every neighbour whose rays land on it: blotches a
   /// few texels wide that no filter of the output's per-texel noise removes.
   float source_filter_radius_texels = -1.0f;
+  /// Step 3's landings nearer than `near_regather_texels` texels take the sky and the
+  /// indirect light at the landing point itself, from this many cosine rays of their own
+  /// (a second gather one level down), instead of reading them from the texels, whose
+  /// samples can lie a texel away in other light (corners, ledges). 0: never.
+  int near_regather_rays = 0;
+  float near_regather_texels = 1.0f;
   std::uint64_t seed = 1;
   ProgressCallback progress;  ///< Fraction done in [0, 1]; return false to cancel.
   /// A distributed bake's shard (docs/distributed-bake.md): steps 1-2 run for every texel

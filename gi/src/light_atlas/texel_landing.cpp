@@ -1,12 +1,17 @@
 #include "light_atlas/texel_landing.h"
 
+#include <engine/sky.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 
 #include "core/color.h"
 #include "light_atlas/texel_direct.h"
+#include "light_atlas/texel_sampling.h"
 #include "raytrace/ray_offset.h"
+#include "raytrace/reference_brdf.h"
 
 namespace gi {
 namespace {
@@ -136,34 +141,78 @@ std::uint32_t landing(const StaticBakeScene& b, const AtlasLayout& layout, const
   return l.texel;
 }
 
-glm::dvec3 read_landing(const StaticBakeScene& b, const TexelTable& t, const GatherSource& src, const Landing& l,
-                        Pcg32& rng, std::uint64_t& rays) {
-  const bool sharp = src.sharp[l.pixel] != 0;
-  if (l.unseen_corners == 0 && !sharp) return glm::dvec3(bilinear(src.reflected, t.width, t.height, l.uv));
-  glm::dvec3 rest(0.0);
-  if (l.unseen_corners != 0) {
-    // The bilinear read without the corners whose samples do not see the point.
-    const Footprint f = footprint_at(t.width, t.height, l.uv);
-    const std::vector<glm::vec3>& img = sharp ? src.without_lights : src.reflected;
-    double weights = 0.0;
-    for (int k = 0; k < 4; ++k) {
-      if (l.unseen_corners & (1u << k)) continue;
-      const double wk = static_cast<double>((k % 2 ? f.ax : 1.0f - f.ax) * (k / 2 ? f.ay : 1.0f - f.ay));
-      rest += wk * glm::dvec3(img[f.pixel[k]]), weights += wk;
-    }
-    if (weights > 0.0) rest /= weights;
-    if (!sharp && weights > 0.0) return rest;
-    if (!(weights > 0.0)) rest = glm::dvec3(0.0);
-  } else {
-    rest = glm::dvec3(bilinear(src.without_lights, t.width, t.height, l.uv));
+namespace {
+
+// The bilinear read of `img` at a landing without the corners whose samples do not see the
+// landing point (Landing::unseen_corners), renormalised; false (and 0) where none does.
+bool read_seen_corners(const TexelTable& t, const std::vector<glm::vec3>& img, const Landing& l, glm::dvec3& out) {
+  out = glm::dvec3(0.0);
+  if (l.unseen_corners == 0) return out = glm::dvec3(bilinear(img, t.width, t.height, l.uv)), true;
+  const Footprint f = footprint_at(t.width, t.height, l.uv);
+  double weights = 0.0;
+  for (int k = 0; k < 4; ++k) {
+    if (l.unseen_corners & (1u << k)) continue;
+    const double wk = static_cast<double>((k % 2 ? f.ax : 1.0f - f.ax) * (k / 2 ? f.ay : 1.0f - f.ay));
+    out += wk * glm::dvec3(img[f.pixel[k]]), weights += wk;
   }
+  if (!(weights > 0.0)) return out = glm::dvec3(0.0), false;
+  out /= weights;
+  return true;
+}
+
+// The point a ray landed on, and its shading normal turned to the side the ray came from.
+struct LandingPoint {
+  glm::vec3 p, n;
+};
+
+LandingPoint landing_point(const StaticBakeScene& b, const Landing& l) {
   const ShadingTriangle& tri = b.index.triangles[l.triangle];
   const float u = l.barycentric.x, v = l.barycentric.y;
-  const glm::vec3 p = tri.p0 + u * tri.e1 + v * tri.e2;
   glm::vec3 n = (1.0f - u - v) * tri.n0 + u * tri.n1 + v * tri.n2;
   n = glm::dot(n, n) > 0.0f ? glm::normalize(n) : l.side;
   if (glm::dot(n, l.side) < 0.0f) n = -n;  // a double-sided surface seen from behind
-  const DirectAt d = direct_at(b, p, n, l.side, 1, rng, &rays);
+  return {tri.p0 + u * tri.e1 + v * tri.e2, n};
+}
+
+// The sky's and the indirect irradiance at a landing point from src.near_rays stratified
+// cosine rays, each reading `reflected` bilinearly where it lands or the sky where it escapes.
+glm::dvec3 regather_at(const StaticBakeScene& b, const TexelTable& t, const GatherSource& src, const Landing& l,
+                       const LandingPoint& at, Pcg32& rng, std::uint64_t& rays) {
+  const glm::vec3 origin = offset_ray_origin(at.p, l.side);
+  const auto m = static_cast<std::uint32_t>(src.near_rays);
+  const float shift_y = rng.next_float();  // drawn first: see random.h
+  const glm::vec2 shift(rng.next_float(), shift_y);
+  glm::dvec3 sum(0.0);
+  for (std::uint32_t r = 0; r < m; ++r) {
+    const glm::vec2 u = hammersley(r, m, shift);
+    const glm::vec3 wi = sample_cosine_hemisphere(at.n, u.x, u.y);
+    if (glm::dot(wi, l.side) <= 0.0f) continue;
+    ++rays;
+    const Landing l2 = land(b, *src.layout, t, Ray{origin, 0.0f, wi}, l.side, true);
+    if (l2.texel == kSky)
+      sum += std::numbers::pi * glm::dvec3(engine::sky_radiance(b.scene.sky_radiance, b.scene.sky_gradient, wi));
+    else if (glm::dvec3 reflected; l2.texel < kBack && read_seen_corners(t, src.reflected, l2, reflected))
+      sum += reflected;
+  }
+  return sum / static_cast<double>(m);
+}
+
+}  // namespace
+
+glm::dvec3 read_landing(const StaticBakeScene& b, const TexelTable& t, const GatherSource& src, const Landing& l,
+                        Pcg32& rng, std::uint64_t& rays) {
+  if (src.near_rays > 0 && l.distance < src.near_m) {
+    const LandingPoint at = landing_point(b, l);
+    const glm::dvec3 rest = regather_at(b, t, src, l, at, rng, rays);
+    const DirectAt d = direct_at(b, at.p, at.n, l.side, 1, rng, &rays);
+    return glm::dvec3(t.albedo[l.texel]) * (rest + glm::dvec3(d.live + d.unlit));
+  }
+  const bool sharp = src.sharp[l.pixel] != 0;
+  glm::dvec3 rest(0.0);
+  // Where no corner sees the point, the lights' direct light there is all the read takes.
+  if (read_seen_corners(t, sharp ? src.without_lights : src.reflected, l, rest) && !sharp) return rest;
+  const LandingPoint at = landing_point(b, l);
+  const DirectAt d = direct_at(b, at.p, at.n, l.side, 1, rng, &rays);
   const glm::dvec3 lights(t.albedo[l.texel] * (d.live + d.unlit));
   return rest + lights;
 }

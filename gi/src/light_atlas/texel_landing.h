@@ -3,7 +3,8 @@
 // it reads there. The rules that keep a read to the light of the landing point: the gap rule
 // (a surface facing the texel across a covered gap of under 0.05 texel is dark), the corners
 // of the bilinear read whose samples do not see the point (samples moved off their surface),
-// and reads across a shadow edge, which take the lights' direct light at the point itself.
+// reads across a shadow edge, which take the lights' direct light at the point itself, and
+// landings nearer than a texel, which take all their light at the point (a regather).
 //   const gi::Landing l = gi::land_ray(bake_scene, layout, table, ray, table.face[i]);
 //   if (l.texel < gi::kBack) radiosity = gi::read_landing(bake_scene, table, source, l, rng, rays);
 
@@ -54,6 +55,12 @@ std::uint32_t landing(const StaticBakeScene& b, const AtlasLayout& layout, const
 struct GatherSource {
   std::vector<glm::vec3> reflected, without_lights;
   std::vector<std::uint8_t> sharp;
+  /// Landings nearer than `near_m` take the sky and the indirect light at the point itself
+  /// from `near_rays` cosine rays (a second gather one level down, reading `reflected`)
+  /// instead of reading them from the texels (0 rays: never).
+  const AtlasLayout* layout = nullptr;
+  int near_rays = 0;
+  float near_m = 0.0f;
 };
 
 /// A texel holds the light at its one sample point. Where a shadow edge crosses it, the light
@@ -63,7 +70,10 @@ struct GatherSource {
 /// sun (issue 35, "Noise against floor"). There the read takes the lights' direct light at the
 /// landing point itself (one sample of each light, unbiased) and only the rest bilinearly.
 /// Bilinear corners whose samples do not see the point (Landing::unseen_corners) are left out;
-/// where none does, that direct light is all the read takes.
+/// where none does, that direct light is all the read takes. A landing nearer than
+/// `src.near_m` (with `src.near_rays` > 0) reads no texel of its own: the lights' direct light,
+/// the sky and the indirect light at the point, the last two from `near_rays` cosine rays
+/// reading `reflected` where they land (with the same corner rule) and the sky where they escape.
 /// Rays it casts (the direct light's shadow rays) are added to `rays`.
 glm::dvec3 read_landing(const StaticBakeScene& b, const TexelTable& t, const GatherSource& src, const Landing& l,
                         Pcg32& rng, std::uint64_t& rays);

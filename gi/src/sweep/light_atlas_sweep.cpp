@@ -106,6 +106,19 @@ std::vector<KnobSpec> light_atlas_knobs() {
        .default_grid = {"-1"},
        .min_value = -1,
        .max_value = 16},
+      {.name = "near_rays",
+       .description = "gather: landings nearer than near_texels regather the sky and indirect light at the point "
+                      "with this many rays (0: read from the texels)",
+       .kind = KnobKind::Integer,
+       .default_grid = {"0"},
+       .min_value = 0,
+       .max_value = 4096},
+      {.name = "near_texels",
+       .description = "gather: the distance, in texels, under which a landing regathers (near_rays)",
+       .kind = KnobKind::Real,
+       .default_grid = {"1"},
+       .min_value = 0,
+       .max_value = 64},
       {.name = "ref_spp",
        .description = "samples per texel of the path-traced reference",
        .kind = KnobKind::Integer,
@@ -154,6 +167,8 @@ engine::Result<MethodOutput> run_light_atlas(const RunContext& ctx) {
     s.gather.denoise_outlier_sigmas = static_cast<float>(ctx.knobs.real("outlier"));
     s.gather.landing_direct_everywhere = ctx.knobs.text("landing_direct") == "everywhere";
     s.gather.source_filter_radius_texels = static_cast<float>(ctx.knobs.real("source_filter"));
+    s.gather.near_regather_rays = static_cast<int>(ctx.knobs.integer("near_rays"));
+    s.gather.near_regather_texels = static_cast<float>(ctx.knobs.real("near_texels"));
     s.gather.bounces = std::max(s.bounces, 1);
   }
   s.seed = ctx.seed;

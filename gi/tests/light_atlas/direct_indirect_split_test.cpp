@@ -63,13 +63,15 @@ struct Split {
   std::size_t texels = 0;
 };
 
-// `facing`: the texels compared, all, the horizontal ones (|normal.y| above 0.9) or those
-// facing down (normal.y below -0.9).
-enum class Facing { All, Horizontal, Down };
+// `facing`: the texels compared, all, the horizontal ones (|normal.y| above 0.9), those
+// facing down (normal.y below -0.9) or the vertical ones (|normal.y| below 0.1).
+enum class Facing { All, Horizontal, Down, Vertical };
 
-Split compare_split(const gi::BakeInput& input, Facing facing = Facing::All) {
+// `near_rays`: TexelGatherSettings::near_regather_rays (the high preset's 0 unless given).
+Split compare_split(const gi::BakeInput& input, Facing facing = Facing::All, int near_rays = 0,
+                    float texels_per_metre = 4.0f) {
   gi::LightAtlasSettings s = gi::light_atlas_preset("high").value();
-  s.texels_per_metre = 4.0f;
+  s.texels_per_metre = texels_per_metre;
   auto layout = gi::static_world_layout(input, s.texels_per_metre);
   EXPECT_TRUE(layout);
   auto scene = gi::prepare_static_scene(input, *layout, gi::BakeLights::Static, gi::texel_placement(s));
@@ -77,6 +79,7 @@ Split compare_split(const gi::BakeInput& input, Facing facing = Facing::All) {
   gi::ThreadPool pool(2);
   gi::TexelGatherSettings g = s.gather;
   g.gather_rays = 4096;
+  g.near_regather_rays = near_rays;
   auto gathered = gi::gather_atlas(*scene, *layout, g, pool);
   EXPECT_TRUE(gathered) << gathered.error().to_string();
   auto truth = gi::reference_atlas_irradiance(input, scene->texels,
@@ -87,7 +90,7 @@ Split compare_split(const gi::BakeInput& input, Facing facing = Facing::All) {
   const auto compared = [&](std::size_t t) {
     const float ny = scene->texels.normal[t].y;
     return scene->texels.valid[t] && !(facing == Facing::Horizontal && std::fabs(ny) < 0.9f) &&
-           !(facing == Facing::Down && ny > -0.9f);
+           !(facing == Facing::Down && ny > -0.9f) && !(facing == Facing::Vertical && std::fabs(ny) > 0.1f);
   };
   for (std::size_t t = 0; t < scene->texels.valid.size(); ++t)
     if (compared(t)) total += static_cast<double>(truth->direct[t].y + truth->indirect[t].y), ++out.texels;
@@ -276,4 +279,23 @@ TEST(AtlasFloor, ASlotUnderASlabReadsItsOwnShade) {
       s.texels, s.worst_direct, s.worst_indirect, s.indirect_bias);
   EXPECT_LT(s.worst_indirect, 0.15);
   EXPECT_LT(std::fabs(s.indirect_bias), 0.12);
+}
+
+// Issue 35's floor, near landings: a ray from the slab's 20 cm sides lands on the floor a few
+// centimetres from the slab's foot, where the floor's texel (17 cm at 6 texels/m) holds the
+// light of its sample, up to a texel out. The sky and the indirect light at the foot are not
+// the sample's (the slab hides half the sky there and lights it from its sunlit side), so a
+// landing nearer than a texel takes them at the landing point itself, from a few rays of its
+// own (near_regather_rays). Measured on the sides: the worst texel 0.056 -> 0.017, the bias
+// -3.0% -> -1.6% of their light (4096 gather rays, against 4096 spp).
+TEST(AtlasFloor, NearLandingsBesideASlabTakeTheLightOfTheirPoint) {
+  const gi::BakeInput input = slab_over_a_floor(0.002f);
+  const Split before = compare_split(input, Facing::Vertical, 0, 6.0f);
+  const Split after = compare_split(input, Facing::Vertical, 4, 6.0f);
+  std::printf(
+      "slab 2 mm over a floor at 6 texels/m, %zu side texels: worst indirect beyond 4 sigma %.4f -> %.4f, indirect "
+      "bias %+.4f -> %+.4f (reads at the texels -> regathered at near landings)\n",
+      after.texels, before.worst_indirect, after.worst_indirect, before.indirect_bias, after.indirect_bias);
+  EXPECT_LT(after.worst_indirect, 0.03);
+  EXPECT_LT(std::fabs(after.indirect_bias), 0.022);
 }

@@ -10,6 +10,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <string>
 
 #include "core/color.h"
@@ -161,6 +162,14 @@ TEST(GatherDenoise, RejectsBadSettings) {
   ASSERT_FALSE(bad);
   EXPECT_NE(bad.error().to_string().find("source_filter_radius_texels"), std::string::npos) << bad.error().to_string();
   g.source_filter_radius_texels = 1.5f;
+  g.near_regather_rays = -1;
+  const auto bad_near = gi::gather_atlas(p.scene, p.layout, g, pool);
+  ASSERT_FALSE(bad_near);
+  EXPECT_NE(bad_near.error().to_string().find("near_regather_rays"), std::string::npos);
+  g.near_regather_rays = 4;
+  g.near_regather_texels = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_FALSE(gi::gather_atlas(p.scene, p.layout, g, pool));
+  g.near_regather_texels = 1.0f;
   EXPECT_TRUE(gi::gather_atlas(p.scene, p.layout, g, pool));
 }
 
