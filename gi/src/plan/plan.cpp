@@ -228,7 +228,11 @@ void plan_light_atlas(const PlanFacts& f, const std::optional<PlanPresets>& p, P
                      (p->atlas.gather.emitter_rays > 0
                           ? " + " + std::to_string(p->atlas.gather.emitter_rays) + " emitter-sampled"
                           : std::string()) +
-                     " rays"
+                     " rays" +
+                     (p->atlas.gather.near_regather_rays > 0
+                          ? " (landings nearer than a texel: " + std::to_string(p->atlas.gather.near_regather_rays) +
+                                " more)"
+                          : std::string())
                : std::to_string(p->atlas.vpl_count) + " VPLs, " + std::to_string(p->atlas.bounces) + " bounces")};
 }
 

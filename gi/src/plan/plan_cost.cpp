@@ -65,13 +65,18 @@ constexpr double kAtlasRayCostPerDoubling = 0.12;
 // doublings above kAtlasCacheTriangles: 0.11 each, Sponza's 5 doublings 0.56.
 constexpr double kVisibilityRaysPerFreshRayPerDoubling = 0.11;
 // An emitter-sampled gather ray (TexelGatherSettings::emitter_rays, 32 in the preview and
-// medium presets since the eighth session) in fresh cosine rays: 1 + this per doubling of the
-// triangles above kAtlasCacheTriangles. Sponza's preview bake took 44.4 CPU s without them and
-// 77.3 s with 32 per texel (557k texels, 2 cores at load ~10): 3.6 cosine rays each at its 5
-// doublings (long rays across the level to its bright texels, a CDF over more clusters); the
-// demo level's preview atlas (~1 doubling) took 19 s with 96 + 32 rays and 21 s with 128 + 0
-// in one loaded run: about 1.
-constexpr double kEmitterRayCostPerDoubling = 0.52;
+// medium presets since the eighth session) costs about one cosine ray. The eighth session took
+// 3.6 from Sponza's preview bake on 2 cores at load ~10 (44.4 CPU s without them, 77.3 s with);
+// on quiet cores (ninth session) the medium settings at 8 texels/m took 29.0 s wall without
+// them (29 Nov, docs/sweeps/light_atlas_sponza/speedup.md) and 29.6 s with 32 per texel, so
+// the loaded CPU time was the load's, not the rays'.
+// A landing nearer than a texel regathers with TexelGatherSettings::near_regather_rays rays of
+// its own (docs/light_atlas.md, "Near landings regather at their point"). Counted in gather-ray
+// equivalents per fresh ray and near ray: on Sponza at 8 texels/m, 4 near rays took the medium
+// settings from 29.6 s to 33.0 s wall (quiet cores, ninth session), ~0.04 each. Scenes with
+// fewer small charts and corners land near less often (the Cornell box at 128 texels/m: 3.9 s
+// either way), so this overestimates them a little.
+constexpr double kNearRegatherPerFreshRay = 0.04;
 
 // PRM (gi/src/prm): every path node (virtual light) is connected to every pane texel facing
 // it by one shadow ray; nodes = E x N_s x a / (1 - a) for a mean albedo a.
@@ -143,7 +148,7 @@ double cache_doublings(std::size_t triangles) {
 // equivalents, kVisibilityRaysPerFreshRayPerDoubling).
 double gather_rays_per_texel(const TexelGatherSettings& g, const LightPointCount& lights, std::size_t triangles) {
   const double doublings = cache_doublings(triangles);
-  const double fresh = g.gather_rays + (1.0 + kEmitterRayCostPerDoubling * doublings) * g.emitter_rays;
+  const double fresh = (g.gather_rays + g.emitter_rays) * (1.0 + kNearRegatherPerFreshRay * g.near_regather_rays);
   const double visibility = kVisibilityRaysPerFreshRayPerDoubling * doublings;
   return g.solve_rays + fresh * (1.0 + visibility) + lights.punctual + lights.directional +
          static_cast<double>(lights.sampled > 0 ? g.direct_samples : 0);
