@@ -42,8 +42,11 @@ if [[ ${FILTERS:-1} != 0 ]]; then  # 32 kept + 128 fresh rays, with the 2.5-texe
     "${common[@]}" --out "$out/gather"
   csvs+=("$out/gather/light_atlas_sponza.csv")
 fi
-# the presets preview / medium now: the guided denoiser, 2 passes, then a 1.5-texel filter
-run "$sweep" "${gather[@]}" --knob solve_rays=32 --knob rays=128 --knob filter=1.5 --knob denoise=2 \
+# the medium preset's settings now (preview's but 8 direct samples): 32 kept + 128 cosine + 32 emitter
+# rays, the lights' direct light at every landing, the read light filtered 1.5 texels, the guided
+# denoiser's 2 passes, no output filter, and near landings regathered with 4 rays (0: without)
+run "$sweep" "${gather[@]}" --knob solve_rays=32 --knob rays=128 --knob emitter_rays=32 --knob filter=0 \
+  --knob denoise=2 --knob landing_direct=everywhere --knob source_filter=1.5 --knob near_rays=0,4 \
   --knob direct_samples=8 "${common[@]}" --out "$out/preset"
 csvs+=("$out/preset/light_atlas_sponza.csv")
 run "$sweep" --method pathtracer_atlas --knob density=8 --knob "spp=$pt_spp" "${common[@]}" --out "$out/pathtracer"

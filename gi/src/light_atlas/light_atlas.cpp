@@ -463,13 +463,8 @@ engine::Result<LightAtlasSettings> light_atlas_preset(std::string_view name) {
   // leave blotches a few texels wide where few bright texels light a wall (the crate room
   // at 16 kept rays); a few fresh gather rays reading the filtered solve remove them. The
   // high preset gathers enough not to blur. The VPLs only feed BRF's world probes.
-  // Preview and medium denoise with the guided a-trous (2 passes, atlas_denoise.h), then
-  // filter 1.5 texels instead of 2.5: better on both scenes the presets are read from (the
-  // Cornell box at 128 texels/m 1.24% of the truth against 1.29%; Dabrovic Sponza at 8
-  // texels/m, where a 2.5-texel filter blurs 31 cm of sun-lit edges, 14.1% / 3.36% on the
-  // indirect-dominated texels / the whole lightmap against 15.6% / 3.88%). The denoiser alone
-  // scores better still (12.7% / 2.72%) but leaves bright blotches on the crate room's walls
-  // (docs/light_atlas.md, "The presets").
+  // Preview and medium denoise with the guided a-trous (2 passes, atlas_denoise.h; the
+  // filter it replaced and why: docs/light_atlas.md, "The presets").
   // Since the eighth session: no output filter; the lights' direct light read at every
   // landing point, the light the rays read filtered by 1.5 texels apart from the output, and
   // 32 emitter-sampled rays towards the bright texels. The emitter rays are what lets the
@@ -481,7 +476,8 @@ engine::Result<LightAtlasSettings> light_atlas_preset(std::string_view name) {
   // Since the ninth session: a landing nearer than a texel regathers the sky and the indirect
   // light at its point with 4 rays of its own instead of reading the texels, whose samples lie
   // up to a texel away in other light (corners, ledges, small charts). Sponza 7.12% / 1.77% ->
-  // 6.03% / 1.46%; the Cornell box 1.280% -> 1.254% (docs/light_atlas.md, "Near landings").
+  // 6.03% / 1.46%; the Cornell box 1.280% -> 1.266% (docs/light_atlas.md, "Near landings
+  // regather at their point").
   s.final_pass = LightAtlasSettings::FinalPass::TexelGather;
   s.gather.filter_radius_texels = 0.0f;
   s.gather.denoise_passes = 2;

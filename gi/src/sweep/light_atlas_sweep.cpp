@@ -13,9 +13,60 @@ namespace gi {
 
 namespace {
 
+// The gather's finer knobs (the denoiser's weights, the reads where rays land) and the
+// reference's samples: the tail of light_atlas_knobs' table.
+std::vector<KnobSpec> gather_detail_knobs() {
+  return {
+      {.name = "denoise_sigma",
+       .description = "gather: the denoiser's value weight, in standard deviations of the difference",
+       .kind = KnobKind::Real,
+       .default_grid = {"2"},
+       .min_value = 0.01,
+       .max_value = 1000},
+      {.name = "outlier",
+       .description =
+           "gather: the denoiser's outlier clamp, standard deviations above the co-planar neighbours' mean (0: off)",
+       .kind = KnobKind::Real,
+       .default_grid = {"0"},
+       .min_value = 0,
+       .max_value = 1000},
+      {.name = "landing_direct",
+       .description = "gather: the lights' direct light where a fresh ray lands, at the point across shadow edges "
+                      "only (edges) or everywhere",
+       .kind = KnobKind::Choice,
+       .default_grid = {"edges"},
+       .choices = {"edges", "everywhere"}},
+      {.name = "source_filter",
+       .description = "gather: world-space filter radius of the light the fresh rays read, texels (-1: filter's)",
+       .kind = KnobKind::Real,
+       .default_grid = {"-1"},
+       .min_value = -1,
+       .max_value = 16},
+      {.name = "near_rays",
+       .description = "gather: landings nearer than near_texels regather the sky and indirect light at the point "
+                      "with this many rays (0: read from the texels)",
+       .kind = KnobKind::Integer,
+       .default_grid = {"0"},
+       .min_value = 0,
+       .max_value = 4096},
+      {.name = "near_texels",
+       .description = "gather: the distance, in texels, under which a landing regathers (near_rays)",
+       .kind = KnobKind::Real,
+       .default_grid = {"1"},
+       .min_value = 0,
+       .max_value = 64},
+      {.name = "ref_spp",
+       .description = "samples per texel of the path-traced reference",
+       .kind = KnobKind::Integer,
+       .default_grid = {"4096"},
+       .min_value = 1,
+       .max_value = 1 << 20},
+  };
+}
+
 // Long because it is one table, one entry per knob with its grid and range, read as a list.
 std::vector<KnobSpec> light_atlas_knobs() {
-  return {
+  std::vector<KnobSpec> knobs = {
       {.name = "vpls",
        .description = "target VPL count",
        .kind = KnobKind::Integer,
@@ -81,51 +132,10 @@ std::vector<KnobSpec> light_atlas_knobs() {
        .default_grid = {"0"},
        .min_value = 0,
        .max_value = 8},
-      {.name = "denoise_sigma",
-       .description = "gather: the denoiser's value weight, in standard deviations of the difference",
-       .kind = KnobKind::Real,
-       .default_grid = {"2"},
-       .min_value = 0.01,
-       .max_value = 1000},
-      {.name = "outlier",
-       .description =
-           "gather: the denoiser's outlier clamp, standard deviations above the co-planar neighbours' mean (0: off)",
-       .kind = KnobKind::Real,
-       .default_grid = {"0"},
-       .min_value = 0,
-       .max_value = 1000},
-      {.name = "landing_direct",
-       .description = "gather: the lights' direct light where a fresh ray lands, at the point across shadow edges "
-                      "only (edges) or everywhere",
-       .kind = KnobKind::Choice,
-       .default_grid = {"edges"},
-       .choices = {"edges", "everywhere"}},
-      {.name = "source_filter",
-       .description = "gather: world-space filter radius of the light the fresh rays read, texels (-1: filter's)",
-       .kind = KnobKind::Real,
-       .default_grid = {"-1"},
-       .min_value = -1,
-       .max_value = 16},
-      {.name = "near_rays",
-       .description = "gather: landings nearer than near_texels regather the sky and indirect light at the point "
-                      "with this many rays (0: read from the texels)",
-       .kind = KnobKind::Integer,
-       .default_grid = {"0"},
-       .min_value = 0,
-       .max_value = 4096},
-      {.name = "near_texels",
-       .description = "gather: the distance, in texels, under which a landing regathers (near_rays)",
-       .kind = KnobKind::Real,
-       .default_grid = {"1"},
-       .min_value = 0,
-       .max_value = 64},
-      {.name = "ref_spp",
-       .description = "samples per texel of the path-traced reference",
-       .kind = KnobKind::Integer,
-       .default_grid = {"4096"},
-       .min_value = 1,
-       .max_value = 1 << 20},
   };
+  std::vector<KnobSpec> more = gather_detail_knobs();
+  knobs.insert(knobs.end(), more.begin(), more.end());
+  return knobs;
 }
 
 TexelPlacement placement_of(const KnobSetting& k) {
