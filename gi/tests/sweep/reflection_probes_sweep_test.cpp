@@ -6,8 +6,6 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <limits>
 #include <string>
 
@@ -41,9 +39,7 @@ TEST(ReflectionProbesSweep, GlossyRoomReflectionsFollowThePathTracer) {
   auto report = gi::run_sweep(request);
   ASSERT_TRUE(report) << report.error().to_string();
   ASSERT_EQ(report->runs, 1u);
-  std::ifstream in(report->csv);
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  auto rows = gi::parse_sweep_csv(text, report->csv.string());
+  auto rows = sweeptest::read_rows(report->csv);
   ASSERT_TRUE(rows) << rows.error().to_string();
   ASSERT_EQ(rows->size(), 1u);
   const gi::SweepRow& row = rows->front();
