@@ -404,6 +404,43 @@ TEST(GltfWriter, MeshWithoutPrimitivesIsLeftOutAndItsNodesKeepNoMesh) {
   }
 }
 
+TEST(GltfWriter, AnImageWithNothingToWriteIsLeftOutAndTheTexturesKeepTheirPixels) {
+  // Found by fuzz_gltf (tests/fuzz/regressions/gltf/): an embedded image that does not decode
+  // and no material uses loads with neither pixels nor a URI; the writer refused the scene.
+  engine::SceneAsset scene = feature_scene();
+  ASSERT_FALSE(scene.images.empty());
+  scene.images.insert(scene.images.begin(), engine::Image{.name = "undecodable"});
+  for (engine::Material& m : scene.materials)
+    for (engine::TextureRef* t : {&m.base_color_texture, &m.metallic_roughness_texture, &m.normal_texture,
+                                  &m.emissive_texture})
+      if (t->present()) ++t->image;
+  const fs::path path = temp_dir("empty_image") / "scene.glb";
+  const engine::Status st = engine::write_gltf(scene, path, {.binary = true});
+  ASSERT_TRUE(st) << st.error().to_string();
+  auto loaded = engine::load_gltf(path);
+  ASSERT_TRUE(loaded) << loaded.error().to_string();
+  EXPECT_EQ(loaded->images.size(), scene.images.size() - 1);
+  ASSERT_EQ(loaded->materials.size(), scene.materials.size());
+  for (std::size_t i = 0; i < scene.materials.size(); ++i) {
+    const engine::TextureRef& before = scene.materials[i].base_color_texture;
+    const engine::TextureRef& after = loaded->materials[i].base_color_texture;
+    ASSERT_EQ(after.present(), before.present()) << i;
+    if (before.present()) {
+      EXPECT_EQ(loaded->images[static_cast<std::size_t>(after.image)].rgba8,
+                scene.images[static_cast<std::size_t>(before.image)].rgba8)
+          << "materials[" << i << "] reads another image's pixels";
+    }
+  }
+  // A material that uses such an image is refused, naming the image.
+  scene.materials[0].base_color_texture.image = 0;
+  const fs::path refused = temp_dir("empty_image_used") / "scene.glb";
+  const engine::Status used = engine::write_gltf(scene, refused, {.binary = true});
+  ASSERT_FALSE(used);
+  EXPECT_NE(used.error().message.find("image 0 has neither pixels nor a URI"), std::string::npos)
+      << used.error().to_string();
+  EXPECT_FALSE(fs::exists(refused));
+}
+
 TEST(GltfWriter, ABareNodeIsWrittenAsAnEmptyObject) {
   // Found by fuzz_gltf: a node with no name, an identity transform and nothing attached was
   // written as null, and the loader refused the file ("nodes 0: must be an object").

@@ -101,12 +101,17 @@ class GltfBuilder {
     return static_cast<int>(accessors_.size()) - 1;
   }
 
+  /// The images with pixels or a URI. An image with neither (an embedded image the loader
+  /// could not decode and no material uses: it warned then) carries nothing to write and is
+  /// left out; the others are renumbered (image_index_), and a material using a left-out
+  /// image is refused in check_texture.
   Status write_images() {
-    if (scene_.images.empty()) return {};
+    image_index_.assign(scene_.images.size(), -1);
     json images = json::array();
     for (std::size_t i = 0; i < scene_.images.size(); ++i) {
       const Image& img = scene_.images[i];
       const std::string where = "images[" + std::to_string(i) + "]";
+      if (img.rgba8.empty() && img.uri.empty()) continue;
       json j;
       if (!img.name.empty()) j["name"] = img.name;
       if (!img.rgba8.empty()) {
@@ -117,14 +122,13 @@ class GltfBuilder {
         if (png.empty()) return error(where, "PNG encoding failed");
         j["bufferView"] = bin_.add_view(png.data(), png.size(), 0);
         j["mimeType"] = "image/png";
-      } else if (!img.uri.empty()) {
-        j["uri"] = img.uri;
       } else {
-        return error(where, "image has neither pixels nor a URI");
+        j["uri"] = img.uri;
       }
+      image_index_[i] = static_cast<int>(images.size());
       images.push_back(std::move(j));
     }
-    doc_["images"] = std::move(images);
+    if (!images.empty()) doc_["images"] = std::move(images);
     return {};
   }
 
@@ -170,6 +174,8 @@ class GltfBuilder {
     if (t.image >= static_cast<int>(scene_.images.size()))
       return error(where, "image " + std::to_string(t.image) + " is out of range (" +
                               std::to_string(scene_.images.size()) + " images)");
+    if (t.image >= 0 && image_index_[static_cast<std::size_t>(t.image)] < 0)
+      return error(where, "image " + std::to_string(t.image) + " has neither pixels nor a URI");
     if (t.texcoord < 0) return error(where, "texcoord must be >= 0, got " + std::to_string(t.texcoord));
     const TextureTransform& x = t.transform;
     if (!engine::all_finite(x.offset) || !engine::all_finite(x.scale) || !std::isfinite(x.rotation_rad))
@@ -254,7 +260,7 @@ class GltfBuilder {
     json samplers = json::array();
     for (const TextureSampler& s : samplers_) samplers.push_back(sampler_json(s));
     json textures = json::array();
-    for (const auto& [image, sampler] : textures_) textures.push_back({{"source", image}, {"sampler", sampler}});
+    for (const auto& [image, sampler] : textures_) textures.push_back({{"source", image_index_[static_cast<std::size_t>(image)]}, {"sampler", sampler}});
     doc_["samplers"] = std::move(samplers);
     doc_["textures"] = std::move(textures);
   }
@@ -537,6 +543,7 @@ class GltfBuilder {
   BinaryChunk bin_;
   std::vector<int> khr_light_index_;
   std::vector<int> mesh_index_;                ///< SceneAsset mesh -> written mesh, -1 when left out (no primitives).
+  std::vector<int> image_index_;               ///< scene image -> written image (-1: left out).
   std::vector<TextureSampler> samplers_;       ///< Distinct samplers, in order of first use.
   std::vector<std::pair<int, int>> textures_;  ///< (image, sampler) per glTF texture.
   std::set<std::string> used_;
