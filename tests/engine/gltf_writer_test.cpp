@@ -411,8 +411,8 @@ TEST(GltfWriter, AnImageWithNothingToWriteIsLeftOutAndTheTexturesKeepTheirPixels
   ASSERT_FALSE(scene.images.empty());
   scene.images.insert(scene.images.begin(), engine::Image{.name = "undecodable"});
   for (engine::Material& m : scene.materials)
-    for (engine::TextureRef* t : {&m.base_color_texture, &m.metallic_roughness_texture, &m.normal_texture,
-                                  &m.emissive_texture})
+    for (engine::TextureRef* t :
+         {&m.base_color_texture, &m.metallic_roughness_texture, &m.normal_texture, &m.emissive_texture})
       if (t->present()) ++t->image;
   const fs::path path = temp_dir("empty_image") / "scene.glb";
   const engine::Status st = engine::write_gltf(scene, path, {.binary = true});

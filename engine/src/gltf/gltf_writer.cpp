@@ -260,7 +260,8 @@ class GltfBuilder {
     json samplers = json::array();
     for (const TextureSampler& s : samplers_) samplers.push_back(sampler_json(s));
     json textures = json::array();
-    for (const auto& [image, sampler] : textures_) textures.push_back({{"source", image_index_[static_cast<std::size_t>(image)]}, {"sampler", sampler}});
+    for (const auto& [image, sampler] : textures_)
+      textures.push_back({{"source", image_index_[static_cast<std::size_t>(image)]}, {"sampler", sampler}});
     doc_["samplers"] = std::move(samplers);
     doc_["textures"] = std::move(textures);
   }
