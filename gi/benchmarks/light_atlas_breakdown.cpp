@@ -13,8 +13,10 @@
 // of the path tracer or of the texel placement).
 // Environment: GI_BREAKDOWN_FILTER=r (filter radius, texels; 0 = the sweep's unfiltered
 // run), GI_BREAKDOWN_SEEDS=2 (a second gather: the gather-noise and floor columns),
-// GI_BREAKDOWN_WORST=N (the N worst texels), GI_BREAKDOWN_TEXEL=i,j (per texel: its normals
-// and face, 16 rays and what they read, the path tracer there at 0, 1 and all bounces).
+// GI_BREAKDOWN_DENOISE=passes, GI_BREAKDOWN_EMITTERS=rays and GI_BREAKDOWN_SOURCE=r (the
+// denoiser's passes, the emitter rays, the source filter's radius in texels), GI_BREAKDOWN_WORST=N (the N worst
+// texels), GI_BREAKDOWN_TEXEL=i,j (per texel: its normals and face, 16 rays and what they read, the path tracer there
+// at 0, 1 and all bounces).
 #include <engine/gltf.h>
 #include <engine/sun.h>
 #include <gi/bake_input.h>
@@ -132,6 +134,10 @@ int main(int argc, char** argv) {
   g.seed = s.seed;
   // GI_BREAKDOWN_FILTER=r: another filter radius (texels) than the preset's; 0 is the sweep's unfiltered run.
   if (const char* r = std::getenv("GI_BREAKDOWN_FILTER")) g.filter_radius_texels = std::strtof(r, nullptr);
+  // GI_BREAKDOWN_DENOISE=passes, GI_BREAKDOWN_SOURCE=r: the denoiser's passes and the source filter's radius.
+  if (const char* d = std::getenv("GI_BREAKDOWN_DENOISE")) g.denoise_passes = std::atoi(d);
+  if (const char* e = std::getenv("GI_BREAKDOWN_EMITTERS")) g.emitter_rays = std::atoi(e);
+  if (const char* r = std::getenv("GI_BREAKDOWN_SOURCE")) g.source_filter_radius_texels = std::strtof(r, nullptr);
   // GI_BREAKDOWN_NEAR=rays,texels: landings nearer than `texels` regather with `rays` rays.
   if (const char* r = std::getenv("GI_BREAKDOWN_NEAR")) {
     g.near_regather_rays = std::atoi(r);
@@ -173,6 +179,25 @@ int main(int argc, char** argv) {
     const float c = glm::dot(tx.normal[i], to_sun);
     lit[i] = c > 0.05f ? gathered->direct[i].y / (650.0f * c) : -1.0f;
   }
+  // Texels sandwiched between their own surface and another a few mm off it (overlapping
+  // geometry): at least half of 16 cosine rays land within 2 cm.
+  std::vector<std::uint8_t> sandwiched(n, 0);
+  pool.parallel_for(n, [&](std::size_t i) {
+    if (!tx.valid[i]) return;
+    const gi::ShadingTriangle& own =
+        scene->index
+            .triangles[scene->index.instance_first[scene->static_instance[static_cast<std::size_t>(tx.mesh[i])]] +
+                       static_cast<std::uint32_t>(tx.triangle[i])];
+    const glm::vec3 face = glm::dot(own.face_normal, tx.normal[i]) < 0.0f ? -own.face_normal : own.face_normal;
+    const glm::vec3 origin = gi::offset_ray_origin(tx.position[i], face);
+    int close = 0;
+    for (int r = 0; r < 16; ++r) {
+      const glm::vec3 wi = gi::sample_cosine_hemisphere(face, (static_cast<float>(r) + 0.5f) / 16.0f,
+                                                        std::fmod(0.618034f * static_cast<float>(r), 1.0f));
+      close += scene->caster->intersect(gi::Ray{origin, 0.0f, wi, 0.02f}).valid() ? 1 : 0;
+    }
+    sandwiched[i] = close >= 8 ? 1 : 0;
+  });
   Sums all, total_direct, total_indirect;
   std::map<std::string, Sums> by;
   std::map<int, Sums> by_material, by_chart;
@@ -230,6 +255,8 @@ int main(int argc, char** argv) {
         into(by_dominated["all"]);
         into(by_dominated[gathered->hidden[i] ? "hidden" : border ? "chart border" : "chart interior"]);
         if (thin) into(by_dominated["thin chart (<= 4 texels across)"]);
+        if (sandwiched[i]) into(by_dominated["sandwiched (half the rays land within 2 cm)"]);
+        if (thin && !sandwiched[i]) into(by_dominated["thin chart, not sandwiched"]);
         into(by_dominated[sz.x * sz.y <= 64 ? "chart <= 64 texels" : "chart > 64 texels"]);
         into(by_dominated[glm::dot(tri.face_normal, tx.normal[i]) < 0.996f ? "normal > 5 deg off face"
                                                                            : "normal on face"]);
@@ -266,6 +293,10 @@ int main(int argc, char** argv) {
         static_cast<double>(tx.normal[i].z), static_cast<double>(face.x), static_cast<double>(face.y),
         static_cast<double>(face.z), static_cast<double>(glm::dot(tx.normal[i], to_sun)),
         static_cast<double>(glm::dot(face, to_sun)), sun_hit.valid() ? "hit" : "sky", static_cast<double>(sun_hit.t));
+    std::printf("texel %zu: gather direct %.1f + %.1f indirect %.1f, moved %d\n", i,
+                static_cast<double>(gathered->direct[i].y), static_cast<double>(gathered->baked_direct[i].y),
+                static_cast<double>(gathered->indirect[i].y),
+                glm::abs(glm::dot(tx.position[i] - own.p0, own.face_normal)) > 1e-4f ? 1 : 0);
     for (int r = 0; r < 16; ++r) {
       const glm::vec3 wi = gi::sample_cosine_hemisphere(tx.normal[i], (static_cast<float>(r) + 0.5f) / 16.0f,
                                                         std::fmod(0.618034f * static_cast<float>(r), 1.0f));
@@ -288,6 +319,26 @@ int main(int argc, char** argv) {
                   static_cast<double>(tx.position[j].x), static_cast<double>(tx.position[j].y),
                   static_cast<double>(tx.position[j].z),
                   static_cast<double>(gathered->direct[j].y + gathered->baked_direct[j].y + gathered->indirect[j].y));
+      // What covers the landing point: a ray straight off its side, and one to the sun.
+      const glm::vec3 side = glm::dot(tri.face_normal, wi) < 0.0f ? tri.face_normal : -tri.face_normal;
+      const gi::Hit up = scene->caster->intersect(gi::Ray{gi::offset_ray_origin(p, side), 0.0f, side});
+      const gi::Hit sun = scene->caster->intersect(gi::Ray{gi::offset_ray_origin(p, side), 0.0f, to_sun});
+      std::printf("    off its side: %s t %.4f; to the sun: %s t %.4f\n", up.valid() ? "hit" : "sky",
+                  static_cast<double>(up.t), sun.valid() ? "hit" : "sky", static_cast<double>(sun.t));
+      if (r < 3) {
+        const float bu = h.barycentric.x, bv = h.barycentric.y;
+        glm::vec3 sn = glm::normalize((1.0f - bu - bv) * tri.n0 + bu * tri.n1 + bv * tri.n2);
+        if (glm::dot(sn, side) < 0.0f) sn = -sn;
+        for (const glm::vec3& nn : {sn, side}) {
+          const gi::SurfacePoint sp{.position_m = p, .normal = nn, .face_normal = side};
+          auto pt = gi::reference_irradiance(input, std::span<const gi::SurfacePoint>(&sp, 1),
+                                             {.samples_per_pixel = 256, .max_bounces = 0, .seed = 9, .threads = 2});
+          if (pt)
+            std::printf("    path tracer at the landing, normal (%.2f %.2f %.2f): direct %.1f\n",
+                        static_cast<double>(nn.x), static_cast<double>(nn.y), static_cast<double>(nn.z),
+                        static_cast<double>(pt->direct[0].y));
+        }
+      }
     }
   }
   // GI_BREAKDOWN_WORST=N: the N texels of the largest error, one line each.

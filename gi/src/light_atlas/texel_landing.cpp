@@ -128,6 +128,14 @@ Landing land(const StaticBakeScene& b, const AtlasLayout& layout, const TexelTab
 
 }  // namespace
 
+glm::vec3 landing_shading_normal(const ShadingTriangle& tri, glm::vec2 barycentric, const glm::vec3& side) {
+  const float u = barycentric.x, v = barycentric.y;
+  glm::vec3 n = (1.0f - u - v) * tri.n0 + u * tri.n1 + v * tri.n2;
+  n = glm::dot(n, n) > 0.0f && std::isfinite(glm::dot(n, n)) ? glm::normalize(n) : side;
+  if (glm::dot(side, tri.face_normal) < 0.0f) n = -n;  // a double-sided surface seen from behind
+  return glm::dot(n, side) > 0.0f ? n : side;
+}
+
 Landing land_ray(const StaticBakeScene& b, const AtlasLayout& layout, const TexelTable& t, const Ray& ray,
                  const glm::vec3& from) {
   return land(b, layout, t, ray, from, true);
@@ -160,7 +168,12 @@ bool read_seen_corners(const TexelTable& t, const std::vector<glm::vec3>& img, c
   return true;
 }
 
-// The point a ray landed on, and its shading normal turned to the side the ray came from.
+// The point a ray landed on, and its shading normal on the side the ray came from, as the
+// path tracer shades it (shading_brdf): turned over on the back of a double-sided surface,
+// and the face's own normal where the interpolated one still points below the surface.
+// Dabrovic Sponza has vertex normals opposite to their face (a column base's ledge): turned
+// over, such a normal leant 50 degrees off the ledge, which then read a third of the sun
+// the path tracer finds there.
 struct LandingPoint {
   glm::vec3 p, n;
 };
@@ -168,10 +181,7 @@ struct LandingPoint {
 LandingPoint landing_point(const StaticBakeScene& b, const Landing& l) {
   const ShadingTriangle& tri = b.index.triangles[l.triangle];
   const float u = l.barycentric.x, v = l.barycentric.y;
-  glm::vec3 n = (1.0f - u - v) * tri.n0 + u * tri.n1 + v * tri.n2;
-  n = glm::dot(n, n) > 0.0f ? glm::normalize(n) : l.side;
-  if (glm::dot(n, l.side) < 0.0f) n = -n;  // a double-sided surface seen from behind
-  return {tri.p0 + u * tri.e1 + v * tri.e2, n};
+  return {tri.p0 + u * tri.e1 + v * tri.e2, landing_shading_normal(tri, l.barycentric, l.side)};
 }
 
 // The sky's and the indirect irradiance at a landing point from src.near_rays stratified

@@ -39,6 +39,13 @@ struct Landing {
   std::uint8_t unseen_corners = 0;
 };
 
+/// The shading normal at a landing on `tri` (barycentric u, v) seen from `side` (its face
+/// normal turned towards the ray's origin), as the path tracer shades a hit (shading_brdf):
+/// the interpolated vertex normal, turned over on the back of a double-sided surface, and
+/// `side` itself where that normal still points below the surface (vertex normals opposite
+/// their face: Dabrovic Sponza's column bases).
+glm::vec3 landing_shading_normal(const ShadingTriangle& tri, glm::vec2 barycentric, const glm::vec3& side);
+
 /// Casts `ray` from a texel whose face is `from` and says where it lands (Landing).
 Landing land_ray(const StaticBakeScene& b, const AtlasLayout& layout, const TexelTable& t, const Ray& ray,
                  const glm::vec3& from);
