@@ -94,7 +94,8 @@ struct ParsedFile {
   bool mesh_quantization = false;  ///< KHR_mesh_quantization is used
 };
 
-// gltf_load_container.cpp: file checks, GLB chunks, JSON pre-validation, tinygltf, images.
+// gltf_load_container.cpp: file checks, GLB chunks, JSON pre-validation (gltf_load_prevalidate.cpp,
+// gltf_load_buffers.cpp), tinygltf, images.
 Result<ParsedFile> parse_file(const Context& ctx, const std::filesystem::path& path);
 
 // gltf_load_accessors.cpp
@@ -154,11 +155,18 @@ Status parse_scene_environment(const Context& ctx, const Json& scene_json, const
 /// `camera_map` maps file camera indices to scene.cameras (-1: skipped).
 Status convert_nodes(const Context& ctx, const ParsedFile& file, const std::vector<int>& camera_map, SceneAsset& scene);
 
-// JSON helpers (gltf_load_container.cpp).
+// JSON helpers (gltf_load_json.cpp).
 /// The member `key` of `object` if `object` is an object holding it, else nullptr.
 const Json* find_member(const Json& object, const char* key);
 /// Reads a number member; absent -> `fallback`; present but not a number -> Error.
 Result<double> number_member(const Context& ctx, const Json& object, const char* key, double fallback,
                              const std::string& location);
+/// A JSON integer, signed or unsigned (not 4.0: integralize those first).
+bool is_integer(const Json& v);
+/// Integer member; absent -> `fallback`; present but not a non-negative integer -> Error.
+Result<std::int64_t> index_member(const Context& ctx, const Json& object, const char* key, std::int64_t fallback,
+                                  const std::string& location);
+/// The size of the top-level array `key` of `doc`; 0 when absent or not an array.
+std::size_t array_size(const Json& doc, const char* key);
 
 }  // namespace engine::gltf_load

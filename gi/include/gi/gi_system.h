@@ -107,6 +107,10 @@ class GISystem final : public engine::IndirectLightProvider {
     double antiradiance_residual = 0.0;              ///< ... its final relative residual.
     /// ... it ran out of its iteration budget before the residual tolerance (a warning was logged).
     bool antiradiance_unconverged = false;
+    /// ... its solve started from the previous move's solution (warm start), not from the
+    /// direct light: false for the first move after load, after a solve that did not
+    /// converge, and for a move back to the baked pose (nothing is solved there).
+    bool antiradiance_warm = false;
     /// Light and dynamic-object entities left out of the last frame's GI because their world
     /// transform or light values are unusable (NaN, infinite, absurd: engine/runtime_limits.h).
     /// A skipped light gives no light; a skipped object keeps its last usable pose. Each is

@@ -31,6 +31,7 @@ class AntiradianceMethod final : public MethodRuntime {
       state.stats.antiradiance_iterations = lighting_->stats().iterations;
       state.stats.antiradiance_residual = lighting_->stats().residual;
       state.stats.antiradiance_unconverged = lighting_->stats().unconverged;
+      state.stats.antiradiance_warm = lighting_->stats().warm;
     }
   }
   std::string label() const override { return "antiradiance"; }

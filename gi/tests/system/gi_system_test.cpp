@@ -10,6 +10,7 @@
 #include <engine/gpu/context.h>
 #include <engine/renderer.h>
 #include <engine/scene.h>
+#include <gi/bake.h>
 #include <gi/gi_system.h>
 #include <gi/plan.h>
 
@@ -17,6 +18,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <string>
+
+#include <glm/gtc/quaternion.hpp>
 
 #include "brf/brf_bake.h"
 #include "brf/brf_io.h"
@@ -355,6 +358,69 @@ TEST(GISystem, AMetalCrateBouncesAsAGlossyObject) {
   auto stale = gi::GISystem::load(dir, rough);
   ASSERT_FALSE(stale);
   EXPECT_NE(stale.error().to_string().find("stale"), std::string::npos) << stale.error().to_string();
+  std::filesystem::remove_all(dir);
+}
+
+// The corridor's door (assets/corridor.gltf, baked at 50 degrees) as an antiradiance region:
+// Stats tells whether a move's solve started warm, from the previous move's solution. The
+// first move after load has none (cold); the next starts from it; a move back to the baked
+// pose solves nothing (not warm), and the GPU tables keep the last solution for the move after.
+TEST(GISystem, ADoorMoveAfterTheFirstReportsAWarmStart) {
+  auto ctx = engine::GpuContext::create_headless();
+  ASSERT_TRUE(ctx) << "no headless GL context: " << ctx.error().to_string();
+  auto asset = engine::load_gltf(GI_SOURCE_DIR "/assets/corridor.gltf");
+  ASSERT_TRUE(asset) << asset.error().to_string();
+  engine::Scene scene = engine::instantiate(std::move(asset.value()));
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("gi_system_warm_" + std::to_string(::getpid()) + ".gibake");
+  std::filesystem::remove_all(dir);
+  gi::BakeOptions options;
+  options.preset = "preview";
+  options.methods = {"light_atlas", "antiradiance"};
+  auto bundle_written = gi::bake_bundle(gi::bake_input_from(scene), dir, options);
+  ASSERT_TRUE(bundle_written) << bundle_written.error().to_string();
+  auto loaded = gi::GISystem::load(dir, scene);
+  ASSERT_TRUE(loaded) << loaded.error().to_string();
+  gi::GISystem& gi = **loaded;
+  gi.frame();
+  EXPECT_FALSE(gi.stats().antiradiance_warm) << "nothing moved yet";
+
+  const engine::Entity door = engine::find_by_name(scene.registry, "door");
+  ASSERT_FALSE(door.is_null());
+  // The pose the bake holds, bit for bit (the region compares transforms exactly).
+  const glm::quat baked = scene.registry.get<engine::Transform>(door).rotation;
+  const auto turn_to = [&](glm::quat rotation) {
+    scene.registry.write<engine::Transform>(door).rotation = rotation;
+    engine::update_world_transforms(scene.registry);
+    gi.frame();
+  };
+  const auto open_to = [&](float degrees) { turn_to(glm::angleAxis(glm::radians(degrees), glm::vec3(0, 1, 0))); };
+  open_to(100.0f);
+  ASSERT_EQ(gi.stats().antiradiance_updates, 1u);
+  ASSERT_FALSE(gi.stats().antiradiance_unconverged);
+  EXPECT_FALSE(gi.stats().antiradiance_warm) << "the first move has no previous solution";
+  const int cold_iterations = gi.stats().antiradiance_iterations;
+
+  open_to(95.0f);
+  ASSERT_EQ(gi.stats().antiradiance_updates, 2u);
+  EXPECT_TRUE(gi.stats().antiradiance_warm);
+  EXPECT_FALSE(gi.stats().antiradiance_unconverged);
+  std::printf("door 50 -> 100 degrees: cold, %d iterations; 100 -> 95 degrees: %s, %d iterations\n", cold_iterations,
+              gi.stats().antiradiance_warm ? "warm" : "cold", gi.stats().antiradiance_iterations);
+
+  gi.frame();  // nothing moved: the stats keep the last move's
+  EXPECT_EQ(gi.stats().antiradiance_updates, 2u);
+  EXPECT_TRUE(gi.stats().antiradiance_warm);
+
+  turn_to(baked);
+  ASSERT_EQ(gi.stats().antiradiance_updates, 3u);
+  EXPECT_EQ(gi.stats().antiradiance_iterations, 0) << "back at the baked pose: no solve";
+  EXPECT_FALSE(gi.stats().antiradiance_warm);
+
+  open_to(90.0f);
+  ASSERT_EQ(gi.stats().antiradiance_updates, 4u);
+  EXPECT_TRUE(gi.stats().antiradiance_warm) << "the 95-degree solution starts it";
+  loaded->reset();
   std::filesystem::remove_all(dir);
 }
 
