@@ -35,6 +35,20 @@ struct AntiradianceSettings {
   /// linked regardless, as one disc). Stored in antiradiance.bin (version 3): a load relinks
   /// the deforming elements with it.
   int leaf_link_pieces = 0;
+  /// Precise near links (issue 37; the paper's CPU scheme, §3.1: "the precise computation of
+  /// exchanges between all pairs of bins in the cone subtended by the sender as seen from the
+  /// receiver"): a link with an end in the near set (a deforming instance's element, or a
+  /// static element within near_radius_m of a deforming instance's swept sphere) is made from
+  /// both ends cut into equal-area pieces (a surface element's own triangle), each piece at
+  /// most 1/q of the oracle's solid angle as seen from the other end (the sender at least q
+  /// pieces), every piece pair adding to the bin of its own direction at its own distance
+  /// (link_mesh.h). q = this; 0: off (near links are made as every other link). Not stored in
+  /// antiradiance.bin, and a loaded hierarchy has no triangles: the sweep's setting only
+  /// (docs/antiradiance.md "Issue 37: precise near links": it did not pay off).
+  int near_link_samples = 0;
+  /// Precise near links: at most this many pieces per end (the touching pairs, a door's edge
+  /// against its frame, run into it; a link sums up to its square of piece pairs).
+  int near_link_max_pieces = 256;
   /// Static triangles within this distance of the deforming region's swept bounds exchange
   /// light with it (metres).
   float exchange_radius_m = 8.0f;

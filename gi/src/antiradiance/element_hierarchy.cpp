@@ -64,6 +64,8 @@ struct Builder {
     h.object_normal.emplace_back(0.0f);
     h.object_radius.push_back(0.0f);
     h.object_area.push_back(0.0f);
+    h.corners.insert(h.corners.end(), 3, glm::vec3(0.0f));
+    h.object_corners.insert(h.object_corners.end(), 3, glm::vec3(0.0f));
     return static_cast<std::int32_t>(h.nodes.size() - 1);
   }
 
@@ -88,6 +90,10 @@ struct Builder {
     h.object_area[static_cast<std::size_t>(id)] = 0.5f * glm::length(cross_o);
     h.object_radius[static_cast<std::size_t>(id)] =
         std::max({glm::length(o[0] - co), glm::length(o[1] - co), glm::length(o[2] - co)});
+    for (std::size_t k = 0; k < 3; ++k) {
+      h.corners[3 * static_cast<std::size_t>(id) + k] = w[k];
+      h.object_corners[3 * static_cast<std::size_t>(id) + k] = o[k];
+    }
     // Longest edge (world lengths decide; object space follows the same split).
     int e = 0;
     float longest = -1.0f;
@@ -351,6 +357,8 @@ void ElementHierarchy::set_group_transform(int group, const glm::mat4& m) {
     if (object_normal[k] != glm::vec3(0.0f)) n.normal = glm::normalize(normal_matrix * object_normal[k]);
     n.radius_m = object_radius[k] * scale;
     n.area_m2 = object_area[k] * scale * scale;
+    if (corners.size() == 3 * nodes.size() && object_corners.size() == corners.size())
+      for (std::size_t c = 3 * k; c < 3 * k + 3; ++c) corners[c] = glm::vec3(m * glm::vec4(object_corners[c], 1.0f));
   }
   // The root's sphere and area cover all groups.
   refit_clusters(*this, 0, 1, false);

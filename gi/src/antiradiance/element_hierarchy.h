@@ -52,6 +52,11 @@ struct ElementHierarchy {
   std::vector<glm::vec3> object_center, object_normal;
   std::vector<float> object_radius, object_area;
   std::vector<glm::mat4> group_transform;  ///< [g - 1].
+  /// The triangle of every surface node (a triangle piece), 3 corners per node (zeros for a
+  /// cluster), world space now and object space: what precise near links sample
+  /// (settings.near_link_samples). Filled by build_element_hierarchy; empty in a hierarchy
+  /// loaded from a bundle (not stored: a precise link then samples a disc of the piece's area).
+  std::vector<glm::vec3> corners, object_corners;
 
   std::size_t leaf_count() const { return leaves.size(); }
   int group_count() const { return static_cast<int>(group_root.size()); }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <utility>
 
 #include <glm/gtc/constants.hpp>
 #include <tbb/blocked_range.h>
@@ -39,6 +40,47 @@ void tangents(const glm::vec3& n, glm::vec3& t, glm::vec3& bt) {
   bt = glm::cross(n, t);
 }
 
+// The near set of precise links (settings.near_link_samples): the deforming groups' elements
+// and the static elements within near_radius_m of a deforming group's swept sphere (its
+// pivot through its farthest leaf's sphere: any rotation about the pivot stays inside; the
+// sphere element_hierarchy.cpp's adaptive leaves use, from the leaves instead of the vertices).
+struct NearSet {
+  int samples = 0;  // q; 0: no precise links
+  int max_pieces = 1;
+  float radius_m = 0.0f;
+  std::vector<glm::vec4> swept;  // centre, radius
+
+  NearSet() = default;
+  NearSet(const ElementHierarchy& h, const AntiradianceSettings& s)
+      : samples(std::max(s.near_link_samples, 0)),
+        max_pieces(std::clamp(s.near_link_max_pieces, 1, kMaxLeafLinkPieces)),
+        radius_m(s.near_radius_m) {
+    if (samples == 0) return;
+    for (int g = 1; g < h.group_count(); ++g) {
+      const std::int32_t root = h.group_root[static_cast<std::size_t>(g)];
+      if (root < 0) continue;
+      const glm::mat4& m = h.group_transform[static_cast<std::size_t>(g - 1)];
+      const float scale =
+          std::max({glm::length(glm::vec3(m[0])), glm::length(glm::vec3(m[1])), glm::length(glm::vec3(m[2]))});
+      float reach = 0.0f;
+      for (std::int32_t i = root; i < h.nodes[static_cast<std::size_t>(root)].end; ++i) {
+        const auto k = static_cast<std::size_t>(i);
+        if (h.nodes[k].child_count == 0)  // the leaves bound the vertices; a cluster's sphere is looser
+          reach = std::max(reach, glm::length(h.object_center[k]) + h.object_radius[k]);
+      }
+      swept.emplace_back(glm::vec3(m[3]), reach * scale);
+    }
+  }
+
+  bool contains(const ElementNode& n) const {
+    if (samples == 0) return false;
+    if (n.group >= 1) return true;
+    for (const glm::vec4& sp : swept)
+      if (glm::length(n.center - glm::vec3(sp)) - n.radius_m - sp.w <= radius_m) return true;
+    return false;
+  }
+};
+
 // The links of one pair of elements (both ways), written to `out`: what refinement decided
 // to link. Scratch per maker, so one maker per thread.
 struct LinkMaker {
@@ -55,11 +97,23 @@ struct LinkMaker {
   std::vector<std::int32_t> touched{};
   /// The pieces' points of a split link's two ends (scratch).
   std::vector<glm::vec3> sender_points{}, receiver_points{};
+  /// Precise near links (settings.near_link_samples > 0).
+  const NearSet* near = nullptr;
+  /// Counters: precise links made (directed), their piece pairs.
+  std::size_t precise_links = 0, precise_pairs = 0;
 
   const ElementNode& node(std::int32_t i) const { return h.nodes[static_cast<std::size_t>(i)]; }
 
   static float regularizer(const ElementNode& n) {
     return std::min(n.area_m2 / glm::pi<float>(), n.radius_m * n.radius_m);
+  }
+
+  // Coplanar neighbours (one surface cut into leaves): every piece pair lies in the
+  // receiver's plane, so they exchange nothing.
+  static bool coplanar(const ElementNode& r, const ElementNode& s) {
+    if (r.normal == glm::vec3(0.0f) || s.normal == glm::vec3(0.0f)) return false;
+    return std::abs(glm::dot(r.normal, s.center - r.center)) <= 1e-5f * (r.radius_m + s.radius_m) &&
+           glm::dot(r.normal, s.normal) >= 0.9999f;
   }
 
   // Receiver r, sender s wholly behind r's plane: nothing to receive.
@@ -79,12 +133,14 @@ struct LinkMaker {
     const ElementNode& rn = node(r);
     const ElementNode& sn = node(s);
     if (behind(rn, sn)) return;
+    if (near != nullptr && (near->contains(rn) || near->contains(sn))) {
+      if (!coplanar(rn, sn)) precise_directed(r, s);
+      return;
+    }
     if (!fine && max_pieces > 0) {
       // Coplanar neighbours (one surface cut into leaves) exchange nothing: every piece pair
       // lies in the receiver's plane. Skipped before the pieces, most of the touching pairs.
-      if (std::abs(glm::dot(rn.normal, sn.center - rn.center)) <= 1e-5f * (rn.radius_m + sn.radius_m) &&
-          glm::dot(rn.normal, sn.normal) >= 0.9999f)
-        return;
+      if (coplanar(rn, sn)) return;
       const LinkPieces p = link_pieces(rn, sn, threshold_sr, max_pieces);
       if (p.sender > 1 || p.receiver > 1) {
         split_directed(r, s, p);
@@ -162,6 +218,85 @@ struct LinkMaker {
     for (std::int32_t b : touched) out.push_back({r, s, b, bin_sum[static_cast<std::size_t>(b)]});
   }
 
+  // About n equal-area pieces' points of node `i` seen from `from`: a surface element as its
+  // triangle cut into k^2 congruent sub-triangles (k = ceil(sqrt(n)); their centroids), or,
+  // without its corners (a hierarchy from a bundle), a disc of its area in its plane; a
+  // cluster (no normal) as a disc of its bounding radius facing `from`. Returns the pieces'
+  // total area (their count is points.size()).
+  float end_points(std::int32_t i, const glm::vec3& from, int n, std::vector<glm::vec3>& points) const {
+    const ElementNode& e = node(i);
+    if (e.normal != glm::vec3(0.0f) && h.corners.size() == 3 * h.nodes.size()) {
+      const glm::vec3* c = &h.corners[3 * static_cast<std::size_t>(i)];
+      const int k = std::max(1, static_cast<int>(std::ceil(std::sqrt(static_cast<float>(n)) - 1e-4f)));
+      const glm::vec3 u = (c[1] - c[0]) / static_cast<float>(k), v = (c[2] - c[0]) / static_cast<float>(k);
+      points.clear();
+      for (int a = 0; a < k; ++a)
+        for (int b = 0; a + b < k; ++b) {
+          const glm::vec3 corner = c[0] + static_cast<float>(a) * u + static_cast<float>(b) * v;
+          points.push_back(corner + (u + v) / 3.0f);                            // upright sub-triangle
+          if (a + b + 1 < k) points.push_back(corner + 2.0f * (u + v) / 3.0f);  // the inverted one beside it
+        }
+      return e.area_m2;
+    }
+    if (e.normal != glm::vec3(0.0f)) {
+      piece_points(e, n, points);
+      return e.area_m2;
+    }
+    const glm::vec3 d = from - e.center;
+    const float len = glm::length(d);
+    const glm::vec3 axis = len > 0.0f ? d / len : glm::vec3(0, 0, 1);
+    glm::vec3 t, bt;
+    tangents(axis, t, bt);
+    points.resize(static_cast<std::size_t>(n));
+    for (int k = 0; k < n; ++k) {
+      const DiscPoint a = spiral_point(k, n);
+      points[static_cast<std::size_t>(k)] = e.center + e.radius_m * (a.x * t + a.y * bt);
+    }
+    return glm::pi<float>() * e.radius_m * e.radius_m;
+  }
+
+  // Precise near link r <- s (§3.1, the paper's CPU scheme): both ends cut into equal-area
+  // pieces (end_points), each piece at most 1/q of the oracle's solid angle as seen from the
+  // other end's centre (the sender at least q pieces, so even a sender within one bin is
+  // sampled across it; at most near->max_pieces per end); every piece pair adds
+  // 1 / (n_s n_r (d^2 + a_s/(pi n_s) + a_r/(pi n_r)) omega_b) to the bin b of its own
+  // direction: bin b's weight is the sender's share in b of the flux reaching the receiver,
+  // over omega_b. Pieces behind a receiver piece's plane add nothing (surface receivers).
+  void precise_directed(std::int32_t r, std::int32_t s) {
+    const ElementNode& rn = node(r);
+    const ElementNode& sn = node(s);
+    const float d2 = std::max(glm::dot(rn.center - sn.center, rn.center - sn.center), 1e-12f);
+    const float q = static_cast<float>(near->samples);
+    const auto pieces = [&](const ElementNode& e, int least) {
+      const double need = static_cast<double>(q) * glm::pi<double>() * static_cast<double>(e.radius_m) *
+                          static_cast<double>(e.radius_m) /
+                          (static_cast<double>(d2) * static_cast<double>(threshold_sr));
+      return static_cast<int>(
+          std::clamp(std::ceil(need), static_cast<double>(least), static_cast<double>(near->max_pieces)));
+    };
+    bin_sum.assign(static_cast<std::size_t>(bins.count()), 0.0f);
+    touched.clear();
+    const float as = end_points(s, rn.center, pieces(sn, std::min(near->samples, near->max_pieces)), sender_points);
+    const float ar = end_points(r, sn.center, pieces(rn, 1), receiver_points);
+    const int ns = static_cast<int>(sender_points.size()), nr = static_cast<int>(receiver_points.size());
+    const float reg = (as / static_cast<float>(ns) + ar / static_cast<float>(nr)) / glm::pi<float>();
+    const float weight = 1.0f / (static_cast<float>(ns) * static_cast<float>(nr));
+    const bool surface = rn.normal != glm::vec3(0.0f);
+    for (const glm::vec3& ps : sender_points)
+      for (const glm::vec3& pr : receiver_points) {
+        const glm::vec3 dir = pr - ps;
+        const float dd = glm::dot(dir, dir);
+        if (!(dd > 0.0f) || (surface && glm::dot(rn.normal, dir) >= 0.0f)) continue;
+        const int bin = bins.bin_of(dir / std::sqrt(dd));
+        if (bin_sum[static_cast<std::size_t>(bin)] == 0.0f) touched.push_back(bin);
+        bin_sum[static_cast<std::size_t>(bin)] += weight / ((dd + reg) * bins.solid_angle(bin));
+      }
+    std::sort(touched.begin(), touched.end());
+    for (std::int32_t b : touched) out.push_back({r, s, b, bin_sum[static_cast<std::size_t>(b)]});
+    ++precise_links;
+    precise_pairs += static_cast<std::size_t>(ns) * static_cast<std::size_t>(nr);
+  }
+
   void link(std::int32_t a, std::int32_t b, bool fine) {
     directed(a, b, fine);
     directed(b, a, fine);
@@ -233,22 +368,34 @@ struct Refinement {
 
 // Appends the links of `pairs` to `out` (in pair order), the pairs' links made on TBB's
 // threads in chunks, each chunk into its own list: the same links as one thread makes.
+// Counts the precise links made (directed) into mesh's counters.
 void make_links(const ElementHierarchy& h, const DirectionalBins& bins, float threshold_sr, const WorkShard& shard,
-                int max_pieces, const std::vector<LinkPair>& pairs, std::vector<Link>& out) {
+                const AntiradianceSettings& settings, const std::vector<LinkPair>& pairs, LinkMesh& mesh) {
   constexpr std::size_t kChunk = 256;
   const std::size_t chunks = (pairs.size() + kChunk - 1) / kChunk;
   std::vector<std::vector<Link>> parts(chunks);
+  std::vector<std::pair<std::size_t, std::size_t>> precise(chunks);
+  const NearSet near(h, settings);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks, 1), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t c = r.begin(); c != r.end(); ++c) {
-      LinkMaker maker{h, bins, threshold_sr, parts[c], shard, max_pieces};
+      LinkMaker maker{h, bins, threshold_sr, parts[c], shard, settings.leaf_link_pieces};
+      if (near.samples > 0) maker.near = &near;
       for (std::size_t i = c * kChunk; i < std::min(pairs.size(), (c + 1) * kChunk); ++i)
         maker.link(pairs[i].a, pairs[i].b, pairs[i].fine);
+      precise[c] = {maker.precise_links, maker.precise_pairs};
     }
   });
+  std::vector<Link>& out = mesh.links;
   std::size_t total = out.size();
   for (const std::vector<Link>& part : parts) total += part.size();
   out.reserve(total);
   for (const std::vector<Link>& part : parts) out.insert(out.end(), part.begin(), part.end());
+  mesh.precise_links = 0;
+  mesh.precise_piece_pairs = 0;
+  for (const auto& [links, piece_pairs] : precise) {
+    mesh.precise_links += links;
+    mesh.precise_piece_pairs += piece_pairs;
+  }
 }
 
 // (receiver, bin, sender): a total order, since refinement links a pair once and a pair's
@@ -299,7 +446,7 @@ LinkMesh link_elements(const ElementHierarchy& h, const DirectionalBins& bins, c
   const float threshold = oracle_threshold_sr(bins, settings);
   std::vector<LinkPair> pairs;
   Refinement{h, threshold, pairs}.self(0);
-  make_links(h, bins, threshold, {}, settings.leaf_link_pieces, pairs, mesh.links);
+  make_links(h, bins, threshold, {}, settings, pairs, mesh);
   sort_and_index(h, mesh);
   mesh.relinked_elements = h.nodes.size();
   mesh.links_made = mesh.links.size();
@@ -312,7 +459,7 @@ LinkMesh link_elements_shard(const ElementHierarchy& h, const DirectionalBins& b
   const float threshold = oracle_threshold_sr(bins, settings);
   std::vector<LinkPair> pairs;
   Refinement{h, threshold, pairs, shard}.self(0);
-  make_links(h, bins, threshold, shard, settings.leaf_link_pieces, pairs, mesh.links);
+  make_links(h, bins, threshold, shard, settings, pairs, mesh);
   sort_and_index(h, mesh);
   mesh.relinked_elements = shard.items(h.nodes.size()).size();
   mesh.links_made = mesh.links.size();
@@ -399,7 +546,7 @@ void relink_moved(const ElementHierarchy& h, const DirectionalBins& bins, const 
     }
   for (int g = 1; g < h.group_count(); ++g)
     if (is_moved[static_cast<std::size_t>(g)]) refinement.self(h.group_root[static_cast<std::size_t>(g)]);
-  make_links(h, bins, threshold, {}, settings.leaf_link_pieces, pairs, mesh.links);
+  make_links(h, bins, threshold, {}, settings, pairs, mesh);
   for (int g = 1; g < h.group_count(); ++g)
     if (is_moved[static_cast<std::size_t>(g)]) {
       const std::int32_t r = h.group_root[static_cast<std::size_t>(g)];
@@ -430,6 +577,8 @@ void merge_posed_links(const ElementHierarchy& h, const LinkMesh& posed, LinkMes
   index_links(h, mesh);
   mesh.relinked_elements = posed.relinked_elements;
   mesh.links_made = posed.links.size();
+  mesh.precise_links = posed.precise_links;
+  mesh.precise_piece_pairs = posed.precise_piece_pairs;
 }
 
 }  // namespace gi

@@ -9,6 +9,15 @@
 // split virtually, each end into as many equal-area pieces as the oracle asks for at the
 // pair's distance (link_pieces, at most leaf_link_pieces), every piece pair with its own
 // distance and bin; the link keeps one record per (receiver, sender, bin).
+// Precise near links (settings.near_link_samples = q > 0, issue 37, the paper's CPU scheme):
+// every link with an end in the near set (the deforming groups' elements and the static
+// elements within near_radius_m of a group's swept sphere) is made from pieces of both ends
+// (a surface element's triangle cut into k^2 congruent sub-triangles, ElementHierarchy::corners;
+// a cluster a disc facing the other end), each at most 1/q of the oracle's solid angle (the
+// sender at least q), every piece pair in
+// the bin of its own direction at its own distance: the link's form factor spread over the
+// bins of the cone the sender subtends, bin by bin. More records per near link, the same
+// record format, so the solver, the GPU pass and the bundle's link planes are unchanged.
 // No visibility anywhere: antiradiance stands for it.
 //
 // Form factor, eq. 17: F = 1 / (d^2 omega_bin), spread over the bins the sender covers as
@@ -56,6 +65,10 @@ struct LinkMesh {
   /// Counters of the last (re)link: elements whose links were rebuilt, links made.
   std::size_t relinked_elements = 0;
   std::size_t links_made = 0;
+  /// Of the last (re)link: directed precise near links made (settings.near_link_samples), and
+  /// the piece pairs they summed (their cost).
+  std::size_t precise_links = 0;
+  std::size_t precise_piece_pairs = 0;
 };
 
 /// The oracle's threshold: oracle_scale x 4 pi / bins (sr).

@@ -230,7 +230,8 @@ std::vector<KnobSpec> solve_knobs() {
        .min_value = 0,
        .max_value = 10},
       {.name = "near_radius",
-       .description = "adaptive leaves: how far from the door's swept sphere the leaves are near_patch, metres",
+       .description = "adaptive leaves and precise near links: how far from the door's swept sphere the leaves are "
+                      "near_patch and links precise, metres",
        .kind = KnobKind::Real,
        .default_grid = {"1"},
        .min_value = 0,
@@ -240,6 +241,19 @@ std::vector<KnobSpec> solve_knobs() {
        .kind = KnobKind::Integer,
        .default_grid = {"0"},
        .min_value = 0,
+       .max_value = 4096},
+      {.name = "near_samples",
+       .description = "precise near links: pieces per oracle solid angle on links with an end on the door or "
+                      "within near_radius of its swept sphere (0: off; link_mesh.h)",
+       .kind = KnobKind::Integer,
+       .default_grid = {"0"},
+       .min_value = 0,
+       .max_value = 1024},
+      {.name = "near_max_pieces",
+       .description = "precise near links: pieces per end at most",
+       .kind = KnobKind::Integer,
+       .default_grid = {"256"},
+       .min_value = 1,
        .max_value = 4096},
       {.name = "solve",
        .description = "off: build the leaves only and score the projection floor (the true change through them) as "
@@ -320,6 +334,8 @@ AntiradianceSettings antiradiance_settings(const RunContext& ctx) {
   s.near_patch_size_m = static_cast<float>(ctx.knobs.real("near_patch"));
   s.near_radius_m = static_cast<float>(ctx.knobs.real("near_radius"));
   s.leaf_link_pieces = static_cast<int>(ctx.knobs.integer("pieces"));
+  s.near_link_samples = static_cast<int>(ctx.knobs.integer("near_samples"));
+  s.near_link_max_pieces = static_cast<int>(ctx.knobs.integer("near_max_pieces"));
   s.seed = ctx.seed;
   return s;
 }
@@ -551,6 +567,9 @@ std::vector<std::pair<std::string, double>> door_move_extras(const RunContext& c
                                {"elements", static_cast<double>(region.hierarchy().nodes.size())},
                                {"leaves", static_cast<double>(region.hierarchy().leaf_count())},
                                {"links", static_cast<double>(region.links().links.size())},
+                               // The last move's relink: directed precise near links and their piece pairs.
+                               {"precise_links", static_cast<double>(region.links().precise_links)},
+                               {"precise_piece_pairs", static_cast<double>(region.links().precise_piece_pairs)},
                                {"compared_texels", static_cast<double>(d.compared)},
                                {"level", sc.level}});
   return extras;
