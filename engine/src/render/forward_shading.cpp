@@ -216,7 +216,7 @@ void ForwardRenderer::shade_group(const ForwardInputs& in, const LightGroup& gro
                            group.count_by_type[1],
                            group.count_by_type[2],
                            group.count_by_type[3],
-                           std::clamp(settings_.area_specular_samples_per_side, 1, 4),
+                           std::clamp(settings_.area_specular_samples_per_side, 0, 4),
                            settings_.area_soft_shadows ? 1 : 0,
                            in.has_sky ? 1 : 0,
                            area_lights_.empty() ? 0 : 1,
@@ -227,7 +227,7 @@ void ForwardRenderer::shade_group(const ForwardInputs& in, const LightGroup& gro
   LightCounts rough_counts = counts;
   rough_counts[4] = 1;
   // (Not for BLEND primitives: two passes would break their back-to-front order.)
-  const bool split_rough = !blend && counts[3] > 0 && counts[4] > 1 && settings_.area_specular_one_point_on_rough;
+  const bool split_rough = !blend && counts[3] > 0 && counts[4] != 1 && settings_.area_specular_one_point_on_rough;
   for (int pass = 0; pass < (split_rough ? 2 : 1); ++pass) {
     const LocatedProgram<ForwardUniforms>& program = forward_program(pass == 0 ? counts : rough_counts);
     const ForwardUniforms& u = program.uniforms;
