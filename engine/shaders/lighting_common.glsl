@@ -2,7 +2,6 @@
 // directional and rectangular area lights in engine units (engine/units.h) with glTF's BRDF
 // (gltf_brdf.glsl). Shadows come from shadow_common.glsl.
 
-#include "area_ltc_table.glsl"
 #include "gltf_brdf.glsl"
 
 const float PI = GLTF_PI;
@@ -34,6 +33,16 @@ struct GpuLight {
 };
 
 layout(std430, binding = 0) readonly buffer Lights { GpuLight lights[]; };
+
+// The fitted inverse transforms of area_ltc_specular (engine/src/render/area_ltc_table.h,
+// written by tools/area-ltc-fit): AREA_LTC_SIDE^2 nodes, node (i, j) at [j AREA_LTC_SIDE + i].
+// A buffer, not a GLSL constant array: llvmpipe took ~25 s to compile the forward pass with
+// the 1024-entry array inlined.
+#ifndef AREA_LTC_BINDING
+#define AREA_LTC_BINDING 9
+#endif
+const int AREA_LTC_SIDE = 32;
+layout(std430, binding = AREA_LTC_BINDING) readonly buffer AreaLtc { vec4 area_ltc_table[]; };
 
 // The shading point: where, which way, and glTF's BRDF there (gltf_brdf.glsl).
 struct Surface {
@@ -106,7 +115,7 @@ vec3 clipped_quad_vector_integral(vec3 q[4], vec3 n) {
 // Integral of cos(theta) d(omega) over the quad q[0..3] clipped to the horizon of n.
 float clipped_quad_cosine_integral(vec3 q[4], vec3 n) { return abs(dot(clipped_quad_vector_integral(q, n), n)); }
 
-// The fitted inverse transform (area_ltc_table.glsl, tools/area-ltc-fit) at a view cosine and
+// The fitted inverse transform (AreaLtc) at a view cosine and
 // perceptual roughness: bilinear between the table's nodes, as the table's spacing.
 vec4 area_ltc_inverse(float n_dot_v, float roughness) {
   const float last = float(AREA_LTC_SIDE - 1);
@@ -117,8 +126,8 @@ vec4 area_ltc_inverse(float n_dot_v, float roughness) {
   float fx = x - float(i0);
   float fy = y - float(j0);
   int k = j0 * AREA_LTC_SIDE + i0;
-  vec4 lo = mix(AREA_LTC_TABLE[k], AREA_LTC_TABLE[k + 1], fx);
-  vec4 hi = mix(AREA_LTC_TABLE[k + AREA_LTC_SIDE], AREA_LTC_TABLE[k + AREA_LTC_SIDE + 1], fx);
+  vec4 lo = mix(area_ltc_table[k], area_ltc_table[k + 1], fx);
+  vec4 hi = mix(area_ltc_table[k + AREA_LTC_SIDE], area_ltc_table[k + AREA_LTC_SIDE + 1], fx);
   return mix(lo, hi, fy);
 }
 
@@ -174,21 +183,13 @@ vec3 area_points_specular(Surface s, vec3 rel, vec3 hx, vec3 hy, vec3 dir, const
   return specular;
 }
 
-// AREA_SPECULAR_SIDE 0: perceptual roughness from which the fitted transforms hand over to
-// 3 x 3 points (linearly over [START, END)). The table's fit follows the GGX lobe within
-// 0.5% of the highlight's energy at roughness 0.05-0.15 but drifts for wide lobes at
-// grazing views (21% at 0.3, 45% at 0.5), where the points are within 1.5%
-// (RendererAreaSpecular).
-const float AREA_LTC_HANDOVER_START = 0.2;
-const float AREA_LTC_HANDOVER_END = 0.3;
-
 // Rectangular area light of radiance L (W/(m^2 sr)), one-sided towards its emission
 // direction. Diffuse: the exact irradiance of the rectangle clipped to the horizon
 // (clipped_quad_cosine_integral) times the diffuse lobe's Fresnel weight (glTF's 1 - F(v.h)
-// changes across the light). Specular, AREA_SPECULAR_SIDE 0: area_ltc_specular for sharp
-// lobes (with the diffuse weight at the clipped rectangle's mean direction), 3 x 3 points
-// for wide ones (AREA_LTC_HANDOVER_*). AREA_SPECULAR_SIDE n > 0: n x n points
-// (area_points_specular) at every roughness.
+// changes across the light). Specular, AREA_SPECULAR_SIDE 0: area_ltc_specular (the renderer
+// draws materials sharper than roughness 0.3 with it, forward_shading.cpp's sharp_for_ltc),
+// with the diffuse weight at the clipped rectangle's mean direction. AREA_SPECULAR_SIDE n > 0:
+// n x n points (area_points_specular).
 vec3 area_light_radiance(GpuLight light, Surface s) {
   vec3 centre = light.position_type.xyz;
   vec3 dir = light.direction_range.xyz;
@@ -201,17 +202,11 @@ vec3 area_light_radiance(GpuLight light, Surface s) {
   float irradiance_per_radiance = abs(dot(vector_integral, s.normal));
   float diffuse_weight = 1.0;
 #if AREA_SPECULAR_SIDE == 0
-  float to_points = clamp(
-      (sqrt(s.brdf.alpha) - AREA_LTC_HANDOVER_START) / (AREA_LTC_HANDOVER_END - AREA_LTC_HANDOVER_START), 0.0, 1.0);
-  vec3 specular = vec3(0.0);
-  if (to_points < 1.0) {
-    specular = (1.0 - to_points) * area_ltc_specular(s, q);
-    vec3 mean_dir = vector_integral * sign(dot(vector_integral, s.normal));
-    float mean_len2 = dot(mean_dir, mean_dir);
-    vec3 l_mean = mean_len2 > 1e-12 ? mean_dir * inversesqrt(mean_len2) : normalize(rel);
-    diffuse_weight = gltf_diffuse_weight(s.brdf, dot(s.view, normalize(l_mean + s.view)));
-  }
-  if (to_points > 0.0) specular += to_points * area_points_specular(s, rel, hx, hy, dir, 3, diffuse_weight);
+  vec3 specular = area_ltc_specular(s, q);
+  vec3 mean_dir = vector_integral * sign(dot(vector_integral, s.normal));
+  float mean_len2 = dot(mean_dir, mean_dir);
+  vec3 l_mean = mean_len2 > 1e-12 ? mean_dir * inversesqrt(mean_len2) : normalize(rel);
+  diffuse_weight = gltf_diffuse_weight(s.brdf, dot(s.view, normalize(l_mean + s.view)));
 #else
   vec3 specular = area_points_specular(s, rel, hx, hy, dir, AREA_SPECULAR_SIDE, diffuse_weight);
 #endif

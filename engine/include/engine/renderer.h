@@ -71,13 +71,13 @@ struct RenderSettings {
   /// W/(m^2 sr) per channel; it is labelled "constant ambient (stand-in)" in timings.
   float stand_in_ambient = 0.02f;
   SplitView split = SplitView::Off;
-  /// Specular of area lights. 0: sharp lobes (roughness below 0.2) take the rectangle's
-  /// integral under a linearly transformed cosine fitted to the GGX lobe (Heitz et al. 2016;
-  /// the table is ours, tools/area-ltc-fit), one smooth highlight; wide lobes (0.3 and up)
-  /// take 3 x 3 points, blended in between. 1..4: n x n stratified points per rectangle at
-  /// every roughness, whose sum draws a sharp lobe as n^2 separate highlights.
-  /// RendererAreaSpecular measures both against a dense quadrature. The diffuse part is
-  /// exact whatever the setting.
+  /// Specular of area lights. 0: materials sharper than roughness 0.3 (no roughness texture)
+  /// take the rectangle's integral under a linearly transformed cosine fitted to the GGX lobe
+  /// (Heitz et al. 2016; the table is ours, tools/area-ltc-fit), one smooth highlight; the
+  /// others (and BLEND primitives) 3 x 3 points, which the fit does not match for wide lobes at
+  /// grazing views. 1..4: n x n stratified points per rectangle for every material, whose sum
+  /// draws a sharp lobe as n^2 separate highlights. RendererAreaSpecular measures both against
+  /// a dense quadrature. The diffuse part is exact whatever the setting.
   int area_specular_samples_per_side = 0;
   /// Dielectrics with roughness >= 0.9 and no roughness texture take one specular point per
   /// rectangle unless area_specular_samples_per_side is 1: their lobe is far wider than
