@@ -3,7 +3,7 @@
 // transformed cosines") to glTF's GGX specular lobe with Fresnel 1, D V cos(theta_l), divided
 // by its integral, and writes the inverse transforms as a C++ table the renderer uploads to
 // the buffer the forward pass reads (engine/shaders/lighting_common.glsl, area_ltc_inverse):
-//   area-ltc-fit engine/src/render/area_ltc_table.h
+//   area-ltc-fit engine/src/render/area_ltc_table.h && tools/check-format.sh --fix engine/src/render/area_ltc_table.h
 // The fit is ours: Nelder-Mead on the paper's three parameters (scale along the lobe's
 // tangent in the plane of incidence, scale across it, skew) about the lobe's mean direction,
 // minimizing the integral of |LTC - GGX|^3 (estimated with stratified samples of both
@@ -273,10 +273,17 @@ int main(int argc, char** argv) {
                "inline constexpr int kAreaLtcSide = %d;\n"
                "inline constexpr float kAreaLtcTable[%d] = {\n",
                kSide, kSide, kSide - 1, kMinRoughness, 1.0 - kMinRoughness, kSide - 1, kSide, kSide, 4 * kSide * kSide);
-  for (std::size_t n = 0; n < table.size(); ++n) {
-    const auto& t = table[n];
-    std::fprintf(out, "    %.7gf, %.7gf, %.7gf, %.7gf,\n", t[0], t[1], t[2], t[3]);
-  }
+  // A float literal of x: 7 significant digits, with a decimal point or an exponent.
+  const auto literal = [](double x) {
+    char text[40];
+    std::snprintf(text, sizeof(text), "%.7g", x);
+    std::string s(text);
+    if (s.find_first_of(".en") == std::string::npos) s += ".0";
+    return s + "f";
+  };
+  for (const auto& t : table)
+    std::fprintf(out, "    %s, %s, %s, %s,\n", literal(t[0]).c_str(), literal(t[1]).c_str(), literal(t[2]).c_str(),
+                 literal(t[3]).c_str());
   std::fprintf(out, "};\n\n}  // namespace engine::render\n");
   std::fclose(out);
   std::fprintf(stderr, "worst fit error %.4g\n", worst_error);
