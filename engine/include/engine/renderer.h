@@ -71,12 +71,16 @@ struct RenderSettings {
   /// W/(m^2 sr) per channel; it is labelled "constant ambient (stand-in)" in timings.
   float stand_in_ambient = 0.02f;
   SplitView split = SplitView::Off;
-  /// Specular of area lights: n x n stratified points per rectangle (1..4). Cost on llvmpipe
-  /// grows about linearly with n^2 (9 points: ~2/3 of an area light's cost); the diffuse
-  /// part is exact whatever n.
-  int area_specular_samples_per_side = 3;
+  /// Specular of area lights. 0: materials sharper than roughness 0.3 (no roughness texture)
+  /// take the rectangle's integral under a linearly transformed cosine fitted to the GGX lobe
+  /// (Heitz et al. 2016; the table is ours, tools/area-ltc-fit), one smooth highlight; the
+  /// others (and BLEND primitives) 3 x 3 points, which the fit does not match for wide lobes at
+  /// grazing views. 1..4: n x n stratified points per rectangle for every material, whose sum
+  /// draws a sharp lobe as n^2 separate highlights. RendererAreaSpecular measures both against
+  /// a dense quadrature. The diffuse part is exact whatever the setting.
+  int area_specular_samples_per_side = 0;
   /// Dielectrics with roughness >= 0.9 and no roughness texture take one specular point per
-  /// rectangle whatever area_specular_samples_per_side says: their lobe is far wider than
+  /// rectangle unless area_specular_samples_per_side is 1: their lobe is far wider than
   /// the light's spread of directions (about 1% of their radiance at worst), and
   /// the area light's specular is the costliest part of the forward pass on llvmpipe.
   bool area_specular_one_point_on_rough = true;

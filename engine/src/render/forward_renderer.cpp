@@ -21,6 +21,7 @@
 #include <engine/log.h>
 #include <engine/runtime_limits.h>
 
+#include "render/area_ltc_table.h"
 #include "render/frame_data.h"
 #include "render/gpu_scene.h"
 #include "render/light_list.h"
@@ -36,6 +37,12 @@ GlSampler raw_depth_sampler() {
   glSamplerParameteri(s.id(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
   glSamplerParameteri(s.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
   return s;
+}
+
+GlBuffer upload_area_ltc_table() {
+  GlBuffer b = GlBuffer::create();
+  glNamedBufferData(b.id(), static_cast<GLsizeiptr>(sizeof(kAreaLtcTable)), kAreaLtcTable, GL_STATIC_DRAW);
+  return b;
 }
 
 GlTexture no_directional_index() {
@@ -255,7 +262,7 @@ Result<std::unique_ptr<Renderer>> Renderer::create(const SceneAsset& assets, con
   GI_EXPECTS(settings.width > 0 && settings.height > 0, "RenderSettings width and height must be positive");
   if (glGetString(GL_VERSION) == nullptr)
     return Error{assets.source, "renderer", "no current OpenGL context (create an engine::GpuContext first)"};
-  auto forward = build_forward_program(LightCounts{0, 0, 0, 0, 3, 1, 1, 0});
+  auto forward = build_forward_program(LightCounts{0, 0, 0, 0, 0, 1, 1, 0});
   if (!forward) return forward.error();
   auto depth = build_depth("depth_only.frag.glsl");
   if (!depth) return depth.error();

@@ -65,6 +65,7 @@ constexpr GLuint kDirectionalRadianceBinding = 2;  // directional_radiance.glsl
 constexpr GLuint kDirectionalDirectionBinding = 3;
 constexpr GLuint kLobeCoefficientsBinding = 6;  // forward.vert.glsl: IndirectLightFrame::vertex_radiance_lobes
 constexpr GLuint kLobeTableBinding = 7;
+constexpr GLuint kAreaLtcBinding = 9;          // lighting_common.glsl: the area-light specular's fitted transforms
 constexpr GLuint kReflectionProbeBinding = 8;  // reflection_probes.glsl: IndirectLightFrame::reflection_probe_buffer
 constexpr GLuint kReflectionProbeUnit = 16;    // reflection_probes.glsl: the probes' cube map array (8: the BRDF table)
 constexpr GLuint kReflectionProbeDistanceUnit = 17;  // reflection_probes.glsl: the probes' distance cubes
@@ -78,6 +79,10 @@ GlSampler raw_depth_sampler();
 // A 1x1 R32I texture holding -1 ("no element"): what the directional index sampler reads
 // when the provider has no directional radiance.
 GlTexture no_directional_index();
+
+// The area-light specular's fitted transforms (area_ltc_table.h) in a buffer for binding
+// kAreaLtcBinding.
+GlBuffer upload_area_ltc_table();
 
 // Point, spot, directional and area light counts, then area specular samples per side,
 // whether area lights are soft-shadowed (RenderSettings::area_soft_shadows), whether the
@@ -130,9 +135,10 @@ class ForwardRenderer final : public Renderer {
         lights_buffer_(GlBuffer::create()),
         empty_vao_(GlVertexArray::create()),
         albedo_table_(upload_gltf_albedo_table()),
+        area_ltc_table_(upload_area_ltc_table()),
         no_directional_index_(no_directional_index()),
         shadow_depth_sampler_(raw_depth_sampler()) {
-    forward_variants_.emplace(LightCounts{0, 0, 0, 0, 3, 1, 1, 0, 0}, std::move(forward));
+    forward_variants_.emplace(LightCounts{0, 0, 0, 0, 0, 1, 1, 0, 0}, std::move(forward));
     ensure_targets();
   }
 
@@ -251,7 +257,8 @@ class ForwardRenderer final : public Renderer {
   glm::mat4 last_camera_world_{1.0f};
   GlBuffer lights_buffer_;
   GlVertexArray empty_vao_;
-  GlTexture albedo_table_;  // gltf_brdf.glsl's directional albedo table
+  GlTexture albedo_table_;   // gltf_brdf.glsl's directional albedo table
+  GlBuffer area_ltc_table_;  // lighting_common.glsl's AreaLtc (area_ltc_table.h)
   GlTexture no_directional_index_;
   GlSampler shadow_depth_sampler_;  // no depth compare: the sun disc's blocker search reads depths
   GlTexture hdr_;

@@ -5,6 +5,7 @@
 #include "render/forward_renderer.h"
 
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <string>
 #include <utility>
@@ -32,6 +33,16 @@ enum IndirectMode : int { kIndirectNone = 0, kIndirectAmbient = 1, kIndirectAtla
 constexpr float kRoughForOnePoint = 0.9f;
 bool rough_dielectric(const render::GpuMaterial& m, GLuint white_texture) {
   return m.metallic == 0.0f && m.roughness >= kRoughForOnePoint && m.metallic_roughness_texture == white_texture;
+}
+
+// A material whose roughness is below kSharpForLtc everywhere (no roughness texture): with
+// RenderSettings::area_specular_samples_per_side 0 it draws area lights' specular from the
+// fitted linearly transformed cosines (AREA_SPECULAR_SIDE 0), which follow its sharp lobe
+// where points split it into separate highlights; wider lobes take 3 x 3 points, which the
+// fit does not match at grazing views (RendererAreaSpecular measures both).
+constexpr float kSharpForLtc = 0.3f;
+bool sharp_for_ltc(const render::GpuMaterial& m, GLuint white_texture) {
+  return m.roughness < kSharpForLtc && m.metallic_roughness_texture == white_texture;
 }
 
 // A provider's SSBO of `Element`s at `binding`, where the engine's shaders declare that element.
@@ -83,6 +94,7 @@ ForwardRenderer::ForwardInputs ForwardRenderer::bind_forward_inputs(const Indire
   glBindTextureUnit(kIrradianceAtlasUnit, in.atlas != 0 ? in.atlas : scene_.white_texture());
   glBindTextureUnit(kGlossyUnit, in.glossy != 0 ? in.glossy : scene_.white_texture());
   glBindTextureUnit(kGltfAlbedoTableUnit, albedo_table_.id());
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kAreaLtcBinding, area_ltc_table_.id());
   // Directional radiance of static surfaces (IndirectLightFrame::directional_*), when provided.
   in.directional = indirect != nullptr && indirect->directional_index_texture &&
                    indirect->directional_radiance_buffer && indirect->directional_direction_buffer &&
@@ -212,39 +224,59 @@ void ForwardRenderer::shade_group(const ForwardInputs& in, const LightGroup& gro
   if (in.reach && !blend) glStencilFunc(GL_EQUAL, group.mask, area_lights_.empty() ? 0xFF : 0xFF & ~kAreaFallbackBit);
   glBindBufferRange(GL_SHADER_STORAGE_BUFFER, kLightsBinding, lights_buffer_.id(), group.offset,
                     static_cast<GLsizeiptr>(std::max<std::size_t>(1, group.lights.size()) * sizeof(render::GpuLight)));
+  const int setting = std::clamp(settings_.area_specular_samples_per_side, 0, 4);
+  // (BLEND primitives draw in one pass, in back-to-front order: with setting 0, 3 x 3 points.)
   const LightCounts counts{group.count_by_type[0],
                            group.count_by_type[1],
                            group.count_by_type[2],
                            group.count_by_type[3],
-                           std::clamp(settings_.area_specular_samples_per_side, 1, 4),
+                           blend && setting == 0 && group.count_by_type[3] > 0 ? 3 : setting,
                            settings_.area_soft_shadows ? 1 : 0,
                            in.has_sky ? 1 : 0,
                            area_lights_.empty() ? 0 : 1,
                            settings_.flat_shading ? 1 : 0};
-  // Rough dielectrics draw with the one-specular-point variant of area lights (rough_dielectric),
-  // the other materials with RenderSettings::area_specular_samples_per_side: two passes over the
-  // items, each with its program, when that makes a difference.
-  LightCounts rough_counts = counts;
-  rough_counts[4] = 1;
-  // (Not for BLEND primitives: two passes would break their back-to-front order.)
-  const bool split_rough = !blend && counts[3] > 0 && counts[4] > 1 && settings_.area_specular_one_point_on_rough;
-  for (int pass = 0; pass < (split_rough ? 2 : 1); ++pass) {
-    const LocatedProgram<ForwardUniforms>& program = forward_program(pass == 0 ? counts : rough_counts);
+  // The area-light specular variant (LightCounts[4]) each material draws with: rough
+  // dielectrics one point (rough_dielectric), with setting 0 sharp materials the fitted
+  // transforms (sharp_for_ltc) and the others 3 x 3 points, else the setting's points. One
+  // pass over the items per variant in use, each with its program.
+  const GLuint white = scene_.white_texture();
+  const auto side_of = [&](const render::GpuMaterial& m) {
+    if (blend || counts[3] == 0) return counts[4];
+    if (settings_.area_specular_one_point_on_rough && setting != 1 && rough_dielectric(m, white)) return 1;
+    if (setting != 0) return setting;
+    return sharp_for_ltc(m, white) ? 0 : 3;
+  };
+  const auto material_of = [&](const DrawItem& item, const render::GpuPrimitive& p) -> const render::GpuMaterial& {
+    return scene_.material(item.material_override >= 0 ? item.material_override : p.material);
+  };
+  const auto in_group = [&](const DrawItem& item) {
+    const render::SceneBounds& gb = group.bounds;
+    return gb.empty ||
+           !(glm::any(glm::lessThan(item.bounds.max, gb.min)) || glm::any(glm::greaterThan(item.bounds.min, gb.max)));
+  };
+  std::array<bool, 5> used{};
+  for (const DrawItem* drawn : order) {
+    if (!in_group(*drawn)) continue;
+    for (const render::GpuPrimitive& p : drawn->mesh->primitives) {
+      const render::GpuMaterial& m = material_of(*drawn, p);
+      if ((m.alpha_mode == AlphaMode::Blend) == blend) used[static_cast<std::size_t>(side_of(m))] = true;
+    }
+  }
+  for (int side = 0; side < 5; ++side) {
+    if (!used[static_cast<std::size_t>(side)]) continue;
+    LightCounts pass_counts = counts;
+    pass_counts[4] = side;
+    const LocatedProgram<ForwardUniforms>& program = forward_program(pass_counts);
     const ForwardUniforms& u = program.uniforms;
     program.use();
     set_forward_frame_uniforms(u, in, blend);
     const auto in_pass = [&](const DrawItem& item, const render::GpuPrimitive& p) {
-      const render::GpuMaterial& m = scene_.material(item.material_override >= 0 ? item.material_override : p.material);
-      if ((m.alpha_mode == AlphaMode::Blend) != blend) return false;
-      if (!split_rough) return true;
-      return rough_dielectric(m, scene_.white_texture()) == (pass == 1);
+      const render::GpuMaterial& m = material_of(item, p);
+      return (m.alpha_mode == AlphaMode::Blend) == blend && side_of(m) == side;
     };
     for (const DrawItem* drawn : order) {
       const DrawItem& item = *drawn;
-      const render::SceneBounds& gb = group.bounds;
-      if (!gb.empty &&
-          (glm::any(glm::lessThan(item.bounds.max, gb.min)) || glm::any(glm::greaterThan(item.bounds.min, gb.max))))
-        continue;  // none of this group's pixels can be on the item
+      if (!in_group(item)) continue;  // none of this group's pixels can be on the item
       if (std::none_of(item.mesh->primitives.begin(), item.mesh->primitives.end(),
                        [&](const render::GpuPrimitive& p) { return in_pass(item, p); }))
         continue;
@@ -254,7 +286,7 @@ void ForwardRenderer::shade_group(const ForwardInputs& in, const LightGroup& gro
       glUniformMatrix4fv(u.normal_matrix, 1, GL_FALSE, glm::value_ptr(normal_matrix));
       for (const render::GpuPrimitive& p : item.mesh->primitives) {
         if (!in_pass(item, p)) continue;
-        draw_shaded_primitive(u, scene_.material(item.material_override >= 0 ? item.material_override : p.material), p);
+        draw_shaded_primitive(u, material_of(item, p), p);
       }
     }
   }

@@ -1,5 +1,7 @@
 #include "transport/static_scene.h"
 
+#include <cmath>
+
 #include <engine/runtime_limits.h>
 
 #include "raytrace/embree_ray_caster.h"
@@ -128,12 +130,18 @@ void drop_cut_out_texels(StaticBakeScene& b, const AtlasLayout& layout) {
     if (!geo.cutout) continue;
     const auto tri = static_cast<std::uint32_t>(tx.triangle[i]);
     if (tri >= geo.cutout->triangle_mask.size() || geo.cutout->triangle_mask[tri] < 0) continue;
-    // 4 x 4 points over the texel's footprint on its triangle: any one kept keeps the texel.
+    // kCutOutPoints points of the R2 sequence (Roberts 2018) over the texel's footprint on its
+    // triangle: any one kept keeps the texel. Not a regular grid: a grid's rows lock in phase
+    // with a periodic cut-out (the demo's wire-mesh grille: 4 x 4 points 3.1 cm apart fell in
+    // its 6.25 cm diamonds' holes at every texel, and the grille had no valid texel).
     const TexelFootprint f = texel_footprint(layout, tx.mesh[i], tx.triangle[i], i);
+    constexpr int kCutOutPoints = 64;
+    constexpr float kR2X = 0.7548776662f, kR2Y = 0.5698402910f;  // 1/g, 1/g^2 of the plastic constant g
     bool kept = false;
-    for (int k = 0; k < 16 && !kept; ++k) {
-      glm::vec2 q = f.centre + ((static_cast<float>(k % 4) + 0.5f) / 4.0f - 0.5f) * f.axis_u +
-                    ((static_cast<float>(k / 4) + 0.5f) / 4.0f - 0.5f) * f.axis_v;
+    for (int k = 0; k < kCutOutPoints && !kept; ++k) {
+      const float u = std::fmod(0.5f + kR2X * static_cast<float>(k), 1.0f) - 0.5f;
+      const float v = std::fmod(0.5f + kR2Y * static_cast<float>(k), 1.0f) - 0.5f;
+      glm::vec2 q = f.centre + u * f.axis_u + v * f.axis_v;
       q = glm::max(q, glm::vec2(0.0f));
       if (q.x + q.y > 1.0f) q /= q.x + q.y;
       kept = !geo.cutout->cut(geo.indices, tri, q);

@@ -68,8 +68,8 @@ struct TexelFootprint {
 };
 TexelFootprint texel_footprint(const AtlasLayout& layout, int mesh, int triangle, std::size_t texel);
 
-/// Marks the texels wholly cut out (alpha MASK / BLEND, none of 4 x 4 points over the
-/// texel's footprint kept) as not valid: nothing there to light. prepare_static_scene runs it.
+/// Marks the texels wholly cut out (alpha MASK / BLEND, none of 64 low-discrepancy points over
+/// the texel's footprint kept) as not valid: nothing there to light. prepare_static_scene runs it.
 void drop_cut_out_texels(StaticBakeScene& scene, const AtlasLayout& layout);
 
 /// A ray caster over the static mesh instances of `input` (what a runtime relighting of the
