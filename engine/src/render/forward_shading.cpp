@@ -219,6 +219,9 @@ void ForwardRenderer::draw_shaded_primitive(const ForwardUniforms& u, const GpuM
 
 // One light group's pixels (its stencil mask), or with `blend` the BLEND primitives of
 // `order` (back to front) over everything, without the stencil.
+// Long because the passes (one per area-specular variant in use) and the scan that finds
+// the variants share the group's counts and the material rules (side_of, in_group): split,
+// each part would take all of them.
 void ForwardRenderer::shade_group(const ForwardInputs& in, const LightGroup& group,
                                   const std::vector<const DrawItem*>& order, bool blend) {
   if (in.reach && !blend) glStencilFunc(GL_EQUAL, group.mask, area_lights_.empty() ? 0xFF : 0xFF & ~kAreaFallbackBit);

@@ -44,19 +44,55 @@ void sample_area_light(const TexelLighting& t, const ReferenceLight& l, Pcg32& r
 }
 
 // A disc (the sun's angular radius): `samples` stratified directions uniform over its
-// cone, each carrying radiant / samples; soft shadows (docs/scene-format.md).
+// cone, each carrying radiant / samples; soft shadows (docs/scene-format.md). Where they
+// disagree (a penumbra: some occluded, some not), kPenumbraFactor x `samples` more, and the
+// mean over all: 8 directions step a 9 cm penumbra (Dabrovic Sponza's arcades at 8 texels/m)
+// in eighths of the sun, 20-25% off the path tracer at single texels, the sun's shadow edges
+// a quarter of the whole lightmap's error. Where the first directions agree, a few on the
+// disc's rim look for a penumbra's sliver they missed (the decision biases only what all of
+// those miss too).
 void sample_sun_disc(const TexelLighting& t, const ReferenceLight& l, Pcg32& rng, glm::dvec3& sum) {
-  const float shift_y = rng.next_float();  // drawn first: see random.h
-  const glm::vec2 shift(rng.next_float(), shift_y);
-  for (int s = 0; s < t.samples; ++s) {
-    const glm::vec2 u = hammersley(static_cast<std::uint32_t>(s), static_cast<std::uint32_t>(t.samples), shift);
-    const glm::vec3 wi = sample_cone(-l.direction, l.cos_disc, u.x, u.y);
-    const float cos_r = glm::dot(wi, t.n);
-    if (cos_r <= 0.0f || glm::dot(wi, t.face) <= 0.0f) continue;
-    ++*t.rays;
-    if (t.b.caster->occluded(Ray{t.origin, 0.0f, wi, std::numeric_limits<float>::infinity()})) continue;
-    sum += glm::dvec3(l.radiant * cos_r) * t.inv;
+  constexpr int kPenumbraFactor = 8;
+  glm::dvec3 lit(0.0);
+  int shadowed = 0, unshadowed = 0;
+  const auto pass = [&](int n) {
+    const float shift_y = rng.next_float();  // drawn first: see random.h
+    const glm::vec2 shift(rng.next_float(), shift_y);
+    for (int s = 0; s < n; ++s) {
+      const glm::vec2 u = hammersley(static_cast<std::uint32_t>(s), static_cast<std::uint32_t>(n), shift);
+      const glm::vec3 wi = sample_cone(-l.direction, l.cos_disc, u.x, u.y);
+      const float cos_r = glm::dot(wi, t.n);
+      if (cos_r <= 0.0f || glm::dot(wi, t.face) <= 0.0f) continue;
+      ++*t.rays;
+      if (t.b.caster->occluded(Ray{t.origin, 0.0f, wi, std::numeric_limits<float>::infinity()})) {
+        ++shadowed;
+        continue;
+      }
+      ++unshadowed;
+      lit += glm::dvec3(l.radiant * cos_r);
+    }
+  };
+  pass(t.samples);
+  int taken = t.samples;
+  // The first directions all agree: kRimProbes more on the disc's rim, where a penumbra's
+  // sliver shows first, tell whether it ends here (they only decide; they are not counted).
+  bool penumbra = shadowed > 0 && unshadowed > 0;
+  if (t.samples > 1 && !penumbra && shadowed + unshadowed > 0) {
+    constexpr int kRimProbes = 6;
+    const float phase = rng.next_float();
+    for (int k = 0; k < kRimProbes && !penumbra; ++k) {
+      const glm::vec3 wi = sample_cone(-l.direction, l.cos_disc, 1.0f, (static_cast<float>(k) + phase) / kRimProbes);
+      if (glm::dot(wi, t.n) <= 0.0f || glm::dot(wi, t.face) <= 0.0f) continue;
+      ++*t.rays;
+      const bool occluded = t.b.caster->occluded(Ray{t.origin, 0.0f, wi, std::numeric_limits<float>::infinity()});
+      penumbra = occluded != (shadowed > 0);
+    }
   }
+  if (t.samples > 1 && penumbra) {
+    pass(kPenumbraFactor * t.samples);
+    taken += kPenumbraFactor * t.samples;
+  }
+  sum += lit / static_cast<double>(taken);
 }
 
 // A point, spot or sharp directional light: one shadow ray.

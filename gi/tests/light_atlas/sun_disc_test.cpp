@@ -168,6 +168,8 @@ TEST(SunDisc, LightAtlasPenumbraMatchesTheDiscGeometry) {
       "worst texel off by %.3f; a point sun: %.4f m\n",
       width, expected, worst, hard);
   EXPECT_NEAR(width, expected, 0.15 * expected);
-  EXPECT_LT(worst, 0.2);  // 16 stratified directions per texel; measured 0.11 (high preset) and 0.15 (this)
+  // 16 stratified directions per texel gave 0.15; with 8 x 16 more where they disagree, 0.088
+  // (a rim texel whose 16 all agreed), and with the rim probes deciding too, 0.027.
+  EXPECT_LT(worst, 0.05);
   EXPECT_LT(hard, 0.25 * expected) << "a sun without a disc casts a hard edge";
 }

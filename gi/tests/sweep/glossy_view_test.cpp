@@ -46,8 +46,11 @@ TEST(GlossyView, AboveTheCorridorFloorSeesTheBandsCameraZeroDoesNot) {
   EXPECT_EQ(a.texels, c.texels);
   EXPECT_GT(a.hi, 0.95f);
   EXPECT_GT(a.lo, 0.3f);
-  // The eye stands on the corridor floor (y = 0, x 3..5, z 8..17), at eye height.
-  EXPECT_NEAR(above->eye.y, 1.7f, 0.05f);
+  // The eye stands on the corridor floor (y = 0, x 3..5, z 8..17), at eye height above the
+  // glossy texels' centroid: the grille's (0.6 m up, valid since the cut-out test samples
+  // each texel off the grille's hole pattern) lift it a few centimetres.
+  EXPECT_GE(above->eye.y, 1.7f);
+  EXPECT_LT(above->eye.y, 1.8f);
   EXPECT_GT(above->eye.x, 3.0f);
   EXPECT_LT(above->eye.x, 5.0f);
   EXPECT_GT(above->eye.z, 8.0f);
