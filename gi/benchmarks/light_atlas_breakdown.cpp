@@ -179,16 +179,22 @@ int main(int argc, char** argv) {
     const float c = glm::dot(tx.normal[i], to_sun);
     lit[i] = c > 0.05f ? gathered->direct[i].y / (650.0f * c) : -1.0f;
   }
+  // Texel i's triangle, and its face turned to the side of the texel's normal.
+  const auto own_triangle = [&](std::size_t i) -> const gi::ShadingTriangle& {
+    return scene->index
+        .triangles[scene->index.instance_first[scene->static_instance[static_cast<std::size_t>(tx.mesh[i])]] +
+                   static_cast<std::uint32_t>(tx.triangle[i])];
+  };
+  const auto texel_face = [&](std::size_t i) {
+    const glm::vec3 f = own_triangle(i).face_normal;
+    return glm::dot(f, tx.normal[i]) < 0.0f ? -f : f;
+  };
   // Texels sandwiched between their own surface and another a few mm off it (overlapping
   // geometry): at least half of 16 cosine rays land within 2 cm.
   std::vector<std::uint8_t> sandwiched(n, 0);
   pool.parallel_for(n, [&](std::size_t i) {
     if (!tx.valid[i]) return;
-    const gi::ShadingTriangle& own =
-        scene->index
-            .triangles[scene->index.instance_first[scene->static_instance[static_cast<std::size_t>(tx.mesh[i])]] +
-                       static_cast<std::uint32_t>(tx.triangle[i])];
-    const glm::vec3 face = glm::dot(own.face_normal, tx.normal[i]) < 0.0f ? -own.face_normal : own.face_normal;
+    const glm::vec3 face = texel_face(i);
     const glm::vec3 origin = gi::offset_ray_origin(tx.position[i], face);
     int close = 0;
     for (int r = 0; r < 16; ++r) {
@@ -240,10 +246,7 @@ int main(int argc, char** argv) {
                                    ? "sky only"
                                    : "shade interior";
       into(by[kind]);
-      const gi::ShadingTriangle& tri =
-          scene->index
-              .triangles[scene->index.instance_first[scene->static_instance[static_cast<std::size_t>(tx.mesh[i])]] +
-                         static_cast<std::uint32_t>(tx.triangle[i])];
+      const gi::ShadingTriangle& tri = own_triangle(i);
       into(by[glm::dot(tri.face_normal, tx.normal[i]) < 0.996f ? "normal > 5 deg off face" : "normal on face"]);
       into(by_material[static_cast<int>(tri.material)]);
       const glm::ivec2 sz = layout->charts[static_cast<std::size_t>(tx.chart[i])].size;
@@ -267,11 +270,8 @@ int main(int argc, char** argv) {
   for (const char* probe = std::getenv("GI_BREAKDOWN_TEXEL"); probe && *probe;
        probe = std::strchr(probe, ',') ? std::strchr(probe, ',') + 1 : nullptr) {
     const std::size_t i = std::strtoul(probe, nullptr, 10);
-    const gi::ShadingTriangle& own =
-        scene->index
-            .triangles[scene->index.instance_first[scene->static_instance[static_cast<std::size_t>(tx.mesh[i])]] +
-                       static_cast<std::uint32_t>(tx.triangle[i])];
-    const glm::vec3 face = glm::dot(own.face_normal, tx.normal[i]) < 0.0f ? -own.face_normal : own.face_normal;
+    const gi::ShadingTriangle& own = own_triangle(i);
+    const glm::vec3 face = texel_face(i);
     const glm::vec3 origin = gi::offset_ray_origin(tx.position[i], face);
     const gi::Hit sun_hit = scene->caster->intersect(gi::Ray{origin, 0.0f, to_sun});
     // The path tracer at the texel's sample with 0, 1 and all bounces: where its light comes from.
