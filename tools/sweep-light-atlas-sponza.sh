@@ -46,7 +46,7 @@ fi
 # rays, the lights' direct light at every landing, the read light filtered 1.5 texels, the guided
 # denoiser's 2 passes, no output filter, and near landings regathered with 4 rays (0: without)
 run "$sweep" "${gather[@]}" --knob solve_rays=32 --knob rays=128 --knob emitter_rays=32 --knob filter=0 \
-  --knob denoise=2 --knob landing_direct=everywhere --knob source_filter=1.5 --knob near_rays=0,4 \
+  --knob denoise=2 --knob landing_direct=punctual --knob source_filter=1.5 --knob near_rays=0,4 \
   --knob direct_samples=8 "${common[@]}" --out "$out/preset"
 csvs+=("$out/preset/light_atlas_sponza.csv")
 run "$sweep" --method pathtracer_atlas --knob density=8 --knob "spp=$pt_spp" "${common[@]}" --out "$out/pathtracer"

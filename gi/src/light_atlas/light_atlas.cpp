@@ -481,7 +481,7 @@ engine::Result<LightAtlasSettings> light_atlas_preset(std::string_view name) {
   s.final_pass = LightAtlasSettings::FinalPass::TexelGather;
   s.gather.filter_radius_texels = 0.0f;
   s.gather.denoise_passes = 2;
-  s.gather.landing_direct_everywhere = true;
+  s.gather.landing_direct = TexelGatherSettings::LandingDirect::Punctual;
   s.gather.source_filter_radius_texels = 1.5f;
   s.gather.emitter_rays = 32;
   s.gather.near_regather_rays = 4;
@@ -503,7 +503,7 @@ engine::Result<LightAtlasSettings> light_atlas_preset(std::string_view name) {
     // At 32 texels/m a filter's bias costs more than its noise saves (against a 65536-spp
     // reference, 0.022 with a 1.5-texel filter, 0.015 without).
     s.gather.filter_radius_texels = 0.0f, s.gather.denoise_passes = 0;
-    s.gather.landing_direct_everywhere = false, s.gather.source_filter_radius_texels = -1.0f;
+    s.gather.landing_direct = TexelGatherSettings::LandingDirect::Edges, s.gather.source_filter_radius_texels = -1.0f;
     s.gather.emitter_rays = 0, s.gather.near_regather_rays = 0;
   }
   return s;

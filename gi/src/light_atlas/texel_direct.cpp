@@ -158,23 +158,25 @@ void sample_emitters(const TexelLighting& t, Pcg32& rng, glm::dvec3& sum, glm::d
 }  // namespace
 
 DirectAt direct_at(const StaticBakeScene& b, const glm::vec3& p, const glm::vec3& n, const glm::vec3& face, int samples,
-                   Pcg32& rng, std::uint64_t* rays) {
+                   Pcg32& rng, std::uint64_t* rays, DirectLights which) {
   const TexelLighting t{b, p, n, face, offset_ray_origin(p, face), samples, 1.0 / static_cast<double>(samples), rays};
-  glm::dvec3 sum(0.0);
+  const bool all = which == DirectLights::All;
+  glm::dvec3 sum(0.0), area(0.0);
   for (std::size_t i = 0; i < b.scene.lights.size(); ++i) {
     const ReferenceLight& l = b.scene.lights[i];
     if (l.type == ReferenceLight::Type::Area) {
-      if (!b.index.light_has_proxy[i]) sample_area_light(t, l, rng, sum);  // else its emissive geometry stands for it
+      // Else its emissive geometry stands for it.
+      if (all && !b.index.light_has_proxy[i]) sample_area_light(t, l, rng, area);
     } else if (l.type == ReferenceLight::Type::Directional && l.cos_disc < 1.0f) {
       sample_sun_disc(t, l, rng, sum);
     } else {
       sample_point_light(t, l, sum);
     }
   }
-  if (b.index.emitters.triangle.empty()) return {glm::vec3(sum), glm::vec3(0.0f)};
-  glm::dvec3 unlit(0.0);
-  sample_emitters(t, rng, sum, unlit);
-  return {glm::vec3(sum), glm::vec3(unlit)};
+  if (!all || b.index.emitters.triangle.empty()) return {glm::vec3(sum + area), glm::vec3(0.0f), glm::vec3(area)};
+  glm::dvec3 lit(0.0), unlit(0.0);
+  sample_emitters(t, rng, lit, unlit);
+  return {glm::vec3(sum + area + lit), glm::vec3(unlit), glm::vec3(area + lit + unlit)};
 }
 
 }  // namespace gi

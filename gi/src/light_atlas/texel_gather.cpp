@@ -281,7 +281,8 @@ bool final_gather(const StaticBakeScene& b, const AtlasLayout& layout, const Tex
 // `sky` the sky's direct light, likewise.
 bool gather_step(const StaticBakeScene& b, const AtlasLayout& layout, const TexelTable& t, const TexelGatherSettings& s,
                  ThreadPool& pool, const ProgressCallback& progress, const KeptRays& kept,
-                 const std::vector<glm::vec3>& emitted, TexelGatherResult& out, std::vector<glm::vec3>& sky) {
+                 const std::vector<glm::vec3>& emitted, const std::vector<glm::vec3>& sampled, TexelGatherResult& out,
+                 std::vector<glm::vec3>& sky) {
   const AtlasTexels& tx = b.texels;
   const std::size_t n = tx.valid.size(), work = t.work.size();
   const float texel_m = layout.texels_per_metre > 0.0f ? 1.0f / layout.texels_per_metre : 0.0f;
@@ -306,7 +307,14 @@ bool gather_step(const StaticBakeScene& b, const AtlasLayout& layout, const Texe
   const int rings = std::max(3, layout.padding_texels);
   for (auto* field : {&src.reflected, &src.without_lights, &lit})
     dilate<glm::vec3>(*field, t.width, t.height, tx.valid, rings);
-  src.sharp = s.landing_direct_everywhere ? std::vector<std::uint8_t>(n, 1) : sharp_pixels(lit, t.width, t.height);
+  src.sharp = s.landing_direct == TexelGatherSettings::LandingDirect::Everywhere ? std::vector<std::uint8_t>(n, 1)
+                                                                                : sharp_pixels(lit, t.width, t.height);
+  if (s.landing_direct == TexelGatherSettings::LandingDirect::Punctual) {
+    src.punctual_everywhere = true;
+    src.without_punctual.assign(n, glm::vec3(0.0f));
+    for (std::uint32_t i : t.work) src.without_punctual[i] = t.albedo[i] * (kept.sky[i] + source[i] + sampled[i]);
+    dilate<glm::vec3>(src.without_punctual, t.width, t.height, tx.valid, rings);
+  }
   src.layout = &layout;
   src.near_rays = s.near_regather_rays;
   src.near_m = s.near_regather_texels * texel_m;
@@ -358,6 +366,7 @@ engine::Result<TexelGatherResult> gather_atlas(const StaticBakeScene& b, const A
   out.indirect.assign(n, glm::vec3(0.0f));
   out.variance.assign(n, 0.0f);
   std::vector<std::uint64_t> rays_of(work, 0);
+  std::vector<glm::vec3> sampled(n, glm::vec3(0.0f));  // step 1's area lights and emitters (DirectAt::sampled)
 
   // Step 1.
   auto t0 = Clock::now();
@@ -367,6 +376,7 @@ engine::Result<TexelGatherResult> gather_atlas(const StaticBakeScene& b, const A
         const DirectAt d = direct_at(b, tx.position[i], tx.normal[i], t.face[i], s.direct_samples, rng, &rays_of[w]);
         out.direct[i] = d.live;
         out.baked_direct[i] = d.unlit;
+        sampled[i] = d.sampled;
       }))
     return engine::cancelled_error("light-atlas gather");
   out.direct_seconds = seconds_since(t0);
@@ -387,7 +397,7 @@ engine::Result<TexelGatherResult> gather_atlas(const StaticBakeScene& b, const A
   t0 = Clock::now();
   std::vector<glm::vec3> sky = kept.sky;
   if (s.gather_rays > 0 || s.emitter_rays > 0) {
-    if (!gather_step(b, layout, t, s, pool, phase(0.5, 0.95), kept, emitted, out, sky))
+    if (!gather_step(b, layout, t, s, pool, phase(0.5, 0.95), kept, emitted, sampled, out, sky))
       return engine::cancelled_error("light-atlas gather");
   } else if (!s.shard.whole()) {
     for (std::size_t w = 0; w < work; ++w)

@@ -65,12 +65,15 @@ struct TexelGatherSettings {
   /// The denoiser's outlier clamp before its passes (DenoiseSettings::outlier_sigmas): a
   /// texel at most its co-planar neighbours' mean + this many standard deviations (0: off).
   float denoise_outlier_sigmas = 0.0f;
-  /// Step 3's reads where a fresh ray lands: false (the default) takes the lights' direct
-  /// light at the landing point itself only across shadow edges (read_landing's `sharp`
-  /// pixels) and reads it from the texels elsewhere; true takes it at the point everywhere
-  /// (one shadow ray per light and landing), the texels then give only the sky and the
-  /// indirect light there.
-  bool landing_direct_everywhere = false;
+  /// Step 3's reads where a fresh ray lands: which lights' direct light it takes at the landing
+  /// point itself (one shadow ray per light and landing) rather than from the texels, which
+  /// then give only the rest. `Edges` (the default): every light's, only across shadow edges
+  /// (read_landing's `sharp` pixels). `Everywhere`: every light's at every landing.
+  /// `Punctual`: the point, spot and directional lights' and the sun's at every landing (one
+  /// ray each, sharp), the area lights' and emitters' (whose one sample at a landing is noise
+  /// the texels' many samples do not have) only across shadow edges.
+  enum class LandingDirect { Edges, Everywhere, Punctual };
+  LandingDirect landing_direct = LandingDirect::Edges;
   /// World-space filter radius, in texels, of the light step 3's rays read (the kept-ray
   /// solve's), apart from the output's; negative: `filter_radius_texels`. A noisy bright
   /// texel in what the rays read lights every neighbour whose rays land on it: blotches a

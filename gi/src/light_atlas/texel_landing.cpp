@@ -219,8 +219,17 @@ glm::dvec3 read_landing(const StaticBakeScene& b, const TexelTable& t, const Gat
   }
   const bool sharp = src.sharp[l.pixel] != 0;
   glm::dvec3 rest(0.0);
+  if (!sharp && src.punctual_everywhere) {
+    if (read_seen_corners(t, src.without_punctual, l, rest)) {
+      const LandingPoint at = landing_point(b, l);
+      const DirectAt d = direct_at(b, at.p, at.n, l.side, 1, rng, &rays, DirectLights::Punctual);
+      return rest + glm::dvec3(t.albedo[l.texel] * d.live);
+    }
+    // No corner sees the point: every light's direct light there is all the read takes.
+  } else if (read_seen_corners(t, sharp ? src.without_lights : src.reflected, l, rest) && !sharp) {
+    return rest;
+  }
   // Where no corner sees the point, the lights' direct light there is all the read takes.
-  if (read_seen_corners(t, sharp ? src.without_lights : src.reflected, l, rest) && !sharp) return rest;
   const LandingPoint at = landing_point(b, l);
   const DirectAt d = direct_at(b, at.p, at.n, l.side, 1, rng, &rays);
   const glm::dvec3 lights(t.albedo[l.texel] * (d.live + d.unlit));

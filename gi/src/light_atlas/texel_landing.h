@@ -62,6 +62,10 @@ std::uint32_t landing(const StaticBakeScene& b, const AtlasLayout& layout, const
 struct GatherSource {
   std::vector<glm::vec3> reflected, without_lights;
   std::vector<std::uint8_t> sharp;
+  /// With `punctual_everywhere`: rho (E_d + E) without the punctual lights' direct light
+  /// (DirectLights::Punctual), which landings off the `sharp` pixels take at their point.
+  std::vector<glm::vec3> without_punctual;
+  bool punctual_everywhere = false;
   /// Landings nearer than `near_m` take the sky and the indirect light at the point itself
   /// from `near_rays` cosine rays (a second gather one level down, reading `reflected`)
   /// instead of reading them from the texels (0 rays: never).
@@ -75,7 +79,10 @@ struct GatherSource {
 /// under a slab of Dabrovic Sponza, the floor's texel straddles the slot's mouth, its sample
 /// lies in the sun, and rays from the slab's underside that land in the dark slot read that
 /// sun (issue 35, "Noise against floor"). There the read takes the lights' direct light at the
-/// landing point itself (one sample of each light, unbiased) and only the rest bilinearly.
+/// landing point itself (one sample of each light, unbiased) and only the rest bilinearly;
+/// with `src.punctual_everywhere`, elsewhere too for the punctual lights (point, spot,
+/// directional, the sun), whose one ray at the point is sharp where an area light's one
+/// sample is noise.
 /// Bilinear corners whose samples do not see the point (Landing::unseen_corners) are left out;
 /// where none does, that direct light is all the read takes. A landing nearer than
 /// `src.near_m` (with `src.near_rays` > 0) reads no texel of its own: the lights' direct light,

@@ -32,10 +32,10 @@ std::vector<KnobSpec> gather_detail_knobs() {
        .max_value = 1000},
       {.name = "landing_direct",
        .description = "gather: the lights' direct light where a fresh ray lands, at the point across shadow edges "
-                      "only (edges) or everywhere",
+                      "only (edges), everywhere, or everywhere for the punctual lights and the sun only (punctual)",
        .kind = KnobKind::Choice,
        .default_grid = {"edges"},
-       .choices = {"edges", "everywhere"}},
+       .choices = {"edges", "everywhere", "punctual"}},
       {.name = "source_filter",
        .description = "gather: world-space filter radius of the light the fresh rays read, texels (-1: filter's)",
        .kind = KnobKind::Real,
@@ -175,7 +175,10 @@ engine::Result<MethodOutput> run_light_atlas(const RunContext& ctx) {
     s.gather.denoise_passes = static_cast<int>(ctx.knobs.integer("denoise"));
     s.gather.denoise_sigma = static_cast<float>(ctx.knobs.real("denoise_sigma"));
     s.gather.denoise_outlier_sigmas = static_cast<float>(ctx.knobs.real("outlier"));
-    s.gather.landing_direct_everywhere = ctx.knobs.text("landing_direct") == "everywhere";
+    const std::string landing = ctx.knobs.text("landing_direct");
+    s.gather.landing_direct = landing == "everywhere" ? gi::TexelGatherSettings::LandingDirect::Everywhere
+                              : landing == "punctual" ? gi::TexelGatherSettings::LandingDirect::Punctual
+                                                      : gi::TexelGatherSettings::LandingDirect::Edges;
     s.gather.source_filter_radius_texels = static_cast<float>(ctx.knobs.real("source_filter"));
     s.gather.near_regather_rays = static_cast<int>(ctx.knobs.integer("near_rays"));
     s.gather.near_regather_texels = static_cast<float>(ctx.knobs.real("near_texels"));

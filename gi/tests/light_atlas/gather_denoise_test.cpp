@@ -207,7 +207,7 @@ TEST(GatherOptions, EstimateTheSameLightAsTheDefaultGather) {
   gi::TexelGatherSettings g{.direct_samples = 4, .solve_rays = 32, .gather_rays = 256};
   const double plain = score("default, 256 rays", g);
   gi::TexelGatherSettings everywhere = g;
-  everywhere.landing_direct_everywhere = true;
+  everywhere.landing_direct = gi::TexelGatherSettings::LandingDirect::Everywhere;
   score("direct light at every landing", everywhere);
   gi::TexelGatherSettings source = everywhere;
   source.source_filter_radius_texels = 1.5f;
