@@ -308,7 +308,7 @@ bool gather_step(const StaticBakeScene& b, const AtlasLayout& layout, const Texe
   for (auto* field : {&src.reflected, &src.without_lights, &lit})
     dilate<glm::vec3>(*field, t.width, t.height, tx.valid, rings);
   src.sharp = s.landing_direct == TexelGatherSettings::LandingDirect::Everywhere ? std::vector<std::uint8_t>(n, 1)
-                                                                                : sharp_pixels(lit, t.width, t.height);
+                                                                                 : sharp_pixels(lit, t.width, t.height);
   if (s.landing_direct == TexelGatherSettings::LandingDirect::Punctual) {
     src.punctual_everywhere = true;
     src.without_punctual.assign(n, glm::vec3(0.0f));
