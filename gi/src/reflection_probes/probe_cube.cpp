@@ -283,8 +283,8 @@ glm::vec3 box_projected_direction(const glm::vec3& p, const glm::vec3& r, const 
 
 glm::vec3 probe_lobe_radiance(const ProbeCube& cube, const engine::GltfBrdf& brdf, const glm::vec3& p,
                               const glm::vec3& n, const glm::vec3& v, int samples, const glm::vec3& centre,
-                              const glm::vec3& box_min, const glm::vec3& box_max, bool box_only,
-                              const ProbeCube* chain, float box_side_tolerance) {
+                              const glm::vec3& box_min, const glm::vec3& box_max, bool box_only, const ProbeCube* chain,
+                              float box_side_tolerance) {
   const int count = std::clamp(samples, 1, kProbeMaxLobeSamples);
   const float alpha = brdf.alpha, a2 = alpha * alpha;
   const float nv = std::max(glm::dot(n, v), 1e-4f);

@@ -15,10 +15,10 @@
 // closes it in front of the wall. A candidate whose centre rays hit
 // a back face is inside solid geometry and places nothing; rays that escape stop at the
 // world's bounds (outdoors). The probe sits at its box's centre when that point is free,
-// else at the candidate (or capture_height above its box's floor). Boxes thinner than min_box_m are dropped. Optionally, a box much
-// longer than wide (corridor_aspect) becomes segments about as long as it is wide, each with its own probe
-// at its centre and its own box, reaching kProbeFadeM / 2 into its neighbours' so the
-// forward pass fades between them.
+// else at the candidate (or capture_height above its box's floor). Boxes thinner than min_box_m are dropped.
+// Optionally, a box much longer than wide (corridor_aspect) becomes segments about as long as it is wide, each with its
+// own probe at its centre and its own box, reaching kProbeFadeM / 2 into its neighbours' so the forward pass fades
+// between them.
 
 #include <vector>
 

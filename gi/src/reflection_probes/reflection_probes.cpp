@@ -227,8 +227,7 @@ std::string check_reflection_probe_settings(const ReflectionProbeSettings& s) {
   if (!(p.cell_m > 0.0f) || !std::isfinite(p.cell_m)) return "placement cell_m must be positive";
   if (!(p.spread_m >= 0.0f) || !(p.min_box_m >= 0.0f) || p.max_probes < 1 || p.max_probes > 256)
     return "placement spread_m, min_box_m >= 0 and max_probes in 1..256";
-  if (!(p.capture_height >= 0.0f) || !std::isfinite(p.capture_height))
-    return "placement capture_height must be >= 0";
+  if (!(p.capture_height >= 0.0f) || !std::isfinite(p.capture_height)) return "placement capture_height must be >= 0";
   return {};
 }
 

@@ -86,13 +86,14 @@ std::vector<KnobSpec> reflection_probes_knobs() {
        .min_value = 0.0,
        .max_value = 100},
       {.name = "estimate",
-       .description = "what is scored (the diagnosis, docs/reflection_probes.md): runtime (the probes as the "
-                      "forward pass reads them); trace (the lobe through the capture's own radiance, traced from "
-                      "the texel: no probe); oracle_level0 / oracle (a probe captured at the texel itself, no "
-                      "parallax error: its level 0 under the exact lobe / read as the runtime reads); level0 "
-                      "(the placed probes' level 0 under the exact lobe, each sample parallax-corrected); exact_parallax "
-                      "(the placed probes without a cube map: each lobe sample's landing point, traced from the "
-                      "texel, as the probe's centre sees it: what the probes' view of the world alone costs)",
+       .description =
+           "what is scored (the diagnosis, docs/reflection_probes.md): runtime (the probes as the "
+           "forward pass reads them); trace (the lobe through the capture's own radiance, traced from "
+           "the texel: no probe); oracle_level0 / oracle (a probe captured at the texel itself, no "
+           "parallax error: its level 0 under the exact lobe / read as the runtime reads); level0 "
+           "(the placed probes' level 0 under the exact lobe, each sample parallax-corrected); exact_parallax "
+           "(the placed probes without a cube map: each lobe sample's landing point, traced from the "
+           "texel, as the probe's centre sees it: what the probes' view of the world alone costs)",
        .kind = KnobKind::Choice,
        .default_grid = {"runtime"},
        .choices = {"runtime", "trace", "oracle_level0", "oracle", "level0", "exact_parallax", "level0_exact_dir"}},
@@ -171,8 +172,9 @@ bool probe_specular(const ReflectionProbeSet& set, const engine::GltfBrdf& brdf,
                                      chains ? &(*chains)[i] : nullptr, box_side);
     } else {
       const float lod = std::sqrt(brdf.alpha) * static_cast<float>(cube.levels.size() - 1);
-      const glm::vec3 d = box_only ? box_projected_direction(p, r, pv.centre, pv.box_min, pv.box_max)
-                                   : distance_corrected_direction(cube, p, r, pv.centre, pv.box_min, pv.box_max, box_side);
+      const glm::vec3 d = box_only
+                              ? box_projected_direction(p, r, pv.centre, pv.box_min, pv.box_max)
+                              : distance_corrected_direction(cube, p, r, pv.centre, pv.box_min, pv.box_max, box_side);
       sum += w * cube_lookup_trilinear(cube, lod, d);
     }
     depth = std::max(depth, depth_in_box(pv, p, n));
@@ -324,10 +326,9 @@ glm::vec3 diagnosis_estimate(Estimate estimate, const BakedProbes& b, const Prob
       if (!(w > 0.0f)) continue;
       const ProbeCube& cube = b.set.cubes[i];
       sum += w * exact_lobe(brdf, n, v, t, kExactLobeSamples, [&](const glm::vec3& l) {
-               const glm::vec3 d = box_only
-                                       ? box_projected_direction(p, l, pv.centre, pv.box_min, pv.box_max)
-                                       : distance_corrected_direction(cube, p, l, pv.centre, pv.box_min,
-                                                                      pv.box_max, box_side);
+               const glm::vec3 d =
+                   box_only ? box_projected_direction(p, l, pv.centre, pv.box_min, pv.box_max)
+                            : distance_corrected_direction(cube, p, l, pv.centre, pv.box_min, pv.box_max, box_side);
                return cube_lookup_trilinear(cube, 0.0f, d);
              });
       weight += w;
@@ -433,8 +434,7 @@ engine::Result<MethodOutput> run_reflection_probes(const RunContext& ctx) {
     covered[t] = 1;
     (depth < border ? edge : inner)[t] = 1;
   }
-  if (auto diagnosed = diagnose(ctx, *baked, input, *g, covered, box_only, box_side, lobe_samples, values);
-      !diagnosed)
+  if (auto diagnosed = diagnose(ctx, *baked, input, *g, covered, box_only, box_side, lobe_samples, values); !diagnosed)
     return diagnosed.error();
   dump_texels(ctx, tex, values, inner, covered);
   MethodOutput out;
