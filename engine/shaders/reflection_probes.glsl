@@ -83,9 +83,22 @@ vec3 probe_direction(vec3 p, vec3 r, ReflectionProbeBox probe, int i) {
   float t_exit = dot(probe_box_exit(p, r, probe) - p, r);
   float g_exit = probe_behind(x + t_exit * r, i), exit_distance = length(x + t_exit * r);
   float tolerance = PROBE_BOX_SIDE_TOLERANCE * exit_distance;
-  if (g_exit >= 0.0 && g_exit <= tolerance) return boxed;
-  if (g_exit < 0.0 && g_exit >= -tolerance && probe_behind(x + (t_exit + tolerance) * r, i) >= 0.0) return boxed;
-  if (g_exit < 0.0) {
+  // An object the ray passes clearly behind before the exit: the search as before.
+  bool blocked = false, front = false;
+  for (int k = 1; k <= PROBE_SEARCH_STEPS && !blocked; ++k) {
+    float a = float(k) / float(PROBE_SEARCH_STEPS + 1);
+    float t = scale * a / (1.0 - a);
+    if (t >= t_exit) break;
+    float g = probe_behind(x + t * r, i);
+    if (g < 0.0)
+      front = true;
+    else if (front && g > PROBE_BOX_SIDE_TOLERANCE * length(x + t * r))
+      blocked = true;
+  }
+  if (!blocked && g_exit >= 0.0 && g_exit <= tolerance) return boxed;
+  if (!blocked && g_exit < 0.0 && g_exit >= -tolerance && probe_behind(x + (t_exit + tolerance) * r, i) >= 0.0)
+    return boxed;
+  if (!blocked && g_exit < 0.0) {
     t0 = t_exit;
     t_lo = t_exit;
     g_lo = g_exit;

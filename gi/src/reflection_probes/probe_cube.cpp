@@ -153,9 +153,22 @@ glm::vec3 distance_corrected_direction(const ProbeCube& cube, const glm::vec3& p
     const float t_exit = glm::dot(box_exit(p, r, box_min, box_max) - p, r);
     const float g_exit = g(t_exit), exit_distance = glm::length(x + t_exit * r);
     const float tolerance = box_side_tolerance * exit_distance;
-    if (g_exit >= 0.0f && g_exit <= tolerance) return boxed;
-    if (g_exit < 0.0f && g_exit >= -tolerance && g(t_exit + tolerance) >= 0.0f) return boxed;
-    if (g_exit < 0.0f)
+    // An object the ray passes clearly behind (by more than the tolerance) before the exit:
+    // the search as before.
+    bool blocked = false, front = false;
+    for (int k = 1; k <= kProbeSearchSteps && !blocked; ++k) {
+      const float a = static_cast<float>(k) / static_cast<float>(kProbeSearchSteps + 1);
+      const float t = scale * a / (1.0f - a);
+      if (t >= t_exit) break;
+      const float gt = g(t);
+      if (gt < 0.0f)
+        front = true;
+      else if (front && gt > box_side_tolerance * glm::length(x + t * r))
+        blocked = true;
+    }
+    if (!blocked && g_exit >= 0.0f && g_exit <= tolerance) return boxed;
+    if (!blocked && g_exit < 0.0f && g_exit >= -tolerance && g(t_exit + tolerance) >= 0.0f) return boxed;
+    if (!blocked && g_exit < 0.0f)
       t0 = t_exit, t_lo = t_exit, g_lo = g_exit, in_front = true,
       step_scale = std::max(exit_distance, kProbeMinSearchScaleM);
   }
