@@ -5,8 +5,9 @@
 // Per pixel: the probes whose box holds the point (grown by PROBE_BOX_MARGIN_M, so the floor
 // and walls the box was fitted to are inside it) each give their radiance along the
 // reflection direction corrected for parallax, by the capture's own distances when the probes
-// carry them (gi's distance_corrected_direction, probe_cube.h: a distance-impostor search
-// along the ray), else by the box (box_projected_direction), read at
+// carry them (gi's distance_corrected_direction, probe_cube.h: the box first where the probe
+// saw the box's side, else a distance-impostor search along the ray), else by the box
+// (box_projected_direction), read at
 // mip roughness x (levels - 1); they are blended by probe_weight (equal inside a room, faded
 // across the overlap of a corridor's segments). The split sum multiplies
 // that by the specular lobe's directional albedo (gltf_directional_albedo: Karis 2013's
@@ -45,16 +46,23 @@ uniform int u_probe_lobe_samples;  // 0: the split sum's single read; 1..PROBE_M
 const int PROBE_SEARCH_STEPS = 12;
 const int PROBE_SECANT_STEPS = 3;
 const float PROBE_MIN_SEARCH_SCALE_M = 0.05;
+// gi's probe_cube.h: kProbeBoxSideTolerance (the box first: the probe saw its side there).
+const float PROBE_BOX_SIDE_TOLERANCE = 0.1;
 // gi's probe_cube.h: kProbeMaxLobeSamples.
 const int PROBE_MAX_LOBE_SAMPLES = 16;
 
-// The direction from the probe's centre to where the ray from p along r leaves the box.
-vec3 probe_box_direction(vec3 p, vec3 r, ReflectionProbeBox probe) {
+// Where the ray from p (clamped onto the box) along r leaves the box (gi's box_exit).
+vec3 probe_box_exit(vec3 p, vec3 r, ReflectionProbeBox probe) {
   vec3 q = clamp(p, probe.box_min.xyz, probe.box_max.xyz);
   vec3 far_side = mix(probe.box_min.xyz, probe.box_max.xyz, step(vec3(0.0), r));
   vec3 t = (far_side - q) / mix(vec3(1e-20), r, notEqual(r, vec3(0.0)));
   t = mix(t, vec3(1e30), equal(r, vec3(0.0)));
-  vec3 d = q + min(t.x, min(t.y, t.z)) * r - probe.centre.xyz;
+  return q + min(t.x, min(t.y, t.z)) * r;
+}
+
+// The direction from the probe's centre to where the ray from p along r leaves the box.
+vec3 probe_box_direction(vec3 p, vec3 r, ReflectionProbeBox probe) {
+  vec3 d = probe_box_exit(p, r, probe) - probe.centre.xyz;
   return dot(d, d) > 1e-12 ? d : r;
 }
 
@@ -68,11 +76,38 @@ vec3 probe_direction(vec3 p, vec3 r, ReflectionProbeBox probe, int i) {
   if (u_probe_has_distances == 0) return boxed;
   vec3 x = p - probe.centre.xyz;
   float scale = max(length(x), PROBE_MIN_SEARCH_SCALE_M);
-  float t_lo = 0.0, g_lo = 0.0;
+  float t_lo = 0.0, g_lo = 0.0, t0 = 0.0;
   bool in_front = false;
-  for (int k = 1; k <= PROBE_SEARCH_STEPS; ++k) {
+  // The box first: the probe saw its side where the ray leaves it (the ray passes behind the
+  // surface there), or (farther, or a surface the ray grazes) an opening, searched on from the side.
+  float t_exit = dot(probe_box_exit(p, r, probe) - p, r);
+  float g_exit = probe_behind(x + t_exit * r, i), exit_distance = length(x + t_exit * r);
+  float tolerance = PROBE_BOX_SIDE_TOLERANCE * exit_distance;
+  // An object the ray passes clearly behind before the exit: the search as before.
+  bool blocked = false, front = false;
+  for (int k = 1; k <= PROBE_SEARCH_STEPS && !blocked; ++k) {
     float a = float(k) / float(PROBE_SEARCH_STEPS + 1);
     float t = scale * a / (1.0 - a);
+    if (t >= t_exit) break;
+    float g = probe_behind(x + t * r, i);
+    if (g < 0.0)
+      front = true;
+    else if (front && g > PROBE_BOX_SIDE_TOLERANCE * length(x + t * r))
+      blocked = true;
+  }
+  if (!blocked && g_exit >= 0.0 && g_exit <= tolerance) return boxed;
+  if (!blocked && g_exit < 0.0 && g_exit >= -tolerance && probe_behind(x + (t_exit + tolerance) * r, i) >= 0.0)
+    return boxed;
+  if (!blocked && g_exit < 0.0) {
+    t0 = t_exit;
+    t_lo = t_exit;
+    g_lo = g_exit;
+    in_front = true;
+    scale = max(exit_distance, PROBE_MIN_SEARCH_SCALE_M);
+  }
+  for (int k = 1; k <= PROBE_SEARCH_STEPS; ++k) {
+    float a = float(k) / float(PROBE_SEARCH_STEPS + 1);
+    float t = t0 + scale * a / (1.0 - a);
     float g = probe_behind(x + t * r, i);
     if (g < 0.0) {
       t_lo = t;

@@ -113,13 +113,25 @@ glm::vec3 cube_lookup_trilinear(const ProbeCube& cube, float lod, const glm::vec
   return glm::mix(a, b, l - static_cast<float>(lo));
 }
 
+// Where the ray from p (clamped onto the box) along r (not zero) leaves [box_min, box_max].
+glm::vec3 box_exit(const glm::vec3& p, const glm::vec3& r, const glm::vec3& box_min, const glm::vec3& box_max) {
+  const glm::vec3 q = glm::clamp(p, box_min, box_max);
+  float t = std::numeric_limits<float>::infinity();
+  for (int a = 0; a < 3; ++a) {
+    if (r[a] > 0.0f) t = std::min(t, (box_max[a] - q[a]) / r[a]);
+    if (r[a] < 0.0f) t = std::min(t, (box_min[a] - q[a]) / r[a]);
+  }
+  return q + t * r;
+}
+
 float cube_distance_bilinear(const ProbeCube& cube, const glm::vec3& d) {
   if (cube.distance.empty()) return kProbeFarDistance;
   return bilinear_level(cube.distance, cube.size, cube_coordinate(d));
 }
 
 glm::vec3 distance_corrected_direction(const ProbeCube& cube, const glm::vec3& p, const glm::vec3& r,
-                                       const glm::vec3& centre, const glm::vec3& box_min, const glm::vec3& box_max) {
+                                       const glm::vec3& centre, const glm::vec3& box_min, const glm::vec3& box_max,
+                                       float box_side_tolerance) {
   const glm::vec3 boxed = box_projected_direction(p, r, centre, box_min, box_max);
   if (cube.distance.empty()) return boxed;
   const glm::vec3 x = p - centre;
@@ -131,11 +143,38 @@ glm::vec3 distance_corrected_direction(const ProbeCube& cube, const glm::vec3& p
     const glm::vec3 q = x + t * r;
     return glm::length(q) - cube_distance_bilinear(cube, q);
   };
-  float t_lo = 0.0f, g_lo = 0.0f;
+  float t_lo = 0.0f, g_lo = 0.0f, t0 = 0.0f, step_scale = scale;
   bool in_front = false;
+  if (box_side_tolerance >= 0.0f) {
+    // The box first: where the probe saw a surface at the box's side, the box's answer is the
+    // ray's own hit; where it saw farther (an opening), search on from the side.
+    // A surface at the side is one the ray passes behind there: just past the exit (a ray that
+    // grazes a floor beyond an open side stays in front of it).
+    const float t_exit = glm::dot(box_exit(p, r, box_min, box_max) - p, r);
+    const float g_exit = g(t_exit), exit_distance = glm::length(x + t_exit * r);
+    const float tolerance = box_side_tolerance * exit_distance;
+    // An object the ray passes clearly behind (by more than the tolerance) before the exit:
+    // the search as before.
+    bool blocked = false, front = false;
+    for (int k = 1; k <= kProbeSearchSteps && !blocked; ++k) {
+      const float a = static_cast<float>(k) / static_cast<float>(kProbeSearchSteps + 1);
+      const float t = scale * a / (1.0f - a);
+      if (t >= t_exit) break;
+      const float gt = g(t);
+      if (gt < 0.0f)
+        front = true;
+      else if (front && gt > box_side_tolerance * glm::length(x + t * r))
+        blocked = true;
+    }
+    if (!blocked && g_exit >= 0.0f && g_exit <= tolerance) return boxed;
+    if (!blocked && g_exit < 0.0f && g_exit >= -tolerance && g(t_exit + tolerance) >= 0.0f) return boxed;
+    if (!blocked && g_exit < 0.0f)
+      t0 = t_exit, t_lo = t_exit, g_lo = g_exit, in_front = true,
+      step_scale = std::max(exit_distance, kProbeMinSearchScaleM);
+  }
   for (int k = 1; k <= kProbeSearchSteps; ++k) {
     const float a = static_cast<float>(k) / static_cast<float>(kProbeSearchSteps + 1);
-    const float t = scale * a / (1.0f - a), gt = g(t);
+    const float t = t0 + step_scale * a / (1.0f - a), gt = g(t);
     if (gt < 0.0f) {
       t_lo = t, g_lo = gt, in_front = true;
       continue;
@@ -250,27 +289,21 @@ glm::vec3 cube_lookup(const ProbeCube& cube, int level, const glm::vec3& d) {
 
 glm::vec3 box_projected_direction(const glm::vec3& p, const glm::vec3& r, const glm::vec3& centre,
                                   const glm::vec3& box_min, const glm::vec3& box_max) {
-  const glm::vec3 q = glm::clamp(p, box_min, box_max);
-  float t = std::numeric_limits<float>::infinity();
-  for (int a = 0; a < 3; ++a) {
-    if (r[a] > 0.0f) t = std::min(t, (box_max[a] - q[a]) / r[a]);
-    if (r[a] < 0.0f) t = std::min(t, (box_min[a] - q[a]) / r[a]);
-  }
-  const glm::vec3 d = q + t * r - centre;
+  const glm::vec3 d = box_exit(p, r, box_min, box_max) - centre;
   const float len = glm::length(d);
   return len > 1e-6f ? d / len : glm::normalize(r);
 }
 
 glm::vec3 probe_lobe_radiance(const ProbeCube& cube, const engine::GltfBrdf& brdf, const glm::vec3& p,
                               const glm::vec3& n, const glm::vec3& v, int samples, const glm::vec3& centre,
-                              const glm::vec3& box_min, const glm::vec3& box_max, bool box_only,
-                              const ProbeCube* chain) {
+                              const glm::vec3& box_min, const glm::vec3& box_max, bool box_only, const ProbeCube* chain,
+                              float box_side_tolerance) {
   const int count = std::clamp(samples, 1, kProbeMaxLobeSamples);
   const float alpha = brdf.alpha, a2 = alpha * alpha;
   const float nv = std::max(glm::dot(n, v), 1e-4f);
   const auto corrected = [&](const glm::vec3& l) {
     return box_only ? box_projected_direction(p, l, centre, box_min, box_max)
-                    : distance_corrected_direction(cube, p, l, centre, box_min, box_max);
+                    : distance_corrected_direction(cube, p, l, centre, box_min, box_max, box_side_tolerance);
   };
   // The frame (t, b, n) with v in the (t, n) plane; the shader builds the same one.
   glm::vec3 t = v - nv * n;

@@ -39,6 +39,13 @@ inline constexpr float kProbeFarDistance = 1e4f;
 inline constexpr int kProbeSearchSteps = 12;
 inline constexpr int kProbeSecantSteps = 3;
 inline constexpr float kProbeMinSearchScaleM = 0.05f;
+/// The distance-corrected lookup reads the box first: where the captured distance in the
+/// direction of the ray's exit from the box is within this fraction of the exit's distance
+/// from the probe, the probe saw the box's side there and the box's answer is taken (exact for
+/// a room's walls, floor and ceiling); farther (an opening) the search goes on from the exit,
+/// nearer (an object inside the box) it searches the whole ray. Negative: the search alone
+/// (before issue 36's "box first"). docs/reflection_probes.md, "The box first".
+inline constexpr float kProbeBoxSideTolerance = 0.1f;
 
 /// An empty (black) cube: `levels` levels from `size` (a power of two; levels <= log2(size) + 1).
 ProbeCube make_probe_cube(int size, int levels);
@@ -98,8 +105,11 @@ float cube_distance_bilinear(const ProbeCube& cube, const glm::vec3& d);
 /// its sides. Falls back to box_projected_direction when `p` itself is hidden from the centre
 /// or the cube has no distances, and to `r` when the ray leaves the scene. The same search as
 /// probe_direction() in the forward shader.
+/// First the box (kProbeBoxSideTolerance, `box_side_tolerance`): where the probe saw a surface
+/// at the box's side in the direction of the ray's exit, the box's answer.
 glm::vec3 distance_corrected_direction(const ProbeCube& cube, const glm::vec3& p, const glm::vec3& r,
-                                       const glm::vec3& centre, const glm::vec3& box_min, const glm::vec3& box_max);
+                                       const glm::vec3& centre, const glm::vec3& box_min, const glm::vec3& box_max,
+                                       float box_side_tolerance = kProbeBoxSideTolerance);
 
 /// The most lobe samples probe_lobe_radiance takes (the shader's PROBE_MAX_LOBE_SAMPLES).
 inline constexpr int kProbeMaxLobeSamples = 16;
@@ -125,10 +135,11 @@ inline constexpr int kProbeLobeSamples = 4;
 /// `chain` (optional, CPU only: the sweep's `lobe=fis_chain`, docs/reflection_probes.md): the
 /// samples read this box-filtered chain of level 0 (box_filtered_chain) instead, at the level
 /// whose texels span the sample's solid angle, + 1 (Colbert and Krivanek's own rule).
+/// `box_side_tolerance`: distance_corrected_direction's.
 glm::vec3 probe_lobe_radiance(const ProbeCube& cube, const engine::GltfBrdf& brdf, const glm::vec3& p,
                               const glm::vec3& n, const glm::vec3& v, int samples, const glm::vec3& centre,
                               const glm::vec3& box_min, const glm::vec3& box_max, bool box_only,
-                              const ProbeCube* chain = nullptr);
+                              const ProbeCube* chain = nullptr, float box_side_tolerance = kProbeBoxSideTolerance);
 
 /// Level 0 of `cube` and its 2 x 2 box averages down to one texel per face, as a cube (what
 /// the prefilter's samples read; its distances are level 0's).

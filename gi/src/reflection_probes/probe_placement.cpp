@@ -138,7 +138,8 @@ std::vector<ProbeVolume> place_probes(const RayCaster& caster, const glm::vec3& 
           if (!v) continue;
           const glm::vec3 size = v->box_max - v->box_min;
           if (std::min({size.x, size.y, size.z}) < settings.min_box_m) continue;
-          const glm::vec3 mid = 0.5f * (v->box_min + v->box_max);
+          glm::vec3 mid = 0.5f * (v->box_min + v->box_max);
+          if (settings.capture_height > 0.0f) mid.y = v->box_min.y + std::min(settings.capture_height, 0.5f * size.y);
           if (free_point(caster, mid, world_min, world_max)) v->centre = mid;
           add_probes(caster, *v, settings.corridor_aspect, world_min, world_max, probes);
           if (static_cast<int>(probes.size()) > settings.max_probes)

@@ -15,10 +15,10 @@
 // closes it in front of the wall. A candidate whose centre rays hit
 // a back face is inside solid geometry and places nothing; rays that escape stop at the
 // world's bounds (outdoors). The probe sits at its box's centre when that point is free,
-// else at the candidate. Boxes thinner than min_box_m are dropped. Optionally, a box much
-// longer than wide (corridor_aspect) becomes segments about as long as it is wide, each with its own probe
-// at its centre and its own box, reaching kProbeFadeM / 2 into its neighbours' so the
-// forward pass fades between them.
+// else at the candidate (or capture_height above its box's floor). Boxes thinner than min_box_m are dropped.
+// Optionally, a box much longer than wide (corridor_aspect) becomes segments about as long as it is wide, each with its
+// own probe at its centre and its own box, reaching kProbeFadeM / 2 into its neighbours' so the forward pass fades
+// between them.
 
 #include <vector>
 
@@ -40,6 +40,11 @@ struct ProbePlacementSettings {
   /// worse (docs/reflection_probes.md, "Where the corridor's error comes from"). Not stored in
   /// the bundle (the boxes are).
   float corridor_aspect = 0.0f;
+  /// When > 0, each probe is captured this far (m) above its box's floor (at most halfway up),
+  /// where the floor's reflections are seen, instead of at the box's middle; the parallax
+  /// correction reads from that point (docs/reflection_probes.md, "Capture height"). 0 (the
+  /// default): the box's middle. Not stored in the bundle (the capture points are).
+  float capture_height = 0.0f;
 };
 
 /// How far (m) the segments of a cut box reach into their neighbours: the width over which

@@ -227,6 +227,7 @@ std::string check_reflection_probe_settings(const ReflectionProbeSettings& s) {
   if (!(p.cell_m > 0.0f) || !std::isfinite(p.cell_m)) return "placement cell_m must be positive";
   if (!(p.spread_m >= 0.0f) || !(p.min_box_m >= 0.0f) || p.max_probes < 1 || p.max_probes > 256)
     return "placement spread_m, min_box_m >= 0 and max_probes in 1..256";
+  if (!(p.capture_height >= 0.0f) || !std::isfinite(p.capture_height)) return "placement capture_height must be >= 0";
   return {};
 }
 
@@ -300,13 +301,15 @@ ProbeCube ProbeCapturer::bake_at(const glm::vec3& centre) const {
   return cube;
 }
 
-glm::vec3 ProbeCapturer::radiance(const glm::vec3& origin, const glm::vec3& d) const {
+glm::vec3 ProbeCapturer::radiance(const glm::vec3& origin, const glm::vec3& d, float* distance) const {
   const CaptureScene c{impl_->prepared.scene, impl_->atlas,
                        impl_->prepared.live,  impl_->sky_uniform,
                        impl_->sky_gradient,   2.0f / static_cast<float>(impl_->settings.resolution)};
   std::uint32_t rays = 0;
-  float distance = 0.0f;
-  return capture_radiance(c, origin, d, rays, distance);
+  float t = -1.0f;
+  const glm::vec3 l = capture_radiance(c, origin, d, rays, t);
+  if (distance) *distance = t;
+  return l;
 }
 
 }  // namespace gi

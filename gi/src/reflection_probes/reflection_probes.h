@@ -111,8 +111,9 @@ class ProbeCapturer {
   /// A probe centred at `centre`, captured and prefiltered as the bake's probes are (the
   /// settings' resolution, supersample, prefilter samples); single-threaded.
   [[nodiscard]] ProbeCube bake_at(const glm::vec3& centre) const;
-  /// What one capture ray from `origin` along unit `d` returns (the renderer's radiance where it lands).
-  [[nodiscard]] glm::vec3 radiance(const glm::vec3& origin, const glm::vec3& d) const;
+  /// What one capture ray from `origin` along unit `d` returns (the renderer's radiance where it
+  /// lands); `distance` (optional): set to the distance to that surface, -1 when the ray escapes.
+  [[nodiscard]] glm::vec3 radiance(const glm::vec3& origin, const glm::vec3& d, float* distance = nullptr) const;
 
  private:
   struct Impl;

@@ -52,6 +52,14 @@ std::vector<KnobSpec> reflection_probes_knobs() {
        .kind = KnobKind::Choice,
        .default_grid = {"distance"},
        .choices = {"distance", "box"}},
+      {.name = "box_side",
+       .description = "the distances' lookup reads the box first where the captured distance at the ray's exit is "
+                      "within this fraction of the exit's (kProbeBoxSideTolerance, the default); negative: the search "
+                      "alone (the lookup before issue 36's box first)",
+       .kind = KnobKind::Real,
+       .default_grid = {format_number(kProbeBoxSideTolerance)},
+       .min_value = -1.0,
+       .max_value = 100},
       {.name = "lobe",
        .description = "the lookup's lobe: the split sum's (one read along the reflection, isotropic, n = v) or "
                       "filtered importance sampling of the lobe at the view (probe_lobe_radiance)",
@@ -70,15 +78,25 @@ std::vector<KnobSpec> reflection_probes_knobs() {
        .kind = KnobKind::Choice,
        .default_grid = {"off"},
        .choices = {"on", "off"}},
+      {.name = "capture_height",
+       .description = "metres above its box's floor each probe is captured at (0: the box's middle, the default; "
+                      "ProbePlacementSettings::capture_height)",
+       .kind = KnobKind::Real,
+       .default_grid = {"0"},
+       .min_value = 0.0,
+       .max_value = 100},
       {.name = "estimate",
-       .description = "what is scored (the diagnosis, docs/reflection_probes.md): runtime (the probes as the "
-                      "forward pass reads them); trace (the lobe through the capture's own radiance, traced from "
-                      "the texel: no probe); oracle_level0 / oracle (a probe captured at the texel itself, no "
-                      "parallax error: its level 0 under the exact lobe / read as the runtime reads); level0 "
-                      "(the placed probes' level 0 under the exact lobe, each sample parallax-corrected)",
+       .description =
+           "what is scored (the diagnosis, docs/reflection_probes.md): runtime (the probes as the "
+           "forward pass reads them); trace (the lobe through the capture's own radiance, traced from "
+           "the texel: no probe); oracle_level0 / oracle (a probe captured at the texel itself, no "
+           "parallax error: its level 0 under the exact lobe / read as the runtime reads); level0 "
+           "(the placed probes' level 0 under the exact lobe, each sample parallax-corrected); exact_parallax "
+           "(the placed probes without a cube map: each lobe sample's landing point, traced from the "
+           "texel, as the probe's centre sees it: what the probes' view of the world alone costs)",
        .kind = KnobKind::Choice,
        .default_grid = {"runtime"},
-       .choices = {"runtime", "trace", "oracle_level0", "oracle", "level0"}},
+       .choices = {"runtime", "trace", "oracle_level0", "oracle", "level0", "exact_parallax", "level0_exact_dir"}},
       {.name = "atlas",
        .description = "light-atlas preset whose irradiance the captures read on the static surfaces",
        .kind = KnobKind::Choice,
@@ -138,8 +156,8 @@ float depth_in_box(const ProbeVolume& v, const glm::vec3& p, const glm::vec3& n)
 // (probe_lobe_radiance), blended by probe_blend_weight (faded across segments), times the specular albedo.
 // `depth`: the largest depth_in_box over those probes. False where no box holds p.
 bool probe_specular(const ReflectionProbeSet& set, const engine::GltfBrdf& brdf, const glm::vec3& p, const glm::vec3& n,
-                    const glm::vec3& v, bool box_only, int lobe_samples, const std::vector<ProbeCube>* chains,
-                    glm::vec3& out, float& depth) {
+                    const glm::vec3& v, bool box_only, float box_side, int lobe_samples,
+                    const std::vector<ProbeCube>* chains, glm::vec3& out, float& depth) {
   const glm::vec3 r = glm::reflect(-v, n);
   glm::vec3 sum(0.0f);
   float weight = 0.0f;
@@ -151,11 +169,12 @@ bool probe_specular(const ReflectionProbeSet& set, const engine::GltfBrdf& brdf,
     const ProbeCube& cube = set.cubes[i];
     if (lobe_samples > 0) {
       sum += w * probe_lobe_radiance(cube, brdf, p, n, v, lobe_samples, pv.centre, pv.box_min, pv.box_max, box_only,
-                                     chains ? &(*chains)[i] : nullptr);
+                                     chains ? &(*chains)[i] : nullptr, box_side);
     } else {
       const float lod = std::sqrt(brdf.alpha) * static_cast<float>(cube.levels.size() - 1);
-      const glm::vec3 d = box_only ? box_projected_direction(p, r, pv.centre, pv.box_min, pv.box_max)
-                                   : distance_corrected_direction(cube, p, r, pv.centre, pv.box_min, pv.box_max);
+      const glm::vec3 d = box_only
+                              ? box_projected_direction(p, r, pv.centre, pv.box_min, pv.box_max)
+                              : distance_corrected_direction(cube, p, r, pv.centre, pv.box_min, pv.box_max, box_side);
       sum += w * cube_lookup_trilinear(cube, lod, d);
     }
     depth = std::max(depth, depth_in_box(pv, p, n));
@@ -219,6 +238,7 @@ engine::Result<BakedProbes> bake_probes(const RunContext& ctx, const BakeInput& 
   s.seed = ctx.seed;
   s.threads = ctx.threads;
   if (ctx.knobs.text("segments") == "on") s.placement.corridor_aspect = 2.0f;
+  s.placement.capture_height = static_cast<float>(ctx.knobs.real("capture_height"));
   auto set = bake_reflection_probes(input, b.source(), s);
   if (!set) return set.error();
   b.set = std::move(set).value();
@@ -249,24 +269,54 @@ glm::vec3 exact_lobe(const engine::GltfBrdf& brdf, const glm::vec3& n, const glm
   return sum / static_cast<float>(samples);
 }
 
-enum class Estimate { Runtime, Trace, OracleLevel0, Oracle, Level0 };
+enum class Estimate { Runtime, Trace, OracleLevel0, Oracle, Level0, ExactParallax, Level0ExactDir };
 
 Estimate estimate_of(const std::string& name) {
   if (name == "trace") return Estimate::Trace;
   if (name == "oracle_level0") return Estimate::OracleLevel0;
   if (name == "oracle") return Estimate::Oracle;
   if (name == "level0") return Estimate::Level0;
+  if (name == "exact_parallax") return Estimate::ExactParallax;
+  if (name == "level0_exact_dir") return Estimate::Level0ExactDir;
   return Estimate::Runtime;
 }
 
 // The diagnosis's estimates at texel t (`estimate` not Runtime): see the knob `estimate`.
 glm::vec3 diagnosis_estimate(Estimate estimate, const BakedProbes& b, const ProbeCapturer& capturer,
                              const engine::GltfBrdf& brdf, const glm::vec3& p, const glm::vec3& n, const glm::vec3& v,
-                             std::size_t t, bool box_only, int lobe_samples) {
+                             std::size_t t, bool box_only, float box_side, int lobe_samples) {
   const glm::vec3 origin = offset_ray_origin(p, n);
   if (estimate == Estimate::Trace)
     return exact_lobe(brdf, n, v, t, kTracedLobeSamples,
                       [&](const glm::vec3& l) { return capturer.radiance(origin, l); });
+  if (estimate == Estimate::ExactParallax || estimate == Estimate::Level0ExactDir) {
+    glm::vec3 sum(0.0f);
+    float weight = 0.0f;
+    for (std::size_t i = 0; i < b.set.probes.size(); ++i) {
+      const ProbeVolume& pv = b.set.probes[i];
+      const float w = probe_blend_weight(pv, p, kBoxMarginM);
+      if (!(w > 0.0f)) continue;
+      if (estimate == Estimate::Level0ExactDir) {
+        sum += w * exact_lobe(brdf, n, v, t, kTracedLobeSamples, [&](const glm::vec3& l) {
+                 float distance = -1.0f;
+                 (void)capturer.radiance(origin, l, &distance);
+                 const glm::vec3 to = distance < 0.0f ? l : origin + distance * l - pv.centre;
+                 return cube_lookup_trilinear(b.set.cubes[i], 0.0f, glm::dot(to, to) > 1e-12f ? to : l);
+               });
+        weight += w;
+        continue;
+      }
+      sum += w * exact_lobe(brdf, n, v, t, kTracedLobeSamples, [&](const glm::vec3& l) {
+               float distance = -1.0f;
+               const glm::vec3 direct = capturer.radiance(origin, l, &distance);
+               if (distance < 0.0f) return direct;  // the sky: the same from anywhere
+               const glm::vec3 to = origin + distance * l - pv.centre;
+               return glm::dot(to, to) > 1e-12f ? capturer.radiance(pv.centre, glm::normalize(to)) : direct;
+             });
+      weight += w;
+    }
+    return weight > 0.0f ? sum / weight : glm::vec3(0.0f);
+  }
   if (estimate == Estimate::Level0) {
     glm::vec3 sum(0.0f);
     float weight = 0.0f;
@@ -276,9 +326,9 @@ glm::vec3 diagnosis_estimate(Estimate estimate, const BakedProbes& b, const Prob
       if (!(w > 0.0f)) continue;
       const ProbeCube& cube = b.set.cubes[i];
       sum += w * exact_lobe(brdf, n, v, t, kExactLobeSamples, [&](const glm::vec3& l) {
-               const glm::vec3 d = box_only
-                                       ? box_projected_direction(p, l, pv.centre, pv.box_min, pv.box_max)
-                                       : distance_corrected_direction(cube, p, l, pv.centre, pv.box_min, pv.box_max);
+               const glm::vec3 d =
+                   box_only ? box_projected_direction(p, l, pv.centre, pv.box_min, pv.box_max)
+                            : distance_corrected_direction(cube, p, l, pv.centre, pv.box_min, pv.box_max, box_side);
                return cube_lookup_trilinear(cube, 0.0f, d);
              });
       weight += w;
@@ -324,7 +374,7 @@ void dump_texels(const RunContext& ctx, const AtlasTexels& tex, const std::vecto
 // With the knob `estimate` other than runtime: `values` at the covered texels replaced by the
 // diagnosis's estimate.
 engine::Status diagnose(const RunContext& ctx, const BakedProbes& baked, const BakeInput& input, const GlossyTexels& g,
-                        const std::vector<std::uint8_t>& covered, bool box_only, int lobe_samples,
+                        const std::vector<std::uint8_t>& covered, bool box_only, float box_side, int lobe_samples,
                         std::vector<glm::vec3>& values) {
   const Estimate estimate = estimate_of(ctx.knobs.text("estimate"));
   if (estimate == Estimate::Runtime) return {};
@@ -336,7 +386,7 @@ engine::Status diagnose(const RunContext& ctx, const BakedProbes& baked, const B
     if (!covered[t]) return;
     const glm::vec3 v = glm::normalize(g.eye - tex.position[t]);
     values[t] = diagnosis_estimate(estimate, baked, *capturer, g.brdf[t], tex.position[t], tex.normal[t], v, t,
-                                   box_only, lobe_samples);
+                                   box_only, box_side, lobe_samples);
   });
   return {};
 }
@@ -368,6 +418,7 @@ engine::Result<MethodOutput> run_reflection_probes(const RunContext& ctx) {
   std::vector<std::uint8_t> covered(tex.valid.size(), 0), inner(tex.valid.size(), 0), edge(tex.valid.size(), 0);
   std::size_t uncovered = 0;
   const bool box_only = ctx.knobs.text("parallax") == "box";
+  const auto box_side = static_cast<float>(ctx.knobs.real("box_side"));
   const int lobe_samples =
       ctx.knobs.text("lobe") != "split_sum" ? static_cast<int>(ctx.knobs.integer("lobe_samples")) : 0;
   const std::vector<ProbeCube> chains = lookup_chains(ctx, *set);
@@ -375,7 +426,7 @@ engine::Result<MethodOutput> run_reflection_probes(const RunContext& ctx) {
     if (!g->glossy[t]) continue;
     float depth = 0.0f;
     const glm::vec3 v = glm::normalize(g->eye - tex.position[t]);
-    if (!probe_specular(*set, g->brdf[t], tex.position[t], tex.normal[t], v, box_only, lobe_samples,
+    if (!probe_specular(*set, g->brdf[t], tex.position[t], tex.normal[t], v, box_only, box_side, lobe_samples,
                         chains.empty() ? nullptr : &chains, values[t], depth)) {
       ++uncovered;
       continue;
@@ -383,7 +434,7 @@ engine::Result<MethodOutput> run_reflection_probes(const RunContext& ctx) {
     covered[t] = 1;
     (depth < border ? edge : inner)[t] = 1;
   }
-  if (auto diagnosed = diagnose(ctx, *baked, input, *g, covered, box_only, lobe_samples, values); !diagnosed)
+  if (auto diagnosed = diagnose(ctx, *baked, input, *g, covered, box_only, box_side, lobe_samples, values); !diagnosed)
     return diagnosed.error();
   dump_texels(ctx, tex, values, inner, covered);
   MethodOutput out;
