@@ -16,7 +16,8 @@
 // GI_BREAKDOWN_DENOISE=passes, GI_BREAKDOWN_EMITTERS=rays and GI_BREAKDOWN_SOURCE=r (the
 // denoiser's passes, the emitter rays, the source filter's radius in texels), GI_BREAKDOWN_WORST=N (the N worst
 // texels), GI_BREAKDOWN_TEXEL=i,j (per texel: its normals and face, 16 rays and what they read, the path tracer there
-// at 0, 1 and all bounces).
+// at 0, 1 and all bounces), GI_BREAKDOWN_DENOISE_GRID=passes:sigma,... (denoiser settings on one gather, a
+// line each).
 #include <engine/gltf.h>
 #include <engine/sun.h>
 #include <gi/bake_input.h>
@@ -143,6 +144,11 @@ int main(int argc, char** argv) {
     g.near_regather_rays = std::atoi(r);
     if (const char* c = std::strchr(r, ',')) g.near_regather_texels = std::strtof(c + 1, nullptr);
   }
+  // GI_BREAKDOWN_DENOISE_GRID=passes:sigma,...: the gathers once, unfiltered, then each
+  // denoiser setting on copies of them, one line each (the whole lightmap and the
+  // indirect-dominated texels), instead of the table.
+  const char* denoise_grid = std::getenv("GI_BREAKDOWN_DENOISE_GRID");
+  g.part_only = denoise_grid != nullptr;
   auto gathered = gi::gather_atlas(*scene, *layout, g, pool);
   if (!gathered) return std::fprintf(stderr, "%s\n", gathered.error().to_string().c_str()), 1;
   // GI_BREAKDOWN_SEEDS=2: a second gather of another seed; the two differ by the gather's noise,
@@ -169,6 +175,38 @@ int main(int argc, char** argv) {
     rd[k] = truth->direct;
     ri[k] = truth->indirect;
     save_cache(file, rd[k], ri[k]);
+  }
+
+  if (denoise_grid) {
+    for (const char* e = denoise_grid; e && *e; e = std::strchr(e, ',') ? std::strchr(e, ',') + 1 : nullptr) {
+      gi::TexelGatherSettings f = g;
+      char* rest = nullptr;
+      f.denoise_passes = static_cast<int>(std::strtol(e, &rest, 10));
+      f.denoise_sigma = std::strtof(rest + 1, &rest);
+      f.part_only = false;
+      gi::TexelGatherResult a = *gathered, b = second ? *second : *gathered;
+      if (!gi::filter_gathered(*scene, *layout, f, pool, a) || !gi::filter_gathered(*scene, *layout, f, pool, b))
+        return std::fprintf(stderr, "filter_gathered failed\n"), 1;
+      Sums whole, dominated;
+      for (std::size_t i = 0; i < n; ++i) {
+        if (!scene->texels.valid[i]) continue;
+        const glm::dvec3 va(a.direct[i] + a.baked_direct[i] + a.indirect[i]),
+            vb(b.direct[i] + b.baked_direct[i] + b.indirect[i]);
+        const glm::dvec3 r1(rd[0][i] + ri[0][i]), r2(rd[1][i] + ri[1][i]);
+        whole.add(va, r1, r2), whole.add_second(va, vb);
+        const glm::dvec3 rim = 0.5 * glm::dvec3(ri[0][i] + ri[1][i]), rm = 0.5 * (r1 + r2);
+        if (rim.x + rim.y + rim.z >= 0.8 * (rm.x + rm.y + rm.z)) dominated.add(va, r1, r2), dominated.add_second(va, vb);
+      }
+      const auto rel = [](const Sums& x, double e2) { return std::sqrt(e2 / std::max(1e-30, x.ref2 - x.noise2)); };
+      std::printf(
+          "denoise %d passes, sigma %.2f: whole %.4f (noise %.4f, floor %.4f, bias %+.4f); "
+          "indirect-dominated %.4f (noise %.4f, floor %.4f, bias %+.4f)\n",
+          f.denoise_passes, static_cast<double>(f.denoise_sigma),
+          rel(whole, whole.truth_err2()), rel(whole, whole.gather_noise2), rel(whole, whole.floor_err2()),
+          whole.diff / whole.ref, rel(dominated, dominated.truth_err2()), rel(dominated, dominated.gather_noise2),
+          rel(dominated, dominated.floor_err2()), dominated.diff / dominated.ref);
+    }
+    return 0;
   }
 
   // The sun's unshadowed irradiance at each texel, to find its shadow edges.
@@ -208,6 +246,9 @@ int main(int argc, char** argv) {
   std::map<std::string, Sums> by;
   std::map<int, Sums> by_material, by_chart;
   std::map<std::string, Sums> by_dominated;
+  // Per texel, for GI_BREAKDOWN_WORST_OF: 1 hidden, 2 sandwiched, 4 thin chart, 8 chart border,
+  // 16 indirect-dominated.
+  std::vector<std::uint8_t> kinds(n, 0);
   for (int y = 0; y < tx.height; ++y)
     for (int x = 0; x < tx.width; ++x) {
       const std::size_t i = tx.index(x, y);
@@ -253,8 +294,11 @@ int main(int argc, char** argv) {
       into(by_chart[sz.x * sz.y <= 16 ? 16 : sz.x * sz.y <= 64 ? 64 : sz.x * sz.y <= 256 ? 256 : 1 << 30]);
       // The measure: texels whose truth indirect is >= 80% of the truth total.
       const glm::dvec3 ri_mean = 0.5 * glm::dvec3(ri[0][i] + ri[1][i]), r_mean = 0.5 * (r1 + r2);
-      if (ri_mean.x + ri_mean.y + ri_mean.z >= 0.8 * (r_mean.x + r_mean.y + r_mean.z)) {
-        const bool thin = std::min(sz.x, sz.y) <= 4;  // the footprint includes the 1-texel rims
+      const bool thin = std::min(sz.x, sz.y) <= 4;  // the footprint includes the 1-texel rims
+      const bool dominated = ri_mean.x + ri_mean.y + ri_mean.z >= 0.8 * (r_mean.x + r_mean.y + r_mean.z);
+      kinds[i] = static_cast<std::uint8_t>((gathered->hidden[i] ? 1 : 0) | (sandwiched[i] ? 2 : 0) |
+                                           (thin ? 4 : 0) | (border ? 8 : 0) | (dominated ? 16 : 0));
+      if (dominated) {
         into(by_dominated["all"]);
         into(by_dominated[gathered->hidden[i] ? "hidden" : border ? "chart border" : "chart interior"]);
         if (thin) into(by_dominated["thin chart (<= 4 texels across)"]);
@@ -342,10 +386,13 @@ int main(int argc, char** argv) {
     }
   }
   // GI_BREAKDOWN_WORST=N: the N texels of the largest error, one line each.
+  // GI_BREAKDOWN_WORST_OF=bits: only texels with all these kind bits (see `kinds`).
   if (const char* worst = std::getenv("GI_BREAKDOWN_WORST")) {
+    const char* of = std::getenv("GI_BREAKDOWN_WORST_OF");
+    const auto mask = static_cast<std::uint8_t>(of ? std::atoi(of) : 0);
     std::vector<std::pair<double, std::size_t>> err;
     for (std::size_t i = 0; i < n; ++i)
-      if (tx.valid[i]) {
+      if (tx.valid[i] && (kinds[i] & mask) == mask) {
         const double a =
             static_cast<double>(gathered->direct[i].y + gathered->baked_direct[i].y + gathered->indirect[i].y);
         const double r = 0.5 * static_cast<double>(rd[0][i].y + ri[0][i].y + rd[1][i].y + ri[1][i].y);
@@ -355,10 +402,10 @@ int main(int argc, char** argv) {
     for (std::size_t k = 0; k < std::min<std::size_t>(err.size(), std::strtoul(worst, nullptr, 10)); ++k) {
       const std::size_t i = err[k].second;
       std::printf(
-          "texel %zu (%d, %d) chart %d hidden %d p (%.3f %.3f %.3f) n (%.3f %.3f %.3f): gather direct %.2f + %.2f "
+          "texel %zu (%d, %d) chart %d kinds %d hidden %d p (%.3f %.3f %.3f) n (%.3f %.3f %.3f): gather direct %.2f + %.2f "
           "indirect %.2f; path tracer direct %.2f / %.2f indirect %.2f / %.2f\n",
           i, static_cast<int>(i % static_cast<std::size_t>(tx.width)),
-          static_cast<int>(i / static_cast<std::size_t>(tx.width)), tx.chart[i], gathered->hidden[i],
+          static_cast<int>(i / static_cast<std::size_t>(tx.width)), tx.chart[i], kinds[i], gathered->hidden[i],
           static_cast<double>(tx.position[i].x), static_cast<double>(tx.position[i].y),
           static_cast<double>(tx.position[i].z), static_cast<double>(tx.normal[i].x),
           static_cast<double>(tx.normal[i].y), static_cast<double>(tx.normal[i].z),

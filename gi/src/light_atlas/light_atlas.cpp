@@ -478,6 +478,10 @@ engine::Result<LightAtlasSettings> light_atlas_preset(std::string_view name) {
   // up to a texel away in other light (corners, ledges, small charts). Sponza 7.12% / 1.77% ->
   // 6.03% / 1.46%; the Cornell box 1.280% -> 1.266% (docs/light_atlas.md, "Near landings
   // regather at their point").
+  // Since the eleventh session: only the punctual lights' and the sun's direct light at every
+  // landing; an area light's one sample there was noise its texels' samples do not have (the
+  // Cornell box 1.266% -> 1.155%; Sponza, sun and sky only, unchanged; docs/light_atlas.md,
+  // "The area lights at landings").
   s.final_pass = LightAtlasSettings::FinalPass::TexelGather;
   s.gather.filter_radius_texels = 0.0f;
   s.gather.denoise_passes = 2;
