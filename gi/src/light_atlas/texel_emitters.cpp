@@ -95,6 +95,8 @@ void TexelEmitters::build_clusters(const std::vector<std::pair<std::uint64_t, st
   std::vector<float> area(tx.valid.size(), 0.0f);
   members_.reserve(keyed.size());
   member_cdf_.reserve(keyed.size());
+  member_points_.reserve(keyed.size());
+  member_guide_.reserve(keyed.size());
   for (std::size_t k = 0; k < keyed.size();) {
     std::size_t end = k;
     while (end < keyed.size() && keyed[end].first == keyed[k].first) ++end;
@@ -108,7 +110,9 @@ void TexelEmitters::build_clusters(const std::vector<std::pair<std::uint64_t, st
       members_.push_back(j);
       centre += glm::dvec3(tx.position[j]);
       normal += glm::dvec3(face[j]);
-      area[j] = square_map(*scene_, *layout_, j).texel_area;
+      const SquareMap sq = square_map(*scene_, *layout_, j);
+      area[j] = sq.texel_area;
+      member_points_.push_back({.p0 = sq.p0, .e1 = sq.e1, .e2 = sq.e2, .a0 = sq.a0, .inverse = sq.inverse});
       power.push_back(area[j] > 0.0f ? static_cast<double>(std::max(luminance(radiosity[j]), 0.0f) * area[j]) : 0.0);
       c.power += power.back();
     }
@@ -124,8 +128,17 @@ void TexelEmitters::build_clusters(const std::vector<std::pair<std::uint64_t, st
       running += power[m - k];
       member_cdf_.push_back(c.power > 0.0 ? static_cast<float>(running / c.power) : 0.0f);
       if (c.power > 0.0 && area[j] > 0.0f) density_[j] = static_cast<float>(power[m - k] / c.power) / area[j];
+      if (density_[j] > 0.0f) member_points_[c.first + (m - k)].texel = j;
     }
     if (c.power > 0.0) member_cdf_.back() = 1.0f;
+    // The cutpoint table: entry g is the first member whose CDF exceeds g / n.
+    const auto n = static_cast<float>(end - k);
+    std::uint32_t first_above = c.first;
+    for (std::size_t g = 0; g < end - k; ++g) {
+      const float threshold = static_cast<float>(g) / n;
+      while (first_above < c.end && !(threshold < member_cdf_[first_above])) ++first_above;
+      member_guide_.push_back(first_above);
+    }
     clusters_.push_back(c);
     k = end;
   }
@@ -186,18 +199,30 @@ TexelEmitters::Sample TexelEmitters::sample(std::uint32_t group, float u, float 
   const float lo = c > 0 ? row[c - 1] : 0.0f;
   const float u2 = std::clamp((u - lo) / (row[c] - lo), 0.0f, 0x1.fffffep-1f);
   const Cluster& cl = clusters_[c];
-  const float* cdf = member_cdf_.data();
-  const auto m = static_cast<std::uint32_t>(std::upper_bound(cdf + cl.first, cdf + cl.end, u2) - cdf);
+  const std::uint32_t m = member_of(cl, u2);
   if (m >= cl.end) return {};
-  const std::uint32_t j = members_[m];
-  if (!(density_[j] > 0.0f)) return {};
-  const SquareMap sq = square_map(*scene_, *layout_, j);
+  const MemberPoint& sq = member_points_[m];
+  const std::uint32_t j = sq.texel;
+  if (j == kNone) return {};
   const int x = static_cast<int>(j % static_cast<std::uint32_t>(width_));
   const int y = static_cast<int>(j / static_cast<std::uint32_t>(width_));
   const glm::vec2 uv((static_cast<float>(x) + v) / static_cast<float>(width_),
                      (static_cast<float>(y) + w) / static_cast<float>(height_));
   const glm::vec2 bary = sq.inverse * (uv - sq.a0);
   return {j, sq.p0 + bary.x * sq.e1 + bary.y * sq.e2};
+}
+
+// std::upper_bound(cdf + first, cdf + end, u) over the cluster's members, started at the
+// cutpoint table's entry for u (stepped back should rounding have put it past the answer).
+std::uint32_t TexelEmitters::member_of(const Cluster& c, float u) const {
+  const std::uint32_t n = c.end - c.first;
+  if (n == 0) return c.end;
+  const float* cdf = member_cdf_.data();
+  const auto g = std::min(n - 1, static_cast<std::uint32_t>(u * static_cast<float>(n)));
+  std::uint32_t m = member_guide_[c.first + g];
+  while (m > c.first && u < cdf[m - 1]) --m;
+  while (m < c.end && !(u < cdf[m])) ++m;
+  return m;
 }
 
 float TexelEmitters::area_pdf(std::uint32_t group, std::uint32_t texel) const {
