@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 namespace gi {
@@ -13,6 +14,7 @@ constexpr std::uint32_t kNone = TexelEmitters::Sample::kNone;
 constexpr std::size_t kMaxClusters = 2048;
 // A cluster whose normals spread less than this (radians) is flat enough for the plane test.
 constexpr float kFlatCone = 0.05f;
+constexpr float kInfinity = std::numeric_limits<float>::infinity();
 
 float luminance(const glm::vec3& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 
@@ -133,11 +135,13 @@ void TexelEmitters::build_clusters(const std::vector<std::pair<std::uint64_t, st
     if (c.power > 0.0) member_cdf_.back() = 1.0f;
     // The cutpoint table: entry g is the first member whose CDF exceeds g / n.
     const auto n = static_cast<float>(end - k);
+    const auto cdf_of = [&](std::uint32_t m) { return m >= c.end ? kInfinity : member_cdf_[m]; };
     std::uint32_t first_above = c.first;
     for (std::size_t g = 0; g < end - k; ++g) {
       const float threshold = static_cast<float>(g) / n;
       while (first_above < c.end && !(threshold < member_cdf_[first_above])) ++first_above;
-      member_guide_.push_back(first_above);
+      const float before = first_above > c.first ? member_cdf_[first_above - 1] : -kInfinity;
+      member_guide_.push_back({first_above, before, cdf_of(first_above), cdf_of(first_above + 1)});
     }
     clusters_.push_back(c);
     k = end;
@@ -217,9 +221,14 @@ TexelEmitters::Sample TexelEmitters::sample(std::uint32_t group, float u, float 
 std::uint32_t TexelEmitters::member_of(const Cluster& c, float u) const {
   const std::uint32_t n = c.end - c.first;
   if (n == 0) return c.end;
-  const float* cdf = member_cdf_.data();
   const auto g = std::min(n - 1, static_cast<std::uint32_t>(u * static_cast<float>(n)));
-  std::uint32_t m = member_guide_[c.first + g];
+  const Guide& guide = member_guide_[c.first + g];
+  std::uint32_t m = guide.member;
+  if (!(u < guide.cdf_before)) {  // the answer is m or after it
+    if (u < guide.cdf_at) return m;
+    if (u < guide.cdf_next) return m + 1;
+  }
+  const float* cdf = member_cdf_.data();
   while (m > c.first && u < cdf[m - 1]) --m;
   while (m < c.end && !(u < cdf[m])) ++m;
   return m;

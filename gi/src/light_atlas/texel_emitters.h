@@ -98,9 +98,15 @@ class TexelEmitters {
 
   // Parallel to members_.
   std::vector<MemberPoint> member_points_;
-  // Parallel to members_: in a cluster of n members, guide entry k is the first member whose
-  // CDF exceeds k / n (a cutpoint table: the draw starts its search there, not at the front).
-  std::vector<std::uint32_t> member_guide_;
+  // Parallel to members_: in a cluster of n members, guide entry k holds the first member m
+  // whose CDF exceeds k / n (a cutpoint table: the draw starts its search there, not at the
+  // front) and the CDF at m - 1, m and m + 1 (-inf before the cluster, +inf past it), so that
+  // most draws end without reading member_cdf_.
+  struct Guide {
+    std::uint32_t member = 0;
+    float cdf_before = 0.0f, cdf_at = 0.0f, cdf_next = 0.0f;
+  };
+  std::vector<Guide> member_guide_;
 };
 
 }  // namespace gi
