@@ -195,17 +195,27 @@ float TexelEmitters::row_probability(std::uint32_t group, std::uint32_t cluster)
 }
 
 TexelEmitters::Sample TexelEmitters::sample(std::uint32_t group, float u, float v, float w) const {
-  if (row_empty_[group]) return {};
+  return place(pick(group, u), v, w);
+}
+
+std::uint32_t TexelEmitters::pick(std::uint32_t group, float u) const {
+  if (row_empty_[group]) return kNoMember;
   const std::size_t k = clusters_.size();
   const float* row = &row_cdf_[static_cast<std::size_t>(group) * k];
   const auto c = static_cast<std::uint32_t>(std::upper_bound(row, row + k, u) - row);
-  if (c >= k) return {};
+  if (c >= k) return kNoMember;
   const float lo = c > 0 ? row[c - 1] : 0.0f;
   const float u2 = std::clamp((u - lo) / (row[c] - lo), 0.0f, 0x1.fffffep-1f);
   const Cluster& cl = clusters_[c];
   const std::uint32_t m = member_of(cl, u2);
-  if (m >= cl.end) return {};
-  const MemberPoint& sq = member_points_[m];
+  if (m >= cl.end) return kNoMember;
+  __builtin_prefetch(&member_points_[m]);
+  return m;
+}
+
+TexelEmitters::Sample TexelEmitters::place(std::uint32_t member, float v, float w) const {
+  if (member == kNoMember) return {};
+  const MemberPoint& sq = member_points_[member];
   const std::uint32_t j = sq.texel;
   if (j == kNone) return {};
   const int x = static_cast<int>(j % static_cast<std::uint32_t>(width_));

@@ -54,6 +54,12 @@ class TexelEmitters {
   /// Draws a texel and a point on it for receiver group `group` from three uniforms in [0, 1)
   /// (u picks the texel, v and w the point in its square).
   Sample sample(std::uint32_t group, float u, float v, float w) const;
+  /// sample() in two halves: pick() draws the member from u (kNoMember when none) and starts
+  /// loading its record; place(member, v, w) is then sample(group, u, v, w). Picks made ahead
+  /// of their rays overlap their cache misses.
+  static constexpr std::uint32_t kNoMember = 0xffffffffu;
+  std::uint32_t pick(std::uint32_t group, float u) const;
+  Sample place(std::uint32_t member, float v, float w) const;
   /// Density (1/m^2) of sample(group, ...) at a point inside atlas texel `texel` (0 when it
   /// is not a valid texel or does not emit).
   float area_pdf(std::uint32_t group, std::uint32_t texel) const;
