@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 namespace gi {
@@ -13,6 +14,7 @@ constexpr std::uint32_t kNone = TexelEmitters::Sample::kNone;
 constexpr std::size_t kMaxClusters = 2048;
 // A cluster whose normals spread less than this (radians) is flat enough for the plane test.
 constexpr float kFlatCone = 0.05f;
+constexpr float kInfinity = std::numeric_limits<float>::infinity();
 
 float luminance(const glm::vec3& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 
@@ -95,6 +97,8 @@ void TexelEmitters::build_clusters(const std::vector<std::pair<std::uint64_t, st
   std::vector<float> area(tx.valid.size(), 0.0f);
   members_.reserve(keyed.size());
   member_cdf_.reserve(keyed.size());
+  member_points_.reserve(keyed.size());
+  member_guide_.reserve(keyed.size());
   for (std::size_t k = 0; k < keyed.size();) {
     std::size_t end = k;
     while (end < keyed.size() && keyed[end].first == keyed[k].first) ++end;
@@ -108,7 +112,9 @@ void TexelEmitters::build_clusters(const std::vector<std::pair<std::uint64_t, st
       members_.push_back(j);
       centre += glm::dvec3(tx.position[j]);
       normal += glm::dvec3(face[j]);
-      area[j] = square_map(*scene_, *layout_, j).texel_area;
+      const SquareMap sq = square_map(*scene_, *layout_, j);
+      area[j] = sq.texel_area;
+      member_points_.push_back({.p0 = sq.p0, .e1 = sq.e1, .e2 = sq.e2, .a0 = sq.a0, .inverse = sq.inverse});
       power.push_back(area[j] > 0.0f ? static_cast<double>(std::max(luminance(radiosity[j]), 0.0f) * area[j]) : 0.0);
       c.power += power.back();
     }
@@ -124,8 +130,19 @@ void TexelEmitters::build_clusters(const std::vector<std::pair<std::uint64_t, st
       running += power[m - k];
       member_cdf_.push_back(c.power > 0.0 ? static_cast<float>(running / c.power) : 0.0f);
       if (c.power > 0.0 && area[j] > 0.0f) density_[j] = static_cast<float>(power[m - k] / c.power) / area[j];
+      if (density_[j] > 0.0f) member_points_[c.first + (m - k)].texel = j;
     }
     if (c.power > 0.0) member_cdf_.back() = 1.0f;
+    // The cutpoint table: entry g is the first member whose CDF exceeds g / n.
+    const auto n = static_cast<float>(end - k);
+    const auto cdf_of = [&](std::uint32_t m) { return m >= c.end ? kInfinity : member_cdf_[m]; };
+    std::uint32_t first_above = c.first;
+    for (std::size_t g = 0; g < end - k; ++g) {
+      const float threshold = static_cast<float>(g) / n;
+      while (first_above < c.end && !(threshold < member_cdf_[first_above])) ++first_above;
+      const float before = first_above > c.first ? member_cdf_[first_above - 1] : -kInfinity;
+      member_guide_.push_back({first_above, before, cdf_of(first_above), cdf_of(first_above + 1)});
+    }
     clusters_.push_back(c);
     k = end;
   }
@@ -178,26 +195,53 @@ float TexelEmitters::row_probability(std::uint32_t group, std::uint32_t cluster)
 }
 
 TexelEmitters::Sample TexelEmitters::sample(std::uint32_t group, float u, float v, float w) const {
-  if (row_empty_[group]) return {};
+  return place(pick(group, u), v, w);
+}
+
+std::uint32_t TexelEmitters::pick(std::uint32_t group, float u) const {
+  if (row_empty_[group]) return kNoMember;
   const std::size_t k = clusters_.size();
   const float* row = &row_cdf_[static_cast<std::size_t>(group) * k];
   const auto c = static_cast<std::uint32_t>(std::upper_bound(row, row + k, u) - row);
-  if (c >= k) return {};
+  if (c >= k) return kNoMember;
   const float lo = c > 0 ? row[c - 1] : 0.0f;
   const float u2 = std::clamp((u - lo) / (row[c] - lo), 0.0f, 0x1.fffffep-1f);
   const Cluster& cl = clusters_[c];
-  const float* cdf = member_cdf_.data();
-  const auto m = static_cast<std::uint32_t>(std::upper_bound(cdf + cl.first, cdf + cl.end, u2) - cdf);
-  if (m >= cl.end) return {};
-  const std::uint32_t j = members_[m];
-  if (!(density_[j] > 0.0f)) return {};
-  const SquareMap sq = square_map(*scene_, *layout_, j);
+  const std::uint32_t m = member_of(cl, u2);
+  if (m >= cl.end) return kNoMember;
+  __builtin_prefetch(&member_points_[m]);
+  return m;
+}
+
+TexelEmitters::Sample TexelEmitters::place(std::uint32_t member, float v, float w) const {
+  if (member == kNoMember) return {};
+  const MemberPoint& sq = member_points_[member];
+  const std::uint32_t j = sq.texel;
+  if (j == kNone) return {};
   const int x = static_cast<int>(j % static_cast<std::uint32_t>(width_));
   const int y = static_cast<int>(j / static_cast<std::uint32_t>(width_));
   const glm::vec2 uv((static_cast<float>(x) + v) / static_cast<float>(width_),
                      (static_cast<float>(y) + w) / static_cast<float>(height_));
   const glm::vec2 bary = sq.inverse * (uv - sq.a0);
   return {j, sq.p0 + bary.x * sq.e1 + bary.y * sq.e2};
+}
+
+// std::upper_bound(cdf + first, cdf + end, u) over the cluster's members, started at the
+// cutpoint table's entry for u (stepped back should rounding have put it past the answer).
+std::uint32_t TexelEmitters::member_of(const Cluster& c, float u) const {
+  const std::uint32_t n = c.end - c.first;
+  if (n == 0) return c.end;
+  const auto g = std::min(n - 1, static_cast<std::uint32_t>(u * static_cast<float>(n)));
+  const Guide& guide = member_guide_[c.first + g];
+  std::uint32_t m = guide.member;
+  if (!(u < guide.cdf_before)) {  // the answer is m or after it
+    if (u < guide.cdf_at) return m;
+    if (u < guide.cdf_next) return m + 1;
+  }
+  const float* cdf = member_cdf_.data();
+  while (m > c.first && u < cdf[m - 1]) --m;
+  while (m < c.end && !(u < cdf[m])) ++m;
+  return m;
 }
 
 float TexelEmitters::area_pdf(std::uint32_t group, std::uint32_t texel) const {

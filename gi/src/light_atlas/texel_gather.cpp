@@ -3,6 +3,7 @@
 #include <engine/sky.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <numbers>
@@ -217,9 +218,17 @@ FreshGather gather_texel(const StaticBakeScene& b, const AtlasLayout& layout, co
   Pcg32 rng = Pcg32::for_item(s.seed, stream_id(i, kEmitterStream));
   const float shift_y = rng.next_float();  // drawn first: see random.h
   const glm::vec2 shift(rng.next_float(), shift_y);
+  // The members drawn ahead, kPicked rays at a time (their u does not depend on the rays),
+  // so that their cache misses overlap instead of stalling each emitter ray in turn.
+  constexpr std::size_t kPicked = 64;
+  std::array<std::uint32_t, kPicked> picked{};
   for (std::size_t r = 0; r < ne; ++r) {
     const glm::vec2 u = hammersley(static_cast<std::uint32_t>(r), static_cast<std::uint32_t>(ne), shift);
-    const TexelEmitters::Sample e = emitters->sample(group, u.x, u.y, rng.next_float());
+    if (r % kPicked == 0)
+      for (std::size_t q = r; q < std::min(ne, r + kPicked); ++q)
+        picked[q - r] =
+            emitters->pick(group, hammersley(static_cast<std::uint32_t>(q), static_cast<std::uint32_t>(ne), shift).x);
+    const TexelEmitters::Sample e = emitters->place(picked[r % kPicked], u.y, rng.next_float());
     if (e.texel == TexelEmitters::Sample::kNone) continue;
     const glm::vec3 to = e.point - origin;
     const float d = glm::length(to);
