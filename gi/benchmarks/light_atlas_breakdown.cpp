@@ -195,15 +195,16 @@ int main(int argc, char** argv) {
         const glm::dvec3 r1(rd[0][i] + ri[0][i]), r2(rd[1][i] + ri[1][i]);
         whole.add(va, r1, r2), whole.add_second(va, vb);
         const glm::dvec3 rim = 0.5 * glm::dvec3(ri[0][i] + ri[1][i]), rm = 0.5 * (r1 + r2);
-        if (rim.x + rim.y + rim.z >= 0.8 * (rm.x + rm.y + rm.z)) dominated.add(va, r1, r2), dominated.add_second(va, vb);
+        if (rim.x + rim.y + rim.z >= 0.8 * (rm.x + rm.y + rm.z))
+          dominated.add(va, r1, r2), dominated.add_second(va, vb);
       }
       const auto rel = [](const Sums& x, double e2) { return std::sqrt(e2 / std::max(1e-30, x.ref2 - x.noise2)); };
       std::printf(
           "denoise %d passes, sigma %.2f: whole %.4f (noise %.4f, floor %.4f, bias %+.4f); "
           "indirect-dominated %.4f (noise %.4f, floor %.4f, bias %+.4f)\n",
-          f.denoise_passes, static_cast<double>(f.denoise_sigma),
-          rel(whole, whole.truth_err2()), rel(whole, whole.gather_noise2), rel(whole, whole.floor_err2()),
-          whole.diff / whole.ref, rel(dominated, dominated.truth_err2()), rel(dominated, dominated.gather_noise2),
+          f.denoise_passes, static_cast<double>(f.denoise_sigma), rel(whole, whole.truth_err2()),
+          rel(whole, whole.gather_noise2), rel(whole, whole.floor_err2()), whole.diff / whole.ref,
+          rel(dominated, dominated.truth_err2()), rel(dominated, dominated.gather_noise2),
           rel(dominated, dominated.floor_err2()), dominated.diff / dominated.ref);
     }
     return 0;
@@ -296,8 +297,8 @@ int main(int argc, char** argv) {
       const glm::dvec3 ri_mean = 0.5 * glm::dvec3(ri[0][i] + ri[1][i]), r_mean = 0.5 * (r1 + r2);
       const bool thin = std::min(sz.x, sz.y) <= 4;  // the footprint includes the 1-texel rims
       const bool dominated = ri_mean.x + ri_mean.y + ri_mean.z >= 0.8 * (r_mean.x + r_mean.y + r_mean.z);
-      kinds[i] = static_cast<std::uint8_t>((gathered->hidden[i] ? 1 : 0) | (sandwiched[i] ? 2 : 0) |
-                                           (thin ? 4 : 0) | (border ? 8 : 0) | (dominated ? 16 : 0));
+      kinds[i] = static_cast<std::uint8_t>((gathered->hidden[i] ? 1 : 0) | (sandwiched[i] ? 2 : 0) | (thin ? 4 : 0) |
+                                           (border ? 8 : 0) | (dominated ? 16 : 0));
       if (dominated) {
         into(by_dominated["all"]);
         into(by_dominated[gathered->hidden[i] ? "hidden" : border ? "chart border" : "chart interior"]);
@@ -402,7 +403,8 @@ int main(int argc, char** argv) {
     for (std::size_t k = 0; k < std::min<std::size_t>(err.size(), std::strtoul(worst, nullptr, 10)); ++k) {
       const std::size_t i = err[k].second;
       std::printf(
-          "texel %zu (%d, %d) chart %d kinds %d hidden %d p (%.3f %.3f %.3f) n (%.3f %.3f %.3f): gather direct %.2f + %.2f "
+          "texel %zu (%d, %d) chart %d kinds %d hidden %d p (%.3f %.3f %.3f) n (%.3f %.3f %.3f): gather direct %.2f + "
+          "%.2f "
           "indirect %.2f; path tracer direct %.2f / %.2f indirect %.2f / %.2f\n",
           i, static_cast<int>(i % static_cast<std::size_t>(tx.width)),
           static_cast<int>(i / static_cast<std::size_t>(tx.width)), tx.chart[i], kinds[i], gathered->hidden[i],
