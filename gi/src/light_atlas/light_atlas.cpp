@@ -450,38 +450,38 @@ engine::Result<LightAtlasUpdateStats> update_light_atlas(const BakeInput& input,
   return LightAtlasUpdateStats{.reshot_vpls = shooters.size(), .seconds = seconds_since(t_start)};
 }
 
+// Final gather (texel_gather.h), chosen from the sweeps against the truth (the
+// reference's own noise removed, docs/light_atlas.md) on the Cornell box at 128 texels/m
+// (docs/sweeps/light_atlas_128) and the demo level at 16 texels/m, and from the demo's
+// frames: kept rays alone with the 2.5-texel filter reach the same error for less, but
+// leave blotches a few texels wide where few bright texels light a wall (the crate room
+// at 16 kept rays); a few fresh gather rays reading the filtered solve remove them. The
+// high preset gathers enough not to blur. The VPLs only feed BRF's world probes.
+// Preview and medium denoise with the guided a-trous (2 passes, atlas_denoise.h; the
+// filter it replaced and why: docs/light_atlas.md, "The presets").
+// Since the eighth session: no output filter; the lights' direct light read at every
+// landing point, the light the rays read filtered by 1.5 texels apart from the output, and
+// 32 emitter-sampled rays towards the bright texels. The emitter rays are what lets the
+// filter go: the crate room's blotches were texels whose rays hit or missed the lamp's
+// small bright patch on the floor, which the emitter rays find every time. Sponza 11.62% /
+// 3.02% -> 7.12% / 1.77%; the Cornell box at 128 texels/m 1.215% -> 1.280% (the filter's
+// blur of 1.2 cm there cost less than its noise saved; docs/light_atlas.md, "Emitter rays
+// instead of the output filter").
+// Since the ninth session: a landing nearer than a texel regathers the sky and the indirect
+// light at its point with 4 rays of its own instead of reading the texels, whose samples lie
+// up to a texel away in other light (corners, ledges, small charts). Sponza 7.12% / 1.77% ->
+// 6.03% / 1.46%; the Cornell box 1.280% -> 1.266% (docs/light_atlas.md, "Near landings
+// regather at their point").
+// Since the eleventh session: only the punctual lights' and the sun's direct light at every
+// landing; an area light's one sample there was noise its texels' samples do not have (the
+// Cornell box 1.266% -> 1.155%; Sponza, sun and sky only, unchanged; docs/light_atlas.md,
+// "The area lights at landings").
 engine::Result<LightAtlasSettings> light_atlas_preset(std::string_view name) {
   auto density = atlas_density_preset(name);
   if (!density)
     return engine::invalid_request("unknown light-atlas preset '" + std::string(name) + "' (preview, medium, high)");
   LightAtlasSettings s;
   s.texels_per_metre = *density;
-  // Final gather (texel_gather.h), chosen from the sweeps against the truth (the
-  // reference's own noise removed, docs/light_atlas.md) on the Cornell box at 128 texels/m
-  // (docs/sweeps/light_atlas_128) and the demo level at 16 texels/m, and from the demo's
-  // frames: kept rays alone with the 2.5-texel filter reach the same error for less, but
-  // leave blotches a few texels wide where few bright texels light a wall (the crate room
-  // at 16 kept rays); a few fresh gather rays reading the filtered solve remove them. The
-  // high preset gathers enough not to blur. The VPLs only feed BRF's world probes.
-  // Preview and medium denoise with the guided a-trous (2 passes, atlas_denoise.h; the
-  // filter it replaced and why: docs/light_atlas.md, "The presets").
-  // Since the eighth session: no output filter; the lights' direct light read at every
-  // landing point, the light the rays read filtered by 1.5 texels apart from the output, and
-  // 32 emitter-sampled rays towards the bright texels. The emitter rays are what lets the
-  // filter go: the crate room's blotches were texels whose rays hit or missed the lamp's
-  // small bright patch on the floor, which the emitter rays find every time. Sponza 11.62% /
-  // 3.02% -> 7.12% / 1.77%; the Cornell box at 128 texels/m 1.215% -> 1.280% (the filter's
-  // blur of 1.2 cm there cost less than its noise saved; docs/light_atlas.md, "Emitter rays
-  // instead of the output filter").
-  // Since the ninth session: a landing nearer than a texel regathers the sky and the indirect
-  // light at its point with 4 rays of its own instead of reading the texels, whose samples lie
-  // up to a texel away in other light (corners, ledges, small charts). Sponza 7.12% / 1.77% ->
-  // 6.03% / 1.46%; the Cornell box 1.280% -> 1.266% (docs/light_atlas.md, "Near landings
-  // regather at their point").
-  // Since the eleventh session: only the punctual lights' and the sun's direct light at every
-  // landing; an area light's one sample there was noise its texels' samples do not have (the
-  // Cornell box 1.266% -> 1.155%; Sponza, sun and sky only, unchanged; docs/light_atlas.md,
-  // "The area lights at landings").
   s.final_pass = LightAtlasSettings::FinalPass::TexelGather;
   s.gather.filter_radius_texels = 0.0f;
   s.gather.denoise_passes = 2;

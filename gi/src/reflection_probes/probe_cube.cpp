@@ -129,6 +129,9 @@ float cube_distance_bilinear(const ProbeCube& cube, const glm::vec3& d) {
   return bilinear_level(cube.distance, cube.size, cube_coordinate(d));
 }
 
+// Long because the box-first test and the search share g, the search's scale and the state the
+// search starts from (t0, t_lo, g_lo, in_front, the step scale): split, those five would travel
+// between the two as parameters and results.
 glm::vec3 distance_corrected_direction(const ProbeCube& cube, const glm::vec3& p, const glm::vec3& r,
                                        const glm::vec3& centre, const glm::vec3& box_min, const glm::vec3& box_max,
                                        float box_side_tolerance) {

@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <string>
+#include <utility>
 
 #include "core/random.h"
 #include "core/thread_pool.h"
@@ -26,9 +27,44 @@ namespace {
 // The shader's PROBE_BOX_MARGIN_M (engine/shaders/reflection_probes.glsl).
 constexpr float kBoxMarginM = 0.05f;
 
+// What the captures read and what the error is measured on: the tail of reflection_probes_knobs' table.
+std::vector<KnobSpec> scene_knobs() {
+  return {
+      {.name = "atlas",
+       .description = "light-atlas preset whose irradiance the captures read on the static surfaces",
+       .kind = KnobKind::Choice,
+       .default_grid = {"preview"},
+       .choices = {"preview", "medium", "high"}},
+      {.name = "roughness",
+       .description = "roughness of the glossy materials (those below 0.35 in the scene: the floors)",
+       .kind = KnobKind::Real,
+       .default_grid = {"0.1", "0.2"},
+       .min_value = 0.0,
+       .max_value = 0.9},
+      {.name = "density",
+       .description = "texels per metre of the layout the error is measured on",
+       .kind = KnobKind::Real,
+       .default_grid = {"8"},
+       .min_value = 0.01,
+       .max_value = 1e4},
+      {.name = "border",
+       .description = "metres from a side of the probe's box within which a texel counts as at its border",
+       .kind = KnobKind::Real,
+       .default_grid = {"0.5"},
+       .min_value = 0.0,
+       .max_value = 100},
+      {.name = "ref_spp",
+       .description = "specular-lobe samples per texel of the path-traced reference",
+       .kind = KnobKind::Integer,
+       .default_grid = {"256"},
+       .min_value = 1,
+       .max_value = 1 << 20},
+  };
+}
+
 // Long because it is one table, one entry per knob with its grid and range, read as a list.
 std::vector<KnobSpec> reflection_probes_knobs() {
-  return {
+  std::vector<KnobSpec> knobs = {
       {.name = "resolution",
        .description = "cube face size of level 0, texels",
        .kind = KnobKind::Integer,
@@ -97,36 +133,9 @@ std::vector<KnobSpec> reflection_probes_knobs() {
        .kind = KnobKind::Choice,
        .default_grid = {"runtime"},
        .choices = {"runtime", "trace", "oracle_level0", "oracle", "level0", "exact_parallax", "level0_exact_dir"}},
-      {.name = "atlas",
-       .description = "light-atlas preset whose irradiance the captures read on the static surfaces",
-       .kind = KnobKind::Choice,
-       .default_grid = {"preview"},
-       .choices = {"preview", "medium", "high"}},
-      {.name = "roughness",
-       .description = "roughness of the glossy materials (those below 0.35 in the scene: the floors)",
-       .kind = KnobKind::Real,
-       .default_grid = {"0.1", "0.2"},
-       .min_value = 0.0,
-       .max_value = 0.9},
-      {.name = "density",
-       .description = "texels per metre of the layout the error is measured on",
-       .kind = KnobKind::Real,
-       .default_grid = {"8"},
-       .min_value = 0.01,
-       .max_value = 1e4},
-      {.name = "border",
-       .description = "metres from a side of the probe's box within which a texel counts as at its border",
-       .kind = KnobKind::Real,
-       .default_grid = {"0.5"},
-       .min_value = 0.0,
-       .max_value = 100},
-      {.name = "ref_spp",
-       .description = "specular-lobe samples per texel of the path-traced reference",
-       .kind = KnobKind::Integer,
-       .default_grid = {"256"},
-       .min_value = 1,
-       .max_value = 1 << 20},
   };
+  for (KnobSpec& k : scene_knobs()) knobs.push_back(std::move(k));
+  return knobs;
 }
 
 ReferenceRequest probes_reference_request(const SweepScene&, const KnobSetting& k) {
@@ -281,6 +290,28 @@ Estimate estimate_of(const std::string& name) {
   return Estimate::Runtime;
 }
 
+// The diagnosis's `level0` estimate at texel t: the placed probes' level 0 under the exact lobe,
+// each direction corrected for parallax as the runtime corrects it, blended as it blends.
+glm::vec3 level0_estimate(const BakedProbes& b, const engine::GltfBrdf& brdf, const glm::vec3& p, const glm::vec3& n,
+                          const glm::vec3& v, std::size_t t, bool box_only, float box_side) {
+  glm::vec3 sum(0.0f);
+  float weight = 0.0f;
+  for (std::size_t i = 0; i < b.set.probes.size(); ++i) {
+    const ProbeVolume& pv = b.set.probes[i];
+    const float w = probe_blend_weight(pv, p, kBoxMarginM);
+    if (!(w > 0.0f)) continue;
+    const ProbeCube& cube = b.set.cubes[i];
+    sum += w * exact_lobe(brdf, n, v, t, kExactLobeSamples, [&](const glm::vec3& l) {
+             const glm::vec3 d =
+                 box_only ? box_projected_direction(p, l, pv.centre, pv.box_min, pv.box_max)
+                          : distance_corrected_direction(cube, p, l, pv.centre, pv.box_min, pv.box_max, box_side);
+             return cube_lookup_trilinear(cube, 0.0f, d);
+           });
+    weight += w;
+  }
+  return weight > 0.0f ? sum / weight : glm::vec3(0.0f);
+}
+
 // The diagnosis's estimates at texel t (`estimate` not Runtime): see the knob `estimate`.
 glm::vec3 diagnosis_estimate(Estimate estimate, const BakedProbes& b, const ProbeCapturer& capturer,
                              const engine::GltfBrdf& brdf, const glm::vec3& p, const glm::vec3& n, const glm::vec3& v,
@@ -317,24 +348,7 @@ glm::vec3 diagnosis_estimate(Estimate estimate, const BakedProbes& b, const Prob
     }
     return weight > 0.0f ? sum / weight : glm::vec3(0.0f);
   }
-  if (estimate == Estimate::Level0) {
-    glm::vec3 sum(0.0f);
-    float weight = 0.0f;
-    for (std::size_t i = 0; i < b.set.probes.size(); ++i) {
-      const ProbeVolume& pv = b.set.probes[i];
-      const float w = probe_blend_weight(pv, p, kBoxMarginM);
-      if (!(w > 0.0f)) continue;
-      const ProbeCube& cube = b.set.cubes[i];
-      sum += w * exact_lobe(brdf, n, v, t, kExactLobeSamples, [&](const glm::vec3& l) {
-               const glm::vec3 d =
-                   box_only ? box_projected_direction(p, l, pv.centre, pv.box_min, pv.box_max)
-                            : distance_corrected_direction(cube, p, l, pv.centre, pv.box_min, pv.box_max, box_side);
-               return cube_lookup_trilinear(cube, 0.0f, d);
-             });
-      weight += w;
-    }
-    return weight > 0.0f ? sum / weight : glm::vec3(0.0f);
-  }
+  if (estimate == Estimate::Level0) return level0_estimate(b, brdf, p, n, v, t, box_only, box_side);
   const ProbeCube cube = capturer.bake_at(origin);
   if (estimate == Estimate::OracleLevel0)
     return exact_lobe(brdf, n, v, t, kExactLobeSamples,
@@ -399,6 +413,16 @@ std::vector<ProbeCube> lookup_chains(const RunContext& ctx, const ReflectionProb
   return chains;
 }
 
+// What the runtime uploads: RGBA16F cube maps with every level, and R32F distances.
+std::size_t gpu_bytes(const ReflectionProbeSet& set, bool box_only) {
+  std::size_t bytes = 0;
+  for (const ProbeCube& c : set.cubes) {
+    for (const std::vector<glm::vec3>& level : c.levels) bytes += level.size() * 8u;
+    if (!box_only) bytes += c.distance.size() * 4u;
+  }
+  return bytes;
+}
+
 engine::Result<MethodOutput> run_reflection_probes(const RunContext& ctx) {
   const double roughness = ctx.knobs.real("roughness");
   const engine::Scene scene = engine::instantiate(with_floor_roughness(ctx.scene.asset, roughness));
@@ -440,11 +464,7 @@ engine::Result<MethodOutput> run_reflection_probes(const RunContext& ctx) {
   MethodOutput out;
   out.field = RgbField::from_texels(tex.width, tex.height, values, covered);
   out.costs.bake_seconds = set->stats.total_seconds;
-  // What the runtime uploads: RGBA16F cube maps with every level, and R32F distances.
-  for (const ProbeCube& c : set->cubes) {
-    for (const std::vector<glm::vec3>& level : c.levels) out.costs.bytes += level.size() * 8u;
-    if (!box_only) out.costs.bytes += c.distance.size() * 4u;
-  }
+  out.costs.bytes = gpu_bytes(*set, box_only);
   const auto count = [](const std::vector<std::uint8_t>& m) {
     return static_cast<double>(std::count(m.begin(), m.end(), std::uint8_t{1}));
   };
