@@ -44,6 +44,7 @@
 #include "raytrace/ray_offset.h"
 #include "raytrace/reference_brdf.h"
 #include "raytrace/texel_samples.h"
+#include "real_level_lighting.h"
 #include "transport/static_scene.h"
 #include "uv/atlas_layout.h"
 
@@ -114,14 +115,9 @@ int main(int argc, char** argv) {
   const int spp = argc > 3 ? std::atoi(argv[3]) : 64;
   const std::string preset = argc > 4 ? argv[4] : "medium";
   const std::filesystem::path cache = argc > 5 ? argv[5] : ".";
-  auto loaded = engine::load_gltf(argv[1]);
+  auto loaded = gi_bench::load_untextured_under_sun_and_sky(argv[1]);
   if (!loaded) return std::fprintf(stderr, "%s\n", loaded.error().to_string().c_str()), 1;
-  engine::SceneAsset asset = gi::without_textures(std::move(loaded).value());
-  asset.environment.sky_radiance = glm::vec3(0.0f);
-  asset.environment.sky_gradient = {.zenith = {10, 16, 30}, .horizon = {28, 30, 34}, .ground = {6, 6, 6}};
-  engine::set_sun(asset, {.direction = {0.25f, -1.0f, 0.15f},
-                          .irradiance = {700.0f, 650.0f, 600.0f},
-                          .angular_radius_rad = 0.27f * 3.14159265f / 180.0f});
+  const engine::SceneAsset& asset = *loaded;
   const gi::BakeInput input = gi::bake_input_from(asset);
 
   gi::LightAtlasSettings s = gi::light_atlas_preset(preset).value();

@@ -36,6 +36,7 @@
 #include "light_atlas/texel_sampling.h"
 #include "raytrace/embree_ray_caster.h"
 #include "raytrace/ray_offset.h"
+#include "real_level_lighting.h"
 #include "transport/static_scene.h"
 #include "uv/atlas_layout.h"
 
@@ -184,14 +185,9 @@ int main(int argc, char** argv) {
   const std::string preset = argc > 3 ? argv[3] : "medium";
   const int runs = argc > 4 ? std::max(1, std::atoi(argv[4])) : 1;
   const std::string dump = argc > 5 ? argv[5] : "", compare = argc > 6 ? argv[6] : "";
-  auto loaded = engine::load_gltf(argv[1]);
+  auto loaded = gi_bench::load_untextured_under_sun_and_sky(argv[1]);
   if (!loaded) return std::fprintf(stderr, "%s\n", loaded.error().to_string().c_str()), 1;
-  engine::SceneAsset asset = gi::without_textures(std::move(loaded).value());
-  asset.environment.sky_radiance = glm::vec3(0.0f);
-  asset.environment.sky_gradient = {.zenith = {10, 16, 30}, .horizon = {28, 30, 34}, .ground = {6, 6, 6}};
-  engine::set_sun(asset, {.direction = {0.25f, -1.0f, 0.15f},
-                          .irradiance = {700.0f, 650.0f, 600.0f},
-                          .angular_radius_rad = 0.27f * 3.14159265f / 180.0f});
+  const engine::SceneAsset& asset = *loaded;
   const gi::BakeInput input = gi::bake_input_from(asset);
   auto preset_settings = gi::light_atlas_preset(preset);
   if (!preset_settings) return std::fprintf(stderr, "%s\n", preset_settings.error().to_string().c_str()), 1;
