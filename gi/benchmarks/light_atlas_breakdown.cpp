@@ -13,11 +13,11 @@
 // of the path tracer or of the texel placement).
 // Environment: GI_BREAKDOWN_FILTER=r (filter radius, texels; 0 = the sweep's unfiltered
 // run), GI_BREAKDOWN_SEEDS=2 (a second gather: the gather-noise and floor columns),
-// GI_BREAKDOWN_DENOISE=passes, GI_BREAKDOWN_EMITTERS=rays and GI_BREAKDOWN_SOURCE=r (the
-// denoiser's passes, the emitter rays, the source filter's radius in texels), GI_BREAKDOWN_WORST=N (the N worst
-// texels), GI_BREAKDOWN_TEXEL=i,j (per texel: its normals and face, 16 rays and what they read, the path tracer there
-// at 0, 1 and all bounces), GI_BREAKDOWN_DENOISE_GRID=passes:sigma,... (denoiser settings on one gather, a
-// line each).
+// GI_BREAKDOWN_DENOISE=passes, GI_BREAKDOWN_EMITTERS=rays, GI_BREAKDOWN_SOURCE=r and GI_BREAKDOWN_SOURCE_RIDGE=x (the
+// denoiser's passes, the emitter rays, the source filter's radius in texels and its linear fit's ridge),
+// GI_BREAKDOWN_WORST=N (the N worst texels), GI_BREAKDOWN_TEXEL=i,j (per texel: its normals and face, 16 rays and what
+// they read, the path tracer there at 0, 1 and all bounces), GI_BREAKDOWN_DENOISE_GRID=passes:sigma[:ridge],...
+// (denoiser settings on one gather, a line each; ridge: the local linear fit's, absent: local mean).
 #include <engine/gltf.h>
 #include <engine/sun.h>
 #include <gi/bake_input.h>
@@ -135,12 +135,13 @@ int main(int argc, char** argv) {
   if (const char* d = std::getenv("GI_BREAKDOWN_DENOISE")) g.denoise_passes = std::atoi(d);
   if (const char* e = std::getenv("GI_BREAKDOWN_EMITTERS")) g.emitter_rays = std::atoi(e);
   if (const char* r = std::getenv("GI_BREAKDOWN_SOURCE")) g.source_filter_radius_texels = std::strtof(r, nullptr);
+  if (const char* r = std::getenv("GI_BREAKDOWN_SOURCE_RIDGE")) g.source_filter_slope_ridge = std::strtof(r, nullptr);
   // GI_BREAKDOWN_NEAR=rays,texels: landings nearer than `texels` regather with `rays` rays.
   if (const char* r = std::getenv("GI_BREAKDOWN_NEAR")) {
     g.near_regather_rays = std::atoi(r);
     if (const char* c = std::strchr(r, ',')) g.near_regather_texels = std::strtof(c + 1, nullptr);
   }
-  // GI_BREAKDOWN_DENOISE_GRID=passes:sigma,...: the gathers once, unfiltered, then each
+  // GI_BREAKDOWN_DENOISE_GRID=passes:sigma[:ridge],...: the gathers once, unfiltered, then each
   // denoiser setting on copies of them, one line each (the whole lightmap and the
   // indirect-dominated texels), instead of the table.
   const char* denoise_grid = std::getenv("GI_BREAKDOWN_DENOISE_GRID");
@@ -179,6 +180,7 @@ int main(int argc, char** argv) {
       char* rest = nullptr;
       f.denoise_passes = static_cast<int>(std::strtol(e, &rest, 10));
       f.denoise_sigma = std::strtof(rest + 1, &rest);
+      if (*rest == ':') f.denoise_slope_ridge = std::strtof(rest + 1, &rest);
       f.part_only = false;
       gi::TexelGatherResult a = *gathered, b = second ? *second : *gathered;
       if (!gi::filter_gathered(*scene, *layout, f, pool, a) || !gi::filter_gathered(*scene, *layout, f, pool, b))
@@ -196,11 +198,11 @@ int main(int argc, char** argv) {
       }
       const auto rel = [](const Sums& x, double e2) { return std::sqrt(e2 / std::max(1e-30, x.ref2 - x.noise2)); };
       std::printf(
-          "denoise %d passes, sigma %.2f: whole %.4f (noise %.4f, floor %.4f, bias %+.4f); "
+          "denoise %d passes, sigma %.2f, ridge %.2f: whole %.4f (noise %.4f, floor %.4f, bias %+.4f); "
           "indirect-dominated %.4f (noise %.4f, floor %.4f, bias %+.4f)\n",
-          f.denoise_passes, static_cast<double>(f.denoise_sigma), rel(whole, whole.truth_err2()),
-          rel(whole, whole.gather_noise2), rel(whole, whole.floor_err2()), whole.diff / whole.ref,
-          rel(dominated, dominated.truth_err2()), rel(dominated, dominated.gather_noise2),
+          f.denoise_passes, static_cast<double>(f.denoise_sigma), static_cast<double>(f.denoise_slope_ridge),
+          rel(whole, whole.truth_err2()), rel(whole, whole.gather_noise2), rel(whole, whole.floor_err2()),
+          whole.diff / whole.ref, rel(dominated, dominated.truth_err2()), rel(dominated, dominated.gather_noise2),
           rel(dominated, dominated.floor_err2()), dominated.diff / dominated.ref);
     }
     return 0;

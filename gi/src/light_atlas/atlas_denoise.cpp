@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "core/color.h"
+#include "light_atlas/local_linear.h"
 #include "light_atlas/texel_cells.h"
 
 namespace gi {
@@ -40,17 +41,18 @@ void atrous_pass(const AtlasTexels& tx, const std::vector<std::uint32_t>& visibl
   const TexelCells all(tx, visible, 2.0f * step_m), on_lattice(tx, lattice, 2.0f * step_m);
   const float plane_m = 0.5f * texel_m, min_cos = std::pow(1e-4f, 1.0f / s.normal_power);
   const std::size_t nf = in.fields.size();
+  const bool linear = s.slope_ridge >= 0.0f;
   pool.parallel_for(
       all.cell_count(),
       [&](std::size_t c) {
         std::vector<std::uint32_t> near;
+        std::vector<Neighbour> taken;
         on_lattice.for_around(all.cell(c), [&](std::uint32_t j) { near.push_back(j); });
         all.for_cell(c, [&](std::uint32_t i) {
           const glm::vec3 p = tx.position[i], n = tx.normal[i];
           const float li = in.lum[i], vi = in.variance[i];
-          const float self = b3_spline(0.0f);
-          float weight = self, var = self * self * vi;
-          glm::vec3 sum[2] = {self * in.fields[0][i], nf > 1 ? self * in.fields[1][i] : glm::vec3(0.0f)};
+          taken.assign(1, Neighbour{i, b3_spline(0.0f), glm::vec2(0.0f)});
+          const glm::mat3 frame = tangent_frame(n);
           for (std::uint32_t j : near) {
             if (j == i) continue;
             const glm::vec3 d = tx.position[j] - p;
@@ -65,11 +67,17 @@ void atrous_pass(const AtlasTexels& tx, const std::vector<std::uint32_t>& visibl
             const float z2 = dl * dl / (s.value_sigma * s.value_sigma * (vi + in.variance[j]) + floor * floor + 1e-30f);
             const float w = ks * std::pow(cos_n, s.normal_power) * std::exp(-off_plane * off_plane - 0.5f * z2);
             if (!(w > 0.0f)) continue;
-            weight += w;
-            var += w * w * in.variance[j];
-            for (std::size_t f = 0; f < nf; ++f) sum[f] += w * in.fields[f][j];
+            taken.push_back({j, w, glm::vec2(glm::dot(d, frame[0]), glm::dot(d, frame[1])) / step_m});
           }
-          for (std::size_t f = 0; f < nf; ++f) out_fields[f][i] = sum[f] / weight;
+          if (linear) to_linear_weights(s.slope_ridge, taken);
+          float weight = 0.0f, var = 0.0f;
+          glm::vec3 sum[2] = {glm::vec3(0.0f), glm::vec3(0.0f)};
+          for (const Neighbour& t : taken) {
+            weight += t.w;
+            var += t.w * t.w * in.variance[t.j];
+            for (std::size_t f = 0; f < nf; ++f) sum[f] += t.w * in.fields[f][t.j];
+          }
+          for (std::size_t f = 0; f < nf; ++f) out_fields[f][i] = glm::max(sum[f] / weight, glm::vec3(0.0f));
           out_variance[i] = var / (weight * weight);
         });
       },

@@ -32,6 +32,13 @@ struct DenoiseSettings {
   /// out (0: no clamp). Off by default: at 3 it removes the crate room's blotches but costs
   /// Dabrovic Sponza 1.5 points of its indirect-dominated error (docs/light_atlas.md).
   float outlier_sigmas = 0.0f;
+  /// Local linear instead of local constant: each pass fits value = a + b . (offset in the
+  /// texel's tangent plane) to the weighted neighbours and keeps a (weighted least squares,
+  /// the slope b penalised by `slope_ridge` x the summed weight, in units of the pass's step).
+  /// A kernel cut off at a chart's edge, or lying on a gradient, then estimates the value at
+  /// the texel rather than at the kernel's centre of mass (the boundary bias of local
+  /// averaging; local linear regression has none to first order). Negative: off.
+  float slope_ridge = -1.0f;
 };
 
 /// Denoises the fields `fields` (each per atlas texel, W/m^2) together over the texels of

@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "light_atlas/local_linear.h"
 #include "light_atlas/texel_cells.h"
 
 namespace gi {
@@ -11,7 +12,7 @@ namespace gi {
 // its own texels against them.
 std::vector<glm::vec3> filter_world(const AtlasTexels& tx, std::span<const std::uint32_t> work,
                                     const std::vector<glm::vec3>& e, const std::vector<std::uint8_t>& hidden,
-                                    float radius_m, float texel_m, ThreadPool& pool) {
+                                    float radius_m, float texel_m, ThreadPool& pool, float slope_ridge) {
   std::vector<std::uint32_t> visible;
   for (std::uint32_t i : work)
     if (!hidden[i]) visible.push_back(i);
@@ -26,19 +27,24 @@ std::vector<glm::vec3> filter_world(const AtlasTexels& tx, std::span<const std::
         };
         std::vector<Candidate> near;
         cells.for_around(cells.cell(c), [&](std::uint32_t j) { near.push_back({tx.position[j], tx.normal[j], e[j]}); });
+        std::vector<Neighbour> taken;
         cells.for_cell(c, [&](std::uint32_t i) {
           const glm::vec3 p = tx.position[i], n = tx.normal[i];
-          glm::vec3 sum(0.0f);
-          float weight = 0.0f;
-          for (const Candidate& q : near) {
+          const glm::mat3 frame = tangent_frame(n);
+          taken.clear();
+          for (std::size_t k = 0; k < near.size(); ++k) {
+            const Candidate& q = near[k];
             const glm::vec3 d = q.position - p;
             const float d2 = glm::dot(d, d);
             if (d2 > r2 || glm::dot(q.normal, n) < 0.95f || std::fabs(glm::dot(d, n)) > plane) continue;
-            const float w = std::exp(-2.0f * d2 / r2);
-            sum += q.value * w;
-            weight += w;
+            taken.push_back({static_cast<std::uint32_t>(k), std::exp(-2.0f * d2 / r2),
+                             glm::vec2(glm::dot(d, frame[0]), glm::dot(d, frame[1])) / radius_m});
           }
-          if (weight > 0.0f) out[i] = sum / weight;
+          if (slope_ridge >= 0.0f && !taken.empty()) to_linear_weights(slope_ridge, taken);
+          glm::vec3 sum(0.0f);
+          float weight = 0.0f;
+          for (const Neighbour& q : taken) sum += near[q.j].value * q.w, weight += q.w;
+          if (weight > 0.0f) out[i] = glm::max(sum / weight, glm::vec3(0.0f));
         });
       },
       4);

@@ -52,6 +52,8 @@ engine::Status validate(const TexelGatherSettings& s) {
   if (!(s.denoise_sigma > 0.0f) || s.denoise_sigma > 1000.0f) return bad("denoise_sigma is outside (0, 1000]");
   if (!(s.denoise_outlier_sigmas >= 0.0f) || s.denoise_outlier_sigmas > 1000.0f)
     return bad("denoise_outlier_sigmas is outside [0, 1000]");
+  if (!(s.denoise_slope_ridge <= 1e6f)) return bad("denoise_slope_ridge is NaN or above 1e6");
+  if (!(s.source_filter_slope_ridge <= 1e6f)) return bad("source_filter_slope_ridge is NaN or above 1e6");
   if (!(s.source_filter_radius_texels <= 16.0f)) return bad("source_filter_radius_texels is above 16 (or NaN)");
   if (s.near_regather_rays < 0 || s.near_regather_rays > 4096) return bad("near_regather_rays is outside 0..4096");
   if (!(s.near_regather_texels >= 0.0f) || s.near_regather_texels > 64.0f)
@@ -301,7 +303,7 @@ bool gather_step(const StaticBakeScene& b, const AtlasLayout& layout, const Texe
   const float radius_m = source_radius * texel_m;
   std::vector<glm::vec3>& e = out.indirect;
   const std::vector<glm::vec3> source =
-      filtering ? filter_world(tx, t.work, e, kept.hidden, radius_m, texel_m, pool) : e;
+      filtering ? filter_world(tx, t.work, e, kept.hidden, radius_m, texel_m, pool, s.source_filter_slope_ridge) : e;
   GatherSource src;
   src.reflected.assign(n, glm::vec3(0.0f));
   src.without_lights.assign(n, glm::vec3(0.0f));
@@ -341,10 +343,12 @@ void filter_result(const AtlasTexels& tx, const TexelTable& t, const TexelGather
                    ThreadPool& pool, TexelGatherResult& out) {
   if (s.denoise_passes > 0 && texel_m > 0.0f) {
     std::vector<glm::vec3>* const fields[] = {&out.indirect, &out.baked_direct};
-    denoise_world(
-        tx, t.work, out.hidden, texel_m,
-        {.passes = s.denoise_passes, .value_sigma = s.denoise_sigma, .outlier_sigmas = s.denoise_outlier_sigmas}, pool,
-        out.variance, fields);
+    denoise_world(tx, t.work, out.hidden, texel_m,
+                  {.passes = s.denoise_passes,
+                   .value_sigma = s.denoise_sigma,
+                   .outlier_sigmas = s.denoise_outlier_sigmas,
+                   .slope_ridge = s.denoise_slope_ridge},
+                  pool, out.variance, fields);
   }
   if (s.filter_radius_texels <= 0.0f || !(texel_m > 0.0f)) return;
   const float radius_m = s.filter_radius_texels * texel_m;

@@ -65,6 +65,11 @@ struct TexelGatherSettings {
   /// The denoiser's outlier clamp before its passes (DenoiseSettings::outlier_sigmas): a
   /// texel at most its co-planar neighbours' mean + this many standard deviations (0: off).
   float denoise_outlier_sigmas = 0.0f;
+  /// The denoiser's local linear fit (DenoiseSettings::slope_ridge; negative: local mean).
+  float denoise_slope_ridge = -1.0f;
+  /// The source filter's (`source_filter_radius_texels`) local linear fit, its slopes' ridge
+  /// (texel_filter.h; negative: the Gaussian mean).
+  float source_filter_slope_ridge = -1.0f;
   /// Step 3's reads where a fresh ray lands: which lights' direct light it takes at the landing
   /// point itself (one shadow ray per light and landing) rather than from the texels, which
   /// then give only the rest. `Edges` (the default): every light's, only across shadow edges

@@ -23,6 +23,18 @@ std::vector<KnobSpec> gather_detail_knobs() {
        .default_grid = {"2"},
        .min_value = 0.01,
        .max_value = 1000},
+      {.name = "denoise_ridge",
+       .description = "gather: the denoiser's local linear fit, its slopes' ridge (-1: local mean)",
+       .kind = KnobKind::Real,
+       .default_grid = {"-1"},
+       .min_value = -1,
+       .max_value = 1e6},
+      {.name = "source_ridge",
+       .description = "gather: the source filter's local linear fit, its slopes' ridge (-1: Gaussian mean)",
+       .kind = KnobKind::Real,
+       .default_grid = {"-1"},
+       .min_value = -1,
+       .max_value = 1e6},
       {.name = "outlier",
        .description =
            "gather: the denoiser's outlier clamp, standard deviations above the co-planar neighbours' mean (0: off)",
@@ -175,6 +187,8 @@ engine::Result<MethodOutput> run_light_atlas(const RunContext& ctx) {
     s.gather.denoise_passes = static_cast<int>(ctx.knobs.integer("denoise"));
     s.gather.denoise_sigma = static_cast<float>(ctx.knobs.real("denoise_sigma"));
     s.gather.denoise_outlier_sigmas = static_cast<float>(ctx.knobs.real("outlier"));
+    s.gather.denoise_slope_ridge = static_cast<float>(ctx.knobs.real("denoise_ridge"));
+    s.gather.source_filter_slope_ridge = static_cast<float>(ctx.knobs.real("source_ridge"));
     const std::string landing = ctx.knobs.text("landing_direct");
     s.gather.landing_direct = landing == "everywhere" ? gi::TexelGatherSettings::LandingDirect::Everywhere
                               : landing == "punctual" ? gi::TexelGatherSettings::LandingDirect::Punctual
