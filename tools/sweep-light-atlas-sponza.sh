@@ -43,10 +43,12 @@ if [[ ${FILTERS:-1} != 0 ]]; then  # 32 kept + 128 fresh rays, with the 2.5-texe
   csvs+=("$out/gather/light_atlas_sponza.csv")
 fi
 # the medium preset's settings now (preview's but 8 direct samples): 32 kept + 128 cosine + 32 emitter
-# rays, the lights' direct light at every landing, the read light filtered 1.5 texels, the guided
-# denoiser's 2 passes, no output filter, and near landings regathered with 4 rays (0: without)
+# rays, the punctual lights' and the sun's direct light at every landing, the read light filtered 1.5
+# texels, the guided denoiser's 3 passes at sigma 1.5, both fitting a local plane (ridge 0), no output
+# filter, and near landings regathered with 4 rays (0: without)
 run "$sweep" "${gather[@]}" --knob solve_rays=32 --knob rays=128 --knob emitter_rays=32 --knob filter=0 \
-  --knob denoise=2 --knob landing_direct=punctual --knob source_filter=1.5 --knob near_rays=0,4 \
+  --knob denoise=3 --knob denoise_sigma=1.5 --knob denoise_ridge=0 --knob source_ridge=0 \
+  --knob landing_direct=punctual --knob source_filter=1.5 --knob near_rays=0,4 \
   --knob direct_samples=8 "${common[@]}" --out "$out/preset"
 csvs+=("$out/preset/light_atlas_sponza.csv")
 run "$sweep" --method pathtracer_atlas --knob density=8 --knob "spp=$pt_spp" "${common[@]}" --out "$out/pathtracer"
