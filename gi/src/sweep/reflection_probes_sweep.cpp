@@ -397,12 +397,10 @@ void dump_texels(const RunContext& ctx, const AtlasTexels& tex, const std::vecto
 // lookup's and the hit's directions from the probe (degrees), the captured distance in the
 // hit's direction against the hit's distance from the probe (the per-texel diagnosis of the
 // lookup's directions, docs/reflection_probes.md).
-void dump_directions(const BakedProbes& b, const ProbeCapturer& capturer, const GlossyTexels& g,
-                     const std::vector<std::uint8_t>& covered, const std::vector<std::uint8_t>& inner, float box_side,
-                     bool rim) {
-  const char* path = std::getenv("GI_PROBE_SWEEP_DIRS");
-  if (!path || !*path) return;
-  std::FILE* f = std::fopen(path, "a");
+void write_directions(const BakedProbes& b, const ProbeCapturer& capturer, const GlossyTexels& g,
+                      const std::vector<std::uint8_t>& covered, const std::vector<std::uint8_t>& inner, float box_side,
+                      bool rim) {
+  std::FILE* f = std::fopen(std::getenv("GI_PROBE_SWEEP_DIRS"), "a");
   if (!f) return;
   const AtlasTexels& tex = g.s.texels;
   for (std::size_t t = 0; t < tex.valid.size(); ++t) {
@@ -437,6 +435,17 @@ void dump_directions(const BakedProbes& b, const ProbeCapturer& capturer, const 
     }
   }
   std::fclose(f);
+}
+
+engine::Status dump_directions(const BakedProbes& b, const BakeInput& input, const GlossyTexels& g,
+                               const std::vector<std::uint8_t>& covered, const std::vector<std::uint8_t>& inner,
+                               float box_side, bool rim) {
+  const char* path = std::getenv("GI_PROBE_SWEEP_DIRS");
+  if (!path || !*path) return {};
+  auto capturer = ProbeCapturer::make(input, b.source(), b.settings);
+  if (!capturer) return capturer.error();
+  write_directions(b, *capturer, g, covered, inner, box_side, rim);
+  return {};
 }
 
 // With the knob `estimate` other than runtime: `values` at the covered texels replaced by the
@@ -517,11 +526,7 @@ engine::Result<MethodOutput> run_reflection_probes(const RunContext& ctx) {
       !diagnosed)
     return diagnosed.error();
   dump_texels(ctx, tex, values, inner, covered);
-  if (const char* dirs = std::getenv("GI_PROBE_SWEEP_DIRS"); dirs && *dirs) {
-    auto capturer = ProbeCapturer::make(input, baked->source(), baked->settings);
-    if (!capturer) return capturer.error();
-    dump_directions(*baked, *capturer, *g, covered, inner, box_side, rim);
-  }
+  if (auto dumped = dump_directions(*baked, input, *g, covered, inner, box_side, rim); !dumped) return dumped.error();
   MethodOutput out;
   out.field = RgbField::from_texels(tex.width, tex.height, values, covered);
   out.costs.bake_seconds = set->stats.total_seconds;
