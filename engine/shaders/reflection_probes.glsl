@@ -48,6 +48,8 @@ const int PROBE_SECANT_STEPS = 3;
 const float PROBE_MIN_SEARCH_SCALE_M = 0.05;
 // gi's probe_cube.h: kProbeBoxSideTolerance (the box first: the probe saw its side there).
 const float PROBE_BOX_SIDE_TOLERANCE = 0.1;
+// gi's probe_cube.h: kProbeRimNearest (the box first at an opening's rim).
+const bool PROBE_RIM_NEAREST = true;
 // gi's probe_cube.h: kProbeMaxLobeSamples.
 const int PROBE_MAX_LOBE_SAMPLES = 16;
 
@@ -68,6 +70,26 @@ vec3 probe_box_direction(vec3 p, vec3 r, ReflectionProbeBox probe) {
 
 // Behind (> 0) or in front of (< 0) the surface probe i saw in the direction of q (from its centre).
 float probe_behind(vec3 q, int i) { return length(q) - textureLod(u_probe_distances, vec4(q, float(i)), 0.0).r; }
+
+// The nearest (x) and farthest (y) of the four distance texels the bilinear read of probe i
+// blends in the direction of q (gi's cube_distance_footprint).
+vec2 probe_distance_footprint(vec3 q, int i) {
+  vec4 d = textureGather(u_probe_distances, vec4(q, float(i)));
+  return vec2(min(min(d.x, d.y), min(d.z, d.w)), max(max(d.x, d.y), max(d.z, d.w)));
+}
+
+// The box first at an opening's rim (gi's rim_is_side): the ray x + t r leaves the box at t_exit,
+// where the bilinear mean distance is `mean`; whether the exit's texels that saw the box's side
+// there weigh at least half, and the ray passes behind that side (there, or within the tolerance past it).
+bool probe_rim_is_side(vec3 x, vec3 r, float t_exit, float mean, float tolerance, int i) {
+  vec3 q = x + t_exit * r;
+  vec2 f = probe_distance_footprint(q, i);
+  if (mean > 0.5 * (f.x + f.y)) return false;
+  float g = length(q) - f.x;
+  if (g >= 0.0) return g <= tolerance;
+  vec3 beyond = x + (t_exit + tolerance) * r;
+  return g >= -tolerance && length(beyond) >= probe_distance_footprint(beyond, i).x;
+}
 
 // The direction from the probe's centre to where the ray from p along r meets the surface the
 // probe captured (distance_corrected_direction in gi's probe_cube.cpp, the same search).
@@ -97,6 +119,10 @@ vec3 probe_direction(vec3 p, vec3 r, ReflectionProbeBox probe, int i) {
   }
   if (!blocked && g_exit >= 0.0 && g_exit <= tolerance) return boxed;
   if (!blocked && g_exit < 0.0 && g_exit >= -tolerance && probe_behind(x + (t_exit + tolerance) * r, i) >= 0.0)
+    return boxed;
+  // At an opening's rim the mean distances mix the side's and the far room's (a thin jamb beside it).
+  if (PROBE_RIM_NEAREST && !blocked && g_exit < -tolerance &&
+      probe_rim_is_side(x, r, t_exit, exit_distance - g_exit, tolerance, i))
     return boxed;
   if (!blocked && g_exit < 0.0) {
     t0 = t_exit;

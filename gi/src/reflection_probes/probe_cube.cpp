@@ -129,12 +129,47 @@ float cube_distance_bilinear(const ProbeCube& cube, const glm::vec3& d) {
   return bilinear_level(cube.distance, cube.size, cube_coordinate(d));
 }
 
+CubeDistanceFootprint cube_distance_footprint(const ProbeCube& cube, const glm::vec3& d) {
+  if (cube.distance.empty()) return {kProbeFarDistance, kProbeFarDistance};
+  const CubeCoordinate c = cube_coordinate(d);
+  const int s = cube.size;
+  const int x0 = static_cast<int>(std::floor((c.u + 1.0f) * 0.5f * static_cast<float>(s) - 0.5f));
+  const int y0 = static_cast<int>(std::floor((c.v + 1.0f) * 0.5f * static_cast<float>(s) - 0.5f));
+  CubeDistanceFootprint f{std::numeric_limits<float>::infinity(), 0.0f};
+  for (int j = 0; j < 2; ++j)
+    for (int i = 0; i < 2; ++i) {
+      const float t =
+          cube.distance[cube_texel_index(c.face, std::clamp(x0 + i, 0, s - 1), std::clamp(y0 + j, 0, s - 1), s)];
+      f.nearest = std::min(f.nearest, t), f.farthest = std::max(f.farthest, t);
+    }
+  return f;
+}
+
+namespace {
+
+// The box-first test at an opening's rim (kProbeRimNearest): the ray x + t r leaves the box at
+// t_exit, where the bilinear mean distance is `mean`. Whether the exit's four distance texels
+// that saw the box's side there weigh at least half, and the ray passes behind that side (at the
+// exit, or within the tolerance past it, as distance_corrected_direction's own test).
+bool rim_is_side(const ProbeCube& cube, const glm::vec3& x, const glm::vec3& r, float t_exit, float mean,
+                 float tolerance) {
+  const glm::vec3 q = x + t_exit * r;
+  const CubeDistanceFootprint f = cube_distance_footprint(cube, q);
+  if (mean > 0.5f * (f.nearest + f.farthest)) return false;
+  const float g = glm::length(q) - f.nearest;
+  if (g >= 0.0f) return g <= tolerance;
+  const glm::vec3 beyond = x + (t_exit + tolerance) * r;
+  return g >= -tolerance && glm::length(beyond) >= cube_distance_footprint(cube, beyond).nearest;
+}
+
+}  // namespace
+
 // Long because the box-first test and the search share g, the search's scale and the state the
 // search starts from (t0, t_lo, g_lo, in_front, the step scale): split, those five would travel
 // between the two as parameters and results.
 glm::vec3 distance_corrected_direction(const ProbeCube& cube, const glm::vec3& p, const glm::vec3& r,
                                        const glm::vec3& centre, const glm::vec3& box_min, const glm::vec3& box_max,
-                                       float box_side_tolerance) {
+                                       float box_side_tolerance, bool rim_nearest) {
   const glm::vec3 boxed = box_projected_direction(p, r, centre, box_min, box_max);
   if (cube.distance.empty()) return boxed;
   const glm::vec3 x = p - centre;
@@ -171,6 +206,12 @@ glm::vec3 distance_corrected_direction(const ProbeCube& cube, const glm::vec3& p
     }
     if (!blocked && g_exit >= 0.0f && g_exit <= tolerance) return boxed;
     if (!blocked && g_exit < 0.0f && g_exit >= -tolerance && g(t_exit + tolerance) >= 0.0f) return boxed;
+    // At an opening's rim the mean distances mix the side's and the far room's: where the
+    // exit's texels that saw the side weigh at least half (the mean nearer their distance than the
+    // far ones'), the same test on the nearest of them (a thin jamb beside the opening is the side).
+    if (rim_nearest && !blocked && g_exit < -tolerance &&
+        rim_is_side(cube, x, r, t_exit, exit_distance - g_exit, tolerance))
+      return boxed;
     if (!blocked && g_exit < 0.0f)
       t0 = t_exit, t_lo = t_exit, g_lo = g_exit, in_front = true,
       step_scale = std::max(exit_distance, kProbeMinSearchScaleM);
@@ -300,13 +341,14 @@ glm::vec3 box_projected_direction(const glm::vec3& p, const glm::vec3& r, const 
 glm::vec3 probe_lobe_radiance(const ProbeCube& cube, const engine::GltfBrdf& brdf, const glm::vec3& p,
                               const glm::vec3& n, const glm::vec3& v, int samples, const glm::vec3& centre,
                               const glm::vec3& box_min, const glm::vec3& box_max, bool box_only, const ProbeCube* chain,
-                              float box_side_tolerance) {
+                              float box_side_tolerance, bool rim_nearest) {
   const int count = std::clamp(samples, 1, kProbeMaxLobeSamples);
   const float alpha = brdf.alpha, a2 = alpha * alpha;
   const float nv = std::max(glm::dot(n, v), 1e-4f);
   const auto corrected = [&](const glm::vec3& l) {
-    return box_only ? box_projected_direction(p, l, centre, box_min, box_max)
-                    : distance_corrected_direction(cube, p, l, centre, box_min, box_max, box_side_tolerance);
+    return box_only
+               ? box_projected_direction(p, l, centre, box_min, box_max)
+               : distance_corrected_direction(cube, p, l, centre, box_min, box_max, box_side_tolerance, rim_nearest);
   };
   // The frame (t, b, n) with v in the (t, n) plane; the shader builds the same one.
   glm::vec3 t = v - nv * n;

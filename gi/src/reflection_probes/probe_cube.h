@@ -46,6 +46,14 @@ inline constexpr float kProbeMinSearchScaleM = 0.05f;
 /// nearer (an object inside the box) it searches the whole ray. Negative: the search alone
 /// (before issue 36's "box first"). docs/reflection_probes.md, "The box first".
 inline constexpr float kProbeBoxSideTolerance = 0.1f;
+/// The box first at an opening's rim: where the ray's exit from the box lies within a texel of
+/// the rim, the bilinear mean distances there mix the side's distance with the far room's, and
+/// a thin wall beside the opening (the demo corridor's 0.2 m jambs, a texel wide at 32^2) reads
+/// as an opening. With this on, the side test also takes the nearest of the four distance texels
+/// around the exit (the GPU's textureGather footprint): where those that saw the box's side there
+/// weigh at least half of the bilinear mean (it lies nearer their distance than the others'), the
+/// box's answer. docs/reflection_probes.md, "The opening's rim".
+inline constexpr bool kProbeRimNearest = true;
 
 /// An empty (black) cube: `levels` levels from `size` (a power of two; levels <= log2(size) + 1).
 ProbeCube make_probe_cube(int size, int levels);
@@ -95,6 +103,12 @@ glm::vec3 box_projected_direction(const glm::vec3& p, const glm::vec3& r, const 
 /// The distance cube read bilinearly in direction d (edge texels clamped, as
 /// cube_lookup_trilinear); kProbeFarDistance when the cube holds no distances.
 float cube_distance_bilinear(const ProbeCube& cube, const glm::vec3& d);
+/// The nearest and farthest of the four distance texels cube_distance_bilinear blends in
+/// direction d (the GPU's textureGather footprint); kProbeFarDistance when the cube holds none.
+struct CubeDistanceFootprint {
+  float nearest = 0.0f, farthest = 0.0f;
+};
+CubeDistanceFootprint cube_distance_footprint(const ProbeCube& cube, const glm::vec3& d);
 
 /// Parallax from the capture's own distances (a localized cube map searched as a distance
 /// impostor: Szirmay-Kalos, Aszodi, Lazanyi and Premecz 2005, "Approximate ray-tracing on the
@@ -107,9 +121,11 @@ float cube_distance_bilinear(const ProbeCube& cube, const glm::vec3& d);
 /// probe_direction() in the forward shader.
 /// First the box (kProbeBoxSideTolerance, `box_side_tolerance`): where the probe saw a surface
 /// at the box's side in the direction of the ray's exit, the box's answer.
+/// `rim_nearest`: kProbeRimNearest's side test at an opening's rim (off: the lookup before it).
 glm::vec3 distance_corrected_direction(const ProbeCube& cube, const glm::vec3& p, const glm::vec3& r,
                                        const glm::vec3& centre, const glm::vec3& box_min, const glm::vec3& box_max,
-                                       float box_side_tolerance = kProbeBoxSideTolerance);
+                                       float box_side_tolerance = kProbeBoxSideTolerance,
+                                       bool rim_nearest = kProbeRimNearest);
 
 /// The most lobe samples probe_lobe_radiance takes (the shader's PROBE_MAX_LOBE_SAMPLES).
 inline constexpr int kProbeMaxLobeSamples = 16;
@@ -135,11 +151,12 @@ inline constexpr int kProbeLobeSamples = 4;
 /// `chain` (optional, CPU only: the sweep's `lobe=fis_chain`, docs/reflection_probes.md): the
 /// samples read this box-filtered chain of level 0 (box_filtered_chain) instead, at the level
 /// whose texels span the sample's solid angle, + 1 (Colbert and Krivanek's own rule).
-/// `box_side_tolerance`: distance_corrected_direction's.
+/// `box_side_tolerance`, `rim_nearest`: distance_corrected_direction's.
 glm::vec3 probe_lobe_radiance(const ProbeCube& cube, const engine::GltfBrdf& brdf, const glm::vec3& p,
                               const glm::vec3& n, const glm::vec3& v, int samples, const glm::vec3& centre,
                               const glm::vec3& box_min, const glm::vec3& box_max, bool box_only,
-                              const ProbeCube* chain = nullptr, float box_side_tolerance = kProbeBoxSideTolerance);
+                              const ProbeCube* chain = nullptr, float box_side_tolerance = kProbeBoxSideTolerance,
+                              bool rim_nearest = kProbeRimNearest);
 
 /// Level 0 of `cube` and its 2 x 2 box averages down to one texel per face, as a cube (what
 /// the prefilter's samples read; its distances are level 0's).

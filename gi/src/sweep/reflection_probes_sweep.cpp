@@ -96,6 +96,12 @@ std::vector<KnobSpec> reflection_probes_knobs() {
        .default_grid = {format_number(kProbeBoxSideTolerance)},
        .min_value = -1.0,
        .max_value = 100},
+      {.name = "rim",
+       .description = "the box-first side test also on the nearest of the exit's four distance texels, at an "
+                      "opening's rim (kProbeRimNearest, the default: on; off: the lookup before it)",
+       .kind = KnobKind::Choice,
+       .default_grid = {kProbeRimNearest ? "on" : "off"},
+       .choices = {"on", "off"}},
       {.name = "lobe",
        .description = "the lookup's lobe: the split sum's (one read along the reflection, isotropic, n = v) or "
                       "filtered importance sampling of the lobe at the view (probe_lobe_radiance)",
@@ -165,7 +171,7 @@ float depth_in_box(const ProbeVolume& v, const glm::vec3& p, const glm::vec3& n)
 // (probe_lobe_radiance), blended by probe_blend_weight (faded across segments), times the specular albedo.
 // `depth`: the largest depth_in_box over those probes. False where no box holds p.
 bool probe_specular(const ReflectionProbeSet& set, const engine::GltfBrdf& brdf, const glm::vec3& p, const glm::vec3& n,
-                    const glm::vec3& v, bool box_only, float box_side, int lobe_samples,
+                    const glm::vec3& v, bool box_only, float box_side, bool rim, int lobe_samples,
                     const std::vector<ProbeCube>* chains, glm::vec3& out, float& depth) {
   const glm::vec3 r = glm::reflect(-v, n);
   glm::vec3 sum(0.0f);
@@ -178,12 +184,12 @@ bool probe_specular(const ReflectionProbeSet& set, const engine::GltfBrdf& brdf,
     const ProbeCube& cube = set.cubes[i];
     if (lobe_samples > 0) {
       sum += w * probe_lobe_radiance(cube, brdf, p, n, v, lobe_samples, pv.centre, pv.box_min, pv.box_max, box_only,
-                                     chains ? &(*chains)[i] : nullptr, box_side);
+                                     chains ? &(*chains)[i] : nullptr, box_side, rim);
     } else {
       const float lod = std::sqrt(brdf.alpha) * static_cast<float>(cube.levels.size() - 1);
-      const glm::vec3 d = box_only
-                              ? box_projected_direction(p, r, pv.centre, pv.box_min, pv.box_max)
-                              : distance_corrected_direction(cube, p, r, pv.centre, pv.box_min, pv.box_max, box_side);
+      const glm::vec3 d =
+          box_only ? box_projected_direction(p, r, pv.centre, pv.box_min, pv.box_max)
+                   : distance_corrected_direction(cube, p, r, pv.centre, pv.box_min, pv.box_max, box_side, rim);
       sum += w * cube_lookup_trilinear(cube, lod, d);
     }
     depth = std::max(depth, depth_in_box(pv, p, n));
@@ -293,7 +299,7 @@ Estimate estimate_of(const std::string& name) {
 // The diagnosis's `level0` estimate at texel t: the placed probes' level 0 under the exact lobe,
 // each direction corrected for parallax as the runtime corrects it, blended as it blends.
 glm::vec3 level0_estimate(const BakedProbes& b, const engine::GltfBrdf& brdf, const glm::vec3& p, const glm::vec3& n,
-                          const glm::vec3& v, std::size_t t, bool box_only, float box_side) {
+                          const glm::vec3& v, std::size_t t, bool box_only, float box_side, bool rim) {
   glm::vec3 sum(0.0f);
   float weight = 0.0f;
   for (std::size_t i = 0; i < b.set.probes.size(); ++i) {
@@ -304,7 +310,7 @@ glm::vec3 level0_estimate(const BakedProbes& b, const engine::GltfBrdf& brdf, co
     sum += w * exact_lobe(brdf, n, v, t, kExactLobeSamples, [&](const glm::vec3& l) {
              const glm::vec3 d =
                  box_only ? box_projected_direction(p, l, pv.centre, pv.box_min, pv.box_max)
-                          : distance_corrected_direction(cube, p, l, pv.centre, pv.box_min, pv.box_max, box_side);
+                          : distance_corrected_direction(cube, p, l, pv.centre, pv.box_min, pv.box_max, box_side, rim);
              return cube_lookup_trilinear(cube, 0.0f, d);
            });
     weight += w;
@@ -315,7 +321,7 @@ glm::vec3 level0_estimate(const BakedProbes& b, const engine::GltfBrdf& brdf, co
 // The diagnosis's estimates at texel t (`estimate` not Runtime): see the knob `estimate`.
 glm::vec3 diagnosis_estimate(Estimate estimate, const BakedProbes& b, const ProbeCapturer& capturer,
                              const engine::GltfBrdf& brdf, const glm::vec3& p, const glm::vec3& n, const glm::vec3& v,
-                             std::size_t t, bool box_only, float box_side, int lobe_samples) {
+                             std::size_t t, bool box_only, float box_side, bool rim, int lobe_samples) {
   const glm::vec3 origin = offset_ray_origin(p, n);
   if (estimate == Estimate::Trace)
     return exact_lobe(brdf, n, v, t, kTracedLobeSamples,
@@ -348,7 +354,7 @@ glm::vec3 diagnosis_estimate(Estimate estimate, const BakedProbes& b, const Prob
     }
     return weight > 0.0f ? sum / weight : glm::vec3(0.0f);
   }
-  if (estimate == Estimate::Level0) return level0_estimate(b, brdf, p, n, v, t, box_only, box_side);
+  if (estimate == Estimate::Level0) return level0_estimate(b, brdf, p, n, v, t, box_only, box_side, rim);
   const ProbeCube cube = capturer.bake_at(origin);
   if (estimate == Estimate::OracleLevel0)
     return exact_lobe(brdf, n, v, t, kExactLobeSamples,
@@ -385,11 +391,68 @@ void dump_texels(const RunContext& ctx, const AtlasTexels& tex, const std::vecto
   std::fclose(f);
 }
 
+// With GI_PROBE_SWEEP_DIRS set to a file: per covered texel and probe holding it, one CSV row
+// appended: the texel's position, inside (1) or border (0), the probe's centre and box, the
+// mirror direction's exact hit (traced) and the lookup's direction, the angle between the
+// lookup's and the hit's directions from the probe (degrees), the captured distance in the
+// hit's direction against the hit's distance from the probe (the per-texel diagnosis of the
+// lookup's directions, docs/reflection_probes.md).
+void write_directions(const BakedProbes& b, const ProbeCapturer& capturer, const GlossyTexels& g,
+                      const std::vector<std::uint8_t>& covered, const std::vector<std::uint8_t>& inner, float box_side,
+                      bool rim) {
+  std::FILE* f = std::fopen(std::getenv("GI_PROBE_SWEEP_DIRS"), "a");
+  if (!f) return;
+  const AtlasTexels& tex = g.s.texels;
+  for (std::size_t t = 0; t < tex.valid.size(); ++t) {
+    if (!covered[t]) continue;
+    const glm::vec3 p = tex.position[t], n = tex.normal[t];
+    const glm::vec3 r = glm::reflect(-glm::normalize(g.eye - p), n);
+    float distance = -1.0f;
+    (void)capturer.radiance(offset_ray_origin(p, n), r, &distance);
+    const glm::vec3 hit = distance < 0.0f ? p + 1e4f * r : p + distance * r;
+    for (std::size_t i = 0; i < b.set.probes.size(); ++i) {
+      const ProbeVolume& pv = b.set.probes[i];
+      if (!(probe_blend_weight(pv, p, kBoxMarginM) > 0.0f)) continue;
+      const ProbeCube& cube = b.set.cubes[i];
+      const glm::vec3 d = distance_corrected_direction(cube, p, r, pv.centre, pv.box_min, pv.box_max, box_side, rim);
+      const glm::vec3 to = hit - pv.centre;
+      const float cos_a = glm::dot(glm::normalize(d), glm::normalize(to));
+      const float angle = std::acos(std::clamp(cos_a, -1.0f, 1.0f)) * 57.29578f;
+      const glm::vec3 l_exact = cube_lookup_trilinear(cube, 0.0f, to), l_got = cube_lookup_trilinear(cube, 0.0f, d);
+      std::fprintf(f,
+                   "%.3f,%.3f,%.3f,%d,%zu,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.4f,%.4f,%.4f,%."
+                   "3f,%.3f,%.5g,%.5g\n",
+                   static_cast<double>(p.x), static_cast<double>(p.y), static_cast<double>(p.z), inner[t] ? 1 : 0, i,
+                   static_cast<double>(pv.centre.x), static_cast<double>(pv.centre.y), static_cast<double>(pv.centre.z),
+                   static_cast<double>(pv.box_min.x), static_cast<double>(pv.box_min.y),
+                   static_cast<double>(pv.box_min.z), static_cast<double>(pv.box_max.x),
+                   static_cast<double>(pv.box_max.y), static_cast<double>(pv.box_max.z), static_cast<double>(hit.x),
+                   static_cast<double>(hit.y), static_cast<double>(hit.z), static_cast<double>(d.x / glm::length(d)),
+                   static_cast<double>(d.y / glm::length(d)), static_cast<double>(d.z / glm::length(d)),
+                   static_cast<double>(angle), static_cast<double>(cube_distance_bilinear(cube, to) - glm::length(to)),
+                   static_cast<double>(l_exact.x + l_exact.y + l_exact.z),
+                   static_cast<double>(l_got.x + l_got.y + l_got.z));
+    }
+  }
+  std::fclose(f);
+}
+
+engine::Status dump_directions(const BakedProbes& b, const BakeInput& input, const GlossyTexels& g,
+                               const std::vector<std::uint8_t>& covered, const std::vector<std::uint8_t>& inner,
+                               float box_side, bool rim) {
+  const char* path = std::getenv("GI_PROBE_SWEEP_DIRS");
+  if (!path || !*path) return {};
+  auto capturer = ProbeCapturer::make(input, b.source(), b.settings);
+  if (!capturer) return capturer.error();
+  write_directions(b, *capturer, g, covered, inner, box_side, rim);
+  return {};
+}
+
 // With the knob `estimate` other than runtime: `values` at the covered texels replaced by the
 // diagnosis's estimate.
 engine::Status diagnose(const RunContext& ctx, const BakedProbes& baked, const BakeInput& input, const GlossyTexels& g,
-                        const std::vector<std::uint8_t>& covered, bool box_only, float box_side, int lobe_samples,
-                        std::vector<glm::vec3>& values) {
+                        const std::vector<std::uint8_t>& covered, bool box_only, float box_side, bool rim,
+                        int lobe_samples, std::vector<glm::vec3>& values) {
   const Estimate estimate = estimate_of(ctx.knobs.text("estimate"));
   if (estimate == Estimate::Runtime) return {};
   auto capturer = ProbeCapturer::make(input, baked.source(), baked.settings);
@@ -400,7 +463,7 @@ engine::Status diagnose(const RunContext& ctx, const BakedProbes& baked, const B
     if (!covered[t]) return;
     const glm::vec3 v = glm::normalize(g.eye - tex.position[t]);
     values[t] = diagnosis_estimate(estimate, baked, *capturer, g.brdf[t], tex.position[t], tex.normal[t], v, t,
-                                   box_only, box_side, lobe_samples);
+                                   box_only, box_side, rim, lobe_samples);
   });
   return {};
 }
@@ -443,6 +506,7 @@ engine::Result<MethodOutput> run_reflection_probes(const RunContext& ctx) {
   std::size_t uncovered = 0;
   const bool box_only = ctx.knobs.text("parallax") == "box";
   const auto box_side = static_cast<float>(ctx.knobs.real("box_side"));
+  const bool rim = ctx.knobs.text("rim") == "on";
   const int lobe_samples =
       ctx.knobs.text("lobe") != "split_sum" ? static_cast<int>(ctx.knobs.integer("lobe_samples")) : 0;
   const std::vector<ProbeCube> chains = lookup_chains(ctx, *set);
@@ -450,7 +514,7 @@ engine::Result<MethodOutput> run_reflection_probes(const RunContext& ctx) {
     if (!g->glossy[t]) continue;
     float depth = 0.0f;
     const glm::vec3 v = glm::normalize(g->eye - tex.position[t]);
-    if (!probe_specular(*set, g->brdf[t], tex.position[t], tex.normal[t], v, box_only, box_side, lobe_samples,
+    if (!probe_specular(*set, g->brdf[t], tex.position[t], tex.normal[t], v, box_only, box_side, rim, lobe_samples,
                         chains.empty() ? nullptr : &chains, values[t], depth)) {
       ++uncovered;
       continue;
@@ -458,9 +522,11 @@ engine::Result<MethodOutput> run_reflection_probes(const RunContext& ctx) {
     covered[t] = 1;
     (depth < border ? edge : inner)[t] = 1;
   }
-  if (auto diagnosed = diagnose(ctx, *baked, input, *g, covered, box_only, box_side, lobe_samples, values); !diagnosed)
+  if (auto diagnosed = diagnose(ctx, *baked, input, *g, covered, box_only, box_side, rim, lobe_samples, values);
+      !diagnosed)
     return diagnosed.error();
   dump_texels(ctx, tex, values, inner, covered);
+  if (auto dumped = dump_directions(*baked, input, *g, covered, inner, box_side, rim); !dumped) return dumped.error();
   MethodOutput out;
   out.field = RgbField::from_texels(tex.width, tex.height, values, covered);
   out.costs.bake_seconds = set->stats.total_seconds;

@@ -276,3 +276,59 @@ TEST(ProbeCube, TheBoxFirstFindsTheCorridorsWallsWhereTheSearchAloneMissesThem) 
               static_cast<double>(sum / static_cast<float>(count)),
               static_cast<double>(sum_search / static_cast<float>(count)));
 }
+
+// The same corridor, the floor 0.5 m from its side walls at z 9-10.6 m: the reflected rays meet
+// the far wall's 0.2 m jambs beside the opening (x 3.0-3.2 and 4.8-5.0 at z = 16.2), which the
+// 32^2 capture sees about a texel wide, its mean distances there mixing the jamb's 4 m with
+// the dark room's 10 m. Read by the bilinear mean alone, the exit looks like the opening: the
+// search goes on through it and stops on the dark room's far wall, 10-11 degrees off (most of
+// the demo corridor's inside error, docs/reflection_probes.md, "The opening's rim"). Where the
+// exit's texels that saw the side weigh at least half, the box's answer: the jamb. Not all: where
+// the mean is within the tolerance of the exit but the ray 10% further on looks through the
+// opening (the test that keeps a floor grazed beyond an open side searched), still the opening.
+TEST(ProbeCube, AtTheOpeningsRimAThinJambIsTheBoxsSideNotTheOpening) {
+  const gi::ProbeCube cube = corridor_cube(32);
+  const glm::vec3 eye(4.0f, 1.7f, 1.0f);
+  float sum = 0.0f, sum_mean_only = 0.0f, worst_mean_only = 0.0f;
+  int jamb_rays = 0, within = 0, within_mean_only = 0;
+  for (float x : {3.5f, 4.5f})
+    for (float z = 9.0f; z < 10.65f; z += 0.125f) {
+      const glm::vec3 p(x, 0.0f, z);
+      const glm::vec3 r = glm::reflect(glm::normalize(p - eye), glm::vec3(0.0f, 1.0f, 0.0f));
+      const glm::vec3 hit = p + corridor_distance(p, r) * r;
+      if (hit.z > 16.25f || std::abs(hit.x - 4.0f) < 0.8f) continue;  // the jambs only
+      ++jamb_rays;
+      const glm::vec3 truth = hit - kCorridorProbe;
+      const float got = degrees_between(
+          gi::distance_corrected_direction(cube, p, r, kCorridorProbe, kCorridorMin, kCorridorBoxMax), truth);
+      const float mean_only =
+          degrees_between(gi::distance_corrected_direction(cube, p, r, kCorridorProbe, kCorridorMin, kCorridorBoxMax,
+                                                           gi::kProbeBoxSideTolerance, false),
+                          truth);
+      sum += got, sum_mean_only += mean_only, worst_mean_only = std::max(worst_mean_only, mean_only);
+      within += got < 1.5f ? 1 : 0, within_mean_only += mean_only < 1.5f ? 1 : 0;
+    }
+  ASSERT_GE(jamb_rays, 20);
+  EXPECT_GT(worst_mean_only, 5.0f);  // what the rim's test is for
+  EXPECT_GE(within, jamb_rays * 4 / 5);
+  EXPECT_LE(within_mean_only, jamb_rays / 2);
+  EXPECT_LT(sum, 0.4f * sum_mean_only);
+  std::printf("%d rays onto the jambs: %d within 1.5 deg, mean %.2f deg (the bilinear mean alone: %d, %.2f)\n",
+              jamb_rays, within, static_cast<double>(sum / static_cast<float>(jamb_rays)), within_mean_only,
+              static_cast<double>(sum_mean_only / static_cast<float>(jamb_rays)));
+}
+
+// The footprint is the four texels the bilinear read blends: their nearest and farthest bound it.
+TEST(ProbeCube, TheDistanceFootprintBoundsTheBilinearRead) {
+  const gi::ProbeCube cube = corridor_cube(16);
+  for (float a = 0.0f; a < 6.28f; a += 0.37f)
+    for (float b = -1.4f; b < 1.5f; b += 0.31f) {
+      const glm::vec3 d(std::cos(a) * std::cos(b), std::sin(b), std::sin(a) * std::cos(b));
+      const gi::CubeDistanceFootprint f = gi::cube_distance_footprint(cube, d);
+      const float mean = gi::cube_distance_bilinear(cube, d);
+      EXPECT_LE(f.nearest, mean * 1.0001f);
+      EXPECT_GE(f.farthest, mean * 0.9999f);
+    }
+  EXPECT_EQ(gi::cube_distance_footprint(gi::make_probe_cube(4, 1), glm::vec3(1.0f, 0.0f, 0.0f)).nearest,
+            gi::kProbeFarDistance);
+}
