@@ -214,6 +214,8 @@ FreshGather gather_texel(const StaticBakeScene& b, const LandingTable& lt, const
         if (glm::dot(wi, t.face[i]) > 0.0f) batch[m++] = Ray{origin, 0.0f, wi};
       }
       land_rays(b, lt, t, std::span(batch).first(m), t.face[i], std::span(landed).first(m));
+      if (ne > 0)
+        for (std::size_t j = 0; j < m; ++j) emitters->prefetch_area_pdf(landed[j].pixel);
       for (std::size_t j = 0; j < m; ++j) {
         const glm::vec3 wi = batch[j].direction;
         const Landing& l = landed[j];
