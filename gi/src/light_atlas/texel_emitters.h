@@ -63,6 +63,13 @@ class TexelEmitters {
   /// Density (1/m^2) of sample(group, ...) at a point inside atlas texel `texel` (0 when it
   /// is not a valid texel or does not emit).
   float area_pdf(std::uint32_t group, std::uint32_t texel) const;
+  /// Starts loading what area_pdf() reads of `texel` (a landing's pixel), so that a batch of
+  /// landings' lookups overlap their cache misses.
+  void prefetch_area_pdf(std::uint32_t texel) const {
+    if (texel >= cluster_of_.size()) return;
+    __builtin_prefetch(&cluster_of_[texel]);
+    __builtin_prefetch(&density_[texel]);
+  }
   /// Emitting clusters (for the tests and the docs).
   std::size_t cluster_count() const { return clusters_.size(); }
 

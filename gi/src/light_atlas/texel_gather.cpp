@@ -35,6 +35,9 @@ constexpr float kPi = std::numbers::pi_v<float>;
 // filter neither reads nor smooths it.
 constexpr float kHiddenBackFraction = 0.1f;
 
+// The rays of a texel cast together before any lands (land_rays).
+constexpr std::size_t kRayBatch = 32;
+
 // Item ids of the four random streams of a texel.
 constexpr std::uint64_t kDirectStream = 0, kSolveStream = 1, kGatherStream = 2, kEmitterStream = 3;
 std::uint64_t stream_id(std::uint64_t texel, std::uint64_t stream) { return texel * 4 + stream; }
@@ -79,9 +82,9 @@ struct KeptRays {
 // Step 2's casting: `solve_rays` stratified cosine rays per texel, each kept as the texel it
 // lands on. The rays that escape see the sky: with cosine sampling E = pi / N x the sum of
 // the sky's radiance over the escaping rays (the sky's direct light, shadowed by the level).
-bool cast_kept_rays(const StaticBakeScene& b, const AtlasLayout& layout, const TexelTable& t,
-                    const TexelGatherSettings& s, ThreadPool& pool, const ProgressCallback& progress,
-                    std::vector<std::uint64_t>& rays_of, KeptRays& k) {
+bool cast_kept_rays(const StaticBakeScene& b, const LandingTable& lt, const TexelTable& t, const TexelGatherSettings& s,
+                    ThreadPool& pool, const ProgressCallback& progress, std::vector<std::uint64_t>& rays_of,
+                    KeptRays& k) {
   const AtlasTexels& tx = b.texels;
   const std::size_t ns = static_cast<std::size_t>(s.solve_rays);
   k.per_texel = ns;
@@ -96,15 +99,24 @@ bool cast_kept_rays(const StaticBakeScene& b, const AtlasLayout& layout, const T
     const glm::vec3 origin = offset_ray_origin(tx.position[i], t.face[i]);
     std::size_t back = 0;
     glm::vec3 sky_seen(0.0f);
-    for (std::size_t r = 0; r < ns; ++r) {
-      const glm::vec2 u = hammersley(static_cast<std::uint32_t>(r), static_cast<std::uint32_t>(ns), shift);
-      const glm::vec3 wi = sample_cosine_hemisphere(tx.normal[i], u.x, u.y);
-      if (glm::dot(wi, t.face[i]) <= 0.0f) continue;  // below the surface: dark
-      ++rays_of[w];
-      const std::uint32_t land = landing(b, layout, t, Ray{origin, 0.0f, wi}, t.face[i], nullptr);
-      k.land[w * ns + r] = land;
-      if (land == kSky) sky_seen += sky_along(b, wi);
-      back += land == kBack;
+    // Cast kRayBatch at a time (land_rays), read in the rays' order.
+    std::array<Ray, kRayBatch> batch;
+    std::array<std::uint32_t, kRayBatch> ray_of, landed;
+    for (std::size_t first = 0; first < ns; first += kRayBatch) {
+      std::size_t m = 0;
+      for (std::size_t r = first; r < std::min(ns, first + kRayBatch); ++r) {
+        const glm::vec2 u = hammersley(static_cast<std::uint32_t>(r), static_cast<std::uint32_t>(ns), shift);
+        const glm::vec3 wi = sample_cosine_hemisphere(tx.normal[i], u.x, u.y);
+        if (glm::dot(wi, t.face[i]) <= 0.0f) continue;  // below the surface: dark
+        batch[m] = Ray{origin, 0.0f, wi}, ray_of[m++] = static_cast<std::uint32_t>(r);
+      }
+      rays_of[w] += m;
+      landings(b, lt, t, std::span(batch).first(m), t.face[i], std::span(landed).first(m));
+      for (std::size_t j = 0; j < m; ++j) {
+        k.land[w * ns + ray_of[j]] = landed[j];
+        if (landed[j] == kSky) sky_seen += sky_along(b, batch[j].direction);
+        back += landed[j] == kBack;
+      }
     }
     k.hidden[i] = static_cast<float>(back) > kHiddenBackFraction * static_cast<float>(ns) ? 1 : 0;
     k.sky[i] = kPi * sky_seen / static_cast<float>(ns);
@@ -170,7 +182,7 @@ double luminance_of(const glm::dvec3& c) { return luminance(c.x, c.y, c.z); }
 // wherever either technique reaches (docs/light_atlas.md, "Emitter-sampled final gather").
 // Long because both kinds of rays share the MIS counts and one spread of their estimates
 // (the variance); split, the two loops would pass all of them back and forth.
-FreshGather gather_texel(const StaticBakeScene& b, const AtlasLayout& layout, const TexelTable& t,
+FreshGather gather_texel(const StaticBakeScene& b, const LandingTable& lt, const TexelTable& t,
                          const TexelGatherSettings& s, const GatherSource& src, const TexelEmitters* emitters,
                          std::uint32_t i, std::uint64_t& rays) {
   const AtlasTexels& tx = b.texels;
@@ -193,24 +205,36 @@ FreshGather gather_texel(const StaticBakeScene& b, const AtlasLayout& layout, co
     Pcg32 rng = Pcg32::for_item(s.seed, stream_id(i, kGatherStream));
     const float shift_y = rng.next_float();  // drawn first: see random.h
     const glm::vec2 shift(rng.next_float(), shift_y);
-    for (std::size_t r = 0; r < nf; ++r) {
-      const glm::vec2 u = hammersley(static_cast<std::uint32_t>(r), static_cast<std::uint32_t>(nf), shift);
-      const glm::vec3 wi = sample_cosine_hemisphere(n, u.x, u.y);
-      if (glm::dot(wi, t.face[i]) <= 0.0f) continue;
-      ++rays;
-      const Landing l = land_ray(b, layout, t, Ray{origin, 0.0f, wi}, t.face[i]);
-      double z = 0.0;
-      if (l.texel < kBack) {
-        const glm::dvec3 radiosity = read_landing(b, t, src, l, rng, rays);
-        const glm::dvec3 share = ne == 0 ? radiosity : radiosity / (nc + emitter_count(l, glm::dot(n, wi)));
-        g.irradiance += share;
-        z = (ne == 0 ? 1.0 : n_all) * luminance_of(share);
+    // Cast kRayBatch at a time (land_rays), read in the rays' order (the rng's).
+    std::array<Ray, kRayBatch> batch;
+    std::array<Landing, kRayBatch> landed;
+    for (std::size_t first = 0; first < nf; first += kRayBatch) {
+      std::size_t m = 0;
+      for (std::size_t r = first; r < std::min(nf, first + kRayBatch); ++r) {
+        const glm::vec2 u = hammersley(static_cast<std::uint32_t>(r), static_cast<std::uint32_t>(nf), shift);
+        const glm::vec3 wi = sample_cosine_hemisphere(n, u.x, u.y);
+        if (glm::dot(wi, t.face[i]) > 0.0f) batch[m++] = Ray{origin, 0.0f, wi};
       }
-      if (l.texel == kSky) {
-        g.sky += glm::dvec3(sky_along(b, wi));
-        z = n_all / nc * static_cast<double>(kPi) * static_cast<double>(luminance(sky_along(b, wi)));
+      land_rays(b, lt, t, std::span(batch).first(m), t.face[i], std::span(landed).first(m));
+      if (ne > 0)
+        for (std::size_t j = 0; j < m; ++j) emitters->prefetch_area_pdf(landed[j].pixel);
+      for (std::size_t j = 0; j < m; ++j) {
+        const glm::vec3 wi = batch[j].direction;
+        const Landing& l = landed[j];
+        ++rays;
+        double z = 0.0;
+        if (l.texel < kBack) {
+          const glm::dvec3 radiosity = read_landing(b, t, src, l, rng, rays);
+          const glm::dvec3 share = ne == 0 ? radiosity : radiosity / (nc + emitter_count(l, glm::dot(n, wi)));
+          g.irradiance += share;
+          z = (ne == 0 ? 1.0 : n_all) * luminance_of(share);
+        }
+        if (l.texel == kSky) {
+          g.sky += glm::dvec3(sky_along(b, wi));
+          z = n_all / nc * static_cast<double>(kPi) * static_cast<double>(luminance(sky_along(b, wi)));
+        }
+        spread.add(z);
       }
-      spread.add(z);
     }
     g.sky /= nc;
     if (ne == 0) g.irradiance /= nc;
@@ -239,7 +263,7 @@ FreshGather gather_texel(const StaticBakeScene& b, const AtlasLayout& layout, co
     const float cos_x = glm::dot(n, wi);
     if (cos_x <= 0.0f || glm::dot(wi, t.face[i]) <= 0.0f) continue;
     ++rays;
-    const Landing l = land_ray(b, layout, t, Ray{origin, 0.0f, wi}, t.face[i]);
+    const Landing l = land_ray(b, lt, t, Ray{origin, 0.0f, wi}, t.face[i]);
     if (l.texel >= kBack || l.pixel != e.texel) continue;  // occluded, or off the surface
     // B cos_x / pi / (n_c p_c + n_e p_e) = B / (n_c + n_e p_e pi / cos_x).
     const double count = nc + emitter_count(l, cos_x);
@@ -256,11 +280,10 @@ FreshGather gather_texel(const StaticBakeScene& b, const AtlasLayout& layout, co
 // `emitter_rays` towards `emitters`) read `reflected` (rho (E_d + E), dilated) bilinearly
 // where they land, and the sky where they escape. Each estimate is averaged with step 2's
 // (in e and k.sky), weighted by ray counts. Texels not in `mine` get 0 in both.
-bool final_gather(const StaticBakeScene& b, const AtlasLayout& layout, const TexelTable& t,
-                  const TexelGatherSettings& s, ThreadPool& pool, const ProgressCallback& progress,
-                  const std::vector<std::size_t>& mine, const GatherSource& src, const TexelEmitters* emitters,
-                  const KeptRays& k, std::vector<glm::vec3>& e, std::vector<glm::vec3>& sky,
-                  std::vector<float>& variance, std::vector<std::uint64_t>& rays_of) {
+bool final_gather(const StaticBakeScene& b, const LandingTable& lt, const TexelTable& t, const TexelGatherSettings& s,
+                  ThreadPool& pool, const ProgressCallback& progress, const std::vector<std::size_t>& mine,
+                  const GatherSource& src, const TexelEmitters* emitters, const KeptRays& k, std::vector<glm::vec3>& e,
+                  std::vector<glm::vec3>& sky, std::vector<float>& variance, std::vector<std::uint64_t>& rays_of) {
   const auto nf = static_cast<std::size_t>(s.gather_rays);
   const auto ne = emitters ? static_cast<std::size_t>(s.emitter_rays) : std::size_t{0};
   // Both estimate T(E_d + E): weighted by their rays (the sky by the cosine rays alone).
@@ -277,7 +300,7 @@ bool final_gather(const StaticBakeScene& b, const AtlasLayout& layout, const Tex
   const bool done = pool.parallel_for_with_progress(mine.size(), progress, [&](std::size_t m) {
     const std::size_t w = mine[m];
     const std::uint32_t i = t.work[w];
-    const FreshGather g = gather_texel(b, layout, t, s, src, emitters, i, rays_of[w]);
+    const FreshGather g = gather_texel(b, lt, t, s, src, emitters, i, rays_of[w]);
     gathered[i] = glm::vec3(w_solve * glm::dvec3(e[i]) + (1.0 - w_solve) * g.irradiance);
     sky[i] = glm::vec3(w_sky * glm::dvec3(k.sky[i]) + (1.0 - w_sky) * static_cast<double>(kPi) * g.sky);
     variance[i] = static_cast<float>(g.ray_variance / rays);
@@ -290,8 +313,8 @@ bool final_gather(const StaticBakeScene& b, const AtlasLayout& layout, const Tex
 // its noise would otherwise come back as blotches a few texels wide, a bright texel lighting
 // its neighbours' rays). `out.indirect` holds the solve on entry and the gather on return;
 // `sky` the sky's direct light, likewise.
-bool gather_step(const StaticBakeScene& b, const AtlasLayout& layout, const TexelTable& t, const TexelGatherSettings& s,
-                 ThreadPool& pool, const ProgressCallback& progress, const KeptRays& kept,
+bool gather_step(const StaticBakeScene& b, const AtlasLayout& layout, const TexelTable& t, LandingTable& lt,
+                 const TexelGatherSettings& s, ThreadPool& pool, const ProgressCallback& progress, const KeptRays& kept,
                  const std::vector<glm::vec3>& emitted, const std::vector<glm::vec3>& sampled, TexelGatherResult& out,
                  std::vector<glm::vec3>& sky) {
   const AtlasTexels& tx = b.texels;
@@ -326,11 +349,12 @@ bool gather_step(const StaticBakeScene& b, const AtlasLayout& layout, const Texe
     for (std::uint32_t i : t.work) src.without_punctual[i] = t.albedo[i] * (kept.sky[i] + source[i] + sampled[i]);
     dilate<glm::vec3>(src.without_punctual, t.width, t.height, tx.valid, rings);
   }
-  src.layout = &layout;
+  mark_sharp(lt, src.sharp);
+  src.table = &lt;
   src.near_rays = s.near_regather_rays;
   src.near_m = s.near_regather_texels * texel_m;
   std::vector<std::uint64_t> gather_rays_of(work, 0);
-  if (!final_gather(b, layout, t, s, pool, progress, s.shard.items(work), src, emitters ? &*emitters : nullptr, kept, e,
+  if (!final_gather(b, lt, t, s, pool, progress, s.shard.items(work), src, emitters ? &*emitters : nullptr, kept, e,
                     sky, out.variance, gather_rays_of))
     return false;
   for (std::uint64_t r : gather_rays_of) out.own_rays += r;
@@ -367,6 +391,9 @@ engine::Result<TexelGatherResult> gather_atlas(const StaticBakeScene& b, const A
   auto table = texel_table(b, layout);
   if (!table) return table.error();
   const TexelTable& t = *table;
+  auto packed = landing_table(b, layout, t);
+  if (!packed) return packed.error();
+  LandingTable& lt = *packed;
   const AtlasTexels& tx = b.texels;
   const std::size_t n = tx.valid.size(), work = t.work.size();
   const auto phase = [&](double begin, double end) -> ProgressCallback {
@@ -397,7 +424,7 @@ engine::Result<TexelGatherResult> gather_atlas(const StaticBakeScene& b, const A
   // Step 2. Every texel reflects the direct light of the lights, of the emitters and of the sky.
   t0 = Clock::now();
   KeptRays kept;
-  if (!cast_kept_rays(b, layout, t, s, pool, phase(0.15, 0.45), rays_of, kept))
+  if (!cast_kept_rays(b, lt, t, s, pool, phase(0.15, 0.45), rays_of, kept))
     return engine::cancelled_error("light-atlas gather");
   std::vector<glm::vec3> emitted(n, glm::vec3(0.0f));
   for (std::uint32_t i : t.work) emitted[i] = out.direct[i] + out.baked_direct[i] + kept.sky[i];
@@ -410,7 +437,7 @@ engine::Result<TexelGatherResult> gather_atlas(const StaticBakeScene& b, const A
   t0 = Clock::now();
   std::vector<glm::vec3> sky = kept.sky;
   if (s.gather_rays > 0 || s.emitter_rays > 0) {
-    if (!gather_step(b, layout, t, s, pool, phase(0.5, 0.95), kept, emitted, sampled, out, sky))
+    if (!gather_step(b, layout, t, lt, s, pool, phase(0.5, 0.95), kept, emitted, sampled, out, sky))
       return engine::cancelled_error("light-atlas gather");
   } else if (!s.shard.whole()) {
     for (std::size_t w = 0; w < work; ++w)
@@ -437,12 +464,14 @@ engine::Result<std::vector<glm::vec3>> sky_direct_light(const StaticBakeScene& b
   if (rays < 1) return engine::invalid_request("the sky's direct light: rays must be >= 1");
   auto table = texel_table(b, layout);
   if (!table) return table.error();
+  auto packed = landing_table(b, layout, *table);
+  if (!packed) return packed.error();
   std::vector<std::uint64_t> rays_of(table->work.size(), 0);
   TexelGatherSettings s;
   s.solve_rays = rays;
   s.seed = seed;
   KeptRays kept;
-  cast_kept_rays(b, layout, *table, s, pool, {}, rays_of, kept);
+  cast_kept_rays(b, *packed, *table, s, pool, {}, rays_of, kept);
   return std::move(kept.sky);
 }
 

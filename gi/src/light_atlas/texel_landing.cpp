@@ -3,6 +3,7 @@
 #include <engine/sky.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -15,13 +16,6 @@
 
 namespace gi {
 namespace {
-
-glm::vec2 hit_uv(const AtlasLayout& layout, const Hit& h) {
-  const AtlasMeshUv& mu = layout.meshes[h.instance];
-  const std::uint32_t* idx = &mu.indices[3u * h.primitive];
-  const float u = h.barycentric.x, v = h.barycentric.y;
-  return (1.0f - u - v) * mu.uv1[idx[0]] + u * mu.uv1[idx[1]] + v * mu.uv1[idx[2]];
-}
 
 // The four atlas pixels of a bilinear read at uv (bilinear()'s), corner k = (x0 + k % 2, y0 + k / 2),
 // and its fractions.
@@ -69,14 +63,17 @@ bool gap_is_covered(const StaticBakeScene& b, const TexelTable& t, const Ray& ra
 // Landing::unseen_corners at the landing point p, `distance` from the ray's
 // origin: each sample checked once, the moved ones always, all of them on a landing closer
 // than a texel (a pocket's floor whose texels' samples lie beyond its walls).
-void mark_unseen(const StaticBakeScene& b, const TexelTable& t, const glm::vec3& p, float distance, Landing& l) {
+void mark_unseen(const StaticBakeScene& b, const LandingTable& lt, const TexelTable& t, const glm::vec3& p,
+                 float distance, Landing& l) {
   const Footprint f = footprint_at(t.width, t.height, l.uv);
   const bool near = distance < t.near_m;
   std::uint32_t checked[5] = {l.texel, kDark, kDark, kDark, kDark};
-  bool unseen[5] = {(near || t.moved[l.texel] != 0) && sample_unseen(b, t, p, l.side, l.texel)};
+  const bool moved = (lt.pixels[l.pixel].bits & LandingTable::kMoved) != 0;
+  bool unseen[5] = {(near || moved) && sample_unseen(b, t, p, l.side, l.texel)};
   for (int k = 0; k < 4; ++k) {
-    const std::uint32_t j = t.redirect[f.pixel[k]];
-    if (j == kDark || !(near || t.moved[j])) continue;
+    const LandingTable::Pixel& corner = lt.pixels[f.pixel[k]];
+    const std::uint32_t j = LandingTable::texel_of(corner);
+    if (j == kDark || !(near || (corner.bits & LandingTable::kMoved) != 0)) continue;
     int c = 0;
     while (c <= k && checked[c] != j && checked[c] != kDark) ++c;
     if (checked[c] != j) checked[c] = j, unseen[c] = sample_unseen(b, t, p, l.side, j);
@@ -98,32 +95,76 @@ glm::vec3 bilinear(const std::vector<glm::vec3>& img, int w, int h, glm::vec2 uv
          ay * ((1.0f - ax) * at(x0, y0 + 1) + ax * at(x0 + 1, y0 + 1));
 }
 
-// land_ray; with `corners` false, Landing::unseen_corners stays 0 (its visibility rays are
-// cast only for the reads that use them).
-Landing land(const StaticBakeScene& b, const AtlasLayout& layout, const TexelTable& t, const Ray& ray,
-             const glm::vec3& from, bool corners) {
-  const Hit h = b.caster->intersect(ray);
+// The atlas pixel under uv (the landing's `pixel`).
+std::uint32_t pixel_at(const TexelTable& t, glm::vec2 uv) {
+  const int x = std::clamp(static_cast<int>(uv.x * static_cast<float>(t.width)), 0, t.width - 1);
+  const int y = std::clamp(static_cast<int>(uv.y * static_cast<float>(t.height)), 0, t.height - 1);
+  return static_cast<std::uint32_t>(static_cast<std::size_t>(y) * static_cast<std::size_t>(t.width) +
+                                    static_cast<std::size_t>(x));
+}
+
+glm::vec2 uv_at(const LandingTable::Triangle& tri, glm::vec2 barycentric) {
+  const float u = barycentric.x, v = barycentric.y;
+  return (1.0f - u - v) * tri.uv[0] + u * tri.uv[1] + v * tri.uv[2];
+}
+
+// land_ray of `ray` whose hit is `h`; with `corners` false, Landing::unseen_corners stays 0
+// (its visibility rays are cast only for the reads that use them).
+Landing land_hit(const StaticBakeScene& b, const LandingTable& lt, const TexelTable& t, const Ray& ray, const Hit& h,
+                 const glm::vec3& from, bool corners) {
   if (!h.valid()) return {};
-  const ShadingTriangle& tri = b.index.triangles[b.triangle_of(h)];
+  const LandingTable::Triangle& tri = lt.triangle_of(h);
   const float cos_surface = glm::dot(tri.face_normal, ray.direction);
-  if (!(cos_surface < 0.0f) && !b.scene.materials[tri.material].double_sided) return {.texel = kBack};
+  if (!(cos_surface < 0.0f) && tri.double_sided == 0) return {.texel = kBack};
   const glm::vec3 side = cos_surface < 0.0f ? tri.face_normal : -tri.face_normal;
   if (h.t < t.gap_m && std::fabs(glm::dot(tri.face_normal, from)) > 0.9f && gap_is_covered(b, t, ray, h, side))
     return {.texel = kBack};
   Landing l;
-  l.triangle = b.triangle_of(h);
+  l.triangle = tri.triangle;
   l.barycentric = h.barycentric;
   l.side = side;
-  l.uv = hit_uv(layout, h);
-  const int x = std::clamp(static_cast<int>(l.uv.x * static_cast<float>(t.width)), 0, t.width - 1);
-  const int y = std::clamp(static_cast<int>(l.uv.y * static_cast<float>(t.height)), 0, t.height - 1);
-  l.pixel = static_cast<std::uint32_t>(static_cast<std::size_t>(y) * static_cast<std::size_t>(t.width) +
-                                       static_cast<std::size_t>(x));
-  l.texel = t.redirect[l.pixel];
-  if (corners && l.texel != kDark) mark_unseen(b, t, ray.origin + h.t * ray.direction, h.t, l);
+  l.uv = uv_at(tri, h.barycentric);
+  l.pixel = pixel_at(t, l.uv);
+  l.texel = LandingTable::texel_of(lt.pixels[l.pixel]);
+  if (corners && l.texel != kDark) mark_unseen(b, lt, t, ray.origin + h.t * ray.direction, h.t, l);
   l.distance = h.t;
   l.cos_surface = std::fabs(cos_surface);
   return l;
+}
+
+Landing land(const StaticBakeScene& b, const LandingTable& lt, const TexelTable& t, const Ray& ray,
+             const glm::vec3& from, bool corners) {
+  return land_hit(b, lt, t, ray, b.caster->intersect_without_normal(ray), from, corners);
+}
+
+// Up to kBatch rays cast before any of them lands: their triangles' records, then their
+// pixels' records (and, for the reads, the shading triangle and the footprint's other rows)
+// are prefetched, so that the landings' cache misses overlap instead of following each other.
+constexpr std::size_t kBatch = 16;
+
+template <typename Land>
+void land_batched(const StaticBakeScene& b, const LandingTable& lt, const TexelTable& t, std::span<const Ray> rays,
+                  bool corners, Land&& land_one) {
+  std::array<Hit, kBatch> hits;
+  for (std::size_t first = 0; first < rays.size(); first += kBatch) {
+    const std::size_t n = std::min(kBatch, rays.size() - first);
+    for (std::size_t r = 0; r < n; ++r) {
+      hits[r] = b.caster->intersect_without_normal(rays[first + r]);
+      if (hits[r].valid()) __builtin_prefetch(&lt.triangle_of(hits[r]));
+    }
+    for (std::size_t r = 0; r < n; ++r) {
+      if (!hits[r].valid()) continue;
+      const LandingTable::Triangle& tri = lt.triangle_of(hits[r]);
+      const std::size_t p = pixel_at(t, uv_at(tri, hits[r].barycentric));
+      __builtin_prefetch(&lt.pixels[p]);
+      if (!corners) continue;
+      const auto w = static_cast<std::size_t>(t.width);
+      if (p >= w) __builtin_prefetch(&lt.pixels[p - w]);
+      if (p + w < lt.pixels.size()) __builtin_prefetch(&lt.pixels[p + w]);
+      __builtin_prefetch(&b.index.triangles[tri.triangle]);
+    }
+    for (std::size_t r = 0; r < n; ++r) land_one(first + r, hits[r]);
+  }
 }
 
 }  // namespace
@@ -136,15 +177,62 @@ glm::vec3 landing_shading_normal(const ShadingTriangle& tri, glm::vec2 barycentr
   return glm::dot(n, side) > 0.0f ? n : side;
 }
 
-Landing land_ray(const StaticBakeScene& b, const AtlasLayout& layout, const TexelTable& t, const Ray& ray,
-                 const glm::vec3& from) {
-  return land(b, layout, t, ray, from, true);
+engine::Result<LandingTable> landing_table(const StaticBakeScene& b, const AtlasLayout& layout, const TexelTable& t) {
+  const std::size_t n = t.redirect.size();
+  if (n >= LandingTable::kTexelMask)
+    return engine::invalid_request("the light atlas's landing table: 2^30 atlas texels or more");
+  LandingTable lt;
+  for (std::size_t m = 0; m < layout.meshes.size(); ++m) {
+    const AtlasMeshUv& mu = layout.meshes[m];
+    const auto first = static_cast<std::uint32_t>(lt.triangles.size());
+    lt.first.push_back(first);
+    const std::uint32_t shading_first = b.index.instance_first[b.static_instance[m]];
+    for (std::size_t p = 0; p < mu.indices.size() / 3; ++p) {
+      const std::uint32_t triangle = shading_first + static_cast<std::uint32_t>(p);
+      const ShadingTriangle& tri = b.index.triangles[triangle];
+      LandingTable::Triangle& r = lt.triangles.emplace_back();
+      r.face_normal = tri.face_normal;
+      r.double_sided = b.scene.materials[tri.material].double_sided ? 1 : 0;
+      r.triangle = triangle;
+      for (int k = 0; k < 3; ++k) r.uv[k] = mu.uv1[mu.indices[3 * p + static_cast<std::size_t>(k)]];
+    }
+  }
+  lt.pixels.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint32_t j = t.redirect[i];
+    if (j == kDark) continue;
+    lt.pixels[i].bits = j | (t.moved[j] != 0 ? LandingTable::kMoved : 0u);
+    lt.pixels[i].albedo = t.albedo[j];
+  }
+  return lt;
 }
 
-std::uint32_t landing(const StaticBakeScene& b, const AtlasLayout& layout, const TexelTable& t, const Ray& ray,
+void mark_sharp(LandingTable& lt, const std::vector<std::uint8_t>& sharp) {
+  for (std::size_t i = 0; i < lt.pixels.size() && i < sharp.size(); ++i)
+    lt.pixels[i].bits = (lt.pixels[i].bits & ~LandingTable::kSharp) | (sharp[i] != 0 ? LandingTable::kSharp : 0u);
+}
+
+Landing land_ray(const StaticBakeScene& b, const LandingTable& lt, const TexelTable& t, const Ray& ray,
+                 const glm::vec3& from) {
+  return land(b, lt, t, ray, from, true);
+}
+
+void land_rays(const StaticBakeScene& b, const LandingTable& lt, const TexelTable& t, std::span<const Ray> rays,
+               const glm::vec3& from, std::span<Landing> out) {
+  land_batched(b, lt, t, rays, true,
+               [&](std::size_t r, const Hit& h) { out[r] = land_hit(b, lt, t, rays[r], h, from, true); });
+}
+
+void landings(const StaticBakeScene& b, const LandingTable& lt, const TexelTable& t, std::span<const Ray> rays,
+              const glm::vec3& from, std::span<std::uint32_t> out) {
+  land_batched(b, lt, t, rays, false,
+               [&](std::size_t r, const Hit& h) { out[r] = land_hit(b, lt, t, rays[r], h, from, false).texel; });
+}
+
+std::uint32_t landing(const StaticBakeScene& b, const LandingTable& lt, const TexelTable& t, const Ray& ray,
                       const glm::vec3& from, glm::vec2* uv) {
   // The kept rays read the texel alone: no corner of a bilinear read to check.
-  const Landing l = land(b, layout, t, ray, from, false);
+  const Landing l = land(b, lt, t, ray, from, false);
   if (uv && l.texel != kSky && l.texel != kBack) *uv = l.uv;
   return l.texel;
 }
@@ -198,7 +286,7 @@ glm::dvec3 regather_at(const StaticBakeScene& b, const TexelTable& t, const Gath
     const glm::vec3 wi = sample_cosine_hemisphere(at.n, u.x, u.y);
     if (glm::dot(wi, l.side) <= 0.0f) continue;
     ++rays;
-    const Landing l2 = land(b, *src.layout, t, Ray{origin, 0.0f, wi}, l.side, true);
+    const Landing l2 = land(b, *src.table, t, Ray{origin, 0.0f, wi}, l.side, true);
     if (l2.texel == kSky)
       sum += std::numbers::pi * glm::dvec3(engine::sky_radiance(b.scene.sky_radiance, b.scene.sky_gradient, wi));
     else if (glm::dvec3 reflected; l2.texel < kBack && read_seen_corners(t, src.reflected, l2, reflected))
@@ -215,15 +303,17 @@ glm::dvec3 read_landing(const StaticBakeScene& b, const TexelTable& t, const Gat
     const LandingPoint at = landing_point(b, l);
     const glm::dvec3 rest = regather_at(b, t, src, l, at, rng, rays);
     const DirectAt d = direct_at(b, at.p, at.n, l.side, 1, rng, &rays);
-    return glm::dvec3(t.albedo[l.texel]) * (rest + glm::dvec3(d.live + d.unlit));
+    return glm::dvec3(src.table->pixels[l.pixel].albedo) * (rest + glm::dvec3(d.live + d.unlit));
   }
-  const bool sharp = src.sharp[l.pixel] != 0;
+  // l.texel is the pixel's redirect: the pixel's record holds its albedo.
+  const LandingTable::Pixel& px = src.table->pixels[l.pixel];
+  const bool sharp = (px.bits & LandingTable::kSharp) != 0;
   glm::dvec3 rest(0.0);
   if (!sharp && src.punctual_everywhere) {
     if (read_seen_corners(t, src.without_punctual, l, rest)) {
       const LandingPoint at = landing_point(b, l);
       const DirectAt d = direct_at(b, at.p, at.n, l.side, 1, rng, &rays, DirectLights::Punctual);
-      return rest + glm::dvec3(t.albedo[l.texel] * d.live);
+      return rest + glm::dvec3(px.albedo * d.live);
     }
     // No corner sees the point: every light's direct light there is all the read takes.
   } else if (read_seen_corners(t, sharp ? src.without_lights : src.reflected, l, rest) && !sharp) {
@@ -232,7 +322,7 @@ glm::dvec3 read_landing(const StaticBakeScene& b, const TexelTable& t, const Gat
   // Where no corner sees the point, the lights' direct light there is all the read takes.
   const LandingPoint at = landing_point(b, l);
   const DirectAt d = direct_at(b, at.p, at.n, l.side, 1, rng, &rays);
-  const glm::dvec3 lights(t.albedo[l.texel] * (d.live + d.unlit));
+  const glm::dvec3 lights(px.albedo * (d.live + d.unlit));
   return rest + lights;
 }
 

@@ -5,10 +5,14 @@
 // of the bilinear read whose samples do not see the point (samples moved off their surface),
 // reads across a shadow edge, which take the lights' direct light at the point itself, and
 // landings nearer than a texel, which take all their light at the point (a regather).
-//   const gi::Landing l = gi::land_ray(bake_scene, layout, table, ray, table.face[i]);
+//   const gi::LandingTable lt = gi::landing_table(bake_scene, layout, table).value();
+//   const gi::Landing l = gi::land_ray(bake_scene, lt, table, ray, table.face[i]);
 //   if (l.texel < gi::kBack) radiosity = gi::read_landing(bake_scene, table, source, l, rng, rays);
 
+#include <engine/result.h>
+
 #include <cstdint>
+#include <span>
 #include <vector>
 #include <glm/glm.hpp>
 
@@ -39,6 +43,46 @@ struct Landing {
   std::uint8_t unseen_corners = 0;
 };
 
+/// What a landing reads of the scene and the atlas, packed so that one landing misses the
+/// cache a few times instead of once per array (issue 35: on Dabrovic Sponza the landing code
+/// was a third of the gather, stalled on atlas-sized arrays). The values are copies of the bake
+/// scene's and the TexelTable's: reading them here computes the same landings.
+struct LandingTable {
+  static constexpr std::uint32_t kTexelMask = 0x3fffffffu, kMoved = 1u << 30, kSharp = 1u << 31;
+  /// Per triangle of the caster: its unit face normal, whether its material is double-sided,
+  /// its index.triangles entry and its atlas UV (uv1) at the corners; one cache line.
+  struct alignas(64) Triangle {
+    glm::vec3 face_normal{0.0f};
+    std::uint32_t double_sided = 0;
+    std::uint32_t triangle = 0;
+    glm::vec2 uv[3]{};
+  };
+  /// Per atlas pixel: the valid texel it is read as (TexelTable::redirect) with that texel's
+  /// `moved` flag and the pixel's shadow-edge flag (GatherSource::sharp) in its top bits, and
+  /// that texel's albedo; 16 bytes.
+  struct Pixel {
+    std::uint32_t bits = kTexelMask;
+    glm::vec3 albedo{0.0f};
+  };
+
+  std::vector<std::uint32_t> first;  // per caster instance: its first entry of `triangles`
+  std::vector<Triangle> triangles;
+  std::vector<Pixel> pixels;
+
+  const Triangle& triangle_of(const Hit& h) const { return triangles[first[h.instance] + h.primitive]; }
+  static std::uint32_t texel_of(const Pixel& p) {
+    const std::uint32_t r = p.bits & kTexelMask;
+    return r == kTexelMask ? kDark : r;
+  }
+};
+
+/// The landing table of `t` (its `sharp` flags all 0: mark_sharp sets them). Errors: an atlas
+/// of 2^30 texels or more (the texel ids share their word with the flags).
+engine::Result<LandingTable> landing_table(const StaticBakeScene& b, const AtlasLayout& layout, const TexelTable& t);
+
+/// Sets the table's shadow-edge flags from `sharp` (per atlas pixel, sharp_pixels).
+void mark_sharp(LandingTable& lt, const std::vector<std::uint8_t>& sharp);
+
 /// The shading normal at a landing on `tri` (barycentric u, v) seen from `side` (its face
 /// normal turned towards the ray's origin), as the path tracer shades a hit (shading_brdf):
 /// the interpolated vertex normal, turned over on the back of a double-sided surface, and
@@ -47,12 +91,22 @@ struct Landing {
 glm::vec3 landing_shading_normal(const ShadingTriangle& tri, glm::vec2 barycentric, const glm::vec3& side);
 
 /// Casts `ray` from a texel whose face is `from` and says where it lands (Landing).
-Landing land_ray(const StaticBakeScene& b, const AtlasLayout& layout, const TexelTable& t, const Ray& ray,
+Landing land_ray(const StaticBakeScene& b, const LandingTable& lt, const TexelTable& t, const Ray& ray,
                  const glm::vec3& from);
+
+/// land_ray of every ray of `rays` (all from a texel whose face is `from`) into `out`, the same
+/// landings, but cast a few at a time before any lands, so that their reads' cache misses
+/// overlap (out.size() == rays.size()).
+void land_rays(const StaticBakeScene& b, const LandingTable& lt, const TexelTable& t, std::span<const Ray> rays,
+               const glm::vec3& from, std::span<Landing> out);
+
+/// landing()'s texel of every ray of `rays`, as land_rays lands them.
+void landings(const StaticBakeScene& b, const LandingTable& lt, const TexelTable& t, std::span<const Ray> rays,
+              const glm::vec3& from, std::span<std::uint32_t> out);
 
 /// land_ray's texel alone (kSky, kBack, kDark or a texel), and its atlas UV in `uv` (if given)
 /// when it lands on a surface; without the visibility rays of Landing::unseen_corners.
-std::uint32_t landing(const StaticBakeScene& b, const AtlasLayout& layout, const TexelTable& t, const Ray& ray,
+std::uint32_t landing(const StaticBakeScene& b, const LandingTable& lt, const TexelTable& t, const Ray& ray,
                       const glm::vec3& from, glm::vec2* uv);
 
 /// What step 3's rays read, per atlas pixel (dilated): rho (E_d + E) of every texel, the same
@@ -69,7 +123,7 @@ struct GatherSource {
   /// Landings nearer than `near_m` take the sky and the indirect light at the point itself
   /// from `near_rays` cosine rays (a second gather one level down, reading `reflected`)
   /// instead of reading them from the texels (0 rays: never).
-  const AtlasLayout* layout = nullptr;
+  const LandingTable* table = nullptr;  // the flags of `sharp` set (mark_sharp)
   int near_rays = 0;
   float near_m = 0.0f;
 };

@@ -151,6 +151,14 @@ class EmbreeRayCaster final : public RayCaster {
     return to_hit(rh);
   }
 
+  Hit intersect_without_normal(const Ray& ray) const override {
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    RTCRayHit rh = to_embree(ray);
+    rtcIntersect1(top_.h, &ctx, &rh);
+    return to_hit(rh, false);
+  }
+
   bool occluded(const Ray& ray) const override {
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
@@ -297,7 +305,7 @@ class EmbreeRayCaster final : public RayCaster {
     return rh;
   }
 
-  Hit to_hit(const RTCRayHit& rh) const {
+  Hit to_hit(const RTCRayHit& rh, bool normal = true) const {
     Hit h;
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return h;
     const std::uint32_t inst = rh.hit.instID[0] != RTC_INVALID_GEOMETRY_ID ? rh.hit.instID[0] : rh.hit.geomID;
@@ -308,6 +316,7 @@ class EmbreeRayCaster final : public RayCaster {
     h.geometry = instance.geometry;
     h.primitive = rh.hit.primID;
     h.barycentric = {rh.hit.u, rh.hit.v};
+    if (!normal) return h;
     // The geometric normal from the world-space triangle (independent of Embree's
     // instance-space conventions).
     const std::uint32_t s = static_normal_of_[inst];

@@ -18,6 +18,9 @@ class RayCaster {
   virtual ~RayCaster() = default;
   /// Closest hit along the ray within [t_min, t_max], or an invalid Hit.
   virtual Hit intersect(const Ray& ray) const = 0;
+  /// intersect() whose Hit::geometric_normal may be left 0 (the rest is the same): for callers
+  /// that take the normal from their own tables, spared its cache miss.
+  virtual Hit intersect_without_normal(const Ray& ray) const { return intersect(ray); }
   /// True when anything lies along the ray within [t_min, t_max].
   virtual bool occluded(const Ray& ray) const = 0;
   /// Closest hits of many rays (a stream; implementations may batch). hits.size() == rays.size().
