@@ -119,7 +119,18 @@ float ExactLeafTransport::pair_coupling(const ElementHierarchy& h, std::size_t i
   const glm::vec3* tj = &h.corners[3 * nj];
   const glm::vec3 n_i = h.nodes[ni].normal, n_j = h.nodes[nj].normal;
   if (behind(tj, ti[0], n_i) || behind(ti, tj[0], n_j)) return 0.0f;
-  const int m = settings_.point_pairs;
+  int m = settings_.point_pairs;
+  if (settings_.reference_area_m2 > 0.0f) {
+    const ElementNode& a = h.nodes[ni];
+    const ElementNode& b = h.nodes[nj];
+    const float reach = 2.0f * (a.radius_m + b.radius_m);
+    if (glm::dot(a.center - b.center, a.center - b.center) >= reach * reach) {
+      const double share =
+          static_cast<double>(a.area_m2) * static_cast<double>(b.area_m2) /
+          (static_cast<double>(settings_.reference_area_m2) * static_cast<double>(settings_.reference_area_m2));
+      m = std::clamp(static_cast<int>(std::ceil(static_cast<double>(m) * share)), 1, m);
+    }
+  }
   const int strata = std::max(1, static_cast<int>(std::sqrt(static_cast<double>(m))));
   const float min_r2 = settings_.min_distance_m * settings_.min_distance_m;
   std::uint64_t state = mix(settings_.seed ^ mix(static_cast<std::uint64_t>(i) * 0x100000001b3ULL + j));

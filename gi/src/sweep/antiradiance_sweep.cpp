@@ -277,6 +277,12 @@ std::vector<KnobSpec> solve_knobs() {
        .default_grid = {"0"},
        .min_value = 0,
        .max_value = 64},
+      {.name = "exact_adaptive",
+       .description = "solve=exact: fewer point pairs for leaves smaller than patch^2 / 2 (ExactTransportSettings::"
+                      "reference_area_m2)",
+       .kind = KnobKind::Choice,
+       .default_grid = {"off"},
+       .choices = {"off", "on"}},
       {.name = "exact_noise",
        .description = "solve=exact: also solve with exact_seed + 1 and report the change's own noise (exact_noise_rel)",
        .kind = KnobKind::Choice,
@@ -663,6 +669,7 @@ engine::Result<ExactMoves> exact_door_moves(const RunContext& ctx, const DoorSet
   if (!direct) return direct.error();
   ExactTransportSettings es;
   es.point_pairs = static_cast<int>(ctx.knobs.integer("exact_pairs"));
+  if (ctx.knobs.text("exact_adaptive") == "on") es.reference_area_m2 = 0.5f * s.patch_size_m * s.patch_size_m;
   es.bounces = static_cast<int>(ctx.knobs.integer("exact_bounces"));
   es.tolerance = s.residual_tolerance > 0.0 ? s.residual_tolerance : 1e-3;
   es.seed = seed;

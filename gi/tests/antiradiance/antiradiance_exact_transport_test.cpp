@@ -83,6 +83,17 @@ TEST(ExactLeafTransport, FacingSquaresMatchTheAnalyticFormFactor) {
   EXPECT_NEAR(f_ba, f_ab, 1e-6);  // one estimate per unordered pair: reciprocity exactly
   // A coplanar pair couples nothing.
   EXPECT_EQ(t->coupling(0, 1), 0.0f);
+  // Fewer point pairs for the small leaves (as if 0.5 m leaves were the reference): noisier,
+  // still unbiased.
+  gi::ExactTransportSettings adaptive;
+  adaptive.reference_area_m2 = 0.125f;
+  auto ta = gi::ExactLeafTransport::create(p.input, adaptive);
+  ASSERT_TRUE(ta) << ta.error().to_string();
+  ta->update(*h);
+  const double f_adaptive = plate_form_factor(*h, *ta, p.a, p.b);
+  std::printf("adaptive F_ab %.5f, rays %zu against %zu\n", f_adaptive, ta->last_rays(), t->last_rays());
+  EXPECT_NEAR(f_adaptive, 0.19982, 0.01);
+  EXPECT_LT(ta->last_rays(), t->last_rays() / 4);
 }
 
 TEST(ExactLeafTransport, ABlockerBetweenTheSquaresCutsTheirCoupling) {
