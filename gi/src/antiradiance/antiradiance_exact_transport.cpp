@@ -182,6 +182,7 @@ void ExactLeafTransport::update(const ElementHierarchy& h) {
     for (std::size_t i = r.begin(); i != r.end(); ++i) {
       const ElementNode& a = h.nodes[static_cast<std::size_t>(h.leaves[i])];
       for (std::size_t j = i + 1; j < n; ++j) {
+        if (!receivers_.empty() && !receivers_[i] && !receivers_[j]) continue;
         bool todo = all || moving[i] || moving[j];
         if (!todo) {
           const ElementNode& b = h.nodes[static_cast<std::size_t>(h.leaves[j])];
@@ -206,6 +207,18 @@ void ExactLeafTransport::update(const ElementHierarchy& h) {
 }
 
 ExactSolveResult ExactLeafTransport::solve(const ElementHierarchy& h, std::span<const glm::vec3> direct) const {
+  return iterate(h, direct, {}, {});
+}
+
+ExactSolveResult ExactLeafTransport::solve_receivers(const ElementHierarchy& h, std::span<const glm::vec3> direct,
+                                                     std::span<const glm::vec3> others) const {
+  GI_EXPECTS(receivers_.size() == h.leaf_count() && others.size() == h.leaf_count(),
+             "ExactLeafTransport::solve_receivers: set_receivers and others for every leaf");
+  return iterate(h, direct, receivers_, others);
+}
+
+ExactSolveResult ExactLeafTransport::iterate(const ElementHierarchy& h, std::span<const glm::vec3> direct,
+                                             std::span<const char> rows, std::span<const glm::vec3> others) const {
   const std::size_t n = h.leaf_count();
   GI_EXPECTS(n == n_ && direct.size() == n, "ExactLeafTransport::solve: update() with this hierarchy first");
   std::vector<glm::vec3> area_rho(n);  // A_j albedo_j / pi
@@ -215,12 +228,15 @@ ExactSolveResult ExactLeafTransport::solve(const ElementHierarchy& h, std::span<
   }
   ExactSolveResult out;
   out.irradiance.assign(n, glm::vec3(0.0f));
-  std::vector<glm::vec3> next(n), source(n);
+  if (!rows.empty())
+    for (std::size_t l = 0; l < n; ++l) out.irradiance[l] = rows[l] ? glm::vec3(0.0f) : others[l];
+  std::vector<glm::vec3> next = out.irradiance, source(n);
   const int budget = settings_.bounces > 0 ? settings_.bounces : settings_.max_iterations;
   for (int it = 0; it < budget; ++it) {
     for (std::size_t l = 0; l < n; ++l) source[l] = area_rho[l] * (direct[l] + out.irradiance[l]);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 16), [&](const tbb::blocked_range<std::size_t>& r) {
       for (std::size_t i = r.begin(); i != r.end(); ++i) {
+        if (!rows.empty() && !rows[i]) continue;  // held
         glm::dvec3 sum(0.0);
         for (std::size_t j = 0; j < i; ++j) sum += static_cast<double>(g_[pair_index(j, i)]) * glm::dvec3(source[j]);
         const std::size_t row = i < n - 1 ? pair_index(i, i + 1) : 0;
@@ -231,11 +247,12 @@ ExactSolveResult ExactLeafTransport::solve(const ElementHierarchy& h, std::span<
     });
     double change = 0.0, total = 0.0;
     for (std::size_t l = 0; l < n; ++l) {
+      if (!rows.empty() && !rows[l]) continue;
       const glm::vec3 d = next[l] - out.irradiance[l];
       change += static_cast<double>(std::abs(d.x) + std::abs(d.y) + std::abs(d.z));
       total += static_cast<double>(next[l].x + next[l].y + next[l].z);
     }
-    out.irradiance.swap(next);
+    out.irradiance = next;
     out.iterations = it + 1;
     out.residual = total > 0.0 ? change / total : 0.0;
     if (settings_.bounces <= 0 && out.residual < settings_.tolerance) {

@@ -84,6 +84,16 @@ class ExactLeafTransport {
   /// The indirect irradiance with `direct` (W/m^2 per leaf) as the source.
   ExactSolveResult solve(const ElementHierarchy& h, std::span<const glm::vec3> direct) const;
 
+  /// Restricts the transport to receivers (issue 37's explicit visibility near the door): set
+  /// before the first update(), one flag per leaf. Only pairs with an end among them are
+  /// computed (the others' coupling stays 0).
+  void set_receivers(std::vector<char> receivers) { receivers_ = std::move(receivers); }
+  /// The receivers' indirect irradiance gathered with visibility from every leaf, the other
+  /// leaves held at `others` (W/m^2 per leaf: e.g. an antiradiance solve's); the receivers'
+  /// own exchange iterated to the tolerance. Returns every leaf's value (the others' as given).
+  ExactSolveResult solve_receivers(const ElementHierarchy& h, std::span<const glm::vec3> direct,
+                                   std::span<const glm::vec3> others) const;
+
   /// G_ij of leaves i != j (m^-2: the mean of cos cos V / r^2); 0 for i == j.
   float coupling(std::size_t i, std::size_t j) const;
 
@@ -95,6 +105,9 @@ class ExactLeafTransport {
   /// G of leaves (i, j), i < j, at the caster's current pose; adds its rays to `rays`.
   float pair_coupling(const ElementHierarchy& h, std::size_t i, std::size_t j, std::size_t& rays) const;
   std::size_t pair_index(std::size_t i, std::size_t j) const;  // i < j
+  /// Jacobi over the rows flagged in `rows` (all when empty), the others held at `others`.
+  ExactSolveResult iterate(const ElementHierarchy& h, std::span<const glm::vec3> direct, std::span<const char> rows,
+                           std::span<const glm::vec3> others) const;
 
   ExactTransportSettings settings_;
   std::unique_ptr<RayCaster> caster_;
@@ -105,6 +118,7 @@ class ExactLeafTransport {
   bool dirty_ = false;
   std::size_t n_ = 0;
   std::vector<float> g_;  ///< Upper triangle, row-major, i < j.
+  std::vector<char> receivers_;
   std::size_t last_pairs_ = 0, last_rays_ = 0;
 };
 

@@ -277,6 +277,13 @@ std::vector<KnobSpec> solve_knobs() {
        .default_grid = {"0"},
        .min_value = 0,
        .max_value = 64},
+      {.name = "near_visibility",
+       .description = "solve=on: the leaves within near_radius of the door's swept sphere (and the door's) gather "
+                      "their light from every leaf with ray-traced visibility instead of antiradiance (exact_pairs "
+                      "point pairs per leaf pair; blend output only)",
+       .kind = KnobKind::Choice,
+       .default_grid = {"off"},
+       .choices = {"off", "on"}},
       {.name = "exact_adaptive",
        .description = "solve=exact: fewer point pairs for leaves smaller than patch^2 / 2 (ExactTransportSettings::"
                       "reference_area_m2)",
@@ -507,10 +514,67 @@ struct TexelOutput {
   }
 };
 
+// `--knob near_visibility=on` (issue 37, off by default): the leaves near the door (its own,
+// and the static ones within near_radius of its swept sphere) take their indirect light from
+// every leaf through ray-traced visibility (form factors, ExactLeafTransport) instead of the
+// antiradiance links: radiance only, every link of such a receiver tested; the other leaves
+// keep the antiradiance solve's. Its change is this hybrid now minus at the baked pose.
+struct NearVisibility {
+  std::optional<ExactLeafTransport> transport;
+  std::vector<glm::vec3> baseline;  // the hybrid at the baked pose
+  std::size_t receivers = 0;
+  double bake_ms = 0.0, move_ms = 0.0, rays = 0.0, pairs = 0.0;
+
+  engine::Status init(const RunContext& ctx, const DoorSetup& d, AntiradianceRegion& region) {
+    const ElementHierarchy& h = region.hierarchy();
+    const glm::vec3 origin(d.authored[3]);
+    float reach = 0.0f;
+    for (const BakePrimitive& p : d.input.meshes[d.input.instances[d.door].mesh].primitives)
+      for (const glm::vec3& v : p.positions) reach = std::max(reach, glm::length(v));
+    const float near = reach + region.settings().near_radius_m;
+    std::vector<char> mask(h.leaf_count(), 0);
+    for (std::size_t l = 0; l < h.leaf_count(); ++l) {
+      const auto node = static_cast<std::size_t>(h.leaves[l]);
+      const ElementNode& e = h.nodes[node];
+      mask[l] = h.node_instance[node] == static_cast<std::int32_t>(d.door) ||
+                glm::length(e.center - origin) <= near + e.radius_m;
+      receivers += static_cast<std::size_t>(mask[l]);
+    }
+    ExactTransportSettings es;
+    es.point_pairs = static_cast<int>(ctx.knobs.integer("exact_pairs"));
+    es.tolerance = region.settings().residual_tolerance > 0.0 ? region.settings().residual_tolerance : 1e-3;
+    es.seed = static_cast<std::uint64_t>(ctx.knobs.integer("exact_seed"));
+    auto t = ExactLeafTransport::create(d.input, es);
+    if (!t) return t.error();
+    transport.emplace(std::move(t).value());
+    transport->set_receivers(std::move(mask));
+    const auto t0 = Clock::now();
+    region.update(false);  // the direct light at the baked pose
+    transport->update(h);
+    baseline = transport->solve_receivers(h, region.direct(), region.baseline()).irradiance;
+    bake_ms = ms_since(t0);
+    return {};
+  }
+  // After the region moved the door to `m` and solved: the hybrid's change per leaf.
+  std::vector<glm::vec3> delta(const DoorSetup& d, const AntiradianceRegion& region, const glm::mat4& m,
+                               std::size_t moves) {
+    const auto t0 = Clock::now();
+    transport->set_instance_transform(d.door, m);
+    transport->update(region.hierarchy());
+    std::vector<glm::vec3> e =
+        transport->solve_receivers(region.hierarchy(), region.direct(), region.irradiance()).irradiance;
+    move_ms += ms_since(t0) / static_cast<double>(moves);
+    rays += static_cast<double>(transport->last_rays()) / static_cast<double>(moves);
+    pairs += static_cast<double>(transport->last_pairs_computed()) / static_cast<double>(moves);
+    for (std::size_t l = 0; l < e.size(); ++l) e[l] -= baseline[l];
+    return e;
+  }
+};
+
 // Each door move on the CPU twin: relink + direct light (update(false)), then the solve.
 engine::Result<DoorMoveScores> score_door_moves(const RunContext& ctx, const DoorSetup& d, AntiradianceRegion& region,
                                                 const std::vector<AntiradianceTexelBlend>& blends,
-                                                const TexelOutput& output) {
+                                                const TexelOutput& output, NearVisibility* near) {
   const std::size_t n = d.texels.valid.size();
   DoorMoveScores s;
   const std::size_t poses = d.poses();
@@ -525,8 +589,12 @@ engine::Result<DoorMoveScores> score_door_moves(const RunContext& ctx, const Doo
     s.solve_ms += ms_since(t1);
     s.add_solve(rep, poses - 1);
     const auto t2 = Clock::now();
-    const std::vector<glm::vec3> dt = output.change(region, blends, n);
+    std::vector<glm::vec3> dt = output.change(region, blends, n);
     s.output_ms += ms_since(t2);
+    if (near) {
+      const std::vector<glm::vec3> delta = near->delta(d, region, d.pose(d.swings[k - 1]), poses - 1);
+      for (const AntiradianceTexelBlend& b : blends) dt[b.texel] = blend_leaves(b, delta);
+    }
     s.add_floor(ctx.reference, d, blends, region.hierarchy().leaf_count(), k);
     s.add_pose(ctx.reference, d, k, dt);
     if (ctx.progress && !ctx.progress(0.3 + 0.5 * static_cast<double>(k) / static_cast<double>(poses - 1)))
@@ -795,7 +863,11 @@ engine::Result<MethodOutput> run_door_moves(const RunContext& ctx) {
       antiradiance_texel_blends(region->hierarchy(), d->input, d->layout);
 
   const TexelOutput output(*d, *region, ctx.knobs.text("output") == "gather");
-  auto scores = score_door_moves(ctx, *d, *region, blends, output);
+  NearVisibility near;
+  const bool near_on = ctx.knobs.text("near_visibility") == "on";
+  if (near_on)
+    if (engine::Status st = near.init(ctx, *d, *region); !st) return st.error();
+  auto scores = score_door_moves(ctx, *d, *region, blends, output, near_on ? &near : nullptr);
   if (!scores) return scores.error();
   DoorMoveScores& sc = *scores;
   const double moves = static_cast<double>(poses - 1);
@@ -811,6 +883,14 @@ engine::Result<MethodOutput> run_door_moves(const RunContext& ctx) {
     gpu = *timed;
   }
   out.extras = door_move_extras(ctx, *d, *region, sc, gpu, out.field, floor_field);
+  if (near_on) {
+    out.costs.frame_ms += near.move_ms;
+    out.extras.insert(out.extras.end(), {{"near_visibility_receivers", static_cast<double>(near.receivers)},
+                                         {"near_visibility_bake_ms", near.bake_ms},
+                                         {"near_visibility_move_ms", near.move_ms},
+                                         {"near_visibility_pairs_per_move", near.pairs},
+                                         {"near_visibility_rays_per_move", near.rays}});
+  }
   return out;
 }
 

@@ -140,6 +140,46 @@ TEST(ExactLeafTransport, OneBounceIsTheCouplingTimesTheLitRadiosity) {
   }
 }
 
+// The receivers' solve (near_visibility in the sweep): with the other leaves held at the full
+// solve's values, the receivers' rows converge to the full solve's own values (its fixed
+// point); with other values held, the receivers follow them.
+TEST(ExactLeafTransport, TheReceiversSolveHoldsTheOthersAndMeetsTheFullSolve) {
+  const Plates p = plates(false);
+  auto h = gi::build_element_hierarchy(p.input, plate_settings());
+  ASSERT_TRUE(h) << h.error().to_string();
+  gi::ExactTransportSettings es;
+  es.point_pairs = 16;
+  es.tolerance = 1e-6;
+  auto full = gi::ExactLeafTransport::create(p.input, es);
+  auto part = gi::ExactLeafTransport::create(p.input, es);
+  ASSERT_TRUE(full && part);
+  std::vector<glm::vec3> direct(h->leaf_count(), glm::vec3(0.0f));
+  std::vector<char> on_b(h->leaf_count(), 0);
+  for (std::size_t l = 0; l < h->leaf_count(); ++l) {
+    const std::int32_t inst = h->node_instance[static_cast<std::size_t>(h->leaves[l])];
+    if (inst == static_cast<std::int32_t>(p.a)) direct[l] = glm::vec3(1.0f);
+    on_b[l] = inst == static_cast<std::int32_t>(p.b);
+  }
+  full->update(*h);
+  part->set_receivers(on_b);
+  part->update(*h);
+  EXPECT_LT(part->last_pairs_computed(), full->last_pairs_computed());
+  const gi::ExactSolveResult e = full->solve(*h, direct);
+  const gi::ExactSolveResult r = part->solve_receivers(*h, direct, e.irradiance);
+  ASSERT_TRUE(r.converged);
+  for (std::size_t l = 0; l < h->leaf_count(); ++l) {
+    if (!on_b[l]) {
+      EXPECT_EQ(r.irradiance[l], e.irradiance[l]);  // held
+      continue;
+    }
+    EXPECT_NEAR(r.irradiance[l].x, e.irradiance[l].x, 1e-4f * e.irradiance[l].x);
+  }
+  // No direct light and the others held dark: the receivers get nothing.
+  std::vector<glm::vec3> dark(h->leaf_count(), glm::vec3(0.0f));
+  const gi::ExactSolveResult no_direct = part->solve_receivers(*h, dark, dark);
+  for (std::size_t l = 0; l < h->leaf_count(); ++l) EXPECT_EQ(no_direct.irradiance[l], glm::vec3(0.0f));
+}
+
 // The door scene (a lit plate, a wall with an opening, the door, a receiver that sees the lit
 // plate only through it): the exact solve lets nothing through the shut door, and its open
 // door agrees with the antiradiance solve on the same 0.25 m elements (both near the path
