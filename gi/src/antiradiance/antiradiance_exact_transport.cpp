@@ -18,6 +18,7 @@ namespace gi {
 namespace {
 
 constexpr float kPi = 3.14159265358979f;
+constexpr int kMinClosePairs = 16;
 
 std::uint64_t mix(std::uint64_t x) {
   x += 0x9e3779b97f4a7c15ULL;
@@ -120,16 +121,18 @@ float ExactLeafTransport::pair_coupling(const ElementHierarchy& h, std::size_t i
   const glm::vec3 n_i = h.nodes[ni].normal, n_j = h.nodes[nj].normal;
   if (behind(tj, ti[0], n_i) || behind(ti, tj[0], n_j)) return 0.0f;
   int m = settings_.point_pairs;
-  if (settings_.reference_area_m2 > 0.0f) {
-    const ElementNode& a = h.nodes[ni];
-    const ElementNode& b = h.nodes[nj];
-    const float reach = 2.0f * (a.radius_m + b.radius_m);
-    if (glm::dot(a.center - b.center, a.center - b.center) >= reach * reach) {
-      const double share =
-          static_cast<double>(a.area_m2) * static_cast<double>(b.area_m2) /
-          (static_cast<double>(settings_.reference_area_m2) * static_cast<double>(settings_.reference_area_m2));
-      m = std::clamp(static_cast<int>(std::ceil(static_cast<double>(m) * share)), 1, m);
-    }
+  const ElementNode& ei = h.nodes[ni];
+  const ElementNode& ej = h.nodes[nj];
+  const float reach = 2.0f * (ei.radius_m + ej.radius_m);
+  const bool close = glm::dot(ei.center - ej.center, ei.center - ej.center) < reach * reach;
+  // Close pairs (touching leaves: the 1/r^2 peak) at least kMinClosePairs: with fewer, one
+  // unlucky pair near the clamp can push the operator's norm above 1 and the solve diverges.
+  if (close) m = std::max(m, kMinClosePairs);
+  if (settings_.reference_area_m2 > 0.0f && !close) {
+    const double share =
+        static_cast<double>(ei.area_m2) * static_cast<double>(ej.area_m2) /
+        (static_cast<double>(settings_.reference_area_m2) * static_cast<double>(settings_.reference_area_m2));
+    m = std::clamp(static_cast<int>(std::ceil(static_cast<double>(m) * share)), 1, m);
   }
   const int strata = std::max(1, static_cast<int>(std::sqrt(static_cast<double>(m))));
   const float min_r2 = settings_.min_distance_m * settings_.min_distance_m;
@@ -255,12 +258,13 @@ ExactSolveResult ExactLeafTransport::iterate(const ElementHierarchy& h, std::spa
     out.irradiance = next;
     out.iterations = it + 1;
     out.residual = total > 0.0 ? change / total : 0.0;
+    if (!std::isfinite(total)) break;  // diverged: not converged, and visibly so
     if (settings_.bounces <= 0 && out.residual < settings_.tolerance) {
       out.converged = true;
       break;
     }
   }
-  if (settings_.bounces > 0) out.converged = true;
+  if (settings_.bounces > 0) out.converged = std::isfinite(out.residual);
   return out;
 }
 

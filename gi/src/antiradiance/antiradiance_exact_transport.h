@@ -33,7 +33,8 @@
 namespace gi {
 
 struct ExactTransportSettings {
-  /// Monte Carlo point pairs per leaf pair (stratified on the first leaf).
+  /// Monte Carlo point pairs per leaf pair (stratified on the first leaf); close pairs (centres
+  /// nearer than twice their radii's sum) at least 16.
   int point_pairs = 64;
   /// Fewer point pairs for small leaves (0: off, point_pairs everywhere): a pair of leaves of
   /// areas A_i, A_j gets ceil(point_pairs A_i A_j / reference_area_m2^2) pairs, at least 1,
