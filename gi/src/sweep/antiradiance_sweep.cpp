@@ -265,6 +265,24 @@ std::vector<KnobSpec> solve_knobs() {
        .kind = KnobKind::Choice,
        .default_grid = {"on"},
        .choices = {"on", "off", "exact"}},
+      {.name = "output",
+       .description = "how the change reaches a texel: blend (the runtime's 4 nearest leaves) or gather (from the "
+                      "hierarchy at the texel, antiradiance_texel_gather.h)",
+       .kind = KnobKind::Choice,
+       .default_grid = {"blend"},
+       .choices = {"blend", "gather"}},
+      {.name = "gpu",
+       .description = "also time the door move with the GPU passes (compute shaders; headless GL)",
+       .kind = KnobKind::Choice,
+       .default_grid = {"on"},
+       .choices = {"on", "off"}},
+  };
+}
+
+// The knobs of the diagnosis (issue 37): the visibility-exact solver on the method's leaves
+// (solve=exact) and the explicit visibility near the door (near_visibility).
+std::vector<KnobSpec> exact_knobs() {
+  return {
       {.name = "exact_pairs",
        .description = "solve=exact: Monte Carlo point pairs per leaf pair",
        .kind = KnobKind::Integer,
@@ -301,17 +319,6 @@ std::vector<KnobSpec> solve_knobs() {
        .default_grid = {"1"},
        .min_value = 1,
        .max_value = 1 << 30},
-      {.name = "output",
-       .description = "how the change reaches a texel: blend (the runtime's 4 nearest leaves) or gather (from the "
-                      "hierarchy at the texel, antiradiance_texel_gather.h)",
-       .kind = KnobKind::Choice,
-       .default_grid = {"blend"},
-       .choices = {"blend", "gather"}},
-      {.name = "gpu",
-       .description = "also time the door move with the GPU passes (compute shaders; headless GL)",
-       .kind = KnobKind::Choice,
-       .default_grid = {"on"},
-       .choices = {"on", "off"}},
   };
 }
 
@@ -353,6 +360,7 @@ std::vector<KnobSpec> scoring_knobs() {
 
 std::vector<KnobSpec> antiradiance_knobs() {
   std::vector<KnobSpec> knobs = solve_knobs();
+  for (KnobSpec& k : exact_knobs()) knobs.push_back(std::move(k));
   for (KnobSpec& k : scoring_knobs()) knobs.push_back(std::move(k));
   return knobs;
 }
