@@ -153,6 +153,7 @@ engine::Result<RgbField> door_reference(const ReferenceJob& job) {
     rs.seed = kReferenceSeed;
     rs.threads = job.threads;
     if (!r.param("bounces").empty()) rs.max_bounces = std::stoi(r.param("bounces"));
+    if (!r.param("seed").empty()) rs.seed = kReferenceSeed ^ std::stoull(r.param("seed"));
     const ProgressFn& outer = job.progress;
     rs.progress = [&outer, k, poses](double f) {
       return !outer || outer((static_cast<double>(k) + f) / static_cast<double>(poses));
@@ -349,6 +350,13 @@ std::vector<KnobSpec> scoring_knobs() {
        .default_grid = {"4096"},
        .min_value = 1,
        .max_value = 1 << 20},
+      {.name = "ref_seed",
+       .description = "another random stream for the reference (0: the sweep's; k: an independent estimate, to "
+                      "measure the reference's own noise)",
+       .kind = KnobKind::Integer,
+       .default_grid = {"0"},
+       .min_value = 0,
+       .max_value = 1 << 30},
       {.name = "ref_bounces",
        .description = "indirect bounces of the reference (0: all; 1: the first bounce off directly lit surfaces)",
        .kind = KnobKind::Integer,
@@ -374,6 +382,7 @@ ReferenceRequest door_reference_request(const SweepScene&, const KnobSetting& k)
               {"swings", k.text("swings")}};
   // Only a bounded reference names its bounces, so the full ones keep their cache keys.
   if (k.integer("ref_bounces") > 0) r.params.emplace_back("bounces", std::to_string(k.integer("ref_bounces")));
+  if (k.integer("ref_seed") > 0) r.params.emplace_back("seed", std::to_string(k.integer("ref_seed")));
   return r;
 }
 
