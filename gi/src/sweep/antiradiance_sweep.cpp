@@ -18,6 +18,8 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "antiradiance/antiradiance_direct_light.h"
+#include "antiradiance/antiradiance_exact_transport.h"
 #include "antiradiance/antiradiance_gpu_pass.h"
 #include "antiradiance/antiradiance_io.h"
 #include "antiradiance/antiradiance_region.h"
@@ -150,6 +152,8 @@ engine::Result<RgbField> door_reference(const ReferenceJob& job) {
     rs.samples_per_pixel = std::stoi(r.param("spp"));
     rs.seed = kReferenceSeed;
     rs.threads = job.threads;
+    if (!r.param("bounces").empty()) rs.max_bounces = std::stoi(r.param("bounces"));
+    if (!r.param("seed").empty()) rs.seed = kReferenceSeed ^ std::stoull(r.param("seed"));
     const ProgressFn& outer = job.progress;
     rs.progress = [&outer, k, poses](double f) {
       return !outer || outer((static_cast<double>(k) + f) / static_cast<double>(poses));
@@ -257,10 +261,11 @@ std::vector<KnobSpec> solve_knobs() {
        .max_value = 4096},
       {.name = "solve",
        .description = "off: build the leaves only and score the projection floor (the true change through them) as "
-                      "the field",
+                      "the field; exact: the same leaves and direct light, transport by form factors with ray-traced "
+                      "visibility (antiradiance_exact_transport.h, diagnosis only)",
        .kind = KnobKind::Choice,
        .default_grid = {"on"},
-       .choices = {"on", "off"}},
+       .choices = {"on", "off", "exact"}},
       {.name = "output",
        .description = "how the change reaches a texel: blend (the runtime's 4 nearest leaves) or gather (from the "
                       "hierarchy at the texel, antiradiance_texel_gather.h)",
@@ -272,6 +277,49 @@ std::vector<KnobSpec> solve_knobs() {
        .kind = KnobKind::Choice,
        .default_grid = {"on"},
        .choices = {"on", "off"}},
+  };
+}
+
+// The knobs of the diagnosis (issue 37): the visibility-exact solver on the method's leaves
+// (solve=exact) and the explicit visibility near the door (near_visibility).
+std::vector<KnobSpec> exact_knobs() {
+  return {
+      {.name = "exact_pairs",
+       .description = "solve=exact: Monte Carlo point pairs per leaf pair",
+       .kind = KnobKind::Integer,
+       .default_grid = {"64"},
+       .min_value = 1,
+       .max_value = 4096},
+      {.name = "exact_bounces",
+       .description = "solve=exact: indirect bounces (0: all, to the tolerance; 1: the first bounce only)",
+       .kind = KnobKind::Integer,
+       .default_grid = {"0"},
+       .min_value = 0,
+       .max_value = 64},
+      {.name = "near_visibility",
+       .description = "solve=on: the leaves within near_radius of the door's swept sphere (and the door's) gather "
+                      "their light from every leaf with ray-traced visibility instead of antiradiance (exact_pairs "
+                      "point pairs per leaf pair; blend output only)",
+       .kind = KnobKind::Choice,
+       .default_grid = {"off"},
+       .choices = {"off", "on"}},
+      {.name = "exact_adaptive",
+       .description = "solve=exact: fewer point pairs for leaves smaller than patch^2 / 2 (ExactTransportSettings::"
+                      "reference_area_m2)",
+       .kind = KnobKind::Choice,
+       .default_grid = {"off"},
+       .choices = {"off", "on"}},
+      {.name = "exact_noise",
+       .description = "solve=exact: also solve with exact_seed + 1 and report the change's own noise (exact_noise_rel)",
+       .kind = KnobKind::Choice,
+       .default_grid = {"off"},
+       .choices = {"off", "on"}},
+      {.name = "exact_seed",
+       .description = "solve=exact: the point pairs' seed (two seeds measure the solver's own noise)",
+       .kind = KnobKind::Integer,
+       .default_grid = {"1"},
+       .min_value = 1,
+       .max_value = 1 << 30},
   };
 }
 
@@ -302,11 +350,25 @@ std::vector<KnobSpec> scoring_knobs() {
        .default_grid = {"4096"},
        .min_value = 1,
        .max_value = 1 << 20},
+      {.name = "ref_seed",
+       .description = "another random stream for the reference (0: the sweep's; k: an independent estimate, to "
+                      "measure the reference's own noise)",
+       .kind = KnobKind::Integer,
+       .default_grid = {"0"},
+       .min_value = 0,
+       .max_value = 1 << 30},
+      {.name = "ref_bounces",
+       .description = "indirect bounces of the reference (0: all; 1: the first bounce off directly lit surfaces)",
+       .kind = KnobKind::Integer,
+       .default_grid = {"0"},
+       .min_value = 0,
+       .max_value = 64},
   };
 }
 
 std::vector<KnobSpec> antiradiance_knobs() {
   std::vector<KnobSpec> knobs = solve_knobs();
+  for (KnobSpec& k : exact_knobs()) knobs.push_back(std::move(k));
   for (KnobSpec& k : scoring_knobs()) knobs.push_back(std::move(k));
   return knobs;
 }
@@ -318,6 +380,9 @@ ReferenceRequest door_reference_request(const SweepScene&, const KnobSetting& k)
               {"radius", k.text("radius")},
               {"spp", std::to_string(k.integer("ref_spp"))},
               {"swings", k.text("swings")}};
+  // Only a bounded reference names its bounces, so the full ones keep their cache keys.
+  if (k.integer("ref_bounces") > 0) r.params.emplace_back("bounces", std::to_string(k.integer("ref_bounces")));
+  if (k.integer("ref_seed") > 0) r.params.emplace_back("seed", std::to_string(k.integer("ref_seed")));
   return r;
 }
 
@@ -373,6 +438,51 @@ struct DoorMoveScores {
     residual = std::max(residual, rep.residual);
     unconverged += rep.budget_exhausted ? 1.0 : 0.0;
   }
+  // Empty fields of every pose; the level of the baked truth.
+  void start(const RgbField& reference, const DoorSetup& d) {
+    const std::size_t n = d.texels.valid.size();
+    values.assign(n * d.poses(), glm::vec3(0.0f));
+    valid.assign(n * d.poses(), 0);
+    floor_values.assign(n * d.poses(), glm::vec3(0.0f));
+    for (std::size_t t = 0; t < n; ++t)
+      if (d.mask[t]) {
+        const glm::vec3 e = ref_at(reference, t);
+        level += static_cast<double>(e.x + e.y + e.z);
+      }
+    level /= 3.0 * static_cast<double>(d.compared);
+  }
+  // Pose k's field (the baked truth plus the change dt per texel) and its scores.
+  void add_pose(const RgbField& reference, const DoorSetup& d, std::size_t k, const std::vector<glm::vec3>& dt) {
+    const std::size_t n = d.texels.valid.size();
+    double err2 = 0.0, change2 = 0.0, mean_o = 0.0, mean_r = 0.0;
+    for (std::size_t t = 0; t < n; ++t) {
+      if (!d.mask[t]) continue;
+      const glm::vec3 base = ref_at(reference, t);
+      values[k * n + t] = base + dt[t];
+      valid[k * n + t] = 1;
+      const glm::vec3 e = dt[t] - (ref_at(reference, k * n + t) - base);
+      err2 += static_cast<double>(glm::dot(e, e));
+      const glm::vec3 c = ref_at(reference, k * n + t) - base;
+      change2 += static_cast<double>(glm::dot(c, c));
+      for (int ch = 0; ch < 3; ++ch) {
+        const double o = static_cast<double>(dt[t][ch]), r = static_cast<double>(c[ch]);
+        mean_o += o, mean_r += r;
+        so += o, sr += r, soo += o * o, srr += r * r, sor += o * r, samples += 1.0;
+      }
+    }
+    const double nrmse = std::sqrt(err2 / (3.0 * static_cast<double>(d.compared))) / level;
+    const int swing = static_cast<int>(d.swings[k - 1]);
+    const std::string name = std::string(swing < 0 ? "m" : "p") + std::to_string(std::abs(swing));
+    per_angle.emplace_back("change_nrmse_swing_" + name, nrmse);
+    // What leaving the baked atlas unchanged scores by the same measure: the true change.
+    per_angle.emplace_back("nothing_nrmse_swing_" + name,
+                           std::sqrt(change2 / (3.0 * static_cast<double>(d.compared))) / level);
+    // The mean over the compared texels (zone averages, as the corridor test compares them):
+    // the true mean change and the error of the method's, both / level.
+    const double count = 3.0 * static_cast<double>(d.compared);
+    per_angle.emplace_back("true_mean_change_swing_" + name, mean_r / count / level);
+    per_angle.emplace_back("mean_change_error_swing_" + name, (mean_o - mean_r) / count / level);
+  }
   // Pose k's floor: the reference's true change through the leaves, on the baked pose's truth.
   void add_floor(const RgbField& reference, const DoorSetup& d, const std::vector<AntiradianceTexelBlend>& blends,
                  std::size_t leaves, std::size_t k) {
@@ -421,23 +531,71 @@ struct TexelOutput {
   }
 };
 
+// `--knob near_visibility=on` (issue 37, off by default): the leaves near the door (its own,
+// and the static ones within near_radius of its swept sphere) take their indirect light from
+// every leaf through ray-traced visibility (form factors, ExactLeafTransport) instead of the
+// antiradiance links: radiance only, every link of such a receiver tested; the other leaves
+// keep the antiradiance solve's. Its change is this hybrid now minus at the baked pose.
+struct NearVisibility {
+  std::optional<ExactLeafTransport> transport;
+  std::vector<glm::vec3> baseline;  // the hybrid at the baked pose
+  std::size_t receivers = 0;
+  double bake_ms = 0.0, move_ms = 0.0, rays = 0.0, pairs = 0.0;
+
+  engine::Status init(const RunContext& ctx, const DoorSetup& d, AntiradianceRegion& region) {
+    const ElementHierarchy& h = region.hierarchy();
+    const glm::vec3 origin(d.authored[3]);
+    float reach = 0.0f;
+    for (const BakePrimitive& p : d.input.meshes[d.input.instances[d.door].mesh].primitives)
+      for (const glm::vec3& v : p.positions) reach = std::max(reach, glm::length(v));
+    const float near = reach + region.settings().near_radius_m;
+    std::vector<char> mask(h.leaf_count(), 0);
+    for (std::size_t l = 0; l < h.leaf_count(); ++l) {
+      const auto node = static_cast<std::size_t>(h.leaves[l]);
+      const ElementNode& e = h.nodes[node];
+      mask[l] = h.node_instance[node] == static_cast<std::int32_t>(d.door) ||
+                glm::length(e.center - origin) <= near + e.radius_m;
+      receivers += static_cast<std::size_t>(mask[l]);
+    }
+    ExactTransportSettings es;
+    es.point_pairs = static_cast<int>(ctx.knobs.integer("exact_pairs"));
+    es.tolerance = region.settings().residual_tolerance > 0.0 ? region.settings().residual_tolerance : 1e-3;
+    es.seed = static_cast<std::uint64_t>(ctx.knobs.integer("exact_seed"));
+    auto t = ExactLeafTransport::create(d.input, es);
+    if (!t) return t.error();
+    transport.emplace(std::move(t).value());
+    transport->set_receivers(std::move(mask));
+    const auto t0 = Clock::now();
+    region.update(false);  // the direct light at the baked pose
+    transport->update(h);
+    baseline = transport->solve_receivers(h, region.direct(), region.baseline()).irradiance;
+    bake_ms = ms_since(t0);
+    return {};
+  }
+  // After the region moved the door to `m` and solved: the hybrid's change per leaf.
+  std::vector<glm::vec3> delta(const DoorSetup& d, const AntiradianceRegion& region, const glm::mat4& m,
+                               std::size_t moves) {
+    const auto t0 = Clock::now();
+    transport->set_instance_transform(d.door, m);
+    transport->update(region.hierarchy());
+    std::vector<glm::vec3> e =
+        transport->solve_receivers(region.hierarchy(), region.direct(), region.irradiance()).irradiance;
+    move_ms += ms_since(t0) / static_cast<double>(moves);
+    rays += static_cast<double>(transport->last_rays()) / static_cast<double>(moves);
+    pairs += static_cast<double>(transport->last_pairs_computed()) / static_cast<double>(moves);
+    for (std::size_t l = 0; l < e.size(); ++l) e[l] -= baseline[l];
+    return e;
+  }
+};
+
 // Each door move on the CPU twin: relink + direct light (update(false)), then the solve.
 engine::Result<DoorMoveScores> score_door_moves(const RunContext& ctx, const DoorSetup& d, AntiradianceRegion& region,
                                                 const std::vector<AntiradianceTexelBlend>& blends,
-                                                const TexelOutput& output) {
+                                                const TexelOutput& output, NearVisibility* near) {
   const std::size_t n = d.texels.valid.size();
   DoorMoveScores s;
   const std::size_t poses = d.poses();
-  s.values.assign(n * poses, glm::vec3(0.0f));
-  s.valid.assign(n * poses, 0);
-  s.floor_values.assign(n * poses, glm::vec3(0.0f));
-  for (std::size_t t = 0; t < n; ++t)
-    if (d.mask[t]) {
-      const glm::vec3 e = ref_at(ctx.reference, t);
-      s.level += static_cast<double>(e.x + e.y + e.z);
-    }
-  s.level /= 3.0 * static_cast<double>(d.compared);
-  const double level = s.level;
+  s.start(ctx.reference, d);
   for (std::size_t k = 1; k < poses; ++k) {
     region.set_instance_transform(d.door, d.pose(d.swings[k - 1]));
     const auto t0 = Clock::now();
@@ -448,37 +606,14 @@ engine::Result<DoorMoveScores> score_door_moves(const RunContext& ctx, const Doo
     s.solve_ms += ms_since(t1);
     s.add_solve(rep, poses - 1);
     const auto t2 = Clock::now();
-    const std::vector<glm::vec3> dt = output.change(region, blends, n);
+    std::vector<glm::vec3> dt = output.change(region, blends, n);
     s.output_ms += ms_since(t2);
-    s.add_floor(ctx.reference, d, blends, region.hierarchy().leaf_count(), k);
-    double err2 = 0.0, change2 = 0.0, mean_o = 0.0, mean_r = 0.0;
-    for (std::size_t t = 0; t < n; ++t) {
-      if (!d.mask[t]) continue;
-      const glm::vec3 base = ref_at(ctx.reference, t);
-      s.values[k * n + t] = base + dt[t];
-      s.valid[k * n + t] = 1;
-      const glm::vec3 e = dt[t] - (ref_at(ctx.reference, k * n + t) - base);
-      err2 += static_cast<double>(glm::dot(e, e));
-      const glm::vec3 c = ref_at(ctx.reference, k * n + t) - base;
-      change2 += static_cast<double>(glm::dot(c, c));
-      for (int ch = 0; ch < 3; ++ch) {
-        const double o = static_cast<double>(dt[t][ch]), r = static_cast<double>(c[ch]);
-        mean_o += o, mean_r += r;
-        s.so += o, s.sr += r, s.soo += o * o, s.srr += r * r, s.sor += o * r, s.samples += 1.0;
-      }
+    if (near) {
+      const std::vector<glm::vec3> delta = near->delta(d, region, d.pose(d.swings[k - 1]), poses - 1);
+      for (const AntiradianceTexelBlend& b : blends) dt[b.texel] = blend_leaves(b, delta);
     }
-    const double nrmse = std::sqrt(err2 / (3.0 * static_cast<double>(d.compared))) / level;
-    const int swing = static_cast<int>(d.swings[k - 1]);
-    const std::string name = std::string(swing < 0 ? "m" : "p") + std::to_string(std::abs(swing));
-    s.per_angle.emplace_back("change_nrmse_swing_" + name, nrmse);
-    // What leaving the baked atlas unchanged scores by the same measure: the true change.
-    s.per_angle.emplace_back("nothing_nrmse_swing_" + name,
-                             std::sqrt(change2 / (3.0 * static_cast<double>(d.compared))) / level);
-    // The mean over the compared texels (zone averages, as the corridor test compares them):
-    // the true mean change and the error of the method's, both / level.
-    const double count = 3.0 * static_cast<double>(d.compared);
-    s.per_angle.emplace_back("true_mean_change_swing_" + name, mean_r / count / level);
-    s.per_angle.emplace_back("mean_change_error_swing_" + name, (mean_o - mean_r) / count / level);
+    s.add_floor(ctx.reference, d, blends, region.hierarchy().leaf_count(), k);
+    s.add_pose(ctx.reference, d, k, dt);
     if (ctx.progress && !ctx.progress(0.3 + 0.5 * static_cast<double>(k) / static_cast<double>(poses - 1)))
       return engine::cancelled_error("antiradiance run");
   }
@@ -602,6 +737,124 @@ engine::Result<MethodOutput> run_projection_floor(const RunContext& ctx, const D
   return out;
 }
 
+// One exact solver's door moves (`--knob solve=exact`): the change per leaf blended to the
+// texels of every moved pose (poses 1.., texel-major as the fields), and what it cost.
+struct ExactMoves {
+  std::vector<std::vector<glm::vec3>> dt;  // [pose - 1][texel]
+  double move_ms = 0.0, pairs = 0.0, rays = 0.0, iterations = 0.0, residual = 0.0, base_ms = 0.0;
+  double base_pairs = 0.0;
+};
+
+engine::Result<ExactMoves> exact_door_moves(const RunContext& ctx, const DoorSetup& d, const AntiradianceSettings& s,
+                                            std::uint64_t seed) {
+  auto h = build_element_hierarchy(d.input, s);
+  if (!h) return h.error();
+  const std::vector<AntiradianceTexelBlend> blends = antiradiance_texel_blends(*h, d.input, d.layout);
+  auto direct = AntiradianceDirectLight::create(d.input, s);
+  if (!direct) return direct.error();
+  ExactTransportSettings es;
+  es.point_pairs = static_cast<int>(ctx.knobs.integer("exact_pairs"));
+  if (ctx.knobs.text("exact_adaptive") == "on") es.reference_area_m2 = 0.5f * s.patch_size_m * s.patch_size_m;
+  es.bounces = static_cast<int>(ctx.knobs.integer("exact_bounces"));
+  es.tolerance = s.residual_tolerance > 0.0 ? s.residual_tolerance : 1e-3;
+  es.seed = seed;
+  auto transport = ExactLeafTransport::create(d.input, es);
+  if (!transport) return transport.error();
+  int group = -1;
+  for (std::size_t g = 0; g < h->deforming_instances.size(); ++g)
+    if (h->deforming_instances[g] == d.door) group = static_cast<int>(g + 1);
+  if (group < 0) return engine::Error{.message = "the door is not a deforming group of the hierarchy"};
+  ExactMoves out;
+  const auto t0 = Clock::now();
+  transport->update(*h);
+  out.base_pairs = static_cast<double>(transport->last_pairs_computed());
+  const ExactSolveResult base = transport->solve(*h, direct->update(*h));
+  out.base_ms = ms_since(t0);
+  const double moves = static_cast<double>(d.poses() - 1);
+  for (std::size_t k = 1; k < d.poses(); ++k) {
+    const glm::mat4 m = d.pose(d.swings[k - 1]);
+    const auto t1 = Clock::now();
+    h->set_group_transform(group, m);
+    direct->set_instance_transform(d.door, m);
+    transport->set_instance_transform(d.door, m);
+    transport->update(*h);
+    const ExactSolveResult e = transport->solve(*h, direct->update(*h));
+    out.move_ms += ms_since(t1) / moves;
+    out.pairs += static_cast<double>(transport->last_pairs_computed()) / moves;
+    out.rays += static_cast<double>(transport->last_rays()) / moves;
+    out.iterations += static_cast<double>(e.iterations) / moves;
+    out.residual = std::max(out.residual, e.residual);
+    std::vector<glm::vec3> delta(e.irradiance.size());
+    for (std::size_t l = 0; l < delta.size(); ++l) delta[l] = e.irradiance[l] - base.irradiance[l];
+    std::vector<glm::vec3> dt(d.texels.valid.size(), glm::vec3(0.0f));
+    for (const AntiradianceTexelBlend& b : blends) dt[b.texel] = blend_leaves(b, delta);
+    out.dt.push_back(std::move(dt));
+    if (ctx.progress && !ctx.progress(0.1 + 0.4 * static_cast<double>(k) / moves))
+      return engine::cancelled_error("antiradiance run");
+  }
+  return out;
+}
+
+// `--knob solve=exact`: the visibility-exact solver on the method's leaves and direct light,
+// scored like the method (its change through the same blend); `exact_seed` + 1 in a second
+// solve when exact_noise is set gives the solver's own noise of the change.
+engine::Result<MethodOutput> run_exact_transport(const RunContext& ctx, const DoorSetup& d,
+                                                 const AntiradianceSettings& s) {
+  const auto seed = static_cast<std::uint64_t>(ctx.knobs.integer("exact_seed"));
+  auto a = exact_door_moves(ctx, d, s, seed);
+  if (!a) return a.error();
+  auto h = build_element_hierarchy(d.input, s);
+  if (!h) return h.error();
+  const std::vector<AntiradianceTexelBlend> blends = antiradiance_texel_blends(*h, d.input, d.layout);
+  const std::size_t n = d.texels.valid.size();
+  DoorMoveScores sc;
+  sc.start(ctx.reference, d);
+  for (std::size_t k = 1; k < d.poses(); ++k) {
+    sc.add_floor(ctx.reference, d, blends, h->leaf_count(), k);
+    sc.add_pose(ctx.reference, d, k, a->dt[k - 1]);
+  }
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  double noise = nan;
+  if (ctx.knobs.text("exact_noise") == "on") {
+    auto b = exact_door_moves(ctx, d, s, seed + 1);
+    if (!b) return b.error();
+    double sum = 0.0, count = 0.0;
+    for (std::size_t k = 0; k < a->dt.size(); ++k)
+      for (std::size_t t = 0; t < n; ++t)
+        if (d.mask[t]) {
+          const glm::vec3 e = a->dt[k][t] - b->dt[k][t];
+          sum += static_cast<double>(glm::dot(e, e)), count += 3.0;
+        }
+    // The difference of two independent estimates has twice the variance of one.
+    noise = std::sqrt(sum / count / 2.0) / sc.level;
+  }
+  const int poses = static_cast<int>(d.poses());
+  MethodOutput out;
+  out.costs.frame_ms = a->move_ms;
+  out.costs.bake_seconds = a->base_ms / 1000.0;
+  const RgbField floor_field =
+      RgbField::from_texels(d.texels.width, d.texels.height * poses, sc.floor_values, sc.valid);
+  out.field = RgbField::from_texels(d.texels.width, d.texels.height * poses, sc.values, std::move(sc.valid));
+  const double cov = sc.sor - sc.so * sc.sr / sc.samples, var_o = sc.soo - sc.so * sc.so / sc.samples,
+               var_r = sc.srr - sc.sr * sc.sr / sc.samples;
+  out.extras = {{"nothing_rel_rmse", compare_rgb(nothing_changed(out.field, ctx.reference, d), ctx.reference).rel_rmse},
+                {"change_correlation", var_o > 0.0 && var_r > 0.0 ? cov / std::sqrt(var_o * var_r) : nan},
+                {"change_fit_scale", sc.soo > 0.0 ? sc.sor / sc.soo : nan},
+                {"projection_floor_rel_rmse", compare_rgb(floor_field, ctx.reference).rel_rmse},
+                {"exact_noise_rel", noise},
+                {"solve_iterations", a->iterations},
+                {"solve_residual_max", a->residual},
+                {"exact_pairs_baked_pose", a->base_pairs},
+                {"exact_pairs_per_move", a->pairs},
+                {"exact_rays_per_move", a->rays}};
+  out.extras.insert(out.extras.end(), sc.per_angle.begin(), sc.per_angle.end());
+  out.extras.insert(out.extras.end(), {{"cpu_move_ms", a->move_ms},
+                                       {"leaves", static_cast<double>(h->leaf_count())},
+                                       {"compared_texels", static_cast<double>(d.compared)},
+                                       {"level", sc.level}});
+  return out;
+}
+
 engine::Result<MethodOutput> run_door_moves(const RunContext& ctx) {
   auto d = door_setup(ctx.scene, ctx.knobs.real("density"), ctx.knobs.real("radius"), ctx.knobs.text("swings"));
   if (!d) return d.error();
@@ -610,6 +863,7 @@ engine::Result<MethodOutput> run_door_moves(const RunContext& ctx) {
     return engine::Error{.message = "the atlas size differs from the reference's"};
   const AntiradianceSettings s = antiradiance_settings(ctx);
   if (ctx.knobs.text("solve") == "off") return run_projection_floor(ctx, *d, s);
+  if (ctx.knobs.text("solve") == "exact") return run_exact_transport(ctx, *d, s);
 
   const auto t_bake = Clock::now();
   auto bake = bake_antiradiance(d->input, s);
@@ -626,7 +880,11 @@ engine::Result<MethodOutput> run_door_moves(const RunContext& ctx) {
       antiradiance_texel_blends(region->hierarchy(), d->input, d->layout);
 
   const TexelOutput output(*d, *region, ctx.knobs.text("output") == "gather");
-  auto scores = score_door_moves(ctx, *d, *region, blends, output);
+  NearVisibility near;
+  const bool near_on = ctx.knobs.text("near_visibility") == "on";
+  if (near_on)
+    if (engine::Status st = near.init(ctx, *d, *region); !st) return st.error();
+  auto scores = score_door_moves(ctx, *d, *region, blends, output, near_on ? &near : nullptr);
   if (!scores) return scores.error();
   DoorMoveScores& sc = *scores;
   const double moves = static_cast<double>(poses - 1);
@@ -642,6 +900,14 @@ engine::Result<MethodOutput> run_door_moves(const RunContext& ctx) {
     gpu = *timed;
   }
   out.extras = door_move_extras(ctx, *d, *region, sc, gpu, out.field, floor_field);
+  if (near_on) {
+    out.costs.frame_ms += near.move_ms;
+    out.extras.insert(out.extras.end(), {{"near_visibility_receivers", static_cast<double>(near.receivers)},
+                                         {"near_visibility_bake_ms", near.bake_ms},
+                                         {"near_visibility_move_ms", near.move_ms},
+                                         {"near_visibility_pairs_per_move", near.pairs},
+                                         {"near_visibility_rays_per_move", near.rays}});
+  }
   return out;
 }
 

@@ -1,0 +1,271 @@
+#include "antiradiance/antiradiance_exact_transport.h"
+
+#include <engine/check.h>
+#include <engine/segment_box.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <limits>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "raytrace/embree_ray_caster.h"
+#include "raytrace/scene_adapter.h"
+
+namespace gi {
+namespace {
+
+constexpr float kPi = 3.14159265358979f;
+constexpr int kMinClosePairs = 16;
+
+std::uint64_t mix(std::uint64_t x) {
+  x += 0x9e3779b97f4a7c15ULL;
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
+  return x ^ (x >> 31);
+}
+
+float unit(std::uint64_t& state) {
+  state = mix(state);
+  return static_cast<float>(state >> 40) * (1.0f / 16777216.0f);
+}
+
+// A uniform point of triangle (a, b, c) from (u, v) in [0, 1)^2 (the square folded on its diagonal).
+glm::vec3 on_triangle(const glm::vec3* t, float u, float v) {
+  if (u + v > 1.0f) {
+    u = 1.0f - u;
+    v = 1.0f - v;
+  }
+  return t[0] + u * (t[1] - t[0]) + v * (t[2] - t[0]);
+}
+
+// True when every corner of `t` lies on or behind the plane through `p` with normal `n`.
+bool behind(const glm::vec3* t, const glm::vec3& p, const glm::vec3& n) {
+  for (int k = 0; k < 3; ++k)
+    if (glm::dot(t[k] - p, n) > 1e-6f) return false;
+  return true;
+}
+
+}  // namespace
+
+engine::Result<ExactLeafTransport> ExactLeafTransport::create(const BakeInput& input,
+                                                              const ExactTransportSettings& settings) {
+  if (settings.point_pairs < 1) return engine::Error{.message = "exact transport: point_pairs must be at least 1"};
+  if (engine::Status st = validate_bake_input(input); !st) return st.error();
+  ExactLeafTransport out;
+  out.settings_ = settings;
+  RtSceneData data = rt_scene_from(input);
+  out.deforming_.assign(input.instances.size(), 0);
+  out.object_bounds_.assign(input.instances.size(), Box{glm::vec3(0.0f), glm::vec3(0.0f)});
+  out.transform_.assign(input.instances.size(), glm::mat4(1.0f));
+  for (std::size_t i = 0; i < input.instances.size(); ++i) {
+    out.transform_[i] = input.instances[i].object_to_world;
+    if (!input.instances[i].deforming) continue;
+    if (i < data.instances.size()) data.instances[i].dynamic = true;
+    out.deforming_[i] = 1;
+    Box b{glm::vec3(std::numeric_limits<float>::infinity()), glm::vec3(-std::numeric_limits<float>::infinity())};
+    for (const BakePrimitive& p : input.meshes[input.instances[i].mesh].primitives)
+      for (const glm::vec3& v : p.positions) {
+        b.lo = glm::min(b.lo, v);
+        b.hi = glm::max(b.hi, v);
+      }
+    out.object_bounds_[i] = b;
+  }
+  auto caster = make_embree_ray_caster(data);
+  if (!caster) return caster.error();
+  out.caster_ = std::move(caster).value();
+  return out;
+}
+
+ExactLeafTransport::Box ExactLeafTransport::world_bounds(std::uint32_t instance, const glm::mat4& m) const {
+  const Box& o = object_bounds_[instance];
+  Box w{glm::vec3(std::numeric_limits<float>::infinity()), glm::vec3(-std::numeric_limits<float>::infinity())};
+  if (!(o.lo.x <= o.hi.x)) return w;
+  for (int c = 0; c < 8; ++c) {
+    const glm::vec3 corner((c & 1) ? o.hi.x : o.lo.x, (c & 2) ? o.hi.y : o.lo.y, (c & 4) ? o.hi.z : o.lo.z);
+    const glm::vec3 p(m * glm::vec4(corner, 1.0f));
+    w.lo = glm::min(w.lo, p);
+    w.hi = glm::max(w.hi, p);
+  }
+  w.lo -= glm::vec3(0.01f);
+  w.hi += glm::vec3(0.01f);
+  return w;
+}
+
+void ExactLeafTransport::set_instance_transform(std::uint32_t instance, const glm::mat4& m) {
+  GI_EXPECTS(instance < deforming_.size() && deforming_[instance] != 0,
+             "ExactLeafTransport: only deforming instances move");
+  caster_->set_instance_transform(instance, m);
+  swept_.push_back(world_bounds(instance, transform_[instance]));
+  swept_.push_back(world_bounds(instance, m));
+  transform_[instance] = m;
+  dirty_ = true;
+}
+
+std::size_t ExactLeafTransport::pair_index(std::size_t i, std::size_t j) const {
+  return i * n_ - i * (i + 1) / 2 + (j - i - 1);
+}
+
+float ExactLeafTransport::coupling(std::size_t i, std::size_t j) const {
+  if (i == j) return 0.0f;
+  return i < j ? g_[pair_index(i, j)] : g_[pair_index(j, i)];
+}
+
+float ExactLeafTransport::pair_coupling(const ElementHierarchy& h, std::size_t i, std::size_t j,
+                                        std::size_t& rays) const {
+  const auto ni = static_cast<std::size_t>(h.leaves[i]), nj = static_cast<std::size_t>(h.leaves[j]);
+  const glm::vec3* ti = &h.corners[3 * ni];
+  const glm::vec3* tj = &h.corners[3 * nj];
+  const glm::vec3 n_i = h.nodes[ni].normal, n_j = h.nodes[nj].normal;
+  if (behind(tj, ti[0], n_i) || behind(ti, tj[0], n_j)) return 0.0f;
+  int m = settings_.point_pairs;
+  const ElementNode& ei = h.nodes[ni];
+  const ElementNode& ej = h.nodes[nj];
+  const float reach = 2.0f * (ei.radius_m + ej.radius_m);
+  const bool close = glm::dot(ei.center - ej.center, ei.center - ej.center) < reach * reach;
+  // Close pairs (touching leaves: the 1/r^2 peak) at least kMinClosePairs: with fewer, one
+  // unlucky pair near the clamp can push the operator's norm above 1 and the solve diverges.
+  if (close) m = std::max(m, kMinClosePairs);
+  if (settings_.reference_area_m2 > 0.0f && !close) {
+    const double share =
+        static_cast<double>(ei.area_m2) * static_cast<double>(ej.area_m2) /
+        (static_cast<double>(settings_.reference_area_m2) * static_cast<double>(settings_.reference_area_m2));
+    m = std::clamp(static_cast<int>(std::ceil(static_cast<double>(m) * share)), 1, m);
+  }
+  const int strata = std::max(1, static_cast<int>(std::sqrt(static_cast<double>(m))));
+  const float min_r2 = settings_.min_distance_m * settings_.min_distance_m;
+  std::uint64_t state = mix(settings_.seed ^ mix(static_cast<std::uint64_t>(i) * 0x100000001b3ULL + j));
+  double sum = 0.0;
+  for (int s = 0; s < m; ++s) {
+    const int cell = s % (strata * strata);
+    const float u = (static_cast<float>(cell % strata) + unit(state)) / static_cast<float>(strata);
+    const float v = (static_cast<float>(cell / strata) + unit(state)) / static_cast<float>(strata);
+    const glm::vec3 x = on_triangle(ti, u, v);
+    const float a = unit(state), b = unit(state);
+    const glm::vec3 y = on_triangle(tj, a, b);
+    const glm::vec3 d = y - x;
+    const float r2 = glm::dot(d, d);
+    if (r2 <= 0.0f) continue;
+    const float r = std::sqrt(r2);
+    const float ci = glm::dot(n_i, d) / r, cj = -glm::dot(n_j, d) / r;
+    if (ci <= 0.0f || cj <= 0.0f) continue;
+    // Off both surfaces by 0.1 mm along their normals, the segment between.
+    const glm::vec3 o = x + 1e-4f * n_i;
+    const glm::vec3 e = y + 1e-4f * n_j;
+    ++rays;
+    if (caster_->occluded(Ray{.origin = o, .t_min = 0.0f, .direction = e - o, .t_max = 1.0f})) continue;
+    sum += static_cast<double>(ci * cj / std::max(r2, min_r2));
+  }
+  return static_cast<float>(sum / static_cast<double>(m));
+}
+
+void ExactLeafTransport::update(const ElementHierarchy& h) {
+  GI_EXPECTS(h.corners.size() == 3 * h.nodes.size(), "ExactLeafTransport: the hierarchy needs its triangles");
+  if (dirty_) {
+    caster_->commit();
+    dirty_ = false;
+  }
+  const std::size_t n = h.leaf_count();
+  const bool all = n != n_ || g_.empty();
+  if (all) {
+    n_ = n;
+    g_.assign(n * (n - 1) / 2, 0.0f);
+  }
+  std::vector<char> moving(n, 0);
+  for (std::size_t l = 0; l < n; ++l) {
+    const std::int32_t inst = h.node_instance[static_cast<std::size_t>(h.leaves[l])];
+    moving[l] = inst >= 0 && static_cast<std::size_t>(inst) < deforming_.size() &&
+                deforming_[static_cast<std::size_t>(inst)] != 0;
+  }
+  std::atomic<std::size_t> pairs{0}, rays{0};
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1), [&](const tbb::blocked_range<std::size_t>& r) {
+    std::size_t my_pairs = 0, my_rays = 0;
+    for (std::size_t i = r.begin(); i != r.end(); ++i) {
+      const ElementNode& a = h.nodes[static_cast<std::size_t>(h.leaves[i])];
+      for (std::size_t j = i + 1; j < n; ++j) {
+        if (!receivers_.empty() && !receivers_[i] && !receivers_[j]) continue;
+        bool todo = all || moving[i] || moving[j];
+        if (!todo) {
+          const ElementNode& b = h.nodes[static_cast<std::size_t>(h.leaves[j])];
+          const glm::vec3 widen(std::max(a.radius_m, b.radius_m));
+          for (const Box& box : swept_)
+            if (engine::segment_meets_box(a.center, b.center - a.center, 1.0f, box.lo - widen, box.hi + widen)) {
+              todo = true;
+              break;
+            }
+        }
+        if (!todo) continue;
+        g_[pair_index(i, j)] = pair_coupling(h, i, j, my_rays);
+        ++my_pairs;
+      }
+    }
+    pairs += my_pairs;
+    rays += my_rays;
+  });
+  swept_.clear();
+  last_pairs_ = pairs;
+  last_rays_ = rays;
+}
+
+ExactSolveResult ExactLeafTransport::solve(const ElementHierarchy& h, std::span<const glm::vec3> direct) const {
+  return iterate(h, direct, {}, {});
+}
+
+ExactSolveResult ExactLeafTransport::solve_receivers(const ElementHierarchy& h, std::span<const glm::vec3> direct,
+                                                     std::span<const glm::vec3> others) const {
+  GI_EXPECTS(receivers_.size() == h.leaf_count() && others.size() == h.leaf_count(),
+             "ExactLeafTransport::solve_receivers: set_receivers and others for every leaf");
+  return iterate(h, direct, receivers_, others);
+}
+
+ExactSolveResult ExactLeafTransport::iterate(const ElementHierarchy& h, std::span<const glm::vec3> direct,
+                                             std::span<const char> rows, std::span<const glm::vec3> others) const {
+  const std::size_t n = h.leaf_count();
+  GI_EXPECTS(n == n_ && direct.size() == n, "ExactLeafTransport::solve: update() with this hierarchy first");
+  std::vector<glm::vec3> area_rho(n);  // A_j albedo_j / pi
+  for (std::size_t l = 0; l < n; ++l) {
+    const ElementNode& e = h.nodes[static_cast<std::size_t>(h.leaves[l])];
+    area_rho[l] = e.area_m2 * e.albedo / kPi;
+  }
+  ExactSolveResult out;
+  out.irradiance.assign(n, glm::vec3(0.0f));
+  if (!rows.empty())
+    for (std::size_t l = 0; l < n; ++l) out.irradiance[l] = rows[l] ? glm::vec3(0.0f) : others[l];
+  std::vector<glm::vec3> next = out.irradiance, source(n);
+  const int budget = settings_.bounces > 0 ? settings_.bounces : settings_.max_iterations;
+  for (int it = 0; it < budget; ++it) {
+    for (std::size_t l = 0; l < n; ++l) source[l] = area_rho[l] * (direct[l] + out.irradiance[l]);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 16), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t i = r.begin(); i != r.end(); ++i) {
+        if (!rows.empty() && !rows[i]) continue;  // held
+        glm::dvec3 sum(0.0);
+        for (std::size_t j = 0; j < i; ++j) sum += static_cast<double>(g_[pair_index(j, i)]) * glm::dvec3(source[j]);
+        const std::size_t row = i < n - 1 ? pair_index(i, i + 1) : 0;
+        for (std::size_t j = i + 1; j < n; ++j)
+          sum += static_cast<double>(g_[row + (j - i - 1)]) * glm::dvec3(source[j]);
+        next[i] = glm::vec3(sum);
+      }
+    });
+    double change = 0.0, total = 0.0;
+    for (std::size_t l = 0; l < n; ++l) {
+      if (!rows.empty() && !rows[l]) continue;
+      const glm::vec3 d = next[l] - out.irradiance[l];
+      change += static_cast<double>(std::abs(d.x) + std::abs(d.y) + std::abs(d.z));
+      total += static_cast<double>(next[l].x + next[l].y + next[l].z);
+    }
+    out.irradiance = next;
+    out.iterations = it + 1;
+    out.residual = total > 0.0 ? change / total : 0.0;
+    if (!std::isfinite(total)) break;  // diverged: not converged, and visibly so
+    if (settings_.bounces <= 0 && out.residual < settings_.tolerance) {
+      out.converged = true;
+      break;
+    }
+  }
+  if (settings_.bounces > 0) out.converged = std::isfinite(out.residual);
+  return out;
+}
+
+}  // namespace gi

@@ -1,0 +1,126 @@
+#pragma once
+// A diagnosis solver for antiradiance (issue 37, docs/antiradiance.md "Issue 37: what limits
+// the change"): the same elements (an ElementHierarchy's leaves) and the same per-leaf direct
+// light, but leaf-to-leaf transport by form factors with ray-traced visibility instead of
+// antiradiance. Every pair of leaves gets the mean of cos_i cos_j V / r^2 over Monte Carlo
+// point pairs on the two leaves' triangles (Embree occlusion through the posed scene); the
+// indirect irradiance solves E_i = sum_j A_j G_ij albedo_j / pi (E_direct_j + E_j) (Jacobi, to a
+// residual tolerance). It answers "how good could the change be at these elements with perfect
+// visibility". Not a runtime method: its cost is n^2 point pairs.
+//   auto t = gi::ExactLeafTransport::create(input, {}).value();
+//   t.update(h);                            // every pair, at h's pose
+//   t.set_instance_transform(door, m);  h.set_group_transform(1, m);
+//   t.update(h);                            // only the pairs the door's motion can change
+//   std::vector<glm::vec3> e = t.solve(h, direct).irradiance;
+//
+// Common random numbers: a pair's point samples depend only on (seed, pair, sample), so a pair
+// whose visibility the motion cannot change keeps its value bit for bit, and the change between
+// poses carries no noise from the pairs that did not change.
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include <engine/result.h>
+#include <gi/bake_input.h>
+
+#include "antiradiance/element_hierarchy.h"
+#include "raytrace/ray_caster.h"
+
+namespace gi {
+
+struct ExactTransportSettings {
+  /// Monte Carlo point pairs per leaf pair (stratified on the first leaf); close pairs (centres
+  /// nearer than twice their radii's sum) at least 16.
+  int point_pairs = 64;
+  /// Fewer point pairs for small leaves (0: off, point_pairs everywhere): a pair of leaves of
+  /// areas A_i, A_j gets ceil(point_pairs A_i A_j / reference_area_m2^2) pairs, at least 1,
+  /// at most point_pairs, and point_pairs when the leaves are close (centres nearer than twice
+  /// their radii's sum). A leaf's irradiance sums ~1 / A_j senders per area, so its noise stays
+  /// that of reference_area_m2 leaves at point_pairs (0.2 m leaves near a door: the n^2 pairs'
+  /// rays 16-256x fewer). The count of a static pair does not depend on the pose.
+  float reference_area_m2 = 0.0f;
+  /// Converged when sum |dE| / sum |E| of a Jacobi step drops below this.
+  double tolerance = 1e-3;
+  int max_iterations = 1000;
+  /// Indirect bounces: -1 all (to the tolerance), k >= 1: at most k (1: the first bounce off
+  /// the directly lit leaves only).
+  int bounces = -1;
+  /// r^2 is clamped to at least this squared (metres): the 1/r^2 singularity of leaves that
+  /// touch (a door's edge against its frame, a wall against the floor) is integrable but makes
+  /// point pairs noisy.
+  float min_distance_m = 0.02f;
+  std::uint64_t seed = 1;
+};
+
+struct ExactSolveResult {
+  std::vector<glm::vec3> irradiance;  ///< Indirect irradiance per leaf (W/m^2), leaf order.
+  int iterations = 0;
+  double residual = 0.0;
+  bool converged = false;
+};
+
+class ExactLeafTransport {
+ public:
+  /// Errors: invalid input, ray caster construction failures, point_pairs < 1.
+  static engine::Result<ExactLeafTransport> create(const BakeInput& input, const ExactTransportSettings& settings);
+
+  /// Moves deforming instance `instance` (BakeInput index) in the ray caster; the next
+  /// update() recomputes the pairs it can change. The caller moves the hierarchy's group.
+  void set_instance_transform(std::uint32_t instance, const glm::mat4& object_to_world);
+  /// The first call (or one with another leaf count): every pair. Later: the pairs with a
+  /// leaf of a deforming instance, and those whose segment hull (the segment between the
+  /// leaves' centres, widened by the larger bounding radius) meets a moved instance's bounds
+  /// before or after its motion. Precondition: `h` is the hierarchy of the previous calls,
+  /// its deforming groups placed as the instances were set here, corners present.
+  void update(const ElementHierarchy& h);
+  /// Pairs the last update() computed (unordered leaf pairs).
+  std::size_t last_pairs_computed() const { return last_pairs_; }
+  /// Rays the last update() cast.
+  std::size_t last_rays() const { return last_rays_; }
+
+  /// The indirect irradiance with `direct` (W/m^2 per leaf) as the source.
+  ExactSolveResult solve(const ElementHierarchy& h, std::span<const glm::vec3> direct) const;
+
+  /// Restricts the transport to receivers (issue 37's explicit visibility near the door): set
+  /// before the first update(), one flag per leaf. Only pairs with an end among them are
+  /// computed (the others' coupling stays 0).
+  void set_receivers(std::vector<char> receivers) { receivers_ = std::move(receivers); }
+  /// The receivers' indirect irradiance gathered with visibility from every leaf, the other
+  /// leaves held at `others` (W/m^2 per leaf: e.g. an antiradiance solve's); the receivers'
+  /// own exchange iterated to the tolerance. Returns every leaf's value (the others' as given).
+  ExactSolveResult solve_receivers(const ElementHierarchy& h, std::span<const glm::vec3> direct,
+                                   std::span<const glm::vec3> others) const;
+
+  /// G_ij of leaves i != j (m^-2: the mean of cos cos V / r^2); 0 for i == j.
+  float coupling(std::size_t i, std::size_t j) const;
+
+ private:
+  struct Box {
+    glm::vec3 lo, hi;
+  };
+  Box world_bounds(std::uint32_t instance, const glm::mat4& m) const;
+  /// G of leaves (i, j), i < j, at the caster's current pose; adds its rays to `rays`.
+  float pair_coupling(const ElementHierarchy& h, std::size_t i, std::size_t j, std::size_t& rays) const;
+  std::size_t pair_index(std::size_t i, std::size_t j) const;  // i < j
+  /// Jacobi over the rows flagged in `rows` (all when empty), the others held at `others`.
+  ExactSolveResult iterate(const ElementHierarchy& h, std::span<const glm::vec3> direct, std::span<const char> rows,
+                           std::span<const glm::vec3> others) const;
+
+  ExactTransportSettings settings_;
+  std::unique_ptr<RayCaster> caster_;
+  std::vector<char> deforming_;
+  std::vector<Box> object_bounds_;
+  std::vector<glm::mat4> transform_;
+  std::vector<Box> swept_;
+  bool dirty_ = false;
+  std::size_t n_ = 0;
+  std::vector<float> g_;  ///< Upper triangle, row-major, i < j.
+  std::vector<char> receivers_;
+  std::size_t last_pairs_ = 0, last_rays_ = 0;
+};
+
+}  // namespace gi
