@@ -18,6 +18,7 @@
 
 #include "antiradiance/antiradiance_settings.h"
 #include "antiradiance/element_hierarchy.h"
+#include "antiradiance/moving_instances.h"
 #include "raytrace/ray_caster.h"
 #include "transport/point_emitters.h"
 
@@ -48,20 +49,12 @@ class AntiradianceDirectLight {
   std::size_t emitter_count() const { return emitters_.size(); }
 
  private:
-  struct Box {
-    glm::vec3 lo, hi;
-  };
-  /// The world bounds of deforming instance `instance` at `m`.
-  Box world_bounds(std::uint32_t instance, const glm::mat4& m) const;
   /// The leaves' values into `out` for the leaves where `todo` is 1 (all when empty).
   void compute(const ElementHierarchy& h, const std::vector<char>& todo, std::vector<glm::vec3>& out) const;
 
   std::vector<PointEmitter> emitters_;
   std::unique_ptr<RayCaster> caster_;
-  std::vector<char> deforming_;
-  std::vector<Box> object_bounds_;    ///< Per BakeInput instance (deforming ones only meaningful).
-  std::vector<glm::mat4> transform_;  ///< Per BakeInput instance: its current transform.
-  std::vector<Box> swept_;            ///< Moved instances' bounds, before and after, since the last update.
+  MovingInstances moving_;  ///< The deforming instances, and their bounds swept since the last update.
   std::vector<glm::vec3> last_;
   std::size_t last_recomputed_ = 0;
   bool dirty_ = false;

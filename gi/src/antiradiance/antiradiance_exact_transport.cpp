@@ -6,7 +6,6 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <limits>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -57,50 +56,18 @@ engine::Result<ExactLeafTransport> ExactLeafTransport::create(const BakeInput& i
   ExactLeafTransport out;
   out.settings_ = settings;
   RtSceneData data = rt_scene_from(input);
-  out.deforming_.assign(input.instances.size(), 0);
-  out.object_bounds_.assign(input.instances.size(), Box{glm::vec3(0.0f), glm::vec3(0.0f)});
-  out.transform_.assign(input.instances.size(), glm::mat4(1.0f));
-  for (std::size_t i = 0; i < input.instances.size(); ++i) {
-    out.transform_[i] = input.instances[i].object_to_world;
-    if (!input.instances[i].deforming) continue;
-    if (i < data.instances.size()) data.instances[i].dynamic = true;
-    out.deforming_[i] = 1;
-    Box b{glm::vec3(std::numeric_limits<float>::infinity()), glm::vec3(-std::numeric_limits<float>::infinity())};
-    for (const BakePrimitive& p : input.meshes[input.instances[i].mesh].primitives)
-      for (const glm::vec3& v : p.positions) {
-        b.lo = glm::min(b.lo, v);
-        b.hi = glm::max(b.hi, v);
-      }
-    out.object_bounds_[i] = b;
-  }
+  out.moving_ = MovingInstances::mark(input, data);
   auto caster = make_embree_ray_caster(data);
   if (!caster) return caster.error();
   out.caster_ = std::move(caster).value();
   return out;
 }
 
-ExactLeafTransport::Box ExactLeafTransport::world_bounds(std::uint32_t instance, const glm::mat4& m) const {
-  const Box& o = object_bounds_[instance];
-  Box w{glm::vec3(std::numeric_limits<float>::infinity()), glm::vec3(-std::numeric_limits<float>::infinity())};
-  if (!(o.lo.x <= o.hi.x)) return w;
-  for (int c = 0; c < 8; ++c) {
-    const glm::vec3 corner((c & 1) ? o.hi.x : o.lo.x, (c & 2) ? o.hi.y : o.lo.y, (c & 4) ? o.hi.z : o.lo.z);
-    const glm::vec3 p(m * glm::vec4(corner, 1.0f));
-    w.lo = glm::min(w.lo, p);
-    w.hi = glm::max(w.hi, p);
-  }
-  w.lo -= glm::vec3(0.01f);
-  w.hi += glm::vec3(0.01f);
-  return w;
-}
-
 void ExactLeafTransport::set_instance_transform(std::uint32_t instance, const glm::mat4& m) {
-  GI_EXPECTS(instance < deforming_.size() && deforming_[instance] != 0,
+  GI_EXPECTS(moving_.deforming(static_cast<std::int32_t>(instance)),
              "ExactLeafTransport: only deforming instances move");
   caster_->set_instance_transform(instance, m);
-  swept_.push_back(world_bounds(instance, transform_[instance]));
-  swept_.push_back(world_bounds(instance, m));
-  transform_[instance] = m;
+  moving_.move(instance, m);
   dirty_ = true;
 }
 
@@ -176,8 +143,7 @@ void ExactLeafTransport::update(const ElementHierarchy& h) {
   std::vector<char> moving(n, 0);
   for (std::size_t l = 0; l < n; ++l) {
     const std::int32_t inst = h.node_instance[static_cast<std::size_t>(h.leaves[l])];
-    moving[l] = inst >= 0 && static_cast<std::size_t>(inst) < deforming_.size() &&
-                deforming_[static_cast<std::size_t>(inst)] != 0;
+    moving[l] = moving_.deforming(inst);
   }
   std::atomic<std::size_t> pairs{0}, rays{0};
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1), [&](const tbb::blocked_range<std::size_t>& r) {
@@ -190,7 +156,7 @@ void ExactLeafTransport::update(const ElementHierarchy& h) {
         if (!todo) {
           const ElementNode& b = h.nodes[static_cast<std::size_t>(h.leaves[j])];
           const glm::vec3 widen(std::max(a.radius_m, b.radius_m));
-          for (const Box& box : swept_)
+          for (const MovingInstances::Box& box : moving_.swept())
             if (engine::segment_meets_box(a.center, b.center - a.center, 1.0f, box.lo - widen, box.hi + widen)) {
               todo = true;
               break;
@@ -204,7 +170,7 @@ void ExactLeafTransport::update(const ElementHierarchy& h) {
     pairs += my_pairs;
     rays += my_rays;
   });
-  swept_.clear();
+  moving_.clear_swept();
   last_pairs_ = pairs;
   last_rays_ = rays;
 }

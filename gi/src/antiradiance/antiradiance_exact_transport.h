@@ -28,6 +28,7 @@
 #include <gi/bake_input.h>
 
 #include "antiradiance/element_hierarchy.h"
+#include "antiradiance/moving_instances.h"
 #include "raytrace/ray_caster.h"
 
 namespace gi {
@@ -99,10 +100,6 @@ class ExactLeafTransport {
   float coupling(std::size_t i, std::size_t j) const;
 
  private:
-  struct Box {
-    glm::vec3 lo, hi;
-  };
-  Box world_bounds(std::uint32_t instance, const glm::mat4& m) const;
   /// G of leaves (i, j), i < j, at the caster's current pose; adds its rays to `rays`.
   float pair_coupling(const ElementHierarchy& h, std::size_t i, std::size_t j, std::size_t& rays) const;
   std::size_t pair_index(std::size_t i, std::size_t j) const;  // i < j
@@ -112,10 +109,7 @@ class ExactLeafTransport {
 
   ExactTransportSettings settings_;
   std::unique_ptr<RayCaster> caster_;
-  std::vector<char> deforming_;
-  std::vector<Box> object_bounds_;
-  std::vector<glm::mat4> transform_;
-  std::vector<Box> swept_;
+  MovingInstances moving_;
   bool dirty_ = false;
   std::size_t n_ = 0;
   std::vector<float> g_;  ///< Upper triangle, row-major, i < j.
