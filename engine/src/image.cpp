@@ -2,6 +2,7 @@
 // implementations are compiled in gltf/tinygltf_impl.cpp; tinyexr is a shared library.
 #include <engine/image.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdint>
 #include <cstdlib>
@@ -46,6 +47,103 @@ Status check_parent_exists(const fs::path& path) {
   std::error_code ec;
   if (!parent.empty() && !fs::is_directory(parent, ec))
     return Error{path.string(), "", "directory " + parent.string() + " does not exist"};
+  return {};
+}
+
+// Reads a NUL-terminated name of at most 255 characters at bytes[at] (advancing `at`), or
+// returns false when none ends in time.
+bool read_exr_name(const std::vector<unsigned char>& bytes, std::size_t& at, std::string& name) {
+  name.clear();
+  while (at < bytes.size() && bytes[at] != 0) {
+    if (name.size() == 255) return false;
+    name.push_back(static_cast<char>(bytes[at++]));
+  }
+  if (at >= bytes.size()) return false;
+  ++at;
+  return true;
+}
+
+std::int32_t read_exr_int(const std::vector<unsigned char>& bytes, std::size_t at) {
+  const std::uint32_t u = std::uint32_t{bytes[at]} | std::uint32_t{bytes[at + 1]} << 8 |
+                          std::uint32_t{bytes[at + 2]} << 16 | std::uint32_t{bytes[at + 3]} << 24;
+  return static_cast<std::int32_t>(u);
+}
+
+// What is wrong with a channel list's data (OpenEXR "chlist"): 1-4 channels of HALF or FLOAT
+// samples, one per pixel. Empty when it is one the project reads.
+std::string exr_channel_list_problem(const std::vector<unsigned char>& bytes, std::size_t at, std::size_t end) {
+  const std::vector<unsigned char> list(bytes.begin() + static_cast<std::ptrdiff_t>(at),
+                                        bytes.begin() + static_cast<std::ptrdiff_t>(end));
+  std::size_t k = 0;
+  int channels = 0;
+  std::string name;
+  while (k < list.size() && list[k] != 0) {
+    if (!read_exr_name(list, k, name) || k + 16 > list.size()) return "a channel list that ends inside a channel";
+    const std::int32_t type = read_exr_int(list, k);
+    if (type != 1 && type != 2)
+      return "channel '" + name + "' of pixel type " + std::to_string(type) + " (half or float expected)";
+    if (read_exr_int(list, k + 8) != 1 || read_exr_int(list, k + 12) != 1)
+      return "channel '" + name + "' is subsampled (one sample per pixel expected)";
+    k += 16;
+    if (++channels > 4) return "more than 4 channels";
+  }
+  if (k >= list.size()) return "a channel list without its end";
+  if (channels == 0) return "no channels";
+  return {};
+}
+
+// Empty when a data window of width x height is within the reader's limits, else what is wrong.
+std::string exr_window_problem(std::int64_t width, std::int64_t height) {
+  if (width >= 1 && height >= 1 && width <= kMaxExrSide && height <= kMaxExrSide && width * height <= kMaxExrPixels)
+    return {};
+  return "data window " + std::to_string(width) + " x " + std::to_string(height) + " outside 1.." +
+         std::to_string(kMaxExrSide) + " per side and " + std::to_string(kMaxExrPixels) + " pixels";
+}
+
+// Debian's tinyexr 1.0.1 asserts (aborts) on header values it does not expect (a "type" other
+// than the four it knows, a pixel type or compression it cannot decode; found by the fuzz leg,
+// tests/fuzz/regressions/exr/tinyexr_asserts_on_unknown_type*.exr), so the attributes are read
+// here first and only what the project writes passes: one scanline part of 1-4 half or float
+// channels, uncompressed or ZIP, its data window within the limits. Empty when the header is
+// one of those, else its first problem (the window's before the others').
+std::string exr_header_problem(const std::vector<unsigned char>& bytes) {
+  std::size_t at = 8;  // after the magic number and the version field
+  std::string name, type, window, part, compression, channels = "no channel list";
+  for (;;) {
+    if (at >= bytes.size()) return "the header ends before its attributes do";
+    if (bytes[at] == 0) break;
+    if (!read_exr_name(bytes, at, name) || !read_exr_name(bytes, at, type) || at + 4 > bytes.size())
+      return "the header ends inside an attribute";
+    const std::int32_t size = read_exr_int(bytes, at);
+    at += 4;
+    if (size < 0 || static_cast<std::size_t>(size) > bytes.size() - at)
+      return "attribute '" + name + "' of " + std::to_string(size) + " bytes runs past the file's end";
+    const std::size_t data = at, end = at + static_cast<std::size_t>(size);
+    at = end;
+    if (name == "dataWindow" && size == 16) {
+      const std::int64_t min_x = read_exr_int(bytes, data), min_y = read_exr_int(bytes, data + 4);
+      window = exr_window_problem(std::int64_t{read_exr_int(bytes, data + 8)} - min_x + 1,
+                                  std::int64_t{read_exr_int(bytes, data + 12)} - min_y + 1);
+    } else if (name == "type") {
+      // tinyexr reads the value up to its first NUL; an empty one it ignores.
+      const std::string value(bytes.begin() + static_cast<std::ptrdiff_t>(data),
+                              std::find(bytes.begin() + static_cast<std::ptrdiff_t>(data),
+                                        bytes.begin() + static_cast<std::ptrdiff_t>(end), 0));
+      part = value.empty() || value == "scanlineimage"
+                 ? ""
+                 : "part type '" + value.substr(0, 64) + "' (scanlineimage expected)";
+    } else if (name == "compression") {
+      const unsigned c = size == 1 ? bytes[data] : 255u;
+      compression =
+          c == TINYEXR_COMPRESSIONTYPE_NONE || c == TINYEXR_COMPRESSIONTYPE_ZIPS || c == TINYEXR_COMPRESSIONTYPE_ZIP
+              ? ""
+              : "compression " + std::to_string(c) + " (none, ZIPS or ZIP expected)";
+    } else if (name == "channels") {
+      channels = exr_channel_list_problem(bytes, data, end);
+    }
+  }
+  for (const std::string* problem : {&window, &part, &compression, &channels})
+    if (!problem->empty()) return *problem;
   return {};
 }
 
@@ -128,6 +226,7 @@ Result<ImageRgbaF> load_exr(const fs::path& path) {
     return fail("not an OpenEXR file (bad magic or version)");
   if (version.tiled != 0 || version.multipart != 0 || version.non_image != 0)
     return fail("tiled, multi-part and deep files are not supported (one scanline part expected)");
+  if (std::string problem = exr_header_problem(bytes); !problem.empty()) return fail(problem);
   EXRHeader header;
   InitEXRHeader(&header);
   const char* err = nullptr;
@@ -143,9 +242,7 @@ Result<ImageRgbaF> load_exr(const fs::path& path) {
   const std::int64_t chunks = header.chunk_count;
   FreeEXRHeader(&header);
   if (tiled) return fail("tiled files are not supported (one scanline part expected)");
-  if (width < 1 || height < 1 || width > kMaxExrSide || height > kMaxExrSide || width * height > kMaxExrPixels)
-    return fail("data window " + std::to_string(width) + " x " + std::to_string(height) + " outside 1.." +
-                std::to_string(kMaxExrSide) + " per side and " + std::to_string(kMaxExrPixels) + " pixels");
+  if (std::string problem = exr_window_problem(width, height); !problem.empty()) return fail(problem);
   if (chunks < 0 || chunks > height)
     return fail("chunkCount " + std::to_string(chunks) + " for " + std::to_string(height) + " scanlines");
 

@@ -3,6 +3,8 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <string>
 
 #include <engine/image.h>
@@ -118,6 +120,46 @@ TEST(ImageExr, AHeaderOutsideTheLimitsIsRefusedBeforeTinyexrSizesAnything) {
   ASSERT_TRUE(back.ok()) << back.error().to_string();
   EXPECT_EQ(back->width, 3);
   EXPECT_EQ(back->height, 2);
+}
+
+// The fuzz leg's second finding: Debian's tinyexr 1.0.1 asserts (aborts the process) while it
+// parses a header whose "type" attribute is none of the four it knows, or later on a pixel
+// type or compression it cannot decode. load_exr reads the attributes first and lets through
+// only what the project writes (one scanline part, 1-4 half or float channels, none or ZIP).
+TEST(ImageExr, AHeaderTinyexrWouldAssertOnIsRefusedWithItsProblem) {
+  for (const char* name : {"tinyexr_asserts_on_unknown_type.exr", "tinyexr_asserts_on_unknown_type_2.exr"}) {
+    const fs::path file = fs::path(GI_SOURCE_DIR) / "tests/fuzz/regressions/exr" / name;
+    ASSERT_TRUE(fs::exists(file));
+    auto image = engine::load_exr(file);
+    ASSERT_FALSE(image.ok()) << name;
+    EXPECT_EQ(image.error().file, file.string());
+    EXPECT_NE(image.error().message.find("cannot read EXR"), std::string::npos) << image.error().to_string();
+  }
+  // A file the project writes (ZIP at 16 x 16 and above), then its compression byte set to PIZ
+  // (4), which the project never writes: refused by name, not handed to the decoder.
+  const fs::path dir = scratch_dir("compression");
+  engine::ImageRgbaF image;
+  image.width = 16;
+  image.height = 16;
+  image.pixels.assign(16 * 16 * 4, 0.25f);
+  for (engine::ExrPixelType type : {engine::ExrPixelType::Half, engine::ExrPixelType::Float}) {
+    ASSERT_TRUE(engine::save_exr(dir / "zip.exr", image, type).ok());
+    auto back = engine::load_exr(dir / "zip.exr");
+    ASSERT_TRUE(back.ok()) << back.error().to_string();
+    EXPECT_FLOAT_EQ(back->pixels[17], 0.25f);
+  }
+  std::ifstream in(dir / "zip.exr", std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string attribute("compression\0compression\0\x01\0\0\0", 28);
+  const std::size_t at = bytes.find(attribute);
+  ASSERT_NE(at, std::string::npos);
+  ASSERT_EQ(bytes[at + attribute.size()], 3) << "save_exr writes ZIP";
+  bytes[at + attribute.size()] = 4;
+  std::ofstream(dir / "piz.exr", std::ios::binary) << bytes;
+  auto piz = engine::load_exr(dir / "piz.exr");
+  ASSERT_FALSE(piz.ok());
+  EXPECT_NE(piz.error().message.find("compression 4 (none, ZIPS or ZIP expected)"), std::string::npos)
+      << piz.error().to_string();
 }
 
 }  // namespace
