@@ -45,6 +45,7 @@
 #include "raytrace/reference_brdf.h"
 #include "raytrace/texel_samples.h"
 #include "real_level_lighting.h"
+#include "sweep/atlas_split_truth.h"
 #include "transport/static_scene.h"
 #include "uv/atlas_layout.h"
 
@@ -193,7 +194,7 @@ int main(int argc, char** argv) {
         const glm::dvec3 r1(rd[0][i] + ri[0][i]), r2(rd[1][i] + ri[1][i]);
         whole.add(va, r1, r2), whole.add_second(va, vb);
         const glm::dvec3 rim = 0.5 * glm::dvec3(ri[0][i] + ri[1][i]), rm = 0.5 * (r1 + r2);
-        if (rim.x + rim.y + rim.z >= 0.8 * (rm.x + rm.y + rm.z))
+        if (gi::is_indirect_dominated(rim.x + rim.y + rim.z, rm.x + rm.y + rm.z))
           dominated.add(va, r1, r2), dominated.add_second(va, vb);
       }
       const auto rel = [](const Sums& x, double e2) { return std::sqrt(e2 / std::max(1e-30, x.ref2 - x.noise2)); };
@@ -291,10 +292,12 @@ int main(int argc, char** argv) {
       into(by_material[static_cast<int>(tri.material)]);
       const glm::ivec2 sz = layout->charts[static_cast<std::size_t>(tx.chart[i])].size;
       into(by_chart[sz.x * sz.y <= 16 ? 16 : sz.x * sz.y <= 64 ? 64 : sz.x * sz.y <= 256 ? 256 : 1 << 30]);
-      // The measure: texels whose truth indirect is >= 80% of the truth total.
+      // The measure, the sweep's definition: texels whose truth total is lit and at least
+      // 80% indirect (texels the truth leaves dark were counted here before, not in the sweep).
       const glm::dvec3 ri_mean = 0.5 * glm::dvec3(ri[0][i] + ri[1][i]), r_mean = 0.5 * (r1 + r2);
       const bool thin = std::min(sz.x, sz.y) <= 4;  // the footprint includes the 1-texel rims
-      const bool dominated = ri_mean.x + ri_mean.y + ri_mean.z >= 0.8 * (r_mean.x + r_mean.y + r_mean.z);
+      const bool dominated =
+          gi::is_indirect_dominated(ri_mean.x + ri_mean.y + ri_mean.z, r_mean.x + r_mean.y + r_mean.z);
       kinds[i] = static_cast<std::uint8_t>((gathered->hidden[i] ? 1 : 0) | (sandwiched[i] ? 2 : 0) | (thin ? 4 : 0) |
                                            (border ? 8 : 0) | (dominated ? 16 : 0));
       if (dominated) {

@@ -89,8 +89,8 @@ std::vector<std::uint8_t> indirect_dominated_mask(const AtlasSplitTruth& truth, 
   std::vector<std::uint8_t> mask(truth.total.count(), 0);
   for (std::size_t i = 0; i < mask.size(); ++i) {
     const double total = channel_sum(truth.total, i);
-    mask[i] = truth.total.is_valid(i) && truth.indirect.is_valid(i) && total > 0.0 &&
-                      channel_sum(truth.indirect, i) >= share * total
+    mask[i] = truth.total.is_valid(i) && truth.indirect.is_valid(i) &&
+                      is_indirect_dominated(channel_sum(truth.indirect, i), total, share)
                   ? 1
                   : 0;
   }

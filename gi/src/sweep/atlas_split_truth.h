@@ -27,6 +27,13 @@ struct AtlasSplitTruth {
 /// Share of the truth's total a texel's truth indirect must reach to count as indirect-dominated.
 inline constexpr double kIndirectDominatedShare = 0.8;
 
+/// Whether a texel whose truth indirect and total (each summed over R, G, B) are given counts
+/// as indirect-dominated: a total > 0 of which the indirect is at least `share`. A texel the
+/// truth leaves dark (a closed pocket) is neither direct- nor indirect-dominated.
+inline bool is_indirect_dominated(double indirect, double total, double share = kIndirectDominatedShare) {
+  return total > 0.0 && indirect >= share * total;
+}
+
 /// One field of width x 2 height: rows [0, h) `indirect`, rows [h, 2h) `total`, masks and
 /// variances stacked the same way (a reference is one RgbField). Precondition: same layout,
 /// consistent, both with a variance or both without, both masked or both not.

@@ -74,6 +74,10 @@ TEST(AtlasSplitTruth, IndirectDominatedTexelsHaveAtLeast80PercentOfTheirTotalInd
   EXPECT_EQ(gi::indirect_dominated_mask(truth), (std::vector<std::uint8_t>{1, 0, 1, 0, 0}))
       << "80% is in, 79% out; an invalid texel and a black one are never selected";
   EXPECT_EQ(gi::indirect_dominated_mask(truth, 0.5), (std::vector<std::uint8_t>{1, 1, 1, 0, 0}));
+  // The per-texel predicate the breakdown shares: a texel the truth leaves dark is not selected
+  // (0 >= 0.8 x 0 would be).
+  EXPECT_FALSE(gi::is_indirect_dominated(0.0, 0.0));
+  EXPECT_TRUE(gi::is_indirect_dominated(0.8, 1.0));
 }
 
 TEST(AtlasSplitTruth, MeasuresTheIndirectDominatedTexelsAndTheWholeLightmapApart) {
