@@ -61,6 +61,8 @@ engine::Status validate(const TexelGatherSettings& s) {
   if (s.near_regather_rays < 0 || s.near_regather_rays > 4096) return bad("near_regather_rays is outside 0..4096");
   if (!(s.near_regather_texels >= 0.0f) || s.near_regather_texels > 64.0f)
     return bad("near_regather_texels is outside [0, 64]");
+  if (!(s.adaptive_share >= 0.0f) || s.adaptive_share > 1.0f) return bad("adaptive_share is outside [0, 1]");
+  if (s.adaptive_passes < 1 || s.adaptive_passes > 16) return bad("adaptive_passes is outside 1..16");
   return {};
 }
 
@@ -182,9 +184,11 @@ double luminance_of(const glm::dvec3& c) { return luminance(c.x, c.y, c.z); }
 // wherever either technique reaches (docs/light_atlas.md, "Emitter-sampled final gather").
 // Long because both kinds of rays share the MIS counts and one spread of their estimates
 // (the variance); split, the two loops would pass all of them back and forth.
+// `pass` > 0: an adaptive pass's rays (another seed; pass 0 is the one every texel gathers).
 FreshGather gather_texel(const StaticBakeScene& b, const LandingTable& lt, const TexelTable& t,
                          const TexelGatherSettings& s, const GatherSource& src, const TexelEmitters* emitters,
-                         std::uint32_t i, std::uint64_t& rays) {
+                         std::uint32_t i, std::uint64_t pass, std::uint64_t& rays) {
+  const std::uint64_t seed = s.seed ^ (pass * 0x9E3779B97F4A7C15ull);
   const AtlasTexels& tx = b.texels;
   const auto nf = static_cast<std::size_t>(s.gather_rays);
   const auto ne = emitters ? static_cast<std::size_t>(s.emitter_rays) : std::size_t{0};
@@ -202,7 +206,7 @@ FreshGather gather_texel(const StaticBakeScene& b, const LandingTable& lt, const
   };
   FreshGather g;
   if (nf > 0) {
-    Pcg32 rng = Pcg32::for_item(s.seed, stream_id(i, kGatherStream));
+    Pcg32 rng = Pcg32::for_item(seed, stream_id(i, kGatherStream));
     const float shift_y = rng.next_float();  // drawn first: see random.h
     const glm::vec2 shift(rng.next_float(), shift_y);
     // Cast kRayBatch at a time (land_rays), read in the rays' order (the rng's).
@@ -241,7 +245,7 @@ FreshGather gather_texel(const StaticBakeScene& b, const LandingTable& lt, const
   }
   g.ray_variance = spread.variance(n_all);
   if (ne == 0) return g;
-  Pcg32 rng = Pcg32::for_item(s.seed, stream_id(i, kEmitterStream));
+  Pcg32 rng = Pcg32::for_item(seed, stream_id(i, kEmitterStream));
   const float shift_y = rng.next_float();  // drawn first: see random.h
   const glm::vec2 shift(rng.next_float(), shift_y);
   // The members drawn ahead, kPicked rays at a time (their u does not depend on the rays),
@@ -282,31 +286,80 @@ FreshGather gather_texel(const StaticBakeScene& b, const LandingTable& lt, const
 // (in e and k.sky), weighted by ray counts. Texels not in `mine` get 0 in both.
 bool final_gather(const StaticBakeScene& b, const LandingTable& lt, const TexelTable& t, const TexelGatherSettings& s,
                   ThreadPool& pool, const ProgressCallback& progress, const std::vector<std::size_t>& mine,
-                  const GatherSource& src, const TexelEmitters* emitters, const KeptRays& k, std::vector<glm::vec3>& e,
-                  std::vector<glm::vec3>& sky, std::vector<float>& variance, std::vector<std::uint64_t>& rays_of) {
+                  const GatherSource& src, const TexelEmitters* emitters, const KeptRays& k,
+                  const std::vector<std::uint8_t>& extra, std::vector<glm::vec3>& e, std::vector<glm::vec3>& sky,
+                  std::vector<float>& variance, std::vector<std::uint64_t>& rays_of) {
   const auto nf = static_cast<std::size_t>(s.gather_rays);
   const auto ne = emitters ? static_cast<std::size_t>(s.emitter_rays) : std::size_t{0};
-  // Both estimate T(E_d + E): weighted by their rays (the sky by the cosine rays alone).
-  // With emitter rays the kept rays are left out: read at their landing texels without MIS
-  // weights (their hit points are not kept), they would bring back the cosine rays' noise
-  // (on the skylit room: 95th-percentile texel 0.36 with them, 0.23 without).
-  const double w_solve = ne > 0 ? 0.0 : static_cast<double>(k.per_texel) / static_cast<double>(k.per_texel + nf);
-  const double w_sky = static_cast<double>(k.per_texel) / static_cast<double>(k.per_texel + nf);
-  // The mean's variance: the kept rays spread as the cosine rays do, so with them it is the
-  // fresh rays' spread over all the rays.
-  const double rays = static_cast<double>(nf + ne + (w_solve > 0.0 ? k.per_texel : 0));
   std::vector<glm::vec3> gathered(e.size(), glm::vec3(0.0f));
   sky.assign(e.size(), glm::vec3(0.0f));
   const bool done = pool.parallel_for_with_progress(mine.size(), progress, [&](std::size_t m) {
     const std::size_t w = mine[m];
     const std::uint32_t i = t.work[w];
-    const FreshGather g = gather_texel(b, lt, t, s, src, emitters, i, rays_of[w]);
-    gathered[i] = glm::vec3(w_solve * glm::dvec3(e[i]) + (1.0 - w_solve) * g.irradiance);
-    sky[i] = glm::vec3(w_sky * glm::dvec3(k.sky[i]) + (1.0 - w_sky) * static_cast<double>(kPi) * g.sky);
-    variance[i] = static_cast<float>(g.ray_variance / rays);
+    // The texel's passes (1, or 1 + adaptive_passes where `extra` chose it): their mean.
+    const std::uint64_t passes = 1 + (extra.empty() || !extra[w] ? 0 : static_cast<std::uint64_t>(s.adaptive_passes));
+    FreshGather g;
+    for (std::uint64_t p = 0; p < passes; ++p) {
+      const FreshGather one = gather_texel(b, lt, t, s, src, emitters, i, p, rays_of[w]);
+      g.irradiance += one.irradiance, g.sky += one.sky, g.ray_variance += one.ray_variance;
+    }
+    const double per_pass = 1.0 / static_cast<double>(passes), fresh = static_cast<double>(passes * nf);
+    // Both estimate T(E_d + E): weighted by their rays (the sky by the cosine rays alone).
+    // With emitter rays the kept rays are left out: read at their landing texels without MIS
+    // weights (their hit points are not kept), they would bring back the cosine rays' noise
+    // (on the skylit room: 95th-percentile texel 0.36 with them, 0.23 without).
+    const double kept = static_cast<double>(k.per_texel);
+    const double w_solve = ne > 0 ? 0.0 : kept / (kept + fresh);
+    const double w_sky = kept / (kept + fresh);
+    gathered[i] = glm::vec3(w_solve * glm::dvec3(e[i]) + (1.0 - w_solve) * per_pass * g.irradiance);
+    sky[i] = glm::vec3(w_sky * glm::dvec3(k.sky[i]) + (1.0 - w_sky) * static_cast<double>(kPi) * per_pass * g.sky);
+    // The mean's variance: the kept rays spread as the cosine rays do, so with them it is the
+    // fresh rays' spread over all the rays.
+    const double rays = fresh + static_cast<double>(passes * ne) + (w_solve > 0.0 ? kept : 0.0);
+    variance[i] = static_cast<float>(per_pass * g.ray_variance / rays);
   });
   e = std::move(gathered);
   return done;
+}
+
+// Step 3's adaptive choice (TexelGatherSettings::adaptive_share): per work item, 1 for the
+// share of the texels whose kept rays read the most variable light in `reflected` (the sample
+// variance of the luminance each ray brings, the sky's rays at their mean), else 0. The kept
+// rays are independent of step 3's, so the choice does not bias the gathers it adds to.
+std::vector<std::uint8_t> adaptive_choice(const TexelTable& t, const KeptRays& k,
+                                          const std::vector<glm::vec3>& reflected, float share, ThreadPool& pool) {
+  const std::size_t work = t.work.size(), ns = k.per_texel;
+  if (!(share > 0.0f) || work == 0 || ns < 2) return {};
+  std::vector<double> spread(work, 0.0);
+  pool.parallel_for(
+      work,
+      [&](std::size_t w) {
+        const std::uint32_t i = t.work[w];
+        std::size_t sky_rays = 0;
+        for (std::size_t r = 0; r < ns; ++r) sky_rays += k.land[w * ns + r] == kSky;
+        const double sky = sky_rays ? luminance(k.sky[i].x, k.sky[i].y, k.sky[i].z) * static_cast<double>(ns) /
+                                          static_cast<double>(sky_rays)
+                                    : 0.0;
+        double sum = 0.0, squares = 0.0;
+        for (std::size_t r = 0; r < ns; ++r) {
+          const std::uint32_t land = k.land[w * ns + r];
+          const glm::vec3& c = land < kBack ? reflected[land] : glm::vec3(0.0f);
+          const double z = land == kSky ? sky : land < kBack ? luminance(c.x, c.y, c.z) : 0.0;
+          sum += z, squares += z * z;
+        }
+        const double n = static_cast<double>(ns);
+        spread[w] = std::max(0.0, (squares - sum * sum / n) / (n - 1.0));
+      },
+      256);
+  std::vector<double> sorted = spread;
+  const auto keep = static_cast<std::size_t>(std::ceil(static_cast<double>(share) * static_cast<double>(work)));
+  std::vector<std::uint8_t> chosen(work, 0);
+  if (keep == 0) return chosen;
+  const std::size_t at = work - std::min(keep, work);
+  std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(at), sorted.end());
+  const double threshold = sorted[at];
+  for (std::size_t w = 0; w < work; ++w) chosen[w] = spread[w] >= threshold && spread[w] > 0.0 ? 1 : 0;
+  return chosen;
 }
 
 // Step 3: the final gather reads the kept-ray solve's light (filtered as the settings ask:
@@ -354,8 +407,9 @@ bool gather_step(const StaticBakeScene& b, const AtlasLayout& layout, const Texe
   src.near_rays = s.near_regather_rays;
   src.near_m = s.near_regather_texels * texel_m;
   std::vector<std::uint64_t> gather_rays_of(work, 0);
-  if (!final_gather(b, lt, t, s, pool, progress, s.shard.items(work), src, emitters ? &*emitters : nullptr, kept, e,
-                    sky, out.variance, gather_rays_of))
+  const std::vector<std::uint8_t> extra = adaptive_choice(t, kept, src.reflected, s.adaptive_share, pool);
+  if (!final_gather(b, lt, t, s, pool, progress, s.shard.items(work), src, emitters ? &*emitters : nullptr, kept, extra,
+                    e, sky, out.variance, gather_rays_of))
     return false;
   for (std::uint64_t r : gather_rays_of) out.own_rays += r;
   return true;

@@ -90,6 +90,12 @@ struct TexelGatherSettings {
   /// samples can lie a texel away in other light (corners, ledges). 0: never.
   int near_regather_rays = 0;
   float near_regather_texels = 1.0f;
+  /// Step 3's adaptive sampling: this share of the texels, those whose kept rays read the most
+  /// variable light (the spread of the solve's light where they land, independent of the fresh
+  /// rays, so that the choice does not bias them), gather `adaptive_passes` more times with
+  /// fresh rays of their own and take the mean (0: none; in [0, 1]).
+  float adaptive_share = 0.0f;
+  int adaptive_passes = 1;  ///< The chosen texels' extra gathers (1..16).
   std::uint64_t seed = 1;
   ProgressCallback progress;  ///< Fraction done in [0, 1]; return false to cancel.
   /// A distributed bake's shard (docs/distributed-bake.md): steps 1-2 run for every texel

@@ -232,6 +232,10 @@ void plan_light_atlas(const PlanFacts& f, const std::optional<PlanPresets>& p, P
                      (p->atlas.gather.near_regather_rays > 0
                           ? " (landings nearer than a texel: " + std::to_string(p->atlas.gather.near_regather_rays) +
                                 " more)"
+                          : std::string()) +
+                     (p->atlas.gather.adaptive_share > 0.0f
+                          ? ", the noisiest " + fixed(100.0 * double{p->atlas.gather.adaptive_share}, 0) +
+                                "% of the texels x " + std::to_string(1 + p->atlas.gather.adaptive_passes)
                           : std::string())
                : std::to_string(p->atlas.vpl_count) + " VPLs, " + std::to_string(p->atlas.bounces) + " bounces")};
 }

@@ -148,7 +148,9 @@ double cache_doublings(std::size_t triangles) {
 // equivalents, kVisibilityRaysPerFreshRayPerDoubling).
 double gather_rays_per_texel(const TexelGatherSettings& g, const LightPointCount& lights, std::size_t triangles) {
   const double doublings = cache_doublings(triangles);
-  const double fresh = (g.gather_rays + g.emitter_rays) * (1.0 + kNearRegatherPerFreshRay * g.near_regather_rays);
+  // The adaptive passes (TexelGatherSettings::adaptive_share) repeat the fresh rays of a share of the texels.
+  const double fresh = (g.gather_rays + g.emitter_rays) * (1.0 + kNearRegatherPerFreshRay * g.near_regather_rays) *
+                       (1.0 + double{g.adaptive_share} * g.adaptive_passes);
   const double visibility = kVisibilityRaysPerFreshRayPerDoubling * doublings;
   return g.solve_rays + fresh * (1.0 + visibility) + lights.punctual + lights.directional +
          static_cast<double>(lights.sampled > 0 ? g.direct_samples : 0);

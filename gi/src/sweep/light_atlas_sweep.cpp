@@ -67,6 +67,19 @@ std::vector<KnobSpec> gather_detail_knobs() {
        .default_grid = {"1"},
        .min_value = 0,
        .max_value = 64},
+      {.name = "adaptive",
+       .description = "gather: the share of the texels, those whose kept rays read the most variable light, that "
+                      "gather adaptive_passes more times (0: none)",
+       .kind = KnobKind::Real,
+       .default_grid = {"0"},
+       .min_value = 0,
+       .max_value = 1},
+      {.name = "adaptive_passes",
+       .description = "gather: the extra gathers of the texels `adaptive` chooses",
+       .kind = KnobKind::Integer,
+       .default_grid = {"1"},
+       .min_value = 1,
+       .max_value = 16},
       {.name = "ref_spp",
        .description = "samples per texel of the path-traced reference",
        .kind = KnobKind::Integer,
@@ -196,6 +209,8 @@ engine::Result<MethodOutput> run_light_atlas(const RunContext& ctx) {
     s.gather.source_filter_radius_texels = static_cast<float>(ctx.knobs.real("source_filter"));
     s.gather.near_regather_rays = static_cast<int>(ctx.knobs.integer("near_rays"));
     s.gather.near_regather_texels = static_cast<float>(ctx.knobs.real("near_texels"));
+    s.gather.adaptive_share = static_cast<float>(ctx.knobs.real("adaptive"));
+    s.gather.adaptive_passes = static_cast<int>(ctx.knobs.integer("adaptive_passes"));
     s.gather.bounces = std::max(s.bounces, 1);
   }
   s.seed = ctx.seed;
