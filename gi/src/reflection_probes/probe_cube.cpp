@@ -162,6 +162,15 @@ bool rim_is_side(const ProbeCube& cube, const glm::vec3& x, const glm::vec3& r, 
   return g >= -tolerance && glm::length(beyond) >= cube_distance_footprint(cube, beyond).nearest;
 }
 
+// Whether the probe saw beyond its box's side in direction d: the captured distance more than the
+// box-side tolerance past where the ray from the centre along d leaves the box (an opening).
+bool beyond_box_side(const ProbeCube& cube, const glm::vec3& d, const glm::vec3& centre, const glm::vec3& box_min,
+                     const glm::vec3& box_max) {
+  const glm::vec3 dn = glm::normalize(d);
+  const float side = glm::length(box_exit(centre, dn, box_min, box_max) - centre);
+  return cube_distance_bilinear(cube, dn) > side * (1.0f + kProbeBoxSideTolerance);
+}
+
 }  // namespace
 
 // Long because the box-first test and the search share g, the search's scale and the state the
@@ -341,7 +350,7 @@ glm::vec3 box_projected_direction(const glm::vec3& p, const glm::vec3& r, const 
 glm::vec3 probe_lobe_radiance(const ProbeCube& cube, const engine::GltfBrdf& brdf, const glm::vec3& p,
                               const glm::vec3& n, const glm::vec3& v, int samples, const glm::vec3& centre,
                               const glm::vec3& box_min, const glm::vec3& box_max, bool box_only, const ProbeCube* chain,
-                              float box_side_tolerance, bool rim_nearest) {
+                              float box_side_tolerance, bool rim_nearest, float opening_level_bias) {
   const int count = std::clamp(samples, 1, kProbeMaxLobeSamples);
   const float alpha = brdf.alpha, a2 = alpha * alpha;
   const float nv = std::max(glm::dot(n, v), 1e-4f);
@@ -391,7 +400,11 @@ glm::vec3 probe_lobe_radiance(const ProbeCube& cube, const engine::GltfBrdf& brd
                         brdf.metallic * (brdf.base_color + (1.0f - brdf.base_color) * w);
     // The BRDF-sample weight F G2 / G1 up to the factor the samples share (G1, 4 n.v).
     const glm::vec3 wi = f * (engine::gltf_smith_visibility(nv, nl, alpha) * nl);
-    sum += wi * cube_lookup_trilinear(chain ? *chain : cube, lod, corrected(l));
+    const glm::vec3 d = corrected(l);
+    if (opening_level_bias > 0.0f && !box_only && !cube.distance.empty() &&
+        beyond_box_side(cube, d, centre, box_min, box_max))
+      lod = std::max(lod - opening_level_bias, 0.0f);
+    sum += wi * cube_lookup_trilinear(chain ? *chain : cube, lod, d);
     weight += wi;
   }
   const glm::vec3 fallback = cube_lookup_trilinear(cube, std::sqrt(alpha) * top_level, corrected(glm::reflect(-v, n)));

@@ -102,6 +102,13 @@ std::vector<KnobSpec> reflection_probes_knobs() {
        .kind = KnobKind::Choice,
        .default_grid = {kProbeRimNearest ? "on" : "off"},
        .choices = {"on", "off"}},
+      {.name = "opening_bias",
+       .description = "levels the lobe's samples read finer where the probe saw beyond its box's side, an opening "
+                      "(kProbeOpeningLevelBias, the default; 0: the lookup before it)",
+       .kind = KnobKind::Real,
+       .default_grid = {format_number(kProbeOpeningLevelBias)},
+       .min_value = 0.0,
+       .max_value = 8},
       {.name = "lobe",
        .description = "the lookup's lobe: the split sum's (one read along the reflection, isotropic, n = v) or "
                       "filtered importance sampling of the lobe at the view (probe_lobe_radiance)",
@@ -172,7 +179,7 @@ float depth_in_box(const ProbeVolume& v, const glm::vec3& p, const glm::vec3& n)
 // `depth`: the largest depth_in_box over those probes. False where no box holds p.
 bool probe_specular(const ReflectionProbeSet& set, const engine::GltfBrdf& brdf, const glm::vec3& p, const glm::vec3& n,
                     const glm::vec3& v, bool box_only, float box_side, bool rim, int lobe_samples,
-                    const std::vector<ProbeCube>* chains, glm::vec3& out, float& depth) {
+                    const std::vector<ProbeCube>* chains, float opening_bias, glm::vec3& out, float& depth) {
   const glm::vec3 r = glm::reflect(-v, n);
   glm::vec3 sum(0.0f);
   float weight = 0.0f;
@@ -184,7 +191,7 @@ bool probe_specular(const ReflectionProbeSet& set, const engine::GltfBrdf& brdf,
     const ProbeCube& cube = set.cubes[i];
     if (lobe_samples > 0) {
       sum += w * probe_lobe_radiance(cube, brdf, p, n, v, lobe_samples, pv.centre, pv.box_min, pv.box_max, box_only,
-                                     chains ? &(*chains)[i] : nullptr, box_side, rim);
+                                     chains ? &(*chains)[i] : nullptr, box_side, rim, opening_bias);
     } else {
       const float lod = std::sqrt(brdf.alpha) * static_cast<float>(cube.levels.size() - 1);
       const glm::vec3 d =
@@ -510,12 +517,13 @@ engine::Result<MethodOutput> run_reflection_probes(const RunContext& ctx) {
   const int lobe_samples =
       ctx.knobs.text("lobe") != "split_sum" ? static_cast<int>(ctx.knobs.integer("lobe_samples")) : 0;
   const std::vector<ProbeCube> chains = lookup_chains(ctx, *set);
+  const auto opening_bias = static_cast<float>(ctx.knobs.real("opening_bias"));
   for (std::size_t t = 0; t < tex.valid.size(); ++t) {
     if (!g->glossy[t]) continue;
     float depth = 0.0f;
     const glm::vec3 v = glm::normalize(g->eye - tex.position[t]);
     if (!probe_specular(*set, g->brdf[t], tex.position[t], tex.normal[t], v, box_only, box_side, rim, lobe_samples,
-                        chains.empty() ? nullptr : &chains, values[t], depth)) {
+                        chains.empty() ? nullptr : &chains, opening_bias, values[t], depth)) {
       ++uncovered;
       continue;
     }
