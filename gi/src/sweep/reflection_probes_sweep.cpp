@@ -127,6 +127,13 @@ std::vector<KnobSpec> reflection_probes_knobs() {
        .kind = KnobKind::Choice,
        .default_grid = {"off"},
        .choices = {"on", "off"}},
+      {.name = "corridor_aspect",
+       .description = "boxes whose longer horizontal side is more than this times the shorter one are cut into "
+                      "segments, a probe each (ProbePlacementSettings::corridor_aspect; 0: as `segments` says)",
+       .kind = KnobKind::Real,
+       .default_grid = {"0"},
+       .min_value = 0.0,
+       .max_value = 100},
       {.name = "capture_height",
        .description = "metres above its box's floor each probe is captured at (0: the box's middle, the default; "
                       "ProbePlacementSettings::capture_height)",
@@ -260,6 +267,8 @@ engine::Result<BakedProbes> bake_probes(const RunContext& ctx, const BakeInput& 
   s.seed = ctx.seed;
   s.threads = ctx.threads;
   if (ctx.knobs.text("segments") == "on") s.placement.corridor_aspect = 2.0f;
+  if (ctx.knobs.real("corridor_aspect") > 0.0)
+    s.placement.corridor_aspect = static_cast<float>(ctx.knobs.real("corridor_aspect"));
   s.placement.capture_height = static_cast<float>(ctx.knobs.real("capture_height"));
   auto set = bake_reflection_probes(input, b.source(), s);
   if (!set) return set.error();
