@@ -171,6 +171,13 @@ bool beyond_box_side(const ProbeCube& cube, const glm::vec3& d, const glm::vec3&
   return cube_distance_bilinear(cube, dn) > side * (1.0f + kProbeBoxSideTolerance);
 }
 
+// The level of a box-filtered chain whose texels span a sample's solid angle (sr), + 1 (Colbert
+// and Krivanek's rule; probe_lobe_radiance's `chain`).
+float chain_level(const ProbeCube& chain, float sample_sr) {
+  const float texel_sr = 4.0f * kPi / (6.0f * static_cast<float>(chain.size * chain.size));
+  return std::max(0.5f * std::log2(sample_sr / texel_sr) + 1.0f, 0.0f);
+}
+
 }  // namespace
 
 // Long because the box-first test and the search share g, the search's scale and the state the
@@ -389,12 +396,7 @@ glm::vec3 probe_lobe_radiance(const ProbeCube& cube, const engine::GltfBrdf& brd
     // the one prefiltered with the GGX lobe (solid angle about 4 pi alpha^2) of that width.
     const float pdf = g1 * engine::gltf_ggx_distribution(std::clamp(hl.z, 0.0f, 1.0f), alpha) / (4.0f * nv);
     const float alpha_m = std::sqrt(vdh / (fn * std::max(pdf, 1e-12f) * 4.0f * kPi));
-    float lod = std::sqrt(alpha_m) * top_level;
-    if (chain) {
-      const float texel_sr = 4.0f * kPi / (6.0f * static_cast<float>(chain->size * chain->size));
-      const float sample_sr = 1.0f / (fn * std::max(pdf, 1e-12f));
-      lod = std::max(0.5f * std::log2(sample_sr / texel_sr) + 1.0f, 0.0f);
-    }
+    float lod = chain ? chain_level(*chain, 1.0f / (fn * std::max(pdf, 1e-12f))) : std::sqrt(alpha_m) * top_level;
     const float w = engine::gltf_schlick_weight(vdh);
     const glm::vec3 f = f_dielectric_scale * (brdf.dielectric_f0 + (1.0f - brdf.dielectric_f0) * w) +
                         brdf.metallic * (brdf.base_color + (1.0f - brdf.base_color) * w);

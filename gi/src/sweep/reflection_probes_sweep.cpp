@@ -502,6 +502,27 @@ std::size_t gpu_bytes(const ReflectionProbeSet& set, bool box_only) {
   return bytes;
 }
 
+// The run's extras: the error inside the probes' volumes and at their borders, the texel counts
+// and the bake's parts.
+std::vector<std::pair<std::string, double>> run_extras(const RgbField& field, const RunContext& ctx,
+                                                       const std::vector<std::uint8_t>& inner,
+                                                       const std::vector<std::uint8_t>& edge, std::size_t uncovered,
+                                                       const BakedProbes& baked) {
+  const auto count = [](const std::vector<std::uint8_t>& m) {
+    return static_cast<double>(std::count(m.begin(), m.end(), std::uint8_t{1}));
+  };
+  const ReflectionProbeSet& set = baked.set;
+  return {{"volume_truth_rel_rmse", compare_rgb(restricted(field, inner), ctx.reference).truth_rel_rmse},
+          {"border_truth_rel_rmse", compare_rgb(restricted(field, edge), ctx.reference).truth_rel_rmse},
+          {"volume_texels", count(inner)},
+          {"border_texels", count(edge)},
+          {"uncovered_texels", static_cast<double>(uncovered)},
+          {"probes", static_cast<double>(set.probes.size())},
+          {"capture_seconds", set.stats.capture_seconds},
+          {"prefilter_seconds", set.stats.prefilter_seconds},
+          {"atlas_seconds", baked.atlas.stats.total_seconds}};
+}
+
 engine::Result<MethodOutput> run_reflection_probes(const RunContext& ctx) {
   const double roughness = ctx.knobs.real("roughness");
   const engine::Scene scene = engine::instantiate(with_floor_roughness(ctx.scene.asset, roughness));
@@ -548,18 +569,7 @@ engine::Result<MethodOutput> run_reflection_probes(const RunContext& ctx) {
   out.field = RgbField::from_texels(tex.width, tex.height, values, covered);
   out.costs.bake_seconds = set->stats.total_seconds;
   out.costs.bytes = gpu_bytes(*set, box_only);
-  const auto count = [](const std::vector<std::uint8_t>& m) {
-    return static_cast<double>(std::count(m.begin(), m.end(), std::uint8_t{1}));
-  };
-  out.extras = {{"volume_truth_rel_rmse", compare_rgb(restricted(out.field, inner), ctx.reference).truth_rel_rmse},
-                {"border_truth_rel_rmse", compare_rgb(restricted(out.field, edge), ctx.reference).truth_rel_rmse},
-                {"volume_texels", count(inner)},
-                {"border_texels", count(edge)},
-                {"uncovered_texels", static_cast<double>(uncovered)},
-                {"probes", static_cast<double>(set->probes.size())},
-                {"capture_seconds", set->stats.capture_seconds},
-                {"prefilter_seconds", set->stats.prefilter_seconds},
-                {"atlas_seconds", baked->atlas.stats.total_seconds}};
+  out.extras = run_extras(out.field, ctx, inner, edge, uncovered, *baked);
   add_view_band_bias(*g, values, covered, ctx.reference, out.extras);
   return out;
 }
