@@ -50,6 +50,8 @@ const float PROBE_MIN_SEARCH_SCALE_M = 0.05;
 const float PROBE_BOX_SIDE_TOLERANCE = 0.1;
 // gi's probe_cube.h: kProbeRimNearest (the box first at an opening's rim).
 const bool PROBE_RIM_NEAREST = true;
+// gi's probe_cube.h: kProbeOpeningLevelBias (levels read finer beyond the box's side, an opening).
+const float PROBE_OPENING_LEVEL_BIAS = 1.0;
 // gi's probe_cube.h: kProbeMaxLobeSamples.
 const int PROBE_MAX_LOBE_SAMPLES = 16;
 
@@ -160,6 +162,14 @@ vec3 probe_direction(vec3 p, vec3 r, ReflectionProbeBox probe, int i) {
   return in_front ? r : boxed;
 }
 
+// Whether probe i saw beyond its box's side in direction d (gi's beyond_box_side): the captured
+// distance more than the box-side tolerance past where the ray from the centre along d leaves the box.
+bool probe_beyond_side(vec3 d, ReflectionProbeBox probe, int i) {
+  vec3 dn = normalize(d);
+  float side = length(probe_box_exit(probe.centre.xyz, dn, probe) - probe.centre.xyz);
+  return textureLod(u_probe_distances, vec4(dn, float(i)), 0.0).r > side * (1.0 + PROBE_BOX_SIDE_TOLERANCE);
+}
+
 // The specular lobe at the view read from probe i by filtered importance sampling (gi's
 // probe_lobe_radiance, probe_cube.cpp, the same samples and weights): u_probe_lobe_samples half
 // vectors from GGX's visible normals at v (Hammersley points), each reflected direction
@@ -200,7 +210,10 @@ vec3 probe_lobe(Surface s, ReflectionProbeBox probe, int i) {
     vec3 f = dielectric * (s.brdf.dielectric_f0 + (vec3(1.0) - s.brdf.dielectric_f0) * w) +
              s.brdf.metallic * (s.brdf.base_color + (vec3(1.0) - s.brdf.base_color) * w);
     vec3 wi = f * (gltf_smith_visibility(nv, nl, alpha) * nl);
-    sum += wi * textureLod(u_probe_cubes, vec4(probe_direction(s.position, l, probe, i), float(i)), lod).rgb;
+    vec3 d = probe_direction(s.position, l, probe, i);
+    if (PROBE_OPENING_LEVEL_BIAS > 0.0 && u_probe_has_distances != 0 && probe_beyond_side(d, probe, i))
+      lod = max(lod - PROBE_OPENING_LEVEL_BIAS, 0.0);
+    sum += wi * textureLod(u_probe_cubes, vec4(d, float(i)), lod).rgb;
     weight += wi;
   }
   bvec3 some = greaterThan(weight, vec3(0.0));

@@ -162,6 +162,22 @@ bool rim_is_side(const ProbeCube& cube, const glm::vec3& x, const glm::vec3& r, 
   return g >= -tolerance && glm::length(beyond) >= cube_distance_footprint(cube, beyond).nearest;
 }
 
+// Whether the probe saw beyond its box's side in direction d: the captured distance more than the
+// box-side tolerance past where the ray from the centre along d leaves the box (an opening).
+bool beyond_box_side(const ProbeCube& cube, const glm::vec3& d, const glm::vec3& centre, const glm::vec3& box_min,
+                     const glm::vec3& box_max) {
+  const glm::vec3 dn = glm::normalize(d);
+  const float side = glm::length(box_exit(centre, dn, box_min, box_max) - centre);
+  return cube_distance_bilinear(cube, dn) > side * (1.0f + kProbeBoxSideTolerance);
+}
+
+// The level of a box-filtered chain whose texels span a sample's solid angle (sr), + 1 (Colbert
+// and Krivanek's rule; probe_lobe_radiance's `chain`).
+float chain_level(const ProbeCube& chain, float sample_sr) {
+  const float texel_sr = 4.0f * kPi / (6.0f * static_cast<float>(chain.size * chain.size));
+  return std::max(0.5f * std::log2(sample_sr / texel_sr) + 1.0f, 0.0f);
+}
+
 }  // namespace
 
 // Long because the box-first test and the search share g, the search's scale and the state the
@@ -341,7 +357,7 @@ glm::vec3 box_projected_direction(const glm::vec3& p, const glm::vec3& r, const 
 glm::vec3 probe_lobe_radiance(const ProbeCube& cube, const engine::GltfBrdf& brdf, const glm::vec3& p,
                               const glm::vec3& n, const glm::vec3& v, int samples, const glm::vec3& centre,
                               const glm::vec3& box_min, const glm::vec3& box_max, bool box_only, const ProbeCube* chain,
-                              float box_side_tolerance, bool rim_nearest) {
+                              float box_side_tolerance, bool rim_nearest, float opening_level_bias) {
   const int count = std::clamp(samples, 1, kProbeMaxLobeSamples);
   const float alpha = brdf.alpha, a2 = alpha * alpha;
   const float nv = std::max(glm::dot(n, v), 1e-4f);
@@ -380,18 +396,17 @@ glm::vec3 probe_lobe_radiance(const ProbeCube& cube, const engine::GltfBrdf& brd
     // the one prefiltered with the GGX lobe (solid angle about 4 pi alpha^2) of that width.
     const float pdf = g1 * engine::gltf_ggx_distribution(std::clamp(hl.z, 0.0f, 1.0f), alpha) / (4.0f * nv);
     const float alpha_m = std::sqrt(vdh / (fn * std::max(pdf, 1e-12f) * 4.0f * kPi));
-    float lod = std::sqrt(alpha_m) * top_level;
-    if (chain) {
-      const float texel_sr = 4.0f * kPi / (6.0f * static_cast<float>(chain->size * chain->size));
-      const float sample_sr = 1.0f / (fn * std::max(pdf, 1e-12f));
-      lod = std::max(0.5f * std::log2(sample_sr / texel_sr) + 1.0f, 0.0f);
-    }
+    float lod = chain ? chain_level(*chain, 1.0f / (fn * std::max(pdf, 1e-12f))) : std::sqrt(alpha_m) * top_level;
     const float w = engine::gltf_schlick_weight(vdh);
     const glm::vec3 f = f_dielectric_scale * (brdf.dielectric_f0 + (1.0f - brdf.dielectric_f0) * w) +
                         brdf.metallic * (brdf.base_color + (1.0f - brdf.base_color) * w);
     // The BRDF-sample weight F G2 / G1 up to the factor the samples share (G1, 4 n.v).
     const glm::vec3 wi = f * (engine::gltf_smith_visibility(nv, nl, alpha) * nl);
-    sum += wi * cube_lookup_trilinear(chain ? *chain : cube, lod, corrected(l));
+    const glm::vec3 d = corrected(l);
+    if (opening_level_bias > 0.0f && !box_only && !cube.distance.empty() &&
+        beyond_box_side(cube, d, centre, box_min, box_max))
+      lod = std::max(lod - opening_level_bias, 0.0f);
+    sum += wi * cube_lookup_trilinear(chain ? *chain : cube, lod, d);
     weight += wi;
   }
   const glm::vec3 fallback = cube_lookup_trilinear(cube, std::sqrt(alpha) * top_level, corrected(glm::reflect(-v, n)));

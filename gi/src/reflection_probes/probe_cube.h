@@ -127,6 +127,13 @@ glm::vec3 distance_corrected_direction(const ProbeCube& cube, const glm::vec3& p
                                        float box_side_tolerance = kProbeBoxSideTolerance,
                                        bool rim_nearest = kProbeRimNearest);
 
+/// Levels the lobe's samples read finer where the probe saw beyond its box's side in the sample's
+/// corrected direction (the captured distance more than kProbeBoxSideTolerance past the box): across
+/// an opening the levels, prefiltered as if everything lay at one depth, blur the opening's lit
+/// frame (near, at the box's side) into the far room's directions. docs/reflection_probes.md,
+/// "Finer beyond the opening". 0: every sample at its lobe's level (the lookup before it).
+inline constexpr float kProbeOpeningLevelBias = 1.0f;
+
 /// The most lobe samples probe_lobe_radiance takes (the shader's PROBE_MAX_LOBE_SAMPLES).
 inline constexpr int kProbeMaxLobeSamples = 16;
 /// The lobe samples the runtime asks the forward pass for (IndirectLightFrame::
@@ -151,12 +158,13 @@ inline constexpr int kProbeLobeSamples = 4;
 /// `chain` (optional, CPU only: the sweep's `lobe=fis_chain`, docs/reflection_probes.md): the
 /// samples read this box-filtered chain of level 0 (box_filtered_chain) instead, at the level
 /// whose texels span the sample's solid angle, + 1 (Colbert and Krivanek's own rule).
-/// `box_side_tolerance`, `rim_nearest`: distance_corrected_direction's.
+/// `box_side_tolerance`, `rim_nearest`: distance_corrected_direction's. `opening_level_bias`: the
+/// levels a sample reads finer where the probe saw beyond its box's side (kProbeOpeningLevelBias).
 glm::vec3 probe_lobe_radiance(const ProbeCube& cube, const engine::GltfBrdf& brdf, const glm::vec3& p,
                               const glm::vec3& n, const glm::vec3& v, int samples, const glm::vec3& centre,
                               const glm::vec3& box_min, const glm::vec3& box_max, bool box_only,
                               const ProbeCube* chain = nullptr, float box_side_tolerance = kProbeBoxSideTolerance,
-                              bool rim_nearest = kProbeRimNearest);
+                              bool rim_nearest = kProbeRimNearest, float opening_level_bias = kProbeOpeningLevelBias);
 
 /// Level 0 of `cube` and its 2 x 2 box averages down to one texel per face, as a cube (what
 /// the prefilter's samples read; its distances are level 0's).

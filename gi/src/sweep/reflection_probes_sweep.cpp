@@ -102,6 +102,13 @@ std::vector<KnobSpec> reflection_probes_knobs() {
        .kind = KnobKind::Choice,
        .default_grid = {kProbeRimNearest ? "on" : "off"},
        .choices = {"on", "off"}},
+      {.name = "opening_bias",
+       .description = "levels the lobe's samples read finer where the probe saw beyond its box's side, an opening "
+                      "(kProbeOpeningLevelBias, the default; 0: the lookup before it)",
+       .kind = KnobKind::Real,
+       .default_grid = {format_number(kProbeOpeningLevelBias)},
+       .min_value = 0.0,
+       .max_value = 8},
       {.name = "lobe",
        .description = "the lookup's lobe: the split sum's (one read along the reflection, isotropic, n = v) or "
                       "filtered importance sampling of the lobe at the view (probe_lobe_radiance)",
@@ -120,6 +127,13 @@ std::vector<KnobSpec> reflection_probes_knobs() {
        .kind = KnobKind::Choice,
        .default_grid = {"off"},
        .choices = {"on", "off"}},
+      {.name = "corridor_aspect",
+       .description = "boxes whose longer horizontal side is more than this times the shorter one are cut into "
+                      "segments, a probe each (ProbePlacementSettings::corridor_aspect; 0: as `segments` says)",
+       .kind = KnobKind::Real,
+       .default_grid = {"0"},
+       .min_value = 0.0,
+       .max_value = 100},
       {.name = "capture_height",
        .description = "metres above its box's floor each probe is captured at (0: the box's middle, the default; "
                       "ProbePlacementSettings::capture_height)",
@@ -172,7 +186,7 @@ float depth_in_box(const ProbeVolume& v, const glm::vec3& p, const glm::vec3& n)
 // `depth`: the largest depth_in_box over those probes. False where no box holds p.
 bool probe_specular(const ReflectionProbeSet& set, const engine::GltfBrdf& brdf, const glm::vec3& p, const glm::vec3& n,
                     const glm::vec3& v, bool box_only, float box_side, bool rim, int lobe_samples,
-                    const std::vector<ProbeCube>* chains, glm::vec3& out, float& depth) {
+                    const std::vector<ProbeCube>* chains, float opening_bias, glm::vec3& out, float& depth) {
   const glm::vec3 r = glm::reflect(-v, n);
   glm::vec3 sum(0.0f);
   float weight = 0.0f;
@@ -184,7 +198,7 @@ bool probe_specular(const ReflectionProbeSet& set, const engine::GltfBrdf& brdf,
     const ProbeCube& cube = set.cubes[i];
     if (lobe_samples > 0) {
       sum += w * probe_lobe_radiance(cube, brdf, p, n, v, lobe_samples, pv.centre, pv.box_min, pv.box_max, box_only,
-                                     chains ? &(*chains)[i] : nullptr, box_side, rim);
+                                     chains ? &(*chains)[i] : nullptr, box_side, rim, opening_bias);
     } else {
       const float lod = std::sqrt(brdf.alpha) * static_cast<float>(cube.levels.size() - 1);
       const glm::vec3 d =
@@ -253,6 +267,8 @@ engine::Result<BakedProbes> bake_probes(const RunContext& ctx, const BakeInput& 
   s.seed = ctx.seed;
   s.threads = ctx.threads;
   if (ctx.knobs.text("segments") == "on") s.placement.corridor_aspect = 2.0f;
+  if (ctx.knobs.real("corridor_aspect") > 0.0)
+    s.placement.corridor_aspect = static_cast<float>(ctx.knobs.real("corridor_aspect"));
   s.placement.capture_height = static_cast<float>(ctx.knobs.real("capture_height"));
   auto set = bake_reflection_probes(input, b.source(), s);
   if (!set) return set.error();
@@ -486,6 +502,27 @@ std::size_t gpu_bytes(const ReflectionProbeSet& set, bool box_only) {
   return bytes;
 }
 
+// The run's extras: the error inside the probes' volumes and at their borders, the texel counts
+// and the bake's parts.
+std::vector<std::pair<std::string, double>> run_extras(const RgbField& field, const RunContext& ctx,
+                                                       const std::vector<std::uint8_t>& inner,
+                                                       const std::vector<std::uint8_t>& edge, std::size_t uncovered,
+                                                       const BakedProbes& baked) {
+  const auto count = [](const std::vector<std::uint8_t>& m) {
+    return static_cast<double>(std::count(m.begin(), m.end(), std::uint8_t{1}));
+  };
+  const ReflectionProbeSet& set = baked.set;
+  return {{"volume_truth_rel_rmse", compare_rgb(restricted(field, inner), ctx.reference).truth_rel_rmse},
+          {"border_truth_rel_rmse", compare_rgb(restricted(field, edge), ctx.reference).truth_rel_rmse},
+          {"volume_texels", count(inner)},
+          {"border_texels", count(edge)},
+          {"uncovered_texels", static_cast<double>(uncovered)},
+          {"probes", static_cast<double>(set.probes.size())},
+          {"capture_seconds", set.stats.capture_seconds},
+          {"prefilter_seconds", set.stats.prefilter_seconds},
+          {"atlas_seconds", baked.atlas.stats.total_seconds}};
+}
+
 engine::Result<MethodOutput> run_reflection_probes(const RunContext& ctx) {
   const double roughness = ctx.knobs.real("roughness");
   const engine::Scene scene = engine::instantiate(with_floor_roughness(ctx.scene.asset, roughness));
@@ -510,12 +547,13 @@ engine::Result<MethodOutput> run_reflection_probes(const RunContext& ctx) {
   const int lobe_samples =
       ctx.knobs.text("lobe") != "split_sum" ? static_cast<int>(ctx.knobs.integer("lobe_samples")) : 0;
   const std::vector<ProbeCube> chains = lookup_chains(ctx, *set);
+  const auto opening_bias = static_cast<float>(ctx.knobs.real("opening_bias"));
   for (std::size_t t = 0; t < tex.valid.size(); ++t) {
     if (!g->glossy[t]) continue;
     float depth = 0.0f;
     const glm::vec3 v = glm::normalize(g->eye - tex.position[t]);
     if (!probe_specular(*set, g->brdf[t], tex.position[t], tex.normal[t], v, box_only, box_side, rim, lobe_samples,
-                        chains.empty() ? nullptr : &chains, values[t], depth)) {
+                        chains.empty() ? nullptr : &chains, opening_bias, values[t], depth)) {
       ++uncovered;
       continue;
     }
@@ -531,18 +569,7 @@ engine::Result<MethodOutput> run_reflection_probes(const RunContext& ctx) {
   out.field = RgbField::from_texels(tex.width, tex.height, values, covered);
   out.costs.bake_seconds = set->stats.total_seconds;
   out.costs.bytes = gpu_bytes(*set, box_only);
-  const auto count = [](const std::vector<std::uint8_t>& m) {
-    return static_cast<double>(std::count(m.begin(), m.end(), std::uint8_t{1}));
-  };
-  out.extras = {{"volume_truth_rel_rmse", compare_rgb(restricted(out.field, inner), ctx.reference).truth_rel_rmse},
-                {"border_truth_rel_rmse", compare_rgb(restricted(out.field, edge), ctx.reference).truth_rel_rmse},
-                {"volume_texels", count(inner)},
-                {"border_texels", count(edge)},
-                {"uncovered_texels", static_cast<double>(uncovered)},
-                {"probes", static_cast<double>(set->probes.size())},
-                {"capture_seconds", set->stats.capture_seconds},
-                {"prefilter_seconds", set->stats.prefilter_seconds},
-                {"atlas_seconds", baked->atlas.stats.total_seconds}};
+  out.extras = run_extras(out.field, ctx, inner, edge, uncovered, *baked);
   add_view_band_bias(*g, values, covered, ctx.reference, out.extras);
   return out;
 }

@@ -95,4 +95,84 @@ TEST(ReflectionProbesLobe, TheShadersLobeLookupIsItsCpuTwinsAtGrazingViews) {
   EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
 }
 
+// A slatted +X side: the room's +X wall at x = 2 m is cut into vertical slats one level-0
+// texel wide (alternate texel columns of the +X face, 0.06-0.12 m at 2 m), bright jambs
+// between dark openings onto the hall's far wall at x = 5 m. Every exit through that side then
+// lies within a texel of an opening's rim, where the bilinear mean distance mixes the jamb's
+// 2 m with the hall's 5 m: the box-first test at the rim (kProbeRimNearest, the shader's
+// PROBE_RIM_NEAREST branch, probe_rim_is_side) decides the lookup there.
+gi::ProbeCube slatted_cube(int size) {
+  gi::ProbeCube cube = gi::make_probe_cube(size, gi::full_mip_count(size));
+  cube.distance.resize(cube.levels[0].size());
+  for (int f = 0; f < 6; ++f)
+    for (int y = 0; y < size; ++y)
+      for (int x = 0; x < size; ++x) {
+        const glm::vec3 d = gi::cube_texel_direction(f, x, y, size);
+        const SideHit room = side_hit(d, kRoomMax.x);
+        const bool jamb = f == 0 && room.axis == 0 && x % 2 == 0;
+        const SideHit h = jamb ? room : side_hit(d, kHallEnd);
+        // The hall's far wall: a gradient along z, so a lookup sent elsewhere along it reads differently.
+        const float far_wall = 0.3f + 0.4f * (h.point.z + 2.0f);
+        const float l = jamb ? 8.0f : h.axis == 0 && d.x > 0.0f ? far_wall : hall_radiance(h, d);
+        cube.levels[0][gi::cube_texel_index(f, x, y, size)] = glm::vec3(l);
+        cube.distance[gi::cube_texel_index(f, x, y, size)] = h.distance;
+      }
+  gi::prefilter_ggx(cube, 64);
+  return cube;
+}
+
+// The shader's rim branch against its CPU twin: a floor of roughness 0.05 seen low towards the
+// slatted side (4 lobe samples, the runtime's count). The twin with the rim's test and without
+// it differ by more than 10% at a tenth of the floor's pixels or more (the branch decides
+// there); at those pixels the shader is the twin with the test within 5% (+ 0.002) at 90% of
+// them and nearer it than the twin without at 90%, and over the whole floor within 3% at 95%.
+// A shader whose rim branch never fired, or always fired, fails the second pair.
+TEST(ReflectionProbesLobe, TheShadersRimTestIsItsCpuTwinsAtASlattedSide) {
+  engine::GpuContext ctx = headless_context();
+  const float roughness = 0.05f;
+  const int samples = 4;
+  GlossyFloor s(roughness, TestCamera{{-1.9f, 0.6f, 0.0f}, {1.5f, 0.0f, 0.0f}, 1.0f, 81});
+  const TestCamera& cam = s.cam;
+  auto r = make_renderer(s.assets, cam.size, 0.0f);
+  ASSERT_NE(r, nullptr);
+  const gi::ProbeCube cube = slatted_cube(32);
+  ProbeProvider probe(cube.size, cube.levels, &cube.distance, {.lobe_samples = samples});
+  r->set_indirect_light(&probe);
+  r->render(s.reg, s.camera);
+  const engine::ImageRgbaF img = r->read_hdr();
+  r->set_indirect_light(nullptr);
+  const engine::GltfBrdf brdf = s.brdf();
+  int pixels = 0, close = 0, decided = 0, decided_close = 0, decided_nearer = 0;
+  for (int py = 0; py < cam.size; ++py)
+    for (int px = 0; px < cam.size; ++px) {
+      const glm::vec3 p = cam.plane_point(px, py);
+      if (!(p.y == p.y) || std::abs(p.x) > 1.9f || std::abs(p.z) > 1.9f || glm::dot(p - cam.eye, p - cam.eye) > 100.0f)
+        continue;
+      if (glm::dot(p - cam.eye, cam.target - cam.eye) <= 0.0f) continue;
+      const glm::vec3 v = glm::normalize(cam.eye - p), up(0.0f, 1.0f, 0.0f);
+      const float albedo = engine::gltf_directional_albedo(brdf, v.y).specular.x;
+      const auto twin = [&](bool rim) {
+        return gi::probe_lobe_radiance(cube, brdf, p, up, v, samples, kProbe, kRoomMin, kRoomMax, false, nullptr,
+                                       gi::kProbeBoxSideTolerance, rim)
+                   .x *
+               albedo;
+      };
+      const float with_rim = twin(true), without = twin(false), gpu = red(img, px, py);
+      ++pixels;
+      if (std::abs(gpu - with_rim) <= 0.03f * with_rim + 0.002f) ++close;
+      if (std::abs(with_rim - without) <= 0.1f * std::max(with_rim, without)) continue;
+      ++decided;
+      if (std::abs(gpu - with_rim) <= 0.05f * with_rim + 0.002f) ++decided_close;
+      if (std::abs(gpu - with_rim) < std::abs(gpu - without)) ++decided_nearer;
+    }
+  std::printf("%d floor pixels (%d within 3%% of the twin); the rim's test decides %d: %d within 5%%, %d nearer\n",
+              pixels, close, decided, decided_close, decided_nearer);
+  ASSERT_GT(pixels, 1000);
+  EXPECT_GE(decided, pixels / 10);
+  EXPECT_GE(decided_close, decided * 9 / 10);
+  EXPECT_GE(decided_nearer, decided * 9 / 10);
+  EXPECT_GE(close, pixels * 95 / 100);
+  EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
+}
+
 }  // namespace
