@@ -18,6 +18,7 @@ namespace {
 
 constexpr float kPi = 3.14159265358979f;
 constexpr int kMinClosePairs = 16;
+constexpr int kMaxReusedPairs = 64;  // one std::uint64_t of visibility bits per leaf pair
 
 std::uint64_t mix(std::uint64_t x) {
   x += 0x9e3779b97f4a7c15ULL;
@@ -52,6 +53,8 @@ bool behind(const glm::vec3* t, const glm::vec3& p, const glm::vec3& n) {
 engine::Result<ExactLeafTransport> ExactLeafTransport::create(const BakeInput& input,
                                                               const ExactTransportSettings& settings) {
   if (settings.point_pairs < 1) return engine::Error{.message = "exact transport: point_pairs must be at least 1"};
+  if (settings.reuse_visibility && settings.point_pairs > kMaxReusedPairs)
+    return engine::Error{.message = "exact transport: reuse_visibility keeps at most 64 point pairs per leaf pair"};
   if (engine::Status st = validate_bake_input(input); !st) return st.error();
   ExactLeafTransport out;
   out.settings_ = settings;
@@ -80,8 +83,8 @@ float ExactLeafTransport::coupling(std::size_t i, std::size_t j) const {
   return i < j ? g_[pair_index(i, j)] : g_[pair_index(j, i)];
 }
 
-float ExactLeafTransport::pair_coupling(const ElementHierarchy& h, std::size_t i, std::size_t j,
-                                        std::size_t& rays) const {
+float ExactLeafTransport::pair_coupling(const ElementHierarchy& h, std::size_t i, std::size_t j, bool reuse,
+                                        std::size_t& rays) {
   const auto ni = static_cast<std::size_t>(h.leaves[i]), nj = static_cast<std::size_t>(h.leaves[j]);
   const glm::vec3* ti = &h.corners[3 * ni];
   const glm::vec3* tj = &h.corners[3 * nj];
@@ -104,6 +107,8 @@ float ExactLeafTransport::pair_coupling(const ElementHierarchy& h, std::size_t i
   const int strata = std::max(1, static_cast<int>(std::sqrt(static_cast<double>(m))));
   const float min_r2 = settings_.min_distance_m * settings_.min_distance_m;
   std::uint64_t state = mix(settings_.seed ^ mix(static_cast<std::uint64_t>(i) * 0x100000001b3ULL + j));
+  std::uint64_t* bits = visible_.empty() ? nullptr : &visible_[pair_index(i, j)];
+  reuse = reuse && bits != nullptr;
   double sum = 0.0;
   for (int s = 0; s < m; ++s) {
     const int cell = s % (strata * strata);
@@ -121,8 +126,19 @@ float ExactLeafTransport::pair_coupling(const ElementHierarchy& h, std::size_t i
     // Off both surfaces by 0.1 mm along their normals, the segment between.
     const glm::vec3 o = x + 1e-4f * n_i;
     const glm::vec3 e = y + 1e-4f * n_j;
-    ++rays;
-    if (caster_->occluded(Ray{.origin = o, .t_min = 0.0f, .direction = e - o, .t_max = 1.0f})) continue;
+    bool crosses = !reuse;
+    for (std::size_t k = 0; k < moving_.swept().size() && !crosses; ++k)
+      crosses = engine::segment_meets_box(o, e - o, 1.0f, moving_.swept()[k].lo, moving_.swept()[k].hi);
+    const std::uint64_t bit = std::uint64_t{1} << s;
+    bool visible = false;
+    if (crosses) {
+      ++rays;
+      visible = !caster_->occluded(Ray{.origin = o, .t_min = 0.0f, .direction = e - o, .t_max = 1.0f});
+      if (bits) *bits = visible ? (*bits | bit) : (*bits & ~bit);
+    } else {
+      visible = (*bits & bit) != 0;  // reuse: the segment meets nothing that moved
+    }
+    if (!visible) continue;
     sum += static_cast<double>(ci * cj / std::max(r2, min_r2));
   }
   return static_cast<float>(sum / static_cast<double>(m));
@@ -139,6 +155,7 @@ void ExactLeafTransport::update(const ElementHierarchy& h) {
   if (all) {
     n_ = n;
     g_.assign(n * (n - 1) / 2, 0.0f);
+    if (settings_.reuse_visibility) visible_.assign(g_.size(), 0);
   }
   std::vector<char> moving(n, 0);
   for (std::size_t l = 0; l < n; ++l) {
@@ -163,7 +180,8 @@ void ExactLeafTransport::update(const ElementHierarchy& h) {
             }
         }
         if (!todo) continue;
-        g_[pair_index(i, j)] = pair_coupling(h, i, j, my_rays);
+        // A pair with a moving leaf moves its samples: every one is traced again.
+        g_[pair_index(i, j)] = pair_coupling(h, i, j, !all && !moving[i] && !moving[j], my_rays);
         ++my_pairs;
       }
     }
