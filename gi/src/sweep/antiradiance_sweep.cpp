@@ -25,6 +25,7 @@
 #include "antiradiance/antiradiance_region.h"
 #include "antiradiance/antiradiance_texel_blend.h"
 #include "antiradiance/antiradiance_texel_gather.h"
+#include "antiradiance/split_truth_change_score.h"
 #include "raytrace/atlas_reference.h"
 #include "uv/atlas_input.h"
 #include "uv/atlas_layout.h"
@@ -135,38 +136,58 @@ engine::Result<DoorSetup> door_setup(const SweepScene& scene, double density, do
   return d;
 }
 
+// One random stream's indirect irradiance at the compared texels of every pose, texel-major
+// per pose; `part` of `parts` of the job's progress.
+engine::Result<std::vector<glm::vec3>> door_truth_stream(const ReferenceJob& job, const DoorSetup& d,
+                                                         std::uint64_t seed, int part, int parts) {
+  const ReferenceRequest& r = job.request;
+  AtlasTexels masked = d.texels;
+  masked.valid = d.mask;
+  const std::size_t n = masked.valid.size();
+  const std::size_t poses = d.poses();
+  std::vector<glm::vec3> values(n * poses, glm::vec3(0.0f));
+  for (std::size_t k = 0; k < poses; ++k) {
+    ReferenceSettings rs;
+    rs.samples_per_pixel = std::stoi(r.param("spp"));
+    rs.seed = seed;
+    rs.threads = job.threads;
+    if (!r.param("bounces").empty()) rs.max_bounces = std::stoi(r.param("bounces"));
+    const ProgressFn& outer = job.progress;
+    const double step = static_cast<double>(poses * static_cast<std::size_t>(parts));
+    const double done = static_cast<double>(static_cast<std::size_t>(part) * poses + k);
+    rs.progress = [&outer, done, step](double f) { return !outer || outer((done + f) / step); };
+    auto truth = reference_atlas_irradiance(d.posed(k == 0 ? 0.0f : d.swings[k - 1]), masked, rs);
+    if (!truth) return truth.error();
+    for (std::size_t t = 0; t < n; ++t)
+      if (d.mask[t]) values[k * n + t] = truth->indirect[t];
+  }
+  return values;
+}
+
+// The door's reference: the sweep's stream (or `seed`'s), and with `pair` a second,
+// independent stream (the one `seed` = pair gives) stacked below it: rows [0, h poses) the
+// first, [h poses, 2 h poses) the second (the split truth of split_truth_change_score.h).
 engine::Result<RgbField> door_reference(const ReferenceJob& job) {
   const ReferenceRequest& r = job.request;
   if (std::find(kSwingChoices.begin(), kSwingChoices.end(), r.param("swings")) == kSwingChoices.end())
     return engine::Error{"<sweep>", r.key(), "unknown swings"};
   auto d = door_setup(job.scene, std::stod(r.param("texels_per_m")), std::stod(r.param("radius")), r.param("swings"));
   if (!d) return engine::Error{"<sweep>", r.key(), d.error().message};
-  AtlasTexels masked = d->texels;
-  masked.valid = d->mask;
-  const std::size_t n = masked.valid.size();
-  const std::size_t poses = d->poses();
-  std::vector<glm::vec3> values(n * poses, glm::vec3(0.0f));
-  std::vector<std::uint8_t> valid(n * poses, 0);
-  for (std::size_t k = 0; k < poses; ++k) {
-    ReferenceSettings rs;
-    rs.samples_per_pixel = std::stoi(r.param("spp"));
-    rs.seed = kReferenceSeed;
-    rs.threads = job.threads;
-    if (!r.param("bounces").empty()) rs.max_bounces = std::stoi(r.param("bounces"));
-    if (!r.param("seed").empty()) rs.seed = kReferenceSeed ^ std::stoull(r.param("seed"));
-    const ProgressFn& outer = job.progress;
-    rs.progress = [&outer, k, poses](double f) {
-      return !outer || outer((static_cast<double>(k) + f) / static_cast<double>(poses));
-    };
-    auto truth = reference_atlas_irradiance(d->posed(k == 0 ? 0.0f : d->swings[k - 1]), masked, rs);
-    if (!truth) return truth.error();
-    for (std::size_t t = 0; t < n; ++t)
-      if (d->mask[t]) {
-        values[k * n + t] = truth->indirect[t];
-        valid[k * n + t] = 1;
-      }
+  const std::uint64_t seed = r.param("seed").empty() ? kReferenceSeed : kReferenceSeed ^ std::stoull(r.param("seed"));
+  const bool paired = !r.param("pair").empty();
+  const int parts = paired ? 2 : 1;
+  auto values = door_truth_stream(job, *d, seed, 0, parts);
+  if (!values) return values.error();
+  if (paired) {
+    auto second = door_truth_stream(job, *d, kReferenceSeed ^ std::stoull(r.param("pair")), 1, parts);
+    if (!second) return second.error();
+    values->insert(values->end(), second->begin(), second->end());
   }
-  return RgbField::from_texels(d->texels.width, d->texels.height * static_cast<int>(poses), values, std::move(valid));
+  std::vector<std::uint8_t> valid;
+  for (int p = 0; p < parts * static_cast<int>(d->poses()); ++p)
+    valid.insert(valid.end(), d->mask.begin(), d->mask.end());
+  const int height = d->texels.height * static_cast<int>(d->poses()) * parts;
+  return RgbField::from_texels(d->texels.width, height, *values, std::move(valid));
 }
 
 // The shared headless GL context of the GPU timings (nullptr when none can be made).
@@ -314,6 +335,13 @@ std::vector<KnobSpec> exact_knobs() {
        .kind = KnobKind::Choice,
        .default_grid = {"off"},
        .choices = {"off", "on"}},
+      {.name = "exact_reuse",
+       .description = "solve=exact and near_visibility: keep each point pair's visibility and trace at a door move "
+                      "only the samples whose segment meets the door's boxes (ExactTransportSettings::"
+                      "reuse_visibility; the same couplings; off above 64 exact_pairs)",
+       .kind = KnobKind::Choice,
+       .default_grid = {"on"},
+       .choices = {"on", "off"}},
       {.name = "exact_seed",
        .description = "solve=exact: the point pairs' seed (two seeds measure the solver's own noise)",
        .kind = KnobKind::Integer,
@@ -357,6 +385,14 @@ std::vector<KnobSpec> scoring_knobs() {
        .default_grid = {"0"},
        .min_value = 0,
        .max_value = 1 << 30},
+      {.name = "ref_pair",
+       .description = "the split truth: a second, independent reference (the stream ref_seed = ref_pair gives) "
+                      "rendered with the first, and the change scored with the references' noise removed "
+                      "(split_* columns; 0: one reference only)",
+       .kind = KnobKind::Integer,
+       .default_grid = {"7"},
+       .min_value = 0,
+       .max_value = 1 << 30},
       {.name = "ref_bounces",
        .description = "indirect bounces of the reference (0: all; 1: the first bounce off directly lit surfaces)",
        .kind = KnobKind::Integer,
@@ -383,6 +419,7 @@ ReferenceRequest door_reference_request(const SweepScene&, const KnobSetting& k)
   // Only a bounded reference names its bounces, so the full ones keep their cache keys.
   if (k.integer("ref_bounces") > 0) r.params.emplace_back("bounces", std::to_string(k.integer("ref_bounces")));
   if (k.integer("ref_seed") > 0) r.params.emplace_back("seed", std::to_string(k.integer("ref_seed")));
+  if (k.integer("ref_pair") > 0) r.params.emplace_back("pair", std::to_string(k.integer("ref_pair")));
   return r;
 }
 
@@ -561,6 +598,7 @@ struct NearVisibility {
     es.point_pairs = static_cast<int>(ctx.knobs.integer("exact_pairs"));
     es.tolerance = region.settings().residual_tolerance > 0.0 ? region.settings().residual_tolerance : 1e-3;
     es.seed = static_cast<std::uint64_t>(ctx.knobs.integer("exact_seed"));
+    es.reuse_visibility = ctx.knobs.text("exact_reuse") == "on" && es.point_pairs <= 64;
     auto t = ExactLeafTransport::create(d.input, es);
     if (!t) return t.error();
     transport.emplace(std::move(t).value());
@@ -758,6 +796,7 @@ engine::Result<ExactMoves> exact_door_moves(const RunContext& ctx, const DoorSet
   es.bounces = static_cast<int>(ctx.knobs.integer("exact_bounces"));
   es.tolerance = s.residual_tolerance > 0.0 ? s.residual_tolerance : 1e-3;
   es.seed = seed;
+  es.reuse_visibility = ctx.knobs.text("exact_reuse") == "on" && es.point_pairs <= 64;
   auto transport = ExactLeafTransport::create(d.input, es);
   if (!transport) return transport.error();
   int group = -1;
@@ -855,7 +894,7 @@ engine::Result<MethodOutput> run_exact_transport(const RunContext& ctx, const Do
   return out;
 }
 
-engine::Result<MethodOutput> run_door_moves(const RunContext& ctx) {
+engine::Result<MethodOutput> run_on_one_truth(const RunContext& ctx) {
   auto d = door_setup(ctx.scene, ctx.knobs.real("density"), ctx.knobs.real("radius"), ctx.knobs.text("swings"));
   if (!d) return d.error();
   const int poses = static_cast<int>(d->poses());
@@ -908,6 +947,96 @@ engine::Result<MethodOutput> run_door_moves(const RunContext& ctx) {
                                          {"near_visibility_pairs_per_move", near.pairs},
                                          {"near_visibility_rays_per_move", near.rays}});
   }
+  return out;
+}
+
+// The run's change against the split truth (two references, `a` the one the run was scored
+// against, `b` independent of it): the error and the correlation of the change with the
+// references' noise removed (split_truth_change_score.h), as `split_*` extras. `field` holds
+// the run's moved poses as the baked truth of `a` plus the run's change.
+std::vector<std::pair<std::string, double>> split_truth_extras(const DoorSetup& d, const RgbField& field,
+                                                               const RgbField& a, const RgbField& b) {
+  const std::size_t n = d.texels.valid.size();
+  SplitTruthChangeScore all, nothing;
+  double truth_sq = 0.0, level = 0.0;  // sum over moved poses of t^2 (unbiased: a b), the baked level
+  for (std::size_t t = 0; t < n; ++t)
+    if (d.mask[t]) level += 0.5 * static_cast<double>(glm::dot(ref_at(a, t) + ref_at(b, t), glm::vec3(1.0f)));
+  level /= 3.0 * static_cast<double>(d.compared);
+  std::vector<std::pair<std::string, double>> per_angle;
+  for (std::size_t k = 1; k < d.poses(); ++k) {
+    SplitTruthChangeScore pose, pose_nothing;
+    for (std::size_t t = 0; t < n; ++t) {
+      if (!d.mask[t] || !field.is_valid(k * n + t)) continue;
+      const glm::vec3 m = ref_at(field, k * n + t) - ref_at(a, t);
+      const glm::vec3 ca = ref_at(a, k * n + t) - ref_at(a, t), cb = ref_at(b, k * n + t) - ref_at(b, t);
+      truth_sq += static_cast<double>(glm::dot(ref_at(a, k * n + t), ref_at(b, k * n + t)));
+      for (int c = 0; c < 3; ++c) {
+        pose.add(static_cast<double>(m[c]), static_cast<double>(ca[c]), static_cast<double>(cb[c]));
+        pose_nothing.add(0.0, static_cast<double>(ca[c]), static_cast<double>(cb[c]));
+      }
+    }
+    all.merge(pose);
+    nothing.merge(pose_nothing);
+    const int swing = static_cast<int>(d.swings[k - 1]);
+    const std::string name = std::string(swing < 0 ? "m" : "p") + std::to_string(std::abs(swing));
+    const double count = std::max(pose.samples(), 1.0);
+    per_angle.emplace_back("split_change_nrmse_swing_" + name,
+                           std::sqrt(std::max(0.0, pose.noise_removed_sse()) / count) / level);
+    per_angle.emplace_back("split_nothing_nrmse_swing_" + name,
+                           std::sqrt(std::max(0.0, pose_nothing.noise_removed_sse()) / count) / level);
+  }
+  std::vector<std::pair<std::string, double>> extras = {
+      // As rel_rmse (the run's error against the first reference), the noise removed.
+      {"split_rel_rmse", std::sqrt(std::max(0.0, all.noise_removed_sse()) / truth_sq)},
+      {"split_nothing_rel_rmse", std::sqrt(std::max(0.0, nothing.noise_removed_sse()) / truth_sq)},
+      // The noise of one reference's change, in the same units (what the old columns include).
+      {"split_ref_noise_rel_rmse", std::sqrt(all.noise_of_one() / truth_sq)},
+      {"split_change_correlation", all.correlation_noise_removed()},
+      {"split_change_correlation_raw", all.correlation_raw()},
+      {"split_change_fit_scale", all.fit_scale()}};
+  extras.insert(extras.end(), per_angle.begin(), per_angle.end());
+  return extras;
+}
+
+// A run: scored against the first reference as always; with `ref_pair` the reference holds
+// a second one below it (door_reference), and the split truth's scores join the extras.
+engine::Result<MethodOutput> run_door_moves(const RunContext& ctx) {
+  if (ctx.knobs.integer("ref_pair") == 0) return run_on_one_truth(ctx);
+  if (ctx.knobs.integer("ref_pair") == ctx.knobs.integer("ref_seed"))
+    return engine::Error{.message = "ref_pair must name another stream than ref_seed"};
+  const RgbField& both = ctx.reference;
+  if (both.height % 2 != 0 || both.valid.size() != both.count())
+    return engine::Error{.message = "the paired reference is not two masked halves"};
+  RgbField a, b;
+  for (RgbField* half : {&a, &b}) {
+    const std::size_t offset = half == &a ? 0 : both.count() / 2;
+    half->width = both.width;
+    half->height = both.height / 2;
+    half->rgb.assign(both.rgb.begin() + static_cast<std::ptrdiff_t>(3 * offset),
+                     both.rgb.begin() + static_cast<std::ptrdiff_t>(3 * (offset + half->count())));
+    half->valid.assign(both.valid.begin() + static_cast<std::ptrdiff_t>(offset),
+                       both.valid.begin() + static_cast<std::ptrdiff_t>(offset + half->count()));
+  }
+  const RunContext first{.scene = ctx.scene,
+                         .knobs = ctx.knobs,
+                         .request = ctx.request,
+                         .reference = a,
+                         .seed = ctx.seed,
+                         .threads = ctx.threads,
+                         .progress = ctx.progress,
+                         .split_truth = ctx.split_truth};
+  auto out = run_on_one_truth(first);
+  if (!out) return out;
+  if (ctx.knobs.text("solve") != "off") {  // the floor's field carries the first reference's noise
+    auto d = door_setup(ctx.scene, ctx.knobs.real("density"), ctx.knobs.real("radius"), ctx.knobs.text("swings"));
+    if (!d) return d.error();
+    for (auto& e : split_truth_extras(*d, out->field, a, b)) out->extras.push_back(std::move(e));
+  }
+  // The output in the reference's layout: the second half is not the run's to match.
+  if (out->field.valid.empty()) out->field.valid.assign(out->field.count(), 1);
+  out->field.height *= 2;
+  out->field.rgb.resize(3 * out->field.count(), 0.0f);
+  out->field.valid.resize(out->field.count(), 0);
   return out;
 }
 
