@@ -158,9 +158,12 @@ void ExactLeafTransport::update(const ElementHierarchy& h) {
     if (settings_.reuse_visibility) visible_.assign(g_.size(), 0);
   }
   std::vector<char> moving(n, 0);
+  std::vector<MovingInstances::Box> bounds(n);  // each leaf's triangle's box
   for (std::size_t l = 0; l < n; ++l) {
-    const std::int32_t inst = h.node_instance[static_cast<std::size_t>(h.leaves[l])];
-    moving[l] = moving_.deforming(inst);
+    const auto node = static_cast<std::size_t>(h.leaves[l]);
+    moving[l] = moving_.deforming(h.node_instance[node]);
+    const glm::vec3* t = &h.corners[3 * node];
+    bounds[l] = {glm::min(glm::min(t[0], t[1]), t[2]), glm::max(glm::max(t[0], t[1]), t[2])};
   }
   std::atomic<std::size_t> pairs{0}, rays{0};
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1), [&](const tbb::blocked_range<std::size_t>& r) {
@@ -171,10 +174,15 @@ void ExactLeafTransport::update(const ElementHierarchy& h) {
         if (!receivers_.empty() && !receivers_[i] && !receivers_[j]) continue;
         bool todo = all || moving[i] || moving[j];
         if (!todo) {
+          // Every segment between the two triangles lies in their convex hull, so within the
+          // box of both triangles' boxes and within the centres' segment widened by the larger
+          // radius: a moved box that misses either cannot change the pair.
           const ElementNode& b = h.nodes[static_cast<std::size_t>(h.leaves[j])];
           const glm::vec3 widen(std::max(a.radius_m, b.radius_m));
+          const glm::vec3 lo = glm::min(bounds[i].lo, bounds[j].lo), hi = glm::max(bounds[i].hi, bounds[j].hi);
           for (const MovingInstances::Box& box : moving_.swept())
-            if (engine::segment_meets_box(a.center, b.center - a.center, 1.0f, box.lo - widen, box.hi + widen)) {
+            if (glm::all(glm::lessThanEqual(box.lo, hi)) && glm::all(glm::lessThanEqual(lo, box.hi)) &&
+                engine::segment_meets_box(a.center, b.center - a.center, 1.0f, box.lo - widen, box.hi + widen)) {
               todo = true;
               break;
             }
@@ -194,18 +202,22 @@ void ExactLeafTransport::update(const ElementHierarchy& h) {
 }
 
 ExactSolveResult ExactLeafTransport::solve(const ElementHierarchy& h, std::span<const glm::vec3> direct) const {
-  return iterate(h, direct, {}, {});
+  return iterate(h, direct, {}, {}, {});
 }
 
 ExactSolveResult ExactLeafTransport::solve_receivers(const ElementHierarchy& h, std::span<const glm::vec3> direct,
-                                                     std::span<const glm::vec3> others) const {
+                                                     std::span<const glm::vec3> others,
+                                                     std::span<const glm::vec3> start) const {
   GI_EXPECTS(receivers_.size() == h.leaf_count() && others.size() == h.leaf_count(),
              "ExactLeafTransport::solve_receivers: set_receivers and others for every leaf");
-  return iterate(h, direct, receivers_, others);
+  GI_EXPECTS(start.empty() || start.size() == h.leaf_count(),
+             "ExactLeafTransport::solve_receivers: a start for every leaf, or none");
+  return iterate(h, direct, receivers_, others, start);
 }
 
 ExactSolveResult ExactLeafTransport::iterate(const ElementHierarchy& h, std::span<const glm::vec3> direct,
-                                             std::span<const char> rows, std::span<const glm::vec3> others) const {
+                                             std::span<const char> rows, std::span<const glm::vec3> others,
+                                             std::span<const glm::vec3> start) const {
   const std::size_t n = h.leaf_count();
   GI_EXPECTS(n == n_ && direct.size() == n, "ExactLeafTransport::solve: update() with this hierarchy first");
   std::vector<glm::vec3> area_rho(n);  // A_j albedo_j / pi
@@ -216,7 +228,8 @@ ExactSolveResult ExactLeafTransport::iterate(const ElementHierarchy& h, std::spa
   ExactSolveResult out;
   out.irradiance.assign(n, glm::vec3(0.0f));
   if (!rows.empty())
-    for (std::size_t l = 0; l < n; ++l) out.irradiance[l] = rows[l] ? glm::vec3(0.0f) : others[l];
+    for (std::size_t l = 0; l < n; ++l)
+      out.irradiance[l] = !rows[l] ? others[l] : start.empty() ? glm::vec3(0.0f) : start[l];
   std::vector<glm::vec3> next = out.irradiance, source(n);
   const int budget = settings_.bounces > 0 ? settings_.bounces : settings_.max_iterations;
   for (int it = 0; it < budget; ++it) {

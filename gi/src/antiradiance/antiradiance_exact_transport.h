@@ -100,8 +100,10 @@ class ExactLeafTransport {
   /// The receivers' indirect irradiance gathered with visibility from every leaf, the other
   /// leaves held at `others` (W/m^2 per leaf: e.g. an antiradiance solve's); the receivers'
   /// own exchange iterated to the tolerance. Returns every leaf's value (the others' as given).
+  /// `start` (empty: 0): the receivers' first iterate, e.g. the previous pose's solution (a
+  /// warm start: the same fixed point in fewer iterations).
   ExactSolveResult solve_receivers(const ElementHierarchy& h, std::span<const glm::vec3> direct,
-                                   std::span<const glm::vec3> others) const;
+                                   std::span<const glm::vec3> others, std::span<const glm::vec3> start = {}) const;
 
   /// G_ij of leaves i != j (m^-2: the mean of cos cos V / r^2); 0 for i == j.
   float coupling(std::size_t i, std::size_t j) const;
@@ -114,7 +116,7 @@ class ExactLeafTransport {
   std::size_t pair_index(std::size_t i, std::size_t j) const;  // i < j
   /// Jacobi over the rows flagged in `rows` (all when empty), the others held at `others`.
   ExactSolveResult iterate(const ElementHierarchy& h, std::span<const glm::vec3> direct, std::span<const char> rows,
-                           std::span<const glm::vec3> others) const;
+                           std::span<const glm::vec3> others, std::span<const glm::vec3> start) const;
 
   ExactTransportSettings settings_;
   std::unique_ptr<RayCaster> caster_;

@@ -25,6 +25,7 @@
 #include "antiradiance/antiradiance_region.h"
 #include "antiradiance/antiradiance_texel_blend.h"
 #include "antiradiance/antiradiance_texel_gather.h"
+#include "antiradiance/near_door_visibility.h"
 #include "antiradiance/split_truth_change_score.h"
 #include "raytrace/atlas_reference.h"
 #include "uv/atlas_input.h"
@@ -572,56 +573,41 @@ struct TexelOutput {
 // and the static ones within near_radius of its swept sphere) take their indirect light from
 // every leaf through ray-traced visibility (form factors, ExactLeafTransport) instead of the
 // antiradiance links: radiance only, every link of such a receiver tested; the other leaves
-// keep the antiradiance solve's. Its change is this hybrid now minus at the baked pose.
+// keep the antiradiance solve's (NearDoorVisibility). Its change is this hybrid now minus at
+// the baked pose.
 struct NearVisibility {
-  std::optional<ExactLeafTransport> transport;
-  std::vector<glm::vec3> baseline;  // the hybrid at the baked pose
+  std::optional<NearDoorVisibility> near;
   std::size_t receivers = 0;
   double bake_ms = 0.0, move_ms = 0.0, rays = 0.0, pairs = 0.0;
+  double update_ms = 0.0;   // of move_ms: the couplings' update (the rest: the receivers' solve)
+  double iterations = 0.0;  // the receivers' solve, mean per move
 
   engine::Status init(const RunContext& ctx, const DoorSetup& d, AntiradianceRegion& region) {
-    const ElementHierarchy& h = region.hierarchy();
-    const glm::vec3 origin(d.authored[3]);
-    float reach = 0.0f;
-    for (const BakePrimitive& p : d.input.meshes[d.input.instances[d.door].mesh].primitives)
-      for (const glm::vec3& v : p.positions) reach = std::max(reach, glm::length(v));
-    const float near = reach + region.settings().near_radius_m;
-    std::vector<char> mask(h.leaf_count(), 0);
-    for (std::size_t l = 0; l < h.leaf_count(); ++l) {
-      const auto node = static_cast<std::size_t>(h.leaves[l]);
-      const ElementNode& e = h.nodes[node];
-      mask[l] = h.node_instance[node] == static_cast<std::int32_t>(d.door) ||
-                glm::length(e.center - origin) <= near + e.radius_m;
-      receivers += static_cast<std::size_t>(mask[l]);
-    }
-    ExactTransportSettings es;
-    es.point_pairs = static_cast<int>(ctx.knobs.integer("exact_pairs"));
-    es.tolerance = region.settings().residual_tolerance > 0.0 ? region.settings().residual_tolerance : 1e-3;
-    es.seed = static_cast<std::uint64_t>(ctx.knobs.integer("exact_seed"));
-    es.reuse_visibility = ctx.knobs.text("exact_reuse") == "on" && es.point_pairs <= 64;
-    auto t = ExactLeafTransport::create(d.input, es);
-    if (!t) return t.error();
-    transport.emplace(std::move(t).value());
-    transport->set_receivers(std::move(mask));
+    NearDoorVisibilitySettings ns;
+    ns.radius_m = region.settings().near_radius_m;
+    ns.point_pairs = static_cast<int>(ctx.knobs.integer("exact_pairs"));
+    ns.seed = static_cast<std::uint64_t>(ctx.knobs.integer("exact_seed"));
+    ns.reuse_visibility = ctx.knobs.text("exact_reuse") == "on" && ns.point_pairs <= 64;
     const auto t0 = Clock::now();
     region.update(false);  // the direct light at the baked pose
-    transport->update(h);
-    baseline = transport->solve_receivers(h, region.direct(), region.baseline()).irradiance;
+    auto n = NearDoorVisibility::create(d.input, region, d.door, ns);
+    if (!n) return n.error();
+    near.emplace(std::move(n).value());
     bake_ms = ms_since(t0);
+    receivers = near->receivers();
     return {};
   }
   // After the region moved the door to `m` and solved: the hybrid's change per leaf.
   std::vector<glm::vec3> delta(const DoorSetup& d, const AntiradianceRegion& region, const glm::mat4& m,
                                std::size_t moves) {
     const auto t0 = Clock::now();
-    transport->set_instance_transform(d.door, m);
-    transport->update(region.hierarchy());
-    std::vector<glm::vec3> e =
-        transport->solve_receivers(region.hierarchy(), region.direct(), region.irradiance()).irradiance;
+    std::vector<glm::vec3> e = near->move(region, d.door, m);
     move_ms += ms_since(t0) / static_cast<double>(moves);
-    rays += static_cast<double>(transport->last_rays()) / static_cast<double>(moves);
-    pairs += static_cast<double>(transport->last_pairs_computed()) / static_cast<double>(moves);
-    for (std::size_t l = 0; l < e.size(); ++l) e[l] -= baseline[l];
+    update_ms += near->last_update_ms() / static_cast<double>(moves);
+    iterations += static_cast<double>(near->last_iterations()) / static_cast<double>(moves);
+    rays += static_cast<double>(near->last_rays()) / static_cast<double>(moves);
+    pairs += static_cast<double>(near->last_pairs()) / static_cast<double>(moves);
+    for (std::size_t l = 0; l < e.size(); ++l) e[l] -= near->baseline()[l];
     return e;
   }
 };
@@ -944,6 +930,8 @@ engine::Result<MethodOutput> run_on_one_truth(const RunContext& ctx) {
     out.extras.insert(out.extras.end(), {{"near_visibility_receivers", static_cast<double>(near.receivers)},
                                          {"near_visibility_bake_ms", near.bake_ms},
                                          {"near_visibility_move_ms", near.move_ms},
+                                         {"near_visibility_update_ms", near.update_ms},
+                                         {"near_visibility_iterations", near.iterations},
                                          {"near_visibility_pairs_per_move", near.pairs},
                                          {"near_visibility_rays_per_move", near.rays}});
   }

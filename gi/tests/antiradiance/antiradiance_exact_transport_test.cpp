@@ -174,6 +174,13 @@ TEST(ExactLeafTransport, TheReceiversSolveHoldsTheOthersAndMeetsTheFullSolve) {
     }
     EXPECT_NEAR(r.irradiance[l].x, e.irradiance[l].x, 1e-4f * e.irradiance[l].x);
   }
+  // Started from its own solution, the receivers' solve stops at once, where it was.
+  const gi::ExactSolveResult warm = part->solve_receivers(*h, direct, e.irradiance, r.irradiance);
+  EXPECT_TRUE(warm.converged);
+  EXPECT_LT(warm.iterations, r.iterations);
+  EXPECT_LE(warm.iterations, 2);
+  for (std::size_t l = 0; l < h->leaf_count(); ++l)
+    EXPECT_NEAR(warm.irradiance[l].x, r.irradiance[l].x, 1e-5f * r.irradiance[l].x + 1e-9f);
   // No direct light and the others held dark: the receivers get nothing.
   std::vector<glm::vec3> dark(h->leaf_count(), glm::vec3(0.0f));
   const gi::ExactSolveResult no_direct = part->solve_receivers(*h, dark, dark);
