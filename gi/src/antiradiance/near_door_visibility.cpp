@@ -34,7 +34,7 @@ engine::Result<NearDoorVisibility> NearDoorVisibility::create(const BakeInput& i
   }
   ExactTransportSettings es;
   es.point_pairs = settings.point_pairs;
-  es.tolerance = region.settings().residual_tolerance > 0.0 ? region.settings().residual_tolerance : 1e-3;
+  es.tolerance = settings.tolerance;
   es.seed = settings.seed;
   es.reuse_visibility = settings.reuse_visibility;
   auto t = ExactLeafTransport::create(input, es);
