@@ -3,7 +3,8 @@
 // phase by phase. llvmpipe timings are CPU timings (DESIGN.md §4); GPU phases end in glFinish.
 // BM_DoorMoveAtPreset (issue 37): one door move at a gi-bake preset's settings, from the bake
 // as a load gets it, against re-baking the corridor's light atlas at the same preset in the
-// same run (what a door without antiradiance would cost).
+// same run (what a door without antiradiance would cost). BM_NearVisibilityMoveAtMedium: the
+// same with explicit visibility near the door (NearDoorVisibility).
 //   ./build/gi/benchmarks/antiradiance_bench --benchmark_counters_tabular=true
 #include <GL/glcorearb.h>
 #include <benchmark/benchmark.h>
@@ -25,6 +26,7 @@
 #include "antiradiance/antiradiance_gpu_pass.h"
 #include "antiradiance/antiradiance_region.h"
 #include "antiradiance/antiradiance_solver.h"
+#include "antiradiance/near_door_visibility.h"
 #include "bench_gl.h"
 #include "light_atlas/light_atlas.h"
 
@@ -289,6 +291,77 @@ BENCHMARK(BM_DoorStepsAtPreset)
     ->Args({2, 1, 0})
     ->Unit(benchmark::kMillisecond)
     ->Iterations(40);
+
+// Door moves at the medium preset with explicit visibility near the door (issue 37,
+// NearDoorVisibility: the leaves within 1 m of the door's reach gather with ray-traced
+// visibility). Args: point_pairs per leaf pair, reuse (1: the visibility kept, only the
+// segments meeting the door's boxes traced), warm (1: the near solve starts from the last
+// pose's). Per iteration the door jumps to 0 / 25 / 100
+// degrees: the antiradiance move and solve (as BM_DoorMoveAtPreset), then the near leaves'
+// update and solve. Counters: door_move_ms (both, wall), antiradiance_ms, near_ms,
+// near_update_ms (of near_ms: the couplings), near_iterations, rays, pairs (per move), near_bake_ms (the
+// baked pose's couplings, once), atlas_rebake_ms (the yardstick), vs_rebake.
+void BM_NearVisibilityMoveAtMedium(benchmark::State& state) {
+  Corridor& c = corridor();
+  const double rebake_ms = atlas_rebake_ms("medium");
+  const gi::AntiradianceSettings s = gi::antiradiance_preset("medium");
+  auto bake = gi::bake_antiradiance(c.input, s);
+  if (!bake) std::exit(1);
+  auto region = gi::AntiradianceRegion::create(c.input, std::move(bake).value());
+  if (!region) std::exit(1);
+  const auto tb = std::chrono::steady_clock::now();
+  region->update(false);
+  gi::NearDoorVisibilitySettings ns;
+  ns.point_pairs = static_cast<int>(state.range(0));
+  ns.reuse_visibility = state.range(1) != 0;
+  ns.warm_start = state.range(2) != 0;
+  auto near = gi::NearDoorVisibility::create(c.input, *region, c.door_instance, ns);
+  if (!near) std::exit(1);
+  const double near_bake_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - tb).count();
+  region->update();
+  std::size_t k = 0;
+  double total_ms = 0.0, ar_ms = 0.0, near_ms = 0.0, update_ms = 0.0, rays = 0.0, pairs = 0.0, iterations = 0.0;
+  for (auto _ : state) {
+    const glm::mat4 m = door(door_angle(false, k++));
+    const auto t0 = std::chrono::steady_clock::now();
+    region->set_instance_transform(c.door_instance, m);
+    region->update(false);
+    region->update();
+    const auto t1 = std::chrono::steady_clock::now();
+    const std::vector<glm::vec3> e = near->move(*region, c.door_instance, m);
+    benchmark::DoNotOptimize(e.data());
+    const auto t2 = std::chrono::steady_clock::now();
+    ar_ms += std::chrono::duration<double, std::milli>(t1 - t0).count();
+    near_ms += std::chrono::duration<double, std::milli>(t2 - t1).count();
+    total_ms += std::chrono::duration<double, std::milli>(t2 - t0).count();
+    update_ms += near->last_update_ms();
+    iterations += static_cast<double>(near->last_iterations());
+    rays += static_cast<double>(near->last_rays());
+    pairs += static_cast<double>(near->last_pairs());
+  }
+  const double moves = static_cast<double>(state.iterations());
+  state.counters["door_move_ms"] = total_ms / moves;
+  state.counters["antiradiance_ms"] = ar_ms / moves;
+  state.counters["near_ms"] = near_ms / moves;
+  state.counters["near_update_ms"] = update_ms / moves;
+  state.counters["rays"] = rays / moves;
+  state.counters["pairs"] = pairs / moves;
+  state.counters["receivers"] = static_cast<double>(near->receivers());
+  state.counters["near_iterations"] = iterations / moves;
+  state.counters["near_bake_ms"] = near_bake_ms;
+  state.counters["atlas_rebake_ms"] = rebake_ms;
+  state.counters["vs_rebake"] = rebake_ms / (total_ms / moves);
+}
+BENCHMARK(BM_NearVisibilityMoveAtMedium)
+    ->ArgNames({"pairs", "reuse", "warm"})
+    ->Args({16, 0, 0})
+    ->Args({16, 1, 0})
+    ->Args({16, 1, 1})
+    ->Args({8, 1, 1})
+    ->Args({4, 1, 0})
+    ->Args({4, 1, 1})
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(3);
 
 // The yardstick for ratios on shared cores: sorting 1.6 M random 16-byte records by
 // (receiver, bin, sender) -- the job a relink did in full before it merged (a fixed

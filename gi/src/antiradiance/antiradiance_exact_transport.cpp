@@ -18,6 +18,7 @@ namespace {
 
 constexpr float kPi = 3.14159265358979f;
 constexpr int kMinClosePairs = 16;
+constexpr int kMaxReusedPairs = 64;  // one std::uint64_t of visibility bits per leaf pair
 
 std::uint64_t mix(std::uint64_t x) {
   x += 0x9e3779b97f4a7c15ULL;
@@ -52,6 +53,8 @@ bool behind(const glm::vec3* t, const glm::vec3& p, const glm::vec3& n) {
 engine::Result<ExactLeafTransport> ExactLeafTransport::create(const BakeInput& input,
                                                               const ExactTransportSettings& settings) {
   if (settings.point_pairs < 1) return engine::Error{.message = "exact transport: point_pairs must be at least 1"};
+  if (settings.reuse_visibility && settings.point_pairs > kMaxReusedPairs)
+    return engine::Error{.message = "exact transport: reuse_visibility keeps at most 64 point pairs per leaf pair"};
   if (engine::Status st = validate_bake_input(input); !st) return st.error();
   ExactLeafTransport out;
   out.settings_ = settings;
@@ -80,8 +83,8 @@ float ExactLeafTransport::coupling(std::size_t i, std::size_t j) const {
   return i < j ? g_[pair_index(i, j)] : g_[pair_index(j, i)];
 }
 
-float ExactLeafTransport::pair_coupling(const ElementHierarchy& h, std::size_t i, std::size_t j,
-                                        std::size_t& rays) const {
+float ExactLeafTransport::pair_coupling(const ElementHierarchy& h, std::size_t i, std::size_t j, bool reuse,
+                                        std::size_t& rays) {
   const auto ni = static_cast<std::size_t>(h.leaves[i]), nj = static_cast<std::size_t>(h.leaves[j]);
   const glm::vec3* ti = &h.corners[3 * ni];
   const glm::vec3* tj = &h.corners[3 * nj];
@@ -104,6 +107,8 @@ float ExactLeafTransport::pair_coupling(const ElementHierarchy& h, std::size_t i
   const int strata = std::max(1, static_cast<int>(std::sqrt(static_cast<double>(m))));
   const float min_r2 = settings_.min_distance_m * settings_.min_distance_m;
   std::uint64_t state = mix(settings_.seed ^ mix(static_cast<std::uint64_t>(i) * 0x100000001b3ULL + j));
+  std::uint64_t* bits = visible_.empty() ? nullptr : &visible_[pair_index(i, j)];
+  reuse = reuse && bits != nullptr;
   double sum = 0.0;
   for (int s = 0; s < m; ++s) {
     const int cell = s % (strata * strata);
@@ -121,8 +126,19 @@ float ExactLeafTransport::pair_coupling(const ElementHierarchy& h, std::size_t i
     // Off both surfaces by 0.1 mm along their normals, the segment between.
     const glm::vec3 o = x + 1e-4f * n_i;
     const glm::vec3 e = y + 1e-4f * n_j;
-    ++rays;
-    if (caster_->occluded(Ray{.origin = o, .t_min = 0.0f, .direction = e - o, .t_max = 1.0f})) continue;
+    bool crosses = !reuse;
+    for (std::size_t k = 0; k < moving_.swept().size() && !crosses; ++k)
+      crosses = engine::segment_meets_box(o, e - o, 1.0f, moving_.swept()[k].lo, moving_.swept()[k].hi);
+    const std::uint64_t bit = std::uint64_t{1} << s;
+    bool visible = false;
+    if (crosses) {
+      ++rays;
+      visible = !caster_->occluded(Ray{.origin = o, .t_min = 0.0f, .direction = e - o, .t_max = 1.0f});
+      if (bits) *bits = visible ? (*bits | bit) : (*bits & ~bit);
+    } else {
+      visible = (*bits & bit) != 0;  // reuse: the segment meets nothing that moved
+    }
+    if (!visible) continue;
     sum += static_cast<double>(ci * cj / std::max(r2, min_r2));
   }
   return static_cast<float>(sum / static_cast<double>(m));
@@ -139,11 +155,15 @@ void ExactLeafTransport::update(const ElementHierarchy& h) {
   if (all) {
     n_ = n;
     g_.assign(n * (n - 1) / 2, 0.0f);
+    if (settings_.reuse_visibility) visible_.assign(g_.size(), 0);
   }
   std::vector<char> moving(n, 0);
+  std::vector<MovingInstances::Box> bounds(n);  // each leaf's triangle's box
   for (std::size_t l = 0; l < n; ++l) {
-    const std::int32_t inst = h.node_instance[static_cast<std::size_t>(h.leaves[l])];
-    moving[l] = moving_.deforming(inst);
+    const auto node = static_cast<std::size_t>(h.leaves[l]);
+    moving[l] = moving_.deforming(h.node_instance[node]);
+    const glm::vec3* t = &h.corners[3 * node];
+    bounds[l] = {glm::min(glm::min(t[0], t[1]), t[2]), glm::max(glm::max(t[0], t[1]), t[2])};
   }
   std::atomic<std::size_t> pairs{0}, rays{0};
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1), [&](const tbb::blocked_range<std::size_t>& r) {
@@ -154,16 +174,22 @@ void ExactLeafTransport::update(const ElementHierarchy& h) {
         if (!receivers_.empty() && !receivers_[i] && !receivers_[j]) continue;
         bool todo = all || moving[i] || moving[j];
         if (!todo) {
+          // Every segment between the two triangles lies in their convex hull, so within the
+          // box of both triangles' boxes and within the centres' segment widened by the larger
+          // radius: a moved box that misses either cannot change the pair.
           const ElementNode& b = h.nodes[static_cast<std::size_t>(h.leaves[j])];
           const glm::vec3 widen(std::max(a.radius_m, b.radius_m));
+          const glm::vec3 lo = glm::min(bounds[i].lo, bounds[j].lo), hi = glm::max(bounds[i].hi, bounds[j].hi);
           for (const MovingInstances::Box& box : moving_.swept())
-            if (engine::segment_meets_box(a.center, b.center - a.center, 1.0f, box.lo - widen, box.hi + widen)) {
+            if (glm::all(glm::lessThanEqual(box.lo, hi)) && glm::all(glm::lessThanEqual(lo, box.hi)) &&
+                engine::segment_meets_box(a.center, b.center - a.center, 1.0f, box.lo - widen, box.hi + widen)) {
               todo = true;
               break;
             }
         }
         if (!todo) continue;
-        g_[pair_index(i, j)] = pair_coupling(h, i, j, my_rays);
+        // A pair with a moving leaf moves its samples: every one is traced again.
+        g_[pair_index(i, j)] = pair_coupling(h, i, j, !all && !moving[i] && !moving[j], my_rays);
         ++my_pairs;
       }
     }
@@ -176,18 +202,22 @@ void ExactLeafTransport::update(const ElementHierarchy& h) {
 }
 
 ExactSolveResult ExactLeafTransport::solve(const ElementHierarchy& h, std::span<const glm::vec3> direct) const {
-  return iterate(h, direct, {}, {});
+  return iterate(h, direct, {}, {}, {});
 }
 
 ExactSolveResult ExactLeafTransport::solve_receivers(const ElementHierarchy& h, std::span<const glm::vec3> direct,
-                                                     std::span<const glm::vec3> others) const {
+                                                     std::span<const glm::vec3> others,
+                                                     std::span<const glm::vec3> start) const {
   GI_EXPECTS(receivers_.size() == h.leaf_count() && others.size() == h.leaf_count(),
              "ExactLeafTransport::solve_receivers: set_receivers and others for every leaf");
-  return iterate(h, direct, receivers_, others);
+  GI_EXPECTS(start.empty() || start.size() == h.leaf_count(),
+             "ExactLeafTransport::solve_receivers: a start for every leaf, or none");
+  return iterate(h, direct, receivers_, others, start);
 }
 
 ExactSolveResult ExactLeafTransport::iterate(const ElementHierarchy& h, std::span<const glm::vec3> direct,
-                                             std::span<const char> rows, std::span<const glm::vec3> others) const {
+                                             std::span<const char> rows, std::span<const glm::vec3> others,
+                                             std::span<const glm::vec3> start) const {
   const std::size_t n = h.leaf_count();
   GI_EXPECTS(n == n_ && direct.size() == n, "ExactLeafTransport::solve: update() with this hierarchy first");
   std::vector<glm::vec3> area_rho(n);  // A_j albedo_j / pi
@@ -198,7 +228,8 @@ ExactSolveResult ExactLeafTransport::iterate(const ElementHierarchy& h, std::spa
   ExactSolveResult out;
   out.irradiance.assign(n, glm::vec3(0.0f));
   if (!rows.empty())
-    for (std::size_t l = 0; l < n; ++l) out.irradiance[l] = rows[l] ? glm::vec3(0.0f) : others[l];
+    for (std::size_t l = 0; l < n; ++l)
+      out.irradiance[l] = !rows[l] ? others[l] : start.empty() ? glm::vec3(0.0f) : start[l];
   std::vector<glm::vec3> next = out.irradiance, source(n);
   const int budget = settings_.bounces > 0 ? settings_.bounces : settings_.max_iterations;
   for (int it = 0; it < budget; ++it) {

@@ -55,6 +55,13 @@ struct ExactTransportSettings {
   /// point pairs noisy.
   float min_distance_m = 0.02f;
   std::uint64_t seed = 1;
+  /// Keep every point pair's visibility (one bit per sample; needs point_pairs <= 64) and, at
+  /// a door move, trace only the samples of a recomputed static pair whose segment meets a
+  /// moved instance's box before or after the move; the others reuse their stored bit (the
+  /// geometry they cross did not move). The couplings are bit for bit those of tracing every
+  /// sample; the rays per move drop to the segments that cross the door's two boxes. 8 bytes
+  /// per leaf pair.
+  bool reuse_visibility = false;
 };
 
 struct ExactSolveResult {
@@ -93,19 +100,23 @@ class ExactLeafTransport {
   /// The receivers' indirect irradiance gathered with visibility from every leaf, the other
   /// leaves held at `others` (W/m^2 per leaf: e.g. an antiradiance solve's); the receivers'
   /// own exchange iterated to the tolerance. Returns every leaf's value (the others' as given).
+  /// `start` (empty: 0): the receivers' first iterate, e.g. the previous pose's solution (a
+  /// warm start: the same fixed point in fewer iterations).
   ExactSolveResult solve_receivers(const ElementHierarchy& h, std::span<const glm::vec3> direct,
-                                   std::span<const glm::vec3> others) const;
+                                   std::span<const glm::vec3> others, std::span<const glm::vec3> start = {}) const;
 
   /// G_ij of leaves i != j (m^-2: the mean of cos cos V / r^2); 0 for i == j.
   float coupling(std::size_t i, std::size_t j) const;
 
  private:
-  /// G of leaves (i, j), i < j, at the caster's current pose; adds its rays to `rays`.
-  float pair_coupling(const ElementHierarchy& h, std::size_t i, std::size_t j, std::size_t& rays) const;
+  /// G of leaves (i, j), i < j, at the caster's current pose; adds its rays to `rays`. With
+  /// `reuse` (and stored visibility) only the samples whose segment meets a swept box are
+  /// traced; the stored bits are updated either way.
+  float pair_coupling(const ElementHierarchy& h, std::size_t i, std::size_t j, bool reuse, std::size_t& rays);
   std::size_t pair_index(std::size_t i, std::size_t j) const;  // i < j
   /// Jacobi over the rows flagged in `rows` (all when empty), the others held at `others`.
   ExactSolveResult iterate(const ElementHierarchy& h, std::span<const glm::vec3> direct, std::span<const char> rows,
-                           std::span<const glm::vec3> others) const;
+                           std::span<const glm::vec3> others, std::span<const glm::vec3> start) const;
 
   ExactTransportSettings settings_;
   std::unique_ptr<RayCaster> caster_;
@@ -113,6 +124,8 @@ class ExactLeafTransport {
   bool dirty_ = false;
   std::size_t n_ = 0;
   std::vector<float> g_;  ///< Upper triangle, row-major, i < j.
+  /// With reuse_visibility: per pair (as g_), bit s set when sample s is unoccluded.
+  std::vector<std::uint64_t> visible_;
   std::vector<char> receivers_;
   std::size_t last_pairs_ = 0, last_rays_ = 0;
 };

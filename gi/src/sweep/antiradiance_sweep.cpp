@@ -18,156 +18,18 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
-#include "antiradiance/antiradiance_direct_light.h"
-#include "antiradiance/antiradiance_exact_transport.h"
 #include "antiradiance/antiradiance_gpu_pass.h"
 #include "antiradiance/antiradiance_io.h"
 #include "antiradiance/antiradiance_region.h"
 #include "antiradiance/antiradiance_texel_blend.h"
 #include "antiradiance/antiradiance_texel_gather.h"
-#include "raytrace/atlas_reference.h"
-#include "uv/atlas_input.h"
-#include "uv/atlas_layout.h"
-#include "uv/atlas_rasterizer.h"
+#include "sweep/antiradiance_diagnosis_sweep.h"
+#include "sweep/antiradiance_door_scoring.h"
 
 namespace gi {
 namespace {
 
-// Other random streams than any bake's (see reference_sweep.cpp). The same for every pose,
-// so a texel's paths that never meet the door are the same in every pose.
-constexpr std::uint64_t kReferenceSeed = 0x616e746972616469ULL;
-
-// Swings about the door's local Y from its authored (baked) pose, degrees. The corridor's
-// door is authored at 50 degrees open: the sweep's poses are 0 (shut), 25 and 100; the knob
-// `swings` scores other ones (issue 37's angle in no sweep: +25, the door at 75 degrees).
-constexpr float kSweepSwings[] = {-50.0f, -25.0f, 50.0f};
-constexpr const char* kSweepSwingsKey = "-50+-25+50";
-const std::vector<std::string> kSwingChoices = {kSweepSwingsKey, "+25", "+10"};
-
-// "-50+-25+50" -> {-50, -25, 50}; "+25" -> {25}.
-std::vector<float> parse_swings(const std::string& key) {
-  std::vector<float> out;
-  std::size_t at = 0;
-  while (at < key.size()) {
-    std::size_t end = key.find('+', at);
-    if (end == std::string::npos) end = key.size();
-    if (end > at) out.push_back(std::stof(key.substr(at, end - at)));
-    at = end + 1;
-  }
-  return out;
-}
-
-using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
-
-// The scene at the baked pose, its atlas and the compared texels.
-struct DoorSetup {
-  BakeInput input;
-  std::uint32_t door = 0;
-  glm::mat4 authored{1.0f};
-  AtlasLayout layout;
-  AtlasTexels texels;
-  std::vector<std::uint8_t> mask;  // per texel: compared
-  std::size_t compared = 0;
-  std::vector<float> swings;  // the moved poses, degrees from the baked one
-
-  // The baked pose and every moved one.
-  std::size_t poses() const { return 1 + swings.size(); }
-
-  glm::mat4 pose(float swing_deg) const {
-    return authored * glm::rotate(glm::mat4(1.0f), glm::radians(swing_deg), glm::vec3(0.0f, 1.0f, 0.0f));
-  }
-  BakeInput posed(float swing_deg) const {
-    BakeInput in = input;
-    in.instances[door].object_to_world = pose(swing_deg);
-    return in;
-  }
-};
-
-engine::Result<DoorSetup> door_setup(const SweepScene& scene, double density, double radius,
-                                     const std::string& swings) {
-  DoorSetup d;
-  d.swings = parse_swings(swings);
-  d.input = bake_input_from(scene.asset);
-  bool found = false;
-  for (std::size_t i = 0; i < d.input.instances.size() && !found; ++i)
-    if (d.input.instances[i].deforming) {
-      d.door = static_cast<std::uint32_t>(i);
-      found = true;
-    }
-  if (!found) return engine::Error{.message = "the scene has no deforming instance (gi.region \"deforming\")"};
-  d.authored = d.input.instances[d.door].object_to_world;
-  const std::vector<AtlasInputMesh> inputs = atlas_inputs_from(d.input);
-  auto layout = build_atlas_layout(inputs, {.texels_per_metre = static_cast<float>(density)});
-  if (!layout) return layout.error();
-  d.layout = std::move(layout).value();
-  d.texels = rasterize_atlas(d.layout, inputs);
-  // The door's swept bounds over the baked pose and the sweep's swings (whatever `swings`
-  // scores, so that every run compares the same texels).
-  glm::vec3 lo(std::numeric_limits<float>::infinity()), hi(-lo);
-  const BakeMesh& mesh = d.input.meshes[d.input.instances[d.door].mesh];
-  for (float swing : {0.0f, kSweepSwings[0], kSweepSwings[1], kSweepSwings[2]}) {
-    const glm::mat4 m = d.pose(swing);
-    for (const BakePrimitive& p : mesh.primitives)
-      for (const glm::vec3& v : p.positions) {
-        const glm::vec3 w(m * glm::vec4(v, 1.0f));
-        lo = glm::min(lo, w);
-        hi = glm::max(hi, w);
-      }
-  }
-  std::vector<std::int32_t> static_instance;  // atlas input mesh -> BakeInput instance
-  for (std::size_t i = 0; i < d.input.instances.size(); ++i)
-    if (d.input.instances[i].mobility == BakeMobility::Static) static_instance.push_back(static_cast<std::int32_t>(i));
-  d.mask.assign(d.texels.valid.size(), 0);
-  for (std::size_t t = 0; t < d.texels.valid.size(); ++t) {
-    if (!d.texels.valid[t] || d.texels.mesh[t] < 0 ||
-        static_cast<std::size_t>(d.texels.mesh[t]) >= static_instance.size())
-      continue;
-    const auto inst = static_cast<std::size_t>(static_instance[static_cast<std::size_t>(d.texels.mesh[t])]);
-    if (d.input.instances[inst].deforming) continue;
-    const glm::vec3 p = d.texels.position[t];
-    const glm::vec3 outside = glm::max(glm::max(lo - p, p - hi), glm::vec3(0.0f));
-    if (glm::length(outside) > static_cast<float>(radius)) continue;
-    d.mask[t] = 1;
-    ++d.compared;
-  }
-  if (d.compared == 0) return engine::Error{.message = "no static atlas texel lies within the radius of the door"};
-  return d;
-}
-
-engine::Result<RgbField> door_reference(const ReferenceJob& job) {
-  const ReferenceRequest& r = job.request;
-  if (std::find(kSwingChoices.begin(), kSwingChoices.end(), r.param("swings")) == kSwingChoices.end())
-    return engine::Error{"<sweep>", r.key(), "unknown swings"};
-  auto d = door_setup(job.scene, std::stod(r.param("texels_per_m")), std::stod(r.param("radius")), r.param("swings"));
-  if (!d) return engine::Error{"<sweep>", r.key(), d.error().message};
-  AtlasTexels masked = d->texels;
-  masked.valid = d->mask;
-  const std::size_t n = masked.valid.size();
-  const std::size_t poses = d->poses();
-  std::vector<glm::vec3> values(n * poses, glm::vec3(0.0f));
-  std::vector<std::uint8_t> valid(n * poses, 0);
-  for (std::size_t k = 0; k < poses; ++k) {
-    ReferenceSettings rs;
-    rs.samples_per_pixel = std::stoi(r.param("spp"));
-    rs.seed = kReferenceSeed;
-    rs.threads = job.threads;
-    if (!r.param("bounces").empty()) rs.max_bounces = std::stoi(r.param("bounces"));
-    if (!r.param("seed").empty()) rs.seed = kReferenceSeed ^ std::stoull(r.param("seed"));
-    const ProgressFn& outer = job.progress;
-    rs.progress = [&outer, k, poses](double f) {
-      return !outer || outer((static_cast<double>(k) + f) / static_cast<double>(poses));
-    };
-    auto truth = reference_atlas_irradiance(d->posed(k == 0 ? 0.0f : d->swings[k - 1]), masked, rs);
-    if (!truth) return truth.error();
-    for (std::size_t t = 0; t < n; ++t)
-      if (d->mask[t]) {
-        values[k * n + t] = truth->indirect[t];
-        valid[k * n + t] = 1;
-      }
-  }
-  return RgbField::from_texels(d->texels.width, d->texels.height * static_cast<int>(poses), values, std::move(valid));
-}
+using namespace antiradiance_sweep;  // the door, its references and scores; the diagnosis runs
 
 // The shared headless GL context of the GPU timings (nullptr when none can be made).
 const engine::GpuContext* gl_context() {
@@ -178,8 +40,6 @@ const engine::GpuContext* gl_context() {
   }();
   return ctx ? &*ctx : nullptr;
 }
-
-glm::vec3 ref_at(const RgbField& f, std::size_t i) { return {f.rgb[3 * i], f.rgb[3 * i + 1], f.rgb[3 * i + 2]}; }
 
 // Long because it is one table: every knob of the method's bake and solve with its grid.
 std::vector<KnobSpec> solve_knobs() {
@@ -280,49 +140,6 @@ std::vector<KnobSpec> solve_knobs() {
   };
 }
 
-// The knobs of the diagnosis (issue 37): the visibility-exact solver on the method's leaves
-// (solve=exact) and the explicit visibility near the door (near_visibility).
-std::vector<KnobSpec> exact_knobs() {
-  return {
-      {.name = "exact_pairs",
-       .description = "solve=exact: Monte Carlo point pairs per leaf pair",
-       .kind = KnobKind::Integer,
-       .default_grid = {"64"},
-       .min_value = 1,
-       .max_value = 4096},
-      {.name = "exact_bounces",
-       .description = "solve=exact: indirect bounces (0: all, to the tolerance; 1: the first bounce only)",
-       .kind = KnobKind::Integer,
-       .default_grid = {"0"},
-       .min_value = 0,
-       .max_value = 64},
-      {.name = "near_visibility",
-       .description = "solve=on: the leaves within near_radius of the door's swept sphere (and the door's) gather "
-                      "their light from every leaf with ray-traced visibility instead of antiradiance (exact_pairs "
-                      "point pairs per leaf pair; blend output only)",
-       .kind = KnobKind::Choice,
-       .default_grid = {"off"},
-       .choices = {"off", "on"}},
-      {.name = "exact_adaptive",
-       .description = "solve=exact: fewer point pairs for leaves smaller than patch^2 / 2 (ExactTransportSettings::"
-                      "reference_area_m2)",
-       .kind = KnobKind::Choice,
-       .default_grid = {"off"},
-       .choices = {"off", "on"}},
-      {.name = "exact_noise",
-       .description = "solve=exact: also solve with exact_seed + 1 and report the change's own noise (exact_noise_rel)",
-       .kind = KnobKind::Choice,
-       .default_grid = {"off"},
-       .choices = {"off", "on"}},
-      {.name = "exact_seed",
-       .description = "solve=exact: the point pairs' seed (two seeds measure the solver's own noise)",
-       .kind = KnobKind::Integer,
-       .default_grid = {"1"},
-       .min_value = 1,
-       .max_value = 1 << 30},
-  };
-}
-
 // The knobs of what is scored: where and at which door angles, against how many samples.
 std::vector<KnobSpec> scoring_knobs() {
   return {
@@ -357,6 +174,14 @@ std::vector<KnobSpec> scoring_knobs() {
        .default_grid = {"0"},
        .min_value = 0,
        .max_value = 1 << 30},
+      {.name = "ref_pair",
+       .description = "the split truth: a second, independent reference (the stream ref_seed = ref_pair gives) "
+                      "rendered with the first, and the change scored with the references' noise removed "
+                      "(split_* columns; 0: one reference only)",
+       .kind = KnobKind::Integer,
+       .default_grid = {"7"},
+       .min_value = 0,
+       .max_value = 1 << 30},
       {.name = "ref_bounces",
        .description = "indirect bounces of the reference (0: all; 1: the first bounce off directly lit surfaces)",
        .kind = KnobKind::Integer,
@@ -383,6 +208,7 @@ ReferenceRequest door_reference_request(const SweepScene&, const KnobSetting& k)
   // Only a bounded reference names its bounces, so the full ones keep their cache keys.
   if (k.integer("ref_bounces") > 0) r.params.emplace_back("bounces", std::to_string(k.integer("ref_bounces")));
   if (k.integer("ref_seed") > 0) r.params.emplace_back("seed", std::to_string(k.integer("ref_seed")));
+  if (k.integer("ref_pair") > 0) r.params.emplace_back("pair", std::to_string(k.integer("ref_pair")));
   return r;
 }
 
@@ -418,84 +244,6 @@ engine::Result<std::uint64_t> stored_bytes(const AntiradianceBake& bake, std::ui
   return bytes;
 }
 
-// The door moves on the CPU twin scored against the reference's changes: the field of every
-// pose, the timings, and the change statistics (correlation sums and per-angle errors).
-struct DoorMoveScores {
-  std::vector<glm::vec3> values;
-  std::vector<std::uint8_t> valid;
-  // The projection floor: every pose's field with the true change passed through the leaves
-  // (project_through_leaves) in place of the method's.
-  std::vector<glm::vec3> floor_values;
-  double move_ms = 0.0, solve_ms = 0.0, output_ms = 0.0;  // output: the change at the texels (gather or blend)
-  double iterations = 0.0, residual = 0.0;  // mean iterations of the moves' solves, largest final residual
-  double unconverged = 0.0;                 // moves whose solve ran out of its budget
-  double so = 0.0, sr = 0.0, soo = 0.0, srr = 0.0, sor = 0.0, samples = 0.0;  // change correlation
-  double level = 0.0;  // mean |E_ref(baked)| per channel over the compared texels
-  std::vector<std::pair<std::string, double>> per_angle;
-
-  void add_solve(const AntiradianceSolveReport& rep, std::size_t moves) {
-    iterations += static_cast<double>(rep.iterations) / static_cast<double>(moves);
-    residual = std::max(residual, rep.residual);
-    unconverged += rep.budget_exhausted ? 1.0 : 0.0;
-  }
-  // Empty fields of every pose; the level of the baked truth.
-  void start(const RgbField& reference, const DoorSetup& d) {
-    const std::size_t n = d.texels.valid.size();
-    values.assign(n * d.poses(), glm::vec3(0.0f));
-    valid.assign(n * d.poses(), 0);
-    floor_values.assign(n * d.poses(), glm::vec3(0.0f));
-    for (std::size_t t = 0; t < n; ++t)
-      if (d.mask[t]) {
-        const glm::vec3 e = ref_at(reference, t);
-        level += static_cast<double>(e.x + e.y + e.z);
-      }
-    level /= 3.0 * static_cast<double>(d.compared);
-  }
-  // Pose k's field (the baked truth plus the change dt per texel) and its scores.
-  void add_pose(const RgbField& reference, const DoorSetup& d, std::size_t k, const std::vector<glm::vec3>& dt) {
-    const std::size_t n = d.texels.valid.size();
-    double err2 = 0.0, change2 = 0.0, mean_o = 0.0, mean_r = 0.0;
-    for (std::size_t t = 0; t < n; ++t) {
-      if (!d.mask[t]) continue;
-      const glm::vec3 base = ref_at(reference, t);
-      values[k * n + t] = base + dt[t];
-      valid[k * n + t] = 1;
-      const glm::vec3 e = dt[t] - (ref_at(reference, k * n + t) - base);
-      err2 += static_cast<double>(glm::dot(e, e));
-      const glm::vec3 c = ref_at(reference, k * n + t) - base;
-      change2 += static_cast<double>(glm::dot(c, c));
-      for (int ch = 0; ch < 3; ++ch) {
-        const double o = static_cast<double>(dt[t][ch]), r = static_cast<double>(c[ch]);
-        mean_o += o, mean_r += r;
-        so += o, sr += r, soo += o * o, srr += r * r, sor += o * r, samples += 1.0;
-      }
-    }
-    const double nrmse = std::sqrt(err2 / (3.0 * static_cast<double>(d.compared))) / level;
-    const int swing = static_cast<int>(d.swings[k - 1]);
-    const std::string name = std::string(swing < 0 ? "m" : "p") + std::to_string(std::abs(swing));
-    per_angle.emplace_back("change_nrmse_swing_" + name, nrmse);
-    // What leaving the baked atlas unchanged scores by the same measure: the true change.
-    per_angle.emplace_back("nothing_nrmse_swing_" + name,
-                           std::sqrt(change2 / (3.0 * static_cast<double>(d.compared))) / level);
-    // The mean over the compared texels (zone averages, as the corridor test compares them):
-    // the true mean change and the error of the method's, both / level.
-    const double count = 3.0 * static_cast<double>(d.compared);
-    per_angle.emplace_back("true_mean_change_swing_" + name, mean_r / count / level);
-    per_angle.emplace_back("mean_change_error_swing_" + name, (mean_o - mean_r) / count / level);
-  }
-  // Pose k's floor: the reference's true change through the leaves, on the baked pose's truth.
-  void add_floor(const RgbField& reference, const DoorSetup& d, const std::vector<AntiradianceTexelBlend>& blends,
-                 std::size_t leaves, std::size_t k) {
-    const std::size_t n = d.texels.valid.size();
-    std::vector<glm::vec3> true_change(n, glm::vec3(0.0f));
-    for (std::size_t t = 0; t < n; ++t)
-      if (d.mask[t]) true_change[t] = ref_at(reference, k * n + t) - ref_at(reference, t);
-    const std::vector<glm::vec3> floor = project_through_leaves(blends, true_change, d.mask, leaves);
-    for (std::size_t t = 0; t < n; ++t)
-      if (d.mask[t]) floor_values[k * n + t] = ref_at(reference, t) + floor[t];
-  }
-};
-
 // The change at the compared texels: blended from the leaves' delta (the runtime's), or
 // gathered at the texels from the solved hierarchy minus the same gather at the baked pose.
 struct TexelOutput {
@@ -528,63 +276,6 @@ struct TexelOutput {
         gather_at_points(region.hierarchy(), region.bins(), region.settings(), region.exitant(), points);
     for (std::size_t i = 0; i < points.size(); ++i) dt[texel[i]] = e[i] - baseline[i];
     return dt;
-  }
-};
-
-// `--knob near_visibility=on` (issue 37, off by default): the leaves near the door (its own,
-// and the static ones within near_radius of its swept sphere) take their indirect light from
-// every leaf through ray-traced visibility (form factors, ExactLeafTransport) instead of the
-// antiradiance links: radiance only, every link of such a receiver tested; the other leaves
-// keep the antiradiance solve's. Its change is this hybrid now minus at the baked pose.
-struct NearVisibility {
-  std::optional<ExactLeafTransport> transport;
-  std::vector<glm::vec3> baseline;  // the hybrid at the baked pose
-  std::size_t receivers = 0;
-  double bake_ms = 0.0, move_ms = 0.0, rays = 0.0, pairs = 0.0;
-
-  engine::Status init(const RunContext& ctx, const DoorSetup& d, AntiradianceRegion& region) {
-    const ElementHierarchy& h = region.hierarchy();
-    const glm::vec3 origin(d.authored[3]);
-    float reach = 0.0f;
-    for (const BakePrimitive& p : d.input.meshes[d.input.instances[d.door].mesh].primitives)
-      for (const glm::vec3& v : p.positions) reach = std::max(reach, glm::length(v));
-    const float near = reach + region.settings().near_radius_m;
-    std::vector<char> mask(h.leaf_count(), 0);
-    for (std::size_t l = 0; l < h.leaf_count(); ++l) {
-      const auto node = static_cast<std::size_t>(h.leaves[l]);
-      const ElementNode& e = h.nodes[node];
-      mask[l] = h.node_instance[node] == static_cast<std::int32_t>(d.door) ||
-                glm::length(e.center - origin) <= near + e.radius_m;
-      receivers += static_cast<std::size_t>(mask[l]);
-    }
-    ExactTransportSettings es;
-    es.point_pairs = static_cast<int>(ctx.knobs.integer("exact_pairs"));
-    es.tolerance = region.settings().residual_tolerance > 0.0 ? region.settings().residual_tolerance : 1e-3;
-    es.seed = static_cast<std::uint64_t>(ctx.knobs.integer("exact_seed"));
-    auto t = ExactLeafTransport::create(d.input, es);
-    if (!t) return t.error();
-    transport.emplace(std::move(t).value());
-    transport->set_receivers(std::move(mask));
-    const auto t0 = Clock::now();
-    region.update(false);  // the direct light at the baked pose
-    transport->update(h);
-    baseline = transport->solve_receivers(h, region.direct(), region.baseline()).irradiance;
-    bake_ms = ms_since(t0);
-    return {};
-  }
-  // After the region moved the door to `m` and solved: the hybrid's change per leaf.
-  std::vector<glm::vec3> delta(const DoorSetup& d, const AntiradianceRegion& region, const glm::mat4& m,
-                               std::size_t moves) {
-    const auto t0 = Clock::now();
-    transport->set_instance_transform(d.door, m);
-    transport->update(region.hierarchy());
-    std::vector<glm::vec3> e =
-        transport->solve_receivers(region.hierarchy(), region.direct(), region.irradiance()).irradiance;
-    move_ms += ms_since(t0) / static_cast<double>(moves);
-    rays += static_cast<double>(transport->last_rays()) / static_cast<double>(moves);
-    pairs += static_cast<double>(transport->last_pairs_computed()) / static_cast<double>(moves);
-    for (std::size_t l = 0; l < e.size(); ++l) e[l] -= baseline[l];
-    return e;
   }
 };
 
@@ -658,20 +349,6 @@ engine::Result<GpuDoorMove> time_gpu_door_move(const DoorSetup& d, AntiradianceR
   return g;
 }
 
-// What changing nothing scores (the baked atlas left as it is) on the same texels: the
-// field with every moved pose's compared texels set back to the reference's baked pose.
-RgbField nothing_changed(const RgbField& field, const RgbField& reference, const DoorSetup& d) {
-  const std::size_t n = d.texels.valid.size();
-  RgbField nothing = field;
-  for (std::size_t k = 1; k < d.poses(); ++k)
-    for (std::size_t t = 0; t < n; ++t)
-      if (d.mask[t])
-        for (int c = 0; c < 3; ++c)
-          nothing.rgb[3 * (k * n + t) + static_cast<std::size_t>(c)] =
-              reference.rgb[3 * t + static_cast<std::size_t>(c)];
-  return nothing;
-}
-
 // The run's extras: the change statistics, the floor, the solves, the costs and sizes.
 std::vector<std::pair<std::string, double>> door_move_extras(const RunContext& ctx, const DoorSetup& d,
                                                              const AntiradianceRegion& region, const DoorMoveScores& sc,
@@ -710,152 +387,7 @@ std::vector<std::pair<std::string, double>> door_move_extras(const RunContext& c
   return extras;
 }
 
-// `--knob solve=off`: the leaves only, the field their projection floor (no solve needed:
-// the true change passed through the leaves), with the leaf counts.
-engine::Result<MethodOutput> run_projection_floor(const RunContext& ctx, const DoorSetup& d,
-                                                  const AntiradianceSettings& s) {
-  const auto t0 = Clock::now();
-  auto h = build_element_hierarchy(d.input, s);
-  if (!h) return h.error();
-  const std::vector<AntiradianceTexelBlend> blends = antiradiance_texel_blends(*h, d.input, d.layout);
-  MethodOutput out;
-  out.costs.bake_seconds = ms_since(t0) / 1000.0;
-  const std::size_t n = d.texels.valid.size();
-  DoorMoveScores sc;
-  sc.floor_values.assign(n * d.poses(), glm::vec3(0.0f));
-  std::vector<std::uint8_t> valid(n * d.poses(), 0);
-  for (std::size_t k = 1; k < d.poses(); ++k) {  // the moved poses, as score_door_moves compares them
-    for (std::size_t t = 0; t < n; ++t) valid[k * n + t] = d.mask[t];
-    sc.add_floor(ctx.reference, d, blends, h->leaf_count(), k);
-  }
-  out.field = RgbField::from_texels(d.texels.width, d.texels.height * static_cast<int>(d.poses()), sc.floor_values,
-                                    std::move(valid));
-  out.extras = {{"projection_floor_rel_rmse", compare_rgb(out.field, ctx.reference).rel_rmse},
-                {"elements", static_cast<double>(h->nodes.size())},
-                {"leaves", static_cast<double>(h->leaf_count())},
-                {"compared_texels", static_cast<double>(d.compared)}};
-  return out;
-}
-
-// One exact solver's door moves (`--knob solve=exact`): the change per leaf blended to the
-// texels of every moved pose (poses 1.., texel-major as the fields), and what it cost.
-struct ExactMoves {
-  std::vector<std::vector<glm::vec3>> dt;  // [pose - 1][texel]
-  double move_ms = 0.0, pairs = 0.0, rays = 0.0, iterations = 0.0, residual = 0.0, base_ms = 0.0;
-  double base_pairs = 0.0;
-};
-
-engine::Result<ExactMoves> exact_door_moves(const RunContext& ctx, const DoorSetup& d, const AntiradianceSettings& s,
-                                            std::uint64_t seed) {
-  auto h = build_element_hierarchy(d.input, s);
-  if (!h) return h.error();
-  const std::vector<AntiradianceTexelBlend> blends = antiradiance_texel_blends(*h, d.input, d.layout);
-  auto direct = AntiradianceDirectLight::create(d.input, s);
-  if (!direct) return direct.error();
-  ExactTransportSettings es;
-  es.point_pairs = static_cast<int>(ctx.knobs.integer("exact_pairs"));
-  if (ctx.knobs.text("exact_adaptive") == "on") es.reference_area_m2 = 0.5f * s.patch_size_m * s.patch_size_m;
-  es.bounces = static_cast<int>(ctx.knobs.integer("exact_bounces"));
-  es.tolerance = s.residual_tolerance > 0.0 ? s.residual_tolerance : 1e-3;
-  es.seed = seed;
-  auto transport = ExactLeafTransport::create(d.input, es);
-  if (!transport) return transport.error();
-  int group = -1;
-  for (std::size_t g = 0; g < h->deforming_instances.size(); ++g)
-    if (h->deforming_instances[g] == d.door) group = static_cast<int>(g + 1);
-  if (group < 0) return engine::Error{.message = "the door is not a deforming group of the hierarchy"};
-  ExactMoves out;
-  const auto t0 = Clock::now();
-  transport->update(*h);
-  out.base_pairs = static_cast<double>(transport->last_pairs_computed());
-  const ExactSolveResult base = transport->solve(*h, direct->update(*h));
-  out.base_ms = ms_since(t0);
-  const double moves = static_cast<double>(d.poses() - 1);
-  for (std::size_t k = 1; k < d.poses(); ++k) {
-    const glm::mat4 m = d.pose(d.swings[k - 1]);
-    const auto t1 = Clock::now();
-    h->set_group_transform(group, m);
-    direct->set_instance_transform(d.door, m);
-    transport->set_instance_transform(d.door, m);
-    transport->update(*h);
-    const ExactSolveResult e = transport->solve(*h, direct->update(*h));
-    out.move_ms += ms_since(t1) / moves;
-    out.pairs += static_cast<double>(transport->last_pairs_computed()) / moves;
-    out.rays += static_cast<double>(transport->last_rays()) / moves;
-    out.iterations += static_cast<double>(e.iterations) / moves;
-    out.residual = std::max(out.residual, e.residual);
-    std::vector<glm::vec3> delta(e.irradiance.size());
-    for (std::size_t l = 0; l < delta.size(); ++l) delta[l] = e.irradiance[l] - base.irradiance[l];
-    std::vector<glm::vec3> dt(d.texels.valid.size(), glm::vec3(0.0f));
-    for (const AntiradianceTexelBlend& b : blends) dt[b.texel] = blend_leaves(b, delta);
-    out.dt.push_back(std::move(dt));
-    if (ctx.progress && !ctx.progress(0.1 + 0.4 * static_cast<double>(k) / moves))
-      return engine::cancelled_error("antiradiance run");
-  }
-  return out;
-}
-
-// `--knob solve=exact`: the visibility-exact solver on the method's leaves and direct light,
-// scored like the method (its change through the same blend); `exact_seed` + 1 in a second
-// solve when exact_noise is set gives the solver's own noise of the change.
-engine::Result<MethodOutput> run_exact_transport(const RunContext& ctx, const DoorSetup& d,
-                                                 const AntiradianceSettings& s) {
-  const auto seed = static_cast<std::uint64_t>(ctx.knobs.integer("exact_seed"));
-  auto a = exact_door_moves(ctx, d, s, seed);
-  if (!a) return a.error();
-  auto h = build_element_hierarchy(d.input, s);
-  if (!h) return h.error();
-  const std::vector<AntiradianceTexelBlend> blends = antiradiance_texel_blends(*h, d.input, d.layout);
-  const std::size_t n = d.texels.valid.size();
-  DoorMoveScores sc;
-  sc.start(ctx.reference, d);
-  for (std::size_t k = 1; k < d.poses(); ++k) {
-    sc.add_floor(ctx.reference, d, blends, h->leaf_count(), k);
-    sc.add_pose(ctx.reference, d, k, a->dt[k - 1]);
-  }
-  const double nan = std::numeric_limits<double>::quiet_NaN();
-  double noise = nan;
-  if (ctx.knobs.text("exact_noise") == "on") {
-    auto b = exact_door_moves(ctx, d, s, seed + 1);
-    if (!b) return b.error();
-    double sum = 0.0, count = 0.0;
-    for (std::size_t k = 0; k < a->dt.size(); ++k)
-      for (std::size_t t = 0; t < n; ++t)
-        if (d.mask[t]) {
-          const glm::vec3 e = a->dt[k][t] - b->dt[k][t];
-          sum += static_cast<double>(glm::dot(e, e)), count += 3.0;
-        }
-    // The difference of two independent estimates has twice the variance of one.
-    noise = std::sqrt(sum / count / 2.0) / sc.level;
-  }
-  const int poses = static_cast<int>(d.poses());
-  MethodOutput out;
-  out.costs.frame_ms = a->move_ms;
-  out.costs.bake_seconds = a->base_ms / 1000.0;
-  const RgbField floor_field =
-      RgbField::from_texels(d.texels.width, d.texels.height * poses, sc.floor_values, sc.valid);
-  out.field = RgbField::from_texels(d.texels.width, d.texels.height * poses, sc.values, std::move(sc.valid));
-  const double cov = sc.sor - sc.so * sc.sr / sc.samples, var_o = sc.soo - sc.so * sc.so / sc.samples,
-               var_r = sc.srr - sc.sr * sc.sr / sc.samples;
-  out.extras = {{"nothing_rel_rmse", compare_rgb(nothing_changed(out.field, ctx.reference, d), ctx.reference).rel_rmse},
-                {"change_correlation", var_o > 0.0 && var_r > 0.0 ? cov / std::sqrt(var_o * var_r) : nan},
-                {"change_fit_scale", sc.soo > 0.0 ? sc.sor / sc.soo : nan},
-                {"projection_floor_rel_rmse", compare_rgb(floor_field, ctx.reference).rel_rmse},
-                {"exact_noise_rel", noise},
-                {"solve_iterations", a->iterations},
-                {"solve_residual_max", a->residual},
-                {"exact_pairs_baked_pose", a->base_pairs},
-                {"exact_pairs_per_move", a->pairs},
-                {"exact_rays_per_move", a->rays}};
-  out.extras.insert(out.extras.end(), sc.per_angle.begin(), sc.per_angle.end());
-  out.extras.insert(out.extras.end(), {{"cpu_move_ms", a->move_ms},
-                                       {"leaves", static_cast<double>(h->leaf_count())},
-                                       {"compared_texels", static_cast<double>(d.compared)},
-                                       {"level", sc.level}});
-  return out;
-}
-
-engine::Result<MethodOutput> run_door_moves(const RunContext& ctx) {
+engine::Result<MethodOutput> run_on_one_truth(const RunContext& ctx) {
   auto d = door_setup(ctx.scene, ctx.knobs.real("density"), ctx.knobs.real("radius"), ctx.knobs.text("swings"));
   if (!d) return d.error();
   const int poses = static_cast<int>(d->poses());
@@ -905,9 +437,53 @@ engine::Result<MethodOutput> run_door_moves(const RunContext& ctx) {
     out.extras.insert(out.extras.end(), {{"near_visibility_receivers", static_cast<double>(near.receivers)},
                                          {"near_visibility_bake_ms", near.bake_ms},
                                          {"near_visibility_move_ms", near.move_ms},
+                                         {"near_visibility_update_ms", near.update_ms},
+                                         {"near_visibility_iterations", near.iterations},
                                          {"near_visibility_pairs_per_move", near.pairs},
                                          {"near_visibility_rays_per_move", near.rays}});
   }
+  return out;
+}
+
+// A run: scored against the first reference as always; with `ref_pair` the reference holds
+// a second one below it (door_reference), and the split truth's scores join the extras.
+engine::Result<MethodOutput> run_door_moves(const RunContext& ctx) {
+  if (ctx.knobs.integer("ref_pair") == 0) return run_on_one_truth(ctx);
+  if (ctx.knobs.integer("ref_pair") == ctx.knobs.integer("ref_seed"))
+    return engine::Error{.message = "ref_pair must name another stream than ref_seed"};
+  const RgbField& both = ctx.reference;
+  if (both.height % 2 != 0 || both.valid.size() != both.count())
+    return engine::Error{.message = "the paired reference is not two masked halves"};
+  RgbField a, b;
+  for (RgbField* half : {&a, &b}) {
+    const std::size_t offset = half == &a ? 0 : both.count() / 2;
+    half->width = both.width;
+    half->height = both.height / 2;
+    half->rgb.assign(both.rgb.begin() + static_cast<std::ptrdiff_t>(3 * offset),
+                     both.rgb.begin() + static_cast<std::ptrdiff_t>(3 * (offset + half->count())));
+    half->valid.assign(both.valid.begin() + static_cast<std::ptrdiff_t>(offset),
+                       both.valid.begin() + static_cast<std::ptrdiff_t>(offset + half->count()));
+  }
+  const RunContext first{.scene = ctx.scene,
+                         .knobs = ctx.knobs,
+                         .request = ctx.request,
+                         .reference = a,
+                         .seed = ctx.seed,
+                         .threads = ctx.threads,
+                         .progress = ctx.progress,
+                         .split_truth = ctx.split_truth};
+  auto out = run_on_one_truth(first);
+  if (!out) return out;
+  if (ctx.knobs.text("solve") != "off") {  // the floor's field carries the first reference's noise
+    auto d = door_setup(ctx.scene, ctx.knobs.real("density"), ctx.knobs.real("radius"), ctx.knobs.text("swings"));
+    if (!d) return d.error();
+    for (auto& e : split_truth_extras(*d, out->field, a, b)) out->extras.push_back(std::move(e));
+  }
+  // The output in the reference's layout: the second half is not the run's to match.
+  if (out->field.valid.empty()) out->field.valid.assign(out->field.count(), 1);
+  out->field.height *= 2;
+  out->field.rgb.resize(3 * out->field.count(), 0.0f);
+  out->field.valid.resize(out->field.count(), 0);
   return out;
 }
 

@@ -174,6 +174,13 @@ TEST(ExactLeafTransport, TheReceiversSolveHoldsTheOthersAndMeetsTheFullSolve) {
     }
     EXPECT_NEAR(r.irradiance[l].x, e.irradiance[l].x, 1e-4f * e.irradiance[l].x);
   }
+  // Started from its own solution, the receivers' solve stops at once, where it was.
+  const gi::ExactSolveResult warm = part->solve_receivers(*h, direct, e.irradiance, r.irradiance);
+  EXPECT_TRUE(warm.converged);
+  EXPECT_LT(warm.iterations, r.iterations);
+  EXPECT_LE(warm.iterations, 2);
+  for (std::size_t l = 0; l < h->leaf_count(); ++l)
+    EXPECT_NEAR(warm.irradiance[l].x, r.irradiance[l].x, 1e-5f * r.irradiance[l].x + 1e-9f);
   // No direct light and the others held dark: the receivers get nothing.
   std::vector<glm::vec3> dark(h->leaf_count(), glm::vec3(0.0f));
   const gi::ExactSolveResult no_direct = part->solve_receivers(*h, dark, dark);
@@ -259,6 +266,57 @@ TEST(ExactLeafTransport, ADoorMoveRecomputesOnlyWhatItCanChange) {
       differ += fresh->coupling(i, j) != first[k];
     }
   EXPECT_GT(differ, 0u);  // the move did change some pairs
+}
+
+// With the visibility kept (reuse_visibility), a door move traces only the samples whose
+// segment meets the door's boxes before or after the move, fewer rays than tracing every
+// sample of the same pairs, and the couplings are still bit for bit a fresh computation's at
+// the new pose (the traced one's, which ADoorMoveRecomputesOnlyWhatItCanChange checks against
+// a fresh computation) and, moved back, the first pose's.
+TEST(ExactLeafTransport, KeptVisibilityTracesOnlyTheDoorsSegmentsAndChangesNothing) {
+  const artest::DoorScene a = artest::door_scene(90.0f);
+  gi::AntiradianceSettings s;
+  s.patch_size_m = 0.5f;
+  auto h = gi::build_element_hierarchy(a.input, s);
+  ASSERT_TRUE(h) << h.error().to_string();
+  h->set_group_transform(1, artest::hinge_matrix(90.0f));
+  gi::ExactTransportSettings es;
+  es.point_pairs = 16;
+  gi::ExactTransportSettings kept = es;
+  kept.reuse_visibility = true;
+  auto traced = gi::ExactLeafTransport::create(a.input, es);
+  auto reused = gi::ExactLeafTransport::create(a.input, kept);
+  ASSERT_TRUE(traced && reused);
+  traced->update(*h);
+  reused->update(*h);
+  EXPECT_EQ(reused->last_rays(), traced->last_rays());  // the first update traces everything
+  const std::size_t n = h->leaf_count();
+  std::vector<float> first;
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t j = i + 1; j < n; ++j) first.push_back(reused->coupling(i, j));
+  for (float angle : {30.0f, 90.0f}) {
+    const glm::mat4 m = artest::hinge_matrix(angle);
+    h->set_group_transform(1, m);
+    for (gi::ExactLeafTransport* t : {&*traced, &*reused}) {
+      t->set_instance_transform(a.door, m);
+      t->update(*h);
+    }
+    EXPECT_EQ(reused->last_pairs_computed(), traced->last_pairs_computed());
+    EXPECT_LT(reused->last_rays(), traced->last_rays()) << angle;
+    std::printf("door to %.0f deg: %zu pairs, %zu rays traced, %zu with the visibility kept\n",
+                static_cast<double>(angle), traced->last_pairs_computed(), traced->last_rays(), reused->last_rays());
+    for (std::size_t i = 0; i < n; ++i)
+      for (std::size_t j = i + 1; j < n; ++j)
+        ASSERT_EQ(reused->coupling(i, j), traced->coupling(i, j)) << angle << ": " << i << " " << j;
+  }
+  std::size_t k = 0;
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t j = i + 1; j < n; ++j, ++k) ASSERT_EQ(reused->coupling(i, j), first[k]) << i << " " << j;
+  EXPECT_FALSE(gi::ExactLeafTransport::create(a.input, [&] {
+    gi::ExactTransportSettings too_many = kept;
+    too_many.point_pairs = 65;
+    return too_many;
+  }()));
 }
 
 }  // namespace

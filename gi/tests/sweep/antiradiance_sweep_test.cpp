@@ -66,6 +66,14 @@ TEST(AntiradianceSweep, CorridorDoorSwingRunIsMeasured) {
   EXPECT_GT(extra("solve_iterations"), 0.0);
   // The door changes the light: the path tracer's change is not zero.
   EXPECT_GT(extra("nothing_rel_rmse"), 0.0);
+  // The split truth (ref_pair's second reference): the references' noise is measured and
+  // removed, so changing nothing scores less than against the first reference alone.
+  std::printf("  split truth: rel RMSE %.4f (changing nothing %.4f), correlation %.3f, one reference's noise %.4f\n",
+              extra("split_rel_rmse"), extra("split_nothing_rel_rmse"), extra("split_change_correlation"),
+              extra("split_ref_noise_rel_rmse"));
+  EXPECT_GT(extra("split_ref_noise_rel_rmse"), 0.0);
+  EXPECT_LT(extra("split_nothing_rel_rmse"), extra("nothing_rel_rmse"));
+  EXPECT_TRUE(std::isfinite(extra("split_rel_rmse")));
   for (const char* swing : {"m50", "m25", "p50"}) {
     const double truth = extra(std::string("true_mean_change_swing_") + swing);
     const double error = extra(std::string("mean_change_error_swing_") + swing);
