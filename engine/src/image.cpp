@@ -108,7 +108,13 @@ std::string exr_window_problem(std::int64_t width, std::int64_t height) {
 // one of those, else its first problem (the window's before the others').
 std::string exr_header_problem(const std::vector<unsigned char>& bytes) {
   std::size_t at = 8;  // after the magic number and the version field
-  std::string name, type, window, part, compression, channels = "no channel list";
+  std::string name, type, window, part, compression, channels;
+  bool listed = false;
+  // Each problem is kept once found: an attribute repeated later (a second "type", empty)
+  // must not clear what tinyexr may still act on.
+  const auto note = [](std::string& slot, std::string problem) {
+    if (slot.empty()) slot = std::move(problem);
+  };
   for (;;) {
     if (at >= bytes.size()) return "the header ends before its attributes do";
     if (bytes[at] == 0) break;
@@ -122,26 +128,25 @@ std::string exr_header_problem(const std::vector<unsigned char>& bytes) {
     at = end;
     if (name == "dataWindow" && size == 16) {
       const std::int64_t min_x = read_exr_int(bytes, data), min_y = read_exr_int(bytes, data + 4);
-      window = exr_window_problem(std::int64_t{read_exr_int(bytes, data + 8)} - min_x + 1,
-                                  std::int64_t{read_exr_int(bytes, data + 12)} - min_y + 1);
+      note(window, exr_window_problem(std::int64_t{read_exr_int(bytes, data + 8)} - min_x + 1,
+                                      std::int64_t{read_exr_int(bytes, data + 12)} - min_y + 1));
     } else if (name == "type") {
       // tinyexr reads the value up to its first NUL; an empty one it ignores.
       const std::string value(bytes.begin() + static_cast<std::ptrdiff_t>(data),
                               std::find(bytes.begin() + static_cast<std::ptrdiff_t>(data),
                                         bytes.begin() + static_cast<std::ptrdiff_t>(end), 0));
-      part = value.empty() || value == "scanlineimage"
-                 ? ""
-                 : "part type '" + value.substr(0, 64) + "' (scanlineimage expected)";
+      if (!value.empty() && value != "scanlineimage")
+        note(part, "part type '" + value.substr(0, 64) + "' (scanlineimage expected)");
     } else if (name == "compression") {
       const unsigned c = size == 1 ? bytes[data] : 255u;
-      compression =
-          c == TINYEXR_COMPRESSIONTYPE_NONE || c == TINYEXR_COMPRESSIONTYPE_ZIPS || c == TINYEXR_COMPRESSIONTYPE_ZIP
-              ? ""
-              : "compression " + std::to_string(c) + " (none, ZIPS or ZIP expected)";
+      if (c != TINYEXR_COMPRESSIONTYPE_NONE && c != TINYEXR_COMPRESSIONTYPE_ZIPS && c != TINYEXR_COMPRESSIONTYPE_ZIP)
+        note(compression, "compression " + std::to_string(c) + " (none, ZIPS or ZIP expected)");
     } else if (name == "channels") {
-      channels = exr_channel_list_problem(bytes, data, end);
+      note(channels, exr_channel_list_problem(bytes, data, end));
+      listed = true;
     }
   }
+  if (!listed) note(channels, "no channel list");
   for (const std::string* problem : {&window, &part, &compression, &channels})
     if (!problem->empty()) return *problem;
   return {};
