@@ -207,6 +207,12 @@ int main(int argc, char** argv) {
   gi::ThreadPool pool(2);
   gi::TexelGatherSettings g = s.gather;
   g.seed = s.seed;
+  // GI_GATHER_ADAPTIVE=share:passes: the preset's gather with adaptive passes (TexelGatherSettings::adaptive_share).
+  if (const char* a = std::getenv("GI_GATHER_ADAPTIVE")) {
+    char* rest = nullptr;
+    g.adaptive_share = std::strtof(a, &rest);
+    if (*rest == ':') g.adaptive_passes = static_cast<int>(std::strtol(rest + 1, nullptr, 10));
+  }
   constexpr std::uint64_t kYardstickRays = 16u << 20;
   raw_embree_rays(*scene, kYardstickRays, pool);
   for (int run = 0; run < runs; ++run) {
