@@ -67,7 +67,7 @@ std::vector<KnobSpec> dlm_knobs() {
        .choices = {"raster", "visible_surface"}},
       {.name = "bins",
        .description = "global (one set of directions, the renderer's) or tangent (per texel about its normal, "
-                      "measurement only: docs/dlm.md, 'The corridor's grazing band')",
+                      "the renderer reads both: docs/dlm.md, 'Tangent-frame bins in the renderer')",
        .kind = KnobKind::Choice,
        .default_grid = {"global"},
        .choices = {"global", "tangent"}},
@@ -164,6 +164,11 @@ engine::Result<MethodOutput> run_dlm(const RunContext& ctx) {
   std::vector<glm::vec3> atlas_values(tex.valid.size(), glm::vec3(0.0f));
   std::vector<std::uint8_t> mask(tex.valid.size(), 0);
   std::vector<glm::vec3> l(dlm->directions.size());
+  // Tangent-frame bins: the same C_k at every normal (as the bake computes them).
+  const std::vector<float> tangent_weights =
+      dlm->settings.tangent_frame_bins
+          ? dlm_bin_cosine_weights(dlm->directions, glm::vec3(0.0f, 0.0f, 1.0f), kDlmTangentQuadrature)
+          : std::vector<float>{};
   for (std::size_t i = 0; i < dlm->texels.size(); ++i) {
     const std::uint32_t t = dlm->texels[i];
     if (!g->glossy[t]) continue;
@@ -174,7 +179,8 @@ engine::Result<MethodOutput> run_dlm(const RunContext& ctx) {
     const glm::vec3 v = glm::normalize(g->eye - tex.position[t]);
     const std::vector<glm::vec3> directions = dlm_texel_directions(*dlm, tex.normal[t]);
     values[t] = engine::directional_specular(g->brdf[t], tex.normal[t], v, directions, l);
-    const std::vector<float> c = dlm_bin_cosine_weights(directions, tex.normal[t]);
+    const std::vector<float> c =
+        dlm->settings.tangent_frame_bins ? tangent_weights : dlm_bin_cosine_weights(directions, tex.normal[t]);
     glm::vec3 e(0.0f);
     for (std::size_t k = 0; k < l.size(); ++k) e += c[k] * l[k];
     atlas_values[t] =
