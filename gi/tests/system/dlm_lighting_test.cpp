@@ -377,14 +377,15 @@ TEST(DlmLighting, GISystemLoadsTheGlossyRoomsMapsAndRefusesADamagedFile) {
     auto gi_system = gi::GISystem::load(dir, scene);
     ASSERT_TRUE(gi_system) << gi_system.error().to_string();
     EXPECT_NE(std::string((*gi_system)->label()).find("DLM"), std::string::npos) << (*gi_system)->label();
-    EXPECT_NE((*gi_system)->describe().find("DLM: 32 directions"), std::string::npos) << (*gi_system)->describe();
+    EXPECT_NE((*gi_system)->describe().find("DLM: 64 directions"), std::string::npos) << (*gi_system)->describe();
     // Baked as told: the plan routes the floor (0.15) to the reflection probes (docs/plan.md, "Routing").
     EXPECT_NE((*gi_system)->describe().find("plan dlm: off"), std::string::npos) << (*gi_system)->describe();
     EXPECT_GT((*gi_system)->stats().dlm_texels, 0u);
     EXPECT_GT((*gi_system)->stats().dlm_gpu_bytes, 0u);
     const engine::IndirectLightFrame& frame = (*gi_system)->frame();
     EXPECT_TRUE(frame.directional_index_texture);
-    EXPECT_EQ(frame.directional_bin_count, 32);
+    EXPECT_EQ(frame.directional_bin_count, 64);
+    EXPECT_TRUE(frame.directional_tangent_frame);  // the presets bake tangent-frame bins
     EXPECT_EQ(static_cast<std::size_t>(frame.directional_element_count), (*gi_system)->stats().dlm_texels);
   }
   {
