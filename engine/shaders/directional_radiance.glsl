@@ -3,7 +3,10 @@
 // the two equal). Include after gltf_brdf.glsl.
 //
 // Data (engine/indirect_light.h, IndirectLightFrame::directional_*):
-//   DirectionalDirections  vec4 per bin: xyz the unit direction psi_k, w the bin's layer scale
+//   DirectionalDirections  vec4 per bin: xyz the unit direction psi_k, w the bin's layer scale;
+//                          with tangent-frame bins (IndirectLightFrame::directional_tangent_frame)
+//                          psi_k is in the frame directional_tangent_frame(n_bins) of the surface's
+//                          vertex normal, so a lobe sample l reads the bin nearest (l.t, l.b, l.n_bins)
 //   DirectionalRadiance    uvec2 per (bin, element), bin-major: packHalf2x16(r, g),
 //                          packHalf2x16(b, 0); radiance = unpacked x the bin's scale (W/(m^2 sr))
 
@@ -63,6 +66,13 @@ vec2 directional_lobe_sample_point(int j) {
   return vec2((float(j) + 0.5) / float(DIRECTIONAL_LOBE_SAMPLES), float(bits) * 2.3283064365386963e-10);
 }
 
+// engine::directional_tangent_frame: t = the x axis (y when |n.x| > 0.9) made orthogonal to n, b = n x t.
+void directional_tangent_frame(vec3 n, out vec3 t, out vec3 b) {
+  t = abs(n.x) > 0.9 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0);
+  t = normalize(t - n * dot(n, t));
+  b = cross(n, t);
+}
+
 int directional_bin_of(vec3 l, int bin_count) {
   int best = -1;
   float best_dot = -2.0;
@@ -76,13 +86,19 @@ int directional_bin_of(vec3 l, int bin_count) {
   return best;
 }
 
-// L_spec of engine::directional_specular for the bins blended over the footprint `texels`.
-vec3 directional_specular(GltfBrdf m, vec3 n, vec3 v, DirectionalTexels texels, int bin_count, int element_count) {
+// L_spec of engine::directional_specular for the bins blended over the footprint `texels`;
+// `tangent_bins`: the bins are in the tangent frame of `bin_normal` (unit, the vertex normal).
+vec3 directional_specular(GltfBrdf m, vec3 n, vec3 v, DirectionalTexels texels, int bin_count, int element_count,
+                          bool tangent_bins, vec3 bin_normal) {
   float a = m.alpha;
   float n_dot_v = max(dot(n, v), 1e-4);
-  vec3 t = abs(n.x) > 0.9 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0);
-  t = normalize(t - n * dot(n, t));
-  vec3 b = cross(n, t);
+  vec3 t, b;
+  directional_tangent_frame(n, t, b);
+  vec3 bin_t = vec3(1.0, 0.0, 0.0), bin_b = vec3(0.0, 1.0, 0.0), bin_n = vec3(0.0, 0.0, 1.0);
+  if (tangent_bins) {
+    bin_n = bin_normal;
+    directional_tangent_frame(bin_n, bin_t, bin_b);
+  }
   vec3 ve = vec3(dot(v, t), dot(v, b), n_dot_v);
   vec3 vh = normalize(vec3(a * ve.x, a * ve.y, ve.z));
   float lensq = vh.x * vh.x + vh.y * vh.y;
@@ -104,7 +120,8 @@ vec3 directional_specular(GltfBrdf m, vec3 n, vec3 v, DirectionalTexels texels, 
     vec3 l = 2.0 * dot(v, h) * h - v;
     float n_dot_l = dot(n, l);
     if (!(n_dot_l > 0.0)) continue;
-    int k = directional_bin_of(l, bin_count);
+    vec3 l_bins = tangent_bins ? vec3(dot(l, bin_t), dot(l, bin_b), dot(l, bin_n)) : l;
+    int k = directional_bin_of(l_bins, bin_count);
     if (k < 0) continue;
     float fresnel_w = gltf_schlick_weight(dot(v, h));
     vec3 fresnel =
@@ -119,9 +136,10 @@ vec3 directional_specular(GltfBrdf m, vec3 n, vec3 v, DirectionalTexels texels, 
 }
 
 // L_spec for stored element `element` alone.
-vec3 directional_specular(GltfBrdf m, vec3 n, vec3 v, int element, int bin_count, int element_count) {
+vec3 directional_specular(GltfBrdf m, vec3 n, vec3 v, int element, int bin_count, int element_count, bool tangent_bins,
+                          vec3 bin_normal) {
   return directional_specular(m, n, v, DirectionalTexels(ivec4(element, -1, -1, -1), vec4(1.0, 0.0, 0.0, 0.0)),
-                              bin_count, element_count);
+                              bin_count, element_count, tangent_bins, bin_normal);
 }
 
 // The footprint of uv1 point `uv` over the index texture (texel centres at (i + 0.5) / size):

@@ -70,6 +70,8 @@ uniform vec3 u_specular_color_factor;  // KHR_materials_specular
 // Directional radiance of static surfaces (engine/indirect_light.h): bins and elements, 0: none.
 uniform int u_directional_bins;
 uniform int u_directional_elements;
+// 1: the bins are in the tangent frame of the vertex normal (IndirectLightFrame::directional_tangent_frame).
+uniform int u_directional_tangent_frame;
 // The scene's sky (RenderSettings::sky_radiance), W/(m^2 sr): unshadowed ambient direct light.
 uniform vec3 u_sky_radiance;
 // The sky's gradient (RenderSettings::sky_gradient, engine/sky.h): horizon, zenith - horizon,
@@ -219,8 +221,11 @@ void main() {
       // Bilinear over the texels with maps (directional_footprint), where the texel under v_uv1 has them.
       int element;
       DirectionalTexels texels = directional_footprint(u_directional_index, v_uv1, element);
+      // Tangent-frame bins turn about the vertex normal (the bake's texel normal), not the normal-mapped one.
+      vec3 bin_normal = normalize(v_normal) * (u_double_sided != 0 && !gl_FrontFacing ? -1.0 : 1.0);
       if (element >= 0)
-        specular = directional_specular(s.brdf, s.normal, s.view, texels, u_directional_bins, u_directional_elements);
+        specular = directional_specular(s.brdf, s.normal, s.view, texels, u_directional_bins, u_directional_elements,
+                                        u_directional_tangent_frame != 0, bin_normal);
     }
     // A dynamic mesh's per-vertex radiance lobes replace the specular lobe's share (the diffuse keeps E).
     if (u_indirect_mode == 3 && u_lobe_terms > 0) specular = v_lobe_radiance;

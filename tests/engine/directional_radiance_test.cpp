@@ -1,7 +1,8 @@
 // Specular reflection of per-bin directional radiance (engine/directional_radiance.h): the
 // GLSL twin (engine/shaders/directional_radiance.glsl) evaluated on the GPU agrees with the C++
 // on a grid of materials, views and random radiance, the data in the packed layout the
-// renderer reads (RGB halves with a per-bin scale).
+// renderer reads (RGB halves with a per-bin scale); with global bins and with tangent-frame
+// bins (a hemisphere set in the frame directional_tangent_frame of the normal).
 #define GL_GLEXT_PROTOTYPES
 #include <GL/glcorearb.h>
 #include <gtest/gtest.h>
@@ -39,12 +40,15 @@ layout(std430, binding = 1) writeonly buffer Outs { vec4 outs[]; };
 layout(location = 0) uniform uint u_count;
 layout(location = 1) uniform int u_bins;
 layout(location = 2) uniform int u_elements;
+layout(location = 3) uniform int u_tangent;
 void main() {
   uint i = gl_GlobalInvocationID.x;
   if (i >= u_count) return;
   Case c = cases[i];
   GltfBrdf m = gltf_brdf(c.base_metallic.rgb, c.base_metallic.w, c.n_roughness.w, 1.0, vec3(1.0));
-  outs[i] = vec4(directional_specular(m, c.n_roughness.xyz, c.v.xyz, int(c.v.w), u_bins, u_elements), 0.0);
+  outs[i] = vec4(directional_specular(m, c.n_roughness.xyz, c.v.xyz, int(c.v.w), u_bins, u_elements, u_tangent != 0,
+                                      c.n_roughness.xyz),
+                 0.0);
 }
 )glsl";
 
@@ -59,11 +63,23 @@ std::vector<glm::vec3> fibonacci(int n) {
   return d;
 }
 
-TEST(DirectionalRadiance, GlslTwinAgreesWithTheCpp) {
+// n directions on the hemisphere z > 0, equal areas (as gi::dlm_hemisphere_directions).
+std::vector<glm::vec3> hemisphere(int n) {
+  std::vector<glm::vec3> d;
+  const double golden = std::numbers::pi * (3.0 - std::sqrt(5.0));
+  for (int i = 0; i < n; ++i) {
+    const double z = 1.0 - (i + 0.5) / n, r = std::sqrt(1.0 - z * z), phi = golden * i;
+    d.emplace_back(static_cast<float>(r * std::cos(phi)), static_cast<float>(r * std::sin(phi)), static_cast<float>(z));
+  }
+  return d;
+}
+
+// The GPU against the C++ on every case; `tangent`: 64 tangent-frame bins, else 32 global ones.
+void twin_agrees(bool tangent) {
   auto ctx = engine::GpuContext::create_headless();
   ASSERT_TRUE(ctx.ok()) << ctx.error().to_string();
-  const int bins = 32, elements = 5;
-  const std::vector<glm::vec3> dirs = fibonacci(bins);
+  const int bins = tangent ? 64 : 32, elements = 5;
+  const std::vector<glm::vec3> dirs = tangent ? hemisphere(bins) : fibonacci(bins);
   // Radiance per (bin, element): random over four decades, some bins empty; stored as the
   // renderer reads it (halves / a power-of-two scale per bin), and the C++ gets the decoded values.
   std::mt19937 rng(7);
@@ -119,6 +135,7 @@ TEST(DirectionalRadiance, GlslTwinAgreesWithTheCpp) {
   glUniform1ui(0, static_cast<GLuint>(cases.size()));
   glUniform1i(1, bins);
   glUniform1i(2, elements);
+  glUniform1i(3, tangent ? 1 : 0);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, in.id());
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, out.id());
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, radiance.id());
@@ -137,7 +154,9 @@ TEST(DirectionalRadiance, GlslTwinAgreesWithTheCpp) {
     const engine::GltfBrdf m =
         engine::gltf_brdf(glm::vec3(c.base_metallic), c.base_metallic.w, c.n_roughness.w, 1.0f, glm::vec3(1.0f));
     const auto e = static_cast<std::size_t>(c.v.w);
-    const glm::vec3 cpu = engine::directional_specular(m, glm::vec3(c.n_roughness), glm::vec3(c.v), dirs, decoded[e]);
+    const glm::vec3 n(c.n_roughness);
+    const glm::vec3* bin_normal = tangent ? &n : nullptr;
+    const glm::vec3 cpu = engine::directional_specular(m, n, glm::vec3(c.v), dirs, decoded[e], bin_normal);
     const glm::vec3 g(gpu[i]);
     const float scale = std::max({cpu.x, cpu.y, cpu.z, 1e-6f});
     const float d = std::max({std::fabs(g.x - cpu.x), std::fabs(g.y - cpu.y), std::fabs(g.z - cpu.z)}) / scale;
@@ -149,8 +168,8 @@ TEST(DirectionalRadiance, GlslTwinAgreesWithTheCpp) {
     // counted, not compared.
     bool boundary = false;
     for (const glm::vec3 dv : {glm::vec3(1e-4f, 0, 0), glm::vec3(0, 0, 1e-4f), glm::vec3(0, 1e-4f, 0)}) {
-      const glm::vec3 moved = engine::directional_specular(m, glm::vec3(c.n_roughness),
-                                                           glm::normalize(glm::vec3(c.v) + dv), dirs, decoded[e]);
+      const glm::vec3 moved =
+          engine::directional_specular(m, n, glm::normalize(glm::vec3(c.v) + dv), dirs, decoded[e], bin_normal);
       for (int ch = 0; ch < 3; ++ch) boundary = boundary || std::fabs(moved[ch] - cpu[ch]) > 1e-2f * scale;
     }
     if (boundary) {
@@ -166,8 +185,15 @@ TEST(DirectionalRadiance, GlslTwinAgreesWithTheCpp) {
   }
   EXPECT_GT(nonzero, cases.size() / 2);
   EXPECT_LT(on_boundary, cases.size() / 50);
-  std::printf("%zu cases (%zu on a bin boundary skipped): worst relative difference GLSL vs C++ %.2e\n", cases.size(),
-              on_boundary, static_cast<double>(worst));
+  std::printf("%s bins: %zu cases (%zu on a bin boundary skipped): worst relative difference GLSL vs C++ %.2e\n",
+              tangent ? "tangent-frame" : "global", cases.size(), on_boundary, static_cast<double>(worst));
 }
+
+TEST(DirectionalRadiance, GlslTwinAgreesWithTheCpp) { twin_agrees(false); }
+
+// Tangent-frame bins: the lobe samples turned into the frame of the normal, on the GPU as in
+// the C++ (one frame function, engine::directional_tangent_frame and its GLSL twin), also at
+// the normal (1, 0, 0) where the frame's first axis switches.
+TEST(DirectionalRadiance, GlslTwinAgreesWithTheCppForTangentFrameBins) { twin_agrees(true); }
 
 }  // namespace

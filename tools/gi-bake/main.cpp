@@ -78,6 +78,8 @@ void add_bake_options(CLI::App& app, ToolOptions& t, gi::BakeOptions& o) {
   app.add_option("--brf-spheres", o.brf_spheres, "Override the preset's BRF field spheres")->check(CLI::Range(1, 256));
   app.add_option("--dlm-directions", o.dlm_directions, "Override the DLM's direction count")->check(CLI::Range(8, 256));
   app.add_option("--dlm-photons", o.dlm_photons, "Override the DLM's photon paths")->check(CLI::PositiveNumber);
+  app.add_option("--dlm-bins", o.dlm_bins, "Override the DLM's bins: tangent (each texel's frame) or global")
+      ->check(CLI::IsMember({"tangent", "global"}));
   app.add_flag("--include-direct", o.include_direct,
                "Bake the static lights' direct light into the atlas too (the renderer then draws none of theirs on "
                "the static world); without it the atlas holds the indirect light and the sky's shadowed direct light");

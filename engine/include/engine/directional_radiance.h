@@ -21,6 +21,14 @@
 // version (horizon bins folded upwards, the lobe widened by half a bin, Fresnel-free weights
 // renormalized to the Fresnel-weighted albedo) are tested in gi/tests/dlm/dlm_lookup_test.cpp.
 //   glm::vec3 s = engine::directional_specular(brdf, n, v, dirs, radiance);
+//
+// Tangent-frame bins (a provider's option, docs/dlm.md "Tangent-frame bins in the renderer"):
+// the directions are given in the tangent frame (t, b, n) of the surface's own normal n_bins
+// (directional_tangent_frame, the one frame of the C++, the GLSL and the bake), usually on the
+// hemisphere z > 0, so every bin lies above the horizon. A lobe sample l then reads the bin
+// nearest (l.t, l.b, l.n_bins). n_bins is the geometric (vertex) normal the bins were baked at,
+// not a normal-mapped one.
+//   glm::vec3 s = engine::directional_specular(brdf, n, v, hemisphere_dirs, radiance, &n);
 
 #include <cstdint>
 #include <span>
@@ -37,12 +45,18 @@ inline constexpr int kDirectionalLobeSamples = 16;
 /// Sample point j of kDirectionalLobeSamples in [0, 1)^2 (Hammersley).
 glm::vec2 directional_lobe_sample_point(int j);
 
+/// The frame (t, b, n) about unit n used for the lobe samples and for tangent-frame bins:
+/// t = the x axis (the y axis when |n.x| > 0.9) made orthogonal to n, b = n x t.
+void directional_tangent_frame(const glm::vec3& n, glm::vec3& t, glm::vec3& b);
+
 /// The bin a direction l falls in: the nearest direction psi_k; -1 when there is none.
 int directional_bin_of(std::span<const glm::vec3> directions, const glm::vec3& l);
 
 /// L_spec above. `directions` (unit) and `radiance` have the same size; n and v unit, v on
-/// the side of n. Returns 0 without bins.
+/// the side of n. Returns 0 without bins. With `bin_normal` the directions are tangent-frame
+/// bins about *bin_normal (unit; directional_tangent_frame), else world-space ones.
 glm::vec3 directional_specular(const GltfBrdf& m, const glm::vec3& n, const glm::vec3& v,
-                               std::span<const glm::vec3> directions, std::span<const glm::vec3> radiance);
+                               std::span<const glm::vec3> directions, std::span<const glm::vec3> radiance,
+                               const glm::vec3* bin_normal = nullptr);
 
 }  // namespace engine

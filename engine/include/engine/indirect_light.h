@@ -155,12 +155,16 @@ struct IndirectLightFrame {
   ///                                  index of each texel, -1 where there is none (read nearest)
   ///   directional_radiance_buffer    one DirectionalRadiance per (bin, element), bin-major
   ///   directional_direction_buffer   one DirectionalBin per bin
+  ///   directional_tangent_frame      false: the bins' directions are world space; true: they
+  ///                                  are in the tangent frame of each surface point's vertex
+  ///                                  normal (engine::directional_tangent_frame)
   /// Empty handles / 0 counts: none.
   TextureHandle directional_index_texture;
   SsboHandle<DirectionalRadiance> directional_radiance_buffer;
   SsboHandle<DirectionalBin> directional_direction_buffer;
   int directional_bin_count = 0;
   int directional_element_count = 0;
+  bool directional_tangent_frame = false;
 
   /// Optional reflection probes (gi fills them from baked probes, docs/reflection_probes.md):
   /// prefiltered cube maps of the static world's radiance, each with a box for parallax. On

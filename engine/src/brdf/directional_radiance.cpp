@@ -17,6 +17,12 @@ glm::vec2 directional_lobe_sample_point(int j) {
           static_cast<float>(bits) * 2.3283064365386963e-10f};
 }
 
+void directional_tangent_frame(const glm::vec3& n, glm::vec3& t, glm::vec3& b) {
+  t = std::fabs(n.x) > 0.9f ? glm::vec3(0.0f, 1.0f, 0.0f) : glm::vec3(1.0f, 0.0f, 0.0f);
+  t = glm::normalize(t - n * glm::dot(n, t));
+  b = glm::cross(n, t);
+}
+
 int directional_bin_of(std::span<const glm::vec3> directions, const glm::vec3& l) {
   int best = -1;
   float best_dot = -2.0f;
@@ -28,13 +34,19 @@ int directional_bin_of(std::span<const glm::vec3> directions, const glm::vec3& l
 }
 
 glm::vec3 directional_specular(const GltfBrdf& m, const glm::vec3& n, const glm::vec3& v,
-                               std::span<const glm::vec3> directions, std::span<const glm::vec3> radiance) {
+                               std::span<const glm::vec3> directions, std::span<const glm::vec3> radiance,
+                               const glm::vec3* bin_normal) {
   const float a = m.alpha;
   const float n_dot_v = std::max(glm::dot(n, v), 1e-4f);
   // The frame (t, b, n) and v in it.
-  glm::vec3 t = std::fabs(n.x) > 0.9f ? glm::vec3(0.0f, 1.0f, 0.0f) : glm::vec3(1.0f, 0.0f, 0.0f);
-  t = glm::normalize(t - n * glm::dot(n, t));
-  const glm::vec3 b = glm::cross(n, t);
+  glm::vec3 t, b;
+  directional_tangent_frame(n, t, b);
+  // Tangent-frame bins: the frame of the bins' own normal (the same function as the bake's).
+  glm::vec3 bin_t(1.0f, 0.0f, 0.0f), bin_b(0.0f, 1.0f, 0.0f), bin_n(0.0f, 0.0f, 1.0f);
+  if (bin_normal != nullptr) {
+    bin_n = *bin_normal;
+    directional_tangent_frame(bin_n, bin_t, bin_b);
+  }
   const glm::vec3 ve(glm::dot(v, t), glm::dot(v, b), n_dot_v);
   // Heitz 2018, "Sampling the GGX Distribution of Visible Normals".
   const glm::vec3 vh = glm::normalize(glm::vec3(a * ve.x, a * ve.y, ve.z));
@@ -58,7 +70,9 @@ glm::vec3 directional_specular(const GltfBrdf& m, const glm::vec3& n, const glm:
     const glm::vec3 l = 2.0f * glm::dot(v, h) * h - v;
     const float n_dot_l = glm::dot(n, l);
     if (!(n_dot_l > 0.0f)) continue;
-    const int k = directional_bin_of(directions.first(count), l);
+    const glm::vec3 l_bins =
+        bin_normal != nullptr ? glm::vec3(glm::dot(l, bin_t), glm::dot(l, bin_b), glm::dot(l, bin_n)) : l;
+    const int k = directional_bin_of(directions.first(count), l_bins);
     if (k < 0) continue;
     // f cos / pdf of the visible-normal sampling: F(v.h) G2(v, l) / G1(v), per channel.
     const float fresnel_w = gltf_schlick_weight(glm::dot(v, h));

@@ -125,6 +125,7 @@ ForwardRenderer::ForwardInputs ForwardRenderer::bind_forward_inputs(const Indire
 void ForwardRenderer::set_forward_frame_uniforms(const ForwardUniforms& u, const ForwardInputs& in, bool blend) {
   glUniform1i(u.directional_bins, in.directional ? in.indirect->directional_bin_count : 0);
   glUniform1i(u.directional_elements, in.directional ? in.indirect->directional_element_count : 0);
+  glUniform1i(u.directional_tangent_frame, in.directional && in.indirect->directional_tangent_frame ? 1 : 0);
   glUniform1i(u.probe_count, in.probes ? in.indirect->reflection_probe_count : 0);
   glUniform1i(u.probe_levels, in.probes ? in.indirect->reflection_probe_levels : 0);
   glUniform1i(u.probe_has_distances, in.probes && in.indirect->reflection_probe_distances ? 1 : 0);

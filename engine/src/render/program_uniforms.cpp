@@ -34,6 +34,7 @@ ForwardUniforms ForwardUniforms::locate(const UniformLookup& at) {
           .specular_color_factor = at.location("u_specular_color_factor"),
           .directional_bins = at.location("u_directional_bins"),
           .directional_elements = at.location("u_directional_elements"),
+          .directional_tangent_frame = at.location("u_directional_tangent_frame"),
           .probe_count = at.location("u_probe_count"),
           .probe_levels = at.location("u_probe_levels"),
           .probe_max_roughness = at.location("u_probe_max_roughness"),

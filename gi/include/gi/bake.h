@@ -40,8 +40,9 @@ struct BakeOptions {
   int samples_per_vpl = 0;           ///< Light atlas: sample points per VPL.
   int brf_basis = 0;                 ///< BRF: basis functions N.
   int brf_spheres = 0;               ///< BRF: field spheres.
-  int dlm_directions = 0;            ///< DLM: directions in the global set (8..256).
+  int dlm_directions = 0;            ///< DLM: directions per texel (8..256).
   std::uint64_t dlm_photons = 0;     ///< DLM: photon paths.
+  std::string dlm_bins;              ///< DLM: "tangent" (each texel's frame, the presets'), "global"; "": preset.
   /// Light atlas: also hold the static lights' direct light (the renderer then draws none
   /// of theirs on the static world). Without it the atlas holds the indirect light and the
   /// direct light the renderer does not draw: the sky's, shadowed by the level, and that of

@@ -36,6 +36,9 @@ engine::Result<DlmSettings> dlm_settings(const BakeOptions& o, const BakeStage& 
   if (o.texels_per_metre > 0.0f) settings->texels_per_metre = o.texels_per_metre;
   if (o.dlm_directions > 0) settings->directions = o.dlm_directions;
   if (o.dlm_photons > 0) settings->photons = o.dlm_photons;
+  if (!o.dlm_bins.empty() && o.dlm_bins != "tangent" && o.dlm_bins != "global")
+    return engine::invalid_request("DLM bins '" + o.dlm_bins + "' (tangent or global)");
+  if (!o.dlm_bins.empty()) settings->tangent_frame_bins = o.dlm_bins == "tangent";
   settings->threads = o.threads;
   settings->seed = o.seed;
   settings->progress = stage.progress();
@@ -71,6 +74,7 @@ std::string bake_settings_hash(const BakeOptions& o) {
   h.add_value(o.brf_spheres);
   h.add_value(o.dlm_directions);
   h.add_value(o.dlm_photons);
+  h.add_string(o.dlm_bins);
   h.add_value(static_cast<std::uint8_t>(o.include_direct ? 1 : 0));
   h.add_value(static_cast<std::uint64_t>(o.moving_lights.size()));
   for (const std::string& l : o.moving_lights) h.add_string(l);

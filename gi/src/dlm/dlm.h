@@ -54,8 +54,9 @@ struct DlmSettings {
   int area_light_samples = 16;        ///< Point emitters per area light or emissive triangle.
   /// Bins in each texel's tangent frame: `directions` on the hemisphere about the texel's
   /// normal (dlm_hemisphere_directions) instead of one global set, so a texel gets all N cells
-  /// above its horizon (docs/dlm.md, "The corridor's grazing band"). Measurement only: the
-  /// renderer reads global bins, so the bundle writer refuses these maps.
+  /// above its horizon (docs/dlm.md, "The corridor's grazing band"). The bundle keeps the flag
+  /// (dlm.bin version 3) and the renderer turns each lobe sample into the texel's frame
+  /// (engine::directional_tangent_frame of the vertex normal, IndirectLightFrame::directional_tangent_frame).
   bool tangent_frame_bins = false;
   std::uint64_t seed = 1;
   unsigned threads = 0;       ///< 0: all hardware threads. The result does not depend on it.
@@ -104,7 +105,8 @@ std::vector<glm::vec3> dlm_directions(int count);
 std::vector<glm::vec3> dlm_hemisphere_directions(int count);
 
 /// The bins' directions in world space at a texel of unit normal `n`: the global set, or
-/// with tangent-frame bins the hemisphere set turned to n (orthonormal_basis(n): x, y, n).
+/// with tangent-frame bins the hemisphere set turned to n (engine::directional_tangent_frame(n):
+/// x, y, n, the renderer's frame).
 std::vector<glm::vec3> dlm_texel_directions(const Dlm& dlm, const glm::vec3& n);
 
 /// The bin of incoming direction `w`: the nearest direction psi_k (the paper's rule, at every
@@ -112,8 +114,14 @@ std::vector<glm::vec3> dlm_texel_directions(const Dlm& dlm, const glm::vec3& n);
 std::uint32_t dlm_bin(std::span<const glm::vec3> directions, const glm::vec3& w);
 
 /// C_k(n) for every bin: integral over the hemisphere of n of n.w, split by dlm_bin(w)
-/// (4096-point Fibonacci quadrature). Sums to ~pi.
-std::vector<float> dlm_bin_cosine_weights(std::span<const glm::vec3> directions, const glm::vec3& n);
+/// (`quadrature`-point Fibonacci quadrature over the sphere). Sums to ~pi.
+std::vector<float> dlm_bin_cosine_weights(std::span<const glm::vec3> directions, const glm::vec3& n,
+                                          int quadrature = 4096);
+
+/// Quadrature points of C_k for tangent-frame bins: their C_k are the same at every normal,
+/// computed once, so finely (4096 points left ~16 per bin of 128 and few near the horizon,
+/// where a grazing lobe reads: docs/dlm.md, "Tangent-frame bins in the renderer").
+inline constexpr int kDlmTangentQuadrature = 1 << 18;
 
 /// Bakes the directional light maps of the glossy Static instances of `input` under its
 /// static lights and emissive static surfaces. Errors: settings out of range, invalid input,

@@ -40,7 +40,6 @@ float from_half(std::uint16_t h) { return glm::unpackHalf1x16(h); }
 // Empty when the Dlm's arrays fit together and its values are valid, else what is wrong.
 std::string check_dlm(const Dlm& d) {
   const DlmSettings& s = d.settings;
-  if (s.tangent_frame_bins) return "tangent-frame bins are for measurement only: the renderer reads global bins";
   if (!(s.texels_per_metre > 0.0f) || !std::isfinite(s.texels_per_metre) || s.directions < 8 || s.directions > 256 ||
       s.photons < 1 || !(s.splat_radius_texels > 0.0f) || !std::isfinite(s.splat_radius_texels) ||
       !(s.glossy_roughness > 0.0f) || !(s.glossy_roughness <= 1.0f) || !(s.glossy_roughness_min >= 0.0f) ||
@@ -75,7 +74,8 @@ json settings_json(const DlmSettings& s) {
               {"glossy_roughness_min", s.glossy_roughness_min},
               {"max_bounces", s.max_bounces},
               {"area_light_samples", s.area_light_samples},
-              {"seed", s.seed}};
+              {"seed", s.seed},
+              {"tangent_frame_bins", s.tangent_frame_bins}};
 }
 
 json stats_json(const DlmStats& s) {
@@ -139,6 +139,7 @@ engine::Status write_dlm_file(const fs::path& path, const Dlm& dlm, const std::s
   w.put(static_cast<std::int32_t>(s.max_bounces));
   w.put(static_cast<std::int32_t>(s.area_light_samples));
   w.put(static_cast<std::uint64_t>(s.seed));
+  w.put(static_cast<std::int32_t>(s.tangent_frame_bins ? 1 : 0));
   w.put(static_cast<std::int32_t>(dlm.width));
   w.put(static_cast<std::int32_t>(dlm.height));
   w.put_array(dlm.directions);
@@ -155,15 +156,15 @@ engine::Result<DlmFile> read_dlm_file(const fs::path& path) {
   DlmFile f;
   Dlm& d = f.dlm;
   DlmSettings& s = d.settings;
-  std::int32_t directions = 0, max_bounces = 0, area_samples = 0, width = 0, height = 0;
+  std::int32_t directions = 0, max_bounces = 0, area_samples = 0, tangent_frame = 0, width = 0, height = 0;
   std::uint64_t photons = 0, seed = 0;
   std::vector<float> scales;
   std::vector<std::uint16_t> halves;
   const bool complete = r.get_string(f.geometry_hash) && r.get(s.texels_per_metre) && r.get(directions) &&
                         r.get(photons) && r.get(s.splat_radius_texels) && r.get(s.glossy_roughness) &&
                         r.get(s.glossy_roughness_min) && r.get(max_bounces) && r.get(area_samples) && r.get(seed) &&
-                        r.get(width) && r.get(height) && r.get_array(d.directions) && r.get_array(d.texels) &&
-                        r.get_array(scales) && r.get_array(halves);
+                        r.get(tangent_frame) && r.get(width) && r.get(height) && r.get_array(d.directions) &&
+                        r.get_array(d.texels) && r.get_array(scales) && r.get_array(halves);
   const std::string location = "payload byte " + std::to_string(r.offset());
   if (!complete) return file_error(path, location, "truncated payload");
   if (r.remaining() != 0) return file_error(path, location, "unexpected data after the last field");
@@ -172,6 +173,9 @@ engine::Result<DlmFile> read_dlm_file(const fs::path& path) {
   s.max_bounces = max_bounces;
   s.area_light_samples = area_samples;
   s.seed = seed;
+  if (tangent_frame != 0 && tangent_frame != 1)
+    return file_error(path, "tangent_frame_bins", "is " + std::to_string(tangent_frame) + ", 0 or 1 expected");
+  s.tangent_frame_bins = tangent_frame == 1;
   d.width = width;
   d.height = height;
   if (scales.size() != d.directions.size())

@@ -4,7 +4,7 @@
 //   auto dlm = gi::load_dlm("level.gibake", input);   // checks the geometry hash
 //
 // Files (docs/bake-bundle.md):
-//   dlm.bin         the checksummed container of io/blob_file.h, magic "GIDLMAPS", version 2.
+//   dlm.bin         the checksummed container of io/blob_file.h, magic "GIDLMAPS", version 3.
 //   manifest.json   methods.dlm = {
 //     "files":    { "maps": {"file": "dlm.bin", "xxh3_64": "<hex of the whole file>"} },
 //     "settings": { DlmSettings' scalar fields but threads and progress },
@@ -21,8 +21,9 @@
 // dlm.bin payload (little-endian; "array" = uint64 count then the elements; vec3 = 3 x float32):
 //   string        geometry_hash
 //   float32 texels_per_metre, int32 directions, uint64 photons, float32 splat_radius_texels,
-//   float32 glossy_roughness, float32 glossy_roughness_min, int32 max_bounces, int32 area_light_samples, uint64 seed
-//                                      DlmSettings' scalar fields
+//   float32 glossy_roughness, float32 glossy_roughness_min, int32 max_bounces, int32 area_light_samples, uint64 seed,
+//   int32 tangent_frame_bins (0 or 1)  DlmSettings' scalar fields
+//                                      (1: directions are on the hemisphere of each texel's tangent frame)
 //   int32 width, int32 height          atlas size (the layout is rebuilt from the scene)
 //   array<vec3> directions             Omega, N unit vectors
 //   array<uint32> texels               ascending atlas texel indices, each < width x height
@@ -50,8 +51,9 @@ inline constexpr const char* kDlmFile = "dlm.bin";
 inline constexpr const char* kDlmLayoutFile = "dlm_layout.bin";
 inline constexpr BlobMagic kDlmMagic{"GIDLMAPS"};
 /// 2: the bins are the nearest psi's at every normal (no folding at the horizon) and the
-/// settings hold glossy_roughness_min; version-1 maps are refused (re-bake).
-inline constexpr std::uint32_t kDlmVersion = 2;
+/// settings hold glossy_roughness_min. 3: tangent_frame_bins (the renderer reads bins in each
+/// texel's tangent frame; the presets bake them). Older versions are refused (re-bake).
+inline constexpr std::uint32_t kDlmVersion = 3;
 inline constexpr double kDlmRelativeError = 1.0 / 2048.0;
 
 /// What dlm.bin holds: a Dlm without its layout (rebuilt from the scene) and stats.

@@ -67,10 +67,16 @@ std::vector<KnobSpec> dlm_knobs() {
        .choices = {"raster", "visible_surface"}},
       {.name = "bins",
        .description = "global (one set of directions, the renderer's) or tangent (per texel about its normal, "
-                      "measurement only: docs/dlm.md, 'The corridor's grazing band')",
+                      "the renderer reads both: docs/dlm.md, 'Tangent-frame bins in the renderer')",
        .kind = KnobKind::Choice,
        .default_grid = {"global"},
        .choices = {"global", "tangent"}},
+      {.name = "surfaces",
+       .description = "which glossy texels are compared: all (the default) or floors (normal within 26 degrees of +y: "
+                      "the demo level's corridor floor without the crate room's cut-out grille)",
+       .kind = KnobKind::Choice,
+       .default_grid = {"all"},
+       .choices = {"all", "floors"}},
       {.name = "view",
        .description = "where the eye is: camera0 (the default, its references' keys unchanged) or above (1.7 m above "
                       "the glossy texels' centroid: the view bands camera 0 does not see, e.g. the demo corridor's)",
@@ -105,13 +111,14 @@ ReferenceRequest dlm_reference_request(const SweepScene&, const KnobSetting& k) 
 // Mean bias per band of cos(theta_v) (view angle to the texel's normal), DLM and the
 // direction-less atlas term: sum of the values / sum of the reference's - 1 over the band's
 // glossy texels (the reference's noise averages out in the sums).
-void add_view_band_bias(const GlossyTexels& g, const std::vector<glm::vec3>& dlm, const std::vector<glm::vec3>& atlas,
-                        const RgbField& reference, std::vector<std::pair<std::string, double>>& extras) {
+void add_view_band_bias(const GlossyTexels& g, const std::vector<std::uint8_t>& mask, const std::vector<glm::vec3>& dlm,
+                        const std::vector<glm::vec3>& atlas, const RgbField& reference,
+                        std::vector<std::pair<std::string, double>>& extras) {
   constexpr double kBands[] = {0.1, 0.3, 0.6, 1.01};
   for (int b = 0; b < 3; ++b) {
     double sd = 0.0, sa = 0.0, sr = 0.0;
     for (std::size_t t = 0; t < dlm.size(); ++t) {
-      if (!g.glossy[t] || !reference.is_valid(t)) continue;
+      if (!g.glossy[t] || !mask[t] || !reference.is_valid(t)) continue;
       const glm::vec3 v = glm::normalize(g.eye - g.s.texels.position[t]);
       const double c = static_cast<double>(glm::dot(g.s.texels.normal[t], v));
       if (c < kBands[b] || c >= kBands[b + 1]) continue;
@@ -164,9 +171,16 @@ engine::Result<MethodOutput> run_dlm(const RunContext& ctx) {
   std::vector<glm::vec3> atlas_values(tex.valid.size(), glm::vec3(0.0f));
   std::vector<std::uint8_t> mask(tex.valid.size(), 0);
   std::vector<glm::vec3> l(dlm->directions.size());
+  // Tangent-frame bins: the same C_k at every normal (as the bake computes them).
+  const std::vector<float> tangent_weights =
+      dlm->settings.tangent_frame_bins
+          ? dlm_bin_cosine_weights(dlm->directions, glm::vec3(0.0f, 0.0f, 1.0f), kDlmTangentQuadrature)
+          : std::vector<float>{};
+  const bool floors_only = ctx.knobs.text("surfaces") == "floors";
   for (std::size_t i = 0; i < dlm->texels.size(); ++i) {
     const std::uint32_t t = dlm->texels[i];
     if (!g->glossy[t]) continue;
+    if (floors_only && !(tex.normal[t].y > 0.9f)) continue;
     for (std::size_t k = 0; k < l.size(); ++k) {
       const float* v = &dlm->radiance[(k * dlm->texels.size() + i) * 3];
       l[k] = glm::vec3(v[0], v[1], v[2]);
@@ -174,13 +188,15 @@ engine::Result<MethodOutput> run_dlm(const RunContext& ctx) {
     const glm::vec3 v = glm::normalize(g->eye - tex.position[t]);
     const std::vector<glm::vec3> directions = dlm_texel_directions(*dlm, tex.normal[t]);
     values[t] = engine::directional_specular(g->brdf[t], tex.normal[t], v, directions, l);
-    const std::vector<float> c = dlm_bin_cosine_weights(directions, tex.normal[t]);
+    const std::vector<float> c =
+        dlm->settings.tangent_frame_bins ? tangent_weights : dlm_bin_cosine_weights(directions, tex.normal[t]);
     glm::vec3 e(0.0f);
     for (std::size_t k = 0; k < l.size(); ++k) e += c[k] * l[k];
     atlas_values[t] =
         e / 3.14159265f * engine::gltf_directional_albedo(g->brdf[t], glm::dot(tex.normal[t], v)).specular;
     mask[t] = 1;
   }
+  const std::vector<std::uint8_t> band_mask = mask;
   MethodOutput out;
   const RgbField atlas_field = RgbField::from_texels(tex.width, tex.height, atlas_values, mask);
   out.field = RgbField::from_texels(tex.width, tex.height, values, std::move(mask));
@@ -192,7 +208,7 @@ engine::Result<MethodOutput> run_dlm(const RunContext& ctx) {
                 {"atlas_truth_rel_rmse", compare_rgb(atlas_field, ctx.reference).truth_rel_rmse},
                 {"glossy_texels", static_cast<double>(dlm->stats.glossy_texels)},
                 {"deposits", static_cast<double>(dlm->stats.deposits)}};
-  add_view_band_bias(*g, values, atlas_values, ctx.reference, out.extras);
+  add_view_band_bias(*g, band_mask, values, atlas_values, ctx.reference, out.extras);
   return out;
 }
 

@@ -24,6 +24,7 @@ engine::Result<std::unique_ptr<DlmLighting>> DlmLighting::from_bake(Dlm dlm, int
   l->height_ = height;
   l->bins_ = static_cast<int>(bins);
   l->elements_ = elements;
+  l->tangent_frame_ = dlm.settings.tangent_frame_bins;
   l->index_.assign(static_cast<std::size_t>(width) * static_cast<std::size_t>(height), -1);
   for (std::size_t i = 0; i < elements; ++i) l->index_[dlm.texels[i]] = static_cast<std::int32_t>(i);
   l->packed_.resize(bins * elements);
@@ -70,6 +71,7 @@ void DlmLighting::fill(engine::IndirectLightFrame& frame) {
   frame.directional_direction_buffer = {direction_buffer_.id()};
   frame.directional_bin_count = bins_;
   frame.directional_element_count = static_cast<int>(elements_);
+  frame.directional_tangent_frame = tangent_frame_;
 }
 
 }  // namespace gi

@@ -38,6 +38,7 @@ class DlmLighting {
   DlmLighting() = default;
   int width_ = 0, height_ = 0, bins_ = 0;
   std::size_t elements_ = 0;
+  bool tangent_frame_ = false;         ///< DlmSettings::tangent_frame_bins: the bins turn with each texel's normal.
   std::vector<std::int32_t> index_;    ///< Released after the upload.
   std::vector<glm::uvec2> packed_;     ///< Released after the upload.
   std::vector<glm::vec4> directions_;  ///< Direction and scale per bin.

@@ -166,6 +166,35 @@ TEST(DlmIo, ABinOfTinyValuesIsWrittenSoThatItReadsBack) {
   for (std::size_t j = 0; j < per_bin; ++j) EXPECT_EQ(back->radiance[j], d.radiance[j]) << j;
 }
 
+// Version 3 added the tangent-frame flag: a version-2 file (global bins, no flag) is refused
+// with a message that says to re-bake, not read as if its fields were shifted.
+TEST(DlmIo, OlderVersionsAreRefusedAskingForAReBake) {
+  const fs::path dir = saved_bundle("version2");
+  const auto payload = gi::read_blob(dir / "dlm.bin", gi::kDlmMagic, gi::kDlmVersion).value();
+  ASSERT_TRUE(gi::write_blob(dir / "dlm.bin", gi::kDlmMagic, 2, payload).ok());
+  resign(dir);
+  expect_load_error(dir, "dlm.bin", "unsupported version 2, this build reads 3 (re-bake)");
+}
+
+// The tangent-frame flag is 0 or 1; any other value is a damaged file.
+TEST(DlmIo, TangentFrameFlagOtherThanZeroOrOneIsRejected) {
+  const gi::Dlm& d = baked();
+  const fs::path dir = saved_bundle("bad_flag");
+  auto p = gi::read_blob(dir / "dlm.bin", gi::kDlmMagic, gi::kDlmVersion).value();
+  // The flag follows the geometry hash (uint64 length + bytes) and 44 bytes of settings.
+  const std::string hash = gi::scene_geometry_hash(gi::bake_input_from(box()));
+  const std::size_t at = 8 + hash.size() + 44;
+  ASSERT_LT(at + 4, p.size());
+  std::int32_t flag = -1;
+  std::memcpy(&flag, p.data() + at, 4);
+  ASSERT_EQ(flag, d.settings.tangent_frame_bins ? 1 : 0);
+  flag = 2;
+  std::memcpy(p.data() + at, &flag, 4);
+  ASSERT_TRUE(gi::write_blob(dir / "dlm.bin", gi::kDlmMagic, gi::kDlmVersion, p).ok());
+  resign(dir);
+  expect_load_error(dir, "dlm.bin", "0 or 1 expected");
+}
+
 TEST(DlmIo, StaleGeometryAndLightsAreRejected) {
   const fs::path dir = saved_bundle("stale");
   engine::SceneAsset moved = box();

@@ -144,3 +144,49 @@ TEST(DlmGrazingBias, LobeSamplesKeepTheirFresnelWeight) {
 }
 
 }  // namespace
+
+namespace {
+
+// The bake assigns a photon to the tangent-frame bin nearest its direction among the
+// hemisphere set turned to the texel's normal (gi::dlm_texel_directions); the renderer turns
+// the lobe sample into the texel's frame instead (engine::directional_specular with a bin
+// normal, the GLSL the same). The two must pick the same bins: the same specular at every
+// normal, including the normals where the frame's first axis switches (|n.x| near 0.9).
+TEST(DlmTangentFrame, LookupTurnsTheSampleAsTheBakeTurnsTheBins) {
+  gi::Dlm dlm;
+  dlm.settings.tangent_frame_bins = true;
+  dlm.directions = gi::dlm_hemisphere_directions(64);
+  std::vector<glm::vec3> radiance;
+  for (std::size_t k = 0; k < dlm.directions.size(); ++k)  // every bin its own value
+    radiance.emplace_back(1.0f + static_cast<float>(k), 0.5f + 0.1f * static_cast<float>(k % 7), 2.0f);
+  const engine::GltfBrdf m = engine::gltf_brdf(glm::vec3(0.5f), 0.0f, 0.5f, 1.0f, glm::vec3(1.0f));
+  const glm::vec3 normals[] = {{0, 1, 0},
+                               {1, 0, 0},
+                               {0, 0, -1},
+                               glm::normalize(glm::vec3(0.9f, 0.43f, 0.05f)),
+                               glm::normalize(glm::vec3(0.91f, -0.4f, 0.1f)),
+                               glm::normalize(glm::vec3(-0.3f, 0.2f, 0.93f))};
+  int compared = 0, differing_world = 0;
+  for (const glm::vec3& n : normals) {
+    const std::vector<glm::vec3> world = gi::dlm_texel_directions(dlm, n);
+    glm::vec3 t, b;
+    engine::directional_tangent_frame(n, t, b);
+    for (float cos_v : {0.95f, 0.6f, 0.3f, 0.12f})
+      for (float phi : {0.3f, 1.9f, 4.1f}) {
+        const float s = std::sqrt(1.0f - cos_v * cos_v);
+        const glm::vec3 v = glm::normalize(cos_v * n + s * (std::cos(phi) * t + std::sin(phi) * b));
+        const glm::vec3 turned = engine::directional_specular(m, n, v, dlm.directions, radiance, &n);
+        const glm::vec3 baked = engine::directional_specular(m, n, v, world, radiance);
+        EXPECT_NEAR(turned.x, baked.x, 1e-3f * baked.x) << n.x << " " << n.y << " " << n.z << " cos_v " << cos_v;
+        EXPECT_NEAR(turned.y, baked.y, 1e-3f * baked.y);
+        // The untouched hemisphere set read as world directions is a different lookup (the
+        // test would not see a lookup that forgot to turn the sample).
+        const glm::vec3 unturned = engine::directional_specular(m, n, v, dlm.directions, radiance);
+        differing_world += std::fabs(unturned.x - baked.x) > 1e-2f * baked.x;
+        ++compared;
+      }
+  }
+  EXPECT_GT(differing_world, compared / 2);
+}
+
+}  // namespace

@@ -210,7 +210,7 @@ TEST(DlmBake, FurnaceBinsHoldTheIndirectRadiance) {
 
 // Tangent-frame bins (docs/dlm.md, "The corridor's grazing band"): the same furnace, every
 // one of the N bins of every texel above its horizon, each holding L_e a / (1 - a). The
-// renderer reads global bins only, so the bundle writer refuses these maps.
+// bundle keeps them (dlm.bin version 3): the loaded maps say they are tangent-frame bins.
 TEST(DlmBake, TangentFrameFurnaceBinsHoldTheIndirectRadiance) {
   const glm::vec3 le(0.5f);
   const gi::BakeInput input = gi::bake_input_from(glossy_furnace(le));
@@ -233,10 +233,14 @@ TEST(DlmBake, TangentFrameFurnaceBinsHoldTheIndirectRadiance) {
     ASSERT_GT(means.bin_count[k], 0u) << k;
     EXPECT_NEAR(means.bin_mean[k], expected, 0.15 * expected) << k;
   }
-  const fs::path dir = fs::temp_directory_path() / "gi_dlm_tangent_frame_refused";
+  const fs::path dir = fs::temp_directory_path() / "gi_dlm_tangent_frame_saved";
   fs::remove_all(dir);
   fs::create_directories(dir);
-  EXPECT_FALSE(gi::save_dlm(dir, *dlm, input));
+  ASSERT_TRUE(gi::save_dlm(dir, *dlm, input));
+  auto loaded = gi::load_dlm(dir, input);
+  ASSERT_TRUE(loaded) << loaded.error().to_string();
+  EXPECT_TRUE(loaded->settings.tangent_frame_bins);
+  EXPECT_EQ(loaded->directions, dlm->directions);
   fs::remove_all(dir);
 }
 
