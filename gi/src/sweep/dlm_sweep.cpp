@@ -27,6 +27,7 @@ engine::Result<RgbField> glossy_specular_reference(const ReferenceJob& job) {
   return glossy_specular_truth(job, LobeRadiance::Reflected);
 }
 
+// Long because it is one table, one entry per knob with its grid and range, read as a list.
 std::vector<KnobSpec> dlm_knobs() {
   return {
       {.name = "directions",
@@ -149,6 +150,47 @@ DlmSettings dlm_settings(const RunContext& ctx, double floor_roughness) {
   return s;
 }
 
+// The renderer's evaluation (engine::directional_specular) at every stored glossy texel of
+// `g` (only the floors' with `floors_only`), and the direction-less alternative on the same
+// texels: the maps' own irradiance E = sum_k L_k C_k reflected as E / pi x the specular albedo
+// (what the renderer draws without DLM from a perfect atlas): the "atlas_rel_rmse" extra.
+struct EvaluatedMaps {
+  std::vector<glm::vec3> values, atlas_values;
+  std::vector<std::uint8_t> mask;
+};
+EvaluatedMaps evaluate_maps(const Dlm& dlm, const GlossyTexels& g, bool floors_only) {
+  const AtlasTexels& tex = g.s.texels;
+  EvaluatedMaps out{.values = std::vector<glm::vec3>(tex.valid.size(), glm::vec3(0.0f)),
+                    .atlas_values = std::vector<glm::vec3>(tex.valid.size(), glm::vec3(0.0f)),
+                    .mask = std::vector<std::uint8_t>(tex.valid.size(), 0)};
+  std::vector<glm::vec3> l(dlm.directions.size());
+  // Tangent-frame bins: the same C_k at every normal (as the bake computes them).
+  const std::vector<float> tangent_weights =
+      dlm.settings.tangent_frame_bins
+          ? dlm_bin_cosine_weights(dlm.directions, glm::vec3(0.0f, 0.0f, 1.0f), kDlmTangentQuadrature)
+          : std::vector<float>{};
+  for (std::size_t i = 0; i < dlm.texels.size(); ++i) {
+    const std::uint32_t t = dlm.texels[i];
+    if (!g.glossy[t]) continue;
+    if (floors_only && !(tex.normal[t].y > 0.9f)) continue;
+    for (std::size_t k = 0; k < l.size(); ++k) {
+      const float* v = &dlm.radiance[(k * dlm.texels.size() + i) * 3];
+      l[k] = glm::vec3(v[0], v[1], v[2]);
+    }
+    const glm::vec3 v = glm::normalize(g.eye - tex.position[t]);
+    const std::vector<glm::vec3> directions = dlm_texel_directions(dlm, tex.normal[t]);
+    out.values[t] = engine::directional_specular(g.brdf[t], tex.normal[t], v, directions, l);
+    const std::vector<float> c =
+        dlm.settings.tangent_frame_bins ? tangent_weights : dlm_bin_cosine_weights(directions, tex.normal[t]);
+    glm::vec3 e(0.0f);
+    for (std::size_t k = 0; k < l.size(); ++k) e += c[k] * l[k];
+    out.atlas_values[t] =
+        e / 3.14159265f * engine::gltf_directional_albedo(g.brdf[t], glm::dot(tex.normal[t], v)).specular;
+    out.mask[t] = 1;
+  }
+  return out;
+}
+
 engine::Result<MethodOutput> run_dlm(const RunContext& ctx) {
   const double floor_roughness = ctx.knobs.real("roughness");
   const DlmSettings s = dlm_settings(ctx, floor_roughness);
@@ -162,40 +204,8 @@ engine::Result<MethodOutput> run_dlm(const RunContext& ctx) {
   const GlossyView view = ctx.knobs.text("view") == "above" ? GlossyView::Above : GlossyView::Camera0;
   auto g = glossy_texels(ctx.scene, ctx.knobs.real("density"), floor_roughness, nullptr, placement, view);
   if (!g) return g.error();
-  // The renderer's evaluation (engine::directional_specular) at every stored glossy texel.
   const AtlasTexels& tex = g->s.texels;
-  std::vector<glm::vec3> values(tex.valid.size(), glm::vec3(0.0f));
-  // The direction-less alternative on the same texels: the maps' own irradiance
-  // E = sum_k L_k C_k reflected as E / pi x the specular albedo (what the renderer draws
-  // without DLM from a perfect atlas): the "atlas_rel_rmse" extra.
-  std::vector<glm::vec3> atlas_values(tex.valid.size(), glm::vec3(0.0f));
-  std::vector<std::uint8_t> mask(tex.valid.size(), 0);
-  std::vector<glm::vec3> l(dlm->directions.size());
-  // Tangent-frame bins: the same C_k at every normal (as the bake computes them).
-  const std::vector<float> tangent_weights =
-      dlm->settings.tangent_frame_bins
-          ? dlm_bin_cosine_weights(dlm->directions, glm::vec3(0.0f, 0.0f, 1.0f), kDlmTangentQuadrature)
-          : std::vector<float>{};
-  const bool floors_only = ctx.knobs.text("surfaces") == "floors";
-  for (std::size_t i = 0; i < dlm->texels.size(); ++i) {
-    const std::uint32_t t = dlm->texels[i];
-    if (!g->glossy[t]) continue;
-    if (floors_only && !(tex.normal[t].y > 0.9f)) continue;
-    for (std::size_t k = 0; k < l.size(); ++k) {
-      const float* v = &dlm->radiance[(k * dlm->texels.size() + i) * 3];
-      l[k] = glm::vec3(v[0], v[1], v[2]);
-    }
-    const glm::vec3 v = glm::normalize(g->eye - tex.position[t]);
-    const std::vector<glm::vec3> directions = dlm_texel_directions(*dlm, tex.normal[t]);
-    values[t] = engine::directional_specular(g->brdf[t], tex.normal[t], v, directions, l);
-    const std::vector<float> c =
-        dlm->settings.tangent_frame_bins ? tangent_weights : dlm_bin_cosine_weights(directions, tex.normal[t]);
-    glm::vec3 e(0.0f);
-    for (std::size_t k = 0; k < l.size(); ++k) e += c[k] * l[k];
-    atlas_values[t] =
-        e / 3.14159265f * engine::gltf_directional_albedo(g->brdf[t], glm::dot(tex.normal[t], v)).specular;
-    mask[t] = 1;
-  }
+  auto [values, atlas_values, mask] = evaluate_maps(*dlm, *g, ctx.knobs.text("surfaces") == "floors");
   const std::vector<std::uint8_t> band_mask = mask;
   MethodOutput out;
   const RgbField atlas_field = RgbField::from_texels(tex.width, tex.height, atlas_values, mask);

@@ -13,8 +13,9 @@ namespace gi {
 
 namespace {
 
-// The gather's finer knobs (the denoiser's weights, the reads where rays land) and the
-// reference's samples: the tail of light_atlas_knobs' table.
+// The gather's finer knobs (the denoiser's weights, the reads where rays land, the adaptive
+// passes) and the reference's samples: the tail of light_atlas_knobs' table.
+// Long because it is one table, one entry per knob with its grid and range, read as a list.
 std::vector<KnobSpec> gather_detail_knobs() {
   return {
       {.name = "denoise_sigma",
