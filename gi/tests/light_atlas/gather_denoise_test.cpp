@@ -10,6 +10,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <limits>
 #include <string>
 
@@ -123,16 +124,17 @@ TEST(GatherDenoise, RemovesTheGathersNoiseWithASmallBias) {
   EXPECT_LT(std::fabs(shift / mean), 0.01);
 }
 
-// A distributed bake denoises on the merge, from the shards' variances: bit for bit the
-// whole bake's atlas.
-TEST(GatherDenoise, ThreeShardsMergeToTheWholeBakeBitForBit) {
+// A small gather bake of floor_and_wall with `option` set: three shards merge to the whole
+// bake's atlas bit for bit, and the bake without `option` (`unset` applied) differs from it.
+void expect_three_shards_merge_to_the_whole(const std::function<void(gi::TexelGatherSettings&)>& option,
+                                            const std::function<void(gi::TexelGatherSettings&)>& unset) {
   const gi::BakeInput input = floor_and_wall();
   gi::LightAtlasSettings s;
   s.texels_per_metre = 4.0f;
   s.vpl_count = 50;
   s.final_pass = gi::LightAtlasSettings::FinalPass::TexelGather;
   s.gather = {.direct_samples = 2, .solve_rays = 8, .gather_rays = 16};
-  s.gather.denoise_passes = 3;
+  option(s.gather);
   s.threads = 2;
   auto whole = gi::bake_light_atlas(input, s);
   ASSERT_TRUE(whole) << whole.error().to_string();
@@ -143,8 +145,15 @@ TEST(GatherDenoise, ThreeShardsMergeToTheWholeBakeBitForBit) {
   ASSERT_TRUE(merged) << merged.error().to_string();
   EXPECT_EQ(merged->irradiance, whole->irradiance);
   gi::LightAtlasSettings plain = s;
-  plain.gather.denoise_passes = 0;
+  unset(plain.gather);
   EXPECT_NE(gi::bake_light_atlas(input, plain).value().irradiance, whole->irradiance);
+}
+
+// A distributed bake denoises on the merge, from the shards' variances: bit for bit the
+// whole bake's atlas.
+TEST(GatherDenoise, ThreeShardsMergeToTheWholeBakeBitForBit) {
+  expect_three_shards_merge_to_the_whole([](gi::TexelGatherSettings& g) { g.denoise_passes = 3; },
+                                         [](gi::TexelGatherSettings& g) { g.denoise_passes = 0; });
 }
 
 // Adaptive sampling (TexelGatherSettings::adaptive_share): a quarter of the texels, those
@@ -184,25 +193,8 @@ TEST(GatherAdaptive, MoreRaysWhereTheKeptRaysSpreadTheMostWithoutBias) {
 // The adaptive choice is made from the kept rays, which every shard casts for every texel:
 // three shards merge to the whole bake bit for bit.
 TEST(GatherAdaptive, ThreeShardsMergeToTheWholeBakeBitForBit) {
-  const gi::BakeInput input = floor_and_wall();
-  gi::LightAtlasSettings s;
-  s.texels_per_metre = 4.0f;
-  s.vpl_count = 50;
-  s.final_pass = gi::LightAtlasSettings::FinalPass::TexelGather;
-  s.gather = {.direct_samples = 2, .solve_rays = 8, .gather_rays = 16};
-  s.gather.adaptive_share = 0.3f;
-  s.threads = 2;
-  auto whole = gi::bake_light_atlas(input, s);
-  ASSERT_TRUE(whole) << whole.error().to_string();
-  std::vector<gi::LightAtlasShardPart> parts;
-  for (std::uint32_t i = 0; i < 3; ++i)
-    parts.push_back(gi::bake_light_atlas_shard(input, s, {.index = i, .count = 3}).value());
-  auto merged = gi::merge_light_atlas(input, s, parts);
-  ASSERT_TRUE(merged) << merged.error().to_string();
-  EXPECT_EQ(merged->irradiance, whole->irradiance);
-  gi::LightAtlasSettings plain = s;
-  plain.gather.adaptive_share = 0.0f;
-  EXPECT_NE(gi::bake_light_atlas(input, plain).value().irradiance, whole->irradiance);
+  expect_three_shards_merge_to_the_whole([](gi::TexelGatherSettings& g) { g.adaptive_share = 0.3f; },
+                                         [](gi::TexelGatherSettings& g) { g.adaptive_share = 0.0f; });
 }
 
 TEST(GatherDenoise, RejectsBadSettings) {
