@@ -9,7 +9,8 @@
 // saw the box's side, else a distance-impostor search along the ray), else by the box
 // (box_projected_direction), read at
 // mip roughness x (levels - 1); they are blended by probe_weight (equal inside a room, faded
-// across the overlap of a corridor's segments). The split sum multiplies
+// across the overlap of a corridor's segments) times probe_visibility (a probe that did not see
+// the point weighs 1e-3: a second viewpoint in the same box takes it). The split sum multiplies
 // that by the specular lobe's directional albedo (gltf_directional_albedo: Karis 2013's
 // environment BRDF). No probe holds the point: the caller keeps its specular.
 
@@ -243,6 +244,22 @@ float probe_weight(vec3 p, ReflectionProbeBox probe) {
   return f.x * f.y * f.z;
 }
 
+// gi's probe_cube.h: kProbeHiddenWeight, kProbeSeesSlackM (a second viewpoint where the first is blocked).
+const float PROBE_HIDDEN_WEIGHT = 1e-3;
+const float PROBE_SEES_SLACK_M = 0.05;
+
+// Whether probe i saw p (gi's probe_visibility_weight): 1 where its captured distance towards p is
+// at least |p - centre| (1 - the box-side tolerance) - the slack, else PROBE_HIDDEN_WEIGHT. Where two
+// probes share a box, a point one did not see takes the other's light.
+float probe_visibility(vec3 p, ReflectionProbeBox probe, int i) {
+  if (u_probe_has_distances == 0) return 1.0;
+  vec3 x = p - probe.centre.xyz;
+  float len = length(x);
+  if (!(len > 0.0)) return 1.0;
+  float seen = textureLod(u_probe_distances, vec4(x, float(i)), 0.0).r;
+  return seen >= len * (1.0 - PROBE_BOX_SIDE_TOLERANCE) - PROBE_SEES_SLACK_M ? 1.0 : PROBE_HIDDEN_WEIGHT;
+}
+
 // The probes' specular at s, given the lobe's directional albedo; false where no box holds it.
 bool probe_specular(Surface s, vec3 specular_albedo, out vec3 specular) {
   specular = vec3(0.0);
@@ -254,6 +271,7 @@ bool probe_specular(Surface s, vec3 specular_albedo, out vec3 specular) {
     ReflectionProbeBox probe = rp_probes[i];
     float w = probe_weight(s.position, probe);
     if (w <= 0.0) continue;
+    w *= probe_visibility(s.position, probe, i);
     if (u_probe_lobe_samples > 0)
       sum += w * probe_lobe(s, probe, i);
     else

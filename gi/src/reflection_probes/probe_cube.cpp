@@ -129,6 +129,15 @@ float cube_distance_bilinear(const ProbeCube& cube, const glm::vec3& d) {
   return bilinear_level(cube.distance, cube.size, cube_coordinate(d));
 }
 
+float probe_visibility_weight(const ProbeCube& cube, const glm::vec3& centre, const glm::vec3& p) {
+  if (cube.distance.empty()) return 1.0f;
+  const glm::vec3 x = p - centre;
+  const float length = glm::length(x);
+  if (!(length > 0.0f)) return 1.0f;
+  const float seen = cube_distance_bilinear(cube, x);
+  return seen >= length * (1.0f - kProbeBoxSideTolerance) - kProbeSeesSlackM ? 1.0f : kProbeHiddenWeight;
+}
+
 CubeDistanceFootprint cube_distance_footprint(const ProbeCube& cube, const glm::vec3& d) {
   if (cube.distance.empty()) return {kProbeFarDistance, kProbeFarDistance};
   const CubeCoordinate c = cube_coordinate(d);

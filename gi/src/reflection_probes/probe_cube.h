@@ -134,6 +134,21 @@ glm::vec3 distance_corrected_direction(const ProbeCube& cube, const glm::vec3& p
 /// "Finer beyond the opening". 0: every sample at its lobe's level (the lookup before it).
 inline constexpr float kProbeOpeningLevelBias = 1.0f;
 
+/// A probe that did not see the shaded point (a second viewpoint in the same box sees it) weighs this
+/// times its blend weight (probe_visibility_weight; the shader's PROBE_HIDDEN_WEIGHT).
+inline constexpr float kProbeHiddenWeight = 1e-3f;
+/// The slack (m) beyond kProbeBoxSideTolerance of the point's distance within which a captured distance
+/// still counts as having seen the point (the shader's PROBE_SEES_SLACK_M).
+inline constexpr float kProbeSeesSlackM = 0.05f;
+
+/// Whether the probe captured at `centre` saw point p (docs/reflection_probes.md, "A second viewpoint where
+/// the first is blocked"): 1 when its captured distance towards p (read bilinearly) is at least
+/// |p - centre| (1 - kProbeBoxSideTolerance) - kProbeSeesSlackM, else kProbeHiddenWeight; 1 when the cube
+/// holds no distances. The forward pass multiplies the probe's blend weight by it (the shader's
+/// probe_visibility): where two probes share a box, a point one of them did not see takes the other's
+/// light; a probe alone in its box keeps its share after the normalization.
+float probe_visibility_weight(const ProbeCube& cube, const glm::vec3& centre, const glm::vec3& p);
+
 /// The most lobe samples probe_lobe_radiance takes (the shader's PROBE_MAX_LOBE_SAMPLES).
 inline constexpr int kProbeMaxLobeSamples = 16;
 /// The lobe samples the runtime asks the forward pass for (IndirectLightFrame::

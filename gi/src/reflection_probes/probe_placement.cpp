@@ -103,10 +103,87 @@ void add_probes(const RayCaster& caster, const ProbeVolume& v, float aspect, con
   }
 }
 
+// The nearest surface along the six axes from p (front faces and back faces alike), at most `limit`.
+float clearance(const RayCaster& caster, const glm::vec3& p, float limit) {
+  float nearest = limit;
+  for (int side = 0; side < 6; ++side) {
+    const Hit h = caster.intersect(Ray{p, 0.0f, axis_direction(side), limit});
+    if (h.valid()) nearest = std::min(nearest, h.t);
+  }
+  return nearest;
+}
+
+// Each box whose probe does not see more than `min_share` of its receivers gets a second probe with the same box.
+void add_second_views(const RayCaster& caster, const glm::vec3& lo, const glm::vec3& hi,
+                      const ProbePlacementSettings& settings, std::vector<ProbeVolume>& probes) {
+  if (!(settings.second_view_min_share <= 1.0f)) return;
+  const std::size_t first = probes.size();
+  for (std::size_t i = 0; i < first && static_cast<int>(probes.size()) < settings.max_probes; ++i) {
+    const HiddenReceivers h = hidden_receivers(caster, probes[i], settings.receiver_step_m);
+    if (h.hidden == 0 || !(h.share() > settings.second_view_min_share)) continue;
+    const auto point = second_view_point(caster, probes[i], h, settings.second_view_height);
+    if (!point || !free_point(caster, *point, lo, hi)) continue;
+    ProbeVolume second = probes[i];
+    second.centre = *point;
+    probes.push_back(second);
+  }
+}
+
 }  // namespace
 
-std::vector<ProbeVolume> place_probes(const RayCaster& caster, const glm::vec3& world_min, const glm::vec3& world_max,
-                                      const ProbePlacementSettings& settings) {
+HiddenReceivers hidden_receivers(const RayCaster& caster, const ProbeVolume& v, float step) {
+  HiddenReceivers r;
+  if (!(step > 0.0f)) return r;
+  const glm::vec3 size = v.box_max - v.box_min;
+  const int nx = std::max(1, static_cast<int>(std::lround(size.x / step)));
+  const int nz = std::max(1, static_cast<int>(std::lround(size.z / step)));
+  const glm::vec3 down(0.0f, -1.0f, 0.0f);
+  glm::vec3 sum(0.0f);
+  for (int z = 0; z < nz; ++z)
+    for (int x = 0; x < nx; ++x) {
+      const glm::vec3 o(v.box_min.x + (static_cast<float>(x) + 0.5f) * size.x / static_cast<float>(nx), v.centre.y,
+                        v.box_min.z + (static_cast<float>(z) + 0.5f) * size.z / static_cast<float>(nz));
+      const Hit below = caster.intersect(Ray{o, 0.0f, down, v.centre.y - v.box_min.y + 0.1f});
+      if (!below.valid() || !(below.geometric_normal.y > 0.7f)) continue;  // none, or inside an object
+      const glm::vec3 q = o + below.t * down + glm::vec3(0.0f, 0.01f, 0.0f);
+      const glm::vec3 d = q - v.centre;
+      const float length = glm::length(d);
+      ++r.samples;
+      if (!(length > 0.02f)) continue;
+      const Hit h = caster.intersect(Ray{v.centre, 0.0f, d / length, length});
+      if (h.valid() && h.t < length - 0.02f) {
+        ++r.hidden;
+        sum += q;
+      }
+    }
+  if (r.hidden > 0) r.centroid = sum / static_cast<float>(r.hidden);
+  return r;
+}
+
+std::optional<glm::vec3> second_view_point(const RayCaster& caster, const ProbeVolume& v, const HiddenReceivers& h,
+                                           float height) {
+  constexpr float kClearanceM = 0.3f, kStepM = 0.25f;
+  constexpr int kRings = 4;  // up to 1 m from the centroid
+  glm::vec3 base = h.centroid;
+  base.y = v.box_min.y + std::min(height, 0.5f * (v.box_max.y - v.box_min.y));
+  // The nearest point to the centroid (ring by ring of a 0.25 m grid around it, in the box) that
+  // has kClearanceM to every surface along the axes.
+  for (int ring = 0; ring <= kRings; ++ring)
+    for (int dz = -ring; dz <= ring; ++dz)
+      for (int dx = -ring; dx <= ring; ++dx) {
+        if (std::max(std::abs(dx), std::abs(dz)) != ring) continue;
+        const glm::vec3 q = base + kStepM * glm::vec3(static_cast<float>(dx), 0.0f, static_cast<float>(dz));
+        if (!v.contains(q)) continue;
+        if (clearance(caster, q, kClearanceM) >= kClearanceM) return q;
+      }
+  return std::nullopt;
+}
+
+namespace {
+
+// One probe per room-sized box (and the segments of a cut corridor): place_probes without the second views.
+std::vector<ProbeVolume> place_room_probes(const RayCaster& caster, const glm::vec3& world_min,
+                                           const glm::vec3& world_max, const ProbePlacementSettings& settings) {
   std::vector<ProbeVolume> probes;
   const glm::vec3 extent = glm::max(world_max - world_min, glm::vec3(0.0f));
   // Two passes: cells of cell_m, then of cell_m / 2 for the space the first left without a
@@ -146,6 +223,15 @@ std::vector<ProbeVolume> place_probes(const RayCaster& caster, const glm::vec3& 
             probes.resize(static_cast<std::size_t>(settings.max_probes));
         }
   }
+  return probes;
+}
+
+}  // namespace
+
+std::vector<ProbeVolume> place_probes(const RayCaster& caster, const glm::vec3& world_min, const glm::vec3& world_max,
+                                      const ProbePlacementSettings& settings) {
+  std::vector<ProbeVolume> probes = place_room_probes(caster, world_min, world_max, settings);
+  add_second_views(caster, world_min, world_max, settings, probes);
   return probes;
 }
 

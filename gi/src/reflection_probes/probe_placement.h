@@ -19,7 +19,10 @@
 // Optionally, a box much longer than wide (corridor_aspect) becomes segments about as long as it is wide, each with its
 // own probe at its centre and its own box, reaching kProbeFadeM / 2 into its neighbours' so the forward pass fades
 // between them.
+// Last, a box whose probe does not see enough of its floor (second_view_min_share) gets a second probe with
+// the same box over the hidden part (hidden_receivers, second_view_point), appended after all the others.
 
+#include <optional>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -45,6 +48,14 @@ struct ProbePlacementSettings {
   /// correction reads from that point (docs/reflection_probes.md, "Capture height"). 0 (the
   /// default): the box's middle. Not stored in the bundle (the capture points are).
   float capture_height = 0.0f;
+  /// A second viewpoint where the first is blocked (docs/reflection_probes.md, "A second viewpoint
+  /// where the first is blocked"): when more than this share of a box's receivers (hidden_receivers)
+  /// is hidden from its probe, a second probe with the same box is captured over the hidden ones
+  /// (second_view_point); the forward pass weighs each by whether it saw the shaded point
+  /// (probe_visibility_weight). > 1: never. Not stored in the bundle (the capture points are).
+  float second_view_min_share = 0.05f;
+  float second_view_height = 0.8f;  ///< The second viewpoint's height (m) above its box's floor (at most halfway up).
+  float receiver_step_m = 0.25f;    ///< Spacing (m) of the receiver samples over the box's floor.
 };
 
 /// How far (m) the segments of a cut box reach into their neighbours: the width over which
@@ -60,6 +71,25 @@ struct ProbeVolume {
     return glm::all(glm::greaterThanEqual(p, box_min)) && glm::all(glm::lessThanEqual(p, box_max));
   }
 };
+
+/// The upward-facing surfaces (floors, the tops of blocks) of v's box, sampled on a grid of `step` m over
+/// its floor (the first surface below each grid point, 1 cm above it), and which of them v's centre
+/// does not see (a ray from the centre towards the sample stops 2 cm or more short of it).
+struct HiddenReceivers {
+  int samples = 0;
+  int hidden = 0;
+  glm::vec3 centroid{0.0f};  ///< Of the hidden samples.
+  [[nodiscard]] float share() const {
+    return samples > 0 ? static_cast<float>(hidden) / static_cast<float>(samples) : 0.0f;
+  }
+};
+HiddenReceivers hidden_receivers(const RayCaster& caster, const ProbeVolume& v, float step);
+
+/// The second viewpoint of v's box: the hidden receivers' centroid at `height` above the box's floor (at
+/// most halfway up), pushed off geometry: the nearest point of a 0.25 m grid around it (up to 1 m away, in
+/// the box) with no surface within 0.3 m along the axes; nullopt when there is none.
+std::optional<glm::vec3> second_view_point(const RayCaster& caster, const ProbeVolume& v, const HiddenReceivers& h,
+                                           float height);
 
 /// The probes of the static world `caster` traces, whose geometry lies in [world_min, world_max].
 std::vector<ProbeVolume> place_probes(const RayCaster& caster, const glm::vec3& world_min, const glm::vec3& world_max,

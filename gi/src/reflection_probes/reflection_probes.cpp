@@ -228,6 +228,9 @@ std::string check_reflection_probe_settings(const ReflectionProbeSettings& s) {
   if (!(p.spread_m >= 0.0f) || !(p.min_box_m >= 0.0f) || p.max_probes < 1 || p.max_probes > 256)
     return "placement spread_m, min_box_m >= 0 and max_probes in 1..256";
   if (!(p.capture_height >= 0.0f) || !std::isfinite(p.capture_height)) return "placement capture_height must be >= 0";
+  if (!(p.second_view_height >= 0.0f) || !std::isfinite(p.second_view_height) || !(p.receiver_step_m > 0.0f) ||
+      std::isnan(p.second_view_min_share))
+    return "placement second_view_height must be >= 0, receiver_step_m > 0 and second_view_min_share a number";
   return {};
 }
 
@@ -266,6 +269,29 @@ engine::Result<std::vector<std::size_t>> rebake_probes_touching(const BakeInput&
     redone.push_back(i);
   }
   return redone;
+}
+
+float probe_visible_blend_weight(const ProbeVolume& v, const ProbeCube& cube, const glm::vec3& p) {
+  const float w = probe_blend_weight(v, p, kProbeBoxMarginM);
+  return w > 0.0f ? w * probe_visibility_weight(cube, v.centre, p) : 0.0f;
+}
+
+bool blended_probe_lobe(std::span<const ProbeVolume> probes, std::span<const ProbeCube> cubes,
+                        const engine::GltfBrdf& brdf, const glm::vec3& p, const glm::vec3& n, const glm::vec3& v,
+                        int samples, glm::vec3& out, bool visibility) {
+  glm::vec3 sum(0.0f);
+  float weight = 0.0f;
+  for (std::size_t i = 0; i < probes.size() && i < cubes.size(); ++i) {
+    const ProbeVolume& pv = probes[i];
+    const float w =
+        visibility ? probe_visible_blend_weight(pv, cubes[i], p) : probe_blend_weight(pv, p, kProbeBoxMarginM);
+    if (!(w > 0.0f)) continue;
+    sum += w * probe_lobe_radiance(cubes[i], brdf, p, n, v, samples, pv.centre, pv.box_min, pv.box_max, false);
+    weight += w;
+  }
+  if (!(weight > 0.0f)) return false;
+  out = sum / weight;
+  return true;
 }
 
 struct ProbeCapturer::Impl {

@@ -96,6 +96,23 @@ engine::Result<std::vector<std::size_t>> rebake_probes_touching(const BakeInput&
                                                                 ReflectionProbeSet& set, const glm::vec3& changed_min,
                                                                 const glm::vec3& changed_max);
 
+/// How far (m) beyond its box a probe still holds a point in the forward pass's blend (the shader's
+/// PROBE_BOX_MARGIN_M): the floor and walls the box was fitted to are inside it.
+inline constexpr float kProbeBoxMarginM = 0.05f;
+
+/// Probe `v`'s weight at p in the forward pass's blend (the shader's probe_weight x probe_visibility):
+/// probe_blend_weight(v, p, kProbeBoxMarginM) x probe_visibility_weight(cube, v.centre, p), so where a
+/// second viewpoint shares the box, a point one probe did not see takes the other's light.
+float probe_visible_blend_weight(const ProbeVolume& v, const ProbeCube& cube, const glm::vec3& p);
+
+/// The CPU twin of the forward pass's blend (reflection_probes.glsl, probe_specular, without the
+/// directional albedo): the probes holding p, each read by probe_lobe_radiance with `samples` lobe
+/// samples and the captured distances, weighted by probe_visible_blend_weight (by probe_blend_weight
+/// alone when `visibility` is false) and normalized. False where no box holds p.
+bool blended_probe_lobe(std::span<const ProbeVolume> probes, std::span<const ProbeCube> cubes,
+                        const engine::GltfBrdf& brdf, const glm::vec3& p, const glm::vec3& n, const glm::vec3& v,
+                        int samples, glm::vec3& out, bool visibility = true);
+
 /// One prepared static world that captures probes anywhere: the oracle probes of the
 /// accuracy diagnosis (docs/reflection_probes.md, "Where the corridor's error comes from": a
 /// probe captured at the shaded point itself has no parallax error).

@@ -25,7 +25,7 @@ namespace gi {
 namespace {
 
 // The shader's PROBE_BOX_MARGIN_M (engine/shaders/reflection_probes.glsl).
-constexpr float kBoxMarginM = 0.05f;
+constexpr float kBoxMarginM = kProbeBoxMarginM;
 
 // What the captures read and what the error is measured on: the tail of reflection_probes_knobs' table.
 std::vector<KnobSpec> scene_knobs() {
@@ -141,6 +141,26 @@ std::vector<KnobSpec> reflection_probes_knobs() {
        .default_grid = {"0"},
        .min_value = 0.0,
        .max_value = 100},
+      {.name = "second_view",
+       .description = "a box whose probe does not see more than this share of its floor gets a second probe over "
+                      "the hidden part (ProbePlacementSettings::second_view_min_share, the default; 2: never)",
+       .kind = KnobKind::Real,
+       .default_grid = {format_number(ProbePlacementSettings{}.second_view_min_share)},
+       .min_value = 0.0,
+       .max_value = 2},
+      {.name = "second_view_height",
+       .description = "metres above its box's floor the second viewpoint is captured at "
+                      "(ProbePlacementSettings::second_view_height)",
+       .kind = KnobKind::Real,
+       .default_grid = {format_number(ProbePlacementSettings{}.second_view_height)},
+       .min_value = 0.0,
+       .max_value = 100},
+      {.name = "visibility",
+       .description = "each probe's blend weight times whether it saw the shaded point (probe_visibility_weight, "
+                      "the default: on; off: by position alone)",
+       .kind = KnobKind::Choice,
+       .default_grid = {"on"},
+       .choices = {"on", "off"}},
       {.name = "estimate",
        .description =
            "what is scored (the diagnosis, docs/reflection_probes.md): runtime (the probes as the "
@@ -169,6 +189,13 @@ ReferenceRequest probes_reference_request(const SweepScene&, const KnobSetting& 
   return r;
 }
 
+// Probe i's weight at p in the blend: its box's (probe_blend_weight), times whether it saw p when
+// `visibility` (probe_visibility_weight), as the shader's probe_weight x probe_visibility.
+float blend_weight(const ReflectionProbeSet& set, std::size_t i, const glm::vec3& p, bool visibility) {
+  return visibility ? probe_visible_blend_weight(set.probes[i], set.cubes[i], p)
+                    : probe_blend_weight(set.probes[i], p, kBoxMarginM);
+}
+
 // How deep `p` lies in the box: its distance to the nearest side the surface does not lie
 // on (the axes along which the normal `n` is small), negative outside.
 float depth_in_box(const ProbeVolume& v, const glm::vec3& p, const glm::vec3& n) {
@@ -186,14 +213,15 @@ float depth_in_box(const ProbeVolume& v, const glm::vec3& p, const glm::vec3& n)
 // `depth`: the largest depth_in_box over those probes. False where no box holds p.
 bool probe_specular(const ReflectionProbeSet& set, const engine::GltfBrdf& brdf, const glm::vec3& p, const glm::vec3& n,
                     const glm::vec3& v, bool box_only, float box_side, bool rim, int lobe_samples,
-                    const std::vector<ProbeCube>* chains, float opening_bias, glm::vec3& out, float& depth) {
+                    const std::vector<ProbeCube>* chains, float opening_bias, bool visibility, glm::vec3& out,
+                    float& depth) {
   const glm::vec3 r = glm::reflect(-v, n);
   glm::vec3 sum(0.0f);
   float weight = 0.0f;
   depth = -1e30f;
   for (std::size_t i = 0; i < set.probes.size(); ++i) {
     const ProbeVolume& pv = set.probes[i];
-    const float w = probe_blend_weight(pv, p, kBoxMarginM);
+    const float w = blend_weight(set, i, p, visibility);
     if (!(w > 0.0f)) continue;
     const ProbeCube& cube = set.cubes[i];
     if (lobe_samples > 0) {
@@ -247,6 +275,7 @@ struct BakedProbes {
   LightAtlasBake atlas;
   ReflectionProbeSettings settings;
   ReflectionProbeSet set;
+  bool visibility = true;  ///< The knob `visibility`: the blend weighs each probe by whether it saw the point.
   [[nodiscard]] ProbeAtlas source() const {
     return ProbeAtlas{&atlas.layout, atlas.width, atlas.height, atlas.irradiance, atlas.settings.include_direct};
   }
@@ -259,7 +288,7 @@ engine::Result<BakedProbes> bake_probes(const RunContext& ctx, const BakeInput& 
   atlas_settings->threads = ctx.threads;
   auto atlas = bake_light_atlas(input, *atlas_settings);
   if (!atlas) return atlas.error();
-  BakedProbes b{std::move(atlas).value(), {}, {}};
+  BakedProbes b{std::move(atlas).value(), {}, {}, ctx.knobs.text("visibility") == "on"};
   ReflectionProbeSettings& s = b.settings;
   s.resolution = static_cast<int>(ctx.knobs.integer("resolution"));
   s.supersample = static_cast<int>(ctx.knobs.integer("supersample"));
@@ -270,6 +299,8 @@ engine::Result<BakedProbes> bake_probes(const RunContext& ctx, const BakeInput& 
   if (ctx.knobs.real("corridor_aspect") > 0.0)
     s.placement.corridor_aspect = static_cast<float>(ctx.knobs.real("corridor_aspect"));
   s.placement.capture_height = static_cast<float>(ctx.knobs.real("capture_height"));
+  s.placement.second_view_min_share = static_cast<float>(ctx.knobs.real("second_view"));
+  s.placement.second_view_height = static_cast<float>(ctx.knobs.real("second_view_height"));
   auto set = bake_reflection_probes(input, b.source(), s);
   if (!set) return set.error();
   b.set = std::move(set).value();
@@ -320,7 +351,7 @@ glm::vec3 level0_estimate(const BakedProbes& b, const engine::GltfBrdf& brdf, co
   float weight = 0.0f;
   for (std::size_t i = 0; i < b.set.probes.size(); ++i) {
     const ProbeVolume& pv = b.set.probes[i];
-    const float w = probe_blend_weight(pv, p, kBoxMarginM);
+    const float w = blend_weight(b.set, i, p, b.visibility);
     if (!(w > 0.0f)) continue;
     const ProbeCube& cube = b.set.cubes[i];
     sum += w * exact_lobe(brdf, n, v, t, kExactLobeSamples, [&](const glm::vec3& l) {
@@ -347,7 +378,7 @@ glm::vec3 diagnosis_estimate(Estimate estimate, const BakedProbes& b, const Prob
     float weight = 0.0f;
     for (std::size_t i = 0; i < b.set.probes.size(); ++i) {
       const ProbeVolume& pv = b.set.probes[i];
-      const float w = probe_blend_weight(pv, p, kBoxMarginM);
+      const float w = blend_weight(b.set, i, p, b.visibility);
       if (!(w > 0.0f)) continue;
       if (estimate == Estimate::Level0ExactDir) {
         sum += w * exact_lobe(brdf, n, v, t, kTracedLobeSamples, [&](const glm::vec3& l) {
@@ -553,7 +584,7 @@ engine::Result<MethodOutput> run_reflection_probes(const RunContext& ctx) {
     float depth = 0.0f;
     const glm::vec3 v = glm::normalize(g->eye - tex.position[t]);
     if (!probe_specular(*set, g->brdf[t], tex.position[t], tex.normal[t], v, box_only, box_side, rim, lobe_samples,
-                        chains.empty() ? nullptr : &chains, opening_bias, values[t], depth)) {
+                        chains.empty() ? nullptr : &chains, opening_bias, baked->visibility, values[t], depth)) {
       ++uncovered;
       continue;
     }

@@ -12,6 +12,7 @@
 #include <random>
 
 #include "reflection_probes/probe_cube.h"
+#include "reflection_probes/reflection_probes.h"
 
 namespace {
 
@@ -155,6 +156,58 @@ TEST(ProbeLobe, BeyondAnOpeningTheSamplesReadAFinerLevel) {
     EXPECT_LT(std::abs(finer - truth), 0.3f * std::abs(before - truth)) << "roughness " << roughness;
     EXPECT_EQ(lookup(closed, 0.0f), lookup(closed, gi::kProbeOpeningLevelBias)) << "roughness " << roughness;
   }
+}
+
+// A constant cube (every level) of `value` whose distances are `distance(d)` per level-0 texel.
+template <typename Distance>
+gi::ProbeCube constant_cube(float value, const Distance& distance) {
+  gi::ProbeCube cube = gi::make_probe_cube(16, gi::full_mip_count(16));
+  for (auto& level : cube.levels) std::fill(level.begin(), level.end(), glm::vec3(value));
+  cube.distance.resize(cube.levels[0].size());
+  for (int f = 0; f < 6; ++f)
+    for (int y = 0; y < 16; ++y)
+      for (int x = 0; x < 16; ++x)
+        cube.distance[gi::cube_texel_index(f, x, y, 16)] = distance(gi::cube_texel_direction(f, x, y, 16));
+  return cube;
+}
+
+// Whether a probe saw the point (probe_visibility_weight): its captured distance towards the point
+// at least 90% of the point's, less 5 cm; no distances: seen.
+TEST(ProbeVisibility, AProbeSeesAPointNoFartherThanWhatItCapturedThere) {
+  const gi::ProbeCube wall4 = constant_cube(1.0f, [](const glm::vec3&) { return 4.0f; });
+  const glm::vec3 d = glm::normalize(glm::vec3(0.3f, -0.5f, 0.8f));
+  EXPECT_EQ(gi::probe_visibility_weight(wall4, kCentre, 4.0f * d), 1.0f);
+  EXPECT_EQ(gi::probe_visibility_weight(wall4, kCentre, 4.4f * d), 1.0f);  // 4 >= 4.4 x 0.9 - 0.05
+  EXPECT_EQ(gi::probe_visibility_weight(wall4, kCentre, 4.6f * d), gi::kProbeHiddenWeight);
+  gi::ProbeCube none = wall4;
+  none.distance.clear();
+  EXPECT_EQ(gi::probe_visibility_weight(none, kCentre, 40.0f * d), 1.0f);
+}
+
+// Two probes sharing a 4 x 3 x 4 m box: A (radiance 1) at its centre, 1.5 m up, with a blocker
+// 0.5 m in front of it towards +z; B (radiance 3) 0.8 m up behind the blocker, seeing everything.
+// A floor point behind the blocker takes B's light (within A's 1e-3 share); one in front of it,
+// seen by both, takes their mean, as every point does when the blend weighs by position alone.
+TEST(ProbeVisibility, APointOneProbeDidNotSeeTakesTheOthersLight) {
+  const glm::vec3 box_min(-2.0f, 0.0f, -2.0f), box_max(2.0f, 3.0f, 2.0f);
+  const std::vector<gi::ProbeVolume> probes = {{{0.0f, 1.5f, 0.0f}, box_min, box_max},
+                                               {{0.0f, 0.8f, 1.5f}, box_min, box_max}};
+  const std::vector<gi::ProbeCube> cubes = {
+      constant_cube(1.0f, [](const glm::vec3& d) { return d.z > 0.3f ? 0.5f : 10.0f; }),
+      constant_cube(3.0f, [](const glm::vec3&) { return 10.0f; })};
+  const engine::GltfBrdf brdf = engine::gltf_brdf(glm::vec3(0.5f), 0.0f, 0.1f);
+  const glm::vec3 v = glm::normalize(glm::vec3(0.0f, 0.5f, -1.0f));
+  const auto read = [&](const glm::vec3& p, bool visibility) {
+    glm::vec3 out(-1.0f);
+    EXPECT_TRUE(gi::blended_probe_lobe(probes, cubes, brdf, p, kUp, v, 4, out, visibility));
+    return out.x;
+  };
+  const glm::vec3 behind(0.0f, 0.0f, 1.5f), in_front(0.0f, 0.0f, -1.5f);
+  EXPECT_NEAR(read(behind, true), 3.0f, 0.01f);
+  EXPECT_NEAR(read(in_front, true), 2.0f, 1e-4f);
+  EXPECT_NEAR(read(behind, false), 2.0f, 1e-4f);
+  glm::vec3 outside(0.0f);
+  EXPECT_FALSE(gi::blended_probe_lobe(probes, cubes, brdf, {3.0f, 0.0f, 0.0f}, kUp, v, 4, outside));
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <numbers>
 
@@ -165,6 +166,67 @@ TEST(ReflectionProbePlacement, ACorridorCutIntoSegmentsFadesFromOneProbeToTheNex
   EXPECT_EQ(gi::probe_blend_weight(probes[2], {4.0f, 0.0f, 11.0f}, 0.05f), 0.0f);
 }
 
+// An outward-facing box [lo, hi] (a block standing in a room).
+gi::BakePrimitive block(glm::vec3 lo, glm::vec3 hi) {
+  gi::BakePrimitive p;
+  const glm::vec3 s = hi - lo;
+  add_quad(p, lo, {s.x, 0, 0}, {0, 0, s.z});                  // bottom, -y
+  add_quad(p, {lo.x, hi.y, lo.z}, {0, 0, s.z}, {s.x, 0, 0});  // top, +y
+  add_quad(p, lo, {0, s.y, 0}, {s.x, 0, 0});                  // z = lo, -z
+  add_quad(p, {lo.x, lo.y, hi.z}, {s.x, 0, 0}, {0, s.y, 0});  // z = hi, +z
+  add_quad(p, lo, {0, 0, s.z}, {0, s.y, 0});                  // x = lo, -x
+  add_quad(p, {hi.x, lo.y, lo.z}, {0, s.y, 0}, {0, 0, s.z});  // x = hi, +x
+  return p;
+}
+
+// glossy_room's plan: an 8 x 3 x 5 m room and, when `blocks`, a 3.4 m long, 1.4 m high row of
+// blocks at z 0.4-1.5 m, between the room's centre and its +z wall.
+gi::BakeInput room_with_blocks(bool blocks) {
+  gi::BakeInput in;
+  in.name = blocks ? "room with blocks" : "empty room";
+  in.materials.push_back(lambert(0.5f));
+  add_static(in, room({-4, 0, -2.5f}, {4, 3, 2.5f}), "room");
+  if (blocks) add_static(in, block({-1.6f, 0, 0.4f}, {1.8f, 1.4f, 1.5f}), "blocks");
+  return in;
+}
+
+// The probe at the room's centre, 1.5 m up, does not see the floor behind the blocks (about an
+// eighth of the floor): a second probe with the same box is captured over it, 0.8 m up; the
+// same room without the blocks gets one probe.
+TEST(ReflectionProbePlacement, AFloorHiddenBehindBlocksGetsASecondViewpointOverIt) {
+  for (const bool blocks : {false, true}) {
+    const gi::BakeInput in = room_with_blocks(blocks);
+    auto caster = gi::make_embree_ray_caster(gi::rt_scene_from(in));
+    ASSERT_TRUE(caster) << caster.error().to_string();
+    const gi::ProbePlacementSettings settings;
+    const auto probes = gi::place_probes(**caster, {-4, 0, -2.5f}, {4, 3, 2.5f}, settings);
+    ASSERT_GE(probes.size(), 1u);
+    const gi::ProbeVolume& first = probes[0];
+    EXPECT_NEAR(glm::length(first.centre - glm::vec3(0, 1.5f, 0)), 0.0f, 1e-3f);
+    const gi::HiddenReceivers h = gi::hidden_receivers(**caster, first, settings.receiver_step_m);
+    std::printf("%s: %d receiver samples, %d hidden from the probe (share %.3f, centroid %.2f %.2f %.2f)\n",
+                in.name.c_str(), h.samples, h.hidden, static_cast<double>(h.share()), static_cast<double>(h.centroid.x),
+                static_cast<double>(h.centroid.y), static_cast<double>(h.centroid.z));
+    ASSERT_EQ(probes.size(), blocks ? 2u : 1u) << in.name;
+    if (!blocks) {
+      EXPECT_EQ(h.hidden, 0);
+      continue;
+    }
+    EXPECT_GT(h.share(), settings.second_view_min_share);
+    const gi::ProbeVolume& second = probes[1];
+    EXPECT_EQ(second.box_min, first.box_min);
+    EXPECT_EQ(second.box_max, first.box_max);
+    EXPECT_NEAR(second.centre.y, settings.second_view_height, 1e-4f);
+    EXPECT_GT(second.centre.z, 1.5f);  // behind the blocks
+    EXPECT_LT(second.centre.z, 2.5f);
+    EXPECT_LT(std::abs(second.centre.x), 1.6f);
+    // From there the floor right behind the blocks is seen.
+    const glm::vec3 behind(0.0f, 0.01f, 2.0f);
+    const glm::vec3 d = behind - second.centre;
+    EXPECT_FALSE((*caster)->occluded(gi::Ray{second.centre, 0.0f, glm::normalize(d), glm::length(d) - 0.02f}));
+  }
+}
+
 // A closed 3 m room of albedo 0.5 whose atlas holds the same irradiance E everywhere: every
 // surface sends E / pi x 0.5 (a Lambertian's directional albedo is its albedo), so the probe
 // sees that radiance in every direction, and each prefiltered level keeps it.
@@ -247,6 +309,41 @@ TEST(ReflectionProbeBake, AChangeInOneRoomRebakesOnlyItsProbe) {
       set->stats.capture_seconds, set->stats.prefilter_seconds, static_cast<unsigned long long>(set->stats.rays),
       updated.stats.capture_seconds, updated.stats.prefilter_seconds,
       static_cast<unsigned long long>(updated.stats.rays));
+}
+
+// The room with blocks, lit by a lamp above its centre: its two viewpoints share the box, so a
+// change anywhere in the room re-bakes both, each bit for bit what a whole bake gives it.
+TEST(ReflectionProbeBake, AChangeInARoomWithTwoViewpointsRebakesBoth) {
+  gi::BakeInput in = room_with_blocks(true);
+  gi::BakeLight lamp;
+  lamp.name = "lamp";
+  lamp.light.type = engine::LightType::Point;
+  lamp.light.intensity = 20.0f;
+  lamp.light_to_world = glm::translate(glm::mat4(1.0f), glm::vec3(0, 2.5f, 0));
+  in.lights.push_back(lamp);
+  const gi::AtlasLayout layout = gi::static_world_layout(in, 4.0f).value();
+  const std::vector<glm::vec3> irradiance(static_cast<std::size_t>(layout.width * layout.height), glm::vec3(0.1f));
+  const gi::ProbeAtlas atlas{&layout, layout.width, layout.height, irradiance, false};
+  gi::ReflectionProbeSettings s;
+  s.resolution = 32;
+  s.prefilter_samples = 64;
+  s.threads = 2;
+  auto set = gi::bake_reflection_probes(in, atlas, s);
+  ASSERT_TRUE(set) << set.error().to_string();
+  ASSERT_EQ(set->probes.size(), 2u);
+  gi::ReflectionProbeSet updated = *set;
+  for (gi::ProbeCube& c : updated.cubes)
+    for (auto& level : c.levels) std::fill(level.begin(), level.end(), glm::vec3(-1.0f));
+  updated.stats = {};
+  auto redone = gi::rebake_probes_touching(in, atlas, updated, {2, 0, 2}, {2.5f, 0.5f, 2.4f});
+  ASSERT_TRUE(redone) << redone.error().to_string();
+  EXPECT_EQ(*redone, (std::vector<std::size_t>{0, 1}));
+  EXPECT_EQ(updated.cubes[0].levels, set->cubes[0].levels);
+  EXPECT_EQ(updated.cubes[1].levels, set->cubes[1].levels);
+  // The cost (docs/reflection_probes.md, "A second viewpoint where the first is blocked"), 32^2 faces, 2 threads.
+  std::printf("room with two viewpoints, re-bake of both: place %.3f s, capture %.3f s, prefilter %.3f s, %llu rays\n",
+              set->stats.place_seconds, updated.stats.capture_seconds, updated.stats.prefilter_seconds,
+              static_cast<unsigned long long>(updated.stats.rays));
 }
 
 // The diagnosis's oracle probes (ProbeCapturer, docs/reflection_probes.md, "Where the corridor's
