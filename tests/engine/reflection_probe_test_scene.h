@@ -26,21 +26,21 @@ inline const glm::vec3 kProbe(0.0f, 1.5f, 0.0f);
 /// The hall's far wall: 3 m beyond the box's +X side.
 inline constexpr float kHallEnd = 5.0f;
 
-/// Where the ray from kProbe along d leaves the room [kRoomMin, kRoomMax] stretched to x = far_x.
+/// Where the ray from `from` (kProbe) along d leaves the room [kRoomMin, kRoomMax] stretched to x = far_x.
 struct SideHit {
   float distance = 0.0f;
   int axis = 0;  ///< The side's axis; its sign is d[axis]'s.
   glm::vec3 point{0.0f};
 };
-inline SideHit side_hit(glm::vec3 d, float far_x) {
+inline SideHit side_hit(glm::vec3 d, float far_x, glm::vec3 from = kProbe) {
   const glm::vec3 hi(far_x, kRoomMax.y, kRoomMax.z);
   SideHit h{1e30f, 0, glm::vec3(0.0f)};
   for (int a = 0; a < 3; ++a) {
     if (d[a] == 0.0f) continue;
-    const float ta = ((d[a] > 0.0f ? hi[a] : kRoomMin[a]) - kProbe[a]) / d[a];
+    const float ta = ((d[a] > 0.0f ? hi[a] : kRoomMin[a]) - from[a]) / d[a];
     if (ta < h.distance) h.distance = ta, h.axis = a;
   }
-  h.point = kProbe + h.distance * d;
+  h.point = from + h.distance * d;
   return h;
 }
 
@@ -83,37 +83,54 @@ struct ProbeFrameSettings {
   int lobe_samples = 0;  ///< 0: the split sum's single read.
 };
 
-/// The probe at kProbe with box [kRoomMin, kRoomMax]: `levels` (face size size >> m each) as
-/// the runtime uploads them (RGBA16F cube-map array), `distances` (level 0's, R32F) when not null.
+/// One probe of a ProbeProvider: where it was captured, its levels (face size size >> m each) and
+/// level 0's distances (null: none). Every probe's box is the room [kRoomMin, kRoomMax].
+struct ProbeLayer {
+  glm::vec3 centre = kProbe;
+  const std::vector<std::vector<glm::vec3>>* levels = nullptr;
+  const std::vector<float>* distances = nullptr;
+};
+
+/// The probes handed to the renderer as the runtime hands them: their levels as one RGBA16F
+/// cube-map array, their distances (when the first has them, all must) as one R32F array, the
+/// boxes in an SSBO. The one-probe form: the probe at kProbe with box [kRoomMin, kRoomMax].
 class ProbeProvider : public engine::IndirectLightProvider {
  public:
   ProbeProvider(int size, const std::vector<std::vector<glm::vec3>>& levels, const std::vector<float>* distances,
-                const ProbeFrameSettings& s) {
-    const int count = static_cast<int>(levels.size());
+                const ProbeFrameSettings& s)
+      : ProbeProvider(size, {ProbeLayer{kProbe, &levels, distances}}, s) {}
+  ProbeProvider(int size, const std::vector<ProbeLayer>& probes, const ProbeFrameSettings& s) {
+    const int count = static_cast<int>(probes.front().levels->size());
+    const int layers = static_cast<int>(probes.size());
     atlas_ = engine::GlTexture::create_2d(GL_RGBA32F, 1, 1);
     const float texel[4] = {s.atlas_irradiance, s.atlas_irradiance, s.atlas_irradiance, 1.0f};
     glTextureSubImage2D(atlas_.id(), 0, 0, 0, 1, 1, GL_RGBA, GL_FLOAT, texel);
-    cubes_ = engine::GlTexture::create_cube_array(GL_RGBA16F, size, 1, count);
-    for (int m = 0; m < count; ++m) {
-      const int w = size >> m > 0 ? size >> m : 1;
-      glTextureSubImage3D(cubes_.id(), m, 0, 0, 0, w, w, 6, GL_RGB, GL_FLOAT,
-                          levels[static_cast<std::size_t>(m)].data());
-    }
+    cubes_ = engine::GlTexture::create_cube_array(GL_RGBA16F, size, layers, count);
+    for (int i = 0; i < layers; ++i)
+      for (int m = 0; m < count; ++m) {
+        const int w = size >> m > 0 ? size >> m : 1;
+        glTextureSubImage3D(cubes_.id(), m, 0, 0, 6 * i, w, w, 6, GL_RGB, GL_FLOAT,
+                            (*probes[static_cast<std::size_t>(i)].levels)[static_cast<std::size_t>(m)].data());
+      }
     glTextureParameteri(cubes_.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
     glTextureParameteri(cubes_.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    if (distances) {
-      distances_ = engine::GlTexture::create_cube_array(GL_R32F, size, 1, 1);
-      glTextureSubImage3D(distances_.id(), 0, 0, 0, 0, size, size, 6, GL_RED, GL_FLOAT, distances->data());
+    if (probes.front().distances) {
+      distances_ = engine::GlTexture::create_cube_array(GL_R32F, size, layers, 1);
+      for (int i = 0; i < layers; ++i)
+        glTextureSubImage3D(distances_.id(), 0, 0, 0, 6 * i, size, size, 6, GL_RED, GL_FLOAT,
+                            probes[static_cast<std::size_t>(i)].distances->data());
       glTextureParameteri(distances_.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
       glTextureParameteri(distances_.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
       frame_.reflection_probe_distances = {distances_.id()};
     }
-    const engine::ReflectionProbeBox box{glm::vec4(kProbe, 0.0f), glm::vec4(kRoomMin, 0.0f), glm::vec4(kRoomMax, 0.0f)};
-    boxes_ = engine::GlBuffer::create(sizeof box, &box);
+    std::vector<engine::ReflectionProbeBox> boxes;
+    for (const ProbeLayer& p : probes)
+      boxes.push_back({glm::vec4(p.centre, 0.0f), glm::vec4(kRoomMin, 0.0f), glm::vec4(kRoomMax, 0.0f)});
+    boxes_ = engine::GlBuffer::create(boxes.size() * sizeof boxes[0], boxes.data());
     frame_.irradiance_atlas_texture = {atlas_.id()};
     frame_.reflection_probe_cubes = {cubes_.id()};
     frame_.reflection_probe_buffer = engine::SsboHandle<engine::ReflectionProbeBox>{boxes_.id()};
-    frame_.reflection_probe_count = 1;
+    frame_.reflection_probe_count = layers;
     frame_.reflection_probe_levels = count;
     frame_.reflection_probe_max_roughness = s.max_roughness;
     frame_.reflection_probe_lobe_samples = s.lobe_samples;
