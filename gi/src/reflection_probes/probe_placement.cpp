@@ -119,8 +119,12 @@ void add_second_views(const RayCaster& caster, const glm::vec3& lo, const glm::v
   if (!(settings.second_view_min_share <= 1.0f)) return;
   const std::size_t first = probes.size();
   for (std::size_t i = 0; i < first && static_cast<int>(probes.size()) < settings.max_probes; ++i) {
-    const HiddenReceivers h = hidden_receivers(caster, probes[i], settings.receiver_step_m);
-    if (h.hidden == 0 || !(h.share() > settings.second_view_min_share)) continue;
+    HiddenReceivers h = hidden_receivers(caster, probes[i], settings.receiver_step_m);
+    if (settings.second_view_min_share < 0.0f) {  // the measurement's "every box": over the box's middle
+      h.centroid = 0.5f * (probes[i].box_min + probes[i].box_max);
+    } else if (h.hidden == 0 || !(h.share() > settings.second_view_min_share)) {
+      continue;
+    }
     const auto point = second_view_point(caster, probes[i], h, settings.second_view_height);
     if (!point || !free_point(caster, *point, lo, hi)) continue;
     ProbeVolume second = probes[i];

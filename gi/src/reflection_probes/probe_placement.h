@@ -52,7 +52,8 @@ struct ProbePlacementSettings {
   /// where the first is blocked"): when more than this share of a box's receivers (hidden_receivers)
   /// is hidden from its probe, a second probe with the same box is captured over the hidden ones
   /// (second_view_point); the forward pass weighs each by whether it saw the shaded point
-  /// (probe_visibility_weight). > 1: never. Not stored in the bundle (the capture points are).
+  /// (probe_visibility_weight). > 1: never; < 0: every box, over its middle (a measurement, not a
+  /// placement rule). Not stored in the bundle (the capture points are).
   float second_view_min_share = 0.05f;
   float second_view_height = 0.8f;  ///< The second viewpoint's height (m) above its box's floor (at most halfway up).
   float receiver_step_m = 0.25f;    ///< Spacing (m) of the receiver samples over the box's floor.

@@ -16,8 +16,10 @@
 #include "core/random.h"
 #include "core/thread_pool.h"
 #include "light_atlas/light_atlas.h"
+#include "raytrace/embree_ray_caster.h"
 #include "raytrace/ray_offset.h"
 #include "raytrace/reference_brdf.h"
+#include "raytrace/scene_adapter.h"
 #include "reflection_probes/reflection_probes.h"
 #include "sweep/glossy_texels.h"
 
@@ -143,10 +145,11 @@ std::vector<KnobSpec> reflection_probes_knobs() {
        .max_value = 100},
       {.name = "second_view",
        .description = "a box whose probe does not see more than this share of its floor gets a second probe over "
-                      "the hidden part (ProbePlacementSettings::second_view_min_share, the default; 2: never)",
+                      "the hidden part (ProbePlacementSettings::second_view_min_share, the default; 2: never; "
+                      "-1: every box, over its middle)",
        .kind = KnobKind::Real,
        .default_grid = {format_number(ProbePlacementSettings{}.second_view_min_share)},
-       .min_value = 0.0,
+       .min_value = -1.0,
        .max_value = 2},
       {.name = "second_view_height",
        .description = "metres above its box's floor the second viewpoint is captured at "
@@ -281,6 +284,23 @@ struct BakedProbes {
   }
 };
 
+// With GI_PROBE_SWEEP_PROBES set: each probe's capture point and box on stderr (where the
+// placement put the second viewpoints).
+void print_probes(const BakeInput& input, const ReflectionProbeSet& set) {
+  if (!std::getenv("GI_PROBE_SWEEP_PROBES")) return;
+  auto caster = make_embree_ray_caster(rt_scene_from(input));  // every instance, as the level stands
+  for (const ProbeVolume& v : set.probes) {
+    const HiddenReceivers h =
+        caster ? hidden_receivers(**caster, v, set.settings.placement.receiver_step_m) : HiddenReceivers{};
+    std::fprintf(stderr, "probe at (%.2f %.2f %.2f), %d of %d receivers hidden (%.3f), ",
+                 static_cast<double>(v.centre.x), static_cast<double>(v.centre.y), static_cast<double>(v.centre.z),
+                 h.hidden, h.samples, static_cast<double>(h.share()));
+    std::fprintf(stderr, "box (%.2f %.2f %.2f)-(%.2f %.2f %.2f)\n", static_cast<double>(v.box_min.x),
+                 static_cast<double>(v.box_min.y), static_cast<double>(v.box_min.z), static_cast<double>(v.box_max.x),
+                 static_cast<double>(v.box_max.y), static_cast<double>(v.box_max.z));
+  }
+}
+
 engine::Result<BakedProbes> bake_probes(const RunContext& ctx, const BakeInput& input) {
   auto atlas_settings = light_atlas_preset(ctx.knobs.text("atlas"));
   if (!atlas_settings) return atlas_settings.error();
@@ -304,6 +324,7 @@ engine::Result<BakedProbes> bake_probes(const RunContext& ctx, const BakeInput& 
   auto set = bake_reflection_probes(input, b.source(), s);
   if (!set) return set.error();
   b.set = std::move(set).value();
+  print_probes(input, b.set);
   return b;
 }
 
