@@ -296,10 +296,13 @@ BENCHMARK(BM_DoorStepsAtPreset)
 // NearDoorVisibility: the leaves within 1 m of the door's reach gather with ray-traced
 // visibility). Args: point_pairs per leaf pair, reuse (1: the visibility kept, only the
 // segments meeting the door's boxes traced), warm (1: the near solve starts from the last
-// pose's). Per iteration the door jumps to 0 / 25 / 100
+// pose's), fast (0: one ray at a time, 1: rays in streams of 256, 2: and the kept samples
+// tested against the door alone). Per iteration the door jumps to 0 / 25 / 100
 // degrees: the antiradiance move and solve (as BM_DoorMoveAtPreset), then the near leaves'
 // update and solve. Counters: door_move_ms (both, wall), antiradiance_ms, near_ms,
-// near_update_ms (of near_ms: the couplings), near_iterations, rays, pairs (per move), near_bake_ms (the
+// near_update_ms (of near_ms: the couplings), near_iterations, rays, pairs (per move), door_rays
+// (of rays: the door's own pairs'), door_only_rays (against the door alone, not in rays), trace_cpu_ms (the
+// update's time in Embree, every thread's), near_bake_ms (the
 // baked pose's couplings, once), atlas_rebake_ms (the yardstick), vs_rebake.
 void BM_NearVisibilityMoveAtMedium(benchmark::State& state) {
   Corridor& c = corridor();
@@ -315,12 +318,15 @@ void BM_NearVisibilityMoveAtMedium(benchmark::State& state) {
   ns.point_pairs = static_cast<int>(state.range(0));
   ns.reuse_visibility = state.range(1) != 0;
   ns.warm_start = state.range(2) != 0;
+  ns.streams = state.range(3) >= 1;
+  ns.door_only_rays = state.range(3) >= 2;
   auto near = gi::NearDoorVisibility::create(c.input, *region, c.door_instance, ns);
   if (!near) std::exit(1);
   const double near_bake_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - tb).count();
   region->update();
   std::size_t k = 0;
   double total_ms = 0.0, ar_ms = 0.0, near_ms = 0.0, update_ms = 0.0, rays = 0.0, pairs = 0.0, iterations = 0.0;
+  double moving_rays = 0.0, trace_cpu_ms = 0.0, door_only_rays = 0.0;
   for (auto _ : state) {
     const glm::mat4 m = door(door_angle(false, k++));
     const auto t0 = std::chrono::steady_clock::now();
@@ -338,6 +344,9 @@ void BM_NearVisibilityMoveAtMedium(benchmark::State& state) {
     iterations += static_cast<double>(near->last_iterations());
     rays += static_cast<double>(near->last_rays());
     pairs += static_cast<double>(near->last_pairs());
+    moving_rays += static_cast<double>(near->last_moving_rays());
+    trace_cpu_ms += near->last_trace_cpu_ms();
+    door_only_rays += static_cast<double>(near->last_door_only_rays());
   }
   const double moves = static_cast<double>(state.iterations());
   state.counters["door_move_ms"] = total_ms / moves;
@@ -346,6 +355,9 @@ void BM_NearVisibilityMoveAtMedium(benchmark::State& state) {
   state.counters["near_update_ms"] = update_ms / moves;
   state.counters["rays"] = rays / moves;
   state.counters["pairs"] = pairs / moves;
+  state.counters["door_rays"] = moving_rays / moves;
+  state.counters["trace_cpu_ms"] = trace_cpu_ms / moves;
+  state.counters["door_only_rays"] = door_only_rays / moves;
   state.counters["receivers"] = static_cast<double>(near->receivers());
   state.counters["near_iterations"] = iterations / moves;
   state.counters["near_bake_ms"] = near_bake_ms;
@@ -353,13 +365,16 @@ void BM_NearVisibilityMoveAtMedium(benchmark::State& state) {
   state.counters["vs_rebake"] = rebake_ms / (total_ms / moves);
 }
 BENCHMARK(BM_NearVisibilityMoveAtMedium)
-    ->ArgNames({"pairs", "reuse", "warm"})
-    ->Args({16, 0, 0})
-    ->Args({16, 1, 0})
-    ->Args({16, 1, 1})
-    ->Args({8, 1, 1})
-    ->Args({4, 1, 0})
-    ->Args({4, 1, 1})
+    ->ArgNames({"pairs", "reuse", "warm", "fast"})
+    ->Args({16, 0, 0, 0})
+    ->Args({16, 1, 0, 0})
+    ->Args({16, 1, 1, 0})
+    ->Args({8, 1, 1, 0})
+    ->Args({4, 1, 0, 0})
+    ->Args({4, 1, 1, 0})
+    ->Args({4, 1, 1, 1})
+    ->Args({16, 1, 1, 2})
+    ->Args({4, 1, 1, 2})
     ->Unit(benchmark::kMillisecond)
     ->Iterations(3);
 

@@ -20,6 +20,7 @@
 #include <cstdint>
 #include <memory>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -62,6 +63,18 @@ struct ExactTransportSettings {
   /// sample; the rays per move drop to the segments that cross the door's two boxes. 8 bytes
   /// per leaf pair.
   bool reuse_visibility = false;
+  /// Trace the rays of consecutive pairs together, a stream of up to 256 (rtcOccluded1M); false:
+  /// one rtcOccluded1 per ray, as before. The couplings are the same bits either way. (Packets
+  /// of 16, rtcOccluded16, hung inside Embree on the door scene's first update: not used.)
+  bool streams = true;
+  /// With reuse_visibility: the kept bits are each sample's visibility in the static part of
+  /// the scene (traced there, on the first update and when a sample's ends move), and a
+  /// sample is visible when its bit is set and, if a deforming instance's box now meets its
+  /// segment, the deforming instances alone (their own small scene) do not occlude it. A door
+  /// move then traces only the door's own pairs in the static scene and tests the static
+  /// pairs' visible samples near the door against the door alone. The same bits (occluded in
+  /// the scene = occluded by its static part or by an instance).
+  bool door_only_rays = true;
 };
 
 struct ExactSolveResult {
@@ -89,6 +102,13 @@ class ExactLeafTransport {
   std::size_t last_pairs_computed() const { return last_pairs_; }
   /// Rays the last update() cast.
   std::size_t last_rays() const { return last_rays_; }
+  /// Rays the last update() cast against the deforming instances alone (door_only_rays; not
+  /// in last_rays()).
+  std::size_t last_door_only_rays() const { return last_door_only_rays_; }
+  /// Of last_rays(): those of pairs with a leaf on a moved instance (their samples moved).
+  std::size_t last_moving_rays() const { return last_moving_rays_; }
+  /// The last update()'s time in the ray caster, summed over its threads (ms).
+  double last_trace_cpu_ms() const { return last_trace_cpu_ms_; }
 
   /// The indirect irradiance with `direct` (W/m^2 per leaf) as the source.
   ExactSolveResult solve(const ElementHierarchy& h, std::span<const glm::vec3> direct) const;
@@ -109,17 +129,53 @@ class ExactLeafTransport {
   float coupling(std::size_t i, std::size_t j) const;
 
  private:
-  /// G of leaves (i, j), i < j, at the caster's current pose; adds its rays to `rays`. With
-  /// `reuse` (and stored visibility) only the samples whose segment meets a swept box are
-  /// traced; the stored bits are updated either way.
-  float pair_coupling(const ElementHierarchy& h, std::size_t i, std::size_t j, bool reuse, std::size_t& rays);
+  struct PairBatch;  // pairs whose samples wait for their rays (the .cpp)
+  /// Point pairs of leaves (ei, ej): point_pairs, at least kMinClosePairs when close, fewer
+  /// with reference_area_m2.
+  int point_pairs_of(const ElementNode& ei, const ElementNode& ej) const;
+  /// Whether segment `r` meets a swept box (a kept sample is traced again).
+  bool meets_swept(const Ray& r) const;
+  /// door_only_rays: queues a sample's rays along `r` (`ray` in the static scene when `traced`,
+  /// else `static_visible` is its stored bit; `door_ray` when a door's box now meets it).
+  void queue_split_sample(const Ray& r, bool traced, bool static_visible, std::int32_t& ray, std::int32_t& door_ray,
+                          PairBatch& batch) const;
+  /// A deforming instance's world box at `m` (door_only_rays).
+  MovingInstances::Box world_box(std::uint32_t instance, const glm::mat4& m) const;
+  /// Queues the point samples of leaves (i, j), i < j, at the caster's current pose: their
+  /// weights, and a ray for each sample to trace. With `reuse` (and stored visibility) only the
+  /// samples whose segment meets a swept box get a ray, the others keep their stored bit.
+  void queue_pair(const ElementHierarchy& h, std::size_t i, std::size_t j, bool reuse, PairBatch& batch) const;
+  /// Traces the batch's rays (a stream, or one by one without `streams`), stores every
+  /// queued pair's G and visibility bits, and empties the batch (counting its rays).
+  void flush(PairBatch& batch);
+  /// The pairs (i, j > i) of row i that update() recomputes, queued and flushed.
+  void update_row(const ElementHierarchy& h, std::size_t i, bool all, std::span<const char> moving,
+                  std::span<const MovingInstances::Box> bounds, PairBatch& batch);
+  /// Whether a swept box can meet a segment between static leaves i and j (`bounds`: each
+  /// leaf's triangle's box).
+  bool pair_may_change(const ElementHierarchy& h, std::size_t i, std::size_t j,
+                       std::span<const MovingInstances::Box> bounds) const;
   std::size_t pair_index(std::size_t i, std::size_t j) const;  // i < j
+  /// Sizes the tables for n leaves (every coupling 0) and the receivers' rows.
+  void reset(std::size_t n);
   /// Jacobi over the rows flagged in `rows` (all when empty), the others held at `others`.
   ExactSolveResult iterate(const ElementHierarchy& h, std::span<const glm::vec3> direct, std::span<const char> rows,
                            std::span<const glm::vec3> others, std::span<const glm::vec3> start) const;
+  /// The receivers' Jacobi on rows_: the senders held at `others` summed once per solve, the
+  /// steps over the receivers' columns only.
+  ExactSolveResult iterate_receivers(const ElementHierarchy& h, std::span<const glm::vec3> direct,
+                                     std::span<const glm::vec3> others, std::span<const glm::vec3> start) const;
+  /// Stores G of pair (i, j), i < j, in g_ and in the receivers' rows.
+  void store(std::size_t i, std::size_t j, float g);
 
   ExactTransportSettings settings_;
   std::unique_ptr<RayCaster> caster_;
+  /// door_only_rays: caster_ holds the static instances only, door_caster_ the deforming ones;
+  /// per BakeInput instance its index there (-1: static) and its object-space box; per
+  /// deforming instance (door_caster_'s order) its world box now.
+  std::unique_ptr<RayCaster> door_caster_;
+  std::vector<std::int32_t> door_slot_;
+  std::vector<MovingInstances::Box> door_box_, door_now_;
   MovingInstances moving_;
   bool dirty_ = false;
   std::size_t n_ = 0;
@@ -127,7 +183,14 @@ class ExactLeafTransport {
   /// With reuse_visibility: per pair (as g_), bit s set when sample s is unoccluded.
   std::vector<std::uint64_t> visible_;
   std::vector<char> receivers_;
-  std::size_t last_pairs_ = 0, last_rays_ = 0;
+  /// With receivers: their leaf indices in order, and every receiver's row of couplings to all
+  /// n leaves (receivers x n, row-major; the same values as g_): the receivers' solve walks
+  /// these rows densely instead of g_'s columns.
+  std::vector<std::uint32_t> recv_;
+  std::vector<std::int32_t> slot_;  ///< Per leaf: its row in rows_, or -1.
+  std::vector<float> rows_;
+  std::size_t last_pairs_ = 0, last_rays_ = 0, last_moving_rays_ = 0, last_door_only_rays_ = 0;
+  double last_trace_cpu_ms_ = 0.0;
 };
 
 }  // namespace gi

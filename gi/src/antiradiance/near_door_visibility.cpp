@@ -37,6 +37,8 @@ engine::Result<NearDoorVisibility> NearDoorVisibility::create(const BakeInput& i
   es.tolerance = settings.tolerance;
   es.seed = settings.seed;
   es.reuse_visibility = settings.reuse_visibility;
+  es.streams = settings.streams;
+  es.door_only_rays = settings.door_only_rays;
   auto t = ExactLeafTransport::create(input, es);
   if (!t) return t.error();
   NearDoorVisibility out(std::move(t).value());

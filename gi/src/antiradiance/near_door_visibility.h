@@ -39,6 +39,11 @@ struct NearDoorVisibilitySettings {
   /// corridor (docs/antiradiance.md); each step is cheap next to the couplings' update.
   double tolerance = 1e-4;
   std::uint64_t seed = 1;
+  /// Rays in streams (ExactTransportSettings::streams; the same couplings).
+  bool streams = true;
+  /// Kept visible samples tested against the door alone (ExactTransportSettings::door_only_rays;
+  /// the same couplings).
+  bool door_only_rays = true;
 };
 
 class NearDoorVisibility {
@@ -62,6 +67,12 @@ class NearDoorVisibility {
   /// The last move's (or create's) recomputed leaf pairs and traced rays.
   std::size_t last_pairs() const { return transport_.last_pairs_computed(); }
   std::size_t last_rays() const { return transport_.last_rays(); }
+  /// Rays against the door alone (not in last_rays()).
+  std::size_t last_door_only_rays() const { return transport_.last_door_only_rays(); }
+  /// Of last_rays(): the door's own pairs' (their samples moved with it).
+  std::size_t last_moving_rays() const { return transport_.last_moving_rays(); }
+  /// The last update's time in the ray caster, summed over its threads (ms).
+  double last_trace_cpu_ms() const { return transport_.last_trace_cpu_ms(); }
   /// The last move's time in the couplings' update and in the receivers' solve, ms.
   double last_update_ms() const { return update_ms_; }
   double last_solve_ms() const { return solve_ms_; }

@@ -68,4 +68,34 @@ class SplitTruthChangeScore {
   double sea_ = 0.0, sec_ = 0.0, sdd_ = 0.0;
 };
 
+/// The floor of a linear projection P (the leaves' blend of a per-texel field,
+/// project_through_leaves) measured on a truth known only through two noisy estimates
+/// a = t + n_a, b = t + n_b (independent noise of the same distribution; it may be correlated
+/// across samples within one estimate). The floor's error is sum |P t - t|^2. Projecting one
+/// estimate carries its noise: (P - I) a = (P - I) t + (P - I) n_a, and -n_a is the whole
+/// noise. With the mean c = (a + b) / 2 and the half difference h = (a - b) / 2, whose noise
+/// (n_a - n_b) / 2 has the covariance of c's (n_a + n_b) / 2 and which holds no truth,
+///   E sum |(P - I) c|^2 = sum |(P - I) t|^2 + E sum |(P - I) h|^2,
+/// so sum |P c - c|^2 - sum |P h - h|^2 estimates the floor without bias. The caller projects
+/// c and h and adds the residuals sample by sample (channel by channel).
+///   floor.add(pc[t][ch] - c[t][ch], ph[t][ch] - h[t][ch]);
+class SplitTruthFloor {
+ public:
+  /// One sample: (P c - c) and (P h - h) there.
+  void add(double residual_of_mean, double residual_of_half_difference) {
+    n_ += 1.0;
+    sc_ += residual_of_mean * residual_of_mean;
+    sh_ += residual_of_half_difference * residual_of_half_difference;
+  }
+  void merge(const SplitTruthFloor& o) { n_ += o.n_, sc_ += o.sc_, sh_ += o.sh_; }
+  double samples() const { return n_; }
+  /// sum |P t - t|^2 estimated without bias; may be negative when the floor is within the noise.
+  double noise_removed_sse() const { return sc_ - sh_; }
+  /// sum |(P - I) h|^2: the noise the mean's floor carries (what noise_removed_sse() removed).
+  double noise_sse() const { return sh_; }
+
+ private:
+  double n_ = 0.0, sc_ = 0.0, sh_ = 0.0;
+};
+
 }  // namespace gi

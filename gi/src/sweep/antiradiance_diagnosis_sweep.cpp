@@ -8,6 +8,7 @@
 
 #include "antiradiance/antiradiance_direct_light.h"
 #include "antiradiance/antiradiance_exact_transport.h"
+#include "antiradiance/split_truth_change_score.h"
 
 namespace gi::antiradiance_sweep {
 
@@ -86,6 +87,50 @@ engine::Result<MethodOutput> run_projection_floor(const RunContext& ctx, const D
                 {"leaves", static_cast<double>(h->leaf_count())},
                 {"compared_texels", static_cast<double>(d.compared)}};
   return out;
+}
+
+engine::Result<std::vector<std::pair<std::string, double>>> split_floor_extras(const DoorSetup& d,
+                                                                               const AntiradianceSettings& s,
+                                                                               const RgbField& a, const RgbField& b) {
+  auto h = build_element_hierarchy(d.input, s);
+  if (!h) return h.error();
+  const std::vector<AntiradianceTexelBlend> blends = antiradiance_texel_blends(*h, d.input, d.layout);
+  const std::size_t n = d.texels.valid.size();
+  double truth_sq = 0.0, level = 0.0;  // as split_truth_extras: sum t^2 over the moved poses, the baked level
+  for (std::size_t t = 0; t < n; ++t)
+    if (d.mask[t]) level += 0.5 * static_cast<double>(glm::dot(ref_at(a, t) + ref_at(b, t), glm::vec3(1.0f)));
+  level /= 3.0 * static_cast<double>(d.compared);
+  SplitTruthFloor all;
+  std::vector<std::pair<std::string, double>> per_angle;
+  for (std::size_t k = 1; k < d.poses(); ++k) {
+    std::vector<glm::vec3> mean(n, glm::vec3(0.0f)), half(n, glm::vec3(0.0f));
+    for (std::size_t t = 0; t < n; ++t) {
+      if (!d.mask[t]) continue;
+      const glm::vec3 ca = ref_at(a, k * n + t) - ref_at(a, t), cb = ref_at(b, k * n + t) - ref_at(b, t);
+      mean[t] = 0.5f * (ca + cb), half[t] = 0.5f * (ca - cb);
+      truth_sq += static_cast<double>(glm::dot(ref_at(a, k * n + t), ref_at(b, k * n + t)));
+    }
+    const std::vector<glm::vec3> pm = project_through_leaves(blends, mean, d.mask, h->leaf_count());
+    const std::vector<glm::vec3> ph = project_through_leaves(blends, half, d.mask, h->leaf_count());
+    SplitTruthFloor pose;
+    for (std::size_t t = 0; t < n; ++t)
+      if (d.mask[t])
+        for (int c = 0; c < 3; ++c)
+          pose.add(static_cast<double>(pm[t][c] - mean[t][c]), static_cast<double>(ph[t][c] - half[t][c]));
+    all.merge(pose);
+    const int swing = static_cast<int>(d.swings[k - 1]);
+    const std::string name = std::string(swing < 0 ? "m" : "p") + std::to_string(std::abs(swing));
+    per_angle.emplace_back("split_floor_nrmse_swing_" + name,
+                           std::sqrt(std::max(0.0, pose.noise_removed_sse()) / std::max(pose.samples(), 1.0)) / level);
+  }
+  std::vector<std::pair<std::string, double>> extras = {
+      {"split_floor_rel_rmse", std::sqrt(std::max(0.0, all.noise_removed_sse()) / truth_sq)},
+      // The floor of the mean of the two references (its noise halved, not removed), and the
+      // noise it carries: split_floor_rel_rmse^2 = the first^2 - the second^2.
+      {"split_floor_of_mean_rel_rmse", std::sqrt((all.noise_removed_sse() + all.noise_sse()) / truth_sq)},
+      {"split_floor_noise_rel_rmse", std::sqrt(all.noise_sse() / truth_sq)}};
+  extras.insert(extras.end(), per_angle.begin(), per_angle.end());
+  return extras;
 }
 
 namespace {

@@ -67,6 +67,13 @@ struct NearVisibility {
 /// `--knob solve=off`: the leaves only; the field is their projection floor.
 engine::Result<MethodOutput> run_projection_floor(const RunContext& ctx, const DoorSetup& d,
                                                   const AntiradianceSettings& s);
+/// `--knob solve=off` with `ref_pair`: the projection floor with the references' noise removed
+/// (SplitTruthFloor: the mean of the two references' changes through the leaves, less the
+/// floor of their half difference), as `split_floor_*` extras in split_rel_rmse's units, and
+/// per angle in split_change_nrmse_swing_*'s.
+engine::Result<std::vector<std::pair<std::string, double>>> split_floor_extras(const DoorSetup& d,
+                                                                               const AntiradianceSettings& s,
+                                                                               const RgbField& a, const RgbField& b);
 /// `--knob solve=exact`: the visibility-exact solver on the method's leaves, scored like it.
 engine::Result<MethodOutput> run_exact_transport(const RunContext& ctx, const DoorSetup& d,
                                                  const AntiradianceSettings& s);

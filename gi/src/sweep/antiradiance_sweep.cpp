@@ -474,10 +474,14 @@ engine::Result<MethodOutput> run_door_moves(const RunContext& ctx) {
                          .split_truth = ctx.split_truth};
   auto out = run_on_one_truth(first);
   if (!out) return out;
+  auto d = door_setup(ctx.scene, ctx.knobs.real("density"), ctx.knobs.real("radius"), ctx.knobs.text("swings"));
+  if (!d) return d.error();
   if (ctx.knobs.text("solve") != "off") {  // the floor's field carries the first reference's noise
-    auto d = door_setup(ctx.scene, ctx.knobs.real("density"), ctx.knobs.real("radius"), ctx.knobs.text("swings"));
-    if (!d) return d.error();
     for (auto& e : split_truth_extras(*d, out->field, a, b)) out->extras.push_back(std::move(e));
+  } else {  // its own split: the floor with the noise removed
+    auto floor = split_floor_extras(*d, antiradiance_settings(ctx), a, b);
+    if (!floor) return floor.error();
+    for (auto& e : *floor) out->extras.push_back(std::move(e));
   }
   // The output in the reference's layout: the second half is not the run's to match.
   if (out->field.valid.empty()) out->field.valid.assign(out->field.count(), 1);

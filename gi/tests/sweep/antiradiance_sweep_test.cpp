@@ -82,4 +82,47 @@ TEST(AntiradianceSweep, CorridorDoorSwingRunIsMeasured) {
   }
 }
 
+// The projection floor (`solve=off`) with the split truth (issue 37): the floor as scored
+// passes the first reference's change through the leaves and carries its noise; the split
+// floor (SplitTruthFloor: the two references' mean change through the leaves, less the floor
+// of their half difference) removes it. The mean of two carries half one's noise, so its
+// floor is below the floor as scored; the noise removed is what separates it from the split
+// floor (the mean's floor squared = floor squared + noise squared; at this test's 256 spp the
+// noise can exceed the floor, and the floor is then reported as 0).
+TEST(AntiradianceSweep, TheProjectionFloorIsMeasuredWithTheReferencesNoiseRemoved) {
+  TempDir dir("antiradiance_floor");
+  gi::SweepRequest request;
+  request.method = "antiradiance";
+  request.scene = fs::path(GI_SOURCE_DIR) / "assets" / "corridor.gltf";
+  request.knobs = {"patch=0.8", "bins=6", "solve=off", "density=4", "ref_spp=256"};
+  request.out_dir = dir.path();
+  auto report = gi::run_sweep(request);
+  ASSERT_TRUE(report) << report.error().to_string();
+  auto rows = sweeptest::read_rows(report->csv);
+  ASSERT_TRUE(rows) << rows.error().to_string();
+  ASSERT_EQ(rows->size(), 1u);
+  const gi::SweepRow& row = rows->front();
+  ASSERT_TRUE(row.ok()) << row.status;
+  auto extra = [&](const std::string& name) {
+    for (const auto& [n, v] : row.extras)
+      if (n == name) return v;
+    ADD_FAILURE() << "no extra " << name;
+    return std::numeric_limits<double>::quiet_NaN();
+  };
+  const double as_scored = extra("projection_floor_rel_rmse"), split = extra("split_floor_rel_rmse");
+  const double of_mean = extra("split_floor_of_mean_rel_rmse"), noise = extra("split_floor_noise_rel_rmse");
+  std::printf("projection floor: %.4f as scored, %.4f of the two references' mean, %.4f noise removed (noise %.4f)\n",
+              as_scored, of_mean, split, noise);
+  EXPECT_GT(noise, 0.0);
+  EXPECT_GE(split, 0.0);
+  EXPECT_LT(split, of_mean);
+  EXPECT_LT(of_mean, as_scored);  // the mean of two carries half the noise of one
+  if (split > 0.0)
+    EXPECT_NEAR(split * split + noise * noise, of_mean * of_mean, 1e-9);
+  else
+    EXPECT_LE(of_mean, noise);
+  for (const char* swing : {"m50", "m25", "p50"})
+    EXPECT_TRUE(std::isfinite(extra(std::string("split_floor_nrmse_swing_") + swing))) << swing;
+}
+
 }  // namespace
