@@ -119,9 +119,12 @@ std::vector<std::string> gi_status_lines(const gi::GISystem* system) {
     lines.emplace_back(line);
   }
   if (st.antiradiance_updates > 0) {
-    std::snprintf(line, sizeof line, "antiradiance: %llu door moves solved, last %.0f ms (%zu elements relinked)",
-                  static_cast<unsigned long long>(st.antiradiance_updates), st.last_antiradiance_ms,
-                  st.antiradiance_relinked_elements);
+    std::snprintf(
+        line, sizeof line,
+        "antiradiance: %llu door moves solved, last %.0f ms (%zu elements relinked; near-door visibility %.0f "
+        "ms of it)",
+        static_cast<unsigned long long>(st.antiradiance_updates), st.last_antiradiance_ms,
+        st.antiradiance_relinked_elements, st.antiradiance_near_ms);
     lines.emplace_back(line);
   }
   for (const std::string& off : st.disabled) lines.push_back("off: " + off);

@@ -111,6 +111,9 @@ class GISystem final : public engine::IndirectLightProvider {
     /// direct light: false for the first move after load, after a solve that did not
     /// converge, and for a move back to the baked pose (nothing is solved there).
     bool antiradiance_warm = false;
+    /// Last such frame: the part of last_antiradiance_ms spent in near-door visibility (its
+    /// couplings' update and solve on the CPU; 0 without it, docs/antiradiance.md).
+    double antiradiance_near_ms = 0.0;
     /// Light and dynamic-object entities left out of the last frame's GI because their world
     /// transform or light values are unusable (NaN, infinite, absurd: engine/runtime_limits.h).
     /// A skipped light gives no light; a skipped object keeps its last usable pose. Each is

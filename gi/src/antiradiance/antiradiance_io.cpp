@@ -97,6 +97,10 @@ std::string check_settings(const AntiradianceSettings& s) {
   if (s.leaf_link_pieces < 0 || s.leaf_link_pieces > kMaxLeafLinkPieces)
     return "leaf_link_pieces outside 0.." + std::to_string(kMaxLeafLinkPieces);
   if (s.scheme != AntiradianceScheme::Symmetric && s.scheme != AntiradianceScheme::Asymmetric) return "unknown scheme";
+  if (!(s.near_visibility_radius_m >= 0.0f) || !std::isfinite(s.near_visibility_radius_m))
+    return "near_visibility_radius_m must be finite and not negative";
+  if (s.near_visibility_point_pairs < 1 || s.near_visibility_point_pairs > 64)
+    return "near_visibility_point_pairs outside 1..64";
   return {};
 }
 
@@ -110,6 +114,13 @@ std::string check_bake(const AntiradianceBake& b) {
   if (h.node_instance.size() != n || h.object_center.size() != n || h.object_normal.size() != n ||
       h.object_radius.size() != n || h.object_area.size() != n)
     return "per-element arrays differ in size from the " + std::to_string(n) + " elements";
+  // The triangles (near-door visibility's rays): 3 corners per element, or none.
+  if ((!h.corners.empty() && h.corners.size() != 3 * n) || h.object_corners.size() != h.corners.size())
+    return "the element triangles are not 3 corners per element";
+  if (b.settings.near_visibility && h.corners.empty()) return "near visibility without the element triangles";
+  for (std::size_t c = 0; c < h.corners.size(); ++c)
+    if (!finite3(h.corners[c]) || !finite3(h.object_corners[c]))
+      return "an element triangle has a NaN or infinite corner";
   if (h.group_transform.size() != h.deforming_instances.size() ||
       h.group_root.size() != h.deforming_instances.size() + 1)
     return "group arrays do not match the " + std::to_string(h.deforming_instances.size()) + " deforming instances";
@@ -297,6 +308,9 @@ json settings_json(const AntiradianceSettings& s) {
               {"near_patch_size_m", s.near_patch_size_m},
               {"near_radius_m", s.near_radius_m},
               {"leaf_link_pieces", s.leaf_link_pieces},
+              {"near_visibility", s.near_visibility},
+              {"near_visibility_radius_m", s.near_visibility_radius_m},
+              {"near_visibility_point_pairs", s.near_visibility_point_pairs},
               {"seed", s.seed}};
 }
 
@@ -322,6 +336,9 @@ engine::Status write_antiradiance(const fs::path& path, const AntiradianceBake& 
   w.put(s.near_patch_size_m);
   w.put(s.near_radius_m);
   w.put(static_cast<std::int32_t>(s.leaf_link_pieces));
+  w.put(static_cast<std::uint8_t>(s.near_visibility ? 1 : 0));
+  w.put(s.near_visibility_radius_m);
+  w.put(static_cast<std::int32_t>(s.near_visibility_point_pairs));
   const ElementHierarchy& h = b.hierarchy;
   w.array(h.deforming_instances);
   w.array(h.group_transform);
@@ -334,6 +351,10 @@ engine::Status write_antiradiance(const fs::path& path, const AntiradianceBake& 
   w.array(h.object_normal);
   w.array(h.object_radius);
   w.array(h.object_area);
+  // The triangles only where the runtime traces rays against them (near-door visibility).
+  const std::vector<glm::vec3> none;
+  w.array(s.near_visibility ? h.corners : none);
+  w.array(s.near_visibility ? h.object_corners : none);
   // The static links, most of the file: their planes as one zstd frame.
   const std::vector<std::uint8_t> planes = link_planes(b.static_links.links);
   auto frame = write_zstd_stream(path, planes, kZstdLevel);
@@ -351,16 +372,18 @@ engine::Result<AntiradianceFile> read_antiradiance(const fs::path& path) {
   AntiradianceFile f;
   AntiradianceSettings& s = f.bake.settings;
   ElementHierarchy& h = f.bake.hierarchy;
-  std::int32_t bins = 0, iterations = 0, steps = 0, growth = 0, samples = 0, pieces = 0;
-  std::uint8_t scheme = 0;
+  std::int32_t bins = 0, iterations = 0, steps = 0, growth = 0, samples = 0, pieces = 0, near_pairs = 0;
+  std::uint8_t scheme = 0, near = 0;
   std::uint64_t seed = 0;
-  const bool ok =
-      r.string(f.geometry_hash) && r.get(bins) && r.get(s.patch_size_m) && r.get(s.exchange_radius_m) &&
-      r.get(s.oracle_scale) && r.get(iterations) && r.get(steps) && r.get(scheme) && r.get(s.residual_tolerance) &&
-      r.get(growth) && r.get(samples) && r.get(seed) && r.get(s.near_patch_size_m) && r.get(s.near_radius_m) &&
-      r.get(pieces) && r.array(h.deforming_instances) && r.array(h.group_transform) && r.array(h.nodes) &&
-      r.array(h.children) && r.array(h.leaves) && r.array(h.group_root) && r.array(h.node_instance) &&
-      r.array(h.object_center) && r.array(h.object_normal) && r.array(h.object_radius) && r.array(h.object_area);
+  const bool ok = r.string(f.geometry_hash) && r.get(bins) && r.get(s.patch_size_m) && r.get(s.exchange_radius_m) &&
+                  r.get(s.oracle_scale) && r.get(iterations) && r.get(steps) && r.get(scheme) &&
+                  r.get(s.residual_tolerance) && r.get(growth) && r.get(samples) && r.get(seed) &&
+                  r.get(s.near_patch_size_m) && r.get(s.near_radius_m) && r.get(pieces) && r.get(near) &&
+                  r.get(s.near_visibility_radius_m) && r.get(near_pairs) && r.array(h.deforming_instances) &&
+                  r.array(h.group_transform) && r.array(h.nodes) && r.array(h.children) && r.array(h.leaves) &&
+                  r.array(h.group_root) && r.array(h.node_instance) && r.array(h.object_center) &&
+                  r.array(h.object_normal) && r.array(h.object_radius) && r.array(h.object_area) &&
+                  r.array(h.corners) && r.array(h.object_corners);
   std::uint64_t link_count = 0;
   std::vector<std::uint8_t> frame;
   if (!ok || !r.get(link_count) || !r.array(frame) || !r.array(f.bake.baseline))
@@ -380,6 +403,9 @@ engine::Result<AntiradianceFile> read_antiradiance(const fs::path& path) {
   s.area_light_samples = samples;
   s.seed = seed;
   s.leaf_link_pieces = pieces;
+  if (near > 1) return file_error(path, "near_visibility", "not 0 or 1 (corrupt)");
+  s.near_visibility = near == 1;
+  s.near_visibility_point_pairs = near_pairs;
   if (std::string problem = check_bake(f.bake); !problem.empty()) return file_error(path, "", problem);
   index_links(h.nodes.size(), f.bake.static_links);
   f.bake.static_links.links_made = f.bake.static_links.links.size();

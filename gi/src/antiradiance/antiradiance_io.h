@@ -5,8 +5,9 @@
 //   auto bake = gi::load_antiradiance("level.gibake", input);   // checks the geometry hash
 //
 // Files (DESIGN.md §5, docs/bake-bundle.md):
-//   antiradiance.bin  the checksummed container of io/blob_file.h, magic "GIANTIRA", version 3
-//                     (version 2 lacked the refinement settings below, so a load relinked the
+//   antiradiance.bin  the checksummed container of io/blob_file.h, magic "GIANTIRA", version 4
+//                     (version 3 lacked the near-door visibility settings and the element
+//                     triangles its rays need; version 2 lacked the refinement settings below, so a load relinked the
 //                     door without split leaf links; version 1 stored the links as 16-byte
 //                     records. Both are refused by name: re-bake).
 //   antiradiance_at_pose.bin  magic "GIANTPOS", version 1: what a load at the baked pose
@@ -33,7 +34,9 @@
 //   int32 bins_per_side, float32 patch_size_m, float32 exchange_radius_m, float32 oracle_scale,
 //   int32 iterations, int32 antiradiance_steps, uint8 scheme, float64 residual_tolerance,
 //   int32 growth_limit, int32 area_light_samples, uint64 seed,
-//   float32 near_patch_size_m, float32 near_radius_m, int32 leaf_link_pieces  AntiradianceSettings
+//   float32 near_patch_size_m, float32 near_radius_m, int32 leaf_link_pieces,
+//   uint8 near_visibility (0/1), float32 near_visibility_radius_m,
+//   int32 near_visibility_point_pairs                                         AntiradianceSettings
 //   array<uint32> deforming_instances      BakeInput instance of each deforming group
 //   array<mat4>   group_transform          the pose each group was baked at
 //   array<node>   nodes                    ElementNode, 18 x 4 bytes: center vec3, radius,
@@ -41,6 +44,9 @@
 //                                          child_count, leaf_begin, leaf_end, group, end (int32s)
 //   array<int32>  children, leaves, group_root, node_instance
 //   array<vec3>   object_center, object_normal;  array<float32> object_radius, object_area
+//   array<vec3>   corners, object_corners  each element's triangle (3 per element, world at the
+//                                          baked pose and object space; zeros for clusters);
+//                                          empty unless near_visibility (the runtime's rays)
 //   uint64        link_count               the static links, sorted by (receiver, bin, sender)
 //   array<uint8>  link_frame               one zstd frame of link_count x 14 bytes, lossless planes:
 //                                          receiver - previous receiver (uint32), bin (uint16),
@@ -67,7 +73,7 @@ namespace gi {
 inline constexpr const char* kAntiradianceMethod = "antiradiance";
 inline constexpr const char* kAntiradianceFile = "antiradiance.bin";
 inline constexpr BlobMagic kAntiradianceMagic{"GIANTIRA"};
-inline constexpr std::uint32_t kAntiradianceVersion = 3;
+inline constexpr std::uint32_t kAntiradianceVersion = 4;
 /// What the bake computed for a load at its pose (AntiradianceBake::AtBakedPose).
 inline constexpr const char* kAntiradianceAtPoseFile = "antiradiance_at_pose.bin";
 inline constexpr BlobMagic kAntiradianceAtPoseMagic{"GIANTPOS"};

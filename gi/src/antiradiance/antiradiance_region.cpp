@@ -156,6 +156,7 @@ std::vector<glm::vec3> AntiradianceRegion::delta(const std::vector<glm::vec3>& i
 
 AntiradianceSolveReport AntiradianceRegion::update(bool solve) {
   counters_ = {};
+  adopted_.clear();
   if (!moved_.empty()) {
     std::sort(moved_.begin(), moved_.end());
     relink_moved(*hierarchy_, *bins_, settings_, moved_, *links_);

@@ -21,6 +21,7 @@
 //   std::vector<glm::vec3> e = region.irradiance();   // indirect W/m^2 per leaf
 
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include <engine/result.h>
@@ -120,11 +121,15 @@ class AntiradianceRegion {
   /// Indirect irradiance (W/m^2) per leaf of the last CPU solve (its energy guard applied);
   /// the baseline when that update found the region posed as baked.
   std::vector<glm::vec3> irradiance() const {
+    if (!adopted_.empty()) return adopted_;
     if (showing_baseline_) return baseline_;
     std::vector<glm::vec3> e = cpu_->irradiance();
     for (glm::vec3& v : e) v *= last_.output_scale;
     return e;
   }
+  /// A solve made elsewhere (the GPU twin's, read back, its energy guard applied): irradiance()
+  /// returns it until the next update(). What near-door visibility holds the other leaves at.
+  void adopt_irradiance(std::vector<glm::vec3> irradiance) { adopted_ = std::move(irradiance); }
   /// The exitant intensities I_ex of the last CPU solve (nodes x bins RGB, W/sr; its energy
   /// guard applied): what gather_at_points reads (antiradiance_texel_gather.h). An update
   /// that skipped the solve (posed as baked) leaves them as they were.
@@ -165,6 +170,7 @@ class AntiradianceRegion {
   std::unique_ptr<CpuAntiradiancePasses> cpu_;
   std::vector<glm::vec3> direct_;
   std::vector<glm::vec3> baseline_;
+  std::vector<glm::vec3> adopted_;          ///< adopt_irradiance's, until the next update().
   std::vector<glm::mat4> baked_transform_;  ///< Per deforming group g: [g - 1], as baked.
   std::vector<int> moved_;
   AntiradianceSolveReport last_;

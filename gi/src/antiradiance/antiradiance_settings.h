@@ -80,6 +80,20 @@ struct AntiradianceSettings {
   /// Stratified points per area light / emissive triangle for the direct light.
   int area_light_samples = 16;
   std::uint64_t seed = 1;
+  /// Near-door visibility at run time (issue 37; NearDoorVisibility, near_door_visibility.h):
+  /// the leaves within near_visibility_radius_m of a deforming instance's reach (and its own
+  /// leaves) gather their light with ray-traced visibility from every leaf, the others keep
+  /// the antiradiance solve. The runtime computes the baked pose's couplings at load and
+  /// updates them on every door move (AntiradianceLighting). Stored in antiradiance.bin
+  /// (version 4, with the elements' triangles the rays need).
+  bool near_visibility = false;
+  /// Leaves whose bounding sphere comes this close to the instance's reach are receivers (m;
+  /// NearDoorVisibilitySettings::radius_m).
+  float near_visibility_radius_m = 1.0f;
+  /// Point pairs per leaf pair (NearDoorVisibilitySettings::point_pairs; 1..64: the kept
+  /// visibility holds 64 bits per pair). 4 scored as 16 on the corridor (0.1033 / 0.1032 of
+  /// the level, docs/antiradiance.md) at a quarter of the rays.
+  int near_visibility_point_pairs = 4;
 };
 
 /// The settings gi-bake bakes a preset at (and the planner estimates; issue 37, measured by
@@ -89,12 +103,16 @@ struct AntiradianceSettings {
 /// 64 / 144 / 324 bins at preview / medium / high (the bins buy the accuracy, at 2.4x / ~4x
 /// the preview's door move and file; 256 bins scored worse than 144 at the door's fourth angle,
 /// and 400 bins put the demo level's 17.3 M static links at 138 MB, above llvmpipe's 128 MiB
-/// SSBO limit for the GPU pass).
+/// SSBO limit for the GPU pass). Near-door visibility at medium and high (the change's error
+/// 0.104 of the level with the noise removed against medium's 0.182 alone, at 1.2-1.9x its
+/// door move), not at preview (its load work and n^2 pair memory on a preview's budget:
+/// docs/antiradiance.md "Issue 37: near-door visibility in the runtime").
 inline AntiradianceSettings antiradiance_preset(std::string_view preset) {
   AntiradianceSettings s;
   s.patch_size_m = 0.8f;
   s.leaf_link_pieces = 64;
   s.bins_per_side = preset == "high" ? 18 : preset == "medium" ? 12 : 8;
+  s.near_visibility = preset == "high" || preset == "medium";
   return s;
 }
 

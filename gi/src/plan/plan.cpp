@@ -349,6 +349,35 @@ void plan_reflection_probes(const BakeInput& input, const PlanFacts& f, const Pl
                          " rays; RGBA16F with mips"};
 }
 
+// Near-door visibility (antiradiance's preset setting): its receivers as NearDoorVisibility
+// picks them (a deforming instance's leaves and those within the radius of its reach), its
+// memory added to the estimate, its load work and per-move cost in the basis.
+void add_near_visibility(const BakeInput& input, const ElementHierarchy& h, const AntiradianceSettings& s,
+                         EffectEstimate& e) {
+  std::size_t receivers = 0;
+  for (std::uint32_t door : h.deforming_instances) {
+    const glm::vec3 origin(input.instances[door].object_to_world[3]);
+    float reach = 0.0f;
+    for (const BakePrimitive& p : input.meshes[input.instances[door].mesh].primitives)
+      for (const glm::vec3& v : p.positions) reach = std::max(reach, glm::length(v));
+    for (std::int32_t leaf : h.leaves) {
+      const ElementNode& n = h.nodes[static_cast<std::size_t>(leaf)];
+      receivers +=
+          static_cast<std::size_t>(h.node_instance[static_cast<std::size_t>(leaf)] == static_cast<std::int32_t>(door) ||
+                                   glm::length(n.center - origin) <= reach + s.near_visibility_radius_m + n.radius_m);
+    }
+  }
+  double move_seconds = 0.0;
+  const BakeWork w = near_visibility_work(h.leaf_count(), receivers, s, &move_seconds);
+  // Not baked (a load computes the couplings: storing them would be their 12 bytes per pair),
+  // so no bake seconds; the memory is the runtime's largest item for the region (CPU-side,
+  // counted here unlike the links' CPU copy: it grows with the square of the leaves).
+  e.runtime_bytes += w.runtime_bytes;
+  e.basis += "; near-door visibility: " + std::to_string(receivers) + " receivers x " + std::to_string(h.leaf_count()) +
+             " leaves, ~" + fixed(w.units * 1e-6, 1) + " M pairs at load (~" + fixed(w.cpu_seconds, 1) + " s), ~" +
+             fixed(move_seconds, 1) + " s per door move, " + format_bytes(w.runtime_bytes) + " CPU";
+}
+
 // Antiradiance: flagged deforming or opening regions.
 void plan_antiradiance(const BakeInput& input, const PlanFacts& f, const PlanOptions& options, bool known_preset,
                        PlannedEffect& anti) {
@@ -373,6 +402,7 @@ void plan_antiradiance(const BakeInput& input, const PlanFacts& f, const PlanOpt
                        fixed(s.patch_size_m, 1) + " m) x " + std::to_string(s.bins_per_side * s.bins_per_side) +
                        " bins -> ~" + fixed(links * 1e-6, 1) + " M links; GPU tables + links; file ~" +
                        format_bytes(static_cast<std::uint64_t>(file))};
+  if (s.near_visibility) add_near_visibility(input, *h, s, anti.estimate);
 }
 
 // Basis radiance fields: the meshes of dynamic instances, once per mesh.

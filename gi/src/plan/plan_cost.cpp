@@ -336,8 +336,28 @@ constexpr double kArFileBytesPerLink = 4.8;
 // Iterations of a solve to a residual tolerance (1e-3): 19 on the corridor at 0.8 m / 64 bins
 // (docs/antiradiance.md, issue 37); at most the budget.
 constexpr int kArConvergedIterations = 19;
+// Near-door visibility on the corridor at medium (docs/antiradiance.md, issue 37: 863
+// receivers of ~2740 leaves, 2.4 M pairs, 4 point pairs): the baked pose's couplings 1.1-1.6 s
+// (BM_NearVisibilityMoveAtMedium's near_bake_ms at load 8-10), so ~0.14 us per point pair;
+// a door move's near update 0.40-0.66 s, ~0.4 of that.
+constexpr double kNearSecondsPerPointPair = 1.4e-7;
+constexpr double kNearMoveFraction = 0.4;
+constexpr double kNearBytesPerPair = 12.0;
 
 }  // namespace
+
+BakeWork near_visibility_work(std::size_t leaves, std::size_t receivers, const AntiradianceSettings& s,
+                              double* move_seconds) {
+  BakeWork w;
+  const double l = static_cast<double>(leaves), r = static_cast<double>(std::min(receivers, leaves));
+  const double pairs = r * (l - 1.0) - r * (r - 1.0) / 2.0;  // pairs with at least one receiver
+  w.units = pairs;
+  w.rays = pairs * std::max(1, s.near_visibility_point_pairs);
+  w.cpu_seconds = w.rays * kNearSecondsPerPointPair;  // at load; nothing is baked
+  w.runtime_bytes = static_cast<std::uint64_t>(kNearBytesPerPair * l * (l - 1.0) / 2.0);
+  if (move_seconds) *move_seconds = kNearMoveFraction * w.cpu_seconds;
+  return w;
+}
 
 BakeWork antiradiance_work(std::size_t elements, std::size_t leaves, const AntiradianceSettings& s, double* links,
                            double* file_bytes) {

@@ -70,6 +70,14 @@ BakeWork dlm_work(const StaticSurfaceCensus& glossy, double albedo, const AtlasT
 /// them and solves the baseline. runtime_bytes: the GPU tables (exitant and incident per
 /// node and bin, I_L and I_A per leaf and bin: 12 B each) and the 8-byte link records with
 /// their (receiver, bin) runs. `links` out: the link estimate; `file_bytes` out: antiradiance.bin.
+/// Near-door visibility (issue 37; settings.near_visibility, AntiradianceLighting): the
+/// couplings of `receivers` leaves with all `leaves` at the baked pose, computed at load, not
+/// baked (cpu_seconds: that load work, bake_seconds 0; units: the leaf pairs), and the memory the
+/// runtime keeps on the CPU (runtime_bytes: a float coupling and 8 bytes of kept visibility per
+/// pair of leaves, every pair allocated). `move_seconds` out: a door move's near update.
+BakeWork near_visibility_work(std::size_t leaves, std::size_t receivers, const AntiradianceSettings& settings,
+                              double* move_seconds = nullptr);
+
 BakeWork antiradiance_work(std::size_t elements, std::size_t leaves, const AntiradianceSettings& settings,
                            double* links = nullptr, double* file_bytes = nullptr);
 

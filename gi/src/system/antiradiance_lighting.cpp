@@ -31,7 +31,69 @@ bool blends_fit(const std::vector<TexelBlend>& blends, const AtlasLayout& layout
   return true;
 }
 
+// The leaves NearDoorVisibility::create makes receivers around `door` (its rule, repeated
+// here because the class tells only their count): a leaf of the door, or one whose bounding
+// sphere comes within radius_m of the sphere the door reaches about its origin.
+std::vector<char> near_receiver_mask(const ElementHierarchy& h, const BakeInput& input, std::uint32_t door,
+                                     float radius_m) {
+  const glm::vec3 origin(input.instances[door].object_to_world[3]);
+  float reach = 0.0f;
+  for (const BakePrimitive& p : input.meshes[input.instances[door].mesh].primitives)
+    for (const glm::vec3& v : p.positions) reach = std::max(reach, glm::length(v));
+  std::vector<char> mask(h.leaf_count(), 0);
+  for (std::size_t l = 0; l < h.leaf_count(); ++l) {
+    const auto node = static_cast<std::size_t>(h.leaves[l]);
+    const ElementNode& e = h.nodes[node];
+    mask[l] = h.node_instance[node] == static_cast<std::int32_t>(door) ||
+              glm::length(e.center - origin) <= reach + radius_m + e.radius_m;
+  }
+  return mask;
+}
+
+double ms_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
 }  // namespace
+
+void AntiradianceLighting::create_near_sets(const BakeInput& input) {
+  const AntiradianceSettings& s = region_->settings();
+  if (!s.near_visibility) return;
+  const auto t0 = std::chrono::steady_clock::now();
+  const ElementHierarchy& h = region_->hierarchy();
+  if (!region_->at_baked_pose())
+    near_reason_ = "the scene's deforming nodes are not at the baked pose (the near sets' zero is that pose)";
+  else if (h.corners.size() != 3 * h.nodes.size())
+    near_reason_ = "the bake holds no element triangles to trace against";
+  NearDoorVisibilitySettings ns;
+  ns.radius_m = s.near_visibility_radius_m;
+  ns.point_pairs = s.near_visibility_point_pairs;
+  for (std::uint32_t door : h.deforming_instances) {
+    if (!near_reason_.empty()) break;
+    auto near = NearDoorVisibility::create(input, *region_, door, ns);
+    if (!near) {
+      near_reason_ = near.error().to_string();
+      break;
+    }
+    NearSet set{door, near_receiver_mask(h, input, door, ns.radius_m),
+                std::make_unique<NearDoorVisibility>(std::move(near).value())};
+    const auto count = static_cast<std::size_t>(std::count(set.receivers.begin(), set.receivers.end(), char{1}));
+    if (count != set.visibility->receivers())
+      near_reason_ = "its receivers (" + std::to_string(set.visibility->receivers()) + ") are not the runtime's (" +
+                     std::to_string(count) + ")";
+    else if (count > 0)
+      near_.push_back(std::move(set));
+  }
+  if (!near_reason_.empty()) {
+    near_.clear();
+    stats_.near_fell_back = true;
+    if (log_) log_(LogLevel::Warning, "antiradiance: near-door visibility off, antiradiance alone: " + near_reason_);
+    return;
+  }
+  stats_.near_visibility = !near_.empty();
+  for (const NearSet& n : near_) stats_.near_receivers += n.visibility->receivers();
+  stats_.near_load_ms = ms_since(t0);
+}
 
 engine::Result<std::unique_ptr<AntiradianceLighting>> AntiradianceLighting::create(AntiradianceBake bake,
                                                                                    const BakeInput& input,
@@ -62,6 +124,7 @@ engine::Result<std::unique_ptr<AntiradianceLighting>> AntiradianceLighting::crea
   a->stats_.covered_texels = blends.size();
   a->stats_.links = a->region_->links().links.size();
   a->blends_host_ = std::move(blends);  // uploaded on the first frame (GL context current)
+  a->create_near_sets(input);           // after the region's first direct light (at create)
   return a;
 }
 
@@ -97,35 +160,71 @@ bool AntiradianceLighting::ensure_gpu() {
   return true;
 }
 
-void AntiradianceLighting::upload_delta(const std::vector<glm::vec3>& irradiance, float scale) {
+void AntiradianceLighting::near_change(const std::vector<std::pair<std::uint32_t, glm::mat4>>& moved) {
+  // The receivers gather from every leaf, the others held at this GPU solve.
+  region_->adopt_irradiance(solved_);
+  std::vector<char> taken(leaf_change_.size(), 0);
+  for (NearSet& n : near_) {
+    // Every moved instance, so each set's ray caster sees every door where it is now.
+    std::vector<glm::vec3> e;
+    for (const auto& [instance, m] : moved) {
+      e = n.visibility->move(*region_, instance, m);
+      stats_.near_ms += n.visibility->last_update_ms() + n.visibility->last_solve_ms();
+      stats_.near_rays += n.visibility->last_rays();
+      stats_.near_pairs += n.visibility->last_pairs();
+    }
+    stats_.near_iterations = std::max(stats_.near_iterations, n.visibility->last_iterations());
+    const std::vector<glm::vec3>& zero = n.visibility->baseline();
+    for (std::size_t l = 0; l < leaf_change_.size() && l < e.size(); ++l)
+      if (n.receivers[l] && !taken[l]) {
+        leaf_change_[l] = e[l] - zero[l];  // against the near set's own baked pose
+        taken[l] = 1;
+      }
+  }
+}
+
+void AntiradianceLighting::upload_change(const std::vector<std::pair<std::uint32_t, glm::mat4>>& moved) {
   const std::vector<glm::vec3>& base = region_->baseline();
-  std::vector<glm::vec4> d(irradiance.size());
-  for (std::size_t l = 0; l < d.size(); ++l)
-    d[l] = glm::vec4(scale * irradiance[l] - (l < base.size() ? base[l] : glm::vec3(0.0f)), 0.0f);
+  leaf_change_.assign(solved_.size(), glm::vec3(0.0f));
+  for (std::size_t l = 0; l < solved_.size(); ++l)
+    leaf_change_[l] = solved_[l] - (l < base.size() ? base[l] : glm::vec3(0.0f));
+  clear_near_stats();
+  if (!near_.empty()) near_change(moved);
+  std::vector<glm::vec4> d(leaf_change_.size());
+  for (std::size_t l = 0; l < d.size(); ++l) d[l] = glm::vec4(leaf_change_[l], 0.0f);
   if (!d.empty()) glNamedBufferSubData(delta_.id(), 0, static_cast<GLsizeiptr>(d.size() * sizeof(glm::vec4)), d.data());
+}
+
+void AntiradianceLighting::clear_near_stats() {
+  stats_.near_ms = 0.0;
+  stats_.near_rays = stats_.near_pairs = 0;
+  stats_.near_iterations = 0;
 }
 
 bool AntiradianceLighting::update() {
   if (!ensure_gpu()) return false;
-  bool moved = false;
+  std::vector<std::pair<std::uint32_t, glm::mat4>> moved;
   for (const auto& [instance, entity] : deforming_) {
     const auto* wt = registry_->try_get<engine::WorldTransform>(entity);
     // NaN or absurd transforms keep the last usable pose (GISystem warns once).
     if (wt != nullptr && !engine::unusable_world_matrix(wt->matrix) &&
         region_->set_instance_transform(instance, wt->matrix))
-      moved = true;
+      moved.emplace_back(instance, wt->matrix);
   }
-  if (!moved) return false;
+  if (moved.empty()) return false;
   const auto t0 = std::chrono::steady_clock::now();
   region_->update(false);  // relink the moved groups, direct light at the elements
   ++stats_.updates;
   if (region_->posed_as_baked()) {
     // Back at the baked pose: the change is 0 (the atlas holds this pose). No solve; the GPU
-    // tables keep the last pose's solution for the next warm start.
+    // tables keep the last pose's solution for the next warm start, the near sets their
+    // couplings of the last pose (their next move recomputes what the door crossed since).
     glClearNamedBufferData(delta_.id(), GL_R32F, GL_RED, GL_FLOAT, nullptr);
     glFinish();
+    leaf_change_.assign(region_->hierarchy().leaf_count(), glm::vec3(0.0f));
+    clear_near_stats();
     record(AntiradianceSolveReport{});
-    stats_.last_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    stats_.last_ms = ms_since(t0);
     return true;
   }
   if (engine::Status st = gpu_->set_links(region_->links()); !st) {
@@ -138,10 +237,12 @@ bool AntiradianceLighting::update() {
                        warm ? AntiradianceStart::Warm : AntiradianceStart::Cold);
   // As the CPU region: only a converged solve starts the next (AntiradianceRegion::update).
   gpu_warm_startable_ = report.converged && !report.diverged && report.output_scale == 1.0f;
-  upload_delta(gpu_->irradiance(), report.output_scale);
+  solved_ = gpu_->irradiance();
+  for (glm::vec3& v : solved_) v *= report.output_scale;
+  upload_change(moved);
   glFinish();
   record(report);
-  stats_.last_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  stats_.last_ms = ms_since(t0);
   return true;
 }
 

@@ -4,7 +4,9 @@
 // elements, recomputes the direct light at the elements, runs the iteration on the GPU
 // (antiradiance_gpu_pass.h; from the previous pose's solution after the first solve) and adds the change against the
 // baked pose into the irradiance atlas (antiradiance_composite.comp.glsl). A frame where nothing moved does nothing;
-// composite() re-adds the last change when the base atlas changed.
+// composite() re-adds the last change when the base atlas changed. With the bake's
+// near_visibility, the leaves near each deforming instance take their change from a
+// NearDoorVisibility (ray-traced visibility, on the CPU after the GPU solve's read-back).
 //   auto a = gi::AntiradianceLighting::create(std::move(bake), input, layout, scene.registry).value();
 //   if (a->update()) { /* moved */ }  a->composite(base_texture, out_texture);
 
@@ -18,11 +20,13 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "antiradiance/antiradiance_gpu_pass.h"
 #include "antiradiance/antiradiance_region.h"
 #include "antiradiance/antiradiance_texel_blend.h"
+#include "antiradiance/near_door_visibility.h"
 #include "uv/atlas_layout.h"
 
 namespace gi {
@@ -48,6 +52,19 @@ class AntiradianceLighting {
     /// Last update: the solve started from the previous pose's solution (warm start), not
     /// from the direct light. An update back at the baked pose solves nothing (iterations 0).
     bool warm = false;
+    /// Near-door visibility (issue 37; the bake's settings.near_visibility): the leaves near a
+    /// deforming instance gather with ray-traced visibility (NearDoorVisibility), the others
+    /// keep the GPU solve. On when the bake asked for it and every near set was made at load.
+    bool near_visibility = false;
+    /// The bake asked for it but a near set could not be made (logged as a warning, the
+    /// reason in near_fell_back_reason()): antiradiance alone.
+    bool near_fell_back = false;
+    std::size_t near_receivers = 0;  ///< Leaves that gather with visibility (all near sets).
+    double near_load_ms = 0.0;       ///< The baked pose's couplings and solve, at load.
+    double near_ms = 0.0;            ///< Last update: the near sets' couplings' update + solve (part of last_ms).
+    std::size_t near_rays = 0;       ///< Last update: rays the near sets cast.
+    std::size_t near_pairs = 0;      ///< Last update: leaf pairs they recomputed.
+    int near_iterations = 0;         ///< Last update: Jacobi iterations of the near solve (the most of any set).
   };
 
   /// Errors: the bake does not fit `input` (AntiradianceRegion::create). `log` hears a
@@ -66,6 +83,15 @@ class AntiradianceLighting {
 
   const Stats& stats() const { return stats_; }
   const std::string& disabled() const { return disabled_; }
+  /// Why near-door visibility fell back (empty: it did not).
+  const std::string& near_fell_back_reason() const { return near_reason_; }
+  /// The change per leaf the last update uploaded (W/m^2; what composite() blends into the
+  /// atlas): the near sets' receivers' move result minus their baseline, the GPU solve's
+  /// change elsewhere. Empty before the first update.
+  const std::vector<glm::vec3>& leaf_change() const { return leaf_change_; }
+  /// The last update's GPU solve per leaf (read back, energy guard applied): what the near
+  /// sets held the other leaves at. Empty before the first solve.
+  const std::vector<glm::vec3>& solved_irradiance() const { return solved_; }
 
  private:
   AntiradianceLighting() = default;
@@ -73,8 +99,24 @@ class AntiradianceLighting {
   bool ensure_gpu();
   /// The last update's solve (and the relink's counters) into stats_; warns when unconverged.
   void record(const AntiradianceSolveReport& report);
-  /// Uploads delta = E(now) - baseline per leaf.
-  void upload_delta(const std::vector<glm::vec3>& irradiance, float scale);
+  /// Makes a NearDoorVisibility per deforming instance with receivers (region at its baked
+  /// pose); on failure none, logged, stats_.near_fell_back.
+  void create_near_sets(const BakeInput& input);
+  /// leaf_change_ = E(now) - baseline per leaf, the near sets' receivers replaced by theirs
+  /// (after moving them as `moved` says); then uploaded.
+  void upload_change(const std::vector<std::pair<std::uint32_t, glm::mat4>>& moved);
+  /// The near sets' part of upload_change: moves them, puts their receivers' change in leaf_change_.
+  void near_change(const std::vector<std::pair<std::uint32_t, glm::mat4>>& moved);
+  void clear_near_stats();
+  /// One near set: its instance, its receivers (the class's rule, near_receiver_mask) and the class.
+  struct NearSet {
+    std::uint32_t instance = 0;
+    std::vector<char> receivers;
+    std::unique_ptr<NearDoorVisibility> visibility;
+  };
+  std::vector<NearSet> near_;
+  std::string near_reason_;
+  std::vector<glm::vec3> solved_, leaf_change_;
   std::vector<TexelBlendHost> blends_host_;
   std::unique_ptr<AntiradianceRegion> region_;
   const engine::Registry* registry_ = nullptr;

@@ -32,6 +32,7 @@ class AntiradianceMethod final : public MethodRuntime {
       state.stats.antiradiance_residual = lighting_->stats().residual;
       state.stats.antiradiance_unconverged = lighting_->stats().unconverged;
       state.stats.antiradiance_warm = lighting_->stats().warm;
+      state.stats.antiradiance_near_ms = lighting_->stats().near_ms;
     }
   }
   std::string label() const override { return "antiradiance"; }
@@ -57,6 +58,12 @@ engine::Result<std::unique_ptr<MethodRuntime>> load_antiradiance_method(MethodLo
   const auto& st = anti.value()->stats();
   load.text << "antiradiance: " << st.elements << " elements, " << st.links << " links, " << st.covered_texels
             << " atlas texels; solved on frames where a deforming node moves\n";
+  if (st.near_visibility)
+    load.text << "antiradiance: near-door visibility for " << st.near_receivers << " leaves (their couplings "
+              << static_cast<long long>(st.near_load_ms) << " ms at load)\n";
+  else if (st.near_fell_back)
+    load.text << "antiradiance: near-door visibility OFF, antiradiance alone: " << anti.value()->near_fell_back_reason()
+              << "\n";
   return std::unique_ptr<MethodRuntime>(new AntiradianceMethod(std::move(anti).value()));
 }
 

@@ -305,20 +305,21 @@ TEST(AntiradianceIo, TheRefinementSettingsComeBackAndTheLoadRelinksWithThem) {
   EXPECT_FALSE(same_links(fresh->links(), regardless->links())) << "the door's leaf links split or not alike";
 }
 
-// A bundle of the previous layout (no refinement settings) is refused by name, not misread.
-TEST(AntiradianceIo, AVersion2FileIsRefusedWithTheFilesName) {
+// A bundle of the previous layout (version 3: no near-door visibility, no triangles) is
+// refused by name, not misread.
+TEST(AntiradianceIo, AVersion3FileIsRefusedWithTheFilesName) {
   const artest::DoorScene scene = artest::door_scene(30.0f);
   auto bake = gi::bake_antiradiance(scene.input, small());
   ASSERT_TRUE(bake) << bake.error().to_string();
-  const fs::path dir = scratch_dir("version2");
+  const fs::path dir = scratch_dir("version3");
   ASSERT_TRUE(gi::save_antiradiance(dir, *bake, scene.input));
   const fs::path file = dir / gi::kAntiradianceFile;
-  reseal_with_version(dir, file, 2);
+  reseal_with_version(dir, file, 3);
   auto loaded = gi::load_antiradiance(dir, scene.input);
   ASSERT_FALSE(loaded);
   const std::string message = loaded.error().to_string();
   EXPECT_EQ(loaded.error().file, file.string()) << message;
-  EXPECT_TRUE(contains(message, "version 2")) << message;
+  EXPECT_TRUE(contains(message, "version 3")) << message;
   EXPECT_TRUE(contains(message, "re-bake")) << message;
   // A file that claims a bad refinement setting (resealed payload) is refused by its checks.
   gi::AntiradianceBake bad = *bake;
@@ -326,4 +327,49 @@ TEST(AntiradianceIo, AVersion2FileIsRefusedWithTheFilesName) {
   auto st = gi::write_antiradiance(dir / "bad.bin", bad, "h");
   ASSERT_FALSE(st);
   EXPECT_TRUE(contains(st.error().to_string(), "leaf_link_pieces")) << st.error().to_string();
+}
+
+// Version 4 carries near-door visibility (issue 37): its settings, and the elements' triangles
+// its rays need (a loaded hierarchy had none), only when it is on.
+TEST(AntiradianceIo, NearVisibilityComesBackWithTheTrianglesItTracesAgainst) {
+  const artest::DoorScene scene = artest::door_scene(30.0f);
+  gi::AntiradianceSettings s = small();
+  s.near_visibility = true;
+  s.near_visibility_radius_m = 0.7f;
+  s.near_visibility_point_pairs = 8;
+  auto bake = gi::bake_antiradiance(scene.input, s);
+  ASSERT_TRUE(bake) << bake.error().to_string();
+  ASSERT_EQ(bake->hierarchy.corners.size(), 3 * bake->hierarchy.nodes.size());
+  const fs::path dir = scratch_dir("near_visibility");
+  ASSERT_TRUE(gi::save_antiradiance(dir, *bake, scene.input));
+  auto loaded = gi::load_antiradiance(dir, scene.input);
+  ASSERT_TRUE(loaded) << loaded.error().to_string();
+  EXPECT_TRUE(loaded->settings.near_visibility);
+  EXPECT_EQ(loaded->settings.near_visibility_radius_m, 0.7f);
+  EXPECT_EQ(loaded->settings.near_visibility_point_pairs, 8);
+  EXPECT_EQ(loaded->hierarchy.corners, bake->hierarchy.corners);
+  EXPECT_EQ(loaded->hierarchy.object_corners, bake->hierarchy.object_corners);
+
+  // Off: no triangles stored, and a load has none (as before version 4).
+  gi::AntiradianceBake off = *bake;
+  off.settings.near_visibility = false;
+  const fs::path dir_off = scratch_dir("near_visibility_off");
+  ASSERT_TRUE(gi::save_antiradiance(dir_off, off, scene.input));
+  auto loaded_off = gi::load_antiradiance(dir_off, scene.input);
+  ASSERT_TRUE(loaded_off) << loaded_off.error().to_string();
+  EXPECT_FALSE(loaded_off->settings.near_visibility);
+  EXPECT_TRUE(loaded_off->hierarchy.corners.empty());
+  EXPECT_LT(fs::file_size(dir_off / gi::kAntiradianceFile), fs::file_size(dir / gi::kAntiradianceFile));
+
+  // Bad settings and triangles are refused before writing, naming the problem.
+  gi::AntiradianceBake bad = *bake;
+  bad.settings.near_visibility_point_pairs = 65;
+  auto st = gi::write_antiradiance(dir / "bad.bin", bad, "h");
+  ASSERT_FALSE(st);
+  EXPECT_TRUE(contains(st.error().to_string(), "near_visibility_point_pairs")) << st.error().to_string();
+  bad = *bake;
+  bad.hierarchy.corners.pop_back();
+  st = gi::write_antiradiance(dir / "bad.bin", bad, "h");
+  ASSERT_FALSE(st);
+  EXPECT_TRUE(contains(st.error().to_string(), "triangles")) << st.error().to_string();
 }

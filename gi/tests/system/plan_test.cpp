@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "antiradiance/near_door_visibility.h"
 #include "bundle/manifest.h"
 #include "plan/plan_cost.h"
 #include "plan/plan_json.h"
@@ -307,6 +308,38 @@ TEST(PlanCost, AntiradianceEstimateIsWithinTheMeasuredLinksBakeTimeAndGpuBytes) 
   // An unknown preset gives no estimate.
   EXPECT_EQ(gi::plan(load("corridor.gltf"), {.preset = "ultra"}).effect(EffectMethod::Antiradiance).estimate.work_units,
             0u);
+}
+
+// Near-door visibility (on at medium and high, issue 37) against what was measured on the
+// corridor at medium (docs/antiradiance.md "Issue 37: the change scored against a split
+// truth": 863 receivers, the baked pose's couplings 1.1-1.6 s at 4 point pairs under load).
+TEST(PlanCost, NearVisibilityAtMediumCountsItsReceiversLoadWorkAndMemory) {
+  const gi::PlannedEffect preview =
+      gi::plan(load("corridor.gltf"), {.preset = "preview"}).effect(EffectMethod::Antiradiance);
+  EXPECT_FALSE(contains(preview.estimate.basis, "near-door")) << preview.estimate.basis;
+  const gi::PlannedEffect medium =
+      gi::plan(load("corridor.gltf"), {.preset = "medium"}).effect(EffectMethod::Antiradiance);
+  const std::string& basis = medium.estimate.basis;
+  std::printf("corridor, medium: %s; ~%.2f s, %.1f MB\n", basis.c_str(), medium.estimate.bake_seconds,
+              static_cast<double>(medium.estimate.runtime_bytes) / 1e6);
+  const std::size_t at = basis.find("near-door visibility: ");
+  ASSERT_NE(at, std::string::npos) << basis;
+  unsigned long receivers = 0, leaves = 0;
+  ASSERT_EQ(std::sscanf(basis.c_str() + at, "near-door visibility: %lu receivers x %lu leaves", &receivers, &leaves), 2)
+      << basis;
+  EXPECT_NEAR(static_cast<double>(receivers), 863.0, 0.25 * 863.0);
+  const gi::AntiradianceSettings s = gi::antiradiance_preset("medium");
+  ASSERT_TRUE(s.near_visibility);
+  EXPECT_EQ(s.near_visibility_radius_m, gi::NearDoorVisibilitySettings{}.radius_m);
+  double move_s = 0.0;
+  const gi::BakeWork w = gi::near_visibility_work(leaves, receivers, s, &move_s);
+  EXPECT_GT(w.cpu_seconds, 0.5 * 1.1);
+  EXPECT_LT(w.cpu_seconds, 2.0 * 1.6);
+  EXPECT_GT(move_s, 0.0);
+  EXPECT_LT(move_s, w.cpu_seconds);
+  // Every pair of leaves is allocated: a float coupling and 64 bits of kept visibility.
+  EXPECT_EQ(w.runtime_bytes, static_cast<std::uint64_t>(12.0 * leaves * (leaves - 1.0) / 2.0));
+  EXPECT_GT(medium.estimate.runtime_bytes, w.runtime_bytes);  // the links' GPU bytes besides
 }
 
 TEST(Plan, LightUnderADynamicNodeMovesWithAWarningWhenNotFlagged) {
