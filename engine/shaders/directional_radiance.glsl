@@ -54,7 +54,7 @@ vec3 directional_bin_radiance(int bin, DirectionalTexels t, int element_count) {
   return sum;
 }
 
-const int DIRECTIONAL_LOBE_SAMPLES = 16;  // engine::kDirectionalLobeSamples
+const int DIRECTIONAL_LOBE_SAMPLES = 32;  // engine::kDirectionalLobeSamples
 
 vec2 directional_lobe_sample_point(int j) {
   uint bits = uint(j);

@@ -184,7 +184,8 @@ void twin_agrees(bool tangent) {
     }
   }
   EXPECT_GT(nonzero, cases.size() / 2);
-  EXPECT_LT(on_boundary, cases.size() / 50);
+  // 32 lobe samples (engine::kDirectionalLobeSamples): twice the chances of 16 that one lies on a boundary.
+  EXPECT_LT(on_boundary, cases.size() / 25);
   std::printf("%s bins: %zu cases (%zu on a bin boundary skipped): worst relative difference GLSL vs C++ %.2e\n",
               tangent ? "tangent-frame" : "global", cases.size(), on_boundary, static_cast<double>(worst));
 }
