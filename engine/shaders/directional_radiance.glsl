@@ -54,7 +54,7 @@ vec3 directional_bin_radiance(int bin, DirectionalTexels t, int element_count) {
   return sum;
 }
 
-const int DIRECTIONAL_LOBE_SAMPLES = 16;
+const int DIRECTIONAL_LOBE_SAMPLES = 32;  // engine::kDirectionalLobeSamples
 
 vec2 directional_lobe_sample_point(int j) {
   uint bits = uint(j);
@@ -73,16 +73,40 @@ void directional_tangent_frame(vec3 n, out vec3 t, out vec3 b) {
   b = cross(n, t);
 }
 
-int directional_bin_of(vec3 l, int bin_count) {
-  int best = -1;
-  float best_dot = -2.0;
-  for (int k = 0; k < bin_count; ++k) {
-    float d = dot(l, dr_directions[k].direction);
-    if (d > best_dot) {
+// engine::directional_bin_of: the nearest direction (lowest index among equals), the directions
+// sorted by non-increasing z; from where l.z would lie among uniform z, outwards on both sides
+// until the z gap alone bounds l.psi below the best found (l.psi <= l.z psi.z + |l.xy| |psi.xy|).
+// The same scan as the C++ (directional_radiance.cpp's scan_side), so the same bin.
+void directional_scan_side(vec3 l, float l_xy, float l_len, int start, int step, int bin_count, inout int best,
+                           inout float best_dot) {
+  for (int k = start + step; k >= 0 && k < bin_count; k += step) {
+    vec3 p = dr_directions[k].direction;
+    bool beyond = step > 0 ? p.z * l_len < l.z : p.z * l_len > l.z;
+    if (beyond && l.z * p.z + l_xy * sqrt(p.x * p.x + p.y * p.y) < best_dot - 1e-4) break;
+    float d = dot(l, p);
+    if (d > best_dot || (d == best_dot && k < best)) {
       best_dot = d;
       best = k;
     }
   }
+}
+
+int directional_bin_of(vec3 l, int bin_count) {
+  if (bin_count <= 0) return -1;
+  float l_len = sqrt(dot(l, l));
+  float z_first = dr_directions[0].direction.z, z_last = dr_directions[bin_count - 1].direction.z;
+  float at = z_first > z_last ? (z_first - l.z / l_len) / (z_first - z_last) * float(bin_count - 1) : 0.0;
+  int start = at >= 0.0 ? (at < float(bin_count - 1) ? int(at + 0.5) : bin_count - 1) : 0;
+  int best = -1;
+  float best_dot = -2.0;
+  float d = dot(l, dr_directions[start].direction);
+  if (d > best_dot) {
+    best_dot = d;
+    best = start;
+  }
+  float l_xy = sqrt(l.x * l.x + l.y * l.y);
+  directional_scan_side(l, l_xy, l_len, start, 1, bin_count, best, best_dot);
+  directional_scan_side(l, l_xy, l_len, start, -1, bin_count, best, best_dot);
   return best;
 }
 

@@ -52,6 +52,7 @@ engine::Status validate(const DlmSettings& s) {
     return bad("glossy_roughness_min must be in [0, glossy_roughness)");
   if (s.max_bounces < 2 || s.max_bounces > 1024) return bad("max_bounces must be in 2..1024");
   if (s.area_light_samples < 1 || s.area_light_samples > 65536) return bad("area_light_samples must be in 1..65536");
+  if (!(s.horizon_warp >= 1.0) || s.horizon_warp > 4.0) return bad("horizon_warp must be in [1, 4]");
   return {};
 }
 
@@ -163,11 +164,12 @@ std::vector<glm::vec3> dlm_directions(int count) {
   return out;
 }
 
-std::vector<glm::vec3> dlm_hemisphere_directions(int count) {
+std::vector<glm::vec3> dlm_hemisphere_directions(int count, double horizon_warp) {
   std::vector<glm::vec3> out;
   const double golden = std::numbers::pi * (3.0 - std::sqrt(5.0));
   for (int i = 0; i < count; ++i) {
-    const double z = 1.0 - (i + 0.5) / count;  // uniform in z: equal areas on the hemisphere
+    // Uniform in z (equal areas on the hemisphere), or z^warp: denser towards the horizon.
+    const double z = std::pow(1.0 - (i + 0.5) / count, horizon_warp);
     const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
     out.push_back(glm::normalize(glm::vec3(static_cast<float>(r * std::cos(golden * i)),
                                            static_cast<float>(r * std::sin(golden * i)), static_cast<float>(z))));
@@ -572,7 +574,7 @@ engine::Result<Dlm> bake_dlm(const BakeInput& input, const DlmSettings& settings
   dlm.layout = std::move(layout).value();
   dlm.width = dlm.layout.width;
   dlm.height = dlm.layout.height;
-  dlm.directions = settings.tangent_frame_bins ? dlm_hemisphere_directions(settings.directions)
+  dlm.directions = settings.tangent_frame_bins ? dlm_hemisphere_directions(settings.directions, settings.horizon_warp)
                                                : dlm_directions(settings.directions);
 
   const TriangleMaterials materials = triangle_materials(s, settings);

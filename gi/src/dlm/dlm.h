@@ -58,6 +58,10 @@ struct DlmSettings {
   /// (dlm.bin version 3) and the renderer turns each lobe sample into the texel's frame
   /// (engine::directional_tangent_frame of the vertex normal, IndirectLightFrame::directional_tangent_frame).
   bool tangent_frame_bins = false;
+  /// Tangent-frame bins only: the hemisphere set's z raised to this power (1: equal areas; 2:
+  /// the cells near the horizon, where a grazing lobe reads, about half as tall). Not in dlm.bin:
+  /// the file holds the directions themselves, which is all the renderer reads.
+  double horizon_warp = 1.0;
   std::uint64_t seed = 1;
   unsigned threads = 0;       ///< 0: all hardware threads. The result does not depend on it.
   ProgressCallback progress;  ///< Fraction done; false cancels.
@@ -101,8 +105,10 @@ engine::Result<DlmSettings> dlm_preset(std::string_view name);
 /// The N directions of Omega (spherical Fibonacci lattice), deterministic.
 std::vector<glm::vec3> dlm_directions(int count);
 
-/// N directions on the hemisphere z > 0 (equal-area spherical Fibonacci), for tangent-frame bins.
-std::vector<glm::vec3> dlm_hemisphere_directions(int count);
+/// N directions on the hemisphere z > 0 (equal-area spherical Fibonacci), for tangent-frame bins;
+/// with `horizon_warp` w > 1 the lattice's z is raised to the power w (denser cells towards the
+/// horizon). Sorted by decreasing z, as the renderer's search needs.
+std::vector<glm::vec3> dlm_hemisphere_directions(int count, double horizon_warp = 1.0);
 
 /// The bins' directions in world space at a texel of unit normal `n`: the global set, or
 /// with tangent-frame bins the hemisphere set turned to n (engine::directional_tangent_frame(n):

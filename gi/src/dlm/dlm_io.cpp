@@ -52,6 +52,8 @@ std::string check_dlm(const Dlm& d) {
   for (std::size_t k = 0; k < d.directions.size(); ++k)
     if (!std::isfinite(glm::length(d.directions[k])) || std::fabs(glm::length(d.directions[k]) - 1.0f) > 1e-3f)
       return "direction " + str(k) + " is not a unit vector";
+    else if (k > 0 && d.directions[k].z > d.directions[k - 1].z)  // the renderer's search walks them by z
+      return "direction " + str(k) + " is not sorted by decreasing z";
   const std::size_t texel_limit = static_cast<std::size_t>(d.width) * static_cast<std::size_t>(d.height);
   for (std::size_t i = 0; i < d.texels.size(); ++i)
     if (d.texels[i] >= texel_limit || (i > 0 && d.texels[i] <= d.texels[i - 1]))

@@ -72,6 +72,13 @@ std::vector<KnobSpec> dlm_knobs() {
        .kind = KnobKind::Choice,
        .default_grid = {"global"},
        .choices = {"global", "tangent"}},
+      {.name = "warp",
+       .description = "tangent-frame bins: their z raised to this power (1: equal areas, the preset; 2: cells near "
+                      "the horizon about half as tall)",
+       .kind = KnobKind::Real,
+       .default_grid = {"1"},
+       .min_value = 1,
+       .max_value = 4},
       {.name = "surfaces",
        .description = "which glossy texels are compared: all (the default) or floors (normal within 26 degrees of +y: "
                       "the demo level's corridor floor without the crate room's cut-out grille)",
@@ -109,29 +116,26 @@ ReferenceRequest dlm_reference_request(const SweepScene&, const KnobSetting& k) 
   return r;
 }
 
-// Mean bias per band of cos(theta_v) (view angle to the texel's normal), DLM and the
-// direction-less atlas term: sum of the values / sum of the reference's - 1 over the band's
-// glossy texels (the reference's noise averages out in the sums).
-void add_view_band_bias(const GlossyTexels& g, const std::vector<std::uint8_t>& mask, const std::vector<glm::vec3>& dlm,
-                        const std::vector<glm::vec3>& atlas, const RgbField& reference,
+// Mean bias per band of cos(theta_v) (view angle to the texel's normal) of `values`: sum of the
+// values / sum of the reference's - 1 over the band's glossy texels (the reference's noise
+// averages out in the sums), as extras "<prefix>bias_cos<lo>_<hi>".
+void add_view_band_bias(const GlossyTexels& g, const std::vector<std::uint8_t>& mask,
+                        const std::vector<glm::vec3>& values, const char* prefix, const RgbField& reference,
                         std::vector<std::pair<std::string, double>>& extras) {
   constexpr double kBands[] = {0.1, 0.3, 0.6, 1.01};
   for (int b = 0; b < 3; ++b) {
-    double sd = 0.0, sa = 0.0, sr = 0.0;
-    for (std::size_t t = 0; t < dlm.size(); ++t) {
+    double sd = 0.0, sr = 0.0;
+    for (std::size_t t = 0; t < values.size(); ++t) {
       if (!g.glossy[t] || !mask[t] || !reference.is_valid(t)) continue;
       const glm::vec3 v = glm::normalize(g.eye - g.s.texels.position[t]);
       const double c = static_cast<double>(glm::dot(g.s.texels.normal[t], v));
       if (c < kBands[b] || c >= kBands[b + 1]) continue;
-      sd += static_cast<double>(dlm[t].x + dlm[t].y + dlm[t].z);
-      sa += static_cast<double>(atlas[t].x + atlas[t].y + atlas[t].z);
+      sd += static_cast<double>(values[t].x + values[t].y + values[t].z);
       sr += static_cast<double>(reference.rgb[3 * t] + reference.rgb[3 * t + 1] + reference.rgb[3 * t + 2]);
     }
-    char name[48];
-    std::snprintf(name, sizeof name, "bias_cos%.1f_%.1f", kBands[b], std::min(kBands[b + 1], 1.0));
+    char name[64];
+    std::snprintf(name, sizeof name, "%sbias_cos%.1f_%.1f", prefix, kBands[b], std::min(kBands[b + 1], 1.0));
     extras.emplace_back(name, sr > 0.0 ? sd / sr - 1.0 : std::nan(""));
-    std::snprintf(name, sizeof name, "atlas_bias_cos%.1f_%.1f", kBands[b], std::min(kBands[b + 1], 1.0));
-    extras.emplace_back(name, sr > 0.0 ? sa / sr - 1.0 : std::nan(""));
   }
 }
 
@@ -144,6 +148,7 @@ DlmSettings dlm_settings(const RunContext& ctx, double floor_roughness) {
   s.splat_radius_texels = static_cast<float>(ctx.knobs.real("splat"));
   s.glossy_roughness = static_cast<float>(glossy_threshold(floor_roughness));
   s.tangent_frame_bins = ctx.knobs.text("bins") == "tangent";
+  s.horizon_warp = ctx.knobs.real("warp");
   s.seed = ctx.seed;
   s.threads = ctx.threads;
   s.progress = ctx.progress;
@@ -154,14 +159,32 @@ DlmSettings dlm_settings(const RunContext& ctx, double floor_roughness) {
 // `g` (only the floors' with `floors_only`), and the direction-less alternative on the same
 // texels: the maps' own irradiance E = sum_k L_k C_k reflected as E / pi x the specular albedo
 // (what the renderer draws without DLM from a perfect atlas): the "atlas_rel_rmse" extra.
+// The same bins are also read with more lobe samples (kLookupVariants; 4096 integrate the lobe
+// over the cells almost exactly): the lookup's quadrature error apart from the bins' (docs/dlm.md,
+// "The grazing band's bias, split and removed"); and with a smooth kernel across the cells' edges
+// (15, 20 or 25 degrees; the 64 tangent-frame cells are about 18 degrees apart).
+struct LookupVariant {
+  const char* name;
+  int samples;
+  float kernel_radius;  ///< radians; 0: the nearest bin
+};
+constexpr LookupVariant kLookupVariants[] = {
+    {"lookup32_", 32, 0.0f},         {"lookup64_", 64, 0.0f},         {"lookup4096_", 4096, 0.0f},
+    {"smooth15x16_", 16, 0.26f},     {"smooth15x4096_", 4096, 0.26f}, {"smooth20x16_", 16, 0.35f},
+    {"smooth20x4096_", 4096, 0.35f}, {"smooth25x16_", 16, 0.44f},
+};
+constexpr std::size_t kExactLookup = 2;  ///< lookup4096_
 struct EvaluatedMaps {
   std::vector<glm::vec3> values, atlas_values;
+  std::vector<std::vector<glm::vec3>> lookup_values;  ///< per kLookupVariants
   std::vector<std::uint8_t> mask;
 };
 EvaluatedMaps evaluate_maps(const Dlm& dlm, const GlossyTexels& g, bool floors_only) {
   const AtlasTexels& tex = g.s.texels;
   EvaluatedMaps out{.values = std::vector<glm::vec3>(tex.valid.size(), glm::vec3(0.0f)),
                     .atlas_values = std::vector<glm::vec3>(tex.valid.size(), glm::vec3(0.0f)),
+                    .lookup_values = std::vector<std::vector<glm::vec3>>(
+                        std::size(kLookupVariants), std::vector<glm::vec3>(tex.valid.size(), glm::vec3(0.0f))),
                     .mask = std::vector<std::uint8_t>(tex.valid.size(), 0)};
   std::vector<glm::vec3> l(dlm.directions.size());
   // Tangent-frame bins: the same C_k at every normal (as the bake computes them).
@@ -178,10 +201,15 @@ EvaluatedMaps evaluate_maps(const Dlm& dlm, const GlossyTexels& g, bool floors_o
       l[k] = glm::vec3(v[0], v[1], v[2]);
     }
     const glm::vec3 v = glm::normalize(g.eye - tex.position[t]);
-    const std::vector<glm::vec3> directions = dlm_texel_directions(dlm, tex.normal[t]);
-    out.values[t] = engine::directional_specular(g.brdf[t], tex.normal[t], v, directions, l);
+    // As the renderer reads them: tangent-frame bins in the frame of the texel's normal.
+    const glm::vec3* bin_normal = dlm.settings.tangent_frame_bins ? &tex.normal[t] : nullptr;
+    out.values[t] = engine::directional_specular(g.brdf[t], tex.normal[t], v, dlm.directions, l, bin_normal);
+    for (std::size_t j = 0; j < std::size(kLookupVariants); ++j)
+      out.lookup_values[j][t] =
+          engine::directional_specular_sampled(g.brdf[t], tex.normal[t], v, dlm.directions, l, bin_normal,
+                                               kLookupVariants[j].samples, kLookupVariants[j].kernel_radius);
     const std::vector<float> c =
-        dlm.settings.tangent_frame_bins ? tangent_weights : dlm_bin_cosine_weights(directions, tex.normal[t]);
+        dlm.settings.tangent_frame_bins ? tangent_weights : dlm_bin_cosine_weights(dlm.directions, tex.normal[t]);
     glm::vec3 e(0.0f);
     for (std::size_t k = 0; k < l.size(); ++k) e += c[k] * l[k];
     out.atlas_values[t] =
@@ -189,6 +217,25 @@ EvaluatedMaps evaluate_maps(const Dlm& dlm, const GlossyTexels& g, bool floors_o
     out.mask[t] = 1;
   }
   return out;
+}
+
+// The lookup variants' truth rel RMSE and band bias: extras "<variant name>truth_rel_rmse", ...
+void add_lookup_extras(const GlossyTexels& g, const std::vector<std::uint8_t>& mask,
+                       const std::vector<glm::vec3>& renderer_values,
+                       const std::vector<std::vector<glm::vec3>>& lookup_values, const RgbField& reference,
+                       std::vector<std::pair<std::string, double>>& extras) {
+  const AtlasTexels& tex = g.s.texels;
+  // The lookup's own quadrature error: each reading against the lobe integrated over the cells (4096 samples).
+  const RgbField exact = RgbField::from_texels(tex.width, tex.height, lookup_values[kExactLookup], mask);
+  extras.emplace_back("lookup16_vs_exact_rel_rmse",
+                      relative_rmse(RgbField::from_texels(tex.width, tex.height, renderer_values, mask), exact));
+  for (std::size_t j = 0; j < lookup_values.size(); ++j) {
+    const std::string prefix = kLookupVariants[j].name;
+    const RgbField field = RgbField::from_texels(tex.width, tex.height, lookup_values[j], mask);
+    extras.emplace_back(prefix + "truth_rel_rmse", compare_rgb(field, reference).truth_rel_rmse);
+    extras.emplace_back(prefix + "vs_exact_rel_rmse", relative_rmse(field, exact));
+    add_view_band_bias(g, mask, lookup_values[j], prefix.c_str(), reference, extras);
+  }
 }
 
 engine::Result<MethodOutput> run_dlm(const RunContext& ctx) {
@@ -205,7 +252,7 @@ engine::Result<MethodOutput> run_dlm(const RunContext& ctx) {
   auto g = glossy_texels(ctx.scene, ctx.knobs.real("density"), floor_roughness, nullptr, placement, view);
   if (!g) return g.error();
   const AtlasTexels& tex = g->s.texels;
-  auto [values, atlas_values, mask] = evaluate_maps(*dlm, *g, ctx.knobs.text("surfaces") == "floors");
+  auto [values, atlas_values, lookup_values, mask] = evaluate_maps(*dlm, *g, ctx.knobs.text("surfaces") == "floors");
   const std::vector<std::uint8_t> band_mask = mask;
   MethodOutput out;
   const RgbField atlas_field = RgbField::from_texels(tex.width, tex.height, atlas_values, mask);
@@ -218,7 +265,9 @@ engine::Result<MethodOutput> run_dlm(const RunContext& ctx) {
                 {"atlas_truth_rel_rmse", compare_rgb(atlas_field, ctx.reference).truth_rel_rmse},
                 {"glossy_texels", static_cast<double>(dlm->stats.glossy_texels)},
                 {"deposits", static_cast<double>(dlm->stats.deposits)}};
-  add_view_band_bias(*g, band_mask, values, atlas_values, ctx.reference, out.extras);
+  add_view_band_bias(*g, band_mask, values, "", ctx.reference, out.extras);
+  add_view_band_bias(*g, band_mask, atlas_values, "atlas_", ctx.reference, out.extras);
+  add_lookup_extras(*g, band_mask, values, lookup_values, ctx.reference, out.extras);
   return out;
 }
 

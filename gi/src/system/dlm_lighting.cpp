@@ -19,6 +19,10 @@ engine::Result<std::unique_ptr<DlmLighting>> DlmLighting::from_bake(Dlm dlm, int
   const std::size_t elements = dlm.texels.size(), bins = dlm.directions.size();
   if (dlm.radiance.size() != bins * elements * 3)
     return engine::Error{"", "dlm", "the maps' radiance array does not match their texels and directions"};
+  // The renderer's nearest-bin search walks the directions by z (engine::directional_bin_of).
+  if (!std::is_sorted(dlm.directions.begin(), dlm.directions.end(),
+                      [](const glm::vec3& p, const glm::vec3& q) { return p.z > q.z; }))
+    return engine::Error{"", "dlm", "the maps' directions are not sorted by decreasing z (re-bake)"};
   std::unique_ptr<DlmLighting> l(new DlmLighting());
   l->width_ = width;
   l->height_ = height;

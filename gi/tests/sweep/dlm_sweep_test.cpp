@@ -37,9 +37,12 @@ TEST(DlmSweep, GlossyRoomBeatsTheDirectionlessAtlasTerm) {
   ASSERT_EQ(rows->size(), 1u);
   const gi::SweepRow& row = rows->front();
   ASSERT_TRUE(row.ok()) << row.status;
-  double atlas = std::numeric_limits<double>::quiet_NaN();
-  for (const auto& [name, value] : row.extras)
+  double atlas = std::numeric_limits<double>::quiet_NaN(), exact_lookup = atlas;
+  for (const auto& [name, value] : row.extras) {
     if (name == "atlas_rel_rmse") atlas = value;
+    if (name == "lookup4096_truth_rel_rmse") exact_lookup = value;  // the same bins, the lobe integrated over them
+  }
+  EXPECT_TRUE(std::isfinite(exact_lookup));
   std::printf("dlm on the glossy room: rel RMSE %.3f, direction-less atlas term %.3f\n", row.error.rel_rmse, atlas);
   EXPECT_TRUE(std::isfinite(row.error.rel_rmse));
   EXPECT_LT(row.error.rel_rmse, 0.6);

@@ -312,6 +312,8 @@ void pixels_match_the_cpp_twin(bool tangent) {
       const glm::vec3 expected = engine::directional_specular(brdf, n, v, dirs, stored, bin_normal);
       // A lobe sample lying on the boundary between two bins switches bins under the
       // rasterizer's interpolation error of v (checked at 6e-3): such pixels are counted, not compared.
+      // A pixel counts as on a boundary from a 2% move; an uncounted switch (one sample of 32,
+      // engine::kDirectionalLobeSamples) can still move it by up to 2%, beside the 2% below.
       bool boundary = false;
       const glm::vec3 tu =
           glm::normalize(glm::cross(n, std::fabs(n.x) > 0.9f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0)));
@@ -319,7 +321,7 @@ void pixels_match_the_cpp_twin(bool tangent) {
       for (const glm::vec3 dv : {6e-3f * tu, -6e-3f * tu, 6e-3f * tv, -6e-3f * tv}) {
         const glm::vec3 e2 = engine::directional_specular(brdf, n, glm::normalize(v + dv), dirs, stored, bin_normal);
         for (int ch = 0; ch < 3; ++ch)
-          boundary = boundary || std::fabs(e2[ch] - expected[ch]) > 3e-2f * expected[ch] + 1e-5f;
+          boundary = boundary || std::fabs(e2[ch] - expected[ch]) > 2e-2f * expected[ch] + 1e-5f;
       }
       if (boundary) {
         ++on_boundary;
@@ -333,8 +335,8 @@ void pixels_match_the_cpp_twin(bool tangent) {
         // Half-float storage of the bins (2^-11) and of the HDR target (2^-11), and the
         // rasterizer's interpolated position and normal against the CPU's ray cast: the view
         // angle differs slightly, which moves the specular albedo by up to ~2% on the walls
-        // seen at grazing angles (a constant channel shows it alone).
-        EXPECT_NEAR(g, e, 3e-2 * e + 1e-5) << "pixel " << px << ", " << py << " channel " << ch << " mesh " << bm;
+        // seen at grazing angles (a constant channel shows it alone); plus an uncounted switch.
+        EXPECT_NEAR(g, e, 4e-2 * e + 1e-5) << "pixel " << px << ", " << py << " channel " << ch << " mesh " << bm;
       }
       ++checked;
     }
@@ -345,8 +347,9 @@ void pixels_match_the_cpp_twin(bool tangent) {
       tangent ? "tangent-frame" : "global", checked, on_boundary, worst);
   EXPECT_GT(checked, 50);
   // 64 hemisphere bins are about half as wide as 32 global ones: twice the lobe samples lie
-  // near a boundary (34 of 169 pixels skipped when this was written, 20 with global bins).
-  EXPECT_LT(on_boundary, tangent ? checked / 3 : checked / 5);
+  // near a boundary; and 32 lobe samples are twice the chances of 16 (52 of 169 pixels skipped
+  // when this was written, 28 with global bins; with 16 samples and a 3% test 34 and 20).
+  EXPECT_LT(on_boundary, tangent ? checked / 2 : checked / 4);
 }
 
 TEST(DlmLighting, DirectionalBinsMatchTheCppTwinAtPixels) { pixels_match_the_cpp_twin(false); }
