@@ -13,11 +13,12 @@
 // of the path tracer or of the texel placement).
 // Environment: GI_BREAKDOWN_FILTER=r (filter radius, texels; 0 = the sweep's unfiltered
 // run), GI_BREAKDOWN_SEEDS=2 (a second gather: the gather-noise and floor columns),
-// GI_BREAKDOWN_DENOISE=passes, GI_BREAKDOWN_EMITTERS=rays, GI_BREAKDOWN_SOURCE=r and GI_BREAKDOWN_SOURCE_RIDGE=x (the
-// denoiser's passes, the emitter rays, the source filter's radius in texels and its linear fit's ridge),
-// GI_BREAKDOWN_WORST=N (the N worst texels), GI_BREAKDOWN_TEXEL=i,j (per texel: its normals and face, 16 rays and what
-// they read, the path tracer there at 0, 1 and all bounces), GI_BREAKDOWN_DENOISE_GRID=passes:sigma[:ridge],...
-// (denoiser settings on one gather, a line each; ridge: the local linear fit's, absent: local mean).
+// GI_BREAKDOWN_NEAR_DEPTH=depth[:deep_rays] (the near regather's levels), GI_BREAKDOWN_DENOISE=passes,
+// GI_BREAKDOWN_EMITTERS=rays, GI_BREAKDOWN_SOURCE=r and GI_BREAKDOWN_SOURCE_RIDGE=x (the denoiser's passes, the emitter
+// rays, the source filter's radius in texels and its linear fit's ridge), GI_BREAKDOWN_WORST=N (the N worst texels),
+// GI_BREAKDOWN_TEXEL=i,j (per texel: its normals and face, 16 rays and what they read, the path tracer there at 0, 1
+// and all bounces), GI_BREAKDOWN_DENOISE_GRID=passes:sigma[:ridge],... (denoiser settings on one gather, a line each;
+// ridge: the local linear fit's, absent: local mean).
 #include <engine/gltf.h>
 #include <engine/sun.h>
 #include <gi/bake_input.h>
@@ -141,6 +142,12 @@ int main(int argc, char** argv) {
   if (const char* r = std::getenv("GI_BREAKDOWN_NEAR")) {
     g.near_regather_rays = std::atoi(r);
     if (const char* c = std::strchr(r, ',')) g.near_regather_texels = std::strtof(c + 1, nullptr);
+  }
+  // GI_BREAKDOWN_NEAR_DEPTH=depth[:deep_rays]: the regather's levels and the rays below the first.
+  if (const char* d = std::getenv("GI_BREAKDOWN_NEAR_DEPTH")) {
+    char* rest = nullptr;
+    g.near_regather_depth = static_cast<int>(std::strtol(d, &rest, 10));
+    if (*rest == ':') g.near_regather_deep_rays = static_cast<int>(std::strtol(rest + 1, nullptr, 10));
   }
   // GI_BREAKDOWN_DENOISE_GRID=passes:sigma[:ridge],...: the gathers once, unfiltered, then each
   // denoiser setting on copies of them, one line each (the whole lightmap and the

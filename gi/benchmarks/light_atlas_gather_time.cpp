@@ -11,6 +11,8 @@
 // compare.bin: read back and compared texel by texel with this run's (the largest and the rms
 // difference of the total, relative to the mean total): a speed-up must leave them equal up
 // to float reassociation.
+// Environment: GI_GATHER_ADAPTIVE=share:passes (adaptive passes), GI_GATHER_NEAR_DEPTH=depth[:deep_rays]
+// (the near regather's levels and the rays of each regather below the first).
 #include <embree3/rtcore.h>
 #include <engine/gltf.h>
 #include <engine/sun.h>
@@ -212,6 +214,12 @@ int main(int argc, char** argv) {
     char* rest = nullptr;
     g.adaptive_share = std::strtof(a, &rest);
     if (*rest == ':') g.adaptive_passes = static_cast<int>(std::strtol(rest + 1, nullptr, 10));
+  }
+  // GI_GATHER_NEAR_DEPTH=depth[:deep_rays]: the regather's levels (TexelGatherSettings::near_regather_depth).
+  if (const char* d = std::getenv("GI_GATHER_NEAR_DEPTH")) {
+    char* rest = nullptr;
+    g.near_regather_depth = static_cast<int>(std::strtol(d, &rest, 10));
+    if (*rest == ':') g.near_regather_deep_rays = static_cast<int>(std::strtol(rest + 1, nullptr, 10));
   }
   constexpr std::uint64_t kYardstickRays = 16u << 20;
   raw_embree_rays(*scene, kYardstickRays, pool);

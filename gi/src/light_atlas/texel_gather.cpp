@@ -59,6 +59,9 @@ engine::Status validate(const TexelGatherSettings& s) {
   if (!(s.source_filter_slope_ridge <= 1e6f)) return bad("source_filter_slope_ridge is NaN or above 1e6");
   if (!(s.source_filter_radius_texels <= 16.0f)) return bad("source_filter_radius_texels is above 16 (or NaN)");
   if (s.near_regather_rays < 0 || s.near_regather_rays > 4096) return bad("near_regather_rays is outside 0..4096");
+  if (s.near_regather_depth < 1 || s.near_regather_depth > 8) return bad("near_regather_depth is outside 1..8");
+  if (s.near_regather_deep_rays < 0 || s.near_regather_deep_rays > 4096)
+    return bad("near_regather_deep_rays is outside 0..4096");
   if (!(s.near_regather_texels >= 0.0f) || s.near_regather_texels > 64.0f)
     return bad("near_regather_texels is outside [0, 64]");
   if (!(s.adaptive_share >= 0.0f) || s.adaptive_share > 1.0f) return bad("adaptive_share is outside [0, 1]");
@@ -406,6 +409,8 @@ bool gather_step(const StaticBakeScene& b, const AtlasLayout& layout, const Texe
   src.table = &lt;
   src.near_rays = s.near_regather_rays;
   src.near_m = s.near_regather_texels * texel_m;
+  src.near_depth = s.near_regather_depth;
+  src.near_deep_rays = s.near_regather_deep_rays;
   std::vector<std::uint64_t> gather_rays_of(work, 0);
   const std::vector<std::uint8_t> extra = adaptive_choice(t, kept, src.reflected, s.adaptive_share, pool);
   if (!final_gather(b, lt, t, s, pool, progress, s.shard.items(work), src, emitters ? &*emitters : nullptr, kept, extra,

@@ -90,6 +90,14 @@ struct TexelGatherSettings {
   /// samples can lie a texel away in other light (corners, ledges). 0: never.
   int near_regather_rays = 0;
   float near_regather_texels = 1.0f;
+  /// The regather's rays are read where they land as the fresh rays' are (the punctual lights
+  /// at the point, the shadow-edge rule); those that land nearer than `near_regather_texels`
+  /// again regather at their point, down to this many levels (1: they read the texels). In a
+  /// concave corner the light arrives by several near bounces, each of which a texel read
+  /// takes from a sample up to a texel away (docs/light_atlas.md, "Regathers in corners").
+  int near_regather_depth = 1;
+  /// Rays of each regather below the first level (0: near_regather_rays).
+  int near_regather_deep_rays = 0;
   /// Step 3's adaptive sampling: this share of the texels, those whose kept rays read the most
   /// variable light (the spread of the solve's light where they land, independent of the fresh
   /// rays, so that the choice does not bias them), gather `adaptive_passes` more times with

@@ -272,12 +272,17 @@ LandingPoint landing_point(const StaticBakeScene& b, const Landing& l) {
   return {tri.p0 + u * tri.e1 + v * tri.e2, landing_shading_normal(tri, l.barycentric, l.side)};
 }
 
-// The sky's and the indirect irradiance at a landing point from src.near_rays stratified
-// cosine rays, each reading `reflected` bilinearly where it lands or the sky where it escapes.
+glm::dvec3 read_at(const StaticBakeScene& b, const TexelTable& t, const GatherSource& src, const Landing& l, Pcg32& rng,
+                   std::uint64_t& rays, int depth);
+
+// The sky's and the indirect irradiance at a landing point `depth` levels down from stratified
+// cosine rays (src.near_rays at the first level, src.near_deep_rays below it where set), each
+// read where it lands as a fresh ray's landing is (read_at one level further down) or the sky
+// where it escapes.
 glm::dvec3 regather_at(const StaticBakeScene& b, const TexelTable& t, const GatherSource& src, const Landing& l,
-                       const LandingPoint& at, Pcg32& rng, std::uint64_t& rays) {
+                       const LandingPoint& at, Pcg32& rng, std::uint64_t& rays, int depth) {
   const glm::vec3 origin = offset_ray_origin(at.p, l.side);
-  const auto m = static_cast<std::uint32_t>(src.near_rays);
+  const auto m = static_cast<std::uint32_t>(depth > 1 && src.near_deep_rays > 0 ? src.near_deep_rays : src.near_rays);
   const float shift_y = rng.next_float();  // drawn first: see random.h
   const glm::vec2 shift(rng.next_float(), shift_y);
   glm::dvec3 sum(0.0);
@@ -289,22 +294,16 @@ glm::dvec3 regather_at(const StaticBakeScene& b, const TexelTable& t, const Gath
     const Landing l2 = land(b, *src.table, t, Ray{origin, 0.0f, wi}, l.side, true);
     if (l2.texel == kSky)
       sum += std::numbers::pi * glm::dvec3(engine::sky_radiance(b.scene.sky_radiance, b.scene.sky_gradient, wi));
-    else if (glm::dvec3 reflected; l2.texel < kBack && read_seen_corners(t, src.reflected, l2, reflected))
-      sum += reflected;
+    else if (l2.texel < kBack)
+      sum += read_at(b, t, src, l2, rng, rays, depth + 1);
   }
   return sum / static_cast<double>(m);
 }
 
-}  // namespace
-
-glm::dvec3 read_landing(const StaticBakeScene& b, const TexelTable& t, const GatherSource& src, const Landing& l,
-                        Pcg32& rng, std::uint64_t& rays) {
-  if (src.near_rays > 0 && l.distance < src.near_m) {
-    const LandingPoint at = landing_point(b, l);
-    const glm::dvec3 rest = regather_at(b, t, src, l, at, rng, rays);
-    const DirectAt d = direct_at(b, at.p, at.n, l.side, 1, rng, &rays);
-    return glm::dvec3(src.table->pixels[l.pixel].albedo) * (rest + glm::dvec3(d.live + d.unlit));
-  }
+// A landing's light read from the texels (no regather): the rest bilinearly, the lights'
+// direct light at the point where the settings ask (read_landing's rules).
+glm::dvec3 read_texels(const StaticBakeScene& b, const TexelTable& t, const GatherSource& src, const Landing& l,
+                       Pcg32& rng, std::uint64_t& rays) {
   // l.texel is the pixel's redirect: the pixel's record holds its albedo.
   const LandingTable::Pixel& px = src.table->pixels[l.pixel];
   const bool sharp = (px.bits & LandingTable::kSharp) != 0;
@@ -324,6 +323,27 @@ glm::dvec3 read_landing(const StaticBakeScene& b, const TexelTable& t, const Gat
   const DirectAt d = direct_at(b, at.p, at.n, l.side, 1, rng, &rays);
   const glm::dvec3 lights(px.albedo * (d.live + d.unlit));
   return rest + lights;
+}
+
+// The read at a landing `depth` levels down (1: a fresh ray's): a near landing, while the
+// regather's depth allows, takes every light's direct light and, from a regather of its own,
+// the sky and the indirect light at its point; any other reads the texels.
+glm::dvec3 read_at(const StaticBakeScene& b, const TexelTable& t, const GatherSource& src, const Landing& l, Pcg32& rng,
+                   std::uint64_t& rays, int depth) {
+  if (src.near_rays > 0 && l.distance < src.near_m && depth <= src.near_depth) {
+    const LandingPoint at = landing_point(b, l);
+    const glm::dvec3 rest = regather_at(b, t, src, l, at, rng, rays, depth);
+    const DirectAt d = direct_at(b, at.p, at.n, l.side, 1, rng, &rays);
+    return glm::dvec3(src.table->pixels[l.pixel].albedo) * (rest + glm::dvec3(d.live + d.unlit));
+  }
+  return read_texels(b, t, src, l, rng, rays);
+}
+
+}  // namespace
+
+glm::dvec3 read_landing(const StaticBakeScene& b, const TexelTable& t, const GatherSource& src, const Landing& l,
+                        Pcg32& rng, std::uint64_t& rays) {
+  return read_at(b, t, src, l, rng, rays, 1);
 }
 
 std::vector<std::uint8_t> sharp_pixels(const std::vector<glm::vec3>& lit, int w, int h) {

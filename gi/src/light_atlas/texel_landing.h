@@ -126,6 +126,10 @@ struct GatherSource {
   const LandingTable* table = nullptr;  // the flags of `sharp` set (mark_sharp)
   int near_rays = 0;
   float near_m = 0.0f;
+  /// A regather's own near landings regather again, down to this many levels (1: they read
+  /// the texels); below the first level with `near_deep_rays` rays each (0: `near_rays`).
+  int near_depth = 1;
+  int near_deep_rays = 0;
 };
 
 /// A texel holds the light at its one sample point. Where a shadow edge crosses it, the light
@@ -140,8 +144,9 @@ struct GatherSource {
 /// Bilinear corners whose samples do not see the point (Landing::unseen_corners) are left out;
 /// where none does, that direct light is all the read takes. A landing nearer than
 /// `src.near_m` (with `src.near_rays` > 0) reads no texel of its own: the lights' direct light,
-/// the sky and the indirect light at the point, the last two from `near_rays` cosine rays
-/// reading `reflected` where they land (with the same corner rule) and the sky where they escape.
+/// the sky and the indirect light at the point, the last two from `near_rays` cosine rays read
+/// where they land as a fresh ray's landing is (down to `src.near_depth` levels of regathers),
+/// and the sky where they escape.
 /// Rays it casts (the direct light's shadow rays) are added to `rays`.
 glm::dvec3 read_landing(const StaticBakeScene& b, const TexelTable& t, const GatherSource& src, const Landing& l,
                         Pcg32& rng, std::uint64_t& rays);

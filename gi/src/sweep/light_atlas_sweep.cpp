@@ -68,6 +68,18 @@ std::vector<KnobSpec> gather_detail_knobs() {
        .default_grid = {"1"},
        .min_value = 0,
        .max_value = 64},
+      {.name = "near_depth",
+       .description = "gather: the levels of regathers at near landings (1: the regather's rays read the texels)",
+       .kind = KnobKind::Integer,
+       .default_grid = {"1"},
+       .min_value = 1,
+       .max_value = 8},
+      {.name = "near_deep_rays",
+       .description = "gather: rays of each regather below the first level (0: near_rays)",
+       .kind = KnobKind::Integer,
+       .default_grid = {"0"},
+       .min_value = 0,
+       .max_value = 4096},
       {.name = "adaptive",
        .description = "gather: the share of the texels, those whose kept rays read the most variable light, that "
                       "gather adaptive_passes more times (0: none)",
@@ -210,6 +222,8 @@ engine::Result<MethodOutput> run_light_atlas(const RunContext& ctx) {
     s.gather.source_filter_radius_texels = static_cast<float>(ctx.knobs.real("source_filter"));
     s.gather.near_regather_rays = static_cast<int>(ctx.knobs.integer("near_rays"));
     s.gather.near_regather_texels = static_cast<float>(ctx.knobs.real("near_texels"));
+    s.gather.near_regather_depth = static_cast<int>(ctx.knobs.integer("near_depth"));
+    s.gather.near_regather_deep_rays = static_cast<int>(ctx.knobs.integer("near_deep_rays"));
     s.gather.adaptive_share = static_cast<float>(ctx.knobs.real("adaptive"));
     s.gather.adaptive_passes = static_cast<int>(ctx.knobs.integer("adaptive_passes"));
     s.gather.bounces = std::max(s.bounces, 1);
