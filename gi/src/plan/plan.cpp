@@ -231,7 +231,11 @@ void plan_light_atlas(const PlanFacts& f, const std::optional<PlanPresets>& p, P
                      " rays" +
                      (p->atlas.gather.near_regather_rays > 0
                           ? " (landings nearer than a texel: " + std::to_string(p->atlas.gather.near_regather_rays) +
-                                " more)"
+                                " more" +
+                                (p->atlas.gather.near_regather_depth > 1
+                                     ? ", theirs " + std::to_string(p->atlas.gather.near_regather_deep_rays) + " more"
+                                     : std::string()) +
+                                ")"
                           : std::string()) +
                      (p->atlas.gather.adaptive_share > 0.0f
                           ? ", the noisiest " + fixed(100.0 * double{p->atlas.gather.adaptive_share}, 0) +

@@ -77,6 +77,10 @@ constexpr double kVisibilityRaysPerFreshRayPerDoubling = 0.11;
 // fewer small charts and corners land near less often (the Cornell box at 128 texels/m: 3.9 s
 // either way), so this overestimates them a little.
 constexpr double kNearRegatherPerFreshRay = 0.04;
+// Each ray of a regather below the first level (TexelGatherSettings::near_regather_depth,
+// near_regather_deep_rays): Sponza at 8 texels/m, medium, 27.8 s -> 28.9 s with one ray at the
+// second level, 32.3 s with four (quiet cores, fourteenth session): ~0.01 per ray and level.
+constexpr double kNearDeepPerFreshRay = 0.01;
 
 // PRM (gi/src/prm): every path node (virtual light) is connected to every pane texel facing
 // it by one shadow ray; nodes = E x N_s x a / (1 - a) for a mean albedo a.
@@ -149,8 +153,12 @@ double cache_doublings(std::size_t triangles) {
 double gather_rays_per_texel(const TexelGatherSettings& g, const LightPointCount& lights, std::size_t triangles) {
   const double doublings = cache_doublings(triangles);
   // The adaptive passes (TexelGatherSettings::adaptive_share) repeat the fresh rays of a share of the texels.
-  const double fresh = (g.gather_rays + g.emitter_rays) * (1.0 + kNearRegatherPerFreshRay * g.near_regather_rays) *
-                       (1.0 + double{g.adaptive_share} * g.adaptive_passes);
+  const int deep_rays = g.near_regather_deep_rays > 0 ? g.near_regather_deep_rays : g.near_regather_rays;
+  const double near = g.near_regather_rays > 0 ? kNearRegatherPerFreshRay * g.near_regather_rays +
+                                                     kNearDeepPerFreshRay * deep_rays * (g.near_regather_depth - 1)
+                                               : 0.0;
+  const double fresh =
+      (g.gather_rays + g.emitter_rays) * (1.0 + near) * (1.0 + double{g.adaptive_share} * g.adaptive_passes);
   const double visibility = kVisibilityRaysPerFreshRayPerDoubling * doublings;
   return g.solve_rays + fresh * (1.0 + visibility) + lights.punctual + lights.directional +
          static_cast<double>(lights.sampled > 0 ? g.direct_samples : 0);
