@@ -78,7 +78,7 @@ def vs_pathtracer(pt_path, atlas_paths):
             e = number(r[col])
             pt_s = const[col] / (e * e) if e > 0 else math.nan
             cells.append((e, pt_s, pt_s / t))
-        label = knobs(r, ["solve_rays", "rays", "emitter_rays", "filter", "denoise", "landing_direct", "source_filter", "near_rays", "direct_samples", "vpls", "bounces"])
+        label = knobs(r, ["solve_rays", "rays", "emitter_rays", "filter", "denoise", "landing_direct", "source_filter", "near_rays", "near_depth", "adaptive", "direct_samples", "vpls", "bounces"])
         print(f"| {label} | {t:.1f} | {cells[0][0]:.4f} | {cells[0][1]:.0f} | {cells[0][2]:.1f}x "
               f"| {cells[1][0]:.4f} | {number(r['extra:whole_bias']):+.4f} | {cells[1][1]:.0f} | {cells[1][2]:.1f}x |")
     share = number(atlas[0].get("extra:indirect_dominated_share", "")) if atlas else math.nan

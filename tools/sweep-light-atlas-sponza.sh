@@ -45,11 +45,12 @@ fi
 # the medium preset's settings now (preview's but 8 direct samples): 32 kept + 128 cosine + 32 emitter
 # rays, the punctual lights' and the sun's direct light at every landing, the read light filtered 1.5
 # texels, the guided denoiser's 3 passes at sigma 1.5, both fitting a local plane (ridge 0), no output
-# filter, and near landings regathered with 4 rays (0: without)
+# filter, near landings regathered with 4 rays and theirs with 1 (near_depth 2; 1: without), and the
+# 15% of the texels whose kept rays read the most variable light gathered twice (adaptive 0: without)
 run "$sweep" "${gather[@]}" --knob solve_rays=32 --knob rays=128 --knob emitter_rays=32 --knob filter=0 \
   --knob denoise=3 --knob denoise_sigma=1.5 --knob denoise_ridge=0 --knob source_ridge=0 \
-  --knob landing_direct=punctual --knob source_filter=1.5 --knob near_rays=0,4 \
-  --knob direct_samples=8 "${common[@]}" --out "$out/preset"
+  --knob landing_direct=punctual --knob source_filter=1.5 --knob near_rays=4 --knob near_depth=1,2 \
+  --knob near_deep_rays=1 --knob adaptive=0,0.15 --knob direct_samples=8 "${common[@]}" --out "$out/preset"
 csvs+=("$out/preset/light_atlas_sponza.csv")
 run "$sweep" --method pathtracer_atlas --knob density=8 --knob "spp=$pt_spp" "${common[@]}" --out "$out/pathtracer"
 if [[ ${DENOISE:-1} != 0 ]]; then  # the guided denoiser alone (docs/light_atlas.md), 2 passes, at two ray budgets
