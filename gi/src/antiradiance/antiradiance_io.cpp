@@ -105,6 +105,7 @@ std::string check_settings(const AntiradianceSettings& s) {
 }
 
 // Empty when the bake's arrays fit together and its values are valid, else what is wrong.
+// Long because it is one list of checks, one per array the file holds, each with its message.
 std::string check_bake(const AntiradianceBake& b) {
   if (std::string problem = check_settings(b.settings); !problem.empty()) return problem;
   const ElementHierarchy& h = b.hierarchy;

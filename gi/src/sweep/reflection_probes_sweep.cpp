@@ -64,6 +64,40 @@ std::vector<KnobSpec> scene_knobs() {
   };
 }
 
+// The placement's knobs: where the probes capture and when a box gets a second viewpoint.
+std::vector<KnobSpec> placement_knobs() {
+  return {
+      {.name = "capture_height",
+       .description = "metres above its box's floor each probe is captured at (0: the box's middle, the default; "
+                      "ProbePlacementSettings::capture_height)",
+       .kind = KnobKind::Real,
+       .default_grid = {"0"},
+       .min_value = 0.0,
+       .max_value = 100},
+      {.name = "second_view",
+       .description = "a box whose probe does not see more than this share of its floor gets a second probe over "
+                      "the hidden part (ProbePlacementSettings::second_view_min_share, the default; 2: never; "
+                      "-1: every box, over its middle)",
+       .kind = KnobKind::Real,
+       .default_grid = {format_number(ProbePlacementSettings{}.second_view_min_share)},
+       .min_value = -1.0,
+       .max_value = 2},
+      {.name = "second_view_height",
+       .description = "metres above its box's floor the second viewpoint is captured at "
+                      "(ProbePlacementSettings::second_view_height)",
+       .kind = KnobKind::Real,
+       .default_grid = {format_number(ProbePlacementSettings{}.second_view_height)},
+       .min_value = 0.0,
+       .max_value = 100},
+      {.name = "visibility",
+       .description = "each probe's blend weight times whether it saw the shaded point (probe_visibility_weight, "
+                      "the default: on; off: by position alone)",
+       .kind = KnobKind::Choice,
+       .default_grid = {"on"},
+       .choices = {"on", "off"}},
+  };
+}
+
 // Long because it is one table, one entry per knob with its grid and range, read as a list.
 std::vector<KnobSpec> reflection_probes_knobs() {
   std::vector<KnobSpec> knobs = {
@@ -136,34 +170,6 @@ std::vector<KnobSpec> reflection_probes_knobs() {
        .default_grid = {"0"},
        .min_value = 0.0,
        .max_value = 100},
-      {.name = "capture_height",
-       .description = "metres above its box's floor each probe is captured at (0: the box's middle, the default; "
-                      "ProbePlacementSettings::capture_height)",
-       .kind = KnobKind::Real,
-       .default_grid = {"0"},
-       .min_value = 0.0,
-       .max_value = 100},
-      {.name = "second_view",
-       .description = "a box whose probe does not see more than this share of its floor gets a second probe over "
-                      "the hidden part (ProbePlacementSettings::second_view_min_share, the default; 2: never; "
-                      "-1: every box, over its middle)",
-       .kind = KnobKind::Real,
-       .default_grid = {format_number(ProbePlacementSettings{}.second_view_min_share)},
-       .min_value = -1.0,
-       .max_value = 2},
-      {.name = "second_view_height",
-       .description = "metres above its box's floor the second viewpoint is captured at "
-                      "(ProbePlacementSettings::second_view_height)",
-       .kind = KnobKind::Real,
-       .default_grid = {format_number(ProbePlacementSettings{}.second_view_height)},
-       .min_value = 0.0,
-       .max_value = 100},
-      {.name = "visibility",
-       .description = "each probe's blend weight times whether it saw the shaded point (probe_visibility_weight, "
-                      "the default: on; off: by position alone)",
-       .kind = KnobKind::Choice,
-       .default_grid = {"on"},
-       .choices = {"on", "off"}},
       {.name = "estimate",
        .description =
            "what is scored (the diagnosis, docs/reflection_probes.md): runtime (the probes as the "
@@ -177,6 +183,7 @@ std::vector<KnobSpec> reflection_probes_knobs() {
        .default_grid = {"runtime"},
        .choices = {"runtime", "trace", "oracle_level0", "oracle", "level0", "exact_parallax", "level0_exact_dir"}},
   };
+  for (KnobSpec& k : placement_knobs()) knobs.push_back(std::move(k));
   for (KnobSpec& k : scene_knobs()) knobs.push_back(std::move(k));
   return knobs;
 }
