@@ -54,6 +54,10 @@ struct GISystemSettings {
   int brf_bounces = 3;               ///< BRF: bounces between dynamic objects.
   float brf_cull_threshold = 1e-3f;  ///< BRF: skip object pairs below this share of the largest (§5.4).
   float probe_spacing_m = 1.0f;      ///< BRF: spacing of the world-light probes for dynamic objects.
+  /// BRF: GPU memory for the object pairs' basis irradiance (bytes; 0: the GPU's largest
+  /// buffer, 128 MiB on llvmpipe). When the pairs in reach need more, each object's reach
+  /// narrows until they fit (Stats::brf_reach), so crowds keep their nearest neighbours' bounce.
+  std::size_t brf_pair_budget_bytes = 0;
   /// Told when a method turns off at run time (e.g. its GPU pass cannot be created); the
   /// system never prints. Stats::disabled keeps the same facts for a host without a log.
   LogCallback log;
@@ -91,9 +95,12 @@ class GISystem final : public engine::IndirectLightProvider {
     std::size_t brf_pairs_evaluated = 0;  ///< Last BRF update: object pairs with light between them,
     std::size_t brf_pairs_reused = 0;     ///< ... of which their basis irradiance was reused (pose unchanged),
     std::size_t brf_pairs_culled = 0;     ///< and pairs skipped by the I_c bound.
-    double last_prm_ms = 0.0;             ///< CPU weights + GPU sum (glFinish-timed).
-    double last_brf_cpu_ms = 0.0;         ///< Direct light at vertices, probes.
-    double last_brf_gpu_ms = 0.0;         ///< Interreflection pass (glFinish-timed).
+    /// BRF: the reach in use, as a multiple of the objects' outermost field spheres (1: as
+    /// baked); below 1 after the pairs in reach outgrew brf_pair_budget_bytes (a warning was logged).
+    float brf_reach = 1.0f;
+    double last_prm_ms = 0.0;      ///< CPU weights + GPU sum (glFinish-timed).
+    double last_brf_cpu_ms = 0.0;  ///< Direct light at vertices, probes.
+    double last_brf_gpu_ms = 0.0;  ///< Interreflection pass (glFinish-timed).
     std::size_t dynamic_objects = 0;
     std::size_t dynamic_vertices = 0;
     std::size_t brf_field_bytes = 0;         ///< Basis + fields of all dynamic meshes (CPU copy).

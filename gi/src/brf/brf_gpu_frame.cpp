@@ -206,6 +206,16 @@ void BrfGpuPass::fit_first_and_cull(std::span<const BrfInstance> instances,
       if (outside[s * n + r] == 0) frame.in_reach.push_back(std::uint64_t{s} * n + r);
 }
 
+namespace {
+
+/// layout_pairs' refusal: the pairs in reach need more Phi than the budget (or the SSBO limit) allows.
+std::string phi_over_limit(std::size_t pairs, std::size_t bytes, std::size_t limit, std::size_t buffer_limit) {
+  return std::to_string(pairs) + " pairs in reach need " + std::to_string(bytes) + " bytes of pair Phi, above " +
+         (limit < buffer_limit ? "the budget of " : "the SSBO limit of ") + std::to_string(limit);
+}
+
+}  // namespace
+
 engine::Status BrfGpuPass::layout_pairs(std::size_t instance_count, const FrameData& frame) {
   stats_.pair_slots = frame.in_reach.size();
   const bool lod = frame.lod_distance > 0.0f && std::isfinite(frame.lod_distance);
@@ -245,10 +255,9 @@ engine::Status BrfGpuPass::layout_pairs(std::size_t instance_count, const FrameD
     slots[k].lod_rows = u32(floats);
     floats += static_cast<std::size_t>(mr.lod_point_count) * padded(models_[layout_models_[s]].channels());
   }
-  if (floats * sizeof(float) > max_buffer_bytes_)
-    return error(std::to_string(frame.in_reach.size()) + " pairs in reach need " +
-                 std::to_string(floats * sizeof(float)) + " bytes of pair Phi, above the SSBO limit of " +
-                 std::to_string(max_buffer_bytes_));
+  stats_.phi_bytes_needed = floats * sizeof(float);
+  if (floats * sizeof(float) > phi_limit_bytes_)
+    return error(phi_over_limit(frame.in_reach.size(), floats * sizeof(float), phi_limit_bytes_, max_buffer_bytes_));
   if (copies.empty()) {
     phi_.reserve(floats * sizeof(float));
   } else {

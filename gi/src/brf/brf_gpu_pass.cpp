@@ -126,6 +126,7 @@ engine::Result<BrfGpuPass> BrfGpuPass::create(std::span<const BrfModel> models, 
 
   BrfGpuPass pass;
   pass.max_buffer_bytes_ = limit;
+  pass.phi_limit_bytes_ = options.phi_budget_bytes > 0 ? std::min(limit, options.phi_budget_bytes) : limit;
   pass.pose_tolerance_ = options.pose_tolerance;
   pass.pack_lod_points_ = options.pack_lod_points;
   if (auto s = pass.build_programs(); !s) return s.error();

@@ -72,6 +72,9 @@ struct BrfGpuPassOptions {
   /// Largest buffer bound as one SSBO (bytes). 0: GL_MAX_SHADER_STORAGE_BLOCK_SIZE, at most
   /// 128 MiB. Tests set it small to exercise field buffers split by model.
   std::size_t max_buffer_bytes = 0;
+  /// Budget of the pairs' Phi (one buffer, bytes). 0: max_buffer_bytes. run() fails above it,
+  /// with Stats::phi_bytes_needed set, so the caller may narrow the reach.
+  std::size_t phi_budget_bytes = 0;
   /// Two poses (relative source-receiver pose, or a source's world transform) are the same
   /// when no matrix element differs by more than this x (1 + |element|).
   float pose_tolerance = 1e-6f;
@@ -156,10 +159,16 @@ class BrfGpuPass {
     std::size_t static_receivers_hidden = 0;
     double static_visibility_ms = 0.0;  ///< CPU time of their visibility rays.
     double cpu_ms = 0.0;                ///< Wall time of the last run() on the CPU.
+    /// Bytes the pairs in reach need for their Phi (set even when run() fails because they
+    /// are above max_buffer_bytes(): the caller may narrow the reach and run again).
+    std::size_t phi_bytes_needed = 0;
   };
   const Stats& stats() const { return stats_; }
   /// GPU memory held by the pass (bytes): models, per-frame buffers, Phi caches.
   std::size_t gpu_bytes() const;
+  /// The most the pairs' Phi may take (bytes): BrfGpuPassOptions::phi_budget_bytes, at most
+  /// the largest buffer the pass binds.
+  std::size_t phi_limit_bytes() const { return phi_limit_bytes_; }
 
  private:
   /// A GL buffer that grows on demand (glNamedBufferData), never shrinks.
@@ -283,6 +292,7 @@ class BrfGpuPass {
   Programs programs_;
   std::vector<ModelInfo> models_;
   std::size_t max_buffer_bytes_ = 0;
+  std::size_t phi_limit_bytes_ = 0;  ///< min(phi_budget_bytes, max_buffer_bytes_)
   float pose_tolerance_ = 1e-6f;
   bool pack_lod_points_ = true;  ///< BrfGpuPassOptions::pack_lod_points.
 

@@ -7,7 +7,9 @@
 #include <engine/gpu/shader_program.h>
 #include <engine/runtime_limits.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <unordered_map>
 
@@ -84,8 +86,37 @@ struct BrfLighting::Impl {
     return false;
   }
 
+  /// The GPU pass over this frame. When the pairs in reach need more Phi than one buffer
+  /// holds (hundreds of objects crowded together), the reach (influence_scale) narrows until
+  /// they fit, keeping each object's nearest neighbours, and stays narrowed; the host is told
+  /// once per narrowing. Any other failure, or a reach below a tenth of the setting, turns
+  /// the fields off.
+  bool run_pass(std::span<const std::vector<glm::vec3>> incoming) {
+    for (;;) {
+      engine::Status s = pass->run(instances, incoming, settings.update);
+      if (s) return true;
+      const std::size_t needed = pass->stats().phi_bytes_needed, limit = pass->phi_limit_bytes();
+      const float scale = settings.update.influence_scale;
+      if (needed <= limit || !(scale > 0.0f) || scale < 0.1f * stats.influence_scale_setting) {
+        gpu_failed = !disable("update failed: " + s.error().to_string());
+        return false;
+      }
+      // Pairs grow about as the reach squared on a floor: aim a little below the limit.
+      const float shrink =
+          std::clamp(0.95f * std::sqrt(static_cast<float>(limit) / static_cast<float>(needed)), 0.5f, 0.95f);
+      settings.update.influence_scale = scale * shrink;
+      stats.influence_scale = settings.update.influence_scale;
+      ++stats.reach_narrowings;
+      if (settings.log)
+        settings.log(LogLevel::Warning, "basis radiance fields: the pairs in reach need " + std::to_string(needed) +
+                                            " bytes of Phi, above the limit of " + std::to_string(limit) +
+                                            ": the reach narrows to x" +
+                                            std::to_string(settings.update.influence_scale));
+    }
+  }
+
   bool create_gpu() {
-    auto p = BrfGpuPass::create(models);
+    auto p = BrfGpuPass::create(models, {.phi_budget_bytes = settings.phi_budget_bytes});
     auto sum = engine::ShaderProgramBuilder(gi_shader_files())
                    .stage(engine::ShaderStage::Compute, "brf_vertex_sum.comp.glsl")
                    .build();
@@ -171,6 +202,7 @@ engine::Result<std::unique_ptr<BrfLighting>> BrfLighting::create(std::vector<Brf
   for (const BrfModel& m : impl->models)
     impl->stats.field_bytes += m.field.bytes() + m.basis.psi.size() * sizeof(float);
   impl->stats.instances = impl->instances.size();
+  impl->stats.influence_scale = impl->stats.influence_scale_setting = settings.update.influence_scale;
   impl->stats.static_receivers = impl->world.receiver_texels.size();
   impl->world_incoming.resize(impl->instances.size());
   return std::unique_ptr<BrfLighting>(new BrfLighting(std::move(impl)));
@@ -273,10 +305,7 @@ bool BrfLighting::update() {
     for (std::size_t j = 0; j < incoming[i].size(); ++j) incoming[i][j] += m.world_incoming[i][j];
   }
   const auto t1 = Clock::now();
-  if (engine::Status s = m.pass->run(m.instances, incoming, m.settings.update); !s) {
-    m.gpu_failed = !m.disable("update failed: " + s.error().to_string());
-    return false;
-  }
+  if (!m.run_pass(incoming)) return false;
   m.sum_vertices();
   glFinish();
   const auto t2 = Clock::now();

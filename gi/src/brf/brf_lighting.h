@@ -59,7 +59,10 @@ struct BrfWorldLink {
 struct BrfLightingSettings {
   BrfUpdateSettings update;
   int area_light_samples = 16;  ///< Point emitters per area light for the direct light.
-  LogCallback log;              ///< Told when the GPU pass cannot run (the fields turn off).
+  /// BrfGpuPassOptions::phi_budget_bytes (0: the GPU's buffer limit). Pairs in reach needing
+  /// more Phi than that narrow update.influence_scale until they fit (Stats::reach_narrowings).
+  std::size_t phi_budget_bytes = 0;
+  LogCallback log;  ///< Told when the GPU pass cannot run (the fields turn off).
 };
 
 class BrfLighting {
@@ -117,7 +120,12 @@ class BrfLighting {
     std::size_t static_receivers = 0;
     std::size_t field_bytes = 0;  ///< Precomputed data of all models (CPU copies).
     std::size_t gpu_bytes = 0;
-    std::string disabled;  ///< Why the fields turned off (no GPU resources); empty: running.
+    std::string disabled;                  ///< Why the fields turned off (no GPU resources); empty: running.
+    float influence_scale_setting = 0.0f;  ///< BrfUpdateSettings::influence_scale as given.
+    /// The reach in use: below the setting after reach_narrowings narrowed it to fit the pairs'
+    /// Phi in the GPU's buffer limit.
+    float influence_scale = 0.0f;
+    std::uint64_t reach_narrowings = 0;
   };
   const Stats& stats() const;
 

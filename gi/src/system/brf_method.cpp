@@ -44,6 +44,7 @@ class BrfMethod final : public MethodRuntime {
       state.stats.brf_pairs_evaluated = bs.pairs_evaluated;
       state.stats.brf_pairs_reused = bs.pairs_reused;
       state.stats.brf_pairs_culled = bs.pairs_culled;
+      state.stats.brf_reach = bs.influence_scale;
       state.stats.last_brf_cpu_ms = bs.last_cpu_ms;
       state.stats.last_brf_gpu_ms = bs.last_gpu_ms;
     }
@@ -178,6 +179,7 @@ engine::Result<std::unique_ptr<MethodRuntime>> load_brf_method(MethodLoad& load)
       BrfLighting::create(std::move(models->models), std::move(models->instances), std::move(models->entities),
                           load.scene.registry, std::move(world),
                           {.update = {.bounces = settings.brf_bounces, .cull_threshold = settings.brf_cull_threshold},
+                           .phi_budget_bytes = settings.brf_pair_budget_bytes,
                            .log = settings.log});
   if (!brf) return brf.error();
   const auto& st = brf.value()->stats();

@@ -142,6 +142,62 @@ TEST(GISystem, RecomputesOnlyWhatChanged) {
   EXPECT_GT(largest, 0.0f);
 }
 
+// The crate's per-vertex irradiance after one frame (vec4 per vertex; empty when it has none).
+std::vector<glm::vec4> vertex_irradiance(gi::GISystem& gi, const engine::Scene& scene, const char* name) {
+  const std::uint32_t buffer = gi.frame().vertex_irradiance_buffer(engine::find_by_name(scene.registry, name)).gl_name;
+  if (buffer == 0) return {};
+  GLint64 bytes = 0;
+  glGetNamedBufferParameteri64v(buffer, GL_BUFFER_SIZE, &bytes);
+  std::vector<glm::vec4> v(static_cast<std::size_t>(bytes) / sizeof(glm::vec4));
+  glGetNamedBufferSubData(buffer, 0, bytes, v.data());
+  return v;
+}
+
+// Hundreds of crates crowded together outgrew the GPU's 128 MiB buffer in the stress run and
+// the fields turned off for every object. Here the five crates' pairs outgrow a small cap:
+// the reach narrows until they fit, the host is told, and each crate keeps its nearest
+// neighbours' bounce (less light than with every pair, never more: bounces only add).
+TEST(GISystem, PairsBeyondTheBufferLimitNarrowTheReachInsteadOfTurningTheFieldsOff) {
+  auto ctx = engine::GpuContext::create_headless();
+  ASSERT_TRUE(ctx) << "no headless GL context: " << ctx.error().to_string();
+  engine::Scene scene = crates_room();
+  auto full = gi::GISystem::load(bundle().dir, scene);
+  ASSERT_TRUE(full) << full.error().to_string();
+  const std::vector<glm::vec4> all_pairs = vertex_irradiance(**full, scene, "crate_1");
+  const std::size_t pairs = (*full)->stats().brf_pairs_evaluated + (*full)->stats().brf_pairs_culled;
+  EXPECT_EQ(pairs, 5u * 4u);
+  EXPECT_EQ((*full)->stats().brf_reach, 1.0f);
+  full->reset();
+
+  std::vector<std::string> warnings;
+  auto narrow = gi::GISystem::load(bundle().dir, scene,
+                                   {.brf_pair_budget_bytes = std::size_t{64} << 10,
+                                    .log = [&](gi::LogLevel, std::string_view line) { warnings.emplace_back(line); }});
+  ASSERT_TRUE(narrow) << narrow.error().to_string();
+  const std::vector<glm::vec4> near_pairs = vertex_irradiance(**narrow, scene, "crate_1");
+  for (const std::string& w : warnings) std::printf("warning: %s\n", w.c_str());
+  const gi::GISystem::Stats& st = (*narrow)->stats();
+  EXPECT_TRUE(st.disabled.empty()) << st.disabled.front();
+  EXPECT_EQ(st.brf_updates, 1u);
+  EXPECT_LT(st.brf_reach, 1.0f);
+  std::printf("reach x%.3f: %zu pairs with light\n", static_cast<double>(st.brf_reach), st.brf_pairs_evaluated);
+  EXPECT_GT(st.brf_pairs_evaluated, 0u);
+  ASSERT_EQ(near_pairs.size(), all_pairs.size());
+  double sum_near = 0.0, sum_all = 0.0;
+  for (std::size_t i = 0; i < near_pairs.size(); ++i) {
+    ASSERT_TRUE(std::isfinite(near_pairs[i].x) && std::isfinite(near_pairs[i].y) && std::isfinite(near_pairs[i].z));
+    EXPECT_LE(near_pairs[i].x, all_pairs[i].x * 1.0001f + 1e-6f) << "vertex " << i;
+    sum_near += static_cast<double>(near_pairs[i].x);
+    sum_all += static_cast<double>(all_pairs[i].x);
+  }
+  std::printf("crate_1's irradiance: %.4g with the nearest pairs, %.4g with all\n", sum_near, sum_all);
+  EXPECT_GT(sum_near, 0.0);
+  EXPECT_LT(sum_near, sum_all) << "the pairs beyond the narrowed reach bring no light";
+  bool told = false;
+  for (const std::string& w : warnings) told = told || w.find("reach narrows") != std::string::npos;
+  EXPECT_TRUE(told);
+}
+
 TEST(GISystem, TheRedCrateTurnsTheStatuePink) {
   auto ctx = engine::GpuContext::create_headless();
   ASSERT_TRUE(ctx) << "no headless GL context: " << ctx.error().to_string();
