@@ -51,6 +51,20 @@ bool behind(const glm::vec3* t, const glm::vec3& p, const glm::vec3& n) {
   return true;
 }
 
+// The Jacobi solves' shared bookkeeping after each step: the iteration count and the relative
+// residual (the step's change over the irradiance it reached). True when the solve stops: it
+// diverged (not converged, and visibly so), or with a tolerance (bounces <= 0) it converged.
+bool end_of_step(ExactSolveResult& out, int it, double change, double total, const ExactTransportSettings& s) {
+  out.iterations = it + 1;
+  out.residual = total > 0.0 ? change / total : 0.0;
+  if (!std::isfinite(total)) return true;
+  if (s.bounces <= 0 && out.residual < s.tolerance) {
+    out.converged = true;
+    return true;
+  }
+  return false;
+}
+
 }  // namespace
 
 engine::Result<ExactLeafTransport> ExactLeafTransport::create(const BakeInput& input,
@@ -380,7 +394,7 @@ void ExactLeafTransport::store(std::size_t i, std::size_t j, float g) {
 }
 
 ExactSolveResult ExactLeafTransport::solve(const ElementHierarchy& h, std::span<const glm::vec3> direct) const {
-  return iterate(h, direct, {}, {}, {});
+  return iterate(h, direct);
 }
 
 ExactSolveResult ExactLeafTransport::solve_receivers(const ElementHierarchy& h, std::span<const glm::vec3> direct,
@@ -438,21 +452,13 @@ ExactSolveResult ExactLeafTransport::iterate_receivers(const ElementHierarchy& h
       total += static_cast<double>(next[q].x + next[q].y + next[q].z);
       out.irradiance[recv_[q]] = next[q];
     }
-    out.iterations = it + 1;
-    out.residual = total > 0.0 ? change / total : 0.0;
-    if (!std::isfinite(total)) break;  // diverged: not converged, and visibly so
-    if (settings_.bounces <= 0 && out.residual < settings_.tolerance) {
-      out.converged = true;
-      break;
-    }
+    if (end_of_step(out, it, change, total, settings_)) break;
   }
   if (settings_.bounces > 0) out.converged = std::isfinite(out.residual);
   return out;
 }
 
-ExactSolveResult ExactLeafTransport::iterate(const ElementHierarchy& h, std::span<const glm::vec3> direct,
-                                             std::span<const char> rows, std::span<const glm::vec3> others,
-                                             std::span<const glm::vec3> start) const {
+ExactSolveResult ExactLeafTransport::iterate(const ElementHierarchy& h, std::span<const glm::vec3> direct) const {
   const std::size_t n = h.leaf_count();
   GI_EXPECTS(n == n_ && direct.size() == n, "ExactLeafTransport::solve: update() with this hierarchy first");
   std::vector<glm::vec3> area_rho(n);  // A_j albedo_j / pi
@@ -462,16 +468,12 @@ ExactSolveResult ExactLeafTransport::iterate(const ElementHierarchy& h, std::spa
   }
   ExactSolveResult out;
   out.irradiance.assign(n, glm::vec3(0.0f));
-  if (!rows.empty())
-    for (std::size_t l = 0; l < n; ++l)
-      out.irradiance[l] = !rows[l] ? others[l] : start.empty() ? glm::vec3(0.0f) : start[l];
   std::vector<glm::vec3> next = out.irradiance, source(n);
   const int budget = settings_.bounces > 0 ? settings_.bounces : settings_.max_iterations;
   for (int it = 0; it < budget; ++it) {
     for (std::size_t l = 0; l < n; ++l) source[l] = area_rho[l] * (direct[l] + out.irradiance[l]);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 16), [&](const tbb::blocked_range<std::size_t>& r) {
       for (std::size_t i = r.begin(); i != r.end(); ++i) {
-        if (!rows.empty() && !rows[i]) continue;  // held
         glm::dvec3 sum(0.0);
         for (std::size_t j = 0; j < i; ++j) sum += static_cast<double>(g_[pair_index(j, i)]) * glm::dvec3(source[j]);
         const std::size_t row = i < n - 1 ? pair_index(i, i + 1) : 0;
@@ -482,19 +484,12 @@ ExactSolveResult ExactLeafTransport::iterate(const ElementHierarchy& h, std::spa
     });
     double change = 0.0, total = 0.0;
     for (std::size_t l = 0; l < n; ++l) {
-      if (!rows.empty() && !rows[l]) continue;
       const glm::vec3 d = next[l] - out.irradiance[l];
       change += static_cast<double>(std::abs(d.x) + std::abs(d.y) + std::abs(d.z));
       total += static_cast<double>(next[l].x + next[l].y + next[l].z);
     }
     out.irradiance = next;
-    out.iterations = it + 1;
-    out.residual = total > 0.0 ? change / total : 0.0;
-    if (!std::isfinite(total)) break;  // diverged: not converged, and visibly so
-    if (settings_.bounces <= 0 && out.residual < settings_.tolerance) {
-      out.converged = true;
-      break;
-    }
+    if (end_of_step(out, it, change, total, settings_)) break;
   }
   if (settings_.bounces > 0) out.converged = std::isfinite(out.residual);
   return out;

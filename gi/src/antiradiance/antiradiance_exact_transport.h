@@ -158,9 +158,8 @@ class ExactLeafTransport {
   std::size_t pair_index(std::size_t i, std::size_t j) const;  // i < j
   /// Sizes the tables for n leaves (every coupling 0) and the receivers' rows.
   void reset(std::size_t n);
-  /// Jacobi over the rows flagged in `rows` (all when empty), the others held at `others`.
-  ExactSolveResult iterate(const ElementHierarchy& h, std::span<const glm::vec3> direct, std::span<const char> rows,
-                           std::span<const glm::vec3> others, std::span<const glm::vec3> start) const;
+  /// Jacobi over every leaf from zero (solve()'s; the receivers' solve is iterate_receivers).
+  ExactSolveResult iterate(const ElementHierarchy& h, std::span<const glm::vec3> direct) const;
   /// The receivers' Jacobi on rows_: the senders held at `others` summed once per solve, the
   /// steps over the receivers' columns only.
   ExactSolveResult iterate_receivers(const ElementHierarchy& h, std::span<const glm::vec3> direct,
