@@ -20,7 +20,7 @@ namespace {
 
 constexpr float kPi = 3.14159265358979f;
 constexpr int kMinClosePairs = 16;
-constexpr int kMaxReusedPairs = 64;      // one std::uint64_t of visibility bits per leaf pair
+constexpr int kMaxReusedPairs = 64;      // at most four 16-bit words of visibility bits per leaf pair
 constexpr std::size_t kBatchRays = 256;  // rays queued before a flush (one stream)
 
 std::uint64_t mix(std::uint64_t x) {
@@ -144,9 +144,18 @@ std::size_t ExactLeafTransport::pair_index(std::size_t i, std::size_t j) const {
   return i * n_ - i * (i + 1) / 2 + (j - i - 1);
 }
 
+std::size_t ExactLeafTransport::pair_slot(std::size_t i, std::size_t j) const {
+  if (slot_.empty()) return pair_index(i, j);
+  return slot_[i] >= 0 ? static_cast<std::size_t>(slot_[i]) * n_ + j : static_cast<std::size_t>(slot_[j]) * n_ + i;
+}
+
 float ExactLeafTransport::coupling(std::size_t i, std::size_t j) const {
   if (i == j) return 0.0f;
-  return i < j ? g_[pair_index(i, j)] : g_[pair_index(j, i)];
+  if (i > j) std::swap(i, j);
+  if (slot_.empty()) return g_[pair_index(i, j)];
+  if (slot_[i] >= 0) return rows_[static_cast<std::size_t>(slot_[i]) * n_ + j];
+  if (slot_[j] >= 0) return rows_[static_cast<std::size_t>(slot_[j]) * n_ + i];
+  return 0.0f;  // neither a receiver: never computed
 }
 
 // Pairs queued for their rays: a task's pairs of one row, traced together (one stream of the
@@ -253,7 +262,7 @@ void ExactLeafTransport::queue_pair(const ElementHierarchy& h, std::size_t i, st
     PairBatch::Sample sample{ci * cj / std::max(r2, min_r2), -1, -1, static_cast<std::uint32_t>(s)};
     const Ray ray{.origin = o, .t_min = 0.0f, .direction = e - o, .t_max = 1.0f};
     if (door_caster_) {
-      const bool kept = reuse && ((visible_[pair_index(i, j)] >> s) & 1u) != 0;
+      const bool kept = reuse && visible_bit(pair_slot(i, j), static_cast<std::uint32_t>(s));
       queue_split_sample(ray, !reuse, kept, sample.ray, sample.door_ray, batch);
     } else if (!reuse || meets_swept(ray)) {
       sample.ray = static_cast<std::int32_t>(batch.rays.size());
@@ -279,18 +288,17 @@ void ExactLeafTransport::flush(PairBatch& batch) {
   batch.rays_done += batch.rays.size();
   batch.door_rays_done += batch.door_rays.size();
   for (const PairBatch::Pair& p : batch.pairs) {
-    const std::size_t index = pair_index(p.i, p.j);
-    std::uint64_t* bits = visible_.empty() ? nullptr : &visible_[index];
+    const std::size_t slot = pair_slot(p.i, p.j);
+    const bool keep = !visible_.empty();
     double sum = 0.0;  // in sample order, as one sample at a time summed
     for (std::uint32_t k = p.first; k < p.first + p.count; ++k) {
       const PairBatch::Sample& s = batch.samples[k];
-      const std::uint64_t bit = std::uint64_t{1} << s.bit;
       bool visible = false;
       if (s.ray >= 0) {
         visible = batch.occluded[static_cast<std::size_t>(s.ray)] == 0;
-        if (bits) *bits = visible ? (*bits | bit) : (*bits & ~bit);
+        if (keep) set_visible_bit(slot, s.bit, visible);
       } else {
-        visible = (*bits & bit) != 0;  // reuse: the segment meets nothing that moved
+        visible = visible_bit(slot, s.bit);  // reuse: the segment meets nothing that moved
       }
       if (visible && s.door_ray >= 0) visible = batch.door_occluded[static_cast<std::size_t>(s.door_ray)] == 0;
       if (visible) sum += static_cast<double>(s.weight);
@@ -305,8 +313,7 @@ void ExactLeafTransport::flush(PairBatch& batch) {
 
 void ExactLeafTransport::reset(std::size_t n) {
   n_ = n;
-  g_.assign(n * (n - 1) / 2, 0.0f);
-  if (settings_.reuse_visibility) visible_.assign(g_.size(), 0);
+  sized_ = true;
   recv_.clear();
   slot_.assign(receivers_.empty() ? 0 : n, -1);
   for (std::size_t l = 0; l < slot_.size(); ++l)
@@ -315,6 +322,12 @@ void ExactLeafTransport::reset(std::size_t n) {
       recv_.push_back(static_cast<std::uint32_t>(l));
     }
   rows_.assign(recv_.size() * n, 0.0f);
+  // With receivers their rows are the only table: the pairs of two other leaves are never
+  // computed, so n(n-1)/2 slots would hold mostly zeros.
+  const std::size_t slots = slot_.empty() ? n * (n - 1) / 2 : recv_.size() * n;
+  g_.assign(slot_.empty() ? slots : 0, 0.0f);
+  visible_words_ = static_cast<std::size_t>(std::max(settings_.point_pairs, kMinClosePairs) + 15) / 16;
+  visible_.assign(settings_.reuse_visibility ? slots * visible_words_ : 0, 0);
 }
 
 void ExactLeafTransport::update(const ElementHierarchy& h) {
@@ -325,7 +338,7 @@ void ExactLeafTransport::update(const ElementHierarchy& h) {
     dirty_ = false;
   }
   const std::size_t n = h.leaf_count();
-  const bool all = n != n_ || g_.empty();
+  const bool all = n != n_ || !sized_;
   if (all) reset(n);
   std::vector<char> moving(n, 0);
   std::vector<MovingInstances::Box> bounds(n);  // each leaf's triangle's box
@@ -387,8 +400,10 @@ void ExactLeafTransport::update_row(const ElementHierarchy& h, std::size_t i, bo
 }
 
 void ExactLeafTransport::store(std::size_t i, std::size_t j, float g) {
-  g_[pair_index(i, j)] = g;
-  if (slot_.empty()) return;
+  if (slot_.empty()) {
+    g_[pair_index(i, j)] = g;
+    return;
+  }
   if (slot_[i] >= 0) rows_[static_cast<std::size_t>(slot_[i]) * n_ + j] = g;
   if (slot_[j] >= 0) rows_[static_cast<std::size_t>(slot_[j]) * n_ + i] = g;
 }
@@ -459,6 +474,7 @@ ExactSolveResult ExactLeafTransport::iterate_receivers(const ElementHierarchy& h
 }
 
 ExactSolveResult ExactLeafTransport::iterate(const ElementHierarchy& h, std::span<const glm::vec3> direct) const {
+  GI_EXPECTS(slot_.empty(), "ExactLeafTransport::solve: with receivers only their pairs exist (solve_receivers)");
   const std::size_t n = h.leaf_count();
   GI_EXPECTS(n == n_ && direct.size() == n, "ExactLeafTransport::solve: update() with this hierarchy first");
   std::vector<glm::vec3> area_rho(n);  // A_j albedo_j / pi

@@ -60,8 +60,8 @@ struct ExactTransportSettings {
   /// a door move, trace only the samples of a recomputed static pair whose segment meets a
   /// moved instance's box before or after the move; the others reuse their stored bit (the
   /// geometry they cross did not move). The couplings are bit for bit those of tracing every
-  /// sample; the rays per move drop to the segments that cross the door's two boxes. 8 bytes
-  /// per leaf pair.
+  /// sample; the rays per move drop to the segments that cross the door's two boxes. 2 bytes
+  /// per leaf pair up to 16 point pairs (and close pairs' 16), 8 up to 64.
   bool reuse_visibility = false;
   /// Trace the rays of consecutive pairs together, a stream of up to 256 (rtcOccluded1M); false:
   /// one rtcOccluded1 per ray, as before. The couplings are the same bits either way. (Packets
@@ -116,7 +116,10 @@ class ExactLeafTransport {
   /// Restricts the transport to receivers (issue 37's explicit visibility near the door): set
   /// before the first update(), one flag per leaf. Only pairs with an end among them are
   /// computed (the others' coupling stays 0).
-  void set_receivers(std::vector<char> receivers) { receivers_ = std::move(receivers); }
+  void set_receivers(std::vector<char> receivers) {
+    receivers_ = std::move(receivers);
+    sized_ = false;
+  }
   /// The receivers' indirect irradiance gathered with visibility from every leaf, the other
   /// leaves held at `others` (W/m^2 per leaf: e.g. an antiradiance solve's); the receivers'
   /// own exchange iterated to the tolerance. Returns every leaf's value (the others' as given).
@@ -125,8 +128,15 @@ class ExactLeafTransport {
   ExactSolveResult solve_receivers(const ElementHierarchy& h, std::span<const glm::vec3> direct,
                                    std::span<const glm::vec3> others, std::span<const glm::vec3> start = {}) const;
 
-  /// G_ij of leaves i != j (m^-2: the mean of cos cos V / r^2); 0 for i == j.
+  /// G_ij of leaves i != j (m^-2: the mean of cos cos V / r^2); 0 for i == j (and, with
+  /// receivers, for a pair of two leaves that are not).
   float coupling(std::size_t i, std::size_t j) const;
+  /// Bytes of the couplings, the kept visibility and the receivers' rows. Without receivers
+  /// n(n-1)/2 pairs; with them only the receivers' rows (receivers x n), where the couplings
+  /// live and the visibility of each pair is kept once.
+  std::size_t table_bytes() const {
+    return g_.size() * sizeof(float) + visible_.size() * sizeof(std::uint16_t) + rows_.size() * sizeof(float);
+  }
 
  private:
   struct PairBatch;  // pairs whose samples wait for their rays (the .cpp)
@@ -156,6 +166,17 @@ class ExactLeafTransport {
   bool pair_may_change(const ElementHierarchy& h, std::size_t i, std::size_t j,
                        std::span<const MovingInstances::Box> bounds) const;
   std::size_t pair_index(std::size_t i, std::size_t j) const;  // i < j
+  /// Pair (i < j)'s place in visible_ (x visible_words_): pair_index without receivers, with
+  /// them the place in rows_ of the first receiver's row (i's when it is one, else j's).
+  std::size_t pair_slot(std::size_t i, std::size_t j) const;
+  bool visible_bit(std::size_t slot, std::uint32_t s) const {
+    return ((visible_[slot * visible_words_ + s / 16] >> (s % 16)) & 1u) != 0;
+  }
+  void set_visible_bit(std::size_t slot, std::uint32_t s, bool visible) {
+    std::uint16_t& w = visible_[slot * visible_words_ + s / 16];
+    const auto bit = static_cast<std::uint16_t>(1u << (s % 16));
+    w = visible ? static_cast<std::uint16_t>(w | bit) : static_cast<std::uint16_t>(w & ~bit);
+  }
   /// Sizes the tables for n leaves (every coupling 0) and the receivers' rows.
   void reset(std::size_t n);
   /// Jacobi over every leaf from zero (solve()'s; the receivers' solve is iterate_receivers).
@@ -164,7 +185,7 @@ class ExactLeafTransport {
   /// steps over the receivers' columns only.
   ExactSolveResult iterate_receivers(const ElementHierarchy& h, std::span<const glm::vec3> direct,
                                      std::span<const glm::vec3> others, std::span<const glm::vec3> start) const;
-  /// Stores G of pair (i, j), i < j, in g_ and in the receivers' rows.
+  /// Stores G of pair (i, j), i < j: in g_ without receivers, else in the receivers' rows.
   void store(std::size_t i, std::size_t j, float g);
 
   ExactTransportSettings settings_;
@@ -177,14 +198,19 @@ class ExactLeafTransport {
   std::vector<MovingInstances::Box> door_box_, door_now_;
   MovingInstances moving_;
   bool dirty_ = false;
+  bool sized_ = false;  ///< reset() ran for these receivers (update() computes every pair until then).
   std::size_t n_ = 0;
-  std::vector<float> g_;  ///< Upper triangle, row-major, i < j.
-  /// With reuse_visibility: per pair (as g_), bit s set when sample s is unoccluded.
-  std::vector<std::uint64_t> visible_;
+  /// Without receivers: every pair's G, upper triangle, row-major, i < j. With receivers:
+  /// empty (rows_ holds their pairs; the demo level's 6666 leaves took 267 MB here).
+  std::vector<float> g_;
+  /// With reuse_visibility: per pair slot (pair_slot), visible_words_ words whose bit s is set
+  /// when sample s is unoccluded (16 bits a word: 1 word up to 16 point pairs, 4 up to 64).
+  std::vector<std::uint16_t> visible_;
+  std::size_t visible_words_ = 1;
   std::vector<char> receivers_;
   /// With receivers: their leaf indices in order, and every receiver's row of couplings to all
-  /// n leaves (receivers x n, row-major; the same values as g_): the receivers' solve walks
-  /// these rows densely instead of g_'s columns.
+  /// n leaves (receivers x n, row-major; a pair of two receivers in both rows): the only copy
+  /// of the couplings, which the receivers' solve walks densely.
   std::vector<std::uint32_t> recv_;
   std::vector<std::int32_t> slot_;  ///< Per leaf: its row in rows_, or -1.
   std::vector<float> rows_;

@@ -64,6 +64,8 @@ class NearDoorVisibility {
   const std::vector<glm::vec3>& baseline() const { return baseline_; }
   /// Leaves that gather with visibility.
   std::size_t receivers() const { return receivers_; }
+  /// CPU bytes of its couplings and kept visibility (the receivers' rows).
+  std::size_t table_bytes() const { return transport_.table_bytes(); }
   /// The last move's (or create's) recomputed leaf pairs and traced rays.
   std::size_t last_pairs() const { return transport_.last_pairs_computed(); }
   std::size_t last_rays() const { return transport_.last_rays(); }

@@ -350,7 +350,6 @@ constexpr int kArConvergedIterations = 19;
 // a door move's near update 0.40-0.66 s, ~0.4 of that.
 constexpr double kNearSecondsPerPointPair = 1.4e-7;
 constexpr double kNearMoveFraction = 0.4;
-constexpr double kNearBytesPerPair = 12.0;
 
 }  // namespace
 
@@ -362,7 +361,10 @@ BakeWork near_visibility_work(std::size_t leaves, std::size_t receivers, const A
   w.units = pairs;
   w.rays = pairs * std::max(1, s.near_visibility_point_pairs);
   w.cpu_seconds = w.rays * kNearSecondsPerPointPair;  // at load; nothing is baked
-  w.runtime_bytes = static_cast<std::uint64_t>(kNearBytesPerPair * l * (l - 1.0) / 2.0);
+  // The receivers' rows, the transport's only table: per receiver and leaf a float coupling
+  // and the kept visibility, a 16-bit word per 16 point pairs (close pairs draw 16).
+  const double words = std::ceil(static_cast<double>(std::max(16, s.near_visibility_point_pairs)) / 16.0);
+  w.runtime_bytes = static_cast<std::uint64_t>(r * l * (4.0 + 2.0 * words));
   if (move_seconds) *move_seconds = kNearMoveFraction * w.cpu_seconds;
   return w;
 }

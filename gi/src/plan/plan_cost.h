@@ -73,8 +73,8 @@ BakeWork dlm_work(const StaticSurfaceCensus& glossy, double albedo, const AtlasT
 /// Near-door visibility (issue 37; settings.near_visibility, AntiradianceLighting): the
 /// couplings of `receivers` leaves with all `leaves` at the baked pose, computed at load, not
 /// baked (cpu_seconds: that load work, bake_seconds 0; units: the leaf pairs), and the memory the
-/// runtime keeps on the CPU (runtime_bytes: a float coupling and 8 bytes of kept visibility per
-/// pair of leaves, every pair allocated). `move_seconds` out: a door move's near update.
+/// runtime keeps on the CPU (runtime_bytes: the receivers' rows, a float coupling and 2 bytes of
+/// kept visibility per 16 point pairs, per receiver and leaf). `move_seconds` out: a door move's near update.
 BakeWork near_visibility_work(std::size_t leaves, std::size_t receivers, const AntiradianceSettings& settings,
                               double* move_seconds = nullptr);
 

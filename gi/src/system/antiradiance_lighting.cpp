@@ -91,7 +91,10 @@ void AntiradianceLighting::create_near_sets(const BakeInput& input) {
     return;
   }
   stats_.near_visibility = !near_.empty();
-  for (const NearSet& n : near_) stats_.near_receivers += n.visibility->receivers();
+  for (const NearSet& n : near_) {
+    stats_.near_receivers += n.visibility->receivers();
+    stats_.near_table_bytes += n.visibility->table_bytes();
+  }
   stats_.near_load_ms = ms_since(t0);
 }
 

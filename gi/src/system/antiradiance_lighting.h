@@ -59,12 +59,13 @@ class AntiradianceLighting {
     /// The bake asked for it but a near set could not be made (logged as a warning, the
     /// reason in near_fell_back_reason()): antiradiance alone.
     bool near_fell_back = false;
-    std::size_t near_receivers = 0;  ///< Leaves that gather with visibility (all near sets).
-    double near_load_ms = 0.0;       ///< The baked pose's couplings and solve, at load.
-    double near_ms = 0.0;            ///< Last update: the near sets' couplings' update + solve (part of last_ms).
-    std::size_t near_rays = 0;       ///< Last update: rays the near sets cast.
-    std::size_t near_pairs = 0;      ///< Last update: leaf pairs they recomputed.
-    int near_iterations = 0;         ///< Last update: Jacobi iterations of the near solve (the most of any set).
+    std::size_t near_receivers = 0;    ///< Leaves that gather with visibility (all near sets).
+    std::size_t near_table_bytes = 0;  ///< Their couplings and kept visibility on the CPU (bytes).
+    double near_load_ms = 0.0;         ///< The baked pose's couplings and solve, at load.
+    double near_ms = 0.0;              ///< Last update: the near sets' couplings' update + solve (part of last_ms).
+    std::size_t near_rays = 0;         ///< Last update: rays the near sets cast.
+    std::size_t near_pairs = 0;        ///< Last update: leaf pairs they recomputed.
+    int near_iterations = 0;           ///< Last update: Jacobi iterations of the near solve (the most of any set).
   };
 
   /// Errors: the bake does not fit `input` (AntiradianceRegion::create). `log` hears a

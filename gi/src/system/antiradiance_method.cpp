@@ -60,7 +60,8 @@ engine::Result<std::unique_ptr<MethodRuntime>> load_antiradiance_method(MethodLo
             << " atlas texels; solved on frames where a deforming node moves\n";
   if (st.near_visibility)
     load.text << "antiradiance: near-door visibility for " << st.near_receivers << " leaves (their couplings "
-              << static_cast<long long>(st.near_load_ms) << " ms at load)\n";
+              << static_cast<long long>(st.near_load_ms) << " ms at load, "
+              << static_cast<double>(st.near_table_bytes) / 1e6 << " MB)\n";
   else if (st.near_fell_back)
     load.text << "antiradiance: near-door visibility OFF, antiradiance alone: " << anti.value()->near_fell_back_reason()
               << "\n";

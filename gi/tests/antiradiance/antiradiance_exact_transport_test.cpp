@@ -164,6 +164,13 @@ TEST(ExactLeafTransport, TheReceiversSolveHoldsTheOthersAndMeetsTheFullSolve) {
   part->set_receivers(on_b);
   part->update(*h);
   EXPECT_LT(part->last_pairs_computed(), full->last_pairs_computed());
+  // The receivers' rows are the only table (no n(n-1)/2 pairs), with the same couplings.
+  for (std::size_t i = 0; i < h->leaf_count(); ++i)
+    for (std::size_t j = i + 1; j < h->leaf_count(); ++j)
+      ASSERT_EQ(part->coupling(i, j), on_b[i] || on_b[j] ? full->coupling(i, j) : 0.0f) << i << " " << j;
+  std::printf("tables: %zu bytes for every pair, %zu for the receivers' rows\n", full->table_bytes(),
+              part->table_bytes());
+  EXPECT_LT(part->table_bytes(), full->table_bytes());
   const gi::ExactSolveResult e = full->solve(*h, direct);
   const gi::ExactSolveResult r = part->solve_receivers(*h, direct, e.irradiance);
   ASSERT_TRUE(r.converged);
@@ -363,8 +370,11 @@ TEST(ExactLeafTransport, StreamsAndReceiverRowsGiveTheSameBitsAsOneRayAtATime) {
     EXPECT_GT(streamed->last_moving_rays(), 0u);
     EXPECT_LE(streamed->last_moving_rays(), streamed->last_rays());
     for (std::size_t i = 0; i < n; ++i)
-      for (std::size_t j = i + 1; j < n; ++j)
+      for (std::size_t j = i + 1; j < n; ++j) {
         ASSERT_EQ(streamed->coupling(i, j), one->coupling(i, j)) << angle << ": " << i << " " << j;
+        // The visibility kept in the receivers' rows reuses as the every-pair table does.
+        ASSERT_EQ(rows->coupling(i, j), one->coupling(i, j)) << angle << ": " << i << " " << j;
+      }
     const gi::ExactSolveResult full = streamed->solve(*h, direct);
     const gi::ExactSolveResult dense = rows->solve_receivers(*h, direct, std::vector<glm::vec3>(n, glm::vec3(0.0f)));
     ASSERT_TRUE(full.converged);
