@@ -338,8 +338,12 @@ GameplayContext prepare_scene(engine::Scene& scene, const GameplayTuning& tuning
   else
     ctx.swinging_pivot = engine::kNullEntity;
 
-  // The corridor door (demo level), if the scene has one.
+  // The door: the demo level's corridor door, else the first mesh node flagged as a deforming
+  // region (gi.region "deforming", e.g. corridor.gltf's "door"), if the scene has one.
   ctx.door = engine::find_by_name(reg, "corridor_door");
+  for (std::size_t i = 0; !ctx.door && i < scene.assets.nodes.size() && i < scene.node_entities.size(); ++i)
+    if (scene.assets.nodes[i].mesh >= 0 && scene.assets.nodes[i].gi.region == engine::GiRegion::Deforming)
+      ctx.door = scene.node_entities[i];
   if (ctx.door && reg.has<engine::Transform>(ctx.door))
     ctx.door_open_rotation = reg.get<engine::Transform>(ctx.door).rotation;
   else

@@ -259,8 +259,6 @@ game_demo::SimulationSettings flying() {
 // The room's meshes span x -5.2..5.2, y -0.2..3.2, z -3.2..3.2 (demo/test_room.h).
 const float kRoomDiagonalM = std::sqrt(10.4f * 10.4f + 3.4f * 3.4f + 6.4f * 6.4f);
 
-}  // namespace
-
 TEST(Locomotion, WalkOnTheDemoLevelFlyElsewhere) {
   EXPECT_EQ(game_demo::default_locomotion(""), game_demo::Locomotion::Walk);
   EXPECT_EQ(game_demo::default_locomotion("assets/demo_level.gltf"), game_demo::Locomotion::Walk);
@@ -351,3 +349,33 @@ TEST(PrepareScene, ACameraUnderAParentStartsAtItsWorldPose) {
   EXPECT_NEAR(glm::length(t.position - glm::vec3(world[3])), 0.0f, 1e-5f);
   EXPECT_NEAR(std::abs(glm::dot(t.rotation, glm::quat_cast(glm::mat3(world)))), 1.0f, 1e-5f);
 }
+
+// O swings the door of any scene: the demo level's "corridor_door" by name, else the first mesh
+// node flagged gi.region "deforming" (corridor.gltf's "door"), between its authored pose and shut.
+TEST(Door, OSwingsTheDeformingRegionsMeshWhenTheSceneHasNoCorridorDoor) {
+  engine::Scene room = demo_test::make_room({});
+  engine::SceneAsset a = room.assets;
+  int mesh = -1;
+  for (const engine::Node& n : a.nodes) mesh = n.mesh >= 0 && mesh < 0 ? n.mesh : mesh;
+  ASSERT_GE(mesh, 0);
+  engine::Node door;
+  door.name = "vault_door";
+  door.mesh = mesh;
+  door.translation = {1.0f, 0.0f, 2.0f};
+  door.rotation = glm::angleAxis(1.2f, glm::vec3(0.0f, 1.0f, 0.0f));
+  door.gi.region = engine::GiRegion::Deforming;
+  a.nodes.push_back(door);
+  game_demo::Simulation sim(engine::instantiate(std::move(a)), flying());
+  const engine::Entity e = sim.context().door;
+  ASSERT_FALSE(e.is_null());
+  EXPECT_EQ(sim.registry().get<engine::Name>(e).value, "vault_door");
+  const glm::quat authored = sim.registry().get<engine::Transform>(e).rotation;
+  sim.step(keys({Key::O}));
+  EXPECT_NEAR(std::abs(sim.registry().get<engine::Transform>(e).rotation.w), 1.0f, 1e-6f) << "shut";
+  sim.step(keys({}));
+  sim.step(keys({Key::O}));
+  EXPECT_NEAR(std::abs(glm::dot(sim.registry().get<engine::Transform>(e).rotation, authored)), 1.0f, 1e-6f)
+      << "open again";
+}
+
+}  // namespace

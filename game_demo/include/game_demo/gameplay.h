@@ -78,10 +78,12 @@ struct GameplayContext {
   glm::quat pivot_rest_rotation{1.0f, 0.0f, 0.0f, 0.0f};
   CollisionWorld collision;
   GameplayTuning tuning;
-  InputFrame input;                                      ///< This step's input (set before each run).
-  std::uint32_t previous_keys = 0;                       ///< Last step's held keys.
-  bool split_view = false;                               ///< Toggled by G; the renderer reads it.
-  engine::Entity door;                                   ///< "corridor_door" when the scene has one, else null.
+  InputFrame input;                 ///< This step's input (set before each run).
+  std::uint32_t previous_keys = 0;  ///< Last step's held keys.
+  bool split_view = false;          ///< Toggled by G; the renderer reads it.
+  /// "corridor_door" when the scene has one, else its first mesh node flagged gi.region
+  /// "deforming" (corridor.gltf's "door"), else null.
+  engine::Entity door;
   glm::quat door_open_rotation{1.0f, 0.0f, 0.0f, 0.0f};  ///< Its authored (open) rotation; closed is identity.
   bool door_closed = false;                              ///< Toggled by O.
 
@@ -94,8 +96,9 @@ struct GameplayContext {
 /// scene's meshes (framing_view), adds its PlayerController (fly speed from those bounds), adds a flashlight (a Spot
 /// light child of the camera, moves = true, switched off) unless a Light entity named "flashlight" exists, gives each
 /// DynamicTag RigidBody a CrateShape and half extents from its mesh bounds, and builds the static collision world;
-/// finds the door ("corridor_door", hinged at its origin; O swings it between its authored rotation and closed). Leaves
-/// world transforms up to date. The collision world keeps the door where it was authored (open).
+/// finds the door ("corridor_door" or the first deforming region's mesh, hinged at its origin; O swings it between its
+/// authored rotation and closed). Leaves world transforms up to date. The collision world keeps the door where it was
+/// authored (open).
 GameplayContext prepare_scene(engine::Scene& scene, const GameplayTuning& tuning = {});
 
 /// The view prepare_scene gives a scene without a camera, framing the world-space box
