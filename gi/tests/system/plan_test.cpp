@@ -409,15 +409,15 @@ TEST(PlanCost, EstimatesAreWithinAFactorOfTwoOfTheCalibrationBakes) {
     const char* preset;
     double lit_texels, pane_texels, atlas_side_texels, path_nodes, atlas_rays, prm_rays, atlas_cpu_s, prm_cpu_s;
   };
-  // Light-atlas columns: the final-gather presets (measured again when they replaced VPL shooting;
-  // the Cornell box's CPU seconds again on quiet cores by tools/plan-calibration.py, 29 Nov 2026).
+  // Light-atlas columns: rays and CPU seconds (user + sys) of `gi-bake --methods light_atlas` with
+  // the presets of 30 Nov 2026 (two-level regathers, the medium's adaptive pass), quiet cores.
   const Measured runs[] = {
-      {"cornell_box.gltf", "preview", 183, 747, 32, 2169, 0.03e6, 0.2e6, 0.03, 0.06},
-      {"cornell_box.gltf", "medium", 555, 1325, 45, 8857, 0.2e6, 3.0e6, 0.05, 0.39},
-      {"spot_chamber.gltf", "preview", 5688, 7637, 128, 2282, 0.9e6, 10.2e6, 0.23, 0.81},
-      {"spot_chamber.gltf", "medium", 21990, 25798, 256, 9151, 7.0e6, 159.6e6, 1.41, 12.15},
-      {"demo_level.gltf", "preview", 45443, 55974, 256, 2237, 8.0e6, 60.6e6, 1.87, 5.98},
-      {"demo_level.gltf", "medium", 177599, 200153, 512, 8673, 60.3e6, 928.9e6, 13.18, 97.64},
+      {"cornell_box.gltf", "preview", 183, 747, 32, 2169, 0.1e6, 0.2e6, 0.03, 0.06},
+      {"cornell_box.gltf", "medium", 555, 1325, 45, 8857, 0.2e6, 3.0e6, 0.06, 0.39},
+      {"spot_chamber.gltf", "preview", 5688, 7637, 128, 2282, 1.6e6, 10.2e6, 0.39, 0.81},
+      {"spot_chamber.gltf", "medium", 21990, 25798, 256, 9151, 6.1e6, 159.6e6, 1.47, 12.15},
+      {"demo_level.gltf", "preview", 45443, 55974, 256, 2237, 31.4e6, 60.6e6, 4.91, 5.98},
+      {"demo_level.gltf", "medium", 177599, 200153, 512, 8673, 126.8e6, 928.9e6, 20.48, 97.64},
   };
   const auto within2 = [](double estimate, double measured) {
     return estimate > 0.5 * measured && estimate < 2.0 * measured;
