@@ -19,17 +19,12 @@
 
 #include <glm/gtc/quaternion.hpp>
 
+#include "asset_scenes.h"
 #include "gl_readback.h"
 
 namespace {
 
 namespace fs = std::filesystem;
-
-engine::Scene corridor() {
-  auto asset = engine::load_gltf(GI_SOURCE_DIR "/assets/corridor.gltf");
-  EXPECT_TRUE(asset) << asset.error().to_string();
-  return engine::instantiate(std::move(asset.value()));
-}
 
 TEST(AntiradianceLighting, TheCorridorDoorChangesTheAtlasOnlyOnFramesItMoves) {
   auto ctx = engine::GpuContext::create_headless();
@@ -37,7 +32,7 @@ TEST(AntiradianceLighting, TheCorridorDoorChangesTheAtlasOnlyOnFramesItMoves) {
   const fs::path dir =
       fs::temp_directory_path() / ("gi_antiradiance_lighting_" + std::to_string(::getpid()) + ".gibake");
   fs::remove_all(dir);
-  engine::Scene scene = corridor();
+  engine::Scene scene = gitest::asset_scene("corridor.gltf");
   gi::BakeOptions options;
   options.preset = "preview";
   options.methods = {"light_atlas", "antiradiance"};

@@ -25,6 +25,8 @@
 #include "antiradiance/antiradiance_exact_transport.h"
 #include "antiradiance/antiradiance_io.h"
 #include "antiradiance/near_door_visibility.h"
+#include "asset_scenes.h"
+#include "gl_context.h"
 #include "system/antiradiance_lighting.h"
 #include "uv/atlas_layout.h"
 
@@ -32,11 +34,14 @@ namespace {
 
 namespace fs = std::filesystem;
 
-engine::Scene corridor() {
-  auto asset = engine::load_gltf(GI_SOURCE_DIR "/assets/corridor.gltf");
-  EXPECT_TRUE(asset) << asset.error().to_string();
-  return engine::instantiate(std::move(asset.value()));
-}
+// Each GPU test's start: the GL context, the corridor, its bake input and a 10 texels/m
+// static layout (built in place: the input refers to the scene).
+struct CorridorRun {
+  engine::GpuContext ctx = gltest::headless_or_fail();
+  engine::Scene scene = gitest::asset_scene("corridor.gltf");
+  gi::BakeInput input = gi::bake_input_from(scene);
+  gi::AtlasLayout layout = gi::static_world_layout(input, 10.0f).value();
+};
 
 // The preview preset (64 bins: the cheapest region) with near visibility on, saved and loaded
 // as a bundle would carry it.
@@ -73,16 +78,13 @@ std::vector<glm::vec3> exact_light(const gi::BakeInput& input, const gi::Antirad
 }
 
 TEST(AntiradianceNearVisibility, TheShutDoorTakesTheLightItLetInAndTheWiringAddsNothing) {
-  auto ctx = engine::GpuContext::create_headless();
-  ASSERT_TRUE(ctx) << "no headless GL context: " << ctx.error().to_string();
-  engine::Scene scene = corridor();
-  const gi::BakeInput input = gi::bake_input_from(scene);
-  auto layout = gi::static_world_layout(input, 10.0f);
-  ASSERT_TRUE(layout) << layout.error().to_string();
+  CorridorRun run;
+  engine::Scene& scene = run.scene;
+  const gi::BakeInput& input = run.input;
   gi::AntiradianceBake bake = near_bake(input, "runtime");
   auto region = gi::AntiradianceRegion::create(input, gi::AntiradianceBake(bake));  // the class's own run
   ASSERT_TRUE(region) << region.error().to_string();
-  auto made = gi::AntiradianceLighting::create(std::move(bake), input, *layout, scene.registry);
+  auto made = gi::AntiradianceLighting::create(std::move(bake), input, run.layout, scene.registry);
   ASSERT_TRUE(made) << made.error().to_string();
   gi::AntiradianceLighting& a = **made;
   ASSERT_TRUE(a.stats().near_visibility) << a.near_fell_back_reason();
@@ -164,17 +166,14 @@ TEST(AntiradianceNearVisibility, TheShutDoorTakesTheLightItLetInAndTheWiringAdds
 }
 
 TEST(AntiradianceNearVisibility, ABakeWithoutTheTrianglesFallsBackVisiblyToAntiradianceAlone) {
-  auto ctx = engine::GpuContext::create_headless();
-  ASSERT_TRUE(ctx) << "no headless GL context: " << ctx.error().to_string();
-  engine::Scene scene = corridor();
-  const gi::BakeInput input = gi::bake_input_from(scene);
-  auto layout = gi::static_world_layout(input, 10.0f);
-  ASSERT_TRUE(layout) << layout.error().to_string();
+  CorridorRun run;
+  engine::Scene& scene = run.scene;
+  const gi::BakeInput& input = run.input;
   gi::AntiradianceBake bake = near_bake(input, "fallback");
   bake.hierarchy.corners.clear();  // as a region made without them
   bake.hierarchy.object_corners.clear();
   std::string warning;
-  auto made = gi::AntiradianceLighting::create(std::move(bake), input, *layout, scene.registry,
+  auto made = gi::AntiradianceLighting::create(std::move(bake), input, run.layout, scene.registry,
                                                [&](gi::LogLevel level, std::string_view message) {
                                                  if (level == gi::LogLevel::Warning) warning = std::string(message);
                                                });
