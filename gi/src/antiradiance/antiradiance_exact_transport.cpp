@@ -12,6 +12,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "core/polygon_form_factor.h"
 #include "raytrace/embree_ray_caster.h"
 #include "raytrace/scene_adapter.h"
 
@@ -44,6 +45,12 @@ glm::vec3 on_triangle(const glm::vec3* t, float u, float v) {
   return t[0] + u * (t[1] - t[0]) + v * (t[2] - t[0]);
 }
 
+// Leaves near enough for the 1/r^2 peak (touching, or nearly): within twice their radii.
+bool close_pair(const ElementNode& ei, const ElementNode& ej) {
+  const float reach = 2.0f * (ei.radius_m + ej.radius_m);
+  return glm::dot(ei.center - ej.center, ei.center - ej.center) < reach * reach;
+}
+
 // True when every corner of `t` lies on or behind the plane through `p` with normal `n`.
 bool behind(const glm::vec3* t, const glm::vec3& p, const glm::vec3& n) {
   for (int k = 0; k < 3; ++k)
@@ -51,14 +58,40 @@ bool behind(const glm::vec3* t, const glm::vec3& p, const glm::vec3& n) {
   return true;
 }
 
+// A Jacobi step's change: sum |dE|, sum E, and the largest share any one leaf moved (|dE_l|
+// over its own E_l, or over 1% of the mean E for the darkest leaves).
+struct StepChange {
+  double change = 0.0, total = 0.0, worst_leaf = 0.0;
+};
+
+template <class Old, class New>
+StepChange step_change(std::size_t count, Old old_at, New new_at) {
+  StepChange c;
+  for (std::size_t q = 0; q < count; ++q) {
+    const glm::vec3 e = new_at(q), d = e - old_at(q);
+    c.change += static_cast<double>(std::abs(d.x) + std::abs(d.y) + std::abs(d.z));
+    c.total += static_cast<double>(e.x + e.y + e.z);
+  }
+  const double floor = count > 0 ? 0.01 * std::abs(c.total) / static_cast<double>(count) : 0.0;
+  for (std::size_t q = 0; q < count; ++q) {
+    const glm::vec3 e = new_at(q), d = e - old_at(q);
+    const double moved = static_cast<double>(std::abs(d.x) + std::abs(d.y) + std::abs(d.z));
+    const double level = static_cast<double>(std::abs(e.x) + std::abs(e.y) + std::abs(e.z));
+    if (moved > 0.0) c.worst_leaf = std::max(c.worst_leaf, moved / std::max(level, floor));
+  }
+  return c;
+}
+
 // The Jacobi solves' shared bookkeeping after each step: the iteration count and the relative
-// residual (the step's change over the irradiance it reached). True when the solve stops: it
-// diverged (not converged, and visibly so), or with a tolerance (bounces <= 0) it converged.
-bool end_of_step(ExactSolveResult& out, int it, double change, double total, const ExactTransportSettings& s) {
+// residuals (the step's change over the irradiance it reached, overall and at the leaf that
+// moved most). True when the solve stops: it diverged (not converged, and visibly so), or with
+// a tolerance (bounces <= 0) it converged overall and at every leaf.
+bool end_of_step(ExactSolveResult& out, int it, const StepChange& c, const ExactTransportSettings& s) {
   out.iterations = it + 1;
-  out.residual = total > 0.0 ? change / total : 0.0;
-  if (!std::isfinite(total)) return true;
-  if (s.bounces <= 0 && out.residual < s.tolerance) {
+  out.residual = c.total > 0.0 ? c.change / c.total : 0.0;
+  out.leaf_residual = c.worst_leaf;
+  if (!std::isfinite(c.total)) return true;
+  if (s.bounces <= 0 && out.residual < s.tolerance && out.leaf_residual < s.leaf_tolerance) {
     out.converged = true;
     return true;
   }
@@ -66,6 +99,11 @@ bool end_of_step(ExactSolveResult& out, int it, double change, double total, con
 }
 
 }  // namespace
+
+std::size_t ExactLeafTransport::row_bytes_per_leaf(int point_pairs) {
+  const auto words = static_cast<std::size_t>(std::max(point_pairs, kMinClosePairs) + 15) / 16;
+  return sizeof(float) + words * sizeof(std::uint16_t);
+}
 
 engine::Result<ExactLeafTransport> ExactLeafTransport::create(const BakeInput& input,
                                                               const ExactTransportSettings& settings) {
@@ -211,8 +249,7 @@ void ExactLeafTransport::queue_split_sample(const Ray& r, bool traced, bool stat
 
 int ExactLeafTransport::point_pairs_of(const ElementNode& ei, const ElementNode& ej) const {
   int m = settings_.point_pairs;
-  const float reach = 2.0f * (ei.radius_m + ej.radius_m);
-  const bool close = glm::dot(ei.center - ej.center, ei.center - ej.center) < reach * reach;
+  const bool close = close_pair(ei, ej);
   // Close pairs (touching leaves: the 1/r^2 peak) at least kMinClosePairs: with fewer, one
   // unlucky pair near the clamp can push the operator's norm above 1 and the solve diverges.
   if (close) m = std::max(m, kMinClosePairs);
@@ -239,6 +276,14 @@ void ExactLeafTransport::queue_pair(const ElementHierarchy& h, std::size_t i, st
   }
   const int m = point_pairs_of(h.nodes[ni], h.nodes[nj]);
   pair.m = m;
+  // Touching leaves: each sample's geometry is the exact form factor from its point on i to
+  // the whole of j (Lambert's formula), pi / A_j of it in G's units; the point on j only
+  // tests visibility. The point-to-point kernel's 1/r^2 peak at a shared edge made single
+  // samples worth several times a whole row's light: 42% of the corridor's rows summed to a
+  // form factor above 1 (up to 2.9), and with every leaf a receiver the solve diverged.
+  const bool close = close_pair(h.nodes[ni], h.nodes[nj]);
+  const float area_j = 0.5f * glm::length(glm::cross(tj[1] - tj[0], tj[2] - tj[0]));
+  const float to_g = area_j > 0.0f ? kPi / area_j : 0.0f;
   const int strata = std::max(1, static_cast<int>(std::sqrt(static_cast<double>(m))));
   const float min_r2 = settings_.min_distance_m * settings_.min_distance_m;
   std::uint64_t state = mix(settings_.seed ^ mix(static_cast<std::uint64_t>(i) * 0x100000001b3ULL + j));
@@ -259,7 +304,9 @@ void ExactLeafTransport::queue_pair(const ElementHierarchy& h, std::size_t i, st
     // Off both surfaces by 0.1 mm along their normals, the segment between.
     const glm::vec3 o = x + 1e-4f * n_i;
     const glm::vec3 e = y + 1e-4f * n_j;
-    PairBatch::Sample sample{ci * cj / std::max(r2, min_r2), -1, -1, static_cast<std::uint32_t>(s)};
+    const float g = close ? to_g * (glm::dot(x - tj[0], n_j) < 0.0f ? 0.0f : polygon_form_factor(x, n_i, {tj, 3}))
+                          : ci * cj / std::max(r2, min_r2);
+    PairBatch::Sample sample{g, -1, -1, static_cast<std::uint32_t>(s)};
     const Ray ray{.origin = o, .t_min = 0.0f, .direction = e - o, .t_max = 1.0f};
     if (door_caster_) {
       const bool kept = reuse && visible_bit(pair_slot(i, j), static_cast<std::uint32_t>(s));
@@ -460,14 +507,10 @@ ExactSolveResult ExactLeafTransport::iterate_receivers(const ElementHierarchy& h
         next[q] = glm::vec3(sum);
       }
     });
-    double change = 0.0, total = 0.0;
-    for (std::size_t q = 0; q < r; ++q) {
-      const glm::vec3 d = next[q] - out.irradiance[recv_[q]];
-      change += static_cast<double>(std::abs(d.x) + std::abs(d.y) + std::abs(d.z));
-      total += static_cast<double>(next[q].x + next[q].y + next[q].z);
-      out.irradiance[recv_[q]] = next[q];
-    }
-    if (end_of_step(out, it, change, total, settings_)) break;
+    const StepChange c = step_change(
+        r, [&](std::size_t q) { return out.irradiance[recv_[q]]; }, [&](std::size_t q) { return next[q]; });
+    for (std::size_t q = 0; q < r; ++q) out.irradiance[recv_[q]] = next[q];
+    if (end_of_step(out, it, c, settings_)) break;
   }
   if (settings_.bounces > 0) out.converged = std::isfinite(out.residual);
   return out;
@@ -498,14 +541,10 @@ ExactSolveResult ExactLeafTransport::iterate(const ElementHierarchy& h, std::spa
         next[i] = glm::vec3(sum);
       }
     });
-    double change = 0.0, total = 0.0;
-    for (std::size_t l = 0; l < n; ++l) {
-      const glm::vec3 d = next[l] - out.irradiance[l];
-      change += static_cast<double>(std::abs(d.x) + std::abs(d.y) + std::abs(d.z));
-      total += static_cast<double>(next[l].x + next[l].y + next[l].z);
-    }
+    const StepChange c = step_change(
+        n, [&](std::size_t l) { return out.irradiance[l]; }, [&](std::size_t l) { return next[l]; });
     out.irradiance = next;
-    if (end_of_step(out, it, change, total, settings_)) break;
+    if (end_of_step(out, it, c, settings_)) break;
   }
   if (settings_.bounces > 0) out.converged = std::isfinite(out.residual);
   return out;
