@@ -297,7 +297,8 @@ BENCHMARK(BM_DoorStepsAtPreset)
 // visibility). Args: point_pairs per leaf pair, reuse (1: the visibility kept, only the
 // segments meeting the door's boxes traced), warm (1: the near solve starts from the last
 // pose's), fast (0: one ray at a time, 1: rays in streams of 256, 2: and the kept samples
-// tested against the door alone). Per iteration the door jumps to 0 / 25 / 100
+// tested against the door alone), budget (0: the 1 m radius alone, 1: the preset's budget,
+// which on the corridor takes every leaf). Per iteration the door jumps to 0 / 25 / 100
 // degrees: the antiradiance move and solve (as BM_DoorMoveAtPreset), then the near leaves'
 // update and solve. Counters: door_move_ms (both, wall), antiradiance_ms, near_ms,
 // near_update_ms (of near_ms: the couplings), near_iterations, rays, pairs (per move), door_rays
@@ -314,7 +315,8 @@ void BM_NearVisibilityMoveAtMedium(benchmark::State& state) {
   if (!region) std::exit(1);
   const auto tb = std::chrono::steady_clock::now();
   region->update(false);
-  gi::NearDoorVisibilitySettings ns;
+  gi::NearDoorVisibilitySettings ns = gi::near_door_settings(s);
+  if (state.range(4) == 0) ns.budget_bytes = 0;
   ns.point_pairs = static_cast<int>(state.range(0));
   ns.reuse_visibility = state.range(1) != 0;
   ns.warm_start = state.range(2) != 0;
@@ -365,16 +367,17 @@ void BM_NearVisibilityMoveAtMedium(benchmark::State& state) {
   state.counters["vs_rebake"] = rebake_ms / (total_ms / moves);
 }
 BENCHMARK(BM_NearVisibilityMoveAtMedium)
-    ->ArgNames({"pairs", "reuse", "warm", "fast"})
-    ->Args({16, 0, 0, 0})
-    ->Args({16, 1, 0, 0})
-    ->Args({16, 1, 1, 0})
-    ->Args({8, 1, 1, 0})
-    ->Args({4, 1, 0, 0})
-    ->Args({4, 1, 1, 0})
-    ->Args({4, 1, 1, 1})
-    ->Args({16, 1, 1, 2})
-    ->Args({4, 1, 1, 2})
+    ->ArgNames({"pairs", "reuse", "warm", "fast", "budget"})
+    ->Args({16, 0, 0, 0, 0})
+    ->Args({16, 1, 0, 0, 0})
+    ->Args({16, 1, 1, 0, 0})
+    ->Args({8, 1, 1, 0, 0})
+    ->Args({4, 1, 0, 0, 0})
+    ->Args({4, 1, 1, 0, 0})
+    ->Args({4, 1, 1, 1, 0})
+    ->Args({16, 1, 1, 2, 0})
+    ->Args({4, 1, 1, 2, 0})
+    ->Args({4, 1, 1, 2, 1})
     ->Unit(benchmark::kMillisecond)
     ->Iterations(3);
 

@@ -101,6 +101,8 @@ std::string check_settings(const AntiradianceSettings& s) {
     return "near_visibility_radius_m must be finite and not negative";
   if (s.near_visibility_point_pairs < 1 || s.near_visibility_point_pairs > 64)
     return "near_visibility_point_pairs outside 1..64";
+  if (s.near_visibility_budget_bytes > (std::uint64_t{1} << 40))
+    return "near_visibility_budget_bytes above 1 TiB (corrupt)";
   return {};
 }
 
@@ -312,6 +314,7 @@ json settings_json(const AntiradianceSettings& s) {
               {"near_visibility", s.near_visibility},
               {"near_visibility_radius_m", s.near_visibility_radius_m},
               {"near_visibility_point_pairs", s.near_visibility_point_pairs},
+              {"near_visibility_budget_bytes", s.near_visibility_budget_bytes},
               {"seed", s.seed}};
 }
 
@@ -340,6 +343,7 @@ engine::Status write_antiradiance(const fs::path& path, const AntiradianceBake& 
   w.put(static_cast<std::uint8_t>(s.near_visibility ? 1 : 0));
   w.put(s.near_visibility_radius_m);
   w.put(static_cast<std::int32_t>(s.near_visibility_point_pairs));
+  w.put(static_cast<std::uint64_t>(s.near_visibility_budget_bytes));
   const ElementHierarchy& h = b.hierarchy;
   w.array(h.deforming_instances);
   w.array(h.group_transform);
@@ -380,11 +384,11 @@ engine::Result<AntiradianceFile> read_antiradiance(const fs::path& path) {
                   r.get(s.oracle_scale) && r.get(iterations) && r.get(steps) && r.get(scheme) &&
                   r.get(s.residual_tolerance) && r.get(growth) && r.get(samples) && r.get(seed) &&
                   r.get(s.near_patch_size_m) && r.get(s.near_radius_m) && r.get(pieces) && r.get(near) &&
-                  r.get(s.near_visibility_radius_m) && r.get(near_pairs) && r.array(h.deforming_instances) &&
-                  r.array(h.group_transform) && r.array(h.nodes) && r.array(h.children) && r.array(h.leaves) &&
-                  r.array(h.group_root) && r.array(h.node_instance) && r.array(h.object_center) &&
-                  r.array(h.object_normal) && r.array(h.object_radius) && r.array(h.object_area) &&
-                  r.array(h.corners) && r.array(h.object_corners);
+                  r.get(s.near_visibility_radius_m) && r.get(near_pairs) && r.get(s.near_visibility_budget_bytes) &&
+                  r.array(h.deforming_instances) && r.array(h.group_transform) && r.array(h.nodes) &&
+                  r.array(h.children) && r.array(h.leaves) && r.array(h.group_root) && r.array(h.node_instance) &&
+                  r.array(h.object_center) && r.array(h.object_normal) && r.array(h.object_radius) &&
+                  r.array(h.object_area) && r.array(h.corners) && r.array(h.object_corners);
   std::uint64_t link_count = 0;
   std::vector<std::uint8_t> frame;
   if (!ok || !r.get(link_count) || !r.array(frame) || !r.array(f.bake.baseline))

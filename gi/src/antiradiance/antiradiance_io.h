@@ -36,7 +36,7 @@
 //   int32 growth_limit, int32 area_light_samples, uint64 seed,
 //   float32 near_patch_size_m, float32 near_radius_m, int32 leaf_link_pieces,
 //   uint8 near_visibility (0/1), float32 near_visibility_radius_m,
-//   int32 near_visibility_point_pairs                                         AntiradianceSettings
+//   int32 near_visibility_point_pairs, uint64 near_visibility_budget_bytes   AntiradianceSettings
 //   array<uint32> deforming_instances      BakeInput instance of each deforming group
 //   array<mat4>   group_transform          the pose each group was baked at
 //   array<node>   nodes                    ElementNode, 18 x 4 bytes: center vec3, radius,
@@ -73,7 +73,7 @@ namespace gi {
 inline constexpr const char* kAntiradianceMethod = "antiradiance";
 inline constexpr const char* kAntiradianceFile = "antiradiance.bin";
 inline constexpr BlobMagic kAntiradianceMagic{"GIANTIRA"};
-inline constexpr std::uint32_t kAntiradianceVersion = 4;
+inline constexpr std::uint32_t kAntiradianceVersion = 5;
 /// What the bake computed for a load at its pose (AntiradianceBake::AtBakedPose).
 inline constexpr const char* kAntiradianceAtPoseFile = "antiradiance_at_pose.bin";
 inline constexpr BlobMagic kAntiradianceAtPoseMagic{"GIANTPOS"};

@@ -90,6 +90,10 @@ struct AntiradianceSettings {
   /// Leaves whose bounding sphere comes this close to the instance's reach are receivers (m;
   /// NearDoorVisibilitySettings::radius_m).
   float near_visibility_radius_m = 1.0f;
+  /// Beyond the radius, more receivers nearest the instance first while their rows fit this
+  /// many bytes per deforming instance (NearDoorVisibilitySettings::budget_bytes; 0: the radius
+  /// alone).
+  std::uint64_t near_visibility_budget_bytes = 0;
   /// Point pairs per leaf pair (NearDoorVisibilitySettings::point_pairs; 1..64: the kept
   /// visibility holds 64 bits per pair). 4 scored as 16 on the corridor (0.1033 / 0.1032 of
   /// the level, docs/antiradiance.md) at a quarter of the rays.
@@ -103,16 +107,18 @@ struct AntiradianceSettings {
 /// 64 / 144 / 324 bins at preview / medium / high (the bins buy the accuracy, at 2.4x / ~4x
 /// the preview's door move and file; 256 bins scored worse than 144 at the door's fourth angle,
 /// and 400 bins put the demo level's 17.3 M static links at 138 MB, above llvmpipe's 128 MiB
-/// SSBO limit for the GPU pass). Near-door visibility at medium and high (the change's error
-/// 0.104 of the level with the noise removed against medium's 0.182 alone, at 1.2-1.9x its
-/// door move), not at preview (its load work and n^2 pair memory on a preview's budget:
-/// docs/antiradiance.md "Issue 37: near-door visibility in the runtime").
+/// SSBO limit for the GPU pass). Near-door visibility at medium and high, its set grown to a
+/// budget of 64 / 128 MiB of rows (on the corridor every leaf: the change's error 0.050 of the
+/// level with the noise removed against medium's 0.182 alone and 0.087 for the 1 m radius, at
+/// ~1.4x the plain door move; docs/antiradiance.md "A near set as large as its budget"), not at
+/// preview (its load work and memory on a preview's budget).
 inline AntiradianceSettings antiradiance_preset(std::string_view preset) {
   AntiradianceSettings s;
   s.patch_size_m = 0.8f;
   s.leaf_link_pieces = 64;
   s.bins_per_side = preset == "high" ? 18 : preset == "medium" ? 12 : 8;
   s.near_visibility = preset == "high" || preset == "medium";
+  s.near_visibility_budget_bytes = preset == "high" ? 128ull << 20 : preset == "medium" ? 64ull << 20 : 0;
   return s;
 }
 

@@ -28,6 +28,13 @@ struct NearDoorVisibilitySettings {
   /// Leaves whose bounding sphere comes within this many metres of the sphere the instance
   /// reaches about its origin (its farthest vertex) are receivers.
   float radius_m = 1.0f;
+  /// Beyond radius_m, more leaves become receivers, nearest that sphere first, while the
+  /// receivers' rows (table_bytes(): receivers x leaves x
+  /// ExactLeafTransport::row_bytes_per_leaf) fit this many
+  /// bytes; 0: the radius alone. The light beyond a shut door reaches its far side over several
+  /// bounces, which antiradiance outside the set does not darken (docs/antiradiance.md
+  /// "A near set as large as its budget").
+  std::size_t budget_bytes = 0;
   /// Point pairs per leaf pair (close pairs at least 16; at most 64 with the visibility kept).
   int point_pairs = 16;
   bool reuse_visibility = true;
@@ -46,6 +53,17 @@ struct NearDoorVisibilitySettings {
   bool door_only_rays = true;
 };
 
+/// The settings an antiradiance bake's preset asks the runtime for (its near_visibility_*).
+NearDoorVisibilitySettings near_door_settings(const AntiradianceSettings& s);
+
+/// The leaves NearDoorVisibility::create makes receivers around deforming instance `door` (at
+/// its transform in `input`): the instance's own leaves, those whose bounding sphere comes within
+/// radius_m of the sphere the instance reaches about its origin (its farthest vertex), then,
+/// within budget_bytes, the others nearest that sphere first. One rule for the class, the
+/// runtime and the planner.
+std::vector<char> near_door_receivers(const BakeInput& input, const ElementHierarchy& h, std::uint32_t door,
+                                      const NearDoorVisibilitySettings& settings);
+
 class NearDoorVisibility {
  public:
   /// Marks the receivers around deforming instance `door` (at its transform in `input`, the
@@ -62,8 +80,9 @@ class NearDoorVisibility {
 
   /// Every leaf's indirect irradiance at the baked pose (the change's zero).
   const std::vector<glm::vec3>& baseline() const { return baseline_; }
-  /// Leaves that gather with visibility.
+  /// Leaves that gather with visibility (near_door_receivers), and their mask per leaf.
   std::size_t receivers() const { return receivers_; }
+  const std::vector<char>& receiver_mask() const { return transport_.receivers(); }
   /// CPU bytes of its couplings and kept visibility (the receivers' rows).
   std::size_t table_bytes() const { return transport_.table_bytes(); }
   /// The last move's (or create's) recomputed leaf pairs and traced rays.

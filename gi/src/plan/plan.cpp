@@ -9,6 +9,7 @@
 #include <set>
 
 #include "antiradiance/element_hierarchy.h"
+#include "antiradiance/near_door_visibility.h"
 #include "brf/brf_bake.h"
 #include "plan/plan_cost.h"
 #include "plan/static_surface_census.h"
@@ -354,22 +355,15 @@ void plan_reflection_probes(const BakeInput& input, const PlanFacts& f, const Pl
 }
 
 // Near-door visibility (antiradiance's preset setting): its receivers as NearDoorVisibility
-// picks them (a deforming instance's leaves and those within the radius of its reach), its
+// picks them (near_door_receivers: the radius of each deforming instance's reach, then the
+// budget), its
 // memory added to the estimate, its load work and per-move cost in the basis.
 void add_near_visibility(const BakeInput& input, const ElementHierarchy& h, const AntiradianceSettings& s,
                          EffectEstimate& e) {
   std::size_t receivers = 0;
   for (std::uint32_t door : h.deforming_instances) {
-    const glm::vec3 origin(input.instances[door].object_to_world[3]);
-    float reach = 0.0f;
-    for (const BakePrimitive& p : input.meshes[input.instances[door].mesh].primitives)
-      for (const glm::vec3& v : p.positions) reach = std::max(reach, glm::length(v));
-    for (std::int32_t leaf : h.leaves) {
-      const ElementNode& n = h.nodes[static_cast<std::size_t>(leaf)];
-      receivers +=
-          static_cast<std::size_t>(h.node_instance[static_cast<std::size_t>(leaf)] == static_cast<std::int32_t>(door) ||
-                                   glm::length(n.center - origin) <= reach + s.near_visibility_radius_m + n.radius_m);
-    }
+    const std::vector<char> mask = near_door_receivers(input, h, door, near_door_settings(s));
+    receivers += static_cast<std::size_t>(std::count(mask.begin(), mask.end(), char{1}));
   }
   double move_seconds = 0.0;
   const BakeWork w = near_visibility_work(h.leaf_count(), receivers, s, &move_seconds);

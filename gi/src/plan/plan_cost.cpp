@@ -355,12 +355,14 @@ constexpr double kArFileBytesPerLink = 4.8;
 // Iterations of a solve to a residual tolerance (1e-3): 19 on the corridor at 0.8 m / 64 bins
 // (docs/antiradiance.md, issue 37); at most the budget.
 constexpr int kArConvergedIterations = 19;
-// Near-door visibility on the corridor at medium (docs/antiradiance.md, issue 37: 863
-// receivers of ~2740 leaves, 2.4 M pairs, 4 point pairs): the baked pose's couplings 1.1-1.6 s
-// (BM_NearVisibilityMoveAtMedium's near_bake_ms at load 8-10), so ~0.14 us per point pair;
-// a door move's near update 0.40-0.66 s, ~0.4 of that.
-constexpr double kNearSecondsPerPointPair = 1.4e-7;
-constexpr double kNearMoveFraction = 0.4;
+// Near-door visibility on the corridor at medium (docs/antiradiance.md, issue 37; quiet
+// machine, BM_NearVisibilityMoveAtMedium/pairs:4/reuse:1/warm:1/fast:2): with every one of
+// its 2738 leaves a receiver (the medium budget), 3.75 M pairs, the baked pose's couplings
+// 0.68 s (near_bake_ms), a door move's near update and solve 0.16 s; with the 1 m radius
+// alone (863 receivers, 2.0 M pairs) 0.30 s and 0.11 s. ~0.05 us per point pair; a move ~0.25
+// of the load. (The older 0.14 us had been measured under load 8-10.)
+constexpr double kNearSecondsPerPointPair = 5.0e-8;
+constexpr double kNearMoveFraction = 0.25;
 
 }  // namespace
 

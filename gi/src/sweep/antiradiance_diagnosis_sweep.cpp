@@ -35,6 +35,14 @@ std::vector<KnobSpec> exact_knobs() {
        .kind = KnobKind::Choice,
        .default_grid = {"off"},
        .choices = {"off", "on"}},
+      {.name = "near_budget_mb",
+       .description = "near_visibility: beyond near_radius, more receivers nearest the door while their rows fit "
+                      "this many MiB (NearDoorVisibilitySettings::budget_bytes; the medium preset's 64 takes every "
+                      "leaf of the corridor; 0: the radius alone)",
+       .kind = KnobKind::Integer,
+       .default_grid = {"0"},
+       .min_value = 0,
+       .max_value = 65536},
       {.name = "exact_adaptive",
        .description = "solve=exact: fewer point pairs for leaves smaller than patch^2 / 2 (ExactTransportSettings::"
                       "reference_area_m2)",

@@ -17,7 +17,7 @@
 
 namespace gi::antiradiance_sweep {
 
-/// The knobs of the diagnosis: exact_pairs, exact_bounces, near_visibility, exact_adaptive,
+/// The knobs of the diagnosis: exact_pairs, exact_bounces, near_visibility, near_budget_mb, exact_adaptive,
 /// exact_noise, exact_reuse, exact_seed.
 std::vector<KnobSpec> exact_knobs();
 
@@ -37,6 +37,7 @@ struct NearVisibility {
   engine::Status init(const RunContext& ctx, const DoorSetup& d, AntiradianceRegion& region) {
     NearDoorVisibilitySettings ns;
     ns.radius_m = region.settings().near_radius_m;
+    ns.budget_bytes = static_cast<std::size_t>(ctx.knobs.integer("near_budget_mb")) << 20;
     ns.point_pairs = static_cast<int>(ctx.knobs.integer("exact_pairs"));
     ns.seed = static_cast<std::uint64_t>(ctx.knobs.integer("exact_seed"));
     ns.reuse_visibility = ctx.knobs.text("exact_reuse") == "on" && ns.point_pairs <= 64;

@@ -305,22 +305,25 @@ TEST(AntiradianceIo, TheRefinementSettingsComeBackAndTheLoadRelinksWithThem) {
   EXPECT_FALSE(same_links(fresh->links(), regardless->links())) << "the door's leaf links split or not alike";
 }
 
-// A bundle of the previous layout (version 3: no near-door visibility, no triangles) is
-// refused by name, not misread.
-TEST(AntiradianceIo, AVersion3FileIsRefusedWithTheFilesName) {
+// A bundle of a previous layout (version 3: no near-door visibility, no triangles; version 4:
+// no near set budget) is refused by name, not misread.
+TEST(AntiradianceIo, AnOlderVersionIsRefusedWithTheFilesName) {
   const artest::DoorScene scene = artest::door_scene(30.0f);
   auto bake = gi::bake_antiradiance(scene.input, small());
   ASSERT_TRUE(bake) << bake.error().to_string();
-  const fs::path dir = scratch_dir("version3");
-  ASSERT_TRUE(gi::save_antiradiance(dir, *bake, scene.input));
-  const fs::path file = dir / gi::kAntiradianceFile;
-  reseal_with_version(dir, file, 3);
-  auto loaded = gi::load_antiradiance(dir, scene.input);
-  ASSERT_FALSE(loaded);
-  const std::string message = loaded.error().to_string();
-  EXPECT_EQ(loaded.error().file, file.string()) << message;
-  EXPECT_TRUE(contains(message, "version 3")) << message;
-  EXPECT_TRUE(contains(message, "re-bake")) << message;
+  for (std::uint32_t version : {3u, 4u}) {
+    const fs::path dir = scratch_dir("version" + std::to_string(version));
+    ASSERT_TRUE(gi::save_antiradiance(dir, *bake, scene.input));
+    const fs::path file = dir / gi::kAntiradianceFile;
+    reseal_with_version(dir, file, version);
+    auto loaded = gi::load_antiradiance(dir, scene.input);
+    ASSERT_FALSE(loaded);
+    const std::string message = loaded.error().to_string();
+    EXPECT_EQ(loaded.error().file, file.string()) << message;
+    EXPECT_TRUE(contains(message, "version " + std::to_string(version))) << message;
+    EXPECT_TRUE(contains(message, "re-bake")) << message;
+  }
+  const fs::path dir = scratch_dir("version_bad_settings");
   // A file that claims a bad refinement setting (resealed payload) is refused by its checks.
   gi::AntiradianceBake bad = *bake;
   bad.settings.leaf_link_pieces = gi::kMaxLeafLinkPieces + 1;
@@ -337,6 +340,7 @@ TEST(AntiradianceIo, NearVisibilityComesBackWithTheTrianglesItTracesAgainst) {
   s.near_visibility = true;
   s.near_visibility_radius_m = 0.7f;
   s.near_visibility_point_pairs = 8;
+  s.near_visibility_budget_bytes = 3u << 20;
   auto bake = gi::bake_antiradiance(scene.input, s);
   ASSERT_TRUE(bake) << bake.error().to_string();
   ASSERT_EQ(bake->hierarchy.corners.size(), 3 * bake->hierarchy.nodes.size());
@@ -347,6 +351,7 @@ TEST(AntiradianceIo, NearVisibilityComesBackWithTheTrianglesItTracesAgainst) {
   EXPECT_TRUE(loaded->settings.near_visibility);
   EXPECT_EQ(loaded->settings.near_visibility_radius_m, 0.7f);
   EXPECT_EQ(loaded->settings.near_visibility_point_pairs, 8);
+  EXPECT_EQ(loaded->settings.near_visibility_budget_bytes, 3u << 20);
   EXPECT_EQ(loaded->hierarchy.corners, bake->hierarchy.corners);
   EXPECT_EQ(loaded->hierarchy.object_corners, bake->hierarchy.object_corners);
 
@@ -367,6 +372,11 @@ TEST(AntiradianceIo, NearVisibilityComesBackWithTheTrianglesItTracesAgainst) {
   auto st = gi::write_antiradiance(dir / "bad.bin", bad, "h");
   ASSERT_FALSE(st);
   EXPECT_TRUE(contains(st.error().to_string(), "near_visibility_point_pairs")) << st.error().to_string();
+  bad = *bake;
+  bad.settings.near_visibility_budget_bytes = std::uint64_t{1} << 50;
+  st = gi::write_antiradiance(dir / "bad.bin", bad, "h");
+  ASSERT_FALSE(st);
+  EXPECT_TRUE(contains(st.error().to_string(), "near_visibility_budget_bytes")) << st.error().to_string();
   bad = *bake;
   bad.hierarchy.corners.pop_back();
   st = gi::write_antiradiance(dir / "bad.bin", bad, "h");

@@ -4,6 +4,7 @@
 // antiradiance solve exactly, and a move back to the baked pose returns to the baseline.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -53,6 +54,68 @@ TEST(NearDoorVisibility, TheShutDoorBlocksTheReceiverAndTheOthersKeepTheRegionsS
   const std::vector<glm::vec3> back = near->move(*region, scene.door, baked);
   const glm::vec3 again = artest::instance_mean(region->hierarchy(), scene.input, scene.receiver, back);
   EXPECT_NEAR(again.x, open.x, 2e-3f * open.x);
+}
+
+// The near set's budget (issue 37: the light beyond a shut door comes over several bounces, so
+// the set reaches beyond the radius as far as its memory allows): beyond the radius set, the
+// leaves nearest the door come first, the rows fit the budget, a budget below the radius set
+// keeps the radius set, and a large one takes every leaf.
+TEST(NearDoorVisibility, BeyondTheRadiusTheBudgetTakesTheLeavesNearestTheDoorFirst) {
+  const artest::DoorScene scene = artest::door_scene(90.0f);
+  gi::AntiradianceSettings s;
+  s.patch_size_m = 0.5f;
+  s.bins_per_side = 8;
+  auto region = gi::AntiradianceRegion::create(scene.input, s);
+  ASSERT_TRUE(region) << region.error().to_string();
+  region->update(false);
+  const gi::ElementHierarchy& h = region->hierarchy();
+  const std::size_t leaves = h.leaf_count();
+  gi::NearDoorVisibilitySettings ns;
+  ns.radius_m = 0.25f;
+  ns.point_pairs = 4;
+  auto count = [](const std::vector<char>& m) {
+    return static_cast<std::size_t>(std::count(m.begin(), m.end(), char{1}));
+  };
+  const std::vector<char> radius = gi::near_door_receivers(scene.input, h, scene.door, ns);
+  const std::size_t r = count(radius);
+  ASSERT_GT(r, 0u);
+  ASSERT_LT(r + 5, leaves);
+  const std::size_t row = leaves * gi::ExactLeafTransport::row_bytes_per_leaf(ns.point_pairs);
+  EXPECT_EQ(row, leaves * 6u);  // a float coupling and one 16-bit word of visibility per leaf
+
+  ns.budget_bytes = (r + 5) * row + row / 2;  // room for five more rows, not six
+  const std::vector<char> more = gi::near_door_receivers(scene.input, h, scene.door, ns);
+  EXPECT_EQ(count(more), r + 5);
+  const glm::vec3 hinge(scene.input.instances[scene.door].object_to_world[3]);
+  auto gap = [&](std::size_t l) {
+    const gi::ElementNode& e = h.nodes[static_cast<std::size_t>(h.leaves[l])];
+    return glm::length(e.center - hinge) - e.radius_m;
+  };
+  float farthest_added = 0.0f, nearest_left = 1e30f;
+  for (std::size_t l = 0; l < leaves; ++l) {
+    if (radius[l]) {
+      EXPECT_TRUE(more[l]) << "leaf " << l << " of the radius set left out";
+    }
+    if (more[l] && !radius[l]) farthest_added = std::max(farthest_added, gap(l));
+    if (!more[l]) nearest_left = std::min(nearest_left, gap(l));
+  }
+  EXPECT_LE(farthest_added, nearest_left);
+
+  ns.budget_bytes = row;  // below the radius set: the radius set
+  EXPECT_EQ(gi::near_door_receivers(scene.input, h, scene.door, ns), radius);
+  ns.budget_bytes = 0;  // off: the radius set
+  EXPECT_EQ(gi::near_door_receivers(scene.input, h, scene.door, ns), radius);
+  ns.budget_bytes = std::size_t{1} << 40;  // everything
+  EXPECT_EQ(count(gi::near_door_receivers(scene.input, h, scene.door, ns)), leaves);
+
+  // The class takes the same set, and its rows fit the budget.
+  ns.budget_bytes = (r + 5) * row + row / 2;
+  auto near = gi::NearDoorVisibility::create(scene.input, *region, scene.door, ns);
+  ASSERT_TRUE(near) << near.error().to_string();
+  EXPECT_EQ(near->receiver_mask(), more);
+  EXPECT_EQ(near->receivers(), r + 5);
+  EXPECT_LE(near->table_bytes(), ns.budget_bytes);
+  EXPECT_EQ(near->table_bytes(), (r + 5) * row);
 }
 
 }  // namespace

@@ -327,20 +327,25 @@ TEST(PlanCost, NearVisibilityAtMediumCountsItsReceiversLoadWorkAndMemory) {
   unsigned long receivers = 0, leaves = 0;
   ASSERT_EQ(std::sscanf(basis.c_str() + at, "near-door visibility: %lu receivers x %lu leaves", &receivers, &leaves), 2)
       << basis;
-  EXPECT_NEAR(static_cast<double>(receivers), 863.0, 0.25 * 863.0);
+  // The medium budget (64 MiB) holds every one of the corridor's leaves (6 bytes each per
+  // receiver: 45 MB), as NearDoorVisibility takes them (the runtime's load printed 2738).
+  EXPECT_EQ(receivers, leaves);
+  EXPECT_NEAR(static_cast<double>(leaves), 2738.0, 0.1 * 2738.0);
   const gi::AntiradianceSettings s = gi::antiradiance_preset("medium");
   ASSERT_TRUE(s.near_visibility);
   EXPECT_EQ(s.near_visibility_radius_m, gi::NearDoorVisibilitySettings{}.radius_m);
+  EXPECT_EQ(s.near_visibility_budget_bytes, 64u << 20);
   double move_s = 0.0;
   const gi::BakeWork w = gi::near_visibility_work(leaves, receivers, s, &move_s);
-  EXPECT_GT(w.cpu_seconds, 0.5 * 1.1);
-  EXPECT_LT(w.cpu_seconds, 2.0 * 1.6);
-  EXPECT_GT(move_s, 0.0);
-  EXPECT_LT(move_s, w.cpu_seconds);
+  // Measured on a quiet machine: the couplings at load 0.68 s, a door move's near part 0.16 s.
+  EXPECT_GT(w.cpu_seconds, 0.5 * 0.68);
+  EXPECT_LT(w.cpu_seconds, 2.0 * 0.68);
+  EXPECT_GT(move_s, 0.5 * 0.16);
+  EXPECT_LT(move_s, 2.0 * 0.16);
   // The receivers' rows only: a float coupling and 16 bits of kept visibility per receiver and
-  // leaf (4 point pairs, close pairs 16), not every pair of leaves (12 bytes each before).
+  // leaf (4 point pairs, close pairs 16), within the budget.
   EXPECT_EQ(w.runtime_bytes, static_cast<std::uint64_t>(6.0 * static_cast<double>(receivers) * leaves));
-  EXPECT_LT(w.runtime_bytes, static_cast<std::uint64_t>(12.0 * leaves * (leaves - 1.0) / 2.0 / 2.0));
+  EXPECT_LE(w.runtime_bytes, s.near_visibility_budget_bytes);
   EXPECT_GT(medium.estimate.runtime_bytes, w.runtime_bytes);  // the links' GPU bytes besides
 }
 
