@@ -36,6 +36,19 @@ std::vector<AntiradianceTexelBlend> antiradiance_texel_blends(const ElementHiera
 /// sum_k weights[k] x per_leaf[leaves[k]].
 glm::vec3 blend_leaves(const AntiradianceTexelBlend& b, std::span<const glm::vec3> per_leaf);
 
+/// A texel's atlas value after the region's change (antiradiance_composite.comp.glsl's rule),
+/// per channel: light the change adds is added (atlas + change). Light it takes away is taken
+/// as added where `share` is 0 (clamped at 0), and as the share of the leaves' own light they
+/// lose where `share` is 1 (atlas x (1 + change / baseline), at least 0), blended between. The
+/// runtime sets share 1 at near-door visibility's receivers, whose baseline is their own
+/// ray-traced light: a texel darkens by the fraction its leaves darken, whatever the atlas's
+/// absolute level. Adding their loss drove texels whose atlas is darker than the leaves' baseline
+/// below 0 (the corridor's cyan texels, docs/antiradiance.md). Antiradiance's own leaves keep 0:
+/// their baseline is its leaky solve's, and the share of it scored worse (0.204 against 0.182 of
+/// the level on the corridor). `change`, `baseline` and `share` are the texel's blended leaf
+/// values; a baseline of 0 or less takes the sum.
+glm::vec3 composite_change(const glm::vec3& atlas, const glm::vec3& change, const glm::vec3& baseline, float share);
+
 /// The floor the per-leaf output sets whatever the solver computes: a per-texel field
 /// (indexed by atlas texel, like blends' texel) projected onto the leaves and blended back.
 /// Each leaf gets the mean of `per_texel` over the texels of `blends` with `use` set whose

@@ -279,6 +279,23 @@ struct TexelOutput {
   }
 };
 
+// The change the runtime's composite makes at each blended texel (composite_change), with the
+// baked truth standing for the atlas it is composited into: what the renderer adds.
+// `share` per leaf (empty: 0 everywhere, antiradiance's own leaves).
+void composite_at_texels(const RgbField& reference, const std::vector<AntiradianceTexelBlend>& blends,
+                         const std::vector<glm::vec3>& delta, const std::vector<glm::vec3>& baseline,
+                         const std::vector<char>& share, std::vector<glm::vec3>& dt) {
+  for (const AntiradianceTexelBlend& b : blends) {
+    const glm::vec3 atlas = ref_at(reference, b.texel);
+    float s = 0.0f;
+    for (int k = 0; k < 4; ++k)
+      if (b.leaves[k] >= 0 && static_cast<std::size_t>(b.leaves[k]) < share.size() &&
+          share[static_cast<std::size_t>(b.leaves[k])])
+        s += b.weights[k];
+    dt[b.texel] = composite_change(atlas, blend_leaves(b, delta), blend_leaves(b, baseline), s) - atlas;
+  }
+}
+
 // Each door move on the CPU twin: relink + direct light (update(false)), then the solve.
 engine::Result<DoorMoveScores> score_door_moves(const RunContext& ctx, const DoorSetup& d, AntiradianceRegion& region,
                                                 const std::vector<AntiradianceTexelBlend>& blends,
@@ -301,7 +318,7 @@ engine::Result<DoorMoveScores> score_door_moves(const RunContext& ctx, const Doo
     s.output_ms += ms_since(t2);
     if (near) {
       const std::vector<glm::vec3> delta = near->delta(d, region, d.pose(d.swings[k - 1]), poses - 1);
-      for (const AntiradianceTexelBlend& b : blends) dt[b.texel] = blend_leaves(b, delta);
+      composite_at_texels(ctx.reference, blends, delta, near->near->baseline(), near->near->receiver_mask(), dt);
     }
     s.add_floor(ctx.reference, d, blends, region.hierarchy().leaf_count(), k);
     s.add_pose(ctx.reference, d, k, dt);

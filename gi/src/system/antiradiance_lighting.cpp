@@ -31,25 +31,6 @@ bool blends_fit(const std::vector<TexelBlend>& blends, const AtlasLayout& layout
   return true;
 }
 
-// The leaves NearDoorVisibility::create makes receivers around `door` (its rule, repeated
-// here because the class tells only their count): a leaf of the door, or one whose bounding
-// sphere comes within radius_m of the sphere the door reaches about its origin.
-std::vector<char> near_receiver_mask(const ElementHierarchy& h, const BakeInput& input, std::uint32_t door,
-                                     float radius_m) {
-  const glm::vec3 origin(input.instances[door].object_to_world[3]);
-  float reach = 0.0f;
-  for (const BakePrimitive& p : input.meshes[input.instances[door].mesh].primitives)
-    for (const glm::vec3& v : p.positions) reach = std::max(reach, glm::length(v));
-  std::vector<char> mask(h.leaf_count(), 0);
-  for (std::size_t l = 0; l < h.leaf_count(); ++l) {
-    const auto node = static_cast<std::size_t>(h.leaves[l]);
-    const ElementNode& e = h.nodes[node];
-    mask[l] = h.node_instance[node] == static_cast<std::int32_t>(door) ||
-              glm::length(e.center - origin) <= reach + radius_m + e.radius_m;
-  }
-  return mask;
-}
-
 double ms_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
@@ -65,9 +46,7 @@ void AntiradianceLighting::create_near_sets(const BakeInput& input) {
     near_reason_ = "the scene's deforming nodes are not at the baked pose (the near sets' zero is that pose)";
   else if (h.corners.size() != 3 * h.nodes.size())
     near_reason_ = "the bake holds no element triangles to trace against";
-  NearDoorVisibilitySettings ns;
-  ns.radius_m = s.near_visibility_radius_m;
-  ns.point_pairs = s.near_visibility_point_pairs;
+  const NearDoorVisibilitySettings ns = near_door_settings(s);
   for (std::uint32_t door : h.deforming_instances) {
     if (!near_reason_.empty()) break;
     auto near = NearDoorVisibility::create(input, *region_, door, ns);
@@ -75,14 +54,8 @@ void AntiradianceLighting::create_near_sets(const BakeInput& input) {
       near_reason_ = near.error().to_string();
       break;
     }
-    NearSet set{door, near_receiver_mask(h, input, door, ns.radius_m),
-                std::make_unique<NearDoorVisibility>(std::move(near).value())};
-    const auto count = static_cast<std::size_t>(std::count(set.receivers.begin(), set.receivers.end(), char{1}));
-    if (count != set.visibility->receivers())
-      near_reason_ = "its receivers (" + std::to_string(set.visibility->receivers()) + ") are not the runtime's (" +
-                     std::to_string(count) + ")";
-    else if (count > 0)
-      near_.push_back(std::move(set));
+    NearSet set{door, std::make_unique<NearDoorVisibility>(std::move(near).value())};
+    if (set.visibility->receivers() > 0) near_.push_back(std::move(set));
   }
   if (!near_reason_.empty()) {
     near_.clear();
@@ -160,7 +133,29 @@ bool AntiradianceLighting::ensure_gpu() {
                     static_cast<GLsizeiptr>(std::max<std::size_t>(region_->hierarchy().leaf_count(), 1) * 16), nullptr,
                     GL_DYNAMIC_DRAW);
   glClearNamedBufferData(delta_.id(), GL_R32F, GL_RED, GL_FLOAT, nullptr);  // baked pose: no change
+  std::vector<glm::vec4> zero = leaf_baseline();
+  zero.resize(std::max<std::size_t>(zero.size(), 1));
+  baseline_ = engine::GlBuffer::create();
+  glNamedBufferData(baseline_.id(), static_cast<GLsizeiptr>(zero.size() * sizeof(glm::vec4)), zero.data(),
+                    GL_STATIC_DRAW);
   return true;
+}
+
+std::vector<glm::vec4> AntiradianceLighting::leaf_baseline() const {
+  std::vector<glm::vec4> out(region_->hierarchy().leaf_count(), glm::vec4(0.0f));
+  for (std::size_t l = 0; l < out.size() && l < region_->baseline().size(); ++l)
+    out[l] = glm::vec4(region_->baseline()[l], 0.0f);
+  std::vector<char> taken(out.size(), 0);
+  for (const NearSet& n : near_) {  // the first set of a leaf holds it, as in near_change
+    const std::vector<char>& receivers = n.visibility->receiver_mask();
+    const std::vector<glm::vec3>& zero = n.visibility->baseline();
+    for (std::size_t l = 0; l < out.size() && l < zero.size(); ++l)
+      if (receivers[l] && !taken[l]) {
+        out[l] = glm::vec4(zero[l], 1.0f);
+        taken[l] = 1;
+      }
+  }
+  return out;
 }
 
 void AntiradianceLighting::near_change(const std::vector<std::pair<std::uint32_t, glm::mat4>>& moved) {
@@ -178,8 +173,9 @@ void AntiradianceLighting::near_change(const std::vector<std::pair<std::uint32_t
     }
     stats_.near_iterations = std::max(stats_.near_iterations, n.visibility->last_iterations());
     const std::vector<glm::vec3>& zero = n.visibility->baseline();
+    const std::vector<char>& receivers = n.visibility->receiver_mask();
     for (std::size_t l = 0; l < leaf_change_.size() && l < e.size(); ++l)
-      if (n.receivers[l] && !taken[l]) {
+      if (receivers[l] && !taken[l]) {
         leaf_change_[l] = e[l] - zero[l];  // against the near set's own baked pose
         taken[l] = 1;
       }
@@ -277,6 +273,7 @@ void AntiradianceLighting::composite(std::uint32_t base_texture, std::uint32_t o
   glProgramUniform1ui(program_.id(), glGetUniformLocation(program_.id(), "u_width"), static_cast<GLuint>(width_));
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, blends_.id());
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, delta_.id());
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, baseline_.id());
   glBindImageTexture(0, out_texture, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
   glBindImageTexture(1, base_texture, 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
   const std::uint32_t groups = (blend_count_ + kGroupSize - 1) / kGroupSize;

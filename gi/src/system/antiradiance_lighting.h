@@ -78,8 +78,9 @@ class AntiradianceLighting {
   /// Reads the deforming entities' world transforms; when one changed, solves (GL context
   /// current). True when it did. Errors of the GPU pass disable the method (stats().disabled).
   bool update();
-  /// out = base + the region's change at the texels it covers, base elsewhere. Both
-  /// textures RGBA32F of the atlas's size.
+  /// out = base with the region's change at the texels it covers (composite_change: light added
+  /// is added, light lost is lost as a share), base elsewhere. Both textures RGBA32F of the
+  /// atlas's size.
   void composite(std::uint32_t base_texture, std::uint32_t out_texture);
 
   const Stats& stats() const { return stats_; }
@@ -90,6 +91,10 @@ class AntiradianceLighting {
   /// atlas): the near sets' receivers' move result minus their baseline, the GPU solve's
   /// change elsewhere. Empty before the first update.
   const std::vector<glm::vec3>& leaf_change() const { return leaf_change_; }
+  /// The change's zero per leaf (W/m^2): the near sets' baseline at their receivers, the
+  /// region's elsewhere; w: the composite's share (composite_change), 1 at the receivers (a
+  /// loss taken as a share of their light), 0 elsewhere (added).
+  std::vector<glm::vec4> leaf_baseline() const;
   /// The last update's GPU solve per leaf (read back, energy guard applied): what the near
   /// sets held the other leaves at. Empty before the first solve.
   const std::vector<glm::vec3>& solved_irradiance() const { return solved_; }
@@ -109,10 +114,9 @@ class AntiradianceLighting {
   /// The near sets' part of upload_change: moves them, puts their receivers' change in leaf_change_.
   void near_change(const std::vector<std::pair<std::uint32_t, glm::mat4>>& moved);
   void clear_near_stats();
-  /// One near set: its instance, its receivers (the class's rule, near_receiver_mask) and the class.
+  /// One near set: its instance and the class (which holds its receivers, near_door_receivers).
   struct NearSet {
     std::uint32_t instance = 0;
-    std::vector<char> receivers;
     std::unique_ptr<NearDoorVisibility> visibility;
   };
   std::vector<NearSet> near_;
@@ -124,7 +128,7 @@ class AntiradianceLighting {
   std::vector<std::pair<std::uint32_t, engine::Entity>> deforming_;  ///< BakeInput instance, entity.
   std::optional<AntiradianceGpuPass> gpu_;
   engine::ShaderProgram program_;
-  engine::GlBuffer blends_, delta_;
+  engine::GlBuffer blends_, delta_, baseline_;
   std::uint32_t blend_count_ = 0;
   bool gpu_warm_startable_ = false;  ///< The GPU tables hold a converged solve.
   int width_ = 0, height_ = 0;
