@@ -21,9 +21,11 @@
 
 #include <glm/gtc/quaternion.hpp>
 
+#include "asset_scenes.h"
 #include "brf/brf_bake.h"
 #include "brf/brf_io.h"
 #include "brf/brf_mesh.h"
+#include "gl_context.h"
 #include "gl_readback.h"
 #include "light_atlas/light_atlas.h"
 #include "light_atlas/light_atlas_io.h"
@@ -34,11 +36,13 @@ namespace {
 
 using gltest::read_texture;
 
-engine::Scene crates_room() {
-  auto asset = engine::load_gltf(GI_SOURCE_DIR "/assets/crates_room.gltf");
-  EXPECT_TRUE(asset) << asset.error().to_string();
-  return engine::instantiate(std::move(asset.value()));
-}
+engine::Scene crates_room() { return gitest::asset_scene("crates_room.gltf"); }
+
+// Each GPU test's start: the GL context and the crates room.
+struct CratesRoomRun {
+  engine::GpuContext ctx = gltest::headless_or_fail();
+  engine::Scene scene = crates_room();
+};
 
 // One bundle for all tests of this process: light atlas (preview, 8 texels/m) + BRF (preview).
 // ctest runs each test in its own process, in parallel: the directory is per process.
@@ -76,9 +80,8 @@ void move_to(engine::Scene& scene, const char* name, glm::vec3 position) {
 }
 
 TEST(GISystem, RecomputesOnlyWhatChanged) {
-  auto ctx = engine::GpuContext::create_headless();
-  ASSERT_TRUE(ctx) << "no headless GL context: " << ctx.error().to_string();
-  engine::Scene scene = crates_room();
+  CratesRoomRun run;
+  engine::Scene& scene = run.scene;
   auto loaded = gi::GISystem::load(bundle().dir, scene);
   ASSERT_TRUE(loaded) << loaded.error().to_string();
   gi::GISystem& gi = **loaded;
@@ -158,9 +161,8 @@ std::vector<glm::vec4> vertex_irradiance(gi::GISystem& gi, const engine::Scene& 
 // the reach narrows until they fit, the host is told, and each crate keeps its nearest
 // neighbours' bounce (less light than with every pair, never more: bounces only add).
 TEST(GISystem, PairsBeyondTheBufferLimitNarrowTheReachInsteadOfTurningTheFieldsOff) {
-  auto ctx = engine::GpuContext::create_headless();
-  ASSERT_TRUE(ctx) << "no headless GL context: " << ctx.error().to_string();
-  engine::Scene scene = crates_room();
+  CratesRoomRun run;
+  engine::Scene& scene = run.scene;
   auto full = gi::GISystem::load(bundle().dir, scene);
   ASSERT_TRUE(full) << full.error().to_string();
   const std::vector<glm::vec4> all_pairs = vertex_irradiance(**full, scene, "crate_1");
@@ -199,9 +201,8 @@ TEST(GISystem, PairsBeyondTheBufferLimitNarrowTheReachInsteadOfTurningTheFieldsO
 }
 
 TEST(GISystem, TheRedCrateTurnsTheStatuePink) {
-  auto ctx = engine::GpuContext::create_headless();
-  ASSERT_TRUE(ctx) << "no headless GL context: " << ctx.error().to_string();
-  engine::Scene scene = crates_room();
+  CratesRoomRun run;
+  engine::Scene& scene = run.scene;
   // The statue's plinth faces +x at x = -0.85 (statue at (-1.2, 0, 1.2), half width 0.35).
   auto layout_scene =
       gi::prepare_static_scene(gi::bake_input_from(scene), bundle().atlas.layout, gi::BakeLights::None).value();
