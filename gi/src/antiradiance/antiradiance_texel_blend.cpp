@@ -4,6 +4,7 @@
 #include <array>
 #include <limits>
 
+#include "uv/atlas_dilation.h"
 #include "uv/atlas_input.h"
 #include "uv/atlas_rasterizer.h"
 
@@ -11,48 +12,26 @@ namespace gi {
 
 namespace {
 
-// The gutter: the light atlas's dilation (dilation_rings rings, as light_atlas.cpp) fills the
-// texels around each chart from their filled neighbours, and bilinear reads at chart borders
-// see them. Each texel it fills next to a covered one takes that neighbour's blend (the first
-// in scan order), ring by ring as dilate() grows, so the change reaches the gutter too: without
-// it the corridor's edges kept the open door's light in thin bright seams.
+// The gutter: the light atlas's dilation (atlas_gutter_rings) fills the texels around each
+// chart from their filled neighbours, and bilinear reads at chart borders see them. Each texel
+// it fills takes the blend of the covered texel its value comes from (dilation_sources), so the
+// change reaches the gutter too: without it the corridor's edges kept the open door's light in
+// thin bright seams.
 void extend_into_gutter(std::vector<AntiradianceTexelBlend>& blends, const std::vector<std::uint8_t>& valid,
                         const AtlasLayout& layout) {
   const int w = static_cast<int>(layout.width), hgt = static_cast<int>(layout.height);
   if (w <= 0 || hgt <= 0 || valid.size() != static_cast<std::size_t>(w) * static_cast<std::size_t>(hgt)) return;
   std::vector<std::int32_t> blend_of(valid.size(), -1);
   for (std::size_t k = 0; k < blends.size(); ++k) blend_of[blends[k].texel] = static_cast<std::int32_t>(k);
-  std::vector<std::uint8_t> filled(valid.begin(), valid.end());
-  const int rings = std::max(4, layout.padding_texels);
-  for (int ring = 0; ring < rings; ++ring) {
-    std::vector<std::pair<std::size_t, std::int32_t>> grown;  // texel, the blend it takes (-1: none)
-    for (int y = 0; y < hgt; ++y)
-      for (int x = 0; x < w; ++x) {
-        const std::size_t t = static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
-        if (filled[t]) continue;
-        bool any = false;
-        std::int32_t from = -1;
-        for (int dy = -1; dy <= 1; ++dy)
-          for (int dx = -1; dx <= 1; ++dx) {
-            const int nx = x + dx, ny = y + dy;
-            if ((dx == 0 && dy == 0) || nx < 0 || ny < 0 || nx >= w || ny >= hgt) continue;
-            const std::size_t n =
-                static_cast<std::size_t>(ny) * static_cast<std::size_t>(w) + static_cast<std::size_t>(nx);
-            if (!filled[n]) continue;
-            any = true;
-            if (from < 0) from = blend_of[n];
-          }
-        if (any) grown.emplace_back(t, from);
-      }
-    if (grown.empty()) break;
-    for (const auto& [t, from] : grown) {
-      filled[t] = 1;
-      if (from < 0) continue;
-      AntiradianceTexelBlend b = blends[static_cast<std::size_t>(from)];
-      b.texel = static_cast<std::uint32_t>(t);
-      blend_of[t] = static_cast<std::int32_t>(blends.size());
-      blends.push_back(b);
-    }
+  const std::vector<std::int32_t> source = dilation_sources(w, hgt, valid, atlas_gutter_rings(layout.padding_texels));
+  const std::size_t covered = blends.size();
+  for (std::size_t t = 0; t < source.size(); ++t) {
+    if (valid[t] || source[t] < 0) continue;
+    const std::int32_t from = blend_of[static_cast<std::size_t>(source[t])];
+    if (from < 0 || static_cast<std::size_t>(from) >= covered) continue;
+    AntiradianceTexelBlend b = blends[static_cast<std::size_t>(from)];
+    b.texel = static_cast<std::uint32_t>(t);
+    blends.push_back(b);
   }
   std::sort(blends.begin(), blends.end(),
             [](const AntiradianceTexelBlend& a, const AntiradianceTexelBlend& b) { return a.texel < b.texel; });

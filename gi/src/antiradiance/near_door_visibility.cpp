@@ -22,12 +22,13 @@ NearDoorVisibilitySettings near_door_settings(const AntiradianceSettings& s) {
 
 std::vector<char> near_door_receivers(const BakeInput& input, const ElementHierarchy& h, std::uint32_t door,
                                       const NearDoorVisibilitySettings& settings) {
+  std::vector<char> mask(h.leaf_count(), 0);
+  if (door >= input.instances.size() || input.instances[door].mesh >= input.meshes.size()) return mask;
   const glm::vec3 origin(input.instances[door].object_to_world[3]);
   float reach = 0.0f;
   for (const BakePrimitive& p : input.meshes[input.instances[door].mesh].primitives)
     for (const glm::vec3& v : p.positions) reach = std::max(reach, glm::length(v));
   // Each leaf's gap to the reached sphere (its bounding sphere's nearest point; <= 0 inside).
-  std::vector<char> mask(h.leaf_count(), 0);
   std::vector<std::pair<float, std::size_t>> others;
   std::size_t receivers = 0;
   for (std::size_t l = 0; l < h.leaf_count(); ++l) {

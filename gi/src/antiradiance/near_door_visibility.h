@@ -60,7 +60,8 @@ NearDoorVisibilitySettings near_door_settings(const AntiradianceSettings& s);
 /// its transform in `input`): the instance's own leaves, those whose bounding sphere comes within
 /// radius_m of the sphere the instance reaches about its origin (its farthest vertex), then,
 /// within budget_bytes, the others nearest that sphere first. One rule for the class, the
-/// runtime and the planner.
+/// runtime and the planner. No receiver where `door` names no instance of `input` (or its
+/// instance no mesh).
 std::vector<char> near_door_receivers(const BakeInput& input, const ElementHierarchy& h, std::uint32_t door,
                                       const NearDoorVisibilitySettings& settings);
 

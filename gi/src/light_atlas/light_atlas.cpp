@@ -137,8 +137,6 @@ engine::Result<VplPowers> light_vpls(const BakeScene& b, const VplSet& vpls, con
   return out;
 }
 
-int dilation_rings(const AtlasLayout& layout) { return std::max(4, layout.padding_texels); }
-
 // Sky rays per texel of the VPL final shooting's baked direct light (the gather presets
 // count the sky on their own solve and gather rays instead).
 constexpr int kVplSkyRays = 64;
@@ -379,7 +377,7 @@ engine::Result<LightAtlasBake> bake_light_atlas_run(const BakeInput& input, cons
                                       : vpl_shooting_pass(b, settings, pool, out, rays);
   if (!finished) return finished.error();
   out.valid = b.texels.valid;
-  dilate<glm::vec3>(out.irradiance, out.width, out.height, out.valid, dilation_rings(out.layout));
+  dilate<glm::vec3>(out.irradiance, out.width, out.height, out.valid, atlas_gutter_rings(out.layout.padding_texels));
 
   out.stats.vpls = out.vpls.size();
   out.stats.sample_points = out.vpls.sample_position.size();
@@ -446,7 +444,7 @@ engine::Result<LightAtlasUpdateStats> update_light_atlas(const BakeInput& input,
     previous.irradiance[t] = glm::max(previous.irradiance[t] + diff->irradiance[t], glm::vec3(0.0f));
   }
   dilate<glm::vec3>(previous.irradiance, previous.width, previous.height, previous.valid,
-                    dilation_rings(previous.layout));
+                    atlas_gutter_rings(previous.layout.padding_texels));
   return LightAtlasUpdateStats{.reshot_vpls = shooters.size(), .seconds = seconds_since(t_start)};
 }
 

@@ -283,7 +283,7 @@ void keep_chart_footprints(const AtlasLayout& layout, std::vector<std::uint8_t>&
 // coarse panes, only those inside the charts' footprints: keep_chart_footprints).
 void dilate_panes(const AtlasTexels& tex, std::vector<glm::vec3>& full, Prm& prm) {
   const auto clusters = static_cast<std::size_t>(prm.cluster_count);
-  const int rings = std::max(4, prm.layout.padding_texels);
+  const int rings = atlas_gutter_rings(prm.layout.padding_texels);
   std::vector<std::uint8_t> filled;
   for (std::size_t c = 0; c < clusters; ++c)
     filled = dilate<glm::vec3>(std::span<glm::vec3>(full.data() + c * tex.valid.size(), tex.valid.size()), prm.width,
@@ -407,8 +407,8 @@ engine::Result<Prm> merge_prm(const BakeInput& input, const PrmSettings& setting
 
 engine::Result<PrmAtlasRead> prm_atlas_read(const Prm& prm, AtlasLayout atlas, const BakeInput& input) {
   const AtlasTexels fine = rasterize_atlas(atlas, atlas_inputs_from(input));
-  // The atlas's gutter rings as the light atlas dilates its own (max(4, padding) rings).
-  auto up = PaneUpsampler::build(prm.layout, prm.texels, atlas, fine, std::max(4, atlas.padding_texels));
+  // The atlas's gutter rings, as the light atlas dilates its own.
+  auto up = PaneUpsampler::build(prm.layout, prm.texels, atlas, fine, atlas_gutter_rings(atlas.padding_texels));
   if (!up) return up.error();
   return PrmAtlasRead{.layout = std::move(atlas),
                       .upsampler = std::make_shared<const PaneUpsampler>(std::move(up).value())};

@@ -64,6 +64,12 @@ void AntiradianceLighting::create_near_sets(const BakeInput& input) {
     return;
   }
   stats_.near_visibility = !near_.empty();
+  near_owner_.assign(h.leaf_count(), -1);
+  for (std::size_t k = 0; k < near_.size(); ++k) {
+    const std::vector<char>& receivers = near_[k].visibility->receiver_mask();
+    for (std::size_t l = 0; l < near_owner_.size() && l < receivers.size(); ++l)
+      if (receivers[l] && near_owner_[l] < 0) near_owner_[l] = static_cast<std::int32_t>(k);
+  }
   for (const NearSet& n : near_) {
     stats_.near_receivers += n.visibility->receivers();
     stats_.near_table_bytes += n.visibility->table_bytes();
@@ -145,15 +151,10 @@ std::vector<glm::vec4> AntiradianceLighting::leaf_baseline() const {
   std::vector<glm::vec4> out(region_->hierarchy().leaf_count(), glm::vec4(0.0f));
   for (std::size_t l = 0; l < out.size() && l < region_->baseline().size(); ++l)
     out[l] = glm::vec4(region_->baseline()[l], 0.0f);
-  std::vector<char> taken(out.size(), 0);
-  for (const NearSet& n : near_) {  // the first set of a leaf holds it, as in near_change
-    const std::vector<char>& receivers = n.visibility->receiver_mask();
-    const std::vector<glm::vec3>& zero = n.visibility->baseline();
-    for (std::size_t l = 0; l < out.size() && l < zero.size(); ++l)
-      if (receivers[l] && !taken[l]) {
-        out[l] = glm::vec4(zero[l], 1.0f);
-        taken[l] = 1;
-      }
+  for (std::size_t l = 0; l < out.size() && l < near_owner_.size(); ++l) {
+    if (near_owner_[l] < 0) continue;
+    const std::vector<glm::vec3>& zero = near_[static_cast<std::size_t>(near_owner_[l])].visibility->baseline();
+    if (l < zero.size()) out[l] = glm::vec4(zero[l], 1.0f);
   }
   return out;
 }
@@ -161,8 +162,8 @@ std::vector<glm::vec4> AntiradianceLighting::leaf_baseline() const {
 void AntiradianceLighting::near_change(const std::vector<std::pair<std::uint32_t, glm::mat4>>& moved) {
   // The receivers gather from every leaf, the others held at this GPU solve.
   region_->adopt_irradiance(solved_);
-  std::vector<char> taken(leaf_change_.size(), 0);
-  for (NearSet& n : near_) {
+  for (std::size_t k = 0; k < near_.size(); ++k) {
+    NearSet& n = near_[k];
     // Every moved instance, so each set's ray caster sees every door where it is now.
     std::vector<glm::vec3> e;
     for (const auto& [instance, m] : moved) {
@@ -173,12 +174,9 @@ void AntiradianceLighting::near_change(const std::vector<std::pair<std::uint32_t
     }
     stats_.near_iterations = std::max(stats_.near_iterations, n.visibility->last_iterations());
     const std::vector<glm::vec3>& zero = n.visibility->baseline();
-    const std::vector<char>& receivers = n.visibility->receiver_mask();
-    for (std::size_t l = 0; l < leaf_change_.size() && l < e.size(); ++l)
-      if (receivers[l] && !taken[l]) {
+    for (std::size_t l = 0; l < leaf_change_.size() && l < e.size() && l < near_owner_.size(); ++l)
+      if (near_owner_[l] == static_cast<std::int32_t>(k))
         leaf_change_[l] = e[l] - zero[l];  // against the near set's own baked pose
-        taken[l] = 1;
-      }
   }
 }
 

@@ -120,6 +120,9 @@ class AntiradianceLighting {
     std::unique_ptr<NearDoorVisibility> visibility;
   };
   std::vector<NearSet> near_;
+  /// Per leaf, the index in near_ of the set that holds it (the first whose receivers include
+  /// it; its change and baseline are that set's), -1 for none. Made with near_.
+  std::vector<std::int32_t> near_owner_;
   std::string near_reason_;
   std::vector<glm::vec3> solved_, leaf_change_;
   std::vector<TexelBlendHost> blends_host_;

@@ -25,6 +25,17 @@ template <class Texel>
 std::vector<std::uint8_t> dilate(std::span<Texel> values, int width, int height, std::span<const std::uint8_t> valid,
                                  int iterations);
 
+/// For each texel, the texel of the valid mask whose value dilate() carries into it over the
+/// same rings: itself where `valid`; where a ring fills it, the source of its first filled
+/// neighbour in scan order (the 8 neighbours, row by row); -1 where no ring reaches it. Lets
+/// data that is not an average (an index, a blend of leaves) follow the dilated image.
+std::vector<std::int32_t> dilation_sources(int width, int height, std::span<const std::uint8_t> valid, int iterations);
+
+/// The rings an irradiance atlas is dilated by: its gutter (the layout's padding), at least 4
+/// so the mip chain's bilinear reads stay on filled texels. The light atlas, the PRM's atlas
+/// read and antiradiance's texel blends grow the same rings.
+inline int atlas_gutter_rings(int padding_texels) { return padding_texels > 4 ? padding_texels : 4; }
+
 extern template std::vector<std::uint8_t> dilate<float>(std::span<float>, int, int, std::span<const std::uint8_t>, int);
 extern template std::vector<std::uint8_t> dilate<glm::vec3>(std::span<glm::vec3>, int, int,
                                                             std::span<const std::uint8_t>, int);

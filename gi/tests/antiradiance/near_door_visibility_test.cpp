@@ -107,6 +107,9 @@ TEST(NearDoorVisibility, BeyondTheRadiusTheBudgetTakesTheLeavesNearestTheDoorFir
   EXPECT_EQ(gi::near_door_receivers(scene.input, h, scene.door, ns), radius);
   ns.budget_bytes = std::size_t{1} << 40;  // everything
   EXPECT_EQ(count(gi::near_door_receivers(scene.input, h, scene.door, ns)), leaves);
+  // A door the input does not hold: no receiver (no read past the instances).
+  EXPECT_EQ(
+      count(gi::near_door_receivers(scene.input, h, static_cast<std::uint32_t>(scene.input.instances.size()), ns)), 0u);
 
   // The class takes the same set, and its rows fit the budget.
   ns.budget_bytes = (r + 5) * row + row / 2;

@@ -55,6 +55,37 @@ TEST(AtlasDilation, FillsRingByRingFromTheMeanOfValidNeighbours) {
   EXPECT_FLOAT_EQ(img[0], 4.0f) << "(0,0) only touches the ring value at (1,1) = 4";
 }
 
+TEST(AtlasDilation, EachFilledTexelNamesTheValidTexelItsValueComesFrom) {
+  // Two valid texels on a 6 x 3 image: (1, 1) and (4, 1); three rings.
+  const int w = 6, h = 3;
+  std::vector<std::uint8_t> valid(18, 0);
+  valid[7] = 1;
+  valid[10] = 1;
+  const std::vector<std::int32_t> src = gi::dilation_sources(w, h, valid, 3);
+  EXPECT_EQ(src[7], 7);
+  EXPECT_EQ(src[10], 10);
+  EXPECT_EQ(src[0], 7) << "(0, 0) touches only (1, 1)";
+  EXPECT_EQ(src[5], 10) << "(5, 0) touches only (4, 1)";
+  EXPECT_EQ(src[8], 7) << "(2, 1) is next to (1, 1) only";
+  EXPECT_EQ(src[9], 10) << "(3, 1) is next to (4, 1) only";
+  // The same rings as dilate(): a one-hot image of each source dilates into exactly its texels.
+  for (std::int32_t s : {7, 10}) {
+    std::vector<float> img(18, 0.0f);
+    img[static_cast<std::size_t>(s)] = 1.0f;
+    gi::dilate<float>(img, w, h, valid, 3);
+    for (std::size_t i = 0; i < img.size(); ++i) {
+      if (src[i] == s) {
+        EXPECT_GT(img[i], 0.0f) << "texel " << i << " named " << s;
+      }
+    }
+  }
+  // Not reached within the rings: -1.
+  const std::vector<std::int32_t> one = gi::dilation_sources(w, h, std::vector<std::uint8_t>(18, 0), 2);
+  EXPECT_TRUE(std::all_of(one.begin(), one.end(), [](std::int32_t v) { return v == -1; }));
+  EXPECT_EQ(gi::atlas_gutter_rings(2), 4);
+  EXPECT_EQ(gi::atlas_gutter_rings(6), 6);
+}
+
 TEST(AtlasDilation, LeavesValidTexelsAndEmptyImagesAlone) {
   std::vector<glm::vec4> img(16, glm::vec4(1.0f, 2.0f, 3.0f, 4.0f));
   std::vector<std::uint8_t> valid(16, 1);
