@@ -14,6 +14,7 @@
 #include <engine/gpu/gl_objects.h>
 #include <engine/indirect_light.h>
 
+#include <cmath>
 #include <vector>
 
 #include "renderer_test_scene.h"
@@ -84,7 +85,8 @@ struct ProbeFrameSettings {
 };
 
 /// One probe of a ProbeProvider: where it was captured, its levels (face size size >> m each) and
-/// level 0's distances (null: none). Every probe's box is the room [kRoomMin, kRoomMax].
+/// its distances (a cube of any face size, 6 x n^2 values; null: none). Every probe's box is the room [kRoomMin,
+/// kRoomMax].
 struct ProbeLayer {
   glm::vec3 centre = kProbe;
   const std::vector<std::vector<glm::vec3>>* levels = nullptr;
@@ -115,9 +117,12 @@ class ProbeProvider : public engine::IndirectLightProvider {
     glTextureParameteri(cubes_.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
     glTextureParameteri(cubes_.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
     if (probes.front().distances) {
-      distances_ = engine::GlTexture::create_cube_array(GL_R32F, size, layers, 1);
+      // Their face size from their count (the bake stores them finer than level 0).
+      const int ds =
+          static_cast<int>(std::lround(std::sqrt(static_cast<double>(probes.front().distances->size()) / 6.0)));
+      distances_ = engine::GlTexture::create_cube_array(GL_R32F, ds, layers, 1);
       for (int i = 0; i < layers; ++i)
-        glTextureSubImage3D(distances_.id(), 0, 0, 0, 6 * i, size, size, 6, GL_RED, GL_FLOAT,
+        glTextureSubImage3D(distances_.id(), 0, 0, 0, 6 * i, ds, ds, 6, GL_RED, GL_FLOAT,
                             probes[static_cast<std::size_t>(i)].distances->data());
       glTextureParameteri(distances_.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
       glTextureParameteri(distances_.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);

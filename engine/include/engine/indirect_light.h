@@ -176,7 +176,7 @@ struct IndirectLightFrame {
   ///   reflection_probe_cubes   cube map array (RGBA16F), cube i = probe i, level m the
   ///                            radiance (W/(m^2 sr)) prefiltered for roughness m / (levels - 1)
   ///   reflection_probe_buffer  one ReflectionProbeBox per probe
-  ///   reflection_probe_distances  optional cube map array (R32F, one level), cube i = probe
+  ///   reflection_probe_distances  optional cube map array (R32F, one level, any face size), cube i = probe
   ///                            i's distance (m) from its centre to the surface it captured per
   ///                            direction: the parallax then follows the captured surfaces (a
   ///                            distance-impostor search along the reflected ray), not the box

@@ -126,7 +126,7 @@ glm::vec3 box_exit(const glm::vec3& p, const glm::vec3& r, const glm::vec3& box_
 
 float cube_distance_bilinear(const ProbeCube& cube, const glm::vec3& d) {
   if (cube.distance.empty()) return kProbeFarDistance;
-  return bilinear_level(cube.distance, cube.size, cube_coordinate(d));
+  return bilinear_level(cube.distance, cube_distance_size(cube), cube_coordinate(d));
 }
 
 float probe_visibility_weight(const ProbeCube& cube, const glm::vec3& centre, const glm::vec3& p) {
@@ -141,7 +141,7 @@ float probe_visibility_weight(const ProbeCube& cube, const glm::vec3& centre, co
 CubeDistanceFootprint cube_distance_footprint(const ProbeCube& cube, const glm::vec3& d) {
   if (cube.distance.empty()) return {kProbeFarDistance, kProbeFarDistance};
   const CubeCoordinate c = cube_coordinate(d);
-  const int s = cube.size;
+  const int s = cube_distance_size(cube);
   const int x0 = static_cast<int>(std::floor((c.u + 1.0f) * 0.5f * static_cast<float>(s) - 0.5f));
   const int y0 = static_cast<int>(std::floor((c.v + 1.0f) * 0.5f * static_cast<float>(s) - 0.5f));
   CubeDistanceFootprint f{std::numeric_limits<float>::infinity(), 0.0f};
@@ -272,6 +272,7 @@ ProbeCube box_filtered_chain(const ProbeCube& cube) {
   out.size = cube.size;
   out.levels = box_chain(cube);
   out.distance = cube.distance;
+  out.distance_size = cube.distance_size;
   return out;
 }
 

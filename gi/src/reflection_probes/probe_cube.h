@@ -27,10 +27,23 @@ class ThreadPool;
 struct ProbeCube {
   int size = 0;                                ///< Face size of level 0, texels.
   std::vector<std::vector<glm::vec3>> levels;  ///< Per level: 6 faces x s x s, face-major, row-major.
-  /// Level 0's texels' distance (m) from the probe's centre to the surface its rays met
-  /// (their mean; kProbeFarDistance where all left the scene). Empty: box projection only.
+  /// The distance (m) from the probe's centre to the surface the capture's rays met, per texel
+  /// of a cube of face size cube_distance_size() (6 faces, row-major as the levels; the mean of
+  /// the rays through the texel, kProbeFarDistance where all left the scene). Empty: box
+  /// projection only.
   std::vector<float> distance;
+  /// Face size of `distance`; 0: `size`. The bake stores kProbeDistanceScale x size.
+  int distance_size = 0;
 };
+
+/// The capture's distances are stored at this multiple of level 0's face size: one texel per
+/// 2 x 2 capture rays' quarter of a level-0 texel. At level 0's size, a wall beside an opening
+/// that is about a texel wide (the demo corridor's 0.2 m jambs at 4 m, 32^2) had each of its
+/// texels' mean mix the wall's and the far room's distances, and the parallax search met
+/// phantom surfaces between them. docs/reflection_probes.md, "Distances finer than level 0".
+inline constexpr int kProbeDistanceScale = 2;
+/// Face size of a cube's distances (ProbeCube::distance_size, or level 0's).
+inline int cube_distance_size(const ProbeCube& cube) { return cube.distance_size > 0 ? cube.distance_size : cube.size; }
 
 /// The distance stored where a capture's rays met nothing (the sky).
 inline constexpr float kProbeFarDistance = 1e4f;

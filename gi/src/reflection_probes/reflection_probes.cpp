@@ -4,6 +4,7 @@
 #include <engine/sky.h>
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <chrono>
 #include <cmath>
@@ -91,20 +92,24 @@ glm::vec3 capture_radiance(const CaptureScene& c, const glm::vec3& origin, const
   return l;
 }
 
-// Level 0 of one probe: the mean of supersample^2 stratified rays per texel; its distances:
-// the mean distance of the rays that met a surface (kProbeFarDistance when none did).
+// Level 0 of one probe: the mean of supersample^2 stratified rays per texel. Its distances, at
+// kProbeDistanceScale x level 0's face size: per quarter of a level-0 texel, the mean distance
+// of the texel's rays through that quarter that met a surface (kProbeFarDistance when none
+// did); a quarter no ray passes through (supersample 1) takes the texel's mean.
 // `pool` null: on the calling thread.
 void capture(const CaptureScene& c, const glm::vec3& centre, int supersample, ProbeCube& cube, ThreadPool* pool,
              std::vector<std::uint32_t>& rays) {
-  const int s = cube.size;
+  static_assert(kProbeDistanceScale == 2, "the capture splits each texel's rays into 2 x 2 quarters");
+  const int s = cube.size, ds = kProbeDistanceScale * s;
   std::vector<glm::vec3>& out = cube.levels[0];
   rays.assign(out.size(), 0);
-  cube.distance.assign(out.size(), kProbeFarDistance);
+  cube.distance_size = ds;
+  cube.distance.assign(static_cast<std::size_t>(6 * ds * ds), kProbeFarDistance);
   const auto texel = [&](std::size_t i) {
     const int face = static_cast<int>(i) / (s * s), y = static_cast<int>(i) / s % s, x = static_cast<int>(i) % s;
     glm::vec3 sum(0.0f);
-    float distance_sum = 0.0f;
-    int hits = 0;
+    std::array<float, 5> distance_sum{};  // the four quarters, then the whole texel
+    std::array<int, 5> hits{}, through{};
     for (int j = 0; j < supersample; ++j)
       for (int k = 0; k < supersample; ++k) {
         const float u = (static_cast<float>(x) + (static_cast<float>(k) + 0.5f) / static_cast<float>(supersample)) /
@@ -115,10 +120,19 @@ void capture(const CaptureScene& c, const glm::vec3& centre, int supersample, Pr
                         1.0f;
         float distance = -1.0f;
         sum += capture_radiance(c, centre, cube_direction(face, u, v), rays[i], distance);
-        if (distance >= 0.0f) distance_sum += distance, ++hits;
+        const auto quarter = static_cast<std::size_t>(2 * (2 * j / supersample) + 2 * k / supersample);
+        ++through[quarter];
+        if (distance < 0.0f) continue;
+        distance_sum[quarter] += distance, ++hits[quarter];
+        distance_sum[4] += distance, ++hits[4];
       }
     out[i] = sum / static_cast<float>(supersample * supersample);
-    if (hits > 0) cube.distance[i] = distance_sum / static_cast<float>(hits);
+    for (int q = 0; q < 4; ++q) {
+      const auto from = static_cast<std::size_t>(through[static_cast<std::size_t>(q)] > 0 ? q : 4);
+      if (hits[from] > 0)
+        cube.distance[cube_texel_index(face, 2 * x + q % 2, 2 * y + q / 2, ds)] =
+            distance_sum[from] / static_cast<float>(hits[from]);
+    }
   };
   if (pool)
     pool->parallel_for(out.size(), texel, 16);

@@ -47,9 +47,13 @@ std::string check_set(const ReflectionProbeSet& set) {
           return "probe " + std::to_string(i) + " level " + std::to_string(m) +
                  " has a negative, infinite or NaN radiance";
     }
-    if (c.distance.size() != c.levels[0].size())
-      return "probe " + std::to_string(i) + " has " + std::to_string(c.distance.size()) + " distances for " +
-             std::to_string(c.levels[0].size()) + " level-0 texels";
+    const int ds = cube_distance_size(c);
+    if (ds != cube_distance_size(set.cubes.front()))
+      return "probe " + std::to_string(i) + " has distances of another size than the first probe's";
+    if (ds < 1 || ds > 4 * c.size || c.distance.size() != static_cast<std::size_t>(6 * ds * ds))
+      return "probe " + std::to_string(i) + " has " + std::to_string(c.distance.size()) +
+             " distances for a distance cube of face size " + std::to_string(ds) +
+             " (level 0: " + std::to_string(c.size) + ")";
     for (float d : c.distance)
       if (!(d >= 0.0f && d <= kProbeFarDistance)) return "probe " + std::to_string(i) + " has a distance out of range";
   }
@@ -132,6 +136,7 @@ engine::Status write_reflection_probes_file(const fs::path& path, const Reflecti
   }
   for (const ProbeCube& c : set.cubes) {
     for (const std::vector<glm::vec3>& level : c.levels) w.put_array(level);
+    w.put(static_cast<std::uint32_t>(cube_distance_size(c)));
     w.put_array(c.distance);
   }
   return write_blob(path, kReflectionProbesMagic, kReflectionProbesVersion, w.bytes());
@@ -157,7 +162,10 @@ engine::Result<ReflectionProbesFile> read_reflection_probes_file(const fs::path&
     c.size = set.settings.resolution;
     c.levels.resize(static_cast<std::size_t>(levels));
     for (std::vector<glm::vec3>& level : c.levels) complete = complete && r.get_array(level);
-    complete = complete && r.get_array(c.distance);
+    std::uint32_t distance_size = 0;
+    complete = complete && r.get(distance_size) && distance_size <= 4u * static_cast<std::uint32_t>(c.size) &&
+               r.get_array(c.distance);
+    c.distance_size = static_cast<int>(distance_size);
   }
   const std::string location = "payload byte " + std::to_string(r.offset());
   if (!complete) return file_error(path, location, "truncated payload");

@@ -26,7 +26,7 @@ namespace gi {
 
 inline constexpr const char* kReflectionProbesFile = "reflection_probes.bin";
 inline constexpr BlobMagic kReflectionProbesMagic{"GIRPROBE"};
-inline constexpr std::uint32_t kReflectionProbesVersion = 2;
+inline constexpr std::uint32_t kReflectionProbesVersion = 3;  // 3: the distances' face size
 
 /// The file's content: the probes and the geometry hash they were baked for.
 struct ReflectionProbesFile {

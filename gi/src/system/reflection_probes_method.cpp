@@ -46,10 +46,12 @@ class ReflectionProbesMethod final : public MethodRuntime {
       }
     glTextureParameteri(cubes_.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
     glTextureParameteri(cubes_.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    // Each probe's distances (level 0's size, one level), read bilinearly by the parallax search.
-    distances_ = engine::GlTexture::create_cube_array(GL_R32F, size, count, 1);
+    // Each probe's distances (one level, kProbeDistanceScale x level 0's size; the file's check
+    // holds every probe's to the first's), read bilinearly by the parallax search.
+    const int ds = count > 0 ? cube_distance_size(set_.cubes.front()) : size;
+    distances_ = engine::GlTexture::create_cube_array(GL_R32F, ds, count, 1);
     for (int i = 0; i < count; ++i)
-      glTextureSubImage3D(distances_.id(), 0, 0, 0, 6 * i, size, size, 6, GL_RED, GL_FLOAT,
+      glTextureSubImage3D(distances_.id(), 0, 0, 0, 6 * i, ds, ds, 6, GL_RED, GL_FLOAT,
                           set_.cubes[static_cast<std::size_t>(i)].distance.data());
     glTextureParameteri(distances_.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
     glTextureParameteri(distances_.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);

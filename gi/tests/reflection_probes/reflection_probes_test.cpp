@@ -257,6 +257,56 @@ TEST(ReflectionProbeBake, UniformlyLitClosedRoomIsUniformAtEveryLevel) {
     }
 }
 
+// The distances are stored at kProbeDistanceScale x level 0's face size, one per quarter of a
+// level-0 texel: with 2 x 2 rays per texel each distance texel is the ray through its own centre,
+// the distance from the probe to the closed room's wall along it (the box, analytically). With one
+// ray per texel, its four quarters take that ray's distance.
+TEST(ReflectionProbeBake, TheDistancesAreOnePerQuarterOfALevel0Texel) {
+  gi::BakeInput in;
+  in.name = "closed room";
+  in.materials.push_back(lambert(0.5f));
+  const glm::vec3 lo(-1.5f, 0.0f, -2.0f), hi(2.5f, 3.0f, 1.0f);
+  add_static(in, room(lo, hi), "room");
+  auto layout = gi::static_world_layout(in, 4.0f);
+  ASSERT_TRUE(layout) << layout.error().to_string();
+  const std::vector<glm::vec3> irradiance(static_cast<std::size_t>(layout->width * layout->height), glm::vec3(1.0f));
+  const gi::ProbeAtlas atlas{&*layout, layout->width, layout->height, irradiance, false};
+  gi::ReflectionProbeSettings s;
+  s.resolution = 8;
+  s.prefilter_samples = 16;
+  s.threads = 2;
+  for (int supersample : {2, 1}) {
+    SCOPED_TRACE(supersample);
+    s.supersample = supersample;
+    auto set = gi::bake_reflection_probes(in, atlas, s);
+    ASSERT_TRUE(set) << set.error().to_string();
+    ASSERT_EQ(set->probes.size(), 1u);
+    const gi::ProbeCube& c = set->cubes[0];
+    const glm::vec3 centre = set->probes[0].centre;
+    const int ds = gi::cube_distance_size(c);
+    ASSERT_EQ(ds, gi::kProbeDistanceScale * s.resolution);
+    ASSERT_EQ(c.distance.size(), static_cast<std::size_t>(6 * ds * ds));
+    const auto wall = [&](const glm::vec3& d) {  // the box's side along d from the centre
+      float t = 1e30f;
+      for (int a = 0; a < 3; ++a) {
+        if (d[a] > 0.0f) t = std::min(t, (hi[a] - centre[a]) / d[a]);
+        if (d[a] < 0.0f) t = std::min(t, (lo[a] - centre[a]) / d[a]);
+      }
+      return t;
+    };
+    int off = 0;
+    for (int f = 0; f < 6; ++f)
+      for (int y = 0; y < ds; ++y)
+        for (int x = 0; x < ds; ++x) {
+          // supersample 2: the quarter's own ray; 1: the level-0 texel's ray.
+          const glm::vec3 d = supersample == 2 ? gi::cube_texel_direction(f, x, y, ds)
+                                               : gi::cube_texel_direction(f, x / 2, y / 2, s.resolution);
+          if (std::abs(c.distance[gi::cube_texel_index(f, x, y, ds)] - wall(d)) > 1e-3f) ++off;
+        }
+    EXPECT_EQ(off, 0) << "of " << 6 * ds * ds << " distance texels";
+  }
+}
+
 // The two rooms lit by a 20 W/sr lamp in room A, 2.5 m above its floor, and an atlas of
 // 0.1 W/m^2 everywhere at 4 texels/m (not holding the lamp's light).
 struct LitTwoRooms {

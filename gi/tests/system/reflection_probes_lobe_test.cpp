@@ -30,15 +30,21 @@ float hall_radiance(const SideHit& h, const glm::vec3& d) {
 
 gi::ProbeCube hall_cube(int size) {
   gi::ProbeCube cube = gi::make_probe_cube(size, gi::full_mip_count(size));
-  cube.distance.resize(cube.levels[0].size());
   for (int f = 0; f < 6; ++f)
     for (int y = 0; y < size; ++y)
       for (int x = 0; x < size; ++x) {
         const glm::vec3 d = gi::cube_texel_direction(f, x, y, size);
-        const SideHit h = side_hit(d, kHallEnd);
-        cube.levels[0][gi::cube_texel_index(f, x, y, size)] = glm::vec3(hall_radiance(h, d));
-        cube.distance[gi::cube_texel_index(f, x, y, size)] = h.distance;
+        cube.levels[0][gi::cube_texel_index(f, x, y, size)] = glm::vec3(hall_radiance(side_hit(d, kHallEnd), d));
       }
+  // The distances as the bake stores them, kProbeDistanceScale x level 0's size.
+  const int ds = gi::kProbeDistanceScale * size;
+  cube.distance_size = ds;
+  cube.distance.resize(static_cast<std::size_t>(6 * ds * ds));
+  for (int f = 0; f < 6; ++f)
+    for (int y = 0; y < ds; ++y)
+      for (int x = 0; x < ds; ++x)
+        cube.distance[gi::cube_texel_index(f, x, y, ds)] =
+            side_hit(gi::cube_texel_direction(f, x, y, ds), kHallEnd).distance;
   gi::prefilter_ggx(cube, 64);
   return cube;
 }
