@@ -53,6 +53,8 @@ const float PROBE_BOX_SIDE_TOLERANCE = 0.1;
 const bool PROBE_RIM_NEAREST = true;
 // gi's probe_cube.h: kProbeOpeningLevelBias (levels read finer beyond the box's side, an opening).
 const float PROBE_OPENING_LEVEL_BIAS = 1.0;
+// gi's probe_cube.h: kProbeLobeLevelBias (levels every lobe sample reads finer than its width asks).
+const float PROBE_LOBE_LEVEL_BIAS = 0.5;
 // gi's probe_cube.h: kProbeMaxLobeSamples.
 const int PROBE_MAX_LOBE_SAMPLES = 16;
 
@@ -206,7 +208,7 @@ vec3 probe_lobe(Surface s, ReflectionProbeBox probe, int i) {
     float nl = dot(n, l);
     if (!(nl > 0.0) || !(vdh > 0.0)) continue;
     float pdf = g1 * gltf_ggx_distribution(clamp(hl.z, 0.0, 1.0), alpha) / (4.0 * nv);
-    float lod = sqrt(sqrt(vdh / (fn * max(pdf, 1e-12) * 4.0 * GLTF_PI))) * top_level;
+    float lod = max(sqrt(sqrt(vdh / (fn * max(pdf, 1e-12) * 4.0 * GLTF_PI))) * top_level - PROBE_LOBE_LEVEL_BIAS, 0.0);
     float w = gltf_schlick_weight(vdh);
     vec3 f = dielectric * (s.brdf.dielectric_f0 + (vec3(1.0) - s.brdf.dielectric_f0) * w) +
              s.brdf.metallic * (s.brdf.base_color + (vec3(1.0) - s.brdf.base_color) * w);

@@ -351,7 +351,7 @@ void plan_reflection_probes(const BakeInput& input, const PlanFacts& f, const Pl
   probes.estimate = {w.bake_seconds, w.runtime_bytes, static_cast<std::uint64_t>(w.units),
                      "~" + std::to_string(count) + " probes (" + fixed(f.census.area_m2, 0) + " m^2 / 80 m^2) x 6 x " +
                          std::to_string(s.resolution) + "^2 texels x " + std::to_string(s.supersample * s.supersample) +
-                         " rays; RGBA16F with mips"};
+                         " rays; RGBA16F with mips, R32F distances " + std::to_string(kProbeDistanceScale) + "x finer"};
 }
 
 // Near-door visibility (antiradiance's preset setting): its receivers as NearDoorVisibility

@@ -325,7 +325,10 @@ BakeWork reflection_probes_work(std::size_t probes, const ReflectionProbeSetting
   const double parallel = w.rays * kProbeCpuPerRay + texels / 3.0 * s.prefilter_samples * kProbeCpuPerPrefilterSample;
   w.cpu_seconds = parallel;
   w.bake_seconds = wall_seconds(parallel, 0.0);
-  w.runtime_bytes = static_cast<std::uint64_t>(texels * 8.0 * 4.0 / 3.0 + 48.0 * static_cast<double>(probes));
+  // RGBA16F levels with their mips, R32F distances at kProbeDistanceScale x level 0's size, the boxes.
+  const double distance_texels = texels * kProbeDistanceScale * kProbeDistanceScale;
+  w.runtime_bytes =
+      static_cast<std::uint64_t>(texels * 8.0 * 4.0 / 3.0 + distance_texels * 4.0 + 48.0 * static_cast<double>(probes));
   return w;
 }
 

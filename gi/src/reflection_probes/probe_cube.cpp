@@ -367,7 +367,7 @@ glm::vec3 box_projected_direction(const glm::vec3& p, const glm::vec3& r, const 
 glm::vec3 probe_lobe_radiance(const ProbeCube& cube, const engine::GltfBrdf& brdf, const glm::vec3& p,
                               const glm::vec3& n, const glm::vec3& v, int samples, const glm::vec3& centre,
                               const glm::vec3& box_min, const glm::vec3& box_max, bool box_only, const ProbeCube* chain,
-                              float box_side_tolerance, bool rim_nearest, float opening_level_bias) {
+                              float box_side_tolerance, bool rim_nearest, float opening_level_bias, float level_bias) {
   const int count = std::clamp(samples, 1, kProbeMaxLobeSamples);
   const float alpha = brdf.alpha, a2 = alpha * alpha;
   const float nv = std::max(glm::dot(n, v), 1e-4f);
@@ -406,7 +406,8 @@ glm::vec3 probe_lobe_radiance(const ProbeCube& cube, const engine::GltfBrdf& brd
     // the one prefiltered with the GGX lobe (solid angle about 4 pi alpha^2) of that width.
     const float pdf = g1 * engine::gltf_ggx_distribution(std::clamp(hl.z, 0.0f, 1.0f), alpha) / (4.0f * nv);
     const float alpha_m = std::sqrt(vdh / (fn * std::max(pdf, 1e-12f) * 4.0f * kPi));
-    float lod = chain ? chain_level(*chain, 1.0f / (fn * std::max(pdf, 1e-12f))) : std::sqrt(alpha_m) * top_level;
+    float lod = chain ? chain_level(*chain, 1.0f / (fn * std::max(pdf, 1e-12f)))
+                      : std::max(std::sqrt(alpha_m) * top_level - level_bias, 0.0f);
     const float w = engine::gltf_schlick_weight(vdh);
     const glm::vec3 f = f_dielectric_scale * (brdf.dielectric_f0 + (1.0f - brdf.dielectric_f0) * w) +
                         brdf.metallic * (brdf.base_color + (1.0f - brdf.base_color) * w);

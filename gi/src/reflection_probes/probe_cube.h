@@ -147,6 +147,15 @@ glm::vec3 distance_corrected_direction(const ProbeCube& cube, const glm::vec3& p
 /// "Finer beyond the opening". 0: every sample at its lobe's level (the lookup before it).
 inline constexpr float kProbeOpeningLevelBias = 1.0f;
 
+/// Levels every lobe sample reads finer than its lobe's width asks for. A level holds its GGX
+/// lobe on texels 2^m times level 0's, and the bilinear read widens it by about a texel; the
+/// trilinear blend between two levels adds the wider one's tails instead of an intermediate width.
+/// Both make a sample's read wider than its share of the lobe, which at grazing views carries a
+/// lit frame's light into a dark opening (the demo corridor) and a lit wall's into the floor
+/// behind an object (glossy_room). Measured 0, 0.25, 0.5 and 1 against the path tracer on both
+/// scenes; docs/reflection_probes.md, "Half a level finer". 0: the lookup before it.
+inline constexpr float kProbeLobeLevelBias = 0.5f;
+
 /// A probe that did not see the shaded point (a second viewpoint in the same box sees it) weighs this
 /// times its blend weight (probe_visibility_weight; the shader's PROBE_HIDDEN_WEIGHT).
 inline constexpr float kProbeHiddenWeight = 1e-3f;
@@ -188,11 +197,13 @@ inline constexpr int kProbeLobeSamples = 4;
 /// whose texels span the sample's solid angle, + 1 (Colbert and Krivanek's own rule).
 /// `box_side_tolerance`, `rim_nearest`: distance_corrected_direction's. `opening_level_bias`: the
 /// levels a sample reads finer where the probe saw beyond its box's side (kProbeOpeningLevelBias).
+/// `level_bias`: the levels every sample reads finer (kProbeLobeLevelBias).
 glm::vec3 probe_lobe_radiance(const ProbeCube& cube, const engine::GltfBrdf& brdf, const glm::vec3& p,
                               const glm::vec3& n, const glm::vec3& v, int samples, const glm::vec3& centre,
                               const glm::vec3& box_min, const glm::vec3& box_max, bool box_only,
                               const ProbeCube* chain = nullptr, float box_side_tolerance = kProbeBoxSideTolerance,
-                              bool rim_nearest = kProbeRimNearest, float opening_level_bias = kProbeOpeningLevelBias);
+                              bool rim_nearest = kProbeRimNearest, float opening_level_bias = kProbeOpeningLevelBias,
+                              float level_bias = kProbeLobeLevelBias);
 
 /// Level 0 of `cube` and its 2 x 2 box averages down to one texel per face, as a cube (what
 /// the prefilter's samples read; its distances are level 0's).

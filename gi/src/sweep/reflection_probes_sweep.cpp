@@ -145,6 +145,13 @@ std::vector<KnobSpec> reflection_probes_knobs() {
        .default_grid = {format_number(kProbeOpeningLevelBias)},
        .min_value = 0.0,
        .max_value = 8},
+      {.name = "level_bias",
+       .description = "levels every lobe sample reads finer than its width asks for (kProbeLobeLevelBias, the "
+                      "default; 0: the lookup before it)",
+       .kind = KnobKind::Real,
+       .default_grid = {format_number(kProbeLobeLevelBias)},
+       .min_value = 0.0,
+       .max_value = 8},
       {.name = "lobe",
        .description = "the lookup's lobe: the split sum's (one read along the reflection, isotropic, n = v) or "
                       "filtered importance sampling of the lobe at the view (probe_lobe_radiance)",
@@ -223,8 +230,8 @@ float depth_in_box(const ProbeVolume& v, const glm::vec3& p, const glm::vec3& n)
 // `depth`: the largest depth_in_box over those probes. False where no box holds p.
 bool probe_specular(const ReflectionProbeSet& set, const engine::GltfBrdf& brdf, const glm::vec3& p, const glm::vec3& n,
                     const glm::vec3& v, bool box_only, float box_side, bool rim, int lobe_samples,
-                    const std::vector<ProbeCube>* chains, float opening_bias, bool visibility, glm::vec3& out,
-                    float& depth) {
+                    const std::vector<ProbeCube>* chains, float opening_bias, float level_bias, bool visibility,
+                    glm::vec3& out, float& depth) {
   const glm::vec3 r = glm::reflect(-v, n);
   glm::vec3 sum(0.0f);
   float weight = 0.0f;
@@ -236,7 +243,7 @@ bool probe_specular(const ReflectionProbeSet& set, const engine::GltfBrdf& brdf,
     const ProbeCube& cube = set.cubes[i];
     if (lobe_samples > 0) {
       sum += w * probe_lobe_radiance(cube, brdf, p, n, v, lobe_samples, pv.centre, pv.box_min, pv.box_max, box_only,
-                                     chains ? &(*chains)[i] : nullptr, box_side, rim, opening_bias);
+                                     chains ? &(*chains)[i] : nullptr, box_side, rim, opening_bias, level_bias);
     } else {
       const float lod = std::sqrt(brdf.alpha) * static_cast<float>(cube.levels.size() - 1);
       const glm::vec3 d =
@@ -607,12 +614,14 @@ engine::Result<MethodOutput> run_reflection_probes(const RunContext& ctx) {
       ctx.knobs.text("lobe") != "split_sum" ? static_cast<int>(ctx.knobs.integer("lobe_samples")) : 0;
   const std::vector<ProbeCube> chains = lookup_chains(ctx, *set);
   const auto opening_bias = static_cast<float>(ctx.knobs.real("opening_bias"));
+  const auto level_bias = static_cast<float>(ctx.knobs.real("level_bias"));
   for (std::size_t t = 0; t < tex.valid.size(); ++t) {
     if (!g->glossy[t]) continue;
     float depth = 0.0f;
     const glm::vec3 v = glm::normalize(g->eye - tex.position[t]);
     if (!probe_specular(*set, g->brdf[t], tex.position[t], tex.normal[t], v, box_only, box_side, rim, lobe_samples,
-                        chains.empty() ? nullptr : &chains, opening_bias, baked->visibility, values[t], depth)) {
+                        chains.empty() ? nullptr : &chains, opening_bias, level_bias, baked->visibility, values[t],
+                        depth)) {
       ++uncovered;
       continue;
     }
