@@ -52,6 +52,18 @@ float slot_environment(const glm::vec3& d) {
   return std::abs(azimuth) < kSlotDeg && elevation < 30.0f ? 0.0f : 1.0f;
 }
 
+// slot_environment captured as a probe of `size`^2 faces, prefiltered with 128 samples.
+gi::ProbeCube slot_cube(int size) {
+  gi::ProbeCube cube = gi::make_probe_cube(size, gi::full_mip_count(size));
+  for (int f = 0; f < 6; ++f)
+    for (int y = 0; y < size; ++y)
+      for (int x = 0; x < size; ++x)
+        cube.levels[0][gi::cube_texel_index(f, x, y, size)] =
+            glm::vec3(slot_environment(gi::cube_texel_direction(f, x, y, size)));
+  gi::prefilter_ggx(cube, 128);
+  return cube;
+}
+
 // The specular lobe's mean of slot_environment at view v, written independently of the
 // lookup: half vectors from D (not the visible normals) at random, weighted by
 // gltf_eval_cos's specular / pdf.
@@ -84,14 +96,7 @@ float lobe_truth(const engine::GltfBrdf& m, const glm::vec3& v, int samples) {
 // levels it reads, isotropic themselves; 0.040 and 0.019 since the samples read half a level
 // finer, kProbeLobeLevelBias).
 TEST(ProbeLobe, AtAGrazingViewTheLobeFollowsTheTruthWhereTheSplitSumBlursAcrossTheSlot) {
-  const int size = 128;
-  gi::ProbeCube cube = gi::make_probe_cube(size, gi::full_mip_count(size));
-  for (int f = 0; f < 6; ++f)
-    for (int y = 0; y < size; ++y)
-      for (int x = 0; x < size; ++x)
-        cube.levels[0][gi::cube_texel_index(f, x, y, size)] =
-            glm::vec3(slot_environment(gi::cube_texel_direction(f, x, y, size)));
-  gi::prefilter_ggx(cube, 128);
+  const gi::ProbeCube cube = slot_cube(128);
   const float roughness = 0.2f, cos_v = 0.15f;
   const engine::GltfBrdf m = engine::gltf_brdf(glm::vec3(0.5f), 0.0f, roughness);
   const glm::vec3 v(-std::sqrt(1.0f - cos_v * cos_v), cos_v, 0.0f);  // reflection towards +x
@@ -115,14 +120,7 @@ TEST(ProbeLobe, AtAGrazingViewTheLobeFollowsTheTruthWhereTheSplitSumBlursAcrossT
 // level's texel-wide bilinear blur and the trilinear blend's wider tails, and reads the slot's bright
 // sides; half a level finer errs less at every view, roughness and sample count.
 TEST(ProbeLobe, HalfALevelFinerReadsTheSlotNearerItsTruth) {
-  const int size = 32;
-  gi::ProbeCube cube = gi::make_probe_cube(size, gi::full_mip_count(size));
-  for (int f = 0; f < 6; ++f)
-    for (int y = 0; y < size; ++y)
-      for (int x = 0; x < size; ++x)
-        cube.levels[0][gi::cube_texel_index(f, x, y, size)] =
-            glm::vec3(slot_environment(gi::cube_texel_direction(f, x, y, size)));
-  gi::prefilter_ggx(cube, 128);
+  const gi::ProbeCube cube = slot_cube(32);
   for (float cos_v : {0.15f, 0.4f})
     for (float roughness : {0.1f, 0.2f, 0.3f}) {
       const engine::GltfBrdf m = engine::gltf_brdf(glm::vec3(0.5f), 0.0f, roughness);
@@ -157,19 +155,16 @@ TEST(ProbeLobe, HalfALevelFinerReadsTheSlotNearerItsTruth) {
 TEST(ProbeLobe, BeyondAnOpeningTheSamplesReadAFinerLevel) {
   const int size = 32;
   const glm::vec3 box_min(-5.0f), box_max(5.0f);
-  gi::ProbeCube cube = gi::make_probe_cube(size, gi::full_mip_count(size));
+  gi::ProbeCube cube = slot_cube(size);
   cube.distance.resize(cube.levels[0].size());
   for (int f = 0; f < 6; ++f)
     for (int y = 0; y < size; ++y)
       for (int x = 0; x < size; ++x) {
         const glm::vec3 d = gi::cube_texel_direction(f, x, y, size);
-        const float l = slot_environment(d);
         const glm::vec3 a = glm::abs(d);
         const float side = 5.0f / std::max({a.x, a.y, a.z});
-        cube.levels[0][gi::cube_texel_index(f, x, y, size)] = glm::vec3(l);
-        cube.distance[gi::cube_texel_index(f, x, y, size)] = l == 0.0f ? 50.0f : side;
+        cube.distance[gi::cube_texel_index(f, x, y, size)] = slot_environment(d) == 0.0f ? 50.0f : side;
       }
-  gi::prefilter_ggx(cube, 128);
   gi::ProbeCube closed = cube;  // the same light, every direction at the box's side
   for (int f = 0; f < 6; ++f)
     for (int y = 0; y < size; ++y)
