@@ -42,6 +42,9 @@ struct ProbeCube {
 /// texels' mean mix the wall's and the far room's distances, and the parallax search met
 /// phantom surfaces between them. docs/reflection_probes.md, "Distances finer than level 0".
 inline constexpr int kProbeDistanceScale = 2;
+/// The largest multiple of level 0's face size a file's distance cube may have (the reader's and
+/// the set check's bound; twice kProbeDistanceScale, so a later finer scale still reads).
+inline constexpr int kProbeMaxDistanceScale = 4;
 /// Face size of a cube's distances (ProbeCube::distance_size, or level 0's).
 inline int cube_distance_size(const ProbeCube& cube) { return cube.distance_size > 0 ? cube.distance_size : cube.size; }
 

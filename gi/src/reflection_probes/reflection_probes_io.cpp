@@ -50,7 +50,7 @@ std::string check_set(const ReflectionProbeSet& set) {
     const int ds = cube_distance_size(c);
     if (ds != cube_distance_size(set.cubes.front()))
       return "probe " + std::to_string(i) + " has distances of another size than the first probe's";
-    if (ds < 1 || ds > 4 * c.size || c.distance.size() != static_cast<std::size_t>(6 * ds * ds))
+    if (ds < 1 || ds > kProbeMaxDistanceScale * c.size || c.distance.size() != static_cast<std::size_t>(6 * ds * ds))
       return "probe " + std::to_string(i) + " has " + std::to_string(c.distance.size()) +
              " distances for a distance cube of face size " + std::to_string(ds) +
              " (level 0: " + std::to_string(c.size) + ")";
@@ -163,8 +163,8 @@ engine::Result<ReflectionProbesFile> read_reflection_probes_file(const fs::path&
     c.levels.resize(static_cast<std::size_t>(levels));
     for (std::vector<glm::vec3>& level : c.levels) complete = complete && r.get_array(level);
     std::uint32_t distance_size = 0;
-    complete = complete && r.get(distance_size) && distance_size <= 4u * static_cast<std::uint32_t>(c.size) &&
-               r.get_array(c.distance);
+    complete = complete && r.get(distance_size) &&
+               distance_size <= static_cast<std::uint32_t>(kProbeMaxDistanceScale * c.size) && r.get_array(c.distance);
     c.distance_size = static_cast<int>(distance_size);
   }
   const std::string location = "payload byte " + std::to_string(r.offset());
