@@ -41,7 +41,8 @@ uniform int u_probe_count;
 uniform int u_probe_has_distances;  // 1: u_probe_distances holds each probe's level-0 distances
 uniform int u_probe_levels;
 uniform float u_probe_max_roughness;
-uniform int u_probe_lobe_samples;  // 0: the split sum's single read; 1..PROBE_MAX_LOBE_SAMPLES: probe_lobe
+uniform int u_probe_lobe_samples;      // 0: the split sum's single read; 1..PROBE_MAX_LOBE_SAMPLES: probe_lobe
+uniform int u_probe_lobe_samples_max;  // the most a grazing view takes (probe_lobe_count)
 
 // gi's probe_cube.h: kProbeSearchSteps, kProbeSecantSteps, kProbeMinSearchScaleM.
 const int PROBE_SEARCH_STEPS = 12;
@@ -56,7 +57,18 @@ const float PROBE_OPENING_LEVEL_BIAS = 1.0;
 // gi's probe_cube.h: kProbeLobeLevelBias (levels every lobe sample reads finer than its width asks).
 const float PROBE_LOBE_LEVEL_BIAS = 0.5;
 // gi's probe_cube.h: kProbeMaxLobeSamples.
-const int PROBE_MAX_LOBE_SAMPLES = 16;
+const int PROBE_MAX_LOBE_SAMPLES = 64;
+
+// The lobe samples a view at cos theta_v = nv takes (gi's probe_lobe_sample_count): the base count
+// doubled while the count times nv stays below it, up to u_probe_lobe_samples_max.
+int probe_lobe_count(float nv) {
+  int base = clamp(u_probe_lobe_samples, 1, PROBE_MAX_LOBE_SAMPLES);
+  int cap = clamp(u_probe_lobe_samples_max, base, PROBE_MAX_LOBE_SAMPLES);
+  float c = clamp(nv, 0.0, 1.0);
+  int count = base;
+  while (count * 2 <= cap && float(count) * c < float(base)) count *= 2;
+  return count;
+}
 
 // Where the ray from p (clamped onto the box) along r leaves the box (gi's box_exit).
 vec3 probe_box_exit(vec3 p, vec3 r, ReflectionProbeBox probe) {
@@ -179,8 +191,7 @@ bool probe_beyond_side(vec3 d, ReflectionProbeBox probe, int i) {
 // corrected for parallax and read at the level prefiltered for the sample's share of the lobe
 // (its solid angle 1 / (count pdf), narrowed across the reflection's plane by v.h); weighted by F G2 / G1 and
 // normalized per channel (the caller multiplies by the directional albedo, as with the split sum).
-vec3 probe_lobe(Surface s, ReflectionProbeBox probe, int i) {
-  int count = clamp(u_probe_lobe_samples, 1, PROBE_MAX_LOBE_SAMPLES);
+vec3 probe_lobe(Surface s, ReflectionProbeBox probe, int i, int count) {
   float alpha = s.brdf.alpha, a2 = alpha * alpha;
   vec3 n = s.normal, v = s.view;
   float nv = max(dot(n, v), 1e-4);
@@ -267,6 +278,7 @@ bool probe_specular(Surface s, vec3 specular_albedo, out vec3 specular) {
   specular = vec3(0.0);
   vec3 r = reflect(-s.view, s.normal);
   float lod = sqrt(s.brdf.alpha) * float(max(u_probe_levels - 1, 0));
+  int count = u_probe_lobe_samples > 0 ? probe_lobe_count(dot(s.normal, s.view)) : 0;
   vec3 sum = vec3(0.0);
   float weight = 0.0;
   for (int i = 0; i < u_probe_count; ++i) {
@@ -275,7 +287,7 @@ bool probe_specular(Surface s, vec3 specular_albedo, out vec3 specular) {
     if (w <= 0.0) continue;
     w *= probe_visibility(s.position, probe, i);
     if (u_probe_lobe_samples > 0)
-      sum += w * probe_lobe(s, probe, i);
+      sum += w * probe_lobe(s, probe, i, count);
     else
       sum += w * textureLod(u_probe_cubes, vec4(probe_direction(s.position, r, probe, i), float(i)), lod).rgb;
     weight += w;

@@ -1,7 +1,8 @@
 // The forward pass's cost of the reflection probes' lookup (docs/reflection_probes.md, "The
 // lobe at the view"): the split sum's single read (lobe_samples 0, the yardstick, measured in
-// the same run) against filtered importance sampling with 4, 8 and 16 samples of the lobe,
-// each sample a parallax search and a trilinear read. On the demo level, baked at preview
+// the same run) against filtered importance sampling with 4, 8, 16 and 32 samples of the lobe
+// and the runtime's count (4 along the normal, doubling as the view grazes, up to 32), each
+// sample a parallax search and a trilinear read. On the demo level, baked at preview
 // (every method its plan asks for; its corridor floor of roughness 0.15 reads the probes),
 // from its camera 0 (the hub, looking through the doorway down the corridor) and from the
 // corridor's floor looking down it (most pixels read the probes). The renderer's
@@ -26,6 +27,7 @@
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <utility>
 
 #include "bench_gl.h"
 
@@ -42,10 +44,11 @@ namespace fs = std::filesystem;
 // gi::kProbeLobeSamples; the benchmark tries each count on the same bundle).
 class LobeOverride : public engine::IndirectLightProvider {
  public:
-  LobeOverride(gi::GISystem& gi, int samples) : gi_(gi), samples_(samples) {}
+  LobeOverride(gi::GISystem& gi, int samples, int samples_max) : gi_(gi), samples_(samples), max_(samples_max) {}
   const engine::IndirectLightFrame& frame() override {
     frame_ = gi_.frame();
     frame_.reflection_probe_lobe_samples = samples_;
+    frame_.reflection_probe_lobe_samples_max = max_;
     return frame_;
   }
   std::span<const engine::AtlasMesh> atlas_meshes() const override { return gi_.atlas_meshes(); }
@@ -53,7 +56,7 @@ class LobeOverride : public engine::IndirectLightProvider {
 
  private:
   gi::GISystem& gi_;
-  int samples_;
+  int samples_, max_;
   engine::IndirectLightFrame frame_;
 };
 
@@ -119,7 +122,7 @@ engine::Transform corridor_view(const engine::Transform& camera0) {
 }
 
 void time_forward(benchmark::State& state, Demo& d) {
-  LobeOverride provider(*d.gi, static_cast<int>(state.range(0)));
+  LobeOverride provider(*d.gi, static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
   d.renderer->set_indirect_light(&provider);
   d.renderer->render(d.scene.registry, d.camera);  // warm-up: uploads, shader variants
   for (auto _ : state) {
@@ -128,21 +131,26 @@ void time_forward(benchmark::State& state, Demo& d) {
   }
   d.renderer->set_indirect_light(nullptr);
   state.counters["lobe_samples"] = static_cast<double>(state.range(0));
+  state.counters["lobe_samples_max"] = static_cast<double>(state.range(1));
 }
 
 // Camera 0's own placement.
 engine::Transform camera0_view(const engine::Transform& camera0) { return camera0; }
 
-// The forward pass from one view, the lobe samples state.range(0).
+// The forward pass from one view, the lobe samples state.range(0) at views along the normal, up to
+// state.range(1) at grazing views (gi::probe_lobe_sample_count; at most range(0): a fixed count).
 void BM_ForwardPass(benchmark::State& state, engine::Transform (*view)(const engine::Transform&)) {
   Demo& d = demo();
   place_camera(d, view(d.camera0));
   time_forward(state, d);
 }
 
-// Interleaved yardstick: the split sum (0) first and last.
+// Interleaved yardstick: the split sum (0) first and last. 4 / 32: the runtime's count (4 along
+// the normal, up to 32 at grazing views); the others fixed counts.
 void lobe_sample_counts(benchmark::internal::Benchmark* b) {
-  b->Arg(0)->Arg(4)->Arg(8)->Arg(16)->Arg(0)->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(2.0);
+  const std::pair<int, int> counts[] = {{0, 0}, {4, 4}, {4, 32}, {8, 8}, {16, 16}, {32, 32}, {0, 0}};
+  for (const auto& [samples, most] : counts) b->Args({samples, most});
+  b->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(2.0);
 }
 
 BENCHMARK_CAPTURE(BM_ForwardPass, DemoCamera0, camera0_view)->Apply(lobe_sample_counts);

@@ -81,7 +81,8 @@ std::vector<T> cube_level(int s, const F& f) {
 struct ProbeFrameSettings {
   float atlas_irradiance = 0.0f;  ///< The atlas's one texel (W/m^2, grey).
   float max_roughness = 0.3f;
-  int lobe_samples = 0;  ///< 0: the split sum's single read.
+  int lobe_samples = 0;      ///< 0: the split sum's single read.
+  int lobe_samples_max = 0;  ///< The most a grazing view takes; lobe_samples or less: a fixed count.
 };
 
 /// One probe of a ProbeProvider: where it was captured, its levels (face size size >> m each) and
@@ -139,6 +140,7 @@ class ProbeProvider : public engine::IndirectLightProvider {
     frame_.reflection_probe_levels = count;
     frame_.reflection_probe_max_roughness = s.max_roughness;
     frame_.reflection_probe_lobe_samples = s.lobe_samples;
+    frame_.reflection_probe_lobe_samples_max = s.lobe_samples_max;
   }
   const engine::IndirectLightFrame& frame() override { return frame_; }
   const char* label() const override { return "test room probe"; }

@@ -180,10 +180,13 @@ struct IndirectLightFrame {
   ///                            i's distance (m) from its centre to the surface it captured per
   ///                            direction: the parallax then follows the captured surfaces (a
   ///                            distance-impostor search along the reflected ray), not the box
-  ///   reflection_probe_lobe_samples  0: the split sum's one read along the reflection; 1..16:
-  ///                            that many GGX samples of the lobe at the view, each read at the
-  ///                            lod of its pdf (filtered importance sampling; follows the lobe's
-  ///                            stretch at grazing views)
+  ///   reflection_probe_lobe_samples  0: the split sum's one read along the reflection; 1..64:
+  ///                            that many GGX samples of the lobe at a view along the normal, each
+  ///                            read at the lod of its pdf (filtered importance sampling; follows
+  ///                            the lobe's stretch at grazing views)
+  ///   reflection_probe_lobe_samples_max  the most samples a grazing view takes (up to 64): the
+  ///                            count doubles while it times cos theta_v stays below
+  ///                            reflection_probe_lobe_samples; no more than that: a fixed count
   /// Empty handles / 0 counts: none.
   TextureHandle reflection_probe_cubes;
   TextureHandle reflection_probe_distances;
@@ -192,6 +195,7 @@ struct IndirectLightFrame {
   int reflection_probe_levels = 0;
   float reflection_probe_max_roughness = 0.0f;
   int reflection_probe_lobe_samples = 0;
+  int reflection_probe_lobe_samples_max = 0;
 
   /// Optional sky occlusion of a dynamic mesh entity (the renderer draws the sky on dynamic
   /// meshes as ambient light, RenderSettings::sky_radiance): the share (0..1) of the sky's unoccluded

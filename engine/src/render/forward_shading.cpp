@@ -131,6 +131,7 @@ void ForwardRenderer::set_forward_frame_uniforms(const ForwardUniforms& u, const
   glUniform1i(u.probe_has_distances, in.probes && in.indirect->reflection_probe_distances ? 1 : 0);
   glUniform1f(u.probe_max_roughness, in.probes ? in.indirect->reflection_probe_max_roughness : 0.0f);
   glUniform1i(u.probe_lobe_samples, in.probes ? in.indirect->reflection_probe_lobe_samples : 0);
+  glUniform1i(u.probe_lobe_samples_max, in.probes ? in.indirect->reflection_probe_lobe_samples_max : 0);
   glUniformMatrix4fv(u.view_proj, 1, GL_FALSE, glm::value_ptr(in.view->view_proj));
   glUniform3fv(u.camera_position, 1, glm::value_ptr(in.view->position));
   glUniform1f(u.ambient_radiance, settings_.stand_in_ambient);

@@ -40,6 +40,7 @@ ForwardUniforms ForwardUniforms::locate(const UniformLookup& at) {
           .probe_max_roughness = at.location("u_probe_max_roughness"),
           .probe_has_distances = at.location("u_probe_has_distances"),
           .probe_lobe_samples = at.location("u_probe_lobe_samples"),
+          .probe_lobe_samples_max = at.location("u_probe_lobe_samples_max"),
           .sky_radiance = at.location("u_sky_radiance"),
           .sky_gradient = at.location("u_sky_gradient"),
           .sky_visibility_pos = at.location("u_sky_visibility_pos"),

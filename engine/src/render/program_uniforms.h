@@ -36,8 +36,8 @@ struct ForwardUniforms {
   int indirect_mode = -1, ambient_radiance = -1, split_x = -1, use_glossy = -1, double_sided = -1;
   int specular_factor = -1, specular_color_factor = -1;
   int directional_bins = -1, directional_elements = -1, directional_tangent_frame = -1;
-  int probe_count = -1, probe_levels = -1, probe_max_roughness = -1, probe_has_distances = -1,
-      probe_lobe_samples = -1;  ///< reflection_probes.glsl
+  int probe_count = -1, probe_levels = -1, probe_max_roughness = -1, probe_has_distances = -1, probe_lobe_samples = -1,
+      probe_lobe_samples_max = -1;  ///< reflection_probes.glsl
   int sky_radiance = -1, sky_gradient = -1, sky_visibility_pos = -1, sky_visibility_neg = -1;
   int baked_direct = -1;
   int normal_scale = -1;  ///< float: normalTexture.scale

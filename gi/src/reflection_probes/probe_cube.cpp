@@ -364,6 +364,15 @@ glm::vec3 box_projected_direction(const glm::vec3& p, const glm::vec3& r, const 
   return len > 1e-6f ? d / len : glm::normalize(r);
 }
 
+int probe_lobe_sample_count(int samples, int most, float nv) {
+  const int base = std::clamp(samples, 1, kProbeMaxLobeSamples);
+  const int cap = std::clamp(most, base, kProbeMaxLobeSamples);
+  const float c = std::clamp(nv, 0.0f, 1.0f);
+  int count = base;
+  while (count * 2 <= cap && static_cast<float>(count) * c < static_cast<float>(base)) count *= 2;
+  return count;
+}
+
 glm::vec3 probe_lobe_radiance(const ProbeCube& cube, const engine::GltfBrdf& brdf, const glm::vec3& p,
                               const glm::vec3& n, const glm::vec3& v, int samples, const glm::vec3& centre,
                               const glm::vec3& box_min, const glm::vec3& box_max, bool box_only, const ProbeCube* chain,

@@ -175,10 +175,22 @@ inline constexpr float kProbeSeesSlackM = 0.05f;
 float probe_visibility_weight(const ProbeCube& cube, const glm::vec3& centre, const glm::vec3& p);
 
 /// The most lobe samples probe_lobe_radiance takes (the shader's PROBE_MAX_LOBE_SAMPLES).
-inline constexpr int kProbeMaxLobeSamples = 16;
-/// The lobe samples the runtime asks the forward pass for (IndirectLightFrame::
-/// reflection_probe_lobe_samples; 0: the split sum's single read; docs/reflection_probes.md).
+inline constexpr int kProbeMaxLobeSamples = 64;
+/// The lobe samples the runtime asks the forward pass for at a view along the normal
+/// (IndirectLightFrame::reflection_probe_lobe_samples; 0: the split sum's single read;
+/// docs/reflection_probes.md).
 inline constexpr int kProbeLobeSamples = 4;
+/// The most lobe samples the runtime lets a grazing view take (IndirectLightFrame::
+/// reflection_probe_lobe_samples_max; probe_lobe_sample_count; docs/reflection_probes.md, "A
+/// sample count that grows with the lobe's stretch").
+inline constexpr int kProbeGrazingLobeSamples = 32;
+
+/// The lobe samples a view at cos theta_v = `nv` takes: `samples` doubled while the count times
+/// nv stays below `samples` (the lobe's extent along the reflection's plane grows about as
+/// 1 / n.v), up to `most` (no more than kProbeMaxLobeSamples); a power-of-two multiple of `samples`,
+/// so each count is a whole Hammersley set when `samples` is. `most` <= `samples`: `samples`
+/// at every view. The shader's probe_lobe_count.
+int probe_lobe_sample_count(int samples, int most, float nv);
 
 /// The specular lobe at the actual view read from a prefiltered probe by filtered importance
 /// sampling (Colbert and Krivanek 2007, "GPU-based importance sampling"): `samples` (1 ..

@@ -98,6 +98,32 @@ std::vector<KnobSpec> placement_knobs() {
   };
 }
 
+// The lookup's lobe: its form and its sample counts.
+std::vector<KnobSpec> lobe_knobs() {
+  return {
+      {.name = "lobe",
+       .description = "the lookup's lobe: the split sum's (one read along the reflection, isotropic, n = v) or "
+                      "filtered importance sampling of the lobe at the view (probe_lobe_radiance)",
+       .kind = KnobKind::Choice,
+       .default_grid = {"fis"},
+       .choices = {"split_sum", "fis", "fis_chain"}},
+      {.name = "lobe_samples",
+       .description = "GGX samples per probe of the filtered-importance-sampled lookup (lobe=fis)",
+       .kind = KnobKind::Integer,
+       .default_grid = {format_number(kProbeLobeSamples)},
+       .min_value = 1,
+       .max_value = kProbeMaxLobeSamples},
+      {.name = "lobe_samples_max",
+       .description = "the most lobe samples a grazing view takes: lobe_samples doubled while their count times "
+                      "cos theta_v stays below lobe_samples (probe_lobe_sample_count; kProbeGrazingLobeSamples, the "
+                      "default; lobe_samples or less: the same count at every view)",
+       .kind = KnobKind::Integer,
+       .default_grid = {format_number(kProbeGrazingLobeSamples)},
+       .min_value = 1,
+       .max_value = kProbeMaxLobeSamples},
+  };
+}
+
 // Long because it is one table, one entry per knob with its grid and range, read as a list.
 std::vector<KnobSpec> reflection_probes_knobs() {
   std::vector<KnobSpec> knobs = {
@@ -152,18 +178,9 @@ std::vector<KnobSpec> reflection_probes_knobs() {
        .default_grid = {format_number(kProbeLobeLevelBias)},
        .min_value = 0.0,
        .max_value = 8},
-      {.name = "lobe",
-       .description = "the lookup's lobe: the split sum's (one read along the reflection, isotropic, n = v) or "
-                      "filtered importance sampling of the lobe at the view (probe_lobe_radiance)",
-       .kind = KnobKind::Choice,
-       .default_grid = {"fis"},
-       .choices = {"split_sum", "fis", "fis_chain"}},
-      {.name = "lobe_samples",
-       .description = "GGX samples per probe of the filtered-importance-sampled lookup (lobe=fis)",
-       .kind = KnobKind::Integer,
-       .default_grid = {"4"},
-       .min_value = 1,
-       .max_value = kProbeMaxLobeSamples},
+  };
+  for (KnobSpec& k : lobe_knobs()) knobs.push_back(std::move(k));
+  const std::vector<KnobSpec> rest = {
       {.name = "segments",
        .description = "corridors cut into segments about as long as they are wide, a probe each (on: "
                       "ProbePlacementSettings::corridor_aspect 2; off: one probe per box, the default)",
@@ -190,6 +207,7 @@ std::vector<KnobSpec> reflection_probes_knobs() {
        .default_grid = {"runtime"},
        .choices = {"runtime", "trace", "oracle_level0", "oracle", "level0", "exact_parallax", "level0_exact_dir"}},
   };
+  knobs.insert(knobs.end(), rest.begin(), rest.end());
   for (KnobSpec& k : placement_knobs()) knobs.push_back(std::move(k));
   for (KnobSpec& k : scene_knobs()) knobs.push_back(std::move(k));
   return knobs;
@@ -534,7 +552,7 @@ engine::Status dump_directions(const BakedProbes& b, const BakeInput& input, con
 // diagnosis's estimate.
 engine::Status diagnose(const RunContext& ctx, const BakedProbes& baked, const BakeInput& input, const GlossyTexels& g,
                         const std::vector<std::uint8_t>& covered, bool box_only, float box_side, bool rim,
-                        int lobe_samples, std::vector<glm::vec3>& values) {
+                        int lobe_samples, int lobe_max, std::vector<glm::vec3>& values) {
   const Estimate estimate = estimate_of(ctx.knobs.text("estimate"));
   if (estimate == Estimate::Runtime) return {};
   auto capturer = ProbeCapturer::make(input, baked.source(), baked.settings);
@@ -544,8 +562,9 @@ engine::Status diagnose(const RunContext& ctx, const BakedProbes& baked, const B
   pool.parallel_for(tex.valid.size(), [&](std::size_t t) {
     if (!covered[t]) return;
     const glm::vec3 v = glm::normalize(g.eye - tex.position[t]);
-    values[t] = diagnosis_estimate(estimate, baked, *capturer, g.brdf[t], tex.position[t], tex.normal[t], v, t,
-                                   box_only, box_side, rim, lobe_samples);
+    values[t] = diagnosis_estimate(
+        estimate, baked, *capturer, g.brdf[t], tex.position[t], tex.normal[t], v, t, box_only, box_side, rim,
+        lobe_samples > 0 ? probe_lobe_sample_count(lobe_samples, lobe_max, glm::dot(tex.normal[t], v)) : 0);
   });
   return {};
 }
@@ -612,6 +631,7 @@ engine::Result<MethodOutput> run_reflection_probes(const RunContext& ctx) {
   const bool rim = ctx.knobs.text("rim") == "on";
   const int lobe_samples =
       ctx.knobs.text("lobe") != "split_sum" ? static_cast<int>(ctx.knobs.integer("lobe_samples")) : 0;
+  const auto lobe_max = static_cast<int>(ctx.knobs.integer("lobe_samples_max"));
   const std::vector<ProbeCube> chains = lookup_chains(ctx, *set);
   const auto opening_bias = static_cast<float>(ctx.knobs.real("opening_bias"));
   const auto level_bias = static_cast<float>(ctx.knobs.real("level_bias"));
@@ -619,7 +639,9 @@ engine::Result<MethodOutput> run_reflection_probes(const RunContext& ctx) {
     if (!g->glossy[t]) continue;
     float depth = 0.0f;
     const glm::vec3 v = glm::normalize(g->eye - tex.position[t]);
-    if (!probe_specular(*set, g->brdf[t], tex.position[t], tex.normal[t], v, box_only, box_side, rim, lobe_samples,
+    const int samples =
+        lobe_samples > 0 ? probe_lobe_sample_count(lobe_samples, lobe_max, glm::dot(tex.normal[t], v)) : 0;
+    if (!probe_specular(*set, g->brdf[t], tex.position[t], tex.normal[t], v, box_only, box_side, rim, samples,
                         chains.empty() ? nullptr : &chains, opening_bias, level_bias, baked->visibility, values[t],
                         depth)) {
       ++uncovered;
@@ -628,7 +650,8 @@ engine::Result<MethodOutput> run_reflection_probes(const RunContext& ctx) {
     covered[t] = 1;
     (depth < border ? edge : inner)[t] = 1;
   }
-  if (auto diagnosed = diagnose(ctx, *baked, input, *g, covered, box_only, box_side, rim, lobe_samples, values);
+  if (auto diagnosed =
+          diagnose(ctx, *baked, input, *g, covered, box_only, box_side, rim, lobe_samples, lobe_max, values);
       !diagnosed)
     return diagnosed.error();
   dump_texels(ctx, tex, values, inner, covered);

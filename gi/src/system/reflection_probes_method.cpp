@@ -27,6 +27,7 @@ class ReflectionProbesMethod final : public MethodRuntime {
     f.reflection_probe_levels = levels_;
     f.reflection_probe_max_roughness = set_.settings.max_roughness;
     f.reflection_probe_lobe_samples = kProbeLobeSamples;
+    f.reflection_probe_lobe_samples_max = kProbeGrazingLobeSamples;
   }
   std::string label() const override { return "reflection probes"; }
 

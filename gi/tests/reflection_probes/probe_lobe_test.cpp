@@ -32,13 +32,39 @@ TEST(ProbeLobe, AConstantCubeReadsAsThatConstantAtEveryViewAndSampleCount) {
                                         engine::gltf_brdf(glm::vec3(0.9f, 0.6f, 0.2f), 1.0f, 0.3f)};
   for (const engine::GltfBrdf& m : materials)
     for (float cos_v : {1.0f, 0.6f, 0.15f, 0.02f})
-      for (int samples : {1, 4, 8, 16}) {
+      for (int samples : {1, 4, 8, 16, 32, 64}) {
         const glm::vec3 v(std::sqrt(1.0f - cos_v * cos_v), cos_v, 0.0f);
         const glm::vec3 got =
             gi::probe_lobe_radiance(cube, m, kCentre, kUp, v, samples, kCentre, kFarMin, kFarMax, true);
         for (int c = 0; c < 3; ++c)
           EXPECT_NEAR(got[c], value[c], 1e-5f * value[c]) << "cos_v " << cos_v << ", " << samples << " samples";
       }
+}
+
+// The count grows with the lobe's stretch: the base count at views along the normal, doubled
+// each time cos theta_v halves (the count times n.v reaches the base count), up to the cap; a
+// cap at or below the base count keeps it fixed; counts stay within 1..kProbeMaxLobeSamples.
+TEST(ProbeLobe, TheSampleCountDoublesAsTheViewGrazesUpToItsCap) {
+  EXPECT_EQ(gi::probe_lobe_sample_count(4, 32, 1.0f), 4);
+  EXPECT_EQ(gi::probe_lobe_sample_count(4, 32, 0.5f), 8);
+  EXPECT_EQ(gi::probe_lobe_sample_count(4, 32, 0.49f), 16);
+  EXPECT_EQ(gi::probe_lobe_sample_count(4, 32, 0.25f), 16);
+  EXPECT_EQ(gi::probe_lobe_sample_count(4, 32, 0.15f), 32);
+  EXPECT_EQ(gi::probe_lobe_sample_count(4, 32, 0.01f), 32);
+  EXPECT_EQ(gi::probe_lobe_sample_count(4, 24, 0.01f), 16);  // powers of two of the base, within the cap
+  EXPECT_EQ(gi::probe_lobe_sample_count(4, 4, 0.01f), 4);
+  EXPECT_EQ(gi::probe_lobe_sample_count(8, 0, 0.01f), 8);
+  EXPECT_EQ(gi::probe_lobe_sample_count(0, 0, 1.0f), 1);
+  EXPECT_EQ(gi::probe_lobe_sample_count(1000, 1000, 0.0f), gi::kProbeMaxLobeSamples);
+  EXPECT_EQ(gi::probe_lobe_sample_count(4, 1000, -1.0f), gi::kProbeMaxLobeSamples);
+  // Never fewer samples at a more grazing view.
+  int previous = 0;
+  for (float nv = 1.0f; nv >= 0.0f; nv -= 0.01f) {
+    const int count = gi::probe_lobe_sample_count(4, gi::kProbeGrazingLobeSamples, nv);
+    EXPECT_GE(count, previous) << "n.v " << nv;
+    EXPECT_GE(static_cast<float>(count) * nv, nv > 4.0f / gi::kProbeGrazingLobeSamples ? 4.0f : 0.0f) << nv;
+    previous = count;
+  }
 }
 
 // The environment at infinity seen from a floor: 1 everywhere but a dark slot (the demo

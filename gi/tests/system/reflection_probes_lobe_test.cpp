@@ -20,6 +20,8 @@ namespace {
 using namespace renderer_test;
 using namespace probe_test;
 
+const glm::vec3 kUp(0.0f, 1.0f, 0.0f);
+
 // What the probe sees along d: the hall [-2, 5] x [0, 3] x [-2, 2]; the far wall bright with a
 // dark 1 m wide opening in its middle, the other sides of different greys.
 float hall_radiance(const SideHit& h, const glm::vec3& d) {
@@ -49,6 +51,48 @@ gi::ProbeCube hall_cube(int size) {
   return cube;
 }
 
+// Calls f(px, py, p, v, albedo) at every floor pixel of `cam` well inside the room (0.1 m from
+// its sides), in front of the camera and within 10 m of it: the floor point p, the view v and the
+// specular lobe's directional albedo there (red channel) for `brdf`.
+template <typename F>
+void for_each_floor_pixel(const TestCamera& cam, const engine::GltfBrdf& brdf, F&& f) {
+  for (int py = 0; py < cam.size; ++py)
+    for (int px = 0; px < cam.size; ++px) {
+      const glm::vec3 p = cam.plane_point(px, py);
+      if (!(p.y == p.y) || std::abs(p.x) > 1.9f || std::abs(p.z) > 1.9f || glm::dot(p - cam.eye, p - cam.eye) > 100.0f)
+        continue;
+      if (glm::dot(p - cam.eye, cam.target - cam.eye) <= 0.0f) continue;
+      const glm::vec3 v = glm::normalize(cam.eye - p);
+      f(px, py, p, v, engine::gltf_directional_albedo(brdf, v.y).specular.x);
+    }
+}
+
+// The shader against a CPU twin whose branch (`with` / `without` it) decides some pixels: all
+// pixels, those within 3% (+ 0.002) of the twin with it, those where the two twins differ by
+// more than 10% (decided), and of those the ones within 5% (+ 0.002) of it and nearer it.
+struct BranchCounts {
+  int pixels = 0, close = 0, decided = 0, decided_close = 0, decided_nearer = 0;
+  void add(float gpu, float with, float without) {
+    ++pixels;
+    if (std::abs(gpu - with) <= 0.03f * with + 0.002f) ++close;
+    if (std::abs(with - without) <= 0.1f * std::max(with, without)) return;
+    ++decided;
+    if (std::abs(gpu - with) <= 0.05f * with + 0.002f) ++decided_close;
+    if (std::abs(gpu - with) < std::abs(gpu - without)) ++decided_nearer;
+  }
+  // The branch decides a tenth of the floor or more; there the shader follows it at 90% of the
+  // pixels; everywhere it is the twin within 3% at 95%.
+  void expect(const char* branch) const {
+    std::printf("%d floor pixels (%d within 3%% of the twin); %s decides %d: %d within 5%%, %d nearer\n", pixels, close,
+                branch, decided, decided_close, decided_nearer);
+    ASSERT_GT(pixels, 1000);
+    EXPECT_GE(decided, pixels / 10);
+    EXPECT_GE(decided_close, decided * 9 / 10);
+    EXPECT_GE(decided_nearer, decided * 9 / 10);
+    EXPECT_GE(close, pixels * 95 / 100);
+  }
+};
+
 // Every floor pixel well inside the room (0.1 m from its sides), the camera low over the floor
 // (cos(theta_v) 0.1-0.45): the shader's lobe lookup at 8 samples is its CPU twin's within 3%
 // (+ 0.002 absolute; the cube is stored as half floats on the GPU, the GPU filters seamlessly
@@ -76,29 +120,72 @@ TEST(ReflectionProbesLobe, TheShadersLobeLookupIsItsCpuTwinsAtGrazingViews) {
   const engine::GltfBrdf brdf = s.brdf();
   int pixels = 0, close = 0, differs = 0;
   double sum_gpu = 0.0, sum_cpu = 0.0;
-  for (int py = 0; py < cam.size; ++py)
-    for (int px = 0; px < cam.size; ++px) {
-      const glm::vec3 p = cam.plane_point(px, py);
-      if (!(p.y == p.y) || std::abs(p.x) > 1.9f || std::abs(p.z) > 1.9f || glm::dot(p - cam.eye, p - cam.eye) > 100.0f)
-        continue;
-      if (glm::dot(cam.plane_point(px, py) - cam.eye, cam.target - cam.eye) <= 0.0f) continue;
-      const glm::vec3 v = glm::normalize(cam.eye - p), up(0.0f, 1.0f, 0.0f);
-      const float albedo = engine::gltf_directional_albedo(brdf, v.y).specular.x;
-      const float cpu =
-          gi::probe_lobe_radiance(cube, brdf, p, up, v, samples, kProbe, kRoomMin, kRoomMax, false).x * albedo;
-      const float gpu = red(lobe, px, py);
-      ++pixels;
-      sum_gpu += static_cast<double>(gpu);
-      sum_cpu += static_cast<double>(cpu);
-      if (std::abs(gpu - cpu) <= 0.03f * cpu + 0.002f) ++close;
-      if (std::abs(red(split, px, py) - gpu) > 0.1f * gpu) ++differs;
-    }
+  for_each_floor_pixel(cam, brdf, [&](int px, int py, const glm::vec3& p, const glm::vec3& v, float albedo) {
+    const float cpu =
+        gi::probe_lobe_radiance(cube, brdf, p, kUp, v, samples, kProbe, kRoomMin, kRoomMax, false).x * albedo;
+    const float gpu = red(lobe, px, py);
+    ++pixels;
+    sum_gpu += static_cast<double>(gpu);
+    sum_cpu += static_cast<double>(cpu);
+    if (std::abs(gpu - cpu) <= 0.03f * cpu + 0.002f) ++close;
+    if (std::abs(red(split, px, py) - gpu) > 0.1f * gpu) ++differs;
+  });
   std::printf("%d floor pixels: %d within 3%% of the twin, mean GPU %.4f CPU %.4f, %d differ from the split sum\n",
               pixels, close, sum_gpu / pixels, sum_cpu / pixels, differs);
   ASSERT_GT(pixels, 1000);
   EXPECT_GE(close, pixels * 95 / 100);
   EXPECT_NEAR(sum_gpu, sum_cpu, 0.01 * sum_cpu);
   EXPECT_GE(differs, pixels / 5);
+  EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
+}
+
+// The runtime's count, which grows at grazing views (4 samples along the normal, up to 32,
+// gi's probe_lobe_sample_count, the shader's probe_lobe_count), on the same floor: the shader is
+// its CPU twin at each pixel's own count within 3% (+ 0.002) at 95% of the pixels and within 1% on
+// the mean; the floor's pixels take 16 and 32 samples, each at a tenth of them or more; and the
+// twin at 4 samples differs from the shader by more than 5% at a tenth of them or more (the
+// count is the one the view asks for, not the base count).
+TEST(ReflectionProbesLobe, TheShadersGrazingSampleCountIsItsCpuTwins) {
+  engine::GpuContext ctx = headless_context();
+  const float roughness = 0.2f;
+  GlossyFloor s(roughness, TestCamera{{-1.9f, 0.6f, 0.0f}, {1.5f, 0.0f, 0.0f}, 1.0f, 81});
+  const TestCamera& cam = s.cam;
+  auto r = make_renderer(s.assets, cam.size, 0.0f);
+  ASSERT_NE(r, nullptr);
+  const gi::ProbeCube cube = hall_cube(32);
+  ProbeProvider probe(cube.size, cube.levels, &cube.distance,
+                      {.lobe_samples = gi::kProbeLobeSamples, .lobe_samples_max = gi::kProbeGrazingLobeSamples});
+  r->set_indirect_light(&probe);
+  r->render(s.reg, s.camera);
+  const engine::ImageRgbaF img = r->read_hdr();
+  r->set_indirect_light(nullptr);
+  const engine::GltfBrdf brdf = s.brdf();
+  int pixels = 0, close = 0, base_differs = 0, at16 = 0, at32 = 0;
+  double sum_gpu = 0.0, sum_cpu = 0.0;
+  for_each_floor_pixel(cam, brdf, [&](int px, int py, const glm::vec3& p, const glm::vec3& v, float albedo) {
+    const int count = gi::probe_lobe_sample_count(gi::kProbeLobeSamples, gi::kProbeGrazingLobeSamples, v.y);
+    const auto twin = [&](int samples) {
+      return gi::probe_lobe_radiance(cube, brdf, p, kUp, v, samples, kProbe, kRoomMin, kRoomMax, false).x * albedo;
+    };
+    const float cpu = twin(count), gpu = red(img, px, py);
+    ++pixels;
+    at16 += count == 16 ? 1 : 0;
+    at32 += count == 32 ? 1 : 0;
+    sum_gpu += static_cast<double>(gpu);
+    sum_cpu += static_cast<double>(cpu);
+    if (std::abs(gpu - cpu) <= 0.03f * cpu + 0.002f) ++close;
+    if (std::abs(twin(gi::kProbeLobeSamples) - gpu) > 0.05f * gpu) ++base_differs;
+  });
+  std::printf(
+      "%d floor pixels (%d at 16 samples, %d at 32): %d within 3%% of the twin, mean GPU %.4f CPU %.4f, "
+      "%d differ from 4 samples\n",
+      pixels, at16, at32, close, sum_gpu / pixels, sum_cpu / pixels, base_differs);
+  ASSERT_GT(pixels, 1000);
+  EXPECT_GE(at16, pixels / 10);
+  EXPECT_GE(at32, pixels / 10);
+  EXPECT_GE(close, pixels * 95 / 100);
+  EXPECT_NEAR(sum_gpu, sum_cpu, 0.01 * sum_cpu);
+  EXPECT_GE(base_differs, pixels / 10);
   EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
 }
 
@@ -149,36 +236,17 @@ TEST(ReflectionProbesLobe, TheShadersRimTestIsItsCpuTwinsAtASlattedSide) {
   const engine::ImageRgbaF img = r->read_hdr();
   r->set_indirect_light(nullptr);
   const engine::GltfBrdf brdf = s.brdf();
-  int pixels = 0, close = 0, decided = 0, decided_close = 0, decided_nearer = 0;
-  for (int py = 0; py < cam.size; ++py)
-    for (int px = 0; px < cam.size; ++px) {
-      const glm::vec3 p = cam.plane_point(px, py);
-      if (!(p.y == p.y) || std::abs(p.x) > 1.9f || std::abs(p.z) > 1.9f || glm::dot(p - cam.eye, p - cam.eye) > 100.0f)
-        continue;
-      if (glm::dot(p - cam.eye, cam.target - cam.eye) <= 0.0f) continue;
-      const glm::vec3 v = glm::normalize(cam.eye - p), up(0.0f, 1.0f, 0.0f);
-      const float albedo = engine::gltf_directional_albedo(brdf, v.y).specular.x;
-      const auto twin = [&](bool rim) {
-        return gi::probe_lobe_radiance(cube, brdf, p, up, v, samples, kProbe, kRoomMin, kRoomMax, false, nullptr,
-                                       gi::kProbeBoxSideTolerance, rim)
-                   .x *
-               albedo;
-      };
-      const float with_rim = twin(true), without = twin(false), gpu = red(img, px, py);
-      ++pixels;
-      if (std::abs(gpu - with_rim) <= 0.03f * with_rim + 0.002f) ++close;
-      if (std::abs(with_rim - without) <= 0.1f * std::max(with_rim, without)) continue;
-      ++decided;
-      if (std::abs(gpu - with_rim) <= 0.05f * with_rim + 0.002f) ++decided_close;
-      if (std::abs(gpu - with_rim) < std::abs(gpu - without)) ++decided_nearer;
-    }
-  std::printf("%d floor pixels (%d within 3%% of the twin); the rim's test decides %d: %d within 5%%, %d nearer\n",
-              pixels, close, decided, decided_close, decided_nearer);
-  ASSERT_GT(pixels, 1000);
-  EXPECT_GE(decided, pixels / 10);
-  EXPECT_GE(decided_close, decided * 9 / 10);
-  EXPECT_GE(decided_nearer, decided * 9 / 10);
-  EXPECT_GE(close, pixels * 95 / 100);
+  BranchCounts counts;
+  for_each_floor_pixel(cam, brdf, [&](int px, int py, const glm::vec3& p, const glm::vec3& v, float albedo) {
+    const auto twin = [&](bool rim) {
+      return gi::probe_lobe_radiance(cube, brdf, p, kUp, v, samples, kProbe, kRoomMin, kRoomMax, false, nullptr,
+                                     gi::kProbeBoxSideTolerance, rim)
+                 .x *
+             albedo;
+    };
+    counts.add(red(img, px, py), twin(true), twin(false));
+  });
+  counts.expect("the rim's test");
   EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
 }
 
@@ -227,36 +295,16 @@ TEST(ReflectionProbesLobe, TheShadersVisibilityWeightedBlendIsItsCpuTwins) {
   const engine::ImageRgbaF img = r->read_hdr();
   r->set_indirect_light(nullptr);
   const engine::GltfBrdf brdf = s.brdf();
-  int pixels = 0, close = 0, decided = 0, decided_close = 0, decided_nearer = 0;
-  for (int py = 0; py < cam.size; ++py)
-    for (int px = 0; px < cam.size; ++px) {
-      const glm::vec3 p = cam.plane_point(px, py);
-      if (!(p.y == p.y) || std::abs(p.x) > 1.9f || std::abs(p.z) > 1.9f || glm::dot(p - cam.eye, p - cam.eye) > 100.0f)
-        continue;
-      if (glm::dot(p - cam.eye, cam.target - cam.eye) <= 0.0f) continue;
-      const glm::vec3 v = glm::normalize(cam.eye - p), up(0.0f, 1.0f, 0.0f);
-      const float albedo = engine::gltf_directional_albedo(brdf, v.y).specular.x;
-      const auto twin = [&](bool visibility) {
-        glm::vec3 out(0.0f);
-        EXPECT_TRUE(gi::blended_probe_lobe(probes, cubes, brdf, p, up, v, samples, out, visibility));
-        return out.x * albedo;
-      };
-      const float weighted = twin(true), by_position = twin(false), gpu = red(img, px, py);
-      ++pixels;
-      if (std::abs(gpu - weighted) <= 0.03f * weighted + 0.002f) ++close;
-      if (std::abs(weighted - by_position) <= 0.1f * std::max(weighted, by_position)) continue;
-      ++decided;
-      if (std::abs(gpu - weighted) <= 0.05f * weighted + 0.002f) ++decided_close;
-      if (std::abs(gpu - weighted) < std::abs(gpu - by_position)) ++decided_nearer;
-    }
-  std::printf(
-      "%d floor pixels (%d within 3%% of the twin); the visibility weight decides %d: %d within 5%%, %d nearer\n",
-      pixels, close, decided, decided_close, decided_nearer);
-  ASSERT_GT(pixels, 1000);
-  EXPECT_GE(decided, pixels / 10);
-  EXPECT_GE(decided_close, decided * 9 / 10);
-  EXPECT_GE(decided_nearer, decided * 9 / 10);
-  EXPECT_GE(close, pixels * 95 / 100);
+  BranchCounts counts;
+  for_each_floor_pixel(cam, brdf, [&](int px, int py, const glm::vec3& p, const glm::vec3& v, float albedo) {
+    const auto twin = [&](bool visibility) {
+      glm::vec3 out(0.0f);
+      EXPECT_TRUE(gi::blended_probe_lobe(probes, cubes, brdf, p, kUp, v, samples, out, visibility));
+      return out.x * albedo;
+    };
+    counts.add(red(img, px, py), twin(true), twin(false));
+  });
+  counts.expect("the visibility weight");
   EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
 }
 
