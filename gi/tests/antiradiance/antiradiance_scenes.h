@@ -28,7 +28,7 @@ inline std::uint32_t instance_named(const gi::BakeInput& in, const std::string& 
 
 /// assets/corridor.gltf as bake input with the door at `degrees` (authored: 50).
 inline gi::BakeInput corridor(float degrees) {
-  auto asset = engine::load_gltf(std::string(GI_SOURCE_DIR) + "/assets/corridor.gltf");
+  auto asset = engine::load_gltf(std::string(GI_SOURCE_DIR "/assets/corridor.gltf"));
   if (!asset) std::abort();
   gi::BakeInput in = gi::bake_input_from(*asset);
   in.instances[instance_named(in, "door")].object_to_world = door_matrix(degrees);

@@ -19,7 +19,7 @@
 namespace {
 
 TEST(DlmDemoLevel, TheGrillesTexelsAreValidAndGetMaps) {
-  auto asset = engine::load_gltf(std::string(GI_SOURCE_DIR) + "/assets/demo_level.gltf");
+  auto asset = engine::load_gltf(GI_SOURCE_DIR "/assets/demo_level.gltf");
   ASSERT_TRUE(asset) << asset.error().to_string();
   const engine::Scene scene = engine::instantiate(std::move(asset).value());
   const gi::BakeInput input = gi::bake_input_from(scene);

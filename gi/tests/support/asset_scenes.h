@@ -13,7 +13,7 @@
 namespace gitest {
 
 inline engine::Scene asset_scene(const std::string& file) {
-  auto asset = engine::load_gltf(std::string(GI_SOURCE_DIR) + "/assets/" + file);
+  auto asset = engine::load_gltf(std::string(GI_SOURCE_DIR "/assets/") + file);
   EXPECT_TRUE(asset) << asset.error().to_string();
   return engine::instantiate(std::move(asset).value());
 }

@@ -28,7 +28,7 @@ namespace fs = std::filesystem;
 using gi::EffectMethod;
 
 engine::Scene load(const std::string& name) {
-  auto asset = engine::load_gltf(std::string(GI_SOURCE_DIR) + "/assets/" + name);
+  auto asset = engine::load_gltf(std::string(GI_SOURCE_DIR "/assets/") + name);
   EXPECT_TRUE(asset) << asset.error().to_string();
   return engine::instantiate(std::move(asset).value());
 }
@@ -267,7 +267,7 @@ TEST(Plan, ASceneWithoutLightGetsNothing) {
 }
 
 TEST(Plan, DeformingRegionsFromTheFileGetAntiradiance) {
-  auto asset = engine::load_gltf(std::string(GI_SOURCE_DIR) + "/assets/corridor.gltf");
+  auto asset = engine::load_gltf(std::string(GI_SOURCE_DIR "/assets/corridor.gltf"));
   ASSERT_TRUE(asset);
   for (engine::Node& n : asset->nodes)
     if (n.name == "door") n.gi.region = engine::GiRegion::Deforming;
@@ -351,7 +351,7 @@ TEST(PlanCost, NearVisibilityAtMediumCountsItsReceiversLoadWorkAndMemory) {
 }
 
 TEST(Plan, LightUnderADynamicNodeMovesWithAWarningWhenNotFlagged) {
-  auto asset = engine::load_gltf(std::string(GI_SOURCE_DIR) + "/assets/demo_level.gltf");
+  auto asset = engine::load_gltf(std::string(GI_SOURCE_DIR "/assets/demo_level.gltf"));
   ASSERT_TRUE(asset);
   for (engine::Node& n : asset->nodes)
     if (n.name == "swinging_lamp") n.gi.mobility = engine::Mobility::Unspecified;
