@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The sanitizer leg: the ctest suite (but the accuracy tests of tests/sanitizer/accuracy_only.txt,
+# The sanitizer leg: the ctest suite (but the long tests of tests/sanitizer/main_leg_only.txt,
 # which the main leg runs) built instrumented (tools/configure-sanitized.sh:
 # clang, AddressSanitizer + UndefinedBehaviorSanitizer with float-cast-overflow, every report
 # fatal) in build-san/ (SANITIZE_BUILD_DIR), the build the fuzz leg shares, GL tests included
@@ -25,6 +25,8 @@ root=$(pwd)
 build_dir=${SANITIZE_BUILD_DIR:-build-san}
 bash tools/configure-sanitized.sh "$build_dir"
 build_start=$(date +%s)
+# As tools/build.sh: ccache caches the users of the tests' precompiled headers only with this.
+export CCACHE_SLOPPINESS=${CCACHE_SLOPPINESS:-pch_defines,time_macros,include_file_mtime,include_file_ctime}
 # SANITIZE_TARGETS: build only these targets (e.g. "engine_tests"; default: everything, the
 # fuzz targets included).
 # shellcheck disable=SC2086
@@ -41,15 +43,15 @@ export LD_PRELOAD="$driver${LD_PRELOAD:+ $LD_PRELOAD}"
 export ASAN_OPTIONS="detect_leaks=1:verify_asan_link_order=0:strict_string_checks=1:detect_stack_use_after_return=1:check_initialization_order=1${ASAN_OPTIONS:+:$ASAN_OPTIONS}"
 export LSAN_OPTIONS="suppressions=$root/tests/sanitizer/lsan.supp:print_suppressions=0${LSAN_OPTIONS:+:$LSAN_OPTIONS}"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1${UBSAN_OPTIONS:+:$UBSAN_OPTIONS}"
-# The accuracy tests of tests/sanitizer/accuracy_only.txt run in the main leg only: each name
+# The long tests of tests/sanitizer/main_leg_only.txt run in the main leg only: each name
 # must still be a test (a renamed one would silently come back here).
 skip=()
 while read -r name _; do
   [ -z "$name" ] || [[ $name == \#* ]] && continue
   ctest --test-dir "$build_dir" -N -R "^${name//./\\.}\$" | grep -q "Total Tests: 1" ||
-    { echo "sanitize.sh: tests/sanitizer/accuracy_only.txt names '$name', which is not a test" >&2; exit 1; }
+    { echo "sanitize.sh: tests/sanitizer/main_leg_only.txt names '$name', which is not a test" >&2; exit 1; }
   skip+=("${name//./\\.}")
-done <"$root/tests/sanitizer/accuracy_only.txt"
+done <"$root/tests/sanitizer/main_leg_only.txt"
 skip_regex="^($(IFS='|'; echo "${skip[*]}"))\$"
 test_start=$(date +%s)
 ctest --test-dir "$build_dir" --output-on-failure -j "$(nproc)" --timeout 1800 -E "$skip_regex" "$@"
